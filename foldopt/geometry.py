@@ -1,0 +1,109 @@
+"""Orientation of a flat panel and of the two sub-panels of a twofold panel.
+
+Conventions follow pvlib: ``surface_tilt`` from horizontal, ``surface_azimuth`` clockwise from
+north (180 = south). ``fold_angle`` is the dihedral angle between the two sub-panels: 180 is flat,
+smaller is more folded; each sub-panel turns by ``(180 - fold_angle) / 2`` away from the flat
+panel. The "east" sub-panel is the one turned toward the morning sun.
+
+Two parametrisations of the twofold panel (foldopt SPEC, "Geometry"):
+
+- ``azimuth-split`` (Shin et al. Sec. IV-B, Fig. 6): both sub-panels keep the base tilt and
+  their azimuths split by -/+ (180 - fold_angle)/2; at 90 deg and azimuth 180 they face 135 and
+  225 deg as in the paper.
+- ``hinge`` (physical): each sub-panel normal is the flat normal rotated by -/+ (180 -
+  fold_angle)/2 about the fold line, which lies in the panel plane along the up-slope direction.
+  The angle between the two normals is then exactly ``180 - fold_angle`` and at zero tilt the
+  panel is a ridge tent along the base azimuth.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+GEOMETRIES = ("azimuth-split", "hinge")
+
+
+def default_orientation(latitude: float) -> tuple[float, float]:
+    """Equator-facing orientation with tilt equal to |latitude|.
+
+    Returns
+    -------
+    surface_tilt, surface_azimuth : float
+        [deg]; azimuth 180 on the northern hemisphere (and the equator), 0 on the southern.
+    """
+    return abs(latitude), 180.0 if latitude >= 0 else 0.0
+
+
+def _east_sign(surface_azimuth):
+    # Turning toward azimuth - 90 faces east for panels facing the southern half of the sky and
+    # west for those facing the northern half, so the east sub-panel turns the other way there.
+    return np.where(np.cos(np.radians(surface_azimuth)) <= 0, 1.0, -1.0)
+
+
+def normal_vector(surface_tilt, surface_azimuth):
+    """Unit normal in east-north-up coordinates, stacked on the last axis."""
+    tilt, azimuth = np.radians(surface_tilt), np.radians(surface_azimuth)
+    return np.stack(
+        np.broadcast_arrays(
+            np.sin(tilt) * np.sin(azimuth), np.sin(tilt) * np.cos(azimuth), np.cos(tilt)
+        ),
+        axis=-1,
+    )
+
+
+def orientation_from_normal(normal):
+    """``surface_tilt`` and ``surface_azimuth`` [deg] of east-north-up unit normals."""
+    east, north, up = np.moveaxis(np.asarray(normal), -1, 0)
+    tilt = np.degrees(np.arccos(np.clip(up, -1.0, 1.0)))
+    azimuth = np.degrees(np.arctan2(east, north)) % 360.0
+    return tilt, azimuth
+
+
+def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hinge"):
+    """Orientation of the east and west sub-panels of a twofold panel.
+
+    Parameters
+    ----------
+    fold_angle : array_like
+        Dihedral angle between the sub-panels [deg], in (0, 180]; 180 is flat.
+    surface_tilt, surface_azimuth : float
+        Orientation of the unfolded (flat) panel [deg].
+    geometry : {'hinge', 'azimuth-split'}
+        Parametrisation, see the module docstring.
+
+    Returns
+    -------
+    dict
+        ``tilt_east``, ``azimuth_east``, ``tilt_west``, ``azimuth_west`` [deg], each shaped as
+        ``fold_angle``.
+    """
+    fold_angle = np.asarray(fold_angle, dtype=float)
+    turn = (180.0 - fold_angle) / 2.0 * _east_sign(surface_azimuth)
+    if geometry == "azimuth-split":
+        tilt = np.full_like(fold_angle, surface_tilt)
+        return {
+            "tilt_east": tilt,
+            "azimuth_east": (surface_azimuth - turn) % 360.0,
+            "tilt_west": tilt.copy(),
+            "azimuth_west": (surface_azimuth + turn) % 360.0,
+        }
+    if geometry == "hinge":
+        tilt, azimuth = np.radians(surface_tilt), np.radians(surface_azimuth)
+        normal = normal_vector(surface_tilt, surface_azimuth)
+        # Rodrigues' rotation of the normal about the up-slope unit vector u, which is
+        # perpendicular to it: n' = n cos(a) + (u x n) sin(a). u x n is horizontal and points to
+        # azimuth - 90; the limit tilt -> 0 keeps u along the base azimuth's back direction.
+        up_slope = np.array([-np.cos(tilt) * np.sin(azimuth), -np.cos(tilt) * np.cos(azimuth), np.sin(tilt)])
+        side = np.cross(up_slope, normal)
+        angle = np.radians(turn)[..., None]
+        east = normal * np.cos(angle) + side * np.sin(angle)
+        west = normal * np.cos(angle) - side * np.sin(angle)
+        tilt_east, azimuth_east = orientation_from_normal(east)
+        tilt_west, azimuth_west = orientation_from_normal(west)
+        return {
+            "tilt_east": tilt_east,
+            "azimuth_east": azimuth_east,
+            "tilt_west": tilt_west,
+            "azimuth_west": azimuth_west,
+        }
+    raise ValueError(f"geometry must be one of {', '.join(GEOMETRIES)}; got {geometry!r}")

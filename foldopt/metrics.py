@@ -1,0 +1,126 @@
+"""Daily metrics of a power curve against a constant load.
+
+The power is sampled at the centres of ``n`` equal steps covering the day. Between samples it is
+taken as linear, so the times where it crosses the load fall inside a step rather than on its
+edges; before the first and after the last centre it is held constant (so a polar day counts the
+full 24 h). ``t_solar`` is the time with ``P_pv >= P_load`` (Shin et al. Sec. I, Fig. 1a).
+
+All functions reduce the last axis (time) and broadcast ``p_load`` against the leading axes, so
+one call serves many fold angles and loads.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import brentq
+
+
+def _time_above_per_segment(p_pv, p_load, step_hours):
+    """Hours above the load in each of the ``n + 1`` segments of the piecewise-linear curve."""
+    excess = np.asarray(p_pv, dtype=float) - np.asarray(p_load, dtype=float)[..., None]
+    start, end = excess[..., :-1], excess[..., 1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        crossing = np.maximum(start, end) / np.abs(start - end)
+    fraction = np.where(
+        (start >= 0) & (end >= 0), 1.0, np.where((start < 0) & (end < 0), 0.0, crossing)
+    )
+    head = (excess[..., :1] >= 0) * 0.5
+    tail = (excess[..., -1:] >= 0) * 0.5
+    return np.concatenate([head, fraction, tail], axis=-1) * step_hours, excess
+
+
+def t_solar(p_pv, p_load, step_hours):
+    """Total solar-powered time [h]: time with ``p_pv >= p_load``.
+
+    Parameters
+    ----------
+    p_pv : array_like
+        Power at step centres [W], time on the last axis.
+    p_load : float or array_like
+        Load [W], broadcast against ``p_pv``'s leading axes.
+    step_hours : float
+        Step length [h].
+    """
+    above, _ = _time_above_per_segment(p_pv, p_load, step_hours)
+    return above.sum(axis=-1)
+
+
+def t_solar_contiguous(p_pv, p_load, step_hours):
+    """Longest contiguous solar-powered interval [h]."""
+    above, excess = _time_above_per_segment(p_pv, p_load, step_hours)
+    # Segment k joins segment k-1 when the sample between them is above the load; a sample below
+    # it starts a new run. Label runs row by row and add up each run's hours with one bincount.
+    below = np.concatenate([excess[..., :1] < 0, excess < 0], axis=-1)
+    run = np.cumsum(below, axis=-1)
+    flat_above = above.reshape(-1, above.shape[-1])
+    n_labels = above.shape[-1] + 1
+    labels = run.reshape(-1, above.shape[-1]) + n_labels * np.arange(flat_above.shape[0])[:, None]
+    per_run = np.bincount(
+        labels.ravel(), weights=flat_above.ravel(), minlength=flat_above.shape[0] * n_labels
+    ).reshape(flat_above.shape[0], n_labels)
+    return per_run.max(axis=-1).reshape(above.shape[:-1])
+
+
+def energy(p_pv, step_hours):
+    """Energy over the day [Wh] by the midpoint rule (steps are interval-centred)."""
+    return np.asarray(p_pv, dtype=float).sum(axis=-1) * step_hours
+
+
+def daily_metrics(p_pv, p_load, step_hours):
+    """All daily metrics of a power curve against a load.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        ``t_solar_h``, ``t_solar_contiguous_h`` [h]; ``energy_wh`` harvested (at the maximum power
+        point), ``energy_served_wh`` = P_load * t_solar, ``energy_wasted_wh`` the rest (without
+        storage, power above the load and power too low to run it are both lost) [Wh];
+        ``peak_power_w`` [W].
+    """
+    p_pv = np.asarray(p_pv, dtype=float)
+    p_load = np.asarray(p_load, dtype=float)
+    hours = t_solar(p_pv, p_load, step_hours)
+    harvested = energy(p_pv, step_hours)
+    served = p_load * hours
+    return {
+        "t_solar_h": hours,
+        "t_solar_contiguous_h": t_solar_contiguous(p_pv, p_load, step_hours),
+        "energy_wh": harvested,
+        "energy_served_wh": served,
+        "energy_wasted_wh": harvested - served,
+        "peak_power_w": p_pv.max(axis=-1),
+    }
+
+
+def load_for_t_solar(p_pv, target_t_solar, step_hours):
+    """The load [W] at which a power curve gives ``target_t_solar`` hours.
+
+    ``t_solar`` falls continuously as the load rises, so the root is found by Brent's method
+    between a vanishing load (the daylight length) and the peak power (zero hours).
+
+    Parameters
+    ----------
+    p_pv : array_like
+        One day's power [W], 1-D.
+    target_t_solar : float
+        [h].
+    step_hours : float
+        [h].
+
+    Returns
+    -------
+    float
+        Load [W]; NaN when the curve never reaches ``target_t_solar`` (longer than daylight).
+    """
+    p_pv = np.asarray(p_pv, dtype=float)
+    peak = p_pv.max()
+    if peak <= 0:
+        return float("nan")
+    smallest = peak * 1e-9
+
+    def shortfall(load):
+        return float(t_solar(p_pv, load, step_hours)) - target_t_solar
+
+    if shortfall(smallest) < 0:
+        return float("nan")
+    return brentq(shortfall, smallest, peak, xtol=peak * 1e-12)

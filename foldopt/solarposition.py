@@ -1,0 +1,181 @@
+"""Solar position over a day, in the paper's approximation or exactly through pvlib.
+
+The paper mode follows Shin et al. [1]_ Eq. 3-4 and 6, whose formulas are those of the
+PVCDROM / PVEducation course [2]_. The OCR text of [1]_ is damaged; the repaired forms used
+here, each checked against [2]_ and against pvlib's implementations of the same textbook
+formulas (``equation_of_time_pvcdrom``, ``declination_cooper69``, ``solar_zenith_analytical``,
+``solar_azimuth_analytical``), are:
+
+- declination ``delta = asin(sin(23.45 deg) * sin(360/365 * (d - 81)))`` (OCR: "360 - 365");
+- hour angle ``HRA = 15 deg * (LST - 12)`` (OCR drops the "- 12");
+- elevation ``asin(sin(delta) sin(phi) + cos(delta) cos(phi) cos(HRA))``;
+- azimuth ``acos((sin(delta) cos(phi) - cos(delta) sin(phi) cos(HRA)) / cos(elevation))``,
+  mirrored to ``360 - azimuth`` after solar noon (OCR has theta_z where phi stands).
+
+Clock time is converted to local solar time LST with the longitude correction and the
+equation of time of [2]_: ``LST = LT + (4 (longitude - LSTM) + EoT) / 60``.
+
+References
+----------
+.. [1] D. Shin, N. Chang, Y. Wang, M. Pedram, "Reconfigurable three dimensional photovoltaic
+   panel architecture for solar-powered time extension", Eq. 3, 4, 6.
+.. [2] C. Honsberg, S. Bowden, "Photovoltaics Education Website" (PVCDROM), pages "Solar Time"
+   and "Elevation Angle", "Azimuth Angle", "Declination Angle".
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import numpy as np
+import pandas as pd
+import pvlib
+
+MODES = ("paper", "exact")
+
+
+def day_times(date: dt.date, timezone, step_min: float = 1.0) -> pd.DatetimeIndex:
+    """Interval-centred time steps covering one local clock day.
+
+    Parameters
+    ----------
+    date : datetime.date
+        The local calendar day.
+    timezone : str or datetime.tzinfo
+        Time zone of the clock (IANA name or fixed offset).
+    step_min : float, default 1
+        Step length [min]; must divide the 24 h day.
+
+    Returns
+    -------
+    pandas.DatetimeIndex
+        Tz-aware times at the centre of each step, ``00:00 + step/2`` to ``24:00 - step/2``.
+    """
+    n_steps = 24 * 60 / step_min
+    if not np.isclose(n_steps, round(n_steps)):
+        raise ValueError(f"step_min must divide 1440 min exactly, got {step_min}")
+    offsets = (np.arange(round(n_steps)) + 0.5) * step_min
+    midnight = pd.Timestamp(date)
+    naive = midnight + pd.to_timedelta(offsets, unit="min")
+    # A DST jump inside the day makes some clock times ambiguous or absent; shift, never drop.
+    return pd.DatetimeIndex(naive).tz_localize(
+        timezone, ambiguous=np.ones(len(naive), dtype=bool), nonexistent="shift_forward"
+    )
+
+
+def declination_paper(dayofyear):
+    """Solar declination by the sine-of-sines form of PVCDROM [2]_ (Shin et al. Eq. 4).
+
+    Parameters
+    ----------
+    dayofyear : array_like
+        Day of year, 1 on January 1 [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        Declination [deg].
+    """
+    day_angle = np.radians(360.0 / 365.0 * (np.asarray(dayofyear, dtype=float) - 81.0))
+    return np.degrees(np.arcsin(np.sin(np.radians(23.45)) * np.sin(day_angle)))
+
+
+def equation_of_time_paper(dayofyear):
+    """Equation of time of PVCDROM [2]_: 9.87 sin 2B - 7.53 cos B - 1.5 sin B [min]."""
+    day_angle = np.radians(360.0 / 365.0 * (np.asarray(dayofyear, dtype=float) - 81.0))
+    return 9.87 * np.sin(2 * day_angle) - 7.53 * np.cos(day_angle) - 1.5 * np.sin(day_angle)
+
+
+def hour_angle_paper(times: pd.DatetimeIndex, longitude: float):
+    """Hour angle from clock time via local solar time, PVCDROM [2]_ ("Solar Time").
+
+    Parameters
+    ----------
+    times : pandas.DatetimeIndex
+        Tz-aware clock times; the UTC offset in force (DST included) sets the local
+        standard time meridian ``LSTM = 15 deg * offset``.
+    longitude : float
+        Site longitude [deg east].
+
+    Returns
+    -------
+    numpy.ndarray
+        Hour angle [deg] in [-180, 180), negative before solar noon.
+    """
+    clock = times.tz_localize(None)
+    utc_offset_h = (clock - times.tz_convert("UTC").tz_localize(None)) / pd.Timedelta(hours=1)
+    local_hours = (clock - clock.normalize()) / pd.Timedelta(hours=1)
+    time_correction_min = (
+        4.0 * (longitude - 15.0 * np.asarray(utc_offset_h))
+        + equation_of_time_paper(times.dayofyear)
+    )
+    local_solar_time = np.asarray(local_hours) + time_correction_min / 60.0
+    return (15.0 * (local_solar_time - 12.0) + 180.0) % 360.0 - 180.0
+
+
+def sun_from_angles(declination, hour_angle, latitude):
+    """Solar zenith and azimuth from declination, hour angle and latitude.
+
+    Shin et al. Eq. 3 and Eq. 6 as repaired (see module docstring), PVCDROM [2]_.
+
+    Parameters
+    ----------
+    declination, hour_angle : array_like
+        [deg]; hour angle negative in the morning.
+    latitude : float
+        [deg north].
+
+    Returns
+    -------
+    solar_zenith, solar_azimuth : numpy.ndarray
+        [deg]; azimuth clockwise from north.
+    """
+    dec, hra, lat = np.radians(declination), np.radians(hour_angle), np.radians(latitude)
+    sin_elev = np.sin(dec) * np.sin(lat) + np.cos(dec) * np.cos(lat) * np.cos(hra)
+    elevation = np.arcsin(np.clip(sin_elev, -1.0, 1.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cos_az = (np.sin(dec) * np.cos(lat) - np.cos(dec) * np.sin(lat) * np.cos(hra)) / np.cos(
+            elevation
+        )
+    azimuth = np.degrees(np.arccos(np.clip(np.nan_to_num(cos_az, nan=1.0), -1.0, 1.0)))
+    azimuth = np.where(np.asarray(hra) > 0, 360.0 - azimuth, azimuth)
+    return 90.0 - np.degrees(elevation), azimuth
+
+
+def get_solar_position(
+    times: pd.DatetimeIndex,
+    latitude: float,
+    longitude: float,
+    altitude: float = 0.0,
+    model: str = "exact",
+) -> pd.DataFrame:
+    """Solar zenith and azimuth at ``times``.
+
+    Parameters
+    ----------
+    times : pandas.DatetimeIndex
+        Tz-aware times.
+    latitude, longitude : float
+        [deg north], [deg east].
+    altitude : float, default 0
+        Site altitude [m]; used by ``exact`` only.
+    model : {'exact', 'paper'}
+        ``paper``: Shin et al. Eq. 3, 4, 6 (repaired), geometric, no refraction.
+        ``exact``: pvlib NREL SPA; the *apparent* (refracted) zenith is returned, as pvlib's
+        ModelChain uses it for air mass and incidence.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``solar_zenith``, ``solar_azimuth`` [deg], indexed by ``times``.
+    """
+    if model == "paper":
+        zenith, azimuth = sun_from_angles(
+            declination_paper(times.dayofyear), hour_angle_paper(times, longitude), latitude
+        )
+    elif model == "exact":
+        spa = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude=altitude)
+        zenith, azimuth = spa["apparent_zenith"].to_numpy(), spa["azimuth"].to_numpy()
+    else:
+        raise ValueError(f"model must be one of {', '.join(MODES)}; got {model!r}")
+    return pd.DataFrame({"solar_zenith": zenith, "solar_azimuth": azimuth}, index=times)
