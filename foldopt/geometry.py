@@ -51,11 +51,16 @@ def normal_vector(surface_tilt, surface_azimuth):
     )
 
 
-def orientation_from_normal(normal):
-    """``surface_tilt`` and ``surface_azimuth`` [deg] of east-north-up unit normals."""
+def orientation_from_normal(normal, level_azimuth=180.0):
+    """``surface_tilt`` and ``surface_azimuth`` [deg] of east-north-up unit normals.
+
+    A level surface has no azimuth; it gets ``level_azimuth`` so that formulas that read one
+    anyway (the paper's Eq. 5) treat it like the panel it came from.
+    """
     east, north, up = np.moveaxis(np.asarray(normal), -1, 0)
-    tilt = np.degrees(np.arccos(np.clip(up, -1.0, 1.0)))
-    azimuth = np.degrees(np.arctan2(east, north)) % 360.0
+    tilt = np.degrees(np.arctan2(np.hypot(east, north), up))
+    level = np.hypot(east, north) < 1e-12
+    azimuth = np.where(level, level_azimuth, np.degrees(np.arctan2(east, north)) % 360.0)
     return tilt, azimuth
 
 
@@ -98,8 +103,8 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
         angle = np.radians(turn)[..., None]
         east = normal * np.cos(angle) + side * np.sin(angle)
         west = normal * np.cos(angle) - side * np.sin(angle)
-        tilt_east, azimuth_east = orientation_from_normal(east)
-        tilt_west, azimuth_west = orientation_from_normal(west)
+        tilt_east, azimuth_east = orientation_from_normal(east, surface_azimuth)
+        tilt_west, azimuth_west = orientation_from_normal(west, surface_azimuth)
         return {
             "tilt_east": tilt_east,
             "azimuth_east": azimuth_east,

@@ -107,7 +107,7 @@ def hour_angle_paper(times: pd.DatetimeIndex, longitude: float):
     local_hours = (clock - clock.normalize()) / pd.Timedelta(hours=1)
     time_correction_min = (
         4.0 * (longitude - 15.0 * np.asarray(utc_offset_h))
-        + equation_of_time_paper(times.dayofyear)
+        + equation_of_time_paper(times.day_of_year)
     )
     local_solar_time = np.asarray(local_hours) + time_correction_min / 60.0
     return (15.0 * (local_solar_time - 12.0) + 180.0) % 360.0 - 180.0
@@ -131,14 +131,14 @@ def sun_from_angles(declination, hour_angle, latitude):
         [deg]; azimuth clockwise from north.
     """
     dec, hra, lat = np.radians(declination), np.radians(hour_angle), np.radians(latitude)
-    sin_elev = np.sin(dec) * np.sin(lat) + np.cos(dec) * np.cos(lat) * np.cos(hra)
-    elevation = np.arcsin(np.clip(sin_elev, -1.0, 1.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cos_az = (np.sin(dec) * np.cos(lat) - np.cos(dec) * np.sin(lat) * np.cos(hra)) / np.cos(
-            elevation
-        )
-    azimuth = np.degrees(np.arccos(np.clip(np.nan_to_num(cos_az, nan=1.0), -1.0, 1.0)))
-    azimuth = np.where(np.asarray(hra) > 0, 360.0 - azimuth, azimuth)
+    # Components of the sun vector: east, north (the numerator of Eq. 6) and up (Eq. 3).
+    # atan2(east, north) is Eq. 6's acos(north / cos(elevation)), mirrored after noon, evaluated
+    # without acos's loss of precision near due north or south.
+    east = -np.cos(dec) * np.sin(hra)
+    north = np.sin(dec) * np.cos(lat) - np.cos(dec) * np.sin(lat) * np.cos(hra)
+    up = np.sin(dec) * np.sin(lat) + np.cos(dec) * np.cos(lat) * np.cos(hra)
+    elevation = np.arcsin(np.clip(up, -1.0, 1.0))
+    azimuth = np.degrees(np.arctan2(east, north)) % 360.0
     return 90.0 - np.degrees(elevation), azimuth
 
 
@@ -171,7 +171,7 @@ def get_solar_position(
     """
     if model == "paper":
         zenith, azimuth = sun_from_angles(
-            declination_paper(times.dayofyear), hour_angle_paper(times, longitude), latitude
+            declination_paper(times.day_of_year), hour_angle_paper(times, longitude), latitude
         )
     elif model == "exact":
         spa = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude=altitude)
