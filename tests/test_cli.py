@@ -1,0 +1,176 @@
+"""The command line end to end, through typer's CliRunner."""
+
+import json
+
+import pandas as pd
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from foldopt.cli import app
+from foldopt.config import default_study_path
+from foldopt.reproduce import PAPER_VALUES
+
+runner = CliRunner()
+FOLDER = {"summary.csv", "sweep.csv", "timeseries.csv", "power_curves.png",
+          "t_solar_vs_fold_angle.png", "comparison.png", "run.json"}
+FAST_SWEEP = ["--lat", "34.05", "--lon", "-118.25", "--date", "2014-09-23", "--p-load", "4.4",
+              "--area", "0.108", "--step-min", "10", "--angle-step", "5"]
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def assert_one_line_error(result, *words):
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("error: ")
+    assert "Traceback" not in result.output
+    for word in words:
+        assert word in lines[0]
+
+
+@pytest.fixture
+def fast_config(tmp_path):
+    """The paper study with 10-min steps and a 5-deg sweep, as a YAML file."""
+    data = yaml.safe_load(default_study_path().read_text())
+    data.update(step_min=10, fold_angles={"start": 5, "stop": 180, "step": 5})
+    path = tmp_path / "fast.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_run_default_study_writes_the_whole_folder(tmp_path):
+    out = tmp_path / "shin"
+    result = invoke("run", "--out", out)
+    assert result.exit_code == 0, result.output
+    assert {p.name for p in out.iterdir()} == FOLDER
+    summary = pd.read_csv(out / "summary.csv")
+    assert list(summary["design"]) == ["flat", "twofold", "twofold-heuristic", "tracker"]
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["mode"] == "paper" and meta["study"]["geometry"] == "azimuth-split"
+    assert meta["study"]["p_load"] == pytest.approx(4.398)
+    assert {"foldopt", "numpy", "pvlib", "python"} <= set(meta["versions"])
+    assert "7.730" in result.stdout
+
+
+def test_existing_folder_is_kept_unless_overwrite(tmp_path, fast_config):
+    out = tmp_path / "r"
+    assert invoke("run", fast_config, "--out", out).exit_code == 0
+    before = (out / "sweep.csv").read_bytes()
+    (out / "note.txt").write_text("mine")
+    assert_one_line_error(invoke("run", fast_config, "--out", out), "already exists", "--overwrite")
+    assert (out / "note.txt").exists()
+    assert invoke("run", fast_config, "--out", out, "--overwrite").exit_code == 0
+    assert not (out / "note.txt").exists()
+    assert (out / "sweep.csv").read_bytes() == before  # a rerun writes identical CSVs
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no staging left
+
+
+@pytest.mark.parametrize(
+    "change,words",
+    [
+        ({"site": {"latitude": 95, "longitude": 0}}, ["site.latitude", "[-90, 90]"]),
+        ({"site": {"latitude": 10, "longitude": -200}}, ["site.longitude", "[-180, 180]"]),
+        ({"p_load": -1}, ["p_load", "(0, 1e+06]"]),
+        ({"panel": {"area": 0}}, ["panel.area", "(0, 1000]"]),
+        ({"panel": {"area": 1, "efficiency": 1.5}}, ["panel.efficiency", "(0, 1]"]),
+        ({"mode": "fast"}, ["mode", "'paper' or 'exact'"]),
+        ({"geometry": "tent"}, ["geometry", "'azimuth-split' or 'hinge'"]),
+        ({"date": "2014-02-30"}, ["date"]),
+        ({"colour": "red"}, ["colour", "unknown field"]),
+        ({"site": {"latitude": "north", "longitude": 0}}, ["site.latitude", "number"]),
+        ({"site": {"latitude": 1, "longitude": 0, "timezone": "Mars/Olympus"}}, ["site.timezone", "Mars/Olympus"]),
+        ({"step_min": 7}, ["step_min", "1440"]),
+        ({"fold_angles": {"start": 90, "stop": 30}}, ["fold_angles", "must not exceed"]),
+    ],
+)
+def test_bad_config_values(tmp_path, fast_config, change, words):
+    data = yaml.safe_load(fast_config.read_text())
+    data.update(change)
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(data))
+    out = tmp_path / "out"
+    assert_one_line_error(invoke("run", path, "--out", out), *words)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "text,words",
+    [
+        ("name: x\nsite: [1, 2\n", ["line", "bad.yaml"]),
+        ("- just\n- a list\n", ["expected a mapping"]),
+        ("name: x\n", ["site", "required field is missing"]),
+    ],
+)
+def test_malformed_config(tmp_path, text, words):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    result = invoke("run", path, "--out", tmp_path / "out")
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+    assert all(word in result.stderr for word in words)
+    assert not (tmp_path / "out").exists()
+
+
+def test_missing_config(tmp_path):
+    assert_one_line_error(invoke("run", tmp_path / "nope.yaml", "--out", tmp_path / "o"), "not found", "nope.yaml")
+
+
+def test_sweep_angle_writes_sweep_and_summary(tmp_path):
+    out = tmp_path / "sweep"
+    result = invoke("sweep", "angle", *FAST_SWEEP, "--mode", "exact", "--out", out)
+    assert result.exit_code == 0, result.output
+    assert FOLDER <= {p.name for p in out.iterdir()}
+    sweep = pd.read_csv(out / "sweep.csv")
+    assert {"fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh"} <= set(sweep.columns)
+    assert sweep["fold_angle_deg"].iloc[0] == 5 and sweep["fold_angle_deg"].iloc[-1] == 180
+    summary = pd.read_csv(out / "summary.csv")
+    assert {"flat", "twofold", "tracker"} <= set(summary["design"])
+    assert json.loads((out / "run.json").read_text())["study"]["geometry"] == "hinge"
+
+
+@pytest.mark.parametrize(
+    "option,value,words",
+    [
+        ("--lat", "91", ["--lat", "[-90, 90]"]),
+        ("--lon", "200", ["--lon", "[-180, 180]"]),
+        ("--p-load", "0", ["--p-load", "(0, 1e+06]"]),
+        ("--area", "-1", ["--area", "(0, 1000]"]),
+        ("--efficiency", "1.5", ["--efficiency", "(0, 1]"]),
+        ("--tilt", "120", ["--tilt", "[0, 90]"]),
+        ("--mode", "fast", ["--mode", "'paper' or 'exact'"]),
+        ("--geometry", "tent", ["--geometry"]),
+        ("--sky", "cloudy", ["--sky", "meinel"]),
+        ("--date", "2014-13-01", ["--date"]),
+        ("--step-min", "7", ["--step-min", "1440"]),
+        ("--lat", "abc", ["--lat", "valid number"]),
+    ],
+)
+def test_sweep_angle_bad_input(tmp_path, option, value, words):
+    args = list(FAST_SWEEP)
+    if option in args:
+        args[args.index(option) + 1] = value
+    else:
+        args += [option, value]
+    out = tmp_path / "out"
+    assert_one_line_error(invoke("sweep", "angle", *args, "--out", out), *words)
+    assert not out.exists()
+
+
+def test_sweep_angle_missing_option_names_it(tmp_path):
+    args = FAST_SWEEP[2:]  # drop --lat
+    assert_one_line_error(invoke("sweep", "angle", *args, "--out", tmp_path / "o"), "--lat", "missing")
+
+
+def test_reproduce_writes_the_agreed_table(tmp_path):
+    out = tmp_path / "repro"
+    result = invoke("reproduce", "--out", out)
+    assert result.exit_code == 0, result.output
+    table = pd.read_csv(out / "reproduction.csv")
+    assert list(table.columns) == ["quantity", "unit", "paper", "paper_mode", "exact_mode"]
+    assert list(table["quantity"]) == list(PAPER_VALUES)
+    assert "twofold_opt_fold_angle_deg" in result.stdout
+    assert_one_line_error(invoke("reproduce", "--out", out), "already exists")
