@@ -160,10 +160,10 @@ class Study(_Strict):
         )
 
 
-def _format_errors(error: ValidationError, prefix: str = "") -> list[str]:
+def _format_errors(error: ValidationError) -> list[str]:
     lines = []
     for item in error.errors():
-        field = prefix + ".".join(str(part) for part in item["loc"]) or "study"
+        field = ".".join(str(part) for part in item["loc"]) or "study"
         message = item["msg"].removeprefix("Value error, ")
         if item["type"] == "missing":
             lines.append(f"{field}: required field is missing")

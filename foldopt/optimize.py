@@ -15,6 +15,10 @@ from foldopt.metrics import t_solar
 PowerOfAngles = Callable[[np.ndarray], np.ndarray]
 
 
+def _last_argmax(values):
+    return int(values.size - 1 - np.argmax(values[::-1]))
+
+
 def optimal_fold_angle(
     combined_power: PowerOfAngles,
     fold_angles,
@@ -27,7 +31,8 @@ def optimal_fold_angle(
 
     ``t_solar`` as a function of the fold angle has kinks (Shin et al. Fig. 12a), so the refinement
     is a second grid spanning one sweep step either side of the best sweep point, not a
-    gradient method. Ties go to the smallest angle.
+    gradient method. Ties go to the largest (least folded) angle: folding that buys no time is not
+    recommended, and a load no design can carry returns the flat panel.
 
     Parameters
     ----------
@@ -53,13 +58,13 @@ def optimal_fold_angle(
     """
     fold_angles = np.asarray(fold_angles, dtype=float)
     hours = np.asarray(sweep_t_solar, dtype=float)
-    best = int(np.argmax(hours))
+    best = _last_argmax(hours)
     if refine_points > 1 and fold_angles.size > 1:
         lo = fold_angles[max(best - 1, 0)]
         hi = fold_angles[min(best + 1, fold_angles.size - 1)]
         fine = np.linspace(lo, hi, refine_points)
         fine_hours = t_solar(combined_power(fine), p_load, step_hours)
-        fine_best = int(np.argmax(fine_hours))
+        fine_best = _last_argmax(fine_hours)
         if fine_hours[fine_best] > hours[best]:
             return float(fine[fine_best]), float(fine_hours[fine_best])
     return float(fold_angles[best]), float(hours[best])

@@ -192,7 +192,10 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
                 result.study,
                 command,
                 optimal_fold_angle_deg=result.optimal_fold_angle,
-                heuristic_fold_angle_deg=result.heuristic_fold_angle,
+                # NaN (the load exceeds the flat panel's noon power) is not JSON: null instead.
+                heuristic_fold_angle_deg=(
+                    result.heuristic_fold_angle if np.isfinite(result.heuristic_fold_angle) else None
+                ),
             ),
         )
     return out

@@ -32,6 +32,12 @@ def test_refinement_finds_a_peak_between_grid_points():
     assert best > sweep.max()
 
 
+def test_ties_go_to_the_least_folded_angle():
+    grid = np.array([10.0, 90.0, 180.0])
+    angle, hours = optimal_fold_angle(lambda a: np.zeros((len(a), 24)), grid, np.zeros(3), 1.0, 1.0)
+    assert (angle, hours) == (180.0, 0.0)
+
+
 def test_heuristic_bisection_finds_the_threshold():
     def subpanels(angles):
         level = np.asarray(angles, dtype=float)[:, None] / 180.0 * np.ones((1, 5))

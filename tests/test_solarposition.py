@@ -38,7 +38,7 @@ def test_declination_close_to_cooper69():
 
 def test_hour_angle_matches_pvlib():
     times = day_times(dt.date(2014, 9, 23), "America/Los_Angeles", 10)
-    eot = pvlib.solarposition.equation_of_time_pvcdrom(times.dayofyear)
+    eot = pvlib.solarposition.equation_of_time_pvcdrom(times.day_of_year)
     expected = pvlib.solarposition.hour_angle(times, -118.25, eot)
     wrapped = (np.asarray(expected) + 180.0) % 360.0 - 180.0
     np.testing.assert_allclose(hour_angle_paper(times, -118.25), wrapped, atol=1e-9)
