@@ -1,43 +1,146 @@
 """Deliverable power of the two sub-panels under each way of connecting them.
 
-With the ``ideal`` PV model the sub-panels have no I-V curve, so both sit at their maximum
-power point in any connection: ``parallel`` is the sum of the two maxima. Shin et al. Sec. V
-describe the architectures; foldopt SPEC "Aggregating the two sub-panels" defines them:
+Shin et al. Sec. V describe the architectures, and the foldopt SPEC ("Aggregating the two
+sub-panels") defines them. All powers are at the best operating point of the connection.
 
-- ``east``, ``west``: one sub-panel alone;
-- ``parallel``: both on one converter;
-- ``independent``: each on its own converter, the sum times a converter efficiency;
-- ``switching``: per step the best of east / parallel / west (Shin et al. Sec. V-C, Fig. 8b).
+- ``east``, ``west``: one sub-panel alone at its maximum power point.
+- ``parallel``: one converter sets a common voltage and the currents add. A blocking diode per
+  sub-panel stops it sinking current above its open-circuit voltage.
+- ``series``: one converter sets a common current and the voltages add. Without bypass diodes the
+  current cannot exceed the weaker sub-panel's short-circuit current. With ideal bypass diodes
+  (no forward drop), a sub-panel driven past its short-circuit current is bypassed at 0 V.
+- ``independent``: each sub-panel on its own converter. It delivers the sum of the two maxima
+  times ``converter_efficiency``; at efficiency 1 this bounds every single-converter connection.
+- ``switching``: per step the best of east / parallel / west, plus series where enabled (Shin et
+  al. Sec. V-C, Fig. 8b and 9).
+
+With the ``ideal`` PV model the sub-panels have no I-V curve, so ``parallel`` and ``series`` are
+the sum of the two maxima.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-CONNECTIONS = ("east", "west", "parallel", "independent", "switching")
-SWITCH_STATES = ("east", "parallel", "west")
+from foldopt.pvmodel import IVCurve
+
+CONNECTIONS = ("east", "west", "parallel", "series", "independent", "switching")
+SWITCH_STATES = ("east", "west", "parallel", "series")  # ties go to the earlier, simpler state
+_GRID_POINTS = 48
+_GOLDEN_STEPS = 40
+_INVPHI = (np.sqrt(5.0) - 1.0) / 2.0
 
 
-def connection_power(p_east, p_west, connection="switching", converter_efficiency=1.0):
-    """Deliverable power of the pair [W] for one connection.
+def _maximise(power_of, upper):
+    """Maximum over ``x`` in [0, upper] of ``power_of(x)``, curve by curve.
+
+    ``power_of`` maps operating points shaped ``upper.shape + (k,)`` to power. A grid locates the
+    best bracket (the parallel and series curves can have two local maxima); golden-section search
+    inside it refines the maximum to ~1e-8 of the bracket.
+    """
+    upper = np.asarray(upper, dtype=float)
+    fractions = np.linspace(0.0, 1.0, _GRID_POINTS)
+    grid = upper[..., None] * fractions
+    values = np.nan_to_num(power_of(grid), nan=-np.inf)
+    best = np.argmax(values, axis=-1)
+    step = upper / (_GRID_POINTS - 1)
+    lo = np.clip(best - 1, 0, None) * step
+    hi = np.clip(best + 1, None, _GRID_POINTS - 1) * step
+    def evaluate(x):
+        return np.nan_to_num(power_of(x[..., None])[..., 0], nan=-np.inf)
+
+    a, b = hi - _INVPHI * (hi - lo), lo + _INVPHI * (hi - lo)
+    fa, fb = evaluate(a), evaluate(b)
+    for _ in range(_GOLDEN_STEPS):
+        left = fa > fb  # the maximum lies in [lo, b]: b's bracket shrinks from above
+        lo, hi = np.where(left, lo, a), np.where(left, b, hi)
+        kept, f_kept = np.where(left, a, b), np.where(left, fa, fb)
+        probe = np.where(left, hi - _INVPHI * (hi - lo), lo + _INVPHI * (hi - lo))
+        f_probe = evaluate(probe)
+        a, fa = np.where(left, probe, kept), np.where(left, f_probe, f_kept)
+        b, fb = np.where(left, kept, probe), np.where(left, f_kept, f_probe)
+    refined = np.maximum(fa, fb)
+    return np.clip(np.maximum(refined, values.max(axis=-1)), 0.0, None)
+
+
+def parallel_power(east: IVCurve, west: IVCurve):
+    """Maximum power [W] of two sub-panels in parallel behind blocking diodes."""
+
+    def power(voltage):
+        current = np.clip(east.current(voltage), 0.0, None) + np.clip(west.current(voltage), 0.0, None)
+        return voltage * current
+
+    return _maximise(power, np.maximum(east.v_oc, west.v_oc))
+
+
+def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
+    """Maximum power [W] of two sub-panels in series, with or without ideal bypass diodes."""
+    isc_e, isc_w = east.i_sc, west.i_sc
+
+    def side_voltage(curve, isc, current):
+        voltage = curve.voltage(np.minimum(current, isc[..., None]))
+        return np.where(current < isc[..., None], np.clip(voltage, 0.0, None), 0.0)
+
+    def power(current):
+        return current * (side_voltage(east, isc_e, current) + side_voltage(west, isc_w, current))
+
+    limit = np.maximum(isc_e, isc_w) if bypass else np.minimum(isc_e, isc_w)
+    return _maximise(power, limit)
+
+
+def pair_powers(east: IVCurve, west: IVCurve, bypass: bool = True):
+    """Parallel and series power [W] of a pair of sub-panels from their I-V curves."""
+    return parallel_power(east, west), series_power(east, west, bypass)
+
+
+def connection_powers(
+    p_east,
+    p_west,
+    p_parallel=None,
+    p_series=None,
+    *,
+    switch_series: bool = False,
+    converter_efficiency: float = 1.0,
+):
+    """Deliverable power of every connection [W], and the state switching chooses.
 
     Parameters
     ----------
     p_east, p_west : array_like
         Maximum power of each sub-panel [W].
-    connection : {'east', 'west', 'parallel', 'independent', 'switching'}
+    p_parallel, p_series : array_like, optional
+        Power of the pair in parallel and in series (:func:`pair_powers`); without them (the
+        ``ideal`` model, no I-V curves) both are the sum of the two maxima.
+    switch_series : bool, default False
+        Whether the switch may also select series.
     converter_efficiency : float, default 1
-        Efficiency of each dedicated converter of ``independent`` [-].
+        Efficiency of each converter of ``independent`` [-].
+
+    Returns
+    -------
+    powers : dict of numpy.ndarray
+        One entry per name of :data:`CONNECTIONS`.
+    state : numpy.ndarray of int
+        Index into :data:`SWITCH_STATES` of the state switching chose per step.
     """
     p_east, p_west = np.asarray(p_east, dtype=float), np.asarray(p_west, dtype=float)
-    if connection == "east":
-        return p_east
-    if connection == "west":
-        return p_west
-    if connection == "parallel":
-        return p_east + p_west
-    if connection == "independent":
-        return converter_efficiency * (p_east + p_west)
-    if connection == "switching":
-        return np.max(np.stack([p_east, p_east + p_west, p_west]), axis=0)
-    raise ValueError(f"connection must be one of {', '.join(CONNECTIONS)}; got {connection!r}")
+    independent = p_east + p_west
+    p_parallel = independent if p_parallel is None else np.asarray(p_parallel, dtype=float)
+    p_series = independent if p_series is None else np.asarray(p_series, dtype=float)
+    stacked = np.stack([p_east, p_west, p_parallel] + ([p_series] if switch_series else []))
+    powers = {
+        "east": p_east,
+        "west": p_west,
+        "parallel": p_parallel,
+        "series": p_series,
+        "independent": converter_efficiency * independent,
+        "switching": stacked.max(axis=0),
+    }
+    return powers, np.argmax(stacked, axis=0)
+
+
+def connection_power(p_east, p_west, connection="switching", p_parallel=None, p_series=None, **options):
+    """Deliverable power [W] of one connection; see :func:`connection_powers`."""
+    if connection not in CONNECTIONS:
+        raise ValueError(f"connection must be one of {', '.join(CONNECTIONS)}; got {connection!r}")
+    return connection_powers(p_east, p_west, p_parallel, p_series, **options)[0][connection]

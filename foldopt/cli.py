@@ -15,6 +15,7 @@ from typer.core import TyperGroup
 
 from foldopt.config import ConfigError, default_study_path, load_study, make_study
 from foldopt.report import OutputExistsError, check_output, write_reproduction, write_study
+from foldopt.reproduce import REPRODUCTIONS
 from foldopt.reproduce import reproduce as reproduce_table
 from foldopt.study import run_study
 
@@ -59,10 +60,9 @@ def _fail(lines: list[str]):
     raise typer.Exit(2)
 
 
-def _print_summary(summary, title: str) -> None:
+def _print_summary(summary) -> None:
     columns = ["design", "fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh",
                "peak_power_w", "gain_vs_flat_pct", "pct_of_tracker_t_solar", "flat_area_multiple"]
-    typer.echo(title)
     typer.echo(summary[columns].to_string(index=False, float_format=lambda v: f"{v:.3f}"))
 
 
@@ -70,7 +70,12 @@ def _run_and_write(study, out: Path, overwrite: bool) -> None:
     check_output(out, overwrite)
     result = run_study(study)
     write_study(result, out, overwrite)
-    _print_summary(result.summary, f"{study.name} ({study.mode} mode, {study.geometry}, P_load {study.p_load:g} W)")
+    study = result.study
+    typer.echo(
+        f"{study.name} ({study.mode} mode, {study.geometry}, {study.pv_model} + {study.connection}, "
+        f"P_load {study.p_load:g} W)"
+    )
+    _print_summary(result.summary)
     typer.echo(f"wrote {out}")
 
 
@@ -93,17 +98,22 @@ def reproduce(
     out: Path = typer.Option(RESULTS / "reproduction", "--out", help="Results folder"),
     overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing results folder"),
 ):
-    """Reproduce Shin et al.'s study in paper and exact modes; write reproduction.csv."""
+    """Reproduce Shin et al.'s study in paper and exact modes.
+
+    Writes reproduction.csv (the embedded study: ideal PV model) and reproduction_single_diode.csv
+    (A-300 single-diode sub-panels with switching).
+    """
     try:
         check_output(out, overwrite)
         study = load_study(default_study_path())
-        table = reproduce_table(study)
-        write_reproduction(table, study, out, overwrite)
+        tables = {name: reproduce_table(study, **changes) for name, changes in REPRODUCTIONS.items()}
+        write_reproduction(tables, study, out, overwrite)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
-    typer.echo("Shin et al. twofold study: paper value, paper-mode and exact-mode reproduction")
-    typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
-    typer.echo(f"wrote {out / 'reproduction.csv'}")
+    for name, table in tables.items():
+        typer.echo(f"Shin et al. twofold study ({name}): paper value, paper-mode and exact-mode reproduction")
+        typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
+        typer.echo(f"wrote {out / (name + '.csv')}")
 
 
 #: Study fields as the sweep options name them, so errors speak the user's words.
@@ -113,6 +123,8 @@ _SWEEP_OPTIONS = {
     "panel.efficiency": "--efficiency", "panel.tilt": "--tilt", "panel.azimuth": "--azimuth",
     "mode": "--mode", "geometry": "--geometry", "sky": "--sky", "step_min": "--step-min",
     "connection": "--connection", "fold_angles.step": "--angle-step", "fold_angles.start": "--angle-step",
+    "pv_model": "--pv-model", "module": "--module", "temp_air": "--temp-air",
+    "converter_efficiency": "--converter-efficiency",
 }
 
 
@@ -137,7 +149,16 @@ def sweep_angle(
     mode: str = typer.Option("exact", "--mode", help="paper | exact"),
     geometry: Optional[str] = typer.Option(None, "--geometry", help="azimuth-split | hinge; default by mode"),
     sky: str = typer.Option("meinel", "--sky", help="Clear-sky model: meinel"),
-    connection: str = typer.Option("switching", "--connection", help="east | west | parallel | independent | switching"),
+    pv_model: str = typer.Option("ideal", "--pv-model", help="ideal | single-diode | b-model"),
+    module: Optional[str] = typer.Option(None, "--module", help="single-diode: CEC module name (default A-300 cell)"),
+    connection: str = typer.Option(
+        "switching", "--connection", help="east | west | parallel | series | independent | switching"
+    ),
+    switch_series: bool = typer.Option(False, "--switch-series", help="Switching may also select series"),
+    no_bypass: bool = typer.Option(False, "--no-bypass", help="No bypass diodes in series"),
+    converter_efficiency: float = typer.Option(1.0, "--converter-efficiency", help="Independent converters' efficiency"),
+    temp_air: float = typer.Option(25.0, "--temp-air", help="Air temperature [C]"),
+    exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve I-V curves per step, not tables"),
     step_min: float = typer.Option(1.0, "--step-min", help="Time step [min], divides 1440"),
     angle_step: float = typer.Option(1.0, "--angle-step", help="Fold-angle sweep step [deg]"),
     out: Path = typer.Option(RESULTS / "sweep-angle", "--out", help="Results folder"),
@@ -155,7 +176,14 @@ def sweep_angle(
         "p_load": p_load,
         "geometry": geometry,
         "sky": sky,
+        "pv_model": pv_model,
+        "module": module,
         "connection": connection,
+        "switch_series": switch_series,
+        "bypass_diodes": not no_bypass,
+        "converter_efficiency": converter_efficiency,
+        "temp_air": temp_air,
+        "exact_electrical": exact_electrical,
         "step_min": step_min,
         "fold_angles": {"start": angle_step, "stop": 180.0, "step": angle_step},
     }

@@ -15,12 +15,21 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import yaml
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from foldopt.aggregation import CONNECTIONS
 from foldopt.atmosphere import SKY_MODELS
 from foldopt.geometry import GEOMETRIES, default_orientation
-from foldopt.pvmodel import PV_MODELS
+from foldopt.pvmodel import PV_MODELS, TEMPERATURE_MODELS, cec_module
 from foldopt.solarposition import MODES
 from foldopt.tracker import TRACKERS
 
@@ -133,12 +142,35 @@ class Study(_Strict):
     fold_angles: FoldAngles = FoldAngles()
     sky: Literal[SKY_MODELS] = "meinel"
     pv_model: Literal[PV_MODELS] = "ideal"
+    module: str | None = Field(None, description="single-diode: CEC module name; default the A-300 cell")
     connection: Literal[CONNECTIONS] = "switching"
+    switch_series: bool = Field(False, description="switching may also select series")
+    bypass_diodes: bool = True
+    converter_efficiency: _interval(0, 1, lo_open=True) = 1.0
+    temperature_model: Literal[TEMPERATURE_MODELS] | None = Field(
+        None, description="default fixed (cells at temp_air) in paper mode, sapm in exact"
+    )
+    temp_air: _interval(-60, 60, unit=" C") = 25.0
+    wind_speed: _interval(0, 60, unit=" m/s") = 1.0
+    exact_electrical: bool = Field(False, description="solve every step's I-V curves, not tables")
     tracker: Literal[TRACKERS] = "dual-axis"
     step_min: Annotated[_interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)] = 1.0
 
+    @field_validator("module")
+    @classmethod
+    def _module_is_known(cls, module, info: ValidationInfo):
+        if module is not None:
+            if info.data.get("pv_model") != "single-diode":
+                raise ValueError("module is only used with pv_model single-diode")
+            cec_module(module)
+        return module
+
     def resolved(self) -> Study:
-        """The study with every default that depends on other fields filled in."""
+        """The study with every default that depends on other fields (site, mode) filled in.
+
+        Studies are kept unresolved so that a variant (another mode, another latitude) gets its
+        own defaults; :class:`foldopt.study.Day` resolves the study it runs.
+        """
         tilt, azimuth = default_orientation(self.site.latitude)
         panel = self.panel.model_copy(
             update={
@@ -151,11 +183,13 @@ class Study(_Strict):
             hours = round(self.site.longitude / 15.0)
             timezone = f"UTC{'+' if hours >= 0 else '-'}{abs(hours):02d}:00"
         geometry = self.geometry or ("azimuth-split" if self.mode == "paper" else "hinge")
+        temperature = self.temperature_model or ("fixed" if self.mode == "paper" else "sapm")
         return self.model_copy(
             update={
                 "panel": panel,
                 "site": self.site.model_copy(update={"timezone": timezone}),
                 "geometry": geometry,
+                "temperature_model": temperature,
             }
         )
 
@@ -169,6 +203,8 @@ def _format_errors(error: ValidationError) -> list[str]:
             lines.append(f"{field}: required field is missing")
         elif item["type"] == "extra_forbidden":
             lines.append(f"{field}: unknown field")
+        elif isinstance(item["input"], dict):
+            lines.append(f"{field}: {message}")
         else:
             lines.append(f"{field} = {item['input']!r}: {message}")
     return lines
@@ -179,7 +215,7 @@ def make_study(data: dict) -> Study:
     if not isinstance(data, dict):
         raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
     try:
-        return Study.model_validate(data).resolved()
+        return Study.model_validate(data)
     except ValidationError as error:
         raise ConfigError(_format_errors(error)) from None
 

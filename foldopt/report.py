@@ -126,11 +126,51 @@ def plot_power_curves(result: StudyResult, path: Path) -> None:
     plt.close(fig)
 
 
+STATE_COLOURS = {"east": "tab:orange", "parallel": "tab:green", "west": "tab:purple", "series": "tab:brown"}
+
+
+def plot_switching(result: StudyResult, path: Path) -> None:
+    """Sub-panel curves and the connection switching chooses over the day (Shin et al. Fig. 9)."""
+    series, hours, study = result.timeseries, _clock_hours(result), result.study
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    state = series["switch_state"].to_numpy()
+    step = hours[1] - hours[0]
+    starts = np.flatnonzero(np.r_[True, state[1:] != state[:-1]])
+    for start, stop in zip(starts, np.r_[starts[1:], state.size]):
+        if state[start] != "off":
+            ax.axvspan(hours[start] - step / 2, hours[stop - 1] + step / 2, color=STATE_COLOURS[state[start]], alpha=0.12, lw=0)
+    for name in ("east", "west", "parallel") + (("series",) if study.switch_series else ()):
+        ax.plot(hours, series[f"p_{name}_w"], color=STATE_COLOURS[name], ls="--", label=name)
+    ax.plot(hours, series["p_switching_w"], color="k", lw=2, label="switching (shaded: state chosen)")
+    ax.axhline(study.p_load, color="tab:red", lw=1, label=f"P_load = {study.p_load:.3g} W")
+    daylight = series["p_switching_w"].to_numpy() > 0
+    if daylight.any():
+        ax.set_xlim(hours[daylight].min() - 0.5, hours[daylight].max() + 0.5)
+    ax.set_xlabel(f"local clock time [h] ({study.site.timezone})")
+    ax.set_ylabel("P_pv [W]")
+    ax.set_title(
+        f"{study.name}: sub-panel switching at {result.optimal_fold_angle:.1f}° ({study.pv_model}, {study.mode} mode)",
+        fontsize=10,
+    )
+    ax.legend(fontsize=8, loc="upper left")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def plot_t_solar_vs_fold_angle(result: StudyResult, path: Path) -> None:
     """t_solar versus fold angle, with flat and tracker levels (Shin et al. Fig. 12a)."""
     summary = result.summary.set_index("design")
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    ax.plot(result.sweep["fold_angle_deg"], result.sweep["t_solar_h"], color="tab:blue", label="twofold")
+    ax.plot(
+        result.sweep["fold_angle_deg"], result.sweep["t_solar_h"], color="tab:blue", label=f"twofold ({result.study.connection})"
+    )
+    if result.study.pv_model != "ideal":
+        for name in ("parallel", "series", "independent"):
+            if name != result.study.connection:
+                ax.plot(result.sweep["fold_angle_deg"], result.sweep[f"t_solar_{name}_h"], lw=1, ls="--",
+                        color=STATE_COLOURS.get(name, "tab:gray"), label=f"twofold ({name})")
     ax.axhline(summary.loc["flat", "t_solar_h"], color="k", ls="--", label="flat")
     ax.axhline(summary.loc["tracker", "t_solar_h"], color="0.5", ls=":", label="ideal tracker")
     ax.axvline(
@@ -186,6 +226,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
         plot_power_curves(result, folder / "power_curves.png")
         plot_t_solar_vs_fold_angle(result, folder / "t_solar_vs_fold_angle.png")
         plot_comparison(result, folder / "comparison.png")
+        plot_switching(result, folder / "switching.png")
         _write_json(
             folder / "run.json",
             run_metadata(
@@ -201,9 +242,10 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
     return out
 
 
-def write_reproduction(table: pd.DataFrame, study: Study, out: Path, overwrite: bool = False, command=None) -> Path:
-    """Write ``reproduction.csv`` and ``run.json`` for a reproduction of the paper."""
+def write_reproduction(tables: dict[str, pd.DataFrame], study: Study, out: Path, overwrite=False, command=None) -> Path:
+    """Write one ``<name>.csv`` per reproduction table and ``run.json``."""
     with staged_folder(out, overwrite) as folder:
-        table.to_csv(folder / "reproduction.csv", index=False, float_format=FLOAT_FORMAT)
-        _write_json(folder / "run.json", run_metadata(study, command, modes=["paper", "exact"]))
+        for name, table in tables.items():
+            table.to_csv(folder / f"{name}.csv", index=False, float_format=FLOAT_FORMAT)
+        _write_json(folder / "run.json", run_metadata(study, command, modes=["paper", "exact"], tables=list(tables)))
     return out

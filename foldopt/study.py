@@ -1,8 +1,9 @@
 """One day's study: flat, twofold and tracked panels at one site, compared.
 
-:class:`Day` holds everything that does not depend on orientation (times, sun, beam) and gives
-the power of each design as arrays over fold angles x time; :func:`run_study` sweeps the fold
-angle, applies the paper's heuristic and tabulates the comparison.
+:class:`Day` holds everything that does not depend on orientation (times, sun, beam, the
+electrical tables) and gives the power of each design as arrays over fold angles x time;
+:func:`run_study` sweeps the fold angle, applies the paper's heuristic and tabulates the
+comparison, for the study's connection and for the others.
 """
 
 from __future__ import annotations
@@ -12,29 +13,32 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from foldopt.aggregation import connection_power
+from foldopt.aggregation import CONNECTIONS, SWITCH_STATES
 from foldopt.atmosphere import clear_sky_dni
 from foldopt.config import Study, parse_timezone
+from foldopt.electrical import Electrical
 from foldopt.geometry import subpanel_orientation
 from foldopt.irradiance import beam_incidence_factor
-from foldopt.metrics import daily_metrics
+from foldopt.metrics import daily_metrics, t_solar
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
-from foldopt.pvmodel import max_power
+from foldopt.pvmodel import PVModel
 from foldopt.sizing import flat_area_multiple
 from foldopt.solarposition import day_times, get_solar_position
 from foldopt.tracker import tracker_incidence_factor
 
 
 class Day:
-    """Sun and beam over one day for a resolved study, and the power of each design on it.
+    """Sun, beam and electrical model over one day, and the power of each design on it.
 
     Paper mode uses the paper's sun, air mass at sea level and Eq. 5 incidence; exact mode pvlib's
-    sun (apparent zenith), Laue's altitude term and the true angle of incidence.
+    sun (apparent zenith), Laue's altitude term and the true angle of incidence. The study is
+    resolved here, so its defaults follow its own site and mode.
     """
 
     def __init__(self, study: Study):
+        study = study.resolved()
         self.study = study
-        site = study.site
+        site, panel = study.site, study.panel
         self.times = day_times(study.date, parse_timezone(site.timezone), study.step_min)
         self.step_hours = study.step_min / 60.0
         sun = get_solar_position(self.times, site.latitude, site.longitude, site.altitude, study.mode)
@@ -42,8 +46,19 @@ class Day:
         self.solar_azimuth = sun["solar_azimuth"].to_numpy()
         altitude = site.altitude if study.mode == "exact" else 0.0
         self.dni = clear_sky_dni(self.solar_zenith, altitude, study.sky)
+        self.electrical = Electrical(
+            pv=PVModel(study.pv_model, panel.efficiency, study.module),
+            subpanel_area=panel.area / 2.0,
+            temp_air=study.temp_air,
+            wind_speed=study.wind_speed,
+            temperature_model=study.temperature_model,
+            bypass=study.bypass_diodes,
+            switch_series=study.switch_series,
+            converter_efficiency=study.converter_efficiency,
+            exact=study.exact_electrical,
+        )
 
-    def _power(self, surface_tilt, surface_azimuth, area):
+    def _poa(self, surface_tilt, surface_azimuth):
         factor = beam_incidence_factor(
             np.asarray(surface_tilt)[..., None],
             np.asarray(surface_azimuth)[..., None],
@@ -51,37 +66,39 @@ class Day:
             self.solar_azimuth,
             model=self.study.mode,
         )
-        panel = self.study.panel
-        return max_power(self.dni * factor, area, panel.efficiency, self.study.pv_model)
+        return self.dni * factor
 
     def flat_power(self):
         """Power of the flat panel over the day [W], shape (n_time,)."""
         panel = self.study.panel
-        return self._power(panel.tilt, panel.azimuth, panel.area)
+        return self.electrical.panel_power(self._poa(panel.tilt, panel.azimuth), panel.area)
 
     def tracker_power(self):
         """Power of the same panel on the tracker [W], shape (n_time,)."""
-        panel = self.study.panel
         poa = self.dni * tracker_incidence_factor(self.solar_zenith, self.study.tracker)
-        return max_power(poa, panel.area, panel.efficiency, self.study.pv_model)
+        return self.electrical.panel_power(poa, self.study.panel.area)
 
-    def subpanel_power(self, fold_angles):
-        """East and west sub-panel powers and their parallel sum [W], each (k, n_time)."""
+    def connections(self, fold_angles):
+        """Every connection's power [W], each (k, n_time), and the switching state per step."""
         panel = self.study.panel
         sides = subpanel_orientation(fold_angles, panel.tilt, panel.azimuth, self.study.geometry)
-        p_east = self._power(sides["tilt_east"], sides["azimuth_east"], panel.area / 2)
-        p_west = self._power(sides["tilt_west"], sides["azimuth_west"], panel.area / 2)
-        return p_east, p_west, connection_power(p_east, p_west, "parallel")
+        poa_east = self._poa(sides["tilt_east"], sides["azimuth_east"])
+        poa_west = self._poa(sides["tilt_west"], sides["azimuth_west"])
+        return self.electrical.connections(poa_east, poa_west)
 
-    def combined_power(self, fold_angles):
-        """Deliverable twofold power under the study's connection [W], (k, n_time)."""
-        p_east, p_west, _ = self.subpanel_power(fold_angles)
-        return connection_power(p_east, p_west, self.study.connection)
+    def subpanel_power(self, fold_angles):
+        """East and west sub-panel powers and their parallel connection [W], each (k, n_time)."""
+        powers, _ = self.connections(fold_angles)
+        return powers["east"], powers["west"], powers["parallel"]
+
+    def combined_power(self, fold_angles, connection=None):
+        """Deliverable twofold power [W], (k, n_time), under ``connection`` (default: the study's)."""
+        return self.connections(fold_angles)[0][connection or self.study.connection]
 
 
 @dataclass(frozen=True)
 class StudyResult:
-    """Everything a report needs from one study."""
+    """Everything a report needs from one study; ``study`` is resolved."""
 
     study: Study
     day: Day
@@ -92,35 +109,49 @@ class StudyResult:
     heuristic_fold_angle: float
 
 
+def _best_angle(day: Day, angles, sweep_t_solar, connection):
+    return optimal_fold_angle(
+        lambda fold: day.combined_power(fold, connection), angles, sweep_t_solar, day.study.p_load, day.step_hours
+    )[0]
+
+
 def run_study(study: Study) -> StudyResult:
-    """Sweep the fold angle of a resolved study and compare flat, twofold and tracker.
+    """Sweep the fold angle and compare flat, twofold and tracker.
 
     Returns
     -------
     StudyResult
-        ``sweep``: metrics per fold angle (and the noon valley of the parallel curve);
-        ``summary``: one row per design (``flat``, ``twofold`` at the sweep's optimum,
-        ``twofold-heuristic`` at the paper's angle, ``tracker``); ``timeseries``: the power curves of
-        the day at the optimum.
+        ``sweep``: metrics per fold angle for the study's connection, ``t_solar`` and energy for
+        every connection, and the noon valley of the parallel curve. ``summary``: one row per
+        design: ``flat``; ``twofold`` at the sweep's optimum; ``twofold-heuristic`` at the paper's
+        angle; with I-V models, ``twofold-<connection>`` for each other connection at its own
+        optimum; ``tracker``. ``timeseries``: the day's curves at the optimum, with the state
+        switching chose.
     """
     day = Day(study)
+    study = day.study
     p_load, step = study.p_load, day.step_hours
     angles = np.asarray(study.fold_angles.grid())
-    p_east, p_west, p_parallel = day.subpanel_power(angles)
-    combined = connection_power(p_east, p_west, study.connection)
-    sweep = pd.DataFrame({"fold_angle_deg": angles, **daily_metrics(combined, p_load, step)})
-    sweep["noon_valley_w"] = noon_valley(p_east, p_west, p_parallel)
+    powers, _ = day.connections(angles)
+    sweep = pd.DataFrame({"fold_angle_deg": angles, **daily_metrics(powers[study.connection], p_load, step)})
+    sweep["noon_valley_w"] = noon_valley(powers["east"], powers["west"], powers["parallel"])
+    for connection in CONNECTIONS:
+        metrics = daily_metrics(powers[connection], p_load, step)
+        sweep[f"t_solar_{connection}_h"] = metrics["t_solar_h"]
+        sweep[f"energy_{connection}_wh"] = metrics["energy_wh"]
 
-    best_angle, _ = optimal_fold_angle(
-        day.combined_power, angles, sweep["t_solar_h"].to_numpy(), p_load, step
-    )
+    best_angle = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
     paper_angle = heuristic_fold_angle(day.subpanel_power, p_load)
 
     p_flat, p_tracker = day.flat_power(), day.tracker_power()
-    p_best = day.combined_power(np.array([best_angle]))[0]
-    designs = {"flat": (180.0, p_flat), "twofold": (best_angle, p_best)}
+    designs = {"flat": (180.0, p_flat), "twofold": (best_angle, day.combined_power(np.array([best_angle]))[0])}
     if np.isfinite(paper_angle):
         designs["twofold-heuristic"] = (paper_angle, day.combined_power(np.array([paper_angle]))[0])
+    if day.electrical.pv.has_iv:
+        for connection in ("parallel", "series", "independent", "switching"):
+            if connection != study.connection:
+                angle = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection)
+                designs[f"twofold-{connection}"] = (angle, day.combined_power(np.array([angle]), connection)[0])
     designs["tracker"] = (np.nan, p_tracker)
 
     rows = []
@@ -138,7 +169,7 @@ def run_study(study: Study) -> StudyResult:
         for hours in summary["t_solar_h"]
     ]
 
-    p_best_east, p_best_west, _ = day.subpanel_power(np.array([best_angle]))
+    at_best, state = day.connections(np.array([best_angle]))
     timeseries = pd.DataFrame(
         {
             "time": day.times.strftime("%Y-%m-%dT%H:%M:%S%z"),
@@ -146,12 +177,17 @@ def run_study(study: Study) -> StudyResult:
             "solar_azimuth": day.solar_azimuth,
             "dni": day.dni,
             "p_flat_w": p_flat,
-            "p_east_w": p_best_east[0],
-            "p_west_w": p_best_west[0],
-            "p_twofold_w": p_best,
+            **{f"p_{connection}_w": at_best[connection][0] for connection in CONNECTIONS},
+            "p_twofold_w": at_best[study.connection][0],
+            "switch_state": np.where(at_best["switching"][0] > 0, np.array(SWITCH_STATES)[state[0]], "off"),
             "p_tracker_w": p_tracker,
             "p_load_w": p_load,
         }
     )
     return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle)
 
+
+def twofold_t_solar(day: Day, fold_angle: float, connection=None) -> float:
+    """``t_solar`` [h] of the twofold panel at one fold angle."""
+    power = day.combined_power(np.array([fold_angle]), connection)[0]
+    return float(t_solar(power, day.study.p_load, day.step_hours))

@@ -13,7 +13,7 @@ from foldopt.reproduce import PAPER_VALUES
 
 runner = CliRunner()
 FOLDER = {"summary.csv", "sweep.csv", "timeseries.csv", "power_curves.png",
-          "t_solar_vs_fold_angle.png", "comparison.png", "run.json"}
+          "t_solar_vs_fold_angle.png", "comparison.png", "switching.png", "run.json"}
 FAST_SWEEP = ["--lat", "34.05", "--lon", "-118.25", "--date", "2014-09-23", "--p-load", "4.4",
               "--area", "0.108", "--step-min", "10", "--angle-step", "5"]
 
@@ -146,6 +146,10 @@ def test_sweep_angle_writes_sweep_and_summary(tmp_path):
         ("--sky", "cloudy", ["--sky", "meinel"]),
         ("--date", "2014-13-01", ["--date"]),
         ("--step-min", "7", ["--step-min", "1440"]),
+        ("--pv-model", "two-diode", ["--pv-model", "single-diode"]),
+        ("--module", "NoSuchModule", ["--module", "only used with pv_model single-diode"]),
+        ("--connection", "star", ["--connection", "series"]),
+        ("--converter-efficiency", "1.2", ["--converter-efficiency", "(0, 1]"]),
         ("--lat", "abc", ["--lat", "valid number"]),
     ],
 )
@@ -160,6 +164,24 @@ def test_sweep_angle_bad_input(tmp_path, option, value, words):
     assert not out.exists()
 
 
+def test_sweep_angle_with_single_diode_switching(tmp_path):
+    out = tmp_path / "sd"
+    result = invoke("sweep", "angle", *FAST_SWEEP, "--pv-model", "single-diode", "--switch-series", "--out", out)
+    assert result.exit_code == 0, result.output
+    summary = pd.read_csv(out / "summary.csv").set_index("design")
+    assert {"twofold-parallel", "twofold-series", "twofold-independent"} <= set(summary.index)
+    sweep = pd.read_csv(out / "sweep.csv")
+    for name in ("east", "west", "parallel", "series", "independent", "switching"):
+        assert f"t_solar_{name}_h" in sweep and f"energy_{name}_wh" in sweep
+    states = set(pd.read_csv(out / "timeseries.csv")["switch_state"])
+    assert {"east", "west", "parallel"} <= states
+
+
+def test_unknown_cec_module_is_named(tmp_path):
+    args = [*FAST_SWEEP, "--pv-model", "single-diode", "--module", "NoSuchModule", "--out", tmp_path / "o"]
+    assert_one_line_error(invoke("sweep", "angle", *args), "--module", "CEC database")
+
+
 def test_sweep_angle_missing_option_names_it(tmp_path):
     args = FAST_SWEEP[2:]  # drop --lat
     assert_one_line_error(invoke("sweep", "angle", *args, "--out", tmp_path / "o"), "--lat", "missing")
@@ -169,8 +191,9 @@ def test_reproduce_writes_the_agreed_table(tmp_path):
     out = tmp_path / "repro"
     result = invoke("reproduce", "--out", out)
     assert result.exit_code == 0, result.output
-    table = pd.read_csv(out / "reproduction.csv")
-    assert list(table.columns) == ["quantity", "unit", "paper", "paper_mode", "exact_mode"]
-    assert list(table["quantity"]) == list(PAPER_VALUES)
+    for name in ("reproduction", "reproduction_single_diode"):
+        table = pd.read_csv(out / f"{name}.csv")
+        assert list(table.columns) == ["quantity", "unit", "paper", "paper_mode", "exact_mode"]
+        assert list(table["quantity"]) == list(PAPER_VALUES)
     assert "twofold_opt_fold_angle_deg" in result.stdout
     assert_one_line_error(invoke("reproduce", "--out", out), "already exists")

@@ -1,0 +1,76 @@
+"""PV models against datasheet / database values and the b-model paper."""
+
+import numpy as np
+import pvlib
+import pytest
+
+from foldopt.pvmodel import A300_CELL, ROBLES_200W, PVModel, cell_temperature, cec_module, fit_b
+
+
+def test_a300_cell_reproduces_its_datasheet_point():
+    # SunPower A-300 typical STC ratings: Voc 0.670 V, Isc 5.90 A, Vmp 0.560 V, Imp 5.54 A (3.10 W).
+    curve = PVModel("single-diode").curves(np.array([1000.0]), 25.0, A300_CELL.area)
+    mpp = pvlib.pvsystem.max_power_point(*curve.params, method="newton")
+    assert float(mpp["v_mp"][0]) == pytest.approx(0.560, rel=1e-4)
+    assert float(mpp["i_mp"][0]) == pytest.approx(5.54, rel=1e-4)
+    assert curve.v_oc[0] == pytest.approx(0.670, rel=1e-4)
+    assert curve.i_sc[0] == pytest.approx(5.90, rel=1e-4)
+    # dVoc/dT -1.9 mV/C, the fifth equation of the De Soto fit.
+    warm = PVModel("single-diode").curves(np.array([1000.0]), 35.0, A300_CELL.area)
+    assert (warm.v_oc[0] - curve.v_oc[0]) / 10 == pytest.approx(-0.0019, rel=1e-3)
+
+
+def test_panel_power_scales_with_area_in_series():
+    model = PVModel("single-diode")
+    one = model.max_power(np.array([800.0]), 40.0, A300_CELL.area)
+    assert model.max_power(np.array([800.0]), 40.0, 6.5 * A300_CELL.area) == pytest.approx(6.5 * one, rel=1e-9)
+    curve = model.curves(np.array([800.0]), 40.0, 6.5 * A300_CELL.area)
+    single = model.curves(np.array([800.0]), 40.0, A300_CELL.area)
+    assert curve.v_oc[0] == pytest.approx(6.5 * single.v_oc[0], rel=1e-6)
+
+
+def test_cec_module_stc_power_matches_the_database():
+    name = "Canadian_Solar_Inc__CS5P_220M"
+    unit = cec_module(name)
+    stc = float(pvlib.pvsystem.retrieve_sam("CECMod")[name]["STC"])
+    power = PVModel("single-diode", module=name).max_power(np.array([1000.0]), 25.0, unit.area)
+    assert power[0] == pytest.approx(stc, rel=2e-3)
+    with pytest.raises(ValueError, match="close matches"):
+        cec_module("Canadian_Solar_Inc__CS5P")
+
+
+def test_b_fitted_from_table1_is_the_papers():
+    # Robles Algarin et al.: Vx 32.1 V, Ix 8.21 A, I 7.69 A at V 26.01 V give b = 0.0683; the
+    # same Eq. 11 approximation evaluated exactly gives 0.06876 (the paper rounds differently).
+    assert ROBLES_200W.b == pytest.approx(0.0683, abs=0.0005)
+    assert fit_b(32.1, 8.21, 26.01, 7.69) == pytest.approx(0.068757, abs=1e-6)
+
+
+def test_b_model_curve_and_closed_form_mpp():
+    model = PVModel("b-model", efficiency=0.15)
+    curve = model.curves(np.array([1000.0, 400.0]), 25.0, model.unit_area)
+    # Eq. 9-10 at STC: Vx = Voc, Ix = Isc.
+    assert curve.v_oc[0] == pytest.approx(32.1)
+    assert curve.i_sc[0] == pytest.approx(8.21, rel=1e-6)
+    # The closed-form maximum equals a brute-force search on Eq. 8, and is Table 1's 200 W
+    # within the Eq. 11 approximation (0.2 %).
+    voltage = np.linspace(0, 32.1, 200001)
+    brute = (voltage * curve.current(np.broadcast_to(voltage, (2, voltage.size)))).max(axis=1)
+    np.testing.assert_allclose(curve.max_power(), brute, rtol=1e-7)
+    assert curve.max_power()[0] == pytest.approx(200.0, rel=2e-3)
+    np.testing.assert_allclose(curve.voltage(curve.current(np.array([12.0, 20.0]))), [12.0, 20.0], rtol=1e-9)
+
+
+def test_zero_irradiance_gives_zero_power_for_every_model():
+    for model in (PVModel("ideal"), PVModel("single-diode"), PVModel("b-model")):
+        assert model.max_power(np.array([0.0]), 25.0, 0.1)[0] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_cell_temperature_models():
+    assert cell_temperature(np.array([800.0]), 20.0, 1.0, "fixed")[0] == 20.0
+    sapm = pvlib.temperature.sapm_cell(800.0, 20.0, 1.0, -3.56, -0.075, 3)  # open rack glass/polymer
+    assert cell_temperature(np.array([800.0]), 20.0, 1.0, "sapm")[0] == pytest.approx(sapm)
+    with pytest.raises(ValueError, match="fixed, sapm"):
+        cell_temperature(np.array([800.0]), 20.0, 1.0, "noct")
+    with pytest.raises(ValueError, match="ideal, single-diode, b-model"):
+        PVModel("two-diode")
