@@ -67,7 +67,8 @@ def parallel_power(east: IVCurve, west: IVCurve):
     """Maximum power [W] of two sub-panels in parallel behind blocking diodes."""
 
     def power(voltage):
-        current = np.clip(east.current(voltage), 0.0, None) + np.clip(west.current(voltage), 0.0, None)
+        # Blocking diodes: a sub-panel adds its current only while it sources it (NaN: dark).
+        current = sum(np.nan_to_num(np.clip(side.current(voltage), 0.0, None)) for side in (east, west))
         return voltage * current
 
     return _maximise(power, np.maximum(east.v_oc, west.v_oc))
@@ -136,7 +137,10 @@ def connection_powers(
         "independent": converter_efficiency * independent,
         "switching": stacked.max(axis=0),
     }
-    return powers, np.argmax(stacked, axis=0)
+    # The state is the first (simplest) one within solver precision of the best: with a dark
+    # sub-panel, parallel equals the lit one alone and must not win on rounding.
+    best = stacked.max(axis=0)
+    return powers, np.argmax(stacked >= best * (1 - 1e-6) - 1e-12, axis=0)
 
 
 def connection_power(p_east, p_west, connection="switching", p_parallel=None, p_series=None, **options):

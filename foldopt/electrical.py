@@ -16,12 +16,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
-from foldopt.aggregation import connection_powers, pair_powers
+from foldopt.aggregation import connection_powers, pair_powers, parallel_power, series_power
 from foldopt.pvmodel import PVModel, cell_temperature
 
 IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the tables; clear-sky beam stays below 1353
 TABLE_NODES_1D = 1025
 TABLE_NODES_2D = 161
+TABLE_NODES_RATIO = 321
 
 
 def _nodes(count):
@@ -72,15 +73,30 @@ class Electrical:
         g1 = _nodes(TABLE_NODES_1D)
         p1 = self.pv.max_power(g1, self._temperature(g1), self.subpanel_area)
         g2 = _nodes(TABLE_NODES_2D)
-        ge, gw = (grid.ravel() for grid in np.meshgrid(g2, g2, indexing="ij"))
+        parallel = self._pair_table("parallel", g2, g2, lambda ge, gw: (ge, gw))
+        # Series is indexed by the stronger irradiance and the weaker/stronger ratio (the pair is
+        # symmetric): its kink, where the weaker current starts to limit the string, then runs
+        # nearly along a ratio grid line instead of across cells.
+        ratio = np.linspace(0.0, 1.0, TABLE_NODES_RATIO)
+        series = self._pair_table("series", g2, ratio, lambda strong, r: (strong, strong * r))
+        self._tables = (g1, p1, parallel, series)
+
+    def _pair_table(self, connection, axis0, axis1, to_irradiance):
+        """Interpolator of a pair's power as a fraction of its two maxima on a 2-D grid.
+
+        The fraction is smoother than the power and zero-safe. Series is tabulated without bypass
+        diodes; with ideal ones its optimum is either that or the stronger sub-panel alone, which
+        needs no table.
+        """
+        first, second = (grid.ravel() for grid in np.meshgrid(axis0, axis1, indexing="ij"))
+        ge, gw = to_irradiance(first, second)
         east = self.pv.curves(ge, self._temperature(ge), self.subpanel_area)
         west = self.pv.curves(gw, self._temperature(gw), self.subpanel_area)
-        shape = (g2.size, g2.size)
-        pair = [
-            RegularGridInterpolator((g2, g2), power.reshape(shape))
-            for power in pair_powers(east, west, self.bypass)
-        ]
-        self._tables = (g1, p1, pair)
+        bound = east.max_power() + west.max_power()
+        power = parallel_power(east, west) if connection == "parallel" else series_power(east, west, bypass=False)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            fraction = np.where(bound > 0, power / bound, 1.0)
+        return RegularGridInterpolator((axis0, axis1), fraction.reshape(axis0.size, axis1.size))
 
     def subpanel_power(self, poa):
         """Maximum power of one sub-panel [W] at irradiance ``poa`` [W/m^2] (any shape)."""
@@ -93,7 +109,7 @@ class Electrical:
             return self.pv.max_power(poa, self._temperature(poa), area)
         if self._tables is None:
             self._build_tables()
-        g1, p1, _ = self._tables
+        g1, p1 = self._tables[:2]
         return np.interp(np.clip(poa, 0.0, IRRADIANCE_MAX), g1, p1) * (area / self.subpanel_area)
 
     def connections(self, poa_east, poa_west):
@@ -108,8 +124,14 @@ class Electrical:
             return connection_powers(p_east, p_west, *pair_powers(east, west, self.bypass), **self._options)
         if self._tables is None:
             self._build_tables()
-        points = np.stack([np.clip(poa_east, 0, IRRADIANCE_MAX), np.clip(poa_west, 0, IRRADIANCE_MAX)], axis=-1)
-        # A pair never delivers more than its two maxima: interpolation must not invent power.
+        _, _, parallel, series = self._tables
+        east, west = np.clip(poa_east, 0.0, IRRADIANCE_MAX), np.clip(poa_west, 0.0, IRRADIANCE_MAX)
+        strong = np.maximum(east, west)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            weak_ratio = np.where(strong > 0, np.minimum(east, west) / strong, 1.0)
         bound = p_east + p_west
-        p_parallel, p_series = (np.minimum(table(points), bound) for table in self._tables[2])
+        p_parallel = np.clip(parallel(np.stack([east, west], axis=-1)), 0.0, 1.0) * bound
+        p_series = np.clip(series(np.stack([strong, weak_ratio], axis=-1)), 0.0, 1.0) * bound
+        if self.bypass:
+            p_series = np.maximum(p_series, np.maximum(p_east, p_west))
         return connection_powers(p_east, p_west, p_parallel, p_series, **self._options)

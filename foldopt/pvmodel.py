@@ -181,13 +181,16 @@ class IVCurve:
 
     @property
     def i_sc(self):
-        return self.current(np.zeros_like(self.params[0]))
+        return np.nan_to_num(self.current(np.zeros_like(self.params[0])))
 
     @property
     def v_oc(self):
         if self.model == "b-model":
             return self.params[0]
-        return self.voltage(np.zeros_like(self.params[0]))
+        # For a practically dark cell (photocurrent below 1 nA) pvlib's v_from_i returns NaN or
+        # absurd voltages (1e24 V seen at 70 C); such a sub-panel delivers nothing.
+        lit = self.i_sc > 1e-9
+        return np.where(lit, np.nan_to_num(self.voltage(np.zeros_like(self.params[0]))), 0.0)
 
     def max_power(self):
         """Maximum power [W] of each curve."""

@@ -35,7 +35,7 @@ class Day:
     resolved here, so its defaults follow its own site and mode.
     """
 
-    def __init__(self, study: Study):
+    def __init__(self, study: Study, electrical: Electrical | None = None):
         study = study.resolved()
         self.study = study
         site, panel = study.site, study.panel
@@ -46,7 +46,8 @@ class Day:
         self.solar_azimuth = sun["solar_azimuth"].to_numpy()
         altitude = site.altitude if study.mode == "exact" else 0.0
         self.dni = clear_sky_dni(self.solar_zenith, altitude, study.sky)
-        self.electrical = Electrical(
+        # Days of one study share its electrical tables: pass the first day's to the next.
+        self.electrical = electrical or Electrical(
             pv=PVModel(study.pv_model, panel.efficiency, study.module),
             subpanel_area=panel.area / 2.0,
             temp_air=study.temp_air,

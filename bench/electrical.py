@@ -1,0 +1,78 @@
+"""Benchmark: the electrical fast path (tables) against the exact per-step I-V solve.
+
+Workload: the paper's site, single-diode A-300 sub-panels with switching, fold angles 1..180 deg
+at 1 deg, 1-minute interval-centred steps over a year (or ``--days`` of it). The fast path runs
+the whole workload; the exact solve runs a slice (``--exact-days`` days x ``--exact-angles``
+angles) and is scaled per point, so the speed-up is a ratio measured in one run.
+
+    python bench/electrical.py [--days 365] [--exact-days 1] [--exact-angles 12] [--mode exact]
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import platform
+import resource
+import time
+
+import numpy as np
+
+from foldopt.config import default_study_path, load_study
+from foldopt.metrics import t_solar
+from foldopt.study import Day
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--days", type=int, default=365)
+    parser.add_argument("--exact-days", type=int, default=1)
+    parser.add_argument("--exact-angles", type=int, default=12)
+    parser.add_argument("--mode", default="exact", choices=["paper", "exact"])
+    args = parser.parse_args()
+
+    base = load_study(default_study_path()).model_copy(
+        update={"pv_model": "single-diode", "connection": "switching", "mode": args.mode,
+                "geometry": "azimuth-split" if args.mode == "paper" else "hinge"}
+    )
+    angles = np.arange(1.0, 181.0)
+    dates = [dt.date(2014, 1, 1) + dt.timedelta(days=int(d)) for d in np.linspace(0, 364, args.days)]
+
+    start = time.perf_counter()
+    electrical = None
+    hours = np.empty((len(dates), angles.size))
+    for i, date in enumerate(dates):
+        day = Day(base.model_copy(update={"date": date}), electrical)
+        electrical = day.electrical
+        hours[i] = t_solar(day.combined_power(angles), base.p_load, day.step_hours)
+    fast_seconds = time.perf_counter() - start
+    fast_points = len(dates) * angles.size * 1440
+
+    exact_study = base.model_copy(update={"exact_electrical": True})
+    slice_angles = np.linspace(1.0, 180.0, args.exact_angles)
+    start = time.perf_counter()
+    worst = 0.0
+    for date in dates[: args.exact_days]:
+        exact_day = Day(exact_study.model_copy(update={"date": date}))
+        exact_hours = t_solar(exact_day.combined_power(slice_angles), base.p_load, exact_day.step_hours)
+        fast_day = Day(base.model_copy(update={"date": date}), electrical)
+        fast_hours = t_solar(fast_day.combined_power(slice_angles), base.p_load, fast_day.step_hours)
+        worst = max(worst, float(np.abs(exact_hours - fast_hours).max()) * 3600)
+    exact_seconds = time.perf_counter() - start
+    exact_points = args.exact_days * slice_angles.size * 1440
+
+    fast_per_point = fast_seconds / fast_points
+    exact_per_point = exact_seconds / exact_points
+    peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, python {platform.python_version()}")
+    print(f"workload: {len(dates)} days x {angles.size} angles x 1440 steps, single-diode + switching, {args.mode} mode")
+    print(f"fast path (tables, incl. building them): {fast_seconds:8.2f} s  {fast_per_point * 1e9:8.1f} ns/point")
+    print(f"exact solve (slice {exact_points} points):  {exact_seconds:8.2f} s  {exact_per_point * 1e9:8.1f} ns/point")
+    print(f"speed-up, measured in this run: {exact_per_point / fast_per_point:8.1f} x")
+    print(f"exact solve scaled to the whole workload: {exact_per_point * fast_points:8.1f} s")
+    print(f"largest t_solar difference on the slice: {worst:.1f} s")
+    print(f"peak memory: {peak_mib:.0f} MiB")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,80 @@
+"""Relations between the connections, solved exactly from the sub-panels' I-V curves."""
+
+import numpy as np
+import pvlib
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from foldopt.aggregation import connection_powers, pair_powers, parallel_power, series_power
+from foldopt.pvmodel import PVModel
+
+AREA = 0.054  # a sub-panel of the paper's 0.108 m^2 panel
+MODELS = {"single-diode": PVModel("single-diode"), "b-model": PVModel("b-model", efficiency=0.19)}
+
+
+def curves(model, poa_east, poa_west, temp=25.0):
+    pv = MODELS[model]
+    east = pv.curves(np.atleast_1d(np.asarray(poa_east, float)), temp, AREA)
+    west = pv.curves(np.atleast_1d(np.asarray(poa_west, float)), temp, AREA)
+    return east, west
+
+
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("poa", [50.0, 300.0, 1000.0])
+def test_equal_irradiance_parallel_and_series_are_twice_one(model, poa):
+    east, west = curves(model, poa, poa)
+    one = east.max_power()
+    assert parallel_power(east, west) == pytest.approx(2 * one, rel=1e-6)
+    assert series_power(east, west, bypass=False) == pytest.approx(2 * one, rel=1e-6)
+
+
+@pytest.mark.parametrize("model", MODELS)
+@settings(max_examples=40, deadline=None)
+@given(poa_east=st.floats(0, 1200), poa_west=st.floats(0, 1200), temp=st.floats(-10, 70),
+       bypass=st.booleans())
+def test_single_converter_never_beats_independent_and_switching_beats_its_states(model, poa_east, poa_west, temp, bypass):
+    east, west = curves(model, poa_east, poa_west, temp)
+    p_east, p_west = east.max_power(), west.max_power()
+    p_parallel, p_series = pair_powers(east, west, bypass)
+    powers, _ = connection_powers(p_east, p_west, p_parallel, p_series, switch_series=True)
+    bound = powers["independent"] * (1 + 1e-9) + 1e-12
+    assert np.all(powers["parallel"] <= bound)
+    assert np.all(powers["series"] <= bound)
+    for state in ("east", "west", "parallel", "series"):
+        assert np.all(powers["switching"] >= powers[state] - 1e-12)
+    # Blocking diodes: parallel never falls below the better sub-panel alone.
+    assert np.all(powers["parallel"] >= np.maximum(p_east, p_west) * (1 - 1e-6) - 1e-12)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_series_without_bypass_is_limited_by_the_weaker_current(model):
+    east, west = curves(model, 1000.0, 150.0)
+    limited = series_power(east, west, bypass=False)[0]
+    # No operating point can carry more than the weaker sub-panel's short-circuit current, so
+    # the pair delivers at most that current times the two open-circuit voltages.
+    assert limited <= west.i_sc[0] * (east.v_oc[0] + west.v_oc[0])
+    # Brute force over currents up to the weaker Isc matches the solver.
+    current = np.linspace(0, west.i_sc[0], 100001)
+    voltage = east.voltage(current[None, :]) + west.voltage(current[None, :])
+    assert limited == pytest.approx(np.nanmax(current * voltage), rel=1e-6)
+    # A bypass diode lets the strong sub-panel run alone at its maximum when that is better.
+    assert series_power(east, west, bypass=True)[0] >= max(limited, east.max_power()[0]) * (1 - 1e-6)
+
+
+def test_parallel_solver_matches_a_brute_force_scan_of_the_summed_curve():
+    east, west = curves("single-diode", [900.0, 600.0, 20.0], [100.0, 550.0, 800.0], 45.0)
+    voltage = np.linspace(0, 3.0, 300001)
+    total = sum(
+        np.clip(pvlib.pvsystem.i_from_v(voltage[None, :], *[p[:, None] for p in c.params]), 0, None)
+        for c in (east, west)
+    )
+    np.testing.assert_allclose(parallel_power(east, west), (voltage * total).max(axis=1), rtol=1e-6)
+
+
+def test_ideal_model_connections_are_sums():
+    powers, state = connection_powers(np.array([3.0, 0.0]), np.array([1.0, 2.0]), converter_efficiency=0.9)
+    np.testing.assert_allclose(powers["parallel"], [4.0, 2.0])
+    np.testing.assert_allclose(powers["independent"], [3.6, 1.8])
+    # Ties go to the single sub-panel (west alone equals parallel when east is dark).
+    assert list(state) == [2, 1]
