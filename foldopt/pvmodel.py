@@ -277,10 +277,14 @@ class PVModel:
         u = self.unit
         if self.model == "single-diode":
             args = (poa, temp_cell, u.alpha_sc, u.a_ref, u.I_L_ref, u.I_o_ref, u.R_sh_ref, u.R_s)
-            if u.adjust is None:
-                il, io, rs, rsh, nnsvth = pvlib.pvsystem.calcparams_desoto(*args, EgRef=u.EgRef, dEgdT=u.dEgdT)
-            else:
-                il, io, rs, rsh, nnsvth = pvlib.pvsystem.calcparams_cec(*args, u.adjust, EgRef=u.EgRef, dEgdT=u.dEgdT)
+            # R_sh scales as 1/irradiance: at vanishing irradiance it overflows to inf, harmlessly.
+            with np.errstate(over="ignore", divide="ignore"):
+                if u.adjust is None:
+                    il, io, rs, rsh, nnsvth = pvlib.pvsystem.calcparams_desoto(*args, EgRef=u.EgRef, dEgdT=u.dEgdT)
+                else:
+                    il, io, rs, rsh, nnsvth = pvlib.pvsystem.calcparams_cec(
+                        *args, u.adjust, EgRef=u.EgRef, dEgdT=u.dEgdT
+                    )
             shape = poa.shape
             params = (il, io, rs * units, rsh * units, nnsvth * units)
             return IVCurve(self.model, tuple(np.broadcast_to(np.asarray(p, dtype=float), shape) for p in params))
