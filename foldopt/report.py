@@ -136,7 +136,7 @@ def plot_switching(result: StudyResult, path: Path) -> None:
     state = series["switch_state"].to_numpy()
     step = hours[1] - hours[0]
     starts = np.flatnonzero(np.r_[True, state[1:] != state[:-1]])
-    for start, stop in zip(starts, np.r_[starts[1:], state.size]):
+    for start, stop in zip(starts, np.r_[starts[1:], state.size], strict=True):
         if state[start] != "off":
             ax.axvspan(hours[start] - step / 2, hours[stop - 1] + step / 2, color=STATE_COLOURS[state[start]], alpha=0.12, lw=0)
     for name in ("east", "west", "parallel") + (("series",) if study.switch_series else ()):
@@ -201,7 +201,7 @@ def plot_comparison(result: StudyResult, path: Path) -> None:
     labels = ["flat", f"twofold {summary.loc['twofold', 'fold_angle_deg']:.1f}°", "ideal tracker"]
     fig, ax = plt.subplots(figsize=(6, 4.5))
     bars = ax.bar(labels, summary["t_solar_h"], color=["0.3", "tab:blue", "0.7"])
-    for bar, hours, share in zip(bars, summary["t_solar_h"], summary["pct_of_tracker_t_solar"]):
+    for bar, hours, share in zip(bars, summary["t_solar_h"], summary["pct_of_tracker_t_solar"], strict=True):
         ax.annotate(
             f"{hours:.2f} h\n{share:.1f} % of tracker",
             (bar.get_x() + bar.get_width() / 2, bar.get_height()),
