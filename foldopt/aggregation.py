@@ -71,22 +71,32 @@ def parallel_power(east: IVCurve, west: IVCurve):
         current = sum(np.nan_to_num(np.clip(side.current(voltage), 0.0, None)) for side in (east, west))
         return voltage * current
 
-    return _maximise(power, np.maximum(east.v_oc, west.v_oc))
+    # Running at the stronger sub-panel's own MPP is always a valid operating point (the other adds
+    # current or is blocked), so it bounds the result from below where a kink near it (the weak
+    # sub-panel's Voc) misleads the search (seen: 1.2e-4 short).
+    best_alone = np.maximum(east.max_power(), west.max_power())
+    return np.maximum(_maximise(power, np.maximum(east.v_oc, west.v_oc)), best_alone)
 
 
 def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
     """Maximum power [W] of two sub-panels in series, with or without ideal bypass diodes."""
     isc_e, isc_w = east.i_sc, west.i_sc
+    voc_e, voc_w = east.v_oc, west.v_oc
 
-    def side_voltage(curve, isc, current):
-        voltage = curve.voltage(np.minimum(current, isc[..., None]))
-        return np.where(current < isc[..., None], np.clip(voltage, 0.0, None), 0.0)
+    def side_voltage(curve, isc, voc, current):
+        # Between 0 and Isc a sub-panel's voltage lies in [0, Voc]; clipping to it also removes
+        # the absurd voltages pvlib returns for a practically dark cell (Voc is 0 there).
+        voltage = np.nan_to_num(curve.voltage(np.minimum(current, isc[..., None])))
+        return np.where(current < isc[..., None], np.clip(voltage, 0.0, voc[..., None]), 0.0)
 
     def power(current):
-        return current * (side_voltage(east, isc_e, current) + side_voltage(west, isc_w, current))
+        return current * (side_voltage(east, isc_e, voc_e, current) + side_voltage(west, isc_w, voc_w, current))
 
-    limit = np.maximum(isc_e, isc_w) if bypass else np.minimum(isc_e, isc_w)
-    return _maximise(power, limit)
+    if not bypass:
+        return _maximise(power, np.minimum(isc_e, isc_w))
+    # With ideal bypass diodes the stronger sub-panel can always run alone at its own MPP.
+    best_alone = np.maximum(east.max_power(), west.max_power())
+    return np.maximum(_maximise(power, np.maximum(isc_e, isc_w)), best_alone)
 
 
 def pair_powers(east: IVCurve, west: IVCurve, bypass: bool = True):

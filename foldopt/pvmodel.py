@@ -184,19 +184,25 @@ class IVCurve:
         return np.nan_to_num(self.current(np.zeros_like(self.params[0])))
 
     @property
+    def lit(self):
+        """Whether each curve sources any current worth modelling (short-circuit current > 1 nA).
+
+        For practically dark cells pvlib's ``v_from_i`` returns NaN or absurd voltages (1e24 V seen
+        at 70 C); such sub-panels are taken as delivering nothing.
+        """
+        return self.i_sc > 1e-9
+
+    @property
     def v_oc(self):
         if self.model == "b-model":
             return self.params[0]
-        # For a practically dark cell (photocurrent below 1 nA) pvlib's v_from_i returns NaN or
-        # absurd voltages (1e24 V seen at 70 C); such a sub-panel delivers nothing.
-        lit = self.i_sc > 1e-9
-        return np.where(lit, np.nan_to_num(self.voltage(np.zeros_like(self.params[0]))), 0.0)
+        return np.where(self.lit, np.nan_to_num(self.voltage(np.zeros_like(self.params[0]))), 0.0)
 
     def max_power(self):
         """Maximum power [W] of each curve."""
         if self.model == "single-diode":
             mpp = pvlib.pvsystem.max_power_point(*self.params, method="newton")
-            return np.clip(np.asarray(mpp["p_mp"], dtype=float), 0.0, None)
+            return np.where(self.lit, np.clip(np.nan_to_num(np.asarray(mpp["p_mp"], dtype=float)), 0.0, None), 0.0)
         # Eq. 8: dP/dV = 0 has the closed form v = b (W(e^(1 + 1/b)) - 1), v = V / V_x, for all
         # irradiances; Lambert's W of the log-argument avoids overflow for small b.
         v_x, i_x, b = self.params
