@@ -79,24 +79,31 @@ def parallel_power(east: IVCurve, west: IVCurve):
 
 
 def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
-    """Maximum power [W] of two sub-panels in series, with or without ideal bypass diodes."""
+    """Maximum power [W] of two sub-panels in series, with or without ideal bypass diodes.
+
+    Without bypass diodes the string current cannot exceed the weaker sub-panel's short-circuit
+    current. With ideal ones (0 V forward drop) the optimum is either that, both sub-panels
+    conducting, or the stronger sub-panel alone at its own MPP with the weaker one bypassed: above
+    the weaker Isc only the stronger sub-panel contributes voltage, at most its MPP power, and
+    below it the no-bypass string already includes that operating point. Taking the larger of the
+    two is exact, and avoids searching across the cliff where the weaker voltage collapses (a
+    search there once settled 0.7 % low).
+    """
     isc_e, isc_w = east.i_sc, west.i_sc
     voc_e, voc_w = east.v_oc, west.v_oc
 
-    def side_voltage(curve, isc, voc, current):
+    def side_voltage(curve, voc, current):
         # Between 0 and Isc a sub-panel's voltage lies in [0, Voc]; clipping to it also removes
         # the absurd voltages pvlib returns for a practically dark cell (Voc is 0 there).
-        voltage = np.nan_to_num(curve.voltage(np.minimum(current, isc[..., None])))
-        return np.where(current < isc[..., None], np.clip(voltage, 0.0, voc[..., None]), 0.0)
+        return np.clip(np.nan_to_num(curve.voltage(current)), 0.0, voc[..., None])
 
     def power(current):
-        return current * (side_voltage(east, isc_e, voc_e, current) + side_voltage(west, isc_w, voc_w, current))
+        return current * (side_voltage(east, voc_e, current) + side_voltage(west, voc_w, current))
 
+    string = _maximise(power, np.minimum(isc_e, isc_w))
     if not bypass:
-        return _maximise(power, np.minimum(isc_e, isc_w))
-    # With ideal bypass diodes the stronger sub-panel can always run alone at its own MPP.
-    best_alone = np.maximum(east.max_power(), west.max_power())
-    return np.maximum(_maximise(power, np.maximum(isc_e, isc_w)), best_alone)
+        return string
+    return np.maximum(string, np.maximum(east.max_power(), west.max_power()))
 
 
 def pair_powers(east: IVCurve, west: IVCurve, bypass: bool = True):

@@ -85,8 +85,8 @@ class Electrical:
         """Interpolator of a pair's power as a fraction of its two maxima on a 2-D grid.
 
         The fraction is smoother than the power and zero-safe. Series is tabulated without bypass
-        diodes; with ideal ones its optimum is either that or the stronger sub-panel alone, which
-        needs no table.
+        diodes; with ideal ones it is the larger of that and the stronger sub-panel alone
+        (:func:`foldopt.aggregation.series_power`), which needs no table.
         """
         first, second = (grid.ravel() for grid in np.meshgrid(axis0, axis1, indexing="ij"))
         ge, gw = to_irradiance(first, second)

@@ -7,7 +7,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from foldopt.aggregation import connection_powers, pair_powers, parallel_power, series_power
-from foldopt.pvmodel import PVModel
+from foldopt.pvmodel import PVModel, cell_temperature
 
 AREA = 0.054  # a sub-panel of the paper's 0.108 m^2 panel
 MODELS = {"single-diode": PVModel("single-diode"), "b-model": PVModel("b-model", efficiency=0.19)}
@@ -63,6 +63,25 @@ def test_series_without_bypass_is_limited_by_the_weaker_current(model):
     assert limited == pytest.approx(np.nanmax(current * voltage), rel=1e-6)
     # A bypass diode lets the strong sub-panel run alone at its maximum when that is better.
     assert series_power(east, west, bypass=True)[0] >= max(limited, east.max_power()[0]) * (1 - 1e-6)
+
+
+def test_bypassed_series_finds_the_peak_before_the_weaker_current_collapses():
+    # Found by the fast-path check (paper's day, exact mode, 142 deg fold, 15:53): both sub-panels
+    # conducting just below the weaker Isc beat the stronger one alone (7.4205 W against 7.3663 W);
+    # a search across the cliff where the weaker voltage collapses had missed it.
+    pv = MODELS["single-diode"]
+    poa = np.array([324.309, 705.093])
+    temp = cell_temperature(poa, 25.0, 1.0, "sapm")
+    east, west = (pv.curves(poa[i : i + 1], temp[i : i + 1], AREA) for i in (0, 1))
+    current = np.linspace(0, west.i_sc[0], 400001)[None, :]
+
+    def side(curve):
+        volts = np.nan_to_num(curve.voltage(np.minimum(current, curve.i_sc[0])))
+        return np.where(current < curve.i_sc[0], np.clip(volts, 0, curve.v_oc[0]), 0.0)
+
+    brute = np.max(current * (side(east) + side(west)))
+    assert series_power(east, west, bypass=True)[0] == pytest.approx(brute, rel=1e-6)
+    assert series_power(east, west, bypass=True)[0] > west.max_power()[0] * 1.005
 
 
 def test_parallel_solver_matches_a_brute_force_scan_of_the_summed_curve():

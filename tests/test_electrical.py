@@ -12,23 +12,25 @@ ANGLES = np.array([15.0, 30.0, 60.0, 120.0, 180.0])
 @pytest.mark.parametrize("pv_model", ["single-diode", "b-model"])
 @pytest.mark.parametrize("mode,geometry", [("paper", "azimuth-split"), ("exact", "hinge")])
 def test_tables_match_the_exact_solve(shin_study, pv_model, mode, geometry):
-    # Stated bound (README, "Fast path"): switching and parallel t_solar within 30 s, energy
-    # within 0.1 % of the exact solve, for loads from 10 % to 90 % of the peak.
+    # Stated bound (README, "Fast path"): every connection's t_solar within 30 s and energy within
+    # 0.1 % of the exact solve, for loads from 10 % to 90 % of the peak.
     study = shin_study.model_copy(
-        update={"pv_model": pv_model, "mode": mode, "geometry": geometry, "step_min": 2}
+        update={"pv_model": pv_model, "mode": mode, "geometry": geometry, "step_min": 2, "switch_series": True}
     )
     fast, fast_state = Day(study).connections(ANGLES)
     exact, exact_state = Day(study.model_copy(update={"exact_electrical": True})).connections(ANGLES)
     loads = np.linspace(0.1, 0.9, 9)[:, None] * exact["switching"].max()
     step = study.step_min / 60
-    for connection in ("east", "west", "parallel", "independent", "switching"):
+    for connection in ("east", "west", "parallel", "series", "independent", "switching"):
         hours = np.abs(t_solar(fast[connection], loads, step) - t_solar(exact[connection], loads, step))
         assert hours.max() * 3600 < 30.0, connection
         relative = np.abs(energy(fast[connection], step) / energy(exact[connection], step) - 1)
         assert relative.max() < 1e-3, connection
-    # The switch picks the same state at almost every daylight step (ties aside).
-    daylight = exact["switching"] > 1e-3
-    assert np.mean(fast_state[daylight] == exact_state[daylight]) > 0.99
+    # Wherever one state wins clearly (by > 0.1 % over the runner-up), the switch picks it too.
+    candidates = np.sort(np.stack([exact[name] for name in ("east", "west", "parallel", "series")]), axis=0)
+    clear = candidates[-1] > 1.001 * candidates[-2]
+    assert clear.sum() > 100
+    assert np.array_equal(fast_state[clear], exact_state[clear])
 
 
 def test_flat_panel_is_two_sub_panels_in_series(shin_study):
