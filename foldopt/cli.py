@@ -1,27 +1,44 @@
 """foldopt command line: thin wrappers over the library.
 
 Every bad input ends the same way: one ``error: <field> ...`` line per fault on stderr, exit code
-2, no traceback and nothing written.
+2, no traceback and nothing written. Anything that runs longer than a second shows a status line
+on stderr (``--quiet`` hides it); ``--format json`` prints the summary on stdout for scripts.
 """
 
 from __future__ import annotations
 
+import json
+import re
 import sys
+import threading
+import time
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Optional
 
+import numpy as np
 import typer
 from typer.core import TyperGroup
 
-from foldopt.config import ConfigError, default_study_path, load_study, make_study
-from foldopt.report import OutputExistsError, check_output, write_reproduction, write_study
+from foldopt.config import ConfigError, default_study_path, load_plan, load_study, make_plan, parse_range
+from foldopt.report import (
+    OutputExistsError,
+    check_output,
+    write_reproduction,
+    write_sizing,
+    write_study,
+    write_sweep,
+)
 from foldopt.reproduce import REPRODUCTIONS
 from foldopt.reproduce import reproduce as reproduce_table
-from foldopt.study import run_study
+from foldopt.sizing import C_GRID, LIFETIME_YEARS, size_panel
+from foldopt.study import Day, run_study
+from foldopt.sweep import run_plan
 
 RESULTS = Path("results")
 # Typer >= 0.29 vendors click; its UsageError is reached through the public BadParameter.
 _USAGE_ERROR = next(cls for cls in typer.BadParameter.__mro__ if cls.__name__ == "UsageError")
+FORMATS = ("table", "json")
 
 
 class _OneLineErrors(TyperGroup):
@@ -50,8 +67,6 @@ app = typer.Typer(
     no_args_is_help=True,
     help="Design-space optimiser for twofold PV panels powering storage-less loads.",
 )
-sweep_app = typer.Typer(cls=_OneLineErrors, no_args_is_help=True, help="Sweep one design variable.")
-app.add_typer(sweep_app, name="sweep")
 
 
 def _fail(lines: list[str]):
@@ -60,35 +75,104 @@ def _fail(lines: list[str]):
     raise typer.Exit(2)
 
 
-def _print_summary(summary) -> None:
-    columns = ["design", "fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh",
-               "peak_power_w", "gain_vs_flat_pct", "pct_of_tracker_t_solar", "flat_area_multiple"]
-    typer.echo(summary[columns].to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+class _Status:
+    """A status line on stderr that appears only once a task has run for a second."""
+
+    def __init__(self, label: str, quiet: bool):
+        self.label, self.quiet = label, quiet
+        self.start = time.monotonic()
+        self.detail = ""
+        self.shown = False
+        self._stop = threading.Event()
+
+    def progress(self, done: int, total: int) -> None:
+        width = 24
+        filled = int(width * done / max(total, 1))
+        self.detail = f"[{'#' * filled}{'.' * (width - filled)}] {done}/{total}"
+
+    def _draw(self):
+        while not self._stop.wait(0.25):
+            if time.monotonic() - self.start >= 1.0:
+                self.shown = True
+                elapsed = time.monotonic() - self.start
+                sys.stderr.write(f"\r{self.label} {self.detail} {elapsed:5.1f} s ")
+                sys.stderr.flush()
+
+    @contextmanager
+    def running(self):
+        thread = None
+        if not self.quiet:
+            thread = threading.Thread(target=self._draw, daemon=True)
+            thread.start()
+        try:
+            yield self
+        finally:
+            self._stop.set()
+            if thread is not None:
+                thread.join()
+            if self.shown:
+                sys.stderr.write("\n")
 
 
-def _run_and_write(study, out: Path, overwrite: bool) -> None:
-    check_output(out, overwrite)
-    result = run_study(study)
-    write_study(result, out, overwrite)
-    study = result.study
-    typer.echo(
-        f"{study.name} ({study.mode} mode, {study.geometry}, {study.pv_model} + {study.connection}, "
-        f"P_load {study.p_load:g} W)"
-    )
-    _print_summary(result.summary)
+def _check_format(output_format: str) -> None:
+    if output_format not in FORMATS:
+        _fail([f"--format = {output_format!r}: must be one of {', '.join(FORMATS)}"])
+
+
+def _emit(table, title: str, output_format: str, out: Path, columns=None) -> None:
+    """The summary: a text table on stdout, or JSON records for scripts (messages then on stderr)."""
+    if output_format == "json":
+        records = json.loads(table.to_json(orient="records", double_precision=10))
+        typer.echo(json.dumps({"title": title, "out": str(out), "rows": records}, indent=1))
+        return
+    shown = table[[c for c in columns if c in table]] if columns else table
+    typer.echo(title)
+    typer.echo(shown.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
     typer.echo(f"wrote {out}")
+
+
+SUMMARY_COLUMNS = ["design", "fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh",
+                   "peak_power_w", "gain_vs_flat_pct", "pct_of_tracker_t_solar", "flat_area_multiple"]
+SWEEP_COLUMNS = ["latitude", "date", "p_load_w", "design", "fold_angle_deg", "t_solar_h", "gain_vs_flat_pct", "note"]
+QUIET = typer.Option(False, "--quiet", "-q", help="No status line")
+FORMAT = typer.Option("table", "--format", help="table | json (summary on stdout for scripts)")
+OVERWRITE = typer.Option(False, "--overwrite", help="Replace an existing results folder")
+
+
+def _run_plan(plan, out: Path, overwrite: bool, quiet: bool, output_format: str) -> None:
+    check_output(out, overwrite)
+    base = plan.base
+    if not plan.axes:
+        with _Status(f"foldopt: {base.name}", quiet).running():
+            result = run_study(base)
+            write_study(result, out, overwrite)
+        study = result.study
+        title = (f"{study.name} ({study.mode} mode, {study.geometry}, {study.pv_model} + {study.connection}, "
+                 f"P_load {study.p_load:g} W)")
+        _emit(result.summary, title, output_format, out, SUMMARY_COLUMNS)
+        return
+    with _Status(f"foldopt: {base.name}, {plan.n_cases} cases", quiet).running() as status:
+        result = run_plan(plan, status.progress)
+        write_sweep(result, out, overwrite)
+    twofold = result.table[result.table["design"] == "twofold"]
+    title = f"{base.name}: {plan.n_cases} cases over {', '.join(p for p, _ in plan.axes)} (twofold rows)"
+    table = result.table if output_format == "json" else twofold
+    _emit(table, title, output_format, out, SWEEP_COLUMNS)
 
 
 @app.command()
 def run(
     config: Optional[Path] = typer.Argument(None, help="YAML study; default: the embedded configs/shin2015.yaml"),
     out: Optional[Path] = typer.Option(None, "--out", help="Results folder; default results/<study name>"),
-    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing results folder"),
+    overwrite: bool = OVERWRITE,
+    quiet: bool = QUIET,
+    output_format: str = FORMAT,
 ):
-    """Run a YAML study: fold-angle sweep, paper heuristic, flat / twofold / tracker comparison."""
+    """Run a YAML study: one case (fold-angle sweep, heuristic, comparison) or a sweep of cases."""
+    _check_format(output_format)
     try:
-        study = load_study(config if config is not None else default_study_path())
-        _run_and_write(study, out or RESULTS / study.name, overwrite)
+        plan = load_plan(config if config is not None else default_study_path())
+        _run_plan(plan, out or RESULTS / plan.base.name, overwrite, quiet, output_format)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
 
@@ -96,53 +180,67 @@ def run(
 @app.command()
 def reproduce(
     out: Path = typer.Option(RESULTS / "reproduction", "--out", help="Results folder"),
-    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing results folder"),
+    overwrite: bool = OVERWRITE,
+    quiet: bool = QUIET,
+    output_format: str = FORMAT,
 ):
     """Reproduce Shin et al.'s study in paper and exact modes.
 
     Writes reproduction.csv (the embedded study: ideal PV model) and reproduction_single_diode.csv
     (A-300 single-diode sub-panels with switching).
     """
+    _check_format(output_format)
     try:
         check_output(out, overwrite)
         study = load_study(default_study_path())
-        tables = {name: reproduce_table(study, **changes) for name, changes in REPRODUCTIONS.items()}
-        write_reproduction(tables, study, out, overwrite)
+        with _Status("foldopt: reproducing Shin et al.", quiet).running():
+            tables = {name: reproduce_table(study, **changes) for name, changes in REPRODUCTIONS.items()}
+            write_reproduction(tables, study, out, overwrite)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
     for name, table in tables.items():
-        typer.echo(f"Shin et al. twofold study ({name}): paper value, paper-mode and exact-mode reproduction")
-        typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
-        typer.echo(f"wrote {out / (name + '.csv')}")
+        title = f"Shin et al. twofold study ({name}): paper value, paper-mode and exact-mode reproduction"
+        _emit(table, title, output_format, out / f"{name}.csv")
 
 
-#: Study fields as the sweep options name them, so errors speak the user's words.
-_SWEEP_OPTIONS = {
+#: Study fields as the command-line options name them, so errors speak the user's words.
+_OPTION_OF_FIELD = {
     "site.latitude": "--lat", "site.longitude": "--lon", "site.altitude": "--altitude",
-    "site.timezone": "--timezone", "date": "--date", "p_load": "--p-load", "panel.area": "--area",
+    "site.timezone": "--timezone", "date": "--days/--date", "p_load": "--p-load", "panel.area": "--area",
     "panel.efficiency": "--efficiency", "panel.tilt": "--tilt", "panel.azimuth": "--azimuth",
     "mode": "--mode", "geometry": "--geometry", "sky": "--sky", "step_min": "--step-min",
     "connection": "--connection", "fold_angles.step": "--angle-step", "fold_angles.start": "--angle-step",
     "pv_model": "--pv-model", "module": "--module", "temp_air": "--temp-air",
-    "converter_efficiency": "--converter-efficiency",
+    "converter_efficiency": "--converter-efficiency", "year": "--year",
 }
+_FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 
 
 def _rename_fields(line: str) -> str:
-    field, sep, rest = line.partition(" ")
-    key = field.rstrip(":")
-    return f"{_SWEEP_OPTIONS[key]}{field[len(key):]}{sep}{rest}" if key in _SWEEP_OPTIONS else line
+    match = _FIELD.match(line)
+    if match and match.group(1) in _OPTION_OF_FIELD:
+        return _OPTION_OF_FIELD[match.group(1)] + line[match.end(1):]
+    return line
 
 
-@sweep_app.command("angle")
-def sweep_angle(
-    lat: Optional[float] = typer.Option(None, "--lat", help="Latitude [deg north], -90..90"),
-    lon: Optional[float] = typer.Option(None, "--lon", help="Longitude [deg east], -180..180"),
-    date: Optional[str] = typer.Option(None, "--date", help="Day, YYYY-MM-DD"),
-    p_load: Optional[float] = typer.Option(None, "--p-load", help="Load [W], > 0"),
+AXES = ("angle", "latitude", "day", "load")
+_DEFAULT_RANGES = {"latitude": "-60:60:5", "day": "1:365:7"}
+
+
+@app.command()
+def sweep(
+    axis: str = typer.Argument(..., help="angle | latitude | day | load"),
+    lat: Optional[str] = typer.Option(None, "--lat", help="Latitude [deg north] or a range -60:60:5"),
+    lon: Optional[str] = typer.Option(None, "--lon", help="Longitude [deg east] (or a range)"),
+    days: Optional[str] = typer.Option(
+        None, "--days", "--date",
+        help="A date YYYY-MM-DD, a range of days 1:365:7 or dates, 'year' or 'equinoxes-solstices'",
+    ),
+    year: int = typer.Option(2025, "--year", help="Year of day-of-year ranges"),
+    p_load: Optional[str] = typer.Option(None, "--p-load", help="Load [W] or a range 1:20:0.5"),
     area: Optional[float] = typer.Option(None, "--area", help="Flat panel area [m^2], > 0"),
     efficiency: float = typer.Option(0.2, "--efficiency", help="PV efficiency (ideal model), 0..1"),
-    tilt: Optional[float] = typer.Option(None, "--tilt", help="Tilt [deg]; default |latitude|"),
+    tilt: Optional[str] = typer.Option(None, "--tilt", help="Tilt [deg]; default |latitude|"),
     azimuth: Optional[float] = typer.Option(None, "--azimuth", help="Azimuth [deg]; default facing the equator"),
     altitude: float = typer.Option(0.0, "--altitude", help="Site altitude [m]"),
     timezone: Optional[str] = typer.Option(None, "--timezone", help="IANA name or UTC offset; default from longitude"),
@@ -161,17 +259,32 @@ def sweep_angle(
     exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve I-V curves per step, not tables"),
     step_min: float = typer.Option(1.0, "--step-min", help="Time step [min], divides 1440"),
     angle_step: float = typer.Option(1.0, "--angle-step", help="Fold-angle sweep step [deg]"),
-    out: Path = typer.Option(RESULTS / "sweep-angle", "--out", help="Results folder"),
-    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing results folder"),
+    out: Optional[Path] = typer.Option(None, "--out", help="Results folder; default results/sweep-<axis>"),
+    overwrite: bool = OVERWRITE,
+    quiet: bool = QUIET,
+    output_format: str = FORMAT,
 ):
-    """t_solar and energy for every fold angle at one site, day and load (sweep.csv, summary.csv)."""
+    """Sweep a design variable from the command line.
+
+    angle: one site, day and load, every fold angle (sweep.csv, summary.csv). latitude, day, load:
+    every combination of the ranges given (--lat, --days, --p-load, --tilt, --lon accept
+    start:stop:step), one row per case x design in results.csv, with heat maps and curves.
+    """
+    _check_format(output_format)
+    if axis not in AXES:
+        _fail([f"sweep: axis {axis!r} must be one of {', '.join(AXES)}"])
+    lat = lat if lat is not None else _DEFAULT_RANGES.get(axis)
+    days = days if days is not None else _DEFAULT_RANGES.get(axis)
+    if axis == "load" and (p_load is None or _single(p_load)):
+        _fail(["--p-load: sweep load needs a range start:stop:step or a list"])
     site = {"latitude": lat, "longitude": lon, "altitude": altitude, "timezone": timezone}
     panel = {"area": area, "efficiency": efficiency, "tilt": tilt, "azimuth": azimuth}
     data = {
-        "name": "sweep-angle",
+        "name": f"sweep-{axis}",
+        "year": year,
         "mode": mode,
         "site": {key: value for key, value in site.items() if value is not None},
-        "date": date,
+        "date": days,
         "panel": {key: value for key, value in panel.items() if value is not None},
         "p_load": p_load,
         "geometry": geometry,
@@ -189,13 +302,62 @@ def sweep_angle(
     }
     data = {key: value for key, value in data.items() if value is not None}
     try:
-        study = make_study(data)
+        plan = make_plan(data)
     except ConfigError as error:
         _fail([_rename_fields(line) for line in error.errors])
+    if axis == "angle" and plan.axes:
+        _fail([f"sweep angle: one site, day and load; {', '.join(p for p, _ in plan.axes)} vary (use sweep latitude/day/load)"])
     try:
-        _run_and_write(study, out, overwrite)
+        _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, quiet, output_format)
     except OutputExistsError as error:
         _fail([str(error)])
+
+
+def _single(text: str) -> bool:
+    return ":" not in text and "," not in text
+
+
+@app.command()
+def size(
+    config: Optional[Path] = typer.Argument(None, help="YAML study (one case); default the embedded paper study"),
+    areas: str = typer.Option("0.01:0.5:0.005", "--areas", help="Panel areas [m^2], start:stop:step"),
+    cost_per_m2: Optional[float] = typer.Option(None, "--cost-per-m2", help="Panel cost [$/m^2]"),
+    cost_per_w: Optional[float] = typer.Option(None, "--cost-per-w", help="Panel cost [$/W at STC]"),
+    c_grid: float = typer.Option(C_GRID, "--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22)"),
+    years: float = typer.Option(LIFETIME_YEARS, "--years", help="Lifetime [years] (Shin et al.: 20)"),
+    days_per_year: float = typer.Option(365.0, "--days-per-year", help="Days a year like the study's day"),
+    out: Optional[Path] = typer.Option(None, "--out", help="Results folder; default results/<study>-sizing"),
+    overwrite: bool = OVERWRITE,
+    quiet: bool = QUIET,
+    output_format: str = FORMAT,
+):
+    """Shin et al. Sec. IV-A sizing: lifetime benefit C_grid * t_solar * P_load against panel cost."""
+    _check_format(output_format)
+    errors = []
+    if (cost_per_m2 is None) == (cost_per_w is None):
+        errors.append("--cost-per-m2 / --cost-per-w: give exactly one panel cost")
+    for name, value, low in (("--cost-per-m2", cost_per_m2, 0.0), ("--cost-per-w", cost_per_w, 0.0),
+                             ("--c-grid", c_grid, 0.0), ("--years", years, 0.0), ("--days-per-year", days_per_year, 0.0)):
+        if value is not None and not (np.isfinite(value) and value > low):
+            errors.append(f"{name} = {value}: must be > {low:g}")
+    try:
+        grid = parse_range(areas)
+        if grid[0] <= 0 or grid[-1] > 1000:
+            errors.append(f"--areas = {areas!r}: areas must be in (0, 1000] m^2")
+    except ValueError as error:
+        errors.append(f"--areas: {error}")
+    if errors:
+        _fail(errors)
+    try:
+        study = load_study(config if config is not None else default_study_path())
+        out = out or RESULTS / f"{study.name}-sizing"
+        check_output(out, overwrite)
+        with _Status(f"foldopt: sizing {study.name}", quiet).running():
+            table = size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
+            best = write_sizing(table, study, out, overwrite)
+    except (ConfigError, OutputExistsError) as error:
+        _fail(getattr(error, "errors", [str(error)]))
+    _emit(best, f"{study.name}: area with the largest lifetime net benefit", output_format, out)
 
 
 def main():  # pragma: no cover - console-script entry point

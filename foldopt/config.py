@@ -7,10 +7,13 @@ value and the allowed range.
 
 from __future__ import annotations
 
+import copy
 import datetime as dt
+import itertools
 import math
 import re
 import zoneinfo
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -93,6 +96,7 @@ class _Strict(BaseModel):
 
 
 class Site(_Strict):
+    name: str | None = None
     latitude: _interval(-90, 90, unit=" deg")
     longitude: _interval(-180, 180, unit=" deg")
     altitude: _interval(-500, 9000, unit=" m") = 0.0
@@ -211,7 +215,7 @@ def _format_errors(error: ValidationError) -> list[str]:
 
 
 def make_study(data: dict) -> Study:
-    """Validate a study from plain data; raises :class:`ConfigError` listing every fault."""
+    """Validate one study from plain data; raises :class:`ConfigError` listing every fault."""
     if not isinstance(data, dict):
         raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
     try:
@@ -220,8 +224,239 @@ def make_study(data: dict) -> Study:
         raise ConfigError(_format_errors(error)) from None
 
 
-def load_study(path: Path | str) -> Study:
-    """Read and validate a YAML study; raises :class:`ConfigError` with a one-line reason."""
+# --- Plans: a study with sweep axes ------------------------------------------------------------
+
+DATE_KEYWORDS = ("year", "equinoxes-solstices")
+MAX_CASES = 2_000_000
+_RANGE = re.compile(r"^\s*([^:\s]+)\s*:\s*([^:\s]+)\s*:\s*([^:\s]+)\s*$")
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_NUMERIC_RANGE = re.compile(rf"^\s*{_NUMBER}\s*:\s*{_NUMBER}\s*:\s*{_NUMBER}\s*$")
+
+
+def parse_range(text: str) -> list[float]:
+    """``"start:stop:step"`` -> the values from start to stop inclusive (stop kept if on the grid)."""
+    match = _RANGE.match(str(text))
+    if not match:
+        raise ValueError(f"expected start:stop:step, got {text!r}")
+    try:
+        start, stop, step = (float(part) for part in match.groups())
+    except ValueError:
+        raise ValueError(f"expected numbers in start:stop:step, got {text!r}") from None
+    if step <= 0 or not all(map(math.isfinite, (start, stop, step))):
+        raise ValueError(f"step must be a positive number, got {text!r}")
+    if stop < start:
+        raise ValueError(f"empty range {text!r}: stop is below start")
+    count = int(math.floor((stop - start) / step + 1e-9)) + 1
+    return [round(start + i * step, 12) for i in range(count)]
+
+
+def parse_dates(spec, year: int) -> list[dt.date]:
+    """Dates from a date, a list, ``"start:stop:step"`` (dates, or days of ``year``), ``year`` or
+    ``equinoxes-solstices`` (20 March, 21 June, 23 September, 21 December of ``year``)."""
+
+    def one(value):
+        if isinstance(value, dt.date):
+            return value
+        if isinstance(value, int) and not isinstance(value, bool):
+            if not 1 <= value <= (366 if _leap(year) else 365):
+                raise ValueError(f"day of year {value} is outside {year}")
+            return dt.date(year, 1, 1) + dt.timedelta(days=value - 1)
+        try:
+            return dt.date.fromisoformat(str(value))
+        except ValueError:
+            raise ValueError(f"{value!r} is not a date (YYYY-MM-DD) or a day of year") from None
+
+    if isinstance(spec, list):
+        if not spec:
+            raise ValueError("empty list of dates")
+        return [one(item) for item in spec]
+    if spec == "year":
+        days = 366 if _leap(year) else 365
+        return [dt.date(year, 1, 1) + dt.timedelta(days=i) for i in range(days)]
+    if spec == "equinoxes-solstices":
+        return [dt.date(year, 3, 20), dt.date(year, 6, 21), dt.date(year, 9, 23), dt.date(year, 12, 21)]
+    match = _RANGE.match(str(spec)) if isinstance(spec, str) else None
+    if match:
+        start, stop, step = match.groups()
+        if not step.isdigit() or int(step) < 1:
+            raise ValueError(f"the step of a date range is a whole number of days, got {step!r}")
+        first, last = one(int(start) if start.isdigit() else start), one(int(stop) if stop.isdigit() else stop)
+        if last < first:
+            raise ValueError(f"empty range {spec!r}: stop is before start")
+        return [first + dt.timedelta(days=d) for d in range(0, (last - first).days + 1, int(step))]
+    return [one(spec)]
+
+
+def _leap(year: int) -> bool:
+    return year % 4 == 0 and (year % 100 != 0 or year % 400 == 0)
+
+
+def _set_path(data: dict, path: str, value) -> dict:
+    """A copy of ``data`` with the dotted ``path`` set to ``value``."""
+    out = copy.deepcopy(data)
+    node = out
+    parts = path.split(".")
+    for part in parts[:-1]:
+        child = node.get(part)
+        if not isinstance(child, dict):
+            child = {}
+        node[part] = child
+        node = child
+    node[parts[-1]] = value
+    return out
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A study and its sweep axes; the cases are the product of the axes' values.
+
+    ``axes`` pairs each dotted field path (``site.latitude``, ``p_load``, ``date``...) with its values.
+    """
+
+    data: dict
+    axes: tuple
+
+    @property
+    def base(self) -> Study:
+        """The study with every axis at its first value."""
+        return self.study({path: values[0] for path, values in self.axes})
+
+    @property
+    def n_cases(self) -> int:
+        return math.prod(len(values) for _, values in self.axes)
+
+    def study(self, choice: dict) -> Study:
+        data = self.data
+        for path, value in choice.items():
+            data = _set_path(data, path, value)
+        return Study.model_validate(data)
+
+    def cases(self):
+        """``(choice, study)`` for every combination of the axes' values, first axis slowest."""
+        paths = [path for path, _ in self.axes]
+        for values in itertools.product(*(values for _, values in self.axes)):
+            choice = dict(zip(paths, values, strict=True))
+            yield choice, self.study(choice)
+
+
+def _listed_leaves(data: dict, prefix: str = ""):
+    """Dotted paths holding a list, a numeric ``start:stop:step`` range or a date keyword."""
+    for key, value in data.items():
+        path = f"{prefix}{key}"
+        if path == "date" and (isinstance(value, list) or value in DATE_KEYWORDS or (
+            isinstance(value, str) and _RANGE.match(value)
+        )):
+            yield path, value
+        elif isinstance(value, list) or (isinstance(value, str) and _NUMERIC_RANGE.match(value)):
+            yield path, value
+        elif isinstance(value, dict):
+            yield from _listed_leaves(value, f"{path}.")
+
+
+def _axis_values(path: str, spec, year: int) -> list:
+    if path == "date":
+        return parse_dates(spec, year)
+    if isinstance(spec, list):
+        if not spec:
+            raise ValueError("empty list")
+        return list(spec)
+    if isinstance(spec, str) and _RANGE.match(spec):
+        return parse_range(spec)
+    return [spec]
+
+
+def make_plan(data, lines: dict | None = None) -> Plan:
+    """Validate a study with optional sweep axes; raises :class:`ConfigError` with every fault.
+
+    Any field may hold a list (``site``: a list of sites) or a numeric range ``"start:stop:step"``;
+    ``date`` also takes a date range, ``year`` or ``equinoxes-solstices`` (of ``year``, default
+    2025). The ``sweep:`` section maps dotted field paths to lists or ranges. Each becomes an axis.
+    ``lines`` maps key paths to YAML line numbers, added to the messages.
+    """
+    lines = lines or {}
+    if not isinstance(data, dict):
+        raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
+    data = dict(data)
+    errors: list[str] = []
+    year = data.pop("year", 2025)
+    if not isinstance(year, int) or isinstance(year, bool) or not 1901 <= year <= 2099:
+        errors.append(_at(lines, ("year",), f"year = {year!r}: must be a whole year in [1901, 2099]"))
+        year = 2025
+    sweep = data.pop("sweep", None) or {}
+    if not isinstance(sweep, dict):
+        errors.append(_at(lines, ("sweep",), "sweep: expected a mapping of field paths to lists or ranges"))
+        sweep = {}
+    specs = {path: (path, value) for path, value in _listed_leaves(data)}
+    for path, value in sweep.items():
+        specs[str(path)] = (f"sweep.{path}", value)
+    axes = []
+    for path, (source, spec) in specs.items():
+        try:
+            values = _axis_values(path, spec, year)
+        except ValueError as error:
+            errors.append(_at(lines, tuple(source.split(".")), f"{source}: {error}"))
+            continue
+        axes.append((path, tuple(values)))
+    if errors:
+        raise ConfigError(errors)
+
+    plan = Plan(data, tuple(axes))
+    if plan.n_cases > MAX_CASES:
+        raise ConfigError([f"sweep: {plan.n_cases} cases exceed the limit of {MAX_CASES}"])
+    first = {path: values[0] for path, values in axes}
+    errors += _validation_errors(plan, first, lines, {})
+    for path, values in axes:
+        source = specs[path][0]
+        for index, value in enumerate(values[1:], start=1):
+            where = {path: (f"{source}[{index}]", tuple(source.split(".")) + (index,))}
+            errors += _validation_errors(plan, {**first, path: value}, lines, where)
+    if errors:
+        raise ConfigError(list(dict.fromkeys(errors)))
+    return plan
+
+
+def _validation_errors(plan: Plan, choice: dict, lines: dict, where: dict) -> list[str]:
+    try:
+        plan.study(choice)
+    except ValidationError as error:
+        messages = []
+        for item, message in zip(error.errors(), _format_errors(error), strict=True):
+            loc = tuple(str(part) for part in item["loc"])
+            for path, (label, yaml_path) in where.items():
+                if ".".join(loc).startswith(path):
+                    message = message.replace(".".join(loc), label, 1)
+                    loc = yaml_path
+            messages.append(_at(lines, loc, message))
+        return messages
+    return []
+
+
+def _at(lines: dict, loc: tuple, message: str) -> str:
+    """Append the YAML line of the longest known prefix of ``loc``."""
+    for end in range(len(loc), 0, -1):
+        line = lines.get(tuple(str(part) for part in loc[:end]))
+        if line is not None:
+            return f"{message} (line {line})"
+    return message
+
+
+def _yaml_lines(node, path=(), out=None) -> dict:
+    """Map every key path of a composed YAML node to its 1-based line."""
+    out = {} if out is None else out
+    if isinstance(node, yaml.MappingNode):
+        for key, value in node.value:
+            child = path + (str(key.value),)
+            out[child] = key.start_mark.line + 1
+            _yaml_lines(value, child, out)
+    elif isinstance(node, yaml.SequenceNode):
+        for index, item in enumerate(node.value):
+            out[path + (str(index),)] = item.start_mark.line + 1
+            _yaml_lines(item, path + (str(index),), out)
+    return out
+
+
+def load_plan(path: Path | str) -> Plan:
+    """Read and validate a YAML study (with any sweep axes); raises :class:`ConfigError`."""
     path = Path(path)
     try:
         text = path.read_text()
@@ -231,12 +466,21 @@ def load_study(path: Path | str) -> Study:
         raise ConfigError([f"config: cannot read {path}: {error.__class__.__name__}"]) from None
     try:
         data = yaml.safe_load(text)
+        lines = _yaml_lines(yaml.compose(text)) if data is not None else {}
     except yaml.YAMLError as error:
         where = getattr(error, "problem_mark", None)
         line = f" at line {where.line + 1}" if where is not None else ""
         problem = getattr(error, "problem", None) or "malformed YAML"
         raise ConfigError([f"config: {path}{line}: {problem}"]) from None
-    return make_study(data)
+    return make_plan(data, lines)
+
+
+def load_study(path: Path | str) -> Study:
+    """Read a YAML study that has no sweep axes; raises :class:`ConfigError`."""
+    plan = load_plan(path)
+    if plan.axes:
+        raise ConfigError([f"config: {path} sweeps {', '.join(p for p, _ in plan.axes)}; run it with `foldopt run`"])
+    return plan.base
 
 
 def default_study_path(name: str = DEFAULT_STUDY) -> Path:

@@ -7,6 +7,7 @@ only when the caller asks for it.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import platform
@@ -232,6 +233,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
             run_metadata(
                 result.study,
                 command,
+                input_sha256=input_hash(result.study.model_dump(mode="json")),
                 optimal_fold_angle_deg=result.optimal_fold_angle,
                 # NaN (the load exceeds the flat panel's noon power) is not JSON: null instead.
                 heuristic_fold_angle_deg=(
@@ -249,3 +251,143 @@ def write_reproduction(tables: dict[str, pd.DataFrame], study: Study, out: Path,
             table.to_csv(folder / f"{name}.csv", index=False, float_format=FLOAT_FORMAT)
         _write_json(folder / "run.json", run_metadata(study, command, modes=["paper", "exact"], tables=list(tables)))
     return out
+
+
+# --- Sweeps -------------------------------------------------------------------------------------
+
+
+def _mean_pivot(table: pd.DataFrame, rows: str, columns: str, value: str) -> pd.DataFrame:
+    return table.pivot_table(index=rows, columns=columns, values=value, aggfunc="mean")
+
+
+def _others(table: pd.DataFrame, used: tuple[str, ...], varied: list[str]) -> str:
+    rest = [name for name in varied if name not in used and name != "date"]
+    return f" (mean over {', '.join(rest)})" if rest else ""
+
+
+def plot_map(table: pd.DataFrame, x: str, y: str, value: str, path: Path, title: str, label: str,
+             diverging: bool) -> None:
+    """A heat map of ``value`` over ``x`` and ``y``, averaged over any other varied field."""
+    grid = _mean_pivot(table, y, x, value)
+    fig, ax = plt.subplots(figsize=(8, 5))
+    data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
+    if diverging:
+        bound = max(float(np.nanmax(np.abs(data))) if data.count() else 1.0, 1e-9)
+        mesh = ax.pcolormesh(grid.columns, grid.index, data, cmap="RdBu", vmin=-bound, vmax=bound, shading="nearest")
+    else:
+        mesh = ax.pcolormesh(grid.columns, grid.index, data, cmap="viridis", shading="nearest")
+    ax.set_facecolor("0.85")
+    fig.colorbar(mesh, ax=ax, label=label)
+    ax.set_xlabel(_AXIS_LABELS.get(x, x))
+    ax.set_ylabel(_AXIS_LABELS.get(y, y))
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+_AXIS_LABELS = {
+    "latitude": "latitude [deg]",
+    "p_load_w": "P_load [W]",
+    "day_of_year": "day of year",
+}
+
+
+def plot_curves(table: pd.DataFrame, x: str, path: Path, title: str) -> None:
+    """t_solar of flat, optimal twofold and tracker against ``x``, averaged over the rest."""
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    styles = {"flat": ("k", "-"), "twofold": ("tab:blue", "-"), "tracker": ("0.5", ":")}
+    for design, (colour, line) in styles.items():
+        rows = table[table["design"] == design]
+        curve = rows.groupby(x)["t_solar_h"].mean()
+        ax.plot(curve.index, curve.to_numpy(), color=colour, ls=line, lw=2 if design == "twofold" else 1.5,
+                label="optimal twofold" if design == "twofold" else design)
+    ax.set_xlabel(_AXIS_LABELS.get(x, x))
+    ax.set_ylabel("t_solar [h]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def sweep_plots(table: pd.DataFrame, varied: list[str], folder: Path, name: str) -> list[str]:
+    """Write the plots that the varied fields call for; return their file names."""
+    twofold = table[table["design"] == "twofold"]
+    written = []
+    maps = [("latitude", "p_load_w", "latitude_load"), ("day_of_year", "latitude", "day_latitude")]
+    for x, y, stem in maps:
+        if x in varied and y in varied:
+            other = _others(table, (x, y, "day_of_year"), varied)
+            plot_map(twofold, x, y, "gain_vs_flat_pct", folder / f"gain_map_{stem}.png",
+                     f"{name}: t_solar gain of the optimal twofold panel over flat{other}",
+                     "gain over flat [%] (grey: flat never runs)", diverging=True)
+            plot_map(twofold, x, y, "fold_angle_deg", folder / f"fold_angle_map_{stem}.png",
+                     f"{name}: optimal fold angle{other}", "fold angle Θ [deg] (180 = flat)", diverging=False)
+            written += [f"gain_map_{stem}.png", f"fold_angle_map_{stem}.png"]
+    for x, stem in (("day_of_year", "annual_t_solar"), ("p_load_w", "t_solar_vs_load"), ("latitude", "t_solar_vs_latitude")):
+        if x in varied:
+            plot_curves(table, x, folder / f"{stem}.png",
+                        f"{name}: t_solar of flat, optimal twofold and tracker{_others(table, (x, 'day_of_year'), varied)}")
+            written.append(f"{stem}.png")
+    return written
+
+
+def input_hash(data) -> str:
+    """SHA-256 of the canonical JSON of a study's inputs."""
+    canonical = json.dumps(data, sort_keys=True, default=str, separators=(",", ":"))
+    return hashlib.sha256(canonical.encode()).hexdigest()
+
+
+def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Path:
+    """Write a sweep's folder: ``results.csv`` (a row per case x design), plots and ``run.json``."""
+    plan = result.plan
+    with staged_folder(out, overwrite) as folder:
+        result.table.to_csv(folder / "results.csv", index=False, float_format=FLOAT_FORMAT)
+        plots = sweep_plots(result.table, result.varied, folder, plan.base.name)
+        _write_json(
+            folder / "run.json",
+            run_metadata(
+                plan.base.resolved(),
+                command,
+                axes={path: [str(v) if hasattr(v, "isoformat") else v for v in values] for path, values in plan.axes},
+                cases=plan.n_cases,
+                plots=plots,
+                input_sha256=input_hash({"study": plan.data, "axes": plan.axes}),
+            ),
+        )
+    return out
+
+
+def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, path: Path, title: str) -> None:
+    """Lifetime net benefit against panel area for flat and twofold (Shin et al. Fig. 3a)."""
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for design, colour in (("flat", "k"), ("twofold", "tab:blue")):
+        rows = table[table["design"] == design]
+        ax.plot(rows["area_m2"], rows["net_benefit_usd"], color=colour, label=design)
+        top = best[best["design"] == design].iloc[0]
+        ax.plot(top["area_m2"], top["net_benefit_usd"], "o", color=colour)
+        ax.annotate(f"{top['area_m2']:.3f} m², {top['t_solar_h']:.2f} h", (top["area_m2"], top["net_benefit_usd"]),
+                    textcoords="offset points", xytext=(5, 5), fontsize=8)
+    ax.axhline(0, color="0.6", lw=0.8)
+    ax.set_xlabel("panel area [m²]")
+    ax.set_ylabel("lifetime net benefit [$]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool = False, command=None) -> pd.DataFrame:
+    """Write ``sizing.csv``, ``sizing_best.csv``, the net-benefit plot and ``run.json``; return the best rows."""
+    best = table.loc[table.groupby("design", sort=False)["net_benefit_usd"].idxmax()].reset_index(drop=True)
+    with staged_folder(out, overwrite) as folder:
+        table.to_csv(folder / "sizing.csv", index=False, float_format=FLOAT_FORMAT)
+        best.to_csv(folder / "sizing_best.csv", index=False, float_format=FLOAT_FORMAT)
+        plot_sizing(table, best, folder / "net_benefit_vs_area.png", f"{study.name}: panel sizing (Shin et al. Sec. IV-A)")
+        _write_json(folder / "run.json", run_metadata(study.resolved(), command,
+                                                       input_sha256=input_hash(study.model_dump(mode="json"))))
+    return best

@@ -1,4 +1,4 @@
-"""Panel sizing.
+"""Panel sizing: the flat-area equivalent and Shin et al.'s cost/benefit sizing (Sec. IV-A).
 
 The flat-area equivalent of a design (Shin et al. Sec. VII: "we need about 2.61x larger PV panel
 to achieve the same t_solar with the flat panel") is the factor k by which a flat panel's area
@@ -9,7 +9,10 @@ k follows from one root search for the load.
 
 from __future__ import annotations
 
-from foldopt.metrics import load_for_t_solar
+import numpy as np
+import pandas as pd
+
+from foldopt.metrics import load_for_t_solar, t_solar
 
 
 def flat_area_multiple(p_flat, p_load, target_t_solar, step_hours):
@@ -33,3 +36,73 @@ def flat_area_multiple(p_flat, p_load, target_t_solar, step_hours):
         flat panel's daylight).
     """
     return p_load / load_for_t_solar(p_flat, target_t_solar, step_hours)
+
+
+C_GRID = 0.22  # [$/kWh], Shin et al. Sec. IV-A
+LIFETIME_YEARS = 20  # Shin et al. Sec. IV-A
+
+
+def stc_power_per_area(pv, temp_ref: float = 25.0) -> float:
+    """Rated power per panel area at STC (1000 W/m^2, 25 C) [W/m^2] of a :class:`PVModel`."""
+    return float(np.asarray(pv.max_power(np.array([1000.0]), temp_ref, 1.0))[0])
+
+
+def size_panel(
+    day,
+    areas,
+    cost_per_m2: float | None = None,
+    cost_per_w: float | None = None,
+    c_grid: float = C_GRID,
+    years: float = LIFETIME_YEARS,
+    days_per_year: float = 365.0,
+):
+    """Net benefit of flat and optimally folded twofold panels over a range of areas.
+
+    Shin et al. Sec. IV-A, Eq. 7: the benefit of the panel is the grid energy it replaces,
+    ``B_pv = C_grid * t_solar * P_load``, here per day of the study taken as representative and
+    summed over ``days_per_year`` and ``years``. The cost is per m^2 of panel or per W of STC
+    rating. Power is proportional to area (see the module docstring), so ``t_solar`` at area
+    ``A`` is that of the study's panel against the load ``P_load * A_0 / A``: one pass covers
+    every area and, for the twofold panel, every fold angle of the study's grid.
+
+    Parameters
+    ----------
+    day : foldopt.study.Day
+    areas : array_like
+        Panel areas [m^2].
+    cost_per_m2, cost_per_w : float
+        Panel cost [$ per m^2] or [$ per W at STC]; exactly one.
+    c_grid : float, default 0.22
+        Grid energy price [$/kWh].
+    years, days_per_year : float
+        Lifetime [years] and days counted per year.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per area and design (``flat``, ``twofold``): ``area_m2``, ``fold_angle_deg``,
+        ``t_solar_h``, ``benefit_usd``, ``cost_usd``, ``net_benefit_usd``.
+    """
+    if (cost_per_m2 is None) == (cost_per_w is None):
+        raise ValueError("give exactly one of cost_per_m2 and cost_per_w")
+    study = day.study
+    areas = np.asarray(areas, dtype=float)
+    reference_area = study.panel.area
+    loads = study.p_load * reference_area / areas
+    angles = np.asarray(study.fold_angles.grid())
+    twofold_hours = t_solar(day.combined_power(angles), loads[:, None], day.step_hours)
+    best = twofold_hours.shape[1] - 1 - np.argmax(twofold_hours[:, ::-1], axis=1)
+    hours = {
+        "flat": (np.full(areas.size, 180.0), t_solar(day.flat_power(), loads, day.step_hours)),
+        "twofold": (angles[best], twofold_hours[np.arange(areas.size), best]),
+    }
+    unit_cost = cost_per_m2 if cost_per_m2 is not None else cost_per_w * stc_power_per_area(day.electrical.pv)
+    rows = []
+    for design, (fold, t) in hours.items():
+        benefit = c_grid * t * study.p_load / 1000.0 * days_per_year * years
+        cost = unit_cost * areas
+        rows.append(pd.DataFrame({
+            "design": design, "area_m2": areas, "fold_angle_deg": fold, "t_solar_h": t,
+            "benefit_usd": benefit, "cost_usd": cost, "net_benefit_usd": benefit - cost,
+        }))
+    return pd.concat(rows, ignore_index=True)
