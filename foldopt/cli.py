@@ -304,7 +304,7 @@ def sweep(
     try:
         plan = make_plan(data)
     except ConfigError as error:
-        _fail([_rename_fields(line) for line in error.errors])
+        _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
     if axis == "angle" and plan.axes:
         _fail([f"sweep angle: one site, day and load; {', '.join(p for p, _ in plan.axes)} vary (use sweep latitude/day/load)"])
     try:

@@ -386,15 +386,16 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     if not isinstance(sweep, dict):
         errors.append(_at(lines, ("sweep",), "sweep: expected a mapping of field paths to lists or ranges"))
         sweep = {}
-    specs = {path: (path, value) for path, value in _listed_leaves(data)}
+    # Each axis: dotted field path -> (name in messages, key path in the YAML, its spec).
+    specs = {path: (path, tuple(path.split(".")), value) for path, value in _listed_leaves(data)}
     for path, value in sweep.items():
-        specs[str(path)] = (f"sweep.{path}", value)
+        specs[str(path)] = (f"sweep.{path}", ("sweep", str(path)), value)
     axes = []
-    for path, (source, spec) in specs.items():
+    for path, (source, yaml_path, spec) in specs.items():
         try:
             values = _axis_values(path, spec, year)
         except ValueError as error:
-            errors.append(_at(lines, tuple(source.split(".")), f"{source}: {error}"))
+            errors.append(_at(lines, yaml_path, f"{source}: {error}"))
             continue
         axes.append((path, tuple(values)))
     if errors:
@@ -404,15 +405,37 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     if plan.n_cases > MAX_CASES:
         raise ConfigError([f"sweep: {plan.n_cases} cases exceed the limit of {MAX_CASES}"])
     first = {path: values[0] for path, values in axes}
-    errors += _validation_errors(plan, first, lines, {})
+    labels = {path: (f"{specs[path][0]}[0]", specs[path][1] + (0,)) for path in first}
+    errors += _validation_errors(plan, first, lines, labels)
     for path, values in axes:
-        source = specs[path][0]
+        source, yaml_path, _ = specs[path]
         for index, value in enumerate(values[1:], start=1):
-            where = {path: (f"{source}[{index}]", tuple(source.split(".")) + (index,))}
+            where = {path: (f"{source}[{index}]", yaml_path + (index,))}
             errors += _validation_errors(plan, {**first, path: value}, lines, where)
     if errors:
-        raise ConfigError(list(dict.fromkeys(errors)))
+        raise ConfigError(_collapse(list(dict.fromkeys(errors))))
     return plan
+
+
+_INDEXED = re.compile(r"^(?P<field>[^\[\s]+)\[(?P<index>\d+)\] = (?P<value>.*?): (?P<problem>.*)$")
+
+
+def _collapse(errors: list[str]) -> list[str]:
+    """One line per field and problem: ``p_load[0,2] = -1.0, 0.0: must be ...`` (values cut at 5)."""
+    groups: dict[tuple, list] = {}
+    for error in errors:
+        match = _INDEXED.match(error)
+        key = (match["field"], match["problem"]) if match else (error, None)
+        groups.setdefault(key, []).append(match)
+    lines = []
+    for (field, problem), matches in groups.items():
+        if problem is None:
+            lines.append(field)
+            continue
+        indices = ",".join(m["index"] for m in matches)
+        values = ", ".join(m["value"] for m in matches[:5]) + (", ..." if len(matches) > 5 else "")
+        lines.append(f"{field}[{indices}] = {values}: {problem}")
+    return lines
 
 
 def _validation_errors(plan: Plan, choice: dict, lines: dict, where: dict) -> list[str]:

@@ -293,20 +293,28 @@ _AXIS_LABELS = {
 }
 
 
-def plot_curves(table: pd.DataFrame, x: str, path: Path, title: str) -> None:
-    """t_solar of flat, optimal twofold and tracker against ``x``, averaged over the rest."""
+def plot_curves(table: pd.DataFrame, x: str, path: Path, title: str, split: str | None = None) -> None:
+    """t_solar of flat, optimal twofold and tracker against ``x``.
+
+    With ``split`` (a varied field of at most four values) each value gets its own line style;
+    anything else that varies is averaged.
+    """
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    styles = {"flat": ("k", "-"), "twofold": ("tab:blue", "-"), "tracker": ("0.5", ":")}
-    for design, (colour, line) in styles.items():
-        rows = table[table["design"] == design]
-        curve = rows.groupby(x)["t_solar_h"].mean()
-        ax.plot(curve.index, curve.to_numpy(), color=colour, ls=line, lw=2 if design == "twofold" else 1.5,
-                label="optimal twofold" if design == "twofold" else design)
+    colours = {"flat": "k", "twofold": "tab:blue", "tracker": "0.55"}
+    styles = ["-", "--", ":", "-."]
+    groups = [(None, table)] if split is None else list(table.groupby(split, sort=True))
+    for (value, rows), style in zip(groups, styles, strict=False):
+        for design, colour in colours.items():
+            curve = rows[rows["design"] == design].groupby(x)["t_solar_h"].mean()
+            name = "optimal twofold" if design == "twofold" else design
+            label = name if split is None else f"{name}, {split} {value}"
+            ax.plot(curve.index, curve.to_numpy(), color=colour, ls=style, lw=2 if design == "twofold" else 1.3,
+                    label=label)
     ax.set_xlabel(_AXIS_LABELS.get(x, x))
     ax.set_ylabel("t_solar [h]")
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, ncol=1 if split is None else 2)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -328,8 +336,11 @@ def sweep_plots(table: pd.DataFrame, varied: list[str], folder: Path, name: str)
             written += [f"gain_map_{stem}.png", f"fold_angle_map_{stem}.png"]
     for x, stem in (("day_of_year", "annual_t_solar"), ("p_load_w", "t_solar_vs_load"), ("latitude", "t_solar_vs_latitude")):
         if x in varied:
+            rest = [v for v in varied if v not in (x, "date", "day_of_year")]
+            split = next((v for v in rest if table[v].nunique() <= 4), None)
+            used = (x, "day_of_year") + ((split,) if split else ())
             plot_curves(table, x, folder / f"{stem}.png",
-                        f"{name}: t_solar of flat, optimal twofold and tracker{_others(table, (x, 'day_of_year'), varied)}")
+                        f"{name}: t_solar of flat, optimal twofold and tracker{_others(table, used, varied)}", split)
             written.append(f"{stem}.png")
     return written
 

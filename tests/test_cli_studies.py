@@ -1,0 +1,108 @@
+"""Study files, sweeps, sizing and script output through the command line."""
+
+import json
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from foldopt.cli import app
+
+runner = CliRunner()
+CONFIGS = sorted(Path(__file__).resolve().parent.parent.joinpath("configs").glob("*.yaml"))
+SMALL = ["--lon", "0", "--timezone", "UTC", "--area", "0.1", "--step-min", "15", "--angle-step", "10"]
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def one_line_error(result, *words):
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert all(word in lines[0] for word in words), lines[0]
+
+
+@pytest.mark.parametrize("config", CONFIGS, ids=[c.stem for c in CONFIGS])
+def test_every_shipped_config_runs(tmp_path, config):
+    out = tmp_path / config.stem
+    result = invoke("run", config, "--out", out, "--quiet")
+    assert result.exit_code == 0, result.output
+    names = {p.name for p in out.iterdir()}
+    assert "run.json" in names and ({"summary.csv"} <= names or {"results.csv"} <= names)
+    assert any(name.endswith(".png") for name in names)
+    assert len(json.loads((out / "run.json").read_text())["input_sha256"]) == 64
+
+
+def test_sweep_latitude_makes_the_design_map(tmp_path):
+    out = tmp_path / "map"
+    result = invoke("sweep", "latitude", "--lat", "-40:40:40", "--p-load", "1:9:4", "--days", "2025-03-20",
+                    *SMALL, "--out", out)
+    assert result.exit_code == 0, result.output
+    table = pd.read_csv(out / "results.csv")
+    assert len(table) == 3 * 3 * 3  # latitudes x loads x designs
+    assert {"gain_map_latitude_load.png", "fold_angle_map_latitude_load.png"} <= {p.name for p in out.iterdir()}
+
+
+def test_sweep_day_and_load_and_identical_reruns(tmp_path):
+    out = tmp_path / "days"
+    args = ["sweep", "day", "--lat", "34", "--days", "1:365:120", "--p-load", "3", *SMALL, "--out", out]
+    assert invoke(*args).exit_code == 0
+    first = (out / "results.csv").read_bytes()
+    assert (out / "annual_t_solar.png").exists()
+    assert invoke(*args, "--overwrite").exit_code == 0
+    assert (out / "results.csv").read_bytes() == first
+    out = tmp_path / "loads"
+    result = invoke("sweep", "load", "--lat", "34", "--days", "2025-06-21", "--p-load", "1:10:3", *SMALL, "--out", out)
+    assert result.exit_code == 0, result.output
+    assert (out / "t_solar_vs_load.png").exists()
+
+
+def test_json_output_is_parseable_and_quiet_is_silent(tmp_path):
+    result = invoke("sweep", "load", "--lat", "34", "--days", "2025-06-21", "--p-load", "1:3:1", *SMALL,
+                    "--out", tmp_path / "j", "--format", "json", "--quiet")
+    assert result.exit_code == 0, result.output
+    payload = json.loads(result.stdout)
+    assert len(payload["rows"]) == 9 and {"design", "t_solar_h"} <= set(payload["rows"][0])
+    assert result.stderr == ""
+
+
+def test_size_finds_the_net_benefit_optimum(tmp_path):
+    out = tmp_path / "size"
+    result = invoke("size", "--cost-per-m2", "400", "--areas", "0.02:0.3:0.01", "--out", out)
+    assert result.exit_code == 0, result.output
+    best = pd.read_csv(out / "sizing_best.csv").set_index("design")
+    table = pd.read_csv(out / "sizing.csv")
+    for design in ("flat", "twofold"):
+        rows = table[table.design == design]
+        assert best.loc[design, "net_benefit_usd"] == pytest.approx(rows["net_benefit_usd"].max())
+        # Shin et al. Eq. 7 over 20 years of 365 days at 0.22 $/kWh.
+        row = rows.iloc[5]
+        assert row["benefit_usd"] == pytest.approx(0.22 * row["t_solar_h"] * 4.398 / 1000 * 365 * 20)
+    assert (out / "net_benefit_vs_area.png").exists()
+
+
+@pytest.mark.parametrize(
+    "args,words",
+    [
+        (["sweep", "latitude", "--lat", "10:0:5", "--p-load", "2", "--days", "2025-03-20"], ["--lat", "empty range"]),
+        (["sweep", "latitude", "--lat", "-95:0:5", "--p-load", "2", "--days", "2025-03-20"], ["--lat[0]", "[-90, 90]"]),
+        (["sweep", "load", "--lat", "10", "--p-load", "-2:4:1", "--days", "2025-03-20"], ["--p-load[0,1,2] = -2.0, -1.0, 0.0", "(0, 1e+06]"]),
+        (["sweep", "load", "--lat", "10", "--p-load", "3", "--days", "2025-03-20"], ["--p-load", "range"]),
+        (["sweep", "day", "--lat", "10", "--p-load", "2", "--days", "300:20:7"], ["--days/--date", "empty range"]),
+        (["sweep", "angle", "--lat", "10", "--p-load", "2", "--days", "2025-03-20", "--angle-step", "200"],
+         ["--angle-step", "(0, 180]"]),
+        (["sweep", "tilt", "--lat", "10"], ["axis", "angle, latitude, day, load"]),
+        (["size", "--areas", "0.1:0.5:0.1"], ["--cost-per-m2 / --cost-per-w"]),
+        (["size", "--cost-per-w", "-1"], ["--cost-per-w", "> 0"]),
+        (["size", "--cost-per-m2", "100", "--areas", "0.5:0.1:0.1"], ["--areas", "empty range"]),
+        (["run", "--format", "xml"], ["--format", "table, json"]),
+    ],
+)
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, words):
+    out = tmp_path / "out"
+    extra = [] if args[0] in ("run", "size") or args[1] == "tilt" else SMALL
+    one_line_error(invoke(*args[:2], *extra, *args[2:], "--out", out), *words)
+    assert not out.exists()

@@ -1,0 +1,85 @@
+"""Study files with sweep axes: ranges, lists, dates, and every error at once with its line."""
+
+import datetime as dt
+
+import pytest
+
+from foldopt.config import ConfigError, load_plan, make_plan, parse_dates, parse_range
+
+BASE = {"name": "t", "site": {"latitude": 10, "longitude": 0}, "date": "2025-03-20",
+        "panel": {"area": 0.1}, "p_load": 2.0}
+
+
+def test_ranges_are_inclusive_and_reject_empty_or_bad_steps():
+    assert parse_range("-60:60:30") == [-60, -30, 0, 30, 60]
+    assert parse_range("1:2:0.4") == [1.0, 1.4, 1.8]
+    for bad in ("5:1:1", "1:5:0", "1:5:-1", "a:b:c", "1:5"):
+        with pytest.raises(ValueError):
+            parse_range(bad)
+
+
+def test_date_specs():
+    assert parse_dates("equinoxes-solstices", 2025) == [dt.date(2025, 3, 20), dt.date(2025, 6, 21),
+                                                        dt.date(2025, 9, 23), dt.date(2025, 12, 21)]
+    assert len(parse_dates("year", 2024)) == 366
+    assert parse_dates("1:365:91", 2025) == [dt.date(2025, 1, 1), dt.date(2025, 4, 2), dt.date(2025, 7, 2),
+                                             dt.date(2025, 10, 1), dt.date(2025, 12, 31)]
+    assert parse_dates("2025-01-30:2025-02-02:1", 2025)[-1] == dt.date(2025, 2, 2)
+    assert parse_dates([dt.date(2025, 1, 1), "2025-02-01", 60], 2025)[2] == dt.date(2025, 3, 1)
+    with pytest.raises(ValueError, match="outside 2025"):
+        parse_dates([366], 2025)
+
+
+def test_axes_from_lists_ranges_and_the_sweep_section():
+    plan = make_plan({**BASE, "site": {"latitude": "-10:10:10", "longitude": 0}, "p_load": [1, 2],
+                      "date": "equinoxes-solstices", "sweep": {"panel.tilt": [0, 45], "geometry": ["hinge"]}})
+    assert dict(plan.axes)["site.latitude"] == (-10.0, 0.0, 10.0)
+    assert plan.n_cases == 3 * 2 * 4 * 2 * 1
+    cases = list(plan.cases())
+    assert len(cases) == plan.n_cases
+    assert {study.panel.tilt for _, study in cases} == {0.0, 45.0}
+    # A list of sites is one axis of whole sites; time zones with a colon are not ranges.
+    plan = make_plan({**BASE, "site": [{"latitude": 1, "longitude": 2, "timezone": "UTC-08:00"},
+                                       {"name": "b", "latitude": -3, "longitude": 4}]})
+    assert [s.site.name for _, s in plan.cases()] == [None, "b"]
+
+
+def test_all_errors_at_once_with_their_yaml_lines(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text(
+        "name: t\n"
+        "site:\n"
+        "  latitude: [10, 95]\n"
+        "  longitude: 0\n"
+        "date: 2025-03-20\n"
+        "panel: {area: 0.1, colour: red}\n"
+        "p_load: '5:1:1'\n"
+        "sweep:\n"
+        "  panel.tilt: [10, 120]\n"
+    )
+    with pytest.raises(ConfigError) as caught:
+        load_plan(path)
+    errors = caught.value.errors
+    assert any(e.startswith("p_load: empty range") and e.endswith("(line 7)") for e in errors), errors
+    # Range errors stop before validation; fix the range and the rest appear together.
+    path.write_text(path.read_text().replace("'5:1:1'", "'1:5:1'"))
+    with pytest.raises(ConfigError) as caught:
+        load_plan(path)
+    errors = caught.value.errors
+    assert "site.latitude[1] = 95: must be in [-90, 90] deg (line 3)" in errors
+    assert "panel.colour: unknown field (line 6)" in errors
+    assert "sweep.panel.tilt[1] = 120: must be in [0, 90] deg (line 9)" in errors
+    assert len(errors) == 3
+
+
+def test_wrong_types_and_limits():
+    with pytest.raises(ConfigError, match="site.latitude"):
+        make_plan({**BASE, "site": {"latitude": "north", "longitude": 0}})
+    with pytest.raises(ConfigError, match="year"):
+        make_plan({**BASE, "year": 1800})
+    with pytest.raises(ConfigError, match="sweep: expected a mapping"):
+        make_plan({**BASE, "sweep": [1, 2]})
+    with pytest.raises(ConfigError, match="empty list"):
+        make_plan({**BASE, "p_load": []})
+    with pytest.raises(ConfigError, match="exceed the limit"):
+        make_plan({**BASE, "site": {"latitude": "-90:90:0.001", "longitude": "-180:180:0.01"}})
