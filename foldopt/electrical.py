@@ -130,8 +130,11 @@ class Electrical:
         with np.errstate(invalid="ignore", divide="ignore"):
             weak_ratio = np.where(strong > 0, np.minimum(east, west) / strong, 1.0)
         bound = p_east + p_west
-        p_parallel = np.clip(parallel(np.stack([east, west], axis=-1)), 0.0, 1.0) * bound
-        p_series = np.clip(series(np.stack([strong, weak_ratio], axis=-1)), 0.0, 1.0) * bound
+        # Identical sub-panels at equal irradiance (a flat fold, or noon) deliver exactly their sum
+        # in parallel and in series; interpolation across the table's diagonal would not.
+        equal = east == west
+        p_parallel = np.where(equal, 1.0, np.clip(parallel(np.stack([east, west], axis=-1)), 0.0, 1.0)) * bound
+        p_series = np.where(equal, 1.0, np.clip(series(np.stack([strong, weak_ratio], axis=-1)), 0.0, 1.0)) * bound
         if self.bypass:
             p_series = np.maximum(p_series, np.maximum(p_east, p_west))
         return connection_powers(p_east, p_west, p_parallel, p_series, **self._options)
