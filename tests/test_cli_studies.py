@@ -99,6 +99,8 @@ def test_size_finds_the_net_benefit_optimum(tmp_path):
         (["size", "--cost-per-w", "-1"], ["--cost-per-w", "> 0"]),
         (["size", "--cost-per-m2", "100", "--areas", "0.5:0.1:0.1"], ["--areas", "empty range"]),
         (["run", "--format", "xml"], ["--format", "table, json"]),
+        (["size", "no-such-study.yaml", "--cost-per-m2", "100"], ["config", "not found"]),
+        (["run", "configs/design-map.yaml", "--format", "json", "--p-load", "2"], ["No such option"]),
     ],
 )
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, words):
