@@ -173,7 +173,9 @@ class IVCurve:
     def voltage(self, current):
         """Voltage [V] at ``current`` [A]; NaN or negative beyond short circuit."""
         if self.model == "single-diode":
-            return pvlib.pvsystem.v_from_i(current, *self._params(current))
+            # pvlib's Lambert-W overflows for practically dark cells; `lit` handles those.
+            with np.errstate(over="ignore", invalid="ignore"):
+                return pvlib.pvsystem.v_from_i(current, *self._params(current))
         v_x, i_x, b = self._params(current)
         scale = i_x / -np.expm1(-1.0 / b)
         with np.errstate(divide="ignore", invalid="ignore"):
