@@ -10,6 +10,11 @@ References
    the exponent 0.678 as "0.076").
 .. [3] E. G. Laue, "The measurement of solar spectral irradiance at different terrestrial
    elevations", Solar Energy 13, 43-57, 1970; altitude term a*h with a = 0.14 /km, via PVEducation.
+.. [4] H. C. Hottel, "A simple model for estimating the transmittance of direct solar radiation
+   through clear atmospheres", Solar Energy 18, 129-134, 1976; as given by J. A. Duffie,
+   W. A. Beckman, "Solar Engineering of Thermal Processes", Sec. 2.8, Eq. 2.8.1 and Table 2.8.1.
+   Robles Algarin et al. Eq. 4-7 quote it with OCR damage: a1* has "+ 0.00595 (6.5 - A)^2" and k*
+   "+ 0.01858 (2.5 - A)^2" (the seed text reads "- 0.005958 (6 - A)^2" and "- 0.01858").
 """
 
 from __future__ import annotations
@@ -17,7 +22,15 @@ from __future__ import annotations
 import numpy as np
 import pvlib
 
-SKY_MODELS = ("meinel",)
+SKY_MODELS = ("meinel", "hottel")
+#: Hottel's climate corrections (r0, r1, rk) of a0, a1 and k, Duffie & Beckman Table 2.8.1.
+HOTTEL_CLIMATES = {
+    "tropical": (0.95, 0.98, 1.02),
+    "midlatitude-summer": (0.97, 0.99, 1.02),
+    "subarctic-summer": (0.99, 0.99, 1.01),
+    "midlatitude-winter": (1.03, 1.01, 1.00),
+}
+SOLAR_CONSTANT_HOTTEL = 1367.0  # [W/m^2], Duffie & Beckman
 
 SOLAR_CONSTANT_MEINEL = 1353.0  # [W/m^2], the constant of Meinel & Meinel [2]
 LAUE_ALTITUDE_COEFFICIENT = 0.14  # [1/km], [3]
@@ -63,7 +76,49 @@ def beam_meinel(airmass, altitude=0.0):
     return np.where(np.isfinite(airmass), SOLAR_CONSTANT_MEINEL * transmitted, 0.0)
 
 
-def clear_sky_dni(solar_zenith, altitude=0.0, model="meinel"):
+def hottel_transmittance(solar_zenith, altitude=0.0, climate="midlatitude-summer"):
+    """Clear-sky beam transmittance of Hottel (1976) [4]_, 23 km visibility standard atmosphere.
+
+    ``tau_b = a0 + a1 exp(-k / cos(zenith))`` with ``a0* = 0.4237 - 0.00821 (6 - A)^2``,
+    ``a1* = 0.5055 + 0.00595 (6.5 - A)^2``, ``k* = 0.2711 + 0.01858 (2.5 - A)^2`` (A: altitude in
+    km, below 2.5 km) times the climate corrections of :data:`HOTTEL_CLIMATES`.
+
+    Parameters
+    ----------
+    solar_zenith : array_like
+        [deg].
+    altitude : float
+        [m], at most 2500.
+    climate : str
+        One of :data:`HOTTEL_CLIMATES`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Transmittance [-]; 0 with the sun below the horizon.
+    """
+    if climate not in HOTTEL_CLIMATES:
+        raise ValueError(f"climate must be one of {', '.join(HOTTEL_CLIMATES)}; got {climate!r}")
+    r0, r1, rk = HOTTEL_CLIMATES[climate]
+    km = altitude / 1000.0
+    a0 = r0 * (0.4237 - 0.00821 * (6.0 - km) ** 2)
+    a1 = r1 * (0.5055 + 0.00595 * (6.5 - km) ** 2)
+    k = rk * (0.2711 + 0.01858 * (2.5 - km) ** 2)
+    cos_zenith = np.cos(np.radians(np.asarray(solar_zenith, dtype=float)))
+    with np.errstate(divide="ignore", over="ignore"):
+        tau = a0 + a1 * np.exp(-k / cos_zenith)
+    return np.where(cos_zenith > 0, tau, 0.0)
+
+
+def extraterrestrial_normal(dayofyear):
+    """Extraterrestrial normal irradiance [W/m^2], Duffie & Beckman Eq. 1.4.1a (pvlib ``asce``)."""
+    return np.asarray(
+        pvlib.irradiance.get_extra_radiation(np.asarray(dayofyear), solar_constant=SOLAR_CONSTANT_HOTTEL, method="asce"),
+        dtype=float,
+    )
+
+
+def clear_sky_dni(solar_zenith, altitude=0.0, model="meinel", dayofyear=None, climate="midlatitude-summer"):
     """Clear-sky direct normal irradiance [W/m^2], zero with the sun below the horizon.
 
     Parameters
@@ -72,9 +127,12 @@ def clear_sky_dni(solar_zenith, altitude=0.0, model="meinel"):
         [deg].
     altitude : float, default 0
         Site altitude [m].
-    model : {'meinel'}
-        Sky model.
+    model : {'meinel', 'hottel'}
+        Sky model. ``hottel`` needs ``dayofyear`` (for the extraterrestrial irradiance) and
+        takes ``climate``.
     """
     if model == "meinel":
         return beam_meinel(relative_airmass(solar_zenith), altitude)
+    if model == "hottel":
+        return extraterrestrial_normal(dayofyear) * hottel_transmittance(solar_zenith, altitude, climate)
     raise ValueError(f"sky must be one of {', '.join(SKY_MODELS)}; got {model!r}")

@@ -150,6 +150,9 @@ def _run_plan(plan, out: Path, overwrite: bool, quiet: bool, output_format: str)
         title = (f"{study.name} ({study.mode} mode, {study.geometry}, {study.pv_model} + {study.connection}, "
                  f"P_load {study.p_load:g} W)")
         _emit(result.summary, title, output_format, out, SUMMARY_COLUMNS)
+        if output_format == "table" and np.isfinite(result.standby[1]):
+            typer.echo(f"the optimal twofold panel outlasts the {study.tracker.model} tracker once the tracker's "
+                       f"standby draw exceeds {result.standby[1]:.2f} W")
         return
     with _Status(f"foldopt: {base.name}, {plan.n_cases} cases", quiet).running() as status:
         result = run_plan(plan, status.progress)

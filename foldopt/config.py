@@ -30,11 +30,11 @@ from pydantic import (
 )
 
 from foldopt.aggregation import CONNECTIONS
-from foldopt.atmosphere import SKY_MODELS
+from foldopt.atmosphere import HOTTEL_CLIMATES, SKY_MODELS
 from foldopt.geometry import GEOMETRIES, default_orientation
 from foldopt.pvmodel import PV_MODELS, TEMPERATURE_MODELS, cec_module
 from foldopt.solarposition import MODES
-from foldopt.tracker import TRACKERS
+from foldopt.tracker import ALEXANDRU_STEP_OFFSETS_H, DRIVES, TRACKERS
 
 DEFAULT_STUDY = "shin2015"
 _OFFSET = re.compile(r"^(?:UTC)?([+-])(\d{1,2})(?::?(\d{2}))?$")
@@ -114,6 +114,32 @@ class Panel(_Strict):
     )
 
 
+class Tracker(_Strict):
+    """The tracker compared against, and the energy it spends (see :mod:`foldopt.tracker`)."""
+
+    model: Literal[TRACKERS] = "dual-axis"
+    steps: Annotated[int, Field(ge=2, le=200, multiple_of=2)] = 12
+    angular_field: _interval(0, 360, lo_open=True, unit=" deg") = 90.0
+    step_offsets_h: list[_interval(0, 12, lo_open=True, hi_open=True, unit=" h")] | None = Field(
+        None, description="afternoon move times from solar noon; default Alexandru's 12-step law"
+    )
+    axis_tilt: _interval(0, 90, unit=" deg") = 0.0
+    axis_azimuth: _interval(0, 360, hi_open=True, unit=" deg") | None = None
+    max_angle: _interval(0, 90, lo_open=True, unit=" deg") = 90.0
+    backtrack: bool = False
+    gcr: _interval(0, 1, lo_open=True) = 0.35
+    standby_w: _interval(0, 1000, unit=" W") = 0.0
+    drive: Literal[DRIVES] = "motor"
+    wh_per_degree: _interval(0, 10, unit=" Wh/deg") = 0.0
+
+    @model_validator(mode="after")
+    def _offsets_match_steps(self):
+        offsets = self.step_offsets_h if self.step_offsets_h is not None else ALEXANDRU_STEP_OFFSETS_H
+        if len(offsets) * 2 != self.steps:
+            raise ValueError(f"steps ({self.steps}) must be twice the number of step_offsets_h ({len(offsets)})")
+        return self
+
+
 class FoldAngles(_Strict):
     start: _interval(0, 180, lo_open=True, unit=" deg") = 1.0
     stop: _interval(0, 180, lo_open=True, unit=" deg") = 180.0
@@ -157,8 +183,14 @@ class Study(_Strict):
     temp_air: _interval(-60, 60, unit=" C") = 25.0
     wind_speed: _interval(0, 60, unit=" m/s") = 1.0
     exact_electrical: bool = Field(False, description="solve every step's I-V curves, not tables")
-    tracker: Literal[TRACKERS] = "dual-axis"
+    tracker: Tracker = Tracker()
+    climate: Literal[tuple(HOTTEL_CLIMATES)] = Field("midlatitude-summer", description="Hottel sky only")
     step_min: Annotated[_interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)] = 1.0
+
+    @field_validator("tracker", mode="before")
+    @classmethod
+    def _tracker_by_name(cls, value):
+        return {"model": value} if isinstance(value, str) else value
 
     @field_validator("module")
     @classmethod
@@ -168,6 +200,10 @@ class Study(_Strict):
                 raise ValueError("module is only used with pv_model single-diode")
             cec_module(module)
         return module
+
+    def variant(self, **changes) -> Study:
+        """A validated copy with ``changes`` (field names to new values, mappings allowed)."""
+        return Study.model_validate({**self.model_dump(), **changes})
 
     def resolved(self) -> Study:
         """The study with every default that depends on other fields (site, mode) filled in.

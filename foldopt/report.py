@@ -197,22 +197,46 @@ def plot_t_solar_vs_fold_angle(result: StudyResult, path: Path) -> None:
 
 
 def plot_comparison(result: StudyResult, path: Path) -> None:
-    """t_solar of flat, optimal twofold and tracker (Shin et al. Fig. 12b)."""
-    summary = result.summary.set_index("design").loc[["flat", "twofold", "tracker"]]
-    labels = ["flat", f"twofold {summary.loc['twofold', 'fold_angle_deg']:.1f}°", "ideal tracker"]
-    fig, ax = plt.subplots(figsize=(6, 4.5))
-    bars = ax.bar(labels, summary["t_solar_h"], color=["0.3", "tab:blue", "0.7"])
-    for bar, hours, share in zip(bars, summary["t_solar_h"], summary["pct_of_tracker_t_solar"], strict=True):
-        ax.annotate(
-            f"{hours:.2f} h\n{share:.1f} % of tracker",
-            (bar.get_x() + bar.get_width() / 2, bar.get_height()),
-            ha="center",
-            va="bottom",
-            fontsize=8,
-        )
+    """t_solar of flat, optimal twofold and every tracker, gross and net (Shin et al. Fig. 12b)."""
+    summary = result.summary.set_index("design")
+    names = ["flat", "twofold"] + [d for d in summary.index if d.startswith("tracker") and not d.endswith("-net")]
+    labels = ["flat", f"twofold\n{summary.loc['twofold', 'fold_angle_deg']:.1f}°"] + [
+        (result.study.tracker.model if d == "tracker" else d.split(":", 1)[1]).replace("-", "-\n", 1)
+        for d in names[2:]
+    ]
+    x = np.arange(len(names))
+    gross = summary.loc[names, "t_solar_h"].to_numpy()
+    net = np.array([summary.loc[f"{d}-net", "t_solar_h"] if f"{d}-net" in summary.index else np.nan for d in names])
+    fig, ax = plt.subplots(figsize=(max(6, 1.1 * len(names) + 2), 4.5))
+    colours = ["0.3", "tab:blue"] + ["0.7"] * (len(names) - 2)
+    ax.bar(x, gross, color=colours, label="gross")
+    ax.bar(x[2:], net[2:], width=0.45, color="tab:orange", label="net of the tracker's own draw")
+    for xi, hours in zip(x, gross, strict=True):
+        ax.annotate(f"{hours:.2f} h", (xi, hours), ha="center", va="bottom", fontsize=8)
+    ax.set_xticks(x, labels, fontsize=8)
     ax.set_ylabel("t_solar [h]")
-    ax.set_ylim(0, max(summary["t_solar_h"].max() * 1.2, 1))
+    ax.set_ylim(0, max(gross.max() * 1.2, 1))
+    ax.legend(fontsize=8, loc="lower right")
     ax.set_title(f"{result.study.name}: {_mode_label(result.study)}", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_standby(result: StudyResult, path: Path) -> None:
+    """The tracker's net t_solar against its standby draw, and where twofold overtakes it."""
+    table, break_even = result.standby
+    study = result.study
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.plot(table["standby_w"], table["tracker_net_t_solar_h"], color="0.4", label=f"{study.tracker.model} tracker, net")
+    ax.axhline(table["twofold_t_solar_h"].iloc[0], color="tab:blue", label="optimal twofold (draws nothing)")
+    if np.isfinite(break_even):
+        ax.axvline(break_even, color="tab:red", ls="--", lw=1, label=f"break-even {break_even:.2f} W")
+    ax.set_xlabel("tracker standby draw [W]")
+    ax.set_ylabel("t_solar [h]")
+    ax.set_title(f"{study.name}: when does the tracker's own draw hand the day to the twofold panel?", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -228,6 +252,8 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
         plot_t_solar_vs_fold_angle(result, folder / "t_solar_vs_fold_angle.png")
         plot_comparison(result, folder / "comparison.png")
         plot_switching(result, folder / "switching.png")
+        plot_standby(result, folder / "tracker_standby.png")
+        result.standby[0].to_csv(folder / "tracker_standby.csv", index=False, float_format=FLOAT_FORMAT)
         _write_json(
             folder / "run.json",
             run_metadata(
@@ -235,6 +261,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
                 command,
                 input_sha256=input_hash(result.study.model_dump(mode="json")),
                 optimal_fold_angle_deg=result.optimal_fold_angle,
+                tracker_break_even_standby_w=result.standby[1] if np.isfinite(result.standby[1]) else None,
                 # NaN (the load exceeds the flat panel's noon power) is not JSON: null instead.
                 heuristic_fold_angle_deg=(
                     result.heuristic_fold_angle if np.isfinite(result.heuristic_fold_angle) else None

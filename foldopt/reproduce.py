@@ -37,7 +37,7 @@ REPRODUCTIONS = {
 
 def infer_p_load(study: Study, flat_t_solar_h: float = PAPER_VALUES["flat_t_solar_h"][1]) -> float:
     """Load [W] at which the study's flat panel, in paper mode, runs ``flat_t_solar_h`` hours."""
-    day = Day(study.model_copy(update={"mode": "paper"}))
+    day = Day(study.variant(mode="paper"))
     return load_for_t_solar(day.flat_power(), flat_t_solar_h, day.step_hours)
 
 
@@ -76,11 +76,11 @@ def reproduce(study: Study, **changes) -> pd.DataFrame:
     pandas.DataFrame
         Columns ``quantity, unit, paper, paper_mode, exact_mode``.
     """
-    study = study.model_copy(update=changes)
+    study = study.variant(**changes)
     p_load = infer_p_load(study)
     columns = {}
     for mode, geometry in GEOMETRY_OF_MODE.items():
-        variant = study.model_copy(update={"mode": mode, "geometry": geometry, "p_load": p_load})
+        variant = study.variant(mode=mode, geometry=geometry, p_load=p_load)
         columns[f"{mode}_mode"] = reproduction_values(variant)
     return pd.DataFrame(
         [

@@ -167,15 +167,25 @@ def get_solar_position(
     Returns
     -------
     pandas.DataFrame
-        Columns ``solar_zenith``, ``solar_azimuth`` [deg], indexed by ``times``.
+        Columns ``solar_zenith``, ``solar_azimuth``, and the equatorial coordinates
+        ``hour_angle`` and ``declination`` [deg] that trackers steer by, indexed by ``times``.
+        In exact mode these come from pvlib (``hour_angle`` with SPA's equation of time,
+        ``declination_spencer71``).
     """
     if model == "paper":
-        zenith, azimuth = sun_from_angles(
-            declination_paper(times.day_of_year), hour_angle_paper(times, longitude), latitude
-        )
+        declination = declination_paper(times.day_of_year)
+        hour_angle = hour_angle_paper(times, longitude)
+        zenith, azimuth = sun_from_angles(declination, hour_angle, latitude)
     elif model == "exact":
         spa = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude=altitude)
         zenith, azimuth = spa["apparent_zenith"].to_numpy(), spa["azimuth"].to_numpy()
+        hour_angle = pvlib.solarposition.hour_angle(times, longitude, spa["equation_of_time"].to_numpy())
+        hour_angle = (np.asarray(hour_angle) + 180.0) % 360.0 - 180.0
+        declination = np.degrees(pvlib.solarposition.declination_spencer71(times.day_of_year))
     else:
         raise ValueError(f"model must be one of {', '.join(MODES)}; got {model!r}")
-    return pd.DataFrame({"solar_zenith": zenith, "solar_azimuth": azimuth}, index=times)
+    return pd.DataFrame(
+        {"solar_zenith": zenith, "solar_azimuth": azimuth, "hour_angle": hour_angle,
+         "declination": np.broadcast_to(declination, np.shape(zenith))},
+        index=times,
+    )

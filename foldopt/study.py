@@ -19,12 +19,12 @@ from foldopt.config import Study, parse_timezone
 from foldopt.electrical import Electrical
 from foldopt.geometry import subpanel_orientation
 from foldopt.irradiance import beam_incidence_factor
-from foldopt.metrics import daily_metrics, t_solar
+from foldopt.metrics import daily_metrics, load_for_t_solar, t_solar
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.pvmodel import PVModel
 from foldopt.sizing import flat_area_multiple
 from foldopt.solarposition import day_times, get_solar_position
-from foldopt.tracker import tracker_incidence_factor
+from foldopt.tracker import TRACKERS, TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
 
 
 class Day:
@@ -44,8 +44,12 @@ class Day:
         sun = get_solar_position(self.times, site.latitude, site.longitude, site.altitude, study.mode)
         self.solar_zenith = sun["solar_zenith"].to_numpy()
         self.solar_azimuth = sun["solar_azimuth"].to_numpy()
+        self.hour_angle = sun["hour_angle"].to_numpy()
+        self.declination = sun["declination"].to_numpy()
         altitude = site.altitude if study.mode == "exact" else 0.0
-        self.dni = clear_sky_dni(self.solar_zenith, altitude, study.sky)
+        self.dni = clear_sky_dni(
+            self.solar_zenith, altitude, study.sky, dayofyear=self.times.day_of_year, climate=study.climate
+        )
         # Days of one study share its electrical tables: pass the first day's to the next.
         self.electrical = electrical or Electrical(
             pv=PVModel(study.pv_model, panel.efficiency, study.module),
@@ -59,14 +63,13 @@ class Day:
             exact=study.exact_electrical,
         )
 
-    def _poa(self, surface_tilt, surface_azimuth):
-        factor = beam_incidence_factor(
-            np.asarray(surface_tilt)[..., None],
-            np.asarray(surface_azimuth)[..., None],
-            self.solar_zenith,
-            self.solar_azimuth,
-            model=self.study.mode,
-        )
+    def _poa(self, surface_tilt, surface_azimuth, per_step=False):
+        """Beam on surfaces [W/m^2]: one orientation per fold angle, (k, n_time), or, with
+        ``per_step``, one per time step (a tracker), (n_time,)."""
+        tilt, azimuth = np.asarray(surface_tilt), np.asarray(surface_azimuth)
+        if not per_step:
+            tilt, azimuth = tilt[..., None], azimuth[..., None]
+        factor = beam_incidence_factor(tilt, azimuth, self.solar_zenith, self.solar_azimuth, model=self.study.mode)
         return self.dni * factor
 
     def flat_power(self):
@@ -74,10 +77,29 @@ class Day:
         panel = self.study.panel
         return self.electrical.panel_power(self._poa(panel.tilt, panel.azimuth), panel.area)
 
-    def tracker_power(self):
-        """Power of the same panel on the tracker [W], shape (n_time,)."""
-        poa = self.dni * tracker_incidence_factor(self.solar_zenith, self.study.tracker)
-        return self.electrical.panel_power(poa, self.study.panel.area)
+    def tracker_orientation(self, model=None):
+        """Surface tilt and azimuth of a tracker over the day [deg] (default: the study's)."""
+        tracker = self.study.tracker
+        options = TrackerOptions(
+            steps=tracker.steps, angular_field=tracker.angular_field,
+            step_offsets_h=tuple(tracker.step_offsets_h or TrackerOptions().step_offsets_h),
+            axis_tilt=tracker.axis_tilt, axis_azimuth=tracker.axis_azimuth, max_angle=tracker.max_angle,
+            backtrack=tracker.backtrack, gcr=tracker.gcr,
+        )
+        return tracker_orientation(
+            model or tracker.model, self.solar_zenith, self.solar_azimuth, self.hour_angle, self.declination,
+            self.study.site.latitude, options,
+        )
+
+    def tracker_power(self, model=None):
+        """Power of the same panel on a tracker [W], shape (n_time,) (default: the study's)."""
+        return self.electrical.panel_power(self._poa(*self.tracker_orientation(model), per_step=True), self.study.panel.area)
+
+    def tracker_draw(self, model=None):
+        """The tracker's own draw [W] per step: standby while the sun is up, plus its moves."""
+        tracker = self.study.tracker
+        drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
+        return tracker_draw(*self.tracker_orientation(model), self.dni > 0, self.step_hours, drive)
 
     def connections(self, fold_angles):
         """Every connection's power [W], each (k, n_time), and the switching state per step."""
@@ -108,6 +130,7 @@ class StudyResult:
     timeseries: pd.DataFrame
     optimal_fold_angle: float
     heuristic_fold_angle: float
+    standby: tuple  # (table, break-even standby draw [W]) of :func:`standby_sweep`
 
 
 def _best_angle(day: Day, angles, sweep_t_solar, connection):
@@ -153,15 +176,21 @@ def run_study(study: Study) -> StudyResult:
             if connection != study.connection:
                 angle = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection)
                 designs[f"twofold-{connection}"] = (angle, day.combined_power(np.array([angle]), connection)[0])
-    designs["tracker"] = (np.nan, p_tracker)
+    # The study's tracker is "tracker"; every other model follows as "tracker:<model>". Each net row
+    # is what is left for the load after the tracker's own draw.
+    for model in (study.tracker.model,) + tuple(m for m in TRACKERS if m != study.tracker.model):
+        name = "tracker" if model == study.tracker.model else f"tracker:{model}"
+        gross = p_tracker if model == study.tracker.model else day.tracker_power(model)
+        designs[name] = (np.nan, gross)
+        designs[f"{name}-net"] = (np.nan, gross - day.tracker_draw(model))
 
     rows = []
     for design, (angle, power) in designs.items():
         metrics = {key: float(value) for key, value in daily_metrics(power, p_load, step).items()}
         rows.append({"design": design, "fold_angle_deg": angle, **metrics})
     summary = pd.DataFrame(rows)
-    flat_hours = summary.loc[0, "t_solar_h"]
-    tracker_hours = summary["t_solar_h"].iloc[-1]
+    by_design = summary.set_index("design")["t_solar_h"]
+    flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     with np.errstate(divide="ignore", invalid="ignore"):
         summary["gain_vs_flat_pct"] = (summary["t_solar_h"] / flat_hours - 1.0) * 100.0
         summary["pct_of_tracker_t_solar"] = summary["t_solar_h"] / tracker_hours * 100.0
@@ -169,6 +198,7 @@ def run_study(study: Study) -> StudyResult:
         flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 else np.nan
         for hours in summary["t_solar_h"]
     ]
+    standby = standby_sweep(day, p_tracker, by_design["twofold"])
 
     at_best, state = day.connections(np.array([best_angle]))
     timeseries = pd.DataFrame(
@@ -185,7 +215,33 @@ def run_study(study: Study) -> StudyResult:
             "p_load_w": p_load,
         }
     )
-    return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle)
+    return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby)
+
+
+def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):
+    """The study's tracker's net ``t_solar`` as its standby draw grows, and the break-even draw.
+
+    A standby draw ``s`` while the sun is up leaves the load ``P_pv - drive - s``; over daylight
+    that is the gross curve less its drive against the load ``P_load + s``, so every draw is one
+    load of a single ``t_solar`` pass, and the break-even draw, where the tracker's net time falls
+    to the optimal twofold panel's, is one root search for the load.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        ``standby_w``, ``tracker_net_t_solar_h``, ``twofold_t_solar_h``.
+    break_even_w : float
+        Standby draw [W] above which the twofold panel runs longer; NaN if it never does.
+    """
+    study, step = day.study, day.step_hours
+    drive_only = day.tracker_draw() - np.where(day.dni > 0, study.tracker.standby_w, 0.0)
+    available = np.where(day.dni > 0, p_tracker - drive_only, 0.0)
+    draws = np.linspace(0.0, max(2.0 * study.p_load, 1e-3), points)
+    hours = t_solar(available, study.p_load + draws, step)
+    load = load_for_t_solar(available, twofold_t_solar, step) if twofold_t_solar > 0 else np.nan
+    break_even = max(load - study.p_load, 0.0) if np.isfinite(load) else float("nan")
+    table = pd.DataFrame({"standby_w": draws, "tracker_net_t_solar_h": hours, "twofold_t_solar_h": twofold_t_solar})
+    return table, break_even
 
 
 def twofold_t_solar(day: Day, fold_angle: float, connection=None) -> float:

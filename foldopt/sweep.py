@@ -19,7 +19,7 @@ from foldopt.config import Plan
 from foldopt.metrics import daily_metrics, t_solar
 from foldopt.study import Day
 
-DESIGNS = ("flat", "twofold", "tracker")
+DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
 _LOAD_CHUNK_VALUES = 4_000_000  # floats per t_solar pass, to bound memory
 
 
@@ -57,10 +57,15 @@ def _day_rows(day: Day, loads: np.ndarray, case: dict) -> list[dict]:
         [t_solar(power, loads[i : i + chunk, None], step) for i in range(0, loads.size, chunk)]
     )
     best = _best_angle_index(hours)
+    p_tracker = day.tracker_power()
     curves = {
         "flat": (np.full(loads.size, 180.0), np.broadcast_to(day.flat_power(), (loads.size, power.shape[1]))),
         "twofold": (angles[best], power[best]),
-        "tracker": (np.full(loads.size, np.nan), np.broadcast_to(day.tracker_power(), (loads.size, power.shape[1]))),
+        "tracker": (np.full(loads.size, np.nan), np.broadcast_to(p_tracker, (loads.size, power.shape[1]))),
+        "tracker-net": (
+            np.full(loads.size, np.nan),
+            np.broadcast_to(p_tracker - day.tracker_draw(), (loads.size, power.shape[1])),
+        ),
     }
     metrics = {name: daily_metrics(curve, loads, step) for name, (_, curve) in curves.items()}
     flat_hours, tracker_hours = metrics["flat"]["t_solar_h"], metrics["tracker"]["t_solar_h"]

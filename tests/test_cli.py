@@ -13,7 +13,8 @@ from foldopt.reproduce import PAPER_VALUES
 
 runner = CliRunner()
 FOLDER = {"summary.csv", "sweep.csv", "timeseries.csv", "power_curves.png",
-          "t_solar_vs_fold_angle.png", "comparison.png", "switching.png", "run.json"}
+          "t_solar_vs_fold_angle.png", "comparison.png", "switching.png", "run.json",
+          "tracker_standby.png", "tracker_standby.csv"}
 FAST_SWEEP = ["--lat", "34.05", "--lon", "-118.25", "--date", "2014-09-23", "--p-load", "4.4",
               "--area", "0.108", "--step-min", "10", "--angle-step", "5"]
 
@@ -48,7 +49,8 @@ def test_run_default_study_writes_the_whole_folder(tmp_path):
     assert result.exit_code == 0, result.output
     assert {p.name for p in out.iterdir()} == FOLDER
     summary = pd.read_csv(out / "summary.csv")
-    assert list(summary["design"]) == ["flat", "twofold", "twofold-heuristic", "tracker"]
+    assert list(summary["design"])[:5] == ["flat", "twofold", "twofold-heuristic", "tracker", "tracker-net"]
+    assert {"tracker:dual-axis-steps", "tracker:dual-axis-steps-net", "tracker:single-axis-net"} <= set(summary["design"])
     meta = json.loads((out / "run.json").read_text())
     assert meta["mode"] == "paper" and meta["study"]["geometry"] == "azimuth-split"
     assert meta["study"]["p_load"] == pytest.approx(4.398)

@@ -42,7 +42,7 @@ def test_sweep_latitude_makes_the_design_map(tmp_path):
                     *SMALL, "--out", out)
     assert result.exit_code == 0, result.output
     table = pd.read_csv(out / "results.csv")
-    assert len(table) == 3 * 3 * 3  # latitudes x loads x designs
+    assert len(table) == 3 * 3 * 4  # latitudes x loads x designs (flat, twofold, tracker gross and net)
     assert {"gain_map_latitude_load.png", "fold_angle_map_latitude_load.png"} <= {p.name for p in out.iterdir()}
 
 
@@ -65,7 +65,7 @@ def test_json_output_is_parseable_and_quiet_is_silent(tmp_path):
                     "--out", tmp_path / "j", "--format", "json", "--quiet")
     assert result.exit_code == 0, result.output
     payload = json.loads(result.stdout)
-    assert len(payload["rows"]) == 9 and {"design", "t_solar_h"} <= set(payload["rows"][0])
+    assert len(payload["rows"]) == 12 and {"design", "t_solar_h"} <= set(payload["rows"][0])
     assert result.stderr == ""
 
 

@@ -7,7 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from foldopt.irradiance import beam_incidence_factor
-from foldopt.tracker import tracker_incidence_factor
+from foldopt.tracker import tracker_orientation
 
 
 @given(
@@ -50,7 +50,10 @@ def test_factor_broadcasts_orientations_against_time():
         beam_incidence_factor(0, 0, 0, 0, "perez")
 
 
-def test_ideal_tracker_sees_all_of_the_beam_by_day():
-    np.testing.assert_array_equal(tracker_incidence_factor(np.array([0.0, 60.0, 89.0, 91.0])), [1, 1, 1, 0])
-    with pytest.raises(ValueError, match="dual-axis"):
-        tracker_incidence_factor(np.array([0.0]), "single-axis")
+@pytest.mark.parametrize("model", ["exact", "paper"])
+def test_ideal_tracker_sees_all_of_the_beam_in_both_modes(model):
+    zenith, azimuth = np.array([5.0, 40.0, 85.0]), np.array([100.0, 180.0, 250.0])
+    tilt, surface_azimuth = tracker_orientation("dual-axis", zenith, azimuth, np.zeros(3), np.zeros(3), 30.0)
+    np.testing.assert_allclose(beam_incidence_factor(tilt, surface_azimuth, zenith, azimuth, model), 1.0, atol=1e-12)
+    with pytest.raises(ValueError, match="dual-axis, equatorial, dual-axis-steps, single-axis"):
+        tracker_orientation("azimuthal", zenith, azimuth, np.zeros(3), np.zeros(3), 30.0)

@@ -1,0 +1,105 @@
+"""Trackers as built: the step law, single-axis against pvlib, tracker energy, and Hottel's sky."""
+
+import numpy as np
+import pvlib
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from foldopt.atmosphere import extraterrestrial_normal, hottel_transmittance
+from foldopt.config import load_study, default_study_path
+from foldopt.metrics import t_solar
+from foldopt.study import Day
+from foldopt.tracker import ALEXANDRU_STEP_OFFSETS_H, TrackerDrive, step_law, tracker_orientation
+
+
+@settings(max_examples=100)
+@given(hour=st.floats(0.0, 9.0), field=st.floats(10, 180))
+def test_step_law_is_odd_about_solar_noon_and_spans_its_field(hour, field):
+    # Away from the actuating instants the daily angle at -h is minus that at +h.
+    offsets = np.asarray(ALEXANDRU_STEP_OFFSETS_H)
+    if np.min(np.abs(offsets - hour)) < 1e-6:
+        return
+    morning, afternoon = step_law(np.array([-15 * hour, 15 * hour]), 12, field)
+    assert morning == pytest.approx(-afternoon)
+    angles = step_law(np.linspace(-180, 180, 3601), 12, field)
+    assert angles.min() == pytest.approx(-field / 2) and angles.max() == pytest.approx(field / 2)
+    assert np.allclose(np.unique(np.diff(np.unique(angles))), field / 12)
+    assert len(np.flatnonzero(np.diff(angles))) == 12  # twelve moves a day
+
+
+def test_alexandru_actuating_times_are_his():
+    # His 12 local times pair up symmetrically about 13.319 h (Alexandru 2013, Sec. 4).
+    times = np.array([8.839, 9.819, 10.619, 11.489, 12.189, 12.919, 13.719, 14.449, 15.149, 16.019, 16.819, 17.799])
+    np.testing.assert_allclose(np.sort(np.abs(times - 13.319))[::2], ALEXANDRU_STEP_OFFSETS_H, atol=1e-9)
+
+
+def test_single_axis_matches_pvlib():
+    zenith = np.linspace(10, 85, 40)
+    azimuth = np.linspace(70, 290, 40)
+    tilt, surface_azimuth = tracker_orientation("single-axis", zenith, azimuth, np.zeros(40), np.zeros(40), 34.0)
+    expected = pvlib.tracking.singleaxis(zenith, azimuth, axis_tilt=0, axis_azimuth=180, max_angle=90,
+                                         backtrack=False, gcr=0.35)
+    np.testing.assert_allclose(tilt, expected["surface_tilt"], atol=1e-9)
+    np.testing.assert_allclose(surface_azimuth, expected["surface_azimuth"], atol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def day():
+    study = load_study(default_study_path())
+    return Day(study.model_copy(update={"mode": "exact", "geometry": "hinge", "step_min": 2}))
+
+
+def test_continuous_equatorial_tracker_without_consumption_is_the_ideal_one(day):
+    # Only the declination's drift during the day separates them (cos of ~0.2 deg).
+    np.testing.assert_allclose(day.tracker_power("equatorial"), day.tracker_power("dual-axis"), rtol=1e-4, atol=1e-9)
+    free = day.study.variant(tracker={"model": "equatorial", "drive": "wh-per-degree"})
+    free_day = Day(free)
+    np.testing.assert_allclose(free_day.tracker_draw(), 0.0)
+    load = day.study.p_load
+    assert t_solar(free_day.tracker_power() - free_day.tracker_draw(), load, free_day.step_hours) == pytest.approx(
+        t_solar(day.tracker_power("dual-axis"), load, day.step_hours), abs=1 / 60
+    )
+
+
+@pytest.mark.parametrize("model", ["dual-axis", "equatorial", "dual-axis-steps", "single-axis"])
+def test_net_never_exceeds_gross(day, model):
+    draw = Day(day.study.variant(tracker={"model": model, "standby_w": 0.2})).tracker_draw()
+    assert np.all(draw >= 0) and draw.sum() > 0
+    gross = day.tracker_power(model)
+    assert t_solar(gross - draw, day.study.p_load, day.step_hours) <= t_solar(gross, day.study.p_load, day.step_hours)
+    # The step law moves 12 times plus the night return; its drive energy is the sum of those moves.
+    if model == "dual-axis-steps":
+        moves = TrackerDrive().move_energy_wh(np.array([7.5] * 12 + [90.0])).sum()
+        standby = 0.2 * (day.dni > 0).sum() * day.step_hours
+        assert draw.sum() * day.step_hours == pytest.approx(standby + moves, rel=1e-3)
+
+
+def test_motor_drive_energy_grows_with_the_move():
+    drive = TrackerDrive()
+    energy = drive.move_energy_wh(np.array([0.0, 1.0, 7.5, 90.0]))
+    assert energy[0] == 0 and np.all(np.diff(energy) > 0)
+    # Long moves approach the free-running cost: 12 V x 0.3 A over 653 x 90 deg at 78 rpm, plus start-up.
+    speed = 5571.57 / 4288 * 360  # deg/s of the gear-motor output
+    assert energy[3] > 12 * 0.3 * (653 * 90 / speed) / 3600
+    assert TrackerDrive(drive="wh-per-degree", wh_per_degree=0.01).move_energy_wh(np.array([10.0]))[0] == pytest.approx(0.1)
+
+
+def test_hottel_against_duffie_beckman_example_2_8_1():
+    # Duffie & Beckman, "Solar Engineering of Thermal Processes", Example 2.8.1: Madison (270 m),
+    # 22 August, 11:30 solar time, cos(zenith) = 0.846, midlatitude summer: tau_b = 0.62,
+    # G_on = 1339 W/m^2, G_cnb = 830 W/m^2.
+    zenith = np.degrees(np.arccos(0.846))
+    tau = hottel_transmittance(zenith, 270.0, "midlatitude-summer")
+    assert tau == pytest.approx(0.62, abs=0.005)
+    assert extraterrestrial_normal(234) == pytest.approx(1339, abs=1)
+    assert extraterrestrial_normal(234) * tau == pytest.approx(830, abs=5)
+    assert hottel_transmittance(95.0) == 0.0
+    with pytest.raises(ValueError, match="tropical"):
+        hottel_transmittance(30.0, climate="arctic")
+
+
+def test_hottel_sky_runs_a_study(day):
+    hottel = Day(day.study.model_copy(update={"sky": "hottel", "climate": "tropical"}))
+    assert 0 < hottel.dni.max() < 1100
+    assert (hottel.dni[day.dni == 0] == 0).all()
