@@ -214,7 +214,8 @@ _OPTION_OF_FIELD = {
     "mode": "--mode", "geometry": "--geometry", "sky": "--sky", "step_min": "--step-min",
     "connection": "--connection", "fold_angles.step": "--angle-step", "fold_angles.start": "--angle-step",
     "pv_model": "--pv-model", "module": "--module", "temp_air": "--temp-air",
-    "converter_efficiency": "--converter-efficiency", "year": "--year",
+    "converter_efficiency": "--converter-efficiency", "year": "--year", "climate": "--climate",
+    "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby",
 }
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 
@@ -249,7 +250,11 @@ def sweep(
     timezone: Optional[str] = typer.Option(None, "--timezone", help="IANA name or UTC offset; default from longitude"),
     mode: str = typer.Option("exact", "--mode", help="paper | exact"),
     geometry: Optional[str] = typer.Option(None, "--geometry", help="azimuth-split | hinge; default by mode"),
-    sky: str = typer.Option("meinel", "--sky", help="Clear-sky model: meinel"),
+    sky: str = typer.Option("meinel", "--sky", help="Clear-sky beam model: meinel | hottel"),
+    climate: str = typer.Option("midlatitude-summer", "--climate", help="hottel: tropical | midlatitude-summer | "
+                                "subarctic-summer | midlatitude-winter"),
+    tracker: str = typer.Option("dual-axis", "--tracker", help="dual-axis | equatorial | dual-axis-steps | single-axis"),
+    tracker_standby: float = typer.Option(0.0, "--tracker-standby", help="Tracker controller standby draw [W]"),
     pv_model: str = typer.Option("ideal", "--pv-model", help="ideal | single-diode | b-model"),
     module: Optional[str] = typer.Option(None, "--module", help="single-diode: CEC module name (default A-300 cell)"),
     connection: str = typer.Option(
@@ -292,6 +297,8 @@ def sweep(
         "p_load": p_load,
         "geometry": geometry,
         "sky": sky,
+        "climate": climate,
+        "tracker": {"model": tracker, "standby_w": tracker_standby},
         "pv_model": pv_model,
         "module": module,
         "connection": connection,

@@ -64,12 +64,18 @@ class Day:
         )
 
     def _poa(self, surface_tilt, surface_azimuth, per_step=False):
-        """Beam on surfaces [W/m^2]: one orientation per fold angle, (k, n_time), or, with
-        ``per_step``, one per time step (a tracker), (n_time,)."""
+        """Beam on surfaces [W/m^2]: one orientation per fold angle, (k, n_time), by the mode's
+        incidence model; or, with ``per_step``, one per time step (a tracker), (n_time,).
+
+        Trackers always take the exact angle of incidence: Eq. 5 is the paper's formula for its
+        fixed panels (it reads an azimuth even for a level panel, which a single-axis tracker is
+        at noon), and for the paper's only tracker, the ideal one, both give 1.
+        """
         tilt, azimuth = np.asarray(surface_tilt), np.asarray(surface_azimuth)
         if not per_step:
             tilt, azimuth = tilt[..., None], azimuth[..., None]
-        factor = beam_incidence_factor(tilt, azimuth, self.solar_zenith, self.solar_azimuth, model=self.study.mode)
+        model = "exact" if per_step else self.study.mode
+        factor = beam_incidence_factor(tilt, azimuth, self.solar_zenith, self.solar_azimuth, model=model)
         return self.dni * factor
 
     def flat_power(self):
