@@ -39,11 +39,10 @@ def main():
     dates = [dt.date(2014, 1, 1) + dt.timedelta(days=int(d)) for d in np.linspace(0, 364, args.days)]
 
     start = time.perf_counter()
-    electrical = None
+    tables: dict = {}
     hours = np.empty((len(dates), angles.size))
     for i, date in enumerate(dates):
-        day = Day(base.model_copy(update={"date": date}), electrical)
-        electrical = day.electrical
+        day = Day(base.model_copy(update={"date": date}), tables)
         hours[i] = t_solar(day.combined_power(angles), base.p_load, day.step_hours)
     fast_seconds = time.perf_counter() - start
     fast_points = len(dates) * angles.size * 1440
@@ -55,7 +54,7 @@ def main():
     for date in dates[: args.exact_days]:
         exact_day = Day(exact_study.model_copy(update={"date": date}))
         exact_hours = t_solar(exact_day.combined_power(slice_angles), base.p_load, exact_day.step_hours)
-        fast_day = Day(base.model_copy(update={"date": date}), electrical)
+        fast_day = Day(base.model_copy(update={"date": date}), tables)
         fast_hours = t_solar(fast_day.combined_power(slice_angles), base.p_load, fast_day.step_hours)
         worst = max(worst, float(np.abs(exact_hours - fast_hours).max()) * 3600)
     exact_seconds = time.perf_counter() - start

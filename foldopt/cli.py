@@ -215,7 +215,8 @@ _OPTION_OF_FIELD = {
     "connection": "--connection", "fold_angles.step": "--angle-step", "fold_angles.start": "--angle-step",
     "pv_model": "--pv-model", "module": "--module", "temp_air": "--temp-air",
     "converter_efficiency": "--converter-efficiency", "year": "--year", "climate": "--climate",
-    "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby",
+    "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby", "transposition": "--transposition",
+    "objective.statistic": "--objective", "weather": "--weather",
 }
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 
@@ -253,6 +254,10 @@ def sweep(
     sky: str = typer.Option("meinel", "--sky", help="Clear-sky beam model: meinel | hottel"),
     climate: str = typer.Option("midlatitude-summer", "--climate", help="hottel: tropical | midlatitude-summer | "
                                 "subarctic-summer | midlatitude-winter"),
+    weather: Optional[Path] = typer.Option(None, "--weather", help="TMY3 / EPW / PVGIS TMY file (with --days year)"),
+    transposition: Optional[str] = typer.Option(None, "--transposition", help="none | isotropic | haydavies | perez"),
+    objective: Optional[str] = typer.Option(None, "--objective", help="One fold angle for all days: mean | min | "
+                                            "worst-month | pNN"),
     tracker: str = typer.Option("dual-axis", "--tracker", help="dual-axis | equatorial | dual-axis-steps | single-axis"),
     tracker_standby: float = typer.Option(0.0, "--tracker-standby", help="Tracker controller standby draw [W]"),
     pv_model: str = typer.Option("ideal", "--pv-model", help="ideal | single-diode | b-model"),
@@ -298,6 +303,9 @@ def sweep(
         "geometry": geometry,
         "sky": sky,
         "climate": climate,
+        "weather": str(weather) if weather is not None else None,
+        "transposition": transposition,
+        "objective": {"statistic": objective} if objective is not None else None,
         "tracker": {"model": tracker, "standby_w": tracker_standby},
         "pv_model": pv_model,
         "module": module,

@@ -140,6 +140,30 @@ class Tracker(_Strict):
         return self
 
 
+class Weather(_Strict):
+    """A weather file: TMY3, EPW or PVGIS TMY, read through pvlib.iotools."""
+
+    path: str
+    format: Literal[("tmy3", "epw", "pvgis")] | None = Field(None, description="default from the extension")
+
+
+_STATISTIC = re.compile(r"^(mean|min|worst-month|p(\d{1,2}))$")
+
+
+class Objective(_Strict):
+    """What a fixed fold angle should maximise over the days of a study."""
+
+    statistic: str = Field("mean", description="mean | min | worst-month | pNN (a percentile, e.g. p10)")
+    months: list[Annotated[int, Field(ge=1, le=12)]] | None = Field(None, description="the season; default all")
+
+    @field_validator("statistic")
+    @classmethod
+    def _known(cls, value):
+        if not _STATISTIC.match(value):
+            raise ValueError("must be mean, min, worst-month or a percentile pNN (e.g. p10)")
+        return value
+
+
 class FoldAngles(_Strict):
     start: _interval(0, 180, lo_open=True, unit=" deg") = 1.0
     stop: _interval(0, 180, lo_open=True, unit=" deg") = 180.0
@@ -170,7 +194,15 @@ class Study(_Strict):
         None, description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact"
     )
     fold_angles: FoldAngles = FoldAngles()
-    sky: Literal[SKY_MODELS] = "meinel"
+    sky: Literal[SKY_MODELS + ("ineichen", "simplified-solis")] = "meinel"
+    linke_turbidity: _interval(0, 10, lo_open=True) | None = Field(None, description="ineichen; default pvlib's climatology")
+    transposition: Literal[("none", "isotropic", "haydavies", "perez")] | None = Field(
+        None, description="diffuse model; default none for beam-only skies, perez otherwise"
+    )
+    albedo: _interval(0, 1) = 0.2
+    iam: Literal[("none", "ashrae", "physical")] = "none"
+    weather: Weather | None = None
+    objective: Objective | None = None
     pv_model: Literal[PV_MODELS] = "ideal"
     module: str | None = Field(None, description="single-diode: CEC module name; default the A-300 cell")
     connection: Literal[CONNECTIONS] = "switching"
@@ -186,6 +218,25 @@ class Study(_Strict):
     tracker: Tracker = Tracker()
     climate: Literal[tuple(HOTTEL_CLIMATES)] = Field("midlatitude-summer", description="Hottel sky only")
     step_min: Annotated[_interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)] = 1.0
+
+    @field_validator("weather", mode="before")
+    @classmethod
+    def _weather_by_path(cls, value):
+        return {"path": value} if isinstance(value, str) else value
+
+    @model_validator(mode="after")
+    def _paper_mode_is_beam_only(self):
+        if self.mode == "paper" and self.transposition not in (None, "none"):
+            raise ValueError("paper mode is beam-only (Shin et al. Eq. 5): transposition must be none")
+        if self.weather is not None and not Path(self.weather.path).is_file():
+            raise ValueError(f"weather: file not found: {self.weather.path}")
+        return self
+
+    def sky_transposition(self) -> str:
+        """The diffuse model in force: none for beam-only skies unless a weather file gives diffuse."""
+        if self.transposition is not None:
+            return self.transposition
+        return "none" if self.mode == "paper" or (self.weather is None and self.sky in SKY_MODELS) else "perez"
 
     @field_validator("tracker", mode="before")
     @classmethod
@@ -531,7 +582,19 @@ def load_plan(path: Path | str) -> Plan:
         line = f" at line {where.line + 1}" if where is not None else ""
         problem = getattr(error, "problem", None) or "malformed YAML"
         raise ConfigError([f"config: {path}{line}: {problem}"]) from None
+    if isinstance(data, dict):
+        data = _resolve_weather_path(data, path.parent)
     return make_plan(data, lines)
+
+
+def _resolve_weather_path(data: dict, folder: Path) -> dict:
+    """A study file's relative weather path is relative to the file, not to the working folder."""
+    weather = data.get("weather")
+    spec = weather.get("path") if isinstance(weather, dict) else weather
+    if isinstance(spec, str) and not Path(spec).is_absolute() and (folder / spec).is_file():
+        resolved = str(folder / spec)
+        data = {**data, "weather": {**weather, "path": resolved} if isinstance(weather, dict) else resolved}
+    return data
 
 
 def load_study(path: Path | str) -> Study:

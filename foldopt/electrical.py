@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
-from foldopt.aggregation import connection_powers, pair_powers, parallel_power, series_power
+from foldopt.aggregation import connection_powers, parallel_power, series_power
 from foldopt.pvmodel import PVModel, cell_temperature
 
 IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the tables; clear-sky beam stays below 1353
@@ -69,17 +69,26 @@ class Electrical:
     def _temperature(self, poa):
         return cell_temperature(poa, self.temp_air, self.wind_speed, self.temperature_model)
 
-    def _build_tables(self):
-        g1 = _nodes(TABLE_NODES_1D)
-        p1 = self.pv.max_power(g1, self._temperature(g1), self.subpanel_area)
-        g2 = _nodes(TABLE_NODES_2D)
-        parallel = self._pair_table("parallel", g2, g2, lambda ge, gw: (ge, gw))
-        # Series is indexed by the stronger irradiance and the weaker/stronger ratio (the pair is
-        # symmetric): its kink, where the weaker current starts to limit the string, then runs
-        # nearly along a ratio grid line instead of across cells.
-        ratio = np.linspace(0.0, 1.0, TABLE_NODES_RATIO)
-        series = self._pair_table("series", g2, ratio, lambda strong, r: (strong, strong * r))
-        self._tables = (g1, p1, parallel, series)
+    def _table(self, name):
+        """A table, built on first use: ``subpanel`` (1-D), ``parallel`` or ``series`` (2-D)."""
+        if self._tables is None:
+            self._tables = {}
+        if name not in self._tables:
+            if name == "subpanel":
+                g1 = _nodes(TABLE_NODES_1D)
+                self._tables[name] = (g1, self.pv.max_power(g1, self._temperature(g1), self.subpanel_area))
+            elif name == "parallel":
+                g2 = _nodes(TABLE_NODES_2D)
+                self._tables[name] = self._pair_table("parallel", g2, g2, lambda ge, gw: (ge, gw))
+            else:
+                # Series is indexed by the stronger irradiance and the weaker/stronger ratio (the pair
+                # is symmetric): its kink, where the weaker current starts to limit the string, then
+                # runs nearly along a ratio grid line instead of across cells.
+                ratio = np.linspace(0.0, 1.0, TABLE_NODES_RATIO)
+                self._tables[name] = self._pair_table(
+                    "series", _nodes(TABLE_NODES_2D), ratio, lambda strong, r: (strong, strong * r)
+                )
+        return self._tables[name]
 
     def _pair_table(self, connection, axis0, axis1, to_irradiance):
         """Interpolator of a pair's power as a fraction of its two maxima on a 2-D grid.
@@ -107,13 +116,15 @@ class Electrical:
         poa = np.asarray(poa, dtype=float)
         if self.exact or not self.pv.has_iv:
             return self.pv.max_power(poa, self._temperature(poa), area)
-        if self._tables is None:
-            self._build_tables()
-        g1, p1 = self._tables[:2]
+        g1, p1 = self._table("subpanel")
         return np.interp(np.clip(poa, 0.0, IRRADIANCE_MAX), g1, p1) * (area / self.subpanel_area)
 
-    def connections(self, poa_east, poa_west):
-        """Every connection's power [W] and the switching state, as :func:`connection_powers`."""
+    def connections(self, poa_east, poa_west, series: bool = True):
+        """Every connection's power [W] and the switching state, as :func:`connection_powers`.
+
+        With ``series`` false the series power is left NaN (and its table unbuilt), for callers
+        whose connection and switch do not use it.
+        """
         poa_east, poa_west = np.broadcast_arrays(np.asarray(poa_east, float), np.asarray(poa_west, float))
         p_east, p_west = self.subpanel_power(poa_east), self.subpanel_power(poa_west)
         if not self.pv.has_iv:
@@ -121,20 +132,23 @@ class Electrical:
         if self.exact:
             east = self.pv.curves(poa_east, self._temperature(poa_east), self.subpanel_area)
             west = self.pv.curves(poa_west, self._temperature(poa_west), self.subpanel_area)
-            return connection_powers(p_east, p_west, *pair_powers(east, west, self.bypass), **self._options)
-        if self._tables is None:
-            self._build_tables()
-        _, _, parallel, series = self._tables
+            p_parallel = parallel_power(east, west)
+            p_series = series_power(east, west, self.bypass) if series else np.full(p_east.shape, np.nan)
+            return connection_powers(p_east, p_west, p_parallel, p_series, **self._options)
         east, west = np.clip(poa_east, 0.0, IRRADIANCE_MAX), np.clip(poa_west, 0.0, IRRADIANCE_MAX)
-        strong = np.maximum(east, west)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            weak_ratio = np.where(strong > 0, np.minimum(east, west) / strong, 1.0)
         bound = p_east + p_west
         # Identical sub-panels at equal irradiance (a flat fold, or noon) deliver exactly their sum
         # in parallel and in series; interpolation across the table's diagonal would not.
         equal = east == west
-        p_parallel = np.where(equal, 1.0, np.clip(parallel(np.stack([east, west], axis=-1)), 0.0, 1.0)) * bound
-        p_series = np.where(equal, 1.0, np.clip(series(np.stack([strong, weak_ratio], axis=-1)), 0.0, 1.0)) * bound
-        if self.bypass:
-            p_series = np.maximum(p_series, np.maximum(p_east, p_west))
+        p_parallel = np.where(equal, 1.0, np.clip(self._table("parallel")(np.stack([east, west], axis=-1)), 0, 1)) * bound
+        if series:
+            strong = np.maximum(east, west)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                weak_ratio = np.where(strong > 0, np.minimum(east, west) / strong, 1.0)
+            fraction = self._table("series")(np.stack([strong, weak_ratio], axis=-1))
+            p_series = np.where(equal, 1.0, np.clip(fraction, 0.0, 1.0)) * bound
+            if self.bypass:
+                p_series = np.maximum(p_series, np.maximum(p_east, p_west))
+        else:
+            p_series = np.full(p_east.shape, np.nan)
         return connection_powers(p_east, p_west, p_parallel, p_series, **self._options)

@@ -24,6 +24,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from foldopt.aggregation import SWITCH_STATES  # noqa: E402
 from foldopt.config import Study  # noqa: E402
 from foldopt.study import StudyResult  # noqa: E402
 
@@ -384,6 +385,8 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
     with staged_folder(out, overwrite) as folder:
         result.table.to_csv(folder / "results.csv", index=False, float_format=FLOAT_FORMAT)
         plots = sweep_plots(result.table, result.varied, folder, plan.base.name)
+        if "date" in result.varied or "day_of_year" in result.varied:
+            plots += annual_outputs(result, folder, plan.base.name)
         _write_json(
             folder / "run.json",
             run_metadata(
@@ -429,3 +432,86 @@ def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool =
         _write_json(folder / "run.json", run_metadata(study.resolved(), command,
                                                        input_sha256=input_hash(study.model_dump(mode="json"))))
     return best
+
+
+# --- Annual studies -----------------------------------------------------------------------------
+
+THRESHOLDS_H = (2, 4, 6, 8, 10, 12)
+
+
+def annual_summary(table: pd.DataFrame) -> pd.DataFrame:
+    """Per design and load: mean, percentiles and minimum of daily t_solar, the days reaching
+    each of :data:`THRESHOLDS_H`, and monthly means."""
+    table = table.assign(month=pd.to_datetime(table["date"]).dt.month)
+    keys = [c for c in ("site_name", "latitude", "p_load_w", "design") if c in table]
+    rows = []
+    for key, group in table.groupby(keys, sort=False):
+        hours = group["t_solar_h"]
+        row = dict(zip(keys, key if isinstance(key, tuple) else (key,), strict=True))
+        row.update(days=len(group), fold_angle_deg=group["fold_angle_deg"].iloc[0], mean_h=hours.mean(),
+                   p10_h=hours.quantile(0.1), p50_h=hours.median(), p90_h=hours.quantile(0.9), min_h=hours.min())
+        row.update({f"days_ge_{x}h": int((hours >= x).sum()) for x in THRESHOLDS_H})
+        row.update({f"month_{m:02d}_mean_h": v for m, v in group.groupby("month")["t_solar_h"].mean().items()})
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def plot_distribution(table: pd.DataFrame, path: Path, title: str) -> None:
+    """Daily t_solar of each design as box plots, one group per load."""
+    designs = [d for d in ("flat", "twofold", "tracker", "tracker-net") if d in set(table["design"])]
+    loads = sorted(table["p_load_w"].unique())
+    fig, ax = plt.subplots(figsize=(max(6, 2.2 * len(loads) + 2), 4.5))
+    width = 0.8 / len(designs)
+    colours = {"flat": "0.35", "twofold": "tab:blue", "tracker": "0.7", "tracker-net": "tab:orange"}
+    for i, design in enumerate(designs):
+        data = [table[(table.design == design) & (table.p_load_w == load)]["t_solar_h"].to_numpy() for load in loads]
+        positions = np.arange(len(loads)) + (i - (len(designs) - 1) / 2) * width
+        box = ax.boxplot(data, positions=positions, widths=width * 0.9, patch_artist=True, showfliers=False)
+        for patch in box["boxes"]:
+            patch.set_facecolor(colours[design])
+        ax.plot([], [], color=colours[design], lw=6, label=design)
+    ax.set_xticks(np.arange(len(loads)), [f"P_load {load:g} W" for load in loads])
+    ax.set_ylabel("daily t_solar [h]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3, axis="y")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_day_hour(extras: dict, key: str, path: Path, title: str, label: str) -> None:
+    """A day x hour heat map of one annual series (twofold power, or the switch state)."""
+    values = np.asarray(extras[key], dtype=float)
+    days = np.arange(1, values.shape[0] + 1)
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    if key == "switch_state":
+        cmap = matplotlib.colors.ListedColormap(["0.15", "tab:orange", "tab:purple", "tab:green", "tab:brown"])
+        mesh = ax.pcolormesh(days, extras["hours"], values.T, cmap=cmap, vmin=-1.5, vmax=3.5, shading="nearest")
+        bar = fig.colorbar(mesh, ax=ax, ticks=range(-1, 4))
+        bar.ax.set_yticklabels(["off", *SWITCH_STATES])
+    else:
+        mesh = ax.pcolormesh(days, extras["hours"], values.T, cmap="magma", shading="nearest")
+        fig.colorbar(mesh, ax=ax, label=label)
+    ax.set_xlabel("day of the study")
+    ax.set_ylabel("local clock time [h]")
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def annual_outputs(result, folder: Path, name: str) -> list[str]:
+    """``annual_summary.csv`` and the annual plots of a study that varies the date."""
+    table = result.table
+    annual_summary(table).to_csv(folder / "annual_summary.csv", index=False, float_format=FLOAT_FORMAT)
+    plot_distribution(table, folder / "daily_t_solar_distribution.png", f"{name}: daily t_solar per design")
+    written = ["annual_summary.csv", "daily_t_solar_distribution.png"]
+    if result.extras:
+        angle = result.extras["fold_angle"]
+        plot_day_hour(result.extras, "p_twofold_w", folder / "day_hour_power.png",
+                      f"{name}: twofold power at {angle:g}° (first load)", "P_pv [W]")
+        plot_day_hour(result.extras, "switch_state", folder / "day_hour_switch_state.png",
+                      f"{name}: connection the switch chooses at {angle:g}°", "")
+        written += ["day_hour_power.png", "day_hour_switch_state.png"]
+    return written

@@ -14,7 +14,9 @@ import numpy as np
 import pandas as pd
 
 from foldopt.aggregation import CONNECTIONS, SWITCH_STATES
-from foldopt.atmosphere import clear_sky_dni
+import pvlib
+
+from foldopt.atmosphere import clear_sky_dni, relative_airmass
 from foldopt.config import Study, parse_timezone
 from foldopt.electrical import Electrical
 from foldopt.geometry import subpanel_orientation
@@ -24,6 +26,7 @@ from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_ang
 from foldopt.pvmodel import PVModel
 from foldopt.sizing import flat_area_multiple
 from foldopt.solarposition import day_times, get_solar_position
+from foldopt.weather import clear_sky, read_weather, weather_day
 from foldopt.tracker import TRACKERS, TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
 
 
@@ -35,26 +38,46 @@ class Day:
     resolved here, so its defaults follow its own site and mode.
     """
 
-    def __init__(self, study: Study, electrical: Electrical | None = None):
+    def __init__(self, study: Study, cache: dict | None = None):
         study = study.resolved()
         self.study = study
         site, panel = study.site, study.panel
-        self.times = day_times(study.date, parse_timezone(site.timezone), study.step_min)
-        self.step_hours = study.step_min / 60.0
+        temp_air = study.temp_air
+        self.ghi = self.dhi = None
+        if study.weather is not None:
+            frame = weather_day(read_weather(study.weather.path, study.weather.format, study.date.year), study.date)
+            self.times = pd.DatetimeIndex(frame.index)
+            self.step_hours = float(pd.Series(self.times).diff().median() / pd.Timedelta(hours=1))
+            # Cells follow the day's mean air temperature (the electrical tables assume one per
+            # day), rounded to 5 C so that days share their tables; wind stays the study's.
+            temp_air = round(float(frame["temp_air"].mean()) / 5.0) * 5.0
+        else:
+            self.times = day_times(study.date, parse_timezone(site.timezone), study.step_min)
+            self.step_hours = study.step_min / 60.0
         sun = get_solar_position(self.times, site.latitude, site.longitude, site.altitude, study.mode)
         self.solar_zenith = sun["solar_zenith"].to_numpy()
         self.solar_azimuth = sun["solar_azimuth"].to_numpy()
         self.hour_angle = sun["hour_angle"].to_numpy()
         self.declination = sun["declination"].to_numpy()
         altitude = site.altitude if study.mode == "exact" else 0.0
-        self.dni = clear_sky_dni(
-            self.solar_zenith, altitude, study.sky, dayofyear=self.times.day_of_year, climate=study.climate
-        )
-        # Days of one study share its electrical tables: pass the first day's to the next.
-        self.electrical = electrical or Electrical(
+        if study.weather is not None:
+            self.dni, self.ghi, self.dhi = (frame[key].to_numpy(dtype=float) for key in ("dni", "ghi", "dhi"))
+        elif study.sky in ("ineichen", "simplified-solis"):
+            sky = clear_sky(self.times, self.solar_zenith, self.solar_zenith, site.latitude, site.longitude,
+                            site.altitude, study.sky, study.linke_turbidity)
+            self.dni, self.ghi, self.dhi = sky["dni"], sky["ghi"], sky["dhi"]
+        else:
+            self.dni = clear_sky_dni(
+                self.solar_zenith, altitude, study.sky, dayofyear=self.times.day_of_year, climate=study.climate
+            )
+        self.transposition = study.sky_transposition()
+        # Orientation-independent inputs of the transposition, computed once for every fold angle.
+        self.dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(self.times), dtype=float)
+        self.airmass = np.nan_to_num(relative_airmass(np.minimum(self.solar_zenith, 90.0)), nan=0.0)
+        settings = dict(
             pv=PVModel(study.pv_model, panel.efficiency, study.module),
             subpanel_area=panel.area / 2.0,
-            temp_air=study.temp_air,
+            temp_air=temp_air,
             wind_speed=study.wind_speed,
             temperature_model=study.temperature_model,
             bypass=study.bypass_diodes,
@@ -62,21 +85,47 @@ class Day:
             converter_efficiency=study.converter_efficiency,
             exact=study.exact_electrical,
         )
+        if cache is None:
+            self.electrical = Electrical(**settings)
+        else:
+            # Days of one setup share their electrical tables.
+            self.electrical = cache.setdefault(tuple(map(repr, settings.values())), Electrical(**settings))
 
     def _poa(self, surface_tilt, surface_azimuth, per_step=False):
-        """Beam on surfaces [W/m^2]: one orientation per fold angle, (k, n_time), by the mode's
-        incidence model; or, with ``per_step``, one per time step (a tracker), (n_time,).
+        """Irradiance on surfaces [W/m^2]: one orientation per fold angle, (k, n_time), or, with
+        ``per_step``, one per time step (a tracker), (n_time,).
 
-        Trackers always take the exact angle of incidence: Eq. 5 is the paper's formula for its
-        fixed panels (it reads an azimuth even for a level panel, which a single-axis tracker is
-        at noon), and for the paper's only tracker, the ideal one, both give 1.
+        Beam only (``transposition: none``): the beam by the mode's incidence model. Trackers always
+        take the exact angle of incidence: Eq. 5 is the paper's formula for its fixed panels (it
+        reads an azimuth even for a level panel, which a single-axis tracker is at noon), and for
+        the paper's only tracker, the ideal one, both give 1. With diffuse light: pvlib's
+        ``get_total_irradiance`` (beam, sky diffuse by the transposition model, ground-reflected
+        with ``albedo``), the beam optionally reduced by an incidence-angle modifier.
         """
-        tilt, azimuth = np.asarray(surface_tilt), np.asarray(surface_azimuth)
+        tilt, azimuth = np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
         if not per_step:
             tilt, azimuth = tilt[..., None], azimuth[..., None]
-        model = "exact" if per_step else self.study.mode
-        factor = beam_incidence_factor(tilt, azimuth, self.solar_zenith, self.solar_azimuth, model=model)
-        return self.dni * factor
+        study = self.study
+        if self.transposition == "none":
+            model = "exact" if per_step else study.mode
+            beam = self.dni * beam_incidence_factor(tilt, azimuth, self.solar_zenith, self.solar_azimuth, model=model)
+            return beam * self._iam(tilt, azimuth)
+        dhi = self.dhi if self.dhi is not None else np.zeros_like(self.dni)
+        ghi = self.ghi if self.ghi is not None else self.dni * np.clip(np.cos(np.radians(self.solar_zenith)), 0, None)
+        poa = pvlib.irradiance.get_total_irradiance(
+            tilt, azimuth, self.solar_zenith, self.solar_azimuth, self.dni, ghi, dhi,
+            dni_extra=self.dni_extra, airmass=self.airmass, albedo=study.albedo, model=self.transposition,
+        )
+        direct = np.nan_to_num(np.asarray(poa["poa_direct"], dtype=float)) * self._iam(tilt, azimuth)
+        return direct + np.nan_to_num(np.asarray(poa["poa_diffuse"], dtype=float))
+
+    def _iam(self, tilt, azimuth):
+        """Incidence-angle modifier of the beam (pvlib ``iam.ashrae`` / ``iam.physical``), or 1."""
+        if self.study.iam == "none":
+            return 1.0
+        aoi = pvlib.irradiance.aoi(tilt, azimuth, self.solar_zenith, self.solar_azimuth)
+        modifier = pvlib.iam.ashrae(aoi) if self.study.iam == "ashrae" else pvlib.iam.physical(aoi)
+        return np.nan_to_num(np.asarray(modifier, dtype=float))
 
     def flat_power(self):
         """Power of the flat panel over the day [W], shape (n_time,)."""
@@ -107,22 +156,26 @@ class Day:
         drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
         return tracker_draw(*self.tracker_orientation(model), self.dni > 0, self.step_hours, drive)
 
-    def connections(self, fold_angles):
-        """Every connection's power [W], each (k, n_time), and the switching state per step."""
+    def connections(self, fold_angles, series: bool = True):
+        """Every connection's power [W], each (k, n_time), and the switching state per step.
+
+        ``series=False`` skips the series connection (NaN) when nothing asks for it."""
         panel = self.study.panel
         sides = subpanel_orientation(fold_angles, panel.tilt, panel.azimuth, self.study.geometry)
         poa_east = self._poa(sides["tilt_east"], sides["azimuth_east"])
         poa_west = self._poa(sides["tilt_west"], sides["azimuth_west"])
-        return self.electrical.connections(poa_east, poa_west)
+        return self.electrical.connections(poa_east, poa_west, series)
 
     def subpanel_power(self, fold_angles):
         """East and west sub-panel powers and their parallel connection [W], each (k, n_time)."""
-        powers, _ = self.connections(fold_angles)
+        powers, _ = self.connections(fold_angles, series=False)
         return powers["east"], powers["west"], powers["parallel"]
 
     def combined_power(self, fold_angles, connection=None):
         """Deliverable twofold power [W], (k, n_time), under ``connection`` (default: the study's)."""
-        return self.connections(fold_angles)[0][connection or self.study.connection]
+        connection = connection or self.study.connection
+        series = connection == "series" or self.study.switch_series
+        return self.connections(fold_angles, series)[0][connection]
 
 
 @dataclass(frozen=True)

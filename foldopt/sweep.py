@@ -8,6 +8,7 @@ local refinement, which a single-study run adds).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -29,6 +30,7 @@ class SweepResult:
 
     plan: Plan
     table: pd.DataFrame
+    extras: dict = dataclasses.field(default_factory=dict)  # day x hour curves of an annual objective
 
     @property
     def varied(self) -> list[str]:
@@ -48,15 +50,28 @@ def _best_angle_index(hours):
     return hours.shape[-1] - 1 - np.argmax(hours[..., ::-1], axis=-1)
 
 
-def _day_rows(day: Day, loads: np.ndarray, case: dict) -> list[dict]:
-    study, step = day.study, day.step_hours
-    angles = np.asarray(study.fold_angles.grid())
+def _angle_hours(day: Day, loads: np.ndarray):
+    """Fold-angle grid, twofold power (k, n_time) and t_solar for every load and angle (L, k)."""
+    angles = np.asarray(day.study.fold_angles.grid())
     power = day.combined_power(angles)
     chunk = max(1, _LOAD_CHUNK_VALUES // power.size)
     hours = np.concatenate(
-        [t_solar(power, loads[i : i + chunk, None], step) for i in range(0, loads.size, chunk)]
+        [t_solar(power, loads[i : i + chunk, None], day.step_hours) for i in range(0, loads.size, chunk)]
     )
-    best = _best_angle_index(hours)
+    return angles, power, hours
+
+
+def _day_rows(day: Day, loads: np.ndarray, case: dict, fixed_angles=None) -> list[dict]:
+    """Rows of one day for every load; the twofold panel at its best angle of the day, or at
+    ``fixed_angles`` (one per load) when a study-wide objective chose them."""
+    step = day.step_hours
+    if fixed_angles is None:
+        angles, power, hours = _angle_hours(day, loads)
+        best = _best_angle_index(hours)
+    else:
+        angles = np.asarray(fixed_angles, dtype=float)
+        power = day.combined_power(angles)
+        best = np.arange(loads.size)
     p_tracker = day.tracker_power()
     curves = {
         "flat": (np.full(loads.size, 180.0), np.broadcast_to(day.flat_power(), (loads.size, power.shape[1]))),
@@ -94,10 +109,23 @@ def _day_rows(day: Day, loads: np.ndarray, case: dict) -> list[dict]:
     return rows
 
 
-def _electrical_key(study) -> tuple:
-    s = study.resolved()
-    return (s.pv_model, s.module, s.panel.efficiency, s.panel.area, s.temp_air, s.wind_speed,
-            s.temperature_model, s.bypass_diodes, s.switch_series, s.converter_efficiency, s.exact_electrical)
+def objective_value(hours, months, statistic: str, season=None):
+    """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
+
+    ``mean``, ``min``, ``pNN`` (the NN-th percentile over days) or ``worst-month`` (the lowest
+    monthly mean); ``season`` (months) restricts the days.
+    """
+    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
+    if season:
+        keep = np.isin(months, season)
+        hours, months = hours[keep], months[keep]
+    if statistic == "mean":
+        return hours.mean(axis=0)
+    if statistic == "min":
+        return hours.min(axis=0)
+    if statistic == "worst-month":
+        return np.min([hours[months == m].mean(axis=0) for m in np.unique(months)], axis=0)
+    return np.percentile(hours, float(statistic[1:]), axis=0)
 
 
 def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None) -> SweepResult:
@@ -119,29 +147,66 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None) -> 
     """
     axes = dict(plan.axes)
     loads = np.asarray(axes.pop("p_load", (plan.data.get("p_load"),)), dtype=float)
+    objective = plan.base.objective
+    dates = axes.pop("date", None) if objective is not None else None
     paths = list(axes)
     groups = list(itertools.product(*axes.values()))
-    tables: dict[tuple, object] = {}
-    rows = []
-    for done, values in enumerate(groups, start=1):
+    tables: dict = {}
+    rows, extras = [], {}
+    total = len(groups) * (2 * len(dates) if dates else 1)  # an annual group is two passes
+    done = 0
+
+    def day_of(choice):
+        return Day(plan.study({**choice, "p_load": float(loads[0])}), tables)
+
+    for values in groups:
         choice = dict(zip(paths, values, strict=True))
-        study = plan.study({**choice, "p_load": float(loads[0])})
-        key = _electrical_key(study)
-        day = Day(study, tables.get(key))
-        tables[key] = day.electrical
-        site = day.study.site
-        case = {
-            "site_name": site.name or "",
-            "latitude": site.latitude,
-            "longitude": site.longitude,
-            "date": day.study.date.isoformat(),
-            "day_of_year": day.study.date.timetuple().tm_yday,
-            **{path: _plain(value) for path, value in choice.items() if path not in _AXIS_COLUMNS},
-        }
-        rows += _day_rows(day, loads, case)
-        if progress is not None:
-            progress(done, len(groups))
-    return SweepResult(plan, pd.DataFrame(rows))
+        if not dates:
+            day = day_of(choice)
+            rows += _day_rows(day, loads, _case(day, choice))
+            done += 1
+            if progress is not None:
+                progress(done, total)
+            continue
+        # A fixed panel keeps one fold angle all year: first t_solar of every angle on every day,
+        # then the angle that maximises the objective, then each day at that angle.
+        days, daily = [], []
+        for date in dates:
+            days.append(day_of({**choice, "date": date}))  # a day keeps only a few arrays of n_time
+            angles, _, hours = _angle_hours(days[-1], loads)
+            daily.append(hours)
+            done += 1
+            if progress is not None:
+                progress(done, total)
+        months = [date.month for date in dates]
+        score = objective_value(np.stack(daily), months, objective.statistic, objective.months)
+        fixed = angles[_best_angle_index(score)]
+        series = {"p_twofold_w": [], "switch_state": []}
+        for day in days:
+            rows += _day_rows(day, loads, _case(day, choice), fixed)
+            powers, state = day.connections(fixed[:1], series=day.study.switch_series)
+            series["p_twofold_w"].append(powers[day.study.connection][0])
+            series["switch_state"].append(np.where(powers["switching"][0] > 0, state[0], -1))
+            done += 1
+            if progress is not None:
+                progress(done, total)
+        if not extras and len({len(p) for p in series["p_twofold_w"]}) == 1:
+            hours_of_day = (day.times - day.times.normalize()) / pd.Timedelta(hours=1)
+            extras = {"dates": list(dates), "hours": np.asarray(hours_of_day), "fold_angle": float(fixed[0]),
+                      **{key: np.stack(value) for key, value in series.items()}}
+    return SweepResult(plan, pd.DataFrame(rows), extras)
+
+
+def _case(day: Day, choice: dict) -> dict:
+    site = day.study.site
+    return {
+        "site_name": site.name or "",
+        "latitude": site.latitude,
+        "longitude": site.longitude,
+        "date": day.study.date.isoformat(),
+        "day_of_year": day.study.date.timetuple().tm_yday,
+        **{path: _plain(value) for path, value in choice.items() if path not in _AXIS_COLUMNS},
+    }
 
 
 def _plain(value):

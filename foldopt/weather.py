@@ -1,0 +1,97 @@
+"""Weather files and pvlib clear skies: global, direct and diffuse irradiance per time step.
+
+Weather files are read through pvlib.iotools (TMY3, EPW, PVGIS TMY) once per study; their
+timestamps label the end (TMY3, EPW) or the start (PVGIS) of each interval, and foldopt moves
+them to the interval centre, like its own clear-sky steps. Years are coerced to one (a TMY mixes
+years), so a non-leap year matches the files' 365 days.
+
+References
+----------
+.. [1] pvlib.iotools.read_tmy3, read_epw, read_pvgis_tmy; pvlib.clearsky.ineichen,
+   simplified_solis; pvlib.clearsky.lookup_linke_turbidity (bundled climatology).
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pvlib
+
+WEATHER_FORMATS = ("tmy3", "epw", "pvgis")
+#: Which edge of its interval each format's timestamp marks.
+INTERVAL_LABELS = {"tmy3": "end", "epw": "end", "pvgis": "start"}
+CLEAR_SKIES = ("ineichen", "simplified-solis")
+
+
+def weather_format(path: Path, fmt: str | None = None) -> str:
+    """The file's format: given, or from its extension (``.epw``; ``.csv`` is TMY3; ``.json`` PVGIS)."""
+    if fmt is not None:
+        if fmt not in WEATHER_FORMATS:
+            raise ValueError(f"weather format must be one of {', '.join(WEATHER_FORMATS)}; got {fmt!r}")
+        return fmt
+    suffix = Path(path).suffix.lower()
+    return {".epw": "epw", ".csv": "tmy3", ".json": "pvgis"}.get(suffix, "tmy3")
+
+
+@functools.lru_cache(maxsize=8)
+def _read(path: str, fmt: str, year: int, mtime: float):
+    if fmt == "tmy3":
+        data, meta = pvlib.iotools.read_tmy3(path, coerce_year=year, map_variables=True)
+    elif fmt == "epw":
+        data, meta = pvlib.iotools.read_epw(path, coerce_year=year)
+    else:
+        data, _, _, meta = pvlib.iotools.read_pvgis_tmy(path, map_variables=True)
+        data.index = data.index.map(lambda t: t.replace(year=year))
+    return data, meta
+
+
+def read_weather(path, fmt: str | None = None, year: int = 2025) -> pd.DataFrame:
+    """Weather as ``ghi``, ``dni``, ``dhi`` [W/m^2], ``temp_air`` [C], ``wind_speed`` [m/s].
+
+    Indexed by tz-aware interval centres (the file's own time zone), years coerced to ``year``.
+    """
+    path = Path(path)
+    fmt = weather_format(path, fmt)
+    data, _ = _read(str(path.resolve()), fmt, year, path.stat().st_mtime)
+    index = pd.DatetimeIndex(data.index)
+    step = pd.Series(index).diff().median()
+    shift = -step / 2 if INTERVAL_LABELS[fmt] == "end" else step / 2
+    frame = pd.DataFrame(
+        {name: pd.to_numeric(data[name], errors="coerce").to_numpy() for name in ("ghi", "dni", "dhi", "temp_air", "wind_speed")},
+        index=index + shift,
+    )
+    return frame.sort_index().fillna({"temp_air": 20.0, "wind_speed": 1.0}).fillna(0.0)
+
+
+def weather_day(frame: pd.DataFrame, date) -> pd.DataFrame:
+    """The intervals of ``frame`` whose centres fall on ``date`` (local to the file)."""
+    day = frame[frame.index.date == date]
+    if day.empty:
+        raise ValueError(f"the weather file has no data for {date}")
+    return day
+
+
+def clear_sky(times, solar_zenith, apparent_zenith, latitude, longitude, altitude, model="ineichen",
+              linke_turbidity=None):
+    """pvlib clear-sky ``ghi``, ``dni``, ``dhi`` [W/m^2] at ``times``.
+
+    ``ineichen`` takes ``linke_turbidity``, or looks it up in pvlib's bundled climatology (offline);
+    ``simplified-solis`` uses its defaults (aerosol optical depth 0.1, precipitable water 1 cm).
+    """
+    if model == "ineichen":
+        turbidity = linke_turbidity
+        if turbidity is None:
+            turbidity = pvlib.clearsky.lookup_linke_turbidity(times, latitude, longitude).to_numpy()
+        airmass = pvlib.atmosphere.get_absolute_airmass(
+            pvlib.atmosphere.get_relative_airmass(apparent_zenith), pvlib.atmosphere.alt2pres(altitude)
+        )
+        dni_extra = pvlib.irradiance.get_extra_radiation(times).to_numpy()
+        sky = pvlib.clearsky.ineichen(apparent_zenith, airmass, turbidity, altitude, dni_extra)
+    elif model == "simplified-solis":
+        sky = pvlib.clearsky.simplified_solis(90.0 - np.asarray(apparent_zenith), pressure=pvlib.atmosphere.alt2pres(altitude))
+    else:
+        raise ValueError(f"clear sky must be one of {', '.join(CLEAR_SKIES)}; got {model!r}")
+    return {key: np.nan_to_num(np.asarray(sky[key], dtype=float)) for key in ("ghi", "dni", "dhi")}
