@@ -145,6 +145,9 @@ class Weather(_Strict):
 
     path: str
     format: Literal[("tmy3", "epw", "pvgis")] | None = Field(None, description="default from the extension")
+    label: Literal[("start", "end", "centre")] | None = Field(
+        None, description="what a timestamp marks; default the format's (TMY3 end, EPW and PVGIS start)"
+    )
 
 
 _STATISTIC = re.compile(r"^(mean|min|worst-month|p(\d{1,2}))$")

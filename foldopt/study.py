@@ -45,7 +45,7 @@ class Day:
         temp_air = study.temp_air
         self.ghi = self.dhi = None
         if study.weather is not None:
-            frame = weather_day(read_weather(study.weather.path, study.weather.format, study.date.year), study.date)
+            frame = weather_day(read_weather(study.weather.path, study.weather.format, study.date.year, study.weather.label), study.date)
             self.times = pd.DatetimeIndex(frame.index)
             self.step_hours = float(pd.Series(self.times).diff().median() / pd.Timedelta(hours=1))
             # Cells follow the day's mean air temperature (the electrical tables assume one per

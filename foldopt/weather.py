@@ -1,8 +1,9 @@
 """Weather files and pvlib clear skies: global, direct and diffuse irradiance per time step.
 
-Weather files are read through pvlib.iotools (TMY3, EPW, PVGIS TMY) once per study; their
-timestamps label the end (TMY3, EPW) or the start (PVGIS) of each interval, and foldopt moves
-them to the interval centre, like its own clear-sky steps. Years are coerced to one (a TMY mixes
+Weather files are read through pvlib.iotools (TMY3, EPW, PVGIS TMY) once per study. As pvlib
+returns them, timestamps mark the end of each interval for TMY3 and its start for EPW (pvlib moves
+EPW's hour-ending rows back an hour) and for PVGIS (hour-start stamps); foldopt moves them to the
+interval centre, like its own clear-sky steps. ``label`` overrides the convention. Years are coerced to one (a TMY mixes
 years), so a non-leap year matches the files' 365 days.
 
 References
@@ -21,8 +22,9 @@ import pandas as pd
 import pvlib
 
 WEATHER_FORMATS = ("tmy3", "epw", "pvgis")
-#: Which edge of its interval each format's timestamp marks.
-INTERVAL_LABELS = {"tmy3": "end", "epw": "end", "pvgis": "start"}
+#: Which edge of its interval each format's timestamp marks, as pvlib.iotools returns it
+#: (checked for TMY3 and EPW in tests/test_weather.py).
+INTERVAL_LABELS = {"tmy3": "end", "epw": "start", "pvgis": "start"}
 CLEAR_SKIES = ("ineichen", "simplified-solis")
 
 
@@ -48,17 +50,19 @@ def _read(path: str, fmt: str, year: int, mtime: float):
     return data, meta
 
 
-def read_weather(path, fmt: str | None = None, year: int = 2025) -> pd.DataFrame:
+def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | None = None) -> pd.DataFrame:
     """Weather as ``ghi``, ``dni``, ``dhi`` [W/m^2], ``temp_air`` [C], ``wind_speed`` [m/s].
 
     Indexed by tz-aware interval centres (the file's own time zone), years coerced to ``year``.
+    ``label`` (``start``, ``end`` or ``centre``) overrides the format's timestamp convention.
     """
     path = Path(path)
     fmt = weather_format(path, fmt)
     data, _ = _read(str(path.resolve()), fmt, year, path.stat().st_mtime)
     index = pd.DatetimeIndex(data.index)
     step = pd.Series(index).diff().median()
-    shift = -step / 2 if INTERVAL_LABELS[fmt] == "end" else step / 2
+    label = label or INTERVAL_LABELS[fmt]
+    shift = {"end": -step / 2, "start": step / 2, "centre": step * 0}[label]
     frame = pd.DataFrame(
         {name: pd.to_numeric(data[name], errors="coerce").to_numpy() for name in ("ghi", "dni", "dhi", "temp_air", "wind_speed")},
         index=index + shift,

@@ -94,3 +94,36 @@ def test_an_annual_objective_keeps_one_angle_all_year():
     # The chosen angle maximises the mean over the days among the grid's angles.
     flat = result.table[result.table.design == "flat"]
     assert twofold["t_solar_h"].mean() >= flat["t_solar_h"].mean() - 1e-9
+
+
+def write_epw(path, ghi_at_noon=800.0):
+    """A minimal two-day EPW (8 header lines, 35 fields a row) with a half-sine day."""
+    header = [
+        "LOCATION,Test,XX,XXX,Synthetic,000000,36.10,-79.95,-5.0,273.0",
+        "DESIGN CONDITIONS,0", "TYPICAL/EXTREME PERIODS,0", "GROUND TEMPERATURES,0",
+        "HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0", "COMMENTS 1,synthetic", "COMMENTS 2,",
+        "DATA PERIODS,1,1,Data,Sunday, 6/21,6/22",
+    ]
+    rows = []
+    for day in (21, 22):
+        for hour in range(1, 25):  # EPW hour h is the interval (h-1, h]
+            centre = hour - 0.5
+            ghi = max(0.0, ghi_at_noon * np.sin(np.pi * (centre - 6) / 12)) if 6 < centre < 18 else 0.0
+            fields = [2005, 6, day, hour, 60, "?", 25.0, 15.0, 50, 100000, 0, 1415, 300, ghi, 0.8 * ghi,
+                      0.2 * ghi, 0, 0, 0, 0, 180, 2.0, 0, 0, 20, 99999, 9, 999999999, 0, 0.1, 0, 88, 0.2, 0, 1]
+            rows.append(",".join(str(f) for f in fields))
+    path.write_text("\n".join(header + rows) + "\n")
+
+
+def test_epw_timestamps_move_to_interval_centres(tmp_path):
+    path = tmp_path / "site.epw"
+    write_epw(path)
+    frame = read_weather(path)
+    assert len(frame) == 48
+    day = weather_day(frame, dt.date(2025, 6, 21))
+    # The row for EPW hour 13 (12:00-13:00) is centred at 12:30 and carries the noon-side value.
+    assert day.index[12].strftime("%H:%M") == "12:30"
+    assert day["ghi"].iloc[12] == pytest.approx(800.0 * np.sin(np.pi * 6.5 / 12))
+    assert day["dni"].iloc[12] == pytest.approx(0.8 * day["ghi"].iloc[12])
+    study = make_study({**BASE, "weather": str(path), "date": "2025-06-22"})
+    assert Day(study).step_hours == pytest.approx(1.0)
