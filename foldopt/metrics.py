@@ -45,6 +45,55 @@ def t_solar(p_pv, p_load, step_hours):
     return above.sum(axis=-1)
 
 
+def t_solar_many_loads(p_pv, loads, step_hours):
+    """``t_solar`` [h] of each curve for many loads in one pass: shape ``p_pv.shape[:-1] + (n_loads,)``.
+
+    Each segment of the piecewise-linear curve, with end values lo <= hi and length dt, is above a
+    load L for ``dt * clip((hi - L) / (hi - lo), 0, 1)``: all of it below lo, none above hi, a
+    linear share between. Summed over segments that is piecewise linear in L, so sorting the
+    segments' lo and hi once and taking prefix sums evaluates every load by binary search, instead
+    of one pass over the power per load. Equals :func:`t_solar` to 1e-6 h (tested; see below).
+    """
+    p_pv = np.asarray(p_pv, dtype=float)
+    loads = np.asarray(loads, dtype=float)
+    flat = p_pv.reshape(-1, p_pv.shape[-1])
+    # Segments: the held half-steps at both ends (lo = hi) and the n - 1 linear ones between.
+    start = np.concatenate([flat[:, :1], flat[:, :-1], flat[:, -1:]], axis=1)
+    end = np.concatenate([flat[:, :1], flat[:, 1:], flat[:, -1:]], axis=1)
+    length = np.r_[0.5, np.ones(flat.shape[1] - 1), 0.5] * step_hours
+    lo, hi = np.minimum(start, end), np.maximum(start, end)
+    width = hi - lo
+    # Segments narrower than 1e-6 of the curve's peak count as flat. Near-flat segments would carry
+    # huge slopes, whose terms cancel only approximately in the prefix sums; with this floor the
+    # rounding stays below n * eps * 1e6 * dt ~ 2e-7 h, and the flat treatment errs only for loads
+    # inside that 1e-6 band.
+    scale = np.maximum(1.0, np.abs(flat).max(axis=1, keepdims=True))
+    sloped = width > 1e-6 * scale
+    # Flat segments count fully while L <= hi (>= keeps P == L as served, like t_solar).
+    full = np.where(sloped, 0.0, length)
+    slope = np.where(sloped, length / np.where(sloped, width, 1.0), 0.0)
+    out = np.empty((flat.shape[0], loads.size))
+    for row in range(flat.shape[0]):
+        order_hi = np.argsort(hi[row])
+        hi_sorted = hi[row][order_hi]
+        # Flat segments: those with hi >= L.
+        full_suffix = np.r_[np.cumsum(full[row][order_hi][::-1])[::-1], 0.0]
+        flat_part = full_suffix[np.searchsorted(hi_sorted, loads, side="left")]
+        # Sloped segments: length where lo >= L, slope * (hi - L) where lo < L < hi.
+        order_lo = np.argsort(lo[row])
+        lo_sorted = lo[row][order_lo]
+        len_lo = np.where(sloped[row], length, 0.0)[order_lo]
+        above_lo = np.r_[np.cumsum(len_lo[::-1])[::-1], 0.0][np.searchsorted(lo_sorted, loads, side="left")]
+        s_lo, sh_lo = slope[row][order_lo], (slope[row] * hi[row])[order_lo]
+        s_hi, sh_hi = slope[row][order_hi], (slope[row] * hi[row])[order_hi]
+        below_lo = np.searchsorted(lo_sorted, loads, side="left")  # segments with lo < L
+        upto_hi = np.searchsorted(hi_sorted, loads, side="right")  # segments with hi <= L
+        cum = lambda values: np.r_[0.0, np.cumsum(values)]  # noqa: E731
+        partial = (cum(sh_lo)[below_lo] - cum(sh_hi)[upto_hi]) - loads * (cum(s_lo)[below_lo] - cum(s_hi)[upto_hi])
+        out[row] = flat_part + above_lo + partial
+    return out.reshape(p_pv.shape[:-1] + (loads.size,))
+
+
 def t_solar_contiguous(p_pv, p_load, step_hours):
     """Longest contiguous solar-powered interval [h]."""
     above, excess = _time_above_per_segment(p_pv, p_load, step_hours)

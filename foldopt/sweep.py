@@ -17,11 +17,11 @@ import numpy as np
 import pandas as pd
 
 from foldopt.config import Plan
-from foldopt.metrics import daily_metrics, t_solar
+from foldopt.metrics import daily_metrics, t_solar, t_solar_many_loads
 from foldopt.study import Day
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
-_LOAD_CHUNK_VALUES = 4_000_000  # floats per t_solar pass, to bound memory
+_MANY_LOADS = 4  # from this many loads, one sorted pass beats a pass per load
 
 
 @dataclass(frozen=True)
@@ -54,11 +54,9 @@ def _angle_hours(day: Day, loads: np.ndarray):
     """Fold-angle grid, twofold power (k, n_time) and t_solar for every load and angle (L, k)."""
     angles = np.asarray(day.study.fold_angles.grid())
     power = day.combined_power(angles)
-    chunk = max(1, _LOAD_CHUNK_VALUES // power.size)
-    hours = np.concatenate(
-        [t_solar(power, loads[i : i + chunk, None], day.step_hours) for i in range(0, loads.size, chunk)]
-    )
-    return angles, power, hours
+    if loads.size >= _MANY_LOADS:
+        return angles, power, t_solar_many_loads(power, loads, day.step_hours).T
+    return angles, power, t_solar(power, loads[:, None], day.step_hours)
 
 
 def _day_rows(day: Day, loads: np.ndarray, case: dict, fixed_angles=None) -> list[dict]:
