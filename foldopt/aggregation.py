@@ -119,6 +119,7 @@ def connection_powers(
     *,
     switch_series: bool = False,
     converter_efficiency: float = 1.0,
+    with_state: bool = True,
 ):
     """Deliverable power of every connection [W], and the state switching chooses.
 
@@ -133,12 +134,14 @@ def connection_powers(
         Whether the switch may also select series.
     converter_efficiency : float, default 1
         Efficiency of each converter of ``independent`` [-].
+    with_state : bool, default True
+        Whether to work out the switch state (None otherwise; it costs a pass over the arrays).
 
     Returns
     -------
     powers : dict of numpy.ndarray
         One entry per name of :data:`CONNECTIONS`.
-    state : numpy.ndarray of int
+    state : numpy.ndarray of int or None
         Index into :data:`SWITCH_STATES` of the state switching chose per step.
     """
     p_east, p_west = np.asarray(p_east, dtype=float), np.asarray(p_west, dtype=float)
@@ -154,9 +157,11 @@ def connection_powers(
         "independent": converter_efficiency * independent,
         "switching": stacked.max(axis=0),
     }
+    if not with_state:
+        return powers, None
     # The state is the first (simplest) one within solver precision of the best: with a dark
     # sub-panel, parallel equals the lit one alone and must not win on rounding.
-    best = stacked.max(axis=0)
+    best = powers["switching"]
     return powers, np.argmax(stacked >= best * (1 - 1e-6) - 1e-12, axis=0)
 
 

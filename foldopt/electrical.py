@@ -4,7 +4,7 @@ With the air temperature and wind fixed for a study, a sub-panel's cell temperat
 maximum power, depends only on its irradiance; a connected pair's power depends only on the two
 irradiances. The fast path tabulates these once per study, a 1-D table of sub-panel maximum power
 and 2-D tables of the parallel and series pair, on irradiance nodes spaced quadratically (dense
-at low irradiance, where power bends), and interpolates linearly. The exact path solves every
+at low irradiance, where power bends), and interpolates linearly in sqrt(E), on which the nodes are uniform. The exact path solves every
 step's I-V curves. ``bench/electrical.py`` and ``tests/test_electrical.py`` measure the
 tables' error against it.
 """
@@ -14,7 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
 
 from foldopt.aggregation import connection_powers, parallel_power, series_power
 from foldopt.pvmodel import PVModel, cell_temperature
@@ -27,6 +26,28 @@ TABLE_NODES_RATIO = 321
 
 def _nodes(count):
     return IRRADIANCE_MAX * np.linspace(0.0, 1.0, count) ** 2
+
+
+def _node_position(poa, count):
+    """Fractional index of irradiances on :func:`_nodes`: the nodes are uniform in sqrt(E / E_max)."""
+    return np.sqrt(np.clip(poa, 0.0, IRRADIANCE_MAX) / IRRADIANCE_MAX) * (count - 1)
+
+
+def _linear(values, position):
+    """Linear interpolation of a 1-D table at fractional indices."""
+    index = np.minimum(position.astype(np.intp), values.size - 2)
+    weight = position - index
+    return values[index] * (1.0 - weight) + values[index + 1] * weight
+
+
+def _bilinear(values, first, second):
+    """Bilinear interpolation of a 2-D table at fractional indices (cheaper than scipy's generic
+    RegularGridInterpolator on these regular index grids)."""
+    i = np.minimum(first.astype(np.intp), values.shape[0] - 2)
+    j = np.minimum(second.astype(np.intp), values.shape[1] - 2)
+    fi, fj = first - i, second - j
+    return ((values[i, j] * (1.0 - fj) + values[i, j + 1] * fj) * (1.0 - fi)
+            + (values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj) * fi)
 
 
 @dataclass
@@ -91,7 +112,7 @@ class Electrical:
         return self._tables[name]
 
     def _pair_table(self, connection, axis0, axis1, to_irradiance):
-        """Interpolator of a pair's power as a fraction of its two maxima on a 2-D grid.
+        """A pair's power as a fraction of its two maxima on a 2-D grid of nodes.
 
         The fraction is smoother than the power and zero-safe. Series is tabulated without bypass
         diodes; with ideal ones it is the larger of that and the stronger sub-panel alone
@@ -105,7 +126,7 @@ class Electrical:
         power = parallel_power(east, west) if connection == "parallel" else series_power(east, west, bypass=False)
         with np.errstate(invalid="ignore", divide="ignore"):
             fraction = np.where(bound > 0, power / bound, 1.0)
-        return RegularGridInterpolator((axis0, axis1), fraction.reshape(axis0.size, axis1.size))
+        return fraction.reshape(axis0.size, axis1.size)
 
     def subpanel_power(self, poa):
         """Maximum power of one sub-panel [W] at irradiance ``poa`` [W/m^2] (any shape)."""
@@ -116,39 +137,47 @@ class Electrical:
         poa = np.asarray(poa, dtype=float)
         if self.exact or not self.pv.has_iv:
             return self.pv.max_power(poa, self._temperature(poa), area)
-        g1, p1 = self._table("subpanel")
-        return np.interp(np.clip(poa, 0.0, IRRADIANCE_MAX), g1, p1) * (area / self.subpanel_area)
+        _, p1 = self._table("subpanel")
+        return _linear(p1, _node_position(poa, TABLE_NODES_1D)) * (area / self.subpanel_area)
 
-    def connections(self, poa_east, poa_west, series: bool = True):
+    def connections(self, poa_east, poa_west, series: bool = True, with_state: bool = True):
         """Every connection's power [W] and the switching state, as :func:`connection_powers`.
 
         With ``series`` false the series power is left NaN (and its table unbuilt), for callers
-        whose connection and switch do not use it.
+        whose connection and switch do not use it; ``with_state`` false skips the switch state.
         """
+        options = {**self._options, "with_state": with_state}
         poa_east, poa_west = np.broadcast_arrays(np.asarray(poa_east, float), np.asarray(poa_west, float))
-        p_east, p_west = self.subpanel_power(poa_east), self.subpanel_power(poa_west)
+        if not self.pv.has_iv or self.exact:
+            p_east, p_west = self.subpanel_power(poa_east), self.subpanel_power(poa_west)
         if not self.pv.has_iv:
-            return connection_powers(p_east, p_west, **self._options)
+            return connection_powers(p_east, p_west, **options)
         if self.exact:
             east = self.pv.curves(poa_east, self._temperature(poa_east), self.subpanel_area)
             west = self.pv.curves(poa_west, self._temperature(poa_west), self.subpanel_area)
             p_parallel = parallel_power(east, west)
             p_series = series_power(east, west, self.bypass) if series else np.full(p_east.shape, np.nan)
-            return connection_powers(p_east, p_west, p_parallel, p_series, **self._options)
+            return connection_powers(p_east, p_west, p_parallel, p_series, **options)
         east, west = np.clip(poa_east, 0.0, IRRADIANCE_MAX), np.clip(poa_west, 0.0, IRRADIANCE_MAX)
+        # Both tables' nodes are uniform in sqrt(E / E_max): one square root serves them all.
+        root_east, root_west = np.sqrt(east / IRRADIANCE_MAX), np.sqrt(west / IRRADIANCE_MAX)
+        _, p1 = self._table("subpanel")
+        p_east = _linear(p1, root_east * (TABLE_NODES_1D - 1))
+        p_west = _linear(p1, root_west * (TABLE_NODES_1D - 1))
         bound = p_east + p_west
         # Identical sub-panels at equal irradiance (a flat fold, or noon) deliver exactly their sum
         # in parallel and in series; interpolation across the table's diagonal would not.
         equal = east == west
-        p_parallel = np.where(equal, 1.0, np.clip(self._table("parallel")(np.stack([east, west], axis=-1)), 0, 1)) * bound
+        at_east, at_west = root_east * (TABLE_NODES_2D - 1), root_west * (TABLE_NODES_2D - 1)
+        p_parallel = np.where(equal, 1.0, np.clip(_bilinear(self._table("parallel"), at_east, at_west), 0, 1)) * bound
         if series:
             strong = np.maximum(east, west)
             with np.errstate(invalid="ignore", divide="ignore"):
                 weak_ratio = np.where(strong > 0, np.minimum(east, west) / strong, 1.0)
-            fraction = self._table("series")(np.stack([strong, weak_ratio], axis=-1))
+            fraction = _bilinear(self._table("series"), np.maximum(at_east, at_west), weak_ratio * (TABLE_NODES_RATIO - 1))
             p_series = np.where(equal, 1.0, np.clip(fraction, 0.0, 1.0)) * bound
             if self.bypass:
                 p_series = np.maximum(p_series, np.maximum(p_east, p_west))
         else:
             p_series = np.full(p_east.shape, np.nan)
-        return connection_powers(p_east, p_west, p_parallel, p_series, **self._options)
+        return connection_powers(p_east, p_west, p_parallel, p_series, **options)

@@ -70,27 +70,33 @@ def t_solar_many_loads(p_pv, loads, step_hours):
     scale = np.maximum(1.0, np.abs(flat).max(axis=1, keepdims=True))
     sloped = width > 1e-6 * scale
     # Flat segments count fully while L <= hi (>= keeps P == L as served, like t_solar).
-    full = np.where(sloped, 0.0, length)
     slope = np.where(sloped, length / np.where(sloped, width, 1.0), 0.0)
-    out = np.empty((flat.shape[0], loads.size))
-    for row in range(flat.shape[0]):
-        order_hi = np.argsort(hi[row])
-        hi_sorted = hi[row][order_hi]
-        # Flat segments: those with hi >= L.
-        full_suffix = np.r_[np.cumsum(full[row][order_hi][::-1])[::-1], 0.0]
-        flat_part = full_suffix[np.searchsorted(hi_sorted, loads, side="left")]
-        # Sloped segments: length where lo >= L, slope * (hi - L) where lo < L < hi.
-        order_lo = np.argsort(lo[row])
-        lo_sorted = lo[row][order_lo]
-        len_lo = np.where(sloped[row], length, 0.0)[order_lo]
-        above_lo = np.r_[np.cumsum(len_lo[::-1])[::-1], 0.0][np.searchsorted(lo_sorted, loads, side="left")]
-        s_lo, sh_lo = slope[row][order_lo], (slope[row] * hi[row])[order_lo]
-        s_hi, sh_hi = slope[row][order_hi], (slope[row] * hi[row])[order_hi]
-        below_lo = np.searchsorted(lo_sorted, loads, side="left")  # segments with lo < L
-        upto_hi = np.searchsorted(hi_sorted, loads, side="right")  # segments with hi <= L
-        cum = lambda values: np.r_[0.0, np.cumsum(values)]  # noqa: E731
-        partial = (cum(sh_lo)[below_lo] - cum(sh_hi)[upto_hi]) - loads * (cum(s_lo)[below_lo] - cum(s_hi)[upto_hi])
-        out[row] = flat_part + above_lo + partial
+    rows, n_seg = flat.shape[0], length.size
+    length = np.broadcast_to(length, lo.shape)
+    full = np.where(sloped, 0.0, length)
+    sloped_length = np.where(sloped, length, 0.0)
+    order_hi, order_lo = np.argsort(hi, axis=1), np.argsort(lo, axis=1)
+    hi_sorted, lo_sorted = np.take_along_axis(hi, order_hi, 1), np.take_along_axis(lo, order_lo, 1)
+
+    def prefix(values, order):  # row-wise prefix sums with a leading 0
+        return np.concatenate([np.zeros((rows, 1)), np.cumsum(np.take_along_axis(values, order, 1), axis=1)], axis=1)
+
+    def counts(keys, side):  # per row, how many keys lie below (left) / at or below (right) each load
+        span = float(max(np.abs(keys).max(), np.abs(loads).max(), 1.0)) * 4.0
+        offsets = np.arange(rows)[:, None] * span
+        found = np.searchsorted((keys + offsets).ravel(), (loads[None, :] + offsets).ravel(), side=side)
+        return found.reshape(rows, loads.size) - np.arange(rows)[:, None] * n_seg
+
+    lo_below, hi_upto, hi_below = counts(lo_sorted, "left"), counts(hi_sorted, "right"), counts(hi_sorted, "left")
+    total = lambda cumulative, index: np.take_along_axis(cumulative, index, 1)  # noqa: E731
+    # Flat segments count while hi >= L; sloped ones fully while lo >= L, partly while lo < L < hi.
+    flat_full = total(prefix(full, order_hi), np.full_like(hi_below, n_seg)) - total(prefix(full, order_hi), hi_below)
+    above_lo = total(prefix(sloped_length, order_lo), np.full_like(lo_below, n_seg)) - total(
+        prefix(sloped_length, order_lo), lo_below)
+    slope_hi = slope * hi
+    partial = (total(prefix(slope_hi, order_lo), lo_below) - total(prefix(slope_hi, order_hi), hi_upto)) - loads * (
+        total(prefix(slope, order_lo), lo_below) - total(prefix(slope, order_hi), hi_upto))
+    out = flat_full + above_lo + partial
     return out.reshape(p_pv.shape[:-1] + (loads.size,))
 
 

@@ -19,7 +19,7 @@ import pvlib
 from foldopt.atmosphere import clear_sky_dni, relative_airmass
 from foldopt.config import Study, parse_timezone
 from foldopt.electrical import Electrical
-from foldopt.geometry import subpanel_orientation
+from foldopt.geometry import normal_vector, subpanel_orientation
 from foldopt.irradiance import beam_incidence_factor
 from foldopt.metrics import daily_metrics, load_for_t_solar, t_solar
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
@@ -59,6 +59,7 @@ class Day:
         self.solar_azimuth = sun["solar_azimuth"].to_numpy()
         self.hour_angle = sun["hour_angle"].to_numpy()
         self.declination = sun["declination"].to_numpy()
+        self.sun_vector = normal_vector(self.solar_zenith, self.solar_azimuth)  # east-north-up, unit
         altitude = site.altitude if study.mode == "exact" else 0.0
         if study.weather is not None:
             self.dni, self.ghi, self.dhi = (frame[key].to_numpy(dtype=float) for key in ("dni", "ghi", "dhi"))
@@ -107,9 +108,14 @@ class Day:
             tilt, azimuth = tilt[..., None], azimuth[..., None]
         study = self.study
         if self.transposition == "none":
-            model = "exact" if per_step else study.mode
-            beam = self.dni * beam_incidence_factor(tilt, azimuth, self.solar_zenith, self.solar_azimuth, model=model)
-            return beam * self._iam(tilt, azimuth)
+            if per_step or study.mode == "paper":
+                model = "exact" if per_step else study.mode
+                factor = beam_incidence_factor(tilt, azimuth, self.solar_zenith, self.solar_azimuth, model=model)
+            else:
+                # cos(AOI) of every fold angle at every step is one matrix product of the surface
+                # normals with the sun vectors (equal to pvlib's aoi_projection; tested).
+                factor = np.clip(normal_vector(tilt[..., 0], azimuth[..., 0]) @ self.sun_vector.T, 0.0, None)
+            return self.dni * factor * self._iam(tilt, azimuth)
         dhi = self.dhi if self.dhi is not None else np.zeros_like(self.dni)
         ghi = self.ghi if self.ghi is not None else self.dni * np.clip(np.cos(np.radians(self.solar_zenith)), 0, None)
         poa = pvlib.irradiance.get_total_irradiance(
@@ -156,7 +162,7 @@ class Day:
         drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
         return tracker_draw(*self.tracker_orientation(model), self.dni > 0, self.step_hours, drive)
 
-    def connections(self, fold_angles, series: bool = True):
+    def connections(self, fold_angles, series: bool = True, with_state: bool = True):
         """Every connection's power [W], each (k, n_time), and the switching state per step.
 
         ``series=False`` skips the series connection (NaN) when nothing asks for it."""
@@ -164,18 +170,18 @@ class Day:
         sides = subpanel_orientation(fold_angles, panel.tilt, panel.azimuth, self.study.geometry)
         poa_east = self._poa(sides["tilt_east"], sides["azimuth_east"])
         poa_west = self._poa(sides["tilt_west"], sides["azimuth_west"])
-        return self.electrical.connections(poa_east, poa_west, series)
+        return self.electrical.connections(poa_east, poa_west, series, with_state)
 
     def subpanel_power(self, fold_angles):
         """East and west sub-panel powers and their parallel connection [W], each (k, n_time)."""
-        powers, _ = self.connections(fold_angles, series=False)
+        powers, _ = self.connections(fold_angles, series=False, with_state=False)
         return powers["east"], powers["west"], powers["parallel"]
 
     def combined_power(self, fold_angles, connection=None):
         """Deliverable twofold power [W], (k, n_time), under ``connection`` (default: the study's)."""
         connection = connection or self.study.connection
         series = connection == "series" or self.study.switch_series
-        return self.connections(fold_angles, series)[0][connection]
+        return self.connections(fold_angles, series, with_state=False)[0][connection]
 
 
 @dataclass(frozen=True)

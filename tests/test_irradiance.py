@@ -57,3 +57,14 @@ def test_ideal_tracker_sees_all_of_the_beam_in_both_modes(model):
     np.testing.assert_allclose(beam_incidence_factor(tilt, surface_azimuth, zenith, azimuth, model), 1.0, atol=1e-12)
     with pytest.raises(ValueError, match="dual-axis, equatorial, dual-axis-steps, single-axis"):
         tracker_orientation("azimuthal", zenith, azimuth, np.zeros(3), np.zeros(3), 30.0)
+
+
+def test_day_incidence_by_matrix_product_equals_pvlib(shin_study):
+    from foldopt.geometry import subpanel_orientation
+    from foldopt.study import Day
+
+    day = Day(shin_study.variant(mode="exact", geometry="hinge", step_min=10))
+    sides = subpanel_orientation(np.array([20.0, 90.0, 180.0]), 34.05, 180.0, "hinge")
+    expected = day.dni * np.clip(pvlib.irradiance.aoi_projection(
+        sides["tilt_east"][:, None], sides["azimuth_east"][:, None], day.solar_zenith, day.solar_azimuth), 0, None)
+    np.testing.assert_allclose(day._poa(sides["tilt_east"], sides["azimuth_east"]), expected, rtol=1e-12, atol=1e-9)
