@@ -52,7 +52,7 @@ def t_solar_many_loads(p_pv, loads, step_hours):
     load L for ``dt * clip((hi - L) / (hi - lo), 0, 1)``: all of it below lo, none above hi, a
     linear share between. Summed over segments that is piecewise linear in L, so sorting the
     segments' lo and hi once and taking prefix sums evaluates every load by binary search, instead
-    of one pass over the power per load. Equals :func:`t_solar` to 1e-6 h (tested; see below).
+    of one pass over the power per load. Equals :func:`t_solar` to 1e-6 h (tested).
     """
     p_pv = np.asarray(p_pv, dtype=float)
     loads = np.asarray(loads, dtype=float)
@@ -63,17 +63,18 @@ def t_solar_many_loads(p_pv, loads, step_hours):
     length = np.r_[0.5, np.ones(flat.shape[1] - 1), 0.5] * step_hours
     lo, hi = np.minimum(start, end), np.maximum(start, end)
     width = hi - lo
-    # Segments narrower than 1e-6 of the curve's peak count as flat. Near-flat segments would carry
-    # huge slopes, whose terms cancel only approximately in the prefix sums; with this floor the
-    # rounding stays below n * eps * 1e6 * dt ~ 2e-7 h, and the flat treatment errs only for loads
-    # inside that 1e-6 band.
+    # Segments narrower than 1e-6 of the curve's peak would carry huge slopes, whose terms cancel
+    # only approximately in the prefix sums; they (rare: night and plateaus are exactly flat) get
+    # their exact share directly below. The rest keep the prefix-sum rounding below
+    # n * eps * 1e6 * dt ~ 2e-7 h.
     scale = np.maximum(1.0, np.abs(flat).max(axis=1, keepdims=True))
     sloped = width > 1e-6 * scale
+    narrow = (width > 0) & ~sloped
     # Flat segments count fully while L <= hi (>= keeps P == L as served, like t_solar).
     slope = np.where(sloped, length / np.where(sloped, width, 1.0), 0.0)
     rows, n_seg = flat.shape[0], length.size
     length = np.broadcast_to(length, lo.shape)
-    full = np.where(sloped, 0.0, length)
+    full = np.where(width == 0, length, 0.0)
     sloped_length = np.where(sloped, length, 0.0)
     order_hi, order_lo = np.argsort(hi, axis=1), np.argsort(lo, axis=1)
     hi_sorted, lo_sorted = np.take_along_axis(hi, order_hi, 1), np.take_along_axis(lo, order_lo, 1)
@@ -82,10 +83,8 @@ def t_solar_many_loads(p_pv, loads, step_hours):
         return np.concatenate([np.zeros((rows, 1)), np.cumsum(np.take_along_axis(values, order, 1), axis=1)], axis=1)
 
     def counts(keys, side):  # per row, how many keys lie below (left) / at or below (right) each load
-        span = float(max(np.abs(keys).max(), np.abs(loads).max(), 1.0)) * 4.0
-        offsets = np.arange(rows)[:, None] * span
-        found = np.searchsorted((keys + offsets).ravel(), (loads[None, :] + offsets).ravel(), side=side)
-        return found.reshape(rows, loads.size) - np.arange(rows)[:, None] * n_seg
+        # Row by row: shifting rows apart to search them at once would round keys next to a load.
+        return np.array([np.searchsorted(row, loads, side=side) for row in keys]).reshape(rows, loads.size)
 
     lo_below, hi_upto, hi_below = counts(lo_sorted, "left"), counts(hi_sorted, "right"), counts(hi_sorted, "left")
     total = lambda cumulative, index: np.take_along_axis(cumulative, index, 1)  # noqa: E731
@@ -97,6 +96,10 @@ def t_solar_many_loads(p_pv, loads, step_hours):
     partial = (total(prefix(slope_hi, order_lo), lo_below) - total(prefix(slope_hi, order_hi), hi_upto)) - loads * (
         total(prefix(slope, order_lo), lo_below) - total(prefix(slope, order_hi), hi_upto))
     out = flat_full + above_lo + partial
+    row, seg = np.nonzero(narrow)
+    if row.size:
+        share = np.clip((hi[row, seg, None] - loads) / width[row, seg, None], 0.0, 1.0) * length[row, seg, None]
+        np.add.at(out, row, share)
     return out.reshape(p_pv.shape[:-1] + (loads.size,))
 
 

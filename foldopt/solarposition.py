@@ -142,6 +142,39 @@ def sun_from_angles(declination, hour_angle, latitude):
     return 90.0 - np.degrees(elevation), azimuth
 
 
+SPA_STRIDE = 10  # steps between full SPA evaluations on long regular series
+
+
+def _spa(times: pd.DatetimeIndex, latitude, longitude, altitude):
+    """Apparent zenith, azimuth [deg] and equation of time [min] by NREL SPA through pvlib.
+
+    On a long regular series SPA runs on every :data:`SPA_STRIDE`-th step only (and the last); the
+    geometric (refraction-free) sun vector and the equation of time, which are smooth, are
+    interpolated linearly between, and SPA's own refraction correction (``pvlib.spa``, with
+    pvlib's default pressure and 12 C) is applied to every step, so that the correction's kink at
+    the horizon stays exact. Measured at 1-minute steps against full SPA: the sun's direction
+    within 0.005 deg (apparent zenith within 0.005 deg; azimuth within 0.05 deg, the most where the
+    sun passes close to the zenith and azimuth hardly matters), the equation of time within 1e-7
+    min (tests/test_solarposition.py). It cuts the cost of a day's sun by about 3x.
+    """
+    if len(times) < 4 * SPA_STRIDE:
+        spa = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude=altitude)
+        return spa["apparent_zenith"].to_numpy(), spa["azimuth"].to_numpy(), spa["equation_of_time"].to_numpy()
+    picked = np.unique(np.r_[np.arange(0, len(times), SPA_STRIDE), len(times) - 1])
+    spa = pvlib.solarposition.get_solarposition(times[picked], latitude, longitude, altitude=altitude)
+    position = np.arange(len(times), dtype=float)
+    zenith0, azimuth = np.radians(spa["zenith"].to_numpy()), np.radians(spa["azimuth"].to_numpy())
+    vector = np.stack([np.sin(zenith0) * np.sin(azimuth), np.sin(zenith0) * np.cos(azimuth), np.cos(zenith0)], -1)
+    east, north, up = (np.interp(position, picked, vector[:, axis]) for axis in range(3))
+    elevation0 = np.degrees(np.arctan2(up, np.hypot(east, north)))
+    pressure = pvlib.atmosphere.alt2pres(altitude)
+    refraction = pvlib.spa.atmospheric_refraction_correction(pressure / 100.0, 12.0, elevation0, 0.5667)
+    zenith = 90.0 - (elevation0 + refraction)
+    azimuth_all = np.degrees(np.arctan2(east, north)) % 360.0
+    equation_of_time = np.interp(position, picked, spa["equation_of_time"].to_numpy())
+    return zenith, azimuth_all, equation_of_time
+
+
 def get_solar_position(
     times: pd.DatetimeIndex,
     latitude: float,
@@ -177,9 +210,8 @@ def get_solar_position(
         hour_angle = hour_angle_paper(times, longitude)
         zenith, azimuth = sun_from_angles(declination, hour_angle, latitude)
     elif model == "exact":
-        spa = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude=altitude)
-        zenith, azimuth = spa["apparent_zenith"].to_numpy(), spa["azimuth"].to_numpy()
-        hour_angle = pvlib.solarposition.hour_angle(times, longitude, spa["equation_of_time"].to_numpy())
+        zenith, azimuth, equation_of_time = _spa(times, latitude, longitude, altitude)
+        hour_angle = pvlib.solarposition.hour_angle(times, longitude, equation_of_time)
         hour_angle = (np.asarray(hour_angle) + 180.0) % 360.0 - 180.0
         declination = np.degrees(pvlib.solarposition.declination_spencer71(times.day_of_year))
     else:

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -102,6 +102,11 @@ def test_t_solar_never_rises_with_the_load_and_contiguous_never_exceeds_total(cu
 
 
 @settings(max_examples=150)
+# A curve a hair below the load: offsetting rows to search them together once rounded it onto it.
+@example(curves=np.r_[np.full((2, 40), 4.0), np.full((1, 40), np.nextafter(4.0, 0))], loads=np.ones(7))
+# A near-flat segment with the load inside it: once taken as flat, off by a whole step.
+@example(curves=np.r_[np.full((1, 40), 0.01), np.full((2, 40), 0.01) + np.r_[0.0, 1e-9, np.zeros(38)]],
+         loads=np.full(7, 0.01))
 @given(curves=arrays(np.float64, (3, 40), elements=st.floats(0, 20)),
        loads=arrays(np.float64, 7, elements=st.floats(0.01, 25)))
 def test_many_loads_in_one_sorted_pass_equals_one_pass_per_load(curves, loads):

@@ -100,3 +100,22 @@ def test_unknown_model_lists_valid_names():
     times = day_times(dt.date(2014, 9, 23), "UTC", 60)
     with pytest.raises(ValueError, match="paper, exact"):
         get_solar_position(times, 0, 0, model="spa")
+
+
+@pytest.mark.parametrize(
+    "latitude,longitude,date,zone",
+    [(34.05, -118.25, dt.date(2014, 9, 23), "America/Los_Angeles"), (70.0, 20.0, dt.date(2025, 6, 21), "UTC"),
+     (-33.9, 151.2, dt.date(2025, 6, 21), "Australia/Sydney"), (0.0, 0.0, dt.date(2025, 3, 20), "UTC")],
+)
+def test_subsampled_spa_stays_on_full_spa(latitude, longitude, date, zone):
+    from foldopt.geometry import normal_vector
+
+    times = day_times(date, zone, 1)
+    fast = get_solar_position(times, latitude, longitude, altitude=100, model="exact")
+    full = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude=100)
+    up = full["apparent_elevation"].to_numpy() > -1
+    a = normal_vector(fast["solar_zenith"].to_numpy(), fast["solar_azimuth"].to_numpy())[up]
+    b = normal_vector(full["apparent_zenith"].to_numpy(), full["azimuth"].to_numpy())[up]
+    angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.sum(a * b, axis=1)))
+    assert angle.max() < 0.006
+    np.testing.assert_allclose(fast["solar_zenith"].to_numpy()[up], full["apparent_zenith"].to_numpy()[up], atol=0.006)
