@@ -98,7 +98,8 @@ def t_solar_many_loads(p_pv, loads, step_hours):
     out = flat_full + above_lo + partial
     row, seg = np.nonzero(narrow)
     if row.size:
-        share = np.clip((hi[row, seg, None] - loads) / width[row, seg, None], 0.0, 1.0) * length[row, seg, None]
+        with np.errstate(over="ignore"):  # denormal widths: the share saturates at 0 or 1
+            share = np.clip((hi[row, seg, None] - loads) / width[row, seg, None], 0.0, 1.0) * length[row, seg, None]
         np.add.at(out, row, share)
     return out.reshape(p_pv.shape[:-1] + (loads.size,))
 

@@ -142,13 +142,14 @@ def sun_from_angles(declination, hour_angle, latitude):
     return 90.0 - np.degrees(elevation), azimuth
 
 
-SPA_STRIDE = 10  # steps between full SPA evaluations on long regular series
+SPA_SPACING_MIN = 10.0  # [min] between full SPA evaluations on finely stepped series
 
 
 def _spa(times: pd.DatetimeIndex, latitude, longitude, altitude):
     """Apparent zenith, azimuth [deg] and equation of time [min] by NREL SPA through pvlib.
 
-    On a long regular series SPA runs on every :data:`SPA_STRIDE`-th step only (and the last); the
+    On a series stepped finer than :data:`SPA_SPACING_MIN`, SPA runs every 10 minutes only (and on
+    the last step); the
     geometric (refraction-free) sun vector and the equation of time, which are smooth, are
     interpolated linearly between, and SPA's own refraction correction (``pvlib.spa``, with
     pvlib's default pressure and 12 C) is applied to every step, so that the correction's kink at
@@ -157,10 +158,12 @@ def _spa(times: pd.DatetimeIndex, latitude, longitude, altitude):
     sun passes close to the zenith and azimuth hardly matters), the equation of time within 1e-7
     min (tests/test_solarposition.py). It cuts the cost of a day's sun by about 3x.
     """
-    if len(times) < 4 * SPA_STRIDE:
+    step_min = (times[1] - times[0]) / pd.Timedelta(minutes=1) if len(times) > 1 else SPA_SPACING_MIN
+    stride = int(SPA_SPACING_MIN // step_min)
+    if stride < 2 or len(times) < 4 * stride:
         spa = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude=altitude)
         return spa["apparent_zenith"].to_numpy(), spa["azimuth"].to_numpy(), spa["equation_of_time"].to_numpy()
-    picked = np.unique(np.r_[np.arange(0, len(times), SPA_STRIDE), len(times) - 1])
+    picked = np.unique(np.r_[np.arange(0, len(times), stride), len(times) - 1])
     spa = pvlib.solarposition.get_solarposition(times[picked], latitude, longitude, altitude=altitude)
     position = np.arange(len(times), dtype=float)
     zenith0, azimuth = np.radians(spa["zenith"].to_numpy()), np.radians(spa["azimuth"].to_numpy())
