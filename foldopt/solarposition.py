@@ -214,8 +214,11 @@ def get_solar_position(
         zenith, azimuth = sun_from_angles(declination, hour_angle, latitude)
     elif model == "exact":
         zenith, azimuth, equation_of_time = _spa(times, latitude, longitude, altitude)
-        hour_angle = pvlib.solarposition.hour_angle(times, longitude, equation_of_time)
-        hour_angle = (np.asarray(hour_angle) + 180.0) % 360.0 - 180.0
+        # pvlib's hour_angle formula, 15 (UTC hours - 12) + longitude + EoT / 4, without its slow
+        # time-zone handling (equal to it; tests/test_solarposition.py).
+        utc_ns = times.tz_convert("UTC").tz_localize(None).to_numpy().astype("datetime64[ns]").astype(np.int64)
+        utc_hours = (utc_ns % 86_400_000_000_000) / 3.6e12
+        hour_angle = (15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0) % 360.0 - 180.0
         declination = np.degrees(pvlib.solarposition.declination_spencer71(times.day_of_year))
     else:
         raise ValueError(f"model must be one of {', '.join(MODES)}; got {model!r}")

@@ -119,3 +119,17 @@ def test_subsampled_spa_stays_on_full_spa(latitude, longitude, date, zone):
     angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.sum(a * b, axis=1)))
     assert angle.max() < 0.006
     np.testing.assert_allclose(fast["solar_zenith"].to_numpy()[up], full["apparent_zenith"].to_numpy()[up], atol=0.006)
+
+
+def test_exact_hour_angle_is_pvlibs_and_zero_at_solar_noon():
+    times = day_times(dt.date(2025, 3, 20), "America/New_York", 30)
+    exact = get_solar_position(times, 40.7, -74.0, model="exact")
+    spa = pvlib.solarposition.get_solarposition(times, 40.7, -74.0)
+    expected = pvlib.solarposition.hour_angle(times, -74.0, spa["equation_of_time"].to_numpy())
+    np.testing.assert_allclose(exact["hour_angle"], (np.asarray(expected) + 180.0) % 360.0 - 180.0, atol=1e-9)
+    # On a DST switch day pvlib's hour_angle is an hour off after the switch (its docs warn of DST
+    # days); foldopt's works from UTC, so the sun is highest where its hour angle crosses zero.
+    times = day_times(dt.date(2025, 3, 9), "America/New_York", 1)
+    exact = get_solar_position(times, 40.7, -74.0, model="exact")
+    noon = np.argmin(exact["solar_zenith"].to_numpy())
+    assert abs(exact["hour_angle"].iloc[noon]) < 0.3
