@@ -13,23 +13,31 @@
   angle by angle) on a slice of W1, scaled per point, so that the speed-up is a ratio measured in
   one run.
 
-Each workload runs in its own process, so its peak memory (max RSS) is its own.
+Each workload runs in its own process, so its peak memory (max RSS) is its own. W1 and W2 use
+``--workers`` processes (default: every core), forked after the electrical tables are built so
+that they share them; the wall time includes building the tables.
 """
 
 from __future__ import annotations
 
-import argparse
-import datetime as dt
-import json
 import os
-import platform
-import resource
-import subprocess
-import sys
-import time
-from pathlib import Path
 
-import numpy as np
+# One BLAS thread a process: the matrix products here are small, and BLAS threads in several
+# worker processes would fight over the cores (measured: 2 workers slower than 1 without this).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import datetime as dt
+import json  # noqa: E402
+import platform
+import resource  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 TARGETS = {"W1": "<= 2 s", "W2": "<= 10 s", "W3": "W1 >= 100x faster per point", "memory": "<= 2 GiB"}
@@ -44,49 +52,81 @@ def _study():
     )
 
 
-def workload_w1(days: int) -> dict:
+_SHARED: dict = {}  # inherited by forked workers: the study, the tables, the grids
+
+
+def _w1_chunk(dates):
     from foldopt.metrics import energy, t_solar
     from foldopt.study import Day
 
-    base = _study()
-    angles = np.arange(1.0, 181.0)
-    dates = [dt.date(2014, 1, 1) + dt.timedelta(days=int(d)) for d in np.linspace(0, 364, days)]
-    tables: dict = {}
-    hours = np.empty((days, angles.size))
-    wh = np.empty((days, angles.size))
-    start = time.perf_counter()
-    for i, date in enumerate(dates):
+    base, tables, angles = _SHARED["base"], _SHARED["tables"], _SHARED["angles"]
+    hours, wh = [], []
+    for date in dates:
         day = Day(base.variant(date=date), tables)
         power = day.combined_power(angles)
-        hours[i] = t_solar(power, base.p_load, day.step_hours)
-        wh[i] = energy(power, day.step_hours)
-    seconds = time.perf_counter() - start
-    return {"seconds": seconds, "points": days * 1440 * angles.size, "days": days,
-            "mean_best_t_solar_h": float(hours.max(axis=1).mean()), "mean_energy_wh": float(wh.mean())}
+        hours.append(t_solar(power, base.p_load, day.step_hours))
+        wh.append(energy(power, day.step_hours))
+    return np.array(hours), np.array(wh)
 
 
-def workload_w2(days_per_latitude: int, latitudes: int) -> dict:
+def _w2_chunk(cases):
     from foldopt.metrics import t_solar_many_loads
     from foldopt.study import Day
 
+    base, tables, angles, loads = _SHARED["base"], _SHARED["tables"], _SHARED["angles"], _SHARED["loads"]
+    best = []
+    for lat, date in cases:
+        study = base.variant(date=date, site={"latitude": float(lat), "longitude": 0.0, "timezone": "UTC"})
+        day = Day(study, tables)
+        best.append(t_solar_many_loads(day.combined_power(angles), loads, day.step_hours).max(axis=0))
+    return np.array(best)
+
+
+def _parallel(function, items, workers):
+    """Map ``function`` over ``workers`` contiguous chunks of ``items`` in forked processes."""
+    import multiprocessing
+
+    chunks = [list(chunk) for chunk in np.array_split(np.array(items, dtype=object), workers) if len(chunk)]
+    if workers == 1:
+        return [function(chunks[0])]
+    with multiprocessing.get_context("fork").Pool(workers) as pool:
+        return pool.map(function, chunks)
+
+
+def _prepare(angles, loads=None):
+    from foldopt.study import Day
+
     base = _study()
+    tables: dict = {}
+    Day(base, tables).combined_power(angles[:1])  # build the electrical tables once, before forking
+    _SHARED.update(base=base, tables=tables, angles=angles, loads=loads)
+
+
+def workload_w1(days: int, workers: int) -> dict:
+    angles = np.arange(1.0, 181.0)
+    dates = [dt.date(2014, 1, 1) + dt.timedelta(days=int(d)) for d in np.linspace(0, 364, days)]
+    start = time.perf_counter()
+    _prepare(angles)
+    parts = _parallel(_w1_chunk, dates, workers)
+    seconds = time.perf_counter() - start
+    hours = np.concatenate([p[0] for p in parts])
+    wh = np.concatenate([p[1] for p in parts])
+    return {"seconds": seconds, "points": days * 1440 * angles.size, "days": days, "workers": workers,
+            "mean_best_t_solar_h": float(hours.max(axis=1).mean()), "mean_energy_wh": float(wh.mean())}
+
+
+def workload_w2(days_per_latitude: int, latitudes: int, workers: int) -> dict:
     angles = np.arange(1.0, 181.0)
     loads = np.linspace(0.2, 10.0, 50)
     lats = np.linspace(-89.0, 89.0, latitudes)
     dates = [dt.date(2014, m, d) for m in range(1, 13) for d in (1, 15)][:days_per_latitude]
-    tables: dict = {}
+    cases = [(lat, date) for lat in lats for date in dates]
     start = time.perf_counter()
-    best = np.zeros((lats.size, len(dates), loads.size))
-    for i, lat in enumerate(lats):
-        for j, date in enumerate(dates):
-            study = base.variant(date=date, site={"latitude": float(lat), "longitude": 0.0, "timezone": "UTC"},
-                                 panel={"area": 0.108})
-            day = Day(study, tables)
-            hours = t_solar_many_loads(day.combined_power(angles), loads, day.step_hours)  # (angles, loads)
-            best[i, j] = hours.max(axis=0)
+    _prepare(angles, loads)
+    best = np.concatenate(_parallel(_w2_chunk, cases, workers))
     seconds = time.perf_counter() - start
-    return {"seconds": seconds, "points": lats.size * len(dates) * angles.size * loads.size,
-            "cases": lats.size * len(dates) * loads.size, "mean_best_t_solar_h": float(best.mean())}
+    return {"seconds": seconds, "points": len(cases) * angles.size * loads.size, "workers": workers,
+            "cases": len(cases) * loads.size, "mean_best_t_solar_h": float(best.mean())}
 
 
 def workload_w3(steps: int, angles_count: int) -> dict:
@@ -130,9 +170,12 @@ def workload_w3(steps: int, angles_count: int) -> dict:
 
 
 def run_one(name: str, args) -> dict:
-    result = {"W1": lambda: workload_w1(args.days), "W2": lambda: workload_w2(args.w2_days, args.w2_latitudes),
+    result = {"W1": lambda: workload_w1(args.days, args.workers),
+              "W2": lambda: workload_w2(args.w2_days, args.w2_latitudes, args.workers),
               "W3": lambda: workload_w3(args.w3_steps, args.w3_angles)}[name]()
-    result["peak_mib"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    result["peak_mib"] = max(own, children) / 1024  # the largest single process
     return result
 
 
@@ -143,6 +186,7 @@ def main():
     parser.add_argument("--w2-days", type=int, default=24)
     parser.add_argument("--w2-latitudes", type=int, default=90)
     parser.add_argument("--w3-steps", type=int, default=30)
+    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="processes for W1 and W2")
     parser.add_argument("--w3-angles", type=int, default=4)
     parser.add_argument("--write", action="store_true", help="write results/bench/bench.md and bench.json")
     parser.add_argument("--workload", help=argparse.SUPPRESS)
