@@ -90,6 +90,12 @@ def _write_json(path: Path, data: dict) -> None:
     path.write_text(json.dumps(data, indent=2, sort_keys=False, default=float) + "\n")
 
 
+def _save(fig, path: Path) -> None:
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def _clock_hours(result: StudyResult):
     times = result.day.times.tz_localize(None)
     return np.asarray((times - times.normalize()) / pd.Timedelta(hours=1))
@@ -123,9 +129,7 @@ def plot_power_curves(result: StudyResult, path: Path) -> None:
     ax.set_title(f"{study.name}: power over the day ({_mode_label(study)})")
     ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 STATE_COLOURS = {"east": "tab:orange", "parallel": "tab:green", "west": "tab:purple", "series": "tab:brown"}
@@ -156,9 +160,7 @@ def plot_switching(result: StudyResult, path: Path) -> None:
     )
     ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def plot_t_solar_vs_fold_angle(result: StudyResult, path: Path) -> None:
@@ -192,9 +194,7 @@ def plot_t_solar_vs_fold_angle(result: StudyResult, path: Path) -> None:
     ax.set_title(f"{result.study.name}: t_solar vs fold angle ({_mode_label(result.study)})", fontsize=10)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def plot_comparison(result: StudyResult, path: Path) -> None:
@@ -219,9 +219,7 @@ def plot_comparison(result: StudyResult, path: Path) -> None:
     ax.set_ylim(0, max(gross.max() * 1.2, 1))
     ax.legend(fontsize=8, loc="lower right")
     ax.set_title(f"{result.study.name}: {_mode_label(result.study)}", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def plot_standby(result: StudyResult, path: Path) -> None:
@@ -238,9 +236,7 @@ def plot_standby(result: StudyResult, path: Path) -> None:
     ax.set_title(f"{study.name}: when does the tracker's own draw hand the day to the twofold panel?", fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def write_study(result: StudyResult, out: Path, overwrite: bool = False, command=None) -> Path:
@@ -309,9 +305,7 @@ def plot_map(table: pd.DataFrame, x: str, y: str, value: str, path: Path, title:
     ax.set_xlabel(_AXIS_LABELS.get(x, x))
     ax.set_ylabel(_AXIS_LABELS.get(y, y))
     ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 _AXIS_LABELS = {
@@ -343,9 +337,7 @@ def plot_curves(table: pd.DataFrame, x: str, path: Path, title: str, split: str 
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, ncol=1 if split is None else 2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def sweep_plots(table: pd.DataFrame, varied: list[str], folder: Path, name: str) -> list[str]:
@@ -417,9 +409,7 @@ def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, path: Path, title: str)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool = False, command=None) -> pd.DataFrame:
@@ -475,9 +465,7 @@ def plot_distribution(table: pd.DataFrame, path: Path, title: str) -> None:
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def plot_day_hour(extras: dict, key: str, path: Path, title: str, label: str) -> None:
@@ -496,9 +484,7 @@ def plot_day_hour(extras: dict, key: str, path: Path, title: str, label: str) ->
     ax.set_xlabel("day of the study")
     ax.set_ylabel("local clock time [h]")
     ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def annual_outputs(result, folder: Path, name: str) -> list[str]:
