@@ -73,7 +73,7 @@ class Day:
             )
         self.transposition = study.sky_transposition()
         # Orientation-independent inputs of the transposition, computed once for every fold angle.
-        self.dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(self.times), dtype=float)
+        self.dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(self.times.day_of_year), dtype=float)
         self.airmass = np.nan_to_num(relative_airmass(np.minimum(self.solar_zenith, 90.0)), nan=0.0)
         settings = dict(
             pv=PVModel(study.pv_model, panel.efficiency, study.module),

@@ -15,6 +15,7 @@ References
 from __future__ import annotations
 
 import functools
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -88,12 +89,17 @@ def clear_sky(times, solar_zenith, apparent_zenith, latitude, longitude, altitud
     if model == "ineichen":
         turbidity = linke_turbidity
         if turbidity is None:
-            turbidity = pvlib.clearsky.lookup_linke_turbidity(times, latitude, longitude).to_numpy()
+            with warnings.catch_warnings():
+                # pvlib reads DatetimeIndex.dayofyear, which pandas 3 deprecates; not ours to fix.
+                warnings.simplefilter("ignore", DeprecationWarning)
+                warnings.simplefilter("ignore", FutureWarning)
+                turbidity = pvlib.clearsky.lookup_linke_turbidity(times, latitude, longitude).to_numpy()
         airmass = pvlib.atmosphere.get_absolute_airmass(
             pvlib.atmosphere.get_relative_airmass(apparent_zenith), pvlib.atmosphere.alt2pres(altitude)
         )
-        dni_extra = pvlib.irradiance.get_extra_radiation(times).to_numpy()
-        sky = pvlib.clearsky.ineichen(apparent_zenith, airmass, turbidity, altitude, dni_extra)
+        dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(times.day_of_year), dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):  # night: zero air mass terms
+            sky = pvlib.clearsky.ineichen(apparent_zenith, airmass, turbidity, altitude, dni_extra)
     elif model == "simplified-solis":
         sky = pvlib.clearsky.simplified_solis(90.0 - np.asarray(apparent_zenith), pressure=pvlib.atmosphere.alt2pres(altitude))
     else:
