@@ -89,9 +89,9 @@ def t_solar_many_loads(p_pv, loads, step_hours):
     lo_below, hi_upto, hi_below = counts(lo_sorted, "left"), counts(hi_sorted, "right"), counts(hi_sorted, "left")
     total = lambda cumulative, index: np.take_along_axis(cumulative, index, 1)  # noqa: E731
     # Flat segments count while hi >= L; sloped ones fully while lo >= L, partly while lo < L < hi.
-    flat_full = total(prefix(full, order_hi), np.full_like(hi_below, n_seg)) - total(prefix(full, order_hi), hi_below)
-    above_lo = total(prefix(sloped_length, order_lo), np.full_like(lo_below, n_seg)) - total(
-        prefix(sloped_length, order_lo), lo_below)
+    full_sums, sloped_sums = prefix(full, order_hi), prefix(sloped_length, order_lo)
+    flat_full = full_sums[:, -1:] - total(full_sums, hi_below)
+    above_lo = sloped_sums[:, -1:] - total(sloped_sums, lo_below)
     slope_hi = slope * hi
     partial = (total(prefix(slope_hi, order_lo), lo_below) - total(prefix(slope_hi, order_hi), hi_upto)) - loads * (
         total(prefix(slope, order_lo), lo_below) - total(prefix(slope, order_hi), hi_upto))
