@@ -35,6 +35,7 @@ from foldopt.geometry import GEOMETRIES, default_orientation
 from foldopt.pvmodel import PV_MODELS, TEMPERATURE_MODELS, cec_module
 from foldopt.solarposition import MODES
 from foldopt.tracker import ALEXANDRU_STEP_OFFSETS_H, DRIVES, TRACKERS
+from foldopt.weather import CLEAR_SKIES
 
 DEFAULT_STUDY = "shin2015"
 _OFFSET = re.compile(r"^(?:UTC)?([+-])(\d{1,2})(?::?(\d{2}))?$")
@@ -197,7 +198,7 @@ class Study(_Strict):
         None, description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact"
     )
     fold_angles: FoldAngles = FoldAngles()
-    sky: Literal[SKY_MODELS + ("ineichen", "simplified-solis")] = "meinel"
+    sky: Literal[SKY_MODELS + CLEAR_SKIES] = "meinel"
     linke_turbidity: _interval(0, 10, lo_open=True) | None = Field(None, description="ineichen; default pvlib's climatology")
     transposition: Literal[("none", "isotropic", "haydavies", "perez")] | None = Field(
         None, description="diffuse model; default none for beam-only skies, perez otherwise"

@@ -72,7 +72,7 @@ def t_solar_many_loads(p_pv, loads, step_hours):
     narrow = (width > 0) & ~sloped
     # Flat segments count fully while L <= hi (>= keeps P == L as served, like t_solar).
     slope = np.where(sloped, length / np.where(sloped, width, 1.0), 0.0)
-    rows, n_seg = flat.shape[0], length.size
+    rows = flat.shape[0]
     length = np.broadcast_to(length, lo.shape)
     full = np.where(width == 0, length, 0.0)
     sloped_length = np.where(sloped, length, 0.0)

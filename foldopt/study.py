@@ -26,7 +26,7 @@ from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_ang
 from foldopt.pvmodel import PVModel
 from foldopt.sizing import flat_area_multiple
 from foldopt.solarposition import day_times, get_solar_position
-from foldopt.weather import clear_sky, read_weather, weather_day
+from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, weather_day
 from foldopt.tracker import TRACKERS, TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
 
 
@@ -63,15 +63,16 @@ class Day:
         altitude = site.altitude if study.mode == "exact" else 0.0
         if study.weather is not None:
             self.dni, self.ghi, self.dhi = (frame[key].to_numpy(dtype=float) for key in ("dni", "ghi", "dhi"))
-        elif study.sky in ("ineichen", "simplified-solis"):
-            sky = clear_sky(self.times, self.solar_zenith, self.solar_zenith, site.latitude, site.longitude,
-                            site.altitude, study.sky, study.linke_turbidity)
+        elif study.sky in CLEAR_SKIES:
+            sky = clear_sky(self.times, self.solar_zenith, site.latitude, site.longitude, site.altitude,
+                            study.sky, study.linke_turbidity)
             self.dni, self.ghi, self.dhi = sky["dni"], sky["ghi"], sky["dhi"]
         else:
             self.dni = clear_sky_dni(
                 self.solar_zenith, altitude, study.sky, dayofyear=self.times.day_of_year, climate=study.climate
             )
         self.transposition = study.sky_transposition()
+        self._tracker_orientations: dict = {}
         # Orientation-independent inputs of the transposition, computed once for every fold angle.
         self.dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(self.times.day_of_year), dtype=float)
         self.airmass = np.nan_to_num(relative_airmass(np.minimum(self.solar_zenith, 90.0)), nan=0.0)
@@ -139,7 +140,16 @@ class Day:
         return self.electrical.panel_power(self._poa(panel.tilt, panel.azimuth), panel.area)
 
     def tracker_orientation(self, model=None):
-        """Surface tilt and azimuth of a tracker over the day [deg] (default: the study's)."""
+        """Surface tilt and azimuth of a tracker over the day [deg] (default: the study's).
+
+        Kept per model: a tracker's power, its draw and the standby sweep all steer by it.
+        """
+        model = model or self.study.tracker.model
+        if model not in self._tracker_orientations:
+            self._tracker_orientations[model] = self._steer(model)
+        return self._tracker_orientations[model]
+
+    def _steer(self, model):
         tracker = self.study.tracker
         options = TrackerOptions(
             steps=tracker.steps, angular_field=tracker.angular_field,
@@ -148,7 +158,7 @@ class Day:
             backtrack=tracker.backtrack, gcr=tracker.gcr,
         )
         return tracker_orientation(
-            model or tracker.model, self.solar_zenith, self.solar_azimuth, self.hour_angle, self.declination,
+            model, self.solar_zenith, self.solar_azimuth, self.hour_angle, self.declination,
             self.study.site.latitude, options,
         )
 

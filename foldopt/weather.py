@@ -79,8 +79,7 @@ def weather_day(frame: pd.DataFrame, date) -> pd.DataFrame:
     return day
 
 
-def clear_sky(times, solar_zenith, apparent_zenith, latitude, longitude, altitude, model="ineichen",
-              linke_turbidity=None):
+def clear_sky(times, apparent_zenith, latitude, longitude, altitude, model="ineichen", linke_turbidity=None):
     """pvlib clear-sky ``ghi``, ``dni``, ``dhi`` [W/m^2] at ``times``.
 
     ``ineichen`` takes ``linke_turbidity``, or looks it up in pvlib's bundled climatology (offline);
