@@ -26,32 +26,16 @@ from foldopt.pvmodel import IVCurve
 
 CONNECTIONS = ("east", "west", "parallel", "series", "independent", "switching")
 SWITCH_STATES = ("east", "west", "parallel", "series")  # ties go to the earlier, simpler state
-_GRID_POINTS = 48
 _GOLDEN_STEPS = 40
 _INVPHI = (np.sqrt(5.0) - 1.0) / 2.0
 
 
-def _maximise(power_of, upper):
-    """Maximum over ``x`` in [0, upper] of ``power_of(x)``, curve by curve.
-
-    ``power_of`` maps operating points shaped ``upper.shape + (k,)`` to power. A grid locates the
-    best bracket (the parallel and series curves can have two local maxima); golden-section search
-    inside it refines the maximum to ~1e-8 of the bracket.
-    """
-    upper = np.asarray(upper, dtype=float)
-    fractions = np.linspace(0.0, 1.0, _GRID_POINTS)
-    grid = upper[..., None] * fractions
-    values = np.nan_to_num(power_of(grid), nan=-np.inf)
-    best = np.argmax(values, axis=-1)
-    step = upper / (_GRID_POINTS - 1)
-    lo = np.clip(best - 1, 0, None) * step
-    hi = np.clip(best + 1, None, _GRID_POINTS - 1) * step
-    def evaluate(x):
-        return np.nan_to_num(power_of(x[..., None])[..., 0], nan=-np.inf)
-
+def _golden(evaluate, lo, hi, steps=_GOLDEN_STEPS):
+    """Maximum of unimodal functions on [lo, hi], curve by curve, by golden-section search
+    (the bracket shrinks by 0.618 a step)."""
     a, b = hi - _INVPHI * (hi - lo), lo + _INVPHI * (hi - lo)
     fa, fb = evaluate(a), evaluate(b)
-    for _ in range(_GOLDEN_STEPS):
+    for _ in range(steps):
         left = fa > fb  # the maximum lies in [lo, b]: b's bracket shrinks from above
         lo, hi = np.where(left, lo, a), np.where(left, b, hi)
         kept, f_kept = np.where(left, a, b), np.where(left, fa, fb)
@@ -59,23 +43,33 @@ def _maximise(power_of, upper):
         f_probe = evaluate(probe)
         a, fa = np.where(left, probe, kept), np.where(left, f_probe, f_kept)
         b, fb = np.where(left, kept, probe), np.where(left, f_kept, f_probe)
-    refined = np.maximum(fa, fb)
-    return np.clip(np.maximum(refined, values.max(axis=-1)), 0.0, None)
+    return np.maximum(fa, fb)
 
 
-def parallel_power(east: IVCurve, west: IVCurve):
-    """Maximum power [W] of two sub-panels in parallel behind blocking diodes."""
+def parallel_power(east: IVCurve, west: IVCurve, golden_steps: int = _GOLDEN_STEPS):
+    """Maximum power [W] of two sub-panels in parallel behind blocking diodes.
+
+    Each sub-panel's power ``P_i(V) = V max(I_i(V), 0)`` is concave up to its open-circuit voltage
+    (``I_i`` is decreasing and concave) and zero beyond, so it rises up to its maximum-power
+    voltage and falls after. The sum therefore peaks between the two maximum-power voltages
+    ``V_a <= V_b``; there the lower one's power is concave up to its ``V_oc``, so the sum is
+    concave on ``[V_a, min(V_b, V_oc,a)]`` (golden-section search, exact to ~1e-8 of the bracket)
+    and equals the other sub-panel alone beyond it, which peaks at ``V_b``. The result is the
+    larger of that search and each sub-panel alone, with no grid search.
+    """
+    (p_east, v_east), (p_west, v_west) = east.mpp(), west.mpp()
 
     def power(voltage):
         # Blocking diodes: a sub-panel adds its current only while it sources it (NaN: dark).
         current = sum(np.nan_to_num(np.clip(side.current(voltage), 0.0, None)) for side in (east, west))
         return voltage * current
 
-    # Running at the stronger sub-panel's own MPP is always a valid operating point (the other adds
-    # current or is blocked), so it bounds the result from below where a kink near it (the weak
-    # sub-panel's Voc) misleads the search (seen: 1.2e-4 short).
-    best_alone = np.maximum(east.max_power(), west.max_power())
-    return np.maximum(_maximise(power, np.maximum(east.v_oc, west.v_oc)), best_alone)
+    lower = np.minimum(v_east, v_west)
+    # The sub-panel whose maximum-power voltage is the lower one stops sourcing at its own Voc.
+    voc_lower = np.where(v_east <= v_west, east.v_oc, west.v_oc)
+    upper = np.maximum(lower, np.minimum(np.maximum(v_east, v_west), voc_lower))
+    searched = _golden(lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf), lower, upper, golden_steps)
+    return np.maximum(searched, np.maximum(p_east, p_west))
 
 
 def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
@@ -100,7 +94,11 @@ def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
     def power(current):
         return current * (side_voltage(east, voc_e, current) + side_voltage(west, voc_w, current))
 
-    string = _maximise(power, np.minimum(isc_e, isc_w))
+    # Each sub-panel's voltage is concave and decreasing in the current, so the string's power is
+    # concave on [0, the weaker Isc]: golden-section search finds its maximum.
+    upper = np.minimum(isc_e, isc_w)
+    string = np.clip(_golden(lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf),
+                             np.zeros_like(upper), upper), 0.0, None)
     if not bypass:
         return string
     return np.maximum(string, np.maximum(east.max_power(), west.max_power()))

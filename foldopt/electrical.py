@@ -7,13 +7,23 @@ and 2-D tables of the parallel and series pair, on irradiance nodes spaced quadr
 at low irradiance, where power bends), and interpolates linearly in sqrt(E), on which the nodes are uniform. The exact path solves every
 step's I-V curves. ``bench/electrical.py`` and ``tests/test_electrical.py`` measure the
 tables' error against it.
+
+Tables are kept on disk, named by a hash of everything they depend on (the PV unit's parameters,
+the sub-panel area, the temperature settings, the nodes, pvlib's version and
+:data:`TABLE_FORMAT`), in ``$FOLDOPT_CACHE_DIR`` or ``~/.cache/foldopt``; a second process loads
+them instead of solving I-V curves again. A cache that cannot be written is skipped.
 """
 
 from __future__ import annotations
 
+import hashlib
+import os
+import tempfile
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+import pvlib
 
 from foldopt.aggregation import connection_powers, parallel_power, series_power
 from foldopt.pvmodel import PVModel, cell_temperature
@@ -22,6 +32,33 @@ IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the tables; clear-sky beam stays belo
 TABLE_NODES_1D = 1025
 TABLE_NODES_2D = 161
 TABLE_NODES_RATIO = 321
+TABLE_FORMAT = 2  # bump when the way tables are built changes
+
+
+def cache_dir() -> Path:
+    """Where electrical tables are kept: ``$FOLDOPT_CACHE_DIR``, else ``$XDG_CACHE_HOME/foldopt``."""
+    if os.environ.get("FOLDOPT_CACHE_DIR"):
+        return Path(os.environ["FOLDOPT_CACHE_DIR"])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "foldopt"
+
+
+def _load_cached(path: Path):
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return tuple(data[f"a{i}"] for i in range(len(data.files)))
+    except (OSError, ValueError, KeyError, EOFError):
+        return None  # absent or damaged: rebuild
+
+
+def _store_cached(path: Path, arrays) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        with os.fdopen(handle, "wb") as file:
+            np.savez(file, **{f"a{i}": array for i, array in enumerate(arrays)})
+        os.replace(temporary, path)  # atomic: readers see the old file or the whole new one
+    except OSError:
+        pass
 
 
 def _nodes(count):
@@ -90,11 +127,24 @@ class Electrical:
     def _temperature(self, poa):
         return cell_temperature(poa, self.temp_air, self.wind_speed, self.temperature_model)
 
+    def cache_key(self, name: str) -> str:
+        """Hash of everything table ``name`` depends on."""
+        settings = (TABLE_FORMAT, name, self.pv.model, repr(self.pv.unit), self.pv.unit_area, self.subpanel_area,
+                    self.temp_air, self.wind_speed, self.temperature_model, IRRADIANCE_MAX, TABLE_NODES_1D,
+                    TABLE_NODES_2D, TABLE_NODES_RATIO, pvlib.__version__)
+        return hashlib.sha256(repr(settings).encode()).hexdigest()[:32]
+
     def _table(self, name):
-        """A table, built on first use: ``subpanel`` (1-D), ``parallel`` or ``series`` (2-D)."""
+        """A table, loaded from the disk cache or built on first use: ``subpanel`` (1-D),
+        ``parallel`` or ``series`` (2-D)."""
         if self._tables is None:
             self._tables = {}
         if name not in self._tables:
+            path = cache_dir() / "tables" / f"{name}-{self.cache_key(name)}.npz"
+            cached = _load_cached(path)
+            if cached is not None:
+                self._tables[name] = cached if name == "subpanel" else cached[0]
+                return self._tables[name]
             if name == "subpanel":
                 g1 = _nodes(TABLE_NODES_1D)
                 self._tables[name] = (g1, self.pv.max_power(g1, self._temperature(g1), self.subpanel_area))
@@ -109,6 +159,8 @@ class Electrical:
                 self._tables[name] = self._pair_table(
                     "series", _nodes(TABLE_NODES_2D), ratio, lambda strong, r: (strong, strong * r)
                 )
+            table = self._tables[name]
+            _store_cached(path, table if name == "subpanel" else (table,))
         return self._tables[name]
 
     def _pair_table(self, connection, axis0, axis1, to_irradiance):

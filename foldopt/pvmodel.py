@@ -200,17 +200,23 @@ class IVCurve:
             return self.params[0]
         return np.where(self.lit, np.nan_to_num(self.voltage(np.zeros_like(self.params[0]))), 0.0)
 
-    def max_power(self):
-        """Maximum power [W] of each curve."""
+    def mpp(self):
+        """Maximum power [W] and its voltage [V] of each curve (both 0 for a dark curve)."""
         if self.model == "single-diode":
             mpp = pvlib.pvsystem.max_power_point(*self.params, method="newton")
-            return np.where(self.lit, np.clip(np.nan_to_num(np.asarray(mpp["p_mp"], dtype=float)), 0.0, None), 0.0)
+            lit = self.lit
+            power = np.clip(np.nan_to_num(np.asarray(mpp["p_mp"], dtype=float)), 0.0, None)
+            return np.where(lit, power, 0.0), np.where(lit, np.nan_to_num(np.asarray(mpp["v_mp"], dtype=float)), 0.0)
         # Eq. 8: dP/dV = 0 has the closed form v = b (W(e^(1 + 1/b)) - 1), v = V / V_x, for all
         # irradiances; Lambert's W of the log-argument avoids overflow for small b.
         v_x, i_x, b = self.params
         w = _lambertw_exp(1.0 + 1.0 / b)
-        v_mp = b * (w - 1.0)
-        return np.where(v_x > 0, v_x * v_mp * self.current(v_x * v_mp), 0.0)
+        v_mp = v_x * b * (w - 1.0)
+        return np.where(v_x > 0, v_mp * self.current(v_mp), 0.0), np.where(v_x > 0, v_mp, 0.0)
+
+    def max_power(self):
+        """Maximum power [W] of each curve."""
+        return self.mpp()[0]
 
 
 def _lambertw_exp(x):

@@ -1,9 +1,10 @@
 """One day's study: flat, twofold and tracked panels at one site, compared.
 
-:class:`Day` holds everything that does not depend on orientation (times, sun, beam, the
-electrical tables) and gives the power of each design as arrays over fold angles x time;
-:func:`run_study` sweeps the fold angle, applies the paper's heuristic and tabulates the
-comparison, for the study's connection and for the others.
+:class:`Day` is a view of one day of a :class:`foldopt.sky.Sky` (times, sun, light, the electrical
+model) that gives the power of each design as arrays over fold angles x time, for reports and for
+the paper's heuristic; :func:`run_study` sweeps the fold angle through the engine, applies the
+heuristic and tabulates the comparison, for the study's connection and for the others. The
+tracker functions work on whole skies (every day at once).
 """
 
 from __future__ import annotations
@@ -13,131 +14,83 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from foldopt import engine as engines
 from foldopt.aggregation import CONNECTIONS, SWITCH_STATES
-import pvlib
-
-from foldopt.atmosphere import clear_sky_dni, relative_airmass
-from foldopt.config import Study, parse_timezone
-from foldopt.electrical import Electrical
-from foldopt.geometry import normal_vector, subpanel_orientation
-from foldopt.irradiance import beam_incidence_factor
-from foldopt.metrics import daily_metrics, load_for_t_solar, t_solar
+from foldopt.config import Study
+from foldopt.metrics import load_for_t_solar, t_solar
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
-from foldopt.pvmodel import PVModel
 from foldopt.sizing import flat_area_multiple
-from foldopt.solarposition import day_times, get_solar_position
-from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, weather_day
+from foldopt.sky import Sky, build_sky
 from foldopt.tracker import TRACKERS, TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
 
 
+def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
+    """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each
+    (default: the study's tracker)."""
+    tracker = study.tracker
+    options = TrackerOptions(
+        steps=tracker.steps, angular_field=tracker.angular_field,
+        step_offsets_h=tuple(tracker.step_offsets_h or TrackerOptions().step_offsets_h),
+        axis_tilt=tracker.axis_tilt, axis_azimuth=tracker.axis_azimuth, max_angle=tracker.max_angle,
+        backtrack=tracker.backtrack, gcr=tracker.gcr,
+    )
+    return tracker_orientation(
+        model or tracker.model, sky.solar_zenith, sky.solar_azimuth, sky.hour_angle, sky.declination,
+        np.asarray(sky.latitude)[:, None], options,
+    )
+
+
+def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
+    """Power [W] of the study's panel on a tracker of that ``orientation`` over every block.
+
+    Trackers take the exact angle of incidence in both modes: Eq. 5 is the paper's formula for its
+    fixed panels (it reads an azimuth even for a level panel, which a single-axis tracker is at
+    noon), and for the paper's only tracker, the ideal one, both give 1."""
+    return engines.panel_power(sky, study, engines.poa(sky, *orientation))
+
+
+def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
+    """The tracker's own draw [W] per step over every block: standby while the sun is up, plus its moves."""
+    tracker = study.tracker
+    drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
+    return tracker_draw(*orientation, sky.dni > 0, sky.step_hours, drive)
+
+
 class Day:
-    """Sun, beam and electrical model over one day, and the power of each design on it.
+    """Sun, light and electrical model over one day, and the power of each design on it.
 
     Paper mode uses the paper's sun, air mass at sea level and Eq. 5 incidence; exact mode pvlib's
     sun (apparent zenith), Laue's altitude term and the true angle of incidence. The study is
     resolved here, so its defaults follow its own site and mode.
     """
 
-    def __init__(self, study: Study, cache: dict | None = None):
+    def __init__(self, study: Study):
         study = study.resolved()
         self.study = study
-        site, panel = study.site, study.panel
-        temp_air = study.temp_air
-        self.ghi = self.dhi = None
-        if study.weather is not None:
-            frame = weather_day(read_weather(study.weather.path, study.weather.format, study.date.year, study.weather.label), study.date)
-            self.times = pd.DatetimeIndex(frame.index)
-            self.step_hours = float(pd.Series(self.times).diff().median() / pd.Timedelta(hours=1))
-            # Cells follow the day's mean air temperature (the electrical tables assume one per
-            # day), rounded to 5 C so that days share their tables; wind stays the study's.
-            temp_air = round(float(frame["temp_air"].mean()) / 5.0) * 5.0
-        else:
-            self.times = day_times(study.date, parse_timezone(site.timezone), study.step_min)
-            self.step_hours = study.step_min / 60.0
-        sun = get_solar_position(self.times, site.latitude, site.longitude, site.altitude, study.mode)
-        self.solar_zenith = sun["solar_zenith"].to_numpy()
-        self.solar_azimuth = sun["solar_azimuth"].to_numpy()
-        self.hour_angle = sun["hour_angle"].to_numpy()
-        self.declination = sun["declination"].to_numpy()
-        self.sun_vector = normal_vector(self.solar_zenith, self.solar_azimuth)  # east-north-up, unit
-        altitude = site.altitude if study.mode == "exact" else 0.0
-        if study.weather is not None:
-            self.dni, self.ghi, self.dhi = (frame[key].to_numpy(dtype=float) for key in ("dni", "ghi", "dhi"))
-        elif study.sky in CLEAR_SKIES:
-            sky = clear_sky(self.times, self.solar_zenith, site.latitude, site.longitude, site.altitude,
-                            study.sky, study.linke_turbidity)
-            self.dni, self.ghi, self.dhi = sky["dni"], sky["ghi"], sky["dhi"]
-        else:
-            self.dni = clear_sky_dni(
-                self.solar_zenith, altitude, study.sky, dayofyear=self.times.day_of_year, climate=study.climate
-            )
+        self.sky = sky = build_sky([study])
+        self.electrical = engines.electrical_for(study, sky.temp_air[0])
+        self.times = sky.grid.times(0)
+        self.step_hours = sky.step_hours
+        self.solar_zenith, self.solar_azimuth = sky.solar_zenith[0], sky.solar_azimuth[0]
+        self.hour_angle, self.declination = sky.hour_angle[0], sky.declination[0]
+        self.sun_vector, self.dni = sky.sun_vector[0], sky.dni[0]
+        self.ghi = None if sky.ghi is None else sky.ghi[0]
+        self.dhi = None if sky.dhi is None else sky.dhi[0]
         self.transposition = study.sky_transposition()
         self._tracker_orientations: dict = {}
-        # Orientation-independent inputs of the transposition, computed once for every fold angle.
-        self.dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(self.times.day_of_year), dtype=float)
-        self.airmass = np.nan_to_num(relative_airmass(np.minimum(self.solar_zenith, 90.0)), nan=0.0)
-        settings = dict(
-            pv=PVModel(study.pv_model, panel.efficiency, study.module),
-            subpanel_area=panel.area / 2.0,
-            temp_air=temp_air,
-            wind_speed=study.wind_speed,
-            temperature_model=study.temperature_model,
-            bypass=study.bypass_diodes,
-            switch_series=study.switch_series,
-            converter_efficiency=study.converter_efficiency,
-            exact=study.exact_electrical,
-        )
-        if cache is None:
-            self.electrical = Electrical(**settings)
-        else:
-            # Days of one setup share their electrical tables.
-            self.electrical = cache.setdefault(tuple(map(repr, settings.values())), Electrical(**settings))
 
     def _poa(self, surface_tilt, surface_azimuth, per_step=False):
-        """Irradiance on surfaces [W/m^2]: one orientation per fold angle, (k, n_time), or, with
-        ``per_step``, one per time step (a tracker), (n_time,).
-
-        Beam only (``transposition: none``): the beam by the mode's incidence model. Trackers always
-        take the exact angle of incidence: Eq. 5 is the paper's formula for its fixed panels (it
-        reads an azimuth even for a level panel, which a single-axis tracker is at noon), and for
-        the paper's only tracker, the ideal one, both give 1. With diffuse light: pvlib's
-        ``get_total_irradiance`` (beam, sky diffuse by the transposition model, ground-reflected
-        with ``albedo``), the beam optionally reduced by an incidence-angle modifier.
-        """
+        """Irradiance on surfaces [W/m^2]: one orientation per row, (k,) -> (k, n_time), or, with
+        ``per_step``, one per time step (a tracker), (n_time,) -> (n_time,)."""
         tilt, azimuth = np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
-        if not per_step:
-            tilt, azimuth = tilt[..., None], azimuth[..., None]
-        study = self.study
-        if self.transposition == "none":
-            if per_step or study.mode == "paper":
-                model = "exact" if per_step else study.mode
-                factor = beam_incidence_factor(tilt, azimuth, self.solar_zenith, self.solar_azimuth, model=model)
-            else:
-                # cos(AOI) of every fold angle at every step is one matrix product of the surface
-                # normals with the sun vectors (equal to pvlib's aoi_projection; tested).
-                factor = np.clip(normal_vector(tilt[..., 0], azimuth[..., 0]) @ self.sun_vector.T, 0.0, None)
-            return self.dni * factor * self._iam(tilt, azimuth)
-        dhi = self.dhi if self.dhi is not None else np.zeros_like(self.dni)
-        ghi = self.ghi if self.ghi is not None else self.dni * np.clip(np.cos(np.radians(self.solar_zenith)), 0, None)
-        poa = pvlib.irradiance.get_total_irradiance(
-            tilt, azimuth, self.solar_zenith, self.solar_azimuth, self.dni, ghi, dhi,
-            dni_extra=self.dni_extra, airmass=self.airmass, albedo=study.albedo, model=self.transposition,
-        )
-        direct = np.nan_to_num(np.asarray(poa["poa_direct"], dtype=float)) * self._iam(tilt, azimuth)
-        return direct + np.nan_to_num(np.asarray(poa["poa_diffuse"], dtype=float))
-
-    def _iam(self, tilt, azimuth):
-        """Incidence-angle modifier of the beam (pvlib ``iam.ashrae`` / ``iam.physical``), or 1."""
-        if self.study.iam == "none":
-            return 1.0
-        aoi = pvlib.irradiance.aoi(tilt, azimuth, self.solar_zenith, self.solar_azimuth)
-        modifier = pvlib.iam.ashrae(aoi) if self.study.iam == "ashrae" else pvlib.iam.physical(aoi)
-        return np.nan_to_num(np.asarray(modifier, dtype=float))
+        if per_step:
+            return engines.poa(self.sky, tilt[None], azimuth[None])[0]
+        return engines.poa(self.sky, tilt[..., None], azimuth[..., None], [0], self.study.mode == "paper")
 
     def flat_power(self):
         """Power of the flat panel over the day [W], shape (n_time,)."""
         panel = self.study.panel
-        return self.electrical.panel_power(self._poa(panel.tilt, panel.azimuth), panel.area)
+        return self.electrical.panel_power(self._poa(np.array([panel.tilt]), np.array([panel.azimuth]))[0], panel.area)
 
     def tracker_orientation(self, model=None):
         """Surface tilt and azimuth of a tracker over the day [deg] (default: the study's).
@@ -146,41 +99,29 @@ class Day:
         """
         model = model or self.study.tracker.model
         if model not in self._tracker_orientations:
-            self._tracker_orientations[model] = self._steer(model)
+            self._tracker_orientations[model] = sky_tracker_orientation(self.sky, self.study, model)
         return self._tracker_orientations[model]
-
-    def _steer(self, model):
-        tracker = self.study.tracker
-        options = TrackerOptions(
-            steps=tracker.steps, angular_field=tracker.angular_field,
-            step_offsets_h=tuple(tracker.step_offsets_h or TrackerOptions().step_offsets_h),
-            axis_tilt=tracker.axis_tilt, axis_azimuth=tracker.axis_azimuth, max_angle=tracker.max_angle,
-            backtrack=tracker.backtrack, gcr=tracker.gcr,
-        )
-        return tracker_orientation(
-            model, self.solar_zenith, self.solar_azimuth, self.hour_angle, self.declination,
-            self.study.site.latitude, options,
-        )
 
     def tracker_power(self, model=None):
         """Power of the same panel on a tracker [W], shape (n_time,) (default: the study's)."""
-        return self.electrical.panel_power(self._poa(*self.tracker_orientation(model), per_step=True), self.study.panel.area)
+        return sky_tracker_power(self.sky, self.study, self.tracker_orientation(model))[0]
 
     def tracker_draw(self, model=None):
         """The tracker's own draw [W] per step: standby while the sun is up, plus its moves."""
-        tracker = self.study.tracker
-        drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
-        return tracker_draw(*self.tracker_orientation(model), self.dni > 0, self.step_hours, drive)
+        return sky_tracker_draw(self.sky, self.study, self.tracker_orientation(model))[0]
+
+    def orientation(self, fold_angles):
+        """Sub-panel orientations (k, 4) of the study's panel at ``fold_angles`` [deg]."""
+        panel = self.study.panel
+        return engines.fold_orientations(self.study, [panel.tilt], [panel.azimuth], np.atleast_1d(fold_angles))[0]
 
     def connections(self, fold_angles, series: bool = True, with_state: bool = True):
         """Every connection's power [W], each (k, n_time), and the switching state per step.
 
         ``series=False`` skips the series connection (NaN) when nothing asks for it."""
-        panel = self.study.panel
-        sides = subpanel_orientation(fold_angles, panel.tilt, panel.azimuth, self.study.geometry)
-        poa_east = self._poa(sides["tilt_east"], sides["azimuth_east"])
-        poa_west = self._poa(sides["tilt_west"], sides["azimuth_west"])
-        return self.electrical.connections(poa_east, poa_west, series, with_state)
+        powers, state = engines.powers(self.sky, self.study, self.orientation(fold_angles), [0], series, with_state)
+        powers.pop("panel")
+        return powers, state
 
     def subpanel_power(self, fold_angles):
         """East and west sub-panel powers and their parallel connection [W], each (k, n_time)."""
@@ -214,8 +155,10 @@ def _best_angle(day: Day, angles, sweep_t_solar, connection):
     )[0]
 
 
-def run_study(study: Study) -> StudyResult:
+def run_study(study: Study, engine: str = "numba") -> StudyResult:
     """Sweep the fold angle and compare flat, twofold and tracker.
+
+    ``engine`` evaluates the fold-angle sweep (:data:`foldopt.engine.ENGINES`).
 
     Returns
     -------
@@ -231,13 +174,16 @@ def run_study(study: Study) -> StudyResult:
     study = day.study
     p_load, step = study.p_load, day.step_hours
     angles = np.asarray(study.fold_angles.grid())
-    powers, _ = day.connections(angles)
-    sweep = pd.DataFrame({"fold_angle_deg": angles, **daily_metrics(powers[study.connection], p_load, step)})
-    sweep["noon_valley_w"] = noon_valley(powers["east"], powers["west"], powers["parallel"])
-    for connection in CONNECTIONS:
-        metrics = daily_metrics(powers[connection], p_load, step)
-        sweep[f"t_solar_{connection}_h"] = metrics["t_solar_h"]
-        sweep[f"energy_{connection}_wh"] = metrics["energy_wh"]
+    metrics = engines.row_metrics(day.sky, study, np.zeros(angles.size), day.orientation(angles), [p_load],
+                                  outputs=CONNECTIONS, contiguous=True, engine=engine)
+    own = CONNECTIONS.index(study.connection)
+    sweep = pd.DataFrame({"fold_angle_deg": angles,
+                          **_metric_columns(metrics.t_solar[:, own, 0], metrics.t_solar_contiguous[:, own, 0],
+                                            metrics.energy[:, own], metrics.peak[:, own], p_load)})
+    sweep["noon_valley_w"] = noon_valley(*day.subpanel_power(angles))
+    for index, connection in enumerate(CONNECTIONS):
+        sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
+        sweep[f"energy_{connection}_wh"] = metrics.energy[:, index]
 
     best_angle = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
     paper_angle = heuristic_fold_angle(day.subpanel_power, p_load)
@@ -259,11 +205,11 @@ def run_study(study: Study) -> StudyResult:
         designs[name] = (np.nan, gross)
         designs[f"{name}-net"] = (np.nan, gross - day.tracker_draw(model))
 
-    rows = []
-    for design, (angle, power) in designs.items():
-        metrics = {key: float(value) for key, value in daily_metrics(power, p_load, step).items()}
-        rows.append({"design": design, "fold_angle_deg": angle, **metrics})
-    summary = pd.DataFrame(rows)
+    curves = engines.curve_metrics(np.stack([power for _, power in designs.values()]), [p_load], step,
+                                   contiguous=True, engine=engine)
+    summary = pd.DataFrame({"design": list(designs), "fold_angle_deg": [angle for angle, _ in designs.values()],
+                            **_metric_columns(curves.t_solar[:, 0, 0], curves.t_solar_contiguous[:, 0, 0],
+                                              curves.energy[:, 0], curves.peak[:, 0], p_load)})
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -291,6 +237,13 @@ def run_study(study: Study) -> StudyResult:
         }
     )
     return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby)
+
+
+def _metric_columns(hours, contiguous, harvested, peak, p_load) -> dict:
+    """The daily metric columns of reports (:func:`foldopt.metrics.daily_metrics`'s names)."""
+    served = np.asarray(p_load) * hours
+    return {"t_solar_h": hours, "t_solar_contiguous_h": contiguous, "energy_wh": harvested,
+            "energy_served_wh": served, "energy_wasted_wh": harvested - served, "peak_power_w": peak}
 
 
 def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):

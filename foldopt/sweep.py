@@ -1,27 +1,35 @@
 """Sweeps: many sites, days, loads and designs, as one tidy table.
 
-Cases that differ only in the load share a day: its power is computed once for every fold angle
-and ``t_solar`` for all loads comes from one broadcast pass. Days of the same electrical setup
-share their tables. The optimal fold angle of a case is the best point of the sweep grid (no
-local refinement, which a single-study run adds).
+The cases of a plan are blocks of skies (:mod:`foldopt.sky`): cases that share everything but the
+site, the date and the load share one sky and one engine call, in chunks of bounded size. Every
+(case, fold angle) row gets ``t_solar`` for all loads in one pass; the best angle per case and
+load is the best point of the grid (no local refinement, which a single-study run adds), and its
+full metrics come from a second, targeted pass. The flat panel is a row of its own; trackers go
+through the same metrics from their power curves.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import itertools
+import json
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from foldopt.config import Plan
-from foldopt.metrics import daily_metrics, t_solar, t_solar_many_loads
-from foldopt.study import Day
+from foldopt import engine as engines
+from foldopt.config import Plan, Study
+from foldopt.sky import Sky, build_sky
+from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
-_MANY_LOADS = 4  # from this many loads, one sorted pass beats a pass per load
+METRICS = ("t_solar_h", "t_solar_contiguous_h", "energy_wh", "energy_served_wh", "energy_wasted_wh", "peak_power_w")
+#: Rows (blocks x fold angles) x loads of one engine call: bounds the memory of a chunk.
+CHUNK_ROW_LOADS = 4_000_000
+#: Time steps of the blocks of one chunk's sky.
+CHUNK_STEPS = 1_100_000
 
 
 @dataclass(frozen=True)
@@ -50,61 +58,86 @@ def _best_angle_index(hours):
     return hours.shape[-1] - 1 - np.argmax(hours[..., ::-1], axis=-1)
 
 
-def _angle_hours(day: Day, loads: np.ndarray):
-    """Fold-angle grid, twofold power (k, n_time) and t_solar for every load and angle (L, k)."""
-    angles = np.asarray(day.study.fold_angles.grid())
-    power = day.combined_power(angles)
-    if loads.size >= _MANY_LOADS:
-        return angles, power, t_solar_many_loads(power, loads, day.step_hours).T
-    return angles, power, t_solar(power, loads[:, None], day.step_hours)
+def _setup_key(study: Study) -> str:
+    """What the blocks of one engine call share: everything but the site, the date and the load
+    (and the panel's orientation, which follows the site)."""
+    data = study.model_dump(mode="json", exclude={"site", "date", "p_load", "name", "description"})
+    data["panel"] = {k: v for k, v in data["panel"].items() if k not in ("tilt", "azimuth")}
+    return json.dumps(data, sort_keys=True)
 
 
-def _day_rows(day: Day, loads: np.ndarray, case: dict, fixed_angles=None) -> list[dict]:
-    """Rows of one day for every load; the twofold panel at its best angle of the day, or at
-    ``fixed_angles`` (one per load) when a study-wide objective chose them."""
-    step = day.step_hours
-    if fixed_angles is None:
-        angles, power, hours = _angle_hours(day, loads)
-        best = _best_angle_index(hours)
-    else:
-        angles = np.asarray(fixed_angles, dtype=float)
-        power = day.combined_power(angles)
-        best = np.arange(loads.size)
-    p_tracker = day.tracker_power()
-    curves = {
-        "flat": (np.full(loads.size, 180.0), np.broadcast_to(day.flat_power(), (loads.size, power.shape[1]))),
-        "twofold": (angles[best], power[best]),
-        "tracker": (np.full(loads.size, np.nan), np.broadcast_to(p_tracker, (loads.size, power.shape[1]))),
-        "tracker-net": (
-            np.full(loads.size, np.nan),
-            np.broadcast_to(p_tracker - day.tracker_draw(), (loads.size, power.shape[1])),
-        ),
+def _chunks(count: int, per_block_rows: int, n_loads: int, n_steps: int):
+    """Slices of ``count`` blocks whose rows x loads and time steps stay within the chunk bounds."""
+    size = max(1, min(CHUNK_ROW_LOADS // max(per_block_rows * n_loads, 1), CHUNK_STEPS // max(n_steps, 1)))
+    return [slice(start, min(start + size, count)) for start in range(0, count, size)]
+
+
+def _panels(studies):
+    resolved = [s.resolved() for s in studies]
+    return np.array([s.panel.tilt for s in resolved]), np.array([s.panel.azimuth for s in resolved])
+
+
+def fold_hours(sky: Sky, studies, loads, engine: str = "numba"):
+    """t_solar [h] of every block's twofold panel at every angle of the grid, for every load.
+
+    Returns
+    -------
+    angles : numpy.ndarray
+        The study's fold-angle grid [deg], (n_angles,).
+    hours : numpy.ndarray
+        (n_blocks, n_angles, n_loads).
+    """
+    study = studies[0]
+    angles = np.asarray(study.fold_angles.grid())
+    orientation = engines.fold_orientations(study, *_panels(studies), angles)
+    rows = np.repeat(np.arange(sky.n_blocks), angles.size)
+    metrics = engines.row_metrics(sky, study, rows, orientation.reshape(-1, 4), loads,
+                                  outputs=(study.resolved().connection,), engine=engine)
+    return angles, metrics.t_solar.reshape(sky.n_blocks, angles.size, -1)
+
+
+def _design_metrics(sky: Sky, studies, loads, angles, chosen, engine: str) -> dict:
+    """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
+    panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net."""
+    study = studies[0].resolved()
+    n_blocks, n_loads = sky.n_blocks, loads.size
+    tilt, azimuth = _panels(studies)
+    every = engines.fold_orientations(study, tilt, azimuth, angles)
+    blocks = np.repeat(np.arange(n_blocks), n_loads)
+    # One row per block and load, at that load's angle, with the load alone.
+    twofold = engines.row_metrics(sky, study, blocks, every[blocks, chosen.ravel()], loads[:, None],
+                                  np.tile(np.arange(n_loads), n_blocks), outputs=(study.connection,),
+                                  contiguous=True, engine=engine)
+    flat = engines.row_metrics(sky, study, np.arange(n_blocks), engines.flat_orientation(tilt, azimuth), loads,
+                               outputs=("panel",), contiguous=True, engine=engine)
+    orientation = sky_tracker_orientation(sky, study)
+    gross = sky_tracker_power(sky, study, orientation)
+    net = gross - sky_tracker_draw(sky, study, orientation)
+    trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
+                                     engine=engine)
+
+    def per_design(twofold_values, flat_values, tracker_values):
+        return np.stack([flat_values, twofold_values.reshape(n_blocks, n_loads), tracker_values[:n_blocks],
+                         tracker_values[n_blocks:]], axis=-1)
+
+    hours = per_design(twofold.t_solar[:, 0, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
+    harvested = per_design(twofold.energy[:, 0], np.repeat(flat.energy, n_loads, axis=1),
+                           np.repeat(trackers.energy, n_loads, axis=1))
+    served = loads[None, :, None] * hours
+    fold = np.stack([np.full((n_blocks, n_loads), 180.0), angles[chosen], np.full((n_blocks, n_loads), np.nan),
+                     np.full((n_blocks, n_loads), np.nan)], axis=-1)
+    return {
+        "fold_angle_deg": fold,
+        "t_solar_h": hours,
+        "t_solar_contiguous_h": per_design(twofold.t_solar_contiguous[:, 0, 0], flat.t_solar_contiguous[:, 0],
+                                           trackers.t_solar_contiguous[:, 0]),
+        "energy_wh": harvested,
+        "energy_served_wh": served,
+        "energy_wasted_wh": harvested - served,
+        "peak_power_w": per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
+                                   np.repeat(trackers.peak, n_loads, axis=1)),
+        "sun_up": np.broadcast_to(np.any(sky.dni > 0, axis=1)[:, None, None], hours.shape),
     }
-    metrics = {name: daily_metrics(curve, loads, step) for name, (_, curve) in curves.items()}
-    flat_hours, tracker_hours = metrics["flat"]["t_solar_h"], metrics["tracker"]["t_solar_h"]
-    sun_up = bool(np.any(day.dni > 0))
-    rows = []
-    for index, load in enumerate(loads):
-        for name in DESIGNS:
-            values = {key: float(value[index]) for key, value in metrics[name].items()}
-            hours_now = values["t_solar_h"]
-            note = "polar night" if not sun_up else ("load above peak" if hours_now == 0 else "")
-            with np.errstate(divide="ignore", invalid="ignore"):
-                gain = (hours_now / flat_hours[index] - 1.0) * 100.0 if flat_hours[index] > 0 else np.nan
-                share = hours_now / tracker_hours[index] * 100.0 if tracker_hours[index] > 0 else np.nan
-            rows.append(
-                {
-                    **case,
-                    "p_load_w": float(load),
-                    "design": name,
-                    "fold_angle_deg": float(curves[name][0][index]),
-                    **values,
-                    "gain_vs_flat_pct": gain,
-                    "pct_of_tracker_t_solar": share,
-                    "note": note,
-                }
-            )
-    return rows
 
 
 def objective_value(hours, months, statistic: str, season=None):
@@ -126,14 +159,16 @@ def objective_value(hours, months, statistic: str, season=None):
     return np.percentile(hours, float(statistic[1:]), axis=0)
 
 
-def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None) -> SweepResult:
+def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, engine: str = "numba") -> SweepResult:
     """Evaluate every case of a plan: flat, optimal twofold and tracker per case.
 
     Parameters
     ----------
     plan : Plan
     progress : callable, optional
-        Called as ``progress(done, total)`` after each day.
+        Called as ``progress(done, total)`` with the cases (days) done so far.
+    engine : {'numba', 'numpy'}
+        :data:`foldopt.engine.ENGINES`.
 
     Returns
     -------
@@ -148,61 +183,116 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None) -> 
     objective = plan.base.objective
     dates = axes.pop("date", None) if objective is not None else None
     paths = list(axes)
-    groups = list(itertools.product(*axes.values()))
-    tables: dict = {}
-    rows, extras = [], {}
-    total = len(groups) * (2 * len(dates) if dates else 1)  # an annual group is two passes
+    choices = [dict(zip(paths, values, strict=True)) for values in itertools.product(*axes.values())]
+    # A fixed panel keeps one fold angle all year: an annual group is the dates of one choice.
+    groups = [[{**choice, "date": date} for date in dates] if dates else [choice] for choice in choices]
+    studies = [[plan.study({**case, "p_load": float(loads[0])}) for case in group] for group in groups]
+    total = sum(len(group) for group in groups) * (2 if dates else 1)
     done = 0
 
-    def day_of(choice):
-        return Day(plan.study({**choice, "p_load": float(loads[0])}), tables)
+    def advance(count):
+        nonlocal done
+        done += count
+        if progress is not None:
+            progress(done, total)
 
-    for values in groups:
-        choice = dict(zip(paths, values, strict=True))
-        if not dates:
-            day = day_of(choice)
-            rows += _day_rows(day, loads, _case(day, choice))
-            done += 1
-            if progress is not None:
-                progress(done, total)
-            continue
-        # A fixed panel keeps one fold angle all year: first t_solar of every angle on every day,
-        # then the angle that maximises the objective, then each day at that angle.
-        days, daily = [], []
-        for date in dates:
-            days.append(day_of({**choice, "date": date}))  # a day keeps only a few arrays of n_time
-            angles, _, hours = _angle_hours(days[-1], loads)
-            daily.append(hours)
-            done += 1
-            if progress is not None:
-                progress(done, total)
-        months = [date.month for date in dates]
-        score = objective_value(np.stack(daily), months, objective.statistic, objective.months)
-        fixed = angles[_best_angle_index(score)]
-        series = {"p_twofold_w": [], "switch_state": []}
-        for day in days:
-            rows += _day_rows(day, loads, _case(day, choice), fixed)
-            powers, state = day.connections(fixed[:1], series=day.study.switch_series)
-            series["p_twofold_w"].append(powers[day.study.connection][0])
-            series["switch_state"].append(np.where(powers["switching"][0] > 0, state[0], -1))
-            done += 1
-            if progress is not None:
-                progress(done, total)
-        if not extras and len({len(p) for p in series["p_twofold_w"]}) == 1:
-            hours_of_day = (day.times - day.times.normalize()) / pd.Timedelta(hours=1)
-            extras = {"dates": list(dates), "hours": np.asarray(hours_of_day), "fold_angle": float(fixed[0]),
-                      **{key: np.stack(value) for key, value in series.items()}}
-    return SweepResult(plan, pd.DataFrame(rows), extras)
+    results: list = [None] * len(groups)
+    extras: dict = {}
+    if dates:
+        for index, group in enumerate(studies):
+            results[index], group_extras = _annual_group(group, loads, objective, advance, engine)
+            extras = extras or group_extras
+    else:
+        # Cases of one setup share skies and engine calls, whatever their order in the plan.
+        setups: dict[str, list[int]] = {}
+        for index, (study,) in enumerate(studies):
+            setups.setdefault(_setup_key(study), []).append(index)
+        for members in setups.values():
+            member_studies = [studies[i][0] for i in members]
+            k = len(member_studies[0].fold_angles.grid())
+            n_steps = round(24 / (member_studies[0].step_min / 60))
+            for part in _chunks(len(members), k, loads.size, n_steps):
+                chunk = member_studies[part]
+                sky = build_sky(chunk)
+                angles, hours = fold_hours(sky, chunk, loads, engine)
+                metrics = _design_metrics(sky, chunk, loads, angles, _best_angle_index(hours.transpose(0, 2, 1)),
+                                          engine)
+                for offset, index in enumerate(members[part]):
+                    results[index] = {name: values[offset:offset + 1] for name, values in metrics.items()}
+                advance(len(chunk))
+    table = _table([study for group in studies for study in group],
+                   [case for group in groups for case in group], loads,
+                   {name: np.concatenate([r[name] for r in results]) for name in results[0]})
+    return SweepResult(plan, table, extras)
 
 
-def _case(day: Day, choice: dict) -> dict:
-    site = day.study.site
+def _annual_group(studies, loads, objective, advance, engine):
+    """One fold angle per load for all the days of a group: the one that maximises the objective
+    over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves."""
+    n_steps = round(24 / (studies[0].step_min / 60))
+    k = len(studies[0].fold_angles.grid())
+    parts = _chunks(len(studies), k, loads.size, n_steps)
+    skies, daily = [], []
+    for part in parts:
+        skies.append(build_sky(studies[part]))
+        angles, hours = fold_hours(skies[-1], studies[part], loads, engine)
+        daily.append(hours)
+        advance(len(studies[part]))
+    months = [study.date.month for study in studies]
+    score = objective_value(np.concatenate(daily).transpose(0, 2, 1), months, objective.statistic, objective.months)
+    fixed = _best_angle_index(score)  # (n_loads,)
+    metrics, series = [], {"p_twofold_w": [], "switch_state": []}
+    for part, sky in zip(parts, skies, strict=True):
+        chunk = studies[part]
+        metrics.append(_design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
+                                       engine))
+        # The day x hour maps of the first load's angle, every day at once.
+        study = chunk[0].resolved()
+        orientation = engines.fold_orientations(study, *_panels(chunk), angles[fixed[:1]])[:, 0]
+        powers, state = engines.powers(sky, study, orientation, series=study.switch_series, with_state=True)
+        series["p_twofold_w"].append(powers[study.connection])
+        series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
+        advance(len(chunk))
+    clock = skies[0].grid.clock_hours[0]
+    extras = {"dates": [study.date for study in studies], "hours": clock, "fold_angle": float(angles[fixed[0]]),
+              **{key: np.concatenate(value) for key, value in series.items()}}
+    return {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}, extras
+
+
+def _table(studies, cases, loads, metrics) -> pd.DataFrame:
+    """The tidy table: per case, load and design (in that order), the case columns and metrics."""
+    n_cases, n_loads, n_designs = len(studies), loads.size, len(DESIGNS)
+    repeat = n_loads * n_designs
+    columns = {}
+    case_rows = [_case(study, case) for study, case in zip(studies, cases, strict=True)]
+    for name in case_rows[0]:
+        columns[name] = np.repeat(np.array([row[name] for row in case_rows], dtype=object), repeat)
+    columns["p_load_w"] = np.tile(np.repeat(loads, n_designs), n_cases)
+    columns["design"] = np.tile(np.array(DESIGNS, dtype=object), n_cases * n_loads)
+    columns["fold_angle_deg"] = metrics["fold_angle_deg"].ravel()
+    hours = metrics["t_solar_h"]
+    for name in METRICS:
+        columns[name] = metrics[name].ravel()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        flat, tracker = hours[..., :1], hours[..., 2:3]
+        columns["gain_vs_flat_pct"] = np.where(flat > 0, (hours / flat - 1.0) * 100.0, np.nan).ravel()
+        columns["pct_of_tracker_t_solar"] = np.where(tracker > 0, hours / tracker * 100.0, np.nan).ravel()
+    sun_up = metrics["sun_up"].ravel()
+    columns["note"] = np.where(~sun_up, "polar night", np.where(hours.ravel() == 0, "load above peak", ""))
+    table = pd.DataFrame(columns)
+    for name in case_rows[0]:
+        table[name] = table[name].infer_objects()
+    return table
+
+
+def _case(study: Study, choice: dict) -> dict:
+    site = study.site
     return {
         "site_name": site.name or "",
         "latitude": site.latitude,
         "longitude": site.longitude,
-        "date": day.study.date.isoformat(),
-        "day_of_year": day.study.date.timetuple().tm_yday,
+        "date": study.date.isoformat(),
+        "day_of_year": study.date.timetuple().tm_yday,
         **{path: _plain(value) for path, value in choice.items() if path not in _AXIS_COLUMNS},
     }
 

@@ -89,9 +89,9 @@ def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declinat
     model : str
         One of :data:`TRACKERS`.
     solar_zenith, solar_azimuth, hour_angle, declination : array_like
-        The sun over the day [deg]; time on the last axis.
-    latitude : float
-        [deg].
+        The sun over the day [deg]; time on the last axis, any leading axes (days).
+    latitude : float or array_like
+        [deg], broadcast against the leading axes (shape (n_days, 1) for one per day).
     options : TrackerOptions, optional
         Step law and single-axis settings.
 
@@ -104,25 +104,29 @@ def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declinat
     zenith = np.asarray(solar_zenith, dtype=float)
     if model == "dual-axis":
         return zenith.copy(), np.asarray(solar_azimuth, dtype=float).copy()
+    north = np.asarray(latitude) >= 0
     if model in ("equatorial", "dual-axis-steps"):
-        noon = np.argmin(np.abs(np.asarray(hour_angle)))
-        seasonal = np.asarray(declination)[noon]
+        hour_angle = np.asarray(hour_angle, dtype=float)
+        noon = np.argmin(np.abs(hour_angle), axis=-1)[..., None]
+        seasonal = np.take_along_axis(np.broadcast_to(declination, hour_angle.shape), noon, axis=-1)
         daily = hour_angle if model == "equatorial" else step_law(
             hour_angle, options.steps, options.angular_field, options.step_offsets_h
         )
         normal = equatorial_normal(daily, seasonal, latitude)
-        return orientation_from_normal(normal, level_azimuth=180.0 if latitude >= 0 else 0.0)
+        return orientation_from_normal(normal, level_azimuth=np.where(north, 180.0, 0.0))
     if model == "single-axis":
-        axis_azimuth = options.axis_azimuth if options.axis_azimuth is not None else (180.0 if latitude >= 0 else 0.0)
+        axis_azimuth = options.axis_azimuth if options.axis_azimuth is not None else np.where(north, 180.0, 0.0)
+        shape = zenith.shape
+        axis_azimuth = np.broadcast_to(axis_azimuth, shape)
         result = pvlib.tracking.singleaxis(
-            zenith, np.asarray(solar_azimuth, dtype=float), axis_tilt=options.axis_tilt,
-            axis_azimuth=axis_azimuth, max_angle=options.max_angle, backtrack=options.backtrack,
+            zenith.ravel(), np.asarray(solar_azimuth, dtype=float).ravel(), axis_tilt=options.axis_tilt,
+            axis_azimuth=axis_azimuth.ravel(), max_angle=options.max_angle, backtrack=options.backtrack,
             gcr=options.gcr,
         )
         # At night pvlib returns NaN; the panel then rests flat along the axis.
-        tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt)
-        azimuth = np.nan_to_num(np.asarray(result["surface_azimuth"], dtype=float), nan=axis_azimuth)
-        return tilt, azimuth
+        tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt).reshape(shape)
+        azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
+        return tilt, np.where(np.isnan(azimuth), axis_azimuth, azimuth)
     raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}; got {model!r}")
 
 
@@ -199,16 +203,20 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
 def moved_degrees(surface_tilt, surface_azimuth, sun_up):
     """Angle [deg] the panel normal turns between consecutive steps, with the nightly return.
 
-    The return from the last daylight orientation to the first is added to the first daylight
-    step (it happens at night, before the day's work).
+    Time on the last axis, any leading axes (days). The return from the last daylight orientation
+    to the first is added to the first daylight step (it happens at night, before the day's work).
     """
     normal = normal_vector(surface_tilt, surface_azimuth)
-    turn = np.zeros(normal.shape[0])
-    turn[1:] = _angle_between(normal[1:], normal[:-1])
-    up = np.flatnonzero(sun_up)
-    turn = np.where(sun_up & np.r_[False, sun_up[:-1]], turn, 0.0)
-    if up.size:
-        turn[up[0]] += _angle_between(normal[up[-1]], normal[up[0]])
+    sun_up = np.asarray(sun_up, dtype=bool)
+    turn = np.zeros(normal.shape[:-1])
+    turn[..., 1:] = _angle_between(normal[..., 1:, :], normal[..., :-1, :])
+    turn = np.where(sun_up & np.concatenate([np.zeros_like(sun_up[..., :1]), sun_up[..., :-1]], axis=-1), turn, 0.0)
+    first = np.argmax(sun_up, axis=-1)[..., None]
+    last = sun_up.shape[-1] - 1 - np.argmax(sun_up[..., ::-1], axis=-1)[..., None]
+    back = _angle_between(np.take_along_axis(normal, last[..., None], axis=-2),
+                          np.take_along_axis(normal, first[..., None], axis=-2))
+    has_day = sun_up.any(axis=-1, keepdims=True)
+    np.put_along_axis(turn, first, np.take_along_axis(turn, first, axis=-1) + np.where(has_day, back, 0.0), axis=-1)
     # A panel that holds still must not be charged a motor start: drop rounding-level turns.
     return np.where(turn > 1e-6, turn, 0.0)
 

@@ -49,7 +49,9 @@ def test_subpanel_irradiance_is_pvlibs_total_irradiance(model):
         tilt, azimuth = sides[f"tilt_{side}"][0], sides[f"azimuth_{side}"][0]
         expected = pvlib.irradiance.get_total_irradiance(
             tilt, azimuth, day.solar_zenith, day.solar_azimuth, day.dni, day.ghi, day.dhi,
-            dni_extra=day.dni_extra, airmass=day.airmass, albedo=0.25, model=model,
+            dni_extra=pvlib.irradiance.get_extra_radiation(day.times.day_of_year),
+            airmass=np.nan_to_num(pvlib.atmosphere.get_relative_airmass(np.minimum(day.solar_zenith, 90.0))),
+            albedo=0.25, model=model,
         )["poa_global"]
         np.testing.assert_allclose(day._poa(np.array([tilt]), np.array([azimuth]))[0],
                                    np.nan_to_num(np.asarray(expected)), rtol=1e-12, atol=1e-9)

@@ -1,0 +1,193 @@
+"""The light over many days and sites at once: everything that does not depend on the panel.
+
+A :class:`Sky` holds, for every *block* (one local day at one site) and every time step, the sun's
+position and unit vector, the direct normal irradiance and, with a transposition model, the four
+orientation-free diffuse terms of :func:`foldopt.irradiance.sky_diffuse_terms`. It is built as
+one array program over all blocks (:func:`build_sky`): one clock grid, one solar-position
+evaluation, one air mass and clear-sky pass. The engine then evaluates any number of panel
+orientations against it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+import pvlib
+
+from foldopt.atmosphere import clear_sky_dni, relative_airmass
+from foldopt.config import Study, parse_timezone
+from foldopt.geometry import normal_vector
+from foldopt.irradiance import sky_diffuse_terms
+from foldopt.solarposition import ClockGrid, clock_grid, solar_position_grid
+from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, weather_day
+
+#: Study fields that every block of one sky shares.
+SHARED_FIELDS = ("mode", "sky", "linke_turbidity", "transposition", "albedo", "iam", "weather", "climate",
+                 "step_min", "temp_air")
+
+
+@dataclass(frozen=True)
+class Sky:
+    """Sun and light per block (a day at a site) and time step; arrays are (n_blocks, n_steps).
+
+    Attributes
+    ----------
+    grid : ClockGrid
+    mode : {'paper', 'exact'}
+    solar_zenith, solar_azimuth, hour_angle, declination : numpy.ndarray
+        [deg]; the apparent zenith in exact mode.
+    sun_vector : numpy.ndarray
+        (n_blocks, n_steps, 3) unit vectors east, north, up.
+    dni : numpy.ndarray
+        Direct normal irradiance [W/m^2].
+    ghi, dhi : numpy.ndarray or None
+        Global and diffuse horizontal irradiance [W/m^2], where the sky has them.
+    terms : numpy.ndarray or None
+        (n_blocks, n_steps, 4) diffuse terms; None when the study is beam only.
+    temp_air : numpy.ndarray
+        (n_blocks,) the air temperature the cells of each block see [C].
+    latitude : numpy.ndarray
+        (n_blocks,) [deg north].
+    iam : {'none', 'ashrae', 'physical'}
+    """
+
+    grid: ClockGrid
+    mode: str
+    solar_zenith: np.ndarray
+    solar_azimuth: np.ndarray
+    hour_angle: np.ndarray
+    declination: np.ndarray
+    sun_vector: np.ndarray
+    dni: np.ndarray
+    ghi: np.ndarray | None
+    dhi: np.ndarray | None
+    terms: np.ndarray | None
+    temp_air: np.ndarray
+    latitude: np.ndarray
+    iam: str
+
+    @property
+    def n_blocks(self) -> int:
+        return self.dni.shape[0]
+
+    @property
+    def step_hours(self) -> float:
+        return self.grid.step_hours
+
+    @property
+    def lit(self) -> np.ndarray:
+        """Steps with any light on some orientation."""
+        if self.terms is None:
+            return self.dni > 0
+        return (self.dni > 0) | np.any(self.terms != 0, axis=-1)
+
+    @property
+    def paper_sun(self) -> np.ndarray:
+        """cos(zenith), sin(zenith), sin(azimuth), cos(azimuth): the sun's part of Eq. 5."""
+        zenith, azimuth = np.radians(self.solar_zenith), np.radians(self.solar_azimuth)
+        return np.stack([np.cos(zenith), np.sin(zenith), np.sin(azimuth), np.cos(azimuth)], axis=-1)
+
+    def block(self, index: int) -> Sky:
+        """One block as a sky of its own (arrays keep their leading axis, of length 1)."""
+        keep = slice(index, index + 1)
+        grid = ClockGrid(self.grid.utc_ns[keep], self.grid.utc_offset_ns[keep], self.grid.timezones[keep],
+                         self.grid.step_hours)
+        take = {name: None if getattr(self, name) is None else getattr(self, name)[keep]
+                for name in ("solar_zenith", "solar_azimuth", "hour_angle", "declination", "sun_vector", "dni",
+                             "ghi", "dhi", "terms", "temp_air", "latitude")}
+        return Sky(grid=grid, mode=self.mode, iam=self.iam, **take)
+
+
+def _check_shared(studies: list[Study]) -> None:
+    first = studies[0]
+    for name in SHARED_FIELDS:
+        if name == "temp_air" and first.weather is not None:
+            continue
+        if any(getattr(s, name) != getattr(first, name) for s in studies[1:]):
+            raise ValueError(f"the blocks of one sky must share {name!r}")
+
+
+def _weather_grid(studies: list[Study]):
+    """Clock grid, light and cell air temperature of each block from the study's weather file."""
+    weather = studies[0].weather
+    days = []
+    for study in studies:
+        frame = read_weather(weather.path, weather.format, study.date.year, weather.label)
+        days.append(weather_day(frame, study.date))
+    lengths = {len(day) for day in days}
+    if len(lengths) != 1:
+        raise ValueError(f"the weather file's days have different numbers of steps: {sorted(lengths)}")
+    grid = ClockGrid.from_times([pd.DatetimeIndex(day.index) for day in days], days[0].index.tz)
+    light = {key: np.stack([day[key].to_numpy(dtype=float) for day in days]) for key in ("dni", "ghi", "dhi")}
+    # Cells follow each day's mean air temperature (the electrical tables assume one per day),
+    # rounded to 5 C so that days share their tables; wind stays the study's.
+    temp_air = np.array([round(float(day["temp_air"].mean()) / 5.0) * 5.0 for day in days])
+    return grid, light, temp_air
+
+
+def build_sky(studies) -> Sky:
+    """The sky over one block per study (its site and date), as one array program.
+
+    Parameters
+    ----------
+    studies : sequence of Study
+        One block each; they must agree on :data:`SHARED_FIELDS` (mode, sky, step, weather...).
+
+    Returns
+    -------
+    Sky
+    """
+    studies = [s.resolved() for s in studies]
+    _check_shared(studies)
+    first = studies[0]
+    latitude = np.array([s.site.latitude for s in studies])[:, None]
+    longitude = np.array([s.site.longitude for s in studies])[:, None]
+    altitude = np.array([s.site.altitude for s in studies], dtype=float)[:, None]
+    light = {}
+    if first.weather is not None:
+        grid, light, temp_air = _weather_grid(studies)
+    else:
+        # One localisation per time zone, blocks back in their order.
+        zones: dict[str, list[int]] = {}
+        for index, study in enumerate(studies):
+            zones.setdefault(study.site.timezone, []).append(index)
+        parts = {zone: clock_grid([studies[i].date for i in members], parse_timezone(zone), first.step_min)
+                 for zone, members in zones.items()}
+        order = np.argsort(np.concatenate(list(zones.values())), kind="stable")
+        stacked = ClockGrid.stack(parts.values())
+        grid = ClockGrid(stacked.utc_ns[order], stacked.utc_offset_ns[order],
+                         tuple(stacked.timezones[i] for i in order), stacked.step_hours)
+        temp_air = np.full(len(studies), float(first.temp_air))
+    sun = solar_position_grid(grid, latitude, longitude, altitude, first.mode)
+    zenith = sun["solar_zenith"]
+    if first.weather is None and first.sky in CLEAR_SKIES:
+        light = {key: np.empty_like(zenith) for key in ("dni", "ghi", "dhi")}
+        for index, study in enumerate(studies):
+            sky = clear_sky(grid.times(index), zenith[index], study.site.latitude, study.site.longitude,
+                            study.site.altitude, first.sky, first.linke_turbidity)
+            for key in light:
+                light[key][index] = sky[key]
+    elif first.weather is None:
+        beam_altitude = altitude if first.mode == "exact" else 0.0
+        light = {"dni": clear_sky_dni(zenith, beam_altitude, first.sky, dayofyear=grid.day_of_year,
+                                      climate=first.climate)}
+    dni = light["dni"]
+    ghi, dhi = light.get("ghi"), light.get("dhi")
+    terms = None
+    transposition = first.sky_transposition()
+    if transposition != "none":
+        dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.day_of_year]
+        airmass = np.nan_to_num(relative_airmass(np.minimum(zenith, 90.0)), nan=0.0)
+        terms = sky_diffuse_terms(
+            transposition, zenith, dni,
+            ghi if ghi is not None else dni * np.clip(np.cos(np.radians(zenith)), 0, None),
+            dhi if dhi is not None else np.zeros_like(dni), dni_extra, airmass, first.albedo,
+        )
+    return Sky(
+        grid=grid, mode=first.mode, solar_zenith=zenith, solar_azimuth=sun["solar_azimuth"],
+        hour_angle=sun["hour_angle"], declination=np.ascontiguousarray(sun["declination"]),
+        sun_vector=normal_vector(zenith, sun["solar_azimuth"]), dni=dni, ghi=ghi, dhi=dhi, terms=terms,
+        temp_air=temp_air, latitude=latitude[:, 0], iam=first.iam,
+    )
