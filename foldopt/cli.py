@@ -39,6 +39,7 @@ RESULTS = Path("results")
 # Typer >= 0.29 vendors click; its UsageError is reached through the public BadParameter.
 _USAGE_ERROR = next(cls for cls in typer.BadParameter.__mro__ if cls.__name__ == "UsageError")
 FORMATS = ("table", "json")
+ENGINES = ("numba", "numpy")  # foldopt.engine.ENGINES, without importing the engine for --help
 
 
 class _OneLineErrors(TyperGroup):
@@ -114,9 +115,14 @@ class _Status:
                 sys.stderr.write("\n")
 
 
-def _check_format(output_format: str) -> None:
+def _check_format(output_format: str, engine: str = "numba") -> None:
+    errors = []
     if output_format not in FORMATS:
-        _fail([f"--format = {output_format!r}: must be one of {', '.join(FORMATS)}"])
+        errors.append(f"--format = {output_format!r}: must be one of {', '.join(FORMATS)}")
+    if engine not in ENGINES:
+        errors.append(f"--engine = {engine!r}: must be one of {', '.join(ENGINES)}")
+    if errors:
+        _fail(errors)
 
 
 def _emit(table, title: str, output_format: str, out: Path, columns=None) -> None:
@@ -137,14 +143,15 @@ SWEEP_COLUMNS = ["latitude", "date", "p_load_w", "design", "fold_angle_deg", "t_
 QUIET = typer.Option(False, "--quiet", "-q", help="No status line")
 FORMAT = typer.Option("table", "--format", help="table | json (summary on stdout for scripts)")
 OVERWRITE = typer.Option(False, "--overwrite", help="Replace an existing results folder")
+ENGINE = typer.Option("numba", "--engine", help="numba (compiled kernel) | numpy (the reference path, slower)")
 
 
-def _run_plan(plan, out: Path, overwrite: bool, quiet: bool, output_format: str) -> None:
+def _run_plan(plan, out: Path, overwrite: bool, quiet: bool, output_format: str, engine: str) -> None:
     check_output(out, overwrite)
     base = plan.base
     if not plan.axes:
         with _Status(f"foldopt: {base.name}", quiet).running():
-            result = run_study(base)
+            result = run_study(base, engine)
             write_study(result, out, overwrite)
         study = result.study
         title = (f"{study.name} ({study.mode} mode, {study.geometry}, {study.pv_model} + {study.connection}, "
@@ -155,7 +162,7 @@ def _run_plan(plan, out: Path, overwrite: bool, quiet: bool, output_format: str)
                        f"standby draw exceeds {result.standby[1]:.2f} W")
         return
     with _Status(f"foldopt: {base.name}, {plan.n_cases} cases", quiet).running() as status:
-        result = run_plan(plan, status.progress)
+        result = run_plan(plan, status.progress, engine)
         write_sweep(result, out, overwrite)
     twofold = result.table[result.table["design"] == "twofold"]
     title = f"{base.name}: {plan.n_cases} cases over {', '.join(p for p, _ in plan.axes)} (twofold rows)"
@@ -170,12 +177,13 @@ def run(
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
     output_format: str = FORMAT,
+    engine: str = ENGINE,
 ):
     """Run a YAML study: one case (fold-angle sweep, heuristic, comparison) or a sweep of cases."""
-    _check_format(output_format)
+    _check_format(output_format, engine)
     try:
         plan = load_plan(config if config is not None else default_study_path())
-        _run_plan(plan, out or RESULTS / plan.base.name, overwrite, quiet, output_format)
+        _run_plan(plan, out or RESULTS / plan.base.name, overwrite, quiet, output_format, engine)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
 
@@ -186,19 +194,20 @@ def reproduce(
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
     output_format: str = FORMAT,
+    engine: str = ENGINE,
 ):
     """Reproduce Shin et al.'s study in paper and exact modes.
 
     Writes reproduction.csv (the embedded study: ideal PV model) and reproduction_single_diode.csv
     (A-300 single-diode sub-panels with switching).
     """
-    _check_format(output_format)
+    _check_format(output_format, engine)
     try:
         check_output(out, overwrite)
         study = load_study(default_study_path())
         with _Status("foldopt: reproducing Shin et al.", quiet).running():
-            tables = {name: reproduce_table(study, **changes) for name, changes in REPRODUCTIONS.items()}
-            write_reproduction(tables, study, out, overwrite)
+            tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
+            write_reproduction(tables, study, out, overwrite, engine=engine)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
     for name, table in tables.items():
@@ -276,6 +285,7 @@ def sweep(
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
     output_format: str = FORMAT,
+    engine: str = ENGINE,
 ):
     """Sweep a design variable from the command line.
 
@@ -283,7 +293,7 @@ def sweep(
     every combination of the ranges given (--lat, --days, --p-load, --tilt, --lon accept
     start:stop:step), one row per case x design in results.csv, with heat maps and curves.
     """
-    _check_format(output_format)
+    _check_format(output_format, engine)
     if axis not in AXES:
         _fail([f"sweep: axis {axis!r} must be one of {', '.join(AXES)}"])
     lat = lat if lat is not None else _DEFAULT_RANGES.get(axis)
@@ -326,7 +336,7 @@ def sweep(
     if axis == "angle" and plan.axes:
         _fail([f"sweep angle: one site, day and load; {', '.join(p for p, _ in plan.axes)} vary (use sweep latitude/day/load)"])
     try:
-        _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, quiet, output_format)
+        _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, quiet, output_format, engine)
     except OutputExistsError as error:
         _fail([str(error)])
 

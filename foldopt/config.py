@@ -106,6 +106,14 @@ class Site(_Strict):
     )
 
 
+    def resolved(self) -> Site:
+        """The site with its time zone filled in: the longitude's standard offset by default."""
+        if self.timezone is not None:
+            return self
+        hours = round(self.longitude / 15.0)
+        return self.model_copy(update={"timezone": f"UTC{'+' if hours >= 0 else '-'}{abs(hours):02d}:00"})
+
+
 class Panel(_Strict):
     area: _interval(0, 1000, lo_open=True, unit=" m^2")
     efficiency: _interval(0, 1, lo_open=True) = 0.2
@@ -273,16 +281,12 @@ class Study(_Strict):
                 "azimuth": azimuth if self.panel.azimuth is None else self.panel.azimuth,
             }
         )
-        timezone = self.site.timezone
-        if timezone is None:
-            hours = round(self.site.longitude / 15.0)
-            timezone = f"UTC{'+' if hours >= 0 else '-'}{abs(hours):02d}:00"
         geometry = self.geometry or ("azimuth-split" if self.mode == "paper" else "hinge")
         temperature = self.temperature_model or ("fixed" if self.mode == "paper" else "sapm")
         return self.model_copy(
             update={
                 "panel": panel,
-                "site": self.site.model_copy(update={"timezone": timezone}),
+                "site": self.site.resolved(),
                 "geometry": geometry,
                 "temperature_model": temperature,
             }

@@ -20,6 +20,7 @@ import functools
 import inspect
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 import pvlib
 
@@ -334,12 +335,21 @@ def _compiled(sky, study, electricals, block_table, row_block, orientation, load
     tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])
     row_paper = np.stack([np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1)
     iam_code, iam_params = _iam_code(sky.iam)
-    terms = sky.terms if sky.terms is not None else np.zeros(sky.dni.shape + (0,))
+    # The kernel reads each component along the time steps: (n_blocks, component, n_steps).
+    terms = np.moveaxis(sky.terms, -1, 1) if sky.terms is not None else np.zeros((sky.n_blocks, 0, 1))
     paper = study.mode == "paper"
-    paper_sun = sky.paper_sun if paper else np.zeros((1, 1, 4))
+    paper_sun = np.moveaxis(sky.paper_sun, -1, 1) if paper else np.zeros((1, 4, 1))
     first = electricals[0]
-    work = kernel.scratch(row_block.size, codes.size, loads.shape[1], contiguous)
-    arrays = [sky.sun_vector, paper_sun, sky.dni, terms, sky.lit, np.asarray(block_table, dtype=np.int64), row_block,
+    work = kernel.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous,
+                          numba.get_num_threads())
+    lit = sky.lit
+    steps = np.arange(lit.shape[1])
+    first_lit = np.where(lit, steps, lit.shape[1]).min(axis=1)
+    last_lit = np.where(lit, steps, -1).max(axis=1)
+    span = np.where((first_lit <= last_lit)[:, None],
+                    np.stack([np.maximum(first_lit - 1, 0), np.minimum(last_lit + 1, steps[-1])], axis=1), 0)
+    arrays = [np.moveaxis(sky.sun_vector, -1, 1), paper_sun, sky.dni, terms, span,
+              np.asarray(block_table, dtype=np.int64), row_block,
               np.stack([east, west], axis=1), row_paper, row_loadset]
     # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
     kernel.fold_rows(
@@ -371,7 +381,7 @@ def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous:
     else:
         from foldopt import kernel
 
-        work = kernel.scratch(power.shape[0], 1, sorted_loads.shape[1], contiguous)
+        work = kernel.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous, numba.get_num_threads())
         kernel.curve_rows(power, row_loadset, sorted_loads, step_hours, contiguous, **work)
         result = RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
                             work["peak_out"])

@@ -1,12 +1,14 @@
-"""Compiled loops of the engine (numba): sun to t_solar in one pass per row, no temporaries.
+"""Compiled loops of the engine (numba): sun to t_solar per row, with no (rows x steps) arrays.
 
 A *row* is one block (a day at a site, see :class:`foldopt.sky.Sky`) seen by one orientation of
-the two sub-panels (a fold angle). :func:`fold_rows` walks the row's time steps once: both
-sub-panel normals against the sun vector give the beam's incidence (or Shin et al.'s Eq. 5 in
-paper mode), the beam with the optional incidence-angle modifier and the diffuse terms give the
-plane-of-array irradiance, the electrical tables give every connection's power, and the power
-feeds the daily metrics of every load at once. No (rows x steps) array is ever made.
-:func:`curve_rows` takes power curves that already exist (a tracker's) through the same metrics.
+the two sub-panels (a fold angle). :func:`fold_rows` takes each row in two tight loops over its
+time steps. The first turns the sun into every asked connection's power: both sub-panel normals
+against the sun vector give the beam's incidence (or Shin et al.'s Eq. 5 in paper mode), the beam
+with the optional incidence-angle modifier and the diffuse terms give the plane-of-array
+irradiance, and the electrical tables give the powers. It writes them to a buffer of one day,
+reused by the next row. The second reduces each power curve to the daily metrics of every load
+at once (:func:`_metrics`). :func:`curve_rows` takes power curves that already exist (a tracker's)
+through the same reduction.
 
 The metrics are those of :mod:`foldopt.metrics`, which is their reference: power is sampled at
 step centres and linear between them (held for half a step at both ends of the day), and a
@@ -16,6 +18,10 @@ segment from ``lo`` to ``hi`` of length ``dt`` is above a load ``L`` for
 only the loads inside the segment's range take a share. The position of the power among the loads
 moves by a few loads a step, so it is walked from the previous step instead of searched. A day's
 cost is then O(steps + loads x crossings), not O(steps x loads).
+
+Rows are split into chunks, a few per thread, and each chunk has its own scratch, allocated by the
+caller outside the parallel loop (:func:`scratch`; arrays zero-filled inside a numba prange body
+have given wrong sums) and cleared per row.
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -32,6 +38,7 @@ from numba import njit, prange
 EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
 IAM_NONE, IAM_ASHRAE, IAM_PHYSICAL = range(3)
 IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the electrical tables (foldopt.electrical)
+CHUNKS_PER_THREAD = 8  # rows are handed out in chunks: enough for balance, few scratch buffers
 
 
 @njit(cache=True, inline="always")
@@ -83,22 +90,8 @@ def _walk(loads, position, power):
 
 
 @njit(cache=True, inline="always")
-def _segment(loads, start, end, start_at, end_at, length, above, whole, run, contiguous):
-    """Add one linear segment of the power curve to every load's time above it.
-
-    ``start_at``/``end_at`` are the loads at or below each end; ``whole[k]`` collects time that
-    every load below index k takes whole; ``above`` the shares of loads inside the segment."""
-    lo_at, hi_at = min(start_at, end_at), max(start_at, end_at)
-    lo, hi = min(start, end), max(start, end)
-    if contiguous:
-        # A sample below a load ends that load's run: the segment starts a new one.
-        for j in range(start_at, loads.shape[0]):
-            if run[j, 1] < run[j, 0]:
-                run[j, 1] = run[j, 0]
-            run[j, 0] = 0.0
-        for j in range(lo_at):
-            run[j, 0] += length
-    whole[lo_at] += length
+def _shares(loads, lo, hi, lo_at, hi_at, length, above, run, contiguous):
+    """Shares of a segment from ``lo`` to ``hi`` for the loads strictly inside its range."""
     for j in range(lo_at, hi_at):
         share = length * (hi - loads[j]) / (hi - lo)
         above[j] += share
@@ -107,19 +100,78 @@ def _segment(loads, start, end, start_at, end_at, length, above, whole, run, con
 
 
 @njit(cache=True, inline="always")
-def _finish(loads, last, last_at, half, above, whole, run, contiguous, t_out, cont_out):
-    """The held half-step after the last sample, then the loads' totals."""
-    _segment(loads, last, last, last_at, last_at, half, above, whole, run, contiguous)
+def _runs(start_at, lo_at, length, run):
+    """Longest runs: a sample below a load ends that load's run (the segment starts a new one);
+    loads below the segment's low end run on through it."""
+    for j in range(start_at, run.shape[0]):
+        run[j, 1] = max(run[j, 1], run[j, 0])
+        run[j, 0] = 0.0
+    for j in range(lo_at):
+        run[j, 0] += length
+
+
+@njit(cache=True)
+def _metrics(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out):
+    """Daily metrics of one power curve [W] sampled at step centres, of which only steps
+    ``first..last`` need walking: the power before and after them is that of the first and the
+    last (zero, or the day's end). Writes t_solar (and its longest run) per load; returns the
+    energy [Wh] and the peak [W].
+
+    A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
+    (summed from the top at the end), and shares to the loads inside its range. Consecutive
+    segments mostly share k, so their lengths gather in a local sum first."""
+    n_steps, n_loads = power.shape[0], loads.shape[0]
+    above[:] = 0.0
+    whole[:] = 0.0
+    if contiguous:
+        run[:] = 0.0
+    # The half-step held at the start of the day, and the steps before ``first``.
+    previous = power[first]
+    position = _walk(loads, 0, previous)
+    harvested, peak = previous, previous
+    pending_at, pending = position, (first + 0.5) * step_hours
+    if contiguous:
+        _runs(position, position, pending, run)
+    for s in range(first + 1, last + 1):
+        p = power[s]
+        harvested += p
+        peak = max(peak, p)
+        at = _walk(loads, position, p)
+        lo_at, hi_at = min(position, at), max(position, at)
+        if contiguous:
+            _runs(position, lo_at, step_hours, run)
+        if lo_at == pending_at:
+            pending += step_hours
+        else:
+            whole[pending_at] += pending
+            pending_at, pending = lo_at, step_hours
+        if hi_at > lo_at:
+            _shares(loads, min(previous, p), max(previous, p), lo_at, hi_at, step_hours, above, run, contiguous)
+        previous, position = p, at
+    # The last sample held to the end of the day.
+    tail = (n_steps - last - 0.5) * step_hours
+    if contiguous:
+        _runs(position, position, tail, run)
+    if position == pending_at:
+        pending += tail
+    else:
+        whole[pending_at] += pending
+        pending_at, pending = position, tail
+    whole[pending_at] += pending
     total = 0.0
-    for j in range(loads.shape[0] - 1, -1, -1):
+    for j in range(n_loads - 1, -1, -1):
         total += whole[j + 1]
         t_out[j] = above[j] + total
         if contiguous:
             cont_out[j] = max(run[j, 0], run[j, 1])
+    return harvested * step_hours, peak
 
 
 @njit(cache=True, inline="always")
 def _connection_power(code, p_east, p_west, p_parallel, p_series, p_panel, converter_efficiency, switch_series):
+    if code == SWITCHING:
+        best = max(max(p_east, p_west), p_parallel)
+        return max(best, p_series) if switch_series else best
     if code == EAST:
         return p_east
     if code == WEST:
@@ -130,34 +182,108 @@ def _connection_power(code, p_east, p_west, p_parallel, p_series, p_panel, conve
         return p_series
     if code == INDEPENDENT:
         return converter_efficiency * (p_east + p_west)
-    if code == PANEL:
-        return p_panel
-    best = max(max(p_east, p_west), p_parallel)
-    if switch_series:
-        best = max(best, p_series)
-    return best
+    return p_panel
+
+
+@njit(cache=True)
+def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, paper_incidence, iam_model,
+                 iam_params, table_1d, table_parallel, table_series, linear_power, panel_scale, bypass, switch_series,
+                 converter_efficiency, connections, irradiance, buffer):
+    """Every asked connection's power [W] of row ``r`` (over block ``b``) at steps
+    ``first..last``, into ``buffer[c, step]``.
+
+    Two loops: the first, free of table look-ups so that it vectorises, gives both sub-panels'
+    irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) into ``irradiance``; the
+    second looks up the powers. Sun, beam and terms are laid out (n_blocks, component, n_steps)."""
+    n_conn = connections.shape[0]
+    has_terms = terms.shape[1] == 4
+    tables = linear_power == 0.0
+    need_series = switch_series
+    for c in range(n_conn):
+        need_series = need_series or connections[c] == SERIES
+    ex, ey, ez = row_normal[r, 0, 0], row_normal[r, 0, 1], row_normal[r, 0, 2]
+    wx, wy, wz = row_normal[r, 1, 0], row_normal[r, 1, 1], row_normal[r, 1, 2]
+    e_sin_tilt = math.sqrt(max(1.0 - ez * ez, 0.0))
+    w_sin_tilt = math.sqrt(max(1.0 - wz * wz, 0.0))
+    to_root = 1.0 / IRRADIANCE_MAX
+    sx, sy, sz, dni = sun[b, 0], sun[b, 1], sun[b, 2], beam[b]
+    for s in range(first, last + 1):
+        cos_east = ex * sx[s] + ey * sy[s] + ez * sz[s]
+        cos_west = wx * sx[s] + wy * sy[s] + wz * sz[s]
+        if paper_incidence:
+            cz, szen, sa, ca = paper_sun[b, 0, s], paper_sun[b, 1, s], paper_sun[b, 2, s], paper_sun[b, 3, s]
+            f_east = (max(cz * row_paper[r, 0, 0] + szen * row_paper[r, 0, 1], 0.0)
+                      * max(ca * row_paper[r, 0, 2] + sa * row_paper[r, 0, 3], 0.0))
+            f_west = (max(cz * row_paper[r, 1, 0] + szen * row_paper[r, 1, 1], 0.0)
+                      * max(ca * row_paper[r, 1, 2] + sa * row_paper[r, 1, 3], 0.0))
+        else:
+            f_east, f_west = max(cos_east, 0.0), max(cos_west, 0.0)
+        g_east, g_west = dni[s] * f_east, dni[s] * f_west
+        if iam_model != IAM_NONE:
+            g_east *= iam_factor(cos_east, iam_model, iam_params)
+            g_west *= iam_factor(cos_west, iam_model, iam_params)
+        if has_terms:
+            iso, circ, hor, ground = terms[b, 0, s], terms[b, 1, s], terms[b, 2, s], terms[b, 3, s]
+            g_east += (max(iso * (1.0 + ez) * 0.5 + circ * max(cos_east, 0.0) + hor * e_sin_tilt, 0.0)
+                       + ground * (1.0 - ez) * 0.5)
+            g_west += (max(iso * (1.0 + wz) * 0.5 + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
+                       + ground * (1.0 - wz) * 0.5)
+        if tables:
+            g_east = math.sqrt(min(max(g_east, 0.0), IRRADIANCE_MAX) * to_root)
+            g_west = math.sqrt(min(max(g_west, 0.0), IRRADIANCE_MAX) * to_root)
+        irradiance[0, s], irradiance[1, s] = g_east, g_west
+    n1 = table_1d.shape[0] - 1
+    n2 = table_parallel.shape[0] - 1
+    nr = table_series.shape[1] - 1
+    for s in range(first, last + 1):
+        root_east, root_west = irradiance[0, s], irradiance[1, s]
+        if not tables:
+            p_east, p_west = linear_power * root_east, linear_power * root_west
+            p_parallel = p_series = p_east + p_west
+        else:
+            p_east = _linear(table_1d, root_east * n1)
+            p_west = _linear(table_1d, root_west * n1)
+            bound = p_east + p_west
+            p_parallel = p_series = bound
+            if root_east != root_west:
+                # (Identical sub-panels at equal irradiance deliver exactly their sum.)
+                fraction = _bilinear(table_parallel, root_east * n2, root_west * n2)
+                p_parallel = min(max(fraction, 0.0), 1.0) * bound
+                if need_series:
+                    # The series table's second axis is the weaker/stronger irradiance ratio.
+                    strong, weak = max(root_east, root_west), min(root_east, root_west)
+                    fraction = _bilinear(table_series, strong * n2, weak * weak / (strong * strong) * nr)
+                    p_series = min(max(fraction, 0.0), 1.0) * bound
+            if bypass:
+                p_series = max(p_series, max(p_east, p_west))
+        p_panel = panel_scale * p_east
+        for c in range(n_conn):
+            buffer[c, s] = _connection_power(connections[c], p_east, p_west, p_parallel, p_series, p_panel,
+                                             converter_efficiency, switch_series)
 
 
 @njit(cache=True, parallel=True)
-def fold_rows(sun, paper_sun, beam, terms, lit, block_table, row_block, row_normal, row_paper, row_loadset,
+def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_normal, row_paper, row_loadset,
               paper_incidence, iam_model, iam_params, table_1d, table_parallel, table_series, linear_power,
               panel_scale, bypass, switch_series, converter_efficiency, connections, loads, step_hours,
-              contiguous, t_out, cont_out, energy_out, peak_out, whole, above, run, previous, position):
+              contiguous, t_out, cont_out, energy_out, peak_out, irradiance, buffer, above, whole, run):
     """Daily metrics of every row and connection, computing the power on the fly.
 
     Parameters
     ----------
-    sun : (n_blocks, n_steps, 3) float
+    sun : (n_blocks, 3, n_steps) float
         Unit sun vectors (east, north, up).
-    paper_sun : (n_blocks, n_steps, 4) float
+    paper_sun : (n_blocks, 4, n_steps) float
         cos(zenith), sin(zenith), sin(azimuth), cos(azimuth) for Eq. 5 (used in paper mode).
     beam : (n_blocks, n_steps) float
         Direct normal irradiance [W/m^2].
-    terms : (n_blocks, n_steps, 4) float
+    terms : (n_blocks, 4, n_steps) float
         Diffuse terms (isotropic, circumsolar, horizon, ground) of
-        :func:`foldopt.irradiance.sky_diffuse_terms`; shape (n_blocks, n_steps, 0) for beam only.
-    lit : (n_blocks, n_steps) bool
-        Steps with any light (power is zero elsewhere).
+        :func:`foldopt.irradiance.sky_diffuse_terms`; shape (n_blocks, 0, n_steps) for beam only.
+    span : (n_blocks, 2) int
+        First and last step to walk: the steps with any light and one dark step either side. The
+        dark steps before and after hold zero power, so they join the half-steps held at the ends
+        of the day.
     block_table : (n_blocks,) int
         Electrical table of each block (its cells' air temperature).
     row_block, row_loadset : (n_rows,) int
@@ -182,135 +308,56 @@ def fold_rows(sun, paper_sun, beam, terms, lit, block_table, row_block, row_norm
         t_solar and its longest contiguous interval [h] (out).
     energy_out, peak_out : (n_rows, n_conn) float
         Energy [Wh] and peak power [W] (out).
-    whole, above, run, previous, position : scratch, zero, allocated outside the parallel loop
-        (n_rows, n_conn) + ``(n_loads + 1,)``, ``(n_loads,)``, ``(n_loads, 2)``, ``()``, ``()``
-        (int); see :func:`scratch`.
+    irradiance, buffer, above, whole, run : per-chunk scratch from :func:`scratch`.
     """
-    n_steps = sun.shape[1]
-    n_conn = connections.shape[0]
-    has_terms = terms.shape[2] == 4
-    need_series = switch_series
-    for c in range(n_conn):
-        if connections[c] == SERIES:
-            need_series = True
-    n1 = table_1d.shape[1] - 1
-    n2 = table_parallel.shape[1] - 1
-    nr = table_series.shape[2] - 1
-    half = 0.5 * step_hours
-    for r in prange(row_block.shape[0]):
-        b = row_block[r]
-        tab = block_table[b]
-        ld = loads[row_loadset[r]]
-        ex, ey, ez = row_normal[r, 0, 0], row_normal[r, 0, 1], row_normal[r, 0, 2]
-        wx, wy, wz = row_normal[r, 1, 0], row_normal[r, 1, 1], row_normal[r, 1, 2]
-        e_sin_tilt = math.sqrt(max(1.0 - ez * ez, 0.0))
-        w_sin_tilt = math.sqrt(max(1.0 - wz * wz, 0.0))
-        for s in range(n_steps):
-            p_east = p_west = p_parallel = p_series = p_panel = 0.0
-            if lit[b, s]:
-                sx, sy, sz = sun[b, s, 0], sun[b, s, 1], sun[b, s, 2]
-                cos_east = ex * sx + ey * sy + ez * sz
-                cos_west = wx * sx + wy * sy + wz * sz
-                if paper_incidence:
-                    cz, sz_, sa, ca = paper_sun[b, s, 0], paper_sun[b, s, 1], paper_sun[b, s, 2], paper_sun[b, s, 3]
-                    f_east = (max(cz * row_paper[r, 0, 0] + sz_ * row_paper[r, 0, 1], 0.0)
-                              * max(ca * row_paper[r, 0, 2] + sa * row_paper[r, 0, 3], 0.0))
-                    f_west = (max(cz * row_paper[r, 1, 0] + sz_ * row_paper[r, 1, 1], 0.0)
-                              * max(ca * row_paper[r, 1, 2] + sa * row_paper[r, 1, 3], 0.0))
-                else:
-                    f_east, f_west = max(cos_east, 0.0), max(cos_west, 0.0)
-                g_east = beam[b, s] * f_east * iam_factor(cos_east, iam_model, iam_params)
-                g_west = beam[b, s] * f_west * iam_factor(cos_west, iam_model, iam_params)
-                if has_terms:
-                    iso, circ, hor, ground = terms[b, s, 0], terms[b, s, 1], terms[b, s, 2], terms[b, s, 3]
-                    g_east += (max(iso * (1.0 + ez) * 0.5 + circ * max(cos_east, 0.0) + hor * e_sin_tilt, 0.0)
-                               + ground * (1.0 - ez) * 0.5)
-                    g_west += (max(iso * (1.0 + wz) * 0.5 + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
-                               + ground * (1.0 - wz) * 0.5)
-                if linear_power > 0.0:
-                    p_east, p_west = linear_power * g_east, linear_power * g_west
-                    p_parallel = p_series = p_east + p_west
-                    p_panel = panel_scale * p_east
-                else:
-                    e_east = min(max(g_east, 0.0), IRRADIANCE_MAX)
-                    e_west = min(max(g_west, 0.0), IRRADIANCE_MAX)
-                    root_east = math.sqrt(e_east / IRRADIANCE_MAX)
-                    root_west = math.sqrt(e_west / IRRADIANCE_MAX)
-                    p_east = _linear(table_1d[tab], root_east * n1)
-                    p_west = _linear(table_1d[tab], root_west * n1)
-                    p_panel = panel_scale * p_east
-                    bound = p_east + p_west
-                    if e_east == e_west:
-                        # Identical sub-panels at equal irradiance deliver exactly their sum.
-                        p_parallel = p_series = bound
-                    else:
-                        fraction = _bilinear(table_parallel[tab], root_east * n2, root_west * n2)
-                        p_parallel = min(max(fraction, 0.0), 1.0) * bound
-                        if need_series:
-                            strong = max(e_east, e_west)
-                            ratio = min(e_east, e_west) / strong
-                            fraction = _bilinear(table_series[tab], max(root_east, root_west) * n2, ratio * nr)
-                            p_series = min(max(fraction, 0.0), 1.0) * bound
-                    if bypass:
-                        p_series = max(p_series, max(p_east, p_west))
-            for c in range(n_conn):
-                power = _connection_power(connections[c], p_east, p_west, p_parallel, p_series, p_panel,
-                                          converter_efficiency, switch_series)
-                energy_out[r, c] += power
-                if power > peak_out[r, c]:
-                    peak_out[r, c] = power
-                at = _walk(ld, position[r, c], power)
-                if s == 0:
-                    _segment(ld, power, power, at, at, half, above[r, c], whole[r, c], run[r, c], contiguous)
-                else:
-                    _segment(ld, previous[r, c], power, position[r, c], at, step_hours, above[r, c], whole[r, c],
-                             run[r, c], contiguous)
-                previous[r, c], position[r, c] = power, at
-        for c in range(n_conn):
-            energy_out[r, c] *= step_hours
-            _finish(ld, previous[r, c], position[r, c], half, above[r, c], whole[r, c], run[r, c], contiguous,
-                    t_out[r, c], cont_out[r, c])
+    n_rows = row_block.shape[0]
+    n_chunks = buffer.shape[0]
+    per_chunk = (n_rows + n_chunks - 1) // n_chunks
+    for k in prange(n_chunks):
+        for r in range(k * per_chunk, min((k + 1) * per_chunk, n_rows)):
+            b = row_block[r]
+            tab = block_table[b]
+            first, last = span[b, 0], span[b, 1]
+            _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, paper_incidence,
+                         iam_model, iam_params, table_1d[tab], table_parallel[tab], table_series[tab], linear_power,
+                         panel_scale, bypass, switch_series, converter_efficiency, connections, irradiance[k],
+                         buffer[k])
+            for c in range(connections.shape[0]):
+                energy_out[r, c], peak_out[r, c] = _metrics(
+                    buffer[k, c], first, last, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
+                    run[k], t_out[r, c], cont_out[r if contiguous else 0, c])
 
 
 @njit(cache=True, parallel=True)
-def curve_rows(power, row_loadset, loads, step_hours, contiguous, t_out, cont_out, energy_out, peak_out,
-               whole, above, run, previous, position):
+def curve_rows(power, row_loadset, loads, step_hours, contiguous, t_out, cont_out, energy_out, peak_out, above,
+               whole, run):
     """Daily metrics of given power curves, ``power`` (n_rows, n_steps) [W]; outputs and scratch as
     :func:`fold_rows` with one connection."""
-    n_steps = power.shape[1]
-    half = 0.5 * step_hours
-    for r in prange(power.shape[0]):
-        ld = loads[row_loadset[r]]
-        for s in range(n_steps):
-            p = power[r, s]
-            energy_out[r, 0] += p
-            if p > peak_out[r, 0]:
-                peak_out[r, 0] = p
-            at = _walk(ld, position[r, 0], p)
-            if s == 0:
-                _segment(ld, p, p, at, at, half, above[r, 0], whole[r, 0], run[r, 0], contiguous)
-            else:
-                _segment(ld, previous[r, 0], p, position[r, 0], at, step_hours, above[r, 0], whole[r, 0], run[r, 0],
-                         contiguous)
-            previous[r, 0], position[r, 0] = p, at
-        energy_out[r, 0] *= step_hours
-        _finish(ld, previous[r, 0], position[r, 0], half, above[r, 0], whole[r, 0], run[r, 0], contiguous, t_out[r, 0],
-                cont_out[r, 0])
+    n_rows = power.shape[0]
+    n_chunks = above.shape[0]
+    per_chunk = (n_rows + n_chunks - 1) // n_chunks
+    for k in prange(n_chunks):
+        for r in range(k * per_chunk, min((k + 1) * per_chunk, n_rows)):
+            energy_out[r, 0], peak_out[r, 0] = _metrics(
+                power[r], 0, power.shape[1] - 1, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
+                run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0])
 
 
-def scratch(n_rows, n_conn, n_loads, contiguous):
-    """Zeroed outputs and scratch of :func:`fold_rows` / :func:`curve_rows`, made outside the
-    parallel loop (arrays zero-filled inside a numba prange body have given wrong sums)."""
+def scratch(n_rows, n_conn, n_loads, n_steps, contiguous, threads):
+    """Outputs and per-chunk scratch of :func:`fold_rows` (``n_steps`` > 0) or :func:`curve_rows`
+    (``n_steps`` = 0), allocated here, outside the parallel loop."""
+    chunks = max(1, min(n_rows, threads * CHUNKS_PER_THREAD))
     shape = (n_rows, n_conn)
-    runs = shape + (n_loads, 2) if contiguous else (n_rows, n_conn, 1, 2)
-    return {
-        "t_out": np.zeros(shape + (n_loads,)),
-        "cont_out": np.zeros(shape + (n_loads,)),
-        "energy_out": np.zeros(shape),
-        "peak_out": np.full(shape, -np.inf),
-        "whole": np.zeros(shape + (n_loads + 1,)),
-        "above": np.zeros(shape + (n_loads,)),
-        "run": np.zeros(runs),
-        "previous": np.zeros(shape),
-        "position": np.zeros(shape, dtype=np.int64),
+    work = {
+        "t_out": np.empty(shape + (n_loads,)),
+        "cont_out": np.zeros(shape + (n_loads,)) if contiguous else np.zeros((1, n_conn, n_loads)),
+        "energy_out": np.empty(shape),
+        "peak_out": np.empty(shape),
+        "above": np.zeros((chunks, n_loads)),
+        "whole": np.zeros((chunks, n_loads + 1)),
+        "run": np.zeros((chunks, n_loads if contiguous else 1, 2)),
     }
+    if n_steps:
+        work["irradiance"] = np.zeros((chunks, 2, n_steps))
+        work["buffer"] = np.zeros((chunks, n_conn, n_steps))
+    return work

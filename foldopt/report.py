@@ -257,6 +257,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
                 result.study,
                 command,
                 input_sha256=input_hash(result.study.model_dump(mode="json")),
+                engine=result.engine,
                 optimal_fold_angle_deg=result.optimal_fold_angle,
                 tracker_break_even_standby_w=result.standby[1] if np.isfinite(result.standby[1]) else None,
                 # NaN (the load exceeds the flat panel's noon power) is not JSON: null instead.
@@ -268,12 +269,14 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
     return out
 
 
-def write_reproduction(tables: dict[str, pd.DataFrame], study: Study, out: Path, overwrite=False, command=None) -> Path:
+def write_reproduction(tables: dict[str, pd.DataFrame], study: Study, out: Path, overwrite=False, command=None,
+                       engine: str = "numba") -> Path:
     """Write one ``<name>.csv`` per reproduction table and ``run.json``."""
     with staged_folder(out, overwrite) as folder:
         for name, table in tables.items():
             table.to_csv(folder / f"{name}.csv", index=False, float_format=FLOAT_FORMAT)
-        _write_json(folder / "run.json", run_metadata(study, command, modes=["paper", "exact"], tables=list(tables)))
+        _write_json(folder / "run.json", run_metadata(study, command, modes=["paper", "exact"], tables=list(tables),
+                                                       engine=engine))
     return out
 
 
@@ -388,6 +391,7 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
                 cases=plan.n_cases,
                 plots=plots,
                 input_sha256=input_hash({"study": plan.data, "axes": plan.axes}),
+                engine=result.engine,
             ),
         )
     return out

@@ -41,9 +41,9 @@ def infer_p_load(study: Study, flat_t_solar_h: float = PAPER_VALUES["flat_t_sola
     return load_for_t_solar(day.flat_power(), flat_t_solar_h, day.step_hours)
 
 
-def reproduction_values(study: Study) -> dict[str, float]:
+def reproduction_values(study: Study, engine: str = "numba") -> dict[str, float]:
     """The reproduced quantities of :data:`PAPER_VALUES` for one resolved study."""
-    result = run_study(study)
+    result = run_study(study, engine)
     summary = result.summary.set_index("design")
     flat, twofold, tracker = (summary.loc[name] for name in ("flat", "twofold", "tracker"))
     fold90 = twofold_t_solar(result.day, 90.0)
@@ -60,7 +60,7 @@ def reproduction_values(study: Study) -> dict[str, float]:
     }
 
 
-def reproduce(study: Study, **changes) -> pd.DataFrame:
+def reproduce(study: Study, engine: str = "numba", **changes) -> pd.DataFrame:
     """Paper value, paper-mode value and exact-mode value of each reproduced quantity.
 
     Parameters
@@ -68,6 +68,8 @@ def reproduce(study: Study, **changes) -> pd.DataFrame:
     study : Study
         The paper's study (``configs/shin2015.yaml``); its mode, geometry and load are replaced:
         paper mode with the azimuth-split geometry, exact mode with the hinge, and the inferred load.
+    engine : {'numba', 'numpy'}
+        :data:`foldopt.engine.ENGINES`.
     **changes
         Other fields to replace first, e.g. ``pv_model="single-diode"``.
 
@@ -81,7 +83,7 @@ def reproduce(study: Study, **changes) -> pd.DataFrame:
     columns = {}
     for mode, geometry in GEOMETRY_OF_MODE.items():
         variant = study.variant(mode=mode, geometry=geometry, p_load=p_load)
-        columns[f"{mode}_mode"] = reproduction_values(variant)
+        columns[f"{mode}_mode"] = reproduction_values(variant, engine)
     return pd.DataFrame(
         [
             {

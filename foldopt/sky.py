@@ -5,7 +5,8 @@ position and unit vector, the direct normal irradiance and, with a transposition
 orientation-free diffuse terms of :func:`foldopt.irradiance.sky_diffuse_terms`. It is built as
 one array program over all blocks (:func:`build_sky`): one clock grid, one solar-position
 evaluation, one air mass and clear-sky pass. The engine then evaluates any number of panel
-orientations against it.
+orientations against it. Blocks may be different sites and days; they share the study's settings
+(mode, sky model, step...).
 """
 
 from __future__ import annotations
@@ -22,11 +23,6 @@ from foldopt.geometry import normal_vector
 from foldopt.irradiance import sky_diffuse_terms
 from foldopt.solarposition import ClockGrid, clock_grid, solar_position_grid
 from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, weather_day
-
-#: Study fields that every block of one sky shares.
-SHARED_FIELDS = ("mode", "sky", "linke_turbidity", "transposition", "albedo", "iam", "weather", "climate",
-                 "step_min", "temp_air")
-
 
 @dataclass(frozen=True)
 class Sky:
@@ -100,22 +96,10 @@ class Sky:
         return Sky(grid=grid, mode=self.mode, iam=self.iam, **take)
 
 
-def _check_shared(studies: list[Study]) -> None:
-    first = studies[0]
-    for name in SHARED_FIELDS:
-        if name == "temp_air" and first.weather is not None:
-            continue
-        if any(getattr(s, name) != getattr(first, name) for s in studies[1:]):
-            raise ValueError(f"the blocks of one sky must share {name!r}")
-
-
-def _weather_grid(studies: list[Study]):
-    """Clock grid, light and cell air temperature of each block from the study's weather file."""
-    weather = studies[0].weather
-    days = []
-    for study in studies:
-        frame = read_weather(weather.path, weather.format, study.date.year, weather.label)
-        days.append(weather_day(frame, study.date))
+def _weather_grid(study: Study, dates):
+    """Clock grid, light and cell air temperature of each date from the study's weather file."""
+    weather = study.weather
+    days = [weather_day(read_weather(weather.path, weather.format, date.year, weather.label), date) for date in dates]
     lengths = {len(day) for day in days}
     if len(lengths) != 1:
         raise ValueError(f"the weather file's days have different numbers of steps: {sorted(lengths)}")
@@ -127,67 +111,72 @@ def _weather_grid(studies: list[Study]):
     return grid, light, temp_air
 
 
-def build_sky(studies) -> Sky:
-    """The sky over one block per study (its site and date), as one array program.
+def build_sky(study: Study, sites, dates) -> Sky:
+    """The sky of a study's settings over blocks, one per (site, date), as one array program.
 
     Parameters
     ----------
-    studies : sequence of Study
-        One block each; they must agree on :data:`SHARED_FIELDS` (mode, sky, step, weather...).
+    study : Study
+        Mode, sky model, weather file, step, transposition, albedo, incidence-angle modifier, air
+        temperature (its site and date are not used).
+    sites : sequence of foldopt.config.Site
+    dates : sequence of datetime.date
+        One per site.
 
     Returns
     -------
     Sky
     """
-    studies = [s.resolved() for s in studies]
-    _check_shared(studies)
-    first = studies[0]
-    latitude = np.array([s.site.latitude for s in studies])[:, None]
-    longitude = np.array([s.site.longitude for s in studies])[:, None]
-    altitude = np.array([s.site.altitude for s in studies], dtype=float)[:, None]
+    study = study.resolved()
+    sites = [site.resolved() for site in sites]
+    if len(sites) != len(dates):
+        raise ValueError(f"{len(sites)} sites for {len(dates)} dates")
+    latitude = np.array([site.latitude for site in sites], dtype=float)[:, None]
+    longitude = np.array([site.longitude for site in sites], dtype=float)[:, None]
+    altitude = np.array([site.altitude for site in sites], dtype=float)[:, None]
     light = {}
-    if first.weather is not None:
-        grid, light, temp_air = _weather_grid(studies)
+    if study.weather is not None:
+        grid, light, temp_air = _weather_grid(study, dates)
     else:
         # One localisation per time zone, blocks back in their order.
         zones: dict[str, list[int]] = {}
-        for index, study in enumerate(studies):
-            zones.setdefault(study.site.timezone, []).append(index)
-        parts = {zone: clock_grid([studies[i].date for i in members], parse_timezone(zone), first.step_min)
-                 for zone, members in zones.items()}
+        for index, site in enumerate(sites):
+            zones.setdefault(site.timezone, []).append(index)
+        parts = [clock_grid([dates[i] for i in members], parse_timezone(zone), study.step_min)
+                 for zone, members in zones.items()]
         order = np.argsort(np.concatenate(list(zones.values())), kind="stable")
-        stacked = ClockGrid.stack(parts.values())
+        stacked = ClockGrid.stack(parts)
         grid = ClockGrid(stacked.utc_ns[order], stacked.utc_offset_ns[order],
                          tuple(stacked.timezones[i] for i in order), stacked.step_hours)
-        temp_air = np.full(len(studies), float(first.temp_air))
-    sun = solar_position_grid(grid, latitude, longitude, altitude, first.mode)
+        temp_air = np.full(len(sites), float(study.temp_air))
+    sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
     zenith = sun["solar_zenith"]
-    if first.weather is None and first.sky in CLEAR_SKIES:
+    if study.weather is None and study.sky in CLEAR_SKIES:
         light = {key: np.empty_like(zenith) for key in ("dni", "ghi", "dhi")}
-        for index, study in enumerate(studies):
-            sky = clear_sky(grid.times(index), zenith[index], study.site.latitude, study.site.longitude,
-                            study.site.altitude, first.sky, first.linke_turbidity)
+        for index, site in enumerate(sites):
+            sky = clear_sky(grid.times(index), zenith[index], site.latitude, site.longitude, site.altitude, study.sky,
+                            study.linke_turbidity)
             for key in light:
                 light[key][index] = sky[key]
-    elif first.weather is None:
-        beam_altitude = altitude if first.mode == "exact" else 0.0
-        light = {"dni": clear_sky_dni(zenith, beam_altitude, first.sky, dayofyear=grid.day_of_year,
-                                      climate=first.climate)}
+    elif study.weather is None:
+        beam_altitude = altitude if study.mode == "exact" else 0.0
+        light = {"dni": clear_sky_dni(zenith, beam_altitude, study.sky, dayofyear=grid.day_of_year,
+                                      climate=study.climate)}
     dni = light["dni"]
     ghi, dhi = light.get("ghi"), light.get("dhi")
     terms = None
-    transposition = first.sky_transposition()
+    transposition = study.sky_transposition()
     if transposition != "none":
         dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.day_of_year]
         airmass = np.nan_to_num(relative_airmass(np.minimum(zenith, 90.0)), nan=0.0)
         terms = sky_diffuse_terms(
             transposition, zenith, dni,
             ghi if ghi is not None else dni * np.clip(np.cos(np.radians(zenith)), 0, None),
-            dhi if dhi is not None else np.zeros_like(dni), dni_extra, airmass, first.albedo,
+            dhi if dhi is not None else np.zeros_like(dni), dni_extra, airmass, study.albedo,
         )
     return Sky(
-        grid=grid, mode=first.mode, solar_zenith=zenith, solar_azimuth=sun["solar_azimuth"],
+        grid=grid, mode=study.mode, solar_zenith=zenith, solar_azimuth=sun["solar_azimuth"],
         hour_angle=sun["hour_angle"], declination=np.ascontiguousarray(sun["declination"]),
         sun_vector=normal_vector(zenith, sun["solar_azimuth"]), dni=dni, ghi=ghi, dhi=dhi, terms=terms,
-        temp_air=temp_air, latitude=latitude[:, 0], iam=first.iam,
+        temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam,
     )

@@ -118,8 +118,12 @@ class ClockGrid:
     @property
     def day_of_year(self) -> np.ndarray:
         """Local day of year of each step (1 on 1 January)."""
-        local = self.local_ns.astype("datetime64[ns]")
-        return (local.astype("datetime64[D]") - local.astype("datetime64[Y]")).astype(np.int64) + 1
+        days = np.floor_divide(self.local_ns, _NS_PER_DAY)
+        # Converted once per calendar day in the grid's range, then looked up.
+        first = days.min()
+        calendar = np.arange(first, days.max() + 1).astype("datetime64[D]")
+        table = (calendar - calendar.astype("datetime64[Y]")).astype(np.int64) + 1
+        return table[days - first]
 
     def times(self, block: int) -> pd.DatetimeIndex:
         """The tz-aware times of one block."""
@@ -224,7 +228,8 @@ def _by_day_of_year(function, dayofyear):
 
 
 def _hour_angle_paper(clock_hours, utc_offset_hours, dayofyear, longitude):
-    time_correction_min = 4.0 * (longitude - 15.0 * utc_offset_hours) + _by_day_of_year(equation_of_time_paper, dayofyear)
+    equation_of_time = _by_day_of_year(equation_of_time_paper, dayofyear)
+    time_correction_min = 4.0 * (longitude - 15.0 * utc_offset_hours) + equation_of_time
     local_solar_time = clock_hours + time_correction_min / 60.0
     return (15.0 * (local_solar_time - 12.0) + 180.0) % 360.0 - 180.0
 
@@ -329,7 +334,8 @@ def _spa_topocentric(geo: dict, latitude, longitude, altitude):
     delta_prime = spa.topocentric_sun_declination(geo["delta"], x, y, geo["xi"], delta_alpha, hour_angle)
     hour_angle_prime = spa.topocentric_local_hour_angle(hour_angle, delta_alpha)
     elevation = spa.topocentric_elevation_angle_without_atmosphere(latitude, delta_prime, hour_angle_prime)
-    azimuth = spa.topocentric_azimuth_angle(spa.topocentric_astronomers_azimuth(hour_angle_prime, delta_prime, latitude))
+    gamma = spa.topocentric_astronomers_azimuth(hour_angle_prime, delta_prime, latitude)
+    azimuth = spa.topocentric_azimuth_angle(gamma)
     return 90.0 - elevation, azimuth
 
 

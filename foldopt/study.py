@@ -17,7 +17,7 @@ import pandas as pd
 from foldopt import engine as engines
 from foldopt.aggregation import CONNECTIONS, SWITCH_STATES
 from foldopt.config import Study
-from foldopt.metrics import load_for_t_solar, t_solar
+from foldopt.metrics import load_for_t_solar, metric_columns, t_solar
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.sizing import flat_area_multiple
 from foldopt.sky import Sky, build_sky
@@ -67,7 +67,7 @@ class Day:
     def __init__(self, study: Study):
         study = study.resolved()
         self.study = study
-        self.sky = sky = build_sky([study])
+        self.sky = sky = build_sky(study, [study.site], [study.date])
         self.electrical = engines.electrical_for(study, sky.temp_air[0])
         self.times = sky.grid.times(0)
         self.step_hours = sky.step_hours
@@ -147,6 +147,7 @@ class StudyResult:
     optimal_fold_angle: float
     heuristic_fold_angle: float
     standby: tuple  # (table, break-even standby draw [W]) of :func:`standby_sweep`
+    engine: str = "numba"
 
 
 def _best_angle(day: Day, angles, sweep_t_solar, connection):
@@ -178,7 +179,7 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
                                   outputs=CONNECTIONS, contiguous=True, engine=engine)
     own = CONNECTIONS.index(study.connection)
     sweep = pd.DataFrame({"fold_angle_deg": angles,
-                          **_metric_columns(metrics.t_solar[:, own, 0], metrics.t_solar_contiguous[:, own, 0],
+                          **metric_columns(metrics.t_solar[:, own, 0], metrics.t_solar_contiguous[:, own, 0],
                                             metrics.energy[:, own], metrics.peak[:, own], p_load)})
     sweep["noon_valley_w"] = noon_valley(*day.subpanel_power(angles))
     for index, connection in enumerate(CONNECTIONS):
@@ -208,7 +209,7 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
     curves = engines.curve_metrics(np.stack([power for _, power in designs.values()]), [p_load], step,
                                    contiguous=True, engine=engine)
     summary = pd.DataFrame({"design": list(designs), "fold_angle_deg": [angle for angle, _ in designs.values()],
-                            **_metric_columns(curves.t_solar[:, 0, 0], curves.t_solar_contiguous[:, 0, 0],
+                            **metric_columns(curves.t_solar[:, 0, 0], curves.t_solar_contiguous[:, 0, 0],
                                               curves.energy[:, 0], curves.peak[:, 0], p_load)})
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
@@ -236,14 +237,7 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
             "p_load_w": p_load,
         }
     )
-    return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby)
-
-
-def _metric_columns(hours, contiguous, harvested, peak, p_load) -> dict:
-    """The daily metric columns of reports (:func:`foldopt.metrics.daily_metrics`'s names)."""
-    served = np.asarray(p_load) * hours
-    return {"t_solar_h": hours, "t_solar_contiguous_h": contiguous, "energy_wh": harvested,
-            "energy_served_wh": served, "energy_wasted_wh": harvested - served, "peak_power_w": peak}
+    return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby, engine)
 
 
 def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):

@@ -21,11 +21,11 @@ import pandas as pd
 
 from foldopt import engine as engines
 from foldopt.config import Plan, Study
+from foldopt.metrics import metric_columns
 from foldopt.sky import Sky, build_sky
 from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
-METRICS = ("t_solar_h", "t_solar_contiguous_h", "energy_wh", "energy_served_wh", "energy_wasted_wh", "peak_power_w")
 #: Rows (blocks x fold angles) x loads of one engine call: bounds the memory of a chunk.
 CHUNK_ROW_LOADS = 4_000_000
 #: Time steps of the blocks of one chunk's sky.
@@ -39,6 +39,7 @@ class SweepResult:
     plan: Plan
     table: pd.DataFrame
     extras: dict = dataclasses.field(default_factory=dict)  # day x hour curves of an annual objective
+    engine: str = "numba"
 
     @property
     def varied(self) -> list[str]:
@@ -70,6 +71,10 @@ def _chunks(count: int, per_block_rows: int, n_loads: int, n_steps: int):
     """Slices of ``count`` blocks whose rows x loads and time steps stay within the chunk bounds."""
     size = max(1, min(CHUNK_ROW_LOADS // max(per_block_rows * n_loads, 1), CHUNK_STEPS // max(n_steps, 1)))
     return [slice(start, min(start + size, count)) for start in range(0, count, size)]
+
+
+def _sky(studies) -> Sky:
+    return build_sky(studies[0], [s.site for s in studies], [s.date for s in studies])
 
 
 def _panels(studies):
@@ -121,21 +126,20 @@ def _design_metrics(sky: Sky, studies, loads, angles, chosen, engine: str) -> di
                          tracker_values[n_blocks:]], axis=-1)
 
     hours = per_design(twofold.t_solar[:, 0, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
-    harvested = per_design(twofold.energy[:, 0], np.repeat(flat.energy, n_loads, axis=1),
-                           np.repeat(trackers.energy, n_loads, axis=1))
-    served = loads[None, :, None] * hours
     fold = np.stack([np.full((n_blocks, n_loads), 180.0), angles[chosen], np.full((n_blocks, n_loads), np.nan),
                      np.full((n_blocks, n_loads), np.nan)], axis=-1)
     return {
         "fold_angle_deg": fold,
-        "t_solar_h": hours,
-        "t_solar_contiguous_h": per_design(twofold.t_solar_contiguous[:, 0, 0], flat.t_solar_contiguous[:, 0],
-                                           trackers.t_solar_contiguous[:, 0]),
-        "energy_wh": harvested,
-        "energy_served_wh": served,
-        "energy_wasted_wh": harvested - served,
-        "peak_power_w": per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
-                                   np.repeat(trackers.peak, n_loads, axis=1)),
+        **metric_columns(
+            hours,
+            per_design(twofold.t_solar_contiguous[:, 0, 0], flat.t_solar_contiguous[:, 0],
+                       trackers.t_solar_contiguous[:, 0]),
+            per_design(twofold.energy[:, 0], np.repeat(flat.energy, n_loads, axis=1),
+                       np.repeat(trackers.energy, n_loads, axis=1)),
+            per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
+                       np.repeat(trackers.peak, n_loads, axis=1)),
+            loads[None, :, None],
+        ),
         "sun_up": np.broadcast_to(np.any(sky.dni > 0, axis=1)[:, None, None], hours.shape),
     }
 
@@ -213,7 +217,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
             n_steps = round(24 / (member_studies[0].step_min / 60))
             for part in _chunks(len(members), k, loads.size, n_steps):
                 chunk = member_studies[part]
-                sky = build_sky(chunk)
+                sky = _sky(chunk)
                 angles, hours = fold_hours(sky, chunk, loads, engine)
                 metrics = _design_metrics(sky, chunk, loads, angles, _best_angle_index(hours.transpose(0, 2, 1)),
                                           engine)
@@ -223,7 +227,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     table = _table([study for group in studies for study in group],
                    [case for group in groups for case in group], loads,
                    {name: np.concatenate([r[name] for r in results]) for name in results[0]})
-    return SweepResult(plan, table, extras)
+    return SweepResult(plan, table, extras, engine)
 
 
 def _annual_group(studies, loads, objective, advance, engine):
@@ -234,7 +238,7 @@ def _annual_group(studies, loads, objective, advance, engine):
     parts = _chunks(len(studies), k, loads.size, n_steps)
     skies, daily = [], []
     for part in parts:
-        skies.append(build_sky(studies[part]))
+        skies.append(_sky(studies[part]))
         angles, hours = fold_hours(skies[-1], studies[part], loads, engine)
         daily.append(hours)
         advance(len(studies[part]))
@@ -271,8 +275,9 @@ def _table(studies, cases, loads, metrics) -> pd.DataFrame:
     columns["design"] = np.tile(np.array(DESIGNS, dtype=object), n_cases * n_loads)
     columns["fold_angle_deg"] = metrics["fold_angle_deg"].ravel()
     hours = metrics["t_solar_h"]
-    for name in METRICS:
-        columns[name] = metrics[name].ravel()
+    for name in metrics:
+        if name not in ("fold_angle_deg", "sun_up"):
+            columns[name] = metrics[name].ravel()
     with np.errstate(divide="ignore", invalid="ignore"):
         flat, tracker = hours[..., :1], hours[..., 2:3]
         columns["gain_vs_flat_pct"] = np.where(flat > 0, (hours / flat - 1.0) * 100.0, np.nan).ravel()
