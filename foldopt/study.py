@@ -97,6 +97,9 @@ class Day:
 
         Kept per model: a tracker's power, its draw and the standby sweep all steer by it.
         """
+        return tuple(angle[0] for angle in self._tracker_sky_orientation(model))
+
+    def _tracker_sky_orientation(self, model=None):
         model = model or self.study.tracker.model
         if model not in self._tracker_orientations:
             self._tracker_orientations[model] = sky_tracker_orientation(self.sky, self.study, model)
@@ -104,11 +107,11 @@ class Day:
 
     def tracker_power(self, model=None):
         """Power of the same panel on a tracker [W], shape (n_time,) (default: the study's)."""
-        return sky_tracker_power(self.sky, self.study, self.tracker_orientation(model))[0]
+        return sky_tracker_power(self.sky, self.study, self._tracker_sky_orientation(model))[0]
 
     def tracker_draw(self, model=None):
         """The tracker's own draw [W] per step: standby while the sun is up, plus its moves."""
-        return sky_tracker_draw(self.sky, self.study, self.tracker_orientation(model))[0]
+        return sky_tracker_draw(self.sky, self.study, self._tracker_sky_orientation(model))[0]
 
     def orientation(self, fold_angles):
         """Sub-panel orientations (k, 4) of the study's panel at ``fold_angles`` [deg]."""

@@ -94,6 +94,30 @@ def test_parallel_solver_matches_a_brute_force_scan_of_the_summed_curve():
     np.testing.assert_allclose(parallel_power(east, west), (voltage * total).max(axis=1), rtol=1e-6)
 
 
+@pytest.mark.parametrize("model", MODELS)
+def test_pair_solvers_never_fall_below_a_brute_force_scan(model):
+    # Parallel is searched only between the two maximum-power voltages and series only up to the
+    # weaker short-circuit current (foldopt.aggregation): on random pairs, weak and near-dark
+    # sub-panels and hot or cold cells included, neither may land below a dense scan.
+    rng = np.random.default_rng(11)
+    poa_east = rng.uniform(0, 1500, 120)
+    poa_west = rng.uniform(0, 1500, 120) * rng.choice([1.0, 0.1, 0.01, 1e-4, 0.0], 120)
+    temp = rng.uniform(-10, 70, 120)
+    east = MODELS[model].curves(poa_east, cell_temperature(poa_east, temp, 1.0, "sapm"), AREA)
+    west = MODELS[model].curves(poa_west, cell_temperature(poa_west, temp, 1.0, "sapm"), AREA)
+    fraction = np.linspace(0.0, 1.0, 20001)[None, :]
+    voltage = np.maximum(east.v_oc, west.v_oc)[:, None] * fraction
+    current = sum(np.nan_to_num(np.clip(side.current(voltage), 0, None)) for side in (east, west))
+    brute = (voltage * current).max(axis=1)
+    assert np.all(parallel_power(east, west) >= brute * (1 - 1e-9) - 1e-15)
+    np.testing.assert_allclose(parallel_power(east, west), brute, rtol=1e-6, atol=1e-12)
+    string = np.minimum(east.i_sc, west.i_sc)[:, None] * fraction
+    volts = sum(np.clip(np.nan_to_num(side.voltage(string)), 0, side.v_oc[:, None]) for side in (east, west))
+    brute = (string * volts).max(axis=1)
+    assert np.all(series_power(east, west, bypass=False) >= brute * (1 - 1e-9) - 1e-15)
+    np.testing.assert_allclose(series_power(east, west, bypass=False), brute, rtol=1e-6, atol=1e-12)
+
+
 def test_ideal_model_connections_are_sums():
     powers, state = connection_powers(np.array([3.0, 0.0]), np.array([1.0, 2.0]), converter_efficiency=0.9)
     np.testing.assert_allclose(powers["parallel"], [4.0, 2.0])

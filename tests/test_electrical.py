@@ -39,3 +39,26 @@ def test_flat_panel_is_two_sub_panels_in_series(shin_study):
     twofold_at_180 = day.connections(np.array([180.0]))[0]
     np.testing.assert_allclose(flat, 2 * twofold_at_180["east"][0], rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(flat, twofold_at_180["parallel"][0], rtol=1e-6, atol=1e-9)
+
+
+def test_tables_are_cached_on_disk_by_their_settings(tmp_path, monkeypatch):
+    from foldopt import electrical
+    from foldopt.pvmodel import PVModel
+
+    monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path))
+    settings = dict(pv=PVModel("b-model", 0.19), subpanel_area=0.054, temp_air=25.0, temperature_model="sapm")
+    built = electrical.Electrical(**settings)._table("parallel")
+    files = list((tmp_path / "tables").glob("parallel-*.npz"))
+    assert len(files) == 1
+    # A second model of the same settings loads the table instead of solving I-V curves.
+    monkeypatch.setattr(PVModel, "curves", lambda *args: pytest.fail("rebuilt a cached table"))
+    np.testing.assert_array_equal(electrical.Electrical(**settings)._table("parallel"), built)
+    monkeypatch.undo()
+    monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path))
+    # Other settings, another file; a damaged file is rebuilt; no writable cache is no error.
+    electrical.Electrical(**{**settings, "temp_air": 30.0})._table("parallel")
+    assert len(list((tmp_path / "tables").glob("parallel-*.npz"))) == 2
+    files[0].write_bytes(b"not a table")
+    np.testing.assert_array_equal(electrical.Electrical(**settings)._table("parallel"), built)
+    monkeypatch.setenv("FOLDOPT_CACHE_DIR", "/proc/foldopt-cannot-write-here")
+    np.testing.assert_array_equal(electrical.Electrical(**settings)._table("parallel"), built)

@@ -133,3 +133,34 @@ def test_exact_hour_angle_is_pvlibs_and_zero_at_solar_noon():
     exact = get_solar_position(times, 40.7, -74.0, model="exact")
     noon = np.argmin(exact["solar_zenith"].to_numpy())
     assert abs(exact["hour_angle"].iloc[noon]) < 0.3
+
+
+def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
+    from foldopt.solarposition import _geocentric_hourly, spa_geocentric
+
+    # Random instants from 1990 to 2060: linear interpolation between whole UTC hours.
+    unix = np.sort(np.random.default_rng(5).uniform(6.3e8, 2.9e9, 5000))
+    exact = spa_geocentric(unix)
+    interpolated = _geocentric_hourly((unix * 1e9).astype(np.int64))
+    for name, values in exact.items():
+        difference = values - interpolated[name]
+        if name in ("alpha", "v"):
+            difference = (difference + 180.0) % 360.0 - 180.0
+        bound = 4e-5 if name == "eot" else 1e-5  # 1e-5 deg; the equation of time in minutes (4 min a degree)
+        assert np.abs(difference).max() < bound, name
+
+
+def test_many_sites_at_once_equal_pvlib_at_each():
+    from foldopt.solarposition import clock_grid, solar_position_grid
+
+    dates = [dt.date(2025, 1, 5), dt.date(2025, 6, 30), dt.date(2025, 10, 1)]
+    latitude = np.array([[-70.0], [12.5], [64.0]])
+    longitude = np.array([[-150.0], [33.0], [179.0]])
+    altitude = np.array([[0.0], [1500.0], [40.0]])
+    grid = clock_grid(dates, "UTC", 30)
+    sun = solar_position_grid(grid, latitude, longitude, altitude, "exact")
+    for block in range(3):
+        spa = pvlib.solarposition.get_solarposition(grid.times(block), latitude[block, 0], longitude[block, 0],
+                                                    altitude=altitude[block, 0])
+        np.testing.assert_allclose(sun["solar_zenith"][block], spa["apparent_zenith"], atol=1e-6)
+        np.testing.assert_allclose(sun["solar_azimuth"][block], spa["azimuth"], atol=1e-6)

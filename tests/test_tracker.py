@@ -103,3 +103,23 @@ def test_hottel_sky_runs_a_study(day):
     hottel = Day(day.study.model_copy(update={"sky": "hottel", "climate": "tropical"}))
     assert 0 < hottel.dni.max() < 1100
     assert (hottel.dni[day.dni == 0] == 0).all()
+
+
+@pytest.mark.parametrize("model", ["dual-axis", "equatorial", "dual-axis-steps", "single-axis"])
+def test_trackers_over_many_days_at_once_equal_each_day_alone(model):
+    import datetime as dt
+
+    from foldopt.sky import build_sky
+    from foldopt.study import sky_tracker_draw, sky_tracker_orientation
+
+    study = load_study(default_study_path()).variant(mode="exact", geometry="hinge", step_min=5,
+                                                     tracker={"model": model, "standby_w": 0.3})
+    dates = [dt.date(2025, 3, 1), dt.date(2025, 6, 21), dt.date(2025, 12, 21)]
+    sky = build_sky(study, [study.site] * 3, dates)
+    orientation = sky_tracker_orientation(sky, study)
+    draw = sky_tracker_draw(sky, study, orientation)
+    for index, date in enumerate(dates):
+        day = Day(study.variant(date=date))
+        np.testing.assert_allclose(orientation[0][index], day.tracker_orientation()[0], atol=1e-9)
+        np.testing.assert_allclose(orientation[1][index], day.tracker_orientation()[1], atol=1e-9)
+        np.testing.assert_allclose(draw[index], day.tracker_draw(), atol=1e-12)

@@ -1,0 +1,188 @@
+"""The compiled kernel against the NumPy reference path, and the array program under it.
+
+The reference (``engine="numpy"``) computes the plane-of-array irradiance, every connection's
+power and the metrics of :mod:`foldopt.metrics` on whole arrays; the kernel fuses them in one
+pass. Stated agreement (issue 11): t_solar and its longest run within 1 s a day, energy and peak
+within 1e-9 relative, on random sites, days, loads, fold angles and models.
+"""
+
+import datetime as dt
+from pathlib import Path
+
+import numpy as np
+import pvlib
+import pytest
+from hypothesis import HealthCheck, example, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from foldopt import engine
+from foldopt.config import Site, make_study
+from foldopt.metrics import t_solar, t_solar_contiguous
+from foldopt.sky import build_sky
+
+SECOND = 1 / 3600  # [h]
+TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
+
+
+@st.composite
+def cases(draw):
+    """A study (model, sky, geometry...), 1-2 blocks (sites and dates), fold angles and loads."""
+    mode = draw(st.sampled_from(["paper", "exact"]))
+    sky = draw(st.sampled_from(["meinel", "hottel"] + (["ineichen", "simplified-solis"] if mode == "exact" else [])))
+    diffuse = sky in ("ineichen", "simplified-solis") or (mode == "exact" and draw(st.booleans()))
+    study = make_study({
+        "name": "kernel", "mode": mode, "sky": sky,
+        "geometry": draw(st.sampled_from(["azimuth-split", "hinge"])),
+        "transposition": draw(st.sampled_from(["isotropic", "haydavies", "perez"])) if diffuse else "none",
+        "albedo": draw(st.floats(0, 0.5)),
+        "iam": draw(st.sampled_from(["none", "ashrae", "physical"])),
+        "pv_model": draw(st.sampled_from(["ideal", "single-diode", "b-model"])),
+        "switch_series": draw(st.booleans()), "bypass_diodes": draw(st.booleans()),
+        "converter_efficiency": draw(st.floats(0.8, 1.0)),
+        "site": {"latitude": 0.0, "longitude": 0.0},
+        "date": "2025-01-01",
+        "panel": {"area": draw(st.sampled_from([0.108, 0.2])), "efficiency": 0.19,
+                  "tilt": draw(st.one_of(st.none(), st.floats(0, 90))),
+                  "azimuth": draw(st.one_of(st.none(), st.floats(0, 359.9)))},
+        "p_load": 1.0,
+        "step_min": draw(st.sampled_from([5, 10, 15])),
+    })
+    n_blocks = draw(st.integers(1, 2))
+    sites = [Site(latitude=draw(st.floats(-89, 89)), longitude=draw(st.floats(-180, 180)),
+                  altitude=draw(st.floats(0, 2000))) for _ in range(n_blocks)]
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=draw(st.integers(0, 364))) for _ in range(n_blocks)]
+    angles = np.array(draw(st.lists(st.floats(1, 180), min_size=1, max_size=4)) + [180.0])
+    loads = np.array(draw(st.lists(st.floats(0.01, 60), min_size=1, max_size=6)))
+    return study, sites, dates, angles, loads
+
+
+def _rows(study, sites, angles):
+    resolved = [study.variant(site=site.model_dump()).resolved().panel for site in sites]
+    orientation = engine.fold_orientations(study, [p.tilt for p in resolved], [p.azimuth for p in resolved], angles)
+    return np.repeat(np.arange(len(sites)), angles.size), orientation.reshape(-1, 4)
+
+
+def assert_engines_agree(compiled, reference):
+    np.testing.assert_allclose(compiled.t_solar, reference.t_solar, rtol=0, atol=SECOND)
+    np.testing.assert_allclose(compiled.t_solar_contiguous, reference.t_solar_contiguous, rtol=0, atol=SECOND)
+    np.testing.assert_allclose(compiled.energy, reference.energy, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(compiled.peak, reference.peak, rtol=1e-9, atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=cases())
+def test_kernel_equals_the_reference_path(case):
+    study, sites, dates, angles, loads = case
+    sky = build_sky(study, sites, dates)
+    rows, orientation = _rows(study, sites, angles)
+    peak = engine.row_metrics(sky, study, rows, orientation, [1.0], outputs=("independent",), engine="numpy").peak
+    loads = loads / 60 * max(peak.max(), 1e-3)  # from a sliver of the peak to above it
+    results = {name: engine.row_metrics(sky, study, rows, orientation, loads, outputs=engine.OUTPUTS,
+                                        contiguous=True, engine=name) for name in engine.ENGINES}
+    assert_engines_agree(results["numba"], results["numpy"])
+
+
+def test_kernel_equals_the_reference_on_a_weather_year_slice():
+    # Real weather: Perez diffuse light, cells at each day's air temperature (several tables).
+    study = make_study({"name": "w", "mode": "exact", "site": {"latitude": 36.1, "longitude": -79.95,
+                        "altitude": 273, "timezone": "UTC-05:00"}, "weather": str(TMY3), "date": "2025-01-01",
+                        "panel": {"area": 0.108}, "p_load": 2.0, "pv_model": "single-diode", "iam": "physical"})
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 365, 45)]
+    sky = build_sky(study, [study.site] * len(dates), dates)
+    assert np.unique(sky.temp_air).size > 2
+    rows, orientation = _rows(study, [study.site] * len(dates), np.array([30.0, 90.0, 150.0]))
+    results = {name: engine.row_metrics(sky, study, rows, orientation, [0.5, 2.0, 4.4], outputs=engine.OUTPUTS,
+                                        contiguous=True, engine=name) for name in engine.ENGINES}
+    assert_engines_agree(results["numba"], results["numpy"])
+
+
+@settings(max_examples=150, deadline=None)
+# A curve a hair below the load, plateaus on a load, and a near-flat segment around a load.
+@example(curves=np.r_[np.full((2, 40), 4.0), np.full((1, 40), np.nextafter(4.0, 0))], loads=np.ones(7))
+@example(curves=np.r_[np.full((1, 40), 0.01), np.full((2, 40), 0.01) + np.r_[0.0, 1e-9, np.zeros(38)]],
+         loads=np.full(7, 0.01))
+@given(curves=arrays(np.float64, (3, 40), elements=st.floats(0, 20)),
+       loads=arrays(np.float64, 7, elements=st.floats(0.01, 25)))
+def test_many_loads_in_one_pass_equal_one_pass_per_load(curves, loads):
+    curves[1] = np.round(curves[1])  # plateaus and exact ties with the loads
+    loads[0] = curves[1, 5]
+    loads[3] = loads[2]  # a repeated load; the loads are not sorted either
+    direct = t_solar(curves[:, None, :], loads[None, :], 0.5)
+    runs = t_solar_contiguous(curves[:, None, :], loads[None, :], 0.5)
+    for name in engine.ENGINES:
+        result = engine.curve_metrics(curves, loads, 0.5, contiguous=True, engine=name)
+        np.testing.assert_allclose(result.t_solar[:, 0], direct, atol=1e-12)
+        np.testing.assert_allclose(result.t_solar_contiguous[:, 0], runs, atol=1e-12)
+        np.testing.assert_allclose(result.energy[:, 0], curves.sum(axis=1) * 0.5, rtol=1e-12)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=cases())
+def test_t_solar_never_rises_when_the_load_rises(case):
+    study, sites, dates, angles, _ = case
+    sky = build_sky(study, sites, dates)
+    rows, orientation = _rows(study, sites, angles)
+    hours = engine.row_metrics(sky, study, rows, orientation, np.linspace(0.01, 30, 50),
+                               outputs=engine.OUTPUTS).t_solar
+    assert np.all(np.diff(hours, axis=-1) <= 1e-12)
+    assert np.all((hours >= 0) & (hours <= 24 + 1e-9))
+
+
+def test_loads_of_each_row_and_unknown_names():
+    study = make_study({"name": "k", "site": {"latitude": 34.05, "longitude": -118.25}, "date": "2025-06-21",
+                        "panel": {"area": 0.108}, "p_load": 4.0, "pv_model": "single-diode"})
+    sky = build_sky(study, [study.site], [study.date])
+    rows, orientation = _rows(study, [study.site], np.array([40.0, 120.0]))
+    sets = np.array([[9.0, 2.0], [2.0, 9.0]])
+    one = engine.row_metrics(sky, study, rows, orientation, sets, row_loadset=[0, 1]).t_solar[:, 0]
+    both = engine.row_metrics(sky, study, rows, orientation, [2.0, 9.0]).t_solar[:, 0]
+    np.testing.assert_array_equal(one[0], both[0, ::-1])
+    np.testing.assert_array_equal(one[1], both[1])
+    with pytest.raises(ValueError, match="numba, numpy"):
+        engine.row_metrics(sky, study, rows, orientation, [2.0], engine="fortran")
+    with pytest.raises(ValueError, match="outputs must be among"):
+        engine.row_metrics(sky, study, rows, orientation, [2.0], outputs=("diagonal",))
+
+
+@pytest.mark.parametrize("model", ["ashrae", "physical"])
+def test_kernel_incidence_angle_modifier_is_pvlibs(model):
+    from foldopt.kernel import iam_factor
+
+    aoi = np.linspace(0.0, 100.0, 1001)
+    code, params = engine._iam_code(model)
+    compiled = np.array([iam_factor(np.cos(np.radians(a)), code, params) for a in aoi])
+    expected = pvlib.iam.ashrae(aoi) if model == "ashrae" else pvlib.iam.physical(aoi)
+    np.testing.assert_allclose(compiled, np.nan_to_num(expected), rtol=1e-12, atol=1e-12)
+
+
+def test_blocks_of_many_sites_and_time_zones_equal_their_own_skies():
+    study = make_study({"name": "s", "mode": "exact", "sky": "ineichen", "site": {"latitude": 0, "longitude": 0},
+                        "date": "2025-01-01", "panel": {"area": 0.1}, "p_load": 1.0, "step_min": 10})
+    sites = [Site(latitude=-33.9, longitude=151.2, timezone="Australia/Sydney"), Site(latitude=52.5, longitude=13.4),
+             Site(latitude=34.05, longitude=-118.25, timezone="America/Los_Angeles"),
+             Site(latitude=-33.9, longitude=151.2, timezone="Australia/Sydney")]
+    dates = [dt.date(2025, 3, 9), dt.date(2025, 6, 21), dt.date(2025, 11, 2), dt.date(2025, 12, 21)]
+    together = build_sky(study, sites, dates)
+    for index, (site, date) in enumerate(zip(sites, dates, strict=True)):
+        alone = build_sky(study, [site], [date])
+        for name in ("solar_zenith", "solar_azimuth", "hour_angle", "dni", "terms"):
+            np.testing.assert_allclose(getattr(together, name)[index], getattr(alone, name)[0], rtol=1e-12, atol=1e-9)
+        assert together.grid.times(index).equals(alone.grid.times(0))
+
+
+def test_run_plan_is_the_same_on_both_engines():
+    from foldopt.config import make_plan
+    from foldopt.sweep import run_plan
+
+    plan = make_plan({"name": "t", "mode": "exact", "site": {"latitude": [-20.0, 45.0], "longitude": 10.0},
+                      "date": ["2025-03-20", "2025-12-21"], "panel": {"area": 0.108}, "p_load": [1.0, 4.4, 40.0],
+                      "pv_model": "single-diode", "fold_angles": {"start": 5, "stop": 180, "step": 5},
+                      "step_min": 10})
+    tables = {name: run_plan(plan, engine=name).table for name in engine.ENGINES}
+    numbers = tables["numba"].select_dtypes("number").columns
+    np.testing.assert_allclose(tables["numba"][numbers], tables["numpy"][numbers], rtol=1e-9, atol=SECOND)
+    assert tables["numba"]["note"].equals(tables["numpy"]["note"])
+    # No design carries 40 W: every angle ties at zero and the flat panel is reported.
+    high = tables["numba"][(tables["numba"].p_load_w == 40.0) & (tables["numba"].design == "twofold")]
+    assert (high["fold_angle_deg"] == 180.0).all() and (high["t_solar_h"] == 0).all()
