@@ -67,22 +67,50 @@ def _setup_key(study: Study) -> str:
     return json.dumps(data, sort_keys=True)
 
 
-def _chunks(count: int, per_block_rows: int, n_loads: int, n_steps: int):
-    """Slices of ``count`` blocks whose rows x loads and time steps stay within the chunk bounds."""
-    size = max(1, min(CHUNK_ROW_LOADS // max(per_block_rows * n_loads, 1), CHUNK_STEPS // max(n_steps, 1)))
-    return [slice(start, min(start + size, count)) for start in range(0, count, size)]
+@dataclass(frozen=True)
+class Blocks:
+    """Blocks that share one setup (:func:`_setup_key`): the study's settings at each (site, date),
+    and each block's flat panel orientation [deg]."""
+
+    study: Study
+    sites: tuple
+    dates: tuple
+    tilt: np.ndarray
+    azimuth: np.ndarray
+
+    @classmethod
+    def of(cls, studies) -> Blocks:
+        """One block per study (its site, date and panel)."""
+        resolved = [s.resolved() for s in studies]
+        return cls(resolved[0], tuple(s.site for s in resolved), tuple(s.date for s in resolved),
+                   np.array([s.panel.tilt for s in resolved]), np.array([s.panel.azimuth for s in resolved]))
+
+    @classmethod
+    def of_dates(cls, study: Study, dates) -> Blocks:
+        """The days of one study at its own site."""
+        study = study.resolved()
+        count = len(dates)
+        return cls(study, (study.site,) * count, tuple(dates), np.full(count, study.panel.tilt),
+                   np.full(count, study.panel.azimuth))
+
+    def __len__(self) -> int:
+        return len(self.dates)
+
+    def __getitem__(self, part: slice) -> Blocks:
+        return Blocks(self.study, self.sites[part], self.dates[part], self.tilt[part], self.azimuth[part])
+
+    def sky(self) -> Sky:
+        return build_sky(self.study, self.sites, self.dates)
+
+    def chunks(self, n_loads: int):
+        """Slices of blocks whose rows x loads and time steps stay within the chunk bounds."""
+        per_block = len(self.study.fold_angles.grid()) * max(n_loads, 1)
+        n_steps = round(24 * 60 / self.study.step_min)
+        size = max(1, min(CHUNK_ROW_LOADS // per_block, CHUNK_STEPS // n_steps))
+        return [slice(start, min(start + size, len(self))) for start in range(0, len(self), size)]
 
 
-def _sky(studies) -> Sky:
-    return build_sky(studies[0], [s.site for s in studies], [s.date for s in studies])
-
-
-def _panels(studies):
-    resolved = [s.resolved() for s in studies]
-    return np.array([s.panel.tilt for s in resolved]), np.array([s.panel.azimuth for s in resolved])
-
-
-def fold_hours(sky: Sky, studies, loads, engine: str = "numba"):
+def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
     """t_solar [h] of every block's twofold panel at every angle of the grid, for every load.
 
     Returns
@@ -92,21 +120,21 @@ def fold_hours(sky: Sky, studies, loads, engine: str = "numba"):
     hours : numpy.ndarray
         (n_blocks, n_angles, n_loads).
     """
-    study = studies[0]
+    study = blocks.study
     angles = np.asarray(study.fold_angles.grid())
-    orientation = engines.fold_orientations(study, *_panels(studies), angles)
+    orientation = engines.fold_orientations(study, blocks.tilt, blocks.azimuth, angles)
     rows = np.repeat(np.arange(sky.n_blocks), angles.size)
-    metrics = engines.row_metrics(sky, study, rows, orientation.reshape(-1, 4), loads,
-                                  outputs=(study.resolved().connection,), engine=engine)
+    metrics = engines.row_metrics(sky, study, rows, orientation.reshape(-1, 4), loads, outputs=(study.connection,),
+                                  engine=engine)
     return angles, metrics.t_solar.reshape(sky.n_blocks, angles.size, -1)
 
 
-def _design_metrics(sky: Sky, studies, loads, angles, chosen, engine: str) -> dict:
+def _design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
     panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net."""
-    study = studies[0].resolved()
+    study = blocks.study
     n_blocks, n_loads = sky.n_blocks, loads.size
-    tilt, azimuth = _panels(studies)
+    tilt, azimuth = blocks.tilt, blocks.azimuth
     every = engines.fold_orientations(study, tilt, azimuth, angles)
     blocks = np.repeat(np.arange(n_blocks), n_loads)
     # One row per block and load, at that load's angle, with the load alone.
@@ -189,9 +217,9 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     paths = list(axes)
     choices = [dict(zip(paths, values, strict=True)) for values in itertools.product(*axes.values())]
     # A fixed panel keeps one fold angle all year: an annual group is the dates of one choice.
-    groups = [[{**choice, "date": date} for date in dates] if dates else [choice] for choice in choices]
-    studies = [[plan.study({**case, "p_load": float(loads[0])}) for case in group] for group in groups]
-    total = sum(len(group) for group in groups) * (2 if dates else 1)
+    studies = [plan.study({**choice, "p_load": float(loads[0]), **({"date": dates[0]} if dates else {})})
+               for choice in choices]
+    total = len(choices) * (2 * len(dates) if dates else 1)
     done = 0
 
     def advance(count):
@@ -200,75 +228,72 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
         if progress is not None:
             progress(done, total)
 
-    results: list = [None] * len(groups)
+    results: list = [None] * len(choices)
     extras: dict = {}
     if dates:
-        for index, group in enumerate(studies):
-            results[index], group_extras = _annual_group(group, loads, objective, advance, engine)
+        for index, study in enumerate(studies):
+            results[index], group_extras = _annual_group(Blocks.of_dates(study, dates), loads, objective, advance,
+                                                         engine)
             extras = extras or group_extras
+        cases = [(study.site, date, choice) for study, choice in zip(studies, choices, strict=True) for date in dates]
     else:
         # Cases of one setup share skies and engine calls, whatever their order in the plan.
         setups: dict[str, list[int]] = {}
-        for index, (study,) in enumerate(studies):
+        for index, study in enumerate(studies):
             setups.setdefault(_setup_key(study), []).append(index)
         for members in setups.values():
-            member_studies = [studies[i][0] for i in members]
-            k = len(member_studies[0].fold_angles.grid())
-            n_steps = round(24 / (member_studies[0].step_min / 60))
-            for part in _chunks(len(members), k, loads.size, n_steps):
-                chunk = member_studies[part]
-                sky = _sky(chunk)
+            blocks = Blocks.of([studies[i] for i in members])
+            for part in blocks.chunks(loads.size):
+                chunk = blocks[part]
+                sky = chunk.sky()
                 angles, hours = fold_hours(sky, chunk, loads, engine)
                 metrics = _design_metrics(sky, chunk, loads, angles, _best_angle_index(hours.transpose(0, 2, 1)),
                                           engine)
                 for offset, index in enumerate(members[part]):
                     results[index] = {name: values[offset:offset + 1] for name, values in metrics.items()}
                 advance(len(chunk))
-    table = _table([study for group in studies for study in group],
-                   [case for group in groups for case in group], loads,
-                   {name: np.concatenate([r[name] for r in results]) for name in results[0]})
+        cases = [(study.site, study.date, choice) for study, choice in zip(studies, choices, strict=True)]
+    table = _table(cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]})
     return SweepResult(plan, table, extras, engine)
 
 
-def _annual_group(studies, loads, objective, advance, engine):
+def _annual_group(blocks: Blocks, loads, objective, advance, engine):
     """One fold angle per load for all the days of a group: the one that maximises the objective
     over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves."""
-    n_steps = round(24 / (studies[0].step_min / 60))
-    k = len(studies[0].fold_angles.grid())
-    parts = _chunks(len(studies), k, loads.size, n_steps)
+    parts = blocks.chunks(loads.size)
     skies, daily = [], []
     for part in parts:
-        skies.append(_sky(studies[part]))
-        angles, hours = fold_hours(skies[-1], studies[part], loads, engine)
+        skies.append(blocks[part].sky())
+        angles, hours = fold_hours(skies[-1], blocks[part], loads, engine)
         daily.append(hours)
-        advance(len(studies[part]))
-    months = [study.date.month for study in studies]
+        advance(len(blocks[part]))
+    months = [date.month for date in blocks.dates]
     score = objective_value(np.concatenate(daily).transpose(0, 2, 1), months, objective.statistic, objective.months)
     fixed = _best_angle_index(score)  # (n_loads,)
     metrics, series = [], {"p_twofold_w": [], "switch_state": []}
+    study = blocks.study
     for part, sky in zip(parts, skies, strict=True):
-        chunk = studies[part]
+        chunk = blocks[part]
         metrics.append(_design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
                                        engine))
         # The day x hour maps of the first load's angle, every day at once.
-        study = chunk[0].resolved()
-        orientation = engines.fold_orientations(study, *_panels(chunk), angles[fixed[:1]])[:, 0]
+        orientation = engines.fold_orientations(study, chunk.tilt, chunk.azimuth, angles[fixed[:1]])[:, 0]
         powers, state = engines.powers(sky, study, orientation, series=study.switch_series, with_state=True)
         series["p_twofold_w"].append(powers[study.connection])
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
         advance(len(chunk))
     clock = skies[0].grid.clock_hours[0]
-    extras = {"dates": [study.date for study in studies], "hours": clock, "fold_angle": float(angles[fixed[0]]),
+    extras = {"dates": list(blocks.dates), "hours": clock, "fold_angle": float(angles[fixed[0]]),
               **{key: np.concatenate(value) for key, value in series.items()}}
     return {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}, extras
 
 
-def _table(studies, cases, loads, metrics) -> pd.DataFrame:
-    """The tidy table: per case, load and design (in that order), the case columns and metrics."""
-    n_cases, n_loads, n_designs = len(studies), loads.size, len(DESIGNS)
+def _table(cases, loads, metrics) -> pd.DataFrame:
+    """The tidy table: per case (site, date, axis choice), load and design, in that order."""
+    n_cases, n_loads, n_designs = len(cases), loads.size, len(DESIGNS)
     repeat = n_loads * n_designs
     columns = {}
-    case_rows = [_case(study, case) for study, case in zip(studies, cases, strict=True)]
+    case_rows = [_case(*case) for case in cases]
     for name in case_rows[0]:
         columns[name] = np.repeat(np.array([row[name] for row in case_rows], dtype=object), repeat)
     columns["p_load_w"] = np.tile(np.repeat(loads, n_designs), n_cases)
@@ -290,14 +315,13 @@ def _table(studies, cases, loads, metrics) -> pd.DataFrame:
     return table
 
 
-def _case(study: Study, choice: dict) -> dict:
-    site = study.site
+def _case(site, date, choice: dict) -> dict:
     return {
         "site_name": site.name or "",
         "latitude": site.latitude,
         "longitude": site.longitude,
-        "date": study.date.isoformat(),
-        "day_of_year": study.date.timetuple().tm_yday,
+        "date": date.isoformat(),
+        "day_of_year": date.timetuple().tm_yday,
         **{path: _plain(value) for path, value in choice.items() if path not in _AXIS_COLUMNS},
     }
 
