@@ -110,6 +110,16 @@ def _runs(start_at, lo_at, length, run):
         run[j, 0] += length
 
 
+@njit(cache=True, inline="always")
+def _gather(whole, pending_at, pending, lo_at, length):
+    """Add ``length`` to the pending sum for ``whole[lo_at]``, writing the previous sum out when
+    the index changes."""
+    if lo_at == pending_at:
+        return pending_at, pending + length
+    whole[pending_at] += pending
+    return lo_at, length
+
+
 @njit(cache=True)
 def _metrics(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out):
     """Daily metrics of one power curve [W] sampled at step centres, of which only steps
@@ -140,11 +150,7 @@ def _metrics(power, first, last, step_hours, loads, contiguous, above, whole, ru
         lo_at, hi_at = min(position, at), max(position, at)
         if contiguous:
             _runs(position, lo_at, step_hours, run)
-        if lo_at == pending_at:
-            pending += step_hours
-        else:
-            whole[pending_at] += pending
-            pending_at, pending = lo_at, step_hours
+        pending_at, pending = _gather(whole, pending_at, pending, lo_at, step_hours)
         if hi_at > lo_at:
             _shares(loads, min(previous, p), max(previous, p), lo_at, hi_at, step_hours, above, run, contiguous)
         previous, position = p, at
@@ -152,11 +158,7 @@ def _metrics(power, first, last, step_hours, loads, contiguous, above, whole, ru
     tail = (n_steps - last - 0.5) * step_hours
     if contiguous:
         _runs(position, position, tail, run)
-    if position == pending_at:
-        pending += tail
-    else:
-        whole[pending_at] += pending
-        pending_at, pending = position, tail
+    pending_at, pending = _gather(whole, pending_at, pending, position, tail)
     whole[pending_at] += pending
     total = 0.0
     for j in range(n_loads - 1, -1, -1):
