@@ -2,11 +2,16 @@
 
 With the air temperature and wind fixed for a study, a sub-panel's cell temperature, and so its
 maximum power, depends only on its irradiance; a connected pair's power depends only on the two
-irradiances. The fast path tabulates these once per study, a 1-D table of sub-panel maximum power
-and 2-D tables of the parallel and series pair, on irradiance nodes spaced quadratically (dense
-at low irradiance, where power bends), and interpolates linearly in sqrt(E), on which the nodes are uniform. The exact path solves every
-step's I-V curves. ``bench/electrical.py`` and ``tests/test_electrical.py`` measure the
-tables' error against it.
+irradiances. The fast path tabulates these once per study: a 1-D table of sub-panel maximum power
+on irradiance nodes spaced quadratically (dense at low irradiance, where power bends), read by
+linear interpolation in sqrt(E), on which the nodes are uniform; and 2-D tables of the parallel and
+the series pair as fractions of the two maxima, over the stronger sub-panel's irradiance (the same
+nodes) and the weaker/stronger irradiance ratio (:func:`_ratio_nodes`). Both pairs are symmetric,
+and along ratio 1 (equal irradiance: a flat fold, or noon) identical sub-panels deliver exactly
+their sum, a grid line of the tables that bilinear interpolation keeps exact, so the fast path has
+no seam there; each pair's kink runs nearly along the ratio lines. The exact path solves every
+step's I-V curves. ``bench/electrical.py`` and ``tests/test_electrical.py`` measure the tables'
+error against it.
 
 Tables are kept on disk, named by a hash of everything they depend on (the PV unit's parameters,
 the sub-panel area, the temperature settings, the nodes, pvlib's version and
@@ -32,7 +37,7 @@ IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the tables; clear-sky beam stays belo
 TABLE_NODES_1D = 1025
 TABLE_NODES_2D = 161
 TABLE_NODES_RATIO = 321
-TABLE_FORMAT = 2  # bump when the way tables are built changes
+TABLE_FORMAT = 4  # bump when the way tables are built changes
 
 
 def cache_dir() -> Path:
@@ -68,6 +73,15 @@ def _nodes(count):
 def _node_position(poa, count):
     """Fractional index of irradiances on :func:`_nodes`: the nodes are uniform in sqrt(E / E_max)."""
     return np.sqrt(np.clip(poa, 0.0, IRRADIANCE_MAX) / IRRADIANCE_MAX) * (count - 1)
+
+
+def _ratio_nodes(connection):
+    """Weaker/stronger irradiance ratios of a pair table's second axis: uniform in the ratio for
+    series (its kink lies near a ratio of Imp/Isc, close to 1), uniform in its square root for
+    parallel (its kink, where the weaker sub-panel's Voc falls below the stronger one's maximum-
+    power voltage, lies at small ratios)."""
+    nodes = np.linspace(0.0, 1.0, TABLE_NODES_RATIO)
+    return nodes**2 if connection == "parallel" else nodes
 
 
 def _linear(values, position):
@@ -148,37 +162,30 @@ class Electrical:
             if name == "subpanel":
                 g1 = _nodes(TABLE_NODES_1D)
                 self._tables[name] = (g1, self.pv.max_power(g1, self._temperature(g1), self.subpanel_area))
-            elif name == "parallel":
-                g2 = _nodes(TABLE_NODES_2D)
-                self._tables[name] = self._pair_table("parallel", g2, g2, lambda ge, gw: (ge, gw))
             else:
-                # Series is indexed by the stronger irradiance and the weaker/stronger ratio (the pair
-                # is symmetric): its kink, where the weaker current starts to limit the string, then
-                # runs nearly along a ratio grid line instead of across cells.
-                ratio = np.linspace(0.0, 1.0, TABLE_NODES_RATIO)
-                self._tables[name] = self._pair_table(
-                    "series", _nodes(TABLE_NODES_2D), ratio, lambda strong, r: (strong, strong * r)
-                )
+                self._tables[name] = self._pair_table(name)
             table = self._tables[name]
             _store_cached(path, table if name == "subpanel" else (table,))
         return self._tables[name]
 
-    def _pair_table(self, connection, axis0, axis1, to_irradiance):
-        """A pair's power as a fraction of its two maxima on a 2-D grid of nodes.
+    def _pair_table(self, connection):
+        """A pair's power as a fraction of its two maxima over (stronger irradiance, ratio).
 
         The fraction is smoother than the power and zero-safe. Series is tabulated without bypass
         diodes; with ideal ones it is the larger of that and the stronger sub-panel alone
         (:func:`foldopt.aggregation.series_power`), which needs no table.
         """
-        first, second = (grid.ravel() for grid in np.meshgrid(axis0, axis1, indexing="ij"))
-        ge, gw = to_irradiance(first, second)
-        east = self.pv.curves(ge, self._temperature(ge), self.subpanel_area)
-        west = self.pv.curves(gw, self._temperature(gw), self.subpanel_area)
+        strong, ratio = (grid.ravel() for grid in np.meshgrid(_nodes(TABLE_NODES_2D), _ratio_nodes(connection),
+                                                              indexing="ij"))
+        weak = strong * ratio
+        east = self.pv.curves(strong, self._temperature(strong), self.subpanel_area)
+        west = self.pv.curves(weak, self._temperature(weak), self.subpanel_area)
         bound = east.max_power() + west.max_power()
         power = parallel_power(east, west) if connection == "parallel" else series_power(east, west, bypass=False)
         with np.errstate(invalid="ignore", divide="ignore"):
-            fraction = np.where(bound > 0, power / bound, 1.0)
-        return fraction.reshape(axis0.size, axis1.size)
+            fraction = np.where(bound > 0, power / bound, 1.0).reshape(TABLE_NODES_2D, TABLE_NODES_RATIO)
+        fraction[:, -1] = 1.0  # identical sub-panels at equal irradiance deliver exactly their sum
+        return fraction
 
     def subpanel_power(self, poa):
         """Maximum power of one sub-panel [W] at irradiance ``poa`` [W/m^2] (any shape)."""
@@ -211,23 +218,21 @@ class Electrical:
             p_series = series_power(east, west, self.bypass) if series else np.full(p_east.shape, np.nan)
             return connection_powers(p_east, p_west, p_parallel, p_series, **options)
         east, west = np.clip(poa_east, 0.0, IRRADIANCE_MAX), np.clip(poa_west, 0.0, IRRADIANCE_MAX)
-        # Both tables' nodes are uniform in sqrt(E / E_max): one square root serves them all.
+        # Every table's irradiance nodes are uniform in sqrt(E / E_max): one square root serves all.
         root_east, root_west = np.sqrt(east / IRRADIANCE_MAX), np.sqrt(west / IRRADIANCE_MAX)
         _, p1 = self._table("subpanel")
         p_east = _linear(p1, root_east * (TABLE_NODES_1D - 1))
         p_west = _linear(p1, root_west * (TABLE_NODES_1D - 1))
         bound = p_east + p_west
-        # Identical sub-panels at equal irradiance (a flat fold, or noon) deliver exactly their sum
-        # in parallel and in series; interpolation across the table's diagonal would not.
-        equal = east == west
-        at_east, at_west = root_east * (TABLE_NODES_2D - 1), root_west * (TABLE_NODES_2D - 1)
-        p_parallel = np.where(equal, 1.0, np.clip(_bilinear(self._table("parallel"), at_east, at_west), 0, 1)) * bound
+        strong, weak = np.maximum(root_east, root_west), np.minimum(root_east, root_west)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            root_ratio = np.where(strong > 0, weak / strong, 1.0)
+        at_strong = strong * (TABLE_NODES_2D - 1)
+        p_parallel = np.clip(_bilinear(self._table("parallel"), at_strong, root_ratio * (TABLE_NODES_RATIO - 1)),
+                             0.0, 1.0) * bound
         if series:
-            strong = np.maximum(east, west)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                weak_ratio = np.where(strong > 0, np.minimum(east, west) / strong, 1.0)
-            fraction = _bilinear(self._table("series"), np.maximum(at_east, at_west), weak_ratio * (TABLE_NODES_RATIO - 1))
-            p_series = np.where(equal, 1.0, np.clip(fraction, 0.0, 1.0)) * bound
+            fraction = _bilinear(self._table("series"), at_strong, root_ratio**2 * (TABLE_NODES_RATIO - 1))
+            p_series = np.clip(fraction, 0.0, 1.0) * bound
             if self.bypass:
                 p_series = np.maximum(p_series, np.maximum(p_east, p_west))
         else:

@@ -26,7 +26,7 @@ import pvlib
 
 from foldopt.aggregation import CONNECTIONS
 from foldopt.config import Study
-from foldopt.electrical import TABLE_NODES_1D, TABLE_NODES_2D, Electrical
+from foldopt.electrical import Electrical
 from foldopt.geometry import normal_vector, subpanel_orientation
 from foldopt.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.metrics import energy, t_solar, t_solar_contiguous
@@ -320,7 +320,6 @@ def _tables(electricals, outputs, study):
     table_1d = np.stack([e._table("subpanel")[1] for e in electricals])
     table_parallel = np.stack([e._table("parallel") for e in electricals])
     table_series = np.stack([e._table("series") for e in electricals]) if series else np.zeros((1, 2, 2))
-    assert table_1d.shape[1] == TABLE_NODES_1D and table_parallel.shape[1] == TABLE_NODES_2D
     return table_1d, table_parallel, table_series, 0.0
 
 

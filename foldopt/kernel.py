@@ -235,8 +235,7 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
             g_west = math.sqrt(min(max(g_west, 0.0), IRRADIANCE_MAX) * to_root)
         irradiance[0, s], irradiance[1, s] = g_east, g_west
     n1 = table_1d.shape[0] - 1
-    n2 = table_parallel.shape[0] - 1
-    nr = table_series.shape[1] - 1
+    n2, nr = table_parallel.shape[0] - 1, table_parallel.shape[1] - 1
     for s in range(first, last + 1):
         root_east, root_west = irradiance[0, s], irradiance[1, s]
         if not tables:
@@ -246,16 +245,15 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
             p_east = _linear(table_1d, root_east * n1)
             p_west = _linear(table_1d, root_west * n1)
             bound = p_east + p_west
-            p_parallel = p_series = bound
-            if root_east != root_west:
-                # (Identical sub-panels at equal irradiance deliver exactly their sum.)
-                fraction = _bilinear(table_parallel, root_east * n2, root_west * n2)
-                p_parallel = min(max(fraction, 0.0), 1.0) * bound
-                if need_series:
-                    # The series table's second axis is the weaker/stronger irradiance ratio.
-                    strong, weak = max(root_east, root_west), min(root_east, root_west)
-                    fraction = _bilinear(table_series, strong * n2, weak * weak / (strong * strong) * nr)
-                    p_series = min(max(fraction, 0.0), 1.0) * bound
+            # The pair tables: stronger irradiance (as its root) x weaker/stronger ratio (parallel:
+            # as its root; series: the ratio itself).
+            strong, weak = max(root_east, root_west), min(root_east, root_west)
+            root_ratio = weak / strong if strong > 0.0 else 1.0
+            p_parallel = min(max(_bilinear(table_parallel, strong * n2, root_ratio * nr), 0.0), 1.0) * bound
+            p_series = bound
+            if need_series:
+                fraction = _bilinear(table_series, strong * n2, root_ratio**2 * nr)
+                p_series = min(max(fraction, 0.0), 1.0) * bound
             if bypass:
                 p_series = max(p_series, max(p_east, p_west))
         p_panel = panel_scale * p_east
@@ -295,7 +293,8 @@ def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_nor
         cos(tilt), sin(tilt), cos(azimuth), sin(azimuth) per sub-panel (paper mode).
     table_1d, table_parallel, table_series : float arrays
         Per table: sub-panel power [W] on sqrt-spaced irradiance nodes, and the parallel and
-        series pairs as fractions of the two maxima (:class:`foldopt.electrical.Electrical`).
+        series pairs as fractions of the two maxima over the stronger irradiance and the
+        weaker/stronger ratio (:class:`foldopt.electrical.Electrical`).
     linear_power : float
         ``efficiency * sub-panel area`` [m^2] for the ideal model (no tables); 0 with tables.
     panel_scale : float
