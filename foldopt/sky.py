@@ -22,7 +22,7 @@ from foldopt.config import Study, parse_timezone
 from foldopt.geometry import normal_vector
 from foldopt.irradiance import sky_diffuse_terms
 from foldopt.solarposition import ClockGrid, clock_grid, solar_position_grid
-from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, weather_day
+from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, weather_days
 
 @dataclass(frozen=True)
 class Sky:
@@ -98,16 +98,29 @@ class Sky:
 
 def _weather_grid(study: Study, dates):
     """Clock grid, light and cell air temperature of each date from the study's weather file."""
-    weather = study.weather
-    days = [weather_day(read_weather(weather.path, weather.format, date.year, weather.label), date) for date in dates]
-    lengths = {len(day) for day in days}
-    if len(lengths) != 1:
-        raise ValueError(f"the weather file's days have different numbers of steps: {sorted(lengths)}")
-    grid = ClockGrid.from_times([pd.DatetimeIndex(day.index) for day in days], days[0].index.tz)
-    light = {key: np.stack([day[key].to_numpy(dtype=float) for day in days]) for key in ("dni", "ghi", "dhi")}
+    weather, columns = study.weather, ("dni", "ghi", "dhi", "temp_air")
+    pieces = []
+    # The file is coerced to each date's year: read once per year, the days picked as arrays.
+    for year in sorted({date.year for date in dates}):
+        positions = [i for i, date in enumerate(dates) if date.year == year]
+        frame = read_weather(weather.path, weather.format, year, weather.label)
+        rows = weather_days(frame, [dates[i] for i in positions])
+        index = pd.DatetimeIndex(frame.index)
+        pieces.append((positions, index.tz_convert("UTC").tz_localize(None).as_unit("ns").asi8[rows],
+                       index.tz_localize(None).as_unit("ns").asi8[rows],
+                       {key: frame[key].to_numpy(dtype=float)[rows] for key in columns}, index.tz))
+    order = np.argsort(np.concatenate([piece[0] for piece in pieces]), kind="stable")
+
+    def gather(parts):
+        return np.concatenate(parts)[order]
+
+    utc, local = gather([piece[1] for piece in pieces]), gather([piece[2] for piece in pieces])
+    light = {key: gather([piece[3][key] for piece in pieces]) for key in columns}
+    step_hours = float(np.median(np.diff(utc[0]))) / 3.6e12 if utc.shape[1] > 1 else 24.0
+    grid = ClockGrid(utc, local - utc, (pieces[0][4],) * len(dates), step_hours)
     # Cells follow each day's mean air temperature (the electrical tables assume one per day),
     # rounded to 5 C so that days share their tables; wind stays the study's.
-    temp_air = np.array([round(float(day["temp_air"].mean()) / 5.0) * 5.0 for day in days])
+    temp_air = np.round(light.pop("temp_air").mean(axis=1) / 5.0) * 5.0
     return grid, light, temp_air
 
 

@@ -71,12 +71,25 @@ def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | No
     return frame.sort_index().fillna({"temp_air": 20.0, "wind_speed": 1.0}).fillna(0.0)
 
 
+def weather_days(frame: pd.DataFrame, dates) -> np.ndarray:
+    """Row numbers of ``frame`` whose interval centres fall on each of ``dates`` (local to the
+    file), (n_dates, n_steps): every date must hold the same number of rows."""
+    days = frame.index.tz_localize(None).to_numpy().astype("datetime64[D]")
+    wanted = np.array(dates, dtype="datetime64[D]")
+    start, stop = np.searchsorted(days, wanted, side="left"), np.searchsorted(days, wanted, side="right")
+    missing = [str(date) for date, a, b in zip(dates, start, stop, strict=True) if a == b]
+    if missing:
+        raise ValueError(f"the weather file has no data for {', '.join(missing[:3])}"
+                         + (f" and {len(missing) - 3} more dates" if len(missing) > 3 else ""))
+    counts = np.unique(stop - start)
+    if counts.size != 1:
+        raise ValueError(f"the weather file's days have different numbers of steps: {counts.tolist()}")
+    return start[:, None] + np.arange(counts[0])
+
+
 def weather_day(frame: pd.DataFrame, date) -> pd.DataFrame:
     """The intervals of ``frame`` whose centres fall on ``date`` (local to the file)."""
-    day = frame[frame.index.date == date]
-    if day.empty:
-        raise ValueError(f"the weather file has no data for {date}")
-    return day
+    return frame.iloc[weather_days(frame, [date])[0]]
 
 
 def clear_sky(times, apparent_zenith, latitude, longitude, altitude, model="ineichen", linke_turbidity=None):
