@@ -46,7 +46,7 @@ def _golden(evaluate, lo, hi, steps=_GOLDEN_STEPS):
     return np.maximum(fa, fb)
 
 
-def parallel_power(east: IVCurve, west: IVCurve, golden_steps: int = _GOLDEN_STEPS):
+def parallel_power(east: IVCurve, west: IVCurve):
     """Maximum power [W] of two sub-panels in parallel behind blocking diodes.
 
     Each sub-panel's power ``P_i(V) = V max(I_i(V), 0)`` is concave up to its open-circuit voltage
@@ -68,7 +68,7 @@ def parallel_power(east: IVCurve, west: IVCurve, golden_steps: int = _GOLDEN_STE
     # The sub-panel whose maximum-power voltage is the lower one stops sourcing at its own Voc.
     voc_lower = np.where(v_east <= v_west, east.v_oc, west.v_oc)
     upper = np.maximum(lower, np.minimum(np.maximum(v_east, v_west), voc_lower))
-    searched = _golden(lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf), lower, upper, golden_steps)
+    searched = _golden(lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf), lower, upper)
     return np.maximum(searched, np.maximum(p_east, p_west))
 
 

@@ -59,11 +59,14 @@ def _store_cached(path: Path, arrays) -> None:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError:
+        return  # no cache where none can be written
+    try:
         with os.fdopen(handle, "wb") as file:
             np.savez(file, **{f"a{i}": array for i, array in enumerate(arrays)})
         os.replace(temporary, path)  # atomic: readers see the old file or the whole new one
     except OSError:
-        pass
+        Path(temporary).unlink(missing_ok=True)
 
 
 def _nodes(count):

@@ -20,7 +20,6 @@ import functools
 import inspect
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 import pvlib
 
@@ -245,11 +244,21 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
         electricals = [electrical_for(study, temp) for temp in temps]
         result = _compiled(sky, study, electricals, block_table, row_block, orientation, sorted_loads, row_loadset,
                            outputs, contiguous)
-    return RowMetrics(
-        _unsort(result.t_solar, order, row_loadset),
-        None if result.t_solar_contiguous is None else _unsort(result.t_solar_contiguous, order, row_loadset),
-        result.energy, result.peak,
-    )
+    return _in_caller_order(result, order, row_loadset)
+
+
+def _in_caller_order(result: RowMetrics, order, row_loadset) -> RowMetrics:
+    contiguous = result.t_solar_contiguous
+    return RowMetrics(_unsort(result.t_solar, order, row_loadset),
+                      None if contiguous is None else _unsort(contiguous, order, row_loadset),
+                      result.energy, result.peak)
+
+
+def _curve_reference(power, row_loads, step_hours, contiguous):
+    """t_solar, its longest run (or None), energy and peak of curves (m, n_steps) with loads (m, L)
+    by :mod:`foldopt.metrics`."""
+    runs = t_solar_contiguous(power[:, None, :], row_loads, step_hours) if contiguous else None
+    return t_solar(power[:, None, :], row_loads, step_hours), runs, energy(power, step_hours), power.max(axis=-1)
 
 
 def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool = True, with_state: bool = False):
@@ -300,26 +309,25 @@ def _reference(sky, study, row_block, orientation, loads, row_loadset, outputs, 
     for block in np.unique(row_block):
         rows = np.flatnonzero(row_block == block)
         curves, _ = powers(sky, study, orientation[rows], [block], series)
-        row_loads = loads[row_loadset[rows]]
         for index, name in enumerate(outputs):
-            power = curves[name]
-            out.t_solar[rows, index] = t_solar(power[:, None, :], row_loads, step)
+            hours, runs, harvested, peak = _curve_reference(curves[name], loads[row_loadset[rows]], step, contiguous)
+            out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = hours, harvested, peak
             if contiguous:
-                out.t_solar_contiguous[rows, index] = t_solar_contiguous(power[:, None, :], row_loads, step)
-            out.energy[rows, index] = energy(power, step)
-            out.peak[rows, index] = power.max(axis=-1)
+                out.t_solar_contiguous[rows, index] = runs
     return out
 
 
 def _tables(electricals, outputs, study):
     """The kernel's stacked tables (one per cell temperature) and the ideal model's linear power."""
-    first = electricals[0]
+    first, count = electricals[0], len(electricals)
+    # Tables a study does not use are placeholders, one per cell temperature all the same.
     if not first.pv.has_iv:
-        return np.zeros((1, 2)), np.zeros((1, 2, 2)), np.zeros((1, 2, 2)), first.pv.efficiency * first.subpanel_area
+        placeholder = np.zeros((count, 2, 2))
+        return np.zeros((count, 2)), placeholder, placeholder, first.pv.efficiency * first.subpanel_area
     series = "series" in outputs or study.switch_series
     table_1d = np.stack([e._table("subpanel")[1] for e in electricals])
     table_parallel = np.stack([e._table("parallel") for e in electricals])
-    table_series = np.stack([e._table("series") for e in electricals]) if series else np.zeros((1, 2, 2))
+    table_series = np.stack([e._table("series") for e in electricals]) if series else np.zeros((count, 2, 2))
     return table_1d, table_parallel, table_series, 0.0
 
 
@@ -339,8 +347,7 @@ def _compiled(sky, study, electricals, block_table, row_block, orientation, load
     paper = study.mode == "paper"
     paper_sun = np.moveaxis(sky.paper_sun, -1, 1) if paper else np.zeros((1, 4, 1))
     first = electricals[0]
-    work = kernel.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous,
-                          numba.get_num_threads())
+    work = kernel.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous)
     lit = sky.lit
     steps = np.arange(lit.shape[1])
     first_lit = np.where(lit, steps, lit.shape[1]).min(axis=1)
@@ -371,21 +378,13 @@ def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous:
     row_loadset = np.zeros(power.shape[0], dtype=np.int64) if row_loadset is None else np.asarray(
         row_loadset, dtype=np.int64)
     if engine == "numpy":
-        row_loads = sorted_loads[row_loadset]
-        result = RowMetrics(
-            t_solar(power[:, None, :], row_loads, step_hours)[:, None],
-            t_solar_contiguous(power[:, None, :], row_loads, step_hours)[:, None] if contiguous else None,
-            energy(power, step_hours)[:, None], power.max(axis=-1)[:, None],
-        )
+        hours, runs, harvested, peak = _curve_reference(power, sorted_loads[row_loadset], step_hours, contiguous)
+        result = RowMetrics(hours[:, None], None if runs is None else runs[:, None], harvested[:, None], peak[:, None])
     else:
         from foldopt import kernel
 
-        work = kernel.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous, numba.get_num_threads())
+        work = kernel.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
         kernel.curve_rows(power, row_loadset, sorted_loads, step_hours, contiguous, **work)
         result = RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
                             work["peak_out"])
-    return RowMetrics(
-        _unsort(result.t_solar, order, row_loadset),
-        None if result.t_solar_contiguous is None else _unsort(result.t_solar_contiguous, order, row_loadset),
-        result.energy, result.peak,
-    )
+    return _in_caller_order(result, order, row_loadset)

@@ -1,14 +1,14 @@
 """Compiled loops of the engine (numba): sun to t_solar per row, with no (rows x steps) arrays.
 
 A *row* is one block (a day at a site, see :class:`foldopt.sky.Sky`) seen by one orientation of
-the two sub-panels (a fold angle). :func:`fold_rows` takes each row in two tight loops over its
-time steps. The first turns the sun into every asked connection's power: both sub-panel normals
-against the sun vector give the beam's incidence (or Shin et al.'s Eq. 5 in paper mode), the beam
-with the optional incidence-angle modifier and the diffuse terms give the plane-of-array
-irradiance, and the electrical tables give the powers. It writes them to a buffer of one day,
-reused by the next row. The second reduces each power curve to the daily metrics of every load
-at once (:func:`_metrics`). :func:`curve_rows` takes power curves that already exist (a tracker's)
-through the same reduction.
+the two sub-panels (a fold angle). :func:`fold_rows` takes each row in three tight loops over its
+time steps. In the first, both sub-panel normals against the sun vector give the beam's incidence
+(or Shin et al.'s Eq. 5 in paper mode), and the beam with the optional incidence-angle modifier
+and the diffuse terms give each sub-panel's plane-of-array irradiance; free of table look-ups, it
+vectorises. The second looks up the electrical tables and writes every asked connection's power
+to a buffer of one day, reused by the next row. The third reduces each power curve to the daily
+metrics of every load at once (:func:`_metrics`). :func:`curve_rows` takes power curves that
+already exist (a tracker's) through the same reduction.
 
 The metrics are those of :mod:`foldopt.metrics`, which is their reference: power is sampled at
 step centres and linear between them (held for half a step at both ends of the day), and a
@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import get_num_threads, njit, prange
 
 # Connection codes; the order of foldopt.aggregation.CONNECTIONS, plus the whole (unfolded) panel.
 EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
@@ -344,10 +344,10 @@ def curve_rows(power, row_loadset, loads, step_hours, contiguous, t_out, cont_ou
                 run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0])
 
 
-def scratch(n_rows, n_conn, n_loads, n_steps, contiguous, threads):
+def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):
     """Outputs and per-chunk scratch of :func:`fold_rows` (``n_steps`` > 0) or :func:`curve_rows`
     (``n_steps`` = 0), allocated here, outside the parallel loop."""
-    chunks = max(1, min(n_rows, threads * CHUNKS_PER_THREAD))
+    chunks = max(1, min(n_rows, get_num_threads() * CHUNKS_PER_THREAD))
     shape = (n_rows, n_conn)
     work = {
         "t_out": np.empty(shape + (n_loads,)),

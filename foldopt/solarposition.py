@@ -62,16 +62,7 @@ def day_times(date: dt.date, timezone, step_min: float = 1.0) -> pd.DatetimeInde
     pandas.DatetimeIndex
         Tz-aware times at the centre of each step, ``00:00 + step/2`` to ``24:00 - step/2``.
     """
-    n_steps = 24 * 60 / step_min
-    if not np.isclose(n_steps, round(n_steps)):
-        raise ValueError(f"step_min must divide 1440 min exactly, got {step_min}")
-    offsets = (np.arange(round(n_steps)) + 0.5) * step_min
-    midnight = pd.Timestamp(date)
-    naive = midnight + pd.to_timedelta(offsets, unit="min")
-    # A DST jump inside the day makes some clock times ambiguous or absent; shift, never drop.
-    return pd.DatetimeIndex(naive).tz_localize(
-        timezone, ambiguous=np.ones(len(naive), dtype=bool), nonexistent="shift_forward"
-    )
+    return clock_grid([date], timezone, step_min).times(0)
 
 
 @dataclass(frozen=True)
@@ -150,7 +141,7 @@ class ClockGrid:
 
 
 def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
-    """Interval-centred steps covering local clock days (:func:`day_times` for every date at once).
+    """Interval-centred steps covering local clock days, all at once.
 
     Parameters
     ----------
@@ -170,7 +161,7 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
         utc = naive - int(timezone.utcoffset(None).total_seconds() * 1e9)
     else:
         # One localisation for the whole grid; a DST jump makes some clock times ambiguous or
-        # absent: shift, never drop (as day_times).
+        # absent: shift, never drop.
         flat = pd.DatetimeIndex(naive.ravel().astype("datetime64[ns]")).tz_localize(
             timezone, ambiguous=np.ones(naive.size, dtype=bool), nonexistent="shift_forward"
         )

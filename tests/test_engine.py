@@ -83,16 +83,18 @@ def test_kernel_equals_the_reference_path(case):
     assert_engines_agree(results["numba"], results["numpy"])
 
 
-def test_kernel_equals_the_reference_on_a_weather_year_slice():
+@pytest.mark.parametrize("pv_model,outputs", [("single-diode", engine.OUTPUTS), ("ideal", engine.OUTPUTS),
+                                              ("b-model", ("switching", "panel"))])
+def test_kernel_equals_the_reference_on_a_weather_year_slice(pv_model, outputs):
     # Real weather: Perez diffuse light, cells at each day's air temperature (several tables).
     study = make_study({"name": "w", "mode": "exact", "site": {"latitude": 36.1, "longitude": -79.95,
                         "altitude": 273, "timezone": "UTC-05:00"}, "weather": str(TMY3), "date": "2025-01-01",
-                        "panel": {"area": 0.108}, "p_load": 2.0, "pv_model": "single-diode", "iam": "physical"})
+                        "panel": {"area": 0.108}, "p_load": 2.0, "pv_model": pv_model, "iam": "physical"})
     dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 365, 45)]
     sky = build_sky(study, [study.site] * len(dates), dates)
     assert np.unique(sky.temp_air).size > 2
     rows, orientation = _rows(study, [study.site] * len(dates), np.array([30.0, 90.0, 150.0]))
-    results = {name: engine.row_metrics(sky, study, rows, orientation, [0.5, 2.0, 4.4], outputs=engine.OUTPUTS,
+    results = {name: engine.row_metrics(sky, study, rows, orientation, [0.5, 2.0, 4.4], outputs=outputs,
                                         contiguous=True, engine=name) for name in engine.ENGINES}
     assert_engines_agree(results["numba"], results["numpy"])
 
