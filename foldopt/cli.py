@@ -18,9 +18,10 @@ from typing import Optional
 
 import numpy as np
 import typer
+import yaml
 from typer.core import TyperGroup
 
-from foldopt.config import ConfigError, default_study_path, load_plan, load_study, make_plan, parse_range
+from foldopt.config import ConfigError, default_study_path, load_plan, load_study, make_plan, parse_range, set_path
 from foldopt.report import (
     OutputExistsError,
     check_output,
@@ -225,7 +226,7 @@ _OPTION_OF_FIELD = {
     "pv_model": "--pv-model", "module": "--module", "temp_air": "--temp-air",
     "converter_efficiency": "--converter-efficiency", "year": "--year", "climate": "--climate",
     "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby", "transposition": "--transposition",
-    "objective.statistic": "--objective", "weather": "--weather",
+    "objective.statistic": "--objective", "weather": "--weather", "albedo": "--albedo", "iam": "--iam",
 }
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 
@@ -256,14 +257,18 @@ def sweep(
     efficiency: float = typer.Option(0.2, "--efficiency", help="PV efficiency (ideal model), 0..1"),
     tilt: Optional[str] = typer.Option(None, "--tilt", help="Tilt [deg]; default |latitude|"),
     azimuth: Optional[float] = typer.Option(None, "--azimuth", help="Azimuth [deg]; default facing the equator"),
-    altitude: float = typer.Option(0.0, "--altitude", help="Site altitude [m]"),
+    altitude: Optional[float] = typer.Option(None, "--altitude", help="Site altitude [m]; default 0"),
     timezone: Optional[str] = typer.Option(None, "--timezone", help="IANA name or UTC offset; default from longitude"),
     mode: str = typer.Option("exact", "--mode", help="paper | exact"),
     geometry: Optional[str] = typer.Option(None, "--geometry", help="azimuth-split | hinge; default by mode"),
     sky: str = typer.Option("meinel", "--sky", help="Clear-sky beam model: meinel | hottel"),
     climate: str = typer.Option("midlatitude-summer", "--climate", help="hottel: tropical | midlatitude-summer | "
                                 "subarctic-summer | midlatitude-winter"),
-    weather: Optional[Path] = typer.Option(None, "--weather", help="TMY3 / EPW / PVGIS TMY file (with --days year)"),
+    weather: Optional[Path] = typer.Option(
+        None, "--weather", help="TMY3 / EPW / PVGIS TMY file: its site and its whole year unless given"),
+    force_site: bool = typer.Option(False, "--force-site", help="Keep --lat/--lon far from the weather file's site"),
+    albedo: Optional[float] = typer.Option(None, "--albedo", help="Ground reflectance 0..1; default 0.2"),
+    iam: Optional[str] = typer.Option(None, "--iam", help="Incidence-angle modifier: none | ashrae | physical"),
     transposition: Optional[str] = typer.Option(None, "--transposition", help="none | isotropic | haydavies | perez"),
     objective: Optional[str] = typer.Option(None, "--objective", help="One fold angle for all days: mean | min | "
                                             "worst-month | pNN"),
@@ -281,6 +286,8 @@ def sweep(
     exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve I-V curves per step, not tables"),
     step_min: float = typer.Option(1.0, "--step-min", help="Time step [min], divides 1440"),
     angle_step: float = typer.Option(1.0, "--angle-step", help="Fold-angle sweep step [deg]"),
+    settings: Optional[list[str]] = typer.Option(
+        None, "--set", help="Any study field, KEY=VALUE (dotted keys, YAML values), e.g. --set tracker.gcr=0.4"),
     out: Optional[Path] = typer.Option(None, "--out", help="Results folder; default results/sweep-<axis>"),
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
@@ -289,24 +296,29 @@ def sweep(
 ):
     """Sweep a design variable from the command line.
 
-    angle: one site, day and load, every fold angle (sweep.csv, summary.csv). latitude, day, load:
+    angle: one site, day and load, every fold angle (sweep.csv, summary.csv); with a weather file,
+    one fold angle for the file's whole year (--objective, default mean). latitude, day, load:
     every combination of the ranges given (--lat, --days, --p-load, --tilt, --lon accept
     start:stop:step), one row per case x design in results.csv, with heat maps and curves.
     """
     _check_format(output_format, engine)
     if axis not in AXES:
         _fail([f"sweep: axis {axis!r} must be one of {', '.join(AXES)}"])
-    lat = lat if lat is not None else _DEFAULT_RANGES.get(axis)
-    days = days if days is not None else _DEFAULT_RANGES.get(axis)
+    if weather is None:
+        lat = lat if lat is not None else _DEFAULT_RANGES.get(axis)
+        days = days if days is not None else _DEFAULT_RANGES.get(axis)
+    if axis == "angle" and weather is not None and objective is None:
+        objective = "mean"  # a year of weather at one fold angle
     if axis == "load" and (p_load is None or _single(p_load)):
         _fail(["--p-load: sweep load needs a range start:stop:step or a list"])
-    site = {"latitude": lat, "longitude": lon, "altitude": altitude, "timezone": timezone}
+    site = {key: value for key, value in
+            {"latitude": lat, "longitude": lon, "altitude": altitude, "timezone": timezone}.items() if value is not None}
     panel = {"area": area, "efficiency": efficiency, "tilt": tilt, "azimuth": azimuth}
     data = {
         "name": f"sweep-{axis}",
         "year": year,
         "mode": mode,
-        "site": {key: value for key, value in site.items() if value is not None},
+        "site": site or None,  # none given: the weather file's, or an error naming the field
         "date": days,
         "panel": {key: value for key, value in panel.items() if value is not None},
         "p_load": p_load,
@@ -314,6 +326,9 @@ def sweep(
         "sky": sky,
         "climate": climate,
         "weather": str(weather) if weather is not None else None,
+        "force_site": force_site,
+        "albedo": albedo,
+        "iam": iam,
         "transposition": transposition,
         "objective": {"statistic": objective} if objective is not None else None,
         "tracker": {"model": tracker, "standby_w": tracker_standby},
@@ -330,15 +345,30 @@ def sweep(
     }
     data = {key: value for key, value in data.items() if value is not None}
     try:
+        for setting in settings or ():
+            data = _apply_setting(data, setting)
         plan = make_plan(data)
     except ConfigError as error:
         _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
-    if axis == "angle" and plan.axes:
-        _fail([f"sweep angle: one site, day and load; {', '.join(p for p, _ in plan.axes)} vary (use sweep latitude/day/load)"])
+    varied = [p for p, _ in plan.axes if not (p == "date" and plan.base.objective is not None)]
+    if axis == "angle" and varied:
+        _fail([f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep latitude/day/load)"])
     try:
         _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, quiet, output_format, engine)
     except OutputExistsError as error:
         _fail([str(error)])
+
+
+def _apply_setting(data: dict, setting: str) -> dict:
+    """``KEY=VALUE`` into the study's data: a dotted field path and a YAML value."""
+    key, separator, text = setting.partition("=")
+    if not separator or not key.strip():
+        raise ConfigError([f"--set = {setting!r}: expected KEY=VALUE, e.g. tracker.gcr=0.4"])
+    try:
+        value = yaml.safe_load(text)
+    except yaml.YAMLError:
+        raise ConfigError([f"--set {key} = {text!r}: not a YAML value"]) from None
+    return set_path(data, key.strip(), value)
 
 
 def _single(text: str) -> bool:

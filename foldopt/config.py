@@ -35,9 +35,11 @@ from foldopt.geometry import GEOMETRIES, default_orientation
 from foldopt.pvmodel import PV_MODELS, TEMPERATURE_MODELS, cec_module
 from foldopt.solarposition import MODES
 from foldopt.tracker import ALEXANDRU_STEP_OFFSETS_H, DRIVES, TRACKERS
-from foldopt.weather import CLEAR_SKIES
+from foldopt.weather import CLEAR_SKIES, weather_site
 
 DEFAULT_STUDY = "shin2015"
+SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
+EARTH_RADIUS_KM = 6371.0
 _OFFSET = re.compile(r"^(?:UTC)?([+-])(\d{1,2})(?::?(\d{2}))?$")
 
 
@@ -61,6 +63,15 @@ def _interval(lo, hi, *, lo_open=False, hi_open=False, unit=""):
         return value
 
     return Annotated[float, AfterValidator(check)]
+
+
+def great_circle_km(latitude_1, longitude_1, latitude_2, longitude_2) -> float:
+    """Distance between two points on a spherical Earth [km] (haversine)."""
+    phi_1, phi_2 = math.radians(latitude_1), math.radians(latitude_2)
+    half_dphi = (phi_2 - phi_1) / 2
+    half_dlambda = math.radians(longitude_2 - longitude_1) / 2
+    a = math.sin(half_dphi) ** 2 + math.cos(phi_1) * math.cos(phi_2) * math.sin(half_dlambda) ** 2
+    return 2 * EARTH_RADIUS_KM * math.asin(min(1.0, math.sqrt(a)))
 
 
 def parse_timezone(name: str) -> dt.tzinfo:
@@ -198,7 +209,8 @@ class Study(_Strict):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=100)]
     description: str = ""
     mode: Literal[MODES] = "exact"
-    site: Site
+    site: Site = Field(description="default with a weather file: the file's own site")
+    force_site: bool = Field(False, description="keep a site more than SITE_TOLERANCE_KM from the weather file's")
     date: dt.date
     panel: Panel
     p_load: _interval(0, 1e6, lo_open=True, unit=" W")
@@ -236,12 +248,37 @@ class Study(_Strict):
     def _weather_by_path(cls, value):
         return {"path": value} if isinstance(value, str) else value
 
+    @model_validator(mode="before")
+    @classmethod
+    def _site_from_weather(cls, data):
+        """A weather file brings its site: the study's unless one is given."""
+        if isinstance(data, dict) and data.get("site") is None and data.get("weather") is not None:
+            weather = data["weather"]
+            path, fmt = (weather, None) if isinstance(weather, str) else (weather.get("path"), weather.get("format"))
+            if isinstance(path, str) and Path(path).is_file():
+                try:
+                    data = {**data, "site": weather_site(path, fmt)}
+                except (ValueError, KeyError, OSError):
+                    pass  # an unreadable file is reported where it is read
+        return data
+
     @model_validator(mode="after")
-    def _paper_mode_is_beam_only(self):
+    def _consistent(self):
         if self.mode == "paper" and self.transposition not in (None, "none"):
             raise ValueError("paper mode is beam-only (Shin et al. Eq. 5): transposition must be none")
         if self.weather is not None and not Path(self.weather.path).is_file():
             raise ValueError(f"weather: file not found: {self.weather.path}")
+        if self.weather is not None and not self.force_site:
+            file_site = weather_site(self.weather.path, self.weather.format)
+            distance = great_circle_km(self.site.latitude, self.site.longitude, file_site["latitude"],
+                                       file_site["longitude"])
+            if distance > SITE_TOLERANCE_KM:
+                name = f"{file_site['name']} " if file_site["name"] else ""
+                raise ValueError(
+                    f"site ({self.site.latitude:g}, {self.site.longitude:g}) is {distance:,.0f} km from the weather "
+                    f"file's site {name}({file_site['latitude']:g}, {file_site['longitude']:g}); leave the site out "
+                    f"to use the file's, or set force_site to keep it"
+                )
         return self
 
     def sky_transposition(self) -> str:
@@ -386,7 +423,7 @@ def _leap(year: int) -> bool:
     return year % 4 == 0 and (year % 100 != 0 or year % 400 == 0)
 
 
-def _set_path(data: dict, path: str, value) -> dict:
+def set_path(data: dict, path: str, value) -> dict:
     """A copy of ``data`` with the dotted ``path`` set to ``value``."""
     out = copy.deepcopy(data)
     node = out
@@ -423,7 +460,7 @@ class Plan:
     def study(self, choice: dict) -> Study:
         data = self.data
         for path, value in choice.items():
-            data = _set_path(data, path, value)
+            data = set_path(data, path, value)
         return Study.model_validate(data)
 
     def cases(self):
@@ -465,13 +502,15 @@ def make_plan(data, lines: dict | None = None) -> Plan:
 
     Any field may hold a list (``site``: a list of sites) or a numeric range ``"start:stop:step"``;
     ``date`` also takes a date range, ``year`` or ``equinoxes-solstices`` (of ``year``, default
-    2025). The ``sweep:`` section maps dotted field paths to lists or ranges. Each becomes an axis.
+    2025), and is the whole ``year`` by default with a weather file. The ``sweep:`` section maps dotted field paths to lists or ranges. Each becomes an axis.
     ``lines`` maps key paths to YAML line numbers, added to the messages.
     """
     lines = lines or {}
     if not isinstance(data, dict):
         raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
     data = dict(data)
+    if data.get("weather") is not None and "date" not in data:
+        data["date"] = "year"  # a weather file is a year
     errors: list[str] = []
     year = data.pop("year", 2025)
     if not isinstance(year, int) or isinstance(year, bool) or not 1901 <= year <= 2099:

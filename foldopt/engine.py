@@ -51,12 +51,16 @@ class RowMetrics:
         (n_rows, n_outputs) harvested energy [Wh].
     peak : numpy.ndarray
         (n_rows, n_outputs) peak power [W].
+    irradiation : numpy.ndarray or None
+        (n_rows,) plane-of-array irradiation [Wh/m^2], the mean of the two sub-panels (rows of
+        orientations; None for given power curves).
     """
 
     t_solar: np.ndarray
     t_solar_contiguous: np.ndarray | None
     energy: np.ndarray
     peak: np.ndarray
+    irradiation: np.ndarray | None = None
 
 
 def electrical_settings(study: Study, temp_air: float) -> dict:
@@ -121,7 +125,7 @@ def flat_orientation(panel_tilt, panel_azimuth) -> np.ndarray:
     return np.stack([tilt, azimuth, tilt, azimuth], axis=-1)
 
 
-def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool = False):
+def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool = False, incident: bool = False):
     """Plane-of-array irradiance [W/m^2] of surfaces over blocks of a sky (the reference path).
 
     Parameters
@@ -136,6 +140,9 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
     paper : bool
         The beam by Shin et al.'s Eq. 5 instead of the angle of incidence (fixed panels in paper
         mode; a tracker always takes the exact incidence).
+    incident : bool
+        The light incident on the surface, before the sky's incidence-angle modifier (the
+        default is what reaches the cells).
 
     Returns
     -------
@@ -148,8 +155,8 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
     cos_aoi = np.sum(normal * sky.sun_vector[blocks], axis=-1)  # pvlib's aoi_projection (tested)
     factor = beam_incidence_factor(tilt, azimuth, zenith, solar_azimuth, model="paper") if paper else None
     terms = None if sky.terms is None else sky.terms[blocks]
-    return plane_of_array(cos_aoi, normal[..., 2], sky.dni[blocks], terms, factor,
-                          iam_modifier(sky.iam, tilt, azimuth, zenith, solar_azimuth))
+    modifier = 1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, zenith, solar_azimuth)
+    return plane_of_array(cos_aoi, normal[..., 2], sky.dni[blocks], terms, factor, modifier)
 
 
 def panel_power(sky: Sky, study: Study, poa_global, area: float | None = None):
@@ -251,7 +258,7 @@ def _in_caller_order(result: RowMetrics, order, row_loadset) -> RowMetrics:
     contiguous = result.t_solar_contiguous
     return RowMetrics(_unsort(result.t_solar, order, row_loadset),
                       None if contiguous is None else _unsort(contiguous, order, row_loadset),
-                      result.energy, result.peak)
+                      result.energy, result.peak, result.irradiation)
 
 
 def _curve_reference(power, row_loads, step_hours, contiguous):
@@ -276,7 +283,8 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
     Returns
     -------
     powers : dict of numpy.ndarray
-        (k or n_blocks, n_steps) per name of :data:`OUTPUTS`.
+        (k or n_blocks, n_steps) per name of :data:`OUTPUTS`, and ``poa``, the two sub-panels'
+        mean incident plane-of-array irradiance [W/m^2] (before the incidence-angle modifier).
     state : numpy.ndarray or None
         The state switching chose (``with_state``).
     """
@@ -288,6 +296,9 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
     out, state = {}, np.zeros(poa_east.shape, dtype=np.int64) if with_state else None
     # Blocks whose cells see other air temperatures take other tables (weather studies).
     groups = [slice(None)] if np.all(temps == temps[0]) else [temps == temp for temp in np.unique(temps)]
+    out["poa"] = 0.5 * (poa_east + poa_west) if sky.iam == "none" else 0.5 * sum(
+        poa(sky, orientation[:, 2 * side, None], orientation[:, 2 * side + 1, None], blocks, paper, incident=True)
+        for side in (0, 1))
     for rows in groups:
         electrical = electrical_for(study, temps[rows][0] if not isinstance(rows, slice) else temps[0])
         part, part_state = electrical.connections(poa_east[rows], poa_west[rows], series, with_state)
@@ -303,12 +314,13 @@ def _reference(sky, study, row_block, orientation, loads, row_loadset, outputs, 
     n_rows, n_loads = row_block.size, loads.shape[1]
     shape = (n_rows, len(outputs))
     out = RowMetrics(np.zeros(shape + (n_loads,)), np.zeros(shape + (n_loads,)) if contiguous else None,
-                     np.zeros(shape), np.zeros(shape))
+                     np.zeros(shape), np.zeros(shape), np.zeros(n_rows))
     series = "series" in outputs or study.switch_series
     step = sky.step_hours
     for block in np.unique(row_block):
         rows = np.flatnonzero(row_block == block)
         curves, _ = powers(sky, study, orientation[rows], [block], series)
+        out.irradiation[rows] = energy(curves["poa"], step)
         for index, name in enumerate(outputs):
             hours, runs, harvested, peak = _curve_reference(curves[name], loads[row_loadset[rows]], step, contiguous)
             out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = hours, harvested, peak
@@ -365,7 +377,7 @@ def _compiled(sky, study, electricals, block_table, row_block, orientation, load
         contiguous, **work,
     )
     return RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
-                      work["peak_out"])
+                      work["peak_out"], work["irradiation_out"])
 
 
 def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous: bool = False,

@@ -192,7 +192,9 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
                  iam_params, table_1d, table_parallel, table_series, linear_power, panel_scale, bypass, switch_series,
                  converter_efficiency, connections, irradiance, buffer):
     """Every asked connection's power [W] of row ``r`` (over block ``b``) at steps
-    ``first..last``, into ``buffer[c, step]``.
+    ``first..last``, into ``buffer[c, step]``; returns the sum over those steps of the two
+    sub-panels' mean incident plane-of-array irradiance [W/m^2] (before the incidence-angle
+    modifier).
 
     Two loops: the first, free of table look-ups so that it vectorises, gives both sub-panels'
     irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) into ``irradiance``; the
@@ -209,6 +211,7 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
     w_sin_tilt = math.sqrt(max(1.0 - wz * wz, 0.0))
     to_root = 1.0 / IRRADIANCE_MAX
     sx, sy, sz, dni = sun[b, 0], sun[b, 1], sun[b, 2], beam[b]
+    irradiation = 0.0
     for s in range(first, last + 1):
         cos_east = ex * sx[s] + ey * sy[s] + ez * sz[s]
         cos_west = wx * sx[s] + wy * sy[s] + wz * sz[s]
@@ -221,15 +224,18 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
         else:
             f_east, f_west = max(cos_east, 0.0), max(cos_west, 0.0)
         g_east, g_west = dni[s] * f_east, dni[s] * f_west
+        d_east = d_west = 0.0
+        if has_terms:
+            iso, circ, hor, ground = terms[b, 0, s], terms[b, 1, s], terms[b, 2, s], terms[b, 3, s]
+            d_east = (max(iso * (1.0 + ez) * 0.5 + circ * max(cos_east, 0.0) + hor * e_sin_tilt, 0.0)
+                      + ground * (1.0 - ez) * 0.5)
+            d_west = (max(iso * (1.0 + wz) * 0.5 + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
+                      + ground * (1.0 - wz) * 0.5)
+        irradiation += 0.5 * (g_east + d_east + g_west + d_west)
         if iam_model != IAM_NONE:
             g_east *= iam_factor(cos_east, iam_model, iam_params)
             g_west *= iam_factor(cos_west, iam_model, iam_params)
-        if has_terms:
-            iso, circ, hor, ground = terms[b, 0, s], terms[b, 1, s], terms[b, 2, s], terms[b, 3, s]
-            g_east += (max(iso * (1.0 + ez) * 0.5 + circ * max(cos_east, 0.0) + hor * e_sin_tilt, 0.0)
-                       + ground * (1.0 - ez) * 0.5)
-            g_west += (max(iso * (1.0 + wz) * 0.5 + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
-                       + ground * (1.0 - wz) * 0.5)
+        g_east, g_west = g_east + d_east, g_west + d_west
         if tables:
             g_east = math.sqrt(min(max(g_east, 0.0), IRRADIANCE_MAX) * to_root)
             g_west = math.sqrt(min(max(g_west, 0.0), IRRADIANCE_MAX) * to_root)
@@ -260,13 +266,15 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
         for c in range(n_conn):
             buffer[c, s] = _connection_power(connections[c], p_east, p_west, p_parallel, p_series, p_panel,
                                              converter_efficiency, switch_series)
+    return irradiation
 
 
 @njit(cache=True, parallel=True)
 def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_normal, row_paper, row_loadset,
               paper_incidence, iam_model, iam_params, table_1d, table_parallel, table_series, linear_power,
               panel_scale, bypass, switch_series, converter_efficiency, connections, loads, step_hours,
-              contiguous, t_out, cont_out, energy_out, peak_out, irradiance, buffer, above, whole, run):
+              contiguous, t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance, buffer, above, whole,
+              run):
     """Daily metrics of every row and connection, computing the power on the fly.
 
     Parameters
@@ -309,6 +317,9 @@ def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_nor
         t_solar and its longest contiguous interval [h] (out).
     energy_out, peak_out : (n_rows, n_conn) float
         Energy [Wh] and peak power [W] (out).
+    irradiation_out : (n_rows,) float
+        Incident plane-of-array irradiation [Wh/m^2] (before the incidence-angle modifier), the
+        mean of the two (equal) sub-panels (out).
     irradiance, buffer, above, whole, run : per-chunk scratch from :func:`scratch`.
     """
     n_rows = row_block.shape[0]
@@ -319,10 +330,11 @@ def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_nor
             b = row_block[r]
             tab = block_table[b]
             first, last = span[b, 0], span[b, 1]
-            _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, paper_incidence,
-                         iam_model, iam_params, table_1d[tab], table_parallel[tab], table_series[tab], linear_power,
-                         panel_scale, bypass, switch_series, converter_efficiency, connections, irradiance[k],
-                         buffer[k])
+            irradiation = _fold_powers(
+                r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, paper_incidence, iam_model,
+                iam_params, table_1d[tab], table_parallel[tab], table_series[tab], linear_power, panel_scale, bypass,
+                switch_series, converter_efficiency, connections, irradiance[k], buffer[k])
+            irradiation_out[r] = irradiation * step_hours
             for c in range(connections.shape[0]):
                 energy_out[r, c], peak_out[r, c] = _metrics(
                     buffer[k, c], first, last, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
@@ -359,6 +371,7 @@ def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):
         "run": np.zeros((chunks, n_loads if contiguous else 1, 2)),
     }
     if n_steps:
+        work["irradiation_out"] = np.empty(n_rows)
         work["irradiance"] = np.zeros((chunks, 2, n_steps))
         work["buffer"] = np.zeros((chunks, n_conn, n_steps))
     return work

@@ -433,21 +433,96 @@ def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool =
 THRESHOLDS_H = (2, 4, 6, 8, 10, 12)
 
 
-def annual_summary(table: pd.DataFrame) -> pd.DataFrame:
-    """Per design and load: mean, percentiles and minimum of daily t_solar, the days reaching
-    each of :data:`THRESHOLDS_H`, and monthly means."""
+def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitude", "p_load_w")) -> pd.DataFrame:
+    """Per case (``cases``: the columns that tell one case from another, but the date) and design:
+
+    - daily t_solar: mean, p10, p50, p90 and minimum, the days reaching each of
+      :data:`THRESHOLDS_H`, and monthly means [h];
+    - the totals over the days: energy harvested, served and wasted [Wh] and plane-of-array
+      irradiation [kWh/m^2];
+    - each design's gain over the case's flat panel and share of its tracker, in energy
+      harvested and in mean daily t_solar (served energy is the load times t_solar, so it moves
+      with the time) [%].
+    """
     table = table.assign(month=pd.to_datetime(table["date"]).dt.month)
-    keys = [c for c in ("site_name", "latitude", "p_load_w", "design") if c in table]
+    cases = [c for c in cases if c in table]
+    keys = cases + ["design"]
     rows = []
     for key, group in table.groupby(keys, sort=False):
         hours = group["t_solar_h"]
         row = dict(zip(keys, key if isinstance(key, tuple) else (key,), strict=True))
         row.update(days=len(group), fold_angle_deg=group["fold_angle_deg"].iloc[0], mean_h=hours.mean(),
-                   p10_h=hours.quantile(0.1), p50_h=hours.median(), p90_h=hours.quantile(0.9), min_h=hours.min())
+                   energy_harvested_wh=group["energy_wh"].sum(), energy_served_wh=group["energy_served_wh"].sum(),
+                   energy_wasted_wh=group["energy_wasted_wh"].sum())
+        if "poa_kwh_m2" in group:
+            row["poa_kwh_m2"] = group["poa_kwh_m2"].sum()
+        row.update(p10_h=hours.quantile(0.1), p50_h=hours.median(), p90_h=hours.quantile(0.9), min_h=hours.min())
         row.update({f"days_ge_{x}h": int((hours >= x).sum()) for x in THRESHOLDS_H})
         row.update({f"month_{m:02d}_mean_h": v for m, v in group.groupby("month")["t_solar_h"].mean().items()})
         rows.append(row)
-    return pd.DataFrame(rows)
+    summary = pd.DataFrame(rows)
+    for reference, gain in (("flat", "gain_vs_flat_pct"), ("tracker", "pct_of_tracker")):
+        base = summary[summary["design"] == reference].set_index(cases)[["energy_harvested_wh", "mean_h"]]
+        matched = base.reindex(pd.MultiIndex.from_frame(summary[cases]) if len(cases) > 1 else summary[cases[0]])
+        energy = summary["energy_harvested_wh"].to_numpy() / matched["energy_harvested_wh"].to_numpy()
+        time = summary["mean_h"].to_numpy() / matched["mean_h"].to_numpy()
+        with np.errstate(divide="ignore", invalid="ignore"):
+            summary[f"energy_{gain}"] = (energy - 1.0) * 100.0 if reference == "flat" else energy * 100.0
+            summary[f"t_solar_{gain}"] = (time - 1.0) * 100.0 if reference == "flat" else time * 100.0
+    return summary
+
+
+def plot_annual_fold_angles(by_angle: pd.DataFrame, path: Path, title: str) -> None:
+    """The objective and the mean daily t_solar of one fold angle kept all year, per load."""
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for (load, rows), colour in zip(by_angle.groupby("p_load_w"), plt.cm.viridis(np.linspace(0, 0.85, 8)),
+                                    strict=False):
+        ax.plot(rows["fold_angle_deg"], rows["mean_t_solar_h"], color=colour, label=f"mean, P_load {load:g} W")
+        ax.plot(rows["fold_angle_deg"], rows["objective_h"], color=colour, ls="--", lw=1, label="objective")
+        chosen = rows[rows["chosen"]]
+        ax.plot(chosen["fold_angle_deg"], chosen["objective_h"], "o", color=colour)
+    ax.set_xlabel("fold angle Θ kept all year [deg] (180 = flat)")
+    ax.set_ylabel("daily t_solar [h]")
+    ax.set_xlim(0, 180)
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    _save(fig, path)
+
+
+MONTH_NAMES = ("J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D")
+
+
+def plot_monthly(table: pd.DataFrame, path: Path, title: str, loads_at_most: int = 4) -> None:
+    """Monthly energy harvested and mean daily t_solar of every design, side by side, a row per
+    load (the first case's site)."""
+    table = table.assign(month=pd.to_datetime(table["date"]).dt.month)
+    first = table.iloc[0]
+    for column in ("site_name", "latitude", "longitude"):
+        if column in table:
+            table = table[table[column] == first[column]]
+    loads = sorted(table["p_load_w"].unique())[:loads_at_most]
+    designs = [d for d in ("flat", "twofold", "tracker", "tracker-net") if d in set(table["design"])]
+    colours = {"flat": "0.35", "twofold": "tab:blue", "tracker": "0.7", "tracker-net": "tab:orange"}
+    fig, axes = plt.subplots(len(loads), 2, figsize=(11, 3.2 * len(loads)), squeeze=False)
+    width = 0.8 / len(designs)
+    for (energy_ax, time_ax), load in zip(axes, loads, strict=True):
+        rows = table[table["p_load_w"] == load]
+        for i, design in enumerate(designs):
+            monthly = rows[rows["design"] == design].groupby("month")
+            x = np.asarray(monthly.size().index) + (i - (len(designs) - 1) / 2) * width
+            energy_ax.bar(x, monthly["energy_wh"].sum() / 1000.0, width, color=colours[design], label=design)
+            time_ax.bar(x, monthly["t_solar_h"].mean(), width, color=colours[design], label=design)
+        energy_ax.set_ylabel("energy harvested [kWh]")
+        time_ax.set_ylabel(f"mean daily t_solar [h]\nP_load {load:g} W")
+        for ax in (energy_ax, time_ax):
+            ax.set_xticks(range(1, 13), MONTH_NAMES)
+            ax.grid(alpha=0.3, axis="y")
+    axes[0, 0].legend(fontsize=8)
+    axes[0, 0].set_title("energy harvested per month", fontsize=10)
+    axes[0, 1].set_title("mean daily t_solar per month", fontsize=10)
+    fig.suptitle(title, fontsize=10)
+    _save(fig, path)
 
 
 def plot_distribution(table: pd.DataFrame, path: Path, title: str) -> None:
@@ -494,10 +569,18 @@ def plot_day_hour(extras: dict, key: str, path: Path, title: str, label: str) ->
 def annual_outputs(result, folder: Path, name: str) -> list[str]:
     """``annual_summary.csv`` and the annual plots of a study that varies the date."""
     table = result.table
-    annual_summary(table).to_csv(folder / "annual_summary.csv", index=False, float_format=FLOAT_FORMAT)
+    cases = [c for c in result.varied if c not in ("date", "day_of_year")]
+    annual_summary(table, cases or ("p_load_w",)).to_csv(folder / "annual_summary.csv", index=False,
+                                                           float_format=FLOAT_FORMAT)
     plot_distribution(table, folder / "daily_t_solar_distribution.png", f"{name}: daily t_solar per design")
-    written = ["annual_summary.csv", "daily_t_solar_distribution.png"]
+    plot_monthly(table, folder / "monthly_energy_t_solar.png", f"{name}: every design month by month")
+    written = ["annual_summary.csv", "daily_t_solar_distribution.png", "monthly_energy_t_solar.png"]
     if result.extras:
+        by_angle = result.extras["by_angle"]
+        by_angle.to_csv(folder / "annual_fold_angles.csv", index=False, float_format=FLOAT_FORMAT)
+        plot_annual_fold_angles(by_angle, folder / "annual_t_solar_vs_fold_angle.png",
+                                f"{name}: the year at each fold angle ({result.plan.base.objective.statistic})")
+        written += ["annual_fold_angles.csv", "annual_t_solar_vs_fold_angle.png"]
         angle = result.extras["fold_angle"]
         plot_day_hour(result.extras, "p_twofold_w", folder / "day_hour_power.png",
                       f"{name}: twofold power at {angle:g}° (first load)", "P_pv [W]")

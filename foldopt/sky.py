@@ -22,7 +22,7 @@ from foldopt.config import Study, parse_timezone
 from foldopt.geometry import normal_vector
 from foldopt.irradiance import sky_diffuse_terms
 from foldopt.solarposition import ClockGrid, clock_grid, solar_position_grid
-from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, weather_days
+from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, sub_hourly, weather_days, weather_site
 
 @dataclass(frozen=True)
 class Sky:
@@ -47,6 +47,9 @@ class Sky:
     latitude : numpy.ndarray
         (n_blocks,) [deg north].
     iam : {'none', 'ashrae', 'physical'}
+    weather_balance : dict or None
+        With a weather file: per component (``dni``, ``ghi``, ``dhi``), the file's summed interval
+        means and what the steps keep of them [W/m^2 x intervals] (:func:`foldopt.weather.sub_hourly`).
     """
 
     grid: ClockGrid
@@ -63,6 +66,7 @@ class Sky:
     temp_air: np.ndarray
     latitude: np.ndarray
     iam: str
+    weather_balance: dict | None = None
 
     @property
     def n_blocks(self) -> int:
@@ -93,35 +97,74 @@ class Sky:
         take = {name: None if getattr(self, name) is None else getattr(self, name)[keep]
                 for name in ("solar_zenith", "solar_azimuth", "hour_angle", "declination", "sun_vector", "dni",
                              "ghi", "dhi", "terms", "temp_air", "latitude")}
-        return Sky(grid=grid, mode=self.mode, iam=self.iam, **take)
+        return Sky(grid=grid, mode=self.mode, iam=self.iam, weather_balance=self.weather_balance, **take)
 
 
-def _weather_grid(study: Study, dates):
-    """Clock grid, light and cell air temperature of each date from the study's weather file."""
-    weather, columns = study.weather, ("dni", "ghi", "dhi", "temp_air")
-    pieces = []
+def _clock(sites, dates, step_min) -> ClockGrid:
+    """One clock grid for every block, one localisation per time zone, blocks in their order."""
+    zones: dict[str, list[int]] = {}
+    for index, site in enumerate(sites):
+        zones.setdefault(site.timezone, []).append(index)
+    parts = [clock_grid([dates[i] for i in members], parse_timezone(zone), step_min) for zone, members in zones.items()]
+    order = np.argsort(np.concatenate(list(zones.values())), kind="stable")
+    stacked = ClockGrid.stack(parts)
+    return ClockGrid(stacked.utc_ns[order], stacked.utc_offset_ns[order],
+                     tuple(stacked.timezones[i] for i in order), stacked.step_hours)
+
+
+def _clear_sky(grid: ClockGrid, zenith, sites, model: str, linke_turbidity) -> dict:
+    """pvlib's clear sky at every step, one call per site (its blocks' steps together)."""
+    light = {key: np.empty_like(zenith) for key in ("dni", "ghi", "dhi")}
+    groups: dict[tuple, list[int]] = {}
+    for index, site in enumerate(sites):
+        groups.setdefault((site.latitude, site.longitude, site.altitude, site.timezone), []).append(index)
+    for (latitude, longitude, altitude, zone), members in groups.items():
+        times = pd.DatetimeIndex(grid.utc_ns[members].ravel().astype("datetime64[ns]"), tz="UTC").tz_convert(
+            parse_timezone(zone))
+        sky = clear_sky(times, zenith[members].ravel(), latitude, longitude, altitude, model, linke_turbidity)
+        for key in light:
+            light[key][members] = sky[key].reshape(len(members), -1)
+    return light
+
+
+def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict):
+    """Light at every step of the grid from the study's weather file (:func:`foldopt.weather.sub_hourly`
+    against the clear sky), the cell air temperature of each day, and how much of the file's
+    irradiation the steps keep."""
+    weather = study.weather
+    columns = ("dni", "ghi", "dhi", "temp_air")
+    hourly = {key: np.empty((len(dates), 0)) for key in columns}
+    starts = np.empty((len(dates), 0), dtype=np.int64)
     # The file is coerced to each date's year: read once per year, the days picked as arrays.
     for year in sorted({date.year for date in dates}):
         positions = [i for i, date in enumerate(dates) if date.year == year]
         frame = read_weather(weather.path, weather.format, year, weather.label)
         rows = weather_days(frame, [dates[i] for i in positions])
         index = pd.DatetimeIndex(frame.index)
-        pieces.append((positions, index.tz_convert("UTC").tz_localize(None).as_unit("ns").asi8[rows],
-                       index.tz_localize(None).as_unit("ns").asi8[rows],
-                       {key: frame[key].to_numpy(dtype=float)[rows] for key in columns}, index.tz))
-    order = np.argsort(np.concatenate([piece[0] for piece in pieces]), kind="stable")
-
-    def gather(parts):
-        return np.concatenate(parts)[order]
-
-    utc, local = gather([piece[1] for piece in pieces]), gather([piece[2] for piece in pieces])
-    light = {key: gather([piece[3][key] for piece in pieces]) for key in columns}
-    step_hours = float(np.median(np.diff(utc[0]))) / 3.6e12 if utc.shape[1] > 1 else 24.0
-    grid = ClockGrid(utc, local - utc, (pieces[0][4],) * len(dates), step_hours)
+        centres = index.tz_localize(None).as_unit("ns").asi8[rows]
+        interval = int(np.median(np.diff(index.as_unit("ns").asi8)))
+        if starts.shape[1] == 0:
+            starts = np.zeros((len(dates), rows.shape[1]), dtype=np.int64)
+            hourly = {key: np.zeros((len(dates), rows.shape[1])) for key in columns}
+        starts[positions] = centres - interval // 2
+        for key in columns:
+            hourly[key][positions] = frame[key].to_numpy(dtype=float)[rows]
+    step_ns = round(grid.step_hours * 3.6e12)
+    day_start = grid.local_ns[:, :1] - step_ns // 2
+    per_interval = interval // step_ns
+    if interval % step_ns or not np.array_equal(starts, day_start + np.arange(starts.shape[1]) * interval):
+        raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must divide the file's "
+                         f"intervals ({interval / 6e10:g} min), which must start at the day's midnight")
+    light, balance = {}, {}
+    # The diffuse light of a cloudy sky is far above a clear sky's; it follows the sun like the
+    # clear sky's global light does, which is its shape here.
+    for key, shape in (("dni", "dni"), ("ghi", "ghi"), ("dhi", "ghi")):
+        light[key], placed = sub_hourly(hourly[key], clear[shape], per_interval)
+        balance[key] = (float(hourly[key].sum()), float(placed.sum()))
     # Cells follow each day's mean air temperature (the electrical tables assume one per day),
     # rounded to 5 C so that days share their tables; wind stays the study's.
-    temp_air = np.round(light.pop("temp_air").mean(axis=1) / 5.0) * 5.0
-    return grid, light, temp_air
+    temp_air = np.round(hourly["temp_air"].mean(axis=1) / 5.0) * 5.0
+    return light, temp_air, balance
 
 
 def build_sky(study: Study, sites, dates) -> Sky:
@@ -144,34 +187,23 @@ def build_sky(study: Study, sites, dates) -> Sky:
     sites = [site.resolved() for site in sites]
     if len(sites) != len(dates):
         raise ValueError(f"{len(sites)} sites for {len(dates)} dates")
+    if study.weather is not None:
+        # A weather file's days are on its own clock, whatever time zone the site names.
+        zone = weather_site(study.weather.path, study.weather.format)["timezone"]
+        sites = [site.model_copy(update={"timezone": zone}) for site in sites]
     latitude = np.array([site.latitude for site in sites], dtype=float)[:, None]
     longitude = np.array([site.longitude for site in sites], dtype=float)[:, None]
     altitude = np.array([site.altitude for site in sites], dtype=float)[:, None]
-    light = {}
-    if study.weather is not None:
-        grid, light, temp_air = _weather_grid(study, dates)
-    else:
-        # One localisation per time zone, blocks back in their order.
-        zones: dict[str, list[int]] = {}
-        for index, site in enumerate(sites):
-            zones.setdefault(site.timezone, []).append(index)
-        parts = [clock_grid([dates[i] for i in members], parse_timezone(zone), study.step_min)
-                 for zone, members in zones.items()]
-        order = np.argsort(np.concatenate(list(zones.values())), kind="stable")
-        stacked = ClockGrid.stack(parts)
-        grid = ClockGrid(stacked.utc_ns[order], stacked.utc_offset_ns[order],
-                         tuple(stacked.timezones[i] for i in order), stacked.step_hours)
-        temp_air = np.full(len(sites), float(study.temp_air))
+    grid = _clock(sites, dates, study.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
     zenith = sun["solar_zenith"]
-    if study.weather is None and study.sky in CLEAR_SKIES:
-        light = {key: np.empty_like(zenith) for key in ("dni", "ghi", "dhi")}
-        for index, site in enumerate(sites):
-            sky = clear_sky(grid.times(index), zenith[index], site.latitude, site.longitude, site.altitude, study.sky,
-                            study.linke_turbidity)
-            for key in light:
-                light[key][index] = sky[key]
-    elif study.weather is None:
+    temp_air, balance = np.full(len(sites), float(study.temp_air)), None
+    if study.weather is not None:
+        clear = _clear_sky(grid, zenith, sites, "ineichen", study.linke_turbidity)
+        light, temp_air, balance = _weather_light(study, grid, dates, clear)
+    elif study.sky in CLEAR_SKIES:
+        light = _clear_sky(grid, zenith, sites, study.sky, study.linke_turbidity)
+    else:
         beam_altitude = altitude if study.mode == "exact" else 0.0
         light = {"dni": clear_sky_dni(zenith, beam_altitude, study.sky, dayofyear=grid.day_of_year,
                                       climate=study.climate)}
@@ -191,5 +223,5 @@ def build_sky(study: Study, sites, dates) -> Sky:
         grid=grid, mode=study.mode, solar_zenith=zenith, solar_azimuth=sun["solar_azimuth"],
         hour_angle=sun["hour_angle"], declination=np.ascontiguousarray(sun["declination"]),
         sun_vector=normal_vector(zenith, sun["solar_azimuth"]), dni=dni, ghi=ghi, dhi=dhi, terms=terms,
-        temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam,
+        temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam, weather_balance=balance,
     )

@@ -21,7 +21,7 @@ import pandas as pd
 
 from foldopt import engine as engines
 from foldopt.config import Plan, Study
-from foldopt.metrics import metric_columns
+from foldopt.metrics import energy, metric_columns
 from foldopt.sky import Sky, build_sky
 from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
 
@@ -145,6 +145,7 @@ def _design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str
                                outputs=("panel",), contiguous=True, engine=engine)
     orientation = sky_tracker_orientation(sky, study)
     gross = sky_tracker_power(sky, study, orientation)
+    tracker_poa = energy(engines.poa(sky, *orientation, incident=True), sky.step_hours)
     net = gross - sky_tracker_draw(sky, study, orientation)
     trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
                                      engine=engine)
@@ -168,6 +169,8 @@ def _design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str
                        np.repeat(trackers.peak, n_loads, axis=1)),
             loads[None, :, None],
         ),
+        "poa_kwh_m2": per_design(twofold.irradiation, np.repeat(flat.irradiation[:, None], n_loads, axis=1),
+                                 np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
         "sun_up": np.broadcast_to(np.any(sky.dni > 0, axis=1)[:, None, None], hours.shape),
     }
 
@@ -268,7 +271,8 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine):
         daily.append(hours)
         advance(len(blocks[part]))
     months = [date.month for date in blocks.dates]
-    score = objective_value(np.concatenate(daily).transpose(0, 2, 1), months, objective.statistic, objective.months)
+    daily = np.concatenate(daily).transpose(0, 2, 1)  # (days, loads, angles)
+    score = objective_value(daily, months, objective.statistic, objective.months)
     fixed = _best_angle_index(score)  # (n_loads,)
     metrics, series = [], {"p_twofold_w": [], "switch_state": []}
     study = blocks.study
@@ -284,7 +288,12 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine):
         advance(len(chunk))
     clock = skies[0].grid.clock_hours[0]
     extras = {"dates": list(blocks.dates), "hours": clock, "fold_angle": float(angles[fixed[0]]),
-              **{key: np.concatenate(value) for key, value in series.items()}}
+              **{key: np.concatenate(value) for key, value in series.items()},
+              "by_angle": pd.DataFrame({
+                  "p_load_w": np.repeat(loads, angles.size), "fold_angle_deg": np.tile(angles, loads.size),
+                  "objective_h": score.ravel(), "mean_t_solar_h": daily.mean(axis=0).ravel(),
+                  "min_t_solar_h": daily.min(axis=0).ravel(), "chosen": np.ravel(np.arange(angles.size) == fixed[:, None]),
+              })}
     return {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}, extras
 
 

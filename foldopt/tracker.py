@@ -99,21 +99,33 @@ def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declinat
     -------
     surface_tilt, surface_azimuth : numpy.ndarray
         [deg] per time step.
+
+    Notes
+    -----
+    While the sun is below the horizon a tracker rests in its stow position: the ideal and the
+    equatorial trackers horizontal (facing the equator's side), the step-law tracker at its
+    morning position (Alexandru's open-loop law returns there at night), the single-axis tracker
+    flat along its axis (pvlib returns no angle then).
     """
     options = options or TrackerOptions()
     zenith = np.asarray(solar_zenith, dtype=float)
-    if model == "dual-axis":
-        return zenith.copy(), np.asarray(solar_azimuth, dtype=float).copy()
+    down = zenith >= 90.0
     north = np.asarray(latitude) >= 0
+    level_azimuth = np.where(north, 180.0, 0.0)
+    if model == "dual-axis":
+        azimuth = np.asarray(solar_azimuth, dtype=float)
+        return np.where(down, 0.0, zenith), np.where(down, level_azimuth, azimuth)
     if model in ("equatorial", "dual-axis-steps"):
         hour_angle = np.asarray(hour_angle, dtype=float)
         noon = np.argmin(np.abs(hour_angle), axis=-1)[..., None]
         seasonal = np.take_along_axis(np.broadcast_to(declination, hour_angle.shape), noon, axis=-1)
-        daily = hour_angle if model == "equatorial" else step_law(
-            hour_angle, options.steps, options.angular_field, options.step_offsets_h
-        )
-        normal = equatorial_normal(daily, seasonal, latitude)
-        return orientation_from_normal(normal, level_azimuth=np.where(north, 180.0, 0.0))
+        if model == "equatorial":
+            normal = equatorial_normal(hour_angle, seasonal, latitude)
+            tilt, azimuth = orientation_from_normal(normal, level_azimuth=level_azimuth)
+            return np.where(down, 0.0, tilt), np.where(down, level_azimuth, azimuth)
+        daily = step_law(hour_angle, options.steps, options.angular_field, options.step_offsets_h)
+        daily = np.where(down, -options.angular_field / 2.0, daily)
+        return orientation_from_normal(equatorial_normal(daily, seasonal, latitude), level_azimuth=level_azimuth)
     if model == "single-axis":
         axis_azimuth = options.axis_azimuth if options.axis_azimuth is not None else np.where(north, 180.0, 0.0)
         shape = zenith.shape
@@ -200,23 +212,13 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     return t
 
 
-def moved_degrees(surface_tilt, surface_azimuth, sun_up):
-    """Angle [deg] the panel normal turns between consecutive steps, with the nightly return.
-
-    Time on the last axis, any leading axes (days). The return from the last daylight orientation
-    to the first is added to the first daylight step (it happens at night, before the day's work).
-    """
+def moved_degrees(surface_tilt, surface_azimuth):
+    """Angle [deg] the panel normal turns between consecutive steps (time on the last axis, any
+    leading axes): tracking by day, and the moves into and out of the stow position at sunset and
+    sunrise (:func:`tracker_orientation`)."""
     normal = normal_vector(surface_tilt, surface_azimuth)
-    sun_up = np.asarray(sun_up, dtype=bool)
     turn = np.zeros(normal.shape[:-1])
     turn[..., 1:] = _angle_between(normal[..., 1:, :], normal[..., :-1, :])
-    turn = np.where(sun_up & np.concatenate([np.zeros_like(sun_up[..., :1]), sun_up[..., :-1]], axis=-1), turn, 0.0)
-    first = np.argmax(sun_up, axis=-1)[..., None]
-    last = sun_up.shape[-1] - 1 - np.argmax(sun_up[..., ::-1], axis=-1)[..., None]
-    back = _angle_between(np.take_along_axis(normal, last[..., None], axis=-2),
-                          np.take_along_axis(normal, first[..., None], axis=-2))
-    has_day = sun_up.any(axis=-1, keepdims=True)
-    np.put_along_axis(turn, first, np.take_along_axis(turn, first, axis=-1) + np.where(has_day, back, 0.0), axis=-1)
     # A panel that holds still must not be charged a motor start: drop rounding-level turns.
     return np.where(turn > 1e-6, turn, 0.0)
 
@@ -232,5 +234,5 @@ def tracker_draw(surface_tilt, surface_azimuth, sun_up, step_hours, drive: Track
     Each step's moves are spread over the step (their energy / step length).
     """
     sun_up = np.asarray(sun_up, dtype=bool)
-    moves = drive.move_energy_wh(moved_degrees(surface_tilt, surface_azimuth, sun_up))
+    moves = drive.move_energy_wh(moved_degrees(surface_tilt, surface_azimuth))
     return np.where(sun_up, drive.standby_w, 0.0) + moves / step_hours

@@ -68,6 +68,7 @@ def assert_engines_agree(compiled, reference):
     np.testing.assert_allclose(compiled.t_solar_contiguous, reference.t_solar_contiguous, rtol=0, atol=SECOND)
     np.testing.assert_allclose(compiled.energy, reference.energy, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(compiled.peak, reference.peak, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(compiled.irradiation, reference.irradiation, rtol=1e-9, atol=1e-9)
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -92,7 +92,7 @@ def test_an_annual_objective_keeps_one_angle_all_year():
     result = run_plan(plan)
     twofold = result.table[result.table.design == "twofold"]
     assert (twofold.groupby("p_load_w")["fold_angle_deg"].nunique() == 1).all()
-    assert result.extras["p_twofold_w"].shape == (13, 24)
+    assert result.extras["p_twofold_w"].shape == (13, 1440)  # the study's 1-min steps, not the file's hours
     # The chosen angle maximises the mean over the days among the grid's angles.
     flat = result.table[result.table.design == "flat"]
     assert twofold["t_solar_h"].mean() >= flat["t_solar_h"].mean() - 1e-9
@@ -127,5 +127,9 @@ def test_epw_timestamps_move_to_interval_centres(tmp_path):
     assert day.index[12].strftime("%H:%M") == "12:30"
     assert day["ghi"].iloc[12] == pytest.approx(800.0 * np.sin(np.pi * 6.5 / 12))
     assert day["dni"].iloc[12] == pytest.approx(0.8 * day["ghi"].iloc[12])
-    study = make_study({**BASE, "weather": str(path), "date": "2025-06-22"})
-    assert Day(study).step_hours == pytest.approx(1.0)
+    # The study runs on its own 1-minute steps; each hour of the file keeps its mean.
+    day = Day(make_study({**BASE, "weather": str(path), "date": "2025-06-22"}))
+    assert day.step_hours == pytest.approx(1 / 60)
+    hourly = weather_day(frame, dt.date(2025, 6, 22))
+    for key in ("ghi", "dni", "dhi"):
+        np.testing.assert_allclose(getattr(day, key).reshape(24, 60).mean(axis=1), hourly[key], rtol=1e-12, atol=1e-9)
