@@ -8,6 +8,7 @@ import pytest
 from typer.testing import CliRunner
 
 from foldopt.cli import app
+from test_cli import assert_one_line_error
 
 runner = CliRunner()
 CONFIGS = sorted(Path(__file__).resolve().parent.parent.joinpath("configs").glob("*.yaml"))
@@ -114,3 +115,34 @@ def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, words):
     extra = [] if args[0] in ("run", "size") or args[1] == "tilt" else SMALL
     one_line_error(invoke(*args[:2], *extra, *args[2:], "--out", out), *words)
     assert not out.exists()
+
+
+def test_a_weather_file_alone_runs_a_year(tmp_path):
+    import pvlib
+
+    tmy3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
+    out = tmp_path / "year"
+    result = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--angle-step", "10",
+                    "--albedo", "0.3", "--iam", "ashrae", "--set", "tracker.model=single-axis", "--out", out, "-q",
+                    "--format", "json")
+    assert result.exit_code == 0, result.output
+    meta = json.loads((out / "run.json").read_text())
+    study = meta["study"]
+    assert study["site"]["latitude"] == 36.1 and study["site"]["altitude"] == 273.0
+    assert (study["albedo"], study["iam"], study["tracker"]["model"]) == (0.3, "ashrae", "single-axis")
+    assert study["objective"]["statistic"] == "mean"
+    summary = pd.read_csv(out / "annual_summary.csv")
+    assert set(summary["design"]) == {"flat", "twofold", "tracker", "tracker-net"} and (summary["days"] == 365).all()
+    for column in ("energy_harvested_wh", "poa_kwh_m2", "energy_gain_vs_flat_pct", "t_solar_pct_of_tracker"):
+        assert summary[column].notna().all(), column
+    # A site far from the file's is refused with both sites named; --force-site keeps it.
+    far = invoke("sweep", "angle", "--weather", tmy3, "--lat", "0", "--lon", "0", "--p-load", "2", "--area", "0.108",
+                 "--out", tmp_path / "far")
+    assert_one_line_error(far, "9,106 km", "GREENSBORO", "(0, 0)")
+    assert not (tmp_path / "far").exists()
+    bad = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--set", "albedo",
+                 "--out", tmp_path / "bad")
+    assert_one_line_error(bad, "--set", "KEY=VALUE")
+    bad = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--set", "tracker.gcr=2",
+                 "--out", tmp_path / "bad")
+    assert_one_line_error(bad, "tracker.gcr", "(0, 1]")
