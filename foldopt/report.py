@@ -392,6 +392,7 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
                 plots=plots,
                 input_sha256=input_hash({"study": plan.data, "axes": plan.axes}),
                 engine=result.engine,
+                **({"weather_light": result.weather_light} if result.weather_light else {}),
             ),
         )
     return out
@@ -569,9 +570,10 @@ def plot_day_hour(extras: dict, key: str, path: Path, title: str, label: str) ->
 def annual_outputs(result, folder: Path, name: str) -> list[str]:
     """``annual_summary.csv`` and the annual plots of a study that varies the date."""
     table = result.table
-    cases = [c for c in result.varied if c not in ("date", "day_of_year")]
-    annual_summary(table, cases or ("p_load_w",)).to_csv(folder / "annual_summary.csv", index=False,
-                                                           float_format=FLOAT_FORMAT)
+    # A case is its site and load, and any other field the plan varies but the date.
+    others = [c for c in result.varied if c not in ("date", "day_of_year", "site_name", "latitude", "p_load_w")]
+    annual_summary(table, ["site_name", "latitude", *others, "p_load_w"]).to_csv(
+        folder / "annual_summary.csv", index=False, float_format=FLOAT_FORMAT)
     plot_distribution(table, folder / "daily_t_solar_distribution.png", f"{name}: daily t_solar per design")
     plot_monthly(table, folder / "monthly_energy_t_solar.png", f"{name}: every design month by month")
     written = ["annual_summary.csv", "daily_t_solar_distribution.png", "monthly_energy_t_solar.png"]

@@ -40,6 +40,8 @@ class SweepResult:
     table: pd.DataFrame
     extras: dict = dataclasses.field(default_factory=dict)  # day x hour curves of an annual objective
     engine: str = "numba"
+    weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
+
 
     @property
     def varied(self) -> list[str]:
@@ -233,10 +235,17 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
 
     results: list = [None] * len(choices)
     extras: dict = {}
+    light: dict = {}
+
+    def counted(sky: Sky) -> Sky:
+        for key, (total, kept) in (sky.weather_balance or {}).items():
+            light[key] = np.add(light.get(key, (0.0, 0.0)), (total, kept))
+        return sky
+
     if dates:
         for index, study in enumerate(studies):
             results[index], group_extras = _annual_group(Blocks.of_dates(study, dates), loads, objective, advance,
-                                                         engine)
+                                                         engine, counted)
             extras = extras or group_extras
         cases = [(study.site, date, choice) for study, choice in zip(studies, choices, strict=True) for date in dates]
     else:
@@ -248,7 +257,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
             blocks = Blocks.of([studies[i] for i in members])
             for part in blocks.chunks(loads.size):
                 chunk = blocks[part]
-                sky = chunk.sky()
+                sky = counted(chunk.sky())
                 angles, hours = fold_hours(sky, chunk, loads, engine)
                 metrics = _design_metrics(sky, chunk, loads, angles, _best_angle_index(hours.transpose(0, 2, 1)),
                                           engine)
@@ -257,16 +266,18 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
                 advance(len(chunk))
         cases = [(study.site, study.date, choice) for study, choice in zip(studies, choices, strict=True)]
     table = _table(cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]})
-    return SweepResult(plan, table, extras, engine)
+    kept = {key: {"file_wh_m2": float(total), "kept_pct": float(100 * kept / total) if total else 100.0}
+            for key, (total, kept) in light.items()} or None
+    return SweepResult(plan, table, extras, engine, kept)
 
 
-def _annual_group(blocks: Blocks, loads, objective, advance, engine):
+def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     """One fold angle per load for all the days of a group: the one that maximises the objective
     over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves."""
     parts = blocks.chunks(loads.size)
     skies, daily = [], []
     for part in parts:
-        skies.append(blocks[part].sky())
+        skies.append(counted(blocks[part].sky()))
         angles, hours = fold_hours(skies[-1], blocks[part], loads, engine)
         daily.append(hours)
         advance(len(blocks[part]))
