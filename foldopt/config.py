@@ -255,11 +255,13 @@ class Study(_Strict):
         if isinstance(data, dict) and data.get("site") is None and data.get("weather") is not None:
             weather = data["weather"]
             path, fmt = (weather, None) if isinstance(weather, str) else (weather.get("path"), weather.get("format"))
-            if isinstance(path, str) and Path(path).is_file():
+            if isinstance(path, str):
+                if not Path(path).is_file():
+                    raise ValueError(f"weather: file not found: {path}")
                 try:
                     data = {**data, "site": weather_site(path, fmt)}
-                except (ValueError, KeyError, OSError):
-                    pass  # an unreadable file is reported where it is read
+                except (ValueError, KeyError, OSError) as error:
+                    raise ValueError(f"weather: cannot read a site from {path} ({error.__class__.__name__})") from None
         return data
 
     @model_validator(mode="after")
