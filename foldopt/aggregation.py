@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from foldopt.names import CONNECTIONS
 from foldopt.pvmodel import IVCurve
 
-CONNECTIONS = ("east", "west", "parallel", "series", "independent", "switching")
 SWITCH_STATES = ("east", "west", "parallel", "series")  # ties go to the earlier, simpler state
 _GOLDEN_STEPS = 40
 _INVPHI = (np.sqrt(5.0) - 1.0) / 2.0

@@ -22,7 +22,9 @@ from __future__ import annotations
 import numpy as np
 import pvlib
 
-SKY_MODELS = ("meinel", "hottel")
+from foldopt.names import BEAM_SKIES
+
+SKY_MODELS = BEAM_SKIES
 #: Hottel's climate corrections (r0, r1, rk) of a0, a1 and k, Duffie & Beckman Table 2.8.1.
 HOTTEL_CLIMATES = {
     "tropical": (0.95, 0.98, 1.02),

@@ -1,46 +1,54 @@
 """foldopt command line: thin wrappers over the library.
 
 Every bad input ends the same way: one ``error: <field> ...`` line per fault on stderr, exit code
-2, no traceback and nothing written. Anything that runs longer than a second shows a status line
-on stderr (``--quiet`` hides it); ``--format json`` prints the summary on stdout for scripts.
+2, no traceback and nothing written. Input is checked before numpy, pandas, pvlib or matplotlib
+load, so that help and errors come at once. Work shows a progress bar on stderr that is removed when
+done; the terminal then gets a short answer (``--table`` adds the full table, always in the CSV
+files), ``--format json`` one JSON document, and ``--quiet`` nothing but errors.
 """
 
 from __future__ import annotations
 
+import inspect
 import json
 import re
 import sys
-import threading
-import time
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Optional
 
-import numpy as np
 import typer
 import yaml
 from typer.core import TyperGroup
 
-from foldopt.config import ConfigError, default_study_path, load_plan, load_study, make_plan, parse_range, set_path
-from foldopt.report import (
-    OutputExistsError,
-    check_output,
-    write_reproduction,
-    write_sizing,
-    write_study,
-    write_sweep,
-)
-from foldopt.reproduce import REPRODUCTIONS
-from foldopt.reproduce import reproduce as reproduce_table
-from foldopt.sizing import C_GRID, LIFETIME_YEARS, size_panel
-from foldopt.study import Day, run_study
-from foldopt.sweep import run_plan
+from foldopt import names
+from foldopt.config import (DATE_KEYWORDS, ConfigError, default_study_path, load_plan, make_plan, parse_range,
+                            read_study, set_path)
+from foldopt.folders import OutputExistsError, check_output
 
 RESULTS = Path("results")
 # Typer >= 0.29 vendors click; its UsageError is reached through the public BadParameter.
 _USAGE_ERROR = next(cls for cls in typer.BadParameter.__mro__ if cls.__name__ == "UsageError")
-FORMATS = ("table", "json")
-ENGINES = ("numba", "numpy")  # foldopt.engine.ENGINES, without importing the engine for --help
+EMBEDDED = "configs/shin2015.yaml"
+#: Shin et al. do not state their panel cost; the 0.108 m^2 optimum of their flat panel implies it.
+PAPER_COST_PER_M2 = 164.0
+
+HELP = """Design-space optimiser for twofold PV panels powering storage-less loads.
+
+Every command runs from its defaults: the embedded study (configs/shin2015.yaml, Shin et al.'s
+pole camera in Los Angeles on the 2014 autumn equinox) or the one --config names.
+
+\b
+Examples:
+  foldopt run                                  the embedded study: best fold angle, flat, tracker
+  foldopt run configs/design-map.yaml          a YAML study, one case or a sweep
+  foldopt reproduce                            Shin et al.'s numbers beside foldopt's
+  foldopt sweep latitude                       the embedded study from 60 S to 60 N
+  foldopt sweep angle --weather FILE.csv       a real year from a TMY3 / EPW / PVGIS file
+  foldopt size --cost-per-w 0.9                panel sizing (Shin et al. Sec. IV-A)
+
+Shell completion: foldopt --install-completion.
+"""
 
 
 class _OneLineErrors(TyperGroup):
@@ -54,6 +62,8 @@ class _OneLineErrors(TyperGroup):
             message = error.format_message()
             if message:  # empty after no_args_is_help has printed the help
                 where = f"{error.ctx.command_path}: " if error.ctx is not None else ""
+                if message.startswith("No such command") and error.ctx is not None:
+                    message += f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
                 typer.echo(f"error: {where}{message}", err=True)
             sys.exit(2)
         except typer.Abort:
@@ -62,13 +72,11 @@ class _OneLineErrors(TyperGroup):
         sys.exit(code if isinstance(code, int) else 0)
 
 
-app = typer.Typer(
-    cls=_OneLineErrors,
-    add_completion=False,
-    pretty_exceptions_enable=False,
-    no_args_is_help=True,
-    help="Design-space optimiser for twofold PV panels powering storage-less loads.",
-)
+app = typer.Typer(cls=_OneLineErrors, add_completion=True, pretty_exceptions_enable=False, no_args_is_help=True,
+                  rich_markup_mode=None, help=HELP)
+sweep_app = typer.Typer(rich_markup_mode=None, no_args_is_help=True,
+                        help="Sweep one design variable over a range, everything else from the study.")
+app.add_typer(sweep_app, name="sweep")
 
 
 def _fail(lines: list[str]):
@@ -77,144 +85,266 @@ def _fail(lines: list[str]):
     raise typer.Exit(2)
 
 
-class _Status:
-    """A status line on stderr that appears only once a task has run for a second."""
+# --- Options every command shares ---------------------------------------------------------------
 
-    def __init__(self, label: str, quiet: bool):
-        self.label, self.quiet = label, quiet
-        self.start = time.monotonic()
-        self.detail = ""
-        self.shown = False
-        self._stop = threading.Event()
+OVERWRITE = typer.Option(False, "--overwrite", help="Replace an existing results folder.")
+QUIET = typer.Option(False, "--quiet", "-q", help="Print nothing but errors (with --format json: the JSON only).")
+FORMAT = typer.Option("table", "--format", help=f"{' | '.join(names.OUTPUT_FORMATS)}: a short answer, or one JSON "
+                                                 "document on stdout for scripts.")
+ENGINE = typer.Option("numba", "--engine", help="numba (the compiled kernel) | numpy (the reference path it is "
+                                                "tested against, slower).")
+TABLE = typer.Option(False, "--table", help="Also print the full table (it is always in the CSV files).")
 
-    def progress(self, done: int, total: int) -> None:
-        width = 24
-        filled = int(width * done / max(total, 1))
-        self.detail = f"[{'#' * filled}{'.' * (width - filled)}] {done}/{total}"
 
-    def _draw(self):
-        while not self._stop.wait(0.25):
-            if time.monotonic() - self.start >= 1.0:
-                self.shown = True
-                elapsed = time.monotonic() - self.start
-                sys.stderr.write(f"\r{self.label} {self.detail} {elapsed:5.1f} s ")
-                sys.stderr.flush()
-
-    @contextmanager
-    def running(self):
-        thread = None
-        if not self.quiet:
-            thread = threading.Thread(target=self._draw, daemon=True)
-            thread.start()
+def _check_choices(output_format: str, engine: str) -> tuple[str, str]:
+    errors, chosen = [], []
+    for option, value, choices in (("--format", output_format, names.OUTPUT_FORMATS),
+                                   ("--engine", engine, names.ENGINES)):
         try:
-            yield self
-        finally:
-            self._stop.set()
-            if thread is not None:
-                thread.join()
-            if self.shown:
-                sys.stderr.write("\n")
-
-
-def _check_format(output_format: str, engine: str = "numba") -> None:
-    errors = []
-    if output_format not in FORMATS:
-        errors.append(f"--format = {output_format!r}: must be one of {', '.join(FORMATS)}")
-    if engine not in ENGINES:
-        errors.append(f"--engine = {engine!r}: must be one of {', '.join(ENGINES)}")
+            chosen.append(names.canonical(value, choices))
+        except ValueError as error:
+            errors.append(f"{option} = {value!r}: {error}")
     if errors:
         _fail(errors)
+    return tuple(chosen)
 
 
-def _emit(table, title: str, output_format: str, out: Path, columns=None) -> None:
-    """The summary: a text table on stdout, or JSON records for scripts (messages then on stderr)."""
-    if output_format == "json":
-        records = json.loads(table.to_json(orient="records", double_precision=10))
-        typer.echo(json.dumps({"title": title, "out": str(out), "rows": records}, indent=1))
-        return
-    shown = table[[c for c in columns if c in table]] if columns else table
-    typer.echo(title)
-    typer.echo(shown.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
-    typer.echo(f"wrote {out}")
+class _Output:
+    """What a command prints: progress on stderr while it works, then the answer."""
+
+    def __init__(self, quiet: bool, output_format: str, table: bool = False):
+        self.quiet, self.json, self.table = quiet, output_format == "json", table
+
+    @contextmanager
+    def progress(self, label: str, total: float | None = None, unit: str = "days"):
+        """A rich progress bar from the first moment of the work, removed when done; yields a
+        ``progress(done, total)`` callback counting ``unit``."""
+        from rich.console import Console
+
+        console = Console(stderr=True)
+        if self.quiet or not console.is_terminal:  # a bar in a log or a pipe is noise
+            yield lambda done, total: None
+            return
+        from rich.progress import (BarColumn, Progress, ProgressColumn, SpinnerColumn, TaskProgressColumn,
+                                   TextColumn, TimeElapsedColumn, TimeRemainingColumn)
+        from rich.text import Text
+
+        class Rate(ProgressColumn):
+            def render(self, task):
+                return Text(f"{task.speed:,.0f} {unit}/s" if task.speed else "")
+
+        columns = [SpinnerColumn(), TextColumn("{task.description}")]
+        if total is not None:
+            columns += [BarColumn(), TaskProgressColumn(), Rate(), TimeRemainingColumn()]
+        with Progress(*columns, TimeElapsedColumn(), console=console, transient=True) as bar:
+            task = bar.add_task(label, total=total)
+            yield lambda done, total: bar.update(task, completed=done, total=total)
+
+    def answer(self, document: dict, lines: list[str], table=None, columns=None) -> None:
+        if self.json:
+            typer.echo(json.dumps(document, indent=1, default=_plain))
+            return
+        if self.quiet:
+            return
+        for line in lines:
+            typer.echo(line)
+        if table is not None and self.table:
+            shown = table[[c for c in columns if c in table]] if columns else table
+            typer.echo(shown.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
+        elif table is not None:
+            typer.echo("(--table prints the full table)")
 
 
-SUMMARY_COLUMNS = ["design", "fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh",
-                   "peak_power_w", "gain_vs_flat_pct", "pct_of_tracker_t_solar", "flat_area_multiple"]
-SWEEP_COLUMNS = ["latitude", "date", "p_load_w", "design", "fold_angle_deg", "t_solar_h", "gain_vs_flat_pct", "note"]
-QUIET = typer.Option(False, "--quiet", "-q", help="No status line")
-FORMAT = typer.Option("table", "--format", help="table | json (summary on stdout for scripts)")
-OVERWRITE = typer.Option(False, "--overwrite", help="Replace an existing results folder")
-ENGINE = typer.Option("numba", "--engine", help="numba (compiled kernel) | numpy (the reference path, slower)")
+def _plain(value):
+    """JSON for what json does not know: numpy numbers, dates, NaN as null."""
+    if hasattr(value, "isoformat"):
+        return value.isoformat()
+    if hasattr(value, "item"):
+        value = value.item()
+    return value
 
 
-def _run_plan(plan, out: Path, overwrite: bool, quiet: bool, output_format: str, engine: str) -> None:
+def _taken(defaults: list[str]) -> dict | None:
+    """The summary's "from" line as JSON: the source study and what was taken from it."""
+    return {"study": defaults[0], "taken": defaults[1:]} if defaults else None
+
+
+def _records(table) -> list[dict]:
+    return json.loads(table.to_json(orient="records", double_precision=10))
+
+
+def _hours(value) -> str:
+    return "-" if value is None else f"{value:.2f} h"
+
+
+def _pct(value, signed: bool = True) -> str:
+    return "-" if value is None else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
+
+
+def _study_lines(digest: dict, defaults: list[str]) -> list[str]:
+    site = digest["site"]
+    where = site["name"] or f"{site['latitude']:g}, {site['longitude']:g}"
+    hours = digest["t_solar_h"]
+    lines = [f"{digest['study']}: {where}, {digest['date']}, P_load {digest['p_load_w']:g} W "
+             f"({digest['mode']} mode, {digest['pv_model']} + {digest['connection']})"]
+    if defaults:
+        lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
+    heuristic = digest["heuristic_fold_angle_deg"]
+    if not hours["twofold"]:
+        lines.append(f"no fold angle reaches the load: t_solar 0 h (flat {_hours(hours['flat'])}, tracker "
+                     f"{_hours(hours['tracker'])})")
+    else:
+        lines.append(f"best fold angle {digest['fold_angle_deg']:.1f} deg"
+                     + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic is not None else "")
+                     + f": t_solar {_hours(hours['twofold'])}, {_pct(digest['gain_vs_flat_pct'])} over flat "
+                     f"({_hours(hours['flat'])}), {_pct(digest['pct_of_tracker_t_solar'], False)} of the tracker's "
+                     f"{_hours(hours['tracker'])}")
+    extras = []
+    if digest["flat_area_multiple"] is not None:
+        extras.append(f"a flat panel would need {digest['flat_area_multiple']:.2f}x the area")
+    if digest["tracker_break_even_standby_w"] is not None:
+        extras.append(f"the twofold panel outlasts the tracker once its standby draw exceeds "
+                      f"{digest['tracker_break_even_standby_w']:.2f} W")
+    if extras:
+        lines.append("; ".join(extras))
+    if digest["notes"]:
+        lines.append(f"note: {'; '.join(digest['notes'])}")
+    return lines
+
+
+def _sweep_lines(digest: dict, defaults: list[str]) -> list[str]:
+    axes = " x ".join(f"{count} {path.split('.')[-1]}" for path, count in digest["axes"].items())
+    lines = [f"{digest['study']}: {digest['cases']} cases ({axes})"]
+    if defaults:
+        lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
+    for year in digest.get("year", []):
+        mean = year["mean_t_solar_h"]
+        lines.append(f"P_load {year['p_load_w']:g} W: fold angle {year['fold_angle_deg']:g} deg all year, mean t_solar "
+                     f"{_hours(mean['twofold'])} ({_pct(year['t_solar_gain_vs_flat_pct'])} over flat "
+                     f"{_hours(mean['flat'])}, energy {_pct(year['energy_gain_vs_flat_pct'])}); tracker "
+                     f"{_hours(mean['tracker'])}")
+    gain = digest.get("gain_vs_flat_pct")
+    if gain and "year" not in digest:
+        at = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
+                       for key, value in gain["at"].items())
+        lines.append(f"twofold over flat: median {_pct(gain['median'])}, best {_pct(gain['max'])} ({at}); "
+                     f"fold angles {digest['fold_angle_deg']['min']:g} to {digest['fold_angle_deg']['max']:g} deg")
+    if digest["notes"]:
+        lines.append("notes: " + ", ".join(f"{note} ({count} of {digest['cases']} cases)"
+                                           for note, count in digest["notes"].items()))
+    return lines
+
+
+STUDY_COLUMNS = ["design", "fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh", "peak_power_w",
+                 "gain_vs_flat_pct", "pct_of_tracker_t_solar", "flat_area_multiple", "note"]
+SWEEP_COLUMNS = ["site_name", "latitude", "date", "p_load_w", "design", "fold_angle_deg", "t_solar_h",
+                 "gain_vs_flat_pct", "note"]
+
+
+def _run_plan(plan, out: Path, overwrite: bool, output: _Output, engine: str, defaults: list[str],
+              command: str) -> None:
+    """Evaluate a plan (one case or many), write its folder, print the answer."""
     check_output(out, overwrite)
     base = plan.base
     if not plan.axes:
-        with _Status(f"foldopt: {base.name}", quiet).running():
+        with output.progress(f"{base.name}: one day, {len(base.fold_angles.grid())} fold angles"):
+            from foldopt.report import digest_study, write_study
+            from foldopt.study import run_study
+
             result = run_study(base, engine)
             write_study(result, out, overwrite)
-        study = result.study
-        title = (f"{study.name} ({study.mode} mode, {study.geometry}, {study.pv_model} + {study.connection}, "
-                 f"P_load {study.p_load:g} W)")
-        _emit(result.summary, title, output_format, out, SUMMARY_COLUMNS)
-        if output_format == "table" and np.isfinite(result.standby[1]):
-            typer.echo(f"the optimal twofold panel outlasts the {study.tracker.model} tracker once the tracker's "
-                       f"standby draw exceeds {result.standby[1]:.2f} W")
+        digest = digest_study(result)
+        lines = _study_lines(digest, defaults) + [f"wrote {out}"]
+        output.answer({"command": command, "out": str(out), "defaults": _taken(defaults), "summary": digest,
+                       "rows": _records(result.summary)},
+                      lines, result.summary, STUDY_COLUMNS)
         return
-    with _Status(f"foldopt: {base.name}, {plan.n_cases} cases", quiet).running() as status:
-        result = run_plan(plan, status.progress, engine)
+    days = plan.n_cases // max(len(dict(plan.axes).get("p_load", (1,))), 1)
+    unit = "site-days" if any(path.startswith("site") for path, _ in plan.axes) else "days"
+    with output.progress(f"{base.name}: {days} {unit}", total=days, unit=unit) as progress:
+        from foldopt.report import digest_sweep, write_sweep
+        from foldopt.sweep import run_plan
+
+        result = run_plan(plan, progress, engine)
         write_sweep(result, out, overwrite)
+    digest = digest_sweep(result)
+    lines = _sweep_lines(digest, defaults) + [f"wrote {out}"]
     twofold = result.table[result.table["design"] == "twofold"]
-    title = f"{base.name}: {plan.n_cases} cases over {', '.join(p for p, _ in plan.axes)} (twofold rows)"
-    table = result.table if output_format == "json" else twofold
-    _emit(table, title, output_format, out, SWEEP_COLUMNS)
+    output.answer({"command": command, "out": str(out), "defaults": _taken(defaults), "summary": digest,
+                   "rows": _records(result.table)},
+                  lines, twofold, SWEEP_COLUMNS)
 
 
-@app.command()
+# --- run, reproduce -----------------------------------------------------------------------------
+
+
+@app.command(short_help="Run a YAML study, one case or a sweep [default: the embedded study].")
 def run(
-    config: Optional[Path] = typer.Argument(None, help="YAML study; default: the embedded configs/shin2015.yaml"),
-    out: Optional[Path] = typer.Option(None, "--out", help="Results folder; default results/<study name>"),
+    config: Optional[Path] = typer.Argument(None, help=f"YAML study [default: the embedded {EMBEDDED}]."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Results folder [default: results/<study name>]."),
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
     output_format: str = FORMAT,
     engine: str = ENGINE,
+    table: bool = TABLE,
 ):
-    """Run a YAML study: one case (fold-angle sweep, heuristic, comparison) or a sweep of cases."""
-    _check_format(output_format, engine)
+    """Run a YAML study: one case (fold-angle sweep, the paper's heuristic, flat and trackers
+    compared) or a sweep of cases (a row per case x design).
+
+    \b
+    Examples:
+      foldopt run
+      foldopt run configs/annual-weather.yaml --out results/greensboro
+    """
+    output_format, engine = _check_choices(output_format, engine)
     try:
         plan = load_plan(config if config is not None else default_study_path())
-        _run_plan(plan, out or RESULTS / plan.base.name, overwrite, quiet, output_format, engine)
+        _run_plan(plan, out or RESULTS / plan.base.name, overwrite, _Output(quiet, output_format, table), engine, [],
+                  "run")
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
 
 
-@app.command()
+@app.command(short_help="Shin et al.'s published values beside foldopt's, paper and exact modes.")
 def reproduce(
-    out: Path = typer.Option(RESULTS / "reproduction", "--out", help="Results folder"),
+    out: Path = typer.Option(RESULTS / "reproduction", "--out", help="Results folder."),
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
     output_format: str = FORMAT,
     engine: str = ENGINE,
 ):
-    """Reproduce Shin et al.'s study in paper and exact modes.
+    """Reproduce Shin et al.'s study in paper and exact modes: their published values beside foldopt's.
 
     Writes reproduction.csv (the embedded study: ideal PV model) and reproduction_single_diode.csv
     (A-300 single-diode sub-panels with switching).
     """
-    _check_format(output_format, engine)
+    output_format, engine = _check_choices(output_format, engine)
+    output = _Output(quiet, output_format)
     try:
         check_output(out, overwrite)
-        study = load_study(default_study_path())
-        with _Status("foldopt: reproducing Shin et al.", quiet).running():
+        with output.progress("reproducing Shin et al. (two PV models x two modes)"):
+            from foldopt.config import load_study
+            from foldopt.report import write_reproduction
+            from foldopt.reproduce import REPRODUCTIONS, reproduce as reproduce_table
+
+            study = load_study(default_study_path())
             tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
             write_reproduction(tables, study, out, overwrite, engine=engine)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
+    lines = []
     for name, table in tables.items():
-        title = f"Shin et al. twofold study ({name}): paper value, paper-mode and exact-mode reproduction"
-        _emit(table, title, output_format, out / f"{name}.csv")
+        model = "ideal PV model" if name == "reproduction" else "A-300 single-diode cells with switching"
+        lines.append(f"Shin et al. ({model}): paper value | paper mode | exact mode")
+        for row in table.itertuples():
+            paper = "-" if row.paper != row.paper else f"{row.paper:g}"
+            lines.append(f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  {row.unit}")
+    lines.append(f"wrote {out}")
+    output.answer({"command": "reproduce", "out": str(out), "tables": {name: _records(t) for name, t in tables.items()}},
+                  lines)
 
+
+# --- sweep angle | latitude | day | load ---------------------------------------------------------
 
 #: Study fields as the command-line options name them, so errors speak the user's words.
 _OPTION_OF_FIELD = {
@@ -227,6 +357,8 @@ _OPTION_OF_FIELD = {
     "converter_efficiency": "--converter-efficiency", "year": "--year", "climate": "--climate",
     "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby", "transposition": "--transposition",
     "objective.statistic": "--objective", "weather": "--weather", "albedo": "--albedo", "iam": "--iam",
+    "switch_series": "--switch-series", "bypass_diodes": "--no-bypass", "exact_electrical": "--exact-electrical",
+    "force_site": "--force-site",
 }
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 
@@ -238,125 +370,237 @@ def _rename_fields(line: str) -> str:
     return line
 
 
-AXES = ("angle", "latitude", "day", "load")
-_DEFAULT_RANGES = {"latitude": "-60:60:5", "day": "1:365:7"}
+def _choices(registry) -> str:
+    return " | ".join(registry)
 
 
-@app.command()
-def sweep(
-    axis: str = typer.Argument(..., help="angle | latitude | day | load"),
-    lat: Optional[str] = typer.Option(None, "--lat", help="Latitude [deg north] or a range -60:60:5"),
-    lon: Optional[str] = typer.Option(None, "--lon", help="Longitude [deg east] (or a range)"),
-    days: Optional[str] = typer.Option(
-        None, "--days", "--date",
-        help="A date YYYY-MM-DD, a range of days 1:365:7 or dates, 'year' or 'equinoxes-solstices'",
-    ),
-    year: int = typer.Option(2025, "--year", help="Year of day-of-year ranges"),
-    p_load: Optional[str] = typer.Option(None, "--p-load", help="Load [W] or a range 1:20:0.5"),
-    area: Optional[float] = typer.Option(None, "--area", help="Flat panel area [m^2], > 0"),
-    efficiency: float = typer.Option(0.2, "--efficiency", help="PV efficiency (ideal model), 0..1"),
-    tilt: Optional[str] = typer.Option(None, "--tilt", help="Tilt [deg]; default |latitude|"),
-    azimuth: Optional[float] = typer.Option(None, "--azimuth", help="Azimuth [deg]; default facing the equator"),
-    altitude: Optional[float] = typer.Option(None, "--altitude", help="Site altitude [m]; default 0"),
-    timezone: Optional[str] = typer.Option(None, "--timezone", help="IANA name or UTC offset; default from longitude"),
-    mode: str = typer.Option("exact", "--mode", help="paper | exact"),
-    geometry: Optional[str] = typer.Option(None, "--geometry", help="azimuth-split | hinge; default by mode"),
-    sky: str = typer.Option("meinel", "--sky", help="Clear-sky beam model: meinel | hottel"),
-    climate: str = typer.Option("midlatitude-summer", "--climate", help="hottel: tropical | midlatitude-summer | "
-                                "subarctic-summer | midlatitude-winter"),
-    weather: Optional[Path] = typer.Option(
-        None, "--weather", help="TMY3 / EPW / PVGIS TMY file: its site and its whole year unless given"),
-    force_site: bool = typer.Option(False, "--force-site", help="Keep --lat/--lon far from the weather file's site"),
-    albedo: Optional[float] = typer.Option(None, "--albedo", help="Ground reflectance 0..1; default 0.2"),
-    iam: Optional[str] = typer.Option(None, "--iam", help="Incidence-angle modifier: none | ashrae | physical"),
-    transposition: Optional[str] = typer.Option(None, "--transposition", help="none | isotropic | haydavies | perez"),
-    objective: Optional[str] = typer.Option(None, "--objective", help="One fold angle for all days: mean | min | "
-                                            "worst-month | pNN"),
-    tracker: str = typer.Option("dual-axis", "--tracker", help="dual-axis | equatorial | dual-axis-steps | single-axis"),
-    tracker_standby: float = typer.Option(0.0, "--tracker-standby", help="Tracker controller standby draw [W]"),
-    pv_model: str = typer.Option("ideal", "--pv-model", help="ideal | single-diode | b-model"),
-    module: Optional[str] = typer.Option(None, "--module", help="single-diode: CEC module name (default A-300 cell)"),
-    connection: str = typer.Option(
-        "switching", "--connection", help="east | west | parallel | series | independent | switching"
-    ),
-    switch_series: bool = typer.Option(False, "--switch-series", help="Switching may also select series"),
-    no_bypass: bool = typer.Option(False, "--no-bypass", help="No bypass diodes in series"),
-    converter_efficiency: float = typer.Option(1.0, "--converter-efficiency", help="Independent converters' efficiency"),
-    temp_air: float = typer.Option(25.0, "--temp-air", help="Air temperature [C]"),
-    exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve I-V curves per step, not tables"),
-    step_min: float = typer.Option(1.0, "--step-min", help="Time step [min], divides 1440"),
-    angle_step: float = typer.Option(1.0, "--angle-step", help="Fold-angle sweep step [deg]"),
-    settings: Optional[list[str]] = typer.Option(
-        None, "--set", help="Any study field, KEY=VALUE (dotted keys, YAML values), e.g. --set tracker.gcr=0.4"),
-    out: Optional[Path] = typer.Option(None, "--out", help="Results folder; default results/sweep-<axis>"),
+def _sweep_options(
+    config: Optional[Path] = typer.Option(None, "--config", help=f"Study to start from [default: {EMBEDDED}]."),
+    lat: Optional[str] = typer.Option(None, "--lat", help="Latitude [deg north], or a range start:stop:step."),
+    lon: Optional[str] = typer.Option(None, "--lon", help="Longitude [deg east], or a range."),
+    altitude: Optional[float] = typer.Option(None, "--altitude", help="Site altitude [m]."),
+    timezone: Optional[str] = typer.Option(None, "--timezone", help="IANA name or UTC offset, e.g. UTC-08:00 "
+                                           "[default: the longitude's standard offset]."),
+    days: Optional[str] = typer.Option(None, "--days", "--date", help="A date YYYY-MM-DD, a range of days 1:365:7 "
+                                       "or of dates, 'year' or 'equinoxes-solstices'."),
+    year: Optional[int] = typer.Option(None, "--year", help="Year of day-of-year ranges [default: the study's]."),
+    p_load: Optional[str] = typer.Option(None, "--p-load", help="Load [W], or a range start:stop:step."),
+    area: Optional[float] = typer.Option(None, "--area", help="Flat panel area [m^2]."),
+    efficiency: Optional[float] = typer.Option(None, "--efficiency", help="PV efficiency [-] (ideal model; sets the "
+                                               "b-model panel's area)."),
+    tilt: Optional[str] = typer.Option(None, "--tilt", help="Panel tilt [deg], or a range [default: the study's, "
+                                       "or |latitude| where the latitude changes]."),
+    azimuth: Optional[float] = typer.Option(None, "--azimuth", help="Panel azimuth [deg from north] [default: the "
+                                            "study's, or facing the equator where the latitude changes]."),
+    mode: Optional[str] = typer.Option(None, "--mode", help=_choices(names.MODES) + " [default: the study's; exact "
+                                       "where the site or day leaves the embedded study's]."),
+    geometry: Optional[str] = typer.Option(None, "--geometry", help=_choices(names.GEOMETRIES)
+                                           + " [default: azimuth-split in paper mode, hinge in exact]."),
+    sky: Optional[str] = typer.Option(None, "--sky", help=_choices(names.SKIES) + "."),
+    climate: Optional[str] = typer.Option(None, "--climate", help="Hottel's climate: "
+                                          + _choices(names.HOTTEL_CLIMATES) + "."),
+    weather: Optional[Path] = typer.Option(None, "--weather", help="TMY3 / EPW / PVGIS TMY file: its site and its "
+                                           "whole year unless given."),
+    force_site: bool = typer.Option(False, "--force-site", help="Keep --lat/--lon though far from the weather "
+                                    "file's site."),
+    transposition: Optional[str] = typer.Option(None, "--transposition", help=_choices(names.TRANSPOSITIONS) + "."),
+    albedo: Optional[float] = typer.Option(None, "--albedo", help="Ground reflectance [-] (with diffuse light)."),
+    iam: Optional[str] = typer.Option(None, "--iam", help="Incidence-angle modifier: " + _choices(names.IAMS) + "."),
+    objective: Optional[str] = typer.Option(None, "--objective", help="One fold angle for all days, maximising: "
+                                            "mean | min | worst-month | pNN (a percentile)."),
+    tracker: Optional[str] = typer.Option(None, "--tracker", help=_choices(names.TRACKERS) + "."),
+    tracker_standby: Optional[float] = typer.Option(None, "--tracker-standby", help="Tracker standby draw [W]."),
+    pv_model: Optional[str] = typer.Option(None, "--pv-model", help=_choices(names.PV_MODELS) + "."),
+    module: Optional[str] = typer.Option(None, "--module", help="single-diode: a module of pvlib's CEC database, any "
+                                         "part of its name, e.g. CS5P-220M [default: the A-300 cell]."),
+    connection: Optional[str] = typer.Option(None, "--connection", help=_choices(names.CONNECTIONS) + "."),
+    switch_series: bool = typer.Option(False, "--switch-series", help="Switching may also choose series."),
+    no_bypass: bool = typer.Option(False, "--no-bypass", help="Series without bypass diodes."),
+    converter_efficiency: Optional[float] = typer.Option(None, "--converter-efficiency", help="Efficiency [-] of "
+                                                         "each converter of connection independent."),
+    temp_air: Optional[float] = typer.Option(None, "--temp-air", help="Air temperature [C] (I-V models)."),
+    exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve every step's I-V curves instead "
+                                          "of the tables (slow)."),
+    step_min: Optional[float] = typer.Option(None, "--step-min", help="Time step [min], a divisor of 1440."),
+    angle_step: Optional[float] = typer.Option(None, "--angle-step", help="Fold-angle grid step [deg]."),
+    settings: Optional[list[str]] = typer.Option(None, "--set", metavar="KEY=VALUE", help="Any study field (a dotted "
+                                                 "key, a YAML value), e.g. --set tracker.gcr=0.4; repeatable."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Results folder [default: results/sweep-<axis>]."),
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
     output_format: str = FORMAT,
     engine: str = ENGINE,
+    table: bool = TABLE,
 ):
-    """Sweep a design variable from the command line.
+    """The options of every sweep (its signature is theirs)."""
 
-    angle: one site, day and load, every fold angle (sweep.csv, summary.csv); with a weather file,
-    one fold angle for the file's whole year (--objective, default mean). latitude, day, load:
-    every combination of the ranges given (--lat, --days, --p-load, --tilt, --lon accept
-    start:stop:step), one row per case x design in results.csv, with heat maps and curves.
-    """
-    _check_format(output_format, engine)
-    if axis not in AXES:
-        _fail([f"sweep: axis {axis!r} must be one of {', '.join(AXES)}"])
-    if weather is None:
-        lat = lat if lat is not None else _DEFAULT_RANGES.get(axis)
-        days = days if days is not None else _DEFAULT_RANGES.get(axis)
-    if axis == "angle" and weather is not None and objective is None:
-        objective = "mean"  # a year of weather at one fold angle
-    if axis == "load" and (p_load is None or _single(p_load)):
-        _fail(["--p-load: sweep load needs a range start:stop:step or a list"])
-    site = {key: value for key, value in
-            {"latitude": lat, "longitude": lon, "altitude": altitude, "timezone": timezone}.items() if value is not None}
-    panel = {"area": area, "efficiency": efficiency, "tilt": tilt, "azimuth": azimuth}
-    data = {
-        "name": f"sweep-{axis}",
-        "year": year,
-        "mode": mode,
-        "site": site or None,  # none given: the weather file's, or an error naming the field
-        "date": days,
-        "panel": {key: value for key, value in panel.items() if value is not None},
-        "p_load": p_load,
-        "geometry": geometry,
-        "sky": sky,
-        "climate": climate,
-        "weather": str(weather) if weather is not None else None,
-        "force_site": force_site,
-        "albedo": albedo,
-        "iam": iam,
-        "transposition": transposition,
-        "objective": {"statistic": objective} if objective is not None else None,
-        "tracker": {"model": tracker, "standby_w": tracker_standby},
-        "pv_model": pv_model,
-        "module": module,
-        "connection": connection,
-        "switch_series": switch_series,
-        "bypass_diodes": not no_bypass,
-        "converter_efficiency": converter_efficiency,
-        "temp_air": temp_air,
-        "exact_electrical": exact_electrical,
-        "step_min": step_min,
-        "fold_angles": {"start": angle_step, "stop": 180.0, "step": angle_step},
-    }
-    data = {key: value for key, value in data.items() if value is not None}
+
+#: Each sweep's own default range where its option is not given.
+_AXIS_OPTION = {"angle": None, "latitude": "lat", "day": "days", "load": "p_load"}
+_SWEEP_HELP = {
+    "angle": ("Every fold angle at one site, day and load (sweep.csv, summary.csv, the paper's plots). With a "
+              "weather file: one fold angle for the file's whole year (--objective, default mean).",
+              ["foldopt sweep angle", "foldopt sweep angle --lat -33.87 --lon 151.21 --timezone Australia/Sydney "
+               "--date 2025-06-21", "foldopt sweep angle --weather configs/weather/723170TYA.CSV --p-load 2"]),
+    "latitude": ("The study at every latitude of a range [default: -60:60:5], the panel tilted at |latitude| toward "
+                 "the equator unless --tilt/--azimuth say otherwise: a row per case x design in results.csv, with "
+                 "maps and curves.",
+                 ["foldopt sweep latitude", "foldopt sweep latitude --lat -40:40:10 --p-load 1:9:2"]),
+    "day": ("The study on every day of a range [default: 1:365:7 of the study's year].",
+            ["foldopt sweep day", "foldopt sweep day --days year --objective p10"]),
+    "load": ("The study at every load of a range [default: 20 loads from 5 % to 100 % of the panel's rating, area x "
+             "1000 W/m^2 x efficiency].",
+             ["foldopt sweep load", "foldopt sweep load --p-load 0.5:19:0.5 --pv-model single-diode"]),
+}
+
+
+def _register_sweep(axis: str) -> None:
+    summary, examples = _SWEEP_HELP[axis]
+
+    def command(**options):
+        _sweep(axis, options)
+
+    command.__signature__ = inspect.signature(_sweep_options)
+    command.__annotations__ = dict(_sweep_options.__annotations__)
+    command.__doc__ = summary + "\n\n\b\nExamples:\n" + "\n".join(f"  {example}" for example in examples)
+    sweep_app.command(axis)(command)
+
+
+def _sweep(axis: str, options: dict) -> None:
+    output_format, engine = _check_choices(options.pop("output_format"), options.pop("engine"))
+    output = _Output(options.pop("quiet"), output_format, options.pop("table"))
+    out, overwrite = options.pop("out"), options.pop("overwrite")
     try:
-        for setting in settings or ():
-            data = _apply_setting(data, setting)
-        plan = make_plan(data)
+        plan, defaults = _sweep_plan(axis, options)
     except ConfigError as error:
         _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
-    varied = [p for p, _ in plan.axes if not (p == "date" and plan.base.objective is not None)]
+    varied = [path for path, _ in plan.axes if not (path == "date" and plan.base.objective is not None)]
     if axis == "angle" and varied:
-        _fail([f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep latitude/day/load)"])
+        _fail([f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep latitude, day or load)"])
     try:
-        _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, quiet, output_format, engine)
+        _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, output, engine, defaults, f"sweep {axis}")
     except OutputExistsError as error:
         _fail([str(error)])
+
+
+def _sweep_plan(axis: str, options: dict):
+    """The plan of a sweep: the study (embedded, or --config), the options given over it, the axis's
+    default range; and, for the summary, the study's values the options left in place."""
+    config = options.pop("config")
+    path = config if config is not None else default_study_path()
+    data, _ = read_study(path)
+    data = dict(data)
+    source_mode = data.get("mode")
+    given = {key for key, value in options.items() if value not in (None, False, [])}
+    weather = options["weather"]
+    site = dict(data.get("site") or {})
+    panel = dict(data.get("panel") or {})
+    if weather is not None:
+        data["weather"] = str(weather)
+        data.pop("sky", None)  # the file's light is shaped by its own clear sky
+        if not given & {"lat", "lon"}:
+            site = {}  # the file's site
+        if "days" not in given:
+            data.pop("date", None)  # the file's year
+        if axis == "angle" and "objective" not in given and not ("days" in given and _single(options["days"])):
+            options["objective"] = "mean"  # a year of weather at one fold angle
+    # Paper mode is the paper's beam-only Eq. 5, fair for its sun-facing panel on its day; at the
+    # equator it would give a level panel no beam at all, and a weather file's diffuse light is lost.
+    elsewhere = bool(given & {"lat", "lon", "days", "weather"}) or axis in ("latitude", "day")
+    if config is None and "mode" not in given and elsewhere:
+        data["mode"] = "exact"
+    if given & {"lat", "lon"} or axis == "latitude":
+        site.pop("name", None)
+    if "lon" in given and "timezone" not in given:
+        site.pop("timezone", None)  # the new longitude's standard offset
+    if (axis == "latitude" or "lat" in given) and not given & {"tilt", "azimuth"}:
+        panel.pop("tilt", None)  # |latitude|, facing the equator
+        panel.pop("azimuth", None)
+    if axis == "latitude" and "lat" not in given:
+        options["lat"] = "-60:60:5"
+    if axis == "day" and "days" not in given:
+        options["days"] = "1:365:7"
+        if "year" not in given and "date" in data:
+            options["year"] = int(str(data["date"])[:4])
+    if axis == "load" and "p_load" not in given:
+        rating = float(options["area"] or panel.get("area", 0.1)) * 1000.0 * float(
+            options["efficiency"] or panel.get("efficiency", 0.2))
+        options["p_load"] = [round(rating * share / 20, 4) for share in range(1, 21)]
+    option = _AXIS_OPTION[axis]
+    if axis != "angle" and option in given and _single(options[option]):
+        flag = _OPTION_OF_FIELD[{"lat": "site.latitude", "days": "date", "p_load": "p_load"}[option]]
+        raise ConfigError([f"{flag}: sweep {axis} needs a range start:stop:step or a list"])
+    if (options["mode"] or data.get("mode")) != source_mode and "geometry" not in given:
+        data.pop("geometry", None)  # the new mode's own geometry
+    for key, field in (("lat", "latitude"), ("lon", "longitude"), ("altitude", "altitude"), ("timezone", "timezone")):
+        if options[key] is not None:
+            site[field] = options[key]
+    for key, field in (("area", "area"), ("efficiency", "efficiency"), ("tilt", "tilt"), ("azimuth", "azimuth")):
+        if options[key] is not None:
+            panel[field] = options[key]
+    data["site"], data["panel"] = site or None, panel
+    data["name"] = f"sweep-{axis}"
+    simple = {"days": "date", "year": "year", "p_load": "p_load", "mode": "mode", "geometry": "geometry", "sky": "sky",
+              "climate": "climate", "transposition": "transposition", "albedo": "albedo", "iam": "iam",
+              "pv_model": "pv_model", "module": "module", "connection": "connection",
+              "converter_efficiency": "converter_efficiency", "temp_air": "temp_air", "step_min": "step_min"}
+    for key, field in simple.items():
+        if options[key] is not None:
+            data[field] = options[key]
+    for key, field in (("switch_series", "switch_series"), ("exact_electrical", "exact_electrical"),
+                       ("force_site", "force_site")):
+        if options[key]:
+            data[field] = True
+    if options["no_bypass"]:
+        data["bypass_diodes"] = False
+    if options["objective"] is not None:
+        data["objective"] = {"statistic": options["objective"]}
+    if options["tracker"] is not None or options["tracker_standby"] is not None:
+        tracker = data.get("tracker")
+        tracker = dict(tracker) if isinstance(tracker, dict) else ({"model": tracker} if tracker else {})
+        if options["tracker"] is not None:
+            tracker = {"model": options["tracker"], **({"standby_w": tracker["standby_w"]} if "standby_w" in tracker
+                                                       else {})}
+        if options["tracker_standby"] is not None:
+            tracker["standby_w"] = options["tracker_standby"]
+        data["tracker"] = tracker
+    if options["angle_step"] is not None:
+        data["fold_angles"] = {"start": options["angle_step"], "stop": 180.0, "step": options["angle_step"]}
+    if data.get("site") is None:
+        data.pop("site")
+    for setting in options["settings"] or ():
+        data = _apply_setting(data, setting)
+    plan = make_plan(data)
+    return plan, _defaults(path, plan.base, axis, options, given)
+
+
+def _defaults(path: Path, study, axis: str, options: dict, given: set) -> list[str]:
+    """What a sweep took from its study and its own defaults, for the summary: the source first."""
+    source = EMBEDDED if path == default_study_path() else str(path)
+    weather = "weather" in given
+    taken = []
+    option = _AXIS_OPTION[axis]
+    if option is not None and option not in given:
+        if option == "p_load":
+            taken.append(f"20 loads, 5 % to 100 % of {options['p_load'][-1]:g} W (default range)")
+        else:
+            year = f" of {options['year']}" if option == "days" and options.get("year") else ""
+            taken.append(f"{axis} {options[option]}{year} (default range)")
+    if not given & {"lat", "lon"} and not weather and axis != "latitude":
+        taken.append(f"site {study.site.latitude:g}, {study.site.longitude:g}")
+    if "days" not in given and not weather and axis != "day":
+        taken.append(f"date {study.date}")
+    if "area" not in given:
+        taken.append(f"panel {study.panel.area:g} m^2")
+    if "p_load" not in given and axis != "load":
+        taken.append(f"P_load {study.p_load:g} W")
+    if "mode" not in given:
+        switched = study.mode == "exact" and source == EMBEDDED
+        taken.append("exact mode (paper mode is for the paper's own site and day: --mode paper)" if switched
+                     else f"{study.mode} mode")
+    if "pv_model" not in given:
+        taken.append(f"{study.pv_model} PV model")
+    return [source, *taken] if taken else []
 
 
 def _apply_setting(data: dict, setting: str) -> dict:
@@ -371,33 +615,53 @@ def _apply_setting(data: dict, setting: str) -> dict:
     return set_path(data, key.strip(), value)
 
 
-def _single(text: str) -> bool:
-    return ":" not in text and "," not in text
+def _single(value) -> bool:
+    text = str(value)
+    return not isinstance(value, list) and ":" not in text and "," not in text and text not in DATE_KEYWORDS
 
 
-@app.command()
+for _axis in _AXIS_OPTION:
+    _register_sweep(_axis)
+
+
+# --- size ---------------------------------------------------------------------------------------
+
+
+@app.command(short_help="Panel sizing: lifetime net benefit against area, flat and twofold.")
 def size(
-    config: Optional[Path] = typer.Argument(None, help="YAML study (one case); default the embedded paper study"),
-    areas: str = typer.Option("0.01:0.5:0.005", "--areas", help="Panel areas [m^2], start:stop:step"),
-    cost_per_m2: Optional[float] = typer.Option(None, "--cost-per-m2", help="Panel cost [$/m^2]"),
-    cost_per_w: Optional[float] = typer.Option(None, "--cost-per-w", help="Panel cost [$/W at STC]"),
-    c_grid: float = typer.Option(C_GRID, "--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22)"),
-    years: float = typer.Option(LIFETIME_YEARS, "--years", help="Lifetime [years] (Shin et al.: 20)"),
-    days_per_year: float = typer.Option(365.0, "--days-per-year", help="Days a year like the study's day"),
-    out: Optional[Path] = typer.Option(None, "--out", help="Results folder; default results/<study>-sizing"),
+    config: Optional[Path] = typer.Argument(None, help=f"YAML study (one case) [default: the embedded {EMBEDDED}]."),
+    areas: str = typer.Option("0.01:0.5:0.005", "--areas", help="Panel areas [m^2], start:stop:step."),
+    cost_per_m2: Optional[float] = typer.Option(None, "--cost-per-m2", help="Panel cost [$/m^2] [default: 164, the "
+                                                "cost Shin et al.'s 0.108 m^2 optimum implies]."),
+    cost_per_w: Optional[float] = typer.Option(None, "--cost-per-w", help="Panel cost [$/W at STC], instead."),
+    c_grid: float = typer.Option(0.22, "--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22)."),
+    years: float = typer.Option(20.0, "--years", help="Lifetime [years] (Shin et al.: 20)."),
+    days_per_year: float = typer.Option(365.0, "--days-per-year", help="Days a year like the study's day."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Results folder [default: results/<study>-sizing]."),
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
     output_format: str = FORMAT,
+    table: bool = TABLE,
 ):
-    """Shin et al. Sec. IV-A sizing: lifetime benefit C_grid * t_solar * P_load against panel cost."""
-    _check_format(output_format)
+    """Shin et al. Sec. IV-A panel sizing: the lifetime benefit C_grid x t_solar x P_load against the
+    panel's cost, for flat and twofold panels of every area.
+
+    \b
+    Examples:
+      foldopt size
+      foldopt size --cost-per-w 0.9 --areas 0.02:0.3:0.002
+    """
+    output_format, _ = _check_choices(output_format, "numba")
     errors = []
-    if (cost_per_m2 is None) == (cost_per_w is None):
-        errors.append("--cost-per-m2 / --cost-per-w: give exactly one panel cost")
-    for name, value, low in (("--cost-per-m2", cost_per_m2, 0.0), ("--cost-per-w", cost_per_w, 0.0),
-                             ("--c-grid", c_grid, 0.0), ("--years", years, 0.0), ("--days-per-year", days_per_year, 0.0)):
-        if value is not None and not (np.isfinite(value) and value > low):
-            errors.append(f"{name} = {value}: must be > {low:g}")
+    if cost_per_m2 is not None and cost_per_w is not None:
+        errors.append("--cost-per-m2 / --cost-per-w: give one panel cost, not both")
+    cost_given = cost_per_m2 is not None or cost_per_w is not None
+    if not cost_given:
+        cost_per_m2 = PAPER_COST_PER_M2
+    for name, value in (("--cost-per-m2", cost_per_m2), ("--cost-per-w", cost_per_w), ("--c-grid", c_grid),
+                        ("--years", years), ("--days-per-year", days_per_year)):
+        if value is not None and not (value == value and 0 < value < float("inf")):
+            errors.append(f"{name} = {value}: must be > 0")
     try:
         grid = parse_range(areas)
         if grid[0] <= 0 or grid[-1] > 1000:
@@ -406,16 +670,41 @@ def size(
         errors.append(f"--areas: {error}")
     if errors:
         _fail(errors)
+    output = _Output(quiet, output_format, table)
+    parameters = {"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
+                  "years": years, "days_per_year": days_per_year}
     try:
+        from foldopt.config import load_study
+
         study = load_study(config if config is not None else default_study_path())
         out = out or RESULTS / f"{study.name}-sizing"
         check_output(out, overwrite)
-        with _Status(f"foldopt: sizing {study.name}", quiet).running():
-            table = size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
-            best = write_sizing(table, study, out, overwrite)
+        with output.progress(f"sizing {study.name}: {len(grid)} areas"):
+            from foldopt.report import write_sizing
+            from foldopt.sizing import size_panel
+            from foldopt.study import Day
+
+            sizing = size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
+            best = write_sizing(sizing, study, out, overwrite, parameters=parameters)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
-    _emit(best, f"{study.name}: area with the largest lifetime net benefit", output_format, out)
+    cost = f"{cost_per_m2:g} $/m^2" if cost_per_w is None else f"{cost_per_w:g} $/W"
+    lines = [f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid {c_grid:g} $/kWh over "
+             f"{years:g} years"]
+    for row in best.itertuples():
+        angle = "" if row.design == "flat" else f", folded to {row.fold_angle_deg:g} deg"
+        lines.append(f"  {row.design}: {row.area_m2:.3f} m^2{angle}, t_solar {row.t_solar_h:.2f} h, "
+                     f"net ${row.net_benefit_usd:.1f}")
+    lines.append(f"wrote {out}")
+    defaults = [EMBEDDED if config is None else str(config), f"site, day, P_load {study.p_load:g} W, efficiency "
+                f"{study.panel.efficiency:g}"]
+    if not cost_given:
+        defaults.append(f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
+                        "--cost-per-m2 or --cost-per-w)")
+    lines.insert(1, f"  from {defaults[0]}: {', '.join(defaults[1:])}")
+    output.answer({"command": "size", "out": str(out), "defaults": _taken(defaults),
+                   "summary": {"study": study.name, **parameters, "best": _records(best)},
+                   "rows": _records(sizing)}, lines, sizing)
 
 
 def main():  # pragma: no cover - console-script entry point

@@ -14,13 +14,15 @@ import math
 import re
 import zoneinfo
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated
 
 import yaml
 from pydantic import (
     AfterValidator,
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Field,
     ValidationError,
@@ -29,13 +31,8 @@ from pydantic import (
     model_validator,
 )
 
-from foldopt.aggregation import CONNECTIONS
-from foldopt.atmosphere import HOTTEL_CLIMATES, SKY_MODELS
-from foldopt.geometry import GEOMETRIES, default_orientation
-from foldopt.pvmodel import PV_MODELS, TEMPERATURE_MODELS, cec_module
-from foldopt.solarposition import MODES
-from foldopt.tracker import ALEXANDRU_STEP_OFFSETS_H, DRIVES, TRACKERS
-from foldopt.weather import CLEAR_SKIES, weather_site
+from foldopt import names
+from foldopt.names import ALEXANDRU_STEP_OFFSETS_H, canonical
 
 DEFAULT_STUDY = "shin2015"
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
@@ -63,6 +60,24 @@ def _interval(lo, hi, *, lo_open=False, hi_open=False, unit=""):
         return value
 
     return Annotated[float, AfterValidator(check)]
+
+
+def _as_tuple(value) -> tuple:
+    """A default as a tuple of its accepted values."""
+    return value if isinstance(value, tuple) else (value,)
+
+
+def _named(choices):
+    """A name among ``choices``, any spelling of :func:`foldopt.names.canonical` accepted."""
+    return Annotated[str, BeforeValidator(partial(canonical, names=choices))]
+
+
+def _weather_site(path: str, fmt: str | None) -> dict:
+    from foldopt.weather import (
+        weather_site,  # pvlib's readers, only when a file is given
+    )
+
+    return weather_site(path, fmt)
 
 
 def great_circle_km(latitude_1, longitude_1, latitude_2, longitude_2) -> float:
@@ -137,7 +152,7 @@ class Panel(_Strict):
 class Tracker(_Strict):
     """The tracker compared against, and the energy it spends (see :mod:`foldopt.tracker`)."""
 
-    model: Literal[TRACKERS] = "dual-axis"
+    model: _named(names.TRACKERS) = "dual-axis"
     steps: Annotated[int, Field(ge=2, le=200, multiple_of=2)] = 12
     angular_field: _interval(0, 360, lo_open=True, unit=" deg") = 90.0
     step_offsets_h: list[_interval(0, 12, lo_open=True, hi_open=True, unit=" h")] | None = Field(
@@ -149,7 +164,7 @@ class Tracker(_Strict):
     backtrack: bool = False
     gcr: _interval(0, 1, lo_open=True) = 0.35
     standby_w: _interval(0, 1000, unit=" W") = 0.0
-    drive: Literal[DRIVES] = "motor"
+    drive: _named(names.DRIVES) = "motor"
     wh_per_degree: _interval(0, 10, unit=" Wh/deg") = 0.0
 
     @model_validator(mode="after")
@@ -164,8 +179,8 @@ class Weather(_Strict):
     """A weather file: TMY3, EPW or PVGIS TMY, read through pvlib.iotools."""
 
     path: str
-    format: Literal[("tmy3", "epw", "pvgis")] | None = Field(None, description="default from the extension")
-    label: Literal[("start", "end", "centre")] | None = Field(
+    format: _named(names.WEATHER_FORMATS) | None = Field(None, description="default from the extension")
+    label: _named(names.INTERVAL_LABELS) | None = Field(
         None, description="what a timestamp marks; default the format's (TMY3 end, EPW and PVGIS start)"
     )
 
@@ -208,39 +223,39 @@ class FoldAngles(_Strict):
 class Study(_Strict):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=100)]
     description: str = ""
-    mode: Literal[MODES] = "exact"
+    mode: _named(names.MODES) = "exact"
     site: Site = Field(description="default with a weather file: the file's own site")
     force_site: bool = Field(False, description="keep a site more than SITE_TOLERANCE_KM from the weather file's")
     date: dt.date
     panel: Panel
     p_load: _interval(0, 1e6, lo_open=True, unit=" W")
-    geometry: Literal[GEOMETRIES] | None = Field(
+    geometry: _named(names.GEOMETRIES) | None = Field(
         None, description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact"
     )
     fold_angles: FoldAngles = FoldAngles()
-    sky: Literal[SKY_MODELS + CLEAR_SKIES] = "meinel"
+    sky: _named(names.SKIES) = "meinel"
     linke_turbidity: _interval(0, 10, lo_open=True) | None = Field(None, description="ineichen; default pvlib's climatology")
-    transposition: Literal[("none", "isotropic", "haydavies", "perez")] | None = Field(
+    transposition: _named(names.TRANSPOSITIONS) | None = Field(
         None, description="diffuse model; default none for beam-only skies, perez otherwise"
     )
     albedo: _interval(0, 1) = 0.2
-    iam: Literal[("none", "ashrae", "physical")] = "none"
+    iam: _named(names.IAMS) = "none"
     weather: Weather | None = None
     objective: Objective | None = None
-    pv_model: Literal[PV_MODELS] = "ideal"
+    pv_model: _named(names.PV_MODELS) = "ideal"
     module: str | None = Field(None, description="single-diode: CEC module name; default the A-300 cell")
-    connection: Literal[CONNECTIONS] = "switching"
+    connection: _named(names.CONNECTIONS) = "switching"
     switch_series: bool = Field(False, description="switching may also select series")
     bypass_diodes: bool = True
     converter_efficiency: _interval(0, 1, lo_open=True) = 1.0
-    temperature_model: Literal[TEMPERATURE_MODELS] | None = Field(
+    temperature_model: _named(names.TEMPERATURE_MODELS) | None = Field(
         None, description="default fixed (cells at temp_air) in paper mode, sapm in exact"
     )
     temp_air: _interval(-60, 60, unit=" C") = 25.0
     wind_speed: _interval(0, 60, unit=" m/s") = 1.0
     exact_electrical: bool = Field(False, description="solve every step's I-V curves, not tables")
     tracker: Tracker = Tracker()
-    climate: Literal[tuple(HOTTEL_CLIMATES)] = Field("midlatitude-summer", description="Hottel sky only")
+    climate: _named(names.HOTTEL_CLIMATES) = Field("midlatitude-summer", description="Hottel sky only")
     step_min: Annotated[_interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)] = 1.0
 
     @field_validator("weather", mode="before")
@@ -259,7 +274,7 @@ class Study(_Strict):
                 if not Path(path).is_file():
                     raise ValueError(f"weather: file not found: {path}")
                 try:
-                    data = {**data, "site": weather_site(path, fmt)}
+                    data = {**data, "site": _weather_site(path, fmt)}
                 except (ValueError, KeyError, OSError) as error:
                     raise ValueError(f"weather: cannot read a site from {path} ({error.__class__.__name__})") from None
         return data
@@ -267,11 +282,16 @@ class Study(_Strict):
     @model_validator(mode="after")
     def _consistent(self):
         if self.mode == "paper" and self.transposition not in (None, "none"):
-            raise ValueError("paper mode is beam-only (Shin et al. Eq. 5): transposition must be none")
+            raise ValueError("transposition: paper mode is beam-only (Shin et al. Eq. 5): transposition must be none")
+        idle = self.idle_settings()
+        if idle:
+            raise ValueError("\n".join(idle))  # one error line each
         if self.weather is not None and not Path(self.weather.path).is_file():
             raise ValueError(f"weather: file not found: {self.weather.path}")
+        if self.weather is not None and not math.isclose(60 / self.step_min, round(60 / self.step_min)):
+            raise ValueError(f"step_min = {self.step_min:g}: must divide the weather file's 60-min intervals")
         if self.weather is not None and not self.force_site:
-            file_site = weather_site(self.weather.path, self.weather.format)
+            file_site = _weather_site(self.weather.path, self.weather.format)
             distance = great_circle_km(self.site.latitude, self.site.longitude, file_site["latitude"],
                                        file_site["longitude"])
             if distance > SITE_TOLERANCE_KM:
@@ -283,11 +303,41 @@ class Study(_Strict):
                 )
         return self
 
+    def idle_settings(self) -> list[str]:
+        """Settings given a value that nothing in the study uses, each as ``field = value: why``."""
+        defaults = {name: field.default for name, field in Study.model_fields.items()}
+        # What a resolved study fills in is no setting of the user's.
+        defaults["temperature_model"] = (None, "fixed" if self.mode == "paper" else "sapm")
+        iv_model = self.pv_model != "ideal"
+        series_used = self.connection == "series" or (self.connection == "switching" and self.switch_series)
+        rules = [
+            ("climate", self.sky == "hottel", "is only used by sky hottel"),
+            ("linke_turbidity", self.sky == "ineichen" or self.weather is not None,
+             "is only used by sky ineichen and weather files"),
+            ("sky", self.weather is None, "has no use with a weather file (its light shapes the minutes)"),
+            ("albedo", self.sky_transposition() != "none", "is only used with a transposition (diffuse light)"),
+            ("switch_series", self.connection == "switching", "is only used by connection switching"),
+            ("bypass_diodes", series_used, "is only used where series is (connection series, or switching "
+                                           "with switch_series)"),
+            ("converter_efficiency", self.connection == "independent", "is only used by connection independent"),
+            ("temperature_model", iv_model, "is only used by pv_model single-diode or b-model"),
+            ("temp_air", iv_model and self.weather is None,
+             "is only used by pv_model single-diode or b-model, without a weather file (which brings its own)"),
+            ("wind_speed", iv_model, "is only used by pv_model single-diode or b-model"),
+            ("exact_electrical", iv_model, "is only used by pv_model single-diode or b-model"),
+        ]
+        idle = [f"{name} = {getattr(self, name)!r}: {why}" for name, used, why in rules
+                if not used and getattr(self, name) not in _as_tuple(defaults[name])]
+        if self.tracker.drive != "wh-per-degree" and self.tracker.wh_per_degree:
+            idle.append(f"tracker.wh_per_degree = {self.tracker.wh_per_degree!r}: is only used by tracker.drive "
+                        "wh-per-degree")
+        return idle
+
     def sky_transposition(self) -> str:
         """The diffuse model in force: none for beam-only skies unless a weather file gives diffuse."""
         if self.transposition is not None:
             return self.transposition
-        return "none" if self.mode == "paper" or (self.weather is None and self.sky in SKY_MODELS) else "perez"
+        return "none" if self.mode == "paper" or (self.weather is None and self.sky in names.BEAM_SKIES) else "perez"
 
     @field_validator("tracker", mode="before")
     @classmethod
@@ -300,7 +350,11 @@ class Study(_Strict):
         if module is not None:
             if info.data.get("pv_model") != "single-diode":
                 raise ValueError("module is only used with pv_model single-diode")
-            cec_module(module)
+            from foldopt.pvmodel import (
+                cec_module_name,  # pvlib's CEC database, only when a module is named
+            )
+
+            return cec_module_name(module)
         return module
 
     def variant(self, **changes) -> Study:
@@ -313,6 +367,8 @@ class Study(_Strict):
         Studies are kept unresolved so that a variant (another mode, another latitude) gets its
         own defaults; :class:`foldopt.study.Day` resolves the study it runs.
         """
+        from foldopt.geometry import default_orientation
+
         tilt, azimuth = default_orientation(self.site.latitude)
         panel = self.panel.model_copy(
             update={
@@ -332,20 +388,24 @@ class Study(_Strict):
         )
 
 
+def _format_error(item: dict) -> list[str]:
+    """The lines of one pydantic error: ``field = value: problem``."""
+    field = ".".join(str(part) for part in item["loc"])
+    message = item["msg"].removeprefix("Value error, ")
+    if not field:
+        # The study's own checks name their fields themselves.
+        return message.splitlines() if item["type"] == "value_error" else [f"study: {message}"]
+    if item["type"] == "missing":
+        return [f"{field}: required field is missing"]
+    if item["type"] == "extra_forbidden":
+        return [f"{field}: unknown field"]
+    if isinstance(item["input"], dict):
+        return [f"{field}: {message}"]
+    return [f"{field} = {item['input']!r}: {message}"]
+
+
 def _format_errors(error: ValidationError) -> list[str]:
-    lines = []
-    for item in error.errors():
-        field = ".".join(str(part) for part in item["loc"]) or "study"
-        message = item["msg"].removeprefix("Value error, ")
-        if item["type"] == "missing":
-            lines.append(f"{field}: required field is missing")
-        elif item["type"] == "extra_forbidden":
-            lines.append(f"{field}: unknown field")
-        elif isinstance(item["input"], dict):
-            lines.append(f"{field}: {message}")
-        else:
-            lines.append(f"{field} = {item['input']!r}: {message}")
-    return lines
+    return [line for item in error.errors() for line in _format_error(item)]
 
 
 def make_study(data: dict) -> Study:
@@ -538,6 +598,9 @@ def make_plan(data, lines: dict | None = None) -> Plan:
         raise ConfigError(errors)
 
     plan = Plan(data, tuple(axes))
+    if data.get("objective") is not None and "date" not in dict(axes):
+        raise ConfigError([_at(lines, ("objective",), "objective: one fold angle for several days needs several "
+                                                      "dates (a date range, 'year', or a weather file)")])
     if plan.n_cases > MAX_CASES:
         raise ConfigError([f"sweep: {plan.n_cases} cases exceed the limit of {MAX_CASES}"])
     first = {path: values[0] for path, values in axes}
@@ -579,13 +642,14 @@ def _validation_errors(plan: Plan, choice: dict, lines: dict, where: dict) -> li
         plan.study(choice)
     except ValidationError as error:
         messages = []
-        for item, message in zip(error.errors(), _format_errors(error), strict=True):
-            loc = tuple(str(part) for part in item["loc"])
-            for path, (label, yaml_path) in where.items():
-                if ".".join(loc).startswith(path):
-                    message = message.replace(".".join(loc), label, 1)
-                    loc = yaml_path
-            messages.append(_at(lines, loc, message))
+        for item in error.errors():
+            for message in _format_error(item):
+                loc = tuple(str(part) for part in item["loc"])
+                for path, (label, yaml_path) in where.items():
+                    if ".".join(loc).startswith(path):
+                        message = message.replace(".".join(loc), label, 1)
+                        loc = yaml_path
+                messages.append(_at(lines, loc, message))
         return messages
     return []
 
@@ -616,6 +680,12 @@ def _yaml_lines(node, path=(), out=None) -> dict:
 
 def load_plan(path: Path | str) -> Plan:
     """Read and validate a YAML study (with any sweep axes); raises :class:`ConfigError`."""
+    return make_plan(*read_study(path))
+
+
+def read_study(path: Path | str) -> tuple:
+    """The data of a YAML study file and the line of each of its keys; a relative weather path is
+    made relative to the file. Raises :class:`ConfigError` for a file that cannot be read."""
     path = Path(path)
     try:
         text = path.read_text()
@@ -633,7 +703,7 @@ def load_plan(path: Path | str) -> Plan:
         raise ConfigError([f"config: {path}{line}: {problem}"]) from None
     if isinstance(data, dict):
         data = _resolve_weather_path(data, path.parent)
-    return make_plan(data, lines)
+    return data, lines
 
 
 def _resolve_weather_path(data: dict, folder: Path) -> dict:

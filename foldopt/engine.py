@@ -29,10 +29,10 @@ from foldopt.electrical import Electrical
 from foldopt.geometry import normal_vector, subpanel_orientation
 from foldopt.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.metrics import energy, t_solar, t_solar_contiguous
+from foldopt.names import ENGINES
 from foldopt.pvmodel import PVModel
 from foldopt.sky import Sky
 
-ENGINES = ("numba", "numpy")
 #: What :func:`row_metrics` can evaluate: the connections, and ``panel``, the whole panel as one.
 OUTPUTS = CONNECTIONS + ("panel",)
 

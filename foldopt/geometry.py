@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-GEOMETRIES = ("azimuth-split", "hinge")
+from foldopt.names import GEOMETRIES
 
 
 def default_orientation(latitude: float) -> tuple[float, float]:

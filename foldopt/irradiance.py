@@ -32,8 +32,10 @@ from __future__ import annotations
 import numpy as np
 import pvlib
 
+from foldopt import names
+
 INCIDENCE_MODELS = ("paper", "exact")
-TRANSPOSITIONS = ("isotropic", "haydavies", "perez")
+TRANSPOSITIONS = tuple(name for name in names.TRANSPOSITIONS if name != "none")
 
 
 def beam_incidence_factor(surface_tilt, surface_azimuth, solar_zenith, solar_azimuth, model="exact"):

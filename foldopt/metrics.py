@@ -134,3 +134,14 @@ def load_for_t_solar(p_pv, target_t_solar, step_hours):
     if shortfall(smallest) < 0:
         return float("nan")
     return brentq(shortfall, smallest, peak, xtol=peak * 1e-12)
+
+
+def notes(condition, t_solar_h):
+    """A report's note: the day's condition (:meth:`foldopt.sky.Sky.conditions`) and, where direct
+    light arrives but the design never reaches the load, ``load above peak``; joined by ``; ``."""
+    condition, hours = np.broadcast_arrays(np.asarray(condition, dtype=object), np.asarray(t_solar_h))
+    # On a polar night or an overcast day the condition is the reason already.
+    dark = np.array([("polar night" in c) or ("overcast" in c) for c in condition.ravel()]).reshape(hours.shape)
+    above = (hours == 0) & ~dark
+    return np.array(["; ".join(p for p in (c, "load above peak" if a else "") if p)
+                     for c, a in zip(condition.ravel(), above.ravel(), strict=True)], dtype=object).reshape(hours.shape)

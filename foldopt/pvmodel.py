@@ -28,15 +28,17 @@ References
 
 from __future__ import annotations
 
+import difflib
 import functools
+import re
 from dataclasses import dataclass
 
 import numpy as np
 import pvlib
 from scipy.special import lambertw
 
-PV_MODELS = ("ideal", "single-diode", "b-model")
-TEMPERATURE_MODELS = ("fixed", "sapm")
+from foldopt.names import PV_MODELS, TEMPERATURE_MODELS
+
 IRRADIANCE_REF = 1000.0  # [W/m^2], STC
 TEMPERATURE_REF = 25.0  # [C], STC
 
@@ -85,13 +87,42 @@ def _cec_modules():
     return pvlib.pvsystem.retrieve_sam("CECMod")
 
 
+def _squashed(name: str) -> str:
+    return re.sub(r"[^0-9a-z]", "", name.lower())
+
+
+def cec_module_name(name: str) -> str:
+    """The exact name in pvlib's bundled CEC database [2]_ of a module given by any part of it,
+    without regard to case and punctuation: ``CS5P-220M`` is ``Canadian_Solar_Inc__CS5P_220M``.
+
+    Raises
+    ------
+    ValueError
+        Where no module matches (with the closest names) or several do (with some of them).
+    """
+    modules = _cec_modules().columns
+    if name in modules:
+        return name
+    key = _squashed(name)
+    squashed = {_squashed(module): module for module in modules}
+    if key in squashed:
+        return squashed[key]
+    matches = [module for short, module in squashed.items() if key and key in short]
+    if len(matches) == 1:
+        return matches[0]
+    if matches:
+        raise ValueError(f"module {name!r} matches {len(matches)} modules of pvlib's CEC database, such as "
+                         f"{', '.join(matches[:4])}; give more of the name")
+    close = [squashed[short] for short in difflib.get_close_matches(key, squashed, n=4, cutoff=0.6)]
+    hint = f"; did you mean {', '.join(close)}?" if close else ""
+    raise ValueError(f"module {name!r} is not in pvlib's CEC database{hint}")
+
+
 def cec_module(name: str) -> DiodeUnit:
-    """A module of pvlib's bundled CEC database [2]_ by its exact name (e.g. ``Canadian_Solar_Inc__CS5P_220M``)."""
+    """A module of pvlib's bundled CEC database [2]_ by its name (any part of it, see
+    :func:`cec_module_name`)."""
+    name = cec_module_name(name)
     modules = _cec_modules()
-    if name not in modules.columns:
-        close = [m for m in modules.columns if name.lower().replace(" ", "_") in m.lower()][:5]
-        hint = f"; close matches: {', '.join(close)}" if close else ""
-        raise ValueError(f"module {name!r} is not in pvlib's CEC database{hint}")
     m = modules[name]
     return DiodeUnit(
         name=name,

@@ -1,19 +1,12 @@
-"""Results folders: CSV tables, PNG plots and ``run.json``.
-
-A folder is built under a temporary name beside its destination and renamed into place only when
-complete, so a failed run never leaves a half-written folder, and an existing folder is replaced
-only when the caller asks for it.
-"""
+"""Results folders: CSV tables, PNG plots and ``run.json`` (built atomically, see
+:mod:`foldopt.folders`), and the digests a command line prints of them."""
 
 from __future__ import annotations
 
 import hashlib
 import json
-import os
 import platform
-import shutil
 import sys
-from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
 
@@ -25,43 +18,12 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from foldopt.aggregation import SWITCH_STATES  # noqa: E402
+from foldopt.folders import staged_folder  # noqa: E402
 from foldopt.config import Study  # noqa: E402
 from foldopt.study import StudyResult  # noqa: E402
 
 FLOAT_FORMAT = "%.10g"
 VERSIONED = ("foldopt", "numpy", "scipy", "pandas", "pvlib", "matplotlib", "pydantic", "typer")
-
-
-class OutputExistsError(FileExistsError):
-    """The results folder exists and overwriting was not asked for."""
-
-
-def check_output(out: Path, overwrite: bool) -> None:
-    """Raise :class:`OutputExistsError` if ``out`` exists and ``overwrite`` is false."""
-    if out.exists() and not overwrite:
-        raise OutputExistsError(f"{out} already exists; pass --overwrite to replace it")
-
-
-@contextmanager
-def staged_folder(out: Path, overwrite: bool):
-    """Yield a temporary folder that replaces ``out`` atomically when the block succeeds."""
-    check_output(out, overwrite)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    staging = out.parent / f".{out.name}.tmp-{os.getpid()}"
-    shutil.rmtree(staging, ignore_errors=True)
-    staging.mkdir()
-    try:
-        yield staging
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
-    if out.exists():
-        retired = out.parent / f".{out.name}.old-{os.getpid()}"
-        out.rename(retired)
-        staging.rename(out)
-        shutil.rmtree(retired)
-    else:
-        staging.rename(out)
 
 
 def versions() -> dict[str, str]:
@@ -417,14 +379,16 @@ def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, path: Path, title: str)
     _save(fig, path)
 
 
-def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool = False, command=None) -> pd.DataFrame:
-    """Write ``sizing.csv``, ``sizing_best.csv``, the net-benefit plot and ``run.json``; return the best rows."""
+def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool = False, command=None,
+                 parameters: dict | None = None) -> pd.DataFrame:
+    """Write ``sizing.csv``, ``sizing_best.csv``, the net-benefit plot and ``run.json`` (with the
+    sizing ``parameters``: costs, price, lifetime); return the best rows."""
     best = table.loc[table.groupby("design", sort=False)["net_benefit_usd"].idxmax()].reset_index(drop=True)
     with staged_folder(out, overwrite) as folder:
         table.to_csv(folder / "sizing.csv", index=False, float_format=FLOAT_FORMAT)
         best.to_csv(folder / "sizing_best.csv", index=False, float_format=FLOAT_FORMAT)
         plot_sizing(table, best, folder / "net_benefit_vs_area.png", f"{study.name}: panel sizing (Shin et al. Sec. IV-A)")
-        _write_json(folder / "run.json", run_metadata(study.resolved(), command,
+        _write_json(folder / "run.json", run_metadata(study.resolved(), command, sizing=parameters,
                                                        input_sha256=input_hash(study.model_dump(mode="json"))))
     return best
 
@@ -590,3 +554,65 @@ def annual_outputs(result, folder: Path, name: str) -> list[str]:
                       f"{name}: connection the switch chooses at {angle:g}°", "")
         written += ["day_hour_power.png", "day_hour_switch_state.png"]
     return written
+
+
+# --- Digests: the answer first, in a few numbers -------------------------------------------------
+
+
+def _number(value):
+    """A plain float, or None where a table shows "-" (NaN)."""
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def digest_study(result: StudyResult) -> dict:
+    """The answer of one study in a few numbers: the best fold angle, its gains, the notes."""
+    study, summary = result.study, result.summary.set_index("design")
+    twofold = summary.loc["twofold"]
+    return {
+        "study": study.name, "mode": study.mode, "pv_model": study.pv_model, "connection": study.connection,
+        "site": {"name": study.site.name, "latitude": study.site.latitude, "longitude": study.site.longitude},
+        "date": study.date.isoformat(), "p_load_w": study.p_load,
+        "fold_angle_deg": result.optimal_fold_angle, "heuristic_fold_angle_deg": _number(result.heuristic_fold_angle),
+        "t_solar_h": {design: _number(summary.loc[design, "t_solar_h"])
+                      for design in ("flat", "twofold", "tracker", "tracker-net")},
+        "gain_vs_flat_pct": _number(twofold["gain_vs_flat_pct"]),
+        "pct_of_tracker_t_solar": _number(twofold["pct_of_tracker_t_solar"]),
+        "flat_area_multiple": _number(twofold["flat_area_multiple"]),
+        "tracker_break_even_standby_w": _number(result.standby[1]),
+        "notes": sorted({note for note in summary["note"] if note}),
+    }
+
+
+def digest_sweep(result) -> dict:
+    """The answer of a sweep in a few numbers: where folding gains most, the fold angles, the notes,
+    and with an annual objective each load's angle and year."""
+    table = result.table
+    twofold = table[table["design"] == "twofold"]
+    gains = twofold["gain_vs_flat_pct"].dropna()
+    digest = {
+        "study": result.plan.base.name, "cases": result.plan.n_cases,
+        "axes": {path: len(values) for path, values in result.plan.axes},
+        "fold_angle_deg": {"min": _number(twofold["fold_angle_deg"].min()),
+                           "max": _number(twofold["fold_angle_deg"].max())},
+        "notes": {note: int(count) for note, count in
+                  twofold["note"].str.split("; ").explode().value_counts().items() if note},
+    }
+    if len(gains):
+        best = twofold.loc[gains.idxmax()]
+        digest["gain_vs_flat_pct"] = {
+            "median": _number(gains.median()), "max": _number(gains.max()),
+            "at": {column: best[column].item() if hasattr(best[column], "item") else best[column]
+                   for column in result.varied if column in best and column != "day_of_year"},
+        }
+    if result.extras and table["site_name"].nunique() == 1 and table["latitude"].nunique() == 1:
+        summary = annual_summary(table, ["p_load_w"]).set_index(["p_load_w", "design"])
+        digest["year"] = [
+            {"p_load_w": float(load), "fold_angle_deg": _number(summary.loc[(load, "twofold"), "fold_angle_deg"]),
+             "mean_t_solar_h": {design: _number(summary.loc[(load, design), "mean_h"])
+                                for design in ("flat", "twofold", "tracker")},
+             "t_solar_gain_vs_flat_pct": _number(summary.loc[(load, "twofold"), "t_solar_gain_vs_flat_pct"]),
+             "energy_gain_vs_flat_pct": _number(summary.loc[(load, "twofold"), "energy_gain_vs_flat_pct"])}
+            for load in sorted(table["p_load_w"].unique())
+        ]
+    return digest

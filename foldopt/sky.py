@@ -22,7 +22,15 @@ from foldopt.config import Study, parse_timezone
 from foldopt.geometry import normal_vector
 from foldopt.irradiance import sky_diffuse_terms
 from foldopt.solarposition import ClockGrid, clock_grid, solar_position_grid
-from foldopt.weather import CLEAR_SKIES, clear_sky, read_weather, sub_hourly, weather_days, weather_site
+from foldopt.weather import (
+    CLEAR_SKIES,
+    clear_sky,
+    read_weather,
+    sub_hourly,
+    weather_days,
+    weather_site,
+)
+
 
 @dataclass(frozen=True)
 class Sky:
@@ -88,6 +96,16 @@ class Sky:
         """cos(zenith), sin(zenith), sin(azimuth), cos(azimuth): the sun's part of Eq. 5."""
         zenith, azimuth = np.radians(self.solar_zenith), np.radians(self.solar_azimuth)
         return np.stack([np.cos(zenith), np.sin(zenith), np.sin(azimuth), np.cos(azimuth)], axis=-1)
+
+    def conditions(self) -> np.ndarray:
+        """What kind of day each block is, for the notes of reports: ``polar night`` (the sun does
+        not rise), ``polar day`` (it does not set), ``overcast`` (it is up but no direct light
+        arrives all day), joined by ``; ``, or ``""``. (n_blocks,) of str."""
+        up = self.solar_zenith < 90.0
+        rises, sets = up.any(axis=1), ~up.all(axis=1)
+        overcast = rises & ~((self.dni > 0) & up).any(axis=1)
+        parts = [np.where(~rises, "polar night", ""), np.where(~sets, "polar day", ""), np.where(overcast, "overcast", "")]
+        return np.array(["; ".join(p for p in block if p) for block in zip(*parts, strict=True)], dtype=object)
 
     def block(self, index: int) -> Sky:
         """One block as a sky of its own (arrays keep their leading axis, of length 1)."""

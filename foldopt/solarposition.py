@@ -40,7 +40,8 @@ import numpy as np
 import pandas as pd
 import pvlib
 
-MODES = ("paper", "exact")
+from foldopt.names import MODES
+
 _NS_PER_HOUR = 3_600_000_000_000
 _NS_PER_DAY = 24 * _NS_PER_HOUR
 

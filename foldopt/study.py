@@ -17,11 +17,17 @@ import pandas as pd
 from foldopt import engine as engines
 from foldopt.aggregation import CONNECTIONS, SWITCH_STATES
 from foldopt.config import Study
-from foldopt.metrics import load_for_t_solar, metric_columns, t_solar
+from foldopt.metrics import load_for_t_solar, metric_columns, notes, t_solar
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.sizing import flat_area_multiple
 from foldopt.sky import Sky, build_sky
-from foldopt.tracker import TRACKERS, TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
+from foldopt.tracker import (
+    TRACKERS,
+    TrackerDrive,
+    TrackerOptions,
+    tracker_draw,
+    tracker_orientation,
+)
 
 
 def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
@@ -223,6 +229,7 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
         flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 else np.nan
         for hours in summary["t_solar_h"]
     ]
+    summary["note"] = notes(day.sky.conditions()[0], summary["t_solar_h"].to_numpy())
     standby = standby_sweep(day, p_tracker, by_design["twofold"])
 
     at_best, state = day.connections(np.array([best_angle]))

@@ -21,7 +21,7 @@ import pandas as pd
 
 from foldopt import engine as engines
 from foldopt.config import Plan, Study
-from foldopt.metrics import energy, metric_columns
+from foldopt.metrics import energy, metric_columns, notes
 from foldopt.sky import Sky, build_sky
 from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
 
@@ -173,7 +173,7 @@ def _design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str
         ),
         "poa_kwh_m2": per_design(twofold.irradiation, np.repeat(flat.irradiation[:, None], n_loads, axis=1),
                                  np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
-        "sun_up": np.broadcast_to(np.any(sky.dni > 0, axis=1)[:, None, None], hours.shape),
+        "condition": np.broadcast_to(sky.conditions()[:, None, None], hours.shape),
     }
 
 
@@ -203,7 +203,8 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     ----------
     plan : Plan
     progress : callable, optional
-        Called as ``progress(done, total)`` with the cases (days) done so far.
+        Called as ``progress(done, total)`` with the days done so far, counted once per case
+        (an annual objective passes over each day twice: halves count).
     engine : {'numba', 'numpy'}
         :data:`foldopt.engine.ENGINES`.
 
@@ -212,8 +213,8 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     SweepResult
         Columns: the case (``site_name``, ``latitude``, ``longitude``, ``date``, ``day_of_year``,
         ``p_load_w`` and any other swept field by its path), ``design``, ``fold_angle_deg`` and the
-        daily metrics, ``gain_vs_flat_pct``, ``pct_of_tracker_t_solar`` and ``note`` (``polar
-        night`` or ``load above peak`` when ``t_solar`` is 0 for those reasons).
+        daily metrics, ``gain_vs_flat_pct``, ``pct_of_tracker_t_solar`` and ``note``
+        (:func:`foldopt.metrics.notes`: polar night, polar day, overcast, load above peak).
     """
     axes = dict(plan.axes)
     loads = np.asarray(axes.pop("p_load", (plan.data.get("p_load"),)), dtype=float)
@@ -224,14 +225,15 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     # A fixed panel keeps one fold angle all year: an annual group is the dates of one choice.
     studies = [plan.study({**choice, "p_load": float(loads[0]), **({"date": dates[0]} if dates else {})})
                for choice in choices]
-    total = len(choices) * (2 * len(dates) if dates else 1)
+    passes = 2 if dates else 1  # an annual group: find the angle over the days, then evaluate them
+    total = len(choices) * (len(dates) if dates else 1)
     done = 0
 
     def advance(count):
         nonlocal done
         done += count
         if progress is not None:
-            progress(done, total)
+            progress(done / passes, total)
 
     results: list = [None] * len(choices)
     extras: dict = {}
@@ -321,14 +323,13 @@ def _table(cases, loads, metrics) -> pd.DataFrame:
     columns["fold_angle_deg"] = metrics["fold_angle_deg"].ravel()
     hours = metrics["t_solar_h"]
     for name in metrics:
-        if name not in ("fold_angle_deg", "sun_up"):
+        if name not in ("fold_angle_deg", "condition"):
             columns[name] = metrics[name].ravel()
     with np.errstate(divide="ignore", invalid="ignore"):
         flat, tracker = hours[..., :1], hours[..., 2:3]
         columns["gain_vs_flat_pct"] = np.where(flat > 0, (hours / flat - 1.0) * 100.0, np.nan).ravel()
         columns["pct_of_tracker_t_solar"] = np.where(tracker > 0, hours / tracker * 100.0, np.nan).ravel()
-    sun_up = metrics["sun_up"].ravel()
-    columns["note"] = np.where(~sun_up, "polar night", np.where(hours.ravel() == 0, "load above peak", ""))
+    columns["note"] = notes(metrics["condition"], hours).ravel()
     table = pd.DataFrame(columns)
     for name in case_rows[0]:
         table[name] = table[name].infer_objects()

@@ -35,15 +35,7 @@ import numpy as np
 import pvlib
 
 from foldopt.geometry import normal_vector, orientation_from_normal
-
-TRACKERS = ("dual-axis", "equatorial", "dual-axis-steps", "single-axis")
-DRIVES = ("motor", "wh-per-degree")
-
-#: Alexandru's half law as offsets from solar noon [h]. His 12 actuating times (local time) pair
-#: up symmetrically about 13.319 h: 8.839/17.799, 9.819/16.819, 10.619/16.019, 11.489/15.149,
-#: 12.189/14.449, 12.919/13.719. (He gives solar noon as 13.206 h local; the 6.8 min offset is
-#: left out, the law being symmetric about solar noon by construction.)
-ALEXANDRU_STEP_OFFSETS_H = (0.400, 1.130, 1.830, 2.700, 3.500, 4.480)
+from foldopt.names import ALEXANDRU_STEP_OFFSETS_H, DRIVES, TRACKERS
 
 
 def equatorial_normal(hour_angle, declination, latitude):

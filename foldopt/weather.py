@@ -35,11 +35,11 @@ import numpy as np
 import pandas as pd
 import pvlib
 
-WEATHER_FORMATS = ("tmy3", "epw", "pvgis")
+from foldopt.names import CLEAR_SKIES, WEATHER_FORMATS
+
 #: Which edge of its interval each format's timestamp marks, as pvlib.iotools returns it
 #: (checked for TMY3 and EPW in tests/test_weather.py).
 INTERVAL_LABELS = {"tmy3": "end", "epw": "start", "pvgis": "start"}
-CLEAR_SKIES = ("ineichen", "simplified-solis")
 #: Bound of the clear-sky index at every step (pvlib's default: over-irradiance up to twice clear).
 MAX_CLEARSKY_INDEX = 2.0
 

@@ -55,7 +55,9 @@ def test_run_default_study_writes_the_whole_folder(tmp_path):
     assert meta["mode"] == "paper" and meta["study"]["geometry"] == "azimuth-split"
     assert meta["study"]["p_load"] == pytest.approx(4.398)
     assert {"foldopt", "numpy", "pvlib", "python"} <= set(meta["versions"])
-    assert "7.730" in result.stdout
+    # The short answer: the optimum and the flat panel's 7.73 h that P_load was inferred from.
+    assert "best fold angle 28.5 deg" in result.stdout and "over flat (7.73 h)" in result.stdout
+    assert str(out) in result.stdout and "sweep.csv" not in result.stdout
 
 
 def test_existing_folder_is_kept_unless_overwrite(tmp_path, fast_config):
@@ -79,8 +81,8 @@ def test_existing_folder_is_kept_unless_overwrite(tmp_path, fast_config):
         ({"p_load": -1}, ["p_load", "(0, 1e+06]"]),
         ({"panel": {"area": 0}}, ["panel.area", "(0, 1000]"]),
         ({"panel": {"area": 1, "efficiency": 1.5}}, ["panel.efficiency", "(0, 1]"]),
-        ({"mode": "fast"}, ["mode", "'paper' or 'exact'"]),
-        ({"geometry": "tent"}, ["geometry", "'azimuth-split' or 'hinge'"]),
+        ({"mode": "fast"}, ["mode", "must be one of paper, exact"]),
+        ({"geometry": "tent"}, ["geometry", "azimuth-split, hinge"]),
         ({"date": "2014-02-30"}, ["date"]),
         ({"colour": "red"}, ["colour", "unknown field"]),
         ({"site": {"latitude": "north", "longitude": 0}}, ["site.latitude", "number"]),
@@ -143,7 +145,7 @@ def test_sweep_angle_writes_sweep_and_summary(tmp_path):
         ("--area", "-1", ["--area", "(0, 1000]"]),
         ("--efficiency", "1.5", ["--efficiency", "(0, 1]"]),
         ("--tilt", "120", ["--tilt", "[0, 90]"]),
-        ("--mode", "fast", ["--mode", "'paper' or 'exact'"]),
+        ("--mode", "fast", ["--mode", "paper, exact"]),
         ("--geometry", "tent", ["--geometry"]),
         ("--sky", "cloudy", ["--sky", "meinel"]),
         ("--tracker", "heliostat", ["--tracker", "single-axis"]),
@@ -187,9 +189,14 @@ def test_unknown_cec_module_is_named(tmp_path):
     assert_one_line_error(invoke("sweep", "angle", *args), "--module", "CEC database")
 
 
-def test_sweep_angle_missing_option_names_it(tmp_path):
-    args = FAST_SWEEP[2:]  # drop --lat
-    assert_one_line_error(invoke("sweep", "angle", *args, "--out", tmp_path / "o"), "--lat", "missing")
+def test_sweep_angle_takes_what_is_not_given_from_the_embedded_study(tmp_path):
+    result = invoke("sweep", "angle", "--lat", "40", "--out", tmp_path / "o")
+    assert result.exit_code == 0, result.output
+    study = json.loads((tmp_path / "o" / "run.json").read_text())["study"]
+    assert study["site"]["latitude"] == 40 and study["site"]["longitude"] == -118.25
+    assert study["panel"]["tilt"] == 40  # tilt follows the new latitude
+    assert (study["p_load"], study["date"]) == (4.398, "2014-09-23")
+    assert "from configs/shin2015.yaml: date 2014-09-23, panel 0.108 m^2, P_load 4.398 W" in result.stdout
 
 
 def test_reproduce_writes_the_agreed_table(tmp_path):

@@ -31,15 +31,21 @@ def cases(draw):
     mode = draw(st.sampled_from(["paper", "exact"]))
     sky = draw(st.sampled_from(["meinel", "hottel"] + (["ineichen", "simplified-solis"] if mode == "exact" else [])))
     diffuse = sky in ("ineichen", "simplified-solis") or (mode == "exact" and draw(st.booleans()))
+    # The connection's own options only with it (a setting nothing uses is an error); the engine
+    # evaluates every connection whatever the study's.
+    connection = draw(st.sampled_from(["switching", "series", "independent"]))
+    switch_series = connection == "switching" and draw(st.booleans())
+    series_used = connection == "series" or switch_series
     study = make_study({
         "name": "kernel", "mode": mode, "sky": sky,
         "geometry": draw(st.sampled_from(["azimuth-split", "hinge"])),
         "transposition": draw(st.sampled_from(["isotropic", "haydavies", "perez"])) if diffuse else "none",
-        "albedo": draw(st.floats(0, 0.5)),
+        "albedo": draw(st.floats(0, 0.5)) if diffuse else 0.2,
         "iam": draw(st.sampled_from(["none", "ashrae", "physical"])),
         "pv_model": draw(st.sampled_from(["ideal", "single-diode", "b-model"])),
-        "switch_series": draw(st.booleans()), "bypass_diodes": draw(st.booleans()),
-        "converter_efficiency": draw(st.floats(0.8, 1.0)),
+        "connection": connection, "switch_series": switch_series,
+        "bypass_diodes": draw(st.booleans()) if series_used else True,
+        "converter_efficiency": draw(st.floats(0.8, 1.0)) if connection == "independent" else 1.0,
         "site": {"latitude": 0.0, "longitude": 0.0},
         "date": "2025-01-01",
         "panel": {"area": draw(st.sampled_from([0.108, 0.2])), "efficiency": 0.19,

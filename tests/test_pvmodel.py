@@ -35,8 +35,13 @@ def test_cec_module_stc_power_matches_the_database():
     stc = float(pvlib.pvsystem.retrieve_sam("CECMod")[name]["STC"])
     power = PVModel("single-diode", module=name).max_power(np.array([1000.0]), 25.0, unit.area)
     assert power[0] == pytest.approx(stc, rel=2e-3)
-    with pytest.raises(ValueError, match="close matches"):
+    # Any part of the name, without regard to case and punctuation; ambiguous parts and unknown
+    # names are told so, with the closest names.
+    assert cec_module("cs5p-220m").name == name
+    with pytest.raises(ValueError, match="matches .* modules .* give more of the name"):
         cec_module("Canadian_Solar_Inc__CS5P")
+    with pytest.raises(ValueError, match="not in pvlib's CEC database; did you mean .*CS5P_220M"):
+        cec_module("Canadian Solar CS5P 220N")
 
 
 def test_b_fitted_from_table1_is_the_papers():

@@ -61,3 +61,15 @@ def test_loads_above_the_peak_are_reported_not_errors():
     assert (high["t_solar_h"] == 0).all()
     assert set(high["note"]) == {"load above peak"}
     assert (rows(table, "twofold")["t_solar_h"] >= rows(table, "flat")["t_solar_h"]).all()
+
+
+@pytest.mark.parametrize("objective", [None, {"statistic": "mean"}], ids=["per-day", "annual"])
+def test_progress_counts_days_to_the_total(objective):
+    plan = make_plan({**BASE, "date": "1:60:10", "year": 2025, "p_load": [2.0, 4.4], "objective": objective})
+    calls = []
+    run_plan(plan, lambda done, total: calls.append((done, total)))
+    days = plan.n_cases // 2
+    assert days == 6
+    assert {total for _, total in calls} == {days}
+    assert calls[-1][0] == days
+    assert all(b >= a for (a, _), (b, _) in zip(calls, calls[1:]))
