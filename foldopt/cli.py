@@ -51,11 +51,17 @@ Shell completion: foldopt --install-completion.
 """
 
 
+#: The command line as typed, for run.json (``sys.argv`` holds the script's path, or pytest's).
+_INVOCATION: list[str] = []
+
+
 class _OneLineErrors(TyperGroup):
     """Report usage errors (unknown option, bad number...) as one line, exit code 2."""
 
     def main(self, *args, **kwargs):
         kwargs["standalone_mode"] = False
+        given = kwargs.get("args", args[0] if args else None)
+        _INVOCATION[:] = ["foldopt", *(sys.argv[1:] if given is None else given)]
         try:
             code = super().main(*args, **kwargs)
         except _USAGE_ERROR as error:
@@ -252,7 +258,7 @@ def _run_plan(plan, out: Path, overwrite: bool, output: _Output, engine: str, de
             from foldopt.study import run_study
 
             result = run_study(base, engine)
-            write_study(result, out, overwrite)
+            write_study(result, out, overwrite, _INVOCATION)
         digest = digest_study(result)
         lines = _study_lines(digest, defaults) + [f"wrote {out}"]
         output.answer({"command": command, "out": str(out), "defaults": _taken(defaults), "summary": digest,
@@ -266,7 +272,7 @@ def _run_plan(plan, out: Path, overwrite: bool, output: _Output, engine: str, de
         from foldopt.sweep import run_plan
 
         result = run_plan(plan, progress, engine)
-        write_sweep(result, out, overwrite)
+        write_sweep(result, out, overwrite, _INVOCATION)
     digest = digest_sweep(result)
     lines = _sweep_lines(digest, defaults) + [f"wrote {out}"]
     twofold = result.table[result.table["design"] == "twofold"]
@@ -329,7 +335,7 @@ def reproduce(
 
             study = load_study(default_study_path())
             tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
-            write_reproduction(tables, study, out, overwrite, engine=engine)
+            write_reproduction(tables, study, out, overwrite, _INVOCATION, engine=engine)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
     lines = []
@@ -540,6 +546,7 @@ def _sweep_plan(axis: str, options: dict):
             panel[field] = options[key]
     data["site"], data["panel"] = site or None, panel
     data["name"] = f"sweep-{axis}"
+    data["description"] = f"foldopt sweep {axis} from {EMBEDDED if config is None else config} (see command)"
     simple = {"days": "date", "year": "year", "p_load": "p_load", "mode": "mode", "geometry": "geometry", "sky": "sky",
               "climate": "climate", "transposition": "transposition", "albedo": "albedo", "iam": "iam",
               "pv_model": "pv_model", "module": "module", "connection": "connection",
@@ -685,7 +692,7 @@ def size(
             from foldopt.study import Day
 
             sizing = size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
-            best = write_sizing(sizing, study, out, overwrite, parameters=parameters)
+            best = write_sizing(sizing, study, out, overwrite, _INVOCATION, parameters=parameters)
     except (ConfigError, OutputExistsError) as error:
         _fail(getattr(error, "errors", [str(error)]))
     cost = f"{cost_per_m2:g} $/m^2" if cost_per_w is None else f"{cost_per_w:g} $/W"

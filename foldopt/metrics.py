@@ -136,6 +136,16 @@ def load_for_t_solar(p_pv, target_t_solar, step_hours):
     return brentq(shortfall, smallest, peak, xtol=peak * 1e-12)
 
 
+def relative_to(t_solar_h, reference_h):
+    """``t_solar_h / reference_h`` [-], NaN where the reference never reaches the load (a gain over
+    nothing has no value); broadcast."""
+    t_solar_h, reference_h = np.broadcast_arrays(np.asarray(t_solar_h, dtype=float), np.asarray(reference_h,
+                                                                                              dtype=float))
+    ratio = np.full(t_solar_h.shape, np.nan)
+    np.divide(t_solar_h, reference_h, out=ratio, where=reference_h > 0)
+    return ratio
+
+
 def notes(condition, t_solar_h):
     """A report's note: the day's condition (:meth:`foldopt.sky.Sky.conditions`) and, where direct
     light arrives but the design never reaches the load, ``load above peak``; joined by ``; ``."""

@@ -20,6 +20,7 @@ import pandas as pd  # noqa: E402
 from foldopt.aggregation import SWITCH_STATES  # noqa: E402
 from foldopt.folders import staged_folder  # noqa: E402
 from foldopt.config import Study  # noqa: E402
+from foldopt.metrics import relative_to  # noqa: E402
 from foldopt.study import StudyResult  # noqa: E402
 
 FLOAT_FORMAT = "%.10g"
@@ -429,11 +430,10 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
     for reference, gain in (("flat", "gain_vs_flat_pct"), ("tracker", "pct_of_tracker")):
         base = summary[summary["design"] == reference].set_index(cases)[["energy_harvested_wh", "mean_h"]]
         matched = base.reindex(pd.MultiIndex.from_frame(summary[cases]) if len(cases) > 1 else summary[cases[0]])
-        energy = summary["energy_harvested_wh"].to_numpy() / matched["energy_harvested_wh"].to_numpy()
-        time = summary["mean_h"].to_numpy() / matched["mean_h"].to_numpy()
-        with np.errstate(divide="ignore", invalid="ignore"):
-            summary[f"energy_{gain}"] = (energy - 1.0) * 100.0 if reference == "flat" else energy * 100.0
-            summary[f"t_solar_{gain}"] = (time - 1.0) * 100.0 if reference == "flat" else time * 100.0
+        energy = relative_to(summary["energy_harvested_wh"], matched["energy_harvested_wh"].to_numpy())
+        time = relative_to(summary["mean_h"], matched["mean_h"].to_numpy())
+        summary[f"energy_{gain}"] = (energy - 1.0) * 100.0 if reference == "flat" else energy * 100.0
+        summary[f"t_solar_{gain}"] = (time - 1.0) * 100.0 if reference == "flat" else time * 100.0
     return summary
 
 

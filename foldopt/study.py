@@ -17,7 +17,7 @@ import pandas as pd
 from foldopt import engine as engines
 from foldopt.aggregation import CONNECTIONS, SWITCH_STATES
 from foldopt.config import Study
-from foldopt.metrics import load_for_t_solar, metric_columns, notes, t_solar
+from foldopt.metrics import load_for_t_solar, metric_columns, notes, relative_to, t_solar
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.sizing import flat_area_multiple
 from foldopt.sky import Sky, build_sky
@@ -222,9 +222,8 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
                                               curves.energy[:, 0], curves.peak[:, 0], p_load)})
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        summary["gain_vs_flat_pct"] = (summary["t_solar_h"] / flat_hours - 1.0) * 100.0
-        summary["pct_of_tracker_t_solar"] = summary["t_solar_h"] / tracker_hours * 100.0
+    summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
+    summary["pct_of_tracker_t_solar"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
     summary["flat_area_multiple"] = [
         flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 else np.nan
         for hours in summary["t_solar_h"]

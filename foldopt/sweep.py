@@ -21,7 +21,7 @@ import pandas as pd
 
 from foldopt import engine as engines
 from foldopt.config import Plan, Study
-from foldopt.metrics import energy, metric_columns, notes
+from foldopt.metrics import energy, metric_columns, notes, relative_to
 from foldopt.sky import Sky, build_sky
 from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
 
@@ -325,10 +325,8 @@ def _table(cases, loads, metrics) -> pd.DataFrame:
     for name in metrics:
         if name not in ("fold_angle_deg", "condition"):
             columns[name] = metrics[name].ravel()
-    with np.errstate(divide="ignore", invalid="ignore"):
-        flat, tracker = hours[..., :1], hours[..., 2:3]
-        columns["gain_vs_flat_pct"] = np.where(flat > 0, (hours / flat - 1.0) * 100.0, np.nan).ravel()
-        columns["pct_of_tracker_t_solar"] = np.where(tracker > 0, hours / tracker * 100.0, np.nan).ravel()
+    columns["gain_vs_flat_pct"] = ((relative_to(hours, hours[..., :1]) - 1.0) * 100.0).ravel()
+    columns["pct_of_tracker_t_solar"] = (relative_to(hours, hours[..., 2:3]) * 100.0).ravel()
     columns["note"] = notes(metrics["condition"], hours).ravel()
     table = pd.DataFrame(columns)
     for name in case_rows[0]:

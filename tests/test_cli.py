@@ -55,6 +55,7 @@ def test_run_default_study_writes_the_whole_folder(tmp_path):
     assert meta["mode"] == "paper" and meta["study"]["geometry"] == "azimuth-split"
     assert meta["study"]["p_load"] == pytest.approx(4.398)
     assert {"foldopt", "numpy", "pvlib", "python"} <= set(meta["versions"])
+    assert meta["command"] == ["foldopt", "run", "--out", str(out)]  # as typed, not the script's path
     # The short answer: the optimum and the flat panel's 7.73 h that P_load was inferred from.
     assert "best fold angle 28.5 deg" in result.stdout and "over flat (7.73 h)" in result.stdout
     assert str(out) in result.stdout and "sweep.csv" not in result.stdout

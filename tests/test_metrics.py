@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from foldopt.metrics import daily_metrics, load_for_t_solar, t_solar, t_solar_contiguous
+from foldopt.metrics import daily_metrics, load_for_t_solar, relative_to, t_solar, t_solar_contiguous
 from foldopt.sizing import flat_area_multiple
 
 P_MAX = 10.0
@@ -99,3 +99,9 @@ def test_t_solar_never_rises_with_the_load_and_contiguous_never_exceeds_total(cu
     assert t_solar(curve, low + rise, step) <= t_solar(curve, low, step) + 1e-12
     assert t_solar_contiguous(curve, low, step) <= t_solar(curve, low, step) + 1e-12
     assert 0.0 <= t_solar(curve, low, step) <= 24.0 + 1e-12
+
+
+def test_relative_to_has_no_value_over_nothing():
+    ratio = relative_to([2.0, 0.0, 3.0, 0.0], [1.0, 1.0, 0.0, 0.0])
+    np.testing.assert_array_equal(ratio[:2], [2.0, 0.0])
+    assert np.isnan(ratio[2:]).all()  # no inf, no warning: a gain over 0 h has no value
