@@ -66,7 +66,10 @@ class _OneLineErrors(TyperGroup):
             code = super().main(*args, **kwargs)
         except _USAGE_ERROR as error:
             message = error.format_message()
-            if message:  # empty after no_args_is_help has printed the help
+            if type(error).__name__ == "NoArgsIsHelpError":  # a bare `foldopt` or `foldopt sweep`
+                typer.echo(message)
+                sys.exit(0)
+            if message:
                 where = f"{error.ctx.command_path}: " if error.ctx is not None else ""
                 if message.startswith("No such command") and error.ctx is not None:
                     message += f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
@@ -82,7 +85,7 @@ app = typer.Typer(cls=_OneLineErrors, add_completion=True, pretty_exceptions_ena
                   rich_markup_mode=None, help=HELP)
 sweep_app = typer.Typer(rich_markup_mode=None, no_args_is_help=True,
                         help="Sweep one design variable over a range, everything else from the study.")
-app.add_typer(sweep_app, name="sweep")
+app.add_typer(sweep_app, name="sweep", short_help="Sweep fold angle, latitude, day or load [default ranges].")
 
 
 def _fail(lines: list[str]):
@@ -460,6 +463,14 @@ _SWEEP_HELP = {
 }
 
 
+_SWEEP_SHORT = {
+    "angle": "Every fold angle at one site, day and load (or over a weather file's year).",
+    "latitude": "Every latitude of a range [default: -60:60:5].",
+    "day": "Every day of a range [default: 1:365:7].",
+    "load": "Every load of a range [default: 5 % to 100 % of the panel's rating].",
+}
+
+
 def _register_sweep(axis: str) -> None:
     summary, examples = _SWEEP_HELP[axis]
 
@@ -469,7 +480,7 @@ def _register_sweep(axis: str) -> None:
     command.__signature__ = inspect.signature(_sweep_options)
     command.__annotations__ = dict(_sweep_options.__annotations__)
     command.__doc__ = summary + "\n\n\b\nExamples:\n" + "\n".join(f"  {example}" for example in examples)
-    sweep_app.command(axis)(command)
+    sweep_app.command(axis, short_help=_SWEEP_SHORT[axis])(command)
 
 
 def _sweep(axis: str, options: dict) -> None:

@@ -68,6 +68,13 @@ def test_the_summary_says_which_values_were_defaults(tmp_path):
     assert "t_solar_h" in table.stdout and len(table.stdout.splitlines()) > 4
 
 
+@pytest.mark.parametrize("command", [[], ["sweep"]], ids=["foldopt", "foldopt sweep"])
+def test_a_bare_command_prints_its_help(command):
+    result = invoke(*command)
+    assert result.exit_code == 0 and result.stdout.startswith("Usage:") and result.stderr == ""
+    assert "error" not in result.stdout and "..." not in result.stdout.split("Commands:")[1]
+
+
 def test_help_keeps_units_and_lists_every_accepted_name():
     top = invoke("--help")
     assert top.exit_code == 0 and "Examples:" in top.stdout and "--install-completion" in top.stdout
