@@ -12,19 +12,21 @@ from __future__ import annotations
 import inspect
 import json
 import re
+import signal
 import sys
+import threading
+import traceback
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Optional
 
 import typer
-import yaml
 from typer.core import TyperGroup
 
 from foldopt import names
 from foldopt.config import (DATE_KEYWORDS, ConfigError, default_study_path, load_plan, make_plan, parse_range,
-                            read_study, set_path)
-from foldopt.folders import OutputExistsError, check_output
+                            parse_study_text, read_study, set_path)
+from foldopt.folders import OutputError, OutputExistsError, check_output
 
 RESULTS = Path("results")
 # Typer >= 0.29 vendors click; its UsageError is reached through the public BadParameter.
@@ -55,15 +57,34 @@ Shell completion: foldopt --install-completion.
 _INVOCATION: list[str] = []
 
 
+#: Set by ``foldopt --debug``: an internal error shows its traceback.
+_DEBUG = {"on": False}
+
+
+def _terminate(signum, frame):
+    raise SystemExit(128 + signum)  # unwinds like an error: a staging folder is removed
+
+
 class _OneLineErrors(TyperGroup):
-    """Report usage errors (unknown option, bad number...) as one line, exit code 2."""
+    """The one error path of the command line. Bad input (usage, study, weather file, results
+    folder) is one line per fault and exit code 2; anything else is an internal error: one line
+    naming it, exit code 1, and the traceback only with ``--debug``."""
 
     def main(self, *args, **kwargs):
         kwargs["standalone_mode"] = False
         given = kwargs.get("args", args[0] if args else None)
         _INVOCATION[:] = ["foldopt", *(sys.argv[1:] if given is None else given)]
+        if threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, _terminate)
         try:
             code = super().main(*args, **kwargs)
+        except ConfigError as error:
+            for line in dict.fromkeys(error.errors):
+                typer.echo(f"error: {line}", err=True)
+            sys.exit(2)
+        except (OutputError, OutputExistsError) as error:
+            typer.echo(f"error: {error}", err=True)
+            sys.exit(2)
         except _USAGE_ERROR as error:
             message = error.format_message()
             if type(error).__name__ == "NoArgsIsHelpError":  # a bare `foldopt` or `foldopt sweep`
@@ -75,8 +96,16 @@ class _OneLineErrors(TyperGroup):
                     message += f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
                 typer.echo(f"error: {where}{message}", err=True)
             sys.exit(2)
-        except typer.Abort:
-            typer.echo("aborted", err=True)
+        except typer.Abort:  # Ctrl-C
+            typer.echo("interrupted", err=True)
+            sys.exit(130)
+        except Exception as error:
+            if _DEBUG["on"]:
+                traceback.print_exc()
+            else:
+                reason = str(error).splitlines()[0][:300] if str(error) else ""
+                typer.echo(f"error: internal error ({type(error).__name__}{': ' + reason if reason else ''}); "
+                           "run again as foldopt --debug ... for the traceback, and please report it", err=True)
             sys.exit(1)
         sys.exit(code if isinstance(code, int) else 0)
 
@@ -85,6 +114,13 @@ app = typer.Typer(cls=_OneLineErrors, add_completion=True, pretty_exceptions_ena
                   rich_markup_mode=None, help=HELP)
 sweep_app = typer.Typer(rich_markup_mode=None, no_args_is_help=True,
                         help="Sweep one design variable over a range, everything else from the study.")
+
+
+@app.callback()
+def _options(debug: bool = typer.Option(False, "--debug", help="Show the traceback of an internal error.")):
+    _DEBUG["on"] = debug
+
+
 app.add_typer(sweep_app, name="sweep", short_help="Sweep fold angle, latitude, day or load [default ranges].")
 
 
@@ -306,12 +342,8 @@ def run(
       foldopt run configs/annual-weather.yaml --out results/greensboro
     """
     output_format, engine = _check_choices(output_format, engine)
-    try:
-        plan = load_plan(config if config is not None else default_study_path())
-        _run_plan(plan, out or RESULTS / plan.base.name, overwrite, _Output(quiet, output_format, table), engine, [],
-                  "run")
-    except (ConfigError, OutputExistsError) as error:
-        _fail(getattr(error, "errors", [str(error)]))
+    plan = load_plan(config if config is not None else default_study_path())
+    _run_plan(plan, out or RESULTS / plan.base.name, overwrite, _Output(quiet, output_format, table), engine, [], "run")
 
 
 @app.command(short_help="Shin et al.'s published values beside foldopt's, paper and exact modes.")
@@ -329,18 +361,15 @@ def reproduce(
     """
     output_format, engine = _check_choices(output_format, engine)
     output = _Output(quiet, output_format)
-    try:
-        check_output(out, overwrite)
-        with output.progress("reproducing Shin et al. (two PV models x two modes)"):
-            from foldopt.config import load_study
-            from foldopt.report import write_reproduction
-            from foldopt.reproduce import REPRODUCTIONS, reproduce as reproduce_table
+    check_output(out, overwrite)
+    with output.progress("reproducing Shin et al. (two PV models x two modes)"):
+        from foldopt.config import load_study
+        from foldopt.report import write_reproduction
+        from foldopt.reproduce import REPRODUCTIONS, reproduce as reproduce_table
 
-            study = load_study(default_study_path())
-            tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
-            write_reproduction(tables, study, out, overwrite, _INVOCATION, engine=engine)
-    except (ConfigError, OutputExistsError) as error:
-        _fail(getattr(error, "errors", [str(error)]))
+        study = load_study(default_study_path())
+        tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
+        write_reproduction(tables, study, out, overwrite, _INVOCATION, engine=engine)
     lines = []
     for name, table in tables.items():
         model = "ideal PV model" if name == "reproduction" else "A-300 single-diode cells with switching"
@@ -494,10 +523,7 @@ def _sweep(axis: str, options: dict) -> None:
     varied = [path for path, _ in plan.axes if not (path == "date" and plan.base.objective is not None)]
     if axis == "angle" and varied:
         _fail([f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep latitude, day or load)"])
-    try:
-        _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, output, engine, defaults, f"sweep {axis}")
-    except OutputExistsError as error:
-        _fail([str(error)])
+    _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, output, engine, defaults, f"sweep {axis}")
 
 
 def _sweep_plan(axis: str, options: dict):
@@ -537,8 +563,9 @@ def _sweep_plan(axis: str, options: dict):
         options["lat"] = "-60:60:5"
     if axis == "day" and "days" not in given:
         options["days"] = "1:365:7"
-        if "year" not in given and "date" in data:
-            options["year"] = int(str(data["date"])[:4])
+    study_year = re.match(r"^(\d{4})-\d\d-\d\d$", str(data.get("date", "")))
+    if "year" not in given and "year" not in data and study_year:
+        options["year"] = int(study_year.group(1))  # days of year are the study's year's
     if axis == "load" and "p_load" not in given:
         rating = float(options["area"] or panel.get("area", 0.1)) * 1000.0 * float(
             options["efficiency"] or panel.get("efficiency", 0.2))
@@ -627,8 +654,8 @@ def _apply_setting(data: dict, setting: str) -> dict:
     if not separator or not key.strip():
         raise ConfigError([f"--set = {setting!r}: expected KEY=VALUE, e.g. tracker.gcr=0.4"])
     try:
-        value = yaml.safe_load(text)
-    except yaml.YAMLError:
+        value, _ = parse_study_text(text, f"--set {key}")
+    except ConfigError:
         raise ConfigError([f"--set {key} = {text!r}: not a YAML value"]) from None
     return set_path(data, key.strip(), value)
 
@@ -691,21 +718,18 @@ def size(
     output = _Output(quiet, output_format, table)
     parameters = {"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
                   "years": years, "days_per_year": days_per_year}
-    try:
-        from foldopt.config import load_study
+    from foldopt.config import load_study
 
-        study = load_study(config if config is not None else default_study_path())
-        out = out or RESULTS / f"{study.name}-sizing"
-        check_output(out, overwrite)
-        with output.progress(f"sizing {study.name}: {len(grid)} areas"):
-            from foldopt.report import write_sizing
-            from foldopt.sizing import size_panel
-            from foldopt.study import Day
+    study = load_study(config if config is not None else default_study_path())
+    out = out or RESULTS / f"{study.name}-sizing"
+    check_output(out, overwrite)
+    with output.progress(f"sizing {study.name}: {len(grid)} areas"):
+        from foldopt.report import write_sizing
+        from foldopt.sizing import size_panel
+        from foldopt.study import Day
 
-            sizing = size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
-            best = write_sizing(sizing, study, out, overwrite, _INVOCATION, parameters=parameters)
-    except (ConfigError, OutputExistsError) as error:
-        _fail(getattr(error, "errors", [str(error)]))
+        sizing = size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
+        best = write_sizing(sizing, study, out, overwrite, _INVOCATION, parameters=parameters)
     cost = f"{cost_per_m2:g} $/m^2" if cost_per_w is None else f"{cost_per_w:g} $/W"
     lines = [f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid {c_grid:g} $/kWh over "
              f"{years:g} years"]

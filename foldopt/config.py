@@ -11,6 +11,7 @@ import copy
 import datetime as dt
 import itertools
 import math
+import os
 import re
 import zoneinfo
 from dataclasses import dataclass
@@ -275,6 +276,8 @@ class Study(_Strict):
                     raise ValueError(f"weather: file not found: {path}")
                 try:
                     data = {**data, "site": _weather_site(path, fmt)}
+                except ConfigError as error:  # foldopt.weather.WeatherError: the file, the line, the reason
+                    raise ValueError(str(error)) from None
                 except (ValueError, KeyError, OSError) as error:
                     raise ValueError(f"weather: cannot read a site from {path} ({error.__class__.__name__})") from None
         return data
@@ -421,7 +424,60 @@ def make_study(data: dict) -> Study:
 # --- Plans: a study with sweep axes ------------------------------------------------------------
 
 DATE_KEYWORDS = ("year", "equinoxes-solstices")
-MAX_CASES = 2_000_000
+
+def _limit(name: str, default: int) -> int:
+    """A size limit, raised by the environment variable ``FOLDOPT_<NAME>``."""
+    text = os.environ.get(f"FOLDOPT_{name}")
+    try:
+        return int(float(text)) if text else default
+    except ValueError:
+        return default
+
+
+#: Values of one sweep axis (a range or a list).
+MAX_AXIS_VALUES = _limit("MAX_AXIS_VALUES", 10_000)
+#: Cases of a plan: one row of results.csv per case and design.
+MAX_CASES = _limit("MAX_CASES", 200_000)
+#: Site-days x fold angles x time steps of a plan: about 6 ns each on one core (README,
+#: "Performance"), so the default is a few minutes of work at most.
+MAX_EVALUATIONS = _limit("MAX_EVALUATIONS", 20_000_000_000)
+#: Days x fold angles x loads of one annual group (a fixed angle chosen over the days), held at
+#: once: 8 bytes each.
+MAX_ANNUAL_CELLS = _limit("MAX_ANNUAL_CELLS", 100_000_000)
+#: Bytes of a study file.
+MAX_STUDY_BYTES = _limit("MAX_STUDY_BYTES", 1_000_000)
+
+
+class StudyLoader(yaml.SafeLoader):
+    """YAML for studies: PyYAML's safe loader, less what a study never needs and an attacker or a
+    slip would use. Aliases (``*name``) are refused, so no "billion laughs" expansion; a key given
+    twice in one mapping is an error rather than silently the last; dates stay text, so that the
+    schema validates them (``2025-02-30`` is a field error, not a crash in the parser)."""
+
+    yaml_implicit_resolvers = {
+        first: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:timestamp"]
+        for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+    }
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.AliasEvent):
+            raise yaml.composer.ComposerError(None, None, "aliases (*name) are not accepted in a study; write the "
+                                              "value out", self.peek_event().start_mark)
+        return super().compose_node(parent, index)
+
+    def construct_mapping(self, node, deep=False):
+        first: dict = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            try:
+                if key in first:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"key {key!r} appears twice (first at line {first[key]})", key_node.start_mark)
+                first[key] = key_node.start_mark.line + 1
+            except TypeError:  # an unhashable key: the base class says so
+                break
+        return super().construct_mapping(node, deep)
+
 _RANGE = re.compile(r"^\s*([^:\s]+)\s*:\s*([^:\s]+)\s*:\s*([^:\s]+)\s*$")
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _NUMERIC_RANGE = re.compile(rf"^\s*{_NUMBER}\s*:\s*{_NUMBER}\s*:\s*{_NUMBER}\s*$")
@@ -440,7 +496,10 @@ def parse_range(text: str) -> list[float]:
         raise ValueError(f"step must be a positive number, got {text!r}")
     if stop < start:
         raise ValueError(f"empty range {text!r}: stop is below start")
-    count = int(math.floor((stop - start) / step + 1e-9)) + 1
+    count = math.floor((stop - start) / step + 1e-9) + 1
+    if count > MAX_AXIS_VALUES:
+        raise ValueError(f"{text!r} has {count:,} values; at most {MAX_AXIS_VALUES:,} per axis "
+                         "(FOLDOPT_MAX_AXIS_VALUES raises it)")
     return [round(start + i * step, 12) for i in range(count)]
 
 
@@ -553,6 +612,9 @@ def _axis_values(path: str, spec, year: int) -> list:
     if isinstance(spec, list):
         if not spec:
             raise ValueError("empty list")
+        if len(spec) > MAX_AXIS_VALUES:
+            raise ValueError(f"a list of {len(spec):,} values; at most {MAX_AXIS_VALUES:,} per axis "
+                             "(FOLDOPT_MAX_AXIS_VALUES raises it)")
         return list(spec)
     if isinstance(spec, str) and _RANGE.match(spec):
         return parse_range(spec)
@@ -602,7 +664,7 @@ def make_plan(data, lines: dict | None = None) -> Plan:
         raise ConfigError([_at(lines, ("objective",), "objective: one fold angle for several days needs several "
                                                       "dates (a date range, 'year', or a weather file)")])
     if plan.n_cases > MAX_CASES:
-        raise ConfigError([f"sweep: {plan.n_cases} cases exceed the limit of {MAX_CASES}"])
+        raise ConfigError([f"sweep: {plan.n_cases:,} cases; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
     first = {path: values[0] for path, values in axes}
     labels = {path: (f"{specs[path][0]}[0]", specs[path][1] + (0,)) for path in first}
     errors += _validation_errors(plan, first, lines, labels)
@@ -613,7 +675,29 @@ def make_plan(data, lines: dict | None = None) -> Plan:
             errors += _validation_errors(plan, {**first, path: value}, lines, where)
     if errors:
         raise ConfigError(_collapse(list(dict.fromkeys(errors))))
+    _check_size(plan)
     return plan
+
+
+def _check_size(plan: Plan) -> None:
+    """Refuse a plan whose work or memory would exceed the limits, before any work."""
+    axes = dict(plan.axes)
+    base = plan.base
+    angles = len(base.fold_angles.grid())
+    steps = round(24 * 60 / base.step_min)
+    loads = len(axes.get("p_load", (None,)))
+    site_days = plan.n_cases // loads
+    evaluations = site_days * angles * steps
+    if evaluations > MAX_EVALUATIONS:
+        raise ConfigError([f"study: {site_days:,} site-days x {angles} fold angles x {steps:,} steps = "
+                           f"{evaluations:.2g} evaluations; the limit is {MAX_EVALUATIONS:.2g} (a coarser "
+                           "fold_angles or step_min, fewer cases, or FOLDOPT_MAX_EVALUATIONS)"])
+    if base.objective is not None and "date" in axes:
+        cells = len(axes["date"]) * angles * loads
+        if cells > MAX_ANNUAL_CELLS:
+            raise ConfigError([f"objective: {len(axes['date'])} days x {angles} fold angles x {loads} loads = "
+                               f"{cells:.2g} values held at once; the limit is {MAX_ANNUAL_CELLS:.2g} (fewer loads "
+                               "or angles, or FOLDOPT_MAX_ANNUAL_CELLS)"])
 
 
 _INDEXED = re.compile(r"^(?P<field>[^\[\s]+)\[(?P<index>\d+)\] = (?P<value>.*?): (?P<problem>.*)$")
@@ -685,25 +769,41 @@ def load_plan(path: Path | str) -> Plan:
 
 def read_study(path: Path | str) -> tuple:
     """The data of a YAML study file and the line of each of its keys; a relative weather path is
-    made relative to the file. Raises :class:`ConfigError` for a file that cannot be read."""
+    made relative to the file. Raises :class:`ConfigError` for a file that cannot be read, is
+    larger than :data:`MAX_STUDY_BYTES` or is not a plain YAML study (:class:`StudyLoader`)."""
     path = Path(path)
     try:
+        size = path.stat().st_size
+        if size > MAX_STUDY_BYTES and path.is_file():
+            raise ConfigError([f"config: {path} is {size:,} bytes; a study file is at most {MAX_STUDY_BYTES:,}"])
         text = path.read_text()
     except FileNotFoundError:
         raise ConfigError([f"config: file not found: {path}"]) from None
     except (IsADirectoryError, PermissionError, UnicodeDecodeError) as error:
         raise ConfigError([f"config: cannot read {path}: {error.__class__.__name__}"]) from None
+    data, lines = parse_study_text(text, str(path))
+    if isinstance(data, dict):
+        data = _resolve_weather_path(data, path.parent)
+    return data, lines
+
+
+def parse_study_text(text: str, source: str = "config") -> tuple:
+    """YAML text of a study (or one ``--set`` value) -> ``(data, lines)``; :class:`ConfigError` with
+    the line for anything :class:`StudyLoader` refuses."""
+    loader = StudyLoader(text)
     try:
-        data = yaml.safe_load(text)
-        lines = _yaml_lines(yaml.compose(text)) if data is not None else {}
+        node = loader.get_single_node()
+        data = loader.construct_document(node) if node is not None else None
     except yaml.YAMLError as error:
         where = getattr(error, "problem_mark", None)
         line = f" at line {where.line + 1}" if where is not None else ""
         problem = getattr(error, "problem", None) or "malformed YAML"
-        raise ConfigError([f"config: {path}{line}: {problem}"]) from None
-    if isinstance(data, dict):
-        data = _resolve_weather_path(data, path.parent)
-    return data, lines
+        raise ConfigError([f"config: {source}{line}: {problem}"]) from None
+    except RecursionError:
+        raise ConfigError([f"config: {source}: nested too deeply"]) from None
+    finally:
+        loader.dispose()
+    return data, (_yaml_lines(node) if node is not None else {})
 
 
 def _resolve_weather_path(data: dict, folder: Path) -> dict:

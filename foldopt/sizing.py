@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from foldopt.metrics import load_for_t_solar, t_solar
+from foldopt import engine as engines
+from foldopt.metrics import load_for_t_solar
 
 
 def flat_area_multiple(p_flat, p_load, target_t_solar, step_hours):
@@ -90,10 +91,13 @@ def size_panel(
     reference_area = study.panel.area
     loads = study.p_load * reference_area / areas
     angles = np.asarray(study.fold_angles.grid())
-    twofold_hours = t_solar(day.combined_power(angles), loads[:, None], day.step_hours)
+    # Every curve against every load in one pass of the kernel, with no (areas x angles x steps) array.
+    curves = np.vstack([day.flat_power()[None, :], day.combined_power(angles)])
+    all_hours = engines.curve_metrics(curves, loads, day.step_hours).t_solar[:, 0, :]  # (1 + angles, areas)
+    twofold_hours = all_hours[1:].T
     best = twofold_hours.shape[1] - 1 - np.argmax(twofold_hours[:, ::-1], axis=1)
     hours = {
-        "flat": (np.full(areas.size, 180.0), t_solar(day.flat_power(), loads, day.step_hours)),
+        "flat": (np.full(areas.size, 180.0), all_hours[0]),
         "twofold": (angles[best], twofold_hours[np.arange(areas.size), best]),
     }
     unit_cost = cost_per_m2 if cost_per_m2 is not None else cost_per_w * stc_power_per_area(day.electrical.pv)

@@ -72,7 +72,7 @@ def test_the_summary_says_which_values_were_defaults(tmp_path):
 def test_a_bare_command_prints_its_help(command):
     result = invoke(*command)
     assert result.exit_code == 0 and result.stdout.startswith("Usage:") and result.stderr == ""
-    assert "error" not in result.stdout and "..." not in result.stdout.split("Commands:")[1]
+    assert "error:" not in result.stdout and "..." not in result.stdout.split("Commands:")[1]
 
 
 def test_help_keeps_units_and_lists_every_accepted_name():

@@ -81,5 +81,10 @@ def test_wrong_types_and_limits():
         make_plan({**BASE, "sweep": [1, 2]})
     with pytest.raises(ConfigError, match="empty list"):
         make_plan({**BASE, "p_load": []})
-    with pytest.raises(ConfigError, match="exceed the limit"):
-        make_plan({**BASE, "site": {"latitude": "-90:90:0.001", "longitude": "-180:180:0.01"}})
+    with pytest.raises(ConfigError, match=r"'-90:90:0.001' has 180,001 values; at most 10,000 per axis"):
+        make_plan({**BASE, "site": {"latitude": "-90:90:0.001", "longitude": 0}})
+    with pytest.raises(ConfigError, match=r"sweep: 260,281 cases; the limit is 200,000 \(FOLDOPT_MAX_CASES"):
+        make_plan({**BASE, "site": {"latitude": "-90:90:0.5", "longitude": "-180:180:0.5"}})
+    with pytest.raises(ConfigError, match=r"110,492 site-days x 180 fold angles x 1,440 steps = 2.9e\+10 evaluations; the limit is 2e\+10"):
+        make_plan({**BASE, "site": {"latitude": "-60:60:0.1", "longitude": 0}, "date": "1:365:4",
+                   "fold_angles": {"start": 1, "stop": 180, "step": 1}, "step_min": 1})

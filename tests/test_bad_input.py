@@ -1,0 +1,338 @@
+"""Bad input never crashes, hangs or destroys: a table of hostile inputs through the command line
+(values, YAML study files, weather files, output folders), each answered by one line naming the
+field and exit code 2, with no traceback and an earlier results folder left as it was; and
+generated YAML studies that either run or fail that same clean way."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import pvlib
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from foldopt.cli import app
+from foldopt.config import default_study_path
+
+runner = CliRunner()
+TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
+#: The embedded study made cheap: hourly steps, a 30-degree fold-angle grid.
+FAST = {**yaml.safe_load(default_study_path().read_text()), "step_min": 60,
+        "fold_angles": {"start": 30, "stop": 180, "step": 30}}
+QUICK = ["--step-min", "60", "--angle-step", "30"]
+
+
+def snapshot(folder: Path) -> dict:
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.fixture
+def place(tmp_path, monkeypatch):
+    """A working folder holding an earlier results folder (``prior``) that no error may touch."""
+    monkeypatch.chdir(tmp_path)
+    prior = tmp_path / "prior"
+    prior.mkdir()
+    (prior / "run.json").write_text(json.dumps({"versions": {"foldopt": "0"}}))
+    (prior / "sweep.csv").write_text("kept\n")
+    return tmp_path
+
+
+def study_file(folder: Path, name: str, text: str | bytes) -> Path:
+    path = folder / name
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
+    return path
+
+
+def fast_yaml(**changes) -> str:
+    return yaml.safe_dump({**FAST, **changes}, sort_keys=False)
+
+
+# (id, files to create {name: text}, command line, words the one error line must hold)
+VALUES = [
+    ("lat-high", ["sweep", "angle", "--lat", "95"], ["--lat", "[-90, 90]"]),
+    ("lat-text", ["sweep", "angle", "--lat", "north"], ["--lat", "number"]),
+    ("lat-nan", ["sweep", "angle", "--lat", "nan"], ["--lat"]),
+    ("lon-high", ["sweep", "angle", "--lon", "200"], ["--lon", "[-180, 180]"]),
+    ("p-load-zero", ["sweep", "angle", "--p-load", "0"], ["--p-load", "(0, 1e+06]"]),
+    ("p-load-range-negative", ["sweep", "load", "--p-load=-1:3:1"], ["--p-load", "(0, 1e+06]"]),
+    ("p-load-million", ["sweep", "load", "--p-load", "1:1000000:1"], ["--p-load", "at most 10,000 per axis"]),
+    ("lat-9e10", ["sweep", "latitude", "--lat", "-90:90:0.000000002"], ["--lat", "at most 10,000 per axis"]),
+    ("area-zero", ["sweep", "angle", "--area", "0"], ["--area", "(0, 1000]"]),
+    ("area-inf", ["sweep", "angle", "--area", "inf"], ["--area"]),
+    ("efficiency", ["sweep", "angle", "--efficiency", "1.5"], ["--efficiency", "(0, 1]"]),
+    ("tilt", ["sweep", "angle", "--tilt", "120"], ["--tilt", "[0, 90]"]),
+    ("azimuth", ["sweep", "angle", "--azimuth", "400"], ["--azimuth", "[0, 360)"]),
+    ("mode", ["sweep", "angle", "--mode", "fast"], ["--mode", "paper, exact"]),
+    ("geometry", ["sweep", "angle", "--geometry", "tent"], ["--geometry", "azimuth-split, hinge"]),
+    ("sky", ["sweep", "angle", "--sky", "cloudy"], ["--sky", "meinel"]),
+    ("climate", ["sweep", "angle", "--sky", "hottel", "--climate", "arctic"], ["--climate", "tropical"]),
+    ("date-month", ["sweep", "angle", "--date", "2014-13-01"], ["--date"]),
+    ("date-feb-30", ["sweep", "angle", "--date", "2025-02-30"], ["--date"]),
+    ("day-of-year", ["sweep", "day", "--days", "1:400:7"], ["--days", "day of year 400 is outside 2014"]),
+    ("step-min", ["sweep", "angle", "--step-min", "7"], ["--step-min", "1440"]),
+    ("angle-step", ["sweep", "angle", "--angle-step", "0"], ["--angle-step", "(0, 180]"]),
+    ("pv-model", ["sweep", "angle", "--pv-model", "two-diode"], ["--pv-model", "single-diode"]),
+    ("module", ["sweep", "angle", "--pv-model", "single-diode", "--module", "NoSuchModule"], ["--module", "CEC"]),
+    ("connection", ["sweep", "angle", "--connection", "star"], ["--connection", "switching"]),
+    ("converter", ["sweep", "angle", "--connection", "independent", "--converter-efficiency", "1.2"],
+     ["--converter-efficiency", "(0, 1]"]),
+    ("tracker", ["sweep", "angle", "--tracker", "heliostat"], ["--tracker", "single-axis"]),
+    ("standby", ["sweep", "angle", "--tracker-standby", "-1"], ["--tracker-standby", "[0, 1000]"]),
+    ("objective", ["sweep", "day", "--objective", "best"], ["--objective", "pNN"]),
+    ("timezone", ["sweep", "angle", "--timezone", "Mars/Olympus"], ["--timezone", "Mars/Olympus"]),
+    ("year", ["sweep", "day", "--year", "1800"], ["--year", "[1901, 2099]"]),
+    ("albedo", ["sweep", "angle", "--mode", "exact", "--sky", "ineichen", "--albedo", "2"], ["--albedo", "[0, 1]"]),
+    ("idle-climate", ["sweep", "angle", "--climate", "tropical"], ["--climate", "only used by sky hottel"]),
+    ("paper-perez", ["sweep", "angle", "--mode", "paper", "--transposition", "perez"], ["paper mode is beam-only"]),
+    ("set-no-value", ["sweep", "angle", "--set", "albedo"], ["--set", "KEY=VALUE"]),
+    ("set-unknown", ["sweep", "angle", "--set", "panel.colour=red"], ["panel.colour", "unknown field"]),
+    ("set-bad-date", ["sweep", "angle", "--set", "date=2025-02-30"], ["date", "valid date"]),
+    ("set-alias", ["sweep", "angle", "--set", "p_load=*x"], ["--set p_load"]),
+    ("format", ["run", "--format", "xml"], ["--format", "table, json"]),
+    ("engine", ["run", "--engine", "gpu"], ["--engine", "numba, numpy"]),
+    ("unknown-option", ["run", "--colour", "red"], ["No such option"]),
+    ("unknown-axis", ["sweep", "tilt"], ["No such command 'tilt'"]),
+    ("size-empty", ["size", "--areas", "0.5:0.1:0.1"], ["--areas", "empty range"]),
+    ("size-cost", ["size", "--cost-per-w", "-1"], ["--cost-per-w", "> 0"]),
+    ("size-both-costs", ["size", "--cost-per-w", "1", "--cost-per-m2", "100"], ["not both"]),
+    ("size-million-areas", ["size", "--areas", "0.0001:100:0.0001"], ["--areas", "at most 10,000 per axis"]),
+    ("size-years", ["size", "--years", "0"], ["--years", "> 0"]),
+    ("weather-missing", ["sweep", "angle", "--weather", "nope.csv"], ["--weather", "file not found"]),
+    ("config-missing", ["run", "nope.yaml"], ["config", "file not found", "nope.yaml"]),
+    ("config-folder", ["run", "prior"], ["config", "prior"]),
+]
+
+YAML_FILES = [
+    ("malformed", "name: x\nsite: [1, 2\n", ["line", "bad.yaml"]),
+    ("a-list", "- just\n- a list\n", ["expected a mapping"]),
+    ("empty", "", ["expected a mapping"]),
+    ("missing-site", yaml.safe_dump({k: v for k, v in FAST.items() if k != "site"}), ["site", "required field is missing"]),
+    ("unknown-field", fast_yaml(colour="red"), ["colour", "unknown field"]),
+    ("aliases", "a: &a [1, 2]\nb: [*a, *a]\nname: x\n", ["aliases", "line 2"]),
+    ("billion-laughs", "a: &a [lol, lol, lol, lol, lol, lol, lol, lol, lol]\nb: &b [*a, *a, *a, *a, *a, *a]\n"
+     "c: &c [*b, *b, *b, *b, *b, *b]\nd: [*c, *c, *c, *c, *c, *c]\n", ["aliases"]),
+    ("duplicate-key", "name: x\np_load: 1\np_load: 2\n", ["'p_load' appears twice", "line 3", "first at line 2"]),
+    ("feb-30", fast_yaml(date="2025-02-30"), ["date", "valid date"]),
+    ("date-text", fast_yaml(date="sometime"), ["date"]),
+    ("date-list", fast_yaml(date=["2025-03-20", "2025-02-31"]), ["date", "2025-02-31"]),
+    ("deep", "name: " + "[" * 20000 + "]" * 20000 + "\n", ["nested too deeply"]),
+    ("big", "name: x\n" + "#" * 1_100_000 + "\n", ["bytes", "at most 1,000,000"]),
+    ("binary", b"\xff\xfe\x00name: x\n", ["config", "cannot read"]),
+    ("sweep-list", fast_yaml(sweep=[1, 2]), ["sweep", "mapping"]),
+    ("huge-range", fast_yaml(p_load="1:2000000:1"), ["p_load", "at most 10,000 per axis"]),
+    ("huge-plan", fast_yaml(step_min=1, fold_angles={"start": 0.1, "stop": 180, "step": 0.1},
+                            site={"latitude": "-60:60:0.1", "longitude": 0}, date="1:365:30"),
+     ["evaluations", "FOLDOPT_MAX_EVALUATIONS"]),
+    ("huge-annual", fast_yaml(p_load="1:500:1", date="year", objective={"statistic": "mean"},
+                              fold_angles={"start": 0.1, "stop": 180, "step": 0.1}),
+     ["objective", "FOLDOPT_MAX_ANNUAL_CELLS"]),
+    ("site-text", fast_yaml(site="Los Angeles"), ["site"]),
+    ("year-1800", fast_yaml(year=1800, date="1:365:7"), ["year", "[1901, 2099]"]),
+    ("objective-one-day", fast_yaml(objective={"statistic": "mean"}), ["objective", "several dates"]),
+    ("weather-missing", fast_yaml(weather="nope.csv"), ["weather", "file not found"]),
+    ("tags", "name: !!python/object:os.system x\n", ["config", "line 1"]),
+]
+
+OUTPUTS = [
+    ("a-file", lambda d: (d / "afile").write_text("x") and ["run", "fast.yaml", "--out", "afile", "--overwrite"],
+     ["--out afile", "is a file"]),
+    ("working-folder", lambda d: ["run", "fast.yaml", "--out", ".", "--overwrite"], ["--out .", "working folder"]),
+    ("parent-folder", lambda d: ["run", "fast.yaml", "--out", "..", "--overwrite"], ["--out ..", "working folder"]),
+    ("foreign-folder", lambda d: (d / "mine").mkdir() or (d / "mine" / "thesis.tex").write_text("x") and
+     ["run", "fast.yaml", "--out", "mine", "--overwrite"], ["--out mine", "foldopt did not write"]),
+    ("under-a-file", lambda d: (d / "afile").write_text("x") and ["run", "fast.yaml", "--out", "afile/sub"],
+     ["--out afile/sub", "is a file"]),
+    ("exists", lambda d: ["run", "fast.yaml", "--out", "prior"], ["prior already exists", "--overwrite"]),
+    ("symlink", lambda d: (d / "link").symlink_to(d / "prior") or ["run", "fast.yaml", "--out", "link", "--overwrite"],
+     ["--out link", "symbolic link"]),
+]
+
+
+def damaged_tmy3(line: int | None = None, column: str | None = None, value: str = "", header=None, keep=None) -> str:
+    """The TMY3 sample with one cell, its header line or its length changed."""
+    lines = TMY3.read_text().splitlines()
+    if header is not None:
+        lines[header[0]] = header[1](lines[header[0]])
+    if line is not None:
+        cells = lines[line - 1].split(",")
+        cells[lines[1].split(",").index(column)] = value
+        lines[line - 1] = ",".join(cells)
+    return "\n".join(lines[:keep]) + "\n"
+
+
+WEATHER_FILES = [
+    ("empty", "w.csv", lambda: "", ["w.csv", "empty"]),
+    ("header-only", "w.csv", lambda: damaged_tmy3(keep=2), ["w.csv", "no data rows"]),
+    ("not-weather", "w.csv", lambda: "a,b\n1,2\n3,4\n", ["w.csv", "line 1", "header"]),
+    ("no-ghi-column", "w.csv", lambda: damaged_tmy3(header=(1, lambda h: h.replace("GHI (W/m^2)", "G"))),
+     ["w.csv", "column ghi missing"]),
+    ("nan-ghi", "w.csv", lambda: damaged_tmy3(500, "GHI (W/m^2)", "nan"), ["w.csv", "line 500", "ghi has no value"]),
+    ("negative-dni", "w.csv", lambda: damaged_tmy3(300, "DNI (W/m^2)", "-5"), ["w.csv", "line 300", "must be >= 0"]),
+    ("dhi-above-ghi", "w.csv", lambda: damaged_tmy3(302, "DHI (W/m^2)", "900"), ["w.csv", "line 302", "dhi = 900"]),
+    ("temperature", "w.csv", lambda: damaged_tmy3(40, "Dry-bulb (C)", "99.9"), ["w.csv", "line 40", "temp_air"]),
+    ("latitude", "w.csv", lambda: damaged_tmy3(header=(0, lambda h: h.replace(",36.100,", ",95,"))),
+     ["w.csv", "latitude = 95"]),
+    ("truncated-year", "w.csv", lambda: damaged_tmy3(keep=4000), ["w.csv", "no data for", "the file holds"]),
+    ("duplicate-hour", "w.csv", lambda: "\n".join(
+        (lambda ls: ls[:100] + [ls[99]] + ls[101:])(TMY3.read_text().splitlines())) + "\n", ["w.csv", "same hour"]),
+    ("pvgis-not-json", "w.json", lambda: "{not json", ["w.json", "not valid JSON"]),
+]
+
+
+def assert_clean_failure(result, words, place: Path, before: dict):
+    assert result.exit_code == 2, (result.exit_code, result.output)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert "Traceback" not in result.output and result.stdout == ""
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+    assert snapshot(place / "prior") == before
+    assert not [p.name for p in place.iterdir() if p.name.startswith(".")]  # nothing staged left
+
+
+@pytest.mark.parametrize("args,words", [case[1:] for case in VALUES], ids=[case[0] for case in VALUES])
+def test_bad_values(place, args, words):
+    before = snapshot(place / "prior")
+    extra = [a for a in QUICK if args[0] == "sweep" and not set(QUICK[::2]) & set(args)]
+    result = runner.invoke(app, [*args, *extra, "--out", "prior", "--overwrite"])
+    assert_clean_failure(result, words, place, before)
+
+
+@pytest.mark.parametrize("text,words", [case[1:] for case in YAML_FILES], ids=[case[0] for case in YAML_FILES])
+def test_bad_study_files(place, text, words):
+    before = snapshot(place / "prior")
+    study_file(place, "bad.yaml", text)
+    result = runner.invoke(app, ["run", "bad.yaml", "--out", "prior", "--overwrite"])
+    assert_clean_failure(result, words, place, before)
+
+
+@pytest.mark.parametrize("name,text,words", [case[1:] for case in WEATHER_FILES],
+                         ids=[case[0] for case in WEATHER_FILES])
+def test_bad_weather_files(place, name, text, words):
+    before = snapshot(place / "prior")
+    study_file(place, name, text())
+    result = runner.invoke(app, ["sweep", "angle", "--weather", name, "--p-load", "2", *QUICK, "--out", "prior",
+                                 "--overwrite"])
+    assert_clean_failure(result, words, place, before)
+
+
+@pytest.mark.parametrize("make,words", [case[1:] for case in OUTPUTS], ids=[case[0] for case in OUTPUTS])
+def test_bad_output_folders(place, make, words):
+    study_file(place, "fast.yaml", fast_yaml())
+    args = make(place)
+    before = snapshot(place / "prior")
+    assert_clean_failure(runner.invoke(app, args), words, place, before)
+
+
+def test_the_battery_is_large_enough():
+    assert len(VALUES) + len(YAML_FILES) + len(WEATHER_FILES) + len(OUTPUTS) >= 60
+
+
+def test_overwrite_replaces_a_results_folder_and_an_empty_one(place):
+    study_file(place, "fast.yaml", fast_yaml())
+    (place / "empty").mkdir()
+    for out in ("prior", "empty"):
+        result = runner.invoke(app, ["run", "fast.yaml", "--out", out, "--overwrite", "-q"])
+        assert result.exit_code == 0, result.output
+        assert (place / out / "summary.csv").exists() and not (place / out / "sweep.csv").read_text() == "kept\n"
+    assert not [p.name for p in place.iterdir() if p.name.startswith(".")]
+
+
+def test_an_internal_error_is_one_line_and_debug_shows_the_traceback(place, monkeypatch):
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr("foldopt.study.run_study", broken)
+    study_file(place, "fast.yaml", fast_yaml())
+    result = runner.invoke(app, ["run", "fast.yaml", "--out", "new"])
+    assert result.exit_code == 1
+    assert result.stderr.strip().splitlines() == [
+        "error: internal error (ZeroDivisionError: float division by zero); run again as foldopt --debug ... for "
+        "the traceback, and please report it"]
+    debug = runner.invoke(app, ["--debug", "run", "fast.yaml", "--out", "new"])
+    assert debug.exit_code == 1 and "Traceback" in debug.stderr and "ZeroDivisionError" in debug.stderr
+    assert not (place / "new").exists()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+def test_a_run_killed_while_it_writes_leaves_nothing_behind(tmp_path, sig):
+    # The run is killed as soon as its staging folder appears, while it writes. With SIGTERM it
+    # removes the folder itself; after SIGKILL the next results folder written beside it does.
+    study_file(tmp_path, "fast.yaml", fast_yaml(step_min=5))
+    prior = tmp_path / "out"
+    prior.mkdir()
+    (prior / "run.json").write_text(json.dumps({"versions": {"foldopt": "0"}}))
+    before = snapshot(prior)
+    command = [sys.executable, "-m", "foldopt.cli", "run", "fast.yaml", "--out", "out", "--overwrite", "-q"]
+    process = subprocess.Popen(command, cwd=tmp_path, stderr=subprocess.PIPE)
+    deadline, staged = time.monotonic() + 120, []
+    while time.monotonic() < deadline and process.poll() is None and not staged:
+        staged = list(tmp_path.glob(".out.tmp-*"))
+        time.sleep(0.002)
+    assert staged, "the run ended before it was seen writing"
+    process.send_signal(sig)
+    process.wait(timeout=60)
+    process.stderr.close()
+    assert snapshot(prior) == before  # the earlier results are intact
+    if sig == signal.SIGKILL:
+        assert staged[0].exists()  # nothing can clean up after SIGKILL...
+        neighbour = runner.invoke(app, ["run", str(tmp_path / "fast.yaml"), "--out", str(tmp_path / "other"), "-q"])
+        assert neighbour.exit_code == 0, neighbour.output  # ...but the next run beside it does
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["fast.yaml", "out"] + (
+        ["other"] if sig == signal.SIGKILL else []))
+
+
+def test_a_folder_retired_by_a_killed_run_is_put_back(tmp_path):
+    from foldopt.folders import clear_leftovers
+
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    retired = tmp_path / f".results.old-{dead.pid}"
+    retired.mkdir()
+    (retired / "run.json").write_text("{}")
+    clear_leftovers(tmp_path)
+    assert (tmp_path / "results" / "run.json").exists() and not retired.exists()
+
+
+FIELDS = {
+    "name": st.text(max_size=8),
+    "mode": st.sampled_from(["paper", "exact", "fast", 3]),
+    "date": st.one_of(st.dates().map(str), st.sampled_from(["2025-02-30", "year", "1:365:90", "x"])),
+    "p_load": st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from(["1:9:4", "0:1:0"])),
+    "step_min": st.sampled_from([60, 30, 7, 0, -5, "x"]),
+    "sky": st.sampled_from(["meinel", "hottel", "ineichen", "simplified_solis", "cloudy"]),
+    "pv_model": st.sampled_from(["ideal", "single-diode", "b-model", "x"]),
+    "connection": st.sampled_from(["switching", "parallel", "independent", "x"]),
+    "site": st.one_of(st.fixed_dictionaries({"latitude": st.floats(-100, 100), "longitude": st.floats(-200, 200)}),
+                      st.text(max_size=5), st.none()),
+    "panel": st.fixed_dictionaries({"area": st.floats(-1, 2), "tilt": st.floats(-10, 100)}),
+    "fold_angles": st.fixed_dictionaries({"start": st.floats(-10, 200), "stop": st.floats(-10, 200),
+                                          "step": st.sampled_from([30, 45, 0, -1])}),
+    "tracker": st.sampled_from(["dual-axis", "single-axis", "x", 5]),
+    "objective": st.sampled_from([{"statistic": "mean"}, {"statistic": "p50"}, "best", None]),
+}
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(changes=st.dictionaries(st.sampled_from(sorted(FIELDS)), st.none()).flatmap(
+    lambda keys: st.fixed_dictionaries({key: FIELDS[key] for key in keys})))
+def test_generated_studies_run_or_fail_cleanly(tmp_path, changes):
+    folder = tmp_path / f"case-{abs(hash(repr(changes)))}"
+    folder.mkdir()
+    study = study_file(folder, "s.yaml", yaml.safe_dump({**FAST, "fold_angles": {"start": 60, "stop": 180, "step": 60},
+                                                         **changes}))
+    result = runner.invoke(app, ["run", str(study), "--out", str(folder / "out"), "-q"])
+    assert result.exit_code in (0, 2), (changes, result.output)
+    assert "Traceback" not in result.output
+    if result.exit_code == 0:
+        assert (folder / "out" / "run.json").exists()
+    else:
+        lines = result.stderr.strip().splitlines()
+        assert lines and all(line.startswith("error: ") for line in lines), result.stderr
+        assert not (folder / "out").exists()
