@@ -478,10 +478,16 @@ def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | No
     """
     path = Path(path)
     fmt = weather_format(path, fmt)
-    data, _ = _read(str(path.resolve()), fmt, year, path.stat().st_mtime)
+    # A typical year has 365 days: it is read as a year without February 29, then its interval
+    # centres move to ``year``, so that a leap year's February 29 is a day the file does not hold.
+    typical = year - 1 if pd.Timestamp(year=year, month=1, day=1).is_leap_year else year
+    data, _ = _read(str(path.resolve()), fmt, typical, path.stat().st_mtime)
     label = label or INTERVAL_LABELS[fmt]
     shift = {"end": -_HOUR / 2, "start": _HOUR / 2, "centre": _HOUR * 0}[label]
-    frame = pd.DataFrame({key: data[key].to_numpy(copy=True) for key in _COLUMNS}, index=data.index + shift)
+    index = data.index + shift
+    if typical != year:
+        index = pd.DatetimeIndex(index.map(lambda t: t.replace(year=t.year + year - typical)))
+    frame = pd.DataFrame({key: data[key].to_numpy(copy=True) for key in _COLUMNS}, index=index)
     frame = frame.sort_index()
     frame.attrs["weather"] = path.name
     return frame
@@ -505,8 +511,9 @@ def weather_days(frame: pd.DataFrame, dates) -> np.ndarray:
     start, stop = np.searchsorted(days, wanted, side="left"), np.searchsorted(days, wanted, side="right")
     missing = [str(date) for date, a, b in zip(wanted, start, stop, strict=True) if a == b]
     if missing:
+        leap = " (a typical year has no February 29)" if any(d.endswith("-02-29") for d in missing) else ""
         raise WeatherError(f"{prefix}no data for {', '.join(missing[:3])}"
-                           + (f" and {len(missing) - 3} more dates" if len(missing) > 3 else "") + f"; {held}")
+                           + (f" and {len(missing) - 3} more dates" if len(missing) > 3 else "") + f"; {held}{leap}")
     step = pd.Series(frame.index).diff().median() if len(frame) > 1 else pd.NaT
     per_day = round(pd.Timedelta(days=1) / step) if pd.notna(step) and step > pd.Timedelta(0) else None
     counts = stop - start

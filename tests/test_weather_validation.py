@@ -247,3 +247,16 @@ def test_a_file_without_temperature_or_wind_gets_the_defaults(tmp_path):
     frame = read_weather(path)
     assert (frame["temp_air"] == 20.0).all() and (frame["wind_speed"] == 1.0).all()
     pd.testing.assert_frame_equal(frame[["ghi", "dni", "dhi"]], read_weather(TMY3)[["ghi", "dni", "dhi"]])
+
+
+def test_a_leap_year_study_on_a_typical_year_lacks_only_february_29():
+    # A TMY holds 365 days. In a leap year its days keep their dates, and February 29 is a day the
+    # file does not hold, with the same light around it as in a common year.
+    common, leap = read_weather(TMY3, year=2025), read_weather(TMY3, year=2024)
+    assert len(leap) == len(common) == 8760
+    for day in ("02-28", "03-01", "12-31"):
+        a, b = (weather_days(frame, [dt.date.fromisoformat(f"{y}-{day}")])[0] for frame, y in
+                ((common, 2025), (leap, 2024)))
+        pd.testing.assert_frame_equal(common.iloc[a].reset_index(drop=True), leap.iloc[b].reset_index(drop=True))
+    with pytest.raises(WeatherError, match=r"no data for 2024-02-29; .*\(a typical year has no February 29\)"):
+        weather_days(leap, [dt.date(2024, 2, 28), dt.date(2024, 2, 29)])
