@@ -64,12 +64,13 @@ def check_output(out: Path, overwrite: bool) -> None:
 
 
 def _alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (another user's process is alive too: PermissionError)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:
-        return True
+        pass
     return True
 
 
