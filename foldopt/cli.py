@@ -669,6 +669,222 @@ for _axis in _AXIS_OPTION:
     _register_sweep(_axis)
 
 
+# --- map ----------------------------------------------------------------------------------------
+
+
+def _values(option: str, text: str) -> list[float]:
+    """A number, a range start:stop:step or a comma-separated list, for ``option``."""
+    try:
+        if ":" in text:
+            return parse_range(text)
+        return [float(part) for part in text.split(",") if part.strip()] or _fail([f"{option}: no values"])
+    except ValueError as error:
+        _fail([f"{option} = {text!r}: {error}" if "expected" in str(error) or "range" in str(error)
+               else f"{option} = {text!r}: expected a number, a range start:stop:step or a list a,b,c"])
+
+
+@app.command("map", short_help="Many sites on Dask: best fold angle, gains and tracker share worldwide.")
+def map_(
+    lat: Optional[str] = typer.Option(None, "--lat", help="Latitudes [deg north]: a range start:stop:step or a "
+                                      "list [default: -60:60:10]."),
+    lon: Optional[str] = typer.Option(None, "--lon", help="Longitudes [deg east] [default: -180:180:30]."),
+    land_only: bool = typer.Option(False, "--land-only", help="Keep only the grid points on land."),
+    sites: Optional[Path] = typer.Option(None, "--sites", help="CSV of named sites: name, latitude, longitude "
+                                         "[, altitude, timezone], instead of a grid."),
+    weather_dir: Optional[Path] = typer.Option(None, "--weather-dir", help="Folder of TMY3 / EPW / PVGIS files, each "
+                                               "file a site (its site read from the file), instead of a grid."),
+    p_load: Optional[str] = typer.Option(None, "--p-load", help="Loads [W]: a value, a range or a list [default: the "
+                                         "study's]."),
+    p_load_fraction: Optional[str] = typer.Option(None, "--p-load-fraction", help="Loads as fractions of each "
+                                                  "site's flat peak, e.g. 0.1:0.9:0.1, instead of --p-load."),
+    area: Optional[float] = typer.Option(None, "--area", help="Flat panel area [m^2]."),
+    efficiency: Optional[float] = typer.Option(None, "--efficiency", help="PV efficiency [-]."),
+    objective: str = typer.Option("mean", "--objective", help="What each period's fold angle maximises: mean | min | "
+                                  "worst-month | pNN."),
+    year: int = typer.Option(2025, "--year", help="Year of the clear-sky days (or that a typical year stands for)."),
+    step_min: Optional[float] = typer.Option(None, "--step-min", help="Time step [min] [default: 5]."),
+    angle_step: Optional[float] = typer.Option(None, "--angle-step", help="Fold-angle grid step [deg] [default: 1]."),
+    config: Optional[Path] = typer.Option(None, "--config", help=f"Study to take the panel and models from [default: "
+                                          f"{EMBEDDED}, in exact mode with the Ineichen clear sky]."),
+    settings: Optional[list[str]] = typer.Option(None, "--set", metavar="KEY=VALUE", help="Any study field, e.g. "
+                                                 "--set pv_model=single-diode; repeatable."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address (tcp://host:8786) "
+                                            "or scheduler file [default: an embedded cluster]."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Worker processes of the embedded cluster "
+                                          "[default: one per core]."),
+    chunk_sites: Optional[int] = typer.Option(None, "--chunk-sites", help="Sites per task [default: about 5 s of "
+                                              "work]."),
+    show_load: int = typer.Option(1, "--show-load", help="Which load (1 = the first) the world maps show."),
+    show_period: str = typer.Option("year", "--show-period", help="Period the world maps show: year | DJF | MAM | "
+                                    "JJA | SON."),
+    resume: bool = typer.Option(False, "--resume", help="Finish an interrupted map in --out: only missing chunks "
+                                "are computed."),
+    out: Path = typer.Option(RESULTS / "map", "--out", help="Results folder."),
+    overwrite: bool = OVERWRITE,
+    quiet: bool = QUIET,
+    output_format: str = FORMAT,
+    engine: str = ENGINE,
+):
+    """Where folding pays: the best fold angle for the year and per season at every site of a grid,
+    a CSV of sites or a folder of weather files, with flat, twofold and tracker t_solar and energy,
+    gains and the tracker's break-even standby draw. Runs on Dask: an embedded cluster by default,
+    any cluster with --scheduler. Writes map.parquet, map.csv, world maps and run.json; --resume
+    finishes a killed run. With --format json the rows are the year's (map.parquet has every
+    period).
+
+    \b
+    Examples:
+      foldopt map --lat -60:60:10 --lon -180:180:30 --p-load 2 --area 0.108
+      foldopt map --lat -60:70:1 --lon -180:179:1 --land-only --p-load-fraction 0.1:0.9:0.1
+      foldopt map --sites sites.csv --scheduler tcp://127.0.0.1:8786
+    """
+    from foldopt.worldmap import PERIODS
+
+    output_format, engine = _check_choices(output_format, engine)
+    output = _Output(quiet, output_format)
+    errors = []
+    if sum(source is not None for source in (sites, weather_dir)) + (lat is not None or lon is not None) > 1:
+        errors.append("--lat/--lon, --sites, --weather-dir: give one source of sites")
+    if land_only and (sites is not None or weather_dir is not None):
+        errors.append("--land-only: only for a --lat/--lon grid")
+    if p_load is not None and p_load_fraction is not None:
+        errors.append("--p-load / --p-load-fraction: give loads one way")
+    if show_period not in PERIODS:
+        errors.append(f"--show-period = {show_period!r}: must be one of {', '.join(PERIODS)}")
+    for option, value in (("--workers", workers), ("--chunk-sites", chunk_sites)):
+        if value is not None and value < 1:
+            errors.append(f"{option} = {value}: must be at least 1")
+    if errors:
+        _fail(errors)
+    latitudes = _values("--lat", lat or "-60:60:10") if sites is None and weather_dir is None else []
+    longitudes = _values("--lon", lon or "-180:180:30") if sites is None and weather_dir is None else []
+    for option, values, bound in (("--lat", latitudes, 90), ("--lon", longitudes, 180)):
+        if any(not -bound <= value <= bound for value in values):
+            errors.append(f"{option}: must be in [-{bound}, {bound}] deg")
+    relative = p_load_fraction is not None
+    loads = _values("--p-load-fraction", p_load_fraction) if relative else None
+    if relative and any(not 0 < value <= 2 for value in loads):
+        errors.append(f"--p-load-fraction = {p_load_fraction!r}: fractions must be in (0, 2]")
+    if p_load is not None:
+        loads = _values("--p-load", p_load)
+        if any(not 0 < value <= 1e6 for value in loads):
+            errors.append(f"--p-load = {p_load!r}: loads must be in (0, 1e+06] W")
+    if errors:
+        _fail(errors)
+    from foldopt.config import MAX_CASES, Objective
+    from foldopt.worldmap import grid_sites, map_study, read_sites, weather_sites
+
+    try:
+        Objective(statistic=objective)
+    except Exception:
+        _fail([f"--objective = {objective!r}: must be mean, min, worst-month or a percentile pNN (e.g. p10)"])
+    data, _ = read_study(config if config is not None else default_study_path())
+    if loads is None:
+        loads = [float(data.get("p_load") or 1.0)]
+    changes = {"objective": {"statistic": objective}}
+    for key, field in (("area", "panel.area"), ("efficiency", "panel.efficiency"), ("step_min", "step_min")):
+        value = {"area": area, "efficiency": efficiency, "step_min": step_min}[key]
+        if value is not None:
+            changes[field] = value
+    if angle_step is not None:
+        changes["fold_angles"] = {"start": angle_step, "stop": 180.0, "step": angle_step}
+    study = map_study(data, embedded=config is None, **changes)
+    for setting in settings or ():
+        study = _apply_setting(study, setting)
+    if sites is not None:
+        site_list = read_sites(sites)
+    elif weather_dir is not None:
+        site_list = weather_sites(weather_dir)
+    else:
+        site_list = grid_sites(latitudes, longitudes, land_only)
+        if not site_list:
+            _fail(["--land-only: no grid point is on land"])
+    if len(site_list) > MAX_CASES:
+        _fail([f"sites: {len(site_list):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
+    if not 1 <= show_load <= len(loads):
+        _fail([f"--show-load = {show_load}: must be in [1, {len(loads)}] (the map has {len(loads)} loads)"])
+    from foldopt.cluster import MapSpec, run_map
+    from foldopt.worldmap import site_study
+
+    site_study(study, site_list[0], year)  # a bad setting fails here, before any cluster starts
+    spec = MapSpec(study, tuple(site_list), tuple(loads), relative, year, chunk_sites or 0, engine)
+    announced = []
+
+    def announce(cluster: str, dashboard: str | None):
+        announced.append(cluster)
+        if not quiet and not output.json:
+            typer.echo(f"{cluster}; dashboard: {dashboard or 'none (pip install bokeh)'}", err=True)
+
+    with output.progress(f"map: {len(site_list)} sites", total=len(site_list), unit="sites") as progress:
+        from foldopt.report import map_figures, versions
+
+        result = run_map(spec, out, scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
+                         progress=progress, announce=announce,
+                         metadata={"command": _INVOCATION, "versions": versions()})
+        figures = map_figures(result.table, out, "map", relative, show_load - 1, show_period)
+    digest = _map_digest(result, relative)
+    lines = _map_lines(digest, result) + [f"wrote {out} (map.parquet, map.csv, {', '.join(figures)})"]
+    year_rows = result.table[result.table["period"] == "year"]
+    output.answer({"command": "map", "out": str(out), "summary": digest, "rows": _records(year_rows)}, lines)
+
+
+def _map_digest(result, relative: bool) -> dict:
+    """Per load, over the sites: where folding pays in the year."""
+    table = result.table
+    year = table[table["period"] == "year"]
+    per_load = []
+    for load, rows in year.groupby("p_load_fraction" if relative else "p_load_w", sort=True):
+        gain = rows["gain_vs_flat_pct"]
+        best = rows.loc[gain.idxmax()] if gain.notna().any() else None
+        per_load.append({
+            ("p_load_fraction" if relative else "p_load_w"): float(load),
+            "sites": int(len(rows)),
+            "sites_folding_pays": int((gain > 0.05).sum()),
+            "median_gain_vs_flat_pct": _number(gain.median()),
+            "best_gain_vs_flat_pct": _number(gain.max()),
+            "best_site": None if best is None else {"site_name": best["site_name"], "latitude": best["latitude"],
+                                                    "longitude": best["longitude"]},
+            "fold_angle_deg": {"min": _number(rows["fold_angle_deg"].min()),
+                               "median": _number(rows["fold_angle_deg"].median()),
+                               "max": _number(rows["fold_angle_deg"].max())},
+            "median_pct_of_tracker": _number(rows["pct_of_tracker"].median()),
+            "median_tracker_break_even_standby_w": _number(rows["tracker_break_even_standby_w"].median()),
+        })
+    return {"sites": int(table["site_id"].nunique()), "loads": per_load, "cluster": result.cluster,
+            "dashboard": result.dashboard, "chunks_computed": len(result.computed),
+            "chunks_from_disk": len(result.from_disk), "seconds": round(result.seconds, 2)}
+
+
+def _number(value):
+    return None if value is None or value != value else float(value)
+
+
+def _map_lines(digest: dict, result) -> list[str]:
+    spec = result.spec
+    study = spec.study
+    sky = "weather files" if any("weather" in site for site in spec.sites) else "Ineichen clear sky" if study.get(
+        "sky") == "ineichen" else f"{study.get('sky')} sky"
+    lines = [f"map: {digest['sites']} sites, year {spec.year}, {sky}, objective {study['objective']['statistic']}, "
+             f"{study['panel']['area']:g} m^2 panel"]
+    for load in digest["loads"]:
+        what = (f"P_load {load['p_load_fraction']:g} x flat peak" if "p_load_fraction" in load
+                else f"P_load {load['p_load_w']:g} W")
+        best = load["best_site"]
+        where = "" if best is None else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
+        angles = load["fold_angle_deg"]
+        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {load['sites']} sites (median "
+                     f"{_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} at {where}); "
+                     f"fold angles {angles['min']:g} to {angles['max']:g} deg; median {_pct(load['median_pct_of_tracker'], False)} "
+                     f"of the tracker, which loses its lead above a median "
+                     f"{load['median_tracker_break_even_standby_w'] or 0:.2f} W of standby")
+    rate = len(spec.sites) / digest["seconds"] if digest["seconds"] else 0
+    computed = (f"computed {digest['chunks_computed']} chunks on {digest['cluster']}" if digest["chunks_computed"]
+                else "nothing to compute")
+    resumed = f", {digest['chunks_from_disk']} from disk" if digest["chunks_from_disk"] else ""
+    lines.append(f"{computed}{resumed} in {digest['seconds']:.1f} s ({rate:.1f} sites/s)")
+    return lines
+
+
 # --- size ---------------------------------------------------------------------------------------
 
 

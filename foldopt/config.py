@@ -48,6 +48,16 @@ class ConfigError(ValueError):
         super().__init__("; ".join(errors))
         self.errors = errors
 
+    def __reduce__(self):
+        # Raised on a Dask worker, the error travels pickled: keep its lines, whatever the subclass.
+        return _config_error, (type(self), self.errors)
+
+
+def _config_error(cls, errors: list[str]) -> ConfigError:
+    error = cls.__new__(cls)
+    ConfigError.__init__(error, errors)
+    return error
+
 
 def _interval(lo, hi, *, lo_open=False, hi_open=False, unit=""):
     """A float constrained to an interval, whose error message states the interval."""

@@ -616,3 +616,115 @@ def digest_sweep(result) -> dict:
             for load in sorted(table["p_load_w"].unique())
         ]
     return digest
+
+
+# --- Maps: many sites (foldopt.worldmap) --------------------------------------------------------
+
+#: The map figures: column, file, what it shows, colour bar label, diverging colours.
+MAP_FIGURES = (
+    ("fold_angle_deg", "map_fold_angle.png", "best fold angle", "fold angle Θ [deg] (180 = flat)", False),
+    ("gain_vs_flat_pct", "map_gain_vs_flat.png", "t_solar gain of the twofold panel over flat",
+     "gain over flat [%]", True),
+    ("pct_of_tracker", "map_pct_of_tracker.png", "twofold panel's t_solar as a share of the tracker's",
+     "share of the tracker [%]", False),
+)
+
+
+def _is_grid(sites: pd.DataFrame) -> bool:
+    """Whether sites lie on a latitude x longitude grid (possibly with holes, e.g. land only)."""
+    if (sites["site_name"].astype(str) != "").any() or len(sites) < 4:
+        return False
+    lats, lons = np.unique(sites["latitude"]), np.unique(sites["longitude"])
+    return lats.size > 1 and lons.size > 1 and all(np.allclose(np.diff(v), np.diff(v)[0]) for v in (lats, lons))
+
+
+def plot_world_map(rows: pd.DataFrame, value: str, path: Path, title: str, label: str, diverging: bool) -> None:
+    """One value per site on a longitude x latitude map with coastlines (:func:`foldopt.land.draw_coastlines`):
+    cells for a grid of sites, dots for named sites."""
+    from foldopt.land import draw_coastlines
+
+    fig, ax = plt.subplots(figsize=(10, 5.2))
+    values = rows[value].to_numpy(dtype=float)
+    finite = values[np.isfinite(values)]
+    if diverging:
+        bound = max(float(np.abs(finite).max()) if finite.size else 1.0, 1e-9)
+        colours = {"cmap": "RdBu", "vmin": -bound, "vmax": bound}
+    else:
+        colours = {"cmap": "viridis"}
+    if _is_grid(rows):
+        grid = rows.pivot_table(index="latitude", columns="longitude", values=value, aggfunc="mean", dropna=False)
+        mesh = ax.pcolormesh(grid.columns, grid.index, np.ma.masked_invalid(grid.to_numpy(dtype=float)),
+                             shading="nearest", **colours)
+    else:
+        mesh = ax.scatter(rows["longitude"], rows["latitude"], c=values, s=40, edgecolors="k", linewidths=0.4,
+                          **colours)
+    coast = draw_coastlines(ax)
+    ax.set_xlim(-180, 180)
+    ax.set_ylim(-90, 90)
+    ax.set_aspect("equal")
+    ax.set_facecolor("0.9")
+    fig.colorbar(mesh, ax=ax, label=label, shrink=0.8)
+    ax.set_xlabel("longitude [deg]")
+    ax.set_ylabel("latitude [deg]")
+    ax.set_title(title + ("" if coast else " (no coastlines: pip install global-land-mask)"), fontsize=10)
+    _save(fig, path)
+
+
+def _edges(centres, width: float) -> np.ndarray:
+    """Cell edges around sorted centres: midpoints between them, ``width`` for a lone centre."""
+    centres = np.asarray(centres, dtype=float)
+    if centres.size == 1:
+        return np.array([centres[0] - width / 2, centres[0] + width / 2])
+    middle = (centres[1:] + centres[:-1]) / 2
+    return np.concatenate([[2 * centres[0] - middle[0]], middle, [2 * centres[-1] - middle[-1]]])
+
+
+def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, path: Path, title: str) -> None:
+    """Where folding pays: the median gain over flat at each latitude and load as a share of the
+    site's flat peak (loads given in watts are a different share at each site: binned to 0.05)."""
+    rows = table[table["period"] == period]
+    share = rows["p_load_fraction"].round(9) if relative else (rows["p_load_fraction"] / 0.05).round() * 0.05
+    grid = rows.assign(share=share).pivot_table(index="share", columns="latitude", values="gain_vs_flat_pct",
+                                                aggfunc="median")
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
+    bound = max(float(np.abs(data).max()) if data.count() else 1.0, 1e-9)
+    mesh = ax.pcolormesh(_edges(grid.columns, 5.0), _edges(grid.index, 0.05), data, cmap="RdBu", vmin=-bound,
+                         vmax=bound)
+    if data.count() > 3 and grid.shape[0] > 1 and grid.shape[1] > 1:
+        ax.contour(grid.columns, grid.index, data.filled(np.nan), levels=[1.0], colors="k", linewidths=0.8)
+    ax.set_facecolor("0.85")
+    fig.colorbar(mesh, ax=ax, label="median gain over flat [%]" + (" (contour: +1 %)" if grid.shape[0] > 1 else ""))
+    ax.set_xlabel("latitude [deg]")
+    ax.set_ylabel("P_load / flat peak [-]" + ("" if relative else " (bins of 0.05)"))
+    ax.set_title(title, fontsize=10)
+    _save(fig, path)
+
+
+def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, load_index: int = 0,
+                period: str = "year") -> list[str]:
+    """Write the maps of one load (by its index among the map's loads, fractions of the flat peak
+    where ``relative``) and period, and the latitude x load chart; return the file names. Each file
+    is written atomically."""
+    loads = table["p_load_fraction"] if relative else table["p_load_w"]
+    values = np.unique(loads.round(12))
+    shown = table[(np.isclose(loads, values[load_index])) & (table["period"] == period)]
+    unit = "of the flat peak" if relative else "W"
+    what = f"P_load {values[load_index]:g} {unit}, {period}"
+    written = []
+    for value, file, description, label, diverging in MAP_FIGURES:
+        _atomic_figure(folder / file, lambda path: plot_world_map(shown, value, path, f"{name}: {description} "
+                                                                 f"({what})", label, diverging))
+        written.append(file)
+    _atomic_figure(folder / "latitude_load_gain.png", lambda path: plot_latitude_load(
+        table, period, relative, path, f"{name}: where folding pays ({period}, median over longitudes)"))
+    return written + ["latitude_load_gain.png"]
+
+
+def _atomic_figure(path: Path, draw) -> None:
+    temporary = path.with_name(f".{path.stem}.tmp{path.suffix}")
+    try:
+        draw(temporary)
+        temporary.replace(path)
+    finally:
+        temporary.unlink(missing_ok=True)

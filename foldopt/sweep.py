@@ -121,6 +121,8 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
         The study's fold-angle grid [deg], (n_angles,).
     hours : numpy.ndarray
         (n_blocks, n_angles, n_loads).
+    energy : numpy.ndarray
+        Harvested energy [Wh], (n_blocks, n_angles).
     """
     study = blocks.study
     angles = np.asarray(study.fold_angles.grid())
@@ -128,7 +130,8 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
     rows = np.repeat(np.arange(sky.n_blocks), angles.size)
     metrics = engines.row_metrics(sky, study, rows, orientation.reshape(-1, 4), loads, outputs=(study.connection,),
                                   engine=engine)
-    return angles, metrics.t_solar.reshape(sky.n_blocks, angles.size, -1)
+    return (angles, metrics.t_solar.reshape(sky.n_blocks, angles.size, -1),
+            metrics.energy.reshape(sky.n_blocks, angles.size))
 
 
 def _design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str) -> dict:
@@ -260,7 +263,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
             for part in blocks.chunks(loads.size):
                 chunk = blocks[part]
                 sky = counted(chunk.sky())
-                angles, hours = fold_hours(sky, chunk, loads, engine)
+                angles, hours, _ = fold_hours(sky, chunk, loads, engine)
                 metrics = _design_metrics(sky, chunk, loads, angles, _best_angle_index(hours.transpose(0, 2, 1)),
                                           engine)
                 for offset, index in enumerate(members[part]):
@@ -280,7 +283,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     skies, daily = [], []
     for part in parts:
         skies.append(counted(blocks[part].sky()))
-        angles, hours = fold_hours(skies[-1], blocks[part], loads, engine)
+        angles, hours, _ = fold_hours(skies[-1], blocks[part], loads, engine)
         daily.append(hours)
         advance(len(blocks[part]))
     months = [date.month for date in blocks.dates]

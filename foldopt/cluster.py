@@ -1,0 +1,318 @@
+"""A map (:mod:`foldopt.worldmap`) run on a Dask cluster, in chunks that survive faults.
+
+The sites are cut into chunks of a few seconds of work each. A chunk ships only its site list and
+the study (plain data, a few kilobytes), never arrays: every worker builds its own skies. Workers
+compute; the client alone writes, so a cluster needs no shared file system. Each finished chunk is
+written at once, atomically, as a Parquet part (``parts/part-NNNNN.parquet``); the final tables
+are assembled from the parts on disk, so an interrupted run resumed with ``resume=True`` computes
+only the missing chunks and gives the same bytes as an uninterrupted one. A worker that dies
+takes nothing with it: Dask runs its chunks elsewhere, and a part is written once per chunk.
+
+Without a scheduler address the work goes to an embedded :class:`distributed.LocalCluster`, one
+single-threaded worker process per core; with one, to that cluster (``dask scheduler`` and
+``dask worker`` by hand, dask-jobqueue, Kubernetes...). Each task runs the compiled kernel on one
+thread: the parallelism is Dask's.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import logging
+import os
+import shutil
+import time
+from collections.abc import Callable
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from foldopt.config import ConfigError
+from foldopt.folders import OutputError, check_output
+
+#: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
+#: about a millisecond), short enough that a lost worker loses little and progress moves.
+CHUNK_SECONDS = 5.0
+#: Single-core seconds per site-day x fold angle x time step of a map, everything included (sky,
+#: trackers, break-even search), measured on W4 (``bench/map.py``).
+SECONDS_PER_EVALUATION = 13e-9
+PARTS = "parts"
+#: Seconds to wait for a cluster's scheduler and its first worker.
+CONNECT_TIMEOUT = 30
+
+
+@dataclass(frozen=True)
+class MapSpec:
+    """Everything that decides a map's numbers: the study (a study's fields but site, date and
+    load), the sites, the loads and whether they are fractions of each site's flat peak, the year,
+    how the sites are chunked and the engine."""
+
+    study: dict
+    sites: tuple
+    loads: tuple
+    relative: bool = False
+    year: int = 2025
+    sites_per_chunk: int = 0
+    engine: str = "numba"
+
+    def __post_init__(self):
+        if not self.sites:
+            raise ConfigError(["sites: a map needs at least one site"])
+        if self.sites_per_chunk <= 0:
+            object.__setattr__(self, "sites_per_chunk", default_sites_per_chunk(self.study, self.year))
+        sites = tuple({**site, "site_id": index} for index, site in enumerate(self.sites))
+        object.__setattr__(self, "sites", sites)
+
+    def chunks(self) -> list[range]:
+        size = self.sites_per_chunk
+        return [range(start, min(start + size, len(self.sites))) for start in range(0, len(self.sites), size)]
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+    @property
+    def key(self) -> str:
+        """A digest of the spec: a resumed run must have the same."""
+        text = json.dumps(self.as_dict(), sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def default_sites_per_chunk(study: dict, year: int) -> int:
+    """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work."""
+    from foldopt.config import FoldAngles
+
+    angles = len(FoldAngles(**study.get("fold_angles", {})).grid())
+    steps = 1440 / float(study.get("step_min", 1.0))
+    per_site = 365 * angles * steps * SECONDS_PER_EVALUATION
+    return max(1, int(CHUNK_SECONDS / per_site))
+
+
+@dataclass(frozen=True)
+class MapRun:
+    """A finished map: its table and how it was computed."""
+
+    spec: MapSpec
+    table: pd.DataFrame
+    out: Path
+    computed: tuple  # chunks computed by this run
+    from_disk: tuple  # chunks a previous run had finished
+    seconds: float
+    cluster: str
+    dashboard: str | None
+
+
+def evaluate_chunk(study: dict, sites: list, loads: list, relative: bool, year: int, engine: str) -> pd.DataFrame:
+    """The task of one chunk, run on a worker: :func:`foldopt.worldmap.evaluate_sites` on one thread."""
+    import numba
+
+    from foldopt.worldmap import evaluate_sites
+
+    numba.set_num_threads(1)
+    _keep_freed_memory()
+    return evaluate_sites(study, sites, loads, relative, year, engine)
+
+
+def _keep_freed_memory() -> None:
+    """Let glibc reuse freed memory for the next arrays rather than hand it back to the system.
+
+    A Dask nanny starts its worker with ``MALLOC_TRIM_THRESHOLD_=65536``, which also fixes glibc's
+    mmap threshold at its default: every array above 128 KiB is then a fresh mmap whose pages fault
+    in one by one. A map allocates many such arrays per site and ran at half speed (0.49 against
+    0.25 s a site, the difference all system time). Thresholds of 32 MiB (mmap) and 128 MiB (trim)
+    keep a site's arrays on the heap and bound what a worker holds back. Elsewhere than glibc,
+    nothing is done."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):
+        return
+    m_trim_threshold, m_mmap_threshold = -1, -3  # glibc's malloc.h
+    mallopt(m_mmap_threshold, 32 << 20)
+    mallopt(m_trim_threshold, 128 << 20)
+
+
+def _part_path(out: Path, index: int) -> Path:
+    return out / PARTS / f"part-{index:05d}.parquet"
+
+
+def _write_atomically(path: Path, write: Callable[[Path], None]) -> None:
+    """``write(temporary path)``, then rename into ``path``: a reader sees all of it or nothing."""
+    temporary = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    try:
+        write(temporary)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
+def _write_parquet(frame: pd.DataFrame, path: Path) -> None:
+    _write_atomically(path, lambda temporary: frame.to_parquet(temporary, index=False, engine="pyarrow"))
+
+
+def _read_part(path: Path) -> pd.DataFrame | None:
+    """A part on disk, or None where it is missing or cannot be read (then it is computed again)."""
+    try:
+        return pd.read_parquet(path, engine="pyarrow")
+    except (OSError, ValueError):
+        return None
+
+
+def prepare_folder(out: Path, spec: MapSpec, resume: bool, overwrite: bool, metadata: dict) -> list[int]:
+    """Make ``out`` ready for the map and return the chunks already done there (``resume``).
+
+    A fresh map writes ``run.json`` (status ``running``) and ``sites.csv`` first, so that a killed
+    run leaves a folder that a later ``resume`` recognises; ``resume`` refuses a folder holding
+    another map."""
+    out = Path(out)
+    run_json = out / "run.json"
+    if resume and out.is_dir() and run_json.exists():
+        try:
+            previous = json.loads(run_json.read_text())
+        except ValueError:
+            previous = {}
+        if previous.get("map_key") != spec.key:
+            theirs = previous.get("spec", {})
+            differ = [name for name in ("study", "sites", "loads", "relative", "year", "sites_per_chunk", "engine")
+                      if json.dumps(theirs.get(name), sort_keys=True, default=str)
+                      != json.dumps(spec.as_dict()[name], sort_keys=True, default=str)]
+            raise OutputError(f"--resume: {out} holds another map (its {', '.join(differ) or 'settings'} differ); "
+                              "run the same command to resume it, or choose another --out")
+        (out / PARTS).mkdir(exist_ok=True)
+        for leftover in (out / PARTS).glob(".*.tmp-*"):
+            leftover.unlink(missing_ok=True)
+        return [index for index in range(len(spec.chunks())) if _part_path(out, index).exists()]
+    if out.exists() and not overwrite and not resume:
+        raise OutputError(f"{out} already exists; pass --resume to finish it or --overwrite to replace it")
+    if out.exists():
+        check_output(out, overwrite=True)  # only a folder foldopt wrote is replaced
+        shutil.rmtree(out)
+    else:
+        check_output(out, overwrite)
+    (out / PARTS).mkdir(parents=True)
+    pd.DataFrame(list(spec.sites)).to_csv(out / "sites.csv", index=False)
+    _write_json(run_json, {**metadata, "status": "running"})
+    return []
+
+
+def _write_json(path: Path, data: dict) -> None:
+    _write_atomically(path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n"))
+
+
+@contextmanager
+def connect(scheduler: str | None = None, workers: int | None = None):
+    """A Dask client: of the cluster at ``scheduler`` (``tcp://host:port`` or a scheduler file), or
+    of an embedded :class:`distributed.LocalCluster` of ``workers`` single-threaded processes
+    (default one per core). Yields ``(client, description)``."""
+    from distributed import Client, LocalCluster
+
+    if scheduler is None:
+        count = workers or os.cpu_count() or 1
+        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
+                               dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
+        try:
+            with Client(cluster) as client:
+                yield client, f"embedded LocalCluster, {count} worker process{'es' if count > 1 else ''}"
+        finally:
+            cluster.close()
+        return
+    try:
+        if Path(scheduler).is_file():
+            client = Client(scheduler_file=scheduler, timeout=CONNECT_TIMEOUT)
+        else:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+    except (OSError, TimeoutError) as error:
+        raise OutputError(f"--scheduler {scheduler}: no Dask scheduler answers there ({error.__class__.__name__}); "
+                          "start one with `dask scheduler`") from None
+    try:
+        client.wait_for_workers(1, timeout=CONNECT_TIMEOUT)
+        yield client, f"Dask scheduler {client.scheduler.address}"
+    finally:
+        client.close()
+
+
+def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: int | None = None,
+            resume: bool = False, overwrite: bool = False, progress: Callable[[int, int], None] | None = None,
+            announce: Callable[[str, str | None], None] | None = None, metadata: dict | None = None) -> MapRun:
+    """Compute a map on a Dask cluster into ``out`` and return its table.
+
+    Parameters
+    ----------
+    spec : MapSpec
+    out : pathlib.Path
+        The results folder: ``run.json``, ``sites.csv``, ``parts/`` and, when every chunk is
+        done, ``map.parquet`` and ``map.csv``.
+    scheduler : str, optional
+        A scheduler's address or scheduler file; default an embedded cluster of ``workers``.
+    resume : bool
+        Finish the map in ``out``, computing only the chunks it lacks.
+    overwrite : bool
+        Replace ``out`` (a folder foldopt wrote).
+    progress : callable, optional
+        ``progress(sites done, sites)``.
+    announce : callable, optional
+        ``announce(cluster description, dashboard address or None)`` once connected.
+    metadata : dict, optional
+        Written into ``run.json`` beside the spec.
+    """
+    started = time.perf_counter()
+    out = Path(out)
+    chunks = spec.chunks()
+    metadata = {**(metadata or {}), "map_key": spec.key, "spec": spec.as_dict(), "chunks": len(chunks)}
+    done = prepare_folder(out, spec, resume, overwrite, metadata)
+    # A part that cannot be read (a disk fault) is computed again.
+    done = [index for index in done if _read_part(_part_path(out, index)) is not None]
+    missing = [index for index in range(len(chunks)) if index not in done]
+    finished_sites = sum(len(chunks[index]) for index in done)
+    if progress is not None:
+        progress(finished_sites, len(spec.sites))
+    description, dashboard = "no computation (every chunk was on disk)", None
+    if missing:
+        from distributed import as_completed
+
+        with connect(scheduler, workers) as (client, description):
+            dashboard = client.dashboard_link if _has_dashboard(client) else None
+            if announce is not None:
+                announce(description, dashboard)
+            futures = [client.submit(evaluate_chunk, spec.study, [spec.sites[i] for i in chunks[index]],
+                                     list(spec.loads), spec.relative, spec.year, spec.engine,
+                                     key=f"foldopt-map-{spec.key}-{index:05d}", pure=False)
+                       for index in missing]
+            index_of = {future.key: index for future, index in zip(futures, missing, strict=True)}
+            for future in as_completed(futures):
+                index = index_of[future.key]
+                try:
+                    frame = future.result()
+                except ConfigError:
+                    client.cancel(futures)
+                    raise
+                _write_parquet(frame, _part_path(out, index))
+                future.release()
+                finished_sites += len(chunks[index])
+                if progress is not None:
+                    progress(finished_sites, len(spec.sites))
+    table = pd.concat([pd.read_parquet(_part_path(out, index), engine="pyarrow") for index in range(len(chunks))],
+                      ignore_index=True)
+    seconds = time.perf_counter() - started
+    _write_parquet(table, out / "map.parquet")
+    _write_atomically(out / "map.csv", lambda temporary: table.to_csv(temporary, index=False, float_format="%.10g"))
+    computed = tuple(missing)
+    _write_json(out / "run.json", {
+        **metadata, "status": "complete", "cluster": description, "dashboard": dashboard,
+        "chunks_computed": list(computed), "chunks_from_disk": sorted(done), "seconds": round(seconds, 3),
+        "sites_per_second": round(sum(len(chunks[i]) for i in computed) / seconds, 3) if computed else None,
+    })
+    return MapRun(spec, table, out, computed, tuple(sorted(done)), seconds, description, dashboard)
+
+
+def _has_dashboard(client) -> bool:
+    """Whether the scheduler serves the dashboard (it needs bokeh)."""
+    try:
+        return bool(client.scheduler_info().get("services", {}).get("dashboard"))
+    except (OSError, TimeoutError, AttributeError):
+        return False
