@@ -802,11 +802,14 @@ def map_(
     if len(site_list) > MAX_CASES:
         _fail([f"sites: {len(site_list):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
     if not 1 <= show_load <= len(loads):
-        _fail([f"--show-load = {show_load}: must be in [1, {len(loads)}] (the map has {len(loads)} loads)"])
+        _fail([f"--show-load = {show_load}: must be in [1, {len(loads)}] (the map has {len(loads)} load{'s' if len(loads) > 1 else ''})"])
     from foldopt.cluster import MapSpec, run_map
     from foldopt.worldmap import site_study
 
-    site_study(study, site_list[0], year)  # a bad setting fails here, before any cluster starts
+    try:
+        site_study(study, site_list[0], year)  # a bad setting fails here, before any cluster starts
+    except ConfigError as error:
+        _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
     spec = MapSpec(study, tuple(site_list), tuple(loads), relative, year, chunk_sites or 0, engine)
     announced = []
 
@@ -816,11 +819,11 @@ def map_(
             typer.echo(f"{cluster}; dashboard: {dashboard or 'none (pip install bokeh)'}", err=True)
 
     with output.progress(f"map: {len(site_list)} sites", total=len(site_list), unit="sites") as progress:
-        from foldopt.report import map_figures, versions
+        from foldopt.report import map_figures
 
         result = run_map(spec, out, scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
                          progress=progress, announce=announce,
-                         metadata={"command": _INVOCATION, "versions": versions()})
+                         metadata={"command": _INVOCATION})
         figures = map_figures(result.table, out, "map", relative, show_load - 1, show_period)
     digest = _map_digest(result, relative)
     lines = _map_lines(digest, result) + [f"wrote {out} (map.parquet, map.csv, {', '.join(figures)})"]

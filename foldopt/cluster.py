@@ -205,10 +205,11 @@ def _write_json(path: Path, data: dict) -> None:
 
 
 @contextmanager
-def connect(scheduler: str | None = None, workers: int | None = None):
+def connect(scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
     """A Dask client: of the cluster at ``scheduler`` (``tcp://host:port`` or a scheduler file), or
     of an embedded :class:`distributed.LocalCluster` of ``workers`` single-threaded processes
-    (default one per core). Yields ``(client, description)``."""
+    (default one per core). Yields ``(client, description)``; raises :class:`ConfigError` when no
+    scheduler with a worker answers within ``timeout`` [s]."""
     from distributed import Client, LocalCluster
 
     if scheduler is None:
@@ -223,14 +224,18 @@ def connect(scheduler: str | None = None, workers: int | None = None):
         return
     try:
         if Path(scheduler).is_file():
-            client = Client(scheduler_file=scheduler, timeout=CONNECT_TIMEOUT)
+            client = Client(scheduler_file=scheduler, timeout=timeout)
         else:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-    except (OSError, TimeoutError) as error:
-        raise OutputError(f"--scheduler {scheduler}: no Dask scheduler answers there ({error.__class__.__name__}); "
-                          "start one with `dask scheduler`") from None
+            client = Client(scheduler, timeout=timeout)
+    except (OSError, TimeoutError, ValueError) as error:
+        raise ConfigError([f"--scheduler = {scheduler!r}: no Dask scheduler answers there within {timeout:g} s "
+                           f"({error.__class__.__name__}); start one with `dask scheduler`"]) from None
     try:
-        client.wait_for_workers(1, timeout=CONNECT_TIMEOUT)
+        try:
+            client.wait_for_workers(1, timeout=timeout)
+        except TimeoutError:
+            raise ConfigError([f"--scheduler = {scheduler!r}: the scheduler has no worker after {timeout:g} s; start "
+                               "some with `dask worker ADDRESS`"]) from None
         yield client, f"Dask scheduler {client.scheduler.address}"
     finally:
         client.close()
@@ -238,7 +243,8 @@ def connect(scheduler: str | None = None, workers: int | None = None):
 
 def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: int | None = None,
             resume: bool = False, overwrite: bool = False, progress: Callable[[int, int], None] | None = None,
-            announce: Callable[[str, str | None], None] | None = None, metadata: dict | None = None) -> MapRun:
+            announce: Callable[[str, str | None], None] | None = None, metadata: dict | None = None,
+            connect_timeout: float = CONNECT_TIMEOUT) -> MapRun:
     """Compute a map on a Dask cluster into ``out`` and return its table.
 
     Parameters
@@ -259,12 +265,29 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
         ``announce(cluster description, dashboard address or None)`` once connected.
     metadata : dict, optional
         Written into ``run.json`` beside the spec.
+    connect_timeout : float
+        Seconds to wait for ``scheduler`` and its first worker.
     """
     started = time.perf_counter()
     out = Path(out)
     chunks = spec.chunks()
-    metadata = {**(metadata or {}), "map_key": spec.key, "spec": spec.as_dict(), "chunks": len(chunks)}
+    from foldopt.report import versions
+
+    metadata = {**(metadata or {}), "versions": {**versions(), **{name: _version(name) for name in (
+        "dask", "distributed", "pyarrow")}}, "map_key": spec.key, "spec": spec.as_dict(), "chunks": len(chunks)}
+    fresh = not out.exists() or overwrite
     done = prepare_folder(out, spec, resume, overwrite, metadata)
+    try:
+        return _compute(spec, out, done, chunks, metadata, started, scheduler, workers, progress, announce,
+                        connect_timeout)
+    except BaseException:
+        if fresh and not any((out / PARTS).glob("part-*")):
+            shutil.rmtree(out, ignore_errors=True)  # nothing done: leave nothing behind
+        raise
+
+
+def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, progress, announce,
+             connect_timeout) -> MapRun:
     # A part that cannot be read (a disk fault) is computed again.
     done = [index for index in done if _read_part(_part_path(out, index)) is not None]
     missing = [index for index in range(len(chunks)) if index not in done]
@@ -275,7 +298,7 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
     if missing:
         from distributed import as_completed
 
-        with connect(scheduler, workers) as (client, description):
+        with connect(scheduler, workers, connect_timeout) as (client, description):
             dashboard = client.dashboard_link if _has_dashboard(client) else None
             if announce is not None:
                 announce(description, dashboard)
@@ -308,6 +331,15 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
         "sites_per_second": round(sum(len(chunks[i]) for i in computed) / seconds, 3) if computed else None,
     })
     return MapRun(spec, table, out, computed, tuple(sorted(done)), seconds, description, dashboard)
+
+
+def _version(package: str) -> str:
+    from importlib import metadata
+
+    try:
+        return metadata.version(package)
+    except metadata.PackageNotFoundError:
+        return "not installed"
 
 
 def _has_dashboard(client) -> bool:

@@ -103,7 +103,7 @@ def read_sites(path: Path | str) -> list[dict]:
     except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise ConfigError([f"--sites: cannot read {path}: {error.__class__.__name__}"]) from None
     missing = [name for name in ("latitude", "longitude") if name not in header]
-    unknown = [name for name in header if name not in SITE_COLUMNS]
+    unknown = [name[:30] for name in header if name not in SITE_COLUMNS][:5]
     if missing or unknown:
         raise ConfigError([f"--sites {path}: the header must name {', '.join(SITE_COLUMNS)} (name, altitude and "
                            f"timezone optional); " + "; ".join(

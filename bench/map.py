@@ -1,0 +1,113 @@
+"""W4: a world map on the embedded Dask cluster, and what a finer map would cost.
+
+    python bench/map.py                  # 2,000 sites, printed
+    python bench/map.py --write          # ... and written to results/bench/map.md and map.json
+    python bench/map.py --sites 200      # a quicker look
+
+W4: 2,000 sites (a 40 x 50 latitude x longitude grid from 58.5 S to 58.5 N) x 365 days x 180
+fold angles (1..180 deg) x 10 loads (5 % to 50 % of each site's flat peak), the map's defaults:
+Ineichen clear sky with pvlib's Linke turbidity climatology, exact mode, 5-min steps, ideal PV
+model with switching, objective mean, every season. Run on an embedded LocalCluster of one worker,
+then of two, each timed from the call to the finished tables (cluster start-up included, and
+reported on its own). Reported: sites per second, the single-core cost of a site, the speed-up
+from one worker to two, and from the per-site cost the time of a 1-degree world grid of land
+sites on this machine and on 100 workers.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+TARGET_SPEEDUP = 1.8
+
+
+def _spec(n_sites: int):
+    from foldopt.cluster import MapSpec
+    from foldopt.config import default_study_path, read_study
+    from foldopt.worldmap import grid_sites, map_study
+
+    n_lat = max(1, round(np.sqrt(n_sites * 0.8)))
+    n_lon = -(-n_sites // n_lat)
+    latitudes = np.linspace(-58.5, 58.5, n_lat)
+    longitudes = -180 + 360 * (np.arange(n_lon) + 0.5) / n_lon
+    sites = grid_sites([round(v, 6) for v in latitudes], [round(v, 6) for v in longitudes])[:n_sites]
+    study = map_study(read_study(default_study_path())[0])
+    return MapSpec(study, tuple(sites), tuple(np.round(np.arange(1, 11) * 0.05, 6)), relative=True)
+
+
+def _run(spec, workers: int, folder: Path) -> dict:
+    from distributed import Client, LocalCluster  # noqa: F401  (imported before the clock starts)
+
+    from foldopt.cluster import run_map
+
+    started = time.perf_counter()
+    ready = {}
+    result = run_map(spec, folder / f"w{workers}", workers=workers,
+                     announce=lambda *_: ready.setdefault("at", time.perf_counter()))
+    wall = time.perf_counter() - started
+    start_up = ready["at"] - started
+    return {"workers": workers, "wall_s": round(wall, 2), "cluster_start_s": round(start_up, 2),
+            "sites_per_s": round(len(spec.sites) / wall, 2), "rows": len(result.table),
+            "table": result.table}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sites", type=int, default=2000)
+    parser.add_argument("--write", action="store_true", help="write results/bench/map.md and map.json")
+    args = parser.parse_args()
+    spec = _spec(args.sites)
+    with tempfile.TemporaryDirectory() as folder:
+        runs = [_run(spec, workers, Path(folder)) for workers in (1, 2)]
+    one, two = runs
+    import pandas as pd
+
+    pd.testing.assert_frame_equal(one.pop("table"), two.pop("table"), check_exact=True)
+    speedup = one["wall_s"] / two["wall_s"]
+    per_site = (one["wall_s"] - one["cluster_start_s"]) / len(spec.sites)  # one core, one site, everything
+    land_sites = 21_637  # 1-degree grid points on land, foldopt.worldmap.grid_sites(..., land_only=True)
+    lines = [
+        f"# W4: world map on the embedded Dask cluster ({platform.node()}, {os.cpu_count()} cores, "
+        f"{time.strftime('%Y-%m-%d')})",
+        "",
+        f"{len(spec.sites):,} sites x 365 days x 180 fold angles x {len(spec.loads)} loads x 5 periods, "
+        f"{spec.sites_per_chunk} sites per chunk ({len(spec.chunks())} chunks), 5-min steps.",
+        "",
+        "| workers | wall [s] | of which cluster start [s] | sites/s |",
+        "|---|---|---|---|",
+        *[f"| {r['workers']} | {r['wall_s']:.1f} | {r['cluster_start_s']:.1f} | {r['sites_per_s']:.2f} |"
+          for r in runs],
+        "",
+        f"Speed-up from 1 to 2 workers: **{speedup:.2f}x** (target >= {TARGET_SPEEDUP}x). Tables bit-identical.",
+        f"Single-core cost of a site (a year, 180 angles, 10 loads, 5 periods): {per_site:.3f} s.",
+        "",
+        f"A 1-degree world grid of land sites ({land_sites:,}) at that cost: "
+        f"{land_sites * per_site / 3600:.2f} core-hours; on this machine's 2 workers, at the measured speed-up, "
+        f"{land_sites * per_site / speedup / 60:.0f} min; on 100 workers {land_sites * per_site / 100:.0f} s of "
+        "compute plus start-up.",
+    ]
+    text = "\n".join(lines)
+    print(text)
+    if args.write:
+        out = ROOT / "results" / "bench"
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "map.md").write_text(text + "\n")
+        (out / "map.json").write_text(json.dumps({"sites": len(spec.sites), "runs": runs, "speedup": speedup,
+                                                   "per_site_s": per_site}, indent=2) + "\n")
+    if speedup < TARGET_SPEEDUP:
+        print(f"speed-up {speedup:.2f}x is below the target {TARGET_SPEEDUP}x", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,175 @@
+"""Maps on real Dask clusters: an embedded one, and a scheduler and workers started here on
+127.0.0.1, bounded in time and stopped by process id; faults (a worker killed, the client killed)
+must lose nothing and change nothing."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from foldopt.config import ConfigError
+from foldopt.cluster import MapSpec, run_map
+from foldopt.folders import OutputError
+from foldopt.worldmap import evaluate_sites
+
+pytest.importorskip("distributed")
+
+#: 16 sites, a chunk each, about 0.25 s of work per chunk: long enough to be killed mid-run.
+MAP = ["--lat", "-60:60:40", "--lon", "-180:90:90", "--p-load", "1,2", "--area", "0.108", "--chunk-sites", "1"]
+N_SITES, N_LOADS = 16, 2
+SECONDS = 240  # any one run or cluster start
+
+
+def _foldopt(*args, **popen):
+    return subprocess.Popen([sys.executable, "-m", "foldopt.cli", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, **popen)
+
+
+def _finish(process) -> tuple[str, str]:
+    out, err = process.communicate(timeout=SECONDS)
+    assert process.returncode == 0, err
+    return out, err
+
+
+def _kill(process) -> None:
+    if process.poll() is None:
+        process.kill()
+        process.wait(timeout=30)
+
+
+def _wait_for(condition, what: str, seconds: float = SECONDS) -> None:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() > deadline:
+            raise TimeoutError(what)
+        time.sleep(0.02)
+
+
+def _parts(folder: Path) -> dict[str, tuple]:
+    return {path.name: (path.stat().st_ino, path.stat().st_mtime_ns) for path in (folder / "parts").glob("part-*")}
+
+
+@pytest.fixture(scope="module")
+def embedded(tmp_path_factory) -> pd.DataFrame:
+    """The reference: the map on the embedded cluster, uninterrupted."""
+    out = tmp_path_factory.mktemp("embedded") / "map"
+    _finish(_foldopt("map", *MAP, "--out", str(out), "-q"))
+    return pd.read_parquet(out / "map.parquet")
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    """A scheduler and two single-threaded workers on 127.0.0.1 (one without a nanny, so that
+    killing it kills the worker); yields the scheduler file and the workers' processes."""
+    scheduler_file = tmp_path / "scheduler.json"
+    python = [sys.executable, "-m"]
+    processes = [subprocess.Popen([*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+                                   "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        _wait_for(scheduler_file.exists, "the scheduler's file", 60)
+        for _ in range(2):
+            processes.append(subprocess.Popen([*python, "distributed.cli.dask_worker", "--scheduler-file",
+                                               str(scheduler_file), "--nthreads", "1", "--no-nanny", "--host",
+                                               "127.0.0.1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        yield scheduler_file, processes[1:]
+    finally:
+        for process in processes:
+            _kill(process)
+
+
+def _every_site_once(table: pd.DataFrame) -> None:
+    counts = table.groupby(["site_id", "p_load_w", "period"]).size()
+    assert len(counts) == N_SITES * N_LOADS * 5 and (counts == 1).all()
+
+
+def test_embedded_map_equals_the_computation_without_dask(embedded):
+    sites = embedded.drop_duplicates("site_id")
+    spec_sites = [{"latitude": lat, "longitude": lon, "site_id": i}
+                  for i, (lat, lon) in enumerate(zip(sites["latitude"], sites["longitude"], strict=True))]
+    from foldopt.config import default_study_path, read_study
+    from foldopt.worldmap import map_study
+
+    study = map_study(read_study(default_study_path())[0], **{"panel.area": 0.108, "objective": {"statistic": "mean"}})
+    direct = evaluate_sites(study, spec_sites[:2], [1.0, 2.0])
+    pd.testing.assert_frame_equal(embedded[embedded["site_id"] < 2].reset_index(drop=True), direct, check_exact=True)
+    _every_site_once(embedded)
+
+
+def test_a_hand_started_cluster_gives_the_same_bits(embedded, cluster, tmp_path):
+    scheduler_file, _ = cluster
+    out = tmp_path / "map"
+    _, err = _finish(_foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file)))
+    assert "Dask scheduler tcp://127.0.0.1:" in err
+    pd.testing.assert_frame_equal(pd.read_parquet(out / "map.parquet"), embedded, check_exact=True)
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "complete" and meta["cluster"].startswith("Dask scheduler tcp://127.0.0.1:")
+
+
+def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
+    scheduler_file, workers = cluster
+    out = tmp_path / "map"
+    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file), "-q")
+    try:
+        _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
+        assert workers[0].poll() is None
+        os.kill(workers[0].pid, signal.SIGKILL)
+        killed_at = len(_parts(out))
+        _finish(run)
+    finally:
+        _kill(run)
+    assert killed_at < N_SITES  # the worker died with work left
+    table = pd.read_parquet(out / "map.parquet")
+    _every_site_once(table)
+    pd.testing.assert_frame_equal(table, embedded, check_exact=True)
+
+
+def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):
+    out = tmp_path / "map"
+    run = _foldopt("map", *MAP, "--out", str(out), "-q", start_new_session=True)
+    try:
+        _wait_for(lambda: len(_parts(out)) >= 3 if out.exists() else False, "three parts")
+    finally:
+        os.killpg(run.pid, signal.SIGKILL)  # the client and its embedded cluster, at once
+        run.wait(timeout=30)
+    before = _parts(out)
+    assert 3 <= len(before) < N_SITES and not (out / "map.parquet").exists()
+    refused = _foldopt("map", *MAP, "--out", str(out))
+    _, err = refused.communicate(timeout=SECONDS)
+    assert refused.returncode == 2 and "pass --resume to finish it" in err
+    _finish(_foldopt("map", *MAP, "--out", str(out), "--resume", "-q"))
+    meta = json.loads((out / "run.json").read_text())
+    finished = sorted(int(name[5:10]) for name in before)
+    assert meta["chunks_from_disk"] == finished
+    assert meta["chunks_computed"] == [index for index in range(N_SITES) if index not in finished]
+    after = _parts(out)
+    assert {name: after[name] for name in before} == before  # the same files, untouched
+    pd.testing.assert_frame_equal(pd.read_parquet(out / "map.parquet"), embedded, check_exact=True)
+    assert not list(out.rglob(".*tmp*"))
+
+
+def test_resume_refuses_another_map(tmp_path):
+    out = tmp_path / "map"
+    spec = MapSpec({"name": "x", "panel": {"area": 0.1}, "sky": "ineichen", "mode": "exact", "step_min": 60,
+                    "fold_angles": {"start": 90, "stop": 180, "step": 90}}, ({"latitude": 0.0, "longitude": 0.0},),
+                   (1.0,), sites_per_chunk=1)
+    run_map(spec, out, workers=1)
+    other = MapSpec({**spec.study, "panel": {"area": 0.2}}, spec.sites, spec.loads, sites_per_chunk=1)
+    with pytest.raises(OutputError, match="holds another map \\(its study differ"):
+        run_map(other, out, resume=True)
+    finished = run_map(spec, out, resume=True)  # nothing left to compute
+    assert finished.computed == () and finished.from_disk == (0,)
+
+
+def test_no_scheduler_is_a_one_line_input_error(tmp_path):
+    spec = MapSpec({"name": "x", "panel": {"area": 0.1}}, ({"latitude": 0.0, "longitude": 0.0},), (1.0,))
+    with pytest.raises(ConfigError, match="no Dask scheduler answers there within 2 s"):
+        run_map(spec, tmp_path / "map", scheduler="tcp://127.0.0.1:9", connect_timeout=2)

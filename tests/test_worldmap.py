@@ -1,0 +1,135 @@
+"""Many-site maps (foldopt.worldmap): each row checked against the annual sweep it must equal, the
+break-even standby against the tracker it describes, and physical identities."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from foldopt.config import ConfigError, make_plan
+from foldopt.sweep import run_plan
+from foldopt.worldmap import PERIODS, SEASONS, evaluate_sites, grid_sites, map_study, read_sites
+
+#: A coarse study keeps a year's evaluation to tens of milliseconds.
+COARSE = map_study({"name": "shin2015", "panel": {"area": 0.108, "efficiency": 0.1905}, "p_load": 2.0,
+                    "pv_model": "ideal", "connection": "switching"},
+                   **{"fold_angles": {"start": 10, "stop": 180, "step": 10}, "step_min": 15.0})
+LA = {"name": "Los Angeles", "latitude": 34.05, "longitude": -118.25, "timezone": "America/Los_Angeles"}
+
+
+@pytest.fixture(scope="module")
+def la_map():
+    return evaluate_sites(COARSE, [LA], [1.0, 4.0, 8.0])
+
+
+def test_year_rows_equal_the_annual_sweep(la_map):
+    """The map's year row is the annual sweep (`foldopt run` with a fixed angle over the year) of the
+    same site: same fold angle, same daily t_solar of every design, same energy."""
+    plan = make_plan({**{k: v for k, v in COARSE.items()}, "site": LA, "date": "year", "p_load": [1.0, 4.0, 8.0]})
+    table = run_plan(plan).table
+    means = table.groupby(["p_load_w", "design"])[["t_solar_h", "energy_wh", "fold_angle_deg"]].agg(
+        {"t_solar_h": "mean", "energy_wh": "sum", "fold_angle_deg": "first"})
+    year = la_map[la_map["period"] == "year"].set_index("p_load_w")
+    for load in (1.0, 4.0, 8.0):
+        row = year.loc[load]
+        assert row["fold_angle_deg"] == means.loc[(load, "twofold"), "fold_angle_deg"]
+        for design in ("flat", "twofold", "tracker"):
+            assert row[f"t_solar_{design}_h"] == pytest.approx(means.loc[(load, design), "t_solar_h"], abs=1e-9)
+            assert row[f"energy_{design}_kwh"] == pytest.approx(means.loc[(load, design), "energy_wh"] / 1000,
+                                                                rel=1e-12)
+        assert row["t_solar_tracker_net_h"] == pytest.approx(means.loc[(load, "tracker-net"), "t_solar_h"], abs=1e-9)
+        # The flat panel's peak over the year is the largest of its daily peaks.
+        assert row["flat_peak_w"] == pytest.approx(table[table["design"] == "flat"]["peak_power_w"].max(), rel=1e-12)
+
+
+def test_each_period_is_its_own_optimum(la_map):
+    """A season's fold angle maximises the objective over that season's days: the year's angle does
+    no better there (the sweep at the year's angle, restricted to the season, is the reference)."""
+    assert list(la_map["period"].unique()) == list(PERIODS)
+    assert la_map.groupby("period")["days"].first().to_dict() == {"year": 365, "DJF": 90, "MAM": 92, "JJA": 92,
+                                                                  "SON": 91}
+    plan = make_plan({**COARSE, "site": LA, "date": "year", "p_load": 4.0})
+    table = run_plan(plan).table
+    twofold = table[table["design"] == "twofold"]
+    months = pd.to_datetime(twofold["date"]).dt.month.to_numpy()
+    for period, season in SEASONS.items():
+        at_year_angle = twofold["t_solar_h"].to_numpy()[np.isin(months, season)].mean()
+        row = la_map[(la_map["period"] == period) & (la_map["p_load_w"] == 4.0)].iloc[0]
+        assert row["objective_twofold_h"] >= at_year_angle - 1e-12
+
+
+def test_break_even_standby_is_where_the_tracker_falls_to_the_twofold_panel(la_map):
+    """A tracker drawing the break-even standby has the twofold panel's objective (the tracker's own
+    t_solar with that draw is the reference, computed again with standby_w set)."""
+    year = la_map[la_map["period"] == "year"]
+    for row in year.itertuples():
+        if row.tracker_break_even_standby_w > 0:
+            study = {**COARSE, "tracker": {"standby_w": float(row.tracker_break_even_standby_w)}}
+            again = evaluate_sites(study, [LA], [row.p_load_w])
+            net = again[again["period"] == "year"].iloc[0]["objective_tracker_net_h"]
+            assert net == pytest.approx(row.objective_twofold_h, abs=2e-3)
+    assert (year["tracker_break_even_standby_w"] > 0).any()
+
+
+def test_a_panel_folded_only_to_180_deg_is_the_flat_panel():
+    flat_only = {**COARSE, "fold_angles": {"start": 180, "stop": 180, "step": 1}}
+    table = evaluate_sites(flat_only, [LA, {"latitude": -45.0, "longitude": 170.0}], [0.2, 0.6], relative=True)
+    assert (table["fold_angle_deg"] == 180).all()
+    np.testing.assert_allclose(table["t_solar_twofold_h"], table["t_solar_flat_h"], atol=1e-12)
+    np.testing.assert_allclose(table["energy_twofold_kwh"], table["energy_flat_kwh"], rtol=1e-12)
+    np.testing.assert_allclose(table["gain_vs_flat_pct"], 0.0, atol=1e-9)
+
+
+def test_relative_loads_are_fractions_of_each_sites_flat_peak():
+    table = evaluate_sites(COARSE, [LA, {"latitude": 60.0, "longitude": 10.0}], [0.25, 0.5], relative=True)
+    for _, rows in table.groupby("site_id"):
+        np.testing.assert_allclose(rows["p_load_w"], rows["p_load_fraction"] * rows["flat_peak_w"], rtol=1e-15)
+    peaks = table.groupby("latitude")["flat_peak_w"].first()
+    assert peaks[34.05] != peaks[60.0]
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(latitude=st.floats(-66, 66), longitude=st.floats(-180, 180),
+       loads=st.lists(st.floats(0.05, 1.2), min_size=2, max_size=4, unique=True))
+def test_invariants_across_sites_and_loads(latitude, longitude, loads):
+    """Anywhere, any loads: the twofold panel (whose grid holds 180 deg, the flat panel) never runs
+    shorter than flat; t_solar never rises when the load rises; the break-even draw is >= 0."""
+    loads = sorted(loads)
+    table = evaluate_sites(COARSE, [{"latitude": latitude, "longitude": longitude}], loads, relative=True)
+    assert (table["objective_twofold_h"] >= table["objective_flat_h"] - 1e-12).all()
+    for _, rows in table.groupby("period"):
+        for design in ("flat", "tracker", "tracker_net"):
+            assert (np.diff(rows[f"t_solar_{design}_h"].to_numpy()) <= 1e-12).all()
+        assert (np.diff(rows["objective_twofold_h"].to_numpy()) <= 1e-12).all()
+    standby = table["tracker_break_even_standby_w"].dropna()
+    assert (standby >= 0).all()
+
+
+def test_grid_sites_and_land():
+    assert len(grid_sites([0, 10], [-180, 0, 180])) == 4  # 180 is -180
+    sites = grid_sites([51.5, 0.0], [-0.1, -30.0], land_only=True)  # London; the mid-Atlantic
+    assert sites == [{"latitude": 51.5, "longitude": -0.1}]
+
+
+def test_sites_csv(tmp_path):
+    good = tmp_path / "sites.csv"
+    good.write_text("name,latitude,longitude,altitude,timezone\nLA,34.05,-118.25,89,America/Los_Angeles\n"
+                    "Quito,-0.18,-78.47,,\n")
+    sites = read_sites(good)
+    assert sites[0] == {"name": "LA", "latitude": 34.05, "longitude": -118.25, "altitude": 89.0,
+                        "timezone": "America/Los_Angeles"}
+    assert sites[1] == {"name": "Quito", "latitude": -0.18, "longitude": -78.47, "altitude": 0.0}
+    bad = tmp_path / "bad.csv"
+    bad.write_text("name,latitude,longitude\nA,95,0\nB,10,x\n")
+    with pytest.raises(ConfigError) as error:
+        read_sites(bad)
+    assert error.value.errors == [f"--sites {bad}, line 2: latitude = '95': must be in [-90, 90] deg",
+                                  f"--sites {bad}, line 3: longitude = 'x': Input should be a valid number, unable "
+                                  "to parse string as a number"]
+    header = tmp_path / "header.csv"
+    header.write_text("site,lat,lon\nA,1,2\n")
+    with pytest.raises(ConfigError, match="missing latitude, longitude; unknown site, lat, lon"):
+        read_sites(header)
