@@ -48,6 +48,7 @@ Examples:
   foldopt sweep latitude                       the embedded study from 60 S to 60 N
   foldopt sweep angle --weather FILE.csv       a real year from a TMY3 / EPW / PVGIS file
   foldopt size --cost-per-w 0.9                panel sizing (Shin et al. Sec. IV-A)
+  foldopt map --p-load 2 --area 0.108          many sites on Dask: where folding pays, worldwide
 
 Shell completion: foldopt --install-completion.
 """

@@ -630,12 +630,24 @@ MAP_FIGURES = (
 )
 
 
-def _is_grid(sites: pd.DataFrame) -> bool:
-    """Whether sites lie on a latitude x longitude grid (possibly with holes, e.g. land only)."""
+def _lattice(values) -> np.ndarray | None:
+    """The regular lattice that sorted ``values`` sit on (gaps allowed, e.g. land only), or None."""
+    values = np.unique(values)
+    if values.size < 2:
+        return None
+    step = np.diff(values).min()
+    steps = (values - values[0]) / step
+    if not np.allclose(steps, np.round(steps), atol=1e-6):
+        return None
+    return values[0] + step * np.arange(int(round(steps[-1])) + 1)
+
+
+def _grid_axes(sites: pd.DataFrame):
+    """The latitude and longitude lattices of a grid of sites, or None for named sites."""
     if (sites["site_name"].astype(str) != "").any() or len(sites) < 4:
-        return False
-    lats, lons = np.unique(sites["latitude"]), np.unique(sites["longitude"])
-    return lats.size > 1 and lons.size > 1 and all(np.allclose(np.diff(v), np.diff(v)[0]) for v in (lats, lons))
+        return None
+    lats, lons = _lattice(sites["latitude"]), _lattice(sites["longitude"])
+    return None if lats is None or lons is None else (lats, lons)
 
 
 def plot_world_map(rows: pd.DataFrame, value: str, path: Path, title: str, label: str, diverging: bool) -> None:
@@ -651,10 +663,13 @@ def plot_world_map(rows: pd.DataFrame, value: str, path: Path, title: str, label
         colours = {"cmap": "RdBu", "vmin": -bound, "vmax": bound}
     else:
         colours = {"cmap": "viridis"}
-    if _is_grid(rows):
-        grid = rows.pivot_table(index="latitude", columns="longitude", values=value, aggfunc="mean", dropna=False)
-        mesh = ax.pcolormesh(grid.columns, grid.index, np.ma.masked_invalid(grid.to_numpy(dtype=float)),
-                             shading="nearest", **colours)
+    axes = _grid_axes(rows)
+    if axes is not None:
+        lats, lons = axes
+        grid = rows.pivot_table(index="latitude", columns="longitude", values=value, aggfunc="mean")
+        grid = grid.reindex(index=lats, columns=lons, method="nearest", tolerance=1e-6)
+        mesh = ax.pcolormesh(lons, lats, np.ma.masked_invalid(grid.to_numpy(dtype=float)), shading="nearest",
+                             **colours)
     else:
         mesh = ax.scatter(rows["longitude"], rows["latitude"], c=values, s=40, edgecolors="k", linewidths=0.4,
                           **colours)

@@ -106,6 +106,20 @@ VALUES = [
     ("weather-missing", ["sweep", "angle", "--weather", "nope.csv"], ["--weather", "file not found"]),
     ("config-missing", ["run", "nope.yaml"], ["config", "file not found", "nope.yaml"]),
     ("config-folder", ["run", "prior"], ["config", "prior"]),
+    ("map-lat", ["map", "--lat", "95"], ["--lat", "[-90, 90]"]),
+    ("map-lon-range", ["map", "--lon", "0:10"], ["--lon", "start:stop:step"]),
+    ("map-load", ["map", "--p-load", "-1"], ["--p-load", "(0, 1e+06]"]),
+    ("map-fraction", ["map", "--p-load-fraction", "0:0.5:0.1"], ["--p-load-fraction", "(0, 2]"]),
+    ("map-two-loads", ["map", "--p-load", "1", "--p-load-fraction", "0.5"], ["one way"]),
+    ("map-two-sources", ["map", "--lat", "0", "--sites", "s.csv"], ["one source of sites"]),
+    ("map-sites-missing", ["map", "--sites", "nope.csv"], ["--sites", "file not found"]),
+    ("map-weather-dir", ["map", "--weather-dir", "nope"], ["--weather-dir", "not a folder"]),
+    ("map-period", ["map", "--show-period", "winter"], ["--show-period", "year, DJF"]),
+    ("map-show-load", ["map", "--p-load", "1,2", "--show-load", "3"], ["--show-load", "[1, 2]"]),
+    ("map-objective", ["map", "--objective", "best"], ["--objective", "pNN"]),
+    ("map-step", ["map", "--step-min", "7"], ["--step-min", "divide the 1440 min"]),
+    ("map-workers", ["map", "--workers", "0"], ["--workers", "at least 1"]),
+    ("map-set", ["map", "--set", "panel.area=-1"], ["--area", "(0, 1000]"]),
 ]
 
 YAML_FILES = [
