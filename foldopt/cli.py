@@ -827,9 +827,17 @@ def map_(
                          metadata={"command": _INVOCATION})
         figures = map_figures(result.table, out, "map", relative, show_load - 1, show_period)
     digest = _map_digest(result, relative)
-    lines = _map_lines(digest, result) + [f"wrote {out} (map.parquet, map.csv, {', '.join(figures)})"]
+    taken = [f"panel {study['panel']['area']:g} m^2" if area is None else None,
+             f"P_load {loads[0]:g} W" if p_load is None and not relative else None,
+             f"{study.get('pv_model', 'ideal')} PV model", f"{study.get('mode')} mode",
+             f"{study.get('step_min'):g}-min steps" if step_min is None else None]
+    defaults = [EMBEDDED if config is None else str(config), *[item for item in taken if item]]
+    lines = _map_lines(digest, result)
+    lines.insert(1, f"  from {defaults[0]}: {', '.join(defaults[1:])}")
+    lines.append(f"wrote {out} (map.parquet, map.csv, {', '.join(figures)})")
     year_rows = result.table[result.table["period"] == "year"]
-    output.answer({"command": "map", "out": str(out), "summary": digest, "rows": _records(year_rows)}, lines)
+    output.answer({"command": "map", "out": str(out), "defaults": _taken(defaults), "summary": digest,
+                   "rows": _records(year_rows)}, lines)
 
 
 def _map_digest(result, relative: bool) -> dict:
@@ -863,12 +871,16 @@ def _number(value):
     return None if value is None or value != value else float(value)
 
 
+def _count(number: int, noun: str) -> str:
+    return f"{number} {noun}{'' if number == 1 else 's'}"
+
+
 def _map_lines(digest: dict, result) -> list[str]:
     spec = result.spec
     study = spec.study
     sky = "weather files" if any("weather" in site for site in spec.sites) else "Ineichen clear sky" if study.get(
         "sky") == "ineichen" else f"{study.get('sky')} sky"
-    lines = [f"map: {digest['sites']} sites, year {spec.year}, {sky}, objective {study['objective']['statistic']}, "
+    lines = [f"map: {_count(digest['sites'], 'site')}, year {spec.year}, {sky}, objective {study['objective']['statistic']}, "
              f"{study['panel']['area']:g} m^2 panel"]
     for load in digest["loads"]:
         what = (f"P_load {load['p_load_fraction']:g} x flat peak" if "p_load_fraction" in load
@@ -876,13 +888,15 @@ def _map_lines(digest: dict, result) -> list[str]:
         best = load["best_site"]
         where = "" if best is None else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
         angles = load["fold_angle_deg"]
-        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {load['sites']} sites (median "
+        standby = load["median_tracker_break_even_standby_w"]
+        tracker = ("" if standby is None else ", whose own moves already cost it its lead" if standby == 0
+                   else f", which loses its lead above a median {standby:.2f} W of standby")
+        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')} (median "
                      f"{_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} at {where}); "
-                     f"fold angles {angles['min']:g} to {angles['max']:g} deg; median {_pct(load['median_pct_of_tracker'], False)} "
-                     f"of the tracker, which loses its lead above a median "
-                     f"{load['median_tracker_break_even_standby_w'] or 0:.2f} W of standby")
+                     f"fold angles {angles['min']:g} to {angles['max']:g} deg; median "
+                     f"{_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}")
     rate = len(spec.sites) / digest["seconds"] if digest["seconds"] else 0
-    computed = (f"computed {digest['chunks_computed']} chunks on {digest['cluster']}" if digest["chunks_computed"]
+    computed = (f"computed {_count(digest['chunks_computed'], 'chunk')} on {digest['cluster']}" if digest["chunks_computed"]
                 else "nothing to compute")
     resumed = f", {digest['chunks_from_disk']} from disk" if digest["chunks_from_disk"] else ""
     lines.append(f"{computed}{resumed} in {digest['seconds']:.1f} s ({rate:.1f} sites/s)")

@@ -56,10 +56,11 @@ def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
 
 
 def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
-    """The tracker's own draw [W] per step over every block: standby while the sun is up, plus its moves."""
+    """The tracker's own draw [W] per step over every block: standby while there is light (the sun up,
+    clouds or not), plus its moves."""
     tracker = study.tracker
     drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
-    return tracker_draw(*orientation, sky.dni > 0, sky.step_hours, drive)
+    return tracker_draw(*orientation, sky.lit, sky.step_hours, drive)
 
 
 class Day:
@@ -265,8 +266,9 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
         Standby draw [W] above which the twofold panel runs longer; NaN if it never does.
     """
     study, step = day.study, day.step_hours
-    drive_only = day.tracker_draw() - np.where(day.dni > 0, study.tracker.standby_w, 0.0)
-    available = np.where(day.dni > 0, p_tracker - drive_only, 0.0)
+    lit = day.sky.lit[0]
+    drive_only = day.tracker_draw() - np.where(lit, study.tracker.standby_w, 0.0)
+    available = np.where(lit, p_tracker - drive_only, 0.0)
     draws = np.linspace(0.0, max(2.0 * study.p_load, 1e-3), points)
     hours = t_solar(available, study.p_load + draws, step)
     load = load_for_t_solar(available, twofold_t_solar, step) if twofold_t_solar > 0 else np.nan

@@ -234,10 +234,11 @@ def _evaluate_site(study_data: dict, site: dict, loads, relative: bool, year: in
         metrics = engines.curve_metrics(np.concatenate([gross, gross - draw]), usable, step_hours, engine=engine)
         tracker.append((metrics.t_solar[:sky.n_blocks, 0], metrics.t_solar[sky.n_blocks:, 0],
                         metrics.energy[:sky.n_blocks, 0]))
-        # The tracker's power less its moves (not its standby) while the sun is up, as
-        # foldopt.study.standby_sweep: a standby draw s is then a load raised by s.
-        sun_up = sky.dni > 0
-        available.append(np.where(sun_up, gross - (draw - np.where(sun_up, study.tracker.standby_w, 0.0)), 0.0))
+        # The tracker's power less its moves (not its standby) where there is light, as
+        # foldopt.study.standby_sweep: there is no power elsewhere, so a standby draw s is a load
+        # raised by s.
+        lit = sky.lit
+        available.append(np.where(lit, gross - (draw - np.where(lit, study.tracker.standby_w, 0.0)), 0.0))
     hours = np.concatenate(hours).transpose(0, 2, 1)  # (days, loads, angles)
     harvest = np.concatenate(harvest)  # (days, angles)
     flat_hours, flat_energy = np.concatenate(flat_hours), np.concatenate(flat_energy)

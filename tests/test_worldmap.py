@@ -3,6 +3,8 @@ break-even standby against the tracker it describes, and physical identities."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -17,6 +19,7 @@ from foldopt.worldmap import PERIODS, SEASONS, evaluate_sites, grid_sites, map_s
 COARSE = map_study({"name": "shin2015", "panel": {"area": 0.108, "efficiency": 0.1905}, "p_load": 2.0,
                     "pv_model": "ideal", "connection": "switching"},
                    **{"fold_angles": {"start": 10, "stop": 180, "step": 10}, "step_min": 15.0})
+GREENSBORO = {"weather": str(Path(__file__).parent.parent / "configs" / "weather" / "723170TYA.CSV")}
 LA = {"name": "Los Angeles", "latitude": 34.05, "longitude": -118.25, "timezone": "America/Los_Angeles"}
 
 
@@ -61,17 +64,22 @@ def test_each_period_is_its_own_optimum(la_map):
         assert row["objective_twofold_h"] >= at_year_angle - 1e-12
 
 
-def test_break_even_standby_is_where_the_tracker_falls_to_the_twofold_panel(la_map):
+@pytest.mark.parametrize("where", ["clear sky", "weather"])
+def test_break_even_standby_is_where_the_tracker_falls_to_the_twofold_panel(la_map, where):
     """A tracker drawing the break-even standby has the twofold panel's objective (the tracker's own
-    t_solar with that draw is the reference, computed again with standby_w set)."""
-    year = la_map[la_map["period"] == "year"]
-    for row in year.itertuples():
-        if row.tracker_break_even_standby_w > 0:
+    t_solar with that draw is the reference, computed again with standby_w set). With weather, the
+    standby is drawn on cloudy days too: wherever there is light."""
+    site, table = (LA, la_map) if where == "clear sky" else (GREENSBORO, evaluate_sites(COARSE, [GREENSBORO],
+                                                                                          [1.0, 4.0, 8.0]))
+    for row in table.itertuples():
+        if row.tracker_break_even_standby_w > 0 and row.period in ("year", "JJA"):
             study = {**COARSE, "tracker": {"standby_w": float(row.tracker_break_even_standby_w)}}
-            again = evaluate_sites(study, [LA], [row.p_load_w])
-            net = again[again["period"] == "year"].iloc[0]["objective_tracker_net_h"]
+            again = evaluate_sites(study, [site], [row.p_load_w])
+            net = again[again["period"] == row.period].iloc[0]["objective_tracker_net_h"]
             assert net == pytest.approx(row.objective_twofold_h, abs=2e-3)
-    assert (year["tracker_break_even_standby_w"] > 0).any()
+        if row.tracker_break_even_standby_w == 0:  # the tracker's moves alone already cost its lead
+            assert row.objective_tracker_net_h <= row.objective_twofold_h
+    assert (table["tracker_break_even_standby_w"] > 0).any()
 
 
 def test_a_panel_folded_only_to_180_deg_is_the_flat_panel():
