@@ -1,8 +1,47 @@
-"""foldopt: design-space optimiser for twofold photovoltaic panels powering storage-less loads."""
+"""foldopt: design-space optimiser for twofold photovoltaic panels powering storage-less loads.
 
-from importlib import metadata
+The public interface (``foldopt.__all__``) loads on first use, so that ``import foldopt`` and the
+command line's help stay fast.
+
+>>> import foldopt
+>>> result = foldopt.run(foldopt.default_study())
+>>> ax = foldopt.plot_power_curves(result)
+"""
+
+from importlib import import_module, metadata
 
 try:
     __version__ = metadata.version("foldopt")
 except metadata.PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
+
+#: Public name -> the module that defines it.
+_PUBLIC = {
+    "Study": "foldopt.config", "Site": "foldopt.config", "Panel": "foldopt.config", "Tracker": "foldopt.config",
+    "Objective": "foldopt.config", "FoldAngles": "foldopt.config", "Weather": "foldopt.config",
+    "Plan": "foldopt.config", "ConfigError": "foldopt.config",
+    "default_study": "foldopt.api", "load_study": "foldopt.api", "run": "foldopt.api", "sweep": "foldopt.api",
+    "write": "foldopt.api",
+    "StudyResult": "foldopt.study", "SweepResult": "foldopt.sweep",
+    "MapSpec": "foldopt.cluster", "MapRun": "foldopt.cluster", "run_map": "foldopt.cluster",
+    "evaluate_sites": "foldopt.worldmap", "grid_sites": "foldopt.worldmap", "read_sites": "foldopt.worldmap",
+    "weather_sites": "foldopt.worldmap", "map_study": "foldopt.worldmap",
+    "annual_summary": "foldopt.report", "write_html": "foldopt.report",
+    **{name: "foldopt.report" for name in (
+        "plot_power_curves", "plot_switching", "plot_t_solar_vs_fold_angle", "plot_comparison", "plot_standby",
+        "plot_map", "plot_curves", "plot_sizing", "plot_annual_fold_angles", "plot_monthly", "plot_distribution",
+        "plot_day_hour", "plot_world_map", "plot_latitude_load", "save_plot")},
+}
+__all__ = ["__version__", *_PUBLIC]
+
+
+def __getattr__(name: str):
+    if name in _PUBLIC:
+        value = getattr(import_module(_PUBLIC[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'foldopt' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_PUBLIC))

@@ -219,68 +219,6 @@ def _records(table) -> list[dict]:
     return json.loads(table.to_json(orient="records", double_precision=10))
 
 
-def _hours(value) -> str:
-    return "-" if value is None else f"{value:.2f} h"
-
-
-def _pct(value, signed: bool = True) -> str:
-    return "-" if value is None else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
-
-
-def _study_lines(digest: dict, defaults: list[str]) -> list[str]:
-    site = digest["site"]
-    where = site["name"] or f"{site['latitude']:g}, {site['longitude']:g}"
-    hours = digest["t_solar_h"]
-    lines = [f"{digest['study']}: {where}, {digest['date']}, P_load {digest['p_load_w']:g} W "
-             f"({digest['mode']} mode, {digest['pv_model']} + {digest['connection']})"]
-    if defaults:
-        lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
-    heuristic = digest["heuristic_fold_angle_deg"]
-    if not hours["twofold"]:
-        lines.append(f"no fold angle reaches the load: t_solar 0 h (flat {_hours(hours['flat'])}, tracker "
-                     f"{_hours(hours['tracker'])})")
-    else:
-        lines.append(f"best fold angle {digest['fold_angle_deg']:.1f} deg"
-                     + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic is not None else "")
-                     + f": t_solar {_hours(hours['twofold'])}, {_pct(digest['gain_vs_flat_pct'])} over flat "
-                     f"({_hours(hours['flat'])}), {_pct(digest['pct_of_tracker_t_solar'], False)} of the tracker's "
-                     f"{_hours(hours['tracker'])}")
-    extras = []
-    if digest["flat_area_multiple"] is not None:
-        extras.append(f"a flat panel would need {digest['flat_area_multiple']:.2f}x the area")
-    if digest["tracker_break_even_standby_w"] is not None:
-        extras.append(f"the twofold panel outlasts the tracker once its standby draw exceeds "
-                      f"{digest['tracker_break_even_standby_w']:.2f} W")
-    if extras:
-        lines.append("; ".join(extras))
-    if digest["notes"]:
-        lines.append(f"note: {'; '.join(digest['notes'])}")
-    return lines
-
-
-def _sweep_lines(digest: dict, defaults: list[str]) -> list[str]:
-    axes = " x ".join(f"{count} {path.split('.')[-1]}" for path, count in digest["axes"].items())
-    lines = [f"{digest['study']}: {digest['cases']} cases ({axes})"]
-    if defaults:
-        lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
-    for year in digest.get("year", []):
-        mean = year["mean_t_solar_h"]
-        lines.append(f"P_load {year['p_load_w']:g} W: fold angle {year['fold_angle_deg']:g} deg all year, mean t_solar "
-                     f"{_hours(mean['twofold'])} ({_pct(year['t_solar_gain_vs_flat_pct'])} over flat "
-                     f"{_hours(mean['flat'])}, energy {_pct(year['energy_gain_vs_flat_pct'])}); tracker "
-                     f"{_hours(mean['tracker'])}")
-    gain = digest.get("gain_vs_flat_pct")
-    if gain and "year" not in digest:
-        at = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
-                       for key, value in gain["at"].items())
-        lines.append(f"twofold over flat: median {_pct(gain['median'])}, best {_pct(gain['max'])} ({at}); "
-                     f"fold angles {digest['fold_angle_deg']['min']:g} to {digest['fold_angle_deg']['max']:g} deg")
-    if digest["notes"]:
-        lines.append("notes: " + ", ".join(f"{note} ({count} of {digest['cases']} cases)"
-                                           for note, count in digest["notes"].items()))
-    return lines
-
-
 STUDY_COLUMNS = ["design", "fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh", "peak_power_w",
                  "gain_vs_flat_pct", "pct_of_tracker_t_solar", "flat_area_multiple", "note"]
 SWEEP_COLUMNS = ["site_name", "latitude", "date", "p_load_w", "design", "fold_angle_deg", "t_solar_h",
@@ -294,13 +232,13 @@ def _run_plan(plan, out: Path, overwrite: bool, output: _Output, engine: str, de
     base = plan.base
     if not plan.axes:
         with output.progress(f"{base.name}: one day, {len(base.fold_angles.grid())} fold angles"):
-            from foldopt.report import digest_study, write_study
-            from foldopt.study import run_study
+            from foldopt.api import run as run_study, write
+            from foldopt.report import digest_study, study_answer
 
             result = run_study(base, engine)
-            write_study(result, out, overwrite, _INVOCATION)
+            write(result, out, overwrite, _INVOCATION)
         digest = digest_study(result)
-        lines = _study_lines(digest, defaults) + [f"wrote {out}"]
+        lines = study_answer(digest, defaults) + [f"wrote {out}"]
         output.answer({"command": command, "out": str(out), "defaults": _taken(defaults), "summary": digest,
                        "rows": _records(result.summary)},
                       lines, result.summary, STUDY_COLUMNS)
@@ -308,13 +246,13 @@ def _run_plan(plan, out: Path, overwrite: bool, output: _Output, engine: str, de
     days = plan.n_cases // max(len(dict(plan.axes).get("p_load", (1,))), 1)
     unit = "site-days" if any(path.startswith("site") for path, _ in plan.axes) else "days"
     with output.progress(f"{base.name}: {days} {unit}", total=days, unit=unit) as progress:
-        from foldopt.report import digest_sweep, write_sweep
-        from foldopt.sweep import run_plan
+        from foldopt.api import run as run_plan, write
+        from foldopt.report import digest_sweep, sweep_answer
 
-        result = run_plan(plan, progress, engine)
-        write_sweep(result, out, overwrite, _INVOCATION)
+        result = run_plan(plan, engine, progress)
+        write(result, out, overwrite, _INVOCATION)
     digest = digest_sweep(result)
-    lines = _sweep_lines(digest, defaults) + [f"wrote {out}"]
+    lines = sweep_answer(digest, defaults) + [f"wrote {out}"]
     twofold = result.table[result.table["design"] == "twofold"]
     output.answer({"command": command, "out": str(out), "defaults": _taken(defaults), "summary": digest,
                    "rows": _records(result.table)},
@@ -820,87 +758,24 @@ def map_(
             typer.echo(f"{cluster}; dashboard: {dashboard or 'none (pip install bokeh)'}", err=True)
 
     with output.progress(f"map: {len(site_list)} sites", total=len(site_list), unit="sites") as progress:
-        from foldopt.report import map_figures
+        from foldopt.report import digest_map, map_answer, map_figures
 
         result = run_map(spec, out, scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
                          progress=progress, announce=announce,
                          metadata={"command": _INVOCATION})
         figures = map_figures(result.table, out, "map", relative, show_load - 1, show_period)
-    digest = _map_digest(result, relative)
+    digest = digest_map(result, relative)
     taken = [f"panel {study['panel']['area']:g} m^2" if area is None else None,
              f"P_load {loads[0]:g} W" if p_load is None and not relative else None,
              f"{study.get('pv_model', 'ideal')} PV model", f"{study.get('mode')} mode",
              f"{study.get('step_min'):g}-min steps" if step_min is None else None]
     defaults = [EMBEDDED if config is None else str(config), *[item for item in taken if item]]
-    lines = _map_lines(digest, result)
+    lines = map_answer(digest, result)
     lines.insert(1, f"  from {defaults[0]}: {', '.join(defaults[1:])}")
     lines.append(f"wrote {out} (map.parquet, map.csv, {', '.join(figures)})")
     year_rows = result.table[result.table["period"] == "year"]
     output.answer({"command": "map", "out": str(out), "defaults": _taken(defaults), "summary": digest,
                    "rows": _records(year_rows)}, lines)
-
-
-def _map_digest(result, relative: bool) -> dict:
-    """Per load, over the sites: where folding pays in the year."""
-    table = result.table
-    year = table[table["period"] == "year"]
-    per_load = []
-    for load, rows in year.groupby("p_load_fraction" if relative else "p_load_w", sort=True):
-        gain = rows["gain_vs_flat_pct"]
-        best = rows.loc[gain.idxmax()] if gain.notna().any() else None
-        per_load.append({
-            ("p_load_fraction" if relative else "p_load_w"): float(load),
-            "sites": int(len(rows)),
-            "sites_folding_pays": int((gain > 0.05).sum()),
-            "median_gain_vs_flat_pct": _number(gain.median()),
-            "best_gain_vs_flat_pct": _number(gain.max()),
-            "best_site": None if best is None else {"site_name": best["site_name"], "latitude": best["latitude"],
-                                                    "longitude": best["longitude"]},
-            "fold_angle_deg": {"min": _number(rows["fold_angle_deg"].min()),
-                               "median": _number(rows["fold_angle_deg"].median()),
-                               "max": _number(rows["fold_angle_deg"].max())},
-            "median_pct_of_tracker": _number(rows["pct_of_tracker"].median()),
-            "median_tracker_break_even_standby_w": _number(rows["tracker_break_even_standby_w"].median()),
-        })
-    return {"sites": int(table["site_id"].nunique()), "loads": per_load, "cluster": result.cluster,
-            "dashboard": result.dashboard, "chunks_computed": len(result.computed),
-            "chunks_from_disk": len(result.from_disk), "seconds": round(result.seconds, 2)}
-
-
-def _number(value):
-    return None if value is None or value != value else float(value)
-
-
-def _count(number: int, noun: str) -> str:
-    return f"{number} {noun}{'' if number == 1 else 's'}"
-
-
-def _map_lines(digest: dict, result) -> list[str]:
-    spec = result.spec
-    study = spec.study
-    sky = "weather files" if any("weather" in site for site in spec.sites) else "Ineichen clear sky" if study.get(
-        "sky") == "ineichen" else f"{study.get('sky')} sky"
-    lines = [f"map: {_count(digest['sites'], 'site')}, year {spec.year}, {sky}, objective {study['objective']['statistic']}, "
-             f"{study['panel']['area']:g} m^2 panel"]
-    for load in digest["loads"]:
-        what = (f"P_load {load['p_load_fraction']:g} x flat peak" if "p_load_fraction" in load
-                else f"P_load {load['p_load_w']:g} W")
-        best = load["best_site"]
-        where = "" if best is None else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
-        angles = load["fold_angle_deg"]
-        standby = load["median_tracker_break_even_standby_w"]
-        tracker = ("" if standby is None else ", whose own moves already cost it its lead" if standby == 0
-                   else f", which loses its lead above a median {standby:.2f} W of standby")
-        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')} (median "
-                     f"{_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} at {where}); "
-                     f"fold angles {angles['min']:g} to {angles['max']:g} deg; median "
-                     f"{_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}")
-    rate = len(spec.sites) / digest["seconds"] if digest["seconds"] else 0
-    computed = (f"computed {_count(digest['chunks_computed'], 'chunk')} on {digest['cluster']}" if digest["chunks_computed"]
-                else "nothing to compute")
-    resumed = f", {digest['chunks_from_disk']} from disk" if digest["chunks_from_disk"] else ""
-    lines.append(f"{computed}{resumed} in {digest['seconds']:.1f} s ({rate:.1f} sites/s)")
-    return lines
 
 
 # --- size ---------------------------------------------------------------------------------------

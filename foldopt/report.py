@@ -24,6 +24,7 @@ from foldopt.metrics import relative_to  # noqa: E402
 from foldopt.study import StudyResult  # noqa: E402
 
 FLOAT_FORMAT = "%.10g"
+TIME_FORMAT = "%Y-%m-%dT%H:%M:%S%z"
 VERSIONED = ("foldopt", "numpy", "scipy", "pandas", "pvlib", "matplotlib", "pydantic", "typer")
 
 
@@ -59,6 +60,20 @@ def _save(fig, path: Path) -> None:
     plt.close(fig)
 
 
+def _axes(ax, figsize):
+    """The figure and axes to draw on: ``ax`` and its figure, or a new figure of ``figsize`` [in]."""
+    if ax is not None:
+        return ax.figure, ax
+    return plt.subplots(figsize=figsize)
+
+
+def save_plot(ax, path: Path) -> Path:
+    """Save the figure that holds ``ax`` (an Axes or an array of them) as ``path`` and close it."""
+    first = np.ravel(ax)[0]
+    _save(first.figure, path)
+    return path
+
+
 def _clock_hours(result: StudyResult):
     times = result.day.times.tz_localize(None)
     return np.asarray((times - times.normalize()) / pd.Timedelta(hours=1))
@@ -68,11 +83,11 @@ def _mode_label(study: Study) -> str:
     return f"{study.mode} mode, {study.geometry} geometry, {study.date}"
 
 
-def plot_power_curves(result: StudyResult, path: Path) -> None:
+def plot_power_curves(result: StudyResult, ax=None):
     """Flat, east, west and combined twofold power with the load (Shin et al. Fig. 6)."""
     series, hours, study = result.timeseries, _clock_hours(result), result.study
     daylight = series["p_tracker_w"].to_numpy() > 0
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = _axes(ax, (8, 4.5))
     ax.plot(hours, series["p_tracker_w"], color="0.6", ls=":", label="ideal dual-axis tracker")
     ax.plot(hours, series["p_flat_w"], color="k", label="flat")
     ax.plot(hours, series["p_east_w"], color="tab:orange", ls="--", label="east sub-panel")
@@ -92,16 +107,16 @@ def plot_power_curves(result: StudyResult, path: Path) -> None:
     ax.set_title(f"{study.name}: power over the day ({_mode_label(study)})")
     ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3)
-    _save(fig, path)
+    return ax
 
 
 STATE_COLOURS = {"east": "tab:orange", "parallel": "tab:green", "west": "tab:purple", "series": "tab:brown"}
 
 
-def plot_switching(result: StudyResult, path: Path) -> None:
+def plot_switching(result: StudyResult, ax=None):
     """Sub-panel curves and the connection switching chooses over the day (Shin et al. Fig. 9)."""
     series, hours, study = result.timeseries, _clock_hours(result), result.study
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = _axes(ax, (8, 4.5))
     state = series["switch_state"].to_numpy()
     step = hours[1] - hours[0]
     starts = np.flatnonzero(np.r_[True, state[1:] != state[:-1]])
@@ -123,13 +138,13 @@ def plot_switching(result: StudyResult, path: Path) -> None:
     )
     ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3)
-    _save(fig, path)
+    return ax
 
 
-def plot_t_solar_vs_fold_angle(result: StudyResult, path: Path) -> None:
+def plot_t_solar_vs_fold_angle(result: StudyResult, ax=None):
     """t_solar versus fold angle, with flat and tracker levels (Shin et al. Fig. 12a)."""
     summary = result.summary.set_index("design")
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = _axes(ax, (7, 4.5))
     ax.plot(
         result.sweep["fold_angle_deg"], result.sweep["t_solar_h"], color="tab:blue", label=f"twofold ({result.study.connection})"
     )
@@ -157,10 +172,10 @@ def plot_t_solar_vs_fold_angle(result: StudyResult, path: Path) -> None:
     ax.set_title(f"{result.study.name}: t_solar vs fold angle ({_mode_label(result.study)})", fontsize=10)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    _save(fig, path)
+    return ax
 
 
-def plot_comparison(result: StudyResult, path: Path) -> None:
+def plot_comparison(result: StudyResult, ax=None):
     """t_solar of flat, optimal twofold and every tracker, gross and net (Shin et al. Fig. 12b)."""
     summary = result.summary.set_index("design")
     names = ["flat", "twofold"] + [d for d in summary.index if d.startswith("tracker") and not d.endswith("-net")]
@@ -171,7 +186,7 @@ def plot_comparison(result: StudyResult, path: Path) -> None:
     x = np.arange(len(names))
     gross = summary.loc[names, "t_solar_h"].to_numpy()
     net = np.array([summary.loc[f"{d}-net", "t_solar_h"] if f"{d}-net" in summary.index else np.nan for d in names])
-    fig, ax = plt.subplots(figsize=(max(6, 1.1 * len(names) + 2), 4.5))
+    fig, ax = _axes(ax, (max(6, 1.1 * len(names) + 2), 4.5))
     colours = ["0.3", "tab:blue"] + ["0.7"] * (len(names) - 2)
     ax.bar(x, gross, color=colours, label="gross")
     ax.bar(x[2:], net[2:], width=0.45, color="tab:orange", label="net of the tracker's own draw")
@@ -182,14 +197,14 @@ def plot_comparison(result: StudyResult, path: Path) -> None:
     ax.set_ylim(0, max(gross.max() * 1.2, 1))
     ax.legend(fontsize=8, loc="lower right")
     ax.set_title(f"{result.study.name}: {_mode_label(result.study)}", fontsize=10)
-    _save(fig, path)
+    return ax
 
 
-def plot_standby(result: StudyResult, path: Path) -> None:
+def plot_standby(result: StudyResult, ax=None):
     """The tracker's net t_solar against its standby draw, and where twofold overtakes it."""
     table, break_even = result.standby
     study = result.study
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = _axes(ax, (7, 4.5))
     ax.plot(table["standby_w"], table["tracker_net_t_solar_h"], color="0.4", label=f"{study.tracker.model} tracker, net")
     ax.axhline(table["twofold_t_solar_h"].iloc[0], color="tab:blue", label="optimal twofold (draws nothing)")
     if np.isfinite(break_even):
@@ -199,7 +214,7 @@ def plot_standby(result: StudyResult, path: Path) -> None:
     ax.set_title(f"{study.name}: when does the tracker's own draw hand the day to the twofold panel?", fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    _save(fig, path)
+    return ax
 
 
 def write_study(result: StudyResult, out: Path, overwrite: bool = False, command=None) -> Path:
@@ -207,12 +222,12 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
     with staged_folder(out, overwrite) as folder:
         result.summary.to_csv(folder / "summary.csv", index=False, float_format=FLOAT_FORMAT)
         result.sweep.to_csv(folder / "sweep.csv", index=False, float_format=FLOAT_FORMAT)
-        result.timeseries.to_csv(folder / "timeseries.csv", index=False, float_format=FLOAT_FORMAT)
-        plot_power_curves(result, folder / "power_curves.png")
-        plot_t_solar_vs_fold_angle(result, folder / "t_solar_vs_fold_angle.png")
-        plot_comparison(result, folder / "comparison.png")
-        plot_switching(result, folder / "switching.png")
-        plot_standby(result, folder / "tracker_standby.png")
+        result.timeseries.to_csv(folder / "timeseries.csv", float_format=FLOAT_FORMAT, date_format=TIME_FORMAT)
+        save_plot(plot_power_curves(result), folder / "power_curves.png")
+        save_plot(plot_t_solar_vs_fold_angle(result), folder / "t_solar_vs_fold_angle.png")
+        save_plot(plot_comparison(result), folder / "comparison.png")
+        save_plot(plot_switching(result), folder / "switching.png")
+        save_plot(plot_standby(result), folder / "tracker_standby.png")
         result.standby[0].to_csv(folder / "tracker_standby.csv", index=False, float_format=FLOAT_FORMAT)
         _write_json(
             folder / "run.json",
@@ -255,11 +270,11 @@ def _others(table: pd.DataFrame, used: tuple[str, ...], varied: list[str]) -> st
     return f" (mean over {', '.join(rest)})" if rest else ""
 
 
-def plot_map(table: pd.DataFrame, x: str, y: str, value: str, path: Path, title: str, label: str,
-             diverging: bool) -> None:
+def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label: str, diverging: bool,
+             ax=None):
     """A heat map of ``value`` over ``x`` and ``y``, averaged over any other varied field."""
     grid = _mean_pivot(table, y, x, value)
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, ax = _axes(ax, (8, 5))
     data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
     if diverging:
         bound = max(float(np.nanmax(np.abs(data))) if data.count() else 1.0, 1e-9)
@@ -267,11 +282,11 @@ def plot_map(table: pd.DataFrame, x: str, y: str, value: str, path: Path, title:
     else:
         mesh = ax.pcolormesh(grid.columns, grid.index, data, cmap="viridis", shading="nearest")
     ax.set_facecolor("0.85")
-    fig.colorbar(mesh, ax=ax, label=label)
+    ax.figure.colorbar(mesh, ax=ax, label=label)
     ax.set_xlabel(_AXIS_LABELS.get(x, x))
     ax.set_ylabel(_AXIS_LABELS.get(y, y))
     ax.set_title(title, fontsize=10)
-    _save(fig, path)
+    return ax
 
 
 _AXIS_LABELS = {
@@ -281,13 +296,13 @@ _AXIS_LABELS = {
 }
 
 
-def plot_curves(table: pd.DataFrame, x: str, path: Path, title: str, split: str | None = None) -> None:
+def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = None, ax=None):
     """t_solar of flat, optimal twofold and tracker against ``x``.
 
     With ``split`` (a varied field of at most four values) each value gets its own line style;
     anything else that varies is averaged.
     """
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = _axes(ax, (8, 4.5))
     colours = {"flat": "k", "twofold": "tab:blue", "tracker": "0.55"}
     styles = ["-", "--", ":", "-."]
     groups = [(None, table)] if split is None else list(table.groupby(split, sort=True))
@@ -303,7 +318,7 @@ def plot_curves(table: pd.DataFrame, x: str, path: Path, title: str, split: str 
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, ncol=1 if split is None else 2)
-    _save(fig, path)
+    return ax
 
 
 def sweep_plots(table: pd.DataFrame, varied: list[str], folder: Path, name: str) -> list[str]:
@@ -314,19 +329,20 @@ def sweep_plots(table: pd.DataFrame, varied: list[str], folder: Path, name: str)
     for x, y, stem in maps:
         if x in varied and y in varied:
             other = _others(table, (x, y, "day_of_year"), varied)
-            plot_map(twofold, x, y, "gain_vs_flat_pct", folder / f"gain_map_{stem}.png",
-                     f"{name}: t_solar gain of the optimal twofold panel over flat{other}",
-                     "gain over flat [%] (grey: flat never runs)", diverging=True)
-            plot_map(twofold, x, y, "fold_angle_deg", folder / f"fold_angle_map_{stem}.png",
-                     f"{name}: optimal fold angle{other}", "fold angle Θ [deg] (180 = flat)", diverging=False)
+            save_plot(plot_map(twofold, x, y, "gain_vs_flat_pct",
+                               f"{name}: t_solar gain of the optimal twofold panel over flat{other}",
+                               "gain over flat [%] (grey: flat never runs)", diverging=True),
+                      folder / f"gain_map_{stem}.png")
+            save_plot(plot_map(twofold, x, y, "fold_angle_deg", f"{name}: optimal fold angle{other}",
+                               "fold angle Θ [deg] (180 = flat)", diverging=False), folder / f"fold_angle_map_{stem}.png")
             written += [f"gain_map_{stem}.png", f"fold_angle_map_{stem}.png"]
     for x, stem in (("day_of_year", "annual_t_solar"), ("p_load_w", "t_solar_vs_load"), ("latitude", "t_solar_vs_latitude")):
         if x in varied:
             rest = [v for v in varied if v not in (x, "date", "day_of_year")]
             split = next((v for v in rest if table[v].nunique() <= 4), None)
             used = (x, "day_of_year") + ((split,) if split else ())
-            plot_curves(table, x, folder / f"{stem}.png",
-                        f"{name}: t_solar of flat, optimal twofold and tracker{_others(table, used, varied)}", split)
+            save_plot(plot_curves(table, x, f"{name}: t_solar of flat, optimal twofold and tracker"
+                                            f"{_others(table, used, varied)}", split), folder / f"{stem}.png")
             written.append(f"{stem}.png")
     return written
 
@@ -361,9 +377,9 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
     return out
 
 
-def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, path: Path, title: str) -> None:
+def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, title: str, ax=None):
     """Lifetime net benefit against panel area for flat and twofold (Shin et al. Fig. 3a)."""
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = _axes(ax, (8, 4.5))
     for design, colour in (("flat", "k"), ("twofold", "tab:blue")):
         rows = table[table["design"] == design]
         ax.plot(rows["area_m2"], rows["net_benefit_usd"], color=colour, label=design)
@@ -377,7 +393,7 @@ def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, path: Path, title: str)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    _save(fig, path)
+    return ax
 
 
 def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool = False, command=None,
@@ -388,7 +404,8 @@ def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool =
     with staged_folder(out, overwrite) as folder:
         table.to_csv(folder / "sizing.csv", index=False, float_format=FLOAT_FORMAT)
         best.to_csv(folder / "sizing_best.csv", index=False, float_format=FLOAT_FORMAT)
-        plot_sizing(table, best, folder / "net_benefit_vs_area.png", f"{study.name}: panel sizing (Shin et al. Sec. IV-A)")
+        save_plot(plot_sizing(table, best, f"{study.name}: panel sizing (Shin et al. Sec. IV-A)"),
+                  folder / "net_benefit_vs_area.png")
         _write_json(folder / "run.json", run_metadata(study.resolved(), command, sizing=parameters,
                                                        input_sha256=input_hash(study.model_dump(mode="json"))))
     return best
@@ -437,9 +454,9 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
     return summary
 
 
-def plot_annual_fold_angles(by_angle: pd.DataFrame, path: Path, title: str) -> None:
+def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, ax=None):
     """The objective and the mean daily t_solar of one fold angle kept all year, per load."""
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = _axes(ax, (7, 4.5))
     for (load, rows), colour in zip(by_angle.groupby("p_load_w"), plt.cm.viridis(np.linspace(0, 0.85, 8)),
                                     strict=False):
         ax.plot(rows["fold_angle_deg"], rows["mean_t_solar_h"], color=colour, label=f"mean, P_load {load:g} W")
@@ -452,15 +469,15 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, path: Path, title: str) -> N
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
-    _save(fig, path)
+    return ax
 
 
 MONTH_NAMES = ("J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D")
 
 
-def plot_monthly(table: pd.DataFrame, path: Path, title: str, loads_at_most: int = 4) -> None:
+def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=None):
     """Monthly energy harvested and mean daily t_solar of every design, side by side, a row per
-    load (the first case's site)."""
+    load (the first case's site). ``axes``: a (loads, 2) array of Axes to draw on; returns it."""
     table = table.assign(month=pd.to_datetime(table["date"]).dt.month)
     first = table.iloc[0]
     for column in ("site_name", "latitude", "longitude"):
@@ -469,7 +486,8 @@ def plot_monthly(table: pd.DataFrame, path: Path, title: str, loads_at_most: int
     loads = sorted(table["p_load_w"].unique())[:loads_at_most]
     designs = [d for d in ("flat", "twofold", "tracker", "tracker-net") if d in set(table["design"])]
     colours = {"flat": "0.35", "twofold": "tab:blue", "tracker": "0.7", "tracker-net": "tab:orange"}
-    fig, axes = plt.subplots(len(loads), 2, figsize=(11, 3.2 * len(loads)), squeeze=False)
+    if axes is None:
+        _, axes = plt.subplots(len(loads), 2, figsize=(11, 3.2 * len(loads)), squeeze=False)
     width = 0.8 / len(designs)
     for (energy_ax, time_ax), load in zip(axes, loads, strict=True):
         rows = table[table["p_load_w"] == load]
@@ -486,15 +504,15 @@ def plot_monthly(table: pd.DataFrame, path: Path, title: str, loads_at_most: int
     axes[0, 0].legend(fontsize=8)
     axes[0, 0].set_title("energy harvested per month", fontsize=10)
     axes[0, 1].set_title("mean daily t_solar per month", fontsize=10)
-    fig.suptitle(title, fontsize=10)
-    _save(fig, path)
+    axes[0, 0].figure.suptitle(title, fontsize=10)
+    return axes
 
 
-def plot_distribution(table: pd.DataFrame, path: Path, title: str) -> None:
+def plot_distribution(table: pd.DataFrame, title: str, ax=None):
     """Daily t_solar of each design as box plots, one group per load."""
     designs = [d for d in ("flat", "twofold", "tracker", "tracker-net") if d in set(table["design"])]
     loads = sorted(table["p_load_w"].unique())
-    fig, ax = plt.subplots(figsize=(max(6, 2.2 * len(loads) + 2), 4.5))
+    fig, ax = _axes(ax, (max(6, 2.2 * len(loads) + 2), 4.5))
     width = 0.8 / len(designs)
     colours = {"flat": "0.35", "twofold": "tab:blue", "tracker": "0.7", "tracker-net": "tab:orange"}
     for i, design in enumerate(designs):
@@ -509,26 +527,26 @@ def plot_distribution(table: pd.DataFrame, path: Path, title: str) -> None:
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=8)
-    _save(fig, path)
+    return ax
 
 
-def plot_day_hour(extras: dict, key: str, path: Path, title: str, label: str) -> None:
+def plot_day_hour(extras: dict, key: str, title: str, label: str, ax=None):
     """A day x hour heat map of one annual series (twofold power, or the switch state)."""
     values = np.asarray(extras[key], dtype=float)
     days = np.arange(1, values.shape[0] + 1)
-    fig, ax = plt.subplots(figsize=(9, 4.5))
+    fig, ax = _axes(ax, (9, 4.5))
     if key == "switch_state":
         cmap = matplotlib.colors.ListedColormap(["0.15", "tab:orange", "tab:purple", "tab:green", "tab:brown"])
         mesh = ax.pcolormesh(days, extras["hours"], values.T, cmap=cmap, vmin=-1.5, vmax=3.5, shading="nearest")
-        bar = fig.colorbar(mesh, ax=ax, ticks=range(-1, 4))
+        bar = ax.figure.colorbar(mesh, ax=ax, ticks=range(-1, 4))
         bar.ax.set_yticklabels(["off", *SWITCH_STATES])
     else:
         mesh = ax.pcolormesh(days, extras["hours"], values.T, cmap="magma", shading="nearest")
-        fig.colorbar(mesh, ax=ax, label=label)
+        ax.figure.colorbar(mesh, ax=ax, label=label)
     ax.set_xlabel("day of the study")
     ax.set_ylabel("local clock time [h]")
     ax.set_title(title, fontsize=10)
-    _save(fig, path)
+    return ax
 
 
 def annual_outputs(result, folder: Path, name: str) -> list[str]:
@@ -538,20 +556,21 @@ def annual_outputs(result, folder: Path, name: str) -> list[str]:
     others = [c for c in result.varied if c not in ("date", "day_of_year", "site_name", "latitude", "p_load_w")]
     annual_summary(table, ["site_name", "latitude", *others, "p_load_w"]).to_csv(
         folder / "annual_summary.csv", index=False, float_format=FLOAT_FORMAT)
-    plot_distribution(table, folder / "daily_t_solar_distribution.png", f"{name}: daily t_solar per design")
-    plot_monthly(table, folder / "monthly_energy_t_solar.png", f"{name}: every design month by month")
+    save_plot(plot_distribution(table, f"{name}: daily t_solar per design"), folder / "daily_t_solar_distribution.png")
+    save_plot(plot_monthly(table, f"{name}: every design month by month"), folder / "monthly_energy_t_solar.png")
     written = ["annual_summary.csv", "daily_t_solar_distribution.png", "monthly_energy_t_solar.png"]
     if result.extras:
         by_angle = result.extras["by_angle"]
         by_angle.to_csv(folder / "annual_fold_angles.csv", index=False, float_format=FLOAT_FORMAT)
-        plot_annual_fold_angles(by_angle, folder / "annual_t_solar_vs_fold_angle.png",
-                                f"{name}: the year at each fold angle ({result.plan.base.objective.statistic})")
+        save_plot(plot_annual_fold_angles(by_angle, f"{name}: the year at each fold angle "
+                                                    f"({result.plan.base.objective.statistic})"),
+                  folder / "annual_t_solar_vs_fold_angle.png")
         written += ["annual_fold_angles.csv", "annual_t_solar_vs_fold_angle.png"]
         angle = result.extras["fold_angle"]
-        plot_day_hour(result.extras, "p_twofold_w", folder / "day_hour_power.png",
-                      f"{name}: twofold power at {angle:g}° (first load)", "P_pv [W]")
-        plot_day_hour(result.extras, "switch_state", folder / "day_hour_switch_state.png",
-                      f"{name}: connection the switch chooses at {angle:g}°", "")
+        save_plot(plot_day_hour(result.extras, "p_twofold_w", f"{name}: twofold power at {angle:g}° (first load)",
+                                "P_pv [W]"), folder / "day_hour_power.png")
+        save_plot(plot_day_hour(result.extras, "switch_state", f"{name}: connection the switch chooses at {angle:g}°",
+                                ""), folder / "day_hour_switch_state.png")
         written += ["day_hour_power.png", "day_hour_switch_state.png"]
     return written
 
@@ -650,12 +669,12 @@ def _grid_axes(sites: pd.DataFrame):
     return None if lats is None or lons is None else (lats, lons)
 
 
-def plot_world_map(rows: pd.DataFrame, value: str, path: Path, title: str, label: str, diverging: bool) -> None:
+def plot_world_map(rows: pd.DataFrame, value: str, title: str, label: str, diverging: bool, ax=None):
     """One value per site on a longitude x latitude map with coastlines (:func:`foldopt.land.draw_coastlines`):
     cells for a grid of sites, dots for named sites."""
     from foldopt.land import draw_coastlines
 
-    fig, ax = plt.subplots(figsize=(10, 5.2))
+    fig, ax = _axes(ax, (10, 5.2))
     values = rows[value].to_numpy(dtype=float)
     finite = values[np.isfinite(values)]
     if diverging:
@@ -678,11 +697,11 @@ def plot_world_map(rows: pd.DataFrame, value: str, path: Path, title: str, label
     ax.set_ylim(-90, 90)
     ax.set_aspect("equal")
     ax.set_facecolor("0.9")
-    fig.colorbar(mesh, ax=ax, label=label, shrink=0.8)
+    ax.figure.colorbar(mesh, ax=ax, label=label, shrink=0.8)
     ax.set_xlabel("longitude [deg]")
     ax.set_ylabel("latitude [deg]")
     ax.set_title(title + ("" if coast else " (no coastlines: pip install global-land-mask)"), fontsize=10)
-    _save(fig, path)
+    return ax
 
 
 def _edges(centres, width: float) -> np.ndarray:
@@ -694,14 +713,14 @@ def _edges(centres, width: float) -> np.ndarray:
     return np.concatenate([[2 * centres[0] - middle[0]], middle, [2 * centres[-1] - middle[-1]]])
 
 
-def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, path: Path, title: str) -> None:
+def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, title: str, ax=None):
     """Where folding pays: the median gain over flat at each latitude and load as a share of the
     site's flat peak (loads given in watts are a different share at each site: binned to 0.05)."""
     rows = table[table["period"] == period]
     share = rows["p_load_fraction"].round(9) if relative else (rows["p_load_fraction"] / 0.05).round() * 0.05
     grid = rows.assign(share=share).pivot_table(index="share", columns="latitude", values="gain_vs_flat_pct",
                                                 aggfunc="median")
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = _axes(ax, (8, 4.5))
     data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
     bound = max(float(np.abs(data).max()) if data.count() else 1.0, 1e-9)
     mesh = ax.pcolormesh(_edges(grid.columns, 5.0), _edges(grid.index, 0.05), data, cmap="RdBu", vmin=-bound,
@@ -709,11 +728,11 @@ def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, path: P
     if data.count() > 3 and grid.shape[0] > 1 and grid.shape[1] > 1:
         ax.contour(grid.columns, grid.index, data.filled(np.nan), levels=[1.0], colors="k", linewidths=0.8)
     ax.set_facecolor("0.85")
-    fig.colorbar(mesh, ax=ax, label="median gain over flat [%]" + (" (contour: +1 %)" if grid.shape[0] > 1 else ""))
+    ax.figure.colorbar(mesh, ax=ax, label="median gain over flat [%]" + (" (contour: +1 %)" if grid.shape[0] > 1 else ""))
     ax.set_xlabel("latitude [deg]")
     ax.set_ylabel("P_load / flat peak [-]" + ("" if relative else " (bins of 0.05)"))
     ax.set_title(title, fontsize=10)
-    _save(fig, path)
+    return ax
 
 
 def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, load_index: int = 0,
@@ -728,18 +747,142 @@ def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, lo
     what = f"P_load {values[load_index]:g} {unit}, {period}"
     written = []
     for value, file, description, label, diverging in MAP_FIGURES:
-        _atomic_figure(folder / file, lambda path: plot_world_map(shown, value, path, f"{name}: {description} "
-                                                                 f"({what})", label, diverging))
+        _atomic_figure(folder / file, plot_world_map(shown, value, f"{name}: {description} ({what})", label,
+                                                     diverging))
         written.append(file)
-    _atomic_figure(folder / "latitude_load_gain.png", lambda path: plot_latitude_load(
-        table, period, relative, path, f"{name}: where folding pays ({period}, median over longitudes)"))
+    _atomic_figure(folder / "latitude_load_gain.png", plot_latitude_load(
+        table, period, relative, f"{name}: where folding pays ({period}, median over longitudes)"))
     return written + ["latitude_load_gain.png"]
 
 
-def _atomic_figure(path: Path, draw) -> None:
+def _atomic_figure(path: Path, ax) -> None:
+    """:func:`save_plot` under a temporary name, then renamed into ``path``."""
     temporary = path.with_name(f".{path.stem}.tmp{path.suffix}")
     try:
-        draw(temporary)
+        save_plot(ax, temporary)
         temporary.replace(path)
     finally:
         temporary.unlink(missing_ok=True)
+
+
+# --- Answers: the few lines that say what a result means ------------------------------------
+
+def _hours(value) -> str:
+    return "-" if value is None else f"{value:.2f} h"
+
+
+def _pct(value, signed: bool = True) -> str:
+    return "-" if value is None else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
+
+
+def study_answer(digest: dict, defaults: list[str]) -> list[str]:
+    site = digest["site"]
+    where = site["name"] or f"{site['latitude']:g}, {site['longitude']:g}"
+    hours = digest["t_solar_h"]
+    lines = [f"{digest['study']}: {where}, {digest['date']}, P_load {digest['p_load_w']:g} W "
+             f"({digest['mode']} mode, {digest['pv_model']} + {digest['connection']})"]
+    if defaults:
+        lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
+    heuristic = digest["heuristic_fold_angle_deg"]
+    if not hours["twofold"]:
+        lines.append(f"no fold angle reaches the load: t_solar 0 h (flat {_hours(hours['flat'])}, tracker "
+                     f"{_hours(hours['tracker'])})")
+    else:
+        lines.append(f"best fold angle {digest['fold_angle_deg']:.1f} deg"
+                     + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic is not None else "")
+                     + f": t_solar {_hours(hours['twofold'])}, {_pct(digest['gain_vs_flat_pct'])} over flat "
+                     f"({_hours(hours['flat'])}), {_pct(digest['pct_of_tracker_t_solar'], False)} of the tracker's "
+                     f"{_hours(hours['tracker'])}")
+    extras = []
+    if digest["flat_area_multiple"] is not None:
+        extras.append(f"a flat panel would need {digest['flat_area_multiple']:.2f}x the area")
+    if digest["tracker_break_even_standby_w"] is not None:
+        extras.append(f"the twofold panel outlasts the tracker once its standby draw exceeds "
+                      f"{digest['tracker_break_even_standby_w']:.2f} W")
+    if extras:
+        lines.append("; ".join(extras))
+    if digest["notes"]:
+        lines.append(f"note: {'; '.join(digest['notes'])}")
+    return lines
+
+
+def sweep_answer(digest: dict, defaults: list[str]) -> list[str]:
+    axes = " x ".join(f"{count} {path.split('.')[-1]}" for path, count in digest["axes"].items())
+    lines = [f"{digest['study']}: {digest['cases']} cases ({axes})"]
+    if defaults:
+        lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
+    for year in digest.get("year", []):
+        mean = year["mean_t_solar_h"]
+        lines.append(f"P_load {year['p_load_w']:g} W: fold angle {year['fold_angle_deg']:g} deg all year, mean t_solar "
+                     f"{_hours(mean['twofold'])} ({_pct(year['t_solar_gain_vs_flat_pct'])} over flat "
+                     f"{_hours(mean['flat'])}, energy {_pct(year['energy_gain_vs_flat_pct'])}); tracker "
+                     f"{_hours(mean['tracker'])}")
+    gain = digest.get("gain_vs_flat_pct")
+    if gain and "year" not in digest:
+        at = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
+                       for key, value in gain["at"].items())
+        lines.append(f"twofold over flat: median {_pct(gain['median'])}, best {_pct(gain['max'])} ({at}); "
+                     f"fold angles {digest['fold_angle_deg']['min']:g} to {digest['fold_angle_deg']['max']:g} deg")
+    if digest["notes"]:
+        lines.append("notes: " + ", ".join(f"{note} ({count} of {digest['cases']} cases)"
+                                           for note, count in digest["notes"].items()))
+    return lines
+
+
+def digest_map(result, relative: bool) -> dict:
+    """Per load, over the sites: where folding pays in the year."""
+    table = result.table
+    year = table[table["period"] == "year"]
+    per_load = []
+    for load, rows in year.groupby("p_load_fraction" if relative else "p_load_w", sort=True):
+        gain = rows["gain_vs_flat_pct"]
+        best = rows.loc[gain.idxmax()] if gain.notna().any() else None
+        per_load.append({
+            ("p_load_fraction" if relative else "p_load_w"): float(load),
+            "sites": int(len(rows)),
+            "sites_folding_pays": int((gain > 0.05).sum()),
+            "median_gain_vs_flat_pct": _number(gain.median()),
+            "best_gain_vs_flat_pct": _number(gain.max()),
+            "best_site": None if best is None else {"site_name": best["site_name"], "latitude": best["latitude"],
+                                                    "longitude": best["longitude"]},
+            "fold_angle_deg": {"min": _number(rows["fold_angle_deg"].min()),
+                               "median": _number(rows["fold_angle_deg"].median()),
+                               "max": _number(rows["fold_angle_deg"].max())},
+            "median_pct_of_tracker": _number(rows["pct_of_tracker"].median()),
+            "median_tracker_break_even_standby_w": _number(rows["tracker_break_even_standby_w"].median()),
+        })
+    return {"sites": int(table["site_id"].nunique()), "loads": per_load, "cluster": result.cluster,
+            "dashboard": result.dashboard, "chunks_computed": len(result.computed),
+            "chunks_from_disk": len(result.from_disk), "seconds": round(result.seconds, 2)}
+
+
+def _count(number: int, noun: str) -> str:
+    return f"{number} {noun}{'' if number == 1 else 's'}"
+
+
+def map_answer(digest: dict, result) -> list[str]:
+    spec = result.spec
+    study = spec.study
+    sky = "weather files" if any("weather" in site for site in spec.sites) else "Ineichen clear sky" if study.get(
+        "sky") == "ineichen" else f"{study.get('sky')} sky"
+    lines = [f"map: {_count(digest['sites'], 'site')}, year {spec.year}, {sky}, objective {study['objective']['statistic']}, "
+             f"{study['panel']['area']:g} m^2 panel"]
+    for load in digest["loads"]:
+        what = (f"P_load {load['p_load_fraction']:g} x flat peak" if "p_load_fraction" in load
+                else f"P_load {load['p_load_w']:g} W")
+        best = load["best_site"]
+        where = "" if best is None else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
+        angles = load["fold_angle_deg"]
+        standby = load["median_tracker_break_even_standby_w"]
+        tracker = ("" if standby is None else ", whose own moves already cost it its lead" if standby == 0
+                   else f", which loses its lead above a median {standby:.2f} W of standby")
+        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')} (median "
+                     f"{_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} at {where}); "
+                     f"fold angles {angles['min']:g} to {angles['max']:g} deg; median "
+                     f"{_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}")
+    rate = len(spec.sites) / digest["seconds"] if digest["seconds"] else 0
+    computed = (f"computed {_count(digest['chunks_computed'], 'chunk')} on {digest['cluster']}" if digest["chunks_computed"]
+                else "nothing to compute")
+    resumed = f", {digest['chunks_from_disk']} from disk" if digest["chunks_from_disk"] else ""
+    lines.append(f"{computed}{resumed} in {digest['seconds']:.1f} s ({rate:.1f} sites/s)")
+    return lines

@@ -147,7 +147,28 @@ class Day:
 
 @dataclass(frozen=True)
 class StudyResult:
-    """Everything a report needs from one study; ``study`` is resolved."""
+    """One study's results (:func:`foldopt.run`); ``study`` is resolved.
+
+    Attributes
+    ----------
+    study : Study
+    day : Day
+        The day's sun, light and models.
+    sweep : pandas.DataFrame
+        Per fold angle of the grid: ``fold_angle_deg``, t_solar [h] and energy [Wh] of every connection.
+    summary : pandas.DataFrame
+        Per design (``flat``, ``twofold``, ``twofold-heuristic``, ``tracker``, ``tracker-net``...):
+        ``fold_angle_deg``, ``t_solar_h``, ``t_solar_contiguous_h``, ``energy_wh``, ``peak_power_w``,
+        ``gain_vs_flat_pct``, ``pct_of_tracker_t_solar``, ``flat_area_multiple``, ``note``.
+    timeseries : pandas.DataFrame
+        Indexed by the day's tz-aware step centres (``time``): sun [deg], ``dni`` [W/m^2], the power
+        [W] of every design at the optimum and the ``switch_state``.
+    optimal_fold_angle, heuristic_fold_angle : float
+        [deg]; the heuristic is NaN where the paper's rule has no answer.
+    standby : tuple
+        (table, break-even draw [W]) of :func:`standby_sweep`.
+    engine : str
+    """
 
     study: Study
     day: Day
@@ -235,7 +256,6 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
     at_best, state = day.connections(np.array([best_angle]))
     timeseries = pd.DataFrame(
         {
-            "time": day.times.strftime("%Y-%m-%dT%H:%M:%S%z"),
             "solar_zenith": day.solar_zenith,
             "solar_azimuth": day.solar_azimuth,
             "dni": day.dni,
@@ -245,7 +265,8 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
             "switch_state": np.where(at_best["switching"][0] > 0, np.array(SWITCH_STATES)[state[0]], "off"),
             "p_tracker_w": p_tracker,
             "p_load_w": p_load,
-        }
+        },
+        index=pd.DatetimeIndex(day.times, name="time"),
     )
     return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby, engine)
 

@@ -1,0 +1,171 @@
+"""foldopt's Python interface: build a study, run it, sweep it, map it, write its folder.
+
+Everything the command line does goes through these functions; a notebook gets pandas objects in
+pvlib's conventions (tz-aware time indexes, tidy tables) and matplotlib Axes.
+
+Examples
+--------
+>>> import foldopt
+>>> study = foldopt.default_study()            # Shin et al.'s pole camera (configs/shin2015.yaml)
+>>> result = foldopt.run(study)
+>>> round(result.optimal_fold_angle)
+113
+>>> table = foldopt.sweep(study.variant(mode="exact"), latitude=[0, 20, 40]).table
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from foldopt.config import ConfigError, Plan, Study, default_study_path, load_plan, make_plan, set_path
+
+#: Short keywords of :func:`sweep` for fields inside a section of the study.
+SWEEP_KEYWORDS = {
+    "latitude": "site.latitude", "longitude": "site.longitude", "altitude": "site.altitude",
+    "timezone": "site.timezone", "area": "panel.area", "efficiency": "panel.efficiency", "tilt": "panel.tilt",
+    "azimuth": "panel.azimuth", "standby_w": "tracker.standby_w",
+}
+
+
+def default_study() -> Study:
+    """The embedded study: Shin et al.'s pole camera in Los Angeles on the 2014 autumn equinox
+    (``configs/shin2015.yaml``; paper mode, ideal PV model, switching).
+
+    Returns
+    -------
+    Study
+    """
+    return load_plan(default_study_path()).base
+
+
+def load_study(path: str | Path) -> Study | Plan:
+    """Read a YAML study (see ``configs/``).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    Study or Plan
+        The study, or a :class:`foldopt.config.Plan` where the file sweeps fields (lists, ranges,
+        a ``sweep:`` section, a year of dates).
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One ``field: problem`` line per fault, with the YAML line.
+    """
+    plan = load_plan(path)
+    return plan if plan.axes else plan.base
+
+
+def run(study: Study | Plan | str | Path, engine: str = "numba",
+        progress: Callable[[float, int], None] | None = None):
+    """Run a study: one case (every fold angle, the paper's heuristic, flat and trackers) or a plan
+    of many cases.
+
+    Parameters
+    ----------
+    study : Study, Plan, str or pathlib.Path
+        A study, a plan, or a YAML file holding either.
+    engine : {'numba', 'numpy'}
+        The compiled kernel or the NumPy reference path it is tested against.
+    progress : callable, optional
+        For a plan: ``progress(done, total)`` in days.
+
+    Returns
+    -------
+    StudyResult or SweepResult
+        :class:`foldopt.study.StudyResult` for one case (``summary``, ``sweep``, ``timeseries``
+        with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.sweep.SweepResult`
+        for a plan (``table``: one row per case and design).
+    """
+    if isinstance(study, (str, Path)):
+        study = load_study(study)
+    if isinstance(study, Plan):
+        if study.axes:
+            from foldopt.sweep import run_plan
+
+            return run_plan(study, progress, engine)
+        study = study.base
+    from foldopt.study import run_study
+
+    return run_study(study, engine)
+
+
+def sweep(study: Study, *, axes: dict | None = None, engine: str = "numba",
+          progress: Callable[[float, int], None] | None = None, **fields):
+    """Evaluate a study at every combination of the values of some fields.
+
+    Parameters
+    ----------
+    study : Study
+    axes : dict, optional
+        Dotted field paths to values, for any field (``{"tracker.gcr": [0.3, 0.4]}``).
+    engine : {'numba', 'numpy'}
+    progress : callable, optional
+        ``progress(done, total)`` in days.
+    **fields
+        Field names (``p_load``, ``date``, ``pv_model``...) or the short names of
+        :data:`SWEEP_KEYWORDS` (``latitude``, ``area``, ``tilt``...) to a sequence of values or a
+        range ``"start:stop:step"``; ``date`` also takes ``"year"``. A swept latitude tilts the
+        panel at |latitude| toward the equator unless the study fixes its tilt.
+
+    Returns
+    -------
+    SweepResult
+        ``table``: one row per case (``site_name``, ``latitude``, ``longitude``, ``date``,
+        ``day_of_year``, ``p_load_w`` and any other swept field) and design (``flat``, ``twofold``,
+        ``tracker``, ``tracker-net``), with ``fold_angle_deg``, ``t_solar_h`` and the other daily
+        metrics. With an ``objective`` and several dates, one fold angle per case for all of them.
+
+    Examples
+    --------
+    >>> import foldopt
+    >>> study = foldopt.default_study().variant(mode="exact")
+    >>> result = foldopt.sweep(study, latitude=[0, 30], p_load=[2.0, 4.0])
+    >>> len(result.table)
+    16
+    """
+    changes = {SWEEP_KEYWORDS.get(name, name): values for name, values in fields.items()}
+    changes.update(axes or {})
+    if not changes:
+        raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
+    data = study.model_dump(mode="json", exclude_none=True)
+    for path, values in changes.items():
+        if isinstance(values, str):
+            value = values
+        elif isinstance(values, Sequence) or hasattr(values, "tolist"):
+            value = [item.item() if hasattr(item, "item") else item for item in values]
+            value = [item.isoformat() if hasattr(item, "isoformat") else item for item in value]
+        else:
+            value = [values]
+        data = set_path(data, path, value)
+    from foldopt.sweep import run_plan
+
+    return run_plan(make_plan(data), progress, engine)
+
+
+def write(result, out: str | Path, overwrite: bool = False, command: list[str] | None = None) -> Path:
+    """Write a result's folder as the command line does: CSV tables, figures, ``report.html`` and
+    ``run.json``, atomically (a folder that exists is replaced only with ``overwrite``).
+
+    Parameters
+    ----------
+    result : StudyResult or SweepResult
+    out : str or pathlib.Path
+    overwrite : bool
+    command : list of str, optional
+        What ``run.json`` records as the command.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from foldopt.report import write_study, write_sweep
+    from foldopt.study import StudyResult
+
+    writer = write_study if isinstance(result, StudyResult) else write_sweep
+    return writer(result, Path(out), overwrite, command if command is not None else ["foldopt.write"])
