@@ -772,7 +772,10 @@ def map_(
     defaults = [EMBEDDED if config is None else str(config), *[item for item in taken if item]]
     lines = map_answer(digest, result)
     lines.insert(1, f"  from {defaults[0]}: {', '.join(defaults[1:])}")
-    lines.append(f"wrote {out} (map.parquet, map.csv, {', '.join(figures)})")
+    from foldopt.report import write_map_report
+
+    write_map_report(result, figures, lines)
+    lines.append(f"wrote {out} (map.parquet, map.csv, report.html, {', '.join(figures)})")
     year_rows = result.table[result.table["period"] == "year"]
     output.answer({"command": "map", "out": str(out), "defaults": _taken(defaults), "summary": digest,
                    "rows": _records(year_rows)}, lines)

@@ -22,6 +22,7 @@ from foldopt.folders import staged_folder  # noqa: E402
 from foldopt.config import Study  # noqa: E402
 from foldopt.metrics import relative_to  # noqa: E402
 from foldopt.study import StudyResult  # noqa: E402
+from foldopt.webpage import write_html  # noqa: E402
 
 FLOAT_FORMAT = "%.10g"
 TIME_FORMAT = "%Y-%m-%dT%H:%M:%S%z"
@@ -229,9 +230,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
         save_plot(plot_switching(result), folder / "switching.png")
         save_plot(plot_standby(result), folder / "tracker_standby.png")
         result.standby[0].to_csv(folder / "tracker_standby.csv", index=False, float_format=FLOAT_FORMAT)
-        _write_json(
-            folder / "run.json",
-            run_metadata(
+        metadata = run_metadata(
                 result.study,
                 command,
                 input_sha256=input_hash(result.study.model_dump(mode="json")),
@@ -242,9 +241,37 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
                 heuristic_fold_angle_deg=(
                     result.heuristic_fold_angle if np.isfinite(result.heuristic_fold_angle) else None
                 ),
-            ),
         )
+        _write_json(folder / "run.json", metadata)
+        digest = digest_study(result)
+        write_html(folder, f"foldopt: {result.study.name}", study_question(result.study), study_answer(digest, []),
+                   STUDY_FIGURES, result.summary, "Designs compared (summary.csv)", digest["notes"], metadata)
     return out
+
+
+STUDY_FIGURES = ["power_curves.png", "t_solar_vs_fold_angle.png", "comparison.png", "switching.png",
+                 "tracker_standby.png"]
+
+
+def study_question(study: Study, varied: tuple = ()) -> dict:
+    """What a study asks, label to text, for a report (fields in ``varied`` are said to vary)."""
+    study = study.resolved()
+    site = study.site
+    where = f"{site.name + ', ' if site.name else ''}{site.latitude:g}, {site.longitude:g} ({site.timezone})"
+    panel = study.panel
+    question = {
+        "site": "varies (see the table)" if {"site", "site.latitude", "site.longitude"} & set(varied) else where,
+        "day": "varies (see the table)" if "date" in varied else study.date.isoformat(),
+        "load": "varies (see the table)" if "p_load" in varied else f"{study.p_load:g} W",
+        "panel": f"{panel.area:g} m^2, efficiency {panel.efficiency:g}, tilt {panel.tilt:g} deg, azimuth "
+                 f"{panel.azimuth:g} deg" + (" (per latitude)" if "site.latitude" in varied else ""),
+        "models": f"{study.mode} mode, {study.pv_model} PV model, {study.connection}, "
+                  + (f"weather {Path(study.weather.path).name}" if study.weather else f"{study.sky} sky"),
+        "fold angles": f"{study.fold_angles.start:g} to {study.fold_angles.stop:g} deg by {study.fold_angles.step:g}",
+    }
+    if study.objective is not None and "date" in varied:
+        question["objective"] = f"one fold angle for all days, maximising {study.objective.statistic} t_solar"
+    return question
 
 
 def write_reproduction(tables: dict[str, pd.DataFrame], study: Study, out: Path, overwrite=False, command=None,
@@ -253,8 +280,14 @@ def write_reproduction(tables: dict[str, pd.DataFrame], study: Study, out: Path,
     with staged_folder(out, overwrite) as folder:
         for name, table in tables.items():
             table.to_csv(folder / f"{name}.csv", index=False, float_format=FLOAT_FORMAT)
-        _write_json(folder / "run.json", run_metadata(study, command, modes=["paper", "exact"], tables=list(tables),
-                                                       engine=engine))
+        metadata = run_metadata(study, command, modes=["paper", "exact"], tables=list(tables), engine=engine)
+        _write_json(folder / "run.json", metadata)
+        combined = pd.concat([table.assign(table=name) for name, table in tables.items()], ignore_index=True)
+        write_html(folder, "foldopt: Shin et al. reproduced", study_question(study),
+                   ["Shin et al.'s published values beside foldopt's, in paper mode (the paper's formulas) and exact "
+                    "mode (pvlib's physics); reproduction: ideal PV model, reproduction_single_diode: A-300 "
+                    "single-diode sub-panels with switching."], [], combined, "Published and reproduced values",
+                   [], metadata)
     return out
 
 
@@ -361,19 +394,24 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
         plots = sweep_plots(result.table, result.varied, folder, plan.base.name)
         if "date" in result.varied or "day_of_year" in result.varied:
             plots += annual_outputs(result, folder, plan.base.name)
-        _write_json(
-            folder / "run.json",
-            run_metadata(
-                plan.base.resolved(),
-                command,
-                axes={path: [str(v) if hasattr(v, "isoformat") else v for v in values] for path, values in plan.axes},
-                cases=plan.n_cases,
-                plots=plots,
-                input_sha256=input_hash({"study": plan.data, "axes": plan.axes}),
-                engine=result.engine,
-                **({"weather_light": result.weather_light} if result.weather_light else {}),
-            ),
+        metadata = run_metadata(
+            plan.base.resolved(),
+            command,
+            axes={path: [str(v) if hasattr(v, "isoformat") else v for v in values] for path, values in plan.axes},
+            cases=plan.n_cases,
+            plots=plots,
+            input_sha256=input_hash({"study": plan.data, "axes": plan.axes}),
+            engine=result.engine,
+            **({"weather_light": result.weather_light} if result.weather_light else {}),
         )
+        _write_json(folder / "run.json", metadata)
+        digest = digest_sweep(result)
+        question = study_question(plan.base, tuple(path for path, _ in plan.axes))
+        question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
+        notes = [f"{note}: {count} of {digest['cases']} cases" for note, count in digest["notes"].items()]
+        write_html(folder, f"foldopt: {plan.base.name}", question, sweep_answer(digest, []),
+                   [name for name in plots if name.endswith(".png")], result.table,
+                   "Every case and design (results.csv; click a header to sort)", notes, metadata)
     return out
 
 
@@ -406,8 +444,18 @@ def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool =
         best.to_csv(folder / "sizing_best.csv", index=False, float_format=FLOAT_FORMAT)
         save_plot(plot_sizing(table, best, f"{study.name}: panel sizing (Shin et al. Sec. IV-A)"),
                   folder / "net_benefit_vs_area.png")
-        _write_json(folder / "run.json", run_metadata(study.resolved(), command, sizing=parameters,
-                                                       input_sha256=input_hash(study.model_dump(mode="json"))))
+        metadata = run_metadata(study.resolved(), command, sizing=parameters,
+                                input_sha256=input_hash(study.model_dump(mode="json")))
+        _write_json(folder / "run.json", metadata)
+        answer = [f"{row.design}: {row.area_m2:.3f} m^2"
+                  + ("" if row.design == "flat" else f", folded to {row.fold_angle_deg:g} deg")
+                  + f", t_solar {row.t_solar_h:.2f} h, lifetime net benefit ${row.net_benefit_usd:.1f}"
+                  for row in best.itertuples()]
+        question = {**study_question(study), "sizing": ", ".join(f"{k} {v:g}" for k, v in (parameters or {}).items()
+                                                                  if v is not None)}
+        write_html(folder, f"foldopt: {study.name} sizing", question,
+                   ["The area with the largest lifetime net benefit (Shin et al. Sec. IV-A):", *answer],
+                   ["net_benefit_vs_area.png"], table, "Every area (sizing.csv)", [], metadata)
     return best
 
 
@@ -886,3 +934,23 @@ def map_answer(digest: dict, result) -> list[str]:
     resumed = f", {digest['chunks_from_disk']} from disk" if digest["chunks_from_disk"] else ""
     lines.append(f"{computed}{resumed} in {digest['seconds']:.1f} s ({rate:.1f} sites/s)")
     return lines
+
+
+def write_map_report(result, figures: list[str], answer: list[str]) -> Path:
+    """``report.html`` of a map's folder: the question, the answer, the maps and the year's rows."""
+    spec = result.spec
+    study = spec.study
+    loads = ", ".join(f"{load:g}" for load in spec.loads)
+    question = {
+        "sites": f"{len(spec.sites):,}",
+        "loads": f"{loads} {'x each site' + chr(39) + 's flat peak' if spec.relative else 'W'}",
+        "year": str(spec.year),
+        "panel": f"{study['panel']['area']:g} m^2 facing the equator at |latitude|",
+        "objective": study.get("objective", {}).get("statistic", "mean"),
+        "models": f"{study.get('mode')} mode, {study.get('pv_model', 'ideal')} PV model, "
+                  f"{'weather files' if any('weather' in s for s in spec.sites) else study.get('sky', '') + ' sky'}",
+    }
+    metadata = json.loads((result.out / "run.json").read_text())
+    year = result.table[result.table["period"] == "year"]
+    return write_html(result.out, "foldopt: map", question, answer, figures, year,
+                      "The year per site and load (map.csv has every season)", [], metadata)
