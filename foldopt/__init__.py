@@ -22,7 +22,7 @@ _PUBLIC = {
     "Plan": "foldopt.config", "ConfigError": "foldopt.config",
     "default_study": "foldopt.api", "load_study": "foldopt.api", "run": "foldopt.api", "sweep": "foldopt.api",
     "write": "foldopt.api",
-    "StudyResult": "foldopt.study", "SweepResult": "foldopt.sweep",
+    "StudyResult": "foldopt.study", "SweepResult": "foldopt.sweeps",
     "MapSpec": "foldopt.cluster", "MapRun": "foldopt.cluster", "run_map": "foldopt.cluster",
     "evaluate_sites": "foldopt.worldmap", "grid_sites": "foldopt.worldmap", "read_sites": "foldopt.worldmap",
     "weather_sites": "foldopt.worldmap", "map_study": "foldopt.worldmap",

@@ -8,8 +8,10 @@ Examples
 >>> import foldopt
 >>> study = foldopt.default_study()            # Shin et al.'s pole camera (configs/shin2015.yaml)
 >>> result = foldopt.run(study)
->>> round(result.optimal_fold_angle)
-113
+>>> round(result.optimal_fold_angle, 1)                 # Shin et al.: 28.5 deg
+28.5
+>>> float(result.summary.set_index("design").loc["flat", "t_solar_h"].round(2))   # the paper's 7.73 h
+7.73
 >>> table = foldopt.sweep(study.variant(mode="exact"), latitude=[0, 20, 40]).table
 """
 
@@ -79,14 +81,14 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
     -------
     StudyResult or SweepResult
         :class:`foldopt.study.StudyResult` for one case (``summary``, ``sweep``, ``timeseries``
-        with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.sweep.SweepResult`
+        with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.sweeps.SweepResult`
         for a plan (``table``: one row per case and design).
     """
     if isinstance(study, (str, Path)):
         study = load_study(study)
     if isinstance(study, Plan):
         if study.axes:
-            from foldopt.sweep import run_plan
+            from foldopt.sweeps import run_plan
 
             return run_plan(study, progress, engine)
         study = study.base
@@ -111,7 +113,7 @@ def sweep(study: Study, *, axes: dict | None = None, engine: str = "numba",
         Field names (``p_load``, ``date``, ``pv_model``...) or the short names of
         :data:`SWEEP_KEYWORDS` (``latitude``, ``area``, ``tilt``...) to a sequence of values or a
         range ``"start:stop:step"``; ``date`` also takes ``"year"``. A swept latitude tilts the
-        panel at |latitude| toward the equator unless the study fixes its tilt.
+        panel at ``|latitude|`` toward the equator unless the study fixes its tilt.
 
     Returns
     -------
@@ -143,7 +145,7 @@ def sweep(study: Study, *, axes: dict | None = None, engine: str = "numba",
         else:
             value = [values]
         data = set_path(data, path, value)
-    from foldopt.sweep import run_plan
+    from foldopt.sweeps import run_plan
 
     return run_plan(make_plan(data), progress, engine)
 

@@ -267,6 +267,12 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
         Written into ``run.json`` beside the spec.
     connect_timeout : float
         Seconds to wait for ``scheduler`` and its first worker.
+
+    Returns
+    -------
+    MapRun
+        ``table`` (the rows of :func:`foldopt.worldmap.evaluate_sites` for every site, in site
+        order), the chunks computed and found on disk, seconds, the cluster and its dashboard.
     """
     started = time.perf_counter()
     out = Path(out)

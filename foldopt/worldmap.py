@@ -30,7 +30,7 @@ import pandas as pd
 
 from foldopt import engine as engines
 from foldopt.config import ConfigError, Site, Study, _format_errors, parse_dates
-from foldopt.sweep import Blocks, _best_angle_index, fold_hours, objective_value
+from foldopt.sweeps import Blocks, _best_angle_index, fold_hours, objective_value
 from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
@@ -58,7 +58,7 @@ def map_study(data: dict, embedded: bool = True, **changes) -> dict:
 
     ``embedded``: the data is the embedded paper study, whose mode, sky, geometry and step give way
     to :data:`MAP_DEFAULTS`; a user's own study keeps its own. The panel faces the equator at a
-    tilt of |latitude| at every site unless ``panel.tilt``/``panel.azimuth`` are in ``changes``;
+    tilt of ``|latitude|`` at every site unless ``panel.tilt``/``panel.azimuth`` are in ``changes``;
     the objective is the mean unless set. ``changes`` are field paths (dotted) to values.
     """
     from foldopt.config import set_path

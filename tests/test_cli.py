@@ -14,7 +14,7 @@ from foldopt.reproduce import PAPER_VALUES
 runner = CliRunner()
 FOLDER = {"summary.csv", "sweep.csv", "timeseries.csv", "power_curves.png",
           "t_solar_vs_fold_angle.png", "comparison.png", "switching.png", "run.json",
-          "tracker_standby.png", "tracker_standby.csv"}
+          "tracker_standby.png", "tracker_standby.csv", "report.html"}
 FAST_SWEEP = ["--lat", "34.05", "--lon", "-118.25", "--date", "2014-09-23", "--p-load", "4.4",
               "--area", "0.108", "--step-min", "10", "--angle-step", "5"]
 

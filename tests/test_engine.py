@@ -182,7 +182,7 @@ def test_blocks_of_many_sites_and_time_zones_equal_their_own_skies():
 
 def test_run_plan_is_the_same_on_both_engines():
     from foldopt.config import make_plan
-    from foldopt.sweep import run_plan
+    from foldopt.sweeps import run_plan
 
     plan = make_plan({"name": "t", "mode": "exact", "site": {"latitude": [-20.0, 45.0], "longitude": 10.0},
                       "date": ["2025-03-20", "2025-12-21"], "panel": {"area": 0.108}, "p_load": [1.0, 4.4, 40.0],

@@ -5,7 +5,7 @@ import pytest
 
 from foldopt.config import make_plan
 from foldopt.study import run_study
-from foldopt.sweep import run_plan
+from foldopt.sweeps import run_plan
 
 BASE = {"name": "t", "mode": "exact", "site": {"latitude": 34.05, "longitude": -118.25},
         "date": "2025-09-22", "panel": {"area": 0.108, "efficiency": 0.1905}, "p_load": 4.4,

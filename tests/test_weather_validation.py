@@ -13,7 +13,7 @@ import pytest
 from test_weather_year import write_epw_year
 
 from foldopt.config import ConfigError, make_plan
-from foldopt.sweep import run_plan
+from foldopt.sweeps import run_plan
 from foldopt.weather import WeatherError, read_weather, weather_days, weather_site
 
 DATA = Path(pvlib.__file__).parent / "data"

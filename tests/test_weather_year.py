@@ -14,7 +14,7 @@ from foldopt import engine
 from foldopt.config import ConfigError, make_plan
 from foldopt.sky import build_sky
 from foldopt.study import sky_tracker_orientation
-from foldopt.sweep import run_plan
+from foldopt.sweeps import run_plan
 from foldopt.weather import read_weather, sub_hourly, weather_site
 
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"  # NREL TMY3 sample pvlib ships

@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from foldopt.config import ConfigError, make_plan
-from foldopt.sweep import run_plan
+from foldopt.sweeps import run_plan
 from foldopt.worldmap import PERIODS, SEASONS, evaluate_sites, grid_sites, map_study, read_sites
 
 #: A coarse study keeps a year's evaluation to tens of milliseconds.

@@ -1,0 +1,87 @@
+"""The public Python API: what `import foldopt` offers, that it is documented, and that it gives the
+command line's numbers as pandas objects in pvlib's conventions."""
+
+from __future__ import annotations
+
+import doctest
+import inspect
+import subprocess
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
+
+import foldopt  # noqa: E402
+from foldopt.config import make_plan  # noqa: E402
+from foldopt.sweeps import run_plan  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.mark.parametrize("name", [name for name in foldopt.__all__ if name != "__version__"])
+def test_every_public_name_resolves_and_is_documented(name):
+    value = getattr(foldopt, name)
+    doc = inspect.getdoc(value) or ""
+    assert len(doc) > 40, name
+    if inspect.isfunction(value) and name.startswith(("run", "sweep", "load", "default", "write", "evaluate")):
+        assert "Returns" in doc and ("Parameters" in doc or not inspect.signature(value).parameters), name
+
+
+def test_import_stays_light():
+    """The command line's help must not pay for pandas or pvlib: `import foldopt` loads neither."""
+    code = "import sys, foldopt; print(sorted(m for m in ('pandas', 'pvlib', 'numba', 'matplotlib') if m in sys.modules))"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "[]"
+
+
+def test_docstring_examples_run():
+    from foldopt import api
+
+    failures, tried = doctest.testmod(api, optionflags=doctest.ELLIPSIS)
+    assert tried >= 4 and failures == 0
+
+
+def test_run_gives_a_tz_aware_time_series_and_the_papers_numbers():
+    result = foldopt.run(foldopt.default_study())
+    index = result.timeseries.index
+    assert isinstance(index, pd.DatetimeIndex) and str(index.tz) == "America/Los_Angeles"
+    assert index[0] == pd.Timestamp("2014-09-23 00:00:30", tz="America/Los_Angeles")
+    # The paper's 7.73 h; the study's load is the inferred 4.3979 W rounded to 4.398 W (0.2 s less).
+    assert result.summary.set_index("design").loc["flat", "t_solar_h"] == pytest.approx(7.73, abs=1e-4)
+    # A YAML path gives the same result.
+    again = foldopt.run(ROOT / "configs" / "shin2015.yaml")
+    pd.testing.assert_frame_equal(again.summary, result.summary)
+
+
+def test_sweep_is_the_plan_the_yaml_would_make():
+    study = foldopt.default_study().variant(mode="exact", geometry=None, step_min=30,
+                                            fold_angles={"start": 30, "stop": 180, "step": 30})
+    result = foldopt.sweep(study, latitude=[0, 30], p_load="2:4:2", axes={"tracker.standby_w": [0.0, 1.0]})
+    data = study.model_dump(mode="json", exclude_none=True)
+    data["site"]["latitude"], data["p_load"], data["tracker"]["standby_w"] = [0, 30], "2:4:2", [0.0, 1.0]
+    expected = run_plan(make_plan(data)).table
+    pd.testing.assert_frame_equal(result.table, expected)
+    assert len(result.table) == 2 * 2 * 2 * 4  # tidy: one row per case x design
+    with pytest.raises(foldopt.ConfigError, match="name at least one field"):
+        foldopt.sweep(study)
+
+
+def test_plots_return_axes_and_draw_into_the_given_one():
+    result = foldopt.run(foldopt.default_study())
+    fig, axes = plt.subplots(1, 2)
+    assert foldopt.plot_power_curves(result, ax=axes[0]) is axes[0]
+    assert foldopt.plot_comparison(result, ax=axes[1]) is axes[1]
+    assert axes[0].lines and axes[1].patches
+    own = foldopt.plot_standby(result)
+    assert isinstance(own, matplotlib.axes.Axes) and own.figure is not fig
+    plt.close("all")
+
+
+def test_write_makes_the_command_lines_folder(tmp_path):
+    result = foldopt.run(foldopt.default_study())
+    out = foldopt.write(result, tmp_path / "study")
+    assert {"summary.csv", "sweep.csv", "timeseries.csv", "run.json", "report.html"} <= {p.name for p in out.iterdir()}
