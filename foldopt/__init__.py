@@ -21,7 +21,7 @@ _PUBLIC = {
     "Objective": "foldopt.config", "FoldAngles": "foldopt.config", "Weather": "foldopt.config",
     "Plan": "foldopt.config", "ConfigError": "foldopt.config",
     "default_study": "foldopt.api", "load_study": "foldopt.api", "run": "foldopt.api", "sweep": "foldopt.api",
-    "write": "foldopt.api",
+    "write": "foldopt.api", "size": "foldopt.api", "reproduce": "foldopt.api", "world_map": "foldopt.api",
     "StudyResult": "foldopt.study", "SweepResult": "foldopt.sweeps",
     "MapSpec": "foldopt.cluster", "MapRun": "foldopt.cluster", "run_map": "foldopt.cluster",
     "evaluate_sites": "foldopt.worldmap", "grid_sites": "foldopt.worldmap", "read_sites": "foldopt.worldmap",

@@ -171,3 +171,107 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
 
     writer = write_study if isinstance(result, StudyResult) else write_sweep
     return writer(result, Path(out), overwrite, command if command is not None else ["foldopt.write"])
+
+
+def size(study: Study, areas, cost_per_m2: float | None = None, cost_per_w: float | None = None,
+         c_grid: float = 0.22, years: float = 20.0, days_per_year: float = 365.0):
+    """Shin et al. Sec. IV-A panel sizing: the lifetime net benefit of flat and twofold panels of
+    every area (:func:`foldopt.sizing.size_panel`).
+
+    Parameters
+    ----------
+    study : Study
+        One case: its site, day and load.
+    areas : array_like
+        Panel areas [m^2].
+    cost_per_m2, cost_per_w : float
+        Panel cost [$ per m^2] or [$ per W at STC]; exactly one.
+    c_grid : float
+        Grid energy price [$/kWh] (Shin et al.: 0.22).
+    years, days_per_year : float
+        Lifetime [years] (Shin et al.: 20) and days a year like the study's.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Per design and area: ``area_m2``, ``fold_angle_deg``, ``t_solar_h``, benefit, cost and
+        ``net_benefit_usd``.
+    """
+    from foldopt.sizing import size_panel
+    from foldopt.study import Day
+
+    return size_panel(Day(study), areas, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
+
+
+def reproduce(engine: str = "numba") -> dict:
+    """Shin et al.'s published values beside foldopt's, in paper and exact mode.
+
+    Parameters
+    ----------
+    engine : {'numba', 'numpy'}
+
+    Returns
+    -------
+    dict of pandas.DataFrame
+        ``reproduction`` (the embedded study, ideal PV model) and ``reproduction_single_diode``
+        (A-300 single-diode sub-panels with switching): ``quantity``, ``unit``, ``paper``,
+        ``paper_mode``, ``exact_mode``.
+    """
+    from foldopt.reproduce import REPRODUCTIONS, reproduce as reproduce_table
+
+    study = default_study()
+    return {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
+
+
+def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, study: dict | None = None,
+              relative: bool = False, year: int = 2025, *, scheduler: str | None = None, workers: int | None = None,
+              sites_per_chunk: int = 0, resume: bool = False, overwrite: bool = False, engine: str = "numba",
+              show_load: int = 0, show_period: str = "year", progress=None, announce=None, command=None):
+    """A map of many sites on Dask (:mod:`foldopt.cluster`), its world maps and its ``report.html``.
+
+    Parameters
+    ----------
+    sites : sequence of dict
+        From :func:`foldopt.grid_sites`, :func:`foldopt.read_sites` or :func:`foldopt.weather_sites`.
+    loads : sequence of float
+        Loads [W], or with ``relative`` fractions of each site's flat peak.
+    out : str or pathlib.Path
+        The results folder (``map.parquet``, ``map.csv``, figures, ``report.html``, ``run.json``).
+    study : dict, optional
+        A map's study (:func:`foldopt.map_study`); default the embedded study's panel and models
+        in exact mode with the Ineichen clear sky.
+    relative : bool
+    year : int
+    scheduler : str, optional
+        A Dask scheduler's address or file; default an embedded cluster of ``workers`` processes.
+    sites_per_chunk : int
+        Default about 5 s of work per chunk.
+    resume, overwrite : bool
+        Finish an interrupted map in ``out``; replace ``out``.
+    engine : {'numba', 'numpy'}
+    show_load, show_period
+        Which load (index) and period (``year``, ``DJF``...) the world maps show.
+    progress, announce : callable, optional
+        See :func:`foldopt.run_map`.
+    command : list of str, optional
+        What ``run.json`` records as the command.
+
+    Returns
+    -------
+    tuple
+        The :class:`foldopt.MapRun`, the figures' file names and the answer's lines.
+    """
+    from foldopt.cluster import MapSpec, run_map
+    from foldopt.report import digest_map, map_answer, map_figures, write_map_report
+    from foldopt.worldmap import map_study, site_study
+
+    if study is None:
+        study = map_study(load_plan(default_study_path()).data)
+    site_study(study, sites[0], year)  # a bad setting fails here, before any cluster starts
+    spec = MapSpec(study, tuple(sites), tuple(loads), relative, year, sites_per_chunk, engine)
+    result = run_map(spec, Path(out), scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
+                     progress=progress, announce=announce, metadata={"command": command or ["foldopt.world_map"]})
+    figures = map_figures(result.table, result.out, "map", relative, show_load, show_period)
+    answer = map_answer(digest_map(result, relative), result)
+    write_map_report(result, figures, answer)
+    return result, figures, answer

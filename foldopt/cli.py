@@ -302,13 +302,11 @@ def reproduce(
     output = _Output(quiet, output_format)
     check_output(out, overwrite)
     with output.progress("reproducing Shin et al. (two PV models x two modes)"):
-        from foldopt.config import load_study
+        from foldopt.api import default_study, reproduce as reproduce_tables
         from foldopt.report import write_reproduction
-        from foldopt.reproduce import REPRODUCTIONS, reproduce as reproduce_table
 
-        study = load_study(default_study_path())
-        tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
-        write_reproduction(tables, study, out, overwrite, _INVOCATION, engine=engine)
+        tables = reproduce_tables(engine)
+        write_reproduction(tables, default_study(), out, overwrite, _INVOCATION, engine=engine)
     lines = []
     for name, table in tables.items():
         model = "ideal PV model" if name == "reproduction" else "A-300 single-diode cells with switching"
@@ -742,39 +740,29 @@ def map_(
         _fail([f"sites: {len(site_list):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
     if not 1 <= show_load <= len(loads):
         _fail([f"--show-load = {show_load}: must be in [1, {len(loads)}] (the map has {len(loads)} load{'s' if len(loads) > 1 else ''})"])
-    from foldopt.cluster import MapSpec, run_map
-    from foldopt.worldmap import site_study
-
-    try:
-        site_study(study, site_list[0], year)  # a bad setting fails here, before any cluster starts
-    except ConfigError as error:
-        _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
-    spec = MapSpec(study, tuple(site_list), tuple(loads), relative, year, chunk_sites or 0, engine)
-    announced = []
-
     def announce(cluster: str, dashboard: str | None):
-        announced.append(cluster)
         if not quiet and not output.json:
             typer.echo(f"{cluster}; dashboard: {dashboard or 'none (pip install bokeh)'}", err=True)
 
     with output.progress(f"map: {len(site_list)} sites", total=len(site_list), unit="sites") as progress:
-        from foldopt.report import digest_map, map_answer, map_figures
+        from foldopt.api import world_map
+        from foldopt.report import digest_map
 
-        result = run_map(spec, out, scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
-                         progress=progress, announce=announce,
-                         metadata={"command": _INVOCATION})
-        figures = map_figures(result.table, out, "map", relative, show_load - 1, show_period)
+        try:
+            result, figures, lines = world_map(
+                site_list, loads, out, study, relative, year, scheduler=scheduler, workers=workers,
+                sites_per_chunk=chunk_sites or 0, resume=resume, overwrite=overwrite, engine=engine,
+                show_load=show_load - 1, show_period=show_period, progress=progress, announce=announce,
+                command=_INVOCATION)
+        except ConfigError as error:
+            _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
     digest = digest_map(result, relative)
     taken = [f"panel {study['panel']['area']:g} m^2" if area is None else None,
              f"P_load {loads[0]:g} W" if p_load is None and not relative else None,
              f"{study.get('pv_model', 'ideal')} PV model", f"{study.get('mode')} mode",
              f"{study.get('step_min'):g}-min steps" if step_min is None else None]
     defaults = [EMBEDDED if config is None else str(config), *[item for item in taken if item]]
-    lines = map_answer(digest, result)
     lines.insert(1, f"  from {defaults[0]}: {', '.join(defaults[1:])}")
-    from foldopt.report import write_map_report
-
-    write_map_report(result, figures, lines)
     lines.append(f"wrote {out} (map.parquet, map.csv, report.html, {', '.join(figures)})")
     year_rows = result.table[result.table["period"] == "year"]
     output.answer({"command": "map", "out": str(out), "defaults": _taken(defaults), "summary": digest,
@@ -836,11 +824,10 @@ def size(
     out = out or RESULTS / f"{study.name}-sizing"
     check_output(out, overwrite)
     with output.progress(f"sizing {study.name}: {len(grid)} areas"):
+        from foldopt.api import size as size_panel
         from foldopt.report import write_sizing
-        from foldopt.sizing import size_panel
-        from foldopt.study import Day
 
-        sizing = size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
+        sizing = size_panel(study, grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
         best = write_sizing(sizing, study, out, overwrite, _INVOCATION, parameters=parameters)
     cost = f"{cost_per_m2:g} $/m^2" if cost_per_w is None else f"{cost_per_w:g} $/W"
     lines = [f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid {c_grid:g} $/kWh over "
