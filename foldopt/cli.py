@@ -331,7 +331,7 @@ _OPTION_OF_FIELD = {
     "pv_model": "--pv-model", "module": "--module", "temp_air": "--temp-air",
     "converter_efficiency": "--converter-efficiency", "year": "--year", "climate": "--climate",
     "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby", "transposition": "--transposition",
-    "objective.statistic": "--objective", "weather": "--weather", "albedo": "--albedo", "iam": "--iam",
+    "objective.statistic": "--objective", "objective.visits": "--visits", "weather": "--weather", "albedo": "--albedo", "iam": "--iam",
     "switch_series": "--switch-series", "bypass_diodes": "--no-bypass", "exact_electrical": "--exact-electrical",
     "force_site": "--force-site",
 }
@@ -383,6 +383,8 @@ def _sweep_options(
     iam: Optional[str] = typer.Option(None, "--iam", help="Incidence-angle modifier: " + _choices(names.IAMS) + "."),
     objective: Optional[str] = typer.Option(None, "--objective", help="One fold angle for all days, maximising: "
                                             "mean | min | worst-month | pNN (a percentile)."),
+    visits: Optional[int] = typer.Option(None, "--visits", help="With --objective mean or worst-month: also the best "
+                                         "re-fold schedule of 1 to this many fold settings a year (at most 12)."),
     tracker: Optional[str] = typer.Option(None, "--tracker", help=_choices(names.TRACKERS) + "."),
     tracker_standby: Optional[float] = typer.Option(None, "--tracker-standby", help="Tracker standby draw [W]."),
     pv_model: Optional[str] = typer.Option(None, "--pv-model", help=_choices(names.PV_MODELS) + "."),
@@ -537,6 +539,8 @@ def _sweep_plan(axis: str, options: dict):
         data["bypass_diodes"] = False
     if options["objective"] is not None:
         data["objective"] = {"statistic": options["objective"]}
+    if options["visits"] is not None:
+        data["objective"] = {**(data.get("objective") or {"statistic": "mean"}), "visits": options["visits"]}
     if options["tracker"] is not None or options["tracker_standby"] is not None:
         tracker = data.get("tracker")
         tracker = dict(tracker) if isinstance(tracker, dict) else ({"model": tracker} if tracker else {})

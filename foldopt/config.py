@@ -204,6 +204,8 @@ class Objective(_Strict):
 
     statistic: str = Field("mean", description="mean | min | worst-month | pNN (a percentile, e.g. p10)")
     months: list[Annotated[int, Field(ge=1, le=12)]] | None = Field(None, description="the season; default all")
+    visits: Annotated[int, Field(ge=1, le=12)] | None = Field(
+        None, description="also the best re-fold schedule of 1..visits settings a year (foldopt.schedule)")
 
     @field_validator("statistic")
     @classmethod
@@ -211,6 +213,14 @@ class Objective(_Strict):
         if not _STATISTIC.match(value):
             raise ValueError("must be mean, min, worst-month or a percentile pNN (e.g. p10)")
         return value
+
+    @model_validator(mode="after")
+    def _schedulable(self):
+        if self.visits is not None and self.statistic not in ("mean", "worst-month"):
+            raise ValueError(f"visits: a re-fold schedule maximises mean or worst-month, not {self.statistic}")
+        if self.visits is not None and self.months:
+            raise ValueError("visits: a re-fold schedule covers the whole year; leave months out")
+        return self
 
 
 class FoldAngles(_Strict):

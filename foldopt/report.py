@@ -620,7 +620,36 @@ def annual_outputs(result, folder: Path, name: str) -> list[str]:
         save_plot(plot_day_hour(result.extras, "switch_state", f"{name}: connection the switch chooses at {angle:g}°",
                                 ""), folder / "day_hour_switch_state.png")
         written += ["day_hour_power.png", "day_hour_switch_state.png"]
+    if "refold_value" in result.extras:
+        result.extras["refold_value"].to_csv(folder / "refold_value.csv", index=False, float_format=FLOAT_FORMAT)
+        result.extras["refold_schedule"].to_csv(folder / "refold_schedule.csv", index=False,
+                                                float_format=FLOAT_FORMAT)
+        save_plot(plot_refold_value(result.extras["refold_value"], f"{name}: what each re-fold visit is worth"),
+                  folder / "refold_value.png")
+        written += ["refold_value.csv", "refold_schedule.csv", "refold_value.png"]
     return written
+
+
+def plot_refold_value(values: pd.DataFrame, title: str, ax=None):
+    """The objective of the best schedule of k fold settings a year against k, per load (the first
+    site's), beside the flat panel and the tracker (:func:`foldopt.sweeps.refold_tables`)."""
+    fig, ax = _axes(ax, (7, 4.5))
+    first = values[(values["latitude"] == values["latitude"].iloc[0])
+                   & (values["longitude"] == values["longitude"].iloc[0])]
+    for (load, rows), colour in zip(first.groupby("p_load_w"), plt.rcParams["axes.prop_cycle"].by_key()["color"],
+                                    strict=False):
+        ax.plot(rows["settings"], rows["objective_h"], "o-", color=colour, label=f"twofold, P_load {load:g} W")
+        ax.axhline(rows["flat_objective_h"].iloc[0], color=colour, ls="--", lw=1)
+        ax.axhline(rows["tracker_objective_h"].iloc[0], color=colour, ls=":", lw=1)
+    ax.plot([], [], "k--", lw=1, label="flat panel")
+    ax.plot([], [], "k:", lw=1, label="tracker")
+    ax.set_xlabel("fold settings a year (1 = one fixed angle)")
+    ax.set_ylabel(f"{values['objective'].iloc[0]} daily t_solar [h]")
+    ax.set_xticks(sorted(first["settings"].unique()))
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(title, fontsize=10)
+    return ax
 
 
 # --- Digests: the answer first, in a few numbers -------------------------------------------------
@@ -682,6 +711,14 @@ def digest_sweep(result) -> dict:
              "energy_gain_vs_flat_pct": _number(summary.loc[(load, "twofold"), "energy_gain_vs_flat_pct"])}
             for load in sorted(table["p_load_w"].unique())
         ]
+    if "refold_value" in result.extras:
+        values = result.extras["refold_value"]
+        digest["refold"] = [
+            {"p_load_w": float(load), "objective": rows["objective"].iloc[0],
+             "objective_h": {int(k): float(v) for k, v in zip(rows["settings"], rows["objective_h"], strict=True)},
+             "flat_h": float(rows["flat_objective_h"].iloc[0]), "tracker_h": float(rows["tracker_objective_h"].iloc[0])}
+            for load, rows in values.groupby("p_load_w")
+        ] if values["latitude"].nunique() == 1 and values["longitude"].nunique() == 1 else []
     return digest
 
 
@@ -865,6 +902,12 @@ def sweep_answer(digest: dict, defaults: list[str]) -> list[str]:
                      f"{_hours(mean['twofold'])} ({_pct(year['t_solar_gain_vs_flat_pct'])} over flat "
                      f"{_hours(mean['flat'])}, energy {_pct(year['energy_gain_vs_flat_pct'])}); tracker "
                      f"{_hours(mean['tracker'])}")
+    for refold in digest.get("refold", []):
+        settings = refold["objective_h"]
+        shown = [k for k in settings if k in (1, 2, 3, 4, 6, 12)]
+        lines.append(f"P_load {refold['p_load_w']:g} W, re-folded ({refold['objective']} t_solar): "
+                     + ", ".join(f"{k} setting{'s' if k > 1 else ''} {settings[k]:.2f} h" for k in shown)
+                     + f"; flat {refold['flat_h']:.2f} h, tracker {refold['tracker_h']:.2f} h (refold_schedule.csv)")
     gain = digest.get("gain_vs_flat_pct")
     if gain and "year" not in digest:
         at = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"

@@ -248,10 +248,16 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
         return sky
 
     if dates:
+        refolds: dict[str, list] = {}
         for index, study in enumerate(studies):
             results[index], group_extras = _annual_group(Blocks.of_dates(study, dates), loads, objective, advance,
                                                          engine, counted)
             extras = extras or group_extras
+            for key in REFOLD_TABLES:
+                if key in group_extras:
+                    refolds.setdefault(key, []).append(group_extras[key].assign(
+                        **{path: _plain(value) for path, value in choices[index].items() if path not in _AXIS_COLUMNS}))
+        extras.update({key: pd.concat(frames, ignore_index=True) for key, frames in refolds.items()})
         cases = [(study.site, date, choice) for study, choice in zip(studies, choices, strict=True) for date in dates]
     else:
         # Cases of one setup share skies and engine calls, whatever their order in the plan.
@@ -303,7 +309,11 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
         advance(len(chunk))
     clock = skies[0].grid.clock_hours[0]
-    extras = {"dates": list(blocks.dates), "hours": clock, "fold_angle": float(angles[fixed[0]]),
+    refold = {}
+    if objective.visits:
+        hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (days, loads, designs)
+        refold = refold_tables(blocks, loads, angles, daily, months, objective, hours)
+    extras = {"dates": list(blocks.dates), "hours": clock, "fold_angle": float(angles[fixed[0]]), **refold,
               **{key: np.concatenate(value) for key, value in series.items()},
               "by_angle": pd.DataFrame({
                   "p_load_w": np.repeat(loads, angles.size), "fold_angle_deg": np.tile(angles, loads.size),
@@ -350,3 +360,41 @@ def _case(site, date, choice: dict) -> dict:
 
 def _plain(value):
     return value.isoformat() if hasattr(value, "isoformat") else value
+
+
+REFOLD_TABLES = ("refold_value", "refold_schedule")
+
+
+def refold_tables(blocks: Blocks, loads, angles, daily, months, objective, design_hours) -> dict:
+    """The best re-fold schedules of one annual group (:func:`foldopt.schedule.best_schedules`):
+
+    ``refold_value``, per load and number of settings k: the objective and the mean daily t_solar
+    [h], the gain over the single fixed angle [%] and what the k-th setting adds [h], beside the
+    flat panel's and the tracker's objective; ``refold_schedule``, per load, k and visit: the date
+    and the fold angle set until the next visit (the last runs on over New Year).
+
+    ``daily`` is (days, loads, angles) t_solar, ``design_hours`` (days, loads, designs) in
+    :data:`DESIGNS` order."""
+    from foldopt.schedule import best_schedules
+
+    statistic = objective.statistic
+    site = blocks.study.site
+    where = {"site_name": site.name or "", "latitude": site.latitude, "longitude": site.longitude}
+    values, visits = [], []
+    for index, load in enumerate(loads):
+        schedules = best_schedules(daily[:, index, :], months, objective.visits, statistic)
+        flat, tracker = (objective_value(design_hours[:, index, d], months, statistic) for d in (0, 2))
+        fixed = schedules[0].objective_h
+        previous = None
+        for k, schedule in enumerate(schedules, start=1):
+            chosen = daily[np.arange(len(months)), index, schedule.daily_angles(len(months))]
+            values.append({**where, "p_load_w": float(load), "settings": k, "objective": statistic,
+                           "objective_h": schedule.objective_h, "mean_t_solar_h": float(chosen.mean()),
+                           "gain_vs_fixed_pct": 100.0 * (schedule.objective_h / fixed - 1.0) if fixed > 0 else np.nan,
+                           "added_by_setting_h": np.nan if previous is None else schedule.objective_h - previous,
+                           "flat_objective_h": float(flat), "tracker_objective_h": float(tracker)})
+            previous = schedule.objective_h
+            for visit, (start, angle) in enumerate(zip(schedule.starts, schedule.angles, strict=True), start=1):
+                visits.append({**where, "p_load_w": float(load), "settings": k, "visit": visit,
+                               "date": blocks.dates[start].isoformat(), "fold_angle_deg": float(angles[angle])})
+    return {"refold_value": pd.DataFrame(values), "refold_schedule": pd.DataFrame(visits)}
