@@ -333,7 +333,7 @@ _OPTION_OF_FIELD = {
     "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby", "transposition": "--transposition",
     "objective.statistic": "--objective", "objective.visits": "--visits", "weather": "--weather", "albedo": "--albedo", "iam": "--iam",
     "switch_series": "--switch-series", "bypass_diodes": "--no-bypass", "exact_electrical": "--exact-electrical",
-    "force_site": "--force-site",
+    "force_site": "--force-site", "load_profile": "--load-profile",
 }
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 
@@ -360,6 +360,10 @@ def _sweep_options(
                                        "or of dates, 'year' or 'equinoxes-solstices'."),
     year: Optional[int] = typer.Option(None, "--year", help="Year of day-of-year ranges [default: the study's]."),
     p_load: Optional[str] = typer.Option(None, "--p-load", help="Load [W], or a range start:stop:step."),
+    load_profile: Optional[Path] = typer.Option(None, "--load-profile", help="A day's load instead of a constant: a "
+                                                "CSV of time,watts rows (HH:MM, held until the next time)."),
+    p_load_scale: Optional[str] = typer.Option(None, "--p-load-scale", help="Scale of the load profile [-], or a range "
+                                               "such as 0.5:2:0.1 [default: 1]."),
     area: Optional[float] = typer.Option(None, "--area", help="Flat panel area [m^2]."),
     efficiency: Optional[float] = typer.Option(None, "--efficiency", help="PV efficiency [-] (ideal model; sets the "
                                                "b-model panel's area)."),
@@ -537,6 +541,17 @@ def _sweep_plan(axis: str, options: dict):
             data[field] = True
     if options["no_bypass"]:
         data["bypass_diodes"] = False
+    if options["load_profile"] is not None:
+        data["load_profile"] = {"file": str(options["load_profile"])}
+    if options["p_load_scale"] is not None:
+        if "p_load" in given:
+            raise ConfigError(["--p-load / --p-load-scale: a constant load or a profile's scale, not both"])
+        if data.get("load_profile") is None:
+            raise ConfigError(["--p-load-scale: scales a load profile; give one with --load-profile (or load_profile "
+                               "in the study)"])
+        data["p_load"] = options["p_load_scale"]
+    elif options["load_profile"] is not None and "p_load" not in given:
+        data["p_load"] = 1.0  # the profile as written, not the study's constant load
     if options["objective"] is not None:
         data["objective"] = {"statistic": options["objective"]}
     if options["visits"] is not None:
@@ -566,7 +581,7 @@ def _defaults(path: Path, study, axis: str, options: dict, given: set) -> list[s
     weather = "weather" in given
     taken = []
     option = _AXIS_OPTION[axis]
-    if option is not None and option not in given:
+    if option is not None and option not in given and not (option == "p_load" and "p_load_scale" in given):
         if option == "p_load":
             taken.append(f"20 loads, 5 % to 100 % of {options['p_load'][-1]:g} W (default range)")
         else:

@@ -223,6 +223,51 @@ class Objective(_Strict):
         return self
 
 
+_CLOCK = re.compile(r"^([01]?\d|2[0-3]):([0-5]\d)$")
+
+
+def _profile_steps(value: dict) -> dict:
+    """``{"HH:MM": watts}``: clock times of a day, each load at least 0 W."""
+    if not isinstance(value, dict) or not value:
+        raise ValueError("expected a mapping of clock times HH:MM to watts, e.g. {'07:00': 6, '19:00': 1.5}")
+    steps = {}
+    for time, watts in value.items():
+        match = _CLOCK.match(str(time).strip())
+        if not match:
+            raise ValueError(f"{time!r} is not a clock time HH:MM in [00:00, 23:59]")
+        if isinstance(watts, bool) or not isinstance(watts, (int, float)) or not math.isfinite(watts) or watts < 0:
+            raise ValueError(f"{time}: {watts!r} is not a load in watts >= 0")
+        steps[f"{int(match.group(1)):02d}:{match.group(2)}"] = float(watts)
+    return dict(sorted(steps.items()))
+
+
+_ProfileSteps = Annotated[dict, AfterValidator(_profile_steps)]
+
+
+class LoadProfile(_Strict):
+    """P_load(t) for a scale (``p_load``) of 1: loads [W] at clock times of the local day, held
+    until the next time (``step``) or interpolated between them (``linear``), and the last carried
+    over midnight to the first. ``weekend`` (Saturday and Sunday) and ``months`` (month number to
+    a day) replace the ``daily`` day where they apply. ``file``: a CSV of ``time,watts`` rows
+    instead of ``daily``."""
+
+    daily: _ProfileSteps | None = None
+    file: str | None = None
+    interpolation: _named(("step", "linear")) = "step"
+    weekend: _ProfileSteps | None = None
+    months: dict[Annotated[int, Field(ge=1, le=12)], _ProfileSteps] | None = None
+
+    @model_validator(mode="after")
+    def _one_day(self):
+        if (self.daily is None) == (self.file is None):
+            raise ValueError("give the day's loads as daily (a mapping HH:MM: watts) or as file (a CSV), not both")
+        if self.file is not None:
+            from foldopt.loads import read_profile  # only when a file is named
+
+            object.__setattr__(self, "daily", read_profile(self.file))
+        return self
+
+
 class FoldAngles(_Strict):
     start: _interval(0, 180, lo_open=True, unit=" deg") = 1.0
     stop: _interval(0, 180, lo_open=True, unit=" deg") = 180.0
@@ -249,7 +294,9 @@ class Study(_Strict):
     force_site: bool = Field(False, description="keep a site more than SITE_TOLERANCE_KM from the weather file's")
     date: dt.date
     panel: Panel
-    p_load: _interval(0, 1e6, lo_open=True, unit=" W")
+    p_load: _interval(0, 1e6, lo_open=True, unit=" W") = Field(
+        description="the load [W]; with a load_profile, the profile's scale [-]")
+    load_profile: LoadProfile | None = None
     geometry: _named(names.GEOMETRIES) | None = Field(
         None, description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact"
     )
@@ -278,6 +325,14 @@ class Study(_Strict):
     tracker: Tracker = Tracker()
     climate: _named(names.HOTTEL_CLIMATES) = Field("midlatitude-summer", description="Hottel sky only")
     step_min: Annotated[_interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)] = 1.0
+
+    @model_validator(mode="before")
+    @classmethod
+    def _profile_scale(cls, data):
+        """A load profile is in watts: its scale defaults to 1."""
+        if isinstance(data, dict) and data.get("load_profile") is not None and data.get("p_load") is None:
+            data = {**data, "p_load": 1.0}
+        return data
 
     @field_validator("weather", mode="before")
     @classmethod

@@ -28,7 +28,7 @@ from foldopt.config import Study
 from foldopt.electrical import Electrical
 from foldopt.geometry import normal_vector, subpanel_orientation
 from foldopt.irradiance import beam_incidence_factor, plane_of_array
-from foldopt.metrics import energy, t_solar, t_solar_contiguous
+from foldopt.metrics import energy, per_load, t_solar, t_solar_contiguous
 from foldopt.names import ENGINES
 from foldopt.pvmodel import PVModel
 from foldopt.sky import Sky
@@ -261,11 +261,12 @@ def _in_caller_order(result: RowMetrics, order, row_loadset) -> RowMetrics:
                       result.energy, result.peak, result.irradiation)
 
 
-def _curve_reference(power, row_loads, step_hours, contiguous):
+def _curve_reference(power, row_loads, step_hours, contiguous, load_shape=None):
     """t_solar, its longest run (or None), energy and peak of curves (m, n_steps) with loads (m, L)
-    by :mod:`foldopt.metrics`."""
-    runs = t_solar_contiguous(power[:, None, :], row_loads, step_hours) if contiguous else None
-    return t_solar(power[:, None, :], row_loads, step_hours), runs, energy(power, step_hours), power.max(axis=-1)
+    (scales of ``load_shape`` where given) by :mod:`foldopt.metrics`."""
+    compared = per_load(power, load_shape)
+    runs = t_solar_contiguous(compared[:, None, :], row_loads, step_hours) if contiguous else None
+    return t_solar(compared[:, None, :], row_loads, step_hours), runs, energy(power, step_hours), power.max(axis=-1)
 
 
 def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool = True, with_state: bool = False):
@@ -321,8 +322,10 @@ def _reference(sky, study, row_block, orientation, loads, row_loadset, outputs, 
         rows = np.flatnonzero(row_block == block)
         curves, _ = powers(sky, study, orientation[rows], [block], series)
         out.irradiation[rows] = energy(curves["poa"], step)
+        shape = None if sky.load_shape is None else sky.load_shape[block]
         for index, name in enumerate(outputs):
-            hours, runs, harvested, peak = _curve_reference(curves[name], loads[row_loadset[rows]], step, contiguous)
+            hours, runs, harvested, peak = _curve_reference(curves[name], loads[row_loadset[rows]], step, contiguous,
+                                                            shape)
             out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = hours, harvested, peak
             if contiguous:
                 out.t_solar_contiguous[rows, index] = runs
@@ -374,29 +377,41 @@ def _compiled(sky, study, electricals, block_table, row_block, orientation, load
         *(np.ascontiguousarray(a) for a in arrays), paper, iam_code, iam_params, table_1d, table_parallel,
         table_series, float(linear_power), study.panel.area / first.subpanel_area, first.bypass,
         first.switch_series, first.converter_efficiency, codes, np.ascontiguousarray(loads), sky.step_hours,
-        contiguous, **work,
+        contiguous, *_shape_arguments(sky.load_shape), **work,
     )
     return RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
                       work["peak_out"], work["irradiation_out"])
 
 
+def _shape_arguments(load_shape):
+    """The kernel's ``load_shape`` and ``use_shape``: one placeholder row for constant loads."""
+    if load_shape is None:
+        return np.zeros((1, 1)), False
+    return np.ascontiguousarray(load_shape, dtype=float), True
+
+
 def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous: bool = False,
-                  engine: str = "numba") -> RowMetrics:
-    """Daily metrics of given power curves (n_rows, n_steps) [W]: t_solar (n_rows, 1, n_loads) etc."""
+                  engine: str = "numba", load_shape=None) -> RowMetrics:
+    """Daily metrics of given power curves (n_rows, n_steps) [W]: t_solar (n_rows, 1, n_loads) etc.;
+    with ``load_shape`` (n_rows, n_steps) [W] the loads are its scales (:func:`per_load`)."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
     power = np.ascontiguousarray(power, dtype=float)
     sorted_loads, order = _sorted_loads(loads)
     row_loadset = np.zeros(power.shape[0], dtype=np.int64) if row_loadset is None else np.asarray(
         row_loadset, dtype=np.int64)
+    if load_shape is not None:
+        load_shape = np.broadcast_to(np.asarray(load_shape, dtype=float), power.shape)
     if engine == "numpy":
-        hours, runs, harvested, peak = _curve_reference(power, sorted_loads[row_loadset], step_hours, contiguous)
+        hours, runs, harvested, peak = _curve_reference(power, sorted_loads[row_loadset], step_hours, contiguous,
+                                                        load_shape)
         result = RowMetrics(hours[:, None], None if runs is None else runs[:, None], harvested[:, None], peak[:, None])
     else:
         from foldopt import kernel
 
         work = kernel.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
-        kernel.curve_rows(power, row_loadset, sorted_loads, step_hours, contiguous, **work)
+        kernel.curve_rows(power, row_loadset, sorted_loads, step_hours, contiguous, *_shape_arguments(load_shape),
+                          **work)
         result = RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
                             work["peak_out"])
     return _in_caller_order(result, order, row_loadset)

@@ -120,12 +120,27 @@ def _gather(whole, pending_at, pending, lo_at, length):
     return lo_at, length
 
 
+@njit(cache=True, inline="always")
+def _per_load(p, shape, s, use_shape):
+    """The power against which the loads are compared at step ``s``: the power itself for constant
+    loads, or for a load profile P_load(t) = scale x shape(t) the ratio P_pv / shape, so that
+    P_pv >= scale x shape is ratio >= scale; a step without load (shape 0) is -inf, which no scale
+    reaches, and neither do the segments next to it (:func:`foldopt.metrics.per_load`)."""
+    if not use_shape:
+        return p
+    g = shape[s]
+    return p / g if g > 0.0 else -math.inf
+
+
 @njit(cache=True)
-def _metrics(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out):
+def _metrics(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
+             use_shape):
     """Daily metrics of one power curve [W] sampled at step centres, of which only steps
     ``first..last`` need walking: the power before and after them is that of the first and the
     last (zero, or the day's end). Writes t_solar (and its longest run) per load; returns the
-    energy [Wh] and the peak [W].
+    energy [Wh] and the peak [W]. With ``use_shape`` the loads are scales of the load profile
+    ``shape`` (n_steps) [W] (:func:`_per_load`); steps outside ``first..last`` hold the power of
+    the first and last, and the shape there is taken as the first's and the last's.
 
     A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
     (summed from the top at the end), and shares to the loads inside its range. Consecutive
@@ -136,16 +151,16 @@ def _metrics(power, first, last, step_hours, loads, contiguous, above, whole, ru
     if contiguous:
         run[:] = 0.0
     # The half-step held at the start of the day, and the steps before ``first``.
-    previous = power[first]
+    harvested = peak = power[first]
+    previous = _per_load(power[first], shape, first, use_shape)
     position = _walk(loads, 0, previous)
-    harvested, peak = previous, previous
     pending_at, pending = position, (first + 0.5) * step_hours
     if contiguous:
         _runs(position, position, pending, run)
     for s in range(first + 1, last + 1):
-        p = power[s]
-        harvested += p
-        peak = max(peak, p)
+        harvested += power[s]
+        peak = max(peak, power[s])
+        p = _per_load(power[s], shape, s, use_shape)
         at = _walk(loads, position, p)
         lo_at, hi_at = min(position, at), max(position, at)
         if contiguous:
@@ -273,8 +288,8 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
 def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_normal, row_paper, row_loadset,
               paper_incidence, iam_model, iam_params, table_1d, table_parallel, table_series, linear_power,
               panel_scale, bypass, switch_series, converter_efficiency, connections, loads, step_hours,
-              contiguous, t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance, buffer, above, whole,
-              run):
+              contiguous, load_shape, use_shape, t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance,
+              buffer, above, whole, run):
     """Daily metrics of every row and connection, computing the power on the fly.
 
     Parameters
@@ -313,6 +328,10 @@ def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_nor
         Loads [W], ascending in each set.
     contiguous : bool
         Whether to track the longest contiguous interval too.
+    load_shape : (n_blocks, n_steps) float
+        With ``use_shape``, each block's load profile [W]: the loads are then its scales (one row
+        (1, 1) without).
+    use_shape : bool
     t_out, cont_out : (n_rows, n_conn, n_loads) float
         t_solar and its longest contiguous interval [h] (out).
     energy_out, peak_out : (n_rows, n_conn) float
@@ -338,14 +357,16 @@ def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_nor
             for c in range(connections.shape[0]):
                 energy_out[r, c], peak_out[r, c] = _metrics(
                     buffer[k, c], first, last, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
-                    run[k], t_out[r, c], cont_out[r if contiguous else 0, c])
+                    run[k], t_out[r, c], cont_out[r if contiguous else 0, c], load_shape[b if use_shape else 0],
+                    use_shape)
 
 
 @njit(cache=True, parallel=True)
-def curve_rows(power, row_loadset, loads, step_hours, contiguous, t_out, cont_out, energy_out, peak_out, above,
-               whole, run):
-    """Daily metrics of given power curves, ``power`` (n_rows, n_steps) [W]; outputs and scratch as
-    :func:`fold_rows` with one connection."""
+def curve_rows(power, row_loadset, loads, step_hours, contiguous, load_shape, use_shape, t_out, cont_out, energy_out,
+               peak_out, above, whole, run):
+    """Daily metrics of given power curves, ``power`` (n_rows, n_steps) [W]; ``load_shape``
+    (n_rows, n_steps) with ``use_shape``; outputs and scratch as :func:`fold_rows` with one
+    connection."""
     n_rows = power.shape[0]
     n_chunks = above.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
@@ -353,7 +374,8 @@ def curve_rows(power, row_loadset, loads, step_hours, contiguous, t_out, cont_ou
         for r in range(k * per_chunk, min((k + 1) * per_chunk, n_rows)):
             energy_out[r, 0], peak_out[r, 0] = _metrics(
                 power[r], 0, power.shape[1] - 1, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
-                run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0])
+                run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0], load_shape[r if use_shape else 0],
+                use_shape)
 
 
 def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):

@@ -19,7 +19,7 @@ def _time_above_per_segment(p_pv, p_load, step_hours):
     """Hours above the load in each of the ``n + 1`` segments of the piecewise-linear curve."""
     excess = np.asarray(p_pv, dtype=float) - np.asarray(p_load, dtype=float)[..., None]
     start, end = excess[..., :-1], excess[..., 1:]
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):  # -inf: a step without load (per_load)
         crossing = np.maximum(start, end) / np.abs(start - end)
     fraction = np.where(
         (start >= 0) & (end >= 0), 1.0, np.where((start < 0) & (end < 0), 0.0, crossing)
@@ -80,7 +80,7 @@ def daily_metrics(p_pv, p_load, step_hours):
                           energy(p_pv, step_hours), p_pv.max(axis=-1), p_load)
 
 
-def metric_columns(t_solar_h, t_solar_contiguous_h, energy_wh, peak_power_w, p_load) -> dict:
+def metric_columns(t_solar_h, t_solar_contiguous_h, energy_wh, peak_power_w, p_load, served_wh=None) -> dict:
     """The daily metrics by their report names, from t_solar, its longest run, the energy and the peak.
 
     Returns
@@ -89,9 +89,10 @@ def metric_columns(t_solar_h, t_solar_contiguous_h, energy_wh, peak_power_w, p_l
         ``t_solar_h``, ``t_solar_contiguous_h`` [h]; ``energy_wh`` harvested (at the maximum power
         point), ``energy_served_wh`` = P_load * t_solar, ``energy_wasted_wh`` the rest (without
         storage, power above the load and power too low to run it are both lost) [Wh];
-        ``peak_power_w`` [W].
+        ``peak_power_w`` [W]. ``served_wh`` replaces ``P_load * t_solar`` for a load profile
+        (:func:`energy_served`).
     """
-    served = np.asarray(p_load, dtype=float) * t_solar_h
+    served = np.asarray(p_load, dtype=float) * t_solar_h if served_wh is None else served_wh
     return {
         "t_solar_h": t_solar_h,
         "t_solar_contiguous_h": t_solar_contiguous_h,
@@ -155,3 +156,50 @@ def notes(condition, t_solar_h):
     above = (hours == 0) & ~dark
     return np.array(["; ".join(p for p in (c, "load above peak" if a else "") if p)
                      for c, a in zip(condition.ravel(), above.ravel(), strict=True)], dtype=object).reshape(hours.shape)
+
+
+def per_load(power, load_shape):
+    """What loads are compared with: the power [W] itself, or with a load profile (``load_shape``
+    [W], broadcast against ``power``) the ratio power / shape, so that P_pv >= scale x shape is
+    ratio >= scale; where the shape is 0 (no load) -inf, which no scale reaches. The segments
+    between a step without load and one with it then count nothing: a profile that is zero outside
+    a window never counts time outside it, and loses at most half a step at each edge of the
+    window."""
+    if load_shape is None:
+        return power
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(load_shape > 0, power / np.where(load_shape > 0, load_shape, 1.0), -np.inf)
+
+
+def energy_served(p_pv, scale, load_shape, step_hours, t_solar_h=None):
+    """Energy a time-varying load draws while solar-powered [Wh]: the integral of
+    P_load(t) = ``scale`` x ``load_shape``(t) over the time with P_pv >= P_load.
+
+    The time above the load is :func:`t_solar`'s, segment by segment, and the load over a segment
+    is the mean of its two samples; for a constant shape of 1 this is ``scale x t_solar``.
+
+    Parameters
+    ----------
+    p_pv : array_like
+        Power at step centres [W], time on the last axis.
+    scale : float or array_like
+        Scales of the profile, broadcast against ``p_pv``'s leading axes.
+    load_shape : array_like
+        P_load(t) for a scale of 1 [W], broadcast against ``p_pv``.
+    step_hours : float
+    t_solar_h : array_like, optional
+        The curves' t_solar at these scales, as computed elsewhere: where the shape is the same at
+        every step, the served energy is then ``scale x shape x t_solar_h`` exactly, as for a
+        constant load.
+    """
+    shape = np.broadcast_to(np.asarray(load_shape, dtype=float), np.shape(p_pv))
+    scale = np.asarray(scale, dtype=float)
+    if t_solar_h is not None and np.all(shape == shape[..., :1]):
+        level = shape[..., 0][..., None] if scale.ndim else shape[..., 0]
+        return scale * level * t_solar_h
+    above, _ = _time_above_per_segment(per_load(p_pv, shape)[..., None, :] if scale.ndim else per_load(p_pv, shape),
+                                       scale, step_hours)
+    segment_load = np.concatenate([shape[..., :1], 0.5 * (shape[..., :-1] + shape[..., 1:]), shape[..., -1:]], axis=-1)
+    if scale.ndim:
+        segment_load = segment_load[..., None, :]
+    return scale * (above * segment_load).sum(axis=-1)

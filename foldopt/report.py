@@ -668,7 +668,7 @@ def digest_study(result: StudyResult) -> dict:
     return {
         "study": study.name, "mode": study.mode, "pv_model": study.pv_model, "connection": study.connection,
         "site": {"name": study.site.name, "latitude": study.site.latitude, "longitude": study.site.longitude},
-        "date": study.date.isoformat(), "p_load_w": study.p_load,
+        "date": study.date.isoformat(), "p_load_w": study.p_load, "load_profile": study.load_profile is not None,
         "fold_angle_deg": result.optimal_fold_angle, "heuristic_fold_angle_deg": _number(result.heuristic_fold_angle),
         "t_solar_h": {design: _number(summary.loc[design, "t_solar_h"])
                       for design in ("flat", "twofold", "tracker", "tracker-net")},
@@ -688,6 +688,7 @@ def digest_sweep(result) -> dict:
     gains = twofold["gain_vs_flat_pct"].dropna()
     digest = {
         "study": result.plan.base.name, "cases": result.plan.n_cases,
+        "load_profile": result.plan.base.load_profile is not None,
         "axes": {path: len(values) for path, values in result.plan.axes},
         "fold_angle_deg": {"min": _number(twofold["fold_angle_deg"].min()),
                            "max": _number(twofold["fold_angle_deg"].max())},
@@ -860,11 +861,16 @@ def _pct(value, signed: bool = True) -> str:
     return "-" if value is None else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
 
 
+def load_text(p_load: float, profile: bool) -> str:
+    """``P_load 2 W``, or for a load profile its scale: ``load profile x0.5``."""
+    return f"load profile x{p_load:g}" if profile else f"P_load {p_load:g} W"
+
+
 def study_answer(digest: dict, defaults: list[str]) -> list[str]:
     site = digest["site"]
     where = site["name"] or f"{site['latitude']:g}, {site['longitude']:g}"
     hours = digest["t_solar_h"]
-    lines = [f"{digest['study']}: {where}, {digest['date']}, P_load {digest['p_load_w']:g} W "
+    lines = [f"{digest['study']}: {where}, {digest['date']}, {load_text(digest['p_load_w'], digest['load_profile'])} "
              f"({digest['mode']} mode, {digest['pv_model']} + {digest['connection']})"]
     if defaults:
         lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
@@ -898,14 +904,14 @@ def sweep_answer(digest: dict, defaults: list[str]) -> list[str]:
         lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
     for year in digest.get("year", []):
         mean = year["mean_t_solar_h"]
-        lines.append(f"P_load {year['p_load_w']:g} W: fold angle {year['fold_angle_deg']:g} deg all year, mean t_solar "
+        lines.append(f"{load_text(year['p_load_w'], digest['load_profile'])}: fold angle {year['fold_angle_deg']:g} deg all year, mean t_solar "
                      f"{_hours(mean['twofold'])} ({_pct(year['t_solar_gain_vs_flat_pct'])} over flat "
                      f"{_hours(mean['flat'])}, energy {_pct(year['energy_gain_vs_flat_pct'])}); tracker "
                      f"{_hours(mean['tracker'])}")
     for refold in digest.get("refold", []):
         settings = refold["objective_h"]
         shown = [k for k in settings if k in (1, 2, 3, 4, 6, 12)]
-        lines.append(f"P_load {refold['p_load_w']:g} W, re-folded ({refold['objective']} t_solar): "
+        lines.append(f"{load_text(refold['p_load_w'], digest['load_profile'])}, re-folded ({refold['objective']} t_solar): "
                      + ", ".join(f"{k} setting{'s' if k > 1 else ''} {settings[k]:.2f} h" for k in shown)
                      + f"; flat {refold['flat_h']:.2f} h, tracker {refold['tracker_h']:.2f} h (refold_schedule.csv)")
     gain = digest.get("gain_vs_flat_pct")

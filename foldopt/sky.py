@@ -21,6 +21,7 @@ from foldopt.atmosphere import clear_sky_dni, relative_airmass
 from foldopt.config import Study, parse_timezone
 from foldopt.geometry import normal_vector
 from foldopt.irradiance import sky_diffuse_terms
+from foldopt.loads import load_shape
 from foldopt.solarposition import ClockGrid, clock_grid, solar_position_grid
 from foldopt.weather import (
     CLEAR_SKIES,
@@ -55,6 +56,9 @@ class Sky:
     latitude : numpy.ndarray
         (n_blocks,) [deg north].
     iam : {'none', 'ashrae', 'physical'}
+    load_shape : numpy.ndarray or None
+        With a load profile, P_load(t) per block and step for a scale of 1 [W]
+        (:func:`foldopt.loads.load_shape`); None for a constant load.
     weather_balance : dict or None
         With a weather file: per component (``dni``, ``ghi``, ``dhi``), the file's summed interval
         means and what the steps keep of them [W/m^2 x intervals] (:func:`foldopt.weather.sub_hourly`).
@@ -75,6 +79,7 @@ class Sky:
     latitude: np.ndarray
     iam: str
     weather_balance: dict | None = None
+    load_shape: np.ndarray | None = None
 
     @property
     def n_blocks(self) -> int:
@@ -115,7 +120,8 @@ class Sky:
         take = {name: None if getattr(self, name) is None else getattr(self, name)[keep]
                 for name in ("solar_zenith", "solar_azimuth", "hour_angle", "declination", "sun_vector", "dni",
                              "ghi", "dhi", "terms", "temp_air", "latitude")}
-        return Sky(grid=grid, mode=self.mode, iam=self.iam, weather_balance=self.weather_balance, **take)
+        return Sky(grid=grid, mode=self.mode, iam=self.iam, weather_balance=self.weather_balance,
+                   load_shape=None if self.load_shape is None else self.load_shape[keep], **take)
 
 
 def _clock(sites, dates, step_min) -> ClockGrid:
@@ -242,4 +248,5 @@ def build_sky(study: Study, sites, dates) -> Sky:
         hour_angle=sun["hour_angle"], declination=np.ascontiguousarray(sun["declination"]),
         sun_vector=normal_vector(zenith, sun["solar_azimuth"]), dni=dni, ghi=ghi, dhi=dhi, terms=terms,
         temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam, weather_balance=balance,
+        load_shape=None if study.load_profile is None else load_shape(study.load_profile, grid.clock_hours, dates),
     )

@@ -17,7 +17,8 @@ import pandas as pd
 from foldopt import engine as engines
 from foldopt.aggregation import CONNECTIONS, SWITCH_STATES
 from foldopt.config import Study
-from foldopt.metrics import load_for_t_solar, metric_columns, notes, relative_to, t_solar
+from foldopt.metrics import (energy_served, load_for_t_solar, metric_columns, notes, per_load, relative_to,
+                             t_solar)
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.sizing import flat_area_multiple
 from foldopt.sky import Sky, build_sky
@@ -182,8 +183,10 @@ class StudyResult:
 
 
 def _best_angle(day: Day, angles, sweep_t_solar, connection):
+    shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
     return optimal_fold_angle(
-        lambda fold: day.combined_power(fold, connection), angles, sweep_t_solar, day.study.p_load, day.step_hours
+        lambda fold: per_load(day.combined_power(fold, connection), shape), angles, sweep_t_solar, day.study.p_load,
+        day.step_hours
     )[0]
 
 
@@ -205,20 +208,25 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
     day = Day(study)
     study = day.study
     p_load, step = study.p_load, day.step_hours
+    # A load profile: P_load(t) = p_load x shape(t). The paper's heuristic, the flat-area multiple
+    # and the standby break-even are defined for a constant load and are left out.
+    shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
     angles = np.asarray(study.fold_angles.grid())
     metrics = engines.row_metrics(day.sky, study, np.zeros(angles.size), day.orientation(angles), [p_load],
                                   outputs=CONNECTIONS, contiguous=True, engine=engine)
     own = CONNECTIONS.index(study.connection)
+    served = None if shape is None else energy_served(day.combined_power(angles), p_load, shape, step,
+                                                      metrics.t_solar[:, own, 0])
     sweep = pd.DataFrame({"fold_angle_deg": angles,
                           **metric_columns(metrics.t_solar[:, own, 0], metrics.t_solar_contiguous[:, own, 0],
-                                            metrics.energy[:, own], metrics.peak[:, own], p_load)})
+                                            metrics.energy[:, own], metrics.peak[:, own], p_load, served)})
     sweep["noon_valley_w"] = noon_valley(*day.subpanel_power(angles))
     for index, connection in enumerate(CONNECTIONS):
         sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
         sweep[f"energy_{connection}_wh"] = metrics.energy[:, index]
 
     best_angle = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
-    paper_angle = heuristic_fold_angle(day.subpanel_power, p_load)
+    paper_angle = heuristic_fold_angle(day.subpanel_power, p_load) if shape is None else np.nan
 
     p_flat, p_tracker = day.flat_power(), day.tracker_power()
     designs = {"flat": (180.0, p_flat), "twofold": (best_angle, day.combined_power(np.array([best_angle]))[0])}
@@ -237,17 +245,18 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
         designs[name] = (np.nan, gross)
         designs[f"{name}-net"] = (np.nan, gross - day.tracker_draw(model))
 
-    curves = engines.curve_metrics(np.stack([power for _, power in designs.values()]), [p_load], step,
-                                   contiguous=True, engine=engine)
+    design_power = np.stack([power for _, power in designs.values()])
+    curves = engines.curve_metrics(design_power, [p_load], step, contiguous=True, engine=engine, load_shape=shape)
+    served = None if shape is None else energy_served(design_power, p_load, shape, step, curves.t_solar[:, 0, 0])
     summary = pd.DataFrame({"design": list(designs), "fold_angle_deg": [angle for angle, _ in designs.values()],
                             **metric_columns(curves.t_solar[:, 0, 0], curves.t_solar_contiguous[:, 0, 0],
-                                              curves.energy[:, 0], curves.peak[:, 0], p_load)})
+                                              curves.energy[:, 0], curves.peak[:, 0], p_load, served)})
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
     summary["pct_of_tracker_t_solar"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
     summary["flat_area_multiple"] = [
-        flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 else np.nan
+        flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 and shape is None else np.nan
         for hours in summary["t_solar_h"]
     ]
     summary["note"] = notes(day.sky.conditions()[0], summary["t_solar_h"].to_numpy())
@@ -264,7 +273,7 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
             "p_twofold_w": at_best[study.connection][0],
             "switch_state": np.where(at_best["switching"][0] > 0, np.array(SWITCH_STATES)[state[0]], "off"),
             "p_tracker_w": p_tracker,
-            "p_load_w": p_load,
+            "p_load_w": p_load if shape is None else p_load * shape,
         },
         index=pd.DatetimeIndex(day.times, name="time"),
     )
@@ -287,6 +296,9 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
         Standby draw [W] above which the twofold panel runs longer; NaN if it never does.
     """
     study, step = day.study, day.step_hours
+    if day.sky.load_shape is not None:  # a standby draw is a load shift only for a constant load
+        return pd.DataFrame({"standby_w": [0.0], "tracker_net_t_solar_h": [np.nan],
+                             "twofold_t_solar_h": [twofold_t_solar]}), float("nan")
     lit = day.sky.lit[0]
     drive_only = day.tracker_draw() - np.where(lit, study.tracker.standby_w, 0.0)
     available = np.where(lit, p_tracker - drive_only, 0.0)

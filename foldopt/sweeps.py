@@ -21,7 +21,7 @@ import pandas as pd
 
 from foldopt import engine as engines
 from foldopt.config import Plan, Study
-from foldopt.metrics import energy, metric_columns, notes, relative_to
+from foldopt.metrics import energy, energy_served, metric_columns, notes, relative_to
 from foldopt.sky import Sky, build_sky
 from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
 
@@ -152,14 +152,27 @@ def _design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str
     gross = sky_tracker_power(sky, study, orientation)
     tracker_poa = energy(engines.poa(sky, *orientation, incident=True), sky.step_hours)
     net = gross - sky_tracker_draw(sky, study, orientation)
+    shape = sky.load_shape
     trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
-                                     engine=engine)
+                                     engine=engine, load_shape=None if shape is None else np.concatenate([shape, shape]))
 
     def per_design(twofold_values, flat_values, tracker_values):
         return np.stack([flat_values, twofold_values.reshape(n_blocks, n_loads), tracker_values[:n_blocks],
                          tracker_values[n_blocks:]], axis=-1)
 
     hours = per_design(twofold.t_solar[:, 0, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
+    served = None
+    if shape is not None:
+        # A load profile's served energy integrates P_load(t) over the solar-powered time: from the curves.
+        step = sky.step_hours
+        curves = [engines.powers(sky, study, every[np.arange(n_blocks), chosen[:, index]], series=study.switch_series
+                                 )[0][study.connection] for index in range(n_loads)]
+        twofold_served = np.stack([energy_served(curve, load, shape, step, twofold.t_solar[index::n_loads, 0, 0])
+                                   for index, (curve, load) in enumerate(zip(curves, loads, strict=True))], 1)
+        flat_curve = engines.powers(sky, study, engines.flat_orientation(tilt, azimuth), series=False)[0]["panel"]
+        served = np.stack([energy_served(flat_curve, loads, shape, step, flat.t_solar[:, 0]), twofold_served,
+                           energy_served(gross, loads, shape, step, trackers.t_solar[:n_blocks, 0]),
+                           energy_served(net, loads, shape, step, trackers.t_solar[n_blocks:, 0])], axis=-1)
     fold = np.stack([np.full((n_blocks, n_loads), 180.0), angles[chosen], np.full((n_blocks, n_loads), np.nan),
                      np.full((n_blocks, n_loads), np.nan)], axis=-1)
     return {
@@ -173,6 +186,7 @@ def _design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str
             per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
                        np.repeat(trackers.peak, n_loads, axis=1)),
             loads[None, :, None],
+            served,
         ),
         "poa_kwh_m2": per_design(twofold.irradiation, np.repeat(flat.irradiation[:, None], n_loads, axis=1),
                                  np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,

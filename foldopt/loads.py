@@ -1,0 +1,79 @@
+"""Loads that vary over the day: P_load(t) = scale x profile(t).
+
+A profile (:class:`foldopt.config.LoadProfile`) gives loads [W] at clock times of the local day,
+held until the next time or interpolated linearly, the last carried over midnight to the first; a
+weekend day and days per month may replace it. :func:`load_shape` evaluates it at every step of
+every block (a day at a site, :class:`foldopt.sky.Sky`), so that the engine compares the power
+with ``scale x shape(t)``: for many scales in one pass it compares P_pv(t) / shape(t) with each
+scale (:func:`foldopt.metrics.per_load`), the method of many constant loads.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+
+def read_profile(path: str | Path) -> dict:
+    """A day's profile from a CSV file with a header ``time,watts`` (``HH:MM`` and watts)."""
+    from foldopt.config import ConfigError, _profile_steps
+
+    path = Path(path)
+    try:
+        with path.open(newline="") as handle:
+            rows = list(csv.DictReader(handle))
+    except FileNotFoundError:
+        raise ConfigError([f"load_profile.file: file not found: {path}"]) from None
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        raise ConfigError([f"load_profile.file: cannot read {path}: {error.__class__.__name__}"]) from None
+    steps = {}
+    for line, row in enumerate(rows, start=2):
+        try:
+            steps[row["time"]] = float(row["watts"])
+        except (KeyError, TypeError, ValueError):
+            raise ConfigError([f"load_profile.file {path}, line {line}: expected time,watts (HH:MM, a number)"]) from None
+    try:
+        return _profile_steps(steps)
+    except ValueError as error:
+        raise ConfigError([f"load_profile.file {path}: {error}"]) from None
+
+
+def _day(steps: dict, clock_hours: np.ndarray, linear: bool) -> np.ndarray:
+    """One day's profile at local clock hours [h]."""
+    times = np.array([int(t[:2]) + int(t[3:]) / 60.0 for t in steps])
+    watts = np.array(list(steps.values()))
+    if linear:
+        # Periodic: the last point joins the first across midnight.
+        return np.interp(clock_hours, np.r_[times - 24.0, times, times + 24.0], np.r_[watts, watts, watts])
+    index = np.searchsorted(times, clock_hours, side="right") - 1  # -1: before the first time, the last's load
+    return watts[index]
+
+
+def load_shape(profile, clock_hours: np.ndarray, dates) -> np.ndarray:
+    """P_load(t) for a scale of 1 [W] at every step of every block.
+
+    Parameters
+    ----------
+    profile : foldopt.config.LoadProfile
+    clock_hours : numpy.ndarray
+        (n_blocks, n_steps) local clock time of each step [h].
+    dates : sequence of datetime.date
+        Each block's local date (weekday and month choose its day).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_blocks, n_steps) [W].
+    """
+    linear = profile.interpolation == "linear"
+    shape = np.empty(clock_hours.shape)
+    for block, date in enumerate(dates):
+        steps = profile.daily
+        if profile.months and date.month in profile.months:
+            steps = profile.months[date.month]
+        if profile.weekend and date.weekday() >= 5:
+            steps = profile.weekend
+        shape[block] = _day(steps, clock_hours[block], linear)
+    return shape
