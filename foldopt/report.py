@@ -624,21 +624,22 @@ def annual_outputs(result, folder: Path, name: str) -> list[str]:
         result.extras["refold_value"].to_csv(folder / "refold_value.csv", index=False, float_format=FLOAT_FORMAT)
         result.extras["refold_schedule"].to_csv(folder / "refold_schedule.csv", index=False,
                                                 float_format=FLOAT_FORMAT)
-        save_plot(plot_refold_value(result.extras["refold_value"], f"{name}: what each re-fold visit is worth"),
-                  folder / "refold_value.png")
+        save_plot(plot_refold_value(result.extras["refold_value"], f"{name}: what each re-fold visit is worth",
+                                    result.plan.base.load_profile is not None), folder / "refold_value.png")
         written += ["refold_value.csv", "refold_schedule.csv", "refold_value.png"]
     return written
 
 
-def plot_refold_value(values: pd.DataFrame, title: str, ax=None):
+def plot_refold_value(values: pd.DataFrame, title: str, profile: bool = False, ax=None):
     """The objective of the best schedule of k fold settings a year against k, per load (the first
-    site's), beside the flat panel and the tracker (:func:`foldopt.sweeps.refold_tables`)."""
+    site's; scales of the load profile where ``profile``), beside the flat panel and the tracker
+    (:func:`foldopt.sweeps.refold_tables`)."""
     fig, ax = _axes(ax, (7, 4.5))
     first = values[(values["latitude"] == values["latitude"].iloc[0])
                    & (values["longitude"] == values["longitude"].iloc[0])]
     for (load, rows), colour in zip(first.groupby("p_load_w"), plt.rcParams["axes.prop_cycle"].by_key()["color"],
                                     strict=False):
-        ax.plot(rows["settings"], rows["objective_h"], "o-", color=colour, label=f"twofold, P_load {load:g} W")
+        ax.plot(rows["settings"], rows["objective_h"], "o-", color=colour, label=f"twofold, {load_text(load, profile)}")
         ax.axhline(rows["flat_objective_h"].iloc[0], color=colour, ls="--", lw=1)
         ax.axhline(rows["tracker_objective_h"].iloc[0], color=colour, ls=":", lw=1)
     ax.plot([], [], "k--", lw=1, label="flat panel")

@@ -87,6 +87,11 @@ def size_panel(
     if (cost_per_m2 is None) == (cost_per_w is None):
         raise ValueError("give exactly one of cost_per_m2 and cost_per_w")
     study = day.study
+    if study.load_profile is not None:
+        from foldopt.config import ConfigError
+
+        raise ConfigError(["load_profile: sizing scales a constant load with the panel's area (Shin et al. Sec. "
+                           "IV-A); use a constant p_load"])
     areas = np.asarray(areas, dtype=float)
     reference_area = study.panel.area
     loads = study.p_load * reference_area / areas

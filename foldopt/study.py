@@ -208,8 +208,8 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
     day = Day(study)
     study = day.study
     p_load, step = study.p_load, day.step_hours
-    # A load profile: P_load(t) = p_load x shape(t). The paper's heuristic, the flat-area multiple
-    # and the standby break-even are defined for a constant load and are left out.
+    # A load profile: P_load(t) = p_load x shape(t). The flat-area multiple and the standby
+    # break-even are defined for a constant load and are left out.
     shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
     angles = np.asarray(study.fold_angles.grid())
     metrics = engines.row_metrics(day.sky, study, np.zeros(angles.size), day.orientation(angles), [p_load],
@@ -226,7 +226,10 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
         sweep[f"energy_{connection}_wh"] = metrics.energy[:, index]
 
     best_angle = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
-    paper_angle = heuristic_fold_angle(day.subpanel_power, p_load) if shape is None else np.nan
+    # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
+    # noon (the flat panel's peak).
+    noon_load = p_load if shape is None else p_load * shape[int(np.argmax(day.flat_power()))]
+    paper_angle = heuristic_fold_angle(day.subpanel_power, noon_load) if noon_load > 0 else np.nan
 
     p_flat, p_tracker = day.flat_power(), day.tracker_power()
     designs = {"flat": (180.0, p_flat), "twofold": (best_angle, day.combined_power(np.array([best_angle]))[0])}

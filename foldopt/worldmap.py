@@ -150,6 +150,9 @@ def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]
     the site, date and load; ``site`` a :class:`foldopt.config.Site`'s fields or a weather file's
     site (``weather``: the path, its site read from the file)."""
     dates = parse_dates("year", year)
+    if study.get("load_profile") is not None:
+        raise ConfigError(["load_profile: maps take constant loads (watts or fractions of the flat peak); run a "
+                           "profile at one site with foldopt run"])
     data = {**study, "date": dates[0], "p_load": 1.0}
     if "weather" in site:
         data.update(weather=site["weather"], site=None)
