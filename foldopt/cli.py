@@ -727,12 +727,14 @@ def map_(
             errors.append(f"--p-load = {p_load!r}: loads must be in (0, 1e+06] W")
     if errors:
         _fail(errors)
+    from pydantic import ValidationError
+
     from foldopt.config import MAX_CASES, Objective
     from foldopt.worldmap import grid_sites, map_study, read_sites, weather_sites
 
     try:
         Objective(statistic=objective)
-    except Exception:
+    except ValidationError:
         _fail([f"--objective = {objective!r}: must be mean, min, worst-month or a percentile pNN (e.g. p10)"])
     data, _ = read_study(config if config is not None else default_study_path())
     if loads is None:
@@ -758,7 +760,9 @@ def map_(
     if len(site_list) > MAX_CASES:
         _fail([f"sites: {len(site_list):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
     if not 1 <= show_load <= len(loads):
-        _fail([f"--show-load = {show_load}: must be in [1, {len(loads)}] (the map has {len(loads)} load{'s' if len(loads) > 1 else ''})"])
+        _fail([f"--show-load = {show_load}: must be in [1, {len(loads)}] (the map has "
+               f"{len(loads)} load{'s' if len(loads) > 1 else ''})"])
+
     def announce(cluster: str, dashboard: str | None):
         if not quiet and not output.json:
             typer.echo(f"{cluster}; dashboard: {dashboard or 'none (pip install bokeh)'}", err=True)

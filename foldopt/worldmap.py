@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from pydantic import ValidationError
 
 from foldopt import engine as engines
 from foldopt.config import ConfigError, Site, Study, _format_errors, parse_dates
@@ -115,7 +116,7 @@ def read_sites(path: Path | str) -> list[dict]:
         data = {key: value for key, value in values.items() if value != ""}
         try:
             site = Site.model_validate(data)
-        except Exception as error:  # pydantic's ValidationError: one message per field
+        except ValidationError as error:
             errors += [f"--sites {path}, line {line}: {message}" for message in _format_errors(error)]
             continue
         sites.append(site.model_dump(exclude_none=True))
@@ -155,16 +156,15 @@ def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]
                            "profile at one site with foldopt run"])
     data = {**study, "date": dates[0], "p_load": 1.0}
     if "weather" in site:
-        data.update(weather=site["weather"], site=None)
-        data.pop("site")
+        data["weather"] = site["weather"]  # the site comes from the file; its light from the file
+        data.pop("site", None)
         data.pop("sky", None)
     else:
         data["site"] = {key: site[key] for key in SITE_COLUMNS if site.get(key) is not None}
     try:
         return Study.model_validate(data), dates
-    except Exception as error:
-        lines = _format_errors(error) if hasattr(error, "errors") else [str(error)]
-        raise ConfigError(lines) from None
+    except ValidationError as error:
+        raise ConfigError(_format_errors(error)) from None
 
 
 def evaluate_sites(study: dict, sites: Sequence[dict], loads: Sequence[float], relative: bool = False,
