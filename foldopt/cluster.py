@@ -31,7 +31,7 @@ from pathlib import Path
 import pandas as pd
 
 from foldopt.config import ConfigError
-from foldopt.folders import OutputError, check_output
+from foldopt.folders import OutputError, check_output, write_atomically
 
 #: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
 #: about a millisecond), short enough that a lost worker loses little and progress moves.
@@ -141,18 +141,8 @@ def _part_path(out: Path, index: int) -> Path:
     return out / PARTS / f"part-{index:05d}.parquet"
 
 
-def _write_atomically(path: Path, write: Callable[[Path], None]) -> None:
-    """``write(temporary path)``, then rename into ``path``: a reader sees all of it or nothing."""
-    temporary = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    try:
-        write(temporary)
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-
-
 def _write_parquet(frame: pd.DataFrame, path: Path) -> None:
-    _write_atomically(path, lambda temporary: frame.to_parquet(temporary, index=False, engine="pyarrow"))
+    write_atomically(path, lambda temporary: frame.to_parquet(temporary, index=False, engine="pyarrow"))
 
 
 def _read_part(path: Path) -> pd.DataFrame | None:
@@ -201,7 +191,7 @@ def prepare_folder(out: Path, spec: MapSpec, resume: bool, overwrite: bool, meta
 
 
 def _write_json(path: Path, data: dict) -> None:
-    _write_atomically(path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n"))
+    write_atomically(path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n"))
 
 
 @contextmanager
@@ -329,7 +319,7 @@ def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, pro
                       ignore_index=True)
     seconds = time.perf_counter() - started
     _write_parquet(table, out / "map.parquet")
-    _write_atomically(out / "map.csv", lambda temporary: table.to_csv(temporary, index=False, float_format="%.10g"))
+    write_atomically(out / "map.csv", lambda temporary: table.to_csv(temporary, index=False, float_format="%.10g"))
     computed = tuple(missing)
     _write_json(out / "run.json", {
         **metadata, "status": "complete", "cluster": description, "dashboard": dashboard,

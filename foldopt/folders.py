@@ -93,6 +93,20 @@ def clear_leftovers(parent: Path) -> None:
             shutil.rmtree(path, ignore_errors=True)
 
 
+def write_atomically(path: Path, write) -> Path:
+    """``write(temporary)`` to a file beside ``path`` (same suffix, so that writers that read it
+    know the format), then rename it into ``path``: a reader sees the old file or the whole new one,
+    and a failed write leaves nothing."""
+    path = Path(path)
+    temporary = path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}")
+    try:
+        write(temporary)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+    return path
+
+
 @contextmanager
 def staged_folder(out: Path, overwrite: bool):
     """Yield a temporary folder that replaces ``out`` atomically when the block succeeds."""

@@ -8,10 +8,11 @@ cache folder (:func:`foldopt.electrical.cache_dir`), built once and written atom
 
 from __future__ import annotations
 
-import os
 from functools import cache
 
 import numpy as np
+
+from foldopt.folders import write_atomically
 
 #: 30-arc-second cells per cell of the cached land fraction (5 arc minutes, ~9 km).
 _FACTOR = 10
@@ -49,9 +50,8 @@ def land_fraction() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     longitude = -180 + step * (np.arange(columns) + 0.5)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        temporary = path.with_name(f".{path.stem}.tmp-{os.getpid()}.npz")
-        np.savez_compressed(temporary, latitude=latitude, longitude=longitude, fraction=fraction)
-        os.replace(temporary, path)
+        write_atomically(path, lambda temporary: np.savez_compressed(temporary, latitude=latitude,
+                                                                      longitude=longitude, fraction=fraction))
     except OSError:
         pass  # an unwritable cache means building it again next time, not an error
     return latitude, longitude, fraction

@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from foldopt.aggregation import SWITCH_STATES  # noqa: E402
-from foldopt.folders import staged_folder  # noqa: E402
+from foldopt.folders import staged_folder, write_atomically  # noqa: E402
 from foldopt.config import Study  # noqa: E402
 from foldopt.metrics import relative_to  # noqa: E402
 from foldopt.study import StudyResult  # noqa: E402
@@ -303,17 +303,23 @@ def _others(table: pd.DataFrame, used: tuple[str, ...], varied: list[str]) -> st
     return f" (mean over {', '.join(rest)})" if rest else ""
 
 
+def _colours(values, diverging: bool) -> dict:
+    """pcolormesh/scatter colours: red-blue around 0, symmetric over the finite ``values``, or viridis."""
+    if not diverging:
+        return {"cmap": "viridis"}
+    finite = np.asarray(np.ma.filled(np.ma.masked_invalid(values), np.nan), dtype=float)
+    finite = finite[np.isfinite(finite)]
+    bound = max(float(np.abs(finite).max()) if finite.size else 1.0, 1e-9)
+    return {"cmap": "RdBu", "vmin": -bound, "vmax": bound}
+
+
 def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label: str, diverging: bool,
              ax=None):
     """A heat map of ``value`` over ``x`` and ``y``, averaged over any other varied field."""
     grid = _mean_pivot(table, y, x, value)
     fig, ax = _axes(ax, (8, 5))
     data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
-    if diverging:
-        bound = max(float(np.nanmax(np.abs(data))) if data.count() else 1.0, 1e-9)
-        mesh = ax.pcolormesh(grid.columns, grid.index, data, cmap="RdBu", vmin=-bound, vmax=bound, shading="nearest")
-    else:
-        mesh = ax.pcolormesh(grid.columns, grid.index, data, cmap="viridis", shading="nearest")
+    mesh = ax.pcolormesh(grid.columns, grid.index, data, shading="nearest", **_colours(data, diverging))
     ax.set_facecolor("0.85")
     ax.figure.colorbar(mesh, ax=ax, label=label)
     ax.set_xlabel(_AXIS_LABELS.get(x, x))
@@ -763,12 +769,7 @@ def plot_world_map(rows: pd.DataFrame, value: str, title: str, label: str, diver
 
     fig, ax = _axes(ax, (10, 5.2))
     values = rows[value].to_numpy(dtype=float)
-    finite = values[np.isfinite(values)]
-    if diverging:
-        bound = max(float(np.abs(finite).max()) if finite.size else 1.0, 1e-9)
-        colours = {"cmap": "RdBu", "vmin": -bound, "vmax": bound}
-    else:
-        colours = {"cmap": "viridis"}
+    colours = _colours(values, diverging)
     axes = _grid_axes(rows)
     if axes is not None:
         lats, lons = axes
@@ -809,9 +810,7 @@ def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, title: 
                                                 aggfunc="median")
     fig, ax = _axes(ax, (8, 4.5))
     data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
-    bound = max(float(np.abs(data).max()) if data.count() else 1.0, 1e-9)
-    mesh = ax.pcolormesh(_edges(grid.columns, 5.0), _edges(grid.index, 0.05), data, cmap="RdBu", vmin=-bound,
-                         vmax=bound)
+    mesh = ax.pcolormesh(_edges(grid.columns, 5.0), _edges(grid.index, 0.05), data, **_colours(data, True))
     if data.count() > 3 and grid.shape[0] > 1 and grid.shape[1] > 1:
         ax.contour(grid.columns, grid.index, data.filled(np.nan), levels=[1.0], colors="k", linewidths=0.8)
     ax.set_facecolor("0.85")
@@ -844,12 +843,7 @@ def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, lo
 
 def _atomic_figure(path: Path, ax) -> None:
     """:func:`save_plot` under a temporary name, then renamed into ``path``."""
-    temporary = path.with_name(f".{path.stem}.tmp{path.suffix}")
-    try:
-        save_plot(ax, temporary)
-        temporary.replace(path)
-    finally:
-        temporary.unlink(missing_ok=True)
+    write_atomically(path, lambda temporary: save_plot(ax, temporary))
 
 
 # --- Answers: the few lines that say what a result means ------------------------------------

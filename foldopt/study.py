@@ -56,6 +56,14 @@ def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
     return engines.panel_power(sky, study, engines.poa(sky, *orientation))
 
 
+def standby_available(gross, draw, lit, standby_w: float):
+    """The tracker's power [W] left for the load and its standby: ``gross`` less ``draw`` but the
+    standby (its moves only), where there is light (``lit``), 0 elsewhere. A standby draw ``s``
+    (drawn wherever there is light) is then the load ``P_load + s`` on this curve, as there is no
+    power where no standby is drawn."""
+    return np.where(lit, gross - (draw - np.where(lit, standby_w, 0.0)), 0.0)
+
+
 def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
     """The tracker's own draw [W] per step over every block: standby while there is light (the sun up,
     clouds or not), plus its moves."""
@@ -302,9 +310,7 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
     if day.sky.load_shape is not None:  # a standby draw is a load shift only for a constant load
         return pd.DataFrame({"standby_w": [0.0], "tracker_net_t_solar_h": [np.nan],
                              "twofold_t_solar_h": [twofold_t_solar]}), float("nan")
-    lit = day.sky.lit[0]
-    drive_only = day.tracker_draw() - np.where(lit, study.tracker.standby_w, 0.0)
-    available = np.where(lit, p_tracker - drive_only, 0.0)
+    available = standby_available(p_tracker, day.tracker_draw(), day.sky.lit[0], study.tracker.standby_w)
     draws = np.linspace(0.0, max(2.0 * study.p_load, 1e-3), points)
     hours = t_solar(available, study.p_load + draws, step)
     load = load_for_t_solar(available, twofold_t_solar, step) if twofold_t_solar > 0 else np.nan

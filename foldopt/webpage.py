@@ -12,10 +12,11 @@ from __future__ import annotations
 import base64
 import html
 import json
-import os
 from pathlib import Path
 
 import pandas as pd
+
+from foldopt.folders import write_atomically
 
 #: Rows of a table that a page shows; the CSV beside it has them all.
 MAX_ROWS = 2000
@@ -156,11 +157,4 @@ def write_html(folder: Path, title: str, question: dict, answer: list[str], figu
             '<meta name="viewport" content="width=device-width, initial-scale=1">'
             f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head>\n<body>\n"
             + "\n".join(parts) + f"\n<script>{_SCRIPT}</script>\n</body></html>\n")
-    path = folder / "report.html"
-    temporary = folder / f".report.html.tmp-{os.getpid()}"
-    try:
-        temporary.write_text(page, encoding="utf-8")
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-    return path
+    return write_atomically(folder / "report.html", lambda temporary: temporary.write_text(page, encoding="utf-8"))

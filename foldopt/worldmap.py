@@ -32,7 +32,7 @@ from pydantic import ValidationError
 from foldopt import engine as engines
 from foldopt.config import ConfigError, Site, Study, _format_errors, parse_dates
 from foldopt.sweeps import Blocks, _best_angle_index, fold_hours, objective_value
-from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
+from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power, standby_available
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
@@ -237,11 +237,7 @@ def _evaluate_site(study_data: dict, site: dict, loads, relative: bool, year: in
         metrics = engines.curve_metrics(np.concatenate([gross, gross - draw]), usable, step_hours, engine=engine)
         tracker.append((metrics.t_solar[:sky.n_blocks, 0], metrics.t_solar[sky.n_blocks:, 0],
                         metrics.energy[:sky.n_blocks, 0]))
-        # The tracker's power less its moves (not its standby) where there is light, as
-        # foldopt.study.standby_sweep: there is no power elsewhere, so a standby draw s is a load
-        # raised by s.
-        lit = sky.lit
-        available.append(np.where(lit, gross - (draw - np.where(lit, study.tracker.standby_w, 0.0)), 0.0))
+        available.append(standby_available(gross, draw, sky.lit, study.tracker.standby_w))
     hours = np.concatenate(hours).transpose(0, 2, 1)  # (days, loads, angles)
     harvest = np.concatenate(harvest)  # (days, angles)
     flat_hours, flat_energy = np.concatenate(flat_hours), np.concatenate(flat_energy)
