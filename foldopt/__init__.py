@@ -32,6 +32,7 @@ _PUBLIC = {
         "plot_map", "plot_curves", "plot_sizing", "plot_annual_fold_angles", "plot_monthly", "plot_distribution",
         "plot_day_hour", "plot_world_map", "plot_latitude_load", "plot_refold_value", "save_plot")},
     "best_schedules": "foldopt.schedule", "LoadProfile": "foldopt.config",
+    "twofold_arrays": "foldopt.pvsystem",
 }
 __all__ = ["__version__", *_PUBLIC]
 

@@ -12,7 +12,7 @@ Examples
 28.5
 >>> float(result.summary.set_index("design").loc["flat", "t_solar_h"].round(2))   # the paper's 7.73 h
 7.73
->>> table = foldopt.sweep(study.variant(mode="exact"), latitude=[0, 20, 40]).table
+>>> table = foldopt.sweep(study, latitude=[0, 20, 40]).table
 """
 
 from __future__ import annotations
@@ -20,15 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from foldopt.config import ConfigError, Plan, Study, default_study_path, load_plan, make_plan, set_path
-
-#: Short keywords of :func:`sweep` for fields inside a section of the study.
-SWEEP_KEYWORDS = {
-    "latitude": "site.latitude", "longitude": "site.longitude", "altitude": "site.altitude",
-    "timezone": "site.timezone", "area": "panel.area", "efficiency": "panel.efficiency", "tilt": "panel.tilt",
-    "azimuth": "panel.azimuth", "standby_w": "tracker.standby_w",
-}
-
+from foldopt.config import ConfigError, Plan, Study, default_study_path, load_plan
 
 def default_study() -> Study:
     """The embedded study: Shin et al.'s pole camera in Los Angeles on the 2014 autumn equinox
@@ -97,13 +89,22 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
     return run_study(study, engine)
 
 
-def sweep(study: Study, *, axes: dict | None = None, engine: str = "numba",
+def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, engine: str = "numba",
           progress: Callable[[float, int], None] | None = None, **fields):
-    """Evaluate a study at every combination of the values of some fields.
+    """Evaluate a study at every combination of the values of some fields, as ``foldopt sweep`` does.
+
+    The request goes through :func:`foldopt.request.plan_request`, as the command line's does, so
+    ``foldopt.sweep(foldopt.default_study(), latitude=[0, 20])`` and ``foldopt sweep latitude
+    --lat 0,20`` give the same table to the bit: a paper-mode study given another site or day
+    runs in exact mode with the hinge geometry, and a new latitude tilts the panel at
+    ``|latitude|`` toward the equator, unless those fields are given.
 
     Parameters
     ----------
     study : Study
+    over : {'angle', 'latitude', 'day', 'load'}, optional
+        A sweep's own axis, over its default range where ``fields`` leave it out (latitude
+        -60:60:5, day 1:365:7, 20 loads up to the panel's rating); ``angle`` is one case.
     axes : dict, optional
         Dotted field paths to values, for any field (``{"tracker.gcr": [0.3, 0.4]}``).
     engine : {'numba', 'numpy'}
@@ -111,9 +112,9 @@ def sweep(study: Study, *, axes: dict | None = None, engine: str = "numba",
         ``progress(done, total)`` in days.
     **fields
         Field names (``p_load``, ``date``, ``pv_model``...) or the short names of
-        :data:`SWEEP_KEYWORDS` (``latitude``, ``area``, ``tilt``...) to a sequence of values or a
-        range ``"start:stop:step"``; ``date`` also takes ``"year"``. A swept latitude tilts the
-        panel at ``|latitude|`` toward the equator unless the study fixes its tilt.
+        :data:`foldopt.request.KEYWORDS` (``latitude``, ``area``, ``tilt``, ``visits``...): a
+        value sets the field, a sequence or a range ``"start:stop:step"`` sweeps it; ``date``
+        also takes ``"year"``, ``objective`` a statistic (``"worst-month"``).
 
     Returns
     -------
@@ -121,33 +122,39 @@ def sweep(study: Study, *, axes: dict | None = None, engine: str = "numba",
         ``table``: one row per case (``site_name``, ``latitude``, ``longitude``, ``date``,
         ``day_of_year``, ``p_load_w`` and any other swept field) and design (``flat``, ``twofold``,
         ``tracker``, ``tracker-net``), with ``fold_angle_deg``, ``t_solar_h`` and the other daily
-        metrics. With an ``objective`` and several dates, one fold angle per case for all of them.
+        metrics; ``answer``, the :class:`foldopt.answer.Answer` every view renders. With an
+        ``objective`` and several dates, one fold angle per case for all of them.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One line per fault, naming the field.
 
     Examples
     --------
     >>> import foldopt
-    >>> study = foldopt.default_study().variant(mode="exact")
-    >>> result = foldopt.sweep(study, latitude=[0, 30], p_load=[2.0, 4.0])
+    >>> result = foldopt.sweep(foldopt.default_study(), latitude=[0, 30], p_load=[2.0, 4.0])
     >>> len(result.table)
     16
     """
-    changes = {SWEEP_KEYWORDS.get(name, name): values for name, values in fields.items()}
-    changes.update(axes or {})
-    if not changes:
+    from foldopt.request import KEYWORDS, plan_request
+
+    changes = {KEYWORDS.get(name, name): _plain_values(values) for name, values in fields.items()}
+    changes.update({path: _plain_values(values) for path, values in (axes or {}).items()})
+    if not changes and over is None:
         raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
-    data = study.model_dump(mode="json", exclude_none=True)
-    for path, values in changes.items():
-        if isinstance(values, str):
-            value = values
-        elif isinstance(values, Sequence) or hasattr(values, "tolist"):
-            value = [item.item() if hasattr(item, "item") else item for item in values]
-            value = [item.isoformat() if hasattr(item, "isoformat") else item for item in value]
-        else:
-            value = [values]
-        data = set_path(data, path, value)
+    request = plan_request(study.data(), changes, axis=over)
     from foldopt.sweeps import run_plan
 
-    return run_plan(make_plan(data), progress, engine)
+    return run_plan(request.plan, progress, engine, request)
+
+
+def _plain_values(values):
+    """A sequence (a list, a tuple, an array) as a list of plain values; text and scalars as they are."""
+    if isinstance(values, (str, dict)) or not (isinstance(values, Sequence) or hasattr(values, "tolist")):
+        return values.item() if hasattr(values, "item") else values
+    items = [item.item() if hasattr(item, "item") else item for item in values]
+    return [item.isoformat() if hasattr(item, "isoformat") else item for item in items]
 
 
 def write(result, out: str | Path, overwrite: bool = False, command: list[str] | None = None) -> Path:

@@ -24,8 +24,10 @@ import typer
 from typer.core import TyperGroup
 
 from foldopt import names
-from foldopt.config import (DATE_KEYWORDS, ConfigError, default_study_path, load_plan, make_plan, parse_range,
-                            parse_study_text, read_study, set_path)
+from foldopt.config import (ConfigError, default_study_path, load_plan, parse_range, parse_study_text, parse_values,
+                            read_study)
+from foldopt.policy import set_path
+from foldopt.request import plan_request
 from foldopt.folders import OutputError, OutputExistsError, check_output
 
 RESULTS = Path("results")
@@ -416,8 +418,6 @@ def _sweep_options(
     """The options of every sweep (its signature is theirs)."""
 
 
-#: Each sweep's own default range where its option is not given.
-_AXIS_OPTION = {"angle": None, "latitude": "lat", "day": "days", "load": "p_load"}
 _SWEEP_HELP = {
     "angle": ("Every fold angle at one site, day and load (sweep.csv, summary.csv, the paper's plots). With a "
               "weather file: one fold angle for the file's whole year (--objective, default mean).",
@@ -459,153 +459,73 @@ def _sweep(axis: str, options: dict) -> None:
     output_format, engine = _check_choices(options.pop("output_format"), options.pop("engine"))
     output = _Output(options.pop("quiet"), output_format, options.pop("table"))
     out, overwrite = options.pop("out"), options.pop("overwrite")
+    config = options.pop("config")
+    source = EMBEDDED if config is None else str(config)
+    data, _ = read_study(config if config is not None else default_study_path())
     try:
-        plan, defaults = _sweep_plan(axis, options)
+        changes = _sweep_changes(options, data)
+        changes["description"] = f"foldopt sweep {axis} from {source} (see command)"
+        request = plan_request(data, changes, axis=axis, source=source, name=f"sweep-{axis}")
     except ConfigError as error:
         _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
-    varied = [path for path, _ in plan.axes if not (path == "date" and plan.base.objective is not None)]
-    if axis == "angle" and varied:
-        _fail([f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep latitude, day or load)"])
-    _run_plan(plan, out or RESULTS / f"sweep-{axis}", overwrite, output, engine, defaults, f"sweep {axis}")
+    _run_plan(request.plan, out or RESULTS / f"sweep-{axis}", overwrite, output, engine,
+              [request.source, *request.taken] if request.taken else [], f"sweep {axis}")
 
 
-def _sweep_plan(axis: str, options: dict):
-    """The plan of a sweep: the study (embedded, or --config), the options given over it, the axis's
-    default range; and, for the summary, the study's values the options left in place."""
-    config = options.pop("config")
-    path = config if config is not None else default_study_path()
-    data, _ = read_study(path)
-    data = dict(data)
-    source_mode = data.get("mode")
-    given = {key for key, value in options.items() if value not in (None, False, [])}
-    weather = options["weather"]
-    site = dict(data.get("site") or {})
-    panel = dict(data.get("panel") or {})
-    if weather is not None:
-        data["weather"] = str(weather)
-        data.pop("sky", None)  # the file's light is shaped by its own clear sky
-        if not given & {"lat", "lon"}:
-            site = {}  # the file's site
-        if "days" not in given:
-            data.pop("date", None)  # the file's year
-        if axis == "angle" and "objective" not in given and not ("days" in given and _single(options["days"])):
-            options["objective"] = "mean"  # a year of weather at one fold angle
-    # Paper mode is the paper's beam-only Eq. 5, fair for its sun-facing panel on its day; at the
-    # equator it would give a level panel no beam at all, and a weather file's diffuse light is lost.
-    elsewhere = bool(given & {"lat", "lon", "days", "weather"}) or axis in ("latitude", "day")
-    if config is None and "mode" not in given and elsewhere:
-        data["mode"] = "exact"
-    if given & {"lat", "lon"} or axis == "latitude":
-        site.pop("name", None)
-    if "lon" in given and "timezone" not in given:
-        site.pop("timezone", None)  # the new longitude's standard offset
-    if (axis == "latitude" or "lat" in given) and not given & {"tilt", "azimuth"}:
-        panel.pop("tilt", None)  # |latitude|, facing the equator
-        panel.pop("azimuth", None)
-    if axis == "latitude" and "lat" not in given:
-        options["lat"] = "-60:60:5"
-    if axis == "day" and "days" not in given:
-        options["days"] = "1:365:7"
-    study_year = re.match(r"^(\d{4})-\d\d-\d\d$", str(data.get("date", "")))
-    if "year" not in given and "year" not in data and study_year:
-        options["year"] = int(study_year.group(1))  # days of year are the study's year's
-    if axis == "load" and "p_load" not in given:
-        rating = float(options["area"] or panel.get("area", 0.1)) * 1000.0 * float(
-            options["efficiency"] or panel.get("efficiency", 0.2))
-        options["p_load"] = [round(rating * share / 20, 4) for share in range(1, 21)]
-    option = _AXIS_OPTION[axis]
-    if axis != "angle" and option in given and _single(options[option]):
-        flag = _OPTION_OF_FIELD[{"lat": "site.latitude", "days": "date", "p_load": "p_load"}[option]]
-        raise ConfigError([f"{flag}: sweep {axis} needs a range start:stop:step or a list"])
-    if (options["mode"] or data.get("mode")) != source_mode and "geometry" not in given:
-        data.pop("geometry", None)  # the new mode's own geometry
-    for key, field in (("lat", "latitude"), ("lon", "longitude"), ("altitude", "altitude"), ("timezone", "timezone")):
-        if options[key] is not None:
-            site[field] = options[key]
-    for key, field in (("area", "area"), ("efficiency", "efficiency"), ("tilt", "tilt"), ("azimuth", "azimuth")):
-        if options[key] is not None:
-            panel[field] = options[key]
-    data["site"], data["panel"] = site or None, panel
-    data["name"] = f"sweep-{axis}"
-    data["description"] = f"foldopt sweep {axis} from {EMBEDDED if config is None else config} (see command)"
-    simple = {"days": "date", "year": "year", "p_load": "p_load", "mode": "mode", "geometry": "geometry", "sky": "sky",
-              "climate": "climate", "transposition": "transposition", "albedo": "albedo", "iam": "iam",
-              "pv_model": "pv_model", "module": "module", "connection": "connection",
-              "converter_efficiency": "converter_efficiency", "temp_air": "temp_air", "step_min": "step_min"}
-    for key, field in simple.items():
-        if options[key] is not None:
-            data[field] = options[key]
-    for key, field in (("switch_series", "switch_series"), ("exact_electrical", "exact_electrical"),
-                       ("force_site", "force_site")):
-        if options[key]:
-            data[field] = True
-    if options["no_bypass"]:
-        data["bypass_diodes"] = False
-    if options["load_profile"] is not None:
-        data["load_profile"] = {"file": str(options["load_profile"])}
+#: Sweep options -> the study field each sets (the request's changes; foldopt.request does the rest).
+_FIELD_OF_OPTION = {
+    "lat": "site.latitude", "lon": "site.longitude", "altitude": "site.altitude", "timezone": "site.timezone",
+    "days": "date", "year": "year", "p_load": "p_load", "p_load_scale": "p_load", "area": "panel.area",
+    "efficiency": "panel.efficiency", "tilt": "panel.tilt", "azimuth": "panel.azimuth", "mode": "mode",
+    "geometry": "geometry", "sky": "sky", "climate": "climate", "weather": "weather", "force_site": "force_site",
+    "transposition": "transposition", "albedo": "albedo", "iam": "iam", "objective": "objective.statistic",
+    "visits": "objective.visits", "tracker": "tracker.model", "tracker_standby": "tracker.standby_w",
+    "pv_model": "pv_model", "module": "module", "connection": "connection", "switch_series": "switch_series",
+    "no_bypass": "bypass_diodes", "converter_efficiency": "converter_efficiency", "temp_air": "temp_air",
+    "exact_electrical": "exact_electrical", "step_min": "step_min", "angle_step": "fold_angles.step",
+    "load_profile": "load_profile",
+}
+#: Options that take a value, a range or a list (:func:`foldopt.config.parse_values`).
+_LISTED = ("lat", "lon", "p_load", "p_load_scale", "tilt", "days")
+#: Flags and what each sets its field to.
+_FLAGS = {"switch_series": True, "exact_electrical": True, "force_site": True, "no_bypass": False}
+
+
+def _sweep_changes(options: dict, data: dict) -> dict:
+    """The fields a sweep's options change, by field path; ``--set`` last."""
+    changes, errors = {}, []
     if options["p_load_scale"] is not None:
-        if "p_load" in given:
-            raise ConfigError(["--p-load / --p-load-scale: a constant load or a profile's scale, not both"])
-        if data.get("load_profile") is None:
-            raise ConfigError(["--p-load-scale: scales a load profile; give one with --load-profile (or load_profile "
-                               "in the study)"])
-        data["p_load"] = options["p_load_scale"]
-    elif options["load_profile"] is not None and "p_load" not in given:
-        data["p_load"] = 1.0  # the profile as written, not the study's constant load
-    if options["objective"] is not None:
-        data["objective"] = {"statistic": options["objective"]}
-    if options["visits"] is not None:
-        data["objective"] = {**(data.get("objective") or {"statistic": "mean"}), "visits": options["visits"]}
-    if options["tracker"] is not None or options["tracker_standby"] is not None:
-        tracker = data.get("tracker")
-        tracker = dict(tracker) if isinstance(tracker, dict) else ({"model": tracker} if tracker else {})
-        if options["tracker"] is not None:
-            tracker = {"model": options["tracker"], **({"standby_w": tracker["standby_w"]} if "standby_w" in tracker
-                                                       else {})}
-        if options["tracker_standby"] is not None:
-            tracker["standby_w"] = options["tracker_standby"]
-        data["tracker"] = tracker
-    if options["angle_step"] is not None:
-        data["fold_angles"] = {"start": options["angle_step"], "stop": 180.0, "step": options["angle_step"]}
-    if data.get("site") is None:
-        data.pop("site")
+        if options["p_load"] is not None:
+            errors.append("--p-load / --p-load-scale: a constant load or a profile's scale, not both")
+        elif data.get("load_profile") is None and options["load_profile"] is None:
+            errors.append("--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
+                          "the study)")
+    for option, value in options.items():
+        if option == "settings" or value is None or value is False:
+            continue
+        if option in _FLAGS:
+            value = _FLAGS[option]
+        elif option in _LISTED:
+            try:
+                value = parse_values(value, numeric=option != "days")
+            except ValueError as error:
+                flag = "--" + option.replace("_", "-")
+                errors.append(f"{flag} = {options[option]!r}: {error}")
+                continue
+        elif option == "weather":
+            value = str(value)
+        elif option == "load_profile":
+            value = {"file": str(value)}
+        changes[_FIELD_OF_OPTION[option]] = value
+    if errors:
+        raise ConfigError(errors)
     for setting in options["settings"] or ():
-        data = _apply_setting(data, setting)
-    plan = make_plan(data)
-    return plan, _defaults(path, plan.base, axis, options, given)
+        changes.update([_setting(setting)])
+    return changes
 
 
-def _defaults(path: Path, study, axis: str, options: dict, given: set) -> list[str]:
-    """What a sweep took from its study and its own defaults, for the summary: the source first."""
-    source = EMBEDDED if path == default_study_path() else str(path)
-    weather = "weather" in given
-    taken = []
-    option = _AXIS_OPTION[axis]
-    if option is not None and option not in given and not (option == "p_load" and "p_load_scale" in given):
-        if option == "p_load":
-            taken.append(f"20 loads, 5 % to 100 % of {options['p_load'][-1]:g} W (default range)")
-        else:
-            year = f" of {options['year']}" if option == "days" and options.get("year") else ""
-            taken.append(f"{axis} {options[option]}{year} (default range)")
-    if not given & {"lat", "lon"} and not weather and axis != "latitude":
-        taken.append(f"site {study.site.latitude:g}, {study.site.longitude:g}")
-    if "days" not in given and not weather and axis != "day":
-        taken.append(f"date {study.date}")
-    if "area" not in given:
-        taken.append(f"panel {study.panel.area:g} m^2")
-    if "p_load" not in given and axis != "load":
-        taken.append(f"P_load {study.p_load:g} W")
-    if "mode" not in given:
-        switched = study.mode == "exact" and source == EMBEDDED
-        taken.append("exact mode (paper mode is for the paper's own site and day: --mode paper)" if switched
-                     else f"{study.mode} mode")
-    if "pv_model" not in given:
-        taken.append(f"{study.pv_model} PV model")
-    return [source, *taken] if taken else []
-
-
-def _apply_setting(data: dict, setting: str) -> dict:
-    """``KEY=VALUE`` into the study's data: a dotted field path and a YAML value."""
+def _setting(setting: str) -> tuple[str, object]:
+    """``KEY=VALUE``: a dotted field path and a YAML value."""
     key, separator, text = setting.partition("=")
     if not separator or not key.strip():
         raise ConfigError([f"--set = {setting!r}: expected KEY=VALUE, e.g. tracker.gcr=0.4"])
@@ -613,15 +533,10 @@ def _apply_setting(data: dict, setting: str) -> dict:
         value, _ = parse_study_text(text, f"--set {key}")
     except ConfigError:
         raise ConfigError([f"--set {key} = {text!r}: not a YAML value"]) from None
-    return set_path(data, key.strip(), value)
+    return key.strip(), value
 
 
-def _single(value) -> bool:
-    text = str(value)
-    return not isinstance(value, list) and ":" not in text and "," not in text and text not in DATE_KEYWORDS
-
-
-for _axis in _AXIS_OPTION:
+for _axis in _SWEEP_HELP:
     _register_sweep(_axis)
 
 
@@ -629,14 +544,13 @@ for _axis in _AXIS_OPTION:
 
 
 def _values(option: str, text: str) -> list[float]:
-    """A number, a range start:stop:step or a comma-separated list, for ``option``."""
+    """A value, a range start:stop:step or a comma list for ``option``, as a list
+    (:func:`foldopt.config.parse_values`, the parser of every sweep axis too)."""
     try:
-        if ":" in text:
-            return parse_range(text)
-        return [float(part) for part in text.split(",") if part.strip()] or _fail([f"{option}: no values"])
+        values = parse_values(text)
     except ValueError as error:
-        _fail([f"{option} = {text!r}: {error}" if "expected" in str(error) or "range" in str(error)
-               else f"{option} = {text!r}: expected a number, a range start:stop:step or a list a,b,c"])
+        _fail([f"{option} = {text!r}: {error}"])
+    return values if isinstance(values, list) else [values]
 
 
 @app.command("map", short_help="Many sites on Dask: best fold angle, gains and tracker share worldwide.")
@@ -748,7 +662,7 @@ def map_(
         changes["fold_angles"] = {"start": angle_step, "stop": 180.0, "step": angle_step}
     study = map_study(data, embedded=config is None, **changes)
     for setting in settings or ():
-        study = _apply_setting(study, setting)
+        study = set_path(study, *_setting(setting))
     if sites is not None:
         site_list = read_sites(sites)
     elif weather_dir is not None:

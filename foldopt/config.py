@@ -32,8 +32,9 @@ from pydantic import (
     model_validator,
 )
 
-from foldopt import names
+from foldopt import names, policy
 from foldopt.names import ALEXANDRU_STEP_OFFSETS_H, canonical
+from foldopt.policy import set_path
 
 DEFAULT_STUDY = "shin2015"
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
@@ -286,6 +287,22 @@ class FoldAngles(_Strict):
         return angles if math.isclose(angles[-1], self.stop) else [*angles, self.stop]
 
 
+class NearOptimal(_Strict):
+    """How close to the best a fold angle must come to count as near-optimal: within ``fraction``
+    of the best t_solar (or objective) or within ``minutes``, whichever is larger. The optimum of a
+    fold angle is a plateau; the near-optimal range is every grid angle on the best one's plateau
+    and the recommended angle its centre, robust to how precisely an installer sets a hinge."""
+
+    fraction: _interval(0, 1) = 0.01
+    minutes: _interval(0, 1440, unit=" min") = 1.0
+
+    def tolerance_h(self, best_h):
+        """The tolerance [h] around a best value ``best_h`` [h] (broadcast)."""
+        import numpy as np
+
+        return np.maximum(self.fraction * np.asarray(best_h, dtype=float), self.minutes / 60.0)
+
+
 class Study(_Strict):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=100)]
     description: str = ""
@@ -301,6 +318,7 @@ class Study(_Strict):
         None, description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact"
     )
     fold_angles: FoldAngles = FoldAngles()
+    near_optimal: NearOptimal = NearOptimal()
     sky: _named(names.SKIES) = "meinel"
     linke_turbidity: _interval(0, 10, lo_open=True) | None = Field(None, description="ineichen; default pvlib's climatology")
     transposition: _named(names.TRANSPOSITIONS) | None = Field(
@@ -338,6 +356,12 @@ class Study(_Strict):
     @classmethod
     def _weather_by_path(cls, value):
         return {"path": value} if isinstance(value, str) else value
+
+    @field_validator("objective", mode="before")
+    @classmethod
+    def _objective_by_statistic(cls, value):
+        """``objective: worst-month`` is ``objective: {statistic: worst-month}``."""
+        return {"statistic": value} if isinstance(value, str) else value
 
     @model_validator(mode="before")
     @classmethod
@@ -436,8 +460,44 @@ class Study(_Strict):
         return module
 
     def variant(self, **changes) -> Study:
-        """A validated copy with ``changes`` (field names to new values, mappings allowed)."""
-        return Study.model_validate({**self.model_dump(), **changes})
+        """A validated copy with ``changes``, made by the study policy (:func:`foldopt.policy.apply`).
+
+        Parameters
+        ----------
+        **changes
+            Field names to new values. A mapping for a section (``site``, ``panel``, ``tracker``,
+            ``objective``, ``fold_angles``, ``near_optimal``) changes only the fields it names:
+            ``variant(panel={"area": 0.1})`` keeps the efficiency, tilt and azimuth. As for the
+            command line, a paper-mode study given another site or day runs in exact mode, a new
+            mode takes its own geometry and a new latitude tilts the panel at ``|latitude|``,
+            unless those fields are given too.
+
+        Returns
+        -------
+        Study
+
+        Raises
+        ------
+        foldopt.ConfigError
+            One ``field = value: problem`` line per fault.
+
+        Examples
+        --------
+        >>> import foldopt
+        >>> study = foldopt.default_study().variant(site={"latitude": 10.0})
+        >>> study.mode, study.geometry, study.panel.tilt, study.panel.efficiency
+        ('exact', None, None, 0.1905)
+        """
+        data, _ = policy.apply(self.data(), changes)
+        return make_study(data)
+
+    def data(self) -> dict:
+        """The study's fields as plain data that validate back into it (``date`` as text, no
+        unset field; a profile read from a file keeps its file, not the steps read from it)."""
+        data = self.model_dump(mode="json", exclude_none=True)
+        if self.load_profile is not None and self.load_profile.file is not None:
+            data["load_profile"].pop("daily", None)
+        return data
 
     def resolved(self) -> Study:
         """The study with every default that depends on other fields (site, mode) filled in.
@@ -578,6 +638,46 @@ def parse_range(text: str) -> list[float]:
     return [round(start + i * step, 12) for i in range(count)]
 
 
+def parse_values(text: str, numeric: bool = True):
+    """The one parser of a value, a range or a list, as typed on the command line.
+
+    ``"5"`` is a value, ``"0:60:10"`` a range (inclusive, :func:`parse_range`) and ``"0,30,60"`` a
+    list; with ``numeric=False`` (dates) the items stay text and a range or keyword (``year``)
+    is left to :func:`parse_dates`.
+
+    Returns
+    -------
+    float, str or list
+        A value, or a list for a range or a list.
+
+    Raises
+    ------
+    ValueError
+        For an empty text or item, a malformed range, a value that is not a number, or more than
+        :data:`MAX_AXIS_VALUES` values.
+    """
+    text = str(text).strip()
+    if not text:
+        raise ValueError("no value; give a value, a range start:stop:step or a list a,b,c")
+    items = [item.strip() for item in text.split(",")]
+    if any(not item for item in items):
+        raise ValueError(f"{text!r} has an empty item; a list is a,b,c")
+    if len(items) > MAX_AXIS_VALUES:
+        raise ValueError(f"a list of {len(items):,} values; at most {MAX_AXIS_VALUES:,} per axis "
+                         "(FOLDOPT_MAX_AXIS_VALUES raises it)")
+    if not numeric:
+        return items if len(items) > 1 else items[0]
+    if len(items) == 1 and ":" in text:
+        return parse_range(text)
+    try:
+        values = [float(item) for item in items]
+    except ValueError:
+        raise ValueError(f"{text!r}: expected a number, a range start:stop:step or a list a,b,c") from None
+    if not all(math.isfinite(value) for value in values):
+        raise ValueError(f"{text!r}: values must be finite numbers")
+    return values if len(values) > 1 else values[0]
+
+
 def parse_dates(spec, year: int) -> list[dt.date]:
     """Dates from a date, a list, ``"start:stop:step"`` (dates, or days of ``year``), ``year`` or
     ``equinoxes-solstices`` (20 March, 21 June, 23 September, 21 December of ``year``)."""
@@ -617,21 +717,6 @@ def parse_dates(spec, year: int) -> list[dt.date]:
 
 def _leap(year: int) -> bool:
     return year % 4 == 0 and (year % 100 != 0 or year % 400 == 0)
-
-
-def set_path(data: dict, path: str, value) -> dict:
-    """A copy of ``data`` with the dotted ``path`` set to ``value``."""
-    out = copy.deepcopy(data)
-    node = out
-    parts = path.split(".")
-    for part in parts[:-1]:
-        child = node.get(part)
-        if not isinstance(child, dict):
-            child = {}
-        node[part] = child
-        node = child
-    node[parts[-1]] = value
-    return out
 
 
 @dataclass(frozen=True)

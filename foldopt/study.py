@@ -21,55 +21,10 @@ from foldopt.metrics import (energy_served, load_for_t_solar, metric_columns, no
                              t_solar)
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.sizing import flat_area_multiple
-from foldopt.sky import Sky, build_sky
-from foldopt.tracker import (
-    TRACKERS,
-    TrackerDrive,
-    TrackerOptions,
-    tracker_draw,
-    tracker_orientation,
-)
-
-
-def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
-    """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each
-    (default: the study's tracker)."""
-    tracker = study.tracker
-    options = TrackerOptions(
-        steps=tracker.steps, angular_field=tracker.angular_field,
-        step_offsets_h=tuple(tracker.step_offsets_h or TrackerOptions().step_offsets_h),
-        axis_tilt=tracker.axis_tilt, axis_azimuth=tracker.axis_azimuth, max_angle=tracker.max_angle,
-        backtrack=tracker.backtrack, gcr=tracker.gcr,
-    )
-    return tracker_orientation(
-        model or tracker.model, sky.solar_zenith, sky.solar_azimuth, sky.hour_angle, sky.declination,
-        np.asarray(sky.latitude)[:, None], options,
-    )
-
-
-def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
-    """Power [W] of the study's panel on a tracker of that ``orientation`` over every block.
-
-    Trackers take the exact angle of incidence in both modes: Eq. 5 is the paper's formula for its
-    fixed panels (it reads an azimuth even for a level panel, which a single-axis tracker is at
-    noon), and for the paper's only tracker, the ideal one, both give 1."""
-    return engines.panel_power(sky, study, engines.poa(sky, *orientation))
-
-
-def standby_available(gross, draw, lit, standby_w: float):
-    """The tracker's power [W] left for the load and its standby: ``gross`` less ``draw`` but the
-    standby (its moves only), where there is light (``lit``), 0 elsewhere. A standby draw ``s``
-    (drawn wherever there is light) is then the load ``P_load + s`` on this curve, as there is no
-    power where no standby is drawn."""
-    return np.where(lit, gross - (draw - np.where(lit, standby_w, 0.0)), 0.0)
-
-
-def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
-    """The tracker's own draw [W] per step over every block: standby while there is light (the sun up,
-    clouds or not), plus its moves."""
-    tracker = study.tracker
-    drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
-    return tracker_draw(*orientation, sky.lit, sky.step_hours, drive)
+from foldopt.designs import (near_optimal, sky_tracker_draw, sky_tracker_orientation, sky_tracker_power,
+                             standby_available)
+from foldopt.sky import build_sky
+from foldopt.tracker import TRACKERS
 
 
 class Day:

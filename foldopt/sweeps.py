@@ -20,17 +20,11 @@ import numpy as np
 import pandas as pd
 
 from foldopt import engine as engines
-from foldopt.config import Plan, Study
-from foldopt.metrics import energy, energy_served, metric_columns, notes, relative_to
-from foldopt.sky import Sky, build_sky
-from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power
-
-DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
-#: Rows (blocks x fold angles) x loads of one engine call: bounds the memory of a chunk.
-CHUNK_ROW_LOADS = 4_000_000
-#: Time steps of the blocks of one chunk's sky.
-CHUNK_STEPS = 1_100_000
-
+from foldopt.config import Plan
+from foldopt.designs import (DESIGNS, Blocks, best_angle_index, design_metrics, fold_hours, near_optimal,
+                             objective_value, setup_key, worst_month)
+from foldopt.metrics import notes, relative_to
+from foldopt.sky import Sky
 
 @dataclass(frozen=True)
 class SweepResult:
@@ -41,6 +35,7 @@ class SweepResult:
     extras: dict = dataclasses.field(default_factory=dict)  # day x hour curves of an annual objective
     engine: str = "numba"
     weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
+    request: object = None  # the foldopt.request.Request the plan came from, if any
 
 
     @property
@@ -56,164 +51,8 @@ CASE_COLUMNS = ("site_name", "latitude", "longitude", "date", "day_of_year", "p_
 _AXIS_COLUMNS = frozenset({"site", "site.name", "site.latitude", "site.longitude", "date", "p_load"})
 
 
-def _best_angle_index(hours):
-    """Index of the longest t_solar along the last axis; ties go to the least folded angle."""
-    return hours.shape[-1] - 1 - np.argmax(hours[..., ::-1], axis=-1)
-
-
-def _setup_key(study: Study) -> str:
-    """What the blocks of one engine call share: everything but the site, the date and the load
-    (and the panel's orientation, which follows the site)."""
-    data = study.model_dump(mode="json", exclude={"site", "date", "p_load", "name", "description"})
-    data["panel"] = {k: v for k, v in data["panel"].items() if k not in ("tilt", "azimuth")}
-    return json.dumps(data, sort_keys=True)
-
-
-@dataclass(frozen=True)
-class Blocks:
-    """Blocks that share one setup (:func:`_setup_key`): the study's settings at each (site, date),
-    and each block's flat panel orientation [deg]."""
-
-    study: Study
-    sites: tuple
-    dates: tuple
-    tilt: np.ndarray
-    azimuth: np.ndarray
-
-    @classmethod
-    def of(cls, studies) -> Blocks:
-        """One block per study (its site, date and panel)."""
-        resolved = [s.resolved() for s in studies]
-        return cls(resolved[0], tuple(s.site for s in resolved), tuple(s.date for s in resolved),
-                   np.array([s.panel.tilt for s in resolved]), np.array([s.panel.azimuth for s in resolved]))
-
-    @classmethod
-    def of_dates(cls, study: Study, dates) -> Blocks:
-        """The days of one study at its own site."""
-        study = study.resolved()
-        count = len(dates)
-        return cls(study, (study.site,) * count, tuple(dates), np.full(count, study.panel.tilt),
-                   np.full(count, study.panel.azimuth))
-
-    def __len__(self) -> int:
-        return len(self.dates)
-
-    def __getitem__(self, part: slice) -> Blocks:
-        return Blocks(self.study, self.sites[part], self.dates[part], self.tilt[part], self.azimuth[part])
-
-    def sky(self) -> Sky:
-        return build_sky(self.study, self.sites, self.dates)
-
-    def chunks(self, n_loads: int):
-        """Slices of blocks whose rows x loads and time steps stay within the chunk bounds."""
-        per_block = len(self.study.fold_angles.grid()) * max(n_loads, 1)
-        n_steps = round(24 * 60 / self.study.step_min)
-        size = max(1, min(CHUNK_ROW_LOADS // per_block, CHUNK_STEPS // n_steps))
-        return [slice(start, min(start + size, len(self))) for start in range(0, len(self), size)]
-
-
-def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
-    """t_solar [h] of every block's twofold panel at every angle of the grid, for every load.
-
-    Returns
-    -------
-    angles : numpy.ndarray
-        The study's fold-angle grid [deg], (n_angles,).
-    hours : numpy.ndarray
-        (n_blocks, n_angles, n_loads).
-    energy : numpy.ndarray
-        Harvested energy [Wh], (n_blocks, n_angles).
-    """
-    study = blocks.study
-    angles = np.asarray(study.fold_angles.grid())
-    orientation = engines.fold_orientations(study, blocks.tilt, blocks.azimuth, angles)
-    rows = np.repeat(np.arange(sky.n_blocks), angles.size)
-    metrics = engines.row_metrics(sky, study, rows, orientation.reshape(-1, 4), loads, outputs=(study.connection,),
-                                  engine=engine)
-    return (angles, metrics.t_solar.reshape(sky.n_blocks, angles.size, -1),
-            metrics.energy.reshape(sky.n_blocks, angles.size))
-
-
-def _design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str) -> dict:
-    """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
-    panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net."""
-    study = blocks.study
-    n_blocks, n_loads = sky.n_blocks, loads.size
-    tilt, azimuth = blocks.tilt, blocks.azimuth
-    every = engines.fold_orientations(study, tilt, azimuth, angles)
-    blocks = np.repeat(np.arange(n_blocks), n_loads)
-    # One row per block and load, at that load's angle, with the load alone.
-    twofold = engines.row_metrics(sky, study, blocks, every[blocks, chosen.ravel()], loads[:, None],
-                                  np.tile(np.arange(n_loads), n_blocks), outputs=(study.connection,),
-                                  contiguous=True, engine=engine)
-    flat = engines.row_metrics(sky, study, np.arange(n_blocks), engines.flat_orientation(tilt, azimuth), loads,
-                               outputs=("panel",), contiguous=True, engine=engine)
-    orientation = sky_tracker_orientation(sky, study)
-    gross = sky_tracker_power(sky, study, orientation)
-    tracker_poa = energy(engines.poa(sky, *orientation, incident=True), sky.step_hours)
-    net = gross - sky_tracker_draw(sky, study, orientation)
-    shape = sky.load_shape
-    trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
-                                     engine=engine, load_shape=None if shape is None else np.concatenate([shape, shape]))
-
-    def per_design(twofold_values, flat_values, tracker_values):
-        return np.stack([flat_values, twofold_values.reshape(n_blocks, n_loads), tracker_values[:n_blocks],
-                         tracker_values[n_blocks:]], axis=-1)
-
-    hours = per_design(twofold.t_solar[:, 0, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
-    served = None
-    if shape is not None:
-        # A load profile's served energy integrates P_load(t) over the solar-powered time: from the curves.
-        step = sky.step_hours
-        curves = [engines.powers(sky, study, every[np.arange(n_blocks), chosen[:, index]], series=study.switch_series
-                                 )[0][study.connection] for index in range(n_loads)]
-        twofold_served = np.stack([energy_served(curve, load, shape, step, twofold.t_solar[index::n_loads, 0, 0])
-                                   for index, (curve, load) in enumerate(zip(curves, loads, strict=True))], 1)
-        flat_curve = engines.powers(sky, study, engines.flat_orientation(tilt, azimuth), series=False)[0]["panel"]
-        served = np.stack([energy_served(flat_curve, loads, shape, step, flat.t_solar[:, 0]), twofold_served,
-                           energy_served(gross, loads, shape, step, trackers.t_solar[:n_blocks, 0]),
-                           energy_served(net, loads, shape, step, trackers.t_solar[n_blocks:, 0])], axis=-1)
-    fold = np.stack([np.full((n_blocks, n_loads), 180.0), angles[chosen], np.full((n_blocks, n_loads), np.nan),
-                     np.full((n_blocks, n_loads), np.nan)], axis=-1)
-    return {
-        "fold_angle_deg": fold,
-        **metric_columns(
-            hours,
-            per_design(twofold.t_solar_contiguous[:, 0, 0], flat.t_solar_contiguous[:, 0],
-                       trackers.t_solar_contiguous[:, 0]),
-            per_design(twofold.energy[:, 0], np.repeat(flat.energy, n_loads, axis=1),
-                       np.repeat(trackers.energy, n_loads, axis=1)),
-            per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
-                       np.repeat(trackers.peak, n_loads, axis=1)),
-            loads[None, :, None],
-            served,
-        ),
-        "poa_kwh_m2": per_design(twofold.irradiation, np.repeat(flat.irradiation[:, None], n_loads, axis=1),
-                                 np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
-        "condition": np.broadcast_to(sky.conditions()[:, None, None], hours.shape),
-    }
-
-
-def objective_value(hours, months, statistic: str, season=None):
-    """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
-
-    ``mean``, ``min``, ``pNN`` (the NN-th percentile over days) or ``worst-month`` (the lowest
-    monthly mean); ``season`` (months) restricts the days.
-    """
-    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
-    if season:
-        keep = np.isin(months, season)
-        hours, months = hours[keep], months[keep]
-    if statistic == "mean":
-        return hours.mean(axis=0)
-    if statistic == "min":
-        return hours.min(axis=0)
-    if statistic == "worst-month":
-        return np.min([hours[months == m].mean(axis=0) for m in np.unique(months)], axis=0)
-    return np.percentile(hours, float(statistic[1:]), axis=0)
-
-
-def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, engine: str = "numba") -> SweepResult:
+def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, engine: str = "numba",
+             request=None) -> SweepResult:
     """Evaluate every case of a plan: flat, optimal twofold and tracker per case.
 
     Parameters
@@ -224,6 +63,8 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
         (an annual objective passes over each day twice: halves count).
     engine : {'numba', 'numpy'}
         :data:`foldopt.engine.ENGINES`.
+    request : foldopt.request.Request, optional
+        The request the plan was made from: what the answer says it took from the study.
 
     Returns
     -------
@@ -267,7 +108,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
             results[index], group_extras = _annual_group(Blocks.of_dates(study, dates), loads, objective, advance,
                                                          engine, counted)
             extras = extras or group_extras
-            for key in REFOLD_TABLES:
+            for key in GROUP_TABLES:
                 if key in group_extras:
                     refolds.setdefault(key, []).append(group_extras[key].assign(
                         **{path: _plain(value) for path, value in choices[index].items() if path not in _AXIS_COLUMNS}))
@@ -277,15 +118,16 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
         # Cases of one setup share skies and engine calls, whatever their order in the plan.
         setups: dict[str, list[int]] = {}
         for index, study in enumerate(studies):
-            setups.setdefault(_setup_key(study), []).append(index)
+            setups.setdefault(setup_key(study), []).append(index)
         for members in setups.values():
             blocks = Blocks.of([studies[i] for i in members])
             for part in blocks.chunks(loads.size):
                 chunk = blocks[part]
                 sky = counted(chunk.sky())
                 angles, hours, _ = fold_hours(sky, chunk, loads, engine)
-                metrics = _design_metrics(sky, chunk, loads, angles, _best_angle_index(hours.transpose(0, 2, 1)),
-                                          engine)
+                hours = hours.transpose(0, 2, 1)  # (blocks, loads, angles)
+                metrics = design_metrics(sky, chunk, loads, angles, best_angle_index(hours), engine)
+                metrics.update(_twofold_only(near_optimal(angles, hours, chunk.study.near_optimal)))
                 for offset, index in enumerate(members[part]):
                     results[index] = {name: values[offset:offset + 1] for name, values in metrics.items()}
                 advance(len(chunk))
@@ -293,7 +135,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     table = _table(cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]})
     kept = {key: {"file_wh_m2": float(total), "kept_pct": float(100 * kept / total) if total else 100.0}
             for key, (total, kept) in light.items()} or None
-    return SweepResult(plan, table, extras, engine, kept)
+    return SweepResult(plan, table, extras, engine, kept, request)
 
 
 def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
@@ -309,12 +151,12 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     months = [date.month for date in blocks.dates]
     daily = np.concatenate(daily).transpose(0, 2, 1)  # (days, loads, angles)
     score = objective_value(daily, months, objective.statistic, objective.months)
-    fixed = _best_angle_index(score)  # (n_loads,)
+    fixed = best_angle_index(score)  # (n_loads,)
     metrics, series = [], {"p_twofold_w": [], "switch_state": []}
     study = blocks.study
     for part, sky in zip(parts, skies, strict=True):
         chunk = blocks[part]
-        metrics.append(_design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
+        metrics.append(design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
                                        engine))
         # The day x hour maps of the first load's angle, every day at once.
         orientation = engines.fold_orientations(study, chunk.tilt, chunk.azimuth, angles[fixed[:1]])[:, 0]
@@ -323,10 +165,11 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
         advance(len(chunk))
     clock = skies[0].grid.clock_hours[0]
-    refold = {}
+    design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (days, loads, designs)
+    near = near_optimal(angles, score, study.near_optimal)  # each (loads,)
+    refold = {"annual_objective": objective_table(blocks, loads, angles[fixed], design_hours, months, objective, near)}
     if objective.visits:
-        hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (days, loads, designs)
-        refold = refold_tables(blocks, loads, angles, daily, months, objective, hours)
+        refold.update(refold_tables(blocks, loads, angles, daily, months, objective, design_hours))
     extras = {"dates": list(blocks.dates), "hours": clock, "fold_angle": float(angles[fixed[0]]), **refold,
               **{key: np.concatenate(value) for key, value in series.items()},
               "by_angle": pd.DataFrame({
@@ -334,7 +177,48 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
                   "objective_h": score.ravel(), "mean_t_solar_h": daily.mean(axis=0).ravel(),
                   "min_t_solar_h": daily.min(axis=0).ravel(), "chosen": np.ravel(np.arange(angles.size) == fixed[:, None]),
               })}
-    return {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}, extras
+    group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
+    group.update(_twofold_only({key: np.broadcast_to(value, (len(blocks), loads.size)) for key, value in near.items()}))
+    return group, extras
+
+
+def _twofold_only(values: dict) -> dict:
+    """Per-block-and-load values of the twofold panel (blocks, loads) as per-design arrays
+    (blocks, loads, designs), NaN for the other designs."""
+    out = {}
+    for key, value in values.items():
+        full = np.full(np.shape(value) + (len(DESIGNS),), np.nan)
+        full[..., DESIGNS.index("twofold")] = value
+        out[key] = full
+    return out
+
+
+def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, objective, near) -> pd.DataFrame:
+    """The objective of one annual group in its own terms, per load and design: the statistic, its
+    value [h], for ``worst-month`` the month it is found in, the mean daily t_solar [h], the fold
+    angle kept all year and, for the twofold panel, the near-optimal range and recommended angle
+    (:func:`foldopt.designs.near_optimal`).
+
+    ``design_hours`` is (days, loads, designs) daily t_solar in :data:`DESIGNS` order."""
+    statistic = objective.statistic
+    values = objective_value(design_hours, months, statistic, objective.months)  # (loads, designs)
+    season = np.isin(months, objective.months) if objective.months else np.ones(len(months), bool)
+    month = worst_month(design_hours[season], np.asarray(months)[season]) if statistic == "worst-month" else None
+    site = blocks.study.site
+    rows = []
+    for index, load in enumerate(loads):
+        for d, design in enumerate(DESIGNS):
+            twofold = design == "twofold"
+            rows.append({
+                "site_name": site.name or "", "latitude": site.latitude, "longitude": site.longitude,
+                "p_load_w": float(load), "design": design, "objective": statistic,
+                "objective_h": float(values[index, d]),
+                "worst_month": int(month[index, d]) if month is not None else np.nan,
+                "mean_t_solar_h": float(design_hours[season][:, index, d].mean()),
+                "fold_angle_deg": float(fold_angles[index]) if twofold else (180.0 if design == "flat" else np.nan),
+                **{key: float(value[index]) if twofold else np.nan for key, value in near.items()},
+            })
+    return pd.DataFrame(rows)
 
 
 def _table(cases, loads, metrics) -> pd.DataFrame:
@@ -376,7 +260,8 @@ def _plain(value):
     return value.isoformat() if hasattr(value, "isoformat") else value
 
 
-REFOLD_TABLES = ("refold_value", "refold_schedule")
+#: The tables of every annual group, one row per load (and design, setting or visit) and group.
+GROUP_TABLES = ("annual_objective", "refold_value", "refold_schedule")
 
 
 def refold_tables(blocks: Blocks, loads, angles, daily, months, objective, design_hours) -> dict:

@@ -31,8 +31,7 @@ from pydantic import ValidationError
 
 from foldopt import engine as engines
 from foldopt.config import ConfigError, Site, Study, _format_errors, parse_dates
-from foldopt.sweeps import Blocks, _best_angle_index, fold_hours, objective_value
-from foldopt.study import sky_tracker_draw, sky_tracker_orientation, sky_tracker_power, standby_available
+from foldopt.designs import Blocks, best_angle_index, daily_designs, near_optimal, objective_value
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
@@ -221,28 +220,11 @@ def _evaluate_site(study_data: dict, site: dict, loads, relative: bool, year: in
     watts = loads * flat_peak if relative else loads
     # A load of 0 W (a site whose flat panel never sees the sun) has no t_solar to speak of.
     usable = np.where(watts > 0, watts, np.inf)
-    hours, harvest, flat_hours, flat_energy, tracker, available = [], [], [], [], [], []
-    for part, sky in zip(parts, skies, strict=True):
-        chunk = blocks[part]
-        angles, day_hours, day_energy = fold_hours(sky, chunk, usable, engine)
-        hours.append(day_hours)
-        harvest.append(day_energy)
-        flat = engines.row_metrics(sky, study, np.arange(sky.n_blocks), engines.flat_orientation(chunk.tilt,
-                                   chunk.azimuth), usable, outputs=("panel",), engine=engine)
-        flat_hours.append(flat.t_solar[:, 0])
-        flat_energy.append(flat.energy[:, 0])
-        orientation = sky_tracker_orientation(sky, study)
-        gross = sky_tracker_power(sky, study, orientation)
-        draw = sky_tracker_draw(sky, study, orientation)
-        metrics = engines.curve_metrics(np.concatenate([gross, gross - draw]), usable, step_hours, engine=engine)
-        tracker.append((metrics.t_solar[:sky.n_blocks, 0], metrics.t_solar[sky.n_blocks:, 0],
-                        metrics.energy[:sky.n_blocks, 0]))
-        available.append(standby_available(gross, draw, sky.lit, study.tracker.standby_w))
-    hours = np.concatenate(hours).transpose(0, 2, 1)  # (days, loads, angles)
-    harvest = np.concatenate(harvest)  # (days, angles)
-    flat_hours, flat_energy = np.concatenate(flat_hours), np.concatenate(flat_energy)
-    tracker_hours, tracker_net, tracker_energy = (np.concatenate(values) for values in zip(*tracker, strict=True))
-    available = np.concatenate(available)
+    days_of = daily_designs([(blocks[part], sky) for part, sky in zip(parts, skies, strict=True)], usable, engine)
+    angles, hours, harvest = days_of.angles, days_of.twofold_h, days_of.twofold_wh
+    flat_hours, flat_energy = days_of.flat_h, days_of.flat_wh
+    tracker_hours, tracker_net, tracker_energy = days_of.tracker_h, days_of.tracker_net_h, days_of.tracker_wh
+    available = days_of.available
     months = np.array([date.month for date in dates])
     seasons = [None, *SEASONS.values()]
 
@@ -253,7 +235,7 @@ def _evaluate_site(study_data: dict, site: dict, loads, relative: bool, year: in
     targets = []
     for period, season in zip(PERIODS, seasons, strict=True):
         days = np.isin(months, season) if season else np.ones(months.size, bool)
-        best = _best_angle_index(statistic_of(hours, season))  # (loads,)
+        best = best_angle_index(statistic_of(hours, season))  # (loads,)
         at_best = hours[:, np.arange(loads.size), best]  # (days, loads)
         values = {
             "objective_flat_h": statistic_of(flat_hours, season),

@@ -16,7 +16,7 @@ from foldopt.api import default_study, run
 from foldopt.config import ConfigError, LoadProfile, make_study
 from foldopt.loads import load_shape, read_profile
 from foldopt.metrics import energy_served, t_solar
-from foldopt.sweeps import Blocks, fold_hours
+from foldopt.designs import Blocks, fold_hours
 
 EXACT = default_study().variant(mode="exact", geometry=None, step_min=10,
                                 fold_angles={"start": 10, "stop": 180, "step": 10})

@@ -94,7 +94,8 @@ def test_a_weather_year_schedule_agrees_with_the_annual_sweep():
     from pathlib import Path
 
     from foldopt.config import make_plan
-    from foldopt.sweeps import fold_hours, run_plan, Blocks
+    from foldopt.designs import Blocks, fold_hours
+    from foldopt.sweeps import run_plan
 
     weather = str(Path(__file__).resolve().parent.parent / "configs" / "weather" / "723170TYA.CSV")
     data = {"name": "refold", "weather": weather, "p_load": [1.0, 3.0], "panel": {"area": 0.108}, "mode": "exact",

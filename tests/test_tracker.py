@@ -110,7 +110,7 @@ def test_trackers_over_many_days_at_once_equal_each_day_alone(model):
     import datetime as dt
 
     from foldopt.sky import build_sky
-    from foldopt.study import sky_tracker_draw, sky_tracker_orientation
+    from foldopt.designs import sky_tracker_draw, sky_tracker_orientation
 
     study = load_study(default_study_path()).variant(mode="exact", geometry="hinge", step_min=5,
                                                      tracker={"model": model, "standby_w": 0.3})

@@ -13,7 +13,7 @@ import pytest
 from foldopt import engine
 from foldopt.config import ConfigError, make_plan
 from foldopt.sky import build_sky
-from foldopt.study import sky_tracker_orientation
+from foldopt.designs import sky_tracker_orientation
 from foldopt.sweeps import run_plan
 from foldopt.weather import read_weather, sub_hourly, weather_site
 

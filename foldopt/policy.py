@@ -1,0 +1,151 @@
+"""Study policy: what a study becomes when a user changes some of its fields.
+
+One function, :func:`apply`, turns a study's data and the fields a user changed into the data of
+the study that runs. The command line's options, :func:`foldopt.sweep`'s keywords and
+:meth:`foldopt.Study.variant` all go through it, so the same request gives the same study however
+it is made. The rules, each said back to the user by :func:`apply`'s second value:
+
+- **paper mode stays with the paper's site and day.** A paper-mode study whose site (latitude,
+  longitude, altitude), day or weather changes runs in exact mode unless the mode is given: the
+  paper's beam-only Eq. 5 gives a level panel at the equator almost no beam, and it has no
+  altitude term and no diffuse light;
+- a change of mode gives the new mode its own geometry (azimuth-split in paper mode, hinge in
+  exact) unless the geometry is given;
+- a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
+  given; a new latitude or longitude drops the site's name, a new longitude its time zone;
+- a weather file brings its own site, year and light (the study's sky, site and day give way);
+- a new tracker model keeps only the tracker's standby draw; a new fold-angle step starts the grid
+  at that step; a load profile given without a scale runs as written (scale 1).
+
+The module is a leaf: plain dictionaries in and out, nothing heavy imported.
+"""
+
+from __future__ import annotations
+
+import copy
+
+#: Sections of a study whose fields a change merges into (a mapping changes the fields it names);
+#: any other field given a mapping (a load profile, a weather file) is replaced whole.
+SECTIONS = ("site", "panel", "tracker", "objective", "fold_angles", "near_optimal")
+#: Fields that take a paper-mode study away from the paper's site and day.
+AWAY_FROM_PAPER = ("site.latitude", "site.longitude", "site.altitude", "date", "weather")
+#: What the policy says where it switches a paper-mode study to exact mode.
+EXACT_NOTE = "exact mode (paper mode is for the paper's own site and day: mode paper keeps it)"
+
+
+def set_path(data: dict, path: str, value) -> dict:
+    """A copy of ``data`` with the dotted ``path`` set to ``value``."""
+    out = copy.deepcopy(data)
+    node = out
+    parts = path.split(".")
+    for part in parts[:-1]:
+        child = node.get(part)
+        if not isinstance(child, dict):
+            child = {}
+        node[part] = child
+        node = child
+    node[parts[-1]] = value
+    return out
+
+
+def flatten(changes: dict) -> dict:
+    """Changes as dotted paths: a mapping given for a :data:`SECTIONS` field becomes one change per
+    field it names (``panel={"area": 0.1}`` is ``panel.area``); anything else stays whole."""
+    flat = {}
+    for path, value in changes.items():
+        if path in SECTIONS and isinstance(value, dict):
+            flat.update({f"{path}.{key}": item for key, item in value.items()})
+        else:
+            flat[path] = value
+    return flat
+
+
+def touched(given, prefix: str) -> bool:
+    """Whether any of the paths ``given`` is ``prefix`` or lies inside it."""
+    return any(path == prefix or path.startswith(prefix + ".") for path in given)
+
+
+def _section(data: dict, name: str) -> dict:
+    """A section of the data as a mapping (a tracker or objective may be written as a name)."""
+    value = data.get(name)
+    if isinstance(value, str):
+        return {"objective": {"statistic": value}, "tracker": {"model": value}}.get(name, {})
+    return dict(value) if isinstance(value, dict) else {}
+
+
+def is_single(value) -> bool:
+    """A value that is no list, range or date keyword: one case, not an axis."""
+    text = str(value)
+    return (not isinstance(value, (list, tuple)) and ":" not in text and "," not in text
+            and text not in ("year", "equinoxes-solstices"))
+
+
+def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dict, list[str]]:
+    """The study data that runs when ``changes`` are made to ``data``.
+
+    Parameters
+    ----------
+    data : dict
+        A study's fields (as a YAML study holds them, or ``Study.model_dump``).
+    changes : dict
+        Field paths (dotted, or a section name with a mapping) to new values; a list or a range
+        ``"start:stop:step"`` makes an axis.
+    axis_field : str, optional
+        The field a sweep varies even where ``changes`` leave it out (``site.latitude`` for a
+        latitude sweep, ``date`` for a day sweep): it counts as changed.
+
+    Returns
+    -------
+    data : dict
+        The new study data.
+    decided : list of str
+        What the policy decided beyond the changes themselves, in the user's words.
+    """
+    data = copy.deepcopy(dict(data))
+    changes = flatten(changes)
+    given = set(changes) | ({axis_field} if axis_field else set())
+    decided = []
+    for name in ("tracker", "objective"):
+        if isinstance(data.get(name), str):
+            data[name] = _section(data, name)
+    weather = changes.get("weather")
+    if weather is not None:
+        data.pop("sky", None)  # the file's light is shaped by its own clear sky
+        if not (touched(given, "site.latitude") or touched(given, "site.longitude") or "site" in given):
+            data.pop("site", None)  # the file's site
+        if not touched(given, "date"):
+            data.pop("date", None)  # the file's year
+    old_mode = data.get("mode", "exact")
+    if old_mode == "paper" and "mode" not in given and any(touched(given, path) for path in AWAY_FROM_PAPER):
+        data["mode"] = "exact"
+        decided.append(EXACT_NOTE)
+    new_mode = changes.get("mode", data.get("mode", "exact"))
+    if new_mode != old_mode and "geometry" not in given:
+        data.pop("geometry", None)  # the new mode's own geometry
+    site = data.get("site")
+    moved = touched(given, "site.latitude") or touched(given, "site.longitude") or (
+        weather is not None and "site" not in data)
+    if isinstance(site, dict) and moved and not touched(given, "site.name"):
+        site.pop("name", None)
+    if isinstance(site, dict) and touched(given, "site.longitude") and not touched(given, "site.timezone"):
+        site.pop("timezone", None)  # the new longitude's standard offset
+    new_latitude = touched(given, "site.latitude") or (weather is not None and "site" not in data)
+    if new_latitude and not (touched(given, "panel.tilt") or touched(given, "panel.azimuth")):
+        panel = _section(data, "panel")
+        dropped = [panel.pop(key, None) for key in ("tilt", "azimuth")]
+        if any(value is not None for value in dropped):
+            decided.append("panel tilted at |latitude| toward the equator")
+        data["panel"] = panel
+    if "tracker.model" in given:
+        tracker = _section(data, "tracker")
+        data["tracker"] = {key: tracker[key] for key in ("standby_w",) if key in tracker}
+    if "fold_angles.step" in given and "fold_angles.start" not in given:
+        step = changes["fold_angles.step"]
+        data["fold_angles"] = {"start": step, "stop": changes.get("fold_angles.stop", 180.0), "step": step}
+    if "load_profile" in given and changes.get("load_profile") is not None and "p_load" not in given:
+        data["p_load"] = 1.0  # the profile as written, not the study's constant load
+    for path, value in changes.items():
+        data = set_path(data, path, value)
+    if data.get("site") is None:
+        data.pop("site", None)
+    return data, decided
