@@ -56,7 +56,7 @@ def load_study(path: str | Path) -> Study | Plan:
 
 
 def run(study: Study | Plan | str | Path, engine: str = "numba",
-        progress: Callable[[float, int], None] | None = None):
+        progress: Callable[[float, int], None] | None = None, request=None):
     """Run a study: one case (every fold angle, the paper's heuristic, flat and trackers) or a plan
     of many cases.
 
@@ -68,13 +68,17 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
         The compiled kernel or the NumPy reference path it is tested against.
     progress : callable, optional
         For a plan: ``progress(done, total)`` in days.
+    request : foldopt.request.Request, optional
+        The request the study came from (:func:`foldopt.request.plan_request`): what the answer
+        says it took from the study.
 
     Returns
     -------
     StudyResult or SweepResult
         :class:`foldopt.study.StudyResult` for one case (``summary``, ``sweep``, ``timeseries``
         with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.sweeps.SweepResult`
-        for a plan (``table``: one row per case and design).
+        for a plan (``table``: one row per case and design); each with ``answer``, the
+        :class:`foldopt.answer.Answer` the command line prints.
     """
     if isinstance(study, (str, Path)):
         study = load_study(study)
@@ -82,11 +86,11 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
         if study.axes:
             from foldopt.sweeps import run_plan
 
-            return run_plan(study, progress, engine)
+            return run_plan(study, progress, engine, request)
         study = study.base
     from foldopt.study import run_study
 
-    return run_study(study, engine)
+    return run_study(study, engine, request)
 
 
 def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, engine: str = "numba",
@@ -180,8 +184,8 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
     return writer(result, Path(out), overwrite, command if command is not None else ["foldopt.write"])
 
 
-def size(study: Study, areas, cost_per_m2: float | None = None, cost_per_w: float | None = None,
-         c_grid: float = 0.22, years: float = 20.0, days_per_year: float = 365.0):
+def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None, cost_per_w: float | None = None,
+         c_grid: float | None = None, years: float | None = None, days_per_year: float | None = None, request=None):
     """Shin et al. Sec. IV-A panel sizing: the lifetime net benefit of flat and twofold panels of
     every area (:func:`foldopt.sizing.size_panel`).
 
@@ -189,28 +193,61 @@ def size(study: Study, areas, cost_per_m2: float | None = None, cost_per_w: floa
     ----------
     study : Study
         One case: its site, day and load.
-    areas : array_like
-        Panel areas [m^2].
-    cost_per_m2, cost_per_w : float
-        Panel cost [$ per m^2] or [$ per W at STC]; exactly one.
-    c_grid : float
-        Grid energy price [$/kWh] (Shin et al.: 0.22).
-    years, days_per_year : float
-        Lifetime [years] (Shin et al.: 20) and days a year like the study's.
+    areas : array_like or str
+        Panel areas [m^2], or a range ``"start:stop:step"``.
+    cost_per_m2, cost_per_w : float, optional
+        Panel cost [$ per m^2] or [$ per W at STC], at most one; default
+        :data:`foldopt.costs.PAPER_COST_PER_M2` (what Shin et al.'s 0.108 m^2 optimum implies).
+    c_grid : float, optional
+        Grid energy price [$/kWh]; default :data:`foldopt.costs.C_GRID` (Shin et al.: 0.22).
+    years, days_per_year : float, optional
+        Lifetime [years] (default Shin et al.'s 20) and days a year like the study's (365).
+    request : foldopt.request.Request, optional
+        The request the study came from: what the answer says it took from the study.
 
     Returns
     -------
-    pandas.DataFrame
-        Per design and area: ``area_m2``, ``fold_angle_deg``, ``t_solar_h``, benefit, cost and
-        ``net_benefit_usd``.
+    foldopt.sizing.SizingResult
+        ``table`` per design and area (``area_m2``, ``fold_angle_deg``, ``t_solar_h``, benefit, cost,
+        ``net_benefit_usd``), ``best`` per design, ``parameters``, ``answer``.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For both costs, a value that is not a positive finite number, or areas outside (0, 1000] m^2.
     """
-    from foldopt.sizing import size_panel
+    import math
+
+    from foldopt import costs, sizing
+    from foldopt.config import parse_range
     from foldopt.study import Day
 
-    return size_panel(Day(study), areas, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
+    errors = []
+    if cost_per_m2 is not None and cost_per_w is not None:
+        errors.append("cost_per_m2 / cost_per_w: give one panel cost, not both")
+    if cost_per_m2 is None and cost_per_w is None:
+        cost_per_m2 = costs.PAPER_COST_PER_M2
+    c_grid = costs.C_GRID if c_grid is None else c_grid
+    years = costs.LIFETIME_YEARS if years is None else years
+    days_per_year = costs.DAYS_PER_YEAR if days_per_year is None else days_per_year
+    parameters = {"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
+                  "years": years, "days_per_year": days_per_year}
+    for name, value in parameters.items():
+        if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            errors.append(f"{name} = {value}: must be a finite number > 0")
+    try:
+        grid = parse_range(areas) if isinstance(areas, str) else [float(a) for a in areas]
+        if not grid or min(grid) <= 0 or max(grid) > 1000:
+            errors.append(f"areas = {areas!r}: areas must be in (0, 1000] m^2")
+    except (TypeError, ValueError) as error:
+        errors.append(f"areas: {error}")
+    if errors:
+        raise ConfigError(errors)
+    table = sizing.size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
+    return sizing.SizingResult(study, table, sizing.best_areas(table), parameters, request)
 
 
-def reproduce(engine: str = "numba") -> dict:
+def reproduce(engine: str = "numba"):
     """Shin et al.'s published values beside foldopt's, in paper and exact mode.
 
     Parameters
@@ -219,21 +256,23 @@ def reproduce(engine: str = "numba") -> dict:
 
     Returns
     -------
-    dict of pandas.DataFrame
-        ``reproduction`` (the embedded study, ideal PV model) and ``reproduction_single_diode``
-        (A-300 single-diode sub-panels with switching): ``quantity``, ``unit``, ``paper``,
-        ``paper_mode``, ``exact_mode``.
+    foldopt.reproduce.Reproduction
+        ``tables``: ``reproduction`` (the embedded study, ideal PV model) and
+        ``reproduction_single_diode`` (A-300 single-diode sub-panels with switching), each with
+        ``quantity``, ``unit``, ``paper``, ``paper_mode``, ``exact_mode``; ``answer``.
     """
-    from foldopt.reproduce import REPRODUCTIONS, reproduce as reproduce_table
+    from foldopt.reproduce import REPRODUCTIONS, Reproduction, reproduce as reproduce_table
 
     study = default_study()
-    return {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
+    tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
+    return Reproduction(tables, study, engine)
 
 
 def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, study: dict | None = None,
               relative: bool = False, year: int = 2025, *, scheduler: str | None = None, workers: int | None = None,
               sites_per_chunk: int = 0, resume: bool = False, overwrite: bool = False, engine: str = "numba",
-              show_load: int = 0, show_period: str = "year", progress=None, announce=None, command=None):
+              show_load: int = 0, show_period: str = "year", progress=None, announce=None, command=None,
+              defaults: dict | None = None):
     """A map of many sites on Dask (:mod:`foldopt.cluster`), its world maps and its ``report.html``.
 
     Parameters
@@ -262,14 +301,19 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
         See :func:`foldopt.run_map`.
     command : list of str, optional
         What ``run.json`` records as the command.
+    defaults : dict, optional
+        ``{"study": source, "taken": [...]}``: what the answer says it took from the study.
 
     Returns
     -------
     tuple
-        The :class:`foldopt.MapRun`, the figures' file names and the answer's lines.
+        The :class:`foldopt.MapRun`, the figures' file names and the :class:`foldopt.answer.Answer`
+        (its ``designs``: the year's rows; its ``near_optimal``: each site's range and recommended
+        fold angle).
     """
     from foldopt.cluster import MapSpec, run_map
-    from foldopt.report import digest_map, map_answer, map_figures, write_map_report
+    from foldopt.answer import of_map
+    from foldopt.report import map_figures, write_map_report
     from foldopt.worldmap import map_study, site_study
 
     if study is None:
@@ -279,6 +323,6 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
     result = run_map(spec, Path(out), scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
                      progress=progress, announce=announce, metadata={"command": command or ["foldopt.world_map"]})
     figures = map_figures(result.table, result.out, "map", relative, show_load, show_period)
-    answer = map_answer(digest_map(result, relative), result)
+    answer = of_map(result, relative, defaults)
     write_map_report(result, figures, answer)
     return result, figures, answer

@@ -27,15 +27,14 @@ from foldopt import names
 from foldopt.config import (ConfigError, default_study_path, load_plan, parse_range, parse_study_text, parse_values,
                             read_study)
 from foldopt.policy import set_path
-from foldopt.request import plan_request
+from foldopt.request import Request, plan_request, size_request
+from foldopt.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2
 from foldopt.folders import OutputError, OutputExistsError, check_output
 
 RESULTS = Path("results")
 # Typer >= 0.29 vendors click; its UsageError is reached through the public BadParameter.
 _USAGE_ERROR = next(cls for cls in typer.BadParameter.__mro__ if cls.__name__ == "UsageError")
 EMBEDDED = "configs/shin2015.yaml"
-#: Shin et al. do not state their panel cost; the 0.108 m^2 optimum of their flat panel implies it.
-PAPER_COST_PER_M2 = 164.0
 
 HELP = """Design-space optimiser for twofold PV panels powering storage-less loads.
 
@@ -188,77 +187,47 @@ class _Output:
             task = bar.add_task(label, total=total)
             yield lambda done, total: bar.update(task, completed=done, total=total)
 
-    def answer(self, document: dict, lines: list[str], table=None, columns=None) -> None:
+    def answer(self, command: str, out: Path, answer, rows=None, lines_after=(), table=None) -> None:
+        """Render an :class:`foldopt.answer.Answer`: its lines (``--table`` adds ``table``), or one
+        JSON document holding it and the rows."""
         if self.json:
-            typer.echo(json.dumps(document, indent=1, default=_plain))
+            document = {"command": command, "out": str(out), "answer": answer.to_dict(), "rows": _records(rows)}
+            typer.echo(json.dumps(document, indent=1))
             return
         if self.quiet:
             return
-        for line in lines:
+        for line in [*answer.lines(), *lines_after]:
             typer.echo(line)
         if table is not None and self.table:
-            shown = table[[c for c in columns if c in table]] if columns else table
-            typer.echo(shown.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
+            typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
         elif table is not None:
             typer.echo("(--table prints the full table)")
 
 
-def _plain(value):
-    """JSON for what json does not know: numpy numbers, dates, NaN as null."""
-    if hasattr(value, "isoformat"):
-        return value.isoformat()
-    if hasattr(value, "item"):
-        value = value.item()
-    return value
-
-
-def _taken(defaults: list[str]) -> dict | None:
-    """The summary's "from" line as JSON: the source study and what was taken from it."""
-    return {"study": defaults[0], "taken": defaults[1:]} if defaults else None
-
-
 def _records(table) -> list[dict]:
-    return json.loads(table.to_json(orient="records", double_precision=10))
+    """A table's rows as JSON-ready records, every number exact (JSON reads back the same float)."""
+    from foldopt.answer import records
+
+    return records(table)
 
 
-STUDY_COLUMNS = ["design", "fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh", "peak_power_w",
-                 "gain_vs_flat_pct", "pct_of_tracker_t_solar", "flat_area_multiple", "note"]
-SWEEP_COLUMNS = ["site_name", "latitude", "date", "p_load_w", "design", "fold_angle_deg", "t_solar_h",
-                 "gain_vs_flat_pct", "note"]
-
-
-def _run_plan(plan, out: Path, overwrite: bool, output: _Output, engine: str, defaults: list[str],
-              command: str) -> None:
-    """Evaluate a plan (one case or many), write its folder, print the answer."""
+def _run_request(request, out: Path, overwrite: bool, output: _Output, engine: str, command: str) -> None:
+    """Evaluate a request's plan (one case or many) through the API, write its folder, print its answer."""
     check_output(out, overwrite)
-    base = plan.base
+    plan, base = request.plan, request.plan.base
     if not plan.axes:
-        with output.progress(f"{base.name}: one day, {len(base.fold_angles.grid())} fold angles"):
-            from foldopt.api import run as run_study, write
-            from foldopt.report import digest_study, study_answer
+        label, total, unit = f"{base.name}: one day, {len(base.fold_angles.grid())} fold angles", None, "days"
+    else:
+        days = plan.n_cases // max(len(dict(plan.axes).get("p_load", (1,))), 1)
+        unit = "site-days" if any(path.startswith("site") for path, _ in plan.axes) else "days"
+        label, total = f"{base.name}: {days} {unit}", days
+    with output.progress(label, total=total, unit=unit) as progress:
+        from foldopt.api import run, write
 
-            result = run_study(base, engine)
-            write(result, out, overwrite, _INVOCATION)
-        digest = digest_study(result)
-        lines = study_answer(digest, defaults) + [f"wrote {out}"]
-        output.answer({"command": command, "out": str(out), "defaults": _taken(defaults), "summary": digest,
-                       "rows": _records(result.summary)},
-                      lines, result.summary, STUDY_COLUMNS)
-        return
-    days = plan.n_cases // max(len(dict(plan.axes).get("p_load", (1,))), 1)
-    unit = "site-days" if any(path.startswith("site") for path, _ in plan.axes) else "days"
-    with output.progress(f"{base.name}: {days} {unit}", total=days, unit=unit) as progress:
-        from foldopt.api import run as run_plan, write
-        from foldopt.report import digest_sweep, sweep_answer
-
-        result = run_plan(plan, engine, progress)
+        result = run(plan, engine, progress, request=request)
         write(result, out, overwrite, _INVOCATION)
-    digest = digest_sweep(result)
-    lines = sweep_answer(digest, defaults) + [f"wrote {out}"]
-    twofold = result.table[result.table["design"] == "twofold"]
-    output.answer({"command": command, "out": str(out), "defaults": _taken(defaults), "summary": digest,
-                   "rows": _records(result.table)},
-                  lines, twofold, SWEEP_COLUMNS)
+    rows = result.summary if not plan.axes else result.table
+    output.answer(command, out, result.answer, rows, [f"wrote {out}"], rows)
 
 
 # --- run, reproduce -----------------------------------------------------------------------------
@@ -283,8 +252,10 @@ def run(
       foldopt run configs/annual-weather.yaml --out results/greensboro
     """
     output_format, engine = _check_choices(output_format, engine)
-    plan = load_plan(config if config is not None else default_study_path())
-    _run_plan(plan, out or RESULTS / plan.base.name, overwrite, _Output(quiet, output_format, table), engine, [], "run")
+    source = EMBEDDED if config is None else str(config)
+    request = Request(load_plan(config if config is not None else default_study_path()), source, ())
+    _run_request(request, out or RESULTS / request.plan.base.name, overwrite, _Output(quiet, output_format, table),
+                 engine, "run")
 
 
 @app.command(short_help="Shin et al.'s published values beside foldopt's, paper and exact modes.")
@@ -304,21 +275,12 @@ def reproduce(
     output = _Output(quiet, output_format)
     check_output(out, overwrite)
     with output.progress("reproducing Shin et al. (two PV models x two modes)"):
-        from foldopt.api import default_study, reproduce as reproduce_tables
+        from foldopt.api import reproduce as reproduce_paper
         from foldopt.report import write_reproduction
 
-        tables = reproduce_tables(engine)
-        write_reproduction(tables, default_study(), out, overwrite, _INVOCATION, engine=engine)
-    lines = []
-    for name, table in tables.items():
-        model = "ideal PV model" if name == "reproduction" else "A-300 single-diode cells with switching"
-        lines.append(f"Shin et al. ({model}): paper value | paper mode | exact mode")
-        for row in table.itertuples():
-            paper = "-" if row.paper != row.paper else f"{row.paper:g}"
-            lines.append(f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  {row.unit}")
-    lines.append(f"wrote {out}")
-    output.answer({"command": "reproduce", "out": str(out), "tables": {name: _records(t) for name, t in tables.items()}},
-                  lines)
+        result = reproduce_paper(engine)
+        write_reproduction(result, out, overwrite, _INVOCATION)
+    output.answer("reproduce", out, result.answer, None, [f"wrote {out}"])
 
 
 # --- sweep angle | latitude | day | load ---------------------------------------------------------
@@ -468,8 +430,7 @@ def _sweep(axis: str, options: dict) -> None:
         request = plan_request(data, changes, axis=axis, source=source, name=f"sweep-{axis}")
     except ConfigError as error:
         _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
-    _run_plan(request.plan, out or RESULTS / f"sweep-{axis}", overwrite, output, engine,
-              [request.source, *request.taken] if request.taken else [], f"sweep {axis}")
+    _run_request(request, out or RESULTS / f"sweep-{axis}", overwrite, output, engine, f"sweep {axis}")
 
 
 #: Sweep options -> the study field each sets (the request's changes; foldopt.request does the rest).
@@ -681,29 +642,24 @@ def map_(
         if not quiet and not output.json:
             typer.echo(f"{cluster}; dashboard: {dashboard or 'none (pip install bokeh)'}", err=True)
 
-    with output.progress(f"map: {len(site_list)} sites", total=len(site_list), unit="sites") as progress:
-        from foldopt.api import world_map
-        from foldopt.report import digest_map
-
-        try:
-            result, figures, lines = world_map(
-                site_list, loads, out, study, relative, year, scheduler=scheduler, workers=workers,
-                sites_per_chunk=chunk_sites or 0, resume=resume, overwrite=overwrite, engine=engine,
-                show_load=show_load - 1, show_period=show_period, progress=progress, announce=announce,
-                command=_INVOCATION)
-        except ConfigError as error:
-            _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
-    digest = digest_map(result, relative)
     taken = [f"panel {study['panel']['area']:g} m^2" if area is None else None,
              f"P_load {loads[0]:g} W" if p_load is None and not relative else None,
              f"{study.get('pv_model', 'ideal')} PV model", f"{study.get('mode')} mode",
              f"{study.get('step_min'):g}-min steps" if step_min is None else None]
-    defaults = [EMBEDDED if config is None else str(config), *[item for item in taken if item]]
-    lines.insert(1, f"  from {defaults[0]}: {', '.join(defaults[1:])}")
-    lines.append(f"wrote {out} (map.parquet, map.csv, report.html, {', '.join(figures)})")
-    year_rows = result.table[result.table["period"] == "year"]
-    output.answer({"command": "map", "out": str(out), "defaults": _taken(defaults), "summary": digest,
-                   "rows": _records(year_rows)}, lines)
+    defaults = {"study": EMBEDDED if config is None else str(config), "taken": [item for item in taken if item]}
+    with output.progress(f"map: {len(site_list)} sites", total=len(site_list), unit="sites") as progress:
+        from foldopt.api import world_map
+
+        try:
+            result, figures, answer = world_map(
+                site_list, loads, out, study, relative, year, scheduler=scheduler, workers=workers,
+                sites_per_chunk=chunk_sites or 0, resume=resume, overwrite=overwrite, engine=engine,
+                show_load=show_load - 1, show_period=show_period, progress=progress, announce=announce,
+                command=_INVOCATION, defaults=defaults)
+        except ConfigError as error:
+            _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
+    output.answer("map", out, answer, answer.designs,
+                  [f"wrote {out} (map.parquet, map.csv, report.html, {', '.join(figures)})"])
 
 
 # --- size ---------------------------------------------------------------------------------------
@@ -716,9 +672,9 @@ def size(
     cost_per_m2: Optional[float] = typer.Option(None, "--cost-per-m2", help="Panel cost [$/m^2] [default: 164, the "
                                                 "cost Shin et al.'s 0.108 m^2 optimum implies]."),
     cost_per_w: Optional[float] = typer.Option(None, "--cost-per-w", help="Panel cost [$/W at STC], instead."),
-    c_grid: float = typer.Option(0.22, "--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22)."),
-    years: float = typer.Option(20.0, "--years", help="Lifetime [years] (Shin et al.: 20)."),
-    days_per_year: float = typer.Option(365.0, "--days-per-year", help="Days a year like the study's day."),
+    c_grid: float = typer.Option(C_GRID, "--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22)."),
+    years: float = typer.Option(LIFETIME_YEARS, "--years", help="Lifetime [years] (Shin et al.: 20)."),
+    days_per_year: float = typer.Option(DAYS_PER_YEAR, "--days-per-year", help="Days a year like the study's day."),
     out: Optional[Path] = typer.Option(None, "--out", help="Results folder [default: results/<study>-sizing]."),
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
@@ -734,55 +690,39 @@ def size(
       foldopt size --cost-per-w 0.9 --areas 0.02:0.3:0.002
     """
     output_format, _ = _check_choices(output_format, "numba")
-    errors = []
-    if cost_per_m2 is not None and cost_per_w is not None:
-        errors.append("--cost-per-m2 / --cost-per-w: give one panel cost, not both")
-    cost_given = cost_per_m2 is not None or cost_per_w is not None
-    if not cost_given:
-        cost_per_m2 = PAPER_COST_PER_M2
-    for name, value in (("--cost-per-m2", cost_per_m2), ("--cost-per-w", cost_per_w), ("--c-grid", c_grid),
-                        ("--years", years), ("--days-per-year", days_per_year)):
-        if value is not None and not (value == value and 0 < value < float("inf")):
-            errors.append(f"{name} = {value}: must be > 0")
-    try:
-        grid = parse_range(areas)
-        if grid[0] <= 0 or grid[-1] > 1000:
-            errors.append(f"--areas = {areas!r}: areas must be in (0, 1000] m^2")
-    except ValueError as error:
-        errors.append(f"--areas: {error}")
-    if errors:
-        _fail(errors)
     output = _Output(quiet, output_format, table)
-    parameters = {"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
-                  "years": years, "days_per_year": days_per_year}
-    from foldopt.config import load_study
-
-    study = load_study(config if config is not None else default_study_path())
+    plan = load_plan(config if config is not None else default_study_path())
+    if plan.axes:
+        _fail([f"config: {config} sweeps {', '.join(p for p, _ in plan.axes)}; size takes one case"])
+    request = size_request(plan, EMBEDDED if config is None else str(config),
+                           cost_per_m2 is not None or cost_per_w is not None)
+    study = plan.base
     out = out or RESULTS / f"{study.name}-sizing"
     check_output(out, overwrite)
-    with output.progress(f"sizing {study.name}: {len(grid)} areas"):
-        from foldopt.api import size as size_panel
-        from foldopt.report import write_sizing
+    from foldopt.api import size as size_panel
 
-        sizing = size_panel(study, grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
-        best = write_sizing(sizing, study, out, overwrite, _INVOCATION, parameters=parameters)
-    cost = f"{cost_per_m2:g} $/m^2" if cost_per_w is None else f"{cost_per_w:g} $/W"
-    lines = [f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid {c_grid:g} $/kWh over "
-             f"{years:g} years"]
-    for row in best.itertuples():
-        angle = "" if row.design == "flat" else f", folded to {row.fold_angle_deg:g} deg"
-        lines.append(f"  {row.design}: {row.area_m2:.3f} m^2{angle}, t_solar {row.t_solar_h:.2f} h, "
-                     f"net ${row.net_benefit_usd:.1f}")
-    lines.append(f"wrote {out}")
-    defaults = [EMBEDDED if config is None else str(config), f"site, day, P_load {study.p_load:g} W, efficiency "
-                f"{study.panel.efficiency:g}"]
-    if not cost_given:
-        defaults.append(f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
-                        "--cost-per-m2 or --cost-per-w)")
-    lines.insert(1, f"  from {defaults[0]}: {', '.join(defaults[1:])}")
-    output.answer({"command": "size", "out": str(out), "defaults": _taken(defaults),
-                   "summary": {"study": study.name, **parameters, "best": _records(best)},
-                   "rows": _records(sizing)}, lines, sizing)
+    try:
+        with output.progress(f"sizing {study.name}"):
+            from foldopt.report import write_sizing
+
+            result = size_panel(study, areas, cost_per_m2, cost_per_w, c_grid, years, days_per_year, request=request)
+            write_sizing(result, out, overwrite, _INVOCATION)
+    except ConfigError as error:
+        _fail([_sizing_option(line) for line in error.errors])
+    output.answer("size", out, result.answer, result.table, [f"wrote {out}"], result.table)
+
+
+#: The sizing's parameters as the command line names them, longest first.
+_OPTION_OF_SIZING = {"cost_per_m2 / cost_per_w": "--cost-per-m2 / --cost-per-w", "c_grid_usd_per_kwh": "--c-grid",
+                     "days_per_year": "--days-per-year", "cost_per_m2": "--cost-per-m2", "cost_per_w": "--cost-per-w",
+                     "years": "--years", "areas": "--areas"}
+
+
+def _sizing_option(line: str) -> str:
+    for field, option in _OPTION_OF_SIZING.items():
+        if line.startswith(field):
+            return option + line[len(field):]
+    return line
 
 
 def main():  # pragma: no cover - console-script entry point

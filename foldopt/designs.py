@@ -328,9 +328,9 @@ def daily_designs(parts, loads, engine: str = "numba") -> DailyDesigns:
     twofold, harvest, flat, flat_energy, tracker, available = [], [], [], [], [], []
     for chunk, sky in parts:
         study = chunk.study
-        angles, hours, energy_wh = fold_hours(sky, chunk, loads, engine)
+        angles, hours, energy_harvested_wh = fold_hours(sky, chunk, loads, engine)
         twofold.append(hours)
-        harvest.append(energy_wh)
+        harvest.append(energy_harvested_wh)
         metrics = engines.row_metrics(sky, study, np.arange(sky.n_blocks), engines.flat_orientation(
             chunk.tilt, chunk.azimuth), loads, outputs=("panel",), engine=engine)
         flat.append(metrics.t_solar[:, 0])

@@ -79,23 +79,25 @@ def load_shape(profile, clock_hours: np.ndarray, dates) -> np.ndarray:
     return shape
 
 
-def describe_load(study) -> dict:
+def describe_load(study, p_load: float | None = None) -> dict:
     """The load of a study as a user knows it: a constant ``p_load_w`` [W], or a profile's
     ``name`` (its file's stem, or ``daily``), ``scale`` [-] and the ``mean_w`` and ``peak_w`` [W]
-    of P_load(t) = scale x profile(t) over its daily day (weekend and monthly days aside)."""
+    of P_load(t) = scale x profile(t) over its daily day (weekend and monthly days aside).
+    ``p_load`` replaces the study's load (a sweep's value)."""
     profile = study.load_profile
+    scale = float(study.p_load if p_load is None else p_load)
     if profile is None:
-        return {"p_load_w": float(study.p_load)}
+        return {"p_load_w": scale}
     minutes = (np.arange(1440) + 0.5) / 60.0
-    day = _day(profile.daily, minutes, profile.interpolation == "linear") * study.p_load
+    day = _day(profile.daily, minutes, profile.interpolation == "linear") * scale
     name = Path(profile.file).stem if profile.file else "daily"
-    return {"profile": name, "scale": float(study.p_load), "mean_w": float(day.mean()), "peak_w": float(day.max())}
+    return {"profile": name, "scale": scale, "mean_w": float(day.mean()), "peak_w": float(day.max())}
 
 
-def load_text(study) -> str:
+def load_text(study, p_load: float | None = None) -> str:
     """``P_load 2 W``, or for a profile ``load profile camera (mean 2.88 W, peak 6 W)`` (with its
     scale where it is not 1)."""
-    load = describe_load(study)
+    load = describe_load(study, p_load)
     if "p_load_w" in load:
         return f"P_load {load['p_load_w']:g} W"
     scale = f" x{load['scale']:g}" if load["scale"] != 1 else ""

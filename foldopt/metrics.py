@@ -80,13 +80,13 @@ def daily_metrics(p_pv, p_load, step_hours):
                           energy(p_pv, step_hours), p_pv.max(axis=-1), p_load)
 
 
-def metric_columns(t_solar_h, t_solar_contiguous_h, energy_wh, peak_power_w, p_load, served_wh=None) -> dict:
+def metric_columns(t_solar_h, t_solar_contiguous_h, energy_harvested_wh, peak_power_w, p_load, served_wh=None) -> dict:
     """The daily metrics by their report names, from t_solar, its longest run, the energy and the peak.
 
     Returns
     -------
     dict of numpy.ndarray
-        ``t_solar_h``, ``t_solar_contiguous_h`` [h]; ``energy_wh`` harvested (at the maximum power
+        ``t_solar_h``, ``t_solar_contiguous_h`` [h]; ``energy_harvested_wh`` harvested (at the maximum power
         point), ``energy_served_wh`` = P_load * t_solar, ``energy_wasted_wh`` the rest (without
         storage, power above the load and power too low to run it are both lost) [Wh];
         ``peak_power_w`` [W]. ``served_wh`` replaces ``P_load * t_solar`` for a load profile
@@ -96,9 +96,9 @@ def metric_columns(t_solar_h, t_solar_contiguous_h, energy_wh, peak_power_w, p_l
     return {
         "t_solar_h": t_solar_h,
         "t_solar_contiguous_h": t_solar_contiguous_h,
-        "energy_wh": energy_wh,
+        "energy_harvested_wh": energy_harvested_wh,
         "energy_served_wh": served,
-        "energy_wasted_wh": energy_wh - served,
+        "energy_wasted_wh": energy_harvested_wh - served,
         "peak_power_w": peak_power_w,
     }
 

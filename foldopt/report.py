@@ -1,5 +1,5 @@
 """Results folders: CSV tables, PNG plots and ``run.json`` (built atomically, see
-:mod:`foldopt.folders`), and the digests a command line prints of them."""
+:mod:`foldopt.folders`), each a view of its result's answer (:mod:`foldopt.answer`)."""
 
 from __future__ import annotations
 
@@ -100,7 +100,7 @@ def plot_power_curves(result: StudyResult, ax=None):
         lw=2,
         label=f"twofold {result.optimal_fold_angle:.1f}° ({study.connection})",
     )
-    ax.axhline(study.p_load, color="tab:red", lw=1, label=f"P_load = {study.p_load:.3g} W")
+    _draw_load(ax, hours, series, study)
     if daylight.any():
         ax.set_xlim(hours[daylight].min() - 0.5, hours[daylight].max() + 0.5)
     ax.set_xlabel(f"local clock time [h] ({study.site.timezone})")
@@ -109,6 +109,25 @@ def plot_power_curves(result: StudyResult, ax=None):
     ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3)
     return ax
+
+
+def _load_label(study, load: float) -> str:
+    """A sweep's load as a load: ``P_load 2 W``, or a profile with its mean and peak watts."""
+    if study is None:
+        return f"P_load {load:g} W"
+    from foldopt.loads import load_text
+
+    return load_text(study, load)
+
+
+def _draw_load(ax, hours, series, study) -> None:
+    """The load: a line at P_load, or a load profile's P_load(t) as its curve, labelled as a load."""
+    from foldopt.loads import load_text
+
+    if study.load_profile is None:
+        ax.axhline(study.p_load, color="tab:red", lw=1, label=f"P_load = {study.p_load:.3g} W")
+    else:
+        ax.step(hours, series["p_load_w"], where="mid", color="tab:red", lw=1, label=load_text(study))
 
 
 STATE_COLOURS = {"east": "tab:orange", "parallel": "tab:green", "west": "tab:purple", "series": "tab:brown"}
@@ -127,7 +146,7 @@ def plot_switching(result: StudyResult, ax=None):
     for name in ("east", "west", "parallel") + (("series",) if study.switch_series else ()):
         ax.plot(hours, series[f"p_{name}_w"], color=STATE_COLOURS[name], ls="--", label=name)
     ax.plot(hours, series["p_switching_w"], color="k", lw=2, label="switching (shaded: state chosen)")
-    ax.axhline(study.p_load, color="tab:red", lw=1, label=f"P_load = {study.p_load:.3g} W")
+    _draw_load(ax, hours, series, study)
     daylight = series["p_switching_w"].to_numpy() > 0
     if daylight.any():
         ax.set_xlim(hours[daylight].min() - 0.5, hours[daylight].max() + 0.5)
@@ -236,6 +255,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
                 input_sha256=input_hash(result.study.model_dump(mode="json")),
                 engine=result.engine,
                 optimal_fold_angle_deg=result.optimal_fold_angle,
+                near_optimal={key: value if np.isfinite(value) else None for key, value in result.near_optimal.items()},
                 tracker_break_even_standby_w=result.standby[1] if np.isfinite(result.standby[1]) else None,
                 # NaN (the load exceeds the flat panel's noon power) is not JSON: null instead.
                 heuristic_fold_angle_deg=(
@@ -243,9 +263,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
                 ),
         )
         _write_json(folder / "run.json", metadata)
-        digest = digest_study(result)
-        write_html(folder, f"foldopt: {result.study.name}", study_question(result.study), study_answer(digest, []),
-                   STUDY_FIGURES, result.summary, "Designs compared (summary.csv)", digest["notes"], metadata)
+        write_html(folder, result.answer, STUDY_FIGURES, result.summary, "Designs compared (summary.csv)", metadata)
     return out
 
 
@@ -253,41 +271,17 @@ STUDY_FIGURES = ["power_curves.png", "t_solar_vs_fold_angle.png", "comparison.pn
                  "tracker_standby.png"]
 
 
-def study_question(study: Study, varied: tuple = ()) -> dict:
-    """What a study asks, label to text, for a report (fields in ``varied`` are said to vary)."""
-    study = study.resolved()
-    site = study.site
-    where = f"{site.name + ', ' if site.name else ''}{site.latitude:g}, {site.longitude:g} ({site.timezone})"
-    panel = study.panel
-    question = {
-        "site": "varies (see the table)" if {"site", "site.latitude", "site.longitude"} & set(varied) else where,
-        "day": "varies (see the table)" if "date" in varied else study.date.isoformat(),
-        "load": "varies (see the table)" if "p_load" in varied else f"{study.p_load:g} W",
-        "panel": f"{panel.area:g} m^2, efficiency {panel.efficiency:g}, tilt {panel.tilt:g} deg, azimuth "
-                 f"{panel.azimuth:g} deg" + (" (per latitude)" if "site.latitude" in varied else ""),
-        "models": f"{study.mode} mode, {study.pv_model} PV model, {study.connection}, "
-                  + (f"weather {Path(study.weather.path).name}" if study.weather else f"{study.sky} sky"),
-        "fold angles": f"{study.fold_angles.start:g} to {study.fold_angles.stop:g} deg by {study.fold_angles.step:g}",
-    }
-    if study.objective is not None and "date" in varied:
-        question["objective"] = f"one fold angle for all days, maximising {study.objective.statistic} t_solar"
-    return question
-
-
-def write_reproduction(tables: dict[str, pd.DataFrame], study: Study, out: Path, overwrite=False, command=None,
-                       engine: str = "numba") -> Path:
-    """Write one ``<name>.csv`` per reproduction table and ``run.json``."""
+def write_reproduction(result, out: Path, overwrite=False, command=None) -> Path:
+    """Write one ``<name>.csv`` per reproduction table (:class:`foldopt.reproduce.Reproduction`),
+    ``report.html`` and ``run.json``."""
     with staged_folder(out, overwrite) as folder:
-        for name, table in tables.items():
+        for name, table in result.tables.items():
             table.to_csv(folder / f"{name}.csv", index=False, float_format=FLOAT_FORMAT)
-        metadata = run_metadata(study, command, modes=["paper", "exact"], tables=list(tables), engine=engine)
+        metadata = run_metadata(result.study, command, modes=["paper", "exact"], tables=list(result.tables),
+                                engine=result.engine)
         _write_json(folder / "run.json", metadata)
-        combined = pd.concat([table.assign(table=name) for name, table in tables.items()], ignore_index=True)
-        write_html(folder, "foldopt: Shin et al. reproduced", study_question(study),
-                   ["Shin et al.'s published values beside foldopt's, in paper mode (the paper's formulas) and exact "
-                    "mode (pvlib's physics); reproduction: ideal PV model, reproduction_single_diode: A-300 "
-                    "single-diode sub-panels with switching."], [], combined, "Published and reproduced values",
-                   [], metadata)
+        write_html(folder, result.answer, [], result.answer.designs, "Published and reproduced values (paper: Shin "
+                   "et al.; paper mode: their formulas; exact mode: pvlib's physics)", metadata)
     return out
 
 
@@ -411,13 +405,14 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
             **({"weather_light": result.weather_light} if result.weather_light else {}),
         )
         _write_json(folder / "run.json", metadata)
-        digest = digest_sweep(result)
-        question = study_question(plan.base, tuple(path for path, _ in plan.axes))
-        question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
-        notes = [f"{note}: {count} of {digest['cases']} cases" for note, count in digest["notes"].items()]
-        write_html(folder, f"foldopt: {plan.base.name}", question, sweep_answer(digest, []),
-                   [name for name in plots if name.endswith(".png")], result.table,
-                   "Every case and design (results.csv; click a header to sort)", notes, metadata)
+        answer = result.answer
+        if answer.kind == "annual":
+            # The year's summary per case and design, not every day's rows (results.csv has them).
+            table, title = annual_summary(result.table, _annual_cases(result)), "The year per case and design (annual_summary.csv)"
+        else:
+            table, title = result.table, "Every case and design (results.csv; click a header to sort)"
+        write_html(folder, answer, [name for name in plots if name.endswith(".png")], table, title, metadata,
+                   designs=answer.kind == "annual")
     return out
 
 
@@ -440,29 +435,21 @@ def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, title: str, ax=None):
     return ax
 
 
-def write_sizing(table: pd.DataFrame, study: Study, out: Path, overwrite: bool = False, command=None,
-                 parameters: dict | None = None) -> pd.DataFrame:
-    """Write ``sizing.csv``, ``sizing_best.csv``, the net-benefit plot and ``run.json`` (with the
-    sizing ``parameters``: costs, price, lifetime); return the best rows."""
-    best = table.loc[table.groupby("design", sort=False)["net_benefit_usd"].idxmax()].reset_index(drop=True)
+def write_sizing(result, out: Path, overwrite: bool = False, command=None) -> Path:
+    """Write ``sizing.csv``, ``sizing_best.csv``, the net-benefit plot, ``report.html`` and
+    ``run.json`` (with the sizing's parameters: costs, price, lifetime) of a
+    :class:`foldopt.sizing.SizingResult`."""
+    study, table, best = result.study, result.table, result.best
     with staged_folder(out, overwrite) as folder:
         table.to_csv(folder / "sizing.csv", index=False, float_format=FLOAT_FORMAT)
         best.to_csv(folder / "sizing_best.csv", index=False, float_format=FLOAT_FORMAT)
         save_plot(plot_sizing(table, best, f"{study.name}: panel sizing (Shin et al. Sec. IV-A)"),
                   folder / "net_benefit_vs_area.png")
-        metadata = run_metadata(study.resolved(), command, sizing=parameters,
+        metadata = run_metadata(study.resolved(), command, sizing=result.parameters,
                                 input_sha256=input_hash(study.model_dump(mode="json")))
         _write_json(folder / "run.json", metadata)
-        answer = [f"{row.design}: {row.area_m2:.3f} m^2"
-                  + ("" if row.design == "flat" else f", folded to {row.fold_angle_deg:g} deg")
-                  + f", t_solar {row.t_solar_h:.2f} h, lifetime net benefit ${row.net_benefit_usd:.1f}"
-                  for row in best.itertuples()]
-        question = {**study_question(study), "sizing": ", ".join(f"{k} {v:g}" for k, v in (parameters or {}).items()
-                                                                  if v is not None)}
-        write_html(folder, f"foldopt: {study.name} sizing", question,
-                   ["The area with the largest lifetime net benefit (Shin et al. Sec. IV-A):", *answer],
-                   ["net_benefit_vs_area.png"], table, "Every area (sizing.csv)", [], metadata)
-    return best
+        write_html(folder, result.answer, ["net_benefit_vs_area.png"], table, "Every area (sizing.csv)", metadata)
+    return out
 
 
 # --- Annual studies -----------------------------------------------------------------------------
@@ -488,32 +475,33 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
     for key, group in table.groupby(keys, sort=False):
         hours = group["t_solar_h"]
         row = dict(zip(keys, key if isinstance(key, tuple) else (key,), strict=True))
-        row.update(days=len(group), fold_angle_deg=group["fold_angle_deg"].iloc[0], mean_h=hours.mean(),
-                   energy_harvested_wh=group["energy_wh"].sum(), energy_served_wh=group["energy_served_wh"].sum(),
+        row.update(days=len(group), fold_angle_deg=group["fold_angle_deg"].iloc[0], mean_t_solar_h=hours.mean(),
+                   energy_harvested_wh=group["energy_harvested_wh"].sum(), energy_served_wh=group["energy_served_wh"].sum(),
                    energy_wasted_wh=group["energy_wasted_wh"].sum())
         if "poa_kwh_m2" in group:
             row["poa_kwh_m2"] = group["poa_kwh_m2"].sum()
-        row.update(p10_h=hours.quantile(0.1), p50_h=hours.median(), p90_h=hours.quantile(0.9), min_h=hours.min())
+        row.update(p10_t_solar_h=hours.quantile(0.1), p50_t_solar_h=hours.median(), p90_t_solar_h=hours.quantile(0.9),
+                   min_t_solar_h=hours.min())
         row.update({f"days_ge_{x}h": int((hours >= x).sum()) for x in THRESHOLDS_H})
-        row.update({f"month_{m:02d}_mean_h": v for m, v in group.groupby("month")["t_solar_h"].mean().items()})
+        row.update({f"month_{m:02d}_mean_t_solar_h": v for m, v in group.groupby("month")["t_solar_h"].mean().items()})
         rows.append(row)
     summary = pd.DataFrame(rows)
     for reference, gain in (("flat", "gain_vs_flat_pct"), ("tracker", "pct_of_tracker")):
-        base = summary[summary["design"] == reference].set_index(cases)[["energy_harvested_wh", "mean_h"]]
+        base = summary[summary["design"] == reference].set_index(cases)[["energy_harvested_wh", "mean_t_solar_h"]]
         matched = base.reindex(pd.MultiIndex.from_frame(summary[cases]) if len(cases) > 1 else summary[cases[0]])
         energy = relative_to(summary["energy_harvested_wh"], matched["energy_harvested_wh"].to_numpy())
-        time = relative_to(summary["mean_h"], matched["mean_h"].to_numpy())
+        time = relative_to(summary["mean_t_solar_h"], matched["mean_t_solar_h"].to_numpy())
         summary[f"energy_{gain}"] = (energy - 1.0) * 100.0 if reference == "flat" else energy * 100.0
-        summary[f"t_solar_{gain}"] = (time - 1.0) * 100.0 if reference == "flat" else time * 100.0
+        summary[gain] = (time - 1.0) * 100.0 if reference == "flat" else time * 100.0
     return summary
 
 
-def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, ax=None):
+def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, study=None, ax=None):
     """The objective and the mean daily t_solar of one fold angle kept all year, per load."""
     fig, ax = _axes(ax, (7, 4.5))
     for (load, rows), colour in zip(by_angle.groupby("p_load_w"), plt.cm.viridis(np.linspace(0, 0.85, 8)),
                                     strict=False):
-        ax.plot(rows["fold_angle_deg"], rows["mean_t_solar_h"], color=colour, label=f"mean, P_load {load:g} W")
+        ax.plot(rows["fold_angle_deg"], rows["mean_t_solar_h"], color=colour, label=f"mean, {_load_label(study, load)}")
         ax.plot(rows["fold_angle_deg"], rows["objective_h"], color=colour, ls="--", lw=1, label="objective")
         chosen = rows[rows["chosen"]]
         ax.plot(chosen["fold_angle_deg"], chosen["objective_h"], "o", color=colour)
@@ -529,7 +517,7 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, ax=None):
 MONTH_NAMES = ("J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D")
 
 
-def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=None):
+def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=None, study=None):
     """Monthly energy harvested and mean daily t_solar of every design, side by side, a row per
     load (the first case's site). ``axes``: a (loads, 2) array of Axes to draw on; returns it."""
     table = table.assign(month=pd.to_datetime(table["date"]).dt.month)
@@ -548,10 +536,10 @@ def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=N
         for i, design in enumerate(designs):
             monthly = rows[rows["design"] == design].groupby("month")
             x = np.asarray(monthly.size().index) + (i - (len(designs) - 1) / 2) * width
-            energy_ax.bar(x, monthly["energy_wh"].sum() / 1000.0, width, color=colours[design], label=design)
+            energy_ax.bar(x, monthly["energy_harvested_wh"].sum() / 1000.0, width, color=colours[design], label=design)
             time_ax.bar(x, monthly["t_solar_h"].mean(), width, color=colours[design], label=design)
         energy_ax.set_ylabel("energy harvested [kWh]")
-        time_ax.set_ylabel(f"mean daily t_solar [h]\nP_load {load:g} W")
+        time_ax.set_ylabel(f"mean daily t_solar [h]\n{_load_label(study, load)}", fontsize=8)
         for ax in (energy_ax, time_ax):
             ax.set_xticks(range(1, 13), MONTH_NAMES)
             ax.grid(alpha=0.3, axis="y")
@@ -562,7 +550,7 @@ def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=N
     return axes
 
 
-def plot_distribution(table: pd.DataFrame, title: str, ax=None):
+def plot_distribution(table: pd.DataFrame, title: str, ax=None, study=None):
     """Daily t_solar of each design as box plots, one group per load."""
     designs = [d for d in ("flat", "twofold", "tracker", "tracker-net") if d in set(table["design"])]
     loads = sorted(table["p_load_w"].unique())
@@ -576,7 +564,7 @@ def plot_distribution(table: pd.DataFrame, title: str, ax=None):
         for patch in box["boxes"]:
             patch.set_facecolor(colours[design])
         ax.plot([], [], color=colours[design], lw=6, label=design)
-    ax.set_xticks(np.arange(len(loads)), [f"P_load {load:g} W" for load in loads])
+    ax.set_xticks(np.arange(len(loads)), [_load_label(study, load) for load in loads], fontsize=7)
     ax.set_ylabel("daily t_solar [h]")
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3, axis="y")
@@ -603,21 +591,28 @@ def plot_day_hour(extras: dict, key: str, title: str, label: str, ax=None):
     return ax
 
 
+def _annual_cases(result) -> list[str]:
+    """A case of an annual study: its site and load, and any other field the plan varies but the date."""
+    others = [c for c in result.varied if c not in ("date", "day_of_year", "site_name", "latitude", "p_load_w")]
+    return ["site_name", "latitude", *others, "p_load_w"]
+
+
 def annual_outputs(result, folder: Path, name: str) -> list[str]:
     """``annual_summary.csv`` and the annual plots of a study that varies the date."""
     table = result.table
-    # A case is its site and load, and any other field the plan varies but the date.
-    others = [c for c in result.varied if c not in ("date", "day_of_year", "site_name", "latitude", "p_load_w")]
-    annual_summary(table, ["site_name", "latitude", *others, "p_load_w"]).to_csv(
-        folder / "annual_summary.csv", index=False, float_format=FLOAT_FORMAT)
-    save_plot(plot_distribution(table, f"{name}: daily t_solar per design"), folder / "daily_t_solar_distribution.png")
-    save_plot(plot_monthly(table, f"{name}: every design month by month"), folder / "monthly_energy_t_solar.png")
+    annual_summary(table, _annual_cases(result)).to_csv(folder / "annual_summary.csv", index=False,
+                                                         float_format=FLOAT_FORMAT)
+    study = result.plan.base
+    save_plot(plot_distribution(table, f"{name}: daily t_solar per design", study=study),
+              folder / "daily_t_solar_distribution.png")
+    save_plot(plot_monthly(table, f"{name}: every design month by month", study=study),
+              folder / "monthly_energy_t_solar.png")
     written = ["annual_summary.csv", "daily_t_solar_distribution.png", "monthly_energy_t_solar.png"]
     if result.extras:
         by_angle = result.extras["by_angle"]
         by_angle.to_csv(folder / "annual_fold_angles.csv", index=False, float_format=FLOAT_FORMAT)
         save_plot(plot_annual_fold_angles(by_angle, f"{name}: the year at each fold angle "
-                                                    f"({result.plan.base.objective.statistic})"),
+                                                    f"({result.plan.base.objective.statistic})", study),
                   folder / "annual_t_solar_vs_fold_angle.png")
         written += ["annual_fold_angles.csv", "annual_t_solar_vs_fold_angle.png"]
         angle = result.extras["fold_angle"]
@@ -626,28 +621,32 @@ def annual_outputs(result, folder: Path, name: str) -> list[str]:
         save_plot(plot_day_hour(result.extras, "switch_state", f"{name}: connection the switch chooses at {angle:g}°",
                                 ""), folder / "day_hour_switch_state.png")
         written += ["day_hour_power.png", "day_hour_switch_state.png"]
+    if "annual_objective" in result.extras:
+        result.extras["annual_objective"].to_csv(folder / "annual_objective.csv", index=False,
+                                                 float_format=FLOAT_FORMAT)
+        written.append("annual_objective.csv")
     if "refold_value" in result.extras:
         result.extras["refold_value"].to_csv(folder / "refold_value.csv", index=False, float_format=FLOAT_FORMAT)
         result.extras["refold_schedule"].to_csv(folder / "refold_schedule.csv", index=False,
                                                 float_format=FLOAT_FORMAT)
         save_plot(plot_refold_value(result.extras["refold_value"], f"{name}: what each re-fold visit is worth",
-                                    result.plan.base.load_profile is not None), folder / "refold_value.png")
+                                    result.plan.base), folder / "refold_value.png")
         written += ["refold_value.csv", "refold_schedule.csv", "refold_value.png"]
     return written
 
 
-def plot_refold_value(values: pd.DataFrame, title: str, profile: bool = False, ax=None):
+def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
     """The objective of the best schedule of k fold settings a year against k, per load (the first
-    site's; scales of the load profile where ``profile``), beside the flat panel and the tracker
+    site's; ``study`` names a load profile's loads), beside the flat panel and the tracker
     (:func:`foldopt.sweeps.refold_tables`)."""
     fig, ax = _axes(ax, (7, 4.5))
     first = values[(values["latitude"] == values["latitude"].iloc[0])
                    & (values["longitude"] == values["longitude"].iloc[0])]
     for (load, rows), colour in zip(first.groupby("p_load_w"), plt.rcParams["axes.prop_cycle"].by_key()["color"],
                                     strict=False):
-        ax.plot(rows["settings"], rows["objective_h"], "o-", color=colour, label=f"twofold, {load_text(load, profile)}")
-        ax.axhline(rows["flat_objective_h"].iloc[0], color=colour, ls="--", lw=1)
-        ax.axhline(rows["tracker_objective_h"].iloc[0], color=colour, ls=":", lw=1)
+        ax.plot(rows["settings"], rows["objective_h"], "o-", color=colour, label=f"twofold, {_load_label(study, load)}")
+        ax.axhline(rows["objective_flat_h"].iloc[0], color=colour, ls="--", lw=1)
+        ax.axhline(rows["objective_tracker_h"].iloc[0], color=colour, ls=":", lw=1)
     ax.plot([], [], "k--", lw=1, label="flat panel")
     ax.plot([], [], "k:", lw=1, label="tracker")
     ax.set_xlabel("fold settings a year (1 = one fixed angle)")
@@ -659,82 +658,12 @@ def plot_refold_value(values: pd.DataFrame, title: str, profile: bool = False, a
     return ax
 
 
-# --- Digests: the answer first, in a few numbers -------------------------------------------------
-
-
-def _number(value):
-    """A plain float, or None where a table shows "-" (NaN)."""
-    value = float(value)
-    return value if np.isfinite(value) else None
-
-
-def digest_study(result: StudyResult) -> dict:
-    """The answer of one study in a few numbers: the best fold angle, its gains, the notes."""
-    study, summary = result.study, result.summary.set_index("design")
-    twofold = summary.loc["twofold"]
-    return {
-        "study": study.name, "mode": study.mode, "pv_model": study.pv_model, "connection": study.connection,
-        "site": {"name": study.site.name, "latitude": study.site.latitude, "longitude": study.site.longitude},
-        "date": study.date.isoformat(), "p_load_w": study.p_load, "load_profile": study.load_profile is not None,
-        "fold_angle_deg": result.optimal_fold_angle, "heuristic_fold_angle_deg": _number(result.heuristic_fold_angle),
-        "t_solar_h": {design: _number(summary.loc[design, "t_solar_h"])
-                      for design in ("flat", "twofold", "tracker", "tracker-net")},
-        "gain_vs_flat_pct": _number(twofold["gain_vs_flat_pct"]),
-        "pct_of_tracker_t_solar": _number(twofold["pct_of_tracker_t_solar"]),
-        "flat_area_multiple": _number(twofold["flat_area_multiple"]),
-        "tracker_break_even_standby_w": _number(result.standby[1]),
-        "notes": sorted({note for note in summary["note"] if note}),
-    }
-
-
-def digest_sweep(result) -> dict:
-    """The answer of a sweep in a few numbers: where folding gains most, the fold angles, the notes,
-    and with an annual objective each load's angle and year."""
-    table = result.table
-    twofold = table[table["design"] == "twofold"]
-    gains = twofold["gain_vs_flat_pct"].dropna()
-    digest = {
-        "study": result.plan.base.name, "cases": result.plan.n_cases,
-        "load_profile": result.plan.base.load_profile is not None,
-        "axes": {path: len(values) for path, values in result.plan.axes},
-        "fold_angle_deg": {"min": _number(twofold["fold_angle_deg"].min()),
-                           "max": _number(twofold["fold_angle_deg"].max())},
-        "notes": {note: int(count) for note, count in
-                  twofold["note"].str.split("; ").explode().value_counts().items() if note},
-    }
-    if len(gains):
-        best = twofold.loc[gains.idxmax()]
-        digest["gain_vs_flat_pct"] = {
-            "median": _number(gains.median()), "max": _number(gains.max()),
-            "at": {column: best[column].item() if hasattr(best[column], "item") else best[column]
-                   for column in result.varied if column in best and column != "day_of_year"},
-        }
-    if result.extras and table["site_name"].nunique() == 1 and table["latitude"].nunique() == 1:
-        summary = annual_summary(table, ["p_load_w"]).set_index(["p_load_w", "design"])
-        digest["year"] = [
-            {"p_load_w": float(load), "fold_angle_deg": _number(summary.loc[(load, "twofold"), "fold_angle_deg"]),
-             "mean_t_solar_h": {design: _number(summary.loc[(load, design), "mean_h"])
-                                for design in ("flat", "twofold", "tracker")},
-             "t_solar_gain_vs_flat_pct": _number(summary.loc[(load, "twofold"), "t_solar_gain_vs_flat_pct"]),
-             "energy_gain_vs_flat_pct": _number(summary.loc[(load, "twofold"), "energy_gain_vs_flat_pct"])}
-            for load in sorted(table["p_load_w"].unique())
-        ]
-    if "refold_value" in result.extras:
-        values = result.extras["refold_value"]
-        digest["refold"] = [
-            {"p_load_w": float(load), "objective": rows["objective"].iloc[0],
-             "objective_h": {int(k): float(v) for k, v in zip(rows["settings"], rows["objective_h"], strict=True)},
-             "flat_h": float(rows["flat_objective_h"].iloc[0]), "tracker_h": float(rows["tracker_objective_h"].iloc[0])}
-            for load, rows in values.groupby("p_load_w")
-        ] if values["latitude"].nunique() == 1 and values["longitude"].nunique() == 1 else []
-    return digest
-
-
 # --- Maps: many sites (foldopt.worldmap) --------------------------------------------------------
 
 #: The map figures: column, file, what it shows, colour bar label, diverging colours.
 MAP_FIGURES = (
-    ("fold_angle_deg", "map_fold_angle.png", "best fold angle", "fold angle Θ [deg] (180 = flat)", False),
+    ("recommended_fold_angle_deg", "map_fold_angle.png", "recommended fold angle (centre of the near-optimal range)",
+     "fold angle Θ [deg] (180 = flat)", False),
     ("gain_vs_flat_pct", "map_gain_vs_flat.png", "t_solar gain of the twofold panel over flat",
      "gain over flat [%]", True),
     ("pct_of_tracker", "map_pct_of_tracker.png", "twofold panel's t_solar as a share of the tracker's",
@@ -846,155 +775,9 @@ def _atomic_figure(path: Path, ax) -> None:
     write_atomically(path, lambda temporary: save_plot(ax, temporary))
 
 
-# --- Answers: the few lines that say what a result means ------------------------------------
-
-def _hours(value) -> str:
-    return "-" if value is None else f"{value:.2f} h"
-
-
-def _pct(value, signed: bool = True) -> str:
-    return "-" if value is None else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
-
-
-def load_text(p_load: float, profile: bool) -> str:
-    """``P_load 2 W``, or for a load profile its scale: ``load profile x0.5``."""
-    return f"load profile x{p_load:g}" if profile else f"P_load {p_load:g} W"
-
-
-def study_answer(digest: dict, defaults: list[str]) -> list[str]:
-    site = digest["site"]
-    where = site["name"] or f"{site['latitude']:g}, {site['longitude']:g}"
-    hours = digest["t_solar_h"]
-    lines = [f"{digest['study']}: {where}, {digest['date']}, {load_text(digest['p_load_w'], digest['load_profile'])} "
-             f"({digest['mode']} mode, {digest['pv_model']} + {digest['connection']})"]
-    if defaults:
-        lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
-    heuristic = digest["heuristic_fold_angle_deg"]
-    if not hours["twofold"]:
-        lines.append(f"no fold angle reaches the load: t_solar 0 h (flat {_hours(hours['flat'])}, tracker "
-                     f"{_hours(hours['tracker'])})")
-    else:
-        lines.append(f"best fold angle {digest['fold_angle_deg']:.1f} deg"
-                     + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic is not None else "")
-                     + f": t_solar {_hours(hours['twofold'])}, {_pct(digest['gain_vs_flat_pct'])} over flat "
-                     f"({_hours(hours['flat'])}), {_pct(digest['pct_of_tracker_t_solar'], False)} of the tracker's "
-                     f"{_hours(hours['tracker'])}")
-    extras = []
-    if digest["flat_area_multiple"] is not None:
-        extras.append(f"a flat panel would need {digest['flat_area_multiple']:.2f}x the area")
-    if digest["tracker_break_even_standby_w"] is not None:
-        extras.append(f"the twofold panel outlasts the tracker once its standby draw exceeds "
-                      f"{digest['tracker_break_even_standby_w']:.2f} W")
-    if extras:
-        lines.append("; ".join(extras))
-    if digest["notes"]:
-        lines.append(f"note: {'; '.join(digest['notes'])}")
-    return lines
-
-
-def sweep_answer(digest: dict, defaults: list[str]) -> list[str]:
-    axes = " x ".join(f"{count} {path.split('.')[-1]}" for path, count in digest["axes"].items())
-    lines = [f"{digest['study']}: {digest['cases']} cases ({axes})"]
-    if defaults:
-        lines.append(f"  from {defaults[0]}: {', '.join(defaults[1:])}")
-    for year in digest.get("year", []):
-        mean = year["mean_t_solar_h"]
-        lines.append(f"{load_text(year['p_load_w'], digest['load_profile'])}: fold angle {year['fold_angle_deg']:g} deg all year, mean t_solar "
-                     f"{_hours(mean['twofold'])} ({_pct(year['t_solar_gain_vs_flat_pct'])} over flat "
-                     f"{_hours(mean['flat'])}, energy {_pct(year['energy_gain_vs_flat_pct'])}); tracker "
-                     f"{_hours(mean['tracker'])}")
-    for refold in digest.get("refold", []):
-        settings = refold["objective_h"]
-        shown = [k for k in settings if k in (1, 2, 3, 4, 6, 12)]
-        lines.append(f"{load_text(refold['p_load_w'], digest['load_profile'])}, re-folded ({refold['objective']} t_solar): "
-                     + ", ".join(f"{k} setting{'s' if k > 1 else ''} {settings[k]:.2f} h" for k in shown)
-                     + f"; flat {refold['flat_h']:.2f} h, tracker {refold['tracker_h']:.2f} h (refold_schedule.csv)")
-    gain = digest.get("gain_vs_flat_pct")
-    if gain and "year" not in digest:
-        at = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
-                       for key, value in gain["at"].items())
-        lines.append(f"twofold over flat: median {_pct(gain['median'])}, best {_pct(gain['max'])} ({at}); "
-                     f"fold angles {digest['fold_angle_deg']['min']:g} to {digest['fold_angle_deg']['max']:g} deg")
-    if digest["notes"]:
-        lines.append("notes: " + ", ".join(f"{note} ({count} of {digest['cases']} cases)"
-                                           for note, count in digest["notes"].items()))
-    return lines
-
-
-def digest_map(result, relative: bool) -> dict:
-    """Per load, over the sites: where folding pays in the year."""
-    table = result.table
-    year = table[table["period"] == "year"]
-    per_load = []
-    for load, rows in year.groupby("p_load_fraction" if relative else "p_load_w", sort=True):
-        gain = rows["gain_vs_flat_pct"]
-        best = rows.loc[gain.idxmax()] if gain.notna().any() else None
-        per_load.append({
-            ("p_load_fraction" if relative else "p_load_w"): float(load),
-            "sites": int(len(rows)),
-            "sites_folding_pays": int((gain > 0.05).sum()),
-            "median_gain_vs_flat_pct": _number(gain.median()),
-            "best_gain_vs_flat_pct": _number(gain.max()),
-            "best_site": None if best is None else {"site_name": best["site_name"], "latitude": best["latitude"],
-                                                    "longitude": best["longitude"]},
-            "fold_angle_deg": {"min": _number(rows["fold_angle_deg"].min()),
-                               "median": _number(rows["fold_angle_deg"].median()),
-                               "max": _number(rows["fold_angle_deg"].max())},
-            "median_pct_of_tracker": _number(rows["pct_of_tracker"].median()),
-            "median_tracker_break_even_standby_w": _number(rows["tracker_break_even_standby_w"].median()),
-        })
-    return {"sites": int(table["site_id"].nunique()), "loads": per_load, "cluster": result.cluster,
-            "dashboard": result.dashboard, "chunks_computed": len(result.computed),
-            "chunks_from_disk": len(result.from_disk), "seconds": round(result.seconds, 2)}
-
-
-def _count(number: int, noun: str) -> str:
-    return f"{number} {noun}{'' if number == 1 else 's'}"
-
-
-def map_answer(digest: dict, result) -> list[str]:
-    spec = result.spec
-    study = spec.study
-    sky = "weather files" if any("weather" in site for site in spec.sites) else "Ineichen clear sky" if study.get(
-        "sky") == "ineichen" else f"{study.get('sky')} sky"
-    lines = [f"map: {_count(digest['sites'], 'site')}, year {spec.year}, {sky}, objective {study['objective']['statistic']}, "
-             f"{study['panel']['area']:g} m^2 panel"]
-    for load in digest["loads"]:
-        what = (f"P_load {load['p_load_fraction']:g} x flat peak" if "p_load_fraction" in load
-                else f"P_load {load['p_load_w']:g} W")
-        best = load["best_site"]
-        where = "" if best is None else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
-        angles = load["fold_angle_deg"]
-        standby = load["median_tracker_break_even_standby_w"]
-        tracker = ("" if standby is None else ", whose own moves already cost it its lead" if standby == 0
-                   else f", which loses its lead above a median {standby:.2f} W of standby")
-        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')} (median "
-                     f"{_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} at {where}); "
-                     f"fold angles {angles['min']:g} to {angles['max']:g} deg; median "
-                     f"{_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}")
-    rate = len(spec.sites) / digest["seconds"] if digest["seconds"] else 0
-    computed = (f"computed {_count(digest['chunks_computed'], 'chunk')} on {digest['cluster']}" if digest["chunks_computed"]
-                else "nothing to compute")
-    resumed = f", {digest['chunks_from_disk']} from disk" if digest["chunks_from_disk"] else ""
-    lines.append(f"{computed}{resumed} in {digest['seconds']:.1f} s ({rate:.1f} sites/s)")
-    return lines
-
-
-def write_map_report(result, figures: list[str], answer: list[str]) -> Path:
+def write_map_report(result, figures: list[str], answer) -> Path:
     """``report.html`` of a map's folder: the question, the answer, the maps and the year's rows."""
-    spec = result.spec
-    study = spec.study
-    loads = ", ".join(f"{load:g}" for load in spec.loads)
-    question = {
-        "sites": f"{len(spec.sites):,}",
-        "loads": f"{loads} {'x each site' + chr(39) + 's flat peak' if spec.relative else 'W'}",
-        "year": str(spec.year),
-        "panel": f"{study['panel']['area']:g} m^2 facing the equator at |latitude|",
-        "objective": study.get("objective", {}).get("statistic", "mean"),
-        "models": f"{study.get('mode')} mode, {study.get('pv_model', 'ideal')} PV model, "
-                  f"{'weather files' if any('weather' in s for s in spec.sites) else study.get('sky', '') + ' sky'}",
-    }
     metadata = json.loads((result.out / "run.json").read_text())
     year = result.table[result.table["period"] == "year"]
-    return write_html(result.out, "foldopt: map", question, answer, figures, year,
-                      "The year per site and load (map.csv has every season)", [], metadata)
+    return write_html(result.out, answer, figures, year, "The year per site and load (map.csv has every season)",
+                      metadata)

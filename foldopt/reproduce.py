@@ -8,6 +8,9 @@ paper's 7.73 h is what its own model gave.
 
 from __future__ import annotations
 
+import functools
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 
@@ -22,9 +25,9 @@ PAPER_VALUES = {
     "tracker_t_solar_h": ("h", 11.11),
     "twofold_opt_fold_angle_deg": ("deg", 29.8),
     "twofold_t_solar_h": ("h", 9.49),
-    "twofold_gain_pct": ("%", 23.0),
-    "twofold_vs_tracker_pct": ("%", 85.4),
-    "fold90_gain_pct": ("%", 15.5),
+    "twofold_gain_vs_flat_pct": ("%", 23.0),
+    "twofold_pct_of_tracker": ("%", 85.4),
+    "fold90_gain_vs_flat_pct": ("%", 15.5),
     "flat_area_multiple": ("-", 2.61),
 }
 GEOMETRY_OF_MODE = {"paper": "azimuth-split", "exact": "hinge"}
@@ -33,6 +36,22 @@ REPRODUCTIONS = {
     "reproduction": {},
     "reproduction_single_diode": {"pv_model": "single-diode", "connection": "switching"},
 }
+
+
+@dataclass(frozen=True)
+class Reproduction:
+    """The reproduction tables (:func:`foldopt.reproduce`), the paper's study and the engine."""
+
+    tables: dict
+    study: Study
+    engine: str = "numba"
+
+    @functools.cached_property
+    def answer(self):
+        """The :class:`foldopt.answer.Answer` every view renders."""
+        from foldopt.answer import of_reproduction
+
+        return of_reproduction(self.tables, self.study)
 
 
 def infer_p_load(study: Study, flat_t_solar_h: float = PAPER_VALUES["flat_t_solar_h"][1]) -> float:
@@ -53,9 +72,9 @@ def reproduction_values(study: Study, engine: str = "numba") -> dict[str, float]
         "tracker_t_solar_h": tracker["t_solar_h"],
         "twofold_opt_fold_angle_deg": twofold["fold_angle_deg"],
         "twofold_t_solar_h": twofold["t_solar_h"],
-        "twofold_gain_pct": twofold["gain_vs_flat_pct"],
-        "twofold_vs_tracker_pct": twofold["pct_of_tracker_t_solar"],
-        "fold90_gain_pct": (fold90 / flat["t_solar_h"] - 1.0) * 100.0,
+        "twofold_gain_vs_flat_pct": twofold["gain_vs_flat_pct"],
+        "twofold_pct_of_tracker": twofold["pct_of_tracker"],
+        "fold90_gain_vs_flat_pct": (fold90 / flat["t_solar_h"] - 1.0) * 100.0,
         "flat_area_multiple": twofold["flat_area_multiple"],
     }
 

@@ -146,3 +146,17 @@ def _taken(plan: Plan, changes: dict, field: str | None, data: dict, decided: li
     taken += [item for item in decided if item != policy.EXACT_NOTE]
     return taken
 
+
+
+def size_request(plan: Plan, source: str, cost_given: bool) -> Request:
+    """A sizing's request: the study's one case, and what the sizing took from it (the site, day,
+    load and efficiency, and the paper's panel cost where no cost is given)."""
+    from foldopt.loads import load_text
+    from foldopt.costs import PAPER_COST_PER_M2
+
+    study = plan.base
+    taken = [f"site, day, {load_text(study)}, efficiency {study.panel.efficiency:g}"]
+    if not cost_given:
+        taken.append(f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
+                     "cost_per_m2 or cost_per_w)")
+    return Request(plan, source, tuple(taken))

@@ -9,10 +9,14 @@ k follows from one root search for the load.
 
 from __future__ import annotations
 
+import functools
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 
 from foldopt import engine as engines
+from foldopt.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2  # noqa: F401 (re-exported)
 from foldopt.metrics import load_for_t_solar
 
 
@@ -39,8 +43,31 @@ def flat_area_multiple(p_flat, p_load, target_t_solar, step_hours):
     return p_load / load_for_t_solar(p_flat, target_t_solar, step_hours)
 
 
-C_GRID = 0.22  # [$/kWh], Shin et al. Sec. IV-A
-LIFETIME_YEARS = 20  # Shin et al. Sec. IV-A
+
+
+@dataclass(frozen=True)
+class SizingResult:
+    """A panel sizing (:func:`foldopt.size`): ``table`` per design and area, ``best`` the area of
+    each design with the largest lifetime net benefit, ``parameters`` the costs, price and
+    lifetime used, ``answer`` the :class:`foldopt.answer.Answer` every view renders."""
+
+    study: object
+    table: pd.DataFrame
+    best: pd.DataFrame
+    parameters: dict
+    request: object = None
+
+    @functools.cached_property
+    def answer(self):
+        from foldopt.answer import of_sizing
+
+        return of_sizing(self.table, self.best, self.study, self.parameters,
+                         self.request.defaults if self.request is not None else None)
+
+
+def best_areas(table: pd.DataFrame) -> pd.DataFrame:
+    """The row of each design with the largest net benefit."""
+    return table.loc[table.groupby("design", sort=False)["net_benefit_usd"].idxmax()].reset_index(drop=True)
 
 
 def stc_power_per_area(pv, temp_ref: float = 25.0) -> float:
@@ -55,7 +82,7 @@ def size_panel(
     cost_per_w: float | None = None,
     c_grid: float = C_GRID,
     years: float = LIFETIME_YEARS,
-    days_per_year: float = 365.0,
+    days_per_year: float = DAYS_PER_YEAR,
 ):
     """Net benefit of flat and optimally folded twofold panels over a range of areas.
 

@@ -9,6 +9,8 @@ tracker functions work on whole skies (every day at once).
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -122,13 +124,16 @@ class StudyResult:
         Per fold angle of the grid: ``fold_angle_deg``, t_solar [h] and energy [Wh] of every connection.
     summary : pandas.DataFrame
         Per design (``flat``, ``twofold``, ``twofold-heuristic``, ``tracker``, ``tracker-net``...):
-        ``fold_angle_deg``, ``t_solar_h``, ``t_solar_contiguous_h``, ``energy_wh``, ``peak_power_w``,
-        ``gain_vs_flat_pct``, ``pct_of_tracker_t_solar``, ``flat_area_multiple``, ``note``.
+        ``fold_angle_deg``, ``t_solar_h``, ``t_solar_contiguous_h``, ``energy_harvested_wh``, ``peak_power_w``,
+        ``gain_vs_flat_pct``, ``pct_of_tracker``, ``flat_area_multiple``, ``note``.
     timeseries : pandas.DataFrame
         Indexed by the day's tz-aware step centres (``time``): sun [deg], ``dni`` [W/m^2], the power
         [W] of every design at the optimum and the ``switch_state``.
     optimal_fold_angle, heuristic_fold_angle : float
         [deg]; the heuristic is NaN where the paper's rule has no answer.
+    near_optimal : dict
+        The near-optimal range of the fold angle on the sweep's grid and the recommended angle at
+        its centre (:func:`foldopt.designs.near_optimal`) [deg], and its tolerance [h].
     standby : tuple
         (table, break-even draw [W]) of :func:`standby_sweep`.
     engine : str
@@ -143,6 +148,15 @@ class StudyResult:
     heuristic_fold_angle: float
     standby: tuple  # (table, break-even standby draw [W]) of :func:`standby_sweep`
     engine: str = "numba"
+    near_optimal: dict = dataclasses.field(default_factory=dict)
+    request: object = None  # the foldopt.request.Request the study came from, if any
+
+    @functools.cached_property
+    def answer(self):
+        """The :class:`foldopt.answer.Answer` every view of this result renders."""
+        from foldopt.answer import of_study
+
+        return of_study(self)
 
 
 def _best_angle(day: Day, angles, sweep_t_solar, connection):
@@ -153,7 +167,7 @@ def _best_angle(day: Day, angles, sweep_t_solar, connection):
     )[0]
 
 
-def run_study(study: Study, engine: str = "numba") -> StudyResult:
+def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     """Sweep the fold angle and compare flat, twofold and tracker.
 
     ``engine`` evaluates the fold-angle sweep (:data:`foldopt.engine.ENGINES`).
@@ -186,7 +200,7 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
     sweep["noon_valley_w"] = noon_valley(*day.subpanel_power(angles))
     for index, connection in enumerate(CONNECTIONS):
         sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
-        sweep[f"energy_{connection}_wh"] = metrics.energy[:, index]
+        sweep[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
 
     best_angle = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
     # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
@@ -220,7 +234,7 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
-    summary["pct_of_tracker_t_solar"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
+    summary["pct_of_tracker"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
     summary["flat_area_multiple"] = [
         flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 and shape is None else np.nan
         for hours in summary["t_solar_h"]
@@ -243,7 +257,9 @@ def run_study(study: Study, engine: str = "numba") -> StudyResult:
         },
         index=pd.DatetimeIndex(day.times, name="time"),
     )
-    return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby, engine)
+    near = {key: float(value) for key, value in near_optimal(angles, sweep["t_solar_h"].to_numpy(),
+                                                             study.near_optimal).items()}
+    return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby, engine, near, request)
 
 
 def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):

@@ -11,6 +11,7 @@ through the same metrics from their power curves.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import json
 from collections.abc import Callable
@@ -36,6 +37,13 @@ class SweepResult:
     engine: str = "numba"
     weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
     request: object = None  # the foldopt.request.Request the plan came from, if any
+
+    @functools.cached_property
+    def answer(self):
+        """The :class:`foldopt.answer.Answer` every view of this result renders."""
+        from foldopt.answer import of_sweep
+
+        return of_sweep(self)
 
 
     @property
@@ -71,7 +79,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     SweepResult
         Columns: the case (``site_name``, ``latitude``, ``longitude``, ``date``, ``day_of_year``,
         ``p_load_w`` and any other swept field by its path), ``design``, ``fold_angle_deg`` and the
-        daily metrics, ``gain_vs_flat_pct``, ``pct_of_tracker_t_solar`` and ``note``
+        daily metrics, ``gain_vs_flat_pct``, ``pct_of_tracker`` and ``note``
         (:func:`foldopt.metrics.notes`: polar night, polar day, overcast, load above peak).
     """
     axes = dict(plan.axes)
@@ -237,7 +245,7 @@ def _table(cases, loads, metrics) -> pd.DataFrame:
         if name not in ("fold_angle_deg", "condition"):
             columns[name] = metrics[name].ravel()
     columns["gain_vs_flat_pct"] = ((relative_to(hours, hours[..., :1]) - 1.0) * 100.0).ravel()
-    columns["pct_of_tracker_t_solar"] = (relative_to(hours, hours[..., 2:3]) * 100.0).ravel()
+    columns["pct_of_tracker"] = (relative_to(hours, hours[..., 2:3]) * 100.0).ravel()
     columns["note"] = notes(metrics["condition"], hours).ravel()
     table = pd.DataFrame(columns)
     for name in case_rows[0]:
@@ -291,7 +299,7 @@ def refold_tables(blocks: Blocks, loads, angles, daily, months, objective, desig
                            "objective_h": schedule.objective_h, "mean_t_solar_h": float(chosen.mean()),
                            "gain_vs_fixed_pct": 100.0 * (schedule.objective_h / fixed - 1.0) if fixed > 0 else np.nan,
                            "added_by_setting_h": np.nan if previous is None else schedule.objective_h - previous,
-                           "flat_objective_h": float(flat), "tracker_objective_h": float(tracker)})
+                           "objective_flat_h": float(flat), "objective_tracker_h": float(tracker)})
             previous = schedule.objective_h
             for visit, (start, angle) in enumerate(zip(schedule.starts, schedule.angles, strict=True), start=1):
                 visits.append({**where, "p_load_w": float(load), "settings": k, "visit": visit,

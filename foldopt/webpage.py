@@ -97,39 +97,42 @@ def table_html(table: pd.DataFrame, max_rows: int = MAX_ROWS) -> str:
     return f'<div class="scroll"><table><thead><tr>{head}</tr></thead><tbody>{"".join(rows)}</tbody></table></div>{more}'
 
 
-def write_html(folder: Path, title: str, question: dict, answer: list[str], figures: list[str],
-               table: pd.DataFrame | None = None, table_title: str = "Table", notes: list[str] | None = None,
-               provenance: dict | None = None) -> Path:
-    """Write ``folder/report.html`` atomically.
+def write_html(folder: Path, answer, figures: list[str], table: pd.DataFrame | None = None,
+               table_title: str = "Table", provenance: dict | None = None, designs: bool = False) -> Path:
+    """Write ``folder/report.html`` atomically: a view of ``answer``, nothing decided here.
 
     Parameters
     ----------
     folder : pathlib.Path
         The results folder; ``figures`` are PNG files in it.
-    title : str
-    question : dict
-        What was asked, label to value (site, days, load, panel...).
-    answer : list of str
-        The answer's lines, first on the page.
+    answer : foldopt.answer.Answer
+        The question, the answer's lines (the terminal's words, notes included), its near-optimal
+        range and re-fold schedule (and with ``designs`` its designs compared), first on the page.
     figures : list of str
         File names of the figures, in order.
     table : pandas.DataFrame, optional
         Shown sortable (at most :data:`MAX_ROWS` rows).
-    notes : list of str, optional
+    table_title : str
     provenance : dict, optional
         ``run.json``'s content: command, versions, input digest.
+    designs : bool
+        Also show the answer's designs table (where ``table`` is not that table already).
 
     Returns
     -------
     pathlib.Path
     """
     folder = Path(folder)
+    title = f"foldopt: {answer.title}"
     parts = [f"<h1>{html.escape(title)}</h1>", '<dl class="question">']
-    for label, value in question.items():
+    for label, value in answer.question.items():
         parts.append(f"<dt>{html.escape(str(label))}</dt><dd>{html.escape(str(value))}</dd>")
     parts.append("</dl>")
     parts.append('<section class="answer"><h2>Answer</h2>'
-                 + "".join(f"<p>{html.escape(line)}</p>" for line in answer) + "</section>")
+                 + "".join(f"<p>{html.escape(line)}</p>" for line in answer.lines()) + "</section>")
+    for name, shown in answer.tables():
+        if name != "Designs compared" or designs:
+            parts.append(f'<h2>{html.escape(name)}</h2>{table_html(shown)}')
     if figures:
         parts.append("<h2>Figures</h2>")
         for name in figures:
@@ -138,8 +141,6 @@ def write_html(folder: Path, title: str, question: dict, answer: list[str], figu
     if table is not None:
         parts.append(f"<h2>{html.escape(table_title)}</h2>")
         parts.append(table_html(table))
-    if notes:
-        parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(note)}</li>" for note in notes) + "</ul>")
     if provenance:
         command = provenance.get("command")
         shown = " ".join(command) if isinstance(command, list) else str(command or "")

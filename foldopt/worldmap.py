@@ -192,10 +192,13 @@ def evaluate_sites(study: dict, sites: Sequence[dict], loads: Sequence[float], r
         ``longitude``, ``weather``, ``flat_peak_w``, ``p_load_w``, ``p_load_fraction``, ``period``,
         ``days``, ``fold_angle_deg``; the objective [h] of each design (``objective_flat_h``,
         ``objective_twofold_h``, ``objective_tracker_h``); mean daily t_solar [h]
-        (``t_solar_flat_h``, ``t_solar_twofold_h``, ``t_solar_tracker_h``, the tracker's net of its
-        own draw ``t_solar_tracker_net_h``); harvested energy [kWh] (``energy_flat_kwh``,
-        ``energy_twofold_kwh``, ``energy_tracker_kwh``); ``gain_vs_flat_pct`` and
+        (``mean_t_solar_flat_h``, ``mean_t_solar_twofold_h``, ``mean_t_solar_tracker_h``, the tracker's net of its
+        own draw ``mean_t_solar_tracker_net_h``); harvested energy [Wh] (``energy_harvested_flat_wh``,
+        ``energy_harvested_twofold_wh``, ``energy_harvested_tracker_wh``); ``gain_vs_flat_pct`` and
         ``pct_of_tracker`` (of the objective), ``energy_gain_vs_flat_pct``; and
+        the near-optimal range of the fold angle and the recommended angle at its centre
+        (``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg``,
+        ``near_optimal_tolerance_h``: :func:`foldopt.designs.near_optimal`);
         ``tracker_break_even_standby_w``, the standby draw [W] above which the twofold panel's
         objective exceeds the tracker's (0 where it already does; NaN where the twofold panel
         never carries the load).
@@ -242,13 +245,14 @@ def _evaluate_site(study_data: dict, site: dict, loads, relative: bool, year: in
             "objective_twofold_h": statistic_of(at_best, season),
             "objective_tracker_h": statistic_of(tracker_hours, season),
             "objective_tracker_net_h": statistic_of(tracker_net, season),
-            "t_solar_flat_h": flat_hours[days].mean(axis=0),
-            "t_solar_twofold_h": at_best[days].mean(axis=0),
-            "t_solar_tracker_h": tracker_hours[days].mean(axis=0),
-            "t_solar_tracker_net_h": tracker_net[days].mean(axis=0),
-            "energy_flat_kwh": np.full(loads.size, flat_energy[days].sum() / 1000.0),
-            "energy_twofold_kwh": harvest[days][:, best].sum(axis=0) / 1000.0,
-            "energy_tracker_kwh": np.full(loads.size, tracker_energy[days].sum() / 1000.0),
+            "mean_t_solar_flat_h": flat_hours[days].mean(axis=0),
+            "mean_t_solar_twofold_h": at_best[days].mean(axis=0),
+            "mean_t_solar_tracker_h": tracker_hours[days].mean(axis=0),
+            "mean_t_solar_tracker_net_h": tracker_net[days].mean(axis=0),
+            "energy_harvested_flat_wh": np.full(loads.size, flat_energy[days].sum()),
+            "energy_harvested_twofold_wh": harvest[days][:, best].sum(axis=0),
+            "energy_harvested_tracker_wh": np.full(loads.size, tracker_energy[days].sum()),
+            **near_optimal(angles, statistic_of(hours, season), study.near_optimal),
         }
         targets.append(values["objective_twofold_h"])
         rows.append((period, int(days.sum()), angles[best], values))
@@ -258,7 +262,7 @@ def _evaluate_site(study_data: dict, site: dict, loads, relative: bool, year: in
     for (period, n_days, fold_angle, values), standby in zip(rows, break_even, strict=True):
         with np.errstate(divide="ignore", invalid="ignore"):
             gain = 100.0 * (values["objective_twofold_h"] / values["objective_flat_h"] - 1.0)
-            energy_gain = 100.0 * (values["energy_twofold_kwh"] / values["energy_flat_kwh"] - 1.0)
+            energy_gain = 100.0 * (values["energy_harvested_twofold_wh"] / values["energy_harvested_flat_wh"] - 1.0)
             share = 100.0 * values["objective_twofold_h"] / values["objective_tracker_h"]
         frames.append(pd.DataFrame({
             "site_id": site.get("site_id", 0),

@@ -63,6 +63,9 @@ def test_sweep_is_the_plan_the_yaml_would_make():
     result = foldopt.sweep(study, latitude=[0, 30], p_load="2:4:2", axes={"tracker.standby_w": [0.0, 1.0]})
     data = study.model_dump(mode="json", exclude_none=True)
     data["site"]["latitude"], data["p_load"], data["tracker"]["standby_w"] = [0, 30], "2:4:2", [0.0, 1.0]
+    # A new latitude tilts the panel at |latitude| toward the equator (foldopt.policy).
+    del data["panel"]["tilt"], data["panel"]["azimuth"]
+    data["year"] = 2014
     expected = run_plan(make_plan(data)).table
     pd.testing.assert_frame_equal(result.table, expected)
     assert len(result.table) == 2 * 2 * 2 * 4  # tidy: one row per case x design

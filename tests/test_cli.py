@@ -130,7 +130,7 @@ def test_sweep_angle_writes_sweep_and_summary(tmp_path):
     assert result.exit_code == 0, result.output
     assert FOLDER <= {p.name for p in out.iterdir()}
     sweep = pd.read_csv(out / "sweep.csv")
-    assert {"fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_wh"} <= set(sweep.columns)
+    assert {"fold_angle_deg", "t_solar_h", "t_solar_contiguous_h", "energy_harvested_wh"} <= set(sweep.columns)
     assert sweep["fold_angle_deg"].iloc[0] == 5 and sweep["fold_angle_deg"].iloc[-1] == 180
     summary = pd.read_csv(out / "summary.csv")
     assert {"flat", "twofold", "tracker"} <= set(summary["design"])
@@ -180,7 +180,7 @@ def test_sweep_angle_with_single_diode_switching(tmp_path):
     assert {"twofold-parallel", "twofold-series", "twofold-independent"} <= set(summary.index)
     sweep = pd.read_csv(out / "sweep.csv")
     for name in ("east", "west", "parallel", "series", "independent", "switching"):
-        assert f"t_solar_{name}_h" in sweep and f"energy_{name}_wh" in sweep
+        assert f"t_solar_{name}_h" in sweep and f"energy_harvested_{name}_wh" in sweep
     states = set(pd.read_csv(out / "timeseries.csv")["switch_state"])
     assert {"east", "west", "parallel"} <= states
 

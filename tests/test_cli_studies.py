@@ -133,7 +133,7 @@ def test_a_weather_file_alone_runs_a_year(tmp_path):
     assert study["objective"]["statistic"] == "mean"
     summary = pd.read_csv(out / "annual_summary.csv")
     assert set(summary["design"]) == {"flat", "twofold", "tracker", "tracker-net"} and (summary["days"] == 365).all()
-    for column in ("energy_harvested_wh", "poa_kwh_m2", "energy_gain_vs_flat_pct", "t_solar_pct_of_tracker"):
+    for column in ("energy_harvested_wh", "poa_kwh_m2", "energy_gain_vs_flat_pct", "pct_of_tracker"):
         assert summary[column].notna().all(), column
     # A site far from the file's is refused with both sites named; --force-site keeps it.
     far = invoke("sweep", "angle", "--weather", tmy3, "--lat", "0", "--lon", "0", "--p-load", "2", "--area", "0.108",

@@ -47,10 +47,10 @@ def test_contiguous_takes_the_longest_hump():
 def test_energy_and_peak_of_a_half_sine():
     hours, step = centres(1)
     metrics = daily_metrics(sine_day(hours), 5.0, step)
-    assert metrics["energy_wh"] == pytest.approx(P_MAX * 24 / np.pi, rel=1e-5)
+    assert metrics["energy_harvested_wh"] == pytest.approx(P_MAX * 24 / np.pi, rel=1e-5)
     assert metrics["peak_power_w"] == pytest.approx(P_MAX, rel=1e-4)
     assert metrics["energy_served_wh"] == pytest.approx(5.0 * sine_t_solar(5.0), rel=1e-4)
-    assert metrics["energy_wasted_wh"] == pytest.approx(metrics["energy_wh"] - metrics["energy_served_wh"])
+    assert metrics["energy_wasted_wh"] == pytest.approx(metrics["energy_harvested_wh"] - metrics["energy_served_wh"])
 
 
 def test_polar_day_night_and_load_above_peak():

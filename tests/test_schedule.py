@@ -110,8 +110,8 @@ def test_a_weather_year_schedule_agrees_with_the_annual_sweep():
         assert one["objective_h"] == pytest.approx(designs["twofold"], abs=1e-9)
         fixed = table[(table["p_load_w"] == load) & (table["design"] == "twofold")]["fold_angle_deg"].iloc[0]
         assert visits[(visits["p_load_w"] == load) & (visits["settings"] == 1)]["fold_angle_deg"].iloc[0] == fixed
-        assert one["flat_objective_h"] == pytest.approx(designs["flat"], abs=1e-9)
-        assert one["tracker_objective_h"] == pytest.approx(designs["tracker"], abs=1e-9)
+        assert one["objective_flat_h"] == pytest.approx(designs["flat"], abs=1e-9)
+        assert one["objective_tracker_h"] == pytest.approx(designs["tracker"], abs=1e-9)
         assert (np.diff(rows["objective_h"]) >= -1e-12).all()
     # Re-folding every day is the bound: the best angle of each day.
     plan = make_plan({**data, "p_load": 1.0})

@@ -38,7 +38,7 @@ def test_hemispheres_mirror_at_a_zero_declination_equinox():
                       "site": {"latitude": [34.0, -34.0], "longitude": 0, "timezone": "UTC"}})
     table = run_plan(plan).table
     north, south = table[table.latitude > 0].reset_index(), table[table.latitude < 0].reset_index()
-    for column in ("t_solar_h", "energy_wh", "fold_angle_deg"):
+    for column in ("t_solar_h", "energy_harvested_wh", "fold_angle_deg"):
         np.testing.assert_allclose(north[column], south[column], rtol=1e-9, equal_nan=True)
 
 

@@ -164,13 +164,13 @@ def test_annual_summary_has_the_years_totals(tmp_path):
     table = result.table
     for (load, design), row in summary.iterrows():
         rows = table[(table.p_load_w == load) & (table.design == design)]
-        assert row.energy_harvested_wh == pytest.approx(rows.energy_wh.sum())
+        assert row.energy_harvested_wh == pytest.approx(rows.energy_harvested_wh.sum())
         assert row.energy_served_wh == pytest.approx(load * rows.t_solar_h.sum())
         assert row.energy_harvested_wh == pytest.approx(row.energy_served_wh + row.energy_wasted_wh)
         assert row.poa_kwh_m2 == pytest.approx(rows.poa_kwh_m2.sum())
         flat, tracker = summary.loc[(load, "flat")], summary.loc[(load, "tracker")]
         assert row.energy_gain_vs_flat_pct == pytest.approx((row.energy_harvested_wh / flat.energy_harvested_wh - 1) * 100)
-        assert row.t_solar_pct_of_tracker == pytest.approx(row.mean_h / tracker.mean_h * 100)
+        assert row.pct_of_tracker == pytest.approx(row.mean_t_solar_h / tracker.mean_t_solar_h * 100)
     # The flat panel's year on the plane of its array: the tilted Perez sum of the file.
     assert summary.loc[(2.0, "flat"), "poa_kwh_m2"] == pytest.approx(1776, abs=5)
     assert summary.loc[(2.0, "flat"), "energy_gain_vs_flat_pct"] == 0

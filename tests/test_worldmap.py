@@ -33,17 +33,17 @@ def test_year_rows_equal_the_annual_sweep(la_map):
     same site: same fold angle, same daily t_solar of every design, same energy."""
     plan = make_plan({**{k: v for k, v in COARSE.items()}, "site": LA, "date": "year", "p_load": [1.0, 4.0, 8.0]})
     table = run_plan(plan).table
-    means = table.groupby(["p_load_w", "design"])[["t_solar_h", "energy_wh", "fold_angle_deg"]].agg(
-        {"t_solar_h": "mean", "energy_wh": "sum", "fold_angle_deg": "first"})
+    means = table.groupby(["p_load_w", "design"])[["t_solar_h", "energy_harvested_wh", "fold_angle_deg"]].agg(
+        {"t_solar_h": "mean", "energy_harvested_wh": "sum", "fold_angle_deg": "first"})
     year = la_map[la_map["period"] == "year"].set_index("p_load_w")
     for load in (1.0, 4.0, 8.0):
         row = year.loc[load]
         assert row["fold_angle_deg"] == means.loc[(load, "twofold"), "fold_angle_deg"]
         for design in ("flat", "twofold", "tracker"):
-            assert row[f"t_solar_{design}_h"] == pytest.approx(means.loc[(load, design), "t_solar_h"], abs=1e-9)
-            assert row[f"energy_{design}_kwh"] == pytest.approx(means.loc[(load, design), "energy_wh"] / 1000,
+            assert row[f"mean_t_solar_{design}_h"] == pytest.approx(means.loc[(load, design), "t_solar_h"], abs=1e-9)
+            assert row[f"energy_harvested_{design}_wh"] == pytest.approx(means.loc[(load, design), "energy_harvested_wh"],
                                                                 rel=1e-12)
-        assert row["t_solar_tracker_net_h"] == pytest.approx(means.loc[(load, "tracker-net"), "t_solar_h"], abs=1e-9)
+        assert row["mean_t_solar_tracker_net_h"] == pytest.approx(means.loc[(load, "tracker-net"), "t_solar_h"], abs=1e-9)
         # The flat panel's peak over the year is the largest of its daily peaks.
         assert row["flat_peak_w"] == pytest.approx(table[table["design"] == "flat"]["peak_power_w"].max(), rel=1e-12)
 
@@ -86,8 +86,8 @@ def test_a_panel_folded_only_to_180_deg_is_the_flat_panel():
     flat_only = {**COARSE, "fold_angles": {"start": 180, "stop": 180, "step": 1}}
     table = evaluate_sites(flat_only, [LA, {"latitude": -45.0, "longitude": 170.0}], [0.2, 0.6], relative=True)
     assert (table["fold_angle_deg"] == 180).all()
-    np.testing.assert_allclose(table["t_solar_twofold_h"], table["t_solar_flat_h"], atol=1e-12)
-    np.testing.assert_allclose(table["energy_twofold_kwh"], table["energy_flat_kwh"], rtol=1e-12)
+    np.testing.assert_allclose(table["mean_t_solar_twofold_h"], table["mean_t_solar_flat_h"], atol=1e-12)
+    np.testing.assert_allclose(table["energy_harvested_twofold_wh"], table["energy_harvested_flat_wh"], rtol=1e-12)
     np.testing.assert_allclose(table["gain_vs_flat_pct"], 0.0, atol=1e-9)
 
 
@@ -110,7 +110,7 @@ def test_invariants_across_sites_and_loads(latitude, longitude, loads):
     assert (table["objective_twofold_h"] >= table["objective_flat_h"] - 1e-12).all()
     for _, rows in table.groupby("period"):
         for design in ("flat", "tracker", "tracker_net"):
-            assert (np.diff(rows[f"t_solar_{design}_h"].to_numpy()) <= 1e-12).all()
+            assert (np.diff(rows[f"mean_t_solar_{design}_h"].to_numpy()) <= 1e-12).all()
         assert (np.diff(rows["objective_twofold_h"].to_numpy()) <= 1e-12).all()
     standby = table["tracker_break_even_standby_w"].dropna()
     assert (standby >= 0).all()
