@@ -31,7 +31,9 @@ _PUBLIC = {
         "plot_power_curves", "plot_switching", "plot_t_solar_vs_fold_angle", "plot_comparison", "plot_standby",
         "plot_map", "plot_curves", "plot_sizing", "plot_annual_fold_angles", "plot_monthly", "plot_distribution",
         "plot_day_hour", "plot_world_map", "plot_latitude_load", "plot_refold_value", "save_plot")},
-    "best_schedules": "foldopt.schedule", "LoadProfile": "foldopt.config",
+    "best_schedules": "foldopt.schedule", "LoadProfile": "foldopt.config", "NearOptimal": "foldopt.config",
+    "Answer": "foldopt.answer", "plan_request": "foldopt.request", "Request": "foldopt.request",
+    "SizingResult": "foldopt.sizing", "Reproduction": "foldopt.reproduce",
     "twofold_arrays": "foldopt.pvsystem",
 }
 __all__ = ["__version__", *_PUBLIC]

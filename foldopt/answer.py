@@ -317,8 +317,8 @@ def _of_annual(result) -> Answer:
                                          if len(groups) > 1 and "latitude" in where else "")
         lines.append(f"{site + ': ' if site else ''}{label}: fold angle {twofold['fold_angle_deg']:g} deg all year; "
                      f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, {_pct(gain)} over flat "
-                     f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}; mean "
-                     f"t_solar {_hours(twofold['mean_t_solar_h'])}")
+                     f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}"
+                     + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"))
         lines.append("  " + _range_text(twofold.to_dict()))
         if len(schedule):
             mine = schedule[(schedule["p_load_w"] == load)] if load is not None else schedule

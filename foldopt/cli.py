@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Optional
 
 import typer
-from typer.core import TyperGroup
+from typer.core import TyperCommand, TyperGroup
 
 from foldopt import names
 from foldopt.config import (ConfigError, default_study_path, load_plan, parse_range, parse_study_text, parse_values,
@@ -110,6 +110,27 @@ class _OneLineErrors(TyperGroup):
                            "run again as foldopt --debug ... for the traceback, and please report it", err=True)
             sys.exit(1)
         sys.exit(code if isinstance(code, int) else 0)
+
+
+class _OnceEach(TyperCommand):
+    """A command whose options are each given at most once: a repeated option (``--days a --days
+    b``) is an error, not a silent last-wins. Options that collect values (``--set``) repeat."""
+
+    def parse_args(self, ctx, args):
+        seen: dict[str, str] = {}
+        for arg in args:
+            if arg == "--":
+                break
+            flag = arg.split("=", 1)[0]
+            for param in self.params:
+                if getattr(param, "multiple", False) or flag not in tuple(getattr(param, "opts", ())) + tuple(
+                        getattr(param, "secondary_opts", ())):
+                    continue
+                if param.name in seen:
+                    raise _USAGE_ERROR(f"{flag}: given twice (first as {seen[param.name]}); give each option once",
+                                       ctx=ctx)
+                seen[param.name] = flag
+        return super().parse_args(ctx, args)
 
 
 app = typer.Typer(cls=_OneLineErrors, add_completion=True, pretty_exceptions_enable=False, no_args_is_help=True,
@@ -233,7 +254,7 @@ def _run_request(request, out: Path, overwrite: bool, output: _Output, engine: s
 # --- run, reproduce -----------------------------------------------------------------------------
 
 
-@app.command(short_help="Run a YAML study, one case or a sweep [default: the embedded study].")
+@app.command(cls=_OnceEach, short_help="Run a YAML study, one case or a sweep [default: the embedded study].")
 def run(
     config: Optional[Path] = typer.Argument(None, help=f"YAML study [default: the embedded {EMBEDDED}]."),
     out: Optional[Path] = typer.Option(None, "--out", help="Results folder [default: results/<study name>]."),
@@ -258,7 +279,7 @@ def run(
                  engine, "run")
 
 
-@app.command(short_help="Shin et al.'s published values beside foldopt's, paper and exact modes.")
+@app.command(cls=_OnceEach, short_help="Shin et al.'s published values beside foldopt's, paper and exact modes.")
 def reproduce(
     out: Path = typer.Option(RESULTS / "reproduction", "--out", help="Results folder."),
     overwrite: bool = OVERWRITE,
@@ -414,7 +435,7 @@ def _register_sweep(axis: str) -> None:
     command.__signature__ = inspect.signature(_sweep_options)
     command.__annotations__ = dict(_sweep_options.__annotations__)
     command.__doc__ = summary + "\n\n\b\nExamples:\n" + "\n".join(f"  {example}" for example in examples)
-    sweep_app.command(axis, short_help=_SWEEP_SHORT[axis])(command)
+    sweep_app.command(axis, cls=_OnceEach, short_help=_SWEEP_SHORT[axis])(command)
 
 
 def _sweep(axis: str, options: dict) -> None:
@@ -514,7 +535,7 @@ def _values(option: str, text: str) -> list[float]:
     return values if isinstance(values, list) else [values]
 
 
-@app.command("map", short_help="Many sites on Dask: best fold angle, gains and tracker share worldwide.")
+@app.command("map", cls=_OnceEach, short_help="Many sites on Dask: best fold angle, gains and tracker share worldwide.")
 def map_(
     lat: Optional[str] = typer.Option(None, "--lat", help="Latitudes [deg north]: a range start:stop:step or a "
                                       "list [default: -60:60:10]."),
@@ -658,14 +679,14 @@ def map_(
                 command=_INVOCATION, defaults=defaults)
         except ConfigError as error:
             _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
-    output.answer("map", out, answer, answer.designs,
+    output.answer("map", out, answer, result.table[result.table["period"] == "year"].reset_index(drop=True),
                   [f"wrote {out} (map.parquet, map.csv, report.html, {', '.join(figures)})"])
 
 
 # --- size ---------------------------------------------------------------------------------------
 
 
-@app.command(short_help="Panel sizing: lifetime net benefit against area, flat and twofold.")
+@app.command(cls=_OnceEach, short_help="Panel sizing: lifetime net benefit against area, flat and twofold.")
 def size(
     config: Optional[Path] = typer.Argument(None, help=f"YAML study (one case) [default: the embedded {EMBEDDED}]."),
     areas: str = typer.Option("0.01:0.5:0.005", "--areas", help="Panel areas [m^2], start:stop:step."),

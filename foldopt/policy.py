@@ -30,7 +30,7 @@ SECTIONS = ("site", "panel", "tracker", "objective", "fold_angles", "near_optima
 #: Fields that take a paper-mode study away from the paper's site and day.
 AWAY_FROM_PAPER = ("site.latitude", "site.longitude", "site.altitude", "date", "weather")
 #: What the policy says where it switches a paper-mode study to exact mode.
-EXACT_NOTE = "exact mode (paper mode is for the paper's own site and day: mode paper keeps it)"
+EXACT_NOTE = "exact mode (paper mode is for the paper's own site and day: set mode paper to keep it)"
 
 
 def set_path(data: dict, path: str, value) -> dict:

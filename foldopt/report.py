@@ -225,8 +225,8 @@ def plot_standby(result: StudyResult, ax=None):
     table, break_even = result.standby
     study = result.study
     fig, ax = _axes(ax, (7, 4.5))
-    ax.plot(table["standby_w"], table["tracker_net_t_solar_h"], color="0.4", label=f"{study.tracker.model} tracker, net")
-    ax.axhline(table["twofold_t_solar_h"].iloc[0], color="tab:blue", label="optimal twofold (draws nothing)")
+    ax.plot(table["standby_w"], table["t_solar_tracker_net_h"], color="0.4", label=f"{study.tracker.model} tracker, net")
+    ax.axhline(table["t_solar_twofold_h"].iloc[0], color="tab:blue", label="optimal twofold (draws nothing)")
     if np.isfinite(break_even):
         ax.axvline(break_even, color="tab:red", ls="--", lw=1, label=f"break-even {break_even:.2f} W")
     ax.set_xlabel("tracker standby draw [W]")

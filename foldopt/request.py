@@ -98,7 +98,7 @@ def plan_request(data: dict, changes: dict | None = None, *, axis: str | None = 
         raise ConfigError([f"{field}: sweep {axis} needs a range start:stop:step or a list"])
     new, decided = policy.apply(data, changes, field)
     if field is not None and field not in changes:
-        new[field] = _default_loads(new) if field == "p_load" else DEFAULT_RANGES[field]
+        new = policy.set_path(new, field, _default_loads(new) if field == "p_load" else DEFAULT_RANGES[field])
     if axis == "angle" and new.get("weather") is not None and "objective" not in new and not (
             "date" in changes and policy.is_single(changes["date"])):
         new["objective"] = {"statistic": "mean"}  # a year of weather at one fold angle
@@ -130,7 +130,7 @@ def _taken(plan: Plan, changes: dict, field: str | None, data: dict, decided: li
         else:
             year = f" of {data['year']}" if field == "date" and data.get("year") else ""
             label = {"site.latitude": "latitude", "date": "day"}[field]
-            taken.append(f"{label} {data[field]}{year} (default range)")
+            taken.append(f"{label} {DEFAULT_RANGES[field]}{year} (default range)")
     if not policy.touched(given, "site") and not weather and field != "site.latitude":
         taken.append(f"site {study.site.latitude:g}, {study.site.longitude:g}")
     if "date" not in given and not weather and field != "date":

@@ -273,20 +273,20 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
     Returns
     -------
     table : pandas.DataFrame
-        ``standby_w``, ``tracker_net_t_solar_h``, ``twofold_t_solar_h``.
+        ``standby_w``, ``t_solar_tracker_net_h``, ``t_solar_twofold_h``.
     break_even_w : float
         Standby draw [W] above which the twofold panel runs longer; NaN if it never does.
     """
     study, step = day.study, day.step_hours
     if day.sky.load_shape is not None:  # a standby draw is a load shift only for a constant load
-        return pd.DataFrame({"standby_w": [0.0], "tracker_net_t_solar_h": [np.nan],
-                             "twofold_t_solar_h": [twofold_t_solar]}), float("nan")
+        return pd.DataFrame({"standby_w": [0.0], "t_solar_tracker_net_h": [np.nan],
+                             "t_solar_twofold_h": [twofold_t_solar]}), float("nan")
     available = standby_available(p_tracker, day.tracker_draw(), day.sky.lit[0], study.tracker.standby_w)
     draws = np.linspace(0.0, max(2.0 * study.p_load, 1e-3), points)
     hours = t_solar(available, study.p_load + draws, step)
     load = load_for_t_solar(available, twofold_t_solar, step) if twofold_t_solar > 0 else np.nan
     break_even = max(load - study.p_load, 0.0) if np.isfinite(load) else float("nan")
-    table = pd.DataFrame({"standby_w": draws, "tracker_net_t_solar_h": hours, "twofold_t_solar_h": twofold_t_solar})
+    table = pd.DataFrame({"standby_w": draws, "t_solar_tracker_net_h": hours, "t_solar_twofold_h": twofold_t_solar})
     return table, break_even
 
 

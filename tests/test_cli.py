@@ -158,7 +158,7 @@ def test_sweep_angle_writes_sweep_and_summary(tmp_path):
         ("--module", "NoSuchModule", ["--module", "only used with pv_model single-diode"]),
         ("--connection", "star", ["--connection", "series"]),
         ("--converter-efficiency", "1.2", ["--converter-efficiency", "(0, 1]"]),
-        ("--lat", "abc", ["--lat", "valid number"]),
+        ("--lat", "abc", ["--lat", "expected a number"]),
     ],
 )
 def test_sweep_angle_bad_input(tmp_path, option, value, words):

@@ -49,8 +49,8 @@ def test_every_command_runs_with_no_option(tmp_path, command, check):
     table = pd.read_csv(out / {"angle": "sweep.csv", "size": "sizing.csv"}.get(command[-1], "results.csv"))
     assert check(table)
     if command[0] == "sweep" and command[1] != "angle":
-        taken = document["defaults"]["taken"]
-        assert document["defaults"]["study"] == "configs/shin2015.yaml"
+        taken = document["answer"]["defaults"]["taken"]
+        assert document["answer"]["defaults"]["study"] == "configs/shin2015.yaml"
         assert "(default range)" in taken[0] and "panel 0.108 m^2" in taken
 
 
@@ -60,7 +60,7 @@ def test_the_summary_says_which_values_were_defaults(tmp_path):
     lines = result.stdout.splitlines()
     assert lines[1] == ("  from configs/shin2015.yaml: day 1:365:7 of 2014 (default range), site 34.05, -118.25, "
                         "panel 0.108 m^2, P_load 4.398 W, exact mode (paper mode is for the paper's own site and "
-                        "day: --mode paper), ideal PV model")
+                        "day: set mode paper to keep it), ideal PV model")
     assert "(--table prints the full table)" in lines and len(lines) < 8
     study = json.loads((tmp_path / "o" / "run.json").read_text())["study"]
     assert (study["mode"], study["geometry"]) == ("exact", "hinge")  # the geometry follows the mode
@@ -103,7 +103,8 @@ def test_one_json_document_and_quiet_silence(tmp_path, command):
     assert result.exit_code == 0, result.output
     document = json.loads(result.stdout)
     assert document["command"] == " ".join(command[:2] if command[0] == "sweep" else command[:1])
-    assert {"summary", "tables"} & set(document)
+    assert set(document) == {"command", "out", "answer", "rows"}
+    assert document["answer"]["lines"] and document["answer"]["question"]
     assert result.stderr == ""  # no progress, no status line in the document's way
     quiet = invoke(*command, "--out", tmp_path / "q", "--quiet")
     assert quiet.exit_code == 0, quiet.output
@@ -126,7 +127,7 @@ def test_notes_name_the_day(tmp_path, args, note, line):
     result = invoke("sweep", "angle", *args, "--angle-step", "10", "--out", tmp_path / "o", "--format", "json")
     assert result.exit_code == 0, result.output
     document = json.loads(result.stdout)
-    assert document["summary"]["notes"] == note
+    assert [entry["note"] for entry in document["answer"]["notes"]] == note
     assert {row["note"] for row in document["rows"]} == {"; ".join(note)}
     text = invoke("sweep", "angle", *args, "--angle-step", "10", "--out", tmp_path / "t").stdout
     assert line in text and (f"note: {note[0]}" in text if note else "note:" not in text)
@@ -136,8 +137,11 @@ def test_overcast_is_no_polar_night_in_a_year(tmp_path):
     result = invoke("sweep", "angle", "--weather", TMY3, "--p-load", "2", "--angle-step", "30", "--out",
                     tmp_path / "y", "--format", "json")
     assert result.exit_code == 0, result.output
-    notes = json.loads(result.stdout)["summary"]["notes"]
-    assert set(notes) == {"overcast"} and 0 < notes["overcast"] < 30
+    notes = {entry["note"]: entry for entry in json.loads(result.stdout)["answer"]["notes"]}
+    assert "polar night" not in notes and 0 < notes["overcast"]["cases"] < 30
+    assert notes["overcast"]["designs"] == []  # the day's own condition concerns every design
+    # A load above a design's peak names that design only (here the tracker net of its drive).
+    assert all(notes["load above peak"]["designs"]) and "twofold" not in notes["load above peak"]["designs"]
 
 
 def test_pvlib_spellings_and_cec_names(tmp_path):

@@ -147,8 +147,8 @@ def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):
     assert refused.returncode == 2 and "pass --resume to finish it" in err
     out_text, _ = _finish(_foldopt("map", *MAP, "--out", str(out), "--resume", "--format", "json", "-q"))
     answer = json.loads(out_text)  # one JSON document: the year's rows
-    assert answer["command"] == "map" and answer["summary"]["sites"] == N_SITES
-    assert len(answer["rows"]) == N_SITES * N_LOADS and answer["summary"]["chunks_from_disk"] == len(before)
+    assert answer["command"] == "map" and answer["answer"]["result"]["sites"] == N_SITES
+    assert len(answer["rows"]) == N_SITES * N_LOADS and answer["answer"]["result"]["chunks_from_disk"] == len(before)
     meta = json.loads((out / "run.json").read_text())
     finished = sorted(int(name[5:10]) for name in before)
     assert meta["chunks_from_disk"] == finished

@@ -1,0 +1,200 @@
+"""One study, one answer: the same request through the command line (a real subprocess with
+``--format json``) and through the Python API gives the same table to the bit, and every view (the
+terminal, the JSON, report.html and ``result.answer``) shows the objective's own value, the
+re-fold schedule and the near-optimal range.
+
+The reference of each comparison is the other route: the CLI's numbers are read back from its JSON
+(exact floats) and compared with ``==`` to the API's, so a policy decided in one place only (a mode,
+a geometry, a tilt, a default range) shows up as a difference."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import foldopt
+from foldopt.answer import records
+
+ROOT = Path(__file__).resolve().parent.parent
+TMY3 = ROOT / "configs" / "weather" / "723170TYA.CSV"
+#: Names a session replaced by one name per quantity (foldopt.columns); none may be written again.
+OLD_NAMES = ("pct_of_tracker_t_solar", "t_solar_pct_of_tracker", "t_solar_gain_vs_flat_pct", "energy_wh",
+             "energy_flat_kwh", "energy_twofold_kwh", "energy_tracker_kwh", "t_solar_flat_h", "t_solar_twofold_h",
+             "t_solar_tracker_h", "mean_h", "p10_h", "min_h", "flat_objective_h", "tracker_objective_h")
+
+
+def cli(tmp_path: Path, *args) -> tuple[dict, Path, str]:
+    """Run ``foldopt ARGS --format json`` in a subprocess; its document, folder and the terminal's text."""
+    out = tmp_path / "cli"
+    command = [sys.executable, "-m", "foldopt.cli", *map(str, args), "--out", str(out)]
+    env = {**os.environ, "COLUMNS": "200"}
+    done = subprocess.run([*command, "--format", "json"], capture_output=True, text=True, env=env, timeout=300,
+                          cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    text = subprocess.run([*command, "--overwrite"], capture_output=True, text=True, env=env, timeout=300, cwd=ROOT)
+    assert text.returncode == 0, text.stderr
+    return json.loads(done.stdout), out, text.stdout
+
+
+def same_rows(document: dict, table: pd.DataFrame) -> None:
+    """The CLI's rows equal the API's table, value for value (floats to the bit, NaN as null)."""
+    expected = json.loads(json.dumps(records(table)))
+    assert document["rows"] == expected
+
+
+def assert_views_agree(document: dict, folder: Path, terminal: str, answer) -> None:
+    """The near-optimal range and recommended angle are in all four views, and the JSON answer is
+    the API's answer."""
+    api = json.loads(json.dumps(answer.to_dict()))
+    for key in ("kind", "result", "designs", "near_optimal", "schedule", "notes"):
+        assert document["answer"][key] == api[key], key
+    assert len(answer.near_optimal) and "recommended_fold_angle_deg" in answer.near_optimal
+    page = (folder / "report.html").read_text()
+    assert "Near-optimal fold angles" in page and "recommended_fold_angle_deg" in page
+    assert "near-optimal" in terminal and "recommended" in terminal
+    for line in answer.lines()[2:]:  # beyond the title and "from" lines (the API's source differs)
+        assert line in terminal
+
+
+def no_old_names(folder: Path, document: dict) -> None:
+    written = set()
+    for path in folder.rglob("*.csv"):
+        written |= set(pd.read_csv(path, nrows=0).columns)
+    text = json.dumps(document)
+    for name in OLD_NAMES:
+        assert name not in written, name
+        assert f'"{name}"' not in text, name
+
+
+def test_embedded_run(tmp_path):
+    document, folder, terminal = cli(tmp_path, "run")
+    result = foldopt.run(foldopt.default_study())
+    same_rows(document, result.summary)
+    assert_views_agree(document, folder, terminal, result.answer)
+    no_old_names(folder, document)
+    # Shin et al. Fig. 12a: the optimum is a plateau; the recommended angle lies on it, inside the range.
+    near = result.answer.near_optimal.iloc[0]
+    assert near["near_optimal_lo_deg"] <= near["recommended_fold_angle_deg"] <= near["near_optimal_hi_deg"]
+
+
+def test_latitude_sweep_plans_the_same_study(tmp_path):
+    document, folder, terminal = cli(tmp_path, "sweep", "latitude", "--lat", "0,20")
+    result = foldopt.sweep(foldopt.default_study(), latitude=[0, 20])
+    same_rows(document, result.table)
+    assert_views_agree(document, folder, terminal, result.answer)
+    study = json.loads((folder / "run.json").read_text())["study"]
+    # The policy, whichever route: exact mode, the hinge, the panel at |latitude| toward the equator.
+    assert (study["mode"], study["geometry"], study["panel"]["tilt"]) == ("exact", "hinge", 0.0)
+    assert (result.plan.base.mode, result.plan.base.resolved().geometry) == ("exact", "hinge")
+
+
+def test_worst_month_year_at_nairobi(tmp_path):
+    args = ("--lat", "-1.29", "--lon", "36.82", "--days", "year", "--objective", "worst-month", "--p-load", "3",
+            "--step-min", "10")
+    document, folder, terminal = cli(tmp_path, "sweep", "day", *args)
+    result = foldopt.sweep(foldopt.default_study(), "day", latitude=-1.29, longitude=36.82, date="year",
+                           objective="worst-month", p_load=3, step_min=10)
+    same_rows(document, result.table)
+    assert_views_agree(document, folder, terminal, result.answer)
+    case = document["answer"]["result"]["per_case"][0]
+    # The objective in its own terms: each design's lowest monthly mean and the month it falls in,
+    # checked against the daily rows the same document holds.
+    daily = pd.DataFrame(document["rows"])
+    daily["month"] = pd.to_datetime(daily["date"]).dt.month
+    monthly = daily[daily["design"] == "twofold"].groupby("month")["t_solar_h"].mean()
+    assert case["objective_h"]["twofold"] == pytest.approx(monthly.min(), abs=1e-12)
+    assert case["worst_month"]["twofold"] == int(monthly.idxmin())
+    page = (folder / "report.html").read_text()
+    month = __import__("calendar").month_name[case["worst_month"]["twofold"]]
+    assert f"worst-month t_solar {case['objective_h']['twofold']:.2f} h (in {month})" in page
+    assert f"(in {month})" in terminal
+    # The report shows the year's summary, not 1,460 daily rows.
+    assert page.count("<tr>") < 100 and len(page) < 600_000
+    no_old_names(folder, document)
+
+
+def test_weather_year_with_a_profile_and_two_visits(tmp_path):
+    profile = tmp_path / "camera.csv"
+    profile.write_text("time,watts\n00:00,1.5\n07:00,6\n19:00,1.5\n")
+    document, folder, terminal = cli(tmp_path, "sweep", "angle", "--weather", TMY3, "--load-profile", profile,
+                                     "--visits", "2", "--angle-step", "5", "--step-min", "10")
+    result = foldopt.sweep(foldopt.default_study(), "angle", weather=str(TMY3), load_profile={"file": str(profile)},
+                           visits=2, fold_angles={"step": 5}, step_min=10)
+    same_rows(document, result.table)
+    assert_views_agree(document, folder, terminal, result.answer)
+    schedule = pd.DataFrame(document["answer"]["schedule"])
+    written = pd.read_csv(folder / "refold_schedule.csv")
+    assert schedule[["settings", "visit", "date", "fold_angle_deg"]].to_dict("list") == written[
+        ["settings", "visit", "date", "fold_angle_deg"]].to_dict("list")
+    assert sorted(set(schedule["settings"])) == [1, 2]
+    page = (folder / "report.html").read_text()
+    for row in schedule.itertuples():
+        assert f"{row.date} at {row.fold_angle_deg:g} deg" in page and f"{row.date} at" in terminal
+    # A profile is reported as its profile, never as its scale.
+    for view in (terminal, page, json.dumps(document["answer"]["question"])):
+        assert "load profile camera (mean 3.75 W, peak 6 W)" in view
+        assert "P_load 1 W" not in view
+    no_old_names(folder, document)
+
+
+def test_size(tmp_path):
+    document, folder, terminal = cli(tmp_path, "size")
+    result = foldopt.size(foldopt.default_study())
+    same_rows(document, result.table)
+    assert document["answer"]["result"] == json.loads(json.dumps(result.answer.to_dict()))["result"]
+    no_old_names(folder, document)
+
+
+def test_six_site_map(tmp_path):
+    sites = tmp_path / "sites.csv"
+    sites.write_text("name,latitude,longitude\nquito,-0.18,-78.47\noslo,59.91,10.75\nsydney,-33.87,151.21\n"
+                     "la,34.05,-118.25\nnairobi,-1.29,36.82\ncairo,30.04,31.24\n")
+    document, folder, terminal = cli(tmp_path, "map", "--sites", sites, "--p-load", "2", "--workers", "1",
+                                     "--step-min", "30", "--angle-step", "10")
+    study = foldopt.map_study(foldopt.default_study().data(), objective={"statistic": "mean"}, step_min=30.0,
+                              fold_angles={"start": 10.0, "stop": 180.0, "step": 10.0})
+    result, _, answer = foldopt.world_map(foldopt.read_sites(sites), [2.0], tmp_path / "api", study, workers=1)
+    year = result.table[result.table["period"] == "year"]
+    same_rows(document, year.reset_index(drop=True))
+    assert document["answer"]["near_optimal"] == json.loads(json.dumps(records(answer.near_optimal)))
+    assert "recommended fold angles" in terminal
+    assert np.isfinite(year["recommended_fold_angle_deg"]).all()
+    no_old_names(folder, document)
+
+
+def test_variant_merges_sections_and_speaks_in_config_errors():
+    study = foldopt.default_study()
+    smaller = study.variant(panel={"area": 0.1})
+    assert (smaller.panel.area, smaller.panel.efficiency, smaller.panel.tilt) == (0.1, 0.1905, 34.05)
+    with pytest.raises(foldopt.ConfigError, match="year: unknown field"):
+        study.variant(year=2014)
+    with pytest.raises(foldopt.ConfigError, match=r"site.latitude = 100.0: must be in \[-90, 90\]"):
+        study.variant(site={"latitude": 100.0})
+    # The policy the command line applies: another latitude leaves the paper's site.
+    moved = study.variant(site={"latitude": 10.0})
+    assert (moved.mode, moved.resolved().geometry, moved.resolved().panel.tilt) == ("exact", "hinge", 10.0)
+    assert study.variant(mode="exact").resolved().geometry == "hinge"
+    assert study.variant(objective="worst-month").objective.statistic == "worst-month"
+
+
+def test_every_written_column_is_in_the_vocabulary_and_the_manual(tmp_path):
+    from foldopt.columns import describe, rst_table
+
+    assert (ROOT / "docs" / "columns.rst").read_text() == rst_table()  # python -m foldopt.columns > docs/columns.rst
+    folders = [path.parent for path in (ROOT / "results" / "examples").rglob("run.json")]
+    assert len(folders) >= 10
+    unknown = set()
+    for folder in folders:
+        for path in folder.glob("*.csv"):
+            unknown |= {(path.name, c) for c in pd.read_csv(path, nrows=0).columns if describe(c) is None}
+            assert not set(pd.read_csv(path, nrows=0).columns) & set(OLD_NAMES), path
+    assert not unknown
+    # The registry knows no name it does not describe, and tells an unknown one.
+    assert describe("energy_wh") is None and describe("energy_harvested_tracker_net_wh")[1] == "Wh"
