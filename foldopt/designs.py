@@ -1,9 +1,11 @@
 """The designs, evaluated once: flat, twofold at every fold angle, trackers gross and net.
 
-Every study that compares designs (a single day's :func:`foldopt.study.run_study`, the cases and
-annual groups of :func:`foldopt.sweeps.run_plan`, the sites of :func:`foldopt.worldmap.evaluate_sites`,
-the sizing of :func:`foldopt.sizing.size_panel`) takes its designs from here, over
-:class:`Blocks` of a sky (days at sites that share one setup) and a set of loads:
+Every study that compares designs takes them from here: the flat, twofold, tracker and
+tracker-net rows of a single day (:func:`foldopt.study.run_study`, which adds the heuristic's
+angle, the other connections and the other tracker models from their power curves), the cases and
+annual groups of :func:`foldopt.sweeps.run_plan` and the sites of
+:func:`foldopt.worldmap.evaluate_sites`; all over :class:`Blocks` of a sky (days at sites that
+share one setup) and a set of loads:
 
 - :func:`fold_hours`: t_solar of the twofold panel at every angle of the study's grid, for every
   load, in one engine pass; :func:`best_angle_index` and :func:`near_optimal` choose from it;

@@ -23,8 +23,8 @@ from foldopt.metrics import (energy_served, load_for_t_solar, metric_columns, no
                              t_solar)
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.sizing import flat_area_multiple
-from foldopt.designs import (near_optimal, sky_tracker_draw, sky_tracker_orientation, sky_tracker_power,
-                             standby_available)
+from foldopt.designs import (DESIGNS, Blocks, design_metrics, near_optimal, sky_tracker_draw,
+                             sky_tracker_orientation, sky_tracker_power, standby_available)
 from foldopt.sky import build_sky
 from foldopt.tracker import TRACKERS
 
@@ -231,6 +231,13 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     summary = pd.DataFrame({"design": list(designs), "fold_angle_deg": [angle for angle, _ in designs.values()],
                             **metric_columns(curves.t_solar[:, 0, 0], curves.t_solar_contiguous[:, 0, 0],
                                               curves.energy[:, 0], curves.peak[:, 0], p_load, served)})
+    # The designs every study compares come from the one design evaluation (as for sweeps, annual
+    # studies and maps); the others (the heuristic, other connections, other trackers) from their curves.
+    main = design_metrics(day.sky, Blocks.of([study]), np.array([p_load]), np.array([best_angle]),
+                          np.zeros((1, 1), dtype=int), engine)
+    rows = [list(designs).index(design) for design in DESIGNS]
+    for column in summary.columns.drop(["design", "fold_angle_deg"]):
+        summary.loc[rows, column] = main[column][0, 0]
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0

@@ -1,11 +1,12 @@
 """Sweeps: many sites, days, loads and designs, as one tidy table.
 
 The cases of a plan are blocks of skies (:mod:`foldopt.sky`): cases that share everything but the
-site, the date and the load share one sky and one engine call, in chunks of bounded size. Every
-(case, fold angle) row gets ``t_solar`` for all loads in one pass; the best angle per case and
-load is the best point of the grid (no local refinement, which a single-study run adds), and its
-full metrics come from a second, targeted pass. The flat panel is a row of its own; trackers go
-through the same metrics from their power curves.
+site, the date and the load share one sky and one engine call, in chunks of bounded size. The
+designs come from :mod:`foldopt.designs`: every (case, fold angle) row gets ``t_solar`` for all
+loads in one pass; the best angle per case and load is the best point of the grid (no local
+refinement, which a single-study run adds), with its near-optimal range, and its full metrics come
+from a second, targeted pass. With an objective, one fold angle serves all the days of a case (an
+annual group), and the group's objective per design, in its own terms, is a table of its own.
 """
 
 from __future__ import annotations
