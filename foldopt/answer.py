@@ -432,9 +432,11 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         standby = load["median_tracker_break_even_standby_w"]
         tracker = ("" if standby is None else ", whose own moves already cost it its lead" if standby == 0
                    else f", which loses its lead above a median {standby:.2f} W of standby")
-        rec_text = ("" if rec["min"] is None else f"recommended fold angles {rec['min']:g} to {rec['max']:g} deg "
-                    f"(median {rec['median']:g}, near-optimal ranges a median {load['median_near_optimal_width_deg']:g} "
-                    "deg wide)")
+        best_angles = load["fold_angle_deg"]
+        rec_text = ("no fold angle carries the load" if rec["min"] is None else
+                    f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended {rec['min']:g} "
+                    f"to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
+                    f"{load['median_near_optimal_width_deg']:g} deg wide)")
         lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')} "
                      f"(median {_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} "
                      f"at {where}); {rec_text}; median {_pct(load['median_pct_of_tracker'], False)} of the "

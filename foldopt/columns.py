@@ -119,7 +119,9 @@ def describe(column: str) -> tuple[str, str, str] | None:
     for pattern, name, unit, meaning in _PATTERNS:
         if pattern.match(column):
             return name, unit, meaning
-    if _FIELD_PATH.match(column):
+    from foldopt.config import Study
+
+    if _FIELD_PATH.match(column) or column in Study.model_fields:
         return column, "", "a swept study field, by its path"
     return None
 
