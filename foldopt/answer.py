@@ -52,10 +52,6 @@ def _pct(value, signed: bool = True) -> str:
     return "-" if value is None or value != value else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
 
 
-def _deg(value) -> str:
-    return "-" if value is None or value != value else f"{value:g} deg"
-
-
 @dataclass(frozen=True)
 class Answer:
     """What a result says, for every view.
@@ -139,7 +135,7 @@ def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dic
     every = set(table["design"])
     notes = []
     for note, rows in exploded.groupby("note", sort=True):
-        designs = [d for d in dict.fromkeys(rows["design"])]
+        designs = list(dict.fromkeys(rows["design"]))
         entry = {"note": note, "designs": [] if set(designs) == every else designs}
         if case_count is not None:
             keys = [c for c in rows.columns if c in ("site_name", "latitude", "longitude", "date", "p_load_w")]
@@ -262,7 +258,8 @@ def of_sweep(result) -> Answer:
         best = twofold.loc[gains.idxmax()]
         at = {column: best[column] for column in result.varied if column in best and column != "day_of_year"}
         part["gain_vs_flat_pct"] = {"median": gains.median(), "max": gains.max(), "at": at}
-        where = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}" for key, value in at.items())
+        where = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
+                          for key, value in at.items())
         lines.append(f"twofold over flat: median {_pct(gains.median())}, best {_pct(gains.max())} ({where}); "
                      f"fold angles {part['fold_angle_deg']['min']:g} to {part['fold_angle_deg']['max']:g} deg")
     rec = part["recommended_fold_angle_deg"]
@@ -334,7 +331,8 @@ def _of_annual(result) -> Answer:
                           "fold_angle_deg"]]
     if statistic != "worst-month":
         designs = designs.drop(columns="worst_month")
-    near = objectives[objectives["design"] == "twofold"][[*keys, "fold_angle_deg", *NEAR_OPTIMAL]].reset_index(drop=True)
+    twofold_rows = objectives[objectives["design"] == "twofold"]
+    near = twofold_rows[[*keys, "fold_angle_deg", *NEAR_OPTIMAL]].reset_index(drop=True)
     question = study_question(study, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
     return Answer("annual", study.name, question, _defaults(result), _plain(part), designs, near, schedule,
@@ -380,7 +378,8 @@ def of_reproduction(tables: dict, study) -> Answer:
         lines.append(f"Shin et al. ({model}): paper value | paper mode | exact mode")
         for row in table.itertuples():
             paper = "-" if row.paper != row.paper else f"{row.paper:g}"
-            lines.append(f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  {row.unit}")
+            lines.append(f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  "
+                         f"{row.unit}")
     combined = pd.concat([table.assign(table=name) for name, table in tables.items()], ignore_index=True)
     return Answer("reproduce", "Shin et al. reproduced", study_question(study), None,
                   {name: records(table) for name, table in tables.items()}, combined, pd.DataFrame(), pd.DataFrame(),
@@ -434,8 +433,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                    else f", which loses its lead above a median {standby:.2f} W of standby")
         best_angles = load["fold_angle_deg"]
         rec_text = ("no fold angle carries the load" if rec["min"] is None else
-                    f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended {rec['min']:g} "
-                    f"to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
+                    f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended "
+                    f"{rec['min']:g} to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
                     f"{load['median_near_optimal_width_deg']:g} deg wide)")
         lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')} "
                      f"(median {_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} "

@@ -167,7 +167,7 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
 
     Parameters
     ----------
-    result : StudyResult or SweepResult
+    result : StudyResult, SweepResult, SizingResult or Reproduction
     out : str or pathlib.Path
     overwrite : bool
     command : list of str, optional
@@ -177,11 +177,15 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
     -------
     pathlib.Path
     """
-    from foldopt.report import write_study, write_sweep
+    from foldopt.report import write_reproduction, write_sizing, write_study, write_sweep
+    from foldopt.reproduce import Reproduction
+    from foldopt.sizing import SizingResult
     from foldopt.study import StudyResult
 
-    writer = write_study if isinstance(result, StudyResult) else write_sweep
-    return writer(result, Path(out), overwrite, command if command is not None else ["foldopt.write"])
+    writers = {StudyResult: write_study, SizingResult: write_sizing, Reproduction: write_reproduction}
+    writer = writers.get(type(result), write_sweep)
+    writer(result, Path(out), overwrite, command if command is not None else ["foldopt.write"])
+    return Path(out)
 
 
 def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None, cost_per_w: float | None = None,

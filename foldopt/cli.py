@@ -24,7 +24,7 @@ import typer
 from typer.core import TyperCommand, TyperGroup
 
 from foldopt import names
-from foldopt.config import (ConfigError, default_study_path, load_plan, parse_range, parse_study_text, parse_values,
+from foldopt.config import (ConfigError, default_study_path, load_plan, parse_study_text, parse_values,
                             read_study)
 from foldopt.policy import set_path
 from foldopt.request import Request, plan_request, size_request
@@ -690,8 +690,8 @@ def map_(
 def size(
     config: Optional[Path] = typer.Argument(None, help=f"YAML study (one case) [default: the embedded {EMBEDDED}]."),
     areas: str = typer.Option("0.01:0.5:0.005", "--areas", help="Panel areas [m^2], start:stop:step."),
-    cost_per_m2: Optional[float] = typer.Option(None, "--cost-per-m2", help="Panel cost [$/m^2] [default: 164, the "
-                                                "cost Shin et al.'s 0.108 m^2 optimum implies]."),
+    cost_per_m2: Optional[float] = typer.Option(None, "--cost-per-m2", help=f"Panel cost [$/m^2] [default: "
+                                                f"{PAPER_COST_PER_M2:g}, the cost Shin et al.'s 0.108 m^2 optimum implies]."),
     cost_per_w: Optional[float] = typer.Option(None, "--cost-per-w", help="Panel cost [$/W at STC], instead."),
     c_grid: float = typer.Option(C_GRID, "--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22)."),
     years: float = typer.Option(LIFETIME_YEARS, "--years", help="Lifetime [years] (Shin et al.: 20)."),

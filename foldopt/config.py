@@ -7,7 +7,6 @@ value and the allowed range.
 
 from __future__ import annotations
 
-import copy
 import datetime as dt
 import itertools
 import math

@@ -408,7 +408,8 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
         answer = result.answer
         if answer.kind == "annual":
             # The year's summary per case and design, not every day's rows (results.csv has them).
-            table, title = annual_summary(result.table, _annual_cases(result)), "The year per case and design (annual_summary.csv)"
+            table = annual_summary(result.table, _annual_cases(result))
+            title = "The year per case and design (annual_summary.csv)"
         else:
             table, title = result.table, "Every case and design (results.csv; click a header to sort)"
         write_html(folder, answer, [name for name in plots if name.endswith(".png")], table, title, metadata,
