@@ -174,7 +174,7 @@ def test_six_site_map(tmp_path):
     year = result.table[result.table["period"] == "year"]
     same_rows(document, year.reset_index(drop=True))
     assert document["answer"]["near_optimal"] == json.loads(json.dumps(records(answer.near_optimal)))
-    assert any("recommended fold angles" in line for line in document["answer"]["lines"])
+    assert any("recommended" in line and "near-optimal ranges" in line for line in document["answer"]["lines"])
     assert "Near-optimal fold angles" in (folder / "report.html").read_text()
     assert np.isfinite(year["recommended_fold_angle_deg"]).all()
     no_old_names(folder, document)
