@@ -9,7 +9,9 @@ files), ``--format json`` one JSON document, and ``--quiet`` nothing but errors.
 
 from __future__ import annotations
 
+import codecs
 import inspect
+import os
 import json
 import re
 import signal
@@ -25,7 +27,7 @@ from typer.core import TyperCommand, TyperGroup
 
 from foldopt import names
 from foldopt.config import (ConfigError, default_study_path, load_plan, parse_study_text, parse_values,
-                            read_study)
+                            read_study, year_problem)
 from foldopt.policy import set_path
 from foldopt.request import Request, plan_request, size_request
 from foldopt.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2
@@ -67,25 +69,59 @@ def _terminate(signum, frame):
     raise SystemExit(128 + signum)  # unwinds like an error: a staging folder is removed
 
 
+class _Interrupted(Exception):
+    """Ctrl-C, carried past typer, which would end the command with code 130 and not a word."""
+
+
+def _as_text(text: str) -> str:
+    """Text from the command line (an argument, a path in a message) as it was typed: under a C
+    locale without Python's UTF-8 mode its bytes arrive as surrogates (PEP 383), which no UTF-8
+    file can hold and a terminal shows as ``?``; they are read as the UTF-8 they are, and bytes
+    that are no UTF-8 as backslash escapes."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
+def _echo(text: str, err: bool = False) -> None:
+    typer.echo(_as_text(text), err=err)
+
+
 class _OneLineErrors(TyperGroup):
     """The one error path of the command line. Bad input (usage, study, weather file, results
     folder) is one line per fault and exit code 2; anything else is an internal error: one line
-    naming it, exit code 1, and the traceback only with ``--debug``."""
+    naming it, exit code 1, and the traceback only with ``--debug``; Ctrl-C is ``interrupted``,
+    exit code 130."""
 
     def main(self, *args, **kwargs):
+        quiet = os.environ.get("FOLDOPT_QUIET")
+        try:
+            self._main(*args, **kwargs)
+        finally:
+            # --quiet silences the caches' notices for this command only (an in-process caller's
+            # environment is left as it was).
+            if quiet is None:
+                os.environ.pop("FOLDOPT_QUIET", None)
+            else:
+                os.environ["FOLDOPT_QUIET"] = quiet
+
+    def _main(self, *args, **kwargs):
         kwargs["standalone_mode"] = False
         given = kwargs.get("args", args[0] if args else None)
-        _INVOCATION[:] = ["foldopt", *(sys.argv[1:] if given is None else given)]
+        _INVOCATION[:] = ["foldopt", *map(_as_text, sys.argv[1:] if given is None else given)]
+        for stream in (sys.stdout, sys.stderr):
+            # A terminal that cannot show a character (a site's name under LANG=C) gets an escape, not an error.
+            if codecs.lookup(getattr(stream, "encoding", None) or "utf-8").name != "utf-8" and hasattr(
+                    stream, "reconfigure"):
+                stream.reconfigure(errors="backslashreplace")
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGTERM, _terminate)
         try:
             code = super().main(*args, **kwargs)
         except ConfigError as error:
             for line in dict.fromkeys(error.errors):
-                typer.echo(f"error: {line}", err=True)
+                _echo(f"error: {line}", err=True)
             sys.exit(2)
         except (OutputError, OutputExistsError) as error:
-            typer.echo(f"error: {error}", err=True)
+            _echo(f"error: {error}", err=True)
             sys.exit(2)
         except _USAGE_ERROR as error:
             message = error.format_message()
@@ -96,9 +132,9 @@ class _OneLineErrors(TyperGroup):
                 where = f"{error.ctx.command_path}: " if error.ctx is not None else ""
                 if message.startswith("No such command") and error.ctx is not None:
                     message += f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
-                typer.echo(f"error: {where}{message}", err=True)
+                _echo(f"error: {where}{message}", err=True)
             sys.exit(2)
-        except typer.Abort:  # Ctrl-C
+        except (_Interrupted, typer.Abort):  # Ctrl-C; typer's Abort: end of input at a prompt
             typer.echo("interrupted", err=True)
             sys.exit(130)
         except Exception as error:
@@ -106,10 +142,16 @@ class _OneLineErrors(TyperGroup):
                 traceback.print_exc()
             else:
                 reason = str(error).splitlines()[0][:300] if str(error) else ""
-                typer.echo(f"error: internal error ({type(error).__name__}{': ' + reason if reason else ''}); "
-                           "run again as foldopt --debug ... for the traceback, and please report it", err=True)
+                _echo(f"error: internal error ({type(error).__name__}{': ' + reason if reason else ''}); "
+                      "run again as foldopt --debug ... for the traceback, and please report it", err=True)
             sys.exit(1)
         sys.exit(code if isinstance(code, int) else 0)
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            raise _Interrupted() from None
 
 
 class _OnceEach(TyperCommand):
@@ -139,8 +181,18 @@ sweep_app = typer.Typer(rich_markup_mode=None, no_args_is_help=True,
                         help="Sweep one design variable over a range, everything else from the study.")
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        from foldopt import __version__
+
+        typer.echo(f"foldopt {__version__}")
+        raise typer.Exit()
+
+
 @app.callback()
-def _options(debug: bool = typer.Option(False, "--debug", help="Show the traceback of an internal error.")):
+def _options(debug: bool = typer.Option(False, "--debug", help="Show the traceback of an internal error."),
+             version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
+                                          help="Print foldopt's version and exit.")):
     _DEBUG["on"] = debug
 
 
@@ -149,7 +201,7 @@ app.add_typer(sweep_app, name="sweep", short_help="Sweep fold angle, latitude, d
 
 def _fail(lines: list[str]):
     for line in lines:
-        typer.echo(f"error: {line}", err=True)
+        _echo(f"error: {line}", err=True)
     raise typer.Exit(2)
 
 
@@ -182,6 +234,8 @@ class _Output:
 
     def __init__(self, quiet: bool, output_format: str, table: bool = False):
         self.quiet, self.json, self.table = quiet, output_format == "json", table
+        if quiet:
+            os.environ["FOLDOPT_QUIET"] = "1"  # the caches' rebuild notices too; embedded workers inherit it
 
     @contextmanager
     def progress(self, label: str, total: float | None = None, unit: str = "days"):
@@ -212,13 +266,14 @@ class _Output:
         """Render an :class:`foldopt.answer.Answer`: its lines (``--table`` adds ``table``), or one
         JSON document holding it and the rows."""
         if self.json:
-            document = {"command": command, "out": str(out), "answer": answer.to_dict(), "rows": _records(rows)}
+            document = {"command": command, "out": _as_text(str(out)), "answer": answer.to_dict(),
+                        "rows": _records(rows)}
             typer.echo(json.dumps(document, indent=1))
             return
         if self.quiet:
             return
         for line in [*answer.lines(), *lines_after]:
-            typer.echo(line)
+            _echo(line)
         if table is not None and self.table:
             typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
         elif table is not None:
@@ -323,10 +378,11 @@ _OPTION_OF_FIELD = {
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 
 
-def _rename_fields(line: str) -> str:
+def _rename_fields(line: str, options: dict = _OPTION_OF_FIELD) -> str:
+    """A message's leading field path as the option that set it (``options``: field -> option)."""
     match = _FIELD.match(line)
-    if match and match.group(1) in _OPTION_OF_FIELD:
-        return _OPTION_OF_FIELD[match.group(1)] + line[match.end(1):]
+    if match and match.group(1) in options:
+        return options[match.group(1)] + line[match.end(1):]
     return line
 
 
@@ -445,12 +501,15 @@ def _sweep(axis: str, options: dict) -> None:
     config = options.pop("config")
     source = EMBEDDED if config is None else str(config)
     data, _ = read_study(config if config is not None else default_study_path())
+    # --p-load and --p-load-scale both set p_load: a message names the one given.
+    options_of = _OPTION_OF_FIELD if options["p_load_scale"] is None else {**_OPTION_OF_FIELD,
+                                                                            "p_load": "--p-load-scale"}
     try:
         changes = _sweep_changes(options, data)
         changes["description"] = f"foldopt sweep {axis} from {source} (see command)"
         request = plan_request(data, changes, axis=axis, source=source, name=f"sweep-{axis}")
     except ConfigError as error:
-        _fail(list(dict.fromkeys(_rename_fields(line) for line in error.errors)))
+        _fail(list(dict.fromkeys(_rename_fields(line, options_of) for line in error.errors)))
     _run_request(request, out or RESULTS / f"sweep-{axis}", overwrite, output, engine, f"sweep {axis}")
 
 
@@ -511,10 +570,13 @@ def _setting(setting: str) -> tuple[str, object]:
     key, separator, text = setting.partition("=")
     if not separator or not key.strip():
         raise ConfigError([f"--set = {setting!r}: expected KEY=VALUE, e.g. tracker.gcr=0.4"])
+    source = f"--set {key}"
     try:
-        value, _ = parse_study_text(text, f"--set {key}")
-    except ConfigError:
-        raise ConfigError([f"--set {key} = {text!r}: not a YAML value"]) from None
+        value, _ = parse_study_text(text, source)
+    except ConfigError as error:
+        # parse_study_text's line is "config: <source> at line <n>: <problem>"; the problem is kept.
+        problem = re.sub(rf"^config: {re.escape(source)}(?: at line \d+)?: ", "", error.errors[0])
+        raise ConfigError([f"--set {key} = {text!r}: not a YAML value ({problem})"]) from None
     return key.strip(), value
 
 
@@ -606,10 +668,14 @@ def map_(
     for option, value in (("--workers", workers), ("--chunk-sites", chunk_sites)):
         if value is not None and value < 1:
             errors.append(f"{option} = {value}: must be at least 1")
+    if year_problem(year):
+        errors.append(f"--year = {year}: {year_problem(year)}")
     if errors:
         _fail(errors)
-    latitudes = _values("--lat", lat or "-60:60:10") if sites is None and weather_dir is None else []
-    longitudes = _values("--lon", lon or "-180:180:30") if sites is None and weather_dir is None else []
+    grid = sites is None and weather_dir is None
+    # An empty --lat is no value (an error), not the default grid.
+    latitudes = _values("--lat", "-60:60:10" if lat is None else lat) if grid else []
+    longitudes = _values("--lon", "-180:180:30" if lon is None else lon) if grid else []
     for option, values, bound in (("--lat", latitudes, 90), ("--lon", longitudes, 180)):
         if any(not -bound <= value <= bound for value in values):
             errors.append(f"{option}: must be in [-{bound}, {bound}] deg")
@@ -712,6 +778,10 @@ def size(
     """
     output_format, _ = _check_choices(output_format, "numba")
     output = _Output(quiet, output_format, table)
+    errors = _beyond_sizing_bounds({"--cost-per-m2": cost_per_m2, "--cost-per-w": cost_per_w, "--c-grid": c_grid,
+                                    "--years": years, "--days-per-year": days_per_year})
+    if errors:
+        _fail(errors)
     plan = load_plan(config if config is not None else default_study_path())
     if plan.axes:
         _fail([f"config: {config} sweeps {', '.join(p for p, _ in plan.axes)}; size takes one case"])
@@ -731,6 +801,21 @@ def size(
     except ConfigError as error:
         _fail([_sizing_option(line) for line in error.errors])
     output.answer("size", out, result.answer, result.table, [f"wrote {out}"], result.table)
+
+
+#: The sizing's largest values and their units. Within them every benefit, cost and net benefit
+#: over areas up to 1000 m^2 stays far below float overflow (the largest is some 1e13 $); beyond
+#: them a value is a slip, and 1e308 $/m^2 would print as a 309-digit net benefit, or as -inf.
+_SIZING_MAX = {"--cost-per-m2": (1e9, " $/m^2"), "--cost-per-w": (1e6, " $/W"), "--c-grid": (1e3, " $/kWh"),
+               "--years": (1e3, " years"), "--days-per-year": (366, " days")}
+
+
+def _beyond_sizing_bounds(values: dict) -> list[str]:
+    """One line per sizing option (``values``: option -> value or None) that is no number in
+    (0, :data:`_SIZING_MAX`]."""
+    return [f"{option} = {values[option]:g}: must be a finite number > 0 and at most {largest:g}{unit}"
+            for option, (largest, unit) in _SIZING_MAX.items()
+            if values[option] is not None and not 0 < values[option] <= largest]
 
 
 #: The sizing's parameters as the command line names them, longest first.

@@ -43,8 +43,8 @@ COLUMNS = (
     ("energy_harvested_{connection}_wh", "Wh", "energy of one connection at each fold angle (sweep.csv)"),
     ("energy_harvested_{design}_wh", "Wh", "energy of one design over the period (maps)"),
     ("energy_served_wh", "Wh", "energy the load draws while solar-powered"),
-    ("energy_wasted_wh", "Wh", "harvested but not served; negative for a tracker whose drive costs more than it "
-                               "harvests"),
+    ("energy_wasted_wh", "Wh", "harvested but not served; never negative (a tracker whose drive costs more than it "
+                               "harvests has a negative net harvest, served and wasted 0, and a note)"),
     ("peak_power_w", "W", "the day's largest power"),
     ("poa_kwh_m2", "kWh/m^2", "plane-of-array irradiation (mean of the two sub-panels)"),
     ("noon_valley_w", "W", "the parallel curve's minimum between the sub-panels' peaks (Shin et al. Eq. 8)"),

@@ -12,6 +12,7 @@ import itertools
 import math
 import os
 import re
+import stat
 import zoneinfo
 from dataclasses import dataclass
 from functools import partial
@@ -230,14 +231,18 @@ def _profile_steps(value: dict) -> dict:
     """``{"HH:MM": watts}``: clock times of a day, each load at least 0 W."""
     if not isinstance(value, dict) or not value:
         raise ValueError("expected a mapping of clock times HH:MM to watts, e.g. {'07:00': 6, '19:00': 1.5}")
-    steps = {}
+    steps, given = {}, {}
     for time, watts in value.items():
         match = _CLOCK.match(str(time).strip())
         if not match:
             raise ValueError(f"{time!r} is not a clock time HH:MM in [00:00, 23:59]")
         if isinstance(watts, bool) or not isinstance(watts, (int, float)) or not math.isfinite(watts) or watts < 0:
             raise ValueError(f"{time}: {watts!r} is not a load in watts >= 0")
-        steps[f"{int(match.group(1)):02d}:{match.group(2)}"] = float(watts)
+        clock = f"{int(match.group(1)):02d}:{match.group(2)}"
+        if clock in given:  # 7:00 beside 07:00: one of the two loads would be dropped unseen
+            raise ValueError(f"{time!r} is the time {given[clock]!r} again; give each time once")
+        given[clock] = time
+        steps[clock] = float(watts)
     return dict(sorted(steps.items()))
 
 
@@ -558,6 +563,8 @@ def make_study(data: dict) -> Study:
 # --- Plans: a study with sweep axes ------------------------------------------------------------
 
 DATE_KEYWORDS = ("year", "equinoxes-solstices")
+#: Fields that label a study rather than design it: a list of them is no sweep.
+UNSWEPT = ("name", "description")
 
 def _limit(name: str, default: int) -> int:
     """A size limit, raised by the environment variable ``FOLDOPT_<NAME>``."""
@@ -580,6 +587,71 @@ MAX_EVALUATIONS = _limit("MAX_EVALUATIONS", 20_000_000_000)
 MAX_ANNUAL_CELLS = _limit("MAX_ANNUAL_CELLS", 100_000_000)
 #: Bytes of a study file.
 MAX_STUDY_BYTES = _limit("MAX_STUDY_BYTES", 1_000_000)
+#: Bytes of a CSV input (a table of sites, a load profile): MAX_CASES sites at 100 bytes a row.
+MAX_CSV_BYTES = _limit("MAX_CSV_BYTES", 20_000_000)
+#: Years of a study's days, checked alike for study files, sweeps and maps: well inside Python's
+#: calendar (years 1 to 9999; a year 0 or 10000 was a traceback) and pvlib's solar position.
+YEARS = (1901, 2099)
+
+
+def year_problem(year) -> str | None:
+    """Why ``year`` cannot be a study's year, or None: a whole year of :data:`YEARS`."""
+    if isinstance(year, bool) or not isinstance(year, int) or not YEARS[0] <= year <= YEARS[1]:
+        return f"must be a whole year in [{YEARS[0]}, {YEARS[1]}]"
+    return None
+
+
+#: What :func:`read_input` calls a file that is no regular file, by its type.
+_SPECIAL_FILES = ((stat.S_ISCHR, "character device"), (stat.S_ISBLK, "block device"), (stat.S_ISFIFO, "FIFO"),
+                  (stat.S_ISSOCK, "socket"))
+
+
+def read_input(path: Path | str, field: str, limit: int, limit_name: str) -> str:
+    """The text of an input file (a study, a table of sites, a load profile), read as UTF-8
+    whatever the locale, a byte-order mark (a spreadsheet's "CSV UTF-8") dropped.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    field : str
+        What messages name the file by (``config``, ``--sites``...).
+    limit : int
+        Its largest size [bytes].
+    limit_name : str
+        The limit's name: ``FOLDOPT_<limit_name>`` raises it.
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``field`` and the file: missing, a folder, no regular file (a device or a
+        FIFO never ends, or never starts), larger than ``limit``, unreadable or not UTF-8 text.
+    """
+    path = Path(path)
+    try:
+        # Opened without blocking and checked by the open descriptor, so that a FIFO cannot hold
+        # the command and no file swapped in after a check is read.
+        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(descriptor, "rb") as handle:
+            info = os.fstat(handle.fileno())
+            mode = info.st_mode
+            if stat.S_ISDIR(mode):
+                raise ConfigError([f"{field}: {path} is a folder; give a file"])
+            kind = next((name for test, name in _SPECIAL_FILES if test(mode)), None)
+            if kind is not None:
+                raise ConfigError([f"{field}: {path} is a {kind}, not a regular file; give a file"])
+            # A file that says it is too large is not read; one that grows while it is read is cut.
+            data = b"" if info.st_size > limit else handle.read(limit + 1)
+    except FileNotFoundError:
+        raise ConfigError([f"{field}: file not found: {path}"]) from None
+    except OSError as error:
+        raise ConfigError([f"{field}: cannot read {path}: {error.__class__.__name__}"]) from None
+    if info.st_size > limit or len(data) > limit:
+        size = f"{info.st_size:,} bytes" if info.st_size > limit else f"over {limit:,} bytes"
+        raise ConfigError([f"{field}: {path} is {size}; at most {limit:,} (FOLDOPT_{limit_name} raises it)"])
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        raise ConfigError([f"{field}: cannot read {path}: not UTF-8 text (byte {error.start + 1:,})"]) from None
 
 
 class StudyLoader(yaml.SafeLoader):
@@ -611,6 +683,28 @@ class StudyLoader(yaml.SafeLoader):
             except TypeError:  # an unhashable key: the base class says so
                 break
         return super().construct_mapping(node, deep)
+
+    def construct_yaml_int(self, node):
+        self._not_sexagesimal(node, "construct_yaml_int")
+        return super().construct_yaml_int(node)
+
+    def construct_yaml_float(self, node):
+        self._not_sexagesimal(node, "construct_yaml_float")
+        return super().construct_yaml_float(node)
+
+    def _not_sexagesimal(self, node, constructor: str):
+        """YAML 1.1 reads ``19:00`` as the base-60 number 1140 and ``1:9:4`` as 4144: a clock time
+        or a range written without quotes would be a wrong number, silently."""
+        text = self.construct_scalar(node)
+        if ":" in text:
+            value = getattr(super(), constructor)(node)
+            raise yaml.constructor.ConstructorError(
+                None, None, f"{text} is read by YAML as the number {value:g} (base 60); write '{text}' in quotes",
+                node.start_mark)
+
+
+StudyLoader.add_constructor("tag:yaml.org,2002:int", StudyLoader.construct_yaml_int)
+StudyLoader.add_constructor("tag:yaml.org,2002:float", StudyLoader.construct_yaml_float)
 
 _RANGE = re.compile(r"^\s*([^:\s]+)\s*:\s*([^:\s]+)\s*:\s*([^:\s]+)\s*$")
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
@@ -783,8 +877,8 @@ def _axis_values(path: str, spec, year: int) -> list:
 def make_plan(data, lines: dict | None = None) -> Plan:
     """Validate a study with optional sweep axes; raises :class:`ConfigError` with every fault.
 
-    Any field may hold a list (``site``: a list of sites) or a numeric range ``"start:stop:step"``;
-    ``date`` also takes a date range, ``year`` or ``equinoxes-solstices`` (of ``year``, default
+    Any field but :data:`UNSWEPT` may hold a list (``site``: a list of sites) or a numeric range
+    ``"start:stop:step"``; ``date`` also takes a date range, ``year`` or ``equinoxes-solstices`` (of ``year``, default
     2025), and is the whole ``year`` by default with a weather file. The ``sweep:`` section maps dotted field paths to lists or ranges. Each becomes an axis.
     ``lines`` maps key paths to YAML line numbers, added to the messages.
     """
@@ -796,8 +890,8 @@ def make_plan(data, lines: dict | None = None) -> Plan:
         data["date"] = "year"  # a weather file is a year
     errors: list[str] = []
     year = data.pop("year", 2025)
-    if not isinstance(year, int) or isinstance(year, bool) or not 1901 <= year <= 2099:
-        errors.append(_at(lines, ("year",), f"year = {year!r}: must be a whole year in [1901, 2099]"))
+    if year_problem(year):
+        errors.append(_at(lines, ("year",), f"year = {year!r}: {year_problem(year)}"))
         year = 2025
     sweep = data.pop("sweep", None) or {}
     if not isinstance(sweep, dict):
@@ -809,6 +903,10 @@ def make_plan(data, lines: dict | None = None) -> Plan:
         specs[str(path)] = (f"sweep.{path}", ("sweep", str(path)), value)
     axes = []
     for path, (source, yaml_path, spec) in specs.items():
+        if path in UNSWEPT:
+            errors.append(_at(lines, yaml_path, f"{source}: the study's {path} labels its results, it is not "
+                                                f"sweepable; give one {path}"))
+            continue
         try:
             values = _axis_values(path, spec, year)
         except ValueError as error:
@@ -928,19 +1026,11 @@ def load_plan(path: Path | str) -> Plan:
 
 def read_study(path: Path | str) -> tuple:
     """The data of a YAML study file and the line of each of its keys; a relative weather path is
-    made relative to the file. Raises :class:`ConfigError` for a file that cannot be read, is
-    larger than :data:`MAX_STUDY_BYTES` or is not a plain YAML study (:class:`StudyLoader`)."""
+    made relative to the file. Raises :class:`ConfigError` for a file that :func:`read_input`
+    refuses (larger than :data:`MAX_STUDY_BYTES`...) or that is not a plain YAML study
+    (:class:`StudyLoader`)."""
     path = Path(path)
-    try:
-        size = path.stat().st_size
-        if size > MAX_STUDY_BYTES and path.is_file():
-            raise ConfigError([f"config: {path} is {size:,} bytes; a study file is at most {MAX_STUDY_BYTES:,}"])
-        text = path.read_text()
-    except FileNotFoundError:
-        raise ConfigError([f"config: file not found: {path}"]) from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as error:
-        raise ConfigError([f"config: cannot read {path}: {error.__class__.__name__}"]) from None
-    data, lines = parse_study_text(text, str(path))
+    data, lines = parse_study_text(read_input(path, "config", MAX_STUDY_BYTES, "MAX_STUDY_BYTES"), str(path))
     if isinstance(data, dict):
         data = _resolve_weather_path(data, path.parent)
     return data, lines

@@ -25,7 +25,7 @@ import numpy as np
 
 from foldopt import engine as engines
 from foldopt.config import NearOptimal, Study
-from foldopt.metrics import energy, energy_served, metric_columns
+from foldopt.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.sky import Sky, build_sky
 from foldopt.tracker import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
 
@@ -157,7 +157,8 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
 
 def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
-    panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net."""
+    panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net;
+    ``condition`` is each design's (:func:`foldopt.metrics.design_condition`)."""
     study = blocks.study
     n_blocks, n_loads = sky.n_blocks, loads.size
     tilt, azimuth = blocks.tilt, blocks.azimuth
@@ -196,22 +197,24 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
                            energy_served(net, loads, shape, step, trackers.t_solar[n_blocks:, 0])], axis=-1)
     fold = np.stack([np.full((n_blocks, n_loads), 180.0), angles[chosen], np.full((n_blocks, n_loads), np.nan),
                      np.full((n_blocks, n_loads), np.nan)], axis=-1)
+    columns = metric_columns(
+        hours,
+        per_design(twofold.t_solar_contiguous[:, 0, 0], flat.t_solar_contiguous[:, 0],
+                   trackers.t_solar_contiguous[:, 0]),
+        per_design(twofold.energy[:, 0], np.repeat(flat.energy, n_loads, axis=1),
+                   np.repeat(trackers.energy, n_loads, axis=1)),
+        per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
+                   np.repeat(trackers.peak, n_loads, axis=1)),
+        loads[None, :, None],
+        served,
+    )
     return {
         "fold_angle_deg": fold,
-        **metric_columns(
-            hours,
-            per_design(twofold.t_solar_contiguous[:, 0, 0], flat.t_solar_contiguous[:, 0],
-                       trackers.t_solar_contiguous[:, 0]),
-            per_design(twofold.energy[:, 0], np.repeat(flat.energy, n_loads, axis=1),
-                       np.repeat(trackers.energy, n_loads, axis=1)),
-            per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
-                       np.repeat(trackers.peak, n_loads, axis=1)),
-            loads[None, :, None],
-            served,
-        ),
+        **columns,
         "poa_kwh_m2": per_design(twofold.irradiation, np.repeat(flat.irradiation[:, None], n_loads, axis=1),
                                  np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
-        "condition": np.broadcast_to(sky.conditions()[:, None, None], hours.shape),
+        # A tracker whose drive costs more than it harvests says so where every table's note starts.
+        "condition": design_condition(sky.conditions()[:, None, None], columns["energy_harvested_wh"]),
     }
 
 

@@ -16,13 +16,17 @@ error against it.
 Tables are kept on disk, named by a hash of everything they depend on (the PV unit's parameters,
 the sub-panel area, the temperature settings, the nodes, pvlib's version and
 :data:`TABLE_FORMAT`), in ``$FOLDOPT_CACHE_DIR`` or ``~/.cache/foldopt``; a second process loads
-them instead of solving I-V curves again. A cache that cannot be written is skipped.
+them instead of solving I-V curves again. A cache file ends with a checksum of its content
+(:func:`store_cache`): a damaged one is built again, with a notice. A cache that cannot be written
+is skipped.
 """
 
 from __future__ import annotations
 
 import hashlib
+import io
 import os
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +42,8 @@ TABLE_NODES_1D = 1025
 TABLE_NODES_2D = 161
 TABLE_NODES_RATIO = 321
 TABLE_FORMAT = 4  # bump when the way tables are built changes
+#: Ends every cache file, followed by the SHA-256 (hex) of the bytes before it.
+_CHECKSUM = b"\nfoldopt-sha256:"
 
 
 def cache_dir() -> Path:
@@ -47,15 +53,36 @@ def cache_dir() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "foldopt"
 
 
-def _load_cached(path: Path):
+def load_cache(path: Path) -> dict | None:
+    """The arrays of the cache file ``path`` (:func:`store_cache`), or None where it is absent or
+    damaged: then the caller builds them again. The checksum is verified before anything is read,
+    so that a truncated or bit-flipped file is caught whatever its bytes; a damaged file gets a
+    one-line notice on stderr (none with ``FOLDOPT_QUIET=1``)."""
     try:
-        with np.load(path, allow_pickle=False) as data:
-            return tuple(data[f"a{i}"] for i in range(len(data.files)))
-    except (OSError, ValueError, KeyError, EOFError):
-        return None  # absent or damaged: rebuild
+        data = Path(path).read_bytes()
+    except FileNotFoundError:
+        return None
+    except OSError as error:
+        _notice(path, f"cannot be read ({error.strerror or error})")
+        return None
+    payload, mark, digest = data.rpartition(_CHECKSUM)
+    if not mark:
+        _notice(path, "has no checksum (written by an earlier foldopt, or truncated)")
+        return None
+    if digest != hashlib.sha256(payload).hexdigest().encode():
+        _notice(path, "is damaged (its checksum does not match)")
+        return None
+    with np.load(io.BytesIO(payload), allow_pickle=False) as arrays:
+        return {name: arrays[name] for name in arrays.files}
 
 
-def _store_cached(path: Path, arrays) -> None:
+def store_cache(path: Path, arrays: dict, compress: bool = False) -> None:
+    """Write ``arrays`` to the cache file ``path``: a NumPy ``.npz`` followed by
+    :data:`_CHECKSUM` and the SHA-256 of the ``.npz``, atomically. A cache that cannot be written
+    is skipped."""
+    buffer = io.BytesIO()
+    (np.savez_compressed if compress else np.savez)(buffer, **arrays)
+    payload = buffer.getvalue()
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -63,10 +90,15 @@ def _store_cached(path: Path, arrays) -> None:
         return  # no cache where none can be written
     try:
         with os.fdopen(handle, "wb") as file:
-            np.savez(file, **{f"a{i}": array for i, array in enumerate(arrays)})
+            file.write(payload + _CHECKSUM + hashlib.sha256(payload).hexdigest().encode())
         os.replace(temporary, path)  # atomic: readers see the old file or the whole new one
     except OSError:
         Path(temporary).unlink(missing_ok=True)
+
+
+def _notice(path: Path, problem: str) -> None:
+    if os.environ.get("FOLDOPT_QUIET") != "1":
+        print(f"foldopt: the cache file {path} {problem}; building it again", file=sys.stderr)
 
 
 def _nodes(count):
@@ -158,9 +190,10 @@ class Electrical:
             self._tables = {}
         if name not in self._tables:
             path = cache_dir() / "tables" / f"{name}-{self.cache_key(name)}.npz"
-            cached = _load_cached(path)
+            cached = load_cache(path)
             if cached is not None:
-                self._tables[name] = cached if name == "subpanel" else cached[0]
+                arrays = tuple(cached[f"a{i}"] for i in range(len(cached)))
+                self._tables[name] = arrays if name == "subpanel" else arrays[0]
                 return self._tables[name]
             if name == "subpanel":
                 g1 = _nodes(TABLE_NODES_1D)
@@ -168,7 +201,7 @@ class Electrical:
             else:
                 self._tables[name] = self._pair_table(name)
             table = self._tables[name]
-            _store_cached(path, table if name == "subpanel" else (table,))
+            store_cache(path, {f"a{i}": array for i, array in enumerate(table if name == "subpanel" else (table,))})
         return self._tables[name]
 
     def _pair_table(self, connection):

@@ -3,7 +3,8 @@
 The source is the ``global-land-mask`` package (NOAA's GLOBE 30-arc-second land mask, 1 km),
 shipped with it, so nothing is downloaded. The full mask is 930 MB in memory and takes seconds to
 load; foldopt keeps a 5-arc-minute land fraction of it (each cell's share of land pixels) in its
-cache folder (:func:`foldopt.electrical.cache_dir`), built once and written atomically.
+cache folder (:func:`foldopt.electrical.cache_dir`), built once and written atomically with a
+checksum (:func:`foldopt.electrical.store_cache`): a damaged cache is built again.
 """
 
 from __future__ import annotations
@@ -11,8 +12,6 @@ from __future__ import annotations
 from functools import cache
 
 import numpy as np
-
-from foldopt.folders import write_atomically
 
 #: 30-arc-second cells per cell of the cached land fraction (5 arc minutes, ~9 km).
 _FACTOR = 10
@@ -28,14 +27,19 @@ def land_fraction() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ImportError
         Without the ``global-land-mask`` package (``pip install foldopt[map]``).
     """
-    from foldopt.electrical import cache_dir
+    from foldopt.electrical import cache_dir, load_cache, store_cache
 
     path = cache_dir() / f"land-fraction-{_FACTOR}.npz"
-    try:
-        with np.load(path) as stored:
-            return stored["latitude"], stored["longitude"], stored["fraction"]
-    except (OSError, ValueError, KeyError):
-        pass
+    stored = load_cache(path)
+    if stored is not None:
+        return stored["latitude"], stored["longitude"], stored["fraction"]
+    latitude, longitude, fraction = _build()
+    store_cache(path, {"latitude": latitude, "longitude": longitude, "fraction": fraction}, compress=True)
+    return latitude, longitude, fraction
+
+
+def _build() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`land_fraction` from the full mask."""
     from global_land_mask import globe  # loads the full mask: seconds, once per cache
 
     water = globe._mask  # (21600, 43200) True on water, latitude descending from 90, longitude from -180
@@ -48,12 +52,6 @@ def land_fraction() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     step = 180.0 / rows
     latitude = -90 + step * (np.arange(rows) + 0.5)
     longitude = -180 + step * (np.arange(columns) + 0.5)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_atomically(path, lambda temporary: np.savez_compressed(temporary, latitude=latitude,
-                                                                      longitude=longitude, fraction=fraction))
-    except OSError:
-        pass  # an unwritable cache means building it again next time, not an error
     return latitude, longitude, fraction
 
 

@@ -11,29 +11,35 @@ scale (:func:`foldopt.metrics.per_load`), the method of many constant loads.
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 
 import numpy as np
 
 
 def read_profile(path: str | Path) -> dict:
-    """A day's profile from a CSV file with a header ``time,watts`` (``HH:MM`` and watts)."""
-    from foldopt.config import ConfigError, _profile_steps
+    """A day's profile from a CSV file with a header ``time,watts`` (``HH:MM`` and watts), UTF-8 with
+    or without a byte-order mark, each time at most once."""
+    from foldopt.config import MAX_CSV_BYTES, ConfigError, _profile_steps, read_input
 
     path = Path(path)
+    text = read_input(path, "load_profile.file", MAX_CSV_BYTES, "MAX_CSV_BYTES")
     try:
-        with path.open(newline="") as handle:
-            rows = list(csv.DictReader(handle))
-    except FileNotFoundError:
-        raise ConfigError([f"load_profile.file: file not found: {path}"]) from None
-    except (OSError, UnicodeDecodeError, csv.Error) as error:
-        raise ConfigError([f"load_profile.file: cannot read {path}: {error.__class__.__name__}"]) from None
-    steps = {}
-    for line, row in enumerate(rows, start=2):
+        reader = csv.DictReader(io.StringIO(text, newline=""))
+        rows = [(reader.line_num, row) for row in reader]
+    except csv.Error as error:
+        raise ConfigError([f"load_profile.file: cannot read {path}: {error}"]) from None
+    steps, lines = {}, {}
+    for line, row in rows:
         try:
-            steps[row["time"]] = float(row["watts"])
-        except (KeyError, TypeError, ValueError):
-            raise ConfigError([f"load_profile.file {path}, line {line}: expected time,watts (HH:MM, a number)"]) from None
+            time, watts = row["time"].strip(), float(row["watts"])
+        except (KeyError, TypeError, ValueError, AttributeError):
+            raise ConfigError([f"load_profile.file {path}, line {line}: expected time,watts (HH:MM, a number)"
+                               ]) from None
+        if time in steps:  # the second load would replace the first unseen
+            raise ConfigError([f"load_profile.file {path}, line {line}: time {time} is also on line {lines[time]}; "
+                               "give each time once"])
+        steps[time], lines[time] = watts, line
     try:
         return _profile_steps(steps)
     except ValueError as error:

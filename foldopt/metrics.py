@@ -90,15 +90,19 @@ def metric_columns(t_solar_h, t_solar_contiguous_h, energy_harvested_wh, peak_po
         point), ``energy_served_wh`` = P_load * t_solar, ``energy_wasted_wh`` the rest (without
         storage, power above the load and power too low to run it are both lost) [Wh];
         ``peak_power_w`` [W]. ``served_wh`` replaces ``P_load * t_solar`` for a load profile
-        (:func:`energy_served`).
+        (:func:`energy_served`). A tracker net of its drive can harvest less than nothing (its
+        drive costs more than it harvests, :data:`DRIVE_NOTE`): it then serves and wastes nothing,
+        so that served energy never exceeds what is harvested and nothing wasted is negative.
     """
     served = np.asarray(p_load, dtype=float) * t_solar_h if served_wh is None else served_wh
+    harvested = np.maximum(energy_harvested_wh, 0.0)
+    served = np.minimum(served, harvested)
     return {
         "t_solar_h": t_solar_h,
         "t_solar_contiguous_h": t_solar_contiguous_h,
         "energy_harvested_wh": energy_harvested_wh,
         "energy_served_wh": served,
-        "energy_wasted_wh": energy_harvested_wh - served,
+        "energy_wasted_wh": harvested - served,
         "peak_power_w": peak_power_w,
     }
 
@@ -147,8 +151,23 @@ def relative_to(t_solar_h, reference_h):
     return ratio
 
 
+#: The note of a tracker whose own draw exceeds its harvest: its net energy is below zero.
+DRIVE_NOTE = "drive costs more than it harvests"
+
+
+def design_condition(condition, energy_harvested_wh):
+    """Each design's condition on its day: the day's (:meth:`foldopt.sky.Sky.conditions`) and,
+    where the design harvests less than nothing (a tracker net of its drive), :data:`DRIVE_NOTE`;
+    broadcast, joined by ``; ``."""
+    condition, harvested = np.broadcast_arrays(np.asarray(condition, dtype=object),
+                                               np.asarray(energy_harvested_wh, dtype=float))
+    return np.array(["; ".join(p for p in (c, DRIVE_NOTE if h < 0 else "") if p)
+                     for c, h in zip(condition.ravel(), harvested.ravel(), strict=True)],
+                    dtype=object).reshape(condition.shape)
+
+
 def notes(condition, t_solar_h):
-    """A report's note: the day's condition (:meth:`foldopt.sky.Sky.conditions`) and, where direct
+    """A report's note: the condition (:func:`design_condition`, or the day's) and, where direct
     light arrives but the design never reaches the load, ``load above peak``; joined by ``; ``."""
     condition, hours = np.broadcast_arrays(np.asarray(condition, dtype=object), np.asarray(t_solar_h))
     # On a polar night or an overcast day the condition is the reason already.

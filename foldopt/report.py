@@ -3,14 +3,55 @@
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import json
+import os
 import platform
+import shutil
 import sys
+import tempfile
 from importlib import metadata
 from pathlib import Path
 
-import matplotlib
+
+def _writable(folder: Path) -> bool:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return False
+    return folder.is_dir() and os.access(folder, os.W_OK)
+
+
+def _matplotlib_folder() -> None:
+    """Give matplotlib a writable folder for its configuration and font cache (``MPLCONFIGDIR``)
+    where its own under HOME is not (HOME read-only, missing or no folder): matplotlib would warn
+    on stderr, which ``--quiet`` keeps empty. foldopt's cache folder is taken where it is
+    writable (the font cache is then kept), else a temporary folder removed at exit. Run before
+    matplotlib is imported, which reads the variable once."""
+    if os.environ.get("MPLCONFIGDIR"):
+        return
+    try:
+        own = [Path(os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config") / "matplotlib",
+               Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "matplotlib"]
+    except RuntimeError:  # no home folder at all
+        own = []
+    if own and all(_writable(folder) for folder in own):
+        return
+    from foldopt.electrical import cache_dir
+
+    try:
+        folder = cache_dir() / "matplotlib"
+    except RuntimeError:
+        folder = None
+    if folder is None or not _writable(folder):
+        folder = Path(tempfile.mkdtemp(prefix="foldopt-matplotlib-"))
+        atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    os.environ["MPLCONFIGDIR"] = str(folder)
+
+
+_matplotlib_folder()
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

@@ -19,8 +19,8 @@ import pandas as pd
 from foldopt import engine as engines
 from foldopt.aggregation import CONNECTIONS, SWITCH_STATES
 from foldopt.config import Study
-from foldopt.metrics import (energy_served, load_for_t_solar, metric_columns, notes, per_load, relative_to,
-                             t_solar)
+from foldopt.metrics import (design_condition, energy_served, load_for_t_solar, metric_columns, notes,
+                             per_load, relative_to, t_solar)
 from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.sizing import flat_area_multiple
 from foldopt.designs import (DESIGNS, Blocks, design_metrics, near_optimal, sky_tracker_draw,
@@ -246,7 +246,8 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
         flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 and shape is None else np.nan
         for hours in summary["t_solar_h"]
     ]
-    summary["note"] = notes(day.sky.conditions()[0], summary["t_solar_h"].to_numpy())
+    summary["note"] = notes(design_condition(day.sky.conditions()[0], summary["energy_harvested_wh"].to_numpy(float)),
+                            summary["t_solar_h"].to_numpy())
     standby = standby_sweep(day, p_tracker, by_design["twofold"])
 
     at_best, state = day.connections(np.array([best_angle]))

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
+import io
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -30,7 +31,8 @@ import pandas as pd
 from pydantic import ValidationError
 
 from foldopt import engine as engines
-from foldopt.config import ConfigError, Site, Study, _format_errors, parse_dates
+from foldopt.config import (MAX_CSV_BYTES, ConfigError, Site, Study, _format_errors, parse_dates, read_input,
+                            year_problem)
 from foldopt.designs import Blocks, best_angle_index, daily_designs, near_optimal, objective_value
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
@@ -91,33 +93,42 @@ def grid_sites(latitudes: Sequence[float], longitudes: Sequence[float], land_onl
 
 def read_sites(path: Path | str) -> list[dict]:
     """Named sites from a CSV file with a header of :data:`SITE_COLUMNS` (altitude [m] and time zone
-    optional). Raises :class:`ConfigError` with the file, line and field of every bad value."""
+    optional), UTF-8 with or without a byte-order mark, each name at most once. Raises
+    :class:`ConfigError` with the file, line and field of every bad value or row."""
     path = Path(path)
+    text = read_input(path, "--sites", MAX_CSV_BYTES, "MAX_CSV_BYTES")
     try:
-        with path.open(newline="") as handle:
-            reader = csv.DictReader(handle)
-            header = [name.strip() for name in reader.fieldnames or []]
-            rows = [(index, row) for index, row in enumerate(reader, start=2)]
-    except FileNotFoundError:
-        raise ConfigError([f"--sites: file not found: {path}"]) from None
-    except (OSError, UnicodeDecodeError, csv.Error) as error:
-        raise ConfigError([f"--sites: cannot read {path}: {error.__class__.__name__}"]) from None
+        reader = csv.reader(io.StringIO(text, newline=""))
+        header = [name.strip() for name in next(reader, [])]
+        rows = [(reader.line_num, cells) for cells in reader if cells]  # a blank line is no row
+    except csv.Error as error:
+        raise ConfigError([f"--sites: cannot read {path}: {error}"]) from None
     missing = [name for name in ("latitude", "longitude") if name not in header]
     unknown = [name[:30] for name in header if name not in SITE_COLUMNS][:5]
-    if missing or unknown:
+    twice = sorted({name for name in header if header.count(name) > 1})
+    if missing or unknown or twice:
         raise ConfigError([f"--sites {path}: the header must name {', '.join(SITE_COLUMNS)} (name, altitude and "
                            f"timezone optional); " + "; ".join(
                                ([f"missing {', '.join(missing)}"] if missing else [])
-                               + ([f"unknown {', '.join(unknown)}"] if unknown else []))])
-    sites, errors = [], []
-    for line, row in rows:
-        values = {key.strip(): (value or "").strip() for key, value in row.items() if key is not None}
-        data = {key: value for key, value in values.items() if value != ""}
+                               + ([f"unknown {', '.join(unknown)}"] if unknown else [])
+                               + ([f"{', '.join(twice)} twice"] if twice else []))])
+    sites, errors, named = [], [], {}
+    for line, cells in rows:
+        if len(cells) > len(header):  # a cell more than the header names: a stray comma, or a shifted row
+            errors.append(f"--sites {path}, line {line}: {len(cells)} fields; the header names {len(header)}")
+            continue
+        data = {key: value.strip() for key, value in zip(header, cells) if value.strip() != ""}
         try:
             site = Site.model_validate(data)
         except ValidationError as error:
             errors += [f"--sites {path}, line {line}: {message}" for message in _format_errors(error)]
             continue
+        if site.name is not None:
+            if site.name in named:  # the map's rows and figures tell sites by name
+                errors.append(f"--sites {path}, line {line}: name {site.name!r} is also on line {named[site.name]}; "
+                              "give each site its own name")
+                continue
+            named[site.name] = line
         sites.append(site.model_dump(exclude_none=True))
     if not sites and not errors:
         errors.append(f"--sites {path}: no sites (a header and one row per site)")
@@ -149,6 +160,8 @@ def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]
     """The study at one site of a map and the days of its year: ``study`` is a study's fields but
     the site, date and load; ``site`` a :class:`foldopt.config.Site`'s fields or a weather file's
     site (``weather``: the path, its site read from the file)."""
+    if year_problem(year):
+        raise ConfigError([f"year = {year!r}: {year_problem(year)}"])
     dates = parse_dates("year", year)
     if study.get("load_profile") is not None:
         raise ConfigError(["load_profile: maps take constant loads (watts or fractions of the flat peak); run a "

@@ -126,6 +126,18 @@ VALUES = [
     ("map-step", ["map", "--step-min", "7"], ["--step-min", "divide the 1440 min"]),
     ("map-workers", ["map", "--workers", "0"], ["--workers", "at least 1"]),
     ("map-set", ["map", "--set", "panel.area=-1"], ["--area", "(0, 1000]"]),
+    ("map-year-0", ["map", "--year", "0"], ["--year = 0", "[1901, 2099]"]),
+    ("map-year-10000", ["map", "--year", "10000"], ["--year = 10000", "[1901, 2099]"]),
+    ("year-10000", ["sweep", "angle", "--year", "10000"], ["--year = 10000", "[1901, 2099]"]),
+    ("map-lat-empty", ["map", "--lat", ""], ["--lat = ''", "no value"]),
+    ("map-lat-million", ["map", "--lat", "0:1:0.000001"], ["--lat", "1,000,001 values", "at most 10,000 per axis",
+                                                            "FOLDOPT_MAX_AXIS_VALUES"]),
+    ("size-cost-1e308", ["size", "--cost-per-m2", "1e308"], ["--cost-per-m2 = 1e+308", "at most 1e+09 $/m^2"]),
+    ("size-cost-per-w-huge", ["size", "--cost-per-w", "1e300"], ["--cost-per-w", "at most 1e+06 $/W"]),
+    ("size-c-grid-huge", ["size", "--c-grid", "1e306"], ["--c-grid = 1e+306", "at most 1000 $/kWh"]),
+    ("size-days-huge", ["size", "--days-per-year", "1e300"], ["--days-per-year", "at most 366 days"]),
+    ("set-unquoted-range", ["sweep", "angle", "--set", "p_load=1:9:4"], ["--set p_load", "number 4144",
+                                                                          "write '1:9:4' in quotes"]),
 ]
 
 YAML_FILES = [
@@ -157,6 +169,13 @@ YAML_FILES = [
     ("objective-one-day", fast_yaml(objective={"statistic": "mean"}), ["objective", "several dates"]),
     ("weather-missing", fast_yaml(weather="nope.csv"), ["weather", "file not found"]),
     ("tags", "name: !!python/object:os.system x\n", ["config", "line 1"]),
+    ("name-list", fast_yaml(name=["a", "b"]), ["name", "not sweepable", "give one name"]),
+    ("sweep-name", fast_yaml(sweep={"name": ["a", "b"]}), ["sweep.name", "not sweepable"]),
+    ("unquoted-clock", fast_yaml() + "load_profile:\n  daily: {'07:00': 6, 19:00: 1.5}\n",
+     ["bad.yaml", "19:00 is read by YAML as the number 1140", "write '19:00' in quotes"]),
+    ("unquoted-range", fast_yaml() + "sweep: {p_load: 1:9:4}\n", ["1:9:4", "write '1:9:4' in quotes"]),
+    ("profile-time-twice", fast_yaml(load_profile={"daily": {"07:00": 6, "7:00": 3}}),
+     ["load_profile.daily", "'7:00' is the time '07:00' again"]),
 ]
 
 OUTPUTS = [
@@ -309,13 +328,18 @@ def test_a_run_killed_while_it_writes_leaves_nothing_behind(tmp_path, sig):
 
 
 def test_a_folder_retired_by_a_killed_run_is_put_back(tmp_path):
-    from foldopt.folders import clear_leftovers
+    import socket
+
+    from foldopt.folders import MARKER, clear_leftovers
 
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
     retired = tmp_path / f".results.old-{dead.pid}"
-    retired.mkdir()
-    (retired / "run.json").write_text("{}")
+    (retired / "results").mkdir(parents=True)
+    # Only a folder that carries foldopt's marker is foldopt's to put back (issue 21: never the name alone).
+    (retired / MARKER).write_text(json.dumps({"writer": "foldopt", "pid": dead.pid, "host": socket.gethostname(),
+                                              "token": "0"}))
+    (retired / "results" / "run.json").write_text("{}")
     clear_leftovers(tmp_path)
     assert (tmp_path / "results" / "run.json").exists() and not retired.exists()
 

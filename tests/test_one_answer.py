@@ -209,3 +209,9 @@ def test_every_written_column_is_in_the_vocabulary_and_the_manual(tmp_path):
     assert not unknown
     # The registry knows no name it does not describe, and tells an unknown one.
     assert describe("energy_wh") is None and describe("energy_harvested_tracker_net_wh")[1] == "Wh"
+
+
+def test_version():
+    done = subprocess.run([sys.executable, "-m", "foldopt.cli", "--version"], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0 and done.stdout.strip() == f"foldopt {foldopt.__version__}"
