@@ -1,6 +1,7 @@
-"""Shared fixtures: the paper's study as shipped, and a cheap variant for fast tests."""
+"""Shared fixtures: the paper's study as shipped, a cheap variant for fast tests, and a small tmpfs for full disks."""
 
 import os
+import subprocess
 
 import pytest
 
@@ -18,3 +19,18 @@ def pytest_configure(config):
     # between runs, ignored by git) rather than in the user's ~/.cache.
     if config.cache is not None:
         os.environ.setdefault("FOLDOPT_CACHE_DIR", str(config.cache.mkdir("foldopt")))
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 2 MB tmpfs at ``tmp_path / "disk"``, unmounted afterwards; skipped where it cannot be mounted."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(disk)], capture_output=True,
+                             text=True)
+    if mounted.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {mounted.stderr.strip() or mounted.returncode}")
+    try:
+        yield disk
+    finally:
+        subprocess.run(["umount", str(disk)], check=True)

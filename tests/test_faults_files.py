@@ -196,19 +196,7 @@ def test_a_truncated_land_mask_cache_is_built_again(tmp_path, monkeypatch, capsy
 # --- full file systems ------------------------------------------------------------------------------
 
 
-@pytest.fixture
-def small_disk(tmp_path):
-    """A 2 MB tmpfs at ``tmp_path / "disk"``, unmounted afterwards; skipped where it cannot be mounted."""
-    disk = tmp_path / "disk"
-    disk.mkdir()
-    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(disk)], capture_output=True,
-                             text=True)
-    if mounted.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {mounted.stderr.strip() or mounted.returncode}")
-    try:
-        yield disk
-    finally:
-        subprocess.run(["umount", str(disk)], check=True)
+# small_disk: a 2 MB tmpfs (tests/conftest.py).
 
 
 def test_a_full_disk_is_one_line_naming_the_folder_and_keeps_the_earlier_one(small_disk):
