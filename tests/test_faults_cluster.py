@@ -25,6 +25,7 @@ import pytest
 from foldopt.cluster import MapSpec, connect, run_map
 from foldopt.config import ConfigError
 from foldopt.folders import OutputError
+from test_faults_files import HOLDS_THE_LOCK
 
 distributed = pytest.importorskip("distributed")
 
@@ -109,19 +110,11 @@ def test_resume_recomputes_a_part_of_another_map(finished, scheduler, tmp_path):
     assert (resumed.table["p_load_w"] == 1.0).all()
 
 
-_HOLDS_THE_LOCK = """
-import sys, time
-from pathlib import Path
-from foldopt.folders import writer_lock
-with writer_lock(Path(sys.argv[1])):
-    print("locked", flush=True)
-    time.sleep(60)
-"""
 
 
 def test_a_second_map_of_one_folder_is_refused_naming_the_first(tmp_path):
     out = tmp_path / "map"
-    holder = subprocess.Popen([sys.executable, "-c", _HOLDS_THE_LOCK, str(out)], stdout=subprocess.PIPE, text=True)
+    holder = subprocess.Popen([sys.executable, "-c", HOLDS_THE_LOCK, str(out)], stdout=subprocess.PIPE, text=True)
     try:
         assert holder.stdout.readline() == "locked\n"
         with pytest.raises(OutputError, match=f"another foldopt run \\(pid {holder.pid} on "):

@@ -104,7 +104,8 @@ def test_a_second_writer_of_one_folder_is_refused(tmp_path):
     assert sorted(path.name for path in tmp_path.iterdir()) == ["out"]
 
 
-_HOLDS_THE_LOCK = """
+#: A process that holds a folder's writer lock for a minute (test_faults_cluster uses it too).
+HOLDS_THE_LOCK = """
 import sys, time
 from pathlib import Path
 from foldopt.folders import writer_lock
@@ -116,7 +117,7 @@ with writer_lock(Path(sys.argv[1])):
 
 def test_a_lock_names_its_holder_and_goes_with_it_even_by_sigkill(tmp_path):
     out = tmp_path / "out"
-    holder = _python(_HOLDS_THE_LOCK, out)
+    holder = _python(HOLDS_THE_LOCK, out)
     try:
         assert holder.stdout.readline() == "locked\n"
         with pytest.raises(OutputError, match=f"pid {holder.pid} on "):
