@@ -26,9 +26,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from foldopt import engine  # noqa: E402
-from foldopt.config import default_study_path, load_study  # noqa: E402
-from foldopt.sky import build_sky  # noqa: E402
+from foldopt.engine import rows as engine  # noqa: E402
+from foldopt.inputs.config import default_study_path, load_study  # noqa: E402
+from foldopt.engine.sky import build_sky  # noqa: E402
 
 
 def _t_solar(study, dates, angles):
@@ -44,8 +44,8 @@ def _t_solar(study, dates, angles):
 
 def accuracy():
     """Largest t_solar [s] and energy [%] differences of the tables from the exact solve."""
-    from foldopt.metrics import energy, t_solar
-    from foldopt.study import Day
+    from foldopt.engine.metrics import energy, t_solar
+    from foldopt.studies.day import Day
 
     base = load_study(default_study_path())
     angles = np.arange(1.0, 181.0)

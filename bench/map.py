@@ -33,9 +33,9 @@ TARGET_SPEEDUP = 1.8
 
 
 def _spec(n_sites: int):
-    from foldopt.cluster import MapSpec
-    from foldopt.config import default_study_path, read_study
-    from foldopt.worldmap import grid_sites, map_study
+    from foldopt.studies.cluster import MapSpec
+    from foldopt.inputs.config import default_study_path, read_study
+    from foldopt.studies.worldmap import grid_sites, map_study
 
     n_lat = max(1, round(np.sqrt(n_sites * 0.8)))
     n_lon = -(-n_sites // n_lat)
@@ -49,7 +49,7 @@ def _spec(n_sites: int):
 def _run(spec, workers: int, folder: Path) -> dict:
     from distributed import Client, LocalCluster  # noqa: F401  (imported before the clock starts)
 
-    from foldopt.cluster import run_map
+    from foldopt.studies.cluster import run_map
 
     started = time.perf_counter()
     ready = {}
@@ -76,7 +76,7 @@ def main() -> None:
     pd.testing.assert_frame_equal(one.pop("table"), two.pop("table"), check_exact=True)
     speedup = one["wall_s"] / two["wall_s"]
     per_site = (one["wall_s"] - one["cluster_start_s"]) / len(spec.sites)  # one core, one site, everything
-    land_sites = 21_637  # 1-degree grid points on land, foldopt.worldmap.grid_sites(..., land_only=True)
+    land_sites = 21_637  # 1-degree grid points on land, foldopt.studies.worldmap.grid_sites(..., land_only=True)
     lines = [
         f"# W4: world map on the embedded Dask cluster ({platform.node()}, {os.cpu_count()} cores, "
         f"{time.strftime('%Y-%m-%d')})",

@@ -47,7 +47,7 @@ W3_ANGLE_DEG = 1.0  # [deg] best angle (the grid step), where the best is clear 
 
 
 def _study():
-    from foldopt.config import default_study_path, load_study
+    from foldopt.inputs.config import default_study_path, load_study
 
     return load_study(default_study_path()).variant(
         pv_model="single-diode", connection="switching", mode="exact", geometry="hinge"
@@ -68,10 +68,10 @@ def _fold_pass(base, sites, dates, loads, threads=None):
     """foldopt's engine over blocks: sky, tables, kernel; per-phase times and the results."""
     import numba
 
-    from foldopt import engine
-    from foldopt.geometry import default_orientation
-    from foldopt.sky import build_sky
-    from foldopt.solarposition import clock_grid, solar_position_grid
+    from foldopt.engine import rows as engine
+    from foldopt.physics.geometry import default_orientation
+    from foldopt.engine.sky import build_sky
+    from foldopt.physics.solarposition import clock_grid, solar_position_grid
 
     if threads:
         numba.set_num_threads(threads)
@@ -100,7 +100,7 @@ def _fold_pass(base, sites, dates, loads, threads=None):
 def _metrics_share(sky, base, orientation, rows, loads, sample: int = 2000):
     """Time per point of the metrics alone (curve_rows on power curves that already exist),
     measured on a sample of rows."""
-    from foldopt import engine
+    from foldopt.engine import rows as engine
 
     pick = np.linspace(0, rows.size - 1, min(sample, rows.size)).astype(int)
     curves = np.concatenate([engine.powers(sky, base, orientation[i:i + 1], [rows[i]], series=False)[0]["switching"]
@@ -111,7 +111,7 @@ def _metrics_share(sky, base, orientation, rows, loads, sample: int = 2000):
 
 
 def workload_w1(days: int) -> dict:
-    from foldopt import engine  # noqa: F401  (imports counted outside the timed phases)
+    from foldopt.engine import rows as engine  # noqa: F401  (imports counted outside the timed phases)
 
     base = _study()
     dates = _w1_dates(days)
@@ -136,8 +136,8 @@ def workload_w1(days: int) -> dict:
 
 
 def workload_w2(days: int, latitudes: int) -> dict:
-    from foldopt import engine  # noqa: F401
-    from foldopt.config import Site
+    from foldopt.engine import rows as engine  # noqa: F401
+    from foldopt.inputs.config import Site
 
     base = _study().variant(panel={"area": 0.108, "efficiency": 0.1905})  # tilt |latitude|, equator-facing
     lats = np.linspace(-89.0, 89.0, latitudes)
@@ -181,8 +181,8 @@ def pvlib_baseline(base, dates, voltage_points: int = 12):
     import pandas as pd
     import pvlib
 
-    from foldopt.geometry import subpanel_orientation
-    from foldopt.pvmodel import A300_CELL
+    from foldopt.physics.geometry import subpanel_orientation
+    from foldopt.physics.pvmodel import A300_CELL
 
     site, panel, unit = base.site, base.resolved().panel, A300_CELL
     cells = panel.area / 2 / unit.area
@@ -273,7 +273,7 @@ def workload_tables() -> dict:
 
     with tempfile.TemporaryDirectory() as folder:
         os.environ["FOLDOPT_CACHE_DIR"] = folder
-        from foldopt.engine import electrical_for
+        from foldopt.engine.rows import electrical_for
 
         electrical = electrical_for(_study(), 25.0)
         seconds = {name: _timed(electrical._table, name)[0] for name in ("subpanel", "parallel", "series")}

@@ -3,7 +3,7 @@
     python bench/startup.py             # 7 runs of each, the minimum and the median printed
     python bench/startup.py --runs 15
 
-Each command runs in a fresh process (``python -m foldopt.cli ...``, and the installed ``foldopt``
+Each command runs in a fresh process (``python -m foldopt.cli.app ...``, and the installed ``foldopt``
 script where there is one), so the figure includes the interpreter's own start. Measured side by side in one run:
 
 - ``foldopt --help``;
@@ -27,9 +27,9 @@ import time
 
 COMMANDS = {
     "python -c pass": [sys.executable, "-c", "pass"],
-    "foldopt --help": [sys.executable, "-m", "foldopt.cli", "--help"],
-    "foldopt sweep angle --help": [sys.executable, "-m", "foldopt.cli", "sweep", "angle", "--help"],
-    "validation error (--lat 95)": [sys.executable, "-m", "foldopt.cli", "sweep", "angle", "--lat", "95"],
+    "foldopt --help": [sys.executable, "-m", "foldopt.cli.app", "--help"],
+    "foldopt sweep angle --help": [sys.executable, "-m", "foldopt.cli.app", "sweep", "angle", "--help"],
+    "validation error (--lat 95)": [sys.executable, "-m", "foldopt.cli.app", "sweep", "angle", "--lat", "95"],
 }
 if shutil.which("foldopt"):  # the installed script, with its entry-point lookup
     COMMANDS["foldopt --help (the script)"] = [shutil.which("foldopt"), "--help"]

@@ -17,24 +17,24 @@ except metadata.PackageNotFoundError:  # running from a source tree that is not 
 
 #: Public name -> the module that defines it.
 _PUBLIC = {
-    "Study": "foldopt.config", "Site": "foldopt.config", "Panel": "foldopt.config", "Tracker": "foldopt.config",
-    "Objective": "foldopt.config", "FoldAngles": "foldopt.config", "Weather": "foldopt.config",
-    "Plan": "foldopt.config", "ConfigError": "foldopt.config",
+    "Study": "foldopt.inputs.config", "Site": "foldopt.inputs.config", "Panel": "foldopt.inputs.config", "Tracker": "foldopt.inputs.config",
+    "Objective": "foldopt.inputs.config", "FoldAngles": "foldopt.inputs.config", "Weather": "foldopt.inputs.config",
+    "Plan": "foldopt.inputs.config", "ConfigError": "foldopt.errors",
     "default_study": "foldopt.api", "load_study": "foldopt.api", "run": "foldopt.api", "sweep": "foldopt.api",
     "write": "foldopt.api", "size": "foldopt.api", "reproduce": "foldopt.api", "world_map": "foldopt.api",
-    "StudyResult": "foldopt.study", "SweepResult": "foldopt.sweeps",
-    "MapSpec": "foldopt.cluster", "MapRun": "foldopt.cluster", "run_map": "foldopt.cluster",
-    "evaluate_sites": "foldopt.worldmap", "grid_sites": "foldopt.worldmap", "read_sites": "foldopt.worldmap",
-    "weather_sites": "foldopt.worldmap", "map_study": "foldopt.worldmap",
-    "annual_summary": "foldopt.report", "write_html": "foldopt.report",
-    **{name: "foldopt.report" for name in (
+    "StudyResult": "foldopt.studies.day", "SweepResult": "foldopt.studies.sweeps",
+    "MapSpec": "foldopt.studies.cluster", "MapRun": "foldopt.studies.cluster", "run_map": "foldopt.studies.cluster",
+    "evaluate_sites": "foldopt.studies.worldmap", "grid_sites": "foldopt.studies.worldmap", "read_sites": "foldopt.studies.worldmap",
+    "weather_sites": "foldopt.studies.worldmap", "map_study": "foldopt.studies.worldmap",
+    "annual_summary": "foldopt.output.report", "write_html": "foldopt.output.report",
+    **{name: "foldopt.output.report" for name in (
         "plot_power_curves", "plot_switching", "plot_t_solar_vs_fold_angle", "plot_comparison", "plot_standby",
         "plot_map", "plot_curves", "plot_sizing", "plot_annual_fold_angles", "plot_monthly", "plot_distribution",
         "plot_day_hour", "plot_world_map", "plot_latitude_load", "plot_refold_value", "save_plot")},
-    "best_schedules": "foldopt.schedule", "LoadProfile": "foldopt.config", "NearOptimal": "foldopt.config",
-    "Answer": "foldopt.answer", "plan_request": "foldopt.request", "Request": "foldopt.request",
-    "SizingResult": "foldopt.sizing", "Reproduction": "foldopt.reproduce",
-    "twofold_arrays": "foldopt.pvsystem",
+    "best_schedules": "foldopt.engine.schedule", "LoadProfile": "foldopt.inputs.config", "NearOptimal": "foldopt.inputs.config",
+    "Answer": "foldopt.studies.answer", "plan_request": "foldopt.studies.request", "Request": "foldopt.studies.request",
+    "SizingResult": "foldopt.studies.sizing", "Reproduction": "foldopt.studies.reproduce",
+    "twofold_arrays": "foldopt.physics.pvsystem",
 }
 __all__ = ["__version__", *_PUBLIC]
 

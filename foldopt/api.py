@@ -20,7 +20,8 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from foldopt.config import ConfigError, Plan, Study, default_study_path, load_plan
+from foldopt.inputs.config import Plan, Study, default_study_path, load_plan
+from foldopt.errors import ConfigError
 
 def default_study() -> Study:
     """The embedded study: Shin et al.'s pole camera in Los Angeles on the 2014 autumn equinox
@@ -43,7 +44,7 @@ def load_study(path: str | Path) -> Study | Plan:
     Returns
     -------
     Study or Plan
-        The study, or a :class:`foldopt.config.Plan` where the file sweeps fields (lists, ranges,
+        The study, or a :class:`foldopt.inputs.config.Plan` where the file sweeps fields (lists, ranges,
         a ``sweep:`` section, a year of dates).
 
     Raises
@@ -68,27 +69,27 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
         The compiled kernel or the NumPy reference path it is tested against.
     progress : callable, optional
         For a plan: ``progress(done, total)`` in days.
-    request : foldopt.request.Request, optional
-        The request the study came from (:func:`foldopt.request.plan_request`): what the answer
+    request : foldopt.studies.request.Request, optional
+        The request the study came from (:func:`foldopt.studies.request.plan_request`): what the answer
         says it took from the study.
 
     Returns
     -------
     StudyResult or SweepResult
-        :class:`foldopt.study.StudyResult` for one case (``summary``, ``sweep``, ``timeseries``
-        with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.sweeps.SweepResult`
+        :class:`foldopt.studies.day.StudyResult` for one case (``summary``, ``sweep``, ``timeseries``
+        with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.studies.sweeps.SweepResult`
         for a plan (``table``: one row per case and design); each with ``answer``, the
-        :class:`foldopt.answer.Answer` the command line prints.
+        :class:`foldopt.studies.answer.Answer` the command line prints.
     """
     if isinstance(study, (str, Path)):
         study = load_study(study)
     if isinstance(study, Plan):
         if study.axes:
-            from foldopt.sweeps import run_plan
+            from foldopt.studies.sweeps import run_plan
 
             return run_plan(study, progress, engine, request)
         study = study.base
-    from foldopt.study import run_study
+    from foldopt.studies.day import run_study
 
     return run_study(study, engine, request)
 
@@ -97,7 +98,7 @@ def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, en
           progress: Callable[[float, int], None] | None = None, **fields):
     """Evaluate a study at every combination of the values of some fields, as ``foldopt sweep`` does.
 
-    The request goes through :func:`foldopt.request.plan_request`, as the command line's does, so
+    The request goes through :func:`foldopt.studies.request.plan_request`, as the command line's does, so
     ``foldopt.sweep(foldopt.default_study(), latitude=[0, 20])`` and ``foldopt sweep latitude
     --lat 0,20`` give the same table to the bit: a paper-mode study given another site or day
     runs in exact mode with the hinge geometry, and a new latitude tilts the panel at
@@ -116,7 +117,7 @@ def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, en
         ``progress(done, total)`` in days.
     **fields
         Field names (``p_load``, ``date``, ``pv_model``...) or the short names of
-        :data:`foldopt.request.KEYWORDS` (``latitude``, ``area``, ``tilt``, ``visits``...): a
+        :data:`foldopt.studies.request.KEYWORDS` (``latitude``, ``area``, ``tilt``, ``visits``...): a
         value sets the field, a sequence or a range ``"start:stop:step"`` sweeps it; ``date``
         also takes ``"year"``, ``objective`` a statistic (``"worst-month"``).
 
@@ -126,7 +127,7 @@ def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, en
         ``table``: one row per case (``site_name``, ``latitude``, ``longitude``, ``date``,
         ``day_of_year``, ``p_load_w`` and any other swept field) and design (``flat``, ``twofold``,
         ``tracker``, ``tracker-net``), with ``fold_angle_deg``, ``t_solar_h`` and the other daily
-        metrics; ``answer``, the :class:`foldopt.answer.Answer` every view renders. With an
+        metrics; ``answer``, the :class:`foldopt.studies.answer.Answer` every view renders. With an
         ``objective`` and several dates, one fold angle per case for all of them.
 
     Raises
@@ -141,14 +142,14 @@ def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, en
     >>> len(result.table)
     16
     """
-    from foldopt.request import KEYWORDS, plan_request
+    from foldopt.studies.request import KEYWORDS, plan_request
 
     changes = {KEYWORDS.get(name, name): _plain_values(values) for name, values in fields.items()}
     changes.update({path: _plain_values(values) for path, values in (axes or {}).items()})
     if not changes and over is None:
         raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
     request = plan_request(study.data(), changes, axis=over)
-    from foldopt.sweeps import run_plan
+    from foldopt.studies.sweeps import run_plan
 
     return run_plan(request.plan, progress, engine, request)
 
@@ -177,10 +178,10 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
     -------
     pathlib.Path
     """
-    from foldopt.report import write_reproduction, write_sizing, write_study, write_sweep
-    from foldopt.reproduce import Reproduction
-    from foldopt.sizing import SizingResult
-    from foldopt.study import StudyResult
+    from foldopt.output.report import write_reproduction, write_sizing, write_study, write_sweep
+    from foldopt.studies.reproduce import Reproduction
+    from foldopt.studies.sizing import SizingResult
+    from foldopt.studies.day import StudyResult
 
     writers = {StudyResult: write_study, SizingResult: write_sizing, Reproduction: write_reproduction}
     writer = writers.get(type(result), write_sweep)
@@ -191,7 +192,7 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
 def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None, cost_per_w: float | None = None,
          c_grid: float | None = None, years: float | None = None, days_per_year: float | None = None, request=None):
     """Shin et al. Sec. IV-A panel sizing: the lifetime net benefit of flat and twofold panels of
-    every area (:func:`foldopt.sizing.size_panel`).
+    every area (:func:`foldopt.studies.sizing.size_panel`).
 
     Parameters
     ----------
@@ -201,17 +202,17 @@ def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None,
         Panel areas [m^2], or a range ``"start:stop:step"``.
     cost_per_m2, cost_per_w : float, optional
         Panel cost [$ per m^2] or [$ per W at STC], at most one; default
-        :data:`foldopt.costs.PAPER_COST_PER_M2` (what Shin et al.'s 0.108 m^2 optimum implies).
+        :data:`foldopt.inputs.costs.PAPER_COST_PER_M2` (what Shin et al.'s 0.108 m^2 optimum implies).
     c_grid : float, optional
-        Grid energy price [$/kWh]; default :data:`foldopt.costs.C_GRID` (Shin et al.: 0.22).
+        Grid energy price [$/kWh]; default :data:`foldopt.inputs.costs.C_GRID` (Shin et al.: 0.22).
     years, days_per_year : float, optional
         Lifetime [years] (default Shin et al.'s 20) and days a year like the study's (365).
-    request : foldopt.request.Request, optional
+    request : foldopt.studies.request.Request, optional
         The request the study came from: what the answer says it took from the study.
 
     Returns
     -------
-    foldopt.sizing.SizingResult
+    foldopt.studies.sizing.SizingResult
         ``table`` per design and area (``area_m2``, ``fold_angle_deg``, ``t_solar_h``, benefit, cost,
         ``net_benefit_usd``), ``best`` per design, ``parameters``, ``answer``.
 
@@ -222,9 +223,10 @@ def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None,
     """
     import math
 
-    from foldopt import costs, sizing
-    from foldopt.config import parse_range
-    from foldopt.study import Day
+    from foldopt.inputs import costs
+    from foldopt.studies import sizing
+    from foldopt.inputs.config import parse_range
+    from foldopt.studies.day import Day
 
     errors = []
     if cost_per_m2 is not None and cost_per_w is not None:
@@ -260,12 +262,12 @@ def reproduce(engine: str = "numba"):
 
     Returns
     -------
-    foldopt.reproduce.Reproduction
+    foldopt.studies.reproduce.Reproduction
         ``tables``: ``reproduction`` (the embedded study, ideal PV model) and
         ``reproduction_single_diode`` (A-300 single-diode sub-panels with switching), each with
         ``quantity``, ``unit``, ``paper``, ``paper_mode``, ``exact_mode``; ``answer``.
     """
-    from foldopt.reproduce import REPRODUCTIONS, Reproduction, reproduce as reproduce_table
+    from foldopt.studies.reproduce import REPRODUCTIONS, Reproduction, reproduce as reproduce_table
 
     study = default_study()
     tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
@@ -277,7 +279,7 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
               sites_per_chunk: int = 0, resume: bool = False, overwrite: bool = False, engine: str = "numba",
               show_load: int = 0, show_period: str = "year", progress=None, announce=None, command=None,
               defaults: dict | None = None):
-    """A map of many sites on Dask (:mod:`foldopt.cluster`), its world maps and its ``report.html``.
+    """A map of many sites on Dask (:mod:`foldopt.studies.cluster`), its world maps and its ``report.html``.
 
     Parameters
     ----------
@@ -311,14 +313,14 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
     Returns
     -------
     tuple
-        The :class:`foldopt.MapRun`, the figures' file names and the :class:`foldopt.answer.Answer`
+        The :class:`foldopt.MapRun`, the figures' file names and the :class:`foldopt.studies.answer.Answer`
         (its ``designs``: the year's rows; its ``near_optimal``: each site's range and recommended
         fold angle).
     """
-    from foldopt.cluster import MapSpec, run_map
-    from foldopt.answer import of_map
-    from foldopt.report import map_figures, write_map_report
-    from foldopt.worldmap import map_study, site_study
+    from foldopt.studies.cluster import MapSpec, run_map
+    from foldopt.studies.answer import of_map
+    from foldopt.output.report import map_figures, write_map_report
+    from foldopt.studies.worldmap import map_study, site_study
 
     if study is None:
         study = map_study(load_plan(default_study_path()).data)

@@ -30,7 +30,7 @@ HOTTEL_CLIMATES = ("tropical", "midlatitude-summer", "subarctic-summer", "midlat
 ENGINES = ("numba", "numpy")
 OUTPUT_FORMATS = ("table", "json")
 
-#: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.tracker).
+#: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.physics.trackers).
 #: His 12 actuating times (local time) pair up symmetrically about 13.319 h: 8.839/17.799,
 #: 9.819/16.819, 10.619/16.019, 11.489/15.149, 12.189/14.449, 12.919/13.719. (He gives solar noon
 #: as 13.206 h local; the 6.8 min offset is left out, the law being symmetric about solar noon by

@@ -5,7 +5,7 @@ import subprocess
 
 import pytest
 
-from foldopt.config import default_study_path, load_study
+from foldopt.inputs.config import default_study_path, load_study
 
 
 @pytest.fixture(scope="session")

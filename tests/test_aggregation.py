@@ -6,8 +6,8 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from foldopt.aggregation import connection_powers, pair_powers, parallel_power, series_power
-from foldopt.pvmodel import PVModel, cell_temperature
+from foldopt.physics.connections import connection_powers, pair_powers, parallel_power, series_power
+from foldopt.physics.pvmodel import PVModel, cell_temperature
 
 AREA = 0.054  # a sub-panel of the paper's 0.108 m^2 panel
 MODELS = {"single-diode": PVModel("single-diode"), "b-model": PVModel("b-model", efficiency=0.19)}
@@ -97,7 +97,7 @@ def test_parallel_solver_matches_a_brute_force_scan_of_the_summed_curve():
 @pytest.mark.parametrize("model", MODELS)
 def test_pair_solvers_never_fall_below_a_brute_force_scan(model):
     # Parallel is searched only between the two maximum-power voltages and series only up to the
-    # weaker short-circuit current (foldopt.aggregation): on random pairs, weak and near-dark
+    # weaker short-circuit current (foldopt.physics.connections): on random pairs, weak and near-dark
     # sub-panels and hot or cold cells included, neither may land below a dense scan.
     rng = np.random.default_rng(11)
     poa_east = rng.uniform(0, 1500, 120)

@@ -17,8 +17,8 @@ import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
 import foldopt  # noqa: E402
-from foldopt.config import make_plan  # noqa: E402
-from foldopt.sweeps import run_plan  # noqa: E402
+from foldopt.inputs.config import make_plan  # noqa: E402
+from foldopt.studies.sweeps import run_plan  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -63,7 +63,7 @@ def test_sweep_is_the_plan_the_yaml_would_make():
     result = foldopt.sweep(study, latitude=[0, 30], p_load="2:4:2", axes={"tracker.standby_w": [0.0, 1.0]})
     data = study.model_dump(mode="json", exclude_none=True)
     data["site"]["latitude"], data["p_load"], data["tracker"]["standby_w"] = [0, 30], "2:4:2", [0.0, 1.0]
-    # A new latitude tilts the panel at |latitude| toward the equator (foldopt.policy).
+    # A new latitude tilts the panel at |latitude| toward the equator (foldopt.inputs.policy).
     del data["panel"]["tilt"], data["panel"]["azimuth"]
     data["year"] = 2014
     expected = run_plan(make_plan(data)).table

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from foldopt.atmosphere import beam_meinel, clear_sky_dni, relative_airmass
+from foldopt.physics.atmosphere import beam_meinel, clear_sky_dni, relative_airmass
 
 
 def shin_eq1(zenith):

@@ -17,8 +17,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
-from foldopt.cli import app
-from foldopt.config import default_study_path
+from foldopt.cli.app import app
+from foldopt.inputs.config import default_study_path
 
 runner = CliRunner()
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
@@ -287,7 +287,7 @@ def test_an_internal_error_is_one_line_and_debug_shows_the_traceback(place, monk
     def broken(*args, **kwargs):
         raise ZeroDivisionError("float division by zero")
 
-    monkeypatch.setattr("foldopt.study.run_study", broken)
+    monkeypatch.setattr("foldopt.studies.day.run_study", broken)
     study_file(place, "fast.yaml", fast_yaml())
     result = runner.invoke(app, ["run", "fast.yaml", "--out", "new"])
     assert result.exit_code == 1
@@ -308,7 +308,7 @@ def test_a_run_killed_while_it_writes_leaves_nothing_behind(tmp_path, sig):
     prior.mkdir()
     (prior / "run.json").write_text(json.dumps({"versions": {"foldopt": "0"}}))
     before = snapshot(prior)
-    command = [sys.executable, "-m", "foldopt.cli", "run", "fast.yaml", "--out", "out", "--overwrite", "-q"]
+    command = [sys.executable, "-m", "foldopt.cli.app", "run", "fast.yaml", "--out", "out", "--overwrite", "-q"]
     process = subprocess.Popen(command, cwd=tmp_path, stderr=subprocess.PIPE)
     deadline, staged = time.monotonic() + 120, []
     while time.monotonic() < deadline and process.poll() is None and not staged:
@@ -330,7 +330,7 @@ def test_a_run_killed_while_it_writes_leaves_nothing_behind(tmp_path, sig):
 def test_a_folder_retired_by_a_killed_run_is_put_back(tmp_path):
     import socket
 
-    from foldopt.folders import MARKER, clear_leftovers
+    from foldopt.files import MARKER, clear_leftovers
 
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()

@@ -7,9 +7,9 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from foldopt.cli import app
-from foldopt.config import default_study_path
-from foldopt.reproduce import PAPER_VALUES
+from foldopt.cli.app import app
+from foldopt.inputs.config import default_study_path
+from foldopt.studies.reproduce import PAPER_VALUES
 
 runner = CliRunner()
 FOLDER = {"summary.csv", "sweep.csv", "timeseries.csv", "power_curves.png",

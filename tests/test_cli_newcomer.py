@@ -11,7 +11,7 @@ import pvlib
 from typer.testing import CliRunner
 
 from foldopt import names
-from foldopt.cli import app
+from foldopt.cli.app import app
 from test_cli import assert_one_line_error
 
 runner = CliRunner()

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
-from foldopt.cli import app
+from foldopt.cli.app import app
 from test_cli import assert_one_line_error
 
 runner = CliRunner()

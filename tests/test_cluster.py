@@ -15,10 +15,10 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from foldopt.config import ConfigError
-from foldopt.cluster import MapSpec, run_map
-from foldopt.folders import OutputError
-from foldopt.worldmap import evaluate_sites
+from foldopt.errors import ConfigError
+from foldopt.studies.cluster import MapSpec, run_map
+from foldopt.errors import OutputError
+from foldopt.studies.worldmap import evaluate_sites
 
 pytest.importorskip("distributed")
 
@@ -29,7 +29,7 @@ SECONDS = 240  # any one run or cluster start
 
 
 def _foldopt(*args, **popen):
-    return subprocess.Popen([sys.executable, "-m", "foldopt.cli", *args], stdout=subprocess.PIPE,
+    return subprocess.Popen([sys.executable, "-m", "foldopt.cli.app", *args], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, **popen)
 
 
@@ -95,8 +95,8 @@ def test_embedded_map_equals_the_computation_without_dask(embedded):
     sites = embedded.drop_duplicates("site_id")
     spec_sites = [{"latitude": lat, "longitude": lon, "site_id": i}
                   for i, (lat, lon) in enumerate(zip(sites["latitude"], sites["longitude"], strict=True))]
-    from foldopt.config import default_study_path, read_study
-    from foldopt.worldmap import map_study
+    from foldopt.inputs.config import default_study_path, read_study
+    from foldopt.studies.worldmap import map_study
 
     study = map_study(read_study(default_study_path())[0], **{"panel.area": 0.108, "objective": {"statistic": "mean"}})
     direct = evaluate_sites(study, spec_sites[:2], [1.0, 2.0])

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from foldopt.metrics import energy, t_solar
-from foldopt.study import Day
+from foldopt.engine.metrics import energy, t_solar
+from foldopt.studies.day import Day
 
 ANGLES = np.array([15.0, 30.0, 60.0, 120.0, 180.0])
 
@@ -42,8 +42,8 @@ def test_flat_panel_is_two_sub_panels_in_series(shin_study):
 
 
 def test_tables_are_cached_on_disk_by_their_settings(tmp_path, monkeypatch):
-    from foldopt import electrical
-    from foldopt.pvmodel import PVModel
+    from foldopt.engine import electrical
+    from foldopt.physics.pvmodel import PVModel
 
     monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path))
     settings = dict(pv=PVModel("b-model", 0.19), subpanel_area=0.054, temp_air=25.0, temperature_model="sapm")

@@ -1,7 +1,7 @@
 """The compiled kernel against the NumPy reference path, and the array program under it.
 
 The reference (``engine="numpy"``) computes the plane-of-array irradiance, every connection's
-power and the metrics of :mod:`foldopt.metrics` on whole arrays; the kernel fuses them in one
+power and the metrics of :mod:`foldopt.engine.metrics` on whole arrays; the kernel fuses them in one
 pass. Stated agreement (issue 11): t_solar and its longest run within 1 s a day, energy and peak
 within 1e-9 relative, on random sites, days, loads, fold angles and models.
 """
@@ -16,10 +16,10 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from foldopt import engine
-from foldopt.config import Site, make_study
-from foldopt.metrics import t_solar, t_solar_contiguous
-from foldopt.sky import build_sky
+from foldopt.engine import rows as engine
+from foldopt.inputs.config import Site, make_study
+from foldopt.engine.metrics import t_solar, t_solar_contiguous
+from foldopt.engine.sky import build_sky
 
 SECOND = 1 / 3600  # [h]
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
@@ -156,7 +156,7 @@ def test_loads_of_each_row_and_unknown_names():
 
 @pytest.mark.parametrize("model", ["ashrae", "physical"])
 def test_kernel_incidence_angle_modifier_is_pvlibs(model):
-    from foldopt.kernel import iam_factor
+    from foldopt.engine.kernel import iam_factor
 
     aoi = np.linspace(0.0, 100.0, 1001)
     code, params = engine._iam_code(model)
@@ -181,8 +181,8 @@ def test_blocks_of_many_sites_and_time_zones_equal_their_own_skies():
 
 
 def test_run_plan_is_the_same_on_both_engines():
-    from foldopt.config import make_plan
-    from foldopt.sweeps import run_plan
+    from foldopt.inputs.config import make_plan
+    from foldopt.studies.sweeps import run_plan
 
     plan = make_plan({"name": "t", "mode": "exact", "site": {"latitude": [-20.0, 45.0], "longitude": 10.0},
                       "date": ["2025-03-20", "2025-12-21"], "panel": {"area": 0.108}, "p_load": [1.0, 4.4, 40.0],

@@ -22,9 +22,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from foldopt.cluster import MapSpec, connect, run_map
-from foldopt.config import ConfigError
-from foldopt.folders import OutputError
+from foldopt.studies.cluster import MapSpec, connect, run_map
+from foldopt.errors import ConfigError
+from foldopt.errors import OutputError
 from test_faults_files import HOLDS_THE_LOCK
 
 distributed = pytest.importorskip("distributed")

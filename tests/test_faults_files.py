@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from foldopt.folders import OutputError, clear_leftovers, staged_folder
+from foldopt.files import clear_leftovers, staged_folder
+from foldopt.errors import OutputError
 
 #: A pid that no process has: above the default pid_max, below the largest one Linux allows.
 DEAD_PID = 4000001
@@ -58,7 +59,7 @@ def test_folders_foldopt_did_not_make_are_never_touched(tmp_path):
 _KILLED_WHILE_WRITING = """
 import os, signal, sys
 from pathlib import Path
-from foldopt.folders import staged_folder
+from foldopt.files import staged_folder
 with staged_folder(Path(sys.argv[1]), overwrite=True) as folder:
     (folder / "half.csv").write_text("1,2")
     os.kill(os.getpid(), signal.SIGKILL)
@@ -67,7 +68,7 @@ with staged_folder(Path(sys.argv[1]), overwrite=True) as folder:
 _KILLED_BETWEEN_RENAMES = """
 import os, signal, sys
 from pathlib import Path
-from foldopt.folders import staged_folder
+from foldopt.files import staged_folder
 out = Path(sys.argv[1])
 rename = Path.rename
 def killed_at_the_second(self, target):
@@ -108,7 +109,7 @@ def test_a_second_writer_of_one_folder_is_refused(tmp_path):
 HOLDS_THE_LOCK = """
 import sys, time
 from pathlib import Path
-from foldopt.folders import writer_lock
+from foldopt.files import writer_lock
 with writer_lock(Path(sys.argv[1])):
     print("locked", flush=True)
     time.sleep(60)
@@ -146,8 +147,8 @@ def _flip_a_bit(path: Path) -> None:
 
 @pytest.mark.parametrize("damage", [_truncate, _flip_a_bit], ids=["truncated", "bit-flipped"])
 def test_a_damaged_electrical_table_is_built_again_once(tmp_path, monkeypatch, capsys, damage):
-    from foldopt.electrical import Electrical
-    from foldopt.pvmodel import PVModel
+    from foldopt.engine.electrical import Electrical
+    from foldopt.physics.pvmodel import PVModel
 
     monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path))
     monkeypatch.delenv("FOLDOPT_QUIET", raising=False)
@@ -171,7 +172,7 @@ def test_a_damaged_electrical_table_is_built_again_once(tmp_path, monkeypatch, c
 
 
 def test_a_truncated_land_mask_cache_is_built_again(tmp_path, monkeypatch, capsys):
-    from foldopt import land
+    from foldopt.inputs import land
 
     # A small stand-in for the 5-arc-minute fraction: the full mask takes seconds to load.
     small = (np.array([-45.0, 45.0]), np.array([-90.0, 90.0]), np.array([[0.0, 1.0], [1.0, 0.0]], np.float32))

@@ -18,9 +18,10 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from foldopt.cli import app
-from foldopt.config import ConfigError, default_study_path
-from foldopt.policy import EXACT_NOTE
+from foldopt.cli.app import app
+from foldopt.inputs.config import default_study_path
+from foldopt.errors import ConfigError
+from foldopt.inputs.policy import EXACT_NOTE
 
 runner = CliRunner()
 QUICK = ["--step-min", "60", "--angle-step", "30"]
@@ -86,7 +87,7 @@ def test_a_csv_over_the_limit_is_refused_unread(here, args, field):
 
 
 def test_a_maps_year_is_checked_by_the_library_too():
-    from foldopt.worldmap import map_study, site_study
+    from foldopt.studies.worldmap import map_study, site_study
 
     study = map_study(FAST)
     with pytest.raises(ConfigError, match=r"year = 10000: must be a whole year in \[1901, 2099\]"):
@@ -124,8 +125,8 @@ def test_a_profiles_scale_is_named_as_given(here, axis):
 
 
 def test_a_spreadsheets_utf8_csv_with_a_byte_order_mark_is_read(here):
-    from foldopt.loads import read_profile
-    from foldopt.worldmap import read_sites
+    from foldopt.inputs.loads import read_profile
+    from foldopt.studies.worldmap import read_sites
 
     (here / "sites.csv").write_bytes("\ufeffname,latitude,longitude\nSão Paulo,-23.55,-46.63\n".encode())
     (here / "p.csv").write_bytes(("\ufeff" + PROFILE).encode())
@@ -171,7 +172,7 @@ def test_a_sweeps_rows_say_so_too(here):
 def test_served_energy_never_exceeds_a_negative_harvest():
     import numpy as np
 
-    from foldopt.metrics import metric_columns
+    from foldopt.engine.metrics import metric_columns
 
     columns = metric_columns(np.array([2.0, 1.0, 0.0]), np.array([2.0, 1.0, 0.0]), np.array([10.0, -3.0, -1.0]),
                              np.array([5.0, 4.0, 0.0]), 2.0)
@@ -204,7 +205,7 @@ def foldopt_env(**changes) -> dict:
 
 
 def foldopt_process(args, cwd: Path, env: dict) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "foldopt.cli", *args], cwd=cwd, env=env, capture_output=True,
+    return subprocess.run([sys.executable, "-m", "foldopt.cli.app", *args], cwd=cwd, env=env, capture_output=True,
                           timeout=TIMEOUT)
 
 
@@ -216,8 +217,8 @@ def test_utf8_input_files_under_the_c_locale(tmp_path):
     (tmp_path / "sites.csv").write_bytes("name,latitude,longitude\nSão Paulo,-23.55,-46.63\n".encode())
     (tmp_path / "p.csv").write_bytes("time,watts\n07:00,6\n".encode())
     (tmp_path / "s.yaml").write_bytes(yaml.safe_dump({**FAST, "description": "Zürich"}, allow_unicode=True).encode())
-    code = ("from foldopt.config import read_study; from foldopt.loads import read_profile; "
-            "from foldopt.worldmap import read_sites; "
+    code = ("from foldopt.inputs.config import read_study; from foldopt.inputs.loads import read_profile; "
+            "from foldopt.studies.worldmap import read_sites; "
             "print(ascii([read_sites('sites.csv')[0]['name'], read_profile('p.csv'), "
             "read_study('s.yaml')[0]['description']]))")
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=foldopt_env(**C_LOCALE),
@@ -247,7 +248,7 @@ def test_a_unicode_folder_under_the_c_locale_with_an_unusable_home(tmp_path):
 
 def test_ctrl_c_says_interrupted_and_leaves_nothing(tmp_path):
     # SIGINT while the run writes its folder (its staging folder appears): one line, exit code 130.
-    process = subprocess.Popen([sys.executable, "-m", "foldopt.cli", "sweep", "angle", "--step-min", "5",
+    process = subprocess.Popen([sys.executable, "-m", "foldopt.cli.app", "sweep", "angle", "--step-min", "5",
                                 "--angle-step", "30", "--out", "out", "-q"], cwd=tmp_path, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE)
     try:

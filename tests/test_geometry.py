@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from foldopt.geometry import default_orientation, normal_vector, subpanel_orientation
+from foldopt.physics.geometry import default_orientation, normal_vector, subpanel_orientation
 
 tilts = st.floats(0, 90)
 azimuths = st.floats(0, 359.999)

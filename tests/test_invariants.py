@@ -7,13 +7,13 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from foldopt.aggregation import connection_power
-from foldopt.config import make_study
-from foldopt.geometry import subpanel_orientation
-from foldopt.irradiance import beam_incidence_factor
-from foldopt.metrics import t_solar
-from foldopt.solarposition import sun_from_angles
-from foldopt.study import Day
+from foldopt.physics.connections import connection_power
+from foldopt.inputs.config import make_study
+from foldopt.physics.geometry import subpanel_orientation
+from foldopt.physics.irradiance import beam_incidence_factor
+from foldopt.engine.metrics import t_solar
+from foldopt.physics.solarposition import sun_from_angles
+from foldopt.studies.day import Day
 
 MODES_AND_GEOMETRIES = [(m, g) for m in ("paper", "exact") for g in ("azimuth-split", "hinge")]
 

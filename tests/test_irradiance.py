@@ -6,8 +6,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from foldopt.irradiance import beam_incidence_factor
-from foldopt.tracker import tracker_orientation
+from foldopt.physics.irradiance import beam_incidence_factor
+from foldopt.physics.trackers import tracker_orientation
 
 
 @given(
@@ -60,8 +60,8 @@ def test_ideal_tracker_sees_all_of_the_beam_in_both_modes(model):
 
 
 def test_day_incidence_by_matrix_product_equals_pvlib(shin_study):
-    from foldopt.geometry import subpanel_orientation
-    from foldopt.study import Day
+    from foldopt.physics.geometry import subpanel_orientation
+    from foldopt.studies.day import Day
 
     day = Day(shin_study.variant(mode="exact", geometry="hinge", step_min=10))
     sides = subpanel_orientation(np.array([20.0, 90.0, 180.0]), 34.05, 180.0, "hinge")

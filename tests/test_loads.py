@@ -11,12 +11,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from foldopt import engine as engines
+from foldopt.engine import rows as engines
 from foldopt.api import default_study, run
-from foldopt.config import ConfigError, LoadProfile, make_study
-from foldopt.loads import load_shape, read_profile
-from foldopt.metrics import energy_served, t_solar
-from foldopt.designs import Blocks, fold_hours
+from foldopt.inputs.config import LoadProfile, make_study
+from foldopt.errors import ConfigError
+from foldopt.inputs.loads import load_shape, read_profile
+from foldopt.engine.metrics import energy_served, t_solar
+from foldopt.studies.designs import Blocks, fold_hours
 
 EXACT = default_study().variant(mode="exact", geometry=None, step_min=10,
                                 fold_angles={"start": 10, "stop": 180, "step": 10})
@@ -25,7 +26,7 @@ DAYS = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 365, 45)]
 
 def test_a_constant_profile_is_the_constant_load_bit_for_bit():
     constant = run(EXACT)
-    # A profile given without a scale runs as written (foldopt.policy): the scale is the constant load.
+    # A profile given without a scale runs as written (foldopt.inputs.policy): the scale is the constant load.
     profiled = run(EXACT.variant(load_profile={"daily": {"00:00": 1.0}}, p_load=EXACT.p_load))
     # The flat-area multiple is for constant loads: a profile has none.
     columns = [c for c in constant.summary.columns if c != "flat_area_multiple"]
@@ -123,8 +124,8 @@ def test_bad_profiles(tmp_path):
 
 
 def test_a_constant_profile_sweep_is_the_constant_load_sweep():
-    from foldopt.config import make_plan
-    from foldopt.sweeps import run_plan
+    from foldopt.inputs.config import make_plan
+    from foldopt.studies.sweeps import run_plan
 
     data = {**EXACT.model_dump(mode="json", exclude_none=True), "date": [d.isoformat() for d in DAYS[:4]],
             "p_load": [1.0, 4.0], "objective": {"statistic": "mean", "visits": 2}}

@@ -6,8 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from foldopt.metrics import daily_metrics, load_for_t_solar, relative_to, t_solar, t_solar_contiguous
-from foldopt.sizing import flat_area_multiple
+from foldopt.engine.metrics import daily_metrics, load_for_t_solar, relative_to, t_solar, t_solar_contiguous
+from foldopt.studies.sizing import flat_area_multiple
 
 P_MAX = 10.0
 

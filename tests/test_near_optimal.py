@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import foldopt
-from foldopt.config import NearOptimal
-from foldopt.designs import near_optimal
+from foldopt.inputs.config import NearOptimal
+from foldopt.studies.designs import near_optimal
 
 
 def reference(angles, values, fraction, minutes):

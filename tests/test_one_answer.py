@@ -20,11 +20,11 @@ import pandas as pd
 import pytest
 
 import foldopt
-from foldopt.answer import records
+from foldopt.studies.answer import records
 
 ROOT = Path(__file__).resolve().parent.parent
 TMY3 = ROOT / "configs" / "weather" / "723170TYA.CSV"
-#: Names a session replaced by one name per quantity (foldopt.columns); none may be written again.
+#: Names a session replaced by one name per quantity (foldopt.output.columns); none may be written again.
 OLD_NAMES = ("pct_of_tracker_t_solar", "t_solar_pct_of_tracker", "t_solar_gain_vs_flat_pct", "energy_wh",
              "energy_flat_kwh", "energy_twofold_kwh", "energy_tracker_kwh", "tracker_net_t_solar_h",
              "twofold_t_solar_h", "mean_h", "p10_h", "min_h", "flat_objective_h", "tracker_objective_h")
@@ -35,14 +35,14 @@ def cli(tmp_path: Path, *args, terminal: bool = False) -> tuple[dict, Path, str]
     ``terminal``, the terminal's text of the same command (in-process, which is cheaper)."""
     out = tmp_path / "cli"
     args = [*map(str, args), "--out", str(out)]
-    done = subprocess.run([sys.executable, "-m", "foldopt.cli", *args, "--format", "json"], capture_output=True,
+    done = subprocess.run([sys.executable, "-m", "foldopt.cli.app", *args, "--format", "json"], capture_output=True,
                           text=True, env={**os.environ, "COLUMNS": "200"}, timeout=300, cwd=ROOT)
     assert done.returncode == 0, done.stderr
     text = ""
     if terminal:
         from typer.testing import CliRunner
 
-        from foldopt.cli import app
+        from foldopt.cli.app import app
 
         shown = CliRunner().invoke(app, [*args, "--overwrite"])
         assert shown.exit_code == 0, shown.output
@@ -196,9 +196,9 @@ def test_variant_merges_sections_and_speaks_in_config_errors():
 
 
 def test_every_written_column_is_in_the_vocabulary_and_the_manual(tmp_path):
-    from foldopt.columns import describe, rst_table
+    from foldopt.output.columns import describe, rst_table
 
-    assert (ROOT / "docs" / "columns.rst").read_text() == rst_table()  # python -m foldopt.columns > docs/columns.rst
+    assert (ROOT / "docs" / "columns.rst").read_text() == rst_table()  # python -m foldopt.output.columns > docs/columns.rst
     folders = [path.parent for path in (ROOT / "results" / "examples").rglob("run.json")]
     assert len(folders) >= 10
     unknown = set()
@@ -212,6 +212,6 @@ def test_every_written_column_is_in_the_vocabulary_and_the_manual(tmp_path):
 
 
 def test_version():
-    done = subprocess.run([sys.executable, "-m", "foldopt.cli", "--version"], capture_output=True, text=True,
+    done = subprocess.run([sys.executable, "-m", "foldopt.cli.app", "--version"], capture_output=True, text=True,
                           timeout=60)
     assert done.returncode == 0 and done.stdout.strip() == f"foldopt {foldopt.__version__}"

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from foldopt.metrics import t_solar
-from foldopt.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
-from foldopt.study import Day, run_study
+from foldopt.engine.metrics import t_solar
+from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
+from foldopt.studies.day import Day, run_study
 
 
 def test_noon_valley_is_the_minimum_between_the_two_peaks():

@@ -4,7 +4,8 @@ import datetime as dt
 
 import pytest
 
-from foldopt.config import ConfigError, load_plan, make_plan, parse_dates, parse_range
+from foldopt.inputs.config import load_plan, make_plan, parse_dates, parse_range
+from foldopt.errors import ConfigError
 
 BASE = {"name": "t", "site": {"latitude": 10, "longitude": 0}, "date": "2025-03-20",
         "panel": {"area": 0.1}, "p_load": 2.0}

@@ -9,11 +9,11 @@ import pvlib
 import pytest
 
 import foldopt
-from foldopt.atmosphere import relative_airmass
-from foldopt.engine import poa
-from foldopt.geometry import default_orientation, normal_vector, subpanel_orientation
-from foldopt.irradiance import sky_diffuse_terms
-from foldopt.sky import Sky
+from foldopt.physics.atmosphere import relative_airmass
+from foldopt.engine.rows import poa
+from foldopt.physics.geometry import default_orientation, normal_vector, subpanel_orientation
+from foldopt.physics.irradiance import sky_diffuse_terms
+from foldopt.engine.sky import Sky
 
 PVWATTS = {"pdc0": 120.0, "gamma_pdc": -0.004}
 SAPM_TEMP = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_glass"]
@@ -93,7 +93,7 @@ def _foldopt_poa(arrays, mc, weather, transposition, dni_extra):
     sun = mc.results.solar_position
     zenith, azimuth = sun["apparent_zenith"].to_numpy(), sun["azimuth"].to_numpy()
     dni, ghi, dhi = (weather[name].to_numpy() for name in ("dni", "ghi", "dhi"))
-    airmass = np.nan_to_num(relative_airmass(np.minimum(zenith, 90.0)), nan=0.0)  # as foldopt.sky
+    airmass = np.nan_to_num(relative_airmass(np.minimum(zenith, 90.0)), nan=0.0)  # as foldopt.engine.sky
     terms = sky_diffuse_terms(transposition, zenith, dni, ghi, dhi, dni_extra, airmass, ALBEDO)
     sky = Sky(grid=None, mode="exact", solar_zenith=zenith[None], solar_azimuth=azimuth[None], hour_angle=None,
               declination=None, sun_vector=normal_vector(zenith, azimuth)[None], dni=dni[None], ghi=ghi[None],
@@ -125,7 +125,7 @@ def test_model_chain_poa_is_foldopts(transposition, geometry, site):
 
 
 def test_foldopts_local_day_dni_extra_is_the_only_difference():
-    # foldopt.sky takes dni_extra from the *local* day of year, pvlib's Array from the UTC day
+    # foldopt.engine.sky takes dni_extra from the *local* day of year, pvlib's Array from the UTC day
     # (pvlib.tools._pandas_to_doy). In Los Angeles (UTC-7) they differ from 17:00 on, and the Hay &
     # Davies anisotropy index A = DNI / dni_extra with it: the POA then differs by exactly
     # DHI * dA * (R_b - (1 + cos tilt) / 2) (pvlib.irradiance.haydavies); ~0.04 W/m^2 here.
@@ -134,7 +134,7 @@ def test_foldopts_local_day_dni_extra_is_the_only_difference():
                                     temperature_model_parameters=SAPM_TEMP, albedo=ALBEDO)
     mc = _model_chain(arrays, location, weather, "haydavies")
     table = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)
-    # As foldopt.sky.build_sky: the table indexed by ClockGrid.day_of_year, the local day.
+    # As foldopt.engine.sky.build_sky: the table indexed by ClockGrid.day_of_year, the local day.
     local, utc = table[weather.index.day_of_year], table[weather.index.tz_convert("UTC").day_of_year]
     zenith, azimuth = (mc.results.solar_position[name].to_numpy() for name in ("apparent_zenith", "azimuth"))
     dni, dhi = weather["dni"].to_numpy(), weather["dhi"].to_numpy()

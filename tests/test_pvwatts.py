@@ -9,10 +9,10 @@ import numpy as np
 import pvlib
 import pytest
 
-from foldopt import engine
-from foldopt.config import make_plan
-from foldopt.sky import build_sky
-from foldopt.designs import sky_tracker_orientation
+from foldopt.engine import rows as engine
+from foldopt.inputs.config import make_plan
+from foldopt.engine.sky import build_sky
+from foldopt.studies.designs import sky_tracker_orientation
 
 pvwatts = pytest.importorskip("PySAM.Pvwattsv8", reason="nrel-pysam is a test dependency ('.[test]')")
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from foldopt.cli import app
+from foldopt.cli.app import app
 
 runner = CliRunner()
 QUICK = ["--step-min", "30", "--angle-step", "30"]

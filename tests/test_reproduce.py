@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from foldopt.reproduce import PAPER_VALUES, infer_p_load, reproduce
+from foldopt.studies.reproduce import PAPER_VALUES, infer_p_load, reproduce
 
 # The acceptance bands around Shin et al. Sec. VII / Fig. 12 values.
 TOLERANCE = {

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from foldopt.schedule import best_schedules
+from foldopt.engine.schedule import best_schedules
 
 
 def _brute_force_mean(hours, k):
@@ -93,9 +93,9 @@ def test_a_weather_year_schedule_agrees_with_the_annual_sweep():
     settings never do worse and never beat re-folding every day; flat and tracker as the sweep's."""
     from pathlib import Path
 
-    from foldopt.config import make_plan
-    from foldopt.designs import Blocks, fold_hours
-    from foldopt.sweeps import run_plan
+    from foldopt.inputs.config import make_plan
+    from foldopt.studies.designs import Blocks, fold_hours
+    from foldopt.studies.sweeps import run_plan
 
     weather = str(Path(__file__).resolve().parent.parent / "configs" / "weather" / "723170TYA.CSV")
     data = {"name": "refold", "weather": weather, "p_load": [1.0, 3.0], "panel": {"area": 0.108}, "mode": "exact",

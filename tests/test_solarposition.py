@@ -8,7 +8,7 @@ import pandas as pd
 import pvlib
 import pytest
 
-from foldopt.solarposition import (
+from foldopt.physics.solarposition import (
     day_times,
     declination_paper,
     equation_of_time_paper,
@@ -108,7 +108,7 @@ def test_unknown_model_lists_valid_names():
      (-33.9, 151.2, dt.date(2025, 6, 21), "Australia/Sydney"), (0.0, 0.0, dt.date(2025, 3, 20), "UTC")],
 )
 def test_subsampled_spa_stays_on_full_spa(latitude, longitude, date, zone):
-    from foldopt.geometry import normal_vector
+    from foldopt.physics.geometry import normal_vector
 
     times = day_times(date, zone, 1)
     fast = get_solar_position(times, latitude, longitude, altitude=100, model="exact")
@@ -136,7 +136,7 @@ def test_exact_hour_angle_is_pvlibs_and_zero_at_solar_noon():
 
 
 def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
-    from foldopt.solarposition import _geocentric_hourly, spa_geocentric
+    from foldopt.physics.solarposition import _geocentric_hourly, spa_geocentric
 
     # Random instants from 1990 to 2060: linear interpolation between whole UTC hours.
     unix = np.sort(np.random.default_rng(5).uniform(6.3e8, 2.9e9, 5000))
@@ -151,7 +151,7 @@ def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
 
 
 def test_many_sites_at_once_equal_pvlib_at_each():
-    from foldopt.solarposition import clock_grid, solar_position_grid
+    from foldopt.physics.solarposition import clock_grid, solar_position_grid
 
     dates = [dt.date(2025, 1, 5), dt.date(2025, 6, 30), dt.date(2025, 10, 1)]
     latitude = np.array([[-70.0], [12.5], [64.0]])

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from foldopt.config import make_plan
-from foldopt.study import run_study
-from foldopt.sweeps import run_plan
+from foldopt.inputs.config import make_plan
+from foldopt.studies.day import run_study
+from foldopt.studies.sweeps import run_plan
 
 BASE = {"name": "t", "mode": "exact", "site": {"latitude": 34.05, "longitude": -118.25},
         "date": "2025-09-22", "panel": {"area": 0.108, "efficiency": 0.1905}, "p_load": 4.4,

@@ -6,11 +6,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from foldopt.atmosphere import extraterrestrial_normal, hottel_transmittance
-from foldopt.config import load_study, default_study_path
-from foldopt.metrics import t_solar
-from foldopt.study import Day
-from foldopt.tracker import ALEXANDRU_STEP_OFFSETS_H, TrackerDrive, step_law, tracker_orientation
+from foldopt.physics.atmosphere import extraterrestrial_normal, hottel_transmittance
+from foldopt.inputs.config import load_study, default_study_path
+from foldopt.engine.metrics import t_solar
+from foldopt.studies.day import Day
+from foldopt.physics.trackers import ALEXANDRU_STEP_OFFSETS_H, TrackerDrive, step_law, tracker_orientation
 
 
 @settings(max_examples=100)
@@ -109,8 +109,8 @@ def test_hottel_sky_runs_a_study(day):
 def test_trackers_over_many_days_at_once_equal_each_day_alone(model):
     import datetime as dt
 
-    from foldopt.sky import build_sky
-    from foldopt.designs import sky_tracker_draw, sky_tracker_orientation
+    from foldopt.engine.sky import build_sky
+    from foldopt.studies.designs import sky_tracker_draw, sky_tracker_orientation
 
     study = load_study(default_study_path()).variant(mode="exact", geometry="hinge", step_min=5,
                                                      tracker={"model": model, "standby_w": 0.3})

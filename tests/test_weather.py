@@ -7,11 +7,11 @@ import numpy as np
 import pvlib
 import pytest
 
-from foldopt.config import make_study
-from foldopt.geometry import subpanel_orientation
-from foldopt.study import Day
-from foldopt.sweeps import objective_value
-from foldopt.weather import read_weather, weather_day
+from foldopt.inputs.config import make_study
+from foldopt.physics.geometry import subpanel_orientation
+from foldopt.studies.day import Day
+from foldopt.studies.sweeps import objective_value
+from foldopt.inputs.weather import read_weather, weather_day
 
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"  # NREL TMY3 sample pvlib ships
 SITE = {"latitude": 36.1, "longitude": -79.95, "altitude": 273, "timezone": "UTC-05:00"}
@@ -84,8 +84,8 @@ def test_objective_statistics():
 
 
 def test_an_annual_objective_keeps_one_angle_all_year():
-    from foldopt.config import make_plan
-    from foldopt.sweeps import run_plan
+    from foldopt.inputs.config import make_plan
+    from foldopt.studies.sweeps import run_plan
 
     plan = make_plan({**BASE, "weather": str(TMY3), "date": "1:365:30", "p_load": [2.0, 4.0],
                       "objective": {"statistic": "mean"}})

@@ -12,9 +12,11 @@ import pvlib
 import pytest
 from test_weather_year import write_epw_year
 
-from foldopt.config import ConfigError, make_plan
-from foldopt.sweeps import run_plan
-from foldopt.weather import WeatherError, read_weather, weather_days, weather_site
+from foldopt.inputs.config import make_plan
+from foldopt.errors import ConfigError
+from foldopt.studies.sweeps import run_plan
+from foldopt.inputs.weather import read_weather, weather_days, weather_site
+from foldopt.errors import WeatherError
 
 DATA = Path(pvlib.__file__).parent / "data"
 TMY3 = DATA / "723170TYA.CSV"  # Greensboro, NC: 2 header lines, then 8760 rows from line 3

@@ -10,12 +10,13 @@ import pandas as pd
 import pvlib
 import pytest
 
-from foldopt import engine
-from foldopt.config import ConfigError, make_plan
-from foldopt.sky import build_sky
-from foldopt.designs import sky_tracker_orientation
-from foldopt.sweeps import run_plan
-from foldopt.weather import read_weather, sub_hourly, weather_site
+from foldopt.engine import rows as engine
+from foldopt.inputs.config import make_plan
+from foldopt.errors import ConfigError
+from foldopt.engine.sky import build_sky
+from foldopt.studies.designs import sky_tracker_orientation
+from foldopt.studies.sweeps import run_plan
+from foldopt.inputs.weather import read_weather, sub_hourly, weather_site
 
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"  # NREL TMY3 sample pvlib ships
 YEAR = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(365)]
@@ -153,7 +154,7 @@ def test_trackers_park_while_the_sun_is_down(greensboro):
 
 
 def test_annual_summary_has_the_years_totals(tmp_path):
-    from foldopt.report import write_sweep
+    from foldopt.output.report import write_sweep
 
     plan = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": [2.0, 4.4],
                       "pv_model": "single-diode", "objective": {"statistic": "mean"},

@@ -1,4 +1,4 @@
-"""Many-site maps (foldopt.worldmap): each row checked against the annual sweep it must equal, the
+"""Many-site maps (foldopt.studies.worldmap): each row checked against the annual sweep it must equal, the
 break-even standby against the tracker it describes, and physical identities."""
 
 from __future__ import annotations
@@ -11,9 +11,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from foldopt.config import ConfigError, make_plan
-from foldopt.sweeps import run_plan
-from foldopt.worldmap import PERIODS, SEASONS, evaluate_sites, grid_sites, map_study, read_sites
+from foldopt.inputs.config import make_plan
+from foldopt.errors import ConfigError
+from foldopt.studies.sweeps import run_plan
+from foldopt.studies.worldmap import PERIODS, SEASONS, evaluate_sites, grid_sites, map_study, read_sites
 
 #: A coarse study keeps a year's evaluation to tens of milliseconds.
 COARSE = map_study({"name": "shin2015", "panel": {"area": 0.108, "efficiency": 0.1905}, "p_load": 2.0,

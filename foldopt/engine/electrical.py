@@ -1,0 +1,213 @@
+"""Per-study electrical evaluation of panels and sub-panel pairs, exact or through tables.
+
+With the air temperature and wind fixed for a study, a sub-panel's cell temperature, and so its
+maximum power, depends only on its irradiance; a connected pair's power depends only on the two
+irradiances. The fast path tabulates these once per study: a 1-D table of sub-panel maximum power
+on irradiance nodes spaced quadratically (dense at low irradiance, where power bends), read by
+linear interpolation in sqrt(E), on which the nodes are uniform; and 2-D tables of the parallel and
+the series pair as fractions of the two maxima, over the stronger sub-panel's irradiance (the same
+nodes) and the weaker/stronger irradiance ratio (:func:`_ratio_nodes`). Both pairs are symmetric,
+and along ratio 1 (equal irradiance: a flat fold, or noon) identical sub-panels deliver exactly
+their sum, a grid line of the tables that bilinear interpolation keeps exact, so the fast path has
+no seam there; each pair's kink runs nearly along the ratio lines. The exact path solves every
+step's I-V curves. ``bench/electrical.py`` and ``tests/test_electrical.py`` measure the tables'
+error against it.
+
+Tables are kept on disk, named by a hash of everything they depend on (the PV unit's parameters,
+the sub-panel area, the temperature settings, the nodes, pvlib's version and
+:data:`TABLE_FORMAT`), in ``$FOLDOPT_CACHE_DIR`` or the user cache folder (:func:`foldopt.files.cache_dir`); a second process loads
+them instead of solving I-V curves again. A cache file ends with a checksum of its content
+(:func:`store_cache`): a damaged one is built again, with a notice. A cache that cannot be written
+is skipped.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+import pvlib
+
+from foldopt.files import cache_dir, load_cache, store_cache
+from foldopt.physics.connections import connection_powers, parallel_power, series_power
+from foldopt.physics.pvmodel import PVModel, cell_temperature
+
+IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the tables; clear-sky beam stays below 1353
+TABLE_NODES_1D = 1025
+TABLE_NODES_2D = 161
+TABLE_NODES_RATIO = 321
+TABLE_FORMAT = 4  # bump when the way tables are built changes
+def _nodes(count):
+    return IRRADIANCE_MAX * np.linspace(0.0, 1.0, count) ** 2
+
+
+def _node_position(poa, count):
+    """Fractional index of irradiances on :func:`_nodes`: the nodes are uniform in sqrt(E / E_max)."""
+    return np.sqrt(np.clip(poa, 0.0, IRRADIANCE_MAX) / IRRADIANCE_MAX) * (count - 1)
+
+
+def _ratio_nodes(connection):
+    """Weaker/stronger irradiance ratios of a pair table's second axis: uniform in the ratio for
+    series (its kink lies near a ratio of Imp/Isc, close to 1), uniform in its square root for
+    parallel (its kink, where the weaker sub-panel's Voc falls below the stronger one's maximum-
+    power voltage, lies at small ratios)."""
+    nodes = np.linspace(0.0, 1.0, TABLE_NODES_RATIO)
+    return nodes**2 if connection == "parallel" else nodes
+
+
+def _linear(values, position):
+    """Linear interpolation of a 1-D table at fractional indices."""
+    index = np.minimum(position.astype(np.intp), values.size - 2)
+    weight = position - index
+    return values[index] * (1.0 - weight) + values[index + 1] * weight
+
+
+def _bilinear(values, first, second):
+    """Bilinear interpolation of a 2-D table at fractional indices (cheaper than scipy's generic
+    RegularGridInterpolator on these regular index grids)."""
+    i = np.minimum(first.astype(np.intp), values.shape[0] - 2)
+    j = np.minimum(second.astype(np.intp), values.shape[1] - 2)
+    fi, fj = first - i, second - j
+    return ((values[i, j] * (1.0 - fj) + values[i, j + 1] * fj) * (1.0 - fi)
+            + (values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj) * fi)
+
+
+@dataclass
+class Electrical:
+    """Maximum power of panels and deliverable power of sub-panel pairs for one study.
+
+    Parameters
+    ----------
+    pv : PVModel
+    subpanel_area : float
+        Area of one sub-panel [m^2].
+    temp_air, wind_speed : float
+        [C], [m/s], constant over the study.
+    temperature_model : {'fixed', 'sapm'}
+    bypass, switch_series : bool
+        Bypass diodes in series; series as a switching state.
+    converter_efficiency : float
+        Efficiency of each converter of the independent architecture.
+    exact : bool
+        Solve every step's I-V curves instead of interpolating the tables.
+    """
+
+    pv: PVModel
+    subpanel_area: float
+    temp_air: float = 25.0
+    wind_speed: float = 1.0
+    temperature_model: str = "fixed"
+    bypass: bool = True
+    switch_series: bool = False
+    converter_efficiency: float = 1.0
+    exact: bool = False
+
+    def __post_init__(self):
+        self._tables = None
+
+    @property
+    def _options(self):
+        return {"switch_series": self.switch_series, "converter_efficiency": self.converter_efficiency}
+
+    def _temperature(self, poa):
+        return cell_temperature(poa, self.temp_air, self.wind_speed, self.temperature_model)
+
+    def cache_key(self, name: str) -> str:
+        """Hash of everything table ``name`` depends on."""
+        settings = (TABLE_FORMAT, name, self.pv.model, repr(self.pv.unit), self.pv.unit_area, self.subpanel_area,
+                    self.temp_air, self.wind_speed, self.temperature_model, IRRADIANCE_MAX, TABLE_NODES_1D,
+                    TABLE_NODES_2D, TABLE_NODES_RATIO, pvlib.__version__)
+        return hashlib.sha256(repr(settings).encode()).hexdigest()[:32]
+
+    def _table(self, name):
+        """A table, loaded from the disk cache or built on first use: ``subpanel`` (1-D),
+        ``parallel`` or ``series`` (2-D)."""
+        if self._tables is None:
+            self._tables = {}
+        if name not in self._tables:
+            path = cache_dir() / "tables" / f"{name}-{self.cache_key(name)}.npz"
+            cached = load_cache(path)
+            if cached is not None:
+                arrays = tuple(cached[f"a{i}"] for i in range(len(cached)))
+                self._tables[name] = arrays if name == "subpanel" else arrays[0]
+                return self._tables[name]
+            if name == "subpanel":
+                g1 = _nodes(TABLE_NODES_1D)
+                self._tables[name] = (g1, self.pv.max_power(g1, self._temperature(g1), self.subpanel_area))
+            else:
+                self._tables[name] = self._pair_table(name)
+            table = self._tables[name]
+            store_cache(path, {f"a{i}": array for i, array in enumerate(table if name == "subpanel" else (table,))})
+        return self._tables[name]
+
+    def _pair_table(self, connection):
+        """A pair's power as a fraction of its two maxima over (stronger irradiance, ratio).
+
+        The fraction is smoother than the power and zero-safe. Series is tabulated without bypass
+        diodes; with ideal ones it is the larger of that and the stronger sub-panel alone
+        (:func:`foldopt.physics.connections.series_power`), which needs no table.
+        """
+        strong, ratio = (grid.ravel() for grid in np.meshgrid(_nodes(TABLE_NODES_2D), _ratio_nodes(connection),
+                                                              indexing="ij"))
+        weak = strong * ratio
+        east = self.pv.curves(strong, self._temperature(strong), self.subpanel_area)
+        west = self.pv.curves(weak, self._temperature(weak), self.subpanel_area)
+        bound = east.max_power() + west.max_power()
+        power = parallel_power(east, west) if connection == "parallel" else series_power(east, west, bypass=False)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            fraction = np.where(bound > 0, power / bound, 1.0).reshape(TABLE_NODES_2D, TABLE_NODES_RATIO)
+        fraction[:, -1] = 1.0  # identical sub-panels at equal irradiance deliver exactly their sum
+        return fraction
+
+    def subpanel_power(self, poa):
+        """Maximum power of one sub-panel [W] at irradiance ``poa`` [W/m^2] (any shape)."""
+        return self.panel_power(poa, self.subpanel_area)
+
+    def panel_power(self, poa, area):
+        """Maximum power [W] of a panel of ``area`` [m^2]: ``area / subpanel_area`` sub-panels in series."""
+        poa = np.asarray(poa, dtype=float)
+        if self.exact or not self.pv.has_iv:
+            return self.pv.max_power(poa, self._temperature(poa), area)
+        _, p1 = self._table("subpanel")
+        return _linear(p1, _node_position(poa, TABLE_NODES_1D)) * (area / self.subpanel_area)
+
+    def connections(self, poa_east, poa_west, series: bool = True, with_state: bool = True):
+        """Every connection's power [W] and the switching state, as :func:`connection_powers`.
+
+        With ``series`` false the series power is left NaN (and its table unbuilt), for callers
+        whose connection and switch do not use it; ``with_state`` false skips the switch state.
+        """
+        options = {**self._options, "with_state": with_state}
+        poa_east, poa_west = np.broadcast_arrays(np.asarray(poa_east, float), np.asarray(poa_west, float))
+        if not self.pv.has_iv or self.exact:
+            p_east, p_west = self.subpanel_power(poa_east), self.subpanel_power(poa_west)
+        if not self.pv.has_iv:
+            return connection_powers(p_east, p_west, **options)
+        if self.exact:
+            east = self.pv.curves(poa_east, self._temperature(poa_east), self.subpanel_area)
+            west = self.pv.curves(poa_west, self._temperature(poa_west), self.subpanel_area)
+            p_parallel = parallel_power(east, west)
+            p_series = series_power(east, west, self.bypass) if series else np.full(p_east.shape, np.nan)
+            return connection_powers(p_east, p_west, p_parallel, p_series, **options)
+        east, west = np.clip(poa_east, 0.0, IRRADIANCE_MAX), np.clip(poa_west, 0.0, IRRADIANCE_MAX)
+        # Every table's irradiance nodes are uniform in sqrt(E / E_max): one square root serves all.
+        root_east, root_west = np.sqrt(east / IRRADIANCE_MAX), np.sqrt(west / IRRADIANCE_MAX)
+        _, p1 = self._table("subpanel")
+        p_east = _linear(p1, root_east * (TABLE_NODES_1D - 1))
+        p_west = _linear(p1, root_west * (TABLE_NODES_1D - 1))
+        bound = p_east + p_west
+        strong, weak = np.maximum(root_east, root_west), np.minimum(root_east, root_west)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            root_ratio = np.where(strong > 0, weak / strong, 1.0)
+        at_strong = strong * (TABLE_NODES_2D - 1)
+        p_parallel = np.clip(_bilinear(self._table("parallel"), at_strong, root_ratio * (TABLE_NODES_RATIO - 1)),
+                             0.0, 1.0) * bound
+        if series:
+            fraction = _bilinear(self._table("series"), at_strong, root_ratio**2 * (TABLE_NODES_RATIO - 1))
+            p_series = np.clip(fraction, 0.0, 1.0) * bound
+            if self.bypass:
+                p_series = np.maximum(p_series, np.maximum(p_east, p_west))
+        else:
+            p_series = np.full(p_east.shape, np.nan)
+        return connection_powers(p_east, p_west, p_parallel, p_series, **options)

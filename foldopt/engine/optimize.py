@@ -1,0 +1,130 @@
+"""Choosing the fold angle: an exhaustive sweep and the heuristic of Shin et al. Sec. VI.
+
+Both take the physics as callables of the fold angle, so they serve any site, sky, geometry and
+PV model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from foldopt.engine.metrics import t_solar
+
+PowerOfAngles = Callable[[np.ndarray], np.ndarray]
+
+
+def _last_argmax(values):
+    return int(values.size - 1 - np.argmax(values[::-1]))
+
+
+def optimal_fold_angle(
+    combined_power: PowerOfAngles,
+    fold_angles,
+    sweep_t_solar,
+    p_load: float,
+    step_hours: float,
+    refine_points: int = 41,
+):
+    """Fold angle with the longest ``t_solar``: best of a sweep, refined on a fine local grid.
+
+    ``t_solar`` as a function of the fold angle has kinks (Shin et al. Fig. 12a), so the refinement
+    is a second grid spanning one sweep step either side of the best sweep point, not a
+    gradient method. Ties go to the largest (least folded) angle: folding that buys no time is not
+    recommended, and a load no design can carry returns the flat panel.
+
+    Parameters
+    ----------
+    combined_power : callable
+        Maps fold angles, shape (k,), to the deliverable power, shape (k, n_time) [W].
+    fold_angles : array_like
+        Sweep grid [deg], ascending.
+    sweep_t_solar : array_like
+        ``t_solar`` [h] at ``fold_angles``, from the sweep the caller already ran.
+    p_load : float
+        [W].
+    step_hours : float
+        [h].
+    refine_points : int, default 41
+        Points of the refinement grid; 1 keeps the sweep's best point.
+
+    Returns
+    -------
+    fold_angle : float
+        [deg].
+    t_solar_h : float
+        [h].
+    """
+    fold_angles = np.asarray(fold_angles, dtype=float)
+    hours = np.asarray(sweep_t_solar, dtype=float)
+    best = _last_argmax(hours)
+    if refine_points > 1 and fold_angles.size > 1:
+        lo = fold_angles[max(best - 1, 0)]
+        hi = fold_angles[min(best + 1, fold_angles.size - 1)]
+        fine = np.linspace(lo, hi, refine_points)
+        fine_hours = t_solar(combined_power(fine), p_load, step_hours)
+        fine_best = _last_argmax(fine_hours)
+        if fine_hours[fine_best] > hours[best]:
+            return float(fine[fine_best]), float(fine_hours[fine_best])
+    return float(fold_angles[best]), float(hours[best])
+
+
+def noon_valley(p_east, p_west, p_parallel):
+    """Minimum of the parallel curve between the peaks of the two sub-panels [W].
+
+    Shin et al. Sec. VI, Fig. 10: folding shifts the east and west curves apart and digs a valley
+    into their parallel sum around noon. Arrays have time on the last axis.
+    """
+    p_parallel = np.asarray(p_parallel, dtype=float)
+    steps = np.arange(p_parallel.shape[-1])
+    first = np.minimum(np.argmax(p_east, axis=-1), np.argmax(p_west, axis=-1))[..., None]
+    last = np.maximum(np.argmax(p_east, axis=-1), np.argmax(p_west, axis=-1))[..., None]
+    between = (steps >= first) & (steps <= last)
+    return np.where(between, p_parallel, np.inf).min(axis=-1)
+
+
+def heuristic_fold_angle(
+    subpanel_power: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+    p_load: float,
+    lo: float = 1.0,
+    hi: float = 180.0,
+    tol: float = 0.01,
+):
+    """The paper's optimum: the smallest fold angle whose noon valley still reaches the load.
+
+    Shin et al. Sec. VI, Eq. 8: ``Min(P_pv,parallel) = P_load``. The valley deepens as the panel
+    folds, so the angle is found by bisection on ``noon_valley(angle) - p_load``.
+
+    Parameters
+    ----------
+    subpanel_power : callable
+        Maps fold angles, shape (k,), to ``(p_east, p_west, p_parallel)``, each (k, n_time) [W].
+    p_load : float
+        [W].
+    lo, hi : float
+        Search interval [deg].
+    tol : float, default 0.01
+        Width of the final bracket [deg].
+
+    Returns
+    -------
+    float
+        Fold angle [deg]; ``lo`` if even the most folded panel reaches the load, NaN if even the
+        flat one does not (the load exceeds the noon power).
+    """
+
+    def valley(angle):
+        return float(noon_valley(*subpanel_power(np.array([angle])))[0])
+
+    if valley(hi) < p_load:
+        return float("nan")
+    if valley(lo) >= p_load:
+        return float(lo)
+    while hi - lo > tol:
+        middle = 0.5 * (lo + hi)
+        if valley(middle) >= p_load:
+            hi = middle
+        else:
+            lo = middle
+    return float(hi)

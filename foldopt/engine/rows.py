@@ -1,0 +1,417 @@
+"""The engine: daily metrics of many panel orientations over a :class:`foldopt.engine.sky.Sky`.
+
+A *row* is one block of the sky (a day at a site) seen by one panel: the east and west sub-panel
+orientations (a fold angle; both the same for the flat panel). :func:`row_metrics` gives, for
+every row, connection and load, ``t_solar``, optionally its longest contiguous interval, and the
+energy and peak power, in one of two engines:
+
+- ``numba`` (default): :func:`foldopt.engine.kernel.fold_rows`, one compiled pass per row from the sun
+  vector to the metrics, parallel over rows, without (rows x steps) arrays;
+- ``numpy``: the reference, block by block: plane-of-array irradiance, the electrical model's
+  powers and :mod:`foldopt.engine.metrics` on whole arrays. Tests hold the kernel to it (equal
+  ``t_solar`` within 1 s a day and energy within 1e-9).
+
+Studies that solve every step's I-V curves (``exact_electrical``) always take the reference path.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+from dataclasses import dataclass
+
+import numpy as np
+import pvlib
+
+from foldopt.physics.connections import CONNECTIONS
+from foldopt.inputs.config import Study
+from foldopt.engine.electrical import Electrical
+from foldopt.physics.geometry import normal_vector, subpanel_orientation
+from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
+from foldopt.engine.metrics import energy, per_load, t_solar, t_solar_contiguous
+from foldopt.names import ENGINES
+from foldopt.physics.pvmodel import PVModel
+from foldopt.engine.sky import Sky
+
+#: What :func:`row_metrics` can evaluate: the connections, and ``panel``, the whole panel as one.
+OUTPUTS = CONNECTIONS + ("panel",)
+
+
+@dataclass(frozen=True)
+class RowMetrics:
+    """Daily metrics per row, output (connection or ``panel``) and load.
+
+    Attributes
+    ----------
+    t_solar : numpy.ndarray
+        (n_rows, n_outputs, n_loads) [h].
+    t_solar_contiguous : numpy.ndarray or None
+        Longest contiguous interval [h], same shape, where asked for.
+    energy : numpy.ndarray
+        (n_rows, n_outputs) harvested energy [Wh].
+    peak : numpy.ndarray
+        (n_rows, n_outputs) peak power [W].
+    irradiation : numpy.ndarray or None
+        (n_rows,) plane-of-array irradiation [Wh/m^2], the mean of the two sub-panels (rows of
+        orientations; None for given power curves).
+    """
+
+    t_solar: np.ndarray
+    t_solar_contiguous: np.ndarray | None
+    energy: np.ndarray
+    peak: np.ndarray
+    irradiation: np.ndarray | None = None
+
+
+def electrical_settings(study: Study, temp_air: float) -> dict:
+    """The :class:`Electrical` of a study whose cells see ``temp_air`` [C]."""
+    study = study.resolved()
+    return dict(
+        pv=PVModel(study.pv_model, study.panel.efficiency, study.module),
+        subpanel_area=study.panel.area / 2.0,
+        temp_air=float(temp_air),
+        wind_speed=study.wind_speed,
+        temperature_model=study.temperature_model,
+        bypass=study.bypass_diodes,
+        switch_series=study.switch_series,
+        converter_efficiency=study.converter_efficiency,
+        exact=study.exact_electrical,
+    )
+
+
+@functools.lru_cache(maxsize=64)
+def _electrical(settings_items: tuple) -> Electrical:
+    return Electrical(**dict(settings_items))
+
+
+def electrical_for(study: Study, temp_air: float) -> Electrical:
+    """The study's electrical model at ``temp_air``, shared by every caller in this process (and
+    its tables by every process, through the disk cache)."""
+    return _electrical(tuple(electrical_settings(study, temp_air).items()))
+
+
+def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> np.ndarray:
+    """Sub-panel orientations of every block's panel at every fold angle.
+
+    Parameters
+    ----------
+    study : Study
+        Gives the geometry (resolved).
+    panel_tilt, panel_azimuth : array_like
+        The flat panel of each block [deg], (n_blocks,).
+    fold_angles : array_like
+        [deg], (n_angles,).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_blocks, n_angles, 4): tilt and azimuth of the east, then of the west sub-panel [deg].
+    """
+    geometry = study.resolved().geometry
+    fold_angles = np.asarray(fold_angles, dtype=float)
+    panels = np.stack([np.asarray(panel_tilt, dtype=float), np.asarray(panel_azimuth, dtype=float)], axis=-1)
+    unique, inverse = np.unique(panels, axis=0, return_inverse=True)
+    per_panel = []
+    for tilt, azimuth in unique:
+        sides = subpanel_orientation(fold_angles, tilt, azimuth, geometry)
+        per_panel.append(np.stack([sides["tilt_east"], sides["azimuth_east"], sides["tilt_west"],
+                                   sides["azimuth_west"]], axis=-1))
+    return np.stack(per_panel)[np.ravel(inverse)]
+
+
+def flat_orientation(panel_tilt, panel_azimuth) -> np.ndarray:
+    """The flat panel as a row orientation: both halves the panel itself, (n_blocks, 4)."""
+    tilt, azimuth = np.asarray(panel_tilt, dtype=float), np.asarray(panel_azimuth, dtype=float)
+    return np.stack([tilt, azimuth, tilt, azimuth], axis=-1)
+
+
+def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool = False, incident: bool = False):
+    """Plane-of-array irradiance [W/m^2] of surfaces over blocks of a sky (the reference path).
+
+    Parameters
+    ----------
+    sky : Sky
+    surface_tilt, surface_azimuth : array_like
+        [deg], broadcast against the selected blocks' (n_blocks, n_steps): (n_blocks, 1) for one
+        orientation per block, (n_blocks, n_steps) for a tracker, (k, 1) for k orientations over
+        one selected block.
+    blocks : slice or array_like, default all
+        The blocks, as an index that keeps the block axis (a slice or a list).
+    paper : bool
+        The beam by Shin et al.'s Eq. 5 instead of the angle of incidence (fixed panels in paper
+        mode; a tracker always takes the exact incidence).
+    incident : bool
+        The light incident on the surface, before the sky's incidence-angle modifier (the
+        default is what reaches the cells).
+
+    Returns
+    -------
+    numpy.ndarray
+        [W/m^2], the broadcast shape.
+    """
+    tilt, azimuth = np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
+    zenith, solar_azimuth = sky.solar_zenith[blocks], sky.solar_azimuth[blocks]
+    normal = normal_vector(tilt, azimuth)
+    cos_aoi = np.sum(normal * sky.sun_vector[blocks], axis=-1)  # pvlib's aoi_projection (tested)
+    factor = beam_incidence_factor(tilt, azimuth, zenith, solar_azimuth, model="paper") if paper else None
+    terms = None if sky.terms is None else sky.terms[blocks]
+    modifier = 1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, zenith, solar_azimuth)
+    return plane_of_array(cos_aoi, normal[..., 2], sky.dni[blocks], terms, factor, modifier)
+
+
+def panel_power(sky: Sky, study: Study, poa_global, area: float | None = None):
+    """Maximum power [W] of panels of ``area`` (default the study's) at ``poa_global`` (n_blocks,
+    n_steps): each block through the electrical model at its cells' air temperature."""
+    area = study.panel.area if area is None else area
+    power = np.empty_like(poa_global)
+    for temp in np.unique(sky.temp_air):
+        rows = sky.temp_air == temp
+        power[rows] = electrical_for(study, temp).panel_power(poa_global[rows], area)
+    return power
+
+
+def iam_modifier(model: str, surface_tilt, surface_azimuth, solar_zenith, solar_azimuth):
+    """Incidence-angle modifier of the beam (pvlib ``iam.ashrae`` / ``iam.physical``), or 1."""
+    if model == "none":
+        return 1.0
+    aoi = pvlib.irradiance.aoi(surface_tilt, surface_azimuth, solar_zenith, solar_azimuth)
+    modifier = pvlib.iam.ashrae(aoi) if model == "ashrae" else pvlib.iam.physical(aoi)
+    return np.nan_to_num(np.asarray(modifier, dtype=float))
+
+
+def _iam_code(model: str):
+    """The kernel's incidence-angle modifier and its parameters: pvlib's defaults."""
+    from foldopt.engine import kernel
+
+    if model == "none":
+        return kernel.IAM_NONE, np.zeros(3)
+    function = pvlib.iam.ashrae if model == "ashrae" else pvlib.iam.physical
+    defaults = [p.default for p in inspect.signature(function).parameters.values()
+                if p.default is not inspect.Parameter.empty and p.name != "n_ar"]
+    code = kernel.IAM_ASHRAE if model == "ashrae" else kernel.IAM_PHYSICAL
+    return code, np.array(defaults + [0.0] * (3 - len(defaults)), dtype=float)
+
+
+def _sorted_loads(loads):
+    """Loads as (n_sets, n_loads), each set ascending, and the order that restores the caller's."""
+    loads = np.atleast_2d(np.asarray(loads, dtype=float))
+    order = np.argsort(loads, axis=1, kind="stable")
+    return np.take_along_axis(loads, order, axis=1), order
+
+
+def _unsort(values, order, row_loadset):
+    """Put the last axis of per-row values back into each row's load order."""
+    out = np.empty_like(values)
+    np.put_along_axis(out, np.broadcast_to(order[row_loadset][:, None, :], values.shape), values, axis=-1)
+    return out
+
+
+def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loadset=None,
+                outputs=("switching",), contiguous: bool = False, engine: str = "numba") -> RowMetrics:
+    """Daily metrics of rows of panel orientations over a sky.
+
+    Parameters
+    ----------
+    sky : Sky
+    study : Study
+        The electrical model, connection options and mode (paper-mode incidence by Eq. 5).
+    row_block : array_like of int
+        (n_rows,) block of each row.
+    orientation : array_like
+        (n_rows, 4) east tilt, east azimuth, west tilt, west azimuth [deg].
+    loads : array_like
+        (n_loads,) loads [W] shared by every row, or (n_sets, n_loads) sets chosen by ``row_loadset``.
+    row_loadset : array_like of int, optional
+        (n_rows,) set of loads of each row; default the first.
+    outputs : sequence of str
+        Names of :data:`OUTPUTS` to evaluate.
+    contiguous : bool
+        Also the longest contiguous interval (costs O(n_loads) a step: for few loads).
+    engine : {'numba', 'numpy'}
+
+    Returns
+    -------
+    RowMetrics
+    """
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
+    study = study.resolved()
+    unknown = [name for name in outputs if name not in OUTPUTS]
+    if unknown:
+        raise ValueError(f"outputs must be among {', '.join(OUTPUTS)}; got {unknown}")
+    row_block = np.asarray(row_block, dtype=np.int64)
+    orientation = np.asarray(orientation, dtype=float).reshape(row_block.size, 4)
+    sorted_loads, order = _sorted_loads(loads)
+    row_loadset = np.zeros(row_block.size, dtype=np.int64) if row_loadset is None else np.asarray(
+        row_loadset, dtype=np.int64)
+    if engine == "numpy" or study.exact_electrical:
+        result = _reference(sky, study, row_block, orientation, sorted_loads, row_loadset, outputs, contiguous)
+    else:
+        temps, block_table = np.unique(sky.temp_air, return_inverse=True)
+        electricals = [electrical_for(study, temp) for temp in temps]
+        result = _compiled(sky, study, electricals, block_table, row_block, orientation, sorted_loads, row_loadset,
+                           outputs, contiguous)
+    return _in_caller_order(result, order, row_loadset)
+
+
+def _in_caller_order(result: RowMetrics, order, row_loadset) -> RowMetrics:
+    contiguous = result.t_solar_contiguous
+    return RowMetrics(_unsort(result.t_solar, order, row_loadset),
+                      None if contiguous is None else _unsort(contiguous, order, row_loadset),
+                      result.energy, result.peak, result.irradiation)
+
+
+def _curve_reference(power, row_loads, step_hours, contiguous, load_shape=None):
+    """t_solar, its longest run (or None), energy and peak of curves (m, n_steps) with loads (m, L)
+    (scales of ``load_shape`` where given) by :mod:`foldopt.engine.metrics`."""
+    compared = per_load(power, load_shape)
+    runs = t_solar_contiguous(compared[:, None, :], row_loads, step_hours) if contiguous else None
+    return t_solar(compared[:, None, :], row_loads, step_hours), runs, energy(power, step_hours), power.max(axis=-1)
+
+
+def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool = True, with_state: bool = False):
+    """Every connection's power [W] and the whole panel's (``panel``), and the switch state, from
+    whole arrays: the reference path, and the source of time series for reports.
+
+    Parameters
+    ----------
+    orientation : array_like
+        (k, 4) sub-panel orientations over one selected block, or (n_blocks, 4), one per selected
+        block (see :func:`row_metrics`).
+    blocks : slice or list of int
+        The selected blocks (an index that keeps the block axis).
+
+    Returns
+    -------
+    powers : dict of numpy.ndarray
+        (k or n_blocks, n_steps) per name of :data:`OUTPUTS`, and ``poa``, the two sub-panels'
+        mean incident plane-of-array irradiance [W/m^2] (before the incidence-angle modifier).
+    state : numpy.ndarray or None
+        The state switching chose (``with_state``).
+    """
+    orientation = np.asarray(orientation, dtype=float)
+    paper = study.mode == "paper"
+    poa_east = poa(sky, orientation[:, 0, None], orientation[:, 1, None], blocks, paper)
+    poa_west = poa(sky, orientation[:, 2, None], orientation[:, 3, None], blocks, paper)
+    temps = np.atleast_1d(sky.temp_air[blocks])
+    out, state = {}, np.zeros(poa_east.shape, dtype=np.int64) if with_state else None
+    # Blocks whose cells see other air temperatures take other tables (weather studies).
+    groups = [slice(None)] if np.all(temps == temps[0]) else [temps == temp for temp in np.unique(temps)]
+    out["poa"] = 0.5 * (poa_east + poa_west) if sky.iam == "none" else 0.5 * sum(
+        poa(sky, orientation[:, 2 * side, None], orientation[:, 2 * side + 1, None], blocks, paper, incident=True)
+        for side in (0, 1))
+    for rows in groups:
+        electrical = electrical_for(study, temps[rows][0] if not isinstance(rows, slice) else temps[0])
+        part, part_state = electrical.connections(poa_east[rows], poa_west[rows], series, with_state)
+        part["panel"] = electrical.panel_power(poa_east[rows], study.panel.area)
+        for name, values in part.items():
+            out.setdefault(name, np.empty(poa_east.shape))[rows] = values
+        if with_state:
+            state[rows] = part_state
+    return out, state
+
+
+def _reference(sky, study, row_block, orientation, loads, row_loadset, outputs, contiguous):
+    n_rows, n_loads = row_block.size, loads.shape[1]
+    shape = (n_rows, len(outputs))
+    out = RowMetrics(np.zeros(shape + (n_loads,)), np.zeros(shape + (n_loads,)) if contiguous else None,
+                     np.zeros(shape), np.zeros(shape), np.zeros(n_rows))
+    series = "series" in outputs or study.switch_series
+    step = sky.step_hours
+    for block in np.unique(row_block):
+        rows = np.flatnonzero(row_block == block)
+        curves, _ = powers(sky, study, orientation[rows], [block], series)
+        out.irradiation[rows] = energy(curves["poa"], step)
+        shape = None if sky.load_shape is None else sky.load_shape[block]
+        for index, name in enumerate(outputs):
+            hours, runs, harvested, peak = _curve_reference(curves[name], loads[row_loadset[rows]], step, contiguous,
+                                                            shape)
+            out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = hours, harvested, peak
+            if contiguous:
+                out.t_solar_contiguous[rows, index] = runs
+    return out
+
+
+def _tables(electricals, outputs, study):
+    """The kernel's stacked tables (one per cell temperature) and the ideal model's linear power."""
+    first, count = electricals[0], len(electricals)
+    # Tables a study does not use are placeholders, one per cell temperature all the same.
+    if not first.pv.has_iv:
+        placeholder = np.zeros((count, 2, 2))
+        return np.zeros((count, 2)), placeholder, placeholder, first.pv.efficiency * first.subpanel_area
+    series = "series" in outputs or study.switch_series
+    table_1d = np.stack([e._table("subpanel")[1] for e in electricals])
+    table_parallel = np.stack([e._table("parallel") for e in electricals])
+    table_series = np.stack([e._table("series") for e in electricals]) if series else np.zeros((count, 2, 2))
+    return table_1d, table_parallel, table_series, 0.0
+
+
+def _compiled(sky, study, electricals, block_table, row_block, orientation, loads, row_loadset, outputs,
+              contiguous):
+    from foldopt.engine import kernel
+
+    table_1d, table_parallel, table_series, linear_power = _tables(electricals, outputs, study)
+    codes = np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64)
+    east = normal_vector(orientation[:, 0], orientation[:, 1])
+    west = normal_vector(orientation[:, 2], orientation[:, 3])
+    tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])
+    row_paper = np.stack([np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1)
+    iam_code, iam_params = _iam_code(sky.iam)
+    # The kernel reads each component along the time steps: (n_blocks, component, n_steps).
+    terms = np.moveaxis(sky.terms, -1, 1) if sky.terms is not None else np.zeros((sky.n_blocks, 0, 1))
+    paper = study.mode == "paper"
+    paper_sun = np.moveaxis(sky.paper_sun, -1, 1) if paper else np.zeros((1, 4, 1))
+    first = electricals[0]
+    work = kernel.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous)
+    lit = sky.lit
+    steps = np.arange(lit.shape[1])
+    first_lit = np.where(lit, steps, lit.shape[1]).min(axis=1)
+    last_lit = np.where(lit, steps, -1).max(axis=1)
+    span = np.where((first_lit <= last_lit)[:, None],
+                    np.stack([np.maximum(first_lit - 1, 0), np.minimum(last_lit + 1, steps[-1])], axis=1), 0)
+    arrays = [np.moveaxis(sky.sun_vector, -1, 1), paper_sun, sky.dni, terms, span,
+              np.asarray(block_table, dtype=np.int64), row_block,
+              np.stack([east, west], axis=1), row_paper, row_loadset]
+    # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
+    kernel.fold_rows(
+        *(np.ascontiguousarray(a) for a in arrays), paper, iam_code, iam_params, table_1d, table_parallel,
+        table_series, float(linear_power), study.panel.area / first.subpanel_area, first.bypass,
+        first.switch_series, first.converter_efficiency, codes, np.ascontiguousarray(loads), sky.step_hours,
+        contiguous, *_shape_arguments(sky.load_shape), **work,
+    )
+    return RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
+                      work["peak_out"], work["irradiation_out"])
+
+
+def _shape_arguments(load_shape):
+    """The kernel's ``load_shape`` and ``use_shape``: one placeholder row for constant loads."""
+    if load_shape is None:
+        return np.zeros((1, 1)), False
+    return np.ascontiguousarray(load_shape, dtype=float), True
+
+
+def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous: bool = False,
+                  engine: str = "numba", load_shape=None) -> RowMetrics:
+    """Daily metrics of given power curves (n_rows, n_steps) [W]: t_solar (n_rows, 1, n_loads) etc.;
+    with ``load_shape`` (n_rows, n_steps) [W] the loads are its scales (:func:`per_load`)."""
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
+    power = np.ascontiguousarray(power, dtype=float)
+    sorted_loads, order = _sorted_loads(loads)
+    row_loadset = np.zeros(power.shape[0], dtype=np.int64) if row_loadset is None else np.asarray(
+        row_loadset, dtype=np.int64)
+    if load_shape is not None:
+        load_shape = np.broadcast_to(np.asarray(load_shape, dtype=float), power.shape)
+    if engine == "numpy":
+        hours, runs, harvested, peak = _curve_reference(power, sorted_loads[row_loadset], step_hours, contiguous,
+                                                        load_shape)
+        result = RowMetrics(hours[:, None], None if runs is None else runs[:, None], harvested[:, None], peak[:, None])
+    else:
+        from foldopt.engine import kernel
+
+        work = kernel.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
+        kernel.curve_rows(power, row_loadset, sorted_loads, step_hours, contiguous, *_shape_arguments(load_shape),
+                          **work)
+        result = RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
+                            work["peak_out"])
+    return _in_caller_order(result, order, row_loadset)

@@ -1,0 +1,145 @@
+"""The vocabulary: one name per quantity, in every CSV, JSON document, report.html and the API.
+
+:data:`COLUMNS` lists every column a command writes, once, with its unit and meaning; a name with
+``{design}`` or ``{connection}`` stands for one column per design (``flat``, ``twofold``,
+``tracker``, ``tracker_net``) or connection. A sweep's other varied fields are columns named by
+their dotted path (``tracker.standby_w``). The manual's table (``docs/columns.rst``) is
+:func:`rst_table`, and a test checks every command's columns against :func:`describe`.
+
+``python -m foldopt.output.columns`` prints the table.
+"""
+
+from __future__ import annotations
+
+import re
+
+#: (name, unit, meaning), in the order the manual lists them.
+COLUMNS = (
+    # the case
+    ("site_id", "-", "the site's index in a map"),
+    ("site_name", "", "the site's name (empty for a grid point)"),
+    ("name", "", "a named site (sites.csv of a map)"),
+    ("latitude", "deg", "site latitude, north positive"),
+    ("longitude", "deg", "site longitude, east positive"),
+    ("altitude", "m", "site altitude"),
+    ("timezone", "", "the site's time zone"),
+    ("weather", "", "the weather file a map's site comes from"),
+    ("date", "", "the local day (YYYY-MM-DD); in a schedule, the day of a re-fold visit"),
+    ("day_of_year", "-", "day of the year of ``date``"),
+    ("p_load_w", "W", "the load; with a load profile, the profile's scale [-] (the answer names the profile)"),
+    ("p_load_fraction", "-", "the load as a share of the site's flat peak (maps)"),
+    ("flat_peak_w", "W", "the flat panel's largest power over the year (maps)"),
+    ("period", "", "year, or the season DJF, MAM, JJA, SON (maps)"),
+    ("days", "-", "days of the period or case"),
+    ("design", "", "flat, twofold (at the optimum), twofold-heuristic, twofold-<connection>, tracker, "
+                   "tracker-net (net of its own draw), tracker:<model> and tracker:<model>-net"),
+    # the design's settings and its daily metrics
+    ("fold_angle_deg", "deg", "the fold angle Θ (180 = flat); empty for trackers"),
+    ("t_solar_h", "h", "solar-powered time of the day: P_pv >= P_load"),
+    ("t_solar_contiguous_h", "h", "the longest contiguous solar-powered interval"),
+    ("t_solar_{connection}_h", "h", "t_solar of one connection at each fold angle (sweep.csv)"),
+    ("t_solar_{design}_h", "h", "t_solar of one design as the tracker's standby grows (tracker_standby.csv)"),
+    ("energy_harvested_wh", "Wh", "energy at the maximum power point over the day (or the period)"),
+    ("energy_harvested_{connection}_wh", "Wh", "energy of one connection at each fold angle (sweep.csv)"),
+    ("energy_harvested_{design}_wh", "Wh", "energy of one design over the period (maps)"),
+    ("energy_served_wh", "Wh", "energy the load draws while solar-powered"),
+    ("energy_wasted_wh", "Wh", "harvested but not served; never negative (a tracker whose drive costs more than it "
+                               "harvests has a negative net harvest, served and wasted 0, and a note)"),
+    ("peak_power_w", "W", "the day's largest power"),
+    ("poa_kwh_m2", "kWh/m^2", "plane-of-array irradiation (mean of the two sub-panels)"),
+    ("noon_valley_w", "W", "the parallel curve's minimum between the sub-panels' peaks (Shin et al. Eq. 8)"),
+    ("flat_area_multiple", "-", "how many times larger a flat panel must be to reach the design's t_solar"),
+    ("gain_vs_flat_pct", "%", "t_solar (or the objective) over the flat panel's, less 100"),
+    ("pct_of_tracker", "%", "t_solar (or the objective) as a share of the tracker's"),
+    ("energy_gain_vs_flat_pct", "%", "harvested energy over the flat panel's, less 100"),
+    ("energy_pct_of_tracker", "%", "harvested energy as a share of the tracker's"),
+    ("note", "", "polar night, polar day, overcast, load above peak (of that design)"),
+    # the near-optimal range
+    ("near_optimal_lo_deg", "deg", "the least fold angle on the best one's plateau"),
+    ("near_optimal_hi_deg", "deg", "the largest fold angle on the best one's plateau"),
+    ("recommended_fold_angle_deg", "deg", "the grid angle at the centre of the near-optimal range"),
+    ("near_optimal_tolerance_h", "h", "how far below the best an angle may fall and still be near-optimal"),
+    # statistics over days
+    ("objective", "", "the statistic maximised: mean, min, worst-month or pNN"),
+    ("objective_h", "h", "the objective's value: that statistic of daily t_solar"),
+    ("objective_{design}_h", "h", "the objective of one design"),
+    ("worst_month", "-", "the month (1-12) of the lowest monthly mean, for worst-month"),
+    ("mean_t_solar_h", "h", "mean daily t_solar"),
+    ("mean_t_solar_{design}_h", "h", "mean daily t_solar of one design (maps)"),
+    ("min_t_solar_h", "h", "the least daily t_solar"),
+    ("p10_t_solar_h", "h", "10th percentile of daily t_solar"),
+    ("p50_t_solar_h", "h", "median daily t_solar"),
+    ("p90_t_solar_h", "h", "90th percentile of daily t_solar"),
+    ("days_ge_{hours}h", "-", "days with t_solar of at least that many hours"),
+    ("month_{month}_mean_t_solar_h", "h", "mean daily t_solar of that month"),
+    ("chosen", "", "the fold angle chosen for the year (annual_fold_angles.csv)"),
+    ("tracker_break_even_standby_w", "W", "the tracker's standby draw at which the twofold panel catches up"),
+    ("standby_w", "W", "the tracker's standby draw"),
+    # re-fold schedules
+    ("settings", "-", "fold settings a year (1 = one fixed angle)"),
+    ("visit", "-", "the visit's number in its schedule"),
+    ("gain_vs_fixed_pct", "%", "the schedule's objective over the single fixed angle's, less 100"),
+    ("added_by_setting_h", "h", "what the schedule's last setting adds to the objective"),
+    # the day's time series
+    ("time", "", "the step's centre, local time with its offset"),
+    ("solar_zenith", "deg", "solar zenith angle"),
+    ("solar_azimuth", "deg", "solar azimuth, clockwise from north"),
+    ("dni", "W/m^2", "direct normal irradiance"),
+    ("p_{design}_w", "W", "a design's power at the optimum (p_twofold_w: the study's connection)"),
+    ("p_{connection}_w", "W", "a connection's power at the optimum"),
+    ("switch_state", "", "the connection switching chose (off where no power)"),
+    # sizing
+    ("area_m2", "m^2", "the panel's area"),
+    ("benefit_usd", "$", "lifetime benefit C_grid x t_solar x P_load (Shin et al. Eq. 7)"),
+    ("cost_usd", "$", "the panel's cost"),
+    ("net_benefit_usd", "$", "benefit less cost"),
+    # reproduction
+    ("quantity", "", "a reproduced quantity of Shin et al."),
+    ("unit", "", "its unit"),
+    ("paper", "", "Shin et al.'s published value"),
+    ("paper_mode", "", "foldopt's value in paper mode"),
+    ("exact_mode", "", "foldopt's value in exact mode"),
+    ("table", "", "which reproduction table a row comes from"),
+)
+
+_WORDS = {
+    "design": "(flat|twofold|tracker|tracker_net)",
+    "connection": "(east|west|parallel|series|independent|switching)",
+    "hours": r"(\d+)",
+    "month": r"(\d\d)",
+}
+_PATTERNS = [(re.compile("^" + re.sub(r"\\\{(\w+)\\\}", lambda m: _WORDS[m.group(1)], re.escape(name)) + "$"),
+              name, unit, meaning) for name, unit, meaning in COLUMNS]
+#: A sweep's other varied fields: their dotted paths, or a study field's name.
+_FIELD_PATH = re.compile(r"^[a-z][a-z_]*(\.[a-z][a-z_]*)+$")
+
+
+def describe(column: str) -> tuple[str, str, str] | None:
+    """The registry's entry ``(name, unit, meaning)`` of a column, or None for an unknown name."""
+    for pattern, name, unit, meaning in _PATTERNS:
+        if pattern.match(column):
+            return name, unit, meaning
+    from foldopt.inputs.config import Study
+
+    if _FIELD_PATH.match(column) or column in Study.model_fields:
+        return column, "", "a swept study field, by its path"
+    return None
+
+
+def rst_table() -> str:
+    """The manual's table of columns (``docs/columns.rst``)."""
+    lines = ["Columns", "=======", "",
+             "One name per quantity, in every CSV file, JSON document, report.html and the Python API. A name with",
+             "``{design}`` or ``{connection}`` stands for one column per design (flat, twofold, tracker, tracker_net)",
+             "or connection. A sweep's other varied fields are columns named by their dotted path",
+             "(``tracker.standby_w``). Generated by ``python -m foldopt.output.columns`` from :mod:`foldopt.output.columns`; the",
+             "test suite checks every command's columns against it.", "",
+             ".. list-table::", "   :header-rows: 1", "   :widths: 30 10 60", "",
+             "   * - column", "     - unit", "     - meaning"]
+    for name, unit, meaning in COLUMNS:
+        lines += [f"   * - ``{name}``", f"     - {unit or ' '}", f"     - {meaning}"]
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":  # pragma: no cover
+    print(rst_table(), end="")

@@ -1,0 +1,230 @@
+"""Sun trackers as they are built: their orientation over the day and the energy they spend.
+
+Every model gives the panel's ``surface_tilt`` and ``surface_azimuth`` per time step, so the
+study's own incidence model applies (exact angle of incidence, or Shin et al. Eq. 5, which is 1
+for a panel facing the sun in both cases):
+
+- ``dual-axis``: ideal, the normal always on the sun (Shin et al. Sec. IV-A).
+- ``equatorial``: a polar daily axis turning with the hour angle and a seasonal axis set once a
+  day to the declination at solar noon (Alexandru, Fig. 1a).
+- ``dual-axis-steps``: the same equatorial mount driven by Alexandru's open-loop step law: N
+  equal moves of the daily axis a day, symmetric about solar noon, over a given angular field;
+  back to the morning position at night.
+- ``single-axis``: pvlib's single-axis tracker (horizontal N-S axis by default, optionally
+  tilted, with optional backtracking).
+
+Energy: a controller's standby power, drawn while the sun is up, plus a drive energy per move,
+from Robles Algarin et al.'s DC motor model or a fixed Wh per degree (:class:`TrackerDrive`).
+
+References
+----------
+.. [1] C. Alexandru, "A Novel Open-Loop Tracking Strategy for Photovoltaic Systems", The
+   Scientific World Journal 2013, 205396: Sec. 4, the 12-step law for Brasov at the summer
+   solstice (actuating times 8.839 ... 17.799 h local time).
+.. [2] C. Robles Algarin, A. Ospino Castro, J. Casas Naranjo, "Dual-Axis Solar Tracker for Using
+   in Photovoltaic Systems": Eq. 1 (motor transfer function), Sec. 2.1 (1:653 worm gear) and
+   Sec. 3.3 (12 V gear motors, 5 A stall and 0.3 A free current, 4288 encoder counts per output
+   revolution).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pvlib
+
+from foldopt.physics.geometry import normal_vector, orientation_from_normal
+from foldopt.names import ALEXANDRU_STEP_OFFSETS_H, DRIVES, TRACKERS
+
+
+def equatorial_normal(hour_angle, declination, latitude):
+    """East-north-up unit vector toward (hour angle, declination) on the sky [deg]."""
+    h, d, lat = np.radians(hour_angle), np.radians(declination), np.radians(latitude)
+    east = -np.cos(d) * np.sin(h)
+    north = np.sin(d) * np.cos(lat) - np.cos(d) * np.sin(lat) * np.cos(h)
+    up = np.sin(d) * np.sin(lat) + np.cos(d) * np.cos(lat) * np.cos(h)
+    return np.stack([east, north, up], axis=-1)
+
+
+def step_law(hour_angle, steps=12, angular_field=90.0, offsets_h=ALEXANDRU_STEP_OFFSETS_H):
+    """Daily angle [deg] of Alexandru's open-loop step law at the sun's hour angles.
+
+    The daily axis starts the day at ``-angular_field / 2`` (facing east), moves by
+    ``angular_field / steps`` at each of ``steps`` actuating times, which lie at ``-/+ offsets_h``
+    hours from solar noon, and ends at ``+angular_field / 2``; the law is odd about noon.
+
+    Parameters
+    ----------
+    hour_angle : array_like
+        The sun's hour angle [deg], negative before solar noon.
+    steps : int
+        Moves a day (even).
+    angular_field : float
+        Total swing of the daily axis [deg].
+    offsets_h : sequence of float
+        ``steps / 2`` positive offsets of the afternoon moves from solar noon [h].
+    """
+    offsets = np.sort(np.asarray(offsets_h, dtype=float))
+    if steps != 2 * offsets.size:
+        raise ValueError(f"steps ({steps}) must be twice the number of offsets ({offsets.size})")
+    times = np.concatenate([-offsets[::-1], offsets]) * 15.0  # hour angles of the moves [deg]
+    moves_done = np.searchsorted(times, np.asarray(hour_angle, dtype=float), side="right")
+    return -angular_field / 2.0 + moves_done * angular_field / steps
+
+
+def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declination, latitude, options=None):
+    """Panel orientation of a tracker over the day.
+
+    Parameters
+    ----------
+    model : str
+        One of :data:`TRACKERS`.
+    solar_zenith, solar_azimuth, hour_angle, declination : array_like
+        The sun over the day [deg]; time on the last axis, any leading axes (days).
+    latitude : float or array_like
+        [deg], broadcast against the leading axes (shape (n_days, 1) for one per day).
+    options : TrackerOptions, optional
+        Step law and single-axis settings.
+
+    Returns
+    -------
+    surface_tilt, surface_azimuth : numpy.ndarray
+        [deg] per time step.
+
+    Notes
+    -----
+    While the sun is below the horizon a tracker rests in its stow position: the ideal and the
+    equatorial trackers horizontal (facing the equator's side), the step-law tracker at its
+    morning position (Alexandru's open-loop law returns there at night), the single-axis tracker
+    flat along its axis (pvlib returns no angle then).
+    """
+    options = options or TrackerOptions()
+    zenith = np.asarray(solar_zenith, dtype=float)
+    down = zenith >= 90.0
+    north = np.asarray(latitude) >= 0
+    level_azimuth = np.where(north, 180.0, 0.0)
+    if model == "dual-axis":
+        azimuth = np.asarray(solar_azimuth, dtype=float)
+        return np.where(down, 0.0, zenith), np.where(down, level_azimuth, azimuth)
+    if model in ("equatorial", "dual-axis-steps"):
+        hour_angle = np.asarray(hour_angle, dtype=float)
+        noon = np.argmin(np.abs(hour_angle), axis=-1)[..., None]
+        seasonal = np.take_along_axis(np.broadcast_to(declination, hour_angle.shape), noon, axis=-1)
+        if model == "equatorial":
+            normal = equatorial_normal(hour_angle, seasonal, latitude)
+            tilt, azimuth = orientation_from_normal(normal, level_azimuth=level_azimuth)
+            return np.where(down, 0.0, tilt), np.where(down, level_azimuth, azimuth)
+        daily = step_law(hour_angle, options.steps, options.angular_field, options.step_offsets_h)
+        daily = np.where(down, -options.angular_field / 2.0, daily)
+        return orientation_from_normal(equatorial_normal(daily, seasonal, latitude), level_azimuth=level_azimuth)
+    if model == "single-axis":
+        axis_azimuth = options.axis_azimuth if options.axis_azimuth is not None else np.where(north, 180.0, 0.0)
+        shape = zenith.shape
+        axis_azimuth = np.broadcast_to(axis_azimuth, shape)
+        result = pvlib.tracking.singleaxis(
+            zenith.ravel(), np.asarray(solar_azimuth, dtype=float).ravel(), axis_tilt=options.axis_tilt,
+            axis_azimuth=axis_azimuth.ravel(), max_angle=options.max_angle, backtrack=options.backtrack,
+            gcr=options.gcr,
+        )
+        # At night pvlib returns NaN; the panel then rests flat along the axis.
+        tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt).reshape(shape)
+        azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
+        return tilt, np.where(np.isnan(azimuth), axis_azimuth, azimuth)
+    raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}; got {model!r}")
+
+
+@dataclass(frozen=True)
+class TrackerOptions:
+    """Settings of the step law and the single-axis tracker."""
+
+    steps: int = 12
+    angular_field: float = 90.0
+    step_offsets_h: tuple = ALEXANDRU_STEP_OFFSETS_H
+    axis_tilt: float = 0.0
+    axis_azimuth: float | None = None
+    max_angle: float = 90.0
+    backtrack: bool = False
+    gcr: float = 0.35
+
+
+@dataclass(frozen=True)
+class TrackerDrive:
+    """Energy a tracker spends: standby plus drive energy per move.
+
+    ``motor`` follows Robles Algarin et al. [2]_: the identified speed response
+    ``omega(s)/V(s) = 5571.57 / ((1 + 0.37138 s)(1 + 0.09175 s))``, read as encoder counts per
+    second of the gear-motor output (4288 counts a revolution) for the 12 V step they used as
+    unit input: 78 rpm at steady state, within the motors' 150-350 rpm no-load ratings. The panel
+    turns 1/653 of the gear-motor output (worm gear). The current falls linearly from the 5 A
+    stall current to the 0.3 A free current as the motor speeds up, all at 12 V. The paper does not
+    state the unit of omega; this reading is foldopt's, and ``wh-per-degree`` replaces it with a
+    measured figure.
+    """
+
+    standby_w: float = 0.0
+    drive: str = "motor"
+    wh_per_degree: float = 0.0
+    gear_ratio: float = 653.0
+    motor_voltage: float = 12.0
+    stall_current: float = 5.0
+    free_current: float = 0.3
+    counts_per_revolution: float = 4288.0
+    gain: float = 5571.57  # [counts/s] for the unit (12 V) step
+    tau_1: float = 0.37138  # [s]
+    tau_2: float = 0.09175  # [s]
+
+    def move_energy_wh(self, degrees):
+        """Drive energy [Wh] of moves of the panel by ``degrees`` [deg] (array)."""
+        degrees = np.abs(np.asarray(degrees, dtype=float))
+        if self.drive == "wh-per-degree":
+            return self.wh_per_degree * degrees
+        if self.drive != "motor":
+            raise ValueError(f"drive must be one of {', '.join(DRIVES)}; got {self.drive!r}")
+        speed = self.gain / self.counts_per_revolution * 360.0  # gear-motor output at steady state [deg/s]
+        target = degrees * self.gear_ratio  # gear-motor output rotation [deg]
+        duration = _time_to_turn(target, speed, self.tau_1, self.tau_2)
+        # I(t) = I_stall - (I_stall - I_free) * omega(t) / omega_ss, so the charge is
+        # I_stall * T - (I_stall - I_free) * angle / omega_ss.
+        charge = self.stall_current * duration - (self.stall_current - self.free_current) * target / speed
+        return np.where(degrees > 0, self.motor_voltage * charge / 3600.0, 0.0)
+
+
+def _turned(t, speed, tau_1, tau_2):
+    """Angle [deg] turned by t [s] after a voltage step, for the two-pole speed response."""
+    return speed * (t - (tau_1**2 * -np.expm1(-t / tau_1) - tau_2**2 * -np.expm1(-t / tau_2)) / (tau_1 - tau_2))
+
+
+def _time_to_turn(angle, speed, tau_1, tau_2):
+    """Time [s] to turn ``angle`` [deg] from rest, by Newton's method on :func:`_turned`."""
+    t = angle / speed + tau_1 + tau_2
+    for _ in range(30):
+        rate = speed * (1 - (tau_1 * np.exp(-t / tau_1) - tau_2 * np.exp(-t / tau_2)) / (tau_1 - tau_2))
+        t = np.maximum(t - (_turned(t, speed, tau_1, tau_2) - angle) / rate, 1e-9)
+    return t
+
+
+def moved_degrees(surface_tilt, surface_azimuth):
+    """Angle [deg] the panel normal turns between consecutive steps (time on the last axis, any
+    leading axes): tracking by day, and the moves into and out of the stow position at sunset and
+    sunrise (:func:`tracker_orientation`)."""
+    normal = normal_vector(surface_tilt, surface_azimuth)
+    turn = np.zeros(normal.shape[:-1])
+    turn[..., 1:] = _angle_between(normal[..., 1:, :], normal[..., :-1, :])
+    # A panel that holds still must not be charged a motor start: drop rounding-level turns.
+    return np.where(turn > 1e-6, turn, 0.0)
+
+
+def _angle_between(a, b):
+    """Angle [deg] between unit vectors, exact for (anti)parallel ones too (atan2, not acos)."""
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1)))
+
+
+def tracker_draw(surface_tilt, surface_azimuth, sun_up, step_hours, drive: TrackerDrive):
+    """The tracker's own power draw per step [W]: standby while the sun is up, plus moves.
+
+    Each step's moves are spread over the step (their energy / step length).
+    """
+    sun_up = np.asarray(sun_up, dtype=bool)
+    moves = drive.move_energy_wh(moved_degrees(surface_tilt, surface_azimuth))
+    return np.where(sun_up, drive.standby_w, 0.0) + moves / step_hours

@@ -1,0 +1,474 @@
+"""A map (:mod:`foldopt.studies.worldmap`) run on a Dask cluster, in chunks that survive faults.
+
+The sites are cut into chunks of a few seconds of work each. A chunk ships only its site list and
+the study (plain data, a few kilobytes), never arrays: every worker builds its own skies. Workers
+compute; the client alone writes, so a cluster needs no shared file system. Each finished chunk is
+written at once, atomically, as a Parquet part (``parts/part-NNNNN.parquet``); the final tables
+are assembled from the parts on disk, so an interrupted run resumed with ``resume=True`` computes
+only the missing chunks and gives the same bytes as an uninterrupted one; a part carries the digest
+of its map, so that a part of another map is computed again, never mixed in. A map that replaces
+another (``overwrite``) is built in a staging folder beside it and swapped in once complete
+(:mod:`foldopt.files`); one process at a time writes a folder. A worker that dies
+takes nothing with it: Dask runs its chunks elsewhere, and a part is written once per chunk.
+
+Without a scheduler address the work goes to an embedded :class:`distributed.LocalCluster`, one
+single-threaded worker process per core; with one, to that cluster (``dask scheduler`` and
+``dask worker`` by hand, dask-jobqueue, Kubernetes...). Each task runs the compiled kernel on one
+thread: the parallelism is Dask's.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import logging
+import os
+import shutil
+import socket
+import time
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from foldopt.errors import ConfigError
+from foldopt.files import (DiskFullError, check_output, versions, clear_leftovers, commit, discard, is_full, new_staging,
+    tree_size, write_atomically, writer_lock)
+from foldopt.errors import OutputError
+
+#: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
+#: about a millisecond), short enough that a lost worker loses little and progress moves.
+CHUNK_SECONDS = 5.0
+#: Single-core seconds per site-day x fold angle x time step of a map, everything included (sky,
+#: trackers, break-even search), measured on W4 (``bench/map.py``).
+SECONDS_PER_EVALUATION = 13e-9
+PARTS = "parts"
+#: Seconds to wait for a cluster's scheduler and its first worker.
+CONNECT_TIMEOUT = 30
+#: Seconds a scheduler has to answer foldopt's first message: Dask answers in milliseconds, while
+#: a server of another kind may never answer.
+HANDSHAKE_TIMEOUT = 5.0
+#: Key of the map's digest (:attr:`MapSpec.key`) in the metadata of its Parquet files.
+MAP_KEY = b"foldopt.map_key"
+
+
+@dataclass(frozen=True)
+class MapSpec:
+    """Everything that decides a map's numbers: the study (a study's fields but site, date and
+    load), the sites, the loads and whether they are fractions of each site's flat peak, the year,
+    how the sites are chunked and the engine."""
+
+    study: dict
+    sites: tuple
+    loads: tuple
+    relative: bool = False
+    year: int = 2025
+    sites_per_chunk: int = 0
+    engine: str = "numba"
+
+    def __post_init__(self):
+        if not self.sites:
+            raise ConfigError(["sites: a map needs at least one site"])
+        if self.sites_per_chunk <= 0:
+            object.__setattr__(self, "sites_per_chunk", default_sites_per_chunk(self.study, self.year))
+        sites = tuple({**site, "site_id": index} for index, site in enumerate(self.sites))
+        object.__setattr__(self, "sites", sites)
+
+    def chunks(self) -> list[range]:
+        size = self.sites_per_chunk
+        return [range(start, min(start + size, len(self.sites))) for start in range(0, len(self.sites), size)]
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+    @property
+    def key(self) -> str:
+        """A digest of the spec: a resumed run must have the same."""
+        text = json.dumps(self.as_dict(), sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def default_sites_per_chunk(study: dict, year: int) -> int:
+    """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work."""
+    from foldopt.inputs.config import FoldAngles
+
+    angles = len(FoldAngles(**study.get("fold_angles", {})).grid())
+    steps = 1440 / float(study.get("step_min", 1.0))
+    per_site = 365 * angles * steps * SECONDS_PER_EVALUATION
+    return max(1, int(CHUNK_SECONDS / per_site))
+
+
+@dataclass(frozen=True)
+class MapRun:
+    """A finished map: its table and how it was computed."""
+
+    spec: MapSpec
+    table: pd.DataFrame
+    out: Path
+    computed: tuple  # chunks computed by this run
+    from_disk: tuple  # chunks a previous run had finished
+    seconds: float
+    cluster: str
+    dashboard: str | None
+
+
+def evaluate_chunk(study: dict, sites: list, loads: list, relative: bool, year: int, engine: str) -> pd.DataFrame:
+    """The task of one chunk, run on a worker: :func:`foldopt.studies.worldmap.evaluate_sites` on one thread."""
+    import numba
+
+    from foldopt.studies.worldmap import evaluate_sites
+
+    numba.set_num_threads(1)
+    _keep_freed_memory()
+    return evaluate_sites(study, sites, loads, relative, year, engine)
+
+
+def _keep_freed_memory() -> None:
+    """Let glibc reuse freed memory for the next arrays rather than hand it back to the system.
+
+    A Dask nanny starts its worker with ``MALLOC_TRIM_THRESHOLD_=65536``, which also fixes glibc's
+    mmap threshold at its default: every array above 128 KiB is then a fresh mmap whose pages fault
+    in one by one. A map allocates many such arrays per site and ran at half speed (0.49 against
+    0.25 s a site, the difference all system time). Thresholds of 32 MiB (mmap) and 128 MiB (trim)
+    keep a site's arrays on the heap and bound what a worker holds back. Elsewhere than glibc,
+    nothing is done."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):
+        return
+    m_trim_threshold, m_mmap_threshold = -1, -3  # glibc's malloc.h
+    mallopt(m_mmap_threshold, 32 << 20)
+    mallopt(m_trim_threshold, 128 << 20)
+
+
+def _part_path(out: Path, index: int) -> Path:
+    return out / PARTS / f"part-{index:05d}.parquet"
+
+
+def _write_parquet(frame: pd.DataFrame, path: Path, key: str) -> None:
+    """Write ``frame`` with the digest of its map (:attr:`MapSpec.key`) in the file's metadata."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    table = table.replace_schema_metadata({**(table.schema.metadata or {}), MAP_KEY: key.encode()})
+    write_atomically(path, lambda temporary: pq.write_table(table, temporary))
+
+
+def _read_part(path: Path, key: str) -> pd.DataFrame | None:
+    """A part of the map ``key`` on disk, or None where it is missing, cannot be read (a disk
+    fault) or belongs to another map: then it is computed again."""
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(path)
+    except (OSError, ValueError):
+        return None
+    if (table.schema.metadata or {}).get(MAP_KEY) != key.encode():
+        return None
+    return table.to_pandas()
+
+
+def map_folder(out: Path, resume: bool, overwrite: bool) -> Path:
+    """The folder to build the map in: ``out`` itself to resume the map there or where there is none,
+    so that a killed run leaves a folder that a later ``resume`` recognises; a staging folder beside
+    ``out`` where the map replaces one (``overwrite``), so that the earlier folder stays whole until
+    the new one is complete (:func:`foldopt.files.commit`)."""
+    out = Path(out)
+    if resume and (out / "run.json").exists():
+        return out
+    if out.exists() and not overwrite and not resume:
+        raise OutputError(f"{out} already exists; pass --resume to finish it or --overwrite to replace it")
+    check_output(out, overwrite=True)  # only a folder foldopt wrote is replaced
+    return new_staging(out) if out.exists() else out
+
+
+def prepare_folder(folder: Path, spec: MapSpec, metadata: dict) -> list[int]:
+    """Make ``folder`` (:func:`map_folder`) ready for the map and return the chunks already done
+    there. A new map starts with ``run.json`` (status ``running``) and ``sites.csv``; a folder
+    with a ``run.json`` is resumed, and refused if it holds another map."""
+    if (folder / "run.json").exists():
+        return _resumable(folder, spec, metadata)
+    (folder / PARTS).mkdir(parents=True)
+    pd.DataFrame(list(spec.sites)).to_csv(folder / "sites.csv", index=False)
+    _write_json(folder / "run.json", {**metadata, "status": "running"})
+    return []
+
+
+def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
+    """The chunks on disk in ``out`` if it holds the map ``spec``; its ``run.json`` says ``running``
+    again until the map is complete."""
+    try:
+        previous = json.loads((out / "run.json").read_text())
+    except ValueError:
+        previous = {}
+    if previous.get("map_key") != spec.key:
+        theirs = previous.get("spec", {})
+        differ = [name for name in ("study", "sites", "loads", "relative", "year", "sites_per_chunk", "engine")
+                  if json.dumps(theirs.get(name), sort_keys=True, default=str)
+                  != json.dumps(spec.as_dict()[name], sort_keys=True, default=str)]
+        raise OutputError(f"--resume: {out} holds another map (its {', '.join(differ) or 'settings'} differ); "
+                          "run the same command to resume it, or choose another --out")
+    (out / PARTS).mkdir(exist_ok=True)
+    for leftover in (out / PARTS).glob(".*.tmp-*"):
+        leftover.unlink(missing_ok=True)
+    _write_json(out / "run.json", {**metadata, "status": "running"})
+    return [index for index in range(len(spec.chunks())) if _part_path(out, index).exists()]
+
+
+def _write_json(path: Path, data: dict) -> None:
+    write_atomically(path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n"))
+
+
+@contextmanager
+def connect(scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
+    """A Dask client: of the cluster at ``scheduler`` (``tcp://host:port`` or a scheduler file), or
+    of an embedded :class:`distributed.LocalCluster` of ``workers`` single-threaded processes
+    (default one per core). Yields ``(client, description)``; raises :class:`ConfigError` when no
+    scheduler with a worker answers within ``timeout`` [s], at once where the port refuses, and
+    within :data:`HANDSHAKE_TIMEOUT` where what listens is not a Dask scheduler."""
+    from distributed import Client, LocalCluster
+
+    if scheduler is None:
+        count = workers or os.cpu_count() or 1
+        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
+                               dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
+        try:
+            with Client(cluster) as client:
+                yield client, f"embedded LocalCluster, {count} worker process{'es' if count > 1 else ''}"
+        finally:
+            cluster.close()
+        return
+    address = scheduler_address(scheduler)
+    check_scheduler(scheduler, address, timeout)
+    try:
+        client = Client(address, timeout=timeout)
+    except (OSError, TimeoutError, ValueError) as error:
+        raise ConfigError([_no_answer(scheduler, timeout, error.__class__.__name__)]) from None
+    try:
+        try:
+            client.wait_for_workers(1, timeout=timeout)
+        except TimeoutError:
+            raise ConfigError([f"--scheduler = {scheduler!r}: the scheduler has no worker after {timeout:g} s; start "
+                               "some with `dask worker ADDRESS`"]) from None
+        yield client, f"Dask scheduler {client.scheduler.address}"
+    finally:
+        client.close()
+
+
+def _no_answer(scheduler: str, timeout: float, reason: str) -> str:
+    return (f"--scheduler = {scheduler!r}: no Dask scheduler answers there within {timeout:g} s ({reason}); start one "
+            "with `dask scheduler`")
+
+
+def scheduler_address(scheduler: str) -> str:
+    """The address ``scheduler`` gives: itself, or the ``address`` of the scheduler file it names
+    (:class:`ConfigError` naming the file where it holds none)."""
+    path = Path(scheduler)
+    if not path.is_file():
+        return scheduler
+    try:
+        text = path.read_text()
+        data = json.loads(text) if text.strip() else {}
+    except OSError as error:
+        raise ConfigError([_not_a_file(scheduler, error.strerror or str(error))]) from None
+    except ValueError as error:  # UnicodeDecodeError too
+        raise ConfigError([_not_a_file(scheduler, f"not JSON: {error}")]) from None
+    address = data.get("address") if isinstance(data, dict) else None
+    if not isinstance(address, str) or not address:
+        raise ConfigError([_not_a_file(scheduler, 'it has no "address"' if text.strip() else "it is empty")])
+    return address
+
+
+def _not_a_file(scheduler: str, reason: str) -> str:
+    return (f"--scheduler = {scheduler!r}: not a Dask scheduler file ({reason}); `dask scheduler --scheduler-file "
+            "FILE` writes one")
+
+
+def check_scheduler(scheduler: str, address: str, timeout: float) -> None:
+    """Raise :class:`ConfigError` unless a Dask scheduler answers at ``address`` (from
+    ``scheduler``): Dask's client retries a refused port until its timeout and waits without end
+    for the greeting of a server that says nothing, so both are asked here first, in bounded time."""
+    from distributed.comm import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
+    except ValueError as error:
+        raise ConfigError([f"--scheduler = {scheduler!r}: neither an existing scheduler file nor an "
+                           f"address like tcp://host:8786 ({error})"]) from None
+    seconds = min(timeout, HANDSHAKE_TIMEOUT)
+    if host is not None:
+        try:
+            socket.create_connection((host, port), timeout=seconds).close()
+        except OSError as error:
+            raise ConfigError([_no_answer(scheduler, timeout, error.strerror or error.__class__.__name__)]) from None
+    identity = _identity(address, seconds)
+    if not (isinstance(identity, dict) and identity.get("type") == "Scheduler"):
+        raise ConfigError([f"--scheduler = {scheduler!r}: what listens at {address} is not a Dask scheduler (no Dask "
+                           f"answer within {seconds:g} s); give the scheduler's address or its scheduler file"])
+
+
+def _identity(address: str, seconds: float):
+    """What the Dask server at ``address`` says it is, or None where no Dask answer comes within
+    ``seconds``. Runs on a thread of its own, so that a caller's event loop (a notebook's) does
+    not matter."""
+    import asyncio
+
+    from distributed.comm import connect as open_comm
+    from distributed.security import Security
+
+    async def ask():
+        comm = await open_comm(address, timeout=seconds, **Security().get_connection_args("client"))
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    with ThreadPoolExecutor(1) as pool:
+        try:
+            return pool.submit(asyncio.run, asyncio.wait_for(ask(), seconds)).result()
+        except Exception:  # whatever a server that is not Dask's sends (garbage can fail in many ways)
+            return None
+
+
+def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: int | None = None,
+            resume: bool = False, overwrite: bool = False, progress: Callable[[int, int], None] | None = None,
+            announce: Callable[[str, str | None], None] | None = None, metadata: dict | None = None,
+            connect_timeout: float = CONNECT_TIMEOUT) -> MapRun:
+    """Compute a map on a Dask cluster into ``out`` and return its table.
+
+    Parameters
+    ----------
+    spec : MapSpec
+    out : pathlib.Path
+        The results folder: ``run.json``, ``sites.csv``, ``parts/`` and, when every chunk is
+        done, ``map.parquet`` and ``map.csv``.
+    scheduler : str, optional
+        A scheduler's address or scheduler file; default an embedded cluster of ``workers``.
+    resume : bool
+        Finish the map in ``out``, computing only the chunks it lacks.
+    overwrite : bool
+        Replace ``out`` (a folder foldopt wrote), once the new map is complete.
+    progress : callable, optional
+        ``progress(sites done, sites)``.
+    announce : callable, optional
+        ``announce(cluster description, dashboard address or None)`` once connected.
+    metadata : dict, optional
+        Written into ``run.json`` beside the spec.
+    connect_timeout : float
+        Seconds to wait for ``scheduler`` and its first worker.
+
+    Returns
+    -------
+    MapRun
+        ``table`` (the rows of :func:`foldopt.studies.worldmap.evaluate_sites` for every site, in site
+        order), the chunks computed and found on disk, seconds, the cluster and its dashboard.
+
+    Raises
+    ------
+    foldopt.errors.OutputError
+        Where ``out`` cannot take the map, another run writes it, or the file system fills.
+    """
+    started = time.perf_counter()
+    out = Path(out)
+    chunks = spec.chunks()
+    metadata = {**(metadata or {}), "versions": versions(("dask", "distributed", "pyarrow")), "map_key": spec.key, "spec": spec.as_dict(), "chunks": len(chunks)}
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"--out {out}: cannot create it ({error.strerror or error})") from None
+    with writer_lock(out):
+        clear_leftovers(out.parent)
+        fresh, folder = not out.exists(), None
+        try:
+            folder = map_folder(out, resume, overwrite)
+            done = prepare_folder(folder, spec, metadata)
+            run = _compute(spec, folder, done, chunks, metadata, started, scheduler, workers, progress, announce,
+                           connect_timeout)
+            if folder != out:
+                commit(folder, out)
+        except BaseException as error:
+            raise _failed(error, out, folder, fresh) from None
+    return dataclasses.replace(run, out=out)
+
+
+def _failed(error: BaseException, out: Path, folder: Path | None, fresh: bool) -> BaseException:
+    """Clear up after a failed map and return the error to raise: a staging folder goes, and so does
+    a new folder in ``out`` with no part done; a full file system is
+    :class:`~foldopt.files.DiskFullError` naming ``out``."""
+    written, kept = getattr(error, "written", 0), False
+    if folder is not None and folder != out:
+        written += discard(folder)
+    elif folder is not None:
+        written += tree_size(out)
+        kept = not fresh or any((out / PARTS).glob("part-*"))
+        if not kept:
+            shutil.rmtree(out, ignore_errors=True)  # nothing done: leave nothing behind
+    if is_full(error):
+        return DiskFullError(out, written, "finish the map with --resume" if kept else "run again")
+    return error
+
+
+def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, progress, announce,
+             connect_timeout) -> MapRun:
+    # A part that cannot be read (a disk fault) or is another map's is computed again.
+    done = [index for index in done if _read_part(_part_path(out, index), spec.key) is not None]
+    missing = [index for index in range(len(chunks)) if index not in done]
+    finished_sites = sum(len(chunks[index]) for index in done)
+    if progress is not None:
+        progress(finished_sites, len(spec.sites))
+    description, dashboard = "no computation (every chunk was on disk)", None
+    if missing:
+        from distributed import as_completed
+
+        with connect(scheduler, workers, connect_timeout) as (client, description):
+            dashboard = client.dashboard_link if _has_dashboard(client) else None
+            if announce is not None:
+                announce(description, dashboard)
+            futures = [client.submit(evaluate_chunk, spec.study, [spec.sites[i] for i in chunks[index]],
+                                     list(spec.loads), spec.relative, spec.year, spec.engine,
+                                     key=f"foldopt-map-{spec.key}-{index:05d}", pure=False)
+                       for index in missing]
+            index_of = {future.key: index for future, index in zip(futures, missing, strict=True)}
+            for future in as_completed(futures):
+                index = index_of[future.key]
+                try:
+                    frame = future.result()
+                except ConfigError:
+                    client.cancel(futures)
+                    raise
+                _write_parquet(frame, _part_path(out, index), spec.key)
+                future.release()
+                finished_sites += len(chunks[index])
+                if progress is not None:
+                    progress(finished_sites, len(spec.sites))
+    table = pd.concat([_read_part(_part_path(out, index), spec.key) for index in range(len(chunks))],
+                      ignore_index=True)
+    seconds = time.perf_counter() - started
+    _write_parquet(table, out / "map.parquet", spec.key)
+    write_atomically(out / "map.csv", lambda temporary: table.to_csv(temporary, index=False, float_format="%.10g"))
+    computed = tuple(missing)
+    _write_json(out / "run.json", {
+        **metadata, "status": "complete", "cluster": description, "dashboard": dashboard,
+        "chunks_computed": list(computed), "chunks_from_disk": sorted(done), "seconds": round(seconds, 3),
+        "sites_per_second": round(sum(len(chunks[i]) for i in computed) / seconds, 3) if computed else None,
+    })
+    return MapRun(spec, table, out, computed, tuple(sorted(done)), seconds, description, dashboard)
+
+
+def _has_dashboard(client) -> bool:
+    """Whether the scheduler serves the dashboard (it needs bokeh)."""
+    try:
+        return bool(client.scheduler_info().get("services", {}).get("dashboard"))
+    except (OSError, TimeoutError, AttributeError):
+        return False

@@ -1,0 +1,304 @@
+"""One day's study: flat, twofold and tracked panels at one site, compared.
+
+:class:`Day` is a view of one day of a :class:`foldopt.engine.sky.Sky` (times, sun, light, the electrical
+model) that gives the power of each design as arrays over fold angles x time, for reports and for
+the paper's heuristic; :func:`run_study` sweeps the fold angle through the engine, applies the
+heuristic and tabulates the comparison, for the study's connection and for the others. The
+tracker functions work on whole skies (every day at once).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from foldopt.engine import rows as engines
+from foldopt.physics.connections import CONNECTIONS, SWITCH_STATES
+from foldopt.inputs.config import Study
+from foldopt.engine.metrics import (design_condition, energy_served, load_for_t_solar, metric_columns, notes,
+                             per_load, relative_to, t_solar)
+from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
+from foldopt.studies.sizing import flat_area_multiple
+from foldopt.studies.designs import (DESIGNS, Blocks, design_metrics, near_optimal, sky_tracker_draw,
+                             sky_tracker_orientation, sky_tracker_power, standby_available)
+from foldopt.engine.sky import build_sky
+from foldopt.physics.trackers import TRACKERS
+
+
+class Day:
+    """Sun, light and electrical model over one day, and the power of each design on it.
+
+    Paper mode uses the paper's sun, air mass at sea level and Eq. 5 incidence; exact mode pvlib's
+    sun (apparent zenith), Laue's altitude term and the true angle of incidence. The study is
+    resolved here, so its defaults follow its own site and mode.
+    """
+
+    def __init__(self, study: Study):
+        study = study.resolved()
+        self.study = study
+        self.sky = sky = build_sky(study, [study.site], [study.date])
+        self.electrical = engines.electrical_for(study, sky.temp_air[0])
+        self.times = sky.grid.times(0)
+        self.step_hours = sky.step_hours
+        self.solar_zenith, self.solar_azimuth = sky.solar_zenith[0], sky.solar_azimuth[0]
+        self.hour_angle, self.declination = sky.hour_angle[0], sky.declination[0]
+        self.sun_vector, self.dni = sky.sun_vector[0], sky.dni[0]
+        self.ghi = None if sky.ghi is None else sky.ghi[0]
+        self.dhi = None if sky.dhi is None else sky.dhi[0]
+        self.transposition = study.sky_transposition()
+        self._tracker_orientations: dict = {}
+
+    def _poa(self, surface_tilt, surface_azimuth, per_step=False):
+        """Irradiance on surfaces [W/m^2]: one orientation per row, (k,) -> (k, n_time), or, with
+        ``per_step``, one per time step (a tracker), (n_time,) -> (n_time,)."""
+        tilt, azimuth = np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
+        if per_step:
+            return engines.poa(self.sky, tilt[None], azimuth[None])[0]
+        return engines.poa(self.sky, tilt[..., None], azimuth[..., None], [0], self.study.mode == "paper")
+
+    def flat_power(self):
+        """Power of the flat panel over the day [W], shape (n_time,)."""
+        panel = self.study.panel
+        return self.electrical.panel_power(self._poa(np.array([panel.tilt]), np.array([panel.azimuth]))[0], panel.area)
+
+    def tracker_orientation(self, model=None):
+        """Surface tilt and azimuth of a tracker over the day [deg] (default: the study's).
+
+        Kept per model: a tracker's power, its draw and the standby sweep all steer by it.
+        """
+        return tuple(angle[0] for angle in self._tracker_sky_orientation(model))
+
+    def _tracker_sky_orientation(self, model=None):
+        model = model or self.study.tracker.model
+        if model not in self._tracker_orientations:
+            self._tracker_orientations[model] = sky_tracker_orientation(self.sky, self.study, model)
+        return self._tracker_orientations[model]
+
+    def tracker_power(self, model=None):
+        """Power of the same panel on a tracker [W], shape (n_time,) (default: the study's)."""
+        return sky_tracker_power(self.sky, self.study, self._tracker_sky_orientation(model))[0]
+
+    def tracker_draw(self, model=None):
+        """The tracker's own draw [W] per step: standby while the sun is up, plus its moves."""
+        return sky_tracker_draw(self.sky, self.study, self._tracker_sky_orientation(model))[0]
+
+    def orientation(self, fold_angles):
+        """Sub-panel orientations (k, 4) of the study's panel at ``fold_angles`` [deg]."""
+        panel = self.study.panel
+        return engines.fold_orientations(self.study, [panel.tilt], [panel.azimuth], np.atleast_1d(fold_angles))[0]
+
+    def connections(self, fold_angles, series: bool = True, with_state: bool = True):
+        """Every connection's power [W], each (k, n_time), and the switching state per step.
+
+        ``series=False`` skips the series connection (NaN) when nothing asks for it."""
+        powers, state = engines.powers(self.sky, self.study, self.orientation(fold_angles), [0], series, with_state)
+        powers.pop("panel")
+        return powers, state
+
+    def subpanel_power(self, fold_angles):
+        """East and west sub-panel powers and their parallel connection [W], each (k, n_time)."""
+        powers, _ = self.connections(fold_angles, series=False, with_state=False)
+        return powers["east"], powers["west"], powers["parallel"]
+
+    def combined_power(self, fold_angles, connection=None):
+        """Deliverable twofold power [W], (k, n_time), under ``connection`` (default: the study's)."""
+        connection = connection or self.study.connection
+        series = connection == "series" or self.study.switch_series
+        return self.connections(fold_angles, series, with_state=False)[0][connection]
+
+
+@dataclass(frozen=True)
+class StudyResult:
+    """One study's results (:func:`foldopt.run`); ``study`` is resolved.
+
+    Attributes
+    ----------
+    study : Study
+    day : Day
+        The day's sun, light and models.
+    sweep : pandas.DataFrame
+        Per fold angle of the grid: ``fold_angle_deg``, t_solar [h] and energy [Wh] of every connection.
+    summary : pandas.DataFrame
+        Per design (``flat``, ``twofold``, ``twofold-heuristic``, ``tracker``, ``tracker-net``...):
+        ``fold_angle_deg``, ``t_solar_h``, ``t_solar_contiguous_h``, ``energy_harvested_wh``, ``peak_power_w``,
+        ``gain_vs_flat_pct``, ``pct_of_tracker``, ``flat_area_multiple``, ``note``.
+    timeseries : pandas.DataFrame
+        Indexed by the day's tz-aware step centres (``time``): sun [deg], ``dni`` [W/m^2], the power
+        [W] of every design at the optimum and the ``switch_state``.
+    optimal_fold_angle, heuristic_fold_angle : float
+        [deg]; the heuristic is NaN where the paper's rule has no answer.
+    near_optimal : dict
+        The near-optimal range of the fold angle on the sweep's grid and the recommended angle at
+        its centre (:func:`foldopt.studies.designs.near_optimal`) [deg], and its tolerance [h].
+    standby : tuple
+        (table, break-even draw [W]) of :func:`standby_sweep`.
+    engine : str
+    """
+
+    study: Study
+    day: Day
+    sweep: pd.DataFrame
+    summary: pd.DataFrame
+    timeseries: pd.DataFrame
+    optimal_fold_angle: float
+    heuristic_fold_angle: float
+    standby: tuple  # (table, break-even standby draw [W]) of :func:`standby_sweep`
+    engine: str = "numba"
+    near_optimal: dict = dataclasses.field(default_factory=dict)
+    request: object = None  # the foldopt.studies.request.Request the study came from, if any
+
+    @functools.cached_property
+    def answer(self):
+        """The :class:`foldopt.studies.answer.Answer` every view of this result renders."""
+        from foldopt.studies.answer import of_study
+
+        return of_study(self)
+
+
+def _best_angle(day: Day, angles, sweep_t_solar, connection):
+    shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
+    return optimal_fold_angle(
+        lambda fold: per_load(day.combined_power(fold, connection), shape), angles, sweep_t_solar, day.study.p_load,
+        day.step_hours
+    )[0]
+
+
+def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
+    """Sweep the fold angle and compare flat, twofold and tracker.
+
+    ``engine`` evaluates the fold-angle sweep (:data:`foldopt.engine.rows.ENGINES`).
+
+    Returns
+    -------
+    StudyResult
+        ``sweep``: metrics per fold angle for the study's connection, ``t_solar`` and energy for
+        every connection, and the noon valley of the parallel curve. ``summary``: one row per
+        design: ``flat``; ``twofold`` at the sweep's optimum; ``twofold-heuristic`` at the paper's
+        angle; with I-V models, ``twofold-<connection>`` for each other connection at its own
+        optimum; ``tracker``. ``timeseries``: the day's curves at the optimum, with the state
+        switching chose.
+    """
+    day = Day(study)
+    study = day.study
+    p_load, step = study.p_load, day.step_hours
+    # A load profile: P_load(t) = p_load x shape(t). The flat-area multiple and the standby
+    # break-even are defined for a constant load and are left out.
+    shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
+    angles = np.asarray(study.fold_angles.grid())
+    metrics = engines.row_metrics(day.sky, study, np.zeros(angles.size), day.orientation(angles), [p_load],
+                                  outputs=CONNECTIONS, contiguous=True, engine=engine)
+    own = CONNECTIONS.index(study.connection)
+    served = None if shape is None else energy_served(day.combined_power(angles), p_load, shape, step,
+                                                      metrics.t_solar[:, own, 0])
+    sweep = pd.DataFrame({"fold_angle_deg": angles,
+                          **metric_columns(metrics.t_solar[:, own, 0], metrics.t_solar_contiguous[:, own, 0],
+                                            metrics.energy[:, own], metrics.peak[:, own], p_load, served)})
+    sweep["noon_valley_w"] = noon_valley(*day.subpanel_power(angles))
+    for index, connection in enumerate(CONNECTIONS):
+        sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
+        sweep[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
+
+    best_angle = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
+    # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
+    # noon (the flat panel's peak).
+    noon_load = p_load if shape is None else p_load * shape[int(np.argmax(day.flat_power()))]
+    paper_angle = heuristic_fold_angle(day.subpanel_power, noon_load) if noon_load > 0 else np.nan
+
+    p_flat, p_tracker = day.flat_power(), day.tracker_power()
+    designs = {"flat": (180.0, p_flat), "twofold": (best_angle, day.combined_power(np.array([best_angle]))[0])}
+    if np.isfinite(paper_angle):
+        designs["twofold-heuristic"] = (paper_angle, day.combined_power(np.array([paper_angle]))[0])
+    if day.electrical.pv.has_iv:
+        for connection in ("parallel", "series", "independent", "switching"):
+            if connection != study.connection:
+                angle = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection)
+                designs[f"twofold-{connection}"] = (angle, day.combined_power(np.array([angle]), connection)[0])
+    # The study's tracker is "tracker"; every other model follows as "tracker:<model>". Each net row
+    # is what is left for the load after the tracker's own draw.
+    for model in (study.tracker.model,) + tuple(m for m in TRACKERS if m != study.tracker.model):
+        name = "tracker" if model == study.tracker.model else f"tracker:{model}"
+        gross = p_tracker if model == study.tracker.model else day.tracker_power(model)
+        designs[name] = (np.nan, gross)
+        designs[f"{name}-net"] = (np.nan, gross - day.tracker_draw(model))
+
+    design_power = np.stack([power for _, power in designs.values()])
+    curves = engines.curve_metrics(design_power, [p_load], step, contiguous=True, engine=engine, load_shape=shape)
+    served = None if shape is None else energy_served(design_power, p_load, shape, step, curves.t_solar[:, 0, 0])
+    summary = pd.DataFrame({"design": list(designs), "fold_angle_deg": [angle for angle, _ in designs.values()],
+                            **metric_columns(curves.t_solar[:, 0, 0], curves.t_solar_contiguous[:, 0, 0],
+                                              curves.energy[:, 0], curves.peak[:, 0], p_load, served)})
+    # The designs every study compares come from the one design evaluation (as for sweeps, annual
+    # studies and maps); the others (the heuristic, other connections, other trackers) from their curves.
+    main = design_metrics(day.sky, Blocks.of([study]), np.array([p_load]), np.array([best_angle]),
+                          np.zeros((1, 1), dtype=int), engine)
+    rows = [list(designs).index(design) for design in DESIGNS]
+    for column in summary.columns.drop(["design", "fold_angle_deg"]):
+        summary.loc[rows, column] = main[column][0, 0]
+    by_design = summary.set_index("design")["t_solar_h"]
+    flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
+    summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
+    summary["pct_of_tracker"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
+    summary["flat_area_multiple"] = [
+        flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 and shape is None else np.nan
+        for hours in summary["t_solar_h"]
+    ]
+    summary["note"] = notes(design_condition(day.sky.conditions()[0], summary["energy_harvested_wh"].to_numpy(float)),
+                            summary["t_solar_h"].to_numpy())
+    standby = standby_sweep(day, p_tracker, by_design["twofold"])
+
+    at_best, state = day.connections(np.array([best_angle]))
+    timeseries = pd.DataFrame(
+        {
+            "solar_zenith": day.solar_zenith,
+            "solar_azimuth": day.solar_azimuth,
+            "dni": day.dni,
+            "p_flat_w": p_flat,
+            **{f"p_{connection}_w": at_best[connection][0] for connection in CONNECTIONS},
+            "p_twofold_w": at_best[study.connection][0],
+            "switch_state": np.where(at_best["switching"][0] > 0, np.array(SWITCH_STATES)[state[0]], "off"),
+            "p_tracker_w": p_tracker,
+            "p_load_w": p_load if shape is None else p_load * shape,
+        },
+        index=pd.DatetimeIndex(day.times, name="time"),
+    )
+    near = {key: float(value) for key, value in near_optimal(angles, sweep["t_solar_h"].to_numpy(),
+                                                             study.near_optimal).items()}
+    return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby, engine, near, request)
+
+
+def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):
+    """The study's tracker's net ``t_solar`` as its standby draw grows, and the break-even draw.
+
+    A standby draw ``s`` while the sun is up leaves the load ``P_pv - drive - s``; over daylight
+    that is the gross curve less its drive against the load ``P_load + s``, so every draw is one
+    load of a single ``t_solar`` pass, and the break-even draw, where the tracker's net time falls
+    to the optimal twofold panel's, is one root search for the load.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        ``standby_w``, ``t_solar_tracker_net_h``, ``t_solar_twofold_h``.
+    break_even_w : float
+        Standby draw [W] above which the twofold panel runs longer; NaN if it never does.
+    """
+    study, step = day.study, day.step_hours
+    if day.sky.load_shape is not None:  # a standby draw is a load shift only for a constant load
+        return pd.DataFrame({"standby_w": [0.0], "t_solar_tracker_net_h": [np.nan],
+                             "t_solar_twofold_h": [twofold_t_solar]}), float("nan")
+    available = standby_available(p_tracker, day.tracker_draw(), day.sky.lit[0], study.tracker.standby_w)
+    draws = np.linspace(0.0, max(2.0 * study.p_load, 1e-3), points)
+    hours = t_solar(available, study.p_load + draws, step)
+    load = load_for_t_solar(available, twofold_t_solar, step) if twofold_t_solar > 0 else np.nan
+    break_even = max(load - study.p_load, 0.0) if np.isfinite(load) else float("nan")
+    table = pd.DataFrame({"standby_w": draws, "t_solar_tracker_net_h": hours, "t_solar_twofold_h": twofold_t_solar})
+    return table, break_even
+
+
+def twofold_t_solar(day: Day, fold_angle: float, connection=None) -> float:
+    """``t_solar`` [h] of the twofold panel at one fold angle."""
+    power = day.combined_power(np.array([fold_angle]), connection)[0]
+    return float(t_solar(power, day.study.p_load, day.step_hours))

@@ -1,0 +1,352 @@
+"""The designs, evaluated once: flat, twofold at every fold angle, trackers gross and net.
+
+Every study that compares designs takes them from here: the flat, twofold, tracker and
+tracker-net rows of a single day (:func:`foldopt.studies.day.run_study`, which adds the heuristic's
+angle, the other connections and the other tracker models from their power curves), the cases and
+annual groups of :func:`foldopt.studies.sweeps.run_plan` and the sites of
+:func:`foldopt.studies.worldmap.evaluate_sites`; all over :class:`Blocks` of a sky (days at sites that
+share one setup) and a set of loads:
+
+- :func:`fold_hours`: t_solar of the twofold panel at every angle of the study's grid, for every
+  load, in one engine pass; :func:`best_angle_index` and :func:`near_optimal` choose from it;
+- :func:`design_metrics`: every daily metric of the four :data:`DESIGNS` at a chosen angle;
+- :func:`daily_designs`: each day's t_solar and energy of every design at every angle, for
+  statistics over many days (:func:`objective_value`);
+- the trackers' orientation, power and own draw (:func:`sky_tracker_power`,
+  :func:`sky_tracker_draw`) and what a standby draw leaves (:func:`standby_available`).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from foldopt.engine import rows as engines
+from foldopt.inputs.config import NearOptimal, Study
+from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
+from foldopt.engine.sky import Sky, build_sky
+from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
+
+DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
+#: Rows (blocks x fold angles) x loads of one engine call: bounds the memory of a chunk.
+CHUNK_ROW_LOADS = 4_000_000
+#: Time steps of the blocks of one chunk's sky.
+CHUNK_STEPS = 1_100_000
+
+
+def best_angle_index(hours):
+    """Index of the longest t_solar along the last axis; ties go to the least folded angle."""
+    return hours.shape[-1] - 1 - np.argmax(hours[..., ::-1], axis=-1)
+
+
+def setup_key(study: Study) -> str:
+    """What the blocks of one engine call share: everything but the site, the date and the load
+    (and the panel's orientation, which follows the site)."""
+    data = study.model_dump(mode="json", exclude={"site", "date", "p_load", "name", "description"})
+    data["panel"] = {k: v for k, v in data["panel"].items() if k not in ("tilt", "azimuth")}
+    return json.dumps(data, sort_keys=True)
+
+
+def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
+    """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each
+    (default: the study's tracker)."""
+    tracker = study.tracker
+    options = TrackerOptions(
+        steps=tracker.steps, angular_field=tracker.angular_field,
+        step_offsets_h=tuple(tracker.step_offsets_h or TrackerOptions().step_offsets_h),
+        axis_tilt=tracker.axis_tilt, axis_azimuth=tracker.axis_azimuth, max_angle=tracker.max_angle,
+        backtrack=tracker.backtrack, gcr=tracker.gcr,
+    )
+    return tracker_orientation(
+        model or tracker.model, sky.solar_zenith, sky.solar_azimuth, sky.hour_angle, sky.declination,
+        np.asarray(sky.latitude)[:, None], options,
+    )
+
+
+def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
+    """Power [W] of the study's panel on a tracker of that ``orientation`` over every block.
+
+    Trackers take the exact angle of incidence in both modes: Eq. 5 is the paper's formula for its
+    fixed panels (it reads an azimuth even for a level panel, which a single-axis tracker is at
+    noon), and for the paper's only tracker, the ideal one, both give 1."""
+    return engines.panel_power(sky, study, engines.poa(sky, *orientation))
+
+
+def standby_available(gross, draw, lit, standby_w: float):
+    """The tracker's power [W] left for the load and its standby: ``gross`` less ``draw`` but the
+    standby (its moves only), where there is light (``lit``), 0 elsewhere. A standby draw ``s``
+    (drawn wherever there is light) is then the load ``P_load + s`` on this curve, as there is no
+    power where no standby is drawn."""
+    return np.where(lit, gross - (draw - np.where(lit, standby_w, 0.0)), 0.0)
+
+
+def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
+    """The tracker's own draw [W] per step over every block: standby while there is light (the sun up,
+    clouds or not), plus its moves."""
+    tracker = study.tracker
+    drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
+    return tracker_draw(*orientation, sky.lit, sky.step_hours, drive)
+
+
+@dataclass(frozen=True)
+class Blocks:
+    """Blocks that share one setup (:func:`setup_key`): the study's settings at each (site, date),
+    and each block's flat panel orientation [deg]."""
+
+    study: Study
+    sites: tuple
+    dates: tuple
+    tilt: np.ndarray
+    azimuth: np.ndarray
+
+    @classmethod
+    def of(cls, studies) -> Blocks:
+        """One block per study (its site, date and panel)."""
+        resolved = [s.resolved() for s in studies]
+        return cls(resolved[0], tuple(s.site for s in resolved), tuple(s.date for s in resolved),
+                   np.array([s.panel.tilt for s in resolved]), np.array([s.panel.azimuth for s in resolved]))
+
+    @classmethod
+    def of_dates(cls, study: Study, dates) -> Blocks:
+        """The days of one study at its own site."""
+        study = study.resolved()
+        count = len(dates)
+        return cls(study, (study.site,) * count, tuple(dates), np.full(count, study.panel.tilt),
+                   np.full(count, study.panel.azimuth))
+
+    def __len__(self) -> int:
+        return len(self.dates)
+
+    def __getitem__(self, part: slice) -> Blocks:
+        return Blocks(self.study, self.sites[part], self.dates[part], self.tilt[part], self.azimuth[part])
+
+    def sky(self) -> Sky:
+        return build_sky(self.study, self.sites, self.dates)
+
+    def chunks(self, n_loads: int):
+        """Slices of blocks whose rows x loads and time steps stay within the chunk bounds."""
+        per_block = len(self.study.fold_angles.grid()) * max(n_loads, 1)
+        n_steps = round(24 * 60 / self.study.step_min)
+        size = max(1, min(CHUNK_ROW_LOADS // per_block, CHUNK_STEPS // n_steps))
+        return [slice(start, min(start + size, len(self))) for start in range(0, len(self), size)]
+
+
+def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
+    """t_solar [h] of every block's twofold panel at every angle of the grid, for every load.
+
+    Returns
+    -------
+    angles : numpy.ndarray
+        The study's fold-angle grid [deg], (n_angles,).
+    hours : numpy.ndarray
+        (n_blocks, n_angles, n_loads).
+    energy : numpy.ndarray
+        Harvested energy [Wh], (n_blocks, n_angles).
+    """
+    study = blocks.study
+    angles = np.asarray(study.fold_angles.grid())
+    orientation = engines.fold_orientations(study, blocks.tilt, blocks.azimuth, angles)
+    rows = np.repeat(np.arange(sky.n_blocks), angles.size)
+    metrics = engines.row_metrics(sky, study, rows, orientation.reshape(-1, 4), loads, outputs=(study.connection,),
+                                  engine=engine)
+    return (angles, metrics.t_solar.reshape(sky.n_blocks, angles.size, -1),
+            metrics.energy.reshape(sky.n_blocks, angles.size))
+
+
+def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str) -> dict:
+    """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
+    panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net;
+    ``condition`` is each design's (:func:`foldopt.engine.metrics.design_condition`)."""
+    study = blocks.study
+    n_blocks, n_loads = sky.n_blocks, loads.size
+    tilt, azimuth = blocks.tilt, blocks.azimuth
+    every = engines.fold_orientations(study, tilt, azimuth, angles)
+    blocks = np.repeat(np.arange(n_blocks), n_loads)
+    # One row per block and load, at that load's angle, with the load alone.
+    twofold = engines.row_metrics(sky, study, blocks, every[blocks, chosen.ravel()], loads[:, None],
+                                  np.tile(np.arange(n_loads), n_blocks), outputs=(study.connection,),
+                                  contiguous=True, engine=engine)
+    flat = engines.row_metrics(sky, study, np.arange(n_blocks), engines.flat_orientation(tilt, azimuth), loads,
+                               outputs=("panel",), contiguous=True, engine=engine)
+    orientation = sky_tracker_orientation(sky, study)
+    gross = sky_tracker_power(sky, study, orientation)
+    tracker_poa = energy(engines.poa(sky, *orientation, incident=True), sky.step_hours)
+    net = gross - sky_tracker_draw(sky, study, orientation)
+    shape = sky.load_shape
+    trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
+                                     engine=engine, load_shape=None if shape is None else np.concatenate([shape, shape]))
+
+    def per_design(twofold_values, flat_values, tracker_values):
+        return np.stack([flat_values, twofold_values.reshape(n_blocks, n_loads), tracker_values[:n_blocks],
+                         tracker_values[n_blocks:]], axis=-1)
+
+    hours = per_design(twofold.t_solar[:, 0, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
+    served = None
+    if shape is not None:
+        # A load profile's served energy integrates P_load(t) over the solar-powered time: from the curves.
+        step = sky.step_hours
+        curves = [engines.powers(sky, study, every[np.arange(n_blocks), chosen[:, index]], series=study.switch_series
+                                 )[0][study.connection] for index in range(n_loads)]
+        twofold_served = np.stack([energy_served(curve, load, shape, step, twofold.t_solar[index::n_loads, 0, 0])
+                                   for index, (curve, load) in enumerate(zip(curves, loads, strict=True))], 1)
+        flat_curve = engines.powers(sky, study, engines.flat_orientation(tilt, azimuth), series=False)[0]["panel"]
+        served = np.stack([energy_served(flat_curve, loads, shape, step, flat.t_solar[:, 0]), twofold_served,
+                           energy_served(gross, loads, shape, step, trackers.t_solar[:n_blocks, 0]),
+                           energy_served(net, loads, shape, step, trackers.t_solar[n_blocks:, 0])], axis=-1)
+    fold = np.stack([np.full((n_blocks, n_loads), 180.0), angles[chosen], np.full((n_blocks, n_loads), np.nan),
+                     np.full((n_blocks, n_loads), np.nan)], axis=-1)
+    columns = metric_columns(
+        hours,
+        per_design(twofold.t_solar_contiguous[:, 0, 0], flat.t_solar_contiguous[:, 0],
+                   trackers.t_solar_contiguous[:, 0]),
+        per_design(twofold.energy[:, 0], np.repeat(flat.energy, n_loads, axis=1),
+                   np.repeat(trackers.energy, n_loads, axis=1)),
+        per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
+                   np.repeat(trackers.peak, n_loads, axis=1)),
+        loads[None, :, None],
+        served,
+    )
+    return {
+        "fold_angle_deg": fold,
+        **columns,
+        "poa_kwh_m2": per_design(twofold.irradiation, np.repeat(flat.irradiation[:, None], n_loads, axis=1),
+                                 np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
+        # A tracker whose drive costs more than it harvests says so where every table's note starts.
+        "condition": design_condition(sky.conditions()[:, None, None], columns["energy_harvested_wh"]),
+    }
+
+
+def objective_value(hours, months, statistic: str, season=None):
+    """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
+
+    ``mean``, ``min``, ``pNN`` (the NN-th percentile over days) or ``worst-month`` (the lowest
+    monthly mean); ``season`` (months) restricts the days.
+    """
+    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
+    if season:
+        keep = np.isin(months, season)
+        hours, months = hours[keep], months[keep]
+    if statistic == "mean":
+        return hours.mean(axis=0)
+    if statistic == "min":
+        return hours.min(axis=0)
+    if statistic == "worst-month":
+        return np.min([hours[months == m].mean(axis=0) for m in np.unique(months)], axis=0)
+    return np.percentile(hours, float(statistic[1:]), axis=0)
+
+
+
+
+def worst_month(hours, months):
+    """The month [1-12] of the lowest monthly mean of daily ``hours`` (days, ...) -> (...): the
+    month in which a ``worst-month`` objective is found."""
+    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
+    present = np.unique(months)
+    means = np.stack([hours[months == m].mean(axis=0) for m in present])
+    return present[np.argmin(means, axis=0)]
+
+
+def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
+    """The plateau of fold angles around the best: every grid angle on the best one's side of the
+    first angles that fall short, and the recommended angle at its centre.
+
+    An angle is near-optimal when its value lies within ``tolerance`` of the best
+    (:meth:`foldopt.inputs.config.NearOptimal.tolerance_h`: 1 % or 1 min by default, whichever is
+    larger). The range is the contiguous run of such angles that holds the best one
+    (:func:`best_angle_index`); the recommended angle is the grid angle nearest its centre (ties to
+    the less folded), so that a hinge set a few degrees off still lies on the plateau.
+
+    Parameters
+    ----------
+    angles : array_like
+        The fold-angle grid [deg], ascending, (n_angles,).
+    values : array_like
+        t_solar or an objective [h] at each angle, (..., n_angles).
+    tolerance : foldopt.inputs.config.NearOptimal
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg`` [deg] and
+        ``near_optimal_tolerance_h`` [h], each (...); NaN where no angle carries the load.
+    """
+    angles = np.asarray(angles, dtype=float)
+    values = np.asarray(values, dtype=float)
+    best = best_angle_index(values)
+    top = np.take_along_axis(values, best[..., None], axis=-1)[..., 0]
+    tol = tolerance.tolerance_h(top)
+    index = np.arange(angles.size)
+    short = values < (top - tol)[..., None]
+    below, above = short & (index < best[..., None]), short & (index > best[..., None])
+    lo = np.where(below.any(axis=-1), angles.size - np.argmax(below[..., ::-1], axis=-1), 0)
+    hi = np.where(above.any(axis=-1), np.argmax(above, axis=-1) - 1, angles.size - 1)
+    centre = (angles[lo] + angles[hi]) / 2.0
+    distance = np.where((index >= lo[..., None]) & (index <= hi[..., None]),
+                        np.abs(angles - centre[..., None]), np.inf)
+    recommended = best_angle_index(-distance)
+    carried = top > 0
+    return {
+        "near_optimal_lo_deg": np.where(carried, angles[lo], np.nan),
+        "near_optimal_hi_deg": np.where(carried, angles[hi], np.nan),
+        "recommended_fold_angle_deg": np.where(carried, angles[recommended], np.nan),
+        "near_optimal_tolerance_h": np.where(carried, tol, np.nan),
+    }
+
+
+@dataclass(frozen=True)
+class DailyDesigns:
+    """Each day's t_solar [h] and harvested energy [Wh] of every design, for statistics over days.
+
+    Attributes
+    ----------
+    angles : numpy.ndarray
+        The fold-angle grid [deg], (n_angles,).
+    twofold_h : numpy.ndarray
+        (days, loads, angles).
+    twofold_wh : numpy.ndarray
+        (days, angles).
+    flat_h, tracker_h, tracker_net_h : numpy.ndarray
+        (days, loads); the tracker net of its own draw.
+    flat_wh, tracker_wh : numpy.ndarray
+        (days,); the tracker's gross harvest.
+    available : numpy.ndarray
+        (days, steps) [W]: the tracker's power left for the load and a standby draw
+        (:func:`standby_available`).
+    """
+
+    angles: np.ndarray
+    twofold_h: np.ndarray
+    twofold_wh: np.ndarray
+    flat_h: np.ndarray
+    flat_wh: np.ndarray
+    tracker_h: np.ndarray
+    tracker_net_h: np.ndarray
+    tracker_wh: np.ndarray
+    available: np.ndarray
+
+
+def daily_designs(parts, loads, engine: str = "numba") -> DailyDesigns:
+    """:class:`DailyDesigns` over chunks of days: ``parts`` pairs each chunk of :class:`Blocks`
+    with its sky; ``loads`` [W] (an infinite load carries nothing)."""
+    twofold, harvest, flat, flat_energy, tracker, available = [], [], [], [], [], []
+    for chunk, sky in parts:
+        study = chunk.study
+        angles, hours, energy_harvested_wh = fold_hours(sky, chunk, loads, engine)
+        twofold.append(hours)
+        harvest.append(energy_harvested_wh)
+        metrics = engines.row_metrics(sky, study, np.arange(sky.n_blocks), engines.flat_orientation(
+            chunk.tilt, chunk.azimuth), loads, outputs=("panel",), engine=engine)
+        flat.append(metrics.t_solar[:, 0])
+        flat_energy.append(metrics.energy[:, 0])
+        orientation = sky_tracker_orientation(sky, study)
+        gross = sky_tracker_power(sky, study, orientation)
+        draw = sky_tracker_draw(sky, study, orientation)
+        both = engines.curve_metrics(np.concatenate([gross, gross - draw]), loads, sky.step_hours, engine=engine)
+        tracker.append((both.t_solar[:sky.n_blocks, 0], both.t_solar[sky.n_blocks:, 0], both.energy[:sky.n_blocks, 0]))
+        available.append(standby_available(gross, draw, sky.lit, study.tracker.standby_w))
+    gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
+    return DailyDesigns(angles, np.concatenate(twofold).transpose(0, 2, 1), np.concatenate(harvest),
+                        np.concatenate(flat), np.concatenate(flat_energy), gross_h, net_h, gross_wh,
+                        np.concatenate(available))

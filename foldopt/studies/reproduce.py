@@ -1,0 +1,117 @@
+"""Reproduction of Shin et al.'s twofold study, in paper and exact modes side by side.
+
+The load is not printed in the paper; it is inferred in paper mode as the load at which the flat
+panel's ``t_solar`` equals the paper's 7.73 h, and the same load is then used in both modes (it is
+a property of the device, not of the physics). Each PV model gets its own inference, since the
+paper's 7.73 h is what its own model gave.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from foldopt.inputs.config import Study
+from foldopt.engine.metrics import load_for_t_solar
+from foldopt.studies.day import Day, run_study, twofold_t_solar
+
+#: Shin et al. Sec. VI-VII and Fig. 12: (unit, published value); NaN where the paper is silent.
+PAPER_VALUES = {
+    "p_load_w": ("W", np.nan),
+    "flat_t_solar_h": ("h", 7.73),
+    "tracker_t_solar_h": ("h", 11.11),
+    "twofold_opt_fold_angle_deg": ("deg", 29.8),
+    "t_solar_twofold_h": ("h", 9.49),
+    "twofold_gain_vs_flat_pct": ("%", 23.0),
+    "twofold_pct_of_tracker": ("%", 85.4),
+    "fold90_gain_vs_flat_pct": ("%", 15.5),
+    "flat_area_multiple": ("-", 2.61),
+}
+GEOMETRY_OF_MODE = {"paper": "azimuth-split", "exact": "hinge"}
+#: The reproduction tables `foldopt reproduce` writes: file stem -> changes to the paper study.
+REPRODUCTIONS = {
+    "reproduction": {},
+    "reproduction_single_diode": {"pv_model": "single-diode", "connection": "switching"},
+}
+
+
+@dataclass(frozen=True)
+class Reproduction:
+    """The reproduction tables (:func:`foldopt.studies.reproduce`), the paper's study and the engine."""
+
+    tables: dict
+    study: Study
+    engine: str = "numba"
+
+    @functools.cached_property
+    def answer(self):
+        """The :class:`foldopt.studies.answer.Answer` every view renders."""
+        from foldopt.studies.answer import of_reproduction
+
+        return of_reproduction(self.tables, self.study)
+
+
+def infer_p_load(study: Study, flat_t_solar_h: float = PAPER_VALUES["flat_t_solar_h"][1]) -> float:
+    """Load [W] at which the study's flat panel, in paper mode, runs ``flat_t_solar_h`` hours."""
+    day = Day(study.variant(mode="paper"))
+    return load_for_t_solar(day.flat_power(), flat_t_solar_h, day.step_hours)
+
+
+def reproduction_values(study: Study, engine: str = "numba") -> dict[str, float]:
+    """The reproduced quantities of :data:`PAPER_VALUES` for one resolved study."""
+    result = run_study(study, engine)
+    summary = result.summary.set_index("design")
+    flat, twofold, tracker = (summary.loc[name] for name in ("flat", "twofold", "tracker"))
+    fold90 = twofold_t_solar(result.day, 90.0)
+    return {
+        "p_load_w": study.p_load,
+        "flat_t_solar_h": flat["t_solar_h"],
+        "tracker_t_solar_h": tracker["t_solar_h"],
+        "twofold_opt_fold_angle_deg": twofold["fold_angle_deg"],
+        "t_solar_twofold_h": twofold["t_solar_h"],
+        "twofold_gain_vs_flat_pct": twofold["gain_vs_flat_pct"],
+        "twofold_pct_of_tracker": twofold["pct_of_tracker"],
+        "fold90_gain_vs_flat_pct": (fold90 / flat["t_solar_h"] - 1.0) * 100.0,
+        "flat_area_multiple": twofold["flat_area_multiple"],
+    }
+
+
+def reproduce(study: Study, engine: str = "numba", **changes) -> pd.DataFrame:
+    """Paper value, paper-mode value and exact-mode value of each reproduced quantity.
+
+    Parameters
+    ----------
+    study : Study
+        The paper's study (``configs/shin2015.yaml``); its mode, geometry and load are replaced:
+        paper mode with the azimuth-split geometry, exact mode with the hinge, and the inferred load.
+    engine : {'numba', 'numpy'}
+        :data:`foldopt.engine.rows.ENGINES`.
+    **changes
+        Other fields to replace first, e.g. ``pv_model="single-diode"``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``quantity, unit, paper, paper_mode, exact_mode``.
+    """
+    study = study.variant(**changes)
+    p_load = infer_p_load(study)
+    columns = {}
+    for mode, geometry in GEOMETRY_OF_MODE.items():
+        variant = study.variant(mode=mode, geometry=geometry, p_load=p_load)
+        columns[f"{mode}_mode"] = reproduction_values(variant, engine)
+    return pd.DataFrame(
+        [
+            {
+                "quantity": quantity,
+                "unit": unit,
+                "paper": paper,
+                "paper_mode": columns["paper_mode"][quantity],
+                "exact_mode": columns["exact_mode"][quantity],
+            }
+            for quantity, (unit, paper) in PAPER_VALUES.items()
+        ]
+    )

@@ -1,0 +1,307 @@
+"""Sweeps: many sites, days, loads and designs, as one tidy table.
+
+The cases of a plan are blocks of skies (:mod:`foldopt.engine.sky`): cases that share everything but the
+site, the date and the load share one sky and one engine call, in chunks of bounded size. The
+designs come from :mod:`foldopt.studies.designs`: every (case, fold angle) row gets ``t_solar`` for all
+loads in one pass; the best angle per case and load is the best point of the grid (no local
+refinement, which a single-study run adds), with its near-optimal range, and its full metrics come
+from a second, targeted pass. With an objective, one fold angle serves all the days of a case (an
+annual group), and the group's objective per design, in its own terms, is a table of its own.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import itertools
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from foldopt.engine import rows as engines
+from foldopt.inputs.config import Plan
+from foldopt.studies.designs import (DESIGNS, Blocks, best_angle_index, design_metrics, fold_hours, near_optimal,
+                             objective_value, setup_key, worst_month)
+from foldopt.engine.metrics import notes, relative_to
+from foldopt.engine.sky import Sky
+
+@dataclass(frozen=True)
+class SweepResult:
+    """A plan and its tidy table: one row per case x design."""
+
+    plan: Plan
+    table: pd.DataFrame
+    extras: dict = dataclasses.field(default_factory=dict)  # day x hour curves of an annual objective
+    engine: str = "numba"
+    weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
+    request: object = None  # the foldopt.studies.request.Request the plan came from, if any
+
+    @functools.cached_property
+    def answer(self):
+        """The :class:`foldopt.studies.answer.Answer` every view of this result renders."""
+        from foldopt.studies.answer import of_sweep
+
+        return of_sweep(self)
+
+
+    @property
+    def varied(self) -> list[str]:
+        """Table columns that vary across cases."""
+        columns = [c for c in CASE_COLUMNS if c in self.table and self.table[c].nunique(dropna=False) > 1]
+        extra = [path for path, values in self.plan.axes if path not in _AXIS_COLUMNS and len(values) > 1]
+        return columns + extra
+
+
+CASE_COLUMNS = ("site_name", "latitude", "longitude", "date", "day_of_year", "p_load_w")
+#: Axes whose values the case columns above already show.
+_AXIS_COLUMNS = frozenset({"site", "site.name", "site.latitude", "site.longitude", "date", "p_load"})
+
+
+def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, engine: str = "numba",
+             request=None) -> SweepResult:
+    """Evaluate every case of a plan: flat, optimal twofold and tracker per case.
+
+    Parameters
+    ----------
+    plan : Plan
+    progress : callable, optional
+        Called as ``progress(done, total)`` with the days done so far, counted once per case
+        (an annual objective passes over each day twice: halves count).
+    engine : {'numba', 'numpy'}
+        :data:`foldopt.engine.rows.ENGINES`.
+    request : foldopt.studies.request.Request, optional
+        The request the plan was made from: what the answer says it took from the study.
+
+    Returns
+    -------
+    SweepResult
+        Columns: the case (``site_name``, ``latitude``, ``longitude``, ``date``, ``day_of_year``,
+        ``p_load_w`` and any other swept field by its path), ``design``, ``fold_angle_deg`` and the
+        daily metrics, ``gain_vs_flat_pct``, ``pct_of_tracker`` and ``note``
+        (:func:`foldopt.engine.metrics.notes`: polar night, polar day, overcast, load above peak).
+    """
+    axes = dict(plan.axes)
+    loads = np.asarray(axes.pop("p_load", (plan.data.get("p_load"),)), dtype=float)
+    objective = plan.base.objective
+    dates = axes.pop("date", None) if objective is not None else None
+    paths = list(axes)
+    choices = [dict(zip(paths, values, strict=True)) for values in itertools.product(*axes.values())]
+    # A fixed panel keeps one fold angle all year: an annual group is the dates of one choice.
+    studies = [plan.study({**choice, "p_load": float(loads[0]), **({"date": dates[0]} if dates else {})})
+               for choice in choices]
+    passes = 2 if dates else 1  # an annual group: find the angle over the days, then evaluate them
+    total = len(choices) * (len(dates) if dates else 1)
+    done = 0
+
+    def advance(count):
+        nonlocal done
+        done += count
+        if progress is not None:
+            progress(done / passes, total)
+
+    results: list = [None] * len(choices)
+    extras: dict = {}
+    light: dict = {}
+
+    def counted(sky: Sky) -> Sky:
+        for key, (total, kept) in (sky.weather_balance or {}).items():
+            light[key] = np.add(light.get(key, (0.0, 0.0)), (total, kept))
+        return sky
+
+    if dates:
+        refolds: dict[str, list] = {}
+        for index, study in enumerate(studies):
+            results[index], group_extras = _annual_group(Blocks.of_dates(study, dates), loads, objective, advance,
+                                                         engine, counted)
+            extras = extras or group_extras
+            for key in GROUP_TABLES:
+                if key in group_extras:
+                    refolds.setdefault(key, []).append(group_extras[key].assign(
+                        **{path: _plain(value) for path, value in choices[index].items() if path not in _AXIS_COLUMNS}))
+        extras.update({key: pd.concat(frames, ignore_index=True) for key, frames in refolds.items()})
+        cases = [(study.site, date, choice) for study, choice in zip(studies, choices, strict=True) for date in dates]
+    else:
+        # Cases of one setup share skies and engine calls, whatever their order in the plan.
+        setups: dict[str, list[int]] = {}
+        for index, study in enumerate(studies):
+            setups.setdefault(setup_key(study), []).append(index)
+        for members in setups.values():
+            blocks = Blocks.of([studies[i] for i in members])
+            for part in blocks.chunks(loads.size):
+                chunk = blocks[part]
+                sky = counted(chunk.sky())
+                angles, hours, _ = fold_hours(sky, chunk, loads, engine)
+                hours = hours.transpose(0, 2, 1)  # (blocks, loads, angles)
+                metrics = design_metrics(sky, chunk, loads, angles, best_angle_index(hours), engine)
+                metrics.update(_twofold_only(near_optimal(angles, hours, chunk.study.near_optimal)))
+                for offset, index in enumerate(members[part]):
+                    results[index] = {name: values[offset:offset + 1] for name, values in metrics.items()}
+                advance(len(chunk))
+        cases = [(study.site, study.date, choice) for study, choice in zip(studies, choices, strict=True)]
+    table = _table(cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]})
+    kept = {key: {"file_wh_m2": float(total), "kept_pct": float(100 * kept / total) if total else 100.0}
+            for key, (total, kept) in light.items()} or None
+    return SweepResult(plan, table, extras, engine, kept, request)
+
+
+def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
+    """One fold angle per load for all the days of a group: the one that maximises the objective
+    over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves."""
+    parts = blocks.chunks(loads.size)
+    skies, daily = [], []
+    for part in parts:
+        skies.append(counted(blocks[part].sky()))
+        angles, hours, _ = fold_hours(skies[-1], blocks[part], loads, engine)
+        daily.append(hours)
+        advance(len(blocks[part]))
+    months = [date.month for date in blocks.dates]
+    daily = np.concatenate(daily).transpose(0, 2, 1)  # (days, loads, angles)
+    score = objective_value(daily, months, objective.statistic, objective.months)
+    fixed = best_angle_index(score)  # (n_loads,)
+    metrics, series = [], {"p_twofold_w": [], "switch_state": []}
+    study = blocks.study
+    for part, sky in zip(parts, skies, strict=True):
+        chunk = blocks[part]
+        metrics.append(design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
+                                       engine))
+        # The day x hour maps of the first load's angle, every day at once.
+        orientation = engines.fold_orientations(study, chunk.tilt, chunk.azimuth, angles[fixed[:1]])[:, 0]
+        powers, state = engines.powers(sky, study, orientation, series=study.switch_series, with_state=True)
+        series["p_twofold_w"].append(powers[study.connection])
+        series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
+        advance(len(chunk))
+    clock = skies[0].grid.clock_hours[0]
+    design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (days, loads, designs)
+    near = near_optimal(angles, score, study.near_optimal)  # each (loads,)
+    refold = {"annual_objective": objective_table(blocks, loads, angles[fixed], design_hours, months, objective, near)}
+    if objective.visits:
+        refold.update(refold_tables(blocks, loads, angles, daily, months, objective, design_hours))
+    extras = {"dates": list(blocks.dates), "hours": clock, "fold_angle": float(angles[fixed[0]]), **refold,
+              **{key: np.concatenate(value) for key, value in series.items()},
+              "by_angle": pd.DataFrame({
+                  "p_load_w": np.repeat(loads, angles.size), "fold_angle_deg": np.tile(angles, loads.size),
+                  "objective_h": score.ravel(), "mean_t_solar_h": daily.mean(axis=0).ravel(),
+                  "min_t_solar_h": daily.min(axis=0).ravel(), "chosen": np.ravel(np.arange(angles.size) == fixed[:, None]),
+              })}
+    group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
+    group.update(_twofold_only({key: np.broadcast_to(value, (len(blocks), loads.size)) for key, value in near.items()}))
+    return group, extras
+
+
+def _twofold_only(values: dict) -> dict:
+    """Per-block-and-load values of the twofold panel (blocks, loads) as per-design arrays
+    (blocks, loads, designs), NaN for the other designs."""
+    out = {}
+    for key, value in values.items():
+        full = np.full(np.shape(value) + (len(DESIGNS),), np.nan)
+        full[..., DESIGNS.index("twofold")] = value
+        out[key] = full
+    return out
+
+
+def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, objective, near) -> pd.DataFrame:
+    """The objective of one annual group in its own terms, per load and design: the statistic, its
+    value [h], for ``worst-month`` the month it is found in, the mean daily t_solar [h], the fold
+    angle kept all year and, for the twofold panel, the near-optimal range and recommended angle
+    (:func:`foldopt.studies.designs.near_optimal`).
+
+    ``design_hours`` is (days, loads, designs) daily t_solar in :data:`DESIGNS` order."""
+    statistic = objective.statistic
+    values = objective_value(design_hours, months, statistic, objective.months)  # (loads, designs)
+    season = np.isin(months, objective.months) if objective.months else np.ones(len(months), bool)
+    month = worst_month(design_hours[season], np.asarray(months)[season]) if statistic == "worst-month" else None
+    site = blocks.study.site
+    rows = []
+    for index, load in enumerate(loads):
+        for d, design in enumerate(DESIGNS):
+            twofold = design == "twofold"
+            rows.append({
+                "site_name": site.name or "", "latitude": site.latitude, "longitude": site.longitude,
+                "p_load_w": float(load), "design": design, "objective": statistic,
+                "objective_h": float(values[index, d]),
+                "worst_month": int(month[index, d]) if month is not None else np.nan,
+                "mean_t_solar_h": float(design_hours[season][:, index, d].mean()),
+                "fold_angle_deg": float(fold_angles[index]) if twofold else (180.0 if design == "flat" else np.nan),
+                **{key: float(value[index]) if twofold else np.nan for key, value in near.items()},
+            })
+    return pd.DataFrame(rows)
+
+
+def _table(cases, loads, metrics) -> pd.DataFrame:
+    """The tidy table: per case (site, date, axis choice), load and design, in that order."""
+    n_cases, n_loads, n_designs = len(cases), loads.size, len(DESIGNS)
+    repeat = n_loads * n_designs
+    columns = {}
+    case_rows = [_case(*case) for case in cases]
+    for name in case_rows[0]:
+        columns[name] = np.repeat(np.array([row[name] for row in case_rows], dtype=object), repeat)
+    columns["p_load_w"] = np.tile(np.repeat(loads, n_designs), n_cases)
+    columns["design"] = np.tile(np.array(DESIGNS, dtype=object), n_cases * n_loads)
+    columns["fold_angle_deg"] = metrics["fold_angle_deg"].ravel()
+    hours = metrics["t_solar_h"]
+    for name in metrics:
+        if name not in ("fold_angle_deg", "condition"):
+            columns[name] = metrics[name].ravel()
+    columns["gain_vs_flat_pct"] = ((relative_to(hours, hours[..., :1]) - 1.0) * 100.0).ravel()
+    columns["pct_of_tracker"] = (relative_to(hours, hours[..., 2:3]) * 100.0).ravel()
+    columns["note"] = notes(metrics["condition"], hours).ravel()
+    table = pd.DataFrame(columns)
+    for name in case_rows[0]:
+        table[name] = table[name].infer_objects()
+    return table
+
+
+def _case(site, date, choice: dict) -> dict:
+    return {
+        "site_name": site.name or "",
+        "latitude": site.latitude,
+        "longitude": site.longitude,
+        "date": date.isoformat(),
+        "day_of_year": date.timetuple().tm_yday,
+        **{path: _plain(value) for path, value in choice.items() if path not in _AXIS_COLUMNS},
+    }
+
+
+def _plain(value):
+    return value.isoformat() if hasattr(value, "isoformat") else value
+
+
+#: The tables of every annual group, one row per load (and design, setting or visit) and group.
+GROUP_TABLES = ("annual_objective", "refold_value", "refold_schedule")
+
+
+def refold_tables(blocks: Blocks, loads, angles, daily, months, objective, design_hours) -> dict:
+    """The best re-fold schedules of one annual group (:func:`foldopt.engine.schedule.best_schedules`):
+
+    ``refold_value``, per load and number of settings k: the objective and the mean daily t_solar
+    [h], the gain over the single fixed angle [%] and what the k-th setting adds [h], beside the
+    flat panel's and the tracker's objective; ``refold_schedule``, per load, k and visit: the date
+    and the fold angle set until the next visit (the last runs on over New Year).
+
+    ``daily`` is (days, loads, angles) t_solar, ``design_hours`` (days, loads, designs) in
+    :data:`DESIGNS` order."""
+    from foldopt.engine.schedule import best_schedules
+
+    statistic = objective.statistic
+    site = blocks.study.site
+    where = {"site_name": site.name or "", "latitude": site.latitude, "longitude": site.longitude}
+    values, visits = [], []
+    for index, load in enumerate(loads):
+        schedules = best_schedules(daily[:, index, :], months, objective.visits, statistic)
+        flat, tracker = (objective_value(design_hours[:, index, d], months, statistic) for d in (0, 2))
+        fixed = schedules[0].objective_h
+        previous = None
+        for k, schedule in enumerate(schedules, start=1):
+            chosen = daily[np.arange(len(months)), index, schedule.daily_angles(len(months))]
+            values.append({**where, "p_load_w": float(load), "settings": k, "objective": statistic,
+                           "objective_h": schedule.objective_h, "mean_t_solar_h": float(chosen.mean()),
+                           "gain_vs_fixed_pct": 100.0 * (schedule.objective_h / fixed - 1.0) if fixed > 0 else np.nan,
+                           "added_by_setting_h": np.nan if previous is None else schedule.objective_h - previous,
+                           "objective_flat_h": float(flat), "objective_tracker_h": float(tracker)})
+            previous = schedule.objective_h
+            for visit, (start, angle) in enumerate(zip(schedule.starts, schedule.angles, strict=True), start=1):
+                visits.append({**where, "p_load_w": float(load), "settings": k, "visit": visit,
+                               "date": blocks.dates[start].isoformat(), "fold_angle_deg": float(angles[angle])})
+    return {"refold_value": pd.DataFrame(values), "refold_schedule": pd.DataFrame(visits)}
