@@ -27,7 +27,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from foldopt.engine import rows as engine  # noqa: E402
-from foldopt.inputs.config import default_study_path, load_study  # noqa: E402
+from foldopt.inputs.load import default_study_path
+from foldopt.inputs.plan import load_study  # noqa: E402
 from foldopt.engine.sky import build_sky  # noqa: E402
 
 
@@ -93,7 +94,8 @@ def main():
     exact_per_point = exact_seconds / exact_points
     peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, python {platform.python_version()}")
-    print(f"workload: {len(dates)} days x {angles.size} angles x 1440 steps, single-diode + switching, {args.mode} mode")
+    print(f"workload: {len(dates)} days x {angles.size} angles x 1440 steps, single-diode + switching, "
+          f"{args.mode} mode")
     print(f"fast path (tables, compiled kernel): {fast_seconds:8.2f} s  {fast_per_point * 1e9:8.1f} ns/point")
     print(f"exact solve (slice {exact_points} points):  {exact_seconds:8.2f} s  {exact_per_point * 1e9:8.1f} ns/point")
     print(f"speed-up, measured in this run: {exact_per_point / fast_per_point:8.1f} x")

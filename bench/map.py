@@ -34,7 +34,7 @@ TARGET_SPEEDUP = 1.8
 
 def _spec(n_sites: int):
     from foldopt.studies.cluster import MapSpec
-    from foldopt.inputs.config import default_study_path, read_study
+    from foldopt.inputs.load import default_study_path, read_study
     from foldopt.studies.worldmap import grid_sites, map_study
 
     n_lat = max(1, round(np.sqrt(n_sites * 0.8)))

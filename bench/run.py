@@ -47,7 +47,8 @@ W3_ANGLE_DEG = 1.0  # [deg] best angle (the grid step), where the best is clear 
 
 
 def _study():
-    from foldopt.inputs.config import default_study_path, load_study
+    from foldopt.inputs.load import default_study_path
+    from foldopt.inputs.plan import load_study
 
     return load_study(default_study_path()).variant(
         pv_model="single-diode", connection="switching", mode="exact", geometry="hinge"
@@ -137,7 +138,7 @@ def workload_w1(days: int) -> dict:
 
 def workload_w2(days: int, latitudes: int) -> dict:
     from foldopt.engine import rows as engine  # noqa: F401
-    from foldopt.inputs.config import Site
+    from foldopt.inputs.sections import Site
 
     base = _study().variant(panel={"area": 0.108, "efficiency": 0.1905})  # tilt |latitude|, equator-facing
     lats = np.linspace(-89.0, 89.0, latitudes)
@@ -200,7 +201,8 @@ def pvlib_baseline(base, dates, voltage_points: int = 12):
         sides = subpanel_orientation(angle, panel.tilt, panel.azimuth, "hinge")
         curves, power = [], {}
         for side in ("east", "west"):
-            projection = pvlib.irradiance.aoi_projection(sides[f"tilt_{side}"], sides[f"azimuth_{side}"], zenith, azimuth)
+            projection = pvlib.irradiance.aoi_projection(sides[f"tilt_{side}"], sides[f"azimuth_{side}"], zenith,
+                                                         azimuth)
             poa = dni * np.clip(projection, 0.0, None)
             lit = poa > 0
             temp = pvlib.temperature.sapm_cell(poa[lit], base.temp_air, base.wind_speed, -3.56, -0.075, 3)
@@ -298,7 +300,8 @@ def report(results: dict) -> str:
     for name in ("W1", "W2"):
         if name in results:
             r = results[name]
-            lines.append(f"| {name} | {r['points']:,} | {r['seconds']:.2f} s | {r['seconds'] / r['points'] * 1e9:.1f} ns "
+            per_point = r['seconds'] / r['points'] * 1e9
+            lines.append(f"| {name} | {r['points']:,} | {r['seconds']:.2f} s | {per_point:.1f} ns "
                          f"| {r['peak_mib']:.0f} MiB | {TARGETS[name]} |")
     if "W3" in results:
         r = results["W3"]
@@ -315,7 +318,8 @@ def report(results: dict) -> str:
                      f"{r['kernel_1_thread'] / r['kernel_2_threads']:.2f}x from the second core")
     if "W3" in results:
         r = results["W3"]
-        lines += ["", f"W3: foldopt is {r['ratio']:,.0f}x faster per point than the vectorised pvlib pipeline, measured "
+        lines += ["", f"W3: foldopt is {r['ratio']:,.0f}x faster per point than the vectorised pvlib pipeline, "
+                  "measured "
                   f"interleaved in this run (minimum of {r['rounds']} rounds each, {r['days']} days spread over "
                   f"the year); they agree on t_solar at the best angle within {r['agreement_t_solar_s']:.1f} s "
                   f"(bound {W3_AGREEMENT_S:g} s) and on clear best angles within {r['agreement_angle_deg']:.0f} deg "
@@ -323,7 +327,8 @@ def report(results: dict) -> str:
     if "tables" in results:
         r = results["tables"]
         lines.append(f"electrical tables built cold: {r['seconds']:.2f} s ("
-                     + ", ".join(f"{k} {v:.2f} s" for k, v in r["phases"].items()) + "); later runs load them from disk")
+                     + ", ".join(f"{k} {v:.2f} s" for k, v in r["phases"].items())
+                     + "); later runs load them from disk")
     return "\n".join(lines)
 
 

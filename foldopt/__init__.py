@@ -17,21 +17,26 @@ except metadata.PackageNotFoundError:  # running from a source tree that is not 
 
 #: Public name -> the module that defines it.
 _PUBLIC = {
-    "Study": "foldopt.inputs.config", "Site": "foldopt.inputs.config", "Panel": "foldopt.inputs.config", "Tracker": "foldopt.inputs.config",
-    "Objective": "foldopt.inputs.config", "FoldAngles": "foldopt.inputs.config", "Weather": "foldopt.inputs.config",
-    "Plan": "foldopt.inputs.config", "ConfigError": "foldopt.errors",
+    "Study": "foldopt.inputs.study", "Plan": "foldopt.inputs.plan", "ConfigError": "foldopt.errors",
+    **{name: "foldopt.inputs.sections" for name in (
+        "Site", "Panel", "Tracker", "Objective", "FoldAngles", "Weather", "LoadProfile", "NearOptimal")},
     "default_study": "foldopt.api", "load_study": "foldopt.api", "run": "foldopt.api", "sweep": "foldopt.api",
     "write": "foldopt.api", "size": "foldopt.api", "reproduce": "foldopt.api", "world_map": "foldopt.api",
     "StudyResult": "foldopt.studies.day", "SweepResult": "foldopt.studies.sweeps",
     "MapSpec": "foldopt.studies.cluster", "MapRun": "foldopt.studies.cluster", "run_map": "foldopt.studies.cluster",
-    "evaluate_sites": "foldopt.studies.worldmap", "grid_sites": "foldopt.studies.worldmap", "read_sites": "foldopt.studies.worldmap",
+    "evaluate_sites": "foldopt.studies.worldmap", "grid_sites": "foldopt.studies.worldmap",
+    "read_sites": "foldopt.studies.worldmap",
     "weather_sites": "foldopt.studies.worldmap", "map_study": "foldopt.studies.worldmap",
-    "annual_summary": "foldopt.output.report", "write_html": "foldopt.output.report",
-    **{name: "foldopt.output.report" for name in (
-        "plot_power_curves", "plot_switching", "plot_t_solar_vs_fold_angle", "plot_comparison", "plot_standby",
-        "plot_map", "plot_curves", "plot_sizing", "plot_annual_fold_angles", "plot_monthly", "plot_distribution",
-        "plot_day_hour", "plot_world_map", "plot_latitude_load", "plot_refold_value", "save_plot")},
-    "best_schedules": "foldopt.engine.schedule", "LoadProfile": "foldopt.inputs.config", "NearOptimal": "foldopt.inputs.config",
+    "annual_summary": "foldopt.studies.annual", "write_html": "foldopt.output.html",
+    "save_plot": "foldopt.output.figures.canvas",
+    **{name: "foldopt.output.figures.day" for name in (
+        "plot_power_curves", "plot_switching", "plot_t_solar_vs_fold_angle", "plot_comparison", "plot_standby")},
+    **{name: "foldopt.output.figures.sweep" for name in ("plot_map", "plot_curves")},
+    **{name: "foldopt.output.figures.annual" for name in (
+        "plot_annual_fold_angles", "plot_monthly", "plot_distribution", "plot_day_hour", "plot_refold_value")},
+    **{name: "foldopt.output.figures.world" for name in ("plot_world_map", "plot_latitude_load")},
+    "plot_sizing": "foldopt.output.figures.sizing",
+    "best_schedules": "foldopt.engine.schedule",
     "Answer": "foldopt.studies.answer", "plan_request": "foldopt.studies.request", "Request": "foldopt.studies.request",
     "SizingResult": "foldopt.studies.sizing", "Reproduction": "foldopt.studies.reproduce",
     "twofold_arrays": "foldopt.physics.pvsystem",

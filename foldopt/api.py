@@ -20,7 +20,9 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from foldopt.inputs.config import Plan, Study, default_study_path, load_plan
+from foldopt.inputs.load import default_study_path, with_files
+from foldopt.inputs.plan import Plan, load_plan
+from foldopt.inputs.study import Study
 from foldopt.errors import ConfigError
 
 def default_study() -> Study:
@@ -44,7 +46,7 @@ def load_study(path: str | Path) -> Study | Plan:
     Returns
     -------
     Study or Plan
-        The study, or a :class:`foldopt.inputs.config.Plan` where the file sweeps fields (lists, ranges,
+        The study, or a :class:`foldopt.inputs.plan.Plan` where the file sweeps fields (lists, ranges,
         a ``sweep:`` section, a year of dates).
 
     Raises
@@ -80,6 +82,11 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
         with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.studies.sweeps.SweepResult`
         for a plan (``table``: one row per case and design); each with ``answer``, the
         :class:`foldopt.studies.answer.Answer` the command line prints.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For a study file that cannot be read or a study that cannot be run.
     """
     if isinstance(study, (str, Path)):
         study = load_study(study)
@@ -91,7 +98,7 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
         study = study.base
     from foldopt.studies.day import run_study
 
-    return run_study(study, engine, request)
+    return run_study(with_files(study), engine, request)
 
 
 def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, engine: str = "numba",
@@ -111,7 +118,7 @@ def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, en
         A sweep's own axis, over its default range where ``fields`` leave it out (latitude
         -60:60:5, day 1:365:7, 20 loads up to the panel's rating); ``angle`` is one case.
     axes : dict, optional
-        Dotted field paths to values, for any field (``{"tracker.gcr": [0.3, 0.4]}``).
+        Dotted field paths to values, for any field (``{"panel.efficiency": [0.18, 0.21]}``).
     engine : {'numba', 'numpy'}
     progress : callable, optional
         ``progress(done, total)`` in days.
@@ -169,16 +176,27 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
     Parameters
     ----------
     result : StudyResult, SweepResult, SizingResult or Reproduction
+        What :func:`run`, :func:`sweep`, :func:`size` or :func:`reproduce` returned.
     out : str or pathlib.Path
-    overwrite : bool
+        The results folder.
+    overwrite : bool, default False
+        Replace an existing folder (only one foldopt wrote).
     command : list of str, optional
         What ``run.json`` records as the command.
 
     Returns
     -------
     pathlib.Path
+        The folder written.
+
+    Raises
+    ------
+    OutputExistsError
+        If ``out`` exists and ``overwrite`` is false (:mod:`foldopt.errors`).
+    OutputError
+        If ``out`` cannot be written there, is not foldopt's to replace, or the disk fills.
     """
-    from foldopt.output.report import write_reproduction, write_sizing, write_study, write_sweep
+    from foldopt.output.folders import write_reproduction, write_sizing, write_study, write_sweep
     from foldopt.studies.reproduce import Reproduction
     from foldopt.studies.sizing import SizingResult
     from foldopt.studies.day import StudyResult
@@ -219,14 +237,15 @@ def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None,
     Raises
     ------
     foldopt.ConfigError
-        For both costs, a value that is not a positive finite number, or areas outside (0, 1000] m^2.
+        For both costs, a value that is not a finite number in (0, its limit]
+        (:data:`foldopt.studies.request.SIZING_LIMITS`, as the command line's), or areas outside
+        (0, 1000] m^2.
     """
-    import math
-
     from foldopt.inputs import costs
     from foldopt.studies import sizing
-    from foldopt.inputs.config import parse_range
+    from foldopt.inputs.plan import parse_range
     from foldopt.studies.day import Day
+    from foldopt.studies.request import sizing_problems
 
     errors = []
     if cost_per_m2 is not None and cost_per_w is not None:
@@ -238,9 +257,7 @@ def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None,
     days_per_year = costs.DAYS_PER_YEAR if days_per_year is None else days_per_year
     parameters = {"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
                   "years": years, "days_per_year": days_per_year}
-    for name, value in parameters.items():
-        if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            errors.append(f"{name} = {value}: must be a finite number > 0")
+    errors += sizing_problems(parameters)
     try:
         grid = parse_range(areas) if isinstance(areas, str) else [float(a) for a in areas]
         if not grid or min(grid) <= 0 or max(grid) > 1000:
@@ -249,6 +266,7 @@ def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None,
         errors.append(f"areas: {error}")
     if errors:
         raise ConfigError(errors)
+    study = with_files(study)  # a study built in Python has its files unread
     table = sizing.size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
     return sizing.SizingResult(study, table, sizing.best_areas(table), parameters, request)
 
@@ -258,7 +276,8 @@ def reproduce(engine: str = "numba"):
 
     Parameters
     ----------
-    engine : {'numba', 'numpy'}
+    engine : {'numba', 'numpy'}, default 'numba'
+        The compiled kernel or the NumPy reference path.
 
     Returns
     -------
@@ -283,10 +302,13 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
 
     Parameters
     ----------
-    sites : sequence of dict
-        From :func:`foldopt.grid_sites`, :func:`foldopt.read_sites` or :func:`foldopt.weather_sites`.
-    loads : sequence of float
-        Loads [W], or with ``relative`` fractions of each site's flat peak.
+    sites : sequence of dict, str or pathlib.Path
+        From :func:`foldopt.grid_sites`, :func:`foldopt.read_sites` or :func:`foldopt.weather_sites`,
+        or a CSV of named sites.
+    loads : float, sequence of float or str
+        Loads [W], or with ``relative`` fractions of each site's flat peak; text is a value, a range
+        ``start:stop:step`` or a list. Checked as the command line's are
+        (:func:`foldopt.studies.worldmap.map_request`).
     out : str or pathlib.Path
         The results folder (``map.parquet``, ``map.csv``, figures, ``report.html``, ``run.json``).
     study : dict, optional
@@ -316,16 +338,21 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
         The :class:`foldopt.MapRun`, the figures' file names and the :class:`foldopt.studies.answer.Answer`
         (its ``designs``: the year's rows; its ``near_optimal``: each site's range and recommended
         fold angle).
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For a bad site, load, year, period or study setting, before any cluster starts.
     """
     from foldopt.studies.cluster import MapSpec, run_map
     from foldopt.studies.answer import of_map
-    from foldopt.output.report import map_figures, write_map_report
-    from foldopt.studies.worldmap import map_study, site_study
+    from foldopt.output.folders import map_figures, write_map_report
+    from foldopt.studies.worldmap import map_request, map_study
 
     if study is None:
         study = map_study(load_plan(default_study_path()).data)
-    site_study(study, sites[0], year)  # a bad setting fails here, before any cluster starts
-    spec = MapSpec(study, tuple(sites), tuple(loads), relative, year, sites_per_chunk, engine)
+    request = map_request(study, loads, sites=sites, relative=relative, year=year, show_period=show_period)
+    spec = MapSpec(study, request.sites, request.loads, relative, year, sites_per_chunk, engine)
     result = run_map(spec, Path(out), scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
                      progress=progress, announce=announce, metadata={"command": command or ["foldopt.world_map"]})
     figures = map_figures(result.table, result.out, "map", relative, show_load, show_period)

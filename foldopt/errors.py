@@ -10,7 +10,14 @@ from __future__ import annotations
 
 
 class ConfigError(ValueError):
-    """A study that cannot be run; ``errors`` holds one ``field: problem`` line per fault."""
+    """A study that cannot be run.
+
+    Parameters
+    ----------
+    errors : list of str
+        One ``field: problem`` line per fault, kept as :attr:`errors`; the message joins them
+        with semicolons.
+    """
 
     def __init__(self, errors: list[str]):
         super().__init__("; ".join(errors))
@@ -28,7 +35,13 @@ def _config_error(cls, errors: list[str]) -> ConfigError:
 
 
 class WeatherError(ConfigError):
-    """A weather file that cannot be used: one line naming the file, where in it and why."""
+    """A weather file that cannot be used.
+
+    Parameters
+    ----------
+    message : str
+        One line naming the file, where in it and why.
+    """
 
     def __init__(self, message: str):
         super().__init__([message])

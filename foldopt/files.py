@@ -1,19 +1,17 @@
-"""Results folders that cannot hurt: built under a temporary name beside their destination and
-renamed into place only when complete; an existing folder is replaced only when the caller asks
-for it, only if foldopt wrote it, and only once its replacement is whole. Light on imports, so that
-the command line can check its output folder before any work.
+"""Results folders that cannot hurt: built under a temporary name beside their destination and renamed into place
+only when complete; an existing folder is replaced only when the caller asks for it, only if foldopt wrote it,
+and only once its replacement is whole. Light on imports, so that the command line can check its output folder
+before any work.
 
-One writer per folder: a writer holds an OS lock (``flock``) on ``.<name>.lock`` beside its
-destination, which the kernel drops when the process ends, even by SIGKILL; a second writer is
-refused by name. The staging folder ``.<name>.tmp-<pid>`` and, between the two renames of a
-replacement, the retired folder ``.<name>.old-<pid>`` hold a marker, :data:`MARKER` (the writer's
-pid, host and a random token), and the results in a folder named like the destination, so that the
-marker never reaches the results. A process killed while it writes leaves them behind; the next
-results folder written into the same parent removes those whose writer is gone and puts a retired
-folder back where it was. A folder without the marker, whatever its name, is never touched. SIGTERM
-and SIGINT are turned into exceptions by the command line, so that the staging folder goes at once.
-A full file system (``ENOSPC``, ``EDQUOT``) is :class:`OutputError` naming the folder and the space
-it needs.
+One writer per folder: a writer holds an OS lock (``flock``) on ``.<name>.lock`` beside its destination, which
+the kernel drops when the process ends, even by SIGKILL; a second writer is refused by name. The staging folder
+``.<name>.tmp-<pid>`` and, between the two renames of a replacement, the retired folder ``.<name>.old-<pid>``
+hold a marker, :data:`MARKER` (the writer's pid, host and a random token), and the results in a folder named
+like the destination, so that the marker never reaches the results. A process killed while it writes leaves
+them behind; the next results folder written into the same parent removes those whose writer is gone and puts
+a retired folder back where it was. A folder without the marker, whatever its name, is never touched. SIGTERM
+and SIGINT are turned into exceptions by the command line, so that the staging folder goes at once. A full file
+system (``ENOSPC``, ``EDQUOT``) is :class:`OutputError` naming the folder and the space it needs.
 """
 
 from __future__ import annotations
@@ -53,7 +51,13 @@ VERSIONED = ("foldopt", "numpy", "scipy", "pandas", "pvlib", "matplotlib", "pyda
 def versions(extra: tuple[str, ...] = ()) -> dict[str, str]:
     """Versions of Python, foldopt and its main dependencies (and of the ``extra`` packages), as
     every ``run.json`` records them: a folder whose ``run.json`` names foldopt's version is one
-    foldopt wrote (:func:`written_by_foldopt`)."""
+    foldopt wrote (:func:`written_by_foldopt`).
+
+    Parameters
+    ----------
+    extra : tuple of str, default ()
+        More distribution names.
+    """
     from importlib import metadata
 
     found = {"python": platform.python_version()}
@@ -77,7 +81,15 @@ def written_by_foldopt(folder: Path) -> bool:
 def check_output(out: Path, overwrite: bool) -> None:
     """Raise if ``out`` cannot take a results folder: :class:`OutputExistsError` if it exists and
     ``overwrite`` is false, :class:`OutputError` if it is a file, the working folder or one of its
-    parents, a folder foldopt did not write, or in a place that cannot be written."""
+    parents, a folder foldopt did not write, or in a place that cannot be written.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The results folder to be.
+    overwrite : bool
+        Whether an existing results folder may be replaced.
+    """
     out = Path(out)
     resolved = out.resolve()
     if resolved == Path.cwd().resolve() or resolved in Path.cwd().resolve().parents:
@@ -104,7 +116,17 @@ def check_output(out: Path, overwrite: bool) -> None:
 
 
 class DiskFullError(OutputError):
-    """The file system filled while results were written; ``written`` [bytes] had been written."""
+    """The file system filled while results were written.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The results folder.
+    written : int
+        Bytes written before the file system filled.
+    remedy : str, default 'run again'
+        What the message tells the user to do once space is free.
+    """
 
     def __init__(self, folder: Path, written: int, remedy: str = "run again"):
         self.folder, self.written = Path(folder), written
@@ -119,7 +141,7 @@ def is_full(error: BaseException) -> bool:
 
 
 def tree_size(path: Path) -> int:
-    """Bytes of the files under ``path`` (0 where it is gone)."""
+    """Bytes of the files under ``path``, or of the file ``path`` (0 where it is gone)."""
     if Path(path).is_file():
         return Path(path).stat().st_size
     return sum((Path(root) / name).stat().st_size for root, _, names in os.walk(path) for name in names)
@@ -132,7 +154,15 @@ def _size_text(size: int) -> str:
 def write_atomically(path: Path, write) -> Path:
     """``write(temporary)`` to a file beside ``path`` (same suffix, so that writers that read it
     know the format), then rename it into ``path``: a reader sees the old file or the whole new one,
-    and a failed write leaves nothing. A full file system is :class:`DiskFullError`."""
+    and a failed write leaves nothing. A full file system is :class:`DiskFullError`.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file to write, returned.
+    write : callable
+        Writes the file whose path it is given.
+    """
     path = Path(path)
     temporary = path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}")
     try:
@@ -312,7 +342,12 @@ def new_staging(out: Path) -> Path:
 
 def commit(staged: Path, out: Path) -> None:
     """Put the results folder ``staged`` (from :func:`new_staging`) in ``out``'s place; an earlier
-    ``out`` is retired first and removed only once ``staged`` is in place."""
+    ``out`` is retired first and removed only once ``staged`` is in place.
+
+    Parameters
+    ----------
+    staged, out : pathlib.Path
+    """
     out = Path(out)
     if out.exists():
         retired = _marked_folder(out, "old")
@@ -339,7 +374,14 @@ def discard(staged: Path) -> int:
 @contextmanager
 def staged_folder(out: Path, overwrite: bool):
     """Yield a temporary folder that replaces ``out`` atomically when the block succeeds; while
-    the block runs, ``out``'s lock is held."""
+    the block runs, ``out``'s lock is held.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+    overwrite : bool
+        Whether an existing results folder may be replaced (:func:`check_output`).
+    """
     out = Path(out)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -385,7 +427,12 @@ def load_cache(path: Path) -> dict | None:
     """The arrays of the cache file ``path`` (:func:`store_cache`), or None where it is absent or
     damaged: then the caller builds them again. The checksum is verified before anything is read,
     so that a truncated or bit-flipped file is caught whatever its bytes; a damaged file gets a
-    one-line notice on stderr (none with ``FOLDOPT_QUIET=1``)."""
+    one-line notice on stderr (none with ``FOLDOPT_QUIET=1``).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    """
     try:
         data = Path(path).read_bytes()
     except FileNotFoundError:
@@ -409,7 +456,16 @@ def load_cache(path: Path) -> dict | None:
 def store_cache(path: Path, arrays: dict, compress: bool = False) -> None:
     """Write ``arrays`` to the cache file ``path``: a NumPy ``.npz`` followed by
     :data:`_CHECKSUM` and the SHA-256 of the ``.npz``, atomically. A cache that cannot be written
-    is skipped."""
+    is skipped.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    arrays : dict of numpy.ndarray
+        By name.
+    compress : bool, default False
+        ``numpy.savez_compressed`` instead of ``numpy.savez``.
+    """
     import numpy as np
 
     buffer = io.BytesIO()

@@ -12,23 +12,122 @@ from __future__ import annotations
 import difflib
 import re
 
-MODES = ("paper", "exact")
-GEOMETRIES = ("azimuth-split", "hinge")
-BEAM_SKIES = ("meinel", "hottel")  # beam only
-CLEAR_SKIES = ("ineichen", "simplified-solis")  # global, direct and diffuse
+class Registry(tuple):
+    """The members of one kind (PV models, connections, trackers...): their names in order, each
+    with a one-line description that help text and the docs print.
+
+    A registry is a tuple of names, so ``name in PV_MODELS`` and ``", ".join(PV_MODELS)`` read it
+    as before; :meth:`describe` and :meth:`choices` give the descriptions, and
+    :func:`canonical` accepts other spellings of its names. Adding a member is one entry here
+    and its implementation in the module that dispatches on it.
+
+    Parameters
+    ----------
+    kind : str
+        What the members are, as a field of a study would name it (``"pv_model"``).
+    members : dict of str to str
+        Each member's name and its one-line description.
+    """
+
+    def __new__(cls, kind: str, members: dict[str, str]):
+        registry = super().__new__(cls, members)
+        registry.kind, registry.descriptions = kind, dict(members)
+        return registry
+
+    def describe(self, name: str) -> str:
+        """The one-line description of a member.
+
+        Parameters
+        ----------
+        name : str
+            One of the registry's names.
+
+        Examples
+        --------
+        >>> MODES.describe("paper")[:22]
+        "Shin et al.'s formulas"
+        """
+        return self.descriptions[name]
+
+    def choices(self) -> str:
+        """The names joined for help text: ``ideal | single-diode | b-model``."""
+        return " | ".join(self)
+
+    def __add__(self, other):
+        if isinstance(other, Registry):
+            return Registry(self.kind, {**self.descriptions, **other.descriptions})
+        return tuple(self) + tuple(other)
+
+    def __reduce__(self):  # pickled to Dask workers with its descriptions
+        return Registry, (self.kind, self.descriptions)
+
+
+MODES = Registry("mode", {
+    "paper": "Shin et al.'s formulas: their solar position, air mass, beam-only sky and incidence (Eq. 1-6)",
+    "exact": "pvlib's SPA solar position, a clear-sky or weather sky, transposition and angle of incidence"})
+GEOMETRIES = Registry("geometry", {
+    "azimuth-split": "the sub-panels keep the base tilt and turn east and west of the base azimuth (the paper's)",
+    "hinge": "the sub-panel normals turn about the fold line, up the panel's slope (a ridge tent at tilt 0)"})
+BEAM_SKIES = Registry("sky", {  # beam only
+    "meinel": "Meinel & Meinel's beam irradiance from air mass (Shin et al. Eq. 2)",
+    "hottel": "Hottel's clear-sky beam transmittance by climate and altitude"})
+CLEAR_SKIES = Registry("sky", {  # global, direct and diffuse
+    "ineichen": "pvlib's Ineichen-Perez clear sky with Linke turbidity",
+    "simplified-solis": "pvlib's simplified Solis clear sky from aerosol and water vapour"})
 SKIES = BEAM_SKIES + CLEAR_SKIES
-TRANSPOSITIONS = ("none", "isotropic", "haydavies", "perez")
-IAMS = ("none", "ashrae", "physical")
-PV_MODELS = ("ideal", "single-diode", "b-model")
-TEMPERATURE_MODELS = ("fixed", "sapm")
-CONNECTIONS = ("east", "west", "parallel", "series", "independent", "switching")
-TRACKERS = ("dual-axis", "equatorial", "dual-axis-steps", "single-axis")
-DRIVES = ("motor", "wh-per-degree")
-WEATHER_FORMATS = ("tmy3", "epw", "pvgis")
-INTERVAL_LABELS = ("start", "end", "centre")
-HOTTEL_CLIMATES = ("tropical", "midlatitude-summer", "subarctic-summer", "midlatitude-winter")
-ENGINES = ("numba", "numpy")
-OUTPUT_FORMATS = ("table", "json")
+TRANSPOSITIONS = Registry("transposition", {
+    "none": "beam only: no diffuse or reflected light",
+    "isotropic": "isotropic sky diffuse (Liu & Jordan) and ground reflection",
+    "haydavies": "Hay & Davies: circumsolar and isotropic sky diffuse",
+    "perez": "Perez et al. 1990: circumsolar, isotropic and horizon-band sky diffuse"})
+IAMS = Registry("iam", {
+    "none": "no reflection loss at the cover",
+    "ashrae": "ASHRAE incidence angle modifier (pvlib.iam.ashrae)",
+    "physical": "Fresnel and absorption in the cover glass (pvlib.iam.physical)"})
+PV_MODELS = Registry("pv_model", {
+    "ideal": "P = efficiency x area x irradiance, no I-V curve (the paper's)",
+    "single-diode": "De Soto et al.'s five-parameter single-diode model of a CEC module, through pvlib",
+    "b-model": "Robles Algarin et al.'s empirical I-V model of a 200 W panel (Eq. 8-11, b = 0.068)"})
+TEMPERATURE_MODELS = Registry("temperature_model", {
+    "fixed": "cells at the air temperature",
+    "sapm": "Sandia's cell temperature model from irradiance, air temperature and wind"})
+CONNECTIONS = Registry("connection", {
+    "east": "the east sub-panel alone",
+    "west": "the west sub-panel alone",
+    "parallel": "the sub-panels in parallel at one operating voltage",
+    "series": "the sub-panels in series at one current (bypass diodes)",
+    "independent": "each sub-panel at its own maximum power point (two converters)",
+    "switching": "the best of east, west, parallel and series at each step (a reconfigurable switch)"})
+TRACKERS = Registry("tracker", {
+    "dual-axis": "ideal: the normal always on the sun (Shin et al. Sec. IV-A)",
+    "equatorial": "a polar daily axis following the hour angle, the seasonal axis set daily (Alexandru)",
+    "dual-axis-steps": "the equatorial mount moved in N equal open-loop steps a day (Alexandru's law)",
+    "single-axis": "pvlib's single-axis tracker: a N-S axis, optionally tilted, optional backtracking"})
+DRIVES = Registry("drive", {
+    "motor": "Robles Algarin et al.'s DC gear motor: the energy of each move from its speed and current",
+    "wh-per-degree": "a fixed energy per degree of rotation"})
+WEATHER_FORMATS = Registry("weather format", {
+    "tmy3": "NREL TMY3 CSV (pvlib.iotools.read_tmy3)",
+    "epw": "EnergyPlus weather (pvlib.iotools.read_epw)",
+    "pvgis": "PVGIS typical meteorological year, CSV or JSON (pvlib.iotools.read_pvgis_tmy)"})
+INTERVAL_LABELS = Registry("interval label", {
+    "start": "a timestamp marks the start of its interval",
+    "end": "a timestamp marks the end of its interval",
+    "centre": "a timestamp marks the centre of its interval"})
+HOTTEL_CLIMATES = Registry("hottel climate", {
+    "tropical": "Hottel's tropical correction factors",
+    "midlatitude-summer": "Hottel's mid-latitude summer correction factors",
+    "subarctic-summer": "Hottel's subarctic summer correction factors",
+    "midlatitude-winter": "Hottel's mid-latitude winter correction factors"})
+ENGINES = Registry("engine", {
+    "numba": "the compiled kernel",
+    "numpy": "the NumPy reference path the kernel is tested against"})
+OUTPUT_FORMATS = Registry("format", {
+    "table": "a short answer on the terminal",
+    "json": "one JSON document of the answer and its rows"})
+#: Every registry, in the order the docs list them.
+REGISTRIES = (MODES, GEOMETRIES, SKIES, TRANSPOSITIONS, IAMS, PV_MODELS, TEMPERATURE_MODELS, CONNECTIONS,
+              TRACKERS, DRIVES, WEATHER_FORMATS, INTERVAL_LABELS, HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS)
 
 #: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.physics.trackers).
 #: His 12 actuating times (local time) pair up symmetrically about 13.319 h: 8.839/17.799,
@@ -62,10 +161,31 @@ def _squash(name: str) -> str:
 def canonical(value, names, field: str = "name"):
     """foldopt's name for ``value`` among ``names``, accepting pvlib's and other spellings.
 
+    Parameters
+    ----------
+    value : str or object
+        A spelling; anything but a string is returned as it is (for the validator that follows).
+    names : sequence of str
+        The valid names, e.g. a :class:`Registry`.
+    field : str, default 'name'
+        Not used (no caller passes it).
+
+    Returns
+    -------
+    str
+        The member of ``names``.
+
     Raises
     ------
     ValueError
         Naming the valid names and, where a spelling is close to one, "did you mean ...".
+
+    Examples
+    --------
+    >>> canonical("singlediode", PV_MODELS)
+    'single-diode'
+    >>> canonical("SingleAxis", TRACKERS)
+    'single-axis'
     """
     if not isinstance(value, str):
         return value

@@ -5,7 +5,8 @@ import subprocess
 
 import pytest
 
-from foldopt.inputs.config import default_study_path, load_study
+from foldopt.inputs.load import default_study_path
+from foldopt.inputs.plan import load_study
 
 
 @pytest.fixture(scope="session")

@@ -36,7 +36,8 @@ def test_equal_irradiance_parallel_and_series_are_twice_one(model, poa):
 # Practically dark cells, for which pvlib's v_from_i returns NaN or absurd voltages.
 @example(poa_east=1.0, poa_west=1.7e-44, temp=38.0, bypass=False)
 @example(poa_east=0.0, poa_west=1.03e-134, temp=69.0, bypass=False)
-def test_single_converter_never_beats_independent_and_switching_beats_its_states(model, poa_east, poa_west, temp, bypass):
+def test_single_converter_never_beats_independent_and_switching_beats_its_states(model, poa_east, poa_west, temp,
+                                                                                  bypass):
     east, west = curves(model, poa_east, poa_west, temp)
     p_east, p_west = east.max_power(), west.max_power()
     p_parallel, p_series = pair_powers(east, west, bypass)

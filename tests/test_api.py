@@ -17,7 +17,7 @@ import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
 import foldopt  # noqa: E402
-from foldopt.inputs.config import make_plan  # noqa: E402
+from foldopt.inputs.plan import make_plan  # noqa: E402
 from foldopt.studies.sweeps import run_plan  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -34,7 +34,8 @@ def test_every_public_name_resolves_and_is_documented(name):
 
 def test_import_stays_light():
     """The command line's help must not pay for pandas or pvlib: `import foldopt` loads neither."""
-    code = "import sys, foldopt; print(sorted(m for m in ('pandas', 'pvlib', 'numba', 'matplotlib') if m in sys.modules))"
+    code = ("import sys, foldopt; "
+            "print(sorted(m for m in ('pandas', 'pvlib', 'numba', 'matplotlib') if m in sys.modules))")
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "[]"
 
 
@@ -88,3 +89,31 @@ def test_write_makes_the_command_lines_folder(tmp_path):
     result = foldopt.run(foldopt.default_study())
     out = foldopt.write(result, tmp_path / "study")
     assert {"summary.csv", "sweep.csv", "timeseries.csv", "run.json", "report.html"} <= {p.name for p in out.iterdir()}
+
+
+def test_a_tracker_option_its_model_does_not_read_is_refused():
+    study = foldopt.default_study()  # a dual-axis tracker
+    with pytest.raises(foldopt.ConfigError, match=r"tracker.gcr = 0.9: is only used by tracker.model single-axis"):
+        study.variant(tracker={"gcr": 0.9})
+    with pytest.raises(foldopt.ConfigError, match=r"tracker.backtrack = True: is only used by tracker.model"):
+        foldopt.sweep(study, axes={"tracker.backtrack": [True, False]})
+    single = study.variant(tracker={"model": "single-axis", "gcr": 0.9, "backtrack": True})
+    assert (single.tracker.gcr, single.tracker.backtrack) == (0.9, True)
+    with pytest.raises(foldopt.ConfigError, match=r"tracker.steps = 10: is only used by tracker.model dual-axis-steps"):
+        single.variant(tracker={"steps": 10})
+
+
+def test_a_study_built_in_python_has_its_files_read_by_the_api():
+    """The models open no files: a weather file's site is read where the API runs the study."""
+    weather = str(ROOT / "configs" / "weather" / "723170TYA.CSV")
+    fields = {"name": "g", "weather": weather, "date": "2025-06-21", "p_load": 2.0, "panel": {"area": 0.108},
+              "step_min": 60, "fold_angles": {"start": 30, "stop": 180, "step": 30}}
+    study = foldopt.Study(**fields)
+    assert study.site is None  # the file's site, unread
+    with pytest.raises(foldopt.ConfigError, match="weather: the file is not read yet"):
+        study.resolved()
+    result = foldopt.run(study)
+    assert (result.study.site.name, result.study.site.latitude) == ("GREENSBORO PIEDMONT TRIAD INT", 36.1)
+    far = foldopt.Study(**fields, site={"latitude": 0.0, "longitude": 0.0})
+    with pytest.raises(foldopt.ConfigError, match="km from the weather file's site GREENSBORO"):
+        foldopt.run(far)

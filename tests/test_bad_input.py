@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from foldopt.cli.app import app
-from foldopt.inputs.config import default_study_path
+from foldopt.inputs.load import default_study_path
 
 runner = CliRunner()
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
@@ -89,6 +89,11 @@ VALUES = [
     ("year", ["sweep", "day", "--year", "1800"], ["--year", "[1901, 2099]"]),
     ("albedo", ["sweep", "angle", "--mode", "exact", "--sky", "ineichen", "--albedo", "2"], ["--albedo", "[0, 1]"]),
     ("idle-climate", ["sweep", "angle", "--climate", "tropical"], ["--climate", "only used by sky hottel"]),
+    # A tracker option the model does not read is refused like any idle setting (physics.trackers.TRACKER_MODELS).
+    ("idle-tracker-gcr", ["sweep", "angle", "--set", "tracker.gcr=0.9"],
+     ["error: tracker.gcr = 0.9", "only used by tracker.model single-axis"]),
+    ("idle-tracker-steps", ["sweep", "angle", "--tracker", "single-axis", "--set", "tracker.steps=10"],
+     ["error: tracker.steps = 10", "only used by tracker.model dual-axis-steps"]),
     ("paper-perez", ["sweep", "angle", "--mode", "paper", "--transposition", "perez"], ["paper mode is beam-only"]),
     ("set-no-value", ["sweep", "angle", "--set", "albedo"], ["--set", "KEY=VALUE"]),
     ("set-unknown", ["sweep", "angle", "--set", "panel.colour=red"], ["panel.colour", "unknown field"]),
@@ -144,7 +149,8 @@ YAML_FILES = [
     ("malformed", "name: x\nsite: [1, 2\n", ["line", "bad.yaml"]),
     ("a-list", "- just\n- a list\n", ["expected a mapping"]),
     ("empty", "", ["expected a mapping"]),
-    ("missing-site", yaml.safe_dump({k: v for k, v in FAST.items() if k != "site"}), ["site", "required field is missing"]),
+    ("missing-site", yaml.safe_dump({k: v for k, v in FAST.items() if k != "site"}),
+     ["site", "required field is missing"]),
     ("unknown-field", fast_yaml(colour="red"), ["colour", "unknown field"]),
     ("aliases", "a: &a [1, 2]\nb: [*a, *a]\nname: x\n", ["aliases", "line 2"]),
     ("billion-laughs", "a: &a [lol, lol, lol, lol, lol, lol, lol, lol, lol]\nb: &b [*a, *a, *a, *a, *a, *a]\n"
@@ -157,6 +163,8 @@ YAML_FILES = [
     ("big", "name: x\n" + "#" * 1_100_000 + "\n", ["bytes", "at most 1,000,000"]),
     ("binary", b"\xff\xfe\x00name: x\n", ["config", "cannot read"]),
     ("sweep-list", fast_yaml(sweep=[1, 2]), ["sweep", "mapping"]),
+    ("idle-tracker-option", fast_yaml(tracker={"model": "equatorial", "backtrack": True}),
+     ["tracker.backtrack = True", "only used by tracker.model single-axis"]),
     ("huge-range", fast_yaml(p_load="1:2000000:1"), ["p_load", "at most 10,000 per axis"]),
     ("huge-plan", fast_yaml(step_min=1, fold_angles={"start": 0.1, "stop": 180, "step": 0.1},
                             site={"latitude": "-60:60:0.1", "longitude": 0}, date="1:365:30"),
@@ -267,6 +275,18 @@ def test_bad_output_folders(place, make, words):
     args = make(place)
     before = snapshot(place / "prior")
     assert_clean_failure(runner.invoke(app, args), words, place, before)
+
+
+def test_every_tracker_option_is_a_field_of_one_model():
+    """The registry the study's idle check reads names the models a study may choose, and options
+    the tracker has; every model option belongs to some model."""
+    from foldopt import names
+    from foldopt.inputs.sections import Tracker
+    from foldopt.physics.trackers import TRACKER_MODELS, TrackerOptions
+
+    assert tuple(TRACKER_MODELS) == tuple(names.TRACKERS)
+    used = {option for entry in TRACKER_MODELS.values() for option in entry.options}
+    assert used == set(TrackerOptions.__dataclass_fields__) and used <= set(Tracker.model_fields)
 
 
 def test_the_battery_is_large_enough():

@@ -8,7 +8,7 @@ import yaml
 from typer.testing import CliRunner
 
 from foldopt.cli.app import app
-from foldopt.inputs.config import default_study_path
+from foldopt.inputs.load import default_study_path
 from foldopt.studies.reproduce import PAPER_VALUES
 
 runner = CliRunner()
@@ -50,7 +50,8 @@ def test_run_default_study_writes_the_whole_folder(tmp_path):
     assert {p.name for p in out.iterdir()} == FOLDER
     summary = pd.read_csv(out / "summary.csv")
     assert list(summary["design"])[:5] == ["flat", "twofold", "twofold-heuristic", "tracker", "tracker-net"]
-    assert {"tracker:dual-axis-steps", "tracker:dual-axis-steps-net", "tracker:single-axis-net"} <= set(summary["design"])
+    assert ({"tracker:dual-axis-steps", "tracker:dual-axis-steps-net", "tracker:single-axis-net"}
+            <= set(summary["design"]))
     meta = json.loads((out / "run.json").read_text())
     assert meta["mode"] == "paper" and meta["study"]["geometry"] == "azimuth-split"
     assert meta["study"]["p_load"] == pytest.approx(4.398)

@@ -90,7 +90,8 @@ def test_size_finds_the_net_benefit_optimum(tmp_path):
     [
         (["sweep", "latitude", "--lat", "10:0:5", "--p-load", "2", "--days", "2025-03-20"], ["--lat", "empty range"]),
         (["sweep", "latitude", "--lat", "-95:0:5", "--p-load", "2", "--days", "2025-03-20"], ["--lat[0]", "[-90, 90]"]),
-        (["sweep", "load", "--lat", "10", "--p-load", "-2:4:1", "--days", "2025-03-20"], ["--p-load[0,1,2] = -2.0, -1.0, 0.0", "(0, 1e+06]"]),
+        (["sweep", "load", "--lat", "10", "--p-load", "-2:4:1", "--days", "2025-03-20"],
+         ["--p-load[0,1,2] = -2.0, -1.0, 0.0", "(0, 1e+06]"]),
         (["sweep", "load", "--lat", "10", "--p-load", "3", "--days", "2025-03-20"], ["--p-load", "range"]),
         (["sweep", "day", "--lat", "10", "--p-load", "2", "--days", "300:20:7"], ["--days/--date", "empty range"]),
         (["sweep", "angle", "--lat", "10", "--p-load", "2", "--days", "2025-03-20", "--angle-step", "200"],

@@ -95,7 +95,7 @@ def test_embedded_map_equals_the_computation_without_dask(embedded):
     sites = embedded.drop_duplicates("site_id")
     spec_sites = [{"latitude": lat, "longitude": lon, "site_id": i}
                   for i, (lat, lon) in enumerate(zip(sites["latitude"], sites["longitude"], strict=True))]
-    from foldopt.inputs.config import default_study_path, read_study
+    from foldopt.inputs.load import default_study_path, read_study
     from foldopt.studies.worldmap import map_study
 
     study = map_study(read_study(default_study_path())[0], **{"panel.area": 0.108, "objective": {"statistic": "mean"}})

@@ -1,28 +1,147 @@
-"""The documentation builds with warnings as errors, running its worked examples, and the example
-notebook runs and reproduces the paper's headline numbers."""
+"""The manual builds from the installed package, with warnings as errors, from a copy of docs/
+outside the source tree; its references hold every command-line option and every study field;
+the README stays a short front page whose tables and figures match the committed examples; the
+example notebook runs and reproduces the paper's headline numbers."""
 
 from __future__ import annotations
 
+import csv
+import filecmp
+import html
+import re
+import shutil
 import subprocess
 import sys
+import typing
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+PAGES = ("index", "quickstart", "cli", "study-file", "outputs", "api", "reproduction", "physics", "performance",
+         "reliability", "architecture", "examples/paper", "examples/weather_year", "examples/camera_profile",
+         "examples/design_map", "examples/world_map", "examples/configs")
 
 
-def test_docs_build_without_warnings(tmp_path):
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """The HTML manual, built from a copy of docs/ with the working folder outside the source tree."""
     pytest.importorskip("sphinx")
     pytest.importorskip("numpydoc")
-    built = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
-                            "-d", str(tmp_path / "doctrees"), str(ROOT / "docs"), str(tmp_path / "html")],
-                           capture_output=True, text=True, timeout=600)
-    assert built.returncode == 0, built.stderr[-3000:]
-    for page in ("index", "api", "physics", "reproduction", "examples/paper", "examples/weather_year",
-                 "examples/design_map"):
-        assert (tmp_path / "html" / f"{page}.html").exists(), page
-    assert len(list((tmp_path / "html" / "_images").glob("*-1.png"))) == 3  # the examples ran
+    work = tmp_path_factory.mktemp("docs")
+    shutil.copytree(ROOT / "docs", work / "docs", ignore=shutil.ignore_patterns("_build", "generated"))
+    result = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
+                             "-d", str(work / "doctrees"), str(work / "docs"), str(work / "html")],
+                            cwd=work, capture_output=True, text=True, timeout=900)
+    assert result.returncode == 0, result.stderr[-3000:]
+    return work / "html"
+
+
+def _first_cells(page: str) -> set[str]:
+    """The text of the first cell of every table row of an HTML page (an option, a field)."""
+    rows = re.findall(r"<tr[^>]*>\s*<td[^>]*>(.*?)</td>", page, flags=re.S)
+    return {" ".join(html.unescape(re.sub(r"<[^>]+>", " ", cell)).split()) for cell in rows}
+
+
+def _commands(command, path):
+    """(path, click command) of the command line and every subcommand."""
+    yield path, command
+    for name, sub in getattr(command, "commands", {}).items():
+        yield from _commands(sub, [*path, name])
+
+
+def _fields(model, prefix=""):
+    """Every dotted field path of a study, nested mappings included."""
+    from pydantic import BaseModel
+
+    for name, field in model.model_fields.items():
+        yield prefix + name
+        pending = [field.annotation]
+        while pending:
+            annotation = pending.pop()
+            if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+                yield from _fields(annotation, f"{prefix}{name}.")
+            else:
+                pending += [arg for arg in typing.get_args(annotation) if not isinstance(arg, (str, int))]
+
+
+def test_every_page_builds_and_the_examples_run(built):
+    for page in PAGES:
+        assert (built / f"{page}.html").exists(), page
+    assert len(list((built / "_images").glob("*-1.png"))) == 3  # the three plot examples ran
+    reproduction = (built / "reproduction.html").read_text(encoding="utf-8")
+    assert "4.398" in reproduction and "4.693" in reproduction  # foldopt.reproduce() ran at build time
+
+
+def test_the_cli_reference_holds_every_command_and_option(built):
+    import typer.main
+
+    from foldopt.cli.app import app
+
+    page = (built / "cli.html").read_text(encoding="utf-8")
+    starts = [match.start() for match in re.finditer(r'<section id="cli-', page)] + [len(page)]
+    missing = []
+    for path, command in _commands(typer.main.get_command(app), ["foldopt"]):
+        ident = f'<section id="cli-{"-".join(path)}">'
+        assert ident in page, " ".join(path)
+        begin = page.index(ident)
+        own = page[begin:min(start for start in starts if start > begin)]
+        shown = {name for cell in _first_cells(own) for name in cell.split(", ")}
+        missing += [f"{' '.join(path)} {name}" for param in command.params
+                    for name in [*param.opts, *param.secondary_opts] if name not in shown]
+    assert missing == []
+
+
+def test_the_study_file_reference_holds_every_field(built):
+    import foldopt
+
+    shown = _first_cells((built / "study-file.html").read_text(encoding="utf-8"))
+    fields = list(_fields(foldopt.Study))
+    assert len(fields) > 60
+    assert [field for field in fields if field not in shown] == []
+
+
+def test_the_docs_figures_are_the_committed_examples():
+    copies = sorted((ROOT / "docs" / "_static" / "examples").rglob("*.png"))
+    assert copies
+    for copy in copies:
+        committed = ROOT / "results" / "examples" / copy.relative_to(ROOT / "docs" / "_static" / "examples")
+        assert filecmp.cmp(copy, committed, shallow=False), f"cp {committed} {copy}"
+
+
+def test_the_readme_is_a_front_page():
+    lines = README.splitlines()
+    assert len(lines) <= 200
+    commands = [line for line in lines if line and not line.startswith("#")][:4]
+    assert commands == ["```bash", "pip install . && foldopt run --overwrite",
+                        "pip install '.[test]' && python -m pytest", "```"]
+    for target in re.findall(r"\]\(([^)#\s]+)", README) + re.findall(r'src="([^"]+)"', README):
+        if "://" not in target:
+            assert (ROOT / target).exists(), target
+    assert len(re.findall(r"!\[[^\]]*\]\(", README)) == 1  # one figure
+
+
+def test_the_readme_reproduction_table_is_the_committed_one():
+    tables = {}
+    for name in ("reproduction", "reproduction_single_diode"):
+        with open(ROOT / "results" / "examples" / "reproduction" / f"{name}.csv", newline="") as file:
+            tables[name] = {row["quantity"]: row for row in csv.DictReader(file)}
+    rows = {cells[0].strip("` "): cells for cells in
+            ([cell.strip() for cell in line.strip("|").split("|")] for line in README.splitlines()
+             if line.startswith("| `"))}
+    assert set(tables["reproduction"]) <= set(rows)
+    for quantity, row in tables["reproduction"].items():
+        shown = rows[quantity][2:7]
+        committed = [row["paper"], row["paper_mode"], row["exact_mode"],
+                     tables["reproduction_single_diode"][quantity]["paper_mode"],
+                     tables["reproduction_single_diode"][quantity]["exact_mode"]]
+        for text, value in zip(shown, committed):
+            if text == "–":
+                assert value == "", quantity
+            else:
+                digits = len(text.partition(".")[2])
+                assert round(float(value), digits) == pytest.approx(float(text)), (quantity, text, value)
 
 
 def test_example_notebook_runs():

@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from foldopt.engine import rows as engine
-from foldopt.inputs.config import Site, make_study
+from foldopt.inputs.sections import Site
+from foldopt.inputs.study import make_study
 from foldopt.engine.metrics import t_solar, t_solar_contiguous
 from foldopt.engine.sky import build_sky
 
@@ -181,7 +182,7 @@ def test_blocks_of_many_sites_and_time_zones_equal_their_own_skies():
 
 
 def test_run_plan_is_the_same_on_both_engines():
-    from foldopt.inputs.config import make_plan
+    from foldopt.inputs.plan import make_plan
     from foldopt.studies.sweeps import run_plan
 
     plan = make_plan({"name": "t", "mode": "exact", "site": {"latitude": [-20.0, 45.0], "longitude": 10.0},

@@ -8,7 +8,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from foldopt.physics.connections import connection_power
-from foldopt.inputs.config import make_study
+from foldopt.inputs.study import make_study
 from foldopt.physics.geometry import subpanel_orientation
 from foldopt.physics.irradiance import beam_incidence_factor
 from foldopt.engine.metrics import t_solar

@@ -13,9 +13,11 @@ from hypothesis import strategies as st
 
 from foldopt.engine import rows as engines
 from foldopt.api import default_study, run
-from foldopt.inputs.config import LoadProfile, make_study
+from foldopt.inputs.sections import LoadProfile
+from foldopt.inputs.study import make_study
 from foldopt.errors import ConfigError
-from foldopt.inputs.loads import load_shape, read_profile
+from foldopt.inputs.loads import load_shape
+from foldopt.inputs.load import read_profile
 from foldopt.engine.metrics import energy_served, t_solar
 from foldopt.studies.designs import Blocks, fold_hours
 
@@ -124,7 +126,7 @@ def test_bad_profiles(tmp_path):
 
 
 def test_a_constant_profile_sweep_is_the_constant_load_sweep():
-    from foldopt.inputs.config import make_plan
+    from foldopt.inputs.plan import make_plan
     from foldopt.studies.sweeps import run_plan
 
     data = {**EXACT.model_dump(mode="json", exclude_none=True), "date": [d.isoformat() for d in DAYS[:4]],

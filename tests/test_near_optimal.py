@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import foldopt
-from foldopt.inputs.config import NearOptimal
+from foldopt.inputs.sections import NearOptimal
 from foldopt.studies.designs import near_optimal
 
 

@@ -180,6 +180,50 @@ def test_six_site_map(tmp_path):
     no_old_names(folder, document)
 
 
+@pytest.mark.parametrize("option,parameter,value", [
+    ("--cost-per-m2", "cost_per_m2", 1e308), ("--cost-per-m2", "cost_per_m2", float("nan")),
+    ("--cost-per-w", "cost_per_w", 0.0), ("--c-grid", "c_grid", 1e306), ("--years", "years", -1.0),
+    ("--days-per-year", "days_per_year", 367.0),
+])
+def test_size_refuses_what_the_api_refuses(option, parameter, value):
+    """One limit of the sizing (foldopt.studies.request.SIZING_LIMITS), whichever way it is asked: the
+    command line's line is the API's, said with the option's name."""
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    shown = CliRunner().invoke(app, ["size", option, repr(value)])
+    with pytest.raises(foldopt.ConfigError) as refused:
+        foldopt.size(foldopt.default_study(), **{parameter: value})
+    [line] = refused.value.errors
+    assert shown.exit_code == 2 and shown.stdout == ""
+    assert shown.stderr == f"error: {option}{line[line.index(' = '):]}\n"
+    assert "must be a finite number > 0 and at most" in line
+
+
+def test_grid_map_request_is_the_api_request(tmp_path):
+    """A map of a grid at the study's load through the command line, and the same request made with
+    foldopt.studies.request.map_request_from and run by foldopt.world_map: the same rows to the bit, the
+    same answer, the same things taken from the study."""
+    from foldopt.studies.request import map_request_from
+
+    document, _, _ = cli(tmp_path, "map", "--lat", "0,40", "--lon", "30", "--workers", "1", "--step-min", "60",
+                         "--angle-step", "30")
+    request = map_request_from(latitudes="0,40", longitudes="30", step_min=60.0, angle_step=30.0)
+    assert [(site["latitude"], site["longitude"]) for site in request.sites] == [(0.0, 30.0), (40.0, 30.0)]
+    result, _, answer = foldopt.world_map(request.sites, request.loads, tmp_path / "api", request.study,
+                                          request.relative, request.year, workers=1, defaults=request.defaults)
+    same_rows(document, result.table[result.table["period"] == "year"].reset_index(drop=True))
+    api = json.loads(json.dumps(answer.to_dict()))
+    for key in ("kind", "designs", "near_optimal", "notes"):
+        assert document["answer"][key] == api[key], key
+    run = ("dashboard", "seconds")  # the cluster's, not the map's
+    assert ({k: v for k, v in document["answer"]["result"].items() if k not in run}
+            == {k: v for k, v in api["result"].items() if k not in run})
+    assert document["answer"]["defaults"]["taken"] == request.defaults["taken"]
+    assert "P_load 4.398 W" in request.defaults["taken"]
+
+
 def test_variant_merges_sections_and_speaks_in_config_errors():
     study = foldopt.default_study()
     smaller = study.variant(panel={"area": 0.1})
@@ -198,7 +242,8 @@ def test_variant_merges_sections_and_speaks_in_config_errors():
 def test_every_written_column_is_in_the_vocabulary_and_the_manual(tmp_path):
     from foldopt.output.columns import describe, rst_table
 
-    assert (ROOT / "docs" / "columns.rst").read_text() == rst_table()  # python -m foldopt.output.columns > docs/columns.rst
+    # python -m foldopt.output.columns > docs/columns.rst
+    assert (ROOT / "docs" / "columns.rst").read_text() == rst_table()
     folders = [path.parent for path in (ROOT / "results" / "examples").rglob("run.json")]
     assert len(folders) >= 10
     unknown = set()

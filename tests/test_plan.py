@@ -4,7 +4,7 @@ import datetime as dt
 
 import pytest
 
-from foldopt.inputs.config import load_plan, make_plan, parse_dates, parse_range
+from foldopt.inputs.plan import load_plan, make_plan, parse_dates, parse_range
 from foldopt.errors import ConfigError
 
 BASE = {"name": "t", "site": {"latitude": 10, "longitude": 0}, "date": "2025-03-20",
@@ -86,6 +86,7 @@ def test_wrong_types_and_limits():
         make_plan({**BASE, "site": {"latitude": "-90:90:0.001", "longitude": 0}})
     with pytest.raises(ConfigError, match=r"sweep: 260,281 cases; the limit is 200,000 \(FOLDOPT_MAX_CASES"):
         make_plan({**BASE, "site": {"latitude": "-90:90:0.5", "longitude": "-180:180:0.5"}})
-    with pytest.raises(ConfigError, match=r"110,492 site-days x 180 fold angles x 1,440 steps = 2.9e\+10 evaluations; the limit is 2e\+10"):
+    with pytest.raises(ConfigError, match=r"110,492 site-days x 180 fold angles x 1,440 steps = 2.9e\+10 "
+                                          r"evaluations; the limit is 2e\+10"):
         make_plan({**BASE, "site": {"latitude": "-60:60:0.1", "longitude": 0}, "date": "1:365:4",
                    "fold_angles": {"start": 1, "stop": 180, "step": 1}, "step_min": 1})

@@ -10,7 +10,7 @@ import pvlib
 import pytest
 
 from foldopt.engine import rows as engine
-from foldopt.inputs.config import make_plan
+from foldopt.inputs.plan import make_plan
 from foldopt.engine.sky import build_sky
 from foldopt.studies.designs import sky_tracker_orientation
 

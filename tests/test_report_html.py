@@ -23,7 +23,8 @@ COMMANDS = {
     "reproduce": ["reproduce"],
     "map": ["map", "--lat", "0,40", "--lon", "0", "--p-load", "2", *QUICK, "--workers", "1"],
 }
-CHROMIUM = next((shutil.which(name) for name in ("chromium", "chromium-browser", "google-chrome") if shutil.which(name)),
+CHROMIUM = next((shutil.which(name) for name in ("chromium", "chromium-browser", "google-chrome")
+                 if shutil.which(name)),
                 None)
 
 

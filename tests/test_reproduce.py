@@ -64,4 +64,5 @@ def test_single_diode_reproduces_the_papers_twofold_numbers_closely(single_diode
     # closer to the paper than with the ideal model (measured: 9.49 h, +22.8 %, 2.61).
     for quantity in ("t_solar_twofold_h", "twofold_gain_vs_flat_pct", "flat_area_multiple"):
         paper = table.loc[quantity, "paper"]
-        assert abs(single_diode_table.loc[quantity, "paper_mode"] - paper) < abs(table.loc[quantity, "paper_mode"] - paper)
+        assert (abs(single_diode_table.loc[quantity, "paper_mode"] - paper)
+                < abs(table.loc[quantity, "paper_mode"] - paper))

@@ -93,7 +93,7 @@ def test_a_weather_year_schedule_agrees_with_the_annual_sweep():
     settings never do worse and never beat re-folding every day; flat and tracker as the sweep's."""
     from pathlib import Path
 
-    from foldopt.inputs.config import make_plan
+    from foldopt.inputs.plan import make_plan
     from foldopt.studies.designs import Blocks, fold_hours
     from foldopt.studies.sweeps import run_plan
 

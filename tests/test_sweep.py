@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from foldopt.inputs.config import make_plan
+from foldopt.inputs.plan import make_plan
 from foldopt.studies.day import run_study
 from foldopt.studies.sweeps import run_plan
 

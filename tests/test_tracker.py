@@ -7,7 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from foldopt.physics.atmosphere import extraterrestrial_normal, hottel_transmittance
-from foldopt.inputs.config import load_study, default_study_path
+from foldopt.inputs.load import default_study_path
+from foldopt.inputs.plan import load_study
 from foldopt.engine.metrics import t_solar
 from foldopt.studies.day import Day
 from foldopt.physics.trackers import ALEXANDRU_STEP_OFFSETS_H, TrackerDrive, step_law, tracker_orientation
@@ -82,7 +83,8 @@ def test_motor_drive_energy_grows_with_the_move():
     # Long moves approach the free-running cost: 12 V x 0.3 A over 653 x 90 deg at 78 rpm, plus start-up.
     speed = 5571.57 / 4288 * 360  # deg/s of the gear-motor output
     assert energy[3] > 12 * 0.3 * (653 * 90 / speed) / 3600
-    assert TrackerDrive(drive="wh-per-degree", wh_per_degree=0.01).move_energy_wh(np.array([10.0]))[0] == pytest.approx(0.1)
+    drive = TrackerDrive(drive="wh-per-degree", wh_per_degree=0.01)
+    assert drive.move_energy_wh(np.array([10.0]))[0] == pytest.approx(0.1)
 
 
 def test_hottel_against_duffie_beckman_example_2_8_1():

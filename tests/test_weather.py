@@ -7,7 +7,7 @@ import numpy as np
 import pvlib
 import pytest
 
-from foldopt.inputs.config import make_study
+from foldopt.inputs.study import make_study
 from foldopt.physics.geometry import subpanel_orientation
 from foldopt.studies.day import Day
 from foldopt.studies.sweeps import objective_value
@@ -84,7 +84,7 @@ def test_objective_statistics():
 
 
 def test_an_annual_objective_keeps_one_angle_all_year():
-    from foldopt.inputs.config import make_plan
+    from foldopt.inputs.plan import make_plan
     from foldopt.studies.sweeps import run_plan
 
     plan = make_plan({**BASE, "weather": str(TMY3), "date": "1:365:30", "p_load": [2.0, 4.0],
@@ -133,3 +133,14 @@ def test_epw_timestamps_move_to_interval_centres(tmp_path):
     hourly = weather_day(frame, dt.date(2025, 6, 22))
     for key in ("ghi", "dni", "dhi"):
         np.testing.assert_allclose(getattr(day, key).reshape(24, 60).mean(axis=1), hourly[key], rtol=1e-12, atol=1e-9)
+
+
+def test_the_formats_registry_is_the_names_a_study_accepts():
+    """A format is one module and one entry of FORMATS; validation and help read the names'."""
+    from foldopt import names
+    from foldopt.inputs.weather import FORMATS, weather_format
+
+    assert tuple(FORMATS) == tuple(names.WEATHER_FORMATS)
+    assert {entry.interval_label for entry in FORMATS.values()} <= set(names.INTERVAL_LABELS)
+    assert [weather_format(Path(f"x{suffix.upper()}")) for suffix in (".csv", ".epw", ".json", ".txt")] == [
+        "tmy3", "epw", "pvgis", "tmy3"]

@@ -12,7 +12,7 @@ import pvlib
 import pytest
 from test_weather_year import write_epw_year
 
-from foldopt.inputs.config import make_plan
+from foldopt.inputs.plan import make_plan
 from foldopt.errors import ConfigError
 from foldopt.studies.sweeps import run_plan
 from foldopt.inputs.weather import read_weather, weather_days, weather_site

@@ -11,12 +11,13 @@ import pvlib
 import pytest
 
 from foldopt.engine import rows as engine
-from foldopt.inputs.config import make_plan
+from foldopt.inputs.plan import make_plan
 from foldopt.errors import ConfigError
 from foldopt.engine.sky import build_sky
 from foldopt.studies.designs import sky_tracker_orientation
 from foldopt.studies.sweeps import run_plan
-from foldopt.inputs.weather import read_weather, sub_hourly, weather_site
+from foldopt.inputs.weather import read_weather, weather_site
+from foldopt.inputs.weather.downscale import sub_hourly
 
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"  # NREL TMY3 sample pvlib ships
 YEAR = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(365)]
@@ -154,7 +155,7 @@ def test_trackers_park_while_the_sun_is_down(greensboro):
 
 
 def test_annual_summary_has_the_years_totals(tmp_path):
-    from foldopt.output.report import write_sweep
+    from foldopt.output.folders import write_sweep
 
     plan = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": [2.0, 4.4],
                       "pv_model": "single-diode", "objective": {"statistic": "mean"},
@@ -170,7 +171,8 @@ def test_annual_summary_has_the_years_totals(tmp_path):
         assert row.energy_harvested_wh == pytest.approx(row.energy_served_wh + row.energy_wasted_wh)
         assert row.poa_kwh_m2 == pytest.approx(rows.poa_kwh_m2.sum())
         flat, tracker = summary.loc[(load, "flat")], summary.loc[(load, "tracker")]
-        assert row.energy_gain_vs_flat_pct == pytest.approx((row.energy_harvested_wh / flat.energy_harvested_wh - 1) * 100)
+        gain = (row.energy_harvested_wh / flat.energy_harvested_wh - 1) * 100
+        assert row.energy_gain_vs_flat_pct == pytest.approx(gain)
         assert row.pct_of_tracker == pytest.approx(row.mean_t_solar_h / tracker.mean_t_solar_h * 100)
     # The flat panel's year on the plane of its array: the tilted Perez sum of the file.
     assert summary.loc[(2.0, "flat"), "poa_kwh_m2"] == pytest.approx(1776, abs=5)

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from foldopt.inputs.config import make_plan
+from foldopt.inputs.plan import make_plan
 from foldopt.errors import ConfigError
 from foldopt.studies.sweeps import run_plan
 from foldopt.studies.worldmap import PERIODS, SEASONS, evaluate_sites, grid_sites, map_study, read_sites
@@ -42,9 +42,10 @@ def test_year_rows_equal_the_annual_sweep(la_map):
         assert row["fold_angle_deg"] == means.loc[(load, "twofold"), "fold_angle_deg"]
         for design in ("flat", "twofold", "tracker"):
             assert row[f"mean_t_solar_{design}_h"] == pytest.approx(means.loc[(load, design), "t_solar_h"], abs=1e-9)
-            assert row[f"energy_harvested_{design}_wh"] == pytest.approx(means.loc[(load, design), "energy_harvested_wh"],
-                                                                rel=1e-12)
-        assert row["mean_t_solar_tracker_net_h"] == pytest.approx(means.loc[(load, "tracker-net"), "t_solar_h"], abs=1e-9)
+            expected = means.loc[(load, design), "energy_harvested_wh"]
+            assert row[f"energy_harvested_{design}_wh"] == pytest.approx(expected, rel=1e-12)
+        expected = means.loc[(load, "tracker-net"), "t_solar_h"]
+        assert row["mean_t_solar_tracker_net_h"] == pytest.approx(expected, abs=1e-9)
         # The flat panel's peak over the year is the largest of its daily peaks.
         assert row["flat_peak_w"] == pytest.approx(table[table["design"] == "flat"]["peak_power_w"].max(), rel=1e-12)
 

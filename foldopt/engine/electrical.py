@@ -15,7 +15,7 @@ error against it.
 
 Tables are kept on disk, named by a hash of everything they depend on (the PV unit's parameters,
 the sub-panel area, the temperature settings, the nodes, pvlib's version and
-:data:`TABLE_FORMAT`), in ``$FOLDOPT_CACHE_DIR`` or the user cache folder (:func:`foldopt.files.cache_dir`); a second process loads
+:data:`TABLE_FORMAT`), in foldopt's cache folder (:func:`foldopt.files.cache_dir`); a second process loads
 them instead of solving I-V curves again. A cache file ends with a checksum of its content
 (:func:`store_cache`): a damaged one is built again, with a notice. A cache that cannot be written
 is skipped.
@@ -80,16 +80,18 @@ class Electrical:
     Parameters
     ----------
     pv : PVModel
+        The electrical model of a sub-panel.
     subpanel_area : float
         Area of one sub-panel [m^2].
-    temp_air, wind_speed : float
+    temp_air, wind_speed : float, default 25 and 1
         [C], [m/s], constant over the study.
     temperature_model : {'fixed', 'sapm'}
-    bypass, switch_series : bool
+        :func:`foldopt.physics.pvmodel.cell_temperature`'s model.
+    bypass, switch_series : bool, default True and False
         Bypass diodes in series; series as a switching state.
-    converter_efficiency : float
-        Efficiency of each converter of the independent architecture.
-    exact : bool
+    converter_efficiency : float, default 1
+        Efficiency of each converter of the independent architecture [-].
+    exact : bool, default False
         Solve every step's I-V curves instead of interpolating the tables.
     """
 
@@ -114,7 +116,18 @@ class Electrical:
         return cell_temperature(poa, self.temp_air, self.wind_speed, self.temperature_model)
 
     def cache_key(self, name: str) -> str:
-        """Hash of everything table ``name`` depends on."""
+        """Hash of everything a table depends on, which names its cache file.
+
+        Parameters
+        ----------
+        name : {'subpanel', 'parallel', 'series'}
+            The table.
+
+        Returns
+        -------
+        str
+            32 hexadecimal digits.
+        """
         settings = (TABLE_FORMAT, name, self.pv.model, repr(self.pv.unit), self.pv.unit_area, self.subpanel_area,
                     self.temp_air, self.wind_speed, self.temperature_model, IRRADIANCE_MAX, TABLE_NODES_1D,
                     TABLE_NODES_2D, TABLE_NODES_RATIO, pvlib.__version__)
@@ -161,11 +174,35 @@ class Electrical:
         return fraction
 
     def subpanel_power(self, poa):
-        """Maximum power of one sub-panel [W] at irradiance ``poa`` [W/m^2] (any shape)."""
+        """Maximum power of one sub-panel.
+
+        Parameters
+        ----------
+        poa : array_like
+            Plane-of-array irradiance [W/m^2], any shape.
+
+        Returns
+        -------
+        numpy.ndarray
+            [W], shaped as ``poa``.
+        """
         return self.panel_power(poa, self.subpanel_area)
 
     def panel_power(self, poa, area):
-        """Maximum power [W] of a panel of ``area`` [m^2]: ``area / subpanel_area`` sub-panels in series."""
+        """Maximum power of a panel of ``area / subpanel_area`` sub-panels in series.
+
+        Parameters
+        ----------
+        poa : array_like
+            Plane-of-array irradiance [W/m^2], any shape.
+        area : float
+            Panel area [m^2].
+
+        Returns
+        -------
+        numpy.ndarray
+            [W], shaped as ``poa``.
+        """
         poa = np.asarray(poa, dtype=float)
         if self.exact or not self.pv.has_iv:
             return self.pv.max_power(poa, self._temperature(poa), area)
@@ -173,10 +210,24 @@ class Electrical:
         return _linear(p1, _node_position(poa, TABLE_NODES_1D)) * (area / self.subpanel_area)
 
     def connections(self, poa_east, poa_west, series: bool = True, with_state: bool = True):
-        """Every connection's power [W] and the switching state, as :func:`connection_powers`.
+        """Every connection's power and the switching state, as :func:`connection_powers`.
 
-        With ``series`` false the series power is left NaN (and its table unbuilt), for callers
-        whose connection and switch do not use it; ``with_state`` false skips the switch state.
+        Parameters
+        ----------
+        poa_east, poa_west : array_like
+            Each sub-panel's plane-of-array irradiance [W/m^2], broadcast.
+        series : bool, default True
+            Whether to work out the series power; without, it is left NaN (and its table
+            unbuilt), for callers whose connection and switch do not use it.
+        with_state : bool, default True
+            Whether to work out the switch state.
+
+        Returns
+        -------
+        powers : dict of numpy.ndarray
+            Power [W] per name of :data:`foldopt.names.CONNECTIONS`.
+        state : numpy.ndarray of int or None
+            Index into :data:`foldopt.physics.connections.SWITCH_STATES` per step.
         """
         options = {**self._options, "with_state": with_state}
         poa_east, poa_west = np.broadcast_arrays(np.asarray(poa_east, float), np.asarray(poa_west, float))

@@ -59,8 +59,31 @@ def _bilinear(values, first, second):
 
 @njit(cache=True)
 def iam_factor(cos_aoi, model, params):
-    """Incidence-angle modifier of the beam at ``cos(AOI)``: pvlib's ``iam.ashrae`` (``params[0]``
-    = b) or ``iam.physical`` without coating (n, K, L), the same arithmetic; 1 for ``IAM_NONE``."""
+    """Incidence-angle modifier of the beam, the arithmetic of pvlib's ``iam.ashrae`` and
+    ``iam.physical`` (without coating) for one angle.
+
+    Parameters
+    ----------
+    cos_aoi : float
+        Cosine of the angle of incidence [-].
+    model : int
+        ``IAM_NONE``, ``IAM_ASHRAE`` or ``IAM_PHYSICAL``.
+    params : (3,) float
+        ASHRAE: ``b`` [-] (then unused); physical: ``n`` [-], ``K`` [1/m], ``L`` [m].
+
+    Returns
+    -------
+    float
+        Modifier [-]; 0 for light from behind, 1 for ``IAM_NONE``.
+
+    References
+    ----------
+    .. [1] A. F. Souka, H. H. Safwat, "Determination of the optimum orientations for the double
+       exposure flat-plate collector and its reflections", Solar Energy 10, 170-174, 1966; ASHRAE
+       standard 93-77 (``1 - b (1 / cos(AOI) - 1)``).
+    .. [2] W. De Soto, S. A. Klein, W. A. Beckman, "Improvement and validation of a model for
+       photovoltaic array performance", Solar Energy 80(1), 78-88, 2006 (physical).
+    """
     if model == IAM_NONE:
         return 1.0
     if cos_aoi <= 0.0:
@@ -364,9 +387,26 @@ def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_nor
 @njit(cache=True, parallel=True)
 def curve_rows(power, row_loadset, loads, step_hours, contiguous, load_shape, use_shape, t_out, cont_out, energy_out,
                peak_out, above, whole, run):
-    """Daily metrics of given power curves, ``power`` (n_rows, n_steps) [W]; ``load_shape``
-    (n_rows, n_steps) with ``use_shape``; outputs and scratch as :func:`fold_rows` with one
-    connection."""
+    """Daily metrics of given power curves (a tracker's), as :func:`fold_rows` with one connection.
+
+    Parameters
+    ----------
+    power : (n_rows, n_steps) float
+        Power at step centres [W].
+    row_loadset : (n_rows,) int
+        Set of loads of each row.
+    loads : (n_loadsets, n_loads) float
+        Loads [W], ascending in each set.
+    step_hours : float
+        Step length [h].
+    contiguous : bool
+        Whether to track the longest contiguous interval too.
+    load_shape : (n_rows, n_steps) float
+        With ``use_shape``, each row's load profile [W] (one row (1, 1) without).
+    use_shape : bool
+    t_out, cont_out, energy_out, peak_out : outputs as :func:`fold_rows`'s, with one connection.
+    above, whole, run : per-chunk scratch from :func:`scratch`.
+    """
     n_rows = power.shape[0]
     n_chunks = above.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
@@ -379,8 +419,23 @@ def curve_rows(power, row_loadset, loads, step_hours, contiguous, load_shape, us
 
 
 def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):
-    """Outputs and per-chunk scratch of :func:`fold_rows` (``n_steps`` > 0) or :func:`curve_rows`
-    (``n_steps`` = 0), allocated here, outside the parallel loop."""
+    """Outputs and per-chunk scratch of :func:`fold_rows` or :func:`curve_rows`, allocated here,
+    outside the parallel loop.
+
+    Parameters
+    ----------
+    n_rows, n_conn, n_loads : int
+        Rows, connections and loads per set.
+    n_steps : int
+        Steps per day for :func:`fold_rows`; 0 for :func:`curve_rows`.
+    contiguous : bool
+        Whether the longest contiguous interval is tracked.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        The keyword arguments ``t_out`` ... ``run`` of the kernel.
+    """
     chunks = max(1, min(n_rows, get_num_threads() * CHUNKS_PER_THREAD))
     shape = (n_rows, n_conn)
     work = {

@@ -40,13 +40,49 @@ def t_solar(p_pv, p_load, step_hours):
         Load [W], broadcast against ``p_pv``'s leading axes.
     step_hours : float
         Step length [h].
+
+    Returns
+    -------
+    numpy.ndarray
+        ``t_solar`` [h], one per leading index (a float for a 1-D curve).
+
+    References
+    ----------
+    .. [1] D. Shin, N. Chang, Y. Wang, M. Pedram, "Reconfigurable three dimensional photovoltaic
+       panel architecture for solar-powered time extension", Sec. I and Fig. 1a.
+
+    Examples
+    --------
+    A half-sine day from 06:00 to 18:00 runs a load of half its peak from 08:00 to 16:00; sampled
+    hourly and taken as linear between samples, 7.96 h:
+
+    >>> import numpy as np
+    >>> hours = np.arange(24) + 0.5
+    >>> power = np.clip(np.sin(np.pi * (hours - 6) / 12), 0, None)
+    >>> print(round(float(t_solar(power, 0.5, 1.0)), 3))
+    7.962
     """
     above, _ = _time_above_per_segment(p_pv, p_load, step_hours)
     return above.sum(axis=-1)
 
 
 def t_solar_contiguous(p_pv, p_load, step_hours):
-    """Longest contiguous solar-powered interval [h]."""
+    """Longest contiguous solar-powered interval: the longest run with ``p_pv >= p_load``.
+
+    Parameters
+    ----------
+    p_pv : array_like
+        Power at step centres [W], time on the last axis.
+    p_load : float or array_like
+        Load [W], broadcast against ``p_pv``'s leading axes.
+    step_hours : float
+        Step length [h].
+
+    Returns
+    -------
+    numpy.ndarray
+        Longest interval [h], shaped as :func:`t_solar`'s result.
+    """
     above, excess = _time_above_per_segment(p_pv, p_load, step_hours)
     # Segment k joins segment k-1 when the sample between them is above the load; a sample below
     # it starts a new run. Label runs row by row and add up each run's hours with one bincount.
@@ -62,12 +98,34 @@ def t_solar_contiguous(p_pv, p_load, step_hours):
 
 
 def energy(p_pv, step_hours):
-    """Energy over the day [Wh] by the midpoint rule (steps are interval-centred)."""
+    """Energy over the day by the midpoint rule (steps are interval-centred).
+
+    Parameters
+    ----------
+    p_pv : array_like
+        Power at step centres [W], time on the last axis.
+    step_hours : float
+        Step length [h].
+
+    Returns
+    -------
+    numpy.ndarray
+        Energy [Wh], one per leading index.
+    """
     return np.asarray(p_pv, dtype=float).sum(axis=-1) * step_hours
 
 
 def daily_metrics(p_pv, p_load, step_hours):
     """All daily metrics of a power curve against a load.
+
+    Parameters
+    ----------
+    p_pv : array_like
+        Power at step centres [W], time on the last axis.
+    p_load : float or array_like
+        Load [W], broadcast against ``p_pv``'s leading axes.
+    step_hours : float
+        Step length [h].
 
     Returns
     -------
@@ -82,6 +140,19 @@ def daily_metrics(p_pv, p_load, step_hours):
 
 def metric_columns(t_solar_h, t_solar_contiguous_h, energy_harvested_wh, peak_power_w, p_load, served_wh=None) -> dict:
     """The daily metrics by their report names, from t_solar, its longest run, the energy and the peak.
+
+    Parameters
+    ----------
+    t_solar_h, t_solar_contiguous_h : array_like
+        :func:`t_solar` and :func:`t_solar_contiguous` [h].
+    energy_harvested_wh : array_like
+        :func:`energy` [Wh].
+    peak_power_w : array_like
+        [W].
+    p_load : float or array_like
+        Load [W] (the scale of a load profile).
+    served_wh : array_like, optional
+        Energy served to a load profile [Wh] (:func:`energy_served`).
 
     Returns
     -------
@@ -118,9 +189,9 @@ def load_for_t_solar(p_pv, target_t_solar, step_hours):
     p_pv : array_like
         One day's power [W], 1-D.
     target_t_solar : float
-        [h].
+        Solar-powered time to reach [h].
     step_hours : float
-        [h].
+        Step length [h].
 
     Returns
     -------
@@ -142,8 +213,24 @@ def load_for_t_solar(p_pv, target_t_solar, step_hours):
 
 
 def relative_to(t_solar_h, reference_h):
-    """``t_solar_h / reference_h`` [-], NaN where the reference never reaches the load (a gain over
-    nothing has no value); broadcast."""
+    """``t_solar_h / reference_h``, NaN where the reference never reaches the load (a gain over
+    nothing has no value).
+
+    Parameters
+    ----------
+    t_solar_h, reference_h : array_like
+        [h], broadcast.
+
+    Returns
+    -------
+    numpy.ndarray
+        Ratio [-].
+
+    Examples
+    --------
+    >>> print(relative_to([9.49, 3.0], [7.73, 0.0]).round(3))
+    [1.228   nan]
+    """
     t_solar_h, reference_h = np.broadcast_arrays(np.asarray(t_solar_h, dtype=float), np.asarray(reference_h,
                                                                                               dtype=float))
     ratio = np.full(t_solar_h.shape, np.nan)
@@ -156,9 +243,21 @@ DRIVE_NOTE = "drive costs more than it harvests"
 
 
 def design_condition(condition, energy_harvested_wh):
-    """Each design's condition on its day: the day's (:meth:`foldopt.engine.sky.Sky.conditions`) and,
-    where the design harvests less than nothing (a tracker net of its drive), :data:`DRIVE_NOTE`;
-    broadcast, joined by ``; ``."""
+    """Each design's condition on its day, for the notes of reports.
+
+    Parameters
+    ----------
+    condition : array_like of str
+        The day's (:meth:`foldopt.engine.sky.Sky.conditions`).
+    energy_harvested_wh : array_like
+        Each design's harvest [Wh], broadcast against ``condition``.
+
+    Returns
+    -------
+    numpy.ndarray of str
+        The day's condition and, where the design harvests less than nothing (a tracker net of
+        its drive), :data:`DRIVE_NOTE`, joined by ``"; "``.
+    """
     condition, harvested = np.broadcast_arrays(np.asarray(condition, dtype=object),
                                                np.asarray(energy_harvested_wh, dtype=float))
     return np.array(["; ".join(p for p in (c, DRIVE_NOTE if h < 0 else "") if p)
@@ -167,8 +266,26 @@ def design_condition(condition, energy_harvested_wh):
 
 
 def notes(condition, t_solar_h):
-    """A report's note: the condition (:func:`design_condition`, or the day's) and, where direct
-    light arrives but the design never reaches the load, ``load above peak``; joined by ``; ``."""
+    """A report's note per design.
+
+    Parameters
+    ----------
+    condition : array_like of str
+        :func:`design_condition`, or the day's condition.
+    t_solar_h : array_like
+        Each design's ``t_solar`` [h], broadcast against ``condition``.
+
+    Returns
+    -------
+    numpy.ndarray of str
+        The condition and, where direct light arrives but the design never reaches the load,
+        ``load above peak``, joined by ``"; "``.
+
+    Examples
+    --------
+    >>> print(list(notes(["", "polar night", ""], [0.0, 0.0, 5.0])))
+    ['load above peak', 'polar night', '']
+    """
     condition, hours = np.broadcast_arrays(np.asarray(condition, dtype=object), np.asarray(t_solar_h))
     # On a polar night or an overcast day the condition is the reason already.
     dark = np.array([("polar night" in c) or ("overcast" in c) for c in condition.ravel()]).reshape(hours.shape)
@@ -178,12 +295,25 @@ def notes(condition, t_solar_h):
 
 
 def per_load(power, load_shape):
-    """What loads are compared with: the power [W] itself, or with a load profile (``load_shape``
-    [W], broadcast against ``power``) the ratio power / shape, so that P_pv >= scale x shape is
-    ratio >= scale; where the shape is 0 (no load) -inf, which no scale reaches. The segments
-    between a step without load and one with it then count nothing: a profile that is zero outside
-    a window never counts time outside it, and loses at most half a step at each edge of the
-    window."""
+    """What loads are compared with: the power itself, or its ratio to a load profile.
+
+    With a profile, ``P_pv >= scale x shape`` is ``ratio >= scale``; where the shape is 0 (no load)
+    the ratio is -inf, which no scale reaches. The segments between a step without load and one
+    with it then count nothing: a profile that is zero outside a window never counts time outside
+    it, and loses at most half a step at each edge of the window.
+
+    Parameters
+    ----------
+    power : array_like
+        Power at step centres [W], time on the last axis.
+    load_shape : array_like or None
+        P_load(t) for a scale of 1 [W], broadcast against ``power``; None for a constant load.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``power`` [W], or ``power / load_shape`` [-] (-inf without load).
+    """
     if load_shape is None:
         return power
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -206,10 +336,16 @@ def energy_served(p_pv, scale, load_shape, step_hours, t_solar_h=None):
     load_shape : array_like
         P_load(t) for a scale of 1 [W], broadcast against ``p_pv``.
     step_hours : float
+        Step length [h].
     t_solar_h : array_like, optional
-        The curves' t_solar at these scales, as computed elsewhere: where the shape is the same at
-        every step, the served energy is then ``scale x shape x t_solar_h`` exactly, as for a
+        The curves' t_solar at these scales [h], as computed elsewhere: where the shape is the same
+        at every step, the served energy is then ``scale x shape x t_solar_h`` exactly, as for a
         constant load.
+
+    Returns
+    -------
+    numpy.ndarray
+        Energy served [Wh], one per leading index of ``p_pv`` (and per scale).
     """
     shape = np.broadcast_to(np.asarray(load_shape, dtype=float), np.shape(p_pv))
     scale = np.asarray(scale, dtype=float)

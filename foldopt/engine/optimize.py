@@ -1,4 +1,4 @@
-"""Choosing the fold angle: an exhaustive sweep and the heuristic of Shin et al. Sec. VI.
+"""Choosing the fold angle: an exhaustive sweep and the heuristic of Shin et al. Sec. VI, Eq. 8.
 
 Both take the physics as callables of the fold angle, so they serve any site, sky, geometry and
 PV model.
@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+import scipy.optimize
 
 from foldopt.engine.metrics import t_solar
 
@@ -43,9 +44,9 @@ def optimal_fold_angle(
     sweep_t_solar : array_like
         ``t_solar`` [h] at ``fold_angles``, from the sweep the caller already ran.
     p_load : float
-        [W].
+        Load power [W].
     step_hours : float
-        [h].
+        Step length [h].
     refine_points : int, default 41
         Points of the refinement grid; 1 keeps the sweep's best point.
 
@@ -71,10 +72,30 @@ def optimal_fold_angle(
 
 
 def noon_valley(p_east, p_west, p_parallel):
-    """Minimum of the parallel curve between the peaks of the two sub-panels [W].
+    """Minimum of the parallel curve between the peaks of the two sub-panels.
 
     Shin et al. Sec. VI, Fig. 10: folding shifts the east and west curves apart and digs a valley
-    into their parallel sum around noon. Arrays have time on the last axis.
+    into their parallel sum around noon; Eq. 8 calls it ``Min(P_pv,parallel)``.
+
+    Parameters
+    ----------
+    p_east, p_west : array_like
+        Each sub-panel's power alone [W], time on the last axis.
+    p_parallel : array_like
+        The pair's power in parallel [W], of the same shape.
+
+    Returns
+    -------
+    numpy.ndarray
+        The valley [W], one per leading index (a float for 1-D curves).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.linspace(0, 24, 241)
+    >>> east, west = np.exp(-((t - 10) ** 2)), np.exp(-((t - 14) ** 2))
+    >>> print(round(float(noon_valley(east, west, east + west)), 6))  # at noon: 2 exp(-4)
+    0.036631
     """
     p_parallel = np.asarray(p_parallel, dtype=float)
     steps = np.arange(p_parallel.shape[-1])
@@ -93,38 +114,51 @@ def heuristic_fold_angle(
 ):
     """The paper's optimum: the smallest fold angle whose noon valley still reaches the load.
 
-    Shin et al. Sec. VI, Eq. 8: ``Min(P_pv,parallel) = P_load``. The valley deepens as the panel
-    folds, so the angle is found by bisection on ``noon_valley(angle) - p_load``.
+    Shin et al. [1]_ Sec. VI, Eq. 8: ``Min(P_pv,parallel) = P_load``. The valley deepens as the
+    panel folds (it rises with the fold angle), so the angle is the root of
+    ``noon_valley(angle) - p_load`` in ``[lo, hi]``, found by Brent's method
+    (:func:`scipy.optimize.brentq`): on the paper's study it evaluates the day 9 or 10 times where
+    bisection to the same tolerance takes 17.
 
     Parameters
     ----------
     subpanel_power : callable
         Maps fold angles, shape (k,), to ``(p_east, p_west, p_parallel)``, each (k, n_time) [W].
     p_load : float
-        [W].
-    lo, hi : float
+        Load power [W].
+    lo, hi : float, default 1 and 180
         Search interval [deg].
     tol : float, default 0.01
-        Width of the final bracket [deg].
+        Absolute tolerance on the angle [deg] (``xtol`` of :func:`scipy.optimize.brentq`).
 
     Returns
     -------
     float
-        Fold angle [deg]; ``lo`` if even the most folded panel reaches the load, NaN if even the
-        flat one does not (the load exceeds the noon power).
+        Fold angle [deg], within ``tol`` of the threshold; ``lo`` if even the most folded panel
+        reaches the load, NaN if even the flat one does not (the load exceeds the noon power).
+
+    References
+    ----------
+    .. [1] D. Shin, N. Chang, Y. Wang, M. Pedram, "Reconfigurable three dimensional photovoltaic
+       panel architecture for solar-powered time extension", Sec. VI, Eq. 8.
+
+    Examples
+    --------
+    A valley that rises linearly with the fold angle reaches a 0.25 W load at 45 deg:
+
+    >>> import numpy as np
+    >>> def subpanels(angles):
+    ...     level = np.asarray(angles)[:, None] / 180.0 * np.ones((1, 5))
+    ...     return level, level, level
+    >>> round(heuristic_fold_angle(subpanels, 0.25), 2)
+    45.0
     """
 
-    def valley(angle):
-        return float(noon_valley(*subpanel_power(np.array([angle])))[0])
+    def shortfall(angle):
+        return float(noon_valley(*subpanel_power(np.array([angle])))[0]) - p_load
 
-    if valley(hi) < p_load:
+    if shortfall(hi) < 0.0:
         return float("nan")
-    if valley(lo) >= p_load:
+    if shortfall(lo) >= 0.0:
         return float(lo)
-    while hi - lo > tol:
-        middle = 0.5 * (lo + hi)
-        if valley(middle) >= p_load:
-            hi = middle
-        else:
-            lo = middle
-    return float(hi)
+    return float(scipy.optimize.brentq(shortfall, lo, hi, xtol=tol))

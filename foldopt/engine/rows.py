@@ -1,15 +1,15 @@
 """The engine: daily metrics of many panel orientations over a :class:`foldopt.engine.sky.Sky`.
 
-A *row* is one block of the sky (a day at a site) seen by one panel: the east and west sub-panel
-orientations (a fold angle; both the same for the flat panel). :func:`row_metrics` gives, for
-every row, connection and load, ``t_solar``, optionally its longest contiguous interval, and the
-energy and peak power, in one of two engines:
+A *row* is one block of the sky (a day at a site) seen by one panel: the east and west sub-panel orientations
+(a fold angle; both the same for the flat panel). :func:`row_metrics` gives, for every row, connection and
+load, ``t_solar``, optionally its longest contiguous interval, and the energy and peak power, in one of two
+engines:
 
-- ``numba`` (default): :func:`foldopt.engine.kernel.fold_rows`, one compiled pass per row from the sun
-  vector to the metrics, parallel over rows, without (rows x steps) arrays;
-- ``numpy``: the reference, block by block: plane-of-array irradiance, the electrical model's
-  powers and :mod:`foldopt.engine.metrics` on whole arrays. Tests hold the kernel to it (equal
-  ``t_solar`` within 1 s a day and energy within 1e-9).
+- ``numba`` (default): :func:`foldopt.engine.kernel.fold_rows`, one compiled pass per row from the sun vector
+  to the metrics, parallel over rows, without (rows x steps) arrays;
+- ``numpy``: the reference, block by block: plane-of-array irradiance, the electrical model's powers and
+  :mod:`foldopt.engine.metrics` on whole arrays. Tests hold the kernel to it (equal ``t_solar`` within 1 s a
+  day and energy within 1e-9).
 
 Studies that solve every step's I-V curves (``exact_electrical``) always take the reference path.
 """
@@ -24,7 +24,7 @@ import numpy as np
 import pvlib
 
 from foldopt.physics.connections import CONNECTIONS
-from foldopt.inputs.config import Study
+from foldopt.inputs.study import Study
 from foldopt.engine.electrical import Electrical
 from foldopt.physics.geometry import normal_vector, subpanel_orientation
 from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
@@ -52,8 +52,8 @@ class RowMetrics:
     peak : numpy.ndarray
         (n_rows, n_outputs) peak power [W].
     irradiation : numpy.ndarray or None
-        (n_rows,) plane-of-array irradiation [Wh/m^2], the mean of the two sub-panels (rows of
-        orientations; None for given power curves).
+        (n_rows,) plane-of-array irradiation [Wh/m^2], the mean of the two sub-panels (rows of orientations;
+        None for given power curves).
     """
 
     t_solar: np.ndarray
@@ -64,7 +64,14 @@ class RowMetrics:
 
 
 def electrical_settings(study: Study, temp_air: float) -> dict:
-    """The :class:`Electrical` of a study whose cells see ``temp_air`` [C]."""
+    """The keyword arguments (dict) of a study's :class:`Electrical` whose cells see ``temp_air``.
+
+    Parameters
+    ----------
+    study : Study
+    temp_air : float
+        Air temperature of the cells [C].
+    """
     study = study.resolved()
     return dict(
         pv=PVModel(study.pv_model, study.panel.efficiency, study.module),
@@ -85,8 +92,14 @@ def _electrical(settings_items: tuple) -> Electrical:
 
 
 def electrical_for(study: Study, temp_air: float) -> Electrical:
-    """The study's electrical model at ``temp_air``, shared by every caller in this process (and
-    its tables by every process, through the disk cache)."""
+    """The study's :class:`Electrical` at an air temperature, shared by every caller in this process (and
+    its tables by every process, through the disk cache).
+
+    Parameters
+    ----------
+    study, temp_air
+        As :func:`electrical_settings`.
+    """
     return _electrical(tuple(electrical_settings(study, temp_air).items()))
 
 
@@ -120,7 +133,13 @@ def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> n
 
 
 def flat_orientation(panel_tilt, panel_azimuth) -> np.ndarray:
-    """The flat panel as a row orientation: both halves the panel itself, (n_blocks, 4)."""
+    """The flat panel as (n_blocks, 4) row orientations, as :func:`fold_orientations`': both halves the panel.
+
+    Parameters
+    ----------
+    panel_tilt, panel_azimuth : array_like
+        The flat panel of each block [deg], (n_blocks,).
+    """
     tilt, azimuth = np.asarray(panel_tilt, dtype=float), np.asarray(panel_azimuth, dtype=float)
     return np.stack([tilt, azimuth, tilt, azimuth], axis=-1)
 
@@ -132,17 +151,16 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
     ----------
     sky : Sky
     surface_tilt, surface_azimuth : array_like
-        [deg], broadcast against the selected blocks' (n_blocks, n_steps): (n_blocks, 1) for one
-        orientation per block, (n_blocks, n_steps) for a tracker, (k, 1) for k orientations over
-        one selected block.
+        [deg], broadcast against the selected blocks' (n_blocks, n_steps): (n_blocks, 1) for one orientation
+        per block, (n_blocks, n_steps) for a tracker, (k, 1) for k orientations over one selected block.
     blocks : slice or array_like, default all
         The blocks, as an index that keeps the block axis (a slice or a list).
     paper : bool
-        The beam by Shin et al.'s Eq. 5 instead of the angle of incidence (fixed panels in paper
-        mode; a tracker always takes the exact incidence).
+        The beam by Shin et al.'s Eq. 5 instead of the angle of incidence (fixed panels in paper mode; a
+        tracker always takes the exact incidence).
     incident : bool
-        The light incident on the surface, before the sky's incidence-angle modifier (the
-        default is what reaches the cells).
+        The light incident on the surface, before the sky's incidence-angle modifier (the default is what
+        reaches the cells).
 
     Returns
     -------
@@ -160,8 +178,22 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
 
 
 def panel_power(sky: Sky, study: Study, poa_global, area: float | None = None):
-    """Maximum power [W] of panels of ``area`` (default the study's) at ``poa_global`` (n_blocks,
-    n_steps): each block through the electrical model at its cells' air temperature."""
+    """Maximum power of panels over the blocks of a sky, each block at its cells' air temperature.
+
+    Parameters
+    ----------
+    sky : Sky
+    study : Study
+    poa_global : numpy.ndarray
+        (n_blocks, n_steps) plane-of-array irradiance [W/m^2].
+    area : float, optional
+        Panel area [m^2]; default the study's.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_blocks, n_steps) [W].
+    """
     area = study.panel.area if area is None else area
     power = np.empty_like(poa_global)
     for temp in np.unique(sky.temp_air):
@@ -171,7 +203,19 @@ def panel_power(sky: Sky, study: Study, poa_global, area: float | None = None):
 
 
 def iam_modifier(model: str, surface_tilt, surface_azimuth, solar_zenith, solar_azimuth):
-    """Incidence-angle modifier of the beam (pvlib ``iam.ashrae`` / ``iam.physical``), or 1."""
+    """Incidence-angle modifier of the beam (pvlib ``iam.ashrae`` / ``iam.physical``), or 1.
+
+    Parameters
+    ----------
+    model : {'none', 'ashrae', 'physical'}
+    surface_tilt, surface_azimuth, solar_zenith, solar_azimuth : array_like
+        [deg], broadcast.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        Modifier [-], 0 for light from behind; 1.0 for ``none``.
+    """
     if model == "none":
         return 1.0
     aoi = pvlib.irradiance.aoi(surface_tilt, surface_azimuth, solar_zenith, solar_azimuth)
@@ -232,6 +276,7 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     Returns
     -------
     RowMetrics
+        An unknown ``engine`` or output raises ValueError.
     """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
@@ -270,22 +315,28 @@ def _curve_reference(power, row_loads, step_hours, contiguous, load_shape=None):
 
 
 def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool = True, with_state: bool = False):
-    """Every connection's power [W] and the whole panel's (``panel``), and the switch state, from
-    whole arrays: the reference path, and the source of time series for reports.
+    """Every connection's power [W] and the whole panel's (``panel``), and the switch state, from whole
+    arrays: the reference path, and the source of time series for reports.
 
     Parameters
     ----------
+    sky : Sky
+    study : Study
+        The electrical model, connection options and mode.
     orientation : array_like
-        (k, 4) sub-panel orientations over one selected block, or (n_blocks, 4), one per selected
-        block (see :func:`row_metrics`).
-    blocks : slice or list of int
+        (k, 4) sub-panel orientations over one selected block, or (n_blocks, 4), one per selected block.
+    blocks : slice or list of int, default all
         The selected blocks (an index that keeps the block axis).
+    series : bool, default True
+        Whether to work out the series power (NaN otherwise).
+    with_state : bool, default False
+        Whether to return the switch state.
 
     Returns
     -------
     powers : dict of numpy.ndarray
-        (k or n_blocks, n_steps) per name of :data:`OUTPUTS`, and ``poa``, the two sub-panels'
-        mean incident plane-of-array irradiance [W/m^2] (before the incidence-angle modifier).
+        (k or n_blocks, n_steps) per name of :data:`OUTPUTS`, and ``poa``, the two sub-panels' mean incident
+        plane-of-array irradiance [W/m^2] (before the incidence-angle modifier).
     state : numpy.ndarray or None
         The state switching chose (``with_state``).
     """
@@ -392,8 +443,30 @@ def _shape_arguments(load_shape):
 
 def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous: bool = False,
                   engine: str = "numba", load_shape=None) -> RowMetrics:
-    """Daily metrics of given power curves (n_rows, n_steps) [W]: t_solar (n_rows, 1, n_loads) etc.;
-    with ``load_shape`` (n_rows, n_steps) [W] the loads are its scales (:func:`per_load`)."""
+    """Daily metrics of given power curves (a tracker's, a design's).
+
+    Parameters
+    ----------
+    power : array_like
+        (n_rows, n_steps) power at step centres [W].
+    loads : array_like
+        (n_loads,) loads [W], or (n_sets, n_loads) sets chosen by ``row_loadset``.
+    step_hours : float
+        Step length [h].
+    row_loadset : array_like of int, optional
+        (n_rows,) set of loads of each row; default the first.
+    contiguous : bool, default False
+        Also the longest contiguous interval.
+    engine : {'numba', 'numpy'}
+    load_shape : array_like, optional
+        (n_rows, n_steps) load profile [W]; the loads are then its scales (:func:`per_load`).
+
+    Returns
+    -------
+    RowMetrics
+        With one output: ``t_solar`` (n_rows, 1, n_loads) and so on; no irradiation. An unknown ``engine``
+        raises ValueError.
+    """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
     power = np.ascontiguousarray(power, dtype=float)

@@ -37,15 +37,40 @@ MAX_VISITS = 12
 
 @dataclass(frozen=True)
 class Schedule:
-    """k settings a year: ``starts`` (day indices, ascending, the first the earliest in the year)
-    and the fold-angle index of each, and the objective they reach [h]."""
+    """k fold settings a year, each kept until the next visit.
+
+    Parameters
+    ----------
+    starts : tuple of int
+        Day index of each visit, ascending (the first the earliest in the year).
+    angles : tuple of int
+        Index into the fold-angle grid of each visit's setting.
+    objective_h : float
+        The objective the schedule reaches [h] (:data:`SCHEDULE_OBJECTIVES`).
+    """
 
     starts: tuple
     angles: tuple
     objective_h: float
 
     def daily_angles(self, n_days: int) -> np.ndarray:
-        """The angle index in force on every day (the last setting wraps into January)."""
+        """The angle index in force on every day (the last setting wraps into January).
+
+        Parameters
+        ----------
+        n_days : int
+            Days of the year.
+
+        Returns
+        -------
+        numpy.ndarray of int
+            (n_days,) index into the fold-angle grid.
+
+        Examples
+        --------
+        >>> print(Schedule((2, 5), (7, 9), 0.0).daily_angles(7))
+        [9 9 7 7 7 9 9]
+        """
         index = np.empty(n_days, dtype=int)
         starts = list(self.starts)
         for position, start in enumerate(starts):
@@ -153,6 +178,20 @@ def best_schedules(hours, months, max_visits: int, objective: str = "mean") -> l
     -------
     list of Schedule
         Index k - 1 holds the best schedule of k settings; k = 1 is the single fixed angle.
+
+    Raises
+    ------
+    ValueError
+        If ``objective`` is unknown or ``max_visits`` is outside [1, min(12, days)].
+
+    Examples
+    --------
+    Two angles, one best in the first half of a 4-day "year", the other in the second:
+
+    >>> hours = [[9.0, 8.0], [9.0, 8.0], [8.0, 9.0], [8.0, 9.0]]
+    >>> one, two = best_schedules(hours, [1, 1, 2, 2], 2)
+    >>> print(one.objective_h, two.starts, two.angles, two.objective_h)
+    8.5 (0, 2) (0, 1) 9.0
     """
     hours = np.asarray(hours, dtype=float)
     if objective not in SCHEDULE_OBJECTIVES:

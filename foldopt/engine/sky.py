@@ -18,19 +18,15 @@ import pandas as pd
 import pvlib
 
 from foldopt.physics.atmosphere import clear_sky_dni, relative_airmass
-from foldopt.inputs.config import Study, parse_timezone
+from foldopt.inputs.sections import parse_timezone
+from foldopt.inputs.study import Study
 from foldopt.physics.geometry import normal_vector
 from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.inputs.loads import load_shape
 from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
-from foldopt.inputs.weather import (
-    CLEAR_SKIES,
-    clear_sky,
-    read_weather,
-    sub_hourly,
-    weather_days,
-    weather_site,
-)
+from foldopt.inputs.weather import read_weather, weather_days, weather_site
+from foldopt.names import CLEAR_SKIES
+from foldopt.inputs.weather.downscale import clear_sky, sub_hourly
 
 
 @dataclass(frozen=True)
@@ -61,7 +57,7 @@ class Sky:
         (:func:`foldopt.inputs.loads.load_shape`); None for a constant load.
     weather_balance : dict or None
         With a weather file: per component (``dni``, ``ghi``, ``dhi``), the file's summed interval
-        means and what the steps keep of them [W/m^2 x intervals] (:func:`foldopt.inputs.weather.sub_hourly`).
+        means and what the steps keep of them [W/m^2 x intervals] (:func:`foldopt.inputs.weather.downscale.sub_hourly`).
     """
 
     grid: ClockGrid
@@ -83,10 +79,12 @@ class Sky:
 
     @property
     def n_blocks(self) -> int:
+        """Number of blocks (days at sites)."""
         return self.dni.shape[0]
 
     @property
     def step_hours(self) -> float:
+        """Step length [h]."""
         return self.grid.step_hours
 
     @property
@@ -109,11 +107,23 @@ class Sky:
         up = self.solar_zenith < 90.0
         rises, sets = up.any(axis=1), ~up.all(axis=1)
         overcast = rises & ~((self.dni > 0) & up).any(axis=1)
-        parts = [np.where(~rises, "polar night", ""), np.where(~sets, "polar day", ""), np.where(overcast, "overcast", "")]
+        parts = [np.where(~rises, "polar night", ""), np.where(~sets, "polar day", ""),
+                 np.where(overcast, "overcast", "")]
         return np.array(["; ".join(p for p in block if p) for block in zip(*parts, strict=True)], dtype=object)
 
     def block(self, index: int) -> Sky:
-        """One block as a sky of its own (arrays keep their leading axis, of length 1)."""
+        """One block as a sky of its own.
+
+        Parameters
+        ----------
+        index : int
+            The block.
+
+        Returns
+        -------
+        Sky
+            Of one block: every array keeps its leading axis, of length 1.
+        """
         keep = slice(index, index + 1)
         grid = ClockGrid(self.grid.utc_ns[keep], self.grid.utc_offset_ns[keep], self.grid.timezones[keep],
                          self.grid.step_hours)
@@ -152,9 +162,9 @@ def _clear_sky(grid: ClockGrid, zenith, sites, model: str, linke_turbidity) -> d
 
 
 def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict):
-    """Light at every step of the grid from the study's weather file (:func:`foldopt.inputs.weather.sub_hourly`
-    against the clear sky), the cell air temperature of each day, and how much of the file's
-    irradiation the steps keep."""
+    """Light at every step of the grid from the study's weather file
+    (:func:`foldopt.inputs.weather.downscale.sub_hourly` against the clear sky), the cell air
+    temperature of each day, and how much of the file's irradiation the steps keep."""
     weather = study.weather
     columns = ("dni", "ghi", "dhi", "temp_air")
     hourly = {key: np.empty((len(dates), 0)) for key in columns}
@@ -199,13 +209,20 @@ def build_sky(study: Study, sites, dates) -> Sky:
     study : Study
         Mode, sky model, weather file, step, transposition, albedo, incidence-angle modifier, air
         temperature (its site and date are not used).
-    sites : sequence of foldopt.inputs.config.Site
+    sites : sequence of foldopt.inputs.sections.Site
+        One per block: latitude, longitude, altitude and time zone.
     dates : sequence of datetime.date
-        One per site.
+        The local day of each block, one per site.
 
     Returns
     -------
     Sky
+
+    Raises
+    ------
+    ValueError
+        If ``sites`` and ``dates`` differ in length, or a weather file's intervals do not fit the
+        study's step.
     """
     study = study.resolved()
     sites = [site.resolved() for site in sites]

@@ -19,8 +19,14 @@ _FACTOR = 10
 
 @cache
 def land_fraction() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The share of land [-] of every 5-arc-minute cell: ``(latitudes, longitudes, fraction)``,
-    cell centres [deg] ascending and a (2160, 4320) float32 array.
+    """The share of land of every 5-arc-minute cell, from the cache or built once.
+
+    Returns
+    -------
+    latitudes, longitudes : numpy.ndarray
+        Cell centres [deg], ascending.
+    fraction : numpy.ndarray
+        (2160, 4320) float32 share of land [-] of each cell.
 
     Raises
     ------
@@ -56,7 +62,23 @@ def _build() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def is_land(latitude, longitude) -> np.ndarray:
-    """Whether each point [deg] lies in a 5-arc-minute cell that is mostly land."""
+    """Whether points lie on land.
+
+    Parameters
+    ----------
+    latitude, longitude : array_like
+        The points [deg], broadcast together.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        Whether each point lies in a 5-arc-minute cell that is mostly land (:func:`land_fraction`).
+
+    Raises
+    ------
+    ImportError
+        Without the ``global-land-mask`` package and no cached fraction.
+    """
     lat_centres, lon_centres, fraction = land_fraction()
     step = lat_centres[1] - lat_centres[0]
     rows = np.clip(((np.asarray(latitude, dtype=float) + 90) / step).astype(int), 0, lat_centres.size - 1)
@@ -66,8 +88,23 @@ def is_land(latitude, longitude) -> np.ndarray:
 
 
 def draw_coastlines(ax, color: str = "0.3", linewidth: float = 0.5) -> bool:
-    """Coastlines on a longitude-latitude ``ax``: the 0.5 contour of the land fraction, at 15 arc
-    minutes (plenty for a world map). Returns False, drawing nothing, without the mask package."""
+    """Coastlines on a map: the 0.5 contour of the land fraction, at 15 arc minutes (plenty for a
+    world map).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Longitude [deg] on x, latitude [deg] on y.
+    color : str
+        The lines' colour.
+    linewidth : float
+        [pt].
+
+    Returns
+    -------
+    bool
+        Whether they were drawn: False, drawing nothing, without the mask package.
+    """
     try:
         latitude, longitude, fraction = land_fraction()
     except ImportError:

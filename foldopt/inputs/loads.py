@@ -1,54 +1,67 @@
 """Loads that vary over the day: P_load(t) = scale x profile(t).
 
-A profile (:class:`foldopt.inputs.config.LoadProfile`) gives loads [W] at clock times of the local day,
-held until the next time or interpolated linearly, the last carried over midnight to the first; a
-weekend day and days per month may replace it. :func:`load_shape` evaluates it at every step of
+A profile (:class:`foldopt.inputs.sections.LoadProfile`) gives loads [W] at clock times of the local
+day, held until the next time or interpolated linearly, the last carried over midnight to the first;
+a weekend day and days per month may replace it. :func:`load_shape` evaluates it at every step of
 every block (a day at a site, :class:`foldopt.engine.sky.Sky`), so that the engine compares the power
 with ``scale x shape(t)``: for many scales in one pass it compares P_pv(t) / shape(t) with each
 scale (:func:`foldopt.engine.metrics.per_load`), the method of many constant loads.
+
+The module opens no files (a profile's CSV is read by :func:`foldopt.inputs.load.read_profile`)
+and imports nothing of the study models, which import :func:`profile_steps` from it; numpy loads
+with the first profile evaluated, not with the models (the command line checks its input and
+prints its help before numpy loads).
 """
 
 from __future__ import annotations
 
-import csv
-import io
+import math
+import re
 from pathlib import Path
 
-import numpy as np
+_CLOCK = re.compile(r"^([01]?\d|2[0-3]):([0-5]\d)$")
 
 
-def read_profile(path: str | Path) -> dict:
-    """A day's profile from a CSV file with a header ``time,watts`` (``HH:MM`` and watts), UTF-8 with
-    or without a byte-order mark, each time at most once."""
-    from foldopt.inputs.config import MAX_CSV_BYTES, _profile_steps, read_input
-    from foldopt.errors import ConfigError
+def profile_steps(value: dict) -> dict:
+    """A day's loads checked and put in order: clock times ``HH:MM`` of the day to loads [W].
 
-    path = Path(path)
-    text = read_input(path, "load_profile.file", MAX_CSV_BYTES, "MAX_CSV_BYTES")
-    try:
-        reader = csv.DictReader(io.StringIO(text, newline=""))
-        rows = [(reader.line_num, row) for row in reader]
-    except csv.Error as error:
-        raise ConfigError([f"load_profile.file: cannot read {path}: {error}"]) from None
-    steps, lines = {}, {}
-    for line, row in rows:
-        try:
-            time, watts = row["time"].strip(), float(row["watts"])
-        except (KeyError, TypeError, ValueError, AttributeError):
-            raise ConfigError([f"load_profile.file {path}, line {line}: expected time,watts (HH:MM, a number)"
-                               ]) from None
-        if time in steps:  # the second load would replace the first unseen
-            raise ConfigError([f"load_profile.file {path}, line {line}: time {time} is also on line {lines[time]}; "
-                               "give each time once"])
-        steps[time], lines[time] = watts, line
-    try:
-        return _profile_steps(steps)
-    except ValueError as error:
-        raise ConfigError([f"load_profile.file {path}: {error}"]) from None
+    Parameters
+    ----------
+    value : dict
+        Clock times (``"7:00"`` or ``"07:00"``, in [00:00, 23:59]) to loads [W], each at least 0.
+
+    Returns
+    -------
+    dict
+        ``{"HH:MM": watts}`` with two-digit hours, in time order, loads as floats [W].
+
+    Raises
+    ------
+    ValueError
+        For an empty or non-mapping value, a time that is no clock time, a load that is not a
+        finite number >= 0, or one time given twice (``7:00`` beside ``07:00``).
+    """
+    if not isinstance(value, dict) or not value:
+        raise ValueError("expected a mapping of clock times HH:MM to watts, e.g. {'07:00': 6, '19:00': 1.5}")
+    steps, given = {}, {}
+    for time, watts in value.items():
+        match = _CLOCK.match(str(time).strip())
+        if not match:
+            raise ValueError(f"{time!r} is not a clock time HH:MM in [00:00, 23:59]")
+        if isinstance(watts, bool) or not isinstance(watts, (int, float)) or not math.isfinite(watts) or watts < 0:
+            raise ValueError(f"{time}: {watts!r} is not a load in watts >= 0")
+        clock = f"{int(match.group(1)):02d}:{match.group(2)}"
+        if clock in given:  # 7:00 beside 07:00: one of the two loads would be dropped unseen
+            raise ValueError(f"{time!r} is the time {given[clock]!r} again; give each time once")
+        given[clock] = time
+        steps[clock] = float(watts)
+    return dict(sorted(steps.items()))
 
 
-def _day(steps: dict, clock_hours: np.ndarray, linear: bool) -> np.ndarray:
+def _day(steps: dict, clock_hours, linear: bool):
     """One day's profile at local clock hours [h]."""
+    import numpy as np
+
     times = np.array([int(t[:2]) + int(t[3:]) / 60.0 for t in steps])
     watts = np.array(list(steps.values()))
     if linear:
@@ -58,12 +71,12 @@ def _day(steps: dict, clock_hours: np.ndarray, linear: bool) -> np.ndarray:
     return watts[index]
 
 
-def load_shape(profile, clock_hours: np.ndarray, dates) -> np.ndarray:
+def load_shape(profile, clock_hours, dates):
     """P_load(t) for a scale of 1 [W] at every step of every block.
 
     Parameters
     ----------
-    profile : foldopt.inputs.config.LoadProfile
+    profile : foldopt.inputs.sections.LoadProfile
     clock_hours : numpy.ndarray
         (n_blocks, n_steps) local clock time of each step [h].
     dates : sequence of datetime.date
@@ -74,6 +87,8 @@ def load_shape(profile, clock_hours: np.ndarray, dates) -> np.ndarray:
     numpy.ndarray
         (n_blocks, n_steps) [W].
     """
+    import numpy as np
+
     linear = profile.interpolation == "linear"
     shape = np.empty(clock_hours.shape)
     for block, date in enumerate(dates):
@@ -87,10 +102,23 @@ def load_shape(profile, clock_hours: np.ndarray, dates) -> np.ndarray:
 
 
 def describe_load(study, p_load: float | None = None) -> dict:
-    """The load of a study as a user knows it: a constant ``p_load_w`` [W], or a profile's
-    ``name`` (its file's stem, or ``daily``), ``scale`` [-] and the ``mean_w`` and ``peak_w`` [W]
-    of P_load(t) = scale x profile(t) over its daily day (weekend and monthly days aside).
-    ``p_load`` replaces the study's load (a sweep's value)."""
+    """The load of a study as a user knows it.
+
+    Parameters
+    ----------
+    study : foldopt.inputs.study.Study
+    p_load : float, optional
+        Replaces the study's load (a sweep's value): [W], or a profile's scale [-].
+
+    Returns
+    -------
+    dict
+        ``{"p_load_w": W}`` for a constant load; for a profile its ``name`` (its file's stem, or
+        ``daily``), ``scale`` [-] and the ``mean_w`` and ``peak_w`` [W] of P_load(t) = scale x
+        profile(t) over its daily day (weekend and monthly days aside).
+    """
+    import numpy as np
+
     profile = study.load_profile
     scale = float(study.p_load if p_load is None else p_load)
     if profile is None:
@@ -102,8 +130,20 @@ def describe_load(study, p_load: float | None = None) -> dict:
 
 
 def load_text(study, p_load: float | None = None) -> str:
-    """``P_load 2 W``, or for a profile ``load profile camera (mean 2.88 W, peak 6 W)`` (with its
-    scale where it is not 1)."""
+    """The load of a study in words, for the answer's lines.
+
+    Parameters
+    ----------
+    study : foldopt.inputs.study.Study
+    p_load : float, optional
+        Replaces the study's load (a sweep's value): [W], or a profile's scale [-].
+
+    Returns
+    -------
+    str
+        ``P_load 2 W``, or for a profile ``load profile camera (mean 2.88 W, peak 6 W)`` (with its
+        scale where it is not 1).
+    """
     load = describe_load(study, p_load)
     if "p_load_w" in load:
         return f"P_load {load['p_load_w']:g} W"

@@ -34,7 +34,20 @@ EXACT_NOTE = "exact mode (paper mode is for the paper's own site and day: set mo
 
 
 def set_path(data: dict, path: str, value) -> dict:
-    """A copy of ``data`` with the dotted ``path`` set to ``value``."""
+    """Set one field of a study's data.
+
+    Parameters
+    ----------
+    data : dict
+    path : str
+        A dotted field path (``site.latitude``); missing sections are made.
+    value : object
+
+    Returns
+    -------
+    dict
+        A deep copy of ``data`` with ``path`` set to ``value``.
+    """
     out = copy.deepcopy(data)
     node = out
     parts = path.split(".")
@@ -49,8 +62,19 @@ def set_path(data: dict, path: str, value) -> dict:
 
 
 def flatten(changes: dict) -> dict:
-    """Changes as dotted paths: a mapping given for a :data:`SECTIONS` field becomes one change per
-    field it names (``panel={"area": 0.1}`` is ``panel.area``); anything else stays whole."""
+    """Changes as dotted paths.
+
+    Parameters
+    ----------
+    changes : dict
+        Field names or dotted paths to values.
+
+    Returns
+    -------
+    dict
+        A mapping given for a :data:`SECTIONS` field as one change per field it names
+        (``panel={"area": 0.1}`` is ``panel.area``); anything else whole.
+    """
     flat = {}
     for path, value in changes.items():
         if path in SECTIONS and isinstance(value, dict):
@@ -61,7 +85,20 @@ def flatten(changes: dict) -> dict:
 
 
 def touched(given, prefix: str) -> bool:
-    """Whether any of the paths ``given`` is ``prefix`` or lies inside it."""
+    """Whether a field, or a field inside it, is among some paths.
+
+    Parameters
+    ----------
+    given : iterable of str
+        Dotted field paths.
+    prefix : str
+        A dotted field path.
+
+    Returns
+    -------
+    bool
+        Whether any of ``given`` is ``prefix`` or lies inside it.
+    """
     return any(path == prefix or path.startswith(prefix + ".") for path in given)
 
 
@@ -74,7 +111,17 @@ def _section(data: dict, name: str) -> dict:
 
 
 def is_single(value) -> bool:
-    """A value that is no list, range or date keyword: one case, not an axis."""
+    """Whether a value is one case, not an axis.
+
+    Parameters
+    ----------
+    value : object
+
+    Returns
+    -------
+    bool
+        True for a value that is no list, range, list text (``a,b``) or date keyword.
+    """
     text = str(value)
     return (not isinstance(value, (list, tuple)) and ":" not in text and "," not in text
             and text not in ("year", "equinoxes-solstices"))

@@ -41,6 +41,8 @@ LAUE_ALTITUDE_COEFFICIENT = 0.14  # [1/km], [3]
 def relative_airmass(solar_zenith):
     """Relative optical air mass by Kasten & Young 1989 [1]_ (pvlib ``kastenyoung1989``).
 
+    ``AM = 1 / (cos(z) + 0.50572 (96.07995 - z) ** -1.6364)``, z in degrees (Shin et al. Eq. 1).
+
     Parameters
     ----------
     solar_zenith : array_like
@@ -50,15 +52,26 @@ def relative_airmass(solar_zenith):
     -------
     numpy.ndarray
         Air mass [-]; NaN with the sun below the horizon.
+
+    References
+    ----------
+    .. [1] F. Kasten, A. T. Young, "Revised optical air mass tables and approximation formula",
+       Applied Optics 28(22), 4735-4738, 1989, Eq. 3.
+
+    Examples
+    --------
+    >>> print(relative_airmass([0.0, 60.0, 95.0]).round(4))
+    [0.9997 1.9943    nan]
     """
     zenith = np.asarray(solar_zenith, dtype=float)
     return np.asarray(pvlib.atmosphere.get_relative_airmass(zenith, model="kastenyoung1989"))
 
 
 def beam_meinel(airmass, altitude=0.0):
-    """Direct normal irradiance of the Meinel & Meinel clear sky [2]_, with Laue's altitude term [3]_.
+    """Direct normal irradiance of the Meinel & Meinel clear sky [1]_, with Laue's altitude term [2]_.
 
-    ``I_D = 1353 * ((1 - a h) * 0.7 ** (AM ** 0.678) + a h)`` W/m^2, a = 0.14 /km, h [km].
+    ``I_D = 1353 * ((1 - a h) * 0.7 ** (AM ** 0.678) + a h)`` W/m^2, a = 0.14 /km, h [km]; at
+    h = 0 this is Shin et al. Eq. 2, whose OCR text reads the exponent 0.678 as "0.076".
 
     Parameters
     ----------
@@ -71,6 +84,18 @@ def beam_meinel(airmass, altitude=0.0):
     -------
     numpy.ndarray
         Direct normal irradiance [W/m^2].
+
+    References
+    ----------
+    .. [1] A. B. Meinel, M. P. Meinel, "Applied Solar Energy: An Introduction", Addison-Wesley,
+       1976, as given by PVCDROM / PVEducation, "Air Mass".
+    .. [2] E. G. Laue, "The measurement of solar spectral irradiance at different terrestrial
+       elevations", Solar Energy 13, 43-57, 1970, via PVEducation ("Air Mass").
+
+    Examples
+    --------
+    >>> print(beam_meinel([1.0, 1.5, np.nan]).round(1))
+    [947.1 846.    0. ]
     """
     airmass = np.asarray(airmass, dtype=float)
     altitude_term = LAUE_ALTITUDE_COEFFICIENT * altitude / 1000.0
@@ -79,7 +104,7 @@ def beam_meinel(airmass, altitude=0.0):
 
 
 def hottel_transmittance(solar_zenith, altitude=0.0, climate="midlatitude-summer"):
-    """Clear-sky beam transmittance of Hottel (1976) [4]_, 23 km visibility standard atmosphere.
+    """Clear-sky beam transmittance of Hottel (1976) [1]_, 23 km visibility standard atmosphere.
 
     ``tau_b = a0 + a1 exp(-k / cos(zenith))`` with ``a0* = 0.4237 - 0.00821 (6 - A)^2``,
     ``a1* = 0.5055 + 0.00595 (6.5 - A)^2``, ``k* = 0.2711 + 0.01858 (2.5 - A)^2`` (A: altitude in
@@ -88,16 +113,33 @@ def hottel_transmittance(solar_zenith, altitude=0.0, climate="midlatitude-summer
     Parameters
     ----------
     solar_zenith : array_like
-        [deg].
-    altitude : float
-        [m], at most 2500.
-    climate : str
+        Solar zenith [deg].
+    altitude : float, default 0
+        Site altitude [m], at most 2500.
+    climate : str, default 'midlatitude-summer'
         One of :data:`HOTTEL_CLIMATES`.
 
     Returns
     -------
     numpy.ndarray
         Transmittance [-]; 0 with the sun below the horizon.
+
+    Raises
+    ------
+    ValueError
+        If ``climate`` is not one of :data:`HOTTEL_CLIMATES`.
+
+    References
+    ----------
+    .. [1] H. C. Hottel, "A simple model for estimating the transmittance of direct solar radiation
+       through clear atmospheres", Solar Energy 18, 129-134, 1976; as given by J. A. Duffie,
+       W. A. Beckman, "Solar Engineering of Thermal Processes", Sec. 2.8, Eq. 2.8.1, 2.8.2 and
+       Table 2.8.1 (Robles Algarin et al. Eq. 4-7, OCR-damaged, see the module docstring).
+
+    Examples
+    --------
+    >>> print(hottel_transmittance([0.0, 60.0, 100.0]).round(4))
+    [0.6291 0.4644 0.    ]
     """
     if climate not in HOTTEL_CLIMATES:
         raise ValueError(f"climate must be one of {', '.join(HOTTEL_CLIMATES)}; got {climate!r}")
@@ -113,25 +155,57 @@ def hottel_transmittance(solar_zenith, altitude=0.0, climate="midlatitude-summer
 
 
 def extraterrestrial_normal(dayofyear):
-    """Extraterrestrial normal irradiance [W/m^2], Duffie & Beckman Eq. 1.4.1a (pvlib ``asce``)."""
+    """Extraterrestrial normal irradiance, Duffie & Beckman Eq. 1.4.1a [1]_ (pvlib ``asce``).
+
+    Parameters
+    ----------
+    dayofyear : array_like
+        Day of year, 1 on January 1 [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        Irradiance on a surface normal to the sun above the atmosphere [W/m^2], with the
+        solar constant :data:`SOLAR_CONSTANT_HOTTEL`.
+
+    References
+    ----------
+    .. [1] J. A. Duffie, W. A. Beckman, "Solar Engineering of Thermal Processes", 4th ed., Wiley,
+       2013, Eq. 1.4.1a.
+    """
     return np.asarray(
-        pvlib.irradiance.get_extra_radiation(np.asarray(dayofyear), solar_constant=SOLAR_CONSTANT_HOTTEL, method="asce"),
+        pvlib.irradiance.get_extra_radiation(np.asarray(dayofyear), solar_constant=SOLAR_CONSTANT_HOTTEL,
+                                             method="asce"),
         dtype=float,
     )
 
 
 def clear_sky_dni(solar_zenith, altitude=0.0, model="meinel", dayofyear=None, climate="midlatitude-summer"):
-    """Clear-sky direct normal irradiance [W/m^2], zero with the sun below the horizon.
+    """Clear-sky direct normal irradiance by one of :data:`SKY_MODELS`.
 
     Parameters
     ----------
     solar_zenith : array_like
-        [deg].
+        Solar zenith [deg].
     altitude : float, default 0
         Site altitude [m].
     model : {'meinel', 'hottel'}
-        Sky model. ``hottel`` needs ``dayofyear`` (for the extraterrestrial irradiance) and
-        takes ``climate``.
+        Sky model: :func:`beam_meinel` of :func:`relative_airmass`, or :func:`hottel_transmittance`
+        times :func:`extraterrestrial_normal`.
+    dayofyear : array_like, optional
+        Day of year, broadcast against ``solar_zenith``; needed by ``hottel``.
+    climate : str, default 'midlatitude-summer'
+        ``hottel``'s climate, one of :data:`HOTTEL_CLIMATES`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Direct normal irradiance [W/m^2], zero with the sun below the horizon.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` or ``climate`` is unknown.
     """
     if model == "meinel":
         return beam_meinel(relative_airmass(solar_zenith), altitude)

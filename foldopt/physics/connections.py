@@ -56,6 +56,24 @@ def parallel_power(east: IVCurve, west: IVCurve):
     concave on ``[V_a, min(V_b, V_oc,a)]`` (golden-section search, exact to ~1e-8 of the bracket)
     and equals the other sub-panel alone beyond it, which peaks at ``V_b``. The result is the
     larger of that search and each sub-panel alone, with no grid search.
+
+    Parameters
+    ----------
+    east, west : IVCurve
+        The two sub-panels' I-V curves, of one shape (one curve per time step, say).
+
+    Returns
+    -------
+    numpy.ndarray
+        Maximum power of the pair [W], shaped as the curves; 0 where both are dark.
+
+    References
+    ----------
+    .. [1] D. Shin, N. Chang, Y. Wang, M. Pedram, "Reconfigurable three dimensional photovoltaic
+       panel architecture for solar-powered time extension", Sec. V-C and Fig. 9 (parallel
+       connection of the sub-panels around noon).
+    .. [2] J. Kiefer, "Sequential minimax search for a maximum", Proc. Amer. Math. Soc. 4(3),
+       502-506, 1953 (golden-section search).
     """
     (p_east, v_east), (p_west, v_west) = east.mpp(), west.mpp()
 
@@ -82,6 +100,18 @@ def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
     below it the no-bypass string already includes that operating point. Taking the larger of the
     two is exact, and avoids searching across the cliff where the weaker voltage collapses (a
     search there once settled 0.7 % low).
+
+    Parameters
+    ----------
+    east, west : IVCurve
+        The two sub-panels' I-V curves, of one shape.
+    bypass : bool, default True
+        Ideal bypass diodes across each sub-panel.
+
+    Returns
+    -------
+    numpy.ndarray
+        Maximum power of the string [W], shaped as the curves.
     """
     isc_e, isc_w = east.i_sc, west.i_sc
     voc_e, voc_w = east.v_oc, west.v_oc
@@ -105,7 +135,21 @@ def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
 
 
 def pair_powers(east: IVCurve, west: IVCurve, bypass: bool = True):
-    """Parallel and series power [W] of a pair of sub-panels from their I-V curves."""
+    """Parallel and series power of a pair of sub-panels from their I-V curves.
+
+    Parameters
+    ----------
+    east, west : IVCurve
+        The two sub-panels' I-V curves, of one shape.
+    bypass : bool, default True
+        Ideal bypass diodes across each sub-panel in series.
+
+    Returns
+    -------
+    p_parallel, p_series : numpy.ndarray
+        :func:`parallel_power` and :func:`series_power` [W], the arguments ``p_parallel`` and
+        ``p_series`` of :func:`connection_powers`.
+    """
     return parallel_power(east, west), series_power(east, west, bypass)
 
 
@@ -164,7 +208,38 @@ def connection_powers(
 
 
 def connection_power(p_east, p_west, connection="switching", p_parallel=None, p_series=None, **options):
-    """Deliverable power [W] of one connection; see :func:`connection_powers`."""
+    """Deliverable power of one connection; see :func:`connection_powers`.
+
+    Parameters
+    ----------
+    p_east, p_west : array_like
+        Maximum power of each sub-panel [W].
+    connection : str, default 'switching'
+        One of :data:`foldopt.names.CONNECTIONS`.
+    p_parallel, p_series : array_like, optional
+        Power of the pair in parallel and in series [W] (:func:`pair_powers`); default the sum
+        of the two maxima (the ``ideal`` model).
+    **options
+        ``switch_series``, ``converter_efficiency``, ``with_state`` of :func:`connection_powers`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Power [W], shaped as ``p_east``.
+
+    Raises
+    ------
+    ValueError
+        If ``connection`` is unknown.
+
+    Examples
+    --------
+    With the ``ideal`` model (no I-V curves), switching takes the better of the two sub-panels
+    alone and both together:
+
+    >>> print(connection_power([3.0, 4.0], [1.0, 0.0], "switching"))
+    [4. 4.]
+    """
     if connection not in CONNECTIONS:
         raise ValueError(f"connection must be one of {', '.join(CONNECTIONS)}; got {connection!r}")
     return connection_powers(p_east, p_west, p_parallel, p_series, **options)[0][connection]

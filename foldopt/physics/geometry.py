@@ -26,10 +26,20 @@ from foldopt.names import GEOMETRIES
 def default_orientation(latitude: float) -> tuple[float, float]:
     """Equator-facing orientation with tilt equal to |latitude|.
 
+    Parameters
+    ----------
+    latitude : float
+        Site latitude [deg north].
+
     Returns
     -------
     surface_tilt, surface_azimuth : float
         [deg]; azimuth 180 on the northern hemisphere (and the equator), 0 on the southern.
+
+    Examples
+    --------
+    >>> default_orientation(-33.9)
+    (33.9, 0.0)
     """
     return abs(latitude), 180.0 if latitude >= 0 else 0.0
 
@@ -41,7 +51,31 @@ def _east_sign(surface_azimuth):
 
 
 def normal_vector(surface_tilt, surface_azimuth):
-    """Unit normal in east-north-up coordinates, stacked on the last axis."""
+    """Unit normal of surfaces in east-north-up coordinates.
+
+    The same vector as the sun's for ``(solar_zenith, solar_azimuth)``, so that a dot product of
+    the two is pvlib's ``irradiance.aoi_projection``.
+
+    Parameters
+    ----------
+    surface_tilt : array_like
+        Tilt from horizontal [deg] (or a zenith angle).
+    surface_azimuth : array_like
+        Azimuth clockwise from north [deg], broadcast against ``surface_tilt``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``broadcast + (3,)``: east, north and up components [-].
+
+    Examples
+    --------
+    Vertical surfaces facing east and south:
+
+    >>> normal_vector(90.0, [90.0, 180.0]).round(12) + 0.0
+    array([[ 1.,  0.,  0.],
+           [ 0., -1.,  0.]])
+    """
     tilt, azimuth = np.radians(surface_tilt), np.radians(surface_azimuth)
     return np.stack(
         np.broadcast_arrays(
@@ -52,10 +86,23 @@ def normal_vector(surface_tilt, surface_azimuth):
 
 
 def orientation_from_normal(normal, level_azimuth=180.0):
-    """``surface_tilt`` and ``surface_azimuth`` [deg] of east-north-up unit normals.
+    """``surface_tilt`` and ``surface_azimuth`` of east-north-up unit normals.
 
-    A level surface has no azimuth; it gets ``level_azimuth`` so that formulas that read one
-    anyway (the paper's Eq. 5) treat it like the panel it came from.
+    The inverse of :func:`normal_vector`. A level surface has no azimuth; it gets
+    ``level_azimuth`` so that formulas that read one anyway (Shin et al. Eq. 5) treat it like the
+    panel it came from.
+
+    Parameters
+    ----------
+    normal : array_like
+        Unit normals, east, north and up on the last axis [-].
+    level_azimuth : float or array_like, default 180
+        Azimuth given to level surfaces [deg], broadcast against the normals' leading axes.
+
+    Returns
+    -------
+    surface_tilt, surface_azimuth : numpy.ndarray
+        [deg]; azimuth in [0, 360).
     """
     east, north, up = np.moveaxis(np.asarray(normal), -1, 0)
     tilt = np.degrees(np.arctan2(np.hypot(east, north), up))
@@ -81,6 +128,35 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
     dict
         ``tilt_east``, ``azimuth_east``, ``tilt_west``, ``azimuth_west`` [deg], each shaped as
         ``fold_angle``.
+
+    Raises
+    ------
+    ValueError
+        If ``geometry`` is not one of :data:`foldopt.names.GEOMETRIES`.
+
+    References
+    ----------
+    .. [1] D. Shin, N. Chang, Y. Wang, M. Pedram, "Reconfigurable three dimensional photovoltaic
+       panel architecture for solar-powered time extension", Sec. IV-B and Fig. 6 (azimuth-split).
+    .. [2] O. Rodrigues, "Des lois geometriques qui regissent les deplacements d'un systeme solide
+       dans l'espace", J. Math. Pures Appl. 5, 380-440, 1840: the rotation of a vector about a unit
+       axis perpendicular to it, ``n cos(a) + (u x n) sin(a)`` (hinge).
+
+    Examples
+    --------
+    Folded to 90 deg, the paper's sub-panels of a south-facing panel face 135 and 225 deg:
+
+    >>> sides = subpanel_orientation(90.0, 34.05, 180.0, geometry="azimuth-split")
+    >>> print(sides["azimuth_east"], sides["azimuth_west"])
+    135.0 225.0
+
+    With the hinge, the two normals stand ``180 - fold_angle`` = 90 deg apart:
+
+    >>> sides = subpanel_orientation(90.0, 34.05, 180.0, geometry="hinge")
+    >>> east = normal_vector(sides["tilt_east"], sides["azimuth_east"])
+    >>> west = normal_vector(sides["tilt_west"], sides["azimuth_west"])
+    >>> print(round(float(np.degrees(np.arccos(east @ west))), 6))
+    90.0
     """
     fold_angle = np.asarray(fold_angle, dtype=float)
     turn = (180.0 - fold_angle) / 2.0 * _east_sign(surface_azimuth)

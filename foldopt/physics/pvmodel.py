@@ -47,7 +47,8 @@ TEMPERATURE_REF = 25.0  # [C], STC
 class DiodeUnit:
     """Reference (STC) single-diode parameters of one unit, De Soto form [1]_.
 
-    ``adjust`` is the CEC model's temperature-coefficient adjustment [%]; None selects De Soto.
+    Names and units as ``pvlib.pvsystem.calcparams_desoto``'s; ``adjust`` is the CEC model's
+    temperature-coefficient adjustment [%] (``calcparams_cec``), None selects De Soto.
     """
 
     name: str
@@ -95,6 +96,16 @@ def cec_module_name(name: str) -> str:
     """The exact name in pvlib's bundled CEC database [2]_ of a module given by any part of it,
     without regard to case and punctuation: ``CS5P-220M`` is ``Canadian_Solar_Inc__CS5P_220M``.
 
+    Parameters
+    ----------
+    name : str
+        The module's name in the database, or any part of it.
+
+    Returns
+    -------
+    str
+        The database's column name of the module (``pvlib.pvsystem.retrieve_sam("CECMod")``).
+
     Raises
     ------
     ValueError
@@ -119,8 +130,23 @@ def cec_module_name(name: str) -> str:
 
 
 def cec_module(name: str) -> DiodeUnit:
-    """A module of pvlib's bundled CEC database [2]_ by its name (any part of it, see
-    :func:`cec_module_name`)."""
+    """A module of pvlib's bundled CEC database [2]_ as a single-diode unit.
+
+    Parameters
+    ----------
+    name : str
+        The module's name, or any part of it (:func:`cec_module_name`).
+
+    Returns
+    -------
+    DiodeUnit
+        Its reference parameters and area, with the CEC ``Adjust`` [%].
+
+    Raises
+    ------
+    ValueError
+        Where no module or several match ``name``.
+    """
     name = cec_module_name(name)
     modules = _cec_modules()
     m = modules[name]
@@ -173,6 +199,25 @@ def fit_b(v_x, i_x, voltage, current):
 
     With ``1 - exp(-1/b) ~ 1``, Eq. 8 gives ``I / I_x = 1 - exp((V / V_x - 1) / b)``, so
     ``b = (V / V_x - 1) / ln(1 - I / I_x)``.
+
+    Parameters
+    ----------
+    v_x, i_x : array_like
+        The curve's end points [V], [A]: open-circuit voltage and short-circuit current.
+    voltage, current : array_like
+        A point of the curve [V], [A], usually the maximum-power point.
+
+    Returns
+    -------
+    numpy.ndarray
+        b [-].
+
+    Examples
+    --------
+    The 200 W panel of Robles Algarin et al. Table 1 (their b = 0.068):
+
+    >>> print(round(float(fit_b(32.1, 8.21, 26.01, 7.69)), 4))
+    0.0688
     """
     return (voltage / v_x - 1.0) / np.log(1.0 - current / i_x)
 
@@ -183,6 +228,14 @@ class IVCurve:
 
     ``current(V)`` and ``voltage(I)`` accept arrays of the parameters' shape or with one extra
     trailing axis (a grid of operating points per curve).
+
+    Parameters
+    ----------
+    model : {'single-diode', 'b-model'}
+    params : tuple of numpy.ndarray
+        ``single-diode``: ``photocurrent, saturation_current, resistance_series,
+        resistance_shunt, nNsVth`` [A, A, ohm, ohm, V], pvlib's ``i_from_v`` order.
+        ``b-model``: ``v_x, i_x, b`` [V, A, -] (Robles Algarin et al. Eq. 8-10).
     """
 
     model: str
@@ -193,7 +246,18 @@ class IVCurve:
         return [np.reshape(p, np.shape(p) + (1,) * extra) for p in self.params]
 
     def current(self, voltage):
-        """Current [A] at ``voltage`` [V]; negative beyond open circuit."""
+        """Current of each curve at a voltage.
+
+        Parameters
+        ----------
+        voltage : array_like
+            [V], of the parameters' shape or with one extra trailing axis.
+
+        Returns
+        -------
+        numpy.ndarray
+            Current [A]; negative beyond open circuit.
+        """
         if self.model == "single-diode":
             return pvlib.pvsystem.i_from_v(voltage, *self._params(voltage))
         v_x, i_x, b = self._params(voltage)
@@ -202,7 +266,18 @@ class IVCurve:
             return np.where(v_x > 0, scale * -np.expm1((voltage / v_x - 1.0) / b), 0.0)
 
     def voltage(self, current):
-        """Voltage [V] at ``current`` [A]; NaN or negative beyond short circuit."""
+        """Voltage of each curve at a current.
+
+        Parameters
+        ----------
+        current : array_like
+            [A], of the parameters' shape or with one extra trailing axis.
+
+        Returns
+        -------
+        numpy.ndarray
+            Voltage [V]; NaN or negative beyond short circuit.
+        """
         if self.model == "single-diode":
             # pvlib's Lambert-W overflows for practically dark cells; `lit` handles those.
             with np.errstate(over="ignore", invalid="ignore"):
@@ -260,10 +335,31 @@ def _lambertw_exp(x):
 
 
 def cell_temperature(poa_global, temp_air, wind_speed, model="fixed"):
-    """Cell temperature [C] from irradiance [W/m^2], air temperature [C] and wind [m/s].
+    """Cell temperature from irradiance, air temperature and wind.
 
     ``fixed``: the air temperature (a cell held at it, e.g. 25 C = STC). ``sapm``: pvlib's SAPM
-    cell temperature, open rack glass/polymer (King et al. 2004).
+    cell temperature, open rack glass/polymer (King et al. 2004, SAND2004-3535, Eq. 11 and 12).
+
+    Parameters
+    ----------
+    poa_global : array_like
+        Plane-of-array irradiance [W/m^2].
+    temp_air : float or array_like
+        Air temperature [C].
+    wind_speed : float or array_like
+        Wind speed [m/s] (``sapm`` only).
+    model : {'fixed', 'sapm'}
+        Temperature model.
+
+    Returns
+    -------
+    numpy.ndarray
+        Cell temperature [C], shaped as ``poa_global``.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not one of :data:`foldopt.names.TEMPERATURE_MODELS`.
     """
     if model == "fixed":
         return np.broadcast_to(np.asarray(temp_air, dtype=float), np.shape(poa_global)).copy()
@@ -285,6 +381,11 @@ class PVModel:
         Robles Algarin et al. do not give, as ``p_mp / (efficiency * 1000 W/m^2)``.
     module : str or None
         ``single-diode``: a CEC module name; None is the A-300 cell.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not one of :data:`foldopt.names.PV_MODELS`.
     """
 
     model: str = "ideal"
@@ -315,7 +416,32 @@ class PVModel:
         return self.model != "ideal"
 
     def curves(self, poa_global, temp_cell, area) -> IVCurve:
-        """I-V curves of panels of ``area`` [m^2] at irradiance [W/m^2] and cell temperature [C]."""
+        """I-V curves of panels of a given area.
+
+        ``single-diode``: the reference parameters moved to the operating conditions by De Soto
+        [1]_ or the CEC [2]_ (pvlib's ``calcparams_desoto`` / ``calcparams_cec``), for
+        ``area / unit_area`` units in series. ``b-model``: Robles Algarin et al. [3]_ Eq. 9 and 10
+        with s = the units in series and p = 1.
+
+        Parameters
+        ----------
+        poa_global : array_like
+            Plane-of-array irradiance [W/m^2].
+        temp_cell : array_like
+            Cell temperature [C], broadcast against ``poa_global``.
+        area : float
+            Panel area [m^2].
+
+        Returns
+        -------
+        IVCurve
+            One curve per element of ``poa_global``.
+
+        Raises
+        ------
+        ValueError
+            For the ``ideal`` model, which has no I-V curve.
+        """
         poa = np.asarray(poa_global, dtype=float)
         temp_cell = np.broadcast_to(np.asarray(temp_cell, dtype=float), poa.shape)
         units = area / self.unit_area
@@ -347,7 +473,22 @@ class PVModel:
         raise ValueError("the ideal model has no I-V curve")
 
     def max_power(self, poa_global, temp_cell, area):
-        """Maximum power [W] of panels of ``area`` [m^2]."""
+        """Maximum power of panels of a given area.
+
+        Parameters
+        ----------
+        poa_global : array_like
+            Plane-of-array irradiance [W/m^2].
+        temp_cell : array_like
+            Cell temperature [C], broadcast against ``poa_global`` (not used by ``ideal``).
+        area : float
+            Panel area [m^2].
+
+        Returns
+        -------
+        numpy.ndarray
+            Power at the maximum-power point [W], shaped as ``poa_global``.
+        """
         if self.model == "ideal":
             return self.efficiency * area * np.asarray(poa_global, dtype=float)
         return self.curves(poa_global, temp_cell, area).max_power()

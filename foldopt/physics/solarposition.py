@@ -15,11 +15,10 @@ formulas (``equation_of_time_pvcdrom``, ``declination_cooper69``, ``solar_zenith
 Clock time is converted to local solar time LST with the longitude correction and the
 equation of time of [2]_: ``LST = LT + (4 (longitude - LSTM) + EoT) / 60``.
 
-The exact mode is NREL's SPA [3]_ through ``pvlib.spa``. Many days and sites are evaluated as one
-array program (:class:`ClockGrid`, :func:`solar_position_grid`): SPA's geocentric part, which
-depends on time only, runs once per UTC hour that any day touches and is interpolated, as SPA
-itself interpolates it for sunrise and sunset [3]_ (Appendix A.2); the topocentric part runs per
-site.
+The exact mode is NREL's SPA [3]_ as pvlib implements it, split by :mod:`foldopt.physics.spa` into
+a time-only part shared by every site and a per-site part, so that many days and sites are one
+array program (:class:`ClockGrid`, :func:`solar_position_grid`); that module says what the split
+buys over ``pvlib.solarposition.get_solarposition`` and what it costs.
 
 References
 ----------
@@ -41,9 +40,9 @@ import pandas as pd
 import pvlib
 
 from foldopt.names import MODES
+from foldopt.physics.spa import NS_PER_HOUR, spa_solar_position
 
-_NS_PER_HOUR = 3_600_000_000_000
-_NS_PER_DAY = 24 * _NS_PER_HOUR
+_NS_PER_DAY = 24 * NS_PER_HOUR
 
 
 def day_times(date: dt.date, timezone, step_min: float = 1.0) -> pd.DatetimeIndex:
@@ -92,20 +91,23 @@ class ClockGrid:
 
     @property
     def shape(self) -> tuple[int, int]:
+        """``(n_blocks, n_steps)``."""
         return self.utc_ns.shape
 
     @property
     def local_ns(self) -> np.ndarray:
+        """Local clock time of each step [ns since 1970-01-01 00:00 local]."""
         return self.utc_ns + self.utc_offset_ns
 
     @property
     def clock_hours(self) -> np.ndarray:
         """Local clock time of each step [h since local midnight]."""
-        return (self.local_ns % _NS_PER_DAY) / _NS_PER_HOUR
+        return (self.local_ns % _NS_PER_DAY) / NS_PER_HOUR
 
     @property
     def utc_offset_hours(self) -> np.ndarray:
-        return self.utc_offset_ns / _NS_PER_HOUR
+        """Local clock minus UTC [h]."""
+        return self.utc_offset_ns / NS_PER_HOUR
 
     @property
     def day_of_year(self) -> np.ndarray:
@@ -118,13 +120,39 @@ class ClockGrid:
         return table[days - first]
 
     def times(self, block: int) -> pd.DatetimeIndex:
-        """The tz-aware times of one block."""
+        """The tz-aware times of one block.
+
+        Parameters
+        ----------
+        block : int
+            Row of the grid.
+
+        Returns
+        -------
+        pandas.DatetimeIndex
+            The block's steps in its own time zone.
+        """
         utc = pd.DatetimeIndex(self.utc_ns[block].astype("datetime64[ns]"), tz="UTC")
         return utc.tz_convert(self.timezones[block])
 
     @classmethod
     def stack(cls, grids) -> ClockGrid:
-        """Blocks of several grids of equal step, one after the other."""
+        """Blocks of several grids of equal step, one after the other.
+
+        Parameters
+        ----------
+        grids : iterable of ClockGrid
+            Of equal steps per day and step length.
+
+        Returns
+        -------
+        ClockGrid
+
+        Raises
+        ------
+        ValueError
+            If the grids' steps differ.
+        """
         grids = list(grids)
         if len({g.shape[1] for g in grids}) != 1 or len({g.step_hours for g in grids}) != 1:
             raise ValueError("stacked grids need the same steps per day")
@@ -133,11 +161,23 @@ class ClockGrid:
 
     @classmethod
     def from_times(cls, days, timezone) -> ClockGrid:
-        """A grid from tz-aware time indexes, one per block, of equal length and step."""
+        """A grid from tz-aware time indexes, one per block, of equal length and step.
+
+        Parameters
+        ----------
+        days : sequence of pandas.DatetimeIndex
+            One index per block.
+        timezone : str or datetime.tzinfo
+            The blocks' time zone.
+
+        Returns
+        -------
+        ClockGrid
+        """
         utc = np.stack([np.asarray(pd.DatetimeIndex(t).tz_convert("UTC").tz_localize(None).as_unit("ns").asi8)
                         for t in days])
         local = np.stack([np.asarray(pd.DatetimeIndex(t).tz_localize(None).as_unit("ns").asi8) for t in days])
-        step = float(np.median(np.diff(utc, axis=1))) / _NS_PER_HOUR if utc.shape[1] > 1 else 24.0
+        step = float(np.median(np.diff(utc, axis=1))) / NS_PER_HOUR if utc.shape[1] > 1 else 24.0
         return cls(utc, local - utc, (timezone,) * len(days), step)
 
 
@@ -147,9 +187,22 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
     Parameters
     ----------
     dates : sequence of datetime.date
+        Local calendar days, one block each.
     timezone : str or datetime.tzinfo
+        Time zone of the clock (IANA name or fixed offset).
     step_min : float, default 1
         Step length [min]; must divide the 24 h day.
+
+    Returns
+    -------
+    ClockGrid
+        ``(len(dates), 1440 / step_min)``; clock times that a DST change skips are shifted
+        forward and repeated ones taken once, so every day keeps its number of steps.
+
+    Raises
+    ------
+    ValueError
+        If ``step_min`` does not divide 1440 min.
     """
     n_steps = 24 * 60 / step_min
     if not np.isclose(n_steps, round(n_steps)):
@@ -189,7 +242,20 @@ def declination_paper(dayofyear):
 
 
 def equation_of_time_paper(dayofyear):
-    """Equation of time of PVCDROM [2]_: 9.87 sin 2B - 7.53 cos B - 1.5 sin B [min]."""
+    """Equation of time of PVCDROM [2]_ ("Solar Time"), as pvlib's ``equation_of_time_pvcdrom``.
+
+    ``EoT = 9.87 sin 2B - 7.53 cos B - 1.5 sin B`` with ``B = 360 / 365 (d - 81)`` deg.
+
+    Parameters
+    ----------
+    dayofyear : array_like
+        Day of year, 1 on January 1 [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        Equation of time [min].
+    """
     day_angle = np.radians(360.0 / 365.0 * (np.asarray(dayofyear, dtype=float) - 81.0))
     return 9.87 * np.sin(2 * day_angle) - 7.53 * np.cos(day_angle) - 1.5 * np.sin(day_angle)
 
@@ -255,118 +321,6 @@ def sun_from_angles(declination, hour_angle, latitude):
     return 90.0 - np.degrees(elevation), azimuth
 
 
-SPA_SPACING_MIN = 10.0  # [min] between topocentric SPA evaluations on finely stepped series
-SPA_DELTA_T = 67.0  # [s], TT - UT1, pvlib's default for spa_python
-SPA_TEMPERATURE = 12.0  # [C], pvlib's default for the refraction correction
-SPA_ATMOS_REFRACT = 0.5667  # [deg], SPA's refraction at sunrise and sunset
-
-
-def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
-    """The time-only part of SPA [3]_ (Sec. 3.1-3.9 and the equation of time) via ``pvlib.spa``.
-
-    Returns the geocentric right ascension ``alpha`` and declination ``delta`` [deg], the apparent
-    sidereal time ``v`` [deg], the equatorial horizontal parallax ``xi`` [deg] and the equation of
-    time ``eot`` [min], the steps of ``pvlib.spa.solar_position_numpy`` before its site enters.
-    """
-    spa = pvlib.spa
-    unixtime = np.asarray(unixtime, dtype=float)
-    jd = spa.julian_day(unixtime)
-    jde = spa.julian_ephemeris_day(jd, delta_t)
-    jc = spa.julian_century(jd)
-    jce = spa.julian_ephemeris_century(jde)
-    jme = spa.julian_ephemeris_millennium(jce)
-    radius = spa.heliocentric_radius_vector(jme)
-    theta = spa.geocentric_longitude(spa.heliocentric_longitude(jme))
-    beta = spa.geocentric_latitude(spa.heliocentric_latitude(jme))
-    args = (spa.mean_elongation(jce), spa.mean_anomaly_sun(jce), spa.mean_anomaly_moon(jce),
-            spa.moon_argument_latitude(jce), spa.moon_ascending_longitude(jce))
-    nutation = np.empty((2, unixtime.size))
-    spa.longitude_obliquity_nutation(jce, *args, nutation)
-    delta_psi, delta_epsilon = nutation
-    epsilon = spa.true_ecliptic_obliquity(spa.mean_ecliptic_obliquity(jme), delta_epsilon)
-    lamd = spa.apparent_sun_longitude(theta, delta_psi, spa.aberration_correction(radius))
-    v = spa.apparent_sidereal_time(spa.mean_sidereal_time(jd, jc), delta_psi, epsilon)
-    alpha = spa.geocentric_sun_right_ascension(lamd, epsilon, beta)
-    delta = spa.geocentric_sun_declination(lamd, epsilon, beta)
-    eot = spa.equation_of_time(spa.sun_mean_longitude(jme), alpha, delta_psi, epsilon)
-    return {"alpha": alpha, "delta": delta, "v": v, "xi": spa.equatorial_horizontal_parallax(radius), "eot": eot}
-
-
-_WRAPPED = ("alpha", "v")  # angles that wrap at 360 deg
-
-
-def _geocentric_hourly(utc_ns: np.ndarray) -> dict:
-    """:func:`spa_geocentric` at ``utc_ns`` (any shape), interpolated linearly between whole UTC
-    hours, each hour evaluated once however many sites and days share it.
-
-    Over an hour the geocentric terms are smooth to within 1e-5 deg of linear (tested)."""
-    hours = np.floor_divide(utc_ns, _NS_PER_HOUR)
-    nodes = np.unique(np.concatenate([hours.ravel(), hours.ravel() + 1]))
-    at_nodes = spa_geocentric(nodes * 3600.0)
-    index = np.searchsorted(nodes, hours)
-    weight = (utc_ns - hours * _NS_PER_HOUR) / _NS_PER_HOUR
-    out = {}
-    for name, values in at_nodes.items():
-        start, end = values[index], values[index + 1]
-        change = end - start
-        if name in _WRAPPED:
-            change = (change + 180.0) % 360.0 - 180.0
-        out[name] = start + weight * change
-    return out
-
-
-def _spa_topocentric(geo: dict, latitude, longitude, altitude):
-    """Geometric (refraction-free) zenith and azimuth [deg] from geocentric terms, SPA Sec. 3.10-3.14
-    via ``pvlib.spa``; site arguments broadcast against the terms."""
-    spa = pvlib.spa
-    hour_angle = spa.local_hour_angle(geo["v"], longitude, geo["alpha"])
-    u = spa.uterm(latitude)
-    x, y = spa.xterm(u, latitude, altitude), spa.yterm(u, latitude, altitude)
-    delta_alpha = spa.parallax_sun_right_ascension(x, geo["xi"], hour_angle, geo["delta"])
-    delta_prime = spa.topocentric_sun_declination(geo["delta"], x, y, geo["xi"], delta_alpha, hour_angle)
-    hour_angle_prime = spa.topocentric_local_hour_angle(hour_angle, delta_alpha)
-    elevation = spa.topocentric_elevation_angle_without_atmosphere(latitude, delta_prime, hour_angle_prime)
-    gamma = spa.topocentric_astronomers_azimuth(hour_angle_prime, delta_prime, latitude)
-    azimuth = spa.topocentric_azimuth_angle(gamma)
-    return 90.0 - elevation, azimuth
-
-
-def _spa_grid(grid: ClockGrid, latitude, longitude, altitude):
-    """Apparent zenith, azimuth [deg] and equation of time [min] by SPA at every step of ``grid``.
-
-    On a grid stepped finer than :data:`SPA_SPACING_MIN`, the topocentric position is evaluated every
-    10 minutes only (and on each day's last step); the geometric sun vector and the equation of time,
-    which are smooth, are interpolated linearly between, and SPA's own refraction correction (with
-    pvlib's default pressure for the altitude and 12 C) is applied to every step, so that the
-    correction's kink at the horizon stays exact. Measured at 1-minute steps against pvlib's full
-    SPA: the sun's direction within 0.005 deg, the equation of time within 1e-6 min
-    (tests/test_solarposition.py).
-    """
-    n_steps = grid.shape[1]
-    stride = int(SPA_SPACING_MIN // (grid.step_hours * 60.0))
-    if stride < 2 or n_steps < 4 * stride:
-        picked = np.arange(n_steps)
-    else:
-        picked = np.unique(np.r_[np.arange(0, n_steps, stride), n_steps - 1])
-    geo = _geocentric_hourly(grid.utc_ns[:, picked])
-    zenith0, azimuth = (np.radians(a) for a in _spa_topocentric(geo, latitude, longitude, altitude))
-    vector = np.stack([np.sin(zenith0) * np.sin(azimuth), np.sin(zenith0) * np.cos(azimuth), np.cos(zenith0)], -1)
-    eot = geo["eot"]
-    if picked.size < n_steps:
-        # Every day has the same pattern of picks, so one set of weights serves all of them.
-        position = np.arange(n_steps)
-        right = np.clip(np.searchsorted(picked, position, side="right"), 1, picked.size - 1)
-        weight = ((position - picked[right - 1]) / (picked[right] - picked[right - 1]))[None, :]
-        vector = vector[:, right - 1] * (1.0 - weight[..., None]) + vector[:, right] * weight[..., None]
-        eot = eot[:, right - 1] * (1.0 - weight) + eot[:, right] * weight
-    east, north, up = np.moveaxis(vector, -1, 0)
-    elevation0 = np.degrees(np.arctan2(up, np.hypot(east, north)))
-    pressure = pvlib.atmosphere.alt2pres(np.asarray(altitude, dtype=float))
-    refraction = pvlib.spa.atmospheric_refraction_correction(pressure / 100.0, SPA_TEMPERATURE, elevation0,
-                                                             SPA_ATMOS_REFRACT)
-    return 90.0 - (elevation0 + refraction), np.degrees(np.arctan2(east, north)) % 360.0, eot
-
-
 def solar_position_grid(grid: ClockGrid, latitude, longitude, altitude=0.0, model: str = "exact") -> dict:
     """Solar position at every step of a grid of days.
 
@@ -397,8 +351,9 @@ def solar_position_grid(grid: ClockGrid, latitude, longitude, altitude=0.0, mode
         hour_angle = _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, doy, longitude)
         zenith, azimuth = sun_from_angles(declination, hour_angle, latitude)
     elif model == "exact":
-        zenith, azimuth, equation_of_time = _spa_grid(grid, latitude, longitude, altitude)
-        utc_hours = (grid.utc_ns % _NS_PER_DAY) / _NS_PER_HOUR
+        zenith, azimuth, equation_of_time = spa_solar_position(grid.utc_ns, grid.step_hours, latitude, longitude,
+                                                               altitude)
+        utc_hours = (grid.utc_ns % _NS_PER_DAY) / NS_PER_HOUR
         hour_angle = (15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0) % 360.0 - 180.0
         declination = _by_day_of_year(lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), doy)
     else:

@@ -29,17 +29,36 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import pvlib
 
 from foldopt.physics.geometry import normal_vector, orientation_from_normal
 from foldopt.names import ALEXANDRU_STEP_OFFSETS_H, DRIVES, TRACKERS
 
 
 def equatorial_normal(hour_angle, declination, latitude):
-    """East-north-up unit vector toward (hour angle, declination) on the sky [deg]."""
+    """East-north-up unit vector toward a point of the sky given in equatorial coordinates.
+
+    The normal of an equatorial mount whose daily (polar) axis is at ``hour_angle`` and whose
+    seasonal axis is at ``declination`` [1]_ (Fig. 1a); with the sun's own coordinates it is the
+    sun vector of Shin et al. Eq. 3 and 6.
+
+    Parameters
+    ----------
+    hour_angle : array_like
+        Hour angle [deg], negative to the east (before solar noon).
+    declination : array_like
+        Declination [deg].
+    latitude : float or array_like
+        Site latitude [deg north]; all three broadcast.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``broadcast + (3,)``: east, north and up components [-].
+    """
     h, d, lat = np.radians(hour_angle), np.radians(declination), np.radians(latitude)
     east = -np.cos(d) * np.sin(h)
     north = np.sin(d) * np.cos(lat) - np.cos(d) * np.sin(lat) * np.cos(h)
@@ -64,6 +83,29 @@ def step_law(hour_angle, steps=12, angular_field=90.0, offsets_h=ALEXANDRU_STEP_
         Total swing of the daily axis [deg].
     offsets_h : sequence of float
         ``steps / 2`` positive offsets of the afternoon moves from solar noon [h].
+
+    Returns
+    -------
+    numpy.ndarray
+        The daily axis' angle [deg] at each hour angle, in ``[-angular_field / 2,
+        angular_field / 2]``.
+
+    Raises
+    ------
+    ValueError
+        If ``steps`` is not twice the number of ``offsets_h``.
+
+    References
+    ----------
+    .. [1] C. Alexandru, "A Novel Open-Loop Tracking Strategy for Photovoltaic Systems", The
+       Scientific World Journal 2013, 205396, Sec. 4.
+
+    Examples
+    --------
+    Two moves a day, an hour either side of solar noon, over a 90 deg field:
+
+    >>> print(step_law([-30.0, 0.0, 30.0], steps=2, angular_field=90.0, offsets_h=(1.0,)))
+    [-45.   0.  45.]
     """
     offsets = np.sort(np.asarray(offsets_h, dtype=float))
     if steps != 2 * offsets.size:
@@ -92,6 +134,11 @@ def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declinat
     surface_tilt, surface_azimuth : numpy.ndarray
         [deg] per time step.
 
+    Raises
+    ------
+    ValueError
+        If ``model`` is not one of :data:`foldopt.names.TRACKERS`.
+
     Notes
     -----
     While the sun is below the horizon a tracker rests in its stow position: the ideal and the
@@ -99,44 +146,121 @@ def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declinat
     morning position (Alexandru's open-loop law returns there at night), the single-axis tracker
     flat along its axis (pvlib returns no angle then).
     """
-    options = options or TrackerOptions()
+    if model not in TRACKER_MODELS:
+        raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}; got {model!r}")
+    return TRACKER_MODELS[model].orientation(solar_zenith, solar_azimuth, hour_angle, declination, latitude,
+                                             options or TrackerOptions())
+
+
+def _resting(solar_zenith, latitude):
+    """The sun's zenith [deg] as floats, where the sun is down, and the azimuth [deg] of a level
+    panel at rest (facing the equator's side)."""
     zenith = np.asarray(solar_zenith, dtype=float)
-    down = zenith >= 90.0
-    north = np.asarray(latitude) >= 0
-    level_azimuth = np.where(north, 180.0, 0.0)
-    if model == "dual-axis":
-        azimuth = np.asarray(solar_azimuth, dtype=float)
-        return np.where(down, 0.0, zenith), np.where(down, level_azimuth, azimuth)
-    if model in ("equatorial", "dual-axis-steps"):
-        hour_angle = np.asarray(hour_angle, dtype=float)
-        noon = np.argmin(np.abs(hour_angle), axis=-1)[..., None]
-        seasonal = np.take_along_axis(np.broadcast_to(declination, hour_angle.shape), noon, axis=-1)
-        if model == "equatorial":
-            normal = equatorial_normal(hour_angle, seasonal, latitude)
-            tilt, azimuth = orientation_from_normal(normal, level_azimuth=level_azimuth)
-            return np.where(down, 0.0, tilt), np.where(down, level_azimuth, azimuth)
-        daily = step_law(hour_angle, options.steps, options.angular_field, options.step_offsets_h)
-        daily = np.where(down, -options.angular_field / 2.0, daily)
-        return orientation_from_normal(equatorial_normal(daily, seasonal, latitude), level_azimuth=level_azimuth)
-    if model == "single-axis":
-        axis_azimuth = options.axis_azimuth if options.axis_azimuth is not None else np.where(north, 180.0, 0.0)
-        shape = zenith.shape
-        axis_azimuth = np.broadcast_to(axis_azimuth, shape)
-        result = pvlib.tracking.singleaxis(
-            zenith.ravel(), np.asarray(solar_azimuth, dtype=float).ravel(), axis_tilt=options.axis_tilt,
-            axis_azimuth=axis_azimuth.ravel(), max_angle=options.max_angle, backtrack=options.backtrack,
-            gcr=options.gcr,
-        )
-        # At night pvlib returns NaN; the panel then rests flat along the axis.
-        tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt).reshape(shape)
-        azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
-        return tilt, np.where(np.isnan(azimuth), axis_azimuth, azimuth)
-    raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}; got {model!r}")
+    return zenith, zenith >= 90.0, np.where(np.asarray(latitude) >= 0, 180.0, 0.0)
+
+
+def _noon_declination(hour_angle, declination):
+    """The declination at each day's solar noon [deg], where an equatorial mount sets its seasonal axis."""
+    noon = np.argmin(np.abs(hour_angle), axis=-1)[..., None]
+    return np.take_along_axis(np.broadcast_to(declination, hour_angle.shape), noon, axis=-1)
+
+
+def _dual_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options):
+    """The ideal tracker: the normal on the sun, level at night."""
+    zenith, down, level_azimuth = _resting(solar_zenith, latitude)
+    azimuth = np.asarray(solar_azimuth, dtype=float)
+    return np.where(down, 0.0, zenith), np.where(down, level_azimuth, azimuth)
+
+
+def _equatorial(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options):
+    """The equatorial mount following the hour angle, level at night."""
+    _, down, level_azimuth = _resting(solar_zenith, latitude)
+    hour_angle = np.asarray(hour_angle, dtype=float)
+    normal = equatorial_normal(hour_angle, _noon_declination(hour_angle, declination), latitude)
+    tilt, azimuth = orientation_from_normal(normal, level_azimuth=level_azimuth)
+    return np.where(down, 0.0, tilt), np.where(down, level_azimuth, azimuth)
+
+
+def _dual_axis_steps(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options):
+    """The equatorial mount on Alexandru's step law, at its morning position at night."""
+    _, down, level_azimuth = _resting(solar_zenith, latitude)
+    hour_angle = np.asarray(hour_angle, dtype=float)
+    seasonal = _noon_declination(hour_angle, declination)
+    daily = step_law(hour_angle, options.steps, options.angular_field, options.step_offsets_h)
+    daily = np.where(down, -options.angular_field / 2.0, daily)
+    return orientation_from_normal(equatorial_normal(daily, seasonal, latitude), level_azimuth=level_azimuth)
+
+
+def _single_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options):
+    """pvlib's single-axis tracker, flat along its axis at night."""
+    import pvlib  # seconds to import: where a single-axis tracker runs, not where a study reads the registry
+
+    zenith, _, level_azimuth = _resting(solar_zenith, latitude)
+    axis_azimuth = options.axis_azimuth if options.axis_azimuth is not None else level_azimuth
+    shape = zenith.shape
+    axis_azimuth = np.broadcast_to(axis_azimuth, shape)
+    result = pvlib.tracking.singleaxis(
+        zenith.ravel(), np.asarray(solar_azimuth, dtype=float).ravel(), axis_tilt=options.axis_tilt,
+        axis_azimuth=axis_azimuth.ravel(), max_angle=options.max_angle, backtrack=options.backtrack,
+        gcr=options.gcr,
+    )
+    # At night pvlib returns NaN; the panel then rests flat along the axis.
+    tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt).reshape(shape)
+    azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
+    return tilt, np.where(np.isnan(azimuth), axis_azimuth, azimuth)
+
+
+@dataclass(frozen=True)
+class TrackerModel:
+    """One tracker model of :data:`TRACKER_MODELS`.
+
+    Parameters
+    ----------
+    orientation : callable
+        ``orientation(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options)``
+        returning ``(surface_tilt, surface_azimuth)`` [deg], as :func:`tracker_orientation`.
+    options : tuple of str
+        The fields of :class:`TrackerOptions` it reads; a study refuses the others given a value
+        (:meth:`foldopt.inputs.sections.Tracker.idle_settings`).
+    """
+
+    orientation: Callable
+    options: tuple = ()
+
+
+#: The tracker models by name, as :data:`foldopt.names.TRACKERS` lists and describes them: a new
+#: model is its function and its entry here (and its name and description there).
+TRACKER_MODELS = {
+    "dual-axis": TrackerModel(_dual_axis),
+    "equatorial": TrackerModel(_equatorial),
+    "dual-axis-steps": TrackerModel(_dual_axis_steps, ("steps", "angular_field", "step_offsets_h")),
+    "single-axis": TrackerModel(_single_axis, ("axis_tilt", "axis_azimuth", "max_angle", "backtrack", "gcr")),
+}
 
 
 @dataclass(frozen=True)
 class TrackerOptions:
-    """Settings of the step law and the single-axis tracker."""
+    """Settings of the step law and the single-axis tracker.
+
+    Parameters
+    ----------
+    steps : int, default 12
+        Moves a day of the step law (:func:`step_law`).
+    angular_field : float, default 90
+        Swing of the step law's daily axis [deg].
+    step_offsets_h : tuple of float, default :data:`foldopt.names.ALEXANDRU_STEP_OFFSETS_H`
+        The step law's afternoon moves after solar noon [h].
+    axis_tilt : float, default 0
+        Single-axis tracker: tilt of its axis [deg].
+    axis_azimuth : float, optional
+        Single-axis tracker: azimuth of its axis [deg]; default toward the equator (a N-S axis).
+    max_angle : float, default 90
+        Single-axis tracker: largest rotation [deg].
+    backtrack : bool, default False
+        Single-axis tracker: backtracking against row-to-row shading.
+    gcr : float, default 0.35
+        Single-axis tracker: ground coverage ratio [-], for backtracking.
+    """
 
     steps: int = 12
     angular_field: float = 90.0
@@ -160,6 +284,27 @@ class TrackerDrive:
     stall current to the 0.3 A free current as the motor speeds up, all at 12 V. The paper does not
     state the unit of omega; this reading is foldopt's, and ``wh-per-degree`` replaces it with a
     measured figure.
+
+    Parameters
+    ----------
+    standby_w : float, default 0
+        The controller's draw while the sun is up [W].
+    drive : {'motor', 'wh-per-degree'}
+        Drive energy by the motor model or by ``wh_per_degree``.
+    wh_per_degree : float, default 0
+        Drive energy per degree the panel turns [Wh/deg] (``wh-per-degree``).
+    gear_ratio : float, default 653
+        Gear-motor output turns per panel turn [-].
+    motor_voltage : float, default 12
+        [V].
+    stall_current, free_current : float, default 5 and 0.3
+        Motor current at rest and at full speed [A].
+    counts_per_revolution : float, default 4288
+        Encoder counts per gear-motor output revolution [-].
+    gain : float, default 5571.57
+        Steady-state speed for the 12 V step [counts/s].
+    tau_1, tau_2 : float, default 0.37138 and 0.09175
+        Time constants of the two-pole speed response [s].
     """
 
     standby_w: float = 0.0
@@ -175,7 +320,28 @@ class TrackerDrive:
     tau_2: float = 0.09175  # [s]
 
     def move_energy_wh(self, degrees):
-        """Drive energy [Wh] of moves of the panel by ``degrees`` [deg] (array)."""
+        """Drive energy of moves of the panel, each from rest.
+
+        Parameters
+        ----------
+        degrees : array_like
+            Angle of each move of the panel [deg]; the sign is ignored.
+
+        Returns
+        -------
+        numpy.ndarray
+            Energy per move [Wh]; 0 for no move.
+
+        Raises
+        ------
+        ValueError
+            If :attr:`drive` is not one of :data:`foldopt.names.DRIVES`.
+
+        Examples
+        --------
+        >>> print(TrackerDrive(drive="wh-per-degree", wh_per_degree=0.01).move_energy_wh([-15.0, 0.0]))
+        [0.15 0.  ]
+        """
         degrees = np.abs(np.asarray(degrees, dtype=float))
         if self.drive == "wh-per-degree":
             return self.wh_per_degree * degrees
@@ -205,9 +371,22 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
 
 
 def moved_degrees(surface_tilt, surface_azimuth):
-    """Angle [deg] the panel normal turns between consecutive steps (time on the last axis, any
-    leading axes): tracking by day, and the moves into and out of the stow position at sunset and
-    sunrise (:func:`tracker_orientation`)."""
+    """Angle the panel normal turns between consecutive steps.
+
+    Tracking by day, and the moves into and out of the stow position at sunset and sunrise
+    (:func:`tracker_orientation`).
+
+    Parameters
+    ----------
+    surface_tilt, surface_azimuth : array_like
+        Panel orientation per step [deg], time on the last axis, any leading axes.
+
+    Returns
+    -------
+    numpy.ndarray
+        Turn into each step [deg], shaped as the orientation; 0 at the first step and where the
+        panel holds still (turns below 1e-6 deg).
+    """
     normal = normal_vector(surface_tilt, surface_azimuth)
     turn = np.zeros(normal.shape[:-1])
     turn[..., 1:] = _angle_between(normal[..., 1:, :], normal[..., :-1, :])
@@ -221,9 +400,25 @@ def _angle_between(a, b):
 
 
 def tracker_draw(surface_tilt, surface_azimuth, sun_up, step_hours, drive: TrackerDrive):
-    """The tracker's own power draw per step [W]: standby while the sun is up, plus moves.
+    """The tracker's own power draw per step: standby while the sun is up, plus moves.
 
     Each step's moves are spread over the step (their energy / step length).
+
+    Parameters
+    ----------
+    surface_tilt, surface_azimuth : array_like
+        Panel orientation per step [deg] (:func:`tracker_orientation`), time on the last axis.
+    sun_up : array_like of bool
+        Steps with the sun above the horizon, broadcast against the orientation.
+    step_hours : float
+        Step length [h].
+    drive : TrackerDrive
+        Standby and drive energy.
+
+    Returns
+    -------
+    numpy.ndarray
+        Draw [W] per step.
     """
     sun_up = np.asarray(sun_up, dtype=bool)
     moves = drive.move_energy_wh(moved_degrees(surface_tilt, surface_azimuth))

@@ -1,12 +1,11 @@
 """The answer: one object per result that every view renders and nothing else.
 
-An :class:`Answer` holds what a user asked and what the result says, in the objective's own terms:
-the question (site, period, load, objective), what was taken from the study rather than asked
-for, the result (the best fold angle and its t_solar; for an annual objective its value per design
-and, for ``worst-month``, the month; for a re-fold schedule each visit's date and fold angle and
-what it adds), the designs compared, the near-optimal range of the fold angle with the
-recommended angle at its centre, and notes that name the design they concern. The terminal's
-lines (:meth:`Answer.lines`), ``--format json`` (:meth:`Answer.to_dict`), ``report.html`` and
+An :class:`Answer` holds what a user asked and what the result says, in the objective's own terms: the question
+(site, period, load, objective), what was taken from the study rather than asked for, the result (the best fold
+angle and its t_solar; for an annual objective its value per design and, for ``worst-month``, the month; for a
+re-fold schedule each visit's date and fold angle and what it adds), the designs compared, the near-optimal
+range of the fold angle with the recommended angle at its centre, and notes that name the design they concern.
+The terminal's lines (:meth:`Answer.lines`), ``--format json`` (:meth:`Answer.to_dict`), ``report.html`` and
 ``result.answer`` in a notebook all show this one object.
 """
 
@@ -40,7 +39,7 @@ def _plain(value):
 
 
 def records(table: pd.DataFrame | None) -> list[dict]:
-    """A table's rows as JSON-ready records (NaN as null, numbers exact)."""
+    """A table's rows as JSON-ready records (NaN as null, numbers exact); none for None."""
     return [] if table is None else [_plain(row) for row in table.to_dict(orient="records")]
 
 
@@ -59,8 +58,8 @@ class Answer:
     Attributes
     ----------
     kind : str
-        ``study`` (one day), ``sweep`` (cases), ``annual`` (one fold angle over many days),
-        ``size``, ``reproduce`` or ``map``.
+        ``study`` (one day), ``sweep`` (cases), ``annual`` (one fold angle over many days), ``size``, ``reproduce``
+        or ``map``.
     title : str
     question : dict
         Label -> text: site, period, load, objective, panel, models...
@@ -73,8 +72,8 @@ class Answer:
     near_optimal : pandas.DataFrame
         Per case and load: the near-optimal range of the fold angle and the recommended angle.
     schedule : pandas.DataFrame
-        Re-fold schedules: per load, number of settings and visit, the date and fold angle, with
-        the schedule's objective and what its last setting adds.
+        Re-fold schedules: per load, number of settings and visit, the date and fold angle, with the schedule's
+        objective and what its last setting adds.
     notes : list of dict
         ``{"note": ..., "designs": [...], "cases": n}``: each note and the designs it concerns.
     summary : list of str
@@ -117,8 +116,13 @@ class Answer:
 
 
 def note_text(note: dict) -> str:
-    """``load above peak (tracker:single-axis, tracker:single-axis-net)``; the designs are left out
-    where a note concerns every design (the day's own condition)."""
+    """A note of :func:`design_notes` as text, ``load above peak (tracker:single-axis,
+    tracker:single-axis-net)``; the designs are left out where a note concerns every design.
+
+    Parameters
+    ----------
+    note : dict
+    """
     designs = note.get("designs")
     where = f" ({', '.join(designs)})" if designs else ""
     cases = f" in {note['cases']} of {note['of']} cases" if note.get("cases") is not None else ""
@@ -127,7 +131,15 @@ def note_text(note: dict) -> str:
 
 def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dict]:
     """Each note of a table's ``note`` column with the designs it concerns (none where it concerns
-    them all) and, for sweeps, in how many cases."""
+    them all) and, for sweeps, in how many cases.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        With ``design`` and ``note`` columns.
+    case_count : int, optional
+        A sweep's number of cases; None for one case.
+    """
     if "note" not in table or not len(table):
         return []
     exploded = table.assign(note=table["note"].astype(str).str.split("; ")).explode("note")
@@ -145,7 +157,13 @@ def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dic
 
 
 def study_question(study, varied: tuple = ()) -> dict:
-    """What a study asks, label to text (fields in ``varied`` are said to vary)."""
+    """What a study asks, label to text; the config paths in ``varied`` are said to vary.
+
+    Parameters
+    ----------
+    study : Study
+    varied : tuple of str, default ()
+    """
     from foldopt.inputs.loads import load_text
 
     study = study.resolved()
@@ -239,7 +257,7 @@ def _defaults(result) -> dict | None:
 
 
 def of_sweep(result) -> Answer:
-    """The answer of a plan of cases (:class:`foldopt.studies.sweeps.SweepResult`)."""
+    """The answer of a plan of cases or of an annual objective (:class:`foldopt.studies.sweeps.SweepResult`)."""
     if "annual_objective" in result.extras:
         return _of_annual(result)
     from foldopt.inputs.loads import describe_load
@@ -355,7 +373,16 @@ def _schedule(extras: dict) -> pd.DataFrame:
 
 
 def of_sizing(table: pd.DataFrame, best: pd.DataFrame, study, parameters: dict, defaults: dict | None) -> Answer:
-    """The answer of a panel sizing (:func:`foldopt.studies.sizing.size_panel`)."""
+    """The answer of a panel sizing: :func:`foldopt.studies.sizing.size_panel`'s ``table`` and its ``best``
+    row per design, with the ``parameters`` used (costs, ``c_grid_usd_per_kwh``, ``years``).
+
+    Parameters
+    ----------
+    table, best : pandas.DataFrame
+    study : Study
+    parameters, defaults : dict
+        ``defaults``: what was taken from the study (:attr:`Answer.defaults`), or None.
+    """
     cost = (f"{parameters['cost_per_m2']:g} $/m^2" if parameters.get("cost_per_w") is None
             else f"{parameters['cost_per_w']:g} $/W")
     lines = [f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid "
@@ -371,7 +398,8 @@ def of_sizing(table: pd.DataFrame, best: pd.DataFrame, study, parameters: dict, 
 
 
 def of_reproduction(tables: dict, study) -> Answer:
-    """Shin et al.'s published values beside foldopt's (:func:`foldopt.studies.reproduce.reproduce`)."""
+    """Shin et al.'s published values beside foldopt's: the ``tables`` of
+    :func:`foldopt.studies.reproduce.reproduce` by file stem, for the paper's ``study``."""
     lines = []
     for name, table in tables.items():
         model = "ideal PV model" if name == "reproduction" else "A-300 single-diode cells with switching"
@@ -391,8 +419,16 @@ def _count(number: int, noun: str) -> str:
 
 
 def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
-    """The answer of a map of many sites (:class:`foldopt.studies.cluster.MapRun`): per load, over the
-    sites, where folding pays in the year and the recommended fold angles."""
+    """The answer of a map of many sites: per load, over the sites, where folding pays in the year and
+    the recommended fold angles.
+
+    Parameters
+    ----------
+    result : foldopt.studies.cluster.MapRun
+    relative : bool
+        Loads as fractions of each site's flat peak (``p_load_fraction``), else in W.
+    defaults : dict, optional
+    """
     table, spec = result.table, result.spec
     study = spec.study
     year = table[table["period"] == "year"]

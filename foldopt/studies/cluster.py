@@ -1,20 +1,18 @@
 """A map (:mod:`foldopt.studies.worldmap`) run on a Dask cluster, in chunks that survive faults.
 
-The sites are cut into chunks of a few seconds of work each. A chunk ships only its site list and
-the study (plain data, a few kilobytes), never arrays: every worker builds its own skies. Workers
-compute; the client alone writes, so a cluster needs no shared file system. Each finished chunk is
-written at once, atomically, as a Parquet part (``parts/part-NNNNN.parquet``); the final tables
-are assembled from the parts on disk, so an interrupted run resumed with ``resume=True`` computes
-only the missing chunks and gives the same bytes as an uninterrupted one; a part carries the digest
-of its map, so that a part of another map is computed again, never mixed in. A map that replaces
-another (``overwrite``) is built in a staging folder beside it and swapped in once complete
-(:mod:`foldopt.files`); one process at a time writes a folder. A worker that dies
-takes nothing with it: Dask runs its chunks elsewhere, and a part is written once per chunk.
+The sites are cut into chunks of a few seconds of work each. A chunk ships only its site list and the study
+(plain data, a few kilobytes), never arrays: every worker builds its own skies. Workers compute; the client
+alone writes, so a cluster needs no shared file system. Each finished chunk is written at once, atomically, as
+a Parquet part (``parts/part-NNNNN.parquet``); the final tables are assembled from the parts on disk, so an
+interrupted run resumed with ``resume=True`` computes only the missing chunks and gives the same bytes as an
+uninterrupted one; a part carries the digest of its map, so that a part of another map is computed again,
+never mixed in. A map that replaces another (``overwrite``) is built in a staging folder beside it and swapped
+in once complete (:mod:`foldopt.files`); one process at a time writes a folder. A worker that dies takes
+nothing with it: Dask runs its chunks elsewhere, and a part is written once per chunk.
 
-Without a scheduler address the work goes to an embedded :class:`distributed.LocalCluster`, one
-single-threaded worker process per core; with one, to that cluster (``dask scheduler`` and
-``dask worker`` by hand, dask-jobqueue, Kubernetes...). Each task runs the compiled kernel on one
-thread: the parallelism is Dask's.
+Without a scheduler address the work goes to an embedded :class:`distributed.LocalCluster`, one single-threaded
+worker process per core; with one, to that cluster (``dask scheduler`` and ``dask worker`` by hand,
+dask-jobqueue, Kubernetes...). Each task runs the compiled kernel on one thread: the parallelism is Dask's.
 """
 
 from __future__ import annotations
@@ -35,10 +33,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from foldopt.errors import ConfigError
-from foldopt.files import (DiskFullError, check_output, versions, clear_leftovers, commit, discard, is_full, new_staging,
-    tree_size, write_atomically, writer_lock)
-from foldopt.errors import OutputError
+from foldopt.errors import ConfigError, OutputError
+from foldopt.files import (DiskFullError, check_output, clear_leftovers, commit, discard, is_full, new_staging,
+                           tree_size, versions, write_atomically, writer_lock)
 
 #: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
 #: about a millisecond), short enough that a lost worker loses little and progress moves.
@@ -58,9 +55,22 @@ MAP_KEY = b"foldopt.map_key"
 
 @dataclass(frozen=True)
 class MapSpec:
-    """Everything that decides a map's numbers: the study (a study's fields but site, date and
-    load), the sites, the loads and whether they are fractions of each site's flat peak, the year,
-    how the sites are chunked and the engine."""
+    """Everything that decides a map's numbers.
+
+    Parameters
+    ----------
+    study : dict
+        A study's fields but site, date and load (:func:`foldopt.studies.worldmap.map_study`).
+    sites : tuple of dict
+        ``latitude``, ``longitude`` and optionally ``name``, ``altitude``, ``timezone``; each gets a ``site_id``.
+    loads : tuple of float
+        Loads [W], or with ``relative`` fractions of each site's flat peak [-].
+    relative : bool, default False
+    year : int, default 2025
+    sites_per_chunk : int, default 0
+        0: sized for about :data:`CHUNK_SECONDS` of one core's work (:func:`default_sites_per_chunk`).
+    engine : {'numba', 'numpy'}
+    """
 
     study: dict
     sites: tuple
@@ -79,10 +89,12 @@ class MapSpec:
         object.__setattr__(self, "sites", sites)
 
     def chunks(self) -> list[range]:
+        """The chunks' site indices, ``sites_per_chunk`` each (the last may be short)."""
         size = self.sites_per_chunk
         return [range(start, min(start + size, len(self.sites))) for start in range(0, len(self.sites), size)]
 
     def as_dict(self) -> dict:
+        """The spec as plain data (``run.json``'s ``spec``)."""
         return dataclasses.asdict(self)
 
     @property
@@ -93,8 +105,15 @@ class MapSpec:
 
 
 def default_sites_per_chunk(study: dict, year: int) -> int:
-    """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work."""
-    from foldopt.inputs.config import FoldAngles
+    """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work (at least 1).
+
+    Parameters
+    ----------
+    study : dict
+        :attr:`MapSpec.study` (its fold angles and step).
+    year : int
+    """
+    from foldopt.inputs.sections import FoldAngles
 
     angles = len(FoldAngles(**study.get("fold_angles", {})).grid())
     steps = 1440 / float(study.get("step_min", 1.0))
@@ -130,12 +149,11 @@ def evaluate_chunk(study: dict, sites: list, loads: list, relative: bool, year: 
 def _keep_freed_memory() -> None:
     """Let glibc reuse freed memory for the next arrays rather than hand it back to the system.
 
-    A Dask nanny starts its worker with ``MALLOC_TRIM_THRESHOLD_=65536``, which also fixes glibc's
-    mmap threshold at its default: every array above 128 KiB is then a fresh mmap whose pages fault
-    in one by one. A map allocates many such arrays per site and ran at half speed (0.49 against
-    0.25 s a site, the difference all system time). Thresholds of 32 MiB (mmap) and 128 MiB (trim)
-    keep a site's arrays on the heap and bound what a worker holds back. Elsewhere than glibc,
-    nothing is done."""
+    A Dask nanny starts its worker with ``MALLOC_TRIM_THRESHOLD_=65536``, which also fixes glibc's mmap threshold
+    at its default: every array above 128 KiB is then a fresh mmap whose pages fault in one by one. A map
+    allocates many such arrays per site and ran at half speed (0.49 against 0.25 s a site, the difference all
+    system time). Thresholds of 32 MiB (mmap) and 128 MiB (trim) keep a site's arrays on the heap and bound
+    what a worker holds back. Elsewhere than glibc, nothing is done."""
     import ctypes
     import ctypes.util
 
@@ -178,10 +196,10 @@ def _read_part(path: Path, key: str) -> pd.DataFrame | None:
 
 
 def map_folder(out: Path, resume: bool, overwrite: bool) -> Path:
-    """The folder to build the map in: ``out`` itself to resume the map there or where there is none,
-    so that a killed run leaves a folder that a later ``resume`` recognises; a staging folder beside
-    ``out`` where the map replaces one (``overwrite``), so that the earlier folder stays whole until
-    the new one is complete (:func:`foldopt.files.commit`)."""
+    """The folder to build the map in: ``out`` itself to resume the map there or where there is none, so that a
+    killed run leaves a folder that a later ``resume`` recognises; a staging folder beside ``out`` where the map
+    replaces one (``overwrite``), so that the earlier folder stays whole until the new one is complete
+    (:func:`foldopt.files.commit`)."""
     out = Path(out)
     if resume and (out / "run.json").exists():
         return out
@@ -230,11 +248,11 @@ def _write_json(path: Path, data: dict) -> None:
 
 @contextmanager
 def connect(scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
-    """A Dask client: of the cluster at ``scheduler`` (``tcp://host:port`` or a scheduler file), or
-    of an embedded :class:`distributed.LocalCluster` of ``workers`` single-threaded processes
-    (default one per core). Yields ``(client, description)``; raises :class:`ConfigError` when no
-    scheduler with a worker answers within ``timeout`` [s], at once where the port refuses, and
-    within :data:`HANDSHAKE_TIMEOUT` where what listens is not a Dask scheduler."""
+    """A Dask client: of the cluster at ``scheduler`` (``tcp://host:port`` or a scheduler file), or of an
+    embedded :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default one per core).
+    Yields ``(client, description)``; raises :class:`ConfigError` when no scheduler with a worker answers within
+    ``timeout`` [s], at once where the port refuses, and within :data:`HANDSHAKE_TIMEOUT` where what listens is
+    not a Dask scheduler."""
     from distributed import Client, LocalCluster
 
     if scheduler is None:
@@ -271,7 +289,13 @@ def _no_answer(scheduler: str, timeout: float, reason: str) -> str:
 
 def scheduler_address(scheduler: str) -> str:
     """The address ``scheduler`` gives: itself, or the ``address`` of the scheduler file it names
-    (:class:`ConfigError` naming the file where it holds none)."""
+    (:class:`ConfigError` naming the file where it holds none).
+
+    Parameters
+    ----------
+    scheduler : str
+        ``tcp://host:port`` or the path of a scheduler file.
+    """
     path = Path(scheduler)
     if not path.is_file():
         return scheduler
@@ -382,7 +406,8 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
     started = time.perf_counter()
     out = Path(out)
     chunks = spec.chunks()
-    metadata = {**(metadata or {}), "versions": versions(("dask", "distributed", "pyarrow")), "map_key": spec.key, "spec": spec.as_dict(), "chunks": len(chunks)}
+    metadata = {**(metadata or {}), "versions": versions(("dask", "distributed", "pyarrow")), "map_key": spec.key,
+                "spec": spec.as_dict(), "chunks": len(chunks)}
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:

@@ -18,7 +18,7 @@ import pandas as pd
 
 from foldopt.engine import rows as engines
 from foldopt.physics.connections import CONNECTIONS, SWITCH_STATES
-from foldopt.inputs.config import Study
+from foldopt.inputs.study import Study
 from foldopt.engine.metrics import (design_condition, energy_served, load_for_t_solar, metric_columns, notes,
                              per_load, relative_to, t_solar)
 from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
@@ -35,6 +35,11 @@ class Day:
     Paper mode uses the paper's sun, air mass at sea level and Eq. 5 incidence; exact mode pvlib's
     sun (apparent zenith), Laue's altitude term and the true angle of incidence. The study is
     resolved here, so its defaults follow its own site and mode.
+
+    Parameters
+    ----------
+    study : Study
+        One site and date.
     """
 
     def __init__(self, study: Study):
@@ -66,9 +71,19 @@ class Day:
         return self.electrical.panel_power(self._poa(np.array([panel.tilt]), np.array([panel.azimuth]))[0], panel.area)
 
     def tracker_orientation(self, model=None):
-        """Surface tilt and azimuth of a tracker over the day [deg] (default: the study's).
+        """Surface tilt and azimuth of a tracker over the day.
 
         Kept per model: a tracker's power, its draw and the standby sweep all steer by it.
+
+        Parameters
+        ----------
+        model : str, optional
+            One of :data:`foldopt.names.TRACKERS`; default the study's.
+
+        Returns
+        -------
+        surface_tilt, surface_azimuth : numpy.ndarray
+            [deg], (n_time,).
         """
         return tuple(angle[0] for angle in self._tracker_sky_orientation(model))
 
@@ -79,33 +94,85 @@ class Day:
         return self._tracker_orientations[model]
 
     def tracker_power(self, model=None):
-        """Power of the same panel on a tracker [W], shape (n_time,) (default: the study's)."""
+        """Power of the same panel on a tracker [W], shape (n_time,).
+
+        Parameters
+        ----------
+        model : str, optional
+            One of :data:`foldopt.names.TRACKERS`; default the study's.
+        """
         return sky_tracker_power(self.sky, self.study, self._tracker_sky_orientation(model))[0]
 
     def tracker_draw(self, model=None):
-        """The tracker's own draw [W] per step: standby while the sun is up, plus its moves."""
+        """The tracker's own draw [W] per step, (n_time,): standby while the sun is up, plus its moves.
+
+        Parameters
+        ----------
+        model : str, optional
+            One of :data:`foldopt.names.TRACKERS`; default the study's.
+        """
         return sky_tracker_draw(self.sky, self.study, self._tracker_sky_orientation(model))[0]
 
     def orientation(self, fold_angles):
-        """Sub-panel orientations (k, 4) of the study's panel at ``fold_angles`` [deg]."""
+        """Sub-panel orientations of the study's panel at fold angles.
+
+        Parameters
+        ----------
+        fold_angles : array_like
+            (k,) [deg].
+
+        Returns
+        -------
+        numpy.ndarray
+            (k, 4): tilt and azimuth of the east, then the west sub-panel [deg].
+        """
         panel = self.study.panel
         return engines.fold_orientations(self.study, [panel.tilt], [panel.azimuth], np.atleast_1d(fold_angles))[0]
 
     def connections(self, fold_angles, series: bool = True, with_state: bool = True):
-        """Every connection's power [W], each (k, n_time), and the switching state per step.
+        """Every connection's power and the switching state per step.
 
-        ``series=False`` skips the series connection (NaN) when nothing asks for it."""
+        Parameters
+        ----------
+        fold_angles : array_like
+            (k,) [deg].
+        series : bool, default True
+            False skips the series connection (NaN) when nothing asks for it.
+        with_state : bool, default True
+            Whether to work out the switching state.
+
+        Returns
+        -------
+        powers : dict of numpy.ndarray
+            (k, n_time) [W] per name of :data:`foldopt.names.CONNECTIONS`.
+        state : numpy.ndarray of int or None
+            (k, n_time) index into :data:`foldopt.physics.connections.SWITCH_STATES`.
+        """
         powers, state = engines.powers(self.sky, self.study, self.orientation(fold_angles), [0], series, with_state)
         powers.pop("panel")
         return powers, state
 
     def subpanel_power(self, fold_angles):
-        """East and west sub-panel powers and their parallel connection [W], each (k, n_time)."""
+        """East and west sub-panel powers and their parallel connection [W], each (k, n_time).
+
+        Parameters
+        ----------
+        fold_angles : array_like
+            (k,) [deg].
+        """
         powers, _ = self.connections(fold_angles, series=False, with_state=False)
         return powers["east"], powers["west"], powers["parallel"]
 
     def combined_power(self, fold_angles, connection=None):
-        """Deliverable twofold power [W], (k, n_time), under ``connection`` (default: the study's)."""
+        """Deliverable twofold power [W], (k, n_time).
+
+        Parameters
+        ----------
+        fold_angles : array_like
+            (k,) [deg].
+        connection : str, optional
+            One of :data:`foldopt.names.CONNECTIONS`; default the study's.
+        """
         connection = connection or self.study.connection
         series = connection == "series" or self.study.switch_series
         return self.connections(fold_angles, series, with_state=False)[0][connection]
@@ -170,7 +237,14 @@ def _best_angle(day: Day, angles, sweep_t_solar, connection):
 def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     """Sweep the fold angle and compare flat, twofold and tracker.
 
-    ``engine`` evaluates the fold-angle sweep (:data:`foldopt.engine.rows.ENGINES`).
+    Parameters
+    ----------
+    study : Study
+        One site and date.
+    engine : {'numba', 'numpy'}
+        Evaluates the fold-angle sweep (:data:`foldopt.names.ENGINES`).
+    request : Request, optional
+        The :class:`foldopt.studies.request.Request` the study came from, kept on the result.
 
     Returns
     -------
@@ -278,6 +352,16 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
     load of a single ``t_solar`` pass, and the break-even draw, where the tracker's net time falls
     to the optimal twofold panel's, is one root search for the load.
 
+    Parameters
+    ----------
+    day : Day
+    p_tracker : array_like
+        The tracker's gross power over the day [W].
+    twofold_t_solar : float
+        ``t_solar`` of the optimal twofold panel [h].
+    points : int, default 101
+        Standby draws from 0 to twice the load.
+
     Returns
     -------
     table : pandas.DataFrame
@@ -299,6 +383,15 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
 
 
 def twofold_t_solar(day: Day, fold_angle: float, connection=None) -> float:
-    """``t_solar`` [h] of the twofold panel at one fold angle."""
+    """``t_solar`` [h] of the twofold panel at one fold angle.
+
+    Parameters
+    ----------
+    day : Day
+    fold_angle : float
+        [deg].
+    connection : str, optional
+        One of :data:`foldopt.names.CONNECTIONS`; default the study's.
+    """
     power = day.combined_power(np.array([fold_angle]), connection)[0]
     return float(t_solar(power, day.study.p_load, day.step_hours))

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from foldopt.engine import rows as engines
-from foldopt.inputs.config import NearOptimal, Study
+from foldopt.inputs.sections import NearOptimal
+from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.engine.sky import Sky, build_sky
 from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
@@ -37,21 +38,40 @@ CHUNK_STEPS = 1_100_000
 
 
 def best_angle_index(hours):
-    """Index of the longest t_solar along the last axis; ties go to the least folded angle."""
+    """Index (...) of the longest t_solar along the last axis; ties go to the least folded angle.
+
+    Parameters
+    ----------
+    hours : numpy.ndarray
+        t_solar [h] on an ascending fold-angle grid, (..., n_angles).
+    """
     return hours.shape[-1] - 1 - np.argmax(hours[..., ::-1], axis=-1)
 
 
 def setup_key(study: Study) -> str:
-    """What the blocks of one engine call share: everything but the site, the date and the load
-    (and the panel's orientation, which follows the site)."""
+    """What the blocks of one engine call share, as sorted JSON: everything but the site, the date and
+    the load (and the panel's orientation, which follows the site).
+
+    Parameters
+    ----------
+    study : Study
+    """
     data = study.model_dump(mode="json", exclude={"site", "date", "p_load", "name", "description"})
     data["panel"] = {k: v for k, v in data["panel"].items() if k not in ("tilt", "azimuth")}
     return json.dumps(data, sort_keys=True)
 
 
 def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
-    """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each
-    (default: the study's tracker)."""
+    """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each.
+
+    Parameters
+    ----------
+    sky : Sky
+    study : Study
+        The tracker's settings.
+    model : str, optional
+        One of :data:`foldopt.names.TRACKERS`; default the study's.
+    """
     tracker = study.tracker
     options = TrackerOptions(
         steps=tracker.steps, angular_field=tracker.angular_field,
@@ -70,7 +90,20 @@ def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
 
     Trackers take the exact angle of incidence in both modes: Eq. 5 is the paper's formula for its
     fixed panels (it reads an azimuth even for a level panel, which a single-axis tracker is at
-    noon), and for the paper's only tracker, the ideal one, both give 1."""
+    noon), and for the paper's only tracker, the ideal one, both give 1.
+
+    Parameters
+    ----------
+    sky : Sky
+    study : Study
+    orientation : tuple of numpy.ndarray
+        The tracker's surface tilt and azimuth [deg] (:func:`sky_tracker_orientation`).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_blocks, n_steps) [W].
+    """
     return engines.panel_power(sky, study, engines.poa(sky, *orientation))
 
 
@@ -78,13 +111,32 @@ def standby_available(gross, draw, lit, standby_w: float):
     """The tracker's power [W] left for the load and its standby: ``gross`` less ``draw`` but the
     standby (its moves only), where there is light (``lit``), 0 elsewhere. A standby draw ``s``
     (drawn wherever there is light) is then the load ``P_load + s`` on this curve, as there is no
-    power where no standby is drawn."""
+    power where no standby is drawn.
+
+    Parameters
+    ----------
+    gross, draw : array_like
+        The tracker's power and its own draw (:func:`sky_tracker_draw`) per step [W].
+    lit : array_like of bool
+        Steps with light (:attr:`foldopt.engine.sky.Sky.lit`).
+    standby_w : float
+        The standby part of ``draw`` [W].
+    """
     return np.where(lit, gross - (draw - np.where(lit, standby_w, 0.0)), 0.0)
 
 
 def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
     """The tracker's own draw [W] per step over every block: standby while there is light (the sun up,
-    clouds or not), plus its moves."""
+    clouds or not), plus its moves.
+
+    Parameters
+    ----------
+    sky : Sky
+    study : Study
+        The tracker's drive and standby settings.
+    orientation : tuple of numpy.ndarray
+        The tracker's surface tilt and azimuth [deg] (:func:`sky_tracker_orientation`).
+    """
     tracker = study.tracker
     drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
     return tracker_draw(*orientation, sky.lit, sky.step_hours, drive)
@@ -93,7 +145,17 @@ def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
 @dataclass(frozen=True)
 class Blocks:
     """Blocks that share one setup (:func:`setup_key`): the study's settings at each (site, date),
-    and each block's flat panel orientation [deg]."""
+    and each block's flat panel orientation.
+
+    Parameters
+    ----------
+    study : Study
+        The shared settings (resolved).
+    sites, dates : tuple
+        Each block's site and local date.
+    tilt, azimuth : numpy.ndarray
+        Each block's flat panel [deg], (n_blocks,).
+    """
 
     study: Study
     sites: tuple
@@ -103,14 +165,26 @@ class Blocks:
 
     @classmethod
     def of(cls, studies) -> Blocks:
-        """One block per study (its site, date and panel)."""
+        """One block per study (its site, date and panel).
+
+        Parameters
+        ----------
+        studies : sequence of Study
+            Of one setup; the first gives the shared settings.
+        """
         resolved = [s.resolved() for s in studies]
         return cls(resolved[0], tuple(s.site for s in resolved), tuple(s.date for s in resolved),
                    np.array([s.panel.tilt for s in resolved]), np.array([s.panel.azimuth for s in resolved]))
 
     @classmethod
     def of_dates(cls, study: Study, dates) -> Blocks:
-        """The days of one study at its own site."""
+        """The days of one study at its own site.
+
+        Parameters
+        ----------
+        study : Study
+        dates : sequence of datetime.date
+        """
         study = study.resolved()
         count = len(dates)
         return cls(study, (study.site,) * count, tuple(dates), np.full(count, study.panel.tilt),
@@ -123,10 +197,22 @@ class Blocks:
         return Blocks(self.study, self.sites[part], self.dates[part], self.tilt[part], self.azimuth[part])
 
     def sky(self) -> Sky:
+        """The blocks' :class:`foldopt.engine.sky.Sky` (:func:`foldopt.engine.sky.build_sky`)."""
         return build_sky(self.study, self.sites, self.dates)
 
     def chunks(self, n_loads: int):
-        """Slices of blocks whose rows x loads and time steps stay within the chunk bounds."""
+        """Slices of blocks whose rows x loads and time steps stay within the chunk bounds.
+
+        Parameters
+        ----------
+        n_loads : int
+            Loads per row.
+
+        Returns
+        -------
+        list of slice
+            Consecutive, covering every block; at least one block each.
+        """
         per_block = len(self.study.fold_angles.grid()) * max(n_loads, 1)
         n_steps = round(24 * 60 / self.study.step_min)
         size = max(1, min(CHUNK_ROW_LOADS // per_block, CHUNK_STEPS // n_steps))
@@ -135,6 +221,15 @@ class Blocks:
 
 def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
     """t_solar [h] of every block's twofold panel at every angle of the grid, for every load.
+
+    Parameters
+    ----------
+    sky : Sky
+        The blocks' sky.
+    blocks : Blocks
+    loads : array_like
+        (n_loads,) [W].
+    engine : {'numba', 'numpy'}
 
     Returns
     -------
@@ -157,8 +252,27 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
 
 def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
-    panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net;
-    ``condition`` is each design's (:func:`foldopt.engine.metrics.design_condition`)."""
+    panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net.
+
+    Parameters
+    ----------
+    sky : Sky
+    blocks : Blocks
+    loads : numpy.ndarray
+        (n_loads,) [W].
+    angles : numpy.ndarray
+        The fold-angle grid [deg].
+    chosen : numpy.ndarray of int
+        (n_blocks, n_loads) index into ``angles`` of the twofold panel's angle.
+    engine : {'numba', 'numpy'}
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        ``fold_angle_deg``, the :func:`foldopt.engine.metrics.metric_columns`, ``poa_kwh_m2`` (incident
+        irradiation [kWh/m^2]) and ``condition`` (:func:`foldopt.engine.metrics.design_condition`), each
+        (n_blocks, n_loads, 4) in the order of :data:`DESIGNS`.
+    """
     study = blocks.study
     n_blocks, n_loads = sky.n_blocks, loads.size
     tilt, azimuth = blocks.tilt, blocks.azimuth
@@ -176,7 +290,8 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
     net = gross - sky_tracker_draw(sky, study, orientation)
     shape = sky.load_shape
     trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
-                                     engine=engine, load_shape=None if shape is None else np.concatenate([shape, shape]))
+                                     engine=engine,
+                                     load_shape=None if shape is None else np.concatenate([shape, shape]))
 
     def per_design(twofold_values, flat_values, tracker_values):
         return np.stack([flat_values, twofold_values.reshape(n_blocks, n_loads), tracker_values[:n_blocks],
@@ -221,8 +336,22 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
 def objective_value(hours, months, statistic: str, season=None):
     """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
 
-    ``mean``, ``min``, ``pNN`` (the NN-th percentile over days) or ``worst-month`` (the lowest
-    monthly mean); ``season`` (months) restricts the days.
+    Parameters
+    ----------
+    hours : array_like
+        Daily t_solar [h], (days, ...).
+    months : array_like
+        (days,) month of each day [1-12].
+    statistic : str
+        ``mean``, ``min``, ``pNN`` (the NN-th percentile over days) or ``worst-month`` (the lowest
+        monthly mean).
+    season : sequence of int, optional
+        Months that restrict the days.
+
+    Returns
+    -------
+    numpy.ndarray
+        The statistic [h], (...).
     """
     hours, months = np.asarray(hours, dtype=float), np.asarray(months)
     if season:
@@ -240,8 +369,15 @@ def objective_value(hours, months, statistic: str, season=None):
 
 
 def worst_month(hours, months):
-    """The month [1-12] of the lowest monthly mean of daily ``hours`` (days, ...) -> (...): the
-    month in which a ``worst-month`` objective is found."""
+    """The month [1-12], (...), of the lowest monthly mean: where a ``worst-month`` objective is found.
+
+    Parameters
+    ----------
+    hours : array_like
+        Daily t_solar [h], (days, ...).
+    months : array_like
+        (days,) month of each day [1-12].
+    """
     hours, months = np.asarray(hours, dtype=float), np.asarray(months)
     present = np.unique(months)
     means = np.stack([hours[months == m].mean(axis=0) for m in present])
@@ -253,7 +389,7 @@ def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
     first angles that fall short, and the recommended angle at its centre.
 
     An angle is near-optimal when its value lies within ``tolerance`` of the best
-    (:meth:`foldopt.inputs.config.NearOptimal.tolerance_h`: 1 % or 1 min by default, whichever is
+    (:meth:`foldopt.inputs.sections.NearOptimal.tolerance_h`: 1 % or 1 min by default, whichever is
     larger). The range is the contiguous run of such angles that holds the best one
     (:func:`best_angle_index`); the recommended angle is the grid angle nearest its centre (ties to
     the less folded), so that a hinge set a few degrees off still lies on the plateau.
@@ -264,7 +400,7 @@ def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
         The fold-angle grid [deg], ascending, (n_angles,).
     values : array_like
         t_solar or an objective [h] at each angle, (..., n_angles).
-    tolerance : foldopt.inputs.config.NearOptimal
+    tolerance : foldopt.inputs.sections.NearOptimal
 
     Returns
     -------
@@ -328,8 +464,16 @@ class DailyDesigns:
 
 
 def daily_designs(parts, loads, engine: str = "numba") -> DailyDesigns:
-    """:class:`DailyDesigns` over chunks of days: ``parts`` pairs each chunk of :class:`Blocks`
-    with its sky; ``loads`` [W] (an infinite load carries nothing)."""
+    """:class:`DailyDesigns` over chunks of days.
+
+    Parameters
+    ----------
+    parts : iterable of (Blocks, Sky)
+        Each chunk of :class:`Blocks` with its sky.
+    loads : array_like
+        (n_loads,) [W]; an infinite load carries nothing.
+    engine : {'numba', 'numpy'}
+    """
     twofold, harvest, flat, flat_energy, tracker, available = [], [], [], [], [], []
     for chunk, sky in parts:
         study = chunk.study

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from foldopt.inputs.config import Study
+from foldopt.inputs.study import Study
 from foldopt.engine.metrics import load_for_t_solar
 from foldopt.studies.day import Day, run_study, twofold_t_solar
 
@@ -55,13 +55,40 @@ class Reproduction:
 
 
 def infer_p_load(study: Study, flat_t_solar_h: float = PAPER_VALUES["flat_t_solar_h"][1]) -> float:
-    """Load [W] at which the study's flat panel, in paper mode, runs ``flat_t_solar_h`` hours."""
+    """Load at which the study's flat panel, in paper mode, runs ``flat_t_solar_h`` hours.
+
+    The paper does not state its load; on the paper's study this gives 4.398 W.
+
+    Parameters
+    ----------
+    study : Study
+        The paper's study (``configs/shin2015.yaml``) or a variant.
+    flat_t_solar_h : float, default 7.73
+        The flat panel's ``t_solar`` [h] (Shin et al. Sec. IV-A).
+
+    Returns
+    -------
+    float
+        Load [W] (:func:`foldopt.engine.metrics.load_for_t_solar`).
+    """
     day = Day(study.variant(mode="paper"))
     return load_for_t_solar(day.flat_power(), flat_t_solar_h, day.step_hours)
 
 
 def reproduction_values(study: Study, engine: str = "numba") -> dict[str, float]:
-    """The reproduced quantities of :data:`PAPER_VALUES` for one resolved study."""
+    """The reproduced quantities of :data:`PAPER_VALUES` for one resolved study.
+
+    Parameters
+    ----------
+    study : Study
+        Mode, geometry and load already set (:func:`reproduce`).
+    engine : {'numba', 'numpy'}
+
+    Returns
+    -------
+    dict of float
+        One value per quantity of :data:`PAPER_VALUES`, in its unit.
+    """
     result = run_study(study, engine)
     summary = result.summary.set_index("design")
     flat, twofold, tracker = (summary.loc[name] for name in ("flat", "twofold", "tracker"))

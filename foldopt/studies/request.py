@@ -6,15 +6,21 @@
 same request gives the same plan, to the bit, whichever way it is made. It applies the study
 policy, each sweep axis's default range and the year of day-of-year ranges, and lists what the
 answer took from the study rather than from the request (:attr:`Request.taken`).
+
+The command line's options become requests here too, not in the command line: a sweep's options
+become field changes (:func:`sweep_changes`, :func:`sweep_request`), a map's become a map's study,
+sites and loads (:func:`map_request_from`), and a sizing's costs are checked against
+:data:`SIZING_LIMITS` (:func:`sizing_problems`), the same limits :func:`foldopt.size` keeps.
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from foldopt.inputs import policy
-from foldopt.inputs.config import Plan, make_plan
+from foldopt.inputs.load import default_study_path, parse_study_text, read_study
+from foldopt.inputs.plan import Plan, make_plan, parse_values
 from foldopt.errors import ConfigError
 
 #: A sweep's axis -> the field it varies (``angle`` varies the fold angle of one case).
@@ -30,6 +36,29 @@ KEYWORDS = {
 #: Loads of a load sweep's default range: shares of the panel's rating (area x 1000 W/m^2 x efficiency).
 DEFAULT_LOAD_SHARES = 20
 _ISO_DATE = re.compile(r"^(\d{4})-\d\d-\d\d$")
+#: The command line's sweep options -> the study field each sets (:func:`sweep_changes`).
+SWEEP_OPTIONS = {
+    "lat": "site.latitude", "lon": "site.longitude", "altitude": "site.altitude", "timezone": "site.timezone",
+    "days": "date", "year": "year", "p_load": "p_load", "p_load_scale": "p_load", "area": "panel.area",
+    "efficiency": "panel.efficiency", "tilt": "panel.tilt", "azimuth": "panel.azimuth", "mode": "mode",
+    "geometry": "geometry", "sky": "sky", "climate": "climate", "weather": "weather", "force_site": "force_site",
+    "transposition": "transposition", "albedo": "albedo", "iam": "iam", "objective": "objective.statistic",
+    "visits": "objective.visits", "tracker": "tracker.model", "tracker_standby": "tracker.standby_w",
+    "pv_model": "pv_model", "module": "module", "connection": "connection", "switch_series": "switch_series",
+    "no_bypass": "bypass_diodes", "converter_efficiency": "converter_efficiency", "temp_air": "temp_air",
+    "exact_electrical": "exact_electrical", "step_min": "step_min", "angle_step": "fold_angles.step",
+    "load_profile": "load_profile",
+}
+#: Sweep options that take a value, a range or a list (:func:`foldopt.inputs.plan.parse_values`).
+_LISTED = ("lat", "lon", "p_load", "p_load_scale", "tilt", "days")
+#: Sweep flags and what each sets its field to.
+_FLAGS = {"switch_series": True, "exact_electrical": True, "force_site": True, "no_bypass": False}
+#: The sizing's largest values and their units, by parameter (:attr:`foldopt.studies.sizing.SizingResult.parameters`).
+#: Within them every benefit, cost and net benefit over areas up to 1000 m^2 stays far below float
+#: overflow (the largest is some 1e13 $); beyond them a value is a slip, and 1e308 $/m^2 would print
+#: as a 309-digit net benefit, or as -inf.
+SIZING_LIMITS = {"cost_per_m2": (1e9, " $/m^2"), "cost_per_w": (1e6, " $/W"), "c_grid_usd_per_kwh": (1e3, " $/kWh"),
+                 "years": (1e3, " years"), "days_per_year": (366, " days")}
 
 
 @dataclass(frozen=True)
@@ -150,14 +179,234 @@ def _taken(plan: Plan, changes: dict, field: str | None, data: dict, decided: li
 
 
 def size_request(plan: Plan, source: str, cost_given: bool) -> Request:
-    """A sizing's request: the study's one case, and what the sizing took from it (the site, day,
-    load and efficiency, and the paper's panel cost where no cost is given)."""
+    """A sizing's request: the study's one case, and what the sizing took from it.
+
+    Parameters
+    ----------
+    plan : Plan
+        The study; a sizing takes one case, so a plan with sweep axes is refused.
+    source : str
+        How the answer (and an error) names the study.
+    cost_given : bool
+        Whether the request gives a panel cost; if not, the answer says it took the paper's.
+
+    Returns
+    -------
+    Request
+        ``taken``: the site, day, load and efficiency, and the paper's panel cost where no cost is
+        given.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For a plan that sweeps fields.
+    """
     from foldopt.inputs.loads import load_text
     from foldopt.inputs.costs import PAPER_COST_PER_M2
 
+    if plan.axes:
+        raise ConfigError([f"config: {source} sweeps {', '.join(p for p, _ in plan.axes)}; size takes one case"])
     study = plan.base
     taken = [f"site, day, {load_text(study)}, efficiency {study.panel.efficiency:g}"]
     if not cost_given:
         taken.append(f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
                      "cost_per_m2 or cost_per_w)")
     return Request(plan, source, tuple(taken))
+
+
+def sizing_problems(parameters: dict) -> list[str]:
+    """The sizing's parameters that are no number in (0, :data:`SIZING_LIMITS`], one line each.
+
+    :func:`foldopt.size` refuses them, and the command line checks them before it reads the study.
+
+    Parameters
+    ----------
+    parameters : dict
+        Parameter name (a key of :data:`SIZING_LIMITS`) -> value, or None where not given.
+
+    Returns
+    -------
+    list of str
+        ``name = value: must be a finite number > 0 and at most <limit> <unit>``, in the order of
+        :data:`SIZING_LIMITS`.
+    """
+    problems = []
+    for name, (largest, unit) in SIZING_LIMITS.items():
+        value = parameters.get(name)
+        if value is None or (isinstance(value, (int, float)) and 0 < value <= largest):
+            continue
+        shown = f"{value:g}" if isinstance(value, (int, float)) else repr(value)
+        problems.append(f"{name} = {shown}: must be a finite number > 0 and at most {largest:g}{unit}")
+    return problems
+
+
+def parse_setting(setting: str) -> tuple[str, object]:
+    """One ``--set KEY=VALUE``: a dotted field path and a YAML value.
+
+    Parameters
+    ----------
+    setting : str
+        ``KEY=VALUE``, e.g. ``panel.efficiency=0.21``.
+
+    Returns
+    -------
+    tuple
+        The field path (``str``) and the value as YAML reads it.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For text without ``=`` or a key, or a value that is no YAML value.
+    """
+    key, separator, text = setting.partition("=")
+    if not separator or not key.strip():
+        raise ConfigError([f"--set = {setting!r}: expected KEY=VALUE, e.g. panel.efficiency=0.21"])
+    source = f"--set {key}"
+    try:
+        value, _ = parse_study_text(text, source)
+    except ConfigError as error:
+        # parse_study_text's line is "config: <source> at line <n>: <problem>"; the problem is kept.
+        problem = re.sub(rf"^config: {re.escape(source)}(?: at line \d+)?: ", "", error.errors[0])
+        raise ConfigError([f"--set {key} = {text!r}: not a YAML value ({problem})"]) from None
+    return key.strip(), value
+
+
+def sweep_changes(options: dict, data: dict) -> dict:
+    """The fields the command line's sweep options change, by field path; ``--set`` last.
+
+    Parameters
+    ----------
+    options : dict
+        Each option of ``foldopt sweep`` by its parameter name (the keys of :data:`SWEEP_OPTIONS`
+        and ``settings``, the ``--set`` texts) -> its value, None (or False) where not given.
+    data : dict
+        The study's fields the sweep starts from.
+
+    Returns
+    -------
+    dict
+        Field path -> value, a range or a list (:func:`plan_request`'s ``changes``).
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One line per fault, naming the option.
+    """
+    changes, errors = {}, []
+    if options["p_load_scale"] is not None:
+        if options["p_load"] is not None:
+            errors.append("--p-load / --p-load-scale: a constant load or a profile's scale, not both")
+        elif data.get("load_profile") is None and options["load_profile"] is None:
+            errors.append("--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
+                          "the study)")
+    for option, value in options.items():
+        if option == "settings" or value is None or value is False:
+            continue
+        if option in _FLAGS:
+            value = _FLAGS[option]
+        elif option in _LISTED:
+            try:
+                value = parse_values(value, numeric=option != "days")
+            except ValueError as error:
+                flag = "--" + option.replace("_", "-")
+                errors.append(f"{flag} = {options[option]!r}: {error}")
+                continue
+        elif option == "weather":
+            value = str(value)
+        elif option == "load_profile":
+            value = {"file": str(value)}
+        changes[SWEEP_OPTIONS[option]] = value
+    if errors:
+        raise ConfigError(errors)
+    for setting in options["settings"] or ():
+        changes.update([parse_setting(setting)])
+    return changes
+
+
+def sweep_request(study, options: dict, axis: str, source: str) -> Request:
+    """The request of ``foldopt sweep AXIS``: the study, changed by the sweep's options.
+
+    Parameters
+    ----------
+    study : dict, str, pathlib.Path or None
+        The study's fields, or a YAML study to read them from; None for the embedded study.
+    options : dict
+        The sweep's options (:func:`sweep_changes`).
+    axis : {'angle', 'latitude', 'day', 'load'}
+    source : str
+        How the answer names the study.
+
+    Returns
+    -------
+    Request
+        Its plan is named ``sweep-<axis>`` and described as the command that made it.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One line per fault, naming the option or the field.
+    """
+    data = study if isinstance(study, dict) else read_study(default_study_path() if study is None else study)[0]
+    changes = sweep_changes(options, data)
+    changes["description"] = f"foldopt sweep {axis} from {source} (see command)"
+    return plan_request(data, changes, axis=axis, source=source, name=f"sweep-{axis}")
+
+
+def map_request_from(study=None, *, source: str = "the given study", objective: str = "mean", area=None,
+                     efficiency=None, step_min=None, angle_step=None, settings=(), loads=None, **where):
+    """The request of ``foldopt map``: a study made into a map's study by the map's options, and
+    the map's sites and loads (:func:`foldopt.studies.worldmap.map_request`).
+
+    Parameters
+    ----------
+    study : dict, str, pathlib.Path or None
+        The study's fields, or a YAML study to read them from, that the map takes its panel, models
+        and load from; None for the embedded study, whose mode, sky, geometry and step give way to
+        :data:`foldopt.studies.worldmap.MAP_DEFAULTS`.
+    source : str
+        How the answer names the study.
+    objective : str
+        What each period's fold angle maximises: ``mean``, ``min``, ``worst-month`` or ``pNN``.
+    area, efficiency : float, optional
+        The flat panel's area [m^2] and PV efficiency [-]; default the study's.
+    step_min : float, optional
+        Time step [min]; default the study's.
+    angle_step : float, optional
+        Fold-angle grid step [deg], the grid from it to 180; default the study's grid.
+    settings : sequence of str
+        ``KEY=VALUE`` texts (:func:`parse_setting`), set last.
+    loads : float, sequence of float or str, optional
+        Default the study's ``p_load`` [W].
+    **where
+        ``sites``, ``weather_dir``, ``latitudes``, ``longitudes``, ``land_only``, ``relative``,
+        ``year`` and ``show_period`` of :func:`foldopt.studies.worldmap.map_request`.
+
+    Returns
+    -------
+    foldopt.studies.worldmap.MapRequest
+        With ``taken``: the panel area, load and step the map took from the study, its PV model and
+        mode.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One line per fault, naming the field or the parameter.
+    """
+    from foldopt.studies.worldmap import map_request, map_study
+
+    data = study if isinstance(study, dict) else read_study(default_study_path() if study is None else study)[0]
+    changes = {"objective": {"statistic": objective}}
+    for field, value in (("panel.area", area), ("panel.efficiency", efficiency), ("step_min", step_min)):
+        if value is not None:
+            changes[field] = value
+    if angle_step is not None:
+        changes["fold_angles"] = {"start": angle_step, "stop": 180.0, "step": angle_step}
+    made = map_study(data, embedded=study is None, **changes)
+    for setting in settings:
+        made = policy.set_path(made, *parse_setting(setting))
+    request = map_request(made, [float(data.get("p_load") or 1.0)] if loads is None else loads, **where)
+    taken = [f"panel {made['panel']['area']:g} m^2" if area is None else None,
+             f"P_load {request.loads[0]:g} W" if loads is None and not request.relative else None,
+             f"{made.get('pv_model', 'ideal')} PV model", f"{made.get('mode')} mode",
+             f"{made.get('step_min'):g}-min steps" if step_min is None else None]
+    return replace(request, source=source, taken=tuple(item for item in taken if item))

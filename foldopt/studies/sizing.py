@@ -66,12 +66,42 @@ class SizingResult:
 
 
 def best_areas(table: pd.DataFrame) -> pd.DataFrame:
-    """The row of each design with the largest net benefit."""
+    """The row of each design with the largest net benefit.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        :func:`size_panel`'s table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design, in the table's order of designs.
+    """
     return table.loc[table.groupby("design", sort=False)["net_benefit_usd"].idxmax()].reset_index(drop=True)
 
 
 def stc_power_per_area(pv, temp_ref: float = 25.0) -> float:
-    """Rated power per panel area at STC (1000 W/m^2, 25 C) [W/m^2] of a :class:`PVModel`."""
+    """Rated power per panel area at STC (1000 W/m^2, 25 C).
+
+    Parameters
+    ----------
+    pv : PVModel
+        :class:`foldopt.physics.pvmodel.PVModel`.
+    temp_ref : float, default 25
+        Cell temperature [C].
+
+    Returns
+    -------
+    float
+        [W/m^2].
+
+    Examples
+    --------
+    >>> from foldopt.physics.pvmodel import PVModel
+    >>> stc_power_per_area(PVModel("ideal", efficiency=0.2))
+    200.0
+    """
     return float(np.asarray(pv.max_power(np.array([1000.0]), temp_ref, 1.0))[0])
 
 

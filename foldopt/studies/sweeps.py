@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from foldopt.engine import rows as engines
-from foldopt.inputs.config import Plan
+from foldopt.inputs.plan import Plan
 from foldopt.studies.designs import (DESIGNS, Blocks, best_angle_index, design_metrics, fold_hours, near_optimal,
                              objective_value, setup_key, worst_month)
 from foldopt.engine.metrics import notes, relative_to
@@ -183,7 +183,8 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
               "by_angle": pd.DataFrame({
                   "p_load_w": np.repeat(loads, angles.size), "fold_angle_deg": np.tile(angles, loads.size),
                   "objective_h": score.ravel(), "mean_t_solar_h": daily.mean(axis=0).ravel(),
-                  "min_t_solar_h": daily.min(axis=0).ravel(), "chosen": np.ravel(np.arange(angles.size) == fixed[:, None]),
+                  "min_t_solar_h": daily.min(axis=0).ravel(),
+                  "chosen": np.ravel(np.arange(angles.size) == fixed[:, None]),
               })}
     group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
     group.update(_twofold_only({key: np.broadcast_to(value, (len(blocks), loads.size)) for key, value in near.items()}))
@@ -207,7 +208,28 @@ def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, ob
     angle kept all year and, for the twofold panel, the near-optimal range and recommended angle
     (:func:`foldopt.studies.designs.near_optimal`).
 
-    ``design_hours`` is (days, loads, designs) daily t_solar in :data:`DESIGNS` order."""
+    Parameters
+    ----------
+    blocks : Blocks
+        The group's days (its study names the site).
+    loads : array_like
+        (n_loads,) [W].
+    fold_angles : array_like
+        (n_loads,) the twofold panel's fold angle kept all year [deg].
+    design_hours : numpy.ndarray
+        (days, loads, designs) daily t_solar [h] in :data:`DESIGNS` order.
+    months : array_like
+        (days,) month of each day.
+    objective : Objective
+        The statistic and season.
+    near : dict of numpy.ndarray
+        The twofold panel's :func:`foldopt.studies.designs.near_optimal`, (n_loads,) each.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per load and design.
+    """
     statistic = objective.statistic
     values = objective_value(design_hours, months, statistic, objective.months)  # (loads, designs)
     season = np.isin(months, objective.months) if objective.months else np.ones(len(months), bool)
@@ -280,8 +302,28 @@ def refold_tables(blocks: Blocks, loads, angles, daily, months, objective, desig
     flat panel's and the tracker's objective; ``refold_schedule``, per load, k and visit: the date
     and the fold angle set until the next visit (the last runs on over New Year).
 
-    ``daily`` is (days, loads, angles) t_solar, ``design_hours`` (days, loads, designs) in
-    :data:`DESIGNS` order."""
+    Parameters
+    ----------
+    blocks : Blocks
+        The group's days.
+    loads : array_like
+        (n_loads,) [W].
+    angles : numpy.ndarray
+        The fold-angle grid [deg].
+    daily : numpy.ndarray
+        (days, loads, angles) daily t_solar of the twofold panel [h].
+    months : array_like
+        (days,) month of each day.
+    objective : Objective
+        The statistic (``mean`` or ``worst-month``) and the number of visits.
+    design_hours : numpy.ndarray
+        (days, loads, designs) daily t_solar [h] in :data:`DESIGNS` order.
+
+    Returns
+    -------
+    dict of pandas.DataFrame
+        ``refold_value`` and ``refold_schedule``.
+    """
     from foldopt.engine.schedule import best_schedules
 
     statistic = objective.statistic

@@ -11,7 +11,8 @@ the twofold panel at that angle and the tracker, and the tracker's break-even st
 
 Loads are in watts or, with ``relative=True``, fractions of each site's flat peak (the largest
 power of the flat panel over the year), so that one map compares like with like from the tropics
-to the poles.
+to the poles. :func:`map_request` checks a map's sites, loads, year and period, once for the command
+line and :func:`foldopt.world_map`.
 
 This module computes; :mod:`foldopt.studies.cluster` spreads the sites over a Dask cluster and writes
 the files.
@@ -24,6 +25,7 @@ import datetime as dt
 import io
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +33,10 @@ import pandas as pd
 from pydantic import ValidationError
 
 from foldopt.engine import rows as engines
-from foldopt.inputs.config import MAX_CSV_BYTES, Site, Study, _format_errors, parse_dates, read_input, year_problem
+from foldopt.inputs.load import MAX_CSV_BYTES, read_input, resolve_files
+from foldopt.inputs.plan import parse_dates, parse_values, year_problem
+from foldopt.inputs.sections import Site
+from foldopt.inputs.study import Study, format_errors
 from foldopt.errors import ConfigError
 from foldopt.studies.designs import Blocks, best_angle_index, daily_designs, near_optimal, objective_value
 
@@ -45,6 +50,12 @@ SITE_COLUMNS = ("name", "latitude", "longitude", "altitude", "timezone")
 #: Rounds and points per round of the break-even search: the bracket shrinks (points + 1)-fold a
 #: round, so a 20 W tracker's break-even is found to 4e-5 W.
 _BREAK_EVEN_ROUNDS, _BREAK_EVEN_POINTS = 6, 8
+
+
+#: The grid a map covers where it is given no sites: latitudes and longitudes [deg], start:stop:step.
+DEFAULT_GRID = ("-60:60:10", "-180:180:30")
+#: Loads a map takes: watts, or fractions of each site's flat peak (``relative``).
+LOAD_BOUNDS = {False: (1e6, "loads must be in (0, 1e+06] W"), True: (2.0, "fractions must be in (0, 2]")}
 
 
 #: What a map changes in the embedded study (the paper's): its beam-only sky and Eq. 5 are for the
@@ -63,7 +74,7 @@ def map_study(data: dict, embedded: bool = True, **changes) -> dict:
     tilt of ``|latitude|`` at every site unless ``panel.tilt``/``panel.azimuth`` are in ``changes``;
     the objective is the mean unless set. ``changes`` are field paths (dotted) to values.
     """
-    from foldopt.inputs.config import set_path
+    from foldopt.inputs.policy import set_path
 
     study = {key: value for key, value in data.items() if key not in _PER_SITE}
     panel = {key: value for key, value in (study.get("panel") or {}).items() if key not in ("tilt", "azimuth")}
@@ -121,7 +132,7 @@ def read_sites(path: Path | str) -> list[dict]:
         try:
             site = Site.model_validate(data)
         except ValidationError as error:
-            errors += [f"--sites {path}, line {line}: {message}" for message in _format_errors(error)]
+            errors += [f"--sites {path}, line {line}: {message}" for message in format_errors(error)]
             continue
         if site.name is not None:
             if site.name in named:  # the map's rows and figures tell sites by name
@@ -156,9 +167,132 @@ def weather_sites(folder: Path | str) -> list[dict]:
     return sites
 
 
+@dataclass(frozen=True)
+class MapRequest:
+    """A map's request made into what runs (:func:`map_request`).
+
+    Attributes
+    ----------
+    study : dict
+        The map's study: a study's fields but site, date and load (:func:`map_study`).
+    sites : tuple of dict
+        Each a site's fields or a weather file's site (:func:`evaluate_sites`).
+    loads : tuple of float
+        Loads [W], or with ``relative`` fractions [-] of each site's flat peak.
+    relative : bool
+    year : int
+    source : str
+        How the answer names the study the map took its panel and models from.
+    taken : tuple of str
+        What the answer took from that study or from defaults, not from the request.
+    """
+
+    study: dict
+    sites: tuple
+    loads: tuple
+    relative: bool = False
+    year: int = 2025
+    source: str = "the given study"
+    taken: tuple = ()
+
+    @property
+    def defaults(self) -> dict | None:
+        """``{"study": source, "taken": [...]}``, or None where nothing was taken."""
+        return {"study": self.source, "taken": list(self.taken)} if self.taken else None
+
+
+def _values(name: str, values) -> list:
+    """A value, a sequence, or text (a value, a range start:stop:step or a list a,b,c:
+    :func:`foldopt.inputs.plan.parse_values`, the parser of every sweep axis too) as a list."""
+    if isinstance(values, str):
+        try:
+            values = parse_values(values)
+        except ValueError as error:
+            raise ConfigError([f"{name} = {values!r}: {error}"]) from None
+    return list(values) if isinstance(values, (list, tuple)) or hasattr(values, "tolist") else [values]
+
+
+def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | None = None, latitudes=None,
+                longitudes=None, land_only: bool = False, relative: bool = False, year: int = 2025,
+                show_period: str = "year") -> MapRequest:
+    """A map's sites, loads, year and period, each checked, with its study: what the command line
+    and :func:`foldopt.world_map` both run.
+
+    Parameters
+    ----------
+    study : dict
+        The map's study (:func:`map_study`); checked at the first site.
+    loads : float, sequence of float or str
+        Loads [W] in (0, 1e6], or with ``relative`` fractions of each site's flat peak in (0, 2];
+        text is a value, a range ``start:stop:step`` or a list ``a,b,c``.
+    sites : sequence of dict, str or pathlib.Path, optional
+        The sites (:func:`grid_sites`, :func:`read_sites`, :func:`weather_sites`), or a CSV of named
+        sites (:func:`read_sites`).
+    weather_dir : str or pathlib.Path, optional
+        Without ``sites``: a folder of weather files, each a site (:func:`weather_sites`).
+    latitudes, longitudes : sequence of float or str, optional
+        Without ``sites`` or ``weather_dir``: the grid [deg], as values or text like ``loads``;
+        default :data:`DEFAULT_GRID`.
+    land_only : bool
+        Keep the grid's points on land.
+    relative : bool
+    year : int
+        The year of clear-sky days, or what a weather file's typical year stands for.
+    show_period : str
+        The period the world maps show: one of :data:`PERIODS`.
+
+    Returns
+    -------
+    MapRequest
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One line per fault, naming the parameter (``latitudes``, ``loads``, ``show_period``...),
+        for more than :data:`foldopt.inputs.plan.MAX_CASES` sites, or for a study that fails at
+        the first site.
+    """
+    from foldopt.inputs.plan import MAX_CASES
+
+    errors = []
+    if show_period not in PERIODS:
+        errors.append(f"show_period = {show_period!r}: must be one of {', '.join(PERIODS)}")
+    if year_problem(year):
+        errors.append(f"year = {year}: {year_problem(year)}")
+    if errors:
+        raise ConfigError(errors)
+    grid = sites is None and weather_dir is None
+    # An empty text is no value (an error), not the default grid.
+    grid_values = [_values(name, default if given is None else given) if grid else []
+                   for name, given, default in (("latitudes", latitudes, DEFAULT_GRID[0]),
+                                                ("longitudes", longitudes, DEFAULT_GRID[1]))]
+    for name, values, bound in zip(("latitudes", "longitudes"), grid_values, (90, 180), strict=True):
+        if any(not -bound <= value <= bound for value in values):
+            errors.append(f"{name}: must be in [-{bound}, {bound}] deg")
+    load_values = _values("loads", loads)
+    largest, bounds = LOAD_BOUNDS[relative]
+    if any(not 0 < value <= largest for value in load_values):
+        errors.append(f"loads = {loads!r}: {bounds}")
+    if errors:
+        raise ConfigError(errors)
+    if isinstance(sites, (str, Path)):
+        sites = read_sites(sites)
+    elif sites is None and weather_dir is not None:
+        sites = weather_sites(weather_dir)
+    elif sites is None:
+        sites = grid_sites(*grid_values, land_only)
+        if not sites:
+            raise ConfigError(["land_only: no grid point is on land"])
+    if len(sites) > MAX_CASES:
+        raise ConfigError([f"sites: {len(sites):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
+    if len(sites):
+        site_study(study, sites[0], year)  # a bad setting fails here, before any cluster starts
+    return MapRequest(study, tuple(sites), tuple(load_values), relative, year)
+
+
 def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]]:
     """The study at one site of a map and the days of its year: ``study`` is a study's fields but
-    the site, date and load; ``site`` a :class:`foldopt.inputs.config.Site`'s fields or a weather file's
+    the site, date and load; ``site`` a :class:`foldopt.inputs.sections.Site`'s fields or a weather file's
     site (``weather``: the path, its site read from the file)."""
     if year_problem(year):
         raise ConfigError([f"year = {year!r}: {year_problem(year)}"])
@@ -174,9 +308,9 @@ def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]
     else:
         data["site"] = {key: site[key] for key in SITE_COLUMNS if site.get(key) is not None}
     try:
-        return Study.model_validate(data), dates
+        return Study.model_validate(data, context=resolve_files(data)), dates
     except ValidationError as error:
-        raise ConfigError(_format_errors(error)) from None
+        raise ConfigError(format_errors(error)) from None
 
 
 def evaluate_sites(study: dict, sites: Sequence[dict], loads: Sequence[float], relative: bool = False,

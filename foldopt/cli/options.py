@@ -1,0 +1,126 @@
+"""The options the commands share, each declared once, and the words of their errors.
+
+A command takes an option by naming it as a parameter's default (``overwrite: bool = OVERWRITE``);
+an option whose default or help differs by command (``--out``, the study argument) is made by one
+function here. Errors from the library name study fields; :func:`rename_fields` says them as the
+options that set them.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import typer
+
+from foldopt import names
+from foldopt.cli.output import fail
+
+#: Where results folders go unless ``--out`` says otherwise.
+RESULTS = Path("results")
+#: The embedded study, as help texts and answers name it.
+EMBEDDED = "configs/shin2015.yaml"
+
+OVERWRITE = typer.Option(False, "--overwrite", help="Replace an existing results folder.")
+QUIET = typer.Option(False, "--quiet", "-q", help="Print nothing but errors (with --format json: the JSON only).")
+FORMAT = typer.Option("table", "--format", help=f"{' | '.join(names.OUTPUT_FORMATS)}: a short answer, or one JSON "
+                                                 "document on stdout for scripts.")
+ENGINE = typer.Option("numba", "--engine", help="numba (the compiled kernel) | numpy (the reference path it is "
+                                                "tested against, slower).")
+TABLE = typer.Option(False, "--table", help="Also print the full table (it is always in the CSV files).")
+AREA = typer.Option(None, "--area", help="Flat panel area [m^2].")
+
+
+def out_option(default: Path | None = None, shown: str | None = None):
+    """The ``--out`` option: the results folder.
+
+    Parameters
+    ----------
+    default : pathlib.Path, optional
+        The folder, or None where the command names it from the study (then ``shown`` says how).
+    shown : str, optional
+        The default as the help text gives it, e.g. ``results/<study name>``.
+
+    Returns
+    -------
+    typer.models.OptionInfo
+    """
+    return typer.Option(default, "--out", help=f"Results folder{f' [default: {shown}]' if shown else ''}.")
+
+
+def study_argument(kind: str = ""):
+    """The optional study argument of ``run`` and ``size``.
+
+    Parameters
+    ----------
+    kind : str
+        What study the command takes, after ``YAML study`` (e.g. `` (one case)``).
+
+    Returns
+    -------
+    typer.models.ArgumentInfo
+    """
+    return typer.Argument(None, help=f"YAML study{kind} [default: the embedded {EMBEDDED}].")
+
+
+def check_choices(output_format: str, engine: str) -> tuple[str, str]:
+    """``--format`` and ``--engine`` as their registries name them; bad ones end the command.
+
+    Parameters
+    ----------
+    output_format, engine : str
+        As given, in any of the names :mod:`foldopt.names` knows.
+
+    Returns
+    -------
+    tuple of str
+        The canonical format and engine.
+    """
+    errors, chosen = [], []
+    for option, value, choices in (("--format", output_format, names.OUTPUT_FORMATS),
+                                   ("--engine", engine, names.ENGINES)):
+        try:
+            chosen.append(names.canonical(value, choices))
+        except ValueError as error:
+            errors.append(f"{option} = {value!r}: {error}")
+    if errors:
+        fail(errors)
+    return tuple(chosen)
+
+
+#: Study fields as the command-line options name them, so errors speak the user's words.
+OPTION_OF_FIELD = {
+    "site.latitude": "--lat", "site.longitude": "--lon", "site.altitude": "--altitude",
+    "site.timezone": "--timezone", "date": "--days/--date", "p_load": "--p-load", "panel.area": "--area",
+    "panel.efficiency": "--efficiency", "panel.tilt": "--tilt", "panel.azimuth": "--azimuth",
+    "mode": "--mode", "geometry": "--geometry", "sky": "--sky", "step_min": "--step-min",
+    "connection": "--connection", "fold_angles.step": "--angle-step", "fold_angles.start": "--angle-step",
+    "pv_model": "--pv-model", "module": "--module", "temp_air": "--temp-air",
+    "converter_efficiency": "--converter-efficiency", "year": "--year", "climate": "--climate",
+    "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby", "transposition": "--transposition",
+    "objective.statistic": "--objective", "objective.visits": "--visits", "weather": "--weather", "albedo": "--albedo",
+    "iam": "--iam", "switch_series": "--switch-series", "bypass_diodes": "--no-bypass",
+    "exact_electrical": "--exact-electrical", "force_site": "--force-site", "load_profile": "--load-profile",
+}
+_FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
+
+
+def rename_fields(line: str, options: dict = OPTION_OF_FIELD) -> str:
+    """A message's leading field path as the option that set it.
+
+    Parameters
+    ----------
+    line : str
+        ``field: problem`` or ``field = value: problem``.
+    options : dict
+        Field path -> option.
+
+    Returns
+    -------
+    str
+        The line with its field renamed, or as it was where ``options`` has no such field.
+    """
+    match = _FIELD.match(line)
+    if match and match.group(1) in options:
+        return options[match.group(1)] + line[match.end(1):]
+    return line

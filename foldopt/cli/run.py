@@ -1,0 +1,99 @@
+"""``foldopt run`` and ``foldopt reproduce``, and the running of a request that ``sweep`` shares."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+from foldopt.cli.options import (EMBEDDED, ENGINE, FORMAT, OVERWRITE, QUIET, RESULTS, TABLE, check_choices, out_option,
+                                 study_argument)
+from foldopt.cli.output import INVOCATION, Output
+from foldopt.files import check_output
+from foldopt.inputs.plan import load_plan
+from foldopt.inputs.load import default_study_path
+from foldopt.studies.request import Request
+
+
+def run_request(request: Request, out: Path, overwrite: bool, output: Output, engine: str, command: str) -> None:
+    """Evaluate a request's plan (one case or many) through the API, write its folder, print its answer.
+
+    Parameters
+    ----------
+    request : foldopt.studies.request.Request
+    out : pathlib.Path
+        The results folder.
+    overwrite : bool
+    output : Output
+    engine : {'numba', 'numpy'}
+    command : str
+        The command's name, for the JSON document.
+    """
+    check_output(out, overwrite)
+    plan, base = request.plan, request.plan.base
+    if not plan.axes:
+        label, total, unit = f"{base.name}: one day, {len(base.fold_angles.grid())} fold angles", None, "days"
+    else:
+        days = plan.n_cases // max(len(dict(plan.axes).get("p_load", (1,))), 1)
+        unit = "site-days" if any(path.startswith("site") for path, _ in plan.axes) else "days"
+        label, total = f"{base.name}: {days} {unit}", days
+    with output.progress(label, total=total, unit=unit) as progress:
+        from foldopt.api import run, write
+
+        result = run(plan, engine, progress, request=request)
+        write(result, out, overwrite, INVOCATION)
+    rows = result.summary if not plan.axes else result.table
+    output.answer(command, out, result.answer, rows, [f"wrote {out}"], rows)
+
+
+def run(
+    config: Optional[Path] = study_argument(),
+    out: Optional[Path] = out_option(shown="results/<study name>"),
+    overwrite: bool = OVERWRITE,
+    quiet: bool = QUIET,
+    output_format: str = FORMAT,
+    engine: str = ENGINE,
+    table: bool = TABLE,
+):
+    """Run a YAML study: one case (fold-angle sweep, the paper's heuristic, flat and trackers
+    compared) or a sweep of cases (a row per case x design).
+
+    \b
+    Examples:
+      foldopt run
+      foldopt run configs/annual-weather.yaml --out results/greensboro
+    """
+    output_format, engine = check_choices(output_format, engine)
+    source = EMBEDDED if config is None else str(config)
+    request = Request(load_plan(config if config is not None else default_study_path()), source, ())
+    run_request(request, out or RESULTS / request.plan.base.name, overwrite, Output(quiet, output_format, table),
+                engine, "run")
+
+
+def reproduce(
+    out: Path = out_option(RESULTS / "reproduction"),
+    overwrite: bool = OVERWRITE,
+    quiet: bool = QUIET,
+    output_format: str = FORMAT,
+    engine: str = ENGINE,
+):
+    """Reproduce Shin et al.'s study in paper and exact modes: their published values beside foldopt's.
+
+    Writes reproduction.csv (the embedded study: ideal PV model) and reproduction_single_diode.csv
+    (A-300 single-diode sub-panels with switching).
+    """
+    output_format, engine = check_choices(output_format, engine)
+    output = Output(quiet, output_format)
+    check_output(out, overwrite)
+    with output.progress("reproducing Shin et al. (two PV models x two modes)"):
+        from foldopt.api import reproduce as reproduce_paper, write
+
+        result = reproduce_paper(engine)
+        write(result, out, overwrite, INVOCATION)
+    output.answer("reproduce", out, result.answer, None, [f"wrote {out}"])
+
+
+#: The commands of this module: name, function, and the line the command list shows.
+COMMANDS = [
+    ("run", run, "Run a YAML study, one case or a sweep [default: the embedded study]."),
+    ("reproduce", reproduce, "Shin et al.'s published values beside foldopt's, paper and exact modes."),
+]

@@ -1,0 +1,82 @@
+"""``foldopt size``: Shin et al.'s panel sizing (Sec. IV-A) through :func:`foldopt.size`, whose
+limits (:data:`foldopt.studies.request.SIZING_LIMITS`) are checked before the study is read."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from foldopt.cli.options import (FORMAT, EMBEDDED, OVERWRITE, QUIET, RESULTS, TABLE, check_choices, out_option,
+                                 study_argument)
+from foldopt.cli.output import INVOCATION, Output, fail
+from foldopt.errors import ConfigError
+from foldopt.files import check_output
+from foldopt.inputs.plan import load_plan
+from foldopt.inputs.load import default_study_path
+from foldopt.inputs.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2
+from foldopt.studies.request import size_request, sizing_problems
+
+#: The sizing's parameters as the command line names them, longest first.
+_OPTION_OF_SIZING = {"cost_per_m2 / cost_per_w": "--cost-per-m2 / --cost-per-w", "c_grid_usd_per_kwh": "--c-grid",
+                     "days_per_year": "--days-per-year", "cost_per_m2": "--cost-per-m2", "cost_per_w": "--cost-per-w",
+                     "years": "--years", "areas": "--areas"}
+
+
+def _sizing_option(line: str) -> str:
+    for field, option in _OPTION_OF_SIZING.items():
+        if line.startswith(field):
+            return option + line[len(field):]
+    return line
+
+
+def size(
+    config: Optional[Path] = study_argument(" (one case)"),
+    areas: str = typer.Option("0.01:0.5:0.005", "--areas", help="Panel areas [m^2], start:stop:step."),
+    cost_per_m2: Optional[float] = typer.Option(None, "--cost-per-m2", help=f"Panel cost [$/m^2] [default: "
+                                                f"{PAPER_COST_PER_M2:g}, the cost Shin et al.'s 0.108 m^2 optimum "
+                                                "implies]."),
+    cost_per_w: Optional[float] = typer.Option(None, "--cost-per-w", help="Panel cost [$/W at STC], instead."),
+    c_grid: float = typer.Option(C_GRID, "--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22)."),
+    years: float = typer.Option(LIFETIME_YEARS, "--years", help="Lifetime [years] (Shin et al.: 20)."),
+    days_per_year: float = typer.Option(DAYS_PER_YEAR, "--days-per-year", help="Days a year like the study's day."),
+    out: Optional[Path] = out_option(shown="results/<study>-sizing"),
+    overwrite: bool = OVERWRITE,
+    quiet: bool = QUIET,
+    output_format: str = FORMAT,
+    table: bool = TABLE,
+):
+    """Shin et al. Sec. IV-A panel sizing: the lifetime benefit C_grid x t_solar x P_load against the
+    panel's cost, for flat and twofold panels of every area.
+
+    \b
+    Examples:
+      foldopt size
+      foldopt size --cost-per-w 0.9 --areas 0.02:0.3:0.002
+    """
+    output_format, _ = check_choices(output_format, "numba")
+    output = Output(quiet, output_format, table)
+    errors = sizing_problems({"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
+                              "years": years, "days_per_year": days_per_year})
+    if errors:
+        fail([_sizing_option(line) for line in errors])
+    plan = load_plan(config if config is not None else default_study_path())
+    request = size_request(plan, EMBEDDED if config is None else str(config),
+                           cost_per_m2 is not None or cost_per_w is not None)
+    study = plan.base
+    out = out or RESULTS / f"{study.name}-sizing"
+    check_output(out, overwrite)
+    from foldopt.api import size as size_panel, write
+
+    try:
+        with output.progress(f"sizing {study.name}"):
+            result = size_panel(study, areas, cost_per_m2, cost_per_w, c_grid, years, days_per_year, request=request)
+            write(result, out, overwrite, INVOCATION)
+    except ConfigError as error:
+        fail([_sizing_option(line) for line in error.errors])
+    output.answer("size", out, result.answer, result.table, [f"wrote {out}"], result.table)
+
+
+#: The commands of this module: name, function, and the line the command list shows.
+COMMANDS = [("size", size, "Panel sizing: lifetime net benefit against area, flat and twofold.")]

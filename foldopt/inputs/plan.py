@@ -1,0 +1,489 @@
+"""Plans: a study with sweep axes, and the values an axis takes.
+
+Any field of a study may hold a list of values or a numeric range ``start:stop:step``
+(:func:`parse_range`, :func:`parse_values`), and ``date`` a date range, ``year`` or
+``equinoxes-solstices`` (:func:`parse_dates`); each is an axis of a :class:`Plan`, whose cases are
+the product of its axes' values. :func:`make_plan` validates every value of every axis, collapses
+the faults to one line per field and problem, and refuses a plan larger than the limits
+(:data:`MAX_CASES`, :data:`MAX_EVALUATIONS`...) before any work.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import itertools
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from pydantic import ValidationError
+
+from foldopt.errors import ConfigError
+from foldopt.inputs.load import read_study, resolve_files, size_limit
+from foldopt.inputs.policy import set_path
+from foldopt.inputs.study import Study, format_error
+
+DATE_KEYWORDS = ("year", "equinoxes-solstices")
+#: Fields that label a study rather than design it: a list of them is no sweep.
+UNSWEPT = ("name", "description")
+
+#: Values of one sweep axis (a range or a list).
+MAX_AXIS_VALUES = size_limit("MAX_AXIS_VALUES", 10_000)
+#: Cases of a plan: one row of results.csv per case and design.
+MAX_CASES = size_limit("MAX_CASES", 200_000)
+#: Site-days x fold angles x time steps of a plan: about 6 ns each on one core (README,
+#: "Performance"), so the default is a few minutes of work at most.
+MAX_EVALUATIONS = size_limit("MAX_EVALUATIONS", 20_000_000_000)
+#: Days x fold angles x loads of one annual group (a fixed angle chosen over the days), held at
+#: once: 8 bytes each.
+MAX_ANNUAL_CELLS = size_limit("MAX_ANNUAL_CELLS", 100_000_000)
+#: Years of a study's days, checked alike for study files, sweeps and maps: well inside Python's
+#: calendar (years 1 to 9999; a year 0 or 10000 was a traceback) and pvlib's solar position.
+YEARS = (1901, 2099)
+
+
+def year_problem(year) -> str | None:
+    """Why a value cannot be a study's year.
+
+    Parameters
+    ----------
+    year : object
+
+    Returns
+    -------
+    str or None
+        The problem, or None for a whole year of :data:`YEARS`.
+    """
+    if isinstance(year, bool) or not isinstance(year, int) or not YEARS[0] <= year <= YEARS[1]:
+        return f"must be a whole year in [{YEARS[0]}, {YEARS[1]}]"
+    return None
+
+
+_RANGE = re.compile(r"^\s*([^:\s]+)\s*:\s*([^:\s]+)\s*:\s*([^:\s]+)\s*$")
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_NUMERIC_RANGE = re.compile(rf"^\s*{_NUMBER}\s*:\s*{_NUMBER}\s*:\s*{_NUMBER}\s*$")
+
+
+def parse_range(text: str) -> list[float]:
+    """The values of a range.
+
+    Parameters
+    ----------
+    text : str
+        ``"start:stop:step"``, numbers with a positive step.
+
+    Returns
+    -------
+    list of float
+        From start to stop inclusive (stop kept if on the grid), rounded to 12 decimals.
+
+    Raises
+    ------
+    ValueError
+        For a malformed or empty range, or more than :data:`MAX_AXIS_VALUES` values.
+    """
+    match = _RANGE.match(str(text))
+    if not match:
+        raise ValueError(f"expected start:stop:step, got {text!r}")
+    try:
+        start, stop, step = (float(part) for part in match.groups())
+    except ValueError:
+        raise ValueError(f"expected numbers in start:stop:step, got {text!r}") from None
+    if step <= 0 or not all(map(math.isfinite, (start, stop, step))):
+        raise ValueError(f"step must be a positive number, got {text!r}")
+    if stop < start:
+        raise ValueError(f"empty range {text!r}: stop is below start")
+    count = math.floor((stop - start) / step + 1e-9) + 1
+    if count > MAX_AXIS_VALUES:
+        raise ValueError(f"{text!r} has {count:,} values; at most {MAX_AXIS_VALUES:,} per axis "
+                         "(FOLDOPT_MAX_AXIS_VALUES raises it)")
+    return [round(start + i * step, 12) for i in range(count)]
+
+
+def parse_values(text: str, numeric: bool = True):
+    """The one parser of a value, a range or a list, as typed on the command line.
+
+    ``"5"`` is a value, ``"0:60:10"`` a range (inclusive, :func:`parse_range`) and ``"0,30,60"`` a
+    list; with ``numeric=False`` (dates) the items stay text and a range or keyword (``year``)
+    is left to :func:`parse_dates`.
+
+    Parameters
+    ----------
+    text : str
+    numeric : bool
+        Whether the items are numbers.
+
+    Returns
+    -------
+    float, str or list
+        A value, or a list for a range or a list.
+
+    Raises
+    ------
+    ValueError
+        For an empty text or item, a malformed range, a value that is not a number, or more than
+        :data:`MAX_AXIS_VALUES` values.
+    """
+    text = str(text).strip()
+    if not text:
+        raise ValueError("no value; give a value, a range start:stop:step or a list a,b,c")
+    items = [item.strip() for item in text.split(",")]
+    if any(not item for item in items):
+        raise ValueError(f"{text!r} has an empty item; a list is a,b,c")
+    if len(items) > MAX_AXIS_VALUES:
+        raise ValueError(f"a list of {len(items):,} values; at most {MAX_AXIS_VALUES:,} per axis "
+                         "(FOLDOPT_MAX_AXIS_VALUES raises it)")
+    if not numeric:
+        return items if len(items) > 1 else items[0]
+    if len(items) == 1 and ":" in text:
+        return parse_range(text)
+    try:
+        values = [float(item) for item in items]
+    except ValueError:
+        raise ValueError(f"{text!r}: expected a number, a range start:stop:step or a list a,b,c") from None
+    if not all(math.isfinite(value) for value in values):
+        raise ValueError(f"{text!r}: values must be finite numbers")
+    return values if len(values) > 1 else values[0]
+
+
+def parse_dates(spec, year: int) -> list[dt.date]:
+    """The dates of a study's ``date`` axis.
+
+    Parameters
+    ----------
+    spec : object
+        A date (or its text, or a day of ``year``), a list of them, ``"start:stop:step"`` (dates
+        or days of ``year``, a step in days), ``year`` or ``equinoxes-solstices`` (20 March,
+        21 June, 23 September, 21 December of ``year``).
+    year : int
+        The year of days of year and keywords.
+
+    Returns
+    -------
+    list of datetime.date
+
+    Raises
+    ------
+    ValueError
+        For a value that is no date or day of ``year``, an empty list or an empty range.
+    """
+
+    def one(value):
+        if isinstance(value, dt.date):
+            return value
+        if isinstance(value, int) and not isinstance(value, bool):
+            if not 1 <= value <= (366 if _leap(year) else 365):
+                raise ValueError(f"day of year {value} is outside {year}")
+            return dt.date(year, 1, 1) + dt.timedelta(days=value - 1)
+        try:
+            return dt.date.fromisoformat(str(value))
+        except ValueError:
+            raise ValueError(f"{value!r} is not a date (YYYY-MM-DD) or a day of year") from None
+
+    if isinstance(spec, list):
+        if not spec:
+            raise ValueError("empty list of dates")
+        return [one(item) for item in spec]
+    if spec == "year":
+        days = 366 if _leap(year) else 365
+        return [dt.date(year, 1, 1) + dt.timedelta(days=i) for i in range(days)]
+    if spec == "equinoxes-solstices":
+        return [dt.date(year, 3, 20), dt.date(year, 6, 21), dt.date(year, 9, 23), dt.date(year, 12, 21)]
+    match = _RANGE.match(str(spec)) if isinstance(spec, str) else None
+    if match:
+        start, stop, step = match.groups()
+        if not step.isdigit() or int(step) < 1:
+            raise ValueError(f"the step of a date range is a whole number of days, got {step!r}")
+        first, last = one(int(start) if start.isdigit() else start), one(int(stop) if stop.isdigit() else stop)
+        if last < first:
+            raise ValueError(f"empty range {spec!r}: stop is before start")
+        return [first + dt.timedelta(days=d) for d in range(0, (last - first).days + 1, int(step))]
+    return [one(spec)]
+
+
+def _leap(year: int) -> bool:
+    return year % 4 == 0 and (year % 100 != 0 or year % 400 == 0)
+
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A study and its sweep axes; the cases are the product of the axes' values.
+
+    Parameters
+    ----------
+    data : dict
+        The study's fields, each axis at its listed values (as a study file holds it).
+    axes : tuple
+        ``(path, values)`` pairs: each dotted field path (``site.latitude``, ``p_load``,
+        ``date``...) with the tuple of its values.
+    """
+
+    data: dict
+    axes: tuple
+
+    @property
+    def base(self) -> Study:
+        """The study with every axis at its first value (:meth:`study`)."""
+        return self.study({path: values[0] for path, values in self.axes})
+
+    @property
+    def n_cases(self) -> int:
+        """The number of cases: the product of the axes' lengths."""
+        return math.prod(len(values) for _, values in self.axes)
+
+    def study(self, choice: dict) -> Study:
+        """One case's study, its files read (:func:`foldopt.inputs.load.resolve_files`).
+
+        Parameters
+        ----------
+        choice : dict
+            Dotted field paths to their values in this case.
+
+        Returns
+        -------
+        Study
+
+        Raises
+        ------
+        pydantic.ValidationError
+        """
+        data = self.data
+        for path, value in choice.items():
+            data = set_path(data, path, value)
+        return Study.model_validate(data, context=resolve_files(data))
+
+    def cases(self):
+        """Every case of the plan.
+
+        Yields
+        ------
+        choice : dict
+            Each axis' path to its value in the case, first axis slowest.
+        study : Study
+        """
+        paths = [path for path, _ in self.axes]
+        for values in itertools.product(*(values for _, values in self.axes)):
+            choice = dict(zip(paths, values, strict=True))
+            yield choice, self.study(choice)
+
+
+
+def _listed_leaves(data: dict, prefix: str = ""):
+    """Dotted paths holding a list, a numeric ``start:stop:step`` range or a date keyword."""
+    for key, value in data.items():
+        path = f"{prefix}{key}"
+        if path == "date" and (isinstance(value, list) or value in DATE_KEYWORDS or (
+            isinstance(value, str) and _RANGE.match(value)
+        )):
+            yield path, value
+        elif isinstance(value, list) or (isinstance(value, str) and _NUMERIC_RANGE.match(value)):
+            yield path, value
+        elif isinstance(value, dict):
+            yield from _listed_leaves(value, f"{path}.")
+
+
+def _axis_values(path: str, spec, year: int) -> list:
+    if path == "date":
+        return parse_dates(spec, year)
+    if isinstance(spec, list):
+        if not spec:
+            raise ValueError("empty list")
+        if len(spec) > MAX_AXIS_VALUES:
+            raise ValueError(f"a list of {len(spec):,} values; at most {MAX_AXIS_VALUES:,} per axis "
+                             "(FOLDOPT_MAX_AXIS_VALUES raises it)")
+        return list(spec)
+    if isinstance(spec, str) and _RANGE.match(spec):
+        return parse_range(spec)
+    return [spec]
+
+
+def make_plan(data, lines: dict | None = None) -> Plan:
+    """Validate a study with optional sweep axes.
+
+    Any field but :data:`UNSWEPT` may hold a list (``site``: a list of sites) or a numeric range
+    ``"start:stop:step"``; ``date`` also takes a date range, ``year`` or ``equinoxes-solstices``
+    (of ``year``, default 2025), and is the whole ``year`` by default with a weather file. The
+    ``sweep:`` section maps dotted field paths to lists or ranges. Each becomes an axis.
+
+    Parameters
+    ----------
+    data : dict
+        The study's fields, as a study file holds them (``year`` and ``sweep`` included).
+    lines : dict, optional
+        Key paths (tuples of str) to YAML line numbers, added to the messages.
+
+    Returns
+    -------
+    Plan
+
+    Raises
+    ------
+    foldopt.ConfigError
+        With every fault, one line per field and problem, or for a plan beyond the size limits.
+    """
+    lines = lines or {}
+    if not isinstance(data, dict):
+        raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
+    data = dict(data)
+    if data.get("weather") is not None and "date" not in data:
+        data["date"] = "year"  # a weather file is a year
+    errors: list[str] = []
+    year = data.pop("year", 2025)
+    if year_problem(year):
+        errors.append(_at(lines, ("year",), f"year = {year!r}: {year_problem(year)}"))
+        year = 2025
+    sweep = data.pop("sweep", None) or {}
+    if not isinstance(sweep, dict):
+        errors.append(_at(lines, ("sweep",), "sweep: expected a mapping of field paths to lists or ranges"))
+        sweep = {}
+    # Each axis: dotted field path -> (name in messages, key path in the YAML, its spec).
+    specs = {path: (path, tuple(path.split(".")), value) for path, value in _listed_leaves(data)}
+    for path, value in sweep.items():
+        specs[str(path)] = (f"sweep.{path}", ("sweep", str(path)), value)
+    axes = []
+    for path, (source, yaml_path, spec) in specs.items():
+        if path in UNSWEPT:
+            errors.append(_at(lines, yaml_path, f"{source}: the study's {path} labels its results, it is not "
+                                                f"sweepable; give one {path}"))
+            continue
+        try:
+            values = _axis_values(path, spec, year)
+        except ValueError as error:
+            errors.append(_at(lines, yaml_path, f"{source}: {error}"))
+            continue
+        axes.append((path, tuple(values)))
+    if errors:
+        raise ConfigError(errors)
+
+    plan = Plan(data, tuple(axes))
+    if data.get("objective") is not None and "date" not in dict(axes):
+        raise ConfigError([_at(lines, ("objective",), "objective: one fold angle for several days needs several "
+                                                      "dates (a date range, 'year', or a weather file)")])
+    if plan.n_cases > MAX_CASES:
+        raise ConfigError([f"sweep: {plan.n_cases:,} cases; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
+    first = {path: values[0] for path, values in axes}
+    labels = {path: (f"{specs[path][0]}[0]", specs[path][1] + (0,)) for path in first}
+    errors += _validation_errors(plan, first, lines, labels)
+    for path, values in axes:
+        source, yaml_path, _ = specs[path]
+        for index, value in enumerate(values[1:], start=1):
+            where = {path: (f"{source}[{index}]", yaml_path + (index,))}
+            errors += _validation_errors(plan, {**first, path: value}, lines, where)
+    if errors:
+        raise ConfigError(_collapse(list(dict.fromkeys(errors))))
+    _check_size(plan)
+    return plan
+
+
+def _check_size(plan: Plan) -> None:
+    """Refuse a plan whose work or memory would exceed the limits, before any work."""
+    axes = dict(plan.axes)
+    base = plan.base
+    angles = len(base.fold_angles.grid())
+    steps = round(24 * 60 / base.step_min)
+    loads = len(axes.get("p_load", (None,)))
+    site_days = plan.n_cases // loads
+    evaluations = site_days * angles * steps
+    if evaluations > MAX_EVALUATIONS:
+        raise ConfigError([f"study: {site_days:,} site-days x {angles} fold angles x {steps:,} steps = "
+                           f"{evaluations:.2g} evaluations; the limit is {MAX_EVALUATIONS:.2g} (a coarser "
+                           "fold_angles or step_min, fewer cases, or FOLDOPT_MAX_EVALUATIONS)"])
+    if base.objective is not None and "date" in axes:
+        cells = len(axes["date"]) * angles * loads
+        if cells > MAX_ANNUAL_CELLS:
+            raise ConfigError([f"objective: {len(axes['date'])} days x {angles} fold angles x {loads} loads = "
+                               f"{cells:.2g} values held at once; the limit is {MAX_ANNUAL_CELLS:.2g} (fewer loads "
+                               "or angles, or FOLDOPT_MAX_ANNUAL_CELLS)"])
+
+
+_INDEXED = re.compile(r"^(?P<field>[^\[\s]+)\[(?P<index>\d+)\] = (?P<value>.*?): (?P<problem>.*)$")
+
+
+def _collapse(errors: list[str]) -> list[str]:
+    """One line per field and problem: ``p_load[0,2] = -1.0, 0.0: must be ...`` (values cut at 5)."""
+    groups: dict[tuple, list] = {}
+    for error in errors:
+        match = _INDEXED.match(error)
+        key = (match["field"], match["problem"]) if match else (error, None)
+        groups.setdefault(key, []).append(match)
+    lines = []
+    for (field, problem), matches in groups.items():
+        if problem is None:
+            lines.append(field)
+            continue
+        indices = ",".join(m["index"] for m in matches)
+        values = ", ".join(m["value"] for m in matches[:5]) + (", ..." if len(matches) > 5 else "")
+        lines.append(f"{field}[{indices}] = {values}: {problem}")
+    return lines
+
+
+def _validation_errors(plan: Plan, choice: dict, lines: dict, where: dict) -> list[str]:
+    try:
+        plan.study(choice)
+    except ValidationError as error:
+        messages = []
+        for item in error.errors():
+            for message in format_error(item):
+                loc = tuple(str(part) for part in item["loc"])
+                for path, (label, yaml_path) in where.items():
+                    if ".".join(loc).startswith(path):
+                        message = message.replace(".".join(loc), label, 1)
+                        loc = yaml_path
+                messages.append(_at(lines, loc, message))
+        return messages
+    return []
+
+
+def _at(lines: dict, loc: tuple, message: str) -> str:
+    """Append the YAML line of the longest known prefix of ``loc``."""
+    for end in range(len(loc), 0, -1):
+        line = lines.get(tuple(str(part) for part in loc[:end]))
+        if line is not None:
+            return f"{message} (line {line})"
+    return message
+
+
+
+def load_plan(path: Path | str) -> Plan:
+    """Read and validate a YAML study, with any sweep axes.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    Plan
+
+    Raises
+    ------
+    foldopt.ConfigError
+        With the YAML line of each fault.
+    """
+    return make_plan(*read_study(path))
+
+
+
+def load_study(path: Path | str) -> Study:
+    """Read a YAML study that has no sweep axes.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For any fault, or a study that sweeps fields.
+    """
+    plan = load_plan(path)
+    if plan.axes:
+        raise ConfigError([f"config: {path} sweeps {', '.join(p for p, _ in plan.axes)}; run it with `foldopt run`"])
+    return plan.base
+

@@ -1,0 +1,486 @@
+"""The parts of a study, as pydantic models: its site, panel, tracker, weather file, objective, load
+profile, fold-angle grid and near-optimal tolerance (:class:`foldopt.inputs.study.Study` holds them).
+
+Every number is checked against its interval, and the message states the interval and its unit
+(:func:`interval`); every name is checked against its registry in :mod:`foldopt.names`, any
+spelling of :func:`foldopt.names.canonical` accepted (:func:`named`). The models open no files:
+what a study's files hold comes from :func:`foldopt.inputs.load.resolve_files`, as a
+:class:`FilesRead` handed to the validation.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+import re
+import zoneinfo
+from dataclasses import dataclass
+from functools import partial
+from typing import Annotated
+
+from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, field_validator,
+                      model_validator)
+
+from foldopt import names
+from foldopt.inputs.loads import profile_steps
+from foldopt.names import ALEXANDRU_STEP_OFFSETS_H, canonical
+
+_OFFSET = re.compile(r"^(?:UTC)?([+-])(\d{1,2})(?::?(\d{2}))?$")
+
+
+def interval(lo, hi, *, lo_open=False, hi_open=False, unit=""):
+    """A float constrained to an interval, whose error message states the interval.
+
+    Parameters
+    ----------
+    lo, hi : float
+        The bounds, in the field's unit.
+    lo_open, hi_open : bool
+        Whether a bound itself is outside the interval.
+    unit : str
+        The unit the message gives after the interval (``" deg"``).
+
+    Returns
+    -------
+    typing.Annotated
+        ``float`` with a validator raising ``ValueError("must be in [lo, hi] unit")`` for a value
+        outside the interval or not finite.
+    """
+    text = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}{unit}"
+
+    def check(value: float) -> float:
+        below = value <= lo if lo_open else value < lo
+        above = value >= hi if hi_open else value > hi
+        if not math.isfinite(value) or below or above:
+            raise ValueError(f"must be in {text}")
+        return value
+
+    return Annotated[float, AfterValidator(check)]
+
+
+def named(choices):
+    """A name among ``choices``, any spelling of :func:`foldopt.names.canonical` accepted.
+
+    Parameters
+    ----------
+    choices : sequence of str
+        The names (a registry of :mod:`foldopt.names`).
+
+    Returns
+    -------
+    typing.Annotated
+        ``str`` validated into foldopt's spelling of the name.
+    """
+    return Annotated[str, BeforeValidator(partial(canonical, names=choices))]
+
+
+def parse_timezone(name: str) -> dt.tzinfo:
+    """A time zone from its IANA name or a fixed offset.
+
+    Parameters
+    ----------
+    name : str
+        An IANA name (``America/Los_Angeles``) or an offset (``UTC-08:00``, ``+5:30``).
+
+    Returns
+    -------
+    datetime.tzinfo
+
+    Raises
+    ------
+    ValueError
+        For an unknown name or an offset beyond +/-14:00.
+    """
+    match = _OFFSET.match(name.strip())
+    if match:
+        sign, hours, minutes = match.groups()
+        offset = dt.timedelta(hours=int(hours), minutes=int(minutes or 0))
+        if offset > dt.timedelta(hours=14):
+            raise ValueError(f"offset {name!r} is beyond +/-14:00")
+        return dt.timezone(offset if sign == "+" else -offset)
+    try:
+        return zoneinfo.ZoneInfo(name)
+    except (zoneinfo.ZoneInfoNotFoundError, ValueError):
+        raise ValueError(
+            f"unknown time zone {name!r}; use an IANA name such as 'Europe/Berlin' or an offset such as 'UTC-08:00'"
+        ) from None
+
+
+def _check_timezone(name: str | None) -> str | None:
+    if name is not None:
+        parse_timezone(name)
+    return name
+
+
+@dataclass(frozen=True)
+class FilesRead:
+    """What :func:`foldopt.inputs.load.resolve_files` read of the files a study names, handed to
+    the study's validation as pydantic's context: the models judge it and open no files. A study
+    validated without it (built in Python, or a :meth:`foldopt.inputs.study.Study.variant`) has
+    its files unread until :func:`foldopt.inputs.load.with_files` reads them.
+
+    Parameters
+    ----------
+    weather_site : dict, optional
+        The site in the weather file's header (:func:`foldopt.inputs.weather.weather_site`).
+    weather_problem : str, optional
+        Why the weather file cannot be used: one line naming the file (and the line, the field).
+    weather_missing : bool
+        Whether the weather file does not exist.
+    profile_daily : dict, optional
+        The load profile file's day: clock times ``HH:MM`` to loads [W].
+    profile_problem : str, optional
+        Why the load profile file cannot be read: one line naming the file and the line.
+    """
+
+    weather_site: dict | None = None
+    weather_problem: str | None = None
+    weather_missing: bool = False
+    profile_daily: dict | None = None
+    profile_problem: str | None = None
+
+    @staticmethod
+    def given(info: ValidationInfo) -> FilesRead | None:
+        """The files read for a validation, or None where it was given none.
+
+        Parameters
+        ----------
+        info : pydantic.ValidationInfo
+
+        Returns
+        -------
+        FilesRead or None
+        """
+        return info.context if isinstance(info.context, FilesRead) else None
+
+
+class StrictModel(BaseModel):
+    """A frozen model that refuses unknown fields: the base of a study and its parts."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Site(StrictModel):
+    """Where a study's panel stands.
+
+    Parameters
+    ----------
+    name : str, optional
+    latitude : float
+        [deg] in [-90, 90], north positive.
+    longitude : float
+        [deg] in [-180, 180], east positive.
+    altitude : float
+        [m] in [-500, 9000]; default 0.
+    timezone : str, optional
+        An IANA name or a UTC offset (:func:`parse_timezone`); default the longitude's standard
+        offset (:meth:`resolved`).
+    """
+
+    name: str | None = None
+    latitude: interval(-90, 90, unit=" deg")
+    longitude: interval(-180, 180, unit=" deg")
+    altitude: interval(-500, 9000, unit=" m") = 0.0
+    timezone: Annotated[str | None, AfterValidator(_check_timezone)] = Field(
+        None, description="IANA name or UTC offset; default: the longitude's standard offset"
+    )
+
+    def resolved(self) -> Site:
+        """The site with its time zone filled in.
+
+        Returns
+        -------
+        Site
+            With ``timezone`` the longitude's standard offset (``UTC-08:00``) where none is given.
+        """
+        if self.timezone is not None:
+            return self
+        hours = round(self.longitude / 15.0)
+        return self.model_copy(update={"timezone": f"UTC{'+' if hours >= 0 else '-'}{abs(hours):02d}:00"})
+
+
+class Panel(StrictModel):
+    """The panel: its size, its efficiency and its orientation when flat (the twofold panel's base).
+
+    Parameters
+    ----------
+    area : float
+        [m^2] in (0, 1000].
+    efficiency : float
+        [-] in (0, 1]; default 0.2.
+    tilt : float, optional
+        [deg] in [0, 90]; default |latitude|.
+    azimuth : float, optional
+        [deg] in [0, 360), clockwise from north; default facing the equator.
+    """
+
+    area: interval(0, 1000, lo_open=True, unit=" m^2")
+    efficiency: interval(0, 1, lo_open=True) = 0.2
+    tilt: interval(0, 90, unit=" deg") | None = Field(None, description="default |latitude|")
+    azimuth: interval(0, 360, hi_open=True, unit=" deg") | None = Field(
+        None, description="default: facing the equator"
+    )
+
+
+class Tracker(StrictModel):
+    """The tracker compared against, and the energy it spends (see :mod:`foldopt.physics.trackers`).
+
+    Each model reads some of the options (:data:`foldopt.physics.trackers.TRACKER_MODELS`); an
+    option of another model given a value is refused by the study (:meth:`idle_settings`).
+
+    Parameters
+    ----------
+    model : str
+        One of :data:`foldopt.names.TRACKERS`; default ``dual-axis``.
+    steps : int
+        Moves a day of ``dual-axis-steps``, even, in [2, 200]; default 12.
+    angular_field : float
+        Swing of its daily axis [deg] in (0, 360]; default 90.
+    step_offsets_h : list of float, optional
+        Its afternoon moves from solar noon [h], each in (0, 12), ``steps / 2`` of them; default
+        Alexandru's 12-step law.
+    axis_tilt : float
+        ``single-axis``: the axis' tilt [deg] in [0, 90]; default 0.
+    axis_azimuth : float, optional
+        Its azimuth [deg] in [0, 360); default toward the equator.
+    max_angle : float
+        Its largest rotation [deg] in (0, 90]; default 90.
+    backtrack : bool
+        Whether it backtracks against the next row; default False.
+    gcr : float
+        Its ground coverage ratio [-] in (0, 1]; default 0.35.
+    standby_w : float
+        The controller's draw while the sun is up [W] in [0, 1000]; default 0.
+    drive : str
+        One of :data:`foldopt.names.DRIVES`; default ``motor``.
+    wh_per_degree : float
+        ``wh-per-degree`` drive's energy [Wh/deg] in [0, 10]; default 0.
+    """
+
+    model: named(names.TRACKERS) = "dual-axis"
+    steps: Annotated[int, Field(ge=2, le=200, multiple_of=2)] = 12
+    angular_field: interval(0, 360, lo_open=True, unit=" deg") = 90.0
+    step_offsets_h: list[interval(0, 12, lo_open=True, hi_open=True, unit=" h")] | None = Field(
+        None, description="afternoon move times from solar noon; default Alexandru's 12-step law"
+    )
+    axis_tilt: interval(0, 90, unit=" deg") = 0.0
+    axis_azimuth: interval(0, 360, hi_open=True, unit=" deg") | None = None
+    max_angle: interval(0, 90, lo_open=True, unit=" deg") = 90.0
+    backtrack: bool = False
+    gcr: interval(0, 1, lo_open=True) = 0.35
+    standby_w: interval(0, 1000, unit=" W") = 0.0
+    drive: named(names.DRIVES) = "motor"
+    wh_per_degree: interval(0, 10, unit=" Wh/deg") = 0.0
+
+    @model_validator(mode="after")
+    def _offsets_match_steps(self):
+        offsets = self.step_offsets_h if self.step_offsets_h is not None else ALEXANDRU_STEP_OFFSETS_H
+        # A model that does not step leaves both idle: the study refuses them as such.
+        if len(offsets) * 2 != self.steps and self.model in self.models_using("steps"):
+            raise ValueError(f"steps ({self.steps}) must be twice the number of step_offsets_h ({len(offsets)})")
+        return self
+
+    @staticmethod
+    def models_using(option: str) -> tuple[str, ...]:
+        """The tracker models that read an option.
+
+        Parameters
+        ----------
+        option : str
+            A field of the tracker (``gcr``).
+
+        Returns
+        -------
+        tuple of str
+            The models of :data:`foldopt.physics.trackers.TRACKER_MODELS` that read it; none for
+            the model itself and the drive's fields, which every model reads.
+        """
+        # numpy with the registry: only for a tracker given options, whose study then runs.
+        from foldopt.physics.trackers import TRACKER_MODELS
+
+        return tuple(model for model, entry in TRACKER_MODELS.items() if option in entry.options)
+
+    def idle_settings(self) -> list[str]:
+        """Options given a value that the tracker does not use.
+
+        Returns
+        -------
+        list of str
+            ``tracker.<option> = value: why`` for each option of another tracker model given a
+            value other than its default, and for ``wh_per_degree`` without its drive.
+        """
+        idle = []
+        for name, field in Tracker.model_fields.items():
+            value = getattr(self, name)
+            users = self.models_using(name) if name != "model" and value != field.default else ()
+            if users and self.model not in users:
+                idle.append(f"tracker.{name} = {value!r}: is only used by tracker.model {' or '.join(users)}")
+        if self.drive != "wh-per-degree" and self.wh_per_degree:
+            idle.append(f"tracker.wh_per_degree = {self.wh_per_degree!r}: is only used by tracker.drive "
+                        "wh-per-degree")
+        return idle
+
+
+class Weather(StrictModel):
+    """A weather file: TMY3, EPW or PVGIS TMY, read through pvlib.iotools (:mod:`foldopt.inputs.weather`).
+
+    Parameters
+    ----------
+    path : str
+        The file; a study file's relative path is relative to the study file.
+    format : str, optional
+        One of :data:`foldopt.names.WEATHER_FORMATS`; default from the extension.
+    label : str, optional
+        What a timestamp marks, one of :data:`foldopt.names.INTERVAL_LABELS`; default the format's.
+    """
+
+    path: str
+    format: named(names.WEATHER_FORMATS) | None = Field(None, description="default from the extension")
+    label: named(names.INTERVAL_LABELS) | None = Field(
+        None, description="what a timestamp marks; default the format's (TMY3 end, EPW and PVGIS start)"
+    )
+
+
+_STATISTIC = re.compile(r"^(mean|min|worst-month|p(\d{1,2}))$")
+
+
+class Objective(StrictModel):
+    """What a fixed fold angle should maximise over the days of a study.
+
+    Parameters
+    ----------
+    statistic : str
+        Of the daily t_solar [h]: ``mean``, ``min``, ``worst-month`` or a percentile ``pNN``.
+    months : list of int, optional
+        The season, months 1 to 12; default all.
+    visits : int, optional
+        Also the best re-fold schedule of 1 to ``visits`` (at most 12) settings a year
+        (:mod:`foldopt.engine.schedule`).
+    """
+
+    statistic: str = Field("mean", description="mean | min | worst-month | pNN (a percentile, e.g. p10)")
+    months: list[Annotated[int, Field(ge=1, le=12)]] | None = Field(None, description="the season; default all")
+    visits: Annotated[int, Field(ge=1, le=12)] | None = Field(
+        None, description="also the best re-fold schedule of 1..visits settings a year (foldopt.engine.schedule)")
+
+    @field_validator("statistic")
+    @classmethod
+    def _known(cls, value):
+        if not _STATISTIC.match(value):
+            raise ValueError("must be mean, min, worst-month or a percentile pNN (e.g. p10)")
+        return value
+
+    @model_validator(mode="after")
+    def _schedulable(self):
+        if self.visits is not None and self.statistic not in ("mean", "worst-month"):
+            raise ValueError(f"visits: a re-fold schedule maximises mean or worst-month, not {self.statistic}")
+        if self.visits is not None and self.months:
+            raise ValueError("visits: a re-fold schedule covers the whole year; leave months out")
+        return self
+
+
+_ProfileSteps = Annotated[dict, AfterValidator(profile_steps)]
+
+
+class LoadProfile(StrictModel):
+    """P_load(t) for a scale (``p_load``) of 1: loads [W] at clock times of the local day, held
+    until the next time (``step``) or interpolated between them (``linear``), and the last carried
+    over midnight to the first (:mod:`foldopt.inputs.loads`).
+
+    Parameters
+    ----------
+    daily : dict, optional
+        Clock times ``HH:MM`` to loads [W] (:func:`foldopt.inputs.loads.profile_steps`).
+    file : str, optional
+        A CSV of ``time,watts`` rows instead of ``daily``; its day becomes ``daily`` where its
+        loader read it (:class:`FilesRead`).
+    interpolation : {'step', 'linear'}
+    weekend : dict, optional
+        The day of Saturdays and Sundays, as ``daily``.
+    months : dict, optional
+        Month numbers 1 to 12 to a day, as ``daily``.
+    """
+
+    daily: _ProfileSteps | None = None
+    file: str | None = None
+    interpolation: named(("step", "linear")) = "step"
+    weekend: _ProfileSteps | None = None
+    months: dict[Annotated[int, Field(ge=1, le=12)], _ProfileSteps] | None = None
+
+    @model_validator(mode="after")
+    def _one_day(self, info: ValidationInfo):
+        if (self.daily is None) == (self.file is None):
+            raise ValueError("give the day's loads as daily (a mapping HH:MM: watts) or as file (a CSV), not both")
+        files = FilesRead.given(info)
+        if self.file is not None and files is not None:
+            if files.profile_problem is not None:
+                raise ValueError(files.profile_problem)
+            object.__setattr__(self, "daily", files.profile_daily)
+        return self
+
+
+class FoldAngles(StrictModel):
+    """The grid of fold angles a study sweeps.
+
+    Parameters
+    ----------
+    start, stop, step : float
+        [deg], each in (0, 180]; default 1 to 180 by 1.
+    """
+
+    start: interval(0, 180, lo_open=True, unit=" deg") = 1.0
+    stop: interval(0, 180, lo_open=True, unit=" deg") = 180.0
+    step: interval(0, 180, lo_open=True, unit=" deg") = 1.0
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.start > self.stop:
+            raise ValueError(f"start ({self.start:g}) must not exceed stop ({self.stop:g})")
+        return self
+
+    def grid(self):
+        """The sweep's fold angles.
+
+        Returns
+        -------
+        list of float
+            [deg]: ``start`` by ``step``, always ending on ``stop``.
+        """
+        count = int(math.floor((self.stop - self.start) / self.step + 1e-9)) + 1
+        angles = [self.start + i * self.step for i in range(count)]
+        return angles if math.isclose(angles[-1], self.stop) else [*angles, self.stop]
+
+
+class NearOptimal(StrictModel):
+    """How close to the best a fold angle must come to count as near-optimal: within ``fraction``
+    of the best t_solar (or objective) or within ``minutes``, whichever is larger. The optimum of a
+    fold angle is a plateau; the near-optimal range is every grid angle on the best one's plateau
+    and the recommended angle its centre, robust to how precisely an installer sets a hinge.
+
+    Parameters
+    ----------
+    fraction : float
+        [-] in [0, 1]; default 0.01.
+    minutes : float
+        [min] in [0, 1440]; default 1.
+    """
+
+    fraction: interval(0, 1) = 0.01
+    minutes: interval(0, 1440, unit=" min") = 1.0
+
+    def tolerance_h(self, best_h):
+        """The tolerance around a best value.
+
+        Parameters
+        ----------
+        best_h : array_like
+            The best t_solar or objective [h].
+
+        Returns
+        -------
+        numpy.ndarray
+            [h], broadcast with ``best_h``.
+        """
+        import numpy as np
+
+        return np.maximum(self.fraction * np.asarray(best_h, dtype=float), self.minutes / 60.0)

@@ -1,0 +1,466 @@
+"""A study: one validated, typed description of what foldopt evaluates (:class:`Study`).
+
+A study is written in YAML (see ``configs/``) or assembled from command-line options; both paths
+go through :class:`Study`, so a bad value gets the same message either way: the field's path, the
+value and the allowed range (:func:`format_errors`). Its parts are the models of
+:mod:`foldopt.inputs.sections`. The models open no files: a weather file's site and a load profile
+file's day are read by :func:`foldopt.inputs.load.resolve_files` and handed to the validation as a
+:class:`~foldopt.inputs.sections.FilesRead`.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+from typing import Annotated
+
+from pydantic import AfterValidator, Field, ValidationError, ValidationInfo, field_validator, model_validator
+
+from foldopt import names
+from foldopt.errors import ConfigError
+from foldopt.inputs import policy
+from foldopt.inputs.sections import (FilesRead, FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site,
+                                     StrictModel, Tracker, Weather, interval, named)
+
+SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
+EARTH_RADIUS_KM = 6371.0
+#: The site of a study whose weather file is not read yet (built in Python): None until
+#: :func:`foldopt.inputs.load.with_files` reads it.
+_UNREAD = object()
+
+
+def _as_tuple(value) -> tuple:
+    """A default as a tuple of its accepted values."""
+    return value if isinstance(value, tuple) else (value,)
+
+
+def great_circle_km(latitude_1, longitude_1, latitude_2, longitude_2) -> float:
+    """Distance between two points on a spherical Earth (haversine).
+
+    Parameters
+    ----------
+    latitude_1, longitude_1, latitude_2, longitude_2 : float
+        The two points [deg].
+
+    Returns
+    -------
+    float
+        The great-circle distance [km] on a sphere of :data:`EARTH_RADIUS_KM`.
+    """
+    phi_1, phi_2 = math.radians(latitude_1), math.radians(latitude_2)
+    half_dphi = (phi_2 - phi_1) / 2
+    half_dlambda = math.radians(longitude_2 - longitude_1) / 2
+    a = math.sin(half_dphi) ** 2 + math.cos(phi_1) * math.cos(phi_2) * math.sin(half_dlambda) ** 2
+    return 2 * EARTH_RADIUS_KM * math.asin(min(1.0, math.sqrt(a)))
+
+
+
+def _check_step_min(value: float) -> float:
+    if not math.isclose(1440 / value, round(1440 / value)):
+        raise ValueError("must divide the 1440 min of a day (e.g. 0.5, 1, 2, 5, 10, 15, 30, 60)")
+    return value
+
+
+class Study(StrictModel):
+    """One study: a panel at a site on a day (or the days of a weather file), its load, and the
+    physics and designs it is evaluated with.
+
+    Parameters
+    ----------
+    name : str
+        Letters, digits, ``.``, ``_`` and ``-``, at most 100 characters: it names the results.
+    description : str
+    mode : {'exact', 'paper'}
+        pvlib's physics, or Shin et al.'s formulas (beam only, Eq. 1-6).
+    site : Site
+        Default with a weather file: the file's own site; ``None`` while that file is unread.
+    force_site : bool
+        Keep a site more than :data:`SITE_TOLERANCE_KM` [km] from the weather file's.
+    date : datetime.date
+        The local day.
+    panel : Panel
+    p_load : float
+        The load [W] in (0, 1e6]; with a ``load_profile``, the profile's scale [-] (default 1).
+    load_profile : LoadProfile, optional
+    geometry : str, optional
+        One of :data:`foldopt.names.GEOMETRIES`; default azimuth-split in paper mode, hinge in exact.
+    fold_angles : FoldAngles
+    near_optimal : NearOptimal
+    sky : str
+        One of :data:`foldopt.names.SKIES` (no use with a weather file); default ``meinel``.
+    linke_turbidity : float, optional
+        [-] in (0, 10] for ``ineichen``; default pvlib's climatology.
+    transposition : str, optional
+        One of :data:`foldopt.names.TRANSPOSITIONS`; default none for beam-only skies, perez otherwise.
+    albedo : float
+        [-] in [0, 1]; default 0.2.
+    iam : str
+        One of :data:`foldopt.names.IAMS`; default ``none``.
+    weather : Weather, optional
+        A weather file (or its path): its site, year and light.
+    objective : Objective, optional
+        One fold angle for all of the study's days, chosen for this statistic.
+    pv_model : str
+        One of :data:`foldopt.names.PV_MODELS`; default ``ideal``.
+    module : str, optional
+        ``single-diode``: a CEC module name; default the A-300 cell.
+    connection : str
+        One of :data:`foldopt.names.CONNECTIONS`; default ``switching``.
+    switch_series, bypass_diodes, exact_electrical : bool
+        Switching may select series; the series string has bypass diodes; every step's I-V
+        curves are solved rather than tabled.
+    converter_efficiency : float
+        ``independent``: [-] in (0, 1]; default 1.
+    temperature_model : str, optional
+        One of :data:`foldopt.names.TEMPERATURE_MODELS`; default fixed in paper mode, sapm in exact.
+    temp_air : float
+        [C] in [-60, 60]; default 25 (a weather file brings its own).
+    wind_speed : float
+        [m/s] in [0, 60]; default 1.
+    tracker : Tracker
+    climate : str
+        Hottel sky only: one of :data:`foldopt.names.HOTTEL_CLIMATES`.
+    step_min : float
+        The time step [min] in (0, 60], dividing a day (and an hour, with a weather file); default 1.
+
+    Raises
+    ------
+    pydantic.ValidationError
+        For every fault (:func:`make_study` turns them into a :class:`foldopt.ConfigError`).
+    """
+
+    name: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=100)]
+    description: str = ""
+    mode: named(names.MODES) = "exact"
+    site: Site = Field(description="default with a weather file: the file's own site")  # None: unread
+    force_site: bool = Field(False, description="keep a site more than SITE_TOLERANCE_KM from the weather file's")
+    date: dt.date
+    panel: Panel
+    p_load: interval(0, 1e6, lo_open=True, unit=" W") = Field(
+        description="the load [W]; with a load_profile, the profile's scale [-]")
+    load_profile: LoadProfile | None = None
+    geometry: named(names.GEOMETRIES) | None = Field(
+        None, description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact"
+    )
+    fold_angles: FoldAngles = FoldAngles()
+    near_optimal: NearOptimal = NearOptimal()
+    sky: named(names.SKIES) = "meinel"
+    linke_turbidity: interval(0, 10, lo_open=True) | None = Field(
+        None, description="ineichen; default pvlib's climatology")
+    transposition: named(names.TRANSPOSITIONS) | None = Field(
+        None, description="diffuse model; default none for beam-only skies, perez otherwise"
+    )
+    albedo: interval(0, 1) = 0.2
+    iam: named(names.IAMS) = "none"
+    weather: Weather | None = None
+    objective: Objective | None = None
+    pv_model: named(names.PV_MODELS) = "ideal"
+    module: str | None = Field(None, description="single-diode: CEC module name; default the A-300 cell")
+    connection: named(names.CONNECTIONS) = "switching"
+    switch_series: bool = Field(False, description="switching may also select series")
+    bypass_diodes: bool = True
+    converter_efficiency: interval(0, 1, lo_open=True) = 1.0
+    temperature_model: named(names.TEMPERATURE_MODELS) | None = Field(
+        None, description="default fixed (cells at temp_air) in paper mode, sapm in exact"
+    )
+    temp_air: interval(-60, 60, unit=" C") = 25.0
+    wind_speed: interval(0, 60, unit=" m/s") = 1.0
+    exact_electrical: bool = Field(False, description="solve every step's I-V curves, not tables")
+    tracker: Tracker = Tracker()
+    climate: named(names.HOTTEL_CLIMATES) = Field("midlatitude-summer", description="Hottel sky only")
+    step_min: Annotated[interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)] = 1.0
+
+    @model_validator(mode="before")
+    @classmethod
+    def _profile_scale(cls, data):
+        """A load profile is in watts: its scale defaults to 1."""
+        if isinstance(data, dict) and data.get("load_profile") is not None and data.get("p_load") is None:
+            data = {**data, "p_load": 1.0}
+        return data
+
+    @field_validator("weather", mode="before")
+    @classmethod
+    def _weather_by_path(cls, value):
+        return {"path": value} if isinstance(value, str) else value
+
+    @field_validator("objective", mode="before")
+    @classmethod
+    def _objective_by_statistic(cls, value):
+        """``objective: worst-month`` is ``objective: {statistic: worst-month}``."""
+        return {"statistic": value} if isinstance(value, str) else value
+
+    @model_validator(mode="before")
+    @classmethod
+    def _site_from_weather(cls, data, info: ValidationInfo):
+        """A weather file brings its site, as its loader read it: the study's unless one is given."""
+        if isinstance(data, dict) and data.get("site") is None and data.get("weather") is not None:
+            weather = data["weather"]
+            path = weather if isinstance(weather, str) else weather.get("path") if isinstance(weather, dict) else None
+            if isinstance(path, str):
+                files = FilesRead.given(info)
+                if files is not None and files.weather_problem is not None:
+                    raise ValueError(files.weather_problem)
+                read = files.weather_site if files is not None else None
+                data = {**data, "site": read if read is not None else _UNREAD}
+        return data
+
+    @field_validator("site", mode="wrap")
+    @classmethod
+    def _unread_site(cls, value, handler):
+        """None for a weather file's site not read yet; a missing or null site is still refused."""
+        return None if value is _UNREAD else handler(value)
+
+    @model_validator(mode="after")
+    def _consistent(self, info: ValidationInfo):
+        if self.mode == "paper" and self.transposition not in (None, "none"):
+            raise ValueError("transposition: paper mode is beam-only (Shin et al. Eq. 5): transposition must be none")
+        idle = self.idle_settings()
+        if idle:
+            raise ValueError("\n".join(idle))  # one error line each
+        files = FilesRead.given(info) if self.weather is not None else None
+        if files is not None and files.weather_missing:
+            raise ValueError(files.weather_problem)
+        if self.weather is not None and not math.isclose(60 / self.step_min, round(60 / self.step_min)):
+            raise ValueError(f"step_min = {self.step_min:g}: must divide the weather file's 60-min intervals")
+        checked = files is not None and not self.force_site
+        if checked and files.weather_problem is not None:
+            raise ValueError(files.weather_problem)
+        file_site = files.weather_site if checked else None
+        if file_site is not None and self.site is not None:
+            distance = great_circle_km(self.site.latitude, self.site.longitude, file_site["latitude"],
+                                       file_site["longitude"])
+            if distance > SITE_TOLERANCE_KM:
+                name = f"{file_site['name']} " if file_site["name"] else ""
+                raise ValueError(
+                    f"site ({self.site.latitude:g}, {self.site.longitude:g}) is {distance:,.0f} km from the weather "
+                    f"file's site {name}({file_site['latitude']:g}, {file_site['longitude']:g}); leave the site out "
+                    f"to use the file's, or set force_site to keep it"
+                )
+        return self
+
+    def idle_settings(self) -> list[str]:
+        """Settings given a value that nothing in the study uses.
+
+        Returns
+        -------
+        list of str
+            ``field = value: why`` for each (the tracker's from :meth:`Tracker.idle_settings`).
+        """
+        defaults = {name: field.default for name, field in Study.model_fields.items()}
+        # What a resolved study fills in is no setting of the user's.
+        defaults["temperature_model"] = (None, "fixed" if self.mode == "paper" else "sapm")
+        iv_model = self.pv_model != "ideal"
+        series_used = self.connection == "series" or (self.connection == "switching" and self.switch_series)
+        rules = [
+            ("climate", self.sky == "hottel", "is only used by sky hottel"),
+            ("linke_turbidity", self.sky == "ineichen" or self.weather is not None,
+             "is only used by sky ineichen and weather files"),
+            ("sky", self.weather is None, "has no use with a weather file (its light shapes the minutes)"),
+            ("albedo", self.sky_transposition() != "none", "is only used with a transposition (diffuse light)"),
+            ("switch_series", self.connection == "switching", "is only used by connection switching"),
+            ("bypass_diodes", series_used, "is only used where series is (connection series, or switching "
+                                           "with switch_series)"),
+            ("converter_efficiency", self.connection == "independent", "is only used by connection independent"),
+            ("temperature_model", iv_model, "is only used by pv_model single-diode or b-model"),
+            ("temp_air", iv_model and self.weather is None,
+             "is only used by pv_model single-diode or b-model, without a weather file (which brings its own)"),
+            ("wind_speed", iv_model, "is only used by pv_model single-diode or b-model"),
+            ("exact_electrical", iv_model, "is only used by pv_model single-diode or b-model"),
+        ]
+        idle = [f"{name} = {getattr(self, name)!r}: {why}" for name, used, why in rules
+                if not used and getattr(self, name) not in _as_tuple(defaults[name])]
+        return idle + self.tracker.idle_settings()
+
+    def sky_transposition(self) -> str:
+        """The diffuse model in force.
+
+        Returns
+        -------
+        str
+            ``transposition``, or by default none for beam-only skies (and paper mode) unless a
+            weather file gives diffuse light, perez otherwise.
+        """
+        if self.transposition is not None:
+            return self.transposition
+        return "none" if self.mode == "paper" or (self.weather is None and self.sky in names.BEAM_SKIES) else "perez"
+
+    @field_validator("tracker", mode="before")
+    @classmethod
+    def _tracker_by_name(cls, value):
+        return {"model": value} if isinstance(value, str) else value
+
+    @field_validator("module")
+    @classmethod
+    def _module_is_known(cls, module, info: ValidationInfo):
+        if module is not None:
+            if info.data.get("pv_model") != "single-diode":
+                raise ValueError("module is only used with pv_model single-diode")
+            from foldopt.physics.pvmodel import (
+                cec_module_name,  # pvlib's CEC database, only when a module is named
+            )
+
+            return cec_module_name(module)
+        return module
+
+    def variant(self, **changes) -> Study:
+        """A validated copy with ``changes``, made by the study policy (:func:`foldopt.inputs.policy.apply`).
+
+        Parameters
+        ----------
+        **changes
+            Field names to new values. A mapping for a section (``site``, ``panel``, ``tracker``,
+            ``objective``, ``fold_angles``, ``near_optimal``) changes only the fields it names:
+            ``variant(panel={"area": 0.1})`` keeps the efficiency, tilt and azimuth. As for the
+            command line, a paper-mode study given another site or day runs in exact mode, a new
+            mode takes its own geometry and a new latitude tilts the panel at ``|latitude|``,
+            unless those fields are given too.
+
+        Returns
+        -------
+        Study
+            Its files unread (:class:`~foldopt.inputs.sections.FilesRead`): the API reads them
+            when it runs the study.
+
+        Raises
+        ------
+        foldopt.ConfigError
+            One ``field = value: problem`` line per fault.
+
+        Examples
+        --------
+        >>> import foldopt
+        >>> study = foldopt.default_study().variant(site={"latitude": 10.0})
+        >>> study.mode, study.geometry, study.panel.tilt, study.panel.efficiency
+        ('exact', None, None, 0.1905)
+        """
+        data, _ = policy.apply(self.data(), changes)
+        return make_study(data)
+
+    def data(self) -> dict:
+        """The study's fields as plain data that validate back into it.
+
+        Returns
+        -------
+        dict
+            ``date`` as text, no unset field; a profile read from a file keeps its file, not the
+            steps read from it.
+        """
+        data = self.model_dump(mode="json", exclude_none=True)
+        if self.load_profile is not None and self.load_profile.file is not None:
+            data["load_profile"].pop("daily", None)
+        return data
+
+    def resolved(self) -> Study:
+        """The study with every default that depends on other fields (site, mode) filled in.
+
+        Studies are kept unresolved so that a variant (another mode, another latitude) gets its
+        own defaults; :class:`foldopt.studies.day.Day` resolves the study it runs.
+
+        Returns
+        -------
+        Study
+            With the panel's tilt and azimuth [deg], the site's time zone, the geometry and the
+            temperature model filled in.
+
+        Raises
+        ------
+        foldopt.ConfigError
+            For a study whose files are unread (:func:`foldopt.inputs.load.with_files` reads them).
+        """
+        from foldopt.physics.geometry import default_orientation
+
+        unread = [f"{name}: the file is not read yet; foldopt.run, foldopt.sweep and foldopt.size read it"
+                  for name, missing in (("weather", self.site is None), ("load_profile", self.load_profile is not None
+                                                                           and self.load_profile.daily is None))
+                  if missing]
+        if unread:
+            raise ConfigError(unread)
+
+        tilt, azimuth = default_orientation(self.site.latitude)
+        panel = self.panel.model_copy(
+            update={
+                "tilt": tilt if self.panel.tilt is None else self.panel.tilt,
+                "azimuth": azimuth if self.panel.azimuth is None else self.panel.azimuth,
+            }
+        )
+        geometry = self.geometry or ("azimuth-split" if self.mode == "paper" else "hinge")
+        temperature = self.temperature_model or ("fixed" if self.mode == "paper" else "sapm")
+        return self.model_copy(
+            update={
+                "panel": panel,
+                "site": self.site.resolved(),
+                "geometry": geometry,
+                "temperature_model": temperature,
+            }
+        )
+
+
+
+def format_error(item: dict) -> list[str]:
+    """The lines of one pydantic error.
+
+    Parameters
+    ----------
+    item : dict
+        One of :meth:`pydantic.ValidationError.errors`.
+
+    Returns
+    -------
+    list of str
+        ``field = value: problem`` (``field: problem`` for a section, a missing or an unknown
+        field); the study's own checks, which name their fields themselves, one line each.
+    """
+    field = ".".join(str(part) for part in item["loc"])
+    message = item["msg"].removeprefix("Value error, ")
+    if not field:
+        # The study's own checks name their fields themselves.
+        return message.splitlines() if item["type"] == "value_error" else [f"study: {message}"]
+    if item["type"] == "missing":
+        return [f"{field}: required field is missing"]
+    if item["type"] == "extra_forbidden":
+        return [f"{field}: unknown field"]
+    if isinstance(item["input"], dict):
+        return [f"{field}: {message}"]
+    return [f"{field} = {item['input']!r}: {message}"]
+
+
+def format_errors(error: ValidationError) -> list[str]:
+    """Every line of a pydantic error (:func:`format_error`).
+
+    Parameters
+    ----------
+    error : pydantic.ValidationError
+
+    Returns
+    -------
+    list of str
+    """
+    return [line for item in error.errors() for line in format_error(item)]
+
+
+def make_study(data: dict, files: FilesRead | None = None) -> Study:
+    """Validate one study from plain data.
+
+    Parameters
+    ----------
+    data : dict
+        The study's fields, as a YAML study holds them.
+    files : FilesRead, optional
+        What :func:`foldopt.inputs.load.resolve_files` read of the files ``data`` names; without
+        it they stay unread (:class:`~foldopt.inputs.sections.FilesRead`).
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    foldopt.ConfigError
+        Listing every fault, one ``field = value: problem`` line each.
+    """
+    if not isinstance(data, dict):
+        raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
+    try:
+        return Study.model_validate(data, context=files)
+    except ValidationError as error:
+        raise ConfigError(format_errors(error)) from None

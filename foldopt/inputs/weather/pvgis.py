@@ -1,0 +1,116 @@
+"""PVGIS typical meteorological years (JSON), through pvlib ``iotools.read_pvgis_tmy``.
+
+One record per hour in ``outputs.tmy_hourly``, stamped with the start of its hour in UTC, and
+the site in ``inputs.location``; the stamps move to the site's standard time once the records
+are checked (:func:`to_local`).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+
+import numpy as np
+import pandas as pd
+import pvlib
+
+from foldopt.inputs.weather.formats import WeatherFormat, offset_zone, read_with_pvlib, site_value
+
+
+def read(path: str, text: str, year: int, fail):
+    """A PVGIS TMY (JSON) file through pvlib, its stamps coerced to ``year`` (still UTC).
+
+    Parameters
+    ----------
+    path : str
+    text : str
+        The file's text.
+    year : int
+    fail : callable
+        ``fail(message)``: the error to raise.
+
+    Returns
+    -------
+    tuple
+        ``(data, meta, index, where)`` (:class:`~foldopt.inputs.weather.formats.WeatherFormat`);
+        ``where(i)`` names the record (``record 5``).
+    """
+    try:
+        source = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise fail(f"not valid JSON: {error.msg} at line {error.lineno} column {error.colno}") from None
+    outputs = source.get("outputs") if isinstance(source, dict) else None
+    hourly = outputs.get("tmy_hourly") if isinstance(outputs, dict) else None
+    if not isinstance(hourly, list):
+        raise fail("not a PVGIS TMY file: no outputs.tmy_hourly list of hourly records")
+    if not hourly:
+        raise fail("no data rows: outputs.tmy_hourly is empty")
+    data, meta = read_with_pvlib(fail, FORMAT.label, pvlib.iotools.read_pvgis_tmy, io.StringIO(text),
+                                 pvgis_format="json", map_variables=True)
+    inputs = meta.get("inputs") or {}
+    location = inputs.get("location", inputs)
+    for key in ("latitude", "longitude", "elevation"):
+        if key not in location:
+            raise fail(f"inputs.location has no {key}")
+        site_value(fail, f"inputs.location.{key}", key, location[key])
+    utc = pd.DatetimeIndex(data.index)
+    leap = (utc.month == 2) & (utc.day == 29)
+    if leap.any() and not pd.Timestamp(year=year, month=1, day=1).is_leap_year:
+        first = int(np.flatnonzero(leap)[0])
+        raise fail(f"record {first + 1} ({utc[first]:%Y-%m-%d %H:%M} UTC): February 29: {year} has none"
+                   + (f"; and {leap.sum() - 1} more rows" if leap.sum() > 1 else ""))
+    index = pd.DatetimeIndex(utc.map(lambda t: t.replace(year=year)))
+
+    def where(i: int) -> str:
+        return f"record {i + 1}"
+
+    return data, meta, index, where
+
+
+def site(meta: dict) -> dict:
+    """The site of a PVGIS file's ``inputs.location``.
+
+    Parameters
+    ----------
+    meta : dict
+        pvlib's metadata.
+
+    Returns
+    -------
+    dict
+        ``name`` (None), ``latitude``, ``longitude`` [deg], ``altitude`` [m] (the elevation) and
+        ``timezone``, the longitude's standard offset (PVGIS gives none).
+    """
+    inputs = meta["inputs"]
+    location = inputs.get("location", inputs)
+    latitude, longitude = float(location["latitude"]), float(location["longitude"])
+    return {"name": None, "latitude": latitude, "longitude": longitude,
+            "altitude": float(location["elevation"]), "timezone": offset_zone(round(longitude / 15.0))}
+
+
+def to_local(frame: pd.DataFrame, site: dict, year: int) -> pd.DataFrame:
+    """Checked rows with UTC stamps on the site's standard time.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Indexed by UTC stamps of ``year``.
+    site : dict
+        The file's site (:func:`site`).
+    year : int
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by local stamps, the year wrapped around (a TMY is a cyclic year) so that every
+        local day is whole, in time order.
+    """
+    local = frame.index.tz_convert(site["timezone"])
+    frame.index = pd.DatetimeIndex(local.map(lambda t: t.replace(year=year)))
+    return frame.sort_index()
+
+
+FORMAT = WeatherFormat(
+    name="pvgis", label="PVGIS TMY", interval_label="start", suffixes=(".json",),
+    columns={"ghi": "G(h)", "dni": "Gb(n)", "dhi": "Gd(h)", "temp_air": "T2m", "wind_speed": "WS10m"},
+    columns_at="outputs.tmy_hourly", read=read, site=site, to_local=to_local)

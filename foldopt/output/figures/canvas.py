@@ -1,0 +1,152 @@
+"""What every figure shares: the Axes a plot draws on, how a figure is saved, a registry entry,
+a load's label and the colour scale of a map.
+
+A plot function draws on the ``ax`` it is given (a notebook's, with the user's backend), or makes
+its own figure: a pyplot figure, which a notebook shows, or inside :func:`for_files` a bare
+:class:`matplotlib.figure.Figure`, which needs no backend and no pyplot (a PNG is drawn by Agg
+whatever backend the user chose), so that writing a results folder changes nothing of theirs.
+"""
+
+from __future__ import annotations
+
+import contextvars
+from collections.abc import Callable
+from contextlib import contextmanager
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+from matplotlib.figure import Figure
+
+
+class FigureFile(NamedTuple):
+    """A figure a results folder may hold, by its file name in a module's ``FIGURES``."""
+
+    #: The public ``plot_*`` function that draws it; it returns the Axes drawn on.
+    plot: Callable
+    #: What it shows, in one line.
+    description: str
+
+
+#: Whether the figures made now are for files (:func:`for_files`); a context variable, so that a
+#: thread or task writing a folder does not change what another's plots make.
+_FOR_FILES = contextvars.ContextVar("foldopt_figures_for_files", default=False)
+
+
+@contextmanager
+def for_files():
+    """Within the block, a plot function that is given no Axes draws on a bare
+    :class:`matplotlib.figure.Figure` (no pyplot, no backend, nothing left open) instead of a
+    pyplot figure.
+
+    Yields
+    ------
+    None
+    """
+    token = _FOR_FILES.set(True)
+    try:
+        yield
+    finally:
+        _FOR_FILES.reset(token)
+
+
+def new_axes(ax, figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, squeeze: bool = True):
+    """The figure and Axes a plot draws on.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes or None
+        The Axes to draw on; None makes a new figure: a pyplot one (shown by the user's backend),
+        or within :func:`for_files` a bare :class:`matplotlib.figure.Figure`.
+    figsize : tuple of float
+        (width, height) of a new figure [in].
+    nrows, ncols : int, default 1
+        The grid of Axes of a new figure.
+    squeeze : bool, default True
+        As :meth:`matplotlib.figure.Figure.subplots`: False always gives a 2-D array of Axes.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    ax : matplotlib.axes.Axes or numpy.ndarray of them
+        ``ax`` itself when given.
+    """
+    if ax is not None:
+        return ax.figure, ax
+    if _FOR_FILES.get():
+        fig = Figure(figsize=figsize)
+        return fig, fig.subplots(nrows, ncols, squeeze=squeeze)
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(nrows, ncols, figsize=figsize, squeeze=squeeze)
+
+
+def save_plot(ax, path: Path) -> Path:
+    """Save the figure that holds ``ax`` as the file ``path`` (110 dpi, tight layout) and close it.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes or array of Axes
+        An Axes of the figure, as the ``plot_*`` functions return it.
+    path : pathlib.Path
+        The file; its suffix gives the format (``.png``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    fig = np.ravel(ax)[0].figure
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    if fig.canvas.manager is not None:  # a pyplot figure: pyplot keeps it until it is closed
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+    return path
+
+
+def load_label(study, load: float) -> str:
+    """A sweep's load in a legend or on an axis.
+
+    Parameters
+    ----------
+    study : foldopt.Study or None
+        The study whose load profile (if any) the load scales; None for a constant load.
+    load : float
+        The sweep's ``p_load_w`` [W].
+
+    Returns
+    -------
+    str
+        ``P_load 2 W``, or a load profile's mean and peak watts
+        (:func:`foldopt.inputs.loads.load_text`).
+    """
+    if study is None:
+        return f"P_load {load:g} W"
+    from foldopt.inputs.loads import load_text
+
+    return load_text(study, load)
+
+
+def colour_scale(values, diverging: bool) -> dict:
+    """The colours of a map of ``values`` (``pcolormesh``/``scatter`` keywords).
+
+    Parameters
+    ----------
+    values : array_like
+        The values shown; NaN and masked values are left out of the scale.
+    diverging : bool
+        Red-blue around 0, symmetric over the finite values (a gain); else viridis.
+
+    Returns
+    -------
+    dict
+        ``cmap`` and, when diverging, ``vmin`` and ``vmax``.
+    """
+    if not diverging:
+        return {"cmap": "viridis"}
+    finite = np.asarray(np.ma.filled(np.ma.masked_invalid(values), np.nan), dtype=float)
+    finite = finite[np.isfinite(finite)]
+    bound = max(float(np.abs(finite).max()) if finite.size else 1.0, 1e-9)
+    return {"cmap": "RdBu", "vmin": -bound, "vmax": bound}

@@ -1,0 +1,107 @@
+"""Figures of a sweep (a :class:`foldopt.SweepResult`'s table): heat maps of the optimal twofold
+panel over two varied fields, and t_solar of each design against one."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from foldopt.output.figures.canvas import FigureFile, colour_scale, new_axes
+
+#: Axis labels of the varied fields that have a unit; any other field is labelled by its name.
+AXIS_LABELS = {
+    "latitude": "latitude [deg]",
+    "p_load_w": "P_load [W]",
+    "day_of_year": "day of year",
+}
+
+
+def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label: str, diverging: bool,
+             ax=None):
+    """A heat map of ``value`` over ``x`` and ``y``, averaged over any other varied field.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep's rows (usually the twofold design's): columns ``x``, ``y`` and ``value``.
+    x, y : str
+        The columns along the horizontal and vertical axes (e.g. ``latitude``, ``p_load_w``).
+    value : str
+        The column shown in colour (e.g. ``gain_vs_flat_pct`` [%], ``fold_angle_deg`` [deg]);
+        NaN cells are grey.
+    title, label : str
+        The Axes' title and the colour bar's label.
+    diverging : bool
+        Red-blue colours symmetric around 0 (a gain), else viridis.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new figure (8 x 5 in).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    grid = table.pivot_table(index=y, columns=x, values=value, aggfunc="mean")
+    fig, ax = new_axes(ax, (8, 5))
+    data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
+    mesh = ax.pcolormesh(grid.columns, grid.index, data, shading="nearest", **colour_scale(data, diverging))
+    ax.set_facecolor("0.85")
+    ax.figure.colorbar(mesh, ax=ax, label=label)
+    ax.set_xlabel(AXIS_LABELS.get(x, x))
+    ax.set_ylabel(AXIS_LABELS.get(y, y))
+    ax.set_title(title, fontsize=10)
+    return ax
+
+
+def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = None, ax=None):
+    """t_solar of the flat panel, the optimal twofold panel and the tracker against ``x``.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep's tidy table: a row per case and design, with ``design`` and ``t_solar_h`` [h].
+    x : str
+        The varied field along the horizontal axis (e.g. ``p_load_w`` [W], ``latitude`` [deg]).
+    title : str
+    split : str, optional
+        A varied field of at most four values: each gets its own line style. Anything else that
+        varies is averaged.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new figure (8 x 4.5 in).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    fig, ax = new_axes(ax, (8, 4.5))
+    colours = {"flat": "k", "twofold": "tab:blue", "tracker": "0.55"}
+    styles = ["-", "--", ":", "-."]
+    groups = [(None, table)] if split is None else list(table.groupby(split, sort=True))
+    for (value, rows), style in zip(groups, styles, strict=False):
+        for design, colour in colours.items():
+            curve = rows[rows["design"] == design].groupby(x)["t_solar_h"].mean()
+            name = "optimal twofold" if design == "twofold" else design
+            label = name if split is None else f"{name}, {split} {value}"
+            ax.plot(curve.index, curve.to_numpy(), color=colour, ls=style, lw=2 if design == "twofold" else 1.3,
+                    label=label)
+    ax.set_xlabel(AXIS_LABELS.get(x, x))
+    ax.set_ylabel("t_solar [h]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=1 if split is None else 2)
+    return ax
+
+
+#: A sweep's folder holds those its varied fields call for (:mod:`foldopt.output.folders`).
+FIGURES = {
+    "gain_map_latitude_load.png": FigureFile(plot_map, "t_solar gain of the optimal twofold panel over flat, by "
+                                                       "latitude and load"),
+    "fold_angle_map_latitude_load.png": FigureFile(plot_map, "optimal fold angle by latitude and load"),
+    "gain_map_day_latitude.png": FigureFile(plot_map, "t_solar gain of the optimal twofold panel over flat, by day "
+                                                      "of the year and latitude"),
+    "fold_angle_map_day_latitude.png": FigureFile(plot_map, "optimal fold angle by day of the year and latitude"),
+    "annual_t_solar.png": FigureFile(plot_curves, "t_solar of flat, optimal twofold and tracker over the days of "
+                                                  "the year"),
+    "t_solar_vs_load.png": FigureFile(plot_curves, "t_solar of flat, optimal twofold and tracker against the load"),
+    "t_solar_vs_latitude.png": FigureFile(plot_curves, "t_solar of flat, optimal twofold and tracker against the "
+                                                       "latitude"),
+}

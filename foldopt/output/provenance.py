@@ -1,0 +1,76 @@
+"""``run.json``: what a results folder was made from, so that it can be made again. The resolved
+study, its mode, the command line, the versions (:func:`foldopt.files.versions`), a digest of the
+inputs and what each kind of result adds (its engine, its answer's headline numbers)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+from pathlib import Path
+
+from foldopt.files import versions
+from foldopt.inputs.study import Study
+
+
+def run_metadata(study: Study, command: list[str] | None = None, **extra) -> dict:
+    """The content of ``run.json``.
+
+    Parameters
+    ----------
+    study : foldopt.Study
+        The study that ran, resolved (its defaults filled in).
+    command : list of str, optional
+        The command line to record; default ``sys.argv``.
+    **extra
+        Further entries, after the standard ones, in their order (JSON-serialisable, or floats).
+
+    Returns
+    -------
+    dict
+        ``study`` (the study as JSON), ``mode``, ``command``, ``versions`` and ``extra``.
+    """
+    return {
+        "study": study.model_dump(mode="json"),
+        "mode": study.mode,
+        "command": command if command is not None else sys.argv,
+        "versions": versions(),
+        **extra,
+    }
+
+
+def input_hash(data) -> str:
+    """SHA-256 of the canonical JSON of a study's inputs (keys sorted, no spaces).
+
+    Parameters
+    ----------
+    data : dict
+        The inputs, as JSON-like data (values that are not JSON are written as their ``str``).
+
+    Returns
+    -------
+    str
+        The digest, 64 hexadecimal characters.
+    """
+    canonical = json.dumps(data, sort_keys=True, default=str, separators=(",", ":"))
+    return hashlib.sha256(canonical.encode()).hexdigest()
+
+
+def write_run_json(folder: Path, metadata: dict) -> Path:
+    """Write ``folder/run.json``: ``metadata`` as indented JSON (ASCII; numpy numbers as floats).
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The results folder being written (a staged folder, :func:`foldopt.files.staged_folder`).
+    metadata : dict
+        Usually :func:`run_metadata`'s.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    path = Path(folder) / "run.json"
+    path.write_text(json.dumps(metadata, indent=2, sort_keys=False, default=float) + "\n")
+    return path

@@ -1,0 +1,88 @@
+"""The year of an annual study in numbers: per case and design, the daily t_solar's statistics,
+the totals over the days and each design's gain over flat and share of the tracker
+(``annual_summary.csv``, the table ``report.html`` shows for an annual study)."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from foldopt.engine.metrics import relative_to
+
+#: The daily t_solar thresholds [h] whose days :func:`annual_summary` counts (``days_ge_<x>h``).
+THRESHOLDS_H = (2, 4, 6, 8, 10, 12)
+
+
+def annual_cases(result) -> list[str]:
+    """The columns that tell one case of an annual study from another: its site and load, and any
+    other field the plan varies but the date.
+
+    Parameters
+    ----------
+    result : foldopt.studies.sweeps.SweepResult
+        A sweep that varies the date (or the day of the year).
+
+    Returns
+    -------
+    list of str
+        Column names of ``result.table``, for :func:`annual_summary`'s ``cases``.
+    """
+    others = [c for c in result.varied if c not in ("date", "day_of_year", "site_name", "latitude", "p_load_w")]
+    return ["site_name", "latitude", *others, "p_load_w"]
+
+
+def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitude", "p_load_w")) -> pd.DataFrame:
+    """The year per case and design: the daily t_solar's statistics, the totals over the days and
+    each design's standing against the case's flat panel and tracker.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep's tidy table (:attr:`foldopt.SweepResult.table`): a row per day, case and design,
+        with ``date``, ``design``, ``fold_angle_deg`` [deg], ``t_solar_h`` [h],
+        ``energy_harvested_wh``, ``energy_served_wh``, ``energy_wasted_wh`` [Wh] and, where the
+        sweep has it, ``poa_kwh_m2`` [kWh/m^2].
+    cases : sequence of str, default ('site_name', 'latitude', 'longitude', 'p_load_w')
+        The columns that tell one case from another, but the date (:func:`annual_cases`); those
+        missing from ``table`` are ignored.
+
+    Returns
+    -------
+    pandas.DataFrame
+        A row per case and design with ``days``, ``fold_angle_deg`` [deg] and:
+
+        - daily t_solar [h]: ``mean_t_solar_h``, ``p10_t_solar_h``, ``p50_t_solar_h``,
+          ``p90_t_solar_h``, ``min_t_solar_h``, the days reaching each of :data:`THRESHOLDS_H`
+          (``days_ge_<x>h``) and the monthly means ``month_<mm>_mean_t_solar_h``;
+        - the totals over the days: energy harvested, served and wasted [Wh] and the
+          plane-of-array irradiation ``poa_kwh_m2`` [kWh/m^2];
+        - each design's gain over the case's flat panel (``gain_vs_flat_pct``) and share of its
+          tracker (``pct_of_tracker``) in mean daily t_solar, and the same in energy harvested
+          (``energy_gain_vs_flat_pct``, ``energy_pct_of_tracker``) [%]; served energy is the load
+          times t_solar, so it moves with the time.
+    """
+    table = table.assign(month=pd.to_datetime(table["date"]).dt.month)
+    cases = [c for c in cases if c in table]
+    keys = cases + ["design"]
+    rows = []
+    for key, group in table.groupby(keys, sort=False):
+        hours = group["t_solar_h"]
+        row = dict(zip(keys, key if isinstance(key, tuple) else (key,), strict=True))
+        row.update(days=len(group), fold_angle_deg=group["fold_angle_deg"].iloc[0], mean_t_solar_h=hours.mean(),
+                   energy_harvested_wh=group["energy_harvested_wh"].sum(),
+                   energy_served_wh=group["energy_served_wh"].sum(), energy_wasted_wh=group["energy_wasted_wh"].sum())
+        if "poa_kwh_m2" in group:
+            row["poa_kwh_m2"] = group["poa_kwh_m2"].sum()
+        row.update(p10_t_solar_h=hours.quantile(0.1), p50_t_solar_h=hours.median(), p90_t_solar_h=hours.quantile(0.9),
+                   min_t_solar_h=hours.min())
+        row.update({f"days_ge_{x}h": int((hours >= x).sum()) for x in THRESHOLDS_H})
+        row.update({f"month_{m:02d}_mean_t_solar_h": v for m, v in group.groupby("month")["t_solar_h"].mean().items()})
+        rows.append(row)
+    summary = pd.DataFrame(rows)
+    for reference, gain in (("flat", "gain_vs_flat_pct"), ("tracker", "pct_of_tracker")):
+        base = summary[summary["design"] == reference].set_index(cases)[["energy_harvested_wh", "mean_t_solar_h"]]
+        matched = base.reindex(pd.MultiIndex.from_frame(summary[cases]) if len(cases) > 1 else summary[cases[0]])
+        energy = relative_to(summary["energy_harvested_wh"], matched["energy_harvested_wh"].to_numpy())
+        time = relative_to(summary["mean_t_solar_h"], matched["mean_t_solar_h"].to_numpy())
+        summary[f"energy_{gain}"] = (energy - 1.0) * 100.0 if reference == "flat" else energy * 100.0
+        summary[gain] = (time - 1.0) * 100.0 if reference == "flat" else time * 100.0
+    return summary

@@ -1,0 +1,94 @@
+"""The figures: one registry (foldopt.output.figures.FIGURES) names every figure file a results
+folder holds, and drawing them changes nothing of a notebook's matplotlib: the plot functions draw
+into the user's Axes with the user's backend, and writing a folder chooses no backend at all."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import foldopt
+from foldopt.output.figures import FIGURES, annual, day, sizing, sweep, world
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_the_registry_is_the_figures_of_the_examples():
+    # results/examples/ holds a folder of every kind: each figure it has is registered, and each
+    # registered figure is one a folder has.
+    written = {path.name for path in (ROOT / "results" / "examples").glob("*/*.png")}
+    assert written == set(FIGURES)
+
+
+def test_the_registry_is_every_kind_once_and_draws_with_public_functions():
+    kinds = [day.FIGURES, sweep.FIGURES, annual.FIGURES, world.FIGURES, sizing.FIGURES]
+    assert sum(len(kind) for kind in kinds) == len(FIGURES)  # no file name in two kinds
+    for file, figure in FIGURES.items():
+        assert file.endswith(".png") and figure.description
+        assert getattr(foldopt, figure.plot.__name__) is figure.plot, file
+
+
+#: Draws every public plot function into Axes of its own and writes two folders, in a process whose
+#: matplotlib backend is svg (as a notebook's is its own): prints what it saw.
+NOTEBOOK = textwrap.dedent("""
+    import json, sys
+    import matplotlib
+    import numpy as np
+    import pandas as pd
+    import foldopt
+
+    backend = matplotlib.get_backend()
+    study = foldopt.default_study().variant(step_min=30, fold_angles={"start": 30, "stop": 180, "step": 30})
+    result = foldopt.run(study)
+    year = foldopt.sweep(study, "day", date="1:365:91", objective="mean", p_load=[2.0, 4.0])
+    sized = foldopt.size(study, areas="0.05:0.2:0.05")
+    foldopt.write(result, sys.argv[1] + "/day")
+    foldopt.write(year, sys.argv[1] + "/year")
+    after_writing = [matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules]
+
+    import matplotlib.pyplot as plt
+    sites = pd.DataFrame({"site_name": ["a", "b"], "latitude": [0.0, 40.0], "longitude": [0.0, 10.0],
+                          "gain_vs_flat_pct": [1.0, -2.0], "period": "year", "p_load_fraction": [0.2, 0.3]})
+    calls = {
+        "plot_power_curves": (result,), "plot_switching": (result,), "plot_t_solar_vs_fold_angle": (result,),
+        "plot_comparison": (result,), "plot_standby": (result,),
+        "plot_map": (year.table, "day_of_year", "p_load_w", "t_solar_h", "t", "t_solar [h]", False),
+        "plot_curves": (year.table, "day_of_year", "t"),
+        "plot_sizing": (sized.table, sized.best, "t"),
+        "plot_annual_fold_angles": (year.extras["by_angle"], "t"),
+        "plot_distribution": (year.table, "t"),
+        "plot_day_hour": (year.extras, "switch_state", "t", ""),
+        "plot_refold_value": (pd.DataFrame({"latitude": 0.0, "longitude": 0.0, "p_load_w": 2.0, "settings": [1, 2],
+                                            "objective": "mean", "objective_h": [5.0, 6.0],
+                                            "objective_flat_h": 4.0, "objective_tracker_h": 7.0}), "t"),
+        "plot_world_map": (sites, "gain_vs_flat_pct", "t", "gain [%]", True),
+        "plot_latitude_load": (sites, "year", True, "t"),
+    }
+    drawn = []
+    for name, args in calls.items():
+        fig, ax = plt.subplots()
+        drawn.append(getattr(foldopt, name)(*args, ax=ax) is ax)
+    fig, axes = plt.subplots(2, 2, squeeze=False)
+    drawn.append(foldopt.plot_monthly(year.table, "t", loads_at_most=2, axes=axes) is axes)
+    print(json.dumps({"before": backend, "after_writing": after_writing, "after_plots": matplotlib.get_backend(),
+                      "rc": matplotlib.rcParams["backend"], "plotted": sorted([*calls, "plot_monthly"]),
+                      "drawn": drawn, "open": plt.get_fignums()}))
+""")
+
+
+def test_plots_and_folders_leave_a_notebooks_backend_alone(tmp_path):
+    env = {**os.environ, "MPLBACKEND": "svg"}
+    done = subprocess.run([sys.executable, "-c", NOTEBOOK, str(tmp_path)], capture_output=True, text=True, env=env,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    seen = json.loads(done.stdout.splitlines()[-1])
+    assert seen["before"] == "svg"
+    assert seen["after_writing"] == ["svg", False]  # writing a folder does not even import pyplot
+    assert seen["after_plots"] == seen["rc"] == "svg"
+    assert seen["plotted"] == sorted(name for name in foldopt.__all__ if name.startswith("plot_"))
+    assert all(seen["drawn"]) and len(seen["open"]) == len(seen["drawn"])  # the user's figures, still open
+    assert {"power_curves.png", "daily_t_solar_distribution.png"} <= {p.name for p in tmp_path.glob("*/*.png")}
