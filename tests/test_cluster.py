@@ -22,8 +22,9 @@ from foldopt.studies.worldmap import evaluate_sites
 
 pytest.importorskip("distributed")
 
-#: 16 sites, a chunk each, about 0.25 s of work per chunk: long enough to be killed mid-run.
-MAP = ["--lat", "-60:60:40", "--lon", "-180:90:90", "--p-load", "1,2", "--area", "0.108", "--chunk-sites", "1"]
+#: 16 sites, a chunk each, at 15-min steps: about 0.1 s of work per chunk, long enough to be killed mid-run.
+MAP = ["--lat", "-60:60:40", "--lon", "-180:90:90", "--p-load", "1,2", "--area", "0.108", "--chunk-sites", "1",
+       "--step-min", "15"]
 N_SITES, N_LOADS = 16, 2
 SECONDS = 240  # any one run or cluster start
 
@@ -98,38 +99,34 @@ def test_embedded_map_equals_the_computation_without_dask(embedded):
     from foldopt.inputs.load import default_study_path, read_study
     from foldopt.studies.worldmap import map_study
 
-    study = map_study(read_study(default_study_path())[0], **{"panel.area": 0.108, "objective": {"statistic": "mean"}})
+    study = map_study(read_study(default_study_path())[0], step_min=15.0,
+                      **{"panel.area": 0.108, "objective": {"statistic": "mean"}})
     direct = evaluate_sites(study, spec_sites[:2], [1.0, 2.0])
     pd.testing.assert_frame_equal(embedded[embedded["site_id"] < 2].reset_index(drop=True), direct, check_exact=True)
     _every_site_once(embedded)
 
 
-def test_a_hand_started_cluster_gives_the_same_bits(embedded, cluster, tmp_path):
-    scheduler_file, _ = cluster
-    out = tmp_path / "map"
-    _, err = _finish(_foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file)))
-    assert "Dask scheduler tcp://127.0.0.1:" in err
-    pd.testing.assert_frame_equal(pd.read_parquet(out / "map.parquet"), embedded, check_exact=True)
-    meta = json.loads((out / "run.json").read_text())
-    assert meta["status"] == "complete" and meta["cluster"].startswith("Dask scheduler tcp://127.0.0.1:")
-
-
 def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
+    """A map on a hand-started cluster, one of whose two workers is killed once the first part is
+    written: every site once, the same bits as the embedded cluster's map."""
     scheduler_file, workers = cluster
     out = tmp_path / "map"
-    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file), "-q")
+    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
     try:
         _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
         assert workers[0].poll() is None
         os.kill(workers[0].pid, signal.SIGKILL)
         killed_at = len(_parts(out))
-        _finish(run)
+        _, err = _finish(run)
     finally:
         _kill(run)
     assert killed_at < N_SITES  # the worker died with work left
+    assert "Dask scheduler tcp://127.0.0.1:" in err
     table = pd.read_parquet(out / "map.parquet")
     _every_site_once(table)
     pd.testing.assert_frame_equal(table, embedded, check_exact=True)
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "complete" and meta["cluster"].startswith("Dask scheduler tcp://127.0.0.1:")
 
 
 def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):

@@ -162,24 +162,6 @@ def test_size(tmp_path):
     no_old_names(folder, document)
 
 
-def test_six_site_map(tmp_path):
-    sites = tmp_path / "sites.csv"
-    sites.write_text("name,latitude,longitude\nquito,-0.18,-78.47\noslo,59.91,10.75\nsydney,-33.87,151.21\n"
-                     "la,34.05,-118.25\nnairobi,-1.29,36.82\ncairo,30.04,31.24\n")
-    document, folder, _ = cli(tmp_path, "map", "--sites", sites, "--p-load", "2", "--workers", "1", "--step-min",
-                              "30", "--angle-step", "10", terminal=False)
-    study = foldopt.map_study(foldopt.default_study().data(), objective={"statistic": "mean"}, step_min=30.0,
-                              fold_angles={"start": 10.0, "stop": 180.0, "step": 10.0})
-    result, _, answer = foldopt.world_map(foldopt.read_sites(sites), [2.0], tmp_path / "api", study, workers=1)
-    year = result.table[result.table["period"] == "year"]
-    same_rows(document, year.reset_index(drop=True))
-    assert document["answer"]["near_optimal"] == json.loads(json.dumps(records(answer.near_optimal)))
-    assert any("recommended" in line and "near-optimal ranges" in line for line in document["answer"]["lines"])
-    assert "Near-optimal fold angles" in (folder / "report.html").read_text()
-    assert np.isfinite(year["recommended_fold_angle_deg"]).all()
-    no_old_names(folder, document)
-
-
 @pytest.mark.parametrize("option,parameter,value", [
     ("--cost-per-m2", "cost_per_m2", 1e308), ("--cost-per-m2", "cost_per_m2", float("nan")),
     ("--cost-per-w", "cost_per_w", 0.0), ("--c-grid", "c_grid", 1e306), ("--years", "years", -1.0),
@@ -201,19 +183,23 @@ def test_size_refuses_what_the_api_refuses(option, parameter, value):
     assert "must be a finite number > 0 and at most" in line
 
 
-def test_grid_map_request_is_the_api_request(tmp_path):
-    """A map of a grid at the study's load through the command line, and the same request made with
-    foldopt.studies.request.map_request_from and run by foldopt.world_map: the same rows to the bit, the
-    same answer, the same things taken from the study."""
+def test_a_map_request_is_the_api_request(tmp_path):
+    """A map of named sites at the study's load through the command line, and the same request
+    made with foldopt.studies.request.map_request_from and run by foldopt.world_map: the same rows
+    to the bit, the same answer, the same things taken from the study; every view carries the
+    near-optimal range and the recommended angle."""
     from foldopt.studies.request import map_request_from
 
-    document, _, _ = cli(tmp_path, "map", "--lat", "0,40", "--lon", "30", "--workers", "1", "--step-min", "60",
-                         "--angle-step", "30")
-    request = map_request_from(latitudes="0,40", longitudes="30", step_min=60.0, angle_step=30.0)
-    assert [(site["latitude"], site["longitude"]) for site in request.sites] == [(0.0, 30.0), (40.0, 30.0)]
+    sites = tmp_path / "sites.csv"
+    sites.write_text("name,latitude,longitude\nquito,-0.18,-78.47\noslo,59.91,10.75\nsydney,-33.87,151.21\n")
+    document, folder, _ = cli(tmp_path, "map", "--sites", sites, "--workers", "1", "--step-min", "60",
+                              "--angle-step", "10")
+    request = map_request_from(sites=str(sites), step_min=60.0, angle_step=10.0)
+    assert [site["name"] for site in request.sites] == ["quito", "oslo", "sydney"]
     result, _, answer = foldopt.world_map(request.sites, request.loads, tmp_path / "api", request.study,
                                           request.relative, request.year, workers=1, defaults=request.defaults)
-    same_rows(document, result.table[result.table["period"] == "year"].reset_index(drop=True))
+    year = result.table[result.table["period"] == "year"].reset_index(drop=True)
+    same_rows(document, year)
     api = json.loads(json.dumps(answer.to_dict()))
     for key in ("kind", "designs", "near_optimal", "notes"):
         assert document["answer"][key] == api[key], key
@@ -222,6 +208,11 @@ def test_grid_map_request_is_the_api_request(tmp_path):
             == {k: v for k, v in api["result"].items() if k not in run})
     assert document["answer"]["defaults"]["taken"] == request.defaults["taken"]
     assert "P_load 4.398 W" in request.defaults["taken"]
+    assert document["answer"]["near_optimal"] == json.loads(json.dumps(records(answer.near_optimal)))
+    assert any("recommended" in line and "near-optimal ranges" in line for line in document["answer"]["lines"])
+    assert "Near-optimal fold angles" in (folder / "report.html").read_text()
+    assert np.isfinite(year["recommended_fold_angle_deg"]).all()
+    no_old_names(folder, document)
 
 
 def test_variant_merges_sections_and_speaks_in_config_errors():
