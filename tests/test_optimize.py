@@ -48,6 +48,25 @@ def test_heuristic_bisection_finds_the_threshold():
     assert heuristic_fold_angle(subpanels, 0.0) == 1.0
 
 
+def test_the_heuristic_angle_reaches_the_load():
+    """Shin et al. Eq. 8 asks for a valley that reaches the load: the angle returned is on that side
+    of the threshold, however the root search lands (a curved valley, many loads)."""
+    def subpanels(angles):
+        level = (np.asarray(angles, dtype=float)[:, None] / 180.0) ** 1.7 * np.ones((1, 5))
+        return level, level, level
+
+    for p_load in np.linspace(0.01, 0.99, 37):
+        angle = heuristic_fold_angle(subpanels, p_load)
+        assert (angle / 180.0) ** 1.7 >= p_load
+        assert angle - 180.0 * p_load ** (1 / 1.7) <= 0.01 + 1e-9  # at most tol above the threshold
+
+
+def test_the_paper_days_heuristic_angle_carries_the_load_through_noon(shin_study):
+    summary = run_study(shin_study).summary.set_index("design")
+    row = summary.loc["twofold-heuristic"]
+    assert row["t_solar_contiguous_h"] == row["t_solar_h"]
+
+
 @pytest.mark.parametrize("mode,geometry", [("paper", "azimuth-split"), ("exact", "hinge")])
 def test_heuristic_agrees_with_the_sweep_on_the_paper_study(shin_study, mode, geometry):
     # Shin et al. Sec. VII: the optimum lies "just before the valley goes down the P_load surface".

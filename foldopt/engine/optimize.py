@@ -134,7 +134,8 @@ def heuristic_fold_angle(
     Returns
     -------
     float
-        Fold angle [deg], within ``tol`` of the threshold; ``lo`` if even the most folded panel
+        Fold angle [deg] whose valley reaches the load, at most ``tol`` above the threshold;
+        ``lo`` if even the most folded panel
         reaches the load, NaN if even the flat one does not (the load exceeds the noon power).
 
     References
@@ -161,4 +162,7 @@ def heuristic_fold_angle(
         return float("nan")
     if shortfall(lo) >= 0.0:
         return float(lo)
-    return float(scipy.optimize.brentq(shortfall, lo, hi, xtol=tol))
+    angle = float(scipy.optimize.brentq(shortfall, lo, hi, xtol=tol))
+    # Brent's estimate may fall just short of the threshold; the answer must reach the load (the
+    # valley rises with the fold angle, and the threshold lies within ``tol`` of the estimate).
+    return angle if shortfall(angle) >= 0.0 else min(angle + tol, hi)
