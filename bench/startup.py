@@ -10,9 +10,12 @@ script where there is one), so the figure includes the interpreter's own start. 
 - ``foldopt sweep angle --help`` (the sweep options, built from the name registry);
 - a validation error (``foldopt sweep angle --lat 95``): the study is checked before pvlib,
   pandas or matplotlib are imported;
+- the embedded study, warm (``foldopt run --out <tmp> --overwrite -q``, after one run that
+  compiles the kernel and fills the caches): imports, the day, its five figures and report.html;
 - a bare ``python -c pass`` for the interpreter alone.
 
-The target is 0.5 s on the 2-core machine for the help and the error (issue 13).
+The targets on the 2-core machine: 0.5 s for the help and the error (issue 13), 1.5 s for the
+embedded run (issue 23).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 
 COMMANDS = {
@@ -33,7 +37,10 @@ COMMANDS = {
 }
 if shutil.which("foldopt"):  # the installed script, with its entry-point lookup
     COMMANDS["foldopt --help (the script)"] = [shutil.which("foldopt"), "--help"]
-TARGET_S = 0.5
+RUN = "foldopt run (embedded, warm)"
+COMMANDS[RUN] = [sys.executable, "-m", "foldopt.cli.app", "run", "--out",
+                 os.path.join(tempfile.mkdtemp(prefix="foldopt-startup-"), "run"), "--overwrite", "-q"]
+TARGETS_S = {RUN: 1.5}
 
 
 def main() -> None:
@@ -41,6 +48,7 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=7)
     runs = parser.parse_args().runs
     times: dict[str, list[float]] = {name: [] for name in COMMANDS}
+    subprocess.run(COMMANDS[RUN], capture_output=True, check=True)  # compiles the kernel, fills the caches
     for _ in range(runs):  # interleaved: a noisy moment hits every command alike
         for name, command in COMMANDS.items():
             start = time.perf_counter()
@@ -51,7 +59,8 @@ def main() -> None:
     print(f"foldopt start-up, {runs} runs each, {os.cpu_count()} cores, python {sys.version.split()[0]}")
     print(f"{'command':32s} {'min [s]':>8s} {'median [s]':>11s}  target")
     for name, values in times.items():
-        target = "" if name.startswith("python") else ("<= 0.5 s ok" if min(values) <= TARGET_S else "> 0.5 s MISSED")
+        limit = TARGETS_S.get(name, 0.5)
+        target = "" if name.startswith("python") else (f"<= {limit} s " + ("ok" if min(values) <= limit else "MISSED"))
         print(f"{name:32s} {min(values):8.3f} {statistics.median(values):11.3f}  {target}")
 
 
