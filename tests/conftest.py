@@ -22,6 +22,15 @@ def pytest_configure(config):
         os.environ.setdefault("FOLDOPT_CACHE_DIR", str(config.cache.mkdir("foldopt")))
 
 
+#: Modules whose tests take longest (Dask clusters, the docs build, whole years): run first, so that
+#: the two workers do not end on one long test while the other idles.
+LONG_FIRST = ("test_cluster.py", "test_docs.py", "test_one_answer.py", "test_report_html.py", "test_faults_cluster.py")
+
+
+def pytest_collection_modifyitems(items):
+    items.sort(key=lambda item: item.path.name not in LONG_FIRST)  # stable: the order within each part is kept
+
+
 @pytest.fixture
 def small_disk(tmp_path):
     """A 2 MB tmpfs at ``tmp_path / "disk"``, unmounted afterwards; skipped where it cannot be mounted."""

@@ -20,6 +20,9 @@ from foldopt.studies.cluster import MapSpec, run_map
 from foldopt.errors import OutputError
 from foldopt.studies.worldmap import evaluate_sites
 
+#: One worker runs this module (the embedded map, every test's reference, is computed once; --dist loadgroup).
+pytestmark = pytest.mark.xdist_group("cluster")
+
 pytest.importorskip("distributed")
 
 #: 16 sites, a chunk each, at 15-min steps: about 0.1 s of work per chunk, long enough to be killed mid-run.

@@ -17,6 +17,9 @@ from pathlib import Path
 
 import pytest
 
+#: One worker runs this module (the manual is built once, by one worker; pytest-xdist --dist loadgroup).
+pytestmark = pytest.mark.xdist_group("docs")
+
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 PAGES = ("index", "quickstart", "cli", "study-file", "outputs", "api", "reproduction", "physics", "performance",

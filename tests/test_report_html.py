@@ -13,6 +13,9 @@ from typer.testing import CliRunner
 
 from foldopt.cli.app import app
 
+#: One worker runs this module (the results folders are written once, by one worker; pytest-xdist --dist loadgroup).
+pytestmark = pytest.mark.xdist_group("reports")
+
 runner = CliRunner()
 QUICK = ["--step-min", "30", "--angle-step", "30"]
 COMMANDS = {
