@@ -10,8 +10,8 @@ from typing import Optional
 
 import typer
 
-from foldopt.cli.options import (AREA, EMBEDDED, ENGINE, FORMAT, OPTION_OF_FIELD, OVERWRITE, QUIET, RESULTS,
-                                 check_choices, out_option, rename_fields)
+from foldopt.cli.options import (ANGLE_STEP, AREA, EFFICIENCY, EMBEDDED, ENGINE, FORMAT, OPTION_OF_FIELD, OVERWRITE,
+                                 QUIET, RESULTS, SETTINGS, STEP_MIN, check_choices, out_option, rename_fields)
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError, WeatherError
 
@@ -34,16 +34,15 @@ def map_(
     p_load_fraction: Optional[str] = typer.Option(None, "--p-load-fraction", help="Loads as fractions of each "
                                                   "site's flat peak, e.g. 0.1:0.9:0.1, instead of --p-load."),
     area: Optional[float] = AREA,
-    efficiency: Optional[float] = typer.Option(None, "--efficiency", help="PV efficiency [-]."),
+    efficiency: Optional[float] = EFFICIENCY,
     objective: str = typer.Option("mean", "--objective", help="What each period's fold angle maximises: mean | min | "
                                   "worst-month | pNN."),
     year: int = typer.Option(2025, "--year", help="Year of the clear-sky days (or that a typical year stands for)."),
-    step_min: Optional[float] = typer.Option(None, "--step-min", help="Time step [min] [default: 5]."),
-    angle_step: Optional[float] = typer.Option(None, "--angle-step", help="Fold-angle grid step [deg] [default: 1]."),
+    step_min: Optional[float] = STEP_MIN,
+    angle_step: Optional[float] = ANGLE_STEP,
     config: Optional[Path] = typer.Option(None, "--config", help=f"Study to take the panel and models from [default: "
                                           f"{EMBEDDED}, in exact mode with the Ineichen clear sky]."),
-    settings: Optional[list[str]] = typer.Option(None, "--set", metavar="KEY=VALUE", help="Any study field, e.g. "
-                                                 "--set pv_model=single-diode; repeatable."),
+    settings: Optional[list[str]] = SETTINGS,
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address (tcp://host:8786) "
                                             "or scheduler file [default: an embedded cluster]."),
     workers: Optional[int] = typer.Option(None, "--workers", help="Worker processes of the embedded cluster "

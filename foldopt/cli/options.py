@@ -29,6 +29,13 @@ ENGINE = typer.Option("numba", "--engine", help="numba (the compiled kernel) | n
                                                 "tested against, slower).")
 TABLE = typer.Option(False, "--table", help="Also print the full table (it is always in the CSV files).")
 AREA = typer.Option(None, "--area", help="Flat panel area [m^2].")
+EFFICIENCY = typer.Option(None, "--efficiency", help="PV efficiency [-] (ideal model; sets the b-model panel's area).")
+STEP_MIN = typer.Option(None, "--step-min", help="Time step [min], a divisor of 1440 [default: the study's; "
+                                                 "foldopt map: 5].")
+ANGLE_STEP = typer.Option(None, "--angle-step", help="Fold-angle grid step [deg] [default: the study's; "
+                                                     "foldopt map: 1].")
+SETTINGS = typer.Option(None, "--set", metavar="KEY=VALUE", help="Any study field (a dotted key, a YAML value), "
+                                                                 "e.g. --set pv_model=single-diode; repeatable.")
 
 
 def out_option(default: Path | None = None, shown: str | None = None):

@@ -12,8 +12,8 @@ from typing import Optional
 import typer
 
 from foldopt import names
-from foldopt.cli.options import (AREA, EMBEDDED, ENGINE, FORMAT, OPTION_OF_FIELD, OVERWRITE, QUIET, RESULTS, TABLE,
-                                 check_choices, out_option, rename_fields)
+from foldopt.cli.options import (ANGLE_STEP, AREA, EFFICIENCY, EMBEDDED, ENGINE, FORMAT, OPTION_OF_FIELD, OVERWRITE,
+                                 QUIET, RESULTS, SETTINGS, STEP_MIN, TABLE, check_choices, out_option, rename_fields)
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
 from foldopt.errors import ConfigError
@@ -44,8 +44,7 @@ def _sweep_options(
     p_load_scale: Optional[str] = typer.Option(None, "--p-load-scale", help="Scale of the load profile [-], or a range "
                                                "such as 0.5:2:0.1 [default: 1]."),
     area: Optional[float] = AREA,
-    efficiency: Optional[float] = typer.Option(None, "--efficiency", help="PV efficiency [-] (ideal model; sets the "
-                                               "b-model panel's area)."),
+    efficiency: Optional[float] = EFFICIENCY,
     tilt: Optional[str] = typer.Option(None, "--tilt", help="Panel tilt [deg], or a range [default: the study's, "
                                        "or |latitude| where the latitude changes]."),
     azimuth: Optional[float] = typer.Option(None, "--azimuth", help="Panel azimuth [deg from north] [default: the "
@@ -81,10 +80,9 @@ def _sweep_options(
     temp_air: Optional[float] = typer.Option(None, "--temp-air", help="Air temperature [C] (I-V models)."),
     exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve every step's I-V curves instead "
                                           "of the tables (slow)."),
-    step_min: Optional[float] = typer.Option(None, "--step-min", help="Time step [min], a divisor of 1440."),
-    angle_step: Optional[float] = typer.Option(None, "--angle-step", help="Fold-angle grid step [deg]."),
-    settings: Optional[list[str]] = typer.Option(None, "--set", metavar="KEY=VALUE", help="Any study field (a dotted "
-                                                 "key, a YAML value), e.g. --set panel.efficiency=0.21; repeatable."),
+    step_min: Optional[float] = STEP_MIN,
+    angle_step: Optional[float] = ANGLE_STEP,
+    settings: Optional[list[str]] = SETTINGS,
     out: Optional[Path] = out_option(shown="results/sweep-<axis>"),
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
