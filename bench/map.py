@@ -35,7 +35,8 @@ TARGET_SPEEDUP = 1.8
 def _spec(n_sites: int):
     from foldopt.studies.cluster import MapSpec
     from foldopt.inputs.load import default_study_path, read_study
-    from foldopt.studies.worldmap import grid_sites, map_study
+    from foldopt.inputs.sites import grid_sites
+    from foldopt.studies.worldmap import map_study
 
     n_lat = max(1, round(np.sqrt(n_sites * 0.8)))
     n_lon = -(-n_sites // n_lat)
@@ -76,7 +77,7 @@ def main() -> None:
     pd.testing.assert_frame_equal(one.pop("table"), two.pop("table"), check_exact=True)
     speedup = one["wall_s"] / two["wall_s"]
     per_site = (one["wall_s"] - one["cluster_start_s"]) / len(spec.sites)  # one core, one site, everything
-    land_sites = 21_637  # 1-degree grid points on land, foldopt.studies.worldmap.grid_sites(..., land_only=True)
+    land_sites = 21_637  # 1-degree grid points on land, foldopt.inputs.sites.grid_sites(..., land_only=True)
     lines = [
         f"# W4: world map on the embedded Dask cluster ({platform.node()}, {os.cpu_count()} cores, "
         f"{time.strftime('%Y-%m-%d')})",

@@ -24,9 +24,8 @@ _PUBLIC = {
     "write": "foldopt.api", "size": "foldopt.api", "reproduce": "foldopt.api", "world_map": "foldopt.api",
     "StudyResult": "foldopt.studies.day", "SweepResult": "foldopt.studies.sweeps",
     "MapSpec": "foldopt.studies.cluster", "MapRun": "foldopt.studies.cluster", "run_map": "foldopt.studies.cluster",
-    "evaluate_sites": "foldopt.studies.worldmap", "grid_sites": "foldopt.studies.worldmap",
-    "read_sites": "foldopt.studies.worldmap",
-    "weather_sites": "foldopt.studies.worldmap", "map_study": "foldopt.studies.worldmap",
+    "evaluate_sites": "foldopt.studies.worldmap", "map_study": "foldopt.studies.worldmap",
+    **{name: "foldopt.inputs.sites" for name in ("grid_sites", "read_sites", "weather_sites")},
     "annual_summary": "foldopt.studies.annual", "write_html": "foldopt.output.html",
     "save_plot": "foldopt.output.figures.canvas",
     **{name: "foldopt.output.figures.day" for name in (

@@ -345,7 +345,7 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
         For a bad site, load, year, period or study setting, before any cluster starts.
     """
     from foldopt.studies.cluster import MapSpec, run_map
-    from foldopt.studies.answer import of_map
+    from foldopt.studies.answering import of_map
     from foldopt.output.folders import map_figures, write_map_report
     from foldopt.studies.worldmap import map_request, map_study
 

@@ -18,8 +18,6 @@ from __future__ import annotations
 
 import errno
 import fcntl
-import hashlib
-import io
 import json
 import os
 import platform
@@ -27,7 +25,6 @@ import re
 import secrets
 import shutil
 import socket
-import sys
 import tempfile
 import time
 from contextlib import contextmanager
@@ -70,7 +67,17 @@ def versions(extra: tuple[str, ...] = ()) -> dict[str, str]:
 
 
 def written_by_foldopt(folder: Path) -> bool:
-    """Whether ``folder`` holds foldopt's ``run.json`` (one that names foldopt's version)."""
+    """Whether ``folder`` holds foldopt's ``run.json`` (one that names foldopt's version).
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+
+    Returns
+    -------
+    bool
+        False where ``run.json`` is missing, cannot be read or is not foldopt's.
+    """
     try:
         meta = json.loads((folder / "run.json").read_text())
     except (OSError, ValueError):
@@ -136,12 +143,33 @@ class DiskFullError(OutputError):
 
 
 def is_full(error: BaseException) -> bool:
-    """Whether ``error`` says that the file system (or the user's quota) is full."""
+    """Whether ``error`` says that the file system (or the user's quota) is full.
+
+    Parameters
+    ----------
+    error : BaseException
+
+    Returns
+    -------
+    bool
+        True for a :class:`DiskFullError` or an :class:`OSError` with ``ENOSPC`` or ``EDQUOT``.
+    """
     return isinstance(error, DiskFullError) or isinstance(error, OSError) and error.errno in _FULL
 
 
 def tree_size(path: Path) -> int:
-    """Bytes of the files under ``path``, or of the file ``path`` (0 where it is gone)."""
+    """Bytes of the files under ``path``, or of the file ``path`` (0 where it is gone).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A folder or a file.
+
+    Returns
+    -------
+    int
+        Size [bytes].
+    """
     if Path(path).is_file():
         return Path(path).stat().st_size
     return sum((Path(root) / name).stat().st_size for root, _, names in os.walk(path) for name in names)
@@ -270,7 +298,20 @@ def _lock_error(out: Path, path: Path, error: OSError) -> OutputError:
 @contextmanager
 def writer_lock(out: Path):
     """Hold ``out``'s lock (``.<name>.lock`` beside it) for the block; :class:`OutputError` names
-    the run that holds it."""
+    the run that holds it.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The results folder (it need not exist; its parent must).
+
+    Raises
+    ------
+    foldopt.errors.OutputError
+        Where another process holds the lock past :data:`_LOCK_PATIENCE` seconds, where the lock
+        file is not foldopt's, or where it cannot be written (:class:`DiskFullError` on a full
+        file system).
+    """
     out = Path(out)
     descriptor = _acquire(out)
     try:
@@ -295,7 +336,13 @@ def _clear_lock(path: Path) -> None:
 
 def clear_leftovers(parent: Path) -> None:
     """Remove the staging folders and lock files that ended writers left in ``parent`` and put the
-    folders they retired back in place (see the module docstring)."""
+    folders they retired back in place (see the module docstring).
+
+    Parameters
+    ----------
+    parent : pathlib.Path
+        The folder results folders are written into; nothing is done where it is not a folder.
+    """
     if not parent.is_dir():
         return
     for path in sorted(parent.iterdir()):
@@ -336,7 +383,24 @@ def _marked_folder(out: Path, kind: str) -> Path:
 
 
 def new_staging(out: Path) -> Path:
-    """A marked staging folder beside ``out``; returns the folder to write the results into."""
+    """A marked staging folder beside ``out``; returns the folder to write the results into.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The results folder to be.
+
+    Returns
+    -------
+    pathlib.Path
+        ``.<name>.tmp-<pid>/<name>`` beside ``out``, empty; :func:`commit` or :func:`discard`
+        takes it.
+
+    Raises
+    ------
+    OSError
+        Where the folder cannot be made (the caller says why: :func:`staged_folder`).
+    """
     return _marked_folder(Path(out), "tmp") / Path(out).name
 
 
@@ -365,7 +429,18 @@ def commit(staged: Path, out: Path) -> None:
 
 
 def discard(staged: Path) -> int:
-    """Remove a staging folder; returns the bytes it held."""
+    """Remove a staging folder; returns the bytes it held.
+
+    Parameters
+    ----------
+    staged : pathlib.Path
+        The results folder inside the staging folder (from :func:`new_staging`).
+
+    Returns
+    -------
+    int
+        The bytes the staging folder held [bytes], 0 where it is gone.
+    """
     size = tree_size(staged.parent) if staged.parent.exists() else 0
     shutil.rmtree(staged.parent, ignore_errors=True)
     return size
@@ -404,86 +479,3 @@ def staged_folder(out: Path, overwrite: bool):
             if is_full(error):
                 raise DiskFullError(out, written + getattr(error, "written", 0)) from None
             raise
-
-
-# --- the cache folder ------------------------------------------------------------------------------
-
-#: Ends every cache file, followed by the SHA-256 (hex) of the bytes before it.
-_CHECKSUM = b"\nfoldopt-sha256:"
-
-
-def cache_dir() -> Path:
-    """foldopt's cache folder (electrical tables, the land mask, matplotlib's settings where HOME
-    cannot be written): ``$FOLDOPT_CACHE_DIR``, else the user's cache folder as platformdirs
-    names it (``$XDG_CACHE_HOME/foldopt`` or ``~/.cache/foldopt`` on Linux)."""
-    if os.environ.get("FOLDOPT_CACHE_DIR"):
-        return Path(os.environ["FOLDOPT_CACHE_DIR"])
-    import platformdirs
-
-    return Path(platformdirs.user_cache_dir("foldopt", appauthor=False))
-
-
-def load_cache(path: Path) -> dict | None:
-    """The arrays of the cache file ``path`` (:func:`store_cache`), or None where it is absent or
-    damaged: then the caller builds them again. The checksum is verified before anything is read,
-    so that a truncated or bit-flipped file is caught whatever its bytes; a damaged file gets a
-    one-line notice on stderr (none with ``FOLDOPT_QUIET=1``).
-
-    Parameters
-    ----------
-    path : pathlib.Path
-    """
-    try:
-        data = Path(path).read_bytes()
-    except FileNotFoundError:
-        return None
-    except OSError as error:
-        _notice(path, f"cannot be read ({error.strerror or error})")
-        return None
-    payload, mark, digest = data.rpartition(_CHECKSUM)
-    if not mark:
-        _notice(path, "has no checksum (written by an earlier foldopt, or truncated)")
-        return None
-    if digest != hashlib.sha256(payload).hexdigest().encode():
-        _notice(path, "is damaged (its checksum does not match)")
-        return None
-    import numpy as np
-
-    with np.load(io.BytesIO(payload), allow_pickle=False) as arrays:
-        return {name: arrays[name] for name in arrays.files}
-
-
-def store_cache(path: Path, arrays: dict, compress: bool = False) -> None:
-    """Write ``arrays`` to the cache file ``path``: a NumPy ``.npz`` followed by
-    :data:`_CHECKSUM` and the SHA-256 of the ``.npz``, atomically. A cache that cannot be written
-    is skipped.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-    arrays : dict of numpy.ndarray
-        By name.
-    compress : bool, default False
-        ``numpy.savez_compressed`` instead of ``numpy.savez``.
-    """
-    import numpy as np
-
-    buffer = io.BytesIO()
-    (np.savez_compressed if compress else np.savez)(buffer, **arrays)
-    payload = buffer.getvalue()
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError:
-        return  # no cache where none can be written
-    try:
-        with os.fdopen(handle, "wb") as file:
-            file.write(payload + _CHECKSUM + hashlib.sha256(payload).hexdigest().encode())
-        os.replace(temporary, path)  # atomic: readers see the old file or the whole new one
-    except OSError:
-        Path(temporary).unlink(missing_ok=True)
-
-
-def _notice(path: Path, problem: str) -> None:
-    if os.environ.get("FOLDOPT_QUIET") != "1":
-        print(f"foldopt: the cache file {path} {problem}; building it again", file=sys.stderr)

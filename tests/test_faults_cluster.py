@@ -22,7 +22,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from foldopt.studies.cluster import MapSpec, connect, run_map
+from foldopt.studies.cluster import MapSpec, run_map
+from foldopt.studies.dask_client import connect
 from foldopt.errors import ConfigError
 from foldopt.errors import OutputError
 from test_faults_files import HOLDS_THE_LOCK

@@ -126,7 +126,7 @@ def test_a_profiles_scale_is_named_as_given(here, axis):
 
 def test_a_spreadsheets_utf8_csv_with_a_byte_order_mark_is_read(here):
     from foldopt.inputs.load import read_profile
-    from foldopt.studies.worldmap import read_sites
+    from foldopt.inputs.sites import read_sites
 
     (here / "sites.csv").write_bytes("\ufeffname,latitude,longitude\nSão Paulo,-23.55,-46.63\n".encode())
     (here / "p.csv").write_bytes(("\ufeff" + PROFILE).encode())
@@ -218,7 +218,7 @@ def test_utf8_input_files_under_the_c_locale(tmp_path):
     (tmp_path / "p.csv").write_bytes("time,watts\n07:00,6\n".encode())
     (tmp_path / "s.yaml").write_bytes(yaml.safe_dump({**FAST, "description": "Zürich"}, allow_unicode=True).encode())
     code = ("from foldopt.inputs.load import read_profile, read_study; "
-            "from foldopt.studies.worldmap import read_sites; "
+            "from foldopt.inputs.sites import read_sites; "
             "print(ascii([read_sites('sites.csv')[0]['name'], read_profile('p.csv'), "
             "read_study('s.yaml')[0]['description']]))")
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=foldopt_env(**C_LOCALE),

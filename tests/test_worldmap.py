@@ -12,9 +12,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from foldopt.inputs.plan import make_plan
+from foldopt.inputs.sites import grid_sites, read_sites
 from foldopt.errors import ConfigError
 from foldopt.studies.sweeps import run_plan
-from foldopt.studies.worldmap import PERIODS, SEASONS, evaluate_sites, grid_sites, map_study, read_sites
+from foldopt.studies.worldmap import PERIODS, SEASONS, evaluate_sites, map_study
 
 #: A coarse study keeps a year's evaluation to tens of milliseconds.
 COARSE = map_study({"name": "shin2015", "panel": {"area": 0.108, "efficiency": 0.1905}, "p_load": 2.0,

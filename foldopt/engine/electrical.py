@@ -15,7 +15,7 @@ error against it.
 
 Tables are kept on disk, named by a hash of everything they depend on (the PV unit's parameters,
 the sub-panel area, the temperature settings, the nodes, pvlib's version and
-:data:`TABLE_FORMAT`), in foldopt's cache folder (:func:`foldopt.files.cache_dir`); a second process loads
+:data:`TABLE_FORMAT`), in foldopt's cache folder (:func:`foldopt.cache.cache_dir`); a second process loads
 them instead of solving I-V curves again. A cache file ends with a checksum of its content
 (:func:`store_cache`): a damaged one is built again, with a notice. A cache that cannot be written
 is skipped.
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 import pvlib
 
-from foldopt.files import cache_dir, load_cache, store_cache
+from foldopt.cache import cache_dir, load_cache, store_cache
 from foldopt.physics.connections import connection_powers, parallel_power, series_power
 from foldopt.physics.pvmodel import PVModel, cell_temperature
 

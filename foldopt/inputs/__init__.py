@@ -4,8 +4,9 @@ profile's day read before validation), ranges, lists and plans of many cases
 (:mod:`~foldopt.inputs.plan`), the pydantic models of a study (:mod:`~foldopt.inputs.study`,
 :mod:`~foldopt.inputs.sections`; they validate and open no files), the policy of what a study
 becomes when a user changes fields, weather files (:mod:`~foldopt.inputs.weather`: one reader per
-format and a registry of them), load profiles, the land mask and the sizing's constants. All file
+format and a registry of them), load profiles, lists of sites (:mod:`~foldopt.inputs.sites`), the land mask
+and the sizing's constants. All file
 reading of a request happens here, before a study runs. It may import :mod:`foldopt.physics` (for
 model names, the tracker registry and default orientations) and the leaves (:mod:`foldopt.errors`,
-:mod:`foldopt.names`, :mod:`foldopt.files`).
+:mod:`foldopt.names`, :mod:`foldopt.files`, :mod:`foldopt.cache`).
 """

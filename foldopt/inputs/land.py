@@ -3,8 +3,8 @@
 The source is the ``global-land-mask`` package (NOAA's GLOBE 30-arc-second land mask, 1 km),
 shipped with it, so nothing is downloaded. The full mask is 930 MB in memory and takes seconds to
 load; foldopt keeps a 5-arc-minute land fraction of it (each cell's share of land pixels) in its
-cache folder (:func:`foldopt.files.cache_dir`), built once and written atomically with a
-checksum (:func:`foldopt.files.store_cache`): a damaged cache is built again.
+cache folder (:func:`foldopt.cache.cache_dir`), built once and written atomically with a
+checksum (:func:`foldopt.cache.store_cache`): a damaged cache is built again.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def land_fraction() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ImportError
         Without the ``global-land-mask`` package (``pip install foldopt[map]``).
     """
-    from foldopt.files import cache_dir, load_cache, store_cache
+    from foldopt.cache import cache_dir, load_cache, store_cache
 
     path = cache_dir() / f"land-fraction-{_FACTOR}.npz"
     stored = load_cache(path)

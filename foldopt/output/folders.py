@@ -282,7 +282,7 @@ def write_map_report(result, figures: list[str], answer) -> Path:
     figures : list of str
         The figures' file names (:func:`map_figures`), in order.
     answer : foldopt.Answer
-        The map's answer (:func:`foldopt.studies.answer.of_map`).
+        The map's answer (:func:`foldopt.studies.answering.of_map`).
 
     Returns
     -------

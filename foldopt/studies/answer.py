@@ -6,29 +6,36 @@ angle and its t_solar; for an annual objective its value per design and, for ``w
 re-fold schedule each visit's date and fold angle and what it adds), the designs compared, the near-optimal
 range of the fold angle with the recommended angle at its centre, and notes that name the design they concern.
 The terminal's lines (:meth:`Answer.lines`), ``--format json`` (:meth:`Answer.to_dict`), ``report.html`` and
-``result.answer`` in a notebook all show this one object.
+``result.answer`` in a notebook all show this one object; :mod:`foldopt.studies.answering` makes it
+of each kind of result.
 """
 
 from __future__ import annotations
 
-import calendar
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import pandas as pd
 
-#: The designs an answer compares, first the ones every study has.
-MAIN_DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
-NEAR_OPTIMAL = ("near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg", "near_optimal_tolerance_h")
 
+def plain(value):
+    """JSON-ready: None for NaN, Python numbers for numpy's, text for dates.
 
-def _plain(value):
-    """JSON-ready: None for NaN, Python numbers for numpy's, text for dates."""
+    Parameters
+    ----------
+    value : object
+        A number, a date, text, or a dict, list or tuple of them (nested).
+
+    Returns
+    -------
+    object
+        ``value`` with dict keys as text, tuples as lists, dates in ISO format, numpy scalars as
+        Python's, and NaN and infinities as None.
+    """
     if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
+        return {str(k): plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [plain(v) for v in value]
     if hasattr(value, "isoformat"):
         return value.isoformat()
     if hasattr(value, "item"):
@@ -39,16 +46,18 @@ def _plain(value):
 
 
 def records(table: pd.DataFrame | None) -> list[dict]:
-    """A table's rows as JSON-ready records (NaN as null, numbers exact); none for None."""
-    return [] if table is None else [_plain(row) for row in table.to_dict(orient="records")]
+    """A table's rows as JSON-ready records (NaN as null, numbers exact); none for None.
 
+    Parameters
+    ----------
+    table : pandas.DataFrame or None
 
-def _hours(value) -> str:
-    return "-" if value is None or value != value else f"{value:.2f} h"
-
-
-def _pct(value, signed: bool = True) -> str:
-    return "-" if value is None or value != value else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
+    Returns
+    -------
+    list of dict
+        One :func:`plain` dict per row, column to value.
+    """
+    return [] if table is None else [plain(row) for row in table.to_dict(orient="records")]
 
 
 @dataclass(frozen=True)
@@ -103,10 +112,10 @@ class Answer:
 
     def to_dict(self) -> dict:
         """The answer as JSON-ready data (NaN as null)."""
-        return {"kind": self.kind, "title": self.title, "question": _plain(self.question),
-                "defaults": self.defaults, "result": _plain(self.result), "designs": records(self.designs),
+        return {"kind": self.kind, "title": self.title, "question": plain(self.question),
+                "defaults": self.defaults, "result": plain(self.result), "designs": records(self.designs),
                 "near_optimal": records(self.near_optimal), "schedule": records(self.schedule),
-                "notes": _plain(self.notes), "lines": self.lines()}
+                "notes": plain(self.notes), "lines": self.lines()}
 
     def tables(self) -> list[tuple[str, pd.DataFrame]]:
         """The answer's tables with their titles, for a report."""
@@ -116,7 +125,7 @@ class Answer:
 
 
 def note_text(note: dict) -> str:
-    """A note of :func:`design_notes` as text, ``load above peak (tracker:single-axis,
+    """A note of :func:`~foldopt.studies.answering.design_notes` as text, ``load above peak (tracker:single-axis,
     tracker:single-axis-net)``; the designs are left out where a note concerns every design.
 
     Parameters
@@ -127,369 +136,3 @@ def note_text(note: dict) -> str:
     where = f" ({', '.join(designs)})" if designs else ""
     cases = f" in {note['cases']} of {note['of']} cases" if note.get("cases") is not None else ""
     return f"{note['note']}{where}{cases}"
-
-
-def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dict]:
-    """Each note of a table's ``note`` column with the designs it concerns (none where it concerns
-    them all) and, for sweeps, in how many cases.
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        With ``design`` and ``note`` columns.
-    case_count : int, optional
-        A sweep's number of cases; None for one case.
-    """
-    if "note" not in table or not len(table):
-        return []
-    exploded = table.assign(note=table["note"].astype(str).str.split("; ")).explode("note")
-    exploded = exploded[exploded["note"] != ""]
-    every = set(table["design"])
-    notes = []
-    for note, rows in exploded.groupby("note", sort=True):
-        designs = list(dict.fromkeys(rows["design"]))
-        entry = {"note": note, "designs": [] if set(designs) == every else designs}
-        if case_count is not None:
-            keys = [c for c in rows.columns if c in ("site_name", "latitude", "longitude", "date", "p_load_w")]
-            entry.update(cases=int(len(rows.drop_duplicates(keys))) if keys else len(rows), of=case_count)
-        notes.append(entry)
-    return notes
-
-
-def study_question(study, varied: tuple = ()) -> dict:
-    """What a study asks, label to text; the config paths in ``varied`` are said to vary.
-
-    Parameters
-    ----------
-    study : Study
-    varied : tuple of str, default ()
-    """
-    from foldopt.inputs.loads import load_text
-
-    study = study.resolved()
-    site = study.site
-    where = f"{site.name + ', ' if site.name else ''}{site.latitude:g}, {site.longitude:g} ({site.timezone})"
-    panel = study.panel
-    tolerance = study.near_optimal
-    question = {
-        "site": "varies (see the table)" if {"site", "site.latitude", "site.longitude"} & set(varied) else where,
-        "day": "varies (see the table)" if "date" in varied else study.date.isoformat(),
-        "load": "varies (see the table)" if "p_load" in varied else load_text(study),
-        "panel": f"{panel.area:g} m^2, efficiency {panel.efficiency:g}, tilt {panel.tilt:g} deg, azimuth "
-                 f"{panel.azimuth:g} deg" + (" (per latitude)" if "site.latitude" in varied else ""),
-        "models": f"{study.mode} mode, {study.geometry} geometry, {study.pv_model} PV model, {study.connection}, "
-                  + (f"weather {Path(study.weather.path).name}" if study.weather else f"{study.sky} sky"),
-        "fold angles": f"{study.fold_angles.start:g} to {study.fold_angles.stop:g} deg by {study.fold_angles.step:g}",
-        "near-optimal": f"within {100 * tolerance.fraction:g} % or {tolerance.minutes:g} min of the best, "
-                        "whichever is larger",
-        "objective": "t_solar of the day",
-    }
-    if study.objective is not None and "date" in varied:
-        objective = study.objective
-        season = f" of months {', '.join(map(str, objective.months))}" if objective.months else ""
-        question["objective"] = (f"one fold angle for all days, maximising the {objective.statistic} of daily "
-                                 f"t_solar{season}" + (f"; re-fold schedules of up to {objective.visits} settings"
-                                                       if objective.visits else ""))
-    return question
-
-
-def _range_text(row) -> str:
-    lo, hi, recommended = (row.get(key) for key in NEAR_OPTIMAL[:3])
-    if lo is None or lo != lo:
-        return "near-optimal: no fold angle carries the load"
-    return (f"near-optimal {lo:g} to {hi:g} deg (within {60 * row['near_optimal_tolerance_h']:.1f} min); "
-            f"recommended {recommended:g} deg")
-
-
-def of_study(result) -> Answer:
-    """The answer of one day's study (:class:`foldopt.studies.day.StudyResult`)."""
-    from foldopt.inputs.loads import describe_load, load_text
-
-    study, summary = result.study, result.summary
-    by = summary.set_index("design")
-    twofold = by.loc["twofold"]
-    near = dict(result.near_optimal)
-    recommended = near["recommended_fold_angle_deg"]
-    sweep = result.sweep.set_index("fold_angle_deg")["t_solar_h"]
-    near["recommended_t_solar_h"] = float(sweep.loc[recommended]) if recommended == recommended else float("nan")
-    near_table = pd.DataFrame([near])
-    heuristic = result.heuristic_fold_angle
-    result_part = {
-        "objective": "t_solar of the day", "load": describe_load(study),
-        "fold_angle_deg": result.optimal_fold_angle, "t_solar_h": float(twofold["t_solar_h"]),
-        "heuristic_fold_angle_deg": heuristic, "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
-        "pct_of_tracker": float(twofold["pct_of_tracker"]), "flat_area_multiple": float(twofold["flat_area_multiple"]),
-        "tracker_break_even_standby_w": float(result.standby[1]), **near,
-        "t_solar_by_design_h": {d: float(by.loc[d, "t_solar_h"]) for d in MAIN_DESIGNS},
-    }
-    site = study.site
-    where = site.name or f"{site.latitude:g}, {site.longitude:g}"
-    lines = [f"{study.name}: {where}, {study.date}, {load_text(study)} ({study.mode} mode, {study.pv_model} + "
-             f"{study.connection})"]
-    hours = result_part["t_solar_by_design_h"]
-    if not hours["twofold"]:
-        lines.append(f"no fold angle reaches the load: t_solar 0 h (flat {_hours(hours['flat'])}, tracker "
-                     f"{_hours(hours['tracker'])})")
-    else:
-        lines.append(f"best fold angle {result.optimal_fold_angle:.1f} deg"
-                     + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic == heuristic else "")
-                     + f": t_solar {_hours(hours['twofold'])}, {_pct(twofold['gain_vs_flat_pct'])} over flat "
-                     f"({_hours(hours['flat'])}), {_pct(twofold['pct_of_tracker'], False)} of the tracker's "
-                     f"{_hours(hours['tracker'])}")
-        lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
-    extras = []
-    if twofold["flat_area_multiple"] == twofold["flat_area_multiple"]:
-        extras.append(f"a flat panel would need {twofold['flat_area_multiple']:.2f}x the area")
-    if result.standby[1] == result.standby[1]:
-        extras.append(f"the twofold panel outlasts the tracker once its standby draw exceeds "
-                      f"{result.standby[1]:.2f} W")
-    if extras:
-        lines.append("; ".join(extras))
-    columns = ["design", "fold_angle_deg", "t_solar_h", "energy_harvested_wh", "gain_vs_flat_pct", "pct_of_tracker",
-               "note"]
-    return Answer("study", study.name, study_question(study), _defaults(result), result_part,
-                  summary[columns], near_table, pd.DataFrame(), design_notes(summary), tuple(lines))
-
-
-def _defaults(result) -> dict | None:
-    request = getattr(result, "request", None)
-    return request.defaults if request is not None else None
-
-
-def of_sweep(result) -> Answer:
-    """The answer of a plan of cases or of an annual objective (:class:`foldopt.studies.sweeps.SweepResult`)."""
-    if "annual_objective" in result.extras:
-        return _of_annual(result)
-    from foldopt.inputs.loads import describe_load
-
-    plan, table = result.plan, result.table
-    twofold = table[table["design"] == "twofold"]
-    gains = twofold["gain_vs_flat_pct"].dropna()
-    axes = " x ".join(f"{len(values)} {path.split('.')[-1]}" for path, values in plan.axes)
-    lines = [f"{plan.base.name}: {plan.n_cases} cases ({axes})"]
-    part = {"cases": plan.n_cases, "axes": {path: len(values) for path, values in plan.axes},
-            "load": describe_load(plan.base),
-            "fold_angle_deg": {"min": twofold["fold_angle_deg"].min(), "max": twofold["fold_angle_deg"].max()},
-            "recommended_fold_angle_deg": {"min": twofold["recommended_fold_angle_deg"].min(),
-                                           "max": twofold["recommended_fold_angle_deg"].max()}}
-    if len(gains):
-        best = twofold.loc[gains.idxmax()]
-        at = {column: best[column] for column in result.varied if column in best and column != "day_of_year"}
-        part["gain_vs_flat_pct"] = {"median": gains.median(), "max": gains.max(), "at": at}
-        where = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
-                          for key, value in at.items())
-        lines.append(f"twofold over flat: median {_pct(gains.median())}, best {_pct(gains.max())} ({where}); "
-                     f"fold angles {part['fold_angle_deg']['min']:g} to {part['fold_angle_deg']['max']:g} deg")
-    rec = part["recommended_fold_angle_deg"]
-    if rec["min"] == rec["min"]:
-        lines.append(f"recommended fold angles (centres of each case's near-optimal range) {rec['min']:g} to "
-                     f"{rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the table)")
-    keys = [c for c in ("site_name", "latitude", "longitude", "date", "p_load_w", *result.varied) if c in table]
-    near = twofold[list(dict.fromkeys(keys)) + ["fold_angle_deg", *NEAR_OPTIMAL]].reset_index(drop=True)
-    designs = table[[c for c in (*dict.fromkeys(keys), "design", "fold_angle_deg", "t_solar_h", "energy_harvested_wh",
-                                 "gain_vs_flat_pct", "pct_of_tracker", "note") if c in table]]
-    question = study_question(plan.base, tuple(path for path, _ in plan.axes))
-    question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
-    return Answer("sweep", plan.base.name, question, _defaults(result), _plain(part), designs, near, pd.DataFrame(),
-                  design_notes(table, plan.n_cases), tuple(lines))
-
-
-def _of_annual(result) -> Answer:
-    """One fold angle over many days: the objective per design in its own terms, the near-optimal
-    range of the angle kept all year, the re-fold schedules."""
-    from foldopt.inputs.loads import describe_load, load_text
-
-    plan = result.plan
-    study = plan.base
-    objective = study.objective
-    statistic = objective.statistic
-    objectives = result.extras["annual_objective"]
-    keys = [c for c in objectives.columns if c not in ("design", "objective", "objective_h", "worst_month",
-                                                       "mean_t_solar_h", "fold_angle_deg", *NEAR_OPTIMAL)]
-    lines = [f"{study.name}: {len(_dates(plan))} days, one fold angle all year, maximising the {statistic} of "
-             f"daily t_solar"]
-    groups = list(objectives.groupby(keys, sort=False))
-    part = {"objective": statistic, "load": describe_load(study), "per_case": []}
-    schedule = _schedule(result.extras)
-    for key, rows in groups[:8]:
-        by = rows.set_index("design")
-        twofold, flat, tracker = by.loc["twofold"], by.loc["flat"], by.loc["tracker"]
-        where = dict(zip(keys, key if isinstance(key, tuple) else (key,), strict=True))
-        load = where.get("p_load_w")
-        case = {**where, "fold_angle_deg": twofold["fold_angle_deg"],
-                "objective_h": {d: by.loc[d, "objective_h"] for d in MAIN_DESIGNS},
-                "mean_t_solar_h": {d: by.loc[d, "mean_t_solar_h"] for d in MAIN_DESIGNS},
-                **{k: twofold[k] for k in NEAR_OPTIMAL}}
-        month = ""
-        if statistic == "worst-month":
-            case["worst_month"] = {d: int(by.loc[d, "worst_month"]) for d in MAIN_DESIGNS}
-            month = f" (in {calendar.month_name[case['worst_month']['twofold']]})"
-        part["per_case"].append(case)
-        gain = 100.0 * (twofold["objective_h"] / flat["objective_h"] - 1.0) if flat["objective_h"] > 0 else float("nan")
-        flat_month = (f" in {calendar.month_name[case['worst_month']['flat']]}" if statistic == "worst-month" else "")
-        label = load_text(study, load)
-        site = where.get("site_name") or (f"{where['latitude']:g}, {where['longitude']:g}"
-                                         if len(groups) > 1 and "latitude" in where else "")
-        lines.append(f"{site + ': ' if site else ''}{label}: fold angle {twofold['fold_angle_deg']:g} deg all year; "
-                     f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, {_pct(gain)} over flat "
-                     f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}"
-                     + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"))
-        lines.append("  " + _range_text(twofold.to_dict()))
-        if len(schedule):
-            mine = schedule[(schedule["p_load_w"] == load)] if load is not None else schedule
-            for settings, visits in mine.groupby("settings", sort=True):
-                first = visits.iloc[0]
-                when = ", ".join(f"{v.date} at {v.fold_angle_deg:g} deg" for v in visits.itertuples())
-                added = "" if settings == 1 else f" (+{first['added_by_setting_h'] * 60:.1f} min)"
-                lines.append(f"  {settings} setting{'s' if settings > 1 else ''}: {statistic} t_solar "
-                             f"{_hours(first['objective_h'])}{added}: {when}")
-    if len(groups) > 8:
-        lines.append(f"... and {len(groups) - 8} more cases (annual_objective.csv)")
-    designs = objectives[[*keys, "design", "objective", "objective_h", "worst_month", "mean_t_solar_h",
-                          "fold_angle_deg"]]
-    if statistic != "worst-month":
-        designs = designs.drop(columns="worst_month")
-    twofold_rows = objectives[objectives["design"] == "twofold"]
-    near = twofold_rows[[*keys, "fold_angle_deg", *NEAR_OPTIMAL]].reset_index(drop=True)
-    question = study_question(study, tuple(path for path, _ in plan.axes))
-    question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
-    return Answer("annual", study.name, question, _defaults(result), _plain(part), designs, near, schedule,
-                  design_notes(result.table, plan.n_cases), tuple(lines))
-
-
-def _dates(plan) -> tuple:
-    return dict(plan.axes).get("date", (plan.base.date,))
-
-
-def _schedule(extras: dict) -> pd.DataFrame:
-    """Each re-fold visit with its schedule's objective and what its last setting adds."""
-    if "refold_schedule" not in extras:
-        return pd.DataFrame()
-    visits, values = extras["refold_schedule"], extras["refold_value"]
-    keys = [c for c in visits.columns if c not in ("visit", "date", "fold_angle_deg")]
-    merged = visits.merge(values[[*keys, "objective", "objective_h", "added_by_setting_h", "gain_vs_fixed_pct"]],
-                          on=keys, how="left")
-    return merged
-
-
-def of_sizing(table: pd.DataFrame, best: pd.DataFrame, study, parameters: dict, defaults: dict | None) -> Answer:
-    """The answer of a panel sizing: :func:`foldopt.studies.sizing.size_panel`'s ``table`` and its ``best``
-    row per design, with the ``parameters`` used (costs, ``c_grid_usd_per_kwh``, ``years``).
-
-    Parameters
-    ----------
-    table, best : pandas.DataFrame
-    study : Study
-    parameters, defaults : dict
-        ``defaults``: what was taken from the study (:attr:`Answer.defaults`), or None.
-    """
-    cost = (f"{parameters['cost_per_m2']:g} $/m^2" if parameters.get("cost_per_w") is None
-            else f"{parameters['cost_per_w']:g} $/W")
-    lines = [f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid "
-             f"{parameters['c_grid_usd_per_kwh']:g} $/kWh over {parameters['years']:g} years"]
-    for row in best.itertuples():
-        angle = "" if row.design == "flat" else f", folded to {row.fold_angle_deg:g} deg"
-        lines.append(f"  {row.design}: {row.area_m2:.3f} m^2{angle}, t_solar {row.t_solar_h:.2f} h, "
-                     f"net ${row.net_benefit_usd:.1f}")
-    question = {**study_question(study),
-                "sizing": ", ".join(f"{k} {v:g}" for k, v in parameters.items() if v is not None)}
-    return Answer("size", study.name, question, defaults, _plain({**parameters, "best": records(best)}), best,
-                  pd.DataFrame(), pd.DataFrame(), [], tuple(lines))
-
-
-def of_reproduction(tables: dict, study) -> Answer:
-    """Shin et al.'s published values beside foldopt's: the ``tables`` of
-    :func:`foldopt.studies.reproduce.reproduce` by file stem, for the paper's ``study``."""
-    lines = []
-    for name, table in tables.items():
-        model = "ideal PV model" if name == "reproduction" else "A-300 single-diode cells with switching"
-        lines.append(f"Shin et al. ({model}): paper value | paper mode | exact mode")
-        for row in table.itertuples():
-            paper = "-" if row.paper != row.paper else f"{row.paper:g}"
-            lines.append(f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  "
-                         f"{row.unit}")
-    combined = pd.concat([table.assign(table=name) for name, table in tables.items()], ignore_index=True)
-    return Answer("reproduce", "Shin et al. reproduced", study_question(study), None,
-                  {name: records(table) for name, table in tables.items()}, combined, pd.DataFrame(), pd.DataFrame(),
-                  [], tuple(lines))
-
-
-def _count(number: int, noun: str) -> str:
-    return f"{number} {noun}{'' if number == 1 else 's'}"
-
-
-def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
-    """The answer of a map of many sites: per load, over the sites, where folding pays in the year and
-    the recommended fold angles.
-
-    Parameters
-    ----------
-    result : foldopt.studies.cluster.MapRun
-    relative : bool
-        Loads as fractions of each site's flat peak (``p_load_fraction``), else in W.
-    defaults : dict, optional
-    """
-    table, spec = result.table, result.spec
-    study = spec.study
-    year = table[table["period"] == "year"]
-    key = "p_load_fraction" if relative else "p_load_w"
-    per_load = []
-    for load, rows in year.groupby(key, sort=True):
-        gain = rows["gain_vs_flat_pct"]
-        best = rows.loc[gain.idxmax()] if gain.notna().any() else None
-        per_load.append({
-            key: float(load), "sites": int(len(rows)), "sites_folding_pays": int((gain > 0.05).sum()),
-            "median_gain_vs_flat_pct": gain.median(), "best_gain_vs_flat_pct": gain.max(),
-            "best_site": None if best is None else {"site_name": best["site_name"], "latitude": best["latitude"],
-                                                    "longitude": best["longitude"]},
-            "fold_angle_deg": {"min": rows["fold_angle_deg"].min(), "median": rows["fold_angle_deg"].median(),
-                               "max": rows["fold_angle_deg"].max()},
-            "recommended_fold_angle_deg": {"min": rows["recommended_fold_angle_deg"].min(),
-                                           "median": rows["recommended_fold_angle_deg"].median(),
-                                           "max": rows["recommended_fold_angle_deg"].max()},
-            "median_near_optimal_width_deg": (rows["near_optimal_hi_deg"] - rows["near_optimal_lo_deg"]).median(),
-            "median_pct_of_tracker": rows["pct_of_tracker"].median(),
-            "median_tracker_break_even_standby_w": rows["tracker_break_even_standby_w"].median(),
-        })
-    part = _plain({"sites": int(table["site_id"].nunique()), "objective": study["objective"]["statistic"],
-                   "loads": per_load, "cluster": result.cluster, "dashboard": result.dashboard,
-                   "chunks_computed": len(result.computed), "chunks_from_disk": len(result.from_disk),
-                   "seconds": round(result.seconds, 2)})
-    sky = "weather files" if any("weather" in site for site in spec.sites) else "Ineichen clear sky" if study.get(
-        "sky") == "ineichen" else f"{study.get('sky')} sky"
-    lines = [f"map: {_count(part['sites'], 'site')}, year {spec.year}, {sky}, objective {part['objective']}, "
-             f"{study['panel']['area']:g} m^2 panel"]
-    for load in part["loads"]:
-        what = (f"P_load {load['p_load_fraction']:g} x flat peak" if relative else f"P_load {load['p_load_w']:g} W")
-        best = load["best_site"]
-        where = "" if best is None else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
-        rec = load["recommended_fold_angle_deg"]
-        standby = load["median_tracker_break_even_standby_w"]
-        tracker = ("" if standby is None else ", whose own moves already cost it its lead" if standby == 0
-                   else f", which loses its lead above a median {standby:.2f} W of standby")
-        best_angles = load["fold_angle_deg"]
-        rec_text = ("no fold angle carries the load" if rec["min"] is None else
-                    f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended "
-                    f"{rec['min']:g} to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
-                    f"{load['median_near_optimal_width_deg']:g} deg wide)")
-        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')} "
-                     f"(median {_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} "
-                     f"at {where}); {rec_text}; median {_pct(load['median_pct_of_tracker'], False)} of the "
-                     f"tracker{tracker}")
-    rate = len(spec.sites) / part["seconds"] if part["seconds"] else 0
-    computed = (f"computed {_count(part['chunks_computed'], 'chunk')} on {part['cluster']}" if part["chunks_computed"]
-                else "nothing to compute")
-    resumed = f", {part['chunks_from_disk']} from disk" if part["chunks_from_disk"] else ""
-    lines.append(f"{computed}{resumed} in {part['seconds']:.1f} s ({rate:.1f} sites/s)")
-    loads = ", ".join(f"{load:g}" for load in spec.loads)
-    question = {
-        "sites": f"{len(spec.sites):,}",
-        "loads": f"{loads} {'x each site' + chr(39) + 's flat peak' if relative else 'W'}",
-        "year": str(spec.year),
-        "panel": f"{study['panel']['area']:g} m^2 facing the equator at |latitude|",
-        "objective": part["objective"],
-        "models": f"{study.get('mode')} mode, {study.get('pv_model', 'ideal')} PV model, {sky}",
-    }
-    columns = ["site_id", "site_name", "latitude", "longitude", key, "fold_angle_deg", *NEAR_OPTIMAL]
-    return Answer("map", "map", question, defaults, part, year[[c for c in year.columns if c not in NEAR_OPTIMAL]],
-                  year[columns].reset_index(drop=True), pd.DataFrame(), [], tuple(lines))

@@ -12,7 +12,8 @@ nothing with it: Dask runs its chunks elsewhere, and a part is written once per 
 
 Without a scheduler address the work goes to an embedded :class:`distributed.LocalCluster`, one single-threaded
 worker process per core; with one, to that cluster (``dask scheduler`` and ``dask worker`` by hand,
-dask-jobqueue, Kubernetes...). Each task runs the compiled kernel on one thread: the parallelism is Dask's.
+dask-jobqueue, Kubernetes...), reached through :mod:`foldopt.studies.dask_client`. Each task runs the compiled
+kernel on one thread: the parallelism is Dask's.
 """
 
 from __future__ import annotations
@@ -20,14 +21,9 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import logging
-import os
 import shutil
-import socket
 import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,6 +32,7 @@ import pandas as pd
 from foldopt.errors import ConfigError, OutputError
 from foldopt.files import (DiskFullError, check_output, clear_leftovers, commit, discard, is_full, new_staging,
                            tree_size, versions, write_atomically, writer_lock)
+from foldopt.studies.dask_client import CONNECT_TIMEOUT, connect
 
 #: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
 #: about a millisecond), short enough that a lost worker loses little and progress moves.
@@ -44,11 +41,6 @@ CHUNK_SECONDS = 5.0
 #: trackers, break-even search), measured on W4 (``bench/map.py``).
 SECONDS_PER_EVALUATION = 13e-9
 PARTS = "parts"
-#: Seconds to wait for a cluster's scheduler and its first worker.
-CONNECT_TIMEOUT = 30
-#: Seconds a scheduler has to answer foldopt's first message: Dask answers in milliseconds, while
-#: a server of another kind may never answer.
-HANDSHAKE_TIMEOUT = 5.0
 #: Key of the map's digest (:attr:`MapSpec.key`) in the metadata of its Parquet files.
 MAP_KEY = b"foldopt.map_key"
 
@@ -136,7 +128,19 @@ class MapRun:
 
 
 def evaluate_chunk(study: dict, sites: list, loads: list, relative: bool, year: int, engine: str) -> pd.DataFrame:
-    """The task of one chunk, run on a worker: :func:`foldopt.studies.worldmap.evaluate_sites` on one thread."""
+    """The task of one chunk, run on a worker: :func:`foldopt.studies.worldmap.evaluate_sites` on one thread.
+
+    Parameters
+    ----------
+    study, sites, loads, relative, year, engine
+        As :func:`~foldopt.studies.worldmap.evaluate_sites` takes them (:class:`MapSpec`'s fields;
+        ``sites`` the chunk's).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The chunk's rows, per site, load and period.
+    """
     import numba
 
     from foldopt.studies.worldmap import evaluate_sites
@@ -199,7 +203,28 @@ def map_folder(out: Path, resume: bool, overwrite: bool) -> Path:
     """The folder to build the map in: ``out`` itself to resume the map there or where there is none, so that a
     killed run leaves a folder that a later ``resume`` recognises; a staging folder beside ``out`` where the map
     replaces one (``overwrite``), so that the earlier folder stays whole until the new one is complete
-    (:func:`foldopt.files.commit`)."""
+    (:func:`foldopt.files.commit`).
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The map's results folder.
+    resume : bool
+        Finish the map in ``out`` where it has a ``run.json``.
+    overwrite : bool
+        Replace ``out`` (a folder foldopt wrote).
+
+    Returns
+    -------
+    pathlib.Path
+        ``out``, or a staging folder beside it.
+
+    Raises
+    ------
+    foldopt.errors.OutputError
+        Where ``out`` exists and neither ``resume`` nor ``overwrite`` is given, or cannot take the
+        map (:func:`foldopt.files.check_output`).
+    """
     out = Path(out)
     if resume and (out / "run.json").exists():
         return out
@@ -212,7 +237,25 @@ def map_folder(out: Path, resume: bool, overwrite: bool) -> Path:
 def prepare_folder(folder: Path, spec: MapSpec, metadata: dict) -> list[int]:
     """Make ``folder`` (:func:`map_folder`) ready for the map and return the chunks already done
     there. A new map starts with ``run.json`` (status ``running``) and ``sites.csv``; a folder
-    with a ``run.json`` is resumed, and refused if it holds another map."""
+    with a ``run.json`` is resumed, and refused if it holds another map.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+    spec : MapSpec
+    metadata : dict
+        What ``run.json`` holds beside its status.
+
+    Returns
+    -------
+    list of int
+        The indices of the chunks whose parts are on disk (none for a new map).
+
+    Raises
+    ------
+    foldopt.errors.OutputError
+        Where ``folder`` holds another map (its :attr:`MapSpec.key` differs).
+    """
     if (folder / "run.json").exists():
         return _resumable(folder, spec, metadata)
     (folder / PARTS).mkdir(parents=True)
@@ -246,123 +289,6 @@ def _write_json(path: Path, data: dict) -> None:
     write_atomically(path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n"))
 
 
-@contextmanager
-def connect(scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
-    """A Dask client: of the cluster at ``scheduler`` (``tcp://host:port`` or a scheduler file), or of an
-    embedded :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default one per core).
-    Yields ``(client, description)``; raises :class:`ConfigError` when no scheduler with a worker answers within
-    ``timeout`` [s], at once where the port refuses, and within :data:`HANDSHAKE_TIMEOUT` where what listens is
-    not a Dask scheduler."""
-    from distributed import Client, LocalCluster
-
-    if scheduler is None:
-        count = workers or os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
-                               dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
-        try:
-            with Client(cluster) as client:
-                yield client, f"embedded LocalCluster, {count} worker process{'es' if count > 1 else ''}"
-        finally:
-            cluster.close()
-        return
-    address = scheduler_address(scheduler)
-    check_scheduler(scheduler, address, timeout)
-    try:
-        client = Client(address, timeout=timeout)
-    except (OSError, TimeoutError, ValueError) as error:
-        raise ConfigError([_no_answer(scheduler, timeout, error.__class__.__name__)]) from None
-    try:
-        try:
-            client.wait_for_workers(1, timeout=timeout)
-        except TimeoutError:
-            raise ConfigError([f"--scheduler = {scheduler!r}: the scheduler has no worker after {timeout:g} s; start "
-                               "some with `dask worker ADDRESS`"]) from None
-        yield client, f"Dask scheduler {client.scheduler.address}"
-    finally:
-        client.close()
-
-
-def _no_answer(scheduler: str, timeout: float, reason: str) -> str:
-    return (f"--scheduler = {scheduler!r}: no Dask scheduler answers there within {timeout:g} s ({reason}); start one "
-            "with `dask scheduler`")
-
-
-def scheduler_address(scheduler: str) -> str:
-    """The address ``scheduler`` gives: itself, or the ``address`` of the scheduler file it names
-    (:class:`ConfigError` naming the file where it holds none).
-
-    Parameters
-    ----------
-    scheduler : str
-        ``tcp://host:port`` or the path of a scheduler file.
-    """
-    path = Path(scheduler)
-    if not path.is_file():
-        return scheduler
-    try:
-        text = path.read_text()
-        data = json.loads(text) if text.strip() else {}
-    except OSError as error:
-        raise ConfigError([_not_a_file(scheduler, error.strerror or str(error))]) from None
-    except ValueError as error:  # UnicodeDecodeError too
-        raise ConfigError([_not_a_file(scheduler, f"not JSON: {error}")]) from None
-    address = data.get("address") if isinstance(data, dict) else None
-    if not isinstance(address, str) or not address:
-        raise ConfigError([_not_a_file(scheduler, 'it has no "address"' if text.strip() else "it is empty")])
-    return address
-
-
-def _not_a_file(scheduler: str, reason: str) -> str:
-    return (f"--scheduler = {scheduler!r}: not a Dask scheduler file ({reason}); `dask scheduler --scheduler-file "
-            "FILE` writes one")
-
-
-def check_scheduler(scheduler: str, address: str, timeout: float) -> None:
-    """Raise :class:`ConfigError` unless a Dask scheduler answers at ``address`` (from
-    ``scheduler``): Dask's client retries a refused port until its timeout and waits without end
-    for the greeting of a server that says nothing, so both are asked here first, in bounded time."""
-    from distributed.comm import parse_address, parse_host_port
-
-    try:
-        scheme, location = parse_address(address)
-        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
-    except ValueError as error:
-        raise ConfigError([f"--scheduler = {scheduler!r}: neither an existing scheduler file nor an "
-                           f"address like tcp://host:8786 ({error})"]) from None
-    seconds = min(timeout, HANDSHAKE_TIMEOUT)
-    if host is not None:
-        try:
-            socket.create_connection((host, port), timeout=seconds).close()
-        except OSError as error:
-            raise ConfigError([_no_answer(scheduler, timeout, error.strerror or error.__class__.__name__)]) from None
-    identity = _identity(address, seconds)
-    if not (isinstance(identity, dict) and identity.get("type") == "Scheduler"):
-        raise ConfigError([f"--scheduler = {scheduler!r}: what listens at {address} is not a Dask scheduler (no Dask "
-                           f"answer within {seconds:g} s); give the scheduler's address or its scheduler file"])
-
-
-def _identity(address: str, seconds: float):
-    """What the Dask server at ``address`` says it is, or None where no Dask answer comes within
-    ``seconds``. Runs on a thread of its own, so that a caller's event loop (a notebook's) does
-    not matter."""
-    import asyncio
-
-    from distributed.comm import connect as open_comm
-    from distributed.security import Security
-
-    async def ask():
-        comm = await open_comm(address, timeout=seconds, **Security().get_connection_args("client"))
-        try:
-            await comm.write({"op": "identity", "reply": True})
-            return await comm.read()
-        finally:
-            comm.abort()
-
-    with ThreadPoolExecutor(1) as pool:
-        try:
-            return pool.submit(asyncio.run, asyncio.wait_for(ask(), seconds)).result()
-        except Exception:  # whatever a server that is not Dask's sends (garbage can fail in many ways)
-            return None
 
 
 def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: int | None = None,

@@ -221,7 +221,7 @@ class StudyResult:
     @functools.cached_property
     def answer(self):
         """The :class:`foldopt.studies.answer.Answer` every view of this result renders."""
-        from foldopt.studies.answer import of_study
+        from foldopt.studies.answering import of_study
 
         return of_study(self)
 

@@ -49,7 +49,7 @@ class Reproduction:
     @functools.cached_property
     def answer(self):
         """The :class:`foldopt.studies.answer.Answer` every view renders."""
-        from foldopt.studies.answer import of_reproduction
+        from foldopt.studies.answering import of_reproduction
 
         return of_reproduction(self.tables, self.study)
 

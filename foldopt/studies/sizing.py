@@ -59,7 +59,7 @@ class SizingResult:
 
     @functools.cached_property
     def answer(self):
-        from foldopt.studies.answer import of_sizing
+        from foldopt.studies.answering import of_sizing
 
         return of_sizing(self.table, self.best, self.study, self.parameters,
                          self.request.defaults if self.request is not None else None)

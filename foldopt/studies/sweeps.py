@@ -41,7 +41,7 @@ class SweepResult:
     @functools.cached_property
     def answer(self):
         """The :class:`foldopt.studies.answer.Answer` every view of this result renders."""
-        from foldopt.studies.answer import of_sweep
+        from foldopt.studies.answering import of_sweep
 
         return of_sweep(self)
 

@@ -1,8 +1,8 @@
 """Many-site studies: where in the world a folded panel pays, for which loads, in which season.
 
 A map is one study (panel, PV and electrical models, tracker, objective) evaluated over a whole
-year at every site of a list: a latitude x longitude grid (:func:`grid_sites`), a table of named
-sites (:func:`read_sites`) or a folder of weather files, each file a site (:func:`weather_sites`).
+year at every site of a list (:mod:`foldopt.inputs.sites`): a latitude x longitude grid, a table of
+named sites or a folder of weather files, each file a site.
 Without weather the sky is the study's clear sky (pvlib's Ineichen model with pvlib's monthly
 Linke turbidity climatology for a map). Per site, load and period (the year and the four
 three-month seasons) the table gives the fold angle that maximises the study's objective over the
@@ -20,9 +20,7 @@ the files.
 
 from __future__ import annotations
 
-import csv
 import datetime as dt
-import io
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -33,9 +31,9 @@ import pandas as pd
 from pydantic import ValidationError
 
 from foldopt.engine import rows as engines
-from foldopt.inputs.load import MAX_CSV_BYTES, read_input, resolve_files
+from foldopt.inputs.load import resolve_files
 from foldopt.inputs.plan import parse_dates, parse_values, year_problem
-from foldopt.inputs.sections import Site
+from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, format_errors
 from foldopt.errors import ConfigError
 from foldopt.studies.designs import Blocks, best_angle_index, daily_designs, near_optimal, objective_value
@@ -43,10 +41,6 @@ from foldopt.studies.designs import Blocks, best_angle_index, daily_designs, nea
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
 PERIODS = ("year", *SEASONS)
-#: Weather files a folder of sites may hold, by extension (pvlib's readers).
-WEATHER_SUFFIXES = (".csv", ".epw", ".json")
-#: Columns of a table of named sites; name, latitude and longitude are required.
-SITE_COLUMNS = ("name", "latitude", "longitude", "altitude", "timezone")
 #: Rounds and points per round of the break-even search: the bracket shrinks (points + 1)-fold a
 #: round, so a 20 W tracker's break-even is found to 4e-5 W.
 _BREAK_EVEN_ROUNDS, _BREAK_EVEN_POINTS = 6, 8
@@ -69,10 +63,23 @@ _PER_SITE = ("site", "date", "p_load", "year", "sweep", "weather", "force_site")
 def map_study(data: dict, embedded: bool = True, **changes) -> dict:
     """A map's study (a study's fields but site, date and load) from a study's data.
 
-    ``embedded``: the data is the embedded paper study, whose mode, sky, geometry and step give way
-    to :data:`MAP_DEFAULTS`; a user's own study keeps its own. The panel faces the equator at a
-    tilt of ``|latitude|`` at every site unless ``panel.tilt``/``panel.azimuth`` are in ``changes``;
-    the objective is the mean unless set. ``changes`` are field paths (dotted) to values.
+    The panel faces the equator at a tilt of ``|latitude|`` at every site unless
+    ``panel.tilt``/``panel.azimuth`` are in ``changes``; the objective is the mean unless set.
+
+    Parameters
+    ----------
+    data : dict
+        A study's fields.
+    embedded : bool, default True
+        The data is the embedded paper study, whose mode, sky, geometry and step give way to
+        :data:`MAP_DEFAULTS`; a user's own study keeps its own.
+    **changes
+        Field paths (dotted, ``panel.area``) to values, set last.
+
+    Returns
+    -------
+    dict
+        The map's study, without the fields a map sets per site.
     """
     from foldopt.inputs.policy import set_path
 
@@ -86,85 +93,6 @@ def map_study(data: dict, embedded: bool = True, **changes) -> dict:
     for path, value in changes.items():
         study = set_path(study, path, value)
     return study
-
-
-def grid_sites(latitudes: Sequence[float], longitudes: Sequence[float], land_only: bool = False) -> list[dict]:
-    """Sites at every latitude x longitude [deg], latitude slowest; ``land_only`` keeps the points
-    on land (:func:`foldopt.inputs.land.is_land`). A longitude of 180 is the same meridian as -180 and is
-    dropped when both are given."""
-    longitudes = [lon for lon in longitudes if not (lon == 180 and -180 in longitudes)]
-    sites = [{"latitude": float(lat), "longitude": float(lon)} for lat in latitudes for lon in longitudes]
-    if land_only:
-        from foldopt.inputs.land import is_land
-
-        keep = is_land([s["latitude"] for s in sites], [s["longitude"] for s in sites])
-        sites = [site for site, land in zip(sites, keep, strict=True) if land]
-    return sites
-
-
-def read_sites(path: Path | str) -> list[dict]:
-    """Named sites from a CSV file with a header of :data:`SITE_COLUMNS` (altitude [m] and time zone
-    optional), UTF-8 with or without a byte-order mark, each name at most once. Raises
-    :class:`ConfigError` with the file, line and field of every bad value or row."""
-    path = Path(path)
-    text = read_input(path, "--sites", MAX_CSV_BYTES, "MAX_CSV_BYTES")
-    try:
-        reader = csv.reader(io.StringIO(text, newline=""))
-        header = [name.strip() for name in next(reader, [])]
-        rows = [(reader.line_num, cells) for cells in reader if cells]  # a blank line is no row
-    except csv.Error as error:
-        raise ConfigError([f"--sites: cannot read {path}: {error}"]) from None
-    missing = [name for name in ("latitude", "longitude") if name not in header]
-    unknown = [name[:30] for name in header if name not in SITE_COLUMNS][:5]
-    twice = sorted({name for name in header if header.count(name) > 1})
-    if missing or unknown or twice:
-        raise ConfigError([f"--sites {path}: the header must name {', '.join(SITE_COLUMNS)} (name, altitude and "
-                           f"timezone optional); " + "; ".join(
-                               ([f"missing {', '.join(missing)}"] if missing else [])
-                               + ([f"unknown {', '.join(unknown)}"] if unknown else [])
-                               + ([f"{', '.join(twice)} twice"] if twice else []))])
-    sites, errors, named = [], [], {}
-    for line, cells in rows:
-        if len(cells) > len(header):  # a cell more than the header names: a stray comma, or a shifted row
-            errors.append(f"--sites {path}, line {line}: {len(cells)} fields; the header names {len(header)}")
-            continue
-        data = {key: value.strip() for key, value in zip(header, cells) if value.strip() != ""}
-        try:
-            site = Site.model_validate(data)
-        except ValidationError as error:
-            errors += [f"--sites {path}, line {line}: {message}" for message in format_errors(error)]
-            continue
-        if site.name is not None:
-            if site.name in named:  # the map's rows and figures tell sites by name
-                errors.append(f"--sites {path}, line {line}: name {site.name!r} is also on line {named[site.name]}; "
-                              "give each site its own name")
-                continue
-            named[site.name] = line
-        sites.append(site.model_dump(exclude_none=True))
-    if not sites and not errors:
-        errors.append(f"--sites {path}: no sites (a header and one row per site)")
-    if errors:
-        raise ConfigError(errors)
-    return sites
-
-
-def weather_sites(folder: Path | str) -> list[dict]:
-    """One site per weather file of ``folder`` (TMY3, EPW, PVGIS JSON/CSV), in name order, each with
-    its site read from the file (:func:`foldopt.inputs.weather.weather_site`)."""
-    from foldopt.inputs.weather import weather_site
-
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise ConfigError([f"--weather-dir: not a folder: {folder}"])
-    files = sorted(path for path in folder.iterdir() if path.suffix.lower() in WEATHER_SUFFIXES and path.is_file())
-    if not files:
-        raise ConfigError([f"--weather-dir {folder}: no weather files ({', '.join(WEATHER_SUFFIXES)})"])
-    sites = []
-    for path in files:
-        site = weather_site(str(path), None)
-        sites.append({"weather": str(path), "name": site["name"] or path.stem, "latitude": site["latitude"],
-                      "longitude": site["longitude"], "altitude": site.get("altitude", 0.0)})
-    return sites
 
 
 @dataclass(frozen=True)
@@ -226,10 +154,11 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
         Loads [W] in (0, 1e6], or with ``relative`` fractions of each site's flat peak in (0, 2];
         text is a value, a range ``start:stop:step`` or a list ``a,b,c``.
     sites : sequence of dict, str or pathlib.Path, optional
-        The sites (:func:`grid_sites`, :func:`read_sites`, :func:`weather_sites`), or a CSV of named
-        sites (:func:`read_sites`).
+        The sites (:func:`~foldopt.inputs.sites.grid_sites`, :func:`~foldopt.inputs.sites.read_sites`,
+        :func:`~foldopt.inputs.sites.weather_sites`), or a CSV of named sites (``read_sites``).
     weather_dir : str or pathlib.Path, optional
-        Without ``sites``: a folder of weather files, each a site (:func:`weather_sites`).
+        Without ``sites``: a folder of weather files, each a site
+        (:func:`~foldopt.inputs.sites.weather_sites`).
     latitudes, longitudes : sequence of float or str, optional
         Without ``sites`` or ``weather_dir``: the grid [deg], as values or text like ``loads``;
         default :data:`DEFAULT_GRID`.
@@ -291,9 +220,30 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
 
 
 def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]]:
-    """The study at one site of a map and the days of its year: ``study`` is a study's fields but
-    the site, date and load; ``site`` a :class:`foldopt.inputs.sections.Site`'s fields or a weather file's
-    site (``weather``: the path, its site read from the file)."""
+    """The study at one site of a map and the days of its year.
+
+    Parameters
+    ----------
+    study : dict
+        A study's fields but the site, date and load (:func:`map_study`).
+    site : dict
+        A :class:`foldopt.inputs.sections.Site`'s fields, or a weather file's site (``weather``: the
+        path, its site read from the file).
+    year : int
+        The year of clear-sky days, or what a weather file's typical year stands for.
+
+    Returns
+    -------
+    tuple of (foldopt.Study, list of datetime.date)
+        The study at the site (its ``p_load`` 1 W, to be replaced by the map's loads) and every
+        day of ``year``.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For a bad year, a load profile (maps take constant loads) or a study that fails
+        validation at the site.
+    """
     if year_problem(year):
         raise ConfigError([f"year = {year!r}: {year_problem(year)}"])
     dates = parse_dates("year", year)

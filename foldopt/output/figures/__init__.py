@@ -18,7 +18,8 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from foldopt.files import cache_dir, write_atomically
+from foldopt.cache import cache_dir
+from foldopt.files import write_atomically
 
 
 def _writable(folder: Path) -> bool:

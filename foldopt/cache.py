@@ -1,0 +1,94 @@
+"""foldopt's cache folder and its files: where the electrical tables, the land mask and matplotlib's
+settings are kept between runs (:func:`cache_dir`), and cache files that carry a checksum
+(:func:`store_cache`, :func:`load_cache`), so that a damaged one is built again rather than read.
+A leaf: it imports nothing of foldopt.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+#: Ends every cache file, followed by the SHA-256 (hex) of the bytes before it.
+_CHECKSUM = b"\nfoldopt-sha256:"
+
+
+def cache_dir() -> Path:
+    """foldopt's cache folder (electrical tables, the land mask, matplotlib's settings where HOME
+    cannot be written): ``$FOLDOPT_CACHE_DIR``, else the user's cache folder as platformdirs
+    names it (``$XDG_CACHE_HOME/foldopt`` or ``~/.cache/foldopt`` on Linux)."""
+    if os.environ.get("FOLDOPT_CACHE_DIR"):
+        return Path(os.environ["FOLDOPT_CACHE_DIR"])
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("foldopt", appauthor=False))
+
+
+def load_cache(path: Path) -> dict | None:
+    """The arrays of the cache file ``path`` (:func:`store_cache`), or None where it is absent or
+    damaged: then the caller builds them again. The checksum is verified before anything is read,
+    so that a truncated or bit-flipped file is caught whatever its bytes; a damaged file gets a
+    one-line notice on stderr (none with ``FOLDOPT_QUIET=1``).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    """
+    try:
+        data = Path(path).read_bytes()
+    except FileNotFoundError:
+        return None
+    except OSError as error:
+        _notice(path, f"cannot be read ({error.strerror or error})")
+        return None
+    payload, mark, digest = data.rpartition(_CHECKSUM)
+    if not mark:
+        _notice(path, "has no checksum (written by an earlier foldopt, or truncated)")
+        return None
+    if digest != hashlib.sha256(payload).hexdigest().encode():
+        _notice(path, "is damaged (its checksum does not match)")
+        return None
+    import numpy as np
+
+    with np.load(io.BytesIO(payload), allow_pickle=False) as arrays:
+        return {name: arrays[name] for name in arrays.files}
+
+
+def store_cache(path: Path, arrays: dict, compress: bool = False) -> None:
+    """Write ``arrays`` to the cache file ``path``: a NumPy ``.npz`` followed by
+    :data:`_CHECKSUM` and the SHA-256 of the ``.npz``, atomically. A cache that cannot be written
+    is skipped.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    arrays : dict of numpy.ndarray
+        By name.
+    compress : bool, default False
+        ``numpy.savez_compressed`` instead of ``numpy.savez``.
+    """
+    import numpy as np
+
+    buffer = io.BytesIO()
+    (np.savez_compressed if compress else np.savez)(buffer, **arrays)
+    payload = buffer.getvalue()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError:
+        return  # no cache where none can be written
+    try:
+        with os.fdopen(handle, "wb") as file:
+            file.write(payload + _CHECKSUM + hashlib.sha256(payload).hexdigest().encode())
+        os.replace(temporary, path)  # atomic: readers see the old file or the whole new one
+    except OSError:
+        Path(temporary).unlink(missing_ok=True)
+
+
+def _notice(path: Path, problem: str) -> None:
+    if os.environ.get("FOLDOPT_QUIET") != "1":
+        print(f"foldopt: the cache file {path} {problem}; building it again", file=sys.stderr)
