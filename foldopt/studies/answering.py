@@ -389,7 +389,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                    "chunks_computed": len(result.computed), "chunks_from_disk": len(result.from_disk),
                    "seconds": round(result.seconds, 2)})
     sky = "weather files" if any("weather" in site for site in spec.sites) else "Ineichen clear sky" if study.get(
-        "sky") == "ineichen" else f"{study.get('sky')} sky"
+        "sky") == "ineichen" else f"{study.get('sky') or 'meinel'} sky"  # a study that names no sky has Meinel's
     lines = [f"map: {_count(part['sites'], 'site')}, year {spec.year}, {sky}, objective {part['objective']}, "
              f"{study['panel']['area']:g} m^2 panel"]
     for load in part["loads"]:
@@ -405,9 +405,11 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                     f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended "
                     f"{rec['min']:g} to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
                     f"{load['median_near_optimal_width_deg']:g} deg wide)")
-        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')} "
-                     f"(median {_pct(load['median_gain_vs_flat_pct'])}, best {_pct(load['best_gain_vs_flat_pct'])} "
-                     f"at {where}); {rec_text}; median {_pct(load['median_pct_of_tracker'], False)} of the "
+        # Where no site carries the load there is no gain to give, nor a best site.
+        gains = ("" if best is None else f" (median {_pct(load['median_gain_vs_flat_pct'])}, best "
+                 f"{_pct(load['best_gain_vs_flat_pct'])} at {where})")
+        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')}"
+                     f"{gains}; {rec_text}; median {_pct(load['median_pct_of_tracker'], False)} of the "
                      f"tracker{tracker}")
     rate = len(spec.sites) / part["seconds"] if part["seconds"] else 0
     computed = (f"computed {_count(part['chunks_computed'], 'chunk')} on {part['cluster']}" if part["chunks_computed"]

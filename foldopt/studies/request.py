@@ -404,9 +404,12 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
     made = map_study(data, embedded=study is None, **changes)
     for setting in settings:
         made = policy.set_path(made, *parse_setting(setting))
-    request = map_request(made, [float(data.get("p_load") or 1.0)] if loads is None else loads, **where)
+    # The study's load as its file gives it: a value, a list or a range text, checked like --p-load.
+    request = map_request(made, (data.get("p_load") or 1.0) if loads is None else loads, **where)
+    study_loads = (f"P_load {request.loads[0]:g} W" if len(request.loads) == 1 else
+                   f"P_load {len(request.loads)} loads, {min(request.loads):g} to {max(request.loads):g} W")
     taken = [f"panel {made['panel']['area']:g} m^2" if area is None else None,
-             f"P_load {request.loads[0]:g} W" if loads is None and not request.relative else None,
+             study_loads if loads is None and not request.relative else None,
              f"{made.get('pv_model', 'ideal')} PV model", f"{made.get('mode')} mode",
              f"{made.get('step_min'):g}-min steps" if step_min is None else None]
     return replace(request, source=source, taken=tuple(item for item in taken if item))
