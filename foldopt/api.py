@@ -25,6 +25,7 @@ from foldopt.inputs.plan import Plan, load_plan
 from foldopt.inputs.study import Study
 from foldopt.errors import ConfigError
 
+
 def default_study() -> Study:
     """The embedded study: Shin et al.'s pole camera in Los Angeles on the 2014 autumn equinox
     (``configs/shin2015.yaml``; paper mode, ideal PV model, switching).

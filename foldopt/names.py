@@ -12,6 +12,7 @@ from __future__ import annotations
 import difflib
 import re
 
+
 class Registry(tuple):
     """The members of one kind (PV models, connections, trackers...): their names in order, each
     with a one-line description that help text and the docs print.

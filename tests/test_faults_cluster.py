@@ -111,8 +111,6 @@ def test_resume_recomputes_a_part_of_another_map(finished, scheduler, tmp_path):
     assert (resumed.table["p_load_w"] == 1.0).all()
 
 
-
-
 def test_a_second_map_of_one_folder_is_refused_naming_the_first(tmp_path):
     out = tmp_path / "map"
     holder = subprocess.Popen([sys.executable, "-c", HOLDS_THE_LOCK, str(out)], stdout=subprocess.PIPE, text=True)

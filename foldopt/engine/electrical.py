@@ -38,6 +38,8 @@ TABLE_NODES_1D = 1025
 TABLE_NODES_2D = 161
 TABLE_NODES_RATIO = 321
 TABLE_FORMAT = 4  # bump when the way tables are built changes
+
+
 def _nodes(count):
     return IRRADIANCE_MAX * np.linspace(0.0, 1.0, count) ** 2
 

@@ -112,7 +112,6 @@ def read_input(path: Path | str, field: str, limit: int, limit_name: str) -> str
         raise ConfigError([f"{field}: cannot read {path}: not UTF-8 text (byte {error.start + 1:,})"]) from None
 
 
-
 class StudyLoader(yaml.SafeLoader):
     """YAML for studies: PyYAML's safe loader, less what a study never needs and an attacker or a
     slip would use. Aliases (``*name``) are refused, so no "billion laughs" expansion; a key given
@@ -267,7 +266,6 @@ def read_study(path: Path | str) -> tuple:
     return data, lines
 
 
-
 def parse_study_text(text: str, source: str = "config") -> tuple:
     """The data of a study's YAML text (or of one ``--set`` value).
 
@@ -305,7 +303,6 @@ def parse_study_text(text: str, source: str = "config") -> tuple:
     return data, (_yaml_lines(node) if node is not None else {})
 
 
-
 def _resolve_weather_path(data: dict, folder: Path) -> dict:
     """A study file's relative weather path is relative to the file, not to the working folder."""
     weather = data.get("weather")
@@ -314,7 +311,6 @@ def _resolve_weather_path(data: dict, folder: Path) -> dict:
         resolved = str(folder / spec)
         data = {**data, "weather": {**weather, "path": resolved} if isinstance(weather, dict) else resolved}
     return data
-
 
 
 def default_study_path(name: str = DEFAULT_STUDY) -> Path:

@@ -206,7 +206,6 @@ def _leap(year: int) -> bool:
     return year % 4 == 0 and (year % 100 != 0 or year % 400 == 0)
 
 
-
 @dataclass(frozen=True)
 class Plan:
     """A study and its sweep axes; the cases are the product of the axes' values.
@@ -267,7 +266,6 @@ class Plan:
         for values in itertools.product(*(values for _, values in self.axes)):
             choice = dict(zip(paths, values, strict=True))
             yield choice, self.study(choice)
-
 
 
 def _listed_leaves(data: dict, prefix: str = ""):
@@ -445,7 +443,6 @@ def _at(lines: dict, loc: tuple, message: str) -> str:
     return message
 
 
-
 def load_plan(path: Path | str) -> Plan:
     """Read and validate a YAML study, with any sweep axes.
 
@@ -463,7 +460,6 @@ def load_plan(path: Path | str) -> Plan:
         With the YAML line of each fault.
     """
     return make_plan(*read_study(path))
-
 
 
 def load_study(path: Path | str) -> Study:

@@ -54,7 +54,6 @@ def great_circle_km(latitude_1, longitude_1, latitude_2, longitude_2) -> float:
     return 2 * EARTH_RADIUS_KM * math.asin(min(1.0, math.sqrt(a)))
 
 
-
 def _check_step_min(value: float) -> float:
     if not math.isclose(1440 / value, round(1440 / value)):
         raise ValueError("must divide the 1440 min of a day (e.g. 0.5, 1, 2, 5, 10, 15, 30, 60)")
@@ -393,7 +392,6 @@ class Study(StrictModel):
                 "temperature_model": temperature,
             }
         )
-
 
 
 def format_error(item: dict) -> list[str]:

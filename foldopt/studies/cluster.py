@@ -289,8 +289,6 @@ def _write_json(path: Path, data: dict) -> None:
     write_atomically(path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n"))
 
 
-
-
 def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: int | None = None,
             resume: bool = False, overwrite: bool = False, progress: Callable[[int, int], None] | None = None,
             announce: Callable[[str, str | None], None] | None = None, metadata: dict | None = None,

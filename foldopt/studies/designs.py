@@ -366,8 +366,6 @@ def objective_value(hours, months, statistic: str, season=None):
     return np.percentile(hours, float(statistic[1:]), axis=0)
 
 
-
-
 def worst_month(hours, months):
     """The month [1-12], (...), of the lowest monthly mean: where a ``worst-month`` objective is found.
 

@@ -177,7 +177,6 @@ def _taken(plan: Plan, changes: dict, field: str | None, data: dict, decided: li
     return taken
 
 
-
 def size_request(plan: Plan, source: str, cost_given: bool) -> Request:
     """A sizing's request: the study's one case, and what the sizing took from it.
 

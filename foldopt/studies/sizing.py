@@ -43,8 +43,6 @@ def flat_area_multiple(p_flat, p_load, target_t_solar, step_hours):
     return p_load / load_for_t_solar(p_flat, target_t_solar, step_hours)
 
 
-
-
 @dataclass(frozen=True)
 class SizingResult:
     """A panel sizing (:func:`foldopt.size`): ``table`` per design and area, ``best`` the area of

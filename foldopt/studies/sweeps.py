@@ -27,6 +27,7 @@ from foldopt.studies.designs import (DESIGNS, Blocks, best_angle_index, design_m
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 
+
 @dataclass(frozen=True)
 class SweepResult:
     """A plan and its tidy table: one row per case x design."""
@@ -44,7 +45,6 @@ class SweepResult:
         from foldopt.studies.answering import of_sweep
 
         return of_sweep(self)
-
 
     @property
     def varied(self) -> list[str]:

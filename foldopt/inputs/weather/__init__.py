@@ -89,7 +89,6 @@ def _read_once(path: str, fmt: str, year: int, mtime: float):
         return None, error.errors[0]
 
 
-
 def _read_checked(path: str, fmt: str, year: int):
     def fail(message: str) -> WeatherError:
         return WeatherError(f"weather {Path(path).name}: {message}")
