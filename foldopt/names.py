@@ -110,7 +110,21 @@ DRIVES = Registry("drive", {
 WEATHER_FORMATS = Registry("weather format", {
     "tmy3": "NREL TMY3 CSV (pvlib.iotools.read_tmy3)",
     "epw": "EnergyPlus weather (pvlib.iotools.read_epw)",
-    "pvgis": "PVGIS typical meteorological year, CSV or JSON (pvlib.iotools.read_pvgis_tmy)"})
+    "pvgis": "PVGIS typical meteorological year, CSV or JSON (pvlib.iotools.read_pvgis_tmy)",
+    "surfrad": "NOAA SURFRAD daily file: measured 1-min light, air temperature and wind (pvlib.iotools.read_surfrad)",
+    "midc": "NREL MIDC daily or raw-data file: measured 1-min columns; give the site (pvlib.iotools.read_midc)",
+    "srml": "UO SRML archival file: measured 1- to 60-min columns; give the site (pvlib.iotools.read_srml)",
+    "bsrn": "BSRN station-to-archive file: measured 1-min light and air temperature (pvlib.iotools.read_bsrn)",
+    "solrad": "NOAA SOLRAD daily file: measured 1-min light (pvlib.iotools.read_solrad)",
+    "crn": "NOAA USCRN sub-hourly file: measured 5-min global light, air temperature, wind (pvlib.iotools.read_crn)",
+    "csv": "a measured CSV: timestamp, ghi, dni, dhi [, temp_air, wind_speed] at any step; give the site"})
+#: The weather formats of hourly files (typical years), brought to the study's step; the others of
+#: :data:`WEATHER_FORMATS` are measured files, evaluated at their own step.
+HOURLY_WEATHER_FORMATS = ("tmy3", "epw", "pvgis")
+DECOMPOSITIONS = Registry("decomposition", {
+    "erbs": "Erbs, Klein and Duffie 1982: the diffuse fraction from the clearness index (pvlib.irradiance.erbs)",
+    "boland": "Boland, Huang and Ridley 2013: a logistic diffuse fraction (pvlib.irradiance.boland)",
+    "dirint": "Perez et al. 1992: DISC with the index's changes and dew point (pvlib.irradiance.dirint)"})
 INTERVAL_LABELS = Registry("interval label", {
     "start": "a timestamp marks the start of its interval",
     "end": "a timestamp marks the end of its interval",
@@ -128,7 +142,8 @@ OUTPUT_FORMATS = Registry("format", {
     "json": "one JSON document of the answer and its rows"})
 #: Every registry, in the order the docs list them.
 REGISTRIES = (MODES, GEOMETRIES, SKIES, TRANSPOSITIONS, IAMS, PV_MODELS, TEMPERATURE_MODELS, CONNECTIONS,
-              TRACKERS, DRIVES, WEATHER_FORMATS, INTERVAL_LABELS, HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS)
+              TRACKERS, DRIVES, WEATHER_FORMATS, DECOMPOSITIONS, INTERVAL_LABELS, HOTTEL_CLIMATES, ENGINES,
+              OUTPUT_FORMATS)
 
 #: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.physics.trackers).
 #: His 12 actuating times (local time) pair up symmetrically about 13.319 h: 8.839/17.799,

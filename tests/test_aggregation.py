@@ -7,7 +7,8 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from foldopt.physics.connections import connection_powers, pair_powers, parallel_power, series_power
-from foldopt.physics.pvmodel import PVModel, cell_temperature
+from foldopt.physics.pvmodel import PVModel
+from foldopt.physics.temperature import cell_temperature
 
 AREA = 0.054  # a sub-panel of the paper's 0.108 m^2 panel
 MODELS = {"single-diode": PVModel("single-diode"), "b-model": PVModel("b-model", efficiency=0.19)}

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 import foldopt
 from foldopt.inputs.sections import NearOptimal
-from foldopt.studies.designs import near_optimal
+from foldopt.studies.objectives import near_optimal
 
 
 def reference(angles, values, fraction, minutes):

@@ -4,7 +4,8 @@ import numpy as np
 import pvlib
 import pytest
 
-from foldopt.physics.pvmodel import A300_CELL, ROBLES_200W, PVModel, cell_temperature, cec_module, fit_b
+from foldopt.physics.pvmodel import A300_CELL, ROBLES_200W, PVModel, cec_module, fit_b
+from foldopt.physics.temperature import cell_temperature
 
 
 def test_a300_cell_reproduces_its_datasheet_point():

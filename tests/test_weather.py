@@ -127,20 +127,24 @@ def test_epw_timestamps_move_to_interval_centres(tmp_path):
     assert day.index[12].strftime("%H:%M") == "12:30"
     assert day["ghi"].iloc[12] == pytest.approx(800.0 * np.sin(np.pi * 6.5 / 12))
     assert day["dni"].iloc[12] == pytest.approx(0.8 * day["ghi"].iloc[12])
-    # The study runs on its own 1-minute steps; each hour of the file keeps its mean.
+    # The study runs on its own 1-minute steps; each hour of the file keeps its direct and diffuse
+    # means, and the global light is their sum (ghi = dni cos(zenith) + dhi) at every step.
     day = Day(make_study({**BASE, "weather": str(path), "date": "2025-06-22"}))
     assert day.step_hours == pytest.approx(1 / 60)
     hourly = weather_day(frame, dt.date(2025, 6, 22))
-    for key in ("ghi", "dni", "dhi"):
+    for key in ("dni", "dhi"):
         np.testing.assert_allclose(getattr(day, key).reshape(24, 60).mean(axis=1), hourly[key], rtol=1e-12, atol=1e-9)
+    beam = day.dni * np.clip(np.cos(np.radians(day.solar_zenith)), 0, None)
+    np.testing.assert_allclose(day.ghi, beam + day.dhi, atol=1e-9)
 
 
 def test_the_formats_registry_is_the_names_a_study_accepts():
     """A format is one module and one entry of FORMATS; validation and help read the names'."""
     from foldopt import names
-    from foldopt.inputs.weather import FORMATS, weather_format
+    from foldopt.inputs.weather import FORMATS, MEASURED_FORMATS, weather_format
 
-    assert tuple(FORMATS) == tuple(names.WEATHER_FORMATS)
+    assert tuple(FORMATS) + tuple(MEASURED_FORMATS) == tuple(names.WEATHER_FORMATS)
+    assert tuple(FORMATS) == names.HOURLY_WEATHER_FORMATS
     assert {entry.interval_label for entry in FORMATS.values()} <= set(names.INTERVAL_LABELS)
     assert [weather_format(Path(f"x{suffix.upper()}")) for suffix in (".csv", ".epw", ".json", ".txt")] == [
         "tmy3", "epw", "pvgis", "tmy3"]

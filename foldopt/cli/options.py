@@ -108,6 +108,7 @@ OPTION_OF_FIELD = {
     "objective.statistic": "--objective", "objective.visits": "--visits", "weather": "--weather", "albedo": "--albedo",
     "iam": "--iam", "switch_series": "--switch-series", "bypass_diodes": "--no-bypass",
     "exact_electrical": "--exact-electrical", "force_site": "--force-site", "load_profile": "--load-profile",
+    "weather.format": "--weather-format", "weather.members": "--members", "weather.seed": "--seed",
 }
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 

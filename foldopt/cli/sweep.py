@@ -56,8 +56,13 @@ def _sweep_options(
     sky: Optional[str] = typer.Option(None, "--sky", help=_choices(names.SKIES) + "."),
     climate: Optional[str] = typer.Option(None, "--climate", help="Hottel's climate: "
                                           + _choices(names.HOTTEL_CLIMATES) + "."),
-    weather: Optional[Path] = typer.Option(None, "--weather", help="TMY3 / EPW / PVGIS TMY file: its site and its "
-                                           "whole year unless given."),
+    weather: Optional[Path] = typer.Option(None, "--weather", help="Weather file: an hourly TMY3 / EPW / PVGIS TMY "
+                                           "(its site and whole year) or a measured file (its days, at its step)."),
+    weather_format: Optional[str] = typer.Option(None, "--weather-format", help=_choices(names.WEATHER_FORMATS)
+                                                  + " [default: from the extension, hourly formats]."),
+    members: Optional[int] = typer.Option(None, "--members", help="An hourly file's cloud ensemble: this many "
+                                          "synthetic minute series (2 to 200)."),
+    seed: Optional[int] = typer.Option(None, "--seed", help="The ensemble's seed [default: 0]."),
     force_site: bool = typer.Option(False, "--force-site", help="Keep --lat/--lon though far from the weather "
                                     "file's site."),
     transposition: Optional[str] = typer.Option(None, "--transposition", help=_choices(names.TRANSPOSITIONS) + "."),

@@ -31,7 +31,8 @@ import pvlib
 
 from foldopt.cache import cache_dir, load_cache, store_cache
 from foldopt.physics.connections import connection_powers, parallel_power, series_power
-from foldopt.physics.pvmodel import PVModel, cell_temperature
+from foldopt.physics.pvmodel import PVModel
+from foldopt.physics.temperature import cell_temperature
 
 IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the tables; clear-sky beam stays below 1353
 TABLE_NODES_1D = 1025
@@ -88,7 +89,7 @@ class Electrical:
     temp_air, wind_speed : float, default 25 and 1
         [C], [m/s], constant over the study.
     temperature_model : {'fixed', 'sapm'}
-        :func:`foldopt.physics.pvmodel.cell_temperature`'s model.
+        :func:`foldopt.physics.temperature.cell_temperature`'s model.
     bypass, switch_series : bool, default True and False
         Bypass diodes in series; series as a switching state.
     converter_efficiency : float, default 1

@@ -57,6 +57,29 @@ def _bilinear(values, first, second):
             + (values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj) * fi)
 
 
+@njit(cache=True, inline="always")
+def _pair_powers(t, root_east, root_west, table_1d, table_parallel, table_series, need_series, bypass):
+    """East, west, parallel and series power [W] from table set ``t`` at both sub-panels'
+    irradiance (as sqrt(E / E_max))."""
+    n1 = table_1d.shape[1] - 1
+    n2, nr = table_parallel.shape[1] - 1, table_parallel.shape[2] - 1
+    p_east = _linear(table_1d[t], root_east * n1)
+    p_west = _linear(table_1d[t], root_west * n1)
+    bound = p_east + p_west
+    # The pair tables: stronger irradiance (as its root) x weaker/stronger ratio (parallel: as its
+    # root; series: the ratio itself).
+    strong, weak = max(root_east, root_west), min(root_east, root_west)
+    root_ratio = weak / strong if strong > 0.0 else 1.0
+    p_parallel = min(max(_bilinear(table_parallel[t], strong * n2, root_ratio * nr), 0.0), 1.0) * bound
+    p_series = bound
+    if need_series:
+        fraction = _bilinear(table_series[t], strong * n2, root_ratio**2 * nr)
+        p_series = min(max(fraction, 0.0), 1.0) * bound
+    if bypass:
+        p_series = max(p_series, max(p_east, p_west))
+    return p_east, p_west, p_parallel, p_series
+
+
 @njit(cache=True)
 def iam_factor(cos_aoi, model, params):
     """Incidence-angle modifier of the beam, the arithmetic of pvlib's ``iam.ashrae`` and
@@ -227,8 +250,8 @@ def _connection_power(code, p_east, p_west, p_parallel, p_series, p_panel, conve
 
 @njit(cache=True)
 def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, paper_incidence, iam_model,
-                 iam_params, table_1d, table_parallel, table_series, linear_power, panel_scale, bypass, switch_series,
-                 converter_efficiency, connections, irradiance, buffer):
+                 iam_params, step_table, step_weight, table_1d, table_parallel, table_series, linear_power,
+                 panel_scale, bypass, switch_series, converter_efficiency, connections, irradiance, buffer):
     """Every asked connection's power [W] of row ``r`` (over block ``b``) at steps
     ``first..last``, into ``buffer[c, step]``; returns the sum over those steps of the two
     sub-panels' mean incident plane-of-array irradiance [W/m^2] (before the incidence-angle
@@ -236,7 +259,9 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
 
     Two loops: the first, free of table look-ups so that it vectorises, gives both sub-panels'
     irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) into ``irradiance``; the
-    second looks up the powers. Sun, beam and terms are laid out (n_blocks, component, n_steps)."""
+    second looks up the powers, from table set ``step_table[b, s]`` and, with weight
+    ``step_weight[b, s]``, the next (both (n_blocks, n_steps), or (n_blocks, 1) for one set a
+    block). Sun, beam and terms are laid out (n_blocks, component, n_steps)."""
     n_conn = connections.shape[0]
     has_terms = terms.shape[1] == 4
     tables = linear_power == 0.0
@@ -278,28 +303,25 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
             g_east = math.sqrt(min(max(g_east, 0.0), IRRADIANCE_MAX) * to_root)
             g_west = math.sqrt(min(max(g_west, 0.0), IRRADIANCE_MAX) * to_root)
         irradiance[0, s], irradiance[1, s] = g_east, g_west
-    n1 = table_1d.shape[0] - 1
-    n2, nr = table_parallel.shape[0] - 1, table_parallel.shape[1] - 1
+    per_step = step_table.shape[1] > 1
     for s in range(first, last + 1):
         root_east, root_west = irradiance[0, s], irradiance[1, s]
         if not tables:
             p_east, p_west = linear_power * root_east, linear_power * root_west
             p_parallel = p_series = p_east + p_west
         else:
-            p_east = _linear(table_1d, root_east * n1)
-            p_west = _linear(table_1d, root_west * n1)
-            bound = p_east + p_west
-            # The pair tables: stronger irradiance (as its root) x weaker/stronger ratio (parallel:
-            # as its root; series: the ratio itself).
-            strong, weak = max(root_east, root_west), min(root_east, root_west)
-            root_ratio = weak / strong if strong > 0.0 else 1.0
-            p_parallel = min(max(_bilinear(table_parallel, strong * n2, root_ratio * nr), 0.0), 1.0) * bound
-            p_series = bound
-            if need_series:
-                fraction = _bilinear(table_series, strong * n2, root_ratio**2 * nr)
-                p_series = min(max(fraction, 0.0), 1.0) * bound
-            if bypass:
-                p_series = max(p_series, max(p_east, p_west))
+            at = s if per_step else 0
+            t, w = step_table[b, at], step_weight[b, at]
+            p_east, p_west, p_parallel, p_series = _pair_powers(t, root_east, root_west, table_1d, table_parallel,
+                                                                table_series, need_series, bypass)
+            if w > 0.0:
+                # The step's cells lie between two tables' air temperatures: linear between them.
+                q_east, q_west, q_parallel, q_series = _pair_powers(t + 1, root_east, root_west, table_1d,
+                                                                    table_parallel, table_series, need_series, bypass)
+                p_east += w * (q_east - p_east)
+                p_west += w * (q_west - p_west)
+                p_parallel += w * (q_parallel - p_parallel)
+                p_series += w * (q_series - p_series)
         p_panel = panel_scale * p_east
         for c in range(n_conn):
             buffer[c, s] = _connection_power(connections[c], p_east, p_west, p_parallel, p_series, p_panel,
@@ -308,7 +330,7 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
 
 
 @njit(cache=True, parallel=True)
-def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_normal, row_paper, row_loadset,
+def fold_rows(sun, paper_sun, beam, terms, span, step_table, step_weight, row_block, row_normal, row_paper, row_loadset,
               paper_incidence, iam_model, iam_params, table_1d, table_parallel, table_series, linear_power,
               panel_scale, bypass, switch_series, converter_efficiency, connections, loads, step_hours,
               contiguous, load_shape, use_shape, t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance,
@@ -330,17 +352,18 @@ def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_nor
         First and last step to walk: the steps with any light and one dark step either side. The
         dark steps before and after hold zero power, so they join the half-steps held at the ends
         of the day.
-    block_table : (n_blocks,) int
-        Electrical table of each block (its cells' air temperature).
+    step_table, step_weight : (n_blocks, n_steps) or (n_blocks, 1) int and float
+        The electrical table set of each step (or of each block): its cells' air temperature lies
+        between set ``t`` and ``t + 1``, at ``weight`` of the way (0: set ``t``).
     row_block, row_loadset : (n_rows,) int
     row_normal : (n_rows, 2, 3) float
         East and west sub-panel normals.
     row_paper : (n_rows, 2, 4) float
         cos(tilt), sin(tilt), cos(azimuth), sin(azimuth) per sub-panel (paper mode).
     table_1d, table_parallel, table_series : float arrays
-        Per table: sub-panel power [W] on sqrt-spaced irradiance nodes, and the parallel and
-        series pairs as fractions of the two maxima over the stronger irradiance and the
-        weaker/stronger ratio (:class:`foldopt.engine.electrical.Electrical`).
+        Stacked over table sets (air temperatures), per set: sub-panel power [W] on sqrt-spaced
+        irradiance nodes, and the parallel and series pairs as fractions of the two maxima over
+        the stronger irradiance and the weaker/stronger ratio (:class:`foldopt.engine.electrical.Electrical`).
     linear_power : float
         ``efficiency * sub-panel area`` [m^2] for the ideal model (no tables); 0 with tables.
     panel_scale : float
@@ -370,12 +393,11 @@ def fold_rows(sun, paper_sun, beam, terms, span, block_table, row_block, row_nor
     for k in prange(n_chunks):
         for r in range(k * per_chunk, min((k + 1) * per_chunk, n_rows)):
             b = row_block[r]
-            tab = block_table[b]
             first, last = span[b, 0], span[b, 1]
             irradiation = _fold_powers(
                 r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, paper_incidence, iam_model,
-                iam_params, table_1d[tab], table_parallel[tab], table_series[tab], linear_power, panel_scale, bypass,
-                switch_series, converter_efficiency, connections, irradiance[k], buffer[k])
+                iam_params, step_table, step_weight, table_1d, table_parallel, table_series, linear_power,
+                panel_scale, bypass, switch_series, converter_efficiency, connections, irradiance[k], buffer[k])
             irradiation_out[r] = irradiation * step_hours
             for c in range(connections.shape[0]):
                 energy_out[r, c], peak_out[r, c] = _metrics(

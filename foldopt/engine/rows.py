@@ -16,22 +16,22 @@ Studies that solve every step's I-V curves (``exact_electrical``) always take th
 
 from __future__ import annotations
 
-import functools
 import inspect
 from dataclasses import dataclass
 
 import numpy as np
 import pvlib
 
-from foldopt.physics.connections import CONNECTIONS
+from foldopt.physics.connections import CONNECTIONS, connection_powers
 from foldopt.inputs.study import Study
-from foldopt.engine.electrical import Electrical
 from foldopt.physics.geometry import normal_vector, subpanel_orientation
 from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.engine.metrics import energy, per_load, t_solar, t_solar_contiguous
 from foldopt.names import ENGINES
-from foldopt.physics.pvmodel import PVModel
 from foldopt.engine.sky import Sky
+# The cells' electrical model is part of the engine's API (engines.electrical_for, panel_power...).
+from foldopt.engine.cells import (TEMPERATURE_NODE_STEP, electrical_for, node_weights, panel_power,  # noqa: F401
+                                  temperature_nodes)
 
 #: What :func:`row_metrics` can evaluate: the connections, and ``panel``, the whole panel as one.
 OUTPUTS = CONNECTIONS + ("panel",)
@@ -61,46 +61,6 @@ class RowMetrics:
     energy: np.ndarray
     peak: np.ndarray
     irradiation: np.ndarray | None = None
-
-
-def electrical_settings(study: Study, temp_air: float) -> dict:
-    """The keyword arguments (dict) of a study's :class:`Electrical` whose cells see ``temp_air``.
-
-    Parameters
-    ----------
-    study : Study
-    temp_air : float
-        Air temperature of the cells [C].
-    """
-    study = study.resolved()
-    return dict(
-        pv=PVModel(study.pv_model, study.panel.efficiency, study.module),
-        subpanel_area=study.panel.area / 2.0,
-        temp_air=float(temp_air),
-        wind_speed=study.wind_speed,
-        temperature_model=study.temperature_model,
-        bypass=study.bypass_diodes,
-        switch_series=study.switch_series,
-        converter_efficiency=study.converter_efficiency,
-        exact=study.exact_electrical,
-    )
-
-
-@functools.lru_cache(maxsize=64)
-def _electrical(settings_items: tuple) -> Electrical:
-    return Electrical(**dict(settings_items))
-
-
-def electrical_for(study: Study, temp_air: float) -> Electrical:
-    """The study's :class:`Electrical` at an air temperature, shared by every caller in this process (and
-    its tables by every process, through the disk cache).
-
-    Parameters
-    ----------
-    study, temp_air
-        As :func:`electrical_settings`.
-    """
-    return _electrical(tuple(electrical_settings(study, temp_air).items()))
 
 
 def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> np.ndarray:
@@ -175,31 +135,6 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
     terms = None if sky.terms is None else sky.terms[blocks]
     modifier = 1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, zenith, solar_azimuth)
     return plane_of_array(cos_aoi, normal[..., 2], sky.dni[blocks], terms, factor, modifier)
-
-
-def panel_power(sky: Sky, study: Study, poa_global, area: float | None = None):
-    """Maximum power of panels over the blocks of a sky, each block at its cells' air temperature.
-
-    Parameters
-    ----------
-    sky : Sky
-    study : Study
-    poa_global : numpy.ndarray
-        (n_blocks, n_steps) plane-of-array irradiance [W/m^2].
-    area : float, optional
-        Panel area [m^2]; default the study's.
-
-    Returns
-    -------
-    numpy.ndarray
-        (n_blocks, n_steps) [W].
-    """
-    area = study.panel.area if area is None else area
-    power = np.empty_like(poa_global)
-    for temp in np.unique(sky.temp_air):
-        rows = sky.temp_air == temp
-        power[rows] = electrical_for(study, temp).panel_power(poa_global[rows], area)
-    return power
 
 
 def iam_modifier(model: str, surface_tilt, surface_azimuth, solar_zenith, solar_azimuth):
@@ -292,10 +227,10 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     if engine == "numpy" or study.exact_electrical:
         result = _reference(sky, study, row_block, orientation, sorted_loads, row_loadset, outputs, contiguous)
     else:
-        temps, block_table = np.unique(sky.temp_air, return_inverse=True)
-        electricals = [electrical_for(study, temp) for temp in temps]
-        result = _compiled(sky, study, electricals, block_table, row_block, orientation, sorted_loads, row_loadset,
-                           outputs, contiguous)
+        nodes, table, weight = temperature_nodes(sky)
+        electricals = [electrical_for(study, temp, sky.wind_ref) for temp in nodes]
+        result = _compiled(sky, study, electricals, (table, weight), row_block, orientation, sorted_loads,
+                           row_loadset, outputs, contiguous)
     return _in_caller_order(result, order, row_loadset)
 
 
@@ -344,22 +279,31 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
     paper = study.mode == "paper"
     poa_east = poa(sky, orientation[:, 0, None], orientation[:, 1, None], blocks, paper)
     poa_west = poa(sky, orientation[:, 2, None], orientation[:, 3, None], blocks, paper)
-    temps = np.atleast_1d(sky.temp_air[blocks])
-    out, state = {}, np.zeros(poa_east.shape, dtype=np.int64) if with_state else None
-    # Blocks whose cells see other air temperatures take other tables (weather studies).
-    groups = [slice(None)] if np.all(temps == temps[0]) else [temps == temp for temp in np.unique(temps)]
+    out = {}
     out["poa"] = 0.5 * (poa_east + poa_west) if sky.iam == "none" else 0.5 * sum(
         poa(sky, orientation[:, 2 * side, None], orientation[:, 2 * side + 1, None], blocks, paper, incident=True)
         for side in (0, 1))
-    for rows in groups:
-        electrical = electrical_for(study, temps[rows][0] if not isinstance(rows, slice) else temps[0])
-        part, part_state = electrical.connections(poa_east[rows], poa_west[rows], series, with_state)
-        part["panel"] = electrical.panel_power(poa_east[rows], study.panel.area)
-        for name, values in part.items():
-            out.setdefault(name, np.empty(poa_east.shape))[rows] = values
-        if with_state:
-            state[rows] = part_state
-    return out, state
+    weights = node_weights(sky, blocks, poa_east.shape)
+    if len(weights) == 1:
+        electrical = electrical_for(study, weights[0][0], sky.wind_ref)
+        part, state = electrical.connections(poa_east, poa_west, series, with_state)
+        part["panel"] = electrical.panel_power(poa_east, study.panel.area)
+        return {**out, **part}, state
+    # Steps between two tables' air temperatures take each sub-panel's and each pair's power
+    # linearly between them, and the connections from those, as the kernel does.
+    parts = {name: np.zeros(poa_east.shape) for name in ("east", "west", "parallel", "series", "panel")}
+    for temp, weight in weights:
+        take = weight > 0
+        electrical = electrical_for(study, temp, sky.wind_ref)
+        part, _ = electrical.connections(poa_east[take], poa_west[take], series, with_state=False)
+        part["panel"] = electrical.panel_power(poa_east[take], study.panel.area)
+        for name, values in parts.items():
+            values[take] += weight[take] * part[name]
+    last = electrical_for(study, weights[-1][0], sky.wind_ref)
+    connected, state = connection_powers(parts["east"], parts["west"], parts["parallel"], parts["series"],
+                                         switch_series=last.switch_series,
+                                         converter_efficiency=last.converter_efficiency, with_state=with_state)
+    return {**out, **connected, "panel": parts["panel"]}, state
 
 
 def _reference(sky, study, row_block, orientation, loads, row_loadset, outputs, contiguous):
@@ -397,7 +341,7 @@ def _tables(electricals, outputs, study):
     return table_1d, table_parallel, table_series, 0.0
 
 
-def _compiled(sky, study, electricals, block_table, row_block, orientation, loads, row_loadset, outputs,
+def _compiled(sky, study, electricals, step_tables, row_block, orientation, loads, row_loadset, outputs,
               contiguous):
     from foldopt.engine import kernel
 
@@ -421,7 +365,7 @@ def _compiled(sky, study, electricals, block_table, row_block, orientation, load
     span = np.where((first_lit <= last_lit)[:, None],
                     np.stack([np.maximum(first_lit - 1, 0), np.minimum(last_lit + 1, steps[-1])], axis=1), 0)
     arrays = [np.moveaxis(sky.sun_vector, -1, 1), paper_sun, sky.dni, terms, span,
-              np.asarray(block_table, dtype=np.int64), row_block,
+              np.asarray(step_tables[0], dtype=np.int64), np.asarray(step_tables[1], dtype=float), row_block,
               np.stack([east, west], axis=1), row_paper, row_loadset]
     # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
     kernel.fold_rows(

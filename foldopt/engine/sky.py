@@ -24,9 +24,12 @@ from foldopt.physics.geometry import normal_vector
 from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.inputs.loads import load_shape
 from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
-from foldopt.inputs.weather import read_weather, weather_days, weather_site
+from foldopt.errors import WeatherError
+from foldopt.inputs.weather import FORMATS, read_weather, study_weather, weather_days, weather_format, weather_site
 from foldopt.names import CLEAR_SKIES
-from foldopt.inputs.weather.downscale import clear_sky, sub_hourly
+from foldopt.inputs.weather.downscale import clear_sky, hourly_light, interpolate_points
+from foldopt.inputs.weather.ensemble import cloud_members
+from foldopt.physics.temperature import equivalent_temp_air
 
 
 @dataclass(frozen=True)
@@ -48,7 +51,8 @@ class Sky:
     terms : numpy.ndarray or None
         (n_blocks, n_steps, 4) diffuse terms; None when the study is beam only.
     temp_air : numpy.ndarray
-        (n_blocks,) the air temperature the cells of each block see [C].
+        (n_blocks,) the air temperature the cells of each block see [C]; with a weather file, its
+        mean over the block's lit steps (``temp_steps`` holds every step's).
     latitude : numpy.ndarray
         (n_blocks,) [deg north].
     iam : {'none', 'ashrae', 'physical'}
@@ -57,7 +61,20 @@ class Sky:
         (:func:`foldopt.inputs.loads.load_shape`); None for a constant load.
     weather_balance : dict or None
         With a weather file: per component (``dni``, ``ghi``, ``dhi``), the file's summed interval
-        means and what the steps keep of them [W/m^2 x intervals] (:func:`foldopt.inputs.weather.downscale.sub_hourly`).
+        means and what the steps keep of them [W/m^2 x intervals]
+        (:func:`foldopt.inputs.weather.downscale.hourly_light`).
+    temp_steps : numpy.ndarray or None
+        With a weather file, (n_blocks, n_steps) the air temperature the cells see at each step
+        [C]: the file's, linear between its stamps, and with the SAPM cell temperature the
+        file's wind folded in as an equivalent air temperature (:func:`equivalent_temp_air`).
+    wind_speed : numpy.ndarray or None
+        With a weather file, (n_blocks, n_steps) the file's wind speed at each step [m/s].
+    wind_ref : float or None
+        With a weather file, the wind speed of the electrical tables [m/s]: the file's mean over
+        the lit steps, to 0.5 m/s, so that the wind folded into ``temp_steps`` stays small.
+    weather_notes : tuple of str
+        With a measured weather file, what reading it did (its step, derived components, gaps:
+        :meth:`foldopt.inputs.weather.measured.MeasuredWeather.report`).
     """
 
     grid: ClockGrid
@@ -76,6 +93,10 @@ class Sky:
     iam: str
     weather_balance: dict | None = None
     load_shape: np.ndarray | None = None
+    temp_steps: np.ndarray | None = None
+    wind_speed: np.ndarray | None = None
+    wind_ref: float | None = None
+    weather_notes: tuple = ()
 
     @property
     def n_blocks(self) -> int:
@@ -129,9 +150,10 @@ class Sky:
                          self.grid.step_hours)
         take = {name: None if getattr(self, name) is None else getattr(self, name)[keep]
                 for name in ("solar_zenith", "solar_azimuth", "hour_angle", "declination", "sun_vector", "dni",
-                             "ghi", "dhi", "terms", "temp_air", "latitude")}
+                             "ghi", "dhi", "terms", "temp_air", "latitude", "temp_steps", "wind_speed")}
+        shape = None if self.load_shape is None else self.load_shape[keep]
         return Sky(grid=grid, mode=self.mode, iam=self.iam, weather_balance=self.weather_balance,
-                   load_shape=None if self.load_shape is None else self.load_shape[keep], **take)
+                   wind_ref=self.wind_ref, weather_notes=self.weather_notes, load_shape=shape, **take)
 
 
 def _clock(sites, dates, step_min) -> ClockGrid:
@@ -161,12 +183,13 @@ def _clear_sky(grid: ClockGrid, zenith, sites, model: str, linke_turbidity) -> d
     return light
 
 
-def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict):
+def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict, zenith):
     """Light at every step of the grid from the study's weather file
-    (:func:`foldopt.inputs.weather.downscale.sub_hourly` against the clear sky), the cell air
-    temperature of each day, and how much of the file's irradiation the steps keep."""
+    (:func:`foldopt.inputs.weather.downscale.hourly_light` along the clear sky), the air
+    temperature and wind at every step (:func:`foldopt.inputs.weather.downscale.interpolate_points`),
+    and how much of the file's irradiation the steps keep."""
     weather = study.weather
-    columns = ("dni", "ghi", "dhi", "temp_air")
+    columns = ("dni", "ghi", "dhi", "temp_air", "wind_speed")
     hourly = {key: np.empty((len(dates), 0)) for key in columns}
     starts = np.empty((len(dates), 0), dtype=np.int64)
     # The file is coerced to each date's year: read once per year, the days picked as arrays.
@@ -189,19 +212,65 @@ def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict):
     if interval % step_ns or not np.array_equal(starts, day_start + np.arange(starts.shape[1]) * interval):
         raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must divide the file's "
                          f"intervals ({interval / 6e10:g} min), which must start at the day's midnight")
-    light, balance = {}, {}
-    # The diffuse light of a cloudy sky is far above a clear sky's; it follows the sun like the
-    # clear sky's global light does, which is its shape here.
-    for key, shape in (("dni", "dni"), ("ghi", "ghi"), ("dhi", "ghi")):
-        light[key], placed = sub_hourly(hourly[key], clear[shape], per_interval)
-        balance[key] = (float(hourly[key].sum()), float(placed.sum()))
-    # Cells follow each day's mean air temperature (the electrical tables assume one per day),
-    # rounded to 5 C so that days share their tables; wind stays the study's.
-    temp_air = np.round(hourly["temp_air"].mean(axis=1) / 5.0) * 5.0
-    return light, temp_air, balance
+    cos_zenith = np.cos(np.radians(zenith))
+    dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.day_of_year]
+    light, placed = hourly_light(hourly["dni"], hourly["dhi"], clear["ghi"], clear["dni"], cos_zenith, per_interval,
+                                 dni_extra)
+    balance = {key: (float(hourly[key].sum()), float(placed[key].sum())) for key in ("dni", "ghi", "dhi")}
+    # Air temperature and wind stand at the file's own stamps (its meteorological fields are
+    # instantaneous), linear between them.
+    entry = FORMATS[weather_format(weather.path, weather.format)]
+    offset = {"end": 0.5, "start": -0.5, "centre": 0.0}[weather.label or entry.interval_label] + entry.stamp_lag
+    temp_air = interpolate_points(hourly["temp_air"], offset, per_interval)
+    wind_speed = interpolate_points(hourly["wind_speed"], offset, per_interval)
+    return light, temp_air, wind_speed, balance, (hourly, per_interval)
 
 
-def build_sky(study: Study, sites, dates) -> Sky:
+def _measured_light(study: Study, grid: ClockGrid, dates):
+    """Light, air temperature and wind at every step of the grid from the study's measured weather
+    file, at its own step (:func:`foldopt.inputs.weather.study_weather`)."""
+    measured = study_weather(study.weather, study.site)
+    frame = measured.frame
+    flagged = sorted(set(dates) & set(measured.flagged_days))
+    if flagged:
+        gaps = [f"{start:%H:%M}-{stop:%H:%M}" for start, stop, minutes in measured.gaps
+                if start.date() in flagged and minutes > study.weather.max_gap_min]
+        raise WeatherError(f"weather {frame.attrs['weather']}: {flagged[0]} has a daylight gap too long to fill "
+                           f"({', '.join(gaps[:3])}; weather.max_gap_min {study.weather.max_gap_min:g} min)"
+                           + (f", and {len(flagged) - 1} more dates" if len(flagged) > 1 else "")
+                           + "; leave those dates out")
+    rows = weather_days(frame, dates)
+    centres = pd.DatetimeIndex(frame.index).tz_localize(None).as_unit("ns").asi8[rows]
+    if centres.shape != grid.local_ns.shape or not np.array_equal(centres, grid.local_ns):
+        raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must be the measured file's "
+                         f"({measured.step.total_seconds() / 60:g} min)")
+    columns = {key: frame[key].to_numpy(dtype=float)[rows] for key in ("ghi", "dni", "dhi", "temp_air", "wind_speed")}
+    return columns, measured
+
+
+def _members(study: Study, hourly: dict, per_interval: int, clear: dict, zenith, dates, share):
+    """Each block's light drawn as its member of the cloud ensemble of its day
+    (:func:`foldopt.inputs.weather.ensemble.cloud_members`), and how much of the file's light the
+    members keep on average. A day's members are drawn from the seed and the day alone, so that a
+    member is the same whatever else a study runs with it."""
+    inverse, member = share
+    cos_zenith = np.cos(np.radians(zenith))
+    count = int(member.max()) + 1
+    drawn = {key: np.empty((count, len(dates), zenith.shape[1])) for key in ("ghi", "dni", "dhi")}
+    for day, date in enumerate(dates):
+        one = cloud_members(hourly["ghi"][day:day + 1], hourly["dhi"][day:day + 1], clear["ghi"][day:day + 1],
+                            cos_zenith[day:day + 1], per_interval, study.step_min, count,
+                            [study.weather.seed, date.toordinal()])
+        for key in drawn:
+            drawn[key][:, day] = one[key][:, 0]
+    light = {key: values[member, inverse] for key, values in drawn.items()}
+    per_day = len(inverse) / len(dates)  # a day's members: all of them in every chunk (Blocks.chunks)
+    balance = {key: (float(hourly[key].sum()), float(light[key].sum()) / per_interval / per_day)
+               for key in ("dni", "ghi", "dhi")}
+    return light, balance
+
+
+def build_sky(study: Study, sites, dates, member=None) -> Sky:
     """The sky of a study's settings over blocks, one per (site, date), as one array program.
 
     Parameters
@@ -213,6 +282,9 @@ def build_sky(study: Study, sites, dates) -> Sky:
         One per block: latitude, longitude, altitude and time zone.
     dates : sequence of datetime.date
         The local day of each block, one per site.
+    member : array_like of int, optional
+        With a cloud ensemble (``weather.members``), the member of each block: its light is that
+        member's draw (:func:`foldopt.inputs.weather.ensemble.cloud_members`) of its day.
 
     Returns
     -------
@@ -230,8 +302,19 @@ def build_sky(study: Study, sites, dates) -> Sky:
         raise ValueError(f"{len(sites)} sites for {len(dates)} dates")
     if study.weather is not None:
         # A weather file's days are on its own clock, whatever time zone the site names.
-        zone = weather_site(study.weather.path, study.weather.format)["timezone"]
+        zone = (study_weather(study.weather, study.site).site if study.weather.measured
+                else weather_site(study.weather.path, study.weather.format))["timezone"]
         sites = [site.model_copy(update={"timezone": zone}) for site in sites]
+    share = None
+    if member is not None and study.weather is not None and study.weather.members:
+        # The members of a day share its sun, clear sky and air: they are worked out once a day
+        # and a site, and only the light is drawn per member.
+        keys = [(site.latitude, site.longitude, site.altitude, date) for site, date in zip(sites, dates, strict=True)]
+        first = {key: index for index, key in reversed(list(enumerate(keys)))}
+        unique = sorted(first.values())
+        position = {keys[index]: k for k, index in enumerate(unique)}
+        share = (np.array([position[key] for key in keys]), np.asarray(member, dtype=np.int64))
+        sites, dates = [sites[i] for i in unique], [dates[i] for i in unique]
     latitude = np.array([site.latitude for site in sites], dtype=float)[:, None]
     longitude = np.array([site.longitude for site in sites], dtype=float)[:, None]
     altitude = np.array([site.altitude for site in sites], dtype=float)[:, None]
@@ -239,9 +322,33 @@ def build_sky(study: Study, sites, dates) -> Sky:
     sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
     zenith = sun["solar_zenith"]
     temp_air, balance = np.full(len(sites), float(study.temp_air)), None
-    if study.weather is not None:
+    temp_steps = wind_speed = wind_ref = None
+    notes = ()
+    if study.weather is not None and study.weather.measured:
+        light, measured = _measured_light(study, grid, dates)
+        temp_steps, wind_speed = light.pop("temp_air"), light.pop("wind_speed")
+        notes = tuple(measured.report())
+    elif study.weather is not None:
         clear = _clear_sky(grid, zenith, sites, "ineichen", study.linke_turbidity)
-        light, temp_air, balance = _weather_light(study, grid, dates, clear)
+        light, temp_steps, wind_speed, balance, (hourly, per_interval) = _weather_light(study, grid, dates, clear,
+                                                                                      zenith)
+        if share is not None:
+            light, balance = _members(study, hourly, per_interval, clear, zenith, dates, share)
+    if share is not None:
+        inverse = share[0]
+        grid = ClockGrid(grid.utc_ns[inverse], grid.utc_offset_ns[inverse], tuple(grid.timezones[i] for i in inverse),
+                         grid.step_hours)
+        sun = {key: value[inverse] for key, value in sun.items()}
+        zenith, latitude, altitude = sun["solar_zenith"], latitude[inverse], altitude[inverse]
+        temp_steps, wind_speed = temp_steps[inverse], wind_speed[inverse]
+        dates = [dates[i] for i in inverse]
+    if study.weather is not None:
+        lit = light["ghi"] > 0
+        wind_ref = float(np.round(2.0 * wind_speed[lit].mean()) / 2.0) if lit.any() else float(study.wind_speed)
+        temp_steps = equivalent_temp_air(temp_steps, wind_speed, wind_ref, light["ghi"], study.temperature_model)
+        # The block's representative temperature: its lit steps' mean (its whole day's if dark).
+        temp_air = np.where(lit.any(axis=1), (temp_steps * lit).sum(axis=1) / np.maximum(lit.sum(axis=1), 1),
+                            temp_steps.mean(axis=1))
     elif study.sky in CLEAR_SKIES:
         light = _clear_sky(grid, zenith, sites, study.sky, study.linke_turbidity)
     else:
@@ -266,4 +373,5 @@ def build_sky(study: Study, sites, dates) -> Sky:
         sun_vector=normal_vector(zenith, sun["solar_azimuth"]), dni=dni, ghi=ghi, dhi=dhi, terms=terms,
         temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam, weather_balance=balance,
         load_shape=None if study.load_profile is None else load_shape(study.load_profile, grid.clock_hours, dates),
+        temp_steps=temp_steps, wind_speed=wind_speed, wind_ref=wind_ref, weather_notes=notes,
     )

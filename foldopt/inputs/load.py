@@ -23,7 +23,7 @@ from foldopt.errors import ConfigError
 from foldopt.inputs.loads import profile_steps
 from foldopt.inputs.sections import FilesRead
 from foldopt.inputs.study import Study, make_study
-from foldopt.names import WEATHER_FORMATS, canonical
+from foldopt.inputs.weather_files import weather_read
 
 DEFAULT_STUDY = "shin2015"
 
@@ -395,28 +395,7 @@ def resolve_files(data) -> FilesRead:
     """
     if not isinstance(data, dict):
         return FilesRead()
-    return FilesRead(**_weather_read(data.get("weather")), **_profile_read(data.get("load_profile")))
-
-
-def _weather_read(weather) -> dict:
-    spec = {"path": weather} if isinstance(weather, str) else weather
-    path = spec.get("path") if isinstance(spec, dict) else None
-    if not isinstance(path, str):
-        return {}
-    if not Path(path).is_file():
-        return {"weather_missing": True, "weather_problem": f"weather: file not found: {path}"}
-    try:
-        fmt = canonical(spec.get("format"), WEATHER_FORMATS)
-    except ValueError:
-        return {}  # the study names the format's fault
-    from foldopt.inputs.weather import weather_site  # pandas and pvlib: only when a file is named
-
-    try:
-        return {"weather_site": weather_site(path, fmt)}
-    except ConfigError as error:  # foldopt.errors.WeatherError: the file, the line, the reason
-        return {"weather_problem": str(error)}
-    except (ValueError, KeyError, OSError) as error:
-        return {"weather_problem": f"weather: cannot read a site from {path} ({error.__class__.__name__})"}
+    return FilesRead(**weather_read(data.get("weather"), data.get("site")), **_profile_read(data.get("load_profile")))
 
 
 def _profile_read(profile) -> dict:

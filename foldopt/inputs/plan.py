@@ -21,6 +21,7 @@ from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
 from foldopt.inputs.load import read_study, resolve_files, size_limit
+from foldopt.inputs.weather_files import weather_defaults
 from foldopt.inputs.policy import set_path
 from foldopt.inputs.study import Study, format_error
 
@@ -325,8 +326,9 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     if not isinstance(data, dict):
         raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
     data = dict(data)
-    if data.get("weather") is not None and "date" not in data:
-        data["date"] = "year"  # a weather file is a year
+    if data.get("weather") is not None and ("date" not in data or "step_min" not in data):
+        # An hourly file is a year; a measured file its own days at its own step.
+        data = {**weather_defaults(data), **data}
     errors: list[str] = []
     year = data.pop("year", 2025)
     if year_problem(year):
@@ -356,7 +358,9 @@ def make_plan(data, lines: dict | None = None) -> Plan:
         raise ConfigError(errors)
 
     plan = Plan(data, tuple(axes))
-    if data.get("objective") is not None and "date" not in dict(axes):
+    weather = data.get("weather")
+    ensemble = isinstance(weather, dict) and weather.get("members") is not None
+    if data.get("objective") is not None and "date" not in dict(axes) and not ensemble:
         raise ConfigError([_at(lines, ("objective",), "objective: one fold angle for several days needs several "
                                                       "dates (a date range, 'year', or a weather file)")])
     if plan.n_cases > MAX_CASES:

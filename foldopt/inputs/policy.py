@@ -33,6 +33,10 @@ AWAY_FROM_PAPER = ("site.latitude", "site.longitude", "site.altitude", "date", "
 EXACT_NOTE = "exact mode (paper mode is for the paper's own site and day: set mode paper to keep it)"
 
 
+#: Sections a study may give as one value, and the field that value is.
+SHORTHANDS = {"weather": "path", "objective": "statistic", "tracker": "model"}
+
+
 def set_path(data: dict, path: str, value) -> dict:
     """Set one field of a study's data.
 
@@ -53,6 +57,8 @@ def set_path(data: dict, path: str, value) -> dict:
     parts = path.split(".")
     for part in parts[:-1]:
         child = node.get(part)
+        if isinstance(child, str) and part in SHORTHANDS:
+            child = {SHORTHANDS[part]: child}  # weather: FILE is weather: {path: FILE}
         if not isinstance(child, dict):
             child = {}
         node[part] = child

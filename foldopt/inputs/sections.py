@@ -127,6 +127,11 @@ class FilesRead:
         Why the weather file cannot be used: one line naming the file (and the line, the field).
     weather_missing : bool
         Whether the weather file does not exist.
+    weather_step_min : float, optional
+        A measured weather file's step [min].
+    weather_dates : tuple of str, optional
+        A measured weather file's whole days (ISO dates), less those with a daylight gap too long
+        to fill.
     profile_daily : dict, optional
         The load profile file's day: clock times ``HH:MM`` to loads [W].
     profile_problem : str, optional
@@ -136,6 +141,8 @@ class FilesRead:
     weather_site: dict | None = None
     weather_problem: str | None = None
     weather_missing: bool = False
+    weather_step_min: float | None = None
+    weather_dates: tuple | None = None
     profile_daily: dict | None = None
     profile_problem: str | None = None
 
@@ -321,24 +328,76 @@ class Tracker(StrictModel):
         return idle
 
 
+def _check_offset(name: str | None) -> str | None:
+    if name is not None and not isinstance(parse_timezone(name), dt.timezone):
+        raise ValueError(f"{name!r}: a measured file's standard time is a fixed offset such as 'UTC-07:00'")
+    return name
+
+
 class Weather(StrictModel):
-    """A weather file: TMY3, EPW or PVGIS TMY, read through pvlib.iotools (:mod:`foldopt.inputs.weather`).
+    """A weather file, read through pvlib.iotools (:mod:`foldopt.inputs.weather`): an hourly
+    typical year (TMY3, EPW, PVGIS TMY), brought to the study's step, or a measured sub-hourly
+    file (SURFRAD, MIDC, SRML, BSRN, SOLRAD, CRN, a CSV), evaluated at its own.
 
     Parameters
     ----------
     path : str
         The file; a study file's relative path is relative to the study file.
     format : str, optional
-        One of :data:`foldopt.names.WEATHER_FORMATS`; default from the extension.
+        One of :data:`foldopt.names.WEATHER_FORMATS`; default from the extension (hourly formats;
+        a measured file names its format).
     label : str, optional
         What a timestamp marks, one of :data:`foldopt.names.INTERVAL_LABELS`; default the format's.
+    timezone : str, optional
+        A measured file's standard time, a fixed offset (``UTC-07:00``): default the file's, else
+        the offset nearest longitude / 15 h; it also places a CSV's stamps that carry none.
+    decomposition : str
+        How a measured file's ``dni`` and ``dhi`` come from ``ghi`` alone, one of
+        :data:`foldopt.names.DECOMPOSITIONS`; default ``erbs``.
+    max_gap_min : float
+        A measured file's longest daylight gap filled along the clear-sky index [min]; a day with
+        a longer one is left out of the study's days (and refused where asked for). Default 60.
+    members : int, optional
+        An hourly file's cloud ensemble: this many synthetic minute series of each hour
+        (:mod:`foldopt.inputs.weather.ensemble`), 2 to 200; default none (the smooth minutes).
+    seed : int
+        The ensemble's seed; the same seed gives the same members. Default 0.
     """
 
     path: str
-    format: named(names.WEATHER_FORMATS) | None = Field(None, description="default from the extension")
+    format: named(names.WEATHER_FORMATS) | None = Field(None, description="default from the extension (hourly "
+                                                       "formats); a measured file names its format")
     label: named(names.INTERVAL_LABELS) | None = Field(
         None, description="what a timestamp marks; default the format's (TMY3 end, EPW and PVGIS start)"
     )
+    timezone: Annotated[str | None, AfterValidator(_check_offset)] = Field(
+        None, description="a measured file's standard time, e.g. UTC-07:00; default the file's")
+    decomposition: named(names.DECOMPOSITIONS) = Field("erbs", description="a measured file's dni and dhi from ghi")
+    max_gap_min: interval(0, 1440, unit=" min") = 60.0
+    members: Annotated[int, Field(ge=2, le=200)] | None = Field(
+        None, description="an hourly file's cloud ensemble of this many members")
+    seed: Annotated[int, Field(ge=0)] = 0
+
+    @property
+    def measured(self) -> bool:
+        """Whether the file is a measured one (its format is not an hourly one)."""
+        return self.format is not None and self.format not in names.HOURLY_WEATHER_FORMATS
+
+    @model_validator(mode="after")
+    def _options_of_its_kind(self):
+        measured_only = [("timezone", self.timezone is not None), ("decomposition", self.decomposition != "erbs"),
+                         ("max_gap_min", self.max_gap_min != 60.0)]
+        problems = [f"weather.{name}: is only used by measured weather files (format "
+                    f"{', '.join(f for f in names.WEATHER_FORMATS if f not in names.HOURLY_WEATHER_FORMATS)})"
+                    for name, given in measured_only if given and not self.measured]
+        if self.measured and self.members is not None:
+            problems.append("weather.members: a cloud ensemble is drawn from an hourly file; a measured file's "
+                            "minutes are its own")
+        if self.seed != 0 and self.members is None:
+            problems.append("weather.seed: is only used by a cloud ensemble (weather.members)")
+        if problems:
+            raise ValueError("\n".join(problems))
+        return self
 
 
 _STATISTIC = re.compile(r"^(mean|min|worst-month|p(\d{1,2}))$")

@@ -219,8 +219,21 @@ class Study(StrictModel):
         files = FilesRead.given(info) if self.weather is not None else None
         if files is not None and files.weather_missing:
             raise ValueError(files.weather_problem)
-        if self.weather is not None and not math.isclose(60 / self.step_min, round(60 / self.step_min)):
+        if self.weather is not None and self.weather.members is not None:
+            if self.objective is None:
+                raise ValueError("weather.members: a cloud ensemble chooses one fold angle over its members; give an "
+                                 "objective (e.g. objective: mean)")
+            if self.objective.visits is not None:
+                raise ValueError("objective.visits: re-fold schedules are not drawn over a cloud ensemble; leave out "
+                                 "weather.members or objective.visits")
+        measured = self.weather is not None and self.weather.measured
+        if self.weather is not None and not measured and not math.isclose(60 / self.step_min,
+                                                                            round(60 / self.step_min)):
             raise ValueError(f"step_min = {self.step_min:g}: must divide the weather file's 60-min intervals")
+        if measured and files is not None and files.weather_step_min is not None and not math.isclose(
+                self.step_min, files.weather_step_min):
+            raise ValueError(f"step_min = {self.step_min:g}: a measured weather file is evaluated at its own step, "
+                             f"{files.weather_step_min:g} min; leave step_min out or set it to that")
         checked = files is not None and not self.force_site
         if checked and files.weather_problem is not None:
             raise ValueError(files.weather_problem)

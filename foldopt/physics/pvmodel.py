@@ -37,7 +37,7 @@ import numpy as np
 import pvlib
 from scipy.special import lambertw
 
-from foldopt.names import PV_MODELS, TEMPERATURE_MODELS
+from foldopt.names import PV_MODELS
 
 IRRADIANCE_REF = 1000.0  # [W/m^2], STC
 TEMPERATURE_REF = 25.0  # [C], STC
@@ -332,41 +332,6 @@ def _lambertw_exp(x):
     for _ in range(4):
         w = w - (w + np.log(w) - x) / (1.0 + 1.0 / w)
     return w
-
-
-def cell_temperature(poa_global, temp_air, wind_speed, model="fixed"):
-    """Cell temperature from irradiance, air temperature and wind.
-
-    ``fixed``: the air temperature (a cell held at it, e.g. 25 C = STC). ``sapm``: pvlib's SAPM
-    cell temperature, open rack glass/polymer (King et al. 2004, SAND2004-3535, Eq. 11 and 12).
-
-    Parameters
-    ----------
-    poa_global : array_like
-        Plane-of-array irradiance [W/m^2].
-    temp_air : float or array_like
-        Air temperature [C].
-    wind_speed : float or array_like
-        Wind speed [m/s] (``sapm`` only).
-    model : {'fixed', 'sapm'}
-        Temperature model.
-
-    Returns
-    -------
-    numpy.ndarray
-        Cell temperature [C], shaped as ``poa_global``.
-
-    Raises
-    ------
-    ValueError
-        If ``model`` is not one of :data:`foldopt.names.TEMPERATURE_MODELS`.
-    """
-    if model == "fixed":
-        return np.broadcast_to(np.asarray(temp_air, dtype=float), np.shape(poa_global)).copy()
-    if model == "sapm":
-        params = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_polymer"]
-        return np.asarray(pvlib.temperature.sapm_cell(poa_global, temp_air, wind_speed, **params))
-    raise ValueError(f"temperature_model must be one of {', '.join(TEMPERATURE_MODELS)}; got {model!r}")
 
 
 @dataclass(frozen=True)

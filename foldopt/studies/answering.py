@@ -55,6 +55,16 @@ def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dic
     return notes
 
 
+def weather_notes(result) -> list[dict]:
+    """What reading a measured weather file did, as notes that concern every design.
+
+    Parameters
+    ----------
+    result : foldopt.studies.sweeps.SweepResult or foldopt.studies.day.StudyResult
+    """
+    return [{"note": note, "designs": []} for note in getattr(result, "weather_notes", ())]
+
+
 def study_question(study, varied: tuple = ()) -> dict:
     """What a study asks, label to text; the config paths in ``varied`` are said to vary.
 
@@ -158,7 +168,8 @@ def of_study(result) -> Answer:
     columns = ["design", "fold_angle_deg", "t_solar_h", "energy_harvested_wh", "gain_vs_flat_pct", "pct_of_tracker",
                "note"]
     return Answer("study", study.name, study_question(study), _defaults(result), result_part,
-                  summary[columns], near_table, pd.DataFrame(), design_notes(summary), tuple(lines))
+                  summary[columns], near_table, pd.DataFrame(),
+                  design_notes(summary) + weather_notes(result.day.sky), tuple(lines))
 
 
 def _defaults(result) -> dict | None:
@@ -212,7 +223,7 @@ def of_sweep(result) -> Answer:
     question = study_question(plan.base, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
     return Answer("sweep", plan.base.name, question, _defaults(result), plain(part), designs, near, pd.DataFrame(),
-                  design_notes(table, plan.n_cases), tuple(lines))
+                  design_notes(table, plan.n_cases) + weather_notes(result), tuple(lines))
 
 
 def _of_annual(result) -> Answer:
@@ -226,9 +237,12 @@ def _of_annual(result) -> Answer:
     statistic = objective.statistic
     objectives = result.extras["annual_objective"]
     keys = [c for c in objectives.columns if c not in ("design", "objective", "objective_h", "worst_month",
-                                                       "mean_t_solar_h", "fold_angle_deg", *NEAR_OPTIMAL)]
-    lines = [f"{study.name}: {len(_dates(plan))} days, one fold angle all year, maximising the {statistic} of "
-             f"daily t_solar"]
+                                                       "mean_t_solar_h", "fold_angle_deg", *NEAR_OPTIMAL,
+                                                       *ENSEMBLE_COLUMNS)]
+    members = study.weather.members if study.weather is not None and study.weather.members else None
+    count = len(_dates(plan))
+    lines = [f"{study.name}: {count} day{'s' if count != 1 else ''}, one fold angle "
+             f"{'all year' if count > 1 else 'for the day'}, maximising the {statistic} of daily t_solar"]
     groups = list(objectives.groupby(keys, sort=False))
     part = {"objective": statistic, "load": describe_load(study), "per_case": []}
     schedule = _schedule(result.extras)
@@ -256,6 +270,17 @@ def _of_annual(result) -> Answer:
                      f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}"
                      + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"))
         lines.append("  " + _range_text(twofold.to_dict()))
+        if members:
+            spread = {d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in (10, 50, 90)} for d in MAIN_DESIGNS}
+            case["objective_spread_h"] = spread
+            case["members"] = members
+            case.update({key: twofold[key] for key in ("chosen_wins_pct", "within_tolerance_pct")})
+            lines.append(f"  over {members} cloud members: {statistic} t_solar P10/P50/P90 "
+                         + "; ".join(f"{d} {_hours(spread[d]['p10'])}/{_hours(spread[d]['p50'])}/"
+                                     f"{_hours(spread[d]['p90'])}" for d in MAIN_DESIGNS))
+            lines.append(f"  {twofold['fold_angle_deg']:g} deg is the best angle of {twofold['chosen_wins_pct']:.0f} % "
+                         f"of the members and within the near-optimal tolerance of their best for "
+                         f"{twofold['within_tolerance_pct']:.0f} %")
         if len(schedule):
             mine = schedule[(schedule["p_load_w"] == load)] if load is not None else schedule
             for settings, visits in mine.groupby("settings", sort=True):
@@ -267,7 +292,7 @@ def _of_annual(result) -> Answer:
     if len(groups) > 8:
         lines.append(f"... and {len(groups) - 8} more cases (annual_objective.csv)")
     designs = objectives[[*keys, "design", "objective", "objective_h", "worst_month", "mean_t_solar_h",
-                          "fold_angle_deg"]]
+                          "fold_angle_deg", *[c for c in ENSEMBLE_COLUMNS if c in objectives]]]
     if statistic != "worst-month":
         designs = designs.drop(columns="worst_month")
     twofold_rows = objectives[objectives["design"] == "twofold"]
@@ -275,7 +300,12 @@ def _of_annual(result) -> Answer:
     question = study_question(study, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
     return Answer("annual", study.name, question, _defaults(result), plain(part), designs, near, schedule,
-                  design_notes(result.table, plan.n_cases), tuple(lines))
+                  design_notes(result.table, plan.n_cases) + weather_notes(result), tuple(lines))
+
+
+#: The annual objective's columns over a cloud ensemble (foldopt.studies.sweeps.objective_table).
+ENSEMBLE_COLUMNS = ("objective_p10_h", "objective_p50_h", "objective_p90_h", "chosen_wins_pct",
+                    "within_tolerance_pct")
 
 
 def _dates(plan) -> tuple:

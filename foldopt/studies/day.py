@@ -23,8 +23,9 @@ from foldopt.engine.metrics import (design_condition, energy_served, load_for_t_
                              per_load, relative_to, t_solar)
 from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.studies.sizing import flat_area_multiple
-from foldopt.studies.designs import (DESIGNS, Blocks, design_metrics, near_optimal, sky_tracker_draw,
-                             sky_tracker_orientation, sky_tracker_power, standby_available)
+from foldopt.studies.designs import (DESIGNS, Blocks, design_metrics, sky_tracker_draw, sky_tracker_orientation,
+                                     sky_tracker_power, standby_available)
+from foldopt.studies.objectives import near_optimal
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
 
@@ -46,7 +47,7 @@ class Day:
         study = study.resolved()
         self.study = study
         self.sky = sky = build_sky(study, [study.site], [study.date])
-        self.electrical = engines.electrical_for(study, sky.temp_air[0])
+        self.electrical = engines.electrical_for(study, sky.temp_air[0], sky.wind_ref)
         self.times = sky.grid.times(0)
         self.step_hours = sky.step_hours
         self.solar_zenith, self.solar_azimuth = sky.solar_zenith[0], sky.solar_azimuth[0]
@@ -68,7 +69,8 @@ class Day:
     def flat_power(self):
         """Power of the flat panel over the day [W], shape (n_time,)."""
         panel = self.study.panel
-        return self.electrical.panel_power(self._poa(np.array([panel.tilt]), np.array([panel.azimuth]))[0], panel.area)
+        return engines.panel_power(self.sky, self.study, self._poa(np.array([panel.tilt]), np.array([panel.azimuth])),
+                                   panel.area)[0]
 
     def tracker_orientation(self, model=None):
         """Surface tilt and azimuth of a tracker over the day.
@@ -200,7 +202,7 @@ class StudyResult:
         [deg]; the heuristic is NaN where the paper's rule has no answer.
     near_optimal : dict
         The near-optimal range of the fold angle on the sweep's grid and the recommended angle at
-        its centre (:func:`foldopt.studies.designs.near_optimal`) [deg], and its tolerance [h].
+        its centre (:func:`foldopt.studies.objectives.near_optimal`) [deg], and its tolerance [h].
     standby : tuple
         (table, break-even draw [W]) of :func:`standby_sweep`.
     engine : str

@@ -8,10 +8,10 @@ annual groups of :func:`foldopt.studies.sweeps.run_plan` and the sites of
 share one setup) and a set of loads:
 
 - :func:`fold_hours`: t_solar of the twofold panel at every angle of the study's grid, for every
-  load, in one engine pass; :func:`best_angle_index` and :func:`near_optimal` choose from it;
+  load, in one engine pass; :mod:`foldopt.studies.objectives` chooses from it;
 - :func:`design_metrics`: every daily metric of the four :data:`DESIGNS` at a chosen angle;
 - :func:`daily_designs`: each day's t_solar and energy of every design at every angle, for
-  statistics over many days (:func:`objective_value`);
+  statistics over many days (:func:`foldopt.studies.objectives.objective_value`);
 - the trackers' orientation, power and own draw (:func:`sky_tracker_power`,
   :func:`sky_tracker_draw`) and what a standby draw leaves (:func:`standby_available`).
 """
@@ -24,7 +24,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from foldopt.engine import rows as engines
-from foldopt.inputs.sections import NearOptimal
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.engine.sky import Sky, build_sky
@@ -35,17 +34,6 @@ DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
 CHUNK_ROW_LOADS = 4_000_000
 #: Time steps of the blocks of one chunk's sky.
 CHUNK_STEPS = 1_100_000
-
-
-def best_angle_index(hours):
-    """Index (...) of the longest t_solar along the last axis; ties go to the least folded angle.
-
-    Parameters
-    ----------
-    hours : numpy.ndarray
-        t_solar [h] on an ascending fold-angle grid, (..., n_angles).
-    """
-    return hours.shape[-1] - 1 - np.argmax(hours[..., ::-1], axis=-1)
 
 
 def setup_key(study: Study) -> str:
@@ -155,6 +143,9 @@ class Blocks:
         Each block's site and local date.
     tilt, azimuth : numpy.ndarray
         Each block's flat panel [deg], (n_blocks,).
+    member : numpy.ndarray, optional
+        With a cloud ensemble (``weather.members``), each block's member (n_blocks,): a day's
+        members are consecutive blocks.
     """
 
     study: Study
@@ -162,6 +153,13 @@ class Blocks:
     dates: tuple
     tilt: np.ndarray
     azimuth: np.ndarray
+    member: np.ndarray | None = None
+
+    @property
+    def members(self) -> int:
+        """Members of the cloud ensemble (1 without one)."""
+        weather = self.study.weather
+        return weather.members if weather is not None and weather.members else 1
 
     @classmethod
     def of(cls, studies) -> Blocks:
@@ -186,19 +184,23 @@ class Blocks:
         dates : sequence of datetime.date
         """
         study = study.resolved()
+        members = study.weather.members if study.weather is not None and study.weather.members else 1
+        dates = tuple(date for date in dates for _ in range(members))  # a day's members together
         count = len(dates)
-        return cls(study, (study.site,) * count, tuple(dates), np.full(count, study.panel.tilt),
-                   np.full(count, study.panel.azimuth))
+        member = np.tile(np.arange(members), count // members) if members > 1 else None
+        return cls(study, (study.site,) * count, dates, np.full(count, study.panel.tilt),
+                   np.full(count, study.panel.azimuth), member)
 
     def __len__(self) -> int:
         return len(self.dates)
 
     def __getitem__(self, part: slice) -> Blocks:
-        return Blocks(self.study, self.sites[part], self.dates[part], self.tilt[part], self.azimuth[part])
+        return Blocks(self.study, self.sites[part], self.dates[part], self.tilt[part], self.azimuth[part],
+                      None if self.member is None else self.member[part])
 
     def sky(self) -> Sky:
         """The blocks' :class:`foldopt.engine.sky.Sky` (:func:`foldopt.engine.sky.build_sky`)."""
-        return build_sky(self.study, self.sites, self.dates)
+        return build_sky(self.study, self.sites, self.dates, self.member)
 
     def chunks(self, n_loads: int):
         """Slices of blocks whose rows x loads and time steps stay within the chunk bounds.
@@ -216,6 +218,8 @@ class Blocks:
         per_block = len(self.study.fold_angles.grid()) * max(n_loads, 1)
         n_steps = round(24 * 60 / self.study.step_min)
         size = max(1, min(CHUNK_ROW_LOADS // per_block, CHUNK_STEPS // n_steps))
+        # A day's members stay in one chunk: they share its sun (foldopt.engine.sky.build_sky).
+        size = max(self.members, size // self.members * self.members)
         return [slice(start, min(start + size, len(self))) for start in range(0, len(self), size)]
 
 
@@ -330,102 +334,6 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
                                  np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
         # A tracker whose drive costs more than it harvests says so where every table's note starts.
         "condition": design_condition(sky.conditions()[:, None, None], columns["energy_harvested_wh"]),
-    }
-
-
-def objective_value(hours, months, statistic: str, season=None):
-    """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
-
-    Parameters
-    ----------
-    hours : array_like
-        Daily t_solar [h], (days, ...).
-    months : array_like
-        (days,) month of each day [1-12].
-    statistic : str
-        ``mean``, ``min``, ``pNN`` (the NN-th percentile over days) or ``worst-month`` (the lowest
-        monthly mean).
-    season : sequence of int, optional
-        Months that restrict the days.
-
-    Returns
-    -------
-    numpy.ndarray
-        The statistic [h], (...).
-    """
-    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
-    if season:
-        keep = np.isin(months, season)
-        hours, months = hours[keep], months[keep]
-    if statistic == "mean":
-        return hours.mean(axis=0)
-    if statistic == "min":
-        return hours.min(axis=0)
-    if statistic == "worst-month":
-        return np.min([hours[months == m].mean(axis=0) for m in np.unique(months)], axis=0)
-    return np.percentile(hours, float(statistic[1:]), axis=0)
-
-
-def worst_month(hours, months):
-    """The month [1-12], (...), of the lowest monthly mean: where a ``worst-month`` objective is found.
-
-    Parameters
-    ----------
-    hours : array_like
-        Daily t_solar [h], (days, ...).
-    months : array_like
-        (days,) month of each day [1-12].
-    """
-    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
-    present = np.unique(months)
-    means = np.stack([hours[months == m].mean(axis=0) for m in present])
-    return present[np.argmin(means, axis=0)]
-
-
-def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
-    """The plateau of fold angles around the best: every grid angle on the best one's side of the
-    first angles that fall short, and the recommended angle at its centre.
-
-    An angle is near-optimal when its value lies within ``tolerance`` of the best
-    (:meth:`foldopt.inputs.sections.NearOptimal.tolerance_h`: 1 % or 1 min by default, whichever is
-    larger). The range is the contiguous run of such angles that holds the best one
-    (:func:`best_angle_index`); the recommended angle is the grid angle nearest its centre (ties to
-    the less folded), so that a hinge set a few degrees off still lies on the plateau.
-
-    Parameters
-    ----------
-    angles : array_like
-        The fold-angle grid [deg], ascending, (n_angles,).
-    values : array_like
-        t_solar or an objective [h] at each angle, (..., n_angles).
-    tolerance : foldopt.inputs.sections.NearOptimal
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg`` [deg] and
-        ``near_optimal_tolerance_h`` [h], each (...); NaN where no angle carries the load.
-    """
-    angles = np.asarray(angles, dtype=float)
-    values = np.asarray(values, dtype=float)
-    best = best_angle_index(values)
-    top = np.take_along_axis(values, best[..., None], axis=-1)[..., 0]
-    tol = tolerance.tolerance_h(top)
-    index = np.arange(angles.size)
-    short = values < (top - tol)[..., None]
-    below, above = short & (index < best[..., None]), short & (index > best[..., None])
-    lo = np.where(below.any(axis=-1), angles.size - np.argmax(below[..., ::-1], axis=-1), 0)
-    hi = np.where(above.any(axis=-1), np.argmax(above, axis=-1) - 1, angles.size - 1)
-    centre = (angles[lo] + angles[hi]) / 2.0
-    distance = np.where((index >= lo[..., None]) & (index <= hi[..., None]),
-                        np.abs(angles - centre[..., None]), np.inf)
-    recommended = best_angle_index(-distance)
-    carried = top > 0
-    return {
-        "near_optimal_lo_deg": np.where(carried, angles[lo], np.nan),
-        "near_optimal_hi_deg": np.where(carried, angles[hi], np.nan),
-        "recommended_fold_angle_deg": np.where(carried, angles[recommended], np.nan),
-        "near_optimal_tolerance_h": np.where(carried, tol, np.nan),
     }
 
 

@@ -47,7 +47,8 @@ SWEEP_OPTIONS = {
     "pv_model": "pv_model", "module": "module", "connection": "connection", "switch_series": "switch_series",
     "no_bypass": "bypass_diodes", "converter_efficiency": "converter_efficiency", "temp_air": "temp_air",
     "exact_electrical": "exact_electrical", "step_min": "step_min", "angle_step": "fold_angles.step",
-    "load_profile": "load_profile",
+    "load_profile": "load_profile", "weather_format": "weather.format", "members": "weather.members",
+    "seed": "weather.seed",
 }
 #: Sweep options that take a value, a range or a list (:func:`foldopt.inputs.plan.parse_values`).
 _LISTED = ("lat", "lon", "p_load", "p_load_scale", "tilt", "days")
@@ -129,9 +130,11 @@ def plan_request(data: dict, changes: dict | None = None, *, axis: str | None = 
     new, decided = policy.apply(data, changes, field)
     if field is not None and field not in changes:
         new = policy.set_path(new, field, _default_loads(new) if field == "p_load" else DEFAULT_RANGES[field])
-    if axis == "angle" and new.get("weather") is not None and "objective" not in new and not (
-            "date" in changes and policy.is_single(changes["date"])):
-        new["objective"] = {"statistic": "mean"}  # a year of weather at one fold angle
+    weather = new.get("weather")
+    ensemble = isinstance(weather, dict) and weather.get("members") is not None
+    if axis == "angle" and weather is not None and "objective" not in new and (ensemble or not (
+            "date" in changes and policy.is_single(changes["date"]))):
+        new["objective"] = {"statistic": "mean"}  # a year of weather (or a day's ensemble) at one fold angle
     study_year = _ISO_DATE.match(str(data.get("date", "")))
     if "year" not in new and study_year:
         new["year"] = int(study_year.group(1))  # days of year are the study's year's
@@ -311,7 +314,7 @@ def sweep_changes(options: dict, data: dict) -> dict:
                 errors.append(f"{flag} = {options[option]!r}: {error}")
                 continue
         elif option == "weather":
-            value = str(value)
+            value = {"path": str(value)}  # a new file: none of the study's file's options
         elif option == "load_profile":
             value = {"file": str(value)}
         changes[SWEEP_OPTIONS[option]] = value

@@ -22,8 +22,8 @@ import pandas as pd
 
 from foldopt.engine import rows as engines
 from foldopt.inputs.plan import Plan
-from foldopt.studies.designs import (DESIGNS, Blocks, best_angle_index, design_metrics, fold_hours, near_optimal,
-                             objective_value, setup_key, worst_month)
+from foldopt.studies.designs import DESIGNS, Blocks, design_metrics, fold_hours, setup_key
+from foldopt.studies.objectives import best_angle_index, ensemble_choice, near_optimal, objective_value, worst_month
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 
@@ -38,6 +38,7 @@ class SweepResult:
     engine: str = "numba"
     weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
     request: object = None  # the foldopt.studies.request.Request the plan came from, if any
+    weather_notes: tuple = ()  # what reading a measured weather file did (foldopt.engine.sky.Sky.weather_notes)
 
     @functools.cached_property
     def answer(self):
@@ -86,6 +87,9 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     loads = np.asarray(axes.pop("p_load", (plan.data.get("p_load"),)), dtype=float)
     objective = plan.base.objective
     dates = axes.pop("date", None) if objective is not None else None
+    weather = plan.base.weather
+    if objective is not None and dates is None and weather is not None and weather.members:
+        dates = (plan.base.date,)  # one day's cloud ensemble: one fold angle over its members
     paths = list(axes)
     choices = [dict(zip(paths, values, strict=True)) for values in itertools.product(*axes.values())]
     # A fixed panel keeps one fold angle all year: an annual group is the dates of one choice.
@@ -105,9 +109,12 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     extras: dict = {}
     light: dict = {}
 
+    weather_notes: dict = {}
+
     def counted(sky: Sky) -> Sky:
         for key, (total, kept) in (sky.weather_balance or {}).items():
             light[key] = np.add(light.get(key, (0.0, 0.0)), (total, kept))
+        weather_notes.update(dict.fromkeys(sky.weather_notes))
         return sky
 
     if dates:
@@ -143,7 +150,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     table = _table(cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]})
     kept = {key: {"file_wh_m2": float(total), "kept_pct": float(100 * kept / total) if total else 100.0}
             for key, (total, kept) in light.items()} or None
-    return SweepResult(plan, table, extras, engine, kept, request)
+    return SweepResult(plan, table, extras, engine, kept, request, tuple(weather_notes))
 
 
 def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
@@ -155,13 +162,20 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         skies.append(counted(blocks[part].sky()))
         angles, hours, _ = fold_hours(skies[-1], blocks[part], loads, engine)
         daily.append(hours)
-        advance(len(blocks[part]))
-    months = [date.month for date in blocks.dates]
-    daily = np.concatenate(daily).transpose(0, 2, 1)  # (days, loads, angles)
-    score = objective_value(daily, months, objective.statistic, objective.months)
-    fixed = best_angle_index(score)  # (n_loads,)
-    metrics, series = [], {"p_twofold_w": [], "switch_state": []}
+        advance(len(blocks[part]) // blocks.members)
+    members = blocks.members
+    months = [date.month for date in blocks.dates[::members]]
+    daily = np.concatenate(daily).transpose(0, 2, 1)  # (blocks, loads, angles): a day's members together
     study = blocks.study
+    ensemble = None
+    if members > 1:
+        by_member = daily.reshape(len(months), members, *daily.shape[1:]).swapaxes(0, 1)
+        ensemble = ensemble_choice(by_member, months, objective.statistic, objective.months, study.near_optimal)
+        score, fixed = ensemble["score"], ensemble["fixed"]
+    else:
+        score = objective_value(daily, months, objective.statistic, objective.months)
+        fixed = best_angle_index(score)  # (n_loads,)
+    metrics, series = [], {"p_twofold_w": [], "switch_state": []}
     for part, sky in zip(parts, skies, strict=True):
         chunk = blocks[part]
         metrics.append(design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
@@ -169,26 +183,55 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         # The day x hour maps of the first load's angle, every day at once.
         orientation = engines.fold_orientations(study, chunk.tilt, chunk.azimuth, angles[fixed[:1]])[:, 0]
         powers, state = engines.powers(sky, study, orientation, series=study.switch_series, with_state=True)
-        series["p_twofold_w"].append(powers[study.connection])
-        series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
-        advance(len(chunk))
+        first = slice(None, None, members)  # the maps show the first member of each day
+        series["p_twofold_w"].append(powers[study.connection][first])
+        series["switch_state"].append(np.where(powers["switching"] > 0, state, -1)[first])
+        advance(len(chunk) // members)
     clock = skies[0].grid.clock_hours[0]
-    design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (days, loads, designs)
+    design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (blocks, loads, designs)
     near = near_optimal(angles, score, study.near_optimal)  # each (loads,)
-    refold = {"annual_objective": objective_table(blocks, loads, angles[fixed], design_hours, months, objective, near)}
+    spread = None
+    if ensemble is not None:
+        design_hours = design_hours.reshape(len(months), members, *design_hours.shape[1:])
+        spread = {"member_objective_h": np.stack([objective_value(design_hours[:, m], months, objective.statistic,
+                                                                  objective.months) for m in range(members)]),
+                  **{key: ensemble[key] for key in ("chosen_wins_pct", "within_tolerance_pct", "regret_h")}}
+        design_hours = design_hours.mean(axis=1)  # (days, loads, designs): the members' mean day
+    refold = {"annual_objective": objective_table(blocks, loads, angles[fixed], design_hours, months, objective, near,
+                                                  spread)}
     if objective.visits:
         refold.update(refold_tables(blocks, loads, angles, daily, months, objective, design_hours))
-    extras = {"dates": list(blocks.dates), "hours": clock, "fold_angle": float(angles[fixed[0]]), **refold,
+    extras = {"dates": list(blocks.dates[::members]), "hours": clock, "fold_angle": float(angles[fixed[0]]), **refold,
               **{key: np.concatenate(value) for key, value in series.items()},
               "by_angle": pd.DataFrame({
                   "p_load_w": np.repeat(loads, angles.size), "fold_angle_deg": np.tile(angles, loads.size),
                   "objective_h": score.ravel(), "mean_t_solar_h": daily.mean(axis=0).ravel(),
                   "min_t_solar_h": daily.min(axis=0).ravel(),
                   "chosen": np.ravel(np.arange(angles.size) == fixed[:, None]),
+                  **({"wins_pct": ensemble["wins_pct"].ravel()} if ensemble is not None else {}),
               })}
     group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
-    group.update(_twofold_only({key: np.broadcast_to(value, (len(blocks), loads.size)) for key, value in near.items()}))
+    if members > 1:
+        group = _over_members(group, members)
+    group.update(_twofold_only({key: np.broadcast_to(value, (len(months), loads.size)) for key, value in near.items()}))
     return group, extras
+
+
+def _over_members(group: dict, members: int) -> dict:
+    """Each day's metrics over the members of a cloud ensemble (blocks of a day's members together):
+    their mean, and the spread of t_solar across members (P10, P50, P90) [h]."""
+    out = {}
+    for name, values in group.items():
+        shaped = values.reshape(values.shape[0] // members, members, *values.shape[1:])
+        out[name] = shaped[:, 0] if name in ("condition", "fold_angle_deg") else np.nanmean(shaped, axis=1)
+    hours = group["t_solar_h"].reshape(-1, members, *group["t_solar_h"].shape[1:])
+    for pct in ENSEMBLE_PERCENTILES:
+        out[f"t_solar_p{pct}_h"] = np.percentile(hours, pct, axis=1)
+    return out
+
+
+#: The percentiles of each day's t_solar and of the objective over a cloud ensemble's members.
+ENSEMBLE_PERCENTILES = (10, 50, 90)
 
 
 def _twofold_only(values: dict) -> dict:
@@ -202,11 +245,12 @@ def _twofold_only(values: dict) -> dict:
     return out
 
 
-def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, objective, near) -> pd.DataFrame:
+def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, objective, near,
+                    spread: dict | None = None) -> pd.DataFrame:
     """The objective of one annual group in its own terms, per load and design: the statistic, its
     value [h], for ``worst-month`` the month it is found in, the mean daily t_solar [h], the fold
     angle kept all year and, for the twofold panel, the near-optimal range and recommended angle
-    (:func:`foldopt.studies.designs.near_optimal`).
+    (:func:`foldopt.studies.objectives.near_optimal`).
 
     Parameters
     ----------
@@ -223,7 +267,13 @@ def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, ob
     objective : Objective
         The statistic and season.
     near : dict of numpy.ndarray
-        The twofold panel's :func:`foldopt.studies.designs.near_optimal`, (n_loads,) each.
+        The twofold panel's :func:`foldopt.studies.objectives.near_optimal`, (n_loads,) each.
+    spread : dict, optional
+        Over a cloud ensemble: ``member_objective_h`` (members, loads, designs), each member's
+        objective, whose mean is the objective and whose P10/P50/P90 the table adds; and the
+        twofold panel's ``chosen_wins_pct`` and ``within_tolerance_pct`` (loads,)
+        (:func:`foldopt.studies.objectives.ensemble_choice`). ``design_hours`` is then the
+        members' mean day.
 
     Returns
     -------
@@ -232,6 +282,9 @@ def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, ob
     """
     statistic = objective.statistic
     values = objective_value(design_hours, months, statistic, objective.months)  # (loads, designs)
+    if spread is not None:
+        values = spread["member_objective_h"].mean(axis=0)
+        quantiles = {pct: np.percentile(spread["member_objective_h"], pct, axis=0) for pct in ENSEMBLE_PERCENTILES}
     season = np.isin(months, objective.months) if objective.months else np.ones(len(months), bool)
     month = worst_month(design_hours[season], np.asarray(months)[season]) if statistic == "worst-month" else None
     site = blocks.study.site
@@ -248,6 +301,10 @@ def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, ob
                 "fold_angle_deg": float(fold_angles[index]) if twofold else (180.0 if design == "flat" else np.nan),
                 **{key: float(value[index]) if twofold else np.nan for key, value in near.items()},
             })
+            if spread is not None:
+                rows[-1].update({f"objective_p{pct}_h": float(q[index, d]) for pct, q in quantiles.items()})
+                rows[-1].update({key: float(spread[key][index]) if twofold else np.nan
+                                 for key in ("chosen_wins_pct", "within_tolerance_pct")})
     return pd.DataFrame(rows)
 
 

@@ -36,7 +36,8 @@ from foldopt.inputs.plan import parse_dates, parse_values, year_problem
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, format_errors
 from foldopt.errors import ConfigError
-from foldopt.studies.designs import Blocks, best_angle_index, daily_designs, near_optimal, objective_value
+from foldopt.studies.designs import Blocks, daily_designs
+from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
@@ -295,7 +296,7 @@ def evaluate_sites(study: dict, sites: Sequence[dict], loads: Sequence[float], r
         ``pct_of_tracker`` (of the objective), ``energy_gain_vs_flat_pct``; and
         the near-optimal range of the fold angle and the recommended angle at its centre
         (``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg``,
-        ``near_optimal_tolerance_h``: :func:`foldopt.studies.designs.near_optimal`);
+        ``near_optimal_tolerance_h``: :func:`foldopt.studies.objectives.near_optimal`);
         ``tracker_break_even_standby_w``, the standby draw [W] above which the twofold panel's
         objective exceeds the tracker's (0 where it already does; NaN where the twofold panel
         never carries the load).

@@ -16,6 +16,10 @@ Every file is checked when it is read (:mod:`~foldopt.inputs.weather.qc`): any f
 period needs the file to hold every day of it, whole (:func:`weather_days`). The hourly means
 become light at every step of a study in :mod:`~foldopt.inputs.weather.downscale`.
 
+Measured files (SURFRAD, MIDC, SRML, BSRN, SOLRAD, CRN and a generic CSV,
+:data:`MEASURED_FORMATS`) are read by :mod:`~foldopt.inputs.weather.measured` and evaluated at
+their own step (:func:`measured_weather`, :func:`study_weather`); a study names their format.
+
 The package may import pandas, pvlib and the leaves (:mod:`foldopt.errors`, :mod:`foldopt.names`).
 
 References
@@ -34,11 +38,16 @@ import pandas as pd
 from foldopt.errors import WeatherError
 from foldopt.inputs.weather import epw, pvgis, tmy3
 from foldopt.inputs.weather.formats import HOUR
+from foldopt.inputs.weather.measured import STATION_FORMATS, MeasuredWeather, read_measured
 from foldopt.inputs.weather.qc import COLUMNS, check_rows
 
-#: The weather formats by name, in the order of :data:`foldopt.names.WEATHER_FORMATS`: a new format
-#: is its module and its entry here (and its name and description there).
+#: The hourly weather formats by name, in the order of :data:`foldopt.names.WEATHER_FORMATS`: a new
+#: format is its module and its entry here (and its name and description there).
 FORMATS = {entry.name: entry for entry in (tmy3.FORMAT, epw.FORMAT, pvgis.FORMAT)}
+#: The measured formats (:mod:`~foldopt.inputs.weather.measured`), the rest of
+#: :data:`foldopt.names.WEATHER_FORMATS`: evaluated at their own step. Their extensions are shared
+#: (``.dat``, ``.txt``, ``.csv``), so a study names the format.
+MEASURED_FORMATS = STATION_FORMATS
 
 
 def weather_format(path: Path, fmt: str | None = None) -> str:
@@ -54,7 +63,8 @@ def weather_format(path: Path, fmt: str | None = None) -> str:
     -------
     str
         ``fmt``, or the format its extension names (``.csv`` TMY3, ``.epw`` EPW, ``.json`` PVGIS:
-        each format's ``suffixes``); TMY3 for any other.
+        each hourly format's ``suffixes``); TMY3 for any other. A measured format is named, never
+        guessed.
 
     Raises
     ------
@@ -62,8 +72,8 @@ def weather_format(path: Path, fmt: str | None = None) -> str:
         For a ``fmt`` that is no format.
     """
     if fmt is not None:
-        if fmt not in FORMATS:
-            raise ValueError(f"weather format must be one of {', '.join(FORMATS)}; got {fmt!r}")
+        if fmt not in FORMATS and fmt not in MEASURED_FORMATS:
+            raise ValueError(f"weather format must be one of {', '.join([*FORMATS, *MEASURED_FORMATS])}; got {fmt!r}")
         return fmt
     suffix = Path(path).suffix.lower()
     return next((name for name, entry in FORMATS.items() if suffix in entry.suffixes), tmy3.FORMAT.name)
@@ -108,30 +118,106 @@ def _read_checked(path: str, fmt: str, year: int):
     return frame, meta
 
 
-def weather_site(path, fmt: str | None = None) -> dict:
+def weather_site(path, fmt: str | None = None, site: dict | None = None, **measured) -> dict | None:
     """The site a weather file describes, from its header.
 
     Parameters
     ----------
     path : str or pathlib.Path
     fmt : str, optional
-        One of :data:`FORMATS`; default from the extension (:func:`weather_format`).
+        One of :data:`FORMATS` or :data:`MEASURED_FORMATS`; default from the extension
+        (:func:`weather_format`).
+    site : dict, optional
+        A measured file's site where the file holds none (:func:`measured_weather`).
+    **measured
+        :func:`measured_weather`'s options, for a measured file.
 
     Returns
     -------
-    dict
+    dict or None
         ``name``, ``latitude``, ``longitude`` [deg], ``altitude`` [m] and ``timezone`` (the fixed
-        offset its timestamps keep).
+        offset its timestamps keep); None for a measured file that holds no site when none is given.
 
     Raises
     ------
     foldopt.errors.WeatherError
-        If the file fails any check (:mod:`~foldopt.inputs.weather.qc`).
+        If the file fails any check (:mod:`~foldopt.inputs.weather.qc`,
+        :mod:`~foldopt.inputs.weather.measured`).
     """
     path = Path(path)
     fmt = weather_format(path, fmt)
+    if fmt in MEASURED_FORMATS:
+        if site is None and not MEASURED_FORMATS[fmt].has_site:
+            return None
+        return measured_weather(path, fmt, site=site, **measured).site
     _, meta = _read(str(path.resolve()), fmt, 2025, path.stat().st_mtime)
     return FORMATS[fmt].site(meta)
+
+
+def measured_weather(path, fmt: str, label: str | None = None, timezone: str | None = None,
+                     site: dict | None = None, decomposition: str = "erbs",
+                     max_gap_min: float = 60.0) -> MeasuredWeather:
+    """A measured weather file (:func:`~foldopt.inputs.weather.measured.read_measured`), read once
+    per file, its date and the options.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    fmt : str
+        One of :data:`MEASURED_FORMATS`.
+    label, timezone, decomposition, max_gap_min
+        As :func:`~foldopt.inputs.weather.measured.read_measured`'s.
+    site : dict, optional
+        ``latitude``, ``longitude``, ``altitude`` (and ``name``) where the file holds no site.
+
+    Returns
+    -------
+    MeasuredWeather
+
+    Raises
+    ------
+    foldopt.errors.WeatherError
+    """
+    path = Path(path)
+    where = None if site is None else tuple(sorted((key, site.get(key)) for key in (
+        "name", "latitude", "longitude", "altitude") if site.get(key) is not None))
+    result, message = _measured_once(str(path.resolve()), path.stat().st_mtime, fmt, label, timezone, where,
+                                     decomposition, float(max_gap_min))
+    if message is not None:
+        raise WeatherError(message)
+    return result
+
+
+@functools.lru_cache(maxsize=8)
+def _measured_once(path, mtime, fmt, label, timezone, site, decomposition, max_gap_min):
+    """:func:`measured_weather`'s result, or its error message (a bad file is read once)."""
+    try:
+        return read_measured(path, fmt, label, timezone, None if site is None else dict(site), decomposition,
+                             max_gap_min), None
+    except WeatherError as error:
+        return None, error.errors[0]
+
+
+def study_weather(weather, site) -> MeasuredWeather:
+    """The measured weather of a study's ``weather`` section at its site.
+
+    Parameters
+    ----------
+    weather : foldopt.inputs.sections.Weather
+        ``path``, ``format`` (measured), ``label``, ``timezone``, ``decomposition``, ``max_gap_min``.
+    site : foldopt.inputs.sections.Site or dict or None
+        The study's site, for a file that holds none (a file's own site is its).
+
+    Returns
+    -------
+    MeasuredWeather
+    """
+    entry = MEASURED_FORMATS[weather.format]
+    given = None
+    if not entry.has_site and site is not None:
+        given = site if isinstance(site, dict) else site.model_dump()
+    return measured_weather(weather.path, weather.format, weather.label, weather.timezone, given,
+                            weather.decomposition, weather.max_gap_min)
 
 
 def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | None = None) -> pd.DataFrame:

@@ -52,6 +52,9 @@ class WeatherFormat:
     to_local : callable, optional
         ``to_local(frame, site, year)``: stamps in UTC moved to the site's standard time, once
         the rows are checked (the checks name UTC times).
+    stamp_lag : float, default 0
+        How many intervals pvlib's stamps lie before the file's own (EPW: 1, pvlib moves its
+        hour-ending stamps back an hour). Air temperature and wind stand at the file's stamps.
     """
 
     name: str
@@ -64,6 +67,7 @@ class WeatherFormat:
     site: Callable
     missing: dict = field(default_factory=dict)
     to_local: Callable | None = None
+    stamp_lag: float = 0.0
 
 
 def reason(error: Exception) -> str:

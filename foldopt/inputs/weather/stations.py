@@ -1,0 +1,464 @@
+"""The readers of measured sub-hourly weather files, one per station network, and their registry.
+
+:data:`STATION_FORMATS` names each format's :class:`StationFormat`: a pvlib.iotools reader [1]_
+wrapped to return the columns foldopt uses (:class:`StationData`), with what the network's
+timestamps mark. :func:`foldopt.inputs.weather.measured.read_measured` turns them into a
+study's weather. What each reader takes from its file:
+
+* ``surfrad``: NOAA SURFRAD daily files [2]_ through ``read_surfrad``: 1-min means (3-min before
+  2009) of ``ghi``, ``dni``, ``dhi``, ``temp_air`` (10 m) and ``wind_speed``, stamped in UTC at the
+  end of each minute, and the site in the header. A value whose QC flag is not 0 is dropped
+  (SURFRAD flags 1 the physically impossible, 2 and up the improbable [2]_); -9999.9 is
+  missing (pvlib). Older files write west longitudes positive (Alamosa, 105.92 in
+  ``surfrad-slv16001.dat``): the sign that fits the file's own solar zenith column is taken.
+* ``midc``: NREL MIDC daily or raw files [3]_ through ``read_midc``: columns as pvlib's
+  ``MIDC_VARIABLE_MAP`` names them for the station whose names the file holds most of, else the
+  first ``Global``, ``Direct`` and ``Diffuse`` [W/m^2], air temperature and mean wind speed
+  columns; -7999 and below are missing. Stamps on the standard time the time column names. The
+  file holds no site.
+* ``srml``: University of Oregon SRML archival files [4]_ through ``read_srml``: the first
+  instrument of elements 100 (``ghi``), 201 (``dni``), 300 (``dhi``), 930 (``temp_air``) and 921
+  (``wind_speed``); flag 99 is missing (pvlib). Pacific standard time. No site in the file.
+* ``bsrn``: BSRN station-to-archive files [5]_ through ``read_bsrn``: LR0100's 1-min means of
+  ``ghi``, ``dni``, ``dhi`` and ``temp_air``, the site from LR0004; -999 and -99.9 are missing.
+* ``solrad``: NOAA SOLRAD daily files [6]_ through ``read_solrad``: 1-min means (3-min before
+  2015) of ``ghi``, ``dni``, ``dhi``, UTC at the end of each minute, values flagged by the
+  network's QC dropped, the site and its standard time in the header.
+* ``crn``: NOAA USCRN sub-hourly files [7]_ through ``read_crn``: 5-min means of ``ghi``
+  (photodiode), ``temp_air`` and ``wind_speed`` (1.5 m), flagged values dropped, the site's
+  coordinates in every row, its standard time from the local and UTC stamps, its altitude from
+  pvlib ``location.lookup_altitude`` (the file has none).
+* ``csv``: foldopt's generic CSV: a header row naming ``timestamp`` (ISO 8601, every stamp with a
+  UTC offset or none, then on ``timezone``), ``ghi``, ``dni``, ``dhi`` (one or two may be
+  absent), optionally ``temp_air`` and ``wind_speed``, in any order and case, other columns
+  ignored; empty or ``NaN`` cells are missing; lines starting with ``#`` are comments. Stamps mark
+  interval ends unless ``label`` says otherwise. No site in the file.
+
+What the stamps mark (``interval_label``): CRN, interval end (pvlib's ``read_crn``); BSRN, the
+start ("All time labels in the station-to-archive files denote the start of a time interval",
+GCOS-174, quoted by pvlib's ``read_bsrn``); SRML, the end ("the ending time of the measurement"
+[4]_), which pvlib moves back one interval, so its stamps mark the start; SURFRAD and SOLRAD,
+whose documents do not say, the end: their files' solar zenith column is pvlib's apparent zenith
+30 s before each stamp, the middle of the minute that ends there (within 0.03 deg below 80 deg
+on ``surfrad-slv16001.dat`` and ``abq19056.dat``, 0.1 deg off at the stamp itself); MIDC, the
+end: its stations log on Campbell Scientific CR1000 loggers (``midc_raw_20181018.txt`` holds
+their temperature and battery columns), which stamp a table's record at the end of its
+interval; the generic CSV, the end, like most loggers. ``label`` overrides.
+
+References
+----------
+.. [1] pvlib.iotools.read_surfrad, read_midc, read_srml, read_bsrn, read_solrad, read_crn.
+.. [2] NOAA GML, "Description of SURFRAD daily data files" (README_SURFRAD.txt).
+.. [3] NREL Measurement and Instrumentation Data Center, https://midcdmz.nrel.gov/.
+.. [4] UO SRML, "Archival (short interval) data files",
+   http://solardat.uoregon.edu/ArchivalFiles.html.
+.. [5] GCOS-174, "Update of the Technical Plan for BSRN Data Management", 2013.
+.. [6] NOAA GML, "Description of SOLRAD daily data files" (README_SOLRAD.txt).
+.. [7] H. J. Diamond et al., "U.S. Climate Reference Network after one decade of operations",
+   Bull. Amer. Meteor. Soc. 94, 489-498, 2013.
+"""
+
+from __future__ import annotations
+
+import datetime
+import re
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+import pvlib
+
+from foldopt.inputs.weather.formats import read_with_pvlib, reason
+
+#: The columns a reader may return, in order.
+COLUMNS = ("ghi", "dni", "dhi", "temp_air", "wind_speed")
+#: MIDC's missing-value marker: values at or below it are missing.
+MIDC_MISSING = -7999.0
+
+
+@dataclass(frozen=True)
+class StationFormat:
+    """One format of :data:`STATION_FORMATS`.
+
+    Parameters
+    ----------
+    name : str
+        As ``read_measured``'s ``fmt`` names it (``surfrad``).
+    label : str
+        What messages call it (``SURFRAD``).
+    description : str
+        One line for help texts.
+    interval_label : {'start', 'end'}
+        Which edge of its interval a stamp marks, as the reader returns it (module docstring).
+    suffixes : tuple of str
+        File extensions (lower case) the network's files carry.
+    reader : callable
+        ``reader(path, fail, zone)``: the file as a :class:`StationData`; ``zone`` [h] is the UTC
+        offset of stamps that carry none (the CSV's), ``fail(message)`` makes the error to raise.
+    has_site : bool
+        Whether the file holds its site's latitude and longitude.
+    """
+
+    name: str
+    label: str
+    description: str
+    interval_label: str
+    suffixes: tuple
+    reader: Callable
+    has_site: bool
+
+
+@dataclass(frozen=True)
+class StationData:
+    """What a reader takes from a file.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Some of :data:`COLUMNS` as floats (NaN where missing or dropped), indexed by the file's
+        stamps, tz-aware, in file order.
+    site : dict
+        What the file says of its site: ``name``, ``latitude``, ``longitude`` [deg],
+        ``altitude`` [m]; empty if nothing.
+    zone : float or None
+        The UTC offset [h] of the site's standard time, if the file tells it.
+    dropped : int
+        Values the network's own QC flags marked bad, made missing.
+    notes : tuple of str
+        One-line remarks for the study's notes.
+    """
+
+    frame: pd.DataFrame
+    site: dict = field(default_factory=dict)
+    zone: float | None = None
+    dropped: int = 0
+    notes: tuple = ()
+
+
+def _columns(data: pd.DataFrame, names: dict, flags: dict | None = None) -> tuple[pd.DataFrame, int]:
+    """``names`` (column -> pvlib's column) of ``data`` as floats, values whose ``flags``
+    (column -> flag column) are not 0 made missing, and how many were."""
+    frame, dropped = {}, 0
+    for key, source in names.items():
+        if source not in data.columns:
+            continue
+        values = pd.to_numeric(data[source], errors="coerce").to_numpy(dtype=float)
+        flag = (flags or {}).get(key)
+        if flag in data.columns:
+            bad = (pd.to_numeric(data[flag], errors="coerce").fillna(0).to_numpy() != 0) & np.isfinite(values)
+            dropped += int(bad.sum())
+            values = np.where(bad, np.nan, values)
+        frame[key] = values
+    return pd.DataFrame(frame, index=pd.DatetimeIndex(data.index)), dropped
+
+
+def _hours(stamp: pd.Timestamp) -> float:
+    return stamp.utcoffset().total_seconds() / 3600.0
+
+
+def read_surfrad(path: str, fail, zone=None) -> StationData:
+    """A SURFRAD daily file (module docstring).
+
+    Parameters
+    ----------
+    path : str
+    fail : callable
+        ``fail(message)``: the error to raise.
+    zone : float, optional
+        Unused: the stamps are UTC.
+
+    Returns
+    -------
+    StationData
+    """
+    data, meta = read_with_pvlib(fail, "SURFRAD", pvlib.iotools.read_surfrad, path)
+    names = {key: key for key in COLUMNS}
+    frame, dropped = _columns(data, names, {key: f"{key}_flag" for key in COLUMNS})
+    latitude, longitude = float(meta["latitude"]), float(meta["longitude"])
+    notes = ()
+    if longitude > 0 and "solar_zenith" in data.columns:
+        # The file's zenith is pvlib's apparent zenith at the middle of each minute: the sign of
+        # the longitude that fits it is the file's.
+        zenith = pd.to_numeric(data["solar_zenith"], errors="coerce").to_numpy(dtype=float)
+        pick = np.flatnonzero(np.isfinite(zenith) & (zenith < 85.0))[::30]
+        if pick.size:
+            times = pd.DatetimeIndex(data.index[pick]) - pd.Timedelta(seconds=30)
+            error = [np.nanmean(np.abs(_zenith(times, latitude, lon) - zenith[pick]))
+                     for lon in (longitude, -longitude)]
+            if error[1] < error[0]:
+                notes = (f"the file's longitude {longitude:g} is degrees west (its solar zenith column says so): "
+                         f"read as {-longitude:g}",)
+                longitude = -longitude
+    site = {"name": str(meta.get("name") or "").strip() or None, "latitude": latitude, "longitude": longitude,
+            "altitude": float(meta["elevation"])}
+    return StationData(frame, site, None, dropped, notes)
+
+
+def _zenith(times, latitude, longitude) -> np.ndarray:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        position = pvlib.solarposition.get_solarposition(times, latitude, longitude)
+    return position["apparent_zenith"].to_numpy(dtype=float)
+
+
+#: MIDC columns by pattern, where pvlib's ``MIDC_VARIABLE_MAP`` names none: the first match wins.
+MIDC_PATTERNS = {
+    "ghi": r"^Global(?!.*(?:Accumulated|stdev|tracker)).*\[W/m\^2\]$",
+    "dni": r"^Direct(?!.*(?:stdev|Accumulated)).*\[W/m\^2\]$",
+    "dhi": r"^Diffuse(?!.*(?:stdev|Accumulated)).*\[W/m\^2\]$",
+    "temp_air": r"^(?:Air Temperature|Tower Dry Bulb Temp|Dry Bulb Temp|Temperature @ ?[\d.]+ ?(?:m|ft))\b.*\[deg C\]$",
+    "wind_speed": r"^Avg Wind Speed.*\[m/s\]$",
+}
+
+
+def read_midc(path: str, fail, zone=None) -> StationData:
+    """An NREL MIDC daily or raw-data file (module docstring).
+
+    Parameters
+    ----------
+    path : str
+    fail : callable
+        ``fail(message)``: the error to raise.
+    zone : float, optional
+        Unused: the time column names the zone.
+
+    Returns
+    -------
+    StationData
+    """
+    try:
+        header = pd.read_csv(path, nrows=0).columns
+    except Exception as error:  # any failure of pandas is an unreadable file
+        raise fail(f"not a readable MIDC file ({reason(error)})") from error
+    raw = "DOY" in header and "Year" in header
+    # A raw file's header may name fewer columns than its rows hold: read those it names.
+    data = read_with_pvlib(fail, "MIDC", pvlib.iotools.read_midc, path, raw_data=raw,
+                           usecols=range(len(header)) if raw else None)
+    columns = [str(name) for name in data.columns]
+    maps = pvlib.iotools.midc.MIDC_VARIABLE_MAP.values()
+    best = max(maps, key=lambda names: sum(name in columns for name in names))
+    names = {}
+    for source, target in best.items():
+        key = {"dni_chp1": "dni", "dni_nip": "dni"}.get(target, target)
+        if source in columns and key in COLUMNS and key not in names:
+            names[key] = source
+    for key, pattern in MIDC_PATTERNS.items():
+        if key not in names:
+            names[key] = next((name for name in columns if re.search(pattern, name)), None)
+    names = {key: source for key, source in names.items() if source is not None}
+    frame, _ = _columns(data, names)
+    frame = frame.where(frame > MIDC_MISSING)
+    used = ", ".join(f"{key} {source!r}" for key, source in names.items())
+    return StationData(frame, {}, _hours(frame.index[0]) if len(frame) else None, 0,
+                       (f"MIDC columns read: {used or 'none of foldopt'}",))
+
+
+def read_srml(path: str, fail, zone=None) -> StationData:
+    """A UO SRML archival file (module docstring).
+
+    Parameters
+    ----------
+    path : str
+    fail : callable
+        ``fail(message)``: the error to raise.
+    zone : float, optional
+        Unused: the stamps are Pacific standard time.
+
+    Returns
+    -------
+    StationData
+    """
+    data = read_with_pvlib(fail, "SRML", pvlib.iotools.read_srml, path)
+    names = {}
+    for key in COLUMNS:
+        found = sorted((column for column in map(str, data.columns) if re.fullmatch(fr"{key}_\d+", column)),
+                       key=lambda column: int(column.rsplit("_", 1)[1]))
+        if found:
+            names[key] = found[0]
+    frame, _ = _columns(data, names)
+    return StationData(frame, {}, _hours(frame.index[0]) if len(frame) else None, 0,
+                       (f"SRML columns read: {', '.join(f'{k} {v!r}' for k, v in names.items())}",))
+
+
+def read_bsrn(path: str, fail, zone=None) -> StationData:
+    """A BSRN station-to-archive file's LR0100 (module docstring).
+
+    Parameters
+    ----------
+    path : str
+    fail : callable
+        ``fail(message)``: the error to raise.
+    zone : float, optional
+        Unused: the stamps are UTC.
+
+    Returns
+    -------
+    StationData
+    """
+    data, meta = read_with_pvlib(fail, "BSRN", pvlib.iotools.read_bsrn, path)
+    if len(data) == 0 or "latitude" not in meta:
+        raise fail("no LR0100 record (basic measurements) and station LR0004: not a BSRN station-to-archive file")
+    frame, _ = _columns(data, {key: key for key in ("ghi", "dni", "dhi", "temp_air")})
+    number = meta.get("station identification number")
+    site = {"name": f"BSRN station {number}" if number is not None else None, "latitude": float(meta["latitude"]),
+            "longitude": float(meta["longitude"]), "altitude": float(meta["altitude"])}
+    return StationData(frame, site)
+
+
+def read_solrad(path: str, fail, zone=None) -> StationData:
+    """A SOLRAD daily file (module docstring).
+
+    Parameters
+    ----------
+    path : str
+    fail : callable
+        ``fail(message)``: the error to raise.
+    zone : float, optional
+        Unused: the stamps are UTC.
+
+    Returns
+    -------
+    StationData
+    """
+    data, meta = read_with_pvlib(fail, "SOLRAD", pvlib.iotools.read_solrad, path)
+    frame, dropped = _columns(data, {key: key for key in ("ghi", "dni", "dhi")},
+                              {key: f"{key}_flag" for key in ("ghi", "dni", "dhi")})
+    site = {"name": str(meta.get("station_name") or "").strip() or None, "latitude": float(meta["latitude"]),
+            "longitude": float(meta["longitude"]), "altitude": float(meta["altitude"])}
+    return StationData(frame, site, float(meta["TZ"]), dropped)
+
+
+def read_crn(path: str, fail, zone=None) -> StationData:
+    """A USCRN sub-hourly file (module docstring).
+
+    Parameters
+    ----------
+    path : str
+    fail : callable
+        ``fail(message)``: the error to raise.
+    zone : float, optional
+        Unused: the stamps are UTC.
+
+    Returns
+    -------
+    StationData
+    """
+    data = read_with_pvlib(fail, "CRN", pvlib.iotools.read_crn, path)
+    if len(data) == 0:
+        raise fail("no data rows")
+    frame, dropped = _columns(data, {"ghi": "ghi", "temp_air": "temp_air", "wind_speed": "wind_speed"},
+                              {"ghi": "ghi_flag", "wind_speed": "wind_speed_flag"})
+    first = data.iloc[0]
+    latitude, longitude = float(first["latitude"]), float(first["longitude"])
+    local = pd.to_datetime(f"{int(first['LST_DATE'])}{int(first['LST_TIME']):04d}", format="%Y%m%d%H%M")
+    utc = pd.Timestamp(data.index[0]).tz_localize(None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        altitude = float(pvlib.location.lookup_altitude(latitude, longitude))
+    site = {"name": f"USCRN station {first['WBANNO']}", "latitude": latitude, "longitude": longitude,
+            "altitude": altitude}
+    notes = (f"altitude {altitude:g} m from pvlib location.lookup_altitude (a CRN file holds none); "
+             "wind speed measured 1.5 m above ground",)
+    return StationData(frame, site, (local - utc).total_seconds() / 3600.0, dropped, notes)
+
+
+_OFFSET = re.compile(r"(?:Z|[+-]\d{2}(?::?\d{2})?)$")
+_TIME = re.compile(r"[T ]\d{1,2}:\d{2}")
+
+
+def read_csv(path: str, fail, zone=None) -> StationData:
+    """foldopt's generic measured CSV (module docstring).
+
+    Parameters
+    ----------
+    path : str
+    fail : callable
+        ``fail(message)``: the error to raise.
+    zone : float, optional
+        The UTC offset [h] of stamps that carry none.
+
+    Returns
+    -------
+    StationData
+    """
+    try:
+        table = pd.read_csv(path, dtype=str, comment="#", skipinitialspace=True, keep_default_na=False)
+    except Exception as error:  # any failure of pandas is an unreadable file
+        raise fail(f"not a readable CSV file ({reason(error)})") from error
+    named = {str(column).strip().lower(): column for column in table.columns}
+    if "timestamp" not in named:
+        held = ", ".join(str(column) for column in table.columns[:8])
+        raise fail(f"no timestamp column: a measured CSV file's header names timestamp, ghi, dni, dhi and optionally "
+                   f"temp_air, wind_speed; this one names {held or 'nothing'}")
+    if len(table) == 0:
+        raise fail("no data rows after the header")
+    text = table[named["timestamp"]].str.strip()
+
+    def refuse(bad, describe) -> None:
+        bad = np.flatnonzero(np.asarray(bad))
+        if bad.size:
+            more = f"; and {bad.size - 1} more rows" if bad.size > 1 else ""
+            raise fail(f"row {bad[0] + 1}: {describe(bad[0])}{more}")
+
+    refuse(~text.str.contains(_TIME), lambda i: f"timestamp = {text.iloc[i][:30]!r}: not an ISO 8601 date and time")
+    # The offset: of a stamp's time, after its clock time (a date's own dashes are no offset).
+    offset = text.str.split(r"[T ]", n=1, regex=True).str[-1].str.contains(_OFFSET)
+    aware = bool(offset.iloc[0])
+    refuse(offset != aware, lambda i: f"timestamp {text.iloc[i]!r} {'has no' if aware else 'has a'} UTC offset, "
+                                      f"unlike row 1's: give every stamp an offset or none")
+    stamps = pd.to_datetime(text, format="ISO8601", utc=aware, errors="coerce")
+    refuse(stamps.isna(), lambda i: f"timestamp = {text.iloc[i][:30]!r}: not an ISO 8601 date and time")
+    if aware:
+        file_zone = _hours(pd.Timestamp(text.iloc[0]))
+        index = pd.DatetimeIndex(stamps).tz_convert(fixed_zone(file_zone))
+    else:
+        if zone is None:
+            raise fail("the timestamps carry no UTC offset: give timezone, a fixed offset like 'UTC-07:00'")
+        file_zone = zone
+        index = pd.DatetimeIndex(stamps).tz_localize(fixed_zone(zone))
+    values = {}
+    for key in COLUMNS:
+        if key not in named:
+            continue
+        cells = table[named[key]].str.strip()
+        numbers = pd.to_numeric(cells, errors="coerce")
+        blank = cells.str.lower().isin(("", "nan", "na", "null"))
+        refuse(numbers.isna() & ~blank, lambda i, key=key, cells=cells: f"{key} = {cells.iloc[i][:20]!r}: not a number")
+        values[key] = numbers.to_numpy(dtype=float)
+    return StationData(pd.DataFrame(values, index=index), {}, file_zone)
+
+
+def fixed_zone(hours: float) -> datetime.timezone:
+    """The fixed-offset time zone of a UTC offset.
+
+    Parameters
+    ----------
+    hours : float
+        The offset [h], to the minute.
+
+    Returns
+    -------
+    datetime.timezone
+    """
+    return datetime.timezone(datetime.timedelta(minutes=round(hours * 60)))
+
+
+#: The measured weather formats by name.
+STATION_FORMATS = {entry.name: entry for entry in (
+    StationFormat("surfrad", "SURFRAD", "NOAA SURFRAD daily file: 1-min ghi, dni, dhi, air temperature and wind, UTC",
+            "end", (".dat",), read_surfrad, True),
+    StationFormat("midc", "MIDC", "NREL MIDC daily or raw-data file: 1-min columns, local standard time; give the site",
+            "end", (".txt", ".csv"), read_midc, False),
+    StationFormat("srml", "SRML", "UO SRML archival file: 1- to 60-min columns, Pacific standard time; give the site",
+            "start", (".txt",), read_srml, False),
+    StationFormat("bsrn", "BSRN", "BSRN station-to-archive file: LR0100 1-min ghi, dni, dhi, air temperature, UTC",
+            "start", (".dat", ".gz"), read_bsrn, True),
+    StationFormat("solrad", "SOLRAD", "NOAA SOLRAD daily file: 1-min ghi, dni, dhi, UTC", "end", (".dat",),
+            read_solrad, True),
+    StationFormat("crn", "CRN", "NOAA USCRN sub-hourly file: 5-min ghi (photodiode), air temperature and wind, UTC",
+            "end", (".txt",), read_crn, True),
+    StationFormat("csv", "CSV", "generic CSV: timestamp, ghi, dni, dhi[, temp_air, wind_speed]; give the site",
+            "end", (".csv",), read_csv, False),
+)}

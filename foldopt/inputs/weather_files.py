@@ -1,0 +1,101 @@
+"""What a study's weather file brings before the study is validated: its site and, for a measured
+file, its step and its days (:func:`weather_read`), and the fields a study takes from it where it
+leaves them out (:func:`weather_defaults`). The file is read through :mod:`foldopt.inputs.weather`,
+imported only when a file is named (pandas and pvlib).
+
+The module may import :mod:`foldopt.errors`, :mod:`foldopt.names` and :mod:`foldopt.inputs.weather`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from foldopt.errors import ConfigError
+from foldopt.names import HOURLY_WEATHER_FORMATS, WEATHER_FORMATS, canonical
+
+
+def weather_read(weather, site=None) -> dict:
+    """What a study's weather file brings to its validation (:class:`~foldopt.inputs.sections.FilesRead`'s
+    weather fields).
+
+    Parameters
+    ----------
+    weather : str or dict or None
+        The study's ``weather`` (a path, or a mapping with ``path``, ``format`` and options).
+    site : dict, optional
+        The study's ``site``, for a measured file that holds none.
+
+    Returns
+    -------
+    dict
+        ``weather_site``, and for a measured file ``weather_step_min`` and ``weather_dates``; or
+        ``weather_problem`` (one line naming the file) and ``weather_missing``; empty where no
+        file is named (or its format is no format: the study names that fault).
+    """
+    spec = {"path": weather} if isinstance(weather, str) else weather
+    path = spec.get("path") if isinstance(spec, dict) else None
+    if not isinstance(path, str):
+        return {}
+    if not Path(path).is_file():
+        return {"weather_missing": True, "weather_problem": f"weather: file not found: {path}"}
+    try:
+        fmt = canonical(spec.get("format"), WEATHER_FORMATS)
+    except ValueError:
+        return {}  # the study names the format's fault
+    from foldopt.inputs import weather as files  # pandas and pvlib: only when a file is named
+
+    try:
+        if fmt in files.MEASURED_FORMATS:
+            return _measured_read(files, path, fmt, spec, site)
+        return {"weather_site": files.weather_site(path, fmt)}
+    except ConfigError as error:  # foldopt.errors.WeatherError: the file, the line, the reason
+        return {"weather_problem": str(error)}
+    except (ValueError, KeyError, OSError) as error:
+        return {"weather_problem": f"weather: cannot read a site from {path} ({error.__class__.__name__})"}
+
+
+def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
+    """A measured file's site, step and days, read with the study's weather options (the study's
+    site for a file that holds none: without one, the file waits for the study to name it)."""
+    entry = files.MEASURED_FORMATS[fmt]
+    given = site if isinstance(site, dict) and not entry.has_site else None
+    if not entry.has_site and not (given and all(isinstance(given.get(k), (int, float)) for k in (
+            "latitude", "longitude", "altitude"))):
+        return {"weather_problem": f"weather {Path(path).name}: the {fmt} format holds no site; give the site's "
+                                   "latitude, longitude and altitude"}
+    options = {key: spec[key] for key in ("label", "timezone", "decomposition", "max_gap_min") if spec.get(key)
+               is not None}
+    measured = files.measured_weather(path, fmt, site=given, **options)
+    days = measured.frame.index.tz_localize(None).normalize().unique()
+    dates = tuple(str(day.date()) for day in days if day.date() not in measured.flagged_days)
+    return {"weather_site": measured.site, "weather_step_min": measured.step.total_seconds() / 60.0,
+            "weather_dates": dates}
+
+
+def weather_defaults(data: dict) -> dict:
+    """What a study's fields take from its weather file where it leaves them out: the dates (an
+    hourly file's whole ``year``; a measured file's days) and, for a measured file, the step.
+
+    Parameters
+    ----------
+    data : dict
+        A study's fields.
+
+    Returns
+    -------
+    dict
+        ``date`` and, for a measured file that can be read, ``step_min`` (where it cannot, the
+        study's validation names why).
+    """
+    weather = data.get("weather")
+    spec = {"path": weather} if isinstance(weather, str) else weather if isinstance(weather, dict) else {}
+    try:
+        fmt = canonical(spec.get("format"), WEATHER_FORMATS)
+    except ValueError:
+        fmt = None
+    if fmt is None or fmt in HOURLY_WEATHER_FORMATS:
+        return {"date": "year"}
+    read = weather_read(weather, data.get("site"))
+    if read.get("weather_dates") is None:
+        return {}
+    return {"date": list(read["weather_dates"]), "step_min": read["weather_step_min"]}

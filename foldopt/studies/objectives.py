@@ -1,0 +1,166 @@
+"""What a fold angle is chosen by: the longest t_solar on a grid of angles (:func:`best_angle_index`),
+a statistic of daily t_solar over the days of a study (:func:`objective_value`, :func:`worst_month`),
+the plateau of near-optimal angles around the best (:func:`near_optimal`), and over a cloud
+ensemble, the members' spread and how sure the choice is (:func:`ensemble_choice`).
+
+The module may import numpy and :mod:`foldopt.inputs.sections`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from foldopt.inputs.sections import NearOptimal
+
+
+def best_angle_index(hours):
+    """Index (...) of the longest t_solar along the last axis; ties go to the least folded angle.
+
+    Parameters
+    ----------
+    hours : numpy.ndarray
+        t_solar [h] on an ascending fold-angle grid, (..., n_angles).
+    """
+    return hours.shape[-1] - 1 - np.argmax(hours[..., ::-1], axis=-1)
+
+
+def objective_value(hours, months, statistic: str, season=None):
+    """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
+
+    Parameters
+    ----------
+    hours : array_like
+        Daily t_solar [h], (days, ...).
+    months : array_like
+        (days,) month of each day [1-12].
+    statistic : str
+        ``mean``, ``min``, ``pNN`` (the NN-th percentile over days) or ``worst-month`` (the lowest
+        monthly mean).
+    season : sequence of int, optional
+        Months that restrict the days.
+
+    Returns
+    -------
+    numpy.ndarray
+        The statistic [h], (...).
+    """
+    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
+    if season:
+        keep = np.isin(months, season)
+        hours, months = hours[keep], months[keep]
+    if statistic == "mean":
+        return hours.mean(axis=0)
+    if statistic == "min":
+        return hours.min(axis=0)
+    if statistic == "worst-month":
+        return np.min([hours[months == m].mean(axis=0) for m in np.unique(months)], axis=0)
+    return np.percentile(hours, float(statistic[1:]), axis=0)
+
+
+def worst_month(hours, months):
+    """The month [1-12], (...), of the lowest monthly mean: where a ``worst-month`` objective is found.
+
+    Parameters
+    ----------
+    hours : array_like
+        Daily t_solar [h], (days, ...).
+    months : array_like
+        (days,) month of each day [1-12].
+    """
+    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
+    present = np.unique(months)
+    means = np.stack([hours[months == m].mean(axis=0) for m in present])
+    return present[np.argmin(means, axis=0)]
+
+
+def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
+    """The plateau of fold angles around the best: every grid angle on the best one's side of the
+    first angles that fall short, and the recommended angle at its centre.
+
+    An angle is near-optimal when its value lies within ``tolerance`` of the best
+    (:meth:`foldopt.inputs.sections.NearOptimal.tolerance_h`: 1 % or 1 min by default, whichever is
+    larger). The range is the contiguous run of such angles that holds the best one
+    (:func:`best_angle_index`); the recommended angle is the grid angle nearest its centre (ties to
+    the less folded), so that a hinge set a few degrees off still lies on the plateau.
+
+    Parameters
+    ----------
+    angles : array_like
+        The fold-angle grid [deg], ascending, (n_angles,).
+    values : array_like
+        t_solar or an objective [h] at each angle, (..., n_angles).
+    tolerance : foldopt.inputs.sections.NearOptimal
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg`` [deg] and
+        ``near_optimal_tolerance_h`` [h], each (...); NaN where no angle carries the load.
+    """
+    angles = np.asarray(angles, dtype=float)
+    values = np.asarray(values, dtype=float)
+    best = best_angle_index(values)
+    top = np.take_along_axis(values, best[..., None], axis=-1)[..., 0]
+    tol = tolerance.tolerance_h(top)
+    index = np.arange(angles.size)
+    short = values < (top - tol)[..., None]
+    below, above = short & (index < best[..., None]), short & (index > best[..., None])
+    lo = np.where(below.any(axis=-1), angles.size - np.argmax(below[..., ::-1], axis=-1), 0)
+    hi = np.where(above.any(axis=-1), np.argmax(above, axis=-1) - 1, angles.size - 1)
+    centre = (angles[lo] + angles[hi]) / 2.0
+    distance = np.where((index >= lo[..., None]) & (index <= hi[..., None]),
+                        np.abs(angles - centre[..., None]), np.inf)
+    recommended = best_angle_index(-distance)
+    carried = top > 0
+    return {
+        "near_optimal_lo_deg": np.where(carried, angles[lo], np.nan),
+        "near_optimal_hi_deg": np.where(carried, angles[hi], np.nan),
+        "recommended_fold_angle_deg": np.where(carried, angles[recommended], np.nan),
+        "near_optimal_tolerance_h": np.where(carried, tol, np.nan),
+    }
+
+
+def ensemble_choice(daily, months, statistic: str, season, tolerance: NearOptimal) -> dict:
+    """One fold angle chosen over the members of a cloud ensemble, and how sure the choice is.
+
+    Each member is a year (or the days) of its own clouds: its objective at every angle
+    (:func:`objective_value`), and its own best angle. The angle chosen maximises the members'
+    mean objective, the expected value of the objective over the clouds the hourly file allows.
+    How sure: the share of members whose own best angle it is, and the share for which it lies
+    within the near-optimal tolerance of the member's own best (its regret, the objective the
+    member loses by the ensemble's angle, within :meth:`NearOptimal.tolerance_h`).
+
+    Parameters
+    ----------
+    daily : array_like
+        Daily t_solar [h], (members, days, loads, angles).
+    months : array_like
+        (days,) month of each day.
+    statistic : str
+        :func:`objective_value`'s.
+    season : sequence of int or None
+        :func:`objective_value`'s.
+    tolerance : foldopt.inputs.sections.NearOptimal
+
+    Returns
+    -------
+    dict
+        ``score`` (loads, angles): the members' mean objective [h]; ``member_score`` (members,
+        loads, angles) [h]; ``fixed`` (loads,) the chosen angle's index; ``wins_pct`` (loads,
+        angles): the share of members whose own best each angle is [%]; ``chosen_wins_pct`` and
+        ``within_tolerance_pct`` (loads,) [%]; ``regret_h`` (members, loads) [h].
+    """
+    daily = np.asarray(daily, dtype=float)
+    member_score = np.stack([objective_value(member, months, statistic, season) for member in daily])
+    score = member_score.mean(axis=0)
+    fixed = best_angle_index(score)
+    own = best_angle_index(member_score)  # (members, loads)
+    n_angles = score.shape[-1]
+    wins = (own[..., None] == np.arange(n_angles)).mean(axis=0) * 100.0
+    best_value = np.take_along_axis(member_score, own[..., None], axis=-1)[..., 0]
+    chosen = np.take_along_axis(member_score, np.broadcast_to(fixed, own.shape)[..., None], axis=-1)[..., 0]
+    regret = best_value - chosen
+    within = (regret <= tolerance.tolerance_h(best_value) + 1e-12).mean(axis=0) * 100.0
+    return {"score": score, "member_score": member_score, "fixed": fixed, "wins_pct": wins,
+            "chosen_wins_pct": np.take_along_axis(wins, fixed[:, None], axis=-1)[:, 0],
+            "within_tolerance_pct": within, "regret_h": regret}
