@@ -134,7 +134,9 @@ def test_notes_name_the_day(tmp_path, args, note, line):
 
 
 def test_overcast_is_no_polar_night_in_a_year(tmp_path):
-    result = invoke("sweep", "angle", "--weather", TMY3, "--p-load", "2", "--angle-step", "30", "--out",
+    # 2.25 W: above the peak of the tracker net of its drive on 3 days that are not overcast, below
+    # every other design's peak on those days.
+    result = invoke("sweep", "angle", "--weather", TMY3, "--p-load", "2.25", "--angle-step", "30", "--out",
                     tmp_path / "y", "--format", "json")
     assert result.exit_code == 0, result.output
     notes = {entry["note"]: entry for entry in json.loads(result.stdout)["answer"]["notes"]}

@@ -108,10 +108,12 @@ def test_a_real_year_keeps_its_hours_continuous_and_closed(greensboro):
     for key, shape in (("dni", clear.dni), ("dhi", clear.ghi)):
         file = frame[key].to_numpy().reshape(365, 24)
         # Hours the bound cuts into: their mean above twice the clear sky's, or a step at the bound.
-        touching = np.isclose(getattr(sky, key), 2.0 * shape, rtol=1e-9).reshape(365, 24, 60).any(axis=-1)
-        saturated = (file > 2.0 * shape.reshape(365, 24, 60).mean(axis=-1)) | (touching & (shape.reshape(
-            365, 24, 60).max(axis=-1) > 0))
-        assert saturated.sum() < 0.05 * high_sun.sum(), key
+        touching = (np.isclose(getattr(sky, key), 2.0 * shape, rtol=1e-9) & (shape > 0)).reshape(365, 24, 60)
+        saturated = (file > 2.0 * shape.reshape(365, 24, 60).mean(axis=-1)) | touching.any(axis=-1)
+        # The bound cuts in at sunrise and sunset (the clear sky's light is faint there); with the
+        # sun above 1 deg all hour, in under 1 % of the hours (measured: DNI 3, DHI 0 of 3993; all
+        # hours: DNI 121, DHI 296).
+        assert (saturated & high_sun).sum() < 0.01 * high_sun.sum(), key
         loss = file - getattr(sky, key).reshape(365, 24, 60).mean(axis=-1)
         held = ~saturated & (high_sun if key == "dni" else True)
         np.testing.assert_allclose(loss[held], 0.0, atol=1e-9)

@@ -13,7 +13,8 @@ it is made. The rules, each said back to the user by :func:`apply`'s second valu
   exact) unless the geometry is given;
 - a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
   given; a new latitude or longitude drops the site's name, a new longitude its time zone;
-- a weather file brings its own site, year and light (the study's sky, site and day give way);
+- a weather file brings its own site, year and light (the study's sky, site and day give way), and
+  a measured file its own days and step;
 - a new tracker model keeps only the tracker's standby draw; a new fold-angle step starts the grid
   at that step; a load profile given without a scale runs as written (scale 1).
 
@@ -23,6 +24,8 @@ The module is a leaf: plain dictionaries in and out, nothing heavy imported.
 from __future__ import annotations
 
 import copy
+
+from foldopt.names import HOURLY_WEATHER_FORMATS, WEATHER_FORMATS, canonical
 
 #: Sections of a study whose fields a change merges into (a mapping changes the fields it names);
 #: any other field given a mapping (a load profile, a weather file) is replaced whole.
@@ -167,7 +170,14 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         if not (touched(given, "site.latitude") or touched(given, "site.longitude") or "site" in given):
             data.pop("site", None)  # the file's site
         if not touched(given, "date"):
-            data.pop("date", None)  # the file's year
+            data.pop("date", None)  # the file's year, or a measured file's days
+        fmt = changes.get("weather.format", weather.get("format") if isinstance(weather, dict) else None)
+        try:
+            measured = fmt is not None and canonical(fmt, WEATHER_FORMATS) not in HOURLY_WEATHER_FORMATS
+        except ValueError:
+            measured = False  # no format: the study's validation names it
+        if measured and not touched(given, "step_min"):
+            data.pop("step_min", None)  # a measured file's own step
     old_mode = data.get("mode", "exact")
     if old_mode == "paper" and "mode" not in given and any(touched(given, path) for path in AWAY_FROM_PAPER):
         data["mode"] = "exact"

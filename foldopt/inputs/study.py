@@ -20,7 +20,8 @@ from foldopt import names
 from foldopt.errors import ConfigError
 from foldopt.inputs import policy
 from foldopt.inputs.sections import (FilesRead, FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site,
-                                     StrictModel, Tracker, Weather, interval, named)
+                                     StrictModel, Tracker, interval, named)
+from foldopt.inputs.weather_section import Weather
 
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
 EARTH_RADIUS_KM = 6371.0

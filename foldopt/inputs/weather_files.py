@@ -84,8 +84,8 @@ def weather_defaults(data: dict) -> dict:
     Returns
     -------
     dict
-        ``date`` and, for a measured file that can be read, ``step_min`` (where it cannot, the
-        study's validation names why).
+        ``date`` and, for a measured file that can be read, ``step_min`` (where it cannot,
+        ``year``, and the study's validation names why).
     """
     weather = data.get("weather")
     spec = {"path": weather} if isinstance(weather, str) else weather if isinstance(weather, dict) else {}
@@ -97,5 +97,5 @@ def weather_defaults(data: dict) -> dict:
         return {"date": "year"}
     read = weather_read(weather, data.get("site"))
     if read.get("weather_dates") is None:
-        return {}
+        return {"date": "year"}  # the file cannot be read: the study's validation names why
     return {"date": list(read["weather_dates"]), "step_min": read["weather_step_min"]}

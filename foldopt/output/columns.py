@@ -2,7 +2,8 @@
 
 :data:`COLUMNS` lists every column a command writes, once, with its unit and meaning; a name with
 ``{design}`` or ``{connection}`` stands for one column per design (``flat``, ``twofold``,
-``tracker``, ``tracker_net``) or connection. A sweep's other varied fields are columns named by
+``tracker``, ``tracker_net``) or connection, ``{pct}`` for one per percentile of a cloud
+ensemble (10, 50, 90). A sweep's other varied fields are columns named by
 their dotted path (``tracker.standby_w``). The manual's table (``docs/columns.rst``) is
 :func:`rst_table`, and a test checks every command's columns against :func:`describe`.
 
@@ -80,11 +81,22 @@ COLUMNS = (
     ("visit", "-", "the visit's number in its schedule"),
     ("gain_vs_fixed_pct", "%", "the schedule's objective over the single fixed angle's, less 100"),
     ("added_by_setting_h", "h", "what the schedule's last setting adds to the objective"),
+    # a cloud ensemble (weather.members)
+    ("t_solar_p{pct}_h", "h", "a day's t_solar over the ensemble's members: percentile 10, 50 or 90"),
+    ("objective_p{pct}_h", "h", "the objective over the ensemble's members: percentile 10, 50 or 90"),
+    ("chosen_wins_pct", "%", "the members whose own best fold angle is the one chosen"),
+    ("within_tolerance_pct", "%", "the members for which the angle chosen is within the near-optimal tolerance "
+                                  "of their own best"),
+    ("wins_pct", "%", "the members whose own best fold angle is this one"),
     # the day's time series
     ("time", "", "the step's centre, local time with its offset"),
     ("solar_zenith", "deg", "solar zenith angle"),
     ("solar_azimuth", "deg", "solar azimuth, clockwise from north"),
     ("dni", "W/m^2", "direct normal irradiance"),
+    ("ghi", "W/m^2", "global horizontal irradiance (with diffuse light)"),
+    ("dhi", "W/m^2", "diffuse horizontal irradiance (with diffuse light)"),
+    ("temp_air", "C", "the air temperature the cells see (a weather file's, with its wind folded in)"),
+    ("wind_speed", "m/s", "a weather file's wind speed"),
     ("p_{design}_w", "W", "a design's power at the optimum (p_twofold_w: the study's connection)"),
     ("p_{connection}_w", "W", "a connection's power at the optimum"),
     ("switch_state", "", "the connection switching chose (off where no power)"),
@@ -107,6 +119,7 @@ _WORDS = {
     "connection": "(east|west|parallel|series|independent|switching)",
     "hours": r"(\d+)",
     "month": r"(\d\d)",
+    "pct": r"(10|50|90)",
 }
 _PATTERNS = [(re.compile("^" + re.sub(r"\\\{(\w+)\\\}", lambda m: _WORDS[m.group(1)], re.escape(name)) + "$"),
               name, unit, meaning) for name, unit, meaning in COLUMNS]

@@ -332,6 +332,11 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
             "solar_zenith": day.solar_zenith,
             "solar_azimuth": day.solar_azimuth,
             "dni": day.dni,
+            # The light and air every step of the day used (the weather's, or the clear sky's).
+            **({"ghi": day.ghi, "dhi": day.dhi} if day.ghi is not None else {}),
+            "temp_air": (day.sky.temp_steps[0] if day.sky.temp_steps is not None
+                         else np.full(day.dni.shape, day.sky.temp_air[0])),
+            **({"wind_speed": day.sky.wind_speed[0]} if day.sky.wind_speed is not None else {}),
             "p_flat_w": p_flat,
             **{f"p_{connection}_w": at_best[connection][0] for connection in CONNECTIONS},
             "p_twofold_w": at_best[study.connection][0],

@@ -203,7 +203,7 @@ def study_weather(weather, site) -> MeasuredWeather:
 
     Parameters
     ----------
-    weather : foldopt.inputs.sections.Weather
+    weather : foldopt.inputs.weather_section.Weather
         ``path``, ``format`` (measured), ``label``, ``timezone``, ``decomposition``, ``max_gap_min``.
     site : foldopt.inputs.sections.Site or dict or None
         The study's site, for a file that holds none (a file's own site is its).

@@ -7,6 +7,7 @@ the end of its hour; pvlib moves the stamps back an hour, to the start of each i
 from __future__ import annotations
 
 from functools import partial
+from pathlib import Path
 
 import pandas as pd
 import pvlib
@@ -70,3 +71,40 @@ FORMAT = WeatherFormat(
     columns_at="its rows", read=read, site=partial(header_site, name="city"), stamp_lag=1.0,
     # Missing values of the columns used (EnergyPlus, "EnergyPlus Weather File (EPW) Data Dictionary").
     missing={"ghi": 9999.0, "dni": 9999.0, "dhi": 9999.0, "temp_air": 99.9, "wind_speed": 999.0})
+
+
+def write_epw(path, hourly: pd.DataFrame, site: dict) -> None:
+    """Write hourly means as an EPW file that :func:`read` (and pvlib) reads back.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    hourly : pandas.DataFrame
+        ``ghi``, ``dni``, ``dhi`` [W/m^2], ``temp_air`` [C], ``wind_speed`` [m/s], indexed by the
+        tz-aware centres of whole hours on the site's standard time.
+    site : dict
+        ``name``, ``latitude``, ``longitude`` [deg], ``altitude`` [m], ``timezone`` (a fixed offset
+        ``UTC-07:00``).
+
+    Notes
+    -----
+    The fields other than these (humidity, pressure, sky cover...) are EPW's missing-value markers
+    or neutral values; EPW hour ``h`` is the interval ``(h - 1, h]`` (EnergyPlus, "EnergyPlus
+    Weather File (EPW) Data Dictionary"), and air temperature and wind are written at it as the
+    hour's means.
+    """
+    offset = pd.Timestamp("2000-01-01", tz=hourly.index.tz).utcoffset().total_seconds() / 3600.0
+    name = str(site.get("name") or "measured").replace(",", " ")
+    header = [f"LOCATION,{name},-,-,measured,000000,{site['latitude']},{site['longitude']},{offset:g},"
+              f"{site['altitude']}", "DESIGN CONDITIONS,0", "TYPICAL/EXTREME PERIODS,0", "GROUND TEMPERATURES,0",
+              "HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0", "COMMENTS 1,hourly means of a measured file written by foldopt",
+              "COMMENTS 2,", "DATA PERIODS,1,1,Data,Sunday, 1/1,12/31"]
+    rows = []
+    for when, row in zip(hourly.index, hourly.itertuples(index=False), strict=True):
+        start = when - pd.Timedelta(minutes=30)
+        fields = [start.year, start.month, start.day, start.hour + 1, 60, "?", round(row.temp_air, 2), 99.9, 999,
+                  999999, 9999, 9999, 9999, round(row.ghi, 3), round(row.dni, 3), round(row.dhi, 3), 999999,
+                  999999, 999999, 9999, 999, round(row.wind_speed, 2), 99, 99, 9999, 99999, 9, 999999999, 999, 0.999,
+                  999, 99, 999, 999, 99]
+        rows.append(",".join(str(field) for field in fields))
+    Path(path).write_text("\n".join(header + rows) + "\n")

@@ -1,0 +1,97 @@
+"""The ``weather`` section of a study: an hourly typical year or a measured sub-hourly file, and
+the options of each kind (:class:`Weather`). Like the other sections it validates and opens no
+file (:mod:`foldopt.inputs.sections`).
+
+The module may import pydantic, :mod:`foldopt.names` and :mod:`foldopt.inputs.sections`.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from typing import Annotated
+
+from pydantic import AfterValidator, Field, ValidationInfo, field_validator
+
+from foldopt import names
+from foldopt.inputs.sections import StrictModel, interval, named, parse_timezone
+
+
+def _check_offset(name: str | None) -> str | None:
+    if name is not None and not isinstance(parse_timezone(name), dt.timezone):
+        raise ValueError(f"{name!r}: a measured file's standard time is a fixed offset such as 'UTC-07:00'")
+    return name
+
+
+class Weather(StrictModel):
+    """A weather file, read through pvlib.iotools (:mod:`foldopt.inputs.weather`): an hourly
+    typical year (TMY3, EPW, PVGIS TMY), brought to the study's step, or a measured sub-hourly
+    file (SURFRAD, MIDC, SRML, BSRN, SOLRAD, CRN, a CSV), evaluated at its own.
+
+    Parameters
+    ----------
+    path : str
+        The file; a study file's relative path is relative to the study file.
+    format : str, optional
+        One of :data:`foldopt.names.WEATHER_FORMATS`; default from the extension (hourly formats;
+        a measured file names its format).
+    label : str, optional
+        What a timestamp marks, one of :data:`foldopt.names.INTERVAL_LABELS`; default the format's.
+    timezone : str, optional
+        A measured file's standard time, a fixed offset (``UTC-07:00``): default the file's, else
+        the offset nearest longitude / 15 h; it also places a CSV's stamps that carry none.
+    decomposition : str
+        How a measured file's ``dni`` and ``dhi`` come from ``ghi`` alone, one of
+        :data:`foldopt.names.DECOMPOSITIONS`; default ``erbs``.
+    max_gap_min : float
+        A measured file's longest daylight gap filled along the clear-sky index [min]; a day with
+        a longer one is left out of the study's days (and refused where asked for). Default 60.
+    members : int, optional
+        An hourly file's cloud ensemble: this many synthetic minute series of each hour
+        (:mod:`foldopt.inputs.weather.ensemble`), 2 to 200; default none (the smooth minutes).
+    seed : int
+        The ensemble's seed; the same seed gives the same members. Default 0.
+    """
+
+    path: str
+    format: named(names.WEATHER_FORMATS) | None = Field(None, description="default from the extension (hourly "
+                                                       "formats); a measured file names its format")
+    label: named(names.INTERVAL_LABELS) | None = Field(
+        None, description="what a timestamp marks; default the format's (TMY3 end, EPW and PVGIS start)"
+    )
+    timezone: Annotated[str | None, AfterValidator(_check_offset)] = Field(
+        None, description="a measured file's standard time, e.g. UTC-07:00; default the file's")
+    decomposition: named(names.DECOMPOSITIONS) = Field("erbs", description="a measured file's dni and dhi from ghi")
+    max_gap_min: interval(0, 1440, unit=" min") = 60.0
+    members: Annotated[int, Field(ge=2, le=200)] | None = Field(
+        None, description="an hourly file's cloud ensemble of this many members")
+    seed: Annotated[int, Field(ge=0)] = 0
+
+    @property
+    def measured(self) -> bool:
+        """Whether the file is a measured one (its format is not an hourly one)."""
+        return self.format is not None and self.format not in names.HOURLY_WEATHER_FORMATS
+
+    @field_validator("timezone", "decomposition", "max_gap_min")
+    @classmethod
+    def _measured_only(cls, value, info: ValidationInfo):
+        defaults = {"timezone": None, "decomposition": "erbs", "max_gap_min": 60.0}
+        fmt = info.data.get("format")
+        if value != defaults[info.field_name] and (fmt is None or fmt in names.HOURLY_WEATHER_FORMATS):
+            measured = ", ".join(f for f in names.WEATHER_FORMATS if f not in names.HOURLY_WEATHER_FORMATS)
+            raise ValueError(f"is only used by measured weather files (format {measured})")
+        return value
+
+    @field_validator("members")
+    @classmethod
+    def _hourly_only(cls, value, info: ValidationInfo):
+        fmt = info.data.get("format")
+        if value is not None and fmt is not None and fmt not in names.HOURLY_WEATHER_FORMATS:
+            raise ValueError("a cloud ensemble is drawn from an hourly file; a measured file's minutes are its own")
+        return value
+
+    @field_validator("seed")
+    @classmethod
+    def _ensemble_only(cls, value, info: ValidationInfo):
+        if value != 0 and info.data.get("members") is None:
+            raise ValueError("is only used by a cloud ensemble (weather.members)")
+        return value
