@@ -19,7 +19,8 @@ except metadata.PackageNotFoundError:  # running from a source tree that is not 
 _PUBLIC = {
     "Study": "foldopt.inputs.study", "Plan": "foldopt.inputs.plan", "ConfigError": "foldopt.errors",
     **{name: "foldopt.inputs.sections" for name in (
-        "Site", "Panel", "Tracker", "Objective", "FoldAngles", "Weather", "LoadProfile", "NearOptimal")},
+        "Site", "Panel", "Tracker", "Objective", "FoldAngles", "LoadProfile", "NearOptimal")},
+    "Weather": "foldopt.inputs.weather_section",
     "default_study": "foldopt.api", "load_study": "foldopt.api", "run": "foldopt.api", "sweep": "foldopt.api",
     "write": "foldopt.api", "size": "foldopt.api", "reproduce": "foldopt.api", "world_map": "foldopt.api",
     "StudyResult": "foldopt.studies.day", "SweepResult": "foldopt.studies.sweeps",
@@ -33,6 +34,7 @@ _PUBLIC = {
     **{name: "foldopt.output.figures.sweep" for name in ("plot_map", "plot_curves")},
     **{name: "foldopt.output.figures.annual" for name in (
         "plot_annual_fold_angles", "plot_monthly", "plot_distribution", "plot_day_hour", "plot_refold_value")},
+    **{name: "foldopt.output.figures.weather" for name in ("plot_weather_minutes", "plot_member_t_solar")},
     **{name: "foldopt.output.figures.world" for name in ("plot_world_map", "plot_latitude_load")},
     "plot_sizing": "foldopt.output.figures.sizing",
     "best_schedules": "foldopt.engine.schedule",

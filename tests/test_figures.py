@@ -12,7 +12,7 @@ import textwrap
 from pathlib import Path
 
 import foldopt
-from foldopt.output.figures import FIGURES, annual, day, sizing, sweep, world
+from foldopt.output.figures import FIGURES, annual, day, sizing, sweep, weather, world
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -25,7 +25,7 @@ def test_the_registry_is_the_figures_of_the_examples():
 
 
 def test_the_registry_is_every_kind_once_and_draws_with_public_functions():
-    kinds = [day.FIGURES, sweep.FIGURES, annual.FIGURES, world.FIGURES, sizing.FIGURES]
+    kinds = [day.FIGURES, sweep.FIGURES, annual.FIGURES, weather.FIGURES, world.FIGURES, sizing.FIGURES]
     assert sum(len(kind) for kind in kinds) == len(FIGURES)  # no file name in two kinds
     for file, figure in FIGURES.items():
         assert file.endswith(".png") and figure.description
@@ -65,6 +65,12 @@ NOTEBOOK = textwrap.dedent("""
         "plot_refold_value": (pd.DataFrame({"latitude": 0.0, "longitude": 0.0, "p_load_w": 2.0, "settings": [1, 2],
                                             "objective": "mean", "objective_h": [5.0, 6.0],
                                             "objective_flat_h": 4.0, "objective_tracker_h": 7.0}), "t"),
+        "plot_weather_minutes": ({"date": "2025-06-01", "hours": np.arange(96) / 4 + 0.125, "kind": "members",
+                                  "ghi": np.random.default_rng(0).uniform(0, 900, (5, 96)),
+                                  "hourly_ghi": np.full(24, 300.0)}, "t"),
+        "plot_member_t_solar": (year.table.assign(t_solar_p10_h=year.table.t_solar_h - 0.1,
+                                                  t_solar_p50_h=year.table.t_solar_h,
+                                                  t_solar_p90_h=year.table.t_solar_h + 0.1), "t"),
         "plot_world_map": (sites, "gain_vs_flat_pct", "t", "gain [%]", True),
         "plot_latitude_load": (sites, "year", True, "t"),
     }

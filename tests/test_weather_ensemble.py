@@ -11,7 +11,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from foldopt.inputs.weather.downscale import MAX_CLEARSKY_INDEX
-from foldopt.inputs.weather.ensemble import MAX_ENHANCEMENT, MIN_COS_ZENITH, cloud_members
+from foldopt.inputs.weather.ensemble import (
+    MAX_ENHANCEMENT,
+    MIN_COS_ZENITH,
+    OVERCAST_PERSISTENCE,
+    _overcast,
+    _overcast_hours,
+    cloud_members,
+)
 
 
 def sky(n_days: int, spi: int, peak: float = 0.8):
@@ -43,7 +50,7 @@ def check_invariants(out, ghi, dhi, clear, cosz, spi):
     clear_mean = interval_means(clear, spi)
     lit = clear_mean > 0
     index = np.divide(ghi, clear_mean, out=np.zeros_like(ghi), where=lit)
-    bound = np.repeat(np.minimum(np.maximum(MAX_ENHANCEMENT, index), MAX_CLEARSKY_INDEX), spi, axis=-1)
+    bound = np.repeat(np.minimum(MAX_ENHANCEMENT * np.maximum(1.0, index), MAX_CLEARSKY_INDEX), spi, axis=-1)
     assert (g <= bound * clear + 1e-9).all()
     for values, target in ((g, ghi), (d, dhi)):
         means = interval_means(values, spi)
@@ -159,3 +166,59 @@ def test_invariants_over_random_hours(data, spi, n_days, peak, with_cover, seed)
             = np.nan
     out = cloud_members(ghi, dhi, clear, cosz, spi, 60.0 / spi, 3, seed, cloud_cover=cover)
     check_invariants(out, ghi, dhi, clear, cosz, spi)
+
+
+def test_overcast_hours_have_their_chance_and_persist():
+    """Each lit interval is overcast in about its chance of the members, and an overcast interval
+    is followed by another about as often as Bright et al.'s 8 oktas persist; a dark interval
+    between two starts the draw afresh."""
+    chance = np.tile([0.2, 0.4, 0.4, 0.4, 0.6, 0.4], 40)
+    fresh = np.zeros(chance.size, dtype=bool)
+    fresh[::6] = True
+    rngs = [np.random.default_rng(child) for child in np.random.SeedSequence(3).spawn(2000)]
+    covered = _overcast_hours(chance, fresh, rngs)
+    assert np.abs(covered.mean(axis=0) - chance).max() < 0.05
+    inside = ~fresh[1:]
+    together = (covered[:, 1:] & covered[:, :-1])[:, inside].mean() / covered[:, :-1][:, inside].mean()
+    assert together > OVERCAST_PERSISTENCE - 0.02
+    across = (covered[:, 6::6] & covered[:, 5:-1:6]).mean() / covered[:, 5:-1:6].mean()
+    assert abs(across - 0.2) < 0.05  # independent across a dark interval (the next one's chance)
+
+
+def test_intermediate_hours_are_smooth_in_some_members_and_broken_in_others():
+    spi = 60
+    clear, cosz = sky(1, spi)
+    ghi, dhi = hourly(clear, spi, np.full((1, 24), 0.4), np.full((1, 24), 0.7))
+    out = cloud_members(ghi, dhi, clear, cosz, spi, 1.0, 100, 11)
+    check_invariants(out, ghi, dhi, clear, cosz, spi)
+    dni = out["dni"][:, 0].reshape(100, 24, spi)[:, 9:15]
+    even = (dni > 0).all(axis=-1)  # overcast, or a broken hour whose clouds never part
+    chance = _overcast(np.array([0.4]), np.array([50.0]))[0]
+    assert 0.3 < chance < even.mean() < 0.95
+
+
+def test_overcast_chance_falls_with_the_index_and_a_full_cover_is_overcast():
+    index = np.linspace(0.1, 0.95, 18)
+    chance = _overcast(index, np.full(index.shape, 30.0))
+    assert chance[0] > 0.5 and chance[-1] < 0.02 and (np.diff(chance) < 0).all()
+    spi = 60
+    clear, cosz = sky(1, spi)
+    ghi, dhi = hourly(clear, spi, np.full((1, 24), 0.6), np.full((1, 24), 0.5))
+    out = cloud_members(ghi, dhi, clear, cosz, spi, 1.0, 10, 4, cloud_cover=np.ones((1, 24)))
+    noon = slice(12 * spi, 13 * spi)
+    dni = out["dni"][:, 0, noon]  # overcast: the beam even, as a hazy sun
+    assert (dni > 0).all() and (dni.std(axis=1) < 0.1 * dni.mean(axis=1)).all()
+
+
+def test_clear_hours_above_the_clear_sky_follow_a_curve_not_a_staircase():
+    """Clear hours brighter than the clear-sky model (its error at a low sun) are not each held at
+    their own index: the index runs on across the hours' edges."""
+    spi = 60
+    clear, cosz = sky(1, spi)
+    index = np.clip(1.0 + 0.1 * np.abs(np.arange(24) - 12.0), None, 1.9)[None]
+    ghi, dhi = hourly(clear, spi, index, np.full((1, 24), 0.12))
+    out = cloud_members(ghi, dhi, clear, cosz, spi, 1.0, 3, 2)
+    check_invariants(out, ghi, dhi, clear, cosz, spi)
+    kc = out["ghi"][:, 0] / np.where(clear[0] > 0, clear[0], 1.0)
+    edges = np.arange(8, 12) * spi
+    assert np.abs(kc[:, edges] - kc[:, edges - 1]).max() < 0.03  # the hours' indices step by 0.1

@@ -11,6 +11,7 @@ orientations against it. Blocks may be different sites and days; they share the 
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -108,9 +109,9 @@ class Sky:
         """Step length [h]."""
         return self.grid.step_hours
 
-    @property
+    @functools.cached_property
     def lit(self) -> np.ndarray:
-        """Steps with any light on some orientation."""
+        """Steps with any light on some orientation (worked out once: many callers ask)."""
         if self.terms is None:
             return self.dni > 0
         return (self.dni > 0) | np.any(self.terms != 0, axis=-1)
@@ -334,8 +335,10 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
                                                                                       zenith)
         if share is not None:
             light, balance = _members(study, hourly, per_interval, clear, zenith, dates, share)
+    sun_vector = normal_vector(zenith, sun["solar_azimuth"])
     if share is not None:
         inverse = share[0]
+        sun_vector = sun_vector[inverse]
         grid = ClockGrid(grid.utc_ns[inverse], grid.utc_offset_ns[inverse], tuple(grid.timezones[i] for i in inverse),
                          grid.step_hours)
         sun = {key: value[inverse] for key, value in sun.items()}
@@ -370,7 +373,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
     return Sky(
         grid=grid, mode=study.mode, solar_zenith=zenith, solar_azimuth=sun["solar_azimuth"],
         hour_angle=sun["hour_angle"], declination=np.ascontiguousarray(sun["declination"]),
-        sun_vector=normal_vector(zenith, sun["solar_azimuth"]), dni=dni, ghi=ghi, dhi=dhi, terms=terms,
+        sun_vector=sun_vector, dni=dni, ghi=ghi, dhi=dhi, terms=terms,
         temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam, weather_balance=balance,
         load_shape=None if study.load_profile is None else load_shape(study.load_profile, grid.clock_hours, dates),
         temp_steps=temp_steps, wind_speed=wind_speed, wind_ref=wind_ref, weather_notes=notes,

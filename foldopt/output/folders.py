@@ -150,6 +150,14 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
     if "annual_objective" in extras:
         write_csv(extras["annual_objective"], folder / "annual_objective.csv")
         written.append("annual_objective.csv")
+    if "weather_sample" in extras:
+        kind = {"measured": "measured minutes", "smooth": "the file's hours on the study's steps",
+                "members": "a cloud ensemble's members"}[extras["weather_sample"]["kind"]]
+        written.append(write_figure(folder, "weather_minutes.png", extras["weather_sample"],
+                                    f"{name}: {kind}, the day most variable within its hours"))
+    if "t_solar_p10_h" in table:
+        written.append(write_figure(folder, "ensemble_t_solar.png", table,
+                                    f"{name}: daily t_solar over the cloud ensemble's members", study=study))
     if "refold_value" in extras:
         write_csv(extras["refold_value"], folder / "refold_value.csv")
         write_csv(extras["refold_schedule"], folder / "refold_schedule.csv")

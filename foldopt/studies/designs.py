@@ -113,7 +113,7 @@ def standby_available(gross, draw, lit, standby_w: float):
     return np.where(lit, gross - (draw - np.where(lit, standby_w, 0.0)), 0.0)
 
 
-def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
+def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.ndarray:
     """The tracker's own draw [W] per step over every block: standby while there is light (the sun up,
     clouds or not), plus its moves.
 
@@ -124,10 +124,16 @@ def sky_tracker_draw(sky: Sky, study: Study, orientation) -> np.ndarray:
         The tracker's drive and standby settings.
     orientation : tuple of numpy.ndarray
         The tracker's surface tilt and azimuth [deg] (:func:`sky_tracker_orientation`).
+    every : int, default 1
+        Work out every ``every``-th block's draw and give it to the next ``every``: a cloud
+        ensemble's members share their day's sun, so the tracker moves alike, and some light
+        reaches every member while the sun is up.
     """
     tracker = study.tracker
     drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
-    return tracker_draw(*orientation, sky.lit, sky.step_hours, drive)
+    shared = slice(None, None, every)
+    draw = tracker_draw(*(angle[shared] for angle in orientation), sky.lit[shared], sky.step_hours, drive)
+    return np.repeat(draw, every, axis=0) if every > 1 else draw
 
 
 @dataclass(frozen=True)
@@ -277,7 +283,7 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
         irradiation [kWh/m^2]) and ``condition`` (:func:`foldopt.engine.metrics.design_condition`), each
         (n_blocks, n_loads, 4) in the order of :data:`DESIGNS`.
     """
-    study = blocks.study
+    study, blocks_of = blocks.study, blocks
     n_blocks, n_loads = sky.n_blocks, loads.size
     tilt, azimuth = blocks.tilt, blocks.azimuth
     every = engines.fold_orientations(study, tilt, azimuth, angles)
@@ -291,7 +297,7 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
     orientation = sky_tracker_orientation(sky, study)
     gross = sky_tracker_power(sky, study, orientation)
     tracker_poa = energy(engines.poa(sky, *orientation, incident=True), sky.step_hours)
-    net = gross - sky_tracker_draw(sky, study, orientation)
+    net = gross - sky_tracker_draw(sky, study, orientation, every=blocks_of.members)
     shape = sky.load_shape
     trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
                                      engine=engine,

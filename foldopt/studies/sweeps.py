@@ -158,8 +158,10 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves."""
     parts = blocks.chunks(loads.size)
     skies, daily = [], []
+    sample: dict = {}
     for part in parts:
         skies.append(counted(blocks[part].sky()))
+        _keep_sample(sample, skies[-1], blocks[part], blocks.members)
         angles, hours, _ = fold_hours(skies[-1], blocks[part], loads, engine)
         daily.append(hours)
         advance(len(blocks[part]) // blocks.members)
@@ -181,11 +183,13 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         metrics.append(design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
                                        engine))
         # The day x hour maps of the first load's angle, every day at once.
-        orientation = engines.fold_orientations(study, chunk.tilt, chunk.azimuth, angles[fixed[:1]])[:, 0]
-        powers, state = engines.powers(sky, study, orientation, series=study.switch_series, with_state=True)
-        first = slice(None, None, members)  # the maps show the first member of each day
-        series["p_twofold_w"].append(powers[study.connection][first])
-        series["switch_state"].append(np.where(powers["switching"] > 0, state, -1)[first])
+        # The maps show the first member of each day.
+        first = list(range(0, len(chunk), members))
+        orientation = engines.fold_orientations(study, chunk.tilt[first], chunk.azimuth[first], angles[fixed[:1]])
+        powers, state = engines.powers(sky, study, orientation[:, 0], first, series=study.switch_series,
+                                       with_state=True)
+        series["p_twofold_w"].append(powers[study.connection])
+        series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
         advance(len(chunk) // members)
     clock = skies[0].grid.clock_hours[0]
     design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (blocks, loads, designs)
@@ -202,6 +206,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     if objective.visits:
         refold.update(refold_tables(blocks, loads, angles, daily, months, objective, design_hours))
     extras = {"dates": list(blocks.dates[::members]), "hours": clock, "fold_angle": float(angles[fixed[0]]), **refold,
+              **({"weather_sample": sample} if sample else {}),
               **{key: np.concatenate(value) for key, value in series.items()},
               "by_angle": pd.DataFrame({
                   "p_load_w": np.repeat(loads, angles.size), "fold_angle_deg": np.tile(angles, loads.size),
@@ -215,6 +220,25 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         group = _over_members(group, members)
     group.update(_twofold_only({key: np.broadcast_to(value, (len(months), loads.size)) for key, value in near.items()}))
     return group, extras
+
+
+def _keep_sample(sample: dict, sky: Sky, blocks: Blocks, members: int) -> None:
+    """Keep, in ``sample``, the day of a weather study whose light varies most within its hours
+    (its first member's): its GHI at every step, every member's, and its hourly means, for the
+    report's figure of the minutes (:mod:`foldopt.output.figures.weather`)."""
+    weather = blocks.study.weather
+    if weather is None or sky.ghi is None:
+        return
+    per_hour = round(1.0 / sky.step_hours)
+    first = sky.ghi[::members].reshape(-1, 24, per_hour)
+    spread = first.std(axis=-1).mean(axis=-1)
+    day = int(np.argmax(spread))
+    if sample and spread[day] <= sample["spread"]:
+        return
+    sample.update(spread=float(spread[day]), date=blocks.dates[day * members].isoformat(),
+                  hours=sky.grid.clock_hours[day * members], ghi=sky.ghi[day * members:(day + 1) * members],
+                  hourly_ghi=first[day].mean(axis=-1),
+                  kind="measured" if weather.measured else "members" if members > 1 else "smooth")
 
 
 def _over_members(group: dict, members: int) -> dict:

@@ -2,62 +2,81 @@
 different passage of clouds over the same hours.
 
 A storage-less load stops whenever a cloud hides the sun, so an hour's mean says too little: a
-broken-cloud hour and a thin-overcast hour of the same mean stop a load very differently. Each
-member here is a sample of the two-state sky of Morf [2]_ and Bright et al. [1]_: at every instant
-the sun is visible or obscured. The beam is the hour's while the sun is visible and none while it
-is obscured; the diffuse is the hour's, smooth, in both states (its cloud-lit share is what makes
-sunny minutes under broken cloud brighter than the clear sky). Every hour of every member keeps the
-file's mean GHI and DHI exactly, so the members differ only in where, within each hour, the sun
-shines.
+broken-cloud hour and a thin-overcast hour of the same mean stop a load very differently, and the
+mean cannot tell them apart. Each member therefore draws, hour by hour, which of the two the hour
+was: overcast (the sun never distinct: smooth light at the hour's level) or broken, the two-state
+sky of Morf [2]_ and Bright et al. [1]_ (at every instant the sun visible or obscured; the beam the
+hour's while visible, none while obscured; the diffuse the hour's, smooth, in both). Every hour of
+every member keeps the file's mean GHI and DHI exactly.
 
 The model, step by step (:func:`cloud_members`):
 
 1. The hour's sunshine fraction ``s``: one minus the file's total sky cover where it gives one
-   (Bright et al.: the sun is obscured for the part of the hour the sky is covered [1]_); else from
-   the hour's clear-sky index ``k`` by Suehrcke, Bowden & Hollands' relation between sunshine and
-   radiation, ``k = beta + (1 - beta) s**gamma`` with their global ``beta = 0.1898``,
-   ``gamma = 0.7410`` [4]_. Then ``s`` is bounded by the hour's beam ``B = ghi - dhi``: the sun
-   shines at most ``B / (120 cos(zenith))`` of the hour, since sunshine is a DNI of at least
-   120 W/m^2 [5]_ (an all-diffuse hour has none), and at least as long as the bound on over-
-   irradiance needs to fit ``B`` into the sunny steps.
-2. Which steps are sunny: a continuous-time two-state Markov chain [2]_ run through the lit hours
-   in order, so that its state carries over from one hour to the next (after a dark hour it starts
-   afresh: a night decorrelates it). Within an hour it is sunny with probability ``s`` and its runs
-   have the mean length of Bright et al.'s cloud and gap chords: their power law ``p(x) ~ x**-1.66``
-   from 100 m to 1500 km after Wood & Field [3]_ (mean 4.9 km), passing at their cloud speed,
-   ``Gamma(2.7, 2.144)`` m/s within 1 to 60 m/s, drawn every hour [1]_ (about 14 min at the mean
-   speed when ``s = 1/2``). Each hour's runs are then stretched or shrunk, in order and keeping its
-   first and last states, so that the sun shines exactly ``s`` of it: Bright et al. keep only
-   sampled hours whose cover is the hour's [1]_; the stretch keeps that condition without cutting
-   the chain at the hour's edges. An hour in which the chain does not switch at all (slow clouds)
-   takes its beam evenly, as a hazy sun.
-3. The light: the diffuse is the hour's clear-sky diffuse index, linear between hour centres (held
-   beyond the first and last), times the clear sky; the beam of a sunny step is the hour's ``B / s``
-   alike. Both take Bright et al.'s white noise, of relative standard deviation
-   ``0.001 + 0.0015 N`` while the sun is visible and ``0.01 + 0.003 N`` while obscured, ``N`` the
-   cover in oktas (``8 (1 - s)`` where the file gives none), their eqs. (12) and (13) [1]_. Each
-   hour's diffuse and beam are then scaled to the file's means; the GHI is their sum, at most
-   :data:`MAX_ENHANCEMENT` times the clear sky (or the hour's own index if higher, up to
-   :data:`~foldopt.inputs.weather.downscale.MAX_CLEARSKY_INDEX`); the DNI is ``beam / cos(zenith)``.
+   (the sun obscured for the part of the hour the sky is covered [1]_); else from the hour's
+   clear-sky index ``k`` by Suehrcke, Bowden & Hollands' relation [4]_ inverted,
+
+   (1) ``k = beta + (1 - beta) s**gamma``, ``beta = 0.1898``, ``gamma = 0.7410``;
+
+   then bounded by the hour's beam ``B = ghi - dhi``: at most ``B / (120 cos(zenith))`` (sunshine
+   is a DNI of at least 120 W/m^2 [5]_), at least what the bound on over-irradiance needs.
+2. Overcast or broken: the hour's chance of 8 oktas given its index and solar elevation ``h``
+   (the nearest 10 deg bin up to 50 deg), by Bayes from Smith, Bright & Crook's fitted densities
+   of the hourly clear-sky index in each cover [6]_, Burr type III for 0-3 oktas and generalised
+   gamma for 4-8,
+
+   (2) ``f_N(x) = (c k / a) (x / a)**(-c - 1) (1 + (x / a)**-c)**(-k - 1)``,
+   (3) ``f_N(x) = p x**(d - 1) exp(-(x / a)**p) / (a**d Gamma(d / p))``,
+   (4) ``P(overcast | k, h) = f_8(k; h) / sum over N = 0..8 of f_N(k; h)``,
+
+   the oktas taken as equally likely beforehand (an assumption: a file says nothing of the site's
+   cloud climate; Smith et al.'s fits are UK hours). Where the file gives a cover, the hour is
+   overcast when the cover is full. An hour of full sunshine (``s = 1``) is never overcast (the
+   fits' tails above ``k = 1`` say nothing of cloud). Overcast spells persist: each member carries
+   a uniform variate ``u`` from one lit hour to the next with Bright et al.'s hourly persistence of
+   8 oktas [1]_, ``rho = 0.85``, redrawing it otherwise (and after a dark hour), and
+
+   (5) the hour is overcast when ``u < P(overcast | k, h)``,
+
+   so that each hour is overcast with its own chance (4) and neighbouring hours tend to agree.
+3. Which steps of a broken hour are sunny: a continuous-time two-state Markov chain [2]_ run
+   through the lit hours in order (its state carried from hour to hour; after a dark hour it starts
+   afresh), sunny with probability ``s``, its runs of the mean length of Bright et al.'s cloud and
+   gap chords: their power law ``p(x) ~ x**-1.66`` from 100 m to 1500 km after Wood & Field [3]_
+   (mean 4.9 km), passing at their cloud speed, ``Gamma(2.7, 2.144)`` m/s within 1 to 60 m/s,
+   drawn every hour [1]_ (about 14 min at the mean speed when ``s = 1/2``). Each hour's runs are
+   then stretched or shrunk, in order and keeping its first and last states, so that the sun
+   shines exactly ``s`` of it (Bright et al. keep only sampled hours of the hour's cover [1]_). An
+   overcast hour, or one in which the chain does not switch (slow clouds), takes its beam evenly,
+   as a hazy sun.
+4. The light: the diffuse is the hour's clear-sky diffuse index, linear between hour centres (held
+   beyond the first and last), times the clear sky; the beam of a sunny step is the hour's sunny
+   DNI ``B / (s cos(zenith))``, linear alike, times ``cos(zenith)`` (a clear DNI varies little
+   within an hour, and a clear-sky model's error at a low sun, where it may be far too dark, does
+   not shape it). Both take Bright et al.'s white noise of relative standard deviation
+
+   (6) ``0.001 + 0.0015 N`` while the sun is visible, ``0.01 + 0.003 N`` while obscured,
+
+   their eqs. (12) and (13) [1]_, ``N`` the cover in oktas (``8 (1 - s)`` where the file gives
+   none, 8 in an overcast hour). Each hour's diffuse and beam are then scaled to the file's means;
+   the GHI is their sum, at most :data:`MAX_ENHANCEMENT` times the clear sky, or that times the
+   hour's own index where it is above 1 (a clear sky the model underrates), and never above
+   :data:`~foldopt.inputs.weather.downscale.MAX_CLEARSKY_INDEX` times it; the DNI is
+   ``beam / cos(zenith)``.
 
 Left out of Bright et al.'s model [1]_: its Markov chains of hourly cover, wind, cloud height and
-pressure (the hours here are the file's); the wind and cloud height that set its cloud speed (the
-speed here is its distribution above 1 km, every hour); its strict alternation of power-law cloud
-and gap chords (here a Markov chain with their mean run length; the power law's many sub-minute
-chords would be averaged away in a minute anyway); its clear-sky index distributions by okta for
-obscured minutes and ``N(0.99, 0.08)`` for sunny days (here the levels follow from the hour's GHI
-and DHI, which are known, with the same diffuse in sun and shade); its smoothing of long clear and
-overcast spells, its cloud-edge peaks, its zenith-dependent bound and its beam relation (here the
-beam is on or off). Suehrcke et al. derive their relation for days and months [4]_; it is used
-here for hours. The chain runs on steps of at most :data:`CHAIN_STEP_MIN`; a coarser study step
-averages its sub-steps, a finer one keeps its own.
+pressure (the hours here are the file's; only the overcast persistence is kept); its cloud speed
+from wind and cloud height (here its distribution above 1 km); its strict alternation of power-law
+chords (here a chain of their mean run length; sub-minute chords average away in a minute); its
+clear-sky index distributions for obscured minutes (here the levels follow from the hour's GHI and
+DHI); its smoothing of long spells, cloud-edge peaks and beam relation. Suehrcke et al. derive (1)
+for days and months [4]_; it is used here for hours. The chain runs on steps of at most
+:data:`CHAIN_STEP_MIN`; a coarser study step averages its sub-steps, a finer one keeps its own.
 
-Checked, not fitted, against pvlib's measured minute days: clear (SURFRAD Alamosa 2016-01-01, MIDC
-BMS 2018-10-18) and overcast (SRML Eugene 2018-01-01) days stay as smooth as measured; on a broken
-day (MIDC BMS 2018-10-14, its DHI by Erbs from the hourly GHI) the within-hour spread of the broken
-hours is about the measured one (medians 125-160 W/m^2 against 135-146), but hours of thin,
-variable overcast get 2.5 to 4 times their measured spread: an hour's means cannot tell them from
-broken cloud, and the relation of [4]_ gives them sunshine they did not have.
+Checked, not fitted, against measured minute days (foldopt.studies.validation): clear days stay
+deterministic and within about 0.1 h of the smooth path's t_solar at most loads; on broken days
+the members' P5-P95 holds the measured t_solar at most low and middle loads. Thin, variable
+overcast that (4) gives a small chance (MIDC BMS 2018-10-14, hours 10-12, ``k`` 0.6-0.7: 5-10 %)
+is still drawn broken by most members, whose t_solar at high loads then falls short.
 
 References
 ----------
@@ -65,7 +84,8 @@ References
    minutely irradiance time series derived from mean hourly weather observation data", Solar
    Energy 115, 229-242, 2015; the parameters as in the authors' code (BrightSolarModel, GitHub
    JamieMBright): chord law, cloud speed (after Mathiesen et al., Solar Energy 92, 47-61, 2013),
-   noise of eqs. (12)-(13).
+   noise of eqs. (12)-(13), and the hourly cloud-cover transitions (supportingfiles
+   cum_winterhp_prob.txt and cum_winterlp_prob.txt: 8 oktas to 8 oktas 0.849 and 0.859).
 .. [2] H. Morf, "The stochastic two-state solar irradiance model (STSIM)", Solar Energy 62(2),
    101-112, 1998: the sun covered or not, the state switching as a Markov process.
 .. [3] R. Wood, P. R. Field, "The distribution of cloud horizontal sizes", Journal of Climate
@@ -75,6 +95,11 @@ References
    against the sunshine fraction, ``beta + (1 - beta) s**gamma``.
 .. [5] WMO, "Guide to Meteorological Instruments and Methods of Observation" (WMO-No. 8), chapter
    on sunshine duration: the sun shines while the direct normal irradiance is at least 120 W/m^2.
+.. [6] C. J. Smith, J. M. Bright, R. Crook, "Cloud cover effect of clear-sky index distributions
+   and differences between human and automatic cloud observations", Solar Energy 144, 10-21,
+   2017: hourly clear-sky index at 63 UK stations 2010-2013 by okta and solar elevation, Burr III
+   (0-3 oktas) and generalised gamma (4-8) fits; the coefficients of automatic observations as
+   in Bright et al.'s code [1]_ (clear-sky-distribution-coefficients.txt).
 """
 
 from __future__ import annotations
@@ -109,6 +134,35 @@ MAX_ENHANCEMENT = 1.5
 MIN_COS_ZENITH = 0.0175
 #: Longest step of the two-state chain [min]; a coarser study step averages sub-steps of this.
 CHAIN_STEP_MIN = 1.0
+#: Smith, Bright & Crook's fits of the hourly clear-sky index in each cloud cover [6]_ (their
+#: automatic observations, as in Bright et al.'s code [1]_): rows 0 to 8 oktas, columns the solar
+#: elevation bins 0, 10, ..., 50 deg, each ``(scale, shape1, shape2)``; 0-3 oktas Burr type III,
+#: 4-8 oktas generalised gamma (eqs. (2)-(3) of the module docstring). The two bins they leave empty
+#: (0 oktas at 30 deg, 8 oktas at 20 deg) take the mean of their neighbours' parameters.
+COVER_FITS = np.array([
+    [(1.00426, 8.05209, 0.33413), (1.05008, 30.0122, 0.15747), (1.04270, 79.3070, 0.10978),
+     (np.nan,) * 3, (1.04161, 90.4486, 0.11474), (1.04035, 106.678, 0.11517)],
+    [(0.86772, 5.95703, 0.46153), (1.03464, 23.3098, 0.13596), (1.05403, 45.7765, 0.08633),
+     (1.05343, 61.2289, 0.07964), (1.04837, 68.6886, 0.08091), (1.05109, 83.3814, 0.07648)],
+    [(0.77206, 4.95605, 0.60222), (0.99764, 16.1237, 0.17120), (1.04272, 33.0440, 0.09915),
+     (1.04420, 43.3609, 0.08753), (1.03914, 44.6569, 0.09412), (1.04245, 59.1349, 0.08163)],
+    [(0.75709, 4.71996, 0.59981), (0.96289, 13.2643, 0.20049), (1.02061, 24.5572, 0.12518),
+     (1.02210, 29.5048, 0.11747), (1.01606, 35.5753, 0.10865), (1.01776, 40.2873, 0.10703)],
+    [(0.00548, 0.55740, 7.91970), (0.80680, 3.78063, 3.21570), (0.97459, 7.68441, 3.13980),
+     (0.99304, 10.0262, 3.49195), (0.99518, 11.9358, 3.63087), (0.99403, 14.3796, 4.15190)],
+    [(0.00202, 0.49130, 8.15754), (0.66456, 2.79245, 3.43021), (0.89225, 5.43828, 3.23124),
+     (0.94539, 7.63587, 3.31306), (0.93125, 8.26040, 3.65375), (0.93577, 9.66092, 3.88766)],
+    [(0.00168, 0.48199, 8.08929), (0.48615, 2.08814, 3.83716), (0.75785, 3.82376, 3.33406),
+     (0.85162, 5.45712, 3.18022), (0.85237, 5.90425, 3.43888), (0.84646, 6.32450, 3.81557)],
+    [(0.00454, 0.48462, 4.42115), (0.43349, 1.79971, 2.24003), (0.61461, 2.62790, 2.02528),
+     (0.70374, 3.46998, 2.06773), (0.73038, 4.01204, 2.19332), (0.74453, 4.48931, 2.18655)],
+    [(0.00017, 0.36012, 5.35531), (0.09720, 1.01097, 3.44283), (np.nan,) * 3,
+     (0.20153, 1.33134, 2.95643), (0.26613, 1.55354, 2.83336), (0.25640, 1.54127, 2.89782)]])
+COVER_FITS[0, 3] = COVER_FITS[0, [2, 4]].mean(axis=0)
+COVER_FITS[8, 2] = COVER_FITS[8, [1, 3]].mean(axis=0)
+#: Bright et al.'s hourly Markov chain of cloud cover [1]_: an overcast (8 okta) hour is followed
+#: by another with probability 0.85 (their winter transition tables: 0.849 and 0.859).
+OVERCAST_PERSISTENCE = 0.85
 
 
 def _mean_chord(exponent=CHORD_EXPONENT, lengths=CHORD_RANGE):
@@ -127,6 +181,33 @@ def _sunshine(index):
     inverted [4]_: 0 up to ``beta``, 1 from the clear sky up."""
     base = np.clip((np.asarray(index, dtype=float) - SUNSHINE_BETA) / (1 - SUNSHINE_BETA), 0.0, 1.0)
     return base ** (1 / SUNSHINE_GAMMA)
+
+
+def _overcast(index, elevation):
+    """Probability that an hour of clear-sky index ``index`` and solar elevation ``elevation`` [deg]
+    is overcast (8 oktas), eq. (4) of the module docstring: Smith et al.'s densities [6]_, the
+    oktas equally likely beforehand."""
+    x = np.clip(np.asarray(index, dtype=float), 1e-3, None)[None]
+    scale, c, k = np.moveaxis(COVER_FITS[:, np.clip(np.rint(elevation / 10.0), 0, 5).astype(int)], -1, 0)
+    log_x = np.log(x / scale)
+    burr = np.log(c * k / scale) - (c + 1) * log_x - (k + 1) * np.logaddexp(0.0, -c * log_x)
+    gamma_fn = np.vectorize(math.lgamma)(k / c)
+    gen = np.log(c / scale) + (k - 1) * log_x - np.exp(c * log_x) - gamma_fn
+    log_f = np.where(np.arange(9).reshape(-1, *([1] * x.ndim)[1:]) < 4, burr, gen)
+    return np.exp(log_f[8] - np.logaddexp.reduce(log_f, axis=0))
+
+
+def _overcast_hours(chance, fresh, rngs):
+    """(members, n) which of ``n`` lit intervals in order each member draws overcast, eq. (5) of the
+    module docstring: a uniform variate per member kept from one interval to the next with the
+    probability :data:`OVERCAST_PERSISTENCE`, else (and where ``fresh``, after a dark one) redrawn,
+    below each interval's ``chance``."""
+    n = chance.size
+    keep = np.stack([rng.random(n) for rng in rngs]) < OVERCAST_PERSISTENCE
+    keep[:, fresh] = False
+    level = np.stack([rng.random(n) for rng in rngs])
+    redrawn = np.maximum.accumulate(np.where(keep, 0, np.arange(n)), axis=1)
+    return np.take_along_axis(level, redrawn, axis=1) < chance
 
 
 def _envelope(index, valid, clear, spi: int):
@@ -223,8 +304,9 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
     cloud_cover : array_like, optional
         (n_days, n_intervals) total sky cover [0..1] (tenths or oktas as a fraction: TMY3
         ``TotCld``, EPW total sky cover); where given and finite, the sun is obscured for this
-        part of the interval [1]_ (within the beam's bounds); elsewhere the part follows from the
-        interval's clear-sky index [4]_.
+        part of the interval [1]_ (within the beam's bounds), and a full cover makes it overcast;
+        elsewhere the part follows from the interval's clear-sky index [4]_, and its chance of
+        being overcast from that index and the sun's elevation [6]_.
 
     Returns
     -------
@@ -232,8 +314,8 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
         ``ghi``, ``dni``, ``dhi``: (members, n_days, n_steps) [W/m^2]. Every member is 0 where the
         clear sky is; ``ghi = dni cos(zenith) + dhi`` at every step, ``dni >= 0`` (0 below
         :data:`MIN_COS_ZENITH`), ``0 <= dhi <= ghi``; ``ghi`` at most :data:`MAX_ENHANCEMENT`
-        times the clear sky, or the interval's own clear-sky index times it if higher, and never
-        above :data:`~foldopt.inputs.weather.downscale.MAX_CLEARSKY_INDEX` times it. Each interval
+        times the clear sky, times the interval's own clear-sky index too where that is above 1,
+        and never above :data:`~foldopt.inputs.weather.downscale.MAX_CLEARSKY_INDEX` times it. Each interval
         lit by the clear sky keeps the file's mean GHI and DHI (to rounding), but where those
         bounds cut in, or where the sun stays within 1 deg of the horizon (its light then all
         diffuse).
@@ -267,7 +349,7 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
     beam = np.where(has_beam, glob - diffuse, 0.0)
     diffuse = glob - beam  # the sun within 1 deg of the horizon all interval: all diffuse
     index = np.divide(glob, clear_mean, out=np.zeros_like(glob), where=lit)
-    bound = np.minimum(np.maximum(MAX_ENHANCEMENT, index), MAX_CLEARSKY_INDEX)
+    bound = np.minimum(MAX_ENHANCEMENT * np.maximum(1.0, index), MAX_CLEARSKY_INDEX)
 
     # 1. Sunshine fraction of each interval, within the beam's bounds.
     share = _sunshine(index)
@@ -285,17 +367,23 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
     share = np.where(beam > 0, np.clip(np.maximum(np.minimum(share, most), least), 0.0, 1.0), 0.0)
     oktas = 8.0 * np.where(np.isfinite(cover), np.clip(np.nan_to_num(cover), 0.0, 1.0), 1.0 - share) \
         if cover is not None else 8.0 * (1.0 - share)
+    # The hour's chance of being overcast (no sunny state), from the file's cover where it gives one.
+    elevation = np.degrees(np.arcsin(np.clip(cos_mean, 0.0, 1.0)))
+    overcast = np.where((share > 0) & (share < 1), _overcast(index, elevation), 0.0)
+    if cover is not None:
+        overcast = np.where(np.isfinite(cover), (np.nan_to_num(cover) >= 1.0) & (share < 1), overcast)
 
     # 2. The sky's state: a chain through the lit intervals in order, on sub-steps of at most
     # CHAIN_STEP_MIN; after a dark interval (an hour of night decorrelates it) it starts afresh.
     sky = _envelope(np.divide(diffuse, clear_mean, out=np.zeros_like(diffuse), where=lit), lit, clear, spi)
-    on = np.divide(beam, share * clear_mean, out=np.zeros_like(beam), where=(share > 0) & lit)
-    direct = _envelope(on, on > 0, clear, spi) * eligible
+    on = np.divide(beam, np.maximum(share, 1e-9) * cos_mean, out=np.zeros_like(beam), where=(share > 0) & has_beam)
+    direct = _envelope(on, on > 0, np.where(eligible, cosz, 0.0), spi)  # the DNI along cos(zenith)
     rows = np.flatnonzero(lit)  # chronological
     if rows.size == 0:
         zeros = np.zeros((members, n_days, n_int * spi))
         return {"ghi": zeros, "dni": zeros.copy(), "dhi": zeros.copy()}
-    share, beam, diffuse, oktas, bound = (a.reshape(-1)[rows] for a in (share, beam, diffuse, oktas, bound))
+    share, beam, diffuse, oktas, bound, overcast = (a.reshape(-1)[rows] for a in (share, beam, diffuse, oktas, bound,
+                                                                                   overcast))
     clear, cosz, eligible, sky, direct = (a.reshape(-1, spi)[rows] for a in (clear, cosz, eligible, sky, direct))
     fresh = np.ones(rows.size, dtype=bool)
     fresh[1:] = np.diff(rows) > 1
@@ -314,13 +402,14 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
     sun = np.take_along_axis(state.reshape(members, -1), last, axis=1).reshape(-1, n)
     del reset, state, last
     sun = _stretch(sun, np.tile(share, members)).reshape(members, rows.size, spi, sub).mean(axis=-1)
+    noise = np.stack([rng.standard_normal((rows.size, spi)) for rng in rngs])
+    covered = _overcast_hours(overcast, fresh, rngs)  # 3. (step 2 of the module docstring)
     hit = sun.mean(axis=-1)
-    uniform = (hit <= 0) | (hit >= 1)  # the chain did not switch all interval: the beam spread evenly
+    uniform = (hit <= 0) | (hit >= 1) | covered  # no switch all interval, or overcast: the beam spread evenly
     sun = np.where(uniform[..., None], np.broadcast_to(share, hit.shape)[..., None], sun)
 
-    # 3. The light: smooth diffuse, the beam on and off, noise, then each interval's means.
-    noise = np.stack([rng.standard_normal((rows.size, spi)) for rng in rngs])
-    okta = oktas[:, None]
+    # 4. The light: smooth diffuse, the beam on and off, noise, then each interval's means.
+    okta = np.where(covered, 8.0, oktas)[..., None]
     sigma = sun * (NOISE_VISIBLE[0] + NOISE_VISIBLE[1] * okta) + (1 - sun) * (NOISE_OBSCURED[0]
                                                                               + NOISE_OBSCURED[1] * okta)
     factor = np.clip(1.0 + sigma * noise, 0.0, None)
