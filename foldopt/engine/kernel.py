@@ -58,22 +58,22 @@ def _bilinear(values, first, second):
 
 
 @njit(cache=True, inline="always")
-def _pair_powers(t, root_east, root_west, table_1d, table_parallel, table_series, need_series, bypass):
-    """East, west, parallel and series power [W] from table set ``t`` at both sub-panels'
+def _pair_powers(root_east, root_west, table_1d, table_parallel, table_series, need_series, bypass):
+    """East, west, parallel and series power [W] from one table set at both sub-panels'
     irradiance (as sqrt(E / E_max))."""
-    n1 = table_1d.shape[1] - 1
-    n2, nr = table_parallel.shape[1] - 1, table_parallel.shape[2] - 1
-    p_east = _linear(table_1d[t], root_east * n1)
-    p_west = _linear(table_1d[t], root_west * n1)
+    n1 = table_1d.shape[0] - 1
+    n2, nr = table_parallel.shape[0] - 1, table_parallel.shape[1] - 1
+    p_east = _linear(table_1d, root_east * n1)
+    p_west = _linear(table_1d, root_west * n1)
     bound = p_east + p_west
     # The pair tables: stronger irradiance (as its root) x weaker/stronger ratio (parallel: as its
     # root; series: the ratio itself).
     strong, weak = max(root_east, root_west), min(root_east, root_west)
     root_ratio = weak / strong if strong > 0.0 else 1.0
-    p_parallel = min(max(_bilinear(table_parallel[t], strong * n2, root_ratio * nr), 0.0), 1.0) * bound
+    p_parallel = min(max(_bilinear(table_parallel, strong * n2, root_ratio * nr), 0.0), 1.0) * bound
     p_series = bound
     if need_series:
-        fraction = _bilinear(table_series[t], strong * n2, root_ratio**2 * nr)
+        fraction = _bilinear(table_series, strong * n2, root_ratio**2 * nr)
         p_series = min(max(fraction, 0.0), 1.0) * bound
     if bypass:
         p_series = max(p_series, max(p_east, p_west))
@@ -304,20 +304,26 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
             g_west = math.sqrt(min(max(g_west, 0.0), IRRADIANCE_MAX) * to_root)
         irradiance[0, s], irradiance[1, s] = g_east, g_west
     per_step = step_table.shape[1] > 1
+    # One table set a block (no weather file): its tables are taken once a row.
+    row_1d, row_parallel, row_series = (table_1d[step_table[b, 0]], table_parallel[step_table[b, 0]],
+                                        table_series[step_table[b, 0]])
     for s in range(first, last + 1):
         root_east, root_west = irradiance[0, s], irradiance[1, s]
         if not tables:
             p_east, p_west = linear_power * root_east, linear_power * root_west
             p_parallel = p_series = p_east + p_west
+        elif not per_step:
+            p_east, p_west, p_parallel, p_series = _pair_powers(root_east, root_west, row_1d, row_parallel,
+                                                                row_series, need_series, bypass)
         else:
-            at = s if per_step else 0
-            t, w = step_table[b, at], step_weight[b, at]
-            p_east, p_west, p_parallel, p_series = _pair_powers(t, root_east, root_west, table_1d, table_parallel,
-                                                                table_series, need_series, bypass)
+            t, w = step_table[b, s], step_weight[b, s]
+            p_east, p_west, p_parallel, p_series = _pair_powers(root_east, root_west, table_1d[t], table_parallel[t],
+                                                                table_series[t], need_series, bypass)
             if w > 0.0:
                 # The step's cells lie between two tables' air temperatures: linear between them.
-                q_east, q_west, q_parallel, q_series = _pair_powers(t + 1, root_east, root_west, table_1d,
-                                                                    table_parallel, table_series, need_series, bypass)
+                q_east, q_west, q_parallel, q_series = _pair_powers(root_east, root_west, table_1d[t + 1],
+                                                                    table_parallel[t + 1], table_series[t + 1],
+                                                                    need_series, bypass)
                 p_east += w * (q_east - p_east)
                 p_west += w * (q_west - p_west)
                 p_parallel += w * (q_parallel - p_parallel)

@@ -242,7 +242,7 @@ def _of_annual(result) -> Answer:
     members = study.weather.members if study.weather is not None and study.weather.members else None
     count = len(_dates(plan))
     lines = [f"{study.name}: {count} day{'s' if count != 1 else ''}, one fold angle "
-             f"{'all year' if count > 1 else 'for the day'}, maximising the {statistic} of daily t_solar"]
+             f"{_period(count)}, maximising the {statistic} of daily t_solar"]
     groups = list(objectives.groupby(keys, sort=False))
     part = {"objective": statistic, "load": describe_load(study), "per_case": []}
     schedule = _schedule(result.extras)
@@ -265,7 +265,8 @@ def _of_annual(result) -> Answer:
         label = load_text(study, load)
         site = where.get("site_name") or (f"{where['latitude']:g}, {where['longitude']:g}"
                                          if len(groups) > 1 and "latitude" in where else "")
-        lines.append(f"{site + ': ' if site else ''}{label}: fold angle {twofold['fold_angle_deg']:g} deg all year; "
+        lines.append(f"{site + ': ' if site else ''}{label}: fold angle {twofold['fold_angle_deg']:g} deg "
+                     f"{_period(count)}; "
                      f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, {_pct(gain)} over flat "
                      f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}"
                      + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"))
@@ -306,6 +307,11 @@ def _of_annual(result) -> Answer:
 #: The annual objective's columns over a cloud ensemble (foldopt.studies.sweeps.objective_table).
 ENSEMBLE_COLUMNS = ("objective_p10_h", "objective_p50_h", "objective_p90_h", "chosen_wins_pct",
                     "within_tolerance_pct")
+
+
+def _period(count: int) -> str:
+    """How long one fold angle is kept: ``all year`` for a year's days (or more), else the days."""
+    return "all year" if count >= 365 else "for the day" if count == 1 else f"for the {count} days"
 
 
 def _dates(plan) -> tuple:
