@@ -66,6 +66,12 @@ def test_a_five_minute_csv_runs_at_its_own_step(tmp_path):
     (["--weather", TMY3, "--seed", "3"], ["--seed", "only used by a cloud ensemble"]),
     (["--weather", TMY3, "--members", "1"], ["--members", "greater than or equal to 2"]),
     (["--weather", FIVE, "--weather-format", "srml9"], ["--weather-format", "did you mean 'srml'"]),
+    (["--weather", SURFRAD, "--weather-format", "surfrad", "--set", "weather.max_gap_min=-5"],
+     ["weather.max_gap_min = -5", "[0, 1440]"]),
+    (["--weather", SURFRAD, "--weather-format", "surfrad", "--set", "weather.decomposition=disc"],
+     ["weather.decomposition", "erbs, boland, dirint"]),
+    (["--weather", SURFRAD, "--weather-format", "surfrad", "--set", "weather.timezone=Europe/Berlin"],
+     ["timezone", "fixed"]),
 ])
 def test_bad_measured_and_ensemble_input_is_one_line(tmp_path, args, words):
     assert_one_line_error(invoke("sweep", "angle", *args, "--out", tmp_path / "b"), *words)

@@ -65,7 +65,10 @@ def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
                                    "latitude, longitude and altitude"}
     options = {key: spec[key] for key in ("label", "timezone", "decomposition", "max_gap_min") if spec.get(key)
                is not None}
-    measured = files.measured_weather(path, fmt, site=given, **options)
+    try:
+        measured = files.measured_weather(path, fmt, site=given, **options)
+    except ValueError:
+        return {}  # an option out of its range: the study's validation names it
     days = measured.frame.index.tz_localize(None).normalize().unique()
     dates = tuple(str(day.date()) for day in days if day.date() not in measured.flagged_days)
     return {"weather_site": measured.site, "weather_step_min": measured.step.total_seconds() / 60.0,
