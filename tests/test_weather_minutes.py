@@ -145,3 +145,14 @@ def test_a_days_time_series_carries_the_light_and_air_it_used(tmp_path):
     beam = series["dni"] * np.clip(np.cos(np.radians(series["solar_zenith"])), 0, None)
     np.testing.assert_allclose(series["ghi"], beam + series["dhi"], atol=1e-6)
     assert series["temp_air"].nunique() > 100  # the cells follow the air through the day
+
+
+def test_an_ensemble_through_the_cli_and_the_api_gives_the_same_answer(tmp_path):
+    result = invoke("sweep", "angle", "--weather", TMY3, "--members", "4", "--seed", "2", "--days", DAYS, "--year",
+                    "2025", "--p-load", "3", "--angle-step", "30", "--out", tmp_path / "e", "--format", "json")
+    assert result.exit_code == 0, result.output
+    cli = json.loads(result.stdout)["answer"]
+    api = foldopt.sweep(foldopt.default_study(), "angle", weather={"path": str(TMY3), "members": 4, "seed": 2},
+                        date=DAYS, year=2025, p_load=3.0, fold_angles={"step": 30}).answer.to_dict()
+    assert api["result"] == cli["result"]
+    assert cli["result"]["per_case"][0]["members"] == 4
