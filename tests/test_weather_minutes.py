@@ -156,3 +156,21 @@ def test_an_ensemble_through_the_cli_and_the_api_gives_the_same_answer(tmp_path)
                         date=DAYS, year=2025, p_load=3.0, fold_angles={"step": 30}).answer.to_dict()
     assert api["result"] == cli["result"]
     assert cli["result"]["per_case"][0]["members"] == 4
+
+
+def test_a_files_sky_cover_reaches_the_ensemble(ensemble_plan):
+    # TMY3's total sky cover (tenths), as pvlib reads it, is the frame's cloud_cover; a member's
+    # hour the file calls overcast (10 tenths) is smooth, one it calls broken (3 to 7) is not
+    # (cloud_members: the sun obscured for the part of the hour the sky is covered).
+    frame = read_weather(TMY3)
+    data, _ = pvlib.iotools.read_tmy3(TMY3, map_variables=True)
+    np.testing.assert_allclose(frame["cloud_cover"].to_numpy(), data["TotCld (tenths)"].to_numpy() / 10.0)
+    study = ensemble_plan.base
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 365, 15)]
+    sky = Blocks.of_dates(study, dates).sky()
+    spread = sky.ghi.reshape(len(dates), 6, 24, 60).std(axis=-1).mean(axis=1)  # (days, hours)
+    cover = np.stack([frame["cloud_cover"][frame.index.date == date].to_numpy() for date in dates])
+    lit = (sky.solar_zenith.reshape(len(dates), 6, 24, 60)[:, 0] < 80).all(axis=-1)
+    overcast, broken = lit & (cover == 1.0), lit & (cover >= 0.3) & (cover <= 0.7)
+    assert overcast.sum() > 10 and broken.sum() > 10
+    assert np.median(spread[broken]) > 3 * np.median(spread[overcast])

@@ -190,7 +190,7 @@ def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict, zenith):
     temperature and wind at every step (:func:`foldopt.inputs.weather.downscale.interpolate_points`),
     and how much of the file's irradiation the steps keep."""
     weather = study.weather
-    columns = ("dni", "ghi", "dhi", "temp_air", "wind_speed")
+    columns = ("dni", "ghi", "dhi", "temp_air", "wind_speed", "cloud_cover")
     hourly = {key: np.empty((len(dates), 0)) for key in columns}
     starts = np.empty((len(dates), 0), dtype=np.int64)
     # The file is coerced to each date's year: read once per year, the days picked as arrays.
@@ -261,7 +261,7 @@ def _members(study: Study, hourly: dict, per_interval: int, clear: dict, zenith,
     for day, date in enumerate(dates):
         one = cloud_members(hourly["ghi"][day:day + 1], hourly["dhi"][day:day + 1], clear["ghi"][day:day + 1],
                             cos_zenith[day:day + 1], per_interval, study.step_min, count,
-                            [study.weather.seed, date.toordinal()])
+                            [study.weather.seed, date.toordinal()], hourly["cloud_cover"][day:day + 1])
         for key in drawn:
             drawn[key][:, day] = one[key][:, 0]
     light = {key: values[member, inverse] for key, values in drawn.items()}

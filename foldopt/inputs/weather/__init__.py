@@ -236,7 +236,8 @@ def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | No
     Returns
     -------
     pandas.DataFrame
-        ``ghi``, ``dni``, ``dhi`` [W/m^2], ``temp_air`` [C], ``wind_speed`` [m/s], indexed by
+        ``ghi``, ``dni``, ``dhi`` [W/m^2], ``temp_air`` [C], ``wind_speed`` [m/s] and
+        ``cloud_cover`` (the total sky cover [0-1], NaN where the file has none), indexed by
         tz-aware interval centres (the file's own time zone) in ``year``. A file without any air
         temperature or wind speed column gets :data:`~foldopt.inputs.weather.qc.DEFAULT_TEMP_AIR`
         and :data:`~foldopt.inputs.weather.qc.DEFAULT_WIND_SPEED`; nothing else is filled in.
@@ -258,7 +259,7 @@ def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | No
     index = data.index + shift
     if typical != year:
         index = pd.DatetimeIndex(index.map(lambda t: t.replace(year=t.year + year - typical)))
-    frame = pd.DataFrame({key: data[key].to_numpy(copy=True) for key in COLUMNS}, index=index)
+    frame = pd.DataFrame({key: data[key].to_numpy(copy=True) for key in (*COLUMNS, "cloud_cover")}, index=index)
     frame = frame.sort_index()
     frame.attrs["weather"] = path.name
     return frame

@@ -69,6 +69,7 @@ FORMAT = WeatherFormat(
     name="epw", label="EPW", interval_label="start", suffixes=(".epw",),
     columns={"ghi": "field 14", "dni": "field 15", "dhi": "field 16", "temp_air": "field 7", "wind_speed": "field 22"},
     columns_at="its rows", read=read, site=partial(header_site, name="city"), stamp_lag=1.0,
+    cover=("total_sky_cover", 10.0),
     # Missing values of the columns used (EnergyPlus, "EnergyPlus Weather File (EPW) Data Dictionary").
     missing={"ghi": 9999.0, "dni": 9999.0, "dhi": 9999.0, "temp_air": 99.9, "wind_speed": 999.0})
 

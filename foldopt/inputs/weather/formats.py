@@ -55,6 +55,9 @@ class WeatherFormat:
     stamp_lag : float, default 0
         How many intervals pvlib's stamps lie before the file's own (EPW: 1, pvlib moves its
         hour-ending stamps back an hour). Air temperature and wind stand at the file's stamps.
+    cover : tuple, optional
+        ``(column, divisor)``: the file's total sky cover and what makes it a fraction of the sky
+        (tenths: 10), for a cloud ensemble (:mod:`foldopt.inputs.weather.ensemble`).
     """
 
     name: str
@@ -68,6 +71,7 @@ class WeatherFormat:
     missing: dict = field(default_factory=dict)
     to_local: Callable | None = None
     stamp_lag: float = 0.0
+    cover: tuple | None = None
 
 
 def reason(error: Exception) -> str:

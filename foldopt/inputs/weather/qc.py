@@ -123,7 +123,8 @@ def check_rows(data: pd.DataFrame, fmt: WeatherFormat, index: pd.DatetimeIndex, 
     Returns
     -------
     pandas.DataFrame
-        :data:`COLUMNS` as floats (``ghi``, ``dni``, ``dhi`` [W/m^2], ``temp_air`` [C],
+        :data:`COLUMNS` and ``cloud_cover`` (the total sky cover [0-1], NaN where unknown) as
+        floats (``ghi``, ``dni``, ``dhi`` [W/m^2], ``temp_air`` [C],
         ``wind_speed`` [m/s]), in file order, indexed by ``index``.
     """
     kind = fmt.label
@@ -202,4 +203,11 @@ def check_rows(data: pd.DataFrame, fmt: WeatherFormat, index: pd.DatetimeIndex, 
            lambda i: f"{value('dni', i)} at solar zenith {zenith[i]:.1f} deg brings {beam[i]:.0f} W/m^2 to "
                      f"the ground, more than {value('ghi', i)} (tolerance {BEAM_TOLERANCE:g} W/m^2): "
                      f"is the file's site, clock or a column wrong?")
+    # The total sky cover, where the format has one: only a cloud ensemble reads it, so a value
+    # out of [0, 1] (a missing-value marker: EPW's 99) is unknown, not a fault.
+    cover = np.full(len(data), np.nan)
+    if fmt.cover is not None and fmt.cover[0] in data.columns:
+        cover = pd.to_numeric(data[fmt.cover[0]], errors="coerce").to_numpy(dtype=float) / fmt.cover[1]
+        cover = np.where((cover >= 0.0) & (cover <= 1.0), cover, np.nan)
+    values["cloud_cover"] = cover
     return pd.DataFrame(values, index=index.rename(None))

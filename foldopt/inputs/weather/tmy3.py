@@ -75,4 +75,5 @@ FORMAT = WeatherFormat(
     name="tmy3", label="TMY3", interval_label="end", suffixes=(".csv",),
     columns={"ghi": "GHI (W/m^2)", "dni": "DNI (W/m^2)", "dhi": "DHI (W/m^2)", "temp_air": "Dry-bulb (C)",
              "wind_speed": "Wspd (m/s)"},
-    columns_at="line 2, the column names", read=read, site=partial(header_site, name="Name"))
+    columns_at="line 2, the column names", read=read, site=partial(header_site, name="Name"),
+    cover=("TotCld (tenths)", 10.0))
