@@ -16,6 +16,7 @@ import pytest
 
 from foldopt.errors import WeatherError
 from foldopt.inputs.weather import weather_days
+from foldopt import names
 from foldopt.inputs.weather.measured import STATION_FORMATS, MeasuredWeather, StationFormat, read_measured
 
 DATA = Path(__file__).resolve().parent / "data" / "measured"
@@ -88,7 +89,8 @@ def test_registry_names_every_format():
     assert set(STATION_FORMATS) == {"surfrad", "midc", "srml", "bsrn", "solrad", "crn", "csv"}
     for name, entry in STATION_FORMATS.items():
         assert isinstance(entry, StationFormat) and entry.name == name
-        assert entry.interval_label in ("start", "end") and entry.suffixes and callable(entry.reader)
+        assert entry.interval_label in ("start", "end") and callable(entry.reader)
+        assert names.WEATHER_FORMATS.describe(name)  # its description, for help and the docs
     assert {name for name, entry in STATION_FORMATS.items() if not entry.has_site} == {"midc", "srml", "csv"}
 
 

@@ -299,10 +299,9 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
         part["panel"] = electrical.panel_power(poa_east[take], study.panel.area)
         for name, values in parts.items():
             values[take] += weight[take] * part[name]
-    last = electrical_for(study, weights[-1][0], sky.wind_ref)
     connected, state = connection_powers(parts["east"], parts["west"], parts["parallel"], parts["series"],
-                                         switch_series=last.switch_series,
-                                         converter_efficiency=last.converter_efficiency, with_state=with_state)
+                                         switch_series=study.switch_series,
+                                         converter_efficiency=study.converter_efficiency, with_state=with_state)
     return {**out, **connected, "panel": parts["panel"]}, state
 
 

@@ -74,9 +74,8 @@ class Weather(StrictModel):
     @field_validator("timezone", "decomposition", "max_gap_min")
     @classmethod
     def _measured_only(cls, value, info: ValidationInfo):
-        defaults = {"timezone": None, "decomposition": "erbs", "max_gap_min": 60.0}
         fmt = info.data.get("format")
-        if value != defaults[info.field_name] and (fmt is None or fmt in names.HOURLY_WEATHER_FORMATS):
+        if value != cls.model_fields[info.field_name].default and (fmt is None or fmt in names.HOURLY_WEATHER_FORMATS):
             measured = ", ".join(f for f in names.WEATHER_FORMATS if f not in names.HOURLY_WEATHER_FORMATS)
             raise ValueError(f"is only used by measured weather files (format {measured})")
         return value

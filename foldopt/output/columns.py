@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import re
 
+from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
+
 #: (name, unit, meaning), in the order the manual lists them.
 COLUMNS = (
     # the case
@@ -119,7 +121,7 @@ _WORDS = {
     "connection": "(east|west|parallel|series|independent|switching)",
     "hours": r"(\d+)",
     "month": r"(\d\d)",
-    "pct": r"(10|50|90)",
+    "pct": "(" + "|".join(str(pct) for pct in ENSEMBLE_PERCENTILES) + ")",
 }
 _PATTERNS = [(re.compile("^" + re.sub(r"\\\{(\w+)\\\}", lambda m: _WORDS[m.group(1)], re.escape(name)) + "$"),
               name, unit, meaning) for name, unit, meaning in COLUMNS]

@@ -14,6 +14,7 @@ from pathlib import Path
 import pandas as pd
 
 from foldopt.studies.answer import Answer, plain, records
+from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
 
 #: The designs an answer compares, first the ones every study has.
 MAIN_DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
@@ -272,13 +273,15 @@ def _of_annual(result) -> Answer:
                      + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"))
         lines.append("  " + _range_text(twofold.to_dict()))
         if members:
-            spread = {d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in (10, 50, 90)} for d in MAIN_DESIGNS}
+            spread = {d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in ENSEMBLE_PERCENTILES}
+                      for d in MAIN_DESIGNS}
             case["objective_spread_h"] = spread
             case["members"] = members
             case.update({key: twofold[key] for key in ("chosen_wins_pct", "within_tolerance_pct")})
-            lines.append(f"  over {members} cloud members: {statistic} t_solar P10/P50/P90 "
-                         + "; ".join(f"{d} {_hours(spread[d]['p10'])}/{_hours(spread[d]['p50'])}/"
-                                     f"{_hours(spread[d]['p90'])}" for d in MAIN_DESIGNS))
+            lines.append(f"  over {members} cloud members: {statistic} t_solar "
+                         + "/".join(f"P{pct}" for pct in ENSEMBLE_PERCENTILES) + " "
+                         + "; ".join(f"{d} " + "/".join(_hours(value) for value in spread[d].values())
+                                     for d in MAIN_DESIGNS))
             lines.append(f"  {twofold['fold_angle_deg']:g} deg is the best angle of {twofold['chosen_wins_pct']:.0f} % "
                          f"of the members and within the near-optimal tolerance of their best for "
                          f"{twofold['within_tolerance_pct']:.0f} %")
@@ -305,7 +308,7 @@ def _of_annual(result) -> Answer:
 
 
 #: The annual objective's columns over a cloud ensemble (foldopt.studies.sweeps.objective_table).
-ENSEMBLE_COLUMNS = ("objective_p10_h", "objective_p50_h", "objective_p90_h", "chosen_wins_pct",
+ENSEMBLE_COLUMNS = (*(f"objective_p{pct}_h" for pct in ENSEMBLE_PERCENTILES), "chosen_wins_pct",
                     "within_tolerance_pct")
 
 

@@ -120,6 +120,11 @@ def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
     }
 
 
+#: The percentiles over a cloud ensemble's members that the answer gives of each day's t_solar and
+#: of the objective (``t_solar_p10_h``..., ``objective_p10_h``...).
+ENSEMBLE_PERCENTILES = (10, 50, 90)
+
+
 def ensemble_choice(daily, months, statistic: str, season, tolerance: NearOptimal) -> dict:
     """One fold angle chosen over the members of a cloud ensemble, and how sure the choice is.
 

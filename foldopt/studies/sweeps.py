@@ -23,7 +23,8 @@ import pandas as pd
 from foldopt.engine import rows as engines
 from foldopt.inputs.plan import Plan
 from foldopt.studies.designs import DESIGNS, Blocks, design_metrics, fold_hours, setup_key
-from foldopt.studies.objectives import best_angle_index, ensemble_choice, near_optimal, objective_value, worst_month
+from foldopt.studies.objectives import (ENSEMBLE_PERCENTILES, best_angle_index, ensemble_choice, near_optimal,
+                                        objective_value, worst_month)
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 
@@ -253,9 +254,6 @@ def _over_members(group: dict, members: int) -> dict:
         out[f"t_solar_p{pct}_h"] = np.percentile(hours, pct, axis=1)
     return out
 
-
-#: The percentiles of each day's t_solar and of the objective over a cloud ensemble's members.
-ENSEMBLE_PERCENTILES = (10, 50, 90)
 
 
 def _twofold_only(values: dict) -> dict:

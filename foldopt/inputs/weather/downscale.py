@@ -48,8 +48,9 @@ from foldopt.names import CLEAR_SKIES
 
 #: Bound of the clear-sky index at every step (pvlib's default: over-irradiance up to twice clear).
 MAX_CLEARSKY_INDEX = 2.0
-#: Below this cosine of the zenith (89 deg) no direct light is placed: an hour's DNI mean would
-#: put it where the sun is still behind the horizon of its refracted position.
+#: Below this cosine of the zenith (89 deg) no direct light is placed (here, in the cloud
+#: ensemble and in measured files): a step's DNI from ``beam / cos(zenith)`` would hang on
+#: rounding, and the sun is barely clear of the horizon of its refracted position.
 MIN_COS_ZENITH = 0.0175
 #: An edge value may be at most this multiple of either neighbouring interval's index: then the
 #: shape term of the weaker interval cannot pull its curve below zero (with uniform weights the
@@ -59,9 +60,22 @@ EDGE_CAP = 2.0
 RAMP_WIDTHS = (0.5, 0.35, 0.25, 0.15, 0.1, 0.05)
 
 
-def _fill_dark(index, lit):
+def fill_dark(index, lit):
     """Each dark interval's index from the nearest lit interval of its day (0 for a dark day), so
-    that the edge values of a lit interval next to a dark one follow the lit one."""
+    that the curve of a lit interval next to a dark one follows the lit one.
+
+    Parameters
+    ----------
+    index : numpy.ndarray
+        (n_days, n_intervals) an index per interval [-].
+    lit : numpy.ndarray of bool
+        Same shape: the intervals whose index counts.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``index`` where ``lit``, else its day's nearest lit interval's; 0 all day without one.
+    """
     n = index.shape[1]
     positions = np.arange(n)
     before = np.maximum.accumulate(np.where(lit, positions, -1), axis=1)
@@ -116,7 +130,7 @@ def mean_preserving(means, clear, steps_per_interval: int, max_index: float = MA
     lit = clear_mean > 0
     with np.errstate(invalid="ignore", divide="ignore"):
         index = np.asarray(pvlib.irradiance.clearsky_index(means, clear_mean, max_index), dtype=float)
-    index = _fill_dark(np.where(lit, index, 0.0), lit)
+    index = fill_dark(np.where(lit, index, 0.0), lit)
     cap = EDGE_CAP * np.minimum(index[:, 1:], index[:, :-1])
     # An interval at the bound (light at twice the clear sky, at sunrise) stays at it up to its
     # edge where its neighbour can take that (the cap), so that it keeps what light it can.

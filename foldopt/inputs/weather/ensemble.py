@@ -108,7 +108,7 @@ import math
 
 import numpy as np
 
-from foldopt.inputs.weather.downscale import MAX_CLEARSKY_INDEX
+from foldopt.inputs.weather.downscale import MAX_CLEARSKY_INDEX, MIN_COS_ZENITH, fill_dark, interpolate_points
 
 #: Suehrcke, Bowden & Hollands' global relation [4]_: clear-sky index ``beta + (1 - beta) s**gamma``
 #: of an hour in sunshine for the fraction ``s`` of it.
@@ -130,8 +130,6 @@ NOISE_VISIBLE = (0.001, 0.0015)
 NOISE_OBSCURED = (0.01, 0.003)
 #: Bound of the clear-sky index of a step (cloud enhancement), unless its hour's own index is higher.
 MAX_ENHANCEMENT = 1.5
-#: Below this cosine of the zenith (89 deg) a step has no beam: its light is all diffuse.
-MIN_COS_ZENITH = 0.0175
 #: Longest step of the two-state chain [min]; a coarser study step averages sub-steps of this.
 CHAIN_STEP_MIN = 1.0
 #: Smith, Bright & Crook's fits of the hourly clear-sky index in each cloud cover [6]_ (their
@@ -214,20 +212,8 @@ def _envelope(index, valid, clear, spi: int):
     """(n_days, n_intervals, spi): an interval index linear between interval centres, held beyond
     the first and the last; an invalid interval takes its day's nearest valid one (0 for a day
     with none); times the clear sky."""
-    n_days, n = index.shape
-    positions = np.arange(n)
-    before = np.maximum.accumulate(np.where(valid, positions, -1), axis=1)
-    after = np.flip(np.minimum.accumulate(np.flip(np.where(valid, positions, n), axis=1), axis=1), axis=1)
-    nearest = np.where(before >= 0, before, np.where(after < n, after, 0))
-    filled = np.where(valid, index, np.take_along_axis(index, nearest, axis=1)) * valid.any(axis=1, keepdims=True)
-    if n == 1:
-        return filled[..., None] * clear
-    centres = (positions + 0.5) * spi - 0.5
-    steps = np.arange(n * spi)
-    right = np.clip(np.searchsorted(centres, steps, side="right"), 1, n - 1)
-    weight = np.clip((steps - centres[right - 1]) / spi, 0.0, 1.0)
-    curve = filled[:, right - 1] * (1.0 - weight) + filled[:, right] * weight
-    return curve.reshape(n_days, n, spi) * clear
+    curve = interpolate_points(fill_dark(index, valid), 0.0, spi)
+    return curve.reshape(index.shape + (spi,)) * clear
 
 
 def _fill(values, cap, means, rounds: int = 16):

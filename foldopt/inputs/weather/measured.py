@@ -36,7 +36,7 @@ what was derived, filled and left out. In this order, vectorised over the steps:
    is above 0. A run of daylight steps missing a component, up to ``max_gap_min`` long, is filled
    along the clear-sky index: ``ghi / ghi_clear`` and ``dhi / ghi_clear`` interpolated linearly
    from the steps on either side (one side's value where the run touches night or the file's
-   end; the ratios capped at :data:`MAX_CLEAR_SKY_INDEX`), times ``ghi_clear``, the ``ghi`` and
+   end; the ratios capped at :data:`GAP_FILL_MAX_INDEX`), times ``ghi_clear``, the ``ghi`` and
    ``dhi`` measured in the run kept; ``dni`` by closure. Longer runs
    stay missing and their days are :attr:`MeasuredWeather.flagged_days`. Missing light at night is
    0. ``temp_air`` and ``wind_speed`` are interpolated linearly in time (nearest at the ends),
@@ -78,10 +78,11 @@ import pvlib
 
 from foldopt.errors import WeatherError
 from foldopt.names import DECOMPOSITIONS, INTERVAL_LABELS
+from foldopt.inputs.weather.downscale import MIN_COS_ZENITH
 from foldopt.inputs.weather.formats import offset_zone, site_value
-from foldopt.inputs.weather.qc import (BEAM_TOLERANCE, DEFAULT_TEMP_AIR, DEFAULT_WIND_SPEED, DHI_TOLERANCE,
+from foldopt.inputs.weather.qc import (BEAM_TOLERANCE, COLUMNS, DEFAULT_TEMP_AIR, DEFAULT_WIND_SPEED, DHI_TOLERANCE,
                                        TEMP_AIR_BOUNDS, WIND_SPEED_BOUNDS)
-from foldopt.inputs.weather.stations import COLUMNS, STATION_FORMATS, StationFormat, fixed_zone
+from foldopt.inputs.weather.stations import STATION_FORMATS, StationFormat, fixed_zone
 
 __all__ = ["STATION_FORMATS", "StationFormat", "MeasuredWeather", "read_measured", "DECOMPOSITIONS", "LABELS"]
 
@@ -90,11 +91,9 @@ __all__ = ["STATION_FORMATS", "StationFormat", "MeasuredWeather", "read_measured
 LABELS = INTERVAL_LABELS
 #: Irradiance [W/m^2] from here to 0 is a thermopile's night offset, made 0; below, a fault.
 NEGATIVE_LIMIT = -20.0
-#: ``cos(zenith)`` below which ``dni`` from closure is unbounded: ``dni`` 0, ``dhi = ghi``.
-MIN_COS_ZENITH = 0.0175
 #: The largest clear-sky index (``ghi / ghi_clear``, ``dhi / ghi_clear``) carried into a gap: at low
 #: sun the clear sky is dim and the ratio of a few W/m^2 to it unbounded.
-MAX_CLEAR_SKY_INDEX = 1.5
+GAP_FILL_MAX_INDEX = 1.5
 _DAY = pd.Timedelta(days=1)
 _WORDS = {"temp_air": "air temperature", "wind_speed": "wind speed"}
 
@@ -351,7 +350,7 @@ def _fill(table, day, clear, cosz, step_min, max_gap_min, index):
     fraction = (at - starts[run] + 1) / (lengths[run] + 1)
     with np.errstate(divide="ignore", invalid="ignore"):
         for key in ("ghi", "dhi"):
-            ratio = np.clip(table[key] / clear, 0.0, MAX_CLEAR_SKY_INDEX)
+            ratio = np.clip(table[key] / clear, 0.0, GAP_FILL_MAX_INDEX)
             lo, hi = ratio[np.clip(left, 0, n - 1)][run], ratio[np.clip(right, 0, n - 1)][run]
             both = left_ok[run] & right_ok[run]
             value = np.where(both, lo + (hi - lo) * fraction, np.where(left_ok[run], lo, hi)) * clear[at]

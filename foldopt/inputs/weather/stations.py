@@ -71,9 +71,8 @@ import pandas as pd
 import pvlib
 
 from foldopt.inputs.weather.formats import read_with_pvlib, reason
+from foldopt.inputs.weather.qc import COLUMNS
 
-#: The columns a reader may return, in order.
-COLUMNS = ("ghi", "dni", "dhi", "temp_air", "wind_speed")
 #: MIDC's missing-value marker: values at or below it are missing.
 MIDC_MISSING = -7999.0
 
@@ -86,14 +85,8 @@ class StationFormat:
     ----------
     name : str
         As ``read_measured``'s ``fmt`` names it (``surfrad``).
-    label : str
-        What messages call it (``SURFRAD``).
-    description : str
-        One line for help texts.
     interval_label : {'start', 'end'}
         Which edge of its interval a stamp marks, as the reader returns it (module docstring).
-    suffixes : tuple of str
-        File extensions (lower case) the network's files carry.
     reader : callable
         ``reader(path, fail, zone)``: the file as a :class:`StationData`; ``zone`` [h] is the UTC
         offset of stamps that carry none (the CSV's), ``fail(message)`` makes the error to raise.
@@ -102,10 +95,7 @@ class StationFormat:
     """
 
     name: str
-    label: str
-    description: str
     interval_label: str
-    suffixes: tuple
     reader: Callable
     has_site: bool
 
@@ -445,20 +435,14 @@ def fixed_zone(hours: float) -> datetime.timezone:
     return datetime.timezone(datetime.timedelta(minutes=round(hours * 60)))
 
 
-#: The measured weather formats by name.
+#: The measured weather formats by name, in the order of :data:`foldopt.names.WEATHER_FORMATS`
+#: (whose descriptions help and the docs print).
 STATION_FORMATS = {entry.name: entry for entry in (
-    StationFormat("surfrad", "SURFRAD", "NOAA SURFRAD daily file: 1-min ghi, dni, dhi, air temperature and wind, UTC",
-            "end", (".dat",), read_surfrad, True),
-    StationFormat("midc", "MIDC", "NREL MIDC daily or raw-data file: 1-min columns, local standard time; give the site",
-            "end", (".txt", ".csv"), read_midc, False),
-    StationFormat("srml", "SRML", "UO SRML archival file: 1- to 60-min columns, Pacific standard time; give the site",
-            "start", (".txt",), read_srml, False),
-    StationFormat("bsrn", "BSRN", "BSRN station-to-archive file: LR0100 1-min ghi, dni, dhi, air temperature, UTC",
-            "start", (".dat", ".gz"), read_bsrn, True),
-    StationFormat("solrad", "SOLRAD", "NOAA SOLRAD daily file: 1-min ghi, dni, dhi, UTC", "end", (".dat",),
-            read_solrad, True),
-    StationFormat("crn", "CRN", "NOAA USCRN sub-hourly file: 5-min ghi (photodiode), air temperature and wind, UTC",
-            "end", (".txt",), read_crn, True),
-    StationFormat("csv", "CSV", "generic CSV: timestamp, ghi, dni, dhi[, temp_air, wind_speed]; give the site",
-            "end", (".csv",), read_csv, False),
+    StationFormat("surfrad", "end", read_surfrad, True),
+    StationFormat("midc", "end", read_midc, False),
+    StationFormat("srml", "start", read_srml, False),
+    StationFormat("bsrn", "start", read_bsrn, True),
+    StationFormat("solrad", "end", read_solrad, True),
+    StationFormat("crn", "end", read_crn, True),
+    StationFormat("csv", "end", read_csv, False),
 )}
