@@ -20,7 +20,8 @@ _PUBLIC = {
     "Study": "foldopt.inputs.study", "Plan": "foldopt.inputs.plan", "ConfigError": "foldopt.errors",
     **{name: "foldopt.inputs.sections" for name in (
         "Site", "Panel", "Tracker", "Objective", "FoldAngles", "LoadProfile", "NearOptimal")},
-    "Weather": "foldopt.inputs.weather_section",
+    "Weather": "foldopt.inputs.weather_section", "Horizon": "foldopt.inputs.horizon_section",
+    "Circuit": "foldopt.inputs.circuit_section",
     "default_study": "foldopt.api", "load_study": "foldopt.api", "run": "foldopt.api", "sweep": "foldopt.api",
     "write": "foldopt.api", "size": "foldopt.api", "reproduce": "foldopt.api", "world_map": "foldopt.api",
     "StudyResult": "foldopt.studies.day", "SweepResult": "foldopt.studies.sweeps",
@@ -37,6 +38,7 @@ _PUBLIC = {
     **{name: "foldopt.output.figures.weather" for name in ("plot_weather_minutes", "plot_member_t_solar")},
     **{name: "foldopt.output.figures.world" for name in ("plot_world_map", "plot_latitude_load")},
     "plot_sizing": "foldopt.output.figures.sizing",
+    "plot_sun_paths": "foldopt.output.figures.horizon",
     "best_schedules": "foldopt.engine.schedule",
     "Answer": "foldopt.studies.answer", "plan_request": "foldopt.studies.request", "Request": "foldopt.studies.request",
     "SizingResult": "foldopt.studies.sizing", "Reproduction": "foldopt.studies.reproduce",

@@ -99,6 +99,17 @@ CONNECTIONS = Registry("connection", {
     "series": "the sub-panels in series at one current (bypass diodes)",
     "independent": "each sub-panel at its own maximum power point (two converters)",
     "switching": "the best of east, west, parallel and series at each step (a reconfigurable switch)"})
+DIODE_MODELS = Registry("diode model", {
+    "ideal": "no forward drop: the diode only stops reverse current",
+    "constant": "a constant forward drop, the datasheet V_F at its rated current",
+    "shockley": "Shockley's diode with series resistance, V = n Vt ln(1 + I/Is) + I Rs (a SPICE model)"})
+CONVERTER_MODELS = Registry("converter model", {
+    "ideal": "every converter delivers its whole input (the paper's)",
+    "pvwatts": "the PVWatts part-load efficiency curve from a nominal efficiency (pvlib.inverter.pvwatts)",
+    "curve": "a table of efficiency against input power as a fraction of the rating"})
+COUPLINGS = Registry("coupling", {
+    "mppt": "a maximum-power-point converter between the panel and the load",
+    "direct": "the load wired to the panel, at the load's own voltage (no converter)"})
 TRACKERS = Registry("tracker", {
     "dual-axis": "ideal: the normal always on the sun (Shin et al. Sec. IV-A)",
     "equatorial": "a polar daily axis following the hour angle, the seasonal axis set daily (Alexandru)",
@@ -142,8 +153,8 @@ OUTPUT_FORMATS = Registry("format", {
     "json": "one JSON document of the answer and its rows"})
 #: Every registry, in the order the docs list them.
 REGISTRIES = (MODES, GEOMETRIES, SKIES, TRANSPOSITIONS, IAMS, PV_MODELS, TEMPERATURE_MODELS, CONNECTIONS,
-              TRACKERS, DRIVES, WEATHER_FORMATS, DECOMPOSITIONS, INTERVAL_LABELS, HOTTEL_CLIMATES, ENGINES,
-              OUTPUT_FORMATS)
+              CONVERTER_MODELS, COUPLINGS, TRACKERS, DRIVES, WEATHER_FORMATS, DECOMPOSITIONS, INTERVAL_LABELS,
+              HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS, DIODE_MODELS)
 
 #: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.physics.trackers).
 #: His 12 actuating times (local time) pair up symmetrically about 13.319 h: 8.839/17.799,

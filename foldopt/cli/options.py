@@ -109,6 +109,9 @@ OPTION_OF_FIELD = {
     "iam": "--iam", "switch_series": "--switch-series", "bypass_diodes": "--no-bypass",
     "exact_electrical": "--exact-electrical", "force_site": "--force-site", "load_profile": "--load-profile",
     "weather.format": "--weather-format", "weather.members": "--members", "weather.seed": "--seed",
+    "site.horizon": "--horizon", "circuit.blocking_diode.model": "--blocking-diode",
+    "circuit.bypass_diode.model": "--bypass-diode", "circuit.converter.model": "--converter",
+    "circuit.load_voltage": "--load-voltage", "circuit.switch_resistance": "--switch-resistance",
 }
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 

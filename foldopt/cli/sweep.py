@@ -82,6 +82,18 @@ def _sweep_options(
     no_bypass: bool = typer.Option(False, "--no-bypass", help="Series without bypass diodes."),
     converter_efficiency: Optional[float] = typer.Option(None, "--converter-efficiency", help="Efficiency [-] of "
                                                          "each converter of connection independent."),
+    horizon: Optional[Path] = typer.Option(None, "--horizon", help="The site's horizon: a PVGIS horizon file (JSON "
+                                           "or CSV) or a CSV azimuth,elevation [deg]."),
+    blocking_diode: Optional[str] = typer.Option(None, "--blocking-diode", help="Blocking diodes in parallel: "
+                                                 + _choices(names.DIODE_MODELS) + " (I-V models)."),
+    bypass_diode: Optional[str] = typer.Option(None, "--bypass-diode", help="Bypass diodes in series: "
+                                               + _choices(names.DIODE_MODELS) + " (I-V models)."),
+    converter: Optional[str] = typer.Option(None, "--converter", help="The MPPT converter's efficiency: "
+                                            + _choices(names.CONVERTER_MODELS) + "."),
+    load_voltage: Optional[float] = typer.Option(None, "--load-voltage", help="Couple the load directly at this "
+                                                 "voltage [V], no converter (I-V models)."),
+    switch_resistance: Optional[float] = typer.Option(None, "--switch-resistance", help="On-resistance [ohm] of "
+                                                      "the switch in each sub-panel's path (connection switching)."),
     temp_air: Optional[float] = typer.Option(None, "--temp-air", help="Air temperature [C] (I-V models)."),
     exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve every step's I-V curves instead "
                                           "of the tables (slow)."),

@@ -16,10 +16,24 @@ import functools
 
 import numpy as np
 
+from foldopt.engine.built import circuit_parts
 from foldopt.engine.electrical import Electrical
 from foldopt.engine.sky import Sky
 from foldopt.inputs.study import Study
-from foldopt.physics.pvmodel import PVModel
+from foldopt.physics.pvmodel import IRRADIANCE_REF, TEMPERATURE_REF, PVModel
+
+
+@functools.lru_cache(maxsize=64)
+def rated_power(pv: PVModel, area: float) -> float:
+    """A panel's maximum power at STC (1000 W/m^2, cells at 25 C) [W]: a converter's default rating.
+
+    Parameters
+    ----------
+    pv : PVModel
+    area : float
+        Panel area [m^2].
+    """
+    return float(pv.max_power(np.array([IRRADIANCE_REF]), TEMPERATURE_REF, area)[0])
 
 
 def electrical_settings(study: Study, temp_air: float, wind_speed: float | None = None) -> dict:
@@ -35,8 +49,9 @@ def electrical_settings(study: Study, temp_air: float, wind_speed: float | None 
         :attr:`foldopt.engine.sky.Sky.wind_ref`).
     """
     study = study.resolved()
+    pv = PVModel(study.pv_model, study.panel.efficiency, study.module)
     return dict(
-        pv=PVModel(study.pv_model, study.panel.efficiency, study.module),
+        pv=pv,
         subpanel_area=study.panel.area / 2.0,
         temp_air=float(temp_air),
         wind_speed=study.wind_speed if wind_speed is None else float(wind_speed),
@@ -45,6 +60,7 @@ def electrical_settings(study: Study, temp_air: float, wind_speed: float | None 
         switch_series=study.switch_series,
         converter_efficiency=study.converter_efficiency,
         exact=study.exact_electrical,
+        circuit=None if study.circuit.ideal else circuit_parts(study, rated_power(pv, study.panel.area)),
     )
 
 
@@ -66,7 +82,8 @@ def electrical_for(study: Study, temp_air: float, wind_speed: float | None = Non
 
 
 def panel_power(sky: Sky, study: Study, poa_global, area: float | None = None):
-    """Maximum power of panels over the blocks of a sky, at their cells' air temperature
+    """Power panels deliver to the load over the blocks of a sky (their maximum power, or as the
+    study's circuit is built: :meth:`Electrical.panel_power`), at their cells' air temperature
     (:func:`temperature_nodes`).
 
     Parameters

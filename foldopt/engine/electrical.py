@@ -30,6 +30,7 @@ import numpy as np
 import pvlib
 
 from foldopt.cache import cache_dir, load_cache, store_cache
+from foldopt.engine.built import PARTS, CircuitParts, alone_power, assemble, pair_power
 from foldopt.physics.connections import connection_powers, parallel_power, series_power
 from foldopt.physics.pvmodel import PVModel
 from foldopt.physics.temperature import cell_temperature
@@ -38,7 +39,7 @@ IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the tables; clear-sky beam stays belo
 TABLE_NODES_1D = 1025
 TABLE_NODES_2D = 161
 TABLE_NODES_RATIO = 321
-TABLE_FORMAT = 4  # bump when the way tables are built changes
+TABLE_FORMAT = 5  # bump when the way tables are built changes
 
 
 def _nodes(count):
@@ -96,6 +97,8 @@ class Electrical:
         Efficiency of each converter of the independent architecture [-].
     exact : bool, default False
         Solve every step's I-V curves instead of interpolating the tables.
+    circuit : foldopt.engine.built.CircuitParts, optional
+        The circuit as built; None for Shin et al.'s ideal parts.
     """
 
     pv: PVModel
@@ -107,6 +110,7 @@ class Electrical:
     switch_series: bool = False
     converter_efficiency: float = 1.0
     exact: bool = False
+    circuit: CircuitParts | None = None
 
     def __post_init__(self):
         self._tables = None
@@ -123,7 +127,7 @@ class Electrical:
 
         Parameters
         ----------
-        name : {'subpanel', 'parallel', 'series'}
+        name : {'subpanel', 'parallel', 'series', 'switching', 'alone', 'panel'}
             The table.
 
         Returns
@@ -134,11 +138,22 @@ class Electrical:
         settings = (TABLE_FORMAT, name, self.pv.model, repr(self.pv.unit), self.pv.unit_area, self.subpanel_area,
                     self.temp_air, self.wind_speed, self.temperature_model, IRRADIANCE_MAX, TABLE_NODES_1D,
                     TABLE_NODES_2D, TABLE_NODES_RATIO, pvlib.__version__)
+        if self._panel_side_built and name != "subpanel":
+            # Only what the table holds: the converter acts after it.
+            parts = self.circuit
+            settings += (repr(parts.blocking), repr(parts.bypass), parts.load_voltage, parts.switch_resistance,
+                         self.bypass, self.switch_series)
         return hashlib.sha256(repr(settings).encode()).hexdigest()[:32]
 
+    @property
+    def _panel_side_built(self) -> bool:
+        """Whether the tables hold the circuit as built (any part but the converter not ideal)."""
+        return self.circuit is not None
+
     def _table(self, name):
-        """A table, loaded from the disk cache or built on first use: ``subpanel`` (1-D),
-        ``parallel`` or ``series`` (2-D)."""
+        """A table, loaded from the disk cache or built on first use: ``subpanel`` (1-D, maximum
+        power), ``parallel``, ``series`` or ``switching`` (2-D) and, as built, ``alone`` and
+        ``panel`` (1-D, at the load's voltage)."""
         if self._tables is None:
             self._tables = {}
         if name not in self._tables:
@@ -146,23 +161,32 @@ class Electrical:
             cached = load_cache(path)
             if cached is not None:
                 arrays = tuple(cached[f"a{i}"] for i in range(len(cached)))
-                self._tables[name] = arrays if name == "subpanel" else arrays[0]
+                self._tables[name] = arrays if len(arrays) == 2 else arrays[0]
                 return self._tables[name]
-            if name == "subpanel":
+            if name in ("subpanel", "alone", "panel"):
                 g1 = _nodes(TABLE_NODES_1D)
-                self._tables[name] = (g1, self.pv.max_power(g1, self._temperature(g1), self.subpanel_area))
+                temp_cell = self._temperature(g1)
+                if name == "subpanel":
+                    power = self.pv.max_power(g1, temp_cell, self.subpanel_area)
+                else:
+                    area = self.subpanel_area * (2.0 if name == "panel" else 1.0)
+                    power = alone_power(self.circuit, self.pv.curves(g1, temp_cell, area))
+                self._tables[name] = (g1, power)
             else:
                 self._tables[name] = self._pair_table(name)
             table = self._tables[name]
-            store_cache(path, {f"a{i}": array for i, array in enumerate(table if name == "subpanel" else (table,))})
+            arrays = table if isinstance(table, tuple) else (table,)
+            store_cache(path, {f"a{i}": array for i, array in enumerate(arrays)})
         return self._tables[name]
 
     def _pair_table(self, connection):
         """A pair's power as a fraction of its two maxima over (stronger irradiance, ratio).
 
-        The fraction is smoother than the power and zero-safe. Series is tabulated without bypass
-        diodes; with ideal ones it is the larger of that and the stronger sub-panel alone
-        (:func:`foldopt.physics.connections.series_power`), which needs no table.
+        The fraction is smoother than the power and zero-safe. For the ideal circuit, series is
+        tabulated without bypass diodes; with ideal ones it is the larger of that and the stronger
+        sub-panel alone (:func:`foldopt.physics.connections.series_power`), which needs no table.
+        As built, the table holds the pair as built, bypass diodes and all
+        (:func:`foldopt.engine.built.pair_power`).
         """
         strong, ratio = (grid.ravel() for grid in np.meshgrid(_nodes(TABLE_NODES_2D), _ratio_nodes(connection),
                                                               indexing="ij"))
@@ -170,10 +194,16 @@ class Electrical:
         east = self.pv.curves(strong, self._temperature(strong), self.subpanel_area)
         west = self.pv.curves(weak, self._temperature(weak), self.subpanel_area)
         bound = east.max_power() + west.max_power()
-        power = parallel_power(east, west) if connection == "parallel" else series_power(east, west, bypass=False)
+        if self._panel_side_built:
+            power = pair_power(self.circuit, connection, east, west, self.bypass, self.switch_series)
+        elif connection == "parallel":
+            power = parallel_power(east, west)
+        else:
+            power = series_power(east, west, bypass=False)
         with np.errstate(invalid="ignore", divide="ignore"):
             fraction = np.where(bound > 0, power / bound, 1.0).reshape(TABLE_NODES_2D, TABLE_NODES_RATIO)
-        fraction[:, -1] = 1.0  # identical sub-panels at equal irradiance deliver exactly their sum
+        if not self._panel_side_built or self.circuit.panel_side_ideal:
+            fraction[:, -1] = 1.0  # identical sub-panels at equal irradiance deliver exactly their sum
         return fraction
 
     def subpanel_power(self, poa):
@@ -189,9 +219,9 @@ class Electrical:
         numpy.ndarray
             [W], shaped as ``poa``.
         """
-        return self.panel_power(poa, self.subpanel_area)
+        return self.max_power(poa, self.subpanel_area)
 
-    def panel_power(self, poa, area):
+    def max_power(self, poa, area):
         """Maximum power of a panel of ``area / subpanel_area`` sub-panels in series.
 
         Parameters
@@ -211,6 +241,98 @@ class Electrical:
             return self.pv.max_power(poa, self._temperature(poa), area)
         _, p1 = self._table("subpanel")
         return _linear(p1, _node_position(poa, TABLE_NODES_1D)) * (area / self.subpanel_area)
+
+    def panel_power(self, poa, area):
+        """Power the whole flat panel (the twofold panel's two sub-panels as one, in series)
+        delivers to the load: its maximum power, as built through the converter, or at the load's
+        voltage with direct coupling.
+
+        Parameters
+        ----------
+        poa : array_like
+            Plane-of-array irradiance [W/m^2], any shape.
+        area : float
+            Panel area [m^2]; with direct coupling, that of the two sub-panels.
+
+        Returns
+        -------
+        numpy.ndarray
+            [W], shaped as ``poa``.
+        """
+        if self.circuit is None:
+            return self.max_power(poa, area)
+        side = self._panel_side(poa, area)
+        zeros = np.zeros_like(side)
+        return assemble(self.circuit, {**dict.fromkeys(PARTS, zeros), "panel": side}, switch_series=False,
+                        converter_efficiency=1.0, with_state=False)[0]["panel"]
+
+    def _panel_side(self, poa, area):
+        """The whole panel's power on the panel side [W]: its maximum, or at the load's voltage."""
+        poa = np.asarray(poa, dtype=float)
+        if not self.circuit.direct or not self.pv.has_iv:
+            return self.max_power(poa, area)
+        if self.exact:
+            return alone_power(self.circuit, self.pv.curves(poa, self._temperature(poa), area))
+        if not np.isclose(area, 2.0 * self.subpanel_area):
+            raise ValueError(f"the direct-coupled panel's table is of area {2.0 * self.subpanel_area:g} m^2, "
+                             f"not {area:g}")
+        _, p1 = self._table("panel")
+        return _linear(p1, _node_position(poa, TABLE_NODES_1D))
+
+    def parts(self, poa_east, poa_west, series: bool = True) -> dict:
+        """The panel side of the circuit as built (:data:`foldopt.engine.built.PARTS`), exact or
+        from the tables as the kernel reads them.
+
+        Parameters
+        ----------
+        poa_east, poa_west : array_like
+            Each sub-panel's plane-of-array irradiance [W/m^2], broadcast.
+        series : bool, default True
+            Whether to work out the series power (NaN otherwise).
+
+        Returns
+        -------
+        dict of numpy.ndarray
+            [W] per part.
+        """
+        parts = self.circuit
+        poa_east, poa_west = np.broadcast_arrays(np.asarray(poa_east, float), np.asarray(poa_west, float))
+        m_east, m_west = self.subpanel_power(poa_east), self.subpanel_power(poa_west)
+        side = {"m_east": m_east, "m_west": m_west}
+        if not self.pv.has_iv:
+            total = m_east + m_west
+            return {**side, "a_east": m_east, "a_west": m_west, "parallel": total, "series": total,
+                    "switching": np.maximum(np.maximum(m_east, m_west), total), "panel": 2.0 * m_east}
+        names = ("parallel",) + (("series",) if series else ()) + (("switching",) if parts.switch_table else ())
+        if self.exact:
+            east = self.pv.curves(poa_east, self._temperature(poa_east), self.subpanel_area)
+            west = self.pv.curves(poa_west, self._temperature(poa_west), self.subpanel_area)
+            side.update({name: pair_power(parts, name, east, west, self.bypass, self.switch_series)
+                         for name in names})
+            side["a_east"], side["a_west"] = ((alone_power(parts, east), alone_power(parts, west)) if parts.direct
+                                              else (m_east, m_west))
+        else:
+            root_east = np.sqrt(np.clip(poa_east, 0.0, IRRADIANCE_MAX) / IRRADIANCE_MAX)
+            root_west = np.sqrt(np.clip(poa_west, 0.0, IRRADIANCE_MAX) / IRRADIANCE_MAX)
+            strong, weak = np.maximum(root_east, root_west), np.minimum(root_east, root_west)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                root_ratio = np.where(strong > 0, weak / strong, 1.0)
+            at_strong, bound = strong * (TABLE_NODES_2D - 1), m_east + m_west
+            for name in names:
+                at_ratio = (root_ratio**2 if name == "series" else root_ratio) * (TABLE_NODES_RATIO - 1)
+                side[name] = np.clip(_bilinear(self._table(name), at_strong, at_ratio), 0.0, 1.0) * bound
+            if parts.direct:
+                _, alone = self._table("alone")
+                side["a_east"] = _linear(alone, root_east * (TABLE_NODES_1D - 1))
+                side["a_west"] = _linear(alone, root_west * (TABLE_NODES_1D - 1))
+            else:
+                side["a_east"], side["a_west"] = m_east, m_west
+        if not parts.switch_table:
+            side["switching"] = np.maximum(np.maximum(side["a_east"], side["a_west"]), side["parallel"])
+        if not series:
+            side["series"] = np.full(m_east.shape, np.nan)
+        side["panel"] = self._panel_side(poa_east, 2.0 * self.subpanel_area) if parts.direct else 2.0 * m_east
+        return side
 
     def connections(self, poa_east, poa_west, series: bool = True, with_state: bool = True):
         """Every connection's power and the switching state, as :func:`connection_powers`.
@@ -232,6 +354,11 @@ class Electrical:
         state : numpy.ndarray of int or None
             Index into :data:`foldopt.physics.connections.SWITCH_STATES` per step.
         """
+        if self.circuit is not None:
+            powers, state = assemble(self.circuit, self.parts(poa_east, poa_west, series), with_state=with_state,
+                                     **self._options)
+            del powers["panel"]
+            return powers, state
         options = {**self._options, "with_state": with_state}
         poa_east, poa_west = np.broadcast_arrays(np.asarray(poa_east, float), np.asarray(poa_west, float))
         if not self.pv.has_iv or self.exact:

@@ -6,22 +6,10 @@ time steps. In the first, both sub-panel normals against the sun vector give the
 (or Shin et al.'s Eq. 5 in paper mode), and the beam with the optional incidence-angle modifier
 and the diffuse terms give each sub-panel's plane-of-array irradiance; free of table look-ups, it
 vectorises. The second looks up the electrical tables and writes every asked connection's power
-to a buffer of one day, reused by the next row. The third reduces each power curve to the daily
-metrics of every load at once (:func:`_metrics`). :func:`curve_rows` takes power curves that
-already exist (a tracker's) through the same reduction.
-
-The metrics are those of :mod:`foldopt.engine.metrics`, which is their reference: power is sampled at
-step centres and linear between them (held for half a step at both ends of the day), and a
-segment from ``lo`` to ``hi`` of length ``dt`` is above a load ``L`` for
-``dt * clip((hi - L) / (hi - lo), 0, 1)``. For many loads sorted ascending, the loads at or below
-``lo`` take the whole segment: one entry of a difference array, summed from the top at the end;
-only the loads inside the segment's range take a share. The position of the power among the loads
-moves by a few loads a step, so it is walked from the previous step instead of searched. A day's
-cost is then O(steps + loads x crossings), not O(steps x loads).
-
-Rows are split into chunks, a few per thread, and each chunk has its own scratch, allocated by the
-caller outside the parallel loop (:func:`scratch`; arrays zero-filled inside a numba prange body
-have given wrong sums) and cleared per row.
+to a buffer of one day, reused by the next row (with the circuit as built, :func:`_built_row`).
+The third reduces each power curve to the daily metrics of every load at once
+(:func:`foldopt.engine.reduce.day_metrics`, with the per-chunk scratch of
+:func:`foldopt.engine.reduce.scratch`).
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.rows` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -32,13 +20,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import njit, prange
+
+from foldopt.engine.reduce import day_metrics
 
 # Connection codes; the order of foldopt.physics.connections.CONNECTIONS, plus the whole (unfolded) panel.
 EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
 IAM_NONE, IAM_ASHRAE, IAM_PHYSICAL = range(3)
 IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the electrical tables (foldopt.engine.electrical)
-CHUNKS_PER_THREAD = 8  # rows are handed out in chunks: enough for balance, few scratch buffers
+ZETA_MAX = 4.0  # top of a converter's table in input / rating (foldopt.physics.converter)
 
 
 @njit(cache=True, inline="always")
@@ -78,6 +68,48 @@ def _pair_powers(root_east, root_west, table_1d, table_parallel, table_series, n
     if bypass:
         p_series = max(p_series, max(p_east, p_west))
     return p_east, p_west, p_parallel, p_series
+
+
+@njit(cache=True, inline="always")
+def _built_parts(root_east, root_west, table_1d, table_alone, table_panel, table_parallel, table_series,
+                 table_switching, need_series, direct, switch_table):
+    """The parts of the circuit as built from one table set at both sub-panels' irradiance (as
+    sqrt(E / E_max)): each sub-panel's maximum power, what it delivers alone, the pair in parallel,
+    in series and switched (each as built, before the converter) and the whole panel's power [W].
+    The pair tables are fractions of the two maximum powers; without a switch resistance
+    (``switch_table`` False) switching is the best of its states."""
+    n1 = table_1d.shape[0] - 1
+    n2, nr = table_parallel.shape[0] - 1, table_parallel.shape[1] - 1
+    m_east = _linear(table_1d, root_east * n1)
+    m_west = _linear(table_1d, root_west * n1)
+    bound = m_east + m_west
+    a_east, a_west, p_panel = m_east, m_west, 0.0
+    if direct:
+        a_east = _linear(table_alone, root_east * n1)
+        a_west = _linear(table_alone, root_west * n1)
+        p_panel = _linear(table_panel, root_east * n1)
+    strong, weak = max(root_east, root_west), min(root_east, root_west)
+    root_ratio = weak / strong if strong > 0.0 else 1.0
+    p_parallel = min(max(_bilinear(table_parallel, strong * n2, root_ratio * nr), 0.0), 1.0) * bound
+    p_series = 0.0
+    if need_series:
+        p_series = min(max(_bilinear(table_series, strong * n2, root_ratio**2 * nr), 0.0), 1.0) * bound
+    if switch_table:
+        p_switching = min(max(_bilinear(table_switching, strong * n2, root_ratio * nr), 0.0), 1.0) * bound
+    else:
+        p_switching = max(max(a_east, a_west), p_parallel)
+    return m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel
+
+
+@njit(cache=True, inline="always")
+def _delivered(power, conv_table, conv_rated):
+    """What a converter of rating ``conv_rated`` [W] delivers of ``power`` [W], from its table of
+    delivered power / rating on nodes uniform in sqrt(input / rating / ZETA_MAX)
+    (:func:`foldopt.physics.converter.table_delivered`); ``conv_rated`` 0: an ideal converter."""
+    if conv_rated <= 0.0:
+        return power
+    zeta = min(max(power / conv_rated, 0.0), ZETA_MAX)
+    return conv_rated * _linear(conv_table, math.sqrt(zeta / ZETA_MAX) * (conv_table.shape[0] - 1))
 
 
 @njit(cache=True)
@@ -125,112 +157,6 @@ def iam_factor(cos_aoi, model, params):
 
 
 @njit(cache=True, inline="always")
-def _walk(loads, position, power):
-    """Number of loads at or below ``power``, walked from the previous step's ``position``."""
-    count = loads.shape[0]
-    while position < count and loads[position] <= power:
-        position += 1
-    while position > 0 and loads[position - 1] > power:
-        position -= 1
-    return position
-
-
-@njit(cache=True, inline="always")
-def _shares(loads, lo, hi, lo_at, hi_at, length, above, run, contiguous):
-    """Shares of a segment from ``lo`` to ``hi`` for the loads strictly inside its range."""
-    for j in range(lo_at, hi_at):
-        share = length * (hi - loads[j]) / (hi - lo)
-        above[j] += share
-        if contiguous:
-            run[j, 0] += share
-
-
-@njit(cache=True, inline="always")
-def _runs(start_at, lo_at, length, run):
-    """Longest runs: a sample below a load ends that load's run (the segment starts a new one);
-    loads below the segment's low end run on through it."""
-    for j in range(start_at, run.shape[0]):
-        run[j, 1] = max(run[j, 1], run[j, 0])
-        run[j, 0] = 0.0
-    for j in range(lo_at):
-        run[j, 0] += length
-
-
-@njit(cache=True, inline="always")
-def _gather(whole, pending_at, pending, lo_at, length):
-    """Add ``length`` to the pending sum for ``whole[lo_at]``, writing the previous sum out when
-    the index changes."""
-    if lo_at == pending_at:
-        return pending_at, pending + length
-    whole[pending_at] += pending
-    return lo_at, length
-
-
-@njit(cache=True, inline="always")
-def _per_load(p, shape, s, use_shape):
-    """The power against which the loads are compared at step ``s``: the power itself for constant
-    loads, or for a load profile P_load(t) = scale x shape(t) the ratio P_pv / shape, so that
-    P_pv >= scale x shape is ratio >= scale; a step without load (shape 0) is -inf, which no scale
-    reaches, and neither do the segments next to it (:func:`foldopt.engine.metrics.per_load`)."""
-    if not use_shape:
-        return p
-    g = shape[s]
-    return p / g if g > 0.0 else -math.inf
-
-
-@njit(cache=True)
-def _metrics(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
-             use_shape):
-    """Daily metrics of one power curve [W] sampled at step centres, of which only steps
-    ``first..last`` need walking: the power before and after them is that of the first and the
-    last (zero, or the day's end). Writes t_solar (and its longest run) per load; returns the
-    energy [Wh] and the peak [W]. With ``use_shape`` the loads are scales of the load profile
-    ``shape`` (n_steps) [W] (:func:`_per_load`); steps outside ``first..last`` hold the power of
-    the first and last, and the shape there is taken as the first's and the last's.
-
-    A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
-    (summed from the top at the end), and shares to the loads inside its range. Consecutive
-    segments mostly share k, so their lengths gather in a local sum first."""
-    n_steps, n_loads = power.shape[0], loads.shape[0]
-    above[:] = 0.0
-    whole[:] = 0.0
-    if contiguous:
-        run[:] = 0.0
-    # The half-step held at the start of the day, and the steps before ``first``.
-    harvested = peak = power[first]
-    previous = _per_load(power[first], shape, first, use_shape)
-    position = _walk(loads, 0, previous)
-    pending_at, pending = position, (first + 0.5) * step_hours
-    if contiguous:
-        _runs(position, position, pending, run)
-    for s in range(first + 1, last + 1):
-        harvested += power[s]
-        peak = max(peak, power[s])
-        p = _per_load(power[s], shape, s, use_shape)
-        at = _walk(loads, position, p)
-        lo_at, hi_at = min(position, at), max(position, at)
-        if contiguous:
-            _runs(position, lo_at, step_hours, run)
-        pending_at, pending = _gather(whole, pending_at, pending, lo_at, step_hours)
-        if hi_at > lo_at:
-            _shares(loads, min(previous, p), max(previous, p), lo_at, hi_at, step_hours, above, run, contiguous)
-        previous, position = p, at
-    # The last sample held to the end of the day.
-    tail = (n_steps - last - 0.5) * step_hours
-    if contiguous:
-        _runs(position, position, tail, run)
-    pending_at, pending = _gather(whole, pending_at, pending, position, tail)
-    whole[pending_at] += pending
-    total = 0.0
-    for j in range(n_loads - 1, -1, -1):
-        total += whole[j + 1]
-        t_out[j] = above[j] + total
-        if contiguous:
-            cont_out[j] = max(run[j, 0], run[j, 1])
-    return harvested * step_hours, peak
-
-
-@njit(cache=True, inline="always")
 def _connection_power(code, p_east, p_west, p_parallel, p_series, p_panel, converter_efficiency, switch_series):
     if code == SWITCHING:
         best = max(max(p_east, p_west), p_parallel)
@@ -249,9 +175,10 @@ def _connection_power(code, p_east, p_west, p_parallel, p_series, p_panel, conve
 
 
 @njit(cache=True)
-def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, paper_incidence, iam_model,
-                 iam_params, step_table, step_weight, table_1d, table_parallel, table_series, linear_power,
-                 panel_scale, bypass, switch_series, converter_efficiency, connections, irradiance, buffer):
+def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, row_view, paper_incidence,
+                 iam_model, iam_params, step_table, step_weight, table_1d, table_parallel, table_series, linear_power,
+                 panel_scale, bypass, switch_series, converter_efficiency, connections, built, table_alone,
+                 table_panel, table_switching, conv_table, conv_rated, irradiance, buffer):
     """Every asked connection's power [W] of row ``r`` (over block ``b``) at steps
     ``first..last``, into ``buffer[c, step]``; returns the sum over those steps of the two
     sub-panels' mean incident plane-of-array irradiance [W/m^2] (before the incidence-angle
@@ -261,7 +188,9 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
     irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) into ``irradiance``; the
     second looks up the powers, from table set ``step_table[b, s]`` and, with weight
     ``step_weight[b, s]``, the next (both (n_blocks, n_steps), or (n_blocks, 1) for one set a
-    block). Sun, beam and terms are laid out (n_blocks, component, n_steps)."""
+    block). Sun, beam and terms are laid out (n_blocks, component, n_steps). With the circuit as
+    built (``built[0]``), the powers come from :func:`_built_parts` and reach the load through
+    :func:`_built_power`."""
     n_conn = connections.shape[0]
     has_terms = terms.shape[1] == 4
     tables = linear_power == 0.0
@@ -270,8 +199,10 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
         need_series = need_series or connections[c] == SERIES
     ex, ey, ez = row_normal[r, 0, 0], row_normal[r, 0, 1], row_normal[r, 0, 2]
     wx, wy, wz = row_normal[r, 1, 0], row_normal[r, 1, 1], row_normal[r, 1, 2]
-    e_sin_tilt = math.sqrt(max(1.0 - ez * ez, 0.0))
-    w_sin_tilt = math.sqrt(max(1.0 - wz * wz, 0.0))
+    # Each sub-panel's view of the isotropic sky and of the horizon band: (1 + cos tilt) / 2 and
+    # sin tilt on an open plain, less what a horizon hides (foldopt.physics.horizon).
+    e_iso, e_sin_tilt = row_view[r, 0, 0], row_view[r, 0, 1]
+    w_iso, w_sin_tilt = row_view[r, 1, 0], row_view[r, 1, 1]
     to_root = 1.0 / IRRADIANCE_MAX
     sx, sy, sz, dni = sun[b, 0], sun[b, 1], sun[b, 2], beam[b]
     irradiation = 0.0
@@ -290,9 +221,9 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
         d_east = d_west = 0.0
         if has_terms:
             iso, circ, hor, ground = terms[b, 0, s], terms[b, 1, s], terms[b, 2, s], terms[b, 3, s]
-            d_east = (max(iso * (1.0 + ez) * 0.5 + circ * max(cos_east, 0.0) + hor * e_sin_tilt, 0.0)
+            d_east = (max(iso * e_iso + circ * max(cos_east, 0.0) + hor * e_sin_tilt, 0.0)
                       + ground * (1.0 - ez) * 0.5)
-            d_west = (max(iso * (1.0 + wz) * 0.5 + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
+            d_west = (max(iso * w_iso + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
                       + ground * (1.0 - wz) * 0.5)
         irradiation += 0.5 * (g_east + d_east + g_west + d_west)
         if iam_model != IAM_NONE:
@@ -304,6 +235,12 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
             g_west = math.sqrt(min(max(g_west, 0.0), IRRADIANCE_MAX) * to_root)
         irradiance[0, s], irradiance[1, s] = g_east, g_west
     per_step = step_table.shape[1] > 1
+    if built[0]:
+        _built_row(b, first, last, step_table, step_weight, table_1d, table_alone, table_panel, table_parallel,
+                   table_series, table_switching, need_series, built[1] == 1, built[2] == 1, linear_power,
+                   panel_scale, switch_series, converter_efficiency, connections, conv_table, conv_rated, irradiance,
+                   buffer)
+        return irradiation
     # One table set a block (no weather file): its tables are taken once a row.
     row_1d, row_parallel, row_series = (table_1d[step_table[b, 0]], table_parallel[step_table[b, 0]],
                                         table_series[step_table[b, 0]])
@@ -335,12 +272,81 @@ def _fold_powers(r, b, first, last, sun, paper_sun, beam, terms, row_normal, row
     return irradiation
 
 
+@njit(cache=True, inline="always")
+def _built_power(code, m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel, switch_series,
+                 switch_table, converter_efficiency, conv_table, conv_rated):
+    """The power a connection delivers to the load [W] from the parts of :func:`_built_parts`:
+    through the converter, or the independent connection's two converters each rated for its
+    sub-panel (half the rating)."""
+    if code == INDEPENDENT:
+        return converter_efficiency * (_delivered(m_east, conv_table, 0.5 * conv_rated)
+                                       + _delivered(m_west, conv_table, 0.5 * conv_rated))
+    if code == SWITCHING:
+        power = max(p_switching, p_series) if switch_series and not switch_table else p_switching
+    elif code == EAST:
+        power = a_east
+    elif code == WEST:
+        power = a_west
+    elif code == PARALLEL:
+        power = p_parallel
+    elif code == SERIES:
+        power = p_series
+    else:
+        power = p_panel
+    return _delivered(power, conv_table, conv_rated)
+
+
+@njit(cache=True)
+def _built_row(b, first, last, step_table, step_weight, table_1d, table_alone, table_panel, table_parallel,
+               table_series, table_switching, need_series, direct, switch_table, linear_power, panel_scale,
+               switch_series, converter_efficiency, connections, conv_table, conv_rated, irradiance, buffer):
+    """:func:`_fold_powers`'s second loop for the circuit as built: the parts at each step (linear
+    between two table sets where the step's air temperature lies between them), then what each
+    connection delivers. With the ideal PV model (``linear_power`` > 0, no tables), only the
+    converter is as built: ``irradiance`` holds the irradiance itself."""
+    per_step = step_table.shape[1] > 1
+    parts = np.empty(8)
+    for s in range(first, last + 1):
+        root_east, root_west = irradiance[0, s], irradiance[1, s]
+        t = step_table[b, s] if per_step else step_table[b, 0]
+        w = step_weight[b, s] if per_step else 0.0
+        if linear_power > 0.0:
+            m_east, m_west = linear_power * root_east, linear_power * root_west
+            a_east, a_west, p_panel = m_east, m_west, panel_scale * m_east
+            p_parallel = p_series = m_east + m_west
+            p_switching = max(max(m_east, m_west), p_parallel)
+            w = 0.0
+        else:
+            m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel = _built_parts(
+                root_east, root_west, table_1d[t], table_alone[t], table_panel[t], table_parallel[t],
+                table_series[t], table_switching[t], need_series, direct, switch_table)
+        if w > 0.0:
+            parts[:] = _built_parts(root_east, root_west, table_1d[t + 1], table_alone[t + 1], table_panel[t + 1],
+                                    table_parallel[t + 1], table_series[t + 1], table_switching[t + 1], need_series,
+                                    direct, switch_table)
+            m_east += w * (parts[0] - m_east)
+            m_west += w * (parts[1] - m_west)
+            a_east += w * (parts[2] - a_east)
+            a_west += w * (parts[3] - a_west)
+            p_parallel += w * (parts[4] - p_parallel)
+            p_series += w * (parts[5] - p_series)
+            p_switching += w * (parts[6] - p_switching)
+            p_panel += w * (parts[7] - p_panel)
+        if not direct:
+            p_panel = panel_scale * m_east
+        for c in range(connections.shape[0]):
+            buffer[c, s] = _built_power(connections[c], m_east, m_west, a_east, a_west, p_parallel, p_series,
+                                        p_switching, p_panel, switch_series, switch_table, converter_efficiency,
+                                        conv_table, conv_rated)
+
+
 @njit(cache=True, parallel=True)
-def fold_rows(sun, paper_sun, beam, terms, span, step_table, step_weight, row_block, row_normal, row_paper, row_loadset,
-              paper_incidence, iam_model, iam_params, table_1d, table_parallel, table_series, linear_power,
-              panel_scale, bypass, switch_series, converter_efficiency, connections, loads, step_hours,
-              contiguous, load_shape, use_shape, t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance,
-              buffer, above, whole, run):
+def fold_rows(sun, paper_sun, beam, terms, span, step_table, step_weight, row_block, row_normal, row_paper, row_view,
+              row_loadset, paper_incidence, iam_model, iam_params, table_1d, table_parallel, table_series,
+              linear_power, panel_scale, bypass, switch_series, converter_efficiency, connections, built, table_alone,
+              table_panel, table_switching, conv_table, conv_rated, loads, step_hours, contiguous, load_shape,
+              use_shape, t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance, buffer, above, whole,
+              run):
     """Daily metrics of every row and connection, computing the power on the fly.
 
     Parameters
@@ -366,6 +372,10 @@ def fold_rows(sun, paper_sun, beam, terms, span, step_table, step_weight, row_bl
         East and west sub-panel normals.
     row_paper : (n_rows, 2, 4) float
         cos(tilt), sin(tilt), cos(azimuth), sin(azimuth) per sub-panel (paper mode).
+    row_view : (n_rows, 2, 2) float
+        Per sub-panel, the factors of the isotropic and the horizon-band diffuse terms:
+        (1 + cos tilt) / 2 and sin tilt, less what the site's horizon hides
+        (:func:`foldopt.physics.horizon.sky_view_factors`).
     table_1d, table_parallel, table_series : float arrays
         Stacked over table sets (air temperatures), per set: sub-panel power [W] on sqrt-spaced
         irradiance nodes, and the parallel and series pairs as fractions of the two maxima over
@@ -376,6 +386,17 @@ def fold_rows(sun, paper_sun, beam, terms, span, step_table, step_weight, row_bl
         Panel area / sub-panel area.
     connections : (n_conn,) int
         Connection codes to evaluate.
+    built : (3,) int
+        The circuit as built: whether it is (1) or Shin et al.'s ideal parts (0), direct coupling,
+        and whether switching has its own table (a switch resistance).
+    table_alone, table_panel, table_switching : float arrays
+        As built, stacked as the other tables: a sub-panel's and the whole panel's power delivered
+        at the load's voltage (direct coupling), and switching as a fraction of the two maxima
+        (placeholders where unused).
+    conv_table : (n,) float
+        The converter's delivered power / rating (:func:`foldopt.physics.converter.delivered_table`).
+    conv_rated : float
+        The converter's rating [W]; 0 for an ideal converter.
     loads : (n_loadsets, n_loads) float
         Loads [W], ascending in each set.
     contiguous : bool
@@ -401,82 +422,13 @@ def fold_rows(sun, paper_sun, beam, terms, span, step_table, step_weight, row_bl
             b = row_block[r]
             first, last = span[b, 0], span[b, 1]
             irradiation = _fold_powers(
-                r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, paper_incidence, iam_model,
-                iam_params, step_table, step_weight, table_1d, table_parallel, table_series, linear_power,
-                panel_scale, bypass, switch_series, converter_efficiency, connections, irradiance[k], buffer[k])
+                r, b, first, last, sun, paper_sun, beam, terms, row_normal, row_paper, row_view, paper_incidence,
+                iam_model, iam_params, step_table, step_weight, table_1d, table_parallel, table_series, linear_power,
+                panel_scale, bypass, switch_series, converter_efficiency, connections, built, table_alone,
+                table_panel, table_switching, conv_table, conv_rated, irradiance[k], buffer[k])
             irradiation_out[r] = irradiation * step_hours
             for c in range(connections.shape[0]):
-                energy_out[r, c], peak_out[r, c] = _metrics(
+                energy_out[r, c], peak_out[r, c] = day_metrics(
                     buffer[k, c], first, last, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
                     run[k], t_out[r, c], cont_out[r if contiguous else 0, c], load_shape[b if use_shape else 0],
                     use_shape)
-
-
-@njit(cache=True, parallel=True)
-def curve_rows(power, row_loadset, loads, step_hours, contiguous, load_shape, use_shape, t_out, cont_out, energy_out,
-               peak_out, above, whole, run):
-    """Daily metrics of given power curves (a tracker's), as :func:`fold_rows` with one connection.
-
-    Parameters
-    ----------
-    power : (n_rows, n_steps) float
-        Power at step centres [W].
-    row_loadset : (n_rows,) int
-        Set of loads of each row.
-    loads : (n_loadsets, n_loads) float
-        Loads [W], ascending in each set.
-    step_hours : float
-        Step length [h].
-    contiguous : bool
-        Whether to track the longest contiguous interval too.
-    load_shape : (n_rows, n_steps) float
-        With ``use_shape``, each row's load profile [W] (one row (1, 1) without).
-    use_shape : bool
-    t_out, cont_out, energy_out, peak_out : outputs as :func:`fold_rows`'s, with one connection.
-    above, whole, run : per-chunk scratch from :func:`scratch`.
-    """
-    n_rows = power.shape[0]
-    n_chunks = above.shape[0]
-    per_chunk = (n_rows + n_chunks - 1) // n_chunks
-    for k in prange(n_chunks):
-        for r in range(k * per_chunk, min((k + 1) * per_chunk, n_rows)):
-            energy_out[r, 0], peak_out[r, 0] = _metrics(
-                power[r], 0, power.shape[1] - 1, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
-                run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0], load_shape[r if use_shape else 0],
-                use_shape)
-
-
-def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):
-    """Outputs and per-chunk scratch of :func:`fold_rows` or :func:`curve_rows`, allocated here,
-    outside the parallel loop.
-
-    Parameters
-    ----------
-    n_rows, n_conn, n_loads : int
-        Rows, connections and loads per set.
-    n_steps : int
-        Steps per day for :func:`fold_rows`; 0 for :func:`curve_rows`.
-    contiguous : bool
-        Whether the longest contiguous interval is tracked.
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        The keyword arguments ``t_out`` ... ``run`` of the kernel.
-    """
-    chunks = max(1, min(n_rows, get_num_threads() * CHUNKS_PER_THREAD))
-    shape = (n_rows, n_conn)
-    work = {
-        "t_out": np.empty(shape + (n_loads,)),
-        "cont_out": np.zeros(shape + (n_loads,)) if contiguous else np.zeros((1, n_conn, n_loads)),
-        "energy_out": np.empty(shape),
-        "peak_out": np.empty(shape),
-        "above": np.zeros((chunks, n_loads)),
-        "whole": np.zeros((chunks, n_loads + 1)),
-        "run": np.zeros((chunks, n_loads if contiguous else 1, 2)),
-    }
-    if n_steps:
-        work["irradiation_out"] = np.empty(n_rows)
-        work["irradiance"] = np.zeros((chunks, 2, n_steps))
-        work["buffer"] = np.zeros((chunks, n_conn, n_steps))
-    return work

@@ -28,7 +28,9 @@ from foldopt.physics.geometry import normal_vector, subpanel_orientation
 from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.engine.metrics import energy, per_load, t_solar, t_solar_contiguous
 from foldopt.names import ENGINES
+from foldopt.engine.built import PARTS, assemble
 from foldopt.engine.sky import Sky
+from foldopt.engine.views import row_views, surface_views
 # The cells' electrical model is part of the engine's API (engines.electrical_for, panel_power...).
 from foldopt.engine.cells import (TEMPERATURE_NODE_STEP, electrical_for, node_weights, panel_power,  # noqa: F401
                                   temperature_nodes)
@@ -134,7 +136,8 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
     factor = beam_incidence_factor(tilt, azimuth, zenith, solar_azimuth, model="paper") if paper else None
     terms = None if sky.terms is None else sky.terms[blocks]
     modifier = 1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, zenith, solar_azimuth)
-    return plane_of_array(cos_aoi, normal[..., 2], sky.dni[blocks], terms, factor, modifier)
+    views = None if terms is None else surface_views(sky, blocks, tilt, azimuth, normal[..., 2])
+    return plane_of_array(cos_aoi, normal[..., 2], sky.dni[blocks], terms, factor, modifier, views)
 
 
 def iam_modifier(model: str, surface_tilt, surface_azimuth, solar_zenith, solar_azimuth):
@@ -284,6 +287,18 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
         poa(sky, orientation[:, 2 * side, None], orientation[:, 2 * side + 1, None], blocks, paper, incident=True)
         for side in (0, 1))
     weights = node_weights(sky, blocks, poa_east.shape)
+    circuit = electrical_for(study, weights[0][0], sky.wind_ref).circuit
+    if circuit is not None:
+        # As built, the panel side is taken linearly between tables and the converter acts on that.
+        side = {name: np.zeros(poa_east.shape) for name in PARTS}
+        for temp, weight in weights:
+            take = weight > 0
+            part = electrical_for(study, temp, sky.wind_ref).parts(poa_east[take], poa_west[take], series)
+            for name, values in side.items():
+                values[take] += weight[take] * part[name]
+        connected, state = assemble(circuit, side, switch_series=study.switch_series,
+                                    converter_efficiency=study.converter_efficiency, with_state=with_state)
+        return {**out, **connected}, state
     if len(weights) == 1:
         electrical = electrical_for(study, weights[0][0], sky.wind_ref)
         part, state = electrical.connections(poa_east, poa_west, series, with_state)
@@ -327,24 +342,36 @@ def _reference(sky, study, row_block, orientation, loads, row_loadset, outputs, 
 
 
 def _tables(electricals, outputs, study):
-    """The kernel's stacked tables (one per cell temperature) and the ideal model's linear power."""
+    """The kernel's stacked tables (one per cell temperature), the ideal model's linear power, and
+    the circuit as built: its flags, tables and converter (:func:`foldopt.engine.kernel.fold_rows`)."""
     first, count = electricals[0], len(electricals)
+    parts = first.circuit
     # Tables a study does not use are placeholders, one per cell temperature all the same.
+    placeholder_1d, placeholder = np.zeros((count, 2)), np.zeros((count, 2, 2))
+    built = {"built": np.array([parts is not None, parts is not None and parts.direct,
+                                parts is not None and parts.switch_table], dtype=np.int64),
+             "table_alone": placeholder_1d, "table_panel": placeholder_1d, "table_switching": placeholder,
+             "conv_table": np.zeros(1) if parts is None else parts.conv_table,
+             "conv_rated": 0.0 if parts is None else parts.conv_rated}
     if not first.pv.has_iv:
-        placeholder = np.zeros((count, 2, 2))
-        return np.zeros((count, 2)), placeholder, placeholder, first.pv.efficiency * first.subpanel_area
+        return placeholder_1d, placeholder, placeholder, first.pv.efficiency * first.subpanel_area, built
     series = "series" in outputs or study.switch_series
     table_1d = np.stack([e._table("subpanel")[1] for e in electricals])
     table_parallel = np.stack([e._table("parallel") for e in electricals])
-    table_series = np.stack([e._table("series") for e in electricals]) if series else np.zeros((count, 2, 2))
-    return table_1d, table_parallel, table_series, 0.0
+    table_series = np.stack([e._table("series") for e in electricals]) if series else placeholder
+    if parts is not None and parts.direct:
+        built["table_alone"] = np.stack([e._table("alone")[1] for e in electricals])
+        built["table_panel"] = np.stack([e._table("panel")[1] for e in electricals])
+    if parts is not None and parts.switch_table:
+        built["table_switching"] = np.stack([e._table("switching") for e in electricals])
+    return table_1d, table_parallel, table_series, 0.0, built
 
 
 def _compiled(sky, study, electricals, step_tables, row_block, orientation, loads, row_loadset, outputs,
               contiguous):
-    from foldopt.engine import kernel
+    from foldopt.engine import kernel, reduce
 
-    table_1d, table_parallel, table_series, linear_power = _tables(electricals, outputs, study)
+    table_1d, table_parallel, table_series, linear_power, built = _tables(electricals, outputs, study)
     codes = np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64)
     east = normal_vector(orientation[:, 0], orientation[:, 1])
     west = normal_vector(orientation[:, 2], orientation[:, 3])
@@ -356,7 +383,7 @@ def _compiled(sky, study, electricals, step_tables, row_block, orientation, load
     paper = study.mode == "paper"
     paper_sun = np.moveaxis(sky.paper_sun, -1, 1) if paper else np.zeros((1, 4, 1))
     first = electricals[0]
-    work = kernel.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous)
+    work = reduce.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous)
     lit = sky.lit
     steps = np.arange(lit.shape[1])
     first_lit = np.where(lit, steps, lit.shape[1]).min(axis=1)
@@ -365,13 +392,15 @@ def _compiled(sky, study, electricals, step_tables, row_block, orientation, load
                     np.stack([np.maximum(first_lit - 1, 0), np.minimum(last_lit + 1, steps[-1])], axis=1), 0)
     arrays = [np.moveaxis(sky.sun_vector, -1, 1), paper_sun, sky.dni, terms, span,
               np.asarray(step_tables[0], dtype=np.int64), np.asarray(step_tables[1], dtype=float), row_block,
-              np.stack([east, west], axis=1), row_paper, row_loadset]
+              np.stack([east, west], axis=1), row_paper, row_views(sky, row_block, east, west, orientation),
+              row_loadset]
     # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
     kernel.fold_rows(
         *(np.ascontiguousarray(a) for a in arrays), paper, iam_code, iam_params, table_1d, table_parallel,
         table_series, float(linear_power), study.panel.area / first.subpanel_area, first.bypass,
-        first.switch_series, first.converter_efficiency, codes, np.ascontiguousarray(loads), sky.step_hours,
-        contiguous, *_shape_arguments(sky.load_shape), **work,
+        first.switch_series, first.converter_efficiency, codes, built["built"], built["table_alone"],
+        built["table_panel"], built["table_switching"], built["conv_table"], float(built["conv_rated"]),
+        np.ascontiguousarray(loads), sky.step_hours, contiguous, *_shape_arguments(sky.load_shape), **work,
     )
     return RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
                       work["peak_out"], work["irradiation_out"])
@@ -423,10 +452,10 @@ def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous:
                                                         load_shape)
         result = RowMetrics(hours[:, None], None if runs is None else runs[:, None], harvested[:, None], peak[:, None])
     else:
-        from foldopt.engine import kernel
+        from foldopt.engine import reduce
 
-        work = kernel.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
-        kernel.curve_rows(power, row_loadset, sorted_loads, step_hours, contiguous, *_shape_arguments(load_shape),
+        work = reduce.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
+        reduce.curve_rows(power, row_loadset, sorted_loads, step_hours, contiguous, *_shape_arguments(load_shape),
                           **work)
         result = RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
                             work["peak_out"])

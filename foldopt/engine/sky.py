@@ -22,6 +22,7 @@ from foldopt.physics.atmosphere import clear_sky_dni, relative_airmass
 from foldopt.inputs.sections import parse_timezone
 from foldopt.inputs.study import Study
 from foldopt.physics.geometry import normal_vector
+from foldopt.physics.horizon import sun_visible
 from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.inputs.loads import load_shape
 from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
@@ -76,6 +77,13 @@ class Sky:
     weather_notes : tuple of str
         With a measured weather file, what reading it did (its step, derived components, gaps:
         :meth:`foldopt.inputs.weather.measured.MeasuredWeather.report`).
+    horizons : tuple of (numpy.ndarray, numpy.ndarray)
+        The sites' horizon profiles, (azimuth, elevation) [deg] each, once per profile.
+    horizon_of : numpy.ndarray or None
+        (n_blocks,) the profile of each block's site in ``horizons``, -1 for an open plain; None
+        where no site has a horizon. The beam and the circumsolar term are already blocked where
+        the sun is below the horizon line; the sky's other diffuse terms are reduced per surface
+        (:func:`foldopt.physics.horizon.sky_view_factors`).
     """
 
     grid: ClockGrid
@@ -98,6 +106,8 @@ class Sky:
     wind_speed: np.ndarray | None = None
     wind_ref: float | None = None
     weather_notes: tuple = ()
+    horizons: tuple = ()
+    horizon_of: np.ndarray | None = None
 
     @property
     def n_blocks(self) -> int:
@@ -153,8 +163,58 @@ class Sky:
                 for name in ("solar_zenith", "solar_azimuth", "hour_angle", "declination", "sun_vector", "dni",
                              "ghi", "dhi", "terms", "temp_air", "latitude", "temp_steps", "wind_speed")}
         shape = None if self.load_shape is None else self.load_shape[keep]
+        horizon_of = None if self.horizon_of is None else self.horizon_of[keep]
         return Sky(grid=grid, mode=self.mode, iam=self.iam, weather_balance=self.weather_balance,
-                   wind_ref=self.wind_ref, weather_notes=self.weather_notes, load_shape=shape, **take)
+                   wind_ref=self.wind_ref, weather_notes=self.weather_notes, load_shape=shape,
+                   horizons=self.horizons, horizon_of=horizon_of, **take)
+
+
+def _horizon_blocks(sites):
+    """Each distinct horizon profile of the sites once, and the profile of each site (-1: none)."""
+    profiles, index, of = [], {}, []
+    for site in sites:
+        horizon = site.horizon
+        if horizon is None or horizon.flat():
+            of.append(-1)
+            continue
+        key = tuple(map(tuple, horizon.points))
+        if key not in index:
+            index[key] = len(profiles)
+            profiles.append(horizon.profile())
+        of.append(index[key])
+    if not profiles:
+        return (), None
+    return tuple(profiles), np.array(of, dtype=np.int64)
+
+
+def block_behind_horizon(horizons, horizon_of, solar_zenith, solar_azimuth, dni, terms):
+    """The beam and the circumsolar light with the sun below each block's horizon line taken out.
+
+    Parameters
+    ----------
+    horizons, horizon_of
+        As :class:`Sky`'s.
+    solar_zenith, solar_azimuth : numpy.ndarray
+        (n_blocks, n_steps) [deg].
+    dni : numpy.ndarray
+        (n_blocks, n_steps) [W/m^2].
+    terms : numpy.ndarray or None
+        (n_blocks, n_steps, 4) diffuse terms (:func:`foldopt.physics.irradiance.sky_diffuse_terms`).
+
+    Returns
+    -------
+    dni, terms : numpy.ndarray
+        Copies, blocked.
+    """
+    dni = dni.copy()
+    terms = None if terms is None else terms.copy()
+    for k, (azimuth, elevation) in enumerate(horizons):
+        blocks = np.flatnonzero(horizon_of == k)
+        hidden = ~sun_visible(solar_zenith[blocks], solar_azimuth[blocks], azimuth, elevation)
+        dni[blocks] = np.where(hidden, 0.0, dni[blocks])
+        if terms is not None:
+            terms[blocks, :, 1] = np.where(hidden, 0.0, terms[blocks, :, 1])
+    return dni, terms
 
 
 def _clock(sites, dates, step_min) -> ClockGrid:
@@ -316,6 +376,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         position = {keys[index]: k for k, index in enumerate(unique)}
         share = (np.array([position[key] for key in keys]), np.asarray(member, dtype=np.int64))
         sites, dates = [sites[i] for i in unique], [dates[i] for i in unique]
+    horizons, horizon_of = _horizon_blocks(sites)
     latitude = np.array([site.latitude for site in sites], dtype=float)[:, None]
     longitude = np.array([site.longitude for site in sites], dtype=float)[:, None]
     altitude = np.array([site.altitude for site in sites], dtype=float)[:, None]
@@ -370,11 +431,14 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
             ghi if ghi is not None else dni * np.clip(np.cos(np.radians(zenith)), 0, None),
             dhi if dhi is not None else np.zeros_like(dni), dni_extra, airmass, study.albedo,
         )
+    if horizons:
+        dni, terms = block_behind_horizon(horizons, horizon_of, zenith, sun["solar_azimuth"], dni, terms)
     return Sky(
         grid=grid, mode=study.mode, solar_zenith=zenith, solar_azimuth=sun["solar_azimuth"],
         hour_angle=sun["hour_angle"], declination=np.ascontiguousarray(sun["declination"]),
         sun_vector=sun_vector, dni=dni, ghi=ghi, dhi=dhi, terms=terms,
         temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam, weather_balance=balance,
         load_shape=None if study.load_profile is None else load_shape(study.load_profile, grid.clock_hours, dates),
-        temp_steps=temp_steps, wind_speed=wind_speed, wind_ref=wind_ref, weather_notes=notes,
+        temp_steps=temp_steps, wind_speed=wind_speed, wind_ref=wind_ref, weather_notes=notes, horizons=horizons,
+        horizon_of=horizon_of,
     )

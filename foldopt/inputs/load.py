@@ -20,8 +20,9 @@ from pathlib import Path
 import yaml
 
 from foldopt.errors import ConfigError
+from foldopt.inputs.fields import FilesRead
+from foldopt.inputs.horizon import read_horizon
 from foldopt.inputs.loads import profile_steps
-from foldopt.inputs.sections import FilesRead
 from foldopt.inputs.study import Study, make_study
 from foldopt.inputs.weather_files import weather_read
 
@@ -262,7 +263,7 @@ def read_study(path: Path | str) -> tuple:
     path = Path(path)
     data, lines = parse_study_text(read_input(path, "config", MAX_STUDY_BYTES, "MAX_STUDY_BYTES"), str(path))
     if isinstance(data, dict):
-        data = _resolve_weather_path(data, path.parent)
+        data = _resolve_horizon_path(_resolve_weather_path(data, path.parent), path.parent)
     return data, lines
 
 
@@ -310,6 +311,18 @@ def _resolve_weather_path(data: dict, folder: Path) -> dict:
     if isinstance(spec, str) and not Path(spec).is_absolute() and (folder / spec).is_file():
         resolved = str(folder / spec)
         data = {**data, "weather": {**weather, "path": resolved} if isinstance(weather, dict) else resolved}
+    return data
+
+
+def _resolve_horizon_path(data: dict, folder: Path) -> dict:
+    """A study file's relative horizon file is relative to the file, as its weather file is."""
+    site = data.get("site")
+    horizon = site.get("horizon") if isinstance(site, dict) else None
+    spec = horizon.get("file") if isinstance(horizon, dict) else horizon
+    if isinstance(spec, str) and not Path(spec).is_absolute() and (folder / spec).is_file():
+        resolved = str(folder / spec)
+        data = {**data, "site": {**site, "horizon": {**horizon, "file": resolved} if isinstance(horizon, dict)
+                                 else resolved}}
     return data
 
 
@@ -395,7 +408,8 @@ def resolve_files(data) -> FilesRead:
     """
     if not isinstance(data, dict):
         return FilesRead()
-    return FilesRead(**weather_read(data.get("weather"), data.get("site")), **_profile_read(data.get("load_profile")))
+    return FilesRead(**weather_read(data.get("weather"), data.get("site")), **_profile_read(data.get("load_profile")),
+                     **_horizon_read(data.get("site")))
 
 
 def _profile_read(profile) -> dict:
@@ -406,6 +420,18 @@ def _profile_read(profile) -> dict:
         return {"profile_daily": read_profile(path)}
     except ConfigError as error:
         return {"profile_problem": str(error)}
+
+
+def _horizon_read(site) -> dict:
+    horizon = site.get("horizon") if isinstance(site, dict) else None
+    path = horizon.get("file") if isinstance(horizon, dict) else horizon
+    if not isinstance(path, str):
+        return {}
+    try:
+        azimuth, elevation = read_horizon(path)
+    except ConfigError as error:
+        return {"horizon_problem": str(error).removeprefix("site.horizon: ")}
+    return {"horizon_points": [[float(a), float(e)] for a, e in zip(azimuth, elevation, strict=True)]}
 
 
 def with_files(study: Study) -> Study:
@@ -430,7 +456,9 @@ def with_files(study: Study) -> Study:
     foldopt.ConfigError
         For a file that cannot be used, or a site too far from the weather file's.
     """
-    if study.weather is None and (study.load_profile is None or study.load_profile.file is None):
+    horizon = study.site.horizon if study.site is not None else None
+    if (study.weather is None and (study.load_profile is None or study.load_profile.file is None)
+            and (horizon is None or horizon.read)):
         return study
     data = study.data()
     return make_study(data, resolve_files(data))

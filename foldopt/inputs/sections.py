@@ -14,64 +14,17 @@ import datetime as dt
 import math
 import re
 import zoneinfo
-from dataclasses import dataclass
-from functools import partial
 from typing import Annotated
 
-from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, field_validator,
-                      model_validator)
+from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
 
 from foldopt import names
+from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
+from foldopt.inputs.horizon_section import Horizon
 from foldopt.inputs.loads import profile_steps
-from foldopt.names import ALEXANDRU_STEP_OFFSETS_H, canonical
+from foldopt.names import ALEXANDRU_STEP_OFFSETS_H
 
 _OFFSET = re.compile(r"^(?:UTC)?([+-])(\d{1,2})(?::?(\d{2}))?$")
-
-
-def interval(lo, hi, *, lo_open=False, hi_open=False, unit=""):
-    """A float constrained to an interval, whose error message states the interval.
-
-    Parameters
-    ----------
-    lo, hi : float
-        The bounds, in the field's unit.
-    lo_open, hi_open : bool
-        Whether a bound itself is outside the interval.
-    unit : str
-        The unit the message gives after the interval (``" deg"``).
-
-    Returns
-    -------
-    typing.Annotated
-        ``float`` with a validator raising ``ValueError("must be in [lo, hi] unit")`` for a value
-        outside the interval or not finite.
-    """
-    text = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}{unit}"
-
-    def check(value: float) -> float:
-        below = value <= lo if lo_open else value < lo
-        above = value >= hi if hi_open else value > hi
-        if not math.isfinite(value) or below or above:
-            raise ValueError(f"must be in {text}")
-        return value
-
-    return Annotated[float, AfterValidator(check)]
-
-
-def named(choices):
-    """A name among ``choices``, any spelling of :func:`foldopt.names.canonical` accepted.
-
-    Parameters
-    ----------
-    choices : sequence of str
-        The names (a registry of :mod:`foldopt.names`).
-
-    Returns
-    -------
-    typing.Annotated
-        ``str`` validated into foldopt's spelling of the name.
-    """
-    return Annotated[str, BeforeValidator(partial(canonical, names=choices))]
 
 
 def parse_timezone(name: str) -> dt.tzinfo:
@@ -112,61 +65,6 @@ def _check_timezone(name: str | None) -> str | None:
     return name
 
 
-@dataclass(frozen=True)
-class FilesRead:
-    """What :func:`foldopt.inputs.load.resolve_files` read of the files a study names, handed to
-    the study's validation as pydantic's context: the models judge it and open no files. A study
-    validated without it (built in Python, or a :meth:`foldopt.inputs.study.Study.variant`) has
-    its files unread until :func:`foldopt.inputs.load.with_files` reads them.
-
-    Parameters
-    ----------
-    weather_site : dict, optional
-        The site in the weather file's header (:func:`foldopt.inputs.weather.weather_site`).
-    weather_problem : str, optional
-        Why the weather file cannot be used: one line naming the file (and the line, the field).
-    weather_missing : bool
-        Whether the weather file does not exist.
-    weather_step_min : float, optional
-        A measured weather file's step [min].
-    weather_dates : tuple of str, optional
-        A measured weather file's whole days (ISO dates), less those with a daylight gap too long
-        to fill.
-    profile_daily : dict, optional
-        The load profile file's day: clock times ``HH:MM`` to loads [W].
-    profile_problem : str, optional
-        Why the load profile file cannot be read: one line naming the file and the line.
-    """
-
-    weather_site: dict | None = None
-    weather_problem: str | None = None
-    weather_missing: bool = False
-    weather_step_min: float | None = None
-    weather_dates: tuple | None = None
-    profile_daily: dict | None = None
-    profile_problem: str | None = None
-
-    @staticmethod
-    def given(info: ValidationInfo) -> FilesRead | None:
-        """The files read for a validation, or None where it was given none.
-
-        Parameters
-        ----------
-        info : pydantic.ValidationInfo
-
-        Returns
-        -------
-        FilesRead or None
-        """
-        return info.context if isinstance(info.context, FilesRead) else None
-
-
-class StrictModel(BaseModel):
-    """A frozen model that refuses unknown fields: the base of a study and its parts."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
 class Site(StrictModel):
     """Where a study's panel stands.
 
@@ -182,6 +80,8 @@ class Site(StrictModel):
     timezone : str, optional
         An IANA name or a UTC offset (:func:`parse_timezone`); default the longitude's standard
         offset (:meth:`resolved`).
+    horizon : Horizon, optional
+        The horizon line around the panel; default none (an open plain).
     """
 
     name: str | None = None
@@ -191,6 +91,7 @@ class Site(StrictModel):
     timezone: Annotated[str | None, AfterValidator(_check_timezone)] = Field(
         None, description="IANA name or UTC offset; default: the longitude's standard offset"
     )
+    horizon: Horizon | None = Field(None, description="(azimuth, elevation) points or a file; default an open plain")
 
     def resolved(self) -> Site:
         """The site with its time zone filled in.

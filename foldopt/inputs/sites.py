@@ -15,6 +15,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
+from foldopt.inputs.horizon import read_horizon
 from foldopt.inputs.load import MAX_CSV_BYTES, read_input
 from foldopt.inputs.sections import Site
 from foldopt.inputs.study import format_errors
@@ -22,7 +23,7 @@ from foldopt.inputs.study import format_errors
 #: Weather files a folder of sites may hold, by extension (pvlib's readers).
 WEATHER_SUFFIXES = (".csv", ".epw", ".json")
 #: Columns of a table of named sites; name, latitude and longitude are required.
-SITE_COLUMNS = ("name", "latitude", "longitude", "altitude", "timezone")
+SITE_COLUMNS = ("name", "latitude", "longitude", "altitude", "timezone", "horizon")
 
 
 def grid_sites(latitudes: Sequence[float], longitudes: Sequence[float], land_only: bool = False) -> list[dict]:
@@ -72,7 +73,9 @@ def read_sites(path: Path | str) -> list[dict]:
     -------
     list of dict
         Each row's :class:`foldopt.inputs.sections.Site` fields as given: ``latitude``,
-        ``longitude`` [deg] and, where given, ``name``, ``altitude`` [m] and ``timezone``.
+        ``longitude`` [deg] and, where given, ``name``, ``altitude`` [m], ``timezone`` and
+        ``horizon`` (a horizon file, relative to the table's folder, read into its points:
+        :func:`foldopt.inputs.horizon.read_horizon`).
 
     Raises
     ------
@@ -92,8 +95,8 @@ def read_sites(path: Path | str) -> list[dict]:
     unknown = [name[:30] for name in header if name not in SITE_COLUMNS][:5]
     twice = sorted({name for name in header if header.count(name) > 1})
     if missing or unknown or twice:
-        raise ConfigError([f"--sites {path}: the header must name {', '.join(SITE_COLUMNS)} (name, altitude and "
-                           f"timezone optional); " + "; ".join(
+        raise ConfigError([f"--sites {path}: the header must name {', '.join(SITE_COLUMNS)} (name, altitude, "
+                           f"timezone and horizon optional); " + "; ".join(
                                ([f"missing {', '.join(missing)}"] if missing else [])
                                + ([f"unknown {', '.join(unknown)}"] if unknown else [])
                                + ([f"{', '.join(twice)} twice"] if twice else []))])
@@ -103,6 +106,15 @@ def read_sites(path: Path | str) -> list[dict]:
             errors.append(f"--sites {path}, line {line}: {len(cells)} fields; the header names {len(header)}")
             continue
         data = {key: value.strip() for key, value in zip(header, cells) if value.strip() != ""}
+        if "horizon" in data:
+            # A horizon file is named relative to the table of sites, and read here (the model opens none).
+            file = data["horizon"] if Path(data["horizon"]).is_absolute() else str(path.parent / data["horizon"])
+            try:
+                azimuth, elevation = read_horizon(file)
+            except ConfigError as error:
+                errors.append(f"--sites {path}, line {line}: {error.errors[0]}")
+                continue
+            data["horizon"] = {"file": file, "points": [[float(a), float(e)] for a, e in zip(azimuth, elevation)]}
         try:
             site = Site.model_validate(data)
         except ValidationError as error:

@@ -19,8 +19,9 @@ from pydantic import AfterValidator, Field, ValidationError, ValidationInfo, fie
 from foldopt import names
 from foldopt.errors import ConfigError
 from foldopt.inputs import policy
-from foldopt.inputs.sections import (FilesRead, FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site,
-                                     StrictModel, Tracker, interval, named)
+from foldopt.inputs.circuit_section import Circuit
+from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
+from foldopt.inputs.sections import FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site, Tracker
 from foldopt.inputs.weather_section import Weather
 
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
@@ -110,7 +111,9 @@ class Study(StrictModel):
         Switching may select series; the series string has bypass diodes; every step's I-V
         curves are solved rather than tabled.
     converter_efficiency : float
-        ``independent``: [-] in (0, 1]; default 1.
+        ``independent`` with ideal converters: [-] in (0, 1]; default 1.
+    circuit : Circuit
+        Diodes, converter, coupling to the load and switch as built; default Shin et al.'s ideal parts.
     temperature_model : str, optional
         One of :data:`foldopt.names.TEMPERATURE_MODELS`; default fixed in paper mode, sapm in exact.
     temp_air : float
@@ -160,6 +163,7 @@ class Study(StrictModel):
     switch_series: bool = Field(False, description="switching may also select series")
     bypass_diodes: bool = True
     converter_efficiency: interval(0, 1, lo_open=True) = 1.0
+    circuit: Circuit = Field(Circuit(), description="diodes, converter, coupling and switch as built; default ideal")
     temperature_model: named(names.TEMPERATURE_MODELS) | None = Field(
         None, description="default fixed (cells at temp_air) in paper mode, sapm in exact"
     )
@@ -274,6 +278,8 @@ class Study(StrictModel):
             ("bypass_diodes", series_used, "is only used where series is (connection series, or switching "
                                            "with switch_series)"),
             ("converter_efficiency", self.connection == "independent", "is only used by connection independent"),
+            ("converter_efficiency", self.circuit.converter.model == "ideal",
+             "is the ideal converters' efficiency; circuit.converter sets every converter's"),
             ("temperature_model", iv_model, "is only used by pv_model single-diode or b-model"),
             ("temp_air", iv_model and self.weather is None,
              "is only used by pv_model single-diode or b-model, without a weather file (which brings its own)"),
@@ -282,7 +288,8 @@ class Study(StrictModel):
         ]
         idle = [f"{name} = {getattr(self, name)!r}: {why}" for name, used, why in rules
                 if not used and getattr(self, name) not in _as_tuple(defaults[name])]
-        return idle + self.tracker.idle_settings()
+        circuit = self.circuit.idle_settings(self.connection, series_used and self.bypass_diodes, iv_model)
+        return idle + circuit + self.tracker.idle_settings()
 
     def sky_transposition(self) -> str:
         """The diffuse model in force.
@@ -355,12 +362,14 @@ class Study(StrictModel):
         Returns
         -------
         dict
-            ``date`` as text, no unset field; a profile read from a file keeps its file, not the
-            steps read from it.
+            ``date`` as text, no unset field; a profile or a horizon read from a file keeps its
+            file, not what was read from it.
         """
         data = self.model_dump(mode="json", exclude_none=True)
         if self.load_profile is not None and self.load_profile.file is not None:
             data["load_profile"].pop("daily", None)
+        if self.site is not None and self.site.horizon is not None and self.site.horizon.file is not None:
+            data["site"]["horizon"].pop("points", None)
         return data
 
     def resolved(self) -> Study:

@@ -13,7 +13,8 @@ from typing import Annotated
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 
 from foldopt import names
-from foldopt.inputs.sections import StrictModel, interval, named, parse_timezone
+from foldopt.inputs.fields import StrictModel, interval, named
+from foldopt.inputs.sections import parse_timezone
 
 
 def _check_offset(name: str | None) -> str | None:

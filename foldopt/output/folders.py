@@ -18,11 +18,18 @@ from foldopt.output.provenance import input_hash, run_metadata, write_run_json
 from foldopt.output.tables import write_csv
 from foldopt.studies.annual import annual_cases, annual_summary
 from foldopt.studies.day import StudyResult
+from foldopt.studies.horizon_paths import sun_paths
 
 
 def _finite_or_none(value: float) -> float | None:
     # NaN (e.g. no heuristic angle: the load exceeds the flat panel's noon power) is not JSON.
     return value if np.isfinite(value) else None
+
+
+def _horizon_figure(study, dates, folder: Path, name: str) -> list[str]:
+    """``horizon_sun_paths.png`` where the study's site has a horizon."""
+    paths = sun_paths(study, dates)
+    return [] if paths is None else [write_figure(folder, "horizon_sun_paths.png", paths, name)]
 
 
 def write_study(result: StudyResult, out: Path, overwrite: bool = False, command=None) -> Path:
@@ -49,6 +56,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
         write_csv(result.sweep, folder / "sweep.csv")
         write_csv(result.timeseries, folder / "timeseries.csv", index=True)
         figures = [write_figure(folder, file, result) for file in day.FIGURES]
+        figures += _horizon_figure(result.study, [result.study.date], folder, result.study.name)
         write_csv(result.standby[0], folder / "tracker_standby.csv")
         metadata = run_metadata(
             result.study,
@@ -190,6 +198,7 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
         plots = _sweep_plots(result.table, result.varied, folder, plan.base.name)
         if "date" in result.varied or "day_of_year" in result.varied:
             plots += _annual_outputs(result, folder, plan.base.name)
+        plots += _horizon_figure(plan.base, dict(plan.axes).get("date", (plan.base.date,)), folder, plan.base.name)
         metadata = run_metadata(
             plan.base.resolved(),
             command,

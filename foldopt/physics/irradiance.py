@@ -146,7 +146,7 @@ def sky_diffuse_terms(model, solar_zenith, dni, ghi, dhi, dni_extra, airmass, al
     return np.nan_to_num(terms)  # no diffuse light: pvlib's NaN, foldopt's 0
 
 
-def plane_of_array(cos_aoi, cos_tilt, dni, terms=None, beam_factor=None, iam=1.0):
+def plane_of_array(cos_aoi, cos_tilt, dni, terms=None, beam_factor=None, iam=1.0, views=None):
     """Irradiance on surfaces [W/m^2] from the sun's incidence and the diffuse terms.
 
     Parameters
@@ -163,6 +163,10 @@ def plane_of_array(cos_aoi, cos_tilt, dni, terms=None, beam_factor=None, iam=1.0
         The beam's incidence factor, default ``max(cos_aoi, 0)`` (paper mode: Eq. 5).
     iam : array_like, default 1
         Incidence-angle modifier of the beam [-].
+    views : tuple of array_like, optional
+        The surfaces' factors of the isotropic and the horizon-band terms, in place of
+        ``(1 + cos_tilt) / 2`` and ``sin(tilt)`` (a horizon hides part of the sky:
+        :func:`foldopt.physics.horizon.sky_view_factors`).
 
     Returns
     -------
@@ -184,6 +188,9 @@ def plane_of_array(cos_aoi, cos_tilt, dni, terms=None, beam_factor=None, iam=1.0
         return poa
     iso, circ, hor, ground = np.moveaxis(np.asarray(terms), -1, 0)
     cos_tilt = np.asarray(cos_tilt, dtype=float)
-    sin_tilt = np.sqrt(np.clip(1.0 - cos_tilt**2, 0.0, None))
-    sky = np.maximum(iso * (1.0 + cos_tilt) * 0.5 + circ * np.clip(cos_aoi, 0.0, None) + hor * sin_tilt, 0.0)
+    if views is None:
+        sky_view, sin_tilt = (1.0 + cos_tilt) * 0.5, np.sqrt(np.clip(1.0 - cos_tilt**2, 0.0, None))
+    else:
+        sky_view, sin_tilt = views
+    sky = np.maximum(iso * sky_view + circ * np.clip(cos_aoi, 0.0, None) + hor * sin_tilt, 0.0)
     return poa + sky + ground * (1.0 - cos_tilt) * 0.5

@@ -14,6 +14,7 @@ from pathlib import Path
 import pandas as pd
 
 from foldopt.studies.answer import Answer, plain, records
+from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
 
 #: The designs an answer compares, first the ones every study has.
@@ -94,6 +95,10 @@ def study_question(study, varied: tuple = ()) -> dict:
                         "whichever is larger",
         "objective": "t_solar of the day",
     }
+    if site.horizon is not None:
+        question["site"] += f", {site.horizon.describe()}"
+    if not study.circuit.ideal or any(path.startswith("circuit") for path in varied):
+        question["circuit"] = study.circuit.describe()
     if study.objective is not None and "date" in varied:
         objective = study.objective
         season = f" of months {', '.join(map(str, objective.months))}" if objective.months else ""
@@ -170,7 +175,8 @@ def of_study(result) -> Answer:
                "note"]
     return Answer("study", study.name, study_question(study), _defaults(result), result_part,
                   summary[columns], near_table, pd.DataFrame(),
-                  design_notes(summary) + weather_notes(result.day.sky), tuple(lines))
+                  design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
+                  tuple(lines))
 
 
 def _defaults(result) -> dict | None:
@@ -224,7 +230,8 @@ def of_sweep(result) -> Answer:
     question = study_question(plan.base, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
     return Answer("sweep", plan.base.name, question, _defaults(result), plain(part), designs, near, pd.DataFrame(),
-                  design_notes(table, plan.n_cases) + weather_notes(result), tuple(lines))
+                  design_notes(table, plan.n_cases) + weather_notes(result) + horizon_notes(plan.base, _dates(plan)),
+                  tuple(lines))
 
 
 def _of_annual(result) -> Answer:
@@ -304,7 +311,8 @@ def _of_annual(result) -> Answer:
     question = study_question(study, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
     return Answer("annual", study.name, question, _defaults(result), plain(part), designs, near, schedule,
-                  design_notes(result.table, plan.n_cases) + weather_notes(result), tuple(lines))
+                  design_notes(result.table, plan.n_cases) + weather_notes(result)
+                  + horizon_notes(study, _dates(plan)), tuple(lines))
 
 
 #: The annual objective's columns over a cloud ensemble (foldopt.studies.sweeps.objective_table).

@@ -48,7 +48,9 @@ SWEEP_OPTIONS = {
     "no_bypass": "bypass_diodes", "converter_efficiency": "converter_efficiency", "temp_air": "temp_air",
     "exact_electrical": "exact_electrical", "step_min": "step_min", "angle_step": "fold_angles.step",
     "load_profile": "load_profile", "weather_format": "weather.format", "members": "weather.members",
-    "seed": "weather.seed",
+    "seed": "weather.seed", "horizon": "site.horizon", "blocking_diode": "circuit.blocking_diode.model",
+    "bypass_diode": "circuit.bypass_diode.model", "converter": "circuit.converter.model",
+    "load_voltage": "circuit.load_voltage", "switch_resistance": "circuit.switch_resistance",
 }
 #: Sweep options that take a value, a range or a list (:func:`foldopt.inputs.plan.parse_values`).
 _LISTED = ("lat", "lon", "p_load", "p_load_scale", "tilt", "days")
@@ -317,6 +319,10 @@ def sweep_changes(options: dict, data: dict) -> dict:
             value = {"path": str(value)}  # a new file: none of the study's file's options
         elif option == "load_profile":
             value = {"file": str(value)}
+        elif option == "horizon":
+            value = {"file": str(value)}
+        elif option == "load_voltage":
+            changes["circuit.coupling"] = "direct"
         changes[SWEEP_OPTIONS[option]] = value
     if errors:
         raise ConfigError(errors)

@@ -1,0 +1,204 @@
+"""Compiled reduction of power curves to daily metrics (numba), and the scratch of the kernels.
+
+:func:`day_metrics` reduces one power curve to the daily metrics of every load at once; the
+kernel :func:`foldopt.engine.kernel.fold_rows` calls it per row and connection, and
+:func:`curve_rows` takes power curves that already exist (a tracker's) through it.
+
+The metrics are those of :mod:`foldopt.engine.metrics`, which is their reference: power is sampled at
+step centres and linear between them (held for half a step at both ends of the day), and a
+segment from ``lo`` to ``hi`` of length ``dt`` is above a load ``L`` for
+``dt * clip((hi - L) / (hi - lo), 0, 1)``. For many loads sorted ascending, the loads at or below
+``lo`` take the whole segment: one entry of a difference array, summed from the top at the end;
+only the loads inside the segment's range take a share. The position of the power among the loads
+moves by a few loads a step, so it is walked from the previous step instead of searched. A day's
+cost is then O(steps + loads x crossings), not O(steps x loads).
+
+Rows are split into chunks, a few per thread, and each chunk has its own scratch, allocated by the
+caller outside the parallel loop (:func:`scratch`; arrays zero-filled inside a numba prange body
+have given wrong sums) and cleared per row.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import get_num_threads, njit, prange
+
+CHUNKS_PER_THREAD = 8  # rows are handed out in chunks: enough for balance, few scratch buffers
+
+
+@njit(cache=True, inline="always")
+def _walk(loads, position, power):
+    """Number of loads at or below ``power``, walked from the previous step's ``position``."""
+    count = loads.shape[0]
+    while position < count and loads[position] <= power:
+        position += 1
+    while position > 0 and loads[position - 1] > power:
+        position -= 1
+    return position
+
+
+@njit(cache=True, inline="always")
+def _shares(loads, lo, hi, lo_at, hi_at, length, above, run, contiguous):
+    """Shares of a segment from ``lo`` to ``hi`` for the loads strictly inside its range."""
+    for j in range(lo_at, hi_at):
+        share = length * (hi - loads[j]) / (hi - lo)
+        above[j] += share
+        if contiguous:
+            run[j, 0] += share
+
+
+@njit(cache=True, inline="always")
+def _runs(start_at, lo_at, length, run):
+    """Longest runs: a sample below a load ends that load's run (the segment starts a new one);
+    loads below the segment's low end run on through it."""
+    for j in range(start_at, run.shape[0]):
+        run[j, 1] = max(run[j, 1], run[j, 0])
+        run[j, 0] = 0.0
+    for j in range(lo_at):
+        run[j, 0] += length
+
+
+@njit(cache=True, inline="always")
+def _gather(whole, pending_at, pending, lo_at, length):
+    """Add ``length`` to the pending sum for ``whole[lo_at]``, writing the previous sum out when
+    the index changes."""
+    if lo_at == pending_at:
+        return pending_at, pending + length
+    whole[pending_at] += pending
+    return lo_at, length
+
+
+@njit(cache=True, inline="always")
+def _per_load(p, shape, s, use_shape):
+    """The power against which the loads are compared at step ``s``: the power itself for constant
+    loads, or for a load profile P_load(t) = scale x shape(t) the ratio P_pv / shape, so that
+    P_pv >= scale x shape is ratio >= scale; a step without load (shape 0) is -inf, which no scale
+    reaches, and neither do the segments next to it (:func:`foldopt.engine.metrics.per_load`)."""
+    if not use_shape:
+        return p
+    g = shape[s]
+    return p / g if g > 0.0 else -math.inf
+
+
+@njit(cache=True)
+def day_metrics(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
+             use_shape):
+    """Daily metrics of one power curve [W] sampled at step centres, of which only steps
+    ``first..last`` need walking: the power before and after them is that of the first and the
+    last (zero, or the day's end). Writes t_solar (and its longest run) per load; returns the
+    energy [Wh] and the peak [W]. With ``use_shape`` the loads are scales of the load profile
+    ``shape`` (n_steps) [W] (:func:`_per_load`); steps outside ``first..last`` hold the power of
+    the first and last, and the shape there is taken as the first's and the last's.
+
+    A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
+    (summed from the top at the end), and shares to the loads inside its range. Consecutive
+    segments mostly share k, so their lengths gather in a local sum first."""
+    n_steps, n_loads = power.shape[0], loads.shape[0]
+    above[:] = 0.0
+    whole[:] = 0.0
+    if contiguous:
+        run[:] = 0.0
+    # The half-step held at the start of the day, and the steps before ``first``.
+    harvested = peak = power[first]
+    previous = _per_load(power[first], shape, first, use_shape)
+    position = _walk(loads, 0, previous)
+    pending_at, pending = position, (first + 0.5) * step_hours
+    if contiguous:
+        _runs(position, position, pending, run)
+    for s in range(first + 1, last + 1):
+        harvested += power[s]
+        peak = max(peak, power[s])
+        p = _per_load(power[s], shape, s, use_shape)
+        at = _walk(loads, position, p)
+        lo_at, hi_at = min(position, at), max(position, at)
+        if contiguous:
+            _runs(position, lo_at, step_hours, run)
+        pending_at, pending = _gather(whole, pending_at, pending, lo_at, step_hours)
+        if hi_at > lo_at:
+            _shares(loads, min(previous, p), max(previous, p), lo_at, hi_at, step_hours, above, run, contiguous)
+        previous, position = p, at
+    # The last sample held to the end of the day.
+    tail = (n_steps - last - 0.5) * step_hours
+    if contiguous:
+        _runs(position, position, tail, run)
+    pending_at, pending = _gather(whole, pending_at, pending, position, tail)
+    whole[pending_at] += pending
+    total = 0.0
+    for j in range(n_loads - 1, -1, -1):
+        total += whole[j + 1]
+        t_out[j] = above[j] + total
+        if contiguous:
+            cont_out[j] = max(run[j, 0], run[j, 1])
+    return harvested * step_hours, peak
+
+
+@njit(cache=True, parallel=True)
+def curve_rows(power, row_loadset, loads, step_hours, contiguous, load_shape, use_shape, t_out, cont_out, energy_out,
+               peak_out, above, whole, run):
+    """Daily metrics of given power curves (a tracker's), as :func:`fold_rows` with one connection.
+
+    Parameters
+    ----------
+    power : (n_rows, n_steps) float
+        Power at step centres [W].
+    row_loadset : (n_rows,) int
+        Set of loads of each row.
+    loads : (n_loadsets, n_loads) float
+        Loads [W], ascending in each set.
+    step_hours : float
+        Step length [h].
+    contiguous : bool
+        Whether to track the longest contiguous interval too.
+    load_shape : (n_rows, n_steps) float
+        With ``use_shape``, each row's load profile [W] (one row (1, 1) without).
+    use_shape : bool
+    t_out, cont_out, energy_out, peak_out : outputs as :func:`fold_rows`'s, with one connection.
+    above, whole, run : per-chunk scratch from :func:`scratch`.
+    """
+    n_rows = power.shape[0]
+    n_chunks = above.shape[0]
+    per_chunk = (n_rows + n_chunks - 1) // n_chunks
+    for k in prange(n_chunks):
+        for r in range(k * per_chunk, min((k + 1) * per_chunk, n_rows)):
+            energy_out[r, 0], peak_out[r, 0] = day_metrics(
+                power[r], 0, power.shape[1] - 1, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
+                run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0], load_shape[r if use_shape else 0],
+                use_shape)
+
+
+def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):
+    """Outputs and per-chunk scratch of :func:`fold_rows` or :func:`curve_rows`, allocated here,
+    outside the parallel loop.
+
+    Parameters
+    ----------
+    n_rows, n_conn, n_loads : int
+        Rows, connections and loads per set.
+    n_steps : int
+        Steps per day for :func:`fold_rows`; 0 for :func:`curve_rows`.
+    contiguous : bool
+        Whether the longest contiguous interval is tracked.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        The keyword arguments ``t_out`` ... ``run`` of the kernel.
+    """
+    chunks = max(1, min(n_rows, get_num_threads() * CHUNKS_PER_THREAD))
+    shape = (n_rows, n_conn)
+    work = {
+        "t_out": np.empty(shape + (n_loads,)),
+        "cont_out": np.zeros(shape + (n_loads,)) if contiguous else np.zeros((1, n_conn, n_loads)),
+        "energy_out": np.empty(shape),
+        "peak_out": np.empty(shape),
+        "above": np.zeros((chunks, n_loads)),
+        "whole": np.zeros((chunks, n_loads + 1)),
+        "run": np.zeros((chunks, n_loads if contiguous else 1, 2)),
+    }
+    if n_steps:
+        work["irradiation_out"] = np.empty(n_rows)
+        work["irradiance"] = np.zeros((chunks, 2, n_steps))
+        work["buffer"] = np.zeros((chunks, n_conn, n_steps))
+    return work

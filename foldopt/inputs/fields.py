@@ -1,0 +1,121 @@
+"""The building blocks of a study's models: checked numbers and names, the strict base model, and
+what a study's files hold (:class:`FilesRead`), which the models judge and never read themselves.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import partial
+from typing import Annotated
+
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, ValidationInfo
+
+from foldopt.names import canonical
+
+
+def interval(lo, hi, *, lo_open=False, hi_open=False, unit=""):
+    """A float constrained to an interval, whose error message states the interval.
+
+    Parameters
+    ----------
+    lo, hi : float
+        The bounds, in the field's unit.
+    lo_open, hi_open : bool
+        Whether a bound itself is outside the interval.
+    unit : str
+        The unit the message gives after the interval (``" deg"``).
+
+    Returns
+    -------
+    typing.Annotated
+        ``float`` with a validator raising ``ValueError("must be in [lo, hi] unit")`` for a value
+        outside the interval or not finite.
+    """
+    text = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}{unit}"
+
+    def check(value: float) -> float:
+        below = value <= lo if lo_open else value < lo
+        above = value >= hi if hi_open else value > hi
+        if not math.isfinite(value) or below or above:
+            raise ValueError(f"must be in {text}")
+        return value
+
+    return Annotated[float, AfterValidator(check)]
+
+
+def named(choices):
+    """A name among ``choices``, any spelling of :func:`foldopt.names.canonical` accepted.
+
+    Parameters
+    ----------
+    choices : sequence of str
+        The names (a registry of :mod:`foldopt.names`).
+
+    Returns
+    -------
+    typing.Annotated
+        ``str`` validated into foldopt's spelling of the name.
+    """
+    return Annotated[str, BeforeValidator(partial(canonical, names=choices))]
+
+
+@dataclass(frozen=True)
+class FilesRead:
+    """What :func:`foldopt.inputs.load.resolve_files` read of the files a study names, handed to
+    the study's validation as pydantic's context: the models judge it and open no files. A study
+    validated without it (built in Python, or a :meth:`foldopt.inputs.study.Study.variant`) has
+    its files unread until :func:`foldopt.inputs.load.with_files` reads them.
+
+    Parameters
+    ----------
+    weather_site : dict, optional
+        The site in the weather file's header (:func:`foldopt.inputs.weather.weather_site`).
+    weather_problem : str, optional
+        Why the weather file cannot be used: one line naming the file (and the line, the field).
+    weather_missing : bool
+        Whether the weather file does not exist.
+    weather_step_min : float, optional
+        A measured weather file's step [min].
+    weather_dates : tuple of str, optional
+        A measured weather file's whole days (ISO dates), less those with a daylight gap too long
+        to fill.
+    profile_daily : dict, optional
+        The load profile file's day: clock times ``HH:MM`` to loads [W].
+    profile_problem : str, optional
+        Why the load profile file cannot be read: one line naming the file and the line.
+    horizon_points : list, optional
+        The site's horizon file's (azimuth, elevation) points [deg].
+    horizon_problem : str, optional
+        Why the horizon file cannot be read: one line naming the file.
+    """
+
+    weather_site: dict | None = None
+    weather_problem: str | None = None
+    weather_missing: bool = False
+    weather_step_min: float | None = None
+    weather_dates: tuple | None = None
+    profile_daily: dict | None = None
+    profile_problem: str | None = None
+    horizon_points: list | None = None
+    horizon_problem: str | None = None
+
+    @staticmethod
+    def given(info: ValidationInfo) -> FilesRead | None:
+        """The files read for a validation, or None where it was given none.
+
+        Parameters
+        ----------
+        info : pydantic.ValidationInfo
+
+        Returns
+        -------
+        FilesRead or None
+        """
+        return info.context if isinstance(info.context, FilesRead) else None
+
+
+class StrictModel(BaseModel):
+    """A frozen model that refuses unknown fields: the base of a study and its parts."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
