@@ -55,29 +55,10 @@ from foldopt.physics.pvmodel import IVCurve
 
 SWITCH_STATES = connections.SWITCH_STATES
 IDEAL_DIODE = Diode("ideal")
-_INVPHI = (np.sqrt(5.0) - 1.0) / 2.0
-_GOLDEN_STEPS = 40  # the bracket shrinks to 0.618^40 = 4e-9 of its width
 _NEWTON_TOL = 1e-12  # [V]
 _NEWTON_MAX = 100
 _BISECTIONS = 60  # a 10 A bracket shrinks to 1e-17 A
 _GRID = 12  # points bracketing a maximum where a Shockley diode breaks concavity
-
-
-def _golden(evaluate, lo, hi, steps=_GOLDEN_STEPS):
-    """Maximum and its argument of unimodal functions on [lo, hi], element by element."""
-    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-    a, b = hi - _INVPHI * (hi - lo), lo + _INVPHI * (hi - lo)
-    fa, fb = evaluate(a), evaluate(b)
-    for _ in range(steps):
-        left = fa > fb  # the maximum lies in [lo, b]
-        lo, hi = np.where(left, lo, a), np.where(left, b, hi)
-        kept, f_kept = np.where(left, a, b), np.where(left, fa, fb)
-        probe = np.where(left, hi - _INVPHI * (hi - lo), lo + _INVPHI * (hi - lo))
-        f_probe = evaluate(probe)
-        a, fa = np.where(left, probe, kept), np.where(left, f_probe, f_kept)
-        b, fb = np.where(left, kept, probe), np.where(left, f_kept, f_probe)
-    better = fa >= fb
-    return np.where(better, fa, fb), np.where(better, a, b)
 
 
 def _bracketed(evaluate, lo, hi, count=_GRID):
@@ -89,7 +70,7 @@ def _bracketed(evaluate, lo, hi, count=_GRID):
     best = np.argmax(values, axis=-1)[..., None]
     left = np.take_along_axis(nodes, np.maximum(best - 1, 0), axis=-1)[..., 0]
     right = np.take_along_axis(nodes, np.minimum(best + 1, count - 1), axis=-1)[..., 0]
-    return np.maximum(_golden(evaluate, left, right)[0], values.max(axis=-1))
+    return np.maximum(connections.golden_section(evaluate, left, right)[0], values.max(axis=-1))
 
 
 def _expand(value, like):
@@ -166,7 +147,7 @@ def _branch_mpp(side: _Explicit, diode: Diode, switch_resistance):
         current = np.maximum(current, 0.0)
         return current * (voltage - diode.drop(current) - current * switch_resistance)
 
-    best, x = _golden(power, np.zeros_like(side.x_oc), side.x_oc)
+    best, x = connections.golden_section(power, np.zeros_like(side.x_oc), side.x_oc)
     current, voltage, _, _ = side(x)
     current = np.maximum(current, 0.0)
     lit = best > 0
@@ -266,7 +247,7 @@ def parallel_power(east: IVCurve, west: IVCurve, blocking: Diode, load_voltage=N
     else:
         # The sub-panel of the lower maximum-power voltage stops sourcing at V_oc - V_F.
         reach = np.where(v_e <= v_w, sides[0].x_oc, sides[1].x_oc) - blocking.drop(0.0)
-        searched = _golden(power, lower, np.maximum(lower, np.minimum(upper, reach)))[0]
+        searched = connections.golden_section(power, lower, np.maximum(lower, np.minimum(upper, reach)))[0]
     return np.maximum(np.maximum(searched, 0.0), np.maximum(p_e, p_w))
 
 
@@ -347,13 +328,13 @@ def series_power(east: IVCurve, west: IVCurve, bypass: Diode | None, load_voltag
             lo, hi = np.where(above, middle, lo), np.where(above, hi, middle)
         current = np.where(saturated, top, lo)
         return np.where(reaches, target * current, 0.0)
-    both = _golden(power, np.zeros_like(weaker), weaker)[0]
+    both = connections.golden_section(power, np.zeros_like(weaker), weaker)[0]
     if bypass is None:
         return np.maximum(both, 0.0)
     if bypass.model == "shockley":
         bypassed = _bracketed(power, weaker, stronger)
     else:
-        bypassed = _golden(power, weaker, stronger)[0]
+        bypassed = connections.golden_section(power, weaker, stronger)[0]
     return np.maximum(np.maximum(both, bypassed), 0.0)
 
 
