@@ -12,7 +12,7 @@ import textwrap
 from pathlib import Path
 
 import foldopt
-from foldopt.output.figures import FIGURES, annual, day, sizing, sweep, weather, world
+from foldopt.output.figures import FIGURES, annual, day, horizon, sizing, sweep, weather, world
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -25,7 +25,8 @@ def test_the_registry_is_the_figures_of_the_examples():
 
 
 def test_the_registry_is_every_kind_once_and_draws_with_public_functions():
-    kinds = [day.FIGURES, sweep.FIGURES, annual.FIGURES, weather.FIGURES, world.FIGURES, sizing.FIGURES]
+    kinds = [day.FIGURES, sweep.FIGURES, annual.FIGURES, weather.FIGURES, horizon.FIGURES, world.FIGURES,
+             sizing.FIGURES]
     assert sum(len(kind) for kind in kinds) == len(FIGURES)  # no file name in two kinds
     for file, figure in FIGURES.items():
         assert file.endswith(".png") and figure.description
@@ -73,6 +74,9 @@ NOTEBOOK = textwrap.dedent("""
                                                   t_solar_p90_h=year.table.t_solar_h + 0.1), "t"),
         "plot_world_map": (sites, "gain_vs_flat_pct", "t", "gain [%]", True),
         "plot_latitude_load": (sites, "year", True, "t"),
+        "plot_sun_paths": ({"dates": ["2025-06-21"], "azimuth": np.array([[90.0, 180.0, 270.0]]),
+                            "elevation": np.array([[10.0, 60.0, 10.0]]), "horizon_azimuth": np.array([0.0, 180.0]),
+                            "horizon_elevation": np.array([20.0, 5.0]), "hidden_pct": 12.0}, "t"),
     }
     drawn = []
     for name, args in calls.items():
