@@ -31,22 +31,21 @@ import csv
 import io
 import json
 import math
-import os
 import re
-import stat
 from numbers import Real
 from pathlib import Path
 
 import numpy as np
 
 from foldopt.errors import ConfigError
+from foldopt.inputs.reading import read_input, size_limit
 
 FIELD = "site.horizon"
 #: What a horizon file may be, for the messages.
 ACCEPTS = ("a horizon file is PVGIS printhorizon JSON, PVGIS horizon CSV (columns A and H_hor) or a CSV with "
            "the header azimuth,elevation [deg]")
 #: Bytes of a horizon file: PVGIS's are some 5 kB; a profile every 0.01 deg is under 1 MB.
-MAX_HORIZON_BYTES = 1_000_000
+MAX_HORIZON_BYTES = size_limit("MAX_HORIZON_BYTES", 1_000_000)
 #: Longest value quoted back in a message [characters].
 _QUOTE = 40
 
@@ -127,34 +126,6 @@ def horizon_profile(pairs) -> tuple[np.ndarray, np.ndarray]:
         return _checked(pairs, [])
     pairs = list(pairs)
     return _checked(pairs, [f"point {k}" for k in range(1, len(pairs) + 1)])
-
-
-def _read_text(path: Path) -> str:
-    """The file's text, read as :func:`foldopt.inputs.load.read_input` reads (which imports this
-    module, so that it cannot be imported here): no device or FIFO, a size limit, UTF-8."""
-    try:
-        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-        with os.fdopen(descriptor, "rb") as handle:
-            info = os.fstat(handle.fileno())
-            if stat.S_ISDIR(info.st_mode):
-                raise _Problem(f"{path} is a folder; give a file")
-            if not stat.S_ISREG(info.st_mode):
-                raise _Problem(f"{path} is not a regular file; give a file")
-            data = b"" if info.st_size > MAX_HORIZON_BYTES else handle.read(MAX_HORIZON_BYTES + 1)
-    except FileNotFoundError:
-        raise _Problem(f"file not found: {path}") from None
-    except IsADirectoryError:
-        raise _Problem(f"{path} is a folder; give a file") from None
-    except OSError as error:
-        raise _Problem(f"cannot read {path}: {error.__class__.__name__}") from None
-    if info.st_size > MAX_HORIZON_BYTES or len(data) > MAX_HORIZON_BYTES:
-        raise _Problem(f"{path} is over {MAX_HORIZON_BYTES:,} bytes")
-    if b"\x00" in data:
-        raise _Problem(f"{path} is binary, not text")
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as error:
-        raise _Problem(f"cannot read {path}: not UTF-8 text (byte {error.start + 1:,})") from None
 
 
 class _Problem(Exception):
@@ -266,7 +237,12 @@ def read_horizon(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """
     path = Path(path)
     try:
-        text = _read_text(path)
+        try:
+            text = read_input(path, FIELD, MAX_HORIZON_BYTES, "MAX_HORIZON_BYTES")
+        except ConfigError as error:
+            raise _Problem(error.errors[0].removeprefix(f"{FIELD}: ")) from None
+        if "\x00" in text:
+            raise _Problem(f"{path} is binary, not text")
         if not text.strip():
             raise _Problem(f"{path} is empty")
         if text.lstrip().startswith("{"):

@@ -20,7 +20,8 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
-from foldopt.inputs.load import read_study, resolve_files, size_limit
+from foldopt.inputs.load import read_study, resolve_files
+from foldopt.inputs.reading import size_limit
 from foldopt.inputs.weather_files import weather_defaults
 from foldopt.inputs.policy import set_path
 from foldopt.inputs.study import Study, format_error

@@ -16,7 +16,7 @@ from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
 from foldopt.inputs.horizon import read_horizon
-from foldopt.inputs.load import MAX_CSV_BYTES, read_input
+from foldopt.inputs.reading import MAX_CSV_BYTES, read_input
 from foldopt.inputs.sections import Site
 from foldopt.inputs.study import format_errors
 
@@ -67,7 +67,7 @@ def read_sites(path: Path | str) -> list[dict]:
     Parameters
     ----------
     path : str or pathlib.Path
-        The CSV file, at most :data:`foldopt.inputs.load.MAX_CSV_BYTES`.
+        The CSV file, at most :data:`foldopt.inputs.reading.MAX_CSV_BYTES`.
 
     Returns
     -------
