@@ -3,8 +3,10 @@ physical identities of the horizon."""
 
 import numpy as np
 import pvlib
+import pytest
 
 import foldopt
+from foldopt.engine.cells import electrical_for
 from foldopt.engine.rows import poa
 from foldopt.engine.sky import build_sky
 
@@ -54,3 +56,36 @@ def test_flat_horizon_is_none():
     flat = foldopt.run(_study(site={"horizon": [[0, 0], [180, 0]]}), engine="numba")
     columns = plain.sweep.select_dtypes("number").columns
     assert np.array_equal(plain.sweep[columns].to_numpy(), flat.sweep[columns].to_numpy())
+
+
+def _direct(load_voltage, **changes):
+    return _study(panel={"area": 0.3}, p_load=3.0, connection="parallel", exact_electrical=True,
+                  circuit={"coupling": "direct", "load_voltage": load_voltage,
+                           "blocking_diode": {"model": "constant", "forward_voltage": 0.45}}, **changes)
+
+
+def test_flat_panel_for_a_direct_load_is_the_unfolded_pair():
+    """A 180 deg fold is the flat panel: wired for a 5 V load its halves are in parallel, behind the
+    same blocking diodes, so the flat row and the twofold panel at 180 deg in parallel agree."""
+    answer = foldopt.run(_direct(5.0))
+    flat = answer.summary.set_index("design").loc["flat"]
+    unfolded = answer.sweep.set_index("fold_angle_deg").loc[180.0]
+    assert flat["t_solar_h"] == pytest.approx(unfolded["t_solar_parallel_h"], rel=1e-12)
+    assert flat["energy_harvested_wh"] == pytest.approx(unfolded["energy_harvested_parallel_wh"], rel=1e-12)
+
+
+@pytest.mark.parametrize(("load_voltage", "wiring"), [(5.0, "parallel"), (9.0, "series")])
+def test_flat_panel_is_wired_for_its_load(load_voltage, wiring):
+    """At STC the flat panel delivers the better of its halves in parallel behind the diodes'
+    0.45 V drop and its one string, each from pvlib's i_from_v at the load's voltage."""
+    study = _direct(load_voltage).resolved()
+    electrical = electrical_for(study, study.temp_air, study.wind_speed)
+    poa_stc = np.array([1000.0])
+    temp = electrical._temperature(poa_stc)
+    half = electrical.pv.curves(poa_stc, temp, study.panel.area / 2)
+    whole = electrical.pv.curves(poa_stc, temp, study.panel.area)
+    current = [np.clip(pvlib.pvsystem.i_from_v(v, *curve.params), 0.0, None)[0]
+               for curve, v in ((half, load_voltage + 0.45), (whole, load_voltage))]
+    parallel, series = 2 * load_voltage * current[0], load_voltage * current[1]
+    assert electrical.flat_wiring == wiring == ("parallel" if parallel > series else "series")
+    assert electrical.panel_power(poa_stc, study.panel.area)[0] == pytest.approx(max(parallel, series), rel=1e-9)

@@ -45,6 +45,26 @@ def test_axes_from_lists_ranges_and_the_sweep_section():
     assert [s.site.name for _, s in plan.cases()] == [None, "b"]
 
 
+def test_a_list_valued_field_holds_its_list_and_a_list_of_them_is_an_axis():
+    # A horizon's points, a converter's curve and an objective's months are lists themselves: only a
+    # list of such lists sweeps them (a list of horizon files too).
+    canyon, ridge = [[0, 30], [180, 20]], [[90, 10], [270, 10]]
+    curve = [[0.1, 0.9], [1.0, 0.95]]
+    data = {**BASE, "mode": "exact", "pv_model": "single-diode", "date": "2025-03-18:2025-03-22:1",
+            "site": {**BASE["site"], "horizon": canyon}, "objective": {"statistic": "mean", "months": [3]},
+            "circuit": {"converter": {"model": "curve", "curve": curve}}}
+    plan = make_plan(data)
+    assert [path for path, _ in plan.axes] == ["date"]
+    study = plan.study({"date": dt.date(2025, 3, 20)})
+    assert study.site.horizon.points == [tuple(point) for point in canyon]
+    assert study.objective.months == [3] and study.circuit.converter.curve == [tuple(p) for p in curve]
+    plan = make_plan({**data, "site": {**BASE["site"], "horizon": [canyon, ridge]},
+                      "objective": {"statistic": "mean", "months": [[3], [3, 4]]}})
+    assert dict(plan.axes)["site.horizon"] == (canyon, ridge) and dict(plan.axes)["objective.months"] == ([3], [3, 4])
+    with pytest.raises(ConfigError, match=r"site.horizon\[1\] = \[\[0, 95\]\]: point 1: elevation 95"):
+        make_plan({**data, "site": {**BASE["site"], "horizon": [canyon, [[0, 95]]]}})
+
+
 def test_all_errors_at_once_with_their_yaml_lines(tmp_path):
     path = tmp_path / "bad.yaml"
     path.write_text(

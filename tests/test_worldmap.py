@@ -144,3 +144,22 @@ def test_sites_csv(tmp_path):
     header.write_text("site,lat,lon\nA,1,2\n")
     with pytest.raises(ConfigError, match="missing latitude, longitude; unknown site, lat, lon"):
         read_sites(header)
+
+
+def test_a_sites_horizon_column_names_each_sites_file(tmp_path):
+    """A horizon of 0 deg all round is no horizon; one at 89 deg all round hides the sun all year, so
+    every design is left with the sky's sliver and the ground's light: less t_solar, less energy."""
+    (tmp_path / "flat.csv").write_text("azimuth,elevation\n0,0\n180,0\n")
+    (tmp_path / "walls.csv").write_text("azimuth,elevation\n0,89\n120,89\n240,89\n")
+    table = tmp_path / "sites.csv"
+    table.write_text("name,latitude,longitude,timezone,horizon\nopen,34.05,-118.25,America/Los_Angeles,\n"
+                     "flat,34.05,-118.25,America/Los_Angeles,flat.csv\n"
+                     "walls,34.05,-118.25,America/Los_Angeles,walls.csv\n")
+    sites = read_sites(table)
+    assert "horizon" not in sites[0] and tuple(sites[2]["horizon"]["points"][0]) == (0.0, 89.0)
+    rows = evaluate_sites(COARSE, sites, [1.0]).set_index(["site_name", "period"]).drop(columns="site_id")
+    numbers = rows.select_dtypes("number").columns
+    assert np.array_equal(rows.loc["open", numbers].to_numpy(), rows.loc["flat", numbers].to_numpy())
+    hidden = [f"{kind}_{design}_{unit}" for kind, unit in (("mean_t_solar", "h"), ("energy_harvested", "wh"))
+              for design in ("flat", "twofold", "tracker")]
+    assert (rows.loc["walls", hidden] < rows.loc["open", hidden]).all().all()

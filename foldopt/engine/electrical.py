@@ -23,6 +23,7 @@ is skipped.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from dataclasses import dataclass
 
@@ -39,7 +40,7 @@ IRRADIANCE_MAX = 1500.0  # [W/m^2], top of the tables; clear-sky beam stays belo
 TABLE_NODES_1D = 1025
 TABLE_NODES_2D = 161
 TABLE_NODES_RATIO = 321
-TABLE_FORMAT = 5  # bump when the way tables are built changes
+TABLE_FORMAT = 6  # bump when the way tables are built changes
 
 
 def _nodes(count):
@@ -168,9 +169,10 @@ class Electrical:
                 temp_cell = self._temperature(g1)
                 if name == "subpanel":
                     power = self.pv.max_power(g1, temp_cell, self.subpanel_area)
+                elif name == "alone":
+                    power = alone_power(self.circuit, self.pv.curves(g1, temp_cell, self.subpanel_area))
                 else:
-                    area = self.subpanel_area * (2.0 if name == "panel" else 1.0)
-                    power = alone_power(self.circuit, self.pv.curves(g1, temp_cell, area))
+                    power = self._flat_direct(g1, temp_cell)
                 self._tables[name] = (g1, power)
             else:
                 self._tables[name] = self._pair_table(name)
@@ -243,9 +245,9 @@ class Electrical:
         return _linear(p1, _node_position(poa, TABLE_NODES_1D)) * (area / self.subpanel_area)
 
     def panel_power(self, poa, area):
-        """Power the whole flat panel (the twofold panel's two sub-panels as one, in series)
-        delivers to the load: its maximum power, as built through the converter, or at the load's
-        voltage with direct coupling.
+        """Power the whole flat panel (the twofold panel's two sub-panels as one) delivers to the
+        load: its maximum power, as built through the converter, or at the load's voltage with
+        direct coupling, its halves wired as :attr:`flat_wiring`.
 
         Parameters
         ----------
@@ -271,13 +273,41 @@ class Electrical:
         poa = np.asarray(poa, dtype=float)
         if not self.circuit.direct or not self.pv.has_iv:
             return self.max_power(poa, area)
-        if self.exact:
-            return alone_power(self.circuit, self.pv.curves(poa, self._temperature(poa), area))
         if not np.isclose(area, 2.0 * self.subpanel_area):
             raise ValueError(f"the direct-coupled panel's table is of area {2.0 * self.subpanel_area:g} m^2, "
                              f"not {area:g}")
+        if self.exact:
+            return self._flat_direct(poa, self._temperature(poa))
         _, p1 = self._table("panel")
         return _linear(p1, _node_position(poa, TABLE_NODES_1D))
+
+    @functools.cached_property
+    def flat_wiring(self) -> str | None:
+        """How the flat panel's two halves are wired for a direct-coupled load: ``'series'`` (one
+        string of all its cells) or ``'parallel'`` (behind the blocking diodes), whichever delivers
+        more at the load's voltage at STC (1000 W/m^2, the study's cell temperature); None behind a
+        converter, where the flat panel is one string at its maximum power point.
+
+        A designer wires a panel for its load: one string of the whole panel works at twice the
+        sub-panel's voltage, so at a sub-panel's voltage it would deliver about half its power and
+        flatter the twofold panel.
+        """
+        if self.circuit is None or not self.circuit.direct or not self.pv.has_iv:
+            return None
+        stc = np.array([1000.0])
+        return "parallel" if (self._flat_wired(stc, self._temperature(stc), "parallel")
+                              > self._flat_wired(stc, self._temperature(stc), "series"))[0] else "series"
+
+    def _flat_wired(self, poa, temp_cell, wiring):
+        half = self.pv.curves(poa, temp_cell, self.subpanel_area)
+        if wiring == "parallel":
+            return pair_power(self.circuit, "parallel", half, half, self.bypass, False)
+        # Equal halves in series are the whole panel's string (units in series): no bypass diode conducts.
+        return alone_power(self.circuit, self.pv.curves(poa, temp_cell, 2.0 * self.subpanel_area))
+
+    def _flat_direct(self, poa, temp_cell):
+        """The flat panel's power at the load's voltage, wired as :attr:`flat_wiring` [W]."""
+        return self._flat_wired(poa, temp_cell, self.flat_wiring)
 
     def parts(self, poa_east, poa_west, series: bool = True) -> dict:
         """The panel side of the circuit as built (:data:`foldopt.engine.built.PARTS`), exact or

@@ -115,8 +115,8 @@ class ConverterSpec(StrictModel):
     @model_validator(mode="after")
     def _curve_given(self):
         if self.model == "curve" and self.curve is None:
-            raise ValueError("model curve: give curve, [input power / rating, efficiency] points, e.g. "
-                             "[[0.1, 0.90], [0.5, 0.95], [1.0, 0.94]]")
+            raise ValueError("model curve: give its points, circuit.converter.curve = [[input power / rating, "
+                             "efficiency], ...], e.g. [[0.1, 0.90], [0.5, 0.95], [1.0, 0.94]]")
         if self.curve is not None and any(b[0] <= a[0] for a, b in zip(self.curve, self.curve[1:])):
             raise ValueError("curve: the input fractions must increase from point to point")
         return self
@@ -166,10 +166,10 @@ class Circuit(StrictModel):
     @model_validator(mode="after")
     def _coupled(self):
         if self.coupling == "direct" and self.load_voltage is None:
-            raise ValueError("circuit.coupling = 'direct': give the load's voltage, circuit.load_voltage (e.g. 5)")
+            raise ValueError("coupling 'direct': give the load's voltage, circuit.load_voltage (e.g. 5)")
         if self.coupling == "direct" and self.converter.model != "ideal":
-            raise ValueError(f"circuit.converter.model = {self.converter.model!r}: a direct-coupled load has no "
-                             f"converter; leave circuit.converter out or set coupling mppt")
+            raise ValueError(f"converter {self.converter.model!r} with coupling 'direct': a direct-coupled load has "
+                             f"no converter; leave circuit.converter out, or set circuit.coupling mppt")
         return self
 
     @property

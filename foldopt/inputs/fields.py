@@ -5,6 +5,8 @@ what a study's files hold (:class:`FilesRead`), which the models judge and never
 from __future__ import annotations
 
 import math
+import types
+import typing
 from dataclasses import dataclass
 from functools import partial
 from typing import Annotated
@@ -119,3 +121,59 @@ class StrictModel(BaseModel):
     """A frozen model that refuses unknown fields: the base of a study and its parts."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def _unwrapped(annotation):
+    return _unwrapped(typing.get_args(annotation)[0]) if typing.get_origin(annotation) is Annotated else annotation
+
+
+def _union(annotation) -> tuple:
+    annotation = _unwrapped(annotation)
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        return tuple(_unwrapped(member) for member in typing.get_args(annotation))
+    return (annotation,)
+
+
+def _list_depth(annotation) -> int:
+    """How deep lists nest in a type: 2 for ``list[tuple[float, float]] | None``, 0 for a number."""
+    depths = [1 + max((_list_depth(item) for item in typing.get_args(member) if item is not Ellipsis), default=0)
+              for member in _union(annotation) if typing.get_origin(member) in (list, tuple)]
+    return max(depths, default=0)
+
+
+def list_valued_fields(model: type[BaseModel], prefix: str = "") -> dict[str, int]:
+    """The dotted paths of a model's fields whose value is itself a list, with the lists' depth.
+
+    A study's list is a sweep axis (:mod:`foldopt.inputs.plan`) except in these fields, where a
+    list as deep as the field's type is the value (``site.horizon: [[0, 10], [180, 20]]``,
+    ``objective.months: [6, 7, 8]``) and only a list of such values is an axis. A model that takes
+    a bare list as the shorthand of one of its fields names it in ``LIST_SHORTHAND``.
+
+    Parameters
+    ----------
+    model : type of pydantic.BaseModel
+    prefix : str
+        The model's own path, with its trailing dot.
+
+    Returns
+    -------
+    dict of str to int
+    """
+    depths = {}
+    for name, field in model.model_fields.items():
+        path = f"{prefix}{name}"
+        if depth := _list_depth(field.annotation):
+            depths[path] = depth
+        for member in _union(field.annotation):
+            if isinstance(member, type) and issubclass(member, BaseModel):
+                inner = list_valued_fields(member, f"{path}.")
+                depths.update(inner)
+                shorthand = getattr(member, "LIST_SHORTHAND", None)
+                if shorthand is not None:
+                    depths[path] = inner[f"{path}.{shorthand}"]
+    return depths
+
+
+def list_depth(value) -> int:
+    """How deep lists nest in a value: 2 for ``[[0, 10], [180, 20]]``, 0 for a number."""
+    return 1 + list_depth(value[0]) if isinstance(value, list) and value else int(isinstance(value, list))

@@ -7,6 +7,8 @@ The model opens no file: a horizon file is read by :func:`foldopt.inputs.load.re
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 from pydantic import ValidationInfo, model_validator
 
 from foldopt.inputs.horizon import horizon_profile
@@ -29,6 +31,8 @@ class Horizon(StrictModel):
         writes it) or a CSV with the header ``azimuth,elevation``; its points become ``points``
         where its loader read it (a file's site given with both holds the file's points).
     """
+
+    LIST_SHORTHAND: ClassVar[str] = "points"  # foldopt.inputs.fields.list_valued_fields
 
     points: list[tuple[float, float]] | None = None
     file: str | None = None

@@ -20,6 +20,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
+from foldopt.inputs.fields import list_depth, list_valued_fields
 from foldopt.inputs.load import read_study, resolve_files
 from foldopt.inputs.reading import size_limit
 from foldopt.inputs.weather_files import weather_defaults
@@ -29,6 +30,7 @@ from foldopt.inputs.study import Study, format_error
 DATE_KEYWORDS = ("year", "equinoxes-solstices")
 #: Fields that label a study rather than design it: a list of them is no sweep.
 UNSWEPT = ("name", "description")
+_LIST_VALUED = list_valued_fields(Study)
 
 #: Values of one sweep axis (a range or a list).
 MAX_AXIS_VALUES = size_limit("MAX_AXIS_VALUES", 10_000)
@@ -271,13 +273,17 @@ class Plan:
 
 
 def _listed_leaves(data: dict, prefix: str = ""):
-    """Dotted paths holding a list, a numeric ``start:stop:step`` range or a date keyword."""
+    """Dotted paths holding a list (but a list-valued field's own value,
+    :func:`foldopt.inputs.fields.list_valued_fields`), a numeric ``start:stop:step`` range or a
+    date keyword."""
     for key, value in data.items():
         path = f"{prefix}{key}"
         if path == "date" and (isinstance(value, list) or value in DATE_KEYWORDS or (
             isinstance(value, str) and _RANGE.match(value)
         )):
             yield path, value
+        elif isinstance(value, list) and list_depth(value) == _LIST_VALUED.get(path):
+            continue
         elif isinstance(value, list) or (isinstance(value, str) and _NUMERIC_RANGE.match(value)):
             yield path, value
         elif isinstance(value, dict):
@@ -372,7 +378,7 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     for path, values in axes:
         source, yaml_path, _ = specs[path]
         for index, value in enumerate(values[1:], start=1):
-            where = {path: (f"{source}[{index}]", yaml_path + (index,))}
+            where = {**labels, path: (f"{source}[{index}]", yaml_path + (index,))}
             errors += _validation_errors(plan, {**first, path: value}, lines, where)
     if errors:
         raise ConfigError(_collapse(list(dict.fromkeys(errors))))
@@ -433,7 +439,8 @@ def _validation_errors(plan: Plan, choice: dict, lines: dict, where: dict) -> li
                 for path, (label, yaml_path) in where.items():
                     if ".".join(loc).startswith(path):
                         message = message.replace(".".join(loc), label, 1)
-                        loc = yaml_path
+                        loc = tuple(str(part) for part in yaml_path)
+                        break
                 messages.append(_at(lines, loc, message))
         return messages
     return []

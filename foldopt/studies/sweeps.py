@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import itertools
+import json
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -366,6 +367,10 @@ def _case(site, date, choice: dict) -> dict:
 
 
 def _plain(value):
+    """A case's value as a table cell: a date in ISO form, a section (``circuit: [{...}, ...]``) as
+    compact JSON, which a CSV reader can parse back."""
+    if isinstance(value, (dict, list, tuple)):
+        return json.dumps(value, separators=(", ", ": "), default=str)
     return value.isoformat() if hasattr(value, "isoformat") else value
 
 
