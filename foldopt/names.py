@@ -110,6 +110,10 @@ CONVERTER_MODELS = Registry("converter model", {
 COUPLINGS = Registry("coupling", {
     "mppt": "a maximum-power-point converter between the panel and the load",
     "direct": "the load wired to the panel, at the load's own voltage (no converter)"})
+OPTIMIZE_VARIABLES = Registry("variable", {
+    "fold_angle": "the dihedral angle between the sub-panels [deg] (180 is flat)",
+    "tilt": "the base tilt of the unfolded panel [deg from horizontal]",
+    "azimuth": "the base azimuth of the unfolded panel [deg clockwise from north]"})
 TRACKERS = Registry("tracker", {
     "dual-axis": "ideal: the normal always on the sun (Shin et al. Sec. IV-A)",
     "equatorial": "a polar daily axis following the hour angle, the seasonal axis set daily (Alexandru)",
@@ -154,7 +158,7 @@ OUTPUT_FORMATS = Registry("format", {
 #: Every registry, in the order the docs list them.
 REGISTRIES = (MODES, GEOMETRIES, SKIES, TRANSPOSITIONS, IAMS, PV_MODELS, TEMPERATURE_MODELS, CONNECTIONS,
               CONVERTER_MODELS, COUPLINGS, TRACKERS, DRIVES, WEATHER_FORMATS, DECOMPOSITIONS, INTERVAL_LABELS,
-              HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS, DIODE_MODELS)
+              HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS, DIODE_MODELS, OPTIMIZE_VARIABLES)
 
 #: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.physics.trackers).
 #: His 12 actuating times (local time) pair up symmetrically about 13.319 h: 8.839/17.799,

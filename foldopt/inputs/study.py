@@ -21,6 +21,7 @@ from foldopt.errors import ConfigError
 from foldopt.inputs import policy
 from foldopt.inputs.circuit_section import Circuit
 from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
+from foldopt.inputs.optimize_section import Optimize
 from foldopt.inputs.sections import FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site, Tracker
 from foldopt.inputs.weather_section import Weather
 
@@ -164,6 +165,8 @@ class Study(StrictModel):
     bypass_diodes: bool = True
     converter_efficiency: interval(0, 1, lo_open=True) = 1.0
     circuit: Circuit = Field(Circuit(), description="diodes, converter, coupling and switch as built; default ideal")
+    optimize: Optimize | None = Field(None, description="the fold angle, tilt and azimuth optimised together "
+                                                       "(foldopt optimize)")
     temperature_model: named(names.TEMPERATURE_MODELS) | None = Field(
         None, description="default fixed (cells at temp_air) in paper mode, sapm in exact"
     )
@@ -289,7 +292,8 @@ class Study(StrictModel):
         idle = [f"{name} = {getattr(self, name)!r}: {why}" for name, used, why in rules
                 if not used and getattr(self, name) not in _as_tuple(defaults[name])]
         circuit = self.circuit.idle_settings(self.connection, series_used and self.bypass_diodes, iv_model)
-        return idle + circuit + self.tracker.idle_settings()
+        optimize = self.optimize.idle_settings() if self.optimize is not None else []
+        return idle + circuit + self.tracker.idle_settings() + optimize
 
     def sky_transposition(self) -> str:
         """The diffuse model in force.

@@ -406,3 +406,59 @@ def daily_designs(parts, loads, engine: str = "numba") -> DailyDesigns:
     return DailyDesigns(angles, np.concatenate(twofold).transpose(0, 2, 1), np.concatenate(harvest),
                         np.concatenate(flat), np.concatenate(flat_energy), gross_h, net_h, gross_wh,
                         np.concatenate(available))
+
+
+def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba") -> np.ndarray:
+    """Each day's t_solar [h] of arbitrary designs: a fold angle, base tilt and base azimuth each,
+    for the search of :func:`foldopt.studies.joint.optimize_plan`.
+
+    Parameters
+    ----------
+    parts : sequence of (Blocks, Sky)
+        Chunks of days (:meth:`Blocks.chunks`) with their skies.
+    points : array_like
+        (n, 3) fold angle, base tilt, base azimuth [deg] (the azimuth taken modulo 360).
+    loads : array_like
+        (n_loads,) [W].
+    flat : bool
+        The flat panel (the fold angle unused) with no connection: as the ``flat`` design.
+    engine : {'numba', 'numpy'}
+
+    Returns
+    -------
+    numpy.ndarray
+        (days, n, n_loads).
+    """
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    loads = np.asarray(loads, dtype=float)
+    study = parts[0][0].study
+    tilt, azimuth = points[:, 1], points[:, 2] % 360.0
+    if flat:
+        orientation, output = engines.flat_orientation(tilt, azimuth), "panel"
+    else:
+        orientation, output = _orientations(study, points[:, 0], tilt, azimuth), study.connection
+    days = []
+    for _, sky in parts:
+        per_chunk = max(1, CHUNK_ROW_LOADS // max(sky.n_blocks * loads.size, 1))
+        hours = np.empty((sky.n_blocks, points.shape[0], loads.size))
+        for start in range(0, points.shape[0], per_chunk):
+            piece = slice(start, min(start + per_chunk, points.shape[0]))
+            count = piece.stop - piece.start
+            rows = np.repeat(np.arange(sky.n_blocks), count)
+            metrics = engines.row_metrics(sky, study, rows, np.tile(orientation[piece], (sky.n_blocks, 1)), loads,
+                                          outputs=(output,), engine=engine)
+            hours[:, piece] = metrics.t_solar[:, 0].reshape(sky.n_blocks, count, loads.size)
+        days.append(hours)
+    return np.concatenate(days)
+
+
+def _orientations(study: Study, fold_angle, tilt, azimuth) -> np.ndarray:
+    """(n, 4) the sub-panels' orientation of each design: one geometry call per distinct base."""
+    bases = np.stack([tilt, azimuth], axis=-1)
+    unique, inverse = np.unique(bases, axis=0, return_inverse=True)
+    inverse = np.ravel(inverse)
+    orientation = np.empty((fold_angle.size, 4))
+    for index, (base_tilt, base_azimuth) in enumerate(unique):
+        take = inverse == index
+        orientation[take] = engines.fold_orientations(study, [base_tilt], [base_azimuth], fold_angle[take])[0]
+    return orientation

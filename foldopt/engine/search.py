@@ -1,0 +1,275 @@
+"""A coarse-to-fine search of a box grid for the maximum of an objective, with a bound on what it
+can miss.
+
+The designs of a panel (fold angle, base tilt, base azimuth: any of them) form a box grid, each
+variable from its lower to its upper bound at its resolution (:class:`Axis`). A brute-force sweep
+evaluates every point; :func:`grid_search` evaluates a coarse lattice of the grid and then, level by
+level, halves the lattice's stride only inside the cells that may still hold a better point.
+
+The argument. On a level of stride ``s_i`` grid steps along axis ``i``, the grid is cut into boxes
+whose corners are lattice points, at most ``s_i`` apart (``h_i = s_i step_i`` in the variable's
+units), and every corner is evaluated. Inside a box the multilinear interpolant of the corners
+never exceeds the largest corner, and a function whose second derivative along axis ``i`` is at
+most ``M_i`` departs from that interpolant by at most ``sum_i M_i h_i^2 / 8`` (the error of
+tensor-product linear interpolation); t_solar, counted in whole time steps, also jumps by up to
+``quantum``. So every grid point ``q`` of the box has
+
+    f(q) <= max(f(corners)) + sum_i M_i h_i^2 / 8 + quantum.
+
+A box is dropped only when that bound lies below the best value found so far plus the
+``tolerance``: it cannot hold a point better than the best by more than the tolerance, and the
+best only grows. A tolerance below ``quantum`` is raised to it: the objective cannot tell designs
+apart more finely than its own jumps (for one day's t_solar, one time step). Kept boxes are halved
+along every axis and their new corners evaluated; at stride 1 a box has no grid point but its
+corners, so every grid point was either evaluated or lies in a dropped box. ``M_i`` is not known
+in advance: each level estimates it from the second differences at the box's corners on that
+level's lattice (the largest anywhere along the axis where none is evaluated), times ``safety``
+(default 2). The guarantee is as good as that estimate: a peak narrower than the coarse lattice
+can hide between its points. Curvature, not slope, bounds a box, so the steep flanks of the
+objective (t_solar against a small fold angle) are dropped at once and only the broad plateau
+is refined. ``tests/test_search.py`` holds the answer to the brute-force grid on random sites,
+days, loads and objectives.
+
+Every level's points go to ``evaluate`` in one call, so the caller vectorises across the points and
+its own targets (loads, objectives): the search keeps the union of the cells any target keeps.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Points of the coarse lattice along each axis, at least (the stride is a power of two).
+COARSE_POINTS = 7
+#: The factor on each level's estimate of the objective's change per unit.
+SAFETY = 2.0
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One variable of the search: ``lo`` to ``hi`` by ``step``, always ending on ``hi`` (as
+    :meth:`foldopt.inputs.sections.FoldAngles.grid` does).
+
+    Parameters
+    ----------
+    name : str
+    lo, hi, step : float
+        Bounds and resolution in the variable's units; ``step > 0``, ``hi >= lo``.
+    """
+
+    name: str
+    lo: float
+    hi: float
+    step: float
+
+    @property
+    def size(self) -> int:
+        steps = math.floor((self.hi - self.lo) / self.step + 1e-9)
+        return steps + 1 + (not math.isclose(self.lo + steps * self.step, self.hi, abs_tol=1e-9))
+
+    def values(self, index=None) -> np.ndarray:
+        """The grid's values [units], all or at integer ``index``."""
+        index = np.arange(self.size) if index is None else np.asarray(index)
+        return np.where(index == self.size - 1, self.hi, np.round(self.lo + self.step * index, 12))
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """What :func:`grid_search` evaluated and found.
+
+    Attributes
+    ----------
+    axes : tuple of Axis
+    index : numpy.ndarray of int
+        (n_evaluated, n_axes) grid indices of every evaluated point, in order of evaluation.
+    values : numpy.ndarray
+        (n_evaluated, n_targets) the objective there.
+    best : numpy.ndarray of int
+        (n_targets,) row of ``index`` of each target's best point.
+    levels : tuple of (int, int)
+        Per level, the largest stride and the points evaluated.
+    tolerance : float
+        What the search may have missed above its best, in the objective's units.
+    """
+
+    axes: tuple
+    index: np.ndarray
+    values: np.ndarray
+    best: np.ndarray
+    levels: tuple
+    tolerance: float = 0.0
+
+    @property
+    def points(self) -> np.ndarray:
+        """(n_evaluated, n_axes) every evaluated point in the variables' units."""
+        return np.stack([axis.values(self.index[:, i]) for i, axis in enumerate(self.axes)], axis=-1)
+
+    @property
+    def best_point(self) -> np.ndarray:
+        """(n_targets, n_axes) each target's best point."""
+        return self.points[self.best]
+
+    @property
+    def best_value(self) -> np.ndarray:
+        """(n_targets,) each target's best value."""
+        return self.values[self.best, np.arange(self.best.size)]
+
+    @property
+    def grid_size(self) -> int:
+        """Points of the full grid, what a brute-force sweep evaluates."""
+        return int(np.prod([axis.size for axis in self.axes]))
+
+
+def _best_rows(index, values):
+    """Each target's best row; ties go to the largest indices (least folded, ...), as
+    :func:`foldopt.studies.objectives.best_angle_index` breaks them on one axis."""
+    order = np.lexsort(index.T[::-1])  # ascending in the first axis, then the next...
+    ranked = values[order]
+    last = ranked.shape[0] - 1 - np.argmax(ranked[::-1], axis=0)
+    return order[last]
+
+
+def grid_search(evaluate: Callable[[np.ndarray], np.ndarray], axes, tolerance: float, quantum: float = 0.0,
+                safety: float = SAFETY, coarse_points: int = COARSE_POINTS, seeds=None) -> SearchResult:
+    """The best point of a box grid for each target, coarse to fine (the module's argument).
+
+    Parameters
+    ----------
+    evaluate : callable
+        Maps points, (n, n_axes) in the variables' units, to the objective, (n, n_targets).
+    axes : sequence of Axis
+    tolerance : float
+        What a dropped box may hold above the best, in the objective's units (>= 0); at least
+        ``quantum`` (:attr:`SearchResult.tolerance` is the one used).
+    quantum : float, default 0
+        The objective's own jumps (t_solar's time step over the days it counts).
+    safety : float, default :data:`SAFETY`
+    coarse_points : int, default :data:`COARSE_POINTS`
+    seeds : array_like, optional
+        (k, n_axes) points [units] evaluated first, snapped to the grid: a known good design (the
+        optimum of fewer variables) keeps the best from falling below it.
+
+    Returns
+    -------
+    SearchResult
+    """
+    axes = tuple(axes)
+    tolerance = max(float(tolerance), float(quantum))
+    sizes = np.array([axis.size for axis in axes])
+    steps = np.array([axis.step for axis in axes])
+    strides = np.array([1 << max(0, int(math.floor(math.log2(max(1.0, (n - 1) / (coarse_points - 1))))))
+                        for n in sizes])
+    store = _Store(evaluate, axes, sizes)
+    # The coarse lattice, each axis's last grid point included so the bounds are evaluated.
+    lattice = [np.union1d(np.arange(0, n, s), [n - 1]) for n, s in zip(sizes, strides, strict=True)]
+    store.add(np.stack(np.meshgrid(*lattice, indexing="ij"), axis=-1).reshape(-1, len(axes)))
+    if seeds is not None:
+        store.add(np.stack([np.clip(np.rint((np.asarray(seeds, float)[:, i] - a.lo) / a.step), 0, a.size - 1)
+                            for i, a in enumerate(axes)], axis=-1).astype(int))
+    levels = [(int(strides.max()), store.count)]
+    # Boxes by their lower and upper corners: consecutive lattice points along every axis.
+    edges = [(points[:-1], points[1:]) if points.size > 1 else (points, points) for points in lattice]
+    lower = np.stack(np.meshgrid(*[low for low, _ in edges], indexing="ij"), axis=-1).reshape(-1, len(axes))
+    upper = np.stack(np.meshgrid(*[high for _, high in edges], indexing="ij"), axis=-1).reshape(-1, len(axes))
+    while strides.max() > 1:
+        before = store.count
+        best = store.best_values()
+        bound = _box_bounds(store, lower, upper, strides, steps, sizes, safety) + quantum
+        keep = np.any(bound >= best + tolerance, axis=1)
+        strides = np.maximum(strides // 2, 1)
+        lower, upper = _split(lower[keep], upper[keep], strides)
+        corners = _corners(lower, upper)
+        store.add(np.unique(corners.reshape(-1, len(axes)), axis=0))
+        levels.append((int(strides.max()), store.count - before))
+    return SearchResult(axes, store.index, store.values, _best_rows(store.index, store.values), tuple(levels),
+                        tolerance)
+
+
+class _Store:
+    """The evaluated points by grid index, looked up by their flat key."""
+
+    def __init__(self, evaluate, axes, sizes):
+        self.evaluate, self.axes, self.sizes = evaluate, axes, sizes
+        self.index = np.zeros((0, len(axes)), dtype=int)
+        self.values = None
+        self.keys = np.zeros(0, dtype=np.int64)
+
+    @property
+    def count(self) -> int:
+        return int(self.index.shape[0])
+
+    def add(self, index):
+        """Evaluate the points of ``index`` not evaluated yet."""
+        keys = np.ravel_multi_index(index.T, self.sizes)
+        keys, first = np.unique(keys, return_index=True)
+        new = ~np.isin(keys, self.keys)
+        if not new.any():
+            return
+        index = index[first[new]]
+        points = np.stack([axis.values(index[:, i]) for i, axis in enumerate(self.axes)], axis=-1)
+        found = np.asarray(self.evaluate(points), dtype=float).reshape(index.shape[0], -1)
+        self.index = np.vstack([self.index, index])
+        self.values = found if self.values is None else np.vstack([self.values, found])
+        self.keys = np.concatenate([self.keys, keys[new]])
+        self._order = np.argsort(self.keys)
+
+    def lookup(self, index):
+        """(n, n_targets) the values at ``index`` (NaN where not evaluated or outside the grid)."""
+        inside = np.all((index >= 0) & (index < self.sizes), axis=-1)
+        keys = np.ravel_multi_index(np.where(inside[..., None], index, 0).reshape(-1, len(self.sizes)).T, self.sizes)
+        sorted_keys = self.keys[self._order]
+        at = np.clip(np.searchsorted(sorted_keys, keys), 0, sorted_keys.size - 1)
+        found = inside.ravel() & (sorted_keys[at] == keys)
+        values = np.full((keys.size, self.values.shape[1]), np.nan)
+        values[found] = self.values[self._order[at[found]]]
+        return values.reshape(*index.shape[:-1], self.values.shape[1])
+
+    def best_values(self):
+        return np.nanmax(self.values, axis=0)
+
+
+def _corners(lower, upper):
+    """(n_boxes, 2^n_axes, n_axes) every corner of each box."""
+    picks = np.stack(np.meshgrid(*[np.arange(2)] * lower.shape[1], indexing="ij"), axis=-1).reshape(-1, lower.shape[1])
+    return np.where(picks[None].astype(bool), upper[:, None, :], lower[:, None, :])
+
+
+def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
+    """(n_boxes, n_targets) what a box may hold at most: its largest corner plus ``safety`` times
+    the multilinear interpolant's error bound, ``sum_i M_i h_i^2 / 8`` (``h_i`` the box's width).
+    ``M_i`` is the largest second difference per unit^2 along axis ``i`` at the box's corners, on
+    the lattice of ``strides``; where none is evaluated there (a neighbour dropped, an axis of two
+    points), the axis's largest second difference anywhere stands in."""
+    corners = _corners(lower, upper)
+    top = np.nanmax(store.lookup(corners), axis=1)
+    error = np.zeros_like(top)
+    for axis in range(lower.shape[1]):
+        if sizes[axis] == 1:
+            continue
+        shift = np.zeros(lower.shape[1], dtype=int)
+        shift[axis] = strides[axis]
+        below, here, above = (store.lookup(corners + k * shift) for k in (-1, 0, 1))
+        second = np.abs(above - 2.0 * here + below) / (strides[axis] * steps[axis]) ** 2  # (boxes, corners, targets)
+        known = np.isfinite(second)
+        largest = np.nanmax(np.where(known, second, -np.inf), axis=(0, 1)) if known.any() else np.zeros(top.shape[1])
+        curvature = np.where(known.any(axis=1), np.nanmax(np.where(known, second, -np.inf), axis=1), largest)
+        width = (upper[:, axis] - lower[:, axis]) * steps[axis]
+        error += np.maximum(curvature, 0.0) * (width**2 / 8.0)[:, None]
+    return top + safety * error
+
+
+def _split(lower, upper, strides):
+    """Each box halved along every axis longer than the new ``strides``."""
+    for axis, stride in enumerate(strides):
+        middle = lower[:, axis] + stride
+        split = middle < upper[:, axis]
+        low_half_upper = upper.copy()
+        low_half_upper[split, axis] = middle[split]
+        high_lower = lower[split].copy()
+        high_lower[:, axis] = middle[split]
+        lower = np.vstack([lower, high_lower])
+        upper = np.vstack([low_half_upper, upper[split]])
+    return lower, upper

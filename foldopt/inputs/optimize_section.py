@@ -1,0 +1,80 @@
+"""What a study's joint optimisation varies (:class:`Optimize`): the fold angle, the base tilt and
+the base azimuth, any of them, each over bounds at a resolution.
+
+The search itself is :func:`foldopt.engine.search.grid_search`; the study it runs over is
+:func:`foldopt.studies.joint.optimize_plan`'s.
+"""
+
+from __future__ import annotations
+
+from pydantic import Field, model_validator
+
+from foldopt import names
+from foldopt.inputs.fields import StrictModel, interval, named
+
+#: Each variable's bounds where a study gives none: the fold angle the study's own grid; the tilt
+#: from horizontal to vertical; the azimuth within 90 deg either side of the equator-facing one.
+DEFAULT_TILT = (0.0, 90.0, 1.0)
+DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP = 90.0, 2.0
+
+
+class Bounds(StrictModel):
+    """One variable's range and resolution [deg]: ``min`` to ``max`` by ``step``, ending on ``max``.
+
+    Azimuths may run below 0 or above 360 (a range across north, ``-90`` to ``90``); they are taken
+    modulo 360.
+    """
+
+    min: interval(-360, 720, unit=" deg")
+    max: interval(-360, 720, unit=" deg")
+    step: interval(0, 90, lo_open=True, unit=" deg")
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.min > self.max:
+            raise ValueError(f"min ({self.min:g}) must not exceed max ({self.max:g})")
+        return self
+
+
+class Optimize(StrictModel):
+    """The joint optimisation of a study: which variables vary, over what, and how closely the search
+    must find the optimum.
+
+    Parameters
+    ----------
+    vary : list of str
+        Of :data:`foldopt.names.OPTIMIZE_VARIABLES`; the others keep the study's value (the fold
+        angle its best on the study's grid, the tilt and azimuth the panel's).
+    fold_angle, tilt, azimuth : Bounds, optional
+        Each variable's range; defaults: the study's ``fold_angles``, tilt 0 to 90 by 1, azimuth
+        the equator-facing one +-90 by 2.
+    tolerance_h : float
+        [h] in [0, 1]: the search may miss a better design by at most this much of the objective
+        (:func:`foldopt.engine.search.grid_search`); default 0.01 h (36 s).
+    """
+
+    vary: list[named(names.OPTIMIZE_VARIABLES)] = Field(
+        default_factory=lambda: list(names.OPTIMIZE_VARIABLES), min_length=1, max_length=3,
+        description="fold_angle, tilt, azimuth: any of them")
+    fold_angle: Bounds | None = Field(None, description="default the study's fold_angles")
+    tilt: Bounds | None = Field(None, description="default 0 to 90 by 1 deg")
+    azimuth: Bounds | None = Field(None, description="default facing the equator +-90 by 2 deg")
+    tolerance_h: interval(0, 1, unit=" h") = Field(0.01, description="what the search may miss [h]")
+
+    @model_validator(mode="after")
+    def _once_each(self):
+        if len(set(self.vary)) < len(self.vary):
+            raise ValueError("vary: name each variable once")
+        for name in names.OPTIMIZE_VARIABLES:
+            bounds = getattr(self, name)
+            if name == "fold_angle" and bounds is not None and not (0 < bounds.min and bounds.max <= 180):
+                raise ValueError("fold_angle: min and max must be in (0, 180] deg")
+            if name == "tilt" and bounds is not None and not (0 <= bounds.min and bounds.max <= 90):
+                raise ValueError("tilt: min and max must be in [0, 90] deg")
+        return self
+
+    def idle_settings(self) -> list[str]:
+        """``optimize.name = ...: why`` for the bounds of a variable that does not vary."""
+        return [f"optimize.{name} = {getattr(self, name).model_dump()}: is only used where optimize.vary names "
+                f"{name}" for name in names.OPTIMIZE_VARIABLES if getattr(self, name) is not None
+                and name not in self.vary]

@@ -1,0 +1,87 @@
+"""The answer of a joint optimisation (:class:`foldopt.studies.joint.OptimizeResult`): per load the
+optimum fold angle, tilt and azimuth with the objective, the flat panel at its own best, the
+default mounting and the tracker, the near-optimal region of each variable, what each variable
+adds, and how much of the grid the search evaluated."""
+
+from __future__ import annotations
+
+from foldopt.studies.answer import Answer, records
+from foldopt.studies.answering import study_question
+
+#: How the answer names each variable and its unit.
+_LABELS = {"fold_angle": ("fold", "deg"), "tilt": ("tilt", "deg"), "azimuth": ("azimuth", "deg")}
+
+
+def _row(table, load, design):
+    return table[(table["p_load_w"] == load) & (table["design"] == design)].iloc[0]
+
+
+def _mounting(row) -> str:
+    return f"tilt {row.surface_tilt:g} deg, azimuth {row.surface_azimuth:g} deg"
+
+
+def of_optimize(result) -> Answer:
+    """The answer of :func:`foldopt.studies.joint.optimize_plan`.
+
+    Parameters
+    ----------
+    result : foldopt.studies.joint.OptimizeResult
+
+    Returns
+    -------
+    foldopt.studies.answer.Answer
+        Of kind ``optimize``.
+    """
+    study, table = result.study, result.table
+    spec = study.optimize
+    days = len(result.dates)
+    over = "the day" if days == 1 else f"{days} days"
+    objective = "t_solar" if days == 1 else f"{result.statistic} of daily t_solar"
+    question = {**study_question(study, ("date",) if days > 1 else ()),
+                "optimize": ", ".join(f"{name} {axis.lo:g} to {axis.hi:g} by {axis.step:g} deg"
+                                      for name, axis in zip(spec.vary, _varied_axes(result), strict=True))
+                + f"; within {spec.tolerance_h:g} h",
+                "objective": f"the {objective} over {over}"}
+    lines = [f"{study.name}: the best {', '.join(spec.vary).replace('_', ' ')} together, maximising the {objective} "
+             f"over {over}"]
+    per_load = []
+    for load in result.loads:
+        best, flat = _row(table, load, "twofold"), _row(table, load, "flat")
+        default, flat_default = _row(table, load, "twofold-default"), _row(table, load, "flat-default")
+        tracker = _row(table, load, "tracker")
+        lines.append(f"P_load {load:g} W: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
+                     f"{best.objective_h:.2f} h, {best.gain_vs_flat_pct:+.1f} % over the flat panel at its own best "
+                     f"({_mounting(flat)}: {flat.objective_h:.2f} h); tracker {tracker.objective_h:.2f} h")
+        near = result.near_optimal[result.near_optimal["p_load_w"] == load]
+        if len(near):
+            lines.append("  near-optimal: " + ", ".join(
+                f"{_LABELS[row.variable][0]} {row.lo:g} to {row.hi:g} deg (recommended {row.recommended:g})"
+                for row in near.itertuples()) + f", each within {near['tolerance_h'].iloc[0] * 60:.1f} min")
+        added = result.added[result.added["p_load_w"] == load]
+        lines.append(f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} h, "
+                     f"folded to {default.fold_angle_deg:g} deg {default.objective_h:.2f} h): "
+                     + ", ".join(f"{_LABELS[row.variable][0]} {row.added_h * 60:+.1f} min"
+                                 for row in added.itertuples()))
+        per_load.append({"p_load_w": load, "fold_angle_deg": best.fold_angle_deg, "surface_tilt": best.surface_tilt,
+                         "surface_azimuth": best.surface_azimuth, "objective_h": best.objective_h,
+                         "gain_vs_flat_pct": best.gain_vs_flat_pct,
+                         "flat": {"surface_tilt": flat.surface_tilt, "surface_azimuth": flat.surface_azimuth,
+                                  "objective_h": flat.objective_h},
+                         "default": {"fold_angle_deg": default.fold_angle_deg, "objective_h": default.objective_h,
+                                     "flat_objective_h": flat_default.objective_h},
+                         "tracker_objective_h": tracker.objective_h,
+                         "added_h": dict(zip(added["variable"], added["added_h"], strict=True)),
+                         "near_optimal": records(near.drop(columns="p_load_w"))})
+    search = result.twofold
+    lines.append(f"search: {search.index.shape[0]:,} of the grid's {search.grid_size:,} designs evaluated "
+                 f"({100 * search.index.shape[0] / search.grid_size:.1f} %), within {spec.tolerance_h:g} h of its best")
+    summary = {"statistic": result.statistic, "days": days, "loads": per_load,
+               "search": {"evaluated": int(search.index.shape[0]), "grid": search.grid_size,
+                          "levels": [list(level) for level in search.levels], "tolerance_h": spec.tolerance_h}}
+    defaults = result.request.defaults if result.request is not None and hasattr(result.request, "defaults") else None
+    return Answer("optimize", study.name, question, defaults, summary, table, result.near_optimal, summary=tuple(lines))
+
+
+def _varied_axes(result):
+    axes = {axis.name: axis for axis in result.twofold.axes}
+    return [axes[name] for name in result.study.optimize.vary]

@@ -1,0 +1,261 @@
+"""The joint optimisation of a twofold panel: its fold angle, base tilt and base azimuth together.
+
+A designer chooses all three when mounting a device, and for a storage-less load the best tilt of a
+folded panel is not the best tilt of a flat one. :func:`optimize_plan` takes a study (its site,
+days, loads, objective and models) with an ``optimize`` section (:class:`foldopt.inputs.optimize_section.Optimize`)
+and finds, per load, the design that maximises the study's objective over its days, by the
+coarse-to-fine search of :func:`foldopt.engine.search.grid_search` on the grid of the varied
+variables. Alongside, for a fair comparison, the flat panel's own best tilt and azimuth (the same
+search without the fold), and the default mounting (tilt ``|latitude|``, facing the equator, or the
+study's panel) with its best fold angle on the study's grid, the flat panel and the tracker there
+(:func:`foldopt.studies.designs.daily_designs`, which every study shares).
+
+What each variable adds is the objective gained as the variables join the search in the order of
+:data:`foldopt.names.OPTIMIZE_VARIABLES`: the fold angle alone at the default mounting, then with
+the tilt, then with the azimuth. The near-optimal region of each variable is every value at which
+some evaluated design comes within the study's near-optimal tolerance of the optimum
+(:func:`foldopt.studies.objectives.near_optimal` on the profile, the best over the other variables);
+its edges are as fine as the search refined there. The landscape is the objective over tilt x
+fold angle at the optimum's azimuth, on a grid of its own.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from foldopt import names
+from foldopt.engine.search import Axis, SearchResult, grid_search
+from foldopt.errors import ConfigError
+from foldopt.inputs.optimize_section import DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP, DEFAULT_TILT
+from foldopt.inputs.plan import Plan
+from foldopt.inputs.study import Study
+from foldopt.studies.designs import Blocks, daily_designs, design_hours
+from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
+
+#: Points of the landscape's grid along the fold angle and the tilt.
+LANDSCAPE_POINTS = (46, 31)
+
+
+@dataclass(frozen=True)
+class OptimizeResult:
+    """A joint optimisation (:func:`optimize_plan`).
+
+    Attributes
+    ----------
+    study : Study
+        The study (resolved): its panel is the default mounting.
+    dates : tuple of datetime.date
+    loads : numpy.ndarray
+        (n_loads,) [W].
+    twofold, flat : SearchResult
+        The searches over the varied variables (targets: the loads); the flat panel's over the
+        varied tilt and azimuth (none: its default mounting alone).
+    steps : tuple of (str, SearchResult)
+        The searches as the variables join (the last is ``twofold``).
+    table : pandas.DataFrame
+        Per load and design (``twofold``, ``flat``, ``twofold-default``, ``flat-default``,
+        ``tracker``): ``fold_angle_deg``, ``surface_tilt``, ``surface_azimuth``, ``objective_h`` and
+        ``gain_vs_flat_pct`` (over the flat panel at its own best).
+    near_optimal : pandas.DataFrame
+        Per load and variable: ``lo``, ``hi``, ``recommended``, ``tolerance_h``.
+    added : pandas.DataFrame
+        Per load and variable: what joining the search added [h].
+    landscape : pandas.DataFrame
+        The first load's objective over ``fold_angle_deg`` x ``surface_tilt`` at the optimum's azimuth.
+    request : object, optional
+    """
+
+    study: Study
+    dates: tuple
+    loads: np.ndarray
+    statistic: str
+    twofold: SearchResult
+    flat: SearchResult
+    steps: tuple
+    table: pd.DataFrame
+    near_optimal: pd.DataFrame
+    added: pd.DataFrame
+    landscape: pd.DataFrame
+    request: object = None
+
+    @functools.cached_property
+    def answer(self):
+        """The :class:`foldopt.studies.answer.Answer` every view of this result renders."""
+        from foldopt.studies.answering_joint import of_optimize
+
+        return of_optimize(self)
+
+
+def _axes(study: Study, vary, fold_angle: float = 180.0) -> dict[str, Axis]:
+    """The search's axes by variable; a variable not varied is a one-point axis at the default
+    mounting (the study's panel, folded to ``fold_angle``)."""
+    spec = study.optimize
+    equator = study.panel.azimuth
+    grid = study.fold_angles
+    defaults = {"fold_angle": (grid.start, grid.stop, grid.step), "tilt": DEFAULT_TILT,
+                "azimuth": (equator - DEFAULT_AZIMUTH_SPAN, equator + DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP)}
+    fixed = {"fold_angle": fold_angle, "tilt": study.panel.tilt, "azimuth": study.panel.azimuth}
+    axes = {}
+    for name in names.OPTIMIZE_VARIABLES:
+        bounds = getattr(spec, name)
+        lo, hi, step = (bounds.min, bounds.max, bounds.step) if bounds is not None else defaults[name]
+        axes[name] = Axis(name, lo, hi, step) if name in vary else Axis(name, fixed[name], fixed[name], 1.0)
+    return axes
+
+
+def _quantum(statistic: str, step_hours: float, n_days: int, months) -> float:
+    """The objective's own jumps [h]: one time step of one day, over the days a statistic averages."""
+    if statistic == "mean":
+        return step_hours / n_days
+    if statistic == "worst-month":
+        return step_hours / min(np.bincount(months)[np.unique(months)])
+    return step_hours
+
+
+def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeResult:
+    """The best fold angle, tilt and azimuth of a study's panel, and the flat panel's own best.
+
+    Parameters
+    ----------
+    plan : Plan
+        A study with an ``optimize`` section; its axes may be ``date`` (the days the objective
+        is taken over) and ``p_load`` (the loads), no other.
+    engine : {'numba', 'numpy'}
+    request : foldopt.studies.request.Request, optional
+
+    Returns
+    -------
+    OptimizeResult
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For other axes, a load profile scaled over an axis, or a cloud ensemble.
+    """
+    study = plan.base.resolved()
+    spec = study.optimize
+    axes = dict(plan.axes)
+    other = [path for path in axes if path not in ("date", "p_load")]
+    if other:
+        raise ConfigError([f"optimize: one site and setup over its days and loads; {', '.join(other)} vary (run "
+                           f"one study each)"])
+    if study.weather is not None and study.weather.members:
+        raise ConfigError(["optimize: a cloud ensemble (weather.members) is not searched; leave out weather.members"])
+    dates = tuple(axes.get("date", (study.date,)))
+    loads = np.asarray(axes.get("p_load", (study.p_load,)), dtype=float)
+    statistic = study.objective.statistic if study.objective is not None else "mean"
+    season = study.objective.months if study.objective is not None else None
+    blocks = Blocks.of_dates(study, dates)
+    study = blocks.study
+    parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
+    months = np.array([date.month for date in dates])
+    step_hours = parts[0][1].step_hours
+    quantum = _quantum(statistic, step_hours, len(dates), months)
+
+    def objective(flat):
+        def evaluate(points):
+            return objective_value(design_hours(parts, points, loads, flat, engine), months, statistic, season)
+
+        return evaluate
+
+    days_of = daily_designs(parts, loads, engine)
+    default = {"twofold-default": objective_value(days_of.twofold_h, months, statistic, season),  # (loads, angles)
+               "flat-default": objective_value(days_of.flat_h, months, statistic, season),
+               "tracker": objective_value(days_of.tracker_h, months, statistic, season)}
+    best_default = best_angle_index(default["twofold-default"])
+    # A fold angle that does not vary stays at the default mounting's best (the first load's).
+    fold_angle = float(days_of.angles[best_default[0]])
+    vary = [name for name in names.OPTIMIZE_VARIABLES if name in spec.vary]
+    all_axes = _axes(study, vary, fold_angle)
+    # Each search starts from the one before's optimum, so a variable that joins never loses.
+    steps, seeds = [], [[fold_angle, study.panel.tilt, study.panel.azimuth]]
+    for count in range(1, len(vary) + 1):
+        search = grid_search(objective(False), list(_axes(study, vary[:count], fold_angle).values()),
+                             spec.tolerance_h, quantum, seeds=seeds)
+        steps.append((vary[count - 1], search))
+        seeds = search.best_point
+    twofold = steps[-1][1]
+    flat_axes = _axes(study, [name for name in vary if name != "fold_angle"])
+    flat = grid_search(objective(True), list(flat_axes.values()), spec.tolerance_h, quantum,
+                       seeds=[[180.0, study.panel.tilt, study.panel.azimuth]])
+    table = _table(study, loads, twofold, flat, days_of.angles, best_default, default)
+    near = _near_optimal(study, loads, twofold)
+    added = _added(study, loads, steps, default["flat-default"])
+    landscape = _landscape(parts, study, all_axes, twofold.best_point[0], loads[:1], months, statistic, season,
+                           engine)
+    return OptimizeResult(study, dates, loads, statistic, twofold, flat, tuple(steps), table, near, added, landscape,
+                          request)
+
+
+def _table(study, loads, twofold, flat, angles, best_default, default) -> pd.DataFrame:
+    rows = []
+    flat_best = flat.best_value
+    for index, load in enumerate(loads):
+        designs = [("twofold", *twofold.best_point[index], twofold.best_value[index]),
+                   ("flat", 180.0, *flat.best_point[index][1:], flat_best[index]),
+                   ("twofold-default", angles[best_default[index]], study.panel.tilt, study.panel.azimuth,
+                    default["twofold-default"][index, best_default[index]]),
+                   ("flat-default", 180.0, study.panel.tilt, study.panel.azimuth, default["flat-default"][index]),
+                   ("tracker", np.nan, np.nan, np.nan, default["tracker"][index])]
+        for design, fold, tilt, azimuth, value in designs:
+            rows.append({"p_load_w": load, "design": design, "fold_angle_deg": fold, "surface_tilt": tilt,
+                         "surface_azimuth": azimuth % 360.0 if azimuth == azimuth else azimuth, "objective_h": value,
+                         "gain_vs_flat_pct": 100.0 * (value / flat_best[index] - 1.0) if flat_best[index] > 0
+                         else np.nan})
+    return pd.DataFrame(rows)
+
+
+def _near_optimal(study, loads, search: SearchResult) -> pd.DataFrame:
+    """Per load and varied variable, the range of values within the near-optimal tolerance."""
+    rows = []
+    points, values = search.points, search.values
+    for axis_index, axis in enumerate(search.axes):
+        if axis.size == 1:
+            continue
+        grid = axis.values()
+        profile = np.full((loads.size, grid.size), -np.inf)
+        position = np.searchsorted(grid, points[:, axis_index] - 1e-9)
+        for target in range(loads.size):
+            np.maximum.at(profile[target], position, values[:, target])
+        # Values the search never evaluated (between a refined cell and a dropped one) read the nearer
+        # evaluated neighbours' profile, linearly.
+        seen = np.isfinite(profile[0])
+        profile = np.stack([np.interp(grid, grid[seen], row[seen]) for row in profile])
+        ranges = near_optimal(grid, profile, study.near_optimal)
+        for index, load in enumerate(loads):
+            rows.append({"p_load_w": load, "variable": axis.name, "lo": ranges["near_optimal_lo_deg"][index],
+                         "hi": ranges["near_optimal_hi_deg"][index],
+                         "recommended": ranges["recommended_fold_angle_deg"][index],
+                         "tolerance_h": ranges["near_optimal_tolerance_h"][index]})
+    return pd.DataFrame(rows)
+
+
+def _added(study, loads, steps, flat_default) -> pd.DataFrame:
+    """What each variable adds as it joins the search: the fold angle over the flat panel at the
+    default mounting, then the tilt, then the azimuth [h]."""
+    rows, before = [], np.asarray(flat_default, dtype=float)
+    for name, search in steps:
+        value = search.best_value
+        for index, load in enumerate(loads):
+            rows.append({"p_load_w": load, "variable": name, "objective_h": value[index],
+                         "added_h": value[index] - before[index], "evaluated": search.index.shape[0],
+                         "grid": search.grid_size})
+        before = value
+    return pd.DataFrame(rows)
+
+
+def _landscape(parts, study, axes, best, loads, months, statistic, season, engine) -> pd.DataFrame:
+    """The objective over fold angle x tilt at the optimum's azimuth, on :data:`LANDSCAPE_POINTS`."""
+    fold_axis = axes["fold_angle"] if axes["fold_angle"].size > 1 else _axes(study, ["fold_angle"])["fold_angle"]
+    tilt_axis = axes["tilt"] if axes["tilt"].size > 1 else Axis("tilt", *DEFAULT_TILT)
+    folds = np.linspace(fold_axis.lo, fold_axis.hi, LANDSCAPE_POINTS[0])
+    tilts = np.linspace(tilt_axis.lo, tilt_axis.hi, LANDSCAPE_POINTS[1])
+    fold, tilt = (grid.ravel() for grid in np.meshgrid(folds, tilts, indexing="ij"))
+    points = np.stack([fold, tilt, np.full(fold.size, best[2])], axis=-1)
+    value = objective_value(design_hours(parts, points, loads, False, engine), months, statistic, season)[:, 0]
+    return pd.DataFrame({"fold_angle_deg": fold, "surface_tilt": tilt, "surface_azimuth": best[2] % 360.0,
+                         "objective_h": value})
