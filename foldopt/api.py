@@ -78,10 +78,11 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
 
     Returns
     -------
-    StudyResult or SweepResult
+    StudyResult, SweepResult or OptimizeResult
         :class:`foldopt.studies.day.StudyResult` for one case (``summary``, ``sweep``, ``timeseries``
         with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.studies.sweeps.SweepResult`
-        for a plan (``table``: one row per case and design); each with ``answer``, the
+        for a plan (``table``: one row per case and design), :class:`foldopt.studies.joint.OptimizeResult`
+        for a study with an ``optimize`` section (:func:`optimize`); each with ``answer``, the
         :class:`foldopt.studies.answer.Answer` the command line prints.
 
     Raises
@@ -91,6 +92,11 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
     """
     if isinstance(study, (str, Path)):
         study = load_study(study)
+    base = study.base if isinstance(study, Plan) else study
+    if base.optimize is not None:
+        from foldopt.studies.joint import optimize_plan
+
+        return optimize_plan(study if isinstance(study, Plan) else Plan(study.data(), ()), engine, request)
     if isinstance(study, Plan):
         if study.axes:
             from foldopt.studies.sweeps import run_plan
@@ -162,6 +168,60 @@ def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, en
     return run_plan(request.plan, progress, engine, request)
 
 
+def optimize(study: Study, vary=None, *, fold_angle=None, tilt=None, azimuth=None, tolerance_h: float | None = None,
+             engine: str = "numba", **fields):
+    """The best fold angle, base tilt and base azimuth together, as ``foldopt optimize`` finds them
+    (:func:`foldopt.studies.joint.optimize_plan`), with the flat panel's own best tilt and azimuth,
+    the default mounting and the tracker.
+
+    The request goes through :func:`foldopt.studies.request.plan_request`, as the command line's
+    does, so both give the same answer to the bit.
+
+    Parameters
+    ----------
+    study : Study
+    vary : str or sequence of str, optional
+        Of ``fold_angle``, ``tilt``, ``azimuth`` [default: all three, or the study's ``optimize.vary``].
+    fold_angle, tilt, azimuth : str or sequence of float, optional
+        Each variable's range, ``"min:max:step"`` or ``(min, max, step)`` [deg]; defaults: the
+        study's fold angles, tilt 0:90:1, azimuth the equator-facing one +-90 by 2.
+    tolerance_h : float, optional
+        What the search may miss [h] (default 0.01).
+    engine : {'numba', 'numpy'}
+    **fields
+        As :func:`sweep`'s: ``date="year"`` and ``objective="worst-month"`` take the objective over
+        the days, ``p_load=[1, 2, 4]`` several loads.
+
+    Returns
+    -------
+    foldopt.studies.joint.OptimizeResult
+        ``table`` per load and design (``twofold``, ``flat``, ``twofold-default``, ``flat-default``,
+        ``tracker``), ``near_optimal``, ``added``, ``landscape``, ``answer``.
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One line per fault, naming the parameter or the field.
+
+    Examples
+    --------
+    >>> import foldopt
+    >>> result = foldopt.optimize(foldopt.default_study(), vary="fold_angle,tilt", mode="exact", step_min=10)
+    >>> best = result.table.set_index("design").loc["twofold"]
+    >>> float(best["fold_angle_deg"]), float(best["surface_tilt"])
+    (31.0, 31.0)
+    """
+    from foldopt.studies.joint import optimize_plan
+    from foldopt.studies.request import KEYWORDS, optimize_section, plan_request
+
+    section = optimize_section(vary, fold_angle, tilt, azimuth, tolerance_h)
+    changes = {KEYWORDS.get(name, name): _plain_values(values) for name, values in fields.items()}
+    data = study.data()
+    changes["optimize"] = {**(data.get("optimize") or {}), **section}
+    request = plan_request(data, changes)
+    return optimize_plan(request.plan, engine, request)
+
+
 def _plain_values(values):
     """A sequence (a list, a tuple, an array) as a list of plain values; text and scalars as they are."""
     if isinstance(values, (str, dict)) or not (isinstance(values, Sequence) or hasattr(values, "tolist")):
@@ -176,8 +236,8 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
 
     Parameters
     ----------
-    result : StudyResult, SweepResult, SizingResult or Reproduction
-        What :func:`run`, :func:`sweep`, :func:`size` or :func:`reproduce` returned.
+    result : StudyResult, SweepResult, SizingResult, Reproduction or OptimizeResult
+        What :func:`run`, :func:`sweep`, :func:`size`, :func:`reproduce` or :func:`optimize` returned.
     out : str or pathlib.Path
         The results folder.
     overwrite : bool, default False
@@ -202,7 +262,11 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
     from foldopt.studies.sizing import SizingResult
     from foldopt.studies.day import StudyResult
 
-    writers = {StudyResult: write_study, SizingResult: write_sizing, Reproduction: write_reproduction}
+    from foldopt.output.folders import write_optimize
+    from foldopt.studies.joint import OptimizeResult
+
+    writers = {StudyResult: write_study, SizingResult: write_sizing, Reproduction: write_reproduction,
+               OptimizeResult: write_optimize}
     writer = writers.get(type(result), write_sweep)
     writer(result, Path(out), overwrite, command if command is not None else ["foldopt.write"])
     return Path(out)

@@ -22,7 +22,7 @@ import traceback
 import typer
 from typer.core import TyperCommand, TyperGroup
 
-from foldopt.cli import map as map_command, run, size, sweep
+from foldopt.cli import map as map_command, optimize, run, size, sweep
 from foldopt.cli.output import INVOCATION, as_text, echo
 from foldopt.errors import ConfigError, OutputError, OutputExistsError
 
@@ -172,7 +172,7 @@ def _options(debug: bool = typer.Option(False, "--debug", help="Show the traceba
 
 app.add_typer(sweep_app, name="sweep", short_help=sweep.SHORT_HELP)
 for group, commands in ((app, run.COMMANDS), (sweep_app, sweep.COMMANDS), (app, map_command.COMMANDS),
-                        (app, size.COMMANDS)):
+                        (app, size.COMMANDS), (app, optimize.COMMANDS)):
     for name, command, short_help in commands:
         group.command(name, cls=_OnceEach, short_help=short_help)(command)
 

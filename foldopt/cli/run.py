@@ -11,6 +11,7 @@ from foldopt.cli.output import INVOCATION, Output
 from foldopt.files import check_output
 from foldopt.inputs.plan import load_plan
 from foldopt.inputs.load import default_study_path
+from foldopt.studies.day import StudyResult
 from foldopt.studies.request import Request
 
 
@@ -41,7 +42,7 @@ def run_request(request: Request, out: Path, overwrite: bool, output: Output, en
 
         result = run(plan, engine, progress, request=request)
         write(result, out, overwrite, INVOCATION)
-    rows = result.summary if not plan.axes else result.table
+    rows = result.summary if isinstance(result, StudyResult) else result.table
     output.answer(command, out, result.answer, rows, [f"wrote {out}"], rows)
 
 

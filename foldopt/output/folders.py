@@ -252,6 +252,47 @@ def write_sizing(result, out: Path, overwrite: bool = False, command=None) -> Pa
     return out
 
 
+def write_optimize(result, out: Path, overwrite: bool = False, command=None) -> Path:
+    """Write a joint optimisation's folder: ``optimum.csv`` (per load and design), ``near_optimal.csv``,
+    ``added.csv`` (what each variable adds), ``evaluated.csv`` (every design the search
+    evaluated, per load), ``landscape.csv`` and ``landscape.png``, ``run.json`` (with the search's
+    levels) and ``report.html``.
+
+    Parameters
+    ----------
+    result : foldopt.studies.joint.OptimizeResult
+    out : pathlib.Path
+    overwrite : bool, default False
+    command : list of str, optional
+        What ``run.json`` records as the command; default ``sys.argv``.
+
+    Returns
+    -------
+    pathlib.Path
+        ``out``.
+    """
+    study, search = result.study, result.twofold
+    points = pd.DataFrame(search.points, columns=["fold_angle_deg", "surface_tilt", "surface_azimuth"])
+    points["surface_azimuth"] %= 360.0
+    evaluated = pd.concat([points.assign(p_load_w=load, objective_h=search.values[:, index])
+                           for index, load in enumerate(result.loads)], ignore_index=True)
+    with staged_folder(out, overwrite) as folder:
+        write_csv(result.table, folder / "optimum.csv")
+        write_csv(result.near_optimal, folder / "near_optimal.csv")
+        write_csv(result.added, folder / "added.csv")
+        write_csv(evaluated, folder / "evaluated.csv")
+        write_csv(result.landscape, folder / "landscape.csv")
+        figures = [write_figure(folder, "landscape.png", result.landscape, result.table,
+                                f"{study.name}: objective over tilt x fold angle (azimuth "
+                                f"{result.landscape['surface_azimuth'].iloc[0]:g} deg)")]
+        figures += _horizon_figure(study, list(result.dates), folder, study.name)
+        metadata = run_metadata(study, command, days=len(result.dates), search=result.answer.result["search"],
+                                input_sha256=input_hash(study.model_dump(mode="json")))
+        write_run_json(folder, metadata)
+        write_html(folder, result.answer, figures, result.table, "Designs (optimum.csv)", metadata)
+    return out
+
+
 def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, load_index: int = 0,
                 period: str = "year") -> list[str]:
     """Write the world maps of one load and period and the latitude x load chart

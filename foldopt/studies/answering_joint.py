@@ -42,7 +42,9 @@ def of_optimize(result) -> Answer:
                                       for name, axis in zip(spec.vary, _varied_axes(result), strict=True))
                 + f"; within {spec.tolerance_h:g} h",
                 "objective": f"the {objective} over {over}"}
-    lines = [f"{study.name}: the best {', '.join(spec.vary).replace('_', ' ')} together, maximising the {objective} "
+    varied = [name.replace("_", " ") for name in spec.vary]
+    joined = varied[0] if len(varied) == 1 else f"{', '.join(varied[:-1])} and {varied[-1]}"
+    lines = [f"{study.name}: the best {joined}{' together' if len(varied) > 1 else ''}, maximising the {objective} "
              f"over {over}"]
     per_load = []
     for load in result.loads:

@@ -331,7 +331,59 @@ def sweep_changes(options: dict, data: dict) -> dict:
     return changes
 
 
-def sweep_request(study, options: dict, axis: str, source: str) -> Request:
+_BOUNDS = re.compile(r"^\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)\s*:\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)\s*:\s*"
+                     r"([-+]?[\d.]+(?:[eE][-+]?\d+)?)\s*$")
+#: The joint optimisation's parameters, as :func:`optimize_section` and the command line name them.
+OPTIMIZE_OPTIONS = {"vary": "--vary", "fold_angle": "--fold-range", "tilt": "--tilt-range",
+                    "azimuth": "--azimuth-range", "tolerance_h": "--tolerance"}
+
+
+def optimize_section(vary=None, fold_angle=None, tilt=None, azimuth=None, tolerance_h=None, labels=None) -> dict:
+    """The ``optimize`` section of a study from the API's or the command line's parameters.
+
+    Parameters
+    ----------
+    vary : str or sequence of str, optional
+        Variables of :data:`foldopt.names.OPTIMIZE_VARIABLES`, or them joined by commas.
+    fold_angle, tilt, azimuth : str or sequence of float, optional
+        Each variable's range, ``"min:max:step"`` or ``(min, max, step)`` [deg].
+    tolerance_h : float, optional
+    labels : dict, optional
+        How messages name each parameter (:data:`OPTIMIZE_OPTIONS` for the command line).
+
+    Returns
+    -------
+    dict
+        The section's given fields, validated with the study (:class:`foldopt.inputs.optimize_section.Optimize`).
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For a range that is not three numbers.
+    """
+    labels = labels or {}
+    section, errors = {}, []
+    if vary is not None:
+        section["vary"] = [item.strip() for item in vary.split(",")] if isinstance(vary, str) else list(vary)
+    for name, value in (("fold_angle", fold_angle), ("tilt", tilt), ("azimuth", azimuth)):
+        if value is None:
+            continue
+        match = _BOUNDS.match(value) if isinstance(value, str) else None
+        parts = match.groups() if match else value if not isinstance(value, str) else ()
+        try:
+            low, high, step = (float(part) for part in parts)
+        except (TypeError, ValueError):
+            errors.append(f"{labels.get(name, name)} = {value!r}: expected min:max:step in degrees, e.g. 0:90:1")
+            continue
+        section[name] = {"min": low, "max": high, "step": step}
+    if tolerance_h is not None:
+        section["tolerance_h"] = tolerance_h
+    if errors:
+        raise ConfigError(errors)
+    return section
+
+
+def sweep_request(study, options: dict, axis: str | None, source: str, section: dict | None = None) -> Request:
     """The request of ``foldopt sweep AXIS``: the study, changed by the sweep's options.
 
     Parameters
@@ -340,14 +392,17 @@ def sweep_request(study, options: dict, axis: str, source: str) -> Request:
         The study's fields, or a YAML study to read them from; None for the embedded study.
     options : dict
         The sweep's options (:func:`sweep_changes`).
-    axis : {'angle', 'latitude', 'day', 'load'}
+    axis : {'angle', 'latitude', 'day', 'load'} or None
+        None for ``foldopt optimize``, which sweeps no axis of its own.
     source : str
         How the answer names the study.
+    section : dict, optional
+        ``foldopt optimize``'s ``optimize`` section (:func:`optimize_section`), over the study's own.
 
     Returns
     -------
     Request
-        Its plan is named ``sweep-<axis>`` and described as the command that made it.
+        Its plan is named ``sweep-<axis>`` (or ``optimize``) and described as the command that made it.
 
     Raises
     ------
@@ -356,8 +411,11 @@ def sweep_request(study, options: dict, axis: str, source: str) -> Request:
     """
     data = study if isinstance(study, dict) else read_study(default_study_path() if study is None else study)[0]
     changes = sweep_changes(options, data)
-    changes["description"] = f"foldopt sweep {axis} from {source} (see command)"
-    return plan_request(data, changes, axis=axis, source=source, name=f"sweep-{axis}")
+    command = "optimize" if section is not None else f"sweep {axis}"
+    changes["description"] = f"foldopt {command} from {source} (see command)"
+    if section is not None:
+        changes["optimize"] = {**(data.get("optimize") or {}), **section}
+    return plan_request(data, changes, axis=axis, source=source, name=f"{command.replace(' ', '-')}")
 
 
 def map_request_from(study=None, *, source: str = "the given study", objective: str = "mean", area=None,

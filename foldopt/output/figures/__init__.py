@@ -1,7 +1,8 @@
 """Figures: one module per kind of result (:mod:`~foldopt.output.figures.day`,
 :mod:`~foldopt.output.figures.sweep`, :mod:`~foldopt.output.figures.annual`,
 :mod:`~foldopt.output.figures.weather`, :mod:`~foldopt.output.figures.horizon`,
-:mod:`~foldopt.output.figures.world`, :mod:`~foldopt.output.figures.sizing`), each with the public
+:mod:`~foldopt.output.figures.world`, :mod:`~foldopt.output.figures.sizing`,
+:mod:`~foldopt.output.figures.landscape`), each with the public
 ``plot_*`` functions that draw on an ``ax`` (a notebook's, with its own backend) and its
 ``FIGURES``: file name -> the plot function and what it shows. :data:`FIGURES` gathers them: every
 figure file a results folder can hold, the one list the folder writers draw through
@@ -59,13 +60,13 @@ def _matplotlib_folder() -> None:
 # Every figure module imports matplotlib, and Python runs this package's __init__ before any of
 # them: the folder is set before matplotlib's first import.
 _matplotlib_folder()
-from foldopt.output.figures import annual, day, horizon, sizing, sweep, weather, world  # noqa: E402
+from foldopt.output.figures import annual, day, horizon, landscape, sizing, sweep, weather, world  # noqa: E402
 from foldopt.output.figures.canvas import for_files, save_plot  # noqa: E402
 
 #: Every figure file a results folder can hold -> :class:`~foldopt.output.figures.canvas.FigureFile`
 #: (its plot function and what it shows), by kind of result.
 FIGURES = {**day.FIGURES, **sweep.FIGURES, **annual.FIGURES, **weather.FIGURES, **horizon.FIGURES, **world.FIGURES,
-           **sizing.FIGURES}
+           **sizing.FIGURES, **landscape.FIGURES}
 
 
 def write_figure(folder: Path, file: str, *args, **kwargs) -> str:

@@ -1,0 +1,76 @@
+"""``foldopt optimize``: the fold angle, base tilt and base azimuth together
+(:func:`foldopt.studies.joint.optimize_plan`), with every option of ``foldopt sweep`` for the
+site, days, loads and models; the request is :func:`foldopt.studies.request.sweep_request`'s with
+the ``optimize`` section of :func:`foldopt.studies.request.optimize_section`."""
+
+from __future__ import annotations
+
+import inspect
+from pathlib import Path  # noqa: F401  (the sweep options' annotations, evaluated here by Typer)
+from typing import Optional
+
+import typer
+
+from foldopt import names
+from foldopt.cli.options import EMBEDDED, OPTION_OF_FIELD, RESULTS, check_choices, rename_fields
+from foldopt.cli.output import Output, fail
+from foldopt.cli.run import run_request
+from foldopt.cli.sweep import _sweep_options
+from foldopt.errors import ConfigError
+from foldopt.studies.request import OPTIMIZE_OPTIONS, optimize_section, sweep_request
+
+#: The optimize section's fields as the command line names them.
+_OPTION_OF_OPTIMIZE = {f"optimize.{name}": option for name, option in OPTIMIZE_OPTIONS.items()}
+
+
+def _optimize_options(
+    vary: Optional[str] = typer.Option(None, "--vary", help="What to optimise: any of "
+                                       + ", ".join(names.OPTIMIZE_VARIABLES) + ", joined by commas [default: all "
+                                       "three, or the study's optimize.vary]."),
+    fold_range: Optional[str] = typer.Option(None, "--fold-range", help="Fold angles min:max:step [deg] [default: "
+                                             "the study's fold_angles]."),
+    tilt_range: Optional[str] = typer.Option(None, "--tilt-range", help="Base tilts min:max:step [deg] [default: "
+                                             "0:90:1]."),
+    azimuth_range: Optional[str] = typer.Option(None, "--azimuth-range", help="Base azimuths min:max:step [deg "
+                                                "from north; may cross north, -90:90:2] [default: the equator-facing "
+                                                "one +-90 by 2]."),
+    tolerance: Optional[float] = typer.Option(None, "--tolerance", help="What the search may miss of the best "
+                                              "objective [h] [default: 0.01]."),
+):
+    """The options of the optimisation itself."""
+
+
+def optimize(**options):
+    output_format, engine = check_choices(options.pop("output_format"), options.pop("engine"))
+    output = Output(options.pop("quiet"), output_format, options.pop("table"))
+    out, overwrite = options.pop("out"), options.pop("overwrite")
+    config = options.pop("config")
+    own = {name: options.pop(name) for name in ("vary", "fold_range", "tilt_range", "azimuth_range", "tolerance")}
+    labels = {**OPTION_OF_FIELD, **_OPTION_OF_OPTIMIZE}
+    if options["p_load_scale"] is not None:
+        labels["p_load"] = "--p-load-scale"
+    try:
+        section = optimize_section(own["vary"], own["fold_range"], own["tilt_range"], own["azimuth_range"],
+                                   own["tolerance"], labels=OPTIMIZE_OPTIONS)
+        request = sweep_request(config, options, None, EMBEDDED if config is None else str(config), section)
+    except ConfigError as error:
+        fail(list(dict.fromkeys(rename_fields(line, labels) for line in error.errors)))
+    run_request(request, out or RESULTS / "optimize", overwrite, output, engine, "optimize")
+
+
+_SIGNATURE = inspect.signature(_sweep_options)
+_OWN = inspect.signature(_optimize_options).parameters.values()
+optimize.__signature__ = _SIGNATURE.replace(parameters=[*_OWN, *_SIGNATURE.parameters.values()])
+optimize.__annotations__ = {**_sweep_options.__annotations__, **_optimize_options.__annotations__}
+optimize.__doc__ = """The best fold angle, base tilt and base azimuth together (any of them), maximising the study's
+objective over its days: per load the optimum with its near-optimal region, the flat panel at its own best tilt and
+azimuth, the default mounting and the tracker, what each variable adds, and landscape.png (tilt x fold angle).
+
+\b
+Examples:
+  foldopt optimize --mode exact
+  foldopt optimize --days year --objective worst-month --vary fold_angle,tilt --step-min 10
+  foldopt optimize --lat -33.87 --lon 151.21 --timezone Australia/Sydney --days 1:365:7 --p-load 1,3"""
+
+#: The commands of this module: name, function, and the line the command list shows.
+COMMANDS = [("optimize", optimize, "The best fold angle, tilt and azimuth together, and the flat panel's own best.")]
