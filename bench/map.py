@@ -63,12 +63,50 @@ def _run(spec, workers: int, folder: Path) -> dict:
             "table": result.table}
 
 
+#: The phases of a site's evaluation, by the functions whose cumulative time is each's.
+PHASES = {"sky": ("foldopt/engine/sky.py", "build_sky"), "fold angles": ("foldopt/studies/designs.py", "fold_hours"),
+          "flat": ("foldopt/engine/rows.py", "row_metrics"), "trackers": ("foldopt/studies/designs.py", "sky_tracker_"),
+          "break-even": ("foldopt/studies/worldmap.py", "_break_even_standby")}
+
+
+def phases(spec, n_sites: int = 20) -> dict:
+    """Seconds per site of each phase on one core, from a profile of ``n_sites`` sites of the spec
+    (the first site first, unprofiled, so that compiling and the tables' cache are not counted).
+    ``flat`` is every kernel call but the fold angles' (the flat panel's peak and its year)."""
+    import cProfile
+    import pstats
+
+    from foldopt.studies.worldmap import evaluate_sites
+
+    sites = list(spec.sites[:n_sites + 1])
+    evaluate_sites(spec.study, sites[:1], spec.loads, spec.relative, spec.year)
+    profile = cProfile.Profile()
+    started = time.perf_counter()
+    profile.runcall(evaluate_sites, spec.study, sites[1:], spec.loads, spec.relative, spec.year)
+    total = (time.perf_counter() - started) / n_sites
+    stats = pstats.Stats(profile).stats
+    seconds = {}
+    for phase, (file, function) in PHASES.items():
+        seconds[phase] = sum(entry[3] for (path, _, name), entry in stats.items()
+                             if path.endswith(file) and name.startswith(function)) / n_sites
+    seconds["flat"] -= sum(entry[3] for (path, _, name), entry in stats.items()
+                           if path.endswith("foldopt/studies/designs.py") and name == "fold_hours") / n_sites
+    seconds["other"] = total - sum(seconds.values())
+    return {"per_site_s": total, **seconds}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sites", type=int, default=2000)
     parser.add_argument("--write", action="store_true", help="write results/bench/map.md and map.json")
+    parser.add_argument("--phases", action="store_true", help="only the per-site cost by phase (20 sites, profiled)")
     args = parser.parse_args()
     spec = _spec(args.sites)
+    if args.phases:
+        cost = phases(spec)
+        print(f"per site on one core (profiled, so slower than unprofiled): {cost.pop('per_site_s'):.3f} s; "
+              + ", ".join(f"{phase} {value:.3f} s" for phase, value in cost.items()))
+        return
     with tempfile.TemporaryDirectory() as folder:
         runs = [_run(spec, workers, Path(folder)) for workers in (1, 2)]
     one, two = runs

@@ -209,7 +209,7 @@ def optimize(study: Study, vary=None, *, fold_angle=None, tilt=None, azimuth=Non
     >>> result = foldopt.optimize(foldopt.default_study(), vary="fold_angle,tilt", mode="exact", step_min=10)
     >>> best = result.table.set_index("design").loc["twofold"]
     >>> float(best["fold_angle_deg"]), float(best["surface_tilt"])
-    (31.0, 31.0)
+    (29.0, 35.0)
     """
     from foldopt.studies.joint import optimize_plan
     from foldopt.studies.request import KEYWORDS, optimize_section, plan_request
@@ -412,6 +412,7 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
     from foldopt.studies.cluster import MapSpec, run_map
     from foldopt.studies.answering import of_map
     from foldopt.output.folders import map_figures, write_map_report
+    from foldopt.output.gridded import write_grid_netcdf
     from foldopt.studies.worldmap import map_request, map_study
 
     if study is None:
@@ -421,6 +422,7 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
     result = run_map(spec, Path(out), scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
                      progress=progress, announce=announce, metadata={"command": command or ["foldopt.world_map"]})
     figures = map_figures(result.table, result.out, "map", relative, show_load, show_period)
+    write_grid_netcdf(result.table, result.out, relative, f"foldopt map: {study.get('name', 'map')}")
     answer = of_map(result, relative, defaults)
     write_map_report(result, figures, answer)
     return result, figures, answer

@@ -110,6 +110,8 @@ CONVERTER_MODELS = Registry("converter model", {
 COUPLINGS = Registry("coupling", {
     "mppt": "a maximum-power-point converter between the panel and the load",
     "direct": "the load wired to the panel, at the load's own voltage (no converter)"})
+#: What a joint optimisation varies: field-like names (pvlib's vocabulary), so not among the
+#: kebab-case model names of :data:`REGISTRIES`.
 OPTIMIZE_VARIABLES = Registry("variable", {
     "fold_angle": "the dihedral angle between the sub-panels [deg] (180 is flat)",
     "tilt": "the base tilt of the unfolded panel [deg from horizontal]",
@@ -158,7 +160,7 @@ OUTPUT_FORMATS = Registry("format", {
 #: Every registry, in the order the docs list them.
 REGISTRIES = (MODES, GEOMETRIES, SKIES, TRANSPOSITIONS, IAMS, PV_MODELS, TEMPERATURE_MODELS, CONNECTIONS,
               CONVERTER_MODELS, COUPLINGS, TRACKERS, DRIVES, WEATHER_FORMATS, DECOMPOSITIONS, INTERVAL_LABELS,
-              HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS, DIODE_MODELS, OPTIMIZE_VARIABLES)
+              HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS, DIODE_MODELS)
 
 #: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.physics.trackers).
 #: His 12 actuating times (local time) pair up symmetrically about 13.319 h: 8.839/17.799,

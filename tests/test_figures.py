@@ -12,7 +12,7 @@ import textwrap
 from pathlib import Path
 
 import foldopt
-from foldopt.output.figures import FIGURES, annual, day, horizon, sizing, sweep, weather, world
+from foldopt.output.figures import FIGURES, annual, day, horizon, landscape, sizing, sweep, weather, world
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -26,7 +26,7 @@ def test_the_registry_is_the_figures_of_the_examples():
 
 def test_the_registry_is_every_kind_once_and_draws_with_public_functions():
     kinds = [day.FIGURES, sweep.FIGURES, annual.FIGURES, weather.FIGURES, horizon.FIGURES, world.FIGURES,
-             sizing.FIGURES]
+             sizing.FIGURES, landscape.FIGURES]
     assert sum(len(kind) for kind in kinds) == len(FIGURES)  # no file name in two kinds
     for file, figure in FIGURES.items():
         assert file.endswith(".png") and figure.description
@@ -77,6 +77,11 @@ NOTEBOOK = textwrap.dedent("""
         "plot_sun_paths": ({"dates": ["2025-06-21"], "azimuth": np.array([[90.0, 180.0, 270.0]]),
                             "elevation": np.array([[10.0, 60.0, 10.0]]), "horizon_azimuth": np.array([0.0, 180.0]),
                             "horizon_elevation": np.array([20.0, 5.0]), "hidden_pct": 12.0}, "t"),
+        "plot_landscape": (pd.DataFrame({"fold_angle_deg": [90.0, 180.0, 90.0, 180.0],
+                                         "surface_tilt": [0.0, 0.0, 30.0, 30.0], "objective_h": [9.0, 8.0, 9.5, 8.2]}),
+                           pd.DataFrame({"p_load_w": 2.0, "design": ["twofold", "twofold-default"],
+                                         "fold_angle_deg": [90.0, 90.0], "surface_tilt": [30.0, 0.0],
+                                         "objective_h": [9.5, 9.0]}), "t"),
     }
     drawn = []
     for name, args in calls.items():

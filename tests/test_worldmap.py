@@ -163,3 +163,30 @@ def test_a_sites_horizon_column_names_each_sites_file(tmp_path):
     hidden = [f"{kind}_{design}_{unit}" for kind, unit in (("mean_t_solar", "h"), ("energy_harvested", "wh"))
               for design in ("flat", "twofold", "tracker")]
     assert (rows.loc["walls", hidden] < rows.loc["open", hidden]).all().all()
+
+
+def test_a_grid_map_is_a_cf_netcdf_dataset(tmp_path):
+    """map.nc holds every row of the table at its latitude, longitude, load and period (a missing
+    site, as a sea point of a land grid, is fill), with CF's coordinate metadata; xarray reads it
+    back through its SciPy backend."""
+    import xarray as xr
+
+    from foldopt.output.gridded import grid_dataset, write_grid_netcdf
+
+    sites = grid_sites([-30.0, 0.0, 30.0], [0.0, 60.0], False)
+    table = evaluate_sites(COARSE, sites, [0.1, 0.3], relative=True)
+    land = table[~((table["latitude"] == 0.0) & (table["longitude"] == 60.0))]  # one point "at sea"
+    assert write_grid_netcdf(land, tmp_path, relative=True) == "map.nc"
+    data = xr.open_dataset(tmp_path / "map.nc", engine="scipy")
+    assert data.attrs["Conventions"] == "CF-1.8"
+    assert data["latitude"].attrs["units"] == "degrees_north" and data["longitude"].attrs["units"] == "degrees_east"
+    assert list(data["period"].values) == list(PERIODS)
+    assert data["gain_vs_flat_pct"].attrs["units"] == "percent" and data["objective_twofold_h"].attrs["units"] == "h"
+    for row in land.itertuples():
+        cell = data.sel(latitude=row.latitude, longitude=row.longitude, load=round(row.p_load_fraction, 12),
+                        period=row.period)
+        assert float(cell["objective_twofold_h"]) == row.objective_twofold_h
+        assert float(cell["fold_angle_deg"]) == row.fold_angle_deg
+    assert np.isnan(data["objective_twofold_h"].sel(latitude=0.0, longitude=60.0)).all()
+    named = table.assign(site_name="somewhere")
+    assert grid_dataset(named, relative=True) is None

@@ -121,7 +121,8 @@ def map_(
         except ConfigError as error:
             fail(list(dict.fromkeys(rename_fields(line) for line in error.errors)))
     output.answer("map", out, answer, result.table[result.table["period"] == "year"].reset_index(drop=True),
-                  [f"wrote {out} (map.parquet, map.csv, report.html, {', '.join(figures)})"])
+                  [f"wrote {out} (map.parquet, map.csv{', map.nc' if (out / 'map.nc').exists() else ''}, report.html, "
+                   f"{', '.join(figures)})"])
 
 
 #: The commands of this module: name, function, and the line the command list shows.

@@ -1,5 +1,5 @@
 """``foldopt sweep angle | latitude | day | load``: one design variable over a range, everything
-else from the study. The commands share their options (:func:`_sweep_options`' signature); the
+else from the study. The commands share their options (:func:`sweep_options`' signature); the
 request they make is :func:`foldopt.studies.request.sweep_request`'s.
 """
 
@@ -28,7 +28,7 @@ def _choices(registry) -> str:
     return " | ".join(registry)
 
 
-def _sweep_options(
+def sweep_options(
     config: Optional[Path] = typer.Option(None, "--config", help=f"Study to start from [default: {EMBEDDED}]."),
     lat: Optional[str] = typer.Option(None, "--lat", help="Latitude [deg north], or a range start:stop:step."),
     lon: Optional[str] = typer.Option(None, "--lon", help="Longitude [deg east], or a range."),
@@ -156,8 +156,8 @@ def _command(axis: str):
     def command(**options):
         _sweep(axis, options)
 
-    command.__signature__ = inspect.signature(_sweep_options)
-    command.__annotations__ = dict(_sweep_options.__annotations__)
+    command.__signature__ = inspect.signature(sweep_options)
+    command.__annotations__ = dict(sweep_options.__annotations__)
     command.__doc__ = summary + "\n\n\b\nExamples:\n" + "\n".join(f"  {example}" for example in examples)
     return command
 

@@ -7,10 +7,11 @@ The search itself is :func:`foldopt.engine.search.grid_search`; the study it run
 
 from __future__ import annotations
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from foldopt import names
-from foldopt.inputs.fields import StrictModel, interval, named
+from foldopt.inputs.fields import StrictModel, interval
+from foldopt.names import canonical
 
 #: Each variable's bounds where a study gives none: the fold angle the study's own grid; the tilt
 #: from horizontal to vertical; the azimuth within 90 deg either side of the equator-facing one.
@@ -35,6 +36,10 @@ class Bounds(StrictModel):
             raise ValueError(f"min ({self.min:g}) must not exceed max ({self.max:g})")
         return self
 
+    def describe(self) -> str:
+        """``min:max:step``, as the command line takes it."""
+        return f"{self.min:g}:{self.max:g}:{self.step:g}"
+
 
 class Optimize(StrictModel):
     """The joint optimisation of a study: which variables vary, over what, and how closely the search
@@ -53,7 +58,7 @@ class Optimize(StrictModel):
         (:func:`foldopt.engine.search.grid_search`); default 0.01 h (36 s).
     """
 
-    vary: list[named(names.OPTIMIZE_VARIABLES)] = Field(
+    vary: list[str] = Field(
         default_factory=lambda: list(names.OPTIMIZE_VARIABLES), min_length=1, max_length=3,
         description="fold_angle, tilt, azimuth: any of them")
     fold_angle: Bounds | None = Field(None, description="default the study's fold_angles")
@@ -61,20 +66,34 @@ class Optimize(StrictModel):
     azimuth: Bounds | None = Field(None, description="default facing the equator +-90 by 2 deg")
     tolerance_h: interval(0, 1, unit=" h") = Field(0.01, description="what the search may miss [h]")
 
-    @model_validator(mode="after")
-    def _once_each(self):
-        if len(set(self.vary)) < len(self.vary):
-            raise ValueError("vary: name each variable once")
-        for name in names.OPTIMIZE_VARIABLES:
-            bounds = getattr(self, name)
-            if name == "fold_angle" and bounds is not None and not (0 < bounds.min and bounds.max <= 180):
-                raise ValueError("fold_angle: min and max must be in (0, 180] deg")
-            if name == "tilt" and bounds is not None and not (0 <= bounds.min and bounds.max <= 90):
-                raise ValueError("tilt: min and max must be in [0, 90] deg")
-        return self
+    @field_validator("vary", mode="before")
+    @classmethod
+    def _known(cls, value):
+        """``vary: fold_angle, tilt`` is the list; each name in foldopt's spelling, once."""
+        items = [item.strip() for item in value.split(",")] if isinstance(value, str) else value
+        if not isinstance(items, (list, tuple)) or not all(isinstance(item, str) for item in items):
+            raise ValueError(f"must be a list of {', '.join(names.OPTIMIZE_VARIABLES)}")
+        items = [canonical(item, names=names.OPTIMIZE_VARIABLES) for item in items]
+        if len(set(items)) < len(items):
+            raise ValueError("name each variable once")
+        return items
+
+    @field_validator("fold_angle")
+    @classmethod
+    def _fold_bounds(cls, bounds):
+        if bounds is not None and not (0 < bounds.min and bounds.max <= 180):
+            raise ValueError(f"{bounds.describe()}: min and max must be in (0, 180] deg")
+        return bounds
+
+    @field_validator("tilt")
+    @classmethod
+    def _tilt_bounds(cls, bounds):
+        if bounds is not None and not (0 <= bounds.min and bounds.max <= 90):
+            raise ValueError(f"{bounds.describe()}: min and max must be in [0, 90] deg")
+        return bounds
 
     def idle_settings(self) -> list[str]:
         """``optimize.name = ...: why`` for the bounds of a variable that does not vary."""
-        return [f"optimize.{name} = {getattr(self, name).model_dump()}: is only used where optimize.vary names "
+        return [f"optimize.{name} = {getattr(self, name).describe()}: is only used where optimize.vary names "
                 f"{name}" for name in names.OPTIMIZE_VARIABLES if getattr(self, name) is not None
                 and name not in self.vary]

@@ -38,6 +38,8 @@ COLUMNS = (
                    "tracker-net (net of its own draw), tracker:<model> and tracker:<model>-net"),
     # the design's settings and its daily metrics
     ("fold_angle_deg", "deg", "the fold angle Θ (180 = flat); empty for trackers"),
+    ("surface_tilt", "deg", "the panel's base tilt from horizontal (foldopt optimize)"),
+    ("surface_azimuth", "deg", "the panel's base azimuth, clockwise from north (foldopt optimize)"),
     ("t_solar_h", "h", "solar-powered time of the day: P_pv >= P_load"),
     ("t_solar_contiguous_h", "h", "the longest contiguous solar-powered interval"),
     ("t_solar_{connection}_h", "h", "t_solar of one connection at each fold angle (sweep.csv)"),
@@ -62,6 +64,13 @@ COLUMNS = (
     ("near_optimal_hi_deg", "deg", "the largest fold angle on the best one's plateau"),
     ("recommended_fold_angle_deg", "deg", "the grid angle at the centre of the near-optimal range"),
     ("near_optimal_tolerance_h", "h", "how far below the best an angle may fall and still be near-optimal"),
+    # the joint optimisation (foldopt optimize)
+    ("variable", "", "fold_angle, tilt or azimuth: the variable a row of near_optimal.csv or added.csv is of; "
+                     "its near-optimal range is then in that variable's degrees"),
+    ("recommended_deg", "deg", "the value at the centre of a variable's near-optimal range"),
+    ("added_h", "h", "what a variable adds to the objective as it joins the search (fold angle, tilt, azimuth)"),
+    ("evaluated_designs", "-", "designs the search evaluated"),
+    ("grid_designs", "-", "designs of the full grid, what a brute-force sweep evaluates"),
     # statistics over days
     ("objective", "", "the statistic maximised: mean, min, worst-month or pNN"),
     ("objective_h", "h", "the objective's value: that statistic of daily t_solar"),

@@ -57,8 +57,9 @@ def of_optimize(result) -> Answer:
         near = result.near_optimal[result.near_optimal["p_load_w"] == load]
         if len(near):
             lines.append("  near-optimal: " + ", ".join(
-                f"{_LABELS[row.variable][0]} {row.lo:g} to {row.hi:g} deg (recommended {row.recommended:g})"
-                for row in near.itertuples()) + f", each within {near['tolerance_h'].iloc[0] * 60:.1f} min")
+                f"{_LABELS[row.variable][0]} {row.near_optimal_lo_deg:g} to {row.near_optimal_hi_deg:g} deg "
+                f"(recommended {row.recommended_deg:g})" for row in near.itertuples())
+                + f", each within {near['near_optimal_tolerance_h'].iloc[0] * 60:.1f} min")
         added = result.added[result.added["p_load_w"] == load]
         lines.append(f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} h, "
                      f"folded to {default.fold_angle_deg:g} deg {default.objective_h:.2f} h): "

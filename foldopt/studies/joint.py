@@ -61,9 +61,11 @@ class OptimizeResult:
         ``tracker``): ``fold_angle_deg``, ``surface_tilt``, ``surface_azimuth``, ``objective_h`` and
         ``gain_vs_flat_pct`` (over the flat panel at its own best).
     near_optimal : pandas.DataFrame
-        Per load and variable: ``lo``, ``hi``, ``recommended``, ``tolerance_h``.
+        Per load and variable: ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_deg``,
+        ``near_optimal_tolerance_h``.
     added : pandas.DataFrame
-        Per load and variable: what joining the search added [h].
+        Per load and variable: the objective once it joined the search and what that added [h],
+        with the designs evaluated and the grid's.
     landscape : pandas.DataFrame
         The first load's objective over ``fold_angle_deg`` x ``surface_tilt`` at the optimum's azimuth.
     request : object, optional
@@ -107,7 +109,7 @@ def _axes(study: Study, vary, fold_angle: float = 180.0) -> dict[str, Axis]:
     return axes
 
 
-def _quantum(statistic: str, step_hours: float, n_days: int, months) -> float:
+def objective_quantum(statistic: str, step_hours: float, n_days: int, months) -> float:
     """The objective's own jumps [h]: one time step of one day, over the days a statistic averages."""
     if statistic == "mean":
         return step_hours / n_days
@@ -154,7 +156,7 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
     months = np.array([date.month for date in dates])
     step_hours = parts[0][1].step_hours
-    quantum = _quantum(statistic, step_hours, len(dates), months)
+    quantum = objective_quantum(statistic, step_hours, len(dates), months)
 
     def objective(flat):
         def evaluate(points):
@@ -172,7 +174,7 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     vary = [name for name in names.OPTIMIZE_VARIABLES if name in spec.vary]
     all_axes = _axes(study, vary, fold_angle)
     # Each search starts from the one before's optimum, so a variable that joins never loses.
-    steps, seeds = [], [[fold_angle, study.panel.tilt, study.panel.azimuth]]
+    steps, seeds = [], [[days_of.angles[best], study.panel.tilt, study.panel.azimuth] for best in best_default]
     for count in range(1, len(vary) + 1):
         search = grid_search(objective(False), list(_axes(study, vary[:count], fold_angle).values()),
                              spec.tolerance_h, quantum, seeds=seeds)
@@ -227,10 +229,11 @@ def _near_optimal(study, loads, search: SearchResult) -> pd.DataFrame:
         profile = np.stack([np.interp(grid, grid[seen], row[seen]) for row in profile])
         ranges = near_optimal(grid, profile, study.near_optimal)
         for index, load in enumerate(loads):
-            rows.append({"p_load_w": load, "variable": axis.name, "lo": ranges["near_optimal_lo_deg"][index],
-                         "hi": ranges["near_optimal_hi_deg"][index],
-                         "recommended": ranges["recommended_fold_angle_deg"][index],
-                         "tolerance_h": ranges["near_optimal_tolerance_h"][index]})
+            rows.append({"p_load_w": load, "variable": axis.name,
+                         "near_optimal_lo_deg": ranges["near_optimal_lo_deg"][index],
+                         "near_optimal_hi_deg": ranges["near_optimal_hi_deg"][index],
+                         "recommended_deg": ranges["recommended_fold_angle_deg"][index],
+                         "near_optimal_tolerance_h": ranges["near_optimal_tolerance_h"][index]})
     return pd.DataFrame(rows)
 
 
@@ -242,8 +245,8 @@ def _added(study, loads, steps, flat_default) -> pd.DataFrame:
         value = search.best_value
         for index, load in enumerate(loads):
             rows.append({"p_load_w": load, "variable": name, "objective_h": value[index],
-                         "added_h": value[index] - before[index], "evaluated": search.index.shape[0],
-                         "grid": search.grid_size})
+                         "added_h": value[index] - before[index], "evaluated_designs": search.index.shape[0],
+                         "grid_designs": search.grid_size})
         before = value
     return pd.DataFrame(rows)
 

@@ -1,0 +1,95 @@
+"""A grid map's table as NetCDF (``map.nc``): an xarray Dataset over latitude x longitude x load x
+period with CF metadata, the form gridded solar data takes elsewhere, so that xarray and GIS tools
+(QGIS, Panoply, CDO) open it directly.
+
+The file is NetCDF-3 (classic), written by xarray's SciPy backend, which needs no HDF5 library. It
+is written where a map's sites are points of a regular latitude x longitude grid (a sea point of a
+land-only grid is missing, its values ``_FillValue``); a map of named sites or weather files keeps
+its tables alone. Each variable carries its unit (UDUNITS spelling) and meaning from the column
+registry (:mod:`foldopt.output.columns`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from foldopt.files import versions, write_atomically
+from foldopt.output.columns import describe
+from foldopt.studies.worldmap import PERIODS
+
+#: The registry's units in UDUNITS spelling, as CF asks.
+_UNITS = {"h": "h", "W": "W", "Wh": "W h", "%": "percent", "deg": "degree", "-": "1", "kWh/m^2": "kW h m-2"}
+#: Columns that are coordinates or labels, not variables.
+_NOT_VARIABLES = ("site_id", "site_name", "weather", "latitude", "longitude", "period")
+
+
+def _regular(values: np.ndarray) -> bool:
+    steps = np.diff(values)
+    return values.size < 3 or bool(np.allclose(steps, steps[0], rtol=1e-6, atol=1e-9))
+
+
+def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"):
+    """The map's rows as a Dataset, or None where its sites are no grid.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A map's table (:attr:`foldopt.MapRun.table`): a row per site, load and period.
+    relative : bool
+        Whether the loads are fractions of each site's flat peak: the ``load`` dimension is then
+        ``p_load_fraction`` (and ``p_load_w`` a variable), else ``p_load_w``.
+    title : str
+
+    Returns
+    -------
+    xarray.Dataset or None
+        Dimensions ``latitude``, ``longitude``, ``load`` and ``period``.
+    """
+
+    if (table["site_name"].astype(str) != "").any() or (table["weather"].astype(str) != "").any():
+        return None
+    latitudes, longitudes = np.unique(table["latitude"]), np.unique(table["longitude"])
+    if not (_regular(latitudes) and _regular(longitudes)):
+        return None
+    load = "p_load_fraction" if relative else "p_load_w"
+    # A fraction is watts over the site's peak: the same load to 12 digits at every site.
+    frame = table.assign(load=table[load].round(12)).drop(columns=load).set_index(
+        ["latitude", "longitude", "load", "period"])
+    variables = [c for c in frame.columns if c not in _NOT_VARIABLES and pd.api.types.is_numeric_dtype(frame[c])]
+    data = frame[variables].astype(float).to_xarray()
+    data = data.reindex(latitude=latitudes, longitude=longitudes,
+                        period=[period for period in PERIODS if period in set(table["period"])])
+    for name in variables:
+        entry = describe(name)
+        if entry is not None:
+            data[name].attrs.update(units=_UNITS.get(entry[1], entry[1] or "1"), long_name=entry[2])
+    data["latitude"].attrs.update(units="degrees_north", standard_name="latitude", long_name="latitude", axis="Y")
+    data["longitude"].attrs.update(units="degrees_east", standard_name="longitude", long_name="longitude", axis="X")
+    entry = describe(load)
+    data = data.assign_coords(load=data["load"])
+    data["load"].attrs.update(units=_UNITS.get(entry[1], "1"), long_name=f"{load}: {entry[2]}")
+    data["period"].attrs.update(long_name="year, or the season DJF, MAM, JJA, SON")
+    data.attrs.update(Conventions="CF-1.8", title=title, source=f"foldopt {versions()['foldopt']}",
+                      references="Shin et al., Reconfigurable three dimensional photovoltaic panel architecture for "
+                                 "solar-powered time extension")
+    return data
+
+
+def write_grid_netcdf(table: pd.DataFrame, out: Path, relative: bool, title: str = "foldopt map") -> str | None:
+    """Write ``map.nc`` in a map's folder, atomically, where its sites are a grid.
+
+    Returns
+    -------
+    str or None
+        ``"map.nc"``, or None where nothing was written.
+    """
+    data = grid_dataset(table, relative, title)
+    if data is None:
+        return None
+    encoding = {name: {"_FillValue": np.nan} for name in data.data_vars}
+    write_atomically(Path(out) / "map.nc", lambda temporary: data.to_netcdf(temporary, engine="scipy",
+                                                                             encoding=encoding))
+    return "map.nc"
