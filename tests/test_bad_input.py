@@ -162,6 +162,8 @@ VALUES = [
     ("map-period", ["map", "--show-period", "winter"], ["--show-period", "year, DJF"]),
     ("map-show-load", ["map", "--p-load", "1,2", "--show-load", "3"], ["--show-load", "[1, 2]"]),
     ("map-objective", ["map", "--objective", "best"], ["--objective", "pNN"]),
+    ("map-optimize-tilt", ["map", "--set", "optimize={vary: [fold_angle, tilt]}"],
+     ["optimize.vary", "the fold angle alone"]),
     ("map-step", ["map", "--step-min", "7"], ["--step-min", "divide the 1440 min"]),
     ("map-workers", ["map", "--workers", "0"], ["--workers", "at least 1"]),
     ("map-set", ["map", "--set", "panel.area=-1"], ["--area", "(0, 1000]"]),

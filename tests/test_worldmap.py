@@ -190,3 +190,31 @@ def test_a_grid_map_is_a_cf_netcdf_dataset(tmp_path):
     assert np.isnan(data["objective_twofold_h"].sel(latitude=0.0, longitude=60.0)).all()
     named = table.assign(site_name="somewhere")
     assert grid_dataset(named, relative=True) is None
+
+
+@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(latitude=st.floats(-60, 60), longitude=st.floats(-180, 180),
+       loads=st.lists(st.floats(0.05, 0.9), min_size=1, max_size=3, unique=True),
+       statistic=st.sampled_from(["mean", "min", "worst-month", "p10"]))
+def test_a_searched_map_equals_the_full_sweep_within_the_tolerance(latitude, longitude, loads, statistic):
+    """--fold-search: each period's and load's objective within the search's 0.01 h of the full
+    sweep's (never above it: the search evaluates grid angles), and the near-optimal range, bisected
+    to the grid's step, the same where the search found the full sweep's best; elsewhere its edges
+    may move by one step, the range being taken from a best up to 0.01 h lower."""
+    full = {**COARSE, "objective": {"statistic": statistic}, "fold_angles": {"start": 2, "stop": 180, "step": 2}}
+    searched = {**full, "optimize": {"vary": ["fold_angle"]}}
+    site = [{"latitude": latitude, "longitude": longitude}]
+    a, b = (evaluate_sites(study, site, loads, relative=True) for study in (full, searched))
+    short = a["objective_twofold_h"] - b["objective_twofold_h"]
+    assert (short >= -1e-12).all() and (short <= 0.01 + 1e-12).all()
+    exact = short == 0.0
+    for column in ("near_optimal_lo_deg", "near_optimal_hi_deg"):
+        np.testing.assert_array_equal(a.loc[exact, column], b.loc[exact, column])
+        assert (np.abs(a[column] - b[column]) <= 2.0).all()
+
+
+def test_a_map_searches_the_fold_angle_alone():
+    from foldopt.studies.worldmap import map_request
+
+    with pytest.raises(ConfigError, match="a map searches the fold angle alone"):
+        map_request({**COARSE, "optimize": {"vary": ["fold_angle", "tilt"]}}, [1.0], latitudes=[0], longitudes=[0])

@@ -40,6 +40,9 @@ def map_(
     year: int = typer.Option(2025, "--year", help="Year of the clear-sky days (or that a typical year stands for)."),
     step_min: Optional[float] = STEP_MIN,
     angle_step: Optional[float] = ANGLE_STEP,
+    fold_search: bool = typer.Option(False, "--fold-search", help="Search the fold angles (foldopt.engine.search) "
+                                     "instead of evaluating every one: the same objectives within 0.01 h; fewer "
+                                     "angles for few loads and periods."),
     config: Optional[Path] = typer.Option(None, "--config", help=f"Study to take the panel and models from [default: "
                                           f"{EMBEDDED}, in exact mode with the Ineichen clear sky]."),
     settings: Optional[list[str]] = SETTINGS,
@@ -94,7 +97,8 @@ def map_(
     try:
         request = map_request_from(
             config, source=EMBEDDED if config is None else str(config), objective=objective, area=area,
-            efficiency=efficiency, step_min=step_min, angle_step=angle_step, settings=settings or (),
+            efficiency=efficiency, step_min=step_min, angle_step=angle_step, fold_search=fold_search,
+            settings=settings or (),
             loads=p_load_fraction if relative else p_load, relative=relative, year=year, show_period=show_period,
             sites=sites, weather_dir=weather_dir, latitudes=lat, longitudes=lon, land_only=land_only)
     except WeatherError:

@@ -375,23 +375,30 @@ class DailyDesigns:
     available: np.ndarray
 
 
-def daily_designs(parts, loads, engine: str = "numba") -> DailyDesigns:
+def daily_designs(parts, loads, engine: str = "numba", fold=None) -> DailyDesigns:
     """:class:`DailyDesigns` over chunks of days.
 
     Parameters
     ----------
-    parts : iterable of (Blocks, Sky)
+    parts : sequence of (Blocks, Sky)
         Each chunk of :class:`Blocks` with its sky.
     loads : array_like
         (n_loads,) [W]; an infinite load carries nothing.
     engine : {'numba', 'numpy'}
+    fold : callable, optional
+        ``fold(parts, loads, engine)`` -> the twofold panel's ``(angles, hours (days, loads, angles),
+        energy (days, angles))`` at the angles it chooses to evaluate (a search:
+        :func:`foldopt.studies.joint.fold_search`); default every angle of the study's grid.
     """
     twofold, harvest, flat, flat_energy, tracker, available = [], [], [], [], [], []
+    if fold is not None:
+        angles, searched_hours, searched_energy = fold(parts, loads, engine)
     for chunk, sky in parts:
         study = chunk.study
-        angles, hours, energy_harvested_wh = fold_hours(sky, chunk, loads, engine)
-        twofold.append(hours)
-        harvest.append(energy_harvested_wh)
+        if fold is None:
+            angles, hours, energy_harvested_wh = fold_hours(sky, chunk, loads, engine)
+            twofold.append(hours)
+            harvest.append(energy_harvested_wh)
         metrics = engines.row_metrics(sky, study, np.arange(sky.n_blocks), engines.flat_orientation(
             chunk.tilt, chunk.azimuth), loads, outputs=("panel",), engine=engine)
         flat.append(metrics.t_solar[:, 0])
@@ -403,12 +410,14 @@ def daily_designs(parts, loads, engine: str = "numba") -> DailyDesigns:
         tracker.append((both.t_solar[:sky.n_blocks, 0], both.t_solar[sky.n_blocks:, 0], both.energy[:sky.n_blocks, 0]))
         available.append(standby_available(gross, draw, sky.lit, study.tracker.standby_w))
     gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
+    if fold is not None:
+        twofold, harvest = [searched_hours.transpose(0, 2, 1)], [searched_energy]
     return DailyDesigns(angles, np.concatenate(twofold).transpose(0, 2, 1), np.concatenate(harvest),
                         np.concatenate(flat), np.concatenate(flat_energy), gross_h, net_h, gross_wh,
                         np.concatenate(available))
 
 
-def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba") -> np.ndarray:
+def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba", with_energy: bool = False):
     """Each day's t_solar [h] of arbitrary designs: a fold angle, base tilt and base azimuth each,
     for the search of :func:`foldopt.studies.joint.optimize_plan`.
 
@@ -424,10 +433,13 @@ def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba"
         The flat panel (the fold angle unused) with no connection: as the ``flat`` design.
     engine : {'numba', 'numpy'}
 
+    with_energy : bool
+        Also each day's harvested energy.
+
     Returns
     -------
     numpy.ndarray
-        (days, n, n_loads).
+        (days, n, n_loads); with ``with_energy`` also (days, n) [Wh].
     """
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     loads = np.asarray(loads, dtype=float)
@@ -437,10 +449,11 @@ def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba"
         orientation, output = engines.flat_orientation(tilt, azimuth), "panel"
     else:
         orientation, output = _orientations(study, points[:, 0], tilt, azimuth), study.connection
-    days = []
+    days, harvest = [], []
     for _, sky in parts:
         per_chunk = max(1, CHUNK_ROW_LOADS // max(sky.n_blocks * loads.size, 1))
         hours = np.empty((sky.n_blocks, points.shape[0], loads.size))
+        energy = np.empty((sky.n_blocks, points.shape[0]))
         for start in range(0, points.shape[0], per_chunk):
             piece = slice(start, min(start + per_chunk, points.shape[0]))
             count = piece.stop - piece.start
@@ -448,8 +461,10 @@ def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba"
             metrics = engines.row_metrics(sky, study, rows, np.tile(orientation[piece], (sky.n_blocks, 1)), loads,
                                           outputs=(output,), engine=engine)
             hours[:, piece] = metrics.t_solar[:, 0].reshape(sky.n_blocks, count, loads.size)
+            energy[:, piece] = metrics.energy[:, 0].reshape(sky.n_blocks, count)
         days.append(hours)
-    return np.concatenate(days)
+        harvest.append(energy)
+    return (np.concatenate(days), np.concatenate(harvest)) if with_energy else np.concatenate(days)
 
 
 def _orientations(study: Study, fold_angle, tilt, azimuth) -> np.ndarray:

@@ -262,3 +262,85 @@ def _landscape(parts, study, axes, best, loads, months, statistic, season, engin
     value = objective_value(design_hours(parts, points, loads, False, engine), months, statistic, season)[:, 0]
     return pd.DataFrame({"fold_angle_deg": fold, "surface_tilt": tilt, "surface_azimuth": best[2] % 360.0,
                          "objective_h": value})
+
+
+def fold_search(months, statistic: str, seasons, tolerance_h: float, near_optimal_tolerance):
+    """The fold angles a map evaluates at one site: the search of the study's grid for every period's
+    objective and every load together, as :func:`foldopt.studies.designs.daily_designs` takes it.
+
+    After the search, each target's near-optimal edges (where the objective falls below the best
+    less ``near_optimal_tolerance``) are bisected down to the grid's step, so the near-optimal
+    range (:func:`foldopt.studies.objectives.near_optimal` on the evaluated angles) is the full
+    grid's wherever the objective falls monotonically away from the plateau.
+
+    Parameters
+    ----------
+    months : numpy.ndarray
+        (days,) month of each day.
+    statistic : str
+        :func:`foldopt.studies.objectives.objective_value`'s.
+    seasons : sequence
+        Each period's months (None: every day).
+    tolerance_h : float
+        The search's tolerance [h].
+    near_optimal_tolerance : foldopt.inputs.sections.NearOptimal
+
+    Returns
+    -------
+    callable
+        ``fold(parts, loads, engine)`` -> ``(angles, hours (days, loads, angles), energy (days, angles))``.
+    """
+
+    def fold(parts, loads, engine):
+        study = parts[0][0].study
+        grid = study.fold_angles
+        axis = Axis("fold_angle", grid.start, grid.stop, grid.step)
+        found = {}
+
+        def evaluate(points):
+            designs = np.column_stack([points[:, 0], np.full(len(points), study.panel.tilt),
+                                       np.full(len(points), study.panel.azimuth)])
+            hours, energy = design_hours(parts, designs, loads, engine=engine, with_energy=True)
+            targets = np.concatenate([objective_value(hours, months, statistic, season) for season in seasons], axis=1)
+            for position, angle in enumerate(points[:, 0]):
+                found[float(angle)] = (hours[:, position], energy[:, position], targets[position])
+            return targets
+
+        grid_search(evaluate, [axis], tolerance_h, objective_quantum(statistic, parts[0][1].step_hours,
+                                                                     len(months), months))
+        all_angles = axis.values()
+        for _ in range(int(np.ceil(np.log2(max(axis.size, 2)))) + 3):
+            angles = np.array(sorted(found))
+            values = np.stack([found[angle][2] for angle in angles])  # (angles, targets)
+            best = values.shape[0] - 1 - np.argmax(values[::-1], axis=0)
+            top = values[best, np.arange(values.shape[1])]
+            short = values < top - near_optimal_tolerance.tolerance_h(top)
+            index = np.searchsorted(all_angles, angles - 1e-9)
+            wanted = set()
+            for target in range(values.shape[1]):
+                below = np.flatnonzero(short[:, target] & (np.arange(len(angles)) < best[target]))
+                above = np.flatnonzero(short[:, target] & (np.arange(len(angles)) > best[target]))
+                pairs = ([(below[-1], below[-1] + 1)] if below.size else []) + (
+                    [(above[0] - 1, above[0])] if above.size else [])
+                for a, b in pairs:
+                    if index[b] - index[a] > 1:
+                        wanted.add((index[a] + index[b]) // 2)
+            if not wanted:
+                # The recommended angle is the grid's nearest the range's centre: evaluated too.
+                ranges = near_optimal(angles, values.T, near_optimal_tolerance)
+                centres = (ranges["near_optimal_lo_deg"] + ranges["near_optimal_hi_deg"]) / 2
+                # Ties go to the less folded angle, as near_optimal breaks them.
+                nearest = {int(np.argmin(np.abs(all_angles - centre) - 1e-9 * all_angles))
+                           for centre in centres[np.isfinite(centres)]}
+                missing = sorted(i for i in nearest if float(all_angles[i]) not in found)
+                if not missing:
+                    break
+                evaluate(all_angles[missing][:, None])
+                continue
+            evaluate(all_angles[sorted(wanted)][:, None])
+        angles = np.array(sorted(found))
+        hours = np.stack([found[angle][0] for angle in angles], axis=-1)  # (days, loads, angles)
+        energy = np.stack([found[angle][1] for angle in angles], axis=-1)  # (days, angles)
+        return angles, hours, energy
+
+    return fold

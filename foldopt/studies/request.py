@@ -419,7 +419,8 @@ def sweep_request(study, options: dict, axis: str | None, source: str, section: 
 
 
 def map_request_from(study=None, *, source: str = "the given study", objective: str = "mean", area=None,
-                     efficiency=None, step_min=None, angle_step=None, settings=(), loads=None, **where):
+                     efficiency=None, step_min=None, angle_step=None, fold_search: bool = False, settings=(),
+                     loads=None, **where):
     """The request of ``foldopt map``: a study made into a map's study by the map's options, and
     the map's sites and loads (:func:`foldopt.studies.worldmap.map_request`).
 
@@ -439,6 +440,9 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
         Time step [min]; default the study's.
     angle_step : float, optional
         Fold-angle grid step [deg], the grid from it to 180; default the study's grid.
+    fold_search : bool
+        Search each site's fold angles (``optimize: {vary: [fold_angle]}``,
+        :func:`foldopt.studies.joint.fold_search`) instead of evaluating every one.
     settings : sequence of str
         ``KEY=VALUE`` texts (:func:`parse_setting`), set last.
     loads : float, sequence of float or str, optional
@@ -467,6 +471,8 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
             changes[field] = value
     if angle_step is not None:
         changes["fold_angles"] = {"start": angle_step, "stop": 180.0, "step": angle_step}
+    if fold_search:
+        changes["optimize"] = {**(data.get("optimize") or {}), "vary": ["fold_angle"]}
     made = map_study(data, embedded=study is None, **changes)
     for setting in settings:
         made = policy.set_path(made, *parse_setting(setting))

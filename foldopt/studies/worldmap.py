@@ -37,6 +37,7 @@ from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_s
 from foldopt.inputs.study import Study, format_errors
 from foldopt.errors import ConfigError
 from foldopt.studies.designs import Blocks, daily_designs
+from foldopt.studies.joint import fold_search
 from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
@@ -203,6 +204,10 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
     largest, bounds = LOAD_BOUNDS[relative]
     if any(not 0 < value <= largest for value in load_values):
         errors.append(f"loads = {loads!r}: {bounds}")
+    vary = (study.get("optimize") or {}).get("vary", ["fold_angle"])
+    if study.get("optimize") is not None and list(vary) != ["fold_angle"]:
+        errors.append(f"optimize.vary = {vary!r}: a map searches the fold angle alone (the tilt and azimuth "
+                      f"with it: foldopt optimize, one site at a time)")
     if errors:
         raise ConfigError(errors)
     if isinstance(sites, (str, Path)):
@@ -321,13 +326,18 @@ def _evaluate_site(study_data: dict, site: dict, loads, relative: bool, year: in
     watts = loads * flat_peak if relative else loads
     # A load of 0 W (a site whose flat panel never sees the sun) has no t_solar to speak of.
     usable = np.where(watts > 0, watts, np.inf)
-    days_of = daily_designs([(blocks[part], sky) for part, sky in zip(parts, skies, strict=True)], usable, engine)
+    months = np.array([date.month for date in dates])
+    seasons = [None, *SEASONS.values()]
+    # A map searches the fold angles (foldopt.studies.joint.fold_search) unless its study sweeps them all.
+    search = study.optimize
+    fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h,
+                                                   study.near_optimal)
+    days_of = daily_designs([(blocks[part], sky) for part, sky in zip(parts, skies, strict=True)], usable, engine,
+                            fold)
     angles, hours, harvest = days_of.angles, days_of.twofold_h, days_of.twofold_wh
     flat_hours, flat_energy = days_of.flat_h, days_of.flat_wh
     tracker_hours, tracker_net, tracker_energy = days_of.tracker_h, days_of.tracker_net_h, days_of.tracker_wh
     available = days_of.available
-    months = np.array([date.month for date in dates])
-    seasons = [None, *SEASONS.values()]
 
     def statistic_of(daily, season):
         return objective_value(daily, months, statistic, season)
