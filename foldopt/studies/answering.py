@@ -414,7 +414,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
     year = table[table["period"] == "year"]
     key = "p_load_fraction" if relative else "p_load_w"
     per_load = []
-    for load, rows in year.groupby(key, sort=True):
+    # A fraction is watts over each site's peak: the same load to 12 digits at every site.
+    for load, rows in year.groupby(year[key].round(12), sort=True):
         gain = rows["gain_vs_flat_pct"]
         best = rows.loc[gain.idxmax()] if gain.notna().any() else None
         per_load.append({
