@@ -163,3 +163,18 @@ def test_the_command_line_and_the_api_give_the_same_answer(tmp_path, joint):
     api = json.loads(json.dumps(joint.answer.to_dict()))
     assert cli["result"] == api["result"] and cli["designs"] == api["designs"]
     assert (tmp_path / "out" / "landscape.png").exists()
+
+
+def test_a_mounting_search_leaves_paper_mode_and_a_fold_search_keeps_it():
+    """Shin et al.'s Eq. 5 is the angle of incidence only for a surface facing the sun's azimuth: an
+    optimisation that re-tilts or turns the paper's panel runs in exact mode, and says so."""
+    from foldopt.studies.request import plan_request
+
+    data = foldopt.default_study().data()
+    assert data["mode"] == "paper"
+    mounting = plan_request(data, {"optimize": {"vary": ["fold_angle", "tilt"]}})
+    assert mounting.plan.base.mode == "exact" and any("Eq. 5" in item for item in mounting.taken)
+    fold = plan_request(data, {"optimize": {"vary": ["fold_angle"]}})
+    assert fold.plan.base.mode == "paper"
+    kept = plan_request(data, {"optimize": {"vary": ["tilt"]}, "mode": "paper"})
+    assert kept.plan.base.mode == "paper"

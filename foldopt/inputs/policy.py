@@ -34,6 +34,10 @@ SECTIONS = ("site", "panel", "tracker", "objective", "fold_angles", "near_optima
 AWAY_FROM_PAPER = ("site.latitude", "site.longitude", "site.altitude", "date", "weather")
 #: What the policy says where it switches a paper-mode study to exact mode.
 EXACT_NOTE = "exact mode (paper mode is for the paper's own site and day: set mode paper to keep it)"
+#: An optimisation that turns or re-tilts the panel leaves paper mode too: Shin et al.'s Eq. 5 is the
+#: angle of incidence only for a surface facing the sun's azimuth, so it would choose the mounting.
+MOUNTING_NOTE = ("exact mode (the paper's Eq. 5 is no angle of incidence for a re-tilted or turned panel: set "
+                 "mode paper to keep it)")
 
 
 #: Sections a study may give as one value, and the field that value is.
@@ -182,6 +186,12 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     if old_mode == "paper" and "mode" not in given and any(touched(given, path) for path in AWAY_FROM_PAPER):
         data["mode"] = "exact"
         decided.append(EXACT_NOTE)
+    optimize = changes.get("optimize", data.get("optimize"))
+    vary = (optimize.get("vary") if isinstance(optimize, dict) else None) or ("tilt", "azimuth")
+    if (data.get("mode", "exact") == "paper" and "mode" not in given and touched(given, "optimize")
+            and {"tilt", "azimuth"} & set(vary if isinstance(vary, (list, tuple)) else [vary])):
+        data["mode"] = "exact"
+        decided.append(MOUNTING_NOTE)
     new_mode = changes.get("mode", data.get("mode", "exact"))
     if new_mode != old_mode and "geometry" not in given:
         data.pop("geometry", None)  # the new mode's own geometry

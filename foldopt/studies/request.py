@@ -174,11 +174,12 @@ def _taken(plan: Plan, changes: dict, field: str | None, data: dict, decided: li
         taken.append(f"panel {study.panel.area:g} m^2")
     if "p_load" not in given and field != "p_load":
         taken.append(load_text(study))
+    notes = [note for note in (policy.EXACT_NOTE, policy.MOUNTING_NOTE) if note in decided]
     if "mode" not in given:
-        taken.append(policy.EXACT_NOTE if policy.EXACT_NOTE in decided else f"{study.mode} mode")
+        taken.append(notes[0] if notes else f"{study.mode} mode")
     if "pv_model" not in given:
         taken.append(f"{study.pv_model} PV model")
-    taken += [item for item in decided if item != policy.EXACT_NOTE]
+    taken += [item for item in decided if item not in notes]
     return taken
 
 
