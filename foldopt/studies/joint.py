@@ -136,7 +136,7 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     Raises
     ------
     foldopt.ConfigError
-        For other axes, a load profile scaled over an axis, or a cloud ensemble.
+        For other axes, or a cloud ensemble.
     """
     study = plan.base.resolved()
     spec = study.optimize
@@ -155,8 +155,8 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     study = blocks.study
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
     months = np.array([date.month for date in dates])
-    step_hours = parts[0][1].step_hours
-    quantum = objective_quantum(statistic, step_hours, len(dates), months)
+    counted = months[np.isin(months, season)] if season else months  # the days the objective takes
+    quantum = objective_quantum(statistic, parts[0][1].step_hours, counted.size, counted)
 
     def objective(flat):
         def evaluate(points):
