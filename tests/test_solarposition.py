@@ -192,3 +192,22 @@ def test_split_spa_equals_pvlib_spa_python_on_random_sites():
         b = normal_vector(spa["apparent_zenith"].to_numpy(), spa["azimuth"].to_numpy())[compared]
         angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.sum(a * b, axis=1)))
         assert angle.max() < 0.006, (latitude[block, 0], longitude[block, 0], dates[block])
+
+
+def test_hours_evaluated_once_per_process_are_the_same_bits():
+    """The time-only SPA terms kept per UTC hour (a map's sites share them) are the bits a direct
+    evaluation gives, whichever calls filled the store first."""
+    import foldopt.physics.spa as spa
+
+    hours = np.arange(482_000, 482_000 + 9_000, dtype=np.int64)
+    direct = spa.spa_geocentric(hours * 3600.0)
+    kept = spa._AT_HOURS
+    try:
+        spa._AT_HOURS = (np.zeros(0, dtype=np.int64), {})
+        spa._geocentric_at_hours(hours[1000:3000])
+        spa._geocentric_at_hours(hours[::7])
+        again = spa._geocentric_at_hours(hours)
+    finally:
+        spa._AT_HOURS = kept
+    for name, values in direct.items():
+        np.testing.assert_array_equal(again[name], values)

@@ -99,14 +99,41 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
 _WRAPPED = ("alpha", "v")  # angles that wrap at 360 deg
 
 
+#: The time-only terms at whole UTC hours this process has evaluated: (hours, terms), replaced
+#: whole (one assignment, so a thread reads one state or the other). A map's sites of one year
+#: share every hour; :data:`HOURS_KEPT` bounds it (about 80 MB).
+_AT_HOURS: tuple = (np.zeros(0, dtype=np.int64), {})
+HOURS_KEPT = 2_000_000
+
+
+def _geocentric_at_hours(nodes: np.ndarray) -> dict:
+    """:func:`spa_geocentric` at whole UTC hours (sorted, unique), each hour evaluated once per
+    process. The terms are elementwise in time, so an hour's are the same bits whichever call
+    first asked for it (tested)."""
+    global _AT_HOURS
+    hours, terms = _AT_HOURS
+    missing = nodes[~np.isin(nodes, hours)]
+    if missing.size:
+        found = spa_geocentric(missing * 3600.0)
+        if hours.size + missing.size > HOURS_KEPT:
+            hours, terms = missing[:0], {name: values[:0] for name, values in found.items()}
+        order = np.argsort(np.concatenate([hours, missing]), kind="stable")
+        hours = np.concatenate([hours, missing])[order]
+        terms = {name: np.concatenate([terms.get(name, values[:0]), values])[order] for name, values in found.items()}
+        _AT_HOURS = (hours, terms)
+    index = np.searchsorted(hours, nodes)
+    return {name: values[index] for name, values in terms.items()}
+
+
 def _geocentric_hourly(utc_ns: np.ndarray) -> dict:
     """:func:`spa_geocentric` at ``utc_ns`` (any shape), interpolated linearly between whole UTC
-    hours, each hour evaluated once however many sites and days share it.
+    hours, each hour evaluated once however many sites and days share it
+    (:func:`_geocentric_at_hours`).
 
     Over an hour the geocentric terms are smooth to within 1e-5 deg of linear (tested)."""
     hours = np.floor_divide(utc_ns, NS_PER_HOUR)
     nodes = np.unique(np.concatenate([hours.ravel(), hours.ravel() + 1]))
-    at_nodes = spa_geocentric(nodes * 3600.0)
+    at_nodes = _geocentric_at_hours(nodes)
     index = np.searchsorted(nodes, hours)
     weight = (utc_ns - hours * NS_PER_HOUR) / NS_PER_HOUR
     out = {}
