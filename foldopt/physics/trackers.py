@@ -348,12 +348,15 @@ class TrackerDrive:
         if self.drive != "motor":
             raise ValueError(f"drive must be one of {', '.join(DRIVES)}; got {self.drive!r}")
         speed = self.gain / self.counts_per_revolution * 360.0  # gear-motor output at steady state [deg/s]
-        target = degrees * self.gear_ratio  # gear-motor output rotation [deg]
+        moved = degrees > 0
+        energy = np.zeros(degrees.shape)
+        target = degrees[moved] * self.gear_ratio  # gear-motor output rotation [deg]; only the moves are solved
         duration = _time_to_turn(target, speed, self.tau_1, self.tau_2)
         # I(t) = I_stall - (I_stall - I_free) * omega(t) / omega_ss, so the charge is
         # I_stall * T - (I_stall - I_free) * angle / omega_ss.
         charge = self.stall_current * duration - (self.stall_current - self.free_current) * target / speed
-        return np.where(degrees > 0, self.motor_voltage * charge / 3600.0, 0.0)
+        energy[moved] = self.motor_voltage * charge / 3600.0
+        return energy
 
 
 def _turned(t, speed, tau_1, tau_2):
@@ -362,11 +365,15 @@ def _turned(t, speed, tau_1, tau_2):
 
 
 def _time_to_turn(angle, speed, tau_1, tau_2):
-    """Time [s] to turn ``angle`` [deg] from rest, by Newton's method on :func:`_turned`."""
+    """Time [s] to turn ``angle`` [deg] from rest, by Newton's method on :func:`_turned`: at most 30
+    steps, ended once no element changes (a fixed point, which further steps keep bit for bit)."""
     t = angle / speed + tau_1 + tau_2
     for _ in range(30):
         rate = speed * (1 - (tau_1 * np.exp(-t / tau_1) - tau_2 * np.exp(-t / tau_2)) / (tau_1 - tau_2))
-        t = np.maximum(t - (_turned(t, speed, tau_1, tau_2) - angle) / rate, 1e-9)
+        step = np.maximum(t - (_turned(t, speed, tau_1, tau_2) - angle) / rate, 1e-9)
+        if np.array_equal(step, t):
+            break
+        t = step
     return t
 
 
