@@ -178,3 +178,19 @@ def test_a_mounting_search_leaves_paper_mode_and_a_fold_search_keeps_it():
     assert fold.plan.base.mode == "paper"
     kept = plan_request(data, {"optimize": {"vary": ["tilt"]}, "mode": "paper"})
     assert kept.plan.base.mode == "paper"
+
+
+def test_a_weather_year_with_a_load_profile_is_optimised():
+    """A TMY3 year and a camera's day/night profile, judged by the worst month: the optimum holds
+    its fold angle and tilt, never below the flat panel at its own best, and says the load is the
+    profile's scale."""
+    from pathlib import Path
+
+    weather = Path(__file__).resolve().parent.parent / "configs" / "weather" / "723170TYA.CSV"
+    result = foldopt.optimize(foldopt.default_study(), vary="fold_angle,tilt", weather=str(weather), step_min=30,
+                              panel={"area": 0.3}, objective="worst-month",
+                              load_profile={"daily": {"00:00": 1.5, "07:00": 6, "19:00": 1.5}})
+    table = result.table.set_index("design")["objective_h"]
+    assert table["twofold"] >= table["flat"] - 0.01 and table["twofold"] >= table["flat-default"] - 1e-12
+    assert len(result.dates) == 365 and result.statistic == "worst-month"
+    assert result.answer.summary[1].startswith("load profile x 1:")

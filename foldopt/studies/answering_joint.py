@@ -51,7 +51,8 @@ def of_optimize(result) -> Answer:
         best, flat = _row(table, load, "twofold"), _row(table, load, "flat")
         default, flat_default = _row(table, load, "twofold-default"), _row(table, load, "flat-default")
         tracker = _row(table, load, "tracker")
-        lines.append(f"P_load {load:g} W: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
+        label = f"load profile x {load:g}" if study.load_profile is not None else f"P_load {load:g} W"
+        lines.append(f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
                      f"{best.objective_h:.2f} h, {best.gain_vs_flat_pct:+.1f} % over the flat panel at its own best "
                      f"({_mounting(flat)}: {flat.objective_h:.2f} h); tracker {tracker.objective_h:.2f} h")
         near = result.near_optimal[result.near_optimal["p_load_w"] == load]
@@ -63,8 +64,8 @@ def of_optimize(result) -> Answer:
         added = result.added[result.added["p_load_w"] == load]
         lines.append(f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} h, "
                      f"folded to {default.fold_angle_deg:g} deg {default.objective_h:.2f} h): "
-                     + ", ".join(f"{_LABELS[row.variable][0]} {row.added_h * 60:+.1f} min"
-                                 for row in added.itertuples()))
+                     + ", ".join(f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
+                                 for row in added.itertuples()))  # + 0.0: no "-0.0" for a roundoff
         per_load.append({"p_load_w": load, "fold_angle_deg": best.fold_angle_deg, "surface_tilt": best.surface_tilt,
                          "surface_azimuth": best.surface_azimuth, "objective_h": best.objective_h,
                          "gain_vs_flat_pct": best.gain_vs_flat_pct,
