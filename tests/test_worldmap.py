@@ -190,6 +190,10 @@ def test_a_grid_map_is_a_cf_netcdf_dataset(tmp_path):
     assert np.isnan(data["objective_twofold_h"].sel(latitude=0.0, longitude=60.0)).all()
     named = table.assign(site_name="somewhere")
     assert grid_dataset(named, relative=True) is None
+    column = evaluate_sites(COARSE, grid_sites([-60.0, -30.0, 30.0], [0.0], False), [0.1], relative=True)
+    ocean_row = grid_dataset(column, relative=True)  # the row at 0 deg wholly at sea
+    assert list(ocean_row["latitude"].values) == [-60.0, -30.0, 0.0, 30.0]
+    assert np.isnan(ocean_row["objective_twofold_h"].sel(latitude=0.0)).all()
 
 
 @settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])

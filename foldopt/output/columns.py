@@ -64,6 +64,7 @@ COLUMNS = (
     ("near_optimal_hi_deg", "deg", "the largest fold angle on the best one's plateau"),
     ("recommended_fold_angle_deg", "deg", "the grid angle at the centre of the near-optimal range"),
     ("near_optimal_tolerance_h", "h", "how far below the best an angle may fall and still be near-optimal"),
+    ("near_optimal_width_deg", "deg", "near_optimal_hi_deg - near_optimal_lo_deg (a map's figure of it)"),
     # the joint optimisation (foldopt optimize)
     ("variable", "", "fold_angle, tilt or azimuth: the variable a row of near_optimal.csv or added.csv is of; "
                      "its near-optimal range is then in that variable's degrees"),

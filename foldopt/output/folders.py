@@ -322,6 +322,7 @@ def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, lo
     loads = table["p_load_fraction"] if relative else table["p_load_w"]
     values = np.unique(loads.round(12))
     shown = table[(np.isclose(loads, values[load_index])) & (table["period"] == period)]
+    shown = shown.assign(near_optimal_width_deg=shown["near_optimal_hi_deg"] - shown["near_optimal_lo_deg"])
     unit = "of the flat peak" if relative else "W"
     what = f"P_load {values[load_index]:g} {unit}, {period}"
     written = [write_figure(folder, file, shown, column, f"{name}: {description} ({what})", label, diverging)

@@ -3,9 +3,9 @@ period with CF metadata, the form gridded solar data takes elsewhere, so that xa
 (QGIS, Panoply, CDO) open it directly.
 
 The file is NetCDF-3 (classic), written by xarray's SciPy backend, which needs no HDF5 library. It
-is written where a map's sites are points of a regular latitude x longitude grid (a sea point of a
-land-only grid is missing, its values ``_FillValue``); a map of named sites or weather files keeps
-its tables alone. Each variable carries its unit (UDUNITS spelling) and meaning from the column
+is written where a map's sites are points of a regular latitude x longitude grid (a sea point, or a
+whole row of them, of a land-only grid is missing, its values ``_FillValue``); a map of named sites
+or weather files keeps its tables alone. Each variable carries its unit (UDUNITS spelling) and meaning from the column
 registry (:mod:`foldopt.output.columns`).
 """
 
@@ -26,9 +26,16 @@ _UNITS = {"h": "h", "W": "W", "Wh": "W h", "%": "percent", "deg": "degree", "-":
 _NOT_VARIABLES = ("site_id", "site_name", "weather", "latitude", "longitude", "period")
 
 
-def _regular(values: np.ndarray) -> bool:
-    steps = np.diff(values)
-    return values.size < 3 or bool(np.allclose(steps, steps[0], rtol=1e-6, atol=1e-9))
+def _lattice(values: np.ndarray) -> np.ndarray | None:
+    """The regular axis the values lie on, whole rows or columns missing allowed (a land grid's
+    sea), or None where they lie on none."""
+    if values.size < 3:
+        return values
+    step = np.diff(values).min()
+    position = (values - values[0]) / step
+    if not np.allclose(position, np.round(position), atol=1e-6):
+        return None
+    return values[0] + step * np.arange(int(round(position[-1])) + 1)
 
 
 def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"):
@@ -51,8 +58,8 @@ def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"
 
     if (table["site_name"].astype(str) != "").any() or (table["weather"].astype(str) != "").any():
         return None
-    latitudes, longitudes = np.unique(table["latitude"]), np.unique(table["longitude"])
-    if not (_regular(latitudes) and _regular(longitudes)):
+    latitudes, longitudes = _lattice(np.unique(table["latitude"])), _lattice(np.unique(table["longitude"]))
+    if latitudes is None or longitudes is None:
         return None
     load = "p_load_fraction" if relative else "p_load_w"
     # A fraction is watts over the site's peak: the same load to 12 digits at every site.

@@ -136,6 +136,8 @@ MAPS = (
      "gain over flat [%]", True),
     ("map_pct_of_tracker.png", "pct_of_tracker", "twofold panel's t_solar as a share of the tracker's",
      "share of the tracker [%]", False),
+    ("map_near_optimal_width.png", "near_optimal_width_deg", "near-optimal fold-angle range's width",
+     "near-optimal range, hi - lo [deg]", False),
 )
 
 #: A map's folder holds every one.
