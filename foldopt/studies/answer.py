@@ -120,7 +120,8 @@ class Answer:
     def tables(self) -> list[tuple[str, pd.DataFrame]]:
         """The answer's tables with their titles, for a report."""
         return [(title, table) for title, table in (
-            ("Designs compared", self.designs), ("Near-optimal fold angles", self.near_optimal),
+            ("Designs compared", self.designs),
+            ("Near-optimal ranges" if self.kind == "optimize" else "Near-optimal fold angles", self.near_optimal),
             ("Re-fold schedules", self.schedule)) if len(table)]
 
 
