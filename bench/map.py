@@ -3,6 +3,9 @@
     python bench/map.py                  # 2,000 sites, printed
     python bench/map.py --write          # ... and written to results/bench/map.md and map.json
     python bench/map.py --sites 200      # a quicker look
+    python bench/map.py --phases         # a site's cost by phase (profiled)
+    python bench/map.py --w5 --sites 400 # W5 on 400 of the 1-degree land grid's sites, extrapolated
+    python bench/map.py --w5             # W5: the whole 1-degree land grid (target 600 s)
 
 W4: 2,000 sites (a 40 x 50 latitude x longitude grid from 58.5 S to 58.5 N) x 365 days x 180
 fold angles (1..180 deg) x 10 loads (5 % to 50 % of each site's flat peak), the map's defaults:
@@ -95,12 +98,59 @@ def phases(spec, n_sites: int = 20) -> dict:
     return {"per_site_s": total, **seconds}
 
 
+W5_TARGET_S = 600.0  # the 1-degree land grid on this machine's embedded cluster
+
+
+def w5(subset: int | None, check_sites: int = 200) -> None:
+    """W5: the 1-degree land grid (a year each, 10 loads, 5 periods, 5-min steps) on the embedded
+    cluster of two workers, its fold angles searched (``--fold-search``); ``subset`` sites spread over
+    the grid instead, the whole grid's time extrapolated from them. Then ``check_sites`` of them
+    evaluated again with every fold angle, in this process: each objective within the search's
+    0.01 h of the full sweep's."""
+    import pandas as pd
+
+    from foldopt.inputs.load import default_study_path, read_study
+    from foldopt.inputs.sites import grid_sites
+    from foldopt.studies.cluster import MapSpec, run_map
+    from foldopt.studies.worldmap import evaluate_sites, map_study
+
+    land = grid_sites(list(range(-90, 91)), list(range(-180, 180)), land_only=True)
+    sites = land if subset is None else land[::max(1, len(land) // subset)][:subset]
+    loads = tuple(np.round(np.arange(1, 11) * 0.05, 6))
+    full = map_study(read_study(default_study_path())[0])
+    searched = {**full, "optimize": {"vary": ["fold_angle"]}}
+    with tempfile.TemporaryDirectory() as folder:
+        started = time.perf_counter()
+        result = run_map(MapSpec(searched, tuple(sites), loads, relative=True), Path(folder) / "w5", workers=2)
+        wall = time.perf_counter() - started
+    whole = wall * len(land) / len(sites)
+    print(f"W5: {len(sites):,} of the {len(land):,} land sites in {wall:.1f} s on 2 workers "
+          f"({len(sites) / wall:.2f} sites/s); the whole grid at that pace {whole:.0f} s (target {W5_TARGET_S:.0f} s)")
+    chosen = [{**site, "site_id": index} for index, site in enumerate(sites)][::max(1, len(sites) // check_sites)]
+    chosen = chosen[:check_sites]
+    reference = evaluate_sites(full, chosen, loads, relative=True)
+    ids = [site["site_id"] for site in chosen]
+    mine = result.table[result.table["site_id"].isin(ids)].reset_index(drop=True)
+    keys = ["site_id", "p_load_fraction", "period"]
+    merged = pd.merge(mine.assign(p_load_fraction=mine["p_load_fraction"].round(12)),
+                      reference.assign(p_load_fraction=reference["p_load_fraction"].round(12)), on=keys,
+                      suffixes=("_search", "_full"))
+    short = merged["objective_twofold_h_full"] - merged["objective_twofold_h_search"]
+    print(f"check on {len(chosen)} sites ({len(merged):,} rows): the search short of the full sweep by at most "
+          f"{short.max():.5f} h, never above it by more than {max(0.0, -short.min()):.2e} h (tolerance 0.01 h)")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sites", type=int, default=2000)
     parser.add_argument("--write", action="store_true", help="write results/bench/map.md and map.json")
     parser.add_argument("--phases", action="store_true", help="only the per-site cost by phase (20 sites, profiled)")
+    parser.add_argument("--w5", action="store_true", help="W5: the 1-degree land grid with the fold search "
+                                                          "(--sites N: N of its sites, the whole extrapolated)")
     args = parser.parse_args()
+    if args.w5:
+        w5(args.sites if "--sites" in sys.argv else None)
+        return
     spec = _spec(args.sites)
     if args.phases:
         cost = phases(spec)
