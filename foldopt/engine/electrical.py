@@ -295,8 +295,9 @@ class Electrical:
         if self.circuit is None or not self.circuit.direct or not self.pv.has_iv:
             return None
         stc = np.array([1000.0])
-        return "parallel" if (self._flat_wired(stc, self._temperature(stc), "parallel")
-                              > self._flat_wired(stc, self._temperature(stc), "series"))[0] else "series"
+        temp_cell = self._temperature(stc)
+        parallel, series = (self._flat_wired(stc, temp_cell, wiring)[0] for wiring in ("parallel", "series"))
+        return "parallel" if parallel > series else "series"
 
     def _flat_wired(self, poa, temp_cell, wiring):
         half = self.pv.curves(poa, temp_cell, self.subpanel_area)

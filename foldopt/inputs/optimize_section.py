@@ -19,6 +19,36 @@ DEFAULT_TILT = (0.0, 90.0, 1.0)
 DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP = 90.0, 2.0
 
 
+def vary_names(value) -> list[str]:
+    """The variables an ``optimize.vary`` names: a list, or names joined by commas
+    (``fold_angle, tilt``), each in foldopt's spelling where it is one of
+    :data:`foldopt.names.OPTIMIZE_VARIABLES` (the study's validation names any other).
+
+    Parameters
+    ----------
+    value : str or sequence of str
+
+    Returns
+    -------
+    list of str
+
+    Raises
+    ------
+    ValueError
+        For a value that is no list of names.
+    """
+    items = [item.strip() for item in value.split(",")] if isinstance(value, str) else value
+    if not isinstance(items, (list, tuple)) or not all(isinstance(item, str) for item in items):
+        raise ValueError(f"must be a list of {', '.join(names.OPTIMIZE_VARIABLES)}")
+    spelled = []
+    for item in items:
+        try:
+            spelled.append(canonical(item, names=names.OPTIMIZE_VARIABLES))
+        except ValueError:
+            spelled.append(item)
+    return spelled
+
+
 class Bounds(StrictModel):
     """One variable's range and resolution [deg]: ``min`` to ``max`` by ``step``, ending on ``max``.
 
@@ -70,10 +100,7 @@ class Optimize(StrictModel):
     @classmethod
     def _known(cls, value):
         """``vary: fold_angle, tilt`` is the list; each name in foldopt's spelling, once."""
-        items = [item.strip() for item in value.split(",")] if isinstance(value, str) else value
-        if not isinstance(items, (list, tuple)) or not all(isinstance(item, str) for item in items):
-            raise ValueError(f"must be a list of {', '.join(names.OPTIMIZE_VARIABLES)}")
-        items = [canonical(item, names=names.OPTIMIZE_VARIABLES) for item in items]
+        items = [canonical(item, names=names.OPTIMIZE_VARIABLES) for item in vary_names(value)]
         if len(set(items)) < len(items):
             raise ValueError("name each variable once")
         return items

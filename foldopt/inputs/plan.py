@@ -69,6 +69,17 @@ _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _NUMERIC_RANGE = re.compile(rf"^\s*{_NUMBER}\s*:\s*{_NUMBER}\s*:\s*{_NUMBER}\s*$")
 
 
+def range_parts(text: str) -> tuple[float, float, float]:
+    """The three numbers of ``"start:stop:step"``, unchecked; ValueError for any other text."""
+    match = _RANGE.match(str(text))
+    if not match:
+        raise ValueError(f"expected start:stop:step, got {text!r}")
+    try:
+        return tuple(float(part) for part in match.groups())
+    except ValueError:
+        raise ValueError(f"expected numbers in start:stop:step, got {text!r}") from None
+
+
 def parse_range(text: str) -> list[float]:
     """The values of a range.
 
@@ -87,13 +98,7 @@ def parse_range(text: str) -> list[float]:
     ValueError
         For a malformed or empty range, or more than :data:`MAX_AXIS_VALUES` values.
     """
-    match = _RANGE.match(str(text))
-    if not match:
-        raise ValueError(f"expected start:stop:step, got {text!r}")
-    try:
-        start, stop, step = (float(part) for part in match.groups())
-    except ValueError:
-        raise ValueError(f"expected numbers in start:stop:step, got {text!r}") from None
+    start, stop, step = range_parts(text)
     if step <= 0 or not all(map(math.isfinite, (start, stop, step))):
         raise ValueError(f"step must be a positive number, got {text!r}")
     if stop < start:
@@ -273,14 +278,12 @@ class Plan:
 
 
 def _listed_leaves(data: dict, prefix: str = ""):
-    """Dotted paths holding a list (but a list-valued field's own value,
-    :func:`foldopt.inputs.fields.list_valued_fields`), a numeric ``start:stop:step`` range or a
-    date keyword."""
+    """Dotted paths holding a list (not a list-valued field's own value,
+    :func:`~foldopt.inputs.fields.list_valued_fields`), a numeric range or a date keyword."""
     for key, value in data.items():
         path = f"{prefix}{key}"
-        if path == "date" and (isinstance(value, list) or value in DATE_KEYWORDS or (
-            isinstance(value, str) and _RANGE.match(value)
-        )):
+        if path == "date" and (isinstance(value, list) or value in DATE_KEYWORDS
+                               or (isinstance(value, str) and _RANGE.match(value))):
             yield path, value
         elif isinstance(value, list) and list_depth(value) == _LIST_VALUED.get(path):
             continue

@@ -25,7 +25,8 @@ from __future__ import annotations
 
 import copy
 
-from foldopt.names import HOURLY_WEATHER_FORMATS, WEATHER_FORMATS, canonical
+from foldopt.inputs.optimize_section import vary_names
+from foldopt.names import HOURLY_WEATHER_FORMATS, OPTIMIZE_VARIABLES, WEATHER_FORMATS, canonical
 
 #: Sections of a study whose fields a change merges into (a mapping changes the fields it names);
 #: any other field given a mapping (a load profile, a weather file) is replaced whole.
@@ -140,6 +141,16 @@ def is_single(value) -> bool:
             and text not in ("year", "equinoxes-solstices"))
 
 
+def _varied(optimize) -> list[str]:
+    """The variables an ``optimize`` section varies (all by default); none where it names no list
+    (its validation says so)."""
+    vary = optimize.get("vary") if isinstance(optimize, dict) else None
+    try:
+        return list(OPTIMIZE_VARIABLES) if vary is None else vary_names(vary)
+    except ValueError:
+        return []
+
+
 def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dict, list[str]]:
     """The study data that runs when ``changes`` are made to ``data``.
 
@@ -186,10 +197,8 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     if old_mode == "paper" and "mode" not in given and any(touched(given, path) for path in AWAY_FROM_PAPER):
         data["mode"] = "exact"
         decided.append(EXACT_NOTE)
-    optimize = changes.get("optimize", data.get("optimize"))
-    vary = (optimize.get("vary") if isinstance(optimize, dict) else None) or ("tilt", "azimuth")
     if (data.get("mode", "exact") == "paper" and "mode" not in given and touched(given, "optimize")
-            and {"tilt", "azimuth"} & set(vary if isinstance(vary, (list, tuple)) else [vary])):
+            and {"tilt", "azimuth"} & set(_varied(changes.get("optimize", data.get("optimize"))))):
         data["mode"] = "exact"
         decided.append(MOUNTING_NOTE)
     new_mode = changes.get("mode", data.get("mode", "exact"))

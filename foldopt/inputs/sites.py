@@ -12,6 +12,7 @@ import io
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
 from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
@@ -58,6 +59,31 @@ def grid_sites(latitudes: Sequence[float], longitudes: Sequence[float], land_onl
         keep = is_land([s["latitude"] for s in sites], [s["longitude"] for s in sites])
         sites = [site for site, land in zip(sites, keep, strict=True) if land]
     return sites
+
+
+def lattice(values) -> np.ndarray | None:
+    """The regular lattice that values sit on, whole rows of a grid missing allowed (a land grid's
+    sea), or None where they sit on none.
+
+    Parameters
+    ----------
+    values : array_like
+        Latitudes or longitudes [deg] of a grid's sites.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        Ascending, from the least value to the largest by the smallest spacing; a single value is
+        its own lattice.
+    """
+    values = np.unique(values)
+    if values.size < 2:
+        return values
+    step = np.diff(values).min()
+    steps = (values - values[0]) / step
+    if not np.allclose(steps, np.round(steps), atol=1e-6):
+        return None
+    return values[0] + step * np.arange(int(round(steps[-1])) + 1)
 
 
 def read_sites(path: Path | str) -> list[dict]:

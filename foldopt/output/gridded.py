@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from foldopt.files import versions, write_atomically
+from foldopt.inputs.sites import lattice
 from foldopt.output.columns import describe
 from foldopt.studies.worldmap import PERIODS
 
@@ -24,18 +25,6 @@ from foldopt.studies.worldmap import PERIODS
 _UNITS = {"h": "h", "W": "W", "Wh": "W h", "%": "percent", "deg": "degree", "-": "1", "kWh/m^2": "kW h m-2"}
 #: Columns that are coordinates or labels, not variables.
 _NOT_VARIABLES = ("site_id", "site_name", "weather", "latitude", "longitude", "period")
-
-
-def _lattice(values: np.ndarray) -> np.ndarray | None:
-    """The regular axis the values lie on, whole rows or columns missing allowed (a land grid's
-    sea), or None where they lie on none."""
-    if values.size < 3:
-        return values
-    step = np.diff(values).min()
-    position = (values - values[0]) / step
-    if not np.allclose(position, np.round(position), atol=1e-6):
-        return None
-    return values[0] + step * np.arange(int(round(position[-1])) + 1)
 
 
 def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"):
@@ -58,7 +47,7 @@ def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"
 
     if (table["site_name"].astype(str) != "").any() or (table["weather"].astype(str) != "").any():
         return None
-    latitudes, longitudes = _lattice(np.unique(table["latitude"])), _lattice(np.unique(table["longitude"]))
+    latitudes, longitudes = lattice(table["latitude"]), lattice(table["longitude"])
     if latitudes is None or longitudes is None:
         return None
     load = "p_load_fraction" if relative else "p_load_w"

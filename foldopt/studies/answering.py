@@ -173,13 +173,21 @@ def of_study(result) -> Answer:
         lines.append("; ".join(extras))
     columns = ["design", "fold_angle_deg", "t_solar_h", "energy_harvested_wh", "gain_vs_flat_pct", "pct_of_tracker",
                "note"]
-    return Answer("study", study.name, study_question(study), _defaults(result), result_part,
+    return Answer("study", study.name, study_question(study), request_defaults(result), result_part,
                   summary[columns], near_table, pd.DataFrame(),
                   design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
                   tuple(lines))
 
 
-def _defaults(result) -> dict | None:
+def request_defaults(result) -> dict | None:
+    """What a result's request took from its study (:attr:`foldopt.studies.request.Request.defaults`),
+    None without a request.
+
+    Parameters
+    ----------
+    result : object
+        A result with a ``request`` attribute.
+    """
     request = getattr(result, "request", None)
     return request.defaults if request is not None else None
 
@@ -229,7 +237,8 @@ def of_sweep(result) -> Answer:
                                  "gain_vs_flat_pct", "pct_of_tracker", "note") if c in table]]
     question = study_question(plan.base, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
-    return Answer("sweep", plan.base.name, question, _defaults(result), plain(part), designs, near, pd.DataFrame(),
+    return Answer("sweep", plan.base.name, question, request_defaults(result), plain(part), designs, near,
+                  pd.DataFrame(),
                   design_notes(table, plan.n_cases) + weather_notes(result) + horizon_notes(plan.base, _dates(plan)),
                   tuple(lines))
 
@@ -310,7 +319,7 @@ def _of_annual(result) -> Answer:
     near = twofold_rows[[*keys, "fold_angle_deg", *NEAR_OPTIMAL]].reset_index(drop=True)
     question = study_question(study, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
-    return Answer("annual", study.name, question, _defaults(result), plain(part), designs, near, schedule,
+    return Answer("annual", study.name, question, request_defaults(result), plain(part), designs, near, schedule,
                   design_notes(result.table, plan.n_cases) + weather_notes(result)
                   + horizon_notes(study, _dates(plan)), tuple(lines))
 

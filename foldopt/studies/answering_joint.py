@@ -6,7 +6,7 @@ adds, and how much of the grid the search evaluated."""
 from __future__ import annotations
 
 from foldopt.studies.answer import Answer, records
-from foldopt.studies.answering import study_question
+from foldopt.studies.answering import request_defaults, study_question
 
 #: How the answer names each variable and its unit.
 _LABELS = {"fold_angle": ("fold", "deg"), "tilt": ("tilt", "deg"), "azimuth": ("azimuth", "deg")}
@@ -82,8 +82,8 @@ def of_optimize(result) -> Answer:
     summary = {"statistic": result.statistic, "days": days, "loads": per_load,
                "search": {"evaluated": int(search.index.shape[0]), "grid": search.grid_size,
                           "levels": [list(level) for level in search.levels], "tolerance_h": spec.tolerance_h}}
-    defaults = result.request.defaults if result.request is not None and hasattr(result.request, "defaults") else None
-    return Answer("optimize", study.name, question, defaults, summary, table, result.near_optimal, summary=tuple(lines))
+    return Answer("optimize", study.name, question, request_defaults(result), summary, table, result.near_optimal,
+                  summary=tuple(lines))
 
 
 def _varied_axes(result):

@@ -410,11 +410,10 @@ def daily_designs(parts, loads, engine: str = "numba", fold=None) -> DailyDesign
         tracker.append((both.t_solar[:sky.n_blocks, 0], both.t_solar[sky.n_blocks:, 0], both.energy[:sky.n_blocks, 0]))
         available.append(standby_available(gross, draw, sky.lit, study.tracker.standby_w))
     gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
-    if fold is not None:
-        twofold, harvest = [searched_hours.transpose(0, 2, 1)], [searched_energy]
-    return DailyDesigns(angles, np.concatenate(twofold).transpose(0, 2, 1), np.concatenate(harvest),
-                        np.concatenate(flat), np.concatenate(flat_energy), gross_h, net_h, gross_wh,
-                        np.concatenate(available))
+    if fold is None:
+        searched_hours, searched_energy = np.concatenate(twofold).transpose(0, 2, 1), np.concatenate(harvest)
+    return DailyDesigns(angles, searched_hours, searched_energy, np.concatenate(flat), np.concatenate(flat_energy),
+                        gross_h, net_h, gross_wh, np.concatenate(available))
 
 
 def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba", with_energy: bool = False):
@@ -432,7 +431,6 @@ def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba"
     flat : bool
         The flat panel (the fold angle unused) with no connection: as the ``flat`` design.
     engine : {'numba', 'numpy'}
-
     with_energy : bool
         Also each day's harvested energy.
 

@@ -311,23 +311,20 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, near_optima
         all_angles = axis.values()
         for _ in range(int(np.ceil(np.log2(max(axis.size, 2)))) + 3):
             angles = np.array(sorted(found))
-            values = np.stack([found[angle][2] for angle in angles])  # (angles, targets)
-            best = values.shape[0] - 1 - np.argmax(values[::-1], axis=0)
-            top = values[best, np.arange(values.shape[1])]
-            short = values < top - near_optimal_tolerance.tolerance_h(top)
-            index = np.searchsorted(all_angles, angles - 1e-9)
+            ranges = near_optimal(angles, np.stack([found[angle][2] for angle in angles], axis=-1),
+                                  near_optimal_tolerance)
+            index = np.searchsorted(all_angles, angles - 1e-9)  # each evaluated angle's grid index
             wanted = set()
-            for target in range(values.shape[1]):
-                below = np.flatnonzero(short[:, target] & (np.arange(len(angles)) < best[target]))
-                above = np.flatnonzero(short[:, target] & (np.arange(len(angles)) > best[target]))
-                pairs = ([(below[-1], below[-1] + 1)] if below.size else []) + (
-                    [(above[0] - 1, above[0])] if above.size else [])
-                for a, b in pairs:
-                    if index[b] - index[a] > 1:
+            # Each range's edge lies between its end and the evaluated angle beyond it: halve the gap.
+            for lo, hi in zip(ranges["near_optimal_lo_deg"], ranges["near_optimal_hi_deg"], strict=True):
+                if lo != lo:
+                    continue  # no angle carries the load
+                first, last = np.searchsorted(angles, [lo - 1e-9, hi - 1e-9])
+                for a, b in ((first - 1, first), (last, last + 1)):
+                    if 0 <= a and b < angles.size and index[b] - index[a] > 1:
                         wanted.add((index[a] + index[b]) // 2)
             if not wanted:
                 # The recommended angle is the grid's nearest the range's centre: evaluated too.
-                ranges = near_optimal(angles, values.T, near_optimal_tolerance)
                 centres = (ranges["near_optimal_lo_deg"] + ranges["near_optimal_hi_deg"]) / 2
                 # Ties go to the less folded angle, as near_optimal breaks them.
                 nearest = {int(np.argmin(np.abs(all_angles - centre) - 1e-9 * all_angles))

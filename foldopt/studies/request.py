@@ -20,7 +20,7 @@ from dataclasses import dataclass, replace
 
 from foldopt.inputs import policy
 from foldopt.inputs.load import default_study_path, parse_study_text, read_study
-from foldopt.inputs.plan import Plan, make_plan, parse_values
+from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
 from foldopt.errors import ConfigError
 
 #: A sweep's axis -> the field it varies (``angle`` varies the fold angle of one case).
@@ -332,8 +332,6 @@ def sweep_changes(options: dict, data: dict) -> dict:
     return changes
 
 
-_BOUNDS = re.compile(r"^\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)\s*:\s*([-+]?[\d.]+(?:[eE][-+]?\d+)?)\s*:\s*"
-                     r"([-+]?[\d.]+(?:[eE][-+]?\d+)?)\s*$")
 #: The joint optimisation's parameters, as :func:`optimize_section` and the command line name them.
 OPTIMIZE_OPTIONS = {"vary": "--vary", "fold_angle": "--fold-range", "tilt": "--tilt-range",
                     "azimuth": "--azimuth-range", "tolerance_h": "--tolerance"}
@@ -369,10 +367,8 @@ def optimize_section(vary=None, fold_angle=None, tilt=None, azimuth=None, tolera
     for name, value in (("fold_angle", fold_angle), ("tilt", tilt), ("azimuth", azimuth)):
         if value is None:
             continue
-        match = _BOUNDS.match(value) if isinstance(value, str) else None
-        parts = match.groups() if match else value if not isinstance(value, str) else ()
         try:
-            low, high, step = (float(part) for part in parts)
+            low, high, step = range_parts(value) if isinstance(value, str) else (float(part) for part in value)
         except (TypeError, ValueError):
             errors.append(f"{labels.get(name, name)} = {value!r}: expected min:max:step in degrees, e.g. 0:90:1")
             continue

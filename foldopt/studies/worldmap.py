@@ -30,8 +30,10 @@ import numpy as np
 import pandas as pd
 from pydantic import ValidationError
 
+from foldopt import names
 from foldopt.engine import rows as engines
 from foldopt.inputs.load import resolve_files
+from foldopt.inputs.optimize_section import vary_names
 from foldopt.inputs.plan import parse_dates, parse_values, year_problem
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, format_errors
@@ -204,8 +206,12 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
     largest, bounds = LOAD_BOUNDS[relative]
     if any(not 0 < value <= largest for value in load_values):
         errors.append(f"loads = {loads!r}: {bounds}")
-    vary = (study.get("optimize") or {}).get("vary", ["fold_angle"])
-    if study.get("optimize") is not None and list(vary) != ["fold_angle"]:
+    vary = (study.get("optimize") or {}).get("vary", list(names.OPTIMIZE_VARIABLES))
+    try:
+        fold_only = vary_names(vary) == ["fold_angle"]
+    except ValueError:
+        fold_only = True  # no list of names: the study's validation at the first site says so
+    if study.get("optimize") is not None and not fold_only:
         errors.append(f"optimize.vary = {vary!r}: a map searches the fold angle alone (the tilt and azimuth "
                       f"with it: foldopt optimize, one site at a time)")
     if errors:

@@ -6,27 +6,17 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from foldopt.inputs.sites import lattice
 from foldopt.output.figures.canvas import FigureFile, colour_scale, new_axes
 
 
-def _lattice(values) -> np.ndarray | None:
-    """The regular lattice that sorted ``values`` sit on (gaps allowed, e.g. land only), or None."""
-    values = np.unique(values)
-    if values.size < 2:
-        return None
-    step = np.diff(values).min()
-    steps = (values - values[0]) / step
-    if not np.allclose(steps, np.round(steps), atol=1e-6):
-        return None
-    return values[0] + step * np.arange(int(round(steps[-1])) + 1)
-
-
 def _grid_axes(sites: pd.DataFrame):
-    """The latitude and longitude lattices of a grid of sites, or None for named sites."""
+    """The latitude and longitude lattices of a grid of sites, or None for named sites (or a
+    single row or column, drawn as dots)."""
     if (sites["site_name"].astype(str) != "").any() or len(sites) < 4:
         return None
-    lats, lons = _lattice(sites["latitude"]), _lattice(sites["longitude"])
-    return None if lats is None or lons is None else (lats, lons)
+    lats, lons = lattice(sites["latitude"]), lattice(sites["longitude"])
+    return None if lats is None or lons is None or min(lats.size, lons.size) < 2 else (lats, lons)
 
 
 def plot_world_map(rows: pd.DataFrame, value: str, title: str, label: str, diverging: bool, ax=None):
