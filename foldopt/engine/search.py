@@ -11,7 +11,7 @@ whose corners are lattice points, at most ``s_i`` apart (``h_i = s_i step_i`` in
 units), and every corner is evaluated. Inside a box the multilinear interpolant of the corners
 never exceeds the largest corner, and a function whose second derivative along axis ``i`` is at
 most ``M_i`` departs from that interpolant by at most ``sum_i M_i h_i^2 / 8`` (the error of
-tensor-product linear interpolation); t_solar, counted in whole time steps, also jumps by up to
+tensor-product linear interpolation [1]_); t_solar, counted in whole time steps, also jumps by up to
 ``quantum``. So every grid point ``q`` of the box has
 
     f(q) <= max(f(corners)) + sum_i M_i h_i^2 / 8 + quantum.
@@ -32,6 +32,13 @@ days, loads and objectives.
 
 Every level's points go to ``evaluate`` in one call, so the caller vectorises across the points and
 its own targets (loads, objectives): the search keeps the union of the cells any target keeps.
+
+References
+----------
+.. [1] C. de Boor, "A Practical Guide to Splines", revised ed., Springer, 2001, Ch. II: broken-line
+   interpolation errs by at most ``h^2 / 8 max|f''|`` on an interval of width ``h``; applied along
+   each axis in turn, the tensor-product (multilinear) interpolant errs by at most the sum of the
+   axes' terms.
 """
 
 from __future__ import annotations

@@ -1,12 +1,19 @@
 """A grid map's table as NetCDF (``map.nc``): an xarray Dataset over latitude x longitude x load x
-period with CF metadata, the form gridded solar data takes elsewhere, so that xarray and GIS tools
-(QGIS, Panoply, CDO) open it directly.
+period with CF metadata [1]_, the form gridded solar data takes elsewhere, so that xarray and GIS
+tools (QGIS, Panoply, CDO) open it directly.
 
 The file is NetCDF-3 (classic), written by xarray's SciPy backend, which needs no HDF5 library. It
 is written where a map's sites are points of a regular latitude x longitude grid (a sea point, or a
 whole row of them, of a land-only grid is missing, its values ``_FillValue``); a map of named sites
-or weather files keeps its tables alone. Each variable carries its unit (UDUNITS spelling) and meaning from the column
-registry (:mod:`foldopt.output.columns`).
+or weather files keeps its tables alone. Each variable carries its unit (UDUNITS spelling [2]_)
+and meaning from the column registry (:mod:`foldopt.output.columns`).
+
+References
+----------
+.. [1] NetCDF Climate and Forecast (CF) Metadata Conventions, version 1.8, 2020 (cfconventions.org):
+   Sec. 4.1 (latitude: ``units = degrees_north``, ``standard_name = latitude``), 4.2 (longitude),
+   2.5.1 (``_FillValue`` for missing data), 2.6.1 (the ``Conventions`` attribute).
+.. [2] UDUNITS-2, Unidata: the unit strings of ``units`` (``h``, ``W h``, ``percent``, ``degree``).
 """
 
 from __future__ import annotations
