@@ -157,7 +157,7 @@ def test_loads_of_each_row_and_unknown_names():
 
 @pytest.mark.parametrize("model", ["ashrae", "physical"])
 def test_kernel_incidence_angle_modifier_is_pvlibs(model):
-    from foldopt.engine.kernel import iam_factor
+    from foldopt.engine.incidence import iam_factor
 
     aoi = np.linspace(0.0, 100.0, 1001)
     code, params = engine._iam_code(model)

@@ -82,7 +82,7 @@ def _per_load(p, shape, s, use_shape):
     return p / g if g > 0.0 else -math.inf
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def day_metrics(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
              use_shape):
     """Daily metrics of one power curve [W] sampled at step centres, of which only steps
@@ -95,6 +95,19 @@ def day_metrics(power, first, last, step_hours, loads, contiguous, above, whole,
     A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
     (summed from the top at the end), and shares to the loads inside its range. Consecutive
     segments mostly share k, so their lengths gather in a local sum first."""
+    # Constant loads without runs (every map's) with the flags as constants, so that no step tests
+    # them; the other cases read them at run time.
+    if not contiguous and not use_shape:
+        return _day_steps(power, first, last, step_hours, loads, False, above, whole, run, t_out, cont_out, shape,
+                          False)
+    return _day_steps(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
+                      use_shape)
+
+
+@njit(cache=True, inline="always")
+def _day_steps(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
+               use_shape):
+    """:func:`day_metrics`' walk over the steps."""
     n_steps, n_loads = power.shape[0], loads.shape[0]
     above[:] = 0.0
     whole[:] = 0.0
@@ -199,6 +212,6 @@ def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):
     }
     if n_steps:
         work["irradiation_out"] = np.empty(n_rows)
-        work["irradiance"] = np.zeros((chunks, 2, n_steps))
+        work["irradiance"] = np.zeros((chunks, 5, n_steps))
         work["buffer"] = np.zeros((chunks, n_conn, n_steps))
     return work

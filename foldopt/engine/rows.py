@@ -163,14 +163,14 @@ def iam_modifier(model: str, surface_tilt, surface_azimuth, solar_zenith, solar_
 
 def _iam_code(model: str):
     """The kernel's incidence-angle modifier and its parameters: pvlib's defaults."""
-    from foldopt.engine import kernel
+    from foldopt.engine import incidence
 
     if model == "none":
-        return kernel.IAM_NONE, np.zeros(3)
+        return incidence.IAM_NONE, np.zeros(3)
     function = pvlib.iam.ashrae if model == "ashrae" else pvlib.iam.physical
     defaults = [p.default for p in inspect.signature(function).parameters.values()
                 if p.default is not inspect.Parameter.empty and p.name != "n_ar"]
-    code = kernel.IAM_ASHRAE if model == "ashrae" else kernel.IAM_PHYSICAL
+    code = incidence.IAM_ASHRAE if model == "ashrae" else incidence.IAM_PHYSICAL
     return code, np.array(defaults + [0.0] * (3 - len(defaults)), dtype=float)
 
 
