@@ -9,9 +9,9 @@ each site the apparent zenith, the azimuth and the equation of time at every ste
 foldopt's exact mode needs. Timed, as seconds for the whole workload:
 
 - ``foldopt split``: :func:`foldopt.physics.solarposition.solar_position_grid`, SPA's time-only
-  (geocentric) part once per UTC hour for all sites, the per-site (topocentric) part every
-  10 minutes, interpolated, and the refraction at every step; sites in chunks of ``--chunk``
-  (as the map runs them), so memory stays bounded;
+  (geocentric) part once per UTC hour and its direction once per step for all sites, the
+  per-site (topocentric) part at every step as a rotation of it, and the refraction; sites in
+  chunks of ``--chunk`` (as the map runs them), so memory stays bounded;
 - ``pvlib get_solarposition``: ``pvlib.solarposition.get_solarposition`` (``nrel_numpy``, i.e.
   ``spa_python``) at every step, one call per site;
 - ``pvlib, 10-min + interp``: the same public call every 10 minutes only, with foldopt's
@@ -26,9 +26,9 @@ paths cost one call per site, so they are measured on ``--pvlib-sample`` sites a
 figures are marked ``*``. Last, the split's largest difference from ``get_solarposition`` on the
 sites pvlib ran: the angle between the two sun directions and the apparent zenith, over steps with
 the sun above -1 deg, except within 0.01 deg of -0.8334 deg geometric elevation, where SPA
-switches its refraction off (a jump of up to 0.6 deg that an interpolation error of 0.005 deg can
-move across a step, with the sun's disc below the horizon); how many steps that leaves out is
-printed too.
+switches its refraction off (a jump of up to 0.6 deg that any difference in the geometric
+elevation can move across a step, with the sun's disc below the horizon); how many steps that
+leaves out is printed too.
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-STRIDE_MIN = 10.0  # [min] foldopt's topocentric spacing, SPA_SPACING_MIN
+STRIDE_MIN = 10.0  # [min] the public call's spacing in the subsampled comparison
 
 
 def _sites(n: int, seed: int = 7) -> np.ndarray:
@@ -202,8 +202,8 @@ def main() -> None:
         print(row)
     print("  * scaled per site from a smaller measured run (see the module docstring)")
     angle, zenith, left_out = _agreement(sample, dates, args.step, reference)
-    print(f"split vs get_solarposition on {len(sample)} sites, sun above -1 deg: sun direction within {angle:.4f} deg, "
-          f"apparent zenith within {zenith:.4f} deg ({left_out} of {steps * len(sample)} steps at SPA's "
+    print(f"split vs get_solarposition on {len(sample)} sites, sun above -1 deg: sun direction within {angle:.1e} deg, "
+          f"apparent zenith within {zenith:.1e} deg ({left_out} of {steps * len(sample)} steps at SPA's "
           "refraction switch left out)")
 
 

@@ -40,3 +40,23 @@ def test_clear_sky_dni_zero_at_night_and_falls_with_zenith():
     np.testing.assert_array_equal(dni[4:], 0.0)
     with pytest.raises(ValueError, match="meinel"):
         clear_sky_dni(np.array([0.0]), model="ineichen")
+
+
+@pytest.mark.filterwarnings("ignore:DatetimeIndex.dayofyear is deprecated")  # in pvlib's lookup, not ours to fix
+def test_linke_turbidity_is_pvlibs_lookup_to_the_bit():
+    """foldopt reads pvlib's climatology once per site and interpolates once per UTC day
+    (foldopt.inputs.turbidity); pvlib's own lookup, at every stamp, is the reference: random
+    sites (the poles and the date line included) and instants over 40 years, leap years too."""
+    import pandas as pd
+    import pvlib
+
+    from foldopt.inputs.turbidity import linke_turbidity
+
+    rng = np.random.default_rng(3)
+    places = [(90.0, -180.0), (-90.0, 180.0), *zip(rng.uniform(-90, 90, 30), rng.uniform(-180, 180, 30))]
+    for latitude, longitude in places:
+        stamps = np.sort(rng.integers(0, 40 * 365 * 86_400, 200)) * 10**9 + 10**18 // 2
+        times = pd.DatetimeIndex(stamps).tz_localize("UTC")
+        expected = pvlib.clearsky.lookup_linke_turbidity(times, latitude, longitude).to_numpy()
+        np.testing.assert_array_equal(linke_turbidity(latitude, longitude, stamps), expected)
+    assert linke_turbidity(0.0, 0.0, np.zeros((2, 0), dtype=np.int64)).shape == (2, 0)  # no step with the sun up

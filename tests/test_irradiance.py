@@ -53,7 +53,7 @@ def test_factor_broadcasts_orientations_against_time():
 @pytest.mark.parametrize("model", ["exact", "paper"])
 def test_ideal_tracker_sees_all_of_the_beam_in_both_modes(model):
     zenith, azimuth = np.array([5.0, 40.0, 85.0]), np.array([100.0, 180.0, 250.0])
-    tilt, surface_azimuth = tracker_orientation("dual-axis", zenith, azimuth, np.zeros(3), np.zeros(3), 30.0)
+    tilt, surface_azimuth, _ = tracker_orientation("dual-axis", zenith, azimuth, np.zeros(3), np.zeros(3), 30.0)
     np.testing.assert_allclose(beam_incidence_factor(tilt, surface_azimuth, zenith, azimuth, model), 1.0, atol=1e-12)
     with pytest.raises(ValueError, match="dual-axis, equatorial, dual-axis-steps, single-axis"):
         tracker_orientation("azimuthal", zenith, azimuth, np.zeros(3), np.zeros(3), 30.0)

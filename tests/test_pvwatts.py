@@ -39,9 +39,10 @@ def test_tracker_gain_on_the_plane_of_array_is_pvwatts():
                        "p_load": 1.0, "albedo": 0.2, "transposition": "perez"}).base
     year = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(365)]
     sky = build_sky(study, [study.site] * 365, year)
+    tilt, azimuth, normal = sky_tracker_orientation(sky, study, "dual-axis")
     hourly = {  # foldopt's minutes, hour by hour [W/m^2]
         "fixed": engine.poa(sky, np.full((365, 1), TILT), np.full((365, 1), 180.0), incident=True),
-        "tracker": engine.poa(sky, *sky_tracker_orientation(sky, study, "dual-axis"), incident=True),
+        "tracker": engine.poa(sky, tilt, azimuth, incident=True, normal=normal),
     }
     hourly = {name: poa.reshape(365, 24, 60).mean(axis=-1) for name, poa in hourly.items()}
     (fixed, sunup), (tracker, _) = pvwatts_poa(FIXED), pvwatts_poa(TWO_AXIS)

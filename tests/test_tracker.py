@@ -38,7 +38,7 @@ def test_alexandru_actuating_times_are_his():
 def test_single_axis_matches_pvlib():
     zenith = np.linspace(10, 85, 40)
     azimuth = np.linspace(70, 290, 40)
-    tilt, surface_azimuth = tracker_orientation("single-axis", zenith, azimuth, np.zeros(40), np.zeros(40), 34.0)
+    tilt, surface_azimuth, _ = tracker_orientation("single-axis", zenith, azimuth, np.zeros(40), np.zeros(40), 34.0)
     expected = pvlib.tracking.singleaxis(zenith, azimuth, axis_tilt=0, axis_azimuth=180, max_angle=90,
                                          backtrack=False, gcr=0.35)
     np.testing.assert_allclose(tilt, expected["surface_tilt"], atol=1e-9)

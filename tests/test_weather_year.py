@@ -207,9 +207,9 @@ def test_trackers_park_while_the_sun_is_down(greensboro):
     study, sky = greensboro
     down = sky.solar_zenith >= 90
     for model in ("dual-axis", "equatorial", "single-axis"):
-        tilt, _ = sky_tracker_orientation(sky, study, model)
+        tilt, _, _ = sky_tracker_orientation(sky, study, model)
         assert np.all(tilt[down] == 0), model
-    tilt, azimuth = sky_tracker_orientation(sky, study, "dual-axis")
+    tilt, azimuth, _ = sky_tracker_orientation(sky, study, "dual-axis")
     assert np.all(tilt <= 90)
     poa = engine.poa(sky, tilt, azimuth, incident=True)
     assert np.all(poa[down] == 0)

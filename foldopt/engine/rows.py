@@ -106,7 +106,8 @@ def flat_orientation(panel_tilt, panel_azimuth) -> np.ndarray:
     return np.stack([tilt, azimuth, tilt, azimuth], axis=-1)
 
 
-def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool = False, incident: bool = False):
+def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool = False, incident: bool = False,
+        normal=None):
     """Plane-of-array irradiance [W/m^2] of surfaces over blocks of a sky (the reference path).
 
     Parameters
@@ -123,6 +124,9 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
     incident : bool
         The light incident on the surface, before the sky's incidence-angle modifier (the default is what
         reaches the cells).
+    normal : array_like, optional
+        The surfaces' unit normals (the broadcast shape and 3), where the caller has them (a tracker's):
+        default worked out from the tilt and azimuth.
 
     Returns
     -------
@@ -131,8 +135,10 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
     """
     tilt, azimuth = np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
     zenith, solar_azimuth = sky.solar_zenith[blocks], sky.solar_azimuth[blocks]
-    normal = normal_vector(tilt, azimuth)
-    cos_aoi = np.sum(normal * sky.sun_vector[blocks], axis=-1)  # pvlib's aoi_projection (tested)
+    normal = normal_vector(tilt, azimuth) if normal is None else np.asarray(normal, dtype=float)
+    sun = sky.sun_vector[blocks]
+    # pvlib's aoi_projection (tested), without the (..., 3) temporary of a product.
+    cos_aoi = normal[..., 0] * sun[..., 0] + normal[..., 1] * sun[..., 1] + normal[..., 2] * sun[..., 2]
     factor = beam_incidence_factor(tilt, azimuth, zenith, solar_azimuth, model="paper") if paper else None
     terms = None if sky.terms is None else sky.terms[blocks]
     modifier = 1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, zenith, solar_azimuth)
@@ -183,13 +189,18 @@ def _sorted_loads(loads):
 
 def _unsort(values, order, row_loadset):
     """Put the last axis of per-row values back into each row's load order."""
+    if (order == np.arange(order.shape[1])).all():
+        return values  # the caller's loads were in order
+    if order.shape[0] == 1:
+        return values[..., np.argsort(order[0])]  # one set of loads: one permutation for every row
     out = np.empty_like(values)
     np.put_along_axis(out, np.broadcast_to(order[row_loadset][:, None, :], values.shape), values, axis=-1)
     return out
 
 
 def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loadset=None,
-                outputs=("switching",), contiguous: bool = False, engine: str = "numba") -> RowMetrics:
+                outputs=("switching",), contiguous: bool = False, engine: str = "numba",
+                row_orientation=None) -> RowMetrics:
     """Daily metrics of rows of panel orientations over a sky.
 
     Parameters
@@ -200,7 +211,8 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     row_block : array_like of int
         (n_rows,) block of each row.
     orientation : array_like
-        (n_rows, 4) east tilt, east azimuth, west tilt, west azimuth [deg].
+        (n_rows, 4) east tilt, east azimuth, west tilt, west azimuth [deg]; with ``row_orientation``,
+        (k, 4) orientations that the rows take by index.
     loads : array_like
         (n_loads,) loads [W] shared by every row, or (n_sets, n_loads) sets chosen by ``row_loadset``.
     row_loadset : array_like of int, optional
@@ -210,6 +222,9 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     contiguous : bool
         Also the longest contiguous interval (costs O(n_loads) a step: for few loads).
     engine : {'numba', 'numpy'}
+    row_orientation : array_like of int, optional
+        (n_rows,) each row's orientation in ``orientation``: a few orientations over many blocks
+        (the angles of a search over a year's days) are then worked out once each.
 
     Returns
     -------
@@ -223,17 +238,22 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     if unknown:
         raise ValueError(f"outputs must be among {', '.join(OUTPUTS)}; got {unknown}")
     row_block = np.asarray(row_block, dtype=np.int64)
-    orientation = np.asarray(orientation, dtype=float).reshape(row_block.size, 4)
+    orientation = np.asarray(orientation, dtype=float).reshape(-1, 4)
+    row_orientation = (np.arange(row_block.size) if row_orientation is None
+                       else np.asarray(row_orientation, dtype=np.int64))
+    if row_orientation.size != row_block.size:
+        raise ValueError(f"{row_orientation.size} orientations for {row_block.size} rows")
     sorted_loads, order = _sorted_loads(loads)
     row_loadset = np.zeros(row_block.size, dtype=np.int64) if row_loadset is None else np.asarray(
         row_loadset, dtype=np.int64)
     if engine == "numpy" or study.exact_electrical:
-        result = _reference(sky, study, row_block, orientation, sorted_loads, row_loadset, outputs, contiguous)
+        result = _reference(sky, study, row_block, orientation[row_orientation], sorted_loads, row_loadset, outputs,
+                            contiguous)
     else:
         nodes, table, weight = temperature_nodes(sky)
         electricals = [electrical_for(study, temp, sky.wind_ref) for temp in nodes]
-        result = _compiled(sky, study, electricals, (table, weight), row_block, orientation, sorted_loads,
-                           row_loadset, outputs, contiguous)
+        result = _compiled(sky, study, electricals, (table, weight), row_block, orientation, row_orientation,
+                           sorted_loads, row_loadset, outputs, contiguous)
     return _in_caller_order(result, order, row_loadset)
 
 
@@ -367,33 +387,25 @@ def _tables(electricals, outputs, study):
     return table_1d, table_parallel, table_series, 0.0, built
 
 
-def _compiled(sky, study, electricals, step_tables, row_block, orientation, loads, row_loadset, outputs,
-              contiguous):
+def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_orientation, loads, row_loadset,
+              outputs, contiguous):
     from foldopt.engine import kernel, reduce
 
     table_1d, table_parallel, table_series, linear_power, built = _tables(electricals, outputs, study)
     codes = np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64)
-    east = normal_vector(orientation[:, 0], orientation[:, 1])
-    west = normal_vector(orientation[:, 2], orientation[:, 3])
+    # Each orientation's normals and Eq. 5 factors once, then per row.
+    east = normal_vector(orientation[:, 0], orientation[:, 1])[row_orientation]
+    west = normal_vector(orientation[:, 2], orientation[:, 3])[row_orientation]
     tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])
-    row_paper = np.stack([np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1)
+    row_paper = np.stack([np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1)[row_orientation]
+    orientation = orientation[row_orientation]
     iam_code, iam_params = _iam_code(sky.iam)
-    # The kernel reads each component along the time steps: (n_blocks, component, n_steps).
-    terms = np.moveaxis(sky.terms, -1, 1) if sky.terms is not None else np.zeros((sky.n_blocks, 0, 1))
     paper = study.mode == "paper"
-    paper_sun = np.moveaxis(sky.paper_sun, -1, 1) if paper else np.zeros((1, 4, 1))
     first = electricals[0]
     work = reduce.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous)
-    lit = sky.lit
-    steps = np.arange(lit.shape[1])
-    first_lit = np.where(lit, steps, lit.shape[1]).min(axis=1)
-    last_lit = np.where(lit, steps, -1).max(axis=1)
-    span = np.where((first_lit <= last_lit)[:, None],
-                    np.stack([np.maximum(first_lit - 1, 0), np.minimum(last_lit + 1, steps[-1])], axis=1), 0)
-    arrays = [np.moveaxis(sky.sun_vector, -1, 1), paper_sun, sky.dni, terms, span,
-              np.asarray(step_tables[0], dtype=np.int64), np.asarray(step_tables[1], dtype=float), row_block,
-              np.stack([east, west], axis=1), row_paper, row_views(sky, row_block, east, west, orientation),
-              row_loadset]
+    arrays = [*sky.kernel_layout(paper), np.asarray(step_tables[0], dtype=np.int64),
+              np.asarray(step_tables[1], dtype=float), row_block, np.stack([east, west], axis=1), row_paper,
+              row_views(sky, row_block, east, west, orientation), row_loadset]
     # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
     kernel.fold_rows(
         *(np.ascontiguousarray(a) for a in arrays), paper, iam_code, iam_params, table_1d, table_parallel,

@@ -21,7 +21,6 @@ import pvlib
 from foldopt.physics.atmosphere import clear_sky_dni, relative_airmass
 from foldopt.inputs.sections import parse_timezone
 from foldopt.inputs.study import Study
-from foldopt.physics.geometry import normal_vector
 from foldopt.physics.horizon import sun_visible
 from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.inputs.loads import load_shape
@@ -29,6 +28,7 @@ from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_
 from foldopt.errors import WeatherError
 from foldopt.inputs.weather import FORMATS, read_weather, study_weather, weather_days, weather_format, weather_site
 from foldopt.names import CLEAR_SKIES
+from foldopt.inputs.turbidity import linke_turbidity as climatology_turbidity
 from foldopt.inputs.weather.downscale import clear_sky, hourly_light, interpolate_points
 from foldopt.inputs.weather.ensemble import cloud_members
 from foldopt.physics.temperature import equivalent_temp_air
@@ -125,6 +125,37 @@ class Sky:
         if self.terms is None:
             return self.dni > 0
         return (self.dni > 0) | np.any(self.terms != 0, axis=-1)
+
+    @functools.cached_property
+    def _layout(self) -> tuple:
+        """The sun vector, the beam and the diffuse terms as the kernel reads them, each component
+        along the time steps, contiguous: (n_blocks, 3, n_steps), (n_blocks, n_steps) and
+        (n_blocks, 4, n_steps) (or (n_blocks, 0, 1) for a beam-only sky); and each block's span,
+        (n_blocks, 2), its first and last step with light and one dark step either side."""
+        terms = (np.ascontiguousarray(np.moveaxis(self.terms, -1, 1)) if self.terms is not None
+                 else np.zeros((self.n_blocks, 0, 1)))
+        steps = np.arange(self.lit.shape[1])
+        first_lit = np.where(self.lit, steps, self.lit.shape[1]).min(axis=1)
+        last_lit = np.where(self.lit, steps, -1).max(axis=1)
+        span = np.where((first_lit <= last_lit)[:, None],
+                        np.stack([np.maximum(first_lit - 1, 0), np.minimum(last_lit + 1, steps[-1])], axis=1), 0)
+        return (np.ascontiguousarray(np.moveaxis(self.sun_vector, -1, 1)), np.ascontiguousarray(self.dni), terms,
+                np.ascontiguousarray(span))
+
+    def kernel_layout(self, paper: bool) -> tuple:
+        """``sun, paper_sun, beam, terms, span``: the sky as :func:`foldopt.engine.kernel.fold_rows`
+        reads it (worked out once a sky: every engine call over it takes it), ``paper_sun``
+        (:attr:`paper_sun` along the steps, (n_blocks, 4, n_steps)) only for ``paper`` incidence,
+        a placeholder (1, 4, 1) otherwise.
+
+        Parameters
+        ----------
+        paper : bool
+            Shin et al.'s Eq. 5 for the beam's incidence.
+        """
+        sun, dni, terms, span = self._layout
+        paper_sun = np.ascontiguousarray(np.moveaxis(self.paper_sun, -1, 1)) if paper else np.zeros((1, 4, 1))
+        return sun, paper_sun, dni, terms, span
 
     @property
     def paper_sun(self) -> np.ndarray:
@@ -229,22 +260,29 @@ def _clock(sites, dates, step_min) -> ClockGrid:
                      tuple(stacked.timezones[i] for i in order), stacked.step_hours)
 
 
-def _clear_sky(grid: ClockGrid, zenith, sites, model: str, linke_turbidity) -> dict:
-    """pvlib's clear sky at every step, one call per site (its blocks' steps together)."""
-    light = {key: np.empty_like(zenith) for key in ("dni", "ghi", "dhi")}
+def _clear_sky(grid: ClockGrid, zenith, airmass, dni_extra, sites, model: str, linke_turbidity) -> dict:
+    """pvlib's clear sky at every step with the sun up (0 elsewhere), one call per site (its
+    blocks' steps together), with the climatology's turbidity at the site where the study sets
+    none."""
+    light = {key: np.zeros_like(zenith) for key in ("dni", "ghi", "dhi")}
     groups: dict[tuple, list[int]] = {}
     for index, site in enumerate(sites):
-        groups.setdefault((site.latitude, site.longitude, site.altitude, site.timezone), []).append(index)
-    for (latitude, longitude, altitude, zone), members in groups.items():
-        times = pd.DatetimeIndex(grid.utc_ns[members].ravel().astype("datetime64[ns]"), tz="UTC").tz_convert(
-            parse_timezone(zone))
-        sky = clear_sky(times, zenith[members].ravel(), latitude, longitude, altitude, model, linke_turbidity)
-        for key in light:
-            light[key][members] = sky[key].reshape(len(members), -1)
+        groups.setdefault((site.latitude, site.longitude, site.altitude), []).append(index)
+    for (latitude, longitude, altitude), members in groups.items():
+        up = zenith[members] < 90.0
+        turbidity = linke_turbidity
+        if model == "ineichen" and turbidity is None:
+            turbidity = climatology_turbidity(latitude, longitude, grid.utc_ns[members][up])
+        sky = clear_sky(zenith[members][up], airmass[members][up], dni_extra[members][up], altitude, model,
+                        turbidity)
+        for key, values in light.items():
+            placed = np.zeros(up.shape)
+            placed[up] = sky[key]
+            values[members] = placed
     return light
 
 
-def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict, zenith):
+def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict, zenith, dni_extra):
     """Light at every step of the grid from the study's weather file
     (:func:`foldopt.inputs.weather.downscale.hourly_light` along the clear sky), the air
     temperature and wind at every step (:func:`foldopt.inputs.weather.downscale.interpolate_points`),
@@ -274,7 +312,6 @@ def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict, zenith):
         raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must divide the file's "
                          f"intervals ({interval / 6e10:g} min), which must start at the day's midnight")
     cos_zenith = np.cos(np.radians(zenith))
-    dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.day_of_year]
     light, placed = hourly_light(hourly["dni"], hourly["dhi"], clear["ghi"], clear["dni"], cos_zenith, per_interval,
                                  dni_extra)
     balance = {key: (float(hourly[key].sum()), float(placed[key].sum())) for key in ("dni", "ghi", "dhi")}
@@ -383,6 +420,10 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
     grid = _clock(sites, dates, study.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
     zenith = sun["solar_zenith"]
+    dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.day_of_year]
+    up = zenith < 90.0
+    airmass = np.zeros(zenith.shape)
+    airmass[up] = relative_airmass(zenith[up])
     temp_air, balance = np.full(len(sites), float(study.temp_air)), None
     temp_steps = wind_speed = wind_ref = None
     notes = ()
@@ -391,12 +432,12 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         temp_steps, wind_speed = light.pop("temp_air"), light.pop("wind_speed")
         notes = tuple(measured.report())
     elif study.weather is not None:
-        clear = _clear_sky(grid, zenith, sites, "ineichen", study.linke_turbidity)
+        clear = _clear_sky(grid, zenith, airmass, dni_extra, sites, "ineichen", study.linke_turbidity)
         light, temp_steps, wind_speed, balance, (hourly, per_interval) = _weather_light(study, grid, dates, clear,
-                                                                                      zenith)
+                                                                                      zenith, dni_extra)
         if share is not None:
             light, balance = _members(study, hourly, per_interval, clear, zenith, dates, share)
-    sun_vector = normal_vector(zenith, sun["solar_azimuth"])
+    sun_vector = sun.pop("sun_vector")
     if share is not None:
         inverse = share[0]
         sun_vector = sun_vector[inverse]
@@ -404,6 +445,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
                          grid.step_hours)
         sun = {key: value[inverse] for key, value in sun.items()}
         zenith, latitude, altitude = sun["solar_zenith"], latitude[inverse], altitude[inverse]
+        dni_extra, airmass = dni_extra[inverse], airmass[inverse]
         temp_steps, wind_speed = temp_steps[inverse], wind_speed[inverse]
         dates = [dates[i] for i in inverse]
     if study.weather is not None:
@@ -414,7 +456,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         temp_air = np.where(lit.any(axis=1), (temp_steps * lit).sum(axis=1) / np.maximum(lit.sum(axis=1), 1),
                             temp_steps.mean(axis=1))
     elif study.sky in CLEAR_SKIES:
-        light = _clear_sky(grid, zenith, sites, study.sky, study.linke_turbidity)
+        light = _clear_sky(grid, zenith, airmass, dni_extra, sites, study.sky, study.linke_turbidity)
     else:
         beam_altitude = altitude if study.mode == "exact" else 0.0
         light = {"dni": clear_sky_dni(zenith, beam_altitude, study.sky, dayofyear=grid.day_of_year,
@@ -424,13 +466,14 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
     terms = None
     transposition = study.sky_transposition()
     if transposition != "none":
-        dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.day_of_year]
-        airmass = np.nan_to_num(relative_airmass(np.minimum(zenith, 90.0)), nan=0.0)
-        terms = sky_diffuse_terms(
-            transposition, zenith, dni,
-            ghi if ghi is not None else dni * np.clip(np.cos(np.radians(zenith)), 0, None),
-            dhi if dhi is not None else np.zeros_like(dni), dni_extra, airmass, study.albedo,
-        )
+        # The terms of the steps with light (elementwise, and 0 without it), those steps alone.
+        ghi_of = ghi if ghi is not None else dni * np.clip(np.cos(np.radians(zenith)), 0, None)
+        dhi_of = dhi if dhi is not None else np.zeros_like(dni)
+        shown = np.flatnonzero((dni > 0) | (ghi_of > 0) | (dhi_of > 0))
+        terms = np.zeros(dni.shape + (4,))
+        terms.reshape(-1, 4)[shown] = sky_diffuse_terms(
+            transposition, *(values.ravel()[shown] for values in (zenith, dni, ghi_of, dhi_of, dni_extra, airmass)),
+            study.albedo)
     if horizons:
         dni, terms = block_behind_horizon(horizons, horizon_of, zenith, sun["solar_azimuth"], dni, terms)
     return Sky(

@@ -40,6 +40,7 @@ import pandas as pd
 import pvlib
 
 from foldopt.names import MODES
+from foldopt.physics.geometry import normal_vector
 from foldopt.physics.spa import NS_PER_HOUR, spa_solar_position
 
 _NS_PER_DAY = 24 * NS_PER_HOUR
@@ -340,7 +341,8 @@ def solar_position_grid(grid: ClockGrid, latitude, longitude, altitude=0.0, mode
     -------
     dict of numpy.ndarray
         ``solar_zenith``, ``solar_azimuth`` and the equatorial coordinates ``hour_angle`` and
-        ``declination`` that trackers steer by [deg], each (n_blocks, n_steps). In exact mode the
+        ``declination`` that trackers steer by [deg], each (n_blocks, n_steps), and
+        ``sun_vector``, (n_blocks, n_steps, 3) the unit vector toward the sun (east, north, up). In exact mode the
         hour angle is pvlib's formula ``15 (UTC hours - 12) + longitude + EoT / 4`` with SPA's
         equation of time, worked out from UTC (so DST days need no care), and the declination
         pvlib's ``declination_spencer71``.
@@ -350,16 +352,16 @@ def solar_position_grid(grid: ClockGrid, latitude, longitude, altitude=0.0, mode
         declination = _by_day_of_year(declination_paper, doy)
         hour_angle = _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, doy, longitude)
         zenith, azimuth = sun_from_angles(declination, hour_angle, latitude)
+        vector = normal_vector(zenith, azimuth)
     elif model == "exact":
-        zenith, azimuth, equation_of_time = spa_solar_position(grid.utc_ns, grid.step_hours, latitude, longitude,
-                                                               altitude)
+        zenith, azimuth, equation_of_time, vector = spa_solar_position(grid.utc_ns, latitude, longitude, altitude)
         utc_hours = (grid.utc_ns % _NS_PER_DAY) / NS_PER_HOUR
         hour_angle = (15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0) % 360.0 - 180.0
         declination = _by_day_of_year(lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), doy)
     else:
         raise ValueError(f"model must be one of {', '.join(MODES)}; got {model!r}")
     return {"solar_zenith": zenith, "solar_azimuth": azimuth, "hour_angle": hour_angle,
-            "declination": np.broadcast_to(declination, np.shape(zenith))}
+            "declination": np.broadcast_to(declination, np.shape(zenith)), "sun_vector": vector}
 
 
 def get_solar_position(
@@ -388,4 +390,4 @@ def get_solar_position(
         indexed by ``times``.
     """
     sun = solar_position_grid(ClockGrid.from_times([times], times.tz), latitude, longitude, altitude, model)
-    return pd.DataFrame({name: values[0] for name, values in sun.items()}, index=times)
+    return pd.DataFrame({name: values[0] for name, values in sun.items() if name != "sun_vector"}, index=times)

@@ -3,32 +3,34 @@
 This module runs NREL's SPA [1]_ through the step functions of ``pvlib.spa``, split in two so that
 many days and sites are one array program (:func:`foldopt.physics.solarposition.solar_position_grid`):
 the geocentric part, which depends on time only, runs once per UTC hour that any day touches and
-is interpolated, as SPA itself interpolates it for sunrise and sunset [1]_ (Appendix A.2); the
-topocentric part runs per site every 10 minutes, the sun vector is interpolated between, and the
-refraction is applied at every step: the sun's direction stays within 0.005 deg of
-``pvlib.solarposition.spa_python`` (except at SPA's refraction cut-off, 0.83 deg below the horizon).
+is interpolated, as SPA itself interpolates it for sunrise and sunset [1]_ (Appendix A.2), and
+gives the sun's direction once per UTC step; the topocentric part is a rotation of that direction
+per site and step, in vector form (:func:`spa_solar_position`), and the refraction is applied at
+every step: the sun's direction stays within 2e-6 deg of ``pvlib.solarposition.spa_python``
+(except at SPA's refraction cut-off, 0.83 deg below the horizon).
 
 Why not ``pvlib.solarposition.get_solarposition``: ``bench/solarposition.py`` (2-core x86_64,
-pvlib 0.16.1) times a year of steps per site, in seconds, ``*`` scaled per site from a measured run:
+pvlib 0.16.1, 2026-12-02) times a year of steps per site, in seconds, ``*`` scaled per site from
+a measured run:
 
 =====  ======  ========  =================  ==============================
 step   sites   split     get_solarposition  get_solarposition every 10 min
                                             and foldopt's interpolation
 =====  ======  ========  =================  ==============================
-1 min  1       0.18      4.3                0.39
-1 min  100     19.5      432 *              38.7 *
-1 min  10 000  1 771 *   43 247 *           3 872 *
-5 min  2 000   106 *     1 577 *            521 *
+1 min  1       0.18      2.6                0.26
+1 min  100     7.4       260 *              25.9 *
+1 min  10 000  578 *     26 008 *           2 590 *
+5 min  2 000   19.7 *    899 *              457 *
 =====  ======  ========  =================  ==============================
 
 (``spa_python(how='numba')`` on 2 threads: 1.8 s a site-year at 1 min.) The public call would
-make the sun 11-24 times dearer; at the map's 5-minute steps it would add 0.74 s to a site's whole
-0.26 s (``results/bench/map.md``). With the same subsampling it stays 2-5 times dearer. The
-price of the split is a dependence on ``pvlib.spa``'s step functions, which are not pvlib's
-public API: pyproject.toml pins pvlib to the releases in which they are unchanged (0.11 to 0.16,
-by pvlib's source history; tested with 0.16.1), and tests/test_solarposition.py holds the split
-to ``spa_python`` on random sites. A process that has called ``spa_python(how='numba')`` has
-``pvlib.spa`` reloaded as scalar numba functions, and the split then raises ``TypeError``.
+make the sun 15-46 times dearer; at a map's 5-minute steps it would cost 0.45 s a site-year,
+against the split's 0.01 s. The price of the split is a dependence on ``pvlib.spa``'s step
+functions, which are not pvlib's public API: pyproject.toml pins pvlib to the releases in which
+they are unchanged (0.11 to 0.16, by pvlib's source history; tested with 0.16.1), and
+tests/test_solarposition.py holds the split to ``spa_python`` on random sites. A process that has
+called ``spa_python(how='numba')`` has ``pvlib.spa`` reloaded as scalar numba functions, and the
+split then raises ``TypeError``.
 
 References
 ----------
@@ -38,11 +40,13 @@ References
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pvlib
+from numba import njit, uint64
 
 NS_PER_HOUR = 3_600_000_000_000  # [ns]
-SPA_SPACING_MIN = 10.0  # [min] between topocentric SPA evaluations on finely stepped series
 SPA_DELTA_T = 67.0  # [s], TT - UT1, pvlib's default for spa_python
 SPA_TEMPERATURE = 12.0  # [C], pvlib's default for the refraction correction
 SPA_ATMOS_REFRACT = 0.5667  # [deg], SPA's refraction at sunrise and sunset
@@ -146,40 +150,118 @@ def _geocentric_hourly(utc_ns: np.ndarray) -> dict:
     return out
 
 
-def _spa_topocentric(geo: dict, latitude, longitude, altitude):
-    """Geometric (refraction-free) zenith and azimuth [deg] from geocentric terms, SPA Sec. 3.10-3.14
-    via ``pvlib.spa``; site arguments broadcast against the terms."""
-    spa = pvlib.spa
-    hour_angle = spa.local_hour_angle(geo["v"], longitude, geo["alpha"])
-    u = spa.uterm(latitude)
-    x, y = spa.xterm(u, latitude, altitude), spa.yterm(u, latitude, altitude)
-    delta_alpha = spa.parallax_sun_right_ascension(x, geo["xi"], hour_angle, geo["delta"])
-    delta_prime = spa.topocentric_sun_declination(geo["delta"], x, y, geo["xi"], delta_alpha, hour_angle)
-    hour_angle_prime = spa.topocentric_local_hour_angle(hour_angle, delta_alpha)
-    elevation = spa.topocentric_elevation_angle_without_atmosphere(latitude, delta_prime, hour_angle_prime)
-    gamma = spa.topocentric_astronomers_azimuth(hour_angle_prime, delta_prime, latitude)
-    azimuth = spa.topocentric_azimuth_angle(gamma)
-    return 90.0 - elevation, azimuth
+def _equatorial(utc_ns) -> np.ndarray:
+    """The time-only terms of a site's sun at UTC instants ``utc_ns`` (any shape), from SPA's
+    geocentric terms (:func:`_geocentric_hourly`): the sun's direction in the frame of the
+    Greenwich meridian and the celestial pole, ``cos(delta) cos(H_G)``, ``cos(delta) sin(H_G)``
+    and ``sin(delta)`` with ``H_G = v - alpha`` its Greenwich hour angle [1]_ (Eq. 34 at longitude
+    0); ``sin(xi)``, the scale of the parallax; and the equation of time [min]. (5, ...)."""
+    geo = _geocentric_hourly(utc_ns)
+    greenwich = np.radians(geo["v"] - geo["alpha"])
+    delta = np.radians(geo["delta"])
+    cos_delta = np.cos(delta)
+    return np.stack([cos_delta * np.cos(greenwich), cos_delta * np.sin(greenwich), np.sin(delta),
+                     np.sin(np.radians(geo["xi"])), geo["eot"]])
 
 
-def spa_solar_position(utc_ns, step_hours: float, latitude, longitude, altitude):
-    """Apparent zenith, azimuth and equation of time by SPA [1]_ at every step of days of steps.
+#: The terms of :func:`_equatorial` at the steps of UTC lattices this process has evaluated,
+#: {(step [ns], phase [ns]): (first step's index, terms (5, n))}, replaced whole (one assignment,
+#: so that a thread reads one state or the other). A map's sites of one year and step lie on one
+#: lattice whatever their time zone; :data:`STEPS_KEPT` bounds each (about 60 MB).
+_ON_LATTICE: dict = {}
+STEPS_KEPT = 1_500_000
 
-    On days stepped finer than :data:`SPA_SPACING_MIN`, the topocentric position is evaluated every
-    10 minutes only (and on each day's last step); the geometric sun vector and the equation of time,
-    which are smooth, are interpolated linearly between, and SPA's own refraction correction [1]_
-    (Eq. 42, with pvlib's default pressure for the altitude and 12 C) is applied to every step, so
-    that the correction's kink at the horizon stays exact. Measured at 1-minute steps against
-    pvlib's full SPA: the sun's direction within 0.005 deg, the equation of time within 1e-6 min
-    (tests/test_solarposition.py).
+
+def _shared_terms(utc_ns: np.ndarray) -> tuple:
+    """:func:`_equatorial` at ``utc_ns`` (n_blocks, n_steps) as ``(first, terms)``: block ``b``'s
+    step ``i`` is ``terms[:, first[b] + i]``. Where every day is of equal steps on one lattice of
+    UTC instants, each instant is evaluated once per process however many sites and days share it;
+    the terms are elementwise in time, so an instant's are the same bits whichever call first
+    asked for it."""
+    global _ON_LATTICE
+    n_blocks, n_steps = utc_ns.shape
+    step = int(utc_ns[0, 1] - utc_ns[0, 0]) if n_steps > 1 else 0
+    phase = int(utc_ns[0, 0] % step) if step > 0 else 0
+    # A day of equal steps spans them; a clock's change (a DST day) does not.
+    lattice = step > 0 and np.all(utc_ns[:, 0] % step == phase) and np.all(
+        utc_ns[:, -1] - utc_ns[:, 0] == step * (n_steps - 1))
+    if not lattice:
+        return np.arange(n_blocks) * n_steps, _equatorial(utc_ns).reshape(5, -1)
+    start = (utc_ns[:, 0] - phase) // step
+    low, high = int(start.min()), int(start.max()) + n_steps - 1
+    first, terms = _ON_LATTICE.get((step, phase), (low, np.zeros((5, 0))))
+    if low < first or high >= first + terms.shape[1]:
+        low, high = min(low, first), max(high, first + terms.shape[1] - 1)
+        if high - low + 1 > STEPS_KEPT:
+            return np.arange(n_blocks) * n_steps, _equatorial(utc_ns).reshape(5, -1)
+        first, terms = low, _equatorial(np.arange(low, high + 1) * step + phase)
+        _ON_LATTICE = {**_ON_LATTICE, (step, phase): (first, terms)}
+    return start - first, terms
+
+
+@njit(cache=True)
+def _site_directions(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, direction):
+    """The geometric (refraction-free) topocentric unit vector toward the sun (east, north, up)
+    at every step of every block into ``direction`` (n_blocks, n_steps, 3): block ``b``'s step
+    ``i`` from ``terms[:, first[b] + i]`` (:func:`_shared_terms`), the site's arguments per block.
+    Arithmetic alone, indexed so that it vectorises; the angles are NumPy's (vectorised too)."""
+    n_blocks, n_steps = direction.shape[0], direction.shape[1]
+    for b in range(n_blocks):
+        start = uint64(first[b])
+        for i in range(uint64(n_steps)):
+            k = start + i
+            # cos(delta) cos(H) and cos(delta) sin(H) at the site's hour angle H = H_G + longitude.
+            cos_h = terms[0, k] * cos_lam[b] - terms[1, k] * sin_lam[b]
+            sin_h = terms[1, k] * cos_lam[b] + terms[0, k] * sin_lam[b]
+            # Less the site's position: toward the meridian on the equator, and toward the pole.
+            meridian, pole = cos_h - x[b] * terms[3, k], terms[2, k] - y[b] * terms[3, k]
+            east = -sin_h
+            north = pole * cos_phi[b] - meridian * sin_phi[b]
+            up = pole * sin_phi[b] + meridian * cos_phi[b]
+            scale = 1.0 / math.sqrt(east * east + north * north + up * up)
+            direction[b, i, 0], direction[b, i, 1], direction[b, i, 2] = east * scale, north * scale, up * scale
+
+
+@njit(cache=True)
+def _raise(vector, turn):
+    """Each unit vector (..., 3) raised by ``turn`` [rad] (same leading shape) toward the zenith in
+    its vertical plane. The turn is SPA's refraction, under 0.011 rad: its sine and cosine by their
+    series to the 9th and 10th power, exact in double precision (the next terms are below 1e-21)."""
+    flat, turns = vector.reshape(-1, 3), turn.ravel()
+    for k in range(turns.shape[0]):
+        t = turns[k]
+        if t == 0.0:
+            continue
+        t2 = t * t
+        sin_t = t * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))))
+        cos_t = 1.0 - t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))))
+        east, north, up = flat[k, 0], flat[k, 1], flat[k, 2]
+        level = math.sqrt(east * east + north * north)
+        along = (level * cos_t - up * sin_t) / level if level > 0.0 else 0.0
+        flat[k, 0], flat[k, 1], flat[k, 2] = east * along, north * along, up * cos_t + level * sin_t
+
+
+def spa_solar_position(utc_ns, latitude, longitude, altitude):
+    """Apparent zenith, azimuth, equation of time and the sun's apparent unit vector by SPA [1]_
+    at every step of days of steps.
+
+    SPA's geocentric terms depend on time alone: kept per UTC hour and interpolated
+    (:func:`_geocentric_hourly`), they give the sun's direction in the frame of the Greenwich
+    meridian and the celestial pole (:func:`_equatorial`), the same for every site at an instant
+    and kept per step (:func:`_shared_terms`). A site's topocentric direction is that vector turned
+    by the site's longitude and latitude, less the site's own position seen from the Earth's centre
+    (``x`` and ``y`` of [1]_ Eq. 38-39, scaled by ``sin(xi)``): the vector form of SPA's parallax in
+    right ascension and declination (Eq. 40-41, 43-45), exact, with no trigonometry per step but
+    the elevation's and the azimuth's (:func:`_site_directions`). SPA's refraction correction
+    (Eq. 42, pvlib's function, with pvlib's default pressure for the altitude and 12 C) raises it
+    at every step (:func:`_raise`). Against pvlib's ``spa_python`` on random sites and days at
+    1-min steps, the sun's direction is within 2e-6 deg (tests/test_solarposition.py).
 
     Parameters
     ----------
     utc_ns : numpy.ndarray of int64
-        (n_blocks, n_steps) UTC instants [ns since 1970-01-01], equally stepped along each row
+        (n_blocks, n_steps) UTC instants [ns since 1970-01-01]
         (:attr:`foldopt.physics.solarposition.ClockGrid.utc_ns`).
-    step_hours : float
-        Step length [h].
     latitude, longitude : float or array_like
         [deg north], [deg east]; one value, or one per block, shape (n_blocks, 1).
     altitude : float or array_like
@@ -191,32 +273,34 @@ def spa_solar_position(utc_ns, step_hours: float, latitude, longitude, altitude)
         [deg], azimuth clockwise from north, (n_blocks, n_steps).
     equation_of_time : numpy.ndarray
         [min], (n_blocks, n_steps).
+    sun_vector : numpy.ndarray
+        (n_blocks, n_steps, 3) the apparent direction's east, north and up components [-].
 
     References
     ----------
     .. [1] I. Reda, A. Andreas, "Solar position algorithm for solar radiation applications",
        Solar Energy 76(5), 577-589, 2004, Sec. 3.10-3.14 and A.1.
     """
-    n_steps = np.shape(utc_ns)[1]
-    stride = int(SPA_SPACING_MIN // (step_hours * 60.0))
-    if stride < 2 or n_steps < 4 * stride:
-        picked = np.arange(n_steps)
-    else:
-        picked = np.unique(np.r_[np.arange(0, n_steps, stride), n_steps - 1])
-    geo = _geocentric_hourly(np.asarray(utc_ns)[:, picked])
-    zenith0, azimuth = (np.radians(a) for a in _spa_topocentric(geo, latitude, longitude, altitude))
-    vector = np.stack([np.sin(zenith0) * np.sin(azimuth), np.sin(zenith0) * np.cos(azimuth), np.cos(zenith0)], -1)
-    eot = geo["eot"]
-    if picked.size < n_steps:
-        # Every day has the same pattern of picks, so one set of weights serves all of them.
-        position = np.arange(n_steps)
-        right = np.clip(np.searchsorted(picked, position, side="right"), 1, picked.size - 1)
-        weight = ((position - picked[right - 1]) / (picked[right] - picked[right - 1]))[None, :]
-        vector = vector[:, right - 1] * (1.0 - weight[..., None]) + vector[:, right] * weight[..., None]
-        eot = eot[:, right - 1] * (1.0 - weight) + eot[:, right] * weight
-    east, north, up = np.moveaxis(vector, -1, 0)
-    elevation0 = np.degrees(np.arctan2(up, np.hypot(east, north)))
-    pressure = pvlib.atmosphere.alt2pres(np.asarray(altitude, dtype=float))
-    refraction = pvlib.spa.atmospheric_refraction_correction(pressure / 100.0, SPA_TEMPERATURE, elevation0,
-                                                             SPA_ATMOS_REFRACT)
-    return 90.0 - (elevation0 + refraction), np.degrees(np.arctan2(east, north)) % 360.0, eot
+    utc_ns = np.asarray(utc_ns)
+    shape = utc_ns.shape
+
+    def per_block(values):
+        return np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=float), (shape[0], 1))[:, 0])
+
+    latitude, longitude, altitude = per_block(latitude), per_block(longitude), per_block(altitude)
+    u = pvlib.spa.uterm(latitude)
+    x, y = pvlib.spa.xterm(u, latitude, altitude), pvlib.spa.yterm(u, latitude, altitude)
+    lam, phi = np.radians(longitude), np.radians(latitude)
+    first, terms = _shared_terms(utc_ns)
+    vector = np.empty(shape + (3,))
+    _site_directions(terms, first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, vector)
+    elevation0 = np.degrees(np.arcsin(np.clip(vector[..., 2], -1.0, 1.0)))
+    azimuth = np.degrees(np.arctan2(vector[..., 0], vector[..., 1]))
+    azimuth = np.where(azimuth < 0.0, azimuth + 360.0, azimuth)
+    # SPA's refraction (0 more than 0.83 deg below the horizon) raises the direction in its
+    # vertical plane, its azimuth kept.
+    refraction = pvlib.spa.atmospheric_refraction_correction((pvlib.atmosphere.alt2pres(altitude) / 100.0)[:, None],
+                                                             SPA_TEMPERATURE, elevation0, SPA_ATMOS_REFRACT)
+    _raise(vector, np.radians(refraction))
+    equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
+    return 90.0 - (elevation0 + refraction), azimuth, equation_of_time, vector

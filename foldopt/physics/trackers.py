@@ -115,7 +115,8 @@ def step_law(hour_angle, steps=12, angular_field=90.0, offsets_h=ALEXANDRU_STEP_
     return -angular_field / 2.0 + moves_done * angular_field / steps
 
 
-def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declination, latitude, options=None):
+def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declination, latitude, options=None,
+                        sun_vector=None):
     """Panel orientation of a tracker over the day.
 
     Parameters
@@ -128,11 +129,17 @@ def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declinat
         [deg], broadcast against the leading axes (shape (n_days, 1) for one per day).
     options : TrackerOptions, optional
         Step law and single-axis settings.
+    sun_vector : array_like, optional
+        The sun's unit vector (east, north, up) on a last axis of 3, where the caller has it: the
+        ideal tracker's normal (default worked out from the zenith and azimuth).
 
     Returns
     -------
     surface_tilt, surface_azimuth : numpy.ndarray
         [deg] per time step.
+    normal : numpy.ndarray
+        The panel's unit normal (east, north, up) per time step, on a last axis of 3: what the
+        light on the panel and its moves are worked out from.
 
     Raises
     ------
@@ -149,7 +156,10 @@ def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declinat
     if model not in TRACKER_MODELS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}; got {model!r}")
     return TRACKER_MODELS[model].orientation(solar_zenith, solar_azimuth, hour_angle, declination, latitude,
-                                             options or TrackerOptions())
+                                             options or TrackerOptions(), sun_vector)
+
+
+_UP = np.array([0.0, 0.0, 1.0])  # a level panel's normal
 
 
 def _resting(solar_zenith, latitude):
@@ -165,33 +175,37 @@ def _noon_declination(hour_angle, declination):
     return np.take_along_axis(np.broadcast_to(declination, hour_angle.shape), noon, axis=-1)
 
 
-def _dual_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options):
+def _dual_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector):
     """The ideal tracker: the normal on the sun, level at night."""
     zenith, down, level_azimuth = _resting(solar_zenith, latitude)
     azimuth = np.asarray(solar_azimuth, dtype=float)
-    return np.where(down, 0.0, zenith), np.where(down, level_azimuth, azimuth)
+    on_sun = normal_vector(zenith, azimuth) if sun_vector is None else np.asarray(sun_vector, dtype=float)
+    return (np.where(down, 0.0, zenith), np.where(down, level_azimuth, azimuth),
+            np.where(down[..., None], _UP, on_sun))
 
 
-def _equatorial(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options):
+def _equatorial(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector):
     """The equatorial mount following the hour angle, level at night."""
     _, down, level_azimuth = _resting(solar_zenith, latitude)
     hour_angle = np.asarray(hour_angle, dtype=float)
     normal = equatorial_normal(hour_angle, _noon_declination(hour_angle, declination), latitude)
     tilt, azimuth = orientation_from_normal(normal, level_azimuth=level_azimuth)
-    return np.where(down, 0.0, tilt), np.where(down, level_azimuth, azimuth)
+    return (np.where(down, 0.0, tilt), np.where(down, level_azimuth, azimuth),
+            np.where(down[..., None], _UP, normal))
 
 
-def _dual_axis_steps(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options):
+def _dual_axis_steps(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector):
     """The equatorial mount on Alexandru's step law, at its morning position at night."""
     _, down, level_azimuth = _resting(solar_zenith, latitude)
     hour_angle = np.asarray(hour_angle, dtype=float)
     seasonal = _noon_declination(hour_angle, declination)
     daily = step_law(hour_angle, options.steps, options.angular_field, options.step_offsets_h)
     daily = np.where(down, -options.angular_field / 2.0, daily)
-    return orientation_from_normal(equatorial_normal(daily, seasonal, latitude), level_azimuth=level_azimuth)
+    normal = equatorial_normal(daily, seasonal, latitude)
+    return (*orientation_from_normal(normal, level_azimuth=level_azimuth), normal)
 
 
-def _single_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options):
+def _single_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector):
     """pvlib's single-axis tracker, flat along its axis at night."""
     import pvlib  # seconds to import: where a single-axis tracker runs, not where a study reads the registry
 
@@ -207,7 +221,8 @@ def _single_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude,
     # At night pvlib returns NaN; the panel then rests flat along the axis.
     tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt).reshape(shape)
     azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
-    return tilt, np.where(np.isnan(azimuth), axis_azimuth, azimuth)
+    azimuth = np.where(np.isnan(azimuth), axis_azimuth, azimuth)
+    return tilt, azimuth, normal_vector(tilt, azimuth)
 
 
 @dataclass(frozen=True)
@@ -217,8 +232,9 @@ class TrackerModel:
     Parameters
     ----------
     orientation : callable
-        ``orientation(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options)``
-        returning ``(surface_tilt, surface_azimuth)`` [deg], as :func:`tracker_orientation`.
+        ``orientation(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options,
+        sun_vector)`` returning ``(surface_tilt, surface_azimuth, normal)``, as
+        :func:`tracker_orientation`.
     options : tuple of str
         The fields of :class:`TrackerOptions` it reads; a study refuses the others given a value
         (:meth:`foldopt.inputs.sections.Tracker.idle_settings`).
@@ -359,25 +375,33 @@ class TrackerDrive:
         return energy
 
 
-def _turned(t, speed, tau_1, tau_2):
-    """Angle [deg] turned by t [s] after a voltage step, for the two-pole speed response."""
-    return speed * (t - (tau_1**2 * -np.expm1(-t / tau_1) - tau_2**2 * -np.expm1(-t / tau_2)) / (tau_1 - tau_2))
+#: [s] Newton's last step for a move's time (:func:`_time_to_turn`): its energy then to 1e-11 Wh.
+TURN_TOLERANCE_S = 1e-12
 
 
 def _time_to_turn(angle, speed, tau_1, tau_2):
-    """Time [s] to turn ``angle`` [deg] from rest, by Newton's method on :func:`_turned`: at most 30
-    steps, ended once no element changes (a fixed point, which further steps keep bit for bit)."""
+    """Time [s] to turn ``angle`` [deg] from rest, by Newton's method on the angle turned by ``t``
+    [s] after a voltage step, for the two-pole speed response,
+    ``speed (t - (tau_1^2 (1 - exp(-t / tau_1)) - tau_2^2 (1 - exp(-t / tau_2))) / (tau_1 - tau_2))``.
+
+    It starts on the asymptote ``angle / speed + tau_1 + tau_2`` (the motor at full speed after its
+    delay), which lies above the root; the angle turned is convex in time, so the steps descend
+    onto it monotonically and stop when none moves by more than :data:`TURN_TOLERANCE_S` (some
+    never settle on a fixed point: they change in their last bit, back and forth)."""
     t = angle / speed + tau_1 + tau_2
-    for _ in range(30):
-        rate = speed * (1 - (tau_1 * np.exp(-t / tau_1) - tau_2 * np.exp(-t / tau_2)) / (tau_1 - tau_2))
-        step = np.maximum(t - (_turned(t, speed, tau_1, tau_2) - angle) / rate, 1e-9)
-        if np.array_equal(step, t):
-            break
+    for _ in range(50):
+        decay_1, decay_2 = np.expm1(-t / tau_1), np.expm1(-t / tau_2)
+        turned = speed * (t + (tau_1**2 * decay_1 - tau_2**2 * decay_2) / (tau_1 - tau_2))
+        rate = speed * (1 - (tau_1 * (decay_1 + 1.0) - tau_2 * (decay_2 + 1.0)) / (tau_1 - tau_2))
+        step = np.maximum(t - (turned - angle) / rate, 1e-9)
+        settled = np.all(np.abs(step - t) <= TURN_TOLERANCE_S)
         t = step
+        if settled:
+            break
     return t
 
 
-def moved_degrees(surface_tilt, surface_azimuth):
+def moved_degrees(normal):
     """Angle the panel normal turns between consecutive steps.
 
     Tracking by day, and the moves into and out of the stow position at sunset and sunrise
@@ -385,38 +409,37 @@ def moved_degrees(surface_tilt, surface_azimuth):
 
     Parameters
     ----------
-    surface_tilt, surface_azimuth : array_like
-        Panel orientation per step [deg], time on the last axis, any leading axes.
+    normal : array_like
+        The panel's unit normal per step (east, north, up on the last axis), time on the one
+        before, any leading axes.
 
     Returns
     -------
     numpy.ndarray
-        Turn into each step [deg], shaped as the orientation; 0 at the first step and where the
-        panel holds still (turns below 1e-6 deg).
+        Turn into each step [deg], shaped as the normals' leading axes; 0 at the first step and
+        where the panel holds still (turns below 1e-6 deg).
     """
-    normal = normal_vector(surface_tilt, surface_azimuth)
+    normal = np.asarray(normal, dtype=float)
     turn = np.zeros(normal.shape[:-1])
-    turn[..., 1:] = _angle_between(normal[..., 1:, :], normal[..., :-1, :])
+    # The chord between unit vectors is 2 sin(angle / 2): exact from a standstill to a half turn.
+    chord = np.linalg.norm(normal[..., 1:, :] - normal[..., :-1, :], axis=-1)
+    turn[..., 1:] = np.degrees(2.0 * np.arcsin(np.minimum(chord / 2.0, 1.0)))
     # A panel that holds still must not be charged a motor start: drop rounding-level turns.
     return np.where(turn > 1e-6, turn, 0.0)
 
 
-def _angle_between(a, b):
-    """Angle [deg] between unit vectors, exact for (anti)parallel ones too (atan2, not acos)."""
-    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1)))
-
-
-def tracker_draw(surface_tilt, surface_azimuth, sun_up, step_hours, drive: TrackerDrive):
+def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive):
     """The tracker's own power draw per step: standby while the sun is up, plus moves.
 
     Each step's moves are spread over the step (their energy / step length).
 
     Parameters
     ----------
-    surface_tilt, surface_azimuth : array_like
-        Panel orientation per step [deg] (:func:`tracker_orientation`), time on the last axis.
+    normal : array_like
+        The panel's unit normal per step (:func:`tracker_orientation`), east, north and up on the
+        last axis, time on the one before.
     sun_up : array_like of bool
-        Steps with the sun above the horizon, broadcast against the orientation.
+        Steps with the sun above the horizon, broadcast against the normals' leading axes.
     step_hours : float
         Step length [h].
     drive : TrackerDrive
@@ -428,5 +451,5 @@ def tracker_draw(surface_tilt, surface_azimuth, sun_up, step_hours, drive: Track
         Draw [W] per step.
     """
     sun_up = np.asarray(sun_up, dtype=bool)
-    moves = drive.move_energy_wh(moved_degrees(surface_tilt, surface_azimuth))
+    moves = drive.move_energy_wh(moved_degrees(normal))
     return np.where(sun_up, drive.standby_w, 0.0) + moves / step_hours

@@ -87,7 +87,7 @@ class Day:
         surface_tilt, surface_azimuth : numpy.ndarray
             [deg], (n_time,).
         """
-        return tuple(angle[0] for angle in self._tracker_sky_orientation(model))
+        return tuple(angle[0] for angle in self._tracker_sky_orientation(model)[:2])
 
     def _tracker_sky_orientation(self, model=None):
         model = model or self.study.tracker.model

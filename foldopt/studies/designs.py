@@ -50,7 +50,8 @@ def setup_key(study: Study) -> str:
 
 
 def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
-    """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each.
+    """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each,
+    and its unit normal, (n_blocks, n_steps, 3) (:func:`foldopt.physics.trackers.tracker_orientation`).
 
     Parameters
     ----------
@@ -69,7 +70,7 @@ def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
     )
     return tracker_orientation(
         model or tracker.model, sky.solar_zenith, sky.solar_azimuth, sky.hour_angle, sky.declination,
-        np.asarray(sky.latitude)[:, None], options,
+        np.asarray(sky.latitude)[:, None], options, sky.sun_vector,
     )
 
 
@@ -85,14 +86,15 @@ def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
     sky : Sky
     study : Study
     orientation : tuple of numpy.ndarray
-        The tracker's surface tilt and azimuth [deg] (:func:`sky_tracker_orientation`).
+        The tracker's surface tilt and azimuth [deg] and normal (:func:`sky_tracker_orientation`).
 
     Returns
     -------
     numpy.ndarray
         (n_blocks, n_steps) [W].
     """
-    return engines.panel_power(sky, study, engines.poa(sky, *orientation))
+    tilt, azimuth, normal = orientation
+    return engines.panel_power(sky, study, engines.poa(sky, tilt, azimuth, normal=normal))
 
 
 def standby_available(gross, draw, lit, standby_w: float):
@@ -123,7 +125,7 @@ def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.
     study : Study
         The tracker's drive and standby settings.
     orientation : tuple of numpy.ndarray
-        The tracker's surface tilt and azimuth [deg] (:func:`sky_tracker_orientation`).
+        The tracker's surface tilt and azimuth [deg] and normal (:func:`sky_tracker_orientation`).
     every : int, default 1
         Work out every ``every``-th block's draw and give it to the next ``every``: a cloud
         ensemble's members share their day's sun, so the tracker moves alike, and some light
@@ -132,7 +134,7 @@ def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.
     tracker = study.tracker
     drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
     shared = slice(None, None, every)
-    draw = tracker_draw(*(angle[shared] for angle in orientation), sky.lit[shared], sky.step_hours, drive)
+    draw = tracker_draw(orientation[2][shared], sky.lit[shared], sky.step_hours, drive)
     return np.repeat(draw, every, axis=0) if every > 1 else draw
 
 
@@ -296,7 +298,7 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
                                outputs=("panel",), contiguous=True, engine=engine)
     orientation = sky_tracker_orientation(sky, study)
     gross = sky_tracker_power(sky, study, orientation)
-    tracker_poa = energy(engines.poa(sky, *orientation, incident=True), sky.step_hours)
+    tracker_poa = energy(engines.poa(sky, *orientation[:2], incident=True, normal=orientation[2]), sky.step_hours)
     net = gross - sky_tracker_draw(sky, study, orientation, every=blocks_of.members)
     shape = sky.load_shape
     trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
@@ -456,8 +458,8 @@ def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba"
             piece = slice(start, min(start + per_chunk, points.shape[0]))
             count = piece.stop - piece.start
             rows = np.repeat(np.arange(sky.n_blocks), count)
-            metrics = engines.row_metrics(sky, study, rows, np.tile(orientation[piece], (sky.n_blocks, 1)), loads,
-                                          outputs=(output,), engine=engine)
+            metrics = engines.row_metrics(sky, study, rows, orientation[piece], loads, outputs=(output,),
+                                          engine=engine, row_orientation=np.tile(np.arange(count), sky.n_blocks))
             hours[:, piece] = metrics.t_solar[:, 0].reshape(sky.n_blocks, count, loads.size)
             energy[:, piece] = metrics.energy[:, 0].reshape(sky.n_blocks, count)
         days.append(hours)

@@ -39,7 +39,6 @@ References
 
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 import pvlib
@@ -254,30 +253,30 @@ def interpolate_points(values, offset: float, steps_per_interval: int):
     return values[:, right - 1] * (1.0 - weight) + values[:, right] * weight
 
 
-def clear_sky(times, apparent_zenith, latitude, longitude, altitude, model="ineichen", linke_turbidity=None):
-    """pvlib's clear sky at some times.
+def clear_sky(apparent_zenith, airmass, dni_extra, altitude, model="ineichen", linke_turbidity=None):
+    """pvlib's clear sky at some steps, arrays in and out.
 
     Parameters
     ----------
-    times : pandas.DatetimeIndex
-        tz-aware.
     apparent_zenith : array_like
-        The sun's apparent zenith at ``times`` [deg].
-    latitude, longitude : float
-        [deg].
+        The sun's apparent zenith [deg].
+    airmass : array_like
+        Relative air mass [-] (Kasten & Young's, pvlib's default; NaN or 0 with the sun down).
+    dni_extra : array_like
+        Extraterrestrial irradiance [W/m^2].
     altitude : float
         [m].
     model : {'ineichen', 'simplified-solis'}
-        ``ineichen`` takes ``linke_turbidity``, or looks it up in pvlib's bundled climatology
-        (offline) [2]_; ``simplified-solis`` uses its defaults (aerosol optical depth 0.1,
-        precipitable water 1 cm).
+        ``ineichen`` takes ``linke_turbidity``; ``simplified-solis`` uses its defaults (aerosol
+        optical depth 0.1, precipitable water 1 cm).
     linke_turbidity : float or array_like, optional
-        [-].
+        [-], for ``ineichen``: the study's, or the climatology's at the site
+        (:func:`foldopt.inputs.turbidity.linke_turbidity`) [4]_.
 
     Returns
     -------
     dict
-        ``ghi``, ``dni``, ``dhi`` [W/m^2] at ``times``, 0 at night.
+        ``ghi``, ``dni``, ``dhi`` [W/m^2], 0 with the sun down.
 
     Raises
     ------
@@ -285,19 +284,9 @@ def clear_sky(times, apparent_zenith, latitude, longitude, altitude, model="inei
         For a model that is not one of :data:`foldopt.names.CLEAR_SKIES`.
     """
     if model == "ineichen":
-        turbidity = linke_turbidity
-        if turbidity is None:
-            with warnings.catch_warnings():
-                # pvlib reads DatetimeIndex.dayofyear, which pandas 3 deprecates; not ours to fix.
-                warnings.simplefilter("ignore", DeprecationWarning)
-                warnings.simplefilter("ignore", FutureWarning)
-                turbidity = pvlib.clearsky.lookup_linke_turbidity(times, latitude, longitude).to_numpy()
-        airmass = pvlib.atmosphere.get_absolute_airmass(
-            pvlib.atmosphere.get_relative_airmass(apparent_zenith), pvlib.atmosphere.alt2pres(altitude)
-        )
-        dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(times.day_of_year), dtype=float)
+        absolute = pvlib.atmosphere.get_absolute_airmass(airmass, pvlib.atmosphere.alt2pres(altitude))
         with np.errstate(divide="ignore", invalid="ignore"):  # night: zero air mass terms
-            sky = pvlib.clearsky.ineichen(apparent_zenith, airmass, turbidity, altitude, dni_extra)
+            sky = pvlib.clearsky.ineichen(apparent_zenith, absolute, linke_turbidity, altitude, dni_extra)
     elif model == "simplified-solis":
         sky = pvlib.clearsky.simplified_solis(90.0 - np.asarray(apparent_zenith),
                                               pressure=pvlib.atmosphere.alt2pres(altitude))
