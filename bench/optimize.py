@@ -39,7 +39,7 @@ def main() -> None:
     import foldopt
     from foldopt.engine.search import Axis, grid_search
     from foldopt.studies.designs import Blocks, design_hours
-    from foldopt.studies.joint import objective_quantum
+    from foldopt.studies.objectives import objective_quantum
     from foldopt.studies.objectives import objective_value
 
     base = foldopt.load_study(ROOT / "configs" / "optimize.yaml").base

@@ -15,7 +15,7 @@ import foldopt
 from foldopt.engine.search import Axis, grid_search
 from foldopt.inputs.plan import make_plan
 from foldopt.studies.designs import Blocks, design_hours
-from foldopt.studies.joint import objective_quantum
+from foldopt.studies.objectives import objective_quantum
 from foldopt.studies.objectives import objective_value
 
 

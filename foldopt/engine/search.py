@@ -163,43 +163,86 @@ def grid_search(evaluate: Callable[[np.ndarray], np.ndarray], axes, tolerance: f
     -------
     SearchResult
     """
-    axes = tuple(axes)
-    tolerance = max(float(tolerance), float(quantum))
-    sizes = np.array([axis.size for axis in axes])
-    steps = np.array([axis.step for axis in axes])
-    strides = np.array([1 << max(0, int(math.floor(math.log2(max(1.0, (n - 1) / (coarse_points - 1))))))
-                        for n in sizes])
-    store = _Store(evaluate, axes, sizes)
-    # The coarse lattice, each axis's last grid point included so the bounds are evaluated.
-    lattice = [np.union1d(np.arange(0, n, s), [n - 1]) for n, s in zip(sizes, strides, strict=True)]
-    store.add(np.stack(np.meshgrid(*lattice, indexing="ij"), axis=-1).reshape(-1, len(axes)))
-    if seeds is not None:
-        store.add(np.stack([np.clip(np.rint((np.asarray(seeds, float)[:, i] - a.lo) / a.step), 0, a.size - 1)
-                            for i, a in enumerate(axes)], axis=-1).astype(int))
-    levels = [(int(strides.max()), store.count)]
-    # Boxes by their lower and upper corners: consecutive lattice points along every axis.
-    edges = [(points[:-1], points[1:]) if points.size > 1 else (points, points) for points in lattice]
-    lower = np.stack(np.meshgrid(*[low for low, _ in edges], indexing="ij"), axis=-1).reshape(-1, len(axes))
-    upper = np.stack(np.meshgrid(*[high for _, high in edges], indexing="ij"), axis=-1).reshape(-1, len(axes))
-    while strides.max() > 1:
-        before = store.count
-        best = store.best_values()
-        bound = _box_bounds(store, lower, upper, strides, steps, sizes, safety) + quantum
-        keep = np.any(bound >= best + tolerance, axis=1)
-        strides = np.maximum(strides // 2, 1)
-        lower, upper = _split(lower[keep], upper[keep], strides)
-        corners = _corners(lower, upper)
-        store.add(np.unique(corners.reshape(-1, len(axes)), axis=0))
-        levels.append((int(strides.max()), store.count - before))
-    return SearchResult(axes, store.index, store.values, _best_rows(store.index, store.values), tuple(levels),
-                        tolerance)
+    search = GridSearch(axes, tolerance, quantum, safety, coarse_points, seeds)
+    while (points := search.ask()) is not None:
+        search.tell(evaluate(points))
+    return search.result()
+
+
+class GridSearch:
+    """:func:`grid_search` as a search that asks for points and is told their values, so that a
+    caller can run many at once and evaluate what they all ask for together (a map's sites).
+
+    Parameters
+    ----------
+    axes, tolerance, quantum, safety, coarse_points, seeds
+        As :func:`grid_search`'s.
+    """
+
+    def __init__(self, axes, tolerance: float, quantum: float = 0.0, safety: float = SAFETY,
+                 coarse_points: int = COARSE_POINTS, seeds=None):
+        self.axes = tuple(axes)
+        self.tolerance = max(float(tolerance), float(quantum))
+        self.quantum, self.safety = float(quantum), float(safety)
+        self.sizes = np.array([axis.size for axis in self.axes])
+        self.steps = np.array([axis.step for axis in self.axes])
+        self.strides = np.array([1 << max(0, int(math.floor(math.log2(max(1.0, (n - 1) / (coarse_points - 1))))))
+                                 for n in self.sizes])
+        self.store = _Store(self.axes, self.sizes)
+        # The coarse lattice, each axis's last grid point included so the bounds are evaluated.
+        lattice = [np.union1d(np.arange(0, n, s), [n - 1]) for n, s in zip(self.sizes, self.strides, strict=True)]
+        first = np.stack(np.meshgrid(*lattice, indexing="ij"), axis=-1).reshape(-1, len(self.axes))
+        if seeds is not None:
+            snapped = np.stack([np.clip(np.rint((np.asarray(seeds, float)[:, i] - a.lo) / a.step), 0, a.size - 1)
+                                for i, a in enumerate(self.axes)], axis=-1).astype(int)
+            first = np.vstack([first, snapped])
+        # Boxes by their lower and upper corners: consecutive lattice points along every axis.
+        edges = [(points[:-1], points[1:]) if points.size > 1 else (points, points) for points in lattice]
+        self.lower, self.upper = (np.stack(np.meshgrid(*ends, indexing="ij"), axis=-1).reshape(-1, len(self.axes))
+                                  for ends in zip(*edges, strict=True))
+        self.levels: list = []
+        self._asked = self.store.missing(first)
+
+    def ask(self):
+        """The points [units] to evaluate next, (n, n_axes), or None when the search is done."""
+        while self._asked is not None and self._asked.shape[0] == 0:
+            self._advance()
+        if self._asked is None:
+            return None
+        return np.stack([axis.values(self._asked[:, i]) for i, axis in enumerate(self.axes)], axis=-1)
+
+    def tell(self, values) -> None:
+        """The values of the points :meth:`ask` gave, (n, n_targets)."""
+        self.store.add(self._asked, np.asarray(values, dtype=float).reshape(self._asked.shape[0], -1))
+        self._advance()
+
+    def _advance(self) -> None:
+        """The next level's new corners, or None once the last level's are known."""
+        self.levels.append((int(self.strides.max()), int(self._asked.shape[0])))
+        if self.strides.max() <= 1:
+            self._asked = None
+            return
+        best = self.store.best_values()
+        bound = _box_bounds(self.store, self.lower, self.upper, self.strides, self.steps, self.sizes,
+                            self.safety) + self.quantum
+        keep = np.any(bound >= best + self.tolerance, axis=1)
+        self.strides = np.maximum(self.strides // 2, 1)
+        self.lower, self.upper = _split(self.lower[keep], self.upper[keep], self.strides)
+        corners = _corners(self.lower, self.upper)
+        self._asked = self.store.missing(np.unique(corners.reshape(-1, len(self.axes)), axis=0))
+
+    def result(self) -> SearchResult:
+        """What the search evaluated and found (once :meth:`ask` gives None)."""
+        store = self.store
+        return SearchResult(self.axes, store.index, store.values, _best_rows(store.index, store.values),
+                            tuple(self.levels), self.tolerance)
 
 
 class _Store:
     """The evaluated points by grid index, looked up by their flat key."""
 
-    def __init__(self, evaluate, axes, sizes):
-        self.evaluate, self.axes, self.sizes = evaluate, axes, sizes
+    def __init__(self, axes, sizes):
+        self.axes, self.sizes = axes, sizes
         self.index = np.zeros((0, len(axes)), dtype=int)
         self.values = None
         self.keys = np.zeros(0, dtype=np.int64)
@@ -208,19 +251,20 @@ class _Store:
     def count(self) -> int:
         return int(self.index.shape[0])
 
-    def add(self, index):
-        """Evaluate the points of ``index`` not evaluated yet."""
+    def missing(self, index):
+        """The points of ``index`` not evaluated yet, once each."""
         keys = np.ravel_multi_index(index.T, self.sizes)
         keys, first = np.unique(keys, return_index=True)
-        new = ~np.isin(keys, self.keys)
-        if not new.any():
+        return index[first[~np.isin(keys, self.keys)]]
+
+    def add(self, index, found):
+        """The values ``found`` (n, n_targets) of the points ``index`` (n, n_axes), new ones."""
+        if index.shape[0] == 0:
             return
-        index = index[first[new]]
-        points = np.stack([axis.values(index[:, i]) for i, axis in enumerate(self.axes)], axis=-1)
-        found = np.asarray(self.evaluate(points), dtype=float).reshape(index.shape[0], -1)
+        keys = np.ravel_multi_index(index.T, self.sizes)
         self.index = np.vstack([self.index, index])
         self.values = found if self.values is None else np.vstack([self.values, found])
-        self.keys = np.concatenate([self.keys, keys[new]])
+        self.keys = np.concatenate([self.keys, keys])
         self._order = np.argsort(self.keys)
 
     def lookup(self, index):

@@ -422,7 +422,8 @@ def moved_degrees(normal):
     normal = np.asarray(normal, dtype=float)
     turn = np.zeros(normal.shape[:-1])
     # The chord between unit vectors is 2 sin(angle / 2): exact from a standstill to a half turn.
-    chord = np.linalg.norm(normal[..., 1:, :] - normal[..., :-1, :], axis=-1)
+    east, north, up = (np.diff(normal[..., axis], axis=-1) for axis in range(3))
+    chord = np.sqrt(east * east + north * north + up * up)
     turn[..., 1:] = np.degrees(2.0 * np.arcsin(np.minimum(chord / 2.0, 1.0)))
     # A panel that holds still must not be charged a motor start: drop rounding-level turns.
     return np.where(turn > 1e-6, turn, 0.0)

@@ -18,7 +18,6 @@ share one setup) and a set of loads:
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,29 +25,12 @@ import numpy as np
 from foldopt.engine import rows as engines
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
-from foldopt.engine.sky import Sky, build_sky
+from foldopt.engine.sky import Sky
+# Blocks and their setup are part of the designs' API (the studies take them from here).
+from foldopt.studies.blocks import CHUNK_ROW_LOADS, Blocks, setup_key  # noqa: F401
 from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
-#: Rows (blocks x fold angles) x loads of one engine call: bounds the memory of a chunk.
-CHUNK_ROW_LOADS = 4_000_000
-#: Time steps of the blocks of one chunk's sky.
-CHUNK_STEPS = 1_100_000
-
-
-def setup_key(study: Study) -> str:
-    """What the blocks of one engine call share, as sorted JSON: everything but the site, the date and
-    the load (and the panel's orientation, which follows the site).
-
-    Parameters
-    ----------
-    study : Study
-    """
-    data = study.model_dump(mode="json", exclude={"site", "date", "p_load", "name", "description"})
-    data["panel"] = {k: v for k, v in data["panel"].items() if k not in ("tilt", "azimuth")}
-    return json.dumps(data, sort_keys=True)
-
-
 def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
     """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each,
     and its unit normal, (n_blocks, n_steps, 3) (:func:`foldopt.physics.trackers.tracker_orientation`).
@@ -136,99 +118,6 @@ def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.
     shared = slice(None, None, every)
     draw = tracker_draw(orientation[2][shared], sky.lit[shared], sky.step_hours, drive)
     return np.repeat(draw, every, axis=0) if every > 1 else draw
-
-
-@dataclass(frozen=True)
-class Blocks:
-    """Blocks that share one setup (:func:`setup_key`): the study's settings at each (site, date),
-    and each block's flat panel orientation.
-
-    Parameters
-    ----------
-    study : Study
-        The shared settings (resolved).
-    sites, dates : tuple
-        Each block's site and local date.
-    tilt, azimuth : numpy.ndarray
-        Each block's flat panel [deg], (n_blocks,).
-    member : numpy.ndarray, optional
-        With a cloud ensemble (``weather.members``), each block's member (n_blocks,): a day's
-        members are consecutive blocks.
-    """
-
-    study: Study
-    sites: tuple
-    dates: tuple
-    tilt: np.ndarray
-    azimuth: np.ndarray
-    member: np.ndarray | None = None
-
-    @property
-    def members(self) -> int:
-        """Members of the cloud ensemble (1 without one)."""
-        weather = self.study.weather
-        return weather.members if weather is not None and weather.members else 1
-
-    @classmethod
-    def of(cls, studies) -> Blocks:
-        """One block per study (its site, date and panel).
-
-        Parameters
-        ----------
-        studies : sequence of Study
-            Of one setup; the first gives the shared settings.
-        """
-        resolved = [s.resolved() for s in studies]
-        return cls(resolved[0], tuple(s.site for s in resolved), tuple(s.date for s in resolved),
-                   np.array([s.panel.tilt for s in resolved]), np.array([s.panel.azimuth for s in resolved]))
-
-    @classmethod
-    def of_dates(cls, study: Study, dates) -> Blocks:
-        """The days of one study at its own site.
-
-        Parameters
-        ----------
-        study : Study
-        dates : sequence of datetime.date
-        """
-        study = study.resolved()
-        members = study.weather.members if study.weather is not None and study.weather.members else 1
-        dates = tuple(date for date in dates for _ in range(members))  # a day's members together
-        count = len(dates)
-        member = np.tile(np.arange(members), count // members) if members > 1 else None
-        return cls(study, (study.site,) * count, dates, np.full(count, study.panel.tilt),
-                   np.full(count, study.panel.azimuth), member)
-
-    def __len__(self) -> int:
-        return len(self.dates)
-
-    def __getitem__(self, part: slice) -> Blocks:
-        return Blocks(self.study, self.sites[part], self.dates[part], self.tilt[part], self.azimuth[part],
-                      None if self.member is None else self.member[part])
-
-    def sky(self) -> Sky:
-        """The blocks' :class:`foldopt.engine.sky.Sky` (:func:`foldopt.engine.sky.build_sky`)."""
-        return build_sky(self.study, self.sites, self.dates, self.member)
-
-    def chunks(self, n_loads: int):
-        """Slices of blocks whose rows x loads and time steps stay within the chunk bounds.
-
-        Parameters
-        ----------
-        n_loads : int
-            Loads per row.
-
-        Returns
-        -------
-        list of slice
-            Consecutive, covering every block; at least one block each.
-        """
-        per_block = len(self.study.fold_angles.grid()) * max(n_loads, 1)
-        n_steps = round(24 * 60 / self.study.step_min)
-        size = max(1, min(CHUNK_ROW_LOADS // per_block, CHUNK_STEPS // n_steps))
-        # A day's members stay in one chunk: they share its sun (foldopt.engine.sky.build_sky).
-        size = max(self.members, size // self.members * self.members)
-        return [slice(start, min(start + size, len(self))) for start in range(0, len(self), size)]
 
 
 def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
@@ -378,7 +267,7 @@ class DailyDesigns:
 
 
 def daily_designs(parts, loads, engine: str = "numba", fold=None) -> DailyDesigns:
-    """:class:`DailyDesigns` over chunks of days.
+    """:class:`DailyDesigns` over chunks of days at one site (:func:`site_designs` of one site).
 
     Parameters
     ----------
@@ -388,34 +277,75 @@ def daily_designs(parts, loads, engine: str = "numba", fold=None) -> DailyDesign
         (n_loads,) [W]; an infinite load carries nothing.
     engine : {'numba', 'numpy'}
     fold : callable, optional
-        ``fold(parts, loads, engine)`` -> the twofold panel's ``(angles, hours (days, loads, angles),
-        energy (days, angles))`` at the angles it chooses to evaluate (a search:
-        :func:`foldopt.studies.joint.fold_search`); default every angle of the study's grid.
+        As :func:`site_designs`' (one site); default every angle of the study's grid.
     """
-    twofold, harvest, flat, flat_energy, tracker, available = [], [], [], [], [], []
-    if fold is not None:
-        angles, searched_hours, searched_energy = fold(parts, loads, engine)
+    n_blocks = sum(sky.n_blocks for _, sky in parts)
+    return site_designs(parts, [range(n_blocks)], np.asarray(loads, dtype=float)[None], engine, fold)[0]
+
+
+def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
+    """:class:`DailyDesigns` of many sites over chunks of their days, every engine call over all of
+    them (a map's batch of sites).
+
+    Parameters
+    ----------
+    parts : sequence of (Blocks, Sky)
+        Chunks of :class:`Blocks` with their skies, in order.
+    sites : sequence of range
+        Each site's blocks, consecutive over the chunks.
+    loads : array_like
+        (n_sites, n_loads) each site's loads [W]; an infinite load carries nothing.
+    engine : {'numba', 'numpy'}
+    fold : callable, optional
+        ``fold(parts, sites, loads, loadset, engine)`` -> per site ``(angles, hours (days, loads,
+        angles), energy (days, angles))`` at the angles it chooses to evaluate (a search:
+        :class:`foldopt.studies.site_search.FoldSearch`), ``loadset`` each block's site; default every
+        angle of the study's grid on every day.
+
+    Returns
+    -------
+    list of DailyDesigns
+    """
+    loads = np.asarray(loads, dtype=float)
+    loadset = np.concatenate([np.full(len(blocks), site) for site, blocks in enumerate(sites)])
+    study = parts[0][0].study
+    if fold is None:
+        fold = _every_angle
+    searched = fold(parts, sites, loads, loadset, engine)
+    flat, flat_energy, tracker, available = [], [], [], []
+    start = 0
     for chunk, sky in parts:
-        study = chunk.study
-        if fold is None:
-            angles, hours, energy_harvested_wh = fold_hours(sky, chunk, loads, engine)
-            twofold.append(hours)
-            harvest.append(energy_harvested_wh)
+        rows = slice(start, start + sky.n_blocks)
+        start = rows.stop
         metrics = engines.row_metrics(sky, study, np.arange(sky.n_blocks), engines.flat_orientation(
-            chunk.tilt, chunk.azimuth), loads, outputs=("panel",), engine=engine)
+            chunk.tilt, chunk.azimuth), loads, loadset[rows], outputs=("panel",), engine=engine)
         flat.append(metrics.t_solar[:, 0])
         flat_energy.append(metrics.energy[:, 0])
         orientation = sky_tracker_orientation(sky, study)
         gross = sky_tracker_power(sky, study, orientation)
         draw = sky_tracker_draw(sky, study, orientation)
-        both = engines.curve_metrics(np.concatenate([gross, gross - draw]), loads, sky.step_hours, engine=engine)
+        both = engines.curve_metrics(np.concatenate([gross, gross - draw]), loads, sky.step_hours,
+                                     np.concatenate([loadset[rows], loadset[rows]]), engine=engine)
         tracker.append((both.t_solar[:sky.n_blocks, 0], both.t_solar[sky.n_blocks:, 0], both.energy[:sky.n_blocks, 0]))
         available.append(standby_available(gross, draw, sky.lit, study.tracker.standby_w))
     gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
-    if fold is None:
-        searched_hours, searched_energy = np.concatenate(twofold).transpose(0, 2, 1), np.concatenate(harvest)
-    return DailyDesigns(angles, searched_hours, searched_energy, np.concatenate(flat), np.concatenate(flat_energy),
-                        gross_h, net_h, gross_wh, np.concatenate(available))
+    flat, flat_energy, available = np.concatenate(flat), np.concatenate(flat_energy), np.concatenate(available)
+    return [DailyDesigns(angles, hours, energy, flat[blocks], flat_energy[blocks], gross_h[blocks], net_h[blocks],
+                         gross_wh[blocks], available[blocks])
+            for blocks, (angles, hours, energy) in zip(sites, searched, strict=True)]
+
+
+def _every_angle(parts, sites, loads, loadset, engine):
+    """Every angle of the study's grid on every day of each site: ``site_designs``' default fold."""
+    study = parts[0][0].study
+    angles = np.asarray(study.fold_angles.grid())
+    tilt = np.concatenate([chunk.tilt for chunk, _ in parts])
+    azimuth = np.concatenate([chunk.azimuth for chunk, _ in parts])
+    requests = [(np.asarray(blocks), np.column_stack([angles, np.full(angles.size, tilt[blocks[0]]),
+                                                      np.full(angles.size, azimuth[blocks[0]])]))
+                for blocks in sites]
+    done = requested_hours(parts, requests, loads, loadset, engine=engine)
+    return [(angles, hours.transpose(0, 2, 1), energy) for hours, energy in done]
 
 
 def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba", with_energy: bool = False):
@@ -441,30 +371,83 @@ def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba"
     numpy.ndarray
         (days, n, n_loads); with ``with_energy`` also (days, n) [Wh].
     """
-    points = np.asarray(points, dtype=float).reshape(-1, 3)
-    loads = np.asarray(loads, dtype=float)
+    n_blocks = sum(sky.n_blocks for _, sky in parts)
+    hours, energy = requested_hours(parts, [(np.arange(n_blocks), points)], loads, flat=flat, engine=engine)[0]
+    return (hours, energy) if with_energy else hours
+
+
+def requested_hours(parts, requests, loads, loadset=None, flat: bool = False, engine: str = "numba") -> list:
+    """Each day's t_solar [h] and harvested energy [Wh] of designs, each request on days of its
+    own, every request of a chunk in as few engine calls as its memory bound allows.
+
+    Parameters
+    ----------
+    parts : sequence of (Blocks, Sky)
+        Chunks of :class:`Blocks` with their skies, in order.
+    requests : sequence of (array_like, array_like)
+        ``(blocks, points)``: the blocks (indices over the chunks in order) and the designs,
+        (n, 3) fold angle, base tilt, base azimuth [deg] (the azimuth taken modulo 360).
+    loads : array_like
+        (n_loads,) [W], or (n_sets, n_loads) sets chosen by ``loadset``.
+    loadset : array_like of int, optional
+        (n_blocks,) each block's set of loads; default the first.
+    flat : bool
+        The flat panel (the fold angle unused) with no connection: as the ``flat`` design.
+    engine : {'numba', 'numpy'}
+
+    Returns
+    -------
+    list of (numpy.ndarray, numpy.ndarray)
+        Per request, ``hours`` (blocks, n, n_loads) and ``energy`` (blocks, n).
+    """
+    loads = np.atleast_2d(np.asarray(loads, dtype=float))
     study = parts[0][0].study
-    tilt, azimuth = points[:, 1], points[:, 2] % 360.0
-    if flat:
-        orientation, output = engines.flat_orientation(tilt, azimuth), "panel"
-    else:
-        orientation, output = _orientations(study, points[:, 0], tilt, azimuth), study.connection
-    days, harvest = [], []
+    output = "panel" if flat else study.connection
+    requests = [(np.asarray(blocks, dtype=np.int64), np.asarray(points, dtype=float).reshape(-1, 3))
+                for blocks, points in requests]
+    loadset = np.zeros(sum(sky.n_blocks for _, sky in parts), dtype=np.int64) if loadset is None else loadset
+    # Every request's orientations in one call (one geometry call per distinct base).
+    every = np.concatenate([points for _, points in requests])
+    table = (engines.flat_orientation(every[:, 1], every[:, 2] % 360.0) if flat else
+             _orientations(study, every[:, 0], every[:, 1], every[:, 2] % 360.0))
+    tables = np.split(table, np.cumsum([points.shape[0] for _, points in requests])[:-1])
+    out = [(np.empty((blocks.size, points.shape[0], loads.shape[1])), np.empty((blocks.size, points.shape[0])))
+           for blocks, points in requests]
+    start = 0
     for _, sky in parts:
-        per_chunk = max(1, CHUNK_ROW_LOADS // max(sky.n_blocks * loads.size, 1))
-        hours = np.empty((sky.n_blocks, points.shape[0], loads.size))
-        energy = np.empty((sky.n_blocks, points.shape[0]))
-        for start in range(0, points.shape[0], per_chunk):
-            piece = slice(start, min(start + per_chunk, points.shape[0]))
-            count = piece.stop - piece.start
-            rows = np.repeat(np.arange(sky.n_blocks), count)
-            metrics = engines.row_metrics(sky, study, rows, orientation[piece], loads, outputs=(output,),
-                                          engine=engine, row_orientation=np.tile(np.arange(count), sky.n_blocks))
-            hours[:, piece] = metrics.t_solar[:, 0].reshape(sky.n_blocks, count, loads.size)
-            energy[:, piece] = metrics.energy[:, 0].reshape(sky.n_blocks, count)
-        days.append(hours)
-        harvest.append(energy)
-    return (np.concatenate(days), np.concatenate(harvest)) if with_energy else np.concatenate(days)
+        stop = start + sky.n_blocks
+        # Pieces (request, its blocks in the chunk, points): each within the memory bound, gathered
+        # into calls that stay within it too.
+        calls, size = [[]], 0
+        for k, (blocks, points) in enumerate(requests):
+            inside = np.flatnonzero((blocks >= start) & (blocks < stop))
+            per = max(1, CHUNK_ROW_LOADS // max(inside.size * loads.shape[1], 1))
+            for first in range(0, points.shape[0] if inside.size else 0, per):
+                piece = (k, inside, slice(first, min(first + per, points.shape[0])))
+                cost = inside.size * (piece[2].stop - first) * loads.shape[1]
+                if size + cost > CHUNK_ROW_LOADS and calls[-1]:
+                    calls.append([])
+                    size = 0
+                calls[-1].append(piece)
+                size += cost
+        for call in filter(None, calls):
+            counts = [piece.stop - piece.start for _, _, piece in call]
+            offsets = np.cumsum([0, *counts[:-1]])
+            orientation = np.concatenate([tables[k][piece] for k, _, piece in call])
+            blocks = [requests[k][0][inside] for k, inside, _ in call]
+            row_block = np.concatenate([np.repeat(b - start, n) for b, n in zip(blocks, counts, strict=True)])
+            row_orientation = np.concatenate([offset + np.tile(np.arange(n), b.size)
+                                              for b, n, offset in zip(blocks, counts, offsets, strict=True)])
+            metrics = engines.row_metrics(sky, study, row_block, orientation, loads, loadset[start + row_block],
+                                          outputs=(output,), engine=engine, row_orientation=row_orientation)
+            position = 0
+            for (k, inside, piece), b, n in zip(call, blocks, counts, strict=True):
+                rows = slice(position, position + b.size * n)
+                position = rows.stop
+                out[k][0][inside, piece] = metrics.t_solar[rows, 0].reshape(b.size, n, -1)
+                out[k][1][inside, piece] = metrics.energy[rows, 0].reshape(b.size, n)
+        start = stop
+    return out
 
 
 def _orientations(study: Study, fold_angle, tilt, azimuth) -> np.ndarray:

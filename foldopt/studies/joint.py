@@ -34,7 +34,7 @@ from foldopt.inputs.optimize_section import DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUT
 from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
-from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
+from foldopt.studies.objectives import best_angle_index, near_optimal, objective_quantum, objective_value
 
 #: Points of the landscape's grid along the fold angle and the tilt.
 LANDSCAPE_POINTS = (46, 31)
@@ -107,15 +107,6 @@ def _axes(study: Study, vary, fold_angle: float = 180.0) -> dict[str, Axis]:
         lo, hi, step = (bounds.min, bounds.max, bounds.step) if bounds is not None else defaults[name]
         axes[name] = Axis(name, lo, hi, step) if name in vary else Axis(name, fixed[name], fixed[name], 1.0)
     return axes
-
-
-def objective_quantum(statistic: str, step_hours: float, n_days: int, months) -> float:
-    """The objective's own jumps [h]: one time step of one day, over the days a statistic averages."""
-    if statistic == "mean":
-        return step_hours / n_days
-    if statistic == "worst-month":
-        return step_hours / min(np.bincount(months)[np.unique(months)])
-    return step_hours
 
 
 def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeResult:
@@ -262,82 +253,3 @@ def _landscape(parts, study, axes, best, loads, months, statistic, season, engin
     value = objective_value(design_hours(parts, points, loads, False, engine), months, statistic, season)[:, 0]
     return pd.DataFrame({"fold_angle_deg": fold, "surface_tilt": tilt, "surface_azimuth": best[2] % 360.0,
                          "objective_h": value})
-
-
-def fold_search(months, statistic: str, seasons, tolerance_h: float, near_optimal_tolerance):
-    """The fold angles a map evaluates at one site: the search of the study's grid for every period's
-    objective and every load together, as :func:`foldopt.studies.designs.daily_designs` takes it.
-
-    After the search, each target's near-optimal edges (where the objective falls below the best
-    less ``near_optimal_tolerance``) are bisected down to the grid's step, so the near-optimal
-    range (:func:`foldopt.studies.objectives.near_optimal` on the evaluated angles) is the full
-    grid's wherever the objective falls monotonically away from the plateau.
-
-    Parameters
-    ----------
-    months : numpy.ndarray
-        (days,) month of each day.
-    statistic : str
-        :func:`foldopt.studies.objectives.objective_value`'s.
-    seasons : sequence
-        Each period's months (None: every day).
-    tolerance_h : float
-        The search's tolerance [h].
-    near_optimal_tolerance : foldopt.inputs.sections.NearOptimal
-
-    Returns
-    -------
-    callable
-        ``fold(parts, loads, engine)`` -> ``(angles, hours (days, loads, angles), energy (days, angles))``.
-    """
-
-    def fold(parts, loads, engine):
-        study = parts[0][0].study
-        grid = study.fold_angles
-        axis = Axis("fold_angle", grid.start, grid.stop, grid.step)
-        found = {}
-
-        def evaluate(points):
-            designs = np.column_stack([points[:, 0], np.full(len(points), study.panel.tilt),
-                                       np.full(len(points), study.panel.azimuth)])
-            hours, energy = design_hours(parts, designs, loads, engine=engine, with_energy=True)
-            targets = np.concatenate([objective_value(hours, months, statistic, season) for season in seasons], axis=1)
-            for position, angle in enumerate(points[:, 0]):
-                found[float(angle)] = (hours[:, position], energy[:, position], targets[position])
-            return targets
-
-        grid_search(evaluate, [axis], tolerance_h, objective_quantum(statistic, parts[0][1].step_hours,
-                                                                     len(months), months))
-        all_angles = axis.values()
-        for _ in range(int(np.ceil(np.log2(max(axis.size, 2)))) + 3):
-            angles = np.array(sorted(found))
-            ranges = near_optimal(angles, np.stack([found[angle][2] for angle in angles], axis=-1),
-                                  near_optimal_tolerance)
-            index = np.searchsorted(all_angles, angles - 1e-9)  # each evaluated angle's grid index
-            wanted = set()
-            # Each range's edge lies between its end and the evaluated angle beyond it: halve the gap.
-            for lo, hi in zip(ranges["near_optimal_lo_deg"], ranges["near_optimal_hi_deg"], strict=True):
-                if lo != lo:
-                    continue  # no angle carries the load
-                first, last = np.searchsorted(angles, [lo - 1e-9, hi - 1e-9])
-                for a, b in ((first - 1, first), (last, last + 1)):
-                    if 0 <= a and b < angles.size and index[b] - index[a] > 1:
-                        wanted.add((index[a] + index[b]) // 2)
-            if not wanted:
-                # The recommended angle is the grid's nearest the range's centre: evaluated too.
-                centres = (ranges["near_optimal_lo_deg"] + ranges["near_optimal_hi_deg"]) / 2
-                # Ties go to the less folded angle, as near_optimal breaks them.
-                nearest = {int(np.argmin(np.abs(all_angles - centre) - 1e-9 * all_angles))
-                           for centre in centres[np.isfinite(centres)]}
-                missing = sorted(i for i in nearest if float(all_angles[i]) not in found)
-                if not missing:
-                    break
-                evaluate(all_angles[missing][:, None])
-                continue
-            evaluate(all_angles[sorted(wanted)][:, None])
-        angles = np.array(sorted(found))
-        hours = np.stack([found[angle][0] for angle in angles], axis=-1)  # (days, loads, angles)
-        energy = np.stack([found[angle][1] for angle in angles], axis=-1)  # (days, angles)
-        return angles, hours, energy
-
-    return fold

@@ -57,6 +57,15 @@ def objective_value(hours, months, statistic: str, season=None):
     return np.percentile(hours, float(statistic[1:]), axis=0)
 
 
+def objective_quantum(statistic: str, step_hours: float, n_days: int, months) -> float:
+    """The objective's own jumps [h]: one time step of one day, over the days a statistic averages."""
+    if statistic == "mean":
+        return step_hours / n_days
+    if statistic == "worst-month":
+        return step_hours / min(np.bincount(months)[np.unique(months)])
+    return step_hours
+
+
 def worst_month(hours, months):
     """The month [1-12], (...), of the lowest monthly mean: where a ``worst-month`` objective is found.
 

@@ -21,7 +21,6 @@ the files.
 from __future__ import annotations
 
 import datetime as dt
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,22 +37,25 @@ from foldopt.inputs.plan import parse_dates, parse_values, year_problem
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, format_errors
 from foldopt.errors import ConfigError
-from foldopt.studies.designs import Blocks, daily_designs
-from foldopt.studies.joint import fold_search
+from foldopt.studies.break_even import break_even_standby
+from foldopt.studies.designs import Blocks, setup_key, site_designs
+from foldopt.studies.site_search import fold_search
 from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
 PERIODS = ("year", *SEASONS)
-#: Rounds and points per round of the break-even search: the bracket shrinks (points + 1)-fold a
-#: round, so a 20 W tracker's break-even is found to 4e-5 W.
-_BREAK_EVEN_ROUNDS, _BREAK_EVEN_POINTS = 6, 8
 
 
 #: The grid a map covers where it is given no sites: latitudes and longitudes [deg], start:stop:step.
 DEFAULT_GRID = ("-60:60:10", "-180:180:30")
 #: Loads a map takes: watts, or fractions of each site's flat peak (``relative``).
 LOAD_BOUNDS = {False: (1e6, "loads must be in (0, 1e+06] W"), True: (2.0, "fractions must be in (0, 2]")}
+
+
+#: Sites evaluated together at most: their days one sky, every engine call over all of them
+#: (a year's days of six sites stay within a chunk of the engine, foldopt.studies.blocks).
+SITES_PER_BATCH = 6
 
 
 #: What a map changes in the embedded study (the paper's): its beam-only sky and Eq. 5 are for the
@@ -312,139 +314,119 @@ def evaluate_sites(study: dict, sites: Sequence[dict], loads: Sequence[float], r
         objective exceeds the tracker's (0 where it already does; NaN where the twofold panel
         never carries the load).
     """
-    frames = [_evaluate_site(study, site, np.asarray(loads, dtype=float), relative, year, engine) for site in sites]
+    loads = np.asarray(loads, dtype=float)
+    frames, batch, key = [], [], None
+    for site in sites:
+        resolved, dates = site_study(study, site, year)
+        this = setup_key(resolved)
+        if batch and (this != key or len(batch) == SITES_PER_BATCH):
+            frames.append(_evaluate_batch(batch, loads, relative, engine))
+            batch = []
+        batch.append((site, resolved, dates))
+        key = this
+    if batch:
+        frames.append(_evaluate_batch(batch, loads, relative, engine))
     return pd.concat(frames, ignore_index=True)
 
 
-def _evaluate_site(study_data: dict, site: dict, loads, relative: bool, year: int, engine: str) -> pd.DataFrame:
-    study, dates = site_study(study_data, site, year)
+def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
+    """The rows of sites that share a setup (:func:`foldopt.studies.designs.setup_key`), their days
+    one set of blocks: every engine call runs over all of them (:func:`site_designs`)."""
+    blocks = Blocks.join([Blocks.of_dates(study, dates) for _, study, dates in batch])
+    study = blocks.study
     objective = study.objective
     statistic = objective.statistic if objective is not None else "mean"
-    blocks = Blocks.of_dates(study, dates)
-    study = blocks.study
-    parts = blocks.chunks(loads.size)
-    skies = [blocks[part].sky() for part in parts]
-    step_hours = skies[0].step_hours
-    flat_peak = max(float(engines.row_metrics(sky, study, np.arange(sky.n_blocks),
-                                              engines.flat_orientation(blocks[part].tilt, blocks[part].azimuth),
-                                              [1.0], outputs=("panel",), engine=engine).peak.max())
-                    for part, sky in zip(parts, skies, strict=True))
-    watts = loads * flat_peak if relative else loads
+    starts = np.cumsum([0, *(len(dates) for _, _, dates in batch)])
+    sites = [range(first, stop) for first, stop in zip(starts[:-1], starts[1:], strict=True)]
+    parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
+    step_hours = parts[0][1].step_hours
+    peak = np.concatenate([engines.row_metrics(sky, study, np.arange(sky.n_blocks),
+                                               engines.flat_orientation(chunk.tilt, chunk.azimuth), [1.0],
+                                               outputs=("panel",), engine=engine).peak[:, 0] for chunk, sky in parts])
+    flat_peak = np.array([float(peak[days].max()) for days in sites])
+    watts = loads[None, :] * flat_peak[:, None] if relative else np.broadcast_to(loads, (len(batch), loads.size))
     # A load of 0 W (a site whose flat panel never sees the sun) has no t_solar to speak of.
     usable = np.where(watts > 0, watts, np.inf)
-    months = np.array([date.month for date in dates])
+    months = [np.array([date.month for date in dates]) for _, _, dates in batch]
     seasons = [None, *SEASONS.values()]
-    # A map searches the fold angles (foldopt.studies.joint.fold_search) unless its study sweeps them all.
+    # A map searches the fold angles (foldopt.studies.site_search) unless its study sweeps them all.
     search = study.optimize
-    fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h,
-                                                   study.near_optimal)
-    days_of = daily_designs([(blocks[part], sky) for part, sky in zip(parts, skies, strict=True)], usable, engine,
-                            fold)
+    fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h, study.near_optimal)
+    designs = site_designs(parts, sites, usable, engine, fold)
+    columns: dict[str, list] = {}
+    for (site, resolved, _), days_of, site_months, peak_w, site_watts, site_usable in zip(
+            batch, designs, months, flat_peak, watts, usable, strict=True):
+        for name, values in _site_rows(days_of, site_months, statistic, seasons, site_usable, step_hours,
+                                       study.near_optimal, engine).items():
+            columns.setdefault(name, []).append(values)
+        count = len(PERIODS) * loads.size
+        fixed = {"site_id": site.get("site_id", 0), "site_name": site.get("name") or "",
+                 "latitude": resolved.site.latitude, "longitude": resolved.site.longitude,
+                 "weather": Path(site["weather"]).name if "weather" in site else "", "flat_peak_w": peak_w}
+        for name, value in fixed.items():
+            columns.setdefault(name, []).append(np.full(count, value, dtype=object if isinstance(value, str) else None))
+        columns.setdefault("p_load_w", []).append(np.tile(site_watts, len(PERIODS)))
+        fraction = site_watts / peak_w if peak_w > 0 else np.full(loads.size, np.nan)
+        columns.setdefault("p_load_fraction", []).append(np.tile(fraction, len(PERIODS)))
+    order = ["site_id", "site_name", "latitude", "longitude", "weather", "flat_peak_w", "p_load_w", "p_load_fraction",
+             "period", "days", "fold_angle_deg", *ROW_VALUES, "gain_vs_flat_pct", "energy_gain_vs_flat_pct",
+             "pct_of_tracker", "tracker_break_even_standby_w"]
+    return pd.DataFrame({name: np.concatenate(columns[name]) for name in order})
+
+
+#: The values of a map's row from the designs (in the order of its table).
+ROW_VALUES = ("objective_flat_h", "objective_twofold_h", "objective_tracker_h", "objective_tracker_net_h",
+              "mean_t_solar_flat_h", "mean_t_solar_twofold_h", "mean_t_solar_tracker_h", "mean_t_solar_tracker_net_h",
+              "energy_harvested_flat_wh", "energy_harvested_twofold_wh", "energy_harvested_tracker_wh",
+              "near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg", "near_optimal_tolerance_h")
+
+
+def _site_rows(days_of, months, statistic: str, seasons, usable, step_hours: float, near, engine: str) -> dict:
+    """One site's columns, per period and load (periods slowest), from its :class:`DailyDesigns`."""
     angles, hours, harvest = days_of.angles, days_of.twofold_h, days_of.twofold_wh
-    flat_hours, flat_energy = days_of.flat_h, days_of.flat_wh
-    tracker_hours, tracker_net, tracker_energy = days_of.tracker_h, days_of.tracker_net_h, days_of.tracker_wh
-    available = days_of.available
+    n_loads = usable.size
 
     def statistic_of(daily, season):
         return objective_value(daily, months, statistic, season)
 
-    rows = []
+    rows: dict[str, list] = {}
     targets = []
     for period, season in zip(PERIODS, seasons, strict=True):
         days = np.isin(months, season) if season else np.ones(months.size, bool)
-        best = best_angle_index(statistic_of(hours, season))  # (loads,)
-        at_best = hours[:, np.arange(loads.size), best]  # (days, loads)
+        # The angles evaluated on every day of the period (a search evaluates some on a season's alone).
+        complete = ~np.isnan(harvest[days]).any(axis=0)
+        period_hours, period_angles = hours[:, :, complete], angles[complete]
+        objective = statistic_of(period_hours, season)  # (loads, angles)
+        best = best_angle_index(objective)
+        at_best = period_hours[:, np.arange(n_loads), best]  # (days, loads)
         values = {
-            "objective_flat_h": statistic_of(flat_hours, season),
+            "period": np.full(n_loads, period, dtype=object),
+            "days": np.full(n_loads, int(days.sum())),
+            "fold_angle_deg": np.where(np.isfinite(usable), period_angles[best], np.nan),
+            "objective_flat_h": statistic_of(days_of.flat_h, season),
             "objective_twofold_h": statistic_of(at_best, season),
-            "objective_tracker_h": statistic_of(tracker_hours, season),
-            "objective_tracker_net_h": statistic_of(tracker_net, season),
-            "mean_t_solar_flat_h": flat_hours[days].mean(axis=0),
+            "objective_tracker_h": statistic_of(days_of.tracker_h, season),
+            "objective_tracker_net_h": statistic_of(days_of.tracker_net_h, season),
+            "mean_t_solar_flat_h": days_of.flat_h[days].mean(axis=0),
             "mean_t_solar_twofold_h": at_best[days].mean(axis=0),
-            "mean_t_solar_tracker_h": tracker_hours[days].mean(axis=0),
-            "mean_t_solar_tracker_net_h": tracker_net[days].mean(axis=0),
-            "energy_harvested_flat_wh": np.full(loads.size, flat_energy[days].sum()),
-            "energy_harvested_twofold_wh": harvest[days][:, best].sum(axis=0),
-            "energy_harvested_tracker_wh": np.full(loads.size, tracker_energy[days].sum()),
-            **near_optimal(angles, statistic_of(hours, season), study.near_optimal),
+            "mean_t_solar_tracker_h": days_of.tracker_h[days].mean(axis=0),
+            "mean_t_solar_tracker_net_h": days_of.tracker_net_h[days].mean(axis=0),
+            "energy_harvested_flat_wh": np.full(n_loads, days_of.flat_wh[days].sum()),
+            "energy_harvested_twofold_wh": harvest[days][:, complete][:, best].sum(axis=0),
+            "energy_harvested_tracker_wh": np.full(n_loads, days_of.tracker_wh[days].sum()),
+            **near_optimal(period_angles, objective, near),
         }
         targets.append(values["objective_twofold_h"])
-        rows.append((period, int(days.sum()), angles[best], values))
-    break_even = _break_even_standby(available, np.array(targets), usable, months, statistic, seasons, step_hours,
-                                     engine)
-    frames = []
-    for (period, n_days, fold_angle, values), standby in zip(rows, break_even, strict=True):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            gain = 100.0 * (values["objective_twofold_h"] / values["objective_flat_h"] - 1.0)
-            energy_gain = 100.0 * (values["energy_harvested_twofold_wh"] / values["energy_harvested_flat_wh"] - 1.0)
-            share = 100.0 * values["objective_twofold_h"] / values["objective_tracker_h"]
-        frames.append(pd.DataFrame({
-            "site_id": site.get("site_id", 0),
-            "site_name": site.get("name") or "",
-            "latitude": study.site.latitude,
-            "longitude": study.site.longitude,
-            "weather": Path(site["weather"]).name if "weather" in site else "",
-            "flat_peak_w": flat_peak,
-            "p_load_w": watts,
-            "p_load_fraction": watts / flat_peak if flat_peak > 0 else np.nan,
-            "period": period,
-            "days": n_days,
-            "fold_angle_deg": np.where(np.isfinite(usable), fold_angle, np.nan),
-            **values,
-            "gain_vs_flat_pct": np.where(values["objective_flat_h"] > 0, gain, np.nan),
-            "energy_gain_vs_flat_pct": energy_gain,
-            "pct_of_tracker": np.where(values["objective_tracker_h"] > 0, share, np.nan),
-            "tracker_break_even_standby_w": standby,
-        }))
-    return pd.concat(frames, ignore_index=True)
-
-
-def _break_even_standby(available, targets, loads, months, statistic: str, seasons, step_hours: float,
-                        engine: str):
-    """The tracker's standby draw [W] at which its objective over each period falls to ``targets``.
-
-    A standby draw ``s`` while the sun is up is the load ``P_load + s`` on ``available`` (see
-    :func:`foldopt.studies.day.standby_sweep`), and every day's t_solar, so every objective, falls as the
-    load rises. The root is bracketed by 0 and the largest available power (no time at all) and
-    found for every period and load together: each round evaluates
-    :data:`_BREAK_EVEN_POINTS` draws inside every bracket in one pass of the engine.
-
-    Parameters
-    ----------
-    available : numpy.ndarray
-        (days, steps) [W].
-    targets : numpy.ndarray
-        (periods, loads) the twofold panel's objective [h].
-    loads : numpy.ndarray
-        (loads,) [W].
-
-    Returns
-    -------
-    numpy.ndarray
-        (periods, loads) [W]: 0 where the tracker without standby is already no better; NaN where
-        the target is 0 h.
-    """
-    n_periods, n_loads = targets.shape
-    points = _BREAK_EVEN_POINTS
-    low = np.zeros((n_periods, n_loads))
-    high = np.full((n_periods, n_loads), max(float(available.max()), 0.0))
-    at_zero = None
-    for _ in range(_BREAK_EVEN_ROUNDS):
-        fractions = np.arange(0, points + 1) / (points + 1) if at_zero is None else np.arange(1, points + 1) / (
-            points + 1)
-        draws = low[..., None] + (high - low)[..., None] * fractions  # (periods, loads, points)
-        daily = engines.curve_metrics(available, (loads[None, :, None] + draws).ravel(), step_hours,
-                                      engine=engine).t_solar[:, 0].reshape(-1, n_periods, n_loads, draws.shape[-1])
-        value = np.stack([objective_value(daily[:, index], months, statistic, season)
-                          for index, season in enumerate(seasons)])
-        if at_zero is None:
-            at_zero = value[..., 0]
-            draws, value = draws[..., 1:], value[..., 1:]
-        # The objective falls with the draw: the first `above` points are still above the target.
-        above = (value > targets[..., None]).sum(axis=-1)
-        index = np.arange(points)
-        low = np.where(above > 0, np.sum(np.where(index == above[..., None] - 1, draws, 0.0), axis=-1), low)
-        high = np.where(above < points, np.sum(np.where(index == above[..., None], draws, 0.0), axis=-1), high)
-    found = (low + high) / 2
-    found = np.where(at_zero <= targets, 0.0, found)
-    return np.where((targets > 0) & np.isfinite(loads), found, math.nan)
+        for name, value in values.items():
+            rows.setdefault(name, []).append(value)
+    rows = {name: np.concatenate(values) for name, values in rows.items()}
+    rows["tracker_break_even_standby_w"] = break_even_standby(
+        days_of.available, np.array(targets), usable, months, statistic, seasons, step_hours, engine).ravel()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gain = 100.0 * (rows["objective_twofold_h"] / rows["objective_flat_h"] - 1.0)
+        energy_gain = 100.0 * (rows["energy_harvested_twofold_wh"] / rows["energy_harvested_flat_wh"] - 1.0)
+        share = 100.0 * rows["objective_twofold_h"] / rows["objective_tracker_h"]
+    rows["gain_vs_flat_pct"] = np.where(rows["objective_flat_h"] > 0, gain, np.nan)
+    rows["energy_gain_vs_flat_pct"] = energy_gain
+    rows["pct_of_tracker"] = np.where(rows["objective_tracker_h"] > 0, share, np.nan)
+    return rows

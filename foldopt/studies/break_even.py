@@ -1,0 +1,101 @@
+"""The standby draw at which a tracker loses its lead over the twofold panel: a map's
+``tracker_break_even_standby_w`` (:func:`break_even_standby`).
+
+The module may import numpy, :mod:`foldopt.engine` and :mod:`foldopt.studies.objectives`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from foldopt.engine import rows as engines
+from foldopt.studies.objectives import objective_value
+
+#: The break-even search's brackets close to this share of the largest power (a 20 W tracker's
+#: break-even to 2e-5 W), in at most so many passes of the engine.
+BREAK_EVEN_TOLERANCE, BREAK_EVEN_ROUNDS = 1e-6, 40
+
+
+def break_even_standby(available, targets, loads, months, statistic: str, seasons, step_hours: float,
+                       engine: str = "numba"):
+    """The tracker's standby draw [W] at which its objective over each period falls to ``targets``.
+
+    A standby draw ``s`` while the sun is up is the load ``P_load + s`` on ``available`` (see
+    :func:`foldopt.studies.day.standby_sweep`), and every day's t_solar, so every objective, falls as the
+    load rises. The root is bracketed by 0 and the largest available power (no time at all) and
+    found for every period and load together, one draw a bracket per pass of the engine, by false
+    position with the Illinois rule [1]_ (the end kept twice has its value halved, so that both ends
+    move): the objective is piecewise linear in the draw, and the brackets close to
+    :data:`BREAK_EVEN_TOLERANCE` of the largest power in some ten passes.
+
+    Parameters
+    ----------
+    available : numpy.ndarray
+        (days, steps) [W]: the tracker's power left for the load and a standby draw
+        (:func:`foldopt.studies.designs.standby_available`).
+    targets : numpy.ndarray
+        (periods, loads) the twofold panel's objective [h].
+    loads : numpy.ndarray
+        (loads,) [W].
+    months : numpy.ndarray
+        (days,) month of each day.
+    statistic : str
+        :func:`foldopt.studies.objectives.objective_value`'s.
+    seasons : sequence
+        Each period's months (None: every day).
+    step_hours : float
+        Step length [h].
+    engine : {'numba', 'numpy'}
+
+    Returns
+    -------
+    numpy.ndarray
+        (periods, loads) [W]: 0 where the tracker without standby is already no better; NaN where
+        the target is 0 h.
+
+    References
+    ----------
+    .. [1] M. Dowell, P. Jarratt, "A modified regula falsi method for computing the root of an
+       equation", BIT 11, 168-174, 1971.
+    """
+    n_periods, n_loads = targets.shape
+    top = max(float(available.max()), 0.0)
+    # The days' power from the first to the last step with any (the rest is none).
+    lit = np.flatnonzero((available > 0).any(axis=0))
+    if lit.size:
+        available = available[:, max(lit[0] - 1, 0):lit[-1] + 2]
+
+    def shortfall(draws):
+        """(periods, loads) each period's objective at its loads plus ``draws``, less its target."""
+        daily = engines.curve_metrics(available, (loads[None, :] + draws).ravel(), step_hours,
+                                      engine=engine).t_solar[:, 0].reshape(-1, n_periods, n_loads)
+        return np.stack([objective_value(daily[:, index], months, statistic, season)
+                         for index, season in enumerate(seasons)]) - targets
+
+    low, high = np.zeros((n_periods, n_loads)), np.full((n_periods, n_loads), top)
+    at_low, at_high = shortfall(low), shortfall(high)
+    found = np.where(at_low <= 0, 0.0, np.nan)
+    side = np.zeros((n_periods, n_loads), dtype=int)
+    for _ in range(BREAK_EVEN_ROUNDS):
+        open_ = np.isnan(found) & (high - low > BREAK_EVEN_TOLERANCE * max(top, 1e-12))
+        if not open_.any():
+            break
+        with np.errstate(divide="ignore", invalid="ignore"):
+            draw = np.where(at_low != at_high, (low * at_high - high * at_low) / (at_high - at_low), (low + high) / 2)
+        # A secant that lands on an end (the objective flat there to its last bits) halves instead.
+        draw = np.where((draw > low) & (draw < high), draw, (low + high) / 2)
+        draw = np.where(open_, draw, low)
+        value = shortfall(draw)
+        found = np.where(open_ & (value == 0), draw, found)  # the objective is the target there
+        above = open_ & (value > 0)
+        below = open_ & (value < 0)
+        # Illinois: an end kept a second time in a row has its value halved.
+        at_high = np.where(above & (side == 1), at_high / 2, at_high)
+        at_low = np.where(below & (side == -1), at_low / 2, at_low)
+        low, at_low = np.where(above, draw, low), np.where(above, value, at_low)
+        high, at_high = np.where(below, draw, high), np.where(below, value, at_high)
+        side = np.where(above, 1, np.where(below, -1, side))
+    found = np.where(np.isnan(found), (low + high) / 2, found)
+    return np.where((targets > 0) & np.isfinite(loads), found, math.nan)
