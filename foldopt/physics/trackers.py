@@ -386,18 +386,23 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
 
     It starts on the asymptote ``angle / speed + tau_1 + tau_2`` (the motor at full speed after its
     delay), which lies above the root; the angle turned is convex in time, so the steps descend
-    onto it monotonically and stop when none moves by more than :data:`TURN_TOLERANCE_S` (some
-    never settle on a fixed point: they change in their last bit, back and forth)."""
+    onto it monotonically, and each move's stop once its last moved it by at most
+    :data:`TURN_TOLERANCE_S` (some never settle on a fixed point: they change in their last bit,
+    back and forth)."""
+    angle = np.asarray(angle, dtype=float)
     t = angle / speed + tau_1 + tau_2
+    # Each move stops on its own (its answer the same bits whatever other moves it is solved with).
+    active = np.arange(t.size)
     for _ in range(50):
-        decay_1, decay_2 = np.expm1(-t / tau_1), np.expm1(-t / tau_2)
-        turned = speed * (t + (tau_1**2 * decay_1 - tau_2**2 * decay_2) / (tau_1 - tau_2))
-        rate = speed * (1 - (tau_1 * (decay_1 + 1.0) - tau_2 * (decay_2 + 1.0)) / (tau_1 - tau_2))
-        step = np.maximum(t - (turned - angle) / rate, 1e-9)
-        settled = np.all(np.abs(step - t) <= TURN_TOLERANCE_S)
-        t = step
-        if settled:
+        if active.size == 0:
             break
+        now = t[active]
+        decay_1, decay_2 = np.expm1(-now / tau_1), np.expm1(-now / tau_2)
+        turned = speed * (now + (tau_1**2 * decay_1 - tau_2**2 * decay_2) / (tau_1 - tau_2))
+        rate = speed * (1 - (tau_1 * (decay_1 + 1.0) - tau_2 * (decay_2 + 1.0)) / (tau_1 - tau_2))
+        step = np.maximum(now - (turned - angle[active]) / rate, 1e-9)
+        t[active] = step
+        active = active[np.abs(step - now) > TURN_TOLERANCE_S]
     return t
 
 

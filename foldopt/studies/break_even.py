@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from foldopt.engine import rows as engines
-from foldopt.studies.objectives import objective_value
+from foldopt.studies.objectives import period_values
 
 #: The break-even search's brackets close to this share of the largest power (a 20 W tracker's
 #: break-even to 2e-5 W), in at most so many passes of the engine.
@@ -20,27 +20,28 @@ BREAK_EVEN_TOLERANCE, BREAK_EVEN_ROUNDS = 1e-6, 40
 
 def break_even_standby(available, targets, loads, months, statistic: str, seasons, step_hours: float,
                        engine: str = "numba"):
-    """The tracker's standby draw [W] at which its objective over each period falls to ``targets``.
+    """The tracker's standby draw [W] at which its objective over each period falls to ``targets``,
+    at several sites of the same days at once.
 
     A standby draw ``s`` while the sun is up is the load ``P_load + s`` on ``available`` (see
     :func:`foldopt.studies.day.standby_sweep`), and every day's t_solar, so every objective, falls as the
     load rises. The root is bracketed by 0 and the largest available power (no time at all) and
-    found for every period and load together, one draw a bracket per pass of the engine, by false
-    position with the Illinois rule [1]_ (the end kept twice has its value halved, so that both ends
-    move): the objective is piecewise linear in the draw, and the brackets close to
-    :data:`BREAK_EVEN_TOLERANCE` of the largest power in some ten passes.
+    found for every site, period and load together, one draw a bracket per pass of the engine, by
+    false position with the Illinois rule [1]_ (the end kept twice has its value halved, so that
+    both ends move): the objective is piecewise linear in the draw, and the brackets close to
+    :data:`BREAK_EVEN_TOLERANCE` of the site's largest power in some ten passes.
 
     Parameters
     ----------
     available : numpy.ndarray
-        (days, steps) [W]: the tracker's power left for the load and a standby draw
-        (:func:`foldopt.studies.designs.standby_available`).
+        (sites x days, steps) [W], each site's days in turn: the tracker's power left for the load
+        and a standby draw (:func:`foldopt.studies.designs.standby_available`).
     targets : numpy.ndarray
-        (periods, loads) the twofold panel's objective [h].
+        (sites, periods, loads) the twofold panel's objective [h].
     loads : numpy.ndarray
-        (loads,) [W].
+        (sites, loads) [W].
     months : numpy.ndarray
-        (days,) month of each day.
+        (days,) month of each day, the same at every site.
     statistic : str
         :func:`foldopt.studies.objectives.objective_value`'s.
     seasons : sequence
@@ -52,34 +53,35 @@ def break_even_standby(available, targets, loads, months, statistic: str, season
     Returns
     -------
     numpy.ndarray
-        (periods, loads) [W]: 0 where the tracker without standby is already no better; NaN where
-        the target is 0 h.
+        (sites, periods, loads) [W]: 0 where the tracker without standby is already no better; NaN
+        where the target is 0 h.
 
     References
     ----------
     .. [1] M. Dowell, P. Jarratt, "A modified regula falsi method for computing the root of an
        equation", BIT 11, 168-174, 1971.
     """
-    n_periods, n_loads = targets.shape
-    top = max(float(available.max()), 0.0)
-    # The days' power from the first to the last step with any (the rest is none).
-    lit = np.flatnonzero((available > 0).any(axis=0))
-    if lit.size:
-        available = available[:, max(lit[0] - 1, 0):lit[-1] + 2]
+    n_sites, n_periods, n_loads = targets.shape
+    n_days = len(months)
+    top = available.reshape(n_sites, -1).max(axis=1).clip(0.0)[:, None, None]  # (sites, 1, 1)
+    site_of_day = np.repeat(np.arange(n_sites), n_days)
 
     def shortfall(draws):
-        """(periods, loads) each period's objective at its loads plus ``draws``, less its target."""
-        daily = engines.curve_metrics(available, (loads[None, :] + draws).ravel(), step_hours,
-                                      engine=engine).t_solar[:, 0].reshape(-1, n_periods, n_loads)
-        return np.stack([objective_value(daily[:, index], months, statistic, season)
-                         for index, season in enumerate(seasons)]) - targets
+        """(sites, periods, loads) each period's objective at its loads plus ``draws``, less its target."""
+        daily = engines.curve_metrics(available, (loads[:, None, :] + draws).reshape(n_sites, -1), step_hours,
+                                      site_of_day, engine=engine).t_solar[:, 0]
+        daily = daily.reshape(n_sites, n_days, n_periods, n_loads)
+        # Every period's objective of every period's draws, a site at a time (its own reduction,
+        # the same bits whatever the batch), and each period's own kept.
+        every = np.stack([period_values(days, months, statistic, seasons) for days in daily])  # (s, p, p, l)
+        return every[:, np.arange(n_periods), np.arange(n_periods)] - targets
 
-    low, high = np.zeros((n_periods, n_loads)), np.full((n_periods, n_loads), top)
+    low, high = np.zeros(targets.shape), np.broadcast_to(top, targets.shape).copy()
     at_low, at_high = shortfall(low), shortfall(high)
     found = np.where(at_low <= 0, 0.0, np.nan)
-    side = np.zeros((n_periods, n_loads), dtype=int)
+    side = np.zeros(targets.shape, dtype=int)
     for _ in range(BREAK_EVEN_ROUNDS):
-        open_ = np.isnan(found) & (high - low > BREAK_EVEN_TOLERANCE * max(top, 1e-12))
+        open_ = np.isnan(found) & (high - low > BREAK_EVEN_TOLERANCE * np.maximum(top, 1e-12))
         if not open_.any():
             break
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -98,4 +100,4 @@ def break_even_standby(available, targets, loads, months, statistic: str, season
         high, at_high = np.where(below, draw, high), np.where(below, value, at_high)
         side = np.where(above, 1, np.where(below, -1, side))
     found = np.where(np.isnan(found), (low + high) / 2, found)
-    return np.where((targets > 0) & np.isfinite(loads), found, math.nan)
+    return np.where((targets > 0) & np.isfinite(loads[:, None, :]), found, math.nan)

@@ -57,6 +57,27 @@ def objective_value(hours, months, statistic: str, season=None):
     return np.percentile(hours, float(statistic[1:]), axis=0)
 
 
+def period_values(hours, months, statistic: str, seasons):
+    """:func:`objective_value` of ``hours`` (days, ...) over several periods, (periods, ...).
+
+    Each value is its own period's reduction over its days alone, so that it is the same bits
+    whatever else the array holds (other sites, loads, angles): a map's answers do not depend on
+    how its sites were batched.
+
+    Parameters
+    ----------
+    hours : array_like
+        Daily t_solar [h], (days, ...).
+    months : array_like
+        (days,) month of each day [1-12].
+    statistic : str
+        :func:`objective_value`'s.
+    seasons : sequence
+        Each period's months (None: every day).
+    """
+    return np.stack([objective_value(hours, months, statistic, season) for season in seasons])
+
+
 def objective_quantum(statistic: str, step_hours: float, n_days: int, months) -> float:
     """The objective's own jumps [h]: one time step of one day, over the days a statistic averages."""
     if statistic == "mean":
@@ -127,6 +148,101 @@ def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
         "recommended_fold_angle_deg": np.where(carried, angles[recommended], np.nan),
         "near_optimal_tolerance_h": np.where(carried, tol, np.nan),
     }
+
+
+def _pchip_slopes(x, y):
+    """The slopes of the monotone piecewise-cubic Hermite interpolant through ``(x, y)`` at ``x``
+    (Fritsch & Carlson [1]_ as SciPy's ``PchipInterpolator`` takes them, its end rule too), for
+    each row of ``y`` (..., n); ``x`` (n,) ascending, n >= 2.
+
+    References
+    ----------
+    .. [1] F. N. Fritsch, R. E. Carlson, "Monotone piecewise cubic interpolation", SIAM Journal on
+       Numerical Analysis 17(2), 238-246, 1980.
+    """
+    h = np.diff(x)
+    delta = np.diff(y, axis=-1) / h
+    slopes = np.zeros(y.shape)
+    if x.size == 2:
+        slopes[...] = delta
+        return slopes
+    w1, w2 = 2.0 * h[1:] + h[:-1], h[1:] + 2.0 * h[:-1]
+    left, right = delta[..., :-1], delta[..., 1:]
+    same = (np.sign(left) * np.sign(right) > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        harmonic = (w1 + w2) / (w1 / left + w2 / right)
+    slopes[..., 1:-1] = np.where(same, harmonic, 0.0)
+    for end, (h0, h1, d0, d1) in ((0, (h[0], h[1], delta[..., 0], delta[..., 1])),
+                                  (-1, (h[-1], h[-2], delta[..., -1], delta[..., -2]))):
+        slope = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1)
+        slope = np.where(np.sign(slope) != np.sign(d0), 0.0, slope)
+        slope = np.where((np.sign(d0) != np.sign(d1)) & (np.abs(slope) > 3.0 * np.abs(d0)), 3.0 * d0, slope)
+        slopes[..., end] = slope
+    return slopes
+
+
+def near_optimal_on_grid(angles, values, tolerance: NearOptimal, grid) -> dict:
+    """:func:`near_optimal` on a grid of fold angles from values at some of them (a search's): each
+    edge lies between the evaluated angle inside the range and the one outside, at the last grid
+    angle before the monotone cubic through the values [1]_ (:func:`_pchip_slopes`) falls below the
+    threshold (the best less the tolerance); the recommended angle is the grid angle nearest the
+    range's centre (ties to the less folded). Where every grid angle is evaluated, it is
+    :func:`near_optimal`.
+
+    Parameters
+    ----------
+    angles : array_like
+        The evaluated angles [deg], ascending, (n,), on ``grid``.
+    values : array_like
+        t_solar or an objective [h] at each, (targets, n).
+    tolerance : foldopt.inputs.sections.NearOptimal
+    grid : array_like
+        The grid [deg], ascending.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        As :func:`near_optimal`'s, (targets,).
+
+    References
+    ----------
+    .. [1] F. N. Fritsch, R. E. Carlson, "Monotone piecewise cubic interpolation", SIAM Journal on
+       Numerical Analysis 17(2), 238-246, 1980.
+    """
+    angles, values, grid = (np.asarray(a, dtype=float) for a in (angles, values, grid))
+    ranges = near_optimal(angles, values, tolerance)
+    if angles.size < 2:
+        return ranges
+    best = best_angle_index(values)
+    top = np.take_along_axis(values, best[:, None], axis=-1)[:, 0]
+    line = top - tolerance.tolerance_h(top)
+    slopes = _pchip_slopes(angles, values)
+    edges = {"near_optimal_lo_deg": -1, "near_optimal_hi_deg": 1}
+    for name, outward in edges.items():
+        edge = ranges[name].copy()
+        for target in np.flatnonzero(np.isfinite(edge)):
+            inner = int(np.searchsorted(angles, edge[target] - 1e-9))
+            outer = inner + outward
+            if not 0 <= outer < angles.size:
+                continue
+            a, b = sorted((inner, outer))
+            # The grid angles of the gap, from the inner end outward, and the cubic there.
+            inside = grid[(grid > angles[a]) & (grid < angles[b])][::outward]
+            h = angles[b] - angles[a]
+            t = (inside - angles[a]) / h
+            cubic = ((2 * t**3 - 3 * t**2 + 1) * values[target, a] + (t**3 - 2 * t**2 + t) * h * slopes[target, a]
+                     + (-2 * t**3 + 3 * t**2) * values[target, b] + (t**3 - t**2) * h * slopes[target, b])
+            kept = np.cumprod(cubic >= line[target]).astype(bool)
+            if kept.any():
+                edge[target] = inside[kept][-1]
+        ranges[name] = edge
+    centre = (ranges["near_optimal_lo_deg"] + ranges["near_optimal_hi_deg"]) / 2.0
+    finite = np.isfinite(centre)
+    nearest = np.full(centre.shape, np.nan)
+    # Ties go to the less folded angle, as near_optimal breaks them.
+    nearest[finite] = grid[grid.size - 1 - np.argmin(np.abs(grid[::-1][None, :] - centre[finite, None]), axis=1)]
+    ranges["recommended_fold_angle_deg"] = nearest
+    return ranges
 
 
 #: The percentiles over a cloud ensemble's members that the answer gives of each day's t_solar and

@@ -40,7 +40,7 @@ from foldopt.errors import ConfigError
 from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
 from foldopt.studies.site_search import fold_search
-from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
+from foldopt.studies.objectives import best_angle_index, near_optimal_on_grid, objective_value, period_values
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
@@ -351,13 +351,12 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     seasons = [None, *SEASONS.values()]
     # A map searches the fold angles (foldopt.studies.site_search) unless its study sweeps them all.
     search = study.optimize
-    fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h, study.near_optimal)
+    fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h)
     designs = site_designs(parts, sites, usable, engine, fold)
     columns: dict[str, list] = {}
     for (site, resolved, _), days_of, site_months, peak_w, site_watts, site_usable in zip(
             batch, designs, months, flat_peak, watts, usable, strict=True):
-        for name, values in _site_rows(days_of, site_months, statistic, seasons, site_usable, step_hours,
-                                       study.near_optimal, engine).items():
+        for name, values in _site_rows(days_of, site_months, statistic, seasons, site_usable, study).items():
             columns.setdefault(name, []).append(values)
         count = len(PERIODS) * loads.size
         fixed = {"site_id": site.get("site_id", 0), "site_name": site.get("name") or "",
@@ -368,6 +367,15 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
         columns.setdefault("p_load_w", []).append(np.tile(site_watts, len(PERIODS)))
         fraction = site_watts / peak_w if peak_w > 0 else np.full(loads.size, np.nan)
         columns.setdefault("p_load_fraction", []).append(np.tile(fraction, len(PERIODS)))
+    # The tracker's break-even standby of every site of the same days at once (their sites' own else).
+    targets = np.stack(columns["objective_twofold_h"]).reshape(len(batch), len(PERIODS), loads.size)
+    same_days = all(np.array_equal(site_months, months[0]) for site_months in months)
+    groups = [list(range(len(batch)))] if same_days else [[site] for site in range(len(batch))]
+    standby = np.empty(targets.shape)
+    for group in groups:
+        standby[group] = break_even_standby(np.concatenate([designs[i].available for i in group]), targets[group],
+                                            usable[group], months[group[0]], statistic, seasons, step_hours, engine)
+    columns["tracker_break_even_standby_w"] = list(standby.reshape(len(batch), -1))
     order = ["site_id", "site_name", "latitude", "longitude", "weather", "flat_peak_w", "p_load_w", "p_load_fraction",
              "period", "days", "fold_angle_deg", *ROW_VALUES, "gain_vs_flat_pct", "energy_gain_vs_flat_pct",
              "pct_of_tracker", "tracker_break_even_standby_w"]
@@ -381,47 +389,42 @@ ROW_VALUES = ("objective_flat_h", "objective_twofold_h", "objective_tracker_h", 
               "near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg", "near_optimal_tolerance_h")
 
 
-def _site_rows(days_of, months, statistic: str, seasons, usable, step_hours: float, near, engine: str) -> dict:
+def _site_rows(days_of, months, statistic: str, seasons, usable, study) -> dict:
     """One site's columns, per period and load (periods slowest), from its :class:`DailyDesigns`."""
     angles, hours, harvest = days_of.angles, days_of.twofold_h, days_of.twofold_wh
-    n_loads = usable.size
-
-    def statistic_of(daily, season):
-        return objective_value(daily, months, statistic, season)
-
-    rows: dict[str, list] = {}
-    targets = []
-    for period, season in zip(PERIODS, seasons, strict=True):
-        days = np.isin(months, season) if season else np.ones(months.size, bool)
-        # The angles evaluated on every day of the period (a search evaluates some on a season's alone).
-        complete = ~np.isnan(harvest[days]).any(axis=0)
-        period_hours, period_angles = hours[:, :, complete], angles[complete]
-        objective = statistic_of(period_hours, season)  # (loads, angles)
-        best = best_angle_index(objective)
-        at_best = period_hours[:, np.arange(n_loads), best]  # (days, loads)
-        values = {
-            "period": np.full(n_loads, period, dtype=object),
-            "days": np.full(n_loads, int(days.sum())),
-            "fold_angle_deg": np.where(np.isfinite(usable), period_angles[best], np.nan),
-            "objective_flat_h": statistic_of(days_of.flat_h, season),
-            "objective_twofold_h": statistic_of(at_best, season),
-            "objective_tracker_h": statistic_of(days_of.tracker_h, season),
-            "objective_tracker_net_h": statistic_of(days_of.tracker_net_h, season),
-            "mean_t_solar_flat_h": days_of.flat_h[days].mean(axis=0),
-            "mean_t_solar_twofold_h": at_best[days].mean(axis=0),
-            "mean_t_solar_tracker_h": days_of.tracker_h[days].mean(axis=0),
-            "mean_t_solar_tracker_net_h": days_of.tracker_net_h[days].mean(axis=0),
-            "energy_harvested_flat_wh": np.full(n_loads, days_of.flat_wh[days].sum()),
-            "energy_harvested_twofold_wh": harvest[days][:, complete][:, best].sum(axis=0),
-            "energy_harvested_tracker_wh": np.full(n_loads, days_of.tracker_wh[days].sum()),
-            **near_optimal(period_angles, objective, near),
-        }
-        targets.append(values["objective_twofold_h"])
-        for name, value in values.items():
-            rows.setdefault(name, []).append(value)
-    rows = {name: np.concatenate(values) for name, values in rows.items()}
-    rows["tracker_break_even_standby_w"] = break_even_standby(
-        days_of.available, np.array(targets), usable, months, statistic, seasons, step_hours, engine).ravel()
+    n_periods, n_loads = len(seasons), usable.size
+    member = np.stack([np.isin(months, season) if season else np.ones(months.size, bool) for season in seasons])
+    objective = period_values(hours, months, statistic, seasons)  # (periods, loads, angles)
+    best = best_angle_index(objective)  # (periods, loads)
+    at_best = hours[:, np.arange(n_loads)[None, :], best]  # (days, periods, loads)
+    daily = np.stack([days_of.flat_h, days_of.tracker_h, days_of.tracker_net_h], axis=1)  # (days, 3, loads)
+    designs = period_values(daily, months, statistic, seasons)  # (periods, 3, loads)
+    means = period_values(daily, months, "mean", seasons)
+    twofold = np.stack([objective_value(at_best[:, period], months, statistic, season)
+                        for period, season in enumerate(seasons)])  # (periods, loads)
+    twofold_mean = np.stack([at_best[days, period].mean(axis=0) for period, days in enumerate(member)])
+    energy = np.stack([np.stack([days_of.flat_wh, days_of.tracker_wh], axis=1)[days].sum(axis=0)
+                       for days in member])  # (periods, 2)
+    ranges = near_optimal_on_grid(angles, objective.reshape(-1, angles.size), study.near_optimal,
+                                  np.asarray(study.fold_angles.grid()))
+    rows = {
+        "period": np.repeat(np.array(PERIODS, dtype=object), n_loads),
+        "days": np.repeat(member.sum(axis=1), n_loads),
+        "fold_angle_deg": np.where(np.isfinite(usable), angles[best], np.nan).ravel(),
+        "objective_flat_h": designs[:, 0].ravel(),
+        "objective_twofold_h": twofold.ravel(),
+        "objective_tracker_h": designs[:, 1].ravel(),
+        "objective_tracker_net_h": designs[:, 2].ravel(),
+        "mean_t_solar_flat_h": means[:, 0].ravel(),
+        "mean_t_solar_twofold_h": twofold_mean.ravel(),
+        "mean_t_solar_tracker_h": means[:, 1].ravel(),
+        "mean_t_solar_tracker_net_h": means[:, 2].ravel(),
+        "energy_harvested_flat_wh": np.repeat(energy[:, 0], n_loads),
+        "energy_harvested_twofold_wh": np.stack([harvest[member[period]][:, best[period]].sum(axis=0)
+                                                 for period in range(n_periods)]).ravel(),
+        "energy_harvested_tracker_wh": np.repeat(energy[:, 1], n_loads),
+        **ranges,
+    }
     with np.errstate(divide="ignore", invalid="ignore"):
         gain = 100.0 * (rows["objective_twofold_h"] / rows["objective_flat_h"] - 1.0)
         energy_gain = 100.0 * (rows["energy_harvested_twofold_wh"] / rows["energy_harvested_flat_wh"] - 1.0)
