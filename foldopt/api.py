@@ -413,7 +413,7 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
     from foldopt.studies.answering import of_map
     from foldopt.output.folders import map_figures, write_map_report
     from foldopt.output.gridded import write_grid_netcdf
-    from foldopt.studies.worldmap import map_request, map_study
+    from foldopt.studies.worldmap import map_request, map_study, searched_tilt
 
     if study is None:
         study = map_study(load_plan(default_study_path()).data)
@@ -421,7 +421,8 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
     spec = MapSpec(study, request.sites, request.loads, relative, year, sites_per_chunk, engine)
     result = run_map(spec, Path(out), scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
                      progress=progress, announce=announce, metadata={"command": command or ["foldopt.world_map"]})
-    figures = map_figures(result.table, result.out, "map", relative, show_load, show_period)
+    figures = map_figures(result.table, result.out, "map", relative, show_load, show_period,
+                          tilt=searched_tilt(study) is not None)
     write_grid_netcdf(result.table, result.out, relative, f"foldopt map: {study.get('name', 'map')}")
     answer = of_map(result, relative, defaults)
     write_map_report(result, figures, answer)

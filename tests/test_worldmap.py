@@ -220,11 +220,14 @@ def test_a_searched_map_equals_the_full_sweep_within_the_tolerance(latitude, lon
             assert (np.abs(a[column] - b[column]).fillna(0.0) <= 4.0).all()  # two steps of 2 deg
 
 
-def test_a_map_searches_the_fold_angle_alone():
+def test_a_map_searches_the_fold_angle_and_the_tilt_not_the_azimuth():
     from foldopt.studies.worldmap import map_request
 
-    with pytest.raises(ConfigError, match="a map searches the fold angle alone"):
-        map_request({**COARSE, "optimize": {"vary": ["fold_angle", "tilt"]}}, [1.0], latitudes=[0], longitudes=[0])
+    with pytest.raises(ConfigError, match="a map searches the fold angle, or the fold angle and the tilt"):
+        map_request({**COARSE, "optimize": {"vary": ["fold_angle", "azimuth"]}}, [1.0], latitudes=[0], longitudes=[0])
+    with pytest.raises(ConfigError, match="a map searches the fold angle"):
+        map_request({**COARSE, "optimize": {"vary": ["tilt"]}}, [1.0], latitudes=[0], longitudes=[0])
+    map_request({**COARSE, "optimize": {"vary": ["fold_angle", "tilt"]}}, [1.0], latitudes=[0], longitudes=[0])
 
 
 def test_a_relative_maps_answer_has_one_line_per_load():
@@ -240,3 +243,48 @@ def test_a_relative_maps_answer_has_one_line_per_load():
     answer = of_map(MapRun(spec, table, Path("."), (0,), (), 1.0, "test", None), relative=True)
     assert [load["p_load_fraction"] for load in answer.result["loads"]] == list(fractions)
     assert [load["sites"] for load in answer.result["loads"]] == [6, 6]
+
+
+def test_a_map_searching_the_tilt_finds_the_best_design_of_every_tilt():
+    """--optimize tilt: each period's and load's twofold objective within the search's 0.01 h of
+    the best over every fold angle at every tilt (a full sweep of the fold angles per tilt, the
+    reference), never above it; the flat panel at its own best tilt likewise against the flat panel
+    at every tilt; and the tilts reported are ones that reach those objectives."""
+    grid = {"fold_angles": {"start": 20, "stop": 180, "step": 20}}
+    tilts = {"min": 0, "max": 90, "step": 15}
+    site, loads = [{"latitude": 40.0, "longitude": 10.0}], [2.0, 6.0]
+    searched = evaluate_sites({**COARSE, **grid, "optimize": {"vary": ["fold_angle", "tilt"], "tilt": tilts}},
+                              site, loads)
+    every = pd.concat([evaluate_sites({**COARSE, **grid, "panel": {**COARSE["panel"], "tilt": float(tilt)}}, site,
+                                      loads) for tilt in range(0, 91, 15)])
+    keys = ["period", "p_load_w"]
+    best = every.groupby(keys)[["objective_twofold_h", "objective_flat_h"]].max()
+    found = searched.set_index(keys)
+    for design in ("twofold", "flat"):
+        short = best[f"objective_{design}_h"] - found[f"objective_{design}_h"]
+        assert (short >= -1e-9).all() and (short <= 0.01).all(), design
+    # The reported tilt and fold angle of the year's first load give its objective in the sweep at that tilt.
+    row = found.loc[("year", 2.0)]
+    at_tilt = every[(every["surface_tilt"] == row["surface_tilt"]) & (every["period"] == "year")
+                    & (every["p_load_w"] == 2.0)]
+    assert at_tilt["objective_twofold_h"].max() >= row["objective_twofold_h"] - 1e-9
+    assert (searched["flat_surface_tilt"] % 15 == 0).all() and searched["surface_tilt"].between(0, 90).all()
+    # Without the search every design keeps the site's tilt (|latitude|, the map's mounting).
+    assert (every["surface_tilt"] == every["flat_surface_tilt"]).all()
+
+
+def test_a_map_searching_the_tilt_answers_with_the_tilts():
+    """The answer of a map with --optimize tilt says what it searched and gives the tilts it found."""
+    from foldopt.studies.answering import of_map
+    from foldopt.studies.cluster import MapRun, MapSpec
+
+    study = {**COARSE, "optimize": {"vary": ["fold_angle", "tilt"], "tilt": {"min": 0, "max": 60, "step": 30}}}
+    sites = grid_sites([-20.0, 45.0], [0.0], False)
+    table = evaluate_sites(study, sites, [2.0])
+    answer = of_map(MapRun(MapSpec(study, tuple(sites), (2.0,)), table, Path("."), (0,), (), 1.0, "test", None),
+                    relative=False)
+    year = table[table["period"] == "year"]
+    assert answer.result["loads"][0]["surface_tilt"]["max"] == year["surface_tilt"].max()
+    assert answer.result["loads"][0]["flat_surface_tilt"]["min"] == year["flat_surface_tilt"].min()
+    assert "base tilts" in answer.summary[1] and "0 to 60 by 30 deg" in answer.question["panel"]
+    assert list(answer.near_optimal["surface_tilt"]) == list(year["surface_tilt"])

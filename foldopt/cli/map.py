@@ -17,7 +17,7 @@ from foldopt.errors import ConfigError, WeatherError
 
 #: The map request's parameters as the options name them, beside the study's fields.
 _OPTION_OF_PARAMETER = {"latitudes": "--lat", "longitudes": "--lon", "land_only": "--land-only",
-                        "show_period": "--show-period"}
+                        "show_period": "--show-period", "optimize": "--optimize"}
 
 
 def map_(
@@ -41,8 +41,11 @@ def map_(
     step_min: Optional[float] = STEP_MIN,
     angle_step: Optional[float] = ANGLE_STEP,
     fold_search: bool = typer.Option(False, "--fold-search", help="Search the fold angles (foldopt.engine.search) "
-                                     "instead of evaluating every one: the same objectives within 0.01 h; fewer "
-                                     "angles for few loads and periods."),
+                                     "instead of evaluating every one: the same objectives within 0.01 h from some "
+                                     "70 of 180 angles."),
+    optimize: Optional[str] = typer.Option(None, "--optimize", help="What the search varies with the fold angle: "
+                                           "tilt (each site's best tilt, and the flat panel's own); implies "
+                                           "--fold-search."),
     config: Optional[Path] = typer.Option(None, "--config", help=f"Study to take the panel and models from [default: "
                                           f"{EMBEDDED}, in exact mode with the Ineichen clear sky]."),
     settings: Optional[list[str]] = SETTINGS,
@@ -98,7 +101,7 @@ def map_(
         request = map_request_from(
             config, source=EMBEDDED if config is None else str(config), objective=objective, area=area,
             efficiency=efficiency, step_min=step_min, angle_step=angle_step, fold_search=fold_search,
-            settings=settings or (),
+            optimize=optimize, settings=settings or (),
             loads=p_load_fraction if relative else p_load, relative=relative, year=year, show_period=show_period,
             sites=sites, weather_dir=weather_dir, latitudes=lat, longitudes=lon, land_only=land_only)
     except WeatherError:

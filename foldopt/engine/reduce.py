@@ -148,14 +148,17 @@ def _day_steps(power, first, last, step_hours, loads, contiguous, above, whole, 
 
 
 @njit(cache=True, parallel=True)
-def curve_rows(power, row_loadset, loads, step_hours, contiguous, load_shape, use_shape, t_out, cont_out, energy_out,
-               peak_out, above, whole, run):
+def curve_rows(power, span, row_loadset, loads, step_hours, contiguous, load_shape, use_shape, t_out, cont_out,
+               energy_out, peak_out, above, whole, run):
     """Daily metrics of given power curves (a tracker's), as :func:`fold_rows` with one connection.
 
     Parameters
     ----------
     power : (n_rows, n_steps) float
         Power at step centres [W].
+    span : (n_rows, 2) int
+        First and last step to walk: the steps with power and one without either side (zero power
+        before and after holds no load: the steps outside add to no load's time).
     row_loadset : (n_rows,) int
         Set of loads of each row.
     loads : (n_loadsets, n_loads) float
@@ -176,7 +179,7 @@ def curve_rows(power, row_loadset, loads, step_hours, contiguous, load_shape, us
     for k in prange(n_chunks):
         for r in range(k * per_chunk, min((k + 1) * per_chunk, n_rows)):
             energy_out[r, 0], peak_out[r, 0] = day_metrics(
-                power[r], 0, power.shape[1] - 1, step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
+                power[r], span[r, 0], span[r, 1], step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
                 run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0], load_shape[r if use_shape else 0],
                 use_shape)
 

@@ -418,6 +418,23 @@ def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_
                       work["peak_out"], work["irradiation_out"])
 
 
+def power_span(power) -> np.ndarray:
+    """(n_rows, 2) each curve's first and last step with power, and one step without either side
+    ((0, 0) for a curve without any): what :func:`foldopt.engine.reduce.curve_rows` walks.
+
+    Parameters
+    ----------
+    power : numpy.ndarray
+        (n_rows, n_steps) [W].
+    """
+    some = power != 0.0
+    n_steps = power.shape[1]
+    first = np.argmax(some, axis=1)
+    last = n_steps - 1 - np.argmax(some[:, ::-1], axis=1)
+    return np.ascontiguousarray(np.where(some.any(axis=1)[:, None],
+                                         np.stack([np.maximum(first - 1, 0), np.minimum(last + 1, n_steps - 1)], 1), 0))
+
+
 def _shape_arguments(load_shape):
     """The kernel's ``load_shape`` and ``use_shape``: one placeholder row for constant loads."""
     if load_shape is None:
@@ -426,7 +443,7 @@ def _shape_arguments(load_shape):
 
 
 def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous: bool = False,
-                  engine: str = "numba", load_shape=None) -> RowMetrics:
+                  engine: str = "numba", load_shape=None, span=None) -> RowMetrics:
     """Daily metrics of given power curves (a tracker's, a design's).
 
     Parameters
@@ -444,6 +461,10 @@ def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous:
     engine : {'numba', 'numpy'}
     load_shape : array_like, optional
         (n_rows, n_steps) load profile [W]; the loads are then its scales (:func:`per_load`).
+    span : array_like of int, optional
+        (n_rows, 2) the first and last step of each curve with power and one without either side
+        (:func:`power_span`, its default): what the compiled engine walks; a row given (0, 0) is
+        not walked (its metrics are then those of no power).
 
     Returns
     -------
@@ -467,8 +488,9 @@ def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous:
         from foldopt.engine import reduce
 
         work = reduce.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
-        reduce.curve_rows(power, row_loadset, sorted_loads, step_hours, contiguous, *_shape_arguments(load_shape),
-                          **work)
+        span = power_span(power) if span is None else np.ascontiguousarray(span, dtype=np.int64)
+        reduce.curve_rows(power, span, row_loadset, sorted_loads, step_hours, contiguous,
+                          *_shape_arguments(load_shape), **work)
         result = RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
                             work["peak_out"])
     return _in_caller_order(result, order, row_loadset)

@@ -38,7 +38,8 @@ COLUMNS = (
                    "tracker-net (net of its own draw), tracker:<model> and tracker:<model>-net"),
     # the design's settings and its daily metrics
     ("fold_angle_deg", "deg", "the fold angle Θ (180 = flat); empty for trackers"),
-    ("surface_tilt", "deg", "the panel's base tilt from horizontal (foldopt optimize)"),
+    ("surface_tilt", "deg", "the panel's base tilt from horizontal (foldopt optimize; a map's twofold panel)"),
+    ("flat_surface_tilt", "deg", "the flat panel's tilt: the site's, or its own best with map --optimize tilt"),
     ("surface_azimuth", "deg", "the panel's base azimuth, clockwise from north (foldopt optimize)"),
     ("t_solar_h", "h", "solar-powered time of the day: P_pv >= P_load"),
     ("t_solar_contiguous_h", "h", "the longest contiguous solar-powered interval"),

@@ -294,7 +294,7 @@ def write_optimize(result, out: Path, overwrite: bool = False, command=None) -> 
 
 
 def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, load_index: int = 0,
-                period: str = "year") -> list[str]:
+                period: str = "year", tilt: bool = False) -> list[str]:
     """Write the world maps of one load and period and the latitude x load chart
     (:data:`foldopt.output.figures.world.FIGURES`) in a map's folder, each file atomically.
 
@@ -313,6 +313,8 @@ def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, lo
         The load the maps show, by its index among the map's loads (sorted).
     period : str, default 'year'
         The period the maps and the chart show (``year``, ``DJF``...).
+    tilt : bool, default False
+        Whether the map searched the base tilt: its map of the best tilts too.
 
     Returns
     -------
@@ -326,7 +328,7 @@ def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, lo
     unit = "of the flat peak" if relative else "W"
     what = f"P_load {values[load_index]:g} {unit}, {period}"
     written = [write_figure(folder, file, shown, column, f"{name}: {description} ({what})", label, diverging)
-               for file, column, description, label, diverging in world.MAPS]
+               for file, column, description, label, diverging in (*world.MAPS, *(world.TILT_MAPS if tilt else ()))]
     return written + [write_figure(folder, "latitude_load_gain.png", table, period, relative,
                                    f"{name}: where folding pays ({period}, median over longitudes)")]
 

@@ -16,6 +16,7 @@ import pandas as pd
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
+from foldopt.studies.worldmap import searched_tilt
 
 #: The designs an answer compares, first the ones every study has.
 MAIN_DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
@@ -420,6 +421,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
     """
     table, spec = result.table, result.spec
     study = spec.study
+    tilts = searched_tilt(study)
     year = table[table["period"] == "year"]
     key = "p_load_fraction" if relative else "p_load_w"
     per_load = []
@@ -438,6 +440,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                                            "median": rows["recommended_fold_angle_deg"].median(),
                                            "max": rows["recommended_fold_angle_deg"].max()},
             "median_near_optimal_width_deg": (rows["near_optimal_hi_deg"] - rows["near_optimal_lo_deg"]).median(),
+            **{column: {"min": rows[column].min(), "median": rows[column].median(), "max": rows[column].max()}
+               for column in ("surface_tilt", "flat_surface_tilt")},
             "median_pct_of_tracker": rows["pct_of_tracker"].median(),
             "median_tracker_break_even_standby_w": rows["tracker_break_even_standby_w"].median(),
         })
@@ -462,6 +466,10 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                     f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended "
                     f"{rec['min']:g} to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
                     f"{load['median_near_optimal_width_deg']:g} deg wide)")
+        if tilts is not None and rec["min"] is not None:
+            tilt, flat = load["surface_tilt"], load["flat_surface_tilt"]
+            rec_text += (f", at base tilts {tilt['min']:g} to {tilt['max']:g} deg (median {tilt['median']:g}; "
+                         f"the flat panel's own best {flat['min']:g} to {flat['max']:g}, median {flat['median']:g})")
         # Where no site carries the load there is no gain to give, nor a best site.
         gains = ("" if best is None else f" (median {_pct(load['median_gain_vs_flat_pct'])}, best "
                  f"{_pct(load['best_gain_vs_flat_pct'])} at {where})")
@@ -478,10 +486,13 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         "sites": f"{len(spec.sites):,}",
         "loads": f"{loads} {'x each site' + chr(39) + 's flat peak' if relative else 'W'}",
         "year": str(spec.year),
-        "panel": f"{study['panel']['area']:g} m^2 facing the equator at |latitude|",
+        "panel": f"{study['panel']['area']:g} m^2 facing the equator at " + (
+            "|latitude|" if tilts is None else
+            f"each site's best base tilt, {tilts[0]:g} to {tilts[1]:g} by {tilts[2]:g} deg (the flat panel's own)"),
         "objective": part["objective"],
         "models": f"{study.get('mode')} mode, {study.get('pv_model', 'ideal')} PV model, {sky}",
     }
-    columns = ["site_id", "site_name", "latitude", "longitude", key, "fold_angle_deg", *NEAR_OPTIMAL]
+    columns = ["site_id", "site_name", "latitude", "longitude", key, "fold_angle_deg", "surface_tilt",
+               "flat_surface_tilt", *NEAR_OPTIMAL]
     return Answer("map", "map", question, defaults, part, year[[c for c in year.columns if c not in NEAR_OPTIMAL]],
                   year[columns].reset_index(drop=True), pd.DataFrame(), [], tuple(lines))

@@ -64,20 +64,33 @@ def break_even_standby(available, targets, loads, months, statistic: str, season
     n_sites, n_periods, n_loads = targets.shape
     n_days = len(months)
     top = available.reshape(n_sites, -1).max(axis=1).clip(0.0)[:, None, None]  # (sites, 1, 1)
+    period = np.broadcast_to(np.arange(n_periods)[:, None], (n_periods, n_loads))
+
     site_of_day = np.repeat(np.arange(n_sites), n_days)
+    span = engines.power_span(available)
 
-    def shortfall(draws):
-        """(sites, periods, loads) each period's objective at its loads plus ``draws``, less its target."""
-        daily = engines.curve_metrics(available, (loads[:, None, :] + draws).reshape(n_sites, -1), step_hours,
-                                      site_of_day, engine=engine).t_solar[:, 0]
-        daily = daily.reshape(n_sites, n_days, n_periods, n_loads)
-        # Every period's objective of every period's draws, a site at a time (its own reduction,
-        # the same bits whatever the batch), and each period's own kept.
-        every = np.stack([period_values(days, months, statistic, seasons) for days in daily])  # (s, p, p, l)
-        return every[:, np.arange(n_periods), np.arange(n_periods)] - targets
+    def shortfall(draws, asked):
+        """(sites, periods, loads) each asked target's objective at its load plus its draw, less its
+        target (NaN where not asked). A site's asked loads go to the engine as its own set (padded
+        with loads no power reaches), so that each gets the same bits whatever other sites ask; a
+        site with none is not walked."""
+        count = asked.reshape(n_sites, -1).sum(axis=1)
+        sets = np.full((n_sites, max(int(count.max()), 1)), np.inf)
+        for site in np.flatnonzero(count):
+            sets[site, :count[site]] = (loads[site][None, :] + draws[site])[asked[site]]
+        walked = np.where((count > 0)[site_of_day, None], span, 0)
+        daily = engines.curve_metrics(available, sets, step_hours, site_of_day, engine=engine,
+                                      span=walked).t_solar[:, 0].reshape(n_sites, n_days, -1)
+        value = np.full(targets.shape, np.nan)
+        for site in np.flatnonzero(count):
+            # Every period's objective of the site's asked loads, and each target's own period kept.
+            every = period_values(np.ascontiguousarray(daily[site, :, :count[site]]), months, statistic, seasons)
+            value[site][asked[site]] = every[period[asked[site]], np.arange(count[site])] - targets[site][asked[site]]
+        return value
 
+    every_target = np.ones(targets.shape, bool)
     low, high = np.zeros(targets.shape), np.broadcast_to(top, targets.shape).copy()
-    at_low, at_high = shortfall(low), shortfall(high)
+    at_low, at_high = shortfall(low, every_target), shortfall(high, every_target)
     found = np.where(at_low <= 0, 0.0, np.nan)
     side = np.zeros(targets.shape, dtype=int)
     for _ in range(BREAK_EVEN_ROUNDS):
@@ -88,8 +101,7 @@ def break_even_standby(available, targets, loads, months, statistic: str, season
             draw = np.where(at_low != at_high, (low * at_high - high * at_low) / (at_high - at_low), (low + high) / 2)
         # A secant that lands on an end (the objective flat there to its last bits) halves instead.
         draw = np.where((draw > low) & (draw < high), draw, (low + high) / 2)
-        draw = np.where(open_, draw, low)
-        value = shortfall(draw)
+        value = shortfall(draw, open_)
         found = np.where(open_ & (value == 0), draw, found)  # the objective is the target there
         above = open_ & (value > 0)
         below = open_ & (value < 0)

@@ -241,18 +241,23 @@ class DailyDesigns:
     Attributes
     ----------
     angles : numpy.ndarray
-        The fold-angle grid [deg], (n_angles,).
+        The twofold panel's fold angles [deg], (n,): the study's grid, or those a search evaluated.
     twofold_h : numpy.ndarray
-        (days, loads, angles).
+        (days, loads, n).
     twofold_wh : numpy.ndarray
-        (days, angles).
+        (days, n).
     flat_h, tracker_h, tracker_net_h : numpy.ndarray
-        (days, loads); the tracker net of its own draw.
+        (days, loads); the tracker net of its own draw; the flat panel at the site's mounting.
     flat_wh, tracker_wh : numpy.ndarray
         (days,); the tracker's gross harvest.
     available : numpy.ndarray
         (days, steps) [W]: the tracker's power left for the load and a standby draw
         (:func:`standby_available`).
+    tilts : numpy.ndarray or None
+        With a search of the tilt too, each design's base tilt [deg], (n,); None: the site's.
+    flat_tilted : tuple or None
+        With a search of the tilt, the flat panel at the tilts it evaluated: ``(tilts (m,), hours
+        (days, loads, m), energy (days, m))``.
     """
 
     angles: np.ndarray
@@ -264,6 +269,8 @@ class DailyDesigns:
     tracker_net_h: np.ndarray
     tracker_wh: np.ndarray
     available: np.ndarray
+    tilts: np.ndarray | None = None
+    flat_tilted: tuple | None = None
 
 
 def daily_designs(parts, loads, engine: str = "numba", fold=None) -> DailyDesigns:
@@ -297,10 +304,11 @@ def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
         (n_sites, n_loads) each site's loads [W]; an infinite load carries nothing.
     engine : {'numba', 'numpy'}
     fold : callable, optional
-        ``fold(parts, sites, loads, loadset, engine)`` -> per site ``(angles, hours (days, loads,
-        angles), energy (days, angles))`` at the angles it chooses to evaluate (a search:
-        :class:`foldopt.studies.site_search.FoldSearch`), ``loadset`` each block's site; default every
-        angle of the study's grid on every day.
+        ``fold(parts, sites, loads, loadset, engine)`` -> per site ``(designs (n, 2) fold angle and
+        base tilt, hours (days, loads, n), energy (days, n), flat)`` at the designs it chooses to
+        evaluate (a search: :func:`foldopt.studies.site_search.fold_search`), ``loadset`` each
+        block's site, ``flat`` None or the flat panel at tilts of its own (``tilts, hours,
+        energy``); default every angle of the study's grid on every day at the site's tilt.
 
     Returns
     -------
@@ -330,9 +338,11 @@ def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
         available.append(standby_available(gross, draw, sky.lit, study.tracker.standby_w))
     gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
     flat, flat_energy, available = np.concatenate(flat), np.concatenate(flat_energy), np.concatenate(available)
-    return [DailyDesigns(angles, hours, energy, flat[blocks], flat_energy[blocks], gross_h[blocks], net_h[blocks],
-                         gross_wh[blocks], available[blocks])
-            for blocks, (angles, hours, energy) in zip(sites, searched, strict=True)]
+    tilted = any(flat_tilted is not None for *_, flat_tilted in searched)
+    return [DailyDesigns(points[:, 0], hours, energy, flat[blocks], flat_energy[blocks], gross_h[blocks],
+                         net_h[blocks], gross_wh[blocks], available[blocks], points[:, 1] if tilted else None,
+                         flat_tilted)
+            for blocks, (points, hours, energy, flat_tilted) in zip(sites, searched, strict=True)]
 
 
 def _every_angle(parts, sites, loads, loadset, engine):
@@ -345,7 +355,8 @@ def _every_angle(parts, sites, loads, loadset, engine):
                                                       np.full(angles.size, azimuth[blocks[0]])]))
                 for blocks in sites]
     done = requested_hours(parts, requests, loads, loadset, engine=engine)
-    return [(angles, hours.transpose(0, 2, 1), energy) for hours, energy in done]
+    return [(points, hours.transpose(0, 2, 1), energy, None)
+            for (_, points), (hours, energy) in zip(requests, done, strict=True)]
 
 
 def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba", with_energy: bool = False):

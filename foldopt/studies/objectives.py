@@ -169,7 +169,8 @@ def _pchip_slopes(x, y):
     w1, w2 = 2.0 * h[1:] + h[:-1], h[1:] + 2.0 * h[:-1]
     left, right = delta[..., :-1], delta[..., 1:]
     same = (np.sign(left) * np.sign(right) > 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # a slope of a few ulp overflows w / slope; the harmonic mean then goes to 0, as it should
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         harmonic = (w1 + w2) / (w1 / left + w2 / right)
     slopes[..., 1:-1] = np.where(same, harmonic, 0.0)
     for end, (h0, h1, d0, d1) in ((0, (h[0], h[1], delta[..., 0], delta[..., 1])),

@@ -20,6 +20,8 @@ from dataclasses import dataclass, replace
 
 from foldopt.inputs import policy
 from foldopt.inputs.load import default_study_path, parse_study_text, read_study
+from foldopt.inputs.optimize_section import vary_names
+from foldopt.names import OPTIMIZE_VARIABLES
 from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
 from foldopt.errors import ConfigError
 
@@ -416,8 +418,8 @@ def sweep_request(study, options: dict, axis: str | None, source: str, section: 
 
 
 def map_request_from(study=None, *, source: str = "the given study", objective: str = "mean", area=None,
-                     efficiency=None, step_min=None, angle_step=None, fold_search: bool = False, settings=(),
-                     loads=None, **where):
+                     efficiency=None, step_min=None, angle_step=None, fold_search: bool = False, optimize=None,
+                     settings=(), loads=None, **where):
     """The request of ``foldopt map``: a study made into a map's study by the map's options, and
     the map's sites and loads (:func:`foldopt.studies.worldmap.map_request`).
 
@@ -439,7 +441,10 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
         Fold-angle grid step [deg], the grid from it to 180; default the study's grid.
     fold_search : bool
         Search each site's fold angles (``optimize: {vary: [fold_angle]}``,
-        :func:`foldopt.studies.joint.fold_search`) instead of evaluating every one.
+        :func:`foldopt.studies.site_search.fold_search`) instead of evaluating every one.
+    optimize : str or sequence of str, optional
+        What the search varies with the fold angle: ``tilt`` (each site's best base tilt, the flat
+        panel's own beside it); names joined by commas or a list.
     settings : sequence of str
         ``KEY=VALUE`` texts (:func:`parse_setting`), set last.
     loads : float, sequence of float or str, optional
@@ -468,8 +473,15 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
             changes[field] = value
     if angle_step is not None:
         changes["fold_angles"] = {"start": angle_step, "stop": 180.0, "step": angle_step}
-    if fold_search:
-        changes["optimize"] = {**(data.get("optimize") or {}), "vary": ["fold_angle"]}
+    if fold_search or optimize:
+        try:
+            varied = vary_names(optimize or [])
+        except ValueError as error:
+            raise ConfigError([f"optimize = {optimize!r}: {error}"]) from None
+        if any(name not in OPTIMIZE_VARIABLES for name in varied):
+            raise ConfigError([f"optimize = {optimize!r}: must name some of {', '.join(OPTIMIZE_VARIABLES)}"])
+        extra = [name for name in varied if name != "fold_angle"]
+        changes["optimize"] = {**(data.get("optimize") or {}), "vary": ["fold_angle", *extra]}
     made = map_study(data, embedded=study is None, **changes)
     for setting in settings:
         made = policy.set_path(made, *parse_setting(setting))

@@ -17,6 +17,10 @@ twice short by more than the tolerance). The near-optimal ranges are then placed
 the evaluated angles (:func:`foldopt.studies.objectives.near_optimal_on_grid`).
 ``tests/test_worldmap.py`` holds the answers to a full sweep of the grid on random sites, loads and
 objectives.
+
+With the base tilt (``foldopt map --optimize tilt``) the grid is the fold angle by the tilt, searched
+together the same way, and the flat panel's own best tilt is searched beside it (a grid of the tilt
+alone), so that the gain over flat compares each design at its own best mounting.
 """
 
 from __future__ import annotations
@@ -28,13 +32,14 @@ from foldopt.studies.designs import requested_hours
 from foldopt.studies.objectives import objective_quantum, period_values
 
 
-class FoldSearch:
-    """One site's search of the fold-angle grid for every period's objective and every load.
+class DesignSearch:
+    """One site's search of a grid of designs (the fold angle, and the base tilt where a map varies
+    it) for every period's objective and every load.
 
     Parameters
     ----------
-    axis : Axis
-        The study's grid of fold angles.
+    axes : sequence of Axis
+        The grid's variables.
     months : numpy.ndarray
         (days,) month of each day.
     statistic : str
@@ -47,32 +52,33 @@ class FoldSearch:
         The objective's own jumps [h] (:func:`foldopt.studies.objectives.objective_quantum`).
     """
 
-    def __init__(self, axis: Axis, months, statistic: str, seasons, tolerance_h: float, quantum: float):
+    def __init__(self, axes, months, statistic: str, seasons, tolerance_h: float, quantum: float):
         self.months, self.statistic, self.seasons = np.asarray(months), statistic, list(seasons)
-        self.grid = GridSearch([axis], tolerance_h, quantum)
-        self.found: list = []  # (angles (n,), hours (days, n, loads), energy (days, n)) as told
-        self._asked = np.zeros(0)
+        self.grid = GridSearch(axes, tolerance_h, quantum)
+        self.found: list = []  # (points (n, axes), hours (days, n, loads), energy (days, n)) as told
+        self._asked = None
 
     def ask(self):
-        """The fold angles [deg] to evaluate next on every day, (n,), or None when the search is done."""
-        points = self.grid.ask()
-        self._asked = None if points is None else points[:, 0]
+        """The designs to evaluate next on every day, (n, axes) in the axes' units, or None when the
+        search is done."""
+        self._asked = self.grid.ask()
         return self._asked
 
     def tell(self, hours, energy) -> None:
-        """The asked angles' daily t_solar [h], (days, n, loads), and harvested energy [Wh], (days, n)."""
+        """The asked designs' daily t_solar [h], (days, n, loads), and harvested energy [Wh], (days, n)."""
         hours, energy = np.asarray(hours, dtype=float), np.asarray(energy, dtype=float)
         self.found.append((self._asked, hours, energy))
         self.grid.tell(period_values(hours, self.months, self.statistic, self.seasons).transpose(1, 0, 2).reshape(
-            self._asked.size, -1))
+            self._asked.shape[0], -1))
 
     def result(self):
-        """``(angles (n,), hours (days, loads, n), energy (days, n))`` over every evaluated angle, ascending."""
-        angles = np.concatenate([angles for angles, _, _ in self.found])
-        order = np.argsort(angles)
+        """``(points (n, axes), hours (days, loads, n), energy (days, n))`` over every evaluated design,
+        in ascending order of the first axis, then the next."""
+        points = np.concatenate([points for points, _, _ in self.found])
+        order = np.lexsort(points.T[::-1])
         hours = np.concatenate([hours for _, hours, _ in self.found], axis=1)[:, order].transpose(0, 2, 1)
         energy = np.concatenate([energy for _, _, energy in self.found], axis=1)[:, order]
-        return angles[order], hours, energy
+        return points[order], hours, energy
 
 
 def search_sites(searches, evaluate) -> list:
@@ -81,29 +87,30 @@ def search_sites(searches, evaluate) -> list:
 
     Parameters
     ----------
-    searches : sequence of FoldSearch
+    searches : sequence of DesignSearch
     evaluate : callable
-        ``evaluate({site: angles})`` -> ``{site: (hours (days, n, loads), energy (days, n))}``,
+        ``evaluate({site: designs})`` -> ``{site: (hours (days, n, loads), energy (days, n))}``,
         ``site`` a search's position in ``searches``.
 
     Returns
     -------
     list
-        Each search's :meth:`FoldSearch.result`.
+        Each search's :meth:`DesignSearch.result`.
     """
     asked = {site: search.ask() for site, search in enumerate(searches)}
-    asked = {site: angles for site, angles in asked.items() if angles is not None}
+    asked = {site: designs for site, designs in asked.items() if designs is not None}
     while asked:
         for site, (hours, energy) in evaluate(asked).items():
             searches[site].tell(hours, energy)
         asked = {site: searches[site].ask() for site in asked}
-        asked = {site: angles for site, angles in asked.items() if angles is not None}
+        asked = {site: designs for site, designs in asked.items() if designs is not None}
     return [search.result() for search in searches]
 
 
-def fold_search(months, statistic: str, seasons, tolerance_h: float):
-    """The fold angles of a batch of a map's sites, searched (:class:`FoldSearch`, one a site), as
-    :func:`foldopt.studies.designs.site_designs` takes them.
+def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis | None = None):
+    """The designs of a batch of a map's sites, searched (:class:`DesignSearch`, one a site), as
+    :func:`foldopt.studies.designs.site_designs` takes them: the fold angle at the site's tilt, or
+    with ``tilt`` the fold angle and the tilt together, and the flat panel's own best tilt beside.
 
     Parameters
     ----------
@@ -115,33 +122,48 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float):
         Each period's months (None: every day).
     tolerance_h : float
         The grid search's tolerance [h].
+    tilt : Axis, optional
+        The base tilt's range and resolution, where the map varies it.
 
     Returns
     -------
     callable
-        ``fold(parts, sites, loads, loadset, engine)`` -> per site ``(angles, hours (days, loads,
-        angles), energy (days, angles))``.
+        ``fold(parts, sites, loads, loadset, engine)`` -> per site ``(points (n, 2) fold angle and
+        tilt, hours (days, loads, n), energy (days, n), flat)``, ``flat`` the flat panel's ``(tilts
+        (m,), hours (days, loads, m), energy (days, m))`` with ``tilt``, else None.
     """
 
     def fold(parts, sites, loads, loadset, engine):
         study = parts[0][0].study
         grid = study.fold_angles
-        axis = Axis("fold_angle", grid.start, grid.stop, grid.step)
+        fold_axis = Axis("fold_angle", grid.start, grid.stop, grid.step)
         step_hours = parts[0][1].step_hours
-        tilt = np.concatenate([chunk.tilt for chunk, _ in parts])
+        tilts = np.concatenate([chunk.tilt for chunk, _ in parts])
         azimuth = np.concatenate([chunk.azimuth for chunk, _ in parts])
-        searches = [FoldSearch(axis, days, statistic, seasons, tolerance_h,
-                               objective_quantum(statistic, step_hours, len(days), days)) for days in months]
 
-        def evaluate(asked):
-            requests = []
-            for site, angles in asked.items():
-                first, base = sites[site][0], np.ones(angles.size)
-                requests.append((np.asarray(sites[site]), np.column_stack([angles, tilt[first] * base,
-                                                                           azimuth[first] * base])))
-            done = requested_hours(parts, requests, loads, loadset, engine=engine)
-            return dict(zip(asked, done, strict=True))
+        def run(axes, flat):
+            searches = [DesignSearch(axes, days, statistic, seasons, tolerance_h,
+                                     objective_quantum(statistic, step_hours, len(days), days)) for days in months]
 
-        return search_sites(searches, evaluate)
+            def evaluate(asked):
+                requests = []
+                for site, points in asked.items():
+                    first = sites[site][0]
+                    angle = np.full(points.shape[0], 180.0) if flat else points[:, 0]
+                    tilt_of = points[:, -1] if tilt is not None else np.full(points.shape[0], tilts[first])
+                    requests.append((np.asarray(sites[site]),
+                                     np.column_stack([angle, tilt_of, np.full(points.shape[0], azimuth[first])])))
+                done = requested_hours(parts, requests, loads, loadset, flat=flat, engine=engine)
+                return dict(zip(asked, done, strict=True))
+
+            return search_sites(searches, evaluate)
+
+        if tilt is None:
+            return [(np.column_stack([points[:, 0], np.full(points.shape[0], tilts[site[0]])]), hours, energy, None)
+                    for site, (points, hours, energy) in zip(sites, run([fold_axis], False), strict=True)]
+        flats = run([tilt], True)
+        return [(points, hours, energy, (flat_points[:, 0], flat_hours, flat_energy))
+                for (points, hours, energy), (flat_points, flat_hours, flat_energy)
+                in zip(run([fold_axis, tilt], False), flats, strict=True)]
 
     return fold

@@ -32,7 +32,8 @@ from pydantic import ValidationError
 from foldopt import names
 from foldopt.engine import rows as engines
 from foldopt.inputs.load import resolve_files
-from foldopt.inputs.optimize_section import vary_names
+from foldopt.engine.search import Axis
+from foldopt.inputs.optimize_section import DEFAULT_TILT, vary_names
 from foldopt.inputs.plan import parse_dates, parse_values, year_problem
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, format_errors
@@ -53,6 +54,8 @@ DEFAULT_GRID = ("-60:60:10", "-180:180:30")
 LOAD_BOUNDS = {False: (1e6, "loads must be in (0, 1e+06] W"), True: (2.0, "fractions must be in (0, 2]")}
 
 
+#: What a map's search may vary (``optimize.vary``): the fold angle, and the base tilt with it.
+MAP_VARIABLES = ("fold_angle", "tilt")
 #: Sites evaluated together at most: their days one sky, every engine call over all of them
 #: (a year's days of six sites stay within a chunk of the engine, foldopt.studies.blocks).
 SITES_PER_BATCH = 6
@@ -210,12 +213,12 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
         errors.append(f"loads = {loads!r}: {bounds}")
     vary = (study.get("optimize") or {}).get("vary", list(names.OPTIMIZE_VARIABLES))
     try:
-        fold_only = vary_names(vary) == ["fold_angle"]
+        searchable = "fold_angle" in vary_names(vary) and set(vary_names(vary)) <= set(MAP_VARIABLES)
     except ValueError:
-        fold_only = True  # no list of names: the study's validation at the first site says so
-    if study.get("optimize") is not None and not fold_only:
-        errors.append(f"optimize.vary = {vary!r}: a map searches the fold angle alone (the tilt and azimuth "
-                      f"with it: foldopt optimize, one site at a time)")
+        searchable = True  # no list of names: the study's validation at the first site says so
+    if study.get("optimize") is not None and not searchable:
+        errors.append(f"optimize.vary = {vary!r}: a map searches the fold angle, or the fold angle and the tilt "
+                      f"(the azimuth with them: foldopt optimize, one site at a time)")
     if errors:
         raise ConfigError(errors)
     if isinstance(sites, (str, Path)):
@@ -351,12 +354,14 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     seasons = [None, *SEASONS.values()]
     # A map searches the fold angles (foldopt.studies.site_search) unless its study sweeps them all.
     search = study.optimize
-    fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h)
+    fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h,
+                                                   _tilt_axis(search))
     designs = site_designs(parts, sites, usable, engine, fold)
     columns: dict[str, list] = {}
     for (site, resolved, _), days_of, site_months, peak_w, site_watts, site_usable in zip(
             batch, designs, months, flat_peak, watts, usable, strict=True):
-        for name, values in _site_rows(days_of, site_months, statistic, seasons, site_usable, study).items():
+        for name, values in _site_rows(days_of, site_months, statistic, seasons, site_usable, study,
+                                       resolved.resolved().panel.tilt).items():
             columns.setdefault(name, []).append(values)
         count = len(PERIODS) * loads.size
         fixed = {"site_id": site.get("site_id", 0), "site_name": site.get("name") or "",
@@ -377,9 +382,29 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
                                             usable[group], months[group[0]], statistic, seasons, step_hours, engine)
     columns["tracker_break_even_standby_w"] = list(standby.reshape(len(batch), -1))
     order = ["site_id", "site_name", "latitude", "longitude", "weather", "flat_peak_w", "p_load_w", "p_load_fraction",
-             "period", "days", "fold_angle_deg", *ROW_VALUES, "gain_vs_flat_pct", "energy_gain_vs_flat_pct",
+             "period", "days", "fold_angle_deg", "surface_tilt", "flat_surface_tilt", *ROW_VALUES, "gain_vs_flat_pct",
+             "energy_gain_vs_flat_pct",
              "pct_of_tracker", "tracker_break_even_standby_w"]
     return pd.DataFrame({name: np.concatenate(columns[name]) for name in order})
+
+
+def searched_tilt(study: dict) -> tuple | None:
+    """The base tilt's ``(min, max, step)`` [deg] a map's study searches with the fold angle
+    (``foldopt map --optimize tilt``), or None where the panel keeps the site's tilt."""
+    optimize = study.get("optimize")
+    if optimize is None or "tilt" not in vary_names(optimize.get("vary", list(names.OPTIMIZE_VARIABLES))):
+        return None
+    bounds = optimize.get("tilt")
+    return (bounds["min"], bounds["max"], bounds["step"]) if bounds else DEFAULT_TILT
+
+
+def _tilt_axis(search) -> Axis | None:
+    """The base tilt's range a map's ``optimize`` section searches, or None (the site's tilt)."""
+    if "tilt" not in search.vary:
+        return None
+    bounds = search.tilt
+    lo, hi, step = (bounds.min, bounds.max, bounds.step) if bounds is not None else DEFAULT_TILT
+    return Axis("tilt", lo, hi, step)
 
 
 #: The values of a map's row from the designs (in the order of its table).
@@ -389,40 +414,63 @@ ROW_VALUES = ("objective_flat_h", "objective_twofold_h", "objective_tracker_h", 
               "near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg", "near_optimal_tolerance_h")
 
 
-def _site_rows(days_of, months, statistic: str, seasons, usable, study) -> dict:
-    """One site's columns, per period and load (periods slowest), from its :class:`DailyDesigns`."""
-    angles, hours, harvest = days_of.angles, days_of.twofold_h, days_of.twofold_wh
-    n_periods, n_loads = len(seasons), usable.size
-    member = np.stack([np.isin(months, season) if season else np.ones(months.size, bool) for season in seasons])
-    objective = period_values(hours, months, statistic, seasons)  # (periods, loads, angles)
-    best = best_angle_index(objective)  # (periods, loads)
+def _chosen(hours, energy, months, statistic: str, seasons, member):
+    """Each period's and load's best of some designs, and the objective, the mean daily t_solar and
+    the harvested energy there: ``hours`` (days, loads, n), ``energy`` (days, n) -> ``best``,
+    ``objective``, ``mean_h`` and ``energy_wh``, each (periods, loads); also every design's
+    objective, (periods, loads, n)."""
+    n_loads = hours.shape[1]
+    every = period_values(hours, months, statistic, seasons)  # (periods, loads, n)
+    best = best_angle_index(every)  # (periods, loads); ties to the last (the least folded, the steepest)
     at_best = hours[:, np.arange(n_loads)[None, :], best]  # (days, periods, loads)
-    daily = np.stack([days_of.flat_h, days_of.tracker_h, days_of.tracker_net_h], axis=1)  # (days, 3, loads)
-    designs = period_values(daily, months, statistic, seasons)  # (periods, 3, loads)
-    means = period_values(daily, months, "mean", seasons)
-    twofold = np.stack([objective_value(at_best[:, period], months, statistic, season)
-                        for period, season in enumerate(seasons)])  # (periods, loads)
-    twofold_mean = np.stack([at_best[days, period].mean(axis=0) for period, days in enumerate(member)])
-    energy = np.stack([np.stack([days_of.flat_wh, days_of.tracker_wh], axis=1)[days].sum(axis=0)
-                       for days in member])  # (periods, 2)
-    ranges = near_optimal_on_grid(angles, objective.reshape(-1, angles.size), study.near_optimal,
-                                  np.asarray(study.fold_angles.grid()))
+    objective = np.stack([objective_value(at_best[:, period], months, statistic, season)
+                          for period, season in enumerate(seasons)])
+    mean_h = np.stack([at_best[days, period].mean(axis=0) for period, days in enumerate(member)])
+    energy_wh = np.stack([energy[days][:, best[period]].sum(axis=0) for period, days in enumerate(member)])
+    return best, objective, mean_h, energy_wh, every
+
+
+def _site_rows(days_of, months, statistic: str, seasons, usable, study, site_tilt: float) -> dict:
+    """One site's columns, per period and load (periods slowest), from its :class:`DailyDesigns`."""
+    angles = days_of.angles
+    n_loads = usable.size
+    member = np.stack([np.isin(months, season) if season else np.ones(months.size, bool) for season in seasons])
+    best, twofold, twofold_mean, twofold_wh, objective = _chosen(days_of.twofold_h, days_of.twofold_wh, months,
+                                                                statistic, seasons, member)
+    # The flat panel at the site's mounting, or at each period's and load's own best tilt.
+    flat_hours, flat_energy, flat_tilts = days_of.flat_h[..., None], days_of.flat_wh[:, None], np.array([site_tilt])
+    if days_of.flat_tilted is not None:
+        flat_tilts, flat_hours, flat_energy = days_of.flat_tilted
+    flat_best, flat, flat_mean, flat_wh, _ = _chosen(flat_hours, flat_energy, months, statistic, seasons, member)
+    trackers = np.stack([days_of.tracker_h, days_of.tracker_net_h], axis=1)  # (days, 2, loads)
+    tracker, tracker_mean = (period_values(trackers, months, kind, seasons) for kind in (statistic, "mean"))
+    tracker_wh = np.stack([days_of.tracker_wh[days].sum() for days in member])
+    # The fold angle's near-optimal range: over the tilts too (the best of them at each angle) where searched.
+    fold_angles, profile = angles, objective.reshape(-1, angles.size)
+    if days_of.tilts is not None:
+        fold_angles, column = np.unique(angles, return_inverse=True)
+        profile = np.full((profile.shape[0], fold_angles.size), -np.inf)
+        np.maximum.at(profile, (slice(None), column.ravel()), objective.reshape(-1, angles.size))
+    ranges = near_optimal_on_grid(fold_angles, profile, study.near_optimal, np.asarray(study.fold_angles.grid()))
+    carried = np.isfinite(usable)
     rows = {
         "period": np.repeat(np.array(PERIODS, dtype=object), n_loads),
         "days": np.repeat(member.sum(axis=1), n_loads),
-        "fold_angle_deg": np.where(np.isfinite(usable), angles[best], np.nan).ravel(),
-        "objective_flat_h": designs[:, 0].ravel(),
+        "fold_angle_deg": np.where(carried, angles[best], np.nan).ravel(),
+        "surface_tilt": np.where(carried, days_of.tilts[best] if days_of.tilts is not None
+                                 else np.full(best.shape, site_tilt), np.nan).ravel(),
+        "flat_surface_tilt": np.where(carried, flat_tilts[flat_best], np.nan).ravel(),
+        "objective_flat_h": flat.ravel(),
         "objective_twofold_h": twofold.ravel(),
-        "objective_tracker_h": designs[:, 1].ravel(),
-        "objective_tracker_net_h": designs[:, 2].ravel(),
-        "mean_t_solar_flat_h": means[:, 0].ravel(),
+        "objective_tracker_h": tracker[:, 0].ravel(),
+        "objective_tracker_net_h": tracker[:, 1].ravel(),
+        "mean_t_solar_flat_h": flat_mean.ravel(),
         "mean_t_solar_twofold_h": twofold_mean.ravel(),
-        "mean_t_solar_tracker_h": means[:, 1].ravel(),
-        "mean_t_solar_tracker_net_h": means[:, 2].ravel(),
-        "energy_harvested_flat_wh": np.repeat(energy[:, 0], n_loads),
-        "energy_harvested_twofold_wh": np.stack([harvest[member[period]][:, best[period]].sum(axis=0)
-                                                 for period in range(n_periods)]).ravel(),
-        "energy_harvested_tracker_wh": np.repeat(energy[:, 1], n_loads),
+        "mean_t_solar_tracker_h": tracker_mean[:, 0].ravel(),
+        "mean_t_solar_tracker_net_h": tracker_mean[:, 1].ravel(),
+        "energy_harvested_flat_wh": flat_wh.ravel(),
+        "energy_harvested_twofold_wh": twofold_wh.ravel(),
+        "energy_harvested_tracker_wh": np.repeat(tracker_wh, n_loads),
         **ranges,
     }
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -130,9 +130,16 @@ MAPS = (
      "near-optimal range, hi - lo [deg]", False),
 )
 
-#: A map's folder holds every one.
+#: The world maps a map that searches the base tilt adds (``foldopt map --optimize tilt``).
+TILT_MAPS = (
+    ("map_surface_tilt.png", "surface_tilt", "twofold panel's best base tilt", "base tilt [deg]", False),
+)
+
+#: A map's folder holds every one (the tilt's where the map searched it).
 FIGURES = {
     **{file: FigureFile(plot_world_map, f"world map of the {description}") for file, _, description, _, _ in MAPS},
+    **{file: FigureFile(plot_world_map, f"world map of the {description} (map --optimize tilt)")
+       for file, _, description, _, _ in TILT_MAPS},
     "latitude_load_gain.png": FigureFile(plot_latitude_load, "median gain over flat by latitude and load (share of "
                                                              "the flat peak)"),
 }
