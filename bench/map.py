@@ -3,7 +3,8 @@
     python bench/map.py                  # 2,000 sites, printed
     python bench/map.py --write          # ... and written to results/bench/map.md and map.json
     python bench/map.py --sites 200      # a quicker look
-    python bench/map.py --phases         # a site's cost by phase (profiled)
+    python bench/map.py --phases         # a site's cost by phase, one core (W4's sites: every angle)
+    python bench/map.py --w5 --phases    # ... W5's: land sites, fold angles searched; 100 workers' time
     python bench/map.py --w5 --sites 400 # W5 on 400 of the 1-degree land grid's sites, extrapolated
     python bench/map.py --w5             # W5: the whole 1-degree land grid (target 600 s)
 
@@ -66,36 +67,75 @@ def _run(spec, workers: int, folder: Path) -> dict:
             "table": result.table}
 
 
-#: The phases of a site's evaluation, by the functions whose cumulative time is each's.
-PHASES = {"sky": ("foldopt/engine/sky.py", "build_sky"), "fold angles": ("foldopt/studies/designs.py", "fold_hours"),
-          "flat": ("foldopt/engine/rows.py", "row_metrics"), "trackers": ("foldopt/studies/designs.py", "sky_tracker_"),
-          "break-even": ("foldopt/studies/worldmap.py", "_break_even_standby")}
+def _phase_timers():
+    """Wrap the functions a site's evaluation spends its time in with timers: ``{phase: seconds}``
+    accumulating while they run, and a function that unwraps them. Each phase is the wall time of
+    its functions' calls (nested calls are counted once, in the outer)."""
+    import functools
+
+    from foldopt.engine import kernel
+    from foldopt.studies import blocks, designs, worldmap
+
+    spent: dict[str, float] = {}
+    wrapped = [(blocks.Blocks, "sky", "sky"), (kernel, "fold_rows", "kernel: twofold and flat"),
+               (designs, "sky_tracker_orientation", "trackers"), (designs, "sky_tracker_power", "trackers"),
+               (designs, "sky_tracker_draw", "trackers"), (worldmap, "break_even_standby", "break-even")]
+    originals = [(owner, name, getattr(owner, name)) for owner, name, _ in wrapped]
+
+    def timed(phase, function):
+        @functools.wraps(function)
+        def wrapper(*args, **kwargs):
+            started = time.perf_counter()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                spent[phase] = spent.get(phase, 0.0) + time.perf_counter() - started
+        return wrapper
+
+    for owner, name, phase in wrapped:
+        setattr(owner, name, timed(phase, getattr(owner, name)))
+    return spent, lambda: [setattr(owner, name, function) for owner, name, function in originals]
 
 
-def phases(spec, n_sites: int = 20) -> dict:
-    """Seconds per site of each phase on one core, from a profile of ``n_sites`` sites of the spec
-    (the first site first, unprofiled, so that compiling and the tables' cache are not counted).
-    ``flat`` is every kernel call but the fold angles' (the flat panel's peak and its year)."""
-    import cProfile
-    import pstats
+def phases(study: dict, sites: list, loads, relative: bool, year: int = 2025, repeats: int = 3) -> dict:
+    """Seconds per site of each phase on one core (numba on one thread): ``sites[0]`` first, untimed,
+    so that compiling and the tables' caches are not counted, then the rest, the minimum of
+    ``repeats`` runs of each phase and of the whole."""
+    import numba
 
     from foldopt.studies.worldmap import evaluate_sites
 
-    sites = list(spec.sites[:n_sites + 1])
-    evaluate_sites(spec.study, sites[:1], spec.loads, spec.relative, spec.year)
-    profile = cProfile.Profile()
-    started = time.perf_counter()
-    profile.runcall(evaluate_sites, spec.study, sites[1:], spec.loads, spec.relative, spec.year)
-    total = (time.perf_counter() - started) / n_sites
-    stats = pstats.Stats(profile).stats
-    seconds = {}
-    for phase, (file, function) in PHASES.items():
-        seconds[phase] = sum(entry[3] for (path, _, name), entry in stats.items()
-                             if path.endswith(file) and name.startswith(function)) / n_sites
-    seconds["flat"] -= sum(entry[3] for (path, _, name), entry in stats.items()
-                           if path.endswith("foldopt/studies/designs.py") and name == "fold_hours") / n_sites
-    seconds["other"] = total - sum(seconds.values())
-    return {"per_site_s": total, **seconds}
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    spent, restore = _phase_timers()
+    try:
+        evaluate_sites(study, sites[:1], loads, relative, year)
+        best: dict[str, float] = {}
+        for _ in range(repeats):
+            spent.clear()
+            started = time.perf_counter()
+            evaluate_sites(study, sites[1:], loads, relative, year)
+            run = {"per_site_s": time.perf_counter() - started, **spent}
+            best = {phase: min(value, best.get(phase, value)) for phase, value in run.items()}
+    finally:
+        restore()
+        numba.set_num_threads(threads)
+    per_site = {phase: value / (len(sites) - 1) for phase, value in best.items()}
+    per_site["rest"] = per_site["per_site_s"] - sum(v for k, v in per_site.items() if k != "per_site_s")
+    return per_site
+
+
+def _print_phases(cost: dict) -> None:
+    print(f"per site on one core: {cost['per_site_s'] * 1e3:.0f} ms; "
+          + ", ".join(f"{phase} {value * 1e3:.0f} ms" for phase, value in cost.items() if phase != "per_site_s"))
+
+
+def _land_sites(subset: int | None) -> tuple[list, list]:
+    """The 1-degree grid's land sites, and ``subset`` of them spread over it (all of them: None)."""
+    from foldopt.inputs.sites import grid_sites
+
+    land = grid_sites(list(range(-90, 91)), list(range(-180, 180)), land_only=True)
+    return land, land if subset is None else land[::max(1, len(land) // subset)][:subset]
 
 
 W5_TARGET_S = 600.0  # the 1-degree land grid on this machine's embedded cluster
@@ -104,28 +144,30 @@ W5_TARGET_S = 600.0  # the 1-degree land grid on this machine's embedded cluster
 def w5(subset: int | None, check_sites: int = 200) -> None:
     """W5: the 1-degree land grid (a year each, 10 loads, 5 periods, 5-min steps) on the embedded
     cluster of two workers, its fold angles searched (``--fold-search``); ``subset`` sites spread over
-    the grid instead, the whole grid's time extrapolated from them. Then ``check_sites`` of them
-    evaluated again with every fold angle, in this process: each objective within the search's
-    0.01 h of the full sweep's."""
+    the grid instead, the whole grid's time extrapolated from them (the cluster's start counted once).
+    Then ``check_sites`` of them evaluated again with every fold angle, in this process: each
+    objective within the search's 0.01 h of the full sweep's."""
     import pandas as pd
 
     from foldopt.inputs.load import default_study_path, read_study
-    from foldopt.inputs.sites import grid_sites
     from foldopt.studies.cluster import MapSpec, run_map
     from foldopt.studies.worldmap import evaluate_sites, map_study
 
-    land = grid_sites(list(range(-90, 91)), list(range(-180, 180)), land_only=True)
-    sites = land if subset is None else land[::max(1, len(land) // subset)][:subset]
+    land, sites = _land_sites(subset)
     loads = tuple(np.round(np.arange(1, 11) * 0.05, 6))
     full = map_study(read_study(default_study_path())[0])
     searched = {**full, "optimize": {"vary": ["fold_angle"]}}
+    ready = {}
     with tempfile.TemporaryDirectory() as folder:
         started = time.perf_counter()
-        result = run_map(MapSpec(searched, tuple(sites), loads, relative=True), Path(folder) / "w5", workers=2)
+        result = run_map(MapSpec(searched, tuple(sites), loads, relative=True), Path(folder) / "w5", workers=2,
+                         announce=lambda *_: ready.setdefault("at", time.perf_counter()))
         wall = time.perf_counter() - started
-    whole = wall * len(land) / len(sites)
-    print(f"W5: {len(sites):,} of the {len(land):,} land sites in {wall:.1f} s on 2 workers "
-          f"({len(sites) / wall:.2f} sites/s); the whole grid at that pace {whole:.0f} s (target {W5_TARGET_S:.0f} s)")
+    start_up = ready["at"] - started
+    whole = start_up + (wall - start_up) * len(land) / len(sites)
+    print(f"W5: {len(sites):,} of the {len(land):,} land sites in {wall:.1f} s on 2 workers, of which "
+          f"{start_up:.1f} s the cluster's start ({len(sites) / (wall - start_up):.2f} sites/s after it); the "
+          f"whole grid at that pace {whole:.0f} s (target {W5_TARGET_S:.0f} s)")
     chosen = [{**site, "site_id": index} for index, site in enumerate(sites)][::max(1, len(sites) // check_sites)]
     chosen = chosen[:check_sites]
     reference = evaluate_sites(full, chosen, loads, relative=True)
@@ -144,18 +186,29 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sites", type=int, default=2000)
     parser.add_argument("--write", action="store_true", help="write results/bench/map.md and map.json")
-    parser.add_argument("--phases", action="store_true", help="only the per-site cost by phase (20 sites, profiled)")
+    parser.add_argument("--phases", action="store_true", help="only the per-site cost by phase (one core, timed)")
     parser.add_argument("--w5", action="store_true", help="W5: the 1-degree land grid with the fold search "
                                                           "(--sites N: N of its sites, the whole extrapolated)")
     args = parser.parse_args()
+    if args.w5 and args.phases:
+        from foldopt.inputs.load import default_study_path, read_study
+        from foldopt.studies.worldmap import map_study
+
+        land, sites = _land_sites(25)
+        searched = {**map_study(read_study(default_study_path())[0]), "optimize": {"vary": ["fold_angle"]}}
+        cost = phases(searched, sites, tuple(np.round(np.arange(1, 11) * 0.05, 6)), relative=True)
+        print("W5's sites (24 of the 1-degree land grid, fold angles searched): ", end="")
+        _print_phases(cost)
+        per_site = cost["per_site_s"]
+        print(f"the {len(land):,} land sites at that cost: {len(land) * per_site / 3600:.2f} core-hours; "
+              f"on 100 workers {len(land) * per_site / 100:.0f} s of compute plus the cluster's start")
+        return
     if args.w5:
         w5(args.sites if "--sites" in sys.argv else None)
         return
     spec = _spec(args.sites)
     if args.phases:
-        cost = phases(spec)
-        print(f"per site on one core (profiled, so slower than unprofiled): {cost.pop('per_site_s'):.3f} s; "
-              + ", ".join(f"{phase} {value:.3f} s" for phase, value in cost.items()))
+        _print_phases(phases(spec.study, list(spec.sites[:21]), spec.loads, spec.relative, spec.year))
         return
     with tempfile.TemporaryDirectory() as folder:
         runs = [_run(spec, workers, Path(folder)) for workers in (1, 2)]

@@ -25,9 +25,15 @@ corners, so every grid point was either evaluated or lies in a dropped box. ``M_
 in advance: each level estimates it from the second differences at the box's corners on that
 level's lattice (the largest anywhere along the axis where none is evaluated), times ``safety``
 (default 2). The guarantee is as good as that estimate: a peak narrower than the coarse lattice
-can hide between its points. Curvature, not slope, bounds a box, so the steep flanks of the
-objective (t_solar against a small fold angle) are dropped at once and only the broad plateau
-is refined. ``tests/test_search.py`` holds the answer to the brute-force grid on random sites,
+can hide between its points. A kink between lattice points (a corner in the objective, not a bend)
+leaves no trace in the second differences at them, so a box is also kept while the chords beside
+it, extended over it, cross above the best plus the tolerance (:func:`_tent`): a concave objective
+lies below its chords' extensions, so a kinked plateau is bounded too, whatever its curvature (on
+the 1-degree land grid, a site at 65 N whose summer objective peaks at a fold angle of 2 deg,
+between the lattice's 1 and 5 deg, 0.012 h above both, was missed by the curvature alone).
+Curvature, not slope, bounds a box, so the steep flanks of the objective (t_solar against a small
+fold angle) are dropped at once and only the broad plateau is refined.
+``tests/test_search.py`` holds the answer to the brute-force grid on random sites,
 days, loads and objectives.
 
 Every level's points go to ``evaluate`` in one call, so the caller vectorises across the points and
@@ -297,10 +303,12 @@ def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
     corners = _corners(lower, upper)
     top = np.nanmax(store.lookup(corners), axis=1)
     error = np.zeros_like(top)
-    for axis in range(lower.shape[1]):
+    tent = np.full(top.shape, -np.inf)
+    n_axes = lower.shape[1]
+    for axis in range(n_axes):
         if sizes[axis] == 1:
             continue
-        shift = np.zeros(lower.shape[1], dtype=int)
+        shift = np.zeros(n_axes, dtype=int)
         shift[axis] = strides[axis]
         below, here, above = (store.lookup(corners + k * shift) for k in (-1, 0, 1))
         second = np.abs(above - 2.0 * here + below) / (strides[axis] * steps[axis]) ** 2  # (boxes, corners, targets)
@@ -309,7 +317,37 @@ def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
         curvature = np.where(known.any(axis=1), np.nanmax(np.where(known, second, -np.inf), axis=1), largest)
         width = (upper[:, axis] - lower[:, axis]) * steps[axis]
         error += np.maximum(curvature, 0.0) * (width**2 / 8.0)[:, None]
-    return top + safety * error
+        # The box's edges along the axis: each from a corner with the axis's lower end to the one
+        # with its upper end (the corners' order is _corners', the axis's bit 1 << n_axes-1-axis).
+        low = np.flatnonzero((np.arange(corners.shape[1]) >> (n_axes - 1 - axis)) & 1 == 0)
+        high = low + (1 << (n_axes - 1 - axis))
+        tent = np.maximum(tent, _tent(below[:, low], here[:, low], here[:, high], above[:, high],
+                                      (strides[axis] * steps[axis]), width[:, None, None]).max(axis=1))
+    return np.maximum(top + safety * error, tent)
+
+
+def _tent(before, start, end, after, spacing, width):
+    """The largest a concave function can be on an edge from ``start`` to ``end`` (``width`` apart),
+    given its values a lattice ``spacing`` before the start and after the end: the lowest of the two
+    neighbouring chords extended over the edge (a concave function lies below its chords' extensions),
+    one where only one is known, -inf where neither is.
+
+    A peak between two lattice points leaves no trace in the second differences at them, but it does
+    in the chords beside it: the bound holds where the objective is concave near the edge (its
+    plateau, where the search's answer is), whatever its curvature."""
+    rising = (start - before) / spacing  # the chord before the edge, extended forward
+    falling = (after - end) / spacing  # the chord after it, extended backward
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # Where the two extensions cross inside the edge, the bound is their crossing, else an end's.
+        cross = np.clip((end - start - falling * width) / (rising - falling), 0.0, width)
+    cross = np.where(np.isfinite(cross), cross, 0.0)
+    candidates = []
+    for at in (np.zeros_like(cross), cross, np.broadcast_to(width, cross.shape)):
+        forward = start + rising * at
+        backward = end + falling * (at - width)
+        candidates.append(np.fmin(forward, backward))  # fmin: one chord where the other is unknown
+    bound = np.max(candidates, axis=0)
+    return np.where(np.isnan(bound), -np.inf, bound)
 
 
 def _split(lower, upper, strides):
