@@ -70,6 +70,20 @@ def test_a_seed_keeps_the_best_from_falling_below_it():
     assert grid_search(spike, axes, 1e-3, seeds=[[37.0]]).best_value[0] == 1.0
 
 
+def test_a_kinked_peak_between_lattice_points_is_found():
+    """A concave objective with a corner (the shape of a map site's summer objective against the
+    fold angle at 65 N: up 0.012 h from 1 to 2 deg, then down 0.01 h a degree): its second
+    differences on the coarse lattice are small, the chords beside the first box are not."""
+    axes = [Axis("fold_angle", 1, 180, 1)]
+
+    def kinked(points):
+        x = points[:, :1]
+        return np.where(x < 2, -0.012 * (2 - x), -0.01 * (x - 2))
+
+    result = grid_search(kinked, axes, 0.01)
+    assert result.best_value[0] >= 0.0 - 0.01 and result.best_point[0, 0] == 2.0
+
+
 def test_several_targets_each_get_their_own_best():
     axes = [Axis("x", 0, 90, 1)]
 
