@@ -17,7 +17,8 @@ time. So the loops are written once and inlined once per case, each case's setti
 constants (the incidence per mode, diffuse terms and modifier; the ideal model's power per
 connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
 (:func:`_chunk_rows`) whose scratch is taken once. On a map's year (the ideal model, 10 loads)
-a row step costs about 5 ns on one core, against 21 ns before (``bench/map.py --phases``).
+a row step costs about 5 ns on one core, against 21 ns before (the kernel's share of
+``bench/map.py --w5 --phases``).
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.rows` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).

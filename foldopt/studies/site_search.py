@@ -1,7 +1,7 @@
 """A map site's fold angles, searched: its best angle for every period and load from a small share
 of the grid's angles.
 
-:class:`FoldSearch` asks for fold angles and is told their daily t_solar; a map runs one per site
+:class:`DesignSearch` asks for designs and is told their daily t_solar; a map runs one per site
 and evaluates what all the sites of a batch ask for in one pass of the engine (:func:`search_sites`),
 so that a call's cost is shared by many sites and the kernel sees many rows at once.
 
