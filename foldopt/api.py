@@ -108,7 +108,7 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
     return run_study(with_files(study), engine, request)
 
 
-def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, engine: str = "numba",
+def sweep(study: Study | Plan, over: str | None = None, *, axes: dict | None = None, engine: str = "numba",
           progress: Callable[[float, int], None] | None = None, **fields):
     """Evaluate a study at every combination of the values of some fields, as ``foldopt sweep`` does.
 
@@ -120,7 +120,8 @@ def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, en
 
     Parameters
     ----------
-    study : Study
+    study : Study or Plan
+        A study, or a study file's plan (:func:`load_study`), whose lists the fields given replace.
     over : {'angle', 'latitude', 'day', 'load'}, optional
         A sweep's own axis, over its default range where ``fields`` leave it out (latitude
         -60:60:5, day 1:365:7, 20 loads up to the panel's rating); ``angle`` is one case.
@@ -162,14 +163,14 @@ def sweep(study: Study, over: str | None = None, *, axes: dict | None = None, en
     changes.update({path: _plain_values(values) for path, values in (axes or {}).items()})
     if not changes and over is None:
         raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
-    request = plan_request(study.data(), changes, axis=over)
+    request = plan_request(_study_data(study), changes, axis=over)
     from foldopt.studies.sweeps import run_plan
 
     return run_plan(request.plan, progress, engine, request)
 
 
-def optimize(study: Study, vary=None, *, fold_angle=None, tilt=None, azimuth=None, tolerance_h: float | None = None,
-             engine: str = "numba", **fields):
+def optimize(study: Study | Plan, vary=None, *, fold_angle=None, tilt=None, azimuth=None,
+             tolerance_h: float | None = None, engine: str = "numba", **fields):
     """The best fold angle, base tilt and base azimuth together, as ``foldopt optimize`` finds them
     (:func:`foldopt.studies.joint.optimize_plan`), with the flat panel's own best tilt and azimuth,
     the default mounting and the tracker.
@@ -179,7 +180,8 @@ def optimize(study: Study, vary=None, *, fold_angle=None, tilt=None, azimuth=Non
 
     Parameters
     ----------
-    study : Study
+    study : Study or Plan
+        A study, or a study file's plan (:func:`load_study`: its days and loads are the search's).
     vary : str or sequence of str, optional
         Of ``fold_angle``, ``tilt``, ``azimuth`` [default: all three, or the study's ``optimize.vary``].
     fold_angle, tilt, azimuth : str or sequence of float, optional
@@ -216,10 +218,16 @@ def optimize(study: Study, vary=None, *, fold_angle=None, tilt=None, azimuth=Non
 
     section = optimize_section(vary, fold_angle, tilt, azimuth, tolerance_h)
     changes = {KEYWORDS.get(name, name): _plain_values(values) for name, values in fields.items()}
-    data = study.data()
+    data = _study_data(study)
     changes["optimize"] = {**(data.get("optimize") or {}), **section}
     request = plan_request(data, changes)
     return optimize_plan(request.plan, engine, request)
+
+
+def _study_data(study: Study | Plan) -> dict:
+    """A study's fields as a study file holds them; a plan's (a file that sweeps, a year of dates)
+    with its lists."""
+    return study.data if isinstance(study, Plan) else study.data()
 
 
 def _plain_values(values):

@@ -117,3 +117,20 @@ def test_a_study_built_in_python_has_its_files_read_by_the_api():
     far = foldopt.Study(**fields, site={"latitude": 0.0, "longitude": 0.0})
     with pytest.raises(foldopt.ConfigError, match="km from the weather file's site GREENSBORO"):
         foldopt.run(far)
+
+
+def test_a_study_files_plan_is_swept_and_optimised_as_its_study(tmp_path):
+    """load_study gives a Plan for a file with a range of days: sweep and optimize take it as run
+    does (they raised a TypeError), its days the search's, and give run's numbers."""
+    text = ("name: days\nmode: exact\nsite: {latitude: 34.05, longitude: -118.25, timezone: America/Los_Angeles}\n"
+            "date: \"170:172:1\"\np_load: 2.0\npanel: {area: 0.108}\nstep_min: 30\n"
+            "fold_angles: {start: 30, stop: 180, step: 30}\n")
+    (tmp_path / "days.yaml").write_text(text)
+    (tmp_path / "days-optimize.yaml").write_text(text + "optimize: {vary: [fold_angle]}\n")
+    plan = foldopt.load_study(tmp_path / "days.yaml")
+    assert isinstance(plan, foldopt.Plan)
+    swept = foldopt.sweep(plan, p_load=[2.0, 4.0]).table
+    assert swept["day_of_year"].nunique() == 3 and swept["p_load_w"].nunique() == 2
+    searched = foldopt.optimize(plan, vary="fold_angle").table.set_index("design")
+    ran = foldopt.run(tmp_path / "days-optimize.yaml").table.set_index("design")
+    pd.testing.assert_series_equal(searched.loc["twofold"], ran.loc["twofold"])
