@@ -29,7 +29,7 @@ from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.engine.metrics import energy, per_load, t_solar, t_solar_contiguous
 from foldopt.names import ENGINES
 from foldopt.engine.built import PARTS, assemble
-from foldopt.engine.sky import Sky
+from foldopt.engine.sky import Sky, step_span
 from foldopt.engine.views import row_views, surface_views
 # The cells' electrical model is part of the engine's API (engines.electrical_for, panel_power...).
 from foldopt.engine.cells import (TEMPERATURE_NODE_STEP, electrical_for, node_weights, panel_power,  # noqa: F401
@@ -427,12 +427,7 @@ def power_span(power) -> np.ndarray:
     power : numpy.ndarray
         (n_rows, n_steps) [W].
     """
-    some = power != 0.0
-    n_steps = power.shape[1]
-    first = np.argmax(some, axis=1)
-    last = n_steps - 1 - np.argmax(some[:, ::-1], axis=1)
-    return np.ascontiguousarray(np.where(some.any(axis=1)[:, None],
-                                         np.stack([np.maximum(first - 1, 0), np.minimum(last + 1, n_steps - 1)], 1), 0))
+    return step_span(power != 0.0)
 
 
 def _shape_arguments(load_shape):

@@ -32,9 +32,8 @@ lies below its chords' extensions, so a kinked plateau is bounded too, whatever 
 the 1-degree land grid, a site at 65 N whose summer objective peaks at a fold angle of 2 deg,
 between the lattice's 1 and 5 deg, 0.012 h above both, was missed by the curvature alone).
 Curvature, not slope, bounds a box, so the steep flanks of the objective (t_solar against a small
-fold angle) are dropped at once and only the broad plateau is refined.
-``tests/test_search.py`` holds the answer to the brute-force grid on random sites,
-days, loads and objectives.
+fold angle) are dropped at once and only the broad plateau is refined. ``tests/test_search.py``
+holds the answer to the brute-force grid on random sites, days, loads and objectives.
 
 Every level's points go to ``evaluate`` in one call, so the caller vectorises across the points and
 its own targets (loads, objectives): the search keeps the union of the cells any target keeps.
@@ -194,7 +193,7 @@ class GridSearch:
         self.steps = np.array([axis.step for axis in self.axes])
         self.strides = np.array([1 << max(0, int(math.floor(math.log2(max(1.0, (n - 1) / (coarse_points - 1))))))
                                  for n in self.sizes])
-        self.store = _Store(self.axes, self.sizes)
+        self.store = _Store(self.sizes)
         # The coarse lattice, each axis's last grid point included so the bounds are evaluated.
         lattice = [np.union1d(np.arange(0, n, s), [n - 1]) for n, s in zip(self.sizes, self.strides, strict=True)]
         first = np.stack(np.meshgrid(*lattice, indexing="ij"), axis=-1).reshape(-1, len(self.axes))
@@ -247,15 +246,11 @@ class GridSearch:
 class _Store:
     """The evaluated points by grid index, looked up by their flat key."""
 
-    def __init__(self, axes, sizes):
-        self.axes, self.sizes = axes, sizes
-        self.index = np.zeros((0, len(axes)), dtype=int)
+    def __init__(self, sizes):
+        self.sizes = sizes
+        self.index = np.zeros((0, len(sizes)), dtype=int)
         self.values = None
         self.keys = np.zeros(0, dtype=np.int64)
-
-    @property
-    def count(self) -> int:
-        return int(self.index.shape[0])
 
     def missing(self, index):
         """The points of ``index`` not evaluated yet, once each."""
@@ -322,7 +317,7 @@ def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
         low = np.flatnonzero((np.arange(corners.shape[1]) >> (n_axes - 1 - axis)) & 1 == 0)
         high = low + (1 << (n_axes - 1 - axis))
         tent = np.maximum(tent, _tent(below[:, low], here[:, low], here[:, high], above[:, high],
-                                      (strides[axis] * steps[axis]), width[:, None, None]).max(axis=1))
+                                      strides[axis] * steps[axis], width[:, None, None]).max(axis=1))
     return np.maximum(top + safety * error, tent)
 
 

@@ -34,6 +34,23 @@ from foldopt.inputs.weather.ensemble import cloud_members
 from foldopt.physics.temperature import equivalent_temp_air
 
 
+def step_span(some) -> np.ndarray:
+    """(n_rows, 2) each row's first and last true step, widened by one step either side within the
+    row ((0, 0) for a row with none): the steps the engine walks (light, or power, and the dark step
+    that ends it on each side).
+
+    Parameters
+    ----------
+    some : numpy.ndarray of bool
+        (n_rows, n_steps).
+    """
+    n_steps = some.shape[1]
+    first = np.argmax(some, axis=1)
+    last = n_steps - 1 - np.argmax(some[:, ::-1], axis=1)
+    return np.ascontiguousarray(np.where(some.any(axis=1)[:, None],
+                                         np.stack([np.maximum(first - 1, 0), np.minimum(last + 1, n_steps - 1)], 1), 0))
+
+
 @dataclass(frozen=True)
 class Sky:
     """Sun and light per block (a day at a site) and time step; arrays are (n_blocks, n_steps).
@@ -134,13 +151,8 @@ class Sky:
         (n_blocks, 2), its first and last step with light and one dark step either side."""
         terms = (np.ascontiguousarray(np.moveaxis(self.terms, -1, 1)) if self.terms is not None
                  else np.zeros((self.n_blocks, 0, 1)))
-        steps = np.arange(self.lit.shape[1])
-        first_lit = np.where(self.lit, steps, self.lit.shape[1]).min(axis=1)
-        last_lit = np.where(self.lit, steps, -1).max(axis=1)
-        span = np.where((first_lit <= last_lit)[:, None],
-                        np.stack([np.maximum(first_lit - 1, 0), np.minimum(last_lit + 1, steps[-1])], axis=1), 0)
         return (np.ascontiguousarray(np.moveaxis(self.sun_vector, -1, 1)), np.ascontiguousarray(self.dni), terms,
-                np.ascontiguousarray(span))
+                step_span(self.lit))
 
     def kernel_layout(self, paper: bool) -> tuple:
         """``sun, paper_sun, beam, terms, span``: the sky as :func:`foldopt.engine.kernel.fold_rows`
