@@ -84,21 +84,6 @@ def test_the_range_on_a_grid_is_the_plain_range_where_every_angle_is_known(value
         assert got[name][0] == (value if carried else pytest.approx(np.nan, nan_ok=True))
 
 
-def test_the_cubic_between_evaluated_angles_is_scipys_pchip():
-    """The edges between evaluated angles are placed on the monotone cubic of Fritsch and Carlson,
-    whose slopes are SciPy's PchipInterpolator's (its end rule too) on random points."""
-    from scipy.interpolate import PchipInterpolator
-
-    from foldopt.studies.objectives import _pchip_slopes
-
-    rng = np.random.default_rng(4)
-    for size in (2, 3, 7, 30):
-        x = np.sort(rng.choice(np.arange(1.0, 181.0), size, replace=False))
-        y = rng.normal(size=(5, size)).cumsum(axis=1)
-        expected = np.stack([PchipInterpolator(x, row).derivative()(x) for row in y])
-        np.testing.assert_allclose(_pchip_slopes(x, y), expected, rtol=1e-12, atol=1e-12)
-
-
 def test_an_edge_between_evaluated_angles_is_where_the_cubic_meets_the_threshold():
     """A plateau known at a few angles: the range's edges are the last grid angles inside where
     SciPy's pchip through the known values stays above the best less the tolerance."""

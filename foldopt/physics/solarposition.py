@@ -341,8 +341,8 @@ def solar_position_grid(grid: ClockGrid, latitude, longitude, altitude=0.0, mode
     -------
     dict of numpy.ndarray
         ``solar_zenith``, ``solar_azimuth`` and the equatorial coordinates ``hour_angle`` and
-        ``declination`` that trackers steer by [deg], each (n_blocks, n_steps), and
-        ``sun_vector``, (n_blocks, n_steps, 3) the unit vector toward the sun (east, north, up). In exact mode the
+        ``declination`` that trackers steer by [deg], each (n_blocks, n_steps), and ``sun_vector``,
+        (n_blocks, n_steps, 3) the unit vector toward the sun (east, north, up). In exact mode the
         hour angle is pvlib's formula ``15 (UTC hours - 12) + longitude + EoT / 4`` with SPA's
         equation of time, worked out from UTC (so DST days need no care), and the declination
         pvlib's ``declination_spencer71``.

@@ -380,7 +380,7 @@ TURN_TOLERANCE_S = 1e-12
 
 
 def _time_to_turn(angle, speed, tau_1, tau_2):
-    """Time [s] to turn ``angle`` [deg] from rest, by Newton's method on the angle turned by ``t``
+    """Time [s] to turn each ``angle`` [deg] of a 1-D array from rest, by Newton's method on the angle turned by ``t``
     [s] after a voltage step, for the two-pole speed response,
     ``speed (t - (tau_1^2 (1 - exp(-t / tau_1)) - tau_2^2 (1 - exp(-t / tau_2))) / (tau_1 - tau_2))``.
 

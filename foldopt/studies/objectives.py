@@ -3,12 +3,13 @@ a statistic of daily t_solar over the days of a study (:func:`objective_value`, 
 the plateau of near-optimal angles around the best (:func:`near_optimal`), and over a cloud
 ensemble, the members' spread and how sure the choice is (:func:`ensemble_choice`).
 
-The module may import numpy and :mod:`foldopt.inputs.sections`.
+The module may import numpy, scipy and :mod:`foldopt.inputs.sections`.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
 from foldopt.inputs.sections import NearOptimal
 
@@ -150,43 +151,11 @@ def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
     }
 
 
-def _pchip_slopes(x, y):
-    """The slopes of the monotone piecewise-cubic Hermite interpolant through ``(x, y)`` at ``x``
-    (Fritsch & Carlson [1]_ as SciPy's ``PchipInterpolator`` takes them, its end rule too), for
-    each row of ``y`` (..., n); ``x`` (n,) ascending, n >= 2.
-
-    References
-    ----------
-    .. [1] F. N. Fritsch, R. E. Carlson, "Monotone piecewise cubic interpolation", SIAM Journal on
-       Numerical Analysis 17(2), 238-246, 1980.
-    """
-    h = np.diff(x)
-    delta = np.diff(y, axis=-1) / h
-    slopes = np.zeros(y.shape)
-    if x.size == 2:
-        slopes[...] = delta
-        return slopes
-    w1, w2 = 2.0 * h[1:] + h[:-1], h[1:] + 2.0 * h[:-1]
-    left, right = delta[..., :-1], delta[..., 1:]
-    same = (np.sign(left) * np.sign(right) > 0)
-    # a slope of a few ulp overflows w / slope; the harmonic mean then goes to 0, as it should
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        harmonic = (w1 + w2) / (w1 / left + w2 / right)
-    slopes[..., 1:-1] = np.where(same, harmonic, 0.0)
-    for end, (h0, h1, d0, d1) in ((0, (h[0], h[1], delta[..., 0], delta[..., 1])),
-                                  (-1, (h[-1], h[-2], delta[..., -1], delta[..., -2]))):
-        slope = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1)
-        slope = np.where(np.sign(slope) != np.sign(d0), 0.0, slope)
-        slope = np.where((np.sign(d0) != np.sign(d1)) & (np.abs(slope) > 3.0 * np.abs(d0)), 3.0 * d0, slope)
-        slopes[..., end] = slope
-    return slopes
-
-
 def near_optimal_on_grid(angles, values, tolerance: NearOptimal, grid) -> dict:
     """:func:`near_optimal` on a grid of fold angles from values at some of them (a search's): each
     edge lies between the evaluated angle inside the range and the one outside, at the last grid
-    angle before the monotone cubic through the values [1]_ (:func:`_pchip_slopes`) falls below the
-    threshold (the best less the tolerance); the recommended angle is the grid angle nearest the
+    angle before the monotone cubic through the values [1]_ (SciPy's ``PchipInterpolator``) falls
+    below the threshold (the best less the tolerance); the recommended angle is the grid angle nearest the
     range's centre (ties to the less folded). Where every grid angle is evaluated, it is
     :func:`near_optimal`.
 
@@ -217,7 +186,9 @@ def near_optimal_on_grid(angles, values, tolerance: NearOptimal, grid) -> dict:
     best = best_angle_index(values)
     top = np.take_along_axis(values, best[:, None], axis=-1)[:, 0]
     line = top - tolerance.tolerance_h(top)
-    slopes = _pchip_slopes(angles, values)
+    # A slope of a few ulp overflows in the harmonic mean of the slopes; it then goes to 0, as it should.
+    with np.errstate(over="ignore"):
+        cubic_at = PchipInterpolator(angles, values, axis=-1)(grid)  # (targets, grid)
     edges = {"near_optimal_lo_deg": -1, "near_optimal_hi_deg": 1}
     for name, outward in edges.items():
         edge = ranges[name].copy()
@@ -228,11 +199,8 @@ def near_optimal_on_grid(angles, values, tolerance: NearOptimal, grid) -> dict:
                 continue
             a, b = sorted((inner, outer))
             # The grid angles of the gap, from the inner end outward, and the cubic there.
-            inside = grid[(grid > angles[a]) & (grid < angles[b])][::outward]
-            h = angles[b] - angles[a]
-            t = (inside - angles[a]) / h
-            cubic = ((2 * t**3 - 3 * t**2 + 1) * values[target, a] + (t**3 - 2 * t**2 + t) * h * slopes[target, a]
-                     + (-2 * t**3 + 3 * t**2) * values[target, b] + (t**3 - t**2) * h * slopes[target, b])
+            gap = (grid > angles[a]) & (grid < angles[b])
+            inside, cubic = grid[gap][::outward], cubic_at[target, gap][::outward]
             kept = np.cumprod(cubic >= line[target]).astype(bool)
             if kept.any():
                 edge[target] = inside[kept][-1]
