@@ -119,6 +119,18 @@ class Optimize(StrictModel):
             raise ValueError(f"{bounds.describe()}: min and max must be in [0, 90] deg")
         return bounds
 
+    def range_of(self, name: str, default: tuple) -> tuple:
+        """A variable's ``(min, max, step)`` [deg]: its bounds, or ``default`` where none are set.
+
+        Parameters
+        ----------
+        name : str
+            One of :data:`foldopt.names.OPTIMIZE_VARIABLES`.
+        default : tuple of float
+        """
+        bounds = getattr(self, name)
+        return (bounds.min, bounds.max, bounds.step) if bounds is not None else default
+
     def idle_settings(self) -> list[str]:
         """``optimize.name = ...: why`` for the bounds of a variable that does not vary."""
         return [f"optimize.{name} = {getattr(self, name).describe()}: is only used where optimize.vary names "

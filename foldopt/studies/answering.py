@@ -488,7 +488,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         "year": str(spec.year),
         "panel": f"{study['panel']['area']:g} m^2 facing the equator at " + (
             "|latitude|" if tilts is None else
-            f"each site's best base tilt, {tilts[0]:g} to {tilts[1]:g} by {tilts[2]:g} deg (the flat panel's own)"),
+            f"each site's best base tilt, {tilts.lo:g} to {tilts.hi:g} by {tilts.step:g} deg (the flat panel's own)"),
         "objective": part["objective"],
         "models": f"{study.get('mode')} mode, {study.get('pv_model', 'ideal')} PV model, {sky}",
     }

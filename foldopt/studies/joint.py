@@ -103,8 +103,7 @@ def _axes(study: Study, vary, fold_angle: float = 180.0) -> dict[str, Axis]:
     fixed = {"fold_angle": fold_angle, "tilt": study.panel.tilt, "azimuth": study.panel.azimuth}
     axes = {}
     for name in names.OPTIMIZE_VARIABLES:
-        bounds = getattr(spec, name)
-        lo, hi, step = (bounds.min, bounds.max, bounds.step) if bounds is not None else defaults[name]
+        lo, hi, step = spec.range_of(name, defaults[name])
         axes[name] = Axis(name, lo, hi, step) if name in vary else Axis(name, fixed[name], fixed[name], 1.0)
     return axes
 

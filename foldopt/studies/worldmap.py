@@ -33,7 +33,7 @@ from foldopt import names
 from foldopt.engine import rows as engines
 from foldopt.inputs.load import resolve_files
 from foldopt.engine.search import Axis
-from foldopt.inputs.optimize_section import DEFAULT_TILT, vary_names
+from foldopt.inputs.optimize_section import DEFAULT_TILT, Optimize, vary_names
 from foldopt.inputs.plan import parse_dates, parse_values, year_problem
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, format_errors
@@ -388,23 +388,16 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     return pd.DataFrame({name: np.concatenate(columns[name]) for name in order})
 
 
-def searched_tilt(study: dict) -> tuple | None:
-    """The base tilt's ``(min, max, step)`` [deg] a map's study searches with the fold angle
-    (``foldopt map --optimize tilt``), or None where the panel keeps the site's tilt."""
+def searched_tilt(study: dict) -> Axis | None:
+    """The base tilt's range [deg] a map's study searches with the fold angle (``foldopt map
+    --optimize tilt``), or None where the panel keeps the site's tilt."""
     optimize = study.get("optimize")
-    if optimize is None or "tilt" not in vary_names(optimize.get("vary", list(names.OPTIMIZE_VARIABLES))):
-        return None
-    bounds = optimize.get("tilt")
-    return (bounds["min"], bounds["max"], bounds["step"]) if bounds else DEFAULT_TILT
+    return None if optimize is None else _tilt_axis(Optimize.model_validate(optimize))
 
 
-def _tilt_axis(search) -> Axis | None:
+def _tilt_axis(search: Optimize) -> Axis | None:
     """The base tilt's range a map's ``optimize`` section searches, or None (the site's tilt)."""
-    if "tilt" not in search.vary:
-        return None
-    bounds = search.tilt
-    lo, hi, step = (bounds.min, bounds.max, bounds.step) if bounds is not None else DEFAULT_TILT
-    return Axis("tilt", lo, hi, step)
+    return Axis("tilt", *search.range_of("tilt", DEFAULT_TILT)) if "tilt" in search.vary else None
 
 
 #: The values of a map's row from the designs (in the order of its table).
