@@ -35,15 +35,9 @@ from foldopt.physics.temperature import equivalent_temp_air
 
 
 def step_span(some) -> np.ndarray:
-    """(n_rows, 2) each row's first and last true step, widened by one step either side within the
-    row ((0, 0) for a row with none): the steps the engine walks (light, or power, and the dark step
-    that ends it on each side).
-
-    Parameters
-    ----------
-    some : numpy.ndarray of bool
-        (n_rows, n_steps).
-    """
+    """(n_rows, 2) the first and last true step of each row of ``some``, (n_rows, n_steps) bool,
+    widened by one step either side within the row ((0, 0) for a row with none): the steps the
+    engine walks (light, or power, and the dark step that ends it on each side)."""
     n_steps = some.shape[1]
     first = np.argmax(some, axis=1)
     last = n_steps - 1 - np.argmax(some[:, ::-1], axis=1)
