@@ -34,7 +34,8 @@ from foldopt.inputs.optimize_section import DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUT
 from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
-from foldopt.studies.objectives import best_angle_index, near_optimal, objective_quantum, objective_value
+from foldopt.studies.objectives import (best_angle_index, near_optimal, objective_quantum, objective_value,
+                                       season_days)
 
 #: Points of the landscape's grid along the fold angle and the tilt.
 LANDSCAPE_POINTS = (46, 31)
@@ -145,7 +146,7 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     study = blocks.study
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
     months = np.array([date.month for date in dates])
-    counted = months[np.isin(months, season)] if season else months  # the days the objective takes
+    counted = months[season_days(months, season)]  # the days the objective takes
     quantum = objective_quantum(statistic, parts[0][1].step_hours, counted.size, counted)
 
     def objective(flat):

@@ -25,6 +25,25 @@ def best_angle_index(hours):
     return hours.shape[-1] - 1 - np.argmax(hours[..., ::-1], axis=-1)
 
 
+def season_days(months, season=None) -> np.ndarray:
+    """(days,) bool: the days whose month is in ``season`` (every day for None or no months).
+
+    Parameters
+    ----------
+    months : array_like of int
+        (days,) month of each day [1-12].
+    season : sequence of int, optional
+        Months [1-12].
+    """
+    months = np.asarray(months)
+    if not season:
+        return np.ones(months.shape, bool)
+    # A table of the twelve months rather than np.isin, which costs a map's search a sort per call.
+    table = np.zeros(13, bool)
+    table[list(season)] = True
+    return table[months]
+
+
 def objective_value(hours, months, statistic: str, season=None):
     """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
 
@@ -47,7 +66,7 @@ def objective_value(hours, months, statistic: str, season=None):
     """
     hours, months = np.asarray(hours, dtype=float), np.asarray(months)
     if season:
-        keep = np.isin(months, season)
+        keep = season_days(months, season)
         hours, months = hours[keep], months[keep]
     if statistic == "mean":
         return hours.mean(axis=0)

@@ -25,7 +25,7 @@ from foldopt.engine import rows as engines
 from foldopt.inputs.plan import Plan
 from foldopt.studies.designs import DESIGNS, Blocks, design_metrics, fold_hours, setup_key
 from foldopt.studies.objectives import (ENSEMBLE_PERCENTILES, best_angle_index, ensemble_choice, near_optimal,
-                                        objective_value, worst_month)
+                                        objective_value, season_days, worst_month)
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 
@@ -308,7 +308,7 @@ def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, ob
     if spread is not None:
         values = spread["member_objective_h"].mean(axis=0)
         quantiles = {pct: np.percentile(spread["member_objective_h"], pct, axis=0) for pct in ENSEMBLE_PERCENTILES}
-    season = np.isin(months, objective.months) if objective.months else np.ones(len(months), bool)
+    season = season_days(months, objective.months)
     month = worst_month(design_hours[season], np.asarray(months)[season]) if statistic == "worst-month" else None
     site = blocks.study.site
     rows = []

@@ -41,7 +41,8 @@ from foldopt.errors import ConfigError
 from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
 from foldopt.studies.site_search import fold_search
-from foldopt.studies.objectives import best_angle_index, near_optimal_on_grid, objective_value, period_values
+from foldopt.studies.objectives import (best_angle_index, near_optimal_on_grid, objective_value, period_values,
+                                       season_days)
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
@@ -427,7 +428,7 @@ def _site_rows(days_of, months, statistic: str, seasons, usable, study, site_til
     """One site's columns, per period and load (periods slowest), from its :class:`DailyDesigns`."""
     angles = days_of.angles
     n_loads = usable.size
-    member = np.stack([np.isin(months, season) if season else np.ones(months.size, bool) for season in seasons])
+    member = np.stack([season_days(months, season) for season in seasons])
     best, twofold, twofold_mean, twofold_wh, objective = _chosen(days_of.twofold_h, days_of.twofold_wh, months,
                                                                 statistic, seasons, member)
     # The flat panel at the site's mounting, or at each period's and load's own best tilt.
