@@ -85,6 +85,47 @@ def test_a_kinked_peak_between_lattice_points_is_found():
     assert result.best_value[0] >= 0.0 - 0.01 and result.best_point[0, 0] == 2.0
 
 
+def test_a_concave_kink_on_a_flank_is_not_refined():
+    """A load's objective against the fold angle on the 1-degree land grid (a site at 30 S, 12 E: a
+    steep flank, 0.27 h a degree, meeting at 18 deg a plateau of curvature 1.4e-4 h/deg^2 that
+    peaks at 37 deg): the kink's second differences are large, but the lattice is concave around
+    it and its chords bound it below the plateau, so its boxes are dropped (the curvature alone
+    refined 18-23 deg to the last degree) and the best stays within the tolerance."""
+    axes = [Axis("fold_angle", 1, 180, 1)]
+
+    def flank(points):
+        x = points[:, :1]
+        return np.where(x <= 18, 9.7037 - 0.27 * (18 - x), 9.729 - 0.00007 * (x - 37) ** 2)
+
+    result = grid_search(flank, axes, 0.01, quantum=0.00023)
+    assert result.best_value[0] >= 9.729 - 0.01
+    assert not set(range(18, 24)) & set(result.points[:, 0].astype(int).tolist())
+
+
+#: A site's objective against the fold angle (61 N, 43 W, the SON mean at 20 % of its flat peak,
+#: 5-min clear-sky steps) at 1..40 deg and every 10 deg from 40: 0.054 h a degree up to 12 deg, then
+#: 0.43, 0.37 and 0.16 h to a peak at 15 deg, and down ever faster beyond.
+NARROW_PEAK = ([*range(1, 41), *range(50, 181, 10)], [
+    13.3157, 13.3718, 13.4275, 13.483, 13.5382, 13.5931, 13.6478, 13.7021, 13.7562, 13.81, 13.8635, 13.9168,
+    14.3471, 14.7156, 14.8745, 14.8655, 14.854, 14.8423, 14.8304, 14.8182, 14.8059, 14.7932, 14.7804, 14.7674,
+    14.7541, 14.7405, 14.7268, 14.7128, 14.6985, 14.6841, 14.6694, 14.6544, 14.6392, 14.6237, 14.608, 14.592,
+    14.5757, 14.5592, 14.5425, 14.5254, 14.3391, 14.1227, 13.8739, 13.5909, 13.2735, 12.9207, 12.5331, 12.1127,
+    11.662, 11.1843, 10.6831, 10.3933, 10.4083, 10.4133])
+
+
+def test_a_narrow_peak_behind_a_convex_kink_is_found():
+    """:data:`NARROW_PEAK`: the lattice's second differences at the ends of the box that holds the
+    peak are negative, but one beside it is not (the convex kink at 12 deg), so the box is not taken
+    as concave and its peak is found; bounded by its chords alone, it was missed by 0.020 h."""
+    axes = [Axis("fold_angle", 1, 180, 1)]
+
+    def narrow(points):
+        return np.interp(points[:, 0], *NARROW_PEAK)[:, None]
+
+    result = grid_search(narrow, axes, 0.01, quantum=0.00023)
+    assert result.best_value[0] >= 14.8745 - 0.01
+
+
 def test_several_targets_each_get_their_own_best():
     axes = [Axis("x", 0, 90, 1)]
 

@@ -42,7 +42,7 @@ def map_(
     angle_step: Optional[float] = ANGLE_STEP,
     fold_search: bool = typer.Option(False, "--fold-search", help="Search the fold angles (foldopt.engine.search) "
                                      "instead of evaluating every one: the same objectives within 0.01 h from some "
-                                     "70 of 180 angles."),
+                                     "60 of 180 angles."),
     optimize: Optional[str] = typer.Option(None, "--optimize", help="What the search varies with the fold angle: "
                                            "tilt (each site's best tilt, and the flat panel's own); implies "
                                            "--fold-search."),

@@ -9,9 +9,9 @@ The search, per site, is :class:`foldopt.engine.search.GridSearch` on the study'
 angles over every period's objective and every load together (its *targets*; a map has five
 periods of ten loads): every target's best within the search's tolerance of the grid's (the
 argument is there). The targets share every evaluated angle, and each refines where its own
-objective bends, so that the union, some 70 of 180 angles on a map's sites, holds the steep flanks
-below every load's plateau finely: that shared refinement is what keeps the search's answers on the
-full sweep's (measured on 40 land sites: no target more than 0.005 h short, where a search per
+objective bends, so that the union, some 60 of 180 angles on a map's sites, holds every load's
+plateau finely: that shared refinement is what keeps the search's answers on the full sweep's
+(measured on 40 land sites: no target more than 0.005 h short, where a search per
 period, a quarter of the days for each season, evaluates some 20 % fewer days' angles and was
 twice short by more than the tolerance). The near-optimal ranges are then placed on the grid from
 the evaluated angles (:func:`foldopt.studies.objectives.near_optimal_on_grid`).
