@@ -208,22 +208,27 @@ def near_optimal_on_grid(angles, values, tolerance: NearOptimal, grid) -> dict:
     # A slope of a few ulp overflows in the harmonic mean of the slopes; it then goes to 0, as it should.
     with np.errstate(over="ignore"):
         cubic_at = PchipInterpolator(angles, values, axis=-1)(grid)  # (targets, grid)
-    edges = {"near_optimal_lo_deg": -1, "near_optimal_hi_deg": 1}
-    for name, outward in edges.items():
-        edge = ranges[name].copy()
-        for target in np.flatnonzero(np.isfinite(edge)):
-            inner = int(np.searchsorted(angles, edge[target] - 1e-9))
-            outer = inner + outward
-            if not 0 <= outer < angles.size:
-                continue
-            a, b = sorted((inner, outer))
-            # The grid angles of the gap, from the inner end outward, and the cubic there.
-            gap = (grid > angles[a]) & (grid < angles[b])
-            inside, cubic = grid[gap][::outward], cubic_at[target, gap][::outward]
-            kept = np.cumprod(cubic >= line[target]).astype(bool)
-            if kept.any():
-                edge[target] = inside[kept][-1]
-        ranges[name] = edge
+    place = np.arange(grid.size)
+    for name, outward in {"near_optimal_lo_deg": -1, "near_optimal_hi_deg": 1}.items():
+        edge = ranges[name]
+        # Each target's gap between its evaluated edge (inner) and the next evaluated angle outward.
+        inner = np.searchsorted(angles, np.where(np.isfinite(edge), edge, angles[0]) - 1e-9)
+        outer = inner + outward
+        has_gap = np.isfinite(edge) & (outer >= 0) & (outer < angles.size)
+        outer = np.clip(outer, 0, angles.size - 1)
+        low, high = angles[np.minimum(inner, outer)], angles[np.maximum(inner, outer)]
+        gap = has_gap[:, None] & (grid > low[:, None]) & (grid < high[:, None])  # (targets, grid)
+        below = gap & (cubic_at < line[:, None])
+        # The gap's grid angles from the inner end outward while the cubic stays at or above the line.
+        if outward > 0:
+            stop = np.where(below.any(axis=1), np.argmax(below, axis=1), grid.size)
+            kept = gap & (place < stop[:, None])
+            last = grid.size - 1 - np.argmax(kept[:, ::-1], axis=1)
+        else:
+            stop = np.where(below.any(axis=1), grid.size - 1 - np.argmax(below[:, ::-1], axis=1), -1)
+            kept = gap & (place > stop[:, None])
+            last = np.argmax(kept, axis=1)
+        ranges[name] = np.where(kept.any(axis=1), grid[last], edge)
     centre = (ranges["near_optimal_lo_deg"] + ranges["near_optimal_hi_deg"]) / 2.0
     finite = np.isfinite(centre)
     nearest = np.full(centre.shape, np.nan)
