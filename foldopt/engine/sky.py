@@ -476,12 +476,15 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         ghi_of = ghi if ghi is not None else dni * np.clip(np.cos(np.radians(zenith)), 0, None)
         dhi_of = dhi if dhi is not None else np.zeros_like(dni)
         shown = np.flatnonzero((dni > 0) | (ghi_of > 0) | (dhi_of > 0))
-        # Laid out (n_blocks, 4, n_steps), each term contiguous along the steps as the engine reads it.
-        layout = np.zeros((dni.shape[0], 4, dni.shape[1]))
-        block, step = np.divmod(shown, dni.shape[1])
-        layout[block, :, step] = sky_diffuse_terms(
+        # Laid out (n_blocks, 4, n_steps) as the engine reads it, placed a term at a time by flat index.
+        n_steps = dni.shape[1]
+        layout = np.zeros((dni.shape[0], 4, n_steps))
+        at = shown + shown // n_steps * (3 * n_steps)  # block b's step s: b * 4 n_steps + s
+        found = sky_diffuse_terms(
             transposition, *(values.ravel()[shown] for values in (zenith, dni, ghi_of, dhi_of, dni_extra, airmass)),
             study.albedo)
+        for k in range(4):
+            layout.reshape(-1)[at + k * n_steps] = found[:, k]
         terms = np.moveaxis(layout, 1, -1)
     if horizons:
         dni, terms = block_behind_horizon(horizons, horizon_of, zenith, sun["solar_azimuth"], dni, terms)
