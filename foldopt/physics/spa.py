@@ -301,10 +301,13 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     elevation = np.degrees(np.arcsin(np.clip(vector[:, 2], -1.0, 1.0)))
     azimuth = np.degrees(np.arctan2(vector[:, 0], vector[:, 1]))
     azimuth[azimuth < 0.0] += 360.0
-    # SPA's refraction (0 more than 0.83 deg below the horizon) raises the direction in its
-    # vertical plane, its azimuth kept.
-    refraction = pvlib.spa.atmospheric_refraction_correction((pvlib.atmosphere.alt2pres(altitude) / 100.0)[:, None],
-                                                             SPA_TEMPERATURE, elevation, SPA_ATMOS_REFRACT)
+    # SPA's refraction (0 more than 0.83 deg below the horizon, so worked out only above that)
+    # raises the direction in its vertical plane, its azimuth kept.
+    refraction = np.zeros(shape)
+    near = elevation >= -(0.26667 + SPA_ATMOS_REFRACT)  # pvlib.spa's own switch
+    pressure = np.broadcast_to((pvlib.atmosphere.alt2pres(altitude) / 100.0)[:, None], shape)
+    refraction[near] = pvlib.spa.atmospheric_refraction_correction(pressure[near], SPA_TEMPERATURE, elevation[near],
+                                                                   SPA_ATMOS_REFRACT)
     _raise(vector, np.radians(refraction))
     elevation += refraction
     equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
