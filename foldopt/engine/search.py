@@ -243,7 +243,7 @@ class GridSearch:
         self.strides = np.maximum(self.strides // 2, 1)
         self.lower, self.upper = _split(self.lower[keep], self.upper[keep], self.strides)
         corners = _corners(self.lower, self.upper)
-        self._asked = self.store.missing(np.unique(corners.reshape(-1, len(self.axes)), axis=0))
+        self._asked = self.store.missing(corners.reshape(-1, len(self.axes)))
 
     def result(self) -> SearchResult:
         """What the search evaluated and found (once :meth:`ask` gives None)."""
@@ -265,7 +265,10 @@ class _Store:
         """The points of ``index`` not evaluated yet, once each."""
         keys = np.ravel_multi_index(index.T, self.sizes)
         keys, first = np.unique(keys, return_index=True)
-        return index[first[~np.isin(keys, self.keys)]]
+        if self.keys.size == 0:
+            return index[first]
+        at = np.clip(np.searchsorted(self._sorted, keys), 0, self.keys.size - 1)
+        return index[first[self._sorted[at] != keys]]
 
     def add(self, index, found):
         """The values ``found`` (n, n_targets) of the points ``index`` (n, n_axes), new ones."""
@@ -276,14 +279,14 @@ class _Store:
         self.values = found if self.values is None else np.vstack([self.values, found])
         self.keys = np.concatenate([self.keys, keys])
         self._order = np.argsort(self.keys)
+        self._sorted = self.keys[self._order]
 
     def lookup(self, index):
         """(n, n_targets) the values at ``index`` (NaN where not evaluated or outside the grid)."""
         inside = np.all((index >= 0) & (index < self.sizes), axis=-1)
         keys = np.ravel_multi_index(np.where(inside[..., None], index, 0).reshape(-1, len(self.sizes)).T, self.sizes)
-        sorted_keys = self.keys[self._order]
-        at = np.clip(np.searchsorted(sorted_keys, keys), 0, sorted_keys.size - 1)
-        found = inside.ravel() & (sorted_keys[at] == keys)
+        at = np.clip(np.searchsorted(self._sorted, keys), 0, self.keys.size - 1)
+        found = inside.ravel() & (self._sorted[at] == keys)
         values = np.full((keys.size, self.values.shape[1]), np.nan)
         values[found] = self.values[self._order[at[found]]]
         return values.reshape(*index.shape[:-1], self.values.shape[1])
@@ -317,7 +320,9 @@ def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
             continue
         shift = np.zeros(n_axes, dtype=int)
         shift[axis] = strides[axis]
-        beyond_below, below, here, above, beyond_above = (store.lookup(corners + k * shift) for k in (-2, -1, 0, 1, 2))
+        # The corners and their lattice neighbours along the axis, looked up in one call.
+        offsets = np.arange(-2, 3)[:, None, None, None] * shift  # (5, 1, 1, n_axes)
+        beyond_below, below, here, above, beyond_above = store.lookup(corners[None] + offsets)
         second = np.abs(above - 2.0 * here + below) / (strides[axis] * steps[axis]) ** 2  # (boxes, corners, targets)
         known = np.isfinite(second)
         largest = np.nanmax(np.where(known, second, -np.inf), axis=(0, 1)) if known.any() else np.zeros(top.shape[1])
