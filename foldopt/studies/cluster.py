@@ -97,7 +97,8 @@ class MapSpec:
 
 
 def default_sites_per_chunk(study: dict, year: int) -> int:
-    """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work (at least 1).
+    """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work (at least 1), in whole batches
+    of :data:`foldopt.studies.worldmap.SITES_PER_BATCH` where it holds one or more.
 
     Parameters
     ----------
@@ -106,11 +107,14 @@ def default_sites_per_chunk(study: dict, year: int) -> int:
     year : int
     """
     from foldopt.inputs.sections import FoldAngles
+    from foldopt.studies.worldmap import SITES_PER_BATCH
 
     angles = len(FoldAngles(**study.get("fold_angles", {})).grid())
     steps = 1440 / float(study.get("step_min", 1.0))
     per_site = 365 * angles * steps * SECONDS_PER_EVALUATION
-    return max(1, int(CHUNK_SECONDS / per_site))
+    count = max(1, int(CHUNK_SECONDS / per_site))
+    # Whole batches of sites where a chunk holds one or more, so that no batch runs part-full.
+    return count if count < SITES_PER_BATCH else SITES_PER_BATCH * round(count / SITES_PER_BATCH)
 
 
 @dataclass(frozen=True)
