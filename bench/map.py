@@ -5,7 +5,7 @@
     python bench/map.py --sites 200      # a quicker look
     python bench/map.py --phases         # a site's cost by phase, one core (W4's sites: every angle)
     python bench/map.py --w5 --phases    # ... W5's: land sites, fold angles searched; 100 workers' time
-    python bench/map.py --w5 --sites 400 # W5 on 400 of the 1-degree land grid's sites, extrapolated
+    python bench/map.py --w5 --sites 1000 # W5 on 1,000 of the 1-degree land grid's sites, the grid projected
     python bench/map.py --w5             # W5: the whole 1-degree land grid (target 600 s)
 
 W4: 2,000 sites (a 40 x 50 latitude x longitude grid from 58.5 S to 58.5 N) x 365 days x 180
