@@ -159,6 +159,18 @@ def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):
     assert not list(out.rglob(".*tmp*"))
 
 
+def test_the_maps_digest_is_worked_out_once(monkeypatch):
+    """Every part written and read carries the map's digest, and the spec holds every site: worked
+    out per part, the 1-degree land grid's (0.3 s a time, 902 chunks, three times each) took a
+    third of the client's core, which the two workers share."""
+    calls = []
+    as_dict = MapSpec.as_dict
+    monkeypatch.setattr(MapSpec, "as_dict", lambda self: calls.append(1) or as_dict(self))
+    spec = MapSpec({"name": "x", "panel": {"area": 0.1}}, tuple({"latitude": float(k), "longitude": 0.0}
+                                                                for k in range(50)), (1.0,), sites_per_chunk=1)
+    assert len({spec.key for _ in range(len(spec.chunks()))}) == 1 and len(calls) == 1
+
+
 def test_resume_refuses_another_map(tmp_path):
     out = tmp_path / "map"
     spec = MapSpec({"name": "x", "panel": {"area": 0.1}, "sky": "ineichen", "mode": "exact", "step_min": 60,

@@ -19,6 +19,7 @@ kernel on one thread: the parallelism is Dask's.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import shutil
@@ -89,9 +90,11 @@ class MapSpec:
         """The spec as plain data (``run.json``'s ``spec``)."""
         return dataclasses.asdict(self)
 
-    @property
+    @functools.cached_property
     def key(self) -> str:
-        """A digest of the spec: a resumed run must have the same."""
+        """A digest of the spec: a resumed run must have the same. Worked out once: every part written
+        and read carries it, and the spec holds every site (the 1-degree land grid's 21,637 made it
+        0.2 s a time, some 900 chunks three times each: a third of the client's core through W5)."""
         text = json.dumps(self.as_dict(), sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
