@@ -94,7 +94,7 @@ class MapSpec:
     def key(self) -> str:
         """A digest of the spec: a resumed run must have the same. Worked out once: every part written
         and read carries it, and the spec holds every site (the 1-degree land grid's 21,637 made it
-        0.2 s a time, some 900 chunks three times each: a third of the client's core through W5)."""
+        0.3 s a time, some 900 chunks three times each: a third of the client's core through W5)."""
         text = json.dumps(self.as_dict(), sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
