@@ -149,11 +149,11 @@ def w5(subset: int | None, check_sites: int = 200) -> None:
     0.01 h of the full sweep's.
 
     The projection keeps what a run costs once apart from what each site costs: the cluster's start
-    and each worker's first chunk (it imports foldopt and loads its compiled kernels and tables: a
-    second or so) once, the steady pace after them (sites a second, from the chunks that finished
-    after every worker's first) for the rest of the grid, and the tables written at the end (their
-    rows scale with the sites). Scaling the whole subset's time instead would count the once-only
-    costs some 50 times for 400 sites."""
+    and each worker's first chunk (it imports foldopt and loads its compiled kernels and tables:
+    some 7 s to every worker's first chunk done, on 1,000 sites) once, the steady pace after them
+    (sites a second, from the chunks that finished after every worker's first) for the rest of the
+    grid, and the tables written at the end (their rows scale with the sites). Scaling the whole
+    subset's time instead would count the once-only costs some 50 times for 400 sites."""
     import pandas as pd
 
     from foldopt.inputs.load import default_study_path, read_study
