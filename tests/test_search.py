@@ -86,11 +86,12 @@ def test_a_kinked_peak_between_lattice_points_is_found():
 
 
 def test_a_concave_kink_on_a_flank_is_not_refined():
-    """A load's objective against the fold angle on the 1-degree land grid (a site at 30 S, 12 E: a
-    steep flank, 0.27 h a degree, meeting at 18 deg a plateau of curvature 1.4e-4 h/deg^2 that
-    peaks at 37 deg): the kink's second differences are large, but the lattice is concave around
-    it and its chords bound it below the plateau, so its boxes are dropped (the curvature alone
-    refined 18-23 deg to the last degree) and the best stays within the tolerance."""
+    """A load's objective against the fold angle on the 1-degree land grid (a site at 18 N, 44 E,
+    the year's mean at 25 % of its flat peak, 5-min clear-sky steps, fitted: a steep flank, 0.27 h a
+    degree, meeting at 18 deg a plateau of curvature 1.4e-4 h/deg^2 that peaks at 37 deg): the
+    kink's second differences are large, but the lattice is concave around it and its chords bound
+    it below the plateau, so its boxes are dropped (the curvature alone refined 18-23 deg to the
+    last degree) and the best stays within the tolerance."""
     axes = [Axis("fold_angle", 1, 180, 1)]
 
     def flank(points):
@@ -102,7 +103,7 @@ def test_a_concave_kink_on_a_flank_is_not_refined():
     assert not set(range(18, 24)) & set(result.points[:, 0].astype(int).tolist())
 
 
-#: A site's objective against the fold angle (61 N, 43 W, the SON mean at 20 % of its flat peak,
+#: A site's objective against the fold angle (61 N, 43 W, the JJA mean at 20 % of its flat peak,
 #: 5-min clear-sky steps) at 1..40 deg and every 10 deg from 40: 0.054 h a degree up to 12 deg, then
 #: 0.43, 0.37 and 0.16 h to a peak at 15 deg, and down ever faster beyond.
 NARROW_PEAK = ([*range(1, 41), *range(50, 181, 10)], [
