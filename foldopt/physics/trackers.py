@@ -394,7 +394,13 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     step itself, is at most :data:`TURN_TOLERANCE_S`: a map's moves (some 53,000 a site) in two
     steps where waiting for a step below the tolerance took three, the times the same to within
     their last bits (some moves never settle on a fixed point: they change in their last bit, back
-    and forth)."""
+    and forth).
+
+    References
+    ----------
+    .. [1] E. Süli, D. Mayers, "An Introduction to Numerical Analysis", Cambridge University Press,
+       2003, Sec. 1.4: Newton's error ``e_{n+1} = f''(xi) / (2 f'(x_n)) e_n^2``.
+    """
     angle = np.asarray(angle, dtype=float)
     t = angle / speed + tau_1 + tau_2
     peak = math.log(tau_1 / tau_2) * tau_1 * tau_2 / (tau_1 - tau_2)
