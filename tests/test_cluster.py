@@ -21,6 +21,8 @@ from foldopt.errors import OutputError
 from foldopt.studies.worldmap import evaluate_sites
 
 #: One worker runs this module (the embedded map, every test's reference, is computed once; --dist loadgroup).
+#: Its fixtures are session-scoped: the worker may run other modules' tests between these, which
+#: would tear a module-scoped fixture down and build it again.
 pytestmark = pytest.mark.xdist_group("cluster")
 
 pytest.importorskip("distributed")
@@ -28,6 +30,9 @@ pytest.importorskip("distributed")
 #: 16 sites, a chunk each, at 15-min steps: about 0.1 s of work per chunk, long enough to be killed mid-run.
 MAP = ["--lat", "-60:60:40", "--lon", "-180:90:90", "--p-load", "1,2", "--area", "0.108", "--chunk-sites", "1",
        "--step-min", "15"]
+#: The embedded cluster of one worker: one process to start, not two, on a machine whose two cores the
+#: other tests share (the hand-started cluster below has two, so that one can be killed).
+EMBEDDED = [*MAP, "--workers", "1"]
 N_SITES, N_LOADS = 16, 2
 SECONDS = 240  # any one run or cluster start
 
@@ -61,11 +66,11 @@ def _parts(folder: Path) -> dict[str, tuple]:
     return {path.name: (path.stat().st_ino, path.stat().st_mtime_ns) for path in (folder / "parts").glob("part-*")}
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def embedded(tmp_path_factory) -> pd.DataFrame:
     """The reference: the map on the embedded cluster, uninterrupted."""
     out = tmp_path_factory.mktemp("embedded") / "map"
-    _finish(_foldopt("map", *MAP, "--out", str(out), "-q"))
+    _finish(_foldopt("map", *EMBEDDED, "--out", str(out), "-q"))
     return pd.read_parquet(out / "map.parquet")
 
 
@@ -134,7 +139,7 @@ def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
 
 def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):
     out = tmp_path / "map"
-    run = _foldopt("map", *MAP, "--out", str(out), "-q", start_new_session=True)
+    run = _foldopt("map", *EMBEDDED, "--out", str(out), "-q", start_new_session=True)
     try:
         _wait_for(lambda: len(_parts(out)) >= 3 if out.exists() else False, "three parts")
     finally:
@@ -142,10 +147,10 @@ def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):
         run.wait(timeout=30)
     before = _parts(out)
     assert 3 <= len(before) < N_SITES and not (out / "map.parquet").exists()
-    refused = _foldopt("map", *MAP, "--out", str(out))
+    refused = _foldopt("map", *EMBEDDED, "--out", str(out))
     _, err = refused.communicate(timeout=SECONDS)
     assert refused.returncode == 2 and "pass --resume to finish it" in err
-    out_text, _ = _finish(_foldopt("map", *MAP, "--out", str(out), "--resume", "--format", "json", "-q"))
+    out_text, _ = _finish(_foldopt("map", *EMBEDDED, "--out", str(out), "--resume", "--format", "json", "-q"))
     answer = json.loads(out_text)  # one JSON document: the year's rows
     assert answer["command"] == "map" and answer["answer"]["result"]["sites"] == N_SITES
     assert len(answer["rows"]) == N_SITES * N_LOADS and answer["answer"]["result"]["chunks_from_disk"] == len(before)

@@ -18,6 +18,8 @@ from pathlib import Path
 import pytest
 
 #: One worker runs this module (the manual is built once, by one worker; pytest-xdist --dist loadgroup).
+#: The build is session-scoped: the worker may run other modules' tests between these, which would
+#: tear a module-scoped fixture down and build the manual again (it was, 20 s each time).
 pytestmark = pytest.mark.xdist_group("docs")
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -27,7 +29,7 @@ PAGES = ("index", "quickstart", "cli", "study-file", "outputs", "api", "reproduc
          "examples/design_map", "examples/world_map", "examples/configs")
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def built(tmp_path_factory):
     """The HTML manual, built from a copy of docs/ with the working folder outside the source tree."""
     pytest.importorskip("sphinx")

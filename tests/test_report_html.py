@@ -14,6 +14,8 @@ from typer.testing import CliRunner
 from foldopt.cli.app import app
 
 #: One worker runs this module (the results folders are written once, by one worker; pytest-xdist --dist loadgroup).
+#: The folders are session-scoped: the worker may run other modules' tests between these, which
+#: would tear a module-scoped fixture down and write them again.
 pytestmark = pytest.mark.xdist_group("reports")
 
 runner = CliRunner()
@@ -36,7 +38,7 @@ def _browser(*args: str) -> subprocess.CompletedProcess:
                            "--disable-extensions", *args], capture_output=True, text=True, timeout=120)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def folders(tmp_path_factory) -> dict[str, Path]:
     root = tmp_path_factory.mktemp("reports")
     out = {}

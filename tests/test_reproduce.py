@@ -18,12 +18,12 @@ TOLERANCE = {
 }
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def table(shin_study):
     return reproduce(shin_study).set_index("quantity")
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def single_diode_table(shin_study):
     return reproduce(shin_study, pv_model="single-diode").set_index("quantity")
 

@@ -173,7 +173,7 @@ def test_the_study_objective_matches_the_brute_force_grid(latitude, longitude, d
     assert np.all(result.best_value <= brute + 1e-9)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def joint():
     return foldopt.optimize(foldopt.default_study(), vary="fold_angle,tilt", mode="exact", step_min=15,
                             fold_angle="10:180:5", tilt="0:90:5", p_load=[2.0, 4.398])

@@ -45,7 +45,7 @@ def test_single_axis_matches_pvlib():
     np.testing.assert_allclose(surface_azimuth, expected["surface_azimuth"], atol=1e-9)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def day():
     study = load_study(default_study_path())
     return Day(study.model_copy(update={"mode": "exact", "geometry": "hinge", "step_min": 2}))

@@ -77,7 +77,7 @@ def test_bad_measured_and_ensemble_input_is_one_line(tmp_path, args, words):
     assert_one_line_error(invoke("sweep", "angle", *args, "--out", tmp_path / "b"), *words)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def ensemble_plan():
     return make_plan({"name": "e", "weather": {"path": str(TMY3), "members": 6, "seed": 4}, "panel": {"area": 0.108},
                       "p_load": [1.0, 3.0], "objective": "mean", "date": DAYS, "year": 2025,

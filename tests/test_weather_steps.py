@@ -18,7 +18,7 @@ TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"  # NREL TMY3 sampl
 DAYS = [dt.date(2025, 1, 14), dt.date(2025, 4, 2), dt.date(2025, 7, 17), dt.date(2025, 10, 10)]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def weather_day():
     plan = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": 2.0,
                       "pv_model": "single-diode", "step_min": 5, "transposition": "perez"})

@@ -64,7 +64,7 @@ def write_pvgis_year(path, frame, site):
     path.write_text(json.dumps(source, indent=1))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def written(tmp_path_factory):
     """The TMY3 sample written as EPW and as PVGIS JSON: (epw lines, pvgis text)."""
     folder = tmp_path_factory.mktemp("written")

@@ -17,7 +17,7 @@ import pytest
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "weather_validation.py"
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def table():
     spec = importlib.util.spec_from_file_location("weather_validation", BENCH)
     module = importlib.util.module_from_spec(spec)

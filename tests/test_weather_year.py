@@ -24,7 +24,7 @@ TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"  # NREL TMY3 sampl
 YEAR = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(365)]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def greensboro():
     """The Greensboro TMY3 year on 1-minute steps, Perez diffuse light."""
     study = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": 2.0}).base

@@ -25,7 +25,7 @@ GREENSBORO = {"weather": str(Path(__file__).parent.parent / "configs" / "weather
 LA = {"name": "Los Angeles", "latitude": 34.05, "longitude": -118.25, "timezone": "America/Los_Angeles"}
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def la_map():
     return evaluate_sites(COARSE, [LA], [1.0, 4.0, 8.0])
 
