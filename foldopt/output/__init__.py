@@ -1,5 +1,5 @@
 """Output: views of an answer, deciding nothing. The results folders
-(:mod:`~foldopt.output.folders`: CSV tables, :mod:`~foldopt.output.tables`; PNG figures,
+(:mod:`~foldopt.output.folders`: CSV tables, written by :mod:`foldopt.tables`; PNG figures,
 :mod:`~foldopt.output.figures`; ``run.json``, :mod:`~foldopt.output.provenance`; ``report.html``,
 :mod:`~foldopt.output.html` and its template in ``templates/``) and the columns' vocabulary
 (:mod:`~foldopt.output.columns`). Every number shown comes from a result and its

@@ -15,7 +15,7 @@ from foldopt.files import staged_folder
 from foldopt.output.figures import day, world, write_figure
 from foldopt.output.html import write_html
 from foldopt.output.provenance import input_hash, run_metadata, write_run_json
-from foldopt.output.tables import write_csv
+from foldopt.tables import write_csv
 from foldopt.studies.annual import annual_cases, annual_summary
 from foldopt.studies.day import StudyResult
 from foldopt.studies.horizon_paths import sun_paths

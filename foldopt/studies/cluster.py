@@ -34,6 +34,7 @@ from foldopt.errors import ConfigError, OutputError
 from foldopt.files import (DiskFullError, check_output, clear_leftovers, commit, discard, is_full, new_staging,
                            tree_size, versions, write_atomically, writer_lock)
 from foldopt.studies.dask_client import CONNECT_TIMEOUT, connect
+from foldopt.tables import write_csv
 
 #: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
 #: about a millisecond), short enough that a lost worker loses little and progress moves.
@@ -412,7 +413,7 @@ def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, pro
                       ignore_index=True)
     seconds = time.perf_counter() - started
     _write_parquet(table, out / "map.parquet", spec.key)
-    write_atomically(out / "map.csv", lambda temporary: table.to_csv(temporary, index=False, float_format="%.10g"))
+    write_atomically(out / "map.csv", lambda temporary: write_csv(table, temporary))
     computed = tuple(missing)
     _write_json(out / "run.json", {
         **metadata, "status": "complete", "cluster": description, "dashboard": dashboard,
