@@ -7,6 +7,9 @@ within 1e-9 relative, on random sites, days, loads, fold angles and models.
 """
 
 import datetime as dt
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -89,6 +92,26 @@ def test_kernel_equals_the_reference_path(case):
     results = {name: engine.row_metrics(sky, study, rows, orientation, loads, outputs=engine.OUTPUTS,
                                         contiguous=True, engine=name) for name in engine.ENGINES}
     assert_engines_agree(results["numba"], results["numpy"])
+
+
+def test_the_kernel_on_two_threads():
+    """The kernel's rows go to threads in chunks, each with its own scratch (arrays zero-filled
+    inside a prange body have given wrong sums): the comparison above on two threads, in a process
+    of its own, as pytest-xdist's workers run the suite on one thread each (tests/conftest.py)."""
+    environment = {**os.environ, "NUMBA_NUM_THREADS": "2"}
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider",
+                           f"{__file__}::test_kernel_equals_the_reference_path",
+                           f"{__file__}::test_kernel_threads"], env=environment, capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stdout[-3000:]
+    assert "2 passed" in done.stdout
+
+
+def test_kernel_threads():
+    """How many threads the kernel runs on: two under test_the_kernel_on_two_threads."""
+    import numba
+
+    assert numba.get_num_threads() == int(os.environ.get("NUMBA_NUM_THREADS", numba.config.NUMBA_DEFAULT_NUM_THREADS))
 
 
 @pytest.mark.parametrize("pv_model,outputs", [("single-diode", engine.OUTPUTS), ("ideal", engine.OUTPUTS),
