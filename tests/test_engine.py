@@ -98,7 +98,7 @@ def test_the_kernel_on_two_threads():
     """The kernel's rows go to threads in chunks, each with its own scratch (arrays zero-filled
     inside a prange body have given wrong sums): the comparison above on two threads, in a process
     of its own, as pytest-xdist's workers run the suite on one thread each (tests/conftest.py)."""
-    environment = {**os.environ, "NUMBA_NUM_THREADS": "2"}
+    environment = {**os.environ, "NUMBA_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"}
     done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider",
                            f"{__file__}::test_kernel_equals_the_reference_path",
                            f"{__file__}::test_kernel_threads"], env=environment, capture_output=True, text=True,
