@@ -72,3 +72,13 @@ def test_a_time_series_keeps_its_offset(tmp_path):
     text = write_csv(table, tmp_path / "ts.csv", index=True).read_text()
     assert text == _pandas(table, tmp_path / "pandas.csv", date_format=TIME_FORMAT).decode()
     assert "2014-09-23T12:00:30-0700,0" in text
+
+
+def test_a_table_longer_than_a_slice_is_pandas_bytes(tmp_path, monkeypatch):
+    # Rows are formatted a slice at a time (foldopt.tables.ROWS_AT_ONCE): slices of 2 over 7 rows.
+    import foldopt.tables
+
+    monkeypatch.setattr(foldopt.tables, "ROWS_AT_ONCE", 2)
+    table = pd.DataFrame({"x": np.linspace(-1.0, 1.0, 7), "n": np.arange(7), "s": list("abcdefg")})
+    table.loc[3, "x"] = np.nan
+    assert write_csv(table, tmp_path / "mine.csv").read_bytes() == _pandas(table, tmp_path / "pandas.csv", index=False)
