@@ -4,7 +4,8 @@ A :class:`Sky` holds, for every *block* (one local day at one site) and every ti
 position and unit vector, the direct normal irradiance and, with a transposition model, the four
 orientation-free diffuse terms of :func:`foldopt.physics.irradiance.sky_diffuse_terms`. It is built as
 one array program over all blocks (:func:`build_sky`): one clock grid, one solar-position
-evaluation, one air mass and clear-sky pass. The engine then evaluates any number of panel
+evaluation, and the light of :mod:`foldopt.engine.light` (a clear sky and its diffuse terms in one
+compiled pass, or a weather file's light). The engine then evaluates any number of panel
 orientations against it. Blocks may be different sites and days; they share the study's settings
 (mode, sky model, step...).
 """
@@ -15,24 +16,18 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 import pvlib
 
-from foldopt.physics.atmosphere import clear_sky_dni, relative_airmass
+from foldopt.engine.light import clear_light, diffuse_terms, measured_light, member_light, weather_light
+from foldopt.inputs.loads import load_shape
 from foldopt.inputs.sections import parse_timezone
 from foldopt.inputs.study import Study
-from foldopt.physics.horizon import sun_visible
-from foldopt.physics.irradiance import sky_diffuse_terms
-from foldopt.inputs.loads import load_shape
-from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
-from foldopt.errors import WeatherError
-from foldopt.inputs.weather import FORMATS, read_weather, study_weather, weather_days, weather_format, weather_site
+from foldopt.inputs.weather import study_weather, weather_site
 from foldopt.names import CLEAR_SKIES
-from foldopt.inputs.turbidity import linke_turbidity as climatology_turbidity
-from foldopt.inputs.weather.downscale import clear_sky, hourly_light, interpolate_points
-from foldopt.inputs.weather.ensemble import cloud_members
+from foldopt.physics.atmosphere import clear_sky_dni
+from foldopt.physics.horizon import sun_visible
+from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
 from foldopt.physics.temperature import equivalent_temp_air
-
 
 def step_span(some) -> np.ndarray:
     """(n_rows, 2) the first and last true step of each row of ``some``, (n_rows, n_steps) bool,
@@ -266,114 +261,6 @@ def _clock(sites, dates, step_min) -> ClockGrid:
                      tuple(stacked.timezones[i] for i in order), stacked.step_hours)
 
 
-def _clear_sky(grid: ClockGrid, zenith, airmass, dni_extra, sites, model: str, linke_turbidity) -> dict:
-    """pvlib's clear sky at every step with the sun up (0 elsewhere), one call per site (its
-    blocks' steps together), with the climatology's turbidity at the site where the study sets
-    none."""
-    light = {key: np.zeros_like(zenith) for key in ("dni", "ghi", "dhi")}
-    groups: dict[tuple, list[int]] = {}
-    for index, site in enumerate(sites):
-        groups.setdefault((site.latitude, site.longitude, site.altitude), []).append(index)
-    for (latitude, longitude, altitude), members in groups.items():
-        up = zenith[members] < 90.0
-        turbidity = linke_turbidity
-        if model == "ineichen" and turbidity is None:
-            turbidity = climatology_turbidity(latitude, longitude, grid.utc_ns[members][up])
-        sky = clear_sky(zenith[members][up], airmass[members][up], dni_extra[members][up], altitude, model,
-                        turbidity)
-        for key, values in light.items():
-            placed = np.zeros(up.shape)
-            placed[up] = sky[key]
-            values[members] = placed
-    return light
-
-
-def _weather_light(study: Study, grid: ClockGrid, dates, clear: dict, zenith, dni_extra):
-    """Light at every step of the grid from the study's weather file
-    (:func:`foldopt.inputs.weather.downscale.hourly_light` along the clear sky), the air
-    temperature and wind at every step (:func:`foldopt.inputs.weather.downscale.interpolate_points`),
-    and how much of the file's irradiation the steps keep."""
-    weather = study.weather
-    columns = ("dni", "ghi", "dhi", "temp_air", "wind_speed", "cloud_cover")
-    hourly = {key: np.empty((len(dates), 0)) for key in columns}
-    starts = np.empty((len(dates), 0), dtype=np.int64)
-    # The file is coerced to each date's year: read once per year, the days picked as arrays.
-    for year in sorted({date.year for date in dates}):
-        positions = [i for i, date in enumerate(dates) if date.year == year]
-        frame = read_weather(weather.path, weather.format, year, weather.label)
-        rows = weather_days(frame, [dates[i] for i in positions])
-        index = pd.DatetimeIndex(frame.index)
-        centres = index.tz_localize(None).as_unit("ns").asi8[rows]
-        interval = int(np.median(np.diff(index.as_unit("ns").asi8)))
-        if starts.shape[1] == 0:
-            starts = np.zeros((len(dates), rows.shape[1]), dtype=np.int64)
-            hourly = {key: np.zeros((len(dates), rows.shape[1])) for key in columns}
-        starts[positions] = centres - interval // 2
-        for key in columns:
-            hourly[key][positions] = frame[key].to_numpy(dtype=float)[rows]
-    step_ns = round(grid.step_hours * 3.6e12)
-    day_start = grid.local_ns[:, :1] - step_ns // 2
-    per_interval = interval // step_ns
-    if interval % step_ns or not np.array_equal(starts, day_start + np.arange(starts.shape[1]) * interval):
-        raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must divide the file's "
-                         f"intervals ({interval / 6e10:g} min), which must start at the day's midnight")
-    cos_zenith = np.cos(np.radians(zenith))
-    light, placed = hourly_light(hourly["dni"], hourly["dhi"], clear["ghi"], clear["dni"], cos_zenith, per_interval,
-                                 dni_extra)
-    balance = {key: (float(hourly[key].sum()), float(placed[key].sum())) for key in ("dni", "ghi", "dhi")}
-    # Air temperature and wind stand at the file's own stamps (its meteorological fields are
-    # instantaneous), linear between them.
-    entry = FORMATS[weather_format(weather.path, weather.format)]
-    offset = {"end": 0.5, "start": -0.5, "centre": 0.0}[weather.label or entry.interval_label] + entry.stamp_lag
-    temp_air = interpolate_points(hourly["temp_air"], offset, per_interval)
-    wind_speed = interpolate_points(hourly["wind_speed"], offset, per_interval)
-    return light, temp_air, wind_speed, balance, (hourly, per_interval)
-
-
-def _measured_light(study: Study, grid: ClockGrid, dates):
-    """Light, air temperature and wind at every step of the grid from the study's measured weather
-    file, at its own step (:func:`foldopt.inputs.weather.study_weather`)."""
-    measured = study_weather(study.weather, study.site)
-    frame = measured.frame
-    flagged = sorted(set(dates) & set(measured.flagged_days))
-    if flagged:
-        gaps = [f"{start:%H:%M}-{stop:%H:%M}" for start, stop, minutes in measured.gaps
-                if start.date() in flagged and minutes > study.weather.max_gap_min]
-        raise WeatherError(f"weather {frame.attrs['weather']}: {flagged[0]} has a daylight gap too long to fill "
-                           f"({', '.join(gaps[:3])}; weather.max_gap_min {study.weather.max_gap_min:g} min)"
-                           + (f", and {len(flagged) - 1} more dates" if len(flagged) > 1 else "")
-                           + "; leave those dates out")
-    rows = weather_days(frame, dates)
-    centres = pd.DatetimeIndex(frame.index).tz_localize(None).as_unit("ns").asi8[rows]
-    if centres.shape != grid.local_ns.shape or not np.array_equal(centres, grid.local_ns):
-        raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must be the measured file's "
-                         f"({measured.step.total_seconds() / 60:g} min)")
-    columns = {key: frame[key].to_numpy(dtype=float)[rows] for key in ("ghi", "dni", "dhi", "temp_air", "wind_speed")}
-    return columns, measured
-
-
-def _members(study: Study, hourly: dict, per_interval: int, clear: dict, zenith, dates, share):
-    """Each block's light drawn as its member of the cloud ensemble of its day
-    (:func:`foldopt.inputs.weather.ensemble.cloud_members`), and how much of the file's light the
-    members keep on average. A day's members are drawn from the seed and the day alone, so that a
-    member is the same whatever else a study runs with it."""
-    inverse, member = share
-    cos_zenith = np.cos(np.radians(zenith))
-    count = int(member.max()) + 1
-    drawn = {key: np.empty((count, len(dates), zenith.shape[1])) for key in ("ghi", "dni", "dhi")}
-    for day, date in enumerate(dates):
-        one = cloud_members(hourly["ghi"][day:day + 1], hourly["dhi"][day:day + 1], clear["ghi"][day:day + 1],
-                            cos_zenith[day:day + 1], per_interval, study.step_min, count,
-                            [study.weather.seed, date.toordinal()], hourly["cloud_cover"][day:day + 1])
-        for key in drawn:
-            drawn[key][:, day] = one[key][:, 0]
-    light = {key: values[member, inverse] for key, values in drawn.items()}
-    per_day = len(inverse) / len(dates)  # a day's members: all of them in every chunk (Blocks.chunks)
-    balance = {key: (float(hourly[key].sum()), float(light[key].sum()) / per_interval / per_day)
-               for key in ("dni", "ghi", "dhi")}
-    return light, balance
-
-
 def build_sky(study: Study, sites, dates, member=None) -> Sky:
     """The sky of a study's settings over blocks, one per (site, date), as one array program.
 
@@ -427,22 +314,20 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
     sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
     zenith = sun["solar_zenith"]
     dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.day_of_year]
-    up = zenith < 90.0
-    airmass = np.zeros(zenith.shape)
-    airmass[up] = relative_airmass(zenith[up])
     temp_air, balance = np.full(len(sites), float(study.temp_air)), None
-    temp_steps = wind_speed = wind_ref = None
+    temp_steps = wind_speed = wind_ref = terms = None
     notes = ()
+    transposition = study.sky_transposition()
     if study.weather is not None and study.weather.measured:
-        light, measured = _measured_light(study, grid, dates)
+        light, measured = measured_light(study, grid, dates)
         temp_steps, wind_speed = light.pop("temp_air"), light.pop("wind_speed")
         notes = tuple(measured.report())
     elif study.weather is not None:
-        clear = _clear_sky(grid, zenith, airmass, dni_extra, sites, "ineichen", study.linke_turbidity)
-        light, temp_steps, wind_speed, balance, (hourly, per_interval) = _weather_light(study, grid, dates, clear,
-                                                                                      zenith, dni_extra)
+        clear, _ = clear_light(grid, zenith, dni_extra, sites, "ineichen", study.linke_turbidity)
+        light, temp_steps, wind_speed, balance, (hourly, per_interval) = weather_light(study, grid, dates, clear,
+                                                                                     zenith, dni_extra)
         if share is not None:
-            light, balance = _members(study, hourly, per_interval, clear, zenith, dates, share)
+            light, balance = member_light(study, hourly, per_interval, clear, zenith, dates, share)
     sun_vector = sun.pop("sun_vector")
     if share is not None:
         inverse = share[0]
@@ -451,7 +336,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
                          grid.step_hours)
         sun = {key: value[inverse] for key, value in sun.items()}
         zenith, latitude, altitude = sun["solar_zenith"], latitude[inverse], altitude[inverse]
-        dni_extra, airmass = dni_extra[inverse], airmass[inverse]
+        dni_extra = dni_extra[inverse]
         temp_steps, wind_speed = temp_steps[inverse], wind_speed[inverse]
         dates = [dates[i] for i in inverse]
     if study.weather is not None:
@@ -462,30 +347,16 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         temp_air = np.where(lit.any(axis=1), (temp_steps * lit).sum(axis=1) / np.maximum(lit.sum(axis=1), 1),
                             temp_steps.mean(axis=1))
     elif study.sky in CLEAR_SKIES:
-        light = _clear_sky(grid, zenith, airmass, dni_extra, sites, study.sky, study.linke_turbidity)
+        light, terms = clear_light(grid, zenith, dni_extra, sites, study.sky, study.linke_turbidity, transposition,
+                                   study.albedo)
     else:
         beam_altitude = altitude if study.mode == "exact" else 0.0
         light = {"dni": clear_sky_dni(zenith, beam_altitude, study.sky, dayofyear=grid.day_of_year,
                                       climate=study.climate)}
     dni = light["dni"]
     ghi, dhi = light.get("ghi"), light.get("dhi")
-    terms = None
-    transposition = study.sky_transposition()
-    if transposition != "none":
-        # The terms of the steps with light (elementwise, and 0 without it), those steps alone.
-        ghi_of = ghi if ghi is not None else dni * np.clip(np.cos(np.radians(zenith)), 0, None)
-        dhi_of = dhi if dhi is not None else np.zeros_like(dni)
-        shown = np.flatnonzero((dni > 0) | (ghi_of > 0) | (dhi_of > 0))
-        # Laid out (n_blocks, 4, n_steps) as the engine reads it, placed a term at a time by flat index.
-        n_steps = dni.shape[1]
-        layout = np.zeros((dni.shape[0], 4, n_steps))
-        at = shown + shown // n_steps * (3 * n_steps)  # block b's step s: b * 4 n_steps + s
-        found = sky_diffuse_terms(
-            transposition, *(values.ravel()[shown] for values in (zenith, dni, ghi_of, dhi_of, dni_extra, airmass)),
-            study.albedo)
-        for k in range(4):
-            layout.reshape(-1)[at + k * n_steps] = found[:, k]
-        terms = np.moveaxis(layout, 1, -1)
+    if transposition != "none" and terms is None:
+        terms = diffuse_terms(transposition, zenith, dni, ghi, dhi, dni_extra, study.albedo)
     if horizons:
         dni, terms = block_behind_horizon(horizons, horizon_of, zenith, sun["solar_azimuth"], dni, terms)
     return Sky(
