@@ -125,3 +125,28 @@ def test_trackers_over_many_days_at_once_equal_each_day_alone(model):
         np.testing.assert_allclose(orientation[0][index], day.tracker_orientation()[0], atol=1e-9)
         np.testing.assert_allclose(orientation[1][index], day.tracker_orientation()[1], atol=1e-9)
         np.testing.assert_allclose(draw[index], day.tracker_draw(), atol=1e-12)
+
+
+@settings(max_examples=6, deadline=None)
+@given(st.floats(-65.0, 65.0), st.floats(-180.0, 180.0), st.integers(0, 364),
+       st.sampled_from(["dual-axis", "equatorial", "dual-axis-steps", "single-axis"]),
+       st.sampled_from([("ineichen", "perez"), ("ineichen", "isotropic"), ("meinel", "none")]))
+def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitude, day, model, sky_model):
+    """The compiled tracker irradiance of an open plain (sky_tracker_power's) is
+    foldopt.engine.rows.poa's NumPy expression to the bit, beam-only skies included."""
+    import datetime as dt
+
+    from foldopt.engine import rows as engines
+    from foldopt.engine.sky import build_sky
+    from foldopt.studies.designs import sky_tracker_orientation, sky_tracker_power
+
+    sky_name, transposition = sky_model
+    study = load_study(default_study_path()).variant(mode="exact", step_min=5, sky=sky_name,
+                                                     transposition=transposition, tracker={"model": model})
+    site = study.site.model_copy(update={"latitude": latitude, "longitude": longitude, "timezone": "UTC"})
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=(day + k * 121) % 365) for k in range(3)]
+    sky = build_sky(study, [site] * 3, dates)
+    orientation = sky_tracker_orientation(sky, study)
+    reference = engines.panel_power(sky, study, engines.poa(sky, orientation[0], orientation[1],
+                                                            normal=orientation[2]))
+    np.testing.assert_array_equal(sky_tracker_power(sky, study, orientation), reference)

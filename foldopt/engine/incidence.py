@@ -161,3 +161,28 @@ def steps_sum(values, first, n):
     for i in range(whole, count):
         a += values[start + i]
     return (a + b) + (c + d)
+
+
+@njit(cache=True)
+def turning_poa(normal, sun, beam, terms, span, poa):
+    """Plane-of-array irradiance [W/m^2] of a surface whose normal turns step by step (a tracker's)
+    over every block, into ``poa`` (n_blocks, n_steps), 0 outside each block's span.
+
+    The arithmetic of :func:`foldopt.physics.irradiance.plane_of_array` for the exact incidence on
+    an open plain without an incidence-angle modifier, in its order of operations (so the same
+    bits), walked over the span alone: outside it there is no light, and the NumPy expression gives 0
+    there too. ``normal`` is (n_blocks, n_steps, 3); ``sun``, ``beam``, ``terms`` and ``span`` are
+    :meth:`foldopt.engine.sky.Sky.kernel_layout`'s."""
+    has_terms = terms.shape[1] == 4
+    for b in range(normal.shape[0]):
+        poa[b, :] = 0.0
+        for s in range(span[b, 0], span[b, 1] + 1):
+            nx, ny, nz = normal[b, s, 0], normal[b, s, 1], normal[b, s, 2]
+            cos_aoi = nx * sun[b, 0, s] + ny * sun[b, 1, s] + nz * sun[b, 2, s]
+            lit = max(cos_aoi, 0.0)
+            value = beam[b, s] * lit
+            if has_terms:
+                sky = max(terms[b, 0, s] * ((1.0 + nz) * 0.5) + terms[b, 1, s] * lit
+                          + terms[b, 2, s] * math.sqrt(max(1.0 - nz * nz, 0.0)), 0.0)
+                value = value + sky + terms[b, 3, s] * (1.0 - nz) * 0.5
+            poa[b, s] = value

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from foldopt.engine import rows as engines
+from foldopt.engine.incidence import turning_poa
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.engine.sky import Sky
@@ -76,7 +77,13 @@ def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
         (n_blocks, n_steps) [W].
     """
     tilt, azimuth, normal = orientation
-    return engines.panel_power(sky, study, engines.poa(sky, tilt, azimuth, normal=normal))
+    if sky.horizon_of is not None or sky.iam != "none":
+        return engines.panel_power(sky, study, engines.poa(sky, tilt, azimuth, normal=normal))
+    # An open plain without a modifier (every map's): the same sums compiled, over the lit spans alone.
+    sun, _, beam, terms, span = sky.kernel_layout(False)
+    poa = np.empty(beam.shape)
+    turning_poa(np.ascontiguousarray(normal, dtype=float), sun, beam, terms, span, poa)
+    return engines.panel_power(sky, study, poa)
 
 
 def standby_available(gross, draw, lit, standby_w: float):
