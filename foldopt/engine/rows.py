@@ -393,19 +393,21 @@ def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_
 
     table_1d, table_parallel, table_series, linear_power, built = _tables(electricals, outputs, study)
     codes = np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64)
-    # Each orientation's normals and Eq. 5 factors once, then per row.
-    east = normal_vector(orientation[:, 0], orientation[:, 1])[row_orientation]
-    west = normal_vector(orientation[:, 2], orientation[:, 3])[row_orientation]
-    tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])
-    row_paper = np.stack([np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1)[row_orientation]
-    orientation = orientation[row_orientation]
-    iam_code, iam_params = _iam_code(sky.iam)
+    # Each orientation's normals (and Eq. 5 factors) once, then per row; the exact incidence reads
+    # no Eq. 5 factors (zeros stand in).
+    normals = np.stack([normal_vector(orientation[:, 0], orientation[:, 1]),
+                        normal_vector(orientation[:, 2], orientation[:, 3])], axis=1)
     paper = study.mode == "paper"
+    row_paper = np.zeros((row_block.size, 2, 4))
+    if paper:
+        tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])
+        row_paper = np.stack([np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1)[row_orientation]
+    iam_code, iam_params = _iam_code(sky.iam)
     first = electricals[0]
     work = reduce.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous)
     arrays = [*sky.kernel_layout(paper), np.asarray(step_tables[0], dtype=np.int64),
-              np.asarray(step_tables[1], dtype=float), row_block, np.stack([east, west], axis=1), row_paper,
-              row_views(sky, row_block, east, west, orientation), row_loadset]
+              np.asarray(step_tables[1], dtype=float), row_block, normals[row_orientation], row_paper,
+              row_views(sky, row_block, normals, orientation, row_orientation), row_loadset]
     # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
     kernel.fold_rows(
         *(np.ascontiguousarray(a) for a in arrays), paper, iam_code, iam_params, table_1d, table_parallel,

@@ -257,6 +257,8 @@ def _clock(sites, dates, step_min) -> ClockGrid:
     parts = [clock_grid([dates[i] for i in members], parse_timezone(zone), step_min) for zone, members in zones.items()]
     order = np.argsort(np.concatenate(list(zones.values())), kind="stable")
     stacked = ClockGrid.stack(parts)
+    if np.array_equal(order, np.arange(order.size)):
+        return stacked  # each zone's blocks together already (a map's batch of sites)
     return ClockGrid(stacked.utc_ns[order], stacked.utc_offset_ns[order],
                      tuple(stacked.timezones[i] for i in order), stacked.step_hours)
 

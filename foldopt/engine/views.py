@@ -63,7 +63,7 @@ def surface_views(sky: Sky, blocks, surface_tilt, surface_azimuth, cos_tilt):
     return iso, band
 
 
-def row_views(sky: Sky, row_block, east, west, orientation) -> np.ndarray:
+def row_views(sky: Sky, row_block, normals, orientation, row_orientation) -> np.ndarray:
     """The kernel's ``row_view``: (n_rows, 2, 2) factors per row and sub-panel.
 
     Parameters
@@ -71,25 +71,30 @@ def row_views(sky: Sky, row_block, east, west, orientation) -> np.ndarray:
     sky : Sky
     row_block : numpy.ndarray
         (n_rows,) block of each row.
-    east, west : numpy.ndarray
-        (n_rows, 3) the sub-panels' unit normals.
+    normals : numpy.ndarray
+        (n_orientations, 2, 3) the sub-panels' unit normals (east, west).
     orientation : numpy.ndarray
-        (n_rows, 4) east tilt, east azimuth, west tilt, west azimuth [deg].
+        (n_orientations, 4) east tilt, east azimuth, west tilt, west azimuth [deg].
+    row_orientation : numpy.ndarray
+        (n_rows,) orientation of each row.
 
     Returns
     -------
     numpy.ndarray
     """
-    views = np.empty((row_block.size, 2, 2))
-    for side, normal in enumerate((east, west)):
-        views[:, side, 0], views[:, side, 1] = open_views(normal[:, 2])
+    # On an open plain the factors are the orientation's: worked out once each, then per row.
+    views = np.empty((orientation.shape[0], 2, 2))
+    for side in (0, 1):
+        views[:, side, 0], views[:, side, 1] = open_views(normals[:, side, 2])
+    views = views[row_orientation]
     if sky.horizon_of is not None:
         of = sky.horizon_of[row_block]
         for k in np.unique(of[of >= 0]):
             rows = of == k
+            taken = orientation[row_orientation[rows]]
             for side in (0, 1):
-                views[rows, side, 0], views[rows, side, 1] = _views(
-                    orientation[rows, 2 * side], orientation[rows, 2 * side + 1], sky.horizons[k])
+                views[rows, side, 0], views[rows, side, 1] = _views(taken[:, 2 * side], taken[:, 2 * side + 1],
+                                                                    sky.horizons[k])
     return views
 
 

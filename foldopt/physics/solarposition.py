@@ -157,6 +157,8 @@ class ClockGrid:
         grids = list(grids)
         if len({g.shape[1] for g in grids}) != 1 or len({g.step_hours for g in grids}) != 1:
             raise ValueError("stacked grids need the same steps per day")
+        if len(grids) == 1:
+            return grids[0]
         return cls(np.concatenate([g.utc_ns for g in grids]), np.concatenate([g.utc_offset_ns for g in grids]),
                    sum((g.timezones for g in grids), ()), grids[0].step_hours)
 
@@ -209,7 +211,7 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
     if not np.isclose(n_steps, round(n_steps)):
         raise ValueError(f"step_min must divide 1440 min exactly, got {step_min}")
     offsets = np.round((np.arange(round(n_steps)) + 0.5) * step_min * 60e9).astype(np.int64)
-    midnights = np.array([np.datetime64(date, "ns") for date in dates]).astype(np.int64)
+    midnights = np.array(dates, dtype="datetime64[D]").astype("datetime64[ns]").astype(np.int64)
     naive = midnights[:, None] + offsets[None, :]
     if isinstance(timezone, dt.tzinfo) and not hasattr(timezone, "key"):
         # A fixed offset: no DST, so no localisation is needed.
