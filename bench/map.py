@@ -98,12 +98,17 @@ def _phase_timers():
 
 
 def phases(study: dict, sites: list, loads, relative: bool, year: int = 2025, repeats: int = 3) -> dict:
-    """Seconds per site of each phase on one core (numba on one thread): ``sites[0]`` first, untimed,
-    so that compiling and the tables' caches are not counted, then the rest, the minimum of
-    ``repeats`` runs of each phase and of the whole."""
+    """Seconds per site of each phase on one core, as a map's worker runs its chunks (its task,
+    :func:`foldopt.studies.cluster.evaluate_chunk`: numba on one thread, its memory settings):
+    ``sites[0]`` first, untimed, so that compiling and the tables' caches are not counted, then the
+    rest, the minimum of ``repeats`` runs of each phase and of the whole."""
+    import functools
+
     import numba
 
-    from foldopt.studies.worldmap import evaluate_sites
+    from foldopt.studies.cluster import evaluate_chunk
+
+    evaluate_sites = functools.partial(evaluate_chunk, engine="numba")
 
     threads = numba.get_num_threads()
     numba.set_num_threads(1)

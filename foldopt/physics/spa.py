@@ -201,15 +201,35 @@ def _shared_terms(utc_ns: np.ndarray) -> tuple:
     return start - first, terms
 
 
+@njit(cache=True, inline="always")
+def _raised(east, north, up, t):
+    """The unit vector (east, north, up) raised by ``t`` [rad] toward the zenith in its vertical
+    plane. The turn is SPA's refraction, under 0.011 rad: its sine and cosine by their series to the
+    9th and 10th power, exact in double precision (the next terms are below 1e-21)."""
+    t2 = t * t
+    sin_t = t * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))))
+    cos_t = 1.0 - t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))))
+    level = math.sqrt(east * east + north * north)
+    along = (level * cos_t - up * sin_t) / level if level > 0.0 else 0.0
+    return east * along, north * along, up * cos_t + level * sin_t
+
+
 @njit(cache=True)
-def _site_directions(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, direction):
-    """The geometric (refraction-free) topocentric unit vector toward the sun (east, north, up)
-    at every step of every block into ``direction`` (n_blocks, 3, n_steps): block ``b``'s step
-    ``i`` from ``terms[:, first[b] + i]`` (:func:`_shared_terms`), the site's arguments per block.
-    Arithmetic alone, indexed so that it vectorises; the angles are NumPy's (vectorised too)."""
+def _site_sun(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, pressure, direction, zenith, azimuth):
+    """Every step of every block in one pass: the geometric topocentric unit vector toward the sun
+    (east, north, up), from ``terms[:, first[b] + i]`` (:func:`_shared_terms`) and the site's
+    arguments per block; its elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s
+    formula and switch, at ``pressure`` [hPa] per block and :data:`SPA_TEMPERATURE`), which raises
+    the vector in its vertical plane (:func:`_raised`) and the elevation. Writes ``direction``
+    (n_blocks, 3, n_steps), the apparent ``zenith`` and the ``azimuth`` [deg] (n_blocks, n_steps),
+    each value by the operations of the NumPy expressions this pass replaced, in their order."""
     n_blocks, n_steps = direction.shape[0], direction.shape[2]
+    to_degrees, to_radians = 180.0 / math.pi, math.pi / 180.0
+    cut = -1.0 * (0.26667 + SPA_ATMOS_REFRACT)
     for b in range(n_blocks):
         start = uint64(first[b])
+        # Eq. 42's factor of pressure and temperature, as pvlib groups it.
+        scale = (pressure[b] / 1010.0) * (283.0 / (273 + SPA_TEMPERATURE)) * 1.02
         for i in range(uint64(n_steps)):
             k = start + i
             # cos(delta) cos(H) and cos(delta) sin(H) at the site's hour angle H = H_G + longitude.
@@ -220,28 +240,17 @@ def _site_directions(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, dir
             east = -sin_h
             north = pole * cos_phi[b] - meridian * sin_phi[b]
             up = pole * sin_phi[b] + meridian * cos_phi[b]
-            scale = 1.0 / math.sqrt(east * east + north * north + up * up)
-            direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east * scale, north * scale, up * scale
-
-
-@njit(cache=True)
-def _raise(vector, turn):
-    """Each unit vector of ``vector`` (n_blocks, 3, n_steps) raised by ``turn`` [rad] (n_blocks,
-    n_steps) toward the zenith in its vertical plane. The turn is SPA's refraction, under 0.011
-    rad: its sine and cosine by their series to the 9th and 10th power, exact in double precision
-    (the next terms are below 1e-21)."""
-    for b in range(turn.shape[0]):
-        for i in range(turn.shape[1]):
-            t = turn[b, i]
-            if t == 0.0:
-                continue
-            t2 = t * t
-            sin_t = t * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))))
-            cos_t = 1.0 - t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))))
-            east, north, up = vector[b, 0, i], vector[b, 1, i], vector[b, 2, i]
-            level = math.sqrt(east * east + north * north)
-            along = (level * cos_t - up * sin_t) / level if level > 0.0 else 0.0
-            vector[b, 0, i], vector[b, 1, i], vector[b, 2, i] = east * along, north * along, up * cos_t + level * sin_t
+            norm = 1.0 / math.sqrt(east * east + north * north + up * up)
+            east, north, up = east * norm, north * norm, up * norm
+            elevation = math.asin(min(max(up, -1.0), 1.0)) * to_degrees
+            heading = math.atan2(east, north) * to_degrees
+            azimuth[b, i] = heading + 360.0 if heading < 0.0 else heading
+            if elevation >= cut:
+                refraction = scale / (60 * math.tan((elevation + 10.3 / (elevation + 5.11)) * to_radians))
+                east, north, up = _raised(east, north, up, refraction * to_radians)
+                elevation += refraction
+            direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
+            zenith[b, i] = 90.0 - elevation
 
 
 def spa_solar_position(utc_ns, latitude, longitude, altitude):
@@ -255,9 +264,9 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     by the site's longitude and latitude, less the site's own position seen from the Earth's centre
     (``x`` and ``y`` of [1]_ Eq. 38-39, scaled by ``sin(xi)``): the vector form of SPA's parallax in
     right ascension and declination (Eq. 40-41, 43-45), exact, with no trigonometry per step but
-    the elevation's and the azimuth's (:func:`_site_directions`). SPA's refraction correction
-    (Eq. 42, pvlib's function, with pvlib's default pressure for the altitude and 12 C) raises it
-    at every step (:func:`_raise`). Against pvlib's ``spa_python`` on random sites and days at
+    the elevation's and the azimuth's. SPA's refraction correction (Eq. 42, pvlib's formula, with
+    pvlib's default pressure for the altitude and 12 C) raises it at every step; all of it one
+    compiled pass over the steps (:func:`_site_sun`). Against pvlib's ``spa_python`` on random sites and days at
     1-min steps, the sun's direction is within 2e-6 deg (tests/test_solarposition.py).
 
     Parameters
@@ -297,18 +306,9 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     lam, phi = np.radians(longitude), np.radians(latitude)
     first, terms = _shared_terms(utc_ns)
     vector = np.empty((shape[0], 3, shape[1]))  # each component along the steps, as the engine reads it
-    _site_directions(terms, first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, vector)
-    elevation = np.degrees(np.arcsin(np.clip(vector[:, 2], -1.0, 1.0)))
-    azimuth = np.degrees(np.arctan2(vector[:, 0], vector[:, 1]))
-    azimuth[azimuth < 0.0] += 360.0
-    # SPA's refraction (0 more than 0.83 deg below the horizon, so worked out only above that)
-    # raises the direction in its vertical plane, its azimuth kept.
-    refraction = np.zeros(shape)
-    near = elevation >= -(0.26667 + SPA_ATMOS_REFRACT)  # pvlib.spa's own switch
-    pressure = np.broadcast_to((pvlib.atmosphere.alt2pres(altitude) / 100.0)[:, None], shape)
-    refraction[near] = pvlib.spa.atmospheric_refraction_correction(pressure[near], SPA_TEMPERATURE, elevation[near],
-                                                                   SPA_ATMOS_REFRACT)
-    _raise(vector, np.radians(refraction))
-    elevation += refraction
+    zenith, azimuth = np.empty(shape), np.empty(shape)
+    pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
+    _site_sun(terms, first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure, vector, zenith,
+              azimuth)
     equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
-    return np.subtract(90.0, elevation, out=elevation), azimuth, equation_of_time, np.moveaxis(vector, 1, -1)
+    return zenith, azimuth, equation_of_time, np.moveaxis(vector, 1, -1)
