@@ -29,6 +29,7 @@ from foldopt.physics.horizon import sun_visible
 from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
 from foldopt.physics.temperature import equivalent_temp_air
 
+
 def step_span(some) -> np.ndarray:
     """(n_rows, 2) the first and last true step of each row of ``some``, (n_rows, n_steps) bool,
     widened by one step either side within the row ((0, 0) for a row with none): the steps the
