@@ -69,8 +69,9 @@ def clear_light(grid: ClockGrid, zenith, dni_extra, sites, model: str, linke_tur
     for index, site in enumerate(sites):
         groups.setdefault((site.latitude, site.longitude, site.altitude), []).append(index)
     if model == "ineichen":
-        turbidity = np.full(zenith.shape, np.nan if linke_turbidity is None else float(linke_turbidity))
-        if linke_turbidity is None:
+        turbidity = linke_turbidity
+        if turbidity is None:
+            turbidity = np.empty(zenith.shape)
             for (latitude, longitude, _), members in groups.items():
                 turbidity[members] = climatology_turbidity(latitude, longitude, grid.utc_ns[members])
         altitude = np.array([site.altitude for site in sites], dtype=float)
@@ -121,10 +122,8 @@ def diffuse_terms(transposition: str, zenith, dni, ghi, dhi, dni_extra, albedo: 
     n_steps = dni.shape[1]
     layout = np.zeros((dni.shape[0], 4, n_steps))
     at = shown + shown // n_steps * (3 * n_steps)
-    zenith_of = zenith.ravel()[shown]
-    found = sky_diffuse_terms(transposition, zenith_of, *(values.ravel()[shown] for values in (dni, ghi_of, dhi_of,
-                                                                                               dni_extra)),
-                              _airmass(zenith_of), albedo)
+    values = [array.ravel()[shown] for array in (zenith, dni, ghi_of, dhi_of, dni_extra)]
+    found = sky_diffuse_terms(transposition, *values, _airmass(values[0]), albedo)
     for k in range(4):
         layout.reshape(-1)[at + k * n_steps] = found[:, k]
     return np.moveaxis(layout, 1, -1)

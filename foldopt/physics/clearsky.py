@@ -47,30 +47,22 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pvlib
 from numba import njit
 
 from foldopt import names
+from foldopt.physics.irradiance import (CLEARNESS_EDGES, HAYDAVIES_COS_FLOOR, PEREZ_COS_FLOOR, PEREZ_KAPPA,
+                                        perez_coefficients)
 
 #: Transpositions by their code in the compiled loop (``none``: no diffuse terms).
 TRANSPOSITION_CODES = {"none": 0, "isotropic": 1, "haydavies": 2, "perez": 3}
-#: Lower edges of Perez et al.'s eight sky-clearness bins [5]_ Table 6, the first from 0 as pvlib
-#: places it; a clearness below 0 (or NaN: no diffuse light) has no bin and no diffuse terms.
-CLEARNESS_EDGES = np.array([0.0, 1.065, 1.23, 1.5, 1.95, 2.8, 4.5, 6.2])
-KAPPA = 1.041  # [rad^-3], Perez et al. [5]_ Eq. 1
 STANDARD_PRESSURE = 101325.0  # [Pa]
-
-
-def _perez_coefficients() -> tuple[np.ndarray, np.ndarray]:
-    f1, f2 = pvlib.irradiance._get_perez_coefficients("allsitescomposite1990")
-    return np.ascontiguousarray(f1, dtype=float), np.ascontiguousarray(f2, dtype=float)
+_EDGES = np.array(CLEARNESS_EDGES)  # an array, as the compiled loop takes a global
 
 
 @njit(cache=True)
 def _ineichen_terms(zenith, dni_extra, turbidity, altitude, code, albedo, f1c, f2c, dni, ghi, dhi, terms):
     """The loop of :func:`ineichen_terms` over blocks and steps; writes only steps with the sun up."""
     n_blocks, n_steps = zenith.shape
-    cos85 = math.cos(math.radians(85.0))
     for b in range(n_blocks):
         h = altitude[b]
         fh1 = math.exp(-h / 8000.0)
@@ -104,19 +96,19 @@ def _ineichen_terms(zenith, dni_extra, turbidity, altitude, code, albedo, f1c, f
             elif code == 2:
                 anisotropy = d / extra
                 iso = diffuse * max(1.0 - anisotropy, 0.0)
-                circ = diffuse * anisotropy / max(cos_z, 0.01745)
+                circ = diffuse * anisotropy / max(cos_z, HAYDAVIES_COS_FLOOR)
             elif diffuse != 0.0:
-                kappa_z3 = KAPPA * (z_rad * z_rad * z_rad)
+                kappa_z3 = PEREZ_KAPPA * (z_rad * z_rad * z_rad)
                 eps = ((diffuse + d) / diffuse + kappa_z3) / (1.0 + kappa_z3)
                 k = -1
-                for edge in CLEARNESS_EDGES:
+                for edge in _EDGES:
                     k += eps >= edge
                 if k >= 0:
                     delta = diffuse * airmass / extra
                     f1 = max(f1c[k, 0] + f1c[k, 1] * delta + f1c[k, 2] * z_rad, 0.0)
                     f2 = f2c[k, 0] + f2c[k, 1] * delta + f2c[k, 2] * z_rad
                     iso = diffuse * (1.0 - f1)
-                    circ = diffuse * f1 / max(cos_z, cos85)
+                    circ = diffuse * f1 / max(cos_z, PEREZ_COS_FLOOR)
                     hor = diffuse * f2
             terms[b, 0, s], terms[b, 1, s], terms[b, 2, s], terms[b, 3, s] = iso, circ, hor, g * albedo
 
@@ -163,5 +155,5 @@ def ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, transp
     dni, ghi, dhi = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     code = TRANSPOSITION_CODES[transposition]
     terms = np.zeros((shape[0], 4 if code else 0, shape[1]))
-    _ineichen_terms(zenith, *arrays, heights, code, float(albedo), *_perez_coefficients(), dni, ghi, dhi, terms)
+    _ineichen_terms(zenith, *arrays, heights, code, float(albedo), *perez_coefficients(), dni, ghi, dhi, terms)
     return dni, ghi, dhi, (terms if code else None)

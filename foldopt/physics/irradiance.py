@@ -36,6 +36,19 @@ from foldopt import names
 
 INCIDENCE_MODELS = ("paper", "exact")
 TRANSPOSITIONS = tuple(name for name in names.TRANSPOSITIONS if name != "none")
+#: Lower edges of Perez et al.'s eight sky-clearness bins [5]_ Table 6, the first from 0 as pvlib
+#: places it; a clearness below 0 (or NaN: no diffuse light) has no bin and no diffuse terms.
+CLEARNESS_EDGES = (0.0, 1.065, 1.23, 1.5, 1.95, 2.8, 4.5, 6.2)
+PEREZ_KAPPA = 1.041  # [rad^-3], Perez et al. [5]_ Eq. 1
+#: The floors of cos(zenith) under the circumsolar term, as pvlib's ``haydavies`` and ``perez`` set them.
+HAYDAVIES_COS_FLOOR, PEREZ_COS_FLOOR = 0.01745, float(np.cos(np.radians(85.0)))
+
+
+def perez_coefficients() -> tuple[np.ndarray, np.ndarray]:
+    """Perez et al.'s F1 and F2 coefficients [5]_ Table 6 per clearness bin, (8, 3) each, as pvlib's
+    ``allsitescomposite1990`` set."""
+    f1, f2 = pvlib.irradiance._get_perez_coefficients("allsitescomposite1990")
+    return np.ascontiguousarray(f1, dtype=float), np.ascontiguousarray(f2, dtype=float)
 
 
 def beam_incidence_factor(surface_tilt, surface_azimuth, solar_zenith, solar_azimuth, model="exact"):
@@ -90,19 +103,17 @@ def _perez_brightness(dhi, dni, dni_extra, solar_zenith, airmass):
     """Perez et al.'s circumsolar and horizon brightening coefficients F1, F2 [5]_ Eq. 9, with the
     sky clearness bins and coefficients of pvlib's ``irradiance.perez`` (``allsitescomposite1990``);
     NaN where there is no diffuse light."""
-    kappa = 1.041  # [rad^-3]
     z = np.radians(solar_zenith)
     delta = dhi * airmass / dni_extra
-    kappa_z3 = kappa * (z * z * z)  # products, not a power: a map's sky spent 1.5 ms a site in pow
+    kappa_z3 = PEREZ_KAPPA * (z * z * z)  # products, not a power: a map's sky spent 1.5 ms a site in pow
     with np.errstate(invalid="ignore", divide="ignore"):
         eps = ((dhi + dni) / dhi + kappa_z3) / (1.0 + kappa_z3)
     # The bin is the count of its lower edges at or below eps, less one (np.digitize's), -1 for NaN
     # (no diffuse light), summed edge by edge: eight comparisons are a third of a binary search's cost.
     bins = np.full(np.shape(eps), -1, dtype=np.intp)
-    for edge in (0.0, 1.065, 1.23, 1.5, 1.95, 2.8, 4.5, 6.2):
+    for edge in CLEARNESS_EDGES:
         bins += eps >= edge
-    f1c, f2c = (np.vstack((c, np.full(3, np.nan))) for c in pvlib.irradiance._get_perez_coefficients(
-        "allsitescomposite1990"))
+    f1c, f2c = (np.vstack((c, np.full(3, np.nan))) for c in perez_coefficients())
     f1 = np.maximum(f1c[bins, 0] + f1c[bins, 1] * delta + f1c[bins, 2] * z, 0.0)
     f2 = f2c[bins, 0] + f2c[bins, 1] * delta + f2c[bins, 2] * z
     return f1, f2
@@ -137,12 +148,12 @@ def sky_diffuse_terms(model, solar_zenith, dni, ghi, dhi, dni_extra, airmass, al
     elif model == "haydavies":
         anisotropy = np.asarray(dni, dtype=float) / dni_extra
         iso = dhi * np.maximum(1.0 - anisotropy, 0.0)
-        circ = dhi * anisotropy / np.maximum(np.cos(np.radians(solar_zenith)), 0.01745)
+        circ = dhi * anisotropy / np.maximum(np.cos(np.radians(solar_zenith)), HAYDAVIES_COS_FLOOR)
         hor = zeros
     elif model == "perez":
         f1, f2 = _perez_brightness(dhi, dni, dni_extra, solar_zenith, airmass)
         iso = dhi * (1.0 - f1)
-        circ = dhi * f1 / np.maximum(np.cos(np.radians(solar_zenith)), np.cos(np.radians(85.0)))
+        circ = dhi * f1 / np.maximum(np.cos(np.radians(solar_zenith)), PEREZ_COS_FLOOR)
         hor = dhi * f2
     else:
         raise ValueError(f"transposition must be one of {', '.join(TRANSPOSITIONS)}; got {model!r}")
