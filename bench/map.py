@@ -7,6 +7,7 @@
     python bench/map.py --w5 --phases    # ... W5's: land sites, fold angles searched; 100 workers' time
     python bench/map.py --w5 --sites 1000 # W5 on 1,000 of the 1-degree land grid's sites, the grid projected
     python bench/map.py --w5             # W5: the whole 1-degree land grid (target 600 s)
+    python bench/map.py --w5 --sites 1000 --step-min 10  # ... projected at 10-min steps
 
 W4: 2,000 sites (a 40 x 50 latitude x longitude grid from 58.5 S to 58.5 N) x 365 days x 180
 fold angles (1..180 deg) x 10 loads (5 % to 50 % of each site's flat peak), the map's defaults:
@@ -146,7 +147,7 @@ def _land_sites(subset: int | None) -> tuple[list, list]:
 W5_TARGET_S = 600.0  # the 1-degree land grid on this machine's embedded cluster
 
 
-def w5(subset: int | None, check_sites: int = 200) -> None:
+def w5(subset: int | None, check_sites: int = 200, step_min: float = 5.0) -> None:
     """W5: the 1-degree land grid (a year each, 10 loads, 5 periods, 5-min steps) on the embedded
     cluster of two workers, its fold angles searched (``--fold-search``); ``subset`` sites spread over
     the grid instead, the whole grid's time projected from them. Then ``check_sites`` of them
@@ -158,7 +159,10 @@ def w5(subset: int | None, check_sites: int = 200) -> None:
     some 7 s to every worker's first chunk done, on 1,000 sites) once, the steady pace after them
     (sites a second, from the chunks that finished after every worker's first) for the rest of the
     grid, and the tables written at the end (their rows scale with the sites). Scaling the whole
-    subset's time instead would count the once-only costs some 50 times for 400 sites."""
+    subset's time instead would count the once-only costs some 50 times for 400 sites.
+
+    ``step_min`` other than 5 measures W5 at another time step (``--step-min``), what the issue's
+    target would cost with a coarser clock; the check is then against the full sweep at that step."""
     import pandas as pd
 
     from foldopt.inputs.load import default_study_path, read_study
@@ -167,7 +171,7 @@ def w5(subset: int | None, check_sites: int = 200) -> None:
 
     land, sites = _land_sites(subset)
     loads = tuple(np.round(np.arange(1, 11) * 0.05, 6))
-    full = map_study(read_study(default_study_path())[0])
+    full = {**map_study(read_study(default_study_path())[0]), "step_min": step_min}
     searched = {**full, "optimize": {"vary": ["fold_angle"]}}
     workers = 2
     ready, done = {}, []
@@ -178,7 +182,8 @@ def w5(subset: int | None, check_sites: int = 200) -> None:
                          progress=lambda finished, _: done.append((time.perf_counter(), finished)))
         wall = time.perf_counter() - started
     start_up = ready["at"] - started
-    print(f"W5: {len(sites):,} of the {len(land):,} land sites in {wall:.1f} s on {workers} workers, of which "
+    print(f"W5{'' if step_min == 5.0 else f' at {step_min:g}-min steps'}: {len(sites):,} of the {len(land):,} "
+          f"land sites in {wall:.1f} s on {workers} workers, of which "
           f"{start_up:.1f} s the cluster's start")
     finishes = [(at, finished) for at, finished in done if finished > 0]
     if subset is not None and len(finishes) > workers + 1:
@@ -215,6 +220,7 @@ def main() -> None:
     parser.add_argument("--phases", action="store_true", help="only the per-site cost by phase (one core, timed)")
     parser.add_argument("--w5", action="store_true", help="W5: the 1-degree land grid with the fold search "
                                                           "(--sites N: N of its sites, the whole extrapolated)")
+    parser.add_argument("--step-min", type=float, default=5.0, help="W5 at another time step [min] (default 5)")
     args = parser.parse_args()
     if args.w5 and args.phases:
         from foldopt.inputs.load import default_study_path, read_study
@@ -230,7 +236,7 @@ def main() -> None:
               f"on 100 workers {len(land) * per_site / 100:.0f} s of compute plus the cluster's start")
         return
     if args.w5:
-        w5(args.sites if "--sites" in sys.argv else None)
+        w5(args.sites if "--sites" in sys.argv else None, step_min=args.step_min)
         return
     spec = _spec(args.sites)
     if args.phases:
