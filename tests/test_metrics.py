@@ -105,3 +105,26 @@ def test_relative_to_has_no_value_over_nothing():
     ratio = relative_to([2.0, 0.0, 3.0, 0.0], [1.0, 1.0, 0.0, 0.0])
     np.testing.assert_array_equal(ratio[:2], [2.0, 0.0])
     assert np.isnan(ratio[2:]).all()  # no inf, no warning: a gain over 0 h has no value
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(1, 400), st.integers(1, 6), st.integers(1, 11), st.sampled_from(["mean", "worst-month"]),
+       st.lists(st.one_of(st.none(), st.sets(st.integers(1, 12), min_size=1, max_size=4)), min_size=1, max_size=5),
+       st.integers(0, 2**32 - 1))
+def test_period_values_are_each_periods_own_statistic_to_the_bit(days, n, loads, statistic, seasons, seed):
+    """The periods' means and worst months summed in one pass over the days (a map's search) are
+    the bits of the statistic taken over each period's own days (objective_value, NumPy's mean of
+    the period's days): a map's answers stay those of a study of the same site."""
+    import warnings
+
+    from foldopt.studies.objectives import objective_value, period_values
+
+    rng = np.random.default_rng(seed)
+    months = rng.integers(1, 13, days)
+    if statistic == "worst-month":  # a worst month needs a day in the period
+        seasons = [season for season in seasons if season is None or np.isin(months, list(season)).any()] or [None]
+    hours = rng.random((days, n, loads)) * 12.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # the mean of a period without days: NaN
+        expected = np.stack([objective_value(hours, months, statistic, season) for season in seasons])
+    np.testing.assert_array_equal(period_values(hours, months, statistic, seasons), expected)

@@ -1,4 +1,5 @@
-"""Compiled reduction of power curves to daily metrics (numba), and the scratch of the kernels.
+"""Compiled reduction of power curves to daily metrics (numba), of daily values to the means of
+periods of days (:func:`period_means`), and the scratch of the kernels.
 
 :func:`day_metrics` reduces one power curve to the daily metrics of every load at once; the
 kernel :func:`foldopt.engine.kernel.fold_rows` calls it per row and connection, and
@@ -182,6 +183,41 @@ def curve_rows(power, span, row_loadset, loads, step_hours, contiguous, load_sha
                 power[r], span[r, 0], span[r, 1], step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
                 run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0], load_shape[r if use_shape else 0],
                 use_shape)
+
+
+@njit(cache=True)
+def period_means(hours, member):
+    """The mean over each period's days of daily values, in one pass over the days.
+
+    Parameters
+    ----------
+    hours : (n_days, n) float
+        Daily values (t_solar [h]) of ``n`` designs and loads.
+    member : (n_periods, n_days) bool
+        Whether each day belongs to each period.
+
+    Returns
+    -------
+    (n_periods, n) float
+        Each period's mean, NaN for a period of no day. Each is summed over its days in their order,
+        then divided by their count: for ``n`` of 2 or more the bits of NumPy's
+        ``hours[member[p]].mean(axis=0)``, which adds the days in order (with ``n`` 1 it sums them
+        pairwise), without the copy of the period's days that costs a map's search most of its
+        objective's time (``tests/test_metrics.py``).
+    """
+    n_periods, n = member.shape[0], hours.shape[1]
+    total = np.zeros((n_periods, n))
+    count = np.zeros(n_periods)
+    for d in range(hours.shape[0]):
+        for p in range(n_periods):
+            if member[p, d]:
+                count[p] += 1.0
+                for x in range(n):
+                    total[p, x] += hours[d, x]
+    for p in range(n_periods):
+        for x in range(n):
+            total[p, x] = total[p, x] / count[p] if count[p] > 0.0 else np.nan
+    return total
 
 
 def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):

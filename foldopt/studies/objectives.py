@@ -3,7 +3,7 @@ a statistic of daily t_solar over the days of a study (:func:`objective_value`, 
 the plateau of near-optimal angles around the best (:func:`near_optimal`), and over a cloud
 ensemble, the members' spread and how sure the choice is (:func:`ensemble_choice`).
 
-The module may import numpy, scipy and :mod:`foldopt.inputs.sections`.
+The module may import numpy, scipy, :mod:`foldopt.inputs.sections` and :mod:`foldopt.engine.reduce`.
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
+from foldopt.engine.reduce import period_means
 from foldopt.inputs.sections import NearOptimal
 
 
@@ -95,7 +96,20 @@ def period_values(hours, months, statistic: str, seasons):
     seasons : sequence
         Each period's months (None: every day).
     """
-    return np.stack([objective_value(hours, months, statistic, season) for season in seasons])
+    hours, months = np.asarray(hours, dtype=float), np.asarray(months)
+    if statistic not in ("mean", "worst-month") or hours[0].size < 2:
+        # One value a day: NumPy sums it pairwise, not in the days' order.
+        return np.stack([objective_value(hours, months, statistic, season) for season in seasons])
+    # The same bits as objective_value's, the means summed in one pass over the days (no copy of a
+    # period's days): a period's mean, or the lowest of its months' means (a season keeps whole months).
+    flat = np.ascontiguousarray(hours.reshape(hours.shape[0], -1))
+    if statistic == "mean":
+        value = period_means(flat, np.stack([season_days(months, season) for season in seasons]))
+    else:
+        present = np.unique(months)
+        monthly = period_means(flat, months[None, :] == present[:, None])
+        value = np.stack([monthly[season_days(present, season)].min(axis=0) for season in seasons])
+    return value.reshape((len(seasons),) + hours.shape[1:])
 
 
 def objective_quantum(statistic: str, step_hours: float, n_days: int, months) -> float:
