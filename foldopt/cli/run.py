@@ -11,7 +11,6 @@ from foldopt.cli.output import INVOCATION, Output
 from foldopt.files import check_output
 from foldopt.inputs.plan import load_plan
 from foldopt.inputs.load import default_study_path
-from foldopt.studies.day import StudyResult
 from foldopt.studies.request import Request
 
 
@@ -38,7 +37,9 @@ def run_request(request: Request, out: Path, overwrite: bool, output: Output, en
         unit = "site-days" if any(path.startswith("site") for path, _ in plan.axes) else "days"
         label, total = f"{base.name}: {days} {unit}", days
     with output.progress(label, total=total, unit=unit) as progress:
+        # The studies' modules (pvlib, pandas, numba) only once there is work: help and a bad value stay quick.
         from foldopt.api import run, write
+        from foldopt.studies.day import StudyResult
 
         result = run(plan, engine, progress, request=request)
         write(result, out, overwrite, INVOCATION)
