@@ -16,9 +16,10 @@ are indexed as unsigned integers) and that nothing in it depends on a setting kn
 time. So the loops are written once and inlined once per case, each case's settings passed as
 constants (the incidence per mode, diffuse terms and modifier; the ideal model's power per
 connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
-(:func:`_chunk_rows`) whose scratch is taken once. On a map's year (the ideal model, 10 loads)
-a row step costs about 5 ns on one core, against 21 ns before (the kernel's share of
-``bench/map.py --w5 --phases``).
+(:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
+loop, not called. On a map's year (the ideal model, 10 loads) a row step cost about 5 ns on one
+core on a fast day, against 21 ns before (the kernel's share of ``bench/map.py --w5 --phases``);
+8.8 ns on the slower machine of 2026-12-03, of which some 5.9 ns the walk over the loads.
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.rows` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
