@@ -8,6 +8,8 @@ The module may import numpy, scipy, :mod:`foldopt.inputs.sections` and :mod:`fol
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
@@ -97,8 +99,8 @@ def period_values(hours, months, statistic: str, seasons):
         Each period's months (None: every day).
     """
     hours, months = np.asarray(hours, dtype=float), np.asarray(months)
-    if statistic not in ("mean", "worst-month") or hours[0].size < 2:
-        # One value a day: NumPy sums it pairwise, not in the days' order.
+    if statistic not in ("mean", "worst-month") or math.prod(hours.shape[1:]) < 2 or hours.shape[0] == 0:
+        # One value a day: NumPy sums it pairwise, not in the days' order (and no day: its NaN or error).
         return np.stack([objective_value(hours, months, statistic, season) for season in seasons])
     # The same bits as objective_value's, the means summed in one pass over the days (no copy of a
     # period's days): a period's mean, or the lowest of its months' means (a season keeps whole months).
