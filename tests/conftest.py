@@ -21,6 +21,13 @@ def pytest_configure(config):
     # between runs, ignored by git) rather than in the user's ~/.cache.
     if getattr(config, "cache", None) is not None:  # None under -p no:cacheprovider
         os.environ.setdefault("FOLDOPT_CACHE_DIR", str(config.cache.mkdir("foldopt")))
+    if sys.dont_write_bytecode or os.environ.get("PYTHONDONTWRITEBYTECODE"):
+        # Where the environment asks Python not to write bytecode (this machine's does), each pytest
+        # process would rewrite every test module for its assertions again (some 7 s), and each command
+        # line a test starts would compile foldopt's modules again (some 0.5 s). The suite keeps the
+        # bytecode of its own runs, in the __pycache__ folders git ignores, as Python does by default.
+        sys.dont_write_bytecode = False
+        os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
     if hasattr(config, "workerinput") and "numba" not in sys.modules:
         # Each pytest-xdist worker has a core of its own: numba's threads (OpenMP, which spins while
         # it waits) and OpenBLAS's would fight the other worker for it. One thread each, here and in
