@@ -8,6 +8,7 @@
     python bench/map.py --w5 --sites 1000 # W5 on 1,000 of the 1-degree land grid's sites, the grid projected
     python bench/map.py --w5             # W5: the whole 1-degree land grid (target 600 s)
     python bench/map.py --w5 --sites 1000 --step-min 10  # ... projected at 10-min steps
+    python bench/map.py --w5 --phases --step-min 30      # a site's cost by phase at 30-min steps
 
 W4: 2,000 sites (a 40 x 50 latitude x longitude grid from 58.5 S to 58.5 N) x 365 days x 180
 fold angles (1..180 deg) x 10 loads (5 % to 50 % of each site's flat peak), the map's defaults:
@@ -220,16 +221,19 @@ def main() -> None:
     parser.add_argument("--phases", action="store_true", help="only the per-site cost by phase (one core, timed)")
     parser.add_argument("--w5", action="store_true", help="W5: the 1-degree land grid with the fold search "
                                                           "(--sites N: N of its sites, the whole extrapolated)")
-    parser.add_argument("--step-min", type=float, default=5.0, help="W5 at another time step [min] (default 5)")
+    parser.add_argument("--step-min", type=float, default=5.0, help="W5 (and --w5 --phases) at another time step [min] "
+                                                                        "(default 5)")
     args = parser.parse_args()
     if args.w5 and args.phases:
         from foldopt.inputs.load import default_study_path, read_study
         from foldopt.studies.worldmap import map_study
 
         land, sites = _land_sites(25)
-        searched = {**map_study(read_study(default_study_path())[0]), "optimize": {"vary": ["fold_angle"]}}
+        searched = {**map_study(read_study(default_study_path())[0]), "optimize": {"vary": ["fold_angle"]},
+                    "step_min": args.step_min}
         cost = phases(searched, sites, tuple(np.round(np.arange(1, 11) * 0.05, 6)), relative=True)
-        print("W5's sites (24 of the 1-degree land grid, fold angles searched): ", end="")
+        print(f"W5's sites (24 of the 1-degree land grid, fold angles searched, {args.step_min:g}-min steps): ",
+              end="")
         _print_phases(cost)
         per_site = cost["per_site_s"]
         print(f"the {len(land):,} land sites at that cost: {len(land) * per_site / 3600:.2f} core-hours; "
