@@ -269,3 +269,35 @@ def test_bad_diodes_are_refused_with_the_valid_names():
         diode("constant", forward_voltage=-0.1)
     assert names.DIODE_MODELS in names.REGISTRIES
     assert tuple(names.DIODE_MODELS) == ("ideal", "constant", "shockley")
+
+
+@pytest.mark.filterwarnings("error")  # pvlib's overflow at a load far above open circuit once reached stderr
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("switch_resistance", [0.0, 0.03])
+def test_a_load_beyond_the_panels_reach_draws_nothing_and_warns_nothing(model, switch_resistance):
+    """Wired directly, a connection delivers ``V I`` with ``0 <= I <= I_sc``: nothing where the load's
+    voltage is above every open-circuit voltage it could reach (a string's is the sum of its two), and
+    at most ``V`` times the short-circuit currents at a load voltage near 0 V. Cold cells (-20 C) have
+    the highest open-circuit voltage, dark ones none."""
+    rng = np.random.default_rng(5)
+    poa = np.concatenate([[0.0, 1e-6, 1000.0, 1500.0], rng.uniform(0, 1500, 8)])
+    for temp in (-20.0, 80.0):
+        east, west = curves(poa, poa[::-1], temp, model)
+        string_voc = float(np.max(east.v_oc + west.v_oc))
+        isc = east.i_sc + west.i_sc
+        for blocking, bypass in ((Diode("ideal"), Diode("ideal")), (DROPS["shockley"][0], DROPS["constant"][0])):
+            def every(load):
+                return [circuit.alone_power(east, load, switch_resistance), circuit.alone_power(west, load,
+                                                                                                  switch_resistance),
+                        circuit.parallel_power(east, west, blocking, load, switch_resistance),
+                        circuit.series_power(east, west, bypass, load, switch_resistance),
+                        circuit.series_power(east, west, None, load, switch_resistance),
+                        circuit.switching_power(east, west, blocking, bypass, True, load, switch_resistance)[0]]
+
+            for load in (string_voc * 1.001, 900.0):
+                for power in every(load):
+                    np.testing.assert_array_equal(power, 0.0)
+            for load in (1e-3,):
+                for power in every(load):
+                    assert np.all(np.isfinite(power)) and np.all(power >= 0.0)
+                    assert np.all(power <= load * isc * (1 + 1e-9))

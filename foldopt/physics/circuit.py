@@ -187,7 +187,11 @@ def alone_power(curve: IVCurve, load_voltage=None, switch_resistance=0.0):
         return _branch_mpp(side, IDEAL_DIODE, switch_resistance)[0]
     voltage = _load(load_voltage, curve.params[0])
     if switch_resistance == 0:
-        return voltage * np.clip(np.nan_to_num(curve.current(voltage)), 0.0, None)
+        # A load above open circuit draws nothing. The current is read at most at V_oc: far beyond
+        # it the diode's exponential overflows (pvlib's i_from_v at 900 V), a value never used.
+        reach = curve.v_oc
+        current = np.clip(np.nan_to_num(curve.current(np.minimum(voltage, reach))), 0.0, None)
+        return np.where(voltage < reach, voltage * current, 0.0)
     return voltage * _output_current(side, voltage, IDEAL_DIODE, switch_resistance)
 
 
