@@ -427,11 +427,17 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
         study = map_study(load_plan(default_study_path()).data)
     request = map_request(study, loads, sites=sites, relative=relative, year=year, show_period=show_period)
     spec = MapSpec(study, request.sites, request.loads, relative, year, sites_per_chunk, engine)
+    finished = {}
+
+    def finish(run, metadata):
+        # In the map's folder before it is marked complete or replaces an earlier map (run_map).
+        finished["figures"] = map_figures(run.table, run.out, "map", relative, show_load, show_period,
+                                          tilt=searched_tilt(study) is not None)
+        write_grid_netcdf(run.table, run.out, relative, f"foldopt map: {study.get('name', 'map')}")
+        finished["answer"] = of_map(run, relative, defaults)
+        write_map_report(run, finished["figures"], finished["answer"], metadata)
+
     result = run_map(spec, Path(out), scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
-                     progress=progress, announce=announce, metadata={"command": command or ["foldopt.world_map"]})
-    figures = map_figures(result.table, result.out, "map", relative, show_load, show_period,
-                          tilt=searched_tilt(study) is not None)
-    write_grid_netcdf(result.table, result.out, relative, f"foldopt map: {study.get('name', 'map')}")
-    answer = of_map(result, relative, defaults)
-    write_map_report(result, figures, answer)
-    return result, figures, answer
+                     progress=progress, announce=announce, metadata={"command": command or ["foldopt.world_map"]},
+                     finish=finish)
+    return result, finished["figures"], finished["answer"]

@@ -293,16 +293,54 @@ def _listed_leaves(data: dict, prefix: str = ""):
             yield from _listed_leaves(value, f"{path}.")
 
 
+def check_distinct(values, noun: str = "value", label=None) -> list:
+    """``values`` as a list, refused where one is given twice: a case computed twice is work done
+    twice, and rows with the same key break the tables that index by it (a map's ``map.nc``).
+
+    Parameters
+    ----------
+    values : sequence
+        An axis's values (numbers, dates, text or mappings such as sites).
+    noun : str, default 'value'
+        What the message calls a value.
+    label : callable, optional
+        ``label(value)``: how the message shows a value; default the value itself.
+
+    Returns
+    -------
+    list
+
+    Raises
+    ------
+    ValueError
+        Naming the first value given twice and where.
+    """
+    values, first = list(values), {}
+    for index, value in enumerate(values):
+        key = repr(sorted(value.items())) if isinstance(value, dict) else value
+        try:
+            hash(key)
+        except TypeError:  # a list as one value
+            key = repr(key)
+        if key in first:
+            shown = label(value) if label else f"{value:g}" if isinstance(value, float) else (
+                f"the same {noun}" if isinstance(value, (dict, list)) else str(value))
+            raise ValueError(f"{shown} is given twice ({noun}s {first[key] + 1} and {index + 1}); give each "
+                             f"{noun} once")
+        first[key] = index
+    return values
+
+
 def _axis_values(path: str, spec, year: int) -> list:
     if path == "date":
-        return parse_dates(spec, year)
+        return check_distinct(parse_dates(spec, year))
     if isinstance(spec, list):
         if not spec:
             raise ValueError("empty list")
         if len(spec) > MAX_AXIS_VALUES:
             raise ValueError(f"a list of {len(spec):,} values; at most {MAX_AXIS_VALUES:,} per axis "
                              "(FOLDOPT_MAX_AXIS_VALUES raises it)")
-        return list(spec)
+        return check_distinct(spec)
     if isinstance(spec, str) and _RANGE.match(spec):
         return parse_range(spec)
     return [spec]

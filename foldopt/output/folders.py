@@ -5,7 +5,6 @@ run fills part by part, gets its figures and ``report.html`` one atomic file at 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -333,9 +332,9 @@ def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, lo
                                    f"{name}: where folding pays ({period}, median over longitudes)")]
 
 
-def write_map_report(result, figures: list[str], answer) -> Path:
+def write_map_report(result, figures: list[str], answer, metadata: dict) -> Path:
     """Write ``report.html`` in a map's folder: the question, the answer, the maps and the year's
-    rows (``run.json``, already there, gives the provenance).
+    rows.
 
     Parameters
     ----------
@@ -344,13 +343,14 @@ def write_map_report(result, figures: list[str], answer) -> Path:
         The figures' file names (:func:`map_figures`), in order.
     answer : foldopt.Answer
         The map's answer (:func:`foldopt.studies.answering.of_map`).
+    metadata : dict
+        The provenance: the ``run.json`` the complete map gets.
 
     Returns
     -------
     pathlib.Path
         The page written.
     """
-    metadata = json.loads((result.out / "run.json").read_text())
     year = result.table[result.table["period"] == "year"]
     return write_html(result.out, answer, figures, year, "The year per site and load (map.csv has every season)",
                       metadata)

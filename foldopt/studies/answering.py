@@ -474,8 +474,9 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         gains = ("" if best is None else f" (median {_pct(load['median_gain_vs_flat_pct'])}, best "
                  f"{_pct(load['best_gain_vs_flat_pct'])} at {where})")
         lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')}"
-                     f"{gains}; {rec_text}; median {_pct(load['median_pct_of_tracker'], False)} of the "
-                     f"tracker{tracker}")
+                     f"{gains}; {rec_text}; " + (
+                         "the tracker carries it at no site either" if load["median_pct_of_tracker"] is None else
+                         f"median {_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}"))
     rate = len(spec.sites) / part["seconds"] if part["seconds"] else 0
     computed = (f"computed {_count(part['chunks_computed'], 'chunk')} on {part['cluster']}" if part["chunks_computed"]
                 else "nothing to compute")

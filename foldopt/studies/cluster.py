@@ -273,8 +273,8 @@ def prepare_folder(folder: Path, spec: MapSpec, metadata: dict) -> list[int]:
 
 
 def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
-    """The chunks on disk in ``out`` if it holds the map ``spec``; its ``run.json`` says ``running``
-    again until the map is complete."""
+    """The chunks on disk in ``out`` if it holds the map ``spec`` (:func:`_compute` marks it
+    ``running`` again where it is not complete)."""
     try:
         previous = json.loads((out / "run.json").read_text())
     except ValueError:
@@ -289,7 +289,6 @@ def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
     (out / PARTS).mkdir(exist_ok=True)
     for leftover in (out / PARTS).glob(".*.tmp-*"):
         leftover.unlink(missing_ok=True)
-    _write_json(out / "run.json", {**metadata, "status": "running"})
     return [index for index in range(len(spec.chunks())) if _part_path(out, index).exists()]
 
 
@@ -300,7 +299,8 @@ def _write_json(path: Path, data: dict) -> None:
 def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: int | None = None,
             resume: bool = False, overwrite: bool = False, progress: Callable[[int, int], None] | None = None,
             announce: Callable[[str, str | None], None] | None = None, metadata: dict | None = None,
-            connect_timeout: float = CONNECT_TIMEOUT) -> MapRun:
+            connect_timeout: float = CONNECT_TIMEOUT,
+            finish: Callable[[MapRun, dict], None] | None = None) -> MapRun:
     """Compute a map on a Dask cluster into ``out`` and return its table.
 
     Parameters
@@ -323,6 +323,11 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
         Written into ``run.json`` beside the spec.
     connect_timeout : float
         Seconds to wait for ``scheduler`` and its first worker.
+    finish : callable, optional
+        ``finish(run, metadata)`` writes the rest of what the map promises (its figures, ``map.nc``,
+        ``report.html``) in ``run.out``, given the ``run.json`` it is about to get. It runs before
+        the map is marked complete and before it replaces an earlier one: a map whose figures fail
+        is no complete map, and an ``overwrite`` then leaves the earlier map as it was.
 
     Returns
     -------
@@ -351,7 +356,7 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
             folder = map_folder(out, resume, overwrite)
             done = prepare_folder(folder, spec, metadata)
             run = _compute(spec, folder, done, chunks, metadata, started, scheduler, workers, progress, announce,
-                           connect_timeout)
+                           connect_timeout, finish)
             if folder != out:
                 commit(folder, out)
         except BaseException as error:
@@ -377,10 +382,15 @@ def _failed(error: BaseException, out: Path, folder: Path | None, fresh: bool) -
 
 
 def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, progress, announce,
-             connect_timeout) -> MapRun:
+             connect_timeout, finish) -> MapRun:
     # A part that cannot be read (a disk fault) or is another map's is computed again.
     done = [index for index in done if _read_part(_part_path(out, index), spec.key) is not None]
     missing = [index for index in range(len(chunks)) if index not in done]
+    if missing or json.loads((out / "run.json").read_text()).get("status") != "complete":
+        # Until every file is written again the folder is no complete map; a complete map resumed with
+        # nothing to compute stays marked complete, its files replaced one atomic file at a time by the
+        # same map's (the same digest: the same numbers).
+        _write_json(out / "run.json", {**metadata, "status": "running"})
     finished_sites = sum(len(chunks[index]) for index in done)
     if progress is not None:
         progress(finished_sites, len(spec.sites))
@@ -415,12 +425,16 @@ def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, pro
     _write_parquet(table, out / "map.parquet", spec.key)
     write_atomically(out / "map.csv", lambda temporary: write_csv(table, temporary))
     computed = tuple(missing)
-    _write_json(out / "run.json", {
+    complete = {
         **metadata, "status": "complete", "cluster": description, "dashboard": dashboard,
         "chunks_computed": list(computed), "chunks_from_disk": sorted(done), "seconds": round(seconds, 3),
         "sites_per_second": round(sum(len(chunks[i]) for i in computed) / seconds, 3) if computed else None,
-    })
-    return MapRun(spec, table, out, computed, tuple(sorted(done)), seconds, description, dashboard)
+    }
+    run = MapRun(spec, table, out, computed, tuple(sorted(done)), seconds, description, dashboard)
+    if finish is not None:
+        finish(run, complete)
+    _write_json(out / "run.json", complete)  # last: only a folder holding every promised file is complete
+    return run
 
 
 def _has_dashboard(client) -> bool:

@@ -34,7 +34,7 @@ from foldopt.engine import rows as engines
 from foldopt.inputs.load import resolve_files
 from foldopt.engine.search import Axis
 from foldopt.inputs.optimize_section import DEFAULT_TILT, Optimize, vary_names
-from foldopt.inputs.plan import parse_dates, parse_values, year_problem
+from foldopt.inputs.plan import check_distinct, parse_dates, parse_values, year_problem
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, format_errors
 from foldopt.errors import ConfigError
@@ -149,7 +149,11 @@ def _values(name: str, values) -> list:
             values = parse_values(values)
         except ValueError as error:
             raise ConfigError([f"{name} = {values!r}: {error}"]) from None
-    return list(values) if isinstance(values, (list, tuple)) or hasattr(values, "tolist") else [values]
+    values = list(values) if isinstance(values, (list, tuple)) or hasattr(values, "tolist") else [values]
+    try:
+        return check_distinct(values)
+    except ValueError as error:
+        raise ConfigError([f"{name}: {error}"]) from None
 
 
 def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | None = None, latitudes=None,
@@ -224,6 +228,7 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
                       f"(the azimuth with them: foldopt optimize, one site at a time)")
     if errors:
         raise ConfigError(errors)
+    field = f"--sites {sites}" if isinstance(sites, (str, Path)) else "sites"  # as read_sites names a file
     if isinstance(sites, (str, Path)):
         sites = read_sites(sites)
     elif sites is None and weather_dir is not None:
@@ -234,6 +239,14 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
             raise ConfigError(["land_only: no grid point is on land"])
     if len(sites) > MAX_CASES:
         raise ConfigError([f"sites: {len(sites):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
+    # A map's rows, figures and map.nc tell sites by place, name and weather file: one given twice is refused.
+    try:
+        check_distinct([{key: site.get(key) for key in ("latitude", "longitude", "name", "weather")}
+                        for site in sites], "site",
+                       lambda site: f"the site at {site['latitude']:g}, {site['longitude']:g}"
+                                    + (f" ({site['name']})" if site["name"] else ""))
+    except ValueError as error:
+        raise ConfigError([f"{field}: {error}"]) from None
     if len(sites):
         site_study(study, sites[0], year)  # a bad setting fails here, before any cluster starts
     return MapRequest(study, tuple(sites), tuple(load_values), relative, year)

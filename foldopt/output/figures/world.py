@@ -64,7 +64,8 @@ def plot_world_map(rows: pd.DataFrame, value: str, title: str, label: str, diver
     ax.figure.colorbar(mesh, ax=ax, label=label, shrink=0.8)
     ax.set_xlabel("longitude [deg]")
     ax.set_ylabel("latitude [deg]")
-    ax.set_title(title + ("" if coast else " (no coastlines: pip install global-land-mask)"), fontsize=10)
+    ax.set_title(title + _no_value(values) + ("" if coast else " (no coastlines: pip install global-land-mask)"),
+                 fontsize=10)
     return ax
 
 
@@ -101,8 +102,9 @@ def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, title: 
     """
     rows = table[table["period"] == period]
     share = rows["p_load_fraction"].round(9) if relative else (rows["p_load_fraction"] / 0.05).round() * 0.05
+    # dropna=False: a latitude where no site carries a load (every gain NaN) keeps its grey cell.
     grid = rows.assign(share=share).pivot_table(index="share", columns="latitude", values="gain_vs_flat_pct",
-                                                aggfunc="median")
+                                                aggfunc="median", dropna=False)
     fig, ax = new_axes(ax, (8, 4.5))
     data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
     mesh = ax.pcolormesh(_edges(grid.columns, 5.0), _edges(grid.index, 0.05), data, **colour_scale(data, True))
@@ -113,8 +115,14 @@ def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, title: 
                        label="median gain over flat [%]" + (" (contour: +1 %)" if grid.shape[0] > 1 else ""))
     ax.set_xlabel("latitude [deg]")
     ax.set_ylabel("P_load / flat peak [-]" + ("" if relative else " (bins of 0.05)"))
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title + _no_value(data), fontsize=10)
     return ax
+
+
+def _no_value(values) -> str:
+    """A title's note where no value is finite (no site carries the load), else nothing."""
+    return "" if np.isfinite(np.ma.filled(np.ma.masked_invalid(values), np.nan)).any() else \
+        " (no value: no site carries the load)"
 
 
 #: The world maps of one load and period: file, the column shown, what it shows, the colour bar's

@@ -1,0 +1,165 @@
+"""A map is complete only when every file it promises is written (issue 38, items 1 and 2): a map
+whose figures, ``map.nc`` or report fail never replaces the earlier map and is never marked
+complete; every figure and writer copes with what a map's table can legally hold (no site able to
+carry a load, every value equal, a single site, a single load); inputs given twice are refused in
+one line, before any work. The cluster is a LocalCluster of this process on 127.0.0.1."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import math
+from pathlib import Path
+
+import pytest
+import xarray as xr
+import yaml
+from typer.testing import CliRunner
+
+import foldopt
+from foldopt.cli.app import app
+from foldopt.errors import ConfigError
+from foldopt.inputs.load import default_study_path
+from foldopt.inputs.plan import make_plan
+
+distributed = pytest.importorskip("distributed")
+pytestmark = pytest.mark.xdist_group("map_finish")
+
+runner = CliRunner()
+#: The embedded study made cheap: hourly steps, fold angles 60, 120 and 180 deg.
+STUDY = foldopt.map_study(yaml.safe_load(default_study_path().read_text()), step_min=60,
+                          fold_angles={"start": 60, "stop": 180, "step": 60})
+#: Every file a complete grid map promises beside its parts.
+PROMISED = {"run.json", "sites.csv", "map.parquet", "map.csv", "map.nc", "report.html", "map_fold_angle.png",
+            "map_gain_vs_flat.png", "map_pct_of_tracker.png", "map_near_optimal_width.png",
+            "latitude_load_gain.png"}
+
+
+def snapshot(folder: Path) -> dict[str, str]:
+    return {str(path.relative_to(folder)): hashlib.sha256(path.read_bytes()).hexdigest()
+            for path in sorted(folder.rglob("*")) if path.is_file()}
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://",
+                                       host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR)
+    try:
+        yield cluster.scheduler_address
+    finally:
+        cluster.close()
+
+
+def world_map(scheduler, out, sites, loads, **keywords):
+    return foldopt.world_map(sites, loads, out, STUDY, scheduler=scheduler, engine="numpy", **keywords)
+
+
+@pytest.fixture(scope="module")
+def earlier(scheduler, tmp_path_factory) -> Path:
+    """A complete map of two sites at 2 W."""
+    out = tmp_path_factory.mktemp("earlier") / "map"
+    world_map(scheduler, out, [{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [2.0])
+    return out
+
+
+def _broken(*args, **kwargs):
+    raise RuntimeError("a figure fails")
+
+
+@pytest.mark.parametrize("writer", ["map_figures", "write_map_report"])
+def test_a_map_whose_last_files_fail_leaves_the_earlier_map(earlier, scheduler, tmp_path, monkeypatch, writer):
+    import shutil
+
+    out = tmp_path / "map"
+    shutil.copytree(earlier, out)
+    before = snapshot(out)
+    monkeypatch.setattr(f"foldopt.output.folders.{writer}", _broken)
+    with pytest.raises(RuntimeError, match="a figure fails"):
+        world_map(scheduler, out, [{"latitude": 10.0, "longitude": 0.0}], [3.0], overwrite=True)
+    assert snapshot(out) == before
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["map"]  # no staging folder left
+
+
+def test_a_new_map_whose_last_files_fail_is_not_complete_and_resumes(scheduler, tmp_path, monkeypatch):
+    out = tmp_path / "map"
+    sites = [{"latitude": 10.0, "longitude": 0.0}]
+    with monkeypatch.context() as patch:
+        patch.setattr("foldopt.output.folders.map_figures", _broken)
+        with pytest.raises(RuntimeError):
+            world_map(scheduler, out, sites, [3.0])
+    assert json.loads((out / "run.json").read_text())["status"] == "running"
+    assert not (out / "report.html").exists()
+    run, _, _ = world_map(scheduler, out, sites, [3.0], resume=True)
+    assert run.computed == () and json.loads((out / "run.json").read_text())["status"] == "complete"
+    assert PROMISED <= {path.name for path in out.iterdir()}
+
+
+@pytest.mark.parametrize("sites, loads", [
+    # No site carries 25 W on a 0.108 m^2 panel (its flat peak is about 21 W): every gain is NaN.
+    ([{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [25.0]),
+    # Two sites on the equator 90 deg apart under a clear sky: every value equal.
+    ([{"latitude": 0.0, "longitude": 0.0}, {"latitude": 0.0, "longitude": 90.0}], [2.0]),
+    # A single site and a single load; then a single site and two loads.
+    ([{"latitude": 45.0, "longitude": 8.0}], [2.0]),
+    ([{"latitude": 45.0, "longitude": 8.0}], [1.0, 3.0]),
+], ids=["no-site-carries", "all-equal", "one-site-one-load", "one-site-two-loads"])
+def test_every_figure_and_writer_copes_with_a_legal_table(scheduler, tmp_path, sites, loads):
+    out = tmp_path / "map"
+    run, figures, answer = world_map(scheduler, out, sites, loads)
+    assert PROMISED <= {path.name for path in out.iterdir()}
+    assert json.loads((out / "run.json").read_text())["status"] == "complete"
+    assert set(figures) <= PROMISED
+    # No NaN in what the answer says: the JSON is strict, and its lines say "nan" nowhere.
+    json.dumps(answer.result, allow_nan=False)
+    assert not any("nan" in line.lower().split() for line in answer.lines())
+    with xr.open_dataset(out / "map.nc") as data:
+        assert data.sizes["latitude"] * data.sizes["longitude"] >= len(sites)
+        assert data.sizes["load"] == len(loads)
+
+
+def test_no_site_carrying_the_load_is_said(scheduler, tmp_path):
+    _, _, answer = world_map(scheduler, tmp_path / "map", [{"latitude": 0.0, "longitude": 0.0}], [25.0])
+    assert any("no fold angle carries the load; the tracker carries it at no site either" in line
+               for line in answer.lines())
+    assert math.isnan(answer.designs["gain_vs_flat_pct"].iloc[0])  # the table keeps its NaN; the lines do not
+
+
+# --- inputs given twice -----------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("args, words", [
+    (["map", "--lat", "30,30", "--lon", "0"], ["--lat", "30 is given twice"]),
+    (["map", "--lat", "30", "--lon", "0,10,0"], ["--lon", "0 is given twice (values 1 and 3)"]),
+    (["map", "--lat", "30", "--lon", "0", "--p-load", "2,2"], ["--p-load", "2 is given twice"]),
+    (["sweep", "load", "--p-load", "2,2.0"], ["--p-load", "2 is given twice"]),
+    (["sweep", "day", "--days", "2025-06-21,2025-06-21"], ["--days", "2025-06-21 is given twice"]),
+])
+def test_a_value_given_twice_is_one_line(tmp_path, monkeypatch, args, words):
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, [*args, "--out", "out"])
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and all(word in lines[0] for word in words), result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_site_given_twice_in_a_sites_file_is_one_line(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    Path("sites.csv").write_text("latitude,longitude\n30,0\n10,5\n30.0,0\n")
+    result = runner.invoke(app, ["map", "--sites", "sites.csv", "--out", "out"])
+    assert result.exit_code == 2
+    assert result.output.strip() == ("error: --sites sites.csv: the site at 30, 0 is given twice (sites 1 and 3); "
+                                     "give each site once")
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["sites.csv"]
+
+
+def test_the_same_place_under_two_names_or_two_weather_files_is_two_sites():
+    sites = [{"latitude": 30.0, "longitude": 0.0, "name": "a"}, {"latitude": 30.0, "longitude": 0.0, "name": "b"}]
+    assert len(foldopt.studies.worldmap.map_request(STUDY, 2.0, sites=sites).sites) == 2
+
+
+def test_a_study_files_axis_given_twice_is_one_line():
+    with pytest.raises(ConfigError) as raised:
+        make_plan({**yaml.safe_load(default_study_path().read_text()), "p_load": [2, 3, 2]})
+    assert raised.value.errors == ["p_load: 2 is given twice (values 1 and 3); give each value once"]
