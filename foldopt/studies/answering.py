@@ -136,9 +136,6 @@ def of_study(result) -> Answer:
     by = summary.set_index("design")
     twofold = by.loc["twofold"]
     near = dict(result.near_optimal)
-    recommended = near["recommended_fold_angle_deg"]
-    sweep = result.sweep.set_index("fold_angle_deg")["t_solar_h"]
-    near["recommended_t_solar_h"] = float(sweep.loc[recommended]) if recommended == recommended else float("nan")
     near_table = pd.DataFrame([near])
     heuristic = result.heuristic_fold_angle
     result_part = {

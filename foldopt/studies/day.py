@@ -201,8 +201,10 @@ class StudyResult:
     optimal_fold_angle, heuristic_fold_angle : float
         [deg]; the heuristic is NaN where the paper's rule has no answer.
     near_optimal : dict
-        The near-optimal range of the fold angle on the sweep's grid and the recommended angle at
-        its centre (:func:`foldopt.studies.objectives.near_optimal`) [deg], and its tolerance [h].
+        The near-optimal range of the fold angle over the angles evaluated (the sweep's grid and the
+        refined optimum, which it always holds) and the recommended angle at its centre
+        (:func:`foldopt.studies.objectives.near_optimal`) [deg], its tolerance [h] and the
+        recommended angle's ``recommended_t_solar_h`` [h].
     standby : tuple
         (table, break-even draw [W]) of :func:`standby_sweep`.
     engine : str
@@ -229,11 +231,12 @@ class StudyResult:
 
 
 def _best_angle(day: Day, angles, sweep_t_solar, connection):
+    """The best fold angle [deg] and its t_solar [h]: the sweep's best, refined between its neighbours."""
     shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
     return optimal_fold_angle(
         lambda fold: per_load(day.combined_power(fold, connection), shape), angles, sweep_t_solar, day.study.p_load,
         day.step_hours
-    )[0]
+    )
 
 
 def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
@@ -278,7 +281,7 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
         sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
         sweep[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
 
-    best_angle = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
+    best_angle, best_hours = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
     # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
     # noon (the flat panel's peak).
     noon_load = p_load if shape is None else p_load * shape[int(np.argmax(day.flat_power()))]
@@ -291,7 +294,7 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     if day.electrical.pv.has_iv:
         for connection in ("parallel", "series", "independent", "switching"):
             if connection != study.connection:
-                angle = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection)
+                angle = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection)[0]
                 designs[f"twofold-{connection}"] = (angle, day.combined_power(np.array([angle]), connection)[0])
     # The study's tracker is "tracker"; every other model follows as "tracker:<model>". Each net row
     # is what is left for the load after the tracker's own draw.
@@ -346,13 +349,19 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
         },
         index=pd.DatetimeIndex(day.times, name="time"),
     )
-    near = {key: float(value) for key, value in near_optimal(angles, sweep["t_solar_h"].to_numpy(),
+    # The range is taken over every angle evaluated, the refined optimum among the grid's, so that it
+    # holds the best angle (the grid's own range may end on the far side of a refined optimum).
+    evaluated = sweep.set_index("fold_angle_deg")["t_solar_h"]
+    evaluated = pd.concat([evaluated[evaluated.index != best_angle], pd.Series({best_angle: best_hours})]).sort_index()
+    near = {key: float(value) for key, value in near_optimal(evaluated.index, evaluated.to_numpy(),
                                                              study.near_optimal).items()}
     return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby, engine, near, request)
 
 
 def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):
     """The study's tracker's net ``t_solar`` as its standby draw grows, and the break-even draw.
+    recommended = near["recommended_fold_angle_deg"]
+    near["recommended_t_solar_h"] = float(evaluated[recommended]) if recommended == recommended else float("nan")
 
     A standby draw ``s`` while the sun is up leaves the load ``P_pv - drive - s``; over daylight
     that is the gross curve less its drive against the load ``P_load + s``, so every draw is one
