@@ -3,14 +3,19 @@ computed here: each sub-panel's curve sampled densely (pvlib's bishop88 for the 
 the curve's own closed form for the b-model), each diode's drop by its own formula, the branches
 combined by interpolation on a common voltage or current grid, and the maximum taken."""
 
+import json
+
 import numpy as np
+import pandas as pd
 import pvlib
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from pvlib.singlediode import bishop88
+from typer.testing import CliRunner
 
 from foldopt import names
+from foldopt.cli.app import app
 from foldopt.physics import circuit, connections
 from foldopt.physics.diodes import DEFAULT_DIODE_PART, DIODE_PARTS, Diode, diode
 from foldopt.physics.pvmodel import PVModel
@@ -301,3 +306,38 @@ def test_a_load_beyond_the_panels_reach_draws_nothing_and_warns_nothing(model, s
                 for power in every(load):
                     assert np.all(np.isfinite(power)) and np.all(power >= 0.0)
                     assert np.all(power <= load * isc * (1 + 1e-9))
+
+
+def _designs_of(answer_designs) -> pd.DataFrame:
+    return pd.DataFrame(answer_designs).set_index("design")
+
+
+@pytest.mark.parametrize(("load_voltage", "fresh"), [(900.0, True), (0.001, False)], ids=["900V", "1mV"])
+def test_a_load_wired_out_of_reach_runs_no_design_wired_to_it(tmp_path, monkeypatch, recwarn, load_voltage, fresh):
+    """A load wired directly above the panel's open-circuit voltage (some 5 V for the paper's panel)
+    draws nothing, and at 1 mV at most 1 mV times the short-circuit current: every design wired to it
+    runs 0 h, in summary.csv and in the JSON answer alike. The independent connection keeps its two
+    converters (Shin et al.'s upper bound): its row says so. No warning is raised, the tables at 900 V
+    built afresh (where pvlib once overflowed)."""
+    if fresh:
+        monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path / "cache"))
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["sweep", "angle", "--pv-model", "single-diode", "--load-voltage",
+                                      str(load_voltage), "--angle-step", "10", "--out", str(out), "--format",
+                                      "json"])
+    assert result.exit_code == 0, result.output
+    assert result.stderr == "" and not [str(w.message) for w in recwarn]
+    answer = json.loads(result.stdout)["answer"]
+    summary = pd.read_csv(out / "summary.csv", keep_default_na=False).set_index("design")
+    shown = _designs_of(answer["designs"])
+    assert list(shown.index) == list(summary.index)
+    wired = summary.index != "twofold-independent"
+    assert {"flat", "twofold", "twofold-parallel", "twofold-series", "tracker", "tracker-net"} <= set(summary.index)
+    assert (summary.loc[wired, "t_solar_h"] == 0).all() and (shown.loc[wired, "t_solar_h"] == 0).all()
+    assert answer["result"]["t_solar_h"] == 0 and set(answer["result"]["t_solar_by_design_h"].values()) == {0}
+    # The paper's panel behind its converters runs most of the day: the row says it is not wired directly.
+    note = f"with a converter per sub-panel, not the load wired directly at {load_voltage:g} V"
+    assert summary.loc["twofold-independent", "t_solar_h"] > 8
+    assert summary.loc["twofold-independent", "note"].split("; ")[0] == note
+    assert {"note": note, "designs": ["twofold-independent"]} in answer["notes"]
+    assert not any(note in text for text in summary.loc[wired, "note"])

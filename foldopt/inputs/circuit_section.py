@@ -201,6 +201,27 @@ class Circuit(StrictModel):
             parts.append(f"switch {self.switch_resistance:g} ohm")
         return ", ".join(parts)
 
+    def ignored_by(self, connection: str) -> str | None:
+        """How a connection is wired where it cannot be wired as this circuit says, None where it can.
+
+        The independent connection is a converter per sub-panel (Shin et al.'s upper bound of
+        switching): with a load wired directly it keeps its converters. A study cannot take it as its
+        own connection then (:meth:`idle_settings`); a comparison row of it says so in its note.
+
+        Parameters
+        ----------
+        connection : str
+            One of :data:`foldopt.names.CONNECTIONS`.
+
+        Returns
+        -------
+        str or None
+            The note of a design of that connection.
+        """
+        if self.coupling == "direct" and connection == "independent":
+            return f"with a converter per sub-panel, not the load wired directly at {self.load_voltage:g} V"
+        return None
+
     def idle_settings(self, connection: str, series_used: bool, iv_model: bool) -> list[str]:
         """Values of the circuit that the study's connection and PV model do not use, or cannot.
 
@@ -234,9 +255,9 @@ class Circuit(StrictModel):
                   "is only used by coupling direct"))
         lines += [f"circuit.{name} = {value!r}: {why}" for name, value, default, used, why in rules
                   if not used and value != default]
-        if self.coupling == "direct" and connection == "independent":
-            lines.append("connection = 'independent': needs a converter per sub-panel; a direct-coupled load "
-                         "(circuit.coupling direct) has none")
+        if self.ignored_by(connection):
+            lines.append(f"connection = {connection!r}: needs a converter per sub-panel; a direct-coupled load "
+                         f"(circuit.coupling direct) has none")
         if not iv_model:
             needing = [(name, value) for name, value, default in (
                 ("blocking_diode.model", self.blocking_diode.model, "ideal"),

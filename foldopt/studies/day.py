@@ -327,6 +327,11 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     ]
     summary["note"] = notes(design_condition(day.sky.conditions()[0], summary["energy_harvested_wh"].to_numpy(float)),
                             summary["t_solar_h"].to_numpy())
+    # A connection the study's circuit cannot wire (independent's converters, a load wired directly)
+    # is compared as it is built, and its note says so first.
+    wired = {f"twofold-{connection}": study.circuit.ignored_by(connection) for connection in CONNECTIONS}
+    summary["note"] = ["; ".join(filter(None, (wired.get(design), note)))
+                       for design, note in zip(summary["design"], summary["note"], strict=True)]
     standby = standby_sweep(day, p_tracker, by_design["twofold"])
 
     at_best, state = day.connections(np.array([best_angle]))
