@@ -1,6 +1,8 @@
-"""Relations between the connections, solved exactly from the sub-panels' I-V curves."""
+"""Aggregation: relations between the connections, solved exactly from the sub-panels' I-V
+curves, and a year's days gathered into ``annual_summary.csv``."""
 
 import numpy as np
+import pandas as pd
 import pvlib
 import pytest
 from hypothesis import example, given, settings
@@ -126,3 +128,48 @@ def test_ideal_model_connections_are_sums():
     np.testing.assert_allclose(powers["independent"], [3.6, 1.8])
     # Ties go to the single sub-panel (west alone equals parallel when east is dark).
     assert list(state) == [2, 1]
+
+
+#: Two days six months apart: the twofold panel's best angle differs (at 52.5 N it is flat at the
+#: winter solstice under a 2 W load).
+SOLSTICES = ("sweep", "day", "--lat", "52.52", "--lon", "13.40", "--days", "2025-06-21,2025-12-21", "--p-load", "2",
+             "--step-min", "5", "-q")
+
+
+def _sweep_folder(tmp_path, *extra):
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, [*SOLSTICES, *extra, "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    return out
+
+
+@pytest.mark.parametrize("objective", [(), ("--objective", "mean")], ids=["each-day", "one-angle"])
+def test_the_annual_summary_gives_one_fold_angle_only_where_every_day_has_it(tmp_path, objective):
+    """A design's fold_angle_deg in annual_summary.csv is the angle of every one of its days in
+    results.csv; where the days differ (each day's own best) it is empty, the range of the days'
+    angles is given and a note says so. (It was the first day's.)"""
+    out = _sweep_folder(tmp_path, *objective)
+    days = pd.read_csv(out / "results.csv")
+    summary = pd.read_csv(out / "annual_summary.csv", keep_default_na=False, na_values=[""]).set_index("design")
+    assert set(summary.index) == set(days["design"])
+    for design, rows in days.groupby("design"):
+        angles, row = rows["fold_angle_deg"], summary.loc[design]
+        assert row["days"] == len(rows)
+        if angles.isna().all():  # a tracker: no angle
+            assert np.isnan(row[["fold_angle_deg", "fold_angle_min_deg", "fold_angle_max_deg"]].astype(float)).all()
+        else:
+            assert (row["fold_angle_min_deg"], row["fold_angle_max_deg"]) == (angles.min(), angles.max())
+        if angles.nunique() > 1:
+            assert np.isnan(row["fold_angle_deg"])
+            assert row["note"] == f"fold angle varies by day, {angles.min():g} to {angles.max():g} deg (each " \
+                                  "day's: results.csv)"
+        else:
+            assert row["fold_angle_deg"] == angles.iloc[0] or angles.isna().all()
+            assert np.isnan(row["note"]) if isinstance(row["note"], float) else row["note"] == ""
+    twofold = days[days["design"] == "twofold"]["fold_angle_deg"]
+    # The case each run is about: each solstice its own best angle, or one angle for both.
+    assert twofold.nunique() == (1 if objective else 2)

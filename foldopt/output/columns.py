@@ -37,7 +37,10 @@ COLUMNS = (
     ("design", "", "flat, twofold (at the optimum), twofold-heuristic, twofold-<connection>, tracker, "
                    "tracker-net (net of its own draw), tracker:<model> and tracker:<model>-net"),
     # the design's settings and its daily metrics
-    ("fold_angle_deg", "deg", "the fold angle Θ (180 = flat); empty for trackers"),
+    ("fold_angle_deg", "deg", "the fold angle Θ (180 = flat); empty for trackers, and in annual_summary.csv where "
+                              "the angle varies by day"),
+    ("fold_angle_min_deg", "deg", "the least of the days' fold angles (annual_summary.csv)"),
+    ("fold_angle_max_deg", "deg", "the largest of the days' fold angles (annual_summary.csv)"),
     ("surface_tilt", "deg", "the panel's base tilt from horizontal (foldopt optimize; a map's twofold panel)"),
     ("flat_surface_tilt", "deg", "the flat panel's tilt: the site's, or its own best with map --optimize tilt"),
     ("surface_azimuth", "deg", "the panel's base azimuth, clockwise from north (foldopt optimize)"),
@@ -59,7 +62,8 @@ COLUMNS = (
     ("pct_of_tracker", "%", "t_solar (or the objective) as a share of the tracker's"),
     ("energy_gain_vs_flat_pct", "%", "harvested energy over the flat panel's, less 100"),
     ("energy_pct_of_tracker", "%", "harvested energy as a share of the tracker's"),
-    ("note", "", "polar night, polar day, overcast, load above peak (of that design)"),
+    ("note", "", "polar night, polar day, overcast, load above peak (of that design); in annual_summary.csv, "
+                 "that the fold angle varies by day"),
     # the near-optimal range
     ("near_optimal_lo_deg", "deg", "the least fold angle on the best one's plateau"),
     ("near_optimal_hi_deg", "deg", "the largest fold angle on the best one's plateau"),

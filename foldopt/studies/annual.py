@@ -48,7 +48,12 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
     Returns
     -------
     pandas.DataFrame
-        A row per case and design with ``days``, ``fold_angle_deg`` [deg] and:
+        A row per case and design with ``days``, the fold angle [deg] and:
+
+        - ``fold_angle_min_deg`` and ``fold_angle_max_deg``, the least and largest of the days'
+          fold angles, and ``fold_angle_deg``, the one angle of every day (a flat panel's, an
+          objective's): empty where the angle varies by day (each day's best), with a ``note``
+          that says so and where each day's is, as for a tracker, which has none;
 
         - daily t_solar [h]: ``mean_t_solar_h``, ``p10_t_solar_h``, ``p50_t_solar_h``,
           ``p90_t_solar_h``, ``min_t_solar_h``, the days reaching each of :data:`THRESHOLDS_H`
@@ -67,7 +72,13 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
     for key, group in table.groupby(keys, sort=False):
         hours = group["t_solar_h"]
         row = dict(zip(keys, key if isinstance(key, tuple) else (key,), strict=True))
-        row.update(days=len(group), fold_angle_deg=group["fold_angle_deg"].iloc[0], mean_t_solar_h=hours.mean(),
+        lo, hi = group["fold_angle_deg"].min(), group["fold_angle_deg"].max()
+        # One angle stands for the days only where every day has it: a design re-folded to each day's
+        # best has a range, not an angle, and the first day's would stand for no other day.
+        row.update(days=len(group), fold_angle_deg=lo if lo == hi else float("nan"), fold_angle_min_deg=lo,
+                   fold_angle_max_deg=hi,
+                   note=f"fold angle varies by day, {lo:g} to {hi:g} deg (each day's: results.csv)" if lo < hi
+                   else "", mean_t_solar_h=hours.mean(),
                    energy_harvested_wh=group["energy_harvested_wh"].sum(),
                    energy_served_wh=group["energy_served_wh"].sum(), energy_wasted_wh=group["energy_wasted_wh"].sum())
         if "poa_kwh_m2" in group:
