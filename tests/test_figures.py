@@ -11,6 +11,10 @@ import sys
 import textwrap
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
+import pytest
+
 import foldopt
 from foldopt.output.figures import FIGURES, annual, day, horizon, landscape, sizing, sweep, weather, world
 
@@ -107,3 +111,87 @@ def test_plots_and_folders_leave_a_notebooks_backend_alone(tmp_path):
     assert seen["plotted"] == sorted(name for name in foldopt.__all__ if name.startswith("plot_"))
     assert all(seen["drawn"]) and len(seen["open"]) == len(seen["drawn"])  # the user's figures, still open
     assert {"power_curves.png", "daily_t_solar_distribution.png"} <= {p.name for p in tmp_path.glob("*/*.png")}
+
+
+# What the annual figures draw, read back from their Axes against references computed here.
+
+def _bars(ax) -> dict:
+    """Each design's bars in an Axes: design -> {month: height}."""
+    return {bars.get_label(): {round(bar.get_x() + bar.get_width() / 2): bar.get_height() for bar in bars}
+            for bars in ax.containers}
+
+
+def test_a_months_bars_are_its_mean_day_however_many_days_it_samples():
+    """Every 7th day of 2025 samples five days of January, April... and four of February...: a day
+    the same all year draws every month's bar the same (a month's sum was 25 % taller in those)."""
+    from matplotlib.figure import Figure
+
+    dates = pd.date_range("2025-01-01", "2025-12-31", freq="7D")
+    designs = {"flat": (80.0, 7.0), "twofold": (70.0, 9.0), "tracker": (120.0, 11.0)}
+    table = pd.DataFrame([{"date": date.date().isoformat(), "latitude": 40.0, "longitude": 0.0, "p_load_w": 2.0,
+                           "design": design, "energy_harvested_wh": energy, "t_solar_h": hours}
+                          for date in dates for design, (energy, hours) in designs.items()])
+    assert set(pd.Series(dates.month).value_counts()) == {4, 5}
+    axes = annual.plot_monthly(table, "t", axes=Figure().subplots(1, 2, squeeze=False))
+    for ax, column in zip(axes[0], (0, 1), strict=True):
+        for design, bars in _bars(ax).items():
+            assert list(bars) == list(range(1, 13))
+            assert set(bars.values()) == {designs[design][column]}, (design, column)
+
+
+def test_the_monthly_figure_draws_each_months_mean_day_of_results_csv(tmp_path):
+    """A year of every 7th day, through the folder: the monthly figure's bars are, per design, the
+    mean over the month's days in results.csv (a grid point: no site name) of energy and t_solar."""
+    from matplotlib.figure import Figure
+
+    study = foldopt.default_study().variant(step_min=30, fold_angles={"start": 30, "stop": 180, "step": 30})
+    result = foldopt.sweep(study, "day", date="1:365:7", p_load=[2.0])
+    foldopt.write(result, tmp_path / "year")
+    days = pd.read_csv(tmp_path / "year" / "results.csv")
+    assert (tmp_path / "year" / "monthly_energy_t_solar.png").exists()
+    days["month"] = pd.to_datetime(days["date"]).dt.month
+    reference = days.groupby(["design", "month"])[["energy_harvested_wh", "t_solar_h"]].mean()
+    for table in (result.table, days.drop(columns="month")):
+        axes = annual.plot_monthly(table, "t", axes=Figure().subplots(1, 2, squeeze=False))
+        for ax, column in zip(axes[0], ("energy_harvested_wh", "t_solar_h"), strict=True):
+            drawn = _bars(ax)
+            assert set(drawn) == {"flat", "twofold", "tracker", "tracker-net"}
+            for design, bars in drawn.items():
+                expected = reference.loc[design, column]
+                assert list(bars) == list(expected.index)
+                # results.csv keeps 10 significant digits.
+                np.testing.assert_allclose(list(bars.values()), expected.to_numpy(), rtol=1e-9)
+
+
+def _segments_and_points(line):
+    """A drawn line's stretches joined by a line, and its points drawn as markers."""
+    x = np.asarray(line.get_xdata(), dtype=float)
+    parts = [part[np.isfinite(part)] for part in np.split(x, np.flatnonzero(np.isnan(x)))]
+    stretches = [part for part in parts if part.size > 1]
+    every = line.get_markevery()
+    shown = every is not None and line.get_marker() not in ("", "None")
+    marked = set(x[np.asarray(every, bool)]) if shown else set()
+    return stretches, marked
+
+
+@pytest.mark.parametrize("dates,joined", [(["2025-06-21", "2025-12-21"], False), ("1:365:7", True)],
+                         ids=["solstices", "weekly"])
+def test_a_curve_over_the_days_joins_only_near_days(dates, joined):
+    """annual_t_solar.png: days more than a fortnight apart (the solstices) are markers, with no
+    line across the half year between them that nothing evaluated; weekly days are a line. Every
+    day evaluated is drawn, as a line's point or a marker."""
+    from matplotlib.figure import Figure
+
+    study = foldopt.default_study().variant(step_min=30, fold_angles={"start": 30, "stop": 180, "step": 30},
+                                            site={"latitude": 52.52, "longitude": 13.40})
+    table = foldopt.sweep(study, "day", date=dates, p_load=[2.0]).table
+    ax = sweep.plot_curves(table, "day_of_year", "t", ax=Figure().subplots())
+    evaluated = set(table["day_of_year"].astype(float))
+    assert len(ax.lines) == 3  # flat, optimal twofold, tracker
+    for line in ax.lines:
+        stretches, marked = _segments_and_points(line)
+        for stretch in stretches:
+            assert np.diff(stretch).max() <= sweep.DAY_GAP
+        on_lines = set(np.concatenate(stretches)) if stretches else set()
+        assert on_lines | marked == evaluated and not on_lines & marked
+        assert bool(stretches) == joined

@@ -55,9 +55,44 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, study=None, ax=N
     return ax
 
 
+def monthly_means(table: pd.DataFrame, loads_at_most: int = 4) -> pd.DataFrame:
+    """What :func:`plot_monthly` draws: per load, design and month, the mean day of the days the
+    study has in that month (the first case's site), whatever their number.
+
+    A month's sum over the days sampled would grow with their number (every 7th day: five days in
+    some months, four in others); the mean day is comparable across months, and with every day
+    it is the month's total over its days.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep's tidy table with ``date``, ``design``, ``p_load_w`` [W],
+        ``energy_harvested_wh`` [Wh] and ``t_solar_h`` [h].
+    loads_at_most : int, default 4
+        The lowest loads kept.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``p_load_w`` [W], ``design``, ``month`` [1-12], ``days`` (of the table in that month),
+        ``energy_harvested_wh`` [Wh] and ``t_solar_h`` [h] of the mean day.
+    """
+    table = table.assign(month=pd.to_datetime(table["date"]).dt.month)
+    first = table.iloc[0]
+    for column in ("site_name", "latitude", "longitude"):
+        if column in table:
+            # A grid point's site has no name: NaN, read from results.csv, is its own site.
+            same = table[column].isna() if pd.isna(first[column]) else table[column] == first[column]
+            table = table[same]
+    loads = sorted(table["p_load_w"].unique())[:loads_at_most]
+    rows = table[table["p_load_w"].isin(loads) & table["design"].isin(_designs(table))]
+    means = rows.groupby(["p_load_w", "design", "month"])[["energy_harvested_wh", "t_solar_h"]].mean()
+    return means.assign(days=rows.groupby(["p_load_w", "design", "month"]).size()).reset_index()
+
+
 def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=None, study=None):
-    """Monthly energy harvested and mean daily t_solar of every design, side by side, a row per
-    load (the first case's site).
+    """The mean day of each month, energy harvested and t_solar of every design side by side, a
+    row per load (the first case's site): :func:`monthly_means`.
 
     Parameters
     ----------
@@ -69,8 +104,8 @@ def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=N
     loads_at_most : int, default 4
         The lowest loads shown, a row each.
     axes : numpy.ndarray of matplotlib.axes.Axes, optional
-        A (loads, 2) array to draw on: energy [kWh] on the left, t_solar [h] on the right;
-        default a new figure (11 in wide, 3.2 in per load).
+        A (loads, 2) array to draw on: mean daily energy [Wh] on the left, mean daily t_solar [h]
+        on the right; default a new figure (11 in wide, 3.2 in per load).
     study : foldopt.Study, optional
         Names a load profile's loads.
 
@@ -79,32 +114,26 @@ def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=N
     numpy.ndarray of matplotlib.axes.Axes
         ``axes``.
     """
-    table = table.assign(month=pd.to_datetime(table["date"]).dt.month)
-    first = table.iloc[0]
-    for column in ("site_name", "latitude", "longitude"):
-        if column in table:
-            table = table[table[column] == first[column]]
-    loads = sorted(table["p_load_w"].unique())[:loads_at_most]
-    designs = _designs(table)
+    means = monthly_means(table, loads_at_most)
+    loads = sorted(means["p_load_w"].unique())
+    designs = [d for d in DESIGN_COLOURS if d in set(means["design"])]
     if axes is None:
         _, axes = new_axes(None, (11, 3.2 * len(loads)), len(loads), 2, squeeze=False)
     width = 0.8 / len(designs)
     for (energy_ax, time_ax), load in zip(axes, loads, strict=True):
-        rows = table[table["p_load_w"] == load]
         for i, design in enumerate(designs):
-            monthly = rows[rows["design"] == design].groupby("month")
-            x = np.asarray(monthly.size().index) + (i - (len(designs) - 1) / 2) * width
-            energy_ax.bar(x, monthly["energy_harvested_wh"].sum() / 1000.0, width, color=DESIGN_COLOURS[design],
-                          label=design)
-            time_ax.bar(x, monthly["t_solar_h"].mean(), width, color=DESIGN_COLOURS[design], label=design)
-        energy_ax.set_ylabel("energy harvested [kWh]")
-        time_ax.set_ylabel(f"mean daily t_solar [h]\n{load_label(study, load)}", fontsize=8)
+            monthly = means[(means["p_load_w"] == load) & (means["design"] == design)]
+            x = monthly["month"].to_numpy() + (i - (len(designs) - 1) / 2) * width
+            energy_ax.bar(x, monthly["energy_harvested_wh"], width, color=DESIGN_COLOURS[design], label=design)
+            time_ax.bar(x, monthly["t_solar_h"], width, color=DESIGN_COLOURS[design], label=design)
+        energy_ax.set_ylabel("energy harvested [Wh/day]")
+        time_ax.set_ylabel(f"t_solar [h/day]\n{load_label(study, load)}", fontsize=8)
         for ax in (energy_ax, time_ax):
             ax.set_xticks(range(1, 13), MONTH_NAMES)
             ax.grid(alpha=0.3, axis="y")
     axes[0, 0].legend(fontsize=8)
-    axes[0, 0].set_title("energy harvested per month", fontsize=10)
-    axes[0, 1].set_title("mean daily t_solar per month", fontsize=10)
+    axes[0, 0].set_title("mean daily energy harvested, per month", fontsize=10)
+    axes[0, 1].set_title("mean daily t_solar, per month", fontsize=10)
     axes[0, 0].figure.suptitle(title, fontsize=10)
     return axes
 
@@ -228,8 +257,8 @@ def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
 FIGURES = {
     "daily_t_solar_distribution.png": FigureFile(plot_distribution, "daily t_solar of each design as box plots, per "
                                                                     "load"),
-    "monthly_energy_t_solar.png": FigureFile(plot_monthly, "energy harvested and mean daily t_solar of every design, "
-                                                           "month by month"),
+    "monthly_energy_t_solar.png": FigureFile(plot_monthly, "mean daily energy harvested and t_solar of every "
+                                                           "design, month by month"),
     "annual_t_solar_vs_fold_angle.png": FigureFile(plot_annual_fold_angles, "the year's objective and mean daily "
                                                                             "t_solar at each fold angle kept all year"),
     "day_hour_power.png": FigureFile(plot_day_hour, "the twofold panel's power, day by hour"),

@@ -52,8 +52,43 @@ def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label:
     return ax
 
 
+#: The widest gap [d] between sampled days that a curve over the days of the year bridges with a
+#: line: a fortnight's weekly samples are joined, while days further apart (months, solstices) are
+#: points, not a course through the days between that nothing evaluated.
+DAY_GAP = 16.0
+
+
+def broken_at_gaps(x, y, gap: float):
+    """A curve's points with a NaN between neighbours more than ``gap`` apart, where a line
+    through them stops, and which points have no neighbour within ``gap`` (to draw as markers).
+
+    Parameters
+    ----------
+    x, y : array_like
+        The points, ``x`` ascending, (n,).
+    gap : float
+        The widest step bridged (``numpy.inf``: every one).
+
+    Returns
+    -------
+    x, y : numpy.ndarray
+        (n + breaks,).
+    alone : numpy.ndarray of bool
+        (n + breaks,): a point with no line to either side.
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    wide = np.diff(x) > gap
+    joined = np.zeros(x.size, bool)
+    joined[1:] |= ~wide
+    joined[:-1] |= ~wide
+    at = np.flatnonzero(wide) + 1
+    return np.insert(x, at, np.nan), np.insert(y, at, np.nan), np.insert(~joined, at, False)
+
+
 def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = None, ax=None):
-    """t_solar of the flat panel, the optimal twofold panel and the tracker against ``x``.
+    """t_solar of the flat panel, the optimal twofold panel and the tracker against ``x``; over the
+    days of the year, a line joins only days at most :data:`DAY_GAP` apart, and a day with none
+    so near is a marker (:func:`broken_at_gaps`).
 
     Parameters
     ----------
@@ -81,8 +116,9 @@ def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = Non
             curve = rows[rows["design"] == design].groupby(x)["t_solar_h"].mean()
             name = "optimal twofold" if design == "twofold" else design
             label = name if split is None else f"{name}, {split} {value}"
-            ax.plot(curve.index, curve.to_numpy(), color=colour, ls=style, lw=2 if design == "twofold" else 1.3,
-                    label=label)
+            xs, ys, alone = broken_at_gaps(curve.index, curve.to_numpy(), DAY_GAP if x == "day_of_year" else np.inf)
+            ax.plot(xs, ys, color=colour, ls=style, lw=2 if design == "twofold" else 1.3, label=label, marker="o",
+                    ms=4, markevery=alone.tolist())
     ax.set_xlabel(AXIS_LABELS.get(x, x))
     ax.set_ylabel("t_solar [h]")
     ax.set_title(title, fontsize=10)
