@@ -117,8 +117,8 @@ def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = Non
             name = "optimal twofold" if design == "twofold" else design
             label = name if split is None else f"{name}, {split} {value}"
             xs, ys, alone = broken_at_gaps(curve.index, curve.to_numpy(), DAY_GAP if x == "day_of_year" else np.inf)
-            ax.plot(xs, ys, color=colour, ls=style, lw=2 if design == "twofold" else 1.3, label=label, marker="o",
-                    ms=4, markevery=alone.tolist())
+            ax.plot(xs, ys, color=colour, ls=style, lw=2 if design == "twofold" else 1.3, label=label,
+                    marker="o" if alone.any() else None, ms=4, markevery=alone.tolist())
     ax.set_xlabel(AXIS_LABELS.get(x, x))
     ax.set_ylabel("t_solar [h]")
     ax.set_title(title, fontsize=10)
