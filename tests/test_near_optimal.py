@@ -162,3 +162,20 @@ def test_a_range_on_a_grid_holds_the_best_evaluated_angle(values, data, fraction
     best = angles[best_angle_index(np.array(values))]
     assert got["near_optimal_lo_deg"][0] <= best <= got["near_optimal_hi_deg"][0]
     assert got["near_optimal_lo_deg"][0] <= got["recommended_fold_angle_deg"][0] <= got["near_optimal_hi_deg"][0]
+
+
+def test_foldopt_run_prints_a_range_that_holds_its_best_angle(tmp_path):
+    """The newcomer's `foldopt run`: the best angle it prints lies in the near-optimal range it
+    prints (it printed best 28.5 deg, near-optimal 29 to 52 deg)."""
+    import re
+
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    done = CliRunner().invoke(app, ["run", "--out", str(tmp_path / "run")])
+    assert done.exit_code == 0, done.output
+    best = float(re.search(r"best fold angle ([\d.]+) deg", done.stdout)[1])
+    lo, hi, recommended = map(float, re.search(r"near-optimal ([\d.]+) to ([\d.]+) deg .*recommended ([\d.]+) deg",
+                                               done.stdout).groups())
+    assert lo <= best <= hi and lo <= recommended <= hi
