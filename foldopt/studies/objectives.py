@@ -152,7 +152,9 @@ def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
     Parameters
     ----------
     angles : array_like
-        The fold-angle grid [deg], ascending, (n_angles,).
+        The fold angles evaluated [deg], ascending, (n_angles,): a grid, and with it any optimum
+        refined between its angles (:func:`foldopt.engine.optimize.optimal_fold_angle`), which the
+        range then holds, as it holds the best of the angles given.
     values : array_like
         t_solar or an objective [h] at each angle, (..., n_angles).
     tolerance : foldopt.inputs.sections.NearOptimal
