@@ -80,3 +80,110 @@ def test_heuristic_agrees_with_the_sweep_on_the_paper_study(shin_study, mode, ge
         summary.loc["twofold", "t_solar_h"], abs=0.01
     )
     assert Day(study).combined_power(np.array([180.0])).shape == (1, 1440)
+
+
+# foldopt optimize (foldopt.studies.joint): small searches (15-min steps, 5-deg grids) so each runs in a second.
+
+#: The command line's options and the API's fields of one small search.
+SMALL = ["--step-min", "15", "--vary", "fold_angle,tilt", "--fold-range", "10:180:5", "--tilt-range", "0:90:5"]
+SMALL_API = {"step_min": 15, "vary": "fold_angle,tilt", "fold_angle": "10:180:5", "tilt": "0:90:5"}
+#: At 80 N on the December solstice the sun stays some 13 deg below the horizon all day: polar night.
+POLAR = {"latitude": 80.0, "date": "2014-12-21"}
+
+
+def _optimize(**fields):
+    import foldopt
+
+    return foldopt.optimize(foldopt.default_study(), **{**SMALL_API, **fields})
+
+
+def _no_nan(text):
+    import re
+
+    return re.search(r"\bnan\b", text, flags=re.IGNORECASE) is None
+
+
+@pytest.fixture(scope="module")
+def polar_night():
+    return _optimize(**POLAR)
+
+
+def test_a_flat_landscape_ends_with_the_coarse_lattice():
+    """A constant objective, t_solar counted in whole steps (the tolerance raised to the quantum):
+    no box can hold a design better than the best by more than the tolerance, so the coarse lattice
+    ends the search, not every grid point."""
+    from foldopt.engine.search import Axis, grid_search
+
+    axes = [Axis("fold_angle", 1, 180, 1), Axis("tilt", 0, 90, 1)]
+    result = grid_search(lambda points: np.zeros((len(points), 1)), axes, 0.01, quantum=1 / 60)
+    assert result.levels[0][1] == result.index.shape[0] < result.grid_size / 50
+    assert all(count == 0 for _, count in result.levels[1:])
+
+
+@pytest.mark.parametrize("fields", [POLAR, {"p_load": 1000.0}], ids=["polar-night", "load-above-any-panel"])
+def test_a_landscape_of_zeros_is_answered_at_once(fields, polar_night):
+    """At polar night every design's t_solar is 0 (no light), and a 1 kW load is beyond any design of
+    a 0.108 m^2 panel (some 20 W at noon): the search stops after its coarse lattice and says no
+    design carries the load. It evaluated every grid point before (665 here; 1.5 M designs and some
+    100 s with the default grids)."""
+    result = polar_night if fields is POLAR else _optimize(**fields)
+    search = result.twofold
+    assert np.all(search.values == 0.0) and np.all(result.table["objective_h"] == 0.0)
+    assert all(count == 0 for _, count in search.levels[1:])
+    assert search.index.shape[0] < search.grid_size / 4
+    lines = result.answer.lines()
+    assert any("no design carries the load" in line for line in lines)
+    assert not any("near-optimal" in line for line in lines[2:])
+
+
+def test_no_nan_reaches_an_answer_at_polar_night(tmp_path, polar_night):
+    """The terminal's lines, --format json (strict JSON), the CSVs and report.html of a search where no
+    design carries the load: no NaN (it printed '+nan % over the flat panel' and 'fold nan to nan
+    deg'); the command line gives the API's numbers."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    def refuse(constant):
+        raise ValueError(f"{constant} in the JSON")
+
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["optimize", *SMALL, "--lat", "80", "--date", "2014-12-21", "--format", "json",
+                                      "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    document = json.loads(result.stdout, parse_constant=refuse)
+    assert all(_no_nan(line) for line in document["answer"]["lines"])
+    api = json.loads(json.dumps(polar_night.answer.to_dict(), allow_nan=False))
+    assert document["answer"]["result"] == api["result"] and document["answer"]["designs"] == api["designs"]
+    assert [load["carried"] for load in api["result"]["loads"]] == [False]
+    for path in out.iterdir():
+        if path.suffix in (".csv", ".html", ".json"):
+            assert _no_nan(path.read_text(encoding="utf-8")), path.name
+
+
+def test_no_gain_is_claimed_over_a_flat_panel_that_carries_nothing():
+    """Where the flat panel at its own best carries none of the load but the folded one does, there is
+    no ratio: the answer gives the flat panel's hours, not '+nan %'."""
+    import dataclasses
+
+    from foldopt.studies.answering_joint import of_optimize
+
+    result = _optimize(p_load=[2.0])
+    table = result.table.copy()
+    flat = table["design"] == "flat"
+    table.loc[flat, "objective_h"] = 0.0
+    table["gain_vs_flat_pct"] = np.nan  # as the table holds it where the flat panel gives 0 h
+    lines = of_optimize(dataclasses.replace(result, table=table)).lines()
+    assert all(_no_nan(line) for line in lines)
+    assert any("carries none of it" in line for line in lines)
+
+
+def test_the_search_states_the_tolerance_it_kept():
+    """One day at 15-min steps counts t_solar in quarter hours: the search is within 0.25 h, not the
+    0.01 h asked for, and says so (it claimed 0.01 h)."""
+    result = _optimize()
+    assert result.twofold.tolerance == 0.25
+    assert "within 0.25 h of its best" in result.answer.lines()[-1]
+    assert result.answer.result["search"]["tolerance_h"] == 0.25

@@ -16,12 +16,15 @@ tensor-product linear interpolation [1]_); t_solar, counted in whole time steps,
 
     f(q) <= max(f(corners)) + sum_i M_i h_i^2 / 8 + quantum.
 
-A box is dropped only when that bound lies below the best value found so far plus the
+A box is dropped when that bound lies at or below the best value found so far plus the
 ``tolerance``: it cannot hold a point better than the best by more than the tolerance, and the
 best only grows. A tolerance below ``quantum`` is raised to it: the objective cannot tell designs
-apart more finely than its own jumps (for one day's t_solar, one time step). Kept boxes are halved
-along every axis and their new corners evaluated; at stride 1 a box has no grid point but its
-corners, so every grid point was either evaluated or lies in a dropped box. ``M_i`` is not known
+apart more finely than its own jumps (for one day's t_solar, one time step). At the bound, not only
+below it: a plateau at the best (a landscape of zeros where no design carries the load, at polar
+night) bounds each of its boxes by the best plus ``quantum``, the tolerance there, and was refined
+to every grid point; now its coarse lattice ends the search. Kept boxes are halved along every
+axis and their new corners evaluated; at stride 1 a box has no grid point but its corners, so
+every grid point was either evaluated or lies in a dropped box. ``M_i`` is not known
 in advance: each level estimates it from the second differences at the box's corners on that
 level's lattice (the largest anywhere along the axis where none is evaluated), times ``safety``
 (default 2). The guarantee is as good as that estimate: a peak narrower than the coarse lattice
@@ -239,7 +242,7 @@ class GridSearch:
         best = self.store.best_values()
         bound = _box_bounds(self.store, self.lower, self.upper, self.strides, self.steps, self.sizes,
                             self.safety) + self.quantum
-        keep = np.any(bound >= best + self.tolerance, axis=1)
+        keep = np.any(bound > best + self.tolerance, axis=1)
         self.strides = np.maximum(self.strides // 2, 1)
         self.lower, self.upper = _split(self.lower[keep], self.upper[keep], self.strides)
         corners = _corners(self.lower, self.upper)

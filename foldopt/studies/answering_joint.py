@@ -20,6 +20,15 @@ def _mounting(row) -> str:
     return f"tilt {row.surface_tilt:g} deg, azimuth {row.surface_azimuth:g} deg"
 
 
+def _over_flat(best, flat) -> str:
+    """The optimum against the flat panel at its own best: a gain in per cent, or where the flat
+    panel carries nothing (no ratio to give), its hours."""
+    where = f"the flat panel at its own best ({_mounting(flat)}: {flat.objective_h:.2f} h)"
+    if flat.objective_h > 0:
+        return f"{best.gain_vs_flat_pct:+.1f} % over {where}"
+    return f"where {where} carries none of it"
+
+
 def of_optimize(result) -> Answer:
     """The answer of :func:`foldopt.studies.joint.optimize_plan`.
 
@@ -51,24 +60,31 @@ def of_optimize(result) -> Answer:
         best, flat = _row(table, load, "twofold"), _row(table, load, "flat")
         default, flat_default = _row(table, load, "twofold-default"), _row(table, load, "flat-default")
         tracker = _row(table, load, "tracker")
-        label = f"load profile x {load:g}" if study.load_profile is not None else f"P_load {load:g} W"
-        lines.append(f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
-                     f"{best.objective_h:.2f} h, {best.gain_vs_flat_pct:+.1f} % over the flat panel at its own best "
-                     f"({_mounting(flat)}: {flat.objective_h:.2f} h); tracker {tracker.objective_h:.2f} h")
         near = result.near_optimal[result.near_optimal["p_load_w"] == load]
-        if len(near):
-            lines.append("  near-optimal: " + ", ".join(
-                f"{_LABELS[row.variable][0]} {row.near_optimal_lo_deg:g} to {row.near_optimal_hi_deg:g} deg "
-                f"(recommended {row.recommended_deg:g})" for row in near.itertuples())
-                + f", each within {near['near_optimal_tolerance_h'].iloc[0] * 60:.1f} min")
         added = result.added[result.added["p_load_w"] == load]
-        lines.append(f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} h, "
-                     f"folded to {default.fold_angle_deg:g} deg {default.objective_h:.2f} h): "
-                     + ", ".join(f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
-                                 for row in added.itertuples()))  # + 0.0: no "-0.0" for a roundoff
-        per_load.append({"p_load_w": load, "fold_angle_deg": best.fold_angle_deg, "surface_tilt": best.surface_tilt,
-                         "surface_azimuth": best.surface_azimuth, "objective_h": best.objective_h,
-                         "gain_vs_flat_pct": best.gain_vs_flat_pct,
+        label = f"load profile x {load:g}" if study.load_profile is not None else f"P_load {load:g} W"
+        carried = best.objective_h > 0
+        if not carried:
+            # Every design ties at nothing: the search's tie-break is no optimum, nor is there a gain
+            # or a near-optimal region to give.
+            near = near.iloc[:0]
+            lines.append(f"{label}: no design carries the load: the {objective} is 0.00 h at every design searched "
+                         f"(and the flat panel's); tracker {tracker.objective_h:.2f} h")
+        else:
+            lines.append(f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: {best.objective_h:.2f} h, "
+                         f"{_over_flat(best, flat)}; tracker {tracker.objective_h:.2f} h")
+            if len(near):
+                lines.append("  near-optimal: " + ", ".join(
+                    f"{_LABELS[row.variable][0]} {row.near_optimal_lo_deg:g} to {row.near_optimal_hi_deg:g} deg "
+                    f"(recommended {row.recommended_deg:g})" for row in near.itertuples())
+                    + f", each within {near['near_optimal_tolerance_h'].iloc[0] * 60:.1f} min")
+            lines.append(f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} "
+                         f"h, folded to {default.fold_angle_deg:g} deg {default.objective_h:.2f} h): "
+                         + ", ".join(f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
+                                     for row in added.itertuples()))  # + 0.0: no "-0.0" for a roundoff
+        per_load.append({"p_load_w": load, "carried": bool(carried), "fold_angle_deg": best.fold_angle_deg,
+                         "surface_tilt": best.surface_tilt, "surface_azimuth": best.surface_azimuth,
+                         "objective_h": best.objective_h, "gain_vs_flat_pct": best.gain_vs_flat_pct,
                          "flat": {"surface_tilt": flat.surface_tilt, "surface_azimuth": flat.surface_azimuth,
                                   "objective_h": flat.objective_h},
                          "default": {"fold_angle_deg": default.fold_angle_deg, "objective_h": default.objective_h,
@@ -77,11 +93,15 @@ def of_optimize(result) -> Answer:
                          "added_h": dict(zip(added["variable"], added["added_h"], strict=True)),
                          "near_optimal": records(near.drop(columns="p_load_w"))})
     search = result.twofold
+    # The search's tolerance is the one asked for, or the objective's own step where that is coarser.
+    raised = "" if search.tolerance <= spec.tolerance_h else (
+        f" (the objective's own step: it counts no finer than the {spec.tolerance_h:g} h asked for)")
     lines.append(f"search: {search.index.shape[0]:,} of the grid's {search.grid_size:,} designs evaluated "
-                 f"({100 * search.index.shape[0] / search.grid_size:.1f} %), within {spec.tolerance_h:g} h of its best")
+                 f"({100 * search.index.shape[0] / search.grid_size:.1f} %), within {search.tolerance:.3g} h of its "
+                 f"best{raised}")
     summary = {"statistic": result.statistic, "days": days, "loads": per_load,
                "search": {"evaluated": int(search.index.shape[0]), "grid": search.grid_size,
-                          "levels": [list(level) for level in search.levels], "tolerance_h": spec.tolerance_h}}
+                          "levels": [list(level) for level in search.levels], "tolerance_h": search.tolerance}}
     return Answer("optimize", study.name, question, request_defaults(result), summary, table, result.near_optimal,
                   summary=tuple(lines))
 
