@@ -50,10 +50,10 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
     pandas.DataFrame
         A row per case and design with ``days``, the fold angle [deg] and:
 
-        - ``fold_angle_min_deg`` and ``fold_angle_max_deg``, the least and largest of the days'
-          fold angles, and ``fold_angle_deg``, the one angle of every day (a flat panel's, an
-          objective's): empty where the angle varies by day (each day's best), with a ``note``
-          that says so and where each day's is, as for a tracker, which has none;
+        - ``fold_angle_deg``, the design's angle where every day has the same (a flat panel's, an
+          objective's); empty where it varies by day (each day its own best), as for a tracker,
+          which has none; ``fold_angle_min_deg`` and ``fold_angle_max_deg``, the least and
+          largest of the days' angles; ``note``, where the angle varies, that it does;
 
         - daily t_solar [h]: ``mean_t_solar_h``, ``p10_t_solar_h``, ``p50_t_solar_h``,
           ``p90_t_solar_h``, ``min_t_solar_h``, the days reaching each of :data:`THRESHOLDS_H`
