@@ -232,6 +232,51 @@ def canonical(value, names, field: str = "name"):
     squashed = {_squash(name): name for name in names}
     if _squash(text) in squashed:
         return squashed[_squash(text)]
-    close = difflib.get_close_matches(lowered, names, n=2, cutoff=0.6)
-    hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
-    raise ValueError(f"must be one of {', '.join(names)}{hint}")
+    raise ValueError(f"must be one of {', '.join(names)}{did_you_mean(text, names)}")
+
+
+def close_names(value: str, names) -> list[str]:
+    """The names a misspelling most likely meant: those it begins (``singl`` for ``single-diode``),
+    then the closest by :mod:`difflib`, compared without case or separators.
+
+    Parameters
+    ----------
+    value : str
+        The spelling given.
+    names : sequence of str
+        The valid names.
+
+    Returns
+    -------
+    list of str
+        At most two names, the likeliest first; none where nothing is close.
+
+    Examples
+    --------
+    >>> close_names("worst-mnth", ("mean", "min", "worst-month"))
+    ['worst-month']
+    >>> close_names("singl", PV_MODELS)
+    ['single-diode']
+    """
+    squashed = {_squash(name): name for name in names}
+    key = _squash(value)
+    begun = [name for short, name in squashed.items() if len(key) >= 2 and short.startswith(key)]
+    near = [squashed[short] for short in difflib.get_close_matches(key, squashed, n=2, cutoff=0.6)]
+    return list(dict.fromkeys(begun + near))[:2]
+
+
+def did_you_mean(value: str, names) -> str:
+    """``"; did you mean 'x'?"`` for the names :func:`close_names` finds, or ``""``: the end of
+    every message that refuses a name.
+
+    Parameters
+    ----------
+    value : str
+    names : sequence of str
+
+    Returns
+    -------
+    str
+    """
+    close = close_names(value, names)
+    return f"; did you mean {' or '.join(repr(name) for name in close)}?" if close else ""

@@ -96,6 +96,103 @@ def test_the_cli_reference_holds_every_command_and_option(built):
         missing += [f"{' '.join(path)} {name}" for param in command.params
                     for name in [*param.opts, *param.secondary_opts] if name not in shown]
     assert missing == []
+    assert "taken by foldopt" in page  # the table of the options several commands share
+
+
+def _rst_blocks(lines: list[str]) -> list[str]:
+    """The lines of a reStructuredText page's literal blocks (after a line ending in ``::``)."""
+    found, indent = [], None
+    for line in lines:
+        depth = len(line) - len(line.lstrip())
+        if indent is not None and line.strip() and depth <= indent:
+            indent = None
+        if indent is not None:
+            found.append(line)
+        elif line.rstrip().endswith("::"):
+            indent = depth
+    return found
+
+
+def command_lines(text: str) -> list[str]:
+    """Every ``foldopt ...`` command line of a page: inline literals, and the lines of its bash
+    blocks (Markdown) or literal blocks (reStructuredText), a trailing backslash joining the next;
+    templates (``<command>``, ``[CONFIG]``, ``a | b``, ``...``) left out."""
+    found = [" ".join(span.split()) for span in re.findall(r"(?<!`)``?(foldopt [^`]+?)``?(?!`)", text)]
+    if "```" in text:
+        lines = [line for block in re.findall(r"```bash\n(.*?)```", text, flags=re.S) for line in block.splitlines()]
+    else:
+        lines = _rst_blocks(text.splitlines())
+    index = 0
+    while index < len(lines):
+        line = lines[index].strip().removeprefix("$ ")
+        index += 1
+        if not line.startswith("foldopt "):
+            continue
+        while line.endswith("\\") and index < len(lines):
+            line = line[:-1] + " " + lines[index].strip()
+            index += 1
+        found.append(line)
+    return [line for line in found if not re.search(r"[<\[|]|\.\.\.", line)]
+
+
+def test_every_command_line_in_the_docs_parses():
+    """Each command line the README and the manual show names a command and options it has, with
+    values of their types (Click parses it; nothing runs, and no eager option such as
+    --install-completion is reached: the line of a group is only looked up)."""
+    import shlex
+
+    import typer.main
+
+    from foldopt.cli.app import app
+
+    root = typer.main.get_command(app)
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.rst"))]
+    lines = [(page.name, line) for page in pages for line in command_lines(page.read_text(encoding="utf-8"))]
+    assert len(lines) > 50
+    refused = []
+    for page, line in lines:
+        args, command, name = shlex.split(line, comments=True)[1:], root, "foldopt"
+        while hasattr(command, "commands") and args and not args[0].startswith("-"):
+            name = args.pop(0)
+            command = command.commands.get(name)
+            if command is None:
+                refused.append(f"{page}: {line}: no command {name}")
+                break
+        if command is None or hasattr(command, "commands"):
+            continue
+        try:
+            command.make_context(name, args)
+        except Exception as error:  # click's UsageError and its kin, as the command line would refuse it
+            refused.append(f"{page}: {line}: {error}")
+    assert refused == []
+
+
+def test_the_cli_page_and_the_readme_list_every_command():
+    """The command tables of docs/cli.rst and the README name every command of the command line."""
+    import typer.main
+
+    from foldopt.cli.app import app
+
+    root = typer.main.get_command(app)
+    page = (ROOT / "docs" / "cli.rst").read_text(encoding="utf-8")
+    table = page[:page.index("\n---")]  # the table before the page's first section
+    listed = set(re.findall(r"\* - ``foldopt ([a-z ]+?)[ `\[]", table))
+    leaves = {f"{group} {name}" if hasattr(command, "commands") else group
+              for group, top in root.commands.items() for name, command in
+              (getattr(top, "commands", None) or {group: top}).items()}
+    assert leaves - listed == set()
+    readme = set(re.findall(r"^\| `foldopt ([a-z]+)", README, flags=re.M))
+    assert set(root.commands) - readme == set()
+
+
+def test_the_api_page_lists_every_public_name():
+    import foldopt
+
+    page = (ROOT / "docs" / "api.rst").read_text(encoding="utf-8")
+    shown = re.findall(r"^   foldopt\.(\w+)\s*$", page, flags=re.M)
+    assert sorted(set(foldopt.__all__) - {"__version__"} - set(shown)) == []
+    assert sorted(set(shown) - set(foldopt.__all__)) == []
+    assert len(shown) == len(set(shown))
 
 
 def test_the_study_file_reference_holds_every_field(built):

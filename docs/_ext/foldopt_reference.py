@@ -6,6 +6,8 @@ Directives
 ``.. foldopt-cli::``
     Every command of the command line, read off the Typer app's click tree: its usage, its help
     and every option with its type, default and help, as ``foldopt <command> --help`` prints them.
+``.. foldopt-cli-shared::``
+    The options several commands take, and which commands take each, off the same tree.
 ``.. foldopt-study::``
     Every field of a study file, read off the pydantic models of :class:`foldopt.Study`: its
     dotted path, type, default, what it accepts (the validator's own words) and description.
@@ -135,6 +137,62 @@ class CliReference(Directive):
 
         command = typer.main.get_command(app)
         return [_command_section(self.state.document, command, ["foldopt"], None)]
+
+
+def _leaves(command, path: list[str]):
+    """(path, command) of every command under ``command`` that is no group."""
+    for name, sub in getattr(command, "commands", {}).items():
+        if hasattr(sub, "commands"):
+            yield from _leaves(sub, [*path, name])
+        elif not getattr(sub, "hidden", False):
+            yield [*path, name], sub
+
+
+def shared_options(command, least: int = 3) -> dict[str, list[str]]:
+    """Each option that several commands take -> the commands, a group named once where all its
+    commands take the option (``sweep`` for its four).
+
+    Parameters
+    ----------
+    command : click.Group
+        The command line.
+    least : int
+        How many of its top-level commands (a group as one) must take an option; 3 leaves out
+        those only ``sweep`` and ``optimize`` share (``optimize`` takes every sweep option).
+
+    Returns
+    -------
+    dict
+        The option's names (``-q, --quiet``) -> the commands, in the command line's order.
+    """
+    takers: dict[str, list[list[str]]] = {}
+    groups: dict[str, int] = {}
+    for path, leaf in _leaves(command, []):
+        groups[path[0]] = groups.get(path[0], 0) + 1
+        for param in leaf.params:
+            if param.param_type_name == "option" and not param.hidden:
+                names = ", ".join(sorted([*param.opts, *param.secondary_opts], key=len))
+                takers.setdefault(names, []).append(path)
+    shared = {}
+    for names, paths in takers.items():
+        tops = list(dict.fromkeys(path[0] for path in paths))
+        if len(tops) >= least:
+            whole = {top for top in tops if sum(path[0] == top for path in paths) == groups[top]}
+            shared[names] = list(dict.fromkeys(path[0] if path[0] in whole else " ".join(path) for path in paths))
+    return shared
+
+
+class CliShared(Directive):
+    """The options that several commands take, and which commands take each."""
+
+    def run(self):
+        import typer.main
+
+        from foldopt.cli.app import app
+
+        shared = shared_options(typer.main.get_command(app))
+        rows = [[_literal(names), ", ".join(commands)] for names, commands in shared.items()]
+        return [_table(["option", "taken by foldopt"], rows, [30, 70])]
 
 
 # --- the study file ------------------------------------------------------------------------------
@@ -388,7 +446,8 @@ def _absolute_values(app, what, name, obj, options, lines):
 
 def setup(app):
     app.connect("autodoc-process-docstring", _absolute_values)
-    for name, directive in (("foldopt-cli", CliReference), ("foldopt-study", StudyReference),
+    for name, directive in (("foldopt-cli", CliReference), ("foldopt-cli-shared", CliShared),
+                            ("foldopt-study", StudyReference),
                             ("foldopt-names", NamesReference), ("foldopt-study-file", StudyFile),
                             ("foldopt-reproduction", ReproductionTable), ("foldopt-rst", GeneratedRst)):
         app.add_directive(name, directive)

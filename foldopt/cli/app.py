@@ -25,6 +25,7 @@ from typer.core import TyperCommand, TyperGroup
 from foldopt.cli import map as map_command, optimize, run, size, sweep
 from foldopt.cli.output import INVOCATION, as_text, echo
 from foldopt.errors import ConfigError, OutputError, OutputExistsError
+from foldopt.names import close_names
 
 # Typer >= 0.29 vendors click; its UsageError is reached through the public BadParameter.
 _USAGE_ERROR = next(cls for cls in typer.BadParameter.__mro__ if cls.__name__ == "UsageError")
@@ -46,6 +47,47 @@ Examples:
 
 Shell completion: foldopt --install-completion.
 """
+
+
+def _option_hint(given: str, ctx) -> str:
+    """What an unknown option most likely meant: the command's options it begins or is close to
+    (:func:`foldopt.names.close_names`, without their dashes: Click compares them with theirs, and
+    the ``--`` that every option shares made ``--bogus`` look like ``--out``), or where it belongs to
+    other commands, which; else where the command's options are listed.
+
+    Parameters
+    ----------
+    given : str
+        The option as typed, ``--name`` or ``--name=value``.
+    ctx : click.Context
+        The command's context.
+
+    Returns
+    -------
+    str
+        The end of the error line.
+    """
+    name = given.split("=", 1)[0]
+    own = {opt.lstrip("-"): opt for param in ctx.command.get_params(ctx)
+           for opt in (*param.opts, *param.secondary_opts) if opt.startswith("-")}
+    close = [own[bare] for bare in close_names(name.lstrip("-"), list(own))]
+    if close:
+        return f"; did you mean {' or '.join(close)}?"
+    takers = [top for top, command in _commands(ctx.find_root().command)
+              if any(name in (*param.opts, *param.secondary_opts) for param in command.params)]
+    if takers:
+        return (f" ({name} is an option of foldopt {', '.join(dict.fromkeys(takers))}; {ctx.command_path} --help "
+                "lists its own)")
+    return f" ({ctx.command_path} --help lists its options)"
+
+
+def _commands(group, top: str | None = None):
+    """(top-level name, command) of every command under ``group`` that is no group itself."""
+    for name, command in getattr(group, "commands", {}).items():
+        if hasattr(command, "commands"):
+            yield from _commands(command, top or name)
+        else:
+            yield top or name, command
 
 
 #: Set by ``foldopt --debug``: an internal error shows its traceback.
@@ -105,7 +147,9 @@ class _OneLineErrors(TyperGroup):
                 sys.exit(0)
             if message:
                 where = f"{error.ctx.command_path}: " if error.ctx is not None else ""
-                if message.startswith("No such command") and error.ctx is not None:
+                if type(error).__name__ == "NoSuchOption" and error.ctx is not None:
+                    message = error.message + _option_hint(error.option_name, error.ctx)
+                elif message.startswith("No such command") and error.ctx is not None:
                     message += f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
                 echo(f"error: {where}{message}", err=True)
             sys.exit(2)

@@ -11,7 +11,8 @@ from typing import Optional
 import typer
 
 from foldopt.cli.options import (ANGLE_STEP, AREA, EFFICIENCY, EMBEDDED, ENGINE, FORMAT, OPTION_OF_FIELD, OVERWRITE,
-                                 QUIET, RESULTS, SETTINGS, STEP_MIN, check_choices, out_option, rename_fields)
+                                 QUIET, RESULTS, SETTINGS, check_choices, out_option, rename_fields,
+                                 step_min_option)
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError, WeatherError
 
@@ -38,7 +39,7 @@ def map_(
     objective: str = typer.Option("mean", "--objective", help="What each period's fold angle maximises: mean | min | "
                                   "worst-month | pNN."),
     year: int = typer.Option(2025, "--year", help="Year of the clear-sky days (or that a typical year stands for)."),
-    step_min: Optional[float] = STEP_MIN,
+    step_min: Optional[float] = step_min_option("5"),
     angle_step: Optional[float] = ANGLE_STEP,
     fold_search: bool = typer.Option(False, "--fold-search", help="Search the fold angles (foldopt.engine.search) "
                                      "instead of evaluating every one: the same objectives within 0.01 h from some "

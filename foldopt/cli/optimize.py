@@ -15,7 +15,7 @@ from foldopt import names
 from foldopt.cli.options import EMBEDDED, OPTION_OF_FIELD, RESULTS, check_choices, rename_fields
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
-from foldopt.cli.sweep import sweep_options
+from foldopt.cli.sweep import signature, sweep_options
 from foldopt.errors import ConfigError
 from foldopt.studies.request import OPTIMIZE_OPTIONS, optimize_section, sweep_request
 
@@ -58,7 +58,7 @@ def optimize(**options):
     run_request(request, out or RESULTS / "optimize", overwrite, output, engine, "optimize")
 
 
-_SIGNATURE = inspect.signature(sweep_options)
+_SIGNATURE = signature("optimize", "results/optimize")
 _OWN = inspect.signature(_optimize_options).parameters.values()
 optimize.__signature__ = _SIGNATURE.replace(parameters=[*_OWN, *_SIGNATURE.parameters.values()])
 optimize.__annotations__ = {**sweep_options.__annotations__, **_optimize_options.__annotations__}

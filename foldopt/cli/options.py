@@ -30,10 +30,7 @@ ENGINE = typer.Option("numba", "--engine", help="numba (the compiled kernel) | n
 TABLE = typer.Option(False, "--table", help="Also print the full table (it is always in the CSV files).")
 AREA = typer.Option(None, "--area", help="Flat panel area [m^2].")
 EFFICIENCY = typer.Option(None, "--efficiency", help="PV efficiency [-] (ideal model; sets the b-model panel's area).")
-STEP_MIN = typer.Option(None, "--step-min", help="Time step [min], a divisor of 1440 [default: the study's; "
-                                                 "foldopt map: 5].")
-ANGLE_STEP = typer.Option(None, "--angle-step", help="Fold-angle grid step [deg] [default: the study's; "
-                                                     "foldopt map: 1].")
+ANGLE_STEP = typer.Option(None, "--angle-step", help="Fold-angle grid step [deg] [default: the study's].")
 SETTINGS = typer.Option(None, "--set", metavar="KEY=VALUE", help="Any study field (a dotted key, a YAML value), "
                                                                  "e.g. --set pv_model=single-diode; repeatable.")
 
@@ -53,6 +50,21 @@ def out_option(default: Path | None = None, shown: str | None = None):
     typer.models.OptionInfo
     """
     return typer.Option(default, "--out", help=f"Results folder{f' [default: {shown}]' if shown else ''}.")
+
+
+def step_min_option(shown: str = "the study's"):
+    """The ``--step-min`` option: the time step.
+
+    Parameters
+    ----------
+    shown : str
+        The default as the help text gives it (``foldopt map`` has its own).
+
+    Returns
+    -------
+    typer.models.OptionInfo
+    """
+    return typer.Option(None, "--step-min", help=f"Time step [min], a divisor of 1440 [default: {shown}].")
 
 
 def study_argument(kind: str = ""):

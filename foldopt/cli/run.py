@@ -5,13 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Optional
 
-from foldopt.cli.options import (EMBEDDED, ENGINE, FORMAT, OVERWRITE, QUIET, RESULTS, TABLE, check_choices, out_option,
-                                 study_argument)
+from foldopt.cli.options import (EMBEDDED, ENGINE, FORMAT, OVERWRITE, QUIET, RESULTS, SETTINGS, TABLE, check_choices,
+                                 out_option, study_argument)
 from foldopt.cli.output import INVOCATION, Output
 from foldopt.files import check_output
-from foldopt.inputs.plan import load_plan
 from foldopt.inputs.load import default_study_path
-from foldopt.studies.request import Request
+from foldopt.studies.request import Request, settings_plan
 
 
 def run_request(request: Request, out: Path, overwrite: bool, output: Output, engine: str, command: str) -> None:
@@ -55,6 +54,7 @@ def run(
     output_format: str = FORMAT,
     engine: str = ENGINE,
     table: bool = TABLE,
+    settings: Optional[list[str]] = SETTINGS,
 ):
     """Run a YAML study: one case (fold-angle sweep, the paper's heuristic, flat and trackers
     compared) or a sweep of cases (a row per case x design).
@@ -63,10 +63,12 @@ def run(
     Examples:
       foldopt run
       foldopt run configs/annual-weather.yaml --out results/greensboro
+      foldopt run --set p_load=3 --out results/shin2015-3w
     """
     output_format, engine = check_choices(output_format, engine)
     source = EMBEDDED if config is None else str(config)
-    request = Request(load_plan(config if config is not None else default_study_path()), source, ())
+    request = Request(settings_plan(config if config is not None else default_study_path(), settings or ()),
+                      source, ())
     run_request(request, out or RESULTS / request.plan.base.name, overwrite, Output(quiet, output_format, table),
                 engine, "run")
 

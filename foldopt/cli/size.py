@@ -8,15 +8,14 @@ from typing import Optional
 
 import typer
 
-from foldopt.cli.options import (FORMAT, EMBEDDED, OVERWRITE, QUIET, RESULTS, TABLE, check_choices, out_option,
-                                 study_argument)
+from foldopt.cli.options import (FORMAT, EMBEDDED, OVERWRITE, QUIET, RESULTS, SETTINGS, TABLE, check_choices,
+                                 out_option, study_argument)
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError
 from foldopt.files import check_output
-from foldopt.inputs.plan import load_plan
 from foldopt.inputs.load import default_study_path
 from foldopt.inputs.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2
-from foldopt.studies.request import size_request, sizing_problems
+from foldopt.studies.request import settings_plan, size_request, sizing_problems
 
 #: The sizing's parameters as the command line names them, longest first.
 _OPTION_OF_SIZING = {"cost_per_m2 / cost_per_w": "--cost-per-m2 / --cost-per-w", "c_grid_usd_per_kwh": "--c-grid",
@@ -46,6 +45,7 @@ def size(
     quiet: bool = QUIET,
     output_format: str = FORMAT,
     table: bool = TABLE,
+    settings: Optional[list[str]] = SETTINGS,
 ):
     """Shin et al. Sec. IV-A panel sizing: the lifetime benefit C_grid x t_solar x P_load against the
     panel's cost, for flat and twofold panels of every area.
@@ -61,7 +61,7 @@ def size(
                               "years": years, "days_per_year": days_per_year})
     if errors:
         fail([_sizing_option(line) for line in errors])
-    plan = load_plan(config if config is not None else default_study_path())
+    plan = settings_plan(config if config is not None else default_study_path(), settings or ())
     request = size_request(plan, EMBEDDED if config is None else str(config),
                            cost_per_m2 is not None or cost_per_w is not None)
     study = plan.base

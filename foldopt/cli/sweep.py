@@ -5,6 +5,7 @@ request they make is :func:`foldopt.studies.request.sweep_request`'s.
 
 from __future__ import annotations
 
+import copy
 import inspect
 from pathlib import Path
 from typing import Optional
@@ -13,7 +14,8 @@ import typer
 
 from foldopt import names
 from foldopt.cli.options import (ANGLE_STEP, AREA, EFFICIENCY, EMBEDDED, ENGINE, FORMAT, OPTION_OF_FIELD, OVERWRITE,
-                                 QUIET, RESULTS, SETTINGS, STEP_MIN, TABLE, check_choices, out_option, rename_fields)
+                                 QUIET, RESULTS, SETTINGS, TABLE, check_choices, out_option, rename_fields,
+                                 step_min_option)
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
 from foldopt.errors import ConfigError
@@ -30,23 +32,22 @@ def _choices(registry) -> str:
 
 def sweep_options(
     config: Optional[Path] = typer.Option(None, "--config", help=f"Study to start from [default: {EMBEDDED}]."),
-    lat: Optional[str] = typer.Option(None, "--lat", help="Latitude [deg north], or a range start:stop:step."),
-    lon: Optional[str] = typer.Option(None, "--lon", help="Longitude [deg east], or a range."),
+    lat: Optional[str] = typer.Option(None, "--lat", help="Latitude [deg north]."),
+    lon: Optional[str] = typer.Option(None, "--lon", help="Longitude [deg east]."),
     altitude: Optional[float] = typer.Option(None, "--altitude", help="Site altitude [m]."),
     timezone: Optional[str] = typer.Option(None, "--timezone", help="IANA name or UTC offset, e.g. UTC-08:00 "
                                            "[default: the longitude's standard offset]."),
-    days: Optional[str] = typer.Option(None, "--days", "--date", help="A date YYYY-MM-DD, a range of days 1:365:7 "
-                                       "or of dates, 'year' or 'equinoxes-solstices'."),
+    days: Optional[str] = typer.Option(None, "--days", "--date", help="A date YYYY-MM-DD."),
     year: Optional[int] = typer.Option(None, "--year", help="Year of day-of-year ranges [default: the study's]."),
-    p_load: Optional[str] = typer.Option(None, "--p-load", help="Load [W], or a range start:stop:step."),
+    p_load: Optional[str] = typer.Option(None, "--p-load", help="Load [W]."),
     load_profile: Optional[Path] = typer.Option(None, "--load-profile", help="A day's load instead of a constant: a "
                                                 "CSV of time,watts rows (HH:MM, held until the next time)."),
-    p_load_scale: Optional[str] = typer.Option(None, "--p-load-scale", help="Scale of the load profile [-], or a range "
-                                               "such as 0.5:2:0.1 [default: 1]."),
+    p_load_scale: Optional[str] = typer.Option(None, "--p-load-scale", help="Scale of the load profile [-] "
+                                               "[default: 1]."),
     area: Optional[float] = AREA,
     efficiency: Optional[float] = EFFICIENCY,
-    tilt: Optional[str] = typer.Option(None, "--tilt", help="Panel tilt [deg], or a range [default: the study's, "
-                                       "or |latitude| where the latitude changes]."),
+    tilt: Optional[str] = typer.Option(None, "--tilt", help="Panel tilt [deg] [default: the study's, or |latitude| "
+                                       "where the latitude changes]."),
     azimuth: Optional[float] = typer.Option(None, "--azimuth", help="Panel azimuth [deg from north] [default: the "
                                             "study's, or facing the equator where the latitude changes]."),
     mode: Optional[str] = typer.Option(None, "--mode", help=_choices(names.MODES) + " [default: the study's; exact "
@@ -97,17 +98,66 @@ def sweep_options(
     temp_air: Optional[float] = typer.Option(None, "--temp-air", help="Air temperature [C] (I-V models)."),
     exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve every step's I-V curves instead "
                                           "of the tables (slow)."),
-    step_min: Optional[float] = STEP_MIN,
+    step_min: Optional[float] = step_min_option(),
     angle_step: Optional[float] = ANGLE_STEP,
     settings: Optional[list[str]] = SETTINGS,
-    out: Optional[Path] = out_option(shown="results/sweep-<axis>"),
+    out: Optional[Path] = out_option(),
     overwrite: bool = OVERWRITE,
     quiet: bool = QUIET,
     output_format: str = FORMAT,
     engine: str = ENGINE,
     table: bool = TABLE,
 ):
-    """The options of every sweep (its signature is theirs)."""
+    """The options of every sweep (its signature is theirs, through :func:`signature`)."""
+
+
+#: What each option that can set a field to several values says of them, where the command lets
+#: that field vary (:func:`signature`).
+_SEVERAL = {
+    "lat": "a range start:stop:step or a list a,b,c",
+    "lon": "a range start:stop:step or a list a,b,c",
+    "days": "a range of days 1:365:7 or of dates, 'year', 'equinoxes-solstices' or a list of dates a,b",
+    "p_load": "a range start:stop:step or a list a,b,c",
+    "p_load_scale": "a range such as 0.5:2:0.1 or a list a,b,c",
+    "tilt": "a range start:stop:step or a list a,b,c",
+}
+#: The options each command lets take several values, and on what condition (the rules are the
+#: library's: :func:`foldopt.studies.request.plan_request` for ``sweep angle``,
+#: :func:`foldopt.studies.joint.optimize_plan` for ``optimize``; every other sweep varies any).
+VARYING = {
+    "angle": {"days": "with --objective or --weather"},
+    "latitude": dict.fromkeys(_SEVERAL, ""), "day": dict.fromkeys(_SEVERAL, ""), "load": dict.fromkeys(_SEVERAL, ""),
+    "optimize": {"days": "", "p_load": "", "p_load_scale": ""},
+}
+
+
+def signature(command: str, out: str) -> inspect.Signature:
+    """:func:`sweep_options`' signature as one command takes it: the options that command lets take
+    several values say so (:data:`VARYING`), the others take one, and ``--out`` names its default.
+
+    Parameters
+    ----------
+    command : str
+        A sweep axis or ``optimize``.
+    out : str
+        The results folder's default, as the help gives it.
+
+    Returns
+    -------
+    inspect.Signature
+    """
+    parameters = []
+    for parameter in inspect.signature(sweep_options).parameters.values():
+        option = copy.copy(parameter.default)
+        if parameter.name in VARYING[command]:
+            condition, values = VARYING[command][parameter.name], _SEVERAL[parameter.name]
+            several = f"; {condition}, also {values}" if condition else f", or {values}"
+            head, bracket, tail = option.help.partition(" [default")
+            option.help = head.rstrip(".") + several + (bracket + tail if bracket else ".")
+        elif parameter.name == "out":
+            option = out_option(shown=out)
+        parameters.append(parameter.replace(default=option))
+    return inspect.Signature(parameters)
 
 
 #: Each sweep's help: what it does, and examples.
@@ -156,7 +206,7 @@ def _command(axis: str):
     def command(**options):
         _sweep(axis, options)
 
-    command.__signature__ = inspect.signature(sweep_options)
+    command.__signature__ = signature(axis, f"results/sweep-{axis}")
     command.__annotations__ = dict(sweep_options.__annotations__)
     command.__doc__ = summary + "\n\n\b\nExamples:\n" + "\n".join(f"  {example}" for example in examples)
     return command

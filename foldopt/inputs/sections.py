@@ -255,7 +255,8 @@ class Objective(StrictModel):
     @classmethod
     def _known(cls, value):
         if not _STATISTIC.match(value):
-            raise ValueError("must be mean, min, worst-month or a percentile pNN (e.g. p10)")
+            hint = names.did_you_mean(value, ("mean", "min", "worst-month"))
+            raise ValueError(f"must be mean, min, worst-month or a percentile pNN (e.g. p10){hint}")
         return value
 
     @model_validator(mode="after")

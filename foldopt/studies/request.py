@@ -278,6 +278,43 @@ def parse_setting(setting: str) -> tuple[str, object]:
     return key.strip(), value
 
 
+def settings_plan(path, settings=()) -> Plan:
+    """A YAML study's plan with fields changed by ``--set``, as if its file said so.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The study file.
+    settings : sequence of str
+        ``KEY=VALUE`` texts (:func:`parse_setting`), applied in order.
+
+    Returns
+    -------
+    Plan
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One line per fault: a setting that is no ``KEY=VALUE``, or the study's validation (a
+        field a setting changed without the file's line, which no longer holds it).
+    """
+    data, lines = read_study(path)
+    errors = []
+    for setting in settings:
+        try:
+            key, value = parse_setting(setting)
+        except ConfigError as error:
+            errors += error.errors
+            continue
+        if isinstance(data, dict):
+            data = policy.set_path(data, key, value)
+        parts = tuple(key.split("."))
+        lines = {loc: line for loc, line in lines.items() if loc[:len(parts)] != parts}
+    if errors:
+        raise ConfigError(errors)
+    return make_plan(data, lines)
+
+
 def sweep_changes(options: dict, data: dict) -> dict:
     """The fields the command line's sweep options change, by field path; ``--set`` last.
 

@@ -201,7 +201,8 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
 
     errors = []
     if show_period not in PERIODS:
-        errors.append(f"show_period = {show_period!r}: must be one of {', '.join(PERIODS)}")
+        errors.append(f"show_period = {show_period!r}: must be one of {', '.join(PERIODS)}"
+                      f"{names.did_you_mean(str(show_period), PERIODS)}")
     if year_problem(year):
         errors.append(f"year = {year}: {year_problem(year)}")
     if errors:

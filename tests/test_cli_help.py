@@ -1,0 +1,194 @@
+"""The command line's help and option plumbing, read off the app itself so that no command or
+option is left out: a misspelt option or name gets what it most likely meant, an option whose help
+says it takes a range or a list takes one (and one that does not say so takes one value), help
+names the folder each command writes, and ``--set`` works where the docs say it does."""
+
+import json
+import re
+
+import pytest
+import typer.main
+from typer.testing import CliRunner
+
+from foldopt.cli.app import app
+
+runner = CliRunner()
+ROOT = typer.main.get_command(app)
+
+
+def _leaves(command=ROOT, path=()):
+    for name, sub in command.commands.items():
+        if hasattr(sub, "commands"):
+            yield from _leaves(sub, (*path, name))
+        else:
+            yield (*path, name), sub
+
+
+LEAVES = dict(_leaves())
+
+
+def help_text(command, name: str) -> str:
+    """The help of an option, its line wrapping undone."""
+    param = next(param for param in command.params if name in param.opts)
+    return " ".join((param.help or "").split())
+
+
+def typo(word: str) -> str:
+    """A word with its middle letter dropped (a letter, so that ``dual-axis`` does not become a
+    spelling of itself)."""
+    middle = len(word) // 2
+    index = next(i for i in [*range(middle, len(word)), *range(middle, -1, -1)] if word[i].isalpha())
+    return word[:index] + word[index + 1:]
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(arg) for arg in args], prog_name="foldopt")
+
+
+def refusal(capsys, *args) -> str:
+    """The error line of a command line refused while its arguments are parsed, from the click
+    command built once (CliRunner builds it again for each call: 50 ms); were it accepted, the
+    command would run."""
+    with pytest.raises(SystemExit) as end:
+        ROOT.main([str(arg) for arg in args], prog_name="foldopt")
+    printed = capsys.readouterr()
+    assert end.value.code == 2 and printed.out == "", printed.out
+    return printed.err.strip()
+
+
+def test_a_misspelt_option_gets_that_option_among_all_the_commands_options(capsys):
+    """Click compares the option as typed with every option, dashes and all: the ``--`` they share
+    made ``--bogus`` close to ``--out`` and to nothing else, and a word a letter short was often
+    matched with none."""
+    missed = []
+    for path, command in LEAVES.items():
+        for param in command.params:
+            for name in param.opts:
+                if not name.startswith("--") or name == "--help":
+                    continue
+                wrong = "--" + typo(name[2:])
+                line = refusal(capsys, *path, wrong)
+                if not re.search(rf"did you mean [-\w ]*{re.escape(name)}\b", line):
+                    missed.append(f"{' '.join(path)} {wrong}: {line}")
+    assert missed == []
+
+
+@pytest.mark.parametrize("path,args,end", [
+    ("run", ["--bogus"], "No such option: --bogus (foldopt run --help lists its options)"),
+    ("run", ["--lat", "3"], "No such option: --lat (--lat is an option of foldopt map, optimize, sweep; foldopt run "
+                            "--help lists its own)"),
+    ("sweep angle", ["--p-laod", "3"], "No such option: --p-laod; did you mean --p-load?"),
+    ("size", ["--cost", "3"], "No such option: --cost; did you mean --cost-per-m2 or --cost-per-w?"),
+])
+def test_an_unknown_option_is_one_line_that_suggests_only_what_is_close(path, args, end, capsys):
+    assert refusal(capsys, *path.split(), *args) == f"error: foldopt {path}: {end}"
+
+
+#: What the option choices are validated against needs: a range of days for an objective.
+_CONTEXT = ["--days", "2025-03-20,2025-06-21"]
+
+
+def _choices(text: str) -> list[str]:
+    """The names an option's help lists as ``a | b (what b is) | c``; ``pNN`` is a pattern."""
+    pieces = text.split(" | ")
+    if len(pieces) < 2:
+        return []
+    names = [re.findall(r"[\w.-]+", re.sub(r"\([^)]*\)", "", pieces[0]))[-1]]
+    names += [re.match(r"[\w.-]+", piece).group() for piece in pieces[1:]]
+    return [name.rstrip(".") for name in names if name.rstrip(".") != "pNN"]
+
+
+def test_every_choice_of_every_option_is_suggested_for_its_misspelling(tmp_path, monkeypatch, capsys):
+    """Each option whose help lists its names (``--sky``, ``--objective``, ``--format``,
+    ``--engine``, ``--show-period`` ...) answers a misspelt name with that name: the registries'
+    names (foldopt.names.canonical), the objective's and the map's periods alike."""
+    monkeypatch.chdir(tmp_path)  # nothing is written; were a misspelling accepted, not in the tree
+    seen, missed, count = set(), [], 0
+    for path, command in LEAVES.items():
+        for param in command.params:
+            text = " ".join((param.help or "").split())
+            key = (param.opts[0], text)
+            if key in seen or not param.opts[0].startswith("--"):
+                continue
+            seen.add(key)
+            context = _CONTEXT if any("--days" in other.opts for other in command.params) else []
+            for name in _choices(text):
+                count += 1
+                line = refusal(capsys, *path, param.opts[0], typo(name), *context, "--out", tmp_path / "never")
+                if not re.search(rf"did you mean [^\n]*'{re.escape(name)}'", line):
+                    missed.append(f"{' '.join(path)} {param.opts[0]} {typo(name)}: {line}")
+    assert count > 60
+    assert missed == []
+
+
+#: A list for each option that can take several values, and what it needs beside it.
+_SEVERAL = {"--lat": ["0,10"], "--lon": ["0,10"], "--days": ["2025-03-20,2025-06-21"], "--p-load": ["1,2"],
+            "--tilt": ["10,20"], "--p-load-scale": ["1,2", "--load-profile", "profile.csv"]}
+#: Each command's own axis at a small size, where the option tested does not give it.
+_OWN = {("sweep", "latitude"): ["--lat", "0,10"], ("sweep", "day"): ["--days", "2025-03-20,2025-06-21"],
+        ("sweep", "load"): ["--p-load", "1,2"], ("sweep", "angle"): ["--days", "2025-03-20"],
+        ("optimize",): ["--days", "2025-03-20,2025-06-21", "--vary", "fold_angle"]}
+#: What a condition in an option's help (``with --objective``) takes to hold.
+_CONDITIONS = {"--objective": ["--objective", "mean"]}
+
+
+@pytest.mark.parametrize("path", list(_OWN), ids=" ".join)
+def test_an_option_takes_a_list_exactly_where_its_help_says_so(path, tmp_path, monkeypatch):
+    """``optimize --help`` said "or a range" of --lat and --tilt, which optimize refuses; each
+    option's help now says what the command takes. Runs at 60-min steps and 30-deg angles, the
+    folder not written (foldopt.api.write is what --out's other tests check); the folder the
+    answer names is the one --out's help gives as its default."""
+    import foldopt.api
+
+    monkeypatch.setattr(foldopt.api, "write", lambda *args, **kwargs: None)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "profile.csv").write_text("time,watts\n00:00,1\n07:00,3\n19:00,1\n")
+    command = LEAVES[path]
+    default = re.search(r"\[default: ([^\]]+)\]", help_text(command, "--out")).group(1)
+    checked = []
+    for option, values in _SEVERAL.items():
+        text = help_text(command, option)
+        several = re.search(r"a range .* or a list", text) is not None
+        own = [] if option in _OWN[path] or (option == "--p-load-scale" and "--p-load" in _OWN[path]) else _OWN[path]
+        condition = [arg for name, args in _CONDITIONS.items() if f"with {name}" in text for arg in args]
+        result = invoke(*path, option, *values, *own, *condition, "--step-min", 60, "--angle-step", 30,
+                        "--format", "json")
+        if several:
+            assert result.exit_code == 0, (option, result.stderr)
+            assert json.loads(result.stdout)["out"] == default
+        else:
+            assert result.exit_code == 2 and result.stderr.startswith("error: "), (option, result.stdout)
+        checked.append(several)
+    assert any(checked)
+
+
+def test_help_names_no_other_command():
+    """``optimize --help`` said "foldopt map: 5" of --step-min: each command's help speaks of itself."""
+    wrong = []
+    for path, command in LEAVES.items():
+        text = invoke(*path, "--help").stdout
+        named = {match for match in re.findall(r"foldopt ((?:sweep )?[a-z]+)", text)}
+        wrong += [f"{' '.join(path)}: foldopt {name}" for name in named - {" ".join(path), path[0]}]
+    assert wrong == []
+
+
+def test_run_and_size_take_set(tmp_path, monkeypatch):
+    """``foldopt run --set p_load=3`` was refused though the docs listed --set for every command;
+    it runs the embedded study with that change, as a line of the study file would (the folders
+    not written: foldopt.api.write is tested on its own)."""
+    import foldopt.api
+
+    monkeypatch.setattr(foldopt.api, "write", lambda *args, **kwargs: None)
+    monkeypatch.chdir(tmp_path)
+    result = invoke("run", "--set", "p_load=3", "--set", "step_min=10", "--format", "json")
+    assert result.exit_code == 0, result.stderr
+    document = json.loads(result.stdout)
+    assert document["out"] == "results/shin2015" and "P_load 3 W" in document["answer"]["lines"][0]
+    bad = invoke("run", "--set", "p_load=-3", "--set", "panel")
+    assert bad.exit_code == 2
+    assert bad.stderr.splitlines() == ["error: --set = 'panel': expected KEY=VALUE, e.g. panel.efficiency=0.21"]
+    bad = invoke("run", "--set", "p_load=-3")
+    assert bad.stderr.splitlines() == ["error: p_load = -3: must be in (0, 1e+06] W"]  # no line of the file
+    sized = invoke("size", "--set", "p_load=3", "--areas", "0.1:0.3:0.1", "--format", "json")
+    assert sized.exit_code == 0, sized.stderr
+    assert "3 W" in " ".join(json.loads(sized.stdout)["answer"]["lines"])
