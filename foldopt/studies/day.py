@@ -360,13 +360,13 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     evaluated = pd.concat([evaluated[evaluated.index != best_angle], pd.Series({best_angle: best_hours})]).sort_index()
     near = {key: float(value) for key, value in near_optimal(evaluated.index, evaluated.to_numpy(),
                                                              study.near_optimal).items()}
+    recommended = near["recommended_fold_angle_deg"]
+    near["recommended_t_solar_h"] = float(evaluated[recommended]) if recommended == recommended else float("nan")
     return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby, engine, near, request)
 
 
 def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):
     """The study's tracker's net ``t_solar`` as its standby draw grows, and the break-even draw.
-    recommended = near["recommended_fold_angle_deg"]
-    near["recommended_t_solar_h"] = float(evaluated[recommended]) if recommended == recommended else float("nan")
 
     A standby draw ``s`` while the sun is up leaves the load ``P_pv - drive - s``; over daylight
     that is the gross curve less its drive against the load ``P_load + s``, so every draw is one
