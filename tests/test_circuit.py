@@ -14,8 +14,10 @@ from hypothesis import strategies as st
 from pvlib.singlediode import bishop88
 from typer.testing import CliRunner
 
+import foldopt
 from foldopt import names
 from foldopt.cli.app import app
+from foldopt.engine.cells import electrical_for
 from foldopt.physics import circuit, connections
 from foldopt.physics.diodes import DEFAULT_DIODE_PART, DIODE_PARTS, Diode, diode
 from foldopt.physics.pvmodel import PVModel
@@ -341,3 +343,37 @@ def test_a_load_wired_out_of_reach_runs_no_design_wired_to_it(tmp_path, monkeypa
     assert summary.loc["twofold-independent", "note"].split("; ")[0] == note
     assert {"note": note, "designs": ["twofold-independent"]} in answer["notes"]
     assert not any(note in text for text in summary.loc[wired, "note"])
+    # Why the others run 0 h: at 900 V, the panel's open-circuit voltage (at STC, pvlib's) on every row
+    # wired to the load; at 1 mV it is the load that is above their peak.
+    stc = pvlib.pvsystem.v_from_i(0.0, *MODELS["single-diode"].curves(np.array([1000.0]), 25.0, 2 * AREA).params)
+    reach = (f"the load's 900 V is above the panel's open-circuit voltage, {stc[0]:.3g} V at STC with all its "
+             f"cells in series")
+    firsts = [text.split("; ")[0] for text in summary["note"]]
+    if load_voltage > 1:
+        assert [first == reach for first in firsts] == list(wired)
+        assert {"note": reach, "designs": list(summary.index[wired])} in answer["notes"]
+    else:
+        assert not any("open-circuit" in text for text in summary["note"])
+        assert (summary.loc[wired, "note"].str.contains("load above peak")).all()
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_load_is_called_beyond_reach_only_where_no_wiring_reaches_it(model):
+    """The note that a load wired directly is above the panel's open-circuit voltage is given where
+    every wiring of its cells (each half alone, the halves in parallel or in series, the whole panel
+    as one string) delivers nothing in any light up to 2000 W/m^2 on cells from -70 to 85 C, and is
+    not given where the whole string in the brightest light on the coldest cells still delivers."""
+    def study(load):
+        return foldopt.default_study().variant(pv_model=model, circuit={"coupling": "direct", "load_voltage": load})
+
+    pv = electrical_for(study(5.0).resolved(), 25.0).pv  # the paper's panel, its halves of AREA
+    highest = float(pv.curves(np.array([2000.0]), -70.0, 2 * AREA).v_oc[0])
+    poa, temp = (grid.ravel() for grid in np.meshgrid([50.0, 1000.0, 2000.0], [-70.0, 25.0, 85.0]))
+    half, whole = pv.curves(poa, temp, AREA), pv.curves(poa, temp, 2 * AREA)
+    for factor, beyond in ((1.001, True), (0.999, False)):
+        load = factor * highest
+        assert bool(electrical_for(study(load).resolved(), 25.0).beyond_reach) == beyond
+        delivered = [circuit.alone_power(half, load), circuit.alone_power(whole, load),
+                     circuit.parallel_power(half, half, Diode("ideal"), load),
+                     circuit.series_power(half, half, Diode("ideal"), load)]
+        assert (max(float(np.max(power)) for power in delivered) == 0.0) == beyond

@@ -14,9 +14,10 @@ def pvwatts_by_hand(p_in, p_rated, eta_nom):
     """Dobos 2014, PVWatts v5 inverter model Eq. 1-2: the part-load efficiency, the output clipped
     at eta_nom * p_rated and never negative."""
     zeta = p_in / p_rated
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # At no input the curve's -0.0059 / zeta is infinite, a value np.where sets aside.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         eta = eta_nom / ETA_REF * (-0.0162 * zeta - 0.0059 / zeta + 0.9858)
-    return np.clip(np.where(p_in > 0, eta * p_in, 0.0), 0.0, eta_nom * p_rated)
+        return np.clip(np.where(p_in > 0, eta * p_in, 0.0), 0.0, eta_nom * p_rated)
 
 
 def test_ideal_delivers_its_input():

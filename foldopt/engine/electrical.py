@@ -41,6 +41,10 @@ TABLE_NODES_1D = 1025
 TABLE_NODES_2D = 161
 TABLE_NODES_RATIO = 321
 TABLE_FORMAT = 6  # bump when the way tables are built changes
+#: The brightest light [W/m^2] and the coldest cells [C] of any study: a panel's open-circuit
+#: voltage rises with both (a study's air reaches down to -60 C; minutes of cloud enhancement stay
+#: below 2000 W/m^2).
+BRIGHTEST, COLDEST = 2000.0, -70.0
 
 
 def _nodes(count):
@@ -298,6 +302,20 @@ class Electrical:
         temp_cell = self._temperature(stc)
         parallel, series = (self._flat_wired(stc, temp_cell, wiring)[0] for wiring in ("parallel", "series"))
         return "parallel" if parallel > series else "series"
+
+    @functools.cached_property
+    def beyond_reach(self) -> str:
+        """Why no design wired directly runs, where the load's voltage is above the highest
+        open-circuit voltage of the panel's cells (all of them in one string, in :data:`BRIGHTEST`
+        light at :data:`COLDEST`): a note for every such design; ``''`` elsewhere."""
+        if self.circuit is None or not self.circuit.direct or not self.pv.has_iv:
+            return ""
+        area = 2.0 * self.subpanel_area
+        if self.circuit.load_voltage <= self.pv.curves(np.array([BRIGHTEST]), COLDEST, area).v_oc[0]:
+            return ""
+        stc = self.pv.curves(np.array([1000.0]), 25.0, area).v_oc[0]
+        return (f"the load's {self.circuit.load_voltage:g} V is above the panel's open-circuit voltage, "
+                f"{stc:.3g} V at STC with all its cells in series")
 
     def _flat_wired(self, poa, temp_cell, wiring):
         half = self.pv.curves(poa, temp_cell, self.subpanel_area)

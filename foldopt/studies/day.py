@@ -325,13 +325,14 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
         flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 and shape is None else np.nan
         for hours in summary["t_solar_h"]
     ]
-    summary["note"] = notes(design_condition(day.sky.conditions()[0], summary["energy_harvested_wh"].to_numpy(float)),
-                            summary["t_solar_h"].to_numpy())
-    # A connection the study's circuit cannot wire (independent's converters, a load wired directly)
-    # is compared as it is built, and its note says so first.
+    # Each row's circuit first: a connection the study's circuit cannot wire (independent's
+    # converters, a load wired directly) is compared as it is built and says so; every other design
+    # is wired as the circuit says, and says so where its load is beyond the panel's reach.
     wired = {f"twofold-{connection}": study.circuit.ignored_by(connection) for connection in CONNECTIONS}
-    summary["note"] = ["; ".join(filter(None, (wired.get(design), note)))
-                       for design, note in zip(summary["design"], summary["note"], strict=True)]
+    condition = ["; ".join(filter(None, (wired.get(design) or day.electrical.beyond_reach, day.sky.conditions()[0])))
+                 for design in summary["design"]]
+    summary["note"] = notes(design_condition(condition, summary["energy_harvested_wh"].to_numpy(float)),
+                            summary["t_solar_h"].to_numpy())
     standby = standby_sweep(day, p_tracker, by_design["twofold"])
 
     at_best, state = day.connections(np.array([best_angle]))

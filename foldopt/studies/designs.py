@@ -231,13 +231,16 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
         loads[None, :, None],
         served,
     )
+    # Every design here is wired as the study's circuit says: a load beyond the panel's reach, every one.
+    reach = engines.electrical_for(study, sky.temp_air[0], sky.wind_ref).beyond_reach
+    condition = np.array(["; ".join(filter(None, (reach, day))) for day in sky.conditions()], dtype=object)
     return {
         "fold_angle_deg": fold,
         **columns,
         "poa_kwh_m2": per_design(twofold.irradiation, np.repeat(flat.irradiation[:, None], n_loads, axis=1),
                                  np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
         # A tracker whose drive costs more than it harvests says so where every table's note starts.
-        "condition": design_condition(sky.conditions()[:, None, None], columns["energy_harvested_wh"]),
+        "condition": design_condition(condition[:, None, None], columns["energy_harvested_wh"]),
     }
 
 
