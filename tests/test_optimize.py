@@ -187,3 +187,49 @@ def test_the_search_states_the_tolerance_it_kept():
     assert result.twofold.tolerance == 0.25
     assert "within 0.25 h of its best" in result.answer.lines()[-1]
     assert result.answer.result["search"]["tolerance_h"] == 0.25
+
+
+@pytest.mark.parametrize("options,named", [
+    (["--fold-range", "1:180:1e-9"], "--fold-range = 1:180:1e-09"),
+    (["--vary", "tilt", "--tilt-range", "0:90:1e-9"], "--tilt-range = 0:90:1e-09"),
+    (["--azimuth-range", "90:270:0.001"], "--azimuth-range = 90:270:0.001"),
+    (["--angle-step", "1e-9"], "--angle-step = 1e-09"),  # the fold angle's default grid, the study's
+], ids=["fold", "tilt", "azimuth", "angle-step"])
+def test_a_grid_too_fine_to_search_is_refused_at_once(options, named, tmp_path):
+    """A step of 1e-9 deg made a grid of 1e15 designs and a search that never ended: refused before any
+    work, in one line naming the option, as a map's grid of too many sites is."""
+    import time
+
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+    from foldopt.inputs.optimize_section import MAX_DESIGNS
+
+    start = time.perf_counter()
+    result = CliRunner().invoke(app, ["optimize", *options, "--out", str(tmp_path / "out")])
+    assert time.perf_counter() - start < 10
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {named}: ")
+    assert f"the limit is {MAX_DESIGNS:,}" in lines[0] and "FOLDOPT_MAX_DESIGNS" in lines[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_api_refuses_a_grid_too_fine_to_search():
+    import foldopt
+
+    with pytest.raises(foldopt.ConfigError) as refused:
+        foldopt.optimize(foldopt.default_study(), fold_angle="1:180:1e-9")
+    assert len(refused.value.errors) == 1
+    assert refused.value.errors[0].startswith("optimize.fold_angle = 1:180:1e-09: 179,000,000,001 fold angles")
+
+
+def test_the_limit_counts_the_grid_the_search_walks():
+    """The bound's count is the search's own (foldopt.engine.search.Axis), the grid ending on its
+    upper bound."""
+    from foldopt.engine.search import Axis
+    from foldopt.inputs.optimize_section import grid_points
+
+    for lo, hi, step in [(1, 180, 1), (10, 180, 7), (0, 90, 0.3), (-90, 90, 2), (5, 5, 1)]:
+        assert grid_points(lo, hi, step) == Axis("x", lo, hi, step).size == len(Axis("x", lo, hi, step).values())
+        assert Axis("x", lo, hi, step).values()[-1] == hi

@@ -66,6 +66,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from foldopt.inputs.optimize_section import grid_points
+
 #: Points of the coarse lattice along each axis, at least (the stride is a power of two).
 COARSE_POINTS = 7
 #: The factor on each level's estimate of the objective's change per unit.
@@ -91,8 +93,7 @@ class Axis:
 
     @property
     def size(self) -> int:
-        steps = math.floor((self.hi - self.lo) / self.step + 1e-9)
-        return steps + 1 + (not math.isclose(self.lo + steps * self.step, self.hi, abs_tol=1e-9))
+        return grid_points(self.lo, self.hi, self.step)
 
     def values(self, index=None) -> np.ndarray:
         """The grid's values [units], all or at integer ``index``."""

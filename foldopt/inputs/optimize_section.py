@@ -7,16 +7,40 @@ The search itself is :func:`foldopt.engine.search.grid_search`; the study it run
 
 from __future__ import annotations
 
+import math
+
 from pydantic import Field, field_validator, model_validator
 
 from foldopt import names
 from foldopt.inputs.fields import StrictModel, interval
+from foldopt.inputs.reading import size_limit
 from foldopt.names import canonical
 
 #: Each variable's bounds where a study gives none: the fold angle the study's own grid; the tilt
 #: from horizontal to vertical; the azimuth within 90 deg either side of the equator-facing one.
 DEFAULT_TILT = (0.0, 90.0, 1.0)
 DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP = 90.0, 2.0
+#: Designs of a search's grid (fold angles x tilts x azimuths), as many as it may evaluate: the
+#: default grids hold 1.5 M, of which a search evaluates some 2 % (all of them where nothing
+#: prunes); a step of 1e-9 deg made 1e15 and never ended.
+MAX_DESIGNS = size_limit("MAX_DESIGNS", 20_000_000)
+
+
+def grid_points(lo: float, hi: float, step: float) -> int:
+    """Points of a grid from ``lo`` to ``hi`` by ``step``, always ending on ``hi`` (the last step
+    shorter where ``step`` does not divide the span), counted without making it.
+
+    Parameters
+    ----------
+    lo, hi, step : float
+        ``step > 0``, ``hi >= lo``.
+
+    Returns
+    -------
+    int
+    """
+    steps = math.floor((hi - lo) / step + 1e-9)
+    return steps + 1 + (not math.isclose(lo + steps * step, hi, abs_tol=1e-9))
 
 
 def vary_names(value) -> list[str]:
@@ -130,6 +154,50 @@ class Optimize(StrictModel):
         """
         bounds = getattr(self, name)
         return (bounds.min, bounds.max, bounds.step) if bounds is not None else default
+
+    def searched_range(self, name: str, fold_angles, equator: float = 180.0) -> tuple:
+        """A variable's ``(min, max, step)`` [deg] as the search walks it: its bounds, or the
+        default (the fold angle the study's grid, the tilt :data:`DEFAULT_TILT`, the azimuth
+        ``equator`` +- :data:`DEFAULT_AZIMUTH_SPAN` by :data:`DEFAULT_AZIMUTH_STEP`).
+
+        Parameters
+        ----------
+        name : str
+            One of :data:`foldopt.names.OPTIMIZE_VARIABLES`.
+        fold_angles : foldopt.inputs.sections.FoldAngles
+            The study's grid.
+        equator : float, default 180
+            The equator-facing azimuth [deg].
+        """
+        defaults = {"fold_angle": (fold_angles.start, fold_angles.stop, fold_angles.step), "tilt": DEFAULT_TILT,
+                    "azimuth": (equator - DEFAULT_AZIMUTH_SPAN, equator + DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP)}
+        return self.range_of(name, defaults[name])
+
+    def size_problem(self, fold_angles) -> str | None:
+        """Why the search's grid is too large to search (:data:`MAX_DESIGNS`), naming the largest
+        varied variable's setting.
+
+        Parameters
+        ----------
+        fold_angles : foldopt.inputs.sections.FoldAngles
+            The study's grid, the fold angle's where its bounds are not set.
+
+        Returns
+        -------
+        str or None
+            ``field = value: problem``, or None for a grid within the limit.
+        """
+        counts = {name: grid_points(*self.searched_range(name, fold_angles)) for name in self.vary}
+        designs = math.prod(counts.values())
+        if designs <= MAX_DESIGNS:
+            return None
+        largest = max(counts, key=counts.get)
+        bounds = getattr(self, largest)
+        setting = (f"optimize.{largest} = {bounds.describe()}" if bounds is not None
+                   else f"fold_angles.step = {fold_angles.step:g}")  # only the fold angle's default grid varies
+        nouns = {"fold_angle": "fold angles", "tilt": "tilts", "azimuth": "azimuths"}
+        return (f"{setting}: {' x '.join(f'{counts[name]:,} {nouns[name]}' for name in counts)} = {designs:.2g} "
+                f"designs to search; the limit is {MAX_DESIGNS:,} (a coarser step, or FOLDOPT_MAX_DESIGNS)")
 
     def idle_settings(self) -> list[str]:
         """``optimize.name = ...: why`` for the bounds of a variable that does not vary."""

@@ -224,6 +224,9 @@ class Study(StrictModel):
         idle = self.idle_settings()
         if idle:
             raise ValueError("\n".join(idle))  # one error line each
+        too_large = self.optimize.size_problem(self.fold_angles) if self.optimize is not None else None
+        if too_large:
+            raise ValueError(too_large)
         files = FilesRead.given(info) if self.weather is not None else None
         if files is not None and files.weather_missing:
             raise ValueError(files.weather_problem)

@@ -30,7 +30,7 @@ import pandas as pd
 from foldopt import names
 from foldopt.engine.search import Axis, SearchResult, grid_search
 from foldopt.errors import ConfigError
-from foldopt.inputs.optimize_section import DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP, DEFAULT_TILT
+from foldopt.inputs.optimize_section import DEFAULT_TILT
 from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
@@ -97,14 +97,10 @@ def _axes(study: Study, vary, fold_angle: float = 180.0) -> dict[str, Axis]:
     """The search's axes by variable; a variable not varied is a one-point axis at the default
     mounting (the study's panel, folded to ``fold_angle``)."""
     spec = study.optimize
-    equator = study.panel.azimuth
-    grid = study.fold_angles
-    defaults = {"fold_angle": (grid.start, grid.stop, grid.step), "tilt": DEFAULT_TILT,
-                "azimuth": (equator - DEFAULT_AZIMUTH_SPAN, equator + DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP)}
     fixed = {"fold_angle": fold_angle, "tilt": study.panel.tilt, "azimuth": study.panel.azimuth}
     axes = {}
     for name in names.OPTIMIZE_VARIABLES:
-        lo, hi, step = spec.range_of(name, defaults[name])
+        lo, hi, step = spec.searched_range(name, study.fold_angles, study.panel.azimuth)
         axes[name] = Axis(name, lo, hi, step) if name in vary else Axis(name, fixed[name], fixed[name], 1.0)
     return axes
 
