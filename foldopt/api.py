@@ -103,6 +103,12 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
 
             return run_plan(study, progress, engine, request)
         study = study.base
+    if study.weather is not None and study.weather.members:
+        # A cloud ensemble over one day: the plan of that day runs the members (a case does not).
+        from foldopt.studies.sweeps import run_plan
+
+        day = Plan({**study.data(), "date": [study.date.isoformat()]}, (("date", (study.date,)),))
+        return run_plan(day, progress, engine, request)
     from foldopt.studies.day import run_study
 
     return run_study(with_files(study), engine, request)

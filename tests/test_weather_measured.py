@@ -394,7 +394,7 @@ def test_unusable_files_give_one_line(tmp_path):
     (tmp_path / "junk.dat").write_text("not\na\nsurfrad file\n")
     for name, fmt, message in (("empty.dat", "surfrad", "the file is empty"),
                                ("junk.dat", "surfrad", "not a readable SURFRAD file"),
-                               ("missing.dat", "solrad", "cannot be read"),
+                               ("missing.dat", "solrad", "file not found"),
                                ("junk.dat", "bsrn", "not a readable BSRN file")):
         with pytest.raises(WeatherError) as caught:
             read_measured(tmp_path / name, fmt)

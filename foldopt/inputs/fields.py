@@ -76,7 +76,8 @@ class FilesRead:
     weather_problem : str, optional
         Why the weather file cannot be used: one line naming the file (and the line, the field).
     weather_missing : bool
-        Whether the weather file does not exist.
+        Whether the weather file does not exist, or is no file foldopt reads (a folder, a device,
+        a FIFO, one over the size limit).
     weather_step_min : float, optional
         A measured weather file's step [min].
     weather_dates : tuple of str, optional

@@ -3,7 +3,8 @@ file, its step and its days (:func:`weather_read`), and the fields a study takes
 leaves them out (:func:`weather_defaults`). The file is read through :mod:`foldopt.inputs.weather`,
 imported only when a file is named (pandas and pvlib).
 
-The module may import :mod:`foldopt.errors`, :mod:`foldopt.names` and :mod:`foldopt.inputs.weather`.
+The module may import :mod:`foldopt.errors`, :mod:`foldopt.names`, :mod:`foldopt.inputs.reading` and
+:mod:`foldopt.inputs.weather`.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from foldopt.errors import ConfigError
+from foldopt.inputs.reading import MAX_WEATHER_BYTES, check_input
 from foldopt.names import HOURLY_WEATHER_FORMATS, WEATHER_FORMATS, canonical
 
 
@@ -34,10 +36,12 @@ def weather_read(weather, site=None) -> dict:
     """
     spec = {"path": weather} if isinstance(weather, str) else weather
     path = spec.get("path") if isinstance(spec, dict) else None
-    if not isinstance(path, str):
-        return {}
-    if not Path(path).is_file():
-        return {"weather_missing": True, "weather_problem": f"weather: file not found: {path}"}
+    if not isinstance(path, str) or _options_problem(spec):
+        return {}  # the study names the fault of an option that is not one value of its kind
+    try:
+        check_input(path, "weather", MAX_WEATHER_BYTES, "MAX_WEATHER_BYTES", "weather file")
+    except ConfigError as error:  # missing, a folder, a device, a FIFO, too large: named before any read
+        return {"weather_missing": True, "weather_problem": error.errors[0]}
     try:
         fmt = canonical(spec.get("format"), WEATHER_FORMATS)
     except ValueError:
@@ -75,6 +79,30 @@ def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
             "weather_dates": dates}
 
 
+#: A weather file's options that take one name, and those that take one number.
+_NAMED_OPTIONS = ("format", "label", "timezone", "decomposition")
+_NUMBER_OPTIONS = ("max_gap_min", "members", "seed")
+#: The options a measured file is read with: its days and step follow from them.
+_READ_OPTIONS = ("format", "label", "timezone", "decomposition", "max_gap_min")
+
+
+def _options_problem(spec: dict, keys=(*_NAMED_OPTIONS, *_NUMBER_OPTIONS)) -> str | None:
+    """Why ``spec``'s ``keys`` are not each one value of their kind (``weather.format = [...]:
+    ...``), or None."""
+    for key in keys:
+        value = spec.get(key)
+        kinds = str if key in _NAMED_OPTIONS else (int, float)
+        if value is not None and (not isinstance(value, kinds) or isinstance(value, bool)):
+            what = "one name" if key in _NAMED_OPTIONS else "one number"
+            kind = type(value).__name__
+            kind = f"{'an' if kind[0] in 'aeiou' else 'a'} {kind}"
+            text = repr(value)
+            text = text if len(text) <= 40 else text[:37] + "..."
+            swept = "; the file is read with it, so it is not swept" if isinstance(value, (list, tuple, dict)) else ""
+            return f"weather.{key} = {text}: {what} is expected, not {kind}{swept}"
+    return None
+
+
 def weather_defaults(data: dict) -> dict:
     """What a study's fields take from its weather file where it leaves them out: the dates (an
     hourly file's whole ``year``; a measured file's days) and, for a measured file, the step.
@@ -89,15 +117,27 @@ def weather_defaults(data: dict) -> dict:
     dict
         ``date`` and, for a measured file that can be read, ``step_min`` (where it cannot,
         ``year``, and the study's validation names why).
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        For a ``weather.format`` (or a measured file's reading option) that is not one value, such
+        as a list: the file's days and step follow from it, so it is not swept.
     """
     weather = data.get("weather")
     spec = {"path": weather} if isinstance(weather, str) else weather if isinstance(weather, dict) else {}
+    problem = _options_problem(spec, ("format",))
+    if problem is not None:
+        raise ConfigError([problem])
     try:
         fmt = canonical(spec.get("format"), WEATHER_FORMATS)
     except ValueError:
         fmt = None
     if fmt is None or fmt in HOURLY_WEATHER_FORMATS:
         return {"date": "year"}
+    problem = _options_problem(spec, _READ_OPTIONS)
+    if problem is not None:
+        raise ConfigError([problem])
     read = weather_read(weather, data.get("site"))
     if read.get("weather_dates") is None:
         return {"date": "year"}  # the file cannot be read: the study's validation names why

@@ -20,7 +20,9 @@ Measured files (SURFRAD, MIDC, SRML, BSRN, SOLRAD, CRN and a generic CSV,
 :data:`MEASURED_FORMATS`) are read by :mod:`~foldopt.inputs.weather.measured` and evaluated at
 their own step (:func:`measured_weather`, :func:`study_weather`); a study names their format.
 
-The package may import pandas, pvlib and the leaves (:mod:`foldopt.errors`, :mod:`foldopt.names`).
+The package may import pandas, pvlib, the leaves (:mod:`foldopt.errors`, :mod:`foldopt.names`) and
+:mod:`foldopt.inputs.reading`, whose :func:`~foldopt.inputs.reading.check_input` refuses a file
+that is missing, a folder, a device, a FIFO or too large before anything reads it.
 
 References
 ----------
@@ -37,7 +39,7 @@ import pandas as pd
 
 from foldopt.errors import WeatherError
 from foldopt.inputs.weather import epw, pvgis, tmy3
-from foldopt.inputs.weather.formats import HOUR
+from foldopt.inputs.weather.formats import HOUR, check_file
 from foldopt.inputs.weather.measured import STATION_FORMATS, MeasuredWeather, read_measured
 from foldopt.inputs.weather.qc import COLUMNS, check_rows
 
@@ -150,6 +152,7 @@ def weather_site(path, fmt: str | None = None, site: dict | None = None, **measu
         if site is None and not MEASURED_FORMATS[fmt].has_site:
             return None
         return measured_weather(path, fmt, site=site, **measured).site
+    check_file(path)
     _, meta = _read(str(path.resolve()), fmt, 2025, path.stat().st_mtime)
     return FORMATS[fmt].site(meta)
 
@@ -181,6 +184,7 @@ def measured_weather(path, fmt: str, label: str | None = None, timezone: str | N
     path = Path(path)
     where = None if site is None else tuple(sorted((key, site.get(key)) for key in (
         "name", "latitude", "longitude", "altitude") if site.get(key) is not None))
+    check_file(path)
     result, message = _measured_once(str(path.resolve()), path.stat().st_mtime, fmt, label, timezone, where,
                                      decomposition, float(max_gap_min))
     if message is not None:
@@ -253,6 +257,7 @@ def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | No
     # A typical year has 365 days: it is read as a year without February 29, then its interval
     # centres move to ``year``, so that a leap year's February 29 is a day the file does not hold.
     typical = year - 1 if pd.Timestamp(year=year, month=1, day=1).is_leap_year else year
+    check_file(path)
     data, _ = _read(str(path.resolve()), fmt, typical, path.stat().st_mtime)
     label = label or FORMATS[fmt].interval_label
     shift = {"end": -HOUR / 2, "start": HOUR / 2, "centre": HOUR * 0}[label]

@@ -13,9 +13,13 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from foldopt.errors import ConfigError, WeatherError
+from foldopt.inputs.reading import MAX_WEATHER_BYTES, check_input
 
 HOUR = pd.Timedelta(hours=1)
 
@@ -72,6 +76,25 @@ class WeatherFormat:
     to_local: Callable | None = None
     stamp_lag: float = 0.0
     cover: tuple | None = None
+
+
+def check_file(path) -> None:
+    """Refuse a weather file that is missing, no regular file (a folder, a device, a FIFO) or
+    larger than :data:`~foldopt.inputs.reading.MAX_WEATHER_BYTES`, before anything reads it.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Raises
+    ------
+    foldopt.errors.WeatherError
+        One line naming the file and what it is.
+    """
+    try:
+        check_input(path, f"weather {Path(path).name}", MAX_WEATHER_BYTES, "MAX_WEATHER_BYTES", "weather file")
+    except ConfigError as error:
+        raise WeatherError(error.errors[0]) from None
 
 
 def reason(error: Exception) -> str:

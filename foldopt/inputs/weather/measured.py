@@ -49,9 +49,9 @@ time, else the standard time of the meridian nearest the site (the UTC offset ne
 ``longitude / 15`` h). A ``site`` given overrides the file's; formats whose file holds none
 (``midc``, ``srml``, ``csv``) need one.
 
-The module may import numpy, pandas, pvlib, :mod:`foldopt.errors` and the weather package's
-:mod:`~foldopt.inputs.weather.formats`, :mod:`~foldopt.inputs.weather.qc` (its bounds and
-defaults) and :mod:`~foldopt.inputs.weather.stations`.
+The module may import numpy, pandas, pvlib, :mod:`foldopt.errors`, :mod:`foldopt.inputs.reading` (its
+limits) and the weather package's :mod:`~foldopt.inputs.weather.formats`, :mod:`~foldopt.inputs.weather.qc`
+(its bounds and defaults) and :mod:`~foldopt.inputs.weather.stations`.
 
 References
 ----------
@@ -78,8 +78,9 @@ import pvlib
 
 from foldopt.errors import WeatherError
 from foldopt.names import DECOMPOSITIONS, INTERVAL_LABELS
+from foldopt.inputs.reading import MAX_MEASURED_STEPS
 from foldopt.inputs.weather.downscale import MIN_COS_ZENITH
-from foldopt.inputs.weather.formats import offset_zone, site_value
+from foldopt.inputs.weather.formats import check_file, offset_zone, site_value
 from foldopt.inputs.weather.qc import (BEAM_TOLERANCE, COLUMNS, DEFAULT_TEMP_AIR, DEFAULT_WIND_SPEED, DHI_TOLERANCE,
                                        TEMP_AIR_BOUNDS, WIND_SPEED_BOUNDS)
 from foldopt.inputs.weather.stations import STATION_FORMATS, StationFormat, fixed_zone
@@ -236,6 +237,11 @@ def _grid(frame: pd.DataFrame, label: str, zone, fail):
     phase = (local[0] - first) % step
     days = (local[-1] - first) // _DAY.value + 1
     n = int(days * (_DAY.value // step))
+    if n > MAX_MEASURED_STEPS:
+        span = " to ".join(stamps[i].isoformat(sep=" ") for i in (0, -1))
+        raise fail(f"the stamps span {span}, {_count(int(days), 'day')} at the file's {_minutes(step_td)} step: "
+                   f"{n:,} steps; at most {MAX_MEASURED_STEPS:,} (FOLDOPT_MAX_MEASURED_STEPS raises it); check the "
+                   "stamps' years")
     index = pd.DatetimeIndex(first + phase + step * np.arange(n, dtype=np.int64)).tz_localize(zone)
     rows = (local - first - phase) // step
     table = {key: np.full(n, np.nan) for key in frame.columns}
@@ -430,6 +436,7 @@ def read_measured(path, fmt: str, label: str | None = None, timezone: str | None
     def fail(message: str) -> WeatherError:
         return WeatherError(f"weather {path.name}: {message}")
 
+    check_file(path)
     try:
         if not path.read_bytes().strip():
             raise fail("the file is empty")

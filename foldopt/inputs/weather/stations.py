@@ -127,21 +127,43 @@ class StationData:
     notes: tuple = ()
 
 
-def _columns(data: pd.DataFrame, names: dict, flags: dict | None = None) -> tuple[pd.DataFrame, int]:
+def _columns(data: pd.DataFrame, names: dict, fail, flags: dict | None = None) -> tuple[pd.DataFrame, int]:
     """``names`` (column -> pvlib's column) of ``data`` as floats, values whose ``flags``
-    (column -> flag column) are not 0 made missing, and how many were."""
+    (column -> flag column) are not 0 made missing, and how many were; a cell that is no number
+    (a word where a value or a flag belongs) is refused, as the generic CSV's reader refuses it."""
     frame, dropped = {}, 0
     for key, source in names.items():
         if source not in data.columns:
             continue
-        values = pd.to_numeric(data[source], errors="coerce").to_numpy(dtype=float)
+        values = _numbers(data, source, key, fail)
         flag = (flags or {}).get(key)
         if flag in data.columns:
-            bad = (pd.to_numeric(data[flag], errors="coerce").fillna(0).to_numpy() != 0) & np.isfinite(values)
+            marks = _numbers(data, flag, flag, fail)
+            bad = (np.nan_to_num(marks) != 0) & np.isfinite(values)
             dropped += int(bad.sum())
             values = np.where(bad, np.nan, values)
         frame[key] = values
     return pd.DataFrame(frame, index=pd.DatetimeIndex(data.index)), dropped
+
+
+#: Cells a reader leaves as text that mean "no value".
+_BLANK = ("", "nan", "na", "null")
+
+
+def _numbers(data: pd.DataFrame, source: str, key: str, fail) -> np.ndarray:
+    """Column ``source`` of ``data`` as floats (NaN where pvlib left none); a cell that is text but
+    no number is refused, naming its row and stamp."""
+    column = data[source]
+    numbers = pd.to_numeric(column, errors="coerce")
+    if not pd.api.types.is_numeric_dtype(column):
+        text = column.astype(str).str.strip()
+        bad = np.flatnonzero(numbers.isna().to_numpy() & column.notna().to_numpy()
+                             & ~text.str.lower().isin(_BLANK).to_numpy())
+        if bad.size:
+            more = f"; and {bad.size - 1} more rows" if bad.size > 1 else ""
+            stamp = pd.Timestamp(data.index[bad[0]]).isoformat(sep=" ")
+            raise fail(f"row {bad[0] + 1} (stamped {stamp}): {key} = {text.iloc[bad[0]][:20]!r}: not a number{more}")
+    return numbers.to_numpy(dtype=float)
 
 
 def _hours(stamp: pd.Timestamp) -> float:
@@ -165,7 +187,7 @@ def read_surfrad(path: str, fail, zone=None) -> StationData:
     """
     data, meta = read_with_pvlib(fail, "SURFRAD", pvlib.iotools.read_surfrad, path)
     names = {key: key for key in COLUMNS}
-    frame, dropped = _columns(data, names, {key: f"{key}_flag" for key in COLUMNS})
+    frame, dropped = _columns(data, names, fail, {key: f"{key}_flag" for key in COLUMNS})
     latitude, longitude = float(meta["latitude"]), float(meta["longitude"])
     notes = ()
     if longitude > 0 and "solar_zenith" in data.columns:
@@ -238,7 +260,7 @@ def read_midc(path: str, fail, zone=None) -> StationData:
         if key not in names:
             names[key] = next((name for name in columns if re.search(pattern, name)), None)
     names = {key: source for key, source in names.items() if source is not None}
-    frame, _ = _columns(data, names)
+    frame, _ = _columns(data, names, fail)
     frame = frame.where(frame > MIDC_MISSING)
     used = ", ".join(f"{key} {source!r}" for key, source in names.items())
     return StationData(frame, {}, _hours(frame.index[0]) if len(frame) else None, 0,
@@ -267,7 +289,7 @@ def read_srml(path: str, fail, zone=None) -> StationData:
                        key=lambda column: int(column.rsplit("_", 1)[1]))
         if found:
             names[key] = found[0]
-    frame, _ = _columns(data, names)
+    frame, _ = _columns(data, names, fail)
     return StationData(frame, {}, _hours(frame.index[0]) if len(frame) else None, 0,
                        (f"SRML columns read: {', '.join(f'{k} {v!r}' for k, v in names.items())}",))
 
@@ -290,7 +312,7 @@ def read_bsrn(path: str, fail, zone=None) -> StationData:
     data, meta = read_with_pvlib(fail, "BSRN", pvlib.iotools.read_bsrn, path)
     if len(data) == 0 or "latitude" not in meta:
         raise fail("no LR0100 record (basic measurements) and station LR0004: not a BSRN station-to-archive file")
-    frame, _ = _columns(data, {key: key for key in ("ghi", "dni", "dhi", "temp_air")})
+    frame, _ = _columns(data, {key: key for key in ("ghi", "dni", "dhi", "temp_air")}, fail)
     number = meta.get("station identification number")
     site = {"name": f"BSRN station {number}" if number is not None else None, "latitude": float(meta["latitude"]),
             "longitude": float(meta["longitude"]), "altitude": float(meta["altitude"])}
@@ -313,7 +335,7 @@ def read_solrad(path: str, fail, zone=None) -> StationData:
     StationData
     """
     data, meta = read_with_pvlib(fail, "SOLRAD", pvlib.iotools.read_solrad, path)
-    frame, dropped = _columns(data, {key: key for key in ("ghi", "dni", "dhi")},
+    frame, dropped = _columns(data, {key: key for key in ("ghi", "dni", "dhi")}, fail,
                               {key: f"{key}_flag" for key in ("ghi", "dni", "dhi")})
     site = {"name": str(meta.get("station_name") or "").strip() or None, "latitude": float(meta["latitude"]),
             "longitude": float(meta["longitude"]), "altitude": float(meta["altitude"])}
@@ -338,7 +360,7 @@ def read_crn(path: str, fail, zone=None) -> StationData:
     data = read_with_pvlib(fail, "CRN", pvlib.iotools.read_crn, path)
     if len(data) == 0:
         raise fail("no data rows")
-    frame, dropped = _columns(data, {"ghi": "ghi", "temp_air": "temp_air", "wind_speed": "wind_speed"},
+    frame, dropped = _columns(data, {"ghi": "ghi", "temp_air": "temp_air", "wind_speed": "wind_speed"}, fail,
                               {"ghi": "ghi_flag", "wind_speed": "wind_speed_flag"})
     first = data.iloc[0]
     latitude, longitude = float(first["latitude"]), float(first["longitude"])

@@ -1,0 +1,202 @@
+"""Weather and other input files under faults (issue 38): what is no file foldopt reads (a folder,
+a device, a FIFO, a file of gigabytes) is named for what it is before anything reads it, by every
+reader; a cloud ensemble over one day runs; a weather option given a list is one line; stamps
+that span decades are refused at once; a word where a station file holds a number is refused by
+every reader. Each refusal is exit code 2, one line, no traceback and nothing written."""
+
+from __future__ import annotations
+
+import os
+import re
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from foldopt.cli.app import app
+from foldopt.errors import WeatherError
+from foldopt.inputs.load import default_study_path
+from foldopt.inputs.weather.measured import read_measured
+
+runner = CliRunner()
+ROOT = Path(__file__).resolve().parent.parent
+TMY3 = ROOT / "configs" / "weather" / "723170TYA.CSV"
+MEASURED = ROOT / "tests" / "data" / "measured"
+#: The embedded study made cheap, without its site and day (a weather file brings them).
+FAST = {key: value for key, value in yaml.safe_load(default_study_path().read_text()).items()
+        if key not in ("site", "date", "sky", "geometry", "mode")}
+FAST.update(step_min=30, fold_angles={"start": 30, "stop": 180, "step": 30})
+#: Sites of the sample files that hold none (tests/data/measured/README.md).
+UAT = {"latitude": 32.22969, "longitude": -110.95534, "altitude": 786}
+EUGENE = {"latitude": 44.0468, "longitude": -123.0742, "altitude": 150}
+M2 = {"latitude": 39.9106, "longitude": -105.2347, "altitude": 1855}
+
+
+@pytest.fixture
+def here(tmp_path, monkeypatch):
+    """A working folder; nothing a refusal leaves may appear in it."""
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def refused(folder: Path, args, *words) -> str:
+    """``args`` run in ``folder``: exit code 2, one ``error:`` line holding ``words``, nothing written."""
+    before = sorted(path.name for path in folder.iterdir())
+    result = runner.invoke(app, [*map(str, args), "--out", "out"])
+    assert result.exit_code == 2, (result.exit_code, result.output)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert "Traceback" not in result.output and "internal error" not in result.output
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+    assert sorted(path.name for path in folder.iterdir()) == before
+    return lines[0]
+
+
+# --- files that are no files foldopt reads --------------------------------------------------------
+
+
+def _make(folder: Path, kind: str) -> str:
+    """An input path of ``kind`` in ``folder``: what it is, as messages say it."""
+    if kind == "folder":
+        (folder / "input.csv").mkdir()
+        return "input.csv"
+    if kind == "FIFO":
+        os.mkfifo(folder / "input.csv")  # no writer: a read would wait for ever
+        return "input.csv"
+    if kind == "huge":
+        with open(folder / "input.csv", "wb") as handle:
+            handle.truncate(2_000_000_000)  # sparse: 2.0 GB that take no time to write
+        return "input.csv"
+    return "/dev/zero"  # never ends
+
+
+#: What the message says each kind is.
+KINDS = {"folder": "is a folder, not a file", "FIFO": "is a FIFO, not a regular file",
+         "device": "is a character device, not a regular file",
+         "huge": "is 2,000,000,000 bytes (2.0 GB): larger than any"}
+
+#: Every file foldopt reads as input, by the command line that names it.
+READERS = {
+    "weather": ["sweep", "angle", "--weather", "{file}"],
+    "weather-surfrad": ["sweep", "angle", "--weather", "{file}", "--weather-format", "surfrad"],
+    "weather-csv": ["sweep", "angle", "--weather", "{file}", "--weather-format", "csv", "--lat", "32.2", "--lon",
+                    "-110.9", "--altitude", "786"],
+    "horizon": ["sweep", "angle", "--horizon", "{file}", "--step-min", "60", "--angle-step", "30"],
+    "sites": ["map", "--sites", "{file}"],
+    "load-profile": ["sweep", "angle", "--load-profile", "{file}", "--step-min", "60", "--angle-step", "30"],
+    "study": ["run", "{file}"],
+}
+OPTION = {"weather": "--weather", "weather-surfrad": "--weather", "weather-csv": "--weather", "horizon": "--horizon",
+          "sites": "--sites", "load-profile": "--load-profile", "study": "config"}
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+@pytest.mark.parametrize("reader", list(READERS))
+def test_an_input_that_is_no_file_foldopt_reads_is_named_for_what_it_is(here, reader, kind):
+    name = _make(here, kind)
+    start = time.monotonic()
+    line = refused(here, [arg.format(file=name) for arg in READERS[reader]], OPTION[reader], name, KINDS[kind])
+    assert "not found" not in line
+    assert time.monotonic() - start < 20
+
+
+def test_a_weather_file_of_a_study_that_is_a_folder_is_not_called_missing(here):
+    (here / "weather.csv").mkdir()
+    (here / "study.yaml").write_text(yaml.safe_dump({**FAST, "weather": "weather.csv"}))
+    line = refused(here, ["run", "study.yaml"], "weather", "weather.csv", "is a folder, not a file")
+    assert "not found" not in line
+
+
+@pytest.mark.parametrize("fmt", [None, "surfrad", "csv"])
+def test_the_library_refuses_a_folder_as_a_weather_file(tmp_path, fmt):
+    from foldopt.inputs.weather import measured_weather, read_weather
+
+    with pytest.raises(WeatherError, match="is a folder, not a file"):
+        if fmt is None:
+            read_weather(tmp_path)
+        else:
+            measured_weather(tmp_path, fmt, site=UAT)
+
+
+# --- a cloud ensemble over one day ----------------------------------------------------------------
+
+
+def test_a_cloud_ensemble_over_one_day_runs_its_members(here):
+    result = runner.invoke(app, ["sweep", "angle", "--weather", str(TMY3), "--members", "2", "--days", "2025-06-21",
+                                 "--step-min", "30", "--angle-step", "30", "--out", "out"])
+    assert result.exit_code == 0, result.output
+    assert "over 2 cloud members" in result.stdout and "1 day" in result.stdout
+    assert (here / "out" / "results.csv").is_file()
+
+
+# --- one value where one is expected ---------------------------------------------------------------
+
+
+@pytest.mark.parametrize("weather,words", [
+    ({"path": str(MEASURED / "five_minute.csv"), "format": ["csv", "surfrad"]},
+     ["weather.format = ['csv', 'surfrad']", "one name is expected, not a list"]),
+    ({"path": str(TMY3), "format": ["tmy3", "epw"]}, ["weather.format", "not a list"]),
+    ({"path": str(MEASURED / "surfrad-slv16001.dat"), "format": "surfrad", "label": ["start", "end"]},
+     ["weather.label = ['start', 'end']", "not a list"]),
+    ({"path": str(MEASURED / "surfrad-slv16001.dat"), "format": "surfrad", "max_gap_min": [30, 60]},
+     ["weather.max_gap_min = [30, 60]", "one number is expected"]),
+    ({"path": str(MEASURED / "five_minute.csv"), "format": {"name": "csv"}}, ["weather.format", "not a dict"]),
+], ids=["format-measured", "format-hourly", "label", "max-gap", "format-mapping"])
+def test_a_weather_option_given_a_list_is_one_line(here, weather, words):
+    (here / "study.yaml").write_text(yaml.safe_dump({**FAST, "site": UAT, "weather": weather}))
+    refused(here, ["run", "study.yaml"], *words)
+
+
+# --- stamps that span decades ----------------------------------------------------------------------
+
+
+def test_stamps_that_span_decades_are_refused_at_once(tmp_path):
+    path = tmp_path / "decades.csv"
+    stamps = [f"2018-10-18T12:{minute:02d}:00-07:00" for minute in range(10)] + ["2048-10-18T12:00:00-07:00"]
+    path.write_text("timestamp,ghi\n" + "".join(f"{stamp},500\n" for stamp in stamps))
+    start = time.monotonic()
+    with pytest.raises(WeatherError, match=r"decades.csv: the stamps span 2018-10-18 12:00:00-07:00 to 2048-10-18 "
+                                           r".*1-min step: 15,780,960 steps; at most"):
+        read_measured(path, "csv", site=UAT)
+    assert time.monotonic() - start < 10
+
+
+# --- a word where a number belongs -----------------------------------------------------------------
+
+
+def _word_in_cell(source: Path, target: Path, line: int, field: int, separator: str | None) -> str:
+    """``source`` with field ``field`` of line ``line`` (0-based) made ``abc``, columns kept in
+    place (fixed-width files); returns the value it replaced."""
+    lines = source.read_text().splitlines(True)
+    if separator is None:
+        cell = list(re.finditer(r"\S+", lines[line]))[field]
+        lines[line] = lines[line][:cell.start()] + "abc".rjust(cell.end() - cell.start()) + lines[line][cell.end():]
+        old = cell.group()
+    else:
+        cells = lines[line].rstrip("\n").split(separator)
+        old, cells[field] = cells[field], "abc"
+        lines[line] = separator.join(cells) + "\n"
+    target.write_text("".join(lines))
+    return old
+
+
+@pytest.mark.parametrize("name,fmt,site,line,field,separator,column", [
+    ("surfrad-slv16001.dat", "surfrad", None, 2 + 19 * 60, 8, None, "ghi"),  # local noon
+    ("surfrad-slv16001.dat", "surfrad", None, 2 + 19 * 60, 9, None, "ghi_flag"),
+    ("abq19056.dat", "solrad", None, 3, 8, None, "ghi"),
+    ("SRML-day-EUPO1801.txt", "srml", EUGENE, 1 + 12 * 60, 2, "\t", "ghi"),
+    ("midc_20181014.txt", "midc", M2, 1 + 12 * 60, 2, ",", "ghi"),
+    ("CRNS0101-05-2019-AZ_Tucson_11_W.txt", "crn", None, 2, 10, None, "SOLAR_RADIATION"),
+    ("five_minute.csv", "csv", UAT, 4 + 144, 1, ",", "ghi"),
+], ids=["surfrad", "surfrad-flag", "solrad", "srml", "midc", "crn", "csv"])
+def test_a_word_in_an_irradiance_cell_is_refused_by_every_reader(tmp_path, name, fmt, site, line, field, separator,
+                                                                 column):
+    path = tmp_path / name
+    old = _word_in_cell(MEASURED / name, path, line, field, separator)
+    float(old)  # the cell held a number
+    read_measured(MEASURED / name, fmt, site=site)  # the file as it was is read
+    with pytest.raises(WeatherError, match=rf"{re.escape(name)}: (?=.*{column})(?=.*'abc')"):
+        read_measured(path, fmt, site=site)
