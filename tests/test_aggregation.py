@@ -131,9 +131,8 @@ def test_ideal_model_connections_are_sums():
 
 
 #: Two days six months apart: the twofold panel's best angle differs (at 52.5 N it is flat at the
-#: winter solstice under a 2 W load).
-SOLSTICES = ("sweep", "day", "--lat", "52.52", "--lon", "13.40", "--days", "2025-06-21,2025-12-21", "--p-load", "2",
-             "--step-min", "5", "-q")
+#: winter solstice under a 2 W load); and three days in a row, whose best angle is the same.
+SOLSTICES, MIDSUMMER = "2025-06-21,2025-12-21", "2025-06-20,2025-06-21,2025-06-22"
 
 
 def _sweep_folder(tmp_path, *extra):
@@ -142,34 +141,44 @@ def _sweep_folder(tmp_path, *extra):
     from foldopt.cli.app import app
 
     out = tmp_path / "out"
-    result = CliRunner().invoke(app, [*SOLSTICES, *extra, "--out", str(out)])
+    result = CliRunner().invoke(app, ["sweep", "day", "--lat", "52.52", "--lon", "13.40", "--p-load", "2",
+                                      "--step-min", "5", "-q", *extra, "--out", str(out)])
     assert result.exit_code == 0, result.output
     return out
 
 
-@pytest.mark.parametrize("objective", [(), ("--objective", "mean")], ids=["each-day", "one-angle"])
-def test_the_annual_summary_gives_one_fold_angle_only_where_every_day_has_it(tmp_path, objective):
+@pytest.mark.parametrize("dates,objective,angles", [(SOLSTICES, (), 2), (SOLSTICES, ("--objective", "mean"), 1),
+                                                   (MIDSUMMER, (), 1)],
+                         ids=["solstices", "solstices-one-angle", "days-in-a-row"])
+def test_the_annual_summary_says_what_its_angle_and_totals_stand_for(tmp_path, dates, objective, angles):
     """A design's fold_angle_deg in annual_summary.csv is the angle of every one of its days in
     results.csv; where the days differ (each day's own best) it is empty, the range of the days'
-    angles is given and a note says so. (It was the first day's.)"""
-    out = _sweep_folder(tmp_path, *objective)
+    angles is given and a note says so (it was the first day's). Where the days skip some of their
+    period, the note says the totals are the days' only."""
+    out = _sweep_folder(tmp_path, "--days", dates, *objective)
     days = pd.read_csv(out / "results.csv")
     summary = pd.read_csv(out / "annual_summary.csv", keep_default_na=False, na_values=[""]).set_index("design")
     assert set(summary.index) == set(days["design"])
     for design, rows in days.groupby("design"):
-        angles, row = rows["fold_angle_deg"], summary.loc[design]
+        angles_of_days, row = rows["fold_angle_deg"], summary.loc[design]
         assert row["days"] == len(rows)
-        if angles.isna().all():  # a tracker: no angle
+        assert row["energy_harvested_wh"] == pytest.approx(rows["energy_harvested_wh"].sum(), rel=1e-9)
+        if angles_of_days.isna().all():  # a tracker: no angle
             assert np.isnan(row[["fold_angle_deg", "fold_angle_min_deg", "fold_angle_max_deg"]].astype(float)).all()
         else:
-            assert (row["fold_angle_min_deg"], row["fold_angle_max_deg"]) == (angles.min(), angles.max())
-        if angles.nunique() > 1:
+            assert (row["fold_angle_min_deg"], row["fold_angle_max_deg"]) == (angles_of_days.min(),
+                                                                              angles_of_days.max())
+        expected = []
+        if angles_of_days.nunique() > 1:
             assert np.isnan(row["fold_angle_deg"])
-            assert row["note"] == f"fold angle varies by day, {angles.min():g} to {angles.max():g} deg (each " \
-                                  "day's: results.csv)"
+            expected.append(f"fold angle varies by day, {angles_of_days.min():g} to {angles_of_days.max():g} deg "
+                            "(each day's: results.csv)")
         else:
-            assert row["fold_angle_deg"] == angles.iloc[0] or angles.isna().all()
-            assert np.isnan(row["note"]) if isinstance(row["note"], float) else row["note"] == ""
-    twofold = days[days["design"] == "twofold"]["fold_angle_deg"]
-    # The case each run is about: each solstice its own best angle, or one angle for both.
-    assert twofold.nunique() == (1 if objective else 2)
+            assert row["fold_angle_deg"] == angles_of_days.iloc[0] or angles_of_days.isna().all()
+        span = (pd.to_datetime(rows["date"]).max() - pd.to_datetime(rows["date"]).min()).days + 1
+        if len(rows) < span:
+            expected.append(f"totals over the {len(rows)} days evaluated, not the {span} from "
+                            f"{rows['date'].min()} to {rows['date'].max()}")
+        assert (row["note"] if isinstance(row["note"], str) else "") == "; ".join(expected)
+    # The case each run is about: each solstice its own best angle, or one angle for all days.
+    assert days[days["design"] == "twofold"]["fold_angle_deg"].nunique() == angles

@@ -63,7 +63,8 @@ COLUMNS = (
     ("energy_gain_vs_flat_pct", "%", "harvested energy over the flat panel's, less 100"),
     ("energy_pct_of_tracker", "%", "harvested energy as a share of the tracker's"),
     ("note", "", "polar night, polar day, overcast, load above peak (of that design); in annual_summary.csv, "
-                 "that the fold angle varies by day"),
+                 "that the fold angle varies by day, or that the totals are the days' evaluated, not their "
+                 "period's"),
     # the near-optimal range
     ("near_optimal_lo_deg", "deg", "the least fold angle on the best one's plateau"),
     ("near_optimal_hi_deg", "deg", "the largest fold angle on the best one's plateau"),

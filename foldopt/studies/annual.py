@@ -30,6 +30,17 @@ def annual_cases(result) -> list[str]:
     return ["site_name", "latitude", *others, "p_load_w"]
 
 
+def _note(group: pd.DataFrame, lo: float, hi: float) -> str:
+    """What a row's numbers are not: one fold angle (where the days' differ), the period's totals
+    (where the days evaluated skip some of it, e.g. every 7th day)."""
+    dates = pd.to_datetime(group["date"])
+    span = (dates.max() - dates.min()).days + 1
+    notes = [f"fold angle varies by day, {lo:g} to {hi:g} deg (each day's: results.csv)" if lo < hi else "",
+             f"totals over the {len(group)} days evaluated, not the {span} from {dates.min():%Y-%m-%d} to "
+             f"{dates.max():%Y-%m-%d}" if len(group) < span else ""]
+    return "; ".join(filter(None, notes))
+
+
 def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitude", "p_load_w")) -> pd.DataFrame:
     """The year per case and design: the daily t_solar's statistics, the totals over the days and
     each design's standing against the case's flat panel and tracker.
@@ -58,8 +69,9 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
         - daily t_solar [h]: ``mean_t_solar_h``, ``p10_t_solar_h``, ``p50_t_solar_h``,
           ``p90_t_solar_h``, ``min_t_solar_h``, the days reaching each of :data:`THRESHOLDS_H`
           (``days_ge_<x>h``) and the monthly means ``month_<mm>_mean_t_solar_h``;
-        - the totals over the days: energy harvested, served and wasted [Wh] and the
-          plane-of-array irradiation ``poa_kwh_m2`` [kWh/m^2];
+        - the totals over the days evaluated: energy harvested, served and wasted [Wh] and the
+          plane-of-array irradiation ``poa_kwh_m2`` [kWh/m^2] (where they skip days of their
+          period, e.g. every 7th day, the ``note`` says so: not the period's totals);
         - each design's gain over the case's flat panel (``gain_vs_flat_pct``) and share of its
           tracker (``pct_of_tracker``) in mean daily t_solar, and the same in energy harvested
           (``energy_gain_vs_flat_pct``, ``energy_pct_of_tracker``) [%]; served energy is the load
@@ -76,9 +88,7 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
         # One angle stands for the days only where every day has it: a design re-folded to each day's
         # best has a range, not an angle, and the first day's would stand for no other day.
         row.update(days=len(group), fold_angle_deg=lo if lo == hi else float("nan"), fold_angle_min_deg=lo,
-                   fold_angle_max_deg=hi,
-                   note=f"fold angle varies by day, {lo:g} to {hi:g} deg (each day's: results.csv)" if lo < hi
-                   else "", mean_t_solar_h=hours.mean(),
+                   fold_angle_max_deg=hi, note=_note(group, lo, hi), mean_t_solar_h=hours.mean(),
                    energy_harvested_wh=group["energy_harvested_wh"].sum(),
                    energy_served_wh=group["energy_served_wh"].sum(), energy_wasted_wh=group["energy_wasted_wh"].sum())
         if "poa_kwh_m2" in group:
