@@ -337,6 +337,10 @@ def test_a_load_wired_out_of_reach_runs_no_design_wired_to_it(tmp_path, monkeypa
     assert {"flat", "twofold", "twofold-parallel", "twofold-series", "tracker", "tracker-net"} <= set(summary.index)
     assert (summary.loc[wired, "t_solar_h"] == 0).all() and (shown.loc[wired, "t_solar_h"] == 0).all()
     assert answer["result"]["t_solar_h"] == 0 and set(answer["result"]["t_solar_by_design_h"].values()) == {0}
+    # Their peak: V times at most both halves' short-circuit current (bounded at 1500 W/m^2, 85 C).
+    isc = 2 * float(MODELS["single-diode"].curves(np.array([1500.0]), 85.0, AREA).i_sc[0])
+    assert (summary.loc[wired, "peak_power_w"] <= load_voltage * isc).all()
+    assert (summary.loc[wired, "peak_power_w"] == 0).all() == (load_voltage > 1)
     # The paper's panel behind its converters runs most of the day: the row says it is not wired directly.
     note = f"with a converter per sub-panel, not the load wired directly at {load_voltage:g} V"
     assert summary.loc["twofold-independent", "t_solar_h"] > 8
