@@ -195,3 +195,30 @@ def test_a_curve_over_the_days_joins_only_near_days(dates, joined):
         on_lines = set(np.concatenate(stretches)) if stretches else set()
         assert on_lines | marked == evaluated and not on_lines & marked
         assert bool(stretches) == joined
+
+
+@pytest.mark.parametrize("dates,blank", [(["2025-06-21", "2025-12-21"], True), ("1:365:7", False)],
+                         ids=["solstices", "weekly"])
+def test_a_heat_map_over_the_days_colours_only_near_days(dates, blank):
+    """gain_map_day_latitude.png / fold_angle_map_day_latitude.png: a cell spans at most DAY_GAP
+    of the days, centred on its evaluated day, with that day's value (pandas on the table); the
+    half year between the solstices is blank, weekly days leave no blank."""
+    from matplotlib.figure import Figure
+
+    study = foldopt.default_study().variant(step_min=30, fold_angles={"start": 30, "stop": 180, "step": 30})
+    table = foldopt.sweep(study, "day", date=dates, latitude=[0.0, 50.0], p_load=[2.0]).table
+    twofold = table[table["design"] == "twofold"]
+    ax = sweep.plot_map(twofold, "day_of_year", "latitude", "fold_angle_deg", "t", "deg", False,
+                        ax=Figure().subplots())
+    mesh = ax.collections[0]
+    corners = mesh.get_coordinates()  # (rows + 1, columns + 1, 2)
+    x_edges, y_edges = corners[0, :, 0], corners[:, 0, 1]
+    values = np.ma.filled(mesh.get_array().reshape(len(y_edges) - 1, len(x_edges) - 1).astype(float), np.nan)
+    coloured = np.isfinite(values).any(axis=0)
+    assert (np.diff(x_edges)[coloured] <= sweep.DAY_GAP).all()
+    assert (~coloured).any() == blank
+    for _, row in twofold.iterrows():
+        column = np.searchsorted(x_edges, row["day_of_year"]) - 1
+        line = np.searchsorted(y_edges, row["latitude"]) - 1
+        assert values[line, column] == row["fold_angle_deg"]
+        assert x_edges[column] < row["day_of_year"] < x_edges[column + 1]

@@ -16,45 +16,10 @@ AXIS_LABELS = {
 }
 
 
-def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label: str, diverging: bool,
-             ax=None):
-    """A heat map of ``value`` over ``x`` and ``y``, averaged over any other varied field.
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        A sweep's rows (usually the twofold design's): columns ``x``, ``y`` and ``value``.
-    x, y : str
-        The columns along the horizontal and vertical axes (e.g. ``latitude``, ``p_load_w``).
-    value : str
-        The column shown in colour (e.g. ``gain_vs_flat_pct`` [%], ``fold_angle_deg`` [deg]);
-        NaN cells are grey.
-    title, label : str
-        The Axes' title and the colour bar's label.
-    diverging : bool
-        Red-blue colours symmetric around 0 (a gain), else viridis.
-    ax : matplotlib.axes.Axes, optional
-        Axes to draw on; default a new figure (8 x 5 in).
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-    """
-    grid = table.pivot_table(index=y, columns=x, values=value, aggfunc="mean")
-    fig, ax = new_axes(ax, (8, 5))
-    data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
-    mesh = ax.pcolormesh(grid.columns, grid.index, data, shading="nearest", **colour_scale(data, diverging))
-    ax.set_facecolor("0.85")
-    ax.figure.colorbar(mesh, ax=ax, label=label)
-    ax.set_xlabel(AXIS_LABELS.get(x, x))
-    ax.set_ylabel(AXIS_LABELS.get(y, y))
-    ax.set_title(title, fontsize=10)
-    return ax
-
-
 #: The widest gap [d] between sampled days that a curve over the days of the year bridges with a
-#: line: a fortnight's weekly samples are joined, while days further apart (months, solstices) are
-#: points, not a course through the days between that nothing evaluated.
+#: line, and the widest cell of a heat map along them: a fortnight's weekly samples are joined,
+#: while days further apart (months, solstices) are points or narrow cells, not a course through
+#: the days between that nothing evaluated.
 DAY_GAP = 16.0
 
 
@@ -83,6 +48,81 @@ def broken_at_gaps(x, y, gap: float):
     joined[:-1] |= ~wide
     at = np.flatnonzero(wide) + 1
     return np.insert(x, at, np.nan), np.insert(y, at, np.nan), np.insert(~joined, at, False)
+
+
+def cells(centres, gap: float = np.inf):
+    """A heat map's cells along one axis: each value's cell reaches halfway to its neighbours (the
+    ends as far out as the next step in), but no further than ``gap / 2`` from it; what lies
+    between two cells so bounded is a blank cell.
+
+    Parameters
+    ----------
+    centres : array_like
+        The values along the axis, ascending, (n,).
+    gap : float, default numpy.inf
+        The widest cell (:data:`DAY_GAP` along the days of the year).
+
+    Returns
+    -------
+    edges : numpy.ndarray
+        (m + 1,) the cells' edges.
+    index : numpy.ndarray of int
+        (m,) each cell's value's index in ``centres``; -1 for a blank cell.
+    """
+    centres = np.asarray(centres, dtype=float)
+    if centres.size == 1:
+        return centres + np.array([-0.5, 0.5]) * min(1.0, gap), np.zeros(1, int)
+    mids = (centres[1:] + centres[:-1]) / 2
+    left = np.maximum(np.r_[2 * centres[0] - mids[0], mids], centres - gap / 2)
+    right = np.minimum(np.r_[mids, 2 * centres[-1] - mids[-1]], centres + gap / 2)
+    edges, index = [left[0]], []
+    for i in range(centres.size):
+        if left[i] > edges[-1]:  # nothing evaluated between the two cells
+            edges.append(left[i])
+            index.append(-1)
+        edges.append(right[i])
+        index.append(i)
+    return np.array(edges), np.array(index)
+
+
+def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label: str, diverging: bool,
+             ax=None):
+    """A heat map of ``value`` over ``x`` and ``y``, averaged over any other varied field.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep's rows (usually the twofold design's): columns ``x``, ``y`` and ``value``.
+    x, y : str
+        The columns along the horizontal and vertical axes (e.g. ``latitude``, ``p_load_w``).
+    value : str
+        The column shown in colour (e.g. ``gain_vs_flat_pct`` [%], ``fold_angle_deg`` [deg]);
+        NaN cells are grey, as are days of the year further than :data:`DAY_GAP` / 2 from any
+        evaluated (:func:`cells`).
+    title, label : str
+        The Axes' title and the colour bar's label.
+    diverging : bool
+        Red-blue colours symmetric around 0 (a gain), else viridis.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new figure (8 x 5 in).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    grid = table.pivot_table(index=y, columns=x, values=value, aggfunc="mean")
+    fig, ax = new_axes(ax, (8, 5))
+    (x_edges, x_cells), (y_edges, y_cells) = (cells(axis, DAY_GAP if name == "day_of_year" else np.inf)
+                                              for axis, name in ((grid.columns, x), (grid.index, y)))
+    values = grid.to_numpy(dtype=float)[np.ix_(y_cells, x_cells)]
+    data = np.ma.masked_invalid(np.where((y_cells[:, None] >= 0) & (x_cells[None, :] >= 0), values, np.nan))
+    mesh = ax.pcolormesh(x_edges, y_edges, data, shading="flat", **colour_scale(data, diverging))
+    ax.set_facecolor("0.85")
+    ax.figure.colorbar(mesh, ax=ax, label=label)
+    ax.set_xlabel(AXIS_LABELS.get(x, x))
+    ax.set_ylabel(AXIS_LABELS.get(y, y))
+    ax.set_title(title, fontsize=10)
+    return ax
 
 
 def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = None, ax=None):
