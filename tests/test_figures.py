@@ -222,3 +222,30 @@ def test_a_heat_map_over_the_days_colours_only_near_days(dates, blank):
         line = np.searchsorted(y_edges, row["latitude"]) - 1
         assert values[line, column] == row["fold_angle_deg"]
         assert x_edges[column] < row["day_of_year"] < x_edges[column + 1]
+
+
+@pytest.mark.parametrize("step,blank", [(183, True), (7, False)], ids=["half-year-apart", "weekly"])
+def test_a_day_hour_map_draws_each_day_in_its_own_column_and_no_day_between(step, blank):
+    """day_hour_power.png: each evaluated day's column holds its own hours' values, spans at most
+    DAY_GAP days around its day of the study, and days between sampled days further apart are
+    blank (they were the nearer day's)."""
+    import datetime
+
+    from matplotlib.figure import Figure
+
+    dates = [datetime.date(2025, 6, 21) + datetime.timedelta(days=step * i) for i in range(2 if blank else 10)]
+    hours = np.arange(24) + 0.5
+    power = np.random.default_rng(0).uniform(0, 10, (len(dates), hours.size))
+    ax = annual.plot_day_hour({"dates": dates, "hours": hours, "p_twofold_w": power}, "p_twofold_w", "t", "W",
+                              ax=Figure().subplots())
+    mesh = ax.collections[0]
+    corners = mesh.get_coordinates()
+    x_edges, y_edges = corners[0, :, 0], corners[:, 0, 1]
+    drawn = np.ma.filled(mesh.get_array().reshape(len(y_edges) - 1, len(x_edges) - 1).astype(float), np.nan)
+    coloured = np.isfinite(drawn).all(axis=0)
+    assert (np.diff(x_edges)[coloured] <= annual.DAY_GAP).all() and (~coloured).any() == blank
+    for index, date in enumerate(dates):
+        day = (date - dates[0]).days + 1
+        column = np.searchsorted(x_edges, day) - 1
+        assert x_edges[column] < day < x_edges[column + 1]
+        np.testing.assert_array_equal(drawn[:, column], power[index])

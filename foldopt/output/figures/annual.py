@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from foldopt.output.figures.canvas import FigureFile, load_label, new_axes
+from foldopt.output.figures.sweep import DAY_GAP, cells
 from foldopt.physics.connections import SWITCH_STATES
 
 MONTH_NAMES = ("J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D")
@@ -181,8 +182,10 @@ def plot_day_hour(extras: dict, key: str, title: str, label: str, ax=None):
     Parameters
     ----------
     extras : dict
-        A :class:`foldopt.SweepResult`'s ``extras``: ``hours`` (local clock time [h]) and ``key``,
-        a (days, hours) array.
+        A :class:`foldopt.SweepResult`'s ``extras``: ``dates`` (the days, ascending), ``hours``
+        (local clock time [h]) and ``key``, a (days, hours) array. A day's column spans at most
+        :data:`foldopt.output.figures.sweep.DAY_GAP` around it: days between sampled days further
+        apart are grey, not the nearer day's (:func:`foldopt.output.figures.sweep.cells`).
     key : {'p_twofold_w', 'switch_state'}
         The series: power P_pv [W] (magma colours), or the connection chosen (-1 off, then the
         index in :data:`foldopt.physics.connections.SWITCH_STATES`).
@@ -197,17 +200,21 @@ def plot_day_hour(extras: dict, key: str, title: str, label: str, ax=None):
     matplotlib.axes.Axes
     """
     values = np.asarray(extras[key], dtype=float)
-    days = np.arange(1, values.shape[0] + 1)
+    first = extras["dates"][0]
+    day_edges, day_cells = cells([(date - first).days + 1 for date in extras["dates"]], DAY_GAP)
+    hour_edges, _ = cells(extras["hours"])
+    shown = np.ma.masked_invalid(np.where(day_cells[:, None] >= 0, values[day_cells], np.nan).T)
     fig, ax = new_axes(ax, (9, 4.5))
+    ax.set_facecolor("0.85")
     if key == "switch_state":
         cmap = matplotlib.colors.ListedColormap(["0.15", "tab:orange", "tab:purple", "tab:green", "tab:brown"])
-        mesh = ax.pcolormesh(days, extras["hours"], values.T, cmap=cmap, vmin=-1.5, vmax=3.5, shading="nearest")
+        mesh = ax.pcolormesh(day_edges, hour_edges, shown, cmap=cmap, vmin=-1.5, vmax=3.5, shading="flat")
         bar = ax.figure.colorbar(mesh, ax=ax, ticks=range(-1, 4))
         bar.ax.set_yticklabels(["off", *SWITCH_STATES])
     else:
-        mesh = ax.pcolormesh(days, extras["hours"], values.T, cmap="magma", shading="nearest")
+        mesh = ax.pcolormesh(day_edges, hour_edges, shown, cmap="magma", shading="flat")
         ax.figure.colorbar(mesh, ax=ax, label=label)
-    ax.set_xlabel("day of the study")
+    ax.set_xlabel(f"day of the study (1 = {first:%Y-%m-%d})")
     ax.set_ylabel("local clock time [h]")
     ax.set_title(title, fontsize=10)
     return ax
