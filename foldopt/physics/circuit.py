@@ -322,15 +322,20 @@ def series_power(east: IVCurve, west: IVCurve, bypass: Diode | None, load_voltag
 
     if load_voltage is not None:
         target = _load(load_voltage, isc_e)
-        lo, hi = np.zeros_like(top), np.array(top, dtype=float)
-        # V_string(lo) >= target > V_string(hi) is kept; a target the string cannot reach gives 0.
-        reaches = _string_voltage(east, west, bypass, lo, switch_resistance) >= target
-        saturated = _string_voltage(east, west, bypass, hi, switch_resistance) >= target
+        # A target the string cannot reach gives 0, one it holds at its top current that current;
+        # between them V_string(lo) >= target > V_string(hi) is kept, over those strings alone (a
+        # load beyond the panel's reach bisects nothing).
+        reaches = _string_voltage(east, west, bypass, np.zeros_like(top), switch_resistance) >= target
+        saturated = _string_voltage(east, west, bypass, top, switch_resistance) >= target
+        inside = reaches & ~saturated
+        strings = [IVCurve(curve.model, tuple(np.asarray(p)[inside] for p in curve.params)) for curve in (east, west)]
+        lo, hi, aim = np.zeros(np.count_nonzero(inside)), top[inside], target[inside]
         for _ in range(_BISECTIONS):
             middle = 0.5 * (lo + hi)
-            above = _string_voltage(east, west, bypass, middle, switch_resistance) >= target
+            above = _string_voltage(*strings, bypass, middle, switch_resistance) >= aim
             lo, hi = np.where(above, middle, lo), np.where(above, hi, middle)
-        current = np.where(saturated, top, lo)
+        current = np.where(saturated, top, 0.0)
+        current[inside] = lo
         return np.where(reaches, target * current, 0.0)
     both = connections.golden_section(power, np.zeros_like(weaker), weaker)[0]
     if bypass is None:
