@@ -200,3 +200,62 @@ def test_a_word_in_an_irradiance_cell_is_refused_by_every_reader(tmp_path, name,
     read_measured(MEASURED / name, fmt, site=site)  # the file as it was is read
     with pytest.raises(WeatherError, match=rf"{re.escape(name)}: (?=.*{column})(?=.*'abc')"):
         read_measured(path, fmt, site=site)
+
+
+# --- messages that blame the wrong thing -----------------------------------------------------------
+
+SITE_OPTIONS = ["--lat", "32.22969", "--lon", "-110.95534", "--altitude", "786"]
+
+
+def _day_without_noon(folder: Path, how: str) -> Path:
+    """``five_minute.csv`` with its 10:00-13:00 stamps made unusable: ``negative`` irradiance,
+    ``absurd`` irradiance (beyond any sun) or ``gone`` (a 3-hour gap)."""
+    lines = (MEASURED / "five_minute.csv").read_text().splitlines(True)
+    kept = []
+    for line in lines:
+        noon = re.match(r"2018-10-18T1[0-2]:", line)
+        if noon and how == "gone":
+            continue
+        if noon:
+            cells = line.rstrip("\n").split(",")
+            cells[1:4] = ["-500"] * 3 if how == "negative" else ["5000"] * 3
+            line = ",".join(cells) + "\n"
+        kept.append(line)
+    path = folder / f"{how}.csv"
+    path.write_text("".join(kept))
+    return path
+
+
+@pytest.mark.parametrize("how,found", [("negative", "values beyond physical bounds made missing"),
+                                       ("absurd", "values beyond physical bounds made missing"),
+                                       ("gone", "steps the file lacks")])
+def test_a_measured_file_whose_only_day_is_left_out_says_which_and_why(here, how, found):
+    path = _day_without_noon(here, how)
+    line = refused(here, ["sweep", "angle", "--weather", path.name, "--weather-format", "csv", *SITE_OPTIONS],
+                   f"--weather {path.name}: its only day, 2018-10-18, is left out", "daylight gap of 180 min",
+                   "max_gap_min = 60 min", found)
+    assert "empty list" not in line and "--days" not in line
+
+
+@pytest.mark.parametrize("fmt,label", [("surfrad", "SURFRAD"), ("bsrn", "BSRN"), ("solrad", "SOLRAD"),
+                                       ("crn", "CRN")])
+def test_a_station_file_that_cannot_be_parsed_says_what_is_wrong_with_it(here, fmt, label):
+    (here / "junk.dat").write_text("junk\nmore junk\n1 2 3\n")
+    line = refused(here, ["sweep", "angle", "--weather", "junk.dat", "--weather-format", fmt],
+                   "--weather junk.dat", f"not a readable {label} file")
+    assert "not read yet" not in line
+
+
+def test_a_latitude_sweep_over_a_measured_file_without_a_site_names_the_site(here):
+    line = refused(here, ["sweep", "latitude", "--weather", MEASURED / "five_minute.csv", "--weather-format", "csv",
+                          "--lat", "30:40:5", "--lon", "-110.96", "--altitude", "786"],
+                   "--lat", "varies", "a csv file holds no site", "give one site")
+    assert "step" not in line
+
+
+@pytest.mark.parametrize("option,value", [("--members", "3"), ("--seed", "3"), ("--weather-format", "csv")])
+@pytest.mark.parametrize("axis", ["angle", "day"])
+def test_a_weather_option_without_a_weather_file_names_the_options(here, axis, option, value):
+    line = refused(here, ["sweep", axis, option, value], f"error: {option}: an option of a weather file",
+                   "give one with --weather")
+    assert "weather.path" not in line and "objective" not in line

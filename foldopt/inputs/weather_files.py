@@ -65,18 +65,53 @@ def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
     given = site if isinstance(site, dict) and not entry.has_site else None
     if not entry.has_site and not (given and all(isinstance(given.get(k), (int, float)) for k in (
             "latitude", "longitude", "altitude"))):
+        varied = _varied_site(site)
+        if varied is not None:
+            return {"weather_problem": f"{varied}: varies, but a {fmt} file holds no site and is read at the study's; "
+                                       "a measured file's light is of one place: give one site"}
         return {"weather_problem": f"weather {Path(path).name}: the {fmt} format holds no site; give the site's "
                                    "latitude, longitude and altitude"}
     options = {key: spec[key] for key in ("label", "timezone", "decomposition", "max_gap_min") if spec.get(key)
                is not None}
     try:
         measured = files.measured_weather(path, fmt, site=given, **options)
+    except ConfigError:
+        raise  # foldopt.errors.WeatherError: what is wrong with the file
     except ValueError:
         return {}  # an option out of its range: the study's validation names it
     days = measured.frame.index.tz_localize(None).normalize().unique()
     dates = tuple(str(day.date()) for day in days if day.date() not in measured.flagged_days)
-    return {"weather_site": measured.site, "weather_step_min": measured.step.total_seconds() / 60.0,
+    read = {"weather_site": measured.site, "weather_step_min": measured.step.total_seconds() / 60.0,
             "weather_dates": dates}
+    if not dates:
+        read["weather_problem"] = _every_day_left_out(measured, days, float(spec.get("max_gap_min") or 60.0))
+    return read
+
+
+def _varied_site(site) -> str | None:
+    """``site.latitude = '30:40:5'`` where the study's site is a sweep axis (a list or a range), or None."""
+    if isinstance(site, list):
+        return f"site = {len(site)} sites"
+    for key in ("latitude", "longitude", "altitude"):
+        value = site.get(key) if isinstance(site, dict) else None
+        if isinstance(value, (list, str)):
+            return f"site.{key} = {value!r}"
+    return None
+
+
+def _every_day_left_out(measured, days, max_gap_min: float) -> str:
+    """Why a measured file has no day a study can use: each of its days has a daylight gap longer
+    than ``max_gap_min``, and what reading made missing."""
+    name = measured.frame.attrs.get("weather", "")
+    first = days[0].date()
+    gaps = [gap for gap in measured.gaps if gap[0].date() == first and gap[2] > max_gap_min]
+    longest = max(gaps, key=lambda gap: gap[2]) if gaps else None
+    which = f"its only day, {first}," if len(days) == 1 else f"all {len(days)} of its days are; {first}"
+    why = "has daylight steps missing" if longest is None else (
+        f"has a daylight gap of {longest[2]:g} min ({longest[0]:%H:%M} to {longest[1]:%H:%M})")
+    found = [note for note in measured.notes if note.startswith(("values beyond physical bounds", "values flagged"))]
+    return (f"weather {name}: {which} is left out: it {why}, longer than weather.max_gap_min = {max_gap_min:g} min"
+            + (f" ({'; '.join(found)})" if found else " (steps the file lacks)") + "; no day is left to study")
 
 
 #: A weather file's options that take one name, and those that take one number.
@@ -139,6 +174,8 @@ def weather_defaults(data: dict) -> dict:
     if problem is not None:
         raise ConfigError([problem])
     read = weather_read(weather, data.get("site"))
+    if read.get("weather_problem") is not None and (not read.get("weather_dates") or _varied_site(data.get("site"))):
+        raise ConfigError([read["weather_problem"]])  # its days and step cannot be known: none to default
     if read.get("weather_dates") is None:
         return {"date": "year"}  # the file cannot be read: the study's validation names why
     return {"date": list(read["weather_dates"]), "step_min": read["weather_step_min"]}

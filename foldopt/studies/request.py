@@ -343,6 +343,9 @@ def sweep_changes(options: dict, data: dict) -> dict:
         elif data.get("load_profile") is None and options["load_profile"] is None:
             errors.append("--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
                           "the study)")
+    lonely = [option for option in ("weather_format", "members", "seed") if options.get(option) is not None]
+    if lonely and options.get("weather") is None and data.get("weather") is None:
+        errors.append(f"--{lonely[0].replace('_', '-')}: an option of a weather file; give one with --weather")
     for option, value in options.items():
         if option == "settings" or value is None or value is False:
             continue
