@@ -142,7 +142,7 @@ def _sweep_folder(tmp_path, *extra):
 
     out = tmp_path / "out"
     result = CliRunner().invoke(app, ["sweep", "day", "--lat", "52.52", "--lon", "13.40", "--p-load", "2",
-                                      "--step-min", "5", "-q", *extra, "--out", str(out)])
+                                      "--step-min", "15", "--angle-step", "2", "-q", *extra, "--out", str(out)])
     assert result.exit_code == 0, result.output
     return out
 
