@@ -233,3 +233,37 @@ def test_the_limit_counts_the_grid_the_search_walks():
     for lo, hi, step in [(1, 180, 1), (10, 180, 7), (0, 90, 0.3), (-90, 90, 2), (5, 5, 1)]:
         assert grid_points(lo, hi, step) == Axis("x", lo, hi, step).size == len(Axis("x", lo, hi, step).values())
         assert Axis("x", lo, hi, step).values()[-1] == hi
+
+
+@pytest.mark.parametrize("options,line", [
+    (["--fold-range", "1:180:0"], "error: --fold-range step = 0.0: must be in (0, 90] deg"),
+    (["--tilt-range", "0:90:nan"], "error: --tilt-range step = nan: must be in (0, 90] deg"),
+    (["--azimuth-range", "0:720:1"], "error: --azimuth-range: 0:720:1: spans 720 deg; at most 360"),
+], ids=["fold-step", "tilt-step", "azimuth-span"])
+def test_a_bad_range_is_named_by_its_option(options, line, tmp_path):
+    """A range's part is named by the option that gave it (it was 'optimize.fold_angle.step'), and an
+    azimuth range of more than a turn, which searched every direction twice, is refused."""
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    result = CliRunner().invoke(app, ["optimize", *options, "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(line)
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_bad_range_of_the_study_file_keeps_its_name(tmp_path):
+    """The same fault in the study file's optimize section is the file's, not an option's."""
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+    from foldopt.inputs.load import default_study_path
+
+    study = tmp_path / "study.yaml"
+    study.write_text(default_study_path().read_text(encoding="utf-8")
+                     + "\noptimize:\n  vary: [tilt]\n  tilt: {min: 0, max: 90, step: 0}\n", encoding="utf-8")
+    result = CliRunner().invoke(app, ["optimize", "--config", str(study), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2, result.output
+    assert result.stderr.strip().splitlines() == ["error: optimize.tilt.step = 0: must be in (0, 90] deg"]

@@ -19,8 +19,16 @@ from foldopt.cli.sweep import signature, sweep_options
 from foldopt.errors import ConfigError
 from foldopt.studies.request import OPTIMIZE_OPTIONS, optimize_section, sweep_request
 
-#: The optimize section's fields as the command line names them.
-_OPTION_OF_OPTIMIZE = {f"optimize.{name}": option for name, option in OPTIMIZE_OPTIONS.items()}
+#: The optimize section's fields by the parameters of :func:`_optimize_options` that set them.
+_PARAMETER_OF_FIELD = {"vary": "vary", "fold_angle": "fold_range", "tilt": "tilt_range", "azimuth": "azimuth_range",
+                       "tolerance_h": "tolerance"}
+
+
+def _optimize_labels(own: dict) -> dict:
+    """The optimize section's fields, and a range's parts (``optimize.tilt.step``), as the options
+    given name them: ``--tilt-range step``; a field the study file set keeps its name."""
+    return {f"optimize.{name}{part}": option + part.replace(".", " ") for name, option in OPTIMIZE_OPTIONS.items()
+            if own[_PARAMETER_OF_FIELD[name]] is not None for part in ("", ".min", ".max", ".step")}
 
 
 def _optimize_options(
@@ -35,7 +43,8 @@ def _optimize_options(
                                                 "from north; may cross north, -90:90:2] [default: the equator-facing "
                                                 "one +-90 by 2]."),
     tolerance: Optional[float] = typer.Option(None, "--tolerance", help="What the search may miss of the best "
-                                              "objective [h] [default: 0.01]."),
+                                              "objective [h]; no finer than the objective counts (one day: the "
+                                              "time step) [default: 0.01]."),
 ):
     """The options of the optimisation itself."""
 
@@ -46,7 +55,7 @@ def optimize(**options):
     out, overwrite = options.pop("out"), options.pop("overwrite")
     config = options.pop("config")
     own = {name: options.pop(name) for name in ("vary", "fold_range", "tilt_range", "azimuth_range", "tolerance")}
-    labels = {**OPTION_OF_FIELD, **_OPTION_OF_OPTIMIZE}
+    labels = {**OPTION_OF_FIELD, **_optimize_labels(own)}
     if options["p_load_scale"] is not None:
         labels["p_load"] = "--p-load-scale"
     try:

@@ -143,6 +143,15 @@ class Optimize(StrictModel):
             raise ValueError(f"{bounds.describe()}: min and max must be in [0, 90] deg")
         return bounds
 
+    @field_validator("azimuth")
+    @classmethod
+    def _azimuth_bounds(cls, bounds):
+        """Azimuths repeat after a turn: a wider range searches each direction again."""
+        if bounds is not None and bounds.max - bounds.min > 360:
+            raise ValueError(f"{bounds.describe()}: spans {bounds.max - bounds.min:g} deg; at most 360 (azimuths "
+                             f"repeat after a turn)")
+        return bounds
+
     def range_of(self, name: str, default: tuple) -> tuple:
         """A variable's ``(min, max, step)`` [deg]: its bounds, or ``default`` where none are set.
 
