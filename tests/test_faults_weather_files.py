@@ -6,6 +6,7 @@ every reader. Each refusal is exit code 2, one line, no traceback and nothing wr
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import time
@@ -259,3 +260,48 @@ def test_a_weather_option_without_a_weather_file_names_the_options(here, axis, o
     line = refused(here, ["sweep", axis, option, value], f"error: {option}: an option of a weather file",
                    "give one with --weather")
     assert "weather.path" not in line and "objective" not in line
+
+
+def test_a_horizon_beside_a_weather_files_site_takes_the_files_site(here):
+    horizon = ROOT / "tests" / "data" / "horizon" / "street_canyon.csv"
+    quick = ["--step-min", "60", "--angle-step", "30", "--days", "172:172:1", "--format", "json"]
+    open_sky = runner.invoke(app, ["sweep", "angle", "--weather", str(TMY3), *quick, "--out", "open"])
+    canyon = runner.invoke(app, ["sweep", "angle", "--weather", str(TMY3), "--horizon", str(horizon), *quick,
+                                 "--out", "canyon"])
+    assert open_sky.exit_code == 0 and canyon.exit_code == 0, canyon.output
+    run = json.loads((here / "canyon" / "run.json").read_text())
+    assert "GREENSBORO" in canyon.stdout and "horizon" in json.dumps(run["study"]["site"])
+    assert json.loads(canyon.stdout)["answer"] != json.loads(open_sky.stdout)["answer"]  # the canyon shades
+
+
+#: Bytes a terminal acts on: an escape that turns text red, a bell, NUL.
+BINARY = b"\x1b[31mred\x07,\x00\x01,3\n1,2,3\n"
+
+
+@pytest.mark.parametrize("fmt", ["tmy3", "epw", "surfrad", "midc", "srml", "bsrn", "solrad", "crn", "csv"])
+def test_binary_bytes_reach_no_message_raw(here, fmt):
+    (here / "binary.dat").write_bytes(BINARY)
+    line = refused(here, ["sweep", "angle", "--weather", "binary.dat", "--weather-format", fmt, *SITE_OPTIONS],
+                   "--weather binary.dat")
+    assert not re.search(r"[\x00-\x08\x0b-\x1f\x7f]", line), line
+    assert len(line) < 400
+
+
+@pytest.mark.parametrize("name,fmt", [("surfrad-slv16001.dat", "surfrad"), ("abq19056.dat", "solrad"),
+                                      ("CRNS0101-05-2019-AZ_Tucson_11_W.txt", "crn"),
+                                      ("SRML-day-EUPO1801.txt", "srml"), ("midc_20181014.txt", "midc"),
+                                      ("midc_raw_20181018.txt", "midc"), ("five_minute.csv", "csv")])
+def test_a_station_file_read_as_tmy3_names_its_likely_format(here, name, fmt):
+    from foldopt.inputs.weather import sniff_format
+
+    assert sniff_format(MEASURED / name) == fmt
+    (here / "station.csv").write_bytes((MEASURED / name).read_bytes())  # .csv: read as TMY3 by its extension
+    refused(here, ["sweep", "angle", "--weather", "station.csv"], "--weather station.csv",
+            f"looks like a {fmt} file: give --weather-format {fmt}")
+
+
+def test_the_hourly_formats_are_told_by_their_content():
+    from foldopt.inputs.weather import sniff_format
+
+    assert sniff_format(TMY3) == "tmy3"
+    assert sniff_format(ROOT / "tests" / "data" / "horizon" / "street_canyon.csv") is None

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from contextlib import contextmanager
 from pathlib import Path
 from typing import NoReturn
@@ -38,15 +39,21 @@ def as_text(text: str) -> str:
     return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
 
 
+#: Characters a terminal acts on rather than shows (a binary file's bytes, escapes), but line breaks and tabs.
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+
+
 def echo(text: str, err: bool = False) -> None:
-    """Print a line of text from the command line (:func:`as_text`), on stderr with ``err``.
+    """Print a line of text from the command line (:func:`as_text`), on stderr with ``err``; a
+    control character (text a message took from a binary file) as a ``\\xNN`` escape.
 
     Parameters
     ----------
     text : str
     err : bool
     """
-    typer.echo(as_text(text), err=err)
+    text = _CONTROL.sub(lambda match: f"\\x{ord(match.group()):02x}", as_text(text))
+    typer.echo(text, err=err)
 
 
 def fail(lines: list[str]) -> NoReturn:

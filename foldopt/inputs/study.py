@@ -199,8 +199,11 @@ class Study(StrictModel):
     @model_validator(mode="before")
     @classmethod
     def _site_from_weather(cls, data, info: ValidationInfo):
-        """A weather file brings its site, as its loader read it: the study's unless one is given."""
-        if isinstance(data, dict) and data.get("site") is None and data.get("weather") is not None:
+        """A weather file brings its site, as its loader read it: the study's unless one is given. A
+        site of other fields only (a horizon, an altitude) is the file's with those fields."""
+        site = data.get("site") if isinstance(data, dict) else None
+        partial = isinstance(site, dict) and not {"latitude", "longitude"} & set(site)
+        if isinstance(data, dict) and (site is None or partial) and data.get("weather") is not None:
             weather = data["weather"]
             path = weather if isinstance(weather, str) else weather.get("path") if isinstance(weather, dict) else None
             if isinstance(path, str):
@@ -208,7 +211,10 @@ class Study(StrictModel):
                 if files is not None and files.weather_problem is not None:
                     raise ValueError(files.weather_problem)
                 read = files.weather_site if files is not None else None
-                data = {**data, "site": read if read is not None else _UNREAD}
+                if partial and read is not None:
+                    data = {**data, "site": {**read, **site}}
+                elif not partial:
+                    data = {**data, "site": read if read is not None else _UNREAD}
         return data
 
     @field_validator("site", mode="wrap")

@@ -53,9 +53,22 @@ def weather_read(weather, site=None) -> dict:
             return _measured_read(files, path, fmt, spec, site)
         return {"weather_site": files.weather_site(path, fmt)}
     except ConfigError as error:  # foldopt.errors.WeatherError: the file, the line, the reason
-        return {"weather_problem": str(error)}
+        return {"weather_problem": str(error) + _format_hint(files, path, fmt, spec.get("format"))}
     except (ValueError, KeyError, OSError) as error:
         return {"weather_problem": f"weather: cannot read a site from {path} ({error.__class__.__name__})"}
+
+
+def _format_hint(files, path: str, fmt: str | None, given) -> str:
+    """Where a file that failed was read in the format its extension implies, the format its
+    first lines look like, if another."""
+    if given is not None:
+        return ""
+    used = files.weather_format(path)
+    seen = files.sniff_format(path)
+    if seen is None or seen == used:
+        return ""
+    return f"; read as {used} (by its extension), it looks like a {seen} file: give --weather-format {seen} " \
+           f"(weather.format: {seen} in a study)"
 
 
 def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:

@@ -32,6 +32,7 @@ References
 from __future__ import annotations
 
 import functools
+import re
 from pathlib import Path
 
 import numpy as np
@@ -79,6 +80,33 @@ def weather_format(path: Path, fmt: str | None = None) -> str:
         return fmt
     suffix = Path(path).suffix.lower()
     return next((name for name, entry in FORMATS.items() if suffix in entry.suffixes), tmy3.FORMAT.name)
+
+
+#: Bytes of a file's start that :func:`sniff_format` reads.
+_HEAD_BYTES = 8192
+
+
+def sniff_format(path) -> str | None:
+    """The format a weather file's first lines look like (each format's ``signature``).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A file :func:`~foldopt.inputs.weather.formats.check_file` accepts.
+
+    Returns
+    -------
+    str or None
+        One of :data:`FORMATS` or :data:`MEASURED_FORMATS`, or None where none matches or the
+        file cannot be read.
+    """
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(_HEAD_BYTES).decode("utf-8", errors="replace").replace("\r\n", "\n")
+    except OSError:
+        return None
+    entries = {**FORMATS, **MEASURED_FORMATS}
+    return next((name for name, entry in entries.items() if re.search(entry.signature, head)), None)
 
 
 def _read(path: str, fmt: str, year: int, mtime: float):

@@ -66,7 +66,7 @@ def read(path: str, text: str, year: int, fail):
 
 
 FORMAT = WeatherFormat(
-    name="epw", label="EPW", interval_label="start", suffixes=(".epw",),
+    name="epw", label="EPW", interval_label="start", suffixes=(".epw",), signature=r"\ALOCATION,",
     columns={"ghi": "field 14", "dni": "field 15", "dhi": "field 16", "temp_air": "field 7", "wind_speed": "field 22"},
     columns_at="its rows", read=read, site=partial(header_site, name="city"), stamp_lag=1.0,
     cover=("total_sky_cover", 10.0),

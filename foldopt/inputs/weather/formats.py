@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -62,6 +63,9 @@ class WeatherFormat:
     cover : tuple, optional
         ``(column, divisor)``: the file's total sky cover and what makes it a fraction of the sky
         (tenths: 10), for a cloud ensemble (:mod:`foldopt.inputs.weather.ensemble`).
+    signature : str
+        A regular expression its files' first lines match, to tell the format of a file read as
+        another (:func:`foldopt.inputs.weather.sniff_format`).
     """
 
     name: str
@@ -76,6 +80,7 @@ class WeatherFormat:
     to_local: Callable | None = None
     stamp_lag: float = 0.0
     cover: tuple | None = None
+    signature: str = r"(?!)"
 
 
 def check_file(path) -> None:
@@ -97,6 +102,28 @@ def check_file(path) -> None:
         raise WeatherError(error.errors[0]) from None
 
 
+#: Characters a terminal would act on rather than show: C0 and C1 controls, DEL.
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+
+
+def printable(text, limit: int = 40) -> str:
+    """Text taken from a file, fit for a one-line message: control characters (a binary file's
+    bytes, a terminal's escapes, line breaks) as ``\\xNN`` escapes, cut to ``limit`` characters.
+
+    Parameters
+    ----------
+    text : object
+        Its ``str``.
+    limit : int, default 40
+
+    Returns
+    -------
+    str
+    """
+    text = _CONTROL.sub(lambda match: f"\\x{ord(match.group()):02x}", str(text))
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
 def reason(error: Exception) -> str:
     """pvlib's or pandas' exception as a short reason.
 
@@ -113,9 +140,11 @@ def reason(error: Exception) -> str:
         return f"missing {error}"
     if isinstance(error, json.JSONDecodeError):
         return f"not valid JSON: {error.msg} at line {error.lineno} column {error.colno}"
+    if isinstance(error, UnicodeDecodeError):
+        return f"not text: byte {error.start + 1:,} is 0x{error.object[error.start]:02x}, no UTF-8 (a binary file?)"
     text = str(error).strip().splitlines()
     text = text[0].split(" You might want to try")[0] if text else ""  # pandas' advice, on the next lines
-    return f"{type(error).__name__}: {text}" if text else type(error).__name__
+    return f"{type(error).__name__}: {printable(text, 200)}" if text else type(error).__name__
 
 
 def read_with_pvlib(fail, label: str, reader: Callable, *args, **kwargs):
@@ -215,7 +244,7 @@ def site_value(fail, where: str, key: str, raw) -> float:
     try:
         value = float(raw)
     except (TypeError, ValueError):
-        raise fail(f"{where}: {label} = {str(raw).strip()!r}: not a number") from None
+        raise fail(f"{where}: {label} = {printable(str(raw).strip())!r}: not a number") from None
     if not math.isfinite(value):
         raise fail(f"{where}: {label} = {raw}: must be a finite number")
     if not lo <= value <= hi:

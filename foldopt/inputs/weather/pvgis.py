@@ -112,5 +112,6 @@ def to_local(frame: pd.DataFrame, site: dict, year: int) -> pd.DataFrame:
 
 FORMAT = WeatherFormat(
     name="pvgis", label="PVGIS TMY", interval_label="start", suffixes=(".json",),
+    signature=r'\A\s*\{\s*"(?:inputs|outputs|meta)"',
     columns={"ghi": "G(h)", "dni": "Gb(n)", "dhi": "Gd(h)", "temp_air": "T2m", "wind_speed": "WS10m"},
     columns_at="outputs.tmy_hourly", read=read, site=site, to_local=to_local)

@@ -70,7 +70,7 @@ import numpy as np
 import pandas as pd
 import pvlib
 
-from foldopt.inputs.weather.formats import read_with_pvlib, reason
+from foldopt.inputs.weather.formats import printable, read_with_pvlib, reason
 from foldopt.inputs.weather.qc import COLUMNS
 
 #: MIDC's missing-value marker: values at or below it are missing.
@@ -92,12 +92,16 @@ class StationFormat:
         offset of stamps that carry none (the CSV's), ``fail(message)`` makes the error to raise.
     has_site : bool
         Whether the file holds its site's latitude and longitude.
+    signature : str
+        A regular expression its files' first lines match, to tell the format of a file read as
+        another (:func:`foldopt.inputs.weather.sniff_format`).
     """
 
     name: str
     interval_label: str
     reader: Callable
     has_site: bool
+    signature: str
 
 
 @dataclass(frozen=True)
@@ -401,7 +405,7 @@ def read_csv(path: str, fail, zone=None) -> StationData:
         raise fail(f"not a readable CSV file ({reason(error)})") from error
     named = {str(column).strip().lower(): column for column in table.columns}
     if "timestamp" not in named:
-        held = ", ".join(str(column) for column in table.columns[:8])
+        held = printable(", ".join(str(column) for column in table.columns[:8]), 120)
         raise fail(f"no timestamp column: a measured CSV file's header names timestamp, ghi, dni, dhi and optionally "
                    f"temp_air, wind_speed; this one names {held or 'nothing'}")
     if len(table) == 0:
@@ -418,7 +422,7 @@ def read_csv(path: str, fail, zone=None) -> StationData:
     # The offset: of a stamp's time, after its clock time (a date's own dashes are no offset).
     offset = text.str.split(r"[T ]", n=1, regex=True).str[-1].str.contains(_OFFSET)
     aware = bool(offset.iloc[0])
-    refuse(offset != aware, lambda i: f"timestamp {text.iloc[i]!r} {'has no' if aware else 'has a'} UTC offset, "
+    refuse(offset != aware, lambda i: f"timestamp {text.iloc[i][:40]!r} {'has no' if aware else 'has a'} UTC offset, "
                                       f"unlike row 1's: give every stamp an offset or none")
     stamps = pd.to_datetime(text, format="ISO8601", utc=aware, errors="coerce")
     refuse(stamps.isna(), lambda i: f"timestamp = {text.iloc[i][:30]!r}: not an ISO 8601 date and time")
@@ -460,11 +464,14 @@ def fixed_zone(hours: float) -> datetime.timezone:
 #: The measured weather formats by name, in the order of :data:`foldopt.names.WEATHER_FORMATS`
 #: (whose descriptions help and the docs print).
 STATION_FORMATS = {entry.name: entry for entry in (
-    StationFormat("surfrad", "end", read_surfrad, True),
-    StationFormat("midc", "end", read_midc, False),
-    StationFormat("srml", "start", read_srml, False),
-    StationFormat("bsrn", "start", read_bsrn, True),
-    StationFormat("solrad", "end", read_solrad, True),
-    StationFormat("crn", "end", read_crn, True),
-    StationFormat("csv", "end", read_csv, False),
+    # SURFRAD's and SOLRAD's second line: latitude, longitude, elevation (SURFRAD "m", SOLRAD its
+    # UTC offset), "version"; MIDC's header, daily or raw; SRML's: station, year, elements, by tabs;
+    # BSRN's first record; CRN's rows: WBAN, UTC date and time, local date and time.
+    StationFormat("surfrad", "end", read_surfrad, True, r"\A[^\n]*\n\s*-?[\d.]+\s+-?[\d.]+\s+\d+\s+m\s+version"),
+    StationFormat("midc", "end", read_midc, False, r"\A(?:DATE \(MM/DD/YYYY\),|[^\n]*\bYear,DOY,)"),
+    StationFormat("srml", "start", read_srml, False, r"\A\d+\t\d{4}\t"),
+    StationFormat("bsrn", "start", read_bsrn, True, r"\A\*[CU]0001"),
+    StationFormat("solrad", "end", read_solrad, True, r"\A[^\n]*\n\s*-?[\d.]+\s+-?[\d.]+\s+\d+\s+-?[\d.]+\s+version"),
+    StationFormat("crn", "end", read_crn, True, r"\A\d{5} \d{8} \d{4} \d{8} \d{4} "),
+    StationFormat("csv", "end", read_csv, False, r"(?i)\A(?:#[^\n]*\n|\s*\n)*(?:[^,\n]*,)*\s*timestamp\s*(?:,|\r?\n)"),
 )}

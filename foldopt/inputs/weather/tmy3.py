@@ -73,6 +73,7 @@ def read(path: str, text: str, year: int, fail):
 
 FORMAT = WeatherFormat(
     name="tmy3", label="TMY3", interval_label="end", suffixes=(".csv",),
+    signature=r"\A[^\n]*\n\s*Date \(MM/DD/YYYY\),Time",
     columns={"ghi": "GHI (W/m^2)", "dni": "DNI (W/m^2)", "dhi": "DHI (W/m^2)", "temp_air": "Dry-bulb (C)",
              "wind_speed": "Wspd (m/s)"},
     columns_at="line 2, the column names", read=read, site=partial(header_site, name="Name"),
