@@ -267,3 +267,18 @@ def test_a_bad_range_of_the_study_file_keeps_its_name(tmp_path):
     result = CliRunner().invoke(app, ["optimize", "--config", str(study), "--out", str(tmp_path / "out")])
     assert result.exit_code == 2, result.output
     assert result.stderr.strip().splitlines() == ["error: optimize.tilt.step = 0: must be in (0, 90] deg"]
+
+
+def test_a_season_none_of_the_days_is_in_is_refused(tmp_path):
+    """An objective over June of January's days has no day to take (it was a ZeroDivisionError, an
+    internal error): one line naming objective.months, nothing written."""
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    result = CliRunner().invoke(app, ["optimize", *SMALL, "--days", "1:31:5", "--objective", "mean", "--set",
+                                      "objective.months=[6]", "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: objective.months = [6]: none of the 7 days")
+    assert not (tmp_path / "out").exists()

@@ -123,7 +123,7 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     Raises
     ------
     foldopt.ConfigError
-        For other axes, or a cloud ensemble.
+        For other axes, a cloud ensemble, or a season (``objective.months``) none of the days is in.
     """
     study = plan.base.resolved()
     spec = study.optimize
@@ -138,11 +138,14 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     loads = np.asarray(axes.get("p_load", (study.p_load,)), dtype=float)
     statistic = study.objective.statistic if study.objective is not None else "mean"
     season = study.objective.months if study.objective is not None else None
+    months = np.array([date.month for date in dates])
+    counted = months[season_days(months, season)]  # the days the objective takes
+    if counted.size == 0:
+        raise ConfigError([f"objective.months = {list(season)}: none of the {len(dates)} days ({dates[0]} to "
+                           f"{dates[-1]}) is in these months; give days in them, or other months"])
     blocks = Blocks.of_dates(study, dates)
     study = blocks.study
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
-    months = np.array([date.month for date in dates])
-    counted = months[season_days(months, season)]  # the days the objective takes
     quantum = objective_quantum(statistic, parts[0][1].step_hours, counted.size, counted)
 
     def objective(flat):
