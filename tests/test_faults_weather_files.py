@@ -12,6 +12,7 @@ import re
 import time
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import yaml
 from typer.testing import CliRunner
@@ -154,15 +155,20 @@ def test_a_weather_option_given_a_list_is_one_line(here, weather, words):
 # --- stamps that span decades ----------------------------------------------------------------------
 
 
-def test_stamps_that_span_decades_are_refused_at_once(tmp_path):
+@pytest.mark.parametrize("minutes,rows,steps", [(1, 10, "15,780,960 steps for 11 rows"),
+                                                (60, 48, "263,016 steps for 49 rows")])
+def test_stamps_that_span_decades_are_refused_at_once(tmp_path, minutes, rows, steps):
+    # A slip in a year: ten minutes (or two days of hours) and one stamp thirty years on: 10,959
+    # local days (30 years, 8 of them leap) of 1440 (or 24) steps.
     path = tmp_path / "decades.csv"
-    stamps = [f"2018-10-18T12:{minute:02d}:00-07:00" for minute in range(10)] + ["2048-10-18T12:00:00-07:00"]
-    path.write_text("timestamp,ghi\n" + "".join(f"{stamp},500\n" for stamp in stamps))
-    start = time.monotonic()
-    with pytest.raises(WeatherError, match=r"decades.csv: the stamps span 2018-10-18 12:00:00-07:00 to 2048-10-18 "
-                                           r".*1-min step: 15,780,960 steps; at most"):
+    start = pd.Timestamp("2018-10-18T12:00:00-07:00")
+    stamps = [start + pd.Timedelta(minutes=minutes * i) for i in range(rows)] + [start + pd.DateOffset(years=30)]
+    path.write_text("timestamp,ghi\n" + "".join(f"{stamp.isoformat()},500\n" for stamp in stamps))
+    began = time.monotonic()
+    with pytest.raises(WeatherError, match=rf"decades.csv: the stamps span 2018-10-18 12:00:00-07:00 to 2048-10-18 "
+                                           rf".* {minutes}-min step: {steps}; at most"):
         read_measured(path, "csv", site=UAT)
-    assert time.monotonic() - start < 10
+    assert time.monotonic() - began < 10
 
 
 # --- a word where a number belongs -----------------------------------------------------------------

@@ -237,11 +237,11 @@ def _grid(frame: pd.DataFrame, label: str, zone, fail):
     phase = (local[0] - first) % step
     days = (local[-1] - first) // _DAY.value + 1
     n = int(days * (_DAY.value // step))
-    if n > MAX_MEASURED_STEPS:
+    if n > MAX_MEASURED_STEPS or (days > 31 and n > 100 * ns.size):  # beyond a limit, or a file 99 % gaps
         span = " to ".join(stamps[i].isoformat(sep=" ") for i in (0, -1))
-        raise fail(f"the stamps span {span}, {_count(int(days), 'day')} at the file's {_minutes(step_td)} step: "
-                   f"{n:,} steps; at most {MAX_MEASURED_STEPS:,} (FOLDOPT_MAX_MEASURED_STEPS raises it); check the "
-                   "stamps' years")
+        raise fail(f"the stamps span {span}, {_count(int(days), 'day')} at the file's {_minutes(step_td)} step: {n:,}"
+                   f" steps for {ns.size:,} rows; at most {MAX_MEASURED_STEPS:,} (FOLDOPT_MAX_MEASURED_STEPS) and 100 "
+                   "a row; check the stamps' years")
     index = pd.DatetimeIndex(first + phase + step * np.arange(n, dtype=np.int64)).tz_localize(zone)
     rows = (local - first - phase) // step
     table = {key: np.full(n, np.nan) for key in frame.columns}
