@@ -72,13 +72,17 @@ def _make(folder: Path, kind: str) -> str:
         with open(folder / "input.csv", "wb") as handle:
             handle.truncate(2_000_000_000)  # sparse: 2.0 GB that take no time to write
         return "input.csv"
+    if kind == "dangling":
+        (folder / "input.csv").symlink_to(folder / "gone.csv")  # the link exists, its file does not
+        return "input.csv"
     return "/dev/zero"  # never ends
 
 
 #: What the message says each kind is.
 KINDS = {"folder": "is a folder, not a file", "FIFO": "is a FIFO, not a regular file",
          "device": "is a character device, not a regular file",
-         "huge": "is 2,000,000,000 bytes (2.0 GB): larger than any"}
+         "huge": "is 2,000,000,000 bytes (2.0 GB): larger than any",
+         "dangling": "is a symbolic link to"}
 
 #: Every file foldopt reads as input, by the command line that names it.
 READERS = {

@@ -71,6 +71,13 @@ def _refuse(info: os.stat_result, path: Path, field: str, limit: int, limit_name
                            f"any {what} foldopt reads, at most {limit:,} bytes (FOLDOPT_{limit_name} raises it)"])
 
 
+def _not_found(path: Path, field: str) -> str:
+    """``file not found``, or the missing target of a symbolic link that exists."""
+    if path.is_symlink():
+        return f"{field}: {path} is a symbolic link to {os.readlink(path)}, which does not exist"
+    return f"{field}: file not found: {path}"
+
+
 def check_input(path: Path | str, field: str, limit: int, limit_name: str, what: str = "input file") -> None:
     """Refuse, before anything reads it, an input file that is missing, no regular file (a folder,
     a device or a FIFO: a device never ends, a FIFO may never start) or larger than ``limit``: for
@@ -97,7 +104,7 @@ def check_input(path: Path | str, field: str, limit: int, limit_name: str, what:
     try:
         info = os.stat(path)
     except FileNotFoundError:
-        raise ConfigError([f"{field}: file not found: {path}"]) from None
+        raise ConfigError([_not_found(path, field)]) from None
     except OSError as error:
         raise ConfigError([f"{field}: cannot read {path}: {error.strerror or error.__class__.__name__}"]) from None
     _refuse(info, path, field, limit, limit_name, what)
@@ -141,7 +148,7 @@ def read_input(path: Path | str, field: str, limit: int, limit_name: str, what: 
             # One that grows while it is read is cut.
             data = handle.read(limit + 1)
     except FileNotFoundError:
-        raise ConfigError([f"{field}: file not found: {path}"]) from None
+        raise ConfigError([_not_found(path, field)]) from None
     except IsADirectoryError:  # Python's file object refuses a folder's descriptor itself
         raise ConfigError([f"{field}: {path} is a folder, not a file; give a file"]) from None
     except OSError as error:
