@@ -197,6 +197,47 @@ def test_a_curve_over_the_days_joins_only_near_days(dates, joined):
         assert bool(stretches) == joined
 
 
+@pytest.mark.parametrize("days,joined", [([172, 355], False), (list(range(1, 366, 7)), True),
+                                         ([15, 22, 29, 196, 300], None)], ids=["solstices", "weekly", "mixed"])
+def test_an_ensembles_line_and_band_join_only_near_days(days, joined):
+    """ensemble_t_solar.png: the median line and the P10-P90 band span only days at most DAY_GAP
+    apart (they crossed the half year between the solstices); a lone day is a marker on its median
+    and a bar from its P10 to its P90. Every day is drawn, at its own values."""
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.colors import to_rgb
+    from matplotlib.figure import Figure
+
+    rng = np.random.default_rng(0)
+    table = pd.DataFrame([{"day_of_year": day, "p_load_w": load, "design": design,
+                           "t_solar_p10_h": low, "t_solar_p50_h": low + 1.0, "t_solar_p90_h": low + 2.5}
+                          for day in days for load in (2.0, 4.0) for design in ("flat", "twofold", "tracker")
+                          for low in rng.uniform(3.0, 9.0, 1)])
+    ax = weather.plot_member_t_solar(table, "t", ax=Figure().subplots())
+    bands = [artist for artist in ax.collections if isinstance(artist, PolyCollection)]
+    assert len(ax.lines) == len(bands) == 2  # flat and twofold
+    for line, band in zip(ax.lines, bands, strict=True):
+        design = line.get_label().split(":")[0]
+        rows = table[(table["design"] == design) & (table["p_load_w"] == 2.0)].set_index("day_of_year")
+        stretches, marked = _segments_and_points(line)
+        on_lines = set(np.concatenate(stretches)) if stretches else set()
+        assert on_lines | marked == set(days) and not on_lines & marked
+        if joined is not None:
+            assert bool(stretches) == joined and bool(marked) != joined
+        for stretch in stretches:
+            assert np.diff(stretch).max() <= sweep.DAY_GAP
+        np.testing.assert_array_equal(line.get_ydata()[np.isfinite(line.get_xdata())], rows["t_solar_p50_h"])
+        polygons = [path.vertices for path in band.get_paths()]
+        assert [sorted(set(vertices[:, 0])) for vertices in polygons] == [list(part) for part in stretches]
+        for vertices in polygons:
+            for x, y in vertices:
+                assert y in (rows.loc[x, "t_solar_p10_h"], rows.loc[x, "t_solar_p90_h"])
+        drawn_bars = {segment[0, 0]: (segment[0, 1], segment[1, 1]) for bars in ax.collections
+                      if isinstance(bars, LineCollection) and to_rgb(bars.get_color()[0]) == to_rgb(line.get_color())
+                      for segment in bars.get_segments()}
+        assert drawn_bars == {day: (rows.loc[day, "t_solar_p10_h"], rows.loc[day, "t_solar_p90_h"])
+                              for day in marked}
+
+
 @pytest.mark.parametrize("dates,blank", [(["2025-06-21", "2025-12-21"], True), ("1:365:7", False)],
                          ids=["solstices", "weekly"])
 def test_a_heat_map_over_the_days_colours_only_near_days(dates, blank):

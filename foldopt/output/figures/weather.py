@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from foldopt.output.figures.canvas import FigureFile, load_label, new_axes
+from foldopt.output.figures.sweep import DAY_GAP, broken_at_gaps
 
 #: Members drawn one by one in the sample day's figure (the rest make the band).
 SHOWN_MEMBERS = 3
@@ -53,7 +54,9 @@ def plot_weather_minutes(sample: dict, title: str, ax=None):
 
 def plot_member_t_solar(table: pd.DataFrame, title: str, ax=None, study=None):
     """Each day's t_solar over a cloud ensemble's members: P10 to P90 and the median, for the
-    flat and the twofold panel, at the first load.
+    flat and the twofold panel, at the first load; line and band join only days at most
+    :data:`~foldopt.output.figures.sweep.DAY_GAP` apart, and a day with none so near is a marker
+    and a bar (:func:`~foldopt.output.figures.sweep.broken_at_gaps`).
 
     Parameters
     ----------
@@ -72,9 +75,13 @@ def plot_member_t_solar(table: pd.DataFrame, title: str, ax=None, study=None):
     load = sorted(table["p_load_w"].unique())[0]
     for design, colour in (("flat", "0.35"), ("twofold", "tab:blue")):
         rows = table[(table["design"] == design) & (table["p_load_w"] == load)].sort_values("day_of_year")
-        days = rows["day_of_year"].to_numpy()
-        ax.fill_between(days, rows["t_solar_p10_h"], rows["t_solar_p90_h"], color=colour, alpha=0.25, lw=0)
-        ax.plot(days, rows["t_solar_p50_h"], color=colour, lw=1, marker="." if len(days) < 40 else None,
+        # Line and band stop where nothing was evaluated between two days (solstices, months).
+        (days, p10, alone), (_, p50, _), (_, p90, _) = (
+            broken_at_gaps(rows["day_of_year"], rows[column], DAY_GAP)
+            for column in ("t_solar_p10_h", "t_solar_p50_h", "t_solar_p90_h"))
+        ax.fill_between(days, p10, p90, where=~alone, color=colour, alpha=0.25, lw=0)
+        ax.vlines(days[alone], p10[alone], p90[alone], color=colour, alpha=0.25, lw=4)  # a lone day's band
+        ax.plot(days, p50, color=colour, lw=1, marker="o" if alone.any() else None, ms=4, markevery=alone.tolist(),
                 label=f"{design}: median, P10-P90 band")
     ax.set_xlabel("day of year")
     ax.set_ylabel(f"daily t_solar [h]\n{load_label(study, load)}", fontsize=8)
