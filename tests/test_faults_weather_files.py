@@ -307,7 +307,9 @@ def test_a_station_file_read_as_tmy3_names_its_likely_format(here, name, fmt):
     assert sniff_format(MEASURED / name) == fmt
     (here / "station.csv").write_bytes((MEASURED / name).read_bytes())  # .csv: read as TMY3 by its extension
     refused(here, ["sweep", "angle", "--weather", "station.csv"], "--weather station.csv",
-            f"looks like a {fmt} file: give --weather-format {fmt}")
+            "read as tmy3 (by its extension .csv)", f"looks like a {fmt} file: give --weather-format {fmt}")
+    refused(here, ["sweep", "angle", "--weather", MEASURED / name], f"--weather {name}",
+            "(by its extension .csv)" if name.endswith(".csv") else "(no format given)", f"looks like a {fmt} file")
 
 
 def test_the_hourly_formats_are_told_by_their_content():

@@ -67,7 +67,9 @@ def _format_hint(files, path: str, fmt: str | None, given) -> str:
     seen = files.sniff_format(path)
     if seen is None or seen == used:
         return ""
-    return f"; read as {used} (by its extension), it looks like a {seen} file: give --weather-format {seen} " \
+    suffix = Path(path).suffix.lower()
+    why = f"by its extension {suffix}" if suffix in files.FORMATS[used].suffixes else "no format given"
+    return f"; read as {used} ({why}), it looks like a {seen} file: give --weather-format {seen} " \
            f"(weather.format: {seen} in a study)"
 
 
