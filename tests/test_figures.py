@@ -290,3 +290,27 @@ def test_a_day_hour_map_draws_each_day_in_its_own_column_and_no_day_between(step
         column = np.searchsorted(x_edges, day) - 1
         assert x_edges[column] < day < x_edges[column + 1]
         np.testing.assert_array_equal(drawn[:, column], power[index])
+
+
+@pytest.mark.parametrize("circuit,connection,wired", [
+    ({"coupling": "direct", "load_voltage": 5.0}, "parallel", "not the load wired directly at 5 V"),
+    ({}, "parallel", None), ({}, "independent", None)], ids=["direct", "mppt", "independent-study"])
+def test_the_independent_curve_says_it_runs_through_a_converter_per_sub_panel(circuit, connection, wired):
+    """t_solar_vs_fold_angle.png and power_curves.png: the independent connection's curve is named
+    with its converter per sub-panel, and with a load wired directly says it is not so wired (as the
+    answer's note on twofold-independent does); no other connection's is."""
+    from matplotlib.figure import Figure
+
+    study = foldopt.default_study().variant(mode="exact", pv_model="single-diode", sky="ineichen", p_load=3.0,
+                                            fold_angles={"start": 30, "stop": 180, "step": 30},
+                                            connection=connection, circuit=circuit)
+    result = foldopt.run(study)
+    labels = [text.get_text() for plot in (day.plot_t_solar_vs_fold_angle, day.plot_power_curves)
+              for text in plot(result, ax=Figure().subplots()).get_legend().get_texts()]
+    independent = [label for label in labels if "independent" in label]
+    assert len(independent) == 1 + (connection == "independent")  # the sweep's curve, and the day's
+    for label in independent:
+        assert "with a converter per sub-panel" in label
+        assert ("not the load wired directly" in label) == (wired is not None)
+        assert wired is None or wired in label
+    assert not any("converter" in label for label in labels if label not in independent)

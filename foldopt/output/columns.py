@@ -46,10 +46,13 @@ COLUMNS = (
     ("surface_azimuth", "deg", "the panel's base azimuth, clockwise from north (foldopt optimize)"),
     ("t_solar_h", "h", "solar-powered time of the day: P_pv >= P_load"),
     ("t_solar_contiguous_h", "h", "the longest contiguous solar-powered interval"),
-    ("t_solar_{connection}_h", "h", "t_solar of one connection at each fold angle (sweep.csv)"),
+    ("t_solar_{connection}_h", "h", "t_solar of one connection at each fold angle (sweep.csv); independent's "
+                                    "runs through a converter per sub-panel, even where the load is wired "
+                                    "directly (circuit.coupling direct)"),
     ("t_solar_{design}_h", "h", "t_solar of one design as the tracker's standby grows (tracker_standby.csv)"),
     ("energy_harvested_wh", "Wh", "energy at the maximum power point over the day (or the period)"),
-    ("energy_harvested_{connection}_wh", "Wh", "energy of one connection at each fold angle (sweep.csv)"),
+    ("energy_harvested_{connection}_wh", "Wh", "energy of one connection at each fold angle (sweep.csv); "
+                                               "independent's through a converter per sub-panel, as its t_solar"),
     ("energy_harvested_{design}_wh", "Wh", "energy of one design over the period (maps)"),
     ("energy_served_wh", "Wh", "energy the load draws while solar-powered"),
     ("energy_wasted_wh", "Wh", "harvested but not served; never negative (a tracker whose drive costs more than it "

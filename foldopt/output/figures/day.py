@@ -23,6 +23,14 @@ def _mode_label(study: Study) -> str:
     return f"{study.mode} mode, {study.geometry} geometry, {study.date}"
 
 
+def _connection_label(study: Study, connection: str) -> str:
+    """A connection's name in a legend; independent's says it runs through a converter per
+    sub-panel (and, with a load wired directly, that it is not wired so: Circuit.ignored_by)."""
+    if connection != "independent":
+        return connection
+    return f"{connection}, {study.circuit.ignored_by(connection) or 'with a converter per sub-panel'}"
+
+
 def _draw_load(ax, hours, series, study) -> None:
     """The load: a line at P_load, or a load profile's P_load(t) as its curve, labelled as a load."""
     from foldopt.inputs.loads import load_text
@@ -59,7 +67,7 @@ def plot_power_curves(result: StudyResult, ax=None):
         series["p_twofold_w"],
         color="tab:blue",
         lw=2,
-        label=f"twofold {result.optimal_fold_angle:.1f}° ({study.connection})",
+        label=f"twofold {result.optimal_fold_angle:.1f}° ({_connection_label(study, study.connection)})",
     )
     _draw_load(ax, hours, series, study)
     if daylight.any():
@@ -133,12 +141,13 @@ def plot_t_solar_vs_fold_angle(result: StudyResult, ax=None):
     summary = result.summary.set_index("design")
     fig, ax = new_axes(ax, (7, 4.5))
     ax.plot(result.sweep["fold_angle_deg"], result.sweep["t_solar_h"], color="tab:blue",
-            label=f"twofold ({result.study.connection})")
+            label=f"twofold ({_connection_label(result.study, result.study.connection)})")
     if result.study.pv_model != "ideal":
         for name in ("parallel", "series", "independent"):
             if name != result.study.connection:
                 ax.plot(result.sweep["fold_angle_deg"], result.sweep[f"t_solar_{name}_h"], lw=1, ls="--",
-                        color=STATE_COLOURS.get(name, "tab:gray"), label=f"twofold ({name})")
+                        color=STATE_COLOURS.get(name, "tab:gray"),
+                        label=f"twofold ({_connection_label(result.study, name)})")
     ax.axhline(summary.loc["flat", "t_solar_h"], color="k", ls="--", label="flat")
     ax.axhline(summary.loc["tracker", "t_solar_h"], color="0.5", ls=":", label="ideal tracker")
     ax.axvline(
