@@ -128,6 +128,8 @@ _SEVERAL = {"--lat": ["0,10"], "--lon": ["0,10"], "--days": ["2025-03-20,2025-06
 _OWN = {("sweep", "latitude"): ["--lat", "0,10"], ("sweep", "day"): ["--days", "2025-03-20,2025-06-21"],
         ("sweep", "load"): ["--p-load", "1,2"], ("sweep", "angle"): ["--days", "2025-03-20"],
         ("optimize",): ["--days", "2025-03-20,2025-06-21", "--vary", "fold_angle"]}
+#: How help says that an option takes several values.
+_SAYS_SEVERAL = re.compile(r"a range\b.*\bor a list")
 #: What a condition in an option's help (``with --objective``) takes to hold.
 _CONDITIONS = {"--objective": ["--objective", "mean"]}
 
@@ -148,7 +150,7 @@ def test_an_option_takes_a_list_exactly_where_its_help_says_so(path, tmp_path, m
     checked = []
     for option, values in _SEVERAL.items():
         text = help_text(command, option)
-        several = re.search(r"a range .* or a list", text) is not None
+        several = _SAYS_SEVERAL.search(text) is not None
         own = [] if option in _OWN[path] or (option == "--p-load-scale" and "--p-load" in _OWN[path]) else _OWN[path]
         condition = [arg for name, args in _CONDITIONS.items() if f"with {name}" in text for arg in args]
         result = invoke(*path, option, *values, *own, *condition, "--step-min", 60, "--angle-step", 30,
@@ -160,6 +162,29 @@ def test_an_option_takes_a_list_exactly_where_its_help_says_so(path, tmp_path, m
             assert result.exit_code == 2 and result.stderr.startswith("error: "), (option, result.stdout)
         checked.append(several)
     assert any(checked)
+
+
+class _Reached(Exception):
+    """Raised by a stand-in for the map's run: the command accepted its options."""
+
+
+def test_the_maps_options_take_a_list_exactly_where_their_help_says_so(monkeypatch):
+    """As for the sweeps, with the map's run (a Dask cluster) replaced by one that ends the command
+    where the work would start: the options were accepted once it is reached (exit 1, an internal
+    error naming it), refused with exit 2."""
+    import foldopt.api
+
+    def reached(*args, **kwargs):
+        raise _Reached()
+
+    monkeypatch.setattr(foldopt.api, "world_map", reached)
+    command = LEAVES[("map",)]
+    lists = {"--lat": "0,10", "--lon": "0,10", "--p-load": "1,2", "--p-load-fraction": "0.2,0.4"}
+    for option, value in lists.items():
+        result = invoke("map", option, value, "--quiet")
+        several = _SAYS_SEVERAL.search(help_text(command, option)) is not None
+        assert (result.exit_code, "_Reached" in result.stderr) == ((1, True) if several else (2, False)), (
+            option, result.stderr)
 
 
 def test_help_names_no_other_command():

@@ -24,7 +24,8 @@ _OPTION_OF_PARAMETER = {"latitudes": "--lat", "longitudes": "--lon", "land_only"
 def map_(
     lat: Optional[str] = typer.Option(None, "--lat", help="Latitudes [deg north]: a range start:stop:step or a "
                                       "list [default: -60:60:10]."),
-    lon: Optional[str] = typer.Option(None, "--lon", help="Longitudes [deg east] [default: -180:180:30]."),
+    lon: Optional[str] = typer.Option(None, "--lon", help="Longitudes [deg east]: a range or a list "
+                                      "[default: -180:180:30]."),
     land_only: bool = typer.Option(False, "--land-only", help="Keep only the grid points on land."),
     sites: Optional[Path] = typer.Option(None, "--sites", help="CSV of named sites: name, latitude, longitude "
                                          "[, altitude, timezone], instead of a grid."),
@@ -33,7 +34,8 @@ def map_(
     p_load: Optional[str] = typer.Option(None, "--p-load", help="Loads [W]: a value, a range or a list [default: the "
                                          "study's]."),
     p_load_fraction: Optional[str] = typer.Option(None, "--p-load-fraction", help="Loads as fractions of each "
-                                                  "site's flat peak, e.g. 0.1:0.9:0.1, instead of --p-load."),
+                                                  "site's flat peak: a value, a range such as 0.1:0.9:0.1 or a list, "
+                                                  "instead of --p-load."),
     area: Optional[float] = AREA,
     efficiency: Optional[float] = EFFICIENCY,
     objective: str = typer.Option("mean", "--objective", help="What each period's fold angle maximises: mean | min | "
