@@ -183,8 +183,10 @@ class Optimize(StrictModel):
         return self.range_of(name, defaults[name])
 
     def size_problem(self, fold_angles) -> str | None:
-        """Why the search's grid is too large to search (:data:`MAX_DESIGNS`), naming the largest
-        varied variable's setting.
+        """Why the search's grid is too large to search, naming the largest varied variable's
+        setting: more designs than :data:`MAX_DESIGNS`, or one variable with more values than
+        ``FOLDOPT_MAX_AXIS_VALUES`` (each variable's near-optimal region is evaluated along its
+        whole grid).
 
         Parameters
         ----------
@@ -194,19 +196,25 @@ class Optimize(StrictModel):
         Returns
         -------
         str or None
-            ``field = value: problem``, or None for a grid within the limit.
+            ``field = value: problem``, or None for a grid within the limits.
         """
+        from foldopt.inputs.plan import MAX_AXIS_VALUES  # here: the plan's module imports the study's, and this
+
         counts = {name: grid_points(*self.searched_range(name, fold_angles)) for name in self.vary}
         designs = math.prod(counts.values())
-        if designs <= MAX_DESIGNS:
-            return None
         largest = max(counts, key=counts.get)
         bounds = getattr(self, largest)
         setting = (f"optimize.{largest} = {bounds.describe()}" if bounds is not None
                    else f"fold_angles.step = {fold_angles.step:g}")  # only the fold angle's default grid varies
         nouns = {"fold_angle": "fold angles", "tilt": "tilts", "azimuth": "azimuths"}
-        return (f"{setting}: {' x '.join(f'{counts[name]:,} {nouns[name]}' for name in counts)} = {designs:.2g} "
-                f"designs to search; the limit is {MAX_DESIGNS:,} (a coarser step, or FOLDOPT_MAX_DESIGNS)")
+        if counts[largest] > MAX_AXIS_VALUES:
+            return (f"{setting}: {counts[largest]:,} {nouns[largest]}; the limit is {MAX_AXIS_VALUES:,} values a "
+                    f"range (a coarser step, or FOLDOPT_MAX_AXIS_VALUES)")
+        if designs > MAX_DESIGNS:
+            return (f"{setting}: {' x '.join(f'{counts[name]:,} {nouns[name]}' for name in counts)} = "
+                    f"{designs:.2g} designs to search; the limit is {MAX_DESIGNS:,} (a coarser step, or "
+                    f"FOLDOPT_MAX_DESIGNS)")
+        return None
 
     def idle_settings(self) -> list[str]:
         """``optimize.name = ...: why`` for the bounds of a variable that does not vary."""

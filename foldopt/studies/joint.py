@@ -14,9 +14,10 @@ What each variable adds is the objective gained as the variables join the search
 :data:`foldopt.names.OPTIMIZE_VARIABLES`: the fold angle alone at the default mounting, then with
 the tilt, then with the azimuth. The near-optimal region of each variable is every value at which
 some evaluated design comes within the study's near-optimal tolerance of the optimum
-(:func:`foldopt.studies.objectives.near_optimal` on the profile, the best over the other variables);
-its edges are as fine as the search refined there. The landscape is the objective over tilt x
-fold angle at the optimum's azimuth, on a grid of its own.
+(:func:`foldopt.studies.objectives.near_optimal` on the profile, the best over the other variables):
+the designs the search evaluated and the variable's whole grid with the others at the optimum,
+so its edges are on the grid and never narrower than at the optimum's own mounting. The landscape
+is the objective over tilt x fold angle at the optimum's azimuth, on a grid of its own.
 """
 
 from __future__ import annotations
@@ -175,7 +176,7 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     flat = grid_search(objective(True), list(flat_axes.values()), spec.tolerance_h, quantum,
                        seeds=[[180.0, study.panel.tilt, study.panel.azimuth]])
     table = _table(study, loads, twofold, flat, days_of.angles, best_default, default)
-    near = _near_optimal(study, loads, twofold)
+    near = _near_optimal(study, loads, twofold, objective(False))
     added = _added(study, loads, steps, default["flat-default"])
     landscape = _landscape(parts, study, all_axes, twofold.best_point[0], loads[:1], months, statistic, season,
                            engine)
@@ -201,22 +202,32 @@ def _table(study, loads, twofold, flat, angles, best_default, default) -> pd.Dat
     return pd.DataFrame(rows)
 
 
-def _near_optimal(study, loads, search: SearchResult) -> pd.DataFrame:
-    """Per load and varied variable, the range of values within the near-optimal tolerance."""
+def _near_optimal(study, loads, search: SearchResult, evaluate) -> pd.DataFrame:
+    """Per load and varied variable, the range of values within the near-optimal tolerance, on the
+    profile of the best design evaluated at each value: every design the search evaluated, and the
+    variable's whole grid with the others at the load's optimum. The search alone refines only where
+    the optimum may be: its sparse profile, interpolated, gave a fold angle of 29 to 31 deg where the
+    optimum's own azimuth and tilt keep 29 to 60 deg near-optimal."""
     rows = []
     points, values = search.points, search.values
-    for axis_index, axis in enumerate(search.axes):
-        if axis.size == 1:
-            continue
+    varied = [index for index, axis in enumerate(search.axes) if axis.size > 1]
+    through = []  # per load and varied variable, the optimum's line along it
+    for target in range(loads.size):
+        for axis_index in varied:
+            line = np.repeat(search.best_point[target][None], search.axes[axis_index].size, axis=0)
+            line[:, axis_index] = search.axes[axis_index].values()
+            through.append(line)
+    on_lines = evaluate(np.vstack(through)) if through else None
+    offsets = np.cumsum([0] + [line.shape[0] for line in through])
+    for order, axis_index in enumerate(varied):
+        axis = search.axes[axis_index]
         grid = axis.values()
         profile = np.full((loads.size, grid.size), -np.inf)
         position = np.searchsorted(grid, points[:, axis_index] - 1e-9)
         for target in range(loads.size):
             np.maximum.at(profile[target], position, values[:, target])
-        # Values the search never evaluated (between a refined cell and a dropped one) read the nearer
-        # evaluated neighbours' profile, linearly.
-        seen = np.isfinite(profile[0])
-        profile = np.stack([np.interp(grid, grid[seen], row[seen]) for row in profile])
+            line = target * len(varied) + order
+            profile[target] = np.maximum(profile[target], on_lines[offsets[line]:offsets[line + 1], target])
         ranges = near_optimal(grid, profile, study.near_optimal)
         for index, load in enumerate(loads):
             rows.append({"p_load_w": load, "variable": axis.name,
