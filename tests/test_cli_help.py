@@ -5,6 +5,7 @@ names the folder each command writes, and ``--set`` works where the docs say it 
 
 import json
 import re
+from pathlib import Path
 
 import pytest
 import typer.main
@@ -86,6 +87,9 @@ def test_an_unknown_option_is_one_line_that_suggests_only_what_is_close(path, ar
 
 #: What the option choices are validated against needs: a range of days for an objective.
 _CONTEXT = ["--days", "2025-03-20,2025-06-21"]
+#: What an option needs beside it to be read at all.
+_NEEDS = {"--weather-format": ["--weather", Path(__file__).resolve().parent.parent / "configs" / "weather"
+                               / "723170TYA.CSV"]}
 
 
 def _choices(text: str) -> list[str]:
@@ -114,7 +118,8 @@ def test_every_choice_of_every_option_is_suggested_for_its_misspelling(tmp_path,
             context = _CONTEXT if any("--days" in other.opts for other in command.params) else []
             for name in _choices(text):
                 count += 1
-                line = refusal(capsys, *path, param.opts[0], typo(name), *context, "--out", tmp_path / "never")
+                line = refusal(capsys, *path, param.opts[0], typo(name), *context, *_NEEDS.get(param.opts[0], ()),
+                               "--out", tmp_path / "never")
                 if not re.search(rf"did you mean [^\n]*'{re.escape(name)}'", line):
                     missed.append(f"{' '.join(path)} {param.opts[0]} {typo(name)}: {line}")
     assert count > 60
