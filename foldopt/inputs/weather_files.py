@@ -110,7 +110,8 @@ def _varied_site(site) -> str | None:
     for key in ("latitude", "longitude", "altitude"):
         value = site.get(key) if isinstance(site, dict) else None
         if isinstance(value, (list, str)):
-            return f"site.{key} = {value!r}"
+            text = repr(value)
+            return f"site.{key} = {text if len(text) <= 40 else text[:37] + '...'}"
     return None
 
 
@@ -172,13 +173,22 @@ def weather_defaults(data: dict) -> dict:
     ------
     foldopt.errors.ConfigError
         For a ``weather.format`` (or a measured file's reading option) that is not one value, such
-        as a list: the file's days and step follow from it, so it is not swept.
+        as a list: the file's days and step follow from it, so it is not swept. For a site that
+        varies (a sweep axis) with a file of one site, unless ``force_site``; for a measured file
+        whose days cannot be known (it cannot be read, or every day is left out).
     """
     weather = data.get("weather")
     spec = {"path": weather} if isinstance(weather, str) else weather if isinstance(weather, dict) else {}
     problem = _options_problem(spec, ("format",))
     if problem is not None:
         raise ConfigError([problem])
+    varied = _varied_site(data.get("site"))
+    if varied is not None and not data.get("force_site"):
+        own = weather_read(weather).get("weather_site")  # None for a file that holds no site
+        if own is not None:
+            raise ConfigError([f"{varied}: varies, but a weather file is of one site, {own['name'] or 'its own'} "
+                               f"({own['latitude']:g}, {own['longitude']:g}); leave the site to the file, or set "
+                               "force_site (--force-site) to give each site the file's weather"])
     try:
         fmt = canonical(spec.get("format"), WEATHER_FORMATS)
     except ValueError:
