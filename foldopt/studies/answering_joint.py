@@ -55,6 +55,10 @@ def of_optimize(result) -> Answer:
     joined = varied[0] if len(varied) == 1 else f"{', '.join(varied[:-1])} and {varied[-1]}"
     lines = [f"{study.name}: the best {joined}{' together' if len(varied) > 1 else ''}, maximising the {objective} "
              f"over {over}"]
+    fixed_fold = "fold_angle" not in spec.vary
+    if fixed_fold and len(result.loads) > 1:
+        lines.append(f"  the fold angle stays at {result.twofold.best_point[0][0]:g} deg for every load, the first "
+                     f"load's best at the default mounting (--vary fold_angle searches it)")
     per_load = []
     for load in result.loads:
         best, flat = _row(table, load, "twofold"), _row(table, load, "flat")
@@ -78,8 +82,12 @@ def of_optimize(result) -> Answer:
                     f"{_LABELS[row.variable][0]} {row.near_optimal_lo_deg:g} to {row.near_optimal_hi_deg:g} deg "
                     f"(recommended {row.recommended_deg:g})" for row in near.itertuples())
                     + f", each within {near['near_optimal_tolerance_h'].iloc[0] * 60:.1f} min")
+            # What the variables add starts from the default mounting folded as the search holds it.
+            first = added.iloc[0]
+            folded = ((best.fold_angle_deg, first.objective_h - first.added_h) if fixed_fold
+                      else (default.fold_angle_deg, default.objective_h))
             lines.append(f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} "
-                         f"h, folded to {default.fold_angle_deg:g} deg {default.objective_h:.2f} h): "
+                         f"h, folded to {folded[0]:g} deg {folded[1]:.2f} h): "
                          + ", ".join(f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
                                      for row in added.itertuples()))  # + 0.0: no "-0.0" for a roundoff
         per_load.append({"p_load_w": load, "carried": bool(carried), "fold_angle_deg": best.fold_angle_deg,

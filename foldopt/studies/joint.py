@@ -177,7 +177,10 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
                        seeds=[[180.0, study.panel.tilt, study.panel.azimuth]])
     table = _table(study, loads, twofold, flat, days_of.angles, best_default, default)
     near = _near_optimal(study, loads, twofold, objective(False))
-    added = _added(study, loads, steps, default["flat-default"])
+    # What the first variable adds is over the default mounting as it stands: flat where the fold
+    # angle joins the search, else folded to the fixed angle (the tilt alone took the fold's gain).
+    start = default["flat-default"] if "fold_angle" in vary else default["twofold-default"][:, best_default[0]]
+    added = _added(study, loads, steps, start)
     landscape = _landscape(parts, study, all_axes, twofold.best_point[0], loads[:1], months, statistic, season,
                            engine)
     return OptimizeResult(study, dates, loads, statistic, twofold, flat, tuple(steps), table, near, added, landscape,
@@ -238,10 +241,10 @@ def _near_optimal(study, loads, search: SearchResult, evaluate) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _added(study, loads, steps, flat_default) -> pd.DataFrame:
-    """What each variable adds as it joins the search: the fold angle over the flat panel at the
-    default mounting, then the tilt, then the azimuth [h]."""
-    rows, before = [], np.asarray(flat_default, dtype=float)
+def _added(study, loads, steps, start) -> pd.DataFrame:
+    """What each variable adds as it joins the search, over ``start`` (per load, the default
+    mounting's objective before any joins): the fold angle, then the tilt, then the azimuth [h]."""
+    rows, before = [], np.asarray(start, dtype=float)
     for name, search in steps:
         value = search.best_value
         for index, load in enumerate(loads):
