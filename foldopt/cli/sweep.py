@@ -124,7 +124,7 @@ _SEVERAL = {
 #: The options each command lets take several values, and on what condition (the rules are the
 #: library's: :func:`foldopt.studies.request.plan_request` for ``sweep angle``,
 #: :func:`foldopt.studies.joint.optimize_plan` for ``optimize``; every other sweep varies any).
-VARYING = {
+_VARYING = {
     "angle": {"days": "with --objective or --weather"},
     "latitude": dict.fromkeys(_SEVERAL, ""), "day": dict.fromkeys(_SEVERAL, ""), "load": dict.fromkeys(_SEVERAL, ""),
     "optimize": {"days": "", "p_load": "", "p_load_scale": ""},
@@ -133,7 +133,7 @@ VARYING = {
 
 def signature(command: str, out: str) -> inspect.Signature:
     """:func:`sweep_options`' signature as one command takes it: the options that command lets take
-    several values say so (:data:`VARYING`), the others take one, and ``--out`` names its default.
+    several values say so (:data:`_VARYING`), the others take one, and ``--out`` names its default.
 
     Parameters
     ----------
@@ -149,8 +149,8 @@ def signature(command: str, out: str) -> inspect.Signature:
     parameters = []
     for parameter in inspect.signature(sweep_options).parameters.values():
         option = copy.copy(parameter.default)
-        if parameter.name in VARYING[command]:
-            condition, values = VARYING[command][parameter.name], _SEVERAL[parameter.name]
+        if parameter.name in _VARYING[command]:
+            condition, values = _VARYING[command][parameter.name], _SEVERAL[parameter.name]
             several = f"; {condition}, also {values}" if condition else f", or {values}"
             head, bracket, tail = option.help.partition(" [default")
             option.help = head.rstrip(".") + several + (bracket + tail if bracket else ".")
