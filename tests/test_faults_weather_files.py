@@ -138,6 +138,14 @@ def test_a_cloud_ensemble_over_one_day_runs_its_members(here):
     assert (here / "out" / "results.csv").is_file()
 
 
+def test_a_study_file_of_a_cloud_ensemble_over_one_day_runs_its_members(here):
+    study = {**FAST, "date": "2025-06-21", "objective": "mean", "weather": {"path": str(TMY3), "members": 2}}
+    (here / "study.yaml").write_text(yaml.safe_dump(study))
+    result = runner.invoke(app, ["run", "study.yaml", "--out", "out"])
+    assert result.exit_code == 0, result.output
+    assert "over 2 cloud members" in result.stdout
+
+
 # --- one value where one is expected ---------------------------------------------------------------
 
 
