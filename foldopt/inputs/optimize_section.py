@@ -13,7 +13,7 @@ from pydantic import Field, field_validator, model_validator
 
 from foldopt import names
 from foldopt.inputs.fields import StrictModel, interval
-from foldopt.inputs.reading import size_limit
+from foldopt.inputs.reading import MAX_AXIS_VALUES, size_limit
 from foldopt.names import canonical
 
 #: Each variable's bounds where a study gives none: the fold angle the study's own grid; the tilt
@@ -198,8 +198,6 @@ class Optimize(StrictModel):
         str or None
             ``field = value: problem``, or None for a grid within the limits.
         """
-        from foldopt.inputs.plan import MAX_AXIS_VALUES  # here: the plan's module imports the study's, and this
-
         counts = {name: grid_points(*self.searched_range(name, fold_angles)) for name in self.vary}
         designs = math.prod(counts.values())
         largest = max(counts, key=counts.get)

@@ -22,7 +22,7 @@ from pydantic import ValidationError
 from foldopt.errors import ConfigError
 from foldopt.inputs.fields import list_depth, list_valued_fields
 from foldopt.inputs.load import read_study, resolve_files
-from foldopt.inputs.reading import size_limit
+from foldopt.inputs.reading import MAX_AXIS_VALUES, size_limit
 from foldopt.inputs.weather_files import weather_defaults
 from foldopt.inputs.policy import set_path
 from foldopt.inputs.study import Study, format_error
@@ -32,8 +32,6 @@ DATE_KEYWORDS = ("year", "equinoxes-solstices")
 UNSWEPT = ("name", "description")
 _LIST_VALUED = list_valued_fields(Study)
 
-#: Values of one sweep axis (a range or a list).
-MAX_AXIS_VALUES = size_limit("MAX_AXIS_VALUES", 10_000)
 #: Cases of a plan: one row of results.csv per case and design.
 MAX_CASES = size_limit("MAX_CASES", 200_000)
 #: Site-days x fold angles x time steps of a plan: about 6 ns each on one core (README,

@@ -40,6 +40,8 @@ MAX_CSV_BYTES = size_limit("MAX_CSV_BYTES", 20_000_000)
 #: Bytes of a weather file: a TMY3 or EPW year is under 2 MB, a year of 1-min steps in the generic
 #: CSV about 40 MB, a BSRN station-to-archive month 10 MB.
 MAX_WEATHER_BYTES = size_limit("MAX_WEATHER_BYTES", 100_000_000)
+#: Values of one sweep axis (a range or a list), or of one searched range of foldopt optimize.
+MAX_AXIS_VALUES = size_limit("MAX_AXIS_VALUES", 10_000)
 #: Steps a measured weather file's days may lay out: two years of 1-min steps. Stamps years apart
 #: at a short step (a slip in a year) would otherwise mean a grid of millions of steps.
 MAX_MEASURED_STEPS = size_limit("MAX_MEASURED_STEPS", 2 * 366 * 1440)
