@@ -332,3 +332,10 @@ def test_the_hourly_formats_are_told_by_their_content():
 def test_a_latitude_sweep_over_a_weather_file_of_one_site_is_one_line(here, weather):
     refused(here, ["sweep", "latitude", "--weather", *weather], "--lat = '-60:60:5': varies",
             "a weather file is of one site", "--force-site")
+
+
+@pytest.mark.parametrize("option", ["--weather", "--horizon", "--load-profile"])
+def test_a_file_name_with_terminal_escapes_is_printed_escaped(here, option):
+    line = refused(here, ["sweep", "angle", option, "red\x1b[31m\x07.csv", "--step-min", "60"],
+                   option, "red\\x1b[31m\\x07.csv")
+    assert not re.search(r"[\x00-\x08\x0b-\x1f\x7f]", line), line
