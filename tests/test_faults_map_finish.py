@@ -161,3 +161,12 @@ def test_a_study_files_axis_given_twice_is_one_line():
     with pytest.raises(ConfigError) as raised:
         make_plan({**yaml.safe_load(default_study_path().read_text()), "p_load": [2, 3, 2]})
     assert raised.value.errors == ["p_load: 2 is given twice (values 1 and 3); give each value once"]
+
+
+def test_a_misspelt_objective_is_named_beside_the_missing_dates(tmp_path, monkeypatch):
+    # The "several dates" fault once hid the objective's own: the newcomer saw no "did you mean".
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["sweep", "angle", "--objective", "worst-mnth", "--out", "out"])
+    assert result.exit_code == 2
+    assert "did you mean 'worst-month'?" in result.output and "needs several dates" in result.output
+    assert list(tmp_path.iterdir()) == []

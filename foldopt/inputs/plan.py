@@ -407,8 +407,9 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     weather = data.get("weather")
     ensemble = isinstance(weather, dict) and weather.get("members") is not None
     if data.get("objective") is not None and "date" not in dict(axes) and not ensemble:
-        raise ConfigError([_at(lines, ("objective",), "objective: one fold angle for several days needs several "
-                                                      "dates (a date range, 'year', or a weather file)")])
+        # Said beside the objective's own faults (a misspelt statistic), not instead of them.
+        errors.append(_at(lines, ("objective",), "objective: one fold angle for several days needs several "
+                                                 "dates (a date range, 'year', or a weather file)"))
     if plan.n_cases > MAX_CASES:
         raise ConfigError([f"sweep: {plan.n_cases:,} cases; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
     first = {path: values[0] for path, values in axes}
