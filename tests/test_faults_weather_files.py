@@ -226,13 +226,16 @@ def test_a_word_in_an_irradiance_cell_is_refused_by_every_reader(tmp_path, name,
 SITE_OPTIONS = ["--lat", "32.22969", "--lon", "-110.95534", "--altitude", "786"]
 
 
-def _day_without_noon(folder: Path, how: str) -> Path:
-    """``five_minute.csv`` with its 10:00-13:00 stamps made unusable: ``negative`` irradiance,
-    ``absurd`` irradiance (beyond any sun) or ``gone`` (a 3-hour gap)."""
+def _day_without_noon(folder: Path, how: str, days: int = 1) -> Path:
+    """``five_minute.csv`` (of ``days`` days, the first repeated) with its 10:00-13:00 stamps made
+    unusable: ``negative`` irradiance, ``absurd`` irradiance (beyond any sun) or ``gone`` (a 3-hour
+    gap)."""
     lines = (MEASURED / "five_minute.csv").read_text().splitlines(True)
+    rows = [line for line in lines if line.startswith("2018-")]
+    lines += [line.replace("2018-10-18T", f"2018-10-{18 + day}T") for day in range(1, days) for line in rows]
     kept = []
     for line in lines:
-        noon = re.match(r"2018-10-18T1[0-2]:", line)
+        noon = re.match(r"2018-10-\d\dT1[0-2]:", line)
         if noon and how == "gone":
             continue
         if noon:
@@ -254,6 +257,13 @@ def test_a_measured_file_whose_only_day_is_left_out_says_which_and_why(here, how
                    f"--weather {path.name}: its only day, 2018-10-18, is left out", "daylight gap of 180 min",
                    "max_gap_min = 60 min", found)
     assert "empty list" not in line and "--days" not in line
+
+
+def test_a_measured_file_whose_every_day_is_left_out_says_so(here):
+    path = _day_without_noon(here, "gone", days=2)
+    refused(here, ["sweep", "angle", "--weather", path.name, "--weather-format", "csv", *SITE_OPTIONS],
+            "all 2 of its days are left out; the first, 2018-10-18, has a daylight gap of 180 min",
+            "max_gap_min = 60 min")
 
 
 @pytest.mark.parametrize("fmt,label", [("surfrad", "SURFRAD"), ("bsrn", "BSRN"), ("solrad", "SOLRAD"),

@@ -99,7 +99,8 @@ def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
     read = {"weather_site": measured.site, "weather_step_min": measured.step.total_seconds() / 60.0,
             "weather_dates": dates}
     if not dates:
-        read["weather_problem"] = _every_day_left_out(measured, days, float(spec.get("max_gap_min") or 60.0))
+        given_gap = spec.get("max_gap_min")
+        read["weather_problem"] = _every_day_left_out(measured, days, 60.0 if given_gap is None else float(given_gap))
     return read
 
 
@@ -110,24 +111,30 @@ def _varied_site(site) -> str | None:
     for key in ("latitude", "longitude", "altitude"):
         value = site.get(key) if isinstance(site, dict) else None
         if isinstance(value, (list, str)):
-            text = repr(value)
-            return f"site.{key} = {text if len(text) <= 40 else text[:37] + '...'}"
+            return f"site.{key} = {_shown(value)}"
     return None
 
 
 def _every_day_left_out(measured, days, max_gap_min: float) -> str:
     """Why a measured file has no day a study can use: each of its days has a daylight gap longer
-    than ``max_gap_min``, and what reading made missing."""
+    than ``max_gap_min``; the first's, and what reading made missing."""
     name = measured.frame.attrs.get("weather", "")
     first = days[0].date()
     gaps = [gap for gap in measured.gaps if gap[0].date() == first and gap[2] > max_gap_min]
     longest = max(gaps, key=lambda gap: gap[2]) if gaps else None
-    which = f"its only day, {first}," if len(days) == 1 else f"all {len(days)} of its days are; {first}"
+    which = f"its only day, {first}, is left out: it" if len(days) == 1 else \
+        f"all {len(days)} of its days are left out; the first, {first},"
     why = "has daylight steps missing" if longest is None else (
         f"has a daylight gap of {longest[2]:g} min ({longest[0]:%H:%M} to {longest[1]:%H:%M})")
     found = [note for note in measured.notes if note.startswith(("values beyond physical bounds", "values flagged"))]
-    return (f"weather {name}: {which} is left out: it {why}, longer than weather.max_gap_min = {max_gap_min:g} min"
+    return (f"weather {name}: {which} {why}, longer than weather.max_gap_min = {max_gap_min:g} min"
             + (f" ({'; '.join(found)})" if found else " (steps the file lacks)") + "; no day is left to study")
+
+
+def _shown(value) -> str:
+    """``repr(value)``, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 #: A weather file's options that take one name, and those that take one number.
@@ -147,10 +154,8 @@ def _options_problem(spec: dict, keys=(*_NAMED_OPTIONS, *_NUMBER_OPTIONS)) -> st
             what = "one name" if key in _NAMED_OPTIONS else "one number"
             kind = type(value).__name__
             kind = f"{'an' if kind[0] in 'aeiou' else 'a'} {kind}"
-            text = repr(value)
-            text = text if len(text) <= 40 else text[:37] + "..."
             swept = "; the file is read with it, so it is not swept" if isinstance(value, (list, tuple, dict)) else ""
-            return f"weather.{key} = {text}: {what} is expected, not {kind}{swept}"
+            return f"weather.{key} = {_shown(value)}: {what} is expected, not {kind}{swept}"
     return None
 
 
