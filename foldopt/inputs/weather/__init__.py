@@ -100,6 +100,8 @@ def sniff_format(path) -> str | None:
         One of :data:`FORMATS` or :data:`MEASURED_FORMATS`, or None where none matches or the
         file cannot be read.
     """
+    if not Path(path).is_file():
+        return None  # a FIFO or a device: nothing to read, nor to wait for
     try:
         with open(path, "rb") as handle:
             head = handle.read(_HEAD_BYTES).decode("utf-8", errors="replace").replace("\r\n", "\n")

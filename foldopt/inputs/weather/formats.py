@@ -244,7 +244,7 @@ def site_value(fail, where: str, key: str, raw) -> float:
     try:
         value = float(raw)
     except (TypeError, ValueError):
-        raise fail(f"{where}: {label} = {printable(str(raw).strip())!r}: not a number") from None
+        raise fail(f"{where}: {label} = '{printable(str(raw).strip())}': not a number") from None
     if not math.isfinite(value):
         raise fail(f"{where}: {label} = {raw}: must be a finite number")
     if not lo <= value <= hi:
