@@ -238,7 +238,7 @@ def read_horizon(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     path = Path(path)
     try:
         try:
-            text = read_input(path, FIELD, MAX_HORIZON_BYTES, "MAX_HORIZON_BYTES")
+            text = read_input(path, FIELD, MAX_HORIZON_BYTES, "MAX_HORIZON_BYTES", "horizon file")
         except ConfigError as error:
             raise _Problem(error.errors[0].removeprefix(f"{FIELD}: ")) from None
         if "\x00" in text:

@@ -176,7 +176,8 @@ def read_study(path: Path | str) -> tuple:
         that is not a plain YAML study (:class:`StudyLoader`).
     """
     path = Path(path)
-    data, lines = parse_study_text(read_input(path, "config", MAX_STUDY_BYTES, "MAX_STUDY_BYTES"), str(path))
+    text = read_input(path, "config", MAX_STUDY_BYTES, "MAX_STUDY_BYTES", "study file")
+    data, lines = parse_study_text(text, str(path))
     if isinstance(data, dict):
         data = _resolve_horizon_path(_resolve_weather_path(data, path.parent), path.parent)
     return data, lines
@@ -282,7 +283,7 @@ def read_profile(path: str | Path) -> dict:
         time given twice, or a value :func:`~foldopt.inputs.loads.profile_steps` refuses.
     """
     path = Path(path)
-    text = read_input(path, "load_profile.file", MAX_CSV_BYTES, "MAX_CSV_BYTES")
+    text = read_input(path, "load_profile.file", MAX_CSV_BYTES, "MAX_CSV_BYTES", "load profile")
     try:
         reader = csv.DictReader(io.StringIO(text, newline=""))
         rows = [(reader.line_num, row) for row in reader]

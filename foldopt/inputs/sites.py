@@ -110,7 +110,7 @@ def read_sites(path: Path | str) -> list[dict]:
         file holds no site.
     """
     path = Path(path)
-    text = read_input(path, "--sites", MAX_CSV_BYTES, "MAX_CSV_BYTES")
+    text = read_input(path, "--sites", MAX_CSV_BYTES, "MAX_CSV_BYTES", "sites file")
     try:
         reader = csv.reader(io.StringIO(text, newline=""))
         header = [name.strip() for name in next(reader, [])]
