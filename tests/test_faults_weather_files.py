@@ -267,12 +267,14 @@ def test_a_measured_file_whose_every_day_is_left_out_says_so(here):
 
 
 @pytest.mark.parametrize("fmt,label", [("surfrad", "SURFRAD"), ("bsrn", "BSRN"), ("solrad", "SOLRAD"),
-                                       ("crn", "CRN")])
+                                       ("crn", "CRN"), ("midc", "MIDC"), ("srml", "SRML"),
+                                       ("csv", "CSV")])
 def test_a_station_file_that_cannot_be_parsed_says_what_is_wrong_with_it(here, fmt, label):
     (here / "junk.dat").write_text("junk\nmore junk\n1 2 3\n")
-    line = refused(here, ["sweep", "angle", "--weather", "junk.dat", "--weather-format", fmt],
-                   "--weather junk.dat", f"not a readable {label} file")
-    assert "not read yet" not in line
+    # No site given: a file that holds none (MIDC, SRML, CSV) is parsed before a site is asked for.
+    line = refused(here, ["sweep", "angle", "--weather", "junk.dat", "--weather-format", fmt], "--weather junk.dat",
+                   "no timestamp column" if fmt == "csv" else f"not a readable {label} file")
+    assert "not read yet" not in line and "holds no site" not in line
 
 
 def test_a_latitude_sweep_over_a_measured_file_without_a_site_names_the_site(here):

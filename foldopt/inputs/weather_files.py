@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from foldopt.errors import ConfigError
+from foldopt.errors import ConfigError, WeatherError
 from foldopt.inputs.reading import MAX_WEATHER_BYTES, check_input
 from foldopt.names import HOURLY_WEATHER_FORMATS, WEATHER_FORMATS, canonical
 
@@ -84,8 +84,10 @@ def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
         if varied is not None:
             return {"weather_problem": f"{varied}: varies, but a {fmt} file holds no site and is read at the study's; "
                                        "a measured file's light is of one place: give one site"}
+        # A file that cannot be parsed says so first: naming a site would not make it readable.
+        entry.reader(path, lambda message: WeatherError(f"weather {Path(path).name}: {message}"), 0.0)
         return {"weather_problem": f"weather {Path(path).name}: the {fmt} format holds no site; give the site's "
-                                   "latitude, longitude and altitude"}
+                                   "latitude, longitude and altitude (--lat, --lon, --altitude)"}
     options = {key: spec[key] for key in ("label", "timezone", "decomposition", "max_gap_min") if spec.get(key)
                is not None}
     try:
