@@ -1,8 +1,10 @@
 """Weather and other input files under faults (issue 38): what is no file foldopt reads (a folder,
-a device, a FIFO, a file of gigabytes) is named for what it is before anything reads it, by every
-reader; a cloud ensemble over one day runs; a weather option given a list is one line; stamps
-that span decades are refused at once; a word where a station file holds a number is refused by
-every reader. Each refusal is exit code 2, one line, no traceback and nothing written."""
+a device, a FIFO, a file of gigabytes, a broken link) is named for what it is before anything reads
+it, by every reader; a cloud ensemble over one day runs; a weather option given a list is one line;
+stamps that span decades are refused at once; a word where a station file holds a number is refused
+by every reader; and messages name what is wrong (the day left out and why, the file that cannot be
+parsed, the option given, the format a file looks like), with no raw control characters. Each
+refusal is exit code 2, one line, no traceback and nothing written."""
 
 from __future__ import annotations
 
