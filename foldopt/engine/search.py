@@ -147,6 +147,38 @@ class SearchResult:
         """Points of the full grid, what a brute-force sweep evaluates."""
         return int(np.prod([axis.size for axis in self.axes]))
 
+    def with_lines(self, evaluate: Callable[[np.ndarray], np.ndarray]) -> SearchResult:
+        """The search with, for each target, every grid point along each axis through its best point
+        evaluated too (those not evaluated yet, as one last level): each variable's whole profile
+        near the optimum, and a better point there, if any, the best.
+
+        Parameters
+        ----------
+        evaluate : callable
+            As :func:`grid_search`'s.
+
+        Returns
+        -------
+        SearchResult
+        """
+        sizes = np.array([axis.size for axis in self.axes])
+        lines = []
+        for start in self.index[self.best]:
+            for axis in np.flatnonzero(sizes > 1):
+                line = np.repeat(start[None], sizes[axis], axis=0)
+                line[:, axis] = np.arange(sizes[axis])
+                lines.append(line)
+        if not lines:
+            return self
+        store = _Store(sizes)
+        store.add(self.index, self.values)
+        new = store.missing(np.vstack(lines))
+        if new.shape[0]:
+            points = np.stack([axis.values(new[:, i]) for i, axis in enumerate(self.axes)], axis=-1)
+            store.add(new, np.asarray(evaluate(points), dtype=float).reshape(new.shape[0], -1))
+        return SearchResult(self.axes, store.index, store.values, _best_rows(store.index, store.values),
+                            (*self.levels, (1, int(new.shape[0]))), self.tolerance)
+
 
 def _best_rows(index, values):
     """Each target's best row; ties go to the largest indices (least folded, ...), as

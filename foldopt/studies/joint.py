@@ -171,12 +171,14 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
                              spec.tolerance_h, quantum, seeds=seeds)
         steps.append((vary[count - 1], search))
         seeds = search.best_point
-    twofold = steps[-1][1]
+    # Each variable's near-optimal region walks its whole grid through the optimum.
+    twofold = steps[-1][1].with_lines(objective(False))
+    steps[-1] = (steps[-1][0], twofold)
     flat_axes = _axes(study, [name for name in vary if name != "fold_angle"])
     flat = grid_search(objective(True), list(flat_axes.values()), spec.tolerance_h, quantum,
                        seeds=[[180.0, study.panel.tilt, study.panel.azimuth]])
     table = _table(study, loads, twofold, flat, days_of.angles, best_default, default)
-    near = _near_optimal(study, loads, twofold, objective(False))
+    near = _near_optimal(study, loads, twofold)
     # What the first variable adds is over the default mounting as it stands: flat where the fold
     # angle joins the search, else folded to the fixed angle (the tilt alone took the fold's gain).
     start = default["flat-default"] if "fold_angle" in vary else default["twofold-default"][:, best_default[0]]
@@ -205,32 +207,22 @@ def _table(study, loads, twofold, flat, angles, best_default, default) -> pd.Dat
     return pd.DataFrame(rows)
 
 
-def _near_optimal(study, loads, search: SearchResult, evaluate) -> pd.DataFrame:
+def _near_optimal(study, loads, search: SearchResult) -> pd.DataFrame:
     """Per load and varied variable, the range of values within the near-optimal tolerance, on the
-    profile of the best design evaluated at each value: every design the search evaluated, and the
-    variable's whole grid with the others at the load's optimum. The search alone refines only where
-    the optimum may be: its sparse profile, interpolated, gave a fold angle of 29 to 31 deg where the
-    optimum's own azimuth and tilt keep 29 to 60 deg near-optimal."""
+    profile of the best design evaluated at each value: the search's, which holds every value of each
+    variable with the others at each load's optimum (:meth:`SearchResult.with_lines`). The search
+    alone refines only where the optimum may be: its sparse profile, interpolated, gave a fold angle
+    of 29 to 31 deg where the optimum's own azimuth and tilt keep 29 to 60 deg near-optimal."""
     rows = []
     points, values = search.points, search.values
-    varied = [index for index, axis in enumerate(search.axes) if axis.size > 1]
-    through = []  # per load and varied variable, the optimum's line along it
-    for target in range(loads.size):
-        for axis_index in varied:
-            line = np.repeat(search.best_point[target][None], search.axes[axis_index].size, axis=0)
-            line[:, axis_index] = search.axes[axis_index].values()
-            through.append(line)
-    on_lines = evaluate(np.vstack(through)) if through else None
-    offsets = np.cumsum([0] + [line.shape[0] for line in through])
-    for order, axis_index in enumerate(varied):
-        axis = search.axes[axis_index]
+    for axis_index, axis in enumerate(search.axes):
+        if axis.size == 1:
+            continue
         grid = axis.values()
         profile = np.full((loads.size, grid.size), -np.inf)
         position = np.searchsorted(grid, points[:, axis_index] - 1e-9)
         for target in range(loads.size):
             np.maximum.at(profile[target], position, values[:, target])
-            line = target * len(varied) + order
-            profile[target] = np.maximum(profile[target], on_lines[offsets[line]:offsets[line + 1], target])
         ranges = near_optimal(grid, profile, study.near_optimal)
         for index, load in enumerate(loads):
             rows.append({"p_load_w": load, "variable": axis.name,
