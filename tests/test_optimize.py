@@ -337,3 +337,22 @@ def test_the_optimum_is_the_best_design_evaluated():
     for load, rows in result.near_optimal.groupby("p_load_w"):
         tolerance = max(0.01 * best[load], 1 / 60)  # the study's near-optimal: 1 % or 1 min
         assert np.allclose(rows["near_optimal_tolerance_h"], tolerance, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("latitude,date,p_load", [
+    (80.0, "2014-06-21", 4.398),  # midnight sun
+    (-80.0, "2014-06-21", 4.398),  # polar night in the south
+    (66.5, "2014-12-21", 0.5),  # the sun at the horizon at noon
+    (89.9, "2014-03-21", 4.398),  # the equinox at the pole
+    (0.0, "2014-03-20", 20.0),  # a load near the panel's peak
+])
+def test_no_nan_in_any_answer_where_the_sun_is_scarce_or_never_sets(latitude, date, p_load):
+    """No NaN reaches the answer's lines or its JSON, whatever share of designs carries the load."""
+    import json
+
+    result = _optimize(latitude=latitude, date=date, p_load=p_load, step_min=30)
+    answer = result.answer
+    assert all(_no_nan(line) for line in answer.lines())
+    json.dumps(answer.to_dict(), allow_nan=False)
+    carried = result.twofold.best_value > 0
+    assert [load["carried"] for load in answer.result["loads"]] == carried.tolist()
