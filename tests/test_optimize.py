@@ -383,3 +383,24 @@ def test_a_search_of_many_targets_bounds_its_boxes_a_batch_at_a_time(monkeypatch
     assert np.array_equal(found[1 << 30].index, found[1 << 16].index)
     assert np.array_equal(found[1 << 30].values, found[1 << 16].values)
     assert found[1 << 16, "peak"] < 40e6 < found[1 << 30, "peak"]  # 19 MB against 194 MB
+
+
+def test_loads_times_designs_beyond_the_limit_are_refused_at_once(tmp_path):
+    """The search holds each evaluated design's objective per load (and evaluated.csv writes it):
+    fourteen loads of the default grids' 1.5 M designs are refused before any work, in one line
+    naming --p-load; two hundred loads had run the machine out of memory."""
+    import time
+
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+    from foldopt.inputs.optimize_section import MAX_DESIGNS
+
+    start = time.perf_counter()
+    result = CliRunner().invoke(app, ["optimize", "--p-load", "1:14:1", "--out", str(tmp_path / "out")])
+    assert time.perf_counter() - start < 10
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: --p-load: 14 loads x 1,490,580 designs")
+    assert 14 * 1_490_580 > MAX_DESIGNS and f"the limit is {MAX_DESIGNS:,}" in lines[0]
+    assert not (tmp_path / "out").exists()

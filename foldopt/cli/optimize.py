@@ -62,9 +62,10 @@ def optimize(**options):
         section = optimize_section(own["vary"], own["fold_range"], own["tilt_range"], own["azimuth_range"],
                                    own["tolerance"], labels=OPTIMIZE_OPTIONS)
         request = sweep_request(config, options, None, EMBEDDED if config is None else str(config), section)
+        # The search's own limits (loads x designs) are checked as it starts, before any work.
+        run_request(request, out or RESULTS / "optimize", overwrite, output, engine, "optimize")
     except ConfigError as error:
         fail(list(dict.fromkeys(rename_fields(line, labels) for line in error.errors)))
-    run_request(request, out or RESULTS / "optimize", overwrite, output, engine, "optimize")
 
 
 _SIGNATURE = signature("optimize", "results/optimize")

@@ -20,9 +20,9 @@ from foldopt.names import canonical
 #: from horizontal to vertical; the azimuth within 90 deg either side of the equator-facing one.
 DEFAULT_TILT = (0.0, 90.0, 1.0)
 DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP = 90.0, 2.0
-#: Designs of a search's grid (fold angles x tilts x azimuths), as many as it may evaluate: the
-#: default grids hold 1.5 M, of which a search evaluates some 2 % (all of them where nothing
-#: prunes); a step of 1e-9 deg made 1e15 and never ended.
+#: Designs of a search's grid (fold angles x tilts x azimuths) times its loads, as many as it may
+#: evaluate and hold: the default grids hold 1.5 M, of which a search evaluates some 2 % (all of
+#: them where nothing prunes); a step of 1e-9 deg made 1e15 and never ended.
 MAX_DESIGNS = size_limit("MAX_DESIGNS", 20_000_000)
 
 

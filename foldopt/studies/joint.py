@@ -23,6 +23,7 @@ is the objective over tilt x fold angle at the optimum's azimuth, on a grid of i
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +32,7 @@ import pandas as pd
 from foldopt import names
 from foldopt.engine.search import Axis, SearchResult, grid_search
 from foldopt.errors import ConfigError
-from foldopt.inputs.optimize_section import DEFAULT_TILT
+from foldopt.inputs.optimize_section import DEFAULT_TILT, MAX_DESIGNS
 from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
@@ -124,7 +125,8 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     Raises
     ------
     foldopt.ConfigError
-        For other axes, a cloud ensemble, or a season (``objective.months``) none of the days is in.
+        For other axes, a cloud ensemble, a season (``objective.months``) none of the days is in, or
+        more designs x loads than :data:`foldopt.inputs.optimize_section.MAX_DESIGNS`.
     """
     study = plan.base.resolved()
     spec = study.optimize
@@ -137,6 +139,12 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
         raise ConfigError(["optimize: a cloud ensemble (weather.members) is not searched; leave out weather.members"])
     dates = tuple(axes.get("date", (study.date,)))
     loads = np.asarray(axes.get("p_load", (study.p_load,)), dtype=float)
+    # The search holds, and evaluated.csv writes, each evaluated design's objective per load.
+    designs = math.prod(axis.size for axis in _axes(study, spec.vary).values())
+    if designs * loads.size > MAX_DESIGNS:
+        raise ConfigError([f"p_load: {loads.size:,} loads x {designs:,} designs = {designs * loads.size:.2g} to "
+                           f"search; the limit is {MAX_DESIGNS:,} (fewer loads, coarser steps, or "
+                           f"FOLDOPT_MAX_DESIGNS)"])
     statistic = study.objective.statistic if study.objective is not None else "mean"
     season = study.objective.months if study.objective is not None else None
     months = np.array([date.month for date in dates])
