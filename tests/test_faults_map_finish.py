@@ -170,3 +170,21 @@ def test_a_misspelt_objective_is_named_beside_the_missing_dates(tmp_path, monkey
     assert result.exit_code == 2
     assert "did you mean 'worst-month'?" in result.output and "needs several dates" in result.output
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("args, words", [
+    (["run", "--set", "fold_angles.step=1e-9"], ["fold_angles.step = '1e-9'", "179,000,000,001 fold angles"]),
+    (["sweep", "angle", "--angle-step", "1e-9"], ["--angle-step = 1e-09", "fold angles"]),
+])
+def test_a_fold_angle_grid_too_fine_is_refused_at_once(tmp_path, monkeypatch, args, words):
+    # The grid was listed before any limit looked at it: 1.8e11 angles, a hang.
+    import time
+
+    monkeypatch.chdir(tmp_path)
+    started = time.perf_counter()
+    result = runner.invoke(app, [*args, "--out", "out"])
+    assert time.perf_counter() - started < 10
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and all(word in lines[0] for word in words) and "(line" not in lines[0], result.output
+    assert list(tmp_path.iterdir()) == []

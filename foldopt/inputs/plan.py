@@ -430,7 +430,7 @@ def _check_size(plan: Plan) -> None:
     """Refuse a plan whose work or memory would exceed the limits, before any work."""
     axes = dict(plan.axes)
     base = plan.base
-    angles = len(base.fold_angles.grid())
+    angles = base.fold_angles.count()
     steps = round(24 * 60 / base.step_min)
     loads = len(axes.get("p_load", (None,)))
     site_days = plan.n_cases // loads

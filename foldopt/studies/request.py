@@ -309,7 +309,8 @@ def settings_plan(path, settings=()) -> Plan:
         if isinstance(data, dict):
             data = policy.set_path(data, key, value)
         parts = tuple(key.split("."))
-        lines = {loc: line for loc, line in lines.items() if loc[:len(parts)] != parts}
+        # Neither the changed field's lines nor its sections' (whose line a message falls back on) hold it now.
+        lines = {loc: line for loc, line in lines.items() if loc[:len(parts)] != parts and parts[:len(loc)] != loc}
     if errors:
         raise ConfigError(errors)
     return make_plan(data, lines)
