@@ -341,8 +341,8 @@ class FoldAngles(StrictModel):
         start, stop = info.data.get("start"), info.data.get("stop")
         count = _count(start, stop, step) if start is not None and stop is not None and start <= stop else 0
         if count > MAX_AXIS_VALUES:
-            raise ValueError(f"makes {count:,} fold angles from {start:g} to {stop:g}; at most {MAX_AXIS_VALUES:,} "
-                             "(a coarser step, or FOLDOPT_MAX_AXIS_VALUES)")
+            raise ValueError(f"{count:,} fold angles from {start:g} to {stop:g}; the limit is {MAX_AXIS_VALUES:,} "
+                             "values a range (a coarser step, or FOLDOPT_MAX_AXIS_VALUES)")
         return step
 
     def count(self) -> int:
