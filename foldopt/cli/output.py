@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import json
 import os
-import re
 from contextlib import contextmanager
 from pathlib import Path
 from typing import NoReturn
 
 import typer
+
+from foldopt.errors import printable
 
 #: The command line as typed, for run.json (``sys.argv`` holds the script's path, or pytest's); set
 #: by the app for each command.
@@ -39,10 +40,6 @@ def as_text(text: str) -> str:
     return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
 
 
-#: Characters a terminal acts on rather than shows (a binary file's bytes, escapes), but line breaks and tabs.
-_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
-
-
 def echo(text: str, err: bool = False) -> None:
     """Print a line of text from the command line (:func:`as_text`), on stderr with ``err``; a
     control character (text a message took from a binary file) as a ``\\xNN`` escape.
@@ -52,8 +49,7 @@ def echo(text: str, err: bool = False) -> None:
     text : str
     err : bool
     """
-    text = _CONTROL.sub(lambda match: f"\\x{ord(match.group()):02x}", as_text(text))
-    typer.echo(text, err=err)
+    typer.echo(printable(as_text(text), breaks=True), err=err)
 
 
 def fail(lines: list[str]) -> NoReturn:

@@ -22,6 +22,7 @@ from foldopt import names
 from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
 from foldopt.inputs.horizon_section import Horizon
 from foldopt.inputs.loads import profile_steps
+from foldopt.inputs.optimize_section import grid_points
 from foldopt.inputs.reading import MAX_AXIS_VALUES
 from foldopt.names import ALEXANDRU_STEP_OFFSETS_H
 
@@ -309,12 +310,6 @@ class LoadProfile(StrictModel):
         return self
 
 
-def _count(start: float, stop: float, step: float) -> int:
-    """The fold angles from ``start`` by ``step``, always ending on ``stop`` (:meth:`FoldAngles.grid`)."""
-    count = int(math.floor((stop - start) / step + 1e-9)) + 1
-    return count + (not math.isclose(start + (count - 1) * step, stop))
-
-
 class FoldAngles(StrictModel):
     """The grid of fold angles a study sweeps.
 
@@ -339,7 +334,7 @@ class FoldAngles(StrictModel):
     def _bounded(cls, step: float, info: ValidationInfo):
         # Counted, not listed: a step of 1e-9 deg would list 1.8e11 angles before any limit looked.
         start, stop = info.data.get("start"), info.data.get("stop")
-        count = _count(start, stop, step) if start is not None and stop is not None and start <= stop else 0
+        count = grid_points(start, stop, step) if start is not None and stop is not None and start <= stop else 0
         if count > MAX_AXIS_VALUES:
             raise ValueError(f"{count:,} fold angles from {start:g} to {stop:g}; the limit is {MAX_AXIS_VALUES:,} "
                              "values a range (a coarser step, or FOLDOPT_MAX_AXIS_VALUES)")
@@ -347,7 +342,7 @@ class FoldAngles(StrictModel):
 
     def count(self) -> int:
         """The number of fold angles of :meth:`grid`, worked out without listing them."""
-        return _count(self.start, self.stop, self.step)
+        return grid_points(self.start, self.stop, self.step)
 
     def grid(self):
         """The sweep's fold angles.

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from foldopt.errors import ConfigError, WeatherError
+from foldopt.errors import ConfigError, WeatherError, printable
 from foldopt.inputs.reading import MAX_WEATHER_BYTES, check_input
 from foldopt.names import HOURLY_WEATHER_FORMATS, WEATHER_FORMATS, canonical
 
@@ -113,7 +113,7 @@ def _varied_site(site) -> str | None:
     for key in ("latitude", "longitude", "altitude"):
         value = site.get(key) if isinstance(site, dict) else None
         if isinstance(value, (list, str)):
-            return f"site.{key} = {_shown(value)}"
+            return f"site.{key} = {printable(repr(value), 40)}"
     return None
 
 
@@ -131,12 +131,6 @@ def _every_day_left_out(measured, days, max_gap_min: float) -> str:
     found = [note for note in measured.notes if note.startswith(("values beyond physical bounds", "values flagged"))]
     return (f"weather {name}: {which} {why}, longer than weather.max_gap_min = {max_gap_min:g} min"
             + (f" ({'; '.join(found)})" if found else " (steps the file lacks)") + "; no day is left to study")
-
-
-def _shown(value) -> str:
-    """``repr(value)``, cut to 40 characters."""
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
 
 
 #: A weather file's options that take one name, and those that take one number.
@@ -157,7 +151,7 @@ def _options_problem(spec: dict, keys=(*_NAMED_OPTIONS, *_NUMBER_OPTIONS)) -> st
             kind = type(value).__name__
             kind = f"{'an' if kind[0] in 'aeiou' else 'a'} {kind}"
             swept = "; the file is read with it, so it is not swept" if isinstance(value, (list, tuple, dict)) else ""
-            return f"weather.{key} = {_shown(value)}: {what} is expected, not {kind}{swept}"
+            return f"weather.{key} = {printable(repr(value), 40)}: {what} is expected, not {kind}{swept}"
     return None
 
 

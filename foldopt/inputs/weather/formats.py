@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -19,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from foldopt.errors import ConfigError, WeatherError
+from foldopt.errors import ConfigError, WeatherError, printable
 from foldopt.inputs.reading import MAX_WEATHER_BYTES, check_input
 
 HOUR = pd.Timedelta(hours=1)
@@ -100,28 +99,6 @@ def check_file(path) -> None:
         check_input(path, f"weather {Path(path).name}", MAX_WEATHER_BYTES, "MAX_WEATHER_BYTES", "weather file")
     except ConfigError as error:
         raise WeatherError(error.errors[0]) from None
-
-
-#: Characters a terminal would act on rather than show: C0 and C1 controls, DEL.
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
-
-
-def printable(text, limit: int = 40) -> str:
-    """Text taken from a file, fit for a one-line message: control characters (a binary file's
-    bytes, a terminal's escapes, line breaks) as ``\\xNN`` escapes, cut to ``limit`` characters.
-
-    Parameters
-    ----------
-    text : object
-        Its ``str``.
-    limit : int, default 40
-
-    Returns
-    -------
-    str
-    """
-    text = _CONTROL.sub(lambda match: f"\\x{ord(match.group()):02x}", str(text))
-    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def reason(error: Exception) -> str:
@@ -244,7 +221,7 @@ def site_value(fail, where: str, key: str, raw) -> float:
     try:
         value = float(raw)
     except (TypeError, ValueError):
-        raise fail(f"{where}: {label} = '{printable(str(raw).strip())}': not a number") from None
+        raise fail(f"{where}: {label} = '{printable(str(raw).strip(), 40)}': not a number") from None
     if not math.isfinite(value):
         raise fail(f"{where}: {label} = {raw}: must be a finite number")
     if not lo <= value <= hi:

@@ -70,7 +70,8 @@ import numpy as np
 import pandas as pd
 import pvlib
 
-from foldopt.inputs.weather.formats import printable, read_with_pvlib, reason
+from foldopt.errors import printable
+from foldopt.inputs.weather.formats import read_with_pvlib, reason
 from foldopt.inputs.weather.qc import COLUMNS
 
 #: MIDC's missing-value marker: values at or below it are missing.
