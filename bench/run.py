@@ -201,8 +201,8 @@ def pvlib_baseline(base, dates, voltage_points: int = 12):
         sides = subpanel_orientation(angle, panel.tilt, panel.azimuth, "hinge")
         curves, power = [], {}
         for side in ("east", "west"):
-            projection = pvlib.irradiance.aoi_projection(sides[f"tilt_{side}"], sides[f"azimuth_{side}"], zenith,
-                                                         azimuth)
+            projection = pvlib.irradiance.aoi_projection(sides[f"surface_tilt_{side}"],
+                                                         sides[f"surface_azimuth_{side}"], zenith, azimuth)
             poa = dni * np.clip(projection, 0.0, None)
             lit = poa > 0
             temp = pvlib.temperature.sapm_cell(poa[lit], base.temp_air, base.wind_speed, -3.56, -0.075, 3)

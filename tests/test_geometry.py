@@ -18,15 +18,15 @@ def test_fold_of_180_is_the_flat_panel(geometry, tilt, azimuth):
     sides = subpanel_orientation(180.0, tilt, azimuth, geometry)
     flat = normal_vector(tilt, azimuth)
     for side in ("east", "west"):
-        normal = normal_vector(sides[f"tilt_{side}"], sides[f"azimuth_{side}"])
+        normal = normal_vector(sides[f"surface_tilt_{side}"], sides[f"surface_azimuth_{side}"])
         np.testing.assert_allclose(normal, flat, atol=1e-12)
 
 
 @given(fold=folds, tilt=tilts, azimuth=azimuths)
 def test_hinge_normals_open_by_180_minus_fold_symmetrically(fold, tilt, azimuth):
     sides = subpanel_orientation(fold, tilt, azimuth, "hinge")
-    east = normal_vector(sides["tilt_east"], sides["azimuth_east"])
-    west = normal_vector(sides["tilt_west"], sides["azimuth_west"])
+    east = normal_vector(sides["surface_tilt_east"], sides["surface_azimuth_east"])
+    west = normal_vector(sides["surface_tilt_west"], sides["surface_azimuth_west"])
     flat = normal_vector(tilt, azimuth)
     between = np.degrees(np.arctan2(np.linalg.norm(np.cross(east, west)), east @ west))
     assert between == pytest.approx(180.0 - fold, abs=1e-6)
@@ -41,30 +41,30 @@ def test_east_sub_panel_faces_east_on_both_hemispheres(fold, tilt, latitude):
     _, azimuth = default_orientation(latitude)
     for geometry in ("hinge", "azimuth-split"):
         sides = subpanel_orientation(fold, tilt, azimuth, geometry)
-        east = normal_vector(sides["tilt_east"], sides["azimuth_east"])
-        west = normal_vector(sides["tilt_west"], sides["azimuth_west"])
+        east = normal_vector(sides["surface_tilt_east"], sides["surface_azimuth_east"])
+        west = normal_vector(sides["surface_tilt_west"], sides["surface_azimuth_west"])
         assert east[0] > west[0]
 
 
 def test_paper_fig6_azimuths():
     # Shin et al. Sec. IV-B: a 90 deg fold at azimuth 180 gives sub-panels facing 135 and 225 deg.
     sides = subpanel_orientation(90.0, 34.05, 180.0, "azimuth-split")
-    assert sides["azimuth_east"] == pytest.approx(135.0)
-    assert sides["azimuth_west"] == pytest.approx(225.0)
-    assert sides["tilt_east"] == sides["tilt_west"] == pytest.approx(34.05)
+    assert sides["surface_azimuth_east"] == pytest.approx(135.0)
+    assert sides["surface_azimuth_west"] == pytest.approx(225.0)
+    assert sides["surface_tilt_east"] == sides["surface_tilt_west"] == pytest.approx(34.05)
 
 
 def test_hinge_at_zero_tilt_is_a_ridge_tent():
     sides = subpanel_orientation(90.0, 0.0, 180.0, "hinge")
-    assert sides["tilt_east"] == pytest.approx(45.0)
-    assert sides["azimuth_east"] == pytest.approx(90.0)
-    assert sides["tilt_west"] == pytest.approx(45.0)
-    assert sides["azimuth_west"] == pytest.approx(270.0)
+    assert sides["surface_tilt_east"] == pytest.approx(45.0)
+    assert sides["surface_azimuth_east"] == pytest.approx(90.0)
+    assert sides["surface_tilt_west"] == pytest.approx(45.0)
+    assert sides["surface_azimuth_west"] == pytest.approx(270.0)
 
 
 def test_vectorised_over_fold_angles_and_default_orientation():
     sides = subpanel_orientation(np.array([30.0, 90.0, 180.0]), 34.0, 180.0, "hinge")
-    assert sides["tilt_east"].shape == (3,)
+    assert sides["surface_tilt_east"].shape == (3,)
     assert default_orientation(34.05) == (34.05, 180.0)
     assert default_orientation(-33.9) == (33.9, 0.0)
     with pytest.raises(ValueError, match="azimuth-split, hinge"):

@@ -89,8 +89,10 @@ def test_east_and_west_mirror_each_other_about_solar_noon(
     zenith, sun_azimuth = sun_from_angles(declination, np.array([-hour_angle, hour_angle]), latitude)
     assume(zenith[0] > 0.1)  # overhead, the sun has no azimuth (and Eq. 5 would need one)
     sides = subpanel_orientation(fold, tilt, azimuth, geometry)
-    east = beam_incidence_factor(sides["tilt_east"], sides["azimuth_east"], zenith[0], sun_azimuth[0], model)
-    west = beam_incidence_factor(sides["tilt_west"], sides["azimuth_west"], zenith[1], sun_azimuth[1], model)
+    east = beam_incidence_factor(sides["surface_tilt_east"], sides["surface_azimuth_east"], zenith[0], sun_azimuth[0],
+                                 model)
+    west = beam_incidence_factor(sides["surface_tilt_west"], sides["surface_azimuth_west"], zenith[1], sun_azimuth[1],
+                                 model)
     assert east == pytest.approx(west, abs=1e-9)
 
 

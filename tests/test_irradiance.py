@@ -65,6 +65,7 @@ def test_day_incidence_by_matrix_product_equals_pvlib(shin_study):
 
     day = Day(shin_study.variant(mode="exact", geometry="hinge", step_min=10))
     sides = subpanel_orientation(np.array([20.0, 90.0, 180.0]), 34.05, 180.0, "hinge")
+    tilt, azimuth = sides["surface_tilt_east"], sides["surface_azimuth_east"]
     expected = day.dni * np.clip(pvlib.irradiance.aoi_projection(
-        sides["tilt_east"][:, None], sides["azimuth_east"][:, None], day.solar_zenith, day.solar_azimuth), 0, None)
-    np.testing.assert_allclose(day._poa(sides["tilt_east"], sides["azimuth_east"]), expected, rtol=1e-12, atol=1e-9)
+        tilt[:, None], azimuth[:, None], day.solar_zenith, day.solar_azimuth), 0, None)
+    np.testing.assert_allclose(day._poa(tilt, azimuth), expected, rtol=1e-12, atol=1e-9)

@@ -40,8 +40,8 @@ def test_arrays_are_the_subpanels_east_first(geometry, fold_angle, tilt, azimuth
                                         strings=2, name_prefix="roof-", albedo=ALBEDO)
     sides = subpanel_orientation(fold_angle, tilt, azimuth, geometry)
     # Exactly foldopt's orientations (the function only converts them to float).
-    assert _orientation(east) == (sides["tilt_east"], sides["azimuth_east"])
-    assert _orientation(west) == (sides["tilt_west"], sides["azimuth_west"])
+    assert _orientation(east) == (sides["surface_tilt_east"], sides["surface_azimuth_east"])
+    assert _orientation(west) == (sides["surface_tilt_west"], sides["surface_azimuth_west"])
     for array, name in ((east, "roof-east"), (west, "roof-west")):
         assert isinstance(array, pvlib.pvsystem.Array) and isinstance(array.mount, pvlib.pvsystem.FixedMount)
         assert (array.name, array.modules_per_string, array.strings, array.albedo) == (name, 3, 2, ALBEDO)
@@ -134,7 +134,7 @@ def test_foldopts_local_day_dni_extra_is_the_only_difference():
                                     temperature_model_parameters=SAPM_TEMP, albedo=ALBEDO)
     mc = _model_chain(arrays, location, weather, "haydavies")
     table = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)
-    # As foldopt.engine.sky.build_sky: the table indexed by ClockGrid.day_of_year, the local day.
+    # As foldopt.engine.sky.build_sky: the table indexed by ClockGrid.dayofyear, the local day.
     local, utc = table[weather.index.day_of_year], table[weather.index.tz_convert("UTC").day_of_year]
     zenith, azimuth = (mc.results.solar_position[name].to_numpy() for name in ("apparent_zenith", "azimuth"))
     dni, dhi = weather["dni"].to_numpy(), weather["dhi"].to_numpy()

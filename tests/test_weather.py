@@ -46,7 +46,7 @@ def test_subpanel_irradiance_is_pvlibs_total_irradiance(model):
     day = Day(make_study({**BASE, "weather": str(TMY3), "transposition": model, "albedo": 0.25}))
     sides = subpanel_orientation(np.array([60.0]), 36.1, 180.0, "hinge")
     for side in ("east", "west"):
-        tilt, azimuth = sides[f"tilt_{side}"][0], sides[f"azimuth_{side}"][0]
+        tilt, azimuth = sides[f"surface_tilt_{side}"][0], sides[f"surface_azimuth_{side}"][0]
         expected = pvlib.irradiance.get_total_irradiance(
             tilt, azimuth, day.solar_zenith, day.solar_azimuth, day.dni, day.ghi, day.dhi,
             dni_extra=pvlib.irradiance.get_extra_radiation(day.times.day_of_year),

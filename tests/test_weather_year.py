@@ -128,7 +128,7 @@ def test_a_real_year_keeps_its_hours_continuous_and_closed(greensboro):
     assert np.abs(closure).max() < 1.0  # issue 24: closure to 1 W/m^2 at every step
     assert np.all((sky.dhi >= 0) & (sky.dhi <= sky.ghi + 1e-9) & (sky.dni >= 0))
     assert np.all(sky.dni[sky.solar_zenith > 89] == 0)
-    extra = np.asarray(pvlib.irradiance.get_extra_radiation(sky.grid.day_of_year), dtype=float)
+    extra = np.asarray(pvlib.irradiance.get_extra_radiation(sky.grid.dayofyear), dtype=float)
     assert np.all(sky.dni <= extra + 1e-9)
     boundary = np.arange(1, 1440) % 60 == 0
     for key in ("ghi", "dni", "dhi"):
@@ -220,7 +220,7 @@ def test_trackers_park_while_the_sun_is_down(greensboro):
     zenith, solar_azimuth = sky.solar_zenith.ravel()[low], sky.solar_azimuth.ravel()[low]
     expected = pvlib.irradiance.get_total_irradiance(
         tilt.ravel()[low], azimuth.ravel()[low], zenith, solar_azimuth, sky.dni.ravel()[low], sky.ghi.ravel()[low],
-        sky.dhi.ravel()[low], dni_extra=pvlib.irradiance.get_extra_radiation(sky.grid.day_of_year.ravel()[low]),
+        sky.dhi.ravel()[low], dni_extra=pvlib.irradiance.get_extra_radiation(sky.grid.dayofyear.ravel()[low]),
         airmass=pvlib.atmosphere.get_relative_airmass(zenith), albedo=0.2, model="perez")["poa_global"]
     assert low.size > 50
     np.testing.assert_allclose(poa.ravel()[low], np.nan_to_num(expected), rtol=1e-9, atol=1e-9)

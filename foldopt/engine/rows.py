@@ -89,8 +89,8 @@ def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> n
     per_panel = []
     for tilt, azimuth in unique:
         sides = subpanel_orientation(fold_angles, tilt, azimuth, geometry)
-        per_panel.append(np.stack([sides["tilt_east"], sides["azimuth_east"], sides["tilt_west"],
-                                   sides["azimuth_west"]], axis=-1))
+        per_panel.append(np.stack([sides["surface_tilt_east"], sides["surface_azimuth_east"],
+                                   sides["surface_tilt_west"], sides["surface_azimuth_west"]], axis=-1))
     return np.stack(per_panel)[np.ravel(inverse)]
 
 

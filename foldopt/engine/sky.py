@@ -316,7 +316,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
     grid = _clock(sites, dates, study.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
     zenith = sun["solar_zenith"]
-    dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.day_of_year]
+    dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.dayofyear]
     temp_air, balance = np.full(len(sites), float(study.temp_air)), None
     temp_steps = wind_speed = wind_ref = terms = None
     notes = ()
@@ -354,7 +354,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
                                    study.albedo)
     else:
         beam_altitude = altitude if study.mode == "exact" else 0.0
-        light = {"dni": clear_sky_dni(zenith, beam_altitude, study.sky, dayofyear=grid.day_of_year,
+        light = {"dni": clear_sky_dni(zenith, beam_altitude, study.sky, dayofyear=grid.dayofyear,
                                       climate=study.climate)}
     dni = light["dni"]
     ghi, dhi = light.get("ghi"), light.get("dhi")

@@ -63,8 +63,8 @@ def relative_airmass(solar_zenith):
     >>> print(relative_airmass([0.0, 60.0, 95.0]).round(4))
     [0.9997 1.9943    nan]
     """
-    zenith = np.asarray(solar_zenith, dtype=float)
-    return np.asarray(pvlib.atmosphere.get_relative_airmass(zenith, model="kastenyoung1989"))
+    solar_zenith = np.asarray(solar_zenith, dtype=float)
+    return np.asarray(pvlib.atmosphere.get_relative_airmass(solar_zenith, model="kastenyoung1989"))
 
 
 def beam_meinel(airmass, altitude=0.0):

@@ -60,9 +60,10 @@ _EDGES = np.array(CLEARNESS_EDGES)  # an array, as the compiled loop takes a glo
 
 
 @njit(cache=True)
-def _ineichen_terms(zenith, dni_extra, turbidity, altitude, code, albedo, f1c, f2c, dni, ghi, dhi, terms):
+def _ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, code, albedo, f1c, f2c, dni, ghi, dhi,
+                    terms):
     """The loop of :func:`ineichen_terms` over blocks and steps; writes only steps with the sun up."""
-    n_blocks, n_steps = zenith.shape
+    n_blocks, n_steps = apparent_zenith.shape
     for b in range(n_blocks):
         h = altitude[b]
         fh1 = math.exp(-h / 8000.0)
@@ -73,14 +74,14 @@ def _ineichen_terms(zenith, dni_extra, turbidity, altitude, code, albedo, f1c, f
         b_coefficient = 0.664 + 0.163 / fh1
         correction_base = 0.1 + 0.882 / fh1
         for s in range(n_steps):
-            z = zenith[b, s]
+            z = apparent_zenith[b, s]
             if not z < 90.0:
                 continue
             z_rad = math.radians(z)
             cos_z = math.cos(z_rad)
             airmass = 1.0 / (cos_z + 0.50572 * (6.07995 + (90.0 - z)) ** -1.6364)
             absolute = airmass * pressure_ratio
-            tl = turbidity[b, s]
+            tl = linke_turbidity[b, s]
             extra = dni_extra[b, s]
             g = cg1 * extra * cos_z * max(math.exp(-cg2 * absolute * (fh1 + fh2 * (tl - 1.0))), 0.0)
             beam = extra * max(b_coefficient * math.exp(-0.09 * absolute * (tl - 1.0)), 0.0)
@@ -147,13 +148,13 @@ def ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, transp
     """
     if transposition not in TRANSPOSITION_CODES:
         raise ValueError(f"transposition must be one of {', '.join(names.TRANSPOSITIONS)}; got {transposition!r}")
-    zenith = np.ascontiguousarray(apparent_zenith, dtype=float)
-    shape = zenith.shape
+    apparent_zenith = np.ascontiguousarray(apparent_zenith, dtype=float)
+    shape = apparent_zenith.shape
     arrays = [np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=float), shape))
               for values in (dni_extra, linke_turbidity)]
     heights = np.ascontiguousarray(np.broadcast_to(np.asarray(altitude, dtype=float).reshape(-1), shape[:1]))
     dni, ghi, dhi = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     code = TRANSPOSITION_CODES[transposition]
     terms = np.zeros((shape[0], 4 if code else 0, shape[1]))
-    _ineichen_terms(zenith, *arrays, heights, code, float(albedo), *perez_coefficients(), dni, ghi, dhi, terms)
+    _ineichen_terms(apparent_zenith, *arrays, heights, code, float(albedo), *perez_coefficients(), dni, ghi, dhi, terms)
     return dni, ghi, dhi, (terms if code else None)

@@ -126,8 +126,8 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
     Returns
     -------
     dict
-        ``tilt_east``, ``azimuth_east``, ``tilt_west``, ``azimuth_west`` [deg], each shaped as
-        ``fold_angle``.
+        ``surface_tilt_east``, ``surface_azimuth_east``, ``surface_tilt_west``,
+        ``surface_azimuth_west`` [deg], each shaped as ``fold_angle``.
 
     Raises
     ------
@@ -147,14 +147,14 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
     Folded to 90 deg, the paper's sub-panels of a south-facing panel face 135 and 225 deg:
 
     >>> sides = subpanel_orientation(90.0, 34.05, 180.0, geometry="azimuth-split")
-    >>> print(sides["azimuth_east"], sides["azimuth_west"])
+    >>> print(sides["surface_azimuth_east"], sides["surface_azimuth_west"])
     135.0 225.0
 
     With the hinge, the two normals stand ``180 - fold_angle`` = 90 deg apart:
 
     >>> sides = subpanel_orientation(90.0, 34.05, 180.0, geometry="hinge")
-    >>> east = normal_vector(sides["tilt_east"], sides["azimuth_east"])
-    >>> west = normal_vector(sides["tilt_west"], sides["azimuth_west"])
+    >>> east = normal_vector(sides["surface_tilt_east"], sides["surface_azimuth_east"])
+    >>> west = normal_vector(sides["surface_tilt_west"], sides["surface_azimuth_west"])
     >>> print(round(float(np.degrees(np.arccos(east @ west))), 6))
     90.0
     """
@@ -163,10 +163,10 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
     if geometry == "azimuth-split":
         tilt = np.full_like(fold_angle, surface_tilt)
         return {
-            "tilt_east": tilt,
-            "azimuth_east": (surface_azimuth - turn) % 360.0,
-            "tilt_west": tilt.copy(),
-            "azimuth_west": (surface_azimuth + turn) % 360.0,
+            "surface_tilt_east": tilt,
+            "surface_azimuth_east": (surface_azimuth - turn) % 360.0,
+            "surface_tilt_west": tilt.copy(),
+            "surface_azimuth_west": (surface_azimuth + turn) % 360.0,
         }
     if geometry == "hinge":
         tilt, azimuth = np.radians(surface_tilt), np.radians(surface_azimuth)
@@ -179,12 +179,12 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
         angle = np.radians(turn)[..., None]
         east = normal * np.cos(angle) + side * np.sin(angle)
         west = normal * np.cos(angle) - side * np.sin(angle)
-        tilt_east, azimuth_east = orientation_from_normal(east, surface_azimuth)
-        tilt_west, azimuth_west = orientation_from_normal(west, surface_azimuth)
+        surface_tilt_east, surface_azimuth_east = orientation_from_normal(east, surface_azimuth)
+        surface_tilt_west, surface_azimuth_west = orientation_from_normal(west, surface_azimuth)
         return {
-            "tilt_east": tilt_east,
-            "azimuth_east": azimuth_east,
-            "tilt_west": tilt_west,
-            "azimuth_west": azimuth_west,
+            "surface_tilt_east": surface_tilt_east,
+            "surface_azimuth_east": surface_azimuth_east,
+            "surface_tilt_west": surface_tilt_west,
+            "surface_azimuth_west": surface_azimuth_west,
         }
     raise ValueError(f"geometry must be one of {', '.join(GEOMETRIES)}; got {geometry!r}")

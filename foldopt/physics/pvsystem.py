@@ -101,7 +101,7 @@ def twofold_arrays(fold_angle, surface_tilt, surface_azimuth, geometry="hinge", 
     sides = subpanel_orientation(fold, float(surface_tilt), float(surface_azimuth), name)
     arrays = []
     for side in ("east", "west"):
-        tilt, azimuth = float(sides[f"tilt_{side}"]), float(sides[f"azimuth_{side}"])
+        tilt, azimuth = float(sides[f"surface_tilt_{side}"]), float(sides[f"surface_azimuth_{side}"])
         if not (math.isfinite(tilt) and math.isfinite(azimuth)):
             raise ValueError(f"surface_tilt and surface_azimuth must be finite; got {surface_tilt!r}, "
                              f"{surface_azimuth!r}")

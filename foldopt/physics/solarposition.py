@@ -111,7 +111,7 @@ class ClockGrid:
         return self.utc_offset_ns / NS_PER_HOUR
 
     @property
-    def day_of_year(self) -> np.ndarray:
+    def dayofyear(self) -> np.ndarray:
         """Local day of year of each step (1 on 1 January)."""
         days = np.floor_divide(self.local_ns, _NS_PER_DAY)
         # Converted once per calendar day in the grid's range, then looked up.
@@ -280,16 +280,16 @@ def hour_angle_paper(times: pd.DatetimeIndex, longitude: float):
         Hour angle [deg] in [-180, 180), negative before solar noon.
     """
     grid = ClockGrid.from_times([times], times.tz)
-    return _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, grid.day_of_year, longitude)[0]
+    return _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, grid.dayofyear, longitude)[0]
 
 
-def _by_day_of_year(function, dayofyear):
+def _by_dayofyear(function, dayofyear):
     """``function`` of the day of year at every step, evaluated once per day (1..366) and looked up."""
     return function(np.arange(367))[dayofyear]
 
 
 def _hour_angle_paper(clock_hours, utc_offset_hours, dayofyear, longitude):
-    equation_of_time = _by_day_of_year(equation_of_time_paper, dayofyear)
+    equation_of_time = _by_dayofyear(equation_of_time_paper, dayofyear)
     time_correction_min = 4.0 * (longitude - 15.0 * utc_offset_hours) + equation_of_time
     local_solar_time = clock_hours + time_correction_min / 60.0
     return (15.0 * (local_solar_time - 12.0) + 180.0) % 360.0 - 180.0
@@ -349,21 +349,22 @@ def solar_position_grid(grid: ClockGrid, latitude, longitude, altitude=0.0, mode
         equation of time, worked out from UTC (so DST days need no care), and the declination
         pvlib's ``declination_spencer71``.
     """
-    doy = grid.day_of_year
+    dayofyear = grid.dayofyear
     if model == "paper":
-        declination = _by_day_of_year(declination_paper, doy)
-        hour_angle = _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, doy, longitude)
-        zenith, azimuth = sun_from_angles(declination, hour_angle, latitude)
-        vector = normal_vector(zenith, azimuth)
+        declination = _by_dayofyear(declination_paper, dayofyear)
+        hour_angle = _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, dayofyear, longitude)
+        solar_zenith, solar_azimuth = sun_from_angles(declination, hour_angle, latitude)
+        vector = normal_vector(solar_zenith, solar_azimuth)
     elif model == "exact":
-        zenith, azimuth, equation_of_time, vector = spa_solar_position(grid.utc_ns, latitude, longitude, altitude)
+        solar_zenith, solar_azimuth, equation_of_time, vector = spa_solar_position(grid.utc_ns, latitude, longitude,
+                                                                                   altitude)
         utc_hours = (grid.utc_ns % _NS_PER_DAY) / NS_PER_HOUR
         hour_angle = (15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0) % 360.0 - 180.0
-        declination = _by_day_of_year(lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), doy)
+        declination = _by_dayofyear(lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), dayofyear)
     else:
         raise ValueError(f"model must be one of {', '.join(MODES)}; got {model!r}")
-    return {"solar_zenith": zenith, "solar_azimuth": azimuth, "hour_angle": hour_angle,
-            "declination": np.broadcast_to(declination, np.shape(zenith)), "sun_vector": vector}
+    return {"solar_zenith": solar_zenith, "solar_azimuth": solar_azimuth, "hour_angle": hour_angle,
+            "declination": np.broadcast_to(declination, np.shape(solar_zenith)), "sun_vector": vector}
 
 
 def get_solar_position(

@@ -215,13 +215,14 @@ def _raised(east, north, up, t):
 
 
 @njit(cache=True)
-def _site_sun(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, pressure, direction, zenith, azimuth):
+def _site_sun(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, pressure, direction, apparent_zenith,
+              solar_azimuth):
     """Every step of every block in one pass: the geometric topocentric unit vector toward the sun
     (east, north, up), from ``terms[:, first[b] + i]`` (:func:`_shared_terms`) and the site's
     arguments per block; its elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s
     formula and switch, at ``pressure`` [hPa] per block and :data:`SPA_TEMPERATURE`), which raises
     the vector in its vertical plane (:func:`_raised`) and the elevation. Writes ``direction``
-    (n_blocks, 3, n_steps), the apparent ``zenith`` and the ``azimuth`` [deg] (n_blocks, n_steps),
+    (n_blocks, 3, n_steps), ``apparent_zenith`` and ``solar_azimuth`` [deg] (n_blocks, n_steps),
     each value by the operations of the NumPy expressions this pass replaced, in their order."""
     n_blocks, n_steps = direction.shape[0], direction.shape[2]
     to_degrees, to_radians = 180.0 / math.pi, math.pi / 180.0
@@ -244,13 +245,13 @@ def _site_sun(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, pressure, 
             east, north, up = east * norm, north * norm, up * norm
             elevation = math.asin(min(max(up, -1.0), 1.0)) * to_degrees
             heading = math.atan2(east, north) * to_degrees
-            azimuth[b, i] = heading + 360.0 if heading < 0.0 else heading
+            solar_azimuth[b, i] = heading + 360.0 if heading < 0.0 else heading
             if elevation >= cut:
                 refraction = scale / (60 * math.tan((elevation + 10.3 / (elevation + 5.11)) * to_radians))
                 east, north, up = _raised(east, north, up, refraction * to_radians)
                 elevation += refraction
             direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
-            zenith[b, i] = 90.0 - elevation
+            apparent_zenith[b, i] = 90.0 - elevation
 
 
 def spa_solar_position(utc_ns, latitude, longitude, altitude):
@@ -281,7 +282,7 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
 
     Returns
     -------
-    apparent_zenith, azimuth : numpy.ndarray
+    apparent_zenith, solar_azimuth : numpy.ndarray
         [deg], azimuth clockwise from north, (n_blocks, n_steps).
     equation_of_time : numpy.ndarray
         [min], (n_blocks, n_steps).
@@ -306,9 +307,9 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     lam, phi = np.radians(longitude), np.radians(latitude)
     first, terms = _shared_terms(utc_ns)
     vector = np.empty((shape[0], 3, shape[1]))  # each component along the steps, as the engine reads it
-    zenith, azimuth = np.empty(shape), np.empty(shape)
+    apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
     pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
-    _site_sun(terms, first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure, vector, zenith,
-              azimuth)
+    _site_sun(terms, first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure, vector,
+              apparent_zenith, solar_azimuth)
     equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
-    return zenith, azimuth, equation_of_time, np.moveaxis(vector, 1, -1)
+    return apparent_zenith, solar_azimuth, equation_of_time, np.moveaxis(vector, 1, -1)

@@ -166,8 +166,8 @@ _UP = np.array([0.0, 0.0, 1.0])  # a level panel's normal
 def _resting(solar_zenith, latitude):
     """The sun's zenith [deg] as floats, where the sun is down, and the azimuth [deg] of a level
     panel at rest (facing the equator's side)."""
-    zenith = np.asarray(solar_zenith, dtype=float)
-    return zenith, zenith >= 90.0, np.where(np.asarray(latitude) >= 0, 180.0, 0.0)
+    solar_zenith = np.asarray(solar_zenith, dtype=float)
+    return solar_zenith, solar_zenith >= 90.0, np.where(np.asarray(latitude) >= 0, 180.0, 0.0)
 
 
 def _noon_declination(hour_angle, declination):
@@ -178,10 +178,10 @@ def _noon_declination(hour_angle, declination):
 
 def _dual_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector):
     """The ideal tracker: the normal on the sun, level at night."""
-    zenith, down, level_azimuth = _resting(solar_zenith, latitude)
-    azimuth = np.asarray(solar_azimuth, dtype=float)
-    on_sun = normal_vector(zenith, azimuth) if sun_vector is None else np.asarray(sun_vector, dtype=float)
-    return (np.where(down, 0.0, zenith), np.where(down, level_azimuth, azimuth),
+    solar_zenith, down, level_azimuth = _resting(solar_zenith, latitude)
+    solar_azimuth = np.asarray(solar_azimuth, dtype=float)
+    on_sun = normal_vector(solar_zenith, solar_azimuth) if sun_vector is None else np.asarray(sun_vector, dtype=float)
+    return (np.where(down, 0.0, solar_zenith), np.where(down, level_azimuth, solar_azimuth),
             np.where(down[..., None], _UP, on_sun))
 
 
@@ -190,8 +190,8 @@ def _equatorial(solar_zenith, solar_azimuth, hour_angle, declination, latitude, 
     _, down, level_azimuth = _resting(solar_zenith, latitude)
     hour_angle = np.asarray(hour_angle, dtype=float)
     normal = equatorial_normal(hour_angle, _noon_declination(hour_angle, declination), latitude)
-    tilt, azimuth = orientation_from_normal(normal, level_azimuth=level_azimuth)
-    return (np.where(down, 0.0, tilt), np.where(down, level_azimuth, azimuth),
+    surface_tilt, surface_azimuth = orientation_from_normal(normal, level_azimuth=level_azimuth)
+    return (np.where(down, 0.0, surface_tilt), np.where(down, level_azimuth, surface_azimuth),
             np.where(down[..., None], _UP, normal))
 
 
@@ -210,20 +210,20 @@ def _single_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude,
     """pvlib's single-axis tracker, flat along its axis at night."""
     import pvlib  # seconds to import: where a single-axis tracker runs, not where a study reads the registry
 
-    zenith, _, level_azimuth = _resting(solar_zenith, latitude)
+    solar_zenith, _, level_azimuth = _resting(solar_zenith, latitude)
     axis_azimuth = options.axis_azimuth if options.axis_azimuth is not None else level_azimuth
-    shape = zenith.shape
+    shape = solar_zenith.shape
     axis_azimuth = np.broadcast_to(axis_azimuth, shape)
     result = pvlib.tracking.singleaxis(
-        zenith.ravel(), np.asarray(solar_azimuth, dtype=float).ravel(), axis_tilt=options.axis_tilt,
+        solar_zenith.ravel(), np.asarray(solar_azimuth, dtype=float).ravel(), axis_tilt=options.axis_tilt,
         axis_azimuth=axis_azimuth.ravel(), max_angle=options.max_angle, backtrack=options.backtrack,
         gcr=options.gcr,
     )
     # At night pvlib returns NaN; the panel then rests flat along the axis.
-    tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt).reshape(shape)
-    azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
-    azimuth = np.where(np.isnan(azimuth), axis_azimuth, azimuth)
-    return tilt, azimuth, normal_vector(tilt, azimuth)
+    surface_tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt).reshape(shape)
+    surface_azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
+    surface_azimuth = np.where(np.isnan(surface_azimuth), axis_azimuth, surface_azimuth)
+    return surface_tilt, surface_azimuth, normal_vector(surface_tilt, surface_azimuth)
 
 
 @dataclass(frozen=True)
