@@ -209,5 +209,5 @@ def test_reproduce_writes_the_agreed_table(tmp_path):
         table = pd.read_csv(out / f"{name}.csv")
         assert list(table.columns) == ["quantity", "unit", "paper", "paper_mode", "exact_mode"]
         assert list(table["quantity"]) == list(PAPER_VALUES)
-    assert "twofold_opt_fold_angle_deg" in result.stdout
+    assert "fold_angle_twofold_deg" in result.stdout
     assert_one_line_error(invoke("reproduce", "--out", out), "already exists")

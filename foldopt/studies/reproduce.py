@@ -21,14 +21,14 @@ from foldopt.studies.day import Day, run_study, twofold_t_solar
 #: Shin et al. Sec. VI-VII and Fig. 12: (unit, published value); NaN where the paper is silent.
 PAPER_VALUES = {
     "p_load_w": ("W", np.nan),
-    "flat_t_solar_h": ("h", 7.73),
-    "tracker_t_solar_h": ("h", 11.11),
-    "twofold_opt_fold_angle_deg": ("deg", 29.8),
+    "t_solar_flat_h": ("h", 7.73),
+    "t_solar_tracker_h": ("h", 11.11),
+    "fold_angle_twofold_deg": ("deg", 29.8),
     "t_solar_twofold_h": ("h", 9.49),
-    "twofold_gain_vs_flat_pct": ("%", 23.0),
-    "twofold_pct_of_tracker": ("%", 85.4),
-    "fold90_gain_vs_flat_pct": ("%", 15.5),
-    "flat_area_multiple": ("-", 2.61),
+    "gain_vs_flat_twofold_pct": ("%", 23.0),
+    "pct_of_tracker_twofold": ("%", 85.4),
+    "gain_vs_flat_twofold90_pct": ("%", 15.5),
+    "flat_area_multiple_twofold": ("-", 2.61),
 }
 GEOMETRY_OF_MODE = {"paper": "azimuth-split", "exact": "hinge"}
 #: The reproduction tables `foldopt reproduce` writes: file stem -> changes to the paper study.
@@ -54,8 +54,8 @@ class Reproduction:
         return of_reproduction(self.tables, self.study)
 
 
-def infer_p_load(study: Study, flat_t_solar_h: float = PAPER_VALUES["flat_t_solar_h"][1]) -> float:
-    """Load at which the study's flat panel, in paper mode, runs ``flat_t_solar_h`` hours.
+def infer_p_load(study: Study, t_solar_flat_h: float = PAPER_VALUES["t_solar_flat_h"][1]) -> float:
+    """Load at which the study's flat panel, in paper mode, runs ``t_solar_flat_h`` hours.
 
     The paper does not state its load; on the paper's study this gives 4.398 W.
 
@@ -63,7 +63,7 @@ def infer_p_load(study: Study, flat_t_solar_h: float = PAPER_VALUES["flat_t_sola
     ----------
     study : Study
         The paper's study (``configs/shin2015.yaml``) or a variant.
-    flat_t_solar_h : float, default 7.73
+    t_solar_flat_h : float, default 7.73
         The flat panel's ``t_solar`` [h] (Shin et al. Sec. IV-A).
 
     Returns
@@ -72,7 +72,7 @@ def infer_p_load(study: Study, flat_t_solar_h: float = PAPER_VALUES["flat_t_sola
         Load [W] (:func:`foldopt.engine.metrics.load_for_t_solar`).
     """
     day = Day(study.variant(mode="paper"))
-    return load_for_t_solar(day.flat_power(), flat_t_solar_h, day.step_hours)
+    return load_for_t_solar(day.flat_power(), t_solar_flat_h, day.step_hours)
 
 
 def reproduction_values(study: Study, engine: str = "numba") -> dict[str, float]:
@@ -92,17 +92,17 @@ def reproduction_values(study: Study, engine: str = "numba") -> dict[str, float]
     result = run_study(study, engine)
     summary = result.summary.set_index("design")
     flat, twofold, tracker = (summary.loc[name] for name in ("flat", "twofold", "tracker"))
-    fold90 = twofold_t_solar(result.day, 90.0)
+    t_solar_twofold90 = twofold_t_solar(result.day, 90.0)
     return {
         "p_load_w": study.p_load,
-        "flat_t_solar_h": flat["t_solar_h"],
-        "tracker_t_solar_h": tracker["t_solar_h"],
-        "twofold_opt_fold_angle_deg": twofold["fold_angle_deg"],
+        "t_solar_flat_h": flat["t_solar_h"],
+        "t_solar_tracker_h": tracker["t_solar_h"],
+        "fold_angle_twofold_deg": twofold["fold_angle_deg"],
         "t_solar_twofold_h": twofold["t_solar_h"],
-        "twofold_gain_vs_flat_pct": twofold["gain_vs_flat_pct"],
-        "twofold_pct_of_tracker": twofold["pct_of_tracker"],
-        "fold90_gain_vs_flat_pct": (fold90 / flat["t_solar_h"] - 1.0) * 100.0,
-        "flat_area_multiple": twofold["flat_area_multiple"],
+        "gain_vs_flat_twofold_pct": twofold["gain_vs_flat_pct"],
+        "pct_of_tracker_twofold": twofold["pct_of_tracker"],
+        "gain_vs_flat_twofold90_pct": (t_solar_twofold90 / flat["t_solar_h"] - 1.0) * 100.0,
+        "flat_area_multiple_twofold": twofold["flat_area_multiple"],
     }
 
 
