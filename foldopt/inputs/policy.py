@@ -10,7 +10,8 @@ it is made. The rules, each said back to the user by :func:`apply`'s second valu
   paper's beam-only Eq. 5 gives a level panel at the equator almost no beam, and it has no
   altitude term and no diffuse light;
 - a change of mode gives the new mode its own geometry (azimuth-split in paper mode, hinge in
-  exact) unless the geometry is given;
+  exact) and its own sky (Ineichen with diffuse light in exact mode, the paper's beam-only Meinel
+  sky in paper mode) unless the geometry or the sky is given;
 - a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
   given; a new latitude or longitude drops the site's name, a new longitude its time zone;
 - a weather file brings its own site, year and light (the study's sky, site and day give way), and
@@ -202,8 +203,9 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         data["mode"] = "exact"
         decided.append(MOUNTING_NOTE)
     new_mode = changes.get("mode", data.get("mode", "exact"))
-    if new_mode != old_mode and "geometry" not in given:
-        data.pop("geometry", None)  # the new mode's own geometry
+    for field in ("geometry", "sky"):
+        if new_mode != old_mode and field not in given:
+            data.pop(field, None)  # the new mode's own
     site = data.get("site")
     moved = touched(given, "site.latitude") or touched(given, "site.longitude") or (
         weather is not None and "site" not in data)

@@ -25,6 +25,9 @@ from foldopt.inputs.optimize_section import Optimize
 from foldopt.inputs.sections import FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site, Tracker
 from foldopt.inputs.weather_section import Weather
 
+#: Each mode's default clear sky: pvlib's Ineichen (with diffuse light, Perez transposition at the
+#: site's Linke turbidity) in exact mode, the paper's beam-only Meinel sky in paper mode.
+MODE_SKIES = {"exact": "ineichen", "paper": "meinel"}
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
 EARTH_RADIUS_KM = 6371.0
 #: The site of a study whose weather file is not read yet (built in Python): None until
@@ -88,8 +91,10 @@ class Study(StrictModel):
         One of :data:`foldopt.names.GEOMETRIES`; default azimuth-split in paper mode, hinge in exact.
     fold_angles : FoldAngles
     near_optimal : NearOptimal
-    sky : str
-        One of :data:`foldopt.names.SKIES` (no use with a weather file); default ``meinel``.
+    sky : str, optional
+        One of :data:`foldopt.names.SKIES` (no use with a weather file); default ``ineichen`` in
+        exact mode (with Perez transposition at the site's Linke turbidity), ``meinel`` (the
+        paper's beam-only sky) in paper mode.
     linke_turbidity : float, optional
         [-] in (0, 10] for ``ineichen``; default pvlib's climatology.
     transposition : str, optional
@@ -148,7 +153,8 @@ class Study(StrictModel):
     )
     fold_angles: FoldAngles = FoldAngles()
     near_optimal: NearOptimal = NearOptimal()
-    sky: named(names.SKIES) = "meinel"
+    sky: named(names.SKIES) | None = Field(
+        None, description="clear sky; default ineichen in exact mode, meinel (the paper's beam-only) in paper")
     linke_turbidity: interval(0, 10, lo_open=True) | None = Field(
         None, description="ineichen; default pvlib's climatology")
     transposition: named(names.TRANSPOSITIONS) | None = Field(
@@ -278,11 +284,13 @@ class Study(StrictModel):
         defaults = {name: field.default for name, field in Study.model_fields.items()}
         # What a resolved study fills in is no setting of the user's.
         defaults["temperature_model"] = (None, "fixed" if self.mode == "paper" else "sapm")
+        defaults["sky"] = (None, MODE_SKIES[self.mode])
+        sky = self.sky or MODE_SKIES[self.mode]
         iv_model = self.pv_model != "ideal"
         series_used = self.connection == "series" or (self.connection == "switching" and self.switch_series)
         rules = [
-            ("climate", self.sky == "hottel", "is only used by sky hottel"),
-            ("linke_turbidity", self.sky == "ineichen" or self.weather is not None,
+            ("climate", sky == "hottel", "is only used by sky hottel"),
+            ("linke_turbidity", sky == "ineichen" or self.weather is not None,
              "is only used by sky ineichen and weather files"),
             ("sky", self.weather is None, "has no use with a weather file (its light shapes the minutes)"),
             ("albedo", self.sky_transposition() != "none", "is only used with a transposition (diffuse light)"),
@@ -315,7 +323,8 @@ class Study(StrictModel):
         """
         if self.transposition is not None:
             return self.transposition
-        return "none" if self.mode == "paper" or (self.weather is None and self.sky in names.BEAM_SKIES) else "perez"
+        sky = self.sky or MODE_SKIES[self.mode]
+        return "none" if self.mode == "paper" or (self.weather is None and sky in names.BEAM_SKIES) else "perez"
 
     @field_validator("tracker", mode="before")
     @classmethod
@@ -394,8 +403,8 @@ class Study(StrictModel):
         Returns
         -------
         Study
-            With the panel's tilt and azimuth [deg], the site's time zone, the geometry and the
-            temperature model filled in.
+            With the panel's tilt and azimuth [deg], the site's time zone, the geometry, the
+            temperature model and the sky filled in.
 
         Raises
         ------
@@ -426,6 +435,7 @@ class Study(StrictModel):
                 "site": self.site.resolved(),
                 "geometry": geometry,
                 "temperature_model": temperature,
+                "sky": self.sky or MODE_SKIES[self.mode],
             }
         )
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from foldopt.inputs.study import MODE_SKIES
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
@@ -446,8 +447,9 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                    "loads": per_load, "cluster": result.cluster, "dashboard": result.dashboard,
                    "chunks_computed": len(result.computed), "chunks_from_disk": len(result.from_disk),
                    "seconds": round(result.seconds, 2)})
-    sky = "weather files" if any("weather" in site for site in spec.sites) else "Ineichen clear sky" if study.get(
-        "sky") == "ineichen" else f"{study.get('sky') or 'meinel'} sky"  # a study that names no sky has Meinel's
+    named_sky = study.get("sky") or MODE_SKIES[study.get("mode", "exact")]  # no sky named: its mode's
+    sky = ("weather files" if any("weather" in site for site in spec.sites)
+           else "Ineichen clear sky" if named_sky == "ineichen" else f"{named_sky} sky")
     lines = [f"map: {_count(part['sites'], 'site')}, year {spec.year}, {sky}, objective {part['objective']}, "
              f"{study['panel']['area']:g} m^2 panel"]
     for load in part["loads"]:

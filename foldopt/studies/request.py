@@ -468,8 +468,8 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
     ----------
     study : dict, str, pathlib.Path or None
         The study's fields, or a YAML study to read them from, that the map takes its panel, models
-        and load from; None for the embedded study, whose mode, sky, geometry and step give way to
-        :data:`foldopt.studies.worldmap.MAP_DEFAULTS`.
+        and load from; None for the embedded study, whose mode and step give way to
+        :data:`foldopt.studies.worldmap.MAP_DEFAULTS` (its sky and geometry exact mode's).
     source : str
         How the answer names the study.
     objective : str
