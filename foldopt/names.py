@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import re
+import typing
 
 
 class Registry(tuple):
@@ -161,6 +162,109 @@ OUTPUT_FORMATS = Registry("format", {
 REGISTRIES = (MODES, GEOMETRIES, SKIES, TRANSPOSITIONS, IAMS, PV_MODELS, TEMPERATURE_MODELS, CONNECTIONS,
               CONVERTER_MODELS, COUPLINGS, TRACKERS, DRIVES, WEATHER_FORMATS, DECOMPOSITIONS, INTERVAL_LABELS,
               HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS, DIODE_MODELS)
+
+class FieldOption(typing.NamedTuple):
+    """One command-line option and the study field it sets (:data:`FIELD_OPTIONS`).
+
+    Attributes
+    ----------
+    option : str
+        The option, ``--p-load``; its parameter (:attr:`parameter`) is its name in snake case.
+    field : str
+        The study field it sets, a dotted path.
+    aliases : tuple of str
+        Other spellings of the option (``--date`` for ``--days``); messages name them all.
+    flag : bool, optional
+        For a flag, the value it sets the field to (``--no-bypass`` sets ``bypass_diodes`` False).
+    also : tuple of str
+        Other fields messages name by this option (``--angle-step`` also sets where the fold
+        angles start).
+    """
+
+    option: str
+    field: str
+    aliases: tuple = ()
+    flag: bool | None = None
+    also: tuple = ()
+
+    @property
+    def parameter(self) -> str:
+        """The option as a Python parameter: ``--p-load-scale`` -> ``p_load_scale``."""
+        return self.option.lstrip("-").replace("-", "_")
+
+    @property
+    def label(self) -> str:
+        """The option as a message names it: ``--days/--date``."""
+        return "/".join((self.option, *self.aliases))
+
+
+#: The command line's options that set study fields, each once: ``foldopt sweep``'s and
+#: ``optimize``'s options become field changes by it (:data:`FIELD_OF_PARAMETER`), and the
+#: library's messages name the options instead of the fields (:func:`option_labels`).
+FIELD_OPTIONS = (
+    FieldOption("--lat", "site.latitude"), FieldOption("--lon", "site.longitude"),
+    FieldOption("--altitude", "site.altitude"), FieldOption("--timezone", "site.timezone"),
+    FieldOption("--days", "date", aliases=("--date",)), FieldOption("--year", "year"),
+    FieldOption("--p-load", "p_load"), FieldOption("--p-load-scale", "p_load"),
+    FieldOption("--area", "panel.area"), FieldOption("--efficiency", "panel.efficiency"),
+    FieldOption("--tilt", "panel.tilt"), FieldOption("--azimuth", "panel.azimuth"),
+    FieldOption("--mode", "mode"), FieldOption("--geometry", "geometry"),
+    FieldOption("--sky", "sky"), FieldOption("--climate", "climate"),
+    FieldOption("--weather", "weather"), FieldOption("--force-site", "force_site", flag=True),
+    FieldOption("--transposition", "transposition"), FieldOption("--albedo", "albedo"),
+    FieldOption("--iam", "iam"), FieldOption("--objective", "objective.statistic"),
+    FieldOption("--visits", "objective.visits"), FieldOption("--tracker", "tracker.model"),
+    FieldOption("--tracker-standby", "tracker.standby_w"), FieldOption("--pv-model", "pv_model"),
+    FieldOption("--module", "module"), FieldOption("--connection", "connection"),
+    FieldOption("--switch-series", "switch_series", flag=True),
+    FieldOption("--no-bypass", "bypass_diodes", flag=False),
+    FieldOption("--converter-efficiency", "converter_efficiency"),
+    FieldOption("--temp-air", "temp_air"),
+    FieldOption("--exact-electrical", "exact_electrical", flag=True),
+    FieldOption("--step-min", "step_min"),
+    FieldOption("--angle-step", "fold_angles.step", also=("fold_angles.start",)),
+    FieldOption("--load-profile", "load_profile"),
+    FieldOption("--weather-format", "weather.format"), FieldOption("--members", "weather.members"),
+    FieldOption("--seed", "weather.seed"), FieldOption("--horizon", "site.horizon"),
+    FieldOption("--blocking-diode", "circuit.blocking_diode.model"),
+    FieldOption("--bypass-diode", "circuit.bypass_diode.model"),
+    FieldOption("--converter", "circuit.converter.model"),
+    FieldOption("--load-voltage", "circuit.load_voltage"),
+    FieldOption("--switch-resistance", "circuit.switch_resistance"),
+)
+#: Each option's parameter -> the field it sets.
+FIELD_OF_PARAMETER = {entry.parameter: entry.field for entry in FIELD_OPTIONS}
+
+
+def option_labels(given=()) -> dict[str, str]:
+    """Study fields as the options that set them name them, for messages.
+
+    Parameters
+    ----------
+    given : collection of str
+        The parameters of the options given: of several options that set one field
+        (``--p-load``, ``--p-load-scale``), the one given names it; else the first.
+
+    Returns
+    -------
+    dict
+        Field path -> option label (:attr:`FieldOption.label`).
+
+    Examples
+    --------
+    >>> option_labels()["p_load"], option_labels({"p_load_scale"})["p_load"]
+    ('--p-load', '--p-load-scale')
+    """
+    labels = {}
+    for entry in FIELD_OPTIONS:
+        for field in (entry.field, *entry.also):
+            if field not in labels or entry.parameter in given:
+                labels[field] = entry.label
+    return labels
+
+
+#: Study fields as the options that set them name them (:func:`option_labels`, none given).
+OPTION_OF_FIELD = option_labels()
 
 #: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.physics.trackers).
 #: His 12 actuating times (local time) pair up symmetrically about 13.319 h: 8.839/17.799,

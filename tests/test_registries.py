@@ -54,3 +54,35 @@ def test_help_lists_the_registries():
     text = re.sub(r"[\s│]+", " ", runner.invoke(app, ["sweep", "angle", "--help"], terminal_width=400).output)
     for registry in (names.PV_MODELS, names.CONNECTIONS, names.TRACKERS):
         assert registry.choices() in text, registry.kind
+
+
+#: Options of ``foldopt sweep`` and ``optimize`` that set no study field, by parameter.
+_OWN_OPTIONS = {"config", "settings", "out", "overwrite", "quiet", "output_format", "engine", "table", "vary",
+                "fold_range", "tilt_range", "azimuth_range", "tolerance"}
+
+
+@pytest.mark.parametrize("path", [["sweep", "angle"], ["sweep", "load"], ["optimize"]], ids=" ".join)
+def test_the_options_that_set_fields_are_one_table(path):
+    """Every option of the command that sets a study field is an entry of names.FIELD_OPTIONS,
+    spelt as the command declares it, and every entry is such an option: the options become field
+    changes, and a message's field becomes the option, through that one table."""
+    import typer.main
+
+    command = typer.main.get_command(app)
+    for name in path:
+        command = command.commands[name]
+    declared = {param.name: [*param.opts, *param.secondary_opts] for param in command.params}
+    for entry in names.FIELD_OPTIONS:
+        assert sorted(declared[entry.parameter]) == sorted([entry.option, *entry.aliases]), entry
+    assert set(declared) - _OWN_OPTIONS == set(names.FIELD_OF_PARAMETER)
+
+
+def test_a_flag_sets_its_field_to_the_table_value():
+    from foldopt.studies.request import sweep_changes
+
+    unset = {**dict.fromkeys(names.FIELD_OF_PARAMETER), "settings": None}
+    for entry in names.FIELD_OPTIONS:
+        if entry.flag is not None:
+            assert sweep_changes({**unset, entry.parameter: True}, {}) == {entry.field: entry.flag}
+    assert names.option_labels()["fold_angles.start"] == "--angle-step"
+    assert names.option_labels({"p_load_scale"})["p_load"] == "--p-load-scale"

@@ -12,7 +12,7 @@ from typing import Optional
 import typer
 
 from foldopt import names
-from foldopt.cli.options import EMBEDDED, OPTION_OF_FIELD, RESULTS, check_choices, rename_fields
+from foldopt.cli.options import EMBEDDED, RESULTS, check_choices, rename_fields
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
 from foldopt.cli.sweep import signature, sweep_options
@@ -55,9 +55,8 @@ def optimize(**options):
     out, overwrite = options.pop("out"), options.pop("overwrite")
     config = options.pop("config")
     own = {name: options.pop(name) for name in ("vary", "fold_range", "tilt_range", "azimuth_range", "tolerance")}
-    labels = {**OPTION_OF_FIELD, **_optimize_labels(own)}
-    if options["p_load_scale"] is not None:
-        labels["p_load"] = "--p-load-scale"
+    given = {name for name, value in options.items() if value is not None}
+    labels = {**names.option_labels(given), **_optimize_labels(own)}
     try:
         section = optimize_section(own["vary"], own["fold_range"], own["tilt_range"], own["azimuth_range"],
                                    own["tolerance"], labels=OPTIMIZE_OPTIONS)

@@ -14,6 +14,7 @@ from pathlib import Path
 import typer
 
 from foldopt import names
+from foldopt.names import OPTION_OF_FIELD
 from foldopt.cli.output import fail
 
 #: Where results folders go unless ``--out`` says otherwise.
@@ -107,24 +108,6 @@ def check_choices(output_format: str, engine: str) -> tuple[str, str]:
     return tuple(chosen)
 
 
-#: Study fields as the command-line options name them, so errors speak the user's words.
-OPTION_OF_FIELD = {
-    "site.latitude": "--lat", "site.longitude": "--lon", "site.altitude": "--altitude",
-    "site.timezone": "--timezone", "date": "--days/--date", "p_load": "--p-load", "panel.area": "--area",
-    "panel.efficiency": "--efficiency", "panel.tilt": "--tilt", "panel.azimuth": "--azimuth",
-    "mode": "--mode", "geometry": "--geometry", "sky": "--sky", "step_min": "--step-min",
-    "connection": "--connection", "fold_angles.step": "--angle-step", "fold_angles.start": "--angle-step",
-    "pv_model": "--pv-model", "module": "--module", "temp_air": "--temp-air",
-    "converter_efficiency": "--converter-efficiency", "year": "--year", "climate": "--climate",
-    "tracker.model": "--tracker", "tracker.standby_w": "--tracker-standby", "transposition": "--transposition",
-    "objective.statistic": "--objective", "objective.visits": "--visits", "weather": "--weather", "albedo": "--albedo",
-    "iam": "--iam", "switch_series": "--switch-series", "bypass_diodes": "--no-bypass",
-    "exact_electrical": "--exact-electrical", "force_site": "--force-site", "load_profile": "--load-profile",
-    "weather.format": "--weather-format", "weather.members": "--members", "weather.seed": "--seed",
-    "site.horizon": "--horizon", "circuit.blocking_diode.model": "--blocking-diode",
-    "circuit.bypass_diode.model": "--bypass-diode", "circuit.converter.model": "--converter",
-    "circuit.load_voltage": "--load-voltage", "circuit.switch_resistance": "--switch-resistance",
-}
 _FIELD = re.compile(r"^([A-Za-z_.]+)(\[\d+\])?")
 
 

@@ -13,7 +13,7 @@ from typing import Optional
 import typer
 
 from foldopt import names
-from foldopt.cli.options import (ANGLE_STEP, AREA, EFFICIENCY, EMBEDDED, ENGINE, FORMAT, OPTION_OF_FIELD, OVERWRITE,
+from foldopt.cli.options import (ANGLE_STEP, AREA, EFFICIENCY, EMBEDDED, ENGINE, FORMAT, OVERWRITE,
                                  QUIET, RESULTS, SETTINGS, TABLE, check_choices, out_option, rename_fields,
                                  step_min_option)
 from foldopt.cli.output import Output, fail
@@ -190,8 +190,8 @@ def _sweep(axis: str, options: dict) -> None:
     output = Output(options.pop("quiet"), output_format, options.pop("table"))
     out, overwrite = options.pop("out"), options.pop("overwrite")
     config = options.pop("config")
-    # --p-load and --p-load-scale both set p_load: a message names the one given.
-    options_of = OPTION_OF_FIELD if options["p_load_scale"] is None else {**OPTION_OF_FIELD, "p_load": "--p-load-scale"}
+    # Of the options that set one field (--p-load, --p-load-scale), a message names the one given.
+    options_of = names.option_labels({name for name, value in options.items() if value is not None})
     try:
         request = sweep_request(config, options, axis, EMBEDDED if config is None else str(config))
     except ConfigError as error:

@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 from foldopt.inputs import policy
 from foldopt.inputs.load import default_study_path, parse_study_text, read_study
 from foldopt.inputs.optimize_section import vary_names
-from foldopt.names import OPTIMIZE_VARIABLES
+from foldopt.names import FIELD_OF_PARAMETER, FIELD_OPTIONS, OPTIMIZE_VARIABLES
 from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
 from foldopt.errors import ConfigError
 
@@ -38,26 +38,10 @@ KEYWORDS = {
 #: Loads of a load sweep's default range: shares of the panel's rating (area x 1000 W/m^2 x efficiency).
 DEFAULT_LOAD_SHARES = 20
 _ISO_DATE = re.compile(r"^(\d{4})-\d\d-\d\d$")
-#: The command line's sweep options -> the study field each sets (:func:`sweep_changes`).
-SWEEP_OPTIONS = {
-    "lat": "site.latitude", "lon": "site.longitude", "altitude": "site.altitude", "timezone": "site.timezone",
-    "days": "date", "year": "year", "p_load": "p_load", "p_load_scale": "p_load", "area": "panel.area",
-    "efficiency": "panel.efficiency", "tilt": "panel.tilt", "azimuth": "panel.azimuth", "mode": "mode",
-    "geometry": "geometry", "sky": "sky", "climate": "climate", "weather": "weather", "force_site": "force_site",
-    "transposition": "transposition", "albedo": "albedo", "iam": "iam", "objective": "objective.statistic",
-    "visits": "objective.visits", "tracker": "tracker.model", "tracker_standby": "tracker.standby_w",
-    "pv_model": "pv_model", "module": "module", "connection": "connection", "switch_series": "switch_series",
-    "no_bypass": "bypass_diodes", "converter_efficiency": "converter_efficiency", "temp_air": "temp_air",
-    "exact_electrical": "exact_electrical", "step_min": "step_min", "angle_step": "fold_angles.step",
-    "load_profile": "load_profile", "weather_format": "weather.format", "members": "weather.members",
-    "seed": "weather.seed", "horizon": "site.horizon", "blocking_diode": "circuit.blocking_diode.model",
-    "bypass_diode": "circuit.bypass_diode.model", "converter": "circuit.converter.model",
-    "load_voltage": "circuit.load_voltage", "switch_resistance": "circuit.switch_resistance",
-}
 #: Sweep options that take a value, a range or a list (:func:`foldopt.inputs.plan.parse_values`).
 _LISTED = ("lat", "lon", "p_load", "p_load_scale", "tilt", "days")
 #: Sweep flags and what each sets its field to.
-_FLAGS = {"switch_series": True, "exact_electrical": True, "force_site": True, "no_bypass": False}
+_FLAGS = {entry.parameter: entry.flag for entry in FIELD_OPTIONS if entry.flag is not None}
 #: The sizing's largest values and their units, by parameter (:attr:`foldopt.studies.sizing.SizingResult.parameters`).
 #: Within them every benefit, cost and net benefit over areas up to 1000 m^2 stays far below float
 #: overflow (the largest is some 1e13 $); beyond them a value is a slip, and 1e308 $/m^2 would print
@@ -322,8 +306,9 @@ def sweep_changes(options: dict, data: dict) -> dict:
     Parameters
     ----------
     options : dict
-        Each option of ``foldopt sweep`` by its parameter name (the keys of :data:`SWEEP_OPTIONS`
-        and ``settings``, the ``--set`` texts) -> its value, None (or False) where not given.
+        Each option of ``foldopt sweep`` by its parameter name (the keys of
+        :data:`foldopt.names.FIELD_OF_PARAMETER` and ``settings``, the ``--set`` texts) -> its
+        value, None (or False) where not given.
     data : dict
         The study's fields the sweep starts from.
 
@@ -367,7 +352,7 @@ def sweep_changes(options: dict, data: dict) -> dict:
             value = {"file": str(value)}
         elif option == "load_voltage":
             changes["circuit.coupling"] = "direct"
-        changes[SWEEP_OPTIONS[option]] = value
+        changes[FIELD_OF_PARAMETER[option]] = value
     if errors:
         raise ConfigError(errors)
     for setting in options["settings"] or ():
