@@ -23,8 +23,7 @@ from foldopt.engine.metrics import (design_condition, energy_served, load_for_t_
                              per_load, relative_to, t_solar)
 from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.studies.sizing import flat_area_multiple
-from foldopt.studies.designs import (DESIGNS, Blocks, design_metrics, sky_tracker_draw, sky_tracker_orientation,
-                                     sky_tracker_power, standby_available)
+from foldopt.studies.designs import DESIGNS, Blocks, TrackerCurves, design_metrics, standby_available, tracker_curves
 from foldopt.studies.objectives import near_optimal
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
@@ -56,7 +55,7 @@ class Day:
         self.ghi = None if sky.ghi is None else sky.ghi[0]
         self.dhi = None if sky.dhi is None else sky.dhi[0]
         self.transposition = study.sky_transposition()
-        self._tracker_orientations: dict = {}
+        self._trackers: dict = {}
 
     def _poa(self, surface_tilt, surface_azimuth, per_step=False):
         """Irradiance on surfaces [W/m^2]: one orientation per row, (k,) -> (k, n_time), or, with
@@ -75,8 +74,6 @@ class Day:
     def tracker_orientation(self, model=None):
         """Surface tilt and azimuth of a tracker over the day.
 
-        Kept per model: a tracker's power, its draw and the standby sweep all steer by it.
-
         Parameters
         ----------
         model : str, optional
@@ -87,13 +84,21 @@ class Day:
         surface_tilt, surface_azimuth : numpy.ndarray
             [deg], (n_time,).
         """
-        return tuple(angle[0] for angle in self._tracker_sky_orientation(model)[:2])
+        return tuple(angle[0] for angle in self.tracker(model).orientation[:2])
 
-    def _tracker_sky_orientation(self, model=None):
+    def tracker(self, model=None) -> TrackerCurves:
+        """A tracker's orientation, power and own draw over the day, worked out once per model: the
+        summary's rows, the standby sweep and the figures all take them from here.
+
+        Parameters
+        ----------
+        model : str, optional
+            One of :data:`foldopt.names.TRACKERS`; default the study's.
+        """
         model = model or self.study.tracker.model
-        if model not in self._tracker_orientations:
-            self._tracker_orientations[model] = sky_tracker_orientation(self.sky, self.study, model)
-        return self._tracker_orientations[model]
+        if model not in self._trackers:
+            self._trackers[model] = tracker_curves(self.sky, self.study, model)
+        return self._trackers[model]
 
     def tracker_power(self, model=None):
         """Power of the same panel on a tracker [W], shape (n_time,).
@@ -103,7 +108,7 @@ class Day:
         model : str, optional
             One of :data:`foldopt.names.TRACKERS`; default the study's.
         """
-        return sky_tracker_power(self.sky, self.study, self._tracker_sky_orientation(model))[0]
+        return self.tracker(model).power[0]
 
     def tracker_draw(self, model=None):
         """The tracker's own draw [W] per step, (n_time,): standby while the sun is up, plus its moves.
@@ -113,7 +118,7 @@ class Day:
         model : str, optional
             One of :data:`foldopt.names.TRACKERS`; default the study's.
         """
-        return sky_tracker_draw(self.sky, self.study, self._tracker_sky_orientation(model))[0]
+        return self.tracker(model).draw[0]
 
     def orientation(self, fold_angles):
         """Sub-panel orientations of the study's panel at fold angles.
@@ -271,52 +276,59 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     metrics = engines.row_metrics(day.sky, study, np.zeros(angles.size), day.orientation(angles), [p_load],
                                   outputs=CONNECTIONS, contiguous=True, engine=engine)
     own = CONNECTIONS.index(study.connection)
-    served = None if shape is None else energy_served(day.combined_power(angles), p_load, shape, step,
+    # The grid's curves, once: the noon valley's sub-panels and, under a load profile, the served
+    # energy's connection (curves the metrics above do not keep).
+    curves, _ = day.connections(angles, shape is not None and (study.connection == "series" or study.switch_series),
+                                with_state=False)
+    served = None if shape is None else energy_served(curves[study.connection], p_load, shape, step,
                                                       metrics.t_solar[:, own, 0])
     sweep = pd.DataFrame({"fold_angle_deg": angles,
                           **metric_columns(metrics.t_solar[:, own, 0], metrics.t_solar_contiguous[:, own, 0],
                                             metrics.energy[:, own], metrics.peak[:, own], p_load, served)})
-    sweep["noon_valley_w"] = noon_valley(*day.subpanel_power(angles))
+    sweep["noon_valley_w"] = noon_valley(curves["east"], curves["west"], curves["parallel"])
     for index, connection in enumerate(CONNECTIONS):
         sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
         sweep[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
 
     best_angle, best_hours = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
+    p_flat, tracker = day.flat_power(), day.tracker()
     # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
     # noon (the flat panel's peak).
-    noon_load = p_load if shape is None else p_load * shape[int(np.argmax(day.flat_power()))]
+    noon_load = p_load if shape is None else p_load * shape[int(np.argmax(p_flat))]
     paper_angle = heuristic_fold_angle(day.subpanel_power, noon_load) if noon_load > 0 else np.nan
 
-    p_flat, p_tracker = day.flat_power(), day.tracker_power()
-    designs = {"flat": (180.0, p_flat), "twofold": (best_angle, day.combined_power(np.array([best_angle]))[0])}
+    # The designs every study compares, each evaluated once, as for sweeps, annual studies and maps
+    # (the study's tracker from the curve the figures draw); the others (the heuristic's angle, the
+    # other connections, the other trackers) from their curves.
+    main = design_metrics(day.sky, Blocks.of([study]), np.array([p_load]), np.array([best_angle]),
+                          np.zeros((1, 1), dtype=int), engine, tracker)
+    others = {}
     if np.isfinite(paper_angle):
-        designs["twofold-heuristic"] = (paper_angle, day.combined_power(np.array([paper_angle]))[0])
+        others["twofold-heuristic"] = (paper_angle, day.combined_power(np.array([paper_angle]))[0])
     if day.electrical.pv.has_iv:
         for connection in ("parallel", "series", "independent", "switching"):
             if connection != study.connection:
                 angle = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection)[0]
-                designs[f"twofold-{connection}"] = (angle, day.combined_power(np.array([angle]), connection)[0])
-    # The study's tracker is "tracker"; every other model follows as "tracker:<model>". Each net row
-    # is what is left for the load after the tracker's own draw.
-    for model in (study.tracker.model,) + tuple(m for m in TRACKERS if m != study.tracker.model):
-        name = "tracker" if model == study.tracker.model else f"tracker:{model}"
-        gross = p_tracker if model == study.tracker.model else day.tracker_power(model)
-        designs[name] = (np.nan, gross)
-        designs[f"{name}-net"] = (np.nan, gross - day.tracker_draw(model))
-
-    design_power = np.stack([power for _, power in designs.values()])
-    curves = engines.curve_metrics(design_power, [p_load], step, contiguous=True, engine=engine, load_shape=shape)
-    served = None if shape is None else energy_served(design_power, p_load, shape, step, curves.t_solar[:, 0, 0])
-    summary = pd.DataFrame({"design": list(designs), "fold_angle_deg": [angle for angle, _ in designs.values()],
-                            **metric_columns(curves.t_solar[:, 0, 0], curves.t_solar_contiguous[:, 0, 0],
-                                              curves.energy[:, 0], curves.peak[:, 0], p_load, served)})
-    # The designs every study compares come from the one design evaluation (as for sweeps, annual
-    # studies and maps); the others (the heuristic, other connections, other trackers) from their curves.
-    main = design_metrics(day.sky, Blocks.of([study]), np.array([p_load]), np.array([best_angle]),
-                          np.zeros((1, 1), dtype=int), engine)
-    rows = [list(designs).index(design) for design in DESIGNS]
-    for column in summary.columns.drop(["design", "fold_angle_deg"]):
-        summary.loc[rows, column] = main[column][0, 0]
+                others[f"twofold-{connection}"] = (angle, day.combined_power(np.array([angle]), connection)[0])
+    # Every other tracker model follows the study's as "tracker:<model>"; each net row is what is
+    # left for the load after the tracker's own draw.
+    for model in (m for m in TRACKERS if m != study.tracker.model):
+        others[f"tracker:{model}"] = (np.nan, day.tracker(model).power[0])
+        others[f"tracker:{model}-net"] = (np.nan, day.tracker(model).net[0])
+    power = np.stack([power for _, power in others.values()])
+    curve = engines.curve_metrics(power, [p_load], step, contiguous=True, engine=engine, load_shape=shape)
+    served = None if shape is None else energy_served(power, p_load, shape, step, curve.t_solar[:, 0, 0])
+    columns = metric_columns(curve.t_solar[:, 0, 0], curve.t_solar_contiguous[:, 0, 0], curve.energy[:, 0],
+                             curve.peak[:, 0], p_load, served)
+    # The rows as the report shows them: flat, the twofold panels, then the trackers.
+    angle_of = {"flat": 180.0, "twofold": best_angle,
+                **{name: angle for name, (angle, _) in others.items() if name.startswith("twofold")},
+                "tracker": np.nan, "tracker-net": np.nan,
+                **{name: angle for name, (angle, _) in others.items() if name.startswith("tracker")}}
+    order = [[*DESIGNS, *others].index(name) for name in angle_of]
+    summary = pd.DataFrame({"design": list(angle_of), "fold_angle_deg": list(angle_of.values()),
+                            **{name: np.concatenate([main[name][0, 0], values])[order]
+                               for name, values in columns.items()}})
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
@@ -333,7 +345,7 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
                  for design in summary["design"]]
     summary["note"] = notes(design_condition(condition, summary["energy_harvested_wh"].to_numpy(float)),
                             summary["t_solar_h"].to_numpy())
-    standby = standby_sweep(day, p_tracker, by_design["twofold"])
+    standby = standby_sweep(day, tracker.power[0], by_design["twofold"])
 
     at_best, state = day.connections(np.array([best_angle]))
     timeseries = pd.DataFrame(
@@ -350,7 +362,7 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
             **{f"p_{connection}_w": at_best[connection][0] for connection in CONNECTIONS},
             "p_twofold_w": at_best[study.connection][0],
             "switch_state": np.where(at_best["switching"][0] > 0, np.array(SWITCH_STATES)[state[0]], "off"),
-            "p_tracker_w": p_tracker,
+            "p_tracker_w": tracker.power[0],
             "p_load_w": p_load if shape is None else p_load * shape,
         },
         index=pd.DatetimeIndex(day.times, name="time"),

@@ -12,8 +12,9 @@ share one setup) and a set of loads:
 - :func:`design_metrics`: every daily metric of the four :data:`DESIGNS` at a chosen angle;
 - :func:`daily_designs`: each day's t_solar and energy of every design at every angle, for
   statistics over many days (:func:`foldopt.studies.objectives.objective_value`);
-- the trackers' orientation, power and own draw (:func:`sky_tracker_power`,
-  :func:`sky_tracker_draw`) and what a standby draw leaves (:func:`standby_available`).
+- the trackers' orientation, power and own draw, worked out once a sky (:func:`tracker_curves`,
+  which a day's figures draw and its table's rows are reduced from), and what a standby draw
+  leaves (:func:`standby_available`).
 """
 
 from __future__ import annotations
@@ -32,6 +33,8 @@ from foldopt.studies.blocks import CHUNK_ROW_LOADS, Blocks, setup_key  # noqa: F
 from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
+
+
 def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
     """Surface tilt and azimuth of a tracker [deg] over every block, (n_blocks, n_steps) each,
     and its unit normal, (n_blocks, n_steps, 3) (:func:`foldopt.physics.trackers.tracker_orientation`).
@@ -127,6 +130,50 @@ def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.
     return np.repeat(draw, every, axis=0) if every > 1 else draw
 
 
+@dataclass(frozen=True)
+class TrackerCurves:
+    """A tracker over every block of a sky, worked out once: what the metrics of its rows are
+    reduced from and what a day's figures draw.
+
+    Attributes
+    ----------
+    orientation : tuple of numpy.ndarray
+        Surface tilt and azimuth [deg], (n_blocks, n_steps) each, and unit normal,
+        (n_blocks, n_steps, 3) (:func:`sky_tracker_orientation`).
+    power : numpy.ndarray
+        Gross power [W], (n_blocks, n_steps) (:func:`sky_tracker_power`).
+    draw : numpy.ndarray
+        Its own draw [W], (n_blocks, n_steps) (:func:`sky_tracker_draw`).
+    """
+
+    orientation: tuple
+    power: np.ndarray
+    draw: np.ndarray
+
+    @property
+    def net(self) -> np.ndarray:
+        """What is left for the load after the tracker's own draw [W], (n_blocks, n_steps)."""
+        return self.power - self.draw
+
+
+def tracker_curves(sky: Sky, study: Study, model: str | None = None, every: int = 1) -> TrackerCurves:
+    """A tracker's orientation, power and own draw over every block of a sky.
+
+    Parameters
+    ----------
+    sky : Sky
+    study : Study
+        The panel and the tracker's settings.
+    model : str, optional
+        One of :data:`foldopt.names.TRACKERS`; default the study's.
+    every : int, default 1
+        As :func:`sky_tracker_draw`'s (a cloud ensemble's members share their day's draw).
+    """
+    orientation = sky_tracker_orientation(sky, study, model)
+    return TrackerCurves(orientation, sky_tracker_power(sky, study, orientation),
+                         sky_tracker_draw(sky, study, orientation, every))
+
+
 def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
     """t_solar [h] of every block's twofold panel at every angle of the grid, for every load.
 
@@ -158,7 +205,8 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
             metrics.energy.reshape(sky.n_blocks, angles.size))
 
 
-def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str) -> dict:
+def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
+                   tracker: TrackerCurves | None = None) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
     panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net.
 
@@ -173,6 +221,9 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
     chosen : numpy.ndarray of int
         (n_blocks, n_loads) index into ``angles`` of the twofold panel's angle.
     engine : {'numba', 'numpy'}
+    tracker : TrackerCurves, optional
+        The study's tracker over ``sky``, where the caller has it (a day's study draws it too);
+        default worked out here (:func:`tracker_curves`).
 
     Returns
     -------
@@ -192,10 +243,9 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str)
                                   contiguous=True, engine=engine)
     flat = engines.row_metrics(sky, study, np.arange(n_blocks), engines.flat_orientation(tilt, azimuth), loads,
                                outputs=("panel",), contiguous=True, engine=engine)
-    orientation = sky_tracker_orientation(sky, study)
-    gross = sky_tracker_power(sky, study, orientation)
+    tracker = tracker or tracker_curves(sky, study, every=blocks_of.members)
+    orientation, gross, net = tracker.orientation, tracker.power, tracker.net
     tracker_poa = energy(engines.poa(sky, *orientation[:2], incident=True, normal=orientation[2]), sky.step_hours)
-    net = gross - sky_tracker_draw(sky, study, orientation, every=blocks_of.members)
     shape = sky.load_shape
     trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
                                      engine=engine,
@@ -339,13 +389,11 @@ def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
             chunk.tilt, chunk.azimuth), loads, loadset[rows], outputs=("panel",), engine=engine)
         flat.append(metrics.t_solar[:, 0])
         flat_energy.append(metrics.energy[:, 0])
-        orientation = sky_tracker_orientation(sky, study)
-        gross = sky_tracker_power(sky, study, orientation)
-        draw = sky_tracker_draw(sky, study, orientation)
-        both = engines.curve_metrics(np.concatenate([gross, gross - draw]), loads, sky.step_hours,
+        curves = tracker_curves(sky, study)
+        both = engines.curve_metrics(np.concatenate([curves.power, curves.net]), loads, sky.step_hours,
                                      np.concatenate([loadset[rows], loadset[rows]]), engine=engine)
         tracker.append((both.t_solar[:sky.n_blocks, 0], both.t_solar[sky.n_blocks:, 0], both.energy[:sky.n_blocks, 0]))
-        available.append(standby_available(gross, draw, sky.lit, study.tracker.standby_w))
+        available.append(standby_available(curves.power, curves.draw, sky.lit, study.tracker.standby_w))
     gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
     flat, flat_energy, available = np.concatenate(flat), np.concatenate(flat_energy), np.concatenate(available)
     tilted = any(flat_tilted is not None for *_, flat_tilted in searched)
