@@ -20,7 +20,7 @@ BREAK_EVEN_TOLERANCE, BREAK_EVEN_ROUNDS = 1e-6, 40
 BREAK_EVEN_LADDER = 64
 
 
-def break_even_standby(available, targets, loads, months, statistic: str, seasons, step_hours: float,
+def break_even_standby(available, targets, p_load, months, statistic: str, seasons, step_hours: float,
                        engine: str = "numba"):
     """The tracker's standby draw [W] at which its objective over each period falls to ``targets``,
     at several sites of the same days at once.
@@ -41,7 +41,7 @@ def break_even_standby(available, targets, loads, months, statistic: str, season
         and a standby draw (:func:`foldopt.studies.designs.standby_available`).
     targets : numpy.ndarray
         (sites, periods, loads) the twofold panel's objective [h].
-    loads : numpy.ndarray
+    p_load : numpy.ndarray
         (sites, loads) [W].
     months : numpy.ndarray
         (days,) month of each day, the same at every site.
@@ -92,7 +92,7 @@ def break_even_standby(available, targets, loads, months, statistic: str, season
         count = asked.reshape(n_sites, -1).sum(axis=1)
         sets = np.full((n_sites, max(int(count.max()), 1)), np.inf)
         for site in np.flatnonzero(count):
-            sets[site, :count[site]] = (loads[site][None, :] + draws[site])[asked[site]]
+            sets[site, :count[site]] = (p_load[site][None, :] + draws[site])[asked[site]]
         every = objectives(sets, count)
         value = np.full(targets.shape, np.nan)
         for site in np.flatnonzero(count):
@@ -100,7 +100,7 @@ def break_even_standby(available, targets, loads, months, statistic: str, season
             value[site][mine] = every[site][period[mine], np.arange(count[site])] - targets[site][mine]
         return value
 
-    low, high, at_low, at_high = _ladder_brackets(objectives, loads, top[:, 0, 0], targets)
+    low, high, at_low, at_high = _ladder_brackets(objectives, p_load, top[:, 0, 0], targets)
     found = np.where(at_low <= 0, 0.0, np.nan)
     side = np.zeros(targets.shape, dtype=int)
     for _ in range(BREAK_EVEN_ROUNDS):
@@ -122,10 +122,10 @@ def break_even_standby(available, targets, loads, months, statistic: str, season
         high, at_high = np.where(below, draw, high), np.where(below, value, at_high)
         side = np.where(above, 1, np.where(below, -1, side))
     found = np.where(np.isnan(found), (low + high) / 2, found)
-    return np.where((targets > 0) & np.isfinite(loads[:, None, :]), found, math.nan)
+    return np.where((targets > 0) & np.isfinite(p_load[:, None, :]), found, math.nan)
 
 
-def _ladder_brackets(objectives, loads, top, targets):
+def _ladder_brackets(objectives, p_load, top, targets):
     """Each target's first bracket of the break-even draw, from one pass of the engine: every
     period's objective at a ladder of loads per site, :data:`BREAK_EVEN_LADDER` steps from its
     lowest load to its highest plus its largest power, with its loads and its loads plus that
@@ -140,7 +140,7 @@ def _ladder_brackets(objectives, loads, top, targets):
     objectives : callable
         ``objectives(sets, count)`` -> (sites, periods, n) every period's objective at each site's
         first ``count`` loads of ``sets`` [h].
-    loads : numpy.ndarray
+    p_load : numpy.ndarray
         (sites, loads) [W].
     top : numpy.ndarray
         (sites,) each site's largest available power [W].
@@ -157,7 +157,7 @@ def _ladder_brackets(objectives, loads, top, targets):
     n_sites, n_periods, n_loads = targets.shape
     ladders = []
     for site in range(n_sites):
-        finite = loads[site][np.isfinite(loads[site])]
+        finite = p_load[site][np.isfinite(p_load[site])]
         ladders.append(np.unique(np.concatenate([finite, finite + top[site], np.linspace(
             finite.min(), finite.max() + top[site], BREAK_EVEN_LADDER)])) if finite.size else np.zeros(0))
     count = np.array([ladder.size for ladder in ladders])
@@ -167,7 +167,7 @@ def _ladder_brackets(objectives, loads, top, targets):
     value = objectives(sets, count)
     low, high, at_low, at_high = (np.full(targets.shape, np.nan) for _ in range(4))
     for site in np.flatnonzero(count):
-        rungs, load = sets[site, :count[site]], loads[site][:, None]
+        rungs, load = sets[site, :count[site]], p_load[site][:, None]
         inside = (rungs >= load) & (rungs <= load + top[site])  # (loads, rungs): the draws 0 to top
         above = (value[site][:, None, :] - targets[site][:, :, None] > 0) & inside  # (periods, loads, rungs)
         first, last = np.argmax(inside, axis=1), count[site] - 1 - np.argmax(inside[:, ::-1], axis=1)

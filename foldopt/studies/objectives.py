@@ -139,7 +139,7 @@ def worst_month(hours, months):
     return present[np.argmin(means, axis=0)]
 
 
-def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
+def near_optimal(fold_angles, values, tolerance: NearOptimal) -> dict:
     """The plateau of fold angles around the best: every grid angle on the best one's side of the
     first angles that fall short, and the recommended angle at its centre.
 
@@ -151,7 +151,7 @@ def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
 
     Parameters
     ----------
-    angles : array_like
+    fold_angles : array_like
         The fold angles evaluated [deg], ascending, (n_angles,): a grid, and with it any optimum
         refined between its angles (:func:`foldopt.engine.optimize.optimal_fold_angle`), which the
         range then holds, as it holds the best of the angles given.
@@ -165,30 +165,30 @@ def near_optimal(angles, values, tolerance: NearOptimal) -> dict:
         ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg`` [deg] and
         ``near_optimal_tolerance_h`` [h], each (...); NaN where no angle carries the load.
     """
-    angles = np.asarray(angles, dtype=float)
+    fold_angles = np.asarray(fold_angles, dtype=float)
     values = np.asarray(values, dtype=float)
     best = best_angle_index(values)
     top = np.take_along_axis(values, best[..., None], axis=-1)[..., 0]
     tol = tolerance.tolerance_h(top)
-    index = np.arange(angles.size)
+    index = np.arange(fold_angles.size)
     short = values < (top - tol)[..., None]
     below, above = short & (index < best[..., None]), short & (index > best[..., None])
-    lo = np.where(below.any(axis=-1), angles.size - np.argmax(below[..., ::-1], axis=-1), 0)
-    hi = np.where(above.any(axis=-1), np.argmax(above, axis=-1) - 1, angles.size - 1)
-    centre = (angles[lo] + angles[hi]) / 2.0
+    lo = np.where(below.any(axis=-1), fold_angles.size - np.argmax(below[..., ::-1], axis=-1), 0)
+    hi = np.where(above.any(axis=-1), np.argmax(above, axis=-1) - 1, fold_angles.size - 1)
+    centre = (fold_angles[lo] + fold_angles[hi]) / 2.0
     distance = np.where((index >= lo[..., None]) & (index <= hi[..., None]),
-                        np.abs(angles - centre[..., None]), np.inf)
+                        np.abs(fold_angles - centre[..., None]), np.inf)
     recommended = best_angle_index(-distance)
     carried = top > 0
     return {
-        "near_optimal_lo_deg": np.where(carried, angles[lo], np.nan),
-        "near_optimal_hi_deg": np.where(carried, angles[hi], np.nan),
-        "recommended_fold_angle_deg": np.where(carried, angles[recommended], np.nan),
+        "near_optimal_lo_deg": np.where(carried, fold_angles[lo], np.nan),
+        "near_optimal_hi_deg": np.where(carried, fold_angles[hi], np.nan),
+        "recommended_fold_angle_deg": np.where(carried, fold_angles[recommended], np.nan),
         "near_optimal_tolerance_h": np.where(carried, tol, np.nan),
     }
 
 
-def near_optimal_on_grid(angles, values, tolerance: NearOptimal, grid) -> dict:
+def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> dict:
     """:func:`near_optimal` on a grid of fold angles from values at some of them (a search's): each
     edge lies between the evaluated angle inside the range and the one outside, at the last grid
     angle before the monotone cubic through the values [1]_ (SciPy's ``PchipInterpolator``) falls
@@ -198,8 +198,8 @@ def near_optimal_on_grid(angles, values, tolerance: NearOptimal, grid) -> dict:
 
     Parameters
     ----------
-    angles : array_like
-        The evaluated angles [deg], ascending, (n,), on ``grid``.
+    fold_angles : array_like
+        The evaluated fold angles [deg], ascending, (n,), on ``grid``.
     values : array_like
         t_solar or an objective [h] at each, (targets, n).
     tolerance : foldopt.inputs.sections.NearOptimal
@@ -216,25 +216,25 @@ def near_optimal_on_grid(angles, values, tolerance: NearOptimal, grid) -> dict:
     .. [1] F. N. Fritsch, R. E. Carlson, "Monotone piecewise cubic interpolation", SIAM Journal on
        Numerical Analysis 17(2), 238-246, 1980.
     """
-    angles, values, grid = (np.asarray(a, dtype=float) for a in (angles, values, grid))
-    ranges = near_optimal(angles, values, tolerance)
-    if angles.size < 2:
+    fold_angles, values, grid = (np.asarray(a, dtype=float) for a in (fold_angles, values, grid))
+    ranges = near_optimal(fold_angles, values, tolerance)
+    if fold_angles.size < 2:
         return ranges
     best = best_angle_index(values)
     top = np.take_along_axis(values, best[:, None], axis=-1)[:, 0]
     line = top - tolerance.tolerance_h(top)
     # A slope of a few ulp overflows in the harmonic mean of the slopes; it then goes to 0, as it should.
     with np.errstate(over="ignore"):
-        cubic_at = PchipInterpolator(angles, values, axis=-1)(grid)  # (targets, grid)
+        cubic_at = PchipInterpolator(fold_angles, values, axis=-1)(grid)  # (targets, grid)
     place = np.arange(grid.size)
     for name, outward in {"near_optimal_lo_deg": -1, "near_optimal_hi_deg": 1}.items():
         edge = ranges[name]
         # Each target's gap between its evaluated edge (inner) and the next evaluated angle outward.
-        inner = np.searchsorted(angles, np.where(np.isfinite(edge), edge, angles[0]) - 1e-9)
+        inner = np.searchsorted(fold_angles, np.where(np.isfinite(edge), edge, fold_angles[0]) - 1e-9)
         outer = inner + outward
-        has_gap = np.isfinite(edge) & (outer >= 0) & (outer < angles.size)
-        outer = np.clip(outer, 0, angles.size - 1)
-        low, high = angles[np.minimum(inner, outer)], angles[np.maximum(inner, outer)]
+        has_gap = np.isfinite(edge) & (outer >= 0) & (outer < fold_angles.size)
+        outer = np.clip(outer, 0, fold_angles.size - 1)
+        low, high = fold_angles[np.minimum(inner, outer)], fold_angles[np.maximum(inner, outer)]
         gap = has_gap[:, None] & (grid > low[:, None]) & (grid < high[:, None])  # (targets, grid)
         below = gap & (cubic_at < line[:, None])
         # The gap's grid angles from the inner end outward while the cubic stays at or above the line.

@@ -149,24 +149,24 @@ def size_panel(
                            "IV-A); use a constant p_load"])
     areas = np.asarray(areas, dtype=float)
     reference_area = study.panel.area
-    loads = study.p_load * reference_area / areas
-    angles = np.asarray(study.fold_angles.grid())
+    p_load = study.p_load * reference_area / areas
+    fold_angles = np.asarray(study.fold_angles.grid())
     # Every curve against every load in one pass of the kernel, with no (areas x angles x steps) array.
-    curves = np.vstack([day.flat_power()[None, :], day.combined_power(angles)])
-    all_hours = engines.curve_metrics(curves, loads, day.step_hours).t_solar[:, 0, :]  # (1 + angles, areas)
+    curves = np.vstack([day.flat_power()[None, :], day.combined_power(fold_angles)])
+    all_hours = engines.curve_metrics(curves, p_load, day.step_hours).t_solar[:, 0, :]  # (1 + angles, areas)
     twofold_hours = all_hours[1:].T
     best = twofold_hours.shape[1] - 1 - np.argmax(twofold_hours[:, ::-1], axis=1)
     hours = {
         "flat": (np.full(areas.size, 180.0), all_hours[0]),
-        "twofold": (angles[best], twofold_hours[np.arange(areas.size), best]),
+        "twofold": (fold_angles[best], twofold_hours[np.arange(areas.size), best]),
     }
     unit_cost = cost_per_m2 if cost_per_m2 is not None else cost_per_w * stc_power_per_area(day.electrical.pv)
     rows = []
-    for design, (fold, t) in hours.items():
+    for design, (fold_angle, t) in hours.items():
         benefit = c_grid * t * study.p_load / 1000.0 * days_per_year * years
         cost = unit_cost * areas
         rows.append(pd.DataFrame({
-            "design": design, "area_m2": areas, "fold_angle_deg": fold, "t_solar_h": t,
+            "design": design, "area_m2": areas, "fold_angle_deg": fold_angle, "t_solar_h": t,
             "benefit_usd": benefit, "cost_usd": cost, "net_benefit_usd": benefit - cost,
         }))
     return pd.concat(rows, ignore_index=True)
