@@ -81,7 +81,7 @@ class Site(StrictModel):
         [m] in [-500, 9000]; default 0.
     timezone : str, optional
         An IANA name or a UTC offset (:func:`parse_timezone`); default the longitude's standard
-        offset (:meth:`resolved`).
+        offset (:func:`standard_timezone`, decided by the study).
     horizon : Horizon, optional
         The horizon line around the panel; default none (an open plain).
     """
@@ -96,17 +96,28 @@ class Site(StrictModel):
     horizon: Horizon | None = Field(None, description="(azimuth, elevation) points or a file; default an open plain")
 
     def resolved(self) -> Site:
-        """The site with its time zone filled in.
+        """The site itself: a study's site is resolved when the study is validated.
 
-        Returns
-        -------
-        Site
-            With ``timezone`` the longitude's standard offset (``UTC-08:00``) where none is given.
+        Kept until :mod:`foldopt.engine.sky`'s call is gone.
         """
-        if self.timezone is not None:
-            return self
-        hours = round(self.longitude / 15.0)
-        return self.model_copy(update={"timezone": f"UTC{'+' if hours >= 0 else '-'}{abs(hours):02d}:00"})
+        return self
+
+
+def standard_timezone(longitude: float) -> str:
+    """The standard offset of a longitude: a site's time zone where none is given.
+
+    Parameters
+    ----------
+    longitude : float
+        [deg], east positive.
+
+    Returns
+    -------
+    str
+        ``UTC+hh:00`` or ``UTC-hh:00``, the nearest whole hour to ``longitude / 15``.
+    """
+    hours = round(longitude / 15.0)
+    return f"UTC{'+' if hours >= 0 else '-'}{abs(hours):02d}:00"
 
 
 class Panel(StrictModel):

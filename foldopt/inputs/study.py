@@ -14,7 +14,8 @@ import datetime as dt
 import math
 from typing import Annotated
 
-from pydantic import AfterValidator, Field, ValidationError, ValidationInfo, field_validator, model_validator
+from pydantic import (AfterValidator, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator,
+                      model_validator)
 
 from foldopt import names
 from foldopt.errors import ConfigError
@@ -22,7 +23,8 @@ from foldopt.inputs import policy
 from foldopt.inputs.circuit_section import Circuit
 from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
 from foldopt.inputs.optimize_section import Optimize
-from foldopt.inputs.sections import FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site, Tracker
+from foldopt.inputs.sections import (FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site, Tracker,
+                                     standard_timezone)
 from foldopt.inputs.weather_section import Weather
 
 #: Each mode's default clear sky: pvlib's Ineichen (with diffuse light, Perez transposition at the
@@ -69,6 +71,13 @@ def _check_step_min(value: float) -> float:
 class Study(StrictModel):
     """One study: a panel at a site on a day (or the days of a weather file), its load, and the
     physics and designs it is evaluated with.
+
+    A study is resolved when it is validated: every default that depends on other fields (the
+    panel's tilt and azimuth and the site's time zone from the site, the geometry, temperature
+    model and sky from the mode) is decided then, once, and nothing downstream decides it again.
+    What was decided is no setting of the user's: :meth:`data` leaves it out, so a variant (another
+    latitude, another mode) decides its own. A study whose weather file is unread (built in
+    Python) has no site yet, so its panel's orientation waits for :func:`foldopt.inputs.load.with_files`.
 
     Parameters
     ----------
@@ -182,6 +191,8 @@ class Study(StrictModel):
     tracker: Tracker = Tracker()
     climate: named(names.HOTTEL_CLIMATES) = Field("midlatitude-summer", description="Hottel sky only")
     step_min: Annotated[interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)] = 1.0
+    #: The dotted paths of the fields the validation decided (:meth:`_decide`), not given.
+    _decided: frozenset = PrivateAttr(frozenset())
 
     @model_validator(mode="before")
     @classmethod
@@ -273,6 +284,34 @@ class Study(StrictModel):
                 )
         return self
 
+    @model_validator(mode="after")
+    def _decide(self):
+        """Every default that depends on other fields, decided once (:attr:`_decided` says which)."""
+        decided = {}
+        if self.geometry is None:
+            decided["geometry"] = "azimuth-split" if self.mode == "paper" else "hinge"
+        if self.temperature_model is None:
+            decided["temperature_model"] = "fixed" if self.mode == "paper" else "sapm"
+        if self.sky is None:
+            decided["sky"] = MODE_SKIES[self.mode]
+        if self.site is not None:
+            from foldopt.physics.geometry import default_orientation
+
+            tilt, azimuth = default_orientation(self.site.latitude)
+            panel = {key: value for key, value in (("tilt", tilt), ("azimuth", azimuth))
+                     if getattr(self.panel, key) is None}
+            if panel:
+                decided["panel"] = self.panel.model_copy(update=panel)
+            if self.site.timezone is None:
+                decided["site"] = self.site.model_copy(update={"timezone": standard_timezone(self.site.longitude)})
+            paths = [f"panel.{key}" for key in panel] + ["site.timezone"] * ("site" in decided)
+        else:
+            paths = []
+        for name, value in decided.items():
+            object.__setattr__(self, name, value)  # frozen to users; decided here, once
+        self._decided = frozenset(paths + [name for name in decided if name not in ("panel", "site")])
+        return self
+
     def idle_settings(self) -> list[str]:
         """Settings given a value that nothing in the study uses.
 
@@ -360,8 +399,8 @@ class Study(StrictModel):
         Returns
         -------
         Study
-            Its files unread (:class:`~foldopt.inputs.sections.FilesRead`): the API reads them
-            when it runs the study.
+            Resolved, its files unread (:class:`~foldopt.inputs.sections.FilesRead`): the API
+            reads them when it runs the study.
 
         Raises
         ------
@@ -372,8 +411,8 @@ class Study(StrictModel):
         --------
         >>> import foldopt
         >>> study = foldopt.default_study().variant(site={"latitude": 10.0})
-        >>> study.mode, study.geometry, study.panel.tilt, study.panel.efficiency
-        ('exact', None, None, 0.1905)
+        >>> study.mode, study.geometry, study.sky, study.panel.tilt, study.panel.efficiency
+        ('exact', 'hinge', 'ineichen', 10.0, 0.1905)
         """
         data, _ = policy.apply(self.data(), changes)
         return make_study(data)
@@ -384,10 +423,13 @@ class Study(StrictModel):
         Returns
         -------
         dict
-            ``date`` as text, no unset field; a profile or a horizon read from a file keeps its
-            file, not what was read from it.
+            ``date`` as text, no unset field and no decided default; a profile or a horizon read
+            from a file keeps its file, not what was read from it.
         """
         data = self.model_dump(mode="json", exclude_none=True)
+        for path in self._decided:
+            section, _, name = path.rpartition(".")
+            (data[section] if section else data).pop(name, None)
         if self.load_profile is not None and self.load_profile.file is not None:
             data["load_profile"].pop("daily", None)
         if self.site is not None and self.site.horizon is not None and self.site.horizon.file is not None:
@@ -395,49 +437,36 @@ class Study(StrictModel):
         return data
 
     def resolved(self) -> Study:
-        """The study with every default that depends on other fields (site, mode) filled in.
-
-        Studies are kept unresolved so that a variant (another mode, another latitude) gets its
-        own defaults; :class:`foldopt.studies.day.Day` resolves the study it runs.
+        """The study itself, resolved when it was validated; kept until the engine's callers are gone.
 
         Returns
         -------
         Study
-            With the panel's tilt and azimuth [deg], the site's time zone, the geometry, the
-            temperature model and the sky filled in.
+            ``self``.
 
         Raises
         ------
         foldopt.ConfigError
-            For a study whose files are unread (:func:`foldopt.inputs.load.with_files` reads them).
+            For a study whose files are unread (:meth:`require_files`).
         """
-        from foldopt.physics.geometry import default_orientation
+        self.require_files()
+        return self
 
+    def require_files(self) -> None:
+        """Refuse to run a study whose files are unread.
+
+        Raises
+        ------
+        foldopt.ConfigError
+            ``weather: the file is not read yet; ...`` (and for ``load_profile``):
+            :func:`foldopt.inputs.load.with_files` reads them, as the API does.
+        """
         unread = [f"{name}: the file is not read yet; foldopt.run, foldopt.sweep and foldopt.size read it"
                   for name, missing in (("weather", self.site is None), ("load_profile", self.load_profile is not None
                                                                            and self.load_profile.daily is None))
                   if missing]
         if unread:
             raise ConfigError(unread)
-
-        tilt, azimuth = default_orientation(self.site.latitude)
-        panel = self.panel.model_copy(
-            update={
-                "tilt": tilt if self.panel.tilt is None else self.panel.tilt,
-                "azimuth": azimuth if self.panel.azimuth is None else self.panel.azimuth,
-            }
-        )
-        geometry = self.geometry or ("azimuth-split" if self.mode == "paper" else "hinge")
-        temperature = self.temperature_model or ("fixed" if self.mode == "paper" else "sapm")
-        return self.model_copy(
-            update={
-                "panel": panel,
-                "site": self.site.resolved(),
-                "geometry": geometry,
-                "temperature_model": temperature,
-                "sky": self.sky or MODE_SKIES[self.mode],
-            }
-        )
 
 
 def format_error(item: dict) -> list[str]:

@@ -60,7 +60,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
         metadata = run_metadata(
             result.study,
             command,
-            input_sha256=input_hash(result.study.model_dump(mode="json")),
+            input_sha256=input_hash(result.study.data()),
             engine=result.engine,
             optimal_fold_angle_deg=result.optimal_fold_angle,
             near_optimal={key: _finite_or_none(value) for key, value in result.near_optimal.items()},
@@ -199,7 +199,7 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
             plots += _annual_outputs(result, folder, plan.base.name)
         plots += _horizon_figure(plan.base, dict(plan.axes).get("date", (plan.base.date,)), folder, plan.base.name)
         metadata = run_metadata(
-            plan.base.resolved(),
+            plan.base,
             command,
             axes={path: [str(v) if hasattr(v, "isoformat") else v for v in values] for path, values in plan.axes},
             cases=plan.n_cases,
@@ -244,8 +244,8 @@ def write_sizing(result, out: Path, overwrite: bool = False, command=None) -> Pa
         write_csv(best, folder / "sizing_best.csv")
         figure = write_figure(folder, "net_benefit_vs_area.png", table, best,
                               f"{study.name}: panel sizing (Shin et al. Sec. IV-A)")
-        metadata = run_metadata(study.resolved(), command, sizing=result.parameters,
-                                input_sha256=input_hash(study.model_dump(mode="json")))
+        metadata = run_metadata(study, command, sizing=result.parameters,
+                                input_sha256=input_hash(study.data()))
         write_run_json(folder, metadata)
         write_html(folder, result.answer, [figure], table, "Every area (sizing.csv)", metadata)
     return out
@@ -286,7 +286,7 @@ def write_optimize(result, out: Path, overwrite: bool = False, command=None) -> 
                                 f"{result.landscape['surface_azimuth'].iloc[0]:g} deg)")]
         figures += _horizon_figure(study, list(result.dates), folder, study.name)
         metadata = run_metadata(study, command, days=len(result.dates), search=result.answer.result["search"],
-                                input_sha256=input_hash(study.model_dump(mode="json")))
+                                input_sha256=input_hash(study.data()))
         write_run_json(folder, metadata)
         write_html(folder, result.answer, figures, result.table, "Designs (optimum.csv)", metadata)
     return out

@@ -79,7 +79,6 @@ def study_question(study, varied: tuple = ()) -> dict:
     """
     from foldopt.inputs.loads import load_text
 
-    study = study.resolved()
     site = study.site
     where = f"{site.name + ', ' if site.name else ''}{site.latitude:g}, {site.longitude:g} ({site.timezone})"
     panel = study.panel

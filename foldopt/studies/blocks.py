@@ -78,9 +78,10 @@ class Blocks:
         studies : sequence of Study
             Of one setup; the first gives the shared settings.
         """
-        resolved = [s.resolved() for s in studies]
-        return cls(resolved[0], tuple(s.site for s in resolved), tuple(s.date for s in resolved),
-                   np.array([s.panel.tilt for s in resolved]), np.array([s.panel.azimuth for s in resolved]))
+        for study in studies:
+            study.require_files()
+        return cls(studies[0], tuple(s.site for s in studies), tuple(s.date for s in studies),
+                   np.array([s.panel.tilt for s in studies]), np.array([s.panel.azimuth for s in studies]))
 
     @classmethod
     def of_dates(cls, study: Study, dates) -> Blocks:
@@ -91,7 +92,7 @@ class Blocks:
         study : Study
         dates : sequence of datetime.date
         """
-        study = study.resolved()
+        study.require_files()
         members = study.weather.members if study.weather is not None and study.weather.members else 1
         dates = tuple(date for date in dates for _ in range(members))  # a day's members together
         count = len(dates)

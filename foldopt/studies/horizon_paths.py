@@ -42,7 +42,6 @@ def sun_paths(study, dates) -> dict | None:
         behind the horizon line [%], over all its days (at most :data:`MAX_COUNTED_DAYS`, evenly
         spaced); None for a site without a horizon.
     """
-    study = study.resolved()
     site = study.site
     if site.horizon is None:
         return None

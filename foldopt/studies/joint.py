@@ -128,7 +128,7 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
         For other axes, a cloud ensemble, a season (``objective.months``) none of the days is in, or
         more designs x loads than :data:`foldopt.inputs.optimize_section.MAX_DESIGNS`.
     """
-    study = plan.base.resolved()
+    study = plan.base
     spec = study.optimize
     axes = dict(plan.axes)
     other = [path for path in axes if path not in ("date", "p_load")]

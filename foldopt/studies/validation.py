@@ -95,7 +95,6 @@ def minute_validation(study: Study, loads, members: int = 20, seed: int = 0) -> 
         ``within_hour_sd_measured_w_m2`` and ``within_hour_sd_smooth_w_m2``: the mean over lit
         hours of the standard deviation of GHI within each hour [W/m^2].
     """
-    study = study.resolved()
     loads = np.atleast_1d(np.asarray(loads, dtype=float))
     measured = study_weather(study.weather, study.site)
     frame = measured.frame
