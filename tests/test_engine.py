@@ -150,6 +150,23 @@ def test_many_loads_in_one_pass_equal_one_pass_per_load(curves, loads):
         np.testing.assert_allclose(result.energy[:, 0], curves.sum(axis=1) * 0.5, rtol=1e-12)
 
 
+def test_curves_sharing_a_chunk_each_get_their_own_metrics():
+    """More curves than the parallel loop has chunks, so that a chunk's scratch serves many rows
+    and must be cleared for each (the compiled engine's records once lost what the loop's body
+    wrote through them: every row's hours added to the last's)."""
+    rng = np.random.default_rng(7)
+    curves = rng.uniform(0, 20, (300, 48)) * np.sin(np.linspace(0, np.pi, 48))
+    loads = np.linspace(0.5, 15, 9)
+    for contiguous in (False, True):
+        kernel, reference = (engine.curve_metrics(curves, loads, 0.5, contiguous=contiguous, engine=name)
+                             for name in ("numba", "numpy"))
+        np.testing.assert_allclose(kernel.t_solar, reference.t_solar, rtol=0, atol=SECOND)
+        np.testing.assert_allclose(kernel.energy, reference.energy, rtol=1e-12)
+        np.testing.assert_allclose(kernel.peak, reference.peak, rtol=1e-12)
+        if contiguous:
+            np.testing.assert_allclose(kernel.t_solar_contiguous, reference.t_solar_contiguous, rtol=0, atol=SECOND)
+
+
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(case=cases())
 def test_t_solar_never_rises_when_the_load_rises(case):

@@ -67,22 +67,25 @@ def iam_factor(cos_aoi, model, params):
 
 
 @njit(cache=True, inline="always")
-def _incidence_steps(r, b, start, count, sun, paper_sun, beam, terms, row_normal, row_paper, row_view,
-                     paper_incidence, has_terms, modified, irradiance):
+def _incidence_steps(r, b, start, count, sky, rows, paper, has_terms, modified, work):
     """:func:`incidence`'s main loop, inlined once per case with the case's flags as constants."""
-    ex, ey, ez = row_normal[r, 0, 0], row_normal[r, 0, 1], row_normal[r, 0, 2]
-    wx, wy, wz = row_normal[r, 1, 0], row_normal[r, 1, 1], row_normal[r, 1, 2]
+    sun, paper_sun, beam, terms = sky.sun, sky.paper_sun, sky.beam, sky.terms
+    east, west, incident, diffuse_east, diffuse_west = (work.east, work.west, work.incident, work.diffuse_east,
+                                                        work.diffuse_west)
+    normal, view, row_paper = rows.normal, rows.sky_view, rows.paper
+    ex, ey, ez = normal[r, 0, 0], normal[r, 0, 1], normal[r, 0, 2]
+    wx, wy, wz = normal[r, 1, 0], normal[r, 1, 1], normal[r, 1, 2]
     # Each sub-panel's view of the isotropic sky and of the horizon band: (1 + cos tilt) / 2 and
     # sin tilt on an open plain, less what a horizon hides (foldopt.physics.horizon).
-    e_iso, e_sin_tilt = row_view[r, 0, 0], row_view[r, 0, 1]
-    w_iso, w_sin_tilt = row_view[r, 1, 0], row_view[r, 1, 1]
+    e_iso, e_sin_tilt = view[r, 0, 0], view[r, 0, 1]
+    w_iso, w_sin_tilt = view[r, 1, 0], view[r, 1, 1]
     pe0, pe1, pe2, pe3 = row_paper[r, 0, 0], row_paper[r, 0, 1], row_paper[r, 0, 2], row_paper[r, 0, 3]
     pw0, pw1, pw2, pw3 = row_paper[r, 1, 0], row_paper[r, 1, 1], row_paper[r, 1, 2], row_paper[r, 1, 3]
     for i in range(count):
         s = start + i
         cos_east = ex * sun[b, 0, s] + ey * sun[b, 1, s] + ez * sun[b, 2, s]
         cos_west = wx * sun[b, 0, s] + wy * sun[b, 1, s] + wz * sun[b, 2, s]
-        if paper_incidence:
+        if paper:
             cz, szen, sa, ca = paper_sun[b, 0, s], paper_sun[b, 1, s], paper_sun[b, 2, s], paper_sun[b, 3, s]
             f_east = max(cz * pe0 + szen * pe1, 0.0) * max(ca * pe2 + sa * pe3, 0.0)
             f_west = max(cz * pw0 + szen * pw1, 0.0) * max(ca * pw2 + sa * pw3, 0.0)
@@ -96,53 +99,55 @@ def _incidence_steps(r, b, start, count, sun, paper_sun, beam, terms, row_normal
                       + ground * (1.0 - ez) * 0.5)
             d_west = (max(iso * w_iso + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
                       + ground * (1.0 - wz) * 0.5)
-        irradiance[2, s] = 0.5 * (g_east + d_east + g_west + d_west)
+        incident[s] = 0.5 * (g_east + d_east + g_west + d_west)
         if modified:
-            irradiance[0, s], irradiance[1, s], irradiance[3, s], irradiance[4, s] = g_east, g_west, d_east, d_west
+            east[s], west[s], diffuse_east[s], diffuse_west[s] = g_east, g_west, d_east, d_west
         else:
-            irradiance[0, s], irradiance[1, s] = g_east + d_east, g_west + d_west
+            east[s], west[s] = g_east + d_east, g_west + d_west
 
 
 @njit(cache=True, inline="always")
-def incidence(r, b, first, n, sun, paper_sun, beam, terms, row_normal, row_paper, row_view, paper_incidence,
-               has_terms, iam_model, iam_params, tables, irradiance):
-    """Both sub-panels' irradiance at steps ``first .. first + n - 1`` of row ``r`` (over block
-    ``b``) into ``irradiance[0]`` and ``[1]`` (as sqrt(E / E_max) with tables), and their mean
-    incident irradiance before the incidence-angle modifier into ``irradiance[2]`` [W/m^2].
+def incidence(r, b, first, n, sky, rows, tables, work):
+    """Both sub-panels' irradiance at steps ``first .. first + n - 1`` of row ``r`` of ``rows``
+    (over block ``b`` of ``sky``, a :class:`foldopt.engine.records.SkyArrays`) into ``work.east``
+    and ``work.west`` (as sqrt(E / E_max) with ``tables``), and their mean incident irradiance
+    before the incidence-angle modifier into ``work.incident`` [W/m^2] (``work`` a chunk's
+    :class:`foldopt.engine.records.Scratch`).
 
     The steps are indexed as unsigned integers, so that no index can wrap around, and the main
     loop (:func:`_incidence_steps`) is inlined once per case, its flags constants: LLVM then
     vectorises each. The incidence-angle modifier, a call per step, has a loop of its own (the beam
-    waits for it in ``irradiance[0]`` and ``[1]``, the diffuse light in ``[3]`` and ``[4]``), as
-    has the tables' coordinate."""
+    waits for it in ``work.east`` and ``work.west``, the diffuse light in ``work.diffuse_east``
+    and ``work.diffuse_west``), as has the tables' coordinate."""
     start, count = uint64(first), uint64(n)
+    iam_model, iam_params, paper = sky.iam_model, sky.iam_params, sky.paper
+    has_terms = sky.terms.shape[1] == 4
     modified = iam_model != IAM_NONE
     # Exact incidence without the modifier, with or without diffuse terms, as constants (every
     # study of a year or a map); paper mode and the modifier read their flags at run time.
-    if not paper_incidence and not modified and has_terms:
-        _incidence_steps(r, b, start, count, sun, paper_sun, beam, terms, row_normal, row_paper, row_view,
-                         False, True, False, irradiance)
-    elif not paper_incidence and not modified:
-        _incidence_steps(r, b, start, count, sun, paper_sun, beam, terms, row_normal, row_paper, row_view,
-                         False, False, False, irradiance)
+    if not paper and not modified and has_terms:
+        _incidence_steps(r, b, start, count, sky, rows, False, True, False, work)
+    elif not paper and not modified:
+        _incidence_steps(r, b, start, count, sky, rows, False, False, False, work)
     else:
-        _incidence_steps(r, b, start, count, sun, paper_sun, beam, terms, row_normal, row_paper, row_view,
-                         paper_incidence, has_terms, modified, irradiance)
+        _incidence_steps(r, b, start, count, sky, rows, paper, has_terms, modified, work)
+    east, west = work.east, work.west
     if modified:
-        ex, ey, ez = row_normal[r, 0, 0], row_normal[r, 0, 1], row_normal[r, 0, 2]
-        wx, wy, wz = row_normal[r, 1, 0], row_normal[r, 1, 1], row_normal[r, 1, 2]
+        sun, normal = sky.sun, rows.normal
+        ex, ey, ez = normal[r, 0, 0], normal[r, 0, 1], normal[r, 0, 2]
+        wx, wy, wz = normal[r, 1, 0], normal[r, 1, 1], normal[r, 1, 2]
         for i in range(count):
             s = start + i
             cos_east = ex * sun[b, 0, s] + ey * sun[b, 1, s] + ez * sun[b, 2, s]
             cos_west = wx * sun[b, 0, s] + wy * sun[b, 1, s] + wz * sun[b, 2, s]
-            irradiance[0, s] = irradiance[0, s] * iam_factor(cos_east, iam_model, iam_params) + irradiance[3, s]
-            irradiance[1, s] = irradiance[1, s] * iam_factor(cos_west, iam_model, iam_params) + irradiance[4, s]
+            east[s] = east[s] * iam_factor(cos_east, iam_model, iam_params) + work.diffuse_east[s]
+            west[s] = west[s] * iam_factor(cos_west, iam_model, iam_params) + work.diffuse_west[s]
     if tables:
         to_root = 1.0 / IRRADIANCE_MAX
         for i in range(count):
             s = start + i
-            irradiance[0, s] = math.sqrt(min(max(irradiance[0, s], 0.0), IRRADIANCE_MAX) * to_root)
-            irradiance[1, s] = math.sqrt(min(max(irradiance[1, s], 0.0), IRRADIANCE_MAX) * to_root)
+            east[s] = math.sqrt(min(max(east[s], 0.0), IRRADIANCE_MAX) * to_root)
+            west[s] = math.sqrt(min(max(west[s], 0.0), IRRADIANCE_MAX) * to_root)
 
 
 @njit(cache=True, inline="always")

@@ -8,8 +8,9 @@ incidence-angle modifier and the diffuse terms give each sub-panel's plane-of-ar
 The second looks up the electrical tables (or, for the ideal model, scales the irradiance) and
 writes every asked connection's power to a buffer of one day, reused by the next row (with the
 circuit as built, :func:`_built_row`). The third reduces each power curve to the daily metrics of
-every load at once (:func:`foldopt.engine.reduce.day_metrics`, with the per-chunk scratch of
-:func:`foldopt.engine.reduce.scratch`).
+every load at once (:func:`foldopt.engine.reduce.day_metrics`). The inputs come as the named
+records of :mod:`foldopt.engine.records` (the sky, the rows, the tables, the loads, the outputs and
+the per-chunk scratch of :func:`foldopt.engine.records.allocate`).
 
 Where the time goes: a loop vectorises only if LLVM can see that no index wraps around (the steps
 are indexed as unsigned integers) and that nothing in it depends on a setting known only at run
@@ -28,12 +29,12 @@ Every function here is checked against the NumPy reference path of :mod:`foldopt
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
-import numpy as np
 from numba import njit, prange, uint64
 
 from foldopt.engine.incidence import incidence, steps_sum
-from foldopt.engine.reduce import day_metrics
+from foldopt.engine.reduce import chunk_scratch, day_metrics
 
 # Connection codes; the order of foldopt.physics.connections.CONNECTIONS, plus the whole (unfolded) panel.
 EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
@@ -79,35 +80,56 @@ def _pair_powers(root_east, root_west, table_1d, table_parallel, table_series, n
     return p_east, p_west, p_parallel, p_series
 
 
+class Parts(NamedTuple):
+    """The parts of the circuit as built at one step [W] (:func:`_built_parts`)."""
+
+    m_east: float  # each sub-panel's maximum power
+    m_west: float
+    a_east: float  # what each delivers alone
+    a_west: float
+    parallel: float  # the pairs and switching as built, before the converter
+    series: float
+    switching: float
+    panel: float  # the whole panel
+
+
 @njit(cache=True, inline="always")
-def _built_parts(root_east, root_west, table_1d, table_alone, table_panel, table_parallel, table_series,
-                 table_switching, need_series, direct, switch_table):
-    """The parts of the circuit as built from one table set at both sub-panels' irradiance (as
-    sqrt(E / E_max)): each sub-panel's maximum power, what it delivers alone, the pair in parallel,
-    in series and switched (each as built, before the converter) and the whole panel's power [W].
-    The pair tables are fractions of the two maximum powers; without a switch resistance
-    (``switch_table`` False) switching is the best of its states."""
+def _built_parts(root_east, root_west, tables, t, need_series):
+    """The :class:`Parts` of the circuit as built from table set ``t`` of ``tables`` at both
+    sub-panels' irradiance (as sqrt(E / E_max)). The pair tables are fractions of the two maximum
+    powers; without a switch resistance (``tables.switch_table`` False) switching is the best of
+    its states."""
+    table_1d, table_parallel = tables.subpanel[t], tables.parallel[t]
     n1 = table_1d.shape[0] - 1
     n2, nr = table_parallel.shape[0] - 1, table_parallel.shape[1] - 1
     m_east = _linear(table_1d, root_east * n1)
     m_west = _linear(table_1d, root_west * n1)
     bound = m_east + m_west
     a_east, a_west, p_panel = m_east, m_west, 0.0
-    if direct:
-        a_east = _linear(table_alone, root_east * n1)
-        a_west = _linear(table_alone, root_west * n1)
-        p_panel = _linear(table_panel, root_east * n1)
+    if tables.direct:
+        a_east = _linear(tables.alone[t], root_east * n1)
+        a_west = _linear(tables.alone[t], root_west * n1)
+        p_panel = _linear(tables.panel[t], root_east * n1)
     strong, weak = max(root_east, root_west), min(root_east, root_west)
     root_ratio = weak / strong if strong > 0.0 else 1.0
     p_parallel = min(max(_bilinear(table_parallel, strong * n2, root_ratio * nr), 0.0), 1.0) * bound
     p_series = 0.0
     if need_series:
-        p_series = min(max(_bilinear(table_series, strong * n2, root_ratio**2 * nr), 0.0), 1.0) * bound
-    if switch_table:
-        p_switching = min(max(_bilinear(table_switching, strong * n2, root_ratio * nr), 0.0), 1.0) * bound
+        p_series = min(max(_bilinear(tables.series[t], strong * n2, root_ratio**2 * nr), 0.0), 1.0) * bound
+    if tables.switch_table:
+        p_switching = min(max(_bilinear(tables.switching[t], strong * n2, root_ratio * nr), 0.0), 1.0) * bound
     else:
         p_switching = max(max(a_east, a_west), p_parallel)
-    return m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel
+    return Parts(m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel)
+
+
+@njit(cache=True, inline="always")
+def _between(lo, hi, w):
+    """:class:`Parts` at ``w`` of the way from ``lo`` to ``hi``."""
+    return Parts(lo.m_east + w * (hi.m_east - lo.m_east), lo.m_west + w * (hi.m_west - lo.m_west),
+                 lo.a_east + w * (hi.a_east - lo.a_east), lo.a_west + w * (hi.a_west - lo.a_west),
+                 lo.parallel + w * (hi.parallel - lo.parallel), lo.series + w * (hi.series - lo.series),
+                 lo.switching + w * (hi.switching - lo.switching), lo.panel + w * (hi.panel - lo.panel))
 
 
 @njit(cache=True, inline="always")
@@ -140,11 +162,14 @@ def _connection_power(code, p_east, p_west, p_parallel, p_series, p_panel, conve
 
 
 @njit(cache=True, inline="always")
-def _linear_steps(c, code, start, count, linear_power, panel_scale, converter_efficiency, irradiance, buffer):
+def _linear_steps(c, code, start, count, tables, work):
     """:func:`_linear_connections`' loop, inlined once per connection with its code a constant."""
+    linear_power, panel_scale = tables.linear_power, tables.panel_scale
+    converter_efficiency = tables.converter_efficiency
+    east, west, buffer = work.east, work.west, work.power
     for i in range(count):
         s = start + i
-        p_east, p_west = linear_power * irradiance[0, s], linear_power * irradiance[1, s]
+        p_east, p_west = linear_power * east[s], linear_power * west[s]
         if code == SWITCHING:
             # The pairs lose nothing: the parallel (and series) pair's power is the sum.
             buffer[c, s] = max(max(p_east, p_west), p_east + p_west)
@@ -161,35 +186,38 @@ def _linear_steps(c, code, start, count, linear_power, panel_scale, converter_ef
 
 
 @njit(cache=True, inline="always")
-def _linear_connections(first, n, linear_power, panel_scale, converter_efficiency, connections, irradiance, buffer):
+def _linear_connections(first, n, tables, work):
     """Every asked connection's power [W] of the ideal PV model (power proportional to
-    irradiance, so that the pairs lose nothing) into ``buffer[c]`` at steps ``first ..
+    irradiance, so that the pairs lose nothing) into ``work.power[c]`` at steps ``first ..
     first + n - 1``: one loop a connection, free of branches, so that each vectorises (the values
     are :func:`_connection_power`'s)."""
     start, count = uint64(first), uint64(n)
+    connections = tables.connections
     for c in range(connections.shape[0]):
         # Switching (every map's) with its code a constant; the others read it at run time.
         if connections[c] == SWITCHING:
-            _linear_steps(c, SWITCHING, start, count, linear_power, panel_scale, converter_efficiency, irradiance,
-                          buffer)
+            _linear_steps(c, SWITCHING, start, count, tables, work)
         else:
-            _linear_steps(c, connections[c], start, count, linear_power, panel_scale, converter_efficiency,
-                          irradiance, buffer)
+            _linear_steps(c, connections[c], start, count, tables, work)
 
 
 @njit(cache=True, inline="always")
-def _table_row(b, first, last, step_table, step_weight, table_1d, table_parallel, table_series, need_series, bypass,
-               panel_scale, converter_efficiency, switch_series, connections, irradiance, buffer):
-    """Every asked connection's power [W] at steps ``first..last`` from the electrical tables at both
-    sub-panels' irradiance (as sqrt(E / E_max), ``irradiance[0]`` and ``[1]``): table set
-    ``step_table[b, s]`` and, with weight ``step_weight[b, s]``, the next (both (n_blocks, n_steps)),
-    or one set a block ((n_blocks, 1))."""
+def _table_row(b, first, last, sky, tables, need_series, work):
+    """Every asked connection's power [W] at steps ``first..last`` into ``work.power`` from the
+    electrical tables at both sub-panels' irradiance (as sqrt(E / E_max), ``work.east`` and
+    ``work.west``): table set ``sky.step_table[b, s]`` and, with weight ``sky.step_weight[b, s]``,
+    the next (both (n_blocks, n_steps)), or one set a block ((n_blocks, 1))."""
+    step_table, step_weight = sky.step_table, sky.step_weight
+    table_1d, table_parallel, table_series = tables.subpanel, tables.parallel, tables.series
+    bypass, panel_scale, switch_series = tables.bypass, tables.panel_scale, tables.switch_series
+    converter_efficiency, connections = tables.converter_efficiency, tables.connections
+    east, west, buffer = work.east, work.west, work.power
     per_step = step_table.shape[1] > 1
     # One table set a block (no weather file): its tables are taken once a row.
     row_1d, row_parallel, row_series = (table_1d[step_table[b, 0]], table_parallel[step_table[b, 0]],
                                         table_series[step_table[b, 0]])
     for s in range(first, last + 1):
-        root_east, root_west = irradiance[0, s], irradiance[1, s]
+        root_east, root_west = east[s], west[s]
         if not per_step:
             p_east, p_west, p_parallel, p_series = _pair_powers(root_east, root_west, row_1d, row_parallel,
                                                                 row_series, need_series, bypass)
@@ -213,202 +241,120 @@ def _table_row(b, first, last, step_table, step_weight, table_1d, table_parallel
 
 
 @njit(cache=True, inline="always")
-def _built_power(code, m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel, switch_series,
-                 switch_table, converter_efficiency, conv_table, conv_rated):
-    """The power a connection delivers to the load [W] from the parts of :func:`_built_parts`:
-    through the converter, or the independent connection's two converters each rated for its
-    sub-panel (half the rating)."""
+def _built_power(code, parts, p_panel, tables):
+    """The power a connection delivers to the load [W] from the :class:`Parts` of
+    :func:`_built_parts` (and the whole panel's ``p_panel``): through the converter, or the
+    independent connection's two converters each rated for its sub-panel (half the rating)."""
+    conv_table, conv_rated = tables.converter, tables.converter_rating
     if code == INDEPENDENT:
-        return converter_efficiency * (_delivered(m_east, conv_table, 0.5 * conv_rated)
-                                       + _delivered(m_west, conv_table, 0.5 * conv_rated))
+        return tables.converter_efficiency * (_delivered(parts.m_east, conv_table, 0.5 * conv_rated)
+                                              + _delivered(parts.m_west, conv_table, 0.5 * conv_rated))
     if code == SWITCHING:
-        power = max(p_switching, p_series) if switch_series and not switch_table else p_switching
+        power = (max(parts.switching, parts.series) if tables.switch_series and not tables.switch_table
+                 else parts.switching)
     elif code == EAST:
-        power = a_east
+        power = parts.a_east
     elif code == WEST:
-        power = a_west
+        power = parts.a_west
     elif code == PARALLEL:
-        power = p_parallel
+        power = parts.parallel
     elif code == SERIES:
-        power = p_series
+        power = parts.series
     else:
         power = p_panel
     return _delivered(power, conv_table, conv_rated)
 
 
 @njit(cache=True)
-def _built_row(b, first, last, step_table, step_weight, table_1d, table_alone, table_panel, table_parallel,
-               table_series, table_switching, need_series, direct, switch_table, linear_power, panel_scale,
-               switch_series, converter_efficiency, connections, conv_table, conv_rated, irradiance, buffer):
+def _built_row(b, first, last, sky, tables, need_series, work):
     """:func:`_chunk_rows`' second loop for the circuit as built: the parts at each step (linear
     between two table sets where the step's air temperature lies between them), then what each
-    connection delivers. With the ideal PV model (``linear_power`` > 0, no tables), only the
-    converter is as built: ``irradiance`` holds the irradiance itself."""
+    connection delivers. With the ideal PV model (``tables.linear_power`` > 0, no tables), only the
+    converter is as built: ``work.east`` and ``work.west`` hold the irradiance itself."""
+    step_table, step_weight = sky.step_table, sky.step_weight
+    linear_power, panel_scale, connections = tables.linear_power, tables.panel_scale, tables.connections
+    east, west, buffer = work.east, work.west, work.power
     per_step = step_table.shape[1] > 1
-    parts = np.empty(8)
     for s in range(first, last + 1):
-        root_east, root_west = irradiance[0, s], irradiance[1, s]
+        root_east, root_west = east[s], west[s]
         t = step_table[b, s] if per_step else step_table[b, 0]
         w = step_weight[b, s] if per_step else 0.0
         if linear_power > 0.0:
             m_east, m_west = linear_power * root_east, linear_power * root_west
-            a_east, a_west, p_panel = m_east, m_west, panel_scale * m_east
-            p_parallel = p_series = m_east + m_west
-            p_switching = max(max(m_east, m_west), p_parallel)
+            pair = m_east + m_west
+            parts = Parts(m_east, m_west, m_east, m_west, pair, pair, max(max(m_east, m_west), pair),
+                          panel_scale * m_east)
             w = 0.0
         else:
-            m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel = _built_parts(
-                root_east, root_west, table_1d[t], table_alone[t], table_panel[t], table_parallel[t],
-                table_series[t], table_switching[t], need_series, direct, switch_table)
+            parts = _built_parts(root_east, root_west, tables, t, need_series)
         if w > 0.0:
-            parts[:] = _built_parts(root_east, root_west, table_1d[t + 1], table_alone[t + 1], table_panel[t + 1],
-                                    table_parallel[t + 1], table_series[t + 1], table_switching[t + 1], need_series,
-                                    direct, switch_table)
-            m_east += w * (parts[0] - m_east)
-            m_west += w * (parts[1] - m_west)
-            a_east += w * (parts[2] - a_east)
-            a_west += w * (parts[3] - a_west)
-            p_parallel += w * (parts[4] - p_parallel)
-            p_series += w * (parts[5] - p_series)
-            p_switching += w * (parts[6] - p_switching)
-            p_panel += w * (parts[7] - p_panel)
-        if not direct:
-            p_panel = panel_scale * m_east
+            parts = _between(parts, _built_parts(root_east, root_west, tables, t + 1, need_series), w)
+        p_panel = parts.panel if tables.direct else panel_scale * parts.m_east
         for c in range(connections.shape[0]):
-            buffer[c, s] = _built_power(connections[c], m_east, m_west, a_east, a_west, p_parallel, p_series,
-                                        p_switching, p_panel, switch_series, switch_table, converter_efficiency,
-                                        conv_table, conv_rated)
+            buffer[c, s] = _built_power(connections[c], parts, p_panel, tables)
 
 
 @njit(cache=True, parallel=True)
-def fold_rows(sun, paper_sun, beam, terms, span, step_table, step_weight, row_block, row_normal, row_paper, row_view,
-              row_loadset, paper_incidence, iam_model, iam_params, table_1d, table_parallel, table_series,
-              linear_power, panel_scale, bypass, switch_series, converter_efficiency, connections, built, table_alone,
-              table_panel, table_switching, conv_table, conv_rated, loads, step_hours, contiguous, load_shape,
-              use_shape, t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance, buffer, above, whole,
-              run):
+def fold_rows(sky, rows, tables, loads, out, scratch):
     """Daily metrics of every row and connection, computing the power on the fly.
 
     Parameters
     ----------
-    sun : (n_blocks, 3, n_steps) float
-        Unit sun vectors (east, north, up).
-    paper_sun : (n_blocks, 4, n_steps) float
-        cos(zenith), sin(zenith), sin(azimuth), cos(azimuth) for Eq. 5 (used in paper mode).
-    beam : (n_blocks, n_steps) float
-        Direct normal irradiance [W/m^2].
-    terms : (n_blocks, 4, n_steps) float
-        Diffuse terms (isotropic, circumsolar, horizon, ground) of
-        :func:`foldopt.physics.irradiance.sky_diffuse_terms`; shape (n_blocks, 0, n_steps) for beam only.
-    span : (n_blocks, 2) int
-        First and last step to walk: the steps with any light and one dark step either side. The
-        dark steps before and after hold zero power, so they join the half-steps held at the ends
-        of the day.
-    step_table, step_weight : (n_blocks, n_steps) or (n_blocks, 1) int and float
-        The electrical table set of each step (or of each block): its cells' air temperature lies
-        between set ``t`` and ``t + 1``, at ``weight`` of the way (0: set ``t``).
-    row_block, row_loadset : (n_rows,) int
-    row_normal : (n_rows, 2, 3) float
-        East and west sub-panel normals.
-    row_paper : (n_rows, 2, 4) float
-        cos(tilt), sin(tilt), cos(azimuth), sin(azimuth) per sub-panel (paper mode).
-    row_view : (n_rows, 2, 2) float
-        Per sub-panel, the factors of the isotropic and the horizon-band diffuse terms:
-        (1 + cos tilt) / 2 and sin tilt, less what the site's horizon hides
-        (:func:`foldopt.physics.horizon.sky_view_factors`).
-    table_1d, table_parallel, table_series : float arrays
-        Stacked over table sets (air temperatures), per set: sub-panel power [W] on sqrt-spaced
-        irradiance nodes, and the parallel and series pairs as fractions of the two maxima over
-        the stronger irradiance and the weaker/stronger ratio (:class:`foldopt.engine.electrical.Electrical`).
-    linear_power : float
-        ``efficiency * sub-panel area`` [m^2] for the ideal model (no tables); 0 with tables.
-    panel_scale : float
-        Panel area / sub-panel area.
-    connections : (n_conn,) int
-        Connection codes to evaluate.
-    built : (3,) int
-        The circuit as built: whether it is (1) or Shin et al.'s ideal parts (0), direct coupling,
-        and whether switching has its own table (a switch resistance).
-    table_alone, table_panel, table_switching : float arrays
-        As built, stacked as the other tables: a sub-panel's and the whole panel's power delivered
-        at the load's voltage (direct coupling), and switching as a fraction of the two maxima
-        (placeholders where unused).
-    conv_table : (n,) float
-        The converter's delivered power / rating (:func:`foldopt.physics.converter.delivered_table`).
-    conv_rated : float
-        The converter's rating [W]; 0 for an ideal converter.
-    loads : (n_loadsets, n_loads) float
-        Loads [W], ascending in each set.
-    contiguous : bool
-        Whether to track the longest contiguous interval too.
-    load_shape : (n_blocks, n_steps) float
-        With ``use_shape``, each block's load profile [W]: the loads are then its scales (one row
-        (1, 1) without).
-    use_shape : bool
-    t_out, cont_out : (n_rows, n_conn, n_loads) float
-        t_solar and its longest contiguous interval [h] (out).
-    energy_out, peak_out : (n_rows, n_conn) float
-        Energy [Wh] and peak power [W] (out).
-    irradiation_out : (n_rows,) float
-        Incident plane-of-array irradiation [Wh/m^2] (before the incidence-angle modifier), the
-        mean of the two (equal) sub-panels (out).
-    irradiance, buffer, above, whole, run : per-chunk scratch from :func:`scratch`.
+    sky : foldopt.engine.records.SkyArrays
+        The light of every block along its steps, and how the beam is taken.
+    rows : foldopt.engine.records.Rows
+        Each row's block, sub-panel normals, Eq. 5 factors, sky-view factors and set of loads.
+    tables : foldopt.engine.records.Tables
+        The electrical tables (or the ideal model's linear power), the circuit as built and the
+        connections to evaluate.
+    loads : foldopt.engine.records.Loads
+        The loads (and load profiles) and the step length.
+    out : foldopt.engine.records.Outputs
+        t_solar (and its longest contiguous interval), energy, peak power and irradiation (out).
+    scratch : foldopt.engine.records.Scratch
+        Per-chunk scratch (:func:`foldopt.engine.records.allocate`).
     """
-    n_rows = row_block.shape[0]
-    n_chunks = buffer.shape[0]
+    n_rows = rows.block.shape[0]
+    n_chunks = scratch.power.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
     for k in prange(n_chunks):
-        _chunk_rows(k * per_chunk, min((k + 1) * per_chunk, n_rows), sun, paper_sun, beam, terms, span, step_table,
-                    step_weight, row_block, row_normal, row_paper, row_view, row_loadset, paper_incidence, iam_model,
-                    iam_params, table_1d, table_parallel, table_series, linear_power, panel_scale, bypass,
-                    switch_series, converter_efficiency, connections, built, table_alone, table_panel,
-                    table_switching, conv_table, conv_rated, loads, step_hours, contiguous, load_shape, use_shape,
-                    t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance[k], buffer[k], above[k],
-                    whole[k], run[k])
+        _chunk_rows(k * per_chunk, min((k + 1) * per_chunk, n_rows), sky, rows, tables, loads, out,
+                    chunk_scratch(scratch, k))
 
 
 @njit(cache=True)
-def _chunk_rows(start, stop, sun, paper_sun, beam, terms, span, step_table, step_weight, row_block, row_normal,
-                row_paper, row_view, row_loadset, paper_incidence, iam_model, iam_params, table_1d, table_parallel,
-                table_series, linear_power, panel_scale, bypass, switch_series, converter_efficiency, connections,
-                built, table_alone, table_panel, table_switching, conv_table, conv_rated, loads, step_hours,
-                contiguous, load_shape, use_shape, t_out, cont_out, energy_out, peak_out, irradiation_out, irradiance,
-                buffer, above, whole, run):
-    """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch: a function of its own
-    (the parallel loop's body calls it) so that the row's functions are inlined into it.
+def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
+    """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work``: a function
+    of its own (the parallel loop's body calls it) so that the row's functions are inlined into it.
 
     Each row takes three loops over its lit steps. The first (:func:`foldopt.engine.incidence.incidence`)
     gives both sub-panels' irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) and
     their mean incident irradiance before the incidence-angle modifier. The second writes every asked
-    connection's power to ``buffer[c, step]``: from the tables (:func:`_table_row`), for the ideal
+    connection's power to ``work.power[c, step]``: from the tables (:func:`_table_row`), for the ideal
     model from :func:`_linear_connections`, or with the circuit as built from :func:`_built_row`,
     through :func:`_built_power`. The third reduces each power curve to the daily metrics. The row's
     work is inlined here rather than called: a call with the kernel's some thirty arrays cost about
     190 ns a row, a quarter of a map row's time at 30-min steps (some 12 % at 5-min steps)."""
+    connections = tables.connections
     n_conn = connections.shape[0]
-    tables = linear_power == 0.0
-    need_series = switch_series
+    with_tables = tables.linear_power == 0.0
+    need_series = tables.switch_series
     for c in range(n_conn):
         need_series = need_series or connections[c] == SERIES
     for r in range(start, stop):
-        b = row_block[r]
-        first, last = span[b, 0], span[b, 1]
+        b = rows.block[r]
+        first, last = sky.span[b, 0], sky.span[b, 1]
         n = last + 1 - first
-        incidence(r, b, first, n, sun, paper_sun, beam, terms, row_normal, row_paper, row_view, paper_incidence,
-                  terms.shape[1] == 4, iam_model, iam_params, tables, irradiance)
-        irradiation_out[r] = steps_sum(irradiance[2], first, n) * step_hours
-        if built[0]:
-            _built_row(b, first, last, step_table, step_weight, table_1d, table_alone, table_panel, table_parallel,
-                       table_series, table_switching, need_series, built[1] == 1, built[2] == 1, linear_power,
-                       panel_scale, switch_series, converter_efficiency, connections, conv_table, conv_rated,
-                       irradiance, buffer)
-        elif not tables:
-            _linear_connections(first, n, linear_power, panel_scale, converter_efficiency, connections, irradiance,
-                                buffer)
+        incidence(r, b, first, n, sky, rows, with_tables, work)
+        out.irradiation[r] = steps_sum(work.incident, first, n) * loads.step_hours
+        if tables.as_built:
+            _built_row(b, first, last, sky, tables, need_series, work)
+        elif not with_tables:
+            _linear_connections(first, n, tables, work)
         else:
-            _table_row(b, first, last, step_table, step_weight, table_1d, table_parallel, table_series, need_series,
-                       bypass, panel_scale, converter_efficiency, switch_series, connections, irradiance, buffer)
+            _table_row(b, first, last, sky, tables, need_series, work)
+        p_load, profile = loads.p_load[rows.loadset[r]], loads.profile[b if loads.use_profile else 0]
         for c in range(n_conn):
-            energy_out[r, c], peak_out[r, c] = day_metrics(
-                buffer[c], first, last, step_hours, loads[row_loadset[r]], contiguous, above, whole, run, t_out[r, c],
-                cont_out[r if contiguous else 0, c], load_shape[b if use_shape else 0], use_shape)
+            out.energy[r, c], out.peak[r, c] = day_metrics(
+                work.power[c], first, last, p_load, profile, loads, work, out.t_solar[r, c],
+                out.t_solar_contiguous[r if loads.contiguous else 0, c])

@@ -1,5 +1,5 @@
-"""Compiled reduction of power curves to daily metrics (numba), of daily values to the means of
-periods of days (:func:`period_means`), and the scratch of the kernels.
+"""Compiled reduction of power curves to daily metrics (numba), and of daily values to the means of
+periods of days (:func:`period_means`).
 
 :func:`day_metrics` reduces one power curve to the daily metrics of every load at once; the
 kernel :func:`foldopt.engine.kernel.fold_rows` calls it per row and connection, and
@@ -15,8 +15,8 @@ moves by a few loads a step, so it is walked from the previous step instead of s
 cost is then O(steps + loads x crossings), not O(steps x loads).
 
 Rows are split into chunks, a few per thread, and each chunk has its own scratch, allocated by the
-caller outside the parallel loop (:func:`scratch`; arrays zero-filled inside a numba prange body
-have given wrong sums) and cleared per row.
+caller outside the parallel loop (:func:`foldopt.engine.records.allocate`; arrays zero-filled inside
+a numba prange body have given wrong sums) and cleared per row.
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import njit, prange
 
-CHUNKS_PER_THREAD = 8  # rows are handed out in chunks: enough for balance, few scratch buffers
+from foldopt.engine.records import Scratch
 
 
 @njit(cache=True, inline="always")
@@ -84,54 +84,55 @@ def _per_load(p, shape, s, use_shape):
 
 
 @njit(cache=True, inline="always")
-def day_metrics(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
-             use_shape):
+def day_metrics(power, first, last, p_load, profile, loads, work, t_out, cont_out):
     """Daily metrics of one power curve [W] sampled at step centres, of which only steps
     ``first..last`` need walking: the power before and after them is that of the first and the
-    last (zero, or the day's end). Writes t_solar (and its longest run) per load; returns the
-    energy [Wh] and the peak [W]. With ``use_shape`` the loads are scales of the load profile
-    ``shape`` (n_steps) [W] (:func:`_per_load`); steps outside ``first..last`` hold the power of
-    the first and last, and the shape there is taken as the first's and the last's.
+    last (zero, or the day's end). Writes t_solar (and its longest run) per load of ``p_load``
+    (one set of :class:`foldopt.engine.records.Loads`, ascending) into ``t_out`` (and
+    ``cont_out``); returns the energy [Wh] and the peak [W]. With ``loads.use_profile`` the loads
+    are scales of the load profile ``profile`` (n_steps) [W] (:func:`_per_load`); steps outside
+    ``first..last`` hold the power of the first and last, and the profile there is taken as the
+    first's and the last's. ``work`` is a chunk's :class:`foldopt.engine.records.Scratch`.
 
     A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
     (summed from the top at the end), and shares to the loads inside its range. Consecutive
     segments mostly share k, so their lengths gather in a local sum first."""
     # Constant loads without runs (every map's) with the flags as constants, so that no step tests
     # them; the other cases read them at run time.
-    if not contiguous and not use_shape:
-        return _day_steps(power, first, last, step_hours, loads, False, above, whole, run, t_out, cont_out, shape,
-                          False)
-    return _day_steps(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
-                      use_shape)
+    if not loads.contiguous and not loads.use_profile:
+        return _day_steps(power, first, last, p_load, profile, loads.step_hours, False, False, work, t_out,
+                          cont_out)
+    return _day_steps(power, first, last, p_load, profile, loads.step_hours, loads.contiguous, loads.use_profile,
+                      work, t_out, cont_out)
 
 
 @njit(cache=True, inline="always")
-def _day_steps(power, first, last, step_hours, loads, contiguous, above, whole, run, t_out, cont_out, shape,
-               use_shape):
+def _day_steps(power, first, last, p_load, profile, step_hours, contiguous, use_profile, work, t_out, cont_out):
     """:func:`day_metrics`' walk over the steps."""
-    n_steps, n_loads = power.shape[0], loads.shape[0]
+    above, whole, run = work.above, work.whole, work.run
+    n_steps, n_loads = power.shape[0], p_load.shape[0]
     above[:] = 0.0
     whole[:] = 0.0
     if contiguous:
         run[:] = 0.0
     # The half-step held at the start of the day, and the steps before ``first``.
     harvested = peak = power[first]
-    previous = _per_load(power[first], shape, first, use_shape)
-    position = _walk(loads, 0, previous)
+    previous = _per_load(power[first], profile, first, use_profile)
+    position = _walk(p_load, 0, previous)
     pending_at, pending = position, (first + 0.5) * step_hours
     if contiguous:
         _runs(position, position, pending, run)
     for s in range(first + 1, last + 1):
         harvested += power[s]
         peak = max(peak, power[s])
-        p = _per_load(power[s], shape, s, use_shape)
-        at = _walk(loads, position, p)
+        p = _per_load(power[s], profile, s, use_profile)
+        at = _walk(p_load, position, p)
         lo_at, hi_at = min(position, at), max(position, at)
         if contiguous:
             _runs(position, lo_at, step_hours, run)
         pending_at, pending = _gather(whole, pending_at, pending, lo_at, step_hours)
         if hi_at > lo_at:
-            _shares(loads, min(previous, p), max(previous, p), lo_at, hi_at, step_hours, above, run, contiguous)
+            _shares(p_load, min(previous, p), max(previous, p), lo_at, hi_at, step_hours, above, run, contiguous)
         previous, position = p, at
     # The last sample held to the end of the day.
     tail = (n_steps - last - 0.5) * step_hours
@@ -148,9 +149,15 @@ def _day_steps(power, first, last, step_hours, loads, contiguous, above, whole, 
     return harvested * step_hours, peak
 
 
+@njit(cache=True, inline="always")
+def chunk_scratch(scratch, k):
+    """Chunk ``k``'s own :class:`foldopt.engine.records.Scratch` of the scratch of every chunk."""
+    return Scratch(scratch.east[k], scratch.west[k], scratch.incident[k], scratch.diffuse_east[k],
+                   scratch.diffuse_west[k], scratch.power[k], scratch.above[k], scratch.whole[k], scratch.run[k])
+
+
 @njit(cache=True, parallel=True)
-def curve_rows(power, span, row_loadset, loads, step_hours, contiguous, load_shape, use_shape, t_out, cont_out,
-               energy_out, peak_out, above, whole, run):
+def curve_rows(power, span, row_loadset, loads, out, scratch):
     """Daily metrics of given power curves (a tracker's), as :func:`fold_rows` with one connection.
 
     Parameters
@@ -162,27 +169,31 @@ def curve_rows(power, span, row_loadset, loads, step_hours, contiguous, load_sha
         before and after holds no load: the steps outside add to no load's time).
     row_loadset : (n_rows,) int
         Set of loads of each row.
-    loads : (n_loadsets, n_loads) float
-        Loads [W], ascending in each set.
-    step_hours : float
-        Step length [h].
-    contiguous : bool
-        Whether to track the longest contiguous interval too.
-    load_shape : (n_rows, n_steps) float
-        With ``use_shape``, each row's load profile [W] (one row (1, 1) without).
-    use_shape : bool
-    t_out, cont_out, energy_out, peak_out : outputs as :func:`fold_rows`'s, with one connection.
-    above, whole, run : per-chunk scratch from :func:`scratch`.
+    loads : foldopt.engine.records.Loads
+        With each row's load profile (n_rows, n_steps) where it has one.
+    out : foldopt.engine.records.Outputs
+        As :func:`fold_rows`'s, with one connection (no irradiation).
+    scratch : foldopt.engine.records.Scratch
+        Per chunk (:func:`foldopt.engine.records.allocate`).
     """
     n_rows = power.shape[0]
-    n_chunks = above.shape[0]
+    n_chunks = scratch.above.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
     for k in prange(n_chunks):
-        for r in range(k * per_chunk, min((k + 1) * per_chunk, n_rows)):
-            energy_out[r, 0], peak_out[r, 0] = day_metrics(
-                power[r], span[r, 0], span[r, 1], step_hours, loads[row_loadset[r]], contiguous, above[k], whole[k],
-                run[k], t_out[r, 0], cont_out[r if contiguous else 0, 0], load_shape[r if use_shape else 0],
-                use_shape)
+        _chunk_curves(k * per_chunk, min((k + 1) * per_chunk, n_rows), power, span, row_loadset, loads, out,
+                      chunk_scratch(scratch, k))
+
+
+@njit(cache=True)
+def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
+    """Rows ``start .. stop - 1`` of :func:`curve_rows` with one chunk's scratch ``work``: a function
+    of its own, as :func:`foldopt.engine.kernel._chunk_rows` (with :func:`day_metrics` inlined into
+    the parallel loop's body itself, what it wrote through the records' fields was lost: numba 0.68)."""
+    for r in range(start, stop):
+        out.energy[r, 0], out.peak[r, 0] = day_metrics(
+            power[r], span[r, 0], span[r, 1], loads.p_load[row_loadset[r]],
+            loads.profile[r if loads.use_profile else 0], loads, work, out.t_solar[r, 0],
+            out.t_solar_contiguous[r if loads.contiguous else 0, 0])
 
 
 @njit(cache=True)
@@ -218,39 +229,3 @@ def period_means(hours, member):
         for x in range(n):
             total[p, x] = total[p, x] / count[p] if count[p] > 0.0 else np.nan
     return total
-
-
-def scratch(n_rows, n_conn, n_loads, n_steps, contiguous):
-    """Outputs and per-chunk scratch of :func:`fold_rows` or :func:`curve_rows`, allocated here,
-    outside the parallel loop.
-
-    Parameters
-    ----------
-    n_rows, n_conn, n_loads : int
-        Rows, connections and loads per set.
-    n_steps : int
-        Steps per day for :func:`fold_rows`; 0 for :func:`curve_rows`.
-    contiguous : bool
-        Whether the longest contiguous interval is tracked.
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        The keyword arguments ``t_out`` ... ``run`` of the kernel.
-    """
-    chunks = max(1, min(n_rows, get_num_threads() * CHUNKS_PER_THREAD))
-    shape = (n_rows, n_conn)
-    work = {
-        "t_out": np.empty(shape + (n_loads,)),
-        "cont_out": np.zeros(shape + (n_loads,)) if contiguous else np.zeros((1, n_conn, n_loads)),
-        "energy_out": np.empty(shape),
-        "peak_out": np.empty(shape),
-        "above": np.zeros((chunks, n_loads)),
-        "whole": np.zeros((chunks, n_loads + 1)),
-        "run": np.zeros((chunks, n_loads if contiguous else 1, 2)),
-    }
-    if n_steps:
-        work["irradiation_out"] = np.empty(n_rows)
-        work["irradiance"] = np.zeros((chunks, 5, n_steps))
-        work["buffer"] = np.zeros((chunks, n_conn, n_steps))
-    return work

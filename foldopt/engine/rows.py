@@ -29,6 +29,7 @@ from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.engine.metrics import energy, per_load, t_solar, t_solar_contiguous
 from foldopt.names import ENGINES
 from foldopt.engine.built import PARTS, assemble
+from foldopt.engine.records import Loads, Rows, SkyArrays, Tables, allocate
 from foldopt.engine.sky import Sky, step_span
 from foldopt.engine.views import row_views, surface_views
 # The cells' electrical model is part of the engine's API (engines.electrical_for, panel_power...).
@@ -246,14 +247,14 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     sorted_loads, order = _sorted_loads(loads)
     row_loadset = np.zeros(row_block.size, dtype=np.int64) if row_loadset is None else np.asarray(
         row_loadset, dtype=np.int64)
+    loads = _loads(sorted_loads, sky.load_shape, contiguous, sky.step_hours)
     if engine == "numpy" or study.exact_electrical:
-        result = _reference(sky, study, row_block, orientation[row_orientation], sorted_loads, row_loadset, outputs,
-                            contiguous)
+        result = _reference(sky, study, row_block, orientation[row_orientation], loads, row_loadset, outputs)
     else:
         nodes, table, weight = temperature_nodes(sky)
         electricals = [electrical_for(study, temp, sky.wind_ref) for temp in nodes]
         result = _compiled(sky, study, electricals, (table, weight), row_block, orientation, row_orientation,
-                           sorted_loads, row_loadset, outputs, contiguous)
+                           loads, row_loadset, outputs)
     return _in_caller_order(result, order, row_loadset)
 
 
@@ -264,11 +265,12 @@ def _in_caller_order(result: RowMetrics, order, row_loadset) -> RowMetrics:
                       result.energy, result.peak, result.irradiation)
 
 
-def _curve_reference(power, row_loads, step_hours, contiguous, load_shape=None):
+def _curve_reference(power, row_loads, profile, loads: Loads):
     """t_solar, its longest run (or None), energy and peak of curves (m, n_steps) with loads (m, L)
-    (scales of ``load_shape`` where given) by :mod:`foldopt.engine.metrics`."""
-    compared = per_load(power, load_shape)
-    runs = t_solar_contiguous(compared[:, None, :], row_loads, step_hours) if contiguous else None
+    (scales of ``profile`` where ``loads.use_profile``) by :mod:`foldopt.engine.metrics`."""
+    step_hours = loads.step_hours
+    compared = per_load(power, profile if loads.use_profile else None)
+    runs = t_solar_contiguous(compared[:, None, :], row_loads, step_hours) if loads.contiguous else None
     return t_solar(compared[:, None, :], row_loads, step_hours), runs, energy(power, step_hours), power.max(axis=-1)
 
 
@@ -340,8 +342,8 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
     return {**out, **connected, "panel": parts["panel"]}, state
 
 
-def _reference(sky, study, row_block, orientation, loads, row_loadset, outputs, contiguous):
-    n_rows, n_loads = row_block.size, loads.shape[1]
+def _reference(sky, study, row_block, orientation, loads: Loads, row_loadset, outputs):
+    n_rows, n_loads, contiguous = row_block.size, loads.p_load.shape[1], loads.contiguous
     shape = (n_rows, len(outputs))
     out = RowMetrics(np.zeros(shape + (n_loads,)), np.zeros(shape + (n_loads,)) if contiguous else None,
                      np.zeros(shape), np.zeros(shape), np.zeros(n_rows))
@@ -351,47 +353,51 @@ def _reference(sky, study, row_block, orientation, loads, row_loadset, outputs, 
         rows = np.flatnonzero(row_block == block)
         curves, _ = powers(sky, study, orientation[rows], [block], series)
         out.irradiation[rows] = energy(curves["poa"], step)
-        shape = None if sky.load_shape is None else sky.load_shape[block]
+        profile = loads.profile[block] if loads.use_profile else None
         for index, name in enumerate(outputs):
-            hours, runs, harvested, peak = _curve_reference(curves[name], loads[row_loadset[rows]], step, contiguous,
-                                                            shape)
+            hours, runs, harvested, peak = _curve_reference(curves[name], loads.p_load[row_loadset[rows]], profile,
+                                                            loads)
             out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = hours, harvested, peak
             if contiguous:
                 out.t_solar_contiguous[rows, index] = runs
     return out
 
 
-def _tables(electricals, outputs, study):
-    """The kernel's stacked tables (one per cell temperature), the ideal model's linear power, and
-    the circuit as built: its flags, tables and converter (:func:`foldopt.engine.kernel.fold_rows`)."""
+def _tables(electricals, outputs, study, codes) -> Tables:
+    """The kernel's electrical side: the stacked tables (one per cell temperature), the ideal
+    model's linear power, and the circuit as built: its flags, tables and converter."""
     first, count = electricals[0], len(electricals)
     parts = first.circuit
     # Tables a study does not use are placeholders, one per cell temperature all the same.
     placeholder_1d, placeholder = np.zeros((count, 2)), np.zeros((count, 2, 2))
-    built = {"built": np.array([parts is not None, parts is not None and parts.direct,
-                                parts is not None and parts.switch_table], dtype=np.int64),
-             "table_alone": placeholder_1d, "table_panel": placeholder_1d, "table_switching": placeholder,
-             "conv_table": np.zeros(1) if parts is None else parts.conv_table,
-             "conv_rated": 0.0 if parts is None else parts.conv_rated}
+    subpanel, parallel, series, linear_power = placeholder_1d, placeholder, placeholder, 0.0
+    alone, panel, switching = placeholder_1d, placeholder_1d, placeholder
     if not first.pv.has_iv:
-        return placeholder_1d, placeholder, placeholder, first.pv.efficiency * first.subpanel_area, built
-    series = "series" in outputs or study.switch_series
-    table_1d = np.stack([e._table("subpanel")[1] for e in electricals])
-    table_parallel = np.stack([e._table("parallel") for e in electricals])
-    table_series = np.stack([e._table("series") for e in electricals]) if series else placeholder
-    if parts is not None and parts.direct:
-        built["table_alone"] = np.stack([e._table("alone")[1] for e in electricals])
-        built["table_panel"] = np.stack([e._table("panel")[1] for e in electricals])
-    if parts is not None and parts.switch_table:
-        built["table_switching"] = np.stack([e._table("switching") for e in electricals])
-    return table_1d, table_parallel, table_series, 0.0, built
+        linear_power = first.pv.efficiency * first.subpanel_area
+    else:
+        subpanel = np.stack([e._table("subpanel")[1] for e in electricals])
+        parallel = np.stack([e._table("parallel") for e in electricals])
+        if "series" in outputs or study.switch_series:
+            series = np.stack([e._table("series") for e in electricals])
+        if parts is not None and parts.direct:
+            alone = np.stack([e._table("alone")[1] for e in electricals])
+            panel = np.stack([e._table("panel")[1] for e in electricals])
+        if parts is not None and parts.switch_table:
+            switching = np.stack([e._table("switching") for e in electricals])
+    return Tables(
+        subpanel=subpanel, parallel=parallel, series=series, linear_power=float(linear_power),
+        panel_scale=float(study.panel.area / first.subpanel_area), bypass=bool(first.bypass),
+        switch_series=bool(first.switch_series), converter_efficiency=float(first.converter_efficiency),
+        connections=codes, as_built=parts is not None, direct=parts is not None and bool(parts.direct),
+        switch_table=parts is not None and bool(parts.switch_table), alone=alone, panel=panel, switching=switching,
+        converter=np.zeros(1) if parts is None else np.ascontiguousarray(parts.conv_table, dtype=float),
+        converter_rating=0.0 if parts is None else float(parts.conv_rated))
 
 
 def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_orientation, loads, row_loadset,
-              outputs, contiguous):
-    from foldopt.engine import kernel, reduce
+              outputs):
+    from foldopt.engine import kernel
 
-    table_1d, table_parallel, table_series, linear_power, built = _tables(electricals, outputs, study)
     codes = np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64)
     # Each orientation's normals (and Eq. 5 factors) once, then per row; the exact incidence reads
     # no Eq. 5 factors (zeros stand in).
@@ -402,22 +408,21 @@ def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_
     if paper:
         tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])
         row_paper = np.stack([np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1)[row_orientation]
-    iam_code, iam_params = _iam_code(sky.iam)
-    first = electricals[0]
-    work = reduce.scratch(row_block.size, codes.size, loads.shape[1], sky.dni.shape[1], contiguous)
-    arrays = [*sky.kernel_layout(paper), np.asarray(step_tables[0], dtype=np.int64),
-              np.asarray(step_tables[1], dtype=float), row_block, normals[row_orientation], row_paper,
-              row_views(sky, row_block, normals, orientation, row_orientation), row_loadset]
+    iam_model, iam_params = _iam_code(sky.iam)
+    sun, paper_sun, beam, terms, span = (np.ascontiguousarray(a) for a in sky.kernel_layout(paper))
     # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
-    kernel.fold_rows(
-        *(np.ascontiguousarray(a) for a in arrays), paper, iam_code, iam_params, table_1d, table_parallel,
-        table_series, float(linear_power), study.panel.area / first.subpanel_area, first.bypass,
-        first.switch_series, first.converter_efficiency, codes, built["built"], built["table_alone"],
-        built["table_panel"], built["table_switching"], built["conv_table"], float(built["conv_rated"]),
-        np.ascontiguousarray(loads), sky.step_hours, contiguous, *_shape_arguments(sky.load_shape), **work,
-    )
-    return RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
-                      work["peak_out"], work["irradiation_out"])
+    light = SkyArrays(sun=sun, paper_sun=paper_sun, beam=beam, terms=terms, span=span,
+                      step_table=np.ascontiguousarray(step_tables[0], dtype=np.int64),
+                      step_weight=np.ascontiguousarray(step_tables[1], dtype=float), paper=paper,
+                      iam_model=int(iam_model), iam_params=iam_params)
+    rows = Rows(block=np.ascontiguousarray(row_block), normal=np.ascontiguousarray(normals[row_orientation]),
+                paper=np.ascontiguousarray(row_paper),
+                sky_view=np.ascontiguousarray(row_views(sky, row_block, normals, orientation, row_orientation)),
+                loadset=np.ascontiguousarray(row_loadset))
+    out, scratch = allocate(row_block.size, codes.size, loads.p_load.shape[1], sky.dni.shape[1], loads.contiguous)
+    kernel.fold_rows(light, rows, _tables(electricals, outputs, study, codes), loads, out, scratch)
+    return RowMetrics(out.t_solar, out.t_solar_contiguous if loads.contiguous else None, out.energy, out.peak,
+                      out.irradiation)
 
 
 def power_span(power) -> np.ndarray:
@@ -432,11 +437,11 @@ def power_span(power) -> np.ndarray:
     return step_span(power != 0.0)
 
 
-def _shape_arguments(load_shape):
-    """The kernel's ``load_shape`` and ``use_shape``: one placeholder row for constant loads."""
-    if load_shape is None:
-        return np.zeros((1, 1)), False
-    return np.ascontiguousarray(load_shape, dtype=float), True
+def _loads(sorted_loads, load_shape, contiguous: bool, step_hours: float) -> Loads:
+    """The engine's :class:`Loads`: one placeholder row (1, 1) of profile for constant loads."""
+    profile = np.zeros((1, 1)) if load_shape is None else np.ascontiguousarray(load_shape, dtype=float)
+    return Loads(p_load=np.ascontiguousarray(sorted_loads, dtype=float), profile=profile,
+                 use_profile=load_shape is not None, contiguous=bool(contiguous), step_hours=float(step_hours))
 
 
 def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous: bool = False,
@@ -477,17 +482,15 @@ def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous:
         row_loadset, dtype=np.int64)
     if load_shape is not None:
         load_shape = np.broadcast_to(np.asarray(load_shape, dtype=float), power.shape)
+    held = _loads(sorted_loads, load_shape, contiguous, step_hours)
     if engine == "numpy":
-        hours, runs, harvested, peak = _curve_reference(power, sorted_loads[row_loadset], step_hours, contiguous,
-                                                        load_shape)
+        hours, runs, harvested, peak = _curve_reference(power, sorted_loads[row_loadset], held.profile, held)
         result = RowMetrics(hours[:, None], None if runs is None else runs[:, None], harvested[:, None], peak[:, None])
     else:
         from foldopt.engine import reduce
 
-        work = reduce.scratch(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
+        out, scratch = allocate(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
         span = power_span(power) if span is None else np.ascontiguousarray(span, dtype=np.int64)
-        reduce.curve_rows(power, span, row_loadset, sorted_loads, step_hours, contiguous,
-                          *_shape_arguments(load_shape), **work)
-        result = RowMetrics(work["t_out"], work["cont_out"] if contiguous else None, work["energy_out"],
-                            work["peak_out"])
+        reduce.curve_rows(power, span, row_loadset, held, out, scratch)
+        result = RowMetrics(out.t_solar, out.t_solar_contiguous if contiguous else None, out.energy, out.peak)
     return _in_caller_order(result, order, row_loadset)

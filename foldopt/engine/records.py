@@ -1,0 +1,250 @@
+"""The compiled engine's inputs and outputs as named records, declared once.
+
+:func:`foldopt.engine.kernel.fold_rows` takes a day's light (:class:`SkyArrays`), the panels
+(:class:`Rows`), the electrical side (:class:`Tables`), the loads (:class:`Loads`), and writes
+:class:`Outputs` with per-chunk :class:`Scratch`; :func:`foldopt.engine.reduce.curve_rows` takes the
+last three. numba takes these module-level named tuples as arguments (and caches functions typed by
+them), so adding an input is a field here and the line of :mod:`foldopt.engine.rows` that fills it.
+Every field is an array, a float, an int or a bool, always of the same type, so that one compiled
+specialisation serves every call.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import get_num_threads
+
+CHUNKS_PER_THREAD = 8  # rows are handed out in chunks: enough for balance, few scratch buffers
+
+
+class SkyArrays(NamedTuple):
+    """The light of every block of a sky, laid out along the steps, and how the beam is taken.
+
+    Attributes
+    ----------
+    sun : (n_blocks, 3, n_steps) float
+        Unit sun vectors (east, north, up).
+    paper_sun : (n_blocks, 4, n_steps) float
+        cos(zenith), sin(zenith), sin(azimuth), cos(azimuth) for Eq. 5 (a placeholder (1, 4, 1)
+        unless ``paper``).
+    beam : (n_blocks, n_steps) float
+        Direct normal irradiance [W/m^2].
+    terms : (n_blocks, 4, n_steps) float
+        Diffuse terms (isotropic, circumsolar, horizon, ground) of
+        :func:`foldopt.physics.irradiance.sky_diffuse_terms`; (n_blocks, 0, n_steps) for beam only.
+    span : (n_blocks, 2) int
+        First and last step to walk: the steps with any light and one dark step either side. The
+        dark steps before and after hold zero power, so they join the half-steps held at the ends
+        of the day.
+    step_table, step_weight : (n_blocks, n_steps) or (n_blocks, 1) int and float
+        The electrical table set of each step (or of each block): its cells' air temperature lies
+        between set ``t`` and ``t + 1``, at ``weight`` of the way (0: set ``t``).
+    paper : bool
+        The beam's incidence by Shin et al.'s Eq. 5 (paper mode) instead of the angle of incidence.
+    iam_model : int
+        The beam's incidence-angle modifier (:data:`foldopt.engine.incidence.IAM_NONE` ...).
+    iam_params : (3,) float
+        Its parameters (:func:`foldopt.engine.incidence.iam_factor`).
+    """
+
+    sun: np.ndarray
+    paper_sun: np.ndarray
+    beam: np.ndarray
+    terms: np.ndarray
+    span: np.ndarray
+    step_table: np.ndarray
+    step_weight: np.ndarray
+    paper: bool
+    iam_model: int
+    iam_params: np.ndarray
+
+
+class Rows(NamedTuple):
+    """The rows: each a block of the sky seen by one panel's two sub-panels.
+
+    Attributes
+    ----------
+    block, loadset : (n_rows,) int
+        Each row's block and set of loads.
+    normal : (n_rows, 2, 3) float
+        East and west sub-panel normals.
+    paper : (n_rows, 2, 4) float
+        cos(tilt), sin(tilt), cos(azimuth), sin(azimuth) per sub-panel (read in paper mode).
+    sky_view : (n_rows, 2, 2) float
+        Per sub-panel, the factors of the isotropic and the horizon-band diffuse terms:
+        (1 + cos tilt) / 2 and sin tilt, less what the site's horizon hides
+        (:func:`foldopt.physics.horizon.sky_view_factors`).
+    """
+
+    block: np.ndarray
+    normal: np.ndarray
+    paper: np.ndarray
+    sky_view: np.ndarray
+    loadset: np.ndarray
+
+
+class Tables(NamedTuple):
+    """The electrical side: the tables (stacked over table sets, one per air temperature), the
+    circuit as built, and the outputs to evaluate.
+
+    Attributes
+    ----------
+    subpanel, parallel, series : float arrays
+        Per set: a sub-panel's power [W] on sqrt-spaced irradiance nodes, and the parallel and
+        series pairs as fractions of the two maxima over the stronger irradiance and the
+        weaker/stronger ratio (:class:`foldopt.engine.electrical.Electrical`); placeholders for the
+        ideal model (and ``series`` where no series power is asked).
+    linear_power : float
+        ``efficiency * sub-panel area`` [m^2] for the ideal model (no tables); 0 with tables.
+    panel_scale : float
+        Panel area / sub-panel area.
+    bypass, switch_series : bool
+        The series pair never below its stronger sub-panel (a bypass diode); switching may also take
+        the series pair.
+    converter_efficiency : float
+        The independent connection's converters' efficiency [-].
+    connections : (n_conn,) int
+        Codes of the outputs to evaluate (:data:`foldopt.engine.kernel.EAST` ...).
+    as_built : bool
+        The circuit as built (:mod:`foldopt.engine.built`), not Shin et al.'s ideal parts.
+    direct, switch_table : bool
+        As built: direct coupling at the load's voltage; switching has a table of its own (a
+        switch resistance).
+    alone, panel, switching : float arrays
+        As built, stacked as the other tables: a sub-panel's and the whole panel's power delivered
+        at the load's voltage (direct coupling), and switching as a fraction of the two maxima
+        (placeholders where unused).
+    converter : (n,) float
+        The converter's delivered power / rating (:func:`foldopt.physics.converter.delivered_table`).
+    converter_rating : float
+        The converter's rating [W]; 0 for an ideal converter.
+    """
+
+    subpanel: np.ndarray
+    parallel: np.ndarray
+    series: np.ndarray
+    linear_power: float
+    panel_scale: float
+    bypass: bool
+    switch_series: bool
+    converter_efficiency: float
+    connections: np.ndarray
+    as_built: bool
+    direct: bool
+    switch_table: bool
+    alone: np.ndarray
+    panel: np.ndarray
+    switching: np.ndarray
+    converter: np.ndarray
+    converter_rating: float
+
+
+class Loads(NamedTuple):
+    """The loads and how a day's power curve is held against them.
+
+    Attributes
+    ----------
+    p_load : (n_loadsets, n_loads) float
+        Loads [W], ascending in each set.
+    profile : (n_blocks, n_steps) float
+        With ``use_profile``, each block's (or curve's) load profile [W]: the loads are then its
+        scales (one row (1, 1) without).
+    use_profile : bool
+    contiguous : bool
+        Whether to track the longest contiguous interval too.
+    step_hours : float
+        Step length [h].
+    """
+
+    p_load: np.ndarray
+    profile: np.ndarray
+    use_profile: bool
+    contiguous: bool
+    step_hours: float
+
+
+class Outputs(NamedTuple):
+    """What the kernels write, per row, connection and load.
+
+    Attributes
+    ----------
+    t_solar, t_solar_contiguous : (n_rows, n_conn, n_loads) float
+        t_solar and its longest contiguous interval [h] (the latter (1, n_conn, n_loads) unless
+        ``contiguous``).
+    energy, peak : (n_rows, n_conn) float
+        Energy [Wh] and peak power [W].
+    irradiation : (n_rows,) float
+        Incident plane-of-array irradiation [Wh/m^2] (before the incidence-angle modifier), the
+        mean of the two (equal) sub-panels; empty for given power curves.
+    """
+
+    t_solar: np.ndarray
+    t_solar_contiguous: np.ndarray
+    energy: np.ndarray
+    peak: np.ndarray
+    irradiation: np.ndarray
+
+
+class Scratch(NamedTuple):
+    """Working arrays of each chunk of rows, allocated outside the parallel loop (arrays
+    zero-filled inside a numba prange body have given wrong sums): each field's first axis is the
+    chunk, and a chunk's own record (:func:`foldopt.engine.reduce.chunk_scratch`) holds the rest.
+
+    Attributes
+    ----------
+    east, west : (n_steps,) float
+        Each sub-panel's irradiance [W/m^2] (the beam alone while the incidence-angle modifier
+        waits; as sqrt(E / E_max), the tables' coordinate, with tables).
+    incident : (n_steps,) float
+        The two sub-panels' mean incident irradiance before the modifier [W/m^2].
+    diffuse_east, diffuse_west : (n_steps,) float
+        Each sub-panel's diffuse irradiance while the beam waits for the modifier [W/m^2].
+    power : (n_conn, n_steps) float
+        Every asked connection's power of the row [W].
+    above, whole : (n_loads,) and (n_loads + 1,) float
+        A day's reduction: the time each load spends inside a segment's range, and the segments'
+        lengths by how many loads lie below them (:func:`foldopt.engine.reduce.day_metrics`).
+    run : (n_loads or 1, 2) float
+        The current and the longest run of each load (``contiguous``).
+    """
+
+    east: np.ndarray
+    west: np.ndarray
+    incident: np.ndarray
+    diffuse_east: np.ndarray
+    diffuse_west: np.ndarray
+    power: np.ndarray
+    above: np.ndarray
+    whole: np.ndarray
+    run: np.ndarray
+
+
+def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: bool) -> tuple[Outputs, Scratch]:
+    """Outputs and per-chunk scratch of :func:`foldopt.engine.kernel.fold_rows` or
+    :func:`foldopt.engine.reduce.curve_rows`, allocated here, outside the parallel loop.
+
+    Parameters
+    ----------
+    n_rows, n_conn, n_loads : int
+        Rows, connections and loads per set.
+    n_steps : int
+        Steps per day for :func:`fold_rows`; 0 for :func:`curve_rows` (which reads no irradiance).
+    contiguous : bool
+        Whether the longest contiguous interval is tracked.
+
+    Returns
+    -------
+    Outputs, Scratch
+    """
+    chunks = max(1, min(n_rows, get_num_threads() * CHUNKS_PER_THREAD))
+    shape = (n_rows, n_conn)
+    out = Outputs(t_solar=np.empty(shape + (n_loads,)),
+                  t_solar_contiguous=np.zeros(shape + (n_loads,)) if contiguous else np.zeros((1, n_conn, n_loads)),
+                  energy=np.empty(shape), peak=np.empty(shape), irradiation=np.empty(n_rows if n_steps else 0))
+    light = [np.zeros((chunks, n_steps)) for _ in range(5)]
+    scratch = Scratch(*light, power=np.zeros((chunks, n_conn if n_steps else 0, n_steps)),
+                      above=np.zeros((chunks, n_loads)), whole=np.zeros((chunks, n_loads + 1)),
+                      run=np.zeros((chunks, n_loads if contiguous else 1, 2)))
+    return out, scratch
