@@ -90,7 +90,7 @@ def study_question(study, varied: tuple = ()) -> dict:
         "panel": f"{panel.area:g} m^2, efficiency {panel.efficiency:g}, tilt {panel.tilt:g} deg, azimuth "
                  f"{panel.azimuth:g} deg" + (" (per latitude)" if "site.latitude" in varied else ""),
         "models": f"{study.mode} mode, {study.geometry} geometry, {study.pv_model} PV model, {study.connection}, "
-                  + (f"weather {Path(study.weather.path).name}" if study.weather else f"{study.sky} sky"),
+                  + sky_text(study, varied),
         "fold angles": f"{study.fold_angles.start:g} to {study.fold_angles.stop:g} deg by {study.fold_angles.step:g}",
         "near-optimal": f"within {100 * tolerance.fraction:g} % or {tolerance.minutes:g} min of the best, "
                         "whichever is larger",
@@ -107,6 +107,61 @@ def study_question(study, varied: tuple = ()) -> dict:
                                  f"t_solar{season}" + (f"; re-fold schedules of up to {objective.visits} settings"
                                                        if objective.visits else ""))
     return question
+
+
+#: How the question names each sky and transposition.
+SKY_LABELS = {"meinel": "Meinel", "hottel": "Hottel", "ineichen": "Ineichen", "simplified-solis": "simplified Solis"}
+TRANSPOSITION_LABELS = {"isotropic": "isotropic", "haydavies": "Hay-Davies", "perez": "Perez"}
+
+
+def sky_text(study, varied: tuple = ()) -> str:
+    """The whole sky in force in a study, as its question says it: the clear sky or the weather
+    file, the Linke turbidity of Ineichen's (the study's, or pvlib's climatology at the site and
+    day, said as a number where neither varies), the transposition and the albedo, or beam only.
+
+    Parameters
+    ----------
+    study : Study
+        Resolved: its sky decided by its mode.
+    varied : tuple of str, default ()
+        The config paths a sweep varies.
+
+    Returns
+    -------
+    str
+        ``Ineichen clear sky at Linke turbidity 3.8 (pvlib climatology for the site and day), Perez
+        diffuse, albedo 0.2`` (exact mode's default, Berlin on 21 June), ``Meinel clear sky, beam
+        only (Shin et al.)`` (paper mode's).
+    """
+    transposition = study.sky_transposition()
+    if study.weather is not None:
+        parts = [f"weather {Path(study.weather.path).name}"]
+    else:
+        parts = [f"{SKY_LABELS[study.sky]} clear sky" + (f" ({study.climate})" if study.sky == "hottel" else "")]
+        if study.sky == "ineichen":
+            parts[0] += f" at Linke turbidity {_turbidity_text(study, varied)}"
+    if transposition == "none":
+        parts.append("beam only" + (" (Shin et al.)" if study.mode == "paper" and study.sky == "meinel" else ""))
+    else:
+        parts += [f"{TRANSPOSITION_LABELS[transposition]} diffuse", f"albedo {study.albedo:g}"]
+    return ", ".join(parts)
+
+
+def _turbidity_text(study, varied: tuple) -> str:
+    """The Linke turbidity of a study's Ineichen sky: the study's own, or pvlib's climatology at its
+    site on the UTC day of its solar noon (as the engine looks it up per site and UTC day)."""
+    import numpy as np
+
+    from foldopt.inputs.turbidity import linke_turbidity
+
+    if study.linke_turbidity is not None:
+        return f"{study.linke_turbidity:g}"
+    if {"site", "site.latitude", "site.longitude", "date"} & set(varied):
+        return "from pvlib climatology for each site and day"
+    site = study.site
+    noon = np.datetime64(f"{study.date.isoformat()}T12:00") - np.timedelta64(round(site.longitude * 240), "s")
+    value = linke_turbidity(site.latitude, site.longitude, noon.astype("datetime64[ns]").astype(np.int64))
+    return f"{float(value):.1f} (pvlib climatology for the site and day)"
 
 
 def _range_text(row) -> str:
