@@ -6,12 +6,12 @@ checks how its options combine and prints.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import Annotated
 
 import typer
 
-from foldopt.cli.options import (ANGLE_STEP, AREA, EFFICIENCY, EMBEDDED, ENGINE, FORMAT, OPTION_OF_FIELD, OVERWRITE,
-                                 QUIET, RESULTS, SETTINGS, check_choices, out_option, rename_fields,
+from foldopt.cli.options import (EMBEDDED, OPTION_OF_FIELD, RESULTS, AngleStep, Area, Efficiency, Engine,
+                                 OutputFormat, Overwrite, Quiet, Settings, check_choices, out_option, rename_fields,
                                  step_min_option)
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError, WeatherError
@@ -22,52 +22,57 @@ _OPTION_OF_PARAMETER = {"latitudes": "--lat", "longitudes": "--lon", "land_only"
 
 
 def map_(
-    lat: Optional[str] = typer.Option(None, "--lat", help="Latitudes [deg north]: a range start:stop:step or a "
-                                      "list [default: -60:60:10]."),
-    lon: Optional[str] = typer.Option(None, "--lon", help="Longitudes [deg east]: a range or a list "
-                                      "[default: -180:180:30]."),
-    land_only: bool = typer.Option(False, "--land-only", help="Keep only the grid points on land."),
-    sites: Optional[Path] = typer.Option(None, "--sites", help="CSV of named sites: name, latitude, longitude "
-                                         "[, altitude, timezone], instead of a grid."),
-    weather_dir: Optional[Path] = typer.Option(None, "--weather-dir", help="Folder of TMY3 / EPW / PVGIS files, each "
-                                               "file a site (its site read from the file), instead of a grid."),
-    p_load: Optional[str] = typer.Option(None, "--p-load", help="Loads [W]: a value, a range or a list [default: the "
-                                         "study's]."),
-    p_load_fraction: Optional[str] = typer.Option(None, "--p-load-fraction", help="Loads as fractions of each "
-                                                  "site's flat peak: a value, a range such as 0.1:0.9:0.1 or a list, "
-                                                  "instead of --p-load."),
-    area: Optional[float] = AREA,
-    efficiency: Optional[float] = EFFICIENCY,
-    objective: str = typer.Option("mean", "--objective", help="What each period's fold angle maximises: mean | min | "
-                                  "worst-month | pNN."),
-    year: int = typer.Option(2025, "--year", help="Year of the clear-sky days (or that a typical year stands for)."),
-    step_min: Optional[float] = step_min_option("5"),
-    angle_step: Optional[float] = ANGLE_STEP,
-    fold_search: bool = typer.Option(False, "--fold-search", help="Search the fold angles (foldopt.engine.search) "
-                                     "instead of evaluating every one: the same objectives within 0.01 h from some "
-                                     "60 of 180 angles."),
-    optimize: Optional[str] = typer.Option(None, "--optimize", help="What the search varies with the fold angle: "
-                                           "tilt (each site's best tilt, and the flat panel's own); implies "
-                                           "--fold-search."),
-    config: Optional[Path] = typer.Option(None, "--config", help=f"Study to take the panel and models from [default: "
-                                          f"{EMBEDDED}, in exact mode with the Ineichen clear sky]."),
-    settings: Optional[list[str]] = SETTINGS,
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="A Dask scheduler's address (tcp://host:8786) "
-                                            "or scheduler file [default: an embedded cluster]."),
-    workers: Optional[int] = typer.Option(None, "--workers", help="Worker processes of the embedded cluster "
-                                          "[default: one per core]."),
-    chunk_sites: Optional[int] = typer.Option(None, "--chunk-sites", help="Sites per task [default: about 5 s of "
-                                              "work]."),
-    show_load: int = typer.Option(1, "--show-load", help="Which load (1 = the first) the world maps show."),
-    show_period: str = typer.Option("year", "--show-period", help="Period the world maps show: year | DJF | MAM | "
-                                    "JJA | SON."),
-    resume: bool = typer.Option(False, "--resume", help="Finish an interrupted map in --out: only missing chunks "
-                                "are computed."),
-    out: Path = out_option(RESULTS / "map"),
-    overwrite: bool = OVERWRITE,
-    quiet: bool = QUIET,
-    output_format: str = FORMAT,
-    engine: str = ENGINE,
+    lat: Annotated[str | None, typer.Option("--lat", help="Latitudes [deg north]: a range start:stop:step or a "
+                                            "list [default: -60:60:10].")] = None,
+    lon: Annotated[str | None, typer.Option("--lon", help="Longitudes [deg east]: a range or a list "
+                                            "[default: -180:180:30].")] = None,
+    land_only: Annotated[bool, typer.Option("--land-only", help="Keep only the grid points on land.")] = False,
+    sites: Annotated[Path | None, typer.Option("--sites", help="CSV of named sites: name, latitude, longitude "
+                                               "[, altitude, timezone], instead of a grid.")] = None,
+    weather_dir: Annotated[Path | None, typer.Option("--weather-dir", help="Folder of TMY3 / EPW / PVGIS files, "
+                                                     "each file a site (its site read from the file), instead of "
+                                                     "a grid.")] = None,
+    p_load: Annotated[str | None, typer.Option("--p-load", help="Loads [W]: a value, a range or a list [default: "
+                                               "the study's].")] = None,
+    p_load_fraction: Annotated[str | None, typer.Option("--p-load-fraction", help="Loads as fractions of each "
+                                                        "site's flat peak: a value, a range such as 0.1:0.9:0.1 or "
+                                                        "a list, instead of --p-load.")] = None,
+    area: Area = None,
+    efficiency: Efficiency = None,
+    objective: Annotated[str, typer.Option("--objective", help="What each period's fold angle maximises: mean | "
+                                           "min | worst-month | pNN.")] = "mean",
+    year: Annotated[int, typer.Option("--year", help="Year of the clear-sky days (or that a typical year stands "
+                                      "for).")] = 2025,
+    step_min: Annotated[float | None, step_min_option("5")] = None,
+    angle_step: AngleStep = None,
+    fold_search: Annotated[bool, typer.Option("--fold-search", help="Search the fold angles (foldopt.engine.search) "
+                                              "instead of evaluating every one: the same objectives within 0.01 h "
+                                              "from some 60 of 180 angles.")] = False,
+    optimize: Annotated[str | None, typer.Option("--optimize", help="What the search varies with the fold angle: "
+                                                 "tilt (each site's best tilt, and the flat panel's own); implies "
+                                                 "--fold-search.")] = None,
+    config: Annotated[Path | None, typer.Option("--config", help=f"Study to take the panel and models from "
+                                                f"[default: {EMBEDDED}, in exact mode with the Ineichen clear "
+                                                "sky].")] = None,
+    settings: Settings = None,
+    scheduler: Annotated[str | None, typer.Option("--scheduler", help="A Dask scheduler's address "
+                                                  "(tcp://host:8786) or scheduler file [default: an embedded "
+                                                  "cluster].")] = None,
+    workers: Annotated[int | None, typer.Option("--workers", help="Worker processes of the embedded cluster "
+                                                "[default: one per core].")] = None,
+    chunk_sites: Annotated[int | None, typer.Option("--chunk-sites", help="Sites per task [default: about 5 s of "
+                                                    "work].")] = None,
+    show_load: Annotated[int, typer.Option("--show-load", help="Which load (1 = the first) the world maps "
+                                           "show.")] = 1,
+    show_period: Annotated[str, typer.Option("--show-period", help="Period the world maps show: year | DJF | MAM | "
+                                             "JJA | SON.")] = "year",
+    resume: Annotated[bool, typer.Option("--resume", help="Finish an interrupted map in --out: only missing chunks "
+                                         "are computed.")] = False,
+    out: Annotated[Path, out_option()] = RESULTS / "map",
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
+    output_format: OutputFormat = "table",
+    engine: Engine = "numba",
 ):
     """Where folding pays: the best fold angle for the year and per season at every site of a grid,
     a CSV of sites or a folder of weather files, with flat, twofold and tracker t_solar and energy,

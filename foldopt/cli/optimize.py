@@ -6,8 +6,7 @@ the ``optimize`` section of :func:`foldopt.studies.request.optimize_section`."""
 from __future__ import annotations
 
 import inspect
-from pathlib import Path  # noqa: F401  (the sweep options' annotations, evaluated here by Typer)
-from typing import Optional
+from typing import Annotated
 
 import typer
 
@@ -15,9 +14,8 @@ from foldopt import names
 from foldopt.cli.options import EMBEDDED, RESULTS, check_choices, rename_fields
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
-from foldopt.cli.sweep import signature, sweep_options
+from foldopt.cli.sweep import signature
 from foldopt.errors import ConfigError
-from foldopt.studies.request import OPTIMIZE_OPTIONS, optimize_section, sweep_request
 
 #: The optimize section's fields by the parameters of :func:`_optimize_options` that set them.
 _PARAMETER_OF_FIELD = {"vary": "vary", "fold_angle": "fold_range", "tilt": "tilt_range", "azimuth": "azimuth_range",
@@ -27,24 +25,26 @@ _PARAMETER_OF_FIELD = {"vary": "vary", "fold_angle": "fold_range", "tilt": "tilt
 def _optimize_labels(own: dict) -> dict:
     """The optimize section's fields, and a range's parts (``optimize.tilt.step``), as the options
     given name them: ``--tilt-range step``; a field the study file set keeps its name."""
+    from foldopt.studies.request import OPTIMIZE_OPTIONS
+
     return {f"optimize.{name}{part}": option + part.replace(".", " ") for name, option in OPTIMIZE_OPTIONS.items()
             if own[_PARAMETER_OF_FIELD[name]] is not None for part in ("", ".min", ".max", ".step")}
 
 
 def _optimize_options(
-    vary: Optional[str] = typer.Option(None, "--vary", help="What to optimise: any of "
-                                       + ", ".join(names.OPTIMIZE_VARIABLES) + ", joined by commas [default: all "
-                                       "three, or the study's optimize.vary]."),
-    fold_range: Optional[str] = typer.Option(None, "--fold-range", help="Fold angles min:max:step [deg] [default: "
-                                             "the study's fold_angles]."),
-    tilt_range: Optional[str] = typer.Option(None, "--tilt-range", help="Base tilts min:max:step [deg] [default: "
-                                             "0:90:1]."),
-    azimuth_range: Optional[str] = typer.Option(None, "--azimuth-range", help="Base azimuths min:max:step [deg "
-                                                "from north; may cross north, -90:90:2] [default: the equator-facing "
-                                                "one +-90 by 2]."),
-    tolerance: Optional[float] = typer.Option(None, "--tolerance", help="What the search may miss of the best "
-                                              "objective [h]; no finer than the objective counts (one day: the "
-                                              "time step) [default: 0.01]."),
+    vary: Annotated[str | None, typer.Option("--vary", help="What to optimise: any of "
+                                             + ", ".join(names.OPTIMIZE_VARIABLES) + ", joined by commas [default: "
+                                             "all three, or the study's optimize.vary].")] = None,
+    fold_range: Annotated[str | None, typer.Option("--fold-range", help="Fold angles min:max:step [deg] [default: "
+                                                   "the study's fold_angles].")] = None,
+    tilt_range: Annotated[str | None, typer.Option("--tilt-range", help="Base tilts min:max:step [deg] [default: "
+                                                   "0:90:1].")] = None,
+    azimuth_range: Annotated[str | None, typer.Option("--azimuth-range", help="Base azimuths min:max:step [deg "
+                                                      "from north; may cross north, -90:90:2] [default: the "
+                                                      "equator-facing one +-90 by 2].")] = None,
+    tolerance: Annotated[float | None, typer.Option("--tolerance", help="What the search may miss of the best "
+                                                    "objective [h]; no finer than the objective counts (one day: "
+                                                    "the time step) [default: 0.01].")] = None,
 ):
     """The options of the optimisation itself."""
 
@@ -55,6 +55,9 @@ def optimize(**options):
     out, overwrite = options.pop("out"), options.pop("overwrite")
     config = options.pop("config")
     own = {name: options.pop(name) for name in ("vary", "fold_range", "tilt_range", "azimuth_range", "tolerance")}
+    # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
+    from foldopt.studies.request import OPTIMIZE_OPTIONS, optimize_section, sweep_request
+
     given = {name for name, value in options.items() if value is not None}
     labels = {**names.option_labels(given), **_optimize_labels(own)}
     try:
@@ -68,9 +71,8 @@ def optimize(**options):
 
 
 _SIGNATURE = signature("optimize", "results/optimize")
-_OWN = inspect.signature(_optimize_options).parameters.values()
+_OWN = inspect.signature(_optimize_options, eval_str=True).parameters.values()
 optimize.__signature__ = _SIGNATURE.replace(parameters=[*_OWN, *_SIGNATURE.parameters.values()])
-optimize.__annotations__ = {**sweep_options.__annotations__, **_optimize_options.__annotations__}
 optimize.__doc__ = """The best fold angle, base tilt and base azimuth together (any of them), maximising the study's
 objective over its days: per load the optimum with its near-optimal region, the flat panel at its own best tilt and
 azimuth, the default mounting and the tracker, what each variable adds, and landscape.png (tilt x fold angle).

@@ -1,15 +1,17 @@
 """The options the commands share, each declared once, and the words of their errors.
 
-A command takes an option by naming it as a parameter's default (``overwrite: bool = OVERWRITE``);
-an option whose default or help differs by command (``--out``, the study argument) is made by one
-function here. Errors from the library name study fields; :func:`rename_fields` says them as the
-options that set them.
+A command takes a shared option by annotating a parameter with it, the default after it
+(``overwrite: Overwrite = False``); an option whose help differs by command (``--out``, ``--step-min``,
+the study argument) is made by one function here, which the command annotates with
+(``out: Annotated[Path | None, out_option(shown="results/<study name>")] = None``). Errors from the
+library name study fields; :func:`rename_fields` says them as the options that set them.
 """
 
 from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Annotated
 
 import typer
 
@@ -22,38 +24,41 @@ RESULTS = Path("results")
 #: The embedded study, as help texts and answers name it.
 EMBEDDED = "configs/shin2015.yaml"
 
-OVERWRITE = typer.Option(False, "--overwrite", help="Replace an existing results folder.")
-QUIET = typer.Option(False, "--quiet", "-q", help="Print nothing but errors (with --format json: the JSON only).")
-FORMAT = typer.Option("table", "--format", help=f"{' | '.join(names.OUTPUT_FORMATS)}: a short answer, or one JSON "
-                                                 "document on stdout for scripts.")
-ENGINE = typer.Option("numba", "--engine", help="numba (the compiled kernel) | numpy (the reference path it is "
-                                                "tested against, slower).")
-TABLE = typer.Option(False, "--table", help="Also print the full table (it is always in the CSV files).")
-AREA = typer.Option(None, "--area", help="Flat panel area [m^2].")
-EFFICIENCY = typer.Option(None, "--efficiency", help="PV efficiency [-] (ideal model; sets the b-model panel's area).")
-ANGLE_STEP = typer.Option(None, "--angle-step", help="Fold-angle grid step [deg] [default: the study's].")
-SETTINGS = typer.Option(None, "--set", metavar="KEY=VALUE", help="Any study field (a dotted key, a YAML value), "
-                                                                 "e.g. --set pv_model=single-diode; repeatable.")
+Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace an existing results folder.")]
+Quiet = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors (with --format json: the JSON "
+                                                           "only).")]
+OutputFormat = Annotated[str, typer.Option("--format", help=f"{' | '.join(names.OUTPUT_FORMATS)}: a short answer, or "
+                                                            "one JSON document on stdout for scripts.")]
+Engine = Annotated[str, typer.Option("--engine", help="numba (the compiled kernel) | numpy (the reference path it is "
+                                                      "tested against, slower).")]
+Table = Annotated[bool, typer.Option("--table", help="Also print the full table (it is always in the CSV files).")]
+Area = Annotated[float | None, typer.Option("--area", help="Flat panel area [m^2].")]
+Efficiency = Annotated[float | None, typer.Option("--efficiency", help="PV efficiency [-] (ideal model; sets the "
+                                                                       "b-model panel's area).")]
+AngleStep = Annotated[float | None, typer.Option("--angle-step", help="Fold-angle grid step [deg] [default: the "
+                                                                      "study's].")]
+Settings = Annotated[list[str] | None, typer.Option("--set", metavar="KEY=VALUE", help="Any study field (a dotted "
+                                                    "key, a YAML value), e.g. --set pv_model=single-diode; "
+                                                    "repeatable.")]
 
 
-def out_option(default: Path | None = None, shown: str | None = None):
+def out_option(shown: str | None = None) -> typer.models.OptionInfo:
     """The ``--out`` option: the results folder.
 
     Parameters
     ----------
-    default : pathlib.Path, optional
-        The folder, or None where the command names it from the study (then ``shown`` says how).
     shown : str, optional
-        The default as the help text gives it, e.g. ``results/<study name>``.
+        The default as the help text gives it where the command names the folder from the study
+        (``results/<study name>``); without it the help shows the parameter's default.
 
     Returns
     -------
     typer.models.OptionInfo
     """
-    return typer.Option(default, "--out", help=f"Results folder{f' [default: {shown}]' if shown else ''}.")
+    return typer.Option("--out", help=f"Results folder{f' [default: {shown}]' if shown else ''}.")
 
 
-def step_min_option(shown: str = "the study's"):
+def step_min_option(shown: str = "the study's") -> typer.models.OptionInfo:
     """The ``--step-min`` option: the time step.
 
     Parameters
@@ -65,10 +70,10 @@ def step_min_option(shown: str = "the study's"):
     -------
     typer.models.OptionInfo
     """
-    return typer.Option(None, "--step-min", help=f"Time step [min], a divisor of 1440 [default: {shown}].")
+    return typer.Option("--step-min", help=f"Time step [min], a divisor of 1440 [default: {shown}].")
 
 
-def study_argument(kind: str = ""):
+def study_argument(kind: str = "") -> typer.models.ArgumentInfo:
     """The optional study argument of ``run`` and ``size``.
 
     Parameters
@@ -80,7 +85,7 @@ def study_argument(kind: str = ""):
     -------
     typer.models.ArgumentInfo
     """
-    return typer.Argument(None, help=f"YAML study{kind} [default: the embedded {EMBEDDED}].")
+    return typer.Argument(help=f"YAML study{kind} [default: the embedded {EMBEDDED}].")
 
 
 def check_choices(output_format: str, engine: str) -> tuple[str, str]:

@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Annotated
 
-from foldopt.cli.options import (EMBEDDED, ENGINE, FORMAT, OVERWRITE, QUIET, RESULTS, SETTINGS, TABLE, check_choices,
-                                 out_option, study_argument)
+from foldopt.cli.options import (EMBEDDED, RESULTS, Engine, OutputFormat, Overwrite, Quiet, Settings, Table,
+                                 check_choices, out_option, study_argument)
 from foldopt.cli.output import INVOCATION, Output
 from foldopt.files import check_output
-from foldopt.inputs.load import default_study_path
-from foldopt.studies.request import Request, settings_plan
+
+if TYPE_CHECKING:
+    from foldopt.studies.request import Request
 
 
 def run_request(request: Request, out: Path, overwrite: bool, output: Output, engine: str, command: str) -> None:
@@ -47,14 +48,14 @@ def run_request(request: Request, out: Path, overwrite: bool, output: Output, en
 
 
 def run(
-    config: Optional[Path] = study_argument(),
-    out: Optional[Path] = out_option(shown="results/<study name>"),
-    overwrite: bool = OVERWRITE,
-    quiet: bool = QUIET,
-    output_format: str = FORMAT,
-    engine: str = ENGINE,
-    table: bool = TABLE,
-    settings: Optional[list[str]] = SETTINGS,
+    config: Annotated[Path | None, study_argument()] = None,
+    out: Annotated[Path | None, out_option(shown="results/<study name>")] = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
+    output_format: OutputFormat = "table",
+    engine: Engine = "numba",
+    table: Table = False,
+    settings: Settings = None,
 ):
     """Run a YAML study: one case (fold-angle sweep, the paper's heuristic, flat and trackers
     compared) or a sweep of cases (a row per case x design).
@@ -66,6 +67,10 @@ def run(
       foldopt run --set p_load=3 --out results/shin2015-3w
     """
     output_format, engine = check_choices(output_format, engine)
+    # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
+    from foldopt.inputs.load import default_study_path
+    from foldopt.studies.request import Request, settings_plan
+
     source = EMBEDDED if config is None else str(config)
     request = Request(settings_plan(config if config is not None else default_study_path(), settings or ()),
                       source, ())
@@ -74,11 +79,11 @@ def run(
 
 
 def reproduce(
-    out: Path = out_option(RESULTS / "reproduction"),
-    overwrite: bool = OVERWRITE,
-    quiet: bool = QUIET,
-    output_format: str = FORMAT,
-    engine: str = ENGINE,
+    out: Annotated[Path, out_option()] = RESULTS / "reproduction",
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
+    output_format: OutputFormat = "table",
+    engine: Engine = "numba",
 ):
     """Reproduce Shin et al.'s study in paper and exact modes: their published values beside foldopt's.
 

@@ -4,18 +4,16 @@ limits (:data:`foldopt.studies.request.SIZING_LIMITS`) are checked before the st
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import Annotated
 
 import typer
 
-from foldopt.cli.options import (FORMAT, EMBEDDED, OVERWRITE, QUIET, RESULTS, SETTINGS, TABLE, check_choices,
+from foldopt.cli.options import (EMBEDDED, RESULTS, OutputFormat, Overwrite, Quiet, Settings, Table, check_choices,
                                  out_option, study_argument)
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError
 from foldopt.files import check_output
-from foldopt.inputs.load import default_study_path
 from foldopt.inputs.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2
-from foldopt.studies.request import settings_plan, size_request, sizing_problems
 
 #: The sizing's parameters as the command line names them, longest first.
 _OPTION_OF_SIZING = {"cost_per_m2 / cost_per_w": "--cost-per-m2 / --cost-per-w", "c_grid_usd_per_kwh": "--c-grid",
@@ -31,21 +29,22 @@ def _sizing_option(line: str) -> str:
 
 
 def size(
-    config: Optional[Path] = study_argument(" (one case)"),
-    areas: str = typer.Option("0.01:0.5:0.005", "--areas", help="Panel areas [m^2], start:stop:step."),
-    cost_per_m2: Optional[float] = typer.Option(None, "--cost-per-m2", help=f"Panel cost [$/m^2] [default: "
-                                                f"{PAPER_COST_PER_M2:g}, the cost Shin et al.'s 0.108 m^2 optimum "
-                                                "implies]."),
-    cost_per_w: Optional[float] = typer.Option(None, "--cost-per-w", help="Panel cost [$/W at STC], instead."),
-    c_grid: float = typer.Option(C_GRID, "--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22)."),
-    years: float = typer.Option(LIFETIME_YEARS, "--years", help="Lifetime [years] (Shin et al.: 20)."),
-    days_per_year: float = typer.Option(DAYS_PER_YEAR, "--days-per-year", help="Days a year like the study's day."),
-    out: Optional[Path] = out_option(shown="results/<study>-sizing"),
-    overwrite: bool = OVERWRITE,
-    quiet: bool = QUIET,
-    output_format: str = FORMAT,
-    table: bool = TABLE,
-    settings: Optional[list[str]] = SETTINGS,
+    config: Annotated[Path | None, study_argument(" (one case)")] = None,
+    areas: Annotated[str, typer.Option("--areas", help="Panel areas [m^2], start:stop:step.")] = "0.01:0.5:0.005",
+    cost_per_m2: Annotated[float | None, typer.Option("--cost-per-m2", help=f"Panel cost [$/m^2] [default: "
+                                                      f"{PAPER_COST_PER_M2:g}, the cost Shin et al.'s 0.108 m^2 "
+                                                      "optimum implies].")] = None,
+    cost_per_w: Annotated[float | None, typer.Option("--cost-per-w", help="Panel cost [$/W at STC], instead.")] = None,
+    c_grid: Annotated[float, typer.Option("--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22).")] = C_GRID,
+    years: Annotated[float, typer.Option("--years", help="Lifetime [years] (Shin et al.: 20).")] = LIFETIME_YEARS,
+    days_per_year: Annotated[float, typer.Option("--days-per-year", help="Days a year like the study's "
+                                                 "day.")] = DAYS_PER_YEAR,
+    out: Annotated[Path | None, out_option(shown="results/<study>-sizing")] = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
+    output_format: OutputFormat = "table",
+    table: Table = False,
+    settings: Settings = None,
 ):
     """Shin et al. Sec. IV-A panel sizing: the lifetime benefit C_grid x t_solar x P_load against the
     panel's cost, for flat and twofold panels of every area.
@@ -57,6 +56,10 @@ def size(
     """
     output_format, _ = check_choices(output_format, "numba")
     output = Output(quiet, output_format, table)
+    # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
+    from foldopt.inputs.load import default_study_path
+    from foldopt.studies.request import settings_plan, size_request, sizing_problems
+
     errors = sizing_problems({"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
                               "years": years, "days_per_year": days_per_year})
     if errors:

@@ -8,18 +8,16 @@ from __future__ import annotations
 import copy
 import inspect
 from pathlib import Path
-from typing import Optional
+from typing import Annotated, get_args
 
 import typer
 
 from foldopt import names
-from foldopt.cli.options import (ANGLE_STEP, AREA, EFFICIENCY, EMBEDDED, ENGINE, FORMAT, OVERWRITE,
-                                 QUIET, RESULTS, SETTINGS, TABLE, check_choices, out_option, rename_fields,
-                                 step_min_option)
+from foldopt.cli.options import (EMBEDDED, RESULTS, AngleStep, Area, Efficiency, Engine, OutputFormat, Overwrite,
+                                 Quiet, Settings, Table, check_choices, out_option, rename_fields, step_min_option)
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
 from foldopt.errors import ConfigError
-from foldopt.studies.request import sweep_request
 
 #: The sweep group's help and its line in the command list.
 HELP = "Sweep one design variable over a range, everything else from the study."
@@ -31,82 +29,96 @@ def _choices(registry) -> str:
 
 
 def sweep_options(
-    config: Optional[Path] = typer.Option(None, "--config", help=f"Study to start from [default: {EMBEDDED}]."),
-    lat: Optional[str] = typer.Option(None, "--lat", help="Latitude [deg north]."),
-    lon: Optional[str] = typer.Option(None, "--lon", help="Longitude [deg east]."),
-    altitude: Optional[float] = typer.Option(None, "--altitude", help="Site altitude [m]."),
-    timezone: Optional[str] = typer.Option(None, "--timezone", help="IANA name or UTC offset, e.g. UTC-08:00 "
-                                           "[default: the longitude's standard offset]."),
-    days: Optional[str] = typer.Option(None, "--days", "--date", help="A date YYYY-MM-DD."),
-    year: Optional[int] = typer.Option(None, "--year", help="Year of day-of-year ranges [default: the study's]."),
-    p_load: Optional[str] = typer.Option(None, "--p-load", help="Load [W]."),
-    load_profile: Optional[Path] = typer.Option(None, "--load-profile", help="A day's load instead of a constant: a "
-                                                "CSV of time,watts rows (HH:MM, held until the next time)."),
-    p_load_scale: Optional[str] = typer.Option(None, "--p-load-scale", help="Scale of the load profile [-] "
-                                               "[default: 1]."),
-    area: Optional[float] = AREA,
-    efficiency: Optional[float] = EFFICIENCY,
-    tilt: Optional[str] = typer.Option(None, "--tilt", help="Panel tilt [deg] [default: the study's, or |latitude| "
-                                       "where the latitude changes]."),
-    azimuth: Optional[float] = typer.Option(None, "--azimuth", help="Panel azimuth [deg from north] [default: the "
-                                            "study's, or facing the equator where the latitude changes]."),
-    mode: Optional[str] = typer.Option(None, "--mode", help=_choices(names.MODES) + " [default: the study's; exact "
-                                       "where the site or day leaves the embedded study's]."),
-    geometry: Optional[str] = typer.Option(None, "--geometry", help=_choices(names.GEOMETRIES)
-                                           + " [default: azimuth-split in paper mode, hinge in exact]."),
-    sky: Optional[str] = typer.Option(None, "--sky", help=_choices(names.SKIES) + "."),
-    climate: Optional[str] = typer.Option(None, "--climate", help="Hottel's climate: "
-                                          + _choices(names.HOTTEL_CLIMATES) + "."),
-    weather: Optional[Path] = typer.Option(None, "--weather", help="Weather file: an hourly TMY3 / EPW / PVGIS TMY "
-                                           "(its site and whole year) or a measured file (its days, at its step)."),
-    weather_format: Optional[str] = typer.Option(None, "--weather-format", help=_choices(names.WEATHER_FORMATS)
-                                                  + " [default: from the extension, hourly formats]."),
-    members: Optional[int] = typer.Option(None, "--members", help="An hourly file's cloud ensemble: this many "
-                                          "synthetic minute series (2 to 200)."),
-    seed: Optional[int] = typer.Option(None, "--seed", help="The ensemble's seed [default: 0]."),
-    force_site: bool = typer.Option(False, "--force-site", help="Keep --lat/--lon though far from the weather "
-                                    "file's site."),
-    transposition: Optional[str] = typer.Option(None, "--transposition", help=_choices(names.TRANSPOSITIONS) + "."),
-    albedo: Optional[float] = typer.Option(None, "--albedo", help="Ground reflectance [-] (with diffuse light)."),
-    iam: Optional[str] = typer.Option(None, "--iam", help="Incidence-angle modifier: " + _choices(names.IAMS) + "."),
-    objective: Optional[str] = typer.Option(None, "--objective", help="One fold angle for all days, maximising: "
-                                            "mean | min | worst-month | pNN (a percentile)."),
-    visits: Optional[int] = typer.Option(None, "--visits", help="With --objective mean or worst-month: also the best "
-                                         "re-fold schedule of 1 to this many fold settings a year (at most 12)."),
-    tracker: Optional[str] = typer.Option(None, "--tracker", help=_choices(names.TRACKERS) + "."),
-    tracker_standby: Optional[float] = typer.Option(None, "--tracker-standby", help="Tracker standby draw [W]."),
-    pv_model: Optional[str] = typer.Option(None, "--pv-model", help=_choices(names.PV_MODELS) + "."),
-    module: Optional[str] = typer.Option(None, "--module", help="single-diode: a module of pvlib's CEC database, any "
-                                         "part of its name, e.g. CS5P-220M [default: the A-300 cell]."),
-    connection: Optional[str] = typer.Option(None, "--connection", help=_choices(names.CONNECTIONS) + "."),
-    switch_series: bool = typer.Option(False, "--switch-series", help="Switching may also choose series."),
-    no_bypass: bool = typer.Option(False, "--no-bypass", help="Series without bypass diodes."),
-    converter_efficiency: Optional[float] = typer.Option(None, "--converter-efficiency", help="Efficiency [-] of "
-                                                         "each converter of connection independent."),
-    horizon: Optional[Path] = typer.Option(None, "--horizon", help="The site's horizon: a PVGIS horizon file (JSON "
-                                           "or CSV) or a CSV azimuth,elevation [deg]."),
-    blocking_diode: Optional[str] = typer.Option(None, "--blocking-diode", help="Blocking diodes in parallel: "
-                                                 + _choices(names.DIODE_MODELS) + " (I-V models)."),
-    bypass_diode: Optional[str] = typer.Option(None, "--bypass-diode", help="Bypass diodes in series: "
-                                               + _choices(names.DIODE_MODELS) + " (I-V models)."),
-    converter: Optional[str] = typer.Option(None, "--converter", help="The MPPT converter's efficiency: "
-                                            + _choices(names.CONVERTER_MODELS) + "."),
-    load_voltage: Optional[float] = typer.Option(None, "--load-voltage", help="Couple the load directly at this "
-                                                 "voltage [V], no converter (I-V models)."),
-    switch_resistance: Optional[float] = typer.Option(None, "--switch-resistance", help="On-resistance [ohm] of "
-                                                      "the switch in each sub-panel's path (connection switching)."),
-    temp_air: Optional[float] = typer.Option(None, "--temp-air", help="Air temperature [C] (I-V models)."),
-    exact_electrical: bool = typer.Option(False, "--exact-electrical", help="Solve every step's I-V curves instead "
-                                          "of the tables (slow)."),
-    step_min: Optional[float] = step_min_option(),
-    angle_step: Optional[float] = ANGLE_STEP,
-    settings: Optional[list[str]] = SETTINGS,
-    out: Optional[Path] = out_option(),
-    overwrite: bool = OVERWRITE,
-    quiet: bool = QUIET,
-    output_format: str = FORMAT,
-    engine: str = ENGINE,
-    table: bool = TABLE,
+    config: Annotated[Path | None, typer.Option("--config", help=f"Study to start from [default: "
+                                                f"{EMBEDDED}].")] = None,
+    lat: Annotated[str | None, typer.Option("--lat", help="Latitude [deg north].")] = None,
+    lon: Annotated[str | None, typer.Option("--lon", help="Longitude [deg east].")] = None,
+    altitude: Annotated[float | None, typer.Option("--altitude", help="Site altitude [m].")] = None,
+    timezone: Annotated[str | None, typer.Option("--timezone", help="IANA name or UTC offset, e.g. UTC-08:00 "
+                                                 "[default: the longitude's standard offset].")] = None,
+    days: Annotated[str | None, typer.Option("--days", "--date", help="A date YYYY-MM-DD.")] = None,
+    year: Annotated[int | None, typer.Option("--year", help="Year of day-of-year ranges [default: the "
+                                             "study's].")] = None,
+    p_load: Annotated[str | None, typer.Option("--p-load", help="Load [W].")] = None,
+    load_profile: Annotated[Path | None, typer.Option("--load-profile", help="A day's load instead of a constant: "
+                                                      "a CSV of time,watts rows (HH:MM, held until the next "
+                                                      "time).")] = None,
+    p_load_scale: Annotated[str | None, typer.Option("--p-load-scale", help="Scale of the load profile [-] "
+                                                     "[default: 1].")] = None,
+    area: Area = None,
+    efficiency: Efficiency = None,
+    tilt: Annotated[str | None, typer.Option("--tilt", help="Panel tilt [deg] [default: the study's, or |latitude| "
+                                             "where the latitude changes].")] = None,
+    azimuth: Annotated[float | None, typer.Option("--azimuth", help="Panel azimuth [deg from north] [default: the "
+                                                  "study's, or facing the equator where the latitude "
+                                                  "changes].")] = None,
+    mode: Annotated[str | None, typer.Option("--mode", help=_choices(names.MODES) + " [default: the study's; exact "
+                                             "where the site or day leaves the embedded study's].")] = None,
+    geometry: Annotated[str | None, typer.Option("--geometry", help=_choices(names.GEOMETRIES) + " [default: "
+                                                 "azimuth-split in paper mode, hinge in exact].")] = None,
+    sky: Annotated[str | None, typer.Option("--sky", help=_choices(names.SKIES) + ".")] = None,
+    climate: Annotated[str | None, typer.Option("--climate", help="Hottel's climate: "
+                                                + _choices(names.HOTTEL_CLIMATES) + ".")] = None,
+    weather: Annotated[Path | None, typer.Option("--weather", help="Weather file: an hourly TMY3 / EPW / PVGIS TMY "
+                                                 "(its site and whole year) or a measured file (its days, at its "
+                                                 "step).")] = None,
+    weather_format: Annotated[str | None, typer.Option("--weather-format", help=_choices(names.WEATHER_FORMATS)
+                                                       + " [default: from the extension, hourly formats].")] = None,
+    members: Annotated[int | None, typer.Option("--members", help="An hourly file's cloud ensemble: this many "
+                                                "synthetic minute series (2 to 200).")] = None,
+    seed: Annotated[int | None, typer.Option("--seed", help="The ensemble's seed [default: 0].")] = None,
+    force_site: Annotated[bool, typer.Option("--force-site", help="Keep --lat/--lon though far from the weather "
+                                             "file's site.")] = False,
+    transposition: Annotated[str | None, typer.Option("--transposition", help=_choices(names.TRANSPOSITIONS)
+                                                      + ".")] = None,
+    albedo: Annotated[float | None, typer.Option("--albedo", help="Ground reflectance [-] (with diffuse "
+                                                 "light).")] = None,
+    iam: Annotated[str | None, typer.Option("--iam", help="Incidence-angle modifier: " + _choices(names.IAMS)
+                                            + ".")] = None,
+    objective: Annotated[str | None, typer.Option("--objective", help="One fold angle for all days, maximising: "
+                                                  "mean | min | worst-month | pNN (a percentile).")] = None,
+    visits: Annotated[int | None, typer.Option("--visits", help="With --objective mean or worst-month: also the "
+                                               "best re-fold schedule of 1 to this many fold settings a year (at "
+                                               "most 12).")] = None,
+    tracker: Annotated[str | None, typer.Option("--tracker", help=_choices(names.TRACKERS) + ".")] = None,
+    tracker_standby: Annotated[float | None, typer.Option("--tracker-standby", help="Tracker standby draw "
+                                                          "[W].")] = None,
+    pv_model: Annotated[str | None, typer.Option("--pv-model", help=_choices(names.PV_MODELS) + ".")] = None,
+    module: Annotated[str | None, typer.Option("--module", help="single-diode: a module of pvlib's CEC database, "
+                                               "any part of its name, e.g. CS5P-220M [default: the A-300 "
+                                               "cell].")] = None,
+    connection: Annotated[str | None, typer.Option("--connection", help=_choices(names.CONNECTIONS) + ".")] = None,
+    switch_series: Annotated[bool, typer.Option("--switch-series", help="Switching may also choose "
+                                                "series.")] = False,
+    no_bypass: Annotated[bool, typer.Option("--no-bypass", help="Series without bypass diodes.")] = False,
+    converter_efficiency: Annotated[float | None, typer.Option("--converter-efficiency", help="Efficiency [-] of "
+                                                               "each converter of connection "
+                                                               "independent.")] = None,
+    horizon: Annotated[Path | None, typer.Option("--horizon", help="The site's horizon: a PVGIS horizon file (JSON "
+                                                 "or CSV) or a CSV azimuth,elevation [deg].")] = None,
+    blocking_diode: Annotated[str | None, typer.Option("--blocking-diode", help="Blocking diodes in parallel: "
+                                                       + _choices(names.DIODE_MODELS) + " (I-V models).")] = None,
+    bypass_diode: Annotated[str | None, typer.Option("--bypass-diode", help="Bypass diodes in series: "
+                                                     + _choices(names.DIODE_MODELS) + " (I-V models).")] = None,
+    converter: Annotated[str | None, typer.Option("--converter", help="The MPPT converter's efficiency: "
+                                                  + _choices(names.CONVERTER_MODELS) + ".")] = None,
+    load_voltage: Annotated[float | None, typer.Option("--load-voltage", help="Couple the load directly at this "
+                                                       "voltage [V], no converter (I-V models).")] = None,
+    switch_resistance: Annotated[float | None, typer.Option("--switch-resistance", help="On-resistance [ohm] of the "
+                                                            "switch in each sub-panel's path (connection "
+                                                            "switching).")] = None,
+    temp_air: Annotated[float | None, typer.Option("--temp-air", help="Air temperature [C] (I-V models).")] = None,
+    exact_electrical: Annotated[bool, typer.Option("--exact-electrical", help="Solve every step's I-V curves "
+                                                   "instead of the tables (slow).")] = False,
+    step_min: Annotated[float | None, step_min_option()] = None,
+    angle_step: AngleStep = None,
+    settings: Settings = None,
+    out: Annotated[Path | None, out_option()] = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
+    output_format: OutputFormat = "table",
+    engine: Engine = "numba",
+    table: Table = False,
 ):
     """The options of every sweep (its signature is theirs, through :func:`signature`)."""
 
@@ -147,16 +159,17 @@ def signature(command: str, out: str) -> inspect.Signature:
     inspect.Signature
     """
     parameters = []
-    for parameter in inspect.signature(sweep_options).parameters.values():
-        option = copy.copy(parameter.default)
+    for parameter in inspect.signature(sweep_options, eval_str=True).parameters.values():
+        kind, option = get_args(parameter.annotation)
         if parameter.name in _VARYING[command]:
             condition, values = _VARYING[command][parameter.name], _SEVERAL[parameter.name]
             several = f"; {condition}, also {values}" if condition else f", or {values}"
             head, bracket, tail = option.help.partition(" [default")
+            option = copy.copy(option)
             option.help = head.rstrip(".") + several + (bracket + tail if bracket else ".")
         elif parameter.name == "out":
             option = out_option(shown=out)
-        parameters.append(parameter.replace(default=option))
+        parameters.append(parameter.replace(annotation=Annotated[kind, option]))
     return inspect.Signature(parameters)
 
 
@@ -192,6 +205,8 @@ def _sweep(axis: str, options: dict) -> None:
     config = options.pop("config")
     # Of the options that set one field (--p-load, --p-load-scale), a message names the one given.
     options_of = names.option_labels({name for name, value in options.items() if value is not None})
+    from foldopt.studies.request import sweep_request  # the study's modules once a command runs
+
     try:
         request = sweep_request(config, options, axis, EMBEDDED if config is None else str(config))
     except ConfigError as error:
@@ -207,7 +222,6 @@ def _command(axis: str):
         _sweep(axis, options)
 
     command.__signature__ = signature(axis, f"results/sweep-{axis}")
-    command.__annotations__ = dict(sweep_options.__annotations__)
     command.__doc__ = summary + "\n\n\b\nExamples:\n" + "\n".join(f"  {example}" for example in examples)
     return command
 
