@@ -211,3 +211,28 @@ def test_reproduce_writes_the_agreed_table(tmp_path):
         assert list(table["quantity"]) == list(PAPER_VALUES)
     assert "fold_angle_twofold_deg" in result.stdout
     assert_one_line_error(invoke("reproduce", "--out", out), "already exists")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["sweep", "angle", "--date", "2025-06-21", "--days", "2025-06-22"], ["--days: given twice (first as --date)"]),
+    (["sweep", "angle", "--quiet", "-q"], ["-q: given twice (first as --quiet)"]),
+    (["map", "--lat=10", "--lat", "20"], ["--lat: given twice (first as --lat)"]),
+])
+def test_an_option_given_twice_is_refused(tmp_path, args, words):
+    """click keeps the last of a repeated option; the command line refuses it, naming both."""
+    assert_one_line_error(invoke(*args, "--out", tmp_path / "out"), *words, "give each option once")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("before", [None, "0"])
+def test_quiet_leaves_an_in_process_callers_environment_as_it_was(monkeypatch, before):
+    """--quiet sets FOLDOPT_QUIET for the command (the caches' notices, the workers); the caller's
+    environment is restored when the command ends, here on a refusal after the output was set up."""
+    import os
+
+    if before is None:
+        monkeypatch.delenv("FOLDOPT_QUIET", raising=False)
+    else:
+        monkeypatch.setenv("FOLDOPT_QUIET", before)
+    assert_one_line_error(invoke("sweep", "angle", "--quiet", "--lat", "95"), "--lat")
+    assert os.environ.get("FOLDOPT_QUIET") == before

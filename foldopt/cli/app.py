@@ -13,11 +13,13 @@ This module is the app: its error path, its global options and the commands of
 from __future__ import annotations
 
 import codecs
+import functools
 import os
 import signal
 import sys
 import threading
 import traceback
+from typing import Annotated
 
 import typer
 from typer.core import TyperCommand, TyperGroup
@@ -27,7 +29,9 @@ from foldopt.cli.output import INVOCATION, as_text, echo
 from foldopt.errors import ConfigError, OutputError, OutputExistsError
 from foldopt.names import close_names
 
-# Typer >= 0.29 vendors click; its UsageError is reached through the public BadParameter.
+# click's UsageError, whose kin are every refusal of the command line's words. Typer >= 0.26 vendors
+# click (typer._click, not public), so the click distribution's click.exceptions.UsageError is another
+# class, one Typer never raises; Typer's public BadParameter is a UsageError with either click.
 _USAGE_ERROR = next(cls for cls in typer.BadParameter.__mro__ if cls.__name__ == "UsageError")
 
 HELP = """Design-space optimiser for twofold PV panels powering storage-less loads.
@@ -102,28 +106,51 @@ class _Interrupted(Exception):
     """Ctrl-C, carried past typer, which would end the command with code 130 and not a word."""
 
 
+def _exit_code(error: BaseException) -> int:
+    """Say what ended a command, as the command line says it, and the exit code it ends with: bad
+    input (usage, study, weather file, results folder) is one ``error:`` line per fault and code 2;
+    Ctrl-C is ``interrupted``, code 130; anything else is an internal error: one line naming it,
+    code 1, and the traceback only with ``--debug``."""
+    if isinstance(error, ConfigError):
+        for line in dict.fromkeys(error.errors):
+            echo(f"error: {line}", err=True)
+        return 2
+    if isinstance(error, (OutputError, OutputExistsError)):
+        echo(f"error: {error}", err=True)
+        return 2
+    if isinstance(error, _USAGE_ERROR):
+        message = error.format_message()
+        if type(error).__name__ == "NoArgsIsHelpError":  # a bare `foldopt` or `foldopt sweep`
+            typer.echo(message)
+            return 0
+        if message:
+            where = f"{error.ctx.command_path}: " if error.ctx is not None else ""
+            if type(error).__name__ == "NoSuchOption" and error.ctx is not None:
+                message = error.message + _option_hint(error.option_name, error.ctx)
+            elif message.startswith("No such command") and error.ctx is not None:
+                message += f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
+            echo(f"error: {where}{message}", err=True)
+        return 2
+    if isinstance(error, (_Interrupted, typer.Abort)):  # Ctrl-C; typer's Abort: end of input at a prompt
+        typer.echo("interrupted", err=True)
+        return 130
+    if _DEBUG["on"]:
+        traceback.print_exception(error)
+    else:
+        reason = str(error).splitlines()[0][:300] if str(error) else ""
+        echo(f"error: internal error ({type(error).__name__}{': ' + reason if reason else ''}); "
+             "run again as foldopt --debug ... for the traceback, and please report it", err=True)
+    return 1
+
+
 class _OneLineErrors(TyperGroup):
-    """The one error path of the command line. Bad input (usage, study, weather file, results
-    folder) is one line per fault and exit code 2; anything else is an internal error: one line
-    naming it, exit code 1, and the traceback only with ``--debug``; Ctrl-C is ``interrupted``,
-    exit code 130."""
+    """The command line's group: one error path (:func:`_exit_code`) for every way it is called."""
 
-    def main(self, *args, **kwargs):
-        quiet = os.environ.get("FOLDOPT_QUIET")
-        try:
-            self._main(*args, **kwargs)
-        finally:
-            # --quiet silences the caches' notices for this command only (an in-process caller's
-            # environment is left as it was).
-            if quiet is None:
-                os.environ.pop("FOLDOPT_QUIET", None)
-            else:
-                os.environ["FOLDOPT_QUIET"] = quiet
-
-    def _main(self, *args, **kwargs):
-        kwargs["standalone_mode"] = False
-        given = kwargs.get("args", args[0] if args else None)
-        INVOCATION[:] = ["foldopt", *map(as_text, sys.argv[1:] if given is None else given)]
+    def main(self, args=None, *rest, **kwargs):
+        # The one override of a method click runs itself: the console script calls the app, and
+        # typer.testing.CliRunner calls this main directly, so only here do both take the one error
+        # path. The rest is click's documented standalone_mode=False: exceptions come to the caller.
+        INVOCATION[:] = ["foldopt", *map(as_text, sys.argv[1:] if args is None else args)]
         for stream in (sys.stdout, sys.stderr):
             # A terminal that cannot show a character (a site's name under LANG=C) gets an escape, not an error.
             if codecs.lookup(getattr(stream, "encoding", None) or "utf-8").name != "utf-8" and hasattr(
@@ -132,41 +159,13 @@ class _OneLineErrors(TyperGroup):
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGTERM, _terminate)
         try:
-            code = super().main(*args, **kwargs)
-        except ConfigError as error:
-            for line in dict.fromkeys(error.errors):
-                echo(f"error: {line}", err=True)
-            sys.exit(2)
-        except (OutputError, OutputExistsError) as error:
-            echo(f"error: {error}", err=True)
-            sys.exit(2)
-        except _USAGE_ERROR as error:
-            message = error.format_message()
-            if type(error).__name__ == "NoArgsIsHelpError":  # a bare `foldopt` or `foldopt sweep`
-                typer.echo(message)
-                sys.exit(0)
-            if message:
-                where = f"{error.ctx.command_path}: " if error.ctx is not None else ""
-                if type(error).__name__ == "NoSuchOption" and error.ctx is not None:
-                    message = error.message + _option_hint(error.option_name, error.ctx)
-                elif message.startswith("No such command") and error.ctx is not None:
-                    message += f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
-                echo(f"error: {where}{message}", err=True)
-            sys.exit(2)
-        except (_Interrupted, typer.Abort):  # Ctrl-C; typer's Abort: end of input at a prompt
-            typer.echo("interrupted", err=True)
-            sys.exit(130)
+            code = super().main(args, *rest, **{**kwargs, "standalone_mode": False})
         except Exception as error:
-            if _DEBUG["on"]:
-                traceback.print_exc()
-            else:
-                reason = str(error).splitlines()[0][:300] if str(error) else ""
-                echo(f"error: internal error ({type(error).__name__}{': ' + reason if reason else ''}); "
-                     "run again as foldopt --debug ... for the traceback, and please report it", err=True)
-            sys.exit(1)
+            sys.exit(_exit_code(error))
         sys.exit(code if isinstance(code, int) else 0)
 
     def invoke(self, ctx):
+        # click's documented hook: Typer would end a Ctrl-C with code 130 and not a word.
         try:
             return super().invoke(ctx)
         except KeyboardInterrupt:
@@ -178,6 +177,9 @@ class _OnceEach(TyperCommand):
     b``) is an error, not a silent last-wins. Options that collect values (``--set``) repeat."""
 
     def parse_args(self, ctx, args):
+        # No documented hook sees a repeat: click's parser keeps the last value, a parameter's
+        # callback gets that one value, and ctx.get_parameter_source says only "command line". So
+        # the arguments are looked at here, before click parses them (as click's own parse_args).
         seen: dict[str, str] = {}
         for arg in args:
             if arg == "--":
@@ -208,10 +210,21 @@ def _print_version(value: bool) -> None:
 
 
 @app.callback()
-def _options(debug: bool = typer.Option(False, "--debug", help="Show the traceback of an internal error."),
-             version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
-                                          help="Print foldopt's version and exit.")):
+def _options(ctx: typer.Context,
+             debug: Annotated[bool, typer.Option("--debug", help="Show the traceback of an internal error.")] = False,
+             version: Annotated[bool, typer.Option("--version", callback=_print_version, is_eager=True,
+                                                   help="Print foldopt's version and exit.")] = False):
     _DEBUG["on"] = debug
+    # --quiet silences the caches' notices for this command only: an in-process caller's
+    # environment is as it was once the command ends.
+    ctx.call_on_close(functools.partial(_restore_environment, "FOLDOPT_QUIET", os.environ.get("FOLDOPT_QUIET")))
+
+
+def _restore_environment(name: str, value: str | None) -> None:
+    if value is None:
+        os.environ.pop(name, None)
+    else:
+        os.environ[name] = value
 
 
 app.add_typer(sweep_app, name="sweep", short_help=sweep.SHORT_HELP)
