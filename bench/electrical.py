@@ -28,7 +28,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from foldopt.engine import rows as engine  # noqa: E402
 from foldopt.inputs.load import default_study_path
-from foldopt.inputs.plan import load_study  # noqa: E402
+from foldopt.api import load_study  # noqa: E402
 from foldopt.engine.sky import build_sky  # noqa: E402
 
 

@@ -48,7 +48,7 @@ W3_ANGLE_DEG = 1.0  # [deg] best angle (the grid step), where the best is clear 
 
 def _study():
     from foldopt.inputs.load import default_study_path
-    from foldopt.inputs.plan import load_study
+    from foldopt.api import load_study
 
     return load_study(default_study_path()).variant(
         pv_model="single-diode", connection="switching", mode="exact", geometry="hinge"

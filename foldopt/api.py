@@ -372,18 +372,18 @@ def reproduce(engine: str = "numba"):
     return Reproduction(tables, study, engine)
 
 
-def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, study: dict | None = None,
-              relative: bool = False, year: int = 2025, *, scheduler: str | None = None, workers: int | None = None,
-              sites_per_chunk: int = 0, resume: bool = False, overwrite: bool = False, engine: str = "numba",
-              show_load: int = 0, show_period: str = "year", progress=None, announce=None, command=None,
-              defaults: dict | None = None):
+def world_map(sites: Sequence[dict] | None = None, loads: Sequence[float] | None = None, out: str | Path | None = None,
+              study: dict | None = None, relative: bool = False, year: int = 2025, *, request=None,
+              scheduler: str | None = None, workers: int | None = None, sites_per_chunk: int = 0, resume: bool = False,
+              overwrite: bool = False, engine: str = "numba", show_load: int = 0, show_period: str = "year",
+              progress=None, announce=None, command=None, defaults: dict | None = None):
     """A map of many sites on Dask (:mod:`foldopt.studies.cluster`), its world maps and its ``report.html``.
 
     Parameters
     ----------
     sites : sequence of dict, str or pathlib.Path
         From :func:`foldopt.grid_sites`, :func:`foldopt.read_sites` or :func:`foldopt.weather_sites`,
-        or a CSV of named sites.
+        or a CSV of named sites; not with ``request``.
     loads : float, sequence of float or str
         Loads [W], or with ``relative`` fractions of each site's flat peak; text is a value, a range
         ``start:stop:step`` or a list. Checked as the command line's are
@@ -392,9 +392,13 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
         The results folder (``map.parquet``, ``map.csv``, figures, ``report.html``, ``run.json``).
     study : dict, optional
         A map's study (:func:`foldopt.map_study`); default the embedded study's panel and models
-        in exact mode with the Ineichen clear sky.
+        in exact mode (with its Ineichen clear sky).
     relative : bool
     year : int
+    request : foldopt.studies.worldmap.MapRequest, optional
+        A map's request made and checked already (the command line's,
+        :func:`foldopt.studies.request.map_request_from`): its sites, loads, study, year and
+        defaults, instead of ``sites``, ``loads``, ``study``, ``relative``, ``year`` and ``defaults``.
     scheduler : str, optional
         A Dask scheduler's address or file; default an embedded cluster of ``workers`` processes.
     sites_per_chunk : int
@@ -429,9 +433,15 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
     from foldopt.output.gridded import write_grid_netcdf
     from foldopt.studies.worldmap import map_request, map_study, searched_tilt
 
-    if study is None:
-        study = map_study(load_plan(default_study_path()).data)
-    request = map_request(study, loads, sites=sites, relative=relative, year=year, show_period=show_period)
+    if out is None:
+        raise ConfigError(["out: give the map's results folder"])
+    if request is None:
+        if study is None:
+            study = map_study(load_plan(default_study_path()).data)
+        request = map_request(study, loads, sites=sites, relative=relative, year=year, show_period=show_period)
+    else:
+        defaults = request.defaults
+    study, relative, year = request.study, request.relative, request.year
     spec = MapSpec(study, request.sites, request.loads, relative, year, sites_per_chunk, engine)
     finished = {}
 
@@ -439,7 +449,7 @@ def world_map(sites: Sequence[dict], loads: Sequence[float], out: str | Path, st
         # In the map's folder before it is marked complete or replaces an earlier map (run_map).
         finished["figures"] = map_figures(run.table, run.out, "map", relative, show_load, show_period,
                                           tilt=searched_tilt(study) is not None)
-        write_grid_netcdf(run.table, run.out, relative, f"foldopt map: {study.get('name', 'map')}")
+        write_grid_netcdf(run.table, run.out, relative, f"foldopt map: {study.name}")
         finished["answer"] = of_map(run, relative, defaults)
         write_map_report(run, finished["figures"], finished["answer"], metadata)
 

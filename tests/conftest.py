@@ -7,7 +7,7 @@ import sys
 import pytest
 
 from foldopt.inputs.load import default_study_path
-from foldopt.inputs.plan import load_study
+from foldopt.api import load_study
 
 
 @pytest.fixture(scope="session")

@@ -182,7 +182,7 @@ def test_resume_refuses_another_map(tmp_path):
                     "fold_angles": {"start": 90, "stop": 180, "step": 90}}, ({"latitude": 0.0, "longitude": 0.0},),
                    (1.0,), sites_per_chunk=1)
     run_map(spec, out, workers=1)
-    other = MapSpec({**spec.study, "panel": {"area": 0.2}}, spec.sites, spec.loads, sites_per_chunk=1)
+    other = MapSpec(spec.study.variant(panel={"area": 0.2}), spec.sites, spec.loads, sites_per_chunk=1)
     with pytest.raises(OutputError, match="holds another map \\(its study differ"):
         run_map(other, out, resume=True)
     finished = run_map(spec, out, resume=True)  # nothing left to compute

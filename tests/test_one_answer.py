@@ -184,11 +184,13 @@ def test_size_refuses_what_the_api_refuses(option, parameter, value):
     assert "must be a finite number > 0 and at most" in line
 
 
-def test_a_map_request_is_the_api_request(tmp_path):
+def test_a_map_request_is_the_api_request(tmp_path, monkeypatch):
     """A map of named sites at the study's load through the command line, and the same request
     made with foldopt.studies.request.map_request_from and run by foldopt.world_map: the same rows
     to the bit, the same answer, the same things taken from the study; every view carries the
-    near-optimal range and the recommended angle."""
+    near-optimal range and the recommended angle. world_map runs the request it is given: it does
+    not build and check it again (it did, after the command line had)."""
+    import foldopt.studies.worldmap
     from foldopt.studies.request import map_request_from
 
     sites = tmp_path / "sites.csv"
@@ -197,8 +199,9 @@ def test_a_map_request_is_the_api_request(tmp_path):
                               "--angle-step", "10")
     request = map_request_from(sites=str(sites), step_min=60.0, angle_step=10.0)
     assert [site["name"] for site in request.sites] == ["quito", "oslo", "sydney"]
-    result, _, answer = foldopt.world_map(request.sites, request.loads, tmp_path / "api", request.study,
-                                          request.relative, request.year, workers=1, defaults=request.defaults)
+    assert isinstance(request.study, foldopt.Study)  # what the map ships to its workers
+    monkeypatch.setattr(foldopt.studies.worldmap, "map_request", None)  # a second build would fail
+    result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", workers=1)
     year = result.table[result.table["period"] == "year"].reset_index(drop=True)
     same_rows(document, year)
     api = json.loads(json.dumps(answer.to_dict()))
@@ -214,6 +217,20 @@ def test_a_map_request_is_the_api_request(tmp_path):
     assert "Near-optimal fold angles" in (folder / "report.html").read_text()
     assert np.isfinite(year["recommended_fold_angle_deg"]).all()
     no_old_names(folder, document)
+
+
+def test_a_map_says_whose_step_it_takes():
+    """The embedded study's 1-min step gives way to the maps' 5 min: the answer says so, and a
+    study's own step is the study's (a study that names no step, and no mode, was a TypeError)."""
+    from foldopt.studies.request import map_request_from
+
+    embedded = map_request_from(latitudes=[0], longitudes=[0])
+    assert "5-min steps (maps' default)" in embedded.defaults["taken"]
+    assert "exact mode" in embedded.defaults["taken"]
+    own = map_request_from({"name": "own", "panel": {"area": 0.1}, "p_load": 1.0}, latitudes=[0], longitudes=[0])
+    assert {"1-min steps", "exact mode", "ideal PV model"} <= set(own.defaults["taken"])
+    assert map_request_from(latitudes=[0], longitudes=[0], settings=["step_min=10"]).defaults["taken"][-1] == (
+        "10-min steps")
 
 
 def test_variant_merges_sections_and_speaks_in_config_errors():

@@ -110,3 +110,31 @@ def test_wrong_types_and_limits():
                                           r"evaluations; the limit is 2e\+10"):
         make_plan({**BASE, "site": {"latitude": "-60:60:0.1", "longitude": 0}, "date": "1:365:4",
                    "fold_angles": {"start": 1, "stop": 180, "step": 1}, "step_min": 1})
+
+
+def test_a_study_is_resolved_when_it_is_made():
+    """Every default that depends on other fields is decided when a study is validated, once (the
+    engine resolved it again in 16 places); what was decided is no setting of the user's, so a
+    variant at another latitude or in another mode decides its own, and a study whose weather file
+    is unread is refused where it would run."""
+    import foldopt
+    from foldopt.studies.blocks import Blocks
+
+    study = make_plan(BASE).base
+    assert (study.panel.tilt, study.panel.azimuth, study.site.timezone) == (10.0, 180.0, "UTC+00:00")
+    assert (study.geometry, study.temperature_model, study.sky) == ("hinge", "sapm", "ineichen")
+    assert study.resolved() is study and study.data() == make_plan(study.data()).base.data()
+    assert not {"geometry", "temperature_model", "sky"} & set(study.data())
+    assert {"tilt", "azimuth"}.isdisjoint(study.data()["panel"]) and "timezone" not in study.data()["site"]
+    south = study.variant(site={"latitude": -33.9, "longitude": 151.2})
+    assert (south.panel.tilt, south.panel.azimuth, south.site.timezone) == (33.9, 0.0, "UTC+10:00")
+    paper = study.variant(mode="paper")
+    assert (paper.geometry, paper.temperature_model, paper.sky) == ("azimuth-split", "fixed", "meinel")
+    given = make_plan({**BASE, "panel": {"area": 0.1, "tilt": 5.0}, "sky": "meinel"}).base
+    assert (given.data()["panel"]["tilt"], given.data()["sky"]) == (5.0, "meinel")  # given: kept
+    assert given.variant(mode="paper").sky == "meinel" and given.variant(p_load=3.0).panel.tilt == 5.0
+    unread = foldopt.Study(name="u", weather="configs/weather/723170TYA.CSV", date="2025-06-21", p_load=2.0,
+                           panel={"area": 0.1}, step_min=60)
+    assert unread.site is None and unread.panel.tilt is None
+    with pytest.raises(ConfigError, match="weather: the file is not read yet"):
+        Blocks.of_dates(unread, [unread.date])

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from foldopt.physics.atmosphere import extraterrestrial_normal, hottel_transmittance
 from foldopt.inputs.load import default_study_path
-from foldopt.inputs.plan import load_study
+from foldopt.api import load_study
 from foldopt.engine.metrics import t_solar
 from foldopt.studies.day import Day
 from foldopt.physics.trackers import ALEXANDRU_STEP_OFFSETS_H, TrackerDrive, step_law, tracker_orientation

@@ -129,10 +129,9 @@ def map_(
 
         try:
             result, figures, answer = world_map(
-                request.sites, request.loads, out, request.study, relative, year, scheduler=scheduler,
-                workers=workers, sites_per_chunk=chunk_sites or 0, resume=resume, overwrite=overwrite, engine=engine,
-                show_load=show_load - 1, show_period=show_period, progress=progress, announce=announce,
-                command=INVOCATION, defaults=request.defaults)
+                request=request, out=out, scheduler=scheduler, workers=workers, sites_per_chunk=chunk_sites or 0,
+                resume=resume, overwrite=overwrite, engine=engine, show_load=show_load - 1, show_period=show_period,
+                progress=progress, announce=announce, command=INVOCATION)
         except ConfigError as error:
             fail(list(dict.fromkeys(rename_fields(line) for line in error.errors)))
     output.answer("map", out, answer, result.table[result.table["period"] == "year"].reset_index(drop=True),

@@ -512,26 +512,3 @@ def load_plan(path: Path | str) -> Plan:
         With the YAML line of each fault.
     """
     return make_plan(*read_study(path))
-
-
-def load_study(path: Path | str) -> Study:
-    """Read a YAML study that has no sweep axes.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-
-    Returns
-    -------
-    Study
-
-    Raises
-    ------
-    foldopt.ConfigError
-        For any fault, or a study that sweeps fields.
-    """
-    plan = load_plan(path)
-    if plan.axes:
-        raise ConfigError([f"config: {path} sweeps {', '.join(p for p, _ in plan.axes)}; run it with `foldopt run`"])
-    return plan.base
-

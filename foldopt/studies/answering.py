@@ -13,7 +13,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from foldopt.inputs.study import MODE_SKIES
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
@@ -497,15 +496,15 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
             "median_pct_of_tracker": rows["pct_of_tracker"].median(),
             "median_tracker_break_even_standby_w": rows["tracker_break_even_standby_w"].median(),
         })
-    part = plain({"sites": int(table["site_id"].nunique()), "objective": study["objective"]["statistic"],
+    statistic = study.objective.statistic if study.objective is not None else "mean"
+    part = plain({"sites": int(table["site_id"].nunique()), "objective": statistic,
                    "loads": per_load, "cluster": result.cluster, "dashboard": result.dashboard,
                    "chunks_computed": len(result.computed), "chunks_from_disk": len(result.from_disk),
                    "seconds": round(result.seconds, 2)})
-    named_sky = study.get("sky") or MODE_SKIES[study.get("mode", "exact")]  # no sky named: its mode's
     sky = ("weather files" if any("weather" in site for site in spec.sites)
-           else "Ineichen clear sky" if named_sky == "ineichen" else f"{named_sky} sky")
+           else "Ineichen clear sky" if study.sky == "ineichen" else f"{study.sky} sky")
     lines = [f"map: {_count(part['sites'], 'site')}, year {spec.year}, {sky}, objective {part['objective']}, "
-             f"{study['panel']['area']:g} m^2 panel"]
+             f"{study.panel.area:g} m^2 panel"]
     for load in part["loads"]:
         what = (f"P_load {load['p_load_fraction']:g} x flat peak" if relative else f"P_load {load['p_load_w']:g} W")
         best = load["best_site"]
@@ -540,11 +539,11 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         "sites": f"{len(spec.sites):,}",
         "loads": f"{loads} {'x each site' + chr(39) + 's flat peak' if relative else 'W'}",
         "year": str(spec.year),
-        "panel": f"{study['panel']['area']:g} m^2 facing the equator at " + (
+        "panel": f"{study.panel.area:g} m^2 facing the equator at " + (
             "|latitude|" if tilts is None else
             f"each site's best base tilt, {tilts.lo:g} to {tilts.hi:g} by {tilts.step:g} deg (the flat panel's own)"),
         "objective": part["objective"],
-        "models": f"{study.get('mode')} mode, {study.get('pv_model', 'ideal')} PV model, {sky}",
+        "models": f"{study.mode} mode, {study.pv_model} PV model, {sky}",
     }
     columns = ["site_id", "site_name", "latitude", "longitude", key, "fold_angle_deg", "surface_tilt",
                "flat_surface_tilt", *NEAR_OPTIMAL]

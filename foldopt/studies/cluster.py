@@ -1,14 +1,15 @@
 """A map (:mod:`foldopt.studies.worldmap`) run on a Dask cluster, in chunks that survive faults.
 
-The sites are cut into chunks of a few seconds of work each. A chunk ships only its site list and the study
-(plain data, a few kilobytes), never arrays: every worker builds its own skies. Workers compute; the client
-alone writes, so a cluster needs no shared file system. Each finished chunk is written at once, atomically, as
-a Parquet part (``parts/part-NNNNN.parquet``); the final tables are assembled from the parts on disk, so an
-interrupted run resumed with ``resume=True`` computes only the missing chunks and gives the same bytes as an
-uninterrupted one; a part carries the digest of its map, so that a part of another map is computed again,
-never mixed in. A map that replaces another (``overwrite``) is built in a staging folder beside it and swapped
-in once complete (:mod:`foldopt.files`); one process at a time writes a folder. A worker that dies takes
-nothing with it: Dask runs its chunks elsewhere, and a part is written once per chunk.
+The sites are cut into chunks of a few seconds of work each. A chunk ships only its site list and the map's
+:class:`~foldopt.inputs.study.Study` (a few kilobytes pickled), never arrays: every worker builds its own
+skies. Workers compute; the client alone writes, so a cluster needs no shared file system. Each finished chunk
+is written at once, atomically, as a Parquet part (``parts/part-NNNNN.parquet``); the final tables are
+assembled from the parts on disk, so an interrupted run resumed with ``resume=True`` computes only the missing
+chunks and gives the same bytes as an uninterrupted one; a part carries the digest of its map, so that a part
+of another map is computed again, never mixed in. A map that replaces another (``overwrite``) is built in a
+staging folder beside it and swapped in once complete (:mod:`foldopt.files`); one process at a time writes a
+folder. A worker that dies takes nothing with it: Dask runs its chunks elsewhere, and a part is written once
+per chunk.
 
 Without a scheduler address the work goes to an embedded :class:`distributed.LocalCluster`, one single-threaded
 worker process per core; with one, to that cluster (``dask scheduler`` and ``dask worker`` by hand,
@@ -31,6 +32,7 @@ from pathlib import Path
 import pandas as pd
 
 from foldopt.errors import ConfigError, OutputError
+from foldopt.inputs.study import Study
 from foldopt.files import (DiskFullError, check_output, clear_leftovers, commit, discard, is_full, new_staging,
                            tree_size, versions, write_atomically, writer_lock)
 from foldopt.studies.dask_client import CONNECT_TIMEOUT, connect
@@ -53,8 +55,9 @@ class MapSpec:
 
     Parameters
     ----------
-    study : dict
-        A study's fields but site, date and load (:func:`foldopt.studies.worldmap.map_study`).
+    study : Study
+        The map's study (:func:`foldopt.studies.worldmap.map_template`; a map study's fields,
+        :func:`foldopt.studies.worldmap.map_study`, are made into it at the first site).
     sites : tuple of dict
         ``latitude``, ``longitude`` and optionally ``name``, ``altitude``, ``timezone``; each gets a ``site_id``.
     loads : tuple of float
@@ -66,7 +69,7 @@ class MapSpec:
     engine : {'numba', 'numpy'}
     """
 
-    study: dict
+    study: Study
     sites: tuple
     loads: tuple
     relative: bool = False
@@ -75,8 +78,11 @@ class MapSpec:
     engine: str = "numba"
 
     def __post_init__(self):
+        from foldopt.studies.worldmap import map_template
+
         if not self.sites:
             raise ConfigError(["sites: a map needs at least one site"])
+        object.__setattr__(self, "study", map_template(self.study, self.sites[0], self.year))
         if self.sites_per_chunk <= 0:
             object.__setattr__(self, "sites_per_chunk", default_sites_per_chunk(self.study, self.year))
         sites = tuple({**site, "site_id": index} for index, site in enumerate(self.sites))
@@ -88,8 +94,12 @@ class MapSpec:
         return [range(start, min(start + size, len(self.sites))) for start in range(0, len(self.sites), size)]
 
     def as_dict(self) -> dict:
-        """The spec as plain data (``run.json``'s ``spec``)."""
-        return dataclasses.asdict(self)
+        """The spec as plain data (``run.json``'s ``spec``): the study as the fields a map keeps for
+        every site (:func:`foldopt.studies.worldmap.map_data`)."""
+        from foldopt.studies.worldmap import map_data
+
+        return {**{field.name: getattr(self, field.name) for field in dataclasses.fields(self)},
+                "study": map_data(self.study)}
 
     @functools.cached_property
     def key(self) -> str:
@@ -100,21 +110,20 @@ class MapSpec:
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def default_sites_per_chunk(study: dict, year: int) -> int:
+def default_sites_per_chunk(study: Study, year: int) -> int:
     """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work (at least 1), in whole batches
     of :data:`foldopt.studies.worldmap.SITES_PER_BATCH` where it holds one or more.
 
     Parameters
     ----------
-    study : dict
+    study : Study
         :attr:`MapSpec.study` (its fold angles and step).
     year : int
     """
-    from foldopt.inputs.sections import FoldAngles
     from foldopt.studies.worldmap import SITES_PER_BATCH
 
-    angles = len(FoldAngles(**study.get("fold_angles", {})).grid())
-    steps = 1440 / float(study.get("step_min", 1.0))
+    angles = len(study.fold_angles.grid())
+    steps = 1440 / study.step_min
     per_site = 365 * angles * steps * SECONDS_PER_EVALUATION
     count = max(1, int(CHUNK_SECONDS / per_site))
     # Whole batches of sites where a chunk holds one or more, so that no batch runs part-full.
@@ -135,7 +144,7 @@ class MapRun:
     dashboard: str | None
 
 
-def evaluate_chunk(study: dict, sites: list, loads: list, relative: bool, year: int, engine: str) -> pd.DataFrame:
+def evaluate_chunk(study: Study, sites: list, loads: list, relative: bool, year: int, engine: str) -> pd.DataFrame:
     """The task of one chunk, run on a worker: :func:`foldopt.studies.worldmap.evaluate_sites` on one thread.
 
     Parameters

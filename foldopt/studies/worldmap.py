@@ -11,8 +11,9 @@ the twofold panel at that angle and the tracker, and the tracker's break-even st
 
 Loads are in watts or, with ``relative=True``, fractions of each site's flat peak (the largest
 power of the flat panel over the year), so that one map compares like with like from the tropics
-to the poles. :func:`map_request` checks a map's sites, loads, year and period, once for the command
-line and :func:`foldopt.world_map`.
+to the poles. :func:`map_request` checks a map's sites, loads, year and period once and makes the map's
+study a :class:`~foldopt.inputs.study.Study` (:func:`map_template`); the command line hands that request
+to :func:`foldopt.world_map` as it is. Each site's study is the map's moved to the site (:func:`site_study`).
 
 This module computes; :mod:`foldopt.studies.cluster` spreads the sites over a Dask cluster and writes
 the files.
@@ -116,8 +117,9 @@ class MapRequest:
 
     Attributes
     ----------
-    study : dict
-        The map's study: a study's fields but site, date and load (:func:`map_study`).
+    study : Study
+        The map's study, resolved at its first site (:func:`map_template`): every site's is this
+        one moved to the site (:func:`site_study`).
     sites : tuple of dict
         Each a site's fields or a weather file's site (:func:`evaluate_sites`).
     loads : tuple of float
@@ -130,7 +132,7 @@ class MapRequest:
         What the answer took from that study or from defaults, not from the request.
     """
 
-    study: dict
+    study: Study
     sites: tuple
     loads: tuple
     relative: bool = False
@@ -167,8 +169,8 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
 
     Parameters
     ----------
-    study : dict
-        The map's study (:func:`map_study`); checked at the first site.
+    study : dict or Study
+        The map's study (:func:`map_study`), made and checked at the first site (:func:`map_template`).
     loads : float, sequence of float or str
         Loads [W] in (0, 1e6], or with ``relative`` fractions of each site's flat peak in (0, 2];
         text is a value, a range ``start:stop:step`` or a list ``a,b,c``.
@@ -222,12 +224,13 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
     largest, bounds = LOAD_BOUNDS[relative]
     if any(not 0 < value <= largest for value in load_values):
         errors.append(f"loads = {loads!r}: {bounds}")
-    vary = (study.get("optimize") or {}).get("vary", list(names.OPTIMIZE_VARIABLES))
+    optimize = map_data(study).get("optimize")
+    vary = (optimize or {}).get("vary", list(names.OPTIMIZE_VARIABLES))
     try:
         searchable = "fold_angle" in vary_names(vary) and set(vary_names(vary)) <= set(MAP_VARIABLES)
     except ValueError:
         searchable = True  # no list of names: the study's validation at the first site says so
-    if study.get("optimize") is not None and not searchable:
+    if optimize is not None and not searchable:
         errors.append(f"optimize.vary = {vary!r}: a map searches the fold angle, or the fold angle and the tilt "
                       f"(the azimuth with them: foldopt optimize, one site at a time)")
     if errors:
@@ -251,18 +254,71 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
                                     + (f" ({site['name']})" if site["name"] else ""))
     except ValueError as error:
         raise ConfigError([f"{field}: {error}"]) from None
-    if len(sites):
-        site_study(study, sites[0], year)  # a bad setting fails here, before any cluster starts
+    if not len(sites):
+        raise ConfigError(["sites: a map needs at least one site"])
+    study = map_template(study, sites[0], year)
+    site_study(study, sites[0], year)  # a bad setting fails here, before any cluster starts
     return MapRequest(study, tuple(sites), tuple(load_values), relative, year)
 
 
-def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]]:
-    """The study at one site of a map and the days of its year.
+def map_data(study: dict | Study) -> dict:
+    """A map's study as data: a study's fields but those a map sets per site.
 
     Parameters
     ----------
-    study : dict
-        A study's fields but the site, date and load (:func:`map_study`).
+    study : dict or Study
+        A map's study's fields (:func:`map_study`), or the map's study (:func:`map_template`).
+
+    Returns
+    -------
+    dict
+        Without the fields of :data:`_PER_SITE` and, of a :class:`Study`, without its decided
+        defaults (each site decides its own: its tilt, its time zone).
+    """
+    data = study.data() if isinstance(study, Study) else study
+    return {key: value for key, value in data.items() if key not in _PER_SITE}
+
+
+def map_template(study: dict | Study, site: dict, year: int) -> Study:
+    """A map's study made a :class:`Study`: validated and resolved at one of its sites' places.
+
+    The study a map ships to its workers (:class:`foldopt.studies.cluster.MapSpec`); each site's
+    is this one moved to the site (:func:`site_study`). A weather file's site stands at its place
+    without its file, so that the map's own sky stays for a map's other sites.
+
+    Parameters
+    ----------
+    study : dict or Study
+        A map's study's fields (:func:`map_study`); a :class:`Study` is returned as it is.
+    site : dict
+        A site of the map (:func:`site_study`'s).
+    year : int
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    foldopt.ConfigError
+        As :func:`site_study`.
+    """
+    if isinstance(study, Study):
+        return study
+    place = {key: site[key] for key in ("latitude", "longitude") if site.get(key) is not None}
+    return site_study(study, place if "weather" in site and len(place) == 2 else site, year)[0]
+
+
+def site_study(study: dict | Study, site: dict, year: int) -> tuple[Study, list[dt.date]]:
+    """The study at one site of a map and the days of its year.
+
+    The map's study moved to the site: what the site does not give (the panel's tilt and azimuth,
+    the time zone) the site decides, unless the map's study gives it.
+
+    Parameters
+    ----------
+    study : dict or Study
+        The map's study (:func:`map_template`) or its fields (:func:`map_data`).
     site : dict
         A :class:`foldopt.inputs.sections.Site`'s fields, or a weather file's site (``weather``: the
         path, its site read from the file).
@@ -284,6 +340,7 @@ def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]
     if year_problem(year):
         raise ConfigError([f"year = {year!r}: {year_problem(year)}"])
     dates = parse_dates("year", year)
+    study = map_data(study)
     if study.get("load_profile") is not None:
         raise ConfigError(["load_profile: maps take constant loads (watts or fractions of the flat peak); run a "
                            "profile at one site with foldopt run"])
@@ -300,15 +357,15 @@ def site_study(study: dict, site: dict, year: int) -> tuple[Study, list[dt.date]
         raise ConfigError(format_errors(error)) from None
 
 
-def evaluate_sites(study: dict, sites: Sequence[dict], loads: Sequence[float], relative: bool = False,
+def evaluate_sites(study: Study | dict, sites: Sequence[dict], loads: Sequence[float], relative: bool = False,
                    year: int = 2025, engine: str = "numba") -> pd.DataFrame:
     """The map's rows for some sites: per site, load and period (:data:`PERIODS`).
 
     Parameters
     ----------
-    study : dict
-        A study's fields but ``site``, ``date`` and ``p_load``; its ``objective`` (default mean)
-        chooses each period's fold angle.
+    study : Study or dict
+        The map's study (:func:`map_template`), or a study's fields but ``site``, ``date`` and
+        ``p_load``; its ``objective`` (default mean) chooses each period's fold angle.
     sites : sequence of dict
         Each a site's fields (``name``, ``latitude``, ``longitude``, ``altitude``, ``timezone``) or a
         weather file's site (``weather``, the path). A ``site_id`` key, if given, is kept.
@@ -339,13 +396,14 @@ def evaluate_sites(study: dict, sites: Sequence[dict], loads: Sequence[float], r
     """
     loads = np.asarray(loads, dtype=float)
     frames, batch, key = [], [], None
+    study = map_data(study)  # once, not per site
     for site in sites:
-        resolved, dates = site_study(study, site, year)
-        this = setup_key(resolved)
+        here, dates = site_study(study, site, year)
+        this = setup_key(here)
         if batch and (this != key or len(batch) == SITES_PER_BATCH):
             frames.append(_evaluate_batch(batch, loads, relative, engine))
             batch = []
-        batch.append((site, resolved, dates))
+        batch.append((site, here, dates))
         key = this
     if batch:
         frames.append(_evaluate_batch(batch, loads, relative, engine))
@@ -378,14 +436,14 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
                                                    _tilt_axis(search))
     designs = site_designs(parts, sites, usable, engine, fold)
     columns: dict[str, list] = {}
-    for (site, resolved, _), days_of, site_months, peak_w, site_watts, site_usable in zip(
+    for (site, here, _), days_of, site_months, peak_w, site_watts, site_usable in zip(
             batch, designs, months, flat_peak, watts, usable, strict=True):
         for name, values in _site_rows(days_of, site_months, statistic, seasons, site_usable, study,
-                                       resolved.resolved().panel.tilt).items():
+                                       here.panel.tilt).items():
             columns.setdefault(name, []).append(values)
         count = len(PERIODS) * loads.size
         fixed = {"site_id": site.get("site_id", 0), "site_name": site.get("name") or "",
-                 "latitude": resolved.site.latitude, "longitude": resolved.site.longitude,
+                 "latitude": here.site.latitude, "longitude": here.site.longitude,
                  "weather": Path(site["weather"]).name if "weather" in site else "", "flat_peak_w": peak_w}
         for name, value in fixed.items():
             columns.setdefault(name, []).append(np.full(count, value, dtype=object if isinstance(value, str) else None))
@@ -408,11 +466,10 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     return pd.DataFrame({name: np.concatenate(columns[name]) for name in order})
 
 
-def searched_tilt(study: dict) -> Axis | None:
+def searched_tilt(study: Study) -> Axis | None:
     """The base tilt's range [deg] a map's study searches with the fold angle (``foldopt map
     --optimize tilt``), or None where the panel keeps the site's tilt."""
-    optimize = study.get("optimize")
-    return None if optimize is None else _tilt_axis(Optimize.model_validate(optimize))
+    return None if study.optimize is None else _tilt_axis(study.optimize)
 
 
 def _tilt_axis(search: Optimize) -> Axis | None:
