@@ -206,7 +206,7 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
 
 
 def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
-                   tracker: TrackerCurves | None = None) -> dict:
+                   tracker: TrackerCurves | None = None, twofold_curves: dict | None = None) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
     panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net.
 
@@ -224,6 +224,11 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     tracker : TrackerCurves, optional
         The study's tracker over ``sky``, where the caller has it (a day's study draws it too);
         default worked out here (:func:`tracker_curves`).
+    twofold_curves : dict, optional
+        Under a load profile, the twofold panel's power [W] over every block, (n_blocks, n_steps),
+        by the grid index every block of a load has, as far as the caller has them (an annual
+        group's day x hour maps draw one); those worked out here are added. Loads that share an
+        angle share its curve.
 
     Returns
     -------
@@ -260,10 +265,21 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     if shape is not None:
         # A load profile's served energy integrates P_load(t) over the solar-powered time: from the curves.
         step = sky.step_hours
-        curves = [engines.powers(sky, study, every[np.arange(n_blocks), chosen[:, index]], series=study.switch_series
-                                 )[0][study.connection] for index in range(n_loads)]
-        twofold_served = np.stack([energy_served(curve, load, shape, step, twofold.t_solar[index::n_loads, 0, 0])
-                                   for index, (curve, load) in enumerate(zip(curves, loads, strict=True))], 1)
+        curves = {} if twofold_curves is None else twofold_curves
+
+        def curve(index):
+            column = chosen[:, index]
+            key = int(column[0]) if (column == column[0]).all() else None
+            if key not in curves:
+                power = engines.powers(sky, study, every[np.arange(n_blocks), column],
+                                       series=study.switch_series)[0][study.connection]
+                if key is None:
+                    return power
+                curves[key] = power
+            return curves[key]
+
+        twofold_served = np.stack([energy_served(curve(index), load, shape, step, twofold.t_solar[index::n_loads, 0, 0])
+                                   for index, load in enumerate(loads)], 1)
         flat_curve = engines.powers(sky, study, engines.flat_orientation(tilt, azimuth), series=False)[0]["panel"]
         served = np.stack([energy_served(flat_curve, loads, shape, step, flat.t_solar[:, 0]), twofold_served,
                            energy_served(gross, loads, shape, step, trackers.t_solar[:n_blocks, 0]),
