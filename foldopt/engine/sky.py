@@ -286,12 +286,13 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
 
     Raises
     ------
+    foldopt.ConfigError
+        If the study's files are unread (:meth:`foldopt.inputs.study.Study.require_files`).
     ValueError
         If ``sites`` and ``dates`` differ in length, or a weather file's intervals do not fit the
         study's step.
     """
-    study = study.resolved()
-    sites = [site.resolved() for site in sites]
+    study.require_files()
     if len(sites) != len(dates):
         raise ValueError(f"{len(sites)} sites for {len(dates)} dates")
     if study.weather is not None:

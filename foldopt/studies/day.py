@@ -33,17 +33,15 @@ class Day:
     """Sun, light and electrical model over one day, and the power of each design on it.
 
     Paper mode uses the paper's sun, air mass at sea level and Eq. 5 incidence; exact mode pvlib's
-    sun (apparent zenith), Laue's altitude term and the true angle of incidence. The study is
-    resolved here, so its defaults follow its own site and mode.
+    sun (apparent zenith), Laue's altitude term and the true angle of incidence.
 
     Parameters
     ----------
     study : Study
-        One site and date.
+        One site and date, its files read (:func:`foldopt.inputs.load.with_files`).
     """
 
     def __init__(self, study: Study):
-        study = study.resolved()
         self.study = study
         self.sky = sky = build_sky(study, [study.site], [study.date])
         self.electrical = engines.electrical_for(study, sky.temp_air[0], sky.wind_ref)
@@ -187,7 +185,7 @@ class Day:
 
 @dataclass(frozen=True)
 class StudyResult:
-    """One study's results (:func:`foldopt.run`); ``study`` is resolved.
+    """One study's results (:func:`foldopt.run`).
 
     Attributes
     ----------
