@@ -393,8 +393,9 @@ class Study(StrictModel):
             ``objective``, ``fold_angles``, ``near_optimal``) changes only the fields it names:
             ``variant(panel={"area": 0.1})`` keeps the efficiency, tilt and azimuth. As for the
             command line, a paper-mode study given another site or day runs in exact mode, a new
-            mode takes its own geometry and a new latitude tilts the panel at ``|latitude|``,
-            unless those fields are given too.
+            mode takes its own geometry and sky and a new latitude tilts the panel at
+            ``|latitude|``, unless those fields are given; what the study decided itself (its
+            temperature model, its time zone...) is decided again (:meth:`data` leaves it out).
 
         Returns
         -------

@@ -28,7 +28,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from pydantic import ValidationError
 
 from foldopt import names
 from foldopt.engine import rows as engines
@@ -37,7 +36,7 @@ from foldopt.engine.search import Axis
 from foldopt.inputs.optimize_section import DEFAULT_TILT, Optimize, vary_names
 from foldopt.inputs.plan import check_distinct, parse_dates, parse_values, year_problem
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
-from foldopt.inputs.study import Study, format_errors
+from foldopt.inputs.study import Study, make_study
 from foldopt.errors import ConfigError
 from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
@@ -351,10 +350,7 @@ def site_study(study: dict | Study, site: dict, year: int) -> tuple[Study, list[
         data.pop("sky", None)
     else:
         data["site"] = {key: site[key] for key in SITE_COLUMNS if site.get(key) is not None}
-    try:
-        return Study.model_validate(data, context=resolve_files(data)), dates
-    except ValidationError as error:
-        raise ConfigError(format_errors(error)) from None
+    return make_study(data, resolve_files(data)), dates
 
 
 def evaluate_sites(study: Study | dict, sites: Sequence[dict], loads: Sequence[float], relative: bool = False,
