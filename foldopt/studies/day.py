@@ -54,6 +54,7 @@ class Day:
         self.dhi = None if sky.dhi is None else sky.dhi[0]
         self.transposition = study.sky_transposition()
         self._trackers: dict = {}
+        self._last_connections: tuple = (None, None)
 
     def _poa(self, surface_tilt, surface_azimuth, per_step=False):
         """Irradiance on surfaces [W/m^2]: one orientation per row, (k,) -> (k, n_time), or, with
@@ -153,9 +154,16 @@ class Day:
         state : numpy.ndarray of int or None
             (k, n_time) index into :data:`foldopt.physics.connections.SWITCH_STATES`.
         """
-        powers, state = engines.powers(self.sky, self.study, self.orientation(fold_angles), [0], series, with_state)
-        powers.pop("panel")
-        return powers, state
+        # The last call's curves are kept: the heuristic's root search ends on its angle, whose curve
+        # the summary's row then takes.
+        fold_angles = np.atleast_1d(np.asarray(fold_angles, dtype=float))
+        key = (fold_angles.tobytes(), series, with_state)
+        if self._last_connections[0] != key:
+            powers, state = engines.powers(self.sky, self.study, self.orientation(fold_angles), [0], series,
+                                           with_state)
+            powers.pop("panel")
+            self._last_connections = (key, (powers, state))
+        return self._last_connections[1]
 
     def subpanel_power(self, fold_angles):
         """East and west sub-panel powers and their parallel connection [W], each (k, n_time).
@@ -233,13 +241,23 @@ class StudyResult:
         return of_study(self)
 
 
-def _best_angle(day: Day, angles, sweep_t_solar, connection):
-    """The best fold angle [deg] and its t_solar [h]: the sweep's best, refined between its neighbours."""
+def _best_angle(day: Day, angles, sweep_t_solar, connection, with_power: bool = False):
+    """The best fold angle [deg] and its t_solar [h]: the sweep's best, refined between its
+    neighbours; ``with_power``, also its power [W], (n_time,), the refinement's curve where the
+    angle is one of the refinement's."""
     shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
-    return optimal_fold_angle(
-        lambda fold: per_load(day.combined_power(fold, connection), shape), angles, sweep_t_solar, day.study.p_load,
-        day.step_hours
-    )
+    evaluated = {}
+
+    def compared(fold):
+        power = day.combined_power(fold, connection)
+        evaluated.update(zip(fold.tolist(), power))
+        return per_load(power, shape)
+
+    angle, hours = optimal_fold_angle(compared, angles, sweep_t_solar, day.study.p_load, day.step_hours)
+    if not with_power:
+        return angle, hours
+    power = evaluated.get(angle)
+    return angle, hours, day.combined_power(np.array([angle]), connection)[0] if power is None else power
 
 
 def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
@@ -306,8 +324,9 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     if day.electrical.pv.has_iv:
         for connection in ("parallel", "series", "independent", "switching"):
             if connection != study.connection:
-                angle = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection)[0]
-                others[f"twofold-{connection}"] = (angle, day.combined_power(np.array([angle]), connection)[0])
+                angle, _, power = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection,
+                                              with_power=True)
+                others[f"twofold-{connection}"] = (angle, power)
     # Every other tracker model follows the study's as "tracker:<model>"; each net row is what is
     # left for the load after the tracker's own draw.
     for model in (m for m in TRACKERS if m != study.tracker.model):
