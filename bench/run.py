@@ -78,7 +78,7 @@ def _fold_pass(base, sites, dates, loads, threads=None):
         numba.set_num_threads(threads)
     phases = {}
     # The sun alone (the sky below computes it again as part of the light): its own phase.
-    zones = {s.resolved().timezone for s in sites}
+    zones = {s.timezone for s in sites}  # a study's site has its time zone decided
     assert len(zones) == 1, "bench workloads keep one time zone"
     phases["sun"], _ = _timed(lambda: solar_position_grid(
         clock_grid(dates, zones.pop(), base.step_min), np.array([[s.latitude] for s in sites]),

@@ -95,13 +95,6 @@ class Site(StrictModel):
     )
     horizon: Horizon | None = Field(None, description="(azimuth, elevation) points or a file; default an open plain")
 
-    def resolved(self) -> Site:
-        """The site itself: a study's site is resolved when the study is validated.
-
-        Kept until :mod:`foldopt.engine.sky`'s call is gone.
-        """
-        return self
-
 
 def standard_timezone(longitude: float) -> str:
     """The standard offset of a longitude: a site's time zone where none is given.
