@@ -220,12 +220,12 @@ def test_a_map_request_is_the_api_request(tmp_path, monkeypatch):
 
 
 def test_a_map_says_whose_step_it_takes():
-    """The embedded study's 1-min step gives way to the maps' 5 min: the answer says so, and a
-    study's own step is the study's (a study that names no step, and no mode, was a TypeError)."""
+    """A map takes the study's step, as every command does (the embedded study's 1 min; maps had
+    their own 5 min), and says so; a study that names no step, and no mode, was a TypeError."""
     from foldopt.studies.request import map_request_from
 
     embedded = map_request_from(latitudes=[0], longitudes=[0])
-    assert "5-min steps (maps' default)" in embedded.defaults["taken"]
+    assert "1-min steps" in embedded.defaults["taken"]
     assert "exact mode" in embedded.defaults["taken"]
     own = map_request_from({"name": "own", "panel": {"area": 0.1}, "p_load": 1.0}, latitudes=[0], longitudes=[0])
     assert {"1-min steps", "exact mode", "ideal PV model"} <= set(own.defaults["taken"])

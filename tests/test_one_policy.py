@@ -4,11 +4,10 @@ says the whole sky in force.
 
 A sweep of a year's days and a map of the same site ask the same question (the embedded study's
 panel, one fold angle all year for the mean daily t_solar): they must give the same answer. The
-two commands differ in two defaults still: a map's step is 5 min
-(:data:`foldopt.studies.worldmap.MAP_DEFAULTS`), a sweep's the study's 1 min, and a map's year is
-2025, a sweep's the embedded study's 2014. The year moves the mean t_solar by 6e-4 h, below the
-answer's 0.01 h; the step moves the best fold angle (Berlin, 2 W: 19 deg at 1-min steps, 20 at
-5-min).
+two commands differ in one default still: a map's year is 2025, a sweep's the embedded study's
+2014, which moves the mean t_solar by 6e-4 h, below the answer's 0.01 h. Maps took 5-min steps of
+their own until both took the study's; the step moves the best fold angle (Berlin, 2 W: 19 deg at
+1-min steps, 20 at 5-min).
 """
 
 from __future__ import annotations
@@ -73,7 +72,6 @@ def test_a_sweep_and_a_map_of_a_site_agree_at_the_same_step(tmp_path, scheduler)
     assert sweep["recommended_fold_angle_deg"] == 40 and round(sweep["gain_vs_flat_pct"], 1) == 11.4
 
 
-@pytest.mark.xfail(strict=True, reason="map's default step")
 def test_a_sweep_and_a_map_of_a_site_agree_with_no_option(tmp_path, scheduler):
     assert_same_answer(sweep_answer(tmp_path / "sweep"), map_answer(tmp_path / "map", scheduler))
 

@@ -43,7 +43,7 @@ def map_(
                                            "min | worst-month | pNN.")] = "mean",
     year: Annotated[int, typer.Option("--year", help="Year of the clear-sky days (or that a typical year stands "
                                       "for).")] = 2025,
-    step_min: Annotated[float | None, step_min_option("5")] = None,
+    step_min: Annotated[float | None, step_min_option()] = None,
     angle_step: AngleStep = None,
     fold_search: Annotated[bool, typer.Option("--fold-search", help="Search the fold angles (foldopt.engine.search) "
                                               "instead of evaluating every one: the same objectives within 0.01 h "

@@ -453,7 +453,7 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
     ----------
     study : dict, str, pathlib.Path or None
         The study's fields, or a YAML study to read them from, that the map takes its panel, models
-        and load from; None for the embedded study, whose mode and step give way to
+        and load from; None for the embedded study, whose mode gives way to
         :data:`foldopt.studies.worldmap.MAP_DEFAULTS` (its sky and geometry exact mode's).
     source : str
         How the answer names the study.
@@ -482,8 +482,8 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
     Returns
     -------
     foldopt.studies.worldmap.MapRequest
-        With ``taken``: the panel area, load and step the map took from the study (or, for the
-        embedded study's, the maps' default step), its PV model and mode.
+        With ``taken``: the panel area, load and step the map took from the study, its PV model
+        and mode.
 
     Raises
     ------
@@ -509,20 +509,16 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
         extra = [name for name in varied if name != "fold_angle"]
         changes["optimize"] = {**(data.get("optimize") or {}), "vary": ["fold_angle", *extra]}
     made = map_study(data, embedded=study is None, **changes)
-    set_fields = []
     for setting in settings:
         field, value = parse_setting(setting)
         made = policy.set_path(made, field, value)
-        set_fields.append(field)
     # The study's load as its file gives it: a value, a list or a range text, checked like --p-load.
     request = map_request(made, (data.get("p_load") or 1.0) if loads is None else loads, **where)
     study_loads = (f"P_load {request.loads[0]:g} W" if len(request.loads) == 1 else
                    f"P_load {len(request.loads)} loads, {min(request.loads):g} to {max(request.loads):g} W")
     made = request.study
-    # The embedded study's step gives way to MAP_DEFAULTS's: the answer says whose it is.
-    whose_step = " (maps' default)" if study is None and "step_min" not in set_fields else ""
     taken = [f"panel {made.panel.area:g} m^2" if area is None else None,
              study_loads if loads is None and not request.relative else None,
              f"{made.pv_model} PV model", f"{made.mode} mode",
-             f"{made.step_min:g}-min steps{whose_step}" if step_min is None else None]
+             f"{made.step_min:g}-min steps" if step_min is None else None]
     return replace(request, source=source, taken=tuple(item for item in taken if item))
