@@ -48,7 +48,6 @@ def electrical_settings(study: Study, temp_air: float, wind_speed: float | None 
         Wind speed of the tables [m/s]; default the study's (a weather study's sky gives its own,
         :attr:`foldopt.engine.sky.Sky.wind_ref`).
     """
-    study = study.resolved()
     pv = PVModel(study.pv_model, study.panel.efficiency, study.module)
     return dict(
         pv=pv,

@@ -72,7 +72,7 @@ def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> n
     Parameters
     ----------
     study : Study
-        Gives the geometry (resolved).
+        Gives the geometry.
     panel_tilt, panel_azimuth : array_like
         The flat panel of each block [deg], (n_blocks,).
     fold_angles : array_like
@@ -83,7 +83,7 @@ def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> n
     numpy.ndarray
         (n_blocks, n_angles, 4): tilt and azimuth of the east, then of the west sub-panel [deg].
     """
-    geometry = study.resolved().geometry
+    geometry = study.geometry
     fold_angles = np.asarray(fold_angles, dtype=float)
     panels = np.stack([np.asarray(panel_tilt, dtype=float), np.asarray(panel_azimuth, dtype=float)], axis=-1)
     unique, inverse = np.unique(panels, axis=0, return_inverse=True)
@@ -234,7 +234,6 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
-    study = study.resolved()
     unknown = [name for name in outputs if name not in OUTPUTS]
     if unknown:
         raise ValueError(f"outputs must be among {', '.join(OUTPUTS)}; got {unknown}")
