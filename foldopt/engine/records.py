@@ -14,7 +14,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import get_num_threads
 
 CHUNKS_PER_THREAD = 8  # rows are handed out in chunks: enough for balance, few scratch buffers
 
@@ -230,7 +229,7 @@ def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: b
     n_rows, n_conn, n_loads : int
         Rows, connections and loads per set.
     n_steps : int
-        Steps per day for :func:`fold_rows`; 0 for :func:`curve_rows` (which reads no irradiance).
+        Steps per day for ``fold_rows``; 0 for ``curve_rows`` (which reads no irradiance).
     contiguous : bool
         Whether the longest contiguous interval is tracked.
 
@@ -238,6 +237,8 @@ def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: b
     -------
     Outputs, Scratch
     """
+    from numba import get_num_threads
+
     chunks = max(1, min(n_rows, get_num_threads() * CHUNKS_PER_THREAD))
     shape = (n_rows, n_conn)
     out = Outputs(t_solar=np.empty(shape + (n_loads,)),
