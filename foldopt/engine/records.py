@@ -6,7 +6,9 @@
 last three. numba takes these module-level named tuples as arguments (and caches functions typed by
 them), so adding an input is a field here and the line of :mod:`foldopt.engine.rows` that fills it.
 Every field is an array, a float, an int or a bool, always of the same type, so that one compiled
-specialisation serves every call.
+specialisation serves every call. A parallel loop hands the records to a function of its own
+(``_chunk_rows``, ``_chunk_curves``): in the loop's body itself, writes through a named tuple's
+fields are lost (numba issue #7135).
 """
 
 from __future__ import annotations

@@ -187,8 +187,8 @@ def curve_rows(power, span, row_loadset, loads, out, scratch):
 @njit(cache=True)
 def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
     """Rows ``start .. stop - 1`` of :func:`curve_rows` with one chunk's scratch ``work``: a function
-    of its own, as :func:`foldopt.engine.kernel._chunk_rows` (with :func:`day_metrics` inlined into
-    the parallel loop's body itself, what it wrote through the records' fields was lost: numba 0.68)."""
+    of its own, as :func:`foldopt.engine.kernel._chunk_rows`, because in a parallel loop's body the
+    writes through a named tuple's fields are lost (numba issue #7135, open in 0.68)."""
     for r in range(start, stop):
         out.energy[r, 0], out.peak[r, 0] = day_metrics(
             power[r], span[r, 0], span[r, 1], loads.p_load[row_loadset[r]],
