@@ -28,6 +28,8 @@ runner = CliRunner()
 BERLIN = ("--lat", "52.5", "--lon", "13.4", "--p-load", "2")
 #: What the answers say at their rounding: angles to the degree, t_solar to 0.01 h, gain to 0.1 %.
 ANGLES = ("fold_angle_deg", "near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg")
+#: Exact mode's sky over a year's days (or many sites), as a question says it.
+SKY = "Ineichen clear sky at Linke turbidity from pvlib climatology for each site and day, Perez diffuse, albedo 0.2"
 
 
 def _answer(*args) -> dict:
@@ -43,7 +45,8 @@ def sweep_answer(out, *options) -> dict:
     t_solar = {row["design"]: row["mean_t_solar_h"] for row in answer["designs"]}
     return {**{key: near[key] for key in ANGLES}, **{f"t_solar_{design}_h": t_solar[design]
                                                      for design in ("flat", "twofold", "tracker")},
-            "gain_vs_flat_pct": 100 * (t_solar["twofold"] / t_solar["flat"] - 1)}
+            "gain_vs_flat_pct": 100 * (t_solar["twofold"] / t_solar["flat"] - 1),
+            "models": answer["question"]["models"]}
 
 
 def map_answer(out, scheduler, *options) -> dict:
@@ -53,7 +56,7 @@ def map_answer(out, scheduler, *options) -> dict:
     row, = answer["designs"]
     return {**{key: near[key] for key in ANGLES},
             **{f"t_solar_{design}_h": row[f"mean_t_solar_{design}_h"] for design in ("flat", "twofold", "tracker")},
-            "gain_vs_flat_pct": row["gain_vs_flat_pct"]}
+            "gain_vs_flat_pct": row["gain_vs_flat_pct"], "models": answer["question"]["models"]}
 
 
 def assert_same_answer(sweep: dict, world: dict) -> None:
@@ -70,6 +73,9 @@ def test_a_sweep_and_a_map_of_a_site_agree_at_the_same_step(tmp_path, scheduler)
     world = map_answer(tmp_path / "map", scheduler, "--step-min", "5")
     assert_same_answer(sweep, world)
     assert sweep["recommended_fold_angle_deg"] == 40 and round(sweep["gain_vs_flat_pct"], 1) == 11.4
+    # And both say so: the same sky in their questions.
+    for answer in (sweep, world):
+        assert answer["models"].startswith("exact mode") and answer["models"].endswith(SKY), answer["models"]
 
 
 def test_a_sweep_and_a_map_of_a_site_agree_with_no_option(tmp_path, scheduler):

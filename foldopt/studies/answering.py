@@ -501,8 +501,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                    "loads": per_load, "cluster": result.cluster, "dashboard": result.dashboard,
                    "chunks_computed": len(result.computed), "chunks_from_disk": len(result.from_disk),
                    "seconds": round(result.seconds, 2)})
-    sky = ("weather files" if any("weather" in site for site in spec.sites)
-           else "Ineichen clear sky" if study.sky == "ineichen" else f"{study.sky} sky")
+    weather = any("weather" in site for site in spec.sites)
+    sky = "weather files" if weather else "Ineichen clear sky" if study.sky == "ineichen" else f"{study.sky} sky"
     lines = [f"map: {_count(part['sites'], 'site')}, year {spec.year}, {sky}, objective {part['objective']}, "
              f"{study.panel.area:g} m^2 panel"]
     for load in part["loads"]:
@@ -543,7 +543,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
             "|latitude|" if tilts is None else
             f"each site's best base tilt, {tilts.lo:g} to {tilts.hi:g} by {tilts.step:g} deg (the flat panel's own)"),
         "objective": part["objective"],
-        "models": f"{study.mode} mode, {study.pv_model} PV model, {sky}",
+        "models": f"{study.mode} mode, {study.pv_model} PV model, "
+                  + (sky if weather else sky_text(study, ("site", "date"))),
     }
     columns = ["site_id", "site_name", "latitude", "longitude", key, "fold_angle_deg", "surface_tilt",
                "flat_surface_tilt", *NEAR_OPTIMAL]
