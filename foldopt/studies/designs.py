@@ -79,14 +79,28 @@ def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
     numpy.ndarray
         (n_blocks, n_steps) [W].
     """
+    return engines.panel_power(sky, study, sky_tracker_poa(sky, orientation))
+
+
+def sky_tracker_poa(sky: Sky, orientation) -> np.ndarray:
+    """Irradiance [W/m^2] reaching a tracker's cells (after the sky's incidence-angle modifier)
+    over every block, (n_blocks, n_steps).
+
+    Parameters
+    ----------
+    sky : Sky
+    orientation : tuple of numpy.ndarray
+        The tracker's surface tilt and azimuth [deg] and normal (:func:`sky_tracker_orientation`).
+    """
     tilt, azimuth, normal = orientation
     if sky.horizon_of is not None or sky.iam != "none":
-        return engines.panel_power(sky, study, engines.poa(sky, tilt, azimuth, normal=normal))
-    # An open plain without a modifier (every map's): the same sums compiled, over the lit spans alone.
+        return engines.poa(sky, tilt, azimuth, normal=normal)
+    # An open plain without a modifier (every map's): the same sums compiled, over the lit spans
+    # alone (the reference path's to the bit, tests/test_tracker.py).
     sun, _, beam, terms, span = sky.kernel_layout(False)
     poa = np.empty(beam.shape)
     turning_poa(np.ascontiguousarray(normal, dtype=float), sun, beam, terms, span, poa)
-    return engines.panel_power(sky, study, poa)
+    return poa
 
 
 def standby_available(gross, draw, lit, standby_w: float):
@@ -144,11 +158,15 @@ class TrackerCurves:
         Gross power [W], (n_blocks, n_steps) (:func:`sky_tracker_power`).
     draw : numpy.ndarray
         Its own draw [W], (n_blocks, n_steps) (:func:`sky_tracker_draw`).
+    incident : numpy.ndarray or None
+        The plane-of-array irradiance incident on it [W/m^2], (n_blocks, n_steps), where it is
+        what the power came from (a sky without an incidence-angle modifier); None otherwise.
     """
 
     orientation: tuple
     power: np.ndarray
     draw: np.ndarray
+    incident: np.ndarray | None = None
 
     @property
     def net(self) -> np.ndarray:
@@ -170,8 +188,9 @@ def tracker_curves(sky: Sky, study: Study, model: str | None = None, every: int 
         As :func:`sky_tracker_draw`'s (a cloud ensemble's members share their day's draw).
     """
     orientation = sky_tracker_orientation(sky, study, model)
-    return TrackerCurves(orientation, sky_tracker_power(sky, study, orientation),
-                         sky_tracker_draw(sky, study, orientation, every))
+    poa = sky_tracker_poa(sky, orientation)
+    draw = sky_tracker_draw(sky, study, orientation, every)
+    return TrackerCurves(orientation, engines.panel_power(sky, study, poa), draw, poa if sky.iam == "none" else None)
 
 
 def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
@@ -250,7 +269,10 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
                                outputs=("panel",), contiguous=True, engine=engine)
     tracker = tracker or tracker_curves(sky, study, every=blocks_of.members)
     orientation, gross, net = tracker.orientation, tracker.power, tracker.net
-    tracker_poa = energy(engines.poa(sky, *orientation[:2], incident=True, normal=orientation[2]), sky.step_hours)
+    incident = tracker.incident
+    if incident is None:
+        incident = engines.poa(sky, *orientation[:2], incident=True, normal=orientation[2])
+    tracker_poa = energy(incident, sky.step_hours)
     shape = sky.load_shape
     trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
                                      engine=engine,
