@@ -54,7 +54,7 @@ class Day:
         self.dhi = None if sky.dhi is None else sky.dhi[0]
         self.transposition = study.sky_transposition()
         self._trackers: dict = {}
-        self._last_connections: tuple = (None, None)
+        self._one_angle: dict = {}
 
     def _poa(self, surface_tilt, surface_azimuth, per_step=False):
         """Irradiance on surfaces [W/m^2]: one orientation per row, (k,) -> (k, n_time), or, with
@@ -154,16 +154,17 @@ class Day:
         state : numpy.ndarray of int or None
             (k, n_time) index into :data:`foldopt.physics.connections.SWITCH_STATES`.
         """
-        # The last call's curves are kept: the heuristic's root search ends on its angle, whose curve
-        # the summary's row then takes.
         fold_angles = np.atleast_1d(np.asarray(fold_angles, dtype=float))
         key = (fold_angles.tobytes(), series, with_state)
-        if self._last_connections[0] != key:
-            powers, state = engines.powers(self.sky, self.study, self.orientation(fold_angles), [0], series,
-                                           with_state)
-            powers.pop("panel")
-            self._last_connections = (key, (powers, state))
-        return self._last_connections[1]
+        if key in self._one_angle:
+            return self._one_angle[key]
+        powers, state = engines.powers(self.sky, self.study, self.orientation(fold_angles), [0], series, with_state)
+        powers.pop("panel")
+        if fold_angles.size == 1:
+            # One angle's curves are kept: the heuristic's root search evaluates its bracket twice
+            # and ends on its angle, whose curve the summary's row then takes.
+            self._one_angle[key] = powers, state
+        return powers, state
 
     def subpanel_power(self, fold_angles):
         """East and west sub-panel powers and their parallel connection [W], each (k, n_time).
@@ -311,7 +312,14 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
     # noon (the flat panel's peak).
     noon_load = p_load if shape is None else p_load * shape[int(np.argmax(p_flat))]
-    paper_angle = heuristic_fold_angle(day.subpanel_power, noon_load) if noon_load > 0 else np.nan
+
+    def subpanels(fold):
+        # An angle of the grid (the root search's bracket) from the grid's curves.
+        at = np.flatnonzero(angles == fold[0]) if fold.size == 1 else []
+        return (tuple(curves[name][at[:1]] for name in ("east", "west", "parallel")) if len(at)
+                else day.subpanel_power(fold))
+
+    paper_angle = heuristic_fold_angle(subpanels, noon_load) if noon_load > 0 else np.nan
 
     # The designs every study compares, each evaluated once, as for sweeps, annual studies and maps
     # (the study's tracker from the curve the figures draw); the others (the heuristic's angle, the

@@ -1,0 +1,52 @@
+"""A day's study evaluates each design once (issue 39, item 2): every tracker model, the heuristic's
+angle and each connection's refined angle; the figures draw the curves the table was reduced from."""
+
+import numpy as np
+
+from foldopt.api import load_study
+from foldopt.engine import rows as engines
+from foldopt.names import TRACKERS
+from foldopt.studies import designs
+from foldopt.studies.day import run_study
+
+
+def _recorded(monkeypatch, module, name):
+    """The arguments of every call of ``module.name`` from now on."""
+    calls, original = [], getattr(module, name)
+
+    def recording(*args, **kwargs):
+        calls.append((args, kwargs))
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(module, name, recording)
+    return calls
+
+
+def test_each_tracker_model_is_evaluated_once(monkeypatch, shin_study):
+    """The study's tracker was evaluated by Day and again by design_metrics (its draw three times)."""
+    orientations = _recorded(monkeypatch, designs, "sky_tracker_orientation")
+    draws = _recorded(monkeypatch, designs, "sky_tracker_draw")
+    result = run_study(shin_study)
+    assert len(orientations) == len(draws) == len(TRACKERS)
+    # The tracker curve the figures draw is the one the table's row was reduced from.
+    curve = engines.curve_metrics(result.timeseries["p_tracker_w"].to_numpy()[None], [shin_study.p_load],
+                                  result.day.step_hours, contiguous=True)
+    row = result.summary.set_index("design").loc["tracker"]
+    assert (curve.t_solar[0, 0, 0], curve.energy[0, 0]) == (row["t_solar_h"], row["energy_harvested_wh"])
+
+
+def test_no_angle_is_evaluated_twice(monkeypatch):
+    """No single fold angle's curves are worked out twice with the same connections: the heuristic's
+    bracket and angle, and each other connection's refined angle, were (an I-V model's study)."""
+    study = load_study("configs/shin2015-single-diode.yaml")
+    calls = _recorded(monkeypatch, engines, "powers")
+    result = run_study(study)
+    assert {"twofold-heuristic", "twofold-parallel", "twofold-series"} <= set(result.summary["design"])
+    seen = set()
+    for args, kwargs in calls:
+        orientation, series = np.asarray(args[2]), args[4] if len(args) > 4 else kwargs.get("series", True)
+        state = args[5] if len(args) > 5 else kwargs.get("with_state", False)
+        rows = {(row.tobytes(), series, state) for row in orientation}
+        if len(orientation) == 1:
+            assert not rows & seen, "one fold angle's curves worked out twice"
+        seen |= rows
