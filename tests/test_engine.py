@@ -59,8 +59,9 @@ def cases(draw):
         "step_min": draw(st.sampled_from([5, 10, 15])),
     })
     n_blocks = draw(st.integers(1, 2))
-    sites = [Site(latitude=draw(st.floats(-89, 89)), longitude=draw(st.floats(-180, 180)),
-                  altitude=draw(st.floats(0, 2000))) for _ in range(n_blocks)]
+    # Each site as a study decides it (its time zone the longitude's standard offset).
+    sites = [study.variant(site={"latitude": draw(st.floats(-89, 89)), "longitude": draw(st.floats(-180, 180)),
+                                 "altitude": draw(st.floats(0, 2000))}).site for _ in range(n_blocks)]
     dates = [dt.date(2025, 1, 1) + dt.timedelta(days=draw(st.integers(0, 364))) for _ in range(n_blocks)]
     angles = np.array(draw(st.lists(st.floats(1, 180), min_size=1, max_size=4)) + [180.0])
     loads = np.array(draw(st.lists(st.floats(0.01, 60), min_size=1, max_size=6)))
@@ -68,7 +69,7 @@ def cases(draw):
 
 
 def _rows(study, sites, angles):
-    resolved = [study.variant(site=site.model_dump()).resolved().panel for site in sites]
+    resolved = [study.variant(site=site.model_dump()).panel for site in sites]
     orientation = engine.fold_orientations(study, [p.tilt for p in resolved], [p.azimuth for p in resolved], angles)
     return np.repeat(np.arange(len(sites)), angles.size), orientation.reshape(-1, 4)
 
@@ -209,7 +210,8 @@ def test_kernel_incidence_angle_modifier_is_pvlibs(model):
 def test_blocks_of_many_sites_and_time_zones_equal_their_own_skies():
     study = make_study({"name": "s", "mode": "exact", "sky": "ineichen", "site": {"latitude": 0, "longitude": 0},
                         "date": "2025-01-01", "panel": {"area": 0.1}, "p_load": 1.0, "step_min": 10})
-    sites = [Site(latitude=-33.9, longitude=151.2, timezone="Australia/Sydney"), Site(latitude=52.5, longitude=13.4),
+    sites = [Site(latitude=-33.9, longitude=151.2, timezone="Australia/Sydney"),
+             Site(latitude=52.5, longitude=13.4, timezone="UTC+01:00"),
              Site(latitude=34.05, longitude=-118.25, timezone="America/Los_Angeles"),
              Site(latitude=-33.9, longitude=151.2, timezone="Australia/Sydney")]
     dates = [dt.date(2025, 3, 9), dt.date(2025, 6, 21), dt.date(2025, 11, 2), dt.date(2025, 12, 21)]
