@@ -36,7 +36,7 @@ def _t_solar(study, dates, angles):
     """t_solar [h] of every date x angle, (n_dates, n_angles), and the seconds it took."""
     start = time.perf_counter()
     sky = build_sky(study, [study.site] * len(dates), dates)
-    panel = study.resolved().panel
+    panel = study.panel
     orientation = engine.fold_orientations(study, [panel.tilt] * len(dates), [panel.azimuth] * len(dates), angles)
     rows = np.repeat(np.arange(len(dates)), angles.size)
     hours = engine.row_metrics(sky, study, rows, orientation.reshape(-1, 4), [study.p_load]).t_solar

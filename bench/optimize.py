@@ -47,7 +47,7 @@ def main() -> None:
         plan = foldopt.plan_request(base.data(), {"site": {"latitude": latitude, "longitude": longitude,
                                                            "timezone": timezone},
                                                   "date": args.days, "optimize": None}).plan
-        study = plan.base.resolved()
+        study = plan.base
         dates = dict(plan.axes)["date"]
         blocks = Blocks.of_dates(study, dates)
         parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(1)]

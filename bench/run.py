@@ -185,7 +185,7 @@ def pvlib_baseline(base, dates, voltage_points: int = 12):
     from foldopt.physics.geometry import subpanel_orientation
     from foldopt.physics.pvmodel import A300_CELL
 
-    site, panel, unit = base.site, base.resolved().panel, A300_CELL
+    site, panel, unit = base.site, base.panel, A300_CELL
     cells = panel.area / 2 / unit.area
     times = pd.DatetimeIndex(np.concatenate([
         pd.date_range(pd.Timestamp(d), periods=1440, freq="min", tz=site.timezone) + pd.Timedelta(seconds=30)

@@ -114,7 +114,7 @@ def test_a_study_built_in_python_has_its_files_read_by_the_api():
     study = foldopt.Study(**fields)
     assert study.site is None  # the file's site, unread
     with pytest.raises(foldopt.ConfigError, match="weather: the file is not read yet"):
-        study.resolved()
+        study.require_files()
     result = foldopt.run(study)
     assert (result.study.site.name, result.study.site.latitude) == ("GREENSBORO PIEDMONT TRIAD INT", 36.1)
     far = foldopt.Study(**fields, site={"latitude": 0.0, "longitude": 0.0})

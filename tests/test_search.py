@@ -143,7 +143,7 @@ STEP_MIN = 10.0
 def _objective(latitude, longitude, dates, loads, statistic):
     data = {**foldopt.default_study().data(), "mode": "exact", "sky": "ineichen", "step_min": STEP_MIN,
             "site": {"latitude": latitude, "longitude": longitude}, "geometry": "hinge"}
-    study = make_plan(data).base.resolved()
+    study = make_plan(data).base
     blocks = Blocks.of_dates(study, dates)
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(len(loads))]
     months = np.array([date.month for date in dates])

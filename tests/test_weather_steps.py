@@ -22,7 +22,7 @@ DAYS = [dt.date(2025, 1, 14), dt.date(2025, 4, 2), dt.date(2025, 7, 17), dt.date
 def weather_day():
     plan = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": 2.0,
                       "pv_model": "single-diode", "step_min": 5, "transposition": "perez"})
-    study = plan.base.resolved()
+    study = plan.base
     return study, build_sky(study, [study.site] * len(DAYS), DAYS)
 
 

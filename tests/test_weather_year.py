@@ -145,7 +145,7 @@ def test_cells_follow_the_air_temperature_through_the_day(greensboro):
     frame = read_weather(TMY3)
     temps = frame["temp_air"].to_numpy().reshape(365, 24)
     winds = frame["wind_speed"].to_numpy().reshape(365, 24)
-    assert study.resolved().temperature_model == "sapm"
+    assert study.temperature_model == "sapm"
     # Every step: the file's temperature and wind linear in time between its hour-ending stamps
     # (held before the first), plus SAPM's wind term (King et al. 2004, Eq. 11, open rack
     # glass/polymer: a = -3.56, b = -0.075) at the step's global light, against the tables' wind (the

@@ -437,22 +437,6 @@ class Study(StrictModel):
             data["site"]["horizon"].pop("points", None)
         return data
 
-    def resolved(self) -> Study:
-        """The study itself, resolved when it was validated; kept until the engine's callers are gone.
-
-        Returns
-        -------
-        Study
-            ``self``.
-
-        Raises
-        ------
-        foldopt.ConfigError
-            For a study whose files are unread (:meth:`require_files`).
-        """
-        self.require_files()
-        return self
-
     def require_files(self) -> None:
         """Refuse to run a study whose files are unread.
 
