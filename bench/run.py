@@ -50,8 +50,10 @@ def _study():
     from foldopt.inputs.load import default_study_path
     from foldopt.api import load_study
 
+    # The paper's beam-only Meinel sky, as the pvlib baseline of W3 computes it (exact mode's own
+    # default is Ineichen with diffuse light).
     return load_study(default_study_path()).variant(
-        pv_model="single-diode", connection="switching", mode="exact", geometry="hinge"
+        pv_model="single-diode", connection="switching", mode="exact", geometry="hinge", sky="meinel"
     )
 
 
