@@ -12,7 +12,7 @@ import typer
 
 from foldopt.cli.options import (EMBEDDED, OPTION_OF_FIELD, RESULTS, AngleStep, Area, Efficiency, Engine,
                                  OutputFormat, Overwrite, Quiet, Settings, check_choices, out_option, rename_fields,
-                                 step_min_option)
+                                 StepMin)
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError, WeatherError
 
@@ -43,7 +43,7 @@ def map_(
                                            "min | worst-month | pNN.")] = "mean",
     year: Annotated[int, typer.Option("--year", help="Year of the clear-sky days (or that a typical year stands "
                                       "for).")] = 2025,
-    step_min: Annotated[float | None, step_min_option()] = None,
+    step_min: StepMin = None,
     angle_step: AngleStep = None,
     fold_search: Annotated[bool, typer.Option("--fold-search", help="Search the fold angles (foldopt.engine.search) "
                                               "instead of evaluating every one: the same objectives within 0.01 h "

@@ -37,6 +37,8 @@ Efficiency = Annotated[float | None, typer.Option("--efficiency", help="PV effic
                                                                        "b-model panel's area).")]
 AngleStep = Annotated[float | None, typer.Option("--angle-step", help="Fold-angle grid step [deg] [default: the "
                                                                       "study's].")]
+StepMin = Annotated[float | None, typer.Option("--step-min", help="Time step [min], a divisor of 1440 [default: the "
+                                                                  "study's].")]
 Settings = Annotated[list[str] | None, typer.Option("--set", metavar="KEY=VALUE", help="Any study field (a dotted "
                                                     "key, a YAML value), e.g. --set pv_model=single-diode; "
                                                     "repeatable.")]
@@ -56,21 +58,6 @@ def out_option(shown: str | None = None) -> typer.models.OptionInfo:
     typer.models.OptionInfo
     """
     return typer.Option("--out", help=f"Results folder{f' [default: {shown}]' if shown else ''}.")
-
-
-def step_min_option(shown: str = "the study's") -> typer.models.OptionInfo:
-    """The ``--step-min`` option: the time step.
-
-    Parameters
-    ----------
-    shown : str
-        The default as the help text gives it (``foldopt map`` has its own).
-
-    Returns
-    -------
-    typer.models.OptionInfo
-    """
-    return typer.Option("--step-min", help=f"Time step [min], a divisor of 1440 [default: {shown}].")
 
 
 def study_argument(kind: str = "") -> typer.models.ArgumentInfo:

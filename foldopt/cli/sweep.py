@@ -14,7 +14,7 @@ import typer
 
 from foldopt import names
 from foldopt.cli.options import (EMBEDDED, RESULTS, AngleStep, Area, Efficiency, Engine, OutputFormat, Overwrite,
-                                 Quiet, Settings, Table, check_choices, out_option, rename_fields, step_min_option)
+                                 Quiet, Settings, Table, check_choices, out_option, rename_fields, StepMin)
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
 from foldopt.errors import ConfigError
@@ -110,7 +110,7 @@ def sweep_options(
     temp_air: Annotated[float | None, typer.Option("--temp-air", help="Air temperature [C] (I-V models).")] = None,
     exact_electrical: Annotated[bool, typer.Option("--exact-electrical", help="Solve every step's I-V curves "
                                                    "instead of the tables (slow).")] = False,
-    step_min: Annotated[float | None, step_min_option()] = None,
+    step_min: StepMin = None,
     angle_step: AngleStep = None,
     settings: Settings = None,
     out: Annotated[Path | None, out_option()] = None,
