@@ -1,5 +1,6 @@
 """A day's study evaluates each design once (issue 39, item 2): every tracker model, the heuristic's
-angle and each connection's refined angle; the figures draw the curves the table was reduced from."""
+angle and each connection's refined angle; the figures draw the curves the table was reduced from.
+A map evaluates its flat panel once."""
 
 import numpy as np
 
@@ -8,6 +9,7 @@ from foldopt.engine import rows as engines
 from foldopt.names import TRACKERS
 from foldopt.studies import designs
 from foldopt.studies.day import run_study
+from foldopt.studies.worldmap import evaluate_sites, map_study
 
 
 def _recorded(monkeypatch, module, name):
@@ -50,3 +52,15 @@ def test_no_angle_is_evaluated_twice(monkeypatch):
         if len(orientation) == 1:
             assert not rows & seen, "one fold angle's curves worked out twice"
         seen |= rows
+
+
+def test_a_map_evaluates_its_flat_panel_once(monkeypatch):
+    """A map in watts took its flat peak from a pass of its own, then evaluated the flat panel
+    again with the loads (site_designs); its rows' flat peak is now that pass's."""
+    study = map_study({"name": "coarse", "panel": {"area": 0.108, "efficiency": 0.1905}, "p_load": 2.0,
+                       "pv_model": "ideal"}, fold_angles={"start": 10, "stop": 180, "step": 10}, step_min=30.0)
+    calls = _recorded(monkeypatch, engines, "row_metrics")
+    table = evaluate_sites(study, [{"latitude": 34.05, "longitude": -118.25}], [1.0, 4.0])
+    flat = [kwargs for _, kwargs in calls if kwargs.get("outputs") == ("panel",)]
+    assert len(flat) == 1
+    assert table["flat_peak_w"].gt(0).all()

@@ -348,6 +348,8 @@ class DailyDesigns:
         (days, loads); the tracker net of its own draw; the flat panel at the site's mounting.
     flat_wh, tracker_wh : numpy.ndarray
         (days,); the tracker's gross harvest.
+    flat_peak_w : numpy.ndarray
+        (days,) the flat panel's peak power [W].
     available : numpy.ndarray
         (days, steps) [W]: the tracker's power left for the load and a standby draw
         (:func:`standby_available`).
@@ -367,6 +369,7 @@ class DailyDesigns:
     tracker_net_h: np.ndarray
     tracker_wh: np.ndarray
     available: np.ndarray
+    flat_peak_w: np.ndarray
     tilts: np.ndarray | None = None
     flat_tilted: tuple | None = None
 
@@ -418,7 +421,7 @@ def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
     if fold is None:
         fold = _every_angle
     searched = fold(parts, sites, loads, loadset, engine)
-    flat, flat_energy, tracker, available = [], [], [], []
+    flat, flat_energy, flat_peak, tracker, available = [], [], [], [], []
     start = 0
     for chunk, sky in parts:
         rows = slice(start, start + sky.n_blocks)
@@ -427,17 +430,19 @@ def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
             chunk.tilt, chunk.azimuth), loads, loadset[rows], outputs=("panel",), engine=engine)
         flat.append(metrics.t_solar[:, 0])
         flat_energy.append(metrics.energy[:, 0])
+        flat_peak.append(metrics.peak[:, 0])
         curves = tracker_curves(sky, study)
         both = engines.curve_metrics(np.concatenate([curves.power, curves.net]), loads, sky.step_hours,
                                      np.concatenate([loadset[rows], loadset[rows]]), engine=engine)
         tracker.append((both.t_solar[:sky.n_blocks, 0], both.t_solar[sky.n_blocks:, 0], both.energy[:sky.n_blocks, 0]))
         available.append(standby_available(curves.power, curves.draw, sky.lit, study.tracker.standby_w))
     gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
-    flat, flat_energy, available = np.concatenate(flat), np.concatenate(flat_energy), np.concatenate(available)
+    flat, flat_energy, flat_peak, available = (np.concatenate(values) for values in (flat, flat_energy, flat_peak,
+                                                                                     available))
     tilted = any(flat_tilted is not None for *_, flat_tilted in searched)
     return [DailyDesigns(points[:, 0], hours, energy, flat[blocks], flat_energy[blocks], gross_h[blocks],
-                         net_h[blocks], gross_wh[blocks], available[blocks], points[:, 1] if tilted else None,
-                         flat_tilted)
+                         net_h[blocks], gross_wh[blocks], available[blocks], flat_peak[blocks],
+                         points[:, 1] if tilted else None, flat_tilted)
             for blocks, (points, hours, energy, flat_tilted) in zip(sites, searched, strict=True)]
 
 

@@ -417,10 +417,15 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     sites = [range(first, stop) for first, stop in zip(starts[:-1], starts[1:], strict=True)]
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
     step_hours = parts[0][1].step_hours
-    peak = np.concatenate([engines.row_metrics(sky, study, np.arange(sky.n_blocks),
-                                               engines.flat_orientation(chunk.tilt, chunk.azimuth), [1.0],
-                                               outputs=("panel",), engine=engine).peak[:, 0] for chunk, sky in parts])
-    flat_peak = np.array([float(peak[days].max()) for days in sites])
+    flat_peak = None
+    if relative:
+        # Loads as fractions of each site's flat peak over all its days: the flat panel's pass for
+        # its peak comes before the loads, and site_designs' flat pass needs them.
+        peak = np.concatenate([engines.row_metrics(sky, study, np.arange(sky.n_blocks),
+                                                   engines.flat_orientation(chunk.tilt, chunk.azimuth), [1.0],
+                                                   outputs=("panel",), engine=engine).peak[:, 0]
+                               for chunk, sky in parts])
+        flat_peak = np.array([float(peak[days].max()) for days in sites])
     watts = loads[None, :] * flat_peak[:, None] if relative else np.broadcast_to(loads, (len(batch), loads.size))
     # A load of 0 W (a site whose flat panel never sees the sun) has no t_solar to speak of.
     usable = np.where(watts > 0, watts, np.inf)
@@ -431,6 +436,9 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h,
                                                    _tilt_axis(search))
     designs = site_designs(parts, sites, usable, engine, fold)
+    if flat_peak is None:
+        # Loads in watts: the peak of the flat panel's one pass, the one its rows come from.
+        flat_peak = np.array([float(days_of.flat_peak_w.max()) for days_of in designs])
     columns: dict[str, list] = {}
     for (site, here, _), days_of, site_months, peak_w, site_watts, site_usable in zip(
             batch, designs, months, flat_peak, watts, usable, strict=True):
