@@ -64,3 +64,16 @@ def test_a_map_evaluates_its_flat_panel_once(monkeypatch):
     flat = [kwargs for _, kwargs in calls if kwargs.get("outputs") == ("panel",)]
     assert len(flat) == 1
     assert table["flat_peak_w"].gt(0).all()
+
+
+def test_the_figures_draw_the_curves_the_table_was_reduced_from(shin_study):
+    """The time series' flat and twofold curves (the figures') were the reference path's while the
+    table's rows were the kernel's: each row's metrics are now those of its drawn curve."""
+    result = run_study(shin_study)
+    series, row = result.timeseries, result.summary.set_index("design")
+    span = result.day.sky.kernel_layout(False)[4]
+    for design, column in (("flat", "p_flat_w"), ("twofold", "p_twofold_w")):
+        curve = engines.curve_metrics(series[column].to_numpy()[None], [shin_study.p_load], result.day.step_hours,
+                                      contiguous=True, span=span)
+        assert (curve.t_solar[0, 0, 0], curve.energy[0, 0], curve.peak[0, 0]) == (
+            row.loc[design, "t_solar_h"], row.loc[design, "energy_harvested_wh"], row.loc[design, "peak_power_w"])

@@ -310,7 +310,8 @@ def fold_rows(sky, rows, tables, loads, out, scratch):
     loads : foldopt.engine.records.Loads
         The loads (and load profiles) and the step length.
     out : foldopt.engine.records.Outputs
-        t_solar (and its longest contiguous interval), energy, peak power and irradiation (out).
+        t_solar (and its longest contiguous interval), energy, peak power and irradiation, and the
+        power curves of the rows that keep them (out).
     scratch : foldopt.engine.records.Scratch
         Per-chunk scratch (:func:`foldopt.engine.records.allocate`).
     """
@@ -332,9 +333,10 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     their mean incident irradiance before the incidence-angle modifier. The second writes every asked
     connection's power to ``work.power[c, step]``: from the tables (:func:`_table_row`), for the ideal
     model from :func:`_linear_connections`, or with the circuit as built from :func:`_built_row`,
-    through :func:`_built_power`. The third reduces each power curve to the daily metrics. The row's
-    work is inlined here rather than called: a call with the kernel's some thirty arrays cost about
-    190 ns a row, a quarter of a map row's time at 30-min steps (some 12 % at 5-min steps)."""
+    through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
+    third reduces each power curve to the daily metrics. The row's work is inlined here rather than
+    called: a call with the kernel's some thirty arrays cost about 190 ns a row, a quarter of a map
+    row's time at 30-min steps (some 12 % at 5-min steps)."""
     connections = tables.connections
     n_conn = connections.shape[0]
     with_tables = tables.linear_power == 0.0
@@ -353,6 +355,8 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
             _linear_connections(first, n, tables, work)
         else:
             _table_row(b, first, last, sky, tables, need_series, work)
+        if rows.curve[r] >= 0:
+            out.power[rows.curve[r], :, first:last + 1] = work.power[:, first:last + 1]
         p_load, profile = loads.p_load[rows.loadset[r]], loads.profile[b if loads.use_profile else 0]
         for c in range(n_conn):
             out.energy[r, c], out.peak[r, c] = day_metrics(

@@ -77,6 +77,9 @@ class Rows(NamedTuple):
         Per sub-panel, the factors of the isotropic and the horizon-band diffuse terms:
         (1 + cos tilt) / 2 and sin tilt, less what the site's horizon hides
         (:func:`foldopt.physics.horizon.sky_view_factors`).
+    curve : (n_rows,) int
+        Where each row's power curves go in :attr:`Outputs.power`; -1 for a row whose curves are
+        not kept.
     """
 
     block: np.ndarray
@@ -84,6 +87,7 @@ class Rows(NamedTuple):
     paper: np.ndarray
     sky_view: np.ndarray
     loadset: np.ndarray
+    curve: np.ndarray
 
 
 class Tables(NamedTuple):
@@ -179,6 +183,9 @@ class Outputs(NamedTuple):
     irradiation : (n_rows,) float
         Incident plane-of-array irradiation [Wh/m^2] (before the incidence-angle modifier), the
         mean of the two (equal) sub-panels; empty for given power curves.
+    power : (n_curves, n_conn, n_steps) float
+        The power [W] at every step of the rows whose curves are kept (:attr:`Rows.curve`), the
+        curves the metrics were reduced from (zero outside the lit span); (0, n_conn, 0) for none.
     """
 
     t_solar: np.ndarray
@@ -186,6 +193,7 @@ class Outputs(NamedTuple):
     energy: np.ndarray
     peak: np.ndarray
     irradiation: np.ndarray
+    power: np.ndarray
 
 
 class Scratch(NamedTuple):
@@ -222,7 +230,8 @@ class Scratch(NamedTuple):
     run: np.ndarray
 
 
-def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: bool) -> tuple[Outputs, Scratch]:
+def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: bool,
+             n_curves: int = 0) -> tuple[Outputs, Scratch]:
     """Outputs and per-chunk scratch of :func:`foldopt.engine.kernel.fold_rows` or
     :func:`foldopt.engine.reduce.curve_rows`, allocated here, outside the parallel loop.
 
@@ -234,6 +243,8 @@ def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: b
         Steps per day for ``fold_rows``; 0 for ``curve_rows`` (which reads no irradiance).
     contiguous : bool
         Whether the longest contiguous interval is tracked.
+    n_curves : int, default 0
+        Rows whose power curves ``fold_rows`` keeps (:attr:`Rows.curve`).
 
     Returns
     -------
@@ -245,7 +256,8 @@ def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: b
     shape = (n_rows, n_conn)
     out = Outputs(t_solar=np.empty(shape + (n_loads,)),
                   t_solar_contiguous=np.zeros(shape + (n_loads,)) if contiguous else np.zeros((1, n_conn, n_loads)),
-                  energy=np.empty(shape), peak=np.empty(shape), irradiation=np.empty(n_rows if n_steps else 0))
+                  energy=np.empty(shape), peak=np.empty(shape), irradiation=np.empty(n_rows if n_steps else 0),
+                  power=np.zeros((n_curves, n_conn, n_steps if n_curves else 0)))
     light = [np.zeros((chunks, n_steps)) for _ in range(5)]
     scratch = Scratch(*light, power=np.zeros((chunks, n_conn if n_steps else 0, n_steps)),
                       above=np.zeros((chunks, n_loads)), whole=np.zeros((chunks, n_loads + 1)),

@@ -57,6 +57,9 @@ class RowMetrics:
     irradiation : numpy.ndarray or None
         (n_rows,) plane-of-array irradiation [Wh/m^2], the mean of the two sub-panels (rows of orientations;
         None for given power curves).
+    power : numpy.ndarray or None
+        (n_curves, n_outputs, n_steps) [W]: the power curves the metrics of the rows asked for
+        (:func:`row_metrics`' ``curves``) were reduced from; None where none were.
     """
 
     t_solar: np.ndarray
@@ -64,6 +67,7 @@ class RowMetrics:
     energy: np.ndarray
     peak: np.ndarray
     irradiation: np.ndarray | None = None
+    power: np.ndarray | None = None
 
 
 def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> np.ndarray:
@@ -201,7 +205,7 @@ def _unsort(values, order, row_loadset):
 
 def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loadset=None,
                 outputs=("switching",), contiguous: bool = False, engine: str = "numba",
-                row_orientation=None) -> RowMetrics:
+                row_orientation=None, curves=None) -> RowMetrics:
     """Daily metrics of rows of panel orientations over a sky.
 
     Parameters
@@ -226,6 +230,9 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     row_orientation : array_like of int, optional
         (n_rows,) each row's orientation in ``orientation``: a few orientations over many blocks
         (the angles of a search over a year's days) are then worked out once each.
+    curves : array_like of int, optional
+        Rows whose power curves to keep (``RowMetrics.power``, in this order): the curves their
+        metrics were reduced from, for a report to draw.
 
     Returns
     -------
@@ -247,13 +254,16 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
     row_loadset = np.zeros(row_block.size, dtype=np.int64) if row_loadset is None else np.asarray(
         row_loadset, dtype=np.int64)
     loads = _loads(sorted_loads, sky.load_shape, contiguous, sky.step_hours)
+    curve = np.full(row_block.size, -1, dtype=np.int64)
+    if curves is not None:
+        curve[np.asarray(curves, dtype=np.int64)] = np.arange(np.size(curves))
     if engine == "numpy" or study.exact_electrical:
-        result = _reference(sky, study, row_block, orientation[row_orientation], loads, row_loadset, outputs)
+        result = _reference(sky, study, row_block, orientation[row_orientation], loads, row_loadset, outputs, curve)
     else:
         nodes, table, weight = temperature_nodes(sky)
         electricals = [electrical_for(study, temp, sky.wind_ref) for temp in nodes]
         result = _compiled(sky, study, electricals, (table, weight), row_block, orientation, row_orientation,
-                           loads, row_loadset, outputs)
+                           loads, row_loadset, outputs, curve)
     return _in_caller_order(result, order, row_loadset)
 
 
@@ -261,7 +271,7 @@ def _in_caller_order(result: RowMetrics, order, row_loadset) -> RowMetrics:
     contiguous = result.t_solar_contiguous
     return RowMetrics(_unsort(result.t_solar, order, row_loadset),
                       None if contiguous is None else _unsort(contiguous, order, row_loadset),
-                      result.energy, result.peak, result.irradiation)
+                      result.energy, result.peak, result.irradiation, result.power)
 
 
 def _curve_reference(power, row_loads, profile, loads: Loads):
@@ -341,11 +351,13 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
     return {**out, **connected, "panel": parts["panel"]}, state
 
 
-def _reference(sky, study, row_block, orientation, loads: Loads, row_loadset, outputs):
+def _reference(sky, study, row_block, orientation, loads: Loads, row_loadset, outputs, curve):
     n_rows, n_loads, contiguous = row_block.size, loads.p_load.shape[1], loads.contiguous
     shape = (n_rows, len(outputs))
+    kept = int((curve >= 0).sum())
     out = RowMetrics(np.zeros(shape + (n_loads,)), np.zeros(shape + (n_loads,)) if contiguous else None,
-                     np.zeros(shape), np.zeros(shape), np.zeros(n_rows))
+                     np.zeros(shape), np.zeros(shape), np.zeros(n_rows),
+                     np.zeros((kept, len(outputs), sky.dni.shape[1])) if kept else None)
     series = "series" in outputs or study.switch_series
     step = sky.step_hours
     for block in np.unique(row_block):
@@ -359,6 +371,9 @@ def _reference(sky, study, row_block, orientation, loads: Loads, row_loadset, ou
             out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = hours, harvested, peak
             if contiguous:
                 out.t_solar_contiguous[rows, index] = runs
+            keep = curve[rows] >= 0
+            if keep.any():
+                out.power[curve[rows][keep], index] = curves[name][keep]
     return out
 
 
@@ -394,7 +409,7 @@ def _tables(electricals, outputs, study, codes) -> Tables:
 
 
 def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_orientation, loads, row_loadset,
-              outputs):
+              outputs, curve):
     from foldopt.engine import kernel
 
     codes = np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64)
@@ -417,11 +432,13 @@ def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_
     rows = Rows(block=np.ascontiguousarray(row_block), normal=np.ascontiguousarray(normals[row_orientation]),
                 paper=np.ascontiguousarray(row_paper),
                 sky_view=np.ascontiguousarray(row_views(sky, row_block, normals, orientation, row_orientation)),
-                loadset=np.ascontiguousarray(row_loadset))
-    out, scratch = allocate(row_block.size, codes.size, loads.p_load.shape[1], sky.dni.shape[1], loads.contiguous)
+                loadset=np.ascontiguousarray(row_loadset), curve=curve)
+    kept = int((curve >= 0).sum())
+    out, scratch = allocate(row_block.size, codes.size, loads.p_load.shape[1], sky.dni.shape[1], loads.contiguous,
+                            kept)
     kernel.fold_rows(light, rows, _tables(electricals, outputs, study, codes), loads, out, scratch)
     return RowMetrics(out.t_solar, out.t_solar_contiguous if loads.contiguous else None, out.energy, out.peak,
-                      out.irradiation)
+                      out.irradiation, out.power if kept else None)
 
 
 def power_span(power) -> np.ndarray:

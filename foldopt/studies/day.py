@@ -308,7 +308,15 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
         sweep[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
 
     best_angle, best_hours = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
-    p_flat, tracker = day.flat_power(), day.tracker()
+    # The designs every study compares, each evaluated once, as for sweeps, annual studies and maps
+    # (the study's tracker from the curve the figures draw); the others (the heuristic's angle, the
+    # other connections, the other trackers) from their curves. The figures and the time series
+    # draw the curves the flat and twofold rows were reduced from.
+    tracker = day.tracker()
+    main = design_metrics(day.sky, Blocks.of([study]), np.array([p_load]), np.array([best_angle]),
+                          np.zeros((1, 1), dtype=int), engine, tracker, curves=True)
+    drawn = main.pop("curves")
+    p_flat = drawn["flat"][0]
     # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
     # noon (the flat panel's peak).
     noon_load = p_load if shape is None else p_load * shape[int(np.argmax(p_flat))]
@@ -321,11 +329,6 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
 
     paper_angle = heuristic_fold_angle(subpanels, noon_load) if noon_load > 0 else np.nan
 
-    # The designs every study compares, each evaluated once, as for sweeps, annual studies and maps
-    # (the study's tracker from the curve the figures draw); the others (the heuristic's angle, the
-    # other connections, the other trackers) from their curves.
-    main = design_metrics(day.sky, Blocks.of([study]), np.array([p_load]), np.array([best_angle]),
-                          np.zeros((1, 1), dtype=int), engine, tracker)
     others = {}
     if np.isfinite(paper_angle):
         others["twofold-heuristic"] = (paper_angle, day.combined_power(np.array([paper_angle]))[0])
@@ -372,7 +375,9 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
                             summary["t_solar_h"].to_numpy())
     standby = standby_sweep(day, tracker.power[0], by_design["twofold"])
 
-    at_best, state = day.connections(np.array([best_angle]))
+    at_best = {connection: drawn[connection][0, 0] for connection in CONNECTIONS}
+    # The state switching chose (no table's number comes from it) from the reference path's parts.
+    state = day.connections(np.array([best_angle]))[1][0]
     timeseries = pd.DataFrame(
         {
             "solar_zenith": day.solar_zenith,
@@ -384,9 +389,9 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
                          else np.full(day.dni.shape, day.sky.temp_air[0])),
             **({"wind_speed": day.sky.wind_speed[0]} if day.sky.wind_speed is not None else {}),
             "p_flat_w": p_flat,
-            **{f"p_{connection}_w": at_best[connection][0] for connection in CONNECTIONS},
-            "p_twofold_w": at_best[study.connection][0],
-            "switch_state": np.where(at_best["switching"][0] > 0, np.array(SWITCH_STATES)[state[0]], "off"),
+            **{f"p_{connection}_w": at_best[connection] for connection in CONNECTIONS},
+            "p_twofold_w": at_best[study.connection],
+            "switch_state": np.where(at_best["switching"] > 0, np.array(SWITCH_STATES)[state], "off"),
             "p_tracker_w": tracker.power[0],
             "p_load_w": p_load if shape is None else p_load * shape,
         },

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from foldopt.engine import rows as engines
+from foldopt.physics.connections import CONNECTIONS
 from foldopt.engine.incidence import turning_poa
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
@@ -225,7 +226,8 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
 
 
 def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
-                   tracker: TrackerCurves | None = None, twofold_curves: dict | None = None) -> dict:
+                   tracker: TrackerCurves | None = None, twofold_curves: dict | None = None,
+                   curves: bool = False) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
     panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net.
 
@@ -248,13 +250,18 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
         by the grid index every block of a load has, as far as the caller has them (an annual
         group's day x hour maps draw one); those worked out here are added. Loads that share an
         angle share its curve.
+    curves : bool, default False
+        Also the power curves [W] the flat and twofold rows were reduced from, for a report to
+        draw: the twofold panel's then of every connection at its chosen angle.
 
     Returns
     -------
     dict of numpy.ndarray
         ``fold_angle_deg``, the :func:`foldopt.engine.metrics.metric_columns`, ``poa_kwh_m2`` (incident
         irradiation [kWh/m^2]) and ``condition`` (:func:`foldopt.engine.metrics.design_condition`), each
-        (n_blocks, n_loads, 4) in the order of :data:`DESIGNS`.
+        (n_blocks, n_loads, 4) in the order of :data:`DESIGNS`; with ``curves``, also ``curves``: a
+        dict of ``flat``, (n_blocks, n_steps), and of each name of
+        :data:`foldopt.physics.connections.CONNECTIONS`, (n_blocks, n_loads, n_steps).
     """
     study, blocks_of = blocks.study, blocks
     n_blocks, n_loads = sky.n_blocks, loads.size
@@ -262,11 +269,14 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     every = engines.fold_orientations(study, tilt, azimuth, angles)
     blocks = np.repeat(np.arange(n_blocks), n_loads)
     # One row per block and load, at that load's angle, with the load alone.
+    outputs = CONNECTIONS if curves else (study.connection,)
+    own = outputs.index(study.connection)
     twofold = engines.row_metrics(sky, study, blocks, every[blocks, chosen.ravel()], loads[:, None],
-                                  np.tile(np.arange(n_loads), n_blocks), outputs=(study.connection,),
-                                  contiguous=True, engine=engine)
+                                  np.tile(np.arange(n_loads), n_blocks), outputs=outputs, contiguous=True,
+                                  engine=engine, curves=np.arange(blocks.size) if curves else None)
     flat = engines.row_metrics(sky, study, np.arange(n_blocks), engines.flat_orientation(tilt, azimuth), loads,
-                               outputs=("panel",), contiguous=True, engine=engine)
+                               outputs=("panel",), contiguous=True, engine=engine,
+                               curves=np.arange(n_blocks) if curves else None)
     tracker = tracker or tracker_curves(sky, study, every=blocks_of.members)
     orientation, gross, net = tracker.orientation, tracker.power, tracker.net
     incident = tracker.incident
@@ -282,25 +292,26 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
         return np.stack([flat_values, twofold_values.reshape(n_blocks, n_loads), tracker_values[:n_blocks],
                          tracker_values[n_blocks:]], axis=-1)
 
-    hours = per_design(twofold.t_solar[:, 0, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
+    hours = per_design(twofold.t_solar[:, own, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
     served = None
     if shape is not None:
         # A load profile's served energy integrates P_load(t) over the solar-powered time: from the curves.
         step = sky.step_hours
-        curves = {} if twofold_curves is None else twofold_curves
+        known = {} if twofold_curves is None else twofold_curves
 
         def curve(index):
             column = chosen[:, index]
             key = int(column[0]) if (column == column[0]).all() else None
-            if key not in curves:
+            if key not in known:
                 power = engines.powers(sky, study, every[np.arange(n_blocks), column],
                                        series=study.switch_series)[0][study.connection]
                 if key is None:
                     return power
-                curves[key] = power
-            return curves[key]
+                known[key] = power
+            return known[key]
 
-        twofold_served = np.stack([energy_served(curve(index), load, shape, step, twofold.t_solar[index::n_loads, 0, 0])
+        twofold_served = np.stack([energy_served(curve(index), load, shape, step,
+                                                 twofold.t_solar[index::n_loads, own, 0])
                                    for index, load in enumerate(loads)], 1)
         flat_curve = engines.powers(sky, study, engines.flat_orientation(tilt, azimuth), series=False)[0]["panel"]
         served = np.stack([energy_served(flat_curve, loads, shape, step, flat.t_solar[:, 0]), twofold_served,
@@ -310,11 +321,11 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
                      np.full((n_blocks, n_loads), np.nan)], axis=-1)
     columns = metric_columns(
         hours,
-        per_design(twofold.t_solar_contiguous[:, 0, 0], flat.t_solar_contiguous[:, 0],
+        per_design(twofold.t_solar_contiguous[:, own, 0], flat.t_solar_contiguous[:, 0],
                    trackers.t_solar_contiguous[:, 0]),
-        per_design(twofold.energy[:, 0], np.repeat(flat.energy, n_loads, axis=1),
+        per_design(twofold.energy[:, own], np.repeat(flat.energy, n_loads, axis=1),
                    np.repeat(trackers.energy, n_loads, axis=1)),
-        per_design(twofold.peak[:, 0], np.repeat(flat.peak, n_loads, axis=1),
+        per_design(twofold.peak[:, own], np.repeat(flat.peak, n_loads, axis=1),
                    np.repeat(trackers.peak, n_loads, axis=1)),
         loads[None, :, None],
         served,
@@ -322,6 +333,8 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     # Every design here is wired as the study's circuit says: a load beyond the panel's reach, every one.
     reach = engines.electrical_for(study, sky.temp_air[0], sky.wind_ref).beyond_reach
     condition = np.array(["; ".join(filter(None, (reach, day))) for day in sky.conditions()], dtype=object)
+    drawn = {} if not curves else {"curves": {"flat": flat.power[:, 0], **{
+        name: twofold.power[:, index].reshape(n_blocks, n_loads, -1) for index, name in enumerate(outputs)}}}
     return {
         "fold_angle_deg": fold,
         **columns,
@@ -329,6 +342,7 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
                                  np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
         # A tracker whose drive costs more than it harvests says so where every table's note starts.
         "condition": design_condition(condition[:, None, None], columns["energy_harvested_wh"]),
+        **drawn,
     }
 
 
