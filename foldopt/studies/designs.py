@@ -226,8 +226,7 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
 
 
 def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
-                   tracker: TrackerCurves | None = None, twofold_curves: dict | None = None,
-                   curves: bool = False) -> dict:
+                   tracker: TrackerCurves | None = None, curves: bool = False) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
     panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net.
 
@@ -245,11 +244,6 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     tracker : TrackerCurves, optional
         The study's tracker over ``sky``, where the caller has it (a day's study draws it too);
         default worked out here (:func:`tracker_curves`).
-    twofold_curves : dict, optional
-        Under a load profile, the twofold panel's power [W] over every block, (n_blocks, n_steps),
-        by the grid index every block of a load has, as far as the caller has them (an annual
-        group's day x hour maps draw one); those worked out here are added. Loads that share an
-        angle share its curve.
     curves : bool, default False
         Also the power curves [W] the flat and twofold rows were reduced from, for a report to
         draw: the twofold panel's then of every connection at its chosen angle.
@@ -268,22 +262,24 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     tilt, azimuth = blocks.tilt, blocks.azimuth
     every = engines.fold_orientations(study, tilt, azimuth, angles)
     blocks = np.repeat(np.arange(n_blocks), n_loads)
-    # One row per block and load, at that load's angle, with the load alone.
+    shape = sky.load_shape
+    # One row per block and load, at that load's angle, with the load alone; the curves kept where
+    # asked for and where a load profile's served energy integrates over them.
     outputs = CONNECTIONS if curves else (study.connection,)
     own = outputs.index(study.connection)
+    keep = curves or shape is not None
     twofold = engines.row_metrics(sky, study, blocks, every[blocks, chosen.ravel()], loads[:, None],
                                   np.tile(np.arange(n_loads), n_blocks), outputs=outputs, contiguous=True,
-                                  engine=engine, curves=np.arange(blocks.size) if curves else None)
+                                  engine=engine, curves=np.arange(blocks.size) if keep else None)
     flat = engines.row_metrics(sky, study, np.arange(n_blocks), engines.flat_orientation(tilt, azimuth), loads,
                                outputs=("panel",), contiguous=True, engine=engine,
-                               curves=np.arange(n_blocks) if curves else None)
+                               curves=np.arange(n_blocks) if keep else None)
     tracker = tracker or tracker_curves(sky, study, every=blocks_of.members)
     orientation, gross, net = tracker.orientation, tracker.power, tracker.net
     incident = tracker.incident
     if incident is None:
         incident = engines.poa(sky, *orientation[:2], incident=True, normal=orientation[2])
     tracker_poa = energy(incident, sky.step_hours)
-    shape = sky.load_shape
     trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
                                      engine=engine,
                                      load_shape=None if shape is None else np.concatenate([shape, shape]))
@@ -295,26 +291,13 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     hours = per_design(twofold.t_solar[:, own, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
     served = None
     if shape is not None:
-        # A load profile's served energy integrates P_load(t) over the solar-powered time: from the curves.
+        # A load profile's served energy integrates P_load(t) over the solar-powered time: from the
+        # curves the rows' t_solar were reduced from.
         step = sky.step_hours
-        known = {} if twofold_curves is None else twofold_curves
-
-        def curve(index):
-            column = chosen[:, index]
-            key = int(column[0]) if (column == column[0]).all() else None
-            if key not in known:
-                power = engines.powers(sky, study, every[np.arange(n_blocks), column],
-                                       series=study.switch_series)[0][study.connection]
-                if key is None:
-                    return power
-                known[key] = power
-            return known[key]
-
-        twofold_served = np.stack([energy_served(curve(index), load, shape, step,
+        twofold_served = np.stack([energy_served(twofold.power[index::n_loads, own], load, shape, step,
                                                  twofold.t_solar[index::n_loads, own, 0])
                                    for index, load in enumerate(loads)], 1)
-        flat_curve = engines.powers(sky, study, engines.flat_orientation(tilt, azimuth), series=False)[0]["panel"]
-        served = np.stack([energy_served(flat_curve, loads, shape, step, flat.t_solar[:, 0]), twofold_served,
+        served = np.stack([energy_served(flat.power[:, 0], loads, shape, step, flat.t_solar[:, 0]), twofold_served,
                            energy_served(gross, loads, shape, step, trackers.t_solar[:n_blocks, 0]),
                            energy_served(net, loads, shape, step, trackers.t_solar[n_blocks:, 0])], axis=-1)
     fold = np.stack([np.full((n_blocks, n_loads), 180.0), angles[chosen], np.full((n_blocks, n_loads), np.nan),

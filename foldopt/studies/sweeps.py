@@ -190,10 +190,8 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
                                        with_state=True)
         series["p_twofold_w"].append(powers[study.connection])
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
-        # Without members the maps' curve is every day's: a load profile's served energy takes it too.
-        drawn = {int(fixed[0]): powers[study.connection]} if members == 1 else None
         metrics.append(design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
-                                      engine, twofold_curves=drawn))
+                                      engine))
         advance(len(chunk) // members)
     clock = skies[0].grid.clock_hours[0]
     design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (blocks, loads, designs)
