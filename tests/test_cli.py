@@ -62,6 +62,37 @@ def test_run_default_study_writes_the_whole_folder(tmp_path):
     assert str(out) in result.stdout and "sweep.csv" not in result.stdout
 
 
+def test_the_answer_comes_before_the_folder_and_a_failing_folder_still_fails(tmp_path, fast_config, monkeypatch):
+    """The figures and report take most of a warm run: the answer's lines are printed before the
+    folder is written, and a folder that cannot be written is still one error line and code 2;
+    the JSON document, which a program reads, only with its folder."""
+    from foldopt import api
+    from foldopt.errors import OutputError
+
+    seen = []
+
+    def write(result, out, *args):
+        seen.append(runner_stdout())
+        raise OutputError(f"cannot write {out}: disk full")
+
+    monkeypatch.setattr(api, "write", write)
+    for output_format, printed in (("table", True), ("json", False)):
+        seen.clear()
+        result = runner.invoke(app, ["run", str(fast_config), "--out", str(tmp_path / "o"), "--format",
+                                     output_format])
+        assert_one_line_error(result, "disk full")
+        assert ("best fold angle" in result.stdout) is printed and "wrote" not in result.stdout
+        assert seen == [printed] and not (tmp_path / "o").exists()
+
+
+def runner_stdout() -> bool:
+    """Whether the answer was on stdout already when the folder's writing began."""
+    import sys
+
+    sys.stdout.flush()
+    return b"best fold angle" in sys.stdout.buffer.getvalue()
+
+
 def test_existing_folder_is_kept_unless_overwrite(tmp_path, fast_config):
     out = tmp_path / "r"
     assert invoke("run", fast_config, "--out", out).exit_code == 0

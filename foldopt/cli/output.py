@@ -98,10 +98,13 @@ class Output:
         callable
             ``progress(done, total)``, counting ``unit``.
         """
+        if self.quiet:  # rich (0.05 s of imports) only where a bar may show
+            yield lambda done, total: None
+            return
         from rich.console import Console
 
         console = Console(stderr=True)
-        if self.quiet or not console.is_terminal:  # a bar in a log or a pipe is noise
+        if not console.is_terminal:  # a bar in a log or a pipe is noise
             yield lambda done, total: None
             return
         from rich.progress import (BarColumn, Progress, ProgressColumn, SpinnerColumn, TaskProgressColumn,
@@ -119,9 +122,13 @@ class Output:
             task = bar.add_task(label, total=total)
             yield lambda done, total: bar.update(task, completed=done, total=total)
 
-    def answer(self, command: str, out: Path, answer, rows=None, lines_after=(), table=None) -> None:
+    def answer(self, command: str, out: Path, answer, rows=None, lines_after=(), table=None, write=None) -> None:
         """Render an answer: its lines (``--table`` adds ``table``), or one JSON document holding it
-        and the rows.
+        and the rows; and write its folder.
+
+        The lines come before the folder is written (its figures and report take most of a warm
+        run), ``lines_after`` once it is; a folder that fails is then an ``error:`` line after the
+        answer. The JSON document comes after: a program reading it gets it only with its folder.
 
         Parameters
         ----------
@@ -136,17 +143,27 @@ class Output:
             Lines printed after the answer's (``wrote <folder>``).
         table : pandas.DataFrame, optional
             The table ``--table`` prints.
+        write : callable, optional
+            Writes the folder ``out``, with no argument.
         """
         if self.json:
             from foldopt.studies.answer import records
 
+            if write is not None:
+                write()
             document = {"command": command, "out": as_text(str(out)), "answer": answer.to_dict(),
                         "rows": records(rows)}
             typer.echo(json.dumps(document, indent=1))
             return
+        if not self.quiet:
+            for line in answer.lines():
+                echo(line)
+        if write is not None:
+            with self.progress(f"writing {as_text(str(out))}"):
+                write()
         if self.quiet:
             return
-        for line in [*answer.lines(), *lines_after]:
+        for line in lines_after:
             echo(line)
         if table is not None and self.table:
             typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))

@@ -15,7 +15,8 @@ if TYPE_CHECKING:
 
 
 def run_request(request: Request, out: Path, overwrite: bool, output: Output, engine: str, command: str) -> None:
-    """Evaluate a request's plan (one case or many) through the API, write its folder, print its answer.
+    """Evaluate a request's plan (one case or many) through the API, print its answer, write its folder
+(:meth:`Output.answer`: the lines before the figures are drawn).
 
     Parameters
     ----------
@@ -42,9 +43,9 @@ def run_request(request: Request, out: Path, overwrite: bool, output: Output, en
         from foldopt.studies.day import StudyResult
 
         result = run(plan, engine, progress, request=request)
-        write(result, out, overwrite, INVOCATION)
     rows = result.summary if isinstance(result, StudyResult) else result.table
-    output.answer(command, out, result.answer, rows, [f"wrote {out}"], rows)
+    output.answer(command, out, result.answer, rows, [f"wrote {out}"], rows,
+                  write=lambda: write(result, out, overwrite, INVOCATION))
 
 
 def run(
@@ -97,8 +98,8 @@ def reproduce(
         from foldopt.api import reproduce as reproduce_paper, write
 
         result = reproduce_paper(engine)
-        write(result, out, overwrite, INVOCATION)
-    output.answer("reproduce", out, result.answer, None, [f"wrote {out}"])
+    output.answer("reproduce", out, result.answer, None, [f"wrote {out}"],
+                  write=lambda: write(result, out, overwrite, INVOCATION))
 
 
 #: The commands of this module: name, function, and the line the command list shows.
