@@ -8,7 +8,11 @@ command line's help stay fast.
 >>> ax = foldopt.plot_power_curves(result)
 """
 
+import sys
 from importlib import import_module, metadata
+from importlib.abc import MetaPathFinder
+from importlib.machinery import PathFinder
+from importlib.util import LazyLoader
 
 try:
     __version__ = metadata.version("foldopt")
@@ -47,6 +51,30 @@ _PUBLIC = {
     "twofold_arrays": "foldopt.physics.pvsystem",
 }
 __all__ = ["__version__", *_PUBLIC]
+
+
+class _OnFirstUse(MetaPathFinder):
+    """Loads pvlib's subpackages that a study does not use when first used rather than when pvlib
+    is imported, which imports all of them: ``pvlib.iotools`` (requests, ssl: 0.07 s), read only for a
+    weather file, and ``pvlib.spectrum`` (scipy.integrate), used by none of foldopt's models.
+
+    :class:`importlib.util.LazyLoader` is not thread-safe before Python 3.12: foldopt's readers
+    first use ``pvlib.iotools`` under a lock (:func:`foldopt.inputs.weather.formats.read_with_pvlib`).
+    """
+
+    _NAMES = ("pvlib.iotools", "pvlib.spectrum")
+
+    def find_spec(self, name, path=None, target=None):
+        if name not in self._NAMES:
+            return None
+        spec = PathFinder.find_spec(name, path)
+        if spec is not None and spec.loader is not None and hasattr(spec.loader, "exec_module"):
+            spec.loader = LazyLoader(spec.loader)
+        return spec
+
+
+if "pvlib" not in sys.modules and not any(isinstance(finder, _OnFirstUse) for finder in sys.meta_path):
+    sys.meta_path.insert(0, _OnFirstUse())
 
 
 def __getattr__(name: str):

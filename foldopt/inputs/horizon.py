@@ -34,11 +34,13 @@ import math
 import re
 from numbers import Real
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from foldopt.errors import ConfigError
 from foldopt.inputs.reading import read_input, size_limit
+
+if TYPE_CHECKING:
+    import numpy as np
 
 FIELD = "site.horizon"
 #: What a horizon file may be, for the messages.
@@ -86,6 +88,8 @@ def _checked(pairs, labels) -> tuple[np.ndarray, np.ndarray]:
         points.setdefault(azimuth, (label, elevation))
     if len(points) < 2:
         raise ValueError(f"a horizon needs at least 2 distinct azimuths; got {len(points)}")
+    import numpy as np  # where a horizon is given: a study's checks (a --help, a bad value) need no numpy
+
     azimuths = np.array(sorted(points))
     return azimuths, np.array([points[a][1] for a in azimuths])
 

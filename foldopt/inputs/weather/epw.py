@@ -10,7 +10,6 @@ from functools import partial
 from pathlib import Path
 
 import pandas as pd
-import pvlib
 
 from foldopt.inputs.weather.formats import (WeatherFormat, check_site_fields, header_fields, header_site, line_locator,
                                             read_with_pvlib, refuse_february_29, table_index, table_rows)
@@ -60,7 +59,7 @@ def read(path: str, text: str, year: int, fail):
     if not pd.Timestamp(year=year, month=1, day=1).is_leap_year:
         refuse_february_29(fail, [n for n in line_of if [f.strip() for f in lines[n - 1].split(",", 3)[1:3]]
                                   == ["2", "29"]], f"{year} has none")
-    data, meta = read_with_pvlib(fail, FORMAT.label, pvlib.iotools.read_epw, path, coerce_year=year)
+    data, meta = read_with_pvlib(fail, FORMAT.label, "read_epw", path, coerce_year=year)
     index = table_index(data, HEADER_LINES, fail)
     return data, meta, index, line_locator(line_of, len(data), HEADER_LINES)
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import threading
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pvlib
 
 from foldopt.errors import ConfigError, WeatherError, printable
 from foldopt.inputs.reading import MAX_WEATHER_BYTES, check_input
@@ -124,7 +126,12 @@ def reason(error: Exception) -> str:
     return f"{type(error).__name__}: {printable(text, 200)}" if text else type(error).__name__
 
 
-def read_with_pvlib(fail, label: str, reader: Callable, *args, **kwargs):
+#: pvlib.iotools loads on first use (``foldopt/__init__.py``), and Python's lazy loading is not
+#: thread-safe before 3.12: the first use is under this lock.
+_IOTOOLS = threading.Lock()
+
+
+def read_with_pvlib(fail, label: str, reader: str, *args, **kwargs):
     """A pvlib.iotools reader's result, any failure of it a file that is not readable.
 
     Parameters
@@ -133,18 +140,20 @@ def read_with_pvlib(fail, label: str, reader: Callable, *args, **kwargs):
         ``fail(message)``: the error to raise.
     label : str
         What messages call the format.
-    reader : callable
-        The pvlib.iotools function, called with ``args`` and ``kwargs``.
+    reader : str
+        The pvlib.iotools function's name (``read_tmy3``), called with ``args`` and ``kwargs``.
 
     Returns
     -------
     tuple
         ``(data, meta)`` as pvlib returns them.
     """
+    with _IOTOOLS:
+        read = getattr(pvlib.iotools, reader)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # pandas' warnings about pvlib's parsing: the checks follow
-            return reader(*args, **kwargs)
+            return read(*args, **kwargs)
     except Exception as error:  # any failure of pvlib's reader is an unreadable file
         raise fail(f"not a readable {label} file ({reason(error)})") from error
 

@@ -12,7 +12,6 @@ import json
 
 import numpy as np
 import pandas as pd
-import pvlib
 
 from foldopt.inputs.weather.formats import WeatherFormat, offset_zone, read_with_pvlib, site_value
 
@@ -45,7 +44,7 @@ def read(path: str, text: str, year: int, fail):
         raise fail("not a PVGIS TMY file: no outputs.tmy_hourly list of hourly records")
     if not hourly:
         raise fail("no data rows: outputs.tmy_hourly is empty")
-    data, meta = read_with_pvlib(fail, FORMAT.label, pvlib.iotools.read_pvgis_tmy, io.StringIO(text),
+    data, meta = read_with_pvlib(fail, FORMAT.label, "read_pvgis_tmy", io.StringIO(text),
                                  pvgis_format="json", map_variables=True)
     inputs = meta.get("inputs") or {}
     location = inputs.get("location", inputs)

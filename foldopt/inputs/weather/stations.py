@@ -190,7 +190,7 @@ def read_surfrad(path: str, fail, zone=None) -> StationData:
     -------
     StationData
     """
-    data, meta = read_with_pvlib(fail, "SURFRAD", pvlib.iotools.read_surfrad, path)
+    data, meta = read_with_pvlib(fail, "SURFRAD", "read_surfrad", path)
     names = {key: key for key in COLUMNS}
     frame, dropped = _columns(data, names, fail, {key: f"{key}_flag" for key in COLUMNS})
     latitude, longitude = float(meta["latitude"]), float(meta["longitude"])
@@ -251,7 +251,7 @@ def read_midc(path: str, fail, zone=None) -> StationData:
         raise fail(f"not a readable MIDC file ({reason(error)})") from error
     raw = "DOY" in header and "Year" in header
     # A raw file's header may name fewer columns than its rows hold: read those it names.
-    data = read_with_pvlib(fail, "MIDC", pvlib.iotools.read_midc, path, raw_data=raw,
+    data = read_with_pvlib(fail, "MIDC", "read_midc", path, raw_data=raw,
                            usecols=range(len(header)) if raw else None)
     columns = [str(name) for name in data.columns]
     maps = pvlib.iotools.midc.MIDC_VARIABLE_MAP.values()
@@ -287,7 +287,7 @@ def read_srml(path: str, fail, zone=None) -> StationData:
     -------
     StationData
     """
-    data = read_with_pvlib(fail, "SRML", pvlib.iotools.read_srml, path)
+    data = read_with_pvlib(fail, "SRML", "read_srml", path)
     names = {}
     for key in COLUMNS:
         found = sorted((column for column in map(str, data.columns) if re.fullmatch(fr"{key}_\d+", column)),
@@ -314,7 +314,7 @@ def read_bsrn(path: str, fail, zone=None) -> StationData:
     -------
     StationData
     """
-    data, meta = read_with_pvlib(fail, "BSRN", pvlib.iotools.read_bsrn, path)
+    data, meta = read_with_pvlib(fail, "BSRN", "read_bsrn", path)
     if len(data) == 0 or "latitude" not in meta:
         raise fail("no LR0100 record (basic measurements) and station LR0004: not a BSRN station-to-archive file")
     frame, _ = _columns(data, {key: key for key in ("ghi", "dni", "dhi", "temp_air")}, fail)
@@ -339,7 +339,7 @@ def read_solrad(path: str, fail, zone=None) -> StationData:
     -------
     StationData
     """
-    data, meta = read_with_pvlib(fail, "SOLRAD", pvlib.iotools.read_solrad, path)
+    data, meta = read_with_pvlib(fail, "SOLRAD", "read_solrad", path)
     frame, dropped = _columns(data, {key: key for key in ("ghi", "dni", "dhi")}, fail,
                               {key: f"{key}_flag" for key in ("ghi", "dni", "dhi")})
     site = {"name": str(meta.get("station_name") or "").strip() or None, "latitude": float(meta["latitude"]),
@@ -362,7 +362,7 @@ def read_crn(path: str, fail, zone=None) -> StationData:
     -------
     StationData
     """
-    data = read_with_pvlib(fail, "CRN", pvlib.iotools.read_crn, path)
+    data = read_with_pvlib(fail, "CRN", "read_crn", path)
     if len(data) == 0:
         raise fail("no data rows")
     frame, dropped = _columns(data, {"ghi": "ghi", "temp_air": "temp_air", "wind_speed": "wind_speed"}, fail,

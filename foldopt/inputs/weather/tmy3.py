@@ -9,7 +9,6 @@ from __future__ import annotations
 from functools import partial
 
 import pandas as pd
-import pvlib
 
 from foldopt.inputs.weather.formats import (WeatherFormat, check_site_fields, header_fields, header_site, line_locator,
                                             read_with_pvlib, refuse_february_29, table_index, table_rows)
@@ -60,7 +59,7 @@ def read(path: str, text: str, year: int, fail):
     # pvlib reads a TMY3 file's February 29 as March 1: a leap year's hours would collide.
     refuse_february_29(fail, [n for n in line_of if lines[n - 1].lstrip('"').startswith("02/29/")],
                        "pvlib reads a TMY3 file's February 29 as March 1")
-    data, meta = read_with_pvlib(fail, FORMAT.label, pvlib.iotools.read_tmy3, path, coerce_year=year,
+    data, meta = read_with_pvlib(fail, FORMAT.label, "read_tmy3", path, coerce_year=year,
                                  map_variables=True)
     index = table_index(data, HEADER_LINES, fail)
     last = index[-1]
