@@ -146,7 +146,7 @@ def sweep(study: Study | Plan, over: str | None = None, *, axes: dict | None = N
     -------
     SweepResult
         ``table``: one row per case (``site_name``, ``latitude``, ``longitude``, ``date``,
-        ``day_of_year``, ``p_load_w`` and any other swept field) and design (``flat``, ``twofold``,
+        ``dayofyear``, ``p_load_w`` and any other swept field) and design (``flat``, ``twofold``,
         ``tracker``, ``tracker-net``), with ``fold_angle_deg``, ``t_solar_h`` and the other daily
         metrics; ``answer``, the :class:`foldopt.studies.answer.Answer` every view renders. With an
         ``objective`` and several dates, one fold angle per case for all of them.

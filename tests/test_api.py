@@ -148,7 +148,7 @@ def test_a_study_files_plan_is_swept_and_optimised_as_its_study(tmp_path):
     plan = foldopt.load_study(tmp_path / "days.yaml")
     assert isinstance(plan, foldopt.Plan)
     swept = foldopt.sweep(plan, p_load=[2.0, 4.0]).table
-    assert swept["day_of_year"].nunique() == 3 and swept["p_load_w"].nunique() == 2
+    assert swept["dayofyear"].nunique() == 3 and swept["p_load_w"].nunique() == 2
     searched = foldopt.optimize(plan, vary="fold_angle").table.set_index("design")
     ran = foldopt.run(tmp_path / "days-optimize.yaml").table.set_index("design")
     pd.testing.assert_series_equal(searched.loc["twofold"], ran.loc["twofold"])

@@ -61,8 +61,8 @@ NOTEBOOK = textwrap.dedent("""
     calls = {
         "plot_power_curves": (result,), "plot_switching": (result,), "plot_t_solar_vs_fold_angle": (result,),
         "plot_comparison": (result,), "plot_standby": (result,),
-        "plot_map": (year.table, "day_of_year", "p_load_w", "t_solar_h", "t", "t_solar [h]", False),
-        "plot_curves": (year.table, "day_of_year", "t"),
+        "plot_map": (year.table, "dayofyear", "p_load_w", "t_solar_h", "t", "t_solar [h]", False),
+        "plot_curves": (year.table, "dayofyear", "t"),
         "plot_sizing": (sized.table, sized.best, "t"),
         "plot_annual_fold_angles": (year.extras["by_angle"], "t"),
         "plot_distribution": (year.table, "t"),
@@ -185,8 +185,8 @@ def test_a_curve_over_the_days_joins_only_near_days(dates, joined):
     study = foldopt.default_study().variant(step_min=30, fold_angles={"start": 30, "stop": 180, "step": 30},
                                             site={"latitude": 52.52, "longitude": 13.40})
     table = foldopt.sweep(study, "day", date=dates, p_load=[2.0]).table
-    ax = sweep.plot_curves(table, "day_of_year", "t", ax=Figure().subplots())
-    evaluated = set(table["day_of_year"].astype(float))
+    ax = sweep.plot_curves(table, "dayofyear", "t", ax=Figure().subplots())
+    evaluated = set(table["dayofyear"].astype(float))
     assert len(ax.lines) == 3  # flat, optimal twofold, tracker
     for line in ax.lines:
         stretches, marked = _segments_and_points(line)
@@ -208,7 +208,7 @@ def test_an_ensembles_line_and_band_join_only_near_days(days, joined):
     from matplotlib.figure import Figure
 
     rng = np.random.default_rng(0)
-    table = pd.DataFrame([{"day_of_year": day, "p_load_w": load, "design": design,
+    table = pd.DataFrame([{"dayofyear": day, "p_load_w": load, "design": design,
                            "t_solar_p10_h": low, "t_solar_p50_h": low + 1.0, "t_solar_p90_h": low + 2.5}
                           for day in days for load in (2.0, 4.0) for design in ("flat", "twofold", "tracker")
                           for low in rng.uniform(3.0, 9.0, 1)])
@@ -217,7 +217,7 @@ def test_an_ensembles_line_and_band_join_only_near_days(days, joined):
     assert len(ax.lines) == len(bands) == 2  # flat and twofold
     for line, band in zip(ax.lines, bands, strict=True):
         design = line.get_label().split(":")[0]
-        rows = table[(table["design"] == design) & (table["p_load_w"] == 2.0)].set_index("day_of_year")
+        rows = table[(table["design"] == design) & (table["p_load_w"] == 2.0)].set_index("dayofyear")
         stretches, marked = _segments_and_points(line)
         on_lines = set(np.concatenate(stretches)) if stretches else set()
         assert on_lines | marked == set(days) and not on_lines & marked
@@ -249,7 +249,7 @@ def test_a_heat_map_over_the_days_colours_only_near_days(dates, blank):
     study = foldopt.default_study().variant(step_min=30, fold_angles={"start": 30, "stop": 180, "step": 30})
     table = foldopt.sweep(study, "day", date=dates, latitude=[0.0, 50.0], p_load=[2.0]).table
     twofold = table[table["design"] == "twofold"]
-    ax = sweep.plot_map(twofold, "day_of_year", "latitude", "fold_angle_deg", "t", "deg", False,
+    ax = sweep.plot_map(twofold, "dayofyear", "latitude", "fold_angle_deg", "t", "deg", False,
                         ax=Figure().subplots())
     mesh = ax.collections[0]
     corners = mesh.get_coordinates()  # (rows + 1, columns + 1, 2)
@@ -259,10 +259,10 @@ def test_a_heat_map_over_the_days_colours_only_near_days(dates, blank):
     assert (np.diff(x_edges)[coloured] <= sweep.DAY_GAP).all()
     assert (~coloured).any() == blank
     for _, row in twofold.iterrows():
-        column = np.searchsorted(x_edges, row["day_of_year"]) - 1
+        column = np.searchsorted(x_edges, row["dayofyear"]) - 1
         line = np.searchsorted(y_edges, row["latitude"]) - 1
         assert values[line, column] == row["fold_angle_deg"]
-        assert x_edges[column] < row["day_of_year"] < x_edges[column + 1]
+        assert x_edges[column] < row["dayofyear"] < x_edges[column + 1]
 
 
 @pytest.mark.parametrize("step,blank", [(183, True), (7, False)], ids=["half-year-apart", "weekly"])

@@ -48,7 +48,8 @@ def test_year_rows_equal_the_annual_sweep(la_map):
         expected = means.loc[(load, "tracker-net"), "t_solar_h"]
         assert row["mean_t_solar_tracker_net_h"] == pytest.approx(expected, abs=1e-9)
         # The flat panel's peak over the year is the largest of its daily peaks.
-        assert row["flat_peak_w"] == pytest.approx(table[table["design"] == "flat"]["peak_power_w"].max(), rel=1e-12)
+        flat_peak = table[table["design"] == "flat"]["peak_power_w"].max()
+        assert row["peak_power_flat_w"] == pytest.approx(flat_peak, rel=1e-12)
 
 
 def test_each_period_is_its_own_optimum(la_map):
@@ -75,14 +76,14 @@ def test_break_even_standby_is_where_the_tracker_falls_to_the_twofold_panel(la_m
     site, table = (LA, la_map) if where == "clear sky" else (GREENSBORO, evaluate_sites(COARSE, [GREENSBORO],
                                                                                           [1.0, 4.0, 8.0]))
     for row in table.itertuples():
-        if row.tracker_break_even_standby_w > 0 and row.period in ("year", "JJA"):
-            study = {**COARSE, "tracker": {"standby_w": float(row.tracker_break_even_standby_w)}}
+        if row.break_even_standby_tracker_w > 0 and row.period in ("year", "JJA"):
+            study = {**COARSE, "tracker": {"standby_w": float(row.break_even_standby_tracker_w)}}
             again = evaluate_sites(study, [site], [row.p_load_w])
             net = again[again["period"] == row.period].iloc[0]["objective_tracker_net_h"]
             assert net == pytest.approx(row.objective_twofold_h, abs=2e-3)
-        if row.tracker_break_even_standby_w == 0:  # the tracker's moves alone already cost its lead
+        if row.break_even_standby_tracker_w == 0:  # the tracker's moves alone already cost its lead
             assert row.objective_tracker_net_h <= row.objective_twofold_h
-    assert (table["tracker_break_even_standby_w"] > 0).any()
+    assert (table["break_even_standby_tracker_w"] > 0).any()
 
 
 def test_a_panel_folded_only_to_180_deg_is_the_flat_panel():
@@ -97,8 +98,8 @@ def test_a_panel_folded_only_to_180_deg_is_the_flat_panel():
 def test_relative_loads_are_fractions_of_each_sites_flat_peak():
     table = evaluate_sites(COARSE, [LA, {"latitude": 60.0, "longitude": 10.0}], [0.25, 0.5], relative=True)
     for _, rows in table.groupby("site_id"):
-        np.testing.assert_allclose(rows["p_load_w"], rows["p_load_fraction"] * rows["flat_peak_w"], rtol=1e-15)
-    peaks = table.groupby("latitude")["flat_peak_w"].first()
+        np.testing.assert_allclose(rows["p_load_w"], rows["p_load_fraction"] * rows["peak_power_flat_w"], rtol=1e-15)
+    peaks = table.groupby("latitude")["peak_power_flat_w"].first()
     assert peaks[34.05] != peaks[60.0]
 
 
@@ -115,7 +116,7 @@ def test_invariants_across_sites_and_loads(latitude, longitude, loads):
         for design in ("flat", "tracker", "tracker_net"):
             assert (np.diff(rows[f"mean_t_solar_{design}_h"].to_numpy()) <= 1e-12).all()
         assert (np.diff(rows["objective_twofold_h"].to_numpy()) <= 1e-12).all()
-    standby = table["tracker_break_even_standby_w"].dropna()
+    standby = table["break_even_standby_tracker_w"].dropna()
     assert (standby >= 0).all()
 
 
@@ -268,9 +269,9 @@ def test_a_map_searching_the_tilt_finds_the_best_design_of_every_tilt():
     at_tilt = every[(every["surface_tilt"] == row["surface_tilt"]) & (every["period"] == "year")
                     & (every["p_load_w"] == 2.0)]
     assert at_tilt["objective_twofold_h"].max() >= row["objective_twofold_h"] - 1e-9
-    assert (searched["flat_surface_tilt"] % 15 == 0).all() and searched["surface_tilt"].between(0, 90).all()
+    assert (searched["surface_tilt_flat"] % 15 == 0).all() and searched["surface_tilt"].between(0, 90).all()
     # Without the search every design keeps the site's tilt (|latitude|, the map's mounting).
-    assert (every["surface_tilt"] == every["flat_surface_tilt"]).all()
+    assert (every["surface_tilt"] == every["surface_tilt_flat"]).all()
 
 
 def test_a_map_searching_the_tilt_answers_with_the_tilts():
@@ -285,6 +286,6 @@ def test_a_map_searching_the_tilt_answers_with_the_tilts():
                     relative=False)
     year = table[table["period"] == "year"]
     assert answer.result["loads"][0]["surface_tilt"]["max"] == year["surface_tilt"].max()
-    assert answer.result["loads"][0]["flat_surface_tilt"]["min"] == year["flat_surface_tilt"].min()
+    assert answer.result["loads"][0]["surface_tilt_flat"]["min"] == year["surface_tilt_flat"].min()
     assert "base tilts" in answer.summary[1] and "0 to 60 by 30 deg" in answer.question["panel"]
     assert list(answer.near_optimal["surface_tilt"]) == list(year["surface_tilt"])

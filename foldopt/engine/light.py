@@ -24,16 +24,16 @@ from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.physics.solarposition import ClockGrid
 
 
-def _airmass(zenith) -> np.ndarray:
+def _airmass(solar_zenith) -> np.ndarray:
     """Kasten & Young's relative air mass with the sun up, 0 with it down (as the sky's arrays
     hold it)."""
-    airmass = np.zeros(np.shape(zenith))
-    up = zenith < 90.0
-    airmass[up] = relative_airmass(zenith[up])
+    airmass = np.zeros(np.shape(solar_zenith))
+    up = solar_zenith < 90.0
+    airmass[up] = relative_airmass(solar_zenith[up])
     return airmass
 
 
-def clear_light(grid: ClockGrid, zenith, dni_extra, sites, model: str, linke_turbidity,
+def clear_light(grid: ClockGrid, solar_zenith, dni_extra, sites, model: str, linke_turbidity,
                 transposition: str = "none", albedo: float = 0.2) -> tuple[dict, np.ndarray | None]:
     """A clear sky at every step of the blocks (0 with the sun down), with its diffuse terms.
 
@@ -45,7 +45,7 @@ def clear_light(grid: ClockGrid, zenith, dni_extra, sites, model: str, linke_tur
     Parameters
     ----------
     grid : ClockGrid
-    zenith, dni_extra : numpy.ndarray
+    solar_zenith, dni_extra : numpy.ndarray
         (n_blocks, n_steps) apparent solar zenith [deg] and extraterrestrial irradiance [W/m^2].
     sites : sequence of foldopt.inputs.sections.Site
         One per block.
@@ -71,17 +71,17 @@ def clear_light(grid: ClockGrid, zenith, dni_extra, sites, model: str, linke_tur
     if model == "ineichen":
         turbidity = linke_turbidity
         if turbidity is None:
-            turbidity = np.empty(zenith.shape)
+            turbidity = np.empty(solar_zenith.shape)
             for (latitude, longitude, _), members in groups.items():
                 turbidity[members] = climatology_turbidity(latitude, longitude, grid.utc_ns[members])
         altitude = np.array([site.altitude for site in sites], dtype=float)
-        dni, ghi, dhi, layout = ineichen_terms(zenith, dni_extra, turbidity, altitude, transposition, albedo)
+        dni, ghi, dhi, layout = ineichen_terms(solar_zenith, dni_extra, turbidity, altitude, transposition, albedo)
         return {"dni": dni, "ghi": ghi, "dhi": dhi}, None if layout is None else np.moveaxis(layout, 1, -1)
-    light = {key: np.zeros_like(zenith) for key in ("dni", "ghi", "dhi")}
-    airmass = _airmass(zenith)
+    light = {key: np.zeros_like(solar_zenith) for key in ("dni", "ghi", "dhi")}
+    airmass = _airmass(solar_zenith)
     for (_, _, altitude), members in groups.items():
-        up = zenith[members] < 90.0
-        sky = clear_sky(zenith[members][up], airmass[members][up], dni_extra[members][up], altitude, model,
+        up = solar_zenith[members] < 90.0
+        sky = clear_sky(solar_zenith[members][up], airmass[members][up], dni_extra[members][up], altitude, model,
                         linke_turbidity)
         for key, values in light.items():
             placed = np.zeros(up.shape)
@@ -89,11 +89,11 @@ def clear_light(grid: ClockGrid, zenith, dni_extra, sites, model: str, linke_tur
             values[members] = placed
     terms = None
     if transposition != "none":
-        terms = diffuse_terms(transposition, zenith, light["dni"], light["ghi"], light["dhi"], dni_extra, albedo)
+        terms = diffuse_terms(transposition, solar_zenith, light["dni"], light["ghi"], light["dhi"], dni_extra, albedo)
     return light, terms
 
 
-def diffuse_terms(transposition: str, zenith, dni, ghi, dhi, dni_extra, albedo: float) -> np.ndarray:
+def diffuse_terms(transposition: str, solar_zenith, dni, ghi, dhi, dni_extra, albedo: float) -> np.ndarray:
     """The diffuse terms of a transposition at every step
     (:func:`foldopt.physics.irradiance.sky_diffuse_terms` at the steps with light, 0 elsewhere).
 
@@ -101,7 +101,7 @@ def diffuse_terms(transposition: str, zenith, dni, ghi, dhi, dni_extra, albedo: 
     ----------
     transposition : str
         One of :data:`foldopt.physics.irradiance.TRANSPOSITIONS`.
-    zenith, dni, dni_extra : numpy.ndarray
+    solar_zenith, dni, dni_extra : numpy.ndarray
         (n_blocks, n_steps) [deg], [W/m^2], [W/m^2].
     ghi, dhi : numpy.ndarray or None
         (n_blocks, n_steps) [W/m^2]; None for a beam-only sky: the beam's horizontal share and no
@@ -115,21 +115,21 @@ def diffuse_terms(transposition: str, zenith, dni, ghi, dhi, dni_extra, albedo: 
         (n_blocks, n_steps, 4), a view of an array laid out (n_blocks, 4, n_steps) as the engine
         reads it.
     """
-    ghi_of = ghi if ghi is not None else dni * np.clip(np.cos(np.radians(zenith)), 0, None)
+    ghi_of = ghi if ghi is not None else dni * np.clip(np.cos(np.radians(solar_zenith)), 0, None)
     dhi_of = dhi if dhi is not None else np.zeros_like(dni)
     shown = np.flatnonzero((dni > 0) | (ghi_of > 0) | (dhi_of > 0))
     # Placed a term at a time by flat index: block b's step s is b * 4 n_steps + s.
     n_steps = dni.shape[1]
     layout = np.zeros((dni.shape[0], 4, n_steps))
     at = shown + shown // n_steps * (3 * n_steps)
-    values = [array.ravel()[shown] for array in (zenith, dni, ghi_of, dhi_of, dni_extra)]
+    values = [array.ravel()[shown] for array in (solar_zenith, dni, ghi_of, dhi_of, dni_extra)]
     found = sky_diffuse_terms(transposition, *values, _airmass(values[0]), albedo)
     for k in range(4):
         layout.reshape(-1)[at + k * n_steps] = found[:, k]
     return np.moveaxis(layout, 1, -1)
 
 
-def weather_light(study: Study, grid: ClockGrid, dates, clear: dict, zenith, dni_extra):
+def weather_light(study: Study, grid: ClockGrid, dates, clear: dict, solar_zenith, dni_extra):
     """Light at every step of the grid from the study's weather file
     (:func:`foldopt.inputs.weather.downscale.hourly_light` along the clear sky), the air
     temperature and wind at every step (:func:`foldopt.inputs.weather.downscale.interpolate_points`),
@@ -158,7 +158,7 @@ def weather_light(study: Study, grid: ClockGrid, dates, clear: dict, zenith, dni
     if interval % step_ns or not np.array_equal(starts, day_start + np.arange(starts.shape[1]) * interval):
         raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must divide the file's "
                          f"intervals ({interval / 6e10:g} min), which must start at the day's midnight")
-    cos_zenith = np.cos(np.radians(zenith))
+    cos_zenith = np.cos(np.radians(solar_zenith))
     light, placed = hourly_light(hourly["dni"], hourly["dhi"], clear["ghi"], clear["dni"], cos_zenith, per_interval,
                                  dni_extra)
     balance = {key: (float(hourly[key].sum()), float(placed[key].sum())) for key in ("dni", "ghi", "dhi")}
@@ -193,15 +193,15 @@ def measured_light(study: Study, grid: ClockGrid, dates):
     return columns, measured
 
 
-def member_light(study: Study, hourly: dict, per_interval: int, clear: dict, zenith, dates, share):
+def member_light(study: Study, hourly: dict, per_interval: int, clear: dict, solar_zenith, dates, share):
     """Each block's light drawn as its member of the cloud ensemble of its day
     (:func:`foldopt.inputs.weather.ensemble.cloud_members`), and how much of the file's light the
     members keep on average. A day's members are drawn from the seed and the day alone, so that a
     member is the same whatever else a study runs with it."""
     inverse, member = share
-    cos_zenith = np.cos(np.radians(zenith))
+    cos_zenith = np.cos(np.radians(solar_zenith))
     count = int(member.max()) + 1
-    drawn = {key: np.empty((count, len(dates), zenith.shape[1])) for key in ("ghi", "dni", "dhi")}
+    drawn = {key: np.empty((count, len(dates), solar_zenith.shape[1])) for key in ("ghi", "dni", "dhi")}
     for day, date in enumerate(dates):
         one = cloud_members(hourly["ghi"][day:day + 1], hourly["dhi"][day:day + 1], clear["ghi"][day:day + 1],
                             cos_zenith[day:day + 1], per_interval, study.step_min, count,

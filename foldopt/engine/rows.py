@@ -70,14 +70,14 @@ class RowMetrics:
     power: np.ndarray | None = None
 
 
-def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> np.ndarray:
+def fold_orientations(study: Study, surface_tilt, surface_azimuth, fold_angles) -> np.ndarray:
     """Sub-panel orientations of every block's panel at every fold angle.
 
     Parameters
     ----------
     study : Study
         Gives the geometry.
-    panel_tilt, panel_azimuth : array_like
+    surface_tilt, surface_azimuth : array_like
         The flat panel of each block [deg], (n_blocks,).
     fold_angles : array_like
         [deg], (n_angles,).
@@ -89,7 +89,7 @@ def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> n
     """
     geometry = study.geometry
     fold_angles = np.asarray(fold_angles, dtype=float)
-    panels = np.stack([np.asarray(panel_tilt, dtype=float), np.asarray(panel_azimuth, dtype=float)], axis=-1)
+    panels = np.stack([np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)], axis=-1)
     unique, inverse = np.unique(panels, axis=0, return_inverse=True)
     per_panel = []
     for tilt, azimuth in unique:
@@ -99,15 +99,15 @@ def fold_orientations(study: Study, panel_tilt, panel_azimuth, fold_angles) -> n
     return np.stack(per_panel)[np.ravel(inverse)]
 
 
-def flat_orientation(panel_tilt, panel_azimuth) -> np.ndarray:
+def flat_orientation(surface_tilt, surface_azimuth) -> np.ndarray:
     """The flat panel as (n_blocks, 4) row orientations, as :func:`fold_orientations`': both halves the panel.
 
     Parameters
     ----------
-    panel_tilt, panel_azimuth : array_like
+    surface_tilt, surface_azimuth : array_like
         The flat panel of each block [deg], (n_blocks,).
     """
-    tilt, azimuth = np.asarray(panel_tilt, dtype=float), np.asarray(panel_azimuth, dtype=float)
+    tilt, azimuth = np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
     return np.stack([tilt, azimuth, tilt, azimuth], axis=-1)
 
 
@@ -139,14 +139,14 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
         [W/m^2], the broadcast shape.
     """
     tilt, azimuth = np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
-    zenith, solar_azimuth = sky.solar_zenith[blocks], sky.solar_azimuth[blocks]
+    solar_zenith, solar_azimuth = sky.solar_zenith[blocks], sky.solar_azimuth[blocks]
     normal = normal_vector(tilt, azimuth) if normal is None else np.asarray(normal, dtype=float)
     sun = sky.sun_vector[blocks]
     # pvlib's aoi_projection (tested), without the (..., 3) temporary of a product.
     cos_aoi = normal[..., 0] * sun[..., 0] + normal[..., 1] * sun[..., 1] + normal[..., 2] * sun[..., 2]
-    factor = beam_incidence_factor(tilt, azimuth, zenith, solar_azimuth, model="paper") if paper else None
+    factor = beam_incidence_factor(tilt, azimuth, solar_zenith, solar_azimuth, model="paper") if paper else None
     terms = None if sky.terms is None else sky.terms[blocks]
-    modifier = 1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, zenith, solar_azimuth)
+    modifier = 1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, solar_zenith, solar_azimuth)
     views = None if terms is None else surface_views(sky, blocks, tilt, azimuth, normal[..., 2])
     return plane_of_array(cos_aoi, normal[..., 2], sky.dni[blocks], terms, factor, modifier, views)
 

@@ -128,9 +128,9 @@ def _mean_schedules(hours: np.ndarray, max_visits: int) -> list[Schedule]:
             cuts.append(int(previous[cuts[-1]]))
         cuts = [0, *cuts[::-1]]  # 0 = c_0 < c_1 < ... < c_k = D, offsets from `first`
         starts = [(first + cut) % n_days for cut in cuts[:-1]]
-        angles = [int(angle[(first + cuts[m]) % n_days, cuts[m + 1] - cuts[m] - 1]) for m in range(k)]
+        fold_angles = [int(angle[(first + cuts[m]) % n_days, cuts[m + 1] - cuts[m] - 1]) for m in range(k)]
         order = np.argsort(starts)
-        schedules.append(Schedule(tuple(int(starts[i]) for i in order), tuple(angles[i] for i in order),
+        schedules.append(Schedule(tuple(int(starts[i]) for i in order), tuple(fold_angles[i] for i in order),
                                   total / n_days))
     return schedules
 
@@ -144,18 +144,18 @@ def _worst_month_schedules(hours: np.ndarray, months: np.ndarray, max_visits: in
     for k in range(1, min(max_visits, n_months) + 1):
         best = (-np.inf, None)
         for cuts in itertools.combinations(range(n_months), k):
-            value, angles = np.inf, []
+            value, fold_angles = np.inf, []
             for position, start in enumerate(cuts):
                 stop = cuts[position + 1] if position + 1 < k else cuts[0] + n_months
                 arc = [(start + m) % n_months for m in range(stop - start)]
                 worst = monthly[arc].min(axis=0)
                 choice = n_angles - 1 - int(np.argmax(worst[::-1]))
-                angles.append(choice)
+                fold_angles.append(choice)
                 value = min(value, worst[choice])
             if value > best[0]:
-                best = (value, (cuts, angles))
-        value, (cuts, angles) = best
-        schedules.append(Schedule(tuple(first_day[c] for c in cuts), tuple(angles), float(value)))
+                best = (value, (cuts, fold_angles))
+        value, (cuts, fold_angles) = best
+        schedules.append(Schedule(tuple(first_day[c] for c in cuts), tuple(fold_angles), float(value)))
     return schedules
 
 

@@ -316,7 +316,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
     altitude = np.array([site.altitude for site in sites], dtype=float)[:, None]
     grid = _clock(sites, dates, study.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
-    zenith = sun["solar_zenith"]
+    solar_zenith = sun["solar_zenith"]
     dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.dayofyear]
     temp_air, balance = np.full(len(sites), float(study.temp_air)), None
     temp_steps = wind_speed = wind_ref = terms = None
@@ -327,11 +327,11 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         temp_steps, wind_speed = light.pop("temp_air"), light.pop("wind_speed")
         notes = tuple(measured.report())
     elif study.weather is not None:
-        clear, _ = clear_light(grid, zenith, dni_extra, sites, "ineichen", study.linke_turbidity)
+        clear, _ = clear_light(grid, solar_zenith, dni_extra, sites, "ineichen", study.linke_turbidity)
         light, temp_steps, wind_speed, balance, (hourly, per_interval) = weather_light(study, grid, dates, clear,
-                                                                                     zenith, dni_extra)
+                                                                                     solar_zenith, dni_extra)
         if share is not None:
-            light, balance = member_light(study, hourly, per_interval, clear, zenith, dates, share)
+            light, balance = member_light(study, hourly, per_interval, clear, solar_zenith, dates, share)
     sun_vector = sun.pop("sun_vector")
     if share is not None:
         inverse = share[0]
@@ -339,7 +339,7 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         grid = ClockGrid(grid.utc_ns[inverse], grid.utc_offset_ns[inverse], tuple(grid.timezones[i] for i in inverse),
                          grid.step_hours)
         sun = {key: value[inverse] for key, value in sun.items()}
-        zenith, latitude, altitude = sun["solar_zenith"], latitude[inverse], altitude[inverse]
+        solar_zenith, latitude, altitude = sun["solar_zenith"], latitude[inverse], altitude[inverse]
         dni_extra = dni_extra[inverse]
         temp_steps, wind_speed = temp_steps[inverse], wind_speed[inverse]
         dates = [dates[i] for i in inverse]
@@ -351,20 +351,20 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         temp_air = np.where(lit.any(axis=1), (temp_steps * lit).sum(axis=1) / np.maximum(lit.sum(axis=1), 1),
                             temp_steps.mean(axis=1))
     elif study.sky in CLEAR_SKIES:
-        light, terms = clear_light(grid, zenith, dni_extra, sites, study.sky, study.linke_turbidity, transposition,
-                                   study.albedo)
+        light, terms = clear_light(grid, solar_zenith, dni_extra, sites, study.sky, study.linke_turbidity,
+                                   transposition, study.albedo)
     else:
         beam_altitude = altitude if study.mode == "exact" else 0.0
-        light = {"dni": clear_sky_dni(zenith, beam_altitude, study.sky, dayofyear=grid.dayofyear,
+        light = {"dni": clear_sky_dni(solar_zenith, beam_altitude, study.sky, dayofyear=grid.dayofyear,
                                       climate=study.climate)}
     dni = light["dni"]
     ghi, dhi = light.get("ghi"), light.get("dhi")
     if transposition != "none" and terms is None:
-        terms = diffuse_terms(transposition, zenith, dni, ghi, dhi, dni_extra, study.albedo)
+        terms = diffuse_terms(transposition, solar_zenith, dni, ghi, dhi, dni_extra, study.albedo)
     if horizons:
-        dni, terms = block_behind_horizon(horizons, horizon_of, zenith, sun["solar_azimuth"], dni, terms)
+        dni, terms = block_behind_horizon(horizons, horizon_of, solar_zenith, sun["solar_azimuth"], dni, terms)
     return Sky(
-        grid=grid, mode=study.mode, solar_zenith=zenith, solar_azimuth=sun["solar_azimuth"],
+        grid=grid, mode=study.mode, solar_zenith=solar_zenith, solar_azimuth=sun["solar_azimuth"],
         hour_angle=sun["hour_angle"], declination=np.ascontiguousarray(sun["declination"]),
         sun_vector=sun_vector, dni=dni, ghi=ghi, dhi=dhi, terms=terms,
         temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam, weather_balance=balance,

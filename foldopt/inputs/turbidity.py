@@ -89,9 +89,9 @@ def linke_turbidity(latitude: float, longitude: float, utc_ns) -> np.ndarray:
     first = int(days.min())
     dates = np.arange(first, int(days.max()) + 1).astype("datetime64[D]")
     years = dates.astype("datetime64[Y]")
-    day_of_year = (dates - years).astype(np.int64) + 1
+    dayofyear = (dates - years).astype(np.int64) + 1
     year = years.astype(np.int64) + 1970
     leap = (year % 4 == 0) & ((year % 100 != 0) | (year % 400 == 0))
-    values = np.where(leap, np.interp(day_of_year, _month_middles(True), around),
-                      np.interp(day_of_year, _month_middles(False), around))
+    values = np.where(leap, np.interp(dayofyear, _month_middles(True), around),
+                      np.interp(dayofyear, _month_middles(False), around))
     return (values / 20.0)[days - first]

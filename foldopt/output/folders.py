@@ -62,10 +62,10 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
             command,
             input_sha256=input_hash(result.study.data()),
             engine=result.engine,
-            optimal_fold_angle_deg=result.optimal_fold_angle,
+            fold_angle_twofold_deg=result.optimal_fold_angle,
             near_optimal={key: _finite_or_none(value) for key, value in result.near_optimal.items()},
-            tracker_break_even_standby_w=_finite_or_none(result.standby[1]),
-            heuristic_fold_angle_deg=_finite_or_none(result.heuristic_fold_angle),
+            break_even_standby_tracker_w=_finite_or_none(result.standby[1]),
+            fold_angle_twofold_heuristic_deg=_finite_or_none(result.heuristic_fold_angle),
         )
         write_run_json(folder, metadata)
         write_html(folder, result.answer, figures, result.summary, "Designs compared (summary.csv)", metadata)
@@ -111,9 +111,9 @@ def _sweep_plots(table: pd.DataFrame, varied: list[str], folder: Path, name: str
     return their file names."""
     twofold = table[table["design"] == "twofold"]
     written = []
-    for x, y, stem in (("latitude", "p_load_w", "latitude_load"), ("day_of_year", "latitude", "day_latitude")):
+    for x, y, stem in (("latitude", "p_load_w", "latitude_load"), ("dayofyear", "latitude", "day_latitude")):
         if x in varied and y in varied:
-            other = _others((x, y, "day_of_year"), varied)
+            other = _others((x, y, "dayofyear"), varied)
             written += [
                 write_figure(folder, f"gain_map_{stem}.png", twofold, x, y, "gain_vs_flat_pct",
                              f"{name}: t_solar gain of the optimal twofold panel over flat{other}",
@@ -121,12 +121,12 @@ def _sweep_plots(table: pd.DataFrame, varied: list[str], folder: Path, name: str
                 write_figure(folder, f"fold_angle_map_{stem}.png", twofold, x, y, "fold_angle_deg",
                              f"{name}: optimal fold angle{other}", "fold angle Θ [deg] (180 = flat)", diverging=False),
             ]
-    for x, stem in (("day_of_year", "annual_t_solar"), ("p_load_w", "t_solar_vs_load"),
+    for x, stem in (("dayofyear", "annual_t_solar"), ("p_load_w", "t_solar_vs_load"),
                     ("latitude", "t_solar_vs_latitude")):
         if x in varied:
-            rest = [v for v in varied if v not in (x, "date", "day_of_year")]
+            rest = [v for v in varied if v not in (x, "date", "dayofyear")]
             split = next((v for v in rest if table[v].nunique() <= 4), None)
-            used = (x, "day_of_year") + ((split,) if split else ())
+            used = (x, "dayofyear") + ((split,) if split else ())
             written.append(write_figure(folder, f"{stem}.png", table, x, f"{name}: t_solar of flat, optimal twofold "
                                         f"and tracker{_others(used, varied)}", split))
     return written
@@ -195,7 +195,7 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
     with staged_folder(out, overwrite) as folder:
         write_csv(result.table, folder / "results.csv")
         plots = _sweep_plots(result.table, result.varied, folder, plan.base.name)
-        if "date" in result.varied or "day_of_year" in result.varied:
+        if "date" in result.varied or "dayofyear" in result.varied:
             plots += _annual_outputs(result, folder, plan.base.name)
         plots += _horizon_figure(plan.base, dict(plan.axes).get("date", (plan.base.date,)), folder, plan.base.name)
         metadata = run_metadata(

@@ -26,7 +26,7 @@ def annual_cases(result) -> list[str]:
     list of str
         Column names of ``result.table``, for :func:`annual_summary`'s ``cases``.
     """
-    others = [c for c in result.varied if c not in ("date", "day_of_year", "site_name", "latitude", "p_load_w")]
+    others = [c for c in result.varied if c not in ("date", "dayofyear", "site_name", "latitude", "p_load_w")]
     return ["site_name", "latitude", *others, "p_load_w"]
 
 

@@ -195,9 +195,9 @@ def of_study(result) -> Answer:
     result_part = {
         "objective": "t_solar of the day", "load": describe_load(study),
         "fold_angle_deg": result.optimal_fold_angle, "t_solar_h": float(twofold["t_solar_h"]),
-        "heuristic_fold_angle_deg": heuristic, "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
+        "fold_angle_twofold_heuristic_deg": heuristic, "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
         "pct_of_tracker": float(twofold["pct_of_tracker"]), "flat_area_multiple": float(twofold["flat_area_multiple"]),
-        "tracker_break_even_standby_w": float(result.standby[1]), **near,
+        "break_even_standby_tracker_w": float(result.standby[1]), **near,
         "t_solar_by_design_h": {d: float(by.loc[d, "t_solar_h"]) for d in MAIN_DESIGNS},
     }
     site = study.site
@@ -273,7 +273,7 @@ def of_sweep(result) -> Answer:
                                            "max": twofold["recommended_fold_angle_deg"].max()}}
     if len(gains):
         best = twofold.loc[gains.idxmax()]
-        at = {column: best[column] for column in result.varied if column in best and column != "day_of_year"}
+        at = {column: best[column] for column in result.varied if column in best and column != "dayofyear"}
         part["gain_vs_flat_pct"] = {"median": gains.median(), "max": gains.max(), "at": at}
         where = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
                           for key, value in at.items())
@@ -492,9 +492,9 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                                            "max": rows["recommended_fold_angle_deg"].max()},
             "median_near_optimal_width_deg": (rows["near_optimal_hi_deg"] - rows["near_optimal_lo_deg"]).median(),
             **{column: {"min": rows[column].min(), "median": rows[column].median(), "max": rows[column].max()}
-               for column in ("surface_tilt", "flat_surface_tilt")},
+               for column in ("surface_tilt", "surface_tilt_flat")},
             "median_pct_of_tracker": rows["pct_of_tracker"].median(),
-            "median_tracker_break_even_standby_w": rows["tracker_break_even_standby_w"].median(),
+            "median_break_even_standby_tracker_w": rows["break_even_standby_tracker_w"].median(),
         })
     statistic = study.objective.statistic if study.objective is not None else "mean"
     part = plain({"sites": int(table["site_id"].nunique()), "objective": statistic,
@@ -510,7 +510,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         best = load["best_site"]
         where = "" if best is None else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
         rec = load["recommended_fold_angle_deg"]
-        standby = load["median_tracker_break_even_standby_w"]
+        standby = load["median_break_even_standby_tracker_w"]
         tracker = ("" if standby is None else ", whose own moves already cost it its lead" if standby == 0
                    else f", which loses its lead above a median {standby:.2f} W of standby")
         best_angles = load["fold_angle_deg"]
@@ -519,7 +519,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                     f"{rec['min']:g} to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
                     f"{load['median_near_optimal_width_deg']:g} deg wide)")
         if tilts is not None and rec["min"] is not None:
-            tilt, flat = load["surface_tilt"], load["flat_surface_tilt"]
+            tilt, flat = load["surface_tilt"], load["surface_tilt_flat"]
             rec_text += (f", at base tilts {tilt['min']:g} to {tilt['max']:g} deg (median {tilt['median']:g}; "
                          f"the flat panel's own best {flat['min']:g} to {flat['max']:g}, median {flat['median']:g})")
         # Where no site carries the load there is no gain to give, nor a best site.
@@ -547,6 +547,6 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                   + (sky if weather else sky_text(study, ("site", "date"))),
     }
     columns = ["site_id", "site_name", "latitude", "longitude", key, "fold_angle_deg", "surface_tilt",
-               "flat_surface_tilt", *NEAR_OPTIMAL]
+               "surface_tilt_flat", *NEAR_OPTIMAL]
     return Answer("map", "map", question, defaults, part, year[[c for c in year.columns if c not in NEAR_OPTIMAL]],
                   year[columns].reset_index(drop=True), pd.DataFrame(), [], tuple(lines))

@@ -1,5 +1,5 @@
 """The standby draw at which a tracker loses its lead over the twofold panel: a map's
-``tracker_break_even_standby_w`` (:func:`break_even_standby`).
+``break_even_standby_tracker_w`` (:func:`break_even_standby`).
 
 The module may import numpy, :mod:`foldopt.engine` and :mod:`foldopt.studies.objectives`.
 """

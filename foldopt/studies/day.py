@@ -242,7 +242,7 @@ class StudyResult:
         return of_study(self)
 
 
-def _best_angle(day: Day, angles, sweep_t_solar, connection, with_power: bool = False):
+def _best_angle(day: Day, fold_angles, sweep_t_solar, connection, with_power: bool = False):
     """The best fold angle [deg] and its t_solar [h]: the sweep's best, refined between its
     neighbours; ``with_power``, also its power [W], (n_time,), the refinement's curve where the
     angle is one of the refinement's."""
@@ -254,7 +254,7 @@ def _best_angle(day: Day, angles, sweep_t_solar, connection, with_power: bool = 
         evaluated.update(zip(fold.tolist(), power))
         return per_load(power, shape)
 
-    angle, hours = optimal_fold_angle(compared, angles, sweep_t_solar, day.study.p_load, day.step_hours)
+    angle, hours = optimal_fold_angle(compared, fold_angles, sweep_t_solar, day.study.p_load, day.step_hours)
     if not with_power:
         return angle, hours
     power = evaluated.get(angle)

@@ -225,7 +225,7 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
             metrics.energy.reshape(sky.n_blocks, angles.size))
 
 
-def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
+def design_metrics(sky: Sky, blocks: Blocks, loads, fold_angles, chosen, engine: str,
                    tracker: TrackerCurves | None = None, curves: bool = False) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
     panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net.
@@ -236,7 +236,7 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     blocks : Blocks
     loads : numpy.ndarray
         (n_loads,) [W].
-    angles : numpy.ndarray
+    fold_angles : numpy.ndarray
         The fold-angle grid [deg].
     chosen : numpy.ndarray of int
         (n_blocks, n_loads) index into ``angles`` of the twofold panel's angle.
@@ -260,7 +260,7 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
     study, blocks_of = blocks.study, blocks
     n_blocks, n_loads = sky.n_blocks, loads.size
     tilt, azimuth = blocks.tilt, blocks.azimuth
-    every = engines.fold_orientations(study, tilt, azimuth, angles)
+    every = engines.fold_orientations(study, tilt, azimuth, fold_angles)
     blocks = np.repeat(np.arange(n_blocks), n_loads)
     shape = sky.load_shape
     # One row per block and load, at that load's angle, with the load alone; the curves kept where
@@ -300,7 +300,7 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, angles, chosen, engine: str,
         served = np.stack([energy_served(flat.power[:, 0], loads, shape, step, flat.t_solar[:, 0]), twofold_served,
                            energy_served(gross, loads, shape, step, trackers.t_solar[:n_blocks, 0]),
                            energy_served(net, loads, shape, step, trackers.t_solar[n_blocks:, 0])], axis=-1)
-    fold = np.stack([np.full((n_blocks, n_loads), 180.0), angles[chosen], np.full((n_blocks, n_loads), np.nan),
+    fold = np.stack([np.full((n_blocks, n_loads), 180.0), fold_angles[chosen], np.full((n_blocks, n_loads), np.nan),
                      np.full((n_blocks, n_loads), np.nan)], axis=-1)
     columns = metric_columns(
         hours,
@@ -371,7 +371,7 @@ class DailyDesigns:
     flat_tilted: tuple | None = None
 
 
-def daily_designs(parts, loads, engine: str = "numba", fold=None) -> DailyDesigns:
+def daily_designs(parts, loads, engine: str = "numba", search=None) -> DailyDesigns:
     """:class:`DailyDesigns` over chunks of days at one site (:func:`site_designs` of one site).
 
     Parameters
@@ -381,14 +381,14 @@ def daily_designs(parts, loads, engine: str = "numba", fold=None) -> DailyDesign
     loads : array_like
         (n_loads,) [W]; an infinite load carries nothing.
     engine : {'numba', 'numpy'}
-    fold : callable, optional
+    search : callable, optional
         As :func:`site_designs`' (one site); default every angle of the study's grid.
     """
     n_blocks = sum(sky.n_blocks for _, sky in parts)
-    return site_designs(parts, [range(n_blocks)], np.asarray(loads, dtype=float)[None], engine, fold)[0]
+    return site_designs(parts, [range(n_blocks)], np.asarray(loads, dtype=float)[None], engine, search)[0]
 
 
-def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
+def site_designs(parts, sites, loads, engine: str = "numba", search=None) -> list:
     """:class:`DailyDesigns` of many sites over chunks of their days, every engine call over all of
     them (a map's batch of sites).
 
@@ -401,8 +401,8 @@ def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
     loads : array_like
         (n_sites, n_loads) each site's loads [W]; an infinite load carries nothing.
     engine : {'numba', 'numpy'}
-    fold : callable, optional
-        ``fold(parts, sites, loads, loadset, engine)`` -> per site ``(designs (n, 2) fold angle and
+    search : callable, optional
+        ``search(parts, sites, loads, loadset, engine)`` -> per site ``(designs (n, 2) fold angle and
         base tilt, hours (days, loads, n), energy (days, n), flat)`` at the designs it chooses to
         evaluate (a search: :func:`foldopt.studies.site_search.fold_search`), ``loadset`` each
         block's site, ``flat`` None or the flat panel at tilts of its own (``tilts, hours,
@@ -415,9 +415,9 @@ def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
     loads = np.asarray(loads, dtype=float)
     loadset = np.concatenate([np.full(len(blocks), site) for site, blocks in enumerate(sites)])
     study = parts[0][0].study
-    if fold is None:
-        fold = _every_angle
-    searched = fold(parts, sites, loads, loadset, engine)
+    if search is None:
+        search = _every_angle
+    searched = search(parts, sites, loads, loadset, engine)
     flat, flat_energy, flat_peak, tracker, available = [], [], [], [], []
     start = 0
     for chunk, sky in parts:
@@ -444,7 +444,7 @@ def site_designs(parts, sites, loads, engine: str = "numba", fold=None) -> list:
 
 
 def _every_angle(parts, sites, loads, loadset, engine):
-    """Every angle of the study's grid on every day of each site: ``site_designs``' default fold."""
+    """Every angle of the study's grid on every day of each site: ``site_designs``' default search."""
     study = parts[0][0].study
     angles = np.asarray(study.fold_angles.grid())
     tilt = np.concatenate([chunk.tilt for chunk, _ in parts])

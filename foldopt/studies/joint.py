@@ -197,13 +197,13 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
                           request)
 
 
-def _table(study, loads, twofold, flat, angles, best_default, default) -> pd.DataFrame:
+def _table(study, loads, twofold, flat, fold_angles, best_default, default) -> pd.DataFrame:
     rows = []
     flat_best = flat.best_value
     for index, load in enumerate(loads):
         designs = [("twofold", *twofold.best_point[index], twofold.best_value[index]),
                    ("flat", 180.0, *flat.best_point[index][1:], flat_best[index]),
-                   ("twofold-default", angles[best_default[index]], study.panel.tilt, study.panel.azimuth,
+                   ("twofold-default", fold_angles[best_default[index]], study.panel.tilt, study.panel.azimuth,
                     default["twofold-default"][index, best_default[index]]),
                    ("flat-default", 180.0, study.panel.tilt, study.panel.azimuth, default["flat-default"][index]),
                    ("tracker", np.nan, np.nan, np.nan, default["tracker"][index])]

@@ -128,12 +128,12 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis 
     Returns
     -------
     callable
-        ``fold(parts, sites, loads, loadset, engine)`` -> per site ``(points (n, 2) fold angle and
+        ``search(parts, sites, loads, loadset, engine)`` -> per site ``(points (n, 2) fold angle and
         tilt, hours (days, loads, n), energy (days, n), flat)``, ``flat`` the flat panel's ``(tilts
         (m,), hours (days, loads, m), energy (days, m))`` with ``tilt``, else None.
     """
 
-    def fold(parts, sites, loads, loadset, engine):
+    def search(parts, sites, loads, loadset, engine):
         study = parts[0][0].study
         grid = study.fold_angles
         fold_axis = Axis("fold_angle", grid.start, grid.stop, grid.step)
@@ -166,4 +166,4 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis 
                 for (points, hours, energy), (flat_points, flat_hours, flat_energy)
                 in zip(run([fold_axis, tilt], False), flats, strict=True)]
 
-    return fold
+    return search

@@ -57,7 +57,7 @@ class SweepResult:
         return columns + extra
 
 
-CASE_COLUMNS = ("site_name", "latitude", "longitude", "date", "day_of_year", "p_load_w")
+CASE_COLUMNS = ("site_name", "latitude", "longitude", "date", "dayofyear", "p_load_w")
 #: Axes whose values the case columns above already show.
 _AXIS_COLUMNS = frozenset({"site", "site.name", "site.latitude", "site.longitude", "date", "p_load"})
 
@@ -80,7 +80,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     Returns
     -------
     SweepResult
-        Columns: the case (``site_name``, ``latitude``, ``longitude``, ``date``, ``day_of_year``,
+        Columns: the case (``site_name``, ``latitude``, ``longitude``, ``date``, ``dayofyear``,
         ``p_load_w`` and any other swept field by its path), ``design``, ``fold_angle_deg`` and the
         daily metrics, ``gain_vs_flat_pct``, ``pct_of_tracker`` and ``note``
         (:func:`foldopt.engine.metrics.notes`: polar night, polar day, overcast, load above peak).
@@ -141,10 +141,10 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
             for part in blocks.chunks(loads.size):
                 chunk = blocks[part]
                 sky = counted(chunk.sky())
-                angles, hours, _ = fold_hours(sky, chunk, loads, engine)
+                fold_angles, hours, _ = fold_hours(sky, chunk, loads, engine)
                 hours = hours.transpose(0, 2, 1)  # (blocks, loads, angles)
-                metrics = design_metrics(sky, chunk, loads, angles, best_angle_index(hours), engine)
-                metrics.update(_twofold_only(near_optimal(angles, hours, chunk.study.near_optimal)))
+                metrics = design_metrics(sky, chunk, loads, fold_angles, best_angle_index(hours), engine)
+                metrics.update(_twofold_only(near_optimal(fold_angles, hours, chunk.study.near_optimal)))
                 for offset, index in enumerate(members[part]):
                     results[index] = {name: values[offset:offset + 1] for name, values in metrics.items()}
                 advance(len(chunk))
@@ -164,7 +164,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     for part in parts:
         skies.append(counted(blocks[part].sky()))
         _keep_sample(sample, skies[-1], blocks[part], blocks.members)
-        angles, hours, _ = fold_hours(skies[-1], blocks[part], loads, engine)
+        fold_angles, hours, _ = fold_hours(skies[-1], blocks[part], loads, engine)
         daily.append(hours)
         advance(len(blocks[part]) // blocks.members)
     members = blocks.members
@@ -185,17 +185,18 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         # The day x hour maps of the first load's angle, every day at once.
         # The maps show the first member of each day.
         first = list(range(0, len(chunk), members))
-        orientation = engines.fold_orientations(study, chunk.tilt[first], chunk.azimuth[first], angles[fixed[:1]])
+        orientation = engines.fold_orientations(study, chunk.tilt[first], chunk.azimuth[first], fold_angles[fixed[:1]])
         powers, state = engines.powers(sky, study, orientation[:, 0], first, series=study.switch_series,
                                        with_state=True)
         series["p_twofold_w"].append(powers[study.connection])
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
-        metrics.append(design_metrics(sky, chunk, loads, angles, np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
+        metrics.append(design_metrics(sky, chunk, loads, fold_angles,
+                                      np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
                                       engine))
         advance(len(chunk) // members)
     clock = skies[0].grid.clock_hours[0]
     design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (blocks, loads, designs)
-    near = near_optimal(angles, score, study.near_optimal)  # each (loads,)
+    near = near_optimal(fold_angles, score, study.near_optimal)  # each (loads,)
     spread = None
     if ensemble is not None:
         design_hours = design_hours.reshape(len(months), members, *design_hours.shape[1:])
@@ -203,18 +204,19 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
                                                                   objective.months) for m in range(members)]),
                   **{key: ensemble[key] for key in ("chosen_wins_pct", "within_tolerance_pct", "regret_h")}}
         design_hours = design_hours.mean(axis=1)  # (days, loads, designs): the members' mean day
-    refold = {"annual_objective": objective_table(blocks, loads, angles[fixed], design_hours, months, objective, near,
-                                                  spread)}
+    refold = {"annual_objective": objective_table(blocks, loads, fold_angles[fixed], design_hours, months, objective,
+                                                  near, spread)}
     if objective.visits:
-        refold.update(refold_tables(blocks, loads, angles, daily, months, objective, design_hours))
-    extras = {"dates": list(blocks.dates[::members]), "hours": clock, "fold_angle": float(angles[fixed[0]]), **refold,
+        refold.update(refold_tables(blocks, loads, fold_angles, daily, months, objective, design_hours))
+    extras = {"dates": list(blocks.dates[::members]), "hours": clock, "fold_angle": float(fold_angles[fixed[0]]),
+              **refold,
               **({"weather_sample": sample} if sample else {}),
               **{key: np.concatenate(value) for key, value in series.items()},
               "by_angle": pd.DataFrame({
-                  "p_load_w": np.repeat(loads, angles.size), "fold_angle_deg": np.tile(angles, loads.size),
+                  "p_load_w": np.repeat(loads, fold_angles.size), "fold_angle_deg": np.tile(fold_angles, loads.size),
                   "objective_h": score.ravel(), "mean_t_solar_h": daily.mean(axis=0).ravel(),
                   "min_t_solar_h": daily.min(axis=0).ravel(),
-                  "chosen": np.ravel(np.arange(angles.size) == fixed[:, None]),
+                  "chosen": np.ravel(np.arange(fold_angles.size) == fixed[:, None]),
                   **({"wins_pct": ensemble["wins_pct"].ravel()} if ensemble is not None else {}),
               })}
     group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
@@ -361,7 +363,7 @@ def _case(site, date, choice: dict) -> dict:
         "latitude": site.latitude,
         "longitude": site.longitude,
         "date": date.isoformat(),
-        "day_of_year": date.timetuple().tm_yday,
+        "dayofyear": date.timetuple().tm_yday,
         **{path: _plain(value) for path, value in choice.items() if path not in _AXIS_COLUMNS},
     }
 
@@ -378,7 +380,7 @@ def _plain(value):
 GROUP_TABLES = ("annual_objective", "refold_value", "refold_schedule")
 
 
-def refold_tables(blocks: Blocks, loads, angles, daily, months, objective, design_hours) -> dict:
+def refold_tables(blocks: Blocks, loads, fold_angles, daily, months, objective, design_hours) -> dict:
     """The best re-fold schedules of one annual group (:func:`foldopt.engine.schedule.best_schedules`):
 
     ``refold_value``, per load and number of settings k: the objective and the mean daily t_solar
@@ -392,7 +394,7 @@ def refold_tables(blocks: Blocks, loads, angles, daily, months, objective, desig
         The group's days.
     loads : array_like
         (n_loads,) [W].
-    angles : numpy.ndarray
+    fold_angles : numpy.ndarray
         The fold-angle grid [deg].
     daily : numpy.ndarray
         (days, loads, angles) daily t_solar of the twofold panel [h].
@@ -429,5 +431,5 @@ def refold_tables(blocks: Blocks, loads, angles, daily, months, objective, desig
             previous = schedule.objective_h
             for visit, (start, angle) in enumerate(zip(schedule.starts, schedule.angles, strict=True), start=1):
                 visits.append({**where, "p_load_w": float(load), "settings": k, "visit": visit,
-                               "date": blocks.dates[start].isoformat(), "fold_angle_deg": float(angles[angle])})
+                               "date": blocks.dates[start].isoformat(), "fold_angle_deg": float(fold_angles[angle])})
     return {"refold_value": pd.DataFrame(values), "refold_schedule": pd.DataFrame(visits)}

@@ -61,12 +61,12 @@ def _design_hours(study: Study, date, loads, members: int = 1):
     panel at each member's own best angle without an ensemble, at the ensemble's with one."""
     blocks = Blocks.of_dates(study, [date])
     sky = blocks.sky()
-    angles, hours, _ = fold_hours(sky, blocks, loads)  # (members, angles, loads)
+    fold_angles, hours, _ = fold_hours(sky, blocks, loads)  # (members, angles, loads)
     hours = hours.transpose(0, 2, 1)
     chosen = best_angle_index(hours.mean(axis=0))  # (loads,)
-    metrics = design_metrics(sky, blocks, loads, angles, np.broadcast_to(chosen, (sky.n_blocks, loads.size)),
+    metrics = design_metrics(sky, blocks, loads, fold_angles, np.broadcast_to(chosen, (sky.n_blocks, loads.size)),
                              "numba")
-    return metrics["t_solar_h"], angles[chosen]
+    return metrics["t_solar_h"], fold_angles[chosen]
 
 
 def minute_validation(study: Study, loads, members: int = 20, seed: int = 0) -> pd.DataFrame:

@@ -376,7 +376,7 @@ def evaluate_sites(study: Study | dict, sites: Sequence[dict], loads: Sequence[f
     -------
     pandas.DataFrame
         One row per site, load and period: ``site_id``, ``site_name``, ``latitude``,
-        ``longitude``, ``weather``, ``flat_peak_w``, ``p_load_w``, ``p_load_fraction``, ``period``,
+        ``longitude``, ``weather``, ``peak_power_flat_w``, ``p_load_w``, ``p_load_fraction``, ``period``,
         ``days``, ``fold_angle_deg``; the objective [h] of each design (``objective_flat_h``,
         ``objective_twofold_h``, ``objective_tracker_h``); mean daily t_solar [h]
         (``mean_t_solar_flat_h``, ``mean_t_solar_twofold_h``, ``mean_t_solar_tracker_h``, the tracker's net of its
@@ -386,7 +386,7 @@ def evaluate_sites(study: Study | dict, sites: Sequence[dict], loads: Sequence[f
         the near-optimal range of the fold angle and the recommended angle at its centre
         (``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg``,
         ``near_optimal_tolerance_h``: :func:`foldopt.studies.objectives.near_optimal`);
-        ``tracker_break_even_standby_w``, the standby draw [W] above which the twofold panel's
+        ``break_even_standby_tracker_w``, the standby draw [W] above which the twofold panel's
         objective exceeds the tracker's (0 where it already does; NaN where the twofold panel
         never carries the load).
     """
@@ -426,33 +426,33 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
                                                    outputs=("panel",), engine=engine).peak[:, 0]
                                for chunk, sky in parts])
         flat_peak = np.array([float(peak[days].max()) for days in sites])
-    watts = loads[None, :] * flat_peak[:, None] if relative else np.broadcast_to(loads, (len(batch), loads.size))
+    p_load = loads[None, :] * flat_peak[:, None] if relative else np.broadcast_to(loads, (len(batch), loads.size))
     # A load of 0 W (a site whose flat panel never sees the sun) has no t_solar to speak of.
-    usable = np.where(watts > 0, watts, np.inf)
+    p_load_evaluated = np.where(p_load > 0, p_load, np.inf)
     months = [np.array([date.month for date in dates]) for _, _, dates in batch]
     seasons = [None, *SEASONS.values()]
     # A map searches the fold angles (foldopt.studies.site_search) unless its study sweeps them all.
     search = study.optimize
-    fold = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h,
+    searcher = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h,
                                                    _tilt_axis(search))
-    designs = site_designs(parts, sites, usable, engine, fold)
+    designs = site_designs(parts, sites, p_load_evaluated, engine, searcher)
     if flat_peak is None:
         # Loads in watts: the peak of the flat panel's one pass, the one its rows come from.
-        flat_peak = np.array([float(days_of.flat_peak_w.max()) for days_of in designs])
+        flat_peak = np.array([float(days_of.peak_power_flat_w.max()) for days_of in designs])
     columns: dict[str, list] = {}
-    for (site, here, _), days_of, site_months, peak_w, site_watts, site_usable in zip(
-            batch, designs, months, flat_peak, watts, usable, strict=True):
-        for name, values in _site_rows(days_of, site_months, statistic, seasons, site_usable, study,
+    for (site, here, _), days_of, site_months, peak_w, site_p_load, site_p_load_evaluated in zip(
+            batch, designs, months, flat_peak, p_load, p_load_evaluated, strict=True):
+        for name, values in _site_rows(days_of, site_months, statistic, seasons, site_p_load_evaluated, study,
                                        here.panel.tilt).items():
             columns.setdefault(name, []).append(values)
         count = len(PERIODS) * loads.size
         fixed = {"site_id": site.get("site_id", 0), "site_name": site.get("name") or "",
                  "latitude": here.site.latitude, "longitude": here.site.longitude,
-                 "weather": Path(site["weather"]).name if "weather" in site else "", "flat_peak_w": peak_w}
+                 "weather": Path(site["weather"]).name if "weather" in site else "", "peak_power_flat_w": peak_w}
         for name, value in fixed.items():
             columns.setdefault(name, []).append(np.full(count, value, dtype=object if isinstance(value, str) else None))
-        columns.setdefault("p_load_w", []).append(np.tile(site_watts, len(PERIODS)))
-        fraction = site_watts / peak_w if peak_w > 0 else np.full(loads.size, np.nan)
+        columns.setdefault("p_load_w", []).append(np.tile(site_p_load, len(PERIODS)))
+        fraction = site_p_load / peak_w if peak_w > 0 else np.full(loads.size, np.nan)
         columns.setdefault("p_load_fraction", []).append(np.tile(fraction, len(PERIODS)))
     # The tracker's break-even standby of every site of the same days at once (their sites' own else).
     targets = np.stack(columns["objective_twofold_h"]).reshape(len(batch), len(PERIODS), loads.size)
@@ -461,12 +461,12 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     standby = np.empty(targets.shape)
     for group in groups:
         standby[group] = break_even_standby(np.concatenate([designs[i].available for i in group]), targets[group],
-                                            usable[group], months[group[0]], statistic, seasons, step_hours, engine)
-    columns["tracker_break_even_standby_w"] = list(standby.reshape(len(batch), -1))
-    order = ["site_id", "site_name", "latitude", "longitude", "weather", "flat_peak_w", "p_load_w", "p_load_fraction",
-             "period", "days", "fold_angle_deg", "surface_tilt", "flat_surface_tilt", *ROW_VALUES, "gain_vs_flat_pct",
-             "energy_gain_vs_flat_pct",
-             "pct_of_tracker", "tracker_break_even_standby_w"]
+                                            p_load_evaluated[group], months[group[0]], statistic, seasons, step_hours,
+                                            engine)
+    columns["break_even_standby_tracker_w"] = list(standby.reshape(len(batch), -1))
+    order = ["site_id", "site_name", "latitude", "longitude", "weather", "peak_power_flat_w", "p_load_w",
+             "p_load_fraction", "period", "days", "fold_angle_deg", "surface_tilt", "surface_tilt_flat", *ROW_VALUES,
+             "gain_vs_flat_pct", "energy_gain_vs_flat_pct", "pct_of_tracker", "break_even_standby_tracker_w"]
     return pd.DataFrame({name: np.concatenate(columns[name]) for name in order})
 
 
@@ -504,15 +504,15 @@ def _chosen(hours, energy, months, statistic: str, seasons, member):
     return best, objective, mean_h, energy_wh, every
 
 
-def _site_rows(days_of, months, statistic: str, seasons, usable, study, site_tilt: float) -> dict:
+def _site_rows(days_of, months, statistic: str, seasons, p_load_evaluated, study, surface_tilt: float) -> dict:
     """One site's columns, per period and load (periods slowest), from its :class:`DailyDesigns`."""
     angles = days_of.angles
-    n_loads = usable.size
+    n_loads = p_load_evaluated.size
     member = np.stack([season_days(months, season) for season in seasons])
     best, twofold, twofold_mean, twofold_wh, objective = _chosen(days_of.twofold_h, days_of.twofold_wh, months,
                                                                 statistic, seasons, member)
     # The flat panel at the site's mounting, or at each period's and load's own best tilt.
-    flat_hours, flat_energy, flat_tilts = days_of.flat_h[..., None], days_of.flat_wh[:, None], np.array([site_tilt])
+    flat_hours, flat_energy, flat_tilts = days_of.flat_h[..., None], days_of.flat_wh[:, None], np.array([surface_tilt])
     if days_of.flat_tilted is not None:
         flat_tilts, flat_hours, flat_energy = days_of.flat_tilted
     flat_best, flat, flat_mean, flat_wh, _ = _chosen(flat_hours, flat_energy, months, statistic, seasons, member)
@@ -526,14 +526,14 @@ def _site_rows(days_of, months, statistic: str, seasons, usable, study, site_til
         profile = np.full((profile.shape[0], fold_angles.size), -np.inf)
         np.maximum.at(profile, (slice(None), column.ravel()), objective.reshape(-1, angles.size))
     ranges = near_optimal_on_grid(fold_angles, profile, study.near_optimal, np.asarray(study.fold_angles.grid()))
-    carried = np.isfinite(usable)
+    carried = np.isfinite(p_load_evaluated)
     rows = {
         "period": np.repeat(np.array(PERIODS, dtype=object), n_loads),
         "days": np.repeat(member.sum(axis=1), n_loads),
         "fold_angle_deg": np.where(carried, angles[best], np.nan).ravel(),
         "surface_tilt": np.where(carried, days_of.tilts[best] if days_of.tilts is not None
-                                 else np.full(best.shape, site_tilt), np.nan).ravel(),
-        "flat_surface_tilt": np.where(carried, flat_tilts[flat_best], np.nan).ravel(),
+                                 else np.full(best.shape, surface_tilt), np.nan).ravel(),
+        "surface_tilt_flat": np.where(carried, flat_tilts[flat_best], np.nan).ravel(),
         "objective_flat_h": flat.ravel(),
         "objective_twofold_h": twofold.ravel(),
         "objective_tracker_h": tracker[:, 0].ravel(),

@@ -12,7 +12,7 @@ from foldopt.output.figures.canvas import FigureFile, colour_scale, new_axes
 AXIS_LABELS = {
     "latitude": "latitude [deg]",
     "p_load_w": "P_load [W]",
-    "day_of_year": "day of year",
+    "dayofyear": "day of year",
 }
 
 
@@ -112,7 +112,7 @@ def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label:
     """
     grid = table.pivot_table(index=y, columns=x, values=value, aggfunc="mean")
     fig, ax = new_axes(ax, (8, 5))
-    (x_edges, x_cells), (y_edges, y_cells) = (cells(axis, DAY_GAP if name == "day_of_year" else np.inf)
+    (x_edges, x_cells), (y_edges, y_cells) = (cells(axis, DAY_GAP if name == "dayofyear" else np.inf)
                                               for axis, name in ((grid.columns, x), (grid.index, y)))
     values = grid.to_numpy(dtype=float)[np.ix_(y_cells, x_cells)]
     data = np.ma.masked_invalid(np.where((y_cells[:, None] >= 0) & (x_cells[None, :] >= 0), values, np.nan))
@@ -156,7 +156,7 @@ def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = Non
             curve = rows[rows["design"] == design].groupby(x)["t_solar_h"].mean()
             name = "optimal twofold" if design == "twofold" else design
             label = name if split is None else f"{name}, {split} {value}"
-            xs, ys, alone = broken_at_gaps(curve.index, curve.to_numpy(), DAY_GAP if x == "day_of_year" else np.inf)
+            xs, ys, alone = broken_at_gaps(curve.index, curve.to_numpy(), DAY_GAP if x == "dayofyear" else np.inf)
             ax.plot(xs, ys, color=colour, ls=style, lw=2 if design == "twofold" else 1.3, label=label,
                     marker="o" if alone.any() else None, ms=4, markevery=alone.tolist())
     ax.set_xlabel(AXIS_LABELS.get(x, x))

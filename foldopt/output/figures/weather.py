@@ -74,10 +74,10 @@ def plot_member_t_solar(table: pd.DataFrame, title: str, ax=None, study=None):
     fig, ax = new_axes(ax, (8, 4))
     load = sorted(table["p_load_w"].unique())[0]
     for design, colour in (("flat", "0.35"), ("twofold", "tab:blue")):
-        rows = table[(table["design"] == design) & (table["p_load_w"] == load)].sort_values("day_of_year")
+        rows = table[(table["design"] == design) & (table["p_load_w"] == load)].sort_values("dayofyear")
         # Line and band stop where nothing was evaluated between two days (solstices, months).
         (days, p10, alone), (_, p50, _), (_, p90, _) = (
-            broken_at_gaps(rows["day_of_year"], rows[column], DAY_GAP)
+            broken_at_gaps(rows["dayofyear"], rows[column], DAY_GAP)
             for column in ("t_solar_p10_h", "t_solar_p50_h", "t_solar_p90_h"))
         ax.fill_between(days, p10, p90, where=~alone, color=colour, alpha=0.25, lw=0)
         ax.vlines(days[alone], p10[alone], p90[alone], color=colour, alpha=0.25, lw=4)  # a lone day's band
