@@ -264,7 +264,10 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, fold_angles, chosen, engine:
     blocks = np.repeat(np.arange(n_blocks), n_loads)
     shape = sky.load_shape
     # One row per block and load, at that load's angle, with the load alone; the curves kept where
-    # asked for and where a load profile's served energy integrates over them.
+    # asked for and where a load profile's served energy integrates over them. A sweep's chosen
+    # angle was in fold_hours' pass too, but without the longest runs, which would cost that pass
+    # 1.4x (one load) to 4.5x (50 loads), some 3 to 10 times this pass; its t_solar, of every load
+    # at once, differs from this row's in the last bits (the loads' bins are summed in another order).
     outputs = CONNECTIONS if curves else (study.connection,)
     own = outputs.index(study.connection)
     keep = curves or shape is not None
