@@ -63,7 +63,7 @@ def test_a_map_evaluates_its_flat_panel_once(monkeypatch):
     table = evaluate_sites(study, [{"latitude": 34.05, "longitude": -118.25}], [1.0, 4.0])
     flat = [kwargs for _, kwargs in calls if kwargs.get("outputs") == ("panel",)]
     assert len(flat) == 1
-    assert table["flat_peak_w"].gt(0).all()
+    assert table["peak_power_flat_w"].gt(0).all()
 
 
 def test_the_figures_draw_the_curves_the_table_was_reduced_from(shin_study):

@@ -289,17 +289,17 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     # A load profile: P_load(t) = p_load x shape(t). The flat-area multiple and the standby
     # break-even are defined for a constant load and are left out.
     shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
-    angles = np.asarray(study.fold_angles.grid())
-    metrics = engines.row_metrics(day.sky, study, np.zeros(angles.size), day.orientation(angles), [p_load],
+    fold_angles = np.asarray(study.fold_angles.grid())
+    metrics = engines.row_metrics(day.sky, study, np.zeros(fold_angles.size), day.orientation(fold_angles), [p_load],
                                   outputs=CONNECTIONS, contiguous=True, engine=engine)
     own = CONNECTIONS.index(study.connection)
     # The grid's curves, once: the noon valley's sub-panels and, under a load profile, the served
     # energy's connection (curves the metrics above do not keep).
-    curves, _ = day.connections(angles, shape is not None and (study.connection == "series" or study.switch_series),
-                                with_state=False)
+    series = shape is not None and (study.connection == "series" or study.switch_series)
+    curves, _ = day.connections(fold_angles, series, with_state=False)
     served = None if shape is None else energy_served(curves[study.connection], p_load, shape, step,
                                                       metrics.t_solar[:, own, 0])
-    sweep = pd.DataFrame({"fold_angle_deg": angles,
+    sweep = pd.DataFrame({"fold_angle_deg": fold_angles,
                           **metric_columns(metrics.t_solar[:, own, 0], metrics.t_solar_contiguous[:, own, 0],
                                             metrics.energy[:, own], metrics.peak[:, own], p_load, served)})
     sweep["noon_valley_w"] = noon_valley(curves["east"], curves["west"], curves["parallel"])
@@ -307,7 +307,7 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
         sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
         sweep[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
 
-    best_angle, best_hours = _best_angle(day, angles, sweep["t_solar_h"].to_numpy(), study.connection)
+    best_angle, best_hours = _best_angle(day, fold_angles, sweep["t_solar_h"].to_numpy(), study.connection)
     # The designs every study compares, each evaluated once, as for sweeps, annual studies and maps
     # (the study's tracker from the curve the figures draw); the others (the heuristic's angle, the
     # other connections, the other trackers) from their curves. The figures and the time series
@@ -323,7 +323,7 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
 
     def subpanels(fold):
         # An angle of the grid (the root search's bracket) from the grid's curves.
-        at = np.flatnonzero(angles == fold[0]) if fold.size == 1 else []
+        at = np.flatnonzero(fold_angles == fold[0]) if fold.size == 1 else []
         return (tuple(curves[name][at[:1]] for name in ("east", "west", "parallel")) if len(at)
                 else day.subpanel_power(fold))
 
@@ -335,7 +335,7 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     if day.electrical.pv.has_iv:
         for connection in ("parallel", "series", "independent", "switching"):
             if connection != study.connection:
-                angle, _, power = _best_angle(day, angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection,
+                angle, _, power = _best_angle(day, fold_angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection,
                                               with_power=True)
                 others[f"twofold-{connection}"] = (angle, power)
     # Every other tracker model follows the study's as "tracker:<model>"; each net row is what is

@@ -208,7 +208,7 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
 
     Returns
     -------
-    angles : numpy.ndarray
+    fold_angles : numpy.ndarray
         The study's fold-angle grid [deg], (n_angles,).
     hours : numpy.ndarray
         (n_blocks, n_angles, n_loads).
@@ -216,13 +216,13 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
         Harvested energy [Wh], (n_blocks, n_angles).
     """
     study = blocks.study
-    angles = np.asarray(study.fold_angles.grid())
-    orientation = engines.fold_orientations(study, blocks.tilt, blocks.azimuth, angles)
-    rows = np.repeat(np.arange(sky.n_blocks), angles.size)
+    fold_angles = np.asarray(study.fold_angles.grid())
+    orientation = engines.fold_orientations(study, blocks.tilt, blocks.azimuth, fold_angles)
+    rows = np.repeat(np.arange(sky.n_blocks), fold_angles.size)
     metrics = engines.row_metrics(sky, study, rows, orientation.reshape(-1, 4), loads, outputs=(study.connection,),
                                   engine=engine)
-    return (angles, metrics.t_solar.reshape(sky.n_blocks, angles.size, -1),
-            metrics.energy.reshape(sky.n_blocks, angles.size))
+    return (fold_angles, metrics.t_solar.reshape(sky.n_blocks, fold_angles.size, -1),
+            metrics.energy.reshape(sky.n_blocks, fold_angles.size))
 
 
 def design_metrics(sky: Sky, blocks: Blocks, loads, fold_angles, chosen, engine: str,
@@ -348,7 +348,7 @@ class DailyDesigns:
         (days, loads); the tracker net of its own draw; the flat panel at the site's mounting.
     flat_wh, tracker_wh : numpy.ndarray
         (days,); the tracker's gross harvest.
-    flat_peak_w : numpy.ndarray
+    peak_power_flat_w : numpy.ndarray
         (days,) the flat panel's peak power [W].
     available : numpy.ndarray
         (days, steps) [W]: the tracker's power left for the load and a standby draw
@@ -369,7 +369,7 @@ class DailyDesigns:
     tracker_net_h: np.ndarray
     tracker_wh: np.ndarray
     available: np.ndarray
-    flat_peak_w: np.ndarray
+    peak_power_flat_w: np.ndarray
     tilts: np.ndarray | None = None
     flat_tilted: tuple | None = None
 
@@ -449,11 +449,11 @@ def site_designs(parts, sites, loads, engine: str = "numba", search=None) -> lis
 def _every_angle(parts, sites, loads, loadset, engine):
     """Every angle of the study's grid on every day of each site: ``site_designs``' default search."""
     study = parts[0][0].study
-    angles = np.asarray(study.fold_angles.grid())
+    fold_angles = np.asarray(study.fold_angles.grid())
     tilt = np.concatenate([chunk.tilt for chunk, _ in parts])
     azimuth = np.concatenate([chunk.azimuth for chunk, _ in parts])
-    requests = [(np.asarray(blocks), np.column_stack([angles, np.full(angles.size, tilt[blocks[0]]),
-                                                      np.full(angles.size, azimuth[blocks[0]])]))
+    requests = [(np.asarray(blocks), np.column_stack([fold_angles, np.full(fold_angles.size, tilt[blocks[0]]),
+                                                      np.full(fold_angles.size, azimuth[blocks[0]])]))
                 for blocks in sites]
     done = requested_hours(parts, requests, loads, loadset, engine=engine)
     return [(points, hours.transpose(0, 2, 1), energy, None)
