@@ -1,5 +1,6 @@
 """Shared fixtures: the paper's study as shipped, a cheap variant for fast tests, and a small tmpfs for full disks."""
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -63,10 +64,10 @@ def small_disk(tmp_path):
         subprocess.run(["umount", str(disk)], check=True)
 
 
-@pytest.fixture(scope="module")
-def scheduler():
-    """A Dask scheduler and one single-threaded worker in this process, on 127.0.0.1 (no process to
-    start: seconds saved); yields its address. Skipped without distributed."""
+@contextlib.contextmanager
+def _in_process_cluster():
+    """A Dask scheduler and one single-threaded worker in this process, on 127.0.0.1; yields its
+    address. Skipped without distributed."""
     import logging
 
     distributed = pytest.importorskip("distributed")
@@ -76,3 +77,20 @@ def scheduler():
         yield cluster.scheduler_address
     finally:
         cluster.close()
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    """The address of a Dask cluster in this process (no process to start: a map's embedded
+    cluster, ``--workers 1``, starts one that imports foldopt and loads its compiled code again,
+    5-18 s on the 2-core machine). Tests whose point is the embedded cluster or a process of its
+    own are tests/test_cluster.py's."""
+    with _in_process_cluster() as address:
+        yield address
+
+
+@pytest.fixture(scope="session")
+def in_process_scheduler():
+    """For session-scoped fixtures that run a map: the context manager :func:`scheduler` enters,
+    to enter for as long as the map runs."""
+    return _in_process_cluster

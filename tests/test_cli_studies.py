@@ -151,14 +151,15 @@ def test_a_weather_file_alone_runs_a_year(tmp_path):
     assert_one_line_error(bad, "tracker.gcr", "(0, 1]")
 
 
-def test_a_map_takes_the_load_range_of_its_study_file(tmp_path):
+def test_a_map_takes_the_load_range_of_its_study_file(tmp_path, scheduler):
     """A study file's ``p_load`` range is the map's loads, checked like ``--p-load`` (it was an
     internal error); a load no site carries is said without a best site."""
     study = tmp_path / "ranged.yaml"
     shipped = Path(__file__).resolve().parent.parent / "configs" / "load-sweep.yaml"
     study.write_text(shipped.read_text().replace('p_load: "0.5:19:0.5"', 'p_load: "1:31:30"'))
+    # On the in-process cluster (conftest.scheduler): what is tested is the map's loads, not its cluster.
     shown = invoke("map", "--config", study, "--lat", "0", "--lon", "0", "--step-min", "60", "--angle-step", "90",
-                   "--workers", "1", "--out", tmp_path / "m", "--format", "json")
+                   "--scheduler", scheduler, "--out", tmp_path / "m", "--format", "json")
     assert shown.exit_code == 0, shown.output
     answer = json.loads(shown.stdout)["answer"]
     assert "P_load 2 loads, 1 to 31 W" in answer["defaults"]["taken"]

@@ -184,24 +184,26 @@ def test_size_refuses_what_the_api_refuses(option, parameter, value):
     assert "must be a finite number > 0 and at most" in line
 
 
-def test_a_map_request_is_the_api_request(tmp_path, monkeypatch):
+def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler):
     """A map of named sites at the study's load through the command line, and the same request
     made with foldopt.studies.request.map_request_from and run by foldopt.world_map: the same rows
     to the bit, the same answer, the same things taken from the study; every view carries the
     near-optimal range and the recommended angle. world_map runs the request it is given: it does
-    not build and check it again (it did, after the command line had)."""
+    not build and check it again (it did, after the command line had). Both on the in-process
+    cluster (conftest.scheduler): an embedded one (workers=1) started a process for each map,
+    which imported foldopt and loaded its compiled code again."""
     import foldopt.studies.worldmap
     from foldopt.studies.request import map_request_from
 
     sites = tmp_path / "sites.csv"
     sites.write_text("name,latitude,longitude\nquito,-0.18,-78.47\noslo,59.91,10.75\nsydney,-33.87,151.21\n")
-    document, folder, _ = cli(tmp_path, "map", "--sites", sites, "--workers", "1", "--step-min", "60",
+    document, folder, _ = cli(tmp_path, "map", "--sites", sites, "--scheduler", scheduler, "--step-min", "60",
                               "--angle-step", "10")
     request = map_request_from(sites=str(sites), step_min=60.0, angle_step=10.0)
     assert [site["name"] for site in request.sites] == ["quito", "oslo", "sydney"]
     assert isinstance(request.study, foldopt.Study)  # what the map ships to its workers
     monkeypatch.setattr(foldopt.studies.worldmap, "map_request", None)  # a second build would fail
-    result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", workers=1)
+    result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", scheduler=scheduler)
     year = result.table[result.table["period"] == "year"].reset_index(drop=True)
     same_rows(document, year)
     api = json.loads(json.dumps(answer.to_dict()))

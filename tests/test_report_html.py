@@ -3,6 +3,7 @@ the page logs nothing to the console, it fetches nothing, and it renders at a ph
 
 from __future__ import annotations
 
+import contextlib
 import re
 import shutil
 import subprocess
@@ -26,7 +27,7 @@ COMMANDS = {
     "annual": ["sweep", "day", "--days", "1:365:61", "--objective", "mean", *QUICK],
     "size": ["size", "--areas", "0.05:0.2:0.05"],
     "reproduce": ["reproduce"],
-    "map": ["map", "--lat", "0,40", "--lon", "0", "--p-load", "2", *QUICK, "--workers", "1"],
+    "map": ["map", "--lat", "0,40", "--lon", "0", "--p-load", "2", *QUICK],  # its cluster: folders
 }
 CHROMIUM = next((shutil.which(name) for name in ("chromium", "chromium-browser", "google-chrome")
                  if shutil.which(name)),
@@ -39,11 +40,15 @@ def _browser(*args: str) -> subprocess.CompletedProcess:
 
 
 @pytest.fixture(scope="session")
-def folders(tmp_path_factory) -> dict[str, Path]:
+def folders(tmp_path_factory, in_process_scheduler) -> dict[str, Path]:
     root = tmp_path_factory.mktemp("reports")
     out = {}
     for name, args in COMMANDS.items():
-        result = runner.invoke(app, [*args, "--out", str(root / name), "-q"])
+        # The map on a cluster in this process: an embedded one (--workers 1) started a process that
+        # imported foldopt and loaded its compiled code again.
+        with in_process_scheduler() if name == "map" else contextlib.nullcontext() as address:
+            cluster = ["--scheduler", address] if address else []
+            result = runner.invoke(app, [*args, *cluster, "--out", str(root / name), "-q"])
         assert result.exit_code == 0, (name, result.output)
         out[name] = root / name
     return out
