@@ -33,8 +33,8 @@ def test_tmy3_timestamps_move_to_interval_centres():
 def test_beam_only_equals_transposition_without_diffuse():
     # Meinel gives beam only; through the isotropic transposition with no diffuse and no ground
     # reflection, the sub-panels must see exactly the beam-only irradiance.
-    beam = Day(make_study({**BASE, "transposition": "none"}))
-    transposed = Day(make_study({**BASE, "transposition": "isotropic", "albedo": 0.0}))
+    beam = Day(make_study({**BASE, "sky": "meinel", "transposition": "none"}))
+    transposed = Day(make_study({**BASE, "sky": "meinel", "transposition": "isotropic", "albedo": 0.0}))
     angles = np.array([30.0, 90.0, 180.0])
     for name in ("east", "west", "switching"):
         np.testing.assert_allclose(transposed.connections(angles)[0][name], beam.connections(angles)[0][name],
