@@ -20,6 +20,9 @@ from foldopt.errors import WeatherError
 
 DATA = Path(pvlib.__file__).parent / "data"
 TMY3 = DATA / "723170TYA.CSV"  # Greensboro, NC: 2 header lines, then 8760 rows from line 3
+#: One worker runs this module (pytest-xdist --dist loadgroup), so that the session's written EPW and
+#: PVGIS years are written once, not by each worker that runs a test of it.
+pytestmark = pytest.mark.xdist_group("weather_validation")
 STUDY = {"name": "g", "panel": {"area": 0.108}, "p_load": 2.0}
 # Columns of a TMY3 row (0-based), as the sample's line 2 names them.
 GHI, DNI, DHI, DRY_BULB = 4, 7, 10, 31

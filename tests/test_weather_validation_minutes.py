@@ -15,6 +15,9 @@ from pathlib import Path
 import pytest
 
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "weather_validation.py"
+#: One worker runs this module (pytest-xdist --dist loadgroup): its three tests share one table of 20-member
+#: ensembles (15-30 s), which each worker built again when both ran a test of it.
+pytestmark = pytest.mark.xdist_group("weather_minutes")
 
 
 @pytest.fixture(scope="session")
