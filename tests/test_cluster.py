@@ -176,12 +176,14 @@ def test_the_maps_digest_is_worked_out_once(monkeypatch):
     assert len({spec.key for _ in range(len(spec.chunks()))}) == 1 and len(calls) == 1
 
 
-def test_resume_refuses_another_map(tmp_path):
+def test_resume_refuses_another_map(tmp_path, scheduler):
     out = tmp_path / "map"
     spec = MapSpec({"name": "x", "panel": {"area": 0.1}, "sky": "ineichen", "mode": "exact", "step_min": 60,
                     "fold_angles": {"start": 90, "stop": 180, "step": 90}}, ({"latitude": 0.0, "longitude": 0.0},),
                    (1.0,), sites_per_chunk=1)
-    run_map(spec, out, workers=1)
+    # What is tested is the folder, not the cluster: conftest's in-process one (an embedded cluster
+    # started a worker process, 3-10 s).
+    run_map(spec, out, scheduler=scheduler)
     other = MapSpec(spec.study.variant(panel={"area": 0.2}), spec.sites, spec.loads, sites_per_chunk=1)
     with pytest.raises(OutputError, match="holds another map \\(its study differ"):
         run_map(other, out, resume=True)
