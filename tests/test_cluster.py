@@ -14,7 +14,9 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from typer.testing import CliRunner
 
+from foldopt.cli.app import app
 from foldopt.errors import ConfigError
 from foldopt.studies.cluster import MapSpec, run_map
 from foldopt.errors import OutputError
@@ -68,9 +70,12 @@ def _parts(folder: Path) -> dict[str, tuple]:
 
 @pytest.fixture(scope="session")
 def embedded(tmp_path_factory) -> pd.DataFrame:
-    """The reference: the map on the embedded cluster, uninterrupted."""
+    """The reference: the map on the embedded cluster, uninterrupted. The command line runs in
+    this process (its cluster's worker is a process of its own still): the runs below that are
+    killed, refused and resumed are the ones whose process is the point."""
     out = tmp_path_factory.mktemp("embedded") / "map"
-    _finish(_foldopt("map", *EMBEDDED, "--out", str(out), "-q"))
+    done = CliRunner().invoke(app, ["map", *EMBEDDED, "--out", str(out), "-q"])
+    assert done.exit_code == 0, done.output
     return pd.read_parquet(out / "map.parquet")
 
 
@@ -104,7 +109,7 @@ def test_embedded_map_equals_the_computation_without_dask(embedded):
     sites = embedded.drop_duplicates("site_id")
     spec_sites = [{"latitude": lat, "longitude": lon, "site_id": i}
                   for i, (lat, lon) in enumerate(zip(sites["latitude"], sites["longitude"], strict=True))]
-    from foldopt.inputs.load import default_study_path, read_study
+    from foldopt.inputs.study_file import default_study_path, read_study
     from foldopt.studies.worldmap import map_study
 
     study = map_study(read_study(default_study_path())[0], step_min=15.0,
