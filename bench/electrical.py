@@ -26,8 +26,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from foldopt.engine import rows as engine  # noqa: E402
-from foldopt.inputs.load import default_study_path
+from foldopt.engine import evaluation as engine  # noqa: E402
+from foldopt.inputs.study_file import default_study_path
 from foldopt.api import load_study  # noqa: E402
 from foldopt.engine.sky import build_sky  # noqa: E402
 

@@ -40,7 +40,7 @@ TARGET_SPEEDUP = 1.8
 
 def _spec(n_sites: int):
     from foldopt.studies.cluster import MapSpec
-    from foldopt.inputs.load import default_study_path, read_study
+    from foldopt.inputs.study_file import default_study_path, read_study
     from foldopt.inputs.sites import grid_sites
     from foldopt.studies.worldmap import map_study
 
@@ -166,7 +166,7 @@ def w5(subset: int | None, check_sites: int = 200, step_min: float = 5.0) -> Non
     target would cost with a coarser clock; the check is then against the full sweep at that step."""
     import pandas as pd
 
-    from foldopt.inputs.load import default_study_path, read_study
+    from foldopt.inputs.study_file import default_study_path, read_study
     from foldopt.studies.cluster import MapSpec, run_map
     from foldopt.studies.worldmap import evaluate_sites, map_study
 
@@ -225,7 +225,7 @@ def main() -> None:
                                                                         "(default 5)")
     args = parser.parse_args()
     if args.w5 and args.phases:
-        from foldopt.inputs.load import default_study_path, read_study
+        from foldopt.inputs.study_file import default_study_path, read_study
         from foldopt.studies.worldmap import map_study
 
         land, sites = _land_sites(25)

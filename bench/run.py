@@ -47,7 +47,7 @@ W3_ANGLE_DEG = 1.0  # [deg] best angle (the grid step), where the best is clear 
 
 
 def _study():
-    from foldopt.inputs.load import default_study_path
+    from foldopt.inputs.study_file import default_study_path
     from foldopt.api import load_study
 
     # The paper's beam-only Meinel sky, as the pvlib baseline of W3 computes it (exact mode's own
@@ -71,7 +71,7 @@ def _fold_pass(base, sites, dates, loads, threads=None):
     """foldopt's engine over blocks: sky, tables, kernel; per-phase times and the results."""
     import numba
 
-    from foldopt.engine import rows as engine
+    from foldopt.engine import evaluation as engine
     from foldopt.physics.geometry import default_orientation
     from foldopt.engine.sky import build_sky
     from foldopt.physics.solarposition import clock_grid, solar_position_grid
@@ -103,7 +103,7 @@ def _fold_pass(base, sites, dates, loads, threads=None):
 def _metrics_share(sky, base, orientation, rows, loads, sample: int = 2000):
     """Time per point of the metrics alone (curve_rows on power curves that already exist),
     measured on a sample of rows."""
-    from foldopt.engine import rows as engine
+    from foldopt.engine import evaluation as engine
 
     pick = np.linspace(0, rows.size - 1, min(sample, rows.size)).astype(int)
     curves = np.concatenate([engine.powers(sky, base, orientation[i:i + 1], [rows[i]], series=False)[0]["switching"]
@@ -114,7 +114,7 @@ def _metrics_share(sky, base, orientation, rows, loads, sample: int = 2000):
 
 
 def workload_w1(days: int) -> dict:
-    from foldopt.engine import rows as engine  # noqa: F401  (imports counted outside the timed phases)
+    from foldopt.engine import evaluation as engine  # noqa: F401  (imports counted outside the timed phases)
 
     base = _study()
     dates = _w1_dates(days)
@@ -139,7 +139,7 @@ def workload_w1(days: int) -> dict:
 
 
 def workload_w2(days: int, latitudes: int) -> dict:
-    from foldopt.engine import rows as engine  # noqa: F401
+    from foldopt.engine import evaluation as engine  # noqa: F401
     from foldopt.inputs.sections import Site
 
     base = _study().variant(panel={"area": 0.108, "efficiency": 0.1905})  # tilt |latitude|, equator-facing
@@ -277,7 +277,7 @@ def workload_tables() -> dict:
 
     with tempfile.TemporaryDirectory() as folder:
         os.environ["FOLDOPT_CACHE_DIR"] = folder
-        from foldopt.engine.rows import electrical_for
+        from foldopt.engine.evaluation import electrical_for
 
         electrical = electrical_for(_study(), 25.0)
         seconds = {name: _timed(electrical._table, name)[0] for name in ("subpanel", "parallel", "series")}

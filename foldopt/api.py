@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from foldopt.inputs.load import default_study_path, with_files
+from foldopt.inputs.study_file import default_study_path, with_files
 from foldopt.inputs.plan import Plan, load_plan
 from foldopt.inputs.study import Study
 from foldopt.errors import ConfigError
@@ -428,7 +428,7 @@ def world_map(sites: Sequence[dict] | None = None, loads: Sequence[float] | None
         For a bad site, load, year, period or study setting, before any cluster starts.
     """
     from foldopt.studies.cluster import MapSpec, run_map
-    from foldopt.studies.answering import of_map
+    from foldopt.studies.result_answers import of_map
     from foldopt.output.folders import map_figures, write_map_report
     from foldopt.output.gridded import write_grid_netcdf
     from foldopt.studies.worldmap import map_request, map_study, searched_tilt

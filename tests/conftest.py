@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from foldopt.inputs.load import default_study_path
+from foldopt.inputs.study_file import default_study_path
 from foldopt.api import load_study
 
 

@@ -6,8 +6,8 @@ import pvlib
 import pytest
 
 import foldopt
-from foldopt.engine.cells import electrical_for
-from foldopt.engine.rows import poa
+from foldopt.engine.cell_tables import electrical_for
+from foldopt.engine.evaluation import poa
 from foldopt.engine.sky import build_sky
 
 

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from foldopt.cli.app import app
-from foldopt.inputs.load import default_study_path
+from foldopt.inputs.study_file import default_study_path
 
 runner = CliRunner()
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"

@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 import foldopt
 from foldopt import names
 from foldopt.cli.app import app
-from foldopt.engine.cells import electrical_for
+from foldopt.engine.cell_tables import electrical_for
 from foldopt.physics import circuit, connections
 from foldopt.physics.diodes import DEFAULT_DIODE_PART, DIODE_PARTS, Diode, diode
 from foldopt.physics.pvmodel import PVModel

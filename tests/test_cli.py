@@ -8,7 +8,7 @@ import yaml
 from typer.testing import CliRunner
 
 from foldopt.cli.app import app
-from foldopt.inputs.load import default_study_path
+from foldopt.inputs.study_file import default_study_path
 from foldopt.studies.reproduce import PAPER_VALUES
 
 runner = CliRunner()

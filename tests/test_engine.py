@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from foldopt.engine import rows as engine
+from foldopt.engine import evaluation as engine
 from foldopt.inputs.sections import Site
 from foldopt.inputs.study import make_study
 from foldopt.engine.metrics import t_solar, t_solar_contiguous

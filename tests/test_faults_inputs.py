@@ -19,7 +19,7 @@ import yaml
 from typer.testing import CliRunner
 
 from foldopt.cli.app import app
-from foldopt.inputs.load import default_study_path
+from foldopt.inputs.study_file import default_study_path
 from foldopt.errors import ConfigError
 from foldopt.inputs.policy import EXACT_NOTE
 
@@ -125,7 +125,7 @@ def test_a_profiles_scale_is_named_as_given(here, axis):
 
 
 def test_a_spreadsheets_utf8_csv_with_a_byte_order_mark_is_read(here):
-    from foldopt.inputs.load import read_profile
+    from foldopt.inputs.study_file import read_profile
     from foldopt.inputs.sites import read_sites
 
     (here / "sites.csv").write_bytes("\ufeffname,latitude,longitude\nSão Paulo,-23.55,-46.63\n".encode())
@@ -217,7 +217,7 @@ def test_utf8_input_files_under_the_c_locale(tmp_path):
     (tmp_path / "sites.csv").write_bytes("name,latitude,longitude\nSão Paulo,-23.55,-46.63\n".encode())
     (tmp_path / "p.csv").write_bytes("time,watts\n07:00,6\n".encode())
     (tmp_path / "s.yaml").write_bytes(yaml.safe_dump({**FAST, "description": "Zürich"}, allow_unicode=True).encode())
-    code = ("from foldopt.inputs.load import read_profile, read_study; "
+    code = ("from foldopt.inputs.study_file import read_profile, read_study; "
             "from foldopt.inputs.sites import read_sites; "
             "print(ascii([read_sites('sites.csv')[0]['name'], read_profile('p.csv'), "
             "read_study('s.yaml')[0]['description']]))")

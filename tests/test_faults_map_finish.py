@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 import foldopt
 from foldopt.cli.app import app
 from foldopt.errors import ConfigError
-from foldopt.inputs.load import default_study_path
+from foldopt.inputs.study_file import default_study_path
 from foldopt.inputs.plan import make_plan
 
 distributed = pytest.importorskip("distributed")

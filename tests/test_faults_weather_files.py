@@ -21,7 +21,7 @@ from typer.testing import CliRunner
 
 from foldopt.cli.app import app
 from foldopt.errors import WeatherError
-from foldopt.inputs.load import default_study_path
+from foldopt.inputs.study_file import default_study_path
 from foldopt.inputs.weather.measured import read_measured
 
 runner = CliRunner()

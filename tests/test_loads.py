@@ -11,13 +11,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from foldopt.engine import rows as engines
+from foldopt.engine import evaluation as engines
 from foldopt.api import default_study, run
 from foldopt.inputs.sections import LoadProfile
 from foldopt.inputs.study import make_study
 from foldopt.errors import ConfigError
-from foldopt.inputs.loads import load_shape
-from foldopt.inputs.load import read_profile
+from foldopt.inputs.load_profile import load_shape
+from foldopt.inputs.study_file import read_profile
 from foldopt.engine.metrics import energy_served, t_solar
 from foldopt.studies.designs import Blocks, fold_hours
 

@@ -5,7 +5,7 @@ A map evaluates its flat panel once."""
 import numpy as np
 
 from foldopt.api import load_study
-from foldopt.engine import rows as engines
+from foldopt.engine import evaluation as engines
 from foldopt.names import TRACKERS
 from foldopt.studies import designs
 from foldopt.studies.day import run_study

@@ -21,7 +21,7 @@ from typer.testing import CliRunner
 
 import foldopt
 from foldopt.cli.app import app
-from foldopt.studies.answering import study_question
+from foldopt.studies.result_answers import study_question
 
 runner = CliRunner()
 #: Berlin, a 2 W load: the issue's own example.

@@ -170,7 +170,7 @@ def test_no_gain_is_claimed_over_a_flat_panel_that_carries_nothing():
     no ratio: the answer gives the flat panel's hours, not '+nan %'."""
     import dataclasses
 
-    from foldopt.studies.answering_joint import of_optimize
+    from foldopt.studies.optimize_answer import of_optimize
 
     result = _optimize(p_load=[2.0])
     table = result.table.copy()
@@ -264,7 +264,7 @@ def test_a_bad_range_of_the_study_file_keeps_its_name(tmp_path):
     from typer.testing import CliRunner
 
     from foldopt.cli.app import app
-    from foldopt.inputs.load import default_study_path
+    from foldopt.inputs.study_file import default_study_path
 
     study = tmp_path / "study.yaml"
     study.write_text(default_study_path().read_text(encoding="utf-8")

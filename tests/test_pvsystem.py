@@ -10,7 +10,7 @@ import pytest
 
 import foldopt
 from foldopt.physics.atmosphere import relative_airmass
-from foldopt.engine.rows import poa
+from foldopt.engine.evaluation import poa
 from foldopt.physics.geometry import default_orientation, normal_vector, subpanel_orientation
 from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.engine.sky import Sky

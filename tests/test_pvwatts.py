@@ -9,7 +9,7 @@ import numpy as np
 import pvlib
 import pytest
 
-from foldopt.engine import rows as engine
+from foldopt.engine import evaluation as engine
 from foldopt.inputs.plan import make_plan
 from foldopt.engine.sky import build_sky
 from foldopt.studies.designs import sky_tracker_orientation

@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from foldopt.physics.atmosphere import extraterrestrial_normal, hottel_transmittance
-from foldopt.inputs.load import default_study_path
+from foldopt.inputs.study_file import default_study_path
 from foldopt.api import load_study
 from foldopt.engine.metrics import t_solar
 from foldopt.studies.day import Day
@@ -133,10 +133,10 @@ def test_trackers_over_many_days_at_once_equal_each_day_alone(model):
        st.sampled_from([("ineichen", "perez"), ("ineichen", "isotropic"), ("meinel", "none")]))
 def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitude, day, model, sky_model):
     """The compiled tracker irradiance of an open plain (sky_tracker_power's) is
-    foldopt.engine.rows.poa's NumPy expression to the bit, beam-only skies included."""
+    foldopt.engine.evaluation.poa's NumPy expression to the bit, beam-only skies included."""
     import datetime as dt
 
-    from foldopt.engine import rows as engines
+    from foldopt.engine import evaluation as engines
     from foldopt.engine.sky import build_sky
     from foldopt.studies.designs import sky_tracker_orientation, sky_tracker_power
 

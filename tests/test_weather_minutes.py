@@ -14,7 +14,7 @@ import pytest
 
 import foldopt
 from foldopt.engine.sky import build_sky
-from foldopt.inputs.load import with_files
+from foldopt.inputs.study_file import with_files
 from foldopt.inputs.plan import make_plan
 from foldopt.inputs.weather import read_weather
 from foldopt.studies.designs import Blocks

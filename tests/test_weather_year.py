@@ -11,7 +11,7 @@ import pandas as pd
 import pvlib
 import pytest
 
-from foldopt.engine import rows as engine
+from foldopt.engine import evaluation as engine
 from foldopt.inputs.plan import make_plan
 from foldopt.errors import ConfigError
 from foldopt.engine.sky import build_sky

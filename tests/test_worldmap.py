@@ -234,7 +234,7 @@ def test_a_map_searches_the_fold_angle_and_the_tilt_not_the_azimuth():
 def test_a_relative_maps_answer_has_one_line_per_load():
     """Loads as fractions of each site's peak: every site's row of a load is that load, however the
     division rounds, so the answer counts each load over every site."""
-    from foldopt.studies.answering import of_map
+    from foldopt.studies.result_answers import of_map
     from foldopt.studies.cluster import MapRun, MapSpec
 
     sites = grid_sites([-30.0, 0.0, 30.0], [0.0, 60.0], False)
@@ -276,7 +276,7 @@ def test_a_map_searching_the_tilt_finds_the_best_design_of_every_tilt():
 
 def test_a_map_searching_the_tilt_answers_with_the_tilts():
     """The answer of a map with --optimize tilt says what it searched and gives the tilts it found."""
-    from foldopt.studies.answering import of_map
+    from foldopt.studies.result_answers import of_map
     from foldopt.studies.cluster import MapRun, MapSpec
 
     study = {**COARSE, "optimize": {"vary": ["fold_angle", "tilt"], "tilt": {"min": 0, "max": 60, "step": 30}}}

@@ -395,7 +395,7 @@ class StudyFile(Directive):
     required_arguments = 1
 
     def run(self):
-        from foldopt.inputs.load import default_study_path
+        from foldopt.inputs.study_file import default_study_path
 
         path = default_study_path(self.arguments[0])
         block = nodes.literal_block(text=path.read_text(encoding="utf-8"), language="yaml")

@@ -69,7 +69,7 @@ def run(
     """
     output_format, engine = check_choices(output_format, engine)
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
-    from foldopt.inputs.load import default_study_path
+    from foldopt.inputs.study_file import default_study_path
     from foldopt.studies.request import Request, settings_plan
 
     source = EMBEDDED if config is None else str(config)

@@ -57,7 +57,7 @@ def size(
     output_format, _ = check_choices(output_format, "numba")
     output = Output(quiet, output_format, table)
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
-    from foldopt.inputs.load import default_study_path
+    from foldopt.inputs.study_file import default_study_path
     from foldopt.studies.request import settings_plan, size_request, sizing_problems
 
     errors = sizing_problems({"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,

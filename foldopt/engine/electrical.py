@@ -31,7 +31,7 @@ import numpy as np
 import pvlib
 
 from foldopt.cache import cache_dir, load_cache, store_cache
-from foldopt.engine.built import PARTS, CircuitParts, alone_power, assemble, pair_power
+from foldopt.engine.as_built import PARTS, CircuitParts, alone_power, assemble, pair_power
 from foldopt.physics.connections import connection_powers, parallel_power, series_power
 from foldopt.physics.pvmodel import PVModel
 from foldopt.physics.temperature import cell_temperature
@@ -102,7 +102,7 @@ class Electrical:
         Efficiency of each converter of the independent architecture [-].
     exact : bool, default False
         Solve every step's I-V curves instead of interpolating the tables.
-    circuit : foldopt.engine.built.CircuitParts, optional
+    circuit : foldopt.engine.as_built.CircuitParts, optional
         The circuit as built; None for Shin et al.'s ideal parts.
     """
 
@@ -192,7 +192,7 @@ class Electrical:
         tabulated without bypass diodes; with ideal ones it is the larger of that and the stronger
         sub-panel alone (:func:`foldopt.physics.connections.series_power`), which needs no table.
         As built, the table holds the pair as built, bypass diodes and all
-        (:func:`foldopt.engine.built.pair_power`).
+        (:func:`foldopt.engine.as_built.pair_power`).
         """
         strong, ratio = (grid.ravel() for grid in np.meshgrid(_nodes(TABLE_NODES_2D), _ratio_nodes(connection),
                                                               indexing="ij"))
@@ -329,7 +329,7 @@ class Electrical:
         return self._flat_wired(poa, temp_cell, self.flat_wiring)
 
     def parts(self, poa_east, poa_west, series: bool = True) -> dict:
-        """The panel side of the circuit as built (:data:`foldopt.engine.built.PARTS`), exact or
+        """The panel side of the circuit as built (:data:`foldopt.engine.as_built.PARTS`), exact or
         from the tables as the kernel reads them.
 
         Parameters

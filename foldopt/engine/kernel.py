@@ -8,7 +8,7 @@ incidence-angle modifier and the diffuse terms give each sub-panel's plane-of-ar
 The second looks up the electrical tables (or, for the ideal model, scales the irradiance) and
 writes every asked connection's power to a buffer of one day, reused by the next row (with the
 circuit as built, :func:`_built_row`). The third reduces each power curve to the daily metrics of
-every load at once (:func:`foldopt.engine.reduce.day_metrics`). The inputs come as the named
+every load at once (:func:`foldopt.engine.curve_reduction.day_metrics`). The inputs come as the named
 records of :mod:`foldopt.engine.records` (the sky, the rows, the tables, the loads, the outputs and
 the per-chunk scratch of :func:`foldopt.engine.records.allocate`).
 
@@ -22,7 +22,7 @@ loop, not called. On a map's year (the ideal model, 10 loads) a row step cost ab
 core on a fast day, against 21 ns before (the kernel's share of ``bench/map.py --w5 --phases``);
 8.8 ns on the slower machine of 2026-12-03, of which some 5.9 ns the walk over the loads.
 
-Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.rows` by
+Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
 """
 
@@ -34,7 +34,7 @@ from typing import NamedTuple
 from numba import njit, prange, uint64
 
 from foldopt.engine.incidence import incidence, steps_sum
-from foldopt.engine.reduce import chunk_scratch, day_metrics
+from foldopt.engine.curve_reduction import chunk_scratch, day_metrics
 
 # Connection codes; the order of foldopt.physics.connections.CONNECTIONS, plus the whole (unfolded) panel.
 EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)

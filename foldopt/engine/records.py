@@ -2,9 +2,9 @@
 
 :func:`foldopt.engine.kernel.fold_rows` takes a day's light (:class:`SkyArrays`), the panels
 (:class:`Rows`), the electrical side (:class:`Tables`), the loads (:class:`Loads`), and writes
-:class:`Outputs` with per-chunk :class:`Scratch`; :func:`foldopt.engine.reduce.curve_rows` takes the
+:class:`Outputs` with per-chunk :class:`Scratch`; :func:`foldopt.engine.curve_reduction.curve_rows` takes the
 last three. numba takes these module-level named tuples as arguments (and caches functions typed by
-them), so adding an input is a field here and the line of :mod:`foldopt.engine.rows` that fills it.
+them), so adding an input is a field here and the line of :mod:`foldopt.engine.evaluation` that fills it.
 Every field is an array, a float, an int or a bool, always of the same type, so that one compiled
 specialisation serves every call. A parallel loop hands the records to a function of its own
 (``_chunk_rows``, ``_chunk_curves``): in the loop's body itself, writes through a named tuple's
@@ -113,7 +113,7 @@ class Tables(NamedTuple):
     connections : (n_conn,) int
         Codes of the outputs to evaluate (:data:`foldopt.engine.kernel.EAST` ...).
     as_built : bool
-        The circuit as built (:mod:`foldopt.engine.built`), not Shin et al.'s ideal parts.
+        The circuit as built (:mod:`foldopt.engine.as_built`), not Shin et al.'s ideal parts.
     direct, switch_table : bool
         As built: direct coupling at the load's voltage; switching has a table of its own (a
         switch resistance).
@@ -199,7 +199,7 @@ class Outputs(NamedTuple):
 class Scratch(NamedTuple):
     """Working arrays of each chunk of rows, allocated outside the parallel loop (arrays
     zero-filled inside a numba prange body have given wrong sums): each field's first axis is the
-    chunk, and a chunk's own record (:func:`foldopt.engine.reduce.chunk_scratch`) holds the rest.
+    chunk, and a chunk's own record (:func:`foldopt.engine.curve_reduction.chunk_scratch`) holds the rest.
 
     Attributes
     ----------
@@ -214,7 +214,7 @@ class Scratch(NamedTuple):
         Every asked connection's power of the row [W].
     above, whole : (n_loads,) and (n_loads + 1,) float
         A day's reduction: the time each load spends inside a segment's range, and the segments'
-        lengths by how many loads lie below them (:func:`foldopt.engine.reduce.day_metrics`).
+        lengths by how many loads lie below them (:func:`foldopt.engine.curve_reduction.day_metrics`).
     run : (n_loads or 1, 2) float
         The current and the longest run of each load (``contiguous``).
     """
@@ -233,7 +233,7 @@ class Scratch(NamedTuple):
 def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: bool,
              n_curves: int = 0) -> tuple[Outputs, Scratch]:
     """Outputs and per-chunk scratch of :func:`foldopt.engine.kernel.fold_rows` or
-    :func:`foldopt.engine.reduce.curve_rows`, allocated here, outside the parallel loop.
+    :func:`foldopt.engine.curve_reduction.curve_rows`, allocated here, outside the parallel loop.
 
     Parameters
     ----------

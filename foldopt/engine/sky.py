@@ -19,7 +19,7 @@ import numpy as np
 import pvlib
 
 from foldopt.engine.light import clear_light, diffuse_terms, measured_light, member_light, weather_light
-from foldopt.inputs.loads import load_shape
+from foldopt.inputs.load_profile import load_shape
 from foldopt.inputs.sections import parse_timezone
 from foldopt.inputs.study import Study
 from foldopt.inputs.weather import study_weather, weather_site
@@ -67,7 +67,7 @@ class Sky:
     iam : {'none', 'ashrae', 'physical'}
     load_shape : numpy.ndarray or None
         With a load profile, P_load(t) per block and step for a scale of 1 [W]
-        (:func:`foldopt.inputs.loads.load_shape`); None for a constant load.
+        (:func:`foldopt.inputs.load_profile.load_shape`); None for a constant load.
     weather_balance : dict or None
         With a weather file: per component (``dni``, ``ghi``, ``dhi``), the file's summed interval
         means and what the steps keep of them [W/m^2 x intervals]

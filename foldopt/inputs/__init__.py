@@ -1,5 +1,5 @@
 """Inputs: what a user hands in, read and validated. Study files and the files a study names
-(:mod:`~foldopt.inputs.load`: YAML with line numbers, size limits, a weather file's site and a load
+(:mod:`~foldopt.inputs.study_file`: YAML with line numbers, size limits, a weather file's site and a load
 profile's day read before validation), ranges, lists and plans of many cases
 (:mod:`~foldopt.inputs.plan`), the pydantic models of a study (:mod:`~foldopt.inputs.study`,
 :mod:`~foldopt.inputs.sections`; they validate and open no files), the policy of what a study

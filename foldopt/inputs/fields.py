@@ -64,10 +64,10 @@ def named(choices):
 
 @dataclass(frozen=True)
 class FilesRead:
-    """What :func:`foldopt.inputs.load.resolve_files` read of the files a study names, handed to
+    """What :func:`foldopt.inputs.study_file.resolve_files` read of the files a study names, handed to
     the study's validation as pydantic's context: the models judge it and open no files. A study
     validated without it (built in Python, or a :meth:`foldopt.inputs.study.Study.variant`) has
-    its files unread until :func:`foldopt.inputs.load.with_files` reads them.
+    its files unread until :func:`foldopt.inputs.study_file.with_files` reads them.
 
     Parameters
     ----------

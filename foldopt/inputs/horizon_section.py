@@ -1,6 +1,6 @@
 """A site's horizon, as a study gives it (:class:`Horizon`): (azimuth, elevation) points, or a file.
 
-The model opens no file: a horizon file is read by :func:`foldopt.inputs.load.resolve_files`
+The model opens no file: a horizon file is read by :func:`foldopt.inputs.study_file.resolve_files`
 (:func:`foldopt.inputs.horizon.read_horizon`) and its points handed to the validation as
 :class:`~foldopt.inputs.sections.FilesRead`, as a load profile's file is.
 """

@@ -21,7 +21,7 @@ from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
 from foldopt.inputs.fields import list_depth, list_valued_fields
-from foldopt.inputs.load import read_study, resolve_files
+from foldopt.inputs.study_file import read_study, resolve_files
 from foldopt.inputs.reading import MAX_AXIS_VALUES, size_limit
 from foldopt.inputs.weather_files import weather_defaults
 from foldopt.inputs.policy import set_path
@@ -240,7 +240,7 @@ class Plan:
         return math.prod(len(values) for _, values in self.axes)
 
     def study(self, choice: dict) -> Study:
-        """One case's study, its files read (:func:`foldopt.inputs.load.resolve_files`).
+        """One case's study, its files read (:func:`foldopt.inputs.study_file.resolve_files`).
 
         Parameters
         ----------

@@ -4,7 +4,7 @@ profile, fold-angle grid and near-optimal tolerance (:class:`foldopt.inputs.stud
 Every number is checked against its interval, and the message states the interval and its unit
 (:func:`interval`); every name is checked against its registry in :mod:`foldopt.names`, any
 spelling of :func:`foldopt.names.canonical` accepted (:func:`named`). The models open no files:
-what a study's files hold comes from :func:`foldopt.inputs.load.resolve_files`, as a
+what a study's files hold comes from :func:`foldopt.inputs.study_file.resolve_files`, as a
 :class:`FilesRead` handed to the validation.
 """
 
@@ -21,7 +21,7 @@ from pydantic import AfterValidator, Field, ValidationInfo, field_validator, mod
 from foldopt import names
 from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
 from foldopt.inputs.horizon_section import Horizon
-from foldopt.inputs.loads import profile_steps
+from foldopt.inputs.load_profile import profile_steps
 from foldopt.inputs.optimize_section import grid_points
 from foldopt.inputs.reading import MAX_AXIS_VALUES
 from foldopt.names import ALEXANDRU_STEP_OFFSETS_H
@@ -280,12 +280,12 @@ _ProfileSteps = Annotated[dict, AfterValidator(profile_steps)]
 class LoadProfile(StrictModel):
     """P_load(t) for a scale (``p_load``) of 1: loads [W] at clock times of the local day, held
     until the next time (``step``) or interpolated between them (``linear``), and the last carried
-    over midnight to the first (:mod:`foldopt.inputs.loads`).
+    over midnight to the first (:mod:`foldopt.inputs.load_profile`).
 
     Parameters
     ----------
     daily : dict, optional
-        Clock times ``HH:MM`` to loads [W] (:func:`foldopt.inputs.loads.profile_steps`).
+        Clock times ``HH:MM`` to loads [W] (:func:`foldopt.inputs.load_profile.profile_steps`).
     file : str, optional
         A CSV of ``time,watts`` rows instead of ``daily``; its day becomes ``daily`` where its
         loader read it (:class:`FilesRead`).

@@ -4,7 +4,7 @@ A study is written in YAML (see ``configs/``) or assembled from command-line opt
 go through :class:`Study`, so a bad value gets the same message either way: the field's path, the
 value and the allowed range (:func:`format_errors`). Its parts are the models of
 :mod:`foldopt.inputs.sections`. The models open no files: a weather file's site and a load profile
-file's day are read by :func:`foldopt.inputs.load.resolve_files` and handed to the validation as a
+file's day are read by :func:`foldopt.inputs.study_file.resolve_files` and handed to the validation as a
 :class:`~foldopt.inputs.sections.FilesRead`.
 """
 
@@ -33,7 +33,7 @@ MODE_SKIES = {"exact": "ineichen", "paper": "meinel"}
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
 EARTH_RADIUS_KM = 6371.0
 #: The site of a study whose weather file is not read yet (built in Python): None until
-#: :func:`foldopt.inputs.load.with_files` reads it.
+#: :func:`foldopt.inputs.study_file.with_files` reads it.
 _UNREAD = object()
 
 
@@ -77,7 +77,7 @@ class Study(StrictModel):
     model and sky from the mode) is decided then, once, and nothing downstream decides it again.
     What was decided is no setting of the user's: :meth:`data` leaves it out, so a variant (another
     latitude, another mode) decides its own. A study whose weather file is unread (built in
-    Python) has no site yet, so its panel's orientation waits for :func:`foldopt.inputs.load.with_files`.
+    Python) has no site yet, so its panel's orientation waits for :func:`foldopt.inputs.study_file.with_files`.
 
     Parameters
     ----------
@@ -444,7 +444,7 @@ class Study(StrictModel):
         ------
         foldopt.ConfigError
             ``weather: the file is not read yet; ...`` (and for ``load_profile``):
-            :func:`foldopt.inputs.load.with_files` reads them, as the API does.
+            :func:`foldopt.inputs.study_file.with_files` reads them, as the API does.
         """
         unread = [f"{name}: the file is not read yet; foldopt.run, foldopt.sweep and foldopt.size read it"
                   for name, missing in (("weather", self.site is None), ("load_profile", self.load_profile is not None
@@ -504,7 +504,7 @@ def make_study(data: dict, files: FilesRead | None = None) -> Study:
     data : dict
         The study's fields, as a YAML study holds them.
     files : FilesRead, optional
-        What :func:`foldopt.inputs.load.resolve_files` read of the files ``data`` names; without
+        What :func:`foldopt.inputs.study_file.resolve_files` read of the files ``data`` names; without
         it they stay unread (:class:`~foldopt.inputs.sections.FilesRead`).
 
     Returns

@@ -342,7 +342,7 @@ def write_map_report(result, figures: list[str], answer, metadata: dict) -> Path
     figures : list of str
         The figures' file names (:func:`map_figures`), in order.
     answer : foldopt.Answer
-        The map's answer (:func:`foldopt.studies.answering.of_map`).
+        The map's answer (:func:`foldopt.studies.result_answers.of_map`).
     metadata : dict
         The provenance: the ``run.json`` the complete map gets.
 

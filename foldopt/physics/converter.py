@@ -14,7 +14,7 @@ delivers that power times its efficiency at that input. Its models (:data:`foldo
   nothing); its input is limited at :data:`ZETA_MAX` times its rating.
 
 The rating ``p_rated`` is the converter's DC input [W]: by default the panel's power at STC
-(:func:`foldopt.engine.cells.electrical_settings`). Each of the two converters of the ``independent``
+(:func:`foldopt.engine.cell_tables.electrical_settings`). Each of the two converters of the ``independent``
 connection is sized to its sub-panel (:meth:`Converter.scaled` by one half), so at a given
 irradiance it works at the same part load as the whole panel's single converter.
 

@@ -6,7 +6,7 @@ angle and its t_solar; for an annual objective its value per design and, for ``w
 re-fold schedule each visit's date and fold angle and what it adds), the designs compared, the near-optimal
 range of the fold angle with the recommended angle at its centre, and notes that name the design they concern.
 The terminal's lines (:meth:`Answer.lines`), ``--format json`` (:meth:`Answer.to_dict`), ``report.html`` and
-``result.answer`` in a notebook all show this one object; :mod:`foldopt.studies.answering` makes it
+``result.answer`` in a notebook all show this one object; :mod:`foldopt.studies.result_answers` makes it
 of each kind of result.
 """
 
@@ -126,7 +126,7 @@ class Answer:
 
 
 def note_text(note: dict) -> str:
-    """A note of :func:`~foldopt.studies.answering.design_notes` as text, ``load above peak (tracker:single-axis,
+    """A note of :func:`~foldopt.studies.result_answers.design_notes` as text, ``load above peak (tracker:single-axis,
     tracker:single-axis-net)``; the designs are left out where a note concerns every design.
 
     Parameters

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from foldopt.engine import rows as engines
+from foldopt.engine import evaluation as engines
 from foldopt.studies.objectives import period_values
 
 #: The break-even search's brackets close to this share of the largest power (a 20 W tracker's

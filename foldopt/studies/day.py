@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from foldopt.engine import rows as engines
+from foldopt.engine import evaluation as engines
 from foldopt.physics.connections import CONNECTIONS, SWITCH_STATES
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import (design_condition, energy_served, load_for_t_solar, metric_columns, notes,
@@ -38,7 +38,7 @@ class Day:
     Parameters
     ----------
     study : Study
-        One site and date, its files read (:func:`foldopt.inputs.load.with_files`).
+        One site and date, its files read (:func:`foldopt.inputs.study_file.with_files`).
     """
 
     def __init__(self, study: Study):
@@ -237,7 +237,7 @@ class StudyResult:
     @functools.cached_property
     def answer(self):
         """The :class:`foldopt.studies.answer.Answer` every view of this result renders."""
-        from foldopt.studies.answering import of_study
+        from foldopt.studies.result_answers import of_study
 
         return of_study(self)
 

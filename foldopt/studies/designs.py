@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from foldopt.engine import rows as engines
+from foldopt.engine import evaluation as engines
 from foldopt.physics.connections import CONNECTIONS
 from foldopt.engine.incidence import turning_poa
 from foldopt.inputs.study import Study

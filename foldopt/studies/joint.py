@@ -90,7 +90,7 @@ class OptimizeResult:
     @functools.cached_property
     def answer(self):
         """The :class:`foldopt.studies.answer.Answer` every view of this result renders."""
-        from foldopt.studies.answering_joint import of_optimize
+        from foldopt.studies.optimize_answer import of_optimize
 
         return of_optimize(self)
 

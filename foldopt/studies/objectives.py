@@ -3,7 +3,7 @@ a statistic of daily t_solar over the days of a study (:func:`objective_value`, 
 the plateau of near-optimal angles around the best (:func:`near_optimal`), and over a cloud
 ensemble, the members' spread and how sure the choice is (:func:`ensemble_choice`).
 
-The module may import numpy, scipy, :mod:`foldopt.inputs.sections` and :mod:`foldopt.engine.reduce`.
+The module may import numpy, scipy, :mod:`foldopt.inputs.sections` and :mod:`foldopt.engine.curve_reduction`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import math
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from foldopt.engine.reduce import period_means
+from foldopt.engine.curve_reduction import period_means
 from foldopt.inputs.sections import NearOptimal
 
 

@@ -49,7 +49,7 @@ class Reproduction:
     @functools.cached_property
     def answer(self):
         """The :class:`foldopt.studies.answer.Answer` every view renders."""
-        from foldopt.studies.answering import of_reproduction
+        from foldopt.studies.result_answers import of_reproduction
 
         return of_reproduction(self.tables, self.study)
 
@@ -115,7 +115,7 @@ def reproduce(study: Study, engine: str = "numba", **changes) -> pd.DataFrame:
         The paper's study (``configs/shin2015.yaml``); its mode, geometry and load are replaced:
         paper mode with the azimuth-split geometry, exact mode with the hinge, and the inferred load.
     engine : {'numba', 'numpy'}
-        :data:`foldopt.engine.rows.ENGINES`.
+        :data:`foldopt.engine.evaluation.ENGINES`.
     **changes
         Other fields to replace first, e.g. ``pv_model="single-diode"``.
 

@@ -19,7 +19,7 @@ import re
 from dataclasses import dataclass, replace
 
 from foldopt.inputs import policy
-from foldopt.inputs.load import default_study_path, parse_study_text, read_study
+from foldopt.inputs.study_file import default_study_path, parse_study_text, read_study
 from foldopt.inputs.optimize_section import vary_names
 from foldopt.names import FIELD_OF_PARAMETER, FIELD_OPTIONS, OPTIMIZE_VARIABLES
 from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
@@ -139,7 +139,7 @@ def plan_request(data: dict, changes: dict | None = None, *, axis: str | None = 
 
 def _taken(plan: Plan, changes: dict, field: str | None, data: dict, decided: list[str]) -> list[str]:
     """What a request took from its study and its defaults, for the answer's "from" line."""
-    from foldopt.inputs.loads import load_text
+    from foldopt.inputs.load_profile import load_text
 
     study = plan.base
     given = set(changes)
@@ -192,7 +192,7 @@ def size_request(plan: Plan, source: str, cost_given: bool) -> Request:
     foldopt.ConfigError
         For a plan that sweeps fields.
     """
-    from foldopt.inputs.loads import load_text
+    from foldopt.inputs.load_profile import load_text
     from foldopt.inputs.costs import PAPER_COST_PER_M2
 
     if plan.axes:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from foldopt.engine import rows as engines
+from foldopt.engine import evaluation as engines
 from foldopt.inputs.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2  # noqa: F401 (re-exported)
 from foldopt.engine.metrics import load_for_t_solar
 
@@ -57,7 +57,7 @@ class SizingResult:
 
     @functools.cached_property
     def answer(self):
-        from foldopt.studies.answering import of_sizing
+        from foldopt.studies.result_answers import of_sizing
 
         return of_sizing(self.table, self.best, self.study, self.parameters,
                          self.request.defaults if self.request is not None else None)

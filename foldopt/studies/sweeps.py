@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from foldopt.engine import rows as engines
+from foldopt.engine import evaluation as engines
 from foldopt.inputs.plan import Plan
 from foldopt.studies.designs import DESIGNS, Blocks, design_metrics, fold_hours, setup_key
 from foldopt.studies.objectives import (ENSEMBLE_PERCENTILES, best_angle_index, ensemble_choice, near_optimal,
@@ -45,7 +45,7 @@ class SweepResult:
     @functools.cached_property
     def answer(self):
         """The :class:`foldopt.studies.answer.Answer` every view of this result renders."""
-        from foldopt.studies.answering import of_sweep
+        from foldopt.studies.result_answers import of_sweep
 
         return of_sweep(self)
 
@@ -73,7 +73,7 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
         Called as ``progress(done, total)`` with the days done so far, counted once per case
         (an annual objective passes over each day twice: halves count).
     engine : {'numba', 'numpy'}
-        :data:`foldopt.engine.rows.ENGINES`.
+        :data:`foldopt.engine.evaluation.ENGINES`.
     request : foldopt.studies.request.Request, optional
         The request the plan was made from: what the answer says it took from the study.
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from foldopt.inputs.load import with_files
+from foldopt.inputs.study_file import with_files
 from foldopt.inputs.study import Study
 from foldopt.inputs.weather import study_weather
 from foldopt.inputs.weather.epw import write_epw

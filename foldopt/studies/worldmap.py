@@ -30,8 +30,8 @@ import numpy as np
 import pandas as pd
 
 from foldopt import names
-from foldopt.engine import rows as engines
-from foldopt.inputs.load import resolve_files
+from foldopt.engine import evaluation as engines
+from foldopt.inputs.study_file import resolve_files
 from foldopt.engine.search import Axis
 from foldopt.inputs.optimize_section import DEFAULT_TILT, Optimize, vary_names
 from foldopt.inputs.plan import check_distinct, parse_dates, parse_values, year_problem

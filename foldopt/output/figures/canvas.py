@@ -120,11 +120,11 @@ def load_label(study, load: float) -> str:
     -------
     str
         ``P_load 2 W``, or a load profile's mean and peak watts
-        (:func:`foldopt.inputs.loads.load_text`).
+        (:func:`foldopt.inputs.load_profile.load_text`).
     """
     if study is None:
         return f"P_load {load:g} W"
-    from foldopt.inputs.loads import load_text
+    from foldopt.inputs.load_profile import load_text
 
     return load_text(study, load)
 

@@ -33,7 +33,7 @@ def _connection_label(study: Study, connection: str) -> str:
 
 def _draw_load(ax, hours, series, study) -> None:
     """The load: a line at P_load, or a load profile's P_load(t) as its curve, labelled as a load."""
-    from foldopt.inputs.loads import load_text
+    from foldopt.inputs.load_profile import load_text
 
     if study.load_profile is None:
         ax.axhline(study.p_load, color="tab:red", lw=1, label=f"P_load = {study.p_load:.3g} W")

@@ -28,12 +28,12 @@ from foldopt.physics.geometry import normal_vector, subpanel_orientation
 from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.engine.metrics import energy, per_load, t_solar, t_solar_contiguous
 from foldopt.names import ENGINES
-from foldopt.engine.built import PARTS, assemble
+from foldopt.engine.as_built import PARTS, assemble
 from foldopt.engine.records import Loads, Rows, SkyArrays, Tables, allocate
 from foldopt.engine.sky import Sky, step_span
-from foldopt.engine.views import row_views, surface_views
+from foldopt.engine.sky_view import row_views, surface_views
 # The cells' electrical model is part of the engine's API (engines.electrical_for, panel_power...).
-from foldopt.engine.cells import (TEMPERATURE_NODE_STEP, electrical_for, node_weights, panel_power,  # noqa: F401
+from foldopt.engine.cell_tables import (TEMPERATURE_NODE_STEP, electrical_for, node_weights, panel_power,  # noqa: F401
                                   temperature_nodes)
 
 #: What :func:`row_metrics` can evaluate: the connections, and ``panel``, the whole panel as one.
@@ -443,7 +443,7 @@ def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_
 
 def power_span(power) -> np.ndarray:
     """(n_rows, 2) each curve's first and last step with power, and one step without either side
-    ((0, 0) for a curve without any): what :func:`foldopt.engine.reduce.curve_rows` walks.
+    ((0, 0) for a curve without any): what :func:`foldopt.engine.curve_reduction.curve_rows` walks.
 
     Parameters
     ----------
@@ -503,10 +503,10 @@ def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous:
         hours, runs, harvested, peak = _curve_reference(power, sorted_loads[row_loadset], held.profile, held)
         result = RowMetrics(hours[:, None], None if runs is None else runs[:, None], harvested[:, None], peak[:, None])
     else:
-        from foldopt.engine import reduce
+        from foldopt.engine import curve_reduction
 
         out, scratch = allocate(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
         span = power_span(power) if span is None else np.ascontiguousarray(span, dtype=np.int64)
-        reduce.curve_rows(power, span, row_loadset, held, out, scratch)
+        curve_reduction.curve_rows(power, span, row_loadset, held, out, scratch)
         result = RowMetrics(out.t_solar, out.t_solar_contiguous if contiguous else None, out.energy, out.peak)
     return _in_caller_order(result, order, row_loadset)

@@ -16,7 +16,7 @@ import functools
 
 import numpy as np
 
-from foldopt.engine.built import circuit_parts
+from foldopt.engine.as_built import circuit_parts
 from foldopt.engine.electrical import Electrical
 from foldopt.engine.sky import Sky
 from foldopt.inputs.study import Study

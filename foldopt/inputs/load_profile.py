@@ -7,7 +7,7 @@ every block (a day at a site, :class:`foldopt.engine.sky.Sky`), so that the engi
 with ``scale x shape(t)``: for many scales in one pass it compares P_pv(t) / shape(t) with each
 scale (:func:`foldopt.engine.metrics.per_load`), the method of many constant loads.
 
-The module opens no files (a profile's CSV is read by :func:`foldopt.inputs.load.read_profile`)
+The module opens no files (a profile's CSV is read by :func:`foldopt.inputs.study_file.read_profile`)
 and imports nothing of the study models, which import :func:`profile_steps` from it; numpy loads
 with the first profile evaluated, not with the models (the command line checks its input and
 prints its help before numpy loads).

@@ -76,7 +76,7 @@ def study_question(study, varied: tuple = ()) -> dict:
     study : Study
     varied : tuple of str, default ()
     """
-    from foldopt.inputs.loads import load_text
+    from foldopt.inputs.load_profile import load_text
 
     site = study.site
     where = f"{site.name + ', ' if site.name else ''}{site.latitude:g}, {site.longitude:g} ({site.timezone})"
@@ -184,7 +184,7 @@ def of_study(result) -> Answer:
         Of kind ``study``: the best fold angle and its t_solar [h] against the flat panel and the
         tracker, the near-optimal range and the recommended angle, the designs compared.
     """
-    from foldopt.inputs.loads import describe_load, load_text
+    from foldopt.inputs.load_profile import describe_load, load_text
 
     study, summary = result.study, result.summary
     by = summary.set_index("design")
@@ -259,7 +259,7 @@ def of_sweep(result) -> Answer:
     """
     if "annual_objective" in result.extras:
         return _of_annual(result)
-    from foldopt.inputs.loads import describe_load
+    from foldopt.inputs.load_profile import describe_load
 
     plan, table = result.plan, result.table
     twofold = table[table["design"] == "twofold"]
@@ -298,7 +298,7 @@ def of_sweep(result) -> Answer:
 def _of_annual(result) -> Answer:
     """One fold angle over many days: the objective per design in its own terms, the near-optimal
     range of the angle kept all year, the re-fold schedules."""
-    from foldopt.inputs.loads import describe_load, load_text
+    from foldopt.inputs.load_profile import describe_load, load_text
 
     plan = result.plan
     study = plan.base

@@ -36,7 +36,7 @@ def surface_views(sky: Sky, blocks, surface_tilt, surface_azimuth, cos_tilt):
     ----------
     sky : Sky
     blocks : slice or array_like
-        The selected blocks, as :func:`foldopt.engine.rows.poa` takes them.
+        The selected blocks, as :func:`foldopt.engine.evaluation.poa` takes them.
     surface_tilt, surface_azimuth : numpy.ndarray
         [deg], broadcast against the selected blocks' (n_selected, n_steps): one row per block, or
         k rows over one selected block.

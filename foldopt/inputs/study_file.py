@@ -20,7 +20,7 @@ import yaml
 from foldopt.errors import ConfigError
 from foldopt.inputs.fields import FilesRead
 from foldopt.inputs.horizon import read_horizon
-from foldopt.inputs.loads import profile_steps
+from foldopt.inputs.load_profile import profile_steps
 from foldopt.inputs.reading import MAX_CSV_BYTES, MAX_STUDY_BYTES, read_input
 from foldopt.inputs.study import Study, make_study
 from foldopt.inputs.weather_files import weather_read
@@ -274,13 +274,13 @@ def read_profile(path: str | Path) -> dict:
     Returns
     -------
     dict
-        Clock times ``HH:MM`` to loads [W] in time order (:func:`foldopt.inputs.loads.profile_steps`).
+        Clock times ``HH:MM`` to loads [W] in time order (:func:`foldopt.inputs.load_profile.profile_steps`).
 
     Raises
     ------
     foldopt.ConfigError
         One line naming the file (and the line): unreadable, a row that is no ``time,watts``, a
-        time given twice, or a value :func:`~foldopt.inputs.loads.profile_steps` refuses.
+        time given twice, or a value :func:`~foldopt.inputs.load_profile.profile_steps` refuses.
     """
     path = Path(path)
     text = read_input(path, "load_profile.file", MAX_CSV_BYTES, "MAX_CSV_BYTES", "load profile")
