@@ -19,7 +19,8 @@ MODES_AND_GEOMETRIES = [(m, g) for m in ("paper", "exact") for g in ("azimuth-sp
 
 
 @st.composite
-def studies(draw):
+def studies(draw, beam_only: bool = False):
+    """Random studies under each mode's own sky; ``beam_only``: the paper's Meinel sky in both modes."""
     mode, geometry = draw(st.sampled_from(MODES_AND_GEOMETRIES))
     latitude = draw(st.floats(-65, 65))
     return make_study(
@@ -27,6 +28,7 @@ def studies(draw):
             "name": "property",
             "mode": mode,
             "geometry": geometry,
+            **({"sky": "meinel"} if beam_only else {}),
             "site": {"latitude": latitude, "longitude": draw(st.floats(-180, 180)),
                      "altitude": draw(st.floats(0, 3000))},
             "date": dt.date(2021, 1, 1) + dt.timedelta(days=draw(st.integers(0, 364))),
@@ -63,9 +65,11 @@ def test_t_solar_never_rises_when_the_load_rises(study, low, rise, fold):
 
 
 @common
-@given(study=studies(), fold=st.floats(1, 180), load_fraction=st.floats(0.01, 1.0))
+@given(study=studies(beam_only=True), fold=st.floats(1, 180), load_fraction=st.floats(0.01, 1.0))
 def test_no_fixed_design_outlasts_the_ideal_tracker(study, fold, load_fraction):
-    # The tracker's normal is on the sun: no surface of the same area collects more beam.
+    # The tracker's normal is on the sun: no surface of the same area collects more beam. Under a
+    # diffuse sky it does not hold: at a low sun a panel facing up sees more of the sky than one
+    # facing the horizon (exact mode's Ineichen sky, a level panel at 6 N on 1 January).
     day = Day(study)
     tracker = day.tracker_power()
     load = load_fraction * max(tracker.max(), 1e-6)
