@@ -144,7 +144,9 @@ def sweep(study: Study | Plan, over: str | None = None, *, axes: dict | None = N
 
     Returns
     -------
-    SweepResult
+    SweepResult or StudyResult
+        As :func:`run` returns for the plan: a :class:`foldopt.studies.day.StudyResult` for one case
+        (``over='angle'`` at one site, day and load, as ``foldopt sweep angle``), otherwise
         ``table``: one row per case (``site_name``, ``latitude``, ``longitude``, ``date``,
         ``dayofyear``, ``p_load_w`` and any other swept field) and design (``flat``, ``twofold``,
         ``tracker``, ``tracker-net``), with ``fold_angle_deg``, ``t_solar_h`` and the other daily
@@ -170,9 +172,7 @@ def sweep(study: Study | Plan, over: str | None = None, *, axes: dict | None = N
     if not changes and over is None:
         raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
     request = plan_request(_study_data(study), changes, axis=over)
-    from foldopt.studies.sweeps import run_plan
-
-    return run_plan(request.plan, progress, engine, request)
+    return run(request.plan, engine, progress, request=request)  # as the command line runs a request
 
 
 def optimize(study: Study | Plan, vary=None, *, fold_angle=None, tilt=None, azimuth=None,

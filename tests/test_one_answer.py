@@ -106,6 +106,16 @@ def test_latitude_sweep_plans_the_same_study(tmp_path):
     assert (result.plan.base.mode, result.plan.base.geometry) == ("exact", "hinge")
 
 
+def test_an_angle_sweep_is_the_api_sweep_over_angle(tmp_path):
+    """``foldopt.sweep(study, "angle", ...)`` runs the request as the command line does: one case is
+    a day's study with its refined best angle (it was a one-case plan, its grid's 23 deg for 22.6)."""
+    document, folder, terminal = cli(tmp_path, "sweep", "angle", "--lat", "52.5", "--lon", "13.4", "--p-load", "2",
+                                     terminal=True)
+    result = foldopt.sweep(foldopt.default_study(), "angle", latitude=52.5, longitude=13.4, p_load=2)
+    same_rows(document, result.summary)
+    assert_views_agree(document, folder, terminal, result.answer)
+
+
 def test_worst_month_year_at_nairobi(tmp_path):
     args = ("--lat", "-1.29", "--lon", "36.82", "--days", "year", "--objective", "worst-month", "--p-load", "3",
             "--step-min", "10")
