@@ -21,33 +21,81 @@ except metadata.PackageNotFoundError:  # running from a source tree that is not 
 
 #: Public name -> the module that defines it.
 _PUBLIC = {
-    "Study": "foldopt.inputs.study", "Plan": "foldopt.inputs.plan", "ConfigError": "foldopt.errors",
-    **{name: "foldopt.inputs.sections" for name in (
-        "Site", "Panel", "Tracker", "Objective", "FoldAngles", "LoadProfile", "NearOptimal")},
-    "Weather": "foldopt.inputs.weather_section", "Horizon": "foldopt.inputs.horizon_section",
+    "Study": "foldopt.inputs.study",
+    "Plan": "foldopt.inputs.plan",
+    "ConfigError": "foldopt.errors",
+    **{
+        name: "foldopt.inputs.sections"
+        for name in (
+            "Site",
+            "Panel",
+            "Tracker",
+            "Objective",
+            "FoldAngles",
+            "LoadProfile",
+            "NearOptimal",
+        )
+    },
+    "Weather": "foldopt.inputs.weather_section",
+    "Horizon": "foldopt.inputs.horizon_section",
     "Circuit": "foldopt.inputs.circuit_section",
-    "default_study": "foldopt.api", "load_study": "foldopt.api", "run": "foldopt.api", "sweep": "foldopt.api",
-    "optimize": "foldopt.api", "write": "foldopt.api", "size": "foldopt.api", "reproduce": "foldopt.api",
+    "default_study": "foldopt.api",
+    "load_study": "foldopt.api",
+    "run": "foldopt.api",
+    "sweep": "foldopt.api",
+    "optimize": "foldopt.api",
+    "write": "foldopt.api",
+    "size": "foldopt.api",
+    "reproduce": "foldopt.api",
     "world_map": "foldopt.api",
-    "StudyResult": "foldopt.studies.day", "SweepResult": "foldopt.studies.sweeps",
-    "MapSpec": "foldopt.studies.cluster", "MapRun": "foldopt.studies.cluster", "run_map": "foldopt.studies.cluster",
-    "evaluate_sites": "foldopt.studies.worldmap", "map_study": "foldopt.studies.worldmap",
+    "StudyResult": "foldopt.studies.day",
+    "SweepResult": "foldopt.studies.sweeps",
+    "MapSpec": "foldopt.studies.cluster",
+    "MapRun": "foldopt.studies.cluster",
+    "run_map": "foldopt.studies.cluster",
+    "evaluate_sites": "foldopt.studies.worldmap",
+    "map_study": "foldopt.studies.worldmap",
     **{name: "foldopt.inputs.sites" for name in ("grid_sites", "read_sites", "weather_sites")},
-    "annual_summary": "foldopt.studies.annual", "write_html": "foldopt.output.html",
+    "annual_summary": "foldopt.studies.annual",
+    "write_html": "foldopt.output.html",
     "save_plot": "foldopt.output.figures.canvas",
-    **{name: "foldopt.output.figures.day" for name in (
-        "plot_power_curves", "plot_switching", "plot_t_solar_vs_fold_angle", "plot_comparison", "plot_standby")},
+    **{
+        name: "foldopt.output.figures.day"
+        for name in (
+            "plot_power_curves",
+            "plot_switching",
+            "plot_t_solar_vs_fold_angle",
+            "plot_comparison",
+            "plot_standby",
+        )
+    },
     **{name: "foldopt.output.figures.sweep" for name in ("plot_map", "plot_curves")},
-    **{name: "foldopt.output.figures.annual" for name in (
-        "plot_annual_fold_angles", "plot_monthly", "plot_distribution", "plot_day_hour", "plot_refold_value")},
-    **{name: "foldopt.output.figures.weather" for name in ("plot_weather_minutes", "plot_member_t_solar")},
+    **{
+        name: "foldopt.output.figures.annual"
+        for name in (
+            "plot_annual_fold_angles",
+            "plot_monthly",
+            "plot_distribution",
+            "plot_day_hour",
+            "plot_refold_value",
+        )
+    },
+    **{
+        name: "foldopt.output.figures.weather"
+        for name in ("plot_weather_minutes", "plot_member_t_solar")
+    },
     **{name: "foldopt.output.figures.world" for name in ("plot_world_map", "plot_latitude_load")},
     "plot_sizing": "foldopt.output.figures.sizing",
-    "plot_sun_paths": "foldopt.output.figures.horizon", "plot_landscape": "foldopt.output.figures.landscape",
-    "OptimizeResult": "foldopt.studies.joint", "Optimize": "foldopt.inputs.optimize_section",
+    "plot_sun_paths": "foldopt.output.figures.horizon",
+    "plot_landscape": "foldopt.output.figures.landscape",
+    "OptimizeResult": "foldopt.studies.joint",
+    "Optimize": "foldopt.inputs.optimize_section",
     "best_schedules": "foldopt.engine.schedule",
-    "Answer": "foldopt.studies.answer", "plan_request": "foldopt.studies.request", "Request": "foldopt.studies.request",
-    "SizingResult": "foldopt.studies.sizing", "Reproduction": "foldopt.studies.reproduce",
+    "Answer": "foldopt.studies.answer",
+    "plan_request": "foldopt.studies.request",
+    "Request": "foldopt.studies.request",
+    "SizingResult": "foldopt.studies.sizing",
+    "Reproduction": "foldopt.studies.reproduce",
     "twofold_arrays": "foldopt.physics.pvsystem",
 }
 __all__ = ["__version__", *_PUBLIC]
@@ -73,7 +121,9 @@ class _OnFirstUse(MetaPathFinder):
         return spec
 
 
-if "pvlib" not in sys.modules and not any(isinstance(finder, _OnFirstUse) for finder in sys.meta_path):
+if "pvlib" not in sys.modules and not any(
+    isinstance(finder, _OnFirstUse) for finder in sys.meta_path
+):
     sys.meta_path.insert(0, _OnFirstUse())
 
 

@@ -59,8 +59,12 @@ def load_study(path: str | Path) -> Study | Plan:
     return plan if plan.axes else plan.base
 
 
-def run(study: Study | Plan | str | Path, engine: str = "numba",
-        progress: Callable[[float, int], None] | None = None, request=None):
+def run(
+    study: Study | Plan | str | Path,
+    engine: str = "numba",
+    progress: Callable[[float, int], None] | None = None,
+    request=None,
+):
     """Run a study: one case (every fold angle, the paper's heuristic, flat and trackers) or a plan
     of many cases.
 
@@ -96,7 +100,9 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
     if base.optimize is not None:
         from foldopt.studies.joint import optimize_plan
 
-        return optimize_plan(study if isinstance(study, Plan) else Plan(study.data(), ()), engine, request)
+        return optimize_plan(
+            study if isinstance(study, Plan) else Plan(study.data(), ()), engine, request
+        )
     if isinstance(study, Plan):
         if study.axes:
             from foldopt.studies.sweeps import run_plan
@@ -114,8 +120,15 @@ def run(study: Study | Plan | str | Path, engine: str = "numba",
     return run_study(with_files(study), engine, request)
 
 
-def sweep(study: Study | Plan, over: str | None = None, *, axes: dict | None = None, engine: str = "numba",
-          progress: Callable[[float, int], None] | None = None, **fields):
+def sweep(
+    study: Study | Plan,
+    over: str | None = None,
+    *,
+    axes: dict | None = None,
+    engine: str = "numba",
+    progress: Callable[[float, int], None] | None = None,
+    **fields,
+):
     """Evaluate a study at every combination of the values of some fields, as ``foldopt sweep`` does.
 
     The request goes through :func:`foldopt.studies.request.plan_request`, as the command line's does, so
@@ -172,11 +185,22 @@ def sweep(study: Study | Plan, over: str | None = None, *, axes: dict | None = N
     if not changes and over is None:
         raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
     request = plan_request(_study_data(study), changes, axis=over)
-    return run(request.plan, engine, progress, request=request)  # as the command line runs a request
+    return run(
+        request.plan, engine, progress, request=request
+    )  # as the command line runs a request
 
 
-def optimize(study: Study | Plan, vary=None, *, fold_angle=None, tilt=None, azimuth=None,
-             tolerance_h: float | None = None, engine: str = "numba", **fields):
+def optimize(
+    study: Study | Plan,
+    vary=None,
+    *,
+    fold_angle=None,
+    tilt=None,
+    azimuth=None,
+    tolerance_h: float | None = None,
+    engine: str = "numba",
+    **fields,
+):
     """The best fold angle, base tilt and base azimuth together, as ``foldopt optimize`` finds them
     (:func:`foldopt.studies.joint.optimize_plan`), with the flat panel's own best tilt and azimuth,
     the default mounting and the tracker.
@@ -238,13 +262,17 @@ def _study_data(study: Study | Plan) -> dict:
 
 def _plain_values(values):
     """A sequence (a list, a tuple, an array) as a list of plain values; text and scalars as they are."""
-    if isinstance(values, (str, dict)) or not (isinstance(values, Sequence) or hasattr(values, "tolist")):
+    if isinstance(values, (str, dict)) or not (
+        isinstance(values, Sequence) or hasattr(values, "tolist")
+    ):
         return values.item() if hasattr(values, "item") else values
     items = [item.item() if hasattr(item, "item") else item for item in values]
     return [item.isoformat() if hasattr(item, "isoformat") else item for item in items]
 
 
-def write(result, out: str | Path, overwrite: bool = False, command: list[str] | None = None) -> Path:
+def write(
+    result, out: str | Path, overwrite: bool = False, command: list[str] | None = None
+) -> Path:
     """Write a result's folder as the command line does: CSV tables, figures, ``report.html`` and
     ``run.json``, atomically (a folder that exists is replaced only with ``overwrite``).
 
@@ -279,15 +307,27 @@ def write(result, out: str | Path, overwrite: bool = False, command: list[str] |
     from foldopt.output.folders import write_optimize
     from foldopt.studies.joint import OptimizeResult
 
-    writers = {StudyResult: write_study, SizingResult: write_sizing, Reproduction: write_reproduction,
-               OptimizeResult: write_optimize}
+    writers = {
+        StudyResult: write_study,
+        SizingResult: write_sizing,
+        Reproduction: write_reproduction,
+        OptimizeResult: write_optimize,
+    }
     writer = writers.get(type(result), write_sweep)
     writer(result, Path(out), overwrite, command if command is not None else ["foldopt.write"])
     return Path(out)
 
 
-def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None, cost_per_w: float | None = None,
-         c_grid: float | None = None, years: float | None = None, days_per_year: float | None = None, request=None):
+def size(
+    study: Study,
+    areas="0.01:0.5:0.005",
+    cost_per_m2: float | None = None,
+    cost_per_w: float | None = None,
+    c_grid: float | None = None,
+    years: float | None = None,
+    days_per_year: float | None = None,
+    request=None,
+):
     """Shin et al. Sec. IV-A panel sizing: the lifetime net benefit of flat and twofold panels of
     every area (:func:`foldopt.studies.sizing.size_panel`).
 
@@ -334,8 +374,13 @@ def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None,
     c_grid = costs.C_GRID if c_grid is None else c_grid
     years = costs.LIFETIME_YEARS if years is None else years
     days_per_year = costs.DAYS_PER_YEAR if days_per_year is None else days_per_year
-    parameters = {"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
-                  "years": years, "days_per_year": days_per_year}
+    parameters = {
+        "cost_per_m2": cost_per_m2,
+        "cost_per_w": cost_per_w,
+        "c_grid_usd_per_kwh": c_grid,
+        "years": years,
+        "days_per_year": days_per_year,
+    }
     errors += sizing_problems(parameters)
     try:
         grid = parse_range(areas) if isinstance(areas, str) else [float(a) for a in areas]
@@ -346,7 +391,9 @@ def size(study: Study, areas="0.01:0.5:0.005", cost_per_m2: float | None = None,
     if errors:
         raise ConfigError(errors)
     study = with_files(study)  # a study built in Python has its files unread
-    table = sizing.size_panel(Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year)
+    table = sizing.size_panel(
+        Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year
+    )
     return sizing.SizingResult(study, table, sizing.best_areas(table), parameters, request)
 
 
@@ -368,15 +415,34 @@ def reproduce(engine: str = "numba"):
     from foldopt.studies.reproduce import REPRODUCTIONS, Reproduction, reproduce as reproduce_table
 
     study = default_study()
-    tables = {name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()}
+    tables = {
+        name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()
+    }
     return Reproduction(tables, study, engine)
 
 
-def world_map(sites: Sequence[dict] | None = None, loads: Sequence[float] | None = None, out: str | Path | None = None,
-              study: dict | None = None, relative: bool = False, year: int = 2025, *, request=None,
-              scheduler: str | None = None, workers: int | None = None, sites_per_chunk: int = 0, resume: bool = False,
-              overwrite: bool = False, engine: str = "numba", show_load: int = 0, show_period: str = "year",
-              progress=None, announce=None, command=None, defaults: dict | None = None):
+def world_map(
+    sites: Sequence[dict] | None = None,
+    loads: Sequence[float] | None = None,
+    out: str | Path | None = None,
+    study: dict | None = None,
+    relative: bool = False,
+    year: int = 2025,
+    *,
+    request=None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    sites_per_chunk: int = 0,
+    resume: bool = False,
+    overwrite: bool = False,
+    engine: str = "numba",
+    show_load: int = 0,
+    show_period: str = "year",
+    progress=None,
+    announce=None,
+    command=None,
+    defaults: dict | None = None,
+):
     """A map of many sites on Dask (:mod:`foldopt.studies.cluster`), its world maps and its ``report.html``.
 
     Parameters
@@ -438,7 +504,9 @@ def world_map(sites: Sequence[dict] | None = None, loads: Sequence[float] | None
     if request is None:
         if study is None:
             study = map_study(load_plan(default_study_path()).data)
-        request = map_request(study, loads, sites=sites, relative=relative, year=year, show_period=show_period)
+        request = map_request(
+            study, loads, sites=sites, relative=relative, year=year, show_period=show_period
+        )
     else:
         defaults = request.defaults
     study, relative, year = request.study, request.relative, request.year
@@ -447,13 +515,29 @@ def world_map(sites: Sequence[dict] | None = None, loads: Sequence[float] | None
 
     def finish(run, metadata):
         # In the map's folder before it is marked complete or replaces an earlier map (run_map).
-        finished["figures"] = map_figures(run.table, run.out, "map", relative, show_load, show_period,
-                                          tilt=searched_tilt(study) is not None)
+        finished["figures"] = map_figures(
+            run.table,
+            run.out,
+            "map",
+            relative,
+            show_load,
+            show_period,
+            tilt=searched_tilt(study) is not None,
+        )
         write_grid_netcdf(run.table, run.out, relative, f"foldopt map: {study.name}")
         finished["answer"] = of_map(run, relative, defaults)
         write_map_report(run, finished["figures"], finished["answer"], metadata)
 
-    result = run_map(spec, Path(out), scheduler=scheduler, workers=workers, resume=resume, overwrite=overwrite,
-                     progress=progress, announce=announce, metadata={"command": command or ["foldopt.world_map"]},
-                     finish=finish)
+    result = run_map(
+        spec,
+        Path(out),
+        scheduler=scheduler,
+        workers=workers,
+        resume=resume,
+        overwrite=overwrite,
+        progress=progress,
+        announce=announce,
+        metadata={"command": command or ["foldopt.world_map"]},
+        finish=finish,
+    )
     return result, finished["figures"], finished["answer"]

@@ -35,7 +35,7 @@ def printable(text, limit: int | None = None, breaks: bool = False) -> str:
     """
     control = _CONTROL_BUT_BREAKS if breaks else _CONTROL
     text = control.sub(lambda match: f"\\x{ord(match.group()):02x}", str(text))
-    return text if limit is None or len(text) <= limit else text[:limit - 3] + "..."
+    return text if limit is None or len(text) <= limit else text[: limit - 3] + "..."
 
 
 class ConfigError(ValueError):

@@ -82,7 +82,11 @@ def written_by_foldopt(folder: Path) -> bool:
         meta = json.loads((folder / "run.json").read_text())
     except (OSError, ValueError):
         return False
-    return isinstance(meta, dict) and isinstance(meta.get("versions"), dict) and "foldopt" in meta["versions"]
+    return (
+        isinstance(meta, dict)
+        and isinstance(meta.get("versions"), dict)
+        and "foldopt" in meta["versions"]
+    )
 
 
 def check_output(out: Path, overwrite: bool) -> None:
@@ -100,7 +104,9 @@ def check_output(out: Path, overwrite: bool) -> None:
     out = Path(out)
     resolved = out.resolve()
     if resolved == Path.cwd().resolve() or resolved in Path.cwd().resolve().parents:
-        raise OutputError(f"--out {out}: is the working folder or one of its parents; name a folder for the results")
+        raise OutputError(
+            f"--out {out}: is the working folder or one of its parents; name a folder for the results"
+        )
     if out.is_symlink():
         raise OutputError(f"--out {out}: is a symbolic link; name the folder itself")
     if out.exists() and not out.is_dir():
@@ -108,8 +114,10 @@ def check_output(out: Path, overwrite: bool) -> None:
     if out.exists() and not overwrite:
         raise OutputExistsError(f"{out} already exists; pass --overwrite to replace it")
     if out.exists() and any(out.iterdir()) and not written_by_foldopt(out):
-        raise OutputError(f"--out {out}: holds files foldopt did not write (no foldopt run.json); --overwrite "
-                          "replaces only results folders, so move them or choose another folder")
+        raise OutputError(
+            f"--out {out}: holds files foldopt did not write (no foldopt run.json); --overwrite "
+            "replaces only results folders, so move them or choose another folder"
+        )
     ancestor = resolved.parent
     while not ancestor.exists():
         ancestor = ancestor.parent
@@ -137,9 +145,11 @@ class DiskFullError(OutputError):
 
     def __init__(self, folder: Path, written: int, remedy: str = "run again"):
         self.folder, self.written = Path(folder), written
-        super().__init__(f"--out {folder}: the file system is full; the results need more than "
-                         f"{_size_text(written)} free there (what was written before it filled); free space and "
-                         f"{remedy}")
+        super().__init__(
+            f"--out {folder}: the file system is full; the results need more than "
+            f"{_size_text(written)} free there (what was written before it filled); free space and "
+            f"{remedy}"
+        )
 
 
 def is_full(error: BaseException) -> bool:
@@ -172,7 +182,9 @@ def tree_size(path: Path) -> int:
     """
     if Path(path).is_file():
         return Path(path).stat().st_size
-    return sum((Path(root) / name).stat().st_size for root, _, names in os.walk(path) for name in names)
+    return sum(
+        (Path(root) / name).stat().st_size for root, _, names in os.walk(path) for name in names
+    )
 
 
 def _size_text(size: int) -> str:
@@ -198,7 +210,9 @@ def write_atomically(path: Path, write) -> Path:
         os.replace(temporary, path)
     except OSError as error:
         if is_full(error):
-            raise DiskFullError(path.parent, tree_size(temporary) if temporary.exists() else 0) from None
+            raise DiskFullError(
+                path.parent, tree_size(temporary) if temporary.exists() else 0
+            ) from None
         raise
     finally:
         temporary.unlink(missing_ok=True)
@@ -209,7 +223,12 @@ def write_atomically(path: Path, write) -> Path:
 
 
 def _record() -> dict:
-    return {"writer": "foldopt", "pid": os.getpid(), "host": socket.gethostname(), "token": secrets.token_hex(8)}
+    return {
+        "writer": "foldopt",
+        "pid": os.getpid(),
+        "host": socket.gethostname(),
+        "token": secrets.token_hex(8),
+    }
 
 
 def _read_record(path: Path) -> dict | None:
@@ -218,7 +237,11 @@ def _read_record(path: Path) -> dict | None:
         record = json.loads(path.read_text())
     except (OSError, ValueError):
         return None
-    if isinstance(record, dict) and record.get("writer") == "foldopt" and isinstance(record.get("pid"), int):
+    if (
+        isinstance(record, dict)
+        and record.get("writer") == "foldopt"
+        and isinstance(record.get("pid"), int)
+    ):
         return record
     return None
 
@@ -237,7 +260,11 @@ def _alive(pid: int) -> bool:
 def _gone(record: dict) -> bool:
     """Whether the writer ``record`` names has ended: a process of this host that no longer runs
     (another host's writer cannot be asked, so its folders stay)."""
-    return record.get("host") == socket.gethostname() and record["pid"] != os.getpid() and not _alive(record["pid"])
+    return (
+        record.get("host") == socket.gethostname()
+        and record["pid"] != os.getpid()
+        and not _alive(record["pid"])
+    )
 
 
 def _lock_path(out: Path) -> Path:
@@ -264,13 +291,17 @@ def _acquire(out: Path) -> int:
     while (descriptor := _locked(path, out)) is None:
         if time.monotonic() > deadline:
             holder = _read_record(path) or {}
-            raise OutputError(f"--out {out}: another foldopt run (pid {holder.get('pid', '?')} on "
-                              f"{holder.get('host', '?')}) is writing it; wait for it to end or choose another --out")
+            raise OutputError(
+                f"--out {out}: another foldopt run (pid {holder.get('pid', '?')} on "
+                f"{holder.get('host', '?')}) is writing it; wait for it to end or choose another --out"
+            )
         time.sleep(0.01)
     if os.fstat(descriptor).st_size and _read_record(path) is None:
         os.close(descriptor)
-        raise OutputError(f"--out {out}: {path.name} beside it is not foldopt's lock file; move it or choose "
-                          "another --out")
+        raise OutputError(
+            f"--out {out}: {path.name} beside it is not foldopt's lock file; move it or choose "
+            "another --out"
+        )
     try:
         os.ftruncate(descriptor, 0)
         os.write(descriptor, json.dumps(_record()).encode())
@@ -292,7 +323,9 @@ def _locked(path: Path, out: Path) -> int | None:
 def _lock_error(out: Path, path: Path, error: OSError) -> OutputError:
     if is_full(error):
         return DiskFullError(out, 0)
-    return OutputError(f"--out {out}: cannot write its lock file {path.name} ({error.strerror or error})")
+    return OutputError(
+        f"--out {out}: cannot write its lock file {path.name} ({error.strerror or error})"
+    )
 
 
 @contextmanager
@@ -470,7 +503,9 @@ def staged_folder(out: Path, overwrite: bool):
         except OSError as error:
             if is_full(error):
                 raise DiskFullError(out, 0) from None
-            raise OutputError(f"--out {out}: cannot create it ({error.strerror or error})") from None
+            raise OutputError(
+                f"--out {out}: cannot create it ({error.strerror or error})"
+            ) from None
         try:
             yield staged
             commit(staged, out)

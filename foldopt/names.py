@@ -64,104 +64,209 @@ class Registry(tuple):
         return Registry, (self.kind, self.descriptions)
 
 
-MODES = Registry("mode", {
-    "paper": "Shin et al.'s formulas: their solar position, air mass, beam-only sky and incidence (Eq. 1-6)",
-    "exact": "pvlib's SPA solar position, a clear-sky or weather sky, transposition and angle of incidence"})
-GEOMETRIES = Registry("geometry", {
-    "azimuth-split": "the sub-panels keep the base tilt and turn east and west of the base azimuth (the paper's)",
-    "hinge": "the sub-panel normals turn about the fold line, up the panel's slope (a ridge tent at tilt 0)"})
-BEAM_SKIES = Registry("sky", {  # beam only
-    "meinel": "Meinel & Meinel's beam irradiance from air mass (Shin et al. Eq. 2)",
-    "hottel": "Hottel's clear-sky beam transmittance by climate and altitude"})
-CLEAR_SKIES = Registry("sky", {  # global, direct and diffuse
-    "ineichen": "pvlib's Ineichen-Perez clear sky with Linke turbidity",
-    "simplified-solis": "pvlib's simplified Solis clear sky from aerosol and water vapour"})
+MODES = Registry(
+    "mode",
+    {
+        "paper": "Shin et al.'s formulas: their solar position, air mass, beam-only sky and incidence (Eq. 1-6)",
+        "exact": "pvlib's SPA solar position, a clear-sky or weather sky, transposition and angle of incidence",
+    },
+)
+GEOMETRIES = Registry(
+    "geometry",
+    {
+        "azimuth-split": "the sub-panels keep the base tilt and turn east and west of the base azimuth (the paper's)",
+        "hinge": "the sub-panel normals turn about the fold line, up the panel's slope (a ridge tent at tilt 0)",
+    },
+)
+BEAM_SKIES = Registry(
+    "sky",
+    {  # beam only
+        "meinel": "Meinel & Meinel's beam irradiance from air mass (Shin et al. Eq. 2)",
+        "hottel": "Hottel's clear-sky beam transmittance by climate and altitude",
+    },
+)
+CLEAR_SKIES = Registry(
+    "sky",
+    {  # global, direct and diffuse
+        "ineichen": "pvlib's Ineichen-Perez clear sky with Linke turbidity",
+        "simplified-solis": "pvlib's simplified Solis clear sky from aerosol and water vapour",
+    },
+)
 SKIES = BEAM_SKIES + CLEAR_SKIES
-TRANSPOSITIONS = Registry("transposition", {
-    "none": "beam only: no diffuse or reflected light",
-    "isotropic": "isotropic sky diffuse (Liu & Jordan) and ground reflection",
-    "haydavies": "Hay & Davies: circumsolar and isotropic sky diffuse",
-    "perez": "Perez et al. 1990: circumsolar, isotropic and horizon-band sky diffuse"})
-IAMS = Registry("iam", {
-    "none": "no reflection loss at the cover",
-    "ashrae": "ASHRAE incidence angle modifier (pvlib.iam.ashrae)",
-    "physical": "Fresnel and absorption in the cover glass (pvlib.iam.physical)"})
-PV_MODELS = Registry("pv_model", {
-    "ideal": "P = efficiency x area x irradiance, no I-V curve (the paper's)",
-    "single-diode": "De Soto et al.'s five-parameter single-diode model of a CEC module, through pvlib",
-    "b-model": "Robles Algarin et al.'s empirical I-V model of a 200 W panel (Eq. 8-11, b = 0.068)"})
-TEMPERATURE_MODELS = Registry("temperature_model", {
-    "fixed": "cells at the air temperature",
-    "sapm": "Sandia's cell temperature model from irradiance, air temperature and wind"})
-CONNECTIONS = Registry("connection", {
-    "east": "the east sub-panel alone",
-    "west": "the west sub-panel alone",
-    "parallel": "the sub-panels in parallel at one operating voltage",
-    "series": "the sub-panels in series at one current (bypass diodes)",
-    "independent": "each sub-panel at its own maximum power point (two converters)",
-    "switching": "the best of east, west, parallel and series at each step (a reconfigurable switch)"})
-DIODE_MODELS = Registry("diode model", {
-    "ideal": "no forward drop: the diode only stops reverse current",
-    "constant": "a constant forward drop, the datasheet V_F at its rated current",
-    "shockley": "Shockley's diode with series resistance, V = n Vt ln(1 + I/Is) + I Rs (a SPICE model)"})
-CONVERTER_MODELS = Registry("converter model", {
-    "ideal": "every converter delivers its whole input (the paper's)",
-    "pvwatts": "the PVWatts part-load efficiency curve from a nominal efficiency (pvlib.inverter.pvwatts)",
-    "curve": "a table of efficiency against input power as a fraction of the rating"})
-COUPLINGS = Registry("coupling", {
-    "mppt": "a maximum-power-point converter between the panel and the load",
-    "direct": "the load wired to the panel, at the load's own voltage (no converter)"})
+TRANSPOSITIONS = Registry(
+    "transposition",
+    {
+        "none": "beam only: no diffuse or reflected light",
+        "isotropic": "isotropic sky diffuse (Liu & Jordan) and ground reflection",
+        "haydavies": "Hay & Davies: circumsolar and isotropic sky diffuse",
+        "perez": "Perez et al. 1990: circumsolar, isotropic and horizon-band sky diffuse",
+    },
+)
+IAMS = Registry(
+    "iam",
+    {
+        "none": "no reflection loss at the cover",
+        "ashrae": "ASHRAE incidence angle modifier (pvlib.iam.ashrae)",
+        "physical": "Fresnel and absorption in the cover glass (pvlib.iam.physical)",
+    },
+)
+PV_MODELS = Registry(
+    "pv_model",
+    {
+        "ideal": "P = efficiency x area x irradiance, no I-V curve (the paper's)",
+        "single-diode": "De Soto et al.'s five-parameter single-diode model of a CEC module, through pvlib",
+        "b-model": "Robles Algarin et al.'s empirical I-V model of a 200 W panel (Eq. 8-11, b = 0.068)",
+    },
+)
+TEMPERATURE_MODELS = Registry(
+    "temperature_model",
+    {
+        "fixed": "cells at the air temperature",
+        "sapm": "Sandia's cell temperature model from irradiance, air temperature and wind",
+    },
+)
+CONNECTIONS = Registry(
+    "connection",
+    {
+        "east": "the east sub-panel alone",
+        "west": "the west sub-panel alone",
+        "parallel": "the sub-panels in parallel at one operating voltage",
+        "series": "the sub-panels in series at one current (bypass diodes)",
+        "independent": "each sub-panel at its own maximum power point (two converters)",
+        "switching": "the best of east, west, parallel and series at each step (a reconfigurable switch)",
+    },
+)
+DIODE_MODELS = Registry(
+    "diode model",
+    {
+        "ideal": "no forward drop: the diode only stops reverse current",
+        "constant": "a constant forward drop, the datasheet V_F at its rated current",
+        "shockley": "Shockley's diode with series resistance, V = n Vt ln(1 + I/Is) + I Rs (a SPICE model)",
+    },
+)
+CONVERTER_MODELS = Registry(
+    "converter model",
+    {
+        "ideal": "every converter delivers its whole input (the paper's)",
+        "pvwatts": "the PVWatts part-load efficiency curve from a nominal efficiency (pvlib.inverter.pvwatts)",
+        "curve": "a table of efficiency against input power as a fraction of the rating",
+    },
+)
+COUPLINGS = Registry(
+    "coupling",
+    {
+        "mppt": "a maximum-power-point converter between the panel and the load",
+        "direct": "the load wired to the panel, at the load's own voltage (no converter)",
+    },
+)
 #: What a joint optimisation varies: field-like names (pvlib's vocabulary), so not among the
 #: kebab-case model names of :data:`REGISTRIES`.
-OPTIMIZE_VARIABLES = Registry("variable", {
-    "fold_angle": "the dihedral angle between the sub-panels [deg] (180 is flat)",
-    "tilt": "the base tilt of the unfolded panel [deg from horizontal]",
-    "azimuth": "the base azimuth of the unfolded panel [deg clockwise from north]"})
-TRACKERS = Registry("tracker", {
-    "dual-axis": "ideal: the normal always on the sun (Shin et al. Sec. IV-A)",
-    "equatorial": "a polar daily axis following the hour angle, the seasonal axis set daily (Alexandru)",
-    "dual-axis-steps": "the equatorial mount moved in N equal open-loop steps a day (Alexandru's law)",
-    "single-axis": "pvlib's single-axis tracker: a N-S axis, optionally tilted, optional backtracking"})
-DRIVES = Registry("drive", {
-    "motor": "Robles Algarin et al.'s DC gear motor: the energy of each move from its speed and current",
-    "wh-per-degree": "a fixed energy per degree of rotation"})
-WEATHER_FORMATS = Registry("weather format", {
-    "tmy3": "NREL TMY3 CSV (pvlib.iotools.read_tmy3)",
-    "epw": "EnergyPlus weather (pvlib.iotools.read_epw)",
-    "pvgis": "PVGIS typical meteorological year, CSV or JSON (pvlib.iotools.read_pvgis_tmy)",
-    "surfrad": "NOAA SURFRAD daily file: measured 1-min light, air temperature and wind (pvlib.iotools.read_surfrad)",
-    "midc": "NREL MIDC daily or raw-data file: measured 1-min columns; give the site (pvlib.iotools.read_midc)",
-    "srml": "UO SRML archival file: measured 1- to 60-min columns; give the site (pvlib.iotools.read_srml)",
-    "bsrn": "BSRN station-to-archive file: measured 1-min light and air temperature (pvlib.iotools.read_bsrn)",
-    "solrad": "NOAA SOLRAD daily file: measured 1-min light (pvlib.iotools.read_solrad)",
-    "crn": "NOAA USCRN sub-hourly file: measured 5-min global light, air temperature, wind (pvlib.iotools.read_crn)",
-    "csv": "a measured CSV: timestamp, ghi, dni, dhi [, temp_air, wind_speed] at any step; give the site"})
+OPTIMIZE_VARIABLES = Registry(
+    "variable",
+    {
+        "fold_angle": "the dihedral angle between the sub-panels [deg] (180 is flat)",
+        "tilt": "the base tilt of the unfolded panel [deg from horizontal]",
+        "azimuth": "the base azimuth of the unfolded panel [deg clockwise from north]",
+    },
+)
+TRACKERS = Registry(
+    "tracker",
+    {
+        "dual-axis": "ideal: the normal always on the sun (Shin et al. Sec. IV-A)",
+        "equatorial": "a polar daily axis following the hour angle, the seasonal axis set daily (Alexandru)",
+        "dual-axis-steps": "the equatorial mount moved in N equal open-loop steps a day (Alexandru's law)",
+        "single-axis": "pvlib's single-axis tracker: a N-S axis, optionally tilted, optional backtracking",
+    },
+)
+DRIVES = Registry(
+    "drive",
+    {
+        "motor": "Robles Algarin et al.'s DC gear motor: the energy of each move from its speed and current",
+        "wh-per-degree": "a fixed energy per degree of rotation",
+    },
+)
+WEATHER_FORMATS = Registry(
+    "weather format",
+    {
+        "tmy3": "NREL TMY3 CSV (pvlib.iotools.read_tmy3)",
+        "epw": "EnergyPlus weather (pvlib.iotools.read_epw)",
+        "pvgis": "PVGIS typical meteorological year, CSV or JSON (pvlib.iotools.read_pvgis_tmy)",
+        "surfrad": "NOAA SURFRAD daily file: measured 1-min light, air temperature and wind "
+        "(pvlib.iotools.read_surfrad)",
+        "midc": "NREL MIDC daily or raw-data file: measured 1-min columns; give the site (pvlib.iotools.read_midc)",
+        "srml": "UO SRML archival file: measured 1- to 60-min columns; give the site (pvlib.iotools.read_srml)",
+        "bsrn": "BSRN station-to-archive file: measured 1-min light and air temperature (pvlib.iotools.read_bsrn)",
+        "solrad": "NOAA SOLRAD daily file: measured 1-min light (pvlib.iotools.read_solrad)",
+        "crn": "NOAA USCRN sub-hourly file: measured 5-min global light, air temperature, wind "
+        "(pvlib.iotools.read_crn)",
+        "csv": "a measured CSV: timestamp, ghi, dni, dhi [, temp_air, wind_speed] at any step; give the site",
+    },
+)
 #: The weather formats of hourly files (typical years), brought to the study's step; the others of
 #: :data:`WEATHER_FORMATS` are measured files, evaluated at their own step.
 HOURLY_WEATHER_FORMATS = ("tmy3", "epw", "pvgis")
-DECOMPOSITIONS = Registry("decomposition", {
-    "erbs": "Erbs, Klein and Duffie 1982: the diffuse fraction from the clearness index (pvlib.irradiance.erbs)",
-    "boland": "Boland, Huang and Ridley 2013: a logistic diffuse fraction (pvlib.irradiance.boland)",
-    "dirint": "Perez et al. 1992: DISC with the index's changes and dew point (pvlib.irradiance.dirint)"})
-INTERVAL_LABELS = Registry("interval label", {
-    "start": "a timestamp marks the start of its interval",
-    "end": "a timestamp marks the end of its interval",
-    "centre": "a timestamp marks the centre of its interval"})
-HOTTEL_CLIMATES = Registry("hottel climate", {
-    "tropical": "Hottel's tropical correction factors",
-    "midlatitude-summer": "Hottel's mid-latitude summer correction factors",
-    "subarctic-summer": "Hottel's subarctic summer correction factors",
-    "midlatitude-winter": "Hottel's mid-latitude winter correction factors"})
-ENGINES = Registry("engine", {
-    "numba": "the compiled kernel",
-    "numpy": "the NumPy reference path the kernel is tested against"})
-OUTPUT_FORMATS = Registry("format", {
-    "table": "a short answer on the terminal",
-    "json": "one JSON document of the answer and its rows"})
+DECOMPOSITIONS = Registry(
+    "decomposition",
+    {
+        "erbs": "Erbs, Klein and Duffie 1982: the diffuse fraction from the clearness index (pvlib.irradiance.erbs)",
+        "boland": "Boland, Huang and Ridley 2013: a logistic diffuse fraction (pvlib.irradiance.boland)",
+        "dirint": "Perez et al. 1992: DISC with the index's changes and dew point (pvlib.irradiance.dirint)",
+    },
+)
+INTERVAL_LABELS = Registry(
+    "interval label",
+    {
+        "start": "a timestamp marks the start of its interval",
+        "end": "a timestamp marks the end of its interval",
+        "centre": "a timestamp marks the centre of its interval",
+    },
+)
+HOTTEL_CLIMATES = Registry(
+    "hottel climate",
+    {
+        "tropical": "Hottel's tropical correction factors",
+        "midlatitude-summer": "Hottel's mid-latitude summer correction factors",
+        "subarctic-summer": "Hottel's subarctic summer correction factors",
+        "midlatitude-winter": "Hottel's mid-latitude winter correction factors",
+    },
+)
+ENGINES = Registry(
+    "engine",
+    {
+        "numba": "the compiled kernel",
+        "numpy": "the NumPy reference path the kernel is tested against",
+    },
+)
+OUTPUT_FORMATS = Registry(
+    "format",
+    {
+        "table": "a short answer on the terminal",
+        "json": "one JSON document of the answer and its rows",
+    },
+)
 #: Every registry, in the order the docs list them.
-REGISTRIES = (MODES, GEOMETRIES, SKIES, TRANSPOSITIONS, IAMS, PV_MODELS, TEMPERATURE_MODELS, CONNECTIONS,
-              CONVERTER_MODELS, COUPLINGS, TRACKERS, DRIVES, WEATHER_FORMATS, DECOMPOSITIONS, INTERVAL_LABELS,
-              HOTTEL_CLIMATES, ENGINES, OUTPUT_FORMATS, DIODE_MODELS)
+REGISTRIES = (
+    MODES,
+    GEOMETRIES,
+    SKIES,
+    TRANSPOSITIONS,
+    IAMS,
+    PV_MODELS,
+    TEMPERATURE_MODELS,
+    CONNECTIONS,
+    CONVERTER_MODELS,
+    COUPLINGS,
+    TRACKERS,
+    DRIVES,
+    WEATHER_FORMATS,
+    DECOMPOSITIONS,
+    INTERVAL_LABELS,
+    HOTTEL_CLIMATES,
+    ENGINES,
+    OUTPUT_FORMATS,
+    DIODE_MODELS,
+)
+
 
 class FieldOption(typing.NamedTuple):
     """One command-line option and the study field it sets (:data:`FIELD_OPTIONS`).
@@ -202,20 +307,34 @@ class FieldOption(typing.NamedTuple):
 #: ``optimize``'s options become field changes by it (:data:`FIELD_OF_PARAMETER`), and the
 #: library's messages name the options instead of the fields (:func:`option_labels`).
 FIELD_OPTIONS = (
-    FieldOption("--lat", "site.latitude"), FieldOption("--lon", "site.longitude"),
-    FieldOption("--altitude", "site.altitude"), FieldOption("--timezone", "site.timezone"),
-    FieldOption("--days", "date", aliases=("--date",)), FieldOption("--year", "year"),
-    FieldOption("--p-load", "p_load"), FieldOption("--p-load-scale", "p_load"),
-    FieldOption("--area", "panel.area"), FieldOption("--efficiency", "panel.efficiency"),
-    FieldOption("--tilt", "panel.tilt"), FieldOption("--azimuth", "panel.azimuth"),
-    FieldOption("--mode", "mode"), FieldOption("--geometry", "geometry"),
-    FieldOption("--sky", "sky"), FieldOption("--climate", "climate"),
-    FieldOption("--weather", "weather"), FieldOption("--force-site", "force_site", flag=True),
-    FieldOption("--transposition", "transposition"), FieldOption("--albedo", "albedo"),
-    FieldOption("--iam", "iam"), FieldOption("--objective", "objective.statistic"),
-    FieldOption("--visits", "objective.visits"), FieldOption("--tracker", "tracker.model"),
-    FieldOption("--tracker-standby", "tracker.standby_w"), FieldOption("--pv-model", "pv_model"),
-    FieldOption("--module", "module"), FieldOption("--connection", "connection"),
+    FieldOption("--lat", "site.latitude"),
+    FieldOption("--lon", "site.longitude"),
+    FieldOption("--altitude", "site.altitude"),
+    FieldOption("--timezone", "site.timezone"),
+    FieldOption("--days", "date", aliases=("--date",)),
+    FieldOption("--year", "year"),
+    FieldOption("--p-load", "p_load"),
+    FieldOption("--p-load-scale", "p_load"),
+    FieldOption("--area", "panel.area"),
+    FieldOption("--efficiency", "panel.efficiency"),
+    FieldOption("--tilt", "panel.tilt"),
+    FieldOption("--azimuth", "panel.azimuth"),
+    FieldOption("--mode", "mode"),
+    FieldOption("--geometry", "geometry"),
+    FieldOption("--sky", "sky"),
+    FieldOption("--climate", "climate"),
+    FieldOption("--weather", "weather"),
+    FieldOption("--force-site", "force_site", flag=True),
+    FieldOption("--transposition", "transposition"),
+    FieldOption("--albedo", "albedo"),
+    FieldOption("--iam", "iam"),
+    FieldOption("--objective", "objective.statistic"),
+    FieldOption("--visits", "objective.visits"),
+    FieldOption("--tracker", "tracker.model"),
+    FieldOption("--tracker-standby", "tracker.standby_w"),
+    FieldOption("--pv-model", "pv_model"),
+    FieldOption("--module", "module"),
+    FieldOption("--connection", "connection"),
     FieldOption("--switch-series", "switch_series", flag=True),
     FieldOption("--no-bypass", "bypass_diodes", flag=False),
     FieldOption("--converter-efficiency", "converter_efficiency"),
@@ -224,8 +343,10 @@ FIELD_OPTIONS = (
     FieldOption("--step-min", "step_min"),
     FieldOption("--angle-step", "fold_angles.step", also=("fold_angles.start",)),
     FieldOption("--load-profile", "load_profile"),
-    FieldOption("--weather-format", "weather.format"), FieldOption("--members", "weather.members"),
-    FieldOption("--seed", "weather.seed"), FieldOption("--horizon", "site.horizon"),
+    FieldOption("--weather-format", "weather.format"),
+    FieldOption("--members", "weather.members"),
+    FieldOption("--seed", "weather.seed"),
+    FieldOption("--horizon", "site.horizon"),
     FieldOption("--blocking-diode", "circuit.blocking_diode.model"),
     FieldOption("--bypass-diode", "circuit.bypass_diode.model"),
     FieldOption("--converter", "circuit.converter.model"),

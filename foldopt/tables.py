@@ -56,7 +56,7 @@ def write_csv(table: pd.DataFrame, path: Path, index: bool = False) -> Path:
         writer = csv.writer(stream, lineterminator="\n")
         writer.writerow([str(name) for name in table.columns])
         for start in range(0, len(table), ROWS_AT_ONCE):
-            writer.writerows(zip(*_fields(table.iloc[start:start + ROWS_AT_ONCE])))
+            writer.writerows(zip(*_fields(table.iloc[start : start + ROWS_AT_ONCE])))
     return path
 
 

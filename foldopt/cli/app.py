@@ -72,16 +72,25 @@ def _option_hint(given: str, ctx) -> str:
         The end of the error line.
     """
     name = given.split("=", 1)[0]
-    own = {opt.lstrip("-"): opt for param in ctx.command.get_params(ctx)
-           for opt in (*param.opts, *param.secondary_opts) if opt.startswith("-")}
+    own = {
+        opt.lstrip("-"): opt
+        for param in ctx.command.get_params(ctx)
+        for opt in (*param.opts, *param.secondary_opts)
+        if opt.startswith("-")
+    }
     close = [own[bare] for bare in close_names(name.lstrip("-"), list(own))]
     if close:
         return f"; did you mean {' or '.join(close)}?"
-    takers = [top for top, command in _commands(ctx.find_root().command)
-              if any(name in (*param.opts, *param.secondary_opts) for param in command.params)]
+    takers = [
+        top
+        for top, command in _commands(ctx.find_root().command)
+        if any(name in (*param.opts, *param.secondary_opts) for param in command.params)
+    ]
     if takers:
-        return (f" ({name} is an option of foldopt {', '.join(dict.fromkeys(takers))}; {ctx.command_path} --help "
-                "lists its own)")
+        return (
+            f" ({name} is an option of foldopt {', '.join(dict.fromkeys(takers))}; {ctx.command_path} --help "
+            "lists its own)"
+        )
     return f" ({ctx.command_path} --help lists its options)"
 
 
@@ -128,18 +137,25 @@ def _exit_code(error: BaseException) -> int:
             if type(error).__name__ == "NoSuchOption" and error.ctx is not None:
                 message = error.message + _option_hint(error.option_name, error.ctx)
             elif message.startswith("No such command") and error.ctx is not None:
-                message += f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
+                message += (
+                    f" Choose one of {', '.join(error.ctx.command.list_commands(error.ctx))}."
+                )
             echo(f"error: {where}{message}", err=True)
         return 2
-    if isinstance(error, (_Interrupted, typer.Abort)):  # Ctrl-C; typer's Abort: end of input at a prompt
+    if isinstance(
+        error, (_Interrupted, typer.Abort)
+    ):  # Ctrl-C; typer's Abort: end of input at a prompt
         typer.echo("interrupted", err=True)
         return 130
     if _DEBUG["on"]:
         traceback.print_exception(error)
     else:
         reason = str(error).splitlines()[0][:300] if str(error) else ""
-        echo(f"error: internal error ({type(error).__name__}{': ' + reason if reason else ''}); "
-             "run again as foldopt --debug ... for the traceback, and please report it", err=True)
+        echo(
+            f"error: internal error ({type(error).__name__}{': ' + reason if reason else ''}); "
+            "run again as foldopt --debug ... for the traceback, and please report it",
+            err=True,
+        )
     return 1
 
 
@@ -153,8 +169,9 @@ class _OneLineErrors(TyperGroup):
         INVOCATION[:] = ["foldopt", *map(as_text, sys.argv[1:] if args is None else args)]
         for stream in (sys.stdout, sys.stderr):
             # A terminal that cannot show a character (a site's name under LANG=C) gets an escape, not an error.
-            if codecs.lookup(getattr(stream, "encoding", None) or "utf-8").name != "utf-8" and hasattr(
-                    stream, "reconfigure"):
+            if codecs.lookup(
+                getattr(stream, "encoding", None) or "utf-8"
+            ).name != "utf-8" and hasattr(stream, "reconfigure"):
                 stream.reconfigure(errors="backslashreplace")
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGTERM, _terminate)
@@ -186,18 +203,27 @@ class _OnceEach(TyperCommand):
                 break
             flag = arg.split("=", 1)[0]
             for param in self.params:
-                if getattr(param, "multiple", False) or flag not in tuple(getattr(param, "opts", ())) + tuple(
-                        getattr(param, "secondary_opts", ())):
+                if getattr(param, "multiple", False) or flag not in tuple(
+                    getattr(param, "opts", ())
+                ) + tuple(getattr(param, "secondary_opts", ())):
                     continue
                 if param.name in seen:
-                    raise _USAGE_ERROR(f"{flag}: given twice (first as {seen[param.name]}); give each option once",
-                                       ctx=ctx)
+                    raise _USAGE_ERROR(
+                        f"{flag}: given twice (first as {seen[param.name]}); give each option once",
+                        ctx=ctx,
+                    )
                 seen[param.name] = flag
         return super().parse_args(ctx, args)
 
 
-app = typer.Typer(cls=_OneLineErrors, add_completion=True, pretty_exceptions_enable=False, no_args_is_help=True,
-                  rich_markup_mode=None, help=HELP)
+app = typer.Typer(
+    cls=_OneLineErrors,
+    add_completion=True,
+    pretty_exceptions_enable=False,
+    no_args_is_help=True,
+    rich_markup_mode=None,
+    help=HELP,
+)
 sweep_app = typer.Typer(rich_markup_mode=None, no_args_is_help=True, help=sweep.HELP)
 
 
@@ -210,14 +236,27 @@ def _print_version(value: bool) -> None:
 
 
 @app.callback()
-def _options(ctx: typer.Context,
-             debug: Annotated[bool, typer.Option("--debug", help="Show the traceback of an internal error.")] = False,
-             version: Annotated[bool, typer.Option("--version", callback=_print_version, is_eager=True,
-                                                   help="Print foldopt's version and exit.")] = False):
+def _options(
+    ctx: typer.Context,
+    debug: Annotated[
+        bool, typer.Option("--debug", help="Show the traceback of an internal error.")
+    ] = False,
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            callback=_print_version,
+            is_eager=True,
+            help="Print foldopt's version and exit.",
+        ),
+    ] = False,
+):
     _DEBUG["on"] = debug
     # --quiet silences the caches' notices for this command only: an in-process caller's
     # environment is as it was once the command ends.
-    ctx.call_on_close(functools.partial(_restore_environment, "FOLDOPT_QUIET", os.environ.get("FOLDOPT_QUIET")))
+    ctx.call_on_close(
+        functools.partial(_restore_environment, "FOLDOPT_QUIET", os.environ.get("FOLDOPT_QUIET"))
+    )
 
 
 def _restore_environment(name: str, value: str | None) -> None:
@@ -228,8 +267,13 @@ def _restore_environment(name: str, value: str | None) -> None:
 
 
 app.add_typer(sweep_app, name="sweep", short_help=sweep.SHORT_HELP)
-for group, commands in ((app, run.COMMANDS), (sweep_app, sweep.COMMANDS), (app, map_command.COMMANDS),
-                        (app, size.COMMANDS), (app, optimize.COMMANDS)):
+for group, commands in (
+    (app, run.COMMANDS),
+    (sweep_app, sweep.COMMANDS),
+    (app, map_command.COMMANDS),
+    (app, size.COMMANDS),
+    (app, optimize.COMMANDS),
+):
     for name, command, short_help in commands:
         group.command(name, cls=_OnceEach, short_help=short_help)(command)
 

@@ -10,64 +10,164 @@ from typing import Annotated
 
 import typer
 
-from foldopt.cli.options import (EMBEDDED, OPTION_OF_FIELD, RESULTS, AngleStep, Area, Efficiency, Engine,
-                                 OutputFormat, Overwrite, Quiet, Settings, check_choices, out_option, rename_fields,
-                                 StepMin)
+from foldopt.cli.options import (
+    EMBEDDED,
+    OPTION_OF_FIELD,
+    RESULTS,
+    AngleStep,
+    Area,
+    Efficiency,
+    Engine,
+    OutputFormat,
+    Overwrite,
+    Quiet,
+    Settings,
+    check_choices,
+    out_option,
+    rename_fields,
+    StepMin,
+)
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError, WeatherError
 
 #: The map request's parameters as the options name them, beside the study's fields.
-_OPTION_OF_PARAMETER = {"latitudes": "--lat", "longitudes": "--lon", "land_only": "--land-only",
-                        "show_period": "--show-period", "optimize": "--optimize"}
+_OPTION_OF_PARAMETER = {
+    "latitudes": "--lat",
+    "longitudes": "--lon",
+    "land_only": "--land-only",
+    "show_period": "--show-period",
+    "optimize": "--optimize",
+}
 
 
 def map_(
-    lat: Annotated[str | None, typer.Option("--lat", help="Latitudes [deg north]: a range start:stop:step or a "
-                                            "list [default: -60:60:10].")] = None,
-    lon: Annotated[str | None, typer.Option("--lon", help="Longitudes [deg east]: a range or a list "
-                                            "[default: -180:180:30].")] = None,
-    land_only: Annotated[bool, typer.Option("--land-only", help="Keep only the grid points on land.")] = False,
-    sites: Annotated[Path | None, typer.Option("--sites", help="CSV of named sites: name, latitude, longitude "
-                                               "[, altitude, timezone], instead of a grid.")] = None,
-    weather_dir: Annotated[Path | None, typer.Option("--weather-dir", help="Folder of TMY3 / EPW / PVGIS files, "
-                                                     "each file a site (its site read from the file), instead of "
-                                                     "a grid.")] = None,
-    p_load: Annotated[str | None, typer.Option("--p-load", help="Loads [W]: a value, a range or a list [default: "
-                                               "the study's].")] = None,
-    p_load_fraction: Annotated[str | None, typer.Option("--p-load-fraction", help="Loads as fractions of each "
-                                                        "site's flat peak: a value, a range such as 0.1:0.9:0.1 or "
-                                                        "a list, instead of --p-load.")] = None,
+    lat: Annotated[
+        str | None,
+        typer.Option(
+            "--lat",
+            help="Latitudes [deg north]: a range start:stop:step or a list [default: -60:60:10].",
+        ),
+    ] = None,
+    lon: Annotated[
+        str | None,
+        typer.Option(
+            "--lon", help="Longitudes [deg east]: a range or a list [default: -180:180:30]."
+        ),
+    ] = None,
+    land_only: Annotated[
+        bool, typer.Option("--land-only", help="Keep only the grid points on land.")
+    ] = False,
+    sites: Annotated[
+        Path | None,
+        typer.Option(
+            "--sites",
+            help="CSV of named sites: name, latitude, longitude "
+            "[, altitude, timezone], instead of a grid.",
+        ),
+    ] = None,
+    weather_dir: Annotated[
+        Path | None,
+        typer.Option(
+            "--weather-dir",
+            help="Folder of TMY3 / EPW / PVGIS files, "
+            "each file a site (its site read from the file), instead of "
+            "a grid.",
+        ),
+    ] = None,
+    p_load: Annotated[
+        str | None,
+        typer.Option(
+            "--p-load", help="Loads [W]: a value, a range or a list [default: the study's]."
+        ),
+    ] = None,
+    p_load_fraction: Annotated[
+        str | None,
+        typer.Option(
+            "--p-load-fraction",
+            help="Loads as fractions of each "
+            "site's flat peak: a value, a range such as 0.1:0.9:0.1 or "
+            "a list, instead of --p-load.",
+        ),
+    ] = None,
     area: Area = None,
     efficiency: Efficiency = None,
-    objective: Annotated[str, typer.Option("--objective", help="What each period's fold angle maximises: mean | "
-                                           "min | worst-month | pNN.")] = "mean",
-    year: Annotated[int, typer.Option("--year", help="Year of the clear-sky days (or that a typical year stands "
-                                      "for).")] = 2025,
+    objective: Annotated[
+        str,
+        typer.Option(
+            "--objective",
+            help="What each period's fold angle maximises: mean | min | worst-month | pNN.",
+        ),
+    ] = "mean",
+    year: Annotated[
+        int,
+        typer.Option(
+            "--year", help="Year of the clear-sky days (or that a typical year stands for)."
+        ),
+    ] = 2025,
     step_min: StepMin = None,
     angle_step: AngleStep = None,
-    fold_search: Annotated[bool, typer.Option("--fold-search", help="Search the fold angles (foldopt.engine.search) "
-                                              "instead of evaluating every one: the same objectives within 0.01 h "
-                                              "from some 60 of 180 angles.")] = False,
-    optimize: Annotated[str | None, typer.Option("--optimize", help="What the search varies with the fold angle: "
-                                                 "tilt (each site's best tilt, and the flat panel's own); implies "
-                                                 "--fold-search.")] = None,
-    config: Annotated[Path | None, typer.Option("--config", help=f"Study to take the panel and models from "
-                                                f"[default: {EMBEDDED}, in exact mode with the Ineichen clear "
-                                                "sky].")] = None,
+    fold_search: Annotated[
+        bool,
+        typer.Option(
+            "--fold-search",
+            help="Search the fold angles (foldopt.engine.search) "
+            "instead of evaluating every one: the same objectives within 0.01 h "
+            "from some 60 of 180 angles.",
+        ),
+    ] = False,
+    optimize: Annotated[
+        str | None,
+        typer.Option(
+            "--optimize",
+            help="What the search varies with the fold angle: "
+            "tilt (each site's best tilt, and the flat panel's own); implies "
+            "--fold-search.",
+        ),
+    ] = None,
+    config: Annotated[
+        Path | None,
+        typer.Option(
+            "--config",
+            help=f"Study to take the panel and models from "
+            f"[default: {EMBEDDED}, in exact mode with the Ineichen clear "
+            "sky].",
+        ),
+    ] = None,
     settings: Settings = None,
-    scheduler: Annotated[str | None, typer.Option("--scheduler", help="A Dask scheduler's address "
-                                                  "(tcp://host:8786) or scheduler file [default: an embedded "
-                                                  "cluster].")] = None,
-    workers: Annotated[int | None, typer.Option("--workers", help="Worker processes of the embedded cluster "
-                                                "[default: one per core].")] = None,
-    chunk_sites: Annotated[int | None, typer.Option("--chunk-sites", help="Sites per task [default: about 5 s of "
-                                                    "work].")] = None,
-    show_load: Annotated[int, typer.Option("--show-load", help="Which load (1 = the first) the world maps "
-                                           "show.")] = 1,
-    show_period: Annotated[str, typer.Option("--show-period", help="Period the world maps show: year | DJF | MAM | "
-                                             "JJA | SON.")] = "year",
-    resume: Annotated[bool, typer.Option("--resume", help="Finish an interrupted map in --out: only missing chunks "
-                                         "are computed.")] = False,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            help="A Dask scheduler's address "
+            "(tcp://host:8786) or scheduler file [default: an embedded "
+            "cluster].",
+        ),
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            "--workers", help="Worker processes of the embedded cluster [default: one per core]."
+        ),
+    ] = None,
+    chunk_sites: Annotated[
+        int | None,
+        typer.Option("--chunk-sites", help="Sites per task [default: about 5 s of work]."),
+    ] = None,
+    show_load: Annotated[
+        int, typer.Option("--show-load", help="Which load (1 = the first) the world maps show.")
+    ] = 1,
+    show_period: Annotated[
+        str,
+        typer.Option(
+            "--show-period", help="Period the world maps show: year | DJF | MAM | JJA | SON."
+        ),
+    ] = "year",
+    resume: Annotated[
+        bool,
+        typer.Option(
+            "--resume", help="Finish an interrupted map in --out: only missing chunks are computed."
+        ),
+    ] = False,
     out: Annotated[Path, out_option()] = RESULTS / "map",
     overwrite: Overwrite = False,
     quiet: Quiet = False,
@@ -90,7 +190,11 @@ def map_(
     output_format, engine = check_choices(output_format, engine)
     output = Output(quiet, output_format)
     errors = []
-    if sum(source is not None for source in (sites, weather_dir)) + (lat is not None or lon is not None) > 1:
+    if (
+        sum(source is not None for source in (sites, weather_dir))
+        + (lat is not None or lon is not None)
+        > 1
+    ):
         errors.append("--lat/--lon, --sites, --weather-dir: give one source of sites")
     if land_only and (sites is not None or weather_dir is not None):
         errors.append("--land-only: only for a --lat/--lon grid")
@@ -102,42 +206,87 @@ def map_(
     if errors:
         fail(errors)
     relative = p_load_fraction is not None
-    options_of = {**OPTION_OF_FIELD, **_OPTION_OF_PARAMETER, "loads": "--p-load-fraction" if relative else "--p-load"}
+    options_of = {
+        **OPTION_OF_FIELD,
+        **_OPTION_OF_PARAMETER,
+        "loads": "--p-load-fraction" if relative else "--p-load",
+    }
     from foldopt.studies.request import map_request_from
 
     try:
         request = map_request_from(
-            config, source=EMBEDDED if config is None else str(config), objective=objective, area=area,
-            efficiency=efficiency, step_min=step_min, angle_step=angle_step, fold_search=fold_search,
-            optimize=optimize, settings=settings or (),
-            loads=p_load_fraction if relative else p_load, relative=relative, year=year, show_period=show_period,
-            sites=sites, weather_dir=weather_dir, latitudes=lat, longitudes=lon, land_only=land_only)
+            config,
+            source=EMBEDDED if config is None else str(config),
+            objective=objective,
+            area=area,
+            efficiency=efficiency,
+            step_min=step_min,
+            angle_step=angle_step,
+            fold_search=fold_search,
+            optimize=optimize,
+            settings=settings or (),
+            loads=p_load_fraction if relative else p_load,
+            relative=relative,
+            year=year,
+            show_period=show_period,
+            sites=sites,
+            weather_dir=weather_dir,
+            latitudes=lat,
+            longitudes=lon,
+            land_only=land_only,
+        )
     except WeatherError:
         raise  # a file of --weather-dir: its line names the file, as the reader says it (map has no --weather)
     except ConfigError as error:
         fail(list(dict.fromkeys(rename_fields(line, options_of) for line in error.errors)))
     if not 1 <= show_load <= len(request.loads):
-        fail([f"--show-load = {show_load}: must be in [1, {len(request.loads)}] (the map has "
-              f"{len(request.loads)} load{'s' if len(request.loads) > 1 else ''})"])
+        fail(
+            [
+                f"--show-load = {show_load}: must be in [1, {len(request.loads)}] (the map has "
+                f"{len(request.loads)} load{'s' if len(request.loads) > 1 else ''})"
+            ]
+        )
 
     def announce(cluster: str, dashboard: str | None):
         if not quiet and not output.json:
             typer.echo(f"{cluster}; dashboard: {dashboard or 'none (pip install bokeh)'}", err=True)
 
-    with output.progress(f"map: {len(request.sites)} sites", total=len(request.sites), unit="sites") as progress:
+    with output.progress(
+        f"map: {len(request.sites)} sites", total=len(request.sites), unit="sites"
+    ) as progress:
         from foldopt.api import world_map
 
         try:
             result, figures, answer = world_map(
-                request=request, out=out, scheduler=scheduler, workers=workers, sites_per_chunk=chunk_sites or 0,
-                resume=resume, overwrite=overwrite, engine=engine, show_load=show_load - 1, show_period=show_period,
-                progress=progress, announce=announce, command=INVOCATION)
+                request=request,
+                out=out,
+                scheduler=scheduler,
+                workers=workers,
+                sites_per_chunk=chunk_sites or 0,
+                resume=resume,
+                overwrite=overwrite,
+                engine=engine,
+                show_load=show_load - 1,
+                show_period=show_period,
+                progress=progress,
+                announce=announce,
+                command=INVOCATION,
+            )
         except ConfigError as error:
             fail(list(dict.fromkeys(rename_fields(line) for line in error.errors)))
-    output.answer("map", out, answer, result.table[result.table["period"] == "year"].reset_index(drop=True),
-                  [f"wrote {out} (map.parquet, map.csv{', map.nc' if (out / 'map.nc').exists() else ''}, report.html, "
-                   f"{', '.join(figures)})"])
+    output.answer(
+        "map",
+        out,
+        answer,
+        result.table[result.table["period"] == "year"].reset_index(drop=True),
+        [
+            f"wrote {out} (map.parquet, map.csv{', map.nc' if (out / 'map.nc').exists() else ''}, report.html, "
+            f"{', '.join(figures)})"
+        ],
+    )
 
 
 #: The commands of this module: name, function, and the line the command list shows.
-COMMANDS = [("map", map_, "Many sites on Dask: best fold angle, gains and tracker share worldwide.")]
+COMMANDS = [
+    ("map", map_, "Many sites on Dask: best fold angle, gains and tracker share worldwide.")
+]

@@ -18,8 +18,13 @@ from foldopt.cli.sweep import signature
 from foldopt.errors import ConfigError
 
 #: The optimize section's fields by the parameters of :func:`_optimize_options` that set them.
-_PARAMETER_OF_FIELD = {"vary": "vary", "fold_angle": "fold_range", "tilt": "tilt_range", "azimuth": "azimuth_range",
-                       "tolerance_h": "tolerance"}
+_PARAMETER_OF_FIELD = {
+    "vary": "vary",
+    "fold_angle": "fold_range",
+    "tilt": "tilt_range",
+    "azimuth": "azimuth_range",
+    "tolerance_h": "tolerance",
+}
 
 
 def _optimize_labels(own: dict) -> dict:
@@ -27,24 +32,54 @@ def _optimize_labels(own: dict) -> dict:
     given name them: ``--tilt-range step``; a field the study file set keeps its name."""
     from foldopt.studies.request import OPTIMIZE_OPTIONS
 
-    return {f"optimize.{name}{part}": option + part.replace(".", " ") for name, option in OPTIMIZE_OPTIONS.items()
-            if own[_PARAMETER_OF_FIELD[name]] is not None for part in ("", ".min", ".max", ".step")}
+    return {
+        f"optimize.{name}{part}": option + part.replace(".", " ")
+        for name, option in OPTIMIZE_OPTIONS.items()
+        if own[_PARAMETER_OF_FIELD[name]] is not None
+        for part in ("", ".min", ".max", ".step")
+    }
 
 
 def _optimize_options(
-    vary: Annotated[str | None, typer.Option("--vary", help="What to optimise: any of "
-                                             + ", ".join(names.OPTIMIZE_VARIABLES) + ", joined by commas [default: "
-                                             "all three, or the study's optimize.vary].")] = None,
-    fold_range: Annotated[str | None, typer.Option("--fold-range", help="Fold angles min:max:step [deg] [default: "
-                                                   "the study's fold_angles].")] = None,
-    tilt_range: Annotated[str | None, typer.Option("--tilt-range", help="Base tilts min:max:step [deg] [default: "
-                                                   "0:90:1].")] = None,
-    azimuth_range: Annotated[str | None, typer.Option("--azimuth-range", help="Base azimuths min:max:step [deg "
-                                                      "from north; may cross north, -90:90:2] [default: the "
-                                                      "equator-facing one +-90 by 2].")] = None,
-    tolerance: Annotated[float | None, typer.Option("--tolerance", help="What the search may miss of the best "
-                                                    "objective [h]; no finer than the objective counts (one day: "
-                                                    "the time step) [default: 0.01].")] = None,
+    vary: Annotated[
+        str | None,
+        typer.Option(
+            "--vary",
+            help="What to optimise: any of "
+            + ", ".join(names.OPTIMIZE_VARIABLES)
+            + ", joined by commas [default: "
+            "all three, or the study's optimize.vary].",
+        ),
+    ] = None,
+    fold_range: Annotated[
+        str | None,
+        typer.Option(
+            "--fold-range",
+            help="Fold angles min:max:step [deg] [default: the study's fold_angles].",
+        ),
+    ] = None,
+    tilt_range: Annotated[
+        str | None,
+        typer.Option("--tilt-range", help="Base tilts min:max:step [deg] [default: 0:90:1]."),
+    ] = None,
+    azimuth_range: Annotated[
+        str | None,
+        typer.Option(
+            "--azimuth-range",
+            help="Base azimuths min:max:step [deg "
+            "from north; may cross north, -90:90:2] [default: the "
+            "equator-facing one +-90 by 2].",
+        ),
+    ] = None,
+    tolerance: Annotated[
+        float | None,
+        typer.Option(
+            "--tolerance",
+            help="What the search may miss of the best "
+            "objective [h]; no finer than the objective counts (one day: "
+            "the time step) [default: 0.01].",
+        ),
+    ] = None,
 ):
     """The options of the optimisation itself."""
 
@@ -54,16 +89,27 @@ def optimize(**options):
     output = Output(options.pop("quiet"), output_format, options.pop("table"))
     out, overwrite = options.pop("out"), options.pop("overwrite")
     config = options.pop("config")
-    own = {name: options.pop(name) for name in ("vary", "fold_range", "tilt_range", "azimuth_range", "tolerance")}
+    own = {
+        name: options.pop(name)
+        for name in ("vary", "fold_range", "tilt_range", "azimuth_range", "tolerance")
+    }
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
     from foldopt.studies.request import OPTIMIZE_OPTIONS, optimize_section, sweep_request
 
     given = {name for name, value in options.items() if value is not None}
     labels = {**names.option_labels(given), **_optimize_labels(own)}
     try:
-        section = optimize_section(own["vary"], own["fold_range"], own["tilt_range"], own["azimuth_range"],
-                                   own["tolerance"], labels=OPTIMIZE_OPTIONS)
-        request = sweep_request(config, options, None, EMBEDDED if config is None else str(config), section)
+        section = optimize_section(
+            own["vary"],
+            own["fold_range"],
+            own["tilt_range"],
+            own["azimuth_range"],
+            own["tolerance"],
+            labels=OPTIMIZE_OPTIONS,
+        )
+        request = sweep_request(
+            config, options, None, EMBEDDED if config is None else str(config), section
+        )
         # The search's own limits (loads x designs) are checked as it starts, before any work.
         run_request(request, out or RESULTS / "optimize", overwrite, output, engine, "optimize")
     except ConfigError as error:
@@ -84,4 +130,10 @@ Examples:
   foldopt optimize --lat -33.87 --lon 151.21 --timezone Australia/Sydney --days 1:365:7 --p-load 1,3"""
 
 #: The commands of this module: name, function, and the line the command list shows.
-COMMANDS = [("optimize", optimize, "The best fold angle, tilt and azimuth together, and the flat panel's own best.")]
+COMMANDS = [
+    (
+        "optimize",
+        optimize,
+        "The best fold angle, tilt and azimuth together, and the flat panel's own best.",
+    )
+]

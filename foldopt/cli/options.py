@@ -25,23 +25,56 @@ RESULTS = Path("results")
 EMBEDDED = "configs/shin2015.yaml"
 
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace an existing results folder.")]
-Quiet = Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing but errors (with --format json: the JSON "
-                                                           "only).")]
-OutputFormat = Annotated[str, typer.Option("--format", help=f"{' | '.join(names.OUTPUT_FORMATS)}: a short answer, or "
-                                                            "one JSON document on stdout for scripts.")]
-Engine = Annotated[str, typer.Option("--engine", help="numba (the compiled kernel) | numpy (the reference path it is "
-                                                      "tested against, slower).")]
-Table = Annotated[bool, typer.Option("--table", help="Also print the full table (it is always in the CSV files).")]
+Quiet = Annotated[
+    bool,
+    typer.Option(
+        "--quiet", "-q", help="Print nothing but errors (with --format json: the JSON only)."
+    ),
+]
+OutputFormat = Annotated[
+    str,
+    typer.Option(
+        "--format",
+        help=f"{' | '.join(names.OUTPUT_FORMATS)}: a short answer, or "
+        "one JSON document on stdout for scripts.",
+    ),
+]
+Engine = Annotated[
+    str,
+    typer.Option(
+        "--engine",
+        help="numba (the compiled kernel) | numpy (the reference path it is "
+        "tested against, slower).",
+    ),
+]
+Table = Annotated[
+    bool, typer.Option("--table", help="Also print the full table (it is always in the CSV files).")
+]
 Area = Annotated[float | None, typer.Option("--area", help="Flat panel area [m^2].")]
-Efficiency = Annotated[float | None, typer.Option("--efficiency", help="PV efficiency [-] (ideal model; sets the "
-                                                                       "b-model panel's area).")]
-AngleStep = Annotated[float | None, typer.Option("--angle-step", help="Fold-angle grid step [deg] [default: the "
-                                                                      "study's].")]
-StepMin = Annotated[float | None, typer.Option("--step-min", help="Time step [min], a divisor of 1440 [default: the "
-                                                                  "study's].")]
-Settings = Annotated[list[str] | None, typer.Option("--set", metavar="KEY=VALUE", help="Any study field (a dotted "
-                                                    "key, a YAML value), e.g. --set pv_model=single-diode; "
-                                                    "repeatable.")]
+Efficiency = Annotated[
+    float | None,
+    typer.Option(
+        "--efficiency", help="PV efficiency [-] (ideal model; sets the b-model panel's area)."
+    ),
+]
+AngleStep = Annotated[
+    float | None,
+    typer.Option("--angle-step", help="Fold-angle grid step [deg] [default: the study's]."),
+]
+StepMin = Annotated[
+    float | None,
+    typer.Option("--step-min", help="Time step [min], a divisor of 1440 [default: the study's]."),
+]
+Settings = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--set",
+        metavar="KEY=VALUE",
+        help="Any study field (a dotted "
+        "key, a YAML value), e.g. --set pv_model=single-diode; "
+        "repeatable.",
+    ),
+]
 
 
 def out_option(shown: str | None = None) -> typer.models.OptionInfo:
@@ -89,8 +122,10 @@ def check_choices(output_format: str, engine: str) -> tuple[str, str]:
         The canonical format and engine.
     """
     errors, chosen = [], []
-    for option, value, choices in (("--format", output_format, names.OUTPUT_FORMATS),
-                                   ("--engine", engine, names.ENGINES)):
+    for option, value, choices in (
+        ("--format", output_format, names.OUTPUT_FORMATS),
+        ("--engine", engine, names.ENGINES),
+    ):
         try:
             chosen.append(names.canonical(value, choices))
         except ValueError as error:
@@ -120,5 +155,5 @@ def rename_fields(line: str, options: dict = OPTION_OF_FIELD) -> str:
     """
     match = _FIELD.match(line)
     if match and match.group(1) in options:
-        return options[match.group(1)] + line[match.end(1):]
+        return options[match.group(1)] + line[match.end(1) :]
     return line

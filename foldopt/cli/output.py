@@ -80,7 +80,9 @@ class Output:
     def __init__(self, quiet: bool, output_format: str, table: bool = False):
         self.quiet, self.json, self.table = quiet, output_format == "json", table
         if quiet:
-            os.environ["FOLDOPT_QUIET"] = "1"  # the caches' rebuild notices too; embedded workers inherit it
+            os.environ["FOLDOPT_QUIET"] = (
+                "1"  # the caches' rebuild notices too; embedded workers inherit it
+            )
 
     @contextmanager
     def progress(self, label: str, total: float | None = None, unit: str = "days"):
@@ -107,8 +109,16 @@ class Output:
         if not console.is_terminal:  # a bar in a log or a pipe is noise
             yield lambda done, total: None
             return
-        from rich.progress import (BarColumn, Progress, ProgressColumn, SpinnerColumn, TaskProgressColumn,
-                                   TextColumn, TimeElapsedColumn, TimeRemainingColumn)
+        from rich.progress import (
+            BarColumn,
+            Progress,
+            ProgressColumn,
+            SpinnerColumn,
+            TaskProgressColumn,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
         from rich.text import Text
 
         class Rate(ProgressColumn):
@@ -122,7 +132,9 @@ class Output:
             task = bar.add_task(label, total=total)
             yield lambda done, total: bar.update(task, completed=done, total=total)
 
-    def answer(self, command: str, out: Path, answer, rows=None, lines_after=(), table=None, write=None) -> None:
+    def answer(
+        self, command: str, out: Path, answer, rows=None, lines_after=(), table=None, write=None
+    ) -> None:
         """Render an answer: its lines (``--table`` adds ``table``), or one JSON document holding it
         and the rows; and write its folder.
 
@@ -151,8 +163,12 @@ class Output:
 
             if write is not None:
                 write()
-            document = {"command": command, "out": as_text(str(out)), "answer": answer.to_dict(),
-                        "rows": records(rows)}
+            document = {
+                "command": command,
+                "out": as_text(str(out)),
+                "answer": answer.to_dict(),
+                "rows": records(rows),
+            }
             typer.echo(json.dumps(document, indent=1))
             return
         if not self.quiet:

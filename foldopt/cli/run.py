@@ -5,8 +5,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
-from foldopt.cli.options import (EMBEDDED, RESULTS, Engine, OutputFormat, Overwrite, Quiet, Settings, Table,
-                                 check_choices, out_option, study_argument)
+from foldopt.cli.options import (
+    EMBEDDED,
+    RESULTS,
+    Engine,
+    OutputFormat,
+    Overwrite,
+    Quiet,
+    Settings,
+    Table,
+    check_choices,
+    out_option,
+    study_argument,
+)
 from foldopt.cli.output import INVOCATION, Output
 from foldopt.files import check_output
 
@@ -14,25 +25,31 @@ if TYPE_CHECKING:
     from foldopt.studies.request import Request
 
 
-def run_request(request: Request, out: Path, overwrite: bool, output: Output, engine: str, command: str) -> None:
+def run_request(
+    request: Request, out: Path, overwrite: bool, output: Output, engine: str, command: str
+) -> None:
     """Evaluate a request's plan (one case or many) through the API, print its answer, write its folder
-(:meth:`Output.answer`: the lines before the figures are drawn).
+    (:meth:`Output.answer`: the lines before the figures are drawn).
 
-    Parameters
-    ----------
-    request : foldopt.studies.request.Request
-    out : pathlib.Path
-        The results folder.
-    overwrite : bool
-    output : Output
-    engine : {'numba', 'numpy'}
-    command : str
-        The command's name, for the JSON document.
+        Parameters
+        ----------
+        request : foldopt.studies.request.Request
+        out : pathlib.Path
+            The results folder.
+        overwrite : bool
+        output : Output
+        engine : {'numba', 'numpy'}
+        command : str
+            The command's name, for the JSON document.
     """
     check_output(out, overwrite)
     plan, base = request.plan, request.plan.base
     if not plan.axes:
-        label, total, unit = f"{base.name}: one day, {len(base.fold_angles.grid())} fold angles", None, "days"
+        label, total, unit = (
+            f"{base.name}: one day, {len(base.fold_angles.grid())} fold angles",
+            None,
+            "days",
+        )
     else:
         days = plan.n_cases // max(len(dict(plan.axes).get("p_load", (1,))), 1)
         unit = "site-days" if any(path.startswith("site") for path, _ in plan.axes) else "days"
@@ -44,8 +61,15 @@ def run_request(request: Request, out: Path, overwrite: bool, output: Output, en
 
         result = run(plan, engine, progress, request=request)
     rows = result.summary if isinstance(result, StudyResult) else result.table
-    output.answer(command, out, result.answer, rows, [f"wrote {out}"], rows,
-                  write=lambda: write(result, out, overwrite, INVOCATION))
+    output.answer(
+        command,
+        out,
+        result.answer,
+        rows,
+        [f"wrote {out}"],
+        rows,
+        write=lambda: write(result, out, overwrite, INVOCATION),
+    )
 
 
 def run(
@@ -73,10 +97,19 @@ def run(
     from foldopt.studies.request import Request, settings_plan
 
     source = EMBEDDED if config is None else str(config)
-    request = Request(settings_plan(config if config is not None else default_study_path(), settings or ()),
-                      source, ())
-    run_request(request, out or RESULTS / request.plan.base.name, overwrite, Output(quiet, output_format, table),
-                engine, "run")
+    request = Request(
+        settings_plan(config if config is not None else default_study_path(), settings or ()),
+        source,
+        (),
+    )
+    run_request(
+        request,
+        out or RESULTS / request.plan.base.name,
+        overwrite,
+        Output(quiet, output_format, table),
+        engine,
+        "run",
+    )
 
 
 def reproduce(
@@ -98,12 +131,22 @@ def reproduce(
         from foldopt.api import reproduce as reproduce_paper, write
 
         result = reproduce_paper(engine)
-    output.answer("reproduce", out, result.answer, None, [f"wrote {out}"],
-                  write=lambda: write(result, out, overwrite, INVOCATION))
+    output.answer(
+        "reproduce",
+        out,
+        result.answer,
+        None,
+        [f"wrote {out}"],
+        write=lambda: write(result, out, overwrite, INVOCATION),
+    )
 
 
 #: The commands of this module: name, function, and the line the command list shows.
 COMMANDS = [
     ("run", run, "Run a YAML study, one case or a sweep [default: the embedded study]."),
-    ("reproduce", reproduce, "Shin et al.'s published values beside foldopt's, paper and exact modes."),
+    (
+        "reproduce",
+        reproduce,
+        "Shin et al.'s published values beside foldopt's, paper and exact modes.",
+    ),
 ]

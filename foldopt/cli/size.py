@@ -8,37 +8,68 @@ from typing import Annotated
 
 import typer
 
-from foldopt.cli.options import (EMBEDDED, RESULTS, OutputFormat, Overwrite, Quiet, Settings, Table, check_choices,
-                                 out_option, study_argument)
+from foldopt.cli.options import (
+    EMBEDDED,
+    RESULTS,
+    OutputFormat,
+    Overwrite,
+    Quiet,
+    Settings,
+    Table,
+    check_choices,
+    out_option,
+    study_argument,
+)
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError
 from foldopt.files import check_output
 from foldopt.inputs.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2
 
 #: The sizing's parameters as the command line names them, longest first.
-_OPTION_OF_SIZING = {"cost_per_m2 / cost_per_w": "--cost-per-m2 / --cost-per-w", "c_grid_usd_per_kwh": "--c-grid",
-                     "days_per_year": "--days-per-year", "cost_per_m2": "--cost-per-m2", "cost_per_w": "--cost-per-w",
-                     "years": "--years", "areas": "--areas"}
+_OPTION_OF_SIZING = {
+    "cost_per_m2 / cost_per_w": "--cost-per-m2 / --cost-per-w",
+    "c_grid_usd_per_kwh": "--c-grid",
+    "days_per_year": "--days-per-year",
+    "cost_per_m2": "--cost-per-m2",
+    "cost_per_w": "--cost-per-w",
+    "years": "--years",
+    "areas": "--areas",
+}
 
 
 def _sizing_option(line: str) -> str:
     for field, option in _OPTION_OF_SIZING.items():
         if line.startswith(field):
-            return option + line[len(field):]
+            return option + line[len(field) :]
     return line
 
 
 def size(
     config: Annotated[Path | None, study_argument(" (one case)")] = None,
-    areas: Annotated[str, typer.Option("--areas", help="Panel areas [m^2], start:stop:step.")] = "0.01:0.5:0.005",
-    cost_per_m2: Annotated[float | None, typer.Option("--cost-per-m2", help=f"Panel cost [$/m^2] [default: "
-                                                      f"{PAPER_COST_PER_M2:g}, the cost Shin et al.'s 0.108 m^2 "
-                                                      "optimum implies].")] = None,
-    cost_per_w: Annotated[float | None, typer.Option("--cost-per-w", help="Panel cost [$/W at STC], instead.")] = None,
-    c_grid: Annotated[float, typer.Option("--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22).")] = C_GRID,
-    years: Annotated[float, typer.Option("--years", help="Lifetime [years] (Shin et al.: 20).")] = LIFETIME_YEARS,
-    days_per_year: Annotated[float, typer.Option("--days-per-year", help="Days a year like the study's "
-                                                 "day.")] = DAYS_PER_YEAR,
+    areas: Annotated[
+        str, typer.Option("--areas", help="Panel areas [m^2], start:stop:step.")
+    ] = "0.01:0.5:0.005",
+    cost_per_m2: Annotated[
+        float | None,
+        typer.Option(
+            "--cost-per-m2",
+            help=f"Panel cost [$/m^2] [default: "
+            f"{PAPER_COST_PER_M2:g}, the cost Shin et al.'s 0.108 m^2 "
+            "optimum implies].",
+        ),
+    ] = None,
+    cost_per_w: Annotated[
+        float | None, typer.Option("--cost-per-w", help="Panel cost [$/W at STC], instead.")
+    ] = None,
+    c_grid: Annotated[
+        float, typer.Option("--c-grid", help="Grid energy price [$/kWh] (Shin et al.: 0.22).")
+    ] = C_GRID,
+    years: Annotated[
+        float, typer.Option("--years", help="Lifetime [years] (Shin et al.: 20).")
+    ] = LIFETIME_YEARS,
+    days_per_year: Annotated[
+        float, typer.Option("--days-per-year", help="Days a year like the study's day.")
+    ] = DAYS_PER_YEAR,
     out: Annotated[Path | None, out_option(shown="results/<study>-sizing")] = None,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
@@ -60,13 +91,23 @@ def size(
     from foldopt.inputs.study_file import default_study_path
     from foldopt.studies.request import settings_plan, size_request, sizing_problems
 
-    errors = sizing_problems({"cost_per_m2": cost_per_m2, "cost_per_w": cost_per_w, "c_grid_usd_per_kwh": c_grid,
-                              "years": years, "days_per_year": days_per_year})
+    errors = sizing_problems(
+        {
+            "cost_per_m2": cost_per_m2,
+            "cost_per_w": cost_per_w,
+            "c_grid_usd_per_kwh": c_grid,
+            "years": years,
+            "days_per_year": days_per_year,
+        }
+    )
     if errors:
         fail([_sizing_option(line) for line in errors])
     plan = settings_plan(config if config is not None else default_study_path(), settings or ())
-    request = size_request(plan, EMBEDDED if config is None else str(config),
-                           cost_per_m2 is not None or cost_per_w is not None)
+    request = size_request(
+        plan,
+        EMBEDDED if config is None else str(config),
+        cost_per_m2 is not None or cost_per_w is not None,
+    )
     study = plan.base
     out = out or RESULTS / f"{study.name}-sizing"
     check_output(out, overwrite)
@@ -74,7 +115,9 @@ def size(
 
     try:
         with output.progress(f"sizing {study.name}"):
-            result = size_panel(study, areas, cost_per_m2, cost_per_w, c_grid, years, days_per_year, request=request)
+            result = size_panel(
+                study, areas, cost_per_m2, cost_per_w, c_grid, years, days_per_year, request=request
+            )
             write(result, out, overwrite, INVOCATION)
     except ConfigError as error:
         fail([_sizing_option(line) for line in error.errors])

@@ -69,8 +69,12 @@ class CircuitParts:
     @property
     def panel_side_ideal(self) -> bool:
         """Whether the panel side is the ideal one (only the converter is as built)."""
-        return (self.blocking.model == "ideal" and self.bypass.model == "ideal" and not self.direct
-                and not self.switch_table)
+        return (
+            self.blocking.model == "ideal"
+            and self.bypass.model == "ideal"
+            and not self.direct
+            and not self.switch_table
+        )
 
     @property
     def conv_table(self) -> np.ndarray:
@@ -99,11 +103,19 @@ def circuit_parts(study: Study, p_rated: float) -> CircuitParts | None:
     if circuit.ideal:
         return None
     spec = circuit.converter
-    converter = Converter(spec.model, spec.p_rated or float(p_rated), spec.efficiency,
-                          tuple(tuple(point) for point in spec.curve or ()))
-    return CircuitParts(circuit.blocking_diode.build(), circuit.bypass_diode.build(), converter,
-                        circuit.load_voltage if circuit.coupling == "direct" else None,
-                        float(circuit.switch_resistance))
+    converter = Converter(
+        spec.model,
+        spec.p_rated or float(p_rated),
+        spec.efficiency,
+        tuple(tuple(point) for point in spec.curve or ()),
+    )
+    return CircuitParts(
+        circuit.blocking_diode.build(),
+        circuit.bypass_diode.build(),
+        converter,
+        circuit.load_voltage if circuit.coupling == "direct" else None,
+        float(circuit.switch_resistance),
+    )
 
 
 def pair_power(parts: CircuitParts, name: str, east, west, bypass: bool, switch_series: bool):
@@ -126,8 +138,15 @@ def pair_power(parts: CircuitParts, name: str, east, west, bypass: bool, switch_
         return built.parallel_power(east, west, parts.blocking, parts.load_voltage)
     if name == "series":
         return built.series_power(east, west, bypass_diode, parts.load_voltage)
-    return built.switching_power(east, west, parts.blocking, bypass_diode, switch_series, parts.load_voltage,
-                                 parts.switch_resistance)[0]
+    return built.switching_power(
+        east,
+        west,
+        parts.blocking,
+        bypass_diode,
+        switch_series,
+        parts.load_voltage,
+        parts.switch_resistance,
+    )[0]
 
 
 def alone_power(parts: CircuitParts, curve):
@@ -135,8 +154,14 @@ def alone_power(parts: CircuitParts, curve):
     return built.alone_power(curve, parts.load_voltage)
 
 
-def assemble(parts: CircuitParts, side: dict, *, switch_series: bool, converter_efficiency: float,
-             with_state: bool = True):
+def assemble(
+    parts: CircuitParts,
+    side: dict,
+    *,
+    switch_series: bool,
+    converter_efficiency: float,
+    with_state: bool = True,
+):
     """Every connection's power delivered to the load [W] from the panel side, as the kernel does.
 
     Parameters
@@ -173,15 +198,16 @@ def assemble(parts: CircuitParts, side: dict, *, switch_series: bool, converter_
         "west": deliver(side["a_west"]),
         "parallel": deliver(side["parallel"]),
         "series": deliver(side["series"]),
-        "independent": converter_efficiency * (deliver(side["m_east"], 0.5 * rated)
-                                               + deliver(side["m_west"], 0.5 * rated)),
+        "independent": converter_efficiency
+        * (deliver(side["m_east"], 0.5 * rated) + deliver(side["m_west"], 0.5 * rated)),
         "switching": deliver(switching),
         "panel": deliver(side["panel"]),
     }
     if not with_state:
         return powers, None
-    states = [side["a_east"], side["a_west"], side["parallel"]] + ([side["series"]] if switch_series else [])
+    states = [side["a_east"], side["a_west"], side["parallel"]] + (
+        [side["series"]] if switch_series else []
+    )
     stacked = np.stack(np.broadcast_arrays(*states))
     best = stacked.max(axis=0)
     return powers, np.argmax(stacked >= best * (1 - 1e-6) - 1e-12, axis=0)
-

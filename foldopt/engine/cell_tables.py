@@ -59,7 +59,9 @@ def electrical_settings(study: Study, temp_air: float, wind_speed: float | None 
         switch_series=study.switch_series,
         converter_efficiency=study.converter_efficiency,
         exact=study.exact_electrical,
-        circuit=None if study.circuit.ideal else circuit_parts(study, rated_power(pv, study.panel.area)),
+        circuit=None
+        if study.circuit.ideal
+        else circuit_parts(study, rated_power(pv, study.panel.area)),
     )
 
 
@@ -103,7 +105,9 @@ def panel_power(sky: Sky, study: Study, poa_global, area: float | None = None):
     power = np.zeros_like(poa_global)
     for temp, weight in node_weights(sky, slice(None), poa_global.shape):
         take = weight > 0
-        power[take] += weight[take] * electrical_for(study, temp, sky.wind_ref).panel_power(poa_global[take], area)
+        power[take] += weight[take] * electrical_for(study, temp, sky.wind_ref).panel_power(
+            poa_global[take], area
+        )
     return power
 
 

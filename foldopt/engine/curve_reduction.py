@@ -100,14 +100,38 @@ def day_metrics(power, first, last, p_load, profile, loads, work, t_out, cont_ou
     # Constant loads without runs (every map's) with the flags as constants, so that no step tests
     # them; the other cases read them at run time.
     if not loads.contiguous and not loads.use_profile:
-        return _day_steps(power, first, last, p_load, profile, loads.step_hours, False, False, work, t_out,
-                          cont_out)
-    return _day_steps(power, first, last, p_load, profile, loads.step_hours, loads.contiguous, loads.use_profile,
-                      work, t_out, cont_out)
+        return _day_steps(
+            power,
+            first,
+            last,
+            p_load,
+            profile,
+            loads.step_hours,
+            False,
+            False,
+            work,
+            t_out,
+            cont_out,
+        )
+    return _day_steps(
+        power,
+        first,
+        last,
+        p_load,
+        profile,
+        loads.step_hours,
+        loads.contiguous,
+        loads.use_profile,
+        work,
+        t_out,
+        cont_out,
+    )
 
 
 @njit(cache=True, inline="always")
-def _day_steps(power, first, last, p_load, profile, step_hours, contiguous, use_profile, work, t_out, cont_out):
+def _day_steps(
+    power, first, last, p_load, profile, step_hours, contiguous, use_profile, work, t_out, cont_out
+):
     """:func:`day_metrics`' walk over the steps."""
     above, whole, run = work.above, work.whole, work.run
     n_steps, n_loads = power.shape[0], p_load.shape[0]
@@ -132,7 +156,17 @@ def _day_steps(power, first, last, p_load, profile, step_hours, contiguous, use_
             _runs(position, lo_at, step_hours, run)
         pending_at, pending = _gather(whole, pending_at, pending, lo_at, step_hours)
         if hi_at > lo_at:
-            _shares(p_load, min(previous, p), max(previous, p), lo_at, hi_at, step_hours, above, run, contiguous)
+            _shares(
+                p_load,
+                min(previous, p),
+                max(previous, p),
+                lo_at,
+                hi_at,
+                step_hours,
+                above,
+                run,
+                contiguous,
+            )
         previous, position = p, at
     # The last sample held to the end of the day.
     tail = (n_steps - last - 0.5) * step_hours
@@ -152,8 +186,17 @@ def _day_steps(power, first, last, p_load, profile, step_hours, contiguous, use_
 @njit(cache=True, inline="always")
 def chunk_scratch(scratch, k):
     """Chunk ``k``'s own :class:`foldopt.engine.records.Scratch` of the scratch of every chunk."""
-    return Scratch(scratch.east[k], scratch.west[k], scratch.incident[k], scratch.diffuse_east[k],
-                   scratch.diffuse_west[k], scratch.power[k], scratch.above[k], scratch.whole[k], scratch.run[k])
+    return Scratch(
+        scratch.east[k],
+        scratch.west[k],
+        scratch.incident[k],
+        scratch.diffuse_east[k],
+        scratch.diffuse_west[k],
+        scratch.power[k],
+        scratch.above[k],
+        scratch.whole[k],
+        scratch.run[k],
+    )
 
 
 @njit(cache=True, parallel=True)
@@ -180,8 +223,16 @@ def curve_rows(power, span, row_loadset, loads, out, scratch):
     n_chunks = scratch.above.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
     for k in prange(n_chunks):
-        _chunk_curves(k * per_chunk, min((k + 1) * per_chunk, n_rows), power, span, row_loadset, loads, out,
-                      chunk_scratch(scratch, k))
+        _chunk_curves(
+            k * per_chunk,
+            min((k + 1) * per_chunk, n_rows),
+            power,
+            span,
+            row_loadset,
+            loads,
+            out,
+            chunk_scratch(scratch, k),
+        )
 
 
 @njit(cache=True)
@@ -191,9 +242,16 @@ def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
     writes through a named tuple's fields are lost (numba issue #7135, open in 0.68)."""
     for r in range(start, stop):
         out.energy[r, 0], out.peak[r, 0] = day_metrics(
-            power[r], span[r, 0], span[r, 1], loads.p_load[row_loadset[r]],
-            loads.profile[r if loads.use_profile else 0], loads, work, out.t_solar[r, 0],
-            out.t_solar_contiguous[r if loads.contiguous else 0, 0])
+            power[r],
+            span[r, 0],
+            span[r, 1],
+            loads.p_load[row_loadset[r]],
+            loads.profile[r if loads.use_profile else 0],
+            loads,
+            work,
+            out.t_solar[r, 0],
+            out.t_solar_contiguous[r if loads.contiguous else 0, 0],
+        )
 
 
 @njit(cache=True)

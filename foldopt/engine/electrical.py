@@ -78,8 +78,9 @@ def _bilinear(values, first, second):
     i = np.minimum(first.astype(np.intp), values.shape[0] - 2)
     j = np.minimum(second.astype(np.intp), values.shape[1] - 2)
     fi, fj = first - i, second - j
-    return ((values[i, j] * (1.0 - fj) + values[i, j + 1] * fj) * (1.0 - fi)
-            + (values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj) * fi)
+    return (values[i, j] * (1.0 - fj) + values[i, j + 1] * fj) * (1.0 - fi) + (
+        values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj
+    ) * fi
 
 
 @dataclass
@@ -122,7 +123,10 @@ class Electrical:
 
     @property
     def _options(self):
-        return {"switch_series": self.switch_series, "converter_efficiency": self.converter_efficiency}
+        return {
+            "switch_series": self.switch_series,
+            "converter_efficiency": self.converter_efficiency,
+        }
 
     def _temperature(self, poa):
         return cell_temperature(poa, self.temp_air, self.wind_speed, self.temperature_model)
@@ -140,14 +144,33 @@ class Electrical:
         str
             32 hexadecimal digits.
         """
-        settings = (TABLE_FORMAT, name, self.pv.model, repr(self.pv.unit), self.pv.unit_area, self.subpanel_area,
-                    self.temp_air, self.wind_speed, self.temperature_model, IRRADIANCE_MAX, TABLE_NODES_1D,
-                    TABLE_NODES_2D, TABLE_NODES_RATIO, pvlib.__version__)
+        settings = (
+            TABLE_FORMAT,
+            name,
+            self.pv.model,
+            repr(self.pv.unit),
+            self.pv.unit_area,
+            self.subpanel_area,
+            self.temp_air,
+            self.wind_speed,
+            self.temperature_model,
+            IRRADIANCE_MAX,
+            TABLE_NODES_1D,
+            TABLE_NODES_2D,
+            TABLE_NODES_RATIO,
+            pvlib.__version__,
+        )
         if self._panel_side_built and name != "subpanel":
             # Only what the table holds: the converter acts after it.
             parts = self.circuit
-            settings += (repr(parts.blocking), repr(parts.bypass), parts.load_voltage, parts.switch_resistance,
-                         self.bypass, self.switch_series)
+            settings += (
+                repr(parts.blocking),
+                repr(parts.bypass),
+                parts.load_voltage,
+                parts.switch_resistance,
+                self.bypass,
+                self.switch_series,
+            )
         return hashlib.sha256(repr(settings).encode()).hexdigest()[:32]
 
     @property
@@ -174,7 +197,9 @@ class Electrical:
                 if name == "subpanel":
                     power = self.pv.max_power(g1, temp_cell, self.subpanel_area)
                 elif name == "alone":
-                    power = alone_power(self.circuit, self.pv.curves(g1, temp_cell, self.subpanel_area))
+                    power = alone_power(
+                        self.circuit, self.pv.curves(g1, temp_cell, self.subpanel_area)
+                    )
                 else:
                     power = self._flat_direct(g1, temp_cell)
                 self._tables[name] = (g1, power)
@@ -194,22 +219,30 @@ class Electrical:
         As built, the table holds the pair as built, bypass diodes and all
         (:func:`foldopt.engine.as_built.pair_power`).
         """
-        strong, ratio = (grid.ravel() for grid in np.meshgrid(_nodes(TABLE_NODES_2D), _ratio_nodes(connection),
-                                                              indexing="ij"))
+        strong, ratio = (
+            grid.ravel()
+            for grid in np.meshgrid(_nodes(TABLE_NODES_2D), _ratio_nodes(connection), indexing="ij")
+        )
         weak = strong * ratio
         east = self.pv.curves(strong, self._temperature(strong), self.subpanel_area)
         west = self.pv.curves(weak, self._temperature(weak), self.subpanel_area)
         bound = east.max_power() + west.max_power()
         if self._panel_side_built:
-            power = pair_power(self.circuit, connection, east, west, self.bypass, self.switch_series)
+            power = pair_power(
+                self.circuit, connection, east, west, self.bypass, self.switch_series
+            )
         elif connection == "parallel":
             power = parallel_power(east, west)
         else:
             power = series_power(east, west, bypass=False)
         with np.errstate(invalid="ignore", divide="ignore"):
-            fraction = np.where(bound > 0, power / bound, 1.0).reshape(TABLE_NODES_2D, TABLE_NODES_RATIO)
+            fraction = np.where(bound > 0, power / bound, 1.0).reshape(
+                TABLE_NODES_2D, TABLE_NODES_RATIO
+            )
         if not self._panel_side_built or self.circuit.panel_side_ideal:
-            fraction[:, -1] = 1.0  # identical sub-panels at equal irradiance deliver exactly their sum
+            fraction[:, -1] = (
+                1.0  # identical sub-panels at equal irradiance deliver exactly their sum
+            )
         return fraction
 
     def subpanel_power(self, poa):
@@ -269,8 +302,13 @@ class Electrical:
             return self.max_power(poa, area)
         side = self._panel_side(poa, area)
         zeros = np.zeros_like(side)
-        return assemble(self.circuit, {**dict.fromkeys(PARTS, zeros), "panel": side}, switch_series=False,
-                        converter_efficiency=1.0, with_state=False)[0]["panel"]
+        return assemble(
+            self.circuit,
+            {**dict.fromkeys(PARTS, zeros), "panel": side},
+            switch_series=False,
+            converter_efficiency=1.0,
+            with_state=False,
+        )[0]["panel"]
 
     def _panel_side(self, poa, area):
         """The whole panel's power on the panel side [W]: its maximum, or at the load's voltage."""
@@ -278,8 +316,10 @@ class Electrical:
         if not self.circuit.direct or not self.pv.has_iv:
             return self.max_power(poa, area)
         if not np.isclose(area, 2.0 * self.subpanel_area):
-            raise ValueError(f"the direct-coupled panel's table is of area {2.0 * self.subpanel_area:g} m^2, "
-                             f"not {area:g}")
+            raise ValueError(
+                f"the direct-coupled panel's table is of area {2.0 * self.subpanel_area:g} m^2, "
+                f"not {area:g}"
+            )
         if self.exact:
             return self._flat_direct(poa, self._temperature(poa))
         _, p1 = self._table("panel")
@@ -300,7 +340,9 @@ class Electrical:
             return None
         stc = np.array([1000.0])
         temp_cell = self._temperature(stc)
-        parallel, series = (self._flat_wired(stc, temp_cell, wiring)[0] for wiring in ("parallel", "series"))
+        parallel, series = (
+            self._flat_wired(stc, temp_cell, wiring)[0] for wiring in ("parallel", "series")
+        )
         return "parallel" if parallel > series else "series"
 
     @functools.cached_property
@@ -311,11 +353,16 @@ class Electrical:
         if self.circuit is None or not self.circuit.direct or not self.pv.has_iv:
             return ""
         area = 2.0 * self.subpanel_area
-        if self.circuit.load_voltage <= self.pv.curves(np.array([BRIGHTEST]), COLDEST, area).v_oc[0]:
+        if (
+            self.circuit.load_voltage
+            <= self.pv.curves(np.array([BRIGHTEST]), COLDEST, area).v_oc[0]
+        ):
             return ""
         stc = self.pv.curves(np.array([1000.0]), 25.0, area).v_oc[0]
-        return (f"the load's {self.circuit.load_voltage:g} V is above the panel's open-circuit voltage, "
-                f"{stc:.3g} V at STC with all its cells in series")
+        return (
+            f"the load's {self.circuit.load_voltage:g} V is above the panel's open-circuit voltage, "
+            f"{stc:.3g} V at STC with all its cells in series"
+        )
 
     def _flat_wired(self, poa, temp_cell, wiring):
         half = self.pv.curves(poa, temp_cell, self.subpanel_area)
@@ -345,21 +392,41 @@ class Electrical:
             [W] per part.
         """
         parts = self.circuit
-        poa_east, poa_west = np.broadcast_arrays(np.asarray(poa_east, float), np.asarray(poa_west, float))
+        poa_east, poa_west = np.broadcast_arrays(
+            np.asarray(poa_east, float), np.asarray(poa_west, float)
+        )
         m_east, m_west = self.subpanel_power(poa_east), self.subpanel_power(poa_west)
         side = {"m_east": m_east, "m_west": m_west}
         if not self.pv.has_iv:
             total = m_east + m_west
-            return {**side, "a_east": m_east, "a_west": m_west, "parallel": total, "series": total,
-                    "switching": np.maximum(np.maximum(m_east, m_west), total), "panel": 2.0 * m_east}
-        names = ("parallel",) + (("series",) if series else ()) + (("switching",) if parts.switch_table else ())
+            return {
+                **side,
+                "a_east": m_east,
+                "a_west": m_west,
+                "parallel": total,
+                "series": total,
+                "switching": np.maximum(np.maximum(m_east, m_west), total),
+                "panel": 2.0 * m_east,
+            }
+        names = (
+            ("parallel",)
+            + (("series",) if series else ())
+            + (("switching",) if parts.switch_table else ())
+        )
         if self.exact:
             east = self.pv.curves(poa_east, self._temperature(poa_east), self.subpanel_area)
             west = self.pv.curves(poa_west, self._temperature(poa_west), self.subpanel_area)
-            side.update({name: pair_power(parts, name, east, west, self.bypass, self.switch_series)
-                         for name in names})
-            side["a_east"], side["a_west"] = ((alone_power(parts, east), alone_power(parts, west)) if parts.direct
-                                              else (m_east, m_west))
+            side.update(
+                {
+                    name: pair_power(parts, name, east, west, self.bypass, self.switch_series)
+                    for name in names
+                }
+            )
+            side["a_east"], side["a_west"] = (
+                (alone_power(parts, east), alone_power(parts, west))
+                if parts.direct
+                else (m_east, m_west)
+            )
         else:
             root_east = np.sqrt(np.clip(poa_east, 0.0, IRRADIANCE_MAX) / IRRADIANCE_MAX)
             root_west = np.sqrt(np.clip(poa_west, 0.0, IRRADIANCE_MAX) / IRRADIANCE_MAX)
@@ -368,8 +435,12 @@ class Electrical:
                 root_ratio = np.where(strong > 0, weak / strong, 1.0)
             at_strong, bound = strong * (TABLE_NODES_2D - 1), m_east + m_west
             for name in names:
-                at_ratio = (root_ratio**2 if name == "series" else root_ratio) * (TABLE_NODES_RATIO - 1)
-                side[name] = np.clip(_bilinear(self._table(name), at_strong, at_ratio), 0.0, 1.0) * bound
+                at_ratio = (root_ratio**2 if name == "series" else root_ratio) * (
+                    TABLE_NODES_RATIO - 1
+                )
+                side[name] = (
+                    np.clip(_bilinear(self._table(name), at_strong, at_ratio), 0.0, 1.0) * bound
+                )
             if parts.direct:
                 _, alone = self._table("alone")
                 side["a_east"] = _linear(alone, root_east * (TABLE_NODES_1D - 1))
@@ -377,10 +448,14 @@ class Electrical:
             else:
                 side["a_east"], side["a_west"] = m_east, m_west
         if not parts.switch_table:
-            side["switching"] = np.maximum(np.maximum(side["a_east"], side["a_west"]), side["parallel"])
+            side["switching"] = np.maximum(
+                np.maximum(side["a_east"], side["a_west"]), side["parallel"]
+            )
         if not series:
             side["series"] = np.full(m_east.shape, np.nan)
-        side["panel"] = self._panel_side(poa_east, 2.0 * self.subpanel_area) if parts.direct else 2.0 * m_east
+        side["panel"] = (
+            self._panel_side(poa_east, 2.0 * self.subpanel_area) if parts.direct else 2.0 * m_east
+        )
         return side
 
     def connections(self, poa_east, poa_west, series: bool = True, with_state: bool = True):
@@ -404,12 +479,18 @@ class Electrical:
             Index into :data:`foldopt.physics.connections.SWITCH_STATES` per step.
         """
         if self.circuit is not None:
-            powers, state = assemble(self.circuit, self.parts(poa_east, poa_west, series), with_state=with_state,
-                                     **self._options)
+            powers, state = assemble(
+                self.circuit,
+                self.parts(poa_east, poa_west, series),
+                with_state=with_state,
+                **self._options,
+            )
             del powers["panel"]
             return powers, state
         options = {**self._options, "with_state": with_state}
-        poa_east, poa_west = np.broadcast_arrays(np.asarray(poa_east, float), np.asarray(poa_west, float))
+        poa_east, poa_west = np.broadcast_arrays(
+            np.asarray(poa_east, float), np.asarray(poa_west, float)
+        )
         if not self.pv.has_iv or self.exact:
             p_east, p_west = self.subpanel_power(poa_east), self.subpanel_power(poa_west)
         if not self.pv.has_iv:
@@ -418,7 +499,9 @@ class Electrical:
             east = self.pv.curves(poa_east, self._temperature(poa_east), self.subpanel_area)
             west = self.pv.curves(poa_west, self._temperature(poa_west), self.subpanel_area)
             p_parallel = parallel_power(east, west)
-            p_series = series_power(east, west, self.bypass) if series else np.full(p_east.shape, np.nan)
+            p_series = (
+                series_power(east, west, self.bypass) if series else np.full(p_east.shape, np.nan)
+            )
             return connection_powers(p_east, p_west, p_parallel, p_series, **options)
         east, west = np.clip(poa_east, 0.0, IRRADIANCE_MAX), np.clip(poa_west, 0.0, IRRADIANCE_MAX)
         # Every table's irradiance nodes are uniform in sqrt(E / E_max): one square root serves all.
@@ -431,10 +514,18 @@ class Electrical:
         with np.errstate(invalid="ignore", divide="ignore"):
             root_ratio = np.where(strong > 0, weak / strong, 1.0)
         at_strong = strong * (TABLE_NODES_2D - 1)
-        p_parallel = np.clip(_bilinear(self._table("parallel"), at_strong, root_ratio * (TABLE_NODES_RATIO - 1)),
-                             0.0, 1.0) * bound
+        p_parallel = (
+            np.clip(
+                _bilinear(self._table("parallel"), at_strong, root_ratio * (TABLE_NODES_RATIO - 1)),
+                0.0,
+                1.0,
+            )
+            * bound
+        )
         if series:
-            fraction = _bilinear(self._table("series"), at_strong, root_ratio**2 * (TABLE_NODES_RATIO - 1))
+            fraction = _bilinear(
+                self._table("series"), at_strong, root_ratio**2 * (TABLE_NODES_RATIO - 1)
+            )
             p_series = np.clip(fraction, 0.0, 1.0) * bound
             if self.bypass:
                 p_series = np.maximum(p_series, np.maximum(p_east, p_west))

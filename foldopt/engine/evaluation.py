@@ -32,9 +32,15 @@ from foldopt.engine.as_built import PARTS, assemble
 from foldopt.engine.records import Loads, Rows, SkyArrays, Tables, allocate
 from foldopt.engine.sky import Sky, step_span
 from foldopt.engine.sky_view import row_views, surface_views
+
 # The cells' electrical model is part of the engine's API (engines.electrical_for, panel_power...).
-from foldopt.engine.cell_tables import (TEMPERATURE_NODE_STEP, electrical_for, node_weights, panel_power,  # noqa: F401
-                                  temperature_nodes)
+from foldopt.engine.cell_tables import (
+    TEMPERATURE_NODE_STEP,  # noqa: F401
+    electrical_for,
+    node_weights,
+    panel_power,  # noqa: F401
+    temperature_nodes,
+)
 
 #: What :func:`row_metrics` can evaluate: the connections, and ``panel``, the whole panel as one.
 OUTPUTS = CONNECTIONS + ("panel",)
@@ -89,13 +95,24 @@ def fold_orientations(study: Study, surface_tilt, surface_azimuth, fold_angles) 
     """
     geometry = study.geometry
     fold_angles = np.asarray(fold_angles, dtype=float)
-    panels = np.stack([np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)], axis=-1)
+    panels = np.stack(
+        [np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)], axis=-1
+    )
     unique, inverse = np.unique(panels, axis=0, return_inverse=True)
     per_panel = []
     for tilt, azimuth in unique:
         sides = subpanel_orientation(fold_angles, tilt, azimuth, geometry)
-        per_panel.append(np.stack([sides["surface_tilt_east"], sides["surface_azimuth_east"],
-                                   sides["surface_tilt_west"], sides["surface_azimuth_west"]], axis=-1))
+        per_panel.append(
+            np.stack(
+                [
+                    sides["surface_tilt_east"],
+                    sides["surface_azimuth_east"],
+                    sides["surface_tilt_west"],
+                    sides["surface_azimuth_west"],
+                ],
+                axis=-1,
+            )
+        )
     return np.stack(per_panel)[np.ravel(inverse)]
 
 
@@ -111,8 +128,15 @@ def flat_orientation(surface_tilt, surface_azimuth) -> np.ndarray:
     return np.stack([tilt, azimuth, tilt, azimuth], axis=-1)
 
 
-def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool = False, incident: bool = False,
-        normal=None):
+def poa(
+    sky: Sky,
+    surface_tilt,
+    surface_azimuth,
+    blocks=slice(None),
+    paper: bool = False,
+    incident: bool = False,
+    normal=None,
+):
     """Plane-of-array irradiance [W/m^2] of surfaces over blocks of a sky (the reference path).
 
     Parameters
@@ -143,10 +167,18 @@ def poa(sky: Sky, surface_tilt, surface_azimuth, blocks=slice(None), paper: bool
     normal = normal_vector(tilt, azimuth) if normal is None else np.asarray(normal, dtype=float)
     sun = sky.sun_vector[blocks]
     # pvlib's aoi_projection (tested), without the (..., 3) temporary of a product.
-    cos_aoi = normal[..., 0] * sun[..., 0] + normal[..., 1] * sun[..., 1] + normal[..., 2] * sun[..., 2]
-    factor = beam_incidence_factor(tilt, azimuth, solar_zenith, solar_azimuth, model="paper") if paper else None
+    cos_aoi = (
+        normal[..., 0] * sun[..., 0] + normal[..., 1] * sun[..., 1] + normal[..., 2] * sun[..., 2]
+    )
+    factor = (
+        beam_incidence_factor(tilt, azimuth, solar_zenith, solar_azimuth, model="paper")
+        if paper
+        else None
+    )
     terms = None if sky.terms is None else sky.terms[blocks]
-    modifier = 1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, solar_zenith, solar_azimuth)
+    modifier = (
+        1.0 if incident else iam_modifier(sky.iam, tilt, azimuth, solar_zenith, solar_azimuth)
+    )
     views = None if terms is None else surface_views(sky, blocks, tilt, azimuth, normal[..., 2])
     return plane_of_array(cos_aoi, normal[..., 2], sky.dni[blocks], terms, factor, modifier, views)
 
@@ -179,8 +211,11 @@ def _iam_code(model: str):
     if model == "none":
         return incidence.IAM_NONE, np.zeros(3)
     function = pvlib.iam.ashrae if model == "ashrae" else pvlib.iam.physical
-    defaults = [p.default for p in inspect.signature(function).parameters.values()
-                if p.default is not inspect.Parameter.empty and p.name != "n_ar"]
+    defaults = [
+        p.default
+        for p in inspect.signature(function).parameters.values()
+        if p.default is not inspect.Parameter.empty and p.name != "n_ar"
+    ]
     code = incidence.IAM_ASHRAE if model == "ashrae" else incidence.IAM_PHYSICAL
     return code, np.array(defaults + [0.0] * (3 - len(defaults)), dtype=float)
 
@@ -197,15 +232,29 @@ def _unsort(values, order, row_loadset):
     if (order == np.arange(order.shape[1])).all():
         return values  # the caller's loads were in order
     if order.shape[0] == 1:
-        return np.take(values, np.argsort(order[0]), axis=-1)  # one set of loads: one permutation for every row
+        return np.take(
+            values, np.argsort(order[0]), axis=-1
+        )  # one set of loads: one permutation for every row
     out = np.empty_like(values)
-    np.put_along_axis(out, np.broadcast_to(order[row_loadset][:, None, :], values.shape), values, axis=-1)
+    np.put_along_axis(
+        out, np.broadcast_to(order[row_loadset][:, None, :], values.shape), values, axis=-1
+    )
     return out
 
 
-def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loadset=None,
-                outputs=("switching",), contiguous: bool = False, engine: str = "numba",
-                row_orientation=None, curves=None) -> RowMetrics:
+def row_metrics(
+    sky: Sky,
+    study: Study,
+    row_block,
+    orientation,
+    loads,
+    row_loadset=None,
+    outputs=("switching",),
+    contiguous: bool = False,
+    engine: str = "numba",
+    row_orientation=None,
+    curves=None,
+) -> RowMetrics:
     """Daily metrics of rows of panel orientations over a sky.
 
     Parameters
@@ -246,32 +295,56 @@ def row_metrics(sky: Sky, study: Study, row_block, orientation, loads, row_loads
         raise ValueError(f"outputs must be among {', '.join(OUTPUTS)}; got {unknown}")
     row_block = np.asarray(row_block, dtype=np.int64)
     orientation = np.asarray(orientation, dtype=float).reshape(-1, 4)
-    row_orientation = (np.arange(row_block.size) if row_orientation is None
-                       else np.asarray(row_orientation, dtype=np.int64))
+    row_orientation = (
+        np.arange(row_block.size)
+        if row_orientation is None
+        else np.asarray(row_orientation, dtype=np.int64)
+    )
     if row_orientation.size != row_block.size:
         raise ValueError(f"{row_orientation.size} orientations for {row_block.size} rows")
     sorted_loads, order = _sorted_loads(loads)
-    row_loadset = np.zeros(row_block.size, dtype=np.int64) if row_loadset is None else np.asarray(
-        row_loadset, dtype=np.int64)
+    row_loadset = (
+        np.zeros(row_block.size, dtype=np.int64)
+        if row_loadset is None
+        else np.asarray(row_loadset, dtype=np.int64)
+    )
     loads = _loads(sorted_loads, sky.load_shape, contiguous, sky.step_hours)
     curve = np.full(row_block.size, -1, dtype=np.int64)
     if curves is not None:
         curve[np.asarray(curves, dtype=np.int64)] = np.arange(np.size(curves))
     if engine == "numpy" or study.exact_electrical:
-        result = _reference(sky, study, row_block, orientation[row_orientation], loads, row_loadset, outputs, curve)
+        result = _reference(
+            sky, study, row_block, orientation[row_orientation], loads, row_loadset, outputs, curve
+        )
     else:
         nodes, table, weight = temperature_nodes(sky)
         electricals = [electrical_for(study, temp, sky.wind_ref) for temp in nodes]
-        result = _compiled(sky, study, electricals, (table, weight), row_block, orientation, row_orientation,
-                           loads, row_loadset, outputs, curve)
+        result = _compiled(
+            sky,
+            study,
+            electricals,
+            (table, weight),
+            row_block,
+            orientation,
+            row_orientation,
+            loads,
+            row_loadset,
+            outputs,
+            curve,
+        )
     return _in_caller_order(result, order, row_loadset)
 
 
 def _in_caller_order(result: RowMetrics, order, row_loadset) -> RowMetrics:
     contiguous = result.t_solar_contiguous
-    return RowMetrics(_unsort(result.t_solar, order, row_loadset),
-                      None if contiguous is None else _unsort(contiguous, order, row_loadset),
-                      result.energy, result.peak, result.irradiation, result.power)
+    return RowMetrics(
+        _unsort(result.t_solar, order, row_loadset),
+        None if contiguous is None else _unsort(contiguous, order, row_loadset),
+        result.energy,
+        result.peak,
+        result.irradiation,
+        result.power,
+    )
 
 
 def _curve_reference(power, row_loads, profile, loads: Loads):
@@ -279,11 +352,27 @@ def _curve_reference(power, row_loads, profile, loads: Loads):
     (scales of ``profile`` where ``loads.use_profile``) by :mod:`foldopt.engine.metrics`."""
     step_hours = loads.step_hours
     compared = per_load(power, profile if loads.use_profile else None)
-    runs = t_solar_contiguous(compared[:, None, :], row_loads, step_hours) if loads.contiguous else None
-    return t_solar(compared[:, None, :], row_loads, step_hours), runs, energy(power, step_hours), power.max(axis=-1)
+    runs = (
+        t_solar_contiguous(compared[:, None, :], row_loads, step_hours)
+        if loads.contiguous
+        else None
+    )
+    return (
+        t_solar(compared[:, None, :], row_loads, step_hours),
+        runs,
+        energy(power, step_hours),
+        power.max(axis=-1),
+    )
 
 
-def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool = True, with_state: bool = False):
+def powers(
+    sky: Sky,
+    study: Study,
+    orientation,
+    blocks=slice(None),
+    series: bool = True,
+    with_state: bool = False,
+):
     """Every connection's power [W] and the whole panel's (``panel``), and the switch state, from whole
     arrays: the reference path, and the source of time series for reports.
 
@@ -314,9 +403,22 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
     poa_east = poa(sky, orientation[:, 0, None], orientation[:, 1, None], blocks, paper)
     poa_west = poa(sky, orientation[:, 2, None], orientation[:, 3, None], blocks, paper)
     out = {}
-    out["poa"] = 0.5 * (poa_east + poa_west) if sky.iam == "none" else 0.5 * sum(
-        poa(sky, orientation[:, 2 * side, None], orientation[:, 2 * side + 1, None], blocks, paper, incident=True)
-        for side in (0, 1))
+    out["poa"] = (
+        0.5 * (poa_east + poa_west)
+        if sky.iam == "none"
+        else 0.5
+        * sum(
+            poa(
+                sky,
+                orientation[:, 2 * side, None],
+                orientation[:, 2 * side + 1, None],
+                blocks,
+                paper,
+                incident=True,
+            )
+            for side in (0, 1)
+        )
+    )
     weights = node_weights(sky, blocks, poa_east.shape)
     circuit = electrical_for(study, weights[0][0], sky.wind_ref).circuit
     if circuit is not None:
@@ -324,11 +426,18 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
         side = {name: np.zeros(poa_east.shape) for name in PARTS}
         for temp, weight in weights:
             take = weight > 0
-            part = electrical_for(study, temp, sky.wind_ref).parts(poa_east[take], poa_west[take], series)
+            part = electrical_for(study, temp, sky.wind_ref).parts(
+                poa_east[take], poa_west[take], series
+            )
             for name, values in side.items():
                 values[take] += weight[take] * part[name]
-        connected, state = assemble(circuit, side, switch_series=study.switch_series,
-                                    converter_efficiency=study.converter_efficiency, with_state=with_state)
+        connected, state = assemble(
+            circuit,
+            side,
+            switch_series=study.switch_series,
+            converter_efficiency=study.converter_efficiency,
+            with_state=with_state,
+        )
         return {**out, **connected}, state
     if len(weights) == 1:
         electrical = electrical_for(study, weights[0][0], sky.wind_ref)
@@ -337,7 +446,9 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
         return {**out, **part}, state
     # Steps between two tables' air temperatures take each sub-panel's and each pair's power
     # linearly between them, and the connections from those, as the kernel does.
-    parts = {name: np.zeros(poa_east.shape) for name in ("east", "west", "parallel", "series", "panel")}
+    parts = {
+        name: np.zeros(poa_east.shape) for name in ("east", "west", "parallel", "series", "panel")
+    }
     for temp, weight in weights:
         take = weight > 0
         electrical = electrical_for(study, temp, sky.wind_ref)
@@ -345,9 +456,15 @@ def powers(sky: Sky, study: Study, orientation, blocks=slice(None), series: bool
         part["panel"] = electrical.panel_power(poa_east[take], study.panel.area)
         for name, values in parts.items():
             values[take] += weight[take] * part[name]
-    connected, state = connection_powers(parts["east"], parts["west"], parts["parallel"], parts["series"],
-                                         switch_series=study.switch_series,
-                                         converter_efficiency=study.converter_efficiency, with_state=with_state)
+    connected, state = connection_powers(
+        parts["east"],
+        parts["west"],
+        parts["parallel"],
+        parts["series"],
+        switch_series=study.switch_series,
+        converter_efficiency=study.converter_efficiency,
+        with_state=with_state,
+    )
     return {**out, **connected, "panel": parts["panel"]}, state
 
 
@@ -355,9 +472,14 @@ def _reference(sky, study, row_block, orientation, loads: Loads, row_loadset, ou
     n_rows, n_loads, contiguous = row_block.size, loads.p_load.shape[1], loads.contiguous
     shape = (n_rows, len(outputs))
     kept = int((curve >= 0).sum())
-    out = RowMetrics(np.zeros(shape + (n_loads,)), np.zeros(shape + (n_loads,)) if contiguous else None,
-                     np.zeros(shape), np.zeros(shape), np.zeros(n_rows),
-                     np.zeros((kept, len(outputs), sky.dni.shape[1])) if kept else None)
+    out = RowMetrics(
+        np.zeros(shape + (n_loads,)),
+        np.zeros(shape + (n_loads,)) if contiguous else None,
+        np.zeros(shape),
+        np.zeros(shape),
+        np.zeros(n_rows),
+        np.zeros((kept, len(outputs), sky.dni.shape[1])) if kept else None,
+    )
     series = "series" in outputs or study.switch_series
     step = sky.step_hours
     for block in np.unique(row_block):
@@ -366,9 +488,14 @@ def _reference(sky, study, row_block, orientation, loads: Loads, row_loadset, ou
         out.irradiation[rows] = energy(curves["poa"], step)
         profile = loads.profile[block] if loads.use_profile else None
         for index, name in enumerate(outputs):
-            hours, runs, harvested, peak = _curve_reference(curves[name], loads.p_load[row_loadset[rows]], profile,
-                                                            loads)
-            out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = hours, harvested, peak
+            hours, runs, harvested, peak = _curve_reference(
+                curves[name], loads.p_load[row_loadset[rows]], profile, loads
+            )
+            out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = (
+                hours,
+                harvested,
+                peak,
+            )
             if contiguous:
                 out.t_solar_contiguous[rows, index] = runs
             keep = curve[rows] >= 0
@@ -399,46 +526,98 @@ def _tables(electricals, outputs, study, codes) -> Tables:
         if parts is not None and parts.switch_table:
             switching = np.stack([e._table("switching") for e in electricals])
     return Tables(
-        subpanel=subpanel, parallel=parallel, series=series, linear_power=float(linear_power),
-        panel_scale=float(study.panel.area / first.subpanel_area), bypass=bool(first.bypass),
-        switch_series=bool(first.switch_series), converter_efficiency=float(first.converter_efficiency),
-        connections=codes, as_built=parts is not None, direct=parts is not None and bool(parts.direct),
-        switch_table=parts is not None and bool(parts.switch_table), alone=alone, panel=panel, switching=switching,
-        converter=np.zeros(1) if parts is None else np.ascontiguousarray(parts.conv_table, dtype=float),
-        converter_rating=0.0 if parts is None else float(parts.conv_rated))
+        subpanel=subpanel,
+        parallel=parallel,
+        series=series,
+        linear_power=float(linear_power),
+        panel_scale=float(study.panel.area / first.subpanel_area),
+        bypass=bool(first.bypass),
+        switch_series=bool(first.switch_series),
+        converter_efficiency=float(first.converter_efficiency),
+        connections=codes,
+        as_built=parts is not None,
+        direct=parts is not None and bool(parts.direct),
+        switch_table=parts is not None and bool(parts.switch_table),
+        alone=alone,
+        panel=panel,
+        switching=switching,
+        converter=np.zeros(1)
+        if parts is None
+        else np.ascontiguousarray(parts.conv_table, dtype=float),
+        converter_rating=0.0 if parts is None else float(parts.conv_rated),
+    )
 
 
-def _compiled(sky, study, electricals, step_tables, row_block, orientation, row_orientation, loads, row_loadset,
-              outputs, curve):
+def _compiled(
+    sky,
+    study,
+    electricals,
+    step_tables,
+    row_block,
+    orientation,
+    row_orientation,
+    loads,
+    row_loadset,
+    outputs,
+    curve,
+):
     from foldopt.engine import kernel
 
     codes = np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64)
     # Each orientation's normals (and Eq. 5 factors) once, then per row; the exact incidence reads
     # no Eq. 5 factors (zeros stand in).
-    normals = np.stack([normal_vector(orientation[:, 0], orientation[:, 1]),
-                        normal_vector(orientation[:, 2], orientation[:, 3])], axis=1)
+    normals = np.stack(
+        [
+            normal_vector(orientation[:, 0], orientation[:, 1]),
+            normal_vector(orientation[:, 2], orientation[:, 3]),
+        ],
+        axis=1,
+    )
     paper = study.mode == "paper"
     row_paper = np.zeros((row_block.size, 2, 4))
     if paper:
         tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])
-        row_paper = np.stack([np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1)[row_orientation]
+        row_paper = np.stack(
+            [np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1
+        )[row_orientation]
     iam_model, iam_params = _iam_code(sky.iam)
     sun, paper_sun, beam, terms, span = (np.ascontiguousarray(a) for a in sky.kernel_layout(paper))
     # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
-    light = SkyArrays(sun=sun, paper_sun=paper_sun, beam=beam, terms=terms, span=span,
-                      step_table=np.ascontiguousarray(step_tables[0], dtype=np.int64),
-                      step_weight=np.ascontiguousarray(step_tables[1], dtype=float), paper=paper,
-                      iam_model=int(iam_model), iam_params=iam_params)
-    rows = Rows(block=np.ascontiguousarray(row_block), normal=np.ascontiguousarray(normals[row_orientation]),
-                paper=np.ascontiguousarray(row_paper),
-                sky_view=np.ascontiguousarray(row_views(sky, row_block, normals, orientation, row_orientation)),
-                loadset=np.ascontiguousarray(row_loadset), curve=curve)
+    light = SkyArrays(
+        sun=sun,
+        paper_sun=paper_sun,
+        beam=beam,
+        terms=terms,
+        span=span,
+        step_table=np.ascontiguousarray(step_tables[0], dtype=np.int64),
+        step_weight=np.ascontiguousarray(step_tables[1], dtype=float),
+        paper=paper,
+        iam_model=int(iam_model),
+        iam_params=iam_params,
+    )
+    rows = Rows(
+        block=np.ascontiguousarray(row_block),
+        normal=np.ascontiguousarray(normals[row_orientation]),
+        paper=np.ascontiguousarray(row_paper),
+        sky_view=np.ascontiguousarray(
+            row_views(sky, row_block, normals, orientation, row_orientation)
+        ),
+        loadset=np.ascontiguousarray(row_loadset),
+        curve=curve,
+    )
     kept = int((curve >= 0).sum())
-    out, scratch = allocate(row_block.size, codes.size, loads.p_load.shape[1], sky.dni.shape[1], loads.contiguous,
-                            kept)
+    out, scratch = allocate(
+        row_block.size, codes.size, loads.p_load.shape[1], sky.dni.shape[1], loads.contiguous, kept
+    )
     kernel.fold_rows(light, rows, _tables(electricals, outputs, study, codes), loads, out, scratch)
-    return RowMetrics(out.t_solar, out.t_solar_contiguous if loads.contiguous else None, out.energy, out.peak,
-                      out.irradiation, out.power if kept else None)
+    return RowMetrics(
+        out.t_solar,
+        out.t_solar_contiguous if loads.contiguous else None,
+        out.energy,
+        out.peak,
+        out.irradiation,
+        out.power if kept else None,
+    )
 
 
 def power_span(power) -> np.ndarray:
@@ -455,13 +634,28 @@ def power_span(power) -> np.ndarray:
 
 def _loads(sorted_loads, load_shape, contiguous: bool, step_hours: float) -> Loads:
     """The engine's :class:`Loads`: one placeholder row (1, 1) of profile for constant loads."""
-    profile = np.zeros((1, 1)) if load_shape is None else np.ascontiguousarray(load_shape, dtype=float)
-    return Loads(p_load=np.ascontiguousarray(sorted_loads, dtype=float), profile=profile,
-                 use_profile=load_shape is not None, contiguous=bool(contiguous), step_hours=float(step_hours))
+    profile = (
+        np.zeros((1, 1)) if load_shape is None else np.ascontiguousarray(load_shape, dtype=float)
+    )
+    return Loads(
+        p_load=np.ascontiguousarray(sorted_loads, dtype=float),
+        profile=profile,
+        use_profile=load_shape is not None,
+        contiguous=bool(contiguous),
+        step_hours=float(step_hours),
+    )
 
 
-def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous: bool = False,
-                  engine: str = "numba", load_shape=None, span=None) -> RowMetrics:
+def curve_metrics(
+    power,
+    loads,
+    step_hours: float,
+    row_loadset=None,
+    contiguous: bool = False,
+    engine: str = "numba",
+    load_shape=None,
+    span=None,
+) -> RowMetrics:
     """Daily metrics of given power curves (a tracker's, a design's).
 
     Parameters
@@ -494,19 +688,31 @@ def curve_metrics(power, loads, step_hours: float, row_loadset=None, contiguous:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
     power = np.ascontiguousarray(power, dtype=float)
     sorted_loads, order = _sorted_loads(loads)
-    row_loadset = np.zeros(power.shape[0], dtype=np.int64) if row_loadset is None else np.asarray(
-        row_loadset, dtype=np.int64)
+    row_loadset = (
+        np.zeros(power.shape[0], dtype=np.int64)
+        if row_loadset is None
+        else np.asarray(row_loadset, dtype=np.int64)
+    )
     if load_shape is not None:
         load_shape = np.broadcast_to(np.asarray(load_shape, dtype=float), power.shape)
     held = _loads(sorted_loads, load_shape, contiguous, step_hours)
     if engine == "numpy":
-        hours, runs, harvested, peak = _curve_reference(power, sorted_loads[row_loadset], held.profile, held)
-        result = RowMetrics(hours[:, None], None if runs is None else runs[:, None], harvested[:, None], peak[:, None])
+        hours, runs, harvested, peak = _curve_reference(
+            power, sorted_loads[row_loadset], held.profile, held
+        )
+        result = RowMetrics(
+            hours[:, None],
+            None if runs is None else runs[:, None],
+            harvested[:, None],
+            peak[:, None],
+        )
     else:
         from foldopt.engine import curve_reduction
 
         out, scratch = allocate(power.shape[0], 1, sorted_loads.shape[1], 0, contiguous)
         span = power_span(power) if span is None else np.ascontiguousarray(span, dtype=np.int64)
         curve_reduction.curve_rows(power, span, row_loadset, held, out, scratch)
-        result = RowMetrics(out.t_solar, out.t_solar_contiguous if contiguous else None, out.energy, out.peak)
+        result = RowMetrics(
+            out.t_solar, out.t_solar_contiguous if contiguous else None, out.energy, out.peak
+        )
     return _in_caller_order(result, order, row_loadset)

@@ -63,15 +63,24 @@ def iam_factor(cos_aoi, model, params):
     rho_p = ((cos_2 - n * cos_aoi) / (cos_2 + n * cos_aoi)) ** 2
     rho_0 = ((1.0 - n) / (1.0 + n)) ** 2
     absorbed = math.exp(-k * thickness / cos_2)
-    return ((1.0 - rho_s) * absorbed + (1.0 - rho_p) * absorbed) / 2.0 / ((1.0 - rho_0) * math.exp(-k * thickness))
+    return (
+        ((1.0 - rho_s) * absorbed + (1.0 - rho_p) * absorbed)
+        / 2.0
+        / ((1.0 - rho_0) * math.exp(-k * thickness))
+    )
 
 
 @njit(cache=True, inline="always")
 def _incidence_steps(r, b, start, count, sky, rows, paper, has_terms, modified, work):
     """:func:`incidence`'s main loop, inlined once per case with the case's flags as constants."""
     sun, paper_sun, beam, terms = sky.sun, sky.paper_sun, sky.beam, sky.terms
-    east, west, incident, diffuse_east, diffuse_west = (work.east, work.west, work.incident, work.diffuse_east,
-                                                        work.diffuse_west)
+    east, west, incident, diffuse_east, diffuse_west = (
+        work.east,
+        work.west,
+        work.incident,
+        work.diffuse_east,
+        work.diffuse_west,
+    )
     normal, view, row_paper = rows.normal, rows.sky_view, rows.paper
     ex, ey, ez = normal[r, 0, 0], normal[r, 0, 1], normal[r, 0, 2]
     wx, wy, wz = normal[r, 1, 0], normal[r, 1, 1], normal[r, 1, 2]
@@ -79,14 +88,29 @@ def _incidence_steps(r, b, start, count, sky, rows, paper, has_terms, modified, 
     # sin tilt on an open plain, less what a horizon hides (foldopt.physics.horizon).
     e_iso, e_sin_tilt = view[r, 0, 0], view[r, 0, 1]
     w_iso, w_sin_tilt = view[r, 1, 0], view[r, 1, 1]
-    pe0, pe1, pe2, pe3 = row_paper[r, 0, 0], row_paper[r, 0, 1], row_paper[r, 0, 2], row_paper[r, 0, 3]
-    pw0, pw1, pw2, pw3 = row_paper[r, 1, 0], row_paper[r, 1, 1], row_paper[r, 1, 2], row_paper[r, 1, 3]
+    pe0, pe1, pe2, pe3 = (
+        row_paper[r, 0, 0],
+        row_paper[r, 0, 1],
+        row_paper[r, 0, 2],
+        row_paper[r, 0, 3],
+    )
+    pw0, pw1, pw2, pw3 = (
+        row_paper[r, 1, 0],
+        row_paper[r, 1, 1],
+        row_paper[r, 1, 2],
+        row_paper[r, 1, 3],
+    )
     for i in range(count):
         s = start + i
         cos_east = ex * sun[b, 0, s] + ey * sun[b, 1, s] + ez * sun[b, 2, s]
         cos_west = wx * sun[b, 0, s] + wy * sun[b, 1, s] + wz * sun[b, 2, s]
         if paper:
-            cz, szen, sa, ca = paper_sun[b, 0, s], paper_sun[b, 1, s], paper_sun[b, 2, s], paper_sun[b, 3, s]
+            cz, szen, sa, ca = (
+                paper_sun[b, 0, s],
+                paper_sun[b, 1, s],
+                paper_sun[b, 2, s],
+                paper_sun[b, 3, s],
+            )
             f_east = max(cz * pe0 + szen * pe1, 0.0) * max(ca * pe2 + sa * pe3, 0.0)
             f_west = max(cz * pw0 + szen * pw1, 0.0) * max(ca * pw2 + sa * pw3, 0.0)
         else:
@@ -95,10 +119,14 @@ def _incidence_steps(r, b, start, count, sky, rows, paper, has_terms, modified, 
         d_east = d_west = 0.0
         if has_terms:
             iso, circ, hor, ground = terms[b, 0, s], terms[b, 1, s], terms[b, 2, s], terms[b, 3, s]
-            d_east = (max(iso * e_iso + circ * max(cos_east, 0.0) + hor * e_sin_tilt, 0.0)
-                      + ground * (1.0 - ez) * 0.5)
-            d_west = (max(iso * w_iso + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
-                      + ground * (1.0 - wz) * 0.5)
+            d_east = (
+                max(iso * e_iso + circ * max(cos_east, 0.0) + hor * e_sin_tilt, 0.0)
+                + ground * (1.0 - ez) * 0.5
+            )
+            d_west = (
+                max(iso * w_iso + circ * max(cos_west, 0.0) + hor * w_sin_tilt, 0.0)
+                + ground * (1.0 - wz) * 0.5
+            )
         incident[s] = 0.5 * (g_east + d_east + g_west + d_west)
         if modified:
             east[s], west[s], diffuse_east[s], diffuse_west[s] = g_east, g_west, d_east, d_west
@@ -187,7 +215,11 @@ def turning_poa(normal, sun, beam, terms, span, poa):
             lit = max(cos_aoi, 0.0)
             value = beam[b, s] * lit
             if has_terms:
-                sky = max(terms[b, 0, s] * ((1.0 + nz) * 0.5) + terms[b, 1, s] * lit
-                          + terms[b, 2, s] * math.sqrt(max(1.0 - nz * nz, 0.0)), 0.0)
+                sky = max(
+                    terms[b, 0, s] * ((1.0 + nz) * 0.5)
+                    + terms[b, 1, s] * lit
+                    + terms[b, 2, s] * math.sqrt(max(1.0 - nz * nz, 0.0)),
+                    0.0,
+                )
                 value = value + sky + terms[b, 3, s] * (1.0 - nz) * 0.5
             poa[b, s] = value

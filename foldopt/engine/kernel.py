@@ -53,8 +53,9 @@ def _bilinear(values, first, second):
     i = min(int(first), values.shape[0] - 2)
     j = min(int(second), values.shape[1] - 2)
     fi, fj = first - i, second - j
-    return ((values[i, j] * (1.0 - fj) + values[i, j + 1] * fj) * (1.0 - fi)
-            + (values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj) * fi)
+    return (values[i, j] * (1.0 - fj) + values[i, j + 1] * fj) * (1.0 - fi) + (
+        values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj
+    ) * fi
 
 
 @njit(cache=True, inline="always")
@@ -115,9 +116,13 @@ def _built_parts(root_east, root_west, tables, t, need_series):
     p_parallel = min(max(_bilinear(table_parallel, strong * n2, root_ratio * nr), 0.0), 1.0) * bound
     p_series = 0.0
     if need_series:
-        p_series = min(max(_bilinear(tables.series[t], strong * n2, root_ratio**2 * nr), 0.0), 1.0) * bound
+        p_series = (
+            min(max(_bilinear(tables.series[t], strong * n2, root_ratio**2 * nr), 0.0), 1.0) * bound
+        )
     if tables.switch_table:
-        p_switching = min(max(_bilinear(tables.switching[t], strong * n2, root_ratio * nr), 0.0), 1.0) * bound
+        p_switching = (
+            min(max(_bilinear(tables.switching[t], strong * n2, root_ratio * nr), 0.0), 1.0) * bound
+        )
     else:
         p_switching = max(max(a_east, a_west), p_parallel)
     return Parts(m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel)
@@ -126,10 +131,16 @@ def _built_parts(root_east, root_west, tables, t, need_series):
 @njit(cache=True, inline="always")
 def _between(lo, hi, w):
     """:class:`Parts` at ``w`` of the way from ``lo`` to ``hi``."""
-    return Parts(lo.m_east + w * (hi.m_east - lo.m_east), lo.m_west + w * (hi.m_west - lo.m_west),
-                 lo.a_east + w * (hi.a_east - lo.a_east), lo.a_west + w * (hi.a_west - lo.a_west),
-                 lo.parallel + w * (hi.parallel - lo.parallel), lo.series + w * (hi.series - lo.series),
-                 lo.switching + w * (hi.switching - lo.switching), lo.panel + w * (hi.panel - lo.panel))
+    return Parts(
+        lo.m_east + w * (hi.m_east - lo.m_east),
+        lo.m_west + w * (hi.m_west - lo.m_west),
+        lo.a_east + w * (hi.a_east - lo.a_east),
+        lo.a_west + w * (hi.a_west - lo.a_west),
+        lo.parallel + w * (hi.parallel - lo.parallel),
+        lo.series + w * (hi.series - lo.series),
+        lo.switching + w * (hi.switching - lo.switching),
+        lo.panel + w * (hi.panel - lo.panel),
+    )
 
 
 @njit(cache=True, inline="always")
@@ -144,7 +155,9 @@ def _delivered(power, conv_table, conv_rated):
 
 
 @njit(cache=True, inline="always")
-def _connection_power(code, p_east, p_west, p_parallel, p_series, p_panel, converter_efficiency, switch_series):
+def _connection_power(
+    code, p_east, p_west, p_parallel, p_series, p_panel, converter_efficiency, switch_series
+):
     if code == SWITCHING:
         best = max(max(p_east, p_west), p_parallel)
         return max(best, p_series) if switch_series else best
@@ -214,30 +227,55 @@ def _table_row(b, first, last, sky, tables, need_series, work):
     east, west, buffer = work.east, work.west, work.power
     per_step = step_table.shape[1] > 1
     # One table set a block (no weather file): its tables are taken once a row.
-    row_1d, row_parallel, row_series = (table_1d[step_table[b, 0]], table_parallel[step_table[b, 0]],
-                                        table_series[step_table[b, 0]])
+    row_1d, row_parallel, row_series = (
+        table_1d[step_table[b, 0]],
+        table_parallel[step_table[b, 0]],
+        table_series[step_table[b, 0]],
+    )
     for s in range(first, last + 1):
         root_east, root_west = east[s], west[s]
         if not per_step:
-            p_east, p_west, p_parallel, p_series = _pair_powers(root_east, root_west, row_1d, row_parallel,
-                                                                row_series, need_series, bypass)
+            p_east, p_west, p_parallel, p_series = _pair_powers(
+                root_east, root_west, row_1d, row_parallel, row_series, need_series, bypass
+            )
         else:
             t, w = step_table[b, s], step_weight[b, s]
-            p_east, p_west, p_parallel, p_series = _pair_powers(root_east, root_west, table_1d[t], table_parallel[t],
-                                                                table_series[t], need_series, bypass)
+            p_east, p_west, p_parallel, p_series = _pair_powers(
+                root_east,
+                root_west,
+                table_1d[t],
+                table_parallel[t],
+                table_series[t],
+                need_series,
+                bypass,
+            )
             if w > 0.0:
                 # The step's cells lie between two tables' air temperatures: linear between them.
-                q_east, q_west, q_parallel, q_series = _pair_powers(root_east, root_west, table_1d[t + 1],
-                                                                    table_parallel[t + 1], table_series[t + 1],
-                                                                    need_series, bypass)
+                q_east, q_west, q_parallel, q_series = _pair_powers(
+                    root_east,
+                    root_west,
+                    table_1d[t + 1],
+                    table_parallel[t + 1],
+                    table_series[t + 1],
+                    need_series,
+                    bypass,
+                )
                 p_east += w * (q_east - p_east)
                 p_west += w * (q_west - p_west)
                 p_parallel += w * (q_parallel - p_parallel)
                 p_series += w * (q_series - p_series)
         p_panel = panel_scale * p_east
         for c in range(connections.shape[0]):
-            buffer[c, s] = _connection_power(connections[c], p_east, p_west, p_parallel, p_series, p_panel,
-                                             converter_efficiency, switch_series)
+            buffer[c, s] = _connection_power(
+                connections[c],
+                p_east,
+                p_west,
+                p_parallel,
+                p_series,
+                p_panel,
+                converter_efficiency,
+                switch_series,
+            )
 
 
 @njit(cache=True, inline="always")
@@ -247,11 +285,16 @@ def _built_power(code, parts, p_panel, tables):
     independent connection's two converters each rated for its sub-panel (half the rating)."""
     conv_table, conv_rated = tables.converter, tables.converter_rating
     if code == INDEPENDENT:
-        return tables.converter_efficiency * (_delivered(parts.m_east, conv_table, 0.5 * conv_rated)
-                                              + _delivered(parts.m_west, conv_table, 0.5 * conv_rated))
+        return tables.converter_efficiency * (
+            _delivered(parts.m_east, conv_table, 0.5 * conv_rated)
+            + _delivered(parts.m_west, conv_table, 0.5 * conv_rated)
+        )
     if code == SWITCHING:
-        power = (max(parts.switching, parts.series) if tables.switch_series and not tables.switch_table
-                 else parts.switching)
+        power = (
+            max(parts.switching, parts.series)
+            if tables.switch_series and not tables.switch_table
+            else parts.switching
+        )
     elif code == EAST:
         power = parts.a_east
     elif code == WEST:
@@ -272,7 +315,11 @@ def _built_row(b, first, last, sky, tables, need_series, work):
     connection delivers. With the ideal PV model (``tables.linear_power`` > 0, no tables), only the
     converter is as built: ``work.east`` and ``work.west`` hold the irradiance itself."""
     step_table, step_weight = sky.step_table, sky.step_weight
-    linear_power, panel_scale, connections = tables.linear_power, tables.panel_scale, tables.connections
+    linear_power, panel_scale, connections = (
+        tables.linear_power,
+        tables.panel_scale,
+        tables.connections,
+    )
     east, west, buffer = work.east, work.west, work.power
     per_step = step_table.shape[1] > 1
     for s in range(first, last + 1):
@@ -282,13 +329,23 @@ def _built_row(b, first, last, sky, tables, need_series, work):
         if linear_power > 0.0:
             m_east, m_west = linear_power * root_east, linear_power * root_west
             pair = m_east + m_west
-            parts = Parts(m_east, m_west, m_east, m_west, pair, pair, max(max(m_east, m_west), pair),
-                          panel_scale * m_east)
+            parts = Parts(
+                m_east,
+                m_west,
+                m_east,
+                m_west,
+                pair,
+                pair,
+                max(max(m_east, m_west), pair),
+                panel_scale * m_east,
+            )
             w = 0.0
         else:
             parts = _built_parts(root_east, root_west, tables, t, need_series)
         if w > 0.0:
-            parts = _between(parts, _built_parts(root_east, root_west, tables, t + 1, need_series), w)
+            parts = _between(
+                parts, _built_parts(root_east, root_west, tables, t + 1, need_series), w
+            )
         p_panel = parts.panel if tables.direct else panel_scale * parts.m_east
         for c in range(connections.shape[0]):
             buffer[c, s] = _built_power(connections[c], parts, p_panel, tables)
@@ -319,8 +376,16 @@ def fold_rows(sky, rows, tables, loads, out, scratch):
     n_chunks = scratch.power.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
     for k in prange(n_chunks):
-        _chunk_rows(k * per_chunk, min((k + 1) * per_chunk, n_rows), sky, rows, tables, loads, out,
-                    chunk_scratch(scratch, k))
+        _chunk_rows(
+            k * per_chunk,
+            min((k + 1) * per_chunk, n_rows),
+            sky,
+            rows,
+            tables,
+            loads,
+            out,
+            chunk_scratch(scratch, k),
+        )
 
 
 @njit(cache=True)
@@ -356,9 +421,20 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         else:
             _table_row(b, first, last, sky, tables, need_series, work)
         if rows.curve[r] >= 0:
-            out.power[rows.curve[r], :, first:last + 1] = work.power[:, first:last + 1]
-        p_load, profile = loads.p_load[rows.loadset[r]], loads.profile[b if loads.use_profile else 0]
+            out.power[rows.curve[r], :, first : last + 1] = work.power[:, first : last + 1]
+        p_load, profile = (
+            loads.p_load[rows.loadset[r]],
+            loads.profile[b if loads.use_profile else 0],
+        )
         for c in range(n_conn):
             out.energy[r, c], out.peak[r, c] = day_metrics(
-                work.power[c], first, last, p_load, profile, loads, work, out.t_solar[r, c],
-                out.t_solar_contiguous[r if loads.contiguous else 0, c])
+                work.power[c],
+                first,
+                last,
+                p_load,
+                profile,
+                loads,
+                work,
+                out.t_solar[r, c],
+                out.t_solar_contiguous[r if loads.contiguous else 0, c],
+            )

@@ -15,7 +15,13 @@ import pandas as pd
 from foldopt.errors import WeatherError
 from foldopt.inputs.study import Study
 from foldopt.inputs.turbidity import linke_turbidity as climatology_turbidity
-from foldopt.inputs.weather import FORMATS, read_weather, study_weather, weather_days, weather_format
+from foldopt.inputs.weather import (
+    FORMATS,
+    read_weather,
+    study_weather,
+    weather_days,
+    weather_format,
+)
 from foldopt.inputs.weather.downscale import clear_sky, hourly_light, interpolate_points
 from foldopt.inputs.weather.ensemble import cloud_members
 from foldopt.physics.atmosphere import relative_airmass
@@ -33,8 +39,16 @@ def _airmass(solar_zenith) -> np.ndarray:
     return airmass
 
 
-def clear_light(grid: ClockGrid, solar_zenith, dni_extra, sites, model: str, linke_turbidity,
-                transposition: str = "none", albedo: float = 0.2) -> tuple[dict, np.ndarray | None]:
+def clear_light(
+    grid: ClockGrid,
+    solar_zenith,
+    dni_extra,
+    sites,
+    model: str,
+    linke_turbidity,
+    transposition: str = "none",
+    albedo: float = 0.2,
+) -> tuple[dict, np.ndarray | None]:
     """A clear sky at every step of the blocks (0 with the sun down), with its diffuse terms.
 
     Ineichen's is one compiled pass (:func:`foldopt.physics.clearsky.ineichen_terms`), the
@@ -73,27 +87,43 @@ def clear_light(grid: ClockGrid, solar_zenith, dni_extra, sites, model: str, lin
         if turbidity is None:
             turbidity = np.empty(solar_zenith.shape)
             for (latitude, longitude, _), members in groups.items():
-                turbidity[members] = climatology_turbidity(latitude, longitude, grid.utc_ns[members])
+                turbidity[members] = climatology_turbidity(
+                    latitude, longitude, grid.utc_ns[members]
+                )
         altitude = np.array([site.altitude for site in sites], dtype=float)
-        dni, ghi, dhi, layout = ineichen_terms(solar_zenith, dni_extra, turbidity, altitude, transposition, albedo)
-        return {"dni": dni, "ghi": ghi, "dhi": dhi}, None if layout is None else np.moveaxis(layout, 1, -1)
+        dni, ghi, dhi, layout = ineichen_terms(
+            solar_zenith, dni_extra, turbidity, altitude, transposition, albedo
+        )
+        return {"dni": dni, "ghi": ghi, "dhi": dhi}, None if layout is None else np.moveaxis(
+            layout, 1, -1
+        )
     light = {key: np.zeros_like(solar_zenith) for key in ("dni", "ghi", "dhi")}
     airmass = _airmass(solar_zenith)
     for (_, _, altitude), members in groups.items():
         up = solar_zenith[members] < 90.0
-        sky = clear_sky(solar_zenith[members][up], airmass[members][up], dni_extra[members][up], altitude, model,
-                        linke_turbidity)
+        sky = clear_sky(
+            solar_zenith[members][up],
+            airmass[members][up],
+            dni_extra[members][up],
+            altitude,
+            model,
+            linke_turbidity,
+        )
         for key, values in light.items():
             placed = np.zeros(up.shape)
             placed[up] = sky[key]
             values[members] = placed
     terms = None
     if transposition != "none":
-        terms = diffuse_terms(transposition, solar_zenith, light["dni"], light["ghi"], light["dhi"], dni_extra, albedo)
+        terms = diffuse_terms(
+            transposition, solar_zenith, light["dni"], light["ghi"], light["dhi"], dni_extra, albedo
+        )
     return light, terms
 
 
-def diffuse_terms(transposition: str, solar_zenith, dni, ghi, dhi, dni_extra, albedo: float) -> np.ndarray:
+def diffuse_terms(
+    transposition: str, solar_zenith, dni, ghi, dhi, dni_extra, albedo: float
+) -> np.ndarray:
     """The diffuse terms of a transposition at every step
     (:func:`foldopt.physics.irradiance.sky_diffuse_terms` at the steps with light, 0 elsewhere).
 
@@ -155,17 +185,32 @@ def weather_light(study: Study, grid: ClockGrid, dates, clear: dict, solar_zenit
     step_ns = round(grid.step_hours * 3.6e12)
     day_start = grid.local_ns[:, :1] - step_ns // 2
     per_interval = interval // step_ns
-    if interval % step_ns or not np.array_equal(starts, day_start + np.arange(starts.shape[1]) * interval):
-        raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must divide the file's "
-                         f"intervals ({interval / 6e10:g} min), which must start at the day's midnight")
+    if interval % step_ns or not np.array_equal(
+        starts, day_start + np.arange(starts.shape[1]) * interval
+    ):
+        raise ValueError(
+            f"weather: the study's step ({grid.step_hours * 60:g} min) must divide the file's "
+            f"intervals ({interval / 6e10:g} min), which must start at the day's midnight"
+        )
     cos_zenith = np.cos(np.radians(solar_zenith))
-    light, placed = hourly_light(hourly["dni"], hourly["dhi"], clear["ghi"], clear["dni"], cos_zenith, per_interval,
-                                 dni_extra)
-    balance = {key: (float(hourly[key].sum()), float(placed[key].sum())) for key in ("dni", "ghi", "dhi")}
+    light, placed = hourly_light(
+        hourly["dni"],
+        hourly["dhi"],
+        clear["ghi"],
+        clear["dni"],
+        cos_zenith,
+        per_interval,
+        dni_extra,
+    )
+    balance = {
+        key: (float(hourly[key].sum()), float(placed[key].sum())) for key in ("dni", "ghi", "dhi")
+    }
     # Air temperature and wind stand at the file's own stamps (its meteorological fields are
     # instantaneous), linear between them.
     entry = FORMATS[weather_format(weather.path, weather.format)]
-    offset = {"end": 0.5, "start": -0.5, "centre": 0.0}[weather.label or entry.interval_label] + entry.stamp_lag
+    offset = {"end": 0.5, "start": -0.5, "centre": 0.0}[
+        weather.label or entry.interval_label
+    ] + entry.stamp_lag
     temp_air = interpolate_points(hourly["temp_air"], offset, per_interval)
     wind_speed = interpolate_points(hourly["wind_speed"], offset, per_interval)
     return light, temp_air, wind_speed, balance, (hourly, per_interval)
@@ -178,22 +223,34 @@ def measured_light(study: Study, grid: ClockGrid, dates):
     frame = measured.frame
     flagged = sorted(set(dates) & set(measured.flagged_days))
     if flagged:
-        gaps = [f"{start:%H:%M}-{stop:%H:%M}" for start, stop, minutes in measured.gaps
-                if start.date() in flagged and minutes > study.weather.max_gap_min]
-        raise WeatherError(f"weather {frame.attrs['weather']}: {flagged[0]} has a daylight gap too long to fill "
-                           f"({', '.join(gaps[:3])}; weather.max_gap_min {study.weather.max_gap_min:g} min)"
-                           + (f", and {len(flagged) - 1} more dates" if len(flagged) > 1 else "")
-                           + "; leave those dates out")
+        gaps = [
+            f"{start:%H:%M}-{stop:%H:%M}"
+            for start, stop, minutes in measured.gaps
+            if start.date() in flagged and minutes > study.weather.max_gap_min
+        ]
+        raise WeatherError(
+            f"weather {frame.attrs['weather']}: {flagged[0]} has a daylight gap too long to fill "
+            f"({', '.join(gaps[:3])}; weather.max_gap_min {study.weather.max_gap_min:g} min)"
+            + (f", and {len(flagged) - 1} more dates" if len(flagged) > 1 else "")
+            + "; leave those dates out"
+        )
     rows = weather_days(frame, dates)
     centres = pd.DatetimeIndex(frame.index).tz_localize(None).as_unit("ns").asi8[rows]
     if centres.shape != grid.local_ns.shape or not np.array_equal(centres, grid.local_ns):
-        raise ValueError(f"weather: the study's step ({grid.step_hours * 60:g} min) must be the measured file's "
-                         f"({measured.step.total_seconds() / 60:g} min)")
-    columns = {key: frame[key].to_numpy(dtype=float)[rows] for key in ("ghi", "dni", "dhi", "temp_air", "wind_speed")}
+        raise ValueError(
+            f"weather: the study's step ({grid.step_hours * 60:g} min) must be the measured file's "
+            f"({measured.step.total_seconds() / 60:g} min)"
+        )
+    columns = {
+        key: frame[key].to_numpy(dtype=float)[rows]
+        for key in ("ghi", "dni", "dhi", "temp_air", "wind_speed")
+    }
     return columns, measured
 
 
-def member_light(study: Study, hourly: dict, per_interval: int, clear: dict, solar_zenith, dates, share):
+def member_light(
+    study: Study, hourly: dict, per_interval: int, clear: dict, solar_zenith, dates, share
+):
     """Each block's light drawn as its member of the cloud ensemble of its day
     (:func:`foldopt.inputs.weather.ensemble.cloud_members`), and how much of the file's light the
     members keep on average. A day's members are drawn from the seed and the day alone, so that a
@@ -201,16 +258,29 @@ def member_light(study: Study, hourly: dict, per_interval: int, clear: dict, sol
     inverse, member = share
     cos_zenith = np.cos(np.radians(solar_zenith))
     count = int(member.max()) + 1
-    drawn = {key: np.empty((count, len(dates), solar_zenith.shape[1])) for key in ("ghi", "dni", "dhi")}
+    drawn = {
+        key: np.empty((count, len(dates), solar_zenith.shape[1])) for key in ("ghi", "dni", "dhi")
+    }
     for day, date in enumerate(dates):
-        one = cloud_members(hourly["ghi"][day:day + 1], hourly["dhi"][day:day + 1], clear["ghi"][day:day + 1],
-                            cos_zenith[day:day + 1], per_interval, study.step_min, count,
-                            [study.weather.seed, date.toordinal()], hourly["cloud_cover"][day:day + 1])
+        one = cloud_members(
+            hourly["ghi"][day : day + 1],
+            hourly["dhi"][day : day + 1],
+            clear["ghi"][day : day + 1],
+            cos_zenith[day : day + 1],
+            per_interval,
+            study.step_min,
+            count,
+            [study.weather.seed, date.toordinal()],
+            hourly["cloud_cover"][day : day + 1],
+        )
         for key in drawn:
             drawn[key][:, day] = one[key][:, 0]
     light = {key: values[member, inverse] for key, values in drawn.items()}
-    per_day = len(inverse) / len(dates)  # a day's members: all of them in every chunk (Blocks.chunks)
-    balance = {key: (float(hourly[key].sum()), float(light[key].sum()) / per_interval / per_day)
-               for key in ("dni", "ghi", "dhi")}
+    per_day = len(inverse) / len(
+        dates
+    )  # a day's members: all of them in every chunk (Blocks.chunks)
+    balance = {
+        key: (float(hourly[key].sum()), float(light[key].sum()) / per_interval / per_day)
+        for key in ("dni", "ghi", "dhi")
+    }
     return light, balance
-

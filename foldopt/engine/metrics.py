@@ -134,11 +134,18 @@ def daily_metrics(p_pv, p_load, step_hours):
     """
     p_pv = np.asarray(p_pv, dtype=float)
     p_load = np.asarray(p_load, dtype=float)
-    return metric_columns(t_solar(p_pv, p_load, step_hours), t_solar_contiguous(p_pv, p_load, step_hours),
-                          energy(p_pv, step_hours), p_pv.max(axis=-1), p_load)
+    return metric_columns(
+        t_solar(p_pv, p_load, step_hours),
+        t_solar_contiguous(p_pv, p_load, step_hours),
+        energy(p_pv, step_hours),
+        p_pv.max(axis=-1),
+        p_load,
+    )
 
 
-def metric_columns(t_solar_h, t_solar_contiguous_h, energy_harvested_wh, peak_power_w, p_load, served_wh=None) -> dict:
+def metric_columns(
+    t_solar_h, t_solar_contiguous_h, energy_harvested_wh, peak_power_w, p_load, served_wh=None
+) -> dict:
     """The daily metrics by their report names, from t_solar, its longest run, the energy and the peak.
 
     Parameters
@@ -231,8 +238,9 @@ def relative_to(t_solar_h, reference_h):
     >>> print(relative_to([9.49, 3.0], [7.73, 0.0]).round(3))
     [1.228   nan]
     """
-    t_solar_h, reference_h = np.broadcast_arrays(np.asarray(t_solar_h, dtype=float), np.asarray(reference_h,
-                                                                                              dtype=float))
+    t_solar_h, reference_h = np.broadcast_arrays(
+        np.asarray(t_solar_h, dtype=float), np.asarray(reference_h, dtype=float)
+    )
     ratio = np.full(t_solar_h.shape, np.nan)
     np.divide(t_solar_h, reference_h, out=ratio, where=reference_h > 0)
     return ratio
@@ -258,11 +266,16 @@ def design_condition(condition, energy_harvested_wh):
         The day's condition and, where the design harvests less than nothing (a tracker net of
         its drive), :data:`DRIVE_NOTE`, joined by ``"; "``.
     """
-    condition, harvested = np.broadcast_arrays(np.asarray(condition, dtype=object),
-                                               np.asarray(energy_harvested_wh, dtype=float))
-    return np.array(["; ".join(p for p in (c, DRIVE_NOTE if h < 0 else "") if p)
-                     for c, h in zip(condition.ravel(), harvested.ravel(), strict=True)],
-                    dtype=object).reshape(condition.shape)
+    condition, harvested = np.broadcast_arrays(
+        np.asarray(condition, dtype=object), np.asarray(energy_harvested_wh, dtype=float)
+    )
+    return np.array(
+        [
+            "; ".join(p for p in (c, DRIVE_NOTE if h < 0 else "") if p)
+            for c, h in zip(condition.ravel(), harvested.ravel(), strict=True)
+        ],
+        dtype=object,
+    ).reshape(condition.shape)
 
 
 def notes(condition, t_solar_h):
@@ -286,12 +299,21 @@ def notes(condition, t_solar_h):
     >>> print(list(notes(["", "polar night", ""], [0.0, 0.0, 5.0])))
     ['load above peak', 'polar night', '']
     """
-    condition, hours = np.broadcast_arrays(np.asarray(condition, dtype=object), np.asarray(t_solar_h))
+    condition, hours = np.broadcast_arrays(
+        np.asarray(condition, dtype=object), np.asarray(t_solar_h)
+    )
     # On a polar night or an overcast day the condition is the reason already.
-    dark = np.array([("polar night" in c) or ("overcast" in c) for c in condition.ravel()]).reshape(hours.shape)
+    dark = np.array([("polar night" in c) or ("overcast" in c) for c in condition.ravel()]).reshape(
+        hours.shape
+    )
     above = (hours == 0) & ~dark
-    return np.array(["; ".join(p for p in (c, "load above peak" if a else "") if p)
-                     for c, a in zip(condition.ravel(), above.ravel(), strict=True)], dtype=object).reshape(hours.shape)
+    return np.array(
+        [
+            "; ".join(p for p in (c, "load above peak" if a else "") if p)
+            for c, a in zip(condition.ravel(), above.ravel(), strict=True)
+        ],
+        dtype=object,
+    ).reshape(hours.shape)
 
 
 def per_load(power, load_shape):
@@ -352,9 +374,14 @@ def energy_served(p_pv, scale, load_shape, step_hours, t_solar_h=None):
     if t_solar_h is not None and np.all(shape == shape[..., :1]):
         level = shape[..., 0][..., None] if scale.ndim else shape[..., 0]
         return scale * level * t_solar_h
-    above, _ = _time_above_per_segment(per_load(p_pv, shape)[..., None, :] if scale.ndim else per_load(p_pv, shape),
-                                       scale, step_hours)
-    segment_load = np.concatenate([shape[..., :1], 0.5 * (shape[..., :-1] + shape[..., 1:]), shape[..., -1:]], axis=-1)
+    above, _ = _time_above_per_segment(
+        per_load(p_pv, shape)[..., None, :] if scale.ndim else per_load(p_pv, shape),
+        scale,
+        step_hours,
+    )
+    segment_load = np.concatenate(
+        [shape[..., :1], 0.5 * (shape[..., :-1] + shape[..., 1:]), shape[..., -1:]], axis=-1
+    )
     if scale.ndim:
         segment_load = segment_load[..., None, :]
     return scale * (above * segment_load).sum(axis=-1)

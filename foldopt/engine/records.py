@@ -230,8 +230,9 @@ class Scratch(NamedTuple):
     run: np.ndarray
 
 
-def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: bool,
-             n_curves: int = 0) -> tuple[Outputs, Scratch]:
+def allocate(
+    n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: bool, n_curves: int = 0
+) -> tuple[Outputs, Scratch]:
     """Outputs and per-chunk scratch of :func:`foldopt.engine.kernel.fold_rows` or
     :func:`foldopt.engine.curve_reduction.curve_rows`, allocated here, outside the parallel loop.
 
@@ -254,12 +255,22 @@ def allocate(n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: b
 
     chunks = max(1, min(n_rows, get_num_threads() * CHUNKS_PER_THREAD))
     shape = (n_rows, n_conn)
-    out = Outputs(t_solar=np.empty(shape + (n_loads,)),
-                  t_solar_contiguous=np.zeros(shape + (n_loads,)) if contiguous else np.zeros((1, n_conn, n_loads)),
-                  energy=np.empty(shape), peak=np.empty(shape), irradiation=np.empty(n_rows if n_steps else 0),
-                  power=np.zeros((n_curves, n_conn, n_steps if n_curves else 0)))
+    out = Outputs(
+        t_solar=np.empty(shape + (n_loads,)),
+        t_solar_contiguous=np.zeros(shape + (n_loads,))
+        if contiguous
+        else np.zeros((1, n_conn, n_loads)),
+        energy=np.empty(shape),
+        peak=np.empty(shape),
+        irradiation=np.empty(n_rows if n_steps else 0),
+        power=np.zeros((n_curves, n_conn, n_steps if n_curves else 0)),
+    )
     light = [np.zeros((chunks, n_steps)) for _ in range(5)]
-    scratch = Scratch(*light, power=np.zeros((chunks, n_conn if n_steps else 0, n_steps)),
-                      above=np.zeros((chunks, n_loads)), whole=np.zeros((chunks, n_loads + 1)),
-                      run=np.zeros((chunks, n_loads if contiguous else 1, 2)))
+    scratch = Scratch(
+        *light,
+        power=np.zeros((chunks, n_conn if n_steps else 0, n_steps)),
+        above=np.zeros((chunks, n_loads)),
+        whole=np.zeros((chunks, n_loads + 1)),
+        run=np.zeros((chunks, n_loads if contiguous else 1, 2)),
+    )
     return out, scratch

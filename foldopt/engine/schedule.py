@@ -76,7 +76,7 @@ class Schedule:
         for position, start in enumerate(starts):
             stop = starts[position + 1] if position + 1 < len(starts) else n_days
             index[start:stop] = self.angles[position]
-        index[:starts[0]] = self.angles[-1]
+        index[: starts[0]] = self.angles[-1]
         return index
 
 
@@ -89,7 +89,7 @@ def _wrapped_best(hours: np.ndarray):
     best = np.empty((n_days, n_days))
     angle = np.empty((n_days, n_days), dtype=int)
     for start in range(n_days):
-        totals = cumulative[start + 1:start + n_days + 1] - cumulative[start]  # (L, A)
+        totals = cumulative[start + 1 : start + n_days + 1] - cumulative[start]  # (L, A)
         reversed_index = np.argmax(totals[:, ::-1], axis=1)
         angle[start] = n_angles - 1 - reversed_index
         best[start] = totals[np.arange(n_days), angle[start]]
@@ -124,18 +124,27 @@ def _mean_schedules(hours: np.ndarray, max_visits: int) -> list[Schedule]:
     for k in range(2, max_visits + 1):
         total, (first, back) = found[k]
         cuts = [n_days]
-        for previous in reversed(back[:k - 1]):
+        for previous in reversed(back[: k - 1]):
             cuts.append(int(previous[cuts[-1]]))
         cuts = [0, *cuts[::-1]]  # 0 = c_0 < c_1 < ... < c_k = D, offsets from `first`
         starts = [(first + cut) % n_days for cut in cuts[:-1]]
-        fold_angles = [int(angle[(first + cuts[m]) % n_days, cuts[m + 1] - cuts[m] - 1]) for m in range(k)]
+        fold_angles = [
+            int(angle[(first + cuts[m]) % n_days, cuts[m + 1] - cuts[m] - 1]) for m in range(k)
+        ]
         order = np.argsort(starts)
-        schedules.append(Schedule(tuple(int(starts[i]) for i in order), tuple(fold_angles[i] for i in order),
-                                  total / n_days))
+        schedules.append(
+            Schedule(
+                tuple(int(starts[i]) for i in order),
+                tuple(fold_angles[i] for i in order),
+                total / n_days,
+            )
+        )
     return schedules
 
 
-def _worst_month_schedules(hours: np.ndarray, months: np.ndarray, max_visits: int) -> list[Schedule]:
+def _worst_month_schedules(
+    hours: np.ndarray, months: np.ndarray, max_visits: int
+) -> list[Schedule]:
     present = np.unique(months)
     monthly = np.stack([hours[months == m].mean(axis=0) for m in present])  # (M, A)
     first_day = [int(np.flatnonzero(months == m)[0]) for m in present]
@@ -155,7 +164,9 @@ def _worst_month_schedules(hours: np.ndarray, months: np.ndarray, max_visits: in
             if value > best[0]:
                 best = (value, (cuts, fold_angles))
         value, (cuts, fold_angles) = best
-        schedules.append(Schedule(tuple(first_day[c] for c in cuts), tuple(fold_angles), float(value)))
+        schedules.append(
+            Schedule(tuple(first_day[c] for c in cuts), tuple(fold_angles), float(value))
+        )
     return schedules
 
 
@@ -195,9 +206,13 @@ def best_schedules(hours, months, max_visits: int, objective: str = "mean") -> l
     """
     hours = np.asarray(hours, dtype=float)
     if objective not in SCHEDULE_OBJECTIVES:
-        raise ValueError(f"objective must be one of {', '.join(SCHEDULE_OBJECTIVES)}; got {objective!r}")
+        raise ValueError(
+            f"objective must be one of {', '.join(SCHEDULE_OBJECTIVES)}; got {objective!r}"
+        )
     if not 1 <= max_visits <= min(MAX_VISITS, hours.shape[0]):
-        raise ValueError(f"max_visits must be in [1, {min(MAX_VISITS, hours.shape[0])}]; got {max_visits}")
+        raise ValueError(
+            f"max_visits must be in [1, {min(MAX_VISITS, hours.shape[0])}]; got {max_visits}"
+        )
     if objective == "mean":
         return _mean_schedules(hours, max_visits)
     return _worst_month_schedules(hours, np.asarray(months), max_visits)

@@ -134,7 +134,9 @@ class SearchResult:
     @property
     def points(self) -> np.ndarray:
         """(n_evaluated, n_axes) every evaluated point in the variables' units."""
-        return np.stack([axis.values(self.index[:, i]) for i, axis in enumerate(self.axes)], axis=-1)
+        return np.stack(
+            [axis.values(self.index[:, i]) for i, axis in enumerate(self.axes)], axis=-1
+        )
 
     @property
     def best_point(self) -> np.ndarray:
@@ -180,8 +182,14 @@ class SearchResult:
         if new.shape[0]:
             points = np.stack([axis.values(new[:, i]) for i, axis in enumerate(self.axes)], axis=-1)
             store.add(new, np.asarray(evaluate(points), dtype=float).reshape(new.shape[0], -1))
-        return SearchResult(self.axes, store.index, store.values, _best_rows(store.index, store.values),
-                            (*self.levels, (1, int(new.shape[0]))), self.tolerance)
+        return SearchResult(
+            self.axes,
+            store.index,
+            store.values,
+            _best_rows(store.index, store.values),
+            (*self.levels, (1, int(new.shape[0]))),
+            self.tolerance,
+        )
 
 
 def _best_rows(index, values):
@@ -193,8 +201,15 @@ def _best_rows(index, values):
     return order[last]
 
 
-def grid_search(evaluate: Callable[[np.ndarray], np.ndarray], axes, tolerance: float, quantum: float = 0.0,
-                safety: float = SAFETY, coarse_points: int = COARSE_POINTS, seeds=None) -> SearchResult:
+def grid_search(
+    evaluate: Callable[[np.ndarray], np.ndarray],
+    axes,
+    tolerance: float,
+    quantum: float = 0.0,
+    safety: float = SAFETY,
+    coarse_points: int = COARSE_POINTS,
+    seeds=None,
+) -> SearchResult:
     """The best point of a box grid for each target, coarse to fine (the module's argument).
 
     Parameters
@@ -233,27 +248,52 @@ class GridSearch:
         As :func:`grid_search`'s.
     """
 
-    def __init__(self, axes, tolerance: float, quantum: float = 0.0, safety: float = SAFETY,
-                 coarse_points: int = COARSE_POINTS, seeds=None):
+    def __init__(
+        self,
+        axes,
+        tolerance: float,
+        quantum: float = 0.0,
+        safety: float = SAFETY,
+        coarse_points: int = COARSE_POINTS,
+        seeds=None,
+    ):
         self.axes = tuple(axes)
         self.tolerance = max(float(tolerance), float(quantum))
         self.quantum, self.safety = float(quantum), float(safety)
         self.sizes = np.array([axis.size for axis in self.axes])
         self.steps = np.array([axis.step for axis in self.axes])
-        self.strides = np.array([1 << max(0, int(math.floor(math.log2(max(1.0, (n - 1) / (coarse_points - 1))))))
-                                 for n in self.sizes])
+        self.strides = np.array(
+            [
+                1 << max(0, int(math.floor(math.log2(max(1.0, (n - 1) / (coarse_points - 1))))))
+                for n in self.sizes
+            ]
+        )
         self.store = _Store(self.sizes)
         # The coarse lattice, each axis's last grid point included so the bounds are evaluated.
-        lattice = [np.union1d(np.arange(0, n, s), [n - 1]) for n, s in zip(self.sizes, self.strides, strict=True)]
+        lattice = [
+            np.union1d(np.arange(0, n, s), [n - 1])
+            for n, s in zip(self.sizes, self.strides, strict=True)
+        ]
         first = np.stack(np.meshgrid(*lattice, indexing="ij"), axis=-1).reshape(-1, len(self.axes))
         if seeds is not None:
-            snapped = np.stack([np.clip(np.rint((np.asarray(seeds, float)[:, i] - a.lo) / a.step), 0, a.size - 1)
-                                for i, a in enumerate(self.axes)], axis=-1).astype(int)
+            snapped = np.stack(
+                [
+                    np.clip(
+                        np.rint((np.asarray(seeds, float)[:, i] - a.lo) / a.step), 0, a.size - 1
+                    )
+                    for i, a in enumerate(self.axes)
+                ],
+                axis=-1,
+            ).astype(int)
             first = np.vstack([first, snapped])
         # Boxes by their lower and upper corners: consecutive lattice points along every axis.
-        edges = [(points[:-1], points[1:]) if points.size > 1 else (points, points) for points in lattice]
-        self.lower, self.upper = (np.stack(np.meshgrid(*ends, indexing="ij"), axis=-1).reshape(-1, len(self.axes))
-                                  for ends in zip(*edges, strict=True))
+        edges = [
+            (points[:-1], points[1:]) if points.size > 1 else (points, points) for points in lattice
+        ]
+        self.lower, self.upper = (
+            np.stack(np.meshgrid(*ends, indexing="ij"), axis=-1).reshape(-1, len(self.axes))
+            for ends in zip(*edges, strict=True)
+        )
         self.levels: list = []
         self._asked = self.store.missing(first)
 
@@ -263,11 +303,15 @@ class GridSearch:
             self._advance()
         if self._asked is None:
             return None
-        return np.stack([axis.values(self._asked[:, i]) for i, axis in enumerate(self.axes)], axis=-1)
+        return np.stack(
+            [axis.values(self._asked[:, i]) for i, axis in enumerate(self.axes)], axis=-1
+        )
 
     def tell(self, values) -> None:
         """The values of the points :meth:`ask` gave, (n, n_targets)."""
-        self.store.add(self._asked, np.asarray(values, dtype=float).reshape(self._asked.shape[0], -1))
+        self.store.add(
+            self._asked, np.asarray(values, dtype=float).reshape(self._asked.shape[0], -1)
+        )
         self._advance()
 
     def _advance(self) -> None:
@@ -277,8 +321,18 @@ class GridSearch:
             self._asked = None
             return
         best = self.store.best_values()
-        bound = _box_bounds(self.store, self.lower, self.upper, self.strides, self.steps, self.sizes,
-                            self.safety) + self.quantum
+        bound = (
+            _box_bounds(
+                self.store,
+                self.lower,
+                self.upper,
+                self.strides,
+                self.steps,
+                self.sizes,
+                self.safety,
+            )
+            + self.quantum
+        )
         keep = np.any(bound > best + self.tolerance, axis=1)
         self.strides = np.maximum(self.strides // 2, 1)
         self.lower, self.upper = _split(self.lower[keep], self.upper[keep], self.strides)
@@ -288,8 +342,14 @@ class GridSearch:
     def result(self) -> SearchResult:
         """What the search evaluated and found (once :meth:`ask` gives None)."""
         store = self.store
-        return SearchResult(self.axes, store.index, store.values, _best_rows(store.index, store.values),
-                            tuple(self.levels), self.tolerance)
+        return SearchResult(
+            self.axes,
+            store.index,
+            store.values,
+            _best_rows(store.index, store.values),
+            tuple(self.levels),
+            self.tolerance,
+        )
 
 
 class _Store:
@@ -324,7 +384,9 @@ class _Store:
     def lookup(self, index):
         """(n, n_targets) the values at ``index`` (NaN where not evaluated or outside the grid)."""
         inside = np.all((index >= 0) & (index < self.sizes), axis=-1)
-        keys = np.ravel_multi_index(np.where(inside[..., None], index, 0).reshape(-1, len(self.sizes)).T, self.sizes)
+        keys = np.ravel_multi_index(
+            np.where(inside[..., None], index, 0).reshape(-1, len(self.sizes)).T, self.sizes
+        )
         at = np.clip(np.searchsorted(self._sorted, keys), 0, self.keys.size - 1)
         found = inside.ravel() & (self._sorted[at] == keys)
         values = np.full((keys.size, self.values.shape[1]), np.nan)
@@ -337,7 +399,9 @@ class _Store:
 
 def _corners(lower, upper):
     """(n_boxes, 2^n_axes, n_axes) every corner of each box."""
-    picks = np.stack(np.meshgrid(*[np.arange(2)] * lower.shape[1], indexing="ij"), axis=-1).reshape(-1, lower.shape[1])
+    picks = np.stack(np.meshgrid(*[np.arange(2)] * lower.shape[1], indexing="ij"), axis=-1).reshape(
+        -1, lower.shape[1]
+    )
     return np.where(picks[None].astype(bool), upper[:, None, :], lower[:, None, :])
 
 
@@ -352,8 +416,12 @@ def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
     looked up per target, and 100,000 boxes of 40 loads held 5.5 GB at once."""
     n_targets = store.values.shape[1]
     per = max(1, BOX_VALUES // (len(_CORNER_LOOKUPS) * 2 ** lower.shape[1] * n_targets))
-    batches = [_box_terms(store, lower[first:first + per], upper[first:first + per], strides, steps, sizes)
-               for first in range(0, max(lower.shape[0], 1), per)]  # one batch of none where none is left
+    batches = [
+        _box_terms(
+            store, lower[first : first + per], upper[first : first + per], strides, steps, sizes
+        )
+        for first in range(0, max(lower.shape[0], 1), per)
+    ]  # one batch of none where none is left
     terms = list(zip(*batches, strict=True))
     top, error, tent, concave = (np.concatenate(terms[k]) for k in (0, 1, 4, 5))
     unknown, width = (np.concatenate(terms[k], axis=1) for k in (2, 3))
@@ -385,22 +453,43 @@ def _box_terms(store, lower, upper, strides, steps, sizes):
         # The corners and their lattice neighbours along the axis, looked up in one call.
         offsets = np.array(_CORNER_LOOKUPS)[:, None, None, None] * shift  # (5, 1, 1, n_axes)
         beyond_below, below, here, above, beyond_above = store.lookup(corners[None] + offsets)
-        second = np.abs(above - 2.0 * here + below) / (strides[axis] * steps[axis]) ** 2  # (boxes, corners, targets)
+        second = (
+            np.abs(above - 2.0 * here + below) / (strides[axis] * steps[axis]) ** 2
+        )  # (boxes, corners, targets)
         known = np.isfinite(second)
         curvature = np.max(np.where(known, second, -np.inf), axis=1)  # (boxes, targets)
         largest[axis] = curvature.max(axis=0, initial=-np.inf)
         unknown[axis] = ~known.any(axis=1)
         widths[axis] = (upper[:, axis] - lower[:, axis]) * steps[axis]
-        error += np.where(unknown[axis], 0.0, np.maximum(curvature, 0.0)) * (widths[axis] ** 2 / 8.0)[:, None]
+        error += (
+            np.where(unknown[axis], 0.0, np.maximum(curvature, 0.0))
+            * (widths[axis] ** 2 / 8.0)[:, None]
+        )
         # The box's edges along the axis: each from a corner with the axis's lower end to the one
         # with its upper end (the corners' order is _corners', the axis's bit 1 << n_axes-1-axis).
         low = np.flatnonzero((np.arange(corners.shape[1]) >> (n_axes - 1 - axis)) & 1 == 0)
         high = low + (1 << (n_axes - 1 - axis))
-        tent = np.maximum(tent, _tent(below[:, low], here[:, low], here[:, high], above[:, high],
-                                      strides[axis] * steps[axis], widths[axis][:, None, None]).max(axis=1))
+        tent = np.maximum(
+            tent,
+            _tent(
+                below[:, low],
+                here[:, low],
+                here[:, high],
+                above[:, high],
+                strides[axis] * steps[axis],
+                widths[axis][:, None, None],
+            ).max(axis=1),
+        )
         if np.count_nonzero(sizes > 1) == 1:
             # Equally spaced: the grid's last box, narrower than the stride, has its neighbour above off the grid.
-            concave = _concave(beyond_below[:, 0], below[:, 0], here[:, 0], here[:, 1], above[:, 1], beyond_above[:, 1])
+            concave = _concave(
+                beyond_below[:, 0],
+                below[:, 0],
+                here[:, 0],
+                here[:, 1],
+                above[:, 1],
+                beyond_above[:, 1],
+            )
     return top, error, unknown, widths, tent, concave, largest
 
 
@@ -411,7 +500,9 @@ def _concave(*values):
     turning up into a narrow peak) shows."""
     values = np.stack(values)
     second = values[2:] - 2.0 * values[1:-1] + values[:-2]
-    return np.all(second <= 0.0, axis=0)  # NaN (a point not evaluated or off the grid) compares False
+    return np.all(
+        second <= 0.0, axis=0
+    )  # NaN (a point not evaluated or off the grid) compares False
 
 
 def _tent(before, start, end, after, spacing, width):

@@ -18,7 +18,13 @@ from dataclasses import dataclass
 import numpy as np
 import pvlib
 
-from foldopt.engine.light import clear_light, diffuse_terms, measured_light, member_light, weather_light
+from foldopt.engine.light import (
+    clear_light,
+    diffuse_terms,
+    measured_light,
+    member_light,
+    weather_light,
+)
 from foldopt.inputs.load_profile import load_shape
 from foldopt.inputs.sections import parse_timezone
 from foldopt.inputs.study import Study
@@ -37,8 +43,13 @@ def step_span(some) -> np.ndarray:
     n_steps = some.shape[1]
     first = np.argmax(some, axis=1)
     last = n_steps - 1 - np.argmax(some[:, ::-1], axis=1)
-    return np.ascontiguousarray(np.where(some.any(axis=1)[:, None],
-                                         np.stack([np.maximum(first - 1, 0), np.minimum(last + 1, n_steps - 1)], 1), 0))
+    return np.ascontiguousarray(
+        np.where(
+            some.any(axis=1)[:, None],
+            np.stack([np.maximum(first - 1, 0), np.minimum(last + 1, n_steps - 1)], 1),
+            0,
+        )
+    )
 
 
 @dataclass(frozen=True)
@@ -139,10 +150,17 @@ class Sky:
         along the time steps, contiguous: (n_blocks, 3, n_steps), (n_blocks, n_steps) and
         (n_blocks, 4, n_steps) (or (n_blocks, 0, 1) for a beam-only sky); and each block's span,
         (n_blocks, 2), its first and last step with light and one dark step either side."""
-        terms = (np.ascontiguousarray(np.moveaxis(self.terms, -1, 1)) if self.terms is not None
-                 else np.zeros((self.n_blocks, 0, 1)))
-        return (np.ascontiguousarray(np.moveaxis(self.sun_vector, -1, 1)), np.ascontiguousarray(self.dni), terms,
-                step_span(self.lit))
+        terms = (
+            np.ascontiguousarray(np.moveaxis(self.terms, -1, 1))
+            if self.terms is not None
+            else np.zeros((self.n_blocks, 0, 1))
+        )
+        return (
+            np.ascontiguousarray(np.moveaxis(self.sun_vector, -1, 1)),
+            np.ascontiguousarray(self.dni),
+            terms,
+            step_span(self.lit),
+        )
 
     def kernel_layout(self, paper: bool) -> tuple:
         """``sun, paper_sun, beam, terms, span``: the sky as :func:`foldopt.engine.kernel.fold_rows`
@@ -156,7 +174,11 @@ class Sky:
             Shin et al.'s Eq. 5 for the beam's incidence.
         """
         sun, dni, terms, span = self._layout
-        paper_sun = np.ascontiguousarray(np.moveaxis(self.paper_sun, -1, 1)) if paper else np.zeros((1, 4, 1))
+        paper_sun = (
+            np.ascontiguousarray(np.moveaxis(self.paper_sun, -1, 1))
+            if paper
+            else np.zeros((1, 4, 1))
+        )
         return sun, paper_sun, dni, terms, span
 
     @property
@@ -172,9 +194,14 @@ class Sky:
         up = self.solar_zenith < 90.0
         rises, sets = up.any(axis=1), ~up.all(axis=1)
         overcast = rises & ~((self.dni > 0) & up).any(axis=1)
-        parts = [np.where(~rises, "polar night", ""), np.where(~sets, "polar day", ""),
-                 np.where(overcast, "overcast", "")]
-        return np.array(["; ".join(p for p in block if p) for block in zip(*parts, strict=True)], dtype=object)
+        parts = [
+            np.where(~rises, "polar night", ""),
+            np.where(~sets, "polar day", ""),
+            np.where(overcast, "overcast", ""),
+        ]
+        return np.array(
+            ["; ".join(p for p in block if p) for block in zip(*parts, strict=True)], dtype=object
+        )
 
     def block(self, index: int) -> Sky:
         """One block as a sky of its own.
@@ -190,16 +217,44 @@ class Sky:
             Of one block: every array keeps its leading axis, of length 1.
         """
         keep = slice(index, index + 1)
-        grid = ClockGrid(self.grid.utc_ns[keep], self.grid.utc_offset_ns[keep], self.grid.timezones[keep],
-                         self.grid.step_hours)
-        take = {name: None if getattr(self, name) is None else getattr(self, name)[keep]
-                for name in ("solar_zenith", "solar_azimuth", "hour_angle", "declination", "sun_vector", "dni",
-                             "ghi", "dhi", "terms", "temp_air", "latitude", "temp_steps", "wind_speed")}
+        grid = ClockGrid(
+            self.grid.utc_ns[keep],
+            self.grid.utc_offset_ns[keep],
+            self.grid.timezones[keep],
+            self.grid.step_hours,
+        )
+        take = {
+            name: None if getattr(self, name) is None else getattr(self, name)[keep]
+            for name in (
+                "solar_zenith",
+                "solar_azimuth",
+                "hour_angle",
+                "declination",
+                "sun_vector",
+                "dni",
+                "ghi",
+                "dhi",
+                "terms",
+                "temp_air",
+                "latitude",
+                "temp_steps",
+                "wind_speed",
+            )
+        }
         shape = None if self.load_shape is None else self.load_shape[keep]
         horizon_of = None if self.horizon_of is None else self.horizon_of[keep]
-        return Sky(grid=grid, mode=self.mode, iam=self.iam, weather_balance=self.weather_balance,
-                   wind_ref=self.wind_ref, weather_notes=self.weather_notes, load_shape=shape,
-                   horizons=self.horizons, horizon_of=horizon_of, **take)
+        return Sky(
+            grid=grid,
+            mode=self.mode,
+            iam=self.iam,
+            weather_balance=self.weather_balance,
+            wind_ref=self.wind_ref,
+            weather_notes=self.weather_notes,
+            load_shape=shape,
+            horizons=self.horizons,
+            horizon_of=horizon_of,
+            **take,
+        )
 
 
 def _horizon_blocks(sites):
@@ -255,13 +310,20 @@ def _clock(sites, dates, step_min) -> ClockGrid:
     zones: dict[str, list[int]] = {}
     for index, site in enumerate(sites):
         zones.setdefault(site.timezone, []).append(index)
-    parts = [clock_grid([dates[i] for i in members], parse_timezone(zone), step_min) for zone, members in zones.items()]
+    parts = [
+        clock_grid([dates[i] for i in members], parse_timezone(zone), step_min)
+        for zone, members in zones.items()
+    ]
     order = np.argsort(np.concatenate(list(zones.values())), kind="stable")
     stacked = ClockGrid.stack(parts)
     if np.array_equal(order, np.arange(order.size)):
         return stacked  # each zone's blocks together already (a map's batch of sites)
-    return ClockGrid(stacked.utc_ns[order], stacked.utc_offset_ns[order],
-                     tuple(stacked.timezones[i] for i in order), stacked.step_hours)
+    return ClockGrid(
+        stacked.utc_ns[order],
+        stacked.utc_offset_ns[order],
+        tuple(stacked.timezones[i] for i in order),
+        stacked.step_hours,
+    )
 
 
 def build_sky(study: Study, sites, dates, member=None) -> Sky:
@@ -297,14 +359,20 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         raise ValueError(f"{len(sites)} sites for {len(dates)} dates")
     if study.weather is not None:
         # A weather file's days are on its own clock, whatever time zone the site names.
-        zone = (study_weather(study.weather, study.site).site if study.weather.measured
-                else weather_site(study.weather.path, study.weather.format))["timezone"]
+        zone = (
+            study_weather(study.weather, study.site).site
+            if study.weather.measured
+            else weather_site(study.weather.path, study.weather.format)
+        )["timezone"]
         sites = [site.model_copy(update={"timezone": zone}) for site in sites]
     share = None
     if member is not None and study.weather is not None and study.weather.members:
         # The members of a day share its sun, clear sky and air: they are worked out once a day
         # and a site, and only the light is drawn per member.
-        keys = [(site.latitude, site.longitude, site.altitude, date) for site, date in zip(sites, dates, strict=True)]
+        keys = [
+            (site.latitude, site.longitude, site.altitude, date)
+            for site, date in zip(sites, dates, strict=True)
+        ]
         first = {key: index for index, key in reversed(list(enumerate(keys)))}
         unique = sorted(first.values())
         position = {keys[index]: k for k, index in enumerate(unique)}
@@ -317,7 +385,9 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
     grid = _clock(sites, dates, study.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
     solar_zenith = sun["solar_zenith"]
-    dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[grid.dayofyear]
+    dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[
+        grid.dayofyear
+    ]
     temp_air, balance = np.full(len(sites), float(study.temp_air)), None
     temp_steps = wind_speed = wind_ref = terms = None
     notes = ()
@@ -327,17 +397,26 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         temp_steps, wind_speed = light.pop("temp_air"), light.pop("wind_speed")
         notes = tuple(measured.report())
     elif study.weather is not None:
-        clear, _ = clear_light(grid, solar_zenith, dni_extra, sites, "ineichen", study.linke_turbidity)
-        light, temp_steps, wind_speed, balance, (hourly, per_interval) = weather_light(study, grid, dates, clear,
-                                                                                     solar_zenith, dni_extra)
+        clear, _ = clear_light(
+            grid, solar_zenith, dni_extra, sites, "ineichen", study.linke_turbidity
+        )
+        light, temp_steps, wind_speed, balance, (hourly, per_interval) = weather_light(
+            study, grid, dates, clear, solar_zenith, dni_extra
+        )
         if share is not None:
-            light, balance = member_light(study, hourly, per_interval, clear, solar_zenith, dates, share)
+            light, balance = member_light(
+                study, hourly, per_interval, clear, solar_zenith, dates, share
+            )
     sun_vector = sun.pop("sun_vector")
     if share is not None:
         inverse = share[0]
         sun_vector = sun_vector[inverse]
-        grid = ClockGrid(grid.utc_ns[inverse], grid.utc_offset_ns[inverse], tuple(grid.timezones[i] for i in inverse),
-                         grid.step_hours)
+        grid = ClockGrid(
+            grid.utc_ns[inverse],
+            grid.utc_offset_ns[inverse],
+            tuple(grid.timezones[i] for i in inverse),
+            grid.step_hours,
+        )
         sun = {key: value[inverse] for key, value in sun.items()}
         solar_zenith, latitude, altitude = sun["solar_zenith"], latitude[inverse], altitude[inverse]
         dni_extra = dni_extra[inverse]
@@ -345,30 +424,73 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         dates = [dates[i] for i in inverse]
     if study.weather is not None:
         lit = light["ghi"] > 0
-        wind_ref = float(np.round(2.0 * wind_speed[lit].mean()) / 2.0) if lit.any() else float(study.wind_speed)
-        temp_steps = equivalent_temp_air(temp_steps, wind_speed, wind_ref, light["ghi"], study.temperature_model)
+        wind_ref = (
+            float(np.round(2.0 * wind_speed[lit].mean()) / 2.0)
+            if lit.any()
+            else float(study.wind_speed)
+        )
+        temp_steps = equivalent_temp_air(
+            temp_steps, wind_speed, wind_ref, light["ghi"], study.temperature_model
+        )
         # The block's representative temperature: its lit steps' mean (its whole day's if dark).
-        temp_air = np.where(lit.any(axis=1), (temp_steps * lit).sum(axis=1) / np.maximum(lit.sum(axis=1), 1),
-                            temp_steps.mean(axis=1))
+        temp_air = np.where(
+            lit.any(axis=1),
+            (temp_steps * lit).sum(axis=1) / np.maximum(lit.sum(axis=1), 1),
+            temp_steps.mean(axis=1),
+        )
     elif study.sky in CLEAR_SKIES:
-        light, terms = clear_light(grid, solar_zenith, dni_extra, sites, study.sky, study.linke_turbidity,
-                                   transposition, study.albedo)
+        light, terms = clear_light(
+            grid,
+            solar_zenith,
+            dni_extra,
+            sites,
+            study.sky,
+            study.linke_turbidity,
+            transposition,
+            study.albedo,
+        )
     else:
         beam_altitude = altitude if study.mode == "exact" else 0.0
-        light = {"dni": clear_sky_dni(solar_zenith, beam_altitude, study.sky, dayofyear=grid.dayofyear,
-                                      climate=study.climate)}
+        light = {
+            "dni": clear_sky_dni(
+                solar_zenith,
+                beam_altitude,
+                study.sky,
+                dayofyear=grid.dayofyear,
+                climate=study.climate,
+            )
+        }
     dni = light["dni"]
     ghi, dhi = light.get("ghi"), light.get("dhi")
     if transposition != "none" and terms is None:
         terms = diffuse_terms(transposition, solar_zenith, dni, ghi, dhi, dni_extra, study.albedo)
     if horizons:
-        dni, terms = block_behind_horizon(horizons, horizon_of, solar_zenith, sun["solar_azimuth"], dni, terms)
+        dni, terms = block_behind_horizon(
+            horizons, horizon_of, solar_zenith, sun["solar_azimuth"], dni, terms
+        )
     return Sky(
-        grid=grid, mode=study.mode, solar_zenith=solar_zenith, solar_azimuth=sun["solar_azimuth"],
-        hour_angle=sun["hour_angle"], declination=np.ascontiguousarray(sun["declination"]),
-        sun_vector=sun_vector, dni=dni, ghi=ghi, dhi=dhi, terms=terms,
-        temp_air=temp_air, latitude=latitude[:, 0], iam=study.iam, weather_balance=balance,
-        load_shape=None if study.load_profile is None else load_shape(study.load_profile, grid.clock_hours, dates),
-        temp_steps=temp_steps, wind_speed=wind_speed, wind_ref=wind_ref, weather_notes=notes, horizons=horizons,
+        grid=grid,
+        mode=study.mode,
+        solar_zenith=solar_zenith,
+        solar_azimuth=sun["solar_azimuth"],
+        hour_angle=sun["hour_angle"],
+        declination=np.ascontiguousarray(sun["declination"]),
+        sun_vector=sun_vector,
+        dni=dni,
+        ghi=ghi,
+        dhi=dhi,
+        terms=terms,
+        temp_air=temp_air,
+        latitude=latitude[:, 0],
+        iam=study.iam,
+        weather_balance=balance,
+        load_shape=None
+        if study.load_profile is None
+        else load_shape(study.load_profile, grid.clock_hours, dates),
+        temp_steps=temp_steps,
+        wind_speed=wind_speed,
+        wind_ref=wind_ref,
+        weather_notes=notes,
+        horizons=horizons,
         horizon_of=horizon_of,
     )

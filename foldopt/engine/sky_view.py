@@ -53,8 +53,11 @@ def surface_views(sky: Sky, blocks, surface_tilt, surface_azimuth, cos_tilt):
     of = np.atleast_1d(sky.horizon_of[blocks])
     if (of < 0).all():
         return None
-    tilt, azimuth, cos_tilt = np.broadcast_arrays(np.asarray(surface_tilt, float), np.asarray(surface_azimuth, float),
-                                                  np.asarray(cos_tilt, float))
+    tilt, azimuth, cos_tilt = np.broadcast_arrays(
+        np.asarray(surface_tilt, float),
+        np.asarray(surface_azimuth, float),
+        np.asarray(cos_tilt, float),
+    )
     iso, band = (np.array(factor) for factor in open_views(cos_tilt))
     per_row = of if of.size == tilt.shape[0] else np.full(tilt.shape[0], of[0])
     for k in np.unique(per_row[per_row >= 0]):
@@ -93,8 +96,9 @@ def row_views(sky: Sky, row_block, normals, orientation, row_orientation) -> np.
             rows = of == k
             taken = orientation[row_orientation[rows]]
             for side in (0, 1):
-                views[rows, side, 0], views[rows, side, 1] = _views(taken[:, 2 * side], taken[:, 2 * side + 1],
-                                                                    sky.horizons[k])
+                views[rows, side, 0], views[rows, side, 1] = _views(
+                    taken[:, 2 * side], taken[:, 2 * side + 1], sky.horizons[k]
+                )
     return views
 
 
@@ -103,8 +107,12 @@ def _views(tilt, azimuth, profile):
     tilt, azimuth = np.asarray(tilt, dtype=float), np.asarray(azimuth, dtype=float)
     if tilt.size <= 4096:
         return sky_view_factors(tilt, azimuth, *profile)
-    pairs = np.round(np.stack([tilt.ravel(), azimuth.ravel() % 360.0], axis=1) / TRACKER_ROUNDING_DEG)
+    pairs = np.round(
+        np.stack([tilt.ravel(), azimuth.ravel() % 360.0], axis=1) / TRACKER_ROUNDING_DEG
+    )
     unique, inverse = np.unique(pairs, axis=0, return_inverse=True)
-    iso, band = sky_view_factors(unique[:, 0] * TRACKER_ROUNDING_DEG, unique[:, 1] * TRACKER_ROUNDING_DEG, *profile)
+    iso, band = sky_view_factors(
+        unique[:, 0] * TRACKER_ROUNDING_DEG, unique[:, 1] * TRACKER_ROUNDING_DEG, *profile
+    )
     inverse = inverse.ravel()
     return iso[inverse].reshape(tilt.shape), band[inverse].reshape(tilt.shape)

@@ -39,18 +39,27 @@ class DiodeSpec(StrictModel):
     """
 
     model: named(names.DIODE_MODELS) = "ideal"
-    part: str | None = Field(None, description="a datasheet part; default foldopt.physics.diodes.DEFAULT_DIODE_PART")
-    forward_voltage: interval(0, 5, unit=" V") | None = Field(None, description="constant; default the part's")
+    part: str | None = Field(
+        None, description="a datasheet part; default foldopt.physics.diodes.DEFAULT_DIODE_PART"
+    )
+    forward_voltage: interval(0, 5, unit=" V") | None = Field(
+        None, description="constant; default the part's"
+    )
     saturation_current: interval(0, 1, lo_open=True, unit=" A") | None = Field(
-        None, description="shockley; default the part's")
+        None, description="shockley; default the part's"
+    )
     ideality: interval(0.5, 5) | None = Field(None, description="shockley; default the part's")
-    series_resistance: interval(0, 10, unit=" ohm") | None = Field(None, description="shockley; default the part's")
+    series_resistance: interval(0, 10, unit=" ohm") | None = Field(
+        None, description="shockley; default the part's"
+    )
 
     @field_validator("part")
     @classmethod
     def _known_part(cls, part):
         if part is not None:
-            from foldopt.physics.diodes import DIODE_PARTS  # the parts' table, only when one is named
+            from foldopt.physics.diodes import (
+                DIODE_PARTS,
+            )  # the parts' table, only when one is named
 
             if part not in DIODE_PARTS:
                 raise ValueError(f"must be one of {', '.join(DIODE_PARTS)}")
@@ -58,13 +67,18 @@ class DiodeSpec(StrictModel):
 
     def idle_settings(self, field: str) -> list[str]:
         """``field.name = value: why`` for each value this model does not use."""
-        rules = (("part", self.model != "ideal", "is only used by a constant or shockley diode"),
-                 ("forward_voltage", self.model == "constant", "is only used by model constant"),
-                 ("saturation_current", self.model == "shockley", "is only used by model shockley"),
-                 ("ideality", self.model == "shockley", "is only used by model shockley"),
-                 ("series_resistance", self.model == "shockley", "is only used by model shockley"))
-        return [f"{field}.{name} = {getattr(self, name)!r}: {why}" for name, used, why in rules
-                if not used and getattr(self, name) is not None]
+        rules = (
+            ("part", self.model != "ideal", "is only used by a constant or shockley diode"),
+            ("forward_voltage", self.model == "constant", "is only used by model constant"),
+            ("saturation_current", self.model == "shockley", "is only used by model shockley"),
+            ("ideality", self.model == "shockley", "is only used by model shockley"),
+            ("series_resistance", self.model == "shockley", "is only used by model shockley"),
+        )
+        return [
+            f"{field}.{name} = {getattr(self, name)!r}: {why}"
+            for name, used, why in rules
+            if not used and getattr(self, name) is not None
+        ]
 
     def describe(self) -> str:
         """The diode in words: ``shockley (SB560)``, ``constant 0.4 V``."""
@@ -72,17 +86,22 @@ class DiodeSpec(StrictModel):
             return "ideal"
         from foldopt.physics.diodes import DEFAULT_DIODE_PART
 
-        given = ", ".join(f"{name} {getattr(self, name):g}" for name in (
-            "forward_voltage", "saturation_current", "ideality", "series_resistance")
-            if getattr(self, name) is not None)
+        given = ", ".join(
+            f"{name} {getattr(self, name):g}"
+            for name in ("forward_voltage", "saturation_current", "ideality", "series_resistance")
+            if getattr(self, name) is not None
+        )
         return f"{self.model} ({self.part or DEFAULT_DIODE_PART}{', ' + given if given else ''})"
 
     def build(self):
         """The diode (:func:`foldopt.physics.diodes.diode`)."""
         from foldopt.physics.diodes import DEFAULT_DIODE_PART, diode
 
-        overrides = {name: getattr(self, name) for name in ("forward_voltage", "saturation_current", "ideality",
-                                                              "series_resistance") if getattr(self, name) is not None}
+        overrides = {
+            name: getattr(self, name)
+            for name in ("forward_voltage", "saturation_current", "ideality", "series_resistance")
+            if getattr(self, name) is not None
+        }
         return diode(self.model, self.part or DEFAULT_DIODE_PART, **overrides)
 
 
@@ -106,28 +125,39 @@ class ConverterSpec(StrictModel):
     """
 
     model: named(names.CONVERTER_MODELS) = "ideal"
-    efficiency: interval(0, 1, lo_open=True) = Field(0.96, description="pvwatts: nominal efficiency")
+    efficiency: interval(0, 1, lo_open=True) = Field(
+        0.96, description="pvwatts: nominal efficiency"
+    )
     p_rated: interval(0, 1e6, lo_open=True, unit=" W") | None = Field(
-        None, description="DC input rating; default the panel's power at STC")
+        None, description="DC input rating; default the panel's power at STC"
+    )
     curve: Annotated[list[_CurvePoint], Field(min_length=1, max_length=100)] | None = Field(
-        None, description="curve: [input power / rating, efficiency] points")
+        None, description="curve: [input power / rating, efficiency] points"
+    )
 
     @model_validator(mode="after")
     def _curve_given(self):
         if self.model == "curve" and self.curve is None:
-            raise ValueError("model curve: give its points, circuit.converter.curve = [[input power / rating, "
-                             "efficiency], ...], e.g. [[0.1, 0.90], [0.5, 0.95], [1.0, 0.94]]")
+            raise ValueError(
+                "model curve: give its points, circuit.converter.curve = [[input power / rating, "
+                "efficiency], ...], e.g. [[0.1, 0.90], [0.5, 0.95], [1.0, 0.94]]"
+            )
         if self.curve is not None and any(b[0] <= a[0] for a, b in zip(self.curve, self.curve[1:])):
             raise ValueError("curve: the input fractions must increase from point to point")
         return self
 
     def idle_settings(self, field: str) -> list[str]:
         """``field.name = value: why`` for each value this model does not use."""
-        rules = (("efficiency", self.model == "pvwatts", 0.96, "is only used by model pvwatts"),
-                 ("p_rated", self.model != "ideal", None, "is only used by model pvwatts or curve"),
-                 ("curve", self.model == "curve", None, "is only used by model curve"))
-        return [f"{field}.{name} = {getattr(self, name)!r}: {why}" for name, used, default, why in rules
-                if not used and getattr(self, name) != default]
+        rules = (
+            ("efficiency", self.model == "pvwatts", 0.96, "is only used by model pvwatts"),
+            ("p_rated", self.model != "ideal", None, "is only used by model pvwatts or curve"),
+            ("curve", self.model == "curve", None, "is only used by model curve"),
+        )
+        return [
+            f"{field}.{name} = {getattr(self, name)!r}: {why}"
+            for name, used, default, why in rules
+            if not used and getattr(self, name) != default
+        ]
 
 
 class Circuit(StrictModel):
@@ -155,8 +185,12 @@ class Circuit(StrictModel):
     bypass_diode: DiodeSpec = DiodeSpec()
     converter: ConverterSpec = ConverterSpec()
     coupling: named(names.COUPLINGS) = "mppt"
-    load_voltage: interval(0, 1000, lo_open=True, unit=" V") | None = Field(None, description="direct: the load's")
-    switch_resistance: interval(0, 10, unit=" ohm") = Field(0.0, description="switching: each path's switch")
+    load_voltage: interval(0, 1000, lo_open=True, unit=" V") | None = Field(
+        None, description="direct: the load's"
+    )
+    switch_resistance: interval(0, 10, unit=" ohm") = Field(
+        0.0, description="switching: each path's switch"
+    )
 
     @field_validator("blocking_diode", "bypass_diode", "converter", mode="before")
     @classmethod
@@ -166,23 +200,36 @@ class Circuit(StrictModel):
     @model_validator(mode="after")
     def _coupled(self):
         if self.coupling == "direct" and self.load_voltage is None:
-            raise ValueError("coupling 'direct': give the load's voltage, circuit.load_voltage (e.g. 5)")
+            raise ValueError(
+                "coupling 'direct': give the load's voltage, circuit.load_voltage (e.g. 5)"
+            )
         if self.coupling == "direct" and self.converter.model != "ideal":
-            raise ValueError(f"converter {self.converter.model!r} with coupling 'direct': a direct-coupled load has "
-                             f"no converter; leave circuit.converter out, or set circuit.coupling mppt")
+            raise ValueError(
+                f"converter {self.converter.model!r} with coupling 'direct': a direct-coupled load has "
+                f"no converter; leave circuit.converter out, or set circuit.coupling mppt"
+            )
         return self
 
     @property
     def ideal(self) -> bool:
         """Whether every part is Shin et al.'s ideal one (the engine's plain path)."""
-        return (self.blocking_diode.model == "ideal" and self.bypass_diode.model == "ideal"
-                and self.converter.model == "ideal" and self.coupling == "mppt" and self.switch_resistance == 0.0)
+        return (
+            self.blocking_diode.model == "ideal"
+            and self.bypass_diode.model == "ideal"
+            and self.converter.model == "ideal"
+            and self.coupling == "mppt"
+            and self.switch_resistance == 0.0
+        )
 
     @property
     def needs_iv(self) -> bool:
         """Whether a part needs the sub-panels' I-V curves (all but the converter do)."""
-        return (self.blocking_diode.model != "ideal" or self.bypass_diode.model != "ideal" or self.coupling == "direct"
-                or self.switch_resistance > 0.0)
+        return (
+            self.blocking_diode.model != "ideal"
+            or self.bypass_diode.model != "ideal"
+            or self.coupling == "direct"
+            or self.switch_resistance > 0.0
+        )
 
     def describe(self) -> str:
         """The circuit in words, for the answer's question."""
@@ -193,10 +240,17 @@ class Circuit(StrictModel):
         else:
             spec = self.converter
             rating = f"{spec.p_rated:g} W" if spec.p_rated is not None else "the panel's STC power"
-            curve = f"nominal {spec.efficiency:g}" if spec.model == "pvwatts" else f"{len(spec.curve)} points"
+            curve = (
+                f"nominal {spec.efficiency:g}"
+                if spec.model == "pvwatts"
+                else f"{len(spec.curve)} points"
+            )
             load = f"MPPT converter {spec.model} ({curve}, rated {rating})"
-        parts = [load, f"blocking diodes {self.blocking_diode.describe()}",
-                 f"bypass diodes {self.bypass_diode.describe()}"]
+        parts = [
+            load,
+            f"blocking diodes {self.blocking_diode.describe()}",
+            f"bypass diodes {self.bypass_diode.describe()}",
+        ]
         if self.switch_resistance:
             parts.append(f"switch {self.switch_resistance:g} ohm")
         return ", ".join(parts)
@@ -241,28 +295,66 @@ class Circuit(StrictModel):
             ``circuit.field = value: why`` lines.
         """
         parallel_used = connection in ("parallel", "switching")
-        lines = [*self.blocking_diode.idle_settings("circuit.blocking_diode"),
-                 *self.bypass_diode.idle_settings("circuit.bypass_diode"),
-                 *self.converter.idle_settings("circuit.converter")]
-        rules = (("blocking_diode.model", self.blocking_diode.model, "ideal", parallel_used,
-                  "is only used where parallel is (connection parallel or switching)"),
-                 ("bypass_diode.model", self.bypass_diode.model, "ideal", series_used,
-                  "is only used where series is, with bypass_diodes (connection series, or switching with "
-                  "switch_series)"),
-                 ("switch_resistance", self.switch_resistance, 0.0, connection == "switching",
-                  "is only used by connection switching"),
-                 ("load_voltage", self.load_voltage, None, self.coupling == "direct",
-                  "is only used by coupling direct"))
-        lines += [f"circuit.{name} = {value!r}: {why}" for name, value, default, used, why in rules
-                  if not used and value != default]
+        lines = [
+            *self.blocking_diode.idle_settings("circuit.blocking_diode"),
+            *self.bypass_diode.idle_settings("circuit.bypass_diode"),
+            *self.converter.idle_settings("circuit.converter"),
+        ]
+        rules = (
+            (
+                "blocking_diode.model",
+                self.blocking_diode.model,
+                "ideal",
+                parallel_used,
+                "is only used where parallel is (connection parallel or switching)",
+            ),
+            (
+                "bypass_diode.model",
+                self.bypass_diode.model,
+                "ideal",
+                series_used,
+                "is only used where series is, with bypass_diodes (connection series, or switching with "
+                "switch_series)",
+            ),
+            (
+                "switch_resistance",
+                self.switch_resistance,
+                0.0,
+                connection == "switching",
+                "is only used by connection switching",
+            ),
+            (
+                "load_voltage",
+                self.load_voltage,
+                None,
+                self.coupling == "direct",
+                "is only used by coupling direct",
+            ),
+        )
+        lines += [
+            f"circuit.{name} = {value!r}: {why}"
+            for name, value, default, used, why in rules
+            if not used and value != default
+        ]
         if self.ignored_by(connection):
-            lines.append(f"connection = {connection!r}: needs a converter per sub-panel; a direct-coupled load "
-                         f"(circuit.coupling direct) has none")
+            lines.append(
+                f"connection = {connection!r}: needs a converter per sub-panel; a direct-coupled load "
+                f"(circuit.coupling direct) has none"
+            )
         if not iv_model:
-            needing = [(name, value) for name, value, default in (
-                ("blocking_diode.model", self.blocking_diode.model, "ideal"),
-                ("bypass_diode.model", self.bypass_diode.model, "ideal"), ("coupling", self.coupling, "mppt"),
-                ("switch_resistance", self.switch_resistance, 0.0)) if value != default]
-            lines += [f"circuit.{name} = {value!r}: needs the sub-panels' I-V curves: pv_model single-diode or "
-                      f"b-model" for name, value in needing]
+            needing = [
+                (name, value)
+                for name, value, default in (
+                    ("blocking_diode.model", self.blocking_diode.model, "ideal"),
+                    ("bypass_diode.model", self.bypass_diode.model, "ideal"),
+                    ("coupling", self.coupling, "mppt"),
+                    ("switch_resistance", self.switch_resistance, 0.0),
+                )
+                if value != default
+            ]
+            lines += [
+                f"circuit.{name} = {value!r}: needs the sub-panels' I-V curves: pv_model single-diode or "
+                f"b-model"
+                for name, value in needing
+            ]
         return lines

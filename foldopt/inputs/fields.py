@@ -125,7 +125,11 @@ class StrictModel(BaseModel):
 
 
 def _unwrapped(annotation):
-    return _unwrapped(typing.get_args(annotation)[0]) if typing.get_origin(annotation) is Annotated else annotation
+    return (
+        _unwrapped(typing.get_args(annotation)[0])
+        if typing.get_origin(annotation) is Annotated
+        else annotation
+    )
 
 
 def _union(annotation) -> tuple:
@@ -137,8 +141,15 @@ def _union(annotation) -> tuple:
 
 def _list_depth(annotation) -> int:
     """How deep lists nest in a type: 2 for ``list[tuple[float, float]] | None``, 0 for a number."""
-    depths = [1 + max((_list_depth(item) for item in typing.get_args(member) if item is not Ellipsis), default=0)
-              for member in _union(annotation) if typing.get_origin(member) in (list, tuple)]
+    depths = [
+        1
+        + max(
+            (_list_depth(item) for item in typing.get_args(member) if item is not Ellipsis),
+            default=0,
+        )
+        for member in _union(annotation)
+        if typing.get_origin(member) in (list, tuple)
+    ]
     return max(depths, default=0)
 
 
@@ -177,4 +188,8 @@ def list_valued_fields(model: type[BaseModel], prefix: str = "") -> dict[str, in
 
 def list_depth(value) -> int:
     """How deep lists nest in a value: 2 for ``[[0, 10], [180, 20]]``, 0 for a number."""
-    return 1 + list_depth(value[0]) if isinstance(value, list) and value else int(isinstance(value, list))
+    return (
+        1 + list_depth(value[0])
+        if isinstance(value, list) and value
+        else int(isinstance(value, list))
+    )

@@ -44,8 +44,10 @@ if TYPE_CHECKING:
 
 FIELD = "site.horizon"
 #: What a horizon file may be, for the messages.
-ACCEPTS = ("a horizon file is PVGIS printhorizon JSON, PVGIS horizon CSV (columns A and H_hor) or a CSV with "
-           "the header azimuth,elevation [deg]")
+ACCEPTS = (
+    "a horizon file is PVGIS printhorizon JSON, PVGIS horizon CSV (columns A and H_hor) or a CSV with "
+    "the header azimuth,elevation [deg]"
+)
 #: Bytes of a horizon file: PVGIS's are some 5 kB; a profile every 0.01 deg is under 1 MB.
 MAX_HORIZON_BYTES = size_limit("MAX_HORIZON_BYTES", 1_000_000)
 #: Longest value quoted back in a message [characters].
@@ -54,7 +56,7 @@ _QUOTE = 40
 
 def _quote(value) -> str:
     text = repr(value)
-    return text if len(text) <= _QUOTE else text[:_QUOTE - 3] + "..."
+    return text if len(text) <= _QUOTE else text[: _QUOTE - 3] + "..."
 
 
 def _number(value) -> float | None:
@@ -68,23 +70,36 @@ def _number(value) -> float | None:
 def _checked(pairs, labels) -> tuple[np.ndarray, np.ndarray]:
     """:func:`horizon_profile`, each point named by its label in the messages."""
     if isinstance(pairs, (str, bytes, dict)) or not hasattr(pairs, "__iter__"):
-        raise ValueError(f"expected a list of [azimuth, elevation] pairs in degrees; got {type(pairs).__name__}")
+        raise ValueError(
+            f"expected a list of [azimuth, elevation] pairs in degrees; got {type(pairs).__name__}"
+        )
     points = {}
     for label, pair in zip(labels, pairs):
         if isinstance(pair, (str, bytes, dict)) or not hasattr(pair, "__len__") or len(pair) != 2:
-            raise ValueError(f"{label}: expected an [azimuth, elevation] pair in degrees; got {_quote(pair)}")
+            raise ValueError(
+                f"{label}: expected an [azimuth, elevation] pair in degrees; got {_quote(pair)}"
+            )
         azimuth, elevation = _number(pair[0]), _number(pair[1])
         if azimuth is None or elevation is None:
-            raise ValueError(f"{label}: azimuth and elevation must be finite numbers [deg]; got {_quote(pair)}")
+            raise ValueError(
+                f"{label}: azimuth and elevation must be finite numbers [deg]; got {_quote(pair)}"
+            )
         if not 0.0 <= azimuth <= 360.0:
-            raise ValueError(f"{label}: azimuth {azimuth:g} deg is outside [0, 360] (clockwise from north)")
+            raise ValueError(
+                f"{label}: azimuth {azimuth:g} deg is outside [0, 360] (clockwise from north)"
+            )
         if elevation > 90.0:
             raise ValueError(f"{label}: elevation {elevation:g} deg is above 90")
-        azimuth, elevation = azimuth % 360.0, max(elevation, 0.0)  # 360 is north again; see horizon_profile
+        azimuth, elevation = (
+            azimuth % 360.0,
+            max(elevation, 0.0),
+        )  # 360 is north again; see horizon_profile
         if azimuth in points and points[azimuth][1] != elevation:
             other, seen = points[azimuth]
-            raise ValueError(f"azimuth {azimuth:g} deg is given twice, at {other} and {label}, with elevations "
-                             f"{seen:g} and {elevation:g} deg")
+            raise ValueError(
+                f"azimuth {azimuth:g} deg is given twice, at {other} and {label}, with elevations "
+                f"{seen:g} and {elevation:g} deg"
+            )
         points.setdefault(azimuth, (label, elevation))
     if len(points) < 2:
         raise ValueError(f"a horizon needs at least 2 distinct azimuths; got {len(points)}")
@@ -152,13 +167,21 @@ def _json_points(text: str, path: Path) -> list:
     outputs = data.get("outputs") if isinstance(data, dict) else None
     profile = outputs.get("horizon_profile") if isinstance(outputs, dict) else None
     if not isinstance(profile, list):
-        raise _Problem(f"{path}: JSON without outputs.horizon_profile, the list a PVGIS printhorizon response holds")
+        raise _Problem(
+            f"{path}: JSON without outputs.horizon_profile, the list a PVGIS printhorizon response holds"
+        )
     points = []
     for k, entry in enumerate(profile, start=1):
         label = f"outputs.horizon_profile[{k - 1}]"
-        if not isinstance(entry, dict) or _number(entry.get("A")) is None or _number(entry.get("H_hor")) is None:
-            raise _Problem(f"{path}, {label}: expected {{\"A\": azimuth, \"H_hor\": elevation}} (numbers, deg); got "
-                           f"{_quote(entry)}")
+        if (
+            not isinstance(entry, dict)
+            or _number(entry.get("A")) is None
+            or _number(entry.get("H_hor")) is None
+        ):
+            raise _Problem(
+                f'{path}, {label}: expected {{"A": azimuth, "H_hor": elevation}} (numbers, deg); got '
+                f"{_quote(entry)}"
+            )
         points.append((label, (float(entry["A"]), float(entry["H_hor"]))))
     return _from_pvgis(points)
 
@@ -179,14 +202,16 @@ def _table_points(lines: list[str], path: Path) -> list | None:
     a_col = names.index("a") if "a" in names else names.index("a_hor")
     h_col = names.index("h_hor")
     points = []
-    for offset, row in enumerate(lines[number + 1:], start=number + 2):
+    for offset, row in enumerate(lines[number + 1 :], start=number + 2):
         cells = _cells(row)
         try:
             pair = (float(cells[a_col]), float(cells[h_col]))
         except (IndexError, ValueError):
             if points:  # the table ends at its first line that is not one of numbers (the legend)
                 break
-            raise _Problem(f"{path}, line {offset}: expected the numbers of columns A and H_hor [deg]") from None
+            raise _Problem(
+                f"{path}, line {offset}: expected the numbers of columns A and H_hor [deg]"
+            ) from None
         points.append((f"line {offset}", pair))
     if not points:
         raise _Problem(f"{path}: the table of A and H_hor has no rows")
@@ -199,13 +224,17 @@ def _csv_points(lines: list[str], path: Path) -> list | None:
     if first is None or [cell.lower() for cell in _cells(lines[first])] != ["azimuth", "elevation"]:
         return None
     points = []
-    for offset, row in enumerate(csv.reader(io.StringIO("\n".join(lines[first + 1:]))), start=first + 2):
+    for offset, row in enumerate(
+        csv.reader(io.StringIO("\n".join(lines[first + 1 :]))), start=first + 2
+    ):
         if not any(cell.strip() for cell in row):
             continue
         try:
             azimuth, elevation = (float(cell) for cell in row)
         except ValueError:
-            raise _Problem(f"{path}, line {offset}: expected azimuth,elevation (two numbers, deg)") from None
+            raise _Problem(
+                f"{path}, line {offset}: expected azimuth,elevation (two numbers, deg)"
+            ) from None
         points.append((f"line {offset}", (azimuth, elevation)))
     return points
 

@@ -49,7 +49,9 @@ class Horizon(StrictModel):
     @model_validator(mode="after")
     def _one_profile(self, info: ValidationInfo):
         if self.points is None and self.file is None:
-            raise ValueError("give the horizon as points (a list of [azimuth, elevation] in degrees) or as file")
+            raise ValueError(
+                "give the horizon as points (a list of [azimuth, elevation] in degrees) or as file"
+            )
         files = FilesRead.given(info)
         if self.file is not None and files is not None:
             if files.horizon_problem is not None:

@@ -40,7 +40,9 @@ def land_fraction() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if stored is not None:
         return stored["latitude"], stored["longitude"], stored["fraction"]
     latitude, longitude, fraction = _build()
-    store_cache(path, {"latitude": latitude, "longitude": longitude, "fraction": fraction}, compress=True)
+    store_cache(
+        path, {"latitude": latitude, "longitude": longitude, "fraction": fraction}, compress=True
+    )
     return latitude, longitude, fraction
 
 
@@ -48,12 +50,16 @@ def _build() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`land_fraction` from the full mask."""
     from global_land_mask import globe  # loads the full mask: seconds, once per cache
 
-    water = globe._mask  # (21600, 43200) True on water, latitude descending from 90, longitude from -180
+    water = (
+        globe._mask
+    )  # (21600, 43200) True on water, latitude descending from 90, longitude from -180
     rows, columns = water.shape[0] // _FACTOR, water.shape[1] // _FACTOR
     fraction = np.zeros((rows, columns), dtype=np.float32)
     for start in range(0, rows, 120):  # in bands, to keep the float copy small
-        band = water[start * _FACTOR:(start + 120) * _FACTOR].reshape(-1, _FACTOR, columns, _FACTOR)
-        fraction[start:start + 120] = 1.0 - band.mean(axis=(1, 3), dtype=np.float32)
+        band = water[start * _FACTOR : (start + 120) * _FACTOR].reshape(
+            -1, _FACTOR, columns, _FACTOR
+        )
+        fraction[start : start + 120] = 1.0 - band.mean(axis=(1, 3), dtype=np.float32)
     fraction = fraction[::-1].copy()  # latitude ascending
     step = 180.0 / rows
     latitude = -90 + step * (np.arange(rows) + 0.5)
@@ -81,9 +87,14 @@ def is_land(latitude, longitude) -> np.ndarray:
     """
     lat_centres, lon_centres, fraction = land_fraction()
     step = lat_centres[1] - lat_centres[0]
-    rows = np.clip(((np.asarray(latitude, dtype=float) + 90) / step).astype(int), 0, lat_centres.size - 1)
-    columns = np.clip(((np.asarray(longitude, dtype=float) + 180) / step).astype(int) % lon_centres.size, 0,
-                      lon_centres.size - 1)
+    rows = np.clip(
+        ((np.asarray(latitude, dtype=float) + 90) / step).astype(int), 0, lat_centres.size - 1
+    )
+    columns = np.clip(
+        ((np.asarray(longitude, dtype=float) + 180) / step).astype(int) % lon_centres.size,
+        0,
+        lon_centres.size - 1,
+    )
     return fraction[rows, columns] >= 0.5
 
 
@@ -109,7 +120,15 @@ def draw_coastlines(ax, color: str = "0.3", linewidth: float = 0.5) -> bool:
         latitude, longitude, fraction = land_fraction()
     except ImportError:
         return False
-    coarse = fraction.reshape(fraction.shape[0] // 3, 3, fraction.shape[1] // 3, 3).mean(axis=(1, 3))
-    ax.contour(longitude.reshape(-1, 3).mean(axis=1), latitude.reshape(-1, 3).mean(axis=1), coarse, levels=[0.5],
-               colors=color, linewidths=linewidth)
+    coarse = fraction.reshape(fraction.shape[0] // 3, 3, fraction.shape[1] // 3, 3).mean(
+        axis=(1, 3)
+    )
+    ax.contour(
+        longitude.reshape(-1, 3).mean(axis=1),
+        latitude.reshape(-1, 3).mean(axis=1),
+        coarse,
+        levels=[0.5],
+        colors=color,
+        linewidths=linewidth,
+    )
     return True

@@ -42,13 +42,20 @@ def profile_steps(value: dict) -> dict:
         finite number >= 0, or one time given twice (``7:00`` beside ``07:00``).
     """
     if not isinstance(value, dict) or not value:
-        raise ValueError("expected a mapping of clock times HH:MM to watts, e.g. {'07:00': 6, '19:00': 1.5}")
+        raise ValueError(
+            "expected a mapping of clock times HH:MM to watts, e.g. {'07:00': 6, '19:00': 1.5}"
+        )
     steps, given = {}, {}
     for time, watts in value.items():
         match = _CLOCK.match(str(time).strip())
         if not match:
             raise ValueError(f"{time!r} is not a clock time HH:MM in [00:00, 23:59]")
-        if isinstance(watts, bool) or not isinstance(watts, (int, float)) or not math.isfinite(watts) or watts < 0:
+        if (
+            isinstance(watts, bool)
+            or not isinstance(watts, (int, float))
+            or not math.isfinite(watts)
+            or watts < 0
+        ):
             raise ValueError(f"{time}: {watts!r} is not a load in watts >= 0")
         clock = f"{int(match.group(1)):02d}:{match.group(2)}"
         if clock in given:  # 7:00 beside 07:00: one of the two loads would be dropped unseen
@@ -66,8 +73,12 @@ def _day(steps: dict, clock_hours, linear: bool):
     watts = np.array(list(steps.values()))
     if linear:
         # Periodic: the last point joins the first across midnight.
-        return np.interp(clock_hours, np.r_[times - 24.0, times, times + 24.0], np.r_[watts, watts, watts])
-    index = np.searchsorted(times, clock_hours, side="right") - 1  # -1: before the first time, the last's load
+        return np.interp(
+            clock_hours, np.r_[times - 24.0, times, times + 24.0], np.r_[watts, watts, watts]
+        )
+    index = (
+        np.searchsorted(times, clock_hours, side="right") - 1
+    )  # -1: before the first time, the last's load
     return watts[index]
 
 
@@ -126,7 +137,12 @@ def describe_load(study, p_load: float | None = None) -> dict:
     minutes = (np.arange(1440) + 0.5) / 60.0
     day = _day(profile.daily, minutes, profile.interpolation == "linear") * scale
     name = Path(profile.file).stem if profile.file else "daily"
-    return {"profile": name, "scale": scale, "mean_w": float(day.mean()), "peak_w": float(day.max())}
+    return {
+        "profile": name,
+        "scale": scale,
+        "mean_w": float(day.mean()),
+        "peak_w": float(day.max()),
+    }
 
 
 def load_text(study, p_load: float | None = None) -> str:

@@ -113,8 +113,11 @@ class Optimize(StrictModel):
     """
 
     vary: list[str] = Field(
-        default_factory=lambda: list(names.OPTIMIZE_VARIABLES), min_length=1, max_length=3,
-        description="fold_angle, tilt, azimuth: any of them")
+        default_factory=lambda: list(names.OPTIMIZE_VARIABLES),
+        min_length=1,
+        max_length=3,
+        description="fold_angle, tilt, azimuth: any of them",
+    )
     fold_angle: Bounds | None = Field(None, description="default the study's fold_angles")
     tilt: Bounds | None = Field(None, description="default 0 to 90 by 1 deg")
     azimuth: Bounds | None = Field(None, description="default facing the equator +-90 by 2 deg")
@@ -148,8 +151,10 @@ class Optimize(StrictModel):
     def _azimuth_bounds(cls, bounds):
         """Azimuths repeat after a turn: a wider range searches each direction again."""
         if bounds is not None and bounds.max - bounds.min > 360:
-            raise ValueError(f"{bounds.describe()}: spans {bounds.max - bounds.min:g} deg; at most 360 (azimuths "
-                             f"repeat after a turn)")
+            raise ValueError(
+                f"{bounds.describe()}: spans {bounds.max - bounds.min:g} deg; at most 360 (azimuths "
+                f"repeat after a turn)"
+            )
         return bounds
 
     def range_of(self, name: str, default: tuple) -> tuple:
@@ -178,8 +183,15 @@ class Optimize(StrictModel):
         equator : float, default 180
             The equator-facing azimuth [deg].
         """
-        defaults = {"fold_angle": (fold_angles.start, fold_angles.stop, fold_angles.step), "tilt": DEFAULT_TILT,
-                    "azimuth": (equator - DEFAULT_AZIMUTH_SPAN, equator + DEFAULT_AZIMUTH_SPAN, DEFAULT_AZIMUTH_STEP)}
+        defaults = {
+            "fold_angle": (fold_angles.start, fold_angles.stop, fold_angles.step),
+            "tilt": DEFAULT_TILT,
+            "azimuth": (
+                equator - DEFAULT_AZIMUTH_SPAN,
+                equator + DEFAULT_AZIMUTH_SPAN,
+                DEFAULT_AZIMUTH_STEP,
+            ),
+        }
         return self.range_of(name, defaults[name])
 
     def size_problem(self, fold_angles) -> str | None:
@@ -202,20 +214,30 @@ class Optimize(StrictModel):
         designs = math.prod(counts.values())
         largest = max(counts, key=counts.get)
         bounds = getattr(self, largest)
-        setting = (f"optimize.{largest} = {bounds.describe()}" if bounds is not None
-                   else f"fold_angles.step = {fold_angles.step:g}")  # only the fold angle's default grid varies
+        setting = (
+            f"optimize.{largest} = {bounds.describe()}"
+            if bounds is not None
+            else f"fold_angles.step = {fold_angles.step:g}"
+        )  # only the fold angle's default grid varies
         nouns = {"fold_angle": "fold angles", "tilt": "tilts", "azimuth": "azimuths"}
         if counts[largest] > MAX_AXIS_VALUES:
-            return (f"{setting}: {counts[largest]:,} {nouns[largest]}; the limit is {MAX_AXIS_VALUES:,} values a "
-                    f"range (a coarser step, or FOLDOPT_MAX_AXIS_VALUES)")
+            return (
+                f"{setting}: {counts[largest]:,} {nouns[largest]}; the limit is {MAX_AXIS_VALUES:,} values a "
+                f"range (a coarser step, or FOLDOPT_MAX_AXIS_VALUES)"
+            )
         if designs > MAX_DESIGNS:
-            return (f"{setting}: {' x '.join(f'{counts[name]:,} {nouns[name]}' for name in counts)} = "
-                    f"{designs:.2g} designs to search; the limit is {MAX_DESIGNS:,} (a coarser step, or "
-                    f"FOLDOPT_MAX_DESIGNS)")
+            return (
+                f"{setting}: {' x '.join(f'{counts[name]:,} {nouns[name]}' for name in counts)} = "
+                f"{designs:.2g} designs to search; the limit is {MAX_DESIGNS:,} (a coarser step, or "
+                f"FOLDOPT_MAX_DESIGNS)"
+            )
         return None
 
     def idle_settings(self) -> list[str]:
         """``optimize.name = ...: why`` for the bounds of a variable that does not vary."""
-        return [f"optimize.{name} = {getattr(self, name).describe()}: is only used where optimize.vary names "
-                f"{name}" for name in names.OPTIMIZE_VARIABLES if getattr(self, name) is not None
-                and name not in self.vary]
+        return [
+            f"optimize.{name} = {getattr(self, name).describe()}: is only used where optimize.vary names "
+            f"{name}"
+            for name in names.OPTIMIZE_VARIABLES
+            if getattr(self, name) is not None and name not in self.vary
+        ]

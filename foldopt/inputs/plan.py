@@ -103,8 +103,10 @@ def parse_range(text: str) -> list[float]:
         raise ValueError(f"empty range {text!r}: stop is below start")
     count = math.floor((stop - start) / step + 1e-9) + 1
     if count > MAX_AXIS_VALUES:
-        raise ValueError(f"{text!r} has {count:,} values; at most {MAX_AXIS_VALUES:,} per axis "
-                         "(FOLDOPT_MAX_AXIS_VALUES raises it)")
+        raise ValueError(
+            f"{text!r} has {count:,} values; at most {MAX_AXIS_VALUES:,} per axis "
+            "(FOLDOPT_MAX_AXIS_VALUES raises it)"
+        )
     return [round(start + i * step, 12) for i in range(count)]
 
 
@@ -139,8 +141,10 @@ def parse_values(text: str, numeric: bool = True):
     if any(not item for item in items):
         raise ValueError(f"{text!r} has an empty item; a list is a,b,c")
     if len(items) > MAX_AXIS_VALUES:
-        raise ValueError(f"a list of {len(items):,} values; at most {MAX_AXIS_VALUES:,} per axis "
-                         "(FOLDOPT_MAX_AXIS_VALUES raises it)")
+        raise ValueError(
+            f"a list of {len(items):,} values; at most {MAX_AXIS_VALUES:,} per axis "
+            "(FOLDOPT_MAX_AXIS_VALUES raises it)"
+        )
     if not numeric:
         return items if len(items) > 1 else items[0]
     if len(items) == 1 and ":" in text:
@@ -148,7 +152,9 @@ def parse_values(text: str, numeric: bool = True):
     try:
         values = [float(item) for item in items]
     except ValueError:
-        raise ValueError(f"{text!r}: expected a number, a range start:stop:step or a list a,b,c") from None
+        raise ValueError(
+            f"{text!r}: expected a number, a range start:stop:step or a list a,b,c"
+        ) from None
     if not all(math.isfinite(value) for value in values):
         raise ValueError(f"{text!r}: values must be finite numbers")
     return values if len(values) > 1 else values[0]
@@ -196,13 +202,21 @@ def parse_dates(spec, year: int) -> list[dt.date]:
         days = 366 if _leap(year) else 365
         return [dt.date(year, 1, 1) + dt.timedelta(days=i) for i in range(days)]
     if spec == "equinoxes-solstices":
-        return [dt.date(year, 3, 20), dt.date(year, 6, 21), dt.date(year, 9, 23), dt.date(year, 12, 21)]
+        return [
+            dt.date(year, 3, 20),
+            dt.date(year, 6, 21),
+            dt.date(year, 9, 23),
+            dt.date(year, 12, 21),
+        ]
     match = _RANGE.match(str(spec)) if isinstance(spec, str) else None
     if match:
         start, stop, step = match.groups()
         if not step.isdigit() or int(step) < 1:
             raise ValueError(f"the step of a date range is a whole number of days, got {step!r}")
-        first, last = one(int(start) if start.isdigit() else start), one(int(stop) if stop.isdigit() else stop)
+        first, last = (
+            one(int(start) if start.isdigit() else start),
+            one(int(stop) if stop.isdigit() else stop),
+        )
         if last < first:
             raise ValueError(f"empty range {spec!r}: stop is before start")
         return [first + dt.timedelta(days=d) for d in range(0, (last - first).days + 1, int(step))]
@@ -280,8 +294,11 @@ def _listed_leaves(data: dict, prefix: str = ""):
     :func:`~foldopt.inputs.fields.list_valued_fields`), a numeric range or a date keyword."""
     for key, value in data.items():
         path = f"{prefix}{key}"
-        if path == "date" and (isinstance(value, list) or value in DATE_KEYWORDS
-                               or (isinstance(value, str) and _RANGE.match(value))):
+        if path == "date" and (
+            isinstance(value, list)
+            or value in DATE_KEYWORDS
+            or (isinstance(value, str) and _RANGE.match(value))
+        ):
             yield path, value
         elif isinstance(value, list) and list_depth(value) == _LIST_VALUED.get(path):
             continue
@@ -321,10 +338,17 @@ def check_distinct(values, noun: str = "value", label=None) -> list:
         except TypeError:  # a list as one value
             key = repr(key)
         if key in first:
-            shown = label(value) if label else f"{value:g}" if isinstance(value, float) else (
-                f"the same {noun}" if isinstance(value, (dict, list)) else str(value))
-            raise ValueError(f"{shown} is given twice ({noun}s {first[key] + 1} and {index + 1}); give each "
-                             f"{noun} once")
+            shown = (
+                label(value)
+                if label
+                else f"{value:g}"
+                if isinstance(value, float)
+                else (f"the same {noun}" if isinstance(value, (dict, list)) else str(value))
+            )
+            raise ValueError(
+                f"{shown} is given twice ({noun}s {first[key] + 1} and {index + 1}); give each "
+                f"{noun} once"
+            )
         first[key] = index
     return values
 
@@ -336,8 +360,10 @@ def _axis_values(path: str, spec, year: int) -> list:
         if not spec:
             raise ValueError("empty list")
         if len(spec) > MAX_AXIS_VALUES:
-            raise ValueError(f"a list of {len(spec):,} values; at most {MAX_AXIS_VALUES:,} per axis "
-                             "(FOLDOPT_MAX_AXIS_VALUES raises it)")
+            raise ValueError(
+                f"a list of {len(spec):,} values; at most {MAX_AXIS_VALUES:,} per axis "
+                "(FOLDOPT_MAX_AXIS_VALUES raises it)"
+            )
         return check_distinct(spec)
     if isinstance(spec, str) and _RANGE.match(spec):
         return parse_range(spec)
@@ -382,7 +408,9 @@ def make_plan(data, lines: dict | None = None) -> Plan:
         year = 2025
     sweep = data.pop("sweep", None) or {}
     if not isinstance(sweep, dict):
-        errors.append(_at(lines, ("sweep",), "sweep: expected a mapping of field paths to lists or ranges"))
+        errors.append(
+            _at(lines, ("sweep",), "sweep: expected a mapping of field paths to lists or ranges")
+        )
         sweep = {}
     # Each axis: dotted field path -> (name in messages, key path in the YAML, its spec).
     specs = {path: (path, tuple(path.split(".")), value) for path, value in _listed_leaves(data)}
@@ -391,8 +419,14 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     axes = []
     for path, (source, yaml_path, spec) in specs.items():
         if path in UNSWEPT:
-            errors.append(_at(lines, yaml_path, f"{source}: the study's {path} labels its results, it is not "
-                                                f"sweepable; give one {path}"))
+            errors.append(
+                _at(
+                    lines,
+                    yaml_path,
+                    f"{source}: the study's {path} labels its results, it is not "
+                    f"sweepable; give one {path}",
+                )
+            )
             continue
         try:
             values = _axis_values(path, spec, year)
@@ -408,10 +442,20 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     ensemble = isinstance(weather, dict) and weather.get("members") is not None
     if data.get("objective") is not None and "date" not in dict(axes) and not ensemble:
         # Said beside the objective's own faults (a misspelt statistic), not instead of them.
-        errors.append(_at(lines, ("objective",), "objective: one fold angle for several days needs several "
-                                                 "dates (a date range, 'year', or a weather file)"))
+        errors.append(
+            _at(
+                lines,
+                ("objective",),
+                "objective: one fold angle for several days needs several "
+                "dates (a date range, 'year', or a weather file)",
+            )
+        )
     if plan.n_cases > MAX_CASES:
-        raise ConfigError([f"sweep: {plan.n_cases:,} cases; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
+        raise ConfigError(
+            [
+                f"sweep: {plan.n_cases:,} cases; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"
+            ]
+        )
     first = {path: values[0] for path, values in axes}
     labels = {path: (f"{specs[path][0]}[0]", specs[path][1] + (0,)) for path in first}
     errors += _validation_errors(plan, first, lines, labels)
@@ -436,15 +480,23 @@ def _check_size(plan: Plan) -> None:
     site_days = plan.n_cases // loads
     evaluations = site_days * angles * steps
     if evaluations > MAX_EVALUATIONS:
-        raise ConfigError([f"study: {site_days:,} site-days x {angles} fold angles x {steps:,} steps = "
-                           f"{evaluations:.2g} evaluations; the limit is {MAX_EVALUATIONS:.2g} (a coarser "
-                           "fold_angles or step_min, fewer cases, or FOLDOPT_MAX_EVALUATIONS)"])
+        raise ConfigError(
+            [
+                f"study: {site_days:,} site-days x {angles} fold angles x {steps:,} steps = "
+                f"{evaluations:.2g} evaluations; the limit is {MAX_EVALUATIONS:.2g} (a coarser "
+                "fold_angles or step_min, fewer cases, or FOLDOPT_MAX_EVALUATIONS)"
+            ]
+        )
     if base.objective is not None and "date" in axes:
         cells = len(axes["date"]) * angles * loads
         if cells > MAX_ANNUAL_CELLS:
-            raise ConfigError([f"objective: {len(axes['date'])} days x {angles} fold angles x {loads} loads = "
-                               f"{cells:.2g} values held at once; the limit is {MAX_ANNUAL_CELLS:.2g} (fewer loads "
-                               "or angles, or FOLDOPT_MAX_ANNUAL_CELLS)"])
+            raise ConfigError(
+                [
+                    f"objective: {len(axes['date'])} days x {angles} fold angles x {loads} loads = "
+                    f"{cells:.2g} values held at once; the limit is {MAX_ANNUAL_CELLS:.2g} (fewer loads "
+                    "or angles, or FOLDOPT_MAX_ANNUAL_CELLS)"
+                ]
+            )
 
 
 _INDEXED = re.compile(r"^(?P<field>[^\[\s]+)\[(?P<index>\d+)\] = (?P<value>.*?): (?P<problem>.*)$")

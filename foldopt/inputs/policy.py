@@ -35,11 +35,15 @@ SECTIONS = ("site", "panel", "tracker", "objective", "fold_angles", "near_optima
 #: Fields that take a paper-mode study away from the paper's site and day.
 AWAY_FROM_PAPER = ("site.latitude", "site.longitude", "site.altitude", "date", "weather")
 #: What the policy says where it switches a paper-mode study to exact mode.
-EXACT_NOTE = "exact mode (paper mode is for the paper's own site and day: set mode paper to keep it)"
+EXACT_NOTE = (
+    "exact mode (paper mode is for the paper's own site and day: set mode paper to keep it)"
+)
 #: An optimisation that turns or re-tilts the panel leaves paper mode too: Shin et al.'s Eq. 5 is the
 #: angle of incidence only for a surface facing the sun's azimuth, so it would choose the mounting.
-MOUNTING_NOTE = ("exact mode (the paper's Eq. 5 is no angle of incidence for a re-tilted or turned panel: set "
-                 "mode paper to keep it)")
+MOUNTING_NOTE = (
+    "exact mode (the paper's Eq. 5 is no angle of incidence for a re-tilted or turned panel: set "
+    "mode paper to keep it)"
+)
 
 
 #: Sections a study may give as one value, and the field that value is.
@@ -138,8 +142,12 @@ def is_single(value) -> bool:
         True for a value that is no list, range, list text (``a,b``) or date keyword.
     """
     text = str(value)
-    return (not isinstance(value, (list, tuple)) and ":" not in text and "," not in text
-            and text not in ("year", "equinoxes-solstices"))
+    return (
+        not isinstance(value, (list, tuple))
+        and ":" not in text
+        and "," not in text
+        and text not in ("year", "equinoxes-solstices")
+    )
 
 
 def _varied(optimize) -> list[str]:
@@ -183,23 +191,37 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     weather = changes.get("weather")
     if weather is not None:
         data.pop("sky", None)  # the file's light is shaped by its own clear sky
-        if not (touched(given, "site.latitude") or touched(given, "site.longitude") or "site" in given):
+        if not (
+            touched(given, "site.latitude") or touched(given, "site.longitude") or "site" in given
+        ):
             data.pop("site", None)  # the file's site
         if not touched(given, "date"):
             data.pop("date", None)  # the file's year, or a measured file's days
-        fmt = changes.get("weather.format", weather.get("format") if isinstance(weather, dict) else None)
+        fmt = changes.get(
+            "weather.format", weather.get("format") if isinstance(weather, dict) else None
+        )
         try:
-            measured = fmt is not None and canonical(fmt, WEATHER_FORMATS) not in HOURLY_WEATHER_FORMATS
+            measured = (
+                fmt is not None and canonical(fmt, WEATHER_FORMATS) not in HOURLY_WEATHER_FORMATS
+            )
         except ValueError:
             measured = False  # no format: the study's validation names it
         if measured and not touched(given, "step_min"):
             data.pop("step_min", None)  # a measured file's own step
     old_mode = data.get("mode", "exact")
-    if old_mode == "paper" and "mode" not in given and any(touched(given, path) for path in AWAY_FROM_PAPER):
+    if (
+        old_mode == "paper"
+        and "mode" not in given
+        and any(touched(given, path) for path in AWAY_FROM_PAPER)
+    ):
         data["mode"] = "exact"
         decided.append(EXACT_NOTE)
-    if (data.get("mode", "exact") == "paper" and "mode" not in given and touched(given, "optimize")
-            and {"tilt", "azimuth"} & set(_varied(changes.get("optimize", data.get("optimize"))))):
+    if (
+        data.get("mode", "exact") == "paper"
+        and "mode" not in given
+        and touched(given, "optimize")
+        and {"tilt", "azimuth"} & set(_varied(changes.get("optimize", data.get("optimize"))))
+    ):
         data["mode"] = "exact"
         decided.append(MOUNTING_NOTE)
     new_mode = changes.get("mode", data.get("mode", "exact"))
@@ -207,11 +229,18 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         if new_mode != old_mode and field not in given:
             data.pop(field, None)  # the new mode's own
     site = data.get("site")
-    moved = touched(given, "site.latitude") or touched(given, "site.longitude") or (
-        weather is not None and "site" not in data)
+    moved = (
+        touched(given, "site.latitude")
+        or touched(given, "site.longitude")
+        or (weather is not None and "site" not in data)
+    )
     if isinstance(site, dict) and moved and not touched(given, "site.name"):
         site.pop("name", None)
-    if isinstance(site, dict) and touched(given, "site.longitude") and not touched(given, "site.timezone"):
+    if (
+        isinstance(site, dict)
+        and touched(given, "site.longitude")
+        and not touched(given, "site.timezone")
+    ):
         site.pop("timezone", None)  # the new longitude's standard offset
     new_latitude = touched(given, "site.latitude") or (weather is not None and "site" not in data)
     if new_latitude and not (touched(given, "panel.tilt") or touched(given, "panel.azimuth")):
@@ -225,8 +254,16 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         data["tracker"] = {key: tracker[key] for key in ("standby_w",) if key in tracker}
     if "fold_angles.step" in given and "fold_angles.start" not in given:
         step = changes["fold_angles.step"]
-        data["fold_angles"] = {"start": step, "stop": changes.get("fold_angles.stop", 180.0), "step": step}
-    if "load_profile" in given and changes.get("load_profile") is not None and "p_load" not in given:
+        data["fold_angles"] = {
+            "start": step,
+            "stop": changes.get("fold_angles.stop", 180.0),
+            "step": step,
+        }
+    if (
+        "load_profile" in given
+        and changes.get("load_profile") is not None
+        and "p_load" not in given
+    ):
         data["p_load"] = 1.0  # the profile as written, not the study's constant load
     for path, value in changes.items():
         data = set_path(data, path, value)

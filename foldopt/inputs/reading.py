@@ -48,8 +48,12 @@ MAX_MEASURED_STEPS = size_limit("MAX_MEASURED_STEPS", 2 * 366 * 1440)
 
 
 #: What :func:`check_input` calls a file that is no regular file, by its type.
-_SPECIAL_FILES = ((stat.S_ISCHR, "character device"), (stat.S_ISBLK, "block device"), (stat.S_ISFIFO, "FIFO"),
-                  (stat.S_ISSOCK, "socket"))
+_SPECIAL_FILES = (
+    (stat.S_ISCHR, "character device"),
+    (stat.S_ISBLK, "block device"),
+    (stat.S_ISFIFO, "FIFO"),
+    (stat.S_ISSOCK, "socket"),
+)
 
 
 def _size_text(size: int) -> str:
@@ -61,7 +65,9 @@ def _size_text(size: int) -> str:
     return f"{size} bytes"
 
 
-def _refuse(info: os.stat_result, path: Path, field: str, limit: int, limit_name: str, what: str) -> None:
+def _refuse(
+    info: os.stat_result, path: Path, field: str, limit: int, limit_name: str, what: str
+) -> None:
     """Raise :class:`ConfigError` unless ``info`` is a regular file of at most ``limit`` bytes."""
     if stat.S_ISDIR(info.st_mode):
         raise ConfigError([f"{field}: {path} is a folder, not a file; give a file"])
@@ -69,8 +75,12 @@ def _refuse(info: os.stat_result, path: Path, field: str, limit: int, limit_name
     if kind is not None:
         raise ConfigError([f"{field}: {path} is a {kind}, not a regular file; give a file"])
     if info.st_size > limit:
-        raise ConfigError([f"{field}: {path} is {info.st_size:,} bytes ({_size_text(info.st_size)}): larger than "
-                           f"any {what} foldopt reads, at most {limit:,} bytes (FOLDOPT_{limit_name} raises it)"])
+        raise ConfigError(
+            [
+                f"{field}: {path} is {info.st_size:,} bytes ({_size_text(info.st_size)}): larger than "
+                f"any {what} foldopt reads, at most {limit:,} bytes (FOLDOPT_{limit_name} raises it)"
+            ]
+        )
 
 
 def _not_found(path: Path, field: str) -> str:
@@ -80,7 +90,9 @@ def _not_found(path: Path, field: str) -> str:
     return f"{field}: file not found: {path}"
 
 
-def check_input(path: Path | str, field: str, limit: int, limit_name: str, what: str = "input file") -> None:
+def check_input(
+    path: Path | str, field: str, limit: int, limit_name: str, what: str = "input file"
+) -> None:
     """Refuse, before anything reads it, an input file that is missing, no regular file (a folder,
     a device or a FIFO: a device never ends, a FIFO may never start) or larger than ``limit``: for
     readers that open the file themselves (pvlib's), as :func:`read_input` does for its own.
@@ -108,11 +120,15 @@ def check_input(path: Path | str, field: str, limit: int, limit_name: str, what:
     except FileNotFoundError:
         raise ConfigError([_not_found(path, field)]) from None
     except OSError as error:
-        raise ConfigError([f"{field}: cannot read {path}: {error.strerror or error.__class__.__name__}"]) from None
+        raise ConfigError(
+            [f"{field}: cannot read {path}: {error.strerror or error.__class__.__name__}"]
+        ) from None
     _refuse(info, path, field, limit, limit_name, what)
 
 
-def read_input(path: Path | str, field: str, limit: int, limit_name: str, what: str = "input file") -> str:
+def read_input(
+    path: Path | str, field: str, limit: int, limit_name: str, what: str = "input file"
+) -> str:
     """The text of an input file (a study, a table of sites, a load profile), read as UTF-8
     whatever the locale, a byte-order mark (a spreadsheet's "CSV UTF-8") dropped.
 
@@ -156,9 +172,15 @@ def read_input(path: Path | str, field: str, limit: int, limit_name: str, what: 
     except OSError as error:
         raise ConfigError([f"{field}: cannot read {path}: {error.__class__.__name__}"]) from None
     if len(data) > limit:
-        raise ConfigError([f"{field}: {path} is over {limit:,} bytes: larger than any {what} foldopt reads "
-                           f"(FOLDOPT_{limit_name} raises it)"])
+        raise ConfigError(
+            [
+                f"{field}: {path} is over {limit:,} bytes: larger than any {what} foldopt reads "
+                f"(FOLDOPT_{limit_name} raises it)"
+            ]
+        )
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
-        raise ConfigError([f"{field}: cannot read {path}: not UTF-8 text (byte {error.start + 1:,})"]) from None
+        raise ConfigError(
+            [f"{field}: cannot read {path}: not UTF-8 text (byte {error.start + 1:,})"]
+        ) from None

@@ -93,7 +93,9 @@ class Site(StrictModel):
     timezone: Annotated[str | None, AfterValidator(_check_timezone)] = Field(
         None, description="IANA name or UTC offset; default: the longitude's standard offset"
     )
-    horizon: Horizon | None = Field(None, description="(azimuth, elevation) points or a file; default an open plain")
+    horizon: Horizon | None = Field(
+        None, description="(azimuth, elevation) points or a file; default an open plain"
+    )
 
 
 def standard_timezone(longitude: float) -> str:
@@ -188,10 +190,14 @@ class Tracker(StrictModel):
 
     @model_validator(mode="after")
     def _offsets_match_steps(self):
-        offsets = self.step_offsets_h if self.step_offsets_h is not None else ALEXANDRU_STEP_OFFSETS_H
+        offsets = (
+            self.step_offsets_h if self.step_offsets_h is not None else ALEXANDRU_STEP_OFFSETS_H
+        )
         # A model that does not step leaves both idle: the study refuses them as such.
         if len(offsets) * 2 != self.steps and self.model in self.models_using("steps"):
-            raise ValueError(f"steps ({self.steps}) must be twice the number of step_offsets_h ({len(offsets)})")
+            raise ValueError(
+                f"steps ({self.steps}) must be twice the number of step_offsets_h ({len(offsets)})"
+            )
         return self
 
     @staticmethod
@@ -228,10 +234,14 @@ class Tracker(StrictModel):
             value = getattr(self, name)
             users = self.models_using(name) if name != "model" and value != field.default else ()
             if users and self.model not in users:
-                idle.append(f"tracker.{name} = {value!r}: is only used by tracker.model {' or '.join(users)}")
+                idle.append(
+                    f"tracker.{name} = {value!r}: is only used by tracker.model {' or '.join(users)}"
+                )
         if self.drive != "wh-per-degree" and self.wh_per_degree:
-            idle.append(f"tracker.wh_per_degree = {self.wh_per_degree!r}: is only used by tracker.drive "
-                        "wh-per-degree")
+            idle.append(
+                f"tracker.wh_per_degree = {self.wh_per_degree!r}: is only used by tracker.drive "
+                "wh-per-degree"
+            )
         return idle
 
 
@@ -252,10 +262,16 @@ class Objective(StrictModel):
         (:mod:`foldopt.engine.schedule`).
     """
 
-    statistic: str = Field("mean", description="mean | min | worst-month | pNN (a percentile, e.g. p10)")
-    months: list[Annotated[int, Field(ge=1, le=12)]] | None = Field(None, description="the season; default all")
+    statistic: str = Field(
+        "mean", description="mean | min | worst-month | pNN (a percentile, e.g. p10)"
+    )
+    months: list[Annotated[int, Field(ge=1, le=12)]] | None = Field(
+        None, description="the season; default all"
+    )
     visits: Annotated[int, Field(ge=1, le=12)] | None = Field(
-        None, description="also the best re-fold schedule of 1..visits settings a year (foldopt.engine.schedule)")
+        None,
+        description="also the best re-fold schedule of 1..visits settings a year (foldopt.engine.schedule)",
+    )
 
     @field_validator("statistic")
     @classmethod
@@ -268,7 +284,9 @@ class Objective(StrictModel):
     @model_validator(mode="after")
     def _schedulable(self):
         if self.visits is not None and self.statistic not in ("mean", "worst-month"):
-            raise ValueError(f"visits: a re-fold schedule maximises mean or worst-month, not {self.statistic}")
+            raise ValueError(
+                f"visits: a re-fold schedule maximises mean or worst-month, not {self.statistic}"
+            )
         if self.visits is not None and self.months:
             raise ValueError("visits: a re-fold schedule covers the whole year; leave months out")
         return self
@@ -305,7 +323,9 @@ class LoadProfile(StrictModel):
     @model_validator(mode="after")
     def _one_day(self, info: ValidationInfo):
         if (self.daily is None) == (self.file is None):
-            raise ValueError("give the day's loads as daily (a mapping HH:MM: watts) or as file (a CSV), not both")
+            raise ValueError(
+                "give the day's loads as daily (a mapping HH:MM: watts) or as file (a CSV), not both"
+            )
         files = FilesRead.given(info)
         if self.file is not None and files is not None:
             if files.profile_problem is not None:
@@ -338,10 +358,16 @@ class FoldAngles(StrictModel):
     def _bounded(cls, step: float, info: ValidationInfo):
         # Counted, not listed: a step of 1e-9 deg would list 1.8e11 angles before any limit looked.
         start, stop = info.data.get("start"), info.data.get("stop")
-        count = grid_points(start, stop, step) if start is not None and stop is not None and start <= stop else 0
+        count = (
+            grid_points(start, stop, step)
+            if start is not None and stop is not None and start <= stop
+            else 0
+        )
         if count > MAX_AXIS_VALUES:
-            raise ValueError(f"{count:,} fold angles from {start:g} to {stop:g}; the limit is {MAX_AXIS_VALUES:,} "
-                             "values a range (a coarser step, or FOLDOPT_MAX_AXIS_VALUES)")
+            raise ValueError(
+                f"{count:,} fold angles from {start:g} to {stop:g}; the limit is {MAX_AXIS_VALUES:,} "
+                "values a range (a coarser step, or FOLDOPT_MAX_AXIS_VALUES)"
+            )
         return step
 
     def count(self) -> int:

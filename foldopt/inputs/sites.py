@@ -27,7 +27,9 @@ WEATHER_SUFFIXES = (".csv", ".epw", ".json")
 SITE_COLUMNS = ("name", "latitude", "longitude", "altitude", "timezone", "horizon")
 
 
-def grid_sites(latitudes: Sequence[float], longitudes: Sequence[float], land_only: bool = False) -> list[dict]:
+def grid_sites(
+    latitudes: Sequence[float], longitudes: Sequence[float], land_only: bool = False
+) -> list[dict]:
     """Sites at every latitude x longitude [deg], latitude slowest; ``land_only`` keeps the points
     on land (:func:`foldopt.inputs.land.is_land`). A longitude of 180 is the same meridian as -180 and is
     dropped when both are given.
@@ -52,7 +54,9 @@ def grid_sites(latitudes: Sequence[float], longitudes: Sequence[float], land_onl
         With ``land_only``, without the ``global-land-mask`` package (``pip install foldopt[map]``).
     """
     longitudes = [lon for lon in longitudes if not (lon == 180 and -180 in longitudes)]
-    sites = [{"latitude": float(lat), "longitude": float(lon)} for lat in latitudes for lon in longitudes]
+    sites = [
+        {"latitude": float(lat), "longitude": float(lon)} for lat in latitudes for lon in longitudes
+    ]
     if land_only:
         from foldopt.inputs.land import is_land
 
@@ -121,35 +125,56 @@ def read_sites(path: Path | str) -> list[dict]:
     unknown = [name[:30] for name in header if name not in SITE_COLUMNS][:5]
     twice = sorted({name for name in header if header.count(name) > 1})
     if missing or unknown or twice:
-        raise ConfigError([f"--sites {path}: the header must name {', '.join(SITE_COLUMNS)} (name, altitude, "
-                           f"timezone and horizon optional); " + "; ".join(
-                               ([f"missing {', '.join(missing)}"] if missing else [])
-                               + ([f"unknown {', '.join(unknown)}"] if unknown else [])
-                               + ([f"{', '.join(twice)} twice"] if twice else []))])
+        raise ConfigError(
+            [
+                f"--sites {path}: the header must name {', '.join(SITE_COLUMNS)} (name, altitude, "
+                f"timezone and horizon optional); "
+                + "; ".join(
+                    ([f"missing {', '.join(missing)}"] if missing else [])
+                    + ([f"unknown {', '.join(unknown)}"] if unknown else [])
+                    + ([f"{', '.join(twice)} twice"] if twice else [])
+                )
+            ]
+        )
     sites, errors, named = [], [], {}
     for line, cells in rows:
-        if len(cells) > len(header):  # a cell more than the header names: a stray comma, or a shifted row
-            errors.append(f"--sites {path}, line {line}: {len(cells)} fields; the header names {len(header)}")
+        if len(cells) > len(
+            header
+        ):  # a cell more than the header names: a stray comma, or a shifted row
+            errors.append(
+                f"--sites {path}, line {line}: {len(cells)} fields; the header names {len(header)}"
+            )
             continue
         data = {key: value.strip() for key, value in zip(header, cells) if value.strip() != ""}
         if "horizon" in data:
             # A horizon file is named relative to the table of sites, and read here (the model opens none).
-            file = data["horizon"] if Path(data["horizon"]).is_absolute() else str(path.parent / data["horizon"])
+            file = (
+                data["horizon"]
+                if Path(data["horizon"]).is_absolute()
+                else str(path.parent / data["horizon"])
+            )
             try:
                 azimuth, elevation = read_horizon(file)
             except ConfigError as error:
                 errors.append(f"--sites {path}, line {line}: {error.errors[0]}")
                 continue
-            data["horizon"] = {"file": file, "points": [[float(a), float(e)] for a, e in zip(azimuth, elevation)]}
+            data["horizon"] = {
+                "file": file,
+                "points": [[float(a), float(e)] for a, e in zip(azimuth, elevation)],
+            }
         try:
             site = Site.model_validate(data)
         except ValidationError as error:
-            errors += [f"--sites {path}, line {line}: {message}" for message in format_errors(error)]
+            errors += [
+                f"--sites {path}, line {line}: {message}" for message in format_errors(error)
+            ]
             continue
         if site.name is not None:
             if site.name in named:  # the map's rows and figures tell sites by name
-                errors.append(f"--sites {path}, line {line}: name {site.name!r} is also on line {named[site.name]}; "
-                              "give each site its own name")
+                errors.append(
+                    f"--sites {path}, line {line}: name {site.name!r} is also on line {named[site.name]}; "
+                    "give each site its own name"
+                )
                 continue
             named[site.name] = line
         sites.append(site.model_dump(exclude_none=True))
@@ -187,12 +212,25 @@ def weather_sites(folder: Path | str) -> list[dict]:
     folder = Path(folder)
     if not folder.is_dir():
         raise ConfigError([f"--weather-dir: not a folder: {folder}"])
-    files = sorted(path for path in folder.iterdir() if path.suffix.lower() in WEATHER_SUFFIXES and path.is_file())
+    files = sorted(
+        path
+        for path in folder.iterdir()
+        if path.suffix.lower() in WEATHER_SUFFIXES and path.is_file()
+    )
     if not files:
-        raise ConfigError([f"--weather-dir {folder}: no weather files ({', '.join(WEATHER_SUFFIXES)})"])
+        raise ConfigError(
+            [f"--weather-dir {folder}: no weather files ({', '.join(WEATHER_SUFFIXES)})"]
+        )
     sites = []
     for path in files:
         site = weather_site(str(path), None)
-        sites.append({"weather": str(path), "name": site["name"] or path.stem, "latitude": site["latitude"],
-                      "longitude": site["longitude"], "altitude": site.get("altitude", 0.0)})
+        sites.append(
+            {
+                "weather": str(path),
+                "name": site["name"] or path.stem,
+                "latitude": site["latitude"],
+                "longitude": site["longitude"],
+                "altitude": site.get("altitude", 0.0),
+            }
+        )
     return sites

@@ -14,8 +14,15 @@ import datetime as dt
 import math
 from typing import Annotated
 
-from pydantic import (AfterValidator, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator,
-                      model_validator)
+from pydantic import (
+    AfterValidator,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from foldopt import names
 from foldopt.errors import ConfigError
@@ -23,8 +30,16 @@ from foldopt.inputs import policy
 from foldopt.inputs.circuit_section import Circuit
 from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
 from foldopt.inputs.optimize_section import Optimize
-from foldopt.inputs.sections import (FoldAngles, LoadProfile, NearOptimal, Objective, Panel, Site, Tracker,
-                                     standard_timezone)
+from foldopt.inputs.sections import (
+    FoldAngles,
+    LoadProfile,
+    NearOptimal,
+    Objective,
+    Panel,
+    Site,
+    Tracker,
+    standard_timezone,
+)
 from foldopt.inputs.weather_section import Weather
 
 #: Each mode's default clear sky: pvlib's Ineichen (with diffuse light, Perez transposition at the
@@ -150,22 +165,31 @@ class Study(StrictModel):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=100)]
     description: str = ""
     mode: named(names.MODES) = "exact"
-    site: Site = Field(description="default with a weather file: the file's own site")  # None: unread
-    force_site: bool = Field(False, description="keep a site more than SITE_TOLERANCE_KM from the weather file's")
+    site: Site = Field(
+        description="default with a weather file: the file's own site"
+    )  # None: unread
+    force_site: bool = Field(
+        False, description="keep a site more than SITE_TOLERANCE_KM from the weather file's"
+    )
     date: dt.date
     panel: Panel
     p_load: interval(0, 1e6, lo_open=True, unit=" W") = Field(
-        description="the load [W]; with a load_profile, the profile's scale [-]")
+        description="the load [W]; with a load_profile, the profile's scale [-]"
+    )
     load_profile: LoadProfile | None = None
     geometry: named(names.GEOMETRIES) | None = Field(
-        None, description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact"
+        None,
+        description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact",
     )
     fold_angles: FoldAngles = FoldAngles()
     near_optimal: NearOptimal = NearOptimal()
     sky: named(names.SKIES) | None = Field(
-        None, description="clear sky; default ineichen in exact mode, meinel (the paper's beam-only) in paper")
+        None,
+        description="clear sky; default ineichen in exact mode, meinel (the paper's beam-only) in paper",
+    )
     linke_turbidity: interval(0, 10, lo_open=True) | None = Field(
-        None, description="ineichen; default pvlib's climatology")
+        None, description="ineichen; default pvlib's climatology"
+    )
     transposition: named(names.TRANSPOSITIONS) | None = Field(
         None, description="diffuse model; default none for beam-only skies, perez otherwise"
     )
@@ -174,14 +198,19 @@ class Study(StrictModel):
     weather: Weather | None = None
     objective: Objective | None = None
     pv_model: named(names.PV_MODELS) = "ideal"
-    module: str | None = Field(None, description="single-diode: CEC module name; default the A-300 cell")
+    module: str | None = Field(
+        None, description="single-diode: CEC module name; default the A-300 cell"
+    )
     connection: named(names.CONNECTIONS) = "switching"
     switch_series: bool = Field(False, description="switching may also select series")
     bypass_diodes: bool = True
     converter_efficiency: interval(0, 1, lo_open=True) = 1.0
-    circuit: Circuit = Field(Circuit(), description="diodes, converter, coupling and switch as built; default ideal")
-    optimize: Optimize | None = Field(None, description="the fold angle, tilt and azimuth optimised together "
-                                                       "(foldopt optimize)")
+    circuit: Circuit = Field(
+        Circuit(), description="diodes, converter, coupling and switch as built; default ideal"
+    )
+    optimize: Optimize | None = Field(
+        None, description="the fold angle, tilt and azimuth optimised together (foldopt optimize)"
+    )
     temperature_model: named(names.TEMPERATURE_MODELS) | None = Field(
         None, description="default fixed (cells at temp_air) in paper mode, sapm in exact"
     )
@@ -189,8 +218,12 @@ class Study(StrictModel):
     wind_speed: interval(0, 60, unit=" m/s") = 1.0
     exact_electrical: bool = Field(False, description="solve every step's I-V curves, not tables")
     tracker: Tracker = Tracker()
-    climate: named(names.HOTTEL_CLIMATES) = Field("midlatitude-summer", description="Hottel sky only")
-    step_min: Annotated[interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)] = 1.0
+    climate: named(names.HOTTEL_CLIMATES) = Field(
+        "midlatitude-summer", description="Hottel sky only"
+    )
+    step_min: Annotated[
+        interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)
+    ] = 1.0
     #: The dotted paths of the fields the validation decided (:meth:`_decide`), not given.
     _decided: frozenset = PrivateAttr(frozenset())
 
@@ -198,7 +231,11 @@ class Study(StrictModel):
     @classmethod
     def _profile_scale(cls, data):
         """A load profile is in watts: its scale defaults to 1."""
-        if isinstance(data, dict) and data.get("load_profile") is not None and data.get("p_load") is None:
+        if (
+            isinstance(data, dict)
+            and data.get("load_profile") is not None
+            and data.get("p_load") is None
+        ):
             data = {**data, "p_load": 1.0}
         return data
 
@@ -222,7 +259,13 @@ class Study(StrictModel):
         partial = isinstance(site, dict) and not {"latitude", "longitude"} & set(site)
         if isinstance(data, dict) and (site is None or partial) and data.get("weather") is not None:
             weather = data["weather"]
-            path = weather if isinstance(weather, str) else weather.get("path") if isinstance(weather, dict) else None
+            path = (
+                weather
+                if isinstance(weather, str)
+                else weather.get("path")
+                if isinstance(weather, dict)
+                else None
+            )
             if isinstance(path, str):
                 files = FilesRead.given(info)
                 if files is not None and files.weather_problem is not None:
@@ -243,11 +286,15 @@ class Study(StrictModel):
     @model_validator(mode="after")
     def _consistent(self, info: ValidationInfo):
         if self.mode == "paper" and self.transposition not in (None, "none"):
-            raise ValueError("transposition: paper mode is beam-only (Shin et al. Eq. 5): transposition must be none")
+            raise ValueError(
+                "transposition: paper mode is beam-only (Shin et al. Eq. 5): transposition must be none"
+            )
         idle = self.idle_settings()
         if idle:
             raise ValueError("\n".join(idle))  # one error line each
-        too_large = self.optimize.size_problem(self.fold_angles) if self.optimize is not None else None
+        too_large = (
+            self.optimize.size_problem(self.fold_angles) if self.optimize is not None else None
+        )
         if too_large:
             raise ValueError(too_large)
         files = FilesRead.given(info) if self.weather is not None else None
@@ -255,26 +302,45 @@ class Study(StrictModel):
             raise ValueError(files.weather_problem)
         if self.weather is not None and self.weather.members is not None:
             if self.objective is None:
-                raise ValueError("weather.members: a cloud ensemble chooses one fold angle over its members; give an "
-                                 "objective (e.g. objective: mean)")
+                raise ValueError(
+                    "weather.members: a cloud ensemble chooses one fold angle over its members; give an "
+                    "objective (e.g. objective: mean)"
+                )
             if self.objective.visits is not None:
-                raise ValueError("objective.visits: re-fold schedules are not drawn over a cloud ensemble; leave out "
-                                 "weather.members or objective.visits")
+                raise ValueError(
+                    "objective.visits: re-fold schedules are not drawn over a cloud ensemble; leave out "
+                    "weather.members or objective.visits"
+                )
         measured = self.weather is not None and self.weather.measured
-        if self.weather is not None and not measured and not math.isclose(60 / self.step_min,
-                                                                            round(60 / self.step_min)):
-            raise ValueError(f"step_min = {self.step_min:g}: must divide the weather file's 60-min intervals")
-        if measured and files is not None and files.weather_step_min is not None and not math.isclose(
-                self.step_min, files.weather_step_min):
-            raise ValueError(f"step_min = {self.step_min:g}: a measured weather file is evaluated at its own step, "
-                             f"{files.weather_step_min:g} min; leave step_min out or set it to that")
+        if (
+            self.weather is not None
+            and not measured
+            and not math.isclose(60 / self.step_min, round(60 / self.step_min))
+        ):
+            raise ValueError(
+                f"step_min = {self.step_min:g}: must divide the weather file's 60-min intervals"
+            )
+        if (
+            measured
+            and files is not None
+            and files.weather_step_min is not None
+            and not math.isclose(self.step_min, files.weather_step_min)
+        ):
+            raise ValueError(
+                f"step_min = {self.step_min:g}: a measured weather file is evaluated at its own step, "
+                f"{files.weather_step_min:g} min; leave step_min out or set it to that"
+            )
         checked = files is not None and not self.force_site
         if checked and files.weather_problem is not None:
             raise ValueError(files.weather_problem)
         file_site = files.weather_site if checked else None
         if file_site is not None and self.site is not None:
-            distance = great_circle_km(self.site.latitude, self.site.longitude, file_site["latitude"],
-                                       file_site["longitude"])
+            distance = great_circle_km(
+                self.site.latitude,
+                self.site.longitude,
+                file_site["latitude"],
+                file_site["longitude"],
+            )
             if distance > SITE_TOLERANCE_KM:
                 name = f"{file_site['name']} " if file_site["name"] else ""
                 raise ValueError(
@@ -298,18 +364,25 @@ class Study(StrictModel):
             from foldopt.physics.geometry import default_orientation
 
             tilt, azimuth = default_orientation(self.site.latitude)
-            panel = {key: value for key, value in (("tilt", tilt), ("azimuth", azimuth))
-                     if getattr(self.panel, key) is None}
+            panel = {
+                key: value
+                for key, value in (("tilt", tilt), ("azimuth", azimuth))
+                if getattr(self.panel, key) is None
+            }
             if panel:
                 decided["panel"] = self.panel.model_copy(update=panel)
             if self.site.timezone is None:
-                decided["site"] = self.site.model_copy(update={"timezone": standard_timezone(self.site.longitude)})
+                decided["site"] = self.site.model_copy(
+                    update={"timezone": standard_timezone(self.site.longitude)}
+                )
             paths = [f"panel.{key}" for key in panel] + ["site.timezone"] * ("site" in decided)
         else:
             paths = []
         for name, value in decided.items():
             object.__setattr__(self, name, value)  # frozen to users; decided here, once
-        self._decided = frozenset(paths + [name for name in decided if name not in ("panel", "site")])
+        self._decided = frozenset(
+            paths + [name for name in decided if name not in ("panel", "site")]
+        )
         return self
 
     def idle_settings(self) -> list[str]:
@@ -326,28 +399,63 @@ class Study(StrictModel):
         defaults["sky"] = (None, MODE_SKIES[self.mode])
         sky = self.sky or MODE_SKIES[self.mode]
         iv_model = self.pv_model != "ideal"
-        series_used = self.connection == "series" or (self.connection == "switching" and self.switch_series)
+        series_used = self.connection == "series" or (
+            self.connection == "switching" and self.switch_series
+        )
         rules = [
             ("climate", sky == "hottel", "is only used by sky hottel"),
-            ("linke_turbidity", sky == "ineichen" or self.weather is not None,
-             "is only used by sky ineichen and weather files"),
-            ("sky", self.weather is None, "has no use with a weather file (its light shapes the minutes)"),
-            ("albedo", self.sky_transposition() != "none", "is only used with a transposition (diffuse light)"),
-            ("switch_series", self.connection == "switching", "is only used by connection switching"),
-            ("bypass_diodes", series_used, "is only used where series is (connection series, or switching "
-                                           "with switch_series)"),
-            ("converter_efficiency", self.connection == "independent", "is only used by connection independent"),
-            ("converter_efficiency", self.circuit.converter.model == "ideal",
-             "is the ideal converters' efficiency; circuit.converter sets every converter's"),
+            (
+                "linke_turbidity",
+                sky == "ineichen" or self.weather is not None,
+                "is only used by sky ineichen and weather files",
+            ),
+            (
+                "sky",
+                self.weather is None,
+                "has no use with a weather file (its light shapes the minutes)",
+            ),
+            (
+                "albedo",
+                self.sky_transposition() != "none",
+                "is only used with a transposition (diffuse light)",
+            ),
+            (
+                "switch_series",
+                self.connection == "switching",
+                "is only used by connection switching",
+            ),
+            (
+                "bypass_diodes",
+                series_used,
+                "is only used where series is (connection series, or switching with switch_series)",
+            ),
+            (
+                "converter_efficiency",
+                self.connection == "independent",
+                "is only used by connection independent",
+            ),
+            (
+                "converter_efficiency",
+                self.circuit.converter.model == "ideal",
+                "is the ideal converters' efficiency; circuit.converter sets every converter's",
+            ),
             ("temperature_model", iv_model, "is only used by pv_model single-diode or b-model"),
-            ("temp_air", iv_model and self.weather is None,
-             "is only used by pv_model single-diode or b-model, without a weather file (which brings its own)"),
+            (
+                "temp_air",
+                iv_model and self.weather is None,
+                "is only used by pv_model single-diode or b-model, without a weather file (which brings its own)",
+            ),
             ("wind_speed", iv_model, "is only used by pv_model single-diode or b-model"),
             ("exact_electrical", iv_model, "is only used by pv_model single-diode or b-model"),
         ]
-        idle = [f"{name} = {getattr(self, name)!r}: {why}" for name, used, why in rules
-                if not used and getattr(self, name) not in _as_tuple(defaults[name])]
-        circuit = self.circuit.idle_settings(self.connection, series_used and self.bypass_diodes, iv_model)
+        idle = [
+            f"{name} = {getattr(self, name)!r}: {why}"
+            for name, used, why in rules
+            if not used and getattr(self, name) not in _as_tuple(defaults[name])
+        ]
+        circuit = self.circuit.idle_settings(
+            self.connection, series_used and self.bypass_diodes, iv_model
+        )
         optimize = self.optimize.idle_settings() if self.optimize is not None else []
         return idle + circuit + self.tracker.idle_settings() + optimize
 
@@ -363,7 +471,11 @@ class Study(StrictModel):
         if self.transposition is not None:
             return self.transposition
         sky = self.sky or MODE_SKIES[self.mode]
-        return "none" if self.mode == "paper" or (self.weather is None and sky in names.BEAM_SKIES) else "perez"
+        return (
+            "none"
+            if self.mode == "paper" or (self.weather is None and sky in names.BEAM_SKIES)
+            else "perez"
+        )
 
     @field_validator("tracker", mode="before")
     @classmethod
@@ -433,7 +545,11 @@ class Study(StrictModel):
             (data[section] if section else data).pop(name, None)
         if self.load_profile is not None and self.load_profile.file is not None:
             data["load_profile"].pop("daily", None)
-        if self.site is not None and self.site.horizon is not None and self.site.horizon.file is not None:
+        if (
+            self.site is not None
+            and self.site.horizon is not None
+            and self.site.horizon.file is not None
+        ):
             data["site"]["horizon"].pop("points", None)
         return data
 
@@ -446,10 +562,14 @@ class Study(StrictModel):
             ``weather: the file is not read yet; ...`` (and for ``load_profile``):
             :func:`foldopt.inputs.study_file.with_files` reads them, as the API does.
         """
-        unread = [f"{name}: the file is not read yet; foldopt.run, foldopt.sweep and foldopt.size read it"
-                  for name, missing in (("weather", self.site is None), ("load_profile", self.load_profile is not None
-                                                                           and self.load_profile.daily is None))
-                  if missing]
+        unread = [
+            f"{name}: the file is not read yet; foldopt.run, foldopt.sweep and foldopt.size read it"
+            for name, missing in (
+                ("weather", self.site is None),
+                ("load_profile", self.load_profile is not None and self.load_profile.daily is None),
+            )
+            if missing
+        ]
         if unread:
             raise ConfigError(unread)
 

@@ -63,8 +63,12 @@ class StudyLoader(yaml.SafeLoader):
             At an alias (``*name``).
         """
         if self.check_event(yaml.AliasEvent):
-            raise yaml.composer.ComposerError(None, None, "aliases (*name) are not accepted in a study; write the "
-                                              "value out", self.peek_event().start_mark)
+            raise yaml.composer.ComposerError(
+                None,
+                None,
+                "aliases (*name) are not accepted in a study; write the value out",
+                self.peek_event().start_mark,
+            )
         return super().compose_node(parent, index)
 
     def construct_mapping(self, node, deep=False):
@@ -90,7 +94,11 @@ class StudyLoader(yaml.SafeLoader):
             try:
                 if key in first:
                     raise yaml.constructor.ConstructorError(
-                        None, None, f"key {key!r} appears twice (first at line {first[key]})", key_node.start_mark)
+                        None,
+                        None,
+                        f"key {key!r} appears twice (first at line {first[key]})",
+                        key_node.start_mark,
+                    )
                 first[key] = key_node.start_mark.line + 1
             except TypeError:  # an unhashable key: the base class says so
                 break
@@ -131,8 +139,11 @@ class StudyLoader(yaml.SafeLoader):
         if ":" in text:
             value = getattr(super(), constructor)(node)
             raise yaml.constructor.ConstructorError(
-                None, None, f"{text} is read by YAML as the number {value:g} (base 60); write '{text}' in quotes",
-                node.start_mark)
+                None,
+                None,
+                f"{text} is read by YAML as the number {value:g} (base 60); write '{text}' in quotes",
+                node.start_mark,
+            )
 
 
 StudyLoader.add_constructor("tag:yaml.org,2002:int", StudyLoader.construct_yaml_int)
@@ -226,7 +237,10 @@ def _resolve_weather_path(data: dict, folder: Path) -> dict:
     spec = weather.get("path") if isinstance(weather, dict) else weather
     if isinstance(spec, str) and not Path(spec).is_absolute() and (folder / spec).is_file():
         resolved = str(folder / spec)
-        data = {**data, "weather": {**weather, "path": resolved} if isinstance(weather, dict) else resolved}
+        data = {
+            **data,
+            "weather": {**weather, "path": resolved} if isinstance(weather, dict) else resolved,
+        }
     return data
 
 
@@ -237,8 +251,13 @@ def _resolve_horizon_path(data: dict, folder: Path) -> dict:
     spec = horizon.get("file") if isinstance(horizon, dict) else horizon
     if isinstance(spec, str) and not Path(spec).is_absolute() and (folder / spec).is_file():
         resolved = str(folder / spec)
-        data = {**data, "site": {**site, "horizon": {**horizon, "file": resolved} if isinstance(horizon, dict)
-                                 else resolved}}
+        data = {
+            **data,
+            "site": {
+                **site,
+                "horizon": {**horizon, "file": resolved} if isinstance(horizon, dict) else resolved,
+            },
+        }
     return data
 
 
@@ -255,7 +274,9 @@ def default_study_path(name: str = DEFAULT_STUDY) -> Path:
     pathlib.Path
         In ``configs/`` of the wheel, or of the checkout.
     """
-    package = Path(__file__).resolve().parents[1]  # foldopt/, this module being foldopt/inputs/<name>.py
+    package = (
+        Path(__file__).resolve().parents[1]
+    )  # foldopt/, this module being foldopt/inputs/<name>.py
     packaged = package / "configs" / f"{name}.yaml"
     if packaged.exists():
         return packaged
@@ -294,11 +315,16 @@ def read_profile(path: str | Path) -> dict:
         try:
             time, watts = row["time"].strip(), float(row["watts"])
         except (KeyError, TypeError, ValueError, AttributeError):
-            raise ConfigError([f"load_profile.file {path}, line {line}: expected time,watts (HH:MM, a number)"
-                               ]) from None
+            raise ConfigError(
+                [f"load_profile.file {path}, line {line}: expected time,watts (HH:MM, a number)"]
+            ) from None
         if time in steps:  # the second load would replace the first unseen
-            raise ConfigError([f"load_profile.file {path}, line {line}: time {time} is also on line {lines[time]}; "
-                               "give each time once"])
+            raise ConfigError(
+                [
+                    f"load_profile.file {path}, line {line}: time {time} is also on line {lines[time]}; "
+                    "give each time once"
+                ]
+            )
         steps[time], lines[time] = watts, line
     try:
         return profile_steps(steps)
@@ -324,8 +350,11 @@ def resolve_files(data) -> FilesRead:
     """
     if not isinstance(data, dict):
         return FilesRead()
-    return FilesRead(**weather_read(data.get("weather"), data.get("site")), **_profile_read(data.get("load_profile")),
-                     **_horizon_read(data.get("site")))
+    return FilesRead(
+        **weather_read(data.get("weather"), data.get("site")),
+        **_profile_read(data.get("load_profile")),
+        **_horizon_read(data.get("site")),
+    )
 
 
 def _profile_read(profile) -> dict:
@@ -347,7 +376,9 @@ def _horizon_read(site) -> dict:
         azimuth, elevation = read_horizon(path)
     except ConfigError as error:
         return {"horizon_problem": str(error).removeprefix("site.horizon: ")}
-    return {"horizon_points": [[float(a), float(e)] for a, e in zip(azimuth, elevation, strict=True)]}
+    return {
+        "horizon_points": [[float(a), float(e)] for a, e in zip(azimuth, elevation, strict=True)]
+    }
 
 
 def with_files(study: Study) -> Study:
@@ -373,8 +404,11 @@ def with_files(study: Study) -> Study:
         For a file that cannot be used, or a site too far from the weather file's.
     """
     horizon = study.site.horizon if study.site is not None else None
-    if (study.weather is None and (study.load_profile is None or study.load_profile.file is None)
-            and (horizon is None or horizon.read)):
+    if (
+        study.weather is None
+        and (study.load_profile is None or study.load_profile.file is None)
+        and (horizon is None or horizon.read)
+    ):
         return study
     data = study.data()
     return make_study(data, resolve_files(data))

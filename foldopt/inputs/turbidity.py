@@ -59,8 +59,13 @@ def _month_middles(leap: bool) -> np.ndarray:
     days = np.array(calendar.mdays[1:], dtype=float)
     if leap:
         days[1] += 1
-    return np.concatenate([[-calendar.mdays[12] / 2.0], np.cumsum(days) - days / 2.0,
-                           [days.sum() + calendar.mdays[1] / 2.0]])
+    return np.concatenate(
+        [
+            [-calendar.mdays[12] / 2.0],
+            np.cumsum(days) - days / 2.0,
+            [days.sum() + calendar.mdays[1] / 2.0],
+        ]
+    )
 
 
 def linke_turbidity(latitude: float, longitude: float, utc_ns) -> np.ndarray:
@@ -80,8 +85,12 @@ def linke_turbidity(latitude: float, longitude: float, utc_ns) -> np.ndarray:
         The turbidity, shaped as ``utc_ns``.
     """
     # pvlib interpolates the values as 20 x the turbidity and divides after.
-    monthly = np.asarray(_dataset()[_grid_index(latitude, 90.0, -90.0, GRID_SHAPE[0]),
-                                    _grid_index(longitude, -180.0, 180.0, GRID_SHAPE[1])])
+    monthly = np.asarray(
+        _dataset()[
+            _grid_index(latitude, 90.0, -90.0, GRID_SHAPE[0]),
+            _grid_index(longitude, -180.0, 180.0, GRID_SHAPE[1]),
+        ]
+    )
     around = np.concatenate([[monthly[-1]], monthly, [monthly[0]]])
     days = np.floor_divide(np.asarray(utc_ns, dtype=np.int64), NS_PER_DAY)
     if days.size == 0:
@@ -92,6 +101,9 @@ def linke_turbidity(latitude: float, longitude: float, utc_ns) -> np.ndarray:
     dayofyear = (dates - years).astype(np.int64) + 1
     year = years.astype(np.int64) + 1970
     leap = (year % 4 == 0) & ((year % 100 != 0) | (year % 400 == 0))
-    values = np.where(leap, np.interp(dayofyear, _month_middles(True), around),
-                      np.interp(dayofyear, _month_middles(False), around))
+    values = np.where(
+        leap,
+        np.interp(dayofyear, _month_middles(True), around),
+        np.interp(dayofyear, _month_middles(False), around),
+    )
     return (values / 20.0)[days - first]

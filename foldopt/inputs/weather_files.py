@@ -40,7 +40,9 @@ def weather_read(weather, site=None) -> dict:
         return {}  # the study names the fault of an option that is not one value of its kind
     try:
         check_input(path, "weather", MAX_WEATHER_BYTES, "MAX_WEATHER_BYTES", "weather file")
-    except ConfigError as error:  # missing, a folder, a device, a FIFO, too large: named before any read
+    except (
+        ConfigError
+    ) as error:  # missing, a folder, a device, a FIFO, too large: named before any read
         return {"weather_missing": True, "weather_problem": error.errors[0]}
     try:
         fmt = canonical(spec.get("format"), WEATHER_FORMATS)
@@ -55,7 +57,9 @@ def weather_read(weather, site=None) -> dict:
     except ConfigError as error:  # foldopt.errors.WeatherError: the file, the line, the reason
         return {"weather_problem": str(error) + _format_hint(files, path, fmt, spec.get("format"))}
     except (ValueError, KeyError, OSError) as error:
-        return {"weather_problem": f"weather: cannot read a site from {path} ({error.__class__.__name__})"}
+        return {
+            "weather_problem": f"weather: cannot read a site from {path} ({error.__class__.__name__})"
+        }
 
 
 def _format_hint(files, path: str, fmt: str | None, given) -> str:
@@ -68,9 +72,15 @@ def _format_hint(files, path: str, fmt: str | None, given) -> str:
     if seen is None or seen == used:
         return ""
     suffix = Path(path).suffix.lower()
-    why = f"by its extension {suffix}" if suffix in files.FORMATS[used].suffixes else "no format given"
-    return f"; read as {used} ({why}), it looks like a {seen} file: give --weather-format {seen} " \
-           f"(weather.format: {seen} in a study)"
+    why = (
+        f"by its extension {suffix}"
+        if suffix in files.FORMATS[used].suffixes
+        else "no format given"
+    )
+    return (
+        f"; read as {used} ({why}), it looks like a {seen} file: give --weather-format {seen} "
+        f"(weather.format: {seen} in a study)"
+    )
 
 
 def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
@@ -78,18 +88,31 @@ def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
     site for a file that holds none: without one, the file waits for the study to name it)."""
     entry = files.MEASURED_FORMATS[fmt]
     given = site if isinstance(site, dict) and not entry.has_site else None
-    if not entry.has_site and not (given and all(isinstance(given.get(k), (int, float)) for k in (
-            "latitude", "longitude", "altitude"))):
+    if not entry.has_site and not (
+        given
+        and all(
+            isinstance(given.get(k), (int, float)) for k in ("latitude", "longitude", "altitude")
+        )
+    ):
         varied = _varied_site(site)
         if varied is not None:
-            return {"weather_problem": f"{varied}: varies, but a {fmt} file holds no site and is read at the study's; "
-                                       "a measured file's light is of one place: give one site"}
+            return {
+                "weather_problem": f"{varied}: varies, but a {fmt} file holds no site and is read at the study's; "
+                "a measured file's light is of one place: give one site"
+            }
         # A file that cannot be parsed says so first: naming a site would not make it readable.
-        entry.reader(path, lambda message: WeatherError(f"weather {Path(path).name}: {message}"), 0.0)
-        return {"weather_problem": f"weather {Path(path).name}: the {fmt} format holds no site; give the site's "
-                                   "latitude, longitude and altitude (--lat, --lon, --altitude)"}
-    options = {key: spec[key] for key in ("label", "timezone", "decomposition", "max_gap_min") if spec.get(key)
-               is not None}
+        entry.reader(
+            path, lambda message: WeatherError(f"weather {Path(path).name}: {message}"), 0.0
+        )
+        return {
+            "weather_problem": f"weather {Path(path).name}: the {fmt} format holds no site; give the site's "
+            "latitude, longitude and altitude (--lat, --lon, --altitude)"
+        }
+    options = {
+        key: spec[key]
+        for key in ("label", "timezone", "decomposition", "max_gap_min")
+        if spec.get(key) is not None
+    }
     try:
         measured = files.measured_weather(path, fmt, site=given, **options)
     except ConfigError:
@@ -98,11 +121,16 @@ def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
         return {}  # an option out of its range: the study's validation names it
     days = measured.frame.index.tz_localize(None).normalize().unique()
     dates = tuple(str(day.date()) for day in days if day.date() not in measured.flagged_days)
-    read = {"weather_site": measured.site, "weather_step_min": measured.step.total_seconds() / 60.0,
-            "weather_dates": dates}
+    read = {
+        "weather_site": measured.site,
+        "weather_step_min": measured.step.total_seconds() / 60.0,
+        "weather_dates": dates,
+    }
     if not dates:
         given_gap = spec.get("max_gap_min")
-        read["weather_problem"] = _every_day_left_out(measured, days, 60.0 if given_gap is None else float(given_gap))
+        read["weather_problem"] = _every_day_left_out(
+            measured, days, 60.0 if given_gap is None else float(given_gap)
+        )
     return read
 
 
@@ -124,13 +152,28 @@ def _every_day_left_out(measured, days, max_gap_min: float) -> str:
     first = days[0].date()
     gaps = [gap for gap in measured.gaps if gap[0].date() == first and gap[2] > max_gap_min]
     longest = max(gaps, key=lambda gap: gap[2]) if gaps else None
-    which = f"its only day, {first}, is left out: it" if len(days) == 1 else \
-        f"all {len(days)} of its days are left out; the first, {first},"
-    why = "has daylight steps missing" if longest is None else (
-        f"has a daylight gap of {longest[2]:g} min ({longest[0]:%H:%M} to {longest[1]:%H:%M})")
-    found = [note for note in measured.notes if note.startswith(("values beyond physical bounds", "values flagged"))]
-    return (f"weather {name}: {which} {why}, longer than weather.max_gap_min = {max_gap_min:g} min"
-            + (f" ({'; '.join(found)})" if found else " (steps the file lacks)") + "; no day is left to study")
+    which = (
+        f"its only day, {first}, is left out: it"
+        if len(days) == 1
+        else f"all {len(days)} of its days are left out; the first, {first},"
+    )
+    why = (
+        "has daylight steps missing"
+        if longest is None
+        else (
+            f"has a daylight gap of {longest[2]:g} min ({longest[0]:%H:%M} to {longest[1]:%H:%M})"
+        )
+    )
+    found = [
+        note
+        for note in measured.notes
+        if note.startswith(("values beyond physical bounds", "values flagged"))
+    ]
+    return (
+        f"weather {name}: {which} {why}, longer than weather.max_gap_min = {max_gap_min:g} min"
+        + (f" ({'; '.join(found)})" if found else " (steps the file lacks)")
+        + "; no day is left to study"
+    )
 
 
 #: A weather file's options that take one name, and those that take one number.
@@ -150,7 +193,11 @@ def _options_problem(spec: dict, keys=(*_NAMED_OPTIONS, *_NUMBER_OPTIONS)) -> st
             what = "one name" if key in _NAMED_OPTIONS else "one number"
             kind = type(value).__name__
             kind = f"{'an' if kind[0] in 'aeiou' else 'a'} {kind}"
-            swept = "; the file is read with it, so it is not swept" if isinstance(value, (list, tuple, dict)) else ""
+            swept = (
+                "; the file is read with it, so it is not swept"
+                if isinstance(value, (list, tuple, dict))
+                else ""
+            )
             return f"weather.{key} = {printable(repr(value), 40)}: {what} is expected, not {kind}{swept}"
     return None
 
@@ -179,7 +226,13 @@ def weather_defaults(data: dict) -> dict:
         whose days cannot be known (it cannot be read, or every day is left out).
     """
     weather = data.get("weather")
-    spec = {"path": weather} if isinstance(weather, str) else weather if isinstance(weather, dict) else {}
+    spec = (
+        {"path": weather}
+        if isinstance(weather, str)
+        else weather
+        if isinstance(weather, dict)
+        else {}
+    )
     problem = _options_problem(spec, ("format",))
     if problem is not None:
         raise ConfigError([problem])
@@ -187,9 +240,13 @@ def weather_defaults(data: dict) -> dict:
     if varied is not None and not data.get("force_site"):
         own = weather_read(weather).get("weather_site")  # None for a file that holds no site
         if own is not None:
-            raise ConfigError([f"{varied}: varies, but a weather file is of one site, {own['name'] or 'its own'} "
-                               f"({own['latitude']:g}, {own['longitude']:g}); leave the site to the file, or set "
-                               "force_site (--force-site) to give each site the file's weather"])
+            raise ConfigError(
+                [
+                    f"{varied}: varies, but a weather file is of one site, {own['name'] or 'its own'} "
+                    f"({own['latitude']:g}, {own['longitude']:g}); leave the site to the file, or set "
+                    "force_site (--force-site) to give each site the file's weather"
+                ]
+            )
     try:
         fmt = canonical(spec.get("format"), WEATHER_FORMATS)
     except ValueError:
@@ -200,8 +257,12 @@ def weather_defaults(data: dict) -> dict:
     if problem is not None:
         raise ConfigError([problem])
     read = weather_read(weather, data.get("site"))
-    if read.get("weather_problem") is not None and (not read.get("weather_dates") or _varied_site(data.get("site"))):
-        raise ConfigError([read["weather_problem"]])  # its days and step cannot be known: none to default
+    if read.get("weather_problem") is not None and (
+        not read.get("weather_dates") or _varied_site(data.get("site"))
+    ):
+        raise ConfigError(
+            [read["weather_problem"]]
+        )  # its days and step cannot be known: none to default
     if read.get("weather_dates") is None:
         return {"date": "year"}  # the file cannot be read: the study's validation names why
     return {"date": list(read["weather_dates"]), "step_min": read["weather_step_min"]}

@@ -19,7 +19,9 @@ from foldopt.inputs.sections import parse_timezone
 
 def _check_offset(name: str | None) -> str | None:
     if name is not None and not isinstance(parse_timezone(name), dt.timezone):
-        raise ValueError(f"{name!r}: a measured file's standard time is a fixed offset such as 'UTC-07:00'")
+        raise ValueError(
+            f"{name!r}: a measured file's standard time is a fixed offset such as 'UTC-07:00'"
+        )
     return name
 
 
@@ -54,17 +56,24 @@ class Weather(StrictModel):
     """
 
     path: str
-    format: named(names.WEATHER_FORMATS) | None = Field(None, description="default from the extension (hourly "
-                                                       "formats); a measured file names its format")
+    format: named(names.WEATHER_FORMATS) | None = Field(
+        None,
+        description="default from the extension (hourly formats); a measured file names its format",
+    )
     label: named(names.INTERVAL_LABELS) | None = Field(
-        None, description="what a timestamp marks; default the format's (TMY3 end, EPW and PVGIS start)"
+        None,
+        description="what a timestamp marks; default the format's (TMY3 end, EPW and PVGIS start)",
     )
     timezone: Annotated[str | None, AfterValidator(_check_offset)] = Field(
-        None, description="a measured file's standard time, e.g. UTC-07:00; default the file's")
-    decomposition: named(names.DECOMPOSITIONS) = Field("erbs", description="a measured file's dni and dhi from ghi")
+        None, description="a measured file's standard time, e.g. UTC-07:00; default the file's"
+    )
+    decomposition: named(names.DECOMPOSITIONS) = Field(
+        "erbs", description="a measured file's dni and dhi from ghi"
+    )
     max_gap_min: interval(0, 1440, unit=" min") = 60.0
     members: Annotated[int, Field(ge=2, le=200)] | None = Field(
-        None, description="an hourly file's cloud ensemble of this many members")
+        None, description="an hourly file's cloud ensemble of this many members"
+    )
     seed: Annotated[int, Field(ge=0)] = 0
 
     @property
@@ -76,8 +85,12 @@ class Weather(StrictModel):
     @classmethod
     def _measured_only(cls, value, info: ValidationInfo):
         fmt = info.data.get("format")
-        if value != cls.model_fields[info.field_name].default and (fmt is None or fmt in names.HOURLY_WEATHER_FORMATS):
-            measured = ", ".join(f for f in names.WEATHER_FORMATS if f not in names.HOURLY_WEATHER_FORMATS)
+        if value != cls.model_fields[info.field_name].default and (
+            fmt is None or fmt in names.HOURLY_WEATHER_FORMATS
+        ):
+            measured = ", ".join(
+                f for f in names.WEATHER_FORMATS if f not in names.HOURLY_WEATHER_FORMATS
+            )
             raise ValueError(f"is only used by measured weather files (format {measured})")
         return value
 
@@ -86,7 +99,9 @@ class Weather(StrictModel):
     def _hourly_only(cls, value, info: ValidationInfo):
         fmt = info.data.get("format")
         if value is not None and fmt is not None and fmt not in names.HOURLY_WEATHER_FORMATS:
-            raise ValueError("a cloud ensemble is drawn from an hourly file; a measured file's minutes are its own")
+            raise ValueError(
+                "a cloud ensemble is drawn from an hourly file; a measured file's minutes are its own"
+            )
         return value
 
     @field_validator("seed")

@@ -29,56 +29,120 @@ COLUMNS = (
     ("weather", "", "the weather file a map's site comes from"),
     ("date", "", "the local day (YYYY-MM-DD); in a schedule, the day of a re-fold visit"),
     ("dayofyear", "-", "day of the year of ``date``"),
-    ("p_load_w", "W", "the load; with a load profile, the profile's scale [-] (the answer names the profile)"),
+    (
+        "p_load_w",
+        "W",
+        "the load; with a load profile, the profile's scale [-] (the answer names the profile)",
+    ),
     ("p_load_fraction", "-", "the load as a share of the site's flat peak (maps)"),
     ("peak_power_flat_w", "W", "the flat panel's largest power over the year (maps)"),
     ("period", "", "year, or the season DJF, MAM, JJA, SON (maps)"),
     ("days", "-", "days of the period or case"),
-    ("design", "", "flat, twofold (at the optimum), twofold-heuristic, twofold-<connection>, tracker, "
-                   "tracker-net (net of its own draw), tracker:<model> and tracker:<model>-net"),
+    (
+        "design",
+        "",
+        "flat, twofold (at the optimum), twofold-heuristic, twofold-<connection>, tracker, "
+        "tracker-net (net of its own draw), tracker:<model> and tracker:<model>-net",
+    ),
     # the design's settings and its daily metrics
-    ("fold_angle_deg", "deg", "the fold angle Θ (180 = flat); empty for trackers, and in annual_summary.csv where "
-                              "the angle varies by day"),
+    (
+        "fold_angle_deg",
+        "deg",
+        "the fold angle Θ (180 = flat); empty for trackers, and in annual_summary.csv where "
+        "the angle varies by day",
+    ),
     ("fold_angle_min_deg", "deg", "the least of the days' fold angles (annual_summary.csv)"),
     ("fold_angle_max_deg", "deg", "the largest of the days' fold angles (annual_summary.csv)"),
-    ("surface_tilt", "deg", "the panel's base tilt from horizontal (foldopt optimize; a map's twofold panel)"),
-    ("surface_tilt_flat", "deg", "the flat panel's tilt: the site's, or its own best with map --optimize tilt"),
+    (
+        "surface_tilt",
+        "deg",
+        "the panel's base tilt from horizontal (foldopt optimize; a map's twofold panel)",
+    ),
+    (
+        "surface_tilt_flat",
+        "deg",
+        "the flat panel's tilt: the site's, or its own best with map --optimize tilt",
+    ),
     ("surface_azimuth", "deg", "the panel's base azimuth, clockwise from north (foldopt optimize)"),
     ("t_solar_h", "h", "solar-powered time of the day: P_pv >= P_load"),
     ("t_solar_contiguous_h", "h", "the longest contiguous solar-powered interval"),
-    ("t_solar_{connection}_h", "h", "t_solar of one connection at each fold angle (sweep.csv); independent's "
-                                    "runs through a converter per sub-panel, even where the load is wired "
-                                    "directly (circuit.coupling direct)"),
-    ("t_solar_{design}_h", "h", "t_solar of one design as the tracker's standby grows (tracker_standby.csv)"),
+    (
+        "t_solar_{connection}_h",
+        "h",
+        "t_solar of one connection at each fold angle (sweep.csv); independent's "
+        "runs through a converter per sub-panel, even where the load is wired "
+        "directly (circuit.coupling direct)",
+    ),
+    (
+        "t_solar_{design}_h",
+        "h",
+        "t_solar of one design as the tracker's standby grows (tracker_standby.csv)",
+    ),
     ("energy_harvested_wh", "Wh", "energy at the maximum power point over the day (or the period)"),
-    ("energy_harvested_{connection}_wh", "Wh", "energy of one connection at each fold angle (sweep.csv); "
-                                               "independent's through a converter per sub-panel, as its t_solar"),
+    (
+        "energy_harvested_{connection}_wh",
+        "Wh",
+        "energy of one connection at each fold angle (sweep.csv); "
+        "independent's through a converter per sub-panel, as its t_solar",
+    ),
     ("energy_harvested_{design}_wh", "Wh", "energy of one design over the period (maps)"),
     ("energy_served_wh", "Wh", "energy the load draws while solar-powered"),
-    ("energy_wasted_wh", "Wh", "harvested but not served; never negative (a tracker whose drive costs more than it "
-                               "harvests has a negative net harvest, served and wasted 0, and a note)"),
+    (
+        "energy_wasted_wh",
+        "Wh",
+        "harvested but not served; never negative (a tracker whose drive costs more than it "
+        "harvests has a negative net harvest, served and wasted 0, and a note)",
+    ),
     ("peak_power_w", "W", "the day's largest power"),
     ("poa_kwh_m2", "kWh/m^2", "plane-of-array irradiation (mean of the two sub-panels)"),
-    ("noon_valley_w", "W", "the parallel curve's minimum between the sub-panels' peaks (Shin et al. Eq. 8)"),
-    ("flat_area_multiple", "-", "how many times larger a flat panel must be to reach the design's t_solar"),
+    (
+        "noon_valley_w",
+        "W",
+        "the parallel curve's minimum between the sub-panels' peaks (Shin et al. Eq. 8)",
+    ),
+    (
+        "flat_area_multiple",
+        "-",
+        "how many times larger a flat panel must be to reach the design's t_solar",
+    ),
     ("gain_vs_flat_pct", "%", "t_solar (or the objective) over the flat panel's, less 100"),
     ("pct_of_tracker", "%", "t_solar (or the objective) as a share of the tracker's"),
     ("energy_gain_vs_flat_pct", "%", "harvested energy over the flat panel's, less 100"),
     ("energy_pct_of_tracker", "%", "harvested energy as a share of the tracker's"),
-    ("note", "", "polar night, polar day, overcast, load above peak (of that design); in annual_summary.csv, "
-                 "that the fold angle varies by day, or that the totals are the days' evaluated, not their "
-                 "period's"),
+    (
+        "note",
+        "",
+        "polar night, polar day, overcast, load above peak (of that design); in annual_summary.csv, "
+        "that the fold angle varies by day, or that the totals are the days' evaluated, not their "
+        "period's",
+    ),
     # the near-optimal range
     ("near_optimal_lo_deg", "deg", "the least fold angle on the best one's plateau"),
     ("near_optimal_hi_deg", "deg", "the largest fold angle on the best one's plateau"),
     ("recommended_fold_angle_deg", "deg", "the grid angle at the centre of the near-optimal range"),
-    ("near_optimal_tolerance_h", "h", "how far below the best an angle may fall and still be near-optimal"),
-    ("near_optimal_width_deg", "deg", "near_optimal_hi_deg - near_optimal_lo_deg (a map's figure of it)"),
+    (
+        "near_optimal_tolerance_h",
+        "h",
+        "how far below the best an angle may fall and still be near-optimal",
+    ),
+    (
+        "near_optimal_width_deg",
+        "deg",
+        "near_optimal_hi_deg - near_optimal_lo_deg (a map's figure of it)",
+    ),
     # the joint optimisation (foldopt optimize)
-    ("variable", "", "fold_angle, tilt or azimuth: the variable a row of near_optimal.csv or added.csv is of; "
-                     "its near-optimal range is then in that variable's degrees"),
+    (
+        "variable",
+        "",
+        "fold_angle, tilt or azimuth: the variable a row of near_optimal.csv or added.csv is of; "
+        "its near-optimal range is then in that variable's degrees",
+    ),
     ("recommended_deg", "deg", "the value at the centre of a variable's near-optimal range"),
-    ("added_h", "h", "what a variable adds to the objective as it joins the search (fold angle, tilt, azimuth)"),
+    (
+        "added_h",
+        "h",
+        "what a variable adds to the objective as it joins the search (fold angle, tilt, azimuth)",
+    ),
     ("evaluated_designs", "-", "designs the search evaluated"),
     ("grid_designs", "-", "designs of the full grid, what a brute-force sweep evaluates"),
     # statistics over days
@@ -95,7 +159,11 @@ COLUMNS = (
     ("days_ge_{hours}h", "-", "days with t_solar of at least that many hours"),
     ("month_{month}_mean_t_solar_h", "h", "mean daily t_solar of that month"),
     ("chosen", "", "the fold angle chosen for the year (annual_fold_angles.csv)"),
-    ("break_even_standby_tracker_w", "W", "the tracker's standby draw at which the twofold panel catches up"),
+    (
+        "break_even_standby_tracker_w",
+        "W",
+        "the tracker's standby draw at which the twofold panel catches up",
+    ),
     ("standby_w", "W", "the tracker's standby draw"),
     # re-fold schedules
     ("settings", "-", "fold settings a year (1 = one fixed angle)"),
@@ -103,11 +171,23 @@ COLUMNS = (
     ("gain_vs_fixed_pct", "%", "the schedule's objective over the single fixed angle's, less 100"),
     ("added_by_setting_h", "h", "what the schedule's last setting adds to the objective"),
     # a cloud ensemble (weather.members)
-    ("t_solar_p{pct}_h", "h", "a day's t_solar over the ensemble's members: percentile 10, 50 or 90"),
-    ("objective_p{pct}_h", "h", "the objective over the ensemble's members: percentile 10, 50 or 90"),
+    (
+        "t_solar_p{pct}_h",
+        "h",
+        "a day's t_solar over the ensemble's members: percentile 10, 50 or 90",
+    ),
+    (
+        "objective_p{pct}_h",
+        "h",
+        "the objective over the ensemble's members: percentile 10, 50 or 90",
+    ),
     ("chosen_wins_pct", "%", "the members whose own best fold angle is the one chosen"),
-    ("within_tolerance_pct", "%", "the members for which the angle chosen is within the near-optimal tolerance "
-                                  "of their own best"),
+    (
+        "within_tolerance_pct",
+        "%",
+        "the members for which the angle chosen is within the near-optimal tolerance "
+        "of their own best",
+    ),
     ("wins_pct", "%", "the members whose own best fold angle is this one"),
     # the day's time series
     ("time", "", "the step's centre, local time with its offset"),
@@ -116,7 +196,11 @@ COLUMNS = (
     ("dni", "W/m^2", "direct normal irradiance"),
     ("ghi", "W/m^2", "global horizontal irradiance (with diffuse light)"),
     ("dhi", "W/m^2", "diffuse horizontal irradiance (with diffuse light)"),
-    ("temp_air", "C", "the air temperature the cells see (a weather file's, with its wind folded in)"),
+    (
+        "temp_air",
+        "C",
+        "the air temperature the cells see (a weather file's, with its wind folded in)",
+    ),
     ("wind_speed", "m/s", "a weather file's wind speed"),
     ("p_{design}_w", "W", "a design's power at the optimum (p_twofold_w: the study's connection)"),
     ("p_{connection}_w", "W", "a connection's power at the optimum"),
@@ -142,8 +226,17 @@ _WORDS = {
     "month": r"(\d\d)",
     "pct": "(" + "|".join(str(pct) for pct in ENSEMBLE_PERCENTILES) + ")",
 }
-_PATTERNS = [(re.compile("^" + re.sub(r"\\\{(\w+)\\\}", lambda m: _WORDS[m.group(1)], re.escape(name)) + "$"),
-              name, unit, meaning) for name, unit, meaning in COLUMNS]
+_PATTERNS = [
+    (
+        re.compile(
+            "^" + re.sub(r"\\\{(\w+)\\\}", lambda m: _WORDS[m.group(1)], re.escape(name)) + "$"
+        ),
+        name,
+        unit,
+        meaning,
+    )
+    for name, unit, meaning in COLUMNS
+]
 #: A sweep's other varied fields: their dotted paths, or a study field's name.
 _FIELD_PATH = re.compile(r"^[a-z][a-z_]*(\.[a-z][a-z_]*)+$")
 
@@ -181,15 +274,25 @@ def rst_table() -> str:
     str
         reStructuredText: a title, a paragraph and a list table of :data:`COLUMNS`.
     """
-    lines = ["Columns", "=======", "",
-             "One name per quantity, in every CSV file, JSON document, report.html and the Python API. A name with",
-             "``{design}`` or ``{connection}`` stands for one column per design (flat, twofold, tracker, tracker_net)",
-             "or connection. A sweep's other varied fields are columns named by their dotted path",
-             "(``tracker.standby_w``). Generated by ``python -m foldopt.output.columns`` from "
-             ":mod:`foldopt.output.columns`; the",
-             "test suite checks every command's columns against it.", "",
-             ".. list-table::", "   :header-rows: 1", "   :widths: 30 10 60", "",
-             "   * - column", "     - unit", "     - meaning"]
+    lines = [
+        "Columns",
+        "=======",
+        "",
+        "One name per quantity, in every CSV file, JSON document, report.html and the Python API. A name with",
+        "``{design}`` or ``{connection}`` stands for one column per design (flat, twofold, tracker, tracker_net)",
+        "or connection. A sweep's other varied fields are columns named by their dotted path",
+        "(``tracker.standby_w``). Generated by ``python -m foldopt.output.columns`` from "
+        ":mod:`foldopt.output.columns`; the",
+        "test suite checks every command's columns against it.",
+        "",
+        ".. list-table::",
+        "   :header-rows: 1",
+        "   :widths: 30 10 60",
+        "",
+        "   * - column",
+        "     - unit",
+        "     - meaning",
+    ]
     for name, unit, meaning in COLUMNS:
         lines += [f"   * - ``{name}``", f"     - {unit or ' '}", f"     - {meaning}"]
     return "\n".join(lines) + "\n"

@@ -63,12 +63,21 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
             input_sha256=input_hash(result.study.data()),
             engine=result.engine,
             fold_angle_twofold_deg=result.optimal_fold_angle,
-            near_optimal={key: _finite_or_none(value) for key, value in result.near_optimal.items()},
+            near_optimal={
+                key: _finite_or_none(value) for key, value in result.near_optimal.items()
+            },
             break_even_standby_tracker_w=_finite_or_none(result.standby[1]),
             fold_angle_twofold_heuristic_deg=_finite_or_none(result.heuristic_fold_angle),
         )
         write_run_json(folder, metadata)
-        write_html(folder, result.answer, figures, result.summary, "Designs compared (summary.csv)", metadata)
+        write_html(
+            folder,
+            result.answer,
+            figures,
+            result.summary,
+            "Designs compared (summary.csv)",
+            metadata,
+        )
     return out
 
 
@@ -92,11 +101,23 @@ def write_reproduction(result, out: Path, overwrite: bool = False, command=None)
     with staged_folder(out, overwrite) as folder:
         for name, table in result.tables.items():
             write_csv(table, folder / f"{name}.csv")
-        metadata = run_metadata(result.study, command, modes=["paper", "exact"], tables=list(result.tables),
-                                engine=result.engine)
+        metadata = run_metadata(
+            result.study,
+            command,
+            modes=["paper", "exact"],
+            tables=list(result.tables),
+            engine=result.engine,
+        )
         write_run_json(folder, metadata)
-        write_html(folder, result.answer, [], result.answer.designs, "Published and reproduced values (paper: Shin "
-                   "et al.; paper mode: their formulas; exact mode: pvlib's physics)", metadata)
+        write_html(
+            folder,
+            result.answer,
+            [],
+            result.answer.designs,
+            "Published and reproduced values (paper: Shin "
+            "et al.; paper mode: their formulas; exact mode: pvlib's physics)",
+            metadata,
+        )
     return out
 
 
@@ -111,24 +132,55 @@ def _sweep_plots(table: pd.DataFrame, varied: list[str], folder: Path, name: str
     return their file names."""
     twofold = table[table["design"] == "twofold"]
     written = []
-    for x, y, stem in (("latitude", "p_load_w", "latitude_load"), ("dayofyear", "latitude", "day_latitude")):
+    for x, y, stem in (
+        ("latitude", "p_load_w", "latitude_load"),
+        ("dayofyear", "latitude", "day_latitude"),
+    ):
         if x in varied and y in varied:
             other = _others((x, y, "dayofyear"), varied)
             written += [
-                write_figure(folder, f"gain_map_{stem}.png", twofold, x, y, "gain_vs_flat_pct",
-                             f"{name}: t_solar gain of the optimal twofold panel over flat{other}",
-                             "gain over flat [%] (grey: flat never runs)", diverging=True),
-                write_figure(folder, f"fold_angle_map_{stem}.png", twofold, x, y, "fold_angle_deg",
-                             f"{name}: optimal fold angle{other}", "fold angle Θ [deg] (180 = flat)", diverging=False),
+                write_figure(
+                    folder,
+                    f"gain_map_{stem}.png",
+                    twofold,
+                    x,
+                    y,
+                    "gain_vs_flat_pct",
+                    f"{name}: t_solar gain of the optimal twofold panel over flat{other}",
+                    "gain over flat [%] (grey: flat never runs)",
+                    diverging=True,
+                ),
+                write_figure(
+                    folder,
+                    f"fold_angle_map_{stem}.png",
+                    twofold,
+                    x,
+                    y,
+                    "fold_angle_deg",
+                    f"{name}: optimal fold angle{other}",
+                    "fold angle Θ [deg] (180 = flat)",
+                    diverging=False,
+                ),
             ]
-    for x, stem in (("dayofyear", "annual_t_solar"), ("p_load_w", "t_solar_vs_load"),
-                    ("latitude", "t_solar_vs_latitude")):
+    for x, stem in (
+        ("dayofyear", "annual_t_solar"),
+        ("p_load_w", "t_solar_vs_load"),
+        ("latitude", "t_solar_vs_latitude"),
+    ):
         if x in varied:
             rest = [v for v in varied if v not in (x, "date", "dayofyear")]
             split = next((v for v in rest if table[v].nunique() <= 4), None)
             used = (x, "dayofyear") + ((split,) if split else ())
-            written.append(write_figure(folder, f"{stem}.png", table, x, f"{name}: t_solar of flat, optimal twofold "
-                                        f"and tracker{_others(used, varied)}", split))
+            written.append(
+                write_figure(
+                    folder,
+                    f"{stem}.png",
+                    table,
+                    x,
+                    f"{name}: t_solar of flat, optimal twofold and tracker{_others(used, varied)}",
+                    split,
+                )
+            )
     return written
 
 
@@ -138,39 +190,94 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
     file names."""
     table, study = result.table, result.plan.base
     write_csv(annual_summary(table, annual_cases(result)), folder / "annual_summary.csv")
-    written = ["annual_summary.csv",
-               write_figure(folder, "daily_t_solar_distribution.png", table, f"{name}: daily t_solar per design",
-                            study=study),
-               write_figure(folder, "monthly_energy_t_solar.png", table, f"{name}: every design month by month",
-                            study=study)]
+    written = [
+        "annual_summary.csv",
+        write_figure(
+            folder,
+            "daily_t_solar_distribution.png",
+            table,
+            f"{name}: daily t_solar per design",
+            study=study,
+        ),
+        write_figure(
+            folder,
+            "monthly_energy_t_solar.png",
+            table,
+            f"{name}: every design month by month",
+            study=study,
+        ),
+    ]
     extras = result.extras
     if extras:
         write_csv(extras["by_angle"], folder / "annual_fold_angles.csv")
         angle = extras["fold_angle"]
-        written += ["annual_fold_angles.csv",
-                    write_figure(folder, "annual_t_solar_vs_fold_angle.png", extras["by_angle"],
-                                 f"{name}: the year at each fold angle ({study.objective.statistic})", study),
-                    write_figure(folder, "day_hour_power.png", extras, "p_twofold_w",
-                                 f"{name}: twofold power at {angle:g}° (first load)", "P_pv [W]"),
-                    write_figure(folder, "day_hour_switch_state.png", extras, "switch_state",
-                                 f"{name}: connection the switch chooses at {angle:g}°", "")]
+        written += [
+            "annual_fold_angles.csv",
+            write_figure(
+                folder,
+                "annual_t_solar_vs_fold_angle.png",
+                extras["by_angle"],
+                f"{name}: the year at each fold angle ({study.objective.statistic})",
+                study,
+            ),
+            write_figure(
+                folder,
+                "day_hour_power.png",
+                extras,
+                "p_twofold_w",
+                f"{name}: twofold power at {angle:g}° (first load)",
+                "P_pv [W]",
+            ),
+            write_figure(
+                folder,
+                "day_hour_switch_state.png",
+                extras,
+                "switch_state",
+                f"{name}: connection the switch chooses at {angle:g}°",
+                "",
+            ),
+        ]
     if "annual_objective" in extras:
         write_csv(extras["annual_objective"], folder / "annual_objective.csv")
         written.append("annual_objective.csv")
     if "weather_sample" in extras:
-        kind = {"measured": "measured minutes", "smooth": "the file's hours on the study's steps",
-                "members": "a cloud ensemble's members"}[extras["weather_sample"]["kind"]]
-        written.append(write_figure(folder, "weather_minutes.png", extras["weather_sample"],
-                                    f"{name}: {kind}, the day most variable within its hours"))
+        kind = {
+            "measured": "measured minutes",
+            "smooth": "the file's hours on the study's steps",
+            "members": "a cloud ensemble's members",
+        }[extras["weather_sample"]["kind"]]
+        written.append(
+            write_figure(
+                folder,
+                "weather_minutes.png",
+                extras["weather_sample"],
+                f"{name}: {kind}, the day most variable within its hours",
+            )
+        )
     if "t_solar_p10_h" in table:
-        written.append(write_figure(folder, "ensemble_t_solar.png", table,
-                                    f"{name}: daily t_solar over the cloud ensemble's members", study=study))
+        written.append(
+            write_figure(
+                folder,
+                "ensemble_t_solar.png",
+                table,
+                f"{name}: daily t_solar over the cloud ensemble's members",
+                study=study,
+            )
+        )
     if "refold_value" in extras:
         write_csv(extras["refold_value"], folder / "refold_value.csv")
         write_csv(extras["refold_schedule"], folder / "refold_schedule.csv")
-        written += ["refold_value.csv", "refold_schedule.csv",
-                    write_figure(folder, "refold_value.png", extras["refold_value"],
-                                 f"{name}: what each re-fold visit is worth", study)]
+        written += [
+            "refold_value.csv",
+            "refold_schedule.csv",
+            write_figure(
+                folder,
+                "refold_value.png",
+                extras["refold_value"],
+                f"{name}: what each re-fold visit is worth",
+                study,
+            ),
+        ]
     return written
 
 
@@ -197,11 +304,16 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
         plots = _sweep_plots(result.table, result.varied, folder, plan.base.name)
         if "date" in result.varied or "dayofyear" in result.varied:
             plots += _annual_outputs(result, folder, plan.base.name)
-        plots += _horizon_figure(plan.base, dict(plan.axes).get("date", (plan.base.date,)), folder, plan.base.name)
+        plots += _horizon_figure(
+            plan.base, dict(plan.axes).get("date", (plan.base.date,)), folder, plan.base.name
+        )
         metadata = run_metadata(
             plan.base,
             command,
-            axes={path: [str(v) if hasattr(v, "isoformat") else v for v in values] for path, values in plan.axes},
+            axes={
+                path: [str(v) if hasattr(v, "isoformat") else v for v in values]
+                for path, values in plan.axes
+            },
             cases=plan.n_cases,
             plots=plots,
             input_sha256=input_hash({"study": plan.data, "axes": plan.axes}),
@@ -215,9 +327,19 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
             table = annual_summary(result.table, annual_cases(result))
             title = "The year per case and design (annual_summary.csv)"
         else:
-            table, title = result.table, "Every case and design (results.csv; click a header to sort)"
-        write_html(folder, answer, [name for name in plots if name.endswith(".png")], table, title, metadata,
-                   designs=answer.kind == "annual")
+            table, title = (
+                result.table,
+                "Every case and design (results.csv; click a header to sort)",
+            )
+        write_html(
+            folder,
+            answer,
+            [name for name in plots if name.endswith(".png")],
+            table,
+            title,
+            metadata,
+            designs=answer.kind == "annual",
+        )
     return out
 
 
@@ -242,10 +364,16 @@ def write_sizing(result, out: Path, overwrite: bool = False, command=None) -> Pa
     with staged_folder(out, overwrite) as folder:
         write_csv(table, folder / "sizing.csv")
         write_csv(best, folder / "sizing_best.csv")
-        figure = write_figure(folder, "net_benefit_vs_area.png", table, best,
-                              f"{study.name}: panel sizing (Shin et al. Sec. IV-A)")
-        metadata = run_metadata(study, command, sizing=result.parameters,
-                                input_sha256=input_hash(study.data()))
+        figure = write_figure(
+            folder,
+            "net_benefit_vs_area.png",
+            table,
+            best,
+            f"{study.name}: panel sizing (Shin et al. Sec. IV-A)",
+        )
+        metadata = run_metadata(
+            study, command, sizing=result.parameters, input_sha256=input_hash(study.data())
+        )
         write_run_json(folder, metadata)
         write_html(folder, result.answer, [figure], table, "Every area (sizing.csv)", metadata)
     return out
@@ -271,29 +399,55 @@ def write_optimize(result, out: Path, overwrite: bool = False, command=None) -> 
         ``out``.
     """
     study, search = result.study, result.twofold
-    points = pd.DataFrame(search.points, columns=["fold_angle_deg", "surface_tilt", "surface_azimuth"])
+    points = pd.DataFrame(
+        search.points, columns=["fold_angle_deg", "surface_tilt", "surface_azimuth"]
+    )
     points["surface_azimuth"] %= 360.0
-    evaluated = pd.concat([points.assign(p_load_w=load, objective_h=search.values[:, index])
-                           for index, load in enumerate(result.loads)], ignore_index=True)
+    evaluated = pd.concat(
+        [
+            points.assign(p_load_w=load, objective_h=search.values[:, index])
+            for index, load in enumerate(result.loads)
+        ],
+        ignore_index=True,
+    )
     with staged_folder(out, overwrite) as folder:
         write_csv(result.table, folder / "optimum.csv")
         write_csv(result.near_optimal, folder / "near_optimal.csv")
         write_csv(result.added, folder / "added.csv")
         write_csv(evaluated, folder / "evaluated.csv")
         write_csv(result.landscape, folder / "landscape.csv")
-        figures = [write_figure(folder, "landscape.png", result.landscape, result.table,
-                                f"{study.name}: objective over tilt x fold angle (azimuth "
-                                f"{result.landscape['surface_azimuth'].iloc[0]:g} deg)")]
+        figures = [
+            write_figure(
+                folder,
+                "landscape.png",
+                result.landscape,
+                result.table,
+                f"{study.name}: objective over tilt x fold angle (azimuth "
+                f"{result.landscape['surface_azimuth'].iloc[0]:g} deg)",
+            )
+        ]
         figures += _horizon_figure(study, list(result.dates), folder, study.name)
-        metadata = run_metadata(study, command, days=len(result.dates), search=result.answer.result["search"],
-                                input_sha256=input_hash(study.data()))
+        metadata = run_metadata(
+            study,
+            command,
+            days=len(result.dates),
+            search=result.answer.result["search"],
+            input_sha256=input_hash(study.data()),
+        )
         write_run_json(folder, metadata)
         write_html(folder, result.answer, figures, result.table, "Designs (optimum.csv)", metadata)
     return out
 
 
-def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, load_index: int = 0,
-                period: str = "year", tilt: bool = False) -> list[str]:
+def map_figures(
+    table: pd.DataFrame,
+    folder: Path,
+    name: str,
+    relative: bool,
+    load_index: int = 0,
+    period: str = "year",
+    tilt: bool = False,
+) -> list[str]:
     """Write the world maps of one load and period and the latitude x load chart
     (:data:`foldopt.output.figures.world.FIGURES`) in a map's folder, each file atomically.
 
@@ -323,13 +477,30 @@ def map_figures(table: pd.DataFrame, folder: Path, name: str, relative: bool, lo
     loads = table["p_load_fraction"] if relative else table["p_load_w"]
     values = np.unique(loads.round(12))
     shown = table[(np.isclose(loads, values[load_index])) & (table["period"] == period)]
-    shown = shown.assign(near_optimal_width_deg=shown["near_optimal_hi_deg"] - shown["near_optimal_lo_deg"])
+    shown = shown.assign(
+        near_optimal_width_deg=shown["near_optimal_hi_deg"] - shown["near_optimal_lo_deg"]
+    )
     unit = "of the flat peak" if relative else "W"
     what = f"P_load {values[load_index]:g} {unit}, {period}"
-    written = [write_figure(folder, file, shown, column, f"{name}: {description} ({what})", label, diverging)
-               for file, column, description, label, diverging in (*world.MAPS, *(world.TILT_MAPS if tilt else ()))]
-    return written + [write_figure(folder, "latitude_load_gain.png", table, period, relative,
-                                   f"{name}: where folding pays ({period}, median over longitudes)")]
+    written = [
+        write_figure(
+            folder, file, shown, column, f"{name}: {description} ({what})", label, diverging
+        )
+        for file, column, description, label, diverging in (
+            *world.MAPS,
+            *(world.TILT_MAPS if tilt else ()),
+        )
+    ]
+    return written + [
+        write_figure(
+            folder,
+            "latitude_load_gain.png",
+            table,
+            period,
+            relative,
+            f"{name}: where folding pays ({period}, median over longitudes)",
+        )
+    ]
 
 
 def write_map_report(result, figures: list[str], answer, metadata: dict) -> Path:
@@ -352,5 +523,11 @@ def write_map_report(result, figures: list[str], answer, metadata: dict) -> Path
         The page written.
     """
     year = result.table[result.table["period"] == "year"]
-    return write_html(result.out, answer, figures, year, "The year per site and load (map.csv has every season)",
-                      metadata)
+    return write_html(
+        result.out,
+        answer,
+        figures,
+        year,
+        "The year per site and load (map.csv has every season)",
+        metadata,
+    )

@@ -29,7 +29,15 @@ from foldopt.output.columns import describe
 from foldopt.studies.worldmap import PERIODS
 
 #: The registry's units in UDUNITS spelling, as CF asks.
-_UNITS = {"h": "h", "W": "W", "Wh": "W h", "%": "percent", "deg": "degree", "-": "1", "kWh/m^2": "kW h m-2"}
+_UNITS = {
+    "h": "h",
+    "W": "W",
+    "Wh": "W h",
+    "%": "percent",
+    "deg": "degree",
+    "-": "1",
+    "kWh/m^2": "kW h m-2",
+}
 #: Columns that are coordinates or labels, not variables.
 _NOT_VARIABLES = ("site_id", "site_name", "weather", "latitude", "longitude", "period")
 
@@ -59,29 +67,49 @@ def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"
         return None
     load = "p_load_fraction" if relative else "p_load_w"
     # A fraction is watts over the site's peak: the same load to 12 digits at every site.
-    frame = table.assign(load=table[load].round(12)).drop(columns=load).set_index(
-        ["latitude", "longitude", "load", "period"])
-    variables = [c for c in frame.columns if c not in _NOT_VARIABLES and pd.api.types.is_numeric_dtype(frame[c])]
+    frame = (
+        table.assign(load=table[load].round(12))
+        .drop(columns=load)
+        .set_index(["latitude", "longitude", "load", "period"])
+    )
+    variables = [
+        c
+        for c in frame.columns
+        if c not in _NOT_VARIABLES and pd.api.types.is_numeric_dtype(frame[c])
+    ]
     data = frame[variables].astype(float).to_xarray()
-    data = data.reindex(latitude=latitudes, longitude=longitudes,
-                        period=[period for period in PERIODS if period in set(table["period"])])
+    data = data.reindex(
+        latitude=latitudes,
+        longitude=longitudes,
+        period=[period for period in PERIODS if period in set(table["period"])],
+    )
     for name in variables:
         entry = describe(name)
         if entry is not None:
             data[name].attrs.update(units=_UNITS.get(entry[1], entry[1] or "1"), long_name=entry[2])
-    data["latitude"].attrs.update(units="degrees_north", standard_name="latitude", long_name="latitude", axis="Y")
-    data["longitude"].attrs.update(units="degrees_east", standard_name="longitude", long_name="longitude", axis="X")
+    data["latitude"].attrs.update(
+        units="degrees_north", standard_name="latitude", long_name="latitude", axis="Y"
+    )
+    data["longitude"].attrs.update(
+        units="degrees_east", standard_name="longitude", long_name="longitude", axis="X"
+    )
     entry = describe(load)
     data = data.assign_coords(load=data["load"])
     data["load"].attrs.update(units=_UNITS.get(entry[1], "1"), long_name=f"{load}: {entry[2]}")
     data["period"].attrs.update(long_name="year, or the season DJF, MAM, JJA, SON")
-    data.attrs.update(Conventions="CF-1.8", title=title, source=f"foldopt {versions()['foldopt']}",
-                      references="Shin et al., Reconfigurable three dimensional photovoltaic panel architecture for "
-                                 "solar-powered time extension")
+    data.attrs.update(
+        Conventions="CF-1.8",
+        title=title,
+        source=f"foldopt {versions()['foldopt']}",
+        references="Shin et al., Reconfigurable three dimensional photovoltaic panel architecture for "
+        "solar-powered time extension",
+    )
     return data
 
 
-def write_grid_netcdf(table: pd.DataFrame, out: Path, relative: bool, title: str = "foldopt map") -> str | None:
+def write_grid_netcdf(
+    table: pd.DataFrame, out: Path, relative: bool, title: str = "foldopt map"
+) -> str | None:
     """Write ``map.nc`` in a map's folder, atomically, where its sites are a grid.
 
     Returns
@@ -93,6 +121,8 @@ def write_grid_netcdf(table: pd.DataFrame, out: Path, relative: bool, title: str
     if data is None:
         return None
     encoding = {name: {"_FillValue": np.nan} for name in data.data_vars}
-    write_atomically(Path(out) / "map.nc", lambda temporary: data.to_netcdf(temporary, engine="scipy",
-                                                                             encoding=encoding))
+    write_atomically(
+        Path(out) / "map.nc",
+        lambda temporary: data.to_netcdf(temporary, engine="scipy", encoding=encoding),
+    )
     return "map.nc"

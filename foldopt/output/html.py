@@ -25,8 +25,14 @@ MAX_ROWS = 2000
 
 # The page's template, shipped in the package; autoescaping makes every value text, and trimming
 # lets a line that holds only a tag leave nothing in the page.
-_TEMPLATES = Environment(loader=PackageLoader("foldopt.output", "templates"), autoescape=True, trim_blocks=True,
-                         lstrip_blocks=True, keep_trailing_newline=True, undefined=StrictUndefined)
+_TEMPLATES = Environment(
+    loader=PackageLoader("foldopt.output", "templates"),
+    autoescape=True,
+    trim_blocks=True,
+    lstrip_blocks=True,
+    keep_trailing_newline=True,
+    undefined=StrictUndefined,
+)
 
 
 def _image(path: Path) -> str:
@@ -49,10 +55,15 @@ def _sortable(table: pd.DataFrame, max_rows: int = MAX_ROWS) -> dict:
     """What the template's sortable table shows of ``table``: its header, at most ``max_rows``
     rows of cells, and a note where rows are left out."""
     shown = table.head(max_rows)
-    return {"head": [(str(c), "text" if shown[c].dtype == object else "") for c in shown.columns],
-            "rows": [[_cell(value) for value in record] for record in shown.itertuples(index=False)],
-            "more": (f"The first {max_rows:,} of {len(table):,} rows; the CSV holds them all."
-                     if len(table) > max_rows else "")}
+    return {
+        "head": [(str(c), "text" if shown[c].dtype == object else "") for c in shown.columns],
+        "rows": [[_cell(value) for value in record] for record in shown.itertuples(index=False)],
+        "more": (
+            f"The first {max_rows:,} of {len(table):,} rows; the CSV holds them all."
+            if len(table) > max_rows
+            else ""
+        ),
+    }
 
 
 def _provenance(provenance: dict) -> dict:
@@ -60,13 +71,23 @@ def _provenance(provenance: dict) -> dict:
     digest and the resolved study as JSON."""
     command = provenance.get("command")
     study = provenance.get("study")
-    return {"command": " ".join(command) if isinstance(command, list) else str(command or ""),
-            "versions": provenance.get("versions", {}), "input_sha256": provenance.get("input_sha256"),
-            "study": json.dumps(study, indent=1, default=str) if study else None}
+    return {
+        "command": " ".join(command) if isinstance(command, list) else str(command or ""),
+        "versions": provenance.get("versions", {}),
+        "input_sha256": provenance.get("input_sha256"),
+        "study": json.dumps(study, indent=1, default=str) if study else None,
+    }
 
 
-def write_html(folder: Path, answer, figures: list[str], table: pd.DataFrame | None = None,
-               table_title: str = "Table", provenance: dict | None = None, designs: bool = False) -> Path:
+def write_html(
+    folder: Path,
+    answer,
+    figures: list[str],
+    table: pd.DataFrame | None = None,
+    table_title: str = "Table",
+    provenance: dict | None = None,
+    designs: bool = False,
+) -> Path:
     """Write ``folder/report.html`` atomically: a view of ``answer``, nothing decided here.
 
     The page is rendered from the template ``foldopt/output/templates/report.html.j2``.
@@ -99,10 +120,16 @@ def write_html(folder: Path, answer, figures: list[str], table: pd.DataFrame | N
         title=f"foldopt: {answer.title}",
         question=list(answer.question.items()),
         lines=answer.lines(),
-        tables=[(name, _sortable(shown)) for name, shown in answer.tables() if name != "Designs compared" or designs],
+        tables=[
+            (name, _sortable(shown))
+            for name, shown in answer.tables()
+            if name != "Designs compared" or designs
+        ],
         figures=[(name, _image(folder / name)) for name in figures],
         table=None if table is None else _sortable(table),
         table_title=table_title,
         provenance=_provenance(provenance) if provenance else None,
     )
-    return write_atomically(folder / "report.html", lambda temporary: temporary.write_text(page, encoding="utf-8"))
+    return write_atomically(
+        folder / "report.html", lambda temporary: temporary.write_text(page, encoding="utf-8")
+    )

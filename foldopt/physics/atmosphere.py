@@ -174,13 +174,16 @@ def extraterrestrial_normal(dayofyear):
        2013, Eq. 1.4.1a.
     """
     return np.asarray(
-        pvlib.irradiance.get_extra_radiation(np.asarray(dayofyear), solar_constant=SOLAR_CONSTANT_HOTTEL,
-                                             method="asce"),
+        pvlib.irradiance.get_extra_radiation(
+            np.asarray(dayofyear), solar_constant=SOLAR_CONSTANT_HOTTEL, method="asce"
+        ),
         dtype=float,
     )
 
 
-def clear_sky_dni(solar_zenith, altitude=0.0, model="meinel", dayofyear=None, climate="midlatitude-summer"):
+def clear_sky_dni(
+    solar_zenith, altitude=0.0, model="meinel", dayofyear=None, climate="midlatitude-summer"
+):
     """Clear-sky direct normal irradiance by one of :data:`SKY_MODELS`.
 
     Parameters
@@ -210,5 +213,7 @@ def clear_sky_dni(solar_zenith, altitude=0.0, model="meinel", dayofyear=None, cl
     if model == "meinel":
         return beam_meinel(relative_airmass(solar_zenith), altitude)
     if model == "hottel":
-        return extraterrestrial_normal(dayofyear) * hottel_transmittance(solar_zenith, altitude, climate)
+        return extraterrestrial_normal(dayofyear) * hottel_transmittance(
+            solar_zenith, altitude, climate
+        )
     raise ValueError(f"sky must be one of {', '.join(SKY_MODELS)}; got {model!r}")

@@ -104,7 +104,12 @@ class _Explicit:
             scale = i_x / -np.expm1(-1.0 / b)
             growth = np.exp((x / v_x - 1.0) / b)
             current = np.where(lit, scale * (1.0 - growth), 0.0)
-            return current, x, np.where(lit, -scale * growth / (v_x * b), 0.0), np.ones_like(current)
+            return (
+                current,
+                x,
+                np.where(lit, -scale * growth / (v_x * b), 0.0),
+                np.ones_like(current),
+            )
         raise ValueError(f"no I-V curve of model {self.curve.model!r}")
 
 
@@ -121,12 +126,19 @@ def _output_current(side: _Explicit, voltage, diode: Diode, switch_resistance):
     def residual(x):
         current, pv_voltage, di, dv = side(x)
         current = np.maximum(current, 0.0)
-        return current, pv_voltage - diode.drop(current) - current * switch_resistance - voltage, di, dv
+        return (
+            current,
+            pv_voltage - diode.drop(current) - current * switch_resistance - voltage,
+            di,
+            dv,
+        )
 
     current, r, di, dv = residual(x)
     sources = r > 0
     for _ in range(_NEWTON_MAX):
-        step = np.where(sources, r / (dv - (diode.resistance(current) + switch_resistance) * di), 0.0)
+        step = np.where(
+            sources, r / (dv - (diode.resistance(current) + switch_resistance) * di), 0.0
+        )
         x = x - step
         current, r, di, dv = residual(x)
         if not np.any(np.abs(step) > _NEWTON_TOL):
@@ -142,6 +154,7 @@ def _branch_mpp(side: _Explicit, diode: Diode, switch_resistance):
     constant; for Shockley's, ``d^2/dI^2 [I ln(1 + I/I_s)] = (I + 2 I_s)/(I + I_s)^2 > 0``). ``I``
     is monotonic in ``x``, so the power is unimodal in ``x`` and golden-section search finds it.
     """
+
     def power(x):
         current, voltage, _, _ = side(x)
         current = np.maximum(current, 0.0)
@@ -195,7 +208,9 @@ def alone_power(curve: IVCurve, load_voltage=None, switch_resistance=0.0):
     return voltage * _output_current(side, voltage, IDEAL_DIODE, switch_resistance)
 
 
-def parallel_power(east: IVCurve, west: IVCurve, blocking: Diode, load_voltage=None, switch_resistance=0.0):
+def parallel_power(
+    east: IVCurve, west: IVCurve, blocking: Diode, load_voltage=None, switch_resistance=0.0
+):
     """Power [W] of two sub-panels in parallel, each behind a blocking diode and a switch.
 
     At bus voltage ``V`` each sub-panel sources the current of :func:`_output_current`; the pair
@@ -238,7 +253,9 @@ def parallel_power(east: IVCurve, west: IVCurve, blocking: Diode, load_voltage=N
     sides = _Explicit(east), _Explicit(west)
 
     def power(voltage):
-        return voltage * sum(_output_current(side, voltage, blocking, switch_resistance) for side in sides)
+        return voltage * sum(
+            _output_current(side, voltage, blocking, switch_resistance) for side in sides
+        )
 
     if load_voltage is not None:
         return np.maximum(power(_load(load_voltage, east.params[0])), 0.0)
@@ -251,7 +268,9 @@ def parallel_power(east: IVCurve, west: IVCurve, blocking: Diode, load_voltage=N
     else:
         # The sub-panel of the lower maximum-power voltage stops sourcing at V_oc - V_F.
         reach = np.where(v_e <= v_w, sides[0].x_oc, sides[1].x_oc) - blocking.drop(0.0)
-        searched = connections.golden_section(power, lower, np.maximum(lower, np.minimum(upper, reach)))[0]
+        searched = connections.golden_section(
+            power, lower, np.maximum(lower, np.minimum(upper, reach))
+        )[0]
     return np.maximum(np.maximum(searched, 0.0), np.maximum(p_e, p_w))
 
 
@@ -266,11 +285,15 @@ def _string_voltage(east: IVCurve, west: IVCurve, bypass: Diode | None, current,
         if bypass is None:
             total = total + inside
         else:
-            total = total + np.where(current <= isc, inside, -bypass.drop(np.maximum(current - isc, 0.0)))
+            total = total + np.where(
+                current <= isc, inside, -bypass.drop(np.maximum(current - isc, 0.0))
+            )
     return total
 
 
-def series_power(east: IVCurve, west: IVCurve, bypass: Diode | None, load_voltage=None, switch_resistance=0.0):
+def series_power(
+    east: IVCurve, west: IVCurve, bypass: Diode | None, load_voltage=None, switch_resistance=0.0
+):
     """Power [W] of two sub-panels in series, with bypass diodes (or none) and one switch.
 
     The string voltage is ``V_e(I) + V_w(I) - I R_sw``, a bypassed sub-panel adding
@@ -317,18 +340,24 @@ def series_power(east: IVCurve, west: IVCurve, bypass: Diode | None, load_voltag
     top = weaker if bypass is None else stronger
 
     def power(current):
-        return np.nan_to_num(current * _string_voltage(east, west, bypass, current, switch_resistance),
-                             nan=-np.inf)
+        return np.nan_to_num(
+            current * _string_voltage(east, west, bypass, current, switch_resistance), nan=-np.inf
+        )
 
     if load_voltage is not None:
         target = _load(load_voltage, isc_e)
         # A target the string cannot reach gives 0, one it holds at its top current that current;
         # between them V_string(lo) >= target > V_string(hi) is kept, over those strings alone (a
         # load beyond the panel's reach bisects nothing).
-        reaches = _string_voltage(east, west, bypass, np.zeros_like(top), switch_resistance) >= target
+        reaches = (
+            _string_voltage(east, west, bypass, np.zeros_like(top), switch_resistance) >= target
+        )
         saturated = _string_voltage(east, west, bypass, top, switch_resistance) >= target
         inside = reaches & ~saturated
-        strings = [IVCurve(curve.model, tuple(np.asarray(p)[inside] for p in curve.params)) for curve in (east, west)]
+        strings = [
+            IVCurve(curve.model, tuple(np.asarray(p)[inside] for p in curve.params))
+            for curve in (east, west)
+        ]
         lo, hi, aim = np.zeros(np.count_nonzero(inside)), top[inside], target[inside]
         for _ in range(_BISECTIONS):
             middle = 0.5 * (lo + hi)
@@ -347,8 +376,15 @@ def series_power(east: IVCurve, west: IVCurve, bypass: Diode | None, load_voltag
     return np.maximum(np.maximum(both, bypassed), 0.0)
 
 
-def switching_power(east: IVCurve, west: IVCurve, blocking: Diode, bypass: Diode | None, switch_series=False,
-                    load_voltage=None, switch_resistance=0.0):
+def switching_power(
+    east: IVCurve,
+    west: IVCurve,
+    blocking: Diode,
+    bypass: Diode | None,
+    switch_series=False,
+    load_voltage=None,
+    switch_resistance=0.0,
+):
     """Power [W] of a reconfigurable switch: the best state per element, and that state.
 
     The states are east alone, west alone (:func:`alone_power`, through a switch but no diode),
@@ -379,8 +415,11 @@ def switching_power(east: IVCurve, west: IVCurve, blocking: Diode, bypass: Diode
         as :func:`foldopt.physics.connections.connection_powers`.
     """
     options = {"load_voltage": load_voltage, "switch_resistance": switch_resistance}
-    candidates = [alone_power(east, **options), alone_power(west, **options),
-                  parallel_power(east, west, blocking, **options)]
+    candidates = [
+        alone_power(east, **options),
+        alone_power(west, **options),
+        parallel_power(east, west, blocking, **options),
+    ]
     if switch_series:
         candidates.append(series_power(east, west, bypass, **options))
     stacked = np.stack(np.broadcast_arrays(*candidates))

@@ -50,8 +50,13 @@ import numpy as np
 from numba import njit
 
 from foldopt import names
-from foldopt.physics.irradiance import (CLEARNESS_EDGES, HAYDAVIES_COS_FLOOR, PEREZ_COS_FLOOR, PEREZ_KAPPA,
-                                        perez_coefficients)
+from foldopt.physics.irradiance import (
+    CLEARNESS_EDGES,
+    HAYDAVIES_COS_FLOOR,
+    PEREZ_COS_FLOOR,
+    PEREZ_KAPPA,
+    perez_coefficients,
+)
 
 #: Transpositions by their code in the compiled loop (``none``: no diffuse terms).
 TRANSPOSITION_CODES = {"none": 0, "isotropic": 1, "haydavies": 2, "perez": 3}
@@ -60,8 +65,20 @@ _EDGES = np.array(CLEARNESS_EDGES)  # an array, as the compiled loop takes a glo
 
 
 @njit(cache=True)
-def _ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, code, albedo, f1c, f2c, dni, ghi, dhi,
-                    terms):
+def _ineichen_terms(
+    apparent_zenith,
+    dni_extra,
+    linke_turbidity,
+    altitude,
+    code,
+    albedo,
+    f1c,
+    f2c,
+    dni,
+    ghi,
+    dhi,
+    terms,
+):
     """The loop of :func:`ineichen_terms` over blocks and steps; writes only steps with the sun up."""
     n_blocks, n_steps = apparent_zenith.shape
     for b in range(n_blocks):
@@ -70,7 +87,9 @@ def _ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, code,
         fh2 = math.exp(-h / 1250.0)
         cg1 = 5.09e-05 * h + 0.868
         cg2 = 3.92e-05 * h + 0.0387
-        pressure_ratio = 100.0 * ((44331.514 - h) / 11880.516) ** (1.0 / 0.1902632) / STANDARD_PRESSURE
+        pressure_ratio = (
+            100.0 * ((44331.514 - h) / 11880.516) ** (1.0 / 0.1902632) / STANDARD_PRESSURE
+        )
         b_coefficient = 0.664 + 0.163 / fh1
         correction_base = 0.1 + 0.882 / fh1
         for s in range(n_steps):
@@ -85,7 +104,9 @@ def _ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, code,
             extra = dni_extra[b, s]
             g = cg1 * extra * cos_z * max(math.exp(-cg2 * absolute * (fh1 + fh2 * (tl - 1.0))), 0.0)
             beam = extra * max(b_coefficient * math.exp(-0.09 * absolute * (tl - 1.0)), 0.0)
-            capped = g * min(max((1.0 - (0.1 - 0.2 * math.exp(-tl)) / correction_base) / cos_z, 0.0), 1e20)
+            capped = g * min(
+                max((1.0 - (0.1 - 0.2 * math.exp(-tl)) / correction_base) / cos_z, 0.0), 1e20
+            )
             d = min(beam, capped)
             diffuse = g - d * cos_z
             dni[b, s], ghi[b, s], dhi[b, s] = d, g, diffuse
@@ -111,11 +132,22 @@ def _ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, code,
                     iso = diffuse * (1.0 - f1)
                     circ = diffuse * f1 / max(cos_z, PEREZ_COS_FLOOR)
                     hor = diffuse * f2
-            terms[b, 0, s], terms[b, 1, s], terms[b, 2, s], terms[b, 3, s] = iso, circ, hor, g * albedo
+            terms[b, 0, s], terms[b, 1, s], terms[b, 2, s], terms[b, 3, s] = (
+                iso,
+                circ,
+                hor,
+                g * albedo,
+            )
 
 
-def ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, transposition: str = "perez",
-                   albedo: float = 0.2):
+def ineichen_terms(
+    apparent_zenith,
+    dni_extra,
+    linke_turbidity,
+    altitude,
+    transposition: str = "perez",
+    albedo: float = 0.2,
+):
     """pvlib's Ineichen clear sky and the diffuse terms of a transposition at every step.
 
     Parameters
@@ -147,14 +179,31 @@ def ineichen_terms(apparent_zenith, dni_extra, linke_turbidity, altitude, transp
         For a transposition that is not one of :data:`foldopt.names.TRANSPOSITIONS`.
     """
     if transposition not in TRANSPOSITION_CODES:
-        raise ValueError(f"transposition must be one of {', '.join(names.TRANSPOSITIONS)}; got {transposition!r}")
+        raise ValueError(
+            f"transposition must be one of {', '.join(names.TRANSPOSITIONS)}; got {transposition!r}"
+        )
     apparent_zenith = np.ascontiguousarray(apparent_zenith, dtype=float)
     shape = apparent_zenith.shape
-    arrays = [np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=float), shape))
-              for values in (dni_extra, linke_turbidity)]
-    heights = np.ascontiguousarray(np.broadcast_to(np.asarray(altitude, dtype=float).reshape(-1), shape[:1]))
+    arrays = [
+        np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=float), shape))
+        for values in (dni_extra, linke_turbidity)
+    ]
+    heights = np.ascontiguousarray(
+        np.broadcast_to(np.asarray(altitude, dtype=float).reshape(-1), shape[:1])
+    )
     dni, ghi, dhi = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     code = TRANSPOSITION_CODES[transposition]
     terms = np.zeros((shape[0], 4 if code else 0, shape[1]))
-    _ineichen_terms(apparent_zenith, *arrays, heights, code, float(albedo), *perez_coefficients(), dni, ghi, dhi, terms)
+    _ineichen_terms(
+        apparent_zenith,
+        *arrays,
+        heights,
+        code,
+        float(albedo),
+        *perez_coefficients(),
+        dni,
+        ghi,
+        dhi,
+        terms,
+    )
     return dni, ghi, dhi, (terms if code else None)

@@ -95,14 +95,18 @@ def parallel_power(east: IVCurve, west: IVCurve):
 
     def power(voltage):
         # Blocking diodes: a sub-panel adds its current only while it sources it (NaN: dark).
-        current = sum(np.nan_to_num(np.clip(side.current(voltage), 0.0, None)) for side in (east, west))
+        current = sum(
+            np.nan_to_num(np.clip(side.current(voltage), 0.0, None)) for side in (east, west)
+        )
         return voltage * current
 
     lower = np.minimum(v_east, v_west)
     # The sub-panel whose maximum-power voltage is the lower one stops sourcing at its own Voc.
     voc_lower = np.where(v_east <= v_west, east.v_oc, west.v_oc)
     upper = np.maximum(lower, np.minimum(np.maximum(v_east, v_west), voc_lower))
-    searched = golden_section(lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf), lower, upper)[0]
+    searched = golden_section(
+        lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf), lower, upper
+    )[0]
     return np.maximum(searched, np.maximum(p_east, p_west))
 
 
@@ -143,8 +147,15 @@ def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
     # Each sub-panel's voltage is concave and decreasing in the current, so the string's power is
     # concave on [0, the weaker Isc]: golden-section search finds its maximum.
     upper = np.minimum(isc_e, isc_w)
-    string = np.clip(golden_section(lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf),
-                                    np.zeros_like(upper), upper)[0], 0.0, None)
+    string = np.clip(
+        golden_section(
+            lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf),
+            np.zeros_like(upper),
+            upper,
+        )[0],
+        0.0,
+        None,
+    )
     if not bypass:
         return string
     return np.maximum(string, np.maximum(east.max_power(), west.max_power()))
@@ -223,7 +234,9 @@ def connection_powers(
     return powers, np.argmax(stacked >= best * (1 - 1e-6) - 1e-12, axis=0)
 
 
-def connection_power(p_east, p_west, connection="switching", p_parallel=None, p_series=None, **options):
+def connection_power(
+    p_east, p_west, connection="switching", p_parallel=None, p_series=None, **options
+):
     """Deliverable power of one connection; see :func:`connection_powers`.
 
     Parameters

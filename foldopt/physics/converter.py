@@ -74,7 +74,9 @@ class Converter:
 
     def __post_init__(self):
         if self.model not in CONVERTER_MODELS:
-            raise ValueError(f"converter model must be one of {', '.join(CONVERTER_MODELS)}; got {self.model!r}")
+            raise ValueError(
+                f"converter model must be one of {', '.join(CONVERTER_MODELS)}; got {self.model!r}"
+            )
         if self.model == "curve" and not self.curve:
             raise ValueError("converter model curve needs its (fraction, efficiency) points")
 
@@ -152,4 +154,8 @@ def table_delivered(p_in, table, p_rated: float):
     position = np.sqrt(np.minimum(np.nan_to_num(zeta), ZETA_MAX) / ZETA_MAX) * (table.size - 1)
     index = np.minimum(position.astype(np.intp), table.size - 2)
     weight = position - index
-    return np.where(np.isnan(zeta), np.nan, p_rated * (table[index] * (1.0 - weight) + table[index + 1] * weight))
+    return np.where(
+        np.isnan(zeta),
+        np.nan,
+        p_rated * (table[index] * (1.0 - weight) + table[index + 1] * weight),
+    )

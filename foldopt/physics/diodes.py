@@ -81,7 +81,9 @@ class Diode:
 
     def __post_init__(self):
         if self.model not in DIODE_MODELS:
-            raise ValueError(f"diode model must be one of {', '.join(DIODE_MODELS)}; got {self.model!r}")
+            raise ValueError(
+                f"diode model must be one of {', '.join(DIODE_MODELS)}; got {self.model!r}"
+            )
         for name in ("forward_voltage", "saturation_current", "ideality", "series_resistance"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
@@ -89,7 +91,9 @@ class Diode:
         if self.model == "shockley" and not (self.saturation_current > 0 and self.ideality > 0):
             raise ValueError("a shockley diode needs saturation_current > 0 and ideality > 0")
         if not self.temperature > -ZERO_CELSIUS:
-            raise ValueError(f"diode temperature must be above absolute zero; got {self.temperature!r} C")
+            raise ValueError(
+                f"diode temperature must be above absolute zero; got {self.temperature!r} C"
+            )
 
     @property
     def n_vth(self) -> float:
@@ -119,8 +123,10 @@ class Diode:
             return np.zeros_like(current)
         if self.model == "constant":
             return np.full_like(current, self.forward_voltage)
-        return (self.n_vth * np.log1p(current / self.saturation_current)
-                + current * self.series_resistance)
+        return (
+            self.n_vth * np.log1p(current / self.saturation_current)
+            + current * self.series_resistance
+        )
 
     def resistance(self, current):
         """Differential resistance ``dV/dI`` [ohm] of :meth:`drop` at a forward current.
@@ -167,22 +173,32 @@ DIODE_PARTS = {
     "mbr745": DiodePart(
         name="mbr745",
         description="ON Semiconductor MBR745, 7.5 A 45 V Schottky rectifier (TO-220AC)",
-        average_current=7.5, reverse_voltage=45.0,
+        average_current=7.5,
+        reverse_voltage=45.0,
         # [3]: maximum instantaneous forward voltage 0.57 V at 7.5 A, T_J = 125 C (a warm
         # junction, as in a sealed junction box). Its SPICE model [4] gives 0.58 V at 5.5 A and
         # 25 C, so one constant drop of 0.57 V stands for both.
-        forward_voltage=0.57, forward_current=7.5, forward_temperature=125.0,
+        forward_voltage=0.57,
+        forward_current=7.5,
+        forward_temperature=125.0,
         # [4]: Is = 159 uA, N = 1.76, Rs = 0.02 ohm.
-        saturation_current=159e-6, ideality=1.76, series_resistance=0.02,
+        saturation_current=159e-6,
+        ideality=1.76,
+        series_resistance=0.02,
         sources="V_F: ON Semiconductor datasheet MBR735/D Rev. 8 (2009); SPICE: LTspice standard.dio",
     ),
     "pds760": DiodePart(
         name="pds760",
         description="Diodes Incorporated PDS760, 7 A 60 V Schottky rectifier (PowerDI 5)",
-        average_current=7.0, reverse_voltage=60.0,
-        forward_voltage=None, forward_current=None, forward_temperature=None,
+        average_current=7.0,
+        reverse_voltage=60.0,
+        forward_voltage=None,
+        forward_current=None,
+        forward_temperature=None,
         # [4]: Is = 360 nA, N = 1.04, Rs = 0.016 ohm (0.53 V at 5.5 A and 25 C).
-        saturation_current=360e-9, ideality=1.04, series_resistance=0.016,
+        saturation_current=360e-9,
+        ideality=1.04,
+        series_resistance=0.016,
         sources="SPICE: LTspice standard.dio (mfg Diodes Inc.)",
     ),
 }
@@ -234,11 +250,18 @@ def diode(model: str = "constant", part: str | None = DEFAULT_DIODE_PART, **over
         spec = DIODE_PARTS[part]
         if model == "constant" and "forward_voltage" not in overrides:
             if spec.forward_voltage is None:
-                with_drop = [name for name, p in DIODE_PARTS.items() if p.forward_voltage is not None]
-                raise ValueError(f"part {part!r} has no datasheet forward voltage; give forward_voltage or "
-                                 f"take one of {', '.join(with_drop)}")
+                with_drop = [
+                    name for name, p in DIODE_PARTS.items() if p.forward_voltage is not None
+                ]
+                raise ValueError(
+                    f"part {part!r} has no datasheet forward voltage; give forward_voltage or "
+                    f"take one of {', '.join(with_drop)}"
+                )
             values["forward_voltage"] = spec.forward_voltage
         if model == "shockley":
-            values.update(saturation_current=spec.saturation_current, ideality=spec.ideality,
-                          series_resistance=spec.series_resistance)
+            values.update(
+                saturation_current=spec.saturation_current,
+                ideality=spec.ideality,
+                series_resistance=spec.series_resistance,
+            )
     return Diode(**{**values, **overrides})

@@ -174,7 +174,9 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
         # Rodrigues' rotation of the normal about the up-slope unit vector u, which is
         # perpendicular to it: n' = n cos(a) + (u x n) sin(a). u x n is horizontal and points to
         # azimuth - 90; the limit tilt -> 0 keeps u along the base azimuth's back direction.
-        up_slope = np.array([-np.cos(tilt) * np.sin(azimuth), -np.cos(tilt) * np.cos(azimuth), np.sin(tilt)])
+        up_slope = np.array(
+            [-np.cos(tilt) * np.sin(azimuth), -np.cos(tilt) * np.cos(azimuth), np.sin(tilt)]
+        )
         side = np.cross(up_slope, normal)
         angle = np.radians(turn)[..., None]
         east = normal * np.cos(angle) + side * np.sin(angle)

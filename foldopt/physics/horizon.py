@@ -62,8 +62,10 @@ def _profile(horizon_azimuth, horizon_elevation):
     azimuth = np.asarray(horizon_azimuth, dtype=float)
     elevation = np.asarray(horizon_elevation, dtype=float)
     if azimuth.ndim != 1 or azimuth.shape != elevation.shape or azimuth.size == 0:
-        raise ValueError(f"horizon_azimuth and horizon_elevation must be 1-D arrays of one length; got shapes "
-                         f"{azimuth.shape} and {elevation.shape}")
+        raise ValueError(
+            f"horizon_azimuth and horizon_elevation must be 1-D arrays of one length; got shapes "
+            f"{azimuth.shape} and {elevation.shape}"
+        )
     if not (np.all(np.isfinite(azimuth)) and np.all(np.isfinite(elevation))):
         raise ValueError("horizon_azimuth and horizon_elevation must be finite")
     if azimuth[0] < 0 or azimuth[-1] >= 360 or np.any(np.diff(azimuth) <= 0):
@@ -102,8 +104,12 @@ def horizon_elevation_at(azimuth, horizon_azimuth, horizon_elevation):
     [15.  5. 15.]
     """
     profile_azimuth, profile_elevation = _profile(horizon_azimuth, horizon_elevation)
-    return np.interp(np.mod(np.asarray(azimuth, dtype=float), 360.0), profile_azimuth, profile_elevation,
-                     period=360.0)
+    return np.interp(
+        np.mod(np.asarray(azimuth, dtype=float), 360.0),
+        profile_azimuth,
+        profile_elevation,
+        period=360.0,
+    )
 
 
 def sun_visible(solar_zenith, solar_azimuth, horizon_azimuth, horizon_elevation):
@@ -133,7 +139,9 @@ def sun_visible(solar_zenith, solar_azimuth, horizon_azimuth, horizon_elevation)
     >>> print(sun_visible([80.0, 60.0], [90.0, 90.0], [0.0, 90.0, 180.0, 270.0], [0.0, 15.0, 0.0, 0.0]))
     [False  True]
     """
-    zenith, azimuth = np.broadcast_arrays(np.asarray(solar_zenith, dtype=float), np.asarray(solar_azimuth, dtype=float))
+    zenith, azimuth = np.broadcast_arrays(
+        np.asarray(solar_zenith, dtype=float), np.asarray(solar_azimuth, dtype=float)
+    )
     line = horizon_elevation_at(azimuth, horizon_azimuth, horizon_elevation)
     with np.errstate(invalid="ignore"):
         return np.asarray((90.0 - zenith) > line)
@@ -192,8 +200,14 @@ def _edges(tilt, azimuth, facing_up):
         scale = np.abs(np.cos(tilt) / np.sin(tilt))
     steps = np.minimum(scale[None, :] * np.array([0.25, 1.0, 4.0, 16.0])[:, None], 0.25 * np.pi)
     edges = (azimuth + 0.5 * np.pi, azimuth - 0.5 * np.pi)
-    runs = [np.vstack([edges[0], edges[0] + steps]) if facing_up else np.vstack([edges[0] - steps[::-1], edges[0]]),
-            np.vstack([edges[1] - steps[::-1], edges[1]]) if facing_up else np.vstack([edges[1], edges[1] + steps])]
+    runs = [
+        np.vstack([edges[0], edges[0] + steps])
+        if facing_up
+        else np.vstack([edges[0] - steps[::-1], edges[0]]),
+        np.vstack([edges[1] - steps[::-1], edges[1]])
+        if facing_up
+        else np.vstack([edges[1], edges[1] + steps]),
+    ]
     return edges, runs, scale < 0.2
 
 
@@ -213,7 +227,11 @@ def _split(sin_t, cos_t, azimuth, run, lo, hi, h_lo, h_hi, facing_up):
         if previous is not None:
             same = (previous_j == j) & (previous <= point)
             start, h_start = np.where(same, previous, start), np.where(same, previous_h, h_start)
-        pieces += [(start, point, h_start, height), (point, hi[j], height, h_hi[j]), (start, hi[j], h_start, h_hi[j])]
+        pieces += [
+            (start, point, h_start, height),
+            (point, hi[j], height, h_hi[j]),
+            (start, hi[j], h_start, h_hi[j]),
+        ]
         previous, previous_j, previous_h = point, j, height
     phi, h, w = _gauss(*(np.stack(column, axis=-1) for column in zip(*pieces)))  # (n, 3 m, 3)
     a = sin_t[:, None, None] * np.cos(phi - azimuth[:, None, None])
@@ -251,27 +269,36 @@ def _isotropic(tilt, azimuth, lo, hi, h_lo, h_hi):
     classes = np.minimum((np.mod(azimuth, _TWO_PI) / width).astype(int), _AZIMUTH_BINS - 1)
     for k in np.unique(classes):
         members = np.flatnonzero(classes == k)
-        centre = (k + 0.5) * width + (np.pi if facing_up else 0.0)  # behind or in front of the plane
+        centre = (k + 0.5) * width + (
+            np.pi if facing_up else 0.0
+        )  # behind or in front of the plane
         cols = _window(lo, hi, centre - 0.5 * (np.pi + width), centre + 0.5 * (np.pi + width))
         c_cos, c_sin, c_h, c_p, c_q, c_w = (x[cols].ravel() for x in (cos_phi, sin_phi, h, p, q, w))
         step = max(1, _BLOCK // c_w.size)
         for start in range(0, members.size, step):
-            rows = members[start:start + step]
+            rows = members[start : start + step]
             a = sin_t[rows, None] * (cos_a[rows, None] * c_cos + sin_a[rows, None] * c_sin)
             total[rows] = _correction(a, b[rows, None], c_h, c_p, c_q, facing_up) @ c_w
     edges, runs, near = _edges(tilt, azimuth, facing_up)
-    for subset, splits in ((np.flatnonzero(~near), [edge[None, :] for edge in edges]), (np.flatnonzero(near), runs)):
+    for subset, splits in (
+        (np.flatnonzero(~near), [edge[None, :] for edge in edges]),
+        (np.flatnonzero(near), runs),
+    ):
         step = max(1, _BLOCK // (9 * splits[0].shape[0]))
         for start in range(0, subset.size, step):
-            part = subset[start:start + step]
+            part = subset[start : start + step]
             for run in splits:  # near-vertical planes split at the refined runs
-                total[part] += _split(sin_t[part], b[part], azimuth[part], run[:, part], lo, hi, h_lo, h_hi, facing_up)
+                total[part] += _split(
+                    sin_t[part], b[part], azimuth[part], run[:, part], lo, hi, h_lo, h_hi, facing_up
+                )
     if not facing_up:
         return total / np.pi
     # The terrain's own part, exact: 16-point rules on intervals where P(h) and Q(h) are smooth.
     phi_x, h_x, w_x = _gauss(lo, hi, h_lo, h_hi, _EXACT_X, _EXACT_W)
     p_x, q_x = _pq(h_x)
-    main = sin_t * (cos_a * np.sum(w_x * np.cos(phi_x) * p_x) + sin_a * np.sum(w_x * np.sin(phi_x) * p_x))
+    main = sin_t * (
+        cos_a * np.sum(w_x * np.cos(phi_x) * p_x) + sin_a * np.sum(w_x * np.sin(phi_x) * p_x)
+    )
     return cos_t - (main + cos_t * np.sum(w_x * q_x) - total) / np.pi
 
 
@@ -288,7 +315,9 @@ def _band_pieces(profile_azimuth, profile_elevation, width):
         return x[:-1], x[1:], hidden, hidden
     # Within a segment the hidden share h / width is linear until the horizon passes the band's top.
     crossing = (h[:-1] - width) * (h[1:] - width) < 0
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # used only where the horizon crosses
+    with np.errstate(
+        invalid="ignore", divide="ignore", over="ignore"
+    ):  # used only where the horizon crosses
         at = x[:-1] + (width - h[:-1]) / (h[1:] - h[:-1]) * (x[1:] - x[:-1])
     points = np.concatenate([x, at[crossing]])
     heights = np.concatenate([h, np.full(np.count_nonzero(crossing), width)])
@@ -313,7 +342,10 @@ def _band(tilt, azimuth, profile_azimuth, profile_elevation, width):
     """The band factor of :func:`sky_view_factors` (exact for a straight-line horizon)."""
     starts, ends, p0, p1 = _band_pieces(profile_azimuth, profile_elevation, width)
     piece_c, piece_s, slope = _band_integrals(starts, ends, p0, p1)
-    cum_c, cum_s = np.concatenate([[0.0], np.cumsum(piece_c)]), np.concatenate([[0.0], np.cumsum(piece_s)])
+    cum_c, cum_s = (
+        np.concatenate([[0.0], np.cumsum(piece_c)]),
+        np.concatenate([[0.0], np.cumsum(piece_s)]),
+    )
     origin = starts[0]
 
     def primitive(x):  # int_origin^x hidden(phi) (cos, sin)(phi) dphi, hidden periodic
@@ -321,8 +353,16 @@ def _band(tilt, azimuth, profile_azimuth, profile_elevation, width):
         r = x - _TWO_PI * turns
         j = np.clip(np.searchsorted(starts, r, side="right") - 1, 0, starts.size - 1)
         p = p0[j] + slope[j] * (r - starts[j])
-        part_c = p * np.sin(r) + slope[j] * np.cos(r) - (p0[j] * np.sin(starts[j]) + slope[j] * np.cos(starts[j]))
-        part_s = -p * np.cos(r) + slope[j] * np.sin(r) - (-p0[j] * np.cos(starts[j]) + slope[j] * np.sin(starts[j]))
+        part_c = (
+            p * np.sin(r)
+            + slope[j] * np.cos(r)
+            - (p0[j] * np.sin(starts[j]) + slope[j] * np.cos(starts[j]))
+        )
+        part_s = (
+            -p * np.cos(r)
+            + slope[j] * np.sin(r)
+            - (-p0[j] * np.cos(starts[j]) + slope[j] * np.sin(starts[j]))
+        )
         return turns * cum_c[-1] + cum_c[j] + part_c, turns * cum_s[-1] + cum_s[j] + part_s
 
     (c_hi, s_hi), (c_lo, s_lo) = primitive(azimuth + 0.5 * np.pi), primitive(azimuth - 0.5 * np.pi)
@@ -330,8 +370,14 @@ def _band(tilt, azimuth, profile_azimuth, profile_elevation, width):
     return np.sin(tilt) * np.clip(1.0 - 0.5 * hidden, 0.0, 1.0)
 
 
-def sky_view_factors(surface_tilt, surface_azimuth, horizon_azimuth, horizon_elevation, n_azimuth=N_AZIMUTH,
-                     band_width=HORIZON_BAND_WIDTH):
+def sky_view_factors(
+    surface_tilt,
+    surface_azimuth,
+    horizon_azimuth,
+    horizon_elevation,
+    n_azimuth=N_AZIMUTH,
+    band_width=HORIZON_BAND_WIDTH,
+):
     r"""The factors of the isotropic sky and of Perez's horizon band for surfaces under one horizon.
 
     **Isotropic.** The factor that replaces ``(1 + cos tilt) / 2``: of an isotropic sky's diffuse
@@ -423,8 +469,9 @@ def sky_view_factors(surface_tilt, surface_azimuth, horizon_azimuth, horizon_ele
         raise ValueError(f"n_azimuth must be an integer of at least 4; got {n_azimuth!r}")
     if not band_width >= 0:
         raise ValueError(f"band_width must be >= 0 deg; got {band_width!r}")
-    tilt_deg, azimuth_deg = np.broadcast_arrays(np.asarray(surface_tilt, dtype=float),
-                                                np.asarray(surface_azimuth, dtype=float))
+    tilt_deg, azimuth_deg = np.broadcast_arrays(
+        np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
+    )
     valid = np.isfinite(tilt_deg) & np.isfinite(azimuth_deg)
     if np.any((tilt_deg[valid] < -1e-9) | (tilt_deg[valid] > 180.0 + 1e-9)):
         raise ValueError("surface_tilt must be in [0, 180] deg")

@@ -51,7 +51,9 @@ def perez_coefficients() -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(f1, dtype=float), np.ascontiguousarray(f2, dtype=float)
 
 
-def beam_incidence_factor(surface_tilt, surface_azimuth, solar_zenith, solar_azimuth, model="exact"):
+def beam_incidence_factor(
+    surface_tilt, surface_azimuth, solar_zenith, solar_azimuth, model="exact"
+):
     """Ratio of beam irradiance on the surface to direct normal irradiance, clipped at zero.
 
     Parameters
@@ -105,7 +107,9 @@ def _perez_brightness(dhi, dni, dni_extra, solar_zenith, airmass):
     NaN where there is no diffuse light."""
     z = np.radians(solar_zenith)
     delta = dhi * airmass / dni_extra
-    kappa_z3 = PEREZ_KAPPA * (z * z * z)  # products, not a power: a map's sky spent 1.5 ms a site in pow
+    kappa_z3 = PEREZ_KAPPA * (
+        z * z * z
+    )  # products, not a power: a map's sky spent 1.5 ms a site in pow
     with np.errstate(invalid="ignore", divide="ignore"):
         eps = ((dhi + dni) / dhi + kappa_z3) / (1.0 + kappa_z3)
     # The bin is the count of its lower edges at or below eps, less one (np.digitize's), -1 for NaN
@@ -157,7 +161,9 @@ def sky_diffuse_terms(model, solar_zenith, dni, ghi, dhi, dni_extra, airmass, al
         hor = dhi * f2
     else:
         raise ValueError(f"transposition must be one of {', '.join(TRANSPOSITIONS)}; got {model!r}")
-    terms = np.stack(np.broadcast_arrays(iso, circ, hor, np.asarray(ghi, dtype=float) * albedo), axis=-1)
+    terms = np.stack(
+        np.broadcast_arrays(iso, circ, hor, np.asarray(ghi, dtype=float) * albedo), axis=-1
+    )
     terms[np.isnan(terms)] = 0.0  # no diffuse light: pvlib's NaN, foldopt's 0
     return terms
 

@@ -122,8 +122,10 @@ def cec_module_name(name: str) -> str:
     if len(matches) == 1:
         return matches[0]
     if matches:
-        raise ValueError(f"module {name!r} matches {len(matches)} modules of pvlib's CEC database, such as "
-                         f"{', '.join(matches[:4])}; give more of the name")
+        raise ValueError(
+            f"module {name!r} matches {len(matches)} modules of pvlib's CEC database, such as "
+            f"{', '.join(matches[:4])}; give more of the name"
+        )
     close = [squashed[short] for short in difflib.get_close_matches(key, squashed, n=4, cutoff=0.6)]
     hint = f"; did you mean {', '.join(close)}?" if close else ""
     raise ValueError(f"module {name!r} is not in pvlib's CEC database{hint}")
@@ -190,7 +192,14 @@ class BModelPanel:
 #: Robles Algarin et al. Table 1: the 200 W panel of their tracker tests.
 ROBLES_200W = BModelPanel(
     name="Robles Algarin et al. 200 W panel (Table 1)",
-    i_sc=8.21, v_oc=32.1, v_mp=26.01, i_mp=7.69, tc_v=-0.07, tc_i=0.002, v_max=33.06, v_min=27.28,
+    i_sc=8.21,
+    v_oc=32.1,
+    v_mp=26.01,
+    i_mp=7.69,
+    tc_v=-0.07,
+    tc_i=0.002,
+    v_max=33.06,
+    v_min=27.28,
 )
 
 
@@ -312,7 +321,9 @@ class IVCurve:
             mpp = pvlib.pvsystem.max_power_point(*self.params, method="newton")
             lit = self.lit
             power = np.clip(np.nan_to_num(np.asarray(mpp["p_mp"], dtype=float)), 0.0, None)
-            return np.where(lit, power, 0.0), np.where(lit, np.nan_to_num(np.asarray(mpp["v_mp"], dtype=float)), 0.0)
+            return np.where(lit, power, 0.0), np.where(
+                lit, np.nan_to_num(np.asarray(mpp["v_mp"], dtype=float)), 0.0
+            )
         # Eq. 8: dP/dV = 0 has the closed form v = b (W(e^(1 + 1/b)) - 1), v = V / V_x, for all
         # irradiances; Lambert's W of the log-argument avoids overflow for small b.
         v_x, i_x, b = self.params
@@ -416,21 +427,27 @@ class PVModel:
             # R_sh scales as 1/irradiance: at vanishing irradiance it overflows to inf, harmlessly.
             with np.errstate(over="ignore", divide="ignore"):
                 if u.adjust is None:
-                    il, io, rs, rsh, nnsvth = pvlib.pvsystem.calcparams_desoto(*args, EgRef=u.EgRef, dEgdT=u.dEgdT)
+                    il, io, rs, rsh, nnsvth = pvlib.pvsystem.calcparams_desoto(
+                        *args, EgRef=u.EgRef, dEgdT=u.dEgdT
+                    )
                 else:
                     il, io, rs, rsh, nnsvth = pvlib.pvsystem.calcparams_cec(
                         *args, u.adjust, EgRef=u.EgRef, dEgdT=u.dEgdT
                     )
             shape = poa.shape
             params = (il, io, rs * units, rsh * units, nnsvth * units)
-            return IVCurve(self.model, tuple(np.broadcast_to(np.asarray(p, dtype=float), shape) for p in params))
+            return IVCurve(
+                self.model,
+                tuple(np.broadcast_to(np.asarray(p, dtype=float), shape) for p in params),
+            )
         if self.model == "b-model":
             ratio = poa / IRRADIANCE_REF
             # Eq. 9 (s = units in series) and Eq. 10 (p = 1). At zero irradiance I_x = 0.
             v_x = units * (
                 ratio * u.tc_v * (temp_cell - TEMPERATURE_REF)
                 + u.v_max
-                - (u.v_max - u.v_min) * np.exp(ratio * np.log((u.v_max - u.v_oc) / (u.v_max - u.v_min)))
+                - (u.v_max - u.v_min)
+                * np.exp(ratio * np.log((u.v_max - u.v_oc) / (u.v_max - u.v_min)))
             )
             i_x = ratio * (u.i_sc + u.tc_i * (temp_cell - TEMPERATURE_REF))
             v_x = np.where(i_x > 0, v_x, 0.0)

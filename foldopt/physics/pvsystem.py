@@ -16,9 +16,19 @@ from foldopt.physics.geometry import subpanel_orientation
 from foldopt.names import GEOMETRIES, canonical
 
 
-def twofold_arrays(fold_angle, surface_tilt, surface_azimuth, geometry="hinge", *, module_parameters=None,
-                   temperature_model_parameters=None, modules_per_string=2, strings=1, name_prefix="",
-                   **array_kwargs):
+def twofold_arrays(
+    fold_angle,
+    surface_tilt,
+    surface_azimuth,
+    geometry="hinge",
+    *,
+    module_parameters=None,
+    temperature_model_parameters=None,
+    modules_per_string=2,
+    strings=1,
+    name_prefix="",
+    **array_kwargs,
+):
     """The east and west sub-panels of a twofold panel as pvlib ``Array`` objects.
 
     The panel of ``modules_per_string`` modules in each of ``strings`` strings is folded along
@@ -94,20 +104,37 @@ def twofold_arrays(fold_angle, surface_tilt, surface_azimuth, geometry="hinge", 
             raise ValueError(f"must be one of {', '.join(GEOMETRIES)}")
     except ValueError as error:
         raise ValueError(f"geometry = {geometry!r}: {error}") from None
-    if (isinstance(modules_per_string, bool) or not isinstance(modules_per_string, int)
-            or modules_per_string < 2 or modules_per_string % 2):
-        raise ValueError("modules_per_string must be an even integer of at least 2 (the panel's "
-                         f"modules, split evenly between the two sub-panels); got {modules_per_string!r}")
+    if (
+        isinstance(modules_per_string, bool)
+        or not isinstance(modules_per_string, int)
+        or modules_per_string < 2
+        or modules_per_string % 2
+    ):
+        raise ValueError(
+            "modules_per_string must be an even integer of at least 2 (the panel's "
+            f"modules, split evenly between the two sub-panels); got {modules_per_string!r}"
+        )
     sides = subpanel_orientation(fold, float(surface_tilt), float(surface_azimuth), name)
     arrays = []
     for side in ("east", "west"):
-        tilt, azimuth = float(sides[f"surface_tilt_{side}"]), float(sides[f"surface_azimuth_{side}"])
+        tilt, azimuth = (
+            float(sides[f"surface_tilt_{side}"]),
+            float(sides[f"surface_azimuth_{side}"]),
+        )
         if not (math.isfinite(tilt) and math.isfinite(azimuth)):
-            raise ValueError(f"surface_tilt and surface_azimuth must be finite; got {surface_tilt!r}, "
-                             f"{surface_azimuth!r}")
-        arrays.append(Array(FixedMount(surface_tilt=tilt, surface_azimuth=azimuth),
-                            module_parameters=module_parameters,
-                            temperature_model_parameters=temperature_model_parameters,
-                            modules_per_string=modules_per_string // 2, strings=strings,
-                            name=f"{name_prefix}{side}", **array_kwargs))
+            raise ValueError(
+                f"surface_tilt and surface_azimuth must be finite; got {surface_tilt!r}, "
+                f"{surface_azimuth!r}"
+            )
+        arrays.append(
+            Array(
+                FixedMount(surface_tilt=tilt, surface_azimuth=azimuth),
+                module_parameters=module_parameters,
+                temperature_model_parameters=temperature_model_parameters,
+                modules_per_string=modules_per_string // 2,
+                strings=strings,
+                name=f"{name_prefix}{side}",
+                **array_kwargs,
+            )
+        )
     return tuple(arrays)

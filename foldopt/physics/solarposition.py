@@ -159,8 +159,12 @@ class ClockGrid:
             raise ValueError("stacked grids need the same steps per day")
         if len(grids) == 1:
             return grids[0]
-        return cls(np.concatenate([g.utc_ns for g in grids]), np.concatenate([g.utc_offset_ns for g in grids]),
-                   sum((g.timezones for g in grids), ()), grids[0].step_hours)
+        return cls(
+            np.concatenate([g.utc_ns for g in grids]),
+            np.concatenate([g.utc_offset_ns for g in grids]),
+            sum((g.timezones for g in grids), ()),
+            grids[0].step_hours,
+        )
 
     @classmethod
     def from_times(cls, days, timezone) -> ClockGrid:
@@ -177,9 +181,17 @@ class ClockGrid:
         -------
         ClockGrid
         """
-        utc = np.stack([np.asarray(pd.DatetimeIndex(t).tz_convert("UTC").tz_localize(None).as_unit("ns").asi8)
-                        for t in days])
-        local = np.stack([np.asarray(pd.DatetimeIndex(t).tz_localize(None).as_unit("ns").asi8) for t in days])
+        utc = np.stack(
+            [
+                np.asarray(
+                    pd.DatetimeIndex(t).tz_convert("UTC").tz_localize(None).as_unit("ns").asi8
+                )
+                for t in days
+            ]
+        )
+        local = np.stack(
+            [np.asarray(pd.DatetimeIndex(t).tz_localize(None).as_unit("ns").asi8) for t in days]
+        )
         step = float(np.median(np.diff(utc, axis=1))) / NS_PER_HOUR if utc.shape[1] > 1 else 24.0
         return cls(utc, local - utc, (timezone,) * len(days), step)
 
@@ -324,7 +336,9 @@ def sun_from_angles(declination, hour_angle, latitude):
     return 90.0 - np.degrees(elevation), azimuth
 
 
-def solar_position_grid(grid: ClockGrid, latitude, longitude, altitude=0.0, model: str = "exact") -> dict:
+def solar_position_grid(
+    grid: ClockGrid, latitude, longitude, altitude=0.0, model: str = "exact"
+) -> dict:
     """Solar position at every step of a grid of days.
 
     Parameters
@@ -352,19 +366,31 @@ def solar_position_grid(grid: ClockGrid, latitude, longitude, altitude=0.0, mode
     dayofyear = grid.dayofyear
     if model == "paper":
         declination = _by_dayofyear(declination_paper, dayofyear)
-        hour_angle = _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, dayofyear, longitude)
+        hour_angle = _hour_angle_paper(
+            grid.clock_hours, grid.utc_offset_hours, dayofyear, longitude
+        )
         solar_zenith, solar_azimuth = sun_from_angles(declination, hour_angle, latitude)
         vector = normal_vector(solar_zenith, solar_azimuth)
     elif model == "exact":
-        solar_zenith, solar_azimuth, equation_of_time, vector = spa_solar_position(grid.utc_ns, latitude, longitude,
-                                                                                   altitude)
+        solar_zenith, solar_azimuth, equation_of_time, vector = spa_solar_position(
+            grid.utc_ns, latitude, longitude, altitude
+        )
         utc_hours = (grid.utc_ns % _NS_PER_DAY) / NS_PER_HOUR
-        hour_angle = (15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0) % 360.0 - 180.0
-        declination = _by_dayofyear(lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), dayofyear)
+        hour_angle = (
+            15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0
+        ) % 360.0 - 180.0
+        declination = _by_dayofyear(
+            lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), dayofyear
+        )
     else:
         raise ValueError(f"model must be one of {', '.join(MODES)}; got {model!r}")
-    return {"solar_zenith": solar_zenith, "solar_azimuth": solar_azimuth, "hour_angle": hour_angle,
-            "declination": np.broadcast_to(declination, np.shape(solar_zenith)), "sun_vector": vector}
+    return {
+        "solar_zenith": solar_zenith,
+        "solar_azimuth": solar_azimuth,
+        "hour_angle": hour_angle,
+        "declination": np.broadcast_to(declination, np.shape(solar_zenith)),
+        "sun_vector": vector,
+    }
 
 
 def get_solar_position(
@@ -392,5 +418,9 @@ def get_solar_position(
         Columns ``solar_zenith``, ``solar_azimuth``, ``hour_angle`` and ``declination`` [deg],
         indexed by ``times``.
     """
-    sun = solar_position_grid(ClockGrid.from_times([times], times.tz), latitude, longitude, altitude, model)
-    return pd.DataFrame({name: values[0] for name, values in sun.items() if name != "sun_vector"}, index=times)
+    sun = solar_position_grid(
+        ClockGrid.from_times([times], times.tz), latitude, longitude, altitude, model
+    )
+    return pd.DataFrame(
+        {name: values[0] for name, values in sun.items() if name != "sun_vector"}, index=times
+    )

@@ -86,8 +86,13 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
     radius = spa.heliocentric_radius_vector(jme)
     theta = spa.geocentric_longitude(spa.heliocentric_longitude(jme))
     beta = spa.geocentric_latitude(spa.heliocentric_latitude(jme))
-    args = (spa.mean_elongation(jce), spa.mean_anomaly_sun(jce), spa.mean_anomaly_moon(jce),
-            spa.moon_argument_latitude(jce), spa.moon_ascending_longitude(jce))
+    args = (
+        spa.mean_elongation(jce),
+        spa.mean_anomaly_sun(jce),
+        spa.mean_anomaly_moon(jce),
+        spa.moon_argument_latitude(jce),
+        spa.moon_ascending_longitude(jce),
+    )
     nutation = np.empty((2, unixtime.size))
     spa.longitude_obliquity_nutation(jce, *args, nutation)
     delta_psi, delta_epsilon = nutation
@@ -97,7 +102,13 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
     alpha = spa.geocentric_sun_right_ascension(lamd, epsilon, beta)
     delta = spa.geocentric_sun_declination(lamd, epsilon, beta)
     eot = spa.equation_of_time(spa.sun_mean_longitude(jme), alpha, delta_psi, epsilon)
-    return {"alpha": alpha, "delta": delta, "v": v, "xi": spa.equatorial_horizontal_parallax(radius), "eot": eot}
+    return {
+        "alpha": alpha,
+        "delta": delta,
+        "v": v,
+        "xi": spa.equatorial_horizontal_parallax(radius),
+        "eot": eot,
+    }
 
 
 _WRAPPED = ("alpha", "v")  # angles that wrap at 360 deg
@@ -123,7 +134,10 @@ def _geocentric_at_hours(nodes: np.ndarray) -> dict:
             hours, terms = missing[:0], {name: values[:0] for name, values in found.items()}
         order = np.argsort(np.concatenate([hours, missing]), kind="stable")
         hours = np.concatenate([hours, missing])[order]
-        terms = {name: np.concatenate([terms.get(name, values[:0]), values])[order] for name, values in found.items()}
+        terms = {
+            name: np.concatenate([terms.get(name, values[:0]), values])[order]
+            for name, values in found.items()
+        }
         _AT_HOURS = (hours, terms)
     index = np.searchsorted(hours, nodes)
     return {name: values[index] for name, values in terms.items()}
@@ -160,8 +174,15 @@ def _equatorial(utc_ns) -> np.ndarray:
     greenwich = np.radians(geo["v"] - geo["alpha"])
     delta = np.radians(geo["delta"])
     cos_delta = np.cos(delta)
-    return np.stack([cos_delta * np.cos(greenwich), cos_delta * np.sin(greenwich), np.sin(delta),
-                     np.sin(np.radians(geo["xi"])), geo["eot"]])
+    return np.stack(
+        [
+            cos_delta * np.cos(greenwich),
+            cos_delta * np.sin(greenwich),
+            np.sin(delta),
+            np.sin(np.radians(geo["xi"])),
+            geo["eot"],
+        ]
+    )
 
 
 #: The terms of :func:`_equatorial` at the steps of UTC lattices this process has evaluated,
@@ -183,8 +204,11 @@ def _shared_terms(utc_ns: np.ndarray) -> tuple:
     step = int(utc_ns[0, 1] - utc_ns[0, 0]) if n_steps > 1 else 0
     phase = int(utc_ns[0, 0] % step) if step > 0 else 0
     # A day of equal steps spans them; a clock's change (a DST day) does not.
-    lattice = step > 0 and np.all(utc_ns[:, 0] % step == phase) and np.all(
-        utc_ns[:, -1] - utc_ns[:, 0] == step * (n_steps - 1))
+    lattice = (
+        step > 0
+        and np.all(utc_ns[:, 0] % step == phase)
+        and np.all(utc_ns[:, -1] - utc_ns[:, 0] == step * (n_steps - 1))
+    )
     if not lattice:
         return np.arange(n_blocks) * n_steps, _equatorial(utc_ns).reshape(5, -1)
     start = (utc_ns[:, 0] - phase) // step
@@ -208,15 +232,29 @@ def _raised(east, north, up, t):
     9th and 10th power, exact in double precision (the next terms are below 1e-21)."""
     t2 = t * t
     sin_t = t * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))))
-    cos_t = 1.0 - t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0))))
+    cos_t = 1.0 - t2 / 2.0 * (
+        1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0)))
+    )
     level = math.sqrt(east * east + north * north)
     along = (level * cos_t - up * sin_t) / level if level > 0.0 else 0.0
     return east * along, north * along, up * cos_t + level * sin_t
 
 
 @njit(cache=True)
-def _site_sun(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, pressure, direction, apparent_zenith,
-              solar_azimuth):
+def _site_sun(
+    terms,
+    first,
+    sin_lam,
+    cos_lam,
+    sin_phi,
+    cos_phi,
+    x,
+    y,
+    pressure,
+    direction,
+    apparent_zenith,
+    solar_azimuth,
+):
     """Every step of every block in one pass: the geometric topocentric unit vector toward the sun
     (east, north, up), from ``terms[:, first[b] + i]`` (:func:`_shared_terms`) and the site's
     arguments per block; its elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s
@@ -247,7 +285,9 @@ def _site_sun(terms, first, sin_lam, cos_lam, sin_phi, cos_phi, x, y, pressure, 
             heading = math.atan2(east, north) * to_degrees
             solar_azimuth[b, i] = heading + 360.0 if heading < 0.0 else heading
             if elevation >= cut:
-                refraction = scale / (60 * math.tan((elevation + 10.3 / (elevation + 5.11)) * to_radians))
+                refraction = scale / (
+                    60 * math.tan((elevation + 10.3 / (elevation + 5.11)) * to_radians)
+                )
                 east, north, up = _raised(east, north, up, refraction * to_radians)
                 elevation += refraction
             direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
@@ -299,17 +339,33 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     shape = utc_ns.shape
 
     def per_block(values):
-        return np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=float), (shape[0], 1))[:, 0])
+        return np.ascontiguousarray(
+            np.broadcast_to(np.asarray(values, dtype=float), (shape[0], 1))[:, 0]
+        )
 
     latitude, longitude, altitude = per_block(latitude), per_block(longitude), per_block(altitude)
     u = pvlib.spa.uterm(latitude)
     x, y = pvlib.spa.xterm(u, latitude, altitude), pvlib.spa.yterm(u, latitude, altitude)
     lam, phi = np.radians(longitude), np.radians(latitude)
     first, terms = _shared_terms(utc_ns)
-    vector = np.empty((shape[0], 3, shape[1]))  # each component along the steps, as the engine reads it
+    vector = np.empty(
+        (shape[0], 3, shape[1])
+    )  # each component along the steps, as the engine reads it
     apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
     pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
-    _site_sun(terms, first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure, vector,
-              apparent_zenith, solar_azimuth)
+    _site_sun(
+        terms,
+        first,
+        np.sin(lam),
+        np.cos(lam),
+        np.sin(phi),
+        np.cos(phi),
+        x,
+        y,
+        pressure,
+        vector,
+        apparent_zenith,
+        solar_azimuth,
+    )
     equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
     return apparent_zenith, solar_azimuth, equation_of_time, np.moveaxis(vector, 1, -1)

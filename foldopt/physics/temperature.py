@@ -44,7 +44,9 @@ def cell_temperature(poa_global, temp_air, wind_speed, model="fixed"):
     if model == "sapm":
         params = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_polymer"]
         return np.asarray(pvlib.temperature.sapm_cell(poa_global, temp_air, wind_speed, **params))
-    raise ValueError(f"temperature_model must be one of {', '.join(TEMPERATURE_MODELS)}; got {model!r}")
+    raise ValueError(
+        f"temperature_model must be one of {', '.join(TEMPERATURE_MODELS)}; got {model!r}"
+    )
 
 
 def equivalent_temp_air(temp_air, wind_speed, wind_ref, irradiance, model="fixed"):
@@ -78,8 +80,11 @@ def equivalent_temp_air(temp_air, wind_speed, wind_ref, irradiance, model="fixed
     """
     temp_air = np.asarray(temp_air, dtype=float)
     if model != "sapm":
-        return np.broadcast_to(temp_air, np.broadcast_shapes(temp_air.shape, np.shape(irradiance))).copy()
+        return np.broadcast_to(
+            temp_air, np.broadcast_shapes(temp_air.shape, np.shape(irradiance))
+        ).copy()
     params = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_polymer"]
     a, b = params["a"], params["b"]
-    return temp_air + np.asarray(irradiance, dtype=float) * (np.exp(a + b * np.asarray(wind_speed, dtype=float))
-                                                            - np.exp(a + b * wind_ref))
+    return temp_air + np.asarray(irradiance, dtype=float) * (
+        np.exp(a + b * np.asarray(wind_speed, dtype=float)) - np.exp(a + b * wind_ref)
+    )

@@ -116,8 +116,16 @@ def step_law(hour_angle, steps=12, angular_field=90.0, offsets_h=ALEXANDRU_STEP_
     return -angular_field / 2.0 + moves_done * angular_field / steps
 
 
-def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declination, latitude, options=None,
-                        sun_vector=None):
+def tracker_orientation(
+    model,
+    solar_zenith,
+    solar_azimuth,
+    hour_angle,
+    declination,
+    latitude,
+    options=None,
+    sun_vector=None,
+):
     """Panel orientation of a tracker over the day.
 
     Parameters
@@ -156,8 +164,15 @@ def tracker_orientation(model, solar_zenith, solar_azimuth, hour_angle, declinat
     """
     if model not in TRACKER_MODELS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}; got {model!r}")
-    return TRACKER_MODELS[model].orientation(solar_zenith, solar_azimuth, hour_angle, declination, latitude,
-                                             options or TrackerOptions(), sun_vector)
+    return TRACKER_MODELS[model].orientation(
+        solar_zenith,
+        solar_azimuth,
+        hour_angle,
+        declination,
+        latitude,
+        options or TrackerOptions(),
+        sun_vector,
+    )
 
 
 _UP = np.array([0.0, 0.0, 1.0])  # a level panel's normal
@@ -180,22 +195,36 @@ def _dual_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, o
     """The ideal tracker: the normal on the sun, level at night."""
     solar_zenith, down, level_azimuth = _resting(solar_zenith, latitude)
     solar_azimuth = np.asarray(solar_azimuth, dtype=float)
-    on_sun = normal_vector(solar_zenith, solar_azimuth) if sun_vector is None else np.asarray(sun_vector, dtype=float)
-    return (np.where(down, 0.0, solar_zenith), np.where(down, level_azimuth, solar_azimuth),
-            np.where(down[..., None], _UP, on_sun))
+    on_sun = (
+        normal_vector(solar_zenith, solar_azimuth)
+        if sun_vector is None
+        else np.asarray(sun_vector, dtype=float)
+    )
+    return (
+        np.where(down, 0.0, solar_zenith),
+        np.where(down, level_azimuth, solar_azimuth),
+        np.where(down[..., None], _UP, on_sun),
+    )
 
 
-def _equatorial(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector):
+def _equatorial(
+    solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector
+):
     """The equatorial mount following the hour angle, level at night."""
     _, down, level_azimuth = _resting(solar_zenith, latitude)
     hour_angle = np.asarray(hour_angle, dtype=float)
     normal = equatorial_normal(hour_angle, _noon_declination(hour_angle, declination), latitude)
     surface_tilt, surface_azimuth = orientation_from_normal(normal, level_azimuth=level_azimuth)
-    return (np.where(down, 0.0, surface_tilt), np.where(down, level_azimuth, surface_azimuth),
-            np.where(down[..., None], _UP, normal))
+    return (
+        np.where(down, 0.0, surface_tilt),
+        np.where(down, level_azimuth, surface_azimuth),
+        np.where(down[..., None], _UP, normal),
+    )
 
 
-def _dual_axis_steps(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector):
+def _dual_axis_steps(
+    solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector
+):
     """The equatorial mount on Alexandru's step law, at its morning position at night."""
     _, down, level_azimuth = _resting(solar_zenith, latitude)
     hour_angle = np.asarray(hour_angle, dtype=float)
@@ -206,7 +235,9 @@ def _dual_axis_steps(solar_zenith, solar_azimuth, hour_angle, declination, latit
     return (*orientation_from_normal(normal, level_azimuth=level_azimuth), normal)
 
 
-def _single_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector):
+def _single_axis(
+    solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector
+):
     """pvlib's single-axis tracker, flat along its axis at night."""
     import pvlib  # seconds to import: where a single-axis tracker runs, not where a study reads the registry
 
@@ -215,12 +246,18 @@ def _single_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude,
     shape = solar_zenith.shape
     axis_azimuth = np.broadcast_to(axis_azimuth, shape)
     result = pvlib.tracking.singleaxis(
-        solar_zenith.ravel(), np.asarray(solar_azimuth, dtype=float).ravel(), axis_tilt=options.axis_tilt,
-        axis_azimuth=axis_azimuth.ravel(), max_angle=options.max_angle, backtrack=options.backtrack,
+        solar_zenith.ravel(),
+        np.asarray(solar_azimuth, dtype=float).ravel(),
+        axis_tilt=options.axis_tilt,
+        axis_azimuth=axis_azimuth.ravel(),
+        max_angle=options.max_angle,
+        backtrack=options.backtrack,
         gcr=options.gcr,
     )
     # At night pvlib returns NaN; the panel then rests flat along the axis.
-    surface_tilt = np.nan_to_num(np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt).reshape(shape)
+    surface_tilt = np.nan_to_num(
+        np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt
+    ).reshape(shape)
     surface_azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
     surface_azimuth = np.where(np.isnan(surface_azimuth), axis_azimuth, surface_azimuth)
     return surface_tilt, surface_azimuth, normal_vector(surface_tilt, surface_azimuth)
@@ -251,7 +288,9 @@ TRACKER_MODELS = {
     "dual-axis": TrackerModel(_dual_axis),
     "equatorial": TrackerModel(_equatorial),
     "dual-axis-steps": TrackerModel(_dual_axis_steps, ("steps", "angular_field", "step_offsets_h")),
-    "single-axis": TrackerModel(_single_axis, ("axis_tilt", "axis_azimuth", "max_angle", "backtrack", "gcr")),
+    "single-axis": TrackerModel(
+        _single_axis, ("axis_tilt", "axis_azimuth", "max_angle", "backtrack", "gcr")
+    ),
 }
 
 
@@ -364,14 +403,21 @@ class TrackerDrive:
             return self.wh_per_degree * degrees
         if self.drive != "motor":
             raise ValueError(f"drive must be one of {', '.join(DRIVES)}; got {self.drive!r}")
-        speed = self.gain / self.counts_per_revolution * 360.0  # gear-motor output at steady state [deg/s]
+        speed = (
+            self.gain / self.counts_per_revolution * 360.0
+        )  # gear-motor output at steady state [deg/s]
         moved = degrees > 0
         energy = np.zeros(degrees.shape)
-        target = degrees[moved] * self.gear_ratio  # gear-motor output rotation [deg]; only the moves are solved
+        target = (
+            degrees[moved] * self.gear_ratio
+        )  # gear-motor output rotation [deg]; only the moves are solved
         duration = _time_to_turn(target, speed, self.tau_1, self.tau_2)
         # I(t) = I_stall - (I_stall - I_free) * omega(t) / omega_ss, so the charge is
         # I_stall * T - (I_stall - I_free) * angle / omega_ss.
-        charge = self.stall_current * duration - (self.stall_current - self.free_current) * target / speed
+        charge = (
+            self.stall_current * duration
+            - (self.stall_current - self.free_current) * target / speed
+        )
         energy[moved] = self.motor_voltage * charge / 3600.0
         return energy
 

@@ -26,7 +26,11 @@ def annual_cases(result) -> list[str]:
     list of str
         Column names of ``result.table``, for :func:`annual_summary`'s ``cases``.
     """
-    others = [c for c in result.varied if c not in ("date", "dayofyear", "site_name", "latitude", "p_load_w")]
+    others = [
+        c
+        for c in result.varied
+        if c not in ("date", "dayofyear", "site_name", "latitude", "p_load_w")
+    ]
     return ["site_name", "latitude", *others, "p_load_w"]
 
 
@@ -35,13 +39,21 @@ def _note(group: pd.DataFrame, lo: float, hi: float) -> str:
     (where the days evaluated skip some of it, e.g. every 7th day)."""
     dates = pd.to_datetime(group["date"])
     span = (dates.max() - dates.min()).days + 1
-    notes = [f"fold angle varies by day, {lo:g} to {hi:g} deg (each day's: results.csv)" if lo < hi else "",
-             f"totals over the {len(group)} days evaluated, not the {span} from {dates.min():%Y-%m-%d} to "
-             f"{dates.max():%Y-%m-%d}" if len(group) < span else ""]
+    notes = [
+        f"fold angle varies by day, {lo:g} to {hi:g} deg (each day's: results.csv)"
+        if lo < hi
+        else "",
+        f"totals over the {len(group)} days evaluated, not the {span} from {dates.min():%Y-%m-%d} to "
+        f"{dates.max():%Y-%m-%d}"
+        if len(group) < span
+        else "",
+    ]
     return "; ".join(filter(None, notes))
 
 
-def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitude", "p_load_w")) -> pd.DataFrame:
+def annual_summary(
+    table: pd.DataFrame, cases=("site_name", "latitude", "longitude", "p_load_w")
+) -> pd.DataFrame:
     """The year per case and design: the daily t_solar's statistics, the totals over the days and
     each design's standing against the case's flat panel and tracker.
 
@@ -87,23 +99,47 @@ def annual_summary(table: pd.DataFrame, cases=("site_name", "latitude", "longitu
         lo, hi = group["fold_angle_deg"].min(), group["fold_angle_deg"].max()
         # One angle stands for the days only where every day has it: a design re-folded to each day's
         # best has a range, not an angle, and the first day's would stand for no other day.
-        row.update(days=len(group), fold_angle_deg=lo if lo == hi else float("nan"), fold_angle_min_deg=lo,
-                   fold_angle_max_deg=hi, note=_note(group, lo, hi), mean_t_solar_h=hours.mean(),
-                   energy_harvested_wh=group["energy_harvested_wh"].sum(),
-                   energy_served_wh=group["energy_served_wh"].sum(), energy_wasted_wh=group["energy_wasted_wh"].sum())
+        row.update(
+            days=len(group),
+            fold_angle_deg=lo if lo == hi else float("nan"),
+            fold_angle_min_deg=lo,
+            fold_angle_max_deg=hi,
+            note=_note(group, lo, hi),
+            mean_t_solar_h=hours.mean(),
+            energy_harvested_wh=group["energy_harvested_wh"].sum(),
+            energy_served_wh=group["energy_served_wh"].sum(),
+            energy_wasted_wh=group["energy_wasted_wh"].sum(),
+        )
         if "poa_kwh_m2" in group:
             row["poa_kwh_m2"] = group["poa_kwh_m2"].sum()
-        row.update(p10_t_solar_h=hours.quantile(0.1), p50_t_solar_h=hours.median(), p90_t_solar_h=hours.quantile(0.9),
-                   min_t_solar_h=hours.min())
+        row.update(
+            p10_t_solar_h=hours.quantile(0.1),
+            p50_t_solar_h=hours.median(),
+            p90_t_solar_h=hours.quantile(0.9),
+            min_t_solar_h=hours.min(),
+        )
         row.update({f"days_ge_{x}h": int((hours >= x).sum()) for x in THRESHOLDS_H})
-        row.update({f"month_{m:02d}_mean_t_solar_h": v for m, v in group.groupby("month")["t_solar_h"].mean().items()})
+        row.update(
+            {
+                f"month_{m:02d}_mean_t_solar_h": v
+                for m, v in group.groupby("month")["t_solar_h"].mean().items()
+            }
+        )
         rows.append(row)
     summary = pd.DataFrame(rows)
     for reference, gain in (("flat", "gain_vs_flat_pct"), ("tracker", "pct_of_tracker")):
-        base = summary[summary["design"] == reference].set_index(cases)[["energy_harvested_wh", "mean_t_solar_h"]]
-        matched = base.reindex(pd.MultiIndex.from_frame(summary[cases]) if len(cases) > 1 else summary[cases[0]])
-        energy = relative_to(summary["energy_harvested_wh"], matched["energy_harvested_wh"].to_numpy())
+        base = summary[summary["design"] == reference].set_index(cases)[
+            ["energy_harvested_wh", "mean_t_solar_h"]
+        ]
+        matched = base.reindex(
+            pd.MultiIndex.from_frame(summary[cases]) if len(cases) > 1 else summary[cases[0]]
+        )
+        energy = relative_to(
+            summary["energy_harvested_wh"], matched["energy_harvested_wh"].to_numpy()
+        )
         time = relative_to(summary["mean_t_solar_h"], matched["mean_t_solar_h"].to_numpy())
-        summary[f"energy_{gain}"] = (energy - 1.0) * 100.0 if reference == "flat" else energy * 100.0
+        summary[f"energy_{gain}"] = (
+            (energy - 1.0) * 100.0 if reference == "flat" else energy * 100.0
+        )
         summary[gain] = (time - 1.0) * 100.0 if reference == "flat" else time * 100.0
     return summary

@@ -112,17 +112,35 @@ class Answer:
 
     def to_dict(self) -> dict:
         """The answer as JSON-ready data (NaN as null)."""
-        return {"kind": self.kind, "title": self.title, "question": plain(self.question),
-                "defaults": self.defaults, "result": plain(self.result), "designs": records(self.designs),
-                "near_optimal": records(self.near_optimal), "schedule": records(self.schedule),
-                "notes": plain(self.notes), "lines": self.lines()}
+        return {
+            "kind": self.kind,
+            "title": self.title,
+            "question": plain(self.question),
+            "defaults": self.defaults,
+            "result": plain(self.result),
+            "designs": records(self.designs),
+            "near_optimal": records(self.near_optimal),
+            "schedule": records(self.schedule),
+            "notes": plain(self.notes),
+            "lines": self.lines(),
+        }
 
     def tables(self) -> list[tuple[str, pd.DataFrame]]:
         """The answer's tables with their titles, for a report."""
-        return [(title, table) for title, table in (
-            ("Designs compared", self.designs),
-            ("Near-optimal ranges" if self.kind == "optimize" else "Near-optimal fold angles", self.near_optimal),
-            ("Re-fold schedules", self.schedule)) if len(table)]
+        return [
+            (title, table)
+            for title, table in (
+                ("Designs compared", self.designs),
+                (
+                    "Near-optimal ranges"
+                    if self.kind == "optimize"
+                    else "Near-optimal fold angles",
+                    self.near_optimal,
+                ),
+                ("Re-fold schedules", self.schedule),
+            )
+            if len(table)
+        ]
 
 
 def note_text(note: dict) -> str:

@@ -80,8 +80,13 @@ class Blocks:
         """
         for study in studies:
             study.require_files()
-        return cls(studies[0], tuple(s.site for s in studies), tuple(s.date for s in studies),
-                   np.array([s.panel.tilt for s in studies]), np.array([s.panel.azimuth for s in studies]))
+        return cls(
+            studies[0],
+            tuple(s.site for s in studies),
+            tuple(s.date for s in studies),
+            np.array([s.panel.tilt for s in studies]),
+            np.array([s.panel.azimuth for s in studies]),
+        )
 
     @classmethod
     def of_dates(cls, study: Study, dates) -> Blocks:
@@ -93,12 +98,20 @@ class Blocks:
         dates : sequence of datetime.date
         """
         study.require_files()
-        members = study.weather.members if study.weather is not None and study.weather.members else 1
+        members = (
+            study.weather.members if study.weather is not None and study.weather.members else 1
+        )
         dates = tuple(date for date in dates for _ in range(members))  # a day's members together
         count = len(dates)
         member = np.tile(np.arange(members), count // members) if members > 1 else None
-        return cls(study, (study.site,) * count, dates, np.full(count, study.panel.tilt),
-                   np.full(count, study.panel.azimuth), member)
+        return cls(
+            study,
+            (study.site,) * count,
+            dates,
+            np.full(count, study.panel.tilt),
+            np.full(count, study.panel.azimuth),
+            member,
+        )
 
     @classmethod
     def join(cls, parts) -> Blocks:
@@ -109,16 +122,27 @@ class Blocks:
         parts : sequence of Blocks
         """
         members = [part.member for part in parts]
-        return cls(parts[0].study, sum((part.sites for part in parts), ()), sum((part.dates for part in parts), ()),
-                   np.concatenate([part.tilt for part in parts]), np.concatenate([part.azimuth for part in parts]),
-                   None if any(member is None for member in members) else np.concatenate(members))
+        return cls(
+            parts[0].study,
+            sum((part.sites for part in parts), ()),
+            sum((part.dates for part in parts), ()),
+            np.concatenate([part.tilt for part in parts]),
+            np.concatenate([part.azimuth for part in parts]),
+            None if any(member is None for member in members) else np.concatenate(members),
+        )
 
     def __len__(self) -> int:
         return len(self.dates)
 
     def __getitem__(self, part: slice) -> Blocks:
-        return Blocks(self.study, self.sites[part], self.dates[part], self.tilt[part], self.azimuth[part],
-                      None if self.member is None else self.member[part])
+        return Blocks(
+            self.study,
+            self.sites[part],
+            self.dates[part],
+            self.tilt[part],
+            self.azimuth[part],
+            None if self.member is None else self.member[part],
+        )
 
     def sky(self) -> Sky:
         """The blocks' :class:`foldopt.engine.sky.Sky` (:func:`foldopt.engine.sky.build_sky`)."""

@@ -20,8 +20,16 @@ BREAK_EVEN_TOLERANCE, BREAK_EVEN_ROUNDS = 1e-6, 40
 BREAK_EVEN_LADDER = 64
 
 
-def break_even_standby(available, targets, p_load, months, statistic: str, seasons, step_hours: float,
-                       engine: str = "numba"):
+def break_even_standby(
+    available,
+    targets,
+    p_load,
+    months,
+    statistic: str,
+    seasons,
+    step_hours: float,
+    engine: str = "numba",
+):
     """The tracker's standby draw [W] at which its objective over each period falls to ``targets``,
     at several sites of the same days at once.
 
@@ -78,12 +86,18 @@ def break_even_standby(available, targets, p_load, months, statistic: str, seaso
         site's loads go to the engine as its own set and get the same bits whatever other sites
         ask; a site with none is not walked (NaN)."""
         walked = np.where((count > 0)[site_of_day, None], span, 0)
-        daily = engines.curve_metrics(available, sets, step_hours, site_of_day, engine=engine,
-                                      span=walked).t_solar[:, 0].reshape(n_sites, n_days, -1)
+        daily = (
+            engines.curve_metrics(
+                available, sets, step_hours, site_of_day, engine=engine, span=walked
+            )
+            .t_solar[:, 0]
+            .reshape(n_sites, n_days, -1)
+        )
         value = np.full((n_sites, n_periods, sets.shape[1]), np.nan)
         for site in np.flatnonzero(count):
-            value[site, :, :count[site]] = period_values(np.ascontiguousarray(daily[site, :, :count[site]]), months,
-                                                         statistic, seasons)
+            value[site, :, : count[site]] = period_values(
+                np.ascontiguousarray(daily[site, :, : count[site]]), months, statistic, seasons
+            )
         return value
 
     def shortfall(draws, asked):
@@ -92,12 +106,14 @@ def break_even_standby(available, targets, p_load, months, statistic: str, seaso
         count = asked.reshape(n_sites, -1).sum(axis=1)
         sets = np.full((n_sites, max(int(count.max()), 1)), np.inf)
         for site in np.flatnonzero(count):
-            sets[site, :count[site]] = (p_load[site][None, :] + draws[site])[asked[site]]
+            sets[site, : count[site]] = (p_load[site][None, :] + draws[site])[asked[site]]
         every = objectives(sets, count)
         value = np.full(targets.shape, np.nan)
         for site in np.flatnonzero(count):
             mine = asked[site]  # each target's own period kept
-            value[site][mine] = every[site][period[mine], np.arange(count[site])] - targets[site][mine]
+            value[site][mine] = (
+                every[site][period[mine], np.arange(count[site])] - targets[site][mine]
+            )
         return value
 
     low, high, at_low, at_high = _ladder_brackets(objectives, p_load, top[:, 0, 0], targets)
@@ -108,7 +124,11 @@ def break_even_standby(available, targets, p_load, months, statistic: str, seaso
         if not open_.any():
             break
         with np.errstate(divide="ignore", invalid="ignore"):
-            draw = np.where(at_low != at_high, (low * at_high - high * at_low) / (at_high - at_low), (low + high) / 2)
+            draw = np.where(
+                at_low != at_high,
+                (low * at_high - high * at_low) / (at_high - at_low),
+                (low + high) / 2,
+            )
         # A secant that lands on an end (the objective flat there to its last bits) halves instead.
         draw = np.where((draw > low) & (draw < high), draw, (low + high) / 2)
         value = shortfall(draw, open_)
@@ -158,21 +178,39 @@ def _ladder_brackets(objectives, p_load, top, targets):
     ladders = []
     for site in range(n_sites):
         finite = p_load[site][np.isfinite(p_load[site])]
-        ladders.append(np.unique(np.concatenate([finite, finite + top[site], np.linspace(
-            finite.min(), finite.max() + top[site], BREAK_EVEN_LADDER)])) if finite.size else np.zeros(0))
+        ladders.append(
+            np.unique(
+                np.concatenate(
+                    [
+                        finite,
+                        finite + top[site],
+                        np.linspace(finite.min(), finite.max() + top[site], BREAK_EVEN_LADDER),
+                    ]
+                )
+            )
+            if finite.size
+            else np.zeros(0)
+        )
     count = np.array([ladder.size for ladder in ladders])
     sets = np.full((n_sites, max(int(count.max()), 1)), np.inf)
     for site, ladder in enumerate(ladders):
-        sets[site, :ladder.size] = ladder
+        sets[site, : ladder.size] = ladder
     value = objectives(sets, count)
     low, high, at_low, at_high = (np.full(targets.shape, np.nan) for _ in range(4))
     for site in np.flatnonzero(count):
-        rungs, load = sets[site, :count[site]], p_load[site][:, None]
+        rungs, load = sets[site, : count[site]], p_load[site][:, None]
         inside = (rungs >= load) & (rungs <= load + top[site])  # (loads, rungs): the draws 0 to top
-        above = (value[site][:, None, :] - targets[site][:, :, None] > 0) & inside  # (periods, loads, rungs)
-        first, last = np.argmax(inside, axis=1), count[site] - 1 - np.argmax(inside[:, ::-1], axis=1)
+        above = (
+            value[site][:, None, :] - targets[site][:, :, None] > 0
+        ) & inside  # (periods, loads, rungs)
+        first, last = (
+            np.argmax(inside, axis=1),
+            count[site] - 1 - np.argmax(inside[:, ::-1], axis=1),
+        )
         # The last rung still above the target, and the next (the load's own rung where none is).
-        start = np.where(above.any(axis=-1), count[site] - 1 - np.argmax(above[..., ::-1], axis=-1), first)
+        start = np.where(
+            above.any(axis=-1), count[site] - 1 - np.argmax(above[..., ::-1], axis=-1), first
+        )
         start = np.maximum(np.minimum(start, last - 1), first)
         stop = np.minimum(start + 1, last)
         periods = np.arange(n_periods)[:, None]

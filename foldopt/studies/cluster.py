@@ -33,8 +33,19 @@ import pandas as pd
 
 from foldopt.errors import ConfigError, OutputError
 from foldopt.inputs.study import Study
-from foldopt.files import (DiskFullError, check_output, clear_leftovers, commit, discard, is_full, new_staging,
-                           tree_size, versions, write_atomically, writer_lock)
+from foldopt.files import (
+    DiskFullError,
+    check_output,
+    clear_leftovers,
+    commit,
+    discard,
+    is_full,
+    new_staging,
+    tree_size,
+    versions,
+    write_atomically,
+    writer_lock,
+)
 from foldopt.studies.dask_client import CONNECT_TIMEOUT, connect
 from foldopt.tables import write_csv
 
@@ -84,22 +95,29 @@ class MapSpec:
             raise ConfigError(["sites: a map needs at least one site"])
         object.__setattr__(self, "study", map_template(self.study, self.sites[0], self.year))
         if self.sites_per_chunk <= 0:
-            object.__setattr__(self, "sites_per_chunk", default_sites_per_chunk(self.study, self.year))
+            object.__setattr__(
+                self, "sites_per_chunk", default_sites_per_chunk(self.study, self.year)
+            )
         sites = tuple({**site, "site_id": index} for index, site in enumerate(self.sites))
         object.__setattr__(self, "sites", sites)
 
     def chunks(self) -> list[range]:
         """The chunks' site indices, ``sites_per_chunk`` each (the last may be short)."""
         size = self.sites_per_chunk
-        return [range(start, min(start + size, len(self.sites))) for start in range(0, len(self.sites), size)]
+        return [
+            range(start, min(start + size, len(self.sites)))
+            for start in range(0, len(self.sites), size)
+        ]
 
     def as_dict(self) -> dict:
         """The spec as plain data (``run.json``'s ``spec``): the study as the fields a map keeps for
         every site (:func:`foldopt.studies.worldmap.map_data`)."""
         from foldopt.studies.worldmap import map_data
 
-        return {**{field.name: getattr(self, field.name) for field in dataclasses.fields(self)},
-                "study": map_data(self.study)}
+        return {
+            **{field.name: getattr(self, field.name) for field in dataclasses.fields(self)},
+            "study": map_data(self.study),
+        }
 
     @functools.cached_property
     def key(self) -> str:
@@ -144,7 +162,9 @@ class MapRun:
     dashboard: str | None
 
 
-def evaluate_chunk(study: Study, sites: list, loads: list, relative: bool, year: int, engine: str) -> pd.DataFrame:
+def evaluate_chunk(
+    study: Study, sites: list, loads: list, relative: bool, year: int, engine: str
+) -> pd.DataFrame:
     """The task of one chunk, run on a worker: :func:`foldopt.studies.worldmap.evaluate_sites` on one thread.
 
     Parameters
@@ -246,7 +266,9 @@ def map_folder(out: Path, resume: bool, overwrite: bool) -> Path:
     if resume and (out / "run.json").exists():
         return out
     if out.exists() and not overwrite and not resume:
-        raise OutputError(f"{out} already exists; pass --resume to finish it or --overwrite to replace it")
+        raise OutputError(
+            f"{out} already exists; pass --resume to finish it or --overwrite to replace it"
+        )
     check_output(out, overwrite=True)  # only a folder foldopt wrote is replaced
     return new_staging(out) if out.exists() else out
 
@@ -290,11 +312,16 @@ def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
         previous = {}
     if previous.get("map_key") != spec.key:
         theirs = previous.get("spec", {})
-        differ = [name for name in ("study", "sites", "loads", "relative", "year", "sites_per_chunk", "engine")
-                  if json.dumps(theirs.get(name), sort_keys=True, default=str)
-                  != json.dumps(spec.as_dict()[name], sort_keys=True, default=str)]
-        raise OutputError(f"--resume: {out} holds another map (its {', '.join(differ) or 'settings'} differ); "
-                          "run the same command to resume it, or choose another --out")
+        differ = [
+            name
+            for name in ("study", "sites", "loads", "relative", "year", "sites_per_chunk", "engine")
+            if json.dumps(theirs.get(name), sort_keys=True, default=str)
+            != json.dumps(spec.as_dict()[name], sort_keys=True, default=str)
+        ]
+        raise OutputError(
+            f"--resume: {out} holds another map (its {', '.join(differ) or 'settings'} differ); "
+            "run the same command to resume it, or choose another --out"
+        )
     (out / PARTS).mkdir(exist_ok=True)
     for leftover in (out / PARTS).glob(".*.tmp-*"):
         leftover.unlink(missing_ok=True)
@@ -302,14 +329,25 @@ def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
 
 
 def _write_json(path: Path, data: dict) -> None:
-    write_atomically(path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n"))
+    write_atomically(
+        path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n")
+    )
 
 
-def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: int | None = None,
-            resume: bool = False, overwrite: bool = False, progress: Callable[[int, int], None] | None = None,
-            announce: Callable[[str, str | None], None] | None = None, metadata: dict | None = None,
-            connect_timeout: float = CONNECT_TIMEOUT,
-            finish: Callable[[MapRun, dict], None] | None = None) -> MapRun:
+def run_map(
+    spec: MapSpec,
+    out: Path,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    resume: bool = False,
+    overwrite: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+    announce: Callable[[str, str | None], None] | None = None,
+    metadata: dict | None = None,
+    connect_timeout: float = CONNECT_TIMEOUT,
+    finish: Callable[[MapRun, dict], None] | None = None,
+) -> MapRun:
     """Compute a map on a Dask cluster into ``out`` and return its table.
 
     Parameters
@@ -352,8 +390,13 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
     started = time.perf_counter()
     out = Path(out)
     chunks = spec.chunks()
-    metadata = {**(metadata or {}), "versions": versions(("dask", "distributed", "pyarrow")), "map_key": spec.key,
-                "spec": spec.as_dict(), "chunks": len(chunks)}
+    metadata = {
+        **(metadata or {}),
+        "versions": versions(("dask", "distributed", "pyarrow")),
+        "map_key": spec.key,
+        "spec": spec.as_dict(),
+        "chunks": len(chunks),
+    }
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:
@@ -364,8 +407,20 @@ def run_map(spec: MapSpec, out: Path, *, scheduler: str | None = None, workers: 
         try:
             folder = map_folder(out, resume, overwrite)
             done = prepare_folder(folder, spec, metadata)
-            run = _compute(spec, folder, done, chunks, metadata, started, scheduler, workers, progress, announce,
-                           connect_timeout, finish)
+            run = _compute(
+                spec,
+                folder,
+                done,
+                chunks,
+                metadata,
+                started,
+                scheduler,
+                workers,
+                progress,
+                announce,
+                connect_timeout,
+                finish,
+            )
             if folder != out:
                 commit(folder, out)
         except BaseException as error:
@@ -390,8 +445,20 @@ def _failed(error: BaseException, out: Path, folder: Path | None, fresh: bool) -
     return error
 
 
-def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, progress, announce,
-             connect_timeout, finish) -> MapRun:
+def _compute(
+    spec,
+    out,
+    done,
+    chunks,
+    metadata,
+    started,
+    scheduler,
+    workers,
+    progress,
+    announce,
+    connect_timeout,
+    finish,
+) -> MapRun:
     # A part that cannot be read (a disk fault) or is another map's is computed again.
     done = [index for index in done if _read_part(_part_path(out, index), spec.key) is not None]
     missing = [index for index in range(len(chunks)) if index not in done]
@@ -411,10 +478,20 @@ def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, pro
             dashboard = client.dashboard_link if _has_dashboard(client) else None
             if announce is not None:
                 announce(description, dashboard)
-            futures = [client.submit(evaluate_chunk, spec.study, [spec.sites[i] for i in chunks[index]],
-                                     list(spec.loads), spec.relative, spec.year, spec.engine,
-                                     key=f"foldopt-map-{spec.key}-{index:05d}", pure=False)
-                       for index in missing]
+            futures = [
+                client.submit(
+                    evaluate_chunk,
+                    spec.study,
+                    [spec.sites[i] for i in chunks[index]],
+                    list(spec.loads),
+                    spec.relative,
+                    spec.year,
+                    spec.engine,
+                    key=f"foldopt-map-{spec.key}-{index:05d}",
+                    pure=False,
+                )
+                for index in missing
+            ]
             index_of = {future.key: index for future, index in zip(futures, missing, strict=True)}
             for future in as_completed(futures):
                 index = index_of[future.key]
@@ -428,21 +505,32 @@ def _compute(spec, out, done, chunks, metadata, started, scheduler, workers, pro
                 finished_sites += len(chunks[index])
                 if progress is not None:
                     progress(finished_sites, len(spec.sites))
-    table = pd.concat([_read_part(_part_path(out, index), spec.key) for index in range(len(chunks))],
-                      ignore_index=True)
+    table = pd.concat(
+        [_read_part(_part_path(out, index), spec.key) for index in range(len(chunks))],
+        ignore_index=True,
+    )
     seconds = time.perf_counter() - started
     _write_parquet(table, out / "map.parquet", spec.key)
     write_atomically(out / "map.csv", lambda temporary: write_csv(table, temporary))
     computed = tuple(missing)
     complete = {
-        **metadata, "status": "complete", "cluster": description, "dashboard": dashboard,
-        "chunks_computed": list(computed), "chunks_from_disk": sorted(done), "seconds": round(seconds, 3),
-        "sites_per_second": round(sum(len(chunks[i]) for i in computed) / seconds, 3) if computed else None,
+        **metadata,
+        "status": "complete",
+        "cluster": description,
+        "dashboard": dashboard,
+        "chunks_computed": list(computed),
+        "chunks_from_disk": sorted(done),
+        "seconds": round(seconds, 3),
+        "sites_per_second": round(sum(len(chunks[i]) for i in computed) / seconds, 3)
+        if computed
+        else None,
     }
     run = MapRun(spec, table, out, computed, tuple(sorted(done)), seconds, description, dashboard)
     if finish is not None:
         finish(run, complete)
-    _write_json(out / "run.json", complete)  # last: only a folder holding every promised file is complete
+    _write_json(
+        out / "run.json", complete
+    )  # last: only a folder holding every promised file is complete
     return run
 
 

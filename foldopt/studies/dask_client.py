@@ -25,7 +25,9 @@ HANDSHAKE_TIMEOUT = 5.0
 
 
 @contextmanager
-def connect(scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
+def connect(
+    scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT
+):
     """A Dask client: of the cluster at ``scheduler`` (``tcp://host:port`` or a scheduler file), or of an
     embedded :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default one per core).
 
@@ -53,11 +55,19 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
 
     if scheduler is None:
         count = workers or os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
-                               dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
+        cluster = LocalCluster(
+            n_workers=count,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address="127.0.0.1:0",
+            silence_logs=logging.ERROR,
+        )
         try:
             with Client(cluster) as client:
-                yield client, f"embedded LocalCluster, {count} worker process{'es' if count > 1 else ''}"
+                yield (
+                    client,
+                    f"embedded LocalCluster, {count} worker process{'es' if count > 1 else ''}",
+                )
         finally:
             cluster.close()
         return
@@ -71,16 +81,22 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
         try:
             client.wait_for_workers(1, timeout=timeout)
         except TimeoutError:
-            raise ConfigError([f"--scheduler = {scheduler!r}: the scheduler has no worker after {timeout:g} s; start "
-                               "some with `dask worker ADDRESS`"]) from None
+            raise ConfigError(
+                [
+                    f"--scheduler = {scheduler!r}: the scheduler has no worker after {timeout:g} s; start "
+                    "some with `dask worker ADDRESS`"
+                ]
+            ) from None
         yield client, f"Dask scheduler {client.scheduler.address}"
     finally:
         client.close()
 
 
 def _no_answer(scheduler: str, timeout: float, reason: str) -> str:
-    return (f"--scheduler = {scheduler!r}: no Dask scheduler answers there within {timeout:g} s ({reason}); start one "
-            "with `dask scheduler`")
+    return (
+        f"--scheduler = {scheduler!r}: no Dask scheduler answers there within {timeout:g} s ({reason}); start one "
+        "with `dask scheduler`"
+    )
 
 
 def scheduler_address(scheduler: str) -> str:
@@ -104,13 +120,17 @@ def scheduler_address(scheduler: str) -> str:
         raise ConfigError([_not_a_file(scheduler, f"not JSON: {error}")]) from None
     address = data.get("address") if isinstance(data, dict) else None
     if not isinstance(address, str) or not address:
-        raise ConfigError([_not_a_file(scheduler, 'it has no "address"' if text.strip() else "it is empty")])
+        raise ConfigError(
+            [_not_a_file(scheduler, 'it has no "address"' if text.strip() else "it is empty")]
+        )
     return address
 
 
 def _not_a_file(scheduler: str, reason: str) -> str:
-    return (f"--scheduler = {scheduler!r}: not a Dask scheduler file ({reason}); `dask scheduler --scheduler-file "
-            "FILE` writes one")
+    return (
+        f"--scheduler = {scheduler!r}: not a Dask scheduler file ({reason}); `dask scheduler --scheduler-file "
+        "FILE` writes one"
+    )
 
 
 def check_scheduler(scheduler: str, address: str, timeout: float) -> None:
@@ -140,18 +160,28 @@ def check_scheduler(scheduler: str, address: str, timeout: float) -> None:
         scheme, location = parse_address(address)
         host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
     except ValueError as error:
-        raise ConfigError([f"--scheduler = {scheduler!r}: neither an existing scheduler file nor an "
-                           f"address like tcp://host:8786 ({error})"]) from None
+        raise ConfigError(
+            [
+                f"--scheduler = {scheduler!r}: neither an existing scheduler file nor an "
+                f"address like tcp://host:8786 ({error})"
+            ]
+        ) from None
     seconds = min(timeout, HANDSHAKE_TIMEOUT)
     if host is not None:
         try:
             socket.create_connection((host, port), timeout=seconds).close()
         except OSError as error:
-            raise ConfigError([_no_answer(scheduler, timeout, error.strerror or error.__class__.__name__)]) from None
+            raise ConfigError(
+                [_no_answer(scheduler, timeout, error.strerror or error.__class__.__name__)]
+            ) from None
     identity = _identity(address, seconds)
     if not (isinstance(identity, dict) and identity.get("type") == "Scheduler"):
-        raise ConfigError([f"--scheduler = {scheduler!r}: what listens at {address} is not a Dask scheduler (no Dask "
-                           f"answer within {seconds:g} s); give the scheduler's address or its scheduler file"])
+        raise ConfigError(
+            [
+                f"--scheduler = {scheduler!r}: what listens at {address} is not a Dask scheduler (no Dask "
+                f"answer within {seconds:g} s); give the scheduler's address or its scheduler file"
+            ]
+        )
 
 
 def _identity(address: str, seconds: float):
@@ -174,5 +204,7 @@ def _identity(address: str, seconds: float):
     with ThreadPoolExecutor(1) as pool:
         try:
             return pool.submit(asyncio.run, asyncio.wait_for(ask(), seconds)).result()
-        except Exception:  # whatever a server that is not Dask's sends (garbage can fail in many ways)
+        except (
+            Exception
+        ):  # whatever a server that is not Dask's sends (garbage can fail in many ways)
             return None

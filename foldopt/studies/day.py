@@ -19,11 +19,26 @@ import pandas as pd
 from foldopt.engine import evaluation as engines
 from foldopt.physics.connections import CONNECTIONS, SWITCH_STATES
 from foldopt.inputs.study import Study
-from foldopt.engine.metrics import (design_condition, energy_served, load_for_t_solar, metric_columns, notes,
-                             per_load, relative_to, t_solar)
+from foldopt.engine.metrics import (
+    design_condition,
+    energy_served,
+    load_for_t_solar,
+    metric_columns,
+    notes,
+    per_load,
+    relative_to,
+    t_solar,
+)
 from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
 from foldopt.studies.sizing import flat_area_multiple
-from foldopt.studies.designs import DESIGNS, Blocks, TrackerCurves, design_metrics, standby_available, tracker_curves
+from foldopt.studies.designs import (
+    DESIGNS,
+    Blocks,
+    TrackerCurves,
+    design_metrics,
+    standby_available,
+    tracker_curves,
+)
 from foldopt.studies.objectives import near_optimal
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
@@ -59,16 +74,25 @@ class Day:
     def _poa(self, surface_tilt, surface_azimuth, per_step=False):
         """Irradiance on surfaces [W/m^2]: one orientation per row, (k,) -> (k, n_time), or, with
         ``per_step``, one per time step (a tracker), (n_time,) -> (n_time,)."""
-        tilt, azimuth = np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)
+        tilt, azimuth = (
+            np.asarray(surface_tilt, dtype=float),
+            np.asarray(surface_azimuth, dtype=float),
+        )
         if per_step:
             return engines.poa(self.sky, tilt[None], azimuth[None])[0]
-        return engines.poa(self.sky, tilt[..., None], azimuth[..., None], [0], self.study.mode == "paper")
+        return engines.poa(
+            self.sky, tilt[..., None], azimuth[..., None], [0], self.study.mode == "paper"
+        )
 
     def flat_power(self):
         """Power of the flat panel over the day [W], shape (n_time,)."""
         panel = self.study.panel
-        return engines.panel_power(self.sky, self.study, self._poa(np.array([panel.tilt]), np.array([panel.azimuth])),
-                                   panel.area)[0]
+        return engines.panel_power(
+            self.sky,
+            self.study,
+            self._poa(np.array([panel.tilt]), np.array([panel.azimuth])),
+            panel.area,
+        )[0]
 
     def tracker_orientation(self, model=None):
         """Surface tilt and azimuth of a tracker over the day.
@@ -133,7 +157,9 @@ class Day:
             (k, 4): tilt and azimuth of the east, then the west sub-panel [deg].
         """
         panel = self.study.panel
-        return engines.fold_orientations(self.study, [panel.tilt], [panel.azimuth], np.atleast_1d(fold_angles))[0]
+        return engines.fold_orientations(
+            self.study, [panel.tilt], [panel.azimuth], np.atleast_1d(fold_angles)
+        )[0]
 
     def connections(self, fold_angles, series: bool = True, with_state: bool = True):
         """Every connection's power and the switching state per step.
@@ -158,7 +184,9 @@ class Day:
         key = (fold_angles.tobytes(), series, with_state)
         if key in self._one_angle:
             return self._one_angle[key]
-        powers, state = engines.powers(self.sky, self.study, self.orientation(fold_angles), [0], series, with_state)
+        powers, state = engines.powers(
+            self.sky, self.study, self.orientation(fold_angles), [0], series, with_state
+        )
         powers.pop("panel")
         if fold_angles.size == 1:
             # One angle's curves are kept: the heuristic's root search evaluates its bracket twice
@@ -254,11 +282,17 @@ def _best_angle(day: Day, fold_angles, sweep_t_solar, connection, with_power: bo
         evaluated.update(zip(fold.tolist(), power))
         return per_load(power, shape)
 
-    angle, hours = optimal_fold_angle(compared, fold_angles, sweep_t_solar, day.study.p_load, day.step_hours)
+    angle, hours = optimal_fold_angle(
+        compared, fold_angles, sweep_t_solar, day.study.p_load, day.step_hours
+    )
     if not with_power:
         return angle, hours
     power = evaluated.get(angle)
-    return angle, hours, day.combined_power(np.array([angle]), connection)[0] if power is None else power
+    return (
+        angle,
+        hours,
+        day.combined_power(np.array([angle]), connection)[0] if power is None else power,
+    )
 
 
 def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
@@ -290,31 +324,64 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     # break-even are defined for a constant load and are left out.
     shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
     fold_angles = np.asarray(study.fold_angles.grid())
-    metrics = engines.row_metrics(day.sky, study, np.zeros(fold_angles.size), day.orientation(fold_angles), [p_load],
-                                  outputs=CONNECTIONS, contiguous=True, engine=engine)
+    metrics = engines.row_metrics(
+        day.sky,
+        study,
+        np.zeros(fold_angles.size),
+        day.orientation(fold_angles),
+        [p_load],
+        outputs=CONNECTIONS,
+        contiguous=True,
+        engine=engine,
+    )
     own = CONNECTIONS.index(study.connection)
     # The grid's curves, once: the noon valley's sub-panels and, under a load profile, the served
     # energy's connection (curves the metrics above do not keep).
     series = shape is not None and (study.connection == "series" or study.switch_series)
     curves, _ = day.connections(fold_angles, series, with_state=False)
-    served = None if shape is None else energy_served(curves[study.connection], p_load, shape, step,
-                                                      metrics.t_solar[:, own, 0])
-    sweep = pd.DataFrame({"fold_angle_deg": fold_angles,
-                          **metric_columns(metrics.t_solar[:, own, 0], metrics.t_solar_contiguous[:, own, 0],
-                                            metrics.energy[:, own], metrics.peak[:, own], p_load, served)})
+    served = (
+        None
+        if shape is None
+        else energy_served(
+            curves[study.connection], p_load, shape, step, metrics.t_solar[:, own, 0]
+        )
+    )
+    sweep = pd.DataFrame(
+        {
+            "fold_angle_deg": fold_angles,
+            **metric_columns(
+                metrics.t_solar[:, own, 0],
+                metrics.t_solar_contiguous[:, own, 0],
+                metrics.energy[:, own],
+                metrics.peak[:, own],
+                p_load,
+                served,
+            ),
+        }
+    )
     sweep["noon_valley_w"] = noon_valley(curves["east"], curves["west"], curves["parallel"])
     for index, connection in enumerate(CONNECTIONS):
         sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
         sweep[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
 
-    best_angle, best_hours = _best_angle(day, fold_angles, sweep["t_solar_h"].to_numpy(), study.connection)
+    best_angle, best_hours = _best_angle(
+        day, fold_angles, sweep["t_solar_h"].to_numpy(), study.connection
+    )
     # The designs every study compares, each evaluated once, as for sweeps, annual studies and maps
     # (the study's tracker from the curve the figures draw); the others (the heuristic's angle, the
     # other connections, the other trackers) from their curves. The figures and the time series
     # draw the curves the flat and twofold rows were reduced from.
     tracker = day.tracker()
-    main = design_metrics(day.sky, Blocks.of([study]), np.array([p_load]), np.array([best_angle]),
-                          np.zeros((1, 1), dtype=int), engine, tracker, curves=True)
+    main = design_metrics(
+        day.sky,
+        Blocks.of([study]),
+        np.array([p_load]),
+        np.array([best_angle]),
+        np.zeros((1, 1), dtype=int),
+        engine,
+        tracker,
+        curves=True,
+    )
     drawn = main.pop("curves")
     p_flat = drawn["flat"][0]
     # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
@@ -324,8 +391,11 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     def subpanels(fold):
         # An angle of the grid (the root search's bracket) from the grid's curves.
         at = np.flatnonzero(fold_angles == fold[0]) if fold.size == 1 else []
-        return (tuple(curves[name][at[:1]] for name in ("east", "west", "parallel")) if len(at)
-                else day.subpanel_power(fold))
+        return (
+            tuple(curves[name][at[:1]] for name in ("east", "west", "parallel"))
+            if len(at)
+            else day.subpanel_power(fold)
+        )
 
     paper_angle = heuristic_fold_angle(subpanels, noon_load) if noon_load > 0 else np.nan
 
@@ -335,8 +405,13 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     if day.electrical.pv.has_iv:
         for connection in ("parallel", "series", "independent", "switching"):
             if connection != study.connection:
-                angle, _, power = _best_angle(day, fold_angles, sweep[f"t_solar_{connection}_h"].to_numpy(), connection,
-                                              with_power=True)
+                angle, _, power = _best_angle(
+                    day,
+                    fold_angles,
+                    sweep[f"t_solar_{connection}_h"].to_numpy(),
+                    connection,
+                    with_power=True,
+                )
                 others[f"twofold-{connection}"] = (angle, power)
     # Every other tracker model follows the study's as "tracker:<model>"; each net row is what is
     # left for the load after the tracker's own draw.
@@ -344,19 +419,40 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
         others[f"tracker:{model}"] = (np.nan, day.tracker(model).power[0])
         others[f"tracker:{model}-net"] = (np.nan, day.tracker(model).net[0])
     power = np.stack([power for _, power in others.values()])
-    curve = engines.curve_metrics(power, [p_load], step, contiguous=True, engine=engine, load_shape=shape)
-    served = None if shape is None else energy_served(power, p_load, shape, step, curve.t_solar[:, 0, 0])
-    columns = metric_columns(curve.t_solar[:, 0, 0], curve.t_solar_contiguous[:, 0, 0], curve.energy[:, 0],
-                             curve.peak[:, 0], p_load, served)
+    curve = engines.curve_metrics(
+        power, [p_load], step, contiguous=True, engine=engine, load_shape=shape
+    )
+    served = (
+        None if shape is None else energy_served(power, p_load, shape, step, curve.t_solar[:, 0, 0])
+    )
+    columns = metric_columns(
+        curve.t_solar[:, 0, 0],
+        curve.t_solar_contiguous[:, 0, 0],
+        curve.energy[:, 0],
+        curve.peak[:, 0],
+        p_load,
+        served,
+    )
     # The rows as the report shows them: flat, the twofold panels, then the trackers.
-    angle_of = {"flat": 180.0, "twofold": best_angle,
-                **{name: angle for name, (angle, _) in others.items() if name.startswith("twofold")},
-                "tracker": np.nan, "tracker-net": np.nan,
-                **{name: angle for name, (angle, _) in others.items() if name.startswith("tracker")}}
+    angle_of = {
+        "flat": 180.0,
+        "twofold": best_angle,
+        **{name: angle for name, (angle, _) in others.items() if name.startswith("twofold")},
+        "tracker": np.nan,
+        "tracker-net": np.nan,
+        **{name: angle for name, (angle, _) in others.items() if name.startswith("tracker")},
+    }
     order = [[*DESIGNS, *others].index(name) for name in angle_of]
-    summary = pd.DataFrame({"design": list(angle_of), "fold_angle_deg": list(angle_of.values()),
-                            **{name: np.concatenate([main[name][0, 0], values])[order]
-                               for name, values in columns.items()}})
+    summary = pd.DataFrame(
+        {
+            "design": list(angle_of),
+            "fold_angle_deg": list(angle_of.values()),
+            **{
+                name: np.concatenate([main[name][0, 0], values])[order]
+                for name, values in columns.items()
+            },
+        }
+    )
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
@@ -368,11 +464,21 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     # Each row's circuit first: a connection the study's circuit cannot wire (independent's
     # converters, a load wired directly) is compared as it is built and says so; every other design
     # is wired as the circuit says, and says so where its load is beyond the panel's reach.
-    wired = {f"twofold-{connection}": study.circuit.ignored_by(connection) for connection in CONNECTIONS}
-    condition = ["; ".join(filter(None, (wired.get(design) or day.electrical.beyond_reach, day.sky.conditions()[0])))
-                 for design in summary["design"]]
-    summary["note"] = notes(design_condition(condition, summary["energy_harvested_wh"].to_numpy(float)),
-                            summary["t_solar_h"].to_numpy())
+    wired = {
+        f"twofold-{connection}": study.circuit.ignored_by(connection) for connection in CONNECTIONS
+    }
+    condition = [
+        "; ".join(
+            filter(
+                None, (wired.get(design) or day.electrical.beyond_reach, day.sky.conditions()[0])
+            )
+        )
+        for design in summary["design"]
+    ]
+    summary["note"] = notes(
+        design_condition(condition, summary["energy_harvested_wh"].to_numpy(float)),
+        summary["t_solar_h"].to_numpy(),
+    )
     standby = standby_sweep(day, tracker.power[0], by_design["twofold"])
 
     at_best = {connection: drawn[connection][0, 0] for connection in CONNECTIONS}
@@ -385,13 +491,18 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
             "dni": day.dni,
             # The light and air every step of the day used (the weather's, or the clear sky's).
             **({"ghi": day.ghi, "dhi": day.dhi} if day.ghi is not None else {}),
-            "temp_air": (day.sky.temp_steps[0] if day.sky.temp_steps is not None
-                         else np.full(day.dni.shape, day.sky.temp_air[0])),
+            "temp_air": (
+                day.sky.temp_steps[0]
+                if day.sky.temp_steps is not None
+                else np.full(day.dni.shape, day.sky.temp_air[0])
+            ),
             **({"wind_speed": day.sky.wind_speed[0]} if day.sky.wind_speed is not None else {}),
             "p_flat_w": p_flat,
             **{f"p_{connection}_w": at_best[connection] for connection in CONNECTIONS},
             "p_twofold_w": at_best[study.connection],
-            "switch_state": np.where(at_best["switching"] > 0, np.array(SWITCH_STATES)[state], "off"),
+            "switch_state": np.where(
+                at_best["switching"] > 0, np.array(SWITCH_STATES)[state], "off"
+            ),
             "p_tracker_w": tracker.power[0],
             "p_load_w": p_load if shape is None else p_load * shape,
         },
@@ -400,12 +511,32 @@ def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
     # The range is taken over every angle evaluated, the refined optimum among the grid's, so that it
     # holds the best angle (the grid's own range may end on the far side of a refined optimum).
     evaluated = sweep.set_index("fold_angle_deg")["t_solar_h"]
-    evaluated = pd.concat([evaluated[evaluated.index != best_angle], pd.Series({best_angle: best_hours})]).sort_index()
-    near = {key: float(value) for key, value in near_optimal(evaluated.index, evaluated.to_numpy(),
-                                                             study.near_optimal).items()}
+    evaluated = pd.concat(
+        [evaluated[evaluated.index != best_angle], pd.Series({best_angle: best_hours})]
+    ).sort_index()
+    near = {
+        key: float(value)
+        for key, value in near_optimal(
+            evaluated.index, evaluated.to_numpy(), study.near_optimal
+        ).items()
+    }
     recommended = near["recommended_fold_angle_deg"]
-    near["recommended_t_solar_h"] = float(evaluated[recommended]) if recommended == recommended else float("nan")
-    return StudyResult(study, day, sweep, summary, timeseries, best_angle, paper_angle, standby, engine, near, request)
+    near["recommended_t_solar_h"] = (
+        float(evaluated[recommended]) if recommended == recommended else float("nan")
+    )
+    return StudyResult(
+        study,
+        day,
+        sweep,
+        summary,
+        timeseries,
+        best_angle,
+        paper_angle,
+        standby,
+        engine,
+        near,
+        request,
+    )
 
 
 def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):
@@ -435,14 +566,23 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
     """
     study, step = day.study, day.step_hours
     if day.sky.load_shape is not None:  # a standby draw is a load shift only for a constant load
-        return pd.DataFrame({"standby_w": [0.0], "t_solar_tracker_net_h": [np.nan],
-                             "t_solar_twofold_h": [twofold_t_solar]}), float("nan")
-    available = standby_available(p_tracker, day.tracker_draw(), day.sky.lit[0], study.tracker.standby_w)
+        return pd.DataFrame(
+            {
+                "standby_w": [0.0],
+                "t_solar_tracker_net_h": [np.nan],
+                "t_solar_twofold_h": [twofold_t_solar],
+            }
+        ), float("nan")
+    available = standby_available(
+        p_tracker, day.tracker_draw(), day.sky.lit[0], study.tracker.standby_w
+    )
     draws = np.linspace(0.0, max(2.0 * study.p_load, 1e-3), points)
     hours = t_solar(available, study.p_load + draws, step)
     load = load_for_t_solar(available, twofold_t_solar, step) if twofold_t_solar > 0 else np.nan
     break_even = max(load - study.p_load, 0.0) if np.isfinite(load) else float("nan")
-    table = pd.DataFrame({"standby_w": draws, "t_solar_tracker_net_h": hours, "t_solar_twofold_h": twofold_t_solar})
+    table = pd.DataFrame(
+        {"standby_w": draws, "t_solar_tracker_net_h": hours, "t_solar_twofold_h": twofold_t_solar}
+    )
     return table, break_even
 
 

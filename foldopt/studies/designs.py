@@ -29,6 +29,7 @@ from foldopt.engine.incidence import turning_poa
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.engine.sky import Sky
+
 # Blocks and their setup are part of the designs' API (the studies take them from here).
 from foldopt.studies.blocks import CHUNK_ROW_LOADS, Blocks, setup_key  # noqa: F401
 from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
@@ -50,14 +51,24 @@ def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
     """
     tracker = study.tracker
     options = TrackerOptions(
-        steps=tracker.steps, angular_field=tracker.angular_field,
+        steps=tracker.steps,
+        angular_field=tracker.angular_field,
         step_offsets_h=tuple(tracker.step_offsets_h or TrackerOptions().step_offsets_h),
-        axis_tilt=tracker.axis_tilt, axis_azimuth=tracker.axis_azimuth, max_angle=tracker.max_angle,
-        backtrack=tracker.backtrack, gcr=tracker.gcr,
+        axis_tilt=tracker.axis_tilt,
+        axis_azimuth=tracker.axis_azimuth,
+        max_angle=tracker.max_angle,
+        backtrack=tracker.backtrack,
+        gcr=tracker.gcr,
     )
     return tracker_orientation(
-        model or tracker.model, sky.solar_zenith, sky.solar_azimuth, sky.hour_angle, sky.declination,
-        np.asarray(sky.latitude)[:, None], options, sky.sun_vector,
+        model or tracker.model,
+        sky.solar_zenith,
+        sky.solar_azimuth,
+        sky.hour_angle,
+        sky.declination,
+        np.asarray(sky.latitude)[:, None],
+        options,
+        sky.sun_vector,
     )
 
 
@@ -139,7 +150,9 @@ def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.
         reaches every member while the sun is up.
     """
     tracker = study.tracker
-    drive = TrackerDrive(standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree)
+    drive = TrackerDrive(
+        standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree
+    )
     shared = slice(None, None, every)
     draw = tracker_draw(orientation[2][shared], sky.lit[shared], sky.step_hours, drive)
     return np.repeat(draw, every, axis=0) if every > 1 else draw
@@ -175,7 +188,9 @@ class TrackerCurves:
         return self.power - self.draw
 
 
-def tracker_curves(sky: Sky, study: Study, model: str | None = None, every: int = 1) -> TrackerCurves:
+def tracker_curves(
+    sky: Sky, study: Study, model: str | None = None, every: int = 1
+) -> TrackerCurves:
     """A tracker's orientation, power and own draw over every block of a sky.
 
     Parameters
@@ -191,7 +206,9 @@ def tracker_curves(sky: Sky, study: Study, model: str | None = None, every: int 
     orientation = sky_tracker_orientation(sky, study, model)
     poa = sky_tracker_poa(sky, orientation)
     draw = sky_tracker_draw(sky, study, orientation, every)
-    return TrackerCurves(orientation, engines.panel_power(sky, study, poa), draw, poa if sky.iam == "none" else None)
+    return TrackerCurves(
+        orientation, engines.panel_power(sky, study, poa), draw, poa if sky.iam == "none" else None
+    )
 
 
 def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
@@ -219,14 +236,32 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
     fold_angles = np.asarray(study.fold_angles.grid())
     orientation = engines.fold_orientations(study, blocks.tilt, blocks.azimuth, fold_angles)
     rows = np.repeat(np.arange(sky.n_blocks), fold_angles.size)
-    metrics = engines.row_metrics(sky, study, rows, orientation.reshape(-1, 4), loads, outputs=(study.connection,),
-                                  engine=engine)
-    return (fold_angles, metrics.t_solar.reshape(sky.n_blocks, fold_angles.size, -1),
-            metrics.energy.reshape(sky.n_blocks, fold_angles.size))
+    metrics = engines.row_metrics(
+        sky,
+        study,
+        rows,
+        orientation.reshape(-1, 4),
+        loads,
+        outputs=(study.connection,),
+        engine=engine,
+    )
+    return (
+        fold_angles,
+        metrics.t_solar.reshape(sky.n_blocks, fold_angles.size, -1),
+        metrics.energy.reshape(sky.n_blocks, fold_angles.size),
+    )
 
 
-def design_metrics(sky: Sky, blocks: Blocks, loads, fold_angles, chosen, engine: str,
-                   tracker: TrackerCurves | None = None, curves: bool = False) -> dict:
+def design_metrics(
+    sky: Sky,
+    blocks: Blocks,
+    loads,
+    fold_angles,
+    chosen,
+    engine: str,
+    tracker: TrackerCurves | None = None,
+    curves: bool = False,
+) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
     panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net.
 
@@ -271,25 +306,54 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, fold_angles, chosen, engine:
     outputs = CONNECTIONS if curves else (study.connection,)
     own = outputs.index(study.connection)
     keep = curves or shape is not None
-    twofold = engines.row_metrics(sky, study, blocks, every[blocks, chosen.ravel()], loads[:, None],
-                                  np.tile(np.arange(n_loads), n_blocks), outputs=outputs, contiguous=True,
-                                  engine=engine, curves=np.arange(blocks.size) if keep else None)
-    flat = engines.row_metrics(sky, study, np.arange(n_blocks), engines.flat_orientation(tilt, azimuth), loads,
-                               outputs=("panel",), contiguous=True, engine=engine,
-                               curves=np.arange(n_blocks) if keep else None)
+    twofold = engines.row_metrics(
+        sky,
+        study,
+        blocks,
+        every[blocks, chosen.ravel()],
+        loads[:, None],
+        np.tile(np.arange(n_loads), n_blocks),
+        outputs=outputs,
+        contiguous=True,
+        engine=engine,
+        curves=np.arange(blocks.size) if keep else None,
+    )
+    flat = engines.row_metrics(
+        sky,
+        study,
+        np.arange(n_blocks),
+        engines.flat_orientation(tilt, azimuth),
+        loads,
+        outputs=("panel",),
+        contiguous=True,
+        engine=engine,
+        curves=np.arange(n_blocks) if keep else None,
+    )
     tracker = tracker or tracker_curves(sky, study, every=blocks_of.members)
     orientation, gross, net = tracker.orientation, tracker.power, tracker.net
     incident = tracker.incident
     if incident is None:
         incident = engines.poa(sky, *orientation[:2], incident=True, normal=orientation[2])
     tracker_poa = energy(incident, sky.step_hours)
-    trackers = engines.curve_metrics(np.concatenate([gross, net]), loads, sky.step_hours, contiguous=True,
-                                     engine=engine,
-                                     load_shape=None if shape is None else np.concatenate([shape, shape]))
+    trackers = engines.curve_metrics(
+        np.concatenate([gross, net]),
+        loads,
+        sky.step_hours,
+        contiguous=True,
+        engine=engine,
+        load_shape=None if shape is None else np.concatenate([shape, shape]),
+    )
 
     def per_design(twofold_values, flat_values, tracker_values):
-        return np.stack([flat_values, twofold_values.reshape(n_blocks, n_loads), tracker_values[:n_blocks],
-                         tracker_values[n_blocks:]], axis=-1)
+        return np.stack(
+            [
+                flat_values,
+                twofold_values.reshape(n_blocks, n_loads),
+                tracker_values[:n_blocks],
+                tracker_values[n_blocks:],
+            ],
+            axis=-1,
+        )
 
     hours = per_design(twofold.t_solar[:, own, 0], flat.t_solar[:, 0], trackers.t_solar[:, 0])
     served = None
@@ -297,35 +361,84 @@ def design_metrics(sky: Sky, blocks: Blocks, loads, fold_angles, chosen, engine:
         # A load profile's served energy integrates P_load(t) over the solar-powered time: from the
         # curves the rows' t_solar were reduced from.
         step = sky.step_hours
-        twofold_served = np.stack([energy_served(twofold.power[index::n_loads, own], load, shape, step,
-                                                 twofold.t_solar[index::n_loads, own, 0])
-                                   for index, load in enumerate(loads)], 1)
-        served = np.stack([energy_served(flat.power[:, 0], loads, shape, step, flat.t_solar[:, 0]), twofold_served,
-                           energy_served(gross, loads, shape, step, trackers.t_solar[:n_blocks, 0]),
-                           energy_served(net, loads, shape, step, trackers.t_solar[n_blocks:, 0])], axis=-1)
-    fold = np.stack([np.full((n_blocks, n_loads), 180.0), fold_angles[chosen], np.full((n_blocks, n_loads), np.nan),
-                     np.full((n_blocks, n_loads), np.nan)], axis=-1)
+        twofold_served = np.stack(
+            [
+                energy_served(
+                    twofold.power[index::n_loads, own],
+                    load,
+                    shape,
+                    step,
+                    twofold.t_solar[index::n_loads, own, 0],
+                )
+                for index, load in enumerate(loads)
+            ],
+            1,
+        )
+        served = np.stack(
+            [
+                energy_served(flat.power[:, 0], loads, shape, step, flat.t_solar[:, 0]),
+                twofold_served,
+                energy_served(gross, loads, shape, step, trackers.t_solar[:n_blocks, 0]),
+                energy_served(net, loads, shape, step, trackers.t_solar[n_blocks:, 0]),
+            ],
+            axis=-1,
+        )
+    fold = np.stack(
+        [
+            np.full((n_blocks, n_loads), 180.0),
+            fold_angles[chosen],
+            np.full((n_blocks, n_loads), np.nan),
+            np.full((n_blocks, n_loads), np.nan),
+        ],
+        axis=-1,
+    )
     columns = metric_columns(
         hours,
-        per_design(twofold.t_solar_contiguous[:, own, 0], flat.t_solar_contiguous[:, 0],
-                   trackers.t_solar_contiguous[:, 0]),
-        per_design(twofold.energy[:, own], np.repeat(flat.energy, n_loads, axis=1),
-                   np.repeat(trackers.energy, n_loads, axis=1)),
-        per_design(twofold.peak[:, own], np.repeat(flat.peak, n_loads, axis=1),
-                   np.repeat(trackers.peak, n_loads, axis=1)),
+        per_design(
+            twofold.t_solar_contiguous[:, own, 0],
+            flat.t_solar_contiguous[:, 0],
+            trackers.t_solar_contiguous[:, 0],
+        ),
+        per_design(
+            twofold.energy[:, own],
+            np.repeat(flat.energy, n_loads, axis=1),
+            np.repeat(trackers.energy, n_loads, axis=1),
+        ),
+        per_design(
+            twofold.peak[:, own],
+            np.repeat(flat.peak, n_loads, axis=1),
+            np.repeat(trackers.peak, n_loads, axis=1),
+        ),
         loads[None, :, None],
         served,
     )
     # Every design here is wired as the study's circuit says: a load beyond the panel's reach, every one.
     reach = engines.electrical_for(study, sky.temp_air[0], sky.wind_ref).beyond_reach
-    condition = np.array(["; ".join(filter(None, (reach, day))) for day in sky.conditions()], dtype=object)
-    drawn = {} if not curves else {"curves": {"flat": flat.power[:, 0], **{
-        name: twofold.power[:, index].reshape(n_blocks, n_loads, -1) for index, name in enumerate(outputs)}}}
+    condition = np.array(
+        ["; ".join(filter(None, (reach, day))) for day in sky.conditions()], dtype=object
+    )
+    drawn = (
+        {}
+        if not curves
+        else {
+            "curves": {
+                "flat": flat.power[:, 0],
+                **{
+                    name: twofold.power[:, index].reshape(n_blocks, n_loads, -1)
+                    for index, name in enumerate(outputs)
+                },
+            }
+        }
+    )
     return {
         "fold_angle_deg": fold,
         **columns,
-        "poa_kwh_m2": per_design(twofold.irradiation, np.repeat(flat.irradiation[:, None], n_loads, axis=1),
-                                 np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1)) / 1000.0,
+        "poa_kwh_m2": per_design(
+            twofold.irradiation,
+            np.repeat(flat.irradiation[:, None], n_loads, axis=1),
+            np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1),
+        )
+        / 1000.0,
         # A tracker whose drive costs more than it harvests says so where every table's note starts.
         "condition": design_condition(condition[:, None, None], columns["energy_harvested_wh"]),
         **drawn,
@@ -388,7 +501,9 @@ def daily_designs(parts, loads, engine: str = "numba", search=None) -> DailyDesi
         As :func:`site_designs`' (one site); default every angle of the study's grid.
     """
     n_blocks = sum(sky.n_blocks for _, sky in parts)
-    return site_designs(parts, [range(n_blocks)], np.asarray(loads, dtype=float)[None], engine, search)[0]
+    return site_designs(
+        parts, [range(n_blocks)], np.asarray(loads, dtype=float)[None], engine, search
+    )[0]
 
 
 def site_designs(parts, sites, loads, engine: str = "numba", search=None) -> list:
@@ -426,24 +541,59 @@ def site_designs(parts, sites, loads, engine: str = "numba", search=None) -> lis
     for chunk, sky in parts:
         rows = slice(start, start + sky.n_blocks)
         start = rows.stop
-        metrics = engines.row_metrics(sky, study, np.arange(sky.n_blocks), engines.flat_orientation(
-            chunk.tilt, chunk.azimuth), loads, loadset[rows], outputs=("panel",), engine=engine)
+        metrics = engines.row_metrics(
+            sky,
+            study,
+            np.arange(sky.n_blocks),
+            engines.flat_orientation(chunk.tilt, chunk.azimuth),
+            loads,
+            loadset[rows],
+            outputs=("panel",),
+            engine=engine,
+        )
         flat.append(metrics.t_solar[:, 0])
         flat_energy.append(metrics.energy[:, 0])
         flat_peak.append(metrics.peak[:, 0])
         curves = tracker_curves(sky, study)
-        both = engines.curve_metrics(np.concatenate([curves.power, curves.net]), loads, sky.step_hours,
-                                     np.concatenate([loadset[rows], loadset[rows]]), engine=engine)
-        tracker.append((both.t_solar[:sky.n_blocks, 0], both.t_solar[sky.n_blocks:, 0], both.energy[:sky.n_blocks, 0]))
-        available.append(standby_available(curves.power, curves.draw, sky.lit, study.tracker.standby_w))
+        both = engines.curve_metrics(
+            np.concatenate([curves.power, curves.net]),
+            loads,
+            sky.step_hours,
+            np.concatenate([loadset[rows], loadset[rows]]),
+            engine=engine,
+        )
+        tracker.append(
+            (
+                both.t_solar[: sky.n_blocks, 0],
+                both.t_solar[sky.n_blocks :, 0],
+                both.energy[: sky.n_blocks, 0],
+            )
+        )
+        available.append(
+            standby_available(curves.power, curves.draw, sky.lit, study.tracker.standby_w)
+        )
     gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
-    flat, flat_energy, flat_peak, available = (np.concatenate(values) for values in (flat, flat_energy, flat_peak,
-                                                                                     available))
+    flat, flat_energy, flat_peak, available = (
+        np.concatenate(values) for values in (flat, flat_energy, flat_peak, available)
+    )
     tilted = any(flat_tilted is not None for *_, flat_tilted in searched)
-    return [DailyDesigns(points[:, 0], hours, energy, flat[blocks], flat_energy[blocks], gross_h[blocks],
-                         net_h[blocks], gross_wh[blocks], available[blocks], flat_peak[blocks],
-                         points[:, 1] if tilted else None, flat_tilted)
-            for blocks, (points, hours, energy, flat_tilted) in zip(sites, searched, strict=True)]
+    return [
+        DailyDesigns(
+            points[:, 0],
+            hours,
+            energy,
+            flat[blocks],
+            flat_energy[blocks],
+            gross_h[blocks],
+            net_h[blocks],
+            gross_wh[blocks],
+            available[blocks],
+            flat_peak[blocks],
+            points[:, 1] if tilted else None,
+            flat_tilted,
+        )
+        for blocks, (points, hours, energy, flat_tilted) in zip(sites, searched, strict=True)
+    ]
 
 
 def _every_angle(parts, sites, loads, loadset, engine):
@@ -452,15 +602,29 @@ def _every_angle(parts, sites, loads, loadset, engine):
     fold_angles = np.asarray(study.fold_angles.grid())
     tilt = np.concatenate([chunk.tilt for chunk, _ in parts])
     azimuth = np.concatenate([chunk.azimuth for chunk, _ in parts])
-    requests = [(np.asarray(blocks), np.column_stack([fold_angles, np.full(fold_angles.size, tilt[blocks[0]]),
-                                                      np.full(fold_angles.size, azimuth[blocks[0]])]))
-                for blocks in sites]
+    requests = [
+        (
+            np.asarray(blocks),
+            np.column_stack(
+                [
+                    fold_angles,
+                    np.full(fold_angles.size, tilt[blocks[0]]),
+                    np.full(fold_angles.size, azimuth[blocks[0]]),
+                ]
+            ),
+        )
+        for blocks in sites
+    ]
     done = requested_hours(parts, requests, loads, loadset, engine=engine)
-    return [(points, hours.transpose(0, 2, 1), energy, None)
-            for (_, points), (hours, energy) in zip(requests, done, strict=True)]
+    return [
+        (points, hours.transpose(0, 2, 1), energy, None)
+        for (_, points), (hours, energy) in zip(requests, done, strict=True)
+    ]
 
 
-def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba", with_energy: bool = False):
+def design_hours(
+    parts, points, loads, flat: bool = False, engine: str = "numba", with_energy: bool = False
+):
     """Each day's t_solar [h] of arbitrary designs: a fold angle, base tilt and base azimuth each,
     for the search of :func:`foldopt.studies.joint.optimize_plan`.
 
@@ -484,11 +648,15 @@ def design_hours(parts, points, loads, flat: bool = False, engine: str = "numba"
         (days, n, n_loads); with ``with_energy`` also (days, n) [Wh].
     """
     n_blocks = sum(sky.n_blocks for _, sky in parts)
-    hours, energy = requested_hours(parts, [(np.arange(n_blocks), points)], loads, flat=flat, engine=engine)[0]
+    hours, energy = requested_hours(
+        parts, [(np.arange(n_blocks), points)], loads, flat=flat, engine=engine
+    )[0]
     return (hours, energy) if with_energy else hours
 
 
-def requested_hours(parts, requests, loads, loadset=None, flat: bool = False, engine: str = "numba") -> list:
+def requested_hours(
+    parts, requests, loads, loadset=None, flat: bool = False, engine: str = "numba"
+) -> list:
     """Each day's t_solar [h] and harvested energy [Wh] of designs, each request on days of its
     own, every request of a chunk in as few engine calls as its memory bound allows.
 
@@ -515,16 +683,30 @@ def requested_hours(parts, requests, loads, loadset=None, flat: bool = False, en
     loads = np.atleast_2d(np.asarray(loads, dtype=float))
     study = parts[0][0].study
     output = "panel" if flat else study.connection
-    requests = [(np.asarray(blocks, dtype=np.int64), np.asarray(points, dtype=float).reshape(-1, 3))
-                for blocks, points in requests]
-    loadset = np.zeros(sum(sky.n_blocks for _, sky in parts), dtype=np.int64) if loadset is None else loadset
+    requests = [
+        (np.asarray(blocks, dtype=np.int64), np.asarray(points, dtype=float).reshape(-1, 3))
+        for blocks, points in requests
+    ]
+    loadset = (
+        np.zeros(sum(sky.n_blocks for _, sky in parts), dtype=np.int64)
+        if loadset is None
+        else loadset
+    )
     # Every request's orientations in one call (one geometry call per distinct base).
     every = np.concatenate([points for _, points in requests])
-    table = (engines.flat_orientation(every[:, 1], every[:, 2] % 360.0) if flat else
-             _orientations(study, every[:, 0], every[:, 1], every[:, 2] % 360.0))
+    table = (
+        engines.flat_orientation(every[:, 1], every[:, 2] % 360.0)
+        if flat
+        else _orientations(study, every[:, 0], every[:, 1], every[:, 2] % 360.0)
+    )
     tables = np.split(table, np.cumsum([points.shape[0] for _, points in requests])[:-1])
-    out = [(np.empty((blocks.size, points.shape[0], loads.shape[1])), np.empty((blocks.size, points.shape[0])))
-           for blocks, points in requests]
+    out = [
+        (
+            np.empty((blocks.size, points.shape[0], loads.shape[1])),
+            np.empty((blocks.size, points.shape[0])),
+        )
+        for blocks, points in requests
+    ]
     start = 0
     for _, sky in parts:
         stop = start + sky.n_blocks
@@ -547,11 +729,26 @@ def requested_hours(parts, requests, loads, loadset=None, flat: bool = False, en
             offsets = np.cumsum([0, *counts[:-1]])
             orientation = np.concatenate([tables[k][piece] for k, _, piece in call])
             blocks = [requests[k][0][inside] for k, inside, _ in call]
-            row_block = np.concatenate([np.repeat(b - start, n) for b, n in zip(blocks, counts, strict=True)])
-            row_orientation = np.concatenate([offset + np.tile(np.arange(n), b.size)
-                                              for b, n, offset in zip(blocks, counts, offsets, strict=True)])
-            metrics = engines.row_metrics(sky, study, row_block, orientation, loads, loadset[start + row_block],
-                                          outputs=(output,), engine=engine, row_orientation=row_orientation)
+            row_block = np.concatenate(
+                [np.repeat(b - start, n) for b, n in zip(blocks, counts, strict=True)]
+            )
+            row_orientation = np.concatenate(
+                [
+                    offset + np.tile(np.arange(n), b.size)
+                    for b, n, offset in zip(blocks, counts, offsets, strict=True)
+                ]
+            )
+            metrics = engines.row_metrics(
+                sky,
+                study,
+                row_block,
+                orientation,
+                loads,
+                loadset[start + row_block],
+                outputs=(output,),
+                engine=engine,
+                row_orientation=row_orientation,
+            )
             position = 0
             for (k, inside, piece), b, n in zip(call, blocks, counts, strict=True):
                 rows = slice(position, position + b.size * n)
@@ -570,5 +767,7 @@ def _orientations(study: Study, fold_angle, tilt, azimuth) -> np.ndarray:
     orientation = np.empty((fold_angle.size, 4))
     for index, (base_tilt, base_azimuth) in enumerate(unique):
         take = inverse == index
-        orientation[take] = engines.fold_orientations(study, [base_tilt], [base_azimuth], fold_angle[take])[0]
+        orientation[take] = engines.fold_orientations(
+            study, [base_tilt], [base_azimuth], fold_angle[take]
+        )[0]
     return orientation

@@ -50,18 +50,26 @@ def sun_paths(study, dates) -> dict | None:
     zone = parse_timezone(site.timezone)
     steps = np.arange(0, 1440, PATH_STEP_MIN)
     start = pd.DatetimeIndex([dt.datetime.combine(day, dt.time(), zone) for day in days])
-    times = pd.DatetimeIndex((start.values[:, None] + steps[None, :].astype("timedelta64[m]")).ravel(), tz="UTC")
-    position = pvlib.solarposition.get_solarposition(times, site.latitude, site.longitude, site.altitude)
+    times = pd.DatetimeIndex(
+        (start.values[:, None] + steps[None, :].astype("timedelta64[m]")).ravel(), tz="UTC"
+    )
+    position = pvlib.solarposition.get_solarposition(
+        times, site.latitude, site.longitude, site.altitude
+    )
     azimuth = position["azimuth"].to_numpy().reshape(len(days), steps.size)
     elevation = position["apparent_elevation"].to_numpy().reshape(len(days), steps.size)
     horizon_azimuth, horizon_elevation = site.horizon.profile()
     up = elevation > 0
     hidden = up & (elevation <= horizon_elevation_at(azimuth, horizon_azimuth, horizon_elevation))
     drawn = _spread(len(days), MAX_DAYS)
-    return {"dates": [days[i].isoformat() for i in drawn], "azimuth": np.where(up, azimuth, np.nan)[drawn],
-            "elevation": np.where(up, elevation, np.nan)[drawn], "horizon_azimuth": horizon_azimuth,
-            "horizon_elevation": horizon_elevation,
-            "hidden_pct": float(100.0 * hidden.sum() / max(up.sum(), 1))}
+    return {
+        "dates": [days[i].isoformat() for i in drawn],
+        "azimuth": np.where(up, azimuth, np.nan)[drawn],
+        "elevation": np.where(up, elevation, np.nan)[drawn],
+        "horizon_azimuth": horizon_azimuth,
+        "horizon_elevation": horizon_elevation,
+        "hidden_pct": float(100.0 * hidden.sum() / max(up.sum(), 1)),
+    }
 
 
 def _spread(count: int, most: int) -> list[int]:
@@ -85,5 +93,10 @@ def horizon_notes(study, dates) -> list[dict]:
     paths = sun_paths(study, dates)
     if paths is None:
         return []
-    return [{"note": f"the horizon hides the sun for {paths['hidden_pct']:.1f} % of the days' daylight "
-                     "(beam and circumsolar light blocked then; the sky diffuse reduced per sub-panel)", "designs": []}]
+    return [
+        {
+            "note": f"the horizon hides the sun for {paths['hidden_pct']:.1f} % of the days' daylight "
+            "(beam and circumsolar light blocked then; the sky diffuse reduced per sub-panel)",
+            "designs": [],
+        }
+    ]

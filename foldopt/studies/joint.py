@@ -36,8 +36,13 @@ from foldopt.inputs.optimize_section import DEFAULT_TILT, MAX_DESIGNS
 from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
-from foldopt.studies.objectives import (best_angle_index, near_optimal, objective_quantum, objective_value,
-                                       season_days)
+from foldopt.studies.objectives import (
+    best_angle_index,
+    near_optimal,
+    objective_quantum,
+    objective_value,
+    season_days,
+)
 
 #: Points of the landscape's grid along the fold angle and the tilt.
 LANDSCAPE_POINTS = (46, 31)
@@ -103,7 +108,9 @@ def _axes(study: Study, vary, fold_angle: float = 180.0) -> dict[str, Axis]:
     axes = {}
     for name in names.OPTIMIZE_VARIABLES:
         lo, hi, step = spec.searched_range(name, study.fold_angles, study.panel.azimuth)
-        axes[name] = Axis(name, lo, hi, step) if name in vary else Axis(name, fixed[name], fixed[name], 1.0)
+        axes[name] = (
+            Axis(name, lo, hi, step) if name in vary else Axis(name, fixed[name], fixed[name], 1.0)
+        )
     return axes
 
 
@@ -133,25 +140,41 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     axes = dict(plan.axes)
     other = [path for path in axes if path not in ("date", "p_load")]
     if other:
-        raise ConfigError([f"optimize: one site and setup over its days and loads; {', '.join(other)} vary (run "
-                           f"one study each)"])
+        raise ConfigError(
+            [
+                f"optimize: one site and setup over its days and loads; {', '.join(other)} vary (run "
+                f"one study each)"
+            ]
+        )
     if study.weather is not None and study.weather.members:
-        raise ConfigError(["optimize: a cloud ensemble (weather.members) is not searched; leave out weather.members"])
+        raise ConfigError(
+            [
+                "optimize: a cloud ensemble (weather.members) is not searched; leave out weather.members"
+            ]
+        )
     dates = tuple(axes.get("date", (study.date,)))
     loads = np.asarray(axes.get("p_load", (study.p_load,)), dtype=float)
     # The search holds, and evaluated.csv writes, each evaluated design's objective per load.
     designs = math.prod(axis.size for axis in _axes(study, spec.vary).values())
     if designs * loads.size > MAX_DESIGNS:
-        raise ConfigError([f"p_load: {loads.size:,} loads x {designs:,} designs = {designs * loads.size:.2g} to "
-                           f"search; the limit is {MAX_DESIGNS:,} (fewer loads, coarser steps, or "
-                           f"FOLDOPT_MAX_DESIGNS)"])
+        raise ConfigError(
+            [
+                f"p_load: {loads.size:,} loads x {designs:,} designs = {designs * loads.size:.2g} to "
+                f"search; the limit is {MAX_DESIGNS:,} (fewer loads, coarser steps, or "
+                f"FOLDOPT_MAX_DESIGNS)"
+            ]
+        )
     statistic = study.objective.statistic if study.objective is not None else "mean"
     season = study.objective.months if study.objective is not None else None
     months = np.array([date.month for date in dates])
     counted = months[season_days(months, season)]  # the days the objective takes
     if counted.size == 0:
-        raise ConfigError([f"objective.months = {list(season)}: none of the {len(dates)} days ({dates[0]} to "
-                           f"{dates[-1]}) is in these months; give days in them, or other months"])
+        raise ConfigError(
+            [
+                f"objective.months = {list(season)}: none of the {len(dates)} days ({dates[0]} to "
+                f"{dates[-1]}) is in these months; give days in them, or other months"
+            ]
+        )
     blocks = Blocks.of_dates(study, dates)
     study = blocks.study
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
@@ -159,59 +182,117 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
 
     def objective(flat):
         def evaluate(points):
-            return objective_value(design_hours(parts, points, loads, flat, engine), months, statistic, season)
+            return objective_value(
+                design_hours(parts, points, loads, flat, engine), months, statistic, season
+            )
 
         return evaluate
 
     days_of = daily_designs(parts, loads, engine)
-    default = {"twofold-default": objective_value(days_of.twofold_h, months, statistic, season),  # (loads, angles)
-               "flat-default": objective_value(days_of.flat_h, months, statistic, season),
-               "tracker": objective_value(days_of.tracker_h, months, statistic, season)}
+    default = {
+        "twofold-default": objective_value(
+            days_of.twofold_h, months, statistic, season
+        ),  # (loads, angles)
+        "flat-default": objective_value(days_of.flat_h, months, statistic, season),
+        "tracker": objective_value(days_of.tracker_h, months, statistic, season),
+    }
     best_default = best_angle_index(default["twofold-default"])
     # A fold angle that does not vary stays at the default mounting's best (the first load's).
     fold_angle = float(days_of.angles[best_default[0]])
     vary = [name for name in names.OPTIMIZE_VARIABLES if name in spec.vary]
     all_axes = _axes(study, vary, fold_angle)
     # Each search starts from the one before's optimum, so a variable that joins never loses.
-    steps, seeds = [], [[days_of.angles[best], study.panel.tilt, study.panel.azimuth] for best in best_default]
+    steps, seeds = (
+        [],
+        [[days_of.angles[best], study.panel.tilt, study.panel.azimuth] for best in best_default],
+    )
     for count in range(1, len(vary) + 1):
-        search = grid_search(objective(False), list(_axes(study, vary[:count], fold_angle).values()),
-                             spec.tolerance_h, quantum, seeds=seeds)
+        search = grid_search(
+            objective(False),
+            list(_axes(study, vary[:count], fold_angle).values()),
+            spec.tolerance_h,
+            quantum,
+            seeds=seeds,
+        )
         steps.append((vary[count - 1], search))
         seeds = search.best_point
     # Each variable's near-optimal region walks its whole grid through the optimum.
     twofold = steps[-1][1].with_lines(objective(False))
     steps[-1] = (steps[-1][0], twofold)
     flat_axes = _axes(study, [name for name in vary if name != "fold_angle"])
-    flat = grid_search(objective(True), list(flat_axes.values()), spec.tolerance_h, quantum,
-                       seeds=[[180.0, study.panel.tilt, study.panel.azimuth]])
+    flat = grid_search(
+        objective(True),
+        list(flat_axes.values()),
+        spec.tolerance_h,
+        quantum,
+        seeds=[[180.0, study.panel.tilt, study.panel.azimuth]],
+    )
     table = _table(study, loads, twofold, flat, days_of.angles, best_default, default)
     near = _near_optimal(study, loads, twofold)
     # What the first variable adds is over the default mounting as it stands: flat where the fold
     # angle joins the search, else folded to the fixed angle (the tilt alone took the fold's gain).
-    start = default["flat-default"] if "fold_angle" in vary else default["twofold-default"][:, best_default[0]]
+    start = (
+        default["flat-default"]
+        if "fold_angle" in vary
+        else default["twofold-default"][:, best_default[0]]
+    )
     added = _added(study, loads, steps, start)
-    landscape = _landscape(parts, study, all_axes, twofold.best_point[0], loads[:1], months, statistic, season,
-                           engine)
-    return OptimizeResult(study, dates, loads, statistic, twofold, flat, tuple(steps), table, near, added, landscape,
-                          request)
+    landscape = _landscape(
+        parts, study, all_axes, twofold.best_point[0], loads[:1], months, statistic, season, engine
+    )
+    return OptimizeResult(
+        study,
+        dates,
+        loads,
+        statistic,
+        twofold,
+        flat,
+        tuple(steps),
+        table,
+        near,
+        added,
+        landscape,
+        request,
+    )
 
 
 def _table(study, loads, twofold, flat, fold_angles, best_default, default) -> pd.DataFrame:
     rows = []
     flat_best = flat.best_value
     for index, load in enumerate(loads):
-        designs = [("twofold", *twofold.best_point[index], twofold.best_value[index]),
-                   ("flat", 180.0, *flat.best_point[index][1:], flat_best[index]),
-                   ("twofold-default", fold_angles[best_default[index]], study.panel.tilt, study.panel.azimuth,
-                    default["twofold-default"][index, best_default[index]]),
-                   ("flat-default", 180.0, study.panel.tilt, study.panel.azimuth, default["flat-default"][index]),
-                   ("tracker", np.nan, np.nan, np.nan, default["tracker"][index])]
+        designs = [
+            ("twofold", *twofold.best_point[index], twofold.best_value[index]),
+            ("flat", 180.0, *flat.best_point[index][1:], flat_best[index]),
+            (
+                "twofold-default",
+                fold_angles[best_default[index]],
+                study.panel.tilt,
+                study.panel.azimuth,
+                default["twofold-default"][index, best_default[index]],
+            ),
+            (
+                "flat-default",
+                180.0,
+                study.panel.tilt,
+                study.panel.azimuth,
+                default["flat-default"][index],
+            ),
+            ("tracker", np.nan, np.nan, np.nan, default["tracker"][index]),
+        ]
         for design, fold, tilt, azimuth, value in designs:
-            rows.append({"p_load_w": load, "design": design, "fold_angle_deg": fold, "surface_tilt": tilt,
-                         "surface_azimuth": azimuth % 360.0 if azimuth == azimuth else azimuth, "objective_h": value,
-                         "gain_vs_flat_pct": 100.0 * (value / flat_best[index] - 1.0) if flat_best[index] > 0
-                         else np.nan})
+            rows.append(
+                {
+                    "p_load_w": load,
+                    "design": design,
+                    "fold_angle_deg": fold,
+                    "surface_tilt": tilt,
+                    "surface_azimuth": azimuth % 360.0 if azimuth == azimuth else azimuth,
+                    "objective_h": value,
+                    "gain_vs_flat_pct": 100.0 * (value / flat_best[index] - 1.0)
+                    if flat_best[index] > 0
+                    else np.nan,
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -233,11 +314,16 @@ def _near_optimal(study, loads, search: SearchResult) -> pd.DataFrame:
             np.maximum.at(profile[target], position, values[:, target])
         ranges = near_optimal(grid, profile, study.near_optimal)
         for index, load in enumerate(loads):
-            rows.append({"p_load_w": load, "variable": axis.name,
-                         "near_optimal_lo_deg": ranges["near_optimal_lo_deg"][index],
-                         "near_optimal_hi_deg": ranges["near_optimal_hi_deg"][index],
-                         "recommended_deg": ranges["recommended_fold_angle_deg"][index],
-                         "near_optimal_tolerance_h": ranges["near_optimal_tolerance_h"][index]})
+            rows.append(
+                {
+                    "p_load_w": load,
+                    "variable": axis.name,
+                    "near_optimal_lo_deg": ranges["near_optimal_lo_deg"][index],
+                    "near_optimal_hi_deg": ranges["near_optimal_hi_deg"][index],
+                    "recommended_deg": ranges["recommended_fold_angle_deg"][index],
+                    "near_optimal_tolerance_h": ranges["near_optimal_tolerance_h"][index],
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -248,21 +334,40 @@ def _added(study, loads, steps, start) -> pd.DataFrame:
     for name, search in steps:
         value = search.best_value
         for index, load in enumerate(loads):
-            rows.append({"p_load_w": load, "variable": name, "objective_h": value[index],
-                         "added_h": value[index] - before[index], "evaluated_designs": search.index.shape[0],
-                         "grid_designs": search.grid_size})
+            rows.append(
+                {
+                    "p_load_w": load,
+                    "variable": name,
+                    "objective_h": value[index],
+                    "added_h": value[index] - before[index],
+                    "evaluated_designs": search.index.shape[0],
+                    "grid_designs": search.grid_size,
+                }
+            )
         before = value
     return pd.DataFrame(rows)
 
 
 def _landscape(parts, study, axes, best, loads, months, statistic, season, engine) -> pd.DataFrame:
     """The objective over fold angle x tilt at the optimum's azimuth, on :data:`LANDSCAPE_POINTS`."""
-    fold_axis = axes["fold_angle"] if axes["fold_angle"].size > 1 else _axes(study, ["fold_angle"])["fold_angle"]
+    fold_axis = (
+        axes["fold_angle"]
+        if axes["fold_angle"].size > 1
+        else _axes(study, ["fold_angle"])["fold_angle"]
+    )
     tilt_axis = axes["tilt"] if axes["tilt"].size > 1 else Axis("tilt", *DEFAULT_TILT)
     folds = np.linspace(fold_axis.lo, fold_axis.hi, LANDSCAPE_POINTS[0])
     tilts = np.linspace(tilt_axis.lo, tilt_axis.hi, LANDSCAPE_POINTS[1])
     fold, tilt = (grid.ravel() for grid in np.meshgrid(folds, tilts, indexing="ij"))
     points = np.stack([fold, tilt, np.full(fold.size, best[2])], axis=-1)
-    value = objective_value(design_hours(parts, points, loads, False, engine), months, statistic, season)[:, 0]
-    return pd.DataFrame({"fold_angle_deg": fold, "surface_tilt": tilt, "surface_azimuth": best[2] % 360.0,
-                         "objective_h": value})
+    value = objective_value(
+        design_hours(parts, points, loads, False, engine), months, statistic, season
+    )[:, 0]
+    return pd.DataFrame(
+        {
+            "fold_angle_deg": fold,
+            "surface_tilt": tilt,
+            "surface_azimuth": best[2] % 360.0,
+            "objective_h": value,
+        }
+    )

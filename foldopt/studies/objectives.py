@@ -99,7 +99,11 @@ def period_values(hours, months, statistic: str, seasons):
         Each period's months (None: every day).
     """
     hours, months = np.asarray(hours, dtype=float), np.asarray(months)
-    if statistic not in ("mean", "worst-month") or math.prod(hours.shape[1:]) < 2 or hours.shape[0] == 0:
+    if (
+        statistic not in ("mean", "worst-month")
+        or math.prod(hours.shape[1:]) < 2
+        or hours.shape[0] == 0
+    ):
         # One value a day: NumPy sums it pairwise, not in the days' order (and no day: its NaN or error).
         return np.stack([objective_value(hours, months, statistic, season) for season in seasons])
     # The same bits as objective_value's, the means summed in one pass over the days (no copy of a
@@ -176,8 +180,11 @@ def near_optimal(fold_angles, values, tolerance: NearOptimal) -> dict:
     lo = np.where(below.any(axis=-1), fold_angles.size - np.argmax(below[..., ::-1], axis=-1), 0)
     hi = np.where(above.any(axis=-1), np.argmax(above, axis=-1) - 1, fold_angles.size - 1)
     centre = (fold_angles[lo] + fold_angles[hi]) / 2.0
-    distance = np.where((index >= lo[..., None]) & (index <= hi[..., None]),
-                        np.abs(fold_angles - centre[..., None]), np.inf)
+    distance = np.where(
+        (index >= lo[..., None]) & (index <= hi[..., None]),
+        np.abs(fold_angles - centre[..., None]),
+        np.inf,
+    )
     recommended = best_angle_index(-distance)
     carried = top > 0
     return {
@@ -230,7 +237,9 @@ def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> d
     for name, outward in {"near_optimal_lo_deg": -1, "near_optimal_hi_deg": 1}.items():
         edge = ranges[name]
         # Each target's gap between its evaluated edge (inner) and the next evaluated angle outward.
-        inner = np.searchsorted(fold_angles, np.where(np.isfinite(edge), edge, fold_angles[0]) - 1e-9)
+        inner = np.searchsorted(
+            fold_angles, np.where(np.isfinite(edge), edge, fold_angles[0]) - 1e-9
+        )
         outer = inner + outward
         has_gap = np.isfinite(edge) & (outer >= 0) & (outer < fold_angles.size)
         outer = np.clip(outer, 0, fold_angles.size - 1)
@@ -243,7 +252,9 @@ def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> d
             kept = gap & (place < stop[:, None])
             last = grid.size - 1 - np.argmax(kept[:, ::-1], axis=1)
         else:
-            stop = np.where(below.any(axis=1), grid.size - 1 - np.argmax(below[:, ::-1], axis=1), -1)
+            stop = np.where(
+                below.any(axis=1), grid.size - 1 - np.argmax(below[:, ::-1], axis=1), -1
+            )
             kept = gap & (place > stop[:, None])
             last = np.argmax(kept, axis=1)
         ranges[name] = np.where(kept.any(axis=1), grid[last], edge)
@@ -251,7 +262,9 @@ def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> d
     finite = np.isfinite(centre)
     nearest = np.full(centre.shape, np.nan)
     # Ties go to the less folded angle, as near_optimal breaks them.
-    nearest[finite] = grid[grid.size - 1 - np.argmin(np.abs(grid[::-1][None, :] - centre[finite, None]), axis=1)]
+    nearest[finite] = grid[
+        grid.size - 1 - np.argmin(np.abs(grid[::-1][None, :] - centre[finite, None]), axis=1)
+    ]
     ranges["recommended_fold_angle_deg"] = nearest
     return ranges
 
@@ -292,16 +305,26 @@ def ensemble_choice(daily, months, statistic: str, season, tolerance: NearOptima
         ``within_tolerance_pct`` (loads,) [%]; ``regret_h`` (members, loads) [h].
     """
     daily = np.asarray(daily, dtype=float)
-    member_score = np.stack([objective_value(member, months, statistic, season) for member in daily])
+    member_score = np.stack(
+        [objective_value(member, months, statistic, season) for member in daily]
+    )
     score = member_score.mean(axis=0)
     fixed = best_angle_index(score)
     own = best_angle_index(member_score)  # (members, loads)
     n_angles = score.shape[-1]
     wins = (own[..., None] == np.arange(n_angles)).mean(axis=0) * 100.0
     best_value = np.take_along_axis(member_score, own[..., None], axis=-1)[..., 0]
-    chosen = np.take_along_axis(member_score, np.broadcast_to(fixed, own.shape)[..., None], axis=-1)[..., 0]
+    chosen = np.take_along_axis(
+        member_score, np.broadcast_to(fixed, own.shape)[..., None], axis=-1
+    )[..., 0]
     regret = best_value - chosen
     within = (regret <= tolerance.tolerance_h(best_value) + 1e-12).mean(axis=0) * 100.0
-    return {"score": score, "member_score": member_score, "fixed": fixed, "wins_pct": wins,
-            "chosen_wins_pct": np.take_along_axis(wins, fixed[:, None], axis=-1)[:, 0],
-            "within_tolerance_pct": within, "regret_h": regret}
+    return {
+        "score": score,
+        "member_score": member_score,
+        "fixed": fixed,
+        "wins_pct": wins,
+        "chosen_wins_pct": np.take_along_axis(wins, fixed[:, None], axis=-1)[:, 0],
+        "within_tolerance_pct": within,
+        "regret_h": regret,
+    }

@@ -46,72 +46,138 @@ def of_optimize(result) -> Answer:
     days = len(result.dates)
     over = "the day" if days == 1 else f"{days} days"
     objective = "t_solar" if days == 1 else f"{result.statistic} of daily t_solar"
-    question = {**study_question(study, ("date",) if days > 1 else ()),
-                "optimize": ", ".join(f"{name} {axis.lo:g} to {axis.hi:g} by {axis.step:g} deg"
-                                      for name, axis in zip(spec.vary, _varied_axes(result), strict=True))
-                + f"; within {spec.tolerance_h:g} h",
-                "objective": f"the {objective} over {over}"}
+    question = {
+        **study_question(study, ("date",) if days > 1 else ()),
+        "optimize": ", ".join(
+            f"{name} {axis.lo:g} to {axis.hi:g} by {axis.step:g} deg"
+            for name, axis in zip(spec.vary, _varied_axes(result), strict=True)
+        )
+        + f"; within {spec.tolerance_h:g} h",
+        "objective": f"the {objective} over {over}",
+    }
     varied = [name.replace("_", " ") for name in spec.vary]
     joined = varied[0] if len(varied) == 1 else f"{', '.join(varied[:-1])} and {varied[-1]}"
-    lines = [f"{study.name}: the best {joined}{' together' if len(varied) > 1 else ''}, maximising the {objective} "
-             f"over {over}"]
+    lines = [
+        f"{study.name}: the best {joined}{' together' if len(varied) > 1 else ''}, maximising the {objective} "
+        f"over {over}"
+    ]
     fixed_fold = "fold_angle" not in spec.vary
     if fixed_fold and len(result.loads) > 1:
-        lines.append(f"  the fold angle stays at {result.twofold.best_point[0][0]:g} deg for every load, the first "
-                     f"load's best at the default mounting (--vary fold_angle searches it)")
+        lines.append(
+            f"  the fold angle stays at {result.twofold.best_point[0][0]:g} deg for every load, the first "
+            f"load's best at the default mounting (--vary fold_angle searches it)"
+        )
     per_load = []
     for load in result.loads:
         best, flat = _row(table, load, "twofold"), _row(table, load, "flat")
-        default, flat_default = _row(table, load, "twofold-default"), _row(table, load, "flat-default")
+        default, flat_default = (
+            _row(table, load, "twofold-default"),
+            _row(table, load, "flat-default"),
+        )
         tracker = _row(table, load, "tracker")
         near = result.near_optimal[result.near_optimal["p_load_w"] == load]
         added = result.added[result.added["p_load_w"] == load]
-        label = f"load profile x {load:g}" if study.load_profile is not None else f"P_load {load:g} W"
+        label = (
+            f"load profile x {load:g}" if study.load_profile is not None else f"P_load {load:g} W"
+        )
         carried = best.objective_h > 0
         if not carried:
             # Every design ties at nothing: the search's tie-break is no optimum, nor is there a gain
             # or a near-optimal region to give.
             near = near.iloc[:0]
-            lines.append(f"{label}: no design carries the load: the {objective} is 0.00 h at every design searched "
-                         f"(and the flat panel's); tracker {tracker.objective_h:.2f} h")
+            lines.append(
+                f"{label}: no design carries the load: the {objective} is 0.00 h at every design searched "
+                f"(and the flat panel's); tracker {tracker.objective_h:.2f} h"
+            )
         else:
-            lines.append(f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: {best.objective_h:.2f} h, "
-                         f"{_over_flat(best, flat)}; tracker {tracker.objective_h:.2f} h")
+            lines.append(
+                f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: {best.objective_h:.2f} h, "
+                f"{_over_flat(best, flat)}; tracker {tracker.objective_h:.2f} h"
+            )
             if len(near):
-                lines.append("  near-optimal: " + ", ".join(
-                    f"{_LABELS[row.variable][0]} {row.near_optimal_lo_deg:g} to {row.near_optimal_hi_deg:g} deg "
-                    f"(recommended {row.recommended_deg:g})" for row in near.itertuples())
-                    + f", each within {near['near_optimal_tolerance_h'].iloc[0] * 60:.1f} min")
+                lines.append(
+                    "  near-optimal: "
+                    + ", ".join(
+                        f"{_LABELS[row.variable][0]} {row.near_optimal_lo_deg:g} to {row.near_optimal_hi_deg:g} deg "
+                        f"(recommended {row.recommended_deg:g})"
+                        for row in near.itertuples()
+                    )
+                    + f", each within {near['near_optimal_tolerance_h'].iloc[0] * 60:.1f} min"
+                )
             # What the variables add starts from the default mounting folded as the search holds it.
             first = added.iloc[0]
-            folded = ((best.fold_angle_deg, first.objective_h - first.added_h) if fixed_fold
-                      else (default.fold_angle_deg, default.objective_h))
-            lines.append(f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} "
-                         f"h, folded to {folded[0]:g} deg {folded[1]:.2f} h): "
-                         + ", ".join(f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
-                                     for row in added.itertuples()))  # + 0.0: no "-0.0" for a roundoff
-        per_load.append({"p_load_w": load, "carried": bool(carried), "fold_angle_deg": best.fold_angle_deg,
-                         "surface_tilt": best.surface_tilt, "surface_azimuth": best.surface_azimuth,
-                         "objective_h": best.objective_h, "gain_vs_flat_pct": best.gain_vs_flat_pct,
-                         "flat": {"surface_tilt": flat.surface_tilt, "surface_azimuth": flat.surface_azimuth,
-                                  "objective_h": flat.objective_h},
-                         "default": {"fold_angle_deg": default.fold_angle_deg, "objective_h": default.objective_h,
-                                     "flat_objective_h": flat_default.objective_h},
-                         "tracker_objective_h": tracker.objective_h,
-                         "added_h": dict(zip(added["variable"], added["added_h"], strict=True)),
-                         "near_optimal": records(near.drop(columns="p_load_w"))})
+            folded = (
+                (best.fold_angle_deg, first.objective_h - first.added_h)
+                if fixed_fold
+                else (default.fold_angle_deg, default.objective_h)
+            )
+            lines.append(
+                f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} "
+                f"h, folded to {folded[0]:g} deg {folded[1]:.2f} h): "
+                + ", ".join(
+                    f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
+                    for row in added.itertuples()
+                )
+            )  # + 0.0: no "-0.0" for a roundoff
+        per_load.append(
+            {
+                "p_load_w": load,
+                "carried": bool(carried),
+                "fold_angle_deg": best.fold_angle_deg,
+                "surface_tilt": best.surface_tilt,
+                "surface_azimuth": best.surface_azimuth,
+                "objective_h": best.objective_h,
+                "gain_vs_flat_pct": best.gain_vs_flat_pct,
+                "flat": {
+                    "surface_tilt": flat.surface_tilt,
+                    "surface_azimuth": flat.surface_azimuth,
+                    "objective_h": flat.objective_h,
+                },
+                "default": {
+                    "fold_angle_deg": default.fold_angle_deg,
+                    "objective_h": default.objective_h,
+                    "flat_objective_h": flat_default.objective_h,
+                },
+                "tracker_objective_h": tracker.objective_h,
+                "added_h": dict(zip(added["variable"], added["added_h"], strict=True)),
+                "near_optimal": records(near.drop(columns="p_load_w")),
+            }
+        )
     search = result.twofold
     # The search's tolerance is the one asked for, or the objective's own step where that is coarser.
-    raised = "" if search.tolerance <= spec.tolerance_h else (
-        f" (the objective's own step: it counts no finer than the {spec.tolerance_h:g} h asked for)")
-    lines.append(f"search: {search.index.shape[0]:,} of the grid's {search.grid_size:,} designs evaluated "
-                 f"({100 * search.index.shape[0] / search.grid_size:.1f} %), within {search.tolerance:.3g} h of its "
-                 f"best{raised}")
-    summary = {"statistic": result.statistic, "days": days, "loads": per_load,
-               "search": {"evaluated": int(search.index.shape[0]), "grid": search.grid_size,
-                          "levels": [list(level) for level in search.levels], "tolerance_h": search.tolerance}}
-    return Answer("optimize", study.name, question, request_defaults(result), summary, table, result.near_optimal,
-                  summary=tuple(lines))
+    raised = (
+        ""
+        if search.tolerance <= spec.tolerance_h
+        else (
+            f" (the objective's own step: it counts no finer than the {spec.tolerance_h:g} h asked for)"
+        )
+    )
+    lines.append(
+        f"search: {search.index.shape[0]:,} of the grid's {search.grid_size:,} designs evaluated "
+        f"({100 * search.index.shape[0] / search.grid_size:.1f} %), within {search.tolerance:.3g} h of its "
+        f"best{raised}"
+    )
+    summary = {
+        "statistic": result.statistic,
+        "days": days,
+        "loads": per_load,
+        "search": {
+            "evaluated": int(search.index.shape[0]),
+            "grid": search.grid_size,
+            "levels": [list(level) for level in search.levels],
+            "tolerance_h": search.tolerance,
+        },
+    }
+    return Answer(
+        "optimize",
+        study.name,
+        question,
+        request_defaults(result),
+        summary,
+        table,
+        result.near_optimal,
+        summary=tuple(lines),
+    )
 
 
 def _varied_axes(result):

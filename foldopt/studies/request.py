@@ -31,9 +31,16 @@ SWEEP_AXES = {"angle": None, "latitude": "site.latitude", "day": "date", "load":
 DEFAULT_RANGES = {"site.latitude": "-60:60:5", "date": "1:365:7"}
 #: Short names of fields inside a section, for :func:`foldopt.sweep`'s keywords.
 KEYWORDS = {
-    "latitude": "site.latitude", "longitude": "site.longitude", "altitude": "site.altitude",
-    "timezone": "site.timezone", "area": "panel.area", "efficiency": "panel.efficiency", "tilt": "panel.tilt",
-    "azimuth": "panel.azimuth", "standby_w": "tracker.standby_w", "visits": "objective.visits",
+    "latitude": "site.latitude",
+    "longitude": "site.longitude",
+    "altitude": "site.altitude",
+    "timezone": "site.timezone",
+    "area": "panel.area",
+    "efficiency": "panel.efficiency",
+    "tilt": "panel.tilt",
+    "azimuth": "panel.azimuth",
+    "standby_w": "tracker.standby_w",
+    "visits": "objective.visits",
 }
 #: Loads of a load sweep's default range: shares of the panel's rating (area x 1000 W/m^2 x efficiency).
 DEFAULT_LOAD_SHARES = 20
@@ -46,8 +53,13 @@ _FLAGS = {entry.parameter: entry.flag for entry in FIELD_OPTIONS if entry.flag i
 #: Within them every benefit, cost and net benefit over areas up to 1000 m^2 stays far below float
 #: overflow (the largest is some 1e13 $); beyond them a value is a slip, and 1e308 $/m^2 would print
 #: as a 309-digit net benefit, or as -inf.
-SIZING_LIMITS = {"cost_per_m2": (1e9, " $/m^2"), "cost_per_w": (1e6, " $/W"), "c_grid_usd_per_kwh": (1e3, " $/kWh"),
-                 "years": (1e3, " years"), "days_per_year": (366, " days")}
+SIZING_LIMITS = {
+    "cost_per_m2": (1e9, " $/m^2"),
+    "cost_per_w": (1e6, " $/W"),
+    "c_grid_usd_per_kwh": (1e3, " $/kWh"),
+    "years": (1e3, " years"),
+    "days_per_year": (366, " days"),
+}
 
 
 @dataclass(frozen=True)
@@ -77,11 +89,20 @@ class Request:
 def _default_loads(data: dict) -> list[float]:
     panel = data.get("panel") or {}
     rating = float(panel.get("area", 0.1)) * 1000.0 * float(panel.get("efficiency", 0.2))
-    return [round(rating * share / DEFAULT_LOAD_SHARES, 4) for share in range(1, DEFAULT_LOAD_SHARES + 1)]
+    return [
+        round(rating * share / DEFAULT_LOAD_SHARES, 4)
+        for share in range(1, DEFAULT_LOAD_SHARES + 1)
+    ]
 
 
-def plan_request(data: dict, changes: dict | None = None, *, axis: str | None = None, source: str = "the given study",
-                 name: str | None = None) -> Request:
+def plan_request(
+    data: dict,
+    changes: dict | None = None,
+    *,
+    axis: str | None = None,
+    source: str = "the given study",
+    name: str | None = None,
+) -> Request:
     """The plan of a study with some fields changed, and what it took from the study.
 
     Parameters
@@ -117,12 +138,20 @@ def plan_request(data: dict, changes: dict | None = None, *, axis: str | None = 
         raise ConfigError([f"{field}: sweep {axis} needs a range start:stop:step or a list"])
     new, decided = policy.apply(data, changes, field)
     if field is not None and field not in changes:
-        new = policy.set_path(new, field, _default_loads(new) if field == "p_load" else DEFAULT_RANGES[field])
+        new = policy.set_path(
+            new, field, _default_loads(new) if field == "p_load" else DEFAULT_RANGES[field]
+        )
     weather = new.get("weather")
     ensemble = isinstance(weather, dict) and weather.get("members") is not None
-    if axis == "angle" and weather is not None and "objective" not in new and (ensemble or not (
-            "date" in changes and policy.is_single(changes["date"]))):
-        new["objective"] = {"statistic": "mean"}  # a year of weather (or a day's ensemble) at one fold angle
+    if (
+        axis == "angle"
+        and weather is not None
+        and "objective" not in new
+        and (ensemble or not ("date" in changes and policy.is_single(changes["date"])))
+    ):
+        new["objective"] = {
+            "statistic": "mean"
+        }  # a year of weather (or a day's ensemble) at one fold angle
     study_year = _ISO_DATE.match(str(data.get("date", "")))
     if "year" not in new and study_year:
         new["year"] = int(study_year.group(1))  # days of year are the study's year's
@@ -130,14 +159,24 @@ def plan_request(data: dict, changes: dict | None = None, *, axis: str | None = 
         new["name"] = name
     plan = make_plan(new)
     if axis == "angle":
-        varied = [path for path, _ in plan.axes if not (path == "date" and plan.base.objective is not None)]
+        varied = [
+            path
+            for path, _ in plan.axes
+            if not (path == "date" and plan.base.objective is not None)
+        ]
         if varied:
-            raise ConfigError([f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep latitude, "
-                               "day or load)"])
+            raise ConfigError(
+                [
+                    f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep latitude, "
+                    "day or load)"
+                ]
+            )
     return Request(plan, source, tuple(_taken(plan, changes, field, new, decided)))
 
 
-def _taken(plan: Plan, changes: dict, field: str | None, data: dict, decided: list[str]) -> list[str]:
+def _taken(
+    plan: Plan, changes: dict, field: str | None, data: dict, decided: list[str]
+) -> list[str]:
     """What a request took from its study and its defaults, for the answer's "from" line."""
     from foldopt.inputs.load_profile import load_text
 
@@ -147,7 +186,9 @@ def _taken(plan: Plan, changes: dict, field: str | None, data: dict, decided: li
     taken = []
     if field is not None and field not in given:
         if field == "p_load":
-            taken.append(f"{DEFAULT_LOAD_SHARES} loads, 5 % to 100 % of {data['p_load'][-1]:g} W (default range)")
+            taken.append(
+                f"{DEFAULT_LOAD_SHARES} loads, 5 % to 100 % of {data['p_load'][-1]:g} W (default range)"
+            )
         else:
             year = f" of {data['year']}" if field == "date" and data.get("year") else ""
             label = {"site.latitude": "latitude", "date": "day"}[field]
@@ -196,12 +237,16 @@ def size_request(plan: Plan, source: str, cost_given: bool) -> Request:
     from foldopt.inputs.costs import PAPER_COST_PER_M2
 
     if plan.axes:
-        raise ConfigError([f"config: {source} sweeps {', '.join(p for p, _ in plan.axes)}; size takes one case"])
+        raise ConfigError(
+            [f"config: {source} sweeps {', '.join(p for p, _ in plan.axes)}; size takes one case"]
+        )
     study = plan.base
     taken = [f"site, day, {load_text(study)}, efficiency {study.panel.efficiency:g}"]
     if not cost_given:
-        taken.append(f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
-                     "cost_per_m2 or cost_per_w)")
+        taken.append(
+            f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
+            "cost_per_m2 or cost_per_w)"
+        )
     return Request(plan, source, tuple(taken))
 
 
@@ -227,7 +272,9 @@ def sizing_problems(parameters: dict) -> list[str]:
         if value is None or (isinstance(value, (int, float)) and 0 < value <= largest):
             continue
         shown = f"{value:g}" if isinstance(value, (int, float)) else repr(value)
-        problems.append(f"{name} = {shown}: must be a finite number > 0 and at most {largest:g}{unit}")
+        problems.append(
+            f"{name} = {shown}: must be a finite number > 0 and at most {largest:g}{unit}"
+        )
     return problems
 
 
@@ -294,7 +341,11 @@ def settings_plan(path, settings=()) -> Plan:
             data = policy.set_path(data, key, value)
         parts = tuple(key.split("."))
         # Neither the changed field's lines nor its sections' (whose line a message falls back on) hold it now.
-        lines = {loc: line for loc, line in lines.items() if loc[:len(parts)] != parts and parts[:len(loc)] != loc}
+        lines = {
+            loc: line
+            for loc, line in lines.items()
+            if loc[: len(parts)] != parts and parts[: len(loc)] != loc
+        }
     if errors:
         raise ConfigError(errors)
     return make_plan(data, lines)
@@ -325,13 +376,23 @@ def sweep_changes(options: dict, data: dict) -> dict:
     changes, errors = {}, []
     if options["p_load_scale"] is not None:
         if options["p_load"] is not None:
-            errors.append("--p-load / --p-load-scale: a constant load or a profile's scale, not both")
+            errors.append(
+                "--p-load / --p-load-scale: a constant load or a profile's scale, not both"
+            )
         elif data.get("load_profile") is None and options["load_profile"] is None:
-            errors.append("--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
-                          "the study)")
-    lonely = [option for option in ("weather_format", "members", "seed") if options.get(option) is not None]
+            errors.append(
+                "--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
+                "the study)"
+            )
+    lonely = [
+        option
+        for option in ("weather_format", "members", "seed")
+        if options.get(option) is not None
+    ]
     if lonely and options.get("weather") is None and data.get("weather") is None:
-        errors.append(f"--{lonely[0].replace('_', '-')}: an option of a weather file; give one with --weather")
+        errors.append(
+            f"--{lonely[0].replace('_', '-')}: an option of a weather file; give one with --weather"
+        )
     for option, value in options.items():
         if option == "settings" or value is None or value is False:
             continue
@@ -361,11 +422,18 @@ def sweep_changes(options: dict, data: dict) -> dict:
 
 
 #: The joint optimisation's parameters, as :func:`optimize_section` and the command line name them.
-OPTIMIZE_OPTIONS = {"vary": "--vary", "fold_angle": "--fold-range", "tilt": "--tilt-range",
-                    "azimuth": "--azimuth-range", "tolerance_h": "--tolerance"}
+OPTIMIZE_OPTIONS = {
+    "vary": "--vary",
+    "fold_angle": "--fold-range",
+    "tilt": "--tilt-range",
+    "azimuth": "--azimuth-range",
+    "tolerance_h": "--tolerance",
+}
 
 
-def optimize_section(vary=None, fold_angle=None, tilt=None, azimuth=None, tolerance_h=None, labels=None) -> dict:
+def optimize_section(
+    vary=None, fold_angle=None, tilt=None, azimuth=None, tolerance_h=None, labels=None
+) -> dict:
     """The ``optimize`` section of a study from the API's or the command line's parameters.
 
     Parameters
@@ -391,14 +459,20 @@ def optimize_section(vary=None, fold_angle=None, tilt=None, azimuth=None, tolera
     labels = labels or {}
     section, errors = {}, []
     if vary is not None:
-        section["vary"] = [item.strip() for item in vary.split(",")] if isinstance(vary, str) else list(vary)
+        section["vary"] = (
+            [item.strip() for item in vary.split(",")] if isinstance(vary, str) else list(vary)
+        )
     for name, value in (("fold_angle", fold_angle), ("tilt", tilt), ("azimuth", azimuth)):
         if value is None:
             continue
         try:
-            low, high, step = range_parts(value) if isinstance(value, str) else (float(part) for part in value)
+            low, high, step = (
+                range_parts(value) if isinstance(value, str) else (float(part) for part in value)
+            )
         except (TypeError, ValueError):
-            errors.append(f"{labels.get(name, name)} = {value!r}: expected min:max:step in degrees, e.g. 0:90:1")
+            errors.append(
+                f"{labels.get(name, name)} = {value!r}: expected min:max:step in degrees, e.g. 0:90:1"
+            )
             continue
         section[name] = {"min": low, "max": high, "step": step}
     if tolerance_h is not None:
@@ -408,7 +482,9 @@ def optimize_section(vary=None, fold_angle=None, tilt=None, azimuth=None, tolera
     return section
 
 
-def sweep_request(study, options: dict, axis: str | None, source: str, section: dict | None = None) -> Request:
+def sweep_request(
+    study, options: dict, axis: str | None, source: str, section: dict | None = None
+) -> Request:
     """The request of ``foldopt sweep AXIS``: the study, changed by the sweep's options.
 
     Parameters
@@ -434,18 +510,36 @@ def sweep_request(study, options: dict, axis: str | None, source: str, section: 
     foldopt.ConfigError
         One line per fault, naming the option or the field.
     """
-    data = study if isinstance(study, dict) else read_study(default_study_path() if study is None else study)[0]
+    data = (
+        study
+        if isinstance(study, dict)
+        else read_study(default_study_path() if study is None else study)[0]
+    )
     changes = sweep_changes(options, data)
     command = "optimize" if section is not None else f"sweep {axis}"
     changes["description"] = f"foldopt {command} from {source} (see command)"
     if section is not None:
         changes["optimize"] = {**(data.get("optimize") or {}), **section}
-    return plan_request(data, changes, axis=axis, source=source, name=f"{command.replace(' ', '-')}")
+    return plan_request(
+        data, changes, axis=axis, source=source, name=f"{command.replace(' ', '-')}"
+    )
 
 
-def map_request_from(study=None, *, source: str = "the given study", objective: str = "mean", area=None,
-                     efficiency=None, step_min=None, angle_step=None, fold_search: bool = False, optimize=None,
-                     settings=(), loads=None, **where):
+def map_request_from(
+    study=None,
+    *,
+    source: str = "the given study",
+    objective: str = "mean",
+    area=None,
+    efficiency=None,
+    step_min=None,
+    angle_step=None,
+    fold_search: bool = False,
+    optimize=None,
+    settings=(),
+    loads=None,
+    **where,
+):
     """The request of ``foldopt map``: a study made into a map's study by the map's options, and
     the map's sites and loads (:func:`foldopt.studies.worldmap.map_request`).
 
@@ -492,9 +586,17 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
     """
     from foldopt.studies.worldmap import map_request, map_study
 
-    data = study if isinstance(study, dict) else read_study(default_study_path() if study is None else study)[0]
+    data = (
+        study
+        if isinstance(study, dict)
+        else read_study(default_study_path() if study is None else study)[0]
+    )
     changes = {"objective": {"statistic": objective}}
-    for field, value in (("panel.area", area), ("panel.efficiency", efficiency), ("step_min", step_min)):
+    for field, value in (
+        ("panel.area", area),
+        ("panel.efficiency", efficiency),
+        ("step_min", step_min),
+    ):
         if value is not None:
             changes[field] = value
     if angle_step is not None:
@@ -505,7 +607,9 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
         except ValueError as error:
             raise ConfigError([f"optimize = {optimize!r}: {error}"]) from None
         if any(name not in OPTIMIZE_VARIABLES for name in varied):
-            raise ConfigError([f"optimize = {optimize!r}: must name some of {', '.join(OPTIMIZE_VARIABLES)}"])
+            raise ConfigError(
+                [f"optimize = {optimize!r}: must name some of {', '.join(OPTIMIZE_VARIABLES)}"]
+            )
         extra = [name for name in varied if name != "fold_angle"]
         changes["optimize"] = {**(data.get("optimize") or {}), "vary": ["fold_angle", *extra]}
     made = map_study(data, embedded=study is None, **changes)
@@ -514,11 +618,17 @@ def map_request_from(study=None, *, source: str = "the given study", objective: 
         made = policy.set_path(made, field, value)
     # The study's load as its file gives it: a value, a list or a range text, checked like --p-load.
     request = map_request(made, (data.get("p_load") or 1.0) if loads is None else loads, **where)
-    study_loads = (f"P_load {request.loads[0]:g} W" if len(request.loads) == 1 else
-                   f"P_load {len(request.loads)} loads, {min(request.loads):g} to {max(request.loads):g} W")
+    study_loads = (
+        f"P_load {request.loads[0]:g} W"
+        if len(request.loads) == 1
+        else f"P_load {len(request.loads)} loads, {min(request.loads):g} to {max(request.loads):g} W"
+    )
     made = request.study
-    taken = [f"panel {made.panel.area:g} m^2" if area is None else None,
-             study_loads if loads is None and not request.relative else None,
-             f"{made.pv_model} PV model", f"{made.mode} mode",
-             f"{made.step_min:g}-min steps" if step_min is None else None]
+    taken = [
+        f"panel {made.panel.area:g} m^2" if area is None else None,
+        study_loads if loads is None and not request.relative else None,
+        f"{made.pv_model} PV model",
+        f"{made.mode} mode",
+        f"{made.step_min:g}-min steps" if step_min is None else None,
+    ]
     return replace(request, source=source, taken=tuple(item for item in taken if item))

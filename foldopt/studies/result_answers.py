@@ -20,7 +20,12 @@ from foldopt.studies.worldmap import searched_tilt
 
 #: The designs an answer compares, first the ones every study has.
 MAIN_DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
-NEAR_OPTIMAL = ("near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg", "near_optimal_tolerance_h")
+NEAR_OPTIMAL = (
+    "near_optimal_lo_deg",
+    "near_optimal_hi_deg",
+    "recommended_fold_angle_deg",
+    "near_optimal_tolerance_h",
+)
 
 
 def _hours(value) -> str:
@@ -28,7 +33,11 @@ def _hours(value) -> str:
 
 
 def _pct(value, signed: bool = True) -> str:
-    return "-" if value is None or value != value else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
+    return (
+        "-"
+        if value is None or value != value
+        else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
+    )
 
 
 def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dict]:
@@ -52,8 +61,14 @@ def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dic
         designs = list(dict.fromkeys(rows["design"]))
         entry = {"note": note, "designs": [] if set(designs) == every else designs}
         if case_count is not None:
-            keys = [c for c in rows.columns if c in ("site_name", "latitude", "longitude", "date", "p_load_w")]
-            entry.update(cases=int(len(rows.drop_duplicates(keys))) if keys else len(rows), of=case_count)
+            keys = [
+                c
+                for c in rows.columns
+                if c in ("site_name", "latitude", "longitude", "date", "p_load_w")
+            ]
+            entry.update(
+                cases=int(len(rows.drop_duplicates(keys))) if keys else len(rows), of=case_count
+            )
         notes.append(entry)
     return notes
 
@@ -83,16 +98,18 @@ def study_question(study, varied: tuple = ()) -> dict:
     panel = study.panel
     tolerance = study.near_optimal
     question = {
-        "site": "varies (see the table)" if {"site", "site.latitude", "site.longitude"} & set(varied) else where,
+        "site": "varies (see the table)"
+        if {"site", "site.latitude", "site.longitude"} & set(varied)
+        else where,
         "day": "varies (see the table)" if "date" in varied else study.date.isoformat(),
         "load": "varies (see the table)" if "p_load" in varied else load_text(study),
         "panel": f"{panel.area:g} m^2, efficiency {panel.efficiency:g}, tilt {panel.tilt:g} deg, azimuth "
-                 f"{panel.azimuth:g} deg" + (" (per latitude)" if "site.latitude" in varied else ""),
+        f"{panel.azimuth:g} deg" + (" (per latitude)" if "site.latitude" in varied else ""),
         "models": f"{study.mode} mode, {study.geometry} geometry, {study.pv_model} PV model, {study.connection}, "
-                  + sky_text(study, varied),
+        + sky_text(study, varied),
         "fold angles": f"{study.fold_angles.start:g} to {study.fold_angles.stop:g} deg by {study.fold_angles.step:g}",
         "near-optimal": f"within {100 * tolerance.fraction:g} % or {tolerance.minutes:g} min of the best, "
-                        "whichever is larger",
+        "whichever is larger",
         "objective": "t_solar of the day",
     }
     if site.horizon is not None:
@@ -102,14 +119,25 @@ def study_question(study, varied: tuple = ()) -> dict:
     if study.objective is not None and "date" in varied:
         objective = study.objective
         season = f" of months {', '.join(map(str, objective.months))}" if objective.months else ""
-        question["objective"] = (f"one fold angle for all days, maximising the {objective.statistic} of daily "
-                                 f"t_solar{season}" + (f"; re-fold schedules of up to {objective.visits} settings"
-                                                       if objective.visits else ""))
+        question["objective"] = (
+            f"one fold angle for all days, maximising the {objective.statistic} of daily "
+            f"t_solar{season}"
+            + (
+                f"; re-fold schedules of up to {objective.visits} settings"
+                if objective.visits
+                else ""
+            )
+        )
     return question
 
 
 #: How the question names each sky and transposition.
-SKY_LABELS = {"meinel": "Meinel", "hottel": "Hottel", "ineichen": "Ineichen", "simplified-solis": "simplified Solis"}
+SKY_LABELS = {
+    "meinel": "Meinel",
+    "hottel": "Hottel",
+    "ineichen": "Ineichen",
+    "simplified-solis": "simplified Solis",
+}
 TRANSPOSITION_LABELS = {"isotropic": "isotropic", "haydavies": "Hay-Davies", "perez": "Perez"}
 
 
@@ -136,11 +164,17 @@ def sky_text(study, varied: tuple = ()) -> str:
     if study.weather is not None:
         parts = [f"weather {Path(study.weather.path).name}"]
     else:
-        parts = [f"{SKY_LABELS[study.sky]} clear sky" + (f" ({study.climate})" if study.sky == "hottel" else "")]
+        parts = [
+            f"{SKY_LABELS[study.sky]} clear sky"
+            + (f" ({study.climate})" if study.sky == "hottel" else "")
+        ]
         if study.sky == "ineichen":
             parts[0] += f" at Linke turbidity {_turbidity_text(study, varied)}"
     if transposition == "none":
-        parts.append("beam only" + (" (Shin et al.)" if study.mode == "paper" and study.sky == "meinel" else ""))
+        parts.append(
+            "beam only"
+            + (" (Shin et al.)" if study.mode == "paper" and study.sky == "meinel" else "")
+        )
     else:
         parts += [f"{TRANSPOSITION_LABELS[transposition]} diffuse", f"albedo {study.albedo:g}"]
     return ", ".join(parts)
@@ -158,8 +192,12 @@ def _turbidity_text(study, varied: tuple) -> str:
     if {"site", "site.latitude", "site.longitude", "date"} & set(varied):
         return "from pvlib climatology for each site and day"
     site = study.site
-    noon = np.datetime64(f"{study.date.isoformat()}T12:00") - np.timedelta64(round(site.longitude * 240), "s")
-    value = linke_turbidity(site.latitude, site.longitude, noon.astype("datetime64[ns]").astype(np.int64))
+    noon = np.datetime64(f"{study.date.isoformat()}T12:00") - np.timedelta64(
+        round(site.longitude * 240), "s"
+    )
+    value = linke_turbidity(
+        site.latitude, site.longitude, noon.astype("datetime64[ns]").astype(np.int64)
+    )
     return f"{float(value):.1f} (pvlib climatology for the site and day)"
 
 
@@ -167,8 +205,10 @@ def _range_text(row) -> str:
     lo, hi, recommended = (row.get(key) for key in NEAR_OPTIMAL[:3])
     if lo is None or lo != lo:
         return "near-optimal: no fold angle carries the load"
-    return (f"near-optimal {lo:g} to {hi:g} deg (within {60 * row['near_optimal_tolerance_h']:.1f} min); "
-            f"recommended {recommended:g} deg")
+    return (
+        f"near-optimal {lo:g} to {hi:g} deg (within {60 * row['near_optimal_tolerance_h']:.1f} min); "
+        f"recommended {recommended:g} deg"
+    )
 
 
 def of_study(result) -> Answer:
@@ -193,42 +233,70 @@ def of_study(result) -> Answer:
     near_table = pd.DataFrame([near])
     heuristic = result.heuristic_fold_angle
     result_part = {
-        "objective": "t_solar of the day", "load": describe_load(study),
-        "fold_angle_deg": result.optimal_fold_angle, "t_solar_h": float(twofold["t_solar_h"]),
-        "fold_angle_twofold_heuristic_deg": heuristic, "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
-        "pct_of_tracker": float(twofold["pct_of_tracker"]), "flat_area_multiple": float(twofold["flat_area_multiple"]),
-        "break_even_standby_tracker_w": float(result.standby[1]), **near,
+        "objective": "t_solar of the day",
+        "load": describe_load(study),
+        "fold_angle_deg": result.optimal_fold_angle,
+        "t_solar_h": float(twofold["t_solar_h"]),
+        "fold_angle_twofold_heuristic_deg": heuristic,
+        "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
+        "pct_of_tracker": float(twofold["pct_of_tracker"]),
+        "flat_area_multiple": float(twofold["flat_area_multiple"]),
+        "break_even_standby_tracker_w": float(result.standby[1]),
+        **near,
         "t_solar_by_design_h": {d: float(by.loc[d, "t_solar_h"]) for d in MAIN_DESIGNS},
     }
     site = study.site
     where = site.name or f"{site.latitude:g}, {site.longitude:g}"
-    lines = [f"{study.name}: {where}, {study.date}, {load_text(study)} ({study.mode} mode, {study.pv_model} + "
-             f"{study.connection})"]
+    lines = [
+        f"{study.name}: {where}, {study.date}, {load_text(study)} ({study.mode} mode, {study.pv_model} + "
+        f"{study.connection})"
+    ]
     hours = result_part["t_solar_by_design_h"]
     if not hours["twofold"]:
-        lines.append(f"no fold angle reaches the load: t_solar 0 h (flat {_hours(hours['flat'])}, tracker "
-                     f"{_hours(hours['tracker'])})")
+        lines.append(
+            f"no fold angle reaches the load: t_solar 0 h (flat {_hours(hours['flat'])}, tracker "
+            f"{_hours(hours['tracker'])})"
+        )
     else:
-        lines.append(f"best fold angle {result.optimal_fold_angle:.1f} deg"
-                     + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic == heuristic else "")
-                     + f": t_solar {_hours(hours['twofold'])}, {_pct(twofold['gain_vs_flat_pct'])} over flat "
-                     f"({_hours(hours['flat'])}), {_pct(twofold['pct_of_tracker'], False)} of the tracker's "
-                     f"{_hours(hours['tracker'])}")
+        lines.append(
+            f"best fold angle {result.optimal_fold_angle:.1f} deg"
+            + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic == heuristic else "")
+            + f": t_solar {_hours(hours['twofold'])}, {_pct(twofold['gain_vs_flat_pct'])} over flat "
+            f"({_hours(hours['flat'])}), {_pct(twofold['pct_of_tracker'], False)} of the tracker's "
+            f"{_hours(hours['tracker'])}"
+        )
         lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
     extras = []
     if twofold["flat_area_multiple"] == twofold["flat_area_multiple"]:
         extras.append(f"a flat panel would need {twofold['flat_area_multiple']:.2f}x the area")
     if result.standby[1] == result.standby[1]:
-        extras.append(f"the twofold panel outlasts the tracker once its standby draw exceeds "
-                      f"{result.standby[1]:.2f} W")
+        extras.append(
+            f"the twofold panel outlasts the tracker once its standby draw exceeds "
+            f"{result.standby[1]:.2f} W"
+        )
     if extras:
         lines.append("; ".join(extras))
-    columns = ["design", "fold_angle_deg", "t_solar_h", "energy_harvested_wh", "gain_vs_flat_pct", "pct_of_tracker",
-               "note"]
-    return Answer("study", study.name, study_question(study), request_defaults(result), result_part,
-                  summary[columns], near_table, pd.DataFrame(),
-                  design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
-                  tuple(lines))
+    columns = [
+        "design",
+        "fold_angle_deg",
+        "t_solar_h",
+        "energy_harvested_wh",
+        "gain_vs_flat_pct",
+        "pct_of_tracker",
+        "note",
+    ]
+    return Answer(
+        "study",
+        study.name,
+        study_question(study),
+        request_defaults(result),
+        result_part,
+        summary[columns],
+        near_table,
+        pd.DataFrame(),
+        design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
+        tuple(lines),
+    )
 
 
 def request_defaults(result) -> dict | None:
@@ -266,33 +334,81 @@ def of_sweep(result) -> Answer:
     gains = twofold["gain_vs_flat_pct"].dropna()
     axes = " x ".join(f"{len(values)} {path.split('.')[-1]}" for path, values in plan.axes)
     lines = [f"{plan.base.name}: {plan.n_cases} cases ({axes})"]
-    part = {"cases": plan.n_cases, "axes": {path: len(values) for path, values in plan.axes},
-            "load": describe_load(plan.base),
-            "fold_angle_deg": {"min": twofold["fold_angle_deg"].min(), "max": twofold["fold_angle_deg"].max()},
-            "recommended_fold_angle_deg": {"min": twofold["recommended_fold_angle_deg"].min(),
-                                           "max": twofold["recommended_fold_angle_deg"].max()}}
+    part = {
+        "cases": plan.n_cases,
+        "axes": {path: len(values) for path, values in plan.axes},
+        "load": describe_load(plan.base),
+        "fold_angle_deg": {
+            "min": twofold["fold_angle_deg"].min(),
+            "max": twofold["fold_angle_deg"].max(),
+        },
+        "recommended_fold_angle_deg": {
+            "min": twofold["recommended_fold_angle_deg"].min(),
+            "max": twofold["recommended_fold_angle_deg"].max(),
+        },
+    }
     if len(gains):
         best = twofold.loc[gains.idxmax()]
-        at = {column: best[column] for column in result.varied if column in best and column != "dayofyear"}
+        at = {
+            column: best[column]
+            for column in result.varied
+            if column in best and column != "dayofyear"
+        }
         part["gain_vs_flat_pct"] = {"median": gains.median(), "max": gains.max(), "at": at}
-        where = ", ".join(f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
-                          for key, value in at.items())
-        lines.append(f"twofold over flat: median {_pct(gains.median())}, best {_pct(gains.max())} ({where}); "
-                     f"fold angles {part['fold_angle_deg']['min']:g} to {part['fold_angle_deg']['max']:g} deg")
+        where = ", ".join(
+            f"{key} {value:g}" if isinstance(value, float) else f"{key} {value}"
+            for key, value in at.items()
+        )
+        lines.append(
+            f"twofold over flat: median {_pct(gains.median())}, best {_pct(gains.max())} ({where}); "
+            f"fold angles {part['fold_angle_deg']['min']:g} to {part['fold_angle_deg']['max']:g} deg"
+        )
     rec = part["recommended_fold_angle_deg"]
     if rec["min"] == rec["min"]:
-        lines.append(f"recommended fold angles (centres of each case's near-optimal range) {rec['min']:g} to "
-                     f"{rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the table)")
-    keys = [c for c in ("site_name", "latitude", "longitude", "date", "p_load_w", *result.varied) if c in table]
-    near = twofold[list(dict.fromkeys(keys)) + ["fold_angle_deg", *NEAR_OPTIMAL]].reset_index(drop=True)
-    designs = table[[c for c in (*dict.fromkeys(keys), "design", "fold_angle_deg", "t_solar_h", "energy_harvested_wh",
-                                 "gain_vs_flat_pct", "pct_of_tracker", "note") if c in table]]
+        lines.append(
+            f"recommended fold angles (centres of each case's near-optimal range) {rec['min']:g} to "
+            f"{rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the table)"
+        )
+    keys = [
+        c
+        for c in ("site_name", "latitude", "longitude", "date", "p_load_w", *result.varied)
+        if c in table
+    ]
+    near = twofold[list(dict.fromkeys(keys)) + ["fold_angle_deg", *NEAR_OPTIMAL]].reset_index(
+        drop=True
+    )
+    designs = table[
+        [
+            c
+            for c in (
+                *dict.fromkeys(keys),
+                "design",
+                "fold_angle_deg",
+                "t_solar_h",
+                "energy_harvested_wh",
+                "gain_vs_flat_pct",
+                "pct_of_tracker",
+                "note",
+            )
+            if c in table
+        ]
+    ]
     question = study_question(plan.base, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
-    return Answer("sweep", plan.base.name, question, request_defaults(result), plain(part), designs, near,
-                  pd.DataFrame(),
-                  design_notes(table, plan.n_cases) + weather_notes(result) + horizon_notes(plan.base, _dates(plan)),
-                  tuple(lines))
+    return Answer(
+        "sweep",
+        plan.base.name,
+        question,
+        request_defaults(result),
+        plain(part),
+        designs,
+        near,
+        pd.DataFrame(),
+        design_notes(table, plan.n_cases)
+        + weather_notes(result)
+        + horizon_notes(plan.base, _dates(plan)),
+        tuple(lines),
+    )
 
 
 def _of_annual(result) -> Answer:
@@ -305,13 +421,27 @@ def _of_annual(result) -> Answer:
     objective = study.objective
     statistic = objective.statistic
     objectives = result.extras["annual_objective"]
-    keys = [c for c in objectives.columns if c not in ("design", "objective", "objective_h", "worst_month",
-                                                       "mean_t_solar_h", "fold_angle_deg", *NEAR_OPTIMAL,
-                                                       *ENSEMBLE_COLUMNS)]
+    keys = [
+        c
+        for c in objectives.columns
+        if c
+        not in (
+            "design",
+            "objective",
+            "objective_h",
+            "worst_month",
+            "mean_t_solar_h",
+            "fold_angle_deg",
+            *NEAR_OPTIMAL,
+            *ENSEMBLE_COLUMNS,
+        )
+    ]
     members = study.weather.members if study.weather is not None and study.weather.members else None
     count = len(_dates(plan))
-    lines = [f"{study.name}: {count} day{'s' if count != 1 else ''}, one fold angle "
-             f"{_period(count)}, maximising the {statistic} of daily t_solar"]
+    lines = [
+        f"{study.name}: {count} day{'s' if count != 1 else ''}, one fold angle "
+        f"{_period(count)}, maximising the {statistic} of daily t_solar"
+    ]
     groups = list(objectives.groupby(keys, sort=False))
     part = {"objective": statistic, "load": describe_load(study), "per_case": []}
     schedule = _schedule(result.extras)
@@ -320,65 +450,118 @@ def _of_annual(result) -> Answer:
         twofold, flat, tracker = by.loc["twofold"], by.loc["flat"], by.loc["tracker"]
         where = dict(zip(keys, key if isinstance(key, tuple) else (key,), strict=True))
         load = where.get("p_load_w")
-        case = {**where, "fold_angle_deg": twofold["fold_angle_deg"],
-                "objective_h": {d: by.loc[d, "objective_h"] for d in MAIN_DESIGNS},
-                "mean_t_solar_h": {d: by.loc[d, "mean_t_solar_h"] for d in MAIN_DESIGNS},
-                **{k: twofold[k] for k in NEAR_OPTIMAL}}
+        case = {
+            **where,
+            "fold_angle_deg": twofold["fold_angle_deg"],
+            "objective_h": {d: by.loc[d, "objective_h"] for d in MAIN_DESIGNS},
+            "mean_t_solar_h": {d: by.loc[d, "mean_t_solar_h"] for d in MAIN_DESIGNS},
+            **{k: twofold[k] for k in NEAR_OPTIMAL},
+        }
         month = ""
         if statistic == "worst-month":
             case["worst_month"] = {d: int(by.loc[d, "worst_month"]) for d in MAIN_DESIGNS}
             month = f" (in {calendar.month_name[case['worst_month']['twofold']]})"
         part["per_case"].append(case)
-        gain = 100.0 * (twofold["objective_h"] / flat["objective_h"] - 1.0) if flat["objective_h"] > 0 else float("nan")
-        flat_month = (f" in {calendar.month_name[case['worst_month']['flat']]}" if statistic == "worst-month" else "")
+        gain = (
+            100.0 * (twofold["objective_h"] / flat["objective_h"] - 1.0)
+            if flat["objective_h"] > 0
+            else float("nan")
+        )
+        flat_month = (
+            f" in {calendar.month_name[case['worst_month']['flat']]}"
+            if statistic == "worst-month"
+            else ""
+        )
         label = load_text(study, load)
-        site = where.get("site_name") or (f"{where['latitude']:g}, {where['longitude']:g}"
-                                         if len(groups) > 1 and "latitude" in where else "")
-        lines.append(f"{site + ': ' if site else ''}{label}: fold angle {twofold['fold_angle_deg']:g} deg "
-                     f"{_period(count)}; "
-                     f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, {_pct(gain)} over flat "
-                     f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}"
-                     + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"))
+        site = where.get("site_name") or (
+            f"{where['latitude']:g}, {where['longitude']:g}"
+            if len(groups) > 1 and "latitude" in where
+            else ""
+        )
+        lines.append(
+            f"{site + ': ' if site else ''}{label}: fold angle {twofold['fold_angle_deg']:g} deg "
+            f"{_period(count)}; "
+            f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, {_pct(gain)} over flat "
+            f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}"
+            + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}")
+        )
         lines.append("  " + _range_text(twofold.to_dict()))
         if members:
-            spread = {d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in ENSEMBLE_PERCENTILES}
-                      for d in MAIN_DESIGNS}
+            spread = {
+                d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in ENSEMBLE_PERCENTILES}
+                for d in MAIN_DESIGNS
+            }
             case["objective_spread_h"] = spread
             case["members"] = members
             case.update({key: twofold[key] for key in ("chosen_wins_pct", "within_tolerance_pct")})
-            lines.append(f"  over {members} cloud members: {statistic} t_solar "
-                         + "/".join(f"P{pct}" for pct in ENSEMBLE_PERCENTILES) + " "
-                         + "; ".join(f"{d} " + "/".join(_hours(value) for value in spread[d].values())
-                                     for d in MAIN_DESIGNS))
-            lines.append(f"  {twofold['fold_angle_deg']:g} deg is the best angle of {twofold['chosen_wins_pct']:.0f} % "
-                         f"of the members and within the near-optimal tolerance of their best for "
-                         f"{twofold['within_tolerance_pct']:.0f} %")
+            lines.append(
+                f"  over {members} cloud members: {statistic} t_solar "
+                + "/".join(f"P{pct}" for pct in ENSEMBLE_PERCENTILES)
+                + " "
+                + "; ".join(
+                    f"{d} " + "/".join(_hours(value) for value in spread[d].values())
+                    for d in MAIN_DESIGNS
+                )
+            )
+            lines.append(
+                f"  {twofold['fold_angle_deg']:g} deg is the best angle of {twofold['chosen_wins_pct']:.0f} % "
+                f"of the members and within the near-optimal tolerance of their best for "
+                f"{twofold['within_tolerance_pct']:.0f} %"
+            )
         if len(schedule):
             mine = schedule[(schedule["p_load_w"] == load)] if load is not None else schedule
             for settings, visits in mine.groupby("settings", sort=True):
                 first = visits.iloc[0]
-                when = ", ".join(f"{v.date} at {v.fold_angle_deg:g} deg" for v in visits.itertuples())
+                when = ", ".join(
+                    f"{v.date} at {v.fold_angle_deg:g} deg" for v in visits.itertuples()
+                )
                 added = "" if settings == 1 else f" (+{first['added_by_setting_h'] * 60:.1f} min)"
-                lines.append(f"  {settings} setting{'s' if settings > 1 else ''}: {statistic} t_solar "
-                             f"{_hours(first['objective_h'])}{added}: {when}")
+                lines.append(
+                    f"  {settings} setting{'s' if settings > 1 else ''}: {statistic} t_solar "
+                    f"{_hours(first['objective_h'])}{added}: {when}"
+                )
     if len(groups) > 8:
         lines.append(f"... and {len(groups) - 8} more cases (annual_objective.csv)")
-    designs = objectives[[*keys, "design", "objective", "objective_h", "worst_month", "mean_t_solar_h",
-                          "fold_angle_deg", *[c for c in ENSEMBLE_COLUMNS if c in objectives]]]
+    designs = objectives[
+        [
+            *keys,
+            "design",
+            "objective",
+            "objective_h",
+            "worst_month",
+            "mean_t_solar_h",
+            "fold_angle_deg",
+            *[c for c in ENSEMBLE_COLUMNS if c in objectives],
+        ]
+    ]
     if statistic != "worst-month":
         designs = designs.drop(columns="worst_month")
     twofold_rows = objectives[objectives["design"] == "twofold"]
     near = twofold_rows[[*keys, "fold_angle_deg", *NEAR_OPTIMAL]].reset_index(drop=True)
     question = study_question(study, tuple(path for path, _ in plan.axes))
     question["sweep"] = ", ".join(f"{path} ({len(values)} values)" for path, values in plan.axes)
-    return Answer("annual", study.name, question, request_defaults(result), plain(part), designs, near, schedule,
-                  design_notes(result.table, plan.n_cases) + weather_notes(result)
-                  + horizon_notes(study, _dates(plan)), tuple(lines))
+    return Answer(
+        "annual",
+        study.name,
+        question,
+        request_defaults(result),
+        plain(part),
+        designs,
+        near,
+        schedule,
+        design_notes(result.table, plan.n_cases)
+        + weather_notes(result)
+        + horizon_notes(study, _dates(plan)),
+        tuple(lines),
+    )
 
 
 #: The annual objective's columns over a cloud ensemble (foldopt.studies.sweeps.objective_table).
-ENSEMBLE_COLUMNS = (*(f"objective_p{pct}_h" for pct in ENSEMBLE_PERCENTILES), "chosen_wins_pct",
-                    "within_tolerance_pct")
+ENSEMBLE_COLUMNS = (
+    *(f"objective_p{pct}_h" for pct in ENSEMBLE_PERCENTILES),
+    "chosen_wins_pct",
+    "within_tolerance_pct",
+)
 
 
 def _period(count: int) -> str:
@@ -396,12 +579,17 @@ def _schedule(extras: dict) -> pd.DataFrame:
         return pd.DataFrame()
     visits, values = extras["refold_schedule"], extras["refold_value"]
     keys = [c for c in visits.columns if c not in ("visit", "date", "fold_angle_deg")]
-    merged = visits.merge(values[[*keys, "objective", "objective_h", "added_by_setting_h", "gain_vs_fixed_pct"]],
-                          on=keys, how="left")
+    merged = visits.merge(
+        values[[*keys, "objective", "objective_h", "added_by_setting_h", "gain_vs_fixed_pct"]],
+        on=keys,
+        how="left",
+    )
     return merged
 
 
-def of_sizing(table: pd.DataFrame, best: pd.DataFrame, study, parameters: dict, defaults: dict | None) -> Answer:
+def of_sizing(
+    table: pd.DataFrame, best: pd.DataFrame, study, parameters: dict, defaults: dict | None
+) -> Answer:
     """The answer of a panel sizing: :func:`foldopt.studies.sizing.size_panel`'s ``table`` and its ``best``
     row per design, with the ``parameters`` used (costs, ``c_grid_usd_per_kwh``, ``years``).
 
@@ -412,18 +600,37 @@ def of_sizing(table: pd.DataFrame, best: pd.DataFrame, study, parameters: dict, 
     parameters, defaults : dict
         ``defaults``: what was taken from the study (:attr:`Answer.defaults`), or None.
     """
-    cost = (f"{parameters['cost_per_m2']:g} $/m^2" if parameters.get("cost_per_w") is None
-            else f"{parameters['cost_per_w']:g} $/W")
-    lines = [f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid "
-             f"{parameters['c_grid_usd_per_kwh']:g} $/kWh over {parameters['years']:g} years"]
+    cost = (
+        f"{parameters['cost_per_m2']:g} $/m^2"
+        if parameters.get("cost_per_w") is None
+        else f"{parameters['cost_per_w']:g} $/W"
+    )
+    lines = [
+        f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid "
+        f"{parameters['c_grid_usd_per_kwh']:g} $/kWh over {parameters['years']:g} years"
+    ]
     for row in best.itertuples():
         angle = "" if row.design == "flat" else f", folded to {row.fold_angle_deg:g} deg"
-        lines.append(f"  {row.design}: {row.area_m2:.3f} m^2{angle}, t_solar {row.t_solar_h:.2f} h, "
-                     f"net ${row.net_benefit_usd:.1f}")
-    question = {**study_question(study),
-                "sizing": ", ".join(f"{k} {v:g}" for k, v in parameters.items() if v is not None)}
-    return Answer("size", study.name, question, defaults, plain({**parameters, "best": records(best)}), best,
-                  pd.DataFrame(), pd.DataFrame(), [], tuple(lines))
+        lines.append(
+            f"  {row.design}: {row.area_m2:.3f} m^2{angle}, t_solar {row.t_solar_h:.2f} h, "
+            f"net ${row.net_benefit_usd:.1f}"
+        )
+    question = {
+        **study_question(study),
+        "sizing": ", ".join(f"{k} {v:g}" for k, v in parameters.items() if v is not None),
+    }
+    return Answer(
+        "size",
+        study.name,
+        question,
+        defaults,
+        plain({**parameters, "best": records(best)}),
+        best,
+        pd.DataFrame(),
+        pd.DataFrame(),
+        [],
+        tuple(lines),
+    )
 
 
 def of_reproduction(tables: dict, study) -> Answer:
@@ -443,16 +650,33 @@ def of_reproduction(tables: dict, study) -> Answer:
     """
     lines = []
     for name, table in tables.items():
-        model = "ideal PV model" if name == "reproduction" else "A-300 single-diode cells with switching"
+        model = (
+            "ideal PV model"
+            if name == "reproduction"
+            else "A-300 single-diode cells with switching"
+        )
         lines.append(f"Shin et al. ({model}): paper value | paper mode | exact mode")
         for row in table.itertuples():
             paper = "-" if row.paper != row.paper else f"{row.paper:g}"
-            lines.append(f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  "
-                         f"{row.unit}")
-    combined = pd.concat([table.assign(table=name) for name, table in tables.items()], ignore_index=True)
-    return Answer("reproduce", "Shin et al. reproduced", study_question(study), None,
-                  {name: records(table) for name, table in tables.items()}, combined, pd.DataFrame(), pd.DataFrame(),
-                  [], tuple(lines))
+            lines.append(
+                f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  "
+                f"{row.unit}"
+            )
+    combined = pd.concat(
+        [table.assign(table=name) for name, table in tables.items()], ignore_index=True
+    )
+    return Answer(
+        "reproduce",
+        "Shin et al. reproduced",
+        study_question(study),
+        None,
+        {name: records(table) for name, table in tables.items()},
+        combined,
+        pd.DataFrame(),
+        pd.DataFrame(),
+        [],
+        tuple(lines),
+    )
 
 
 def _count(number: int, noun: str) -> str:
@@ -480,58 +704,129 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
     for load, rows in year.groupby(year[key].round(12), sort=True):
         gain = rows["gain_vs_flat_pct"]
         best = rows.loc[gain.idxmax()] if gain.notna().any() else None
-        per_load.append({
-            key: float(load), "sites": int(len(rows)), "sites_folding_pays": int((gain > 0.05).sum()),
-            "median_gain_vs_flat_pct": gain.median(), "best_gain_vs_flat_pct": gain.max(),
-            "best_site": None if best is None else {"site_name": best["site_name"], "latitude": best["latitude"],
-                                                    "longitude": best["longitude"]},
-            "fold_angle_deg": {"min": rows["fold_angle_deg"].min(), "median": rows["fold_angle_deg"].median(),
-                               "max": rows["fold_angle_deg"].max()},
-            "recommended_fold_angle_deg": {"min": rows["recommended_fold_angle_deg"].min(),
-                                           "median": rows["recommended_fold_angle_deg"].median(),
-                                           "max": rows["recommended_fold_angle_deg"].max()},
-            "median_near_optimal_width_deg": (rows["near_optimal_hi_deg"] - rows["near_optimal_lo_deg"]).median(),
-            **{column: {"min": rows[column].min(), "median": rows[column].median(), "max": rows[column].max()}
-               for column in ("surface_tilt", "surface_tilt_flat")},
-            "median_pct_of_tracker": rows["pct_of_tracker"].median(),
-            "median_break_even_standby_tracker_w": rows["break_even_standby_tracker_w"].median(),
-        })
+        per_load.append(
+            {
+                key: float(load),
+                "sites": int(len(rows)),
+                "sites_folding_pays": int((gain > 0.05).sum()),
+                "median_gain_vs_flat_pct": gain.median(),
+                "best_gain_vs_flat_pct": gain.max(),
+                "best_site": None
+                if best is None
+                else {
+                    "site_name": best["site_name"],
+                    "latitude": best["latitude"],
+                    "longitude": best["longitude"],
+                },
+                "fold_angle_deg": {
+                    "min": rows["fold_angle_deg"].min(),
+                    "median": rows["fold_angle_deg"].median(),
+                    "max": rows["fold_angle_deg"].max(),
+                },
+                "recommended_fold_angle_deg": {
+                    "min": rows["recommended_fold_angle_deg"].min(),
+                    "median": rows["recommended_fold_angle_deg"].median(),
+                    "max": rows["recommended_fold_angle_deg"].max(),
+                },
+                "median_near_optimal_width_deg": (
+                    rows["near_optimal_hi_deg"] - rows["near_optimal_lo_deg"]
+                ).median(),
+                **{
+                    column: {
+                        "min": rows[column].min(),
+                        "median": rows[column].median(),
+                        "max": rows[column].max(),
+                    }
+                    for column in ("surface_tilt", "surface_tilt_flat")
+                },
+                "median_pct_of_tracker": rows["pct_of_tracker"].median(),
+                "median_break_even_standby_tracker_w": rows[
+                    "break_even_standby_tracker_w"
+                ].median(),
+            }
+        )
     statistic = study.objective.statistic if study.objective is not None else "mean"
-    part = plain({"sites": int(table["site_id"].nunique()), "objective": statistic,
-                   "loads": per_load, "cluster": result.cluster, "dashboard": result.dashboard,
-                   "chunks_computed": len(result.computed), "chunks_from_disk": len(result.from_disk),
-                   "seconds": round(result.seconds, 2)})
+    part = plain(
+        {
+            "sites": int(table["site_id"].nunique()),
+            "objective": statistic,
+            "loads": per_load,
+            "cluster": result.cluster,
+            "dashboard": result.dashboard,
+            "chunks_computed": len(result.computed),
+            "chunks_from_disk": len(result.from_disk),
+            "seconds": round(result.seconds, 2),
+        }
+    )
     weather = any("weather" in site for site in spec.sites)
-    sky = "weather files" if weather else "Ineichen clear sky" if study.sky == "ineichen" else f"{study.sky} sky"
-    lines = [f"map: {_count(part['sites'], 'site')}, year {spec.year}, {sky}, objective {part['objective']}, "
-             f"{study.panel.area:g} m^2 panel"]
+    sky = (
+        "weather files"
+        if weather
+        else "Ineichen clear sky"
+        if study.sky == "ineichen"
+        else f"{study.sky} sky"
+    )
+    lines = [
+        f"map: {_count(part['sites'], 'site')}, year {spec.year}, {sky}, objective {part['objective']}, "
+        f"{study.panel.area:g} m^2 panel"
+    ]
     for load in part["loads"]:
-        what = (f"P_load {load['p_load_fraction']:g} x flat peak" if relative else f"P_load {load['p_load_w']:g} W")
+        what = (
+            f"P_load {load['p_load_fraction']:g} x flat peak"
+            if relative
+            else f"P_load {load['p_load_w']:g} W"
+        )
         best = load["best_site"]
-        where = "" if best is None else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
+        where = (
+            ""
+            if best is None
+            else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
+        )
         rec = load["recommended_fold_angle_deg"]
         standby = load["median_break_even_standby_tracker_w"]
-        tracker = ("" if standby is None else ", whose own moves already cost it its lead" if standby == 0
-                   else f", which loses its lead above a median {standby:.2f} W of standby")
+        tracker = (
+            ""
+            if standby is None
+            else ", whose own moves already cost it its lead"
+            if standby == 0
+            else f", which loses its lead above a median {standby:.2f} W of standby"
+        )
         best_angles = load["fold_angle_deg"]
-        rec_text = ("no fold angle carries the load" if rec["min"] is None else
-                    f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended "
-                    f"{rec['min']:g} to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
-                    f"{load['median_near_optimal_width_deg']:g} deg wide)")
+        rec_text = (
+            "no fold angle carries the load"
+            if rec["min"] is None
+            else f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended "
+            f"{rec['min']:g} to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
+            f"{load['median_near_optimal_width_deg']:g} deg wide)"
+        )
         if tilts is not None and rec["min"] is not None:
             tilt, flat = load["surface_tilt"], load["surface_tilt_flat"]
-            rec_text += (f", at base tilts {tilt['min']:g} to {tilt['max']:g} deg (median {tilt['median']:g}; "
-                         f"the flat panel's own best {flat['min']:g} to {flat['max']:g}, median {flat['median']:g})")
+            rec_text += (
+                f", at base tilts {tilt['min']:g} to {tilt['max']:g} deg (median {tilt['median']:g}; "
+                f"the flat panel's own best {flat['min']:g} to {flat['max']:g}, median {flat['median']:g})"
+            )
         # Where no site carries the load there is no gain to give, nor a best site.
-        gains = ("" if best is None else f" (median {_pct(load['median_gain_vs_flat_pct'])}, best "
-                 f"{_pct(load['best_gain_vs_flat_pct'])} at {where})")
-        lines.append(f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')}"
-                     f"{gains}; {rec_text}; " + (
-                         "the tracker carries it at no site either" if load["median_pct_of_tracker"] is None else
-                         f"median {_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}"))
+        gains = (
+            ""
+            if best is None
+            else f" (median {_pct(load['median_gain_vs_flat_pct'])}, best "
+            f"{_pct(load['best_gain_vs_flat_pct'])} at {where})"
+        )
+        lines.append(
+            f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')}"
+            f"{gains}; {rec_text}; "
+            + (
+                "the tracker carries it at no site either"
+                if load["median_pct_of_tracker"] is None
+                else f"median {_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}"
+            )
+        )
     rate = len(spec.sites) / part["seconds"] if part["seconds"] else 0
-    computed = (f"computed {_count(part['chunks_computed'], 'chunk')} on {part['cluster']}" if part["chunks_computed"]
-                else "nothing to compute")
+    computed = (
+        f"computed {_count(part['chunks_computed'], 'chunk')} on {part['cluster']}"
+        if part["chunks_computed"]
+        else "nothing to compute"
+    )
     resumed = f", {part['chunks_from_disk']} from disk" if part["chunks_from_disk"] else ""
     lines.append(f"{computed}{resumed} in {part['seconds']:.1f} s ({rate:.1f} sites/s)")
     loads = ", ".join(f"{load:g}" for load in spec.loads)
@@ -539,14 +834,37 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         "sites": f"{len(spec.sites):,}",
         "loads": f"{loads} {'x each site' + chr(39) + 's flat peak' if relative else 'W'}",
         "year": str(spec.year),
-        "panel": f"{study.panel.area:g} m^2 facing the equator at " + (
-            "|latitude|" if tilts is None else
-            f"each site's best base tilt, {tilts.lo:g} to {tilts.hi:g} by {tilts.step:g} deg (the flat panel's own)"),
+        "panel": f"{study.panel.area:g} m^2 facing the equator at "
+        + (
+            "|latitude|"
+            if tilts is None
+            else f"each site's best base tilt, {tilts.lo:g} to {tilts.hi:g} by {tilts.step:g} deg "
+            "(the flat panel's own)"
+        ),
         "objective": part["objective"],
         "models": f"{study.mode} mode, {study.pv_model} PV model, "
-                  + (sky if weather else sky_text(study, ("site", "date"))),
+        + (sky if weather else sky_text(study, ("site", "date"))),
     }
-    columns = ["site_id", "site_name", "latitude", "longitude", key, "fold_angle_deg", "surface_tilt",
-               "surface_tilt_flat", *NEAR_OPTIMAL]
-    return Answer("map", "map", question, defaults, part, year[[c for c in year.columns if c not in NEAR_OPTIMAL]],
-                  year[columns].reset_index(drop=True), pd.DataFrame(), [], tuple(lines))
+    columns = [
+        "site_id",
+        "site_name",
+        "latitude",
+        "longitude",
+        key,
+        "fold_angle_deg",
+        "surface_tilt",
+        "surface_tilt_flat",
+        *NEAR_OPTIMAL,
+    ]
+    return Answer(
+        "map",
+        "map",
+        question,
+        defaults,
+        part,
+        year[[c for c in year.columns if c not in NEAR_OPTIMAL]],
+        year[columns].reset_index(drop=True),
+        pd.DataFrame(),
+        [],
+        tuple(lines),
+    )

@@ -68,15 +68,20 @@ class DesignSearch:
         """The asked designs' daily t_solar [h], (days, n, loads), and harvested energy [Wh], (days, n)."""
         hours, energy = np.asarray(hours, dtype=float), np.asarray(energy, dtype=float)
         self.found.append((self._asked, hours, energy))
-        self.grid.tell(period_values(hours, self.months, self.statistic, self.seasons).transpose(1, 0, 2).reshape(
-            self._asked.shape[0], -1))
+        self.grid.tell(
+            period_values(hours, self.months, self.statistic, self.seasons)
+            .transpose(1, 0, 2)
+            .reshape(self._asked.shape[0], -1)
+        )
 
     def result(self):
         """``(points (n, axes), hours (days, loads, n), energy (days, n))`` over every evaluated design,
         in ascending order of the first axis, then the next."""
         points = np.concatenate([points for points, _, _ in self.found])
         order = np.lexsort(points.T[::-1])
-        hours = np.concatenate([hours for _, hours, _ in self.found], axis=1)[:, order].transpose(0, 2, 1)
+        hours = np.concatenate([hours for _, hours, _ in self.found], axis=1)[:, order].transpose(
+            0, 2, 1
+        )
         energy = np.concatenate([energy for _, _, energy in self.found], axis=1)[:, order]
         return points[order], hours, energy
 
@@ -142,28 +147,59 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis 
         azimuth = np.concatenate([chunk.azimuth for chunk, _ in parts])
 
         def run(axes, flat):
-            searches = [DesignSearch(axes, days, statistic, seasons, tolerance_h,
-                                     objective_quantum(statistic, step_hours, len(days), days)) for days in months]
+            searches = [
+                DesignSearch(
+                    axes,
+                    days,
+                    statistic,
+                    seasons,
+                    tolerance_h,
+                    objective_quantum(statistic, step_hours, len(days), days),
+                )
+                for days in months
+            ]
 
             def evaluate(asked):
                 requests = []
                 for site, points in asked.items():
                     first = sites[site][0]
                     angle = np.full(points.shape[0], 180.0) if flat else points[:, 0]
-                    tilt_of = points[:, -1] if tilt is not None else np.full(points.shape[0], tilts[first])
-                    requests.append((np.asarray(sites[site]),
-                                     np.column_stack([angle, tilt_of, np.full(points.shape[0], azimuth[first])])))
+                    tilt_of = (
+                        points[:, -1]
+                        if tilt is not None
+                        else np.full(points.shape[0], tilts[first])
+                    )
+                    requests.append(
+                        (
+                            np.asarray(sites[site]),
+                            np.column_stack(
+                                [angle, tilt_of, np.full(points.shape[0], azimuth[first])]
+                            ),
+                        )
+                    )
                 done = requested_hours(parts, requests, loads, loadset, flat=flat, engine=engine)
                 return dict(zip(asked, done, strict=True))
 
             return search_sites(searches, evaluate)
 
         if tilt is None:
-            return [(np.column_stack([points[:, 0], np.full(points.shape[0], tilts[site[0]])]), hours, energy, None)
-                    for site, (points, hours, energy) in zip(sites, run([fold_axis], False), strict=True)]
+            return [
+                (
+                    np.column_stack([points[:, 0], np.full(points.shape[0], tilts[site[0]])]),
+                    hours,
+                    energy,
+                    None,
+                )
+                for site, (points, hours, energy) in zip(
+                    sites, run([fold_axis], False), strict=True
+                )
+            ]
         flats = run([tilt], True)
-        return [(points, hours, energy, (flat_points[:, 0], flat_hours, flat_energy))
-                for (points, hours, energy), (flat_points, flat_hours, flat_energy)
-                in zip(run([fold_axis, tilt], False), flats, strict=True)]
+        return [
+            (points, hours, energy, (flat_points[:, 0], flat_hours, flat_energy))
+            for (points, hours, energy), (flat_points, flat_hours, flat_energy) in zip(
+                run([fold_axis, tilt], False), flats, strict=True
+            )
+        ]
 
     return search

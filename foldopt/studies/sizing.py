@@ -59,8 +59,13 @@ class SizingResult:
     def answer(self):
         from foldopt.studies.result_answers import of_sizing
 
-        return of_sizing(self.table, self.best, self.study, self.parameters,
-                         self.request.defaults if self.request is not None else None)
+        return of_sizing(
+            self.table,
+            self.best,
+            self.study,
+            self.parameters,
+            self.request.defaults if self.request is not None else None,
+        )
 
 
 def best_areas(table: pd.DataFrame) -> pd.DataFrame:
@@ -76,7 +81,9 @@ def best_areas(table: pd.DataFrame) -> pd.DataFrame:
     pandas.DataFrame
         One row per design, in the table's order of designs.
     """
-    return table.loc[table.groupby("design", sort=False)["net_benefit_usd"].idxmax()].reset_index(drop=True)
+    return table.loc[table.groupby("design", sort=False)["net_benefit_usd"].idxmax()].reset_index(
+        drop=True
+    )
 
 
 def stc_power_per_area(pv, temp_ref: float = 25.0) -> float:
@@ -145,28 +152,47 @@ def size_panel(
     if study.load_profile is not None:
         from foldopt.errors import ConfigError
 
-        raise ConfigError(["load_profile: sizing scales a constant load with the panel's area (Shin et al. Sec. "
-                           "IV-A); use a constant p_load"])
+        raise ConfigError(
+            [
+                "load_profile: sizing scales a constant load with the panel's area (Shin et al. Sec. "
+                "IV-A); use a constant p_load"
+            ]
+        )
     areas = np.asarray(areas, dtype=float)
     reference_area = study.panel.area
     p_load = study.p_load * reference_area / areas
     fold_angles = np.asarray(study.fold_angles.grid())
     # Every curve against every load in one pass of the kernel, with no (areas x angles x steps) array.
     curves = np.vstack([day.flat_power()[None, :], day.combined_power(fold_angles)])
-    all_hours = engines.curve_metrics(curves, p_load, day.step_hours).t_solar[:, 0, :]  # (1 + angles, areas)
+    all_hours = engines.curve_metrics(curves, p_load, day.step_hours).t_solar[
+        :, 0, :
+    ]  # (1 + angles, areas)
     twofold_hours = all_hours[1:].T
     best = twofold_hours.shape[1] - 1 - np.argmax(twofold_hours[:, ::-1], axis=1)
     hours = {
         "flat": (np.full(areas.size, 180.0), all_hours[0]),
         "twofold": (fold_angles[best], twofold_hours[np.arange(areas.size), best]),
     }
-    unit_cost = cost_per_m2 if cost_per_m2 is not None else cost_per_w * stc_power_per_area(day.electrical.pv)
+    unit_cost = (
+        cost_per_m2
+        if cost_per_m2 is not None
+        else cost_per_w * stc_power_per_area(day.electrical.pv)
+    )
     rows = []
     for design, (fold_angle, t) in hours.items():
         benefit = c_grid * t * study.p_load / 1000.0 * days_per_year * years
         cost = unit_cost * areas
-        rows.append(pd.DataFrame({
-            "design": design, "area_m2": areas, "fold_angle_deg": fold_angle, "t_solar_h": t,
-            "benefit_usd": benefit, "cost_usd": cost, "net_benefit_usd": benefit - cost,
-        }))
+        rows.append(
+            pd.DataFrame(
+                {
+                    "design": design,
+                    "area_m2": areas,
+                    "fold_angle_deg": fold_angle,
+                    "t_solar_h": t,
+                    "benefit_usd": benefit,
+                    "cost_usd": cost,
+                    "net_benefit_usd": benefit - cost,
+                }
+            )
+        )
     return pd.concat(rows, ignore_index=True)

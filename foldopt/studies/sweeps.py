@@ -24,8 +24,15 @@ import pandas as pd
 from foldopt.engine import evaluation as engines
 from foldopt.inputs.plan import Plan
 from foldopt.studies.designs import DESIGNS, Blocks, design_metrics, fold_hours, setup_key
-from foldopt.studies.objectives import (ENSEMBLE_PERCENTILES, best_angle_index, ensemble_choice, near_optimal,
-                                        objective_value, season_days, worst_month)
+from foldopt.studies.objectives import (
+    ENSEMBLE_PERCENTILES,
+    best_angle_index,
+    ensemble_choice,
+    near_optimal,
+    objective_value,
+    season_days,
+    worst_month,
+)
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 
@@ -36,7 +43,9 @@ class SweepResult:
 
     plan: Plan
     table: pd.DataFrame
-    extras: dict = dataclasses.field(default_factory=dict)  # day x hour curves of an annual objective
+    extras: dict = dataclasses.field(
+        default_factory=dict
+    )  # day x hour curves of an annual objective
     engine: str = "numba"
     weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
     request: object = None  # the foldopt.studies.request.Request the plan came from, if any
@@ -52,18 +61,28 @@ class SweepResult:
     @property
     def varied(self) -> list[str]:
         """Table columns that vary across cases."""
-        columns = [c for c in CASE_COLUMNS if c in self.table and self.table[c].nunique(dropna=False) > 1]
-        extra = [path for path, values in self.plan.axes if path not in _AXIS_COLUMNS and len(values) > 1]
+        columns = [
+            c for c in CASE_COLUMNS if c in self.table and self.table[c].nunique(dropna=False) > 1
+        ]
+        extra = [
+            path for path, values in self.plan.axes if path not in _AXIS_COLUMNS and len(values) > 1
+        ]
         return columns + extra
 
 
 CASE_COLUMNS = ("site_name", "latitude", "longitude", "date", "dayofyear", "p_load_w")
 #: Axes whose values the case columns above already show.
-_AXIS_COLUMNS = frozenset({"site", "site.name", "site.latitude", "site.longitude", "date", "p_load"})
+_AXIS_COLUMNS = frozenset(
+    {"site", "site.name", "site.latitude", "site.longitude", "date", "p_load"}
+)
 
 
-def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, engine: str = "numba",
-             request=None) -> SweepResult:
+def run_plan(
+    plan: Plan,
+    progress: Callable[[int, int], None] | None = None,
+    engine: str = "numba",
+    request=None,
+) -> SweepResult:
     """Evaluate every case of a plan: flat, optimal twofold and tracker per case.
 
     Parameters
@@ -93,10 +112,14 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     if objective is not None and dates is None and weather is not None and weather.members:
         dates = (plan.base.date,)  # one day's cloud ensemble: one fold angle over its members
     paths = list(axes)
-    choices = [dict(zip(paths, values, strict=True)) for values in itertools.product(*axes.values())]
+    choices = [
+        dict(zip(paths, values, strict=True)) for values in itertools.product(*axes.values())
+    ]
     # A fixed panel keeps one fold angle all year: an annual group is the dates of one choice.
-    studies = [plan.study({**choice, "p_load": float(loads[0]), **({"date": dates[0]} if dates else {})})
-               for choice in choices]
+    studies = [
+        plan.study({**choice, "p_load": float(loads[0]), **({"date": dates[0]} if dates else {})})
+        for choice in choices
+    ]
     passes = 2 if dates else 1  # an annual group: find the angle over the days, then evaluate them
     total = len(choices) * (len(dates) if dates else 1)
     done = 0
@@ -122,15 +145,29 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
     if dates:
         refolds: dict[str, list] = {}
         for index, study in enumerate(studies):
-            results[index], group_extras = _annual_group(Blocks.of_dates(study, dates), loads, objective, advance,
-                                                         engine, counted)
+            results[index], group_extras = _annual_group(
+                Blocks.of_dates(study, dates), loads, objective, advance, engine, counted
+            )
             extras = extras or group_extras
             for key in GROUP_TABLES:
                 if key in group_extras:
-                    refolds.setdefault(key, []).append(group_extras[key].assign(
-                        **{path: _plain(value) for path, value in choices[index].items() if path not in _AXIS_COLUMNS}))
-        extras.update({key: pd.concat(frames, ignore_index=True) for key, frames in refolds.items()})
-        cases = [(study.site, date, choice) for study, choice in zip(studies, choices, strict=True) for date in dates]
+                    refolds.setdefault(key, []).append(
+                        group_extras[key].assign(
+                            **{
+                                path: _plain(value)
+                                for path, value in choices[index].items()
+                                if path not in _AXIS_COLUMNS
+                            }
+                        )
+                    )
+        extras.update(
+            {key: pd.concat(frames, ignore_index=True) for key, frames in refolds.items()}
+        )
+        cases = [
+            (study.site, date, choice)
+            for study, choice in zip(studies, choices, strict=True)
+            for date in dates
+        ]
     else:
         # Cases of one setup share skies and engine calls, whatever their order in the plan.
         setups: dict[str, list[int]] = {}
@@ -143,15 +180,27 @@ def run_plan(plan: Plan, progress: Callable[[int, int], None] | None = None, eng
                 sky = counted(chunk.sky())
                 fold_angles, hours, _ = fold_hours(sky, chunk, loads, engine)
                 hours = hours.transpose(0, 2, 1)  # (blocks, loads, angles)
-                metrics = design_metrics(sky, chunk, loads, fold_angles, best_angle_index(hours), engine)
-                metrics.update(_twofold_only(near_optimal(fold_angles, hours, chunk.study.near_optimal)))
+                metrics = design_metrics(
+                    sky, chunk, loads, fold_angles, best_angle_index(hours), engine
+                )
+                metrics.update(
+                    _twofold_only(near_optimal(fold_angles, hours, chunk.study.near_optimal))
+                )
                 for offset, index in enumerate(members[part]):
-                    results[index] = {name: values[offset:offset + 1] for name, values in metrics.items()}
+                    results[index] = {
+                        name: values[offset : offset + 1] for name, values in metrics.items()
+                    }
                 advance(len(chunk))
-        cases = [(study.site, study.date, choice) for study, choice in zip(studies, choices, strict=True)]
-    table = _table(cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]})
-    kept = {key: {"file_wh_m2": float(total), "kept_pct": float(100 * kept / total) if total else 100.0}
-            for key, (total, kept) in light.items()} or None
+        cases = [
+            (study.site, study.date, choice) for study, choice in zip(studies, choices, strict=True)
+        ]
+    table = _table(
+        cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]}
+    )
+    kept = {
+        key: {"file_wh_m2": float(total), "kept_pct": float(100 * kept / total) if total else 100.0}
+        for key, (total, kept) in light.items()
+    } or None
     return SweepResult(plan, table, extras, engine, kept, request, tuple(weather_notes))
 
 
@@ -169,12 +218,16 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         advance(len(blocks[part]) // blocks.members)
     members = blocks.members
     months = [date.month for date in blocks.dates[::members]]
-    daily = np.concatenate(daily).transpose(0, 2, 1)  # (blocks, loads, angles): a day's members together
+    daily = np.concatenate(daily).transpose(
+        0, 2, 1
+    )  # (blocks, loads, angles): a day's members together
     study = blocks.study
     ensemble = None
     if members > 1:
         by_member = daily.reshape(len(months), members, *daily.shape[1:]).swapaxes(0, 1)
-        ensemble = ensemble_choice(by_member, months, objective.statistic, objective.months, study.near_optimal)
+        ensemble = ensemble_choice(
+            by_member, months, objective.statistic, objective.months, study.near_optimal
+        )
         score, fixed = ensemble["score"], ensemble["fixed"]
     else:
         score = objective_value(daily, months, objective.statistic, objective.months)
@@ -185,14 +238,24 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         # The day x hour maps of the first load's angle, every day at once.
         # The maps show the first member of each day.
         first = list(range(0, len(chunk), members))
-        orientation = engines.fold_orientations(study, chunk.tilt[first], chunk.azimuth[first], fold_angles[fixed[:1]])
-        powers, state = engines.powers(sky, study, orientation[:, 0], first, series=study.switch_series,
-                                       with_state=True)
+        orientation = engines.fold_orientations(
+            study, chunk.tilt[first], chunk.azimuth[first], fold_angles[fixed[:1]]
+        )
+        powers, state = engines.powers(
+            sky, study, orientation[:, 0], first, series=study.switch_series, with_state=True
+        )
         series["p_twofold_w"].append(powers[study.connection])
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
-        metrics.append(design_metrics(sky, chunk, loads, fold_angles,
-                                      np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
-                                      engine))
+        metrics.append(
+            design_metrics(
+                sky,
+                chunk,
+                loads,
+                fold_angles,
+                np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
+                engine,
+            )
+        )
         advance(len(chunk) // members)
     clock = skies[0].grid.clock_hours[0]
     design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (blocks, loads, designs)
@@ -200,29 +263,57 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     spread = None
     if ensemble is not None:
         design_hours = design_hours.reshape(len(months), members, *design_hours.shape[1:])
-        spread = {"member_objective_h": np.stack([objective_value(design_hours[:, m], months, objective.statistic,
-                                                                  objective.months) for m in range(members)]),
-                  **{key: ensemble[key] for key in ("chosen_wins_pct", "within_tolerance_pct", "regret_h")}}
+        spread = {
+            "member_objective_h": np.stack(
+                [
+                    objective_value(
+                        design_hours[:, m], months, objective.statistic, objective.months
+                    )
+                    for m in range(members)
+                ]
+            ),
+            **{
+                key: ensemble[key]
+                for key in ("chosen_wins_pct", "within_tolerance_pct", "regret_h")
+            },
+        }
         design_hours = design_hours.mean(axis=1)  # (days, loads, designs): the members' mean day
-    refold = {"annual_objective": objective_table(blocks, loads, fold_angles[fixed], design_hours, months, objective,
-                                                  near, spread)}
+    refold = {
+        "annual_objective": objective_table(
+            blocks, loads, fold_angles[fixed], design_hours, months, objective, near, spread
+        )
+    }
     if objective.visits:
-        refold.update(refold_tables(blocks, loads, fold_angles, daily, months, objective, design_hours))
-    extras = {"dates": list(blocks.dates[::members]), "hours": clock, "fold_angle": float(fold_angles[fixed[0]]),
-              **refold,
-              **({"weather_sample": sample} if sample else {}),
-              **{key: np.concatenate(value) for key, value in series.items()},
-              "by_angle": pd.DataFrame({
-                  "p_load_w": np.repeat(loads, fold_angles.size), "fold_angle_deg": np.tile(fold_angles, loads.size),
-                  "objective_h": score.ravel(), "mean_t_solar_h": daily.mean(axis=0).ravel(),
-                  "min_t_solar_h": daily.min(axis=0).ravel(),
-                  "chosen": np.ravel(np.arange(fold_angles.size) == fixed[:, None]),
-                  **({"wins_pct": ensemble["wins_pct"].ravel()} if ensemble is not None else {}),
-              })}
+        refold.update(
+            refold_tables(blocks, loads, fold_angles, daily, months, objective, design_hours)
+        )
+    extras = {
+        "dates": list(blocks.dates[::members]),
+        "hours": clock,
+        "fold_angle": float(fold_angles[fixed[0]]),
+        **refold,
+        **({"weather_sample": sample} if sample else {}),
+        **{key: np.concatenate(value) for key, value in series.items()},
+        "by_angle": pd.DataFrame(
+            {
+                "p_load_w": np.repeat(loads, fold_angles.size),
+                "fold_angle_deg": np.tile(fold_angles, loads.size),
+                "objective_h": score.ravel(),
+                "mean_t_solar_h": daily.mean(axis=0).ravel(),
+                "min_t_solar_h": daily.min(axis=0).ravel(),
+                "chosen": np.ravel(np.arange(fold_angles.size) == fixed[:, None]),
+                **({"wins_pct": ensemble["wins_pct"].ravel()} if ensemble is not None else {}),
+            }
+        ),
+    }
     group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
     if members > 1:
         group = _over_members(group, members)
-    group.update(_twofold_only({key: np.broadcast_to(value, (len(months), loads.size)) for key, value in near.items()}))
+    group.update(
+        _twofold_only(
+            {key: np.broadcast_to(value, (len(months), loads.size)) for key, value in near.items()}
+        )
+    )
     return group, extras
 
 
@@ -239,10 +330,14 @@ def _keep_sample(sample: dict, sky: Sky, blocks: Blocks, members: int) -> None:
     day = int(np.argmax(spread))
     if sample and spread[day] <= sample["spread"]:
         return
-    sample.update(spread=float(spread[day]), date=blocks.dates[day * members].isoformat(),
-                  hours=sky.grid.clock_hours[day * members], ghi=sky.ghi[day * members:(day + 1) * members],
-                  hourly_ghi=first[day].mean(axis=-1),
-                  kind="measured" if weather.measured else "members" if members > 1 else "smooth")
+    sample.update(
+        spread=float(spread[day]),
+        date=blocks.dates[day * members].isoformat(),
+        hours=sky.grid.clock_hours[day * members],
+        ghi=sky.ghi[day * members : (day + 1) * members],
+        hourly_ghi=first[day].mean(axis=-1),
+        kind="measured" if weather.measured else "members" if members > 1 else "smooth",
+    )
 
 
 def _over_members(group: dict, members: int) -> dict:
@@ -251,12 +346,13 @@ def _over_members(group: dict, members: int) -> dict:
     out = {}
     for name, values in group.items():
         shaped = values.reshape(values.shape[0] // members, members, *values.shape[1:])
-        out[name] = shaped[:, 0] if name in ("condition", "fold_angle_deg") else np.nanmean(shaped, axis=1)
+        out[name] = (
+            shaped[:, 0] if name in ("condition", "fold_angle_deg") else np.nanmean(shaped, axis=1)
+        )
     hours = group["t_solar_h"].reshape(-1, members, *group["t_solar_h"].shape[1:])
     for pct in ENSEMBLE_PERCENTILES:
         out[f"t_solar_p{pct}_h"] = np.percentile(hours, pct, axis=1)
     return out
-
 
 
 def _twofold_only(values: dict) -> dict:
@@ -270,8 +366,16 @@ def _twofold_only(values: dict) -> dict:
     return out
 
 
-def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, objective, near,
-                    spread: dict | None = None) -> pd.DataFrame:
+def objective_table(
+    blocks: Blocks,
+    loads,
+    fold_angles,
+    design_hours,
+    months,
+    objective,
+    near,
+    spread: dict | None = None,
+) -> pd.DataFrame:
     """The objective of one annual group in its own terms, per load and design: the statistic, its
     value [h], for ``worst-month`` the month it is found in, the mean daily t_solar [h], the fold
     angle kept all year and, for the twofold panel, the near-optimal range and recommended angle
@@ -309,27 +413,51 @@ def objective_table(blocks: Blocks, loads, fold_angles, design_hours, months, ob
     values = objective_value(design_hours, months, statistic, objective.months)  # (loads, designs)
     if spread is not None:
         values = spread["member_objective_h"].mean(axis=0)
-        quantiles = {pct: np.percentile(spread["member_objective_h"], pct, axis=0) for pct in ENSEMBLE_PERCENTILES}
+        quantiles = {
+            pct: np.percentile(spread["member_objective_h"], pct, axis=0)
+            for pct in ENSEMBLE_PERCENTILES
+        }
     season = season_days(months, objective.months)
-    month = worst_month(design_hours[season], np.asarray(months)[season]) if statistic == "worst-month" else None
+    month = (
+        worst_month(design_hours[season], np.asarray(months)[season])
+        if statistic == "worst-month"
+        else None
+    )
     site = blocks.study.site
     rows = []
     for index, load in enumerate(loads):
         for d, design in enumerate(DESIGNS):
             twofold = design == "twofold"
-            rows.append({
-                "site_name": site.name or "", "latitude": site.latitude, "longitude": site.longitude,
-                "p_load_w": float(load), "design": design, "objective": statistic,
-                "objective_h": float(values[index, d]),
-                "worst_month": int(month[index, d]) if month is not None else np.nan,
-                "mean_t_solar_h": float(design_hours[season][:, index, d].mean()),
-                "fold_angle_deg": float(fold_angles[index]) if twofold else (180.0 if design == "flat" else np.nan),
-                **{key: float(value[index]) if twofold else np.nan for key, value in near.items()},
-            })
+            rows.append(
+                {
+                    "site_name": site.name or "",
+                    "latitude": site.latitude,
+                    "longitude": site.longitude,
+                    "p_load_w": float(load),
+                    "design": design,
+                    "objective": statistic,
+                    "objective_h": float(values[index, d]),
+                    "worst_month": int(month[index, d]) if month is not None else np.nan,
+                    "mean_t_solar_h": float(design_hours[season][:, index, d].mean()),
+                    "fold_angle_deg": float(fold_angles[index])
+                    if twofold
+                    else (180.0 if design == "flat" else np.nan),
+                    **{
+                        key: float(value[index]) if twofold else np.nan
+                        for key, value in near.items()
+                    },
+                }
+            )
             if spread is not None:
-                rows[-1].update({f"objective_p{pct}_h": float(q[index, d]) for pct, q in quantiles.items()})
-                rows[-1].update({key: float(spread[key][index]) if twofold else np.nan
-                                 for key in ("chosen_wins_pct", "within_tolerance_pct")})
+                rows[-1].update(
+                    {f"objective_p{pct}_h": float(q[index, d]) for pct, q in quantiles.items()}
+                )
+                rows[-1].update(
+                    {
+                        key: float(spread[key][index]) if twofold else np.nan
+                        for key in ("chosen_wins_pct", "within_tolerance_pct")
+                    }
+                )
     return pd.DataFrame(rows)
 
 
@@ -380,7 +508,9 @@ def _plain(value):
 GROUP_TABLES = ("annual_objective", "refold_value", "refold_schedule")
 
 
-def refold_tables(blocks: Blocks, loads, fold_angles, daily, months, objective, design_hours) -> dict:
+def refold_tables(
+    blocks: Blocks, loads, fold_angles, daily, months, objective, design_hours
+) -> dict:
     """The best re-fold schedules of one annual group (:func:`foldopt.engine.schedule.best_schedules`):
 
     ``refold_value``, per load and number of settings k: the objective and the mean daily t_solar
@@ -418,18 +548,43 @@ def refold_tables(blocks: Blocks, loads, fold_angles, daily, months, objective, 
     values, visits = [], []
     for index, load in enumerate(loads):
         schedules = best_schedules(daily[:, index, :], months, objective.visits, statistic)
-        flat, tracker = (objective_value(design_hours[:, index, d], months, statistic) for d in (0, 2))
+        flat, tracker = (
+            objective_value(design_hours[:, index, d], months, statistic) for d in (0, 2)
+        )
         fixed = schedules[0].objective_h
         previous = None
         for k, schedule in enumerate(schedules, start=1):
             chosen = daily[np.arange(len(months)), index, schedule.daily_angles(len(months))]
-            values.append({**where, "p_load_w": float(load), "settings": k, "objective": statistic,
-                           "objective_h": schedule.objective_h, "mean_t_solar_h": float(chosen.mean()),
-                           "gain_vs_fixed_pct": 100.0 * (schedule.objective_h / fixed - 1.0) if fixed > 0 else np.nan,
-                           "added_by_setting_h": np.nan if previous is None else schedule.objective_h - previous,
-                           "objective_flat_h": float(flat), "objective_tracker_h": float(tracker)})
+            values.append(
+                {
+                    **where,
+                    "p_load_w": float(load),
+                    "settings": k,
+                    "objective": statistic,
+                    "objective_h": schedule.objective_h,
+                    "mean_t_solar_h": float(chosen.mean()),
+                    "gain_vs_fixed_pct": 100.0 * (schedule.objective_h / fixed - 1.0)
+                    if fixed > 0
+                    else np.nan,
+                    "added_by_setting_h": np.nan
+                    if previous is None
+                    else schedule.objective_h - previous,
+                    "objective_flat_h": float(flat),
+                    "objective_tracker_h": float(tracker),
+                }
+            )
             previous = schedule.objective_h
-            for visit, (start, angle) in enumerate(zip(schedule.starts, schedule.angles, strict=True), start=1):
-                visits.append({**where, "p_load_w": float(load), "settings": k, "visit": visit,
-                               "date": blocks.dates[start].isoformat(), "fold_angle_deg": float(fold_angles[angle])})
+            for visit, (start, angle) in enumerate(
+                zip(schedule.starts, schedule.angles, strict=True), start=1
+            ):
+                visits.append(
+                    {
+                        **where,
+                        "p_load_w": float(load),
+                        "settings": k,
+                        "visit": visit,
+                        "date": blocks.dates[start].isoformat(),
+                        "fold_angle_deg": float(fold_angles[angle]),
+                    }
+                )
     return {"refold_value": pd.DataFrame(values), "refold_schedule": pd.DataFrame(visits)}

@@ -64,8 +64,14 @@ def _design_hours(study: Study, date, loads, members: int = 1):
     fold_angles, hours, _ = fold_hours(sky, blocks, loads)  # (members, angles, loads)
     hours = hours.transpose(0, 2, 1)
     chosen = best_angle_index(hours.mean(axis=0))  # (loads,)
-    metrics = design_metrics(sky, blocks, loads, fold_angles, np.broadcast_to(chosen, (sky.n_blocks, loads.size)),
-                             "numba")
+    metrics = design_metrics(
+        sky,
+        blocks,
+        loads,
+        fold_angles,
+        np.broadcast_to(chosen, (sky.n_blocks, loads.size)),
+        "numba",
+    )
     return metrics["t_solar_h"], fold_angles[chosen]
 
 
@@ -98,36 +104,69 @@ def minute_validation(study: Study, loads, members: int = 20, seed: int = 0) -> 
     loads = np.atleast_1d(np.asarray(loads, dtype=float))
     measured = study_weather(study.weather, study.site)
     frame = measured.frame
-    days = [day for day in dict.fromkeys(frame.index.tz_localize(None).date) if day not in measured.flagged_days]
+    days = [
+        day
+        for day in dict.fromkeys(frame.index.tz_localize(None).date)
+        if day not in measured.flagged_days
+    ]
     rows = []
-    site = {key: measured.site[key] for key in ("name", "latitude", "longitude", "altitude", "timezone")}
+    site = {
+        key: measured.site[key] for key in ("name", "latitude", "longitude", "altitude", "timezone")
+    }
     days_of = frame.index.tz_localize(None).date
     with tempfile.TemporaryDirectory() as folder:
         for day in days:
             # One file a day: an hourly file's rows run on without a gap, and a day left out has one.
             path = Path(folder) / f"{Path(study.weather.path).stem}-{day}.epw"
             write_epw(path, hourly_means(frame[days_of == day]), measured.site)
-            hourly = with_files(study.variant(weather={"path": str(path)}, step_min=study.step_min, site=site,
-                                              date=day.isoformat()))
-            ensemble = with_files(hourly.variant(weather={"path": str(path), "members": members, "seed": seed},
-                                                 objective={"statistic": "mean"}, date=day.isoformat()))
-            sources = {"measured": _design_hours(study, day, loads),
-                       "smooth": _design_hours(hourly, day, loads),
-                       "ensemble": _design_hours(ensemble, day, loads, members)}
+            hourly = with_files(
+                study.variant(
+                    weather={"path": str(path)},
+                    step_min=study.step_min,
+                    site=site,
+                    date=day.isoformat(),
+                )
+            )
+            ensemble = with_files(
+                hourly.variant(
+                    weather={"path": str(path), "members": members, "seed": seed},
+                    objective={"statistic": "mean"},
+                    date=day.isoformat(),
+                )
+            )
+            sources = {
+                "measured": _design_hours(study, day, loads),
+                "smooth": _design_hours(hourly, day, loads),
+                "ensemble": _design_hours(ensemble, day, loads, members),
+            }
             spread = {"measured": _spread(study, day), "smooth": _spread(hourly, day)}
             for index, load in enumerate(loads):
                 for design in COMPARED:
                     d = DESIGNS.index(design)
                     members_h = sources["ensemble"][0][:, index, d]
-                    rows.append({
-                        "date": day.isoformat(), "p_load_w": float(load), "design": design,
-                        "measured_h": float(sources["measured"][0][0, index, d]),
-                        "smooth_h": float(sources["smooth"][0][0, index, d]),
-                        **{f"ensemble_p{pct}_h": float(np.percentile(members_h, pct)) for pct in PERCENTILES},
-                        **{f"fold_angle_{name}_deg": float(sources[name][1][index]) if design == "twofold" else np.nan
-                           for name in sources},
-                        **{f"within_hour_sd_{name}_w_m2": value for name, value in spread.items()},
-                    })
+                    rows.append(
+                        {
+                            "date": day.isoformat(),
+                            "p_load_w": float(load),
+                            "design": design,
+                            "measured_h": float(sources["measured"][0][0, index, d]),
+                            "smooth_h": float(sources["smooth"][0][0, index, d]),
+                            **{
+                                f"ensemble_p{pct}_h": float(np.percentile(members_h, pct))
+                                for pct in PERCENTILES
+                            },
+                            **{
+                                f"fold_angle_{name}_deg": float(sources[name][1][index])
+                                if design == "twofold"
+                                else np.nan
+                                for name in sources
+                            },
+                            **{
+                                f"within_hour_sd_{name}_w_m2": value
+                                for name, value in spread.items()
+                            },
+                        }
+                    )
     return pd.DataFrame(rows)
 
 

@@ -41,8 +41,13 @@ from foldopt.errors import ConfigError
 from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
 from foldopt.studies.site_search import fold_search
-from foldopt.studies.objectives import (best_angle_index, near_optimal_on_grid, objective_value, period_values,
-                                       season_days)
+from foldopt.studies.objectives import (
+    best_angle_index,
+    near_optimal_on_grid,
+    objective_value,
+    period_values,
+    season_days,
+)
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
@@ -52,7 +57,10 @@ PERIODS = ("year", *SEASONS)
 #: The grid a map covers where it is given no sites: latitudes and longitudes [deg], start:stop:step.
 DEFAULT_GRID = ("-60:60:10", "-180:180:30")
 #: Loads a map takes: watts, or fractions of each site's flat peak (``relative``).
-LOAD_BOUNDS = {False: (1e6, "loads must be in (0, 1e+06] W"), True: (2.0, "fractions must be in (0, 2]")}
+LOAD_BOUNDS = {
+    False: (1e6, "loads must be in (0, 1e+06] W"),
+    True: (2.0, "fractions must be in (0, 2]"),
+}
 
 
 #: What a map's search may vary (``optimize.vary``): the fold angle, and the base tilt with it.
@@ -98,7 +106,11 @@ def map_study(data: dict, embedded: bool = True, **changes) -> dict:
     from foldopt.inputs.policy import set_path
 
     study = {key: value for key, value in data.items() if key not in _PER_SITE}
-    panel = {key: value for key, value in (study.get("panel") or {}).items() if key not in ("tilt", "azimuth")}
+    panel = {
+        key: value
+        for key, value in (study.get("panel") or {}).items()
+        if key not in ("tilt", "azimuth")
+    }
     study["panel"] = panel
     if embedded:
         study.pop("geometry", None)  # exact mode's own geometry and sky
@@ -153,16 +165,28 @@ def _values(name: str, values) -> list:
             values = parse_values(values)
         except ValueError as error:
             raise ConfigError([f"{name} = {values!r}: {error}"]) from None
-    values = list(values) if isinstance(values, (list, tuple)) or hasattr(values, "tolist") else [values]
+    values = (
+        list(values) if isinstance(values, (list, tuple)) or hasattr(values, "tolist") else [values]
+    )
     try:
         return check_distinct(values)
     except ValueError as error:
         raise ConfigError([f"{name}: {error}"]) from None
 
 
-def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | None = None, latitudes=None,
-                longitudes=None, land_only: bool = False, relative: bool = False, year: int = 2025,
-                show_period: str = "year") -> MapRequest:
+def map_request(
+    study: dict,
+    loads,
+    *,
+    sites=None,
+    weather_dir: Path | str | None = None,
+    latitudes=None,
+    longitudes=None,
+    land_only: bool = False,
+    relative: bool = False,
+    year: int = 2025,
+    show_period: str = "year",
+) -> MapRequest:
     """A map's sites, loads, year and period, each checked, with its study: what the command line
     and :func:`foldopt.world_map` both run.
 
@@ -205,18 +229,26 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
 
     errors = []
     if show_period not in PERIODS:
-        errors.append(f"show_period = {show_period!r}: must be one of {', '.join(PERIODS)}"
-                      f"{names.did_you_mean(str(show_period), PERIODS)}")
+        errors.append(
+            f"show_period = {show_period!r}: must be one of {', '.join(PERIODS)}"
+            f"{names.did_you_mean(str(show_period), PERIODS)}"
+        )
     if year_problem(year):
         errors.append(f"year = {year}: {year_problem(year)}")
     if errors:
         raise ConfigError(errors)
     grid = sites is None and weather_dir is None
     # An empty text is no value (an error), not the default grid.
-    grid_values = [_values(name, default if given is None else given) if grid else []
-                   for name, given, default in (("latitudes", latitudes, DEFAULT_GRID[0]),
-                                                ("longitudes", longitudes, DEFAULT_GRID[1]))]
-    for name, values, bound in zip(("latitudes", "longitudes"), grid_values, (90, 180), strict=True):
+    grid_values = [
+        _values(name, default if given is None else given) if grid else []
+        for name, given, default in (
+            ("latitudes", latitudes, DEFAULT_GRID[0]),
+            ("longitudes", longitudes, DEFAULT_GRID[1]),
+        )
+    ]
+    for name, values, bound in zip(
+        ("latitudes", "longitudes"), grid_values, (90, 180), strict=True
+    ):
         if any(not -bound <= value <= bound for value in values):
             errors.append(f"{name}: must be in [-{bound}, {bound}] deg")
     load_values = _values("loads", loads)
@@ -226,15 +258,21 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
     optimize = map_data(study).get("optimize")
     vary = (optimize or {}).get("vary", list(names.OPTIMIZE_VARIABLES))
     try:
-        searchable = "fold_angle" in vary_names(vary) and set(vary_names(vary)) <= set(MAP_VARIABLES)
+        searchable = "fold_angle" in vary_names(vary) and set(vary_names(vary)) <= set(
+            MAP_VARIABLES
+        )
     except ValueError:
         searchable = True  # no list of names: the study's validation at the first site says so
     if optimize is not None and not searchable:
-        errors.append(f"optimize.vary = {vary!r}: a map searches the fold angle, or the fold angle and the tilt "
-                      f"(the azimuth with them: foldopt optimize, one site at a time)")
+        errors.append(
+            f"optimize.vary = {vary!r}: a map searches the fold angle, or the fold angle and the tilt "
+            f"(the azimuth with them: foldopt optimize, one site at a time)"
+        )
     if errors:
         raise ConfigError(errors)
-    field = f"--sites {sites}" if isinstance(sites, (str, Path)) else "sites"  # as read_sites names a file
+    field = (
+        f"--sites {sites}" if isinstance(sites, (str, Path)) else "sites"
+    )  # as read_sites names a file
     if isinstance(sites, (str, Path)):
         sites = read_sites(sites)
     elif sites is None and weather_dir is not None:
@@ -244,13 +282,22 @@ def map_request(study: dict, loads, *, sites=None, weather_dir: Path | str | Non
         if not sites:
             raise ConfigError(["land_only: no grid point is on land"])
     if len(sites) > MAX_CASES:
-        raise ConfigError([f"sites: {len(sites):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"])
+        raise ConfigError(
+            [f"sites: {len(sites):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"]
+        )
     # A map's rows, figures and map.nc tell sites by place, name and weather file: one given twice is refused.
     try:
-        check_distinct([{key: site.get(key) for key in ("latitude", "longitude", "name", "weather")}
-                        for site in sites], "site",
-                       lambda site: f"the site at {site['latitude']:g}, {site['longitude']:g}"
-                                    + (f" ({site['name']})" if site["name"] else ""))
+        check_distinct(
+            [
+                {key: site.get(key) for key in ("latitude", "longitude", "name", "weather")}
+                for site in sites
+            ],
+            "site",
+            lambda site: (
+                f"the site at {site['latitude']:g}, {site['longitude']:g}"
+                + (f" ({site['name']})" if site["name"] else "")
+            ),
+        )
     except ValueError as error:
         raise ConfigError([f"{field}: {error}"]) from None
     if not len(sites):
@@ -341,8 +388,12 @@ def site_study(study: dict | Study, site: dict, year: int) -> tuple[Study, list[
     dates = parse_dates("year", year)
     study = map_data(study)
     if study.get("load_profile") is not None:
-        raise ConfigError(["load_profile: maps take constant loads (watts or fractions of the flat peak); run a "
-                           "profile at one site with foldopt run"])
+        raise ConfigError(
+            [
+                "load_profile: maps take constant loads (watts or fractions of the flat peak); run a "
+                "profile at one site with foldopt run"
+            ]
+        )
     data = {**study, "date": dates[0], "p_load": 1.0}
     if "weather" in site:
         data["weather"] = site["weather"]  # the site comes from the file; its light from the file
@@ -353,8 +404,14 @@ def site_study(study: dict | Study, site: dict, year: int) -> tuple[Study, list[
     return make_study(data, resolve_files(data)), dates
 
 
-def evaluate_sites(study: Study | dict, sites: Sequence[dict], loads: Sequence[float], relative: bool = False,
-                   year: int = 2025, engine: str = "numba") -> pd.DataFrame:
+def evaluate_sites(
+    study: Study | dict,
+    sites: Sequence[dict],
+    loads: Sequence[float],
+    relative: bool = False,
+    year: int = 2025,
+    engine: str = "numba",
+) -> pd.DataFrame:
     """The map's rows for some sites: per site, load and period (:data:`PERIODS`).
 
     Parameters
@@ -421,36 +478,62 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     if relative:
         # Loads as fractions of each site's flat peak over all its days: the flat panel's pass for
         # its peak comes before the loads, and site_designs' flat pass needs them.
-        peak = np.concatenate([engines.row_metrics(sky, study, np.arange(sky.n_blocks),
-                                                   engines.flat_orientation(chunk.tilt, chunk.azimuth), [1.0],
-                                                   outputs=("panel",), engine=engine).peak[:, 0]
-                               for chunk, sky in parts])
+        peak = np.concatenate(
+            [
+                engines.row_metrics(
+                    sky,
+                    study,
+                    np.arange(sky.n_blocks),
+                    engines.flat_orientation(chunk.tilt, chunk.azimuth),
+                    [1.0],
+                    outputs=("panel",),
+                    engine=engine,
+                ).peak[:, 0]
+                for chunk, sky in parts
+            ]
+        )
         flat_peak = np.array([float(peak[days].max()) for days in sites])
-    p_load = loads[None, :] * flat_peak[:, None] if relative else np.broadcast_to(loads, (len(batch), loads.size))
+    p_load = (
+        loads[None, :] * flat_peak[:, None]
+        if relative
+        else np.broadcast_to(loads, (len(batch), loads.size))
+    )
     # A load of 0 W (a site whose flat panel never sees the sun) has no t_solar to speak of.
     p_load_evaluated = np.where(p_load > 0, p_load, np.inf)
     months = [np.array([date.month for date in dates]) for _, _, dates in batch]
     seasons = [None, *SEASONS.values()]
     # A map searches the fold angles (foldopt.studies.site_search) unless its study sweeps them all.
     search = study.optimize
-    searcher = None if search is None else fold_search(months, statistic, seasons, search.tolerance_h,
-                                                   _tilt_axis(search))
+    searcher = (
+        None
+        if search is None
+        else fold_search(months, statistic, seasons, search.tolerance_h, _tilt_axis(search))
+    )
     designs = site_designs(parts, sites, p_load_evaluated, engine, searcher)
     if flat_peak is None:
         # Loads in watts: the peak of the flat panel's one pass, the one its rows come from.
         flat_peak = np.array([float(days_of.peak_power_flat_w.max()) for days_of in designs])
     columns: dict[str, list] = {}
     for (site, here, _), days_of, site_months, peak_w, site_p_load, site_p_load_evaluated in zip(
-            batch, designs, months, flat_peak, p_load, p_load_evaluated, strict=True):
-        for name, values in _site_rows(days_of, site_months, statistic, seasons, site_p_load_evaluated, study,
-                                       here.panel.tilt).items():
+        batch, designs, months, flat_peak, p_load, p_load_evaluated, strict=True
+    ):
+        for name, values in _site_rows(
+            days_of, site_months, statistic, seasons, site_p_load_evaluated, study, here.panel.tilt
+        ).items():
             columns.setdefault(name, []).append(values)
         count = len(PERIODS) * loads.size
-        fixed = {"site_id": site.get("site_id", 0), "site_name": site.get("name") or "",
-                 "latitude": here.site.latitude, "longitude": here.site.longitude,
-                 "weather": Path(site["weather"]).name if "weather" in site else "", "peak_power_flat_w": peak_w}
+        fixed = {
+            "site_id": site.get("site_id", 0),
+            "site_name": site.get("name") or "",
+            "latitude": here.site.latitude,
+            "longitude": here.site.longitude,
+            "weather": Path(site["weather"]).name if "weather" in site else "",
+            "peak_power_flat_w": peak_w,
+        }
         for name, value in fixed.items():
-            columns.setdefault(name, []).append(np.full(count, value, dtype=object if isinstance(value, str) else None))
+            columns.setdefault(name, []).append(
+                np.full(count, value, dtype=object if isinstance(value, str) else None)
+            )
         columns.setdefault("p_load_w", []).append(np.tile(site_p_load, len(PERIODS)))
         fraction = site_p_load / peak_w if peak_w > 0 else np.full(loads.size, np.nan)
         columns.setdefault("p_load_fraction", []).append(np.tile(fraction, len(PERIODS)))
@@ -460,13 +543,37 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     groups = [list(range(len(batch)))] if same_days else [[site] for site in range(len(batch))]
     standby = np.empty(targets.shape)
     for group in groups:
-        standby[group] = break_even_standby(np.concatenate([designs[i].available for i in group]), targets[group],
-                                            p_load_evaluated[group], months[group[0]], statistic, seasons, step_hours,
-                                            engine)
+        standby[group] = break_even_standby(
+            np.concatenate([designs[i].available for i in group]),
+            targets[group],
+            p_load_evaluated[group],
+            months[group[0]],
+            statistic,
+            seasons,
+            step_hours,
+            engine,
+        )
     columns["break_even_standby_tracker_w"] = list(standby.reshape(len(batch), -1))
-    order = ["site_id", "site_name", "latitude", "longitude", "weather", "peak_power_flat_w", "p_load_w",
-             "p_load_fraction", "period", "days", "fold_angle_deg", "surface_tilt", "surface_tilt_flat", *ROW_VALUES,
-             "gain_vs_flat_pct", "energy_gain_vs_flat_pct", "pct_of_tracker", "break_even_standby_tracker_w"]
+    order = [
+        "site_id",
+        "site_name",
+        "latitude",
+        "longitude",
+        "weather",
+        "peak_power_flat_w",
+        "p_load_w",
+        "p_load_fraction",
+        "period",
+        "days",
+        "fold_angle_deg",
+        "surface_tilt",
+        "surface_tilt_flat",
+        *ROW_VALUES,
+        "gain_vs_flat_pct",
+        "energy_gain_vs_flat_pct",
+        "pct_of_tracker",
+        "break_even_standby_tracker_w",
+    ]
     return pd.DataFrame({name: np.concatenate(columns[name]) for name in order})
 
 
@@ -482,10 +589,23 @@ def _tilt_axis(search: Optimize) -> Axis | None:
 
 
 #: The values of a map's row from the designs (in the order of its table).
-ROW_VALUES = ("objective_flat_h", "objective_twofold_h", "objective_tracker_h", "objective_tracker_net_h",
-              "mean_t_solar_flat_h", "mean_t_solar_twofold_h", "mean_t_solar_tracker_h", "mean_t_solar_tracker_net_h",
-              "energy_harvested_flat_wh", "energy_harvested_twofold_wh", "energy_harvested_tracker_wh",
-              "near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg", "near_optimal_tolerance_h")
+ROW_VALUES = (
+    "objective_flat_h",
+    "objective_twofold_h",
+    "objective_tracker_h",
+    "objective_tracker_net_h",
+    "mean_t_solar_flat_h",
+    "mean_t_solar_twofold_h",
+    "mean_t_solar_tracker_h",
+    "mean_t_solar_tracker_net_h",
+    "energy_harvested_flat_wh",
+    "energy_harvested_twofold_wh",
+    "energy_harvested_tracker_wh",
+    "near_optimal_lo_deg",
+    "near_optimal_hi_deg",
+    "recommended_fold_angle_deg",
+    "near_optimal_tolerance_h",
+)
 
 
 def _chosen(hours, energy, months, statistic: str, seasons, member):
@@ -495,29 +615,48 @@ def _chosen(hours, energy, months, statistic: str, seasons, member):
     objective, (periods, loads, n)."""
     n_loads = hours.shape[1]
     every = period_values(hours, months, statistic, seasons)  # (periods, loads, n)
-    best = best_angle_index(every)  # (periods, loads); ties to the last (the least folded, the steepest)
+    best = best_angle_index(
+        every
+    )  # (periods, loads); ties to the last (the least folded, the steepest)
     at_best = hours[:, np.arange(n_loads)[None, :], best]  # (days, periods, loads)
-    objective = np.stack([objective_value(at_best[:, period], months, statistic, season)
-                          for period, season in enumerate(seasons)])
+    objective = np.stack(
+        [
+            objective_value(at_best[:, period], months, statistic, season)
+            for period, season in enumerate(seasons)
+        ]
+    )
     mean_h = np.stack([at_best[days, period].mean(axis=0) for period, days in enumerate(member)])
-    energy_wh = np.stack([energy[days][:, best[period]].sum(axis=0) for period, days in enumerate(member)])
+    energy_wh = np.stack(
+        [energy[days][:, best[period]].sum(axis=0) for period, days in enumerate(member)]
+    )
     return best, objective, mean_h, energy_wh, every
 
 
-def _site_rows(days_of, months, statistic: str, seasons, p_load_evaluated, study, surface_tilt: float) -> dict:
+def _site_rows(
+    days_of, months, statistic: str, seasons, p_load_evaluated, study, surface_tilt: float
+) -> dict:
     """One site's columns, per period and load (periods slowest), from its :class:`DailyDesigns`."""
     angles = days_of.angles
     n_loads = p_load_evaluated.size
     member = np.stack([season_days(months, season) for season in seasons])
-    best, twofold, twofold_mean, twofold_wh, objective = _chosen(days_of.twofold_h, days_of.twofold_wh, months,
-                                                                statistic, seasons, member)
+    best, twofold, twofold_mean, twofold_wh, objective = _chosen(
+        days_of.twofold_h, days_of.twofold_wh, months, statistic, seasons, member
+    )
     # The flat panel at the site's mounting, or at each period's and load's own best tilt.
-    flat_hours, flat_energy, flat_tilts = days_of.flat_h[..., None], days_of.flat_wh[:, None], np.array([surface_tilt])
+    flat_hours, flat_energy, flat_tilts = (
+        days_of.flat_h[..., None],
+        days_of.flat_wh[:, None],
+        np.array([surface_tilt]),
+    )
     if days_of.flat_tilted is not None:
         flat_tilts, flat_hours, flat_energy = days_of.flat_tilted
-    flat_best, flat, flat_mean, flat_wh, _ = _chosen(flat_hours, flat_energy, months, statistic, seasons, member)
+    flat_best, flat, flat_mean, flat_wh, _ = _chosen(
+        flat_hours, flat_energy, months, statistic, seasons, member
+    )
     trackers = np.stack([days_of.tracker_h, days_of.tracker_net_h], axis=1)  # (days, 2, loads)
-    tracker, tracker_mean = (period_values(trackers, months, kind, seasons) for kind in (statistic, "mean"))
+    tracker, tracker_mean = (
+        period_values(trackers, months, kind, seasons) for kind in (statistic, "mean")
+    )
     tracker_wh = np.stack([days_of.tracker_wh[days].sum() for days in member])
     # The fold angle's near-optimal range: over the tilts too (the best of them at each angle) where searched.
     fold_angles, profile = angles, objective.reshape(-1, angles.size)
@@ -525,14 +664,19 @@ def _site_rows(days_of, months, statistic: str, seasons, p_load_evaluated, study
         fold_angles, column = np.unique(angles, return_inverse=True)
         profile = np.full((profile.shape[0], fold_angles.size), -np.inf)
         np.maximum.at(profile, (slice(None), column.ravel()), objective.reshape(-1, angles.size))
-    ranges = near_optimal_on_grid(fold_angles, profile, study.near_optimal, np.asarray(study.fold_angles.grid()))
+    ranges = near_optimal_on_grid(
+        fold_angles, profile, study.near_optimal, np.asarray(study.fold_angles.grid())
+    )
     carried = np.isfinite(p_load_evaluated)
     rows = {
         "period": np.repeat(np.array(PERIODS, dtype=object), n_loads),
         "days": np.repeat(member.sum(axis=1), n_loads),
         "fold_angle_deg": np.where(carried, angles[best], np.nan).ravel(),
-        "surface_tilt": np.where(carried, days_of.tilts[best] if days_of.tilts is not None
-                                 else np.full(best.shape, surface_tilt), np.nan).ravel(),
+        "surface_tilt": np.where(
+            carried,
+            days_of.tilts[best] if days_of.tilts is not None else np.full(best.shape, surface_tilt),
+            np.nan,
+        ).ravel(),
         "surface_tilt_flat": np.where(carried, flat_tilts[flat_best], np.nan).ravel(),
         "objective_flat_h": flat.ravel(),
         "objective_twofold_h": twofold.ravel(),
@@ -549,7 +693,9 @@ def _site_rows(days_of, months, statistic: str, seasons, p_load_evaluated, study
     }
     with np.errstate(divide="ignore", invalid="ignore"):
         gain = 100.0 * (rows["objective_twofold_h"] / rows["objective_flat_h"] - 1.0)
-        energy_gain = 100.0 * (rows["energy_harvested_twofold_wh"] / rows["energy_harvested_flat_wh"] - 1.0)
+        energy_gain = 100.0 * (
+            rows["energy_harvested_twofold_wh"] / rows["energy_harvested_flat_wh"] - 1.0
+        )
         share = 100.0 * rows["objective_twofold_h"] / rows["objective_tracker_h"]
     rows["gain_vs_flat_pct"] = np.where(rows["objective_flat_h"] > 0, gain, np.nan)
     rows["energy_gain_vs_flat_pct"] = energy_gain

@@ -76,10 +76,14 @@ def weather_format(path: Path, fmt: str | None = None) -> str:
     """
     if fmt is not None:
         if fmt not in FORMATS and fmt not in MEASURED_FORMATS:
-            raise ValueError(f"weather format must be one of {', '.join([*FORMATS, *MEASURED_FORMATS])}; got {fmt!r}")
+            raise ValueError(
+                f"weather format must be one of {', '.join([*FORMATS, *MEASURED_FORMATS])}; got {fmt!r}"
+            )
         return fmt
     suffix = Path(path).suffix.lower()
-    return next((name for name, entry in FORMATS.items() if suffix in entry.suffixes), tmy3.FORMAT.name)
+    return next(
+        (name for name, entry in FORMATS.items() if suffix in entry.suffixes), tmy3.FORMAT.name
+    )
 
 
 #: Bytes of a file's start that :func:`sniff_format` reads.
@@ -187,9 +191,15 @@ def weather_site(path, fmt: str | None = None, site: dict | None = None, **measu
     return FORMATS[fmt].site(meta)
 
 
-def measured_weather(path, fmt: str, label: str | None = None, timezone: str | None = None,
-                     site: dict | None = None, decomposition: str = "erbs",
-                     max_gap_min: float = 60.0) -> MeasuredWeather:
+def measured_weather(
+    path,
+    fmt: str,
+    label: str | None = None,
+    timezone: str | None = None,
+    site: dict | None = None,
+    decomposition: str = "erbs",
+    max_gap_min: float = 60.0,
+) -> MeasuredWeather:
     """A measured weather file (:func:`~foldopt.inputs.weather.measured.read_measured`), read once
     per file, its date and the options.
 
@@ -212,11 +222,28 @@ def measured_weather(path, fmt: str, label: str | None = None, timezone: str | N
     foldopt.errors.WeatherError
     """
     path = Path(path)
-    where = None if site is None else tuple(sorted((key, site.get(key)) for key in (
-        "name", "latitude", "longitude", "altitude") if site.get(key) is not None))
+    where = (
+        None
+        if site is None
+        else tuple(
+            sorted(
+                (key, site.get(key))
+                for key in ("name", "latitude", "longitude", "altitude")
+                if site.get(key) is not None
+            )
+        )
+    )
     check_file(path)
-    result, message = _measured_once(str(path.resolve()), path.stat().st_mtime, fmt, label, timezone, where,
-                                     decomposition, float(max_gap_min))
+    result, message = _measured_once(
+        str(path.resolve()),
+        path.stat().st_mtime,
+        fmt,
+        label,
+        timezone,
+        where,
+        decomposition,
+        float(max_gap_min),
+    )
     if message is not None:
         raise WeatherError(message)
     return result
@@ -226,8 +253,15 @@ def measured_weather(path, fmt: str, label: str | None = None, timezone: str | N
 def _measured_once(path, mtime, fmt, label, timezone, site, decomposition, max_gap_min):
     """:func:`measured_weather`'s result, or its error message (a bad file is read once)."""
     try:
-        return read_measured(path, fmt, label, timezone, None if site is None else dict(site), decomposition,
-                             max_gap_min), None
+        return read_measured(
+            path,
+            fmt,
+            label,
+            timezone,
+            None if site is None else dict(site),
+            decomposition,
+            max_gap_min,
+        ), None
     except WeatherError as error:
         return None, error.errors[0]
 
@@ -250,11 +284,20 @@ def study_weather(weather, site) -> MeasuredWeather:
     given = None
     if not entry.has_site and site is not None:
         given = site if isinstance(site, dict) else site.model_dump()
-    return measured_weather(weather.path, weather.format, weather.label, weather.timezone, given,
-                            weather.decomposition, weather.max_gap_min)
+    return measured_weather(
+        weather.path,
+        weather.format,
+        weather.label,
+        weather.timezone,
+        given,
+        weather.decomposition,
+        weather.max_gap_min,
+    )
 
 
-def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | None = None) -> pd.DataFrame:
+def read_weather(
+    path, fmt: str | None = None, year: int = 2025, label: str | None = None
+) -> pd.DataFrame:
     """A weather file's hours.
 
     Parameters
@@ -294,7 +337,9 @@ def read_weather(path, fmt: str | None = None, year: int = 2025, label: str | No
     index = data.index + shift
     if typical != year:
         index = pd.DatetimeIndex(index.map(lambda t: t.replace(year=t.year + year - typical)))
-    frame = pd.DataFrame({key: data[key].to_numpy(copy=True) for key in (*COLUMNS, "cloud_cover")}, index=index)
+    frame = pd.DataFrame(
+        {key: data[key].to_numpy(copy=True) for key in (*COLUMNS, "cloud_cover")}, index=index
+    )
     frame = frame.sort_index()
     frame.attrs["weather"] = path.name
     return frame
@@ -329,20 +374,35 @@ def weather_days(frame: pd.DataFrame, dates) -> np.ndarray:
         raise WeatherError(f"{prefix}no rows")
     held = f"the file holds {days[0]} to {days[-1]}"
     wanted = np.array(dates, dtype="datetime64[D]")
-    start, stop = np.searchsorted(days, wanted, side="left"), np.searchsorted(days, wanted, side="right")
+    start, stop = (
+        np.searchsorted(days, wanted, side="left"),
+        np.searchsorted(days, wanted, side="right"),
+    )
     missing = [str(date) for date, a, b in zip(wanted, start, stop, strict=True) if a == b]
     if missing:
-        leap = " (a typical year has no February 29)" if any(d.endswith("-02-29") for d in missing) else ""
-        raise WeatherError(f"{prefix}no data for {', '.join(missing[:3])}"
-                           + (f" and {len(missing) - 3} more dates" if len(missing) > 3 else "") + f"; {held}{leap}")
+        leap = (
+            " (a typical year has no February 29)"
+            if any(d.endswith("-02-29") for d in missing)
+            else ""
+        )
+        raise WeatherError(
+            f"{prefix}no data for {', '.join(missing[:3])}"
+            + (f" and {len(missing) - 3} more dates" if len(missing) > 3 else "")
+            + f"; {held}{leap}"
+        )
     step = pd.Series(frame.index).diff().median() if len(frame) > 1 else pd.NaT
-    per_day = round(pd.Timedelta(days=1) / step) if pd.notna(step) and step > pd.Timedelta(0) else None
+    per_day = (
+        round(pd.Timedelta(days=1) / step) if pd.notna(step) and step > pd.Timedelta(0) else None
+    )
     counts = stop - start
     full = per_day if per_day else int(counts.max())
     short = [(str(date), int(n)) for date, n in zip(wanted, counts, strict=True) if n != full]
     if short:
-        raise WeatherError(f"{prefix}{short[0][0]} holds {short[0][1]} rows, a whole day {full}"
-                           + (f"; and {len(short) - 1} more dates" if len(short) > 1 else "") + f"; {held}")
+        raise WeatherError(
+            f"{prefix}{short[0][0]} holds {short[0][1]} rows, a whole day {full}"
+            + (f"; and {len(short) - 1} more dates" if len(short) > 1 else "")
+            + f"; {held}"
+        )
     return start[:, None] + np.arange(full)
 
 

@@ -78,9 +78,13 @@ def fill_dark(index, lit):
     n = index.shape[1]
     positions = np.arange(n)
     before = np.maximum.accumulate(np.where(lit, positions, -1), axis=1)
-    after = np.flip(np.minimum.accumulate(np.flip(np.where(lit, positions, n), axis=1), axis=1), axis=1)
+    after = np.flip(
+        np.minimum.accumulate(np.flip(np.where(lit, positions, n), axis=1), axis=1), axis=1
+    )
     nearest = np.where(before >= 0, before, np.where(after < n, after, 0))
-    return np.where(lit, index, np.take_along_axis(index, nearest, axis=1) * lit.any(axis=1, keepdims=True))
+    return np.where(
+        lit, index, np.take_along_axis(index, nearest, axis=1) * lit.any(axis=1, keepdims=True)
+    )
 
 
 def mean_preserving(means, clear, steps_per_interval: int, max_index: float = MAX_CLEARSKY_INDEX):
@@ -128,20 +132,28 @@ def mean_preserving(means, clear, steps_per_interval: int, max_index: float = MA
     clear_mean = weight.mean(axis=-1)
     lit = clear_mean > 0
     with np.errstate(invalid="ignore", divide="ignore"):
-        index = np.asarray(pvlib.irradiance.clearsky_index(means, clear_mean, max_index), dtype=float)
+        index = np.asarray(
+            pvlib.irradiance.clearsky_index(means, clear_mean, max_index), dtype=float
+        )
     index = fill_dark(np.where(lit, index, 0.0), lit)
     cap = EDGE_CAP * np.minimum(index[:, 1:], index[:, :-1])
     # An interval at the bound (light at twice the clear sky, at sunrise) stays at it up to its
     # edge where its neighbour can take that (the cap), so that it keeps what light it can.
     saturated = lit & (means >= max_index * clear_mean * (1.0 - 1e-9))
-    inner = np.where(saturated[:, 1:] | saturated[:, :-1], cap, np.minimum(0.5 * (index[:, 1:] + index[:, :-1]), cap))
+    inner = np.where(
+        saturated[:, 1:] | saturated[:, :-1],
+        cap,
+        np.minimum(0.5 * (index[:, 1:] + index[:, :-1]), cap),
+    )
     edges = np.minimum(np.concatenate([index[:, :1], inner, index[:, -1:]], axis=1), max_index)
     u = (np.arange(n) + 0.5) / n
     bump = 4.0 * u * (1.0 - u)
     weighted_bump = (weight * bump).mean(axis=-1)
     line = edges[:, :-1, None] * (1.0 - u) + edges[:, 1:, None] * u
     with np.errstate(invalid="ignore", divide="ignore"):
-        size = np.where(lit & (weighted_bump > 0), (means - (weight * line).mean(axis=-1)) / weighted_bump, 0.0)
+        size = np.where(
+            lit & (weighted_bump > 0), (means - (weight * line).mean(axis=-1)) / weighted_bump, 0.0
+        )
     shaped = line + size[..., None] * bump
     bad = lit & ((shaped.min(axis=-1) < 0.0) | (shaped.max(axis=-1) > max_index))
     if bad.any():
@@ -169,7 +181,9 @@ def _ramped(means, weight, edges, bad, max_index):
     # The narrowest ramp spans two steps: its change at the interval's edge is then half its
     # largest inside (a one-step ramp would put half its change on the edge).
     widths = np.array(RAMP_WIDTHS + (min(2.0 / n, 0.5),))
-    rise = np.clip(1.0 - u[None, :] / widths[:, None], 0.0, None)  # (n_widths, n) from the left edge
+    rise = np.clip(
+        1.0 - u[None, :] / widths[:, None], 0.0, None
+    )  # (n_widths, n) from the left edge
     fall = rise[:, ::-1]  # from the right edge
     left, right = edges[:, :-1, None], edges[:, 1:, None]
     ramps = weight @ rise.T, weight @ fall.T  # (n_days, n_intervals, n_widths) weighted sums
@@ -179,12 +193,16 @@ def _ramped(means, weight, edges, bad, max_index):
     fits = (plateau >= 0.0) & (plateau <= max_index) & (rest > 0)
     choice = np.where(fits.any(axis=-1), np.argmax(fits, axis=-1), widths.size - 1)
     # Where none fits (an interval the bound cannot hold: the narrowest ramp), the plateau is the bound.
-    level = np.clip(np.nan_to_num(np.take_along_axis(plateau, choice[..., None], axis=-1)), 0.0, max_index)
+    level = np.clip(
+        np.nan_to_num(np.take_along_axis(plateau, choice[..., None], axis=-1)), 0.0, max_index
+    )
     r0, r1 = rise[choice], fall[choice]
     return np.where(bad[..., None], level * (1.0 - r0 - r1) + left * r0 + right * r1, 0.0)
 
 
-def hourly_light(dni, dhi, clear_ghi, clear_dni, cos_zenith, steps_per_interval: int, dni_extra=None):
+def hourly_light(
+    dni, dhi, clear_ghi, clear_dni, cos_zenith, steps_per_interval: int, dni_extra=None
+):
     """Direct, diffuse and global light at every step from interval means, closed at every step
     (module docstring).
 
@@ -253,7 +271,9 @@ def interpolate_points(values, offset: float, steps_per_interval: int):
     return values[:, right - 1] * (1.0 - weight) + values[:, right] * weight
 
 
-def clear_sky(apparent_zenith, airmass, dni_extra, altitude, model="ineichen", linke_turbidity=None):
+def clear_sky(
+    apparent_zenith, airmass, dni_extra, altitude, model="ineichen", linke_turbidity=None
+):
     """pvlib's clear sky at some steps, arrays in and out.
 
     Parameters
@@ -284,12 +304,17 @@ def clear_sky(apparent_zenith, airmass, dni_extra, altitude, model="ineichen", l
         For a model that is not one of :data:`foldopt.names.CLEAR_SKIES`.
     """
     if model == "ineichen":
-        absolute = pvlib.atmosphere.get_absolute_airmass(airmass, pvlib.atmosphere.alt2pres(altitude))
+        absolute = pvlib.atmosphere.get_absolute_airmass(
+            airmass, pvlib.atmosphere.alt2pres(altitude)
+        )
         with np.errstate(divide="ignore", invalid="ignore"):  # night: zero air mass terms
-            sky = pvlib.clearsky.ineichen(apparent_zenith, absolute, linke_turbidity, altitude, dni_extra)
+            sky = pvlib.clearsky.ineichen(
+                apparent_zenith, absolute, linke_turbidity, altitude, dni_extra
+            )
     elif model == "simplified-solis":
-        sky = pvlib.clearsky.simplified_solis(90.0 - np.asarray(apparent_zenith),
-                                              pressure=pvlib.atmosphere.alt2pres(altitude))
+        sky = pvlib.clearsky.simplified_solis(
+            90.0 - np.asarray(apparent_zenith), pressure=pvlib.atmosphere.alt2pres(altitude)
+        )
     else:
         raise ValueError(f"clear sky must be one of {', '.join(CLEAR_SKIES)}; got {model!r}")
     return {key: np.nan_to_num(np.asarray(sky[key], dtype=float)) for key in ("ghi", "dni", "dhi")}

@@ -108,7 +108,12 @@ import math
 
 import numpy as np
 
-from foldopt.inputs.weather.downscale import MAX_CLEARSKY_INDEX, MIN_COS_ZENITH, fill_dark, interpolate_points
+from foldopt.inputs.weather.downscale import (
+    MAX_CLEARSKY_INDEX,
+    MIN_COS_ZENITH,
+    fill_dark,
+    interpolate_points,
+)
 
 #: Suehrcke, Bowden & Hollands' global relation [4]_: clear-sky index ``beta + (1 - beta) s**gamma``
 #: of an hour in sunshine for the fraction ``s`` of it.
@@ -137,25 +142,82 @@ CHAIN_STEP_MIN = 1.0
 #: elevation bins 0, 10, ..., 50 deg, each ``(scale, shape1, shape2)``; 0-3 oktas Burr type III,
 #: 4-8 oktas generalised gamma (eqs. (2)-(3) of the module docstring). The two bins they leave empty
 #: (0 oktas at 30 deg, 8 oktas at 20 deg) take the mean of their neighbours' parameters.
-COVER_FITS = np.array([
-    [(1.00426, 8.05209, 0.33413), (1.05008, 30.0122, 0.15747), (1.04270, 79.3070, 0.10978),
-     (np.nan,) * 3, (1.04161, 90.4486, 0.11474), (1.04035, 106.678, 0.11517)],
-    [(0.86772, 5.95703, 0.46153), (1.03464, 23.3098, 0.13596), (1.05403, 45.7765, 0.08633),
-     (1.05343, 61.2289, 0.07964), (1.04837, 68.6886, 0.08091), (1.05109, 83.3814, 0.07648)],
-    [(0.77206, 4.95605, 0.60222), (0.99764, 16.1237, 0.17120), (1.04272, 33.0440, 0.09915),
-     (1.04420, 43.3609, 0.08753), (1.03914, 44.6569, 0.09412), (1.04245, 59.1349, 0.08163)],
-    [(0.75709, 4.71996, 0.59981), (0.96289, 13.2643, 0.20049), (1.02061, 24.5572, 0.12518),
-     (1.02210, 29.5048, 0.11747), (1.01606, 35.5753, 0.10865), (1.01776, 40.2873, 0.10703)],
-    [(0.00548, 0.55740, 7.91970), (0.80680, 3.78063, 3.21570), (0.97459, 7.68441, 3.13980),
-     (0.99304, 10.0262, 3.49195), (0.99518, 11.9358, 3.63087), (0.99403, 14.3796, 4.15190)],
-    [(0.00202, 0.49130, 8.15754), (0.66456, 2.79245, 3.43021), (0.89225, 5.43828, 3.23124),
-     (0.94539, 7.63587, 3.31306), (0.93125, 8.26040, 3.65375), (0.93577, 9.66092, 3.88766)],
-    [(0.00168, 0.48199, 8.08929), (0.48615, 2.08814, 3.83716), (0.75785, 3.82376, 3.33406),
-     (0.85162, 5.45712, 3.18022), (0.85237, 5.90425, 3.43888), (0.84646, 6.32450, 3.81557)],
-    [(0.00454, 0.48462, 4.42115), (0.43349, 1.79971, 2.24003), (0.61461, 2.62790, 2.02528),
-     (0.70374, 3.46998, 2.06773), (0.73038, 4.01204, 2.19332), (0.74453, 4.48931, 2.18655)],
-    [(0.00017, 0.36012, 5.35531), (0.09720, 1.01097, 3.44283), (np.nan,) * 3,
-     (0.20153, 1.33134, 2.95643), (0.26613, 1.55354, 2.83336), (0.25640, 1.54127, 2.89782)]])
+COVER_FITS = np.array(
+    [
+        [
+            (1.00426, 8.05209, 0.33413),
+            (1.05008, 30.0122, 0.15747),
+            (1.04270, 79.3070, 0.10978),
+            (np.nan,) * 3,
+            (1.04161, 90.4486, 0.11474),
+            (1.04035, 106.678, 0.11517),
+        ],
+        [
+            (0.86772, 5.95703, 0.46153),
+            (1.03464, 23.3098, 0.13596),
+            (1.05403, 45.7765, 0.08633),
+            (1.05343, 61.2289, 0.07964),
+            (1.04837, 68.6886, 0.08091),
+            (1.05109, 83.3814, 0.07648),
+        ],
+        [
+            (0.77206, 4.95605, 0.60222),
+            (0.99764, 16.1237, 0.17120),
+            (1.04272, 33.0440, 0.09915),
+            (1.04420, 43.3609, 0.08753),
+            (1.03914, 44.6569, 0.09412),
+            (1.04245, 59.1349, 0.08163),
+        ],
+        [
+            (0.75709, 4.71996, 0.59981),
+            (0.96289, 13.2643, 0.20049),
+            (1.02061, 24.5572, 0.12518),
+            (1.02210, 29.5048, 0.11747),
+            (1.01606, 35.5753, 0.10865),
+            (1.01776, 40.2873, 0.10703),
+        ],
+        [
+            (0.00548, 0.55740, 7.91970),
+            (0.80680, 3.78063, 3.21570),
+            (0.97459, 7.68441, 3.13980),
+            (0.99304, 10.0262, 3.49195),
+            (0.99518, 11.9358, 3.63087),
+            (0.99403, 14.3796, 4.15190),
+        ],
+        [
+            (0.00202, 0.49130, 8.15754),
+            (0.66456, 2.79245, 3.43021),
+            (0.89225, 5.43828, 3.23124),
+            (0.94539, 7.63587, 3.31306),
+            (0.93125, 8.26040, 3.65375),
+            (0.93577, 9.66092, 3.88766),
+        ],
+        [
+            (0.00168, 0.48199, 8.08929),
+            (0.48615, 2.08814, 3.83716),
+            (0.75785, 3.82376, 3.33406),
+            (0.85162, 5.45712, 3.18022),
+            (0.85237, 5.90425, 3.43888),
+            (0.84646, 6.32450, 3.81557),
+        ],
+        [
+            (0.00454, 0.48462, 4.42115),
+            (0.43349, 1.79971, 2.24003),
+            (0.61461, 2.62790, 2.02528),
+            (0.70374, 3.46998, 2.06773),
+            (0.73038, 4.01204, 2.19332),
+            (0.74453, 4.48931, 2.18655),
+        ],
+        [
+            (0.00017, 0.36012, 5.35531),
+            (0.09720, 1.01097, 3.44283),
+            (np.nan,) * 3,
+            (0.20153, 1.33134, 2.95643),
+            (0.26613, 1.55354, 2.83336),
+            (0.25640, 1.54127, 2.89782),
+        ],
+    ]
+)
 COVER_FITS[0, 3] = COVER_FITS[0, [2, 4]].mean(axis=0)
 COVER_FITS[8, 2] = COVER_FITS[8, [1, 3]].mean(axis=0)
 #: Bright et al.'s hourly Markov chain of cloud cover [1]_: an overcast (8 okta) hour is followed
@@ -166,8 +228,12 @@ OVERCAST_PERSISTENCE = 0.85
 def _mean_chord(exponent=CHORD_EXPONENT, lengths=CHORD_RANGE):
     """Mean of the power law ``p(x) ~ x**-exponent`` between two lengths [m]."""
     a, b = lengths
-    return (1 - exponent) / (2 - exponent) * (b ** (2 - exponent) - a ** (2 - exponent)) / (
-        b ** (1 - exponent) - a ** (1 - exponent))
+    return (
+        (1 - exponent)
+        / (2 - exponent)
+        * (b ** (2 - exponent) - a ** (2 - exponent))
+        / (b ** (1 - exponent) - a ** (1 - exponent))
+    )
 
 
 #: Mean length of Bright et al.'s chords [m] (4.9 km): one mean run of the chain when ``s = 1/2``.
@@ -186,7 +252,9 @@ def _overcast(index, elevation):
     is overcast (8 oktas), eq. (4) of the module docstring: Smith et al.'s densities [6]_, the
     oktas equally likely beforehand."""
     x = np.clip(np.asarray(index, dtype=float), 1e-3, None)[None]
-    scale, c, k = np.moveaxis(COVER_FITS[:, np.clip(np.rint(elevation / 10.0), 0, 5).astype(int)], -1, 0)
+    scale, c, k = np.moveaxis(
+        COVER_FITS[:, np.clip(np.rint(elevation / 10.0), 0, 5).astype(int)], -1, 0
+    )
     log_x = np.log(x / scale)
     burr = np.log(c * k / scale) - (c + 1) * log_x - (k + 1) * np.logaddexp(0.0, -c * log_x)
     gamma_fn = np.vectorize(math.lgamma)(k / c)
@@ -227,7 +295,12 @@ def _fill(values, cap, means, rounds: int = 16):
     out = factor[..., None] * values
     rows = (out > cap).any(axis=-1)
     if rows.any():  # the few intervals the cap cuts: iterate on those alone
-        v, c, t, f = values[rows], np.broadcast_to(cap, values.shape)[rows], total[rows], factor[rows]
+        v, c, t, f = (
+            values[rows],
+            np.broadcast_to(cap, values.shape)[rows],
+            total[rows],
+            factor[rows],
+        )
         full = np.zeros(t.shape, dtype=bool)  # every step at its cap
         for _ in range(rounds):
             capped = f[:, None] * v > c
@@ -257,13 +330,24 @@ def _stretch(sun, share):
     # Sub-step j's centre j + 0.5 lies in original sub-step i = #{ends <= j + 0.5}: count the ends
     # by the first centre past each (a bincount and a cumulative sum, no search).
     first = np.clip(np.ceil(ends - 0.5), 0, n).astype(np.int64)
-    marks = np.bincount((first + (n + 1) * np.arange(rows)[:, None]).ravel(), minlength=rows * (n + 1))
+    marks = np.bincount(
+        (first + (n + 1) * np.arange(rows)[:, None]).ravel(), minlength=rows * (n + 1)
+    )
     source = np.minimum(np.cumsum(marks.reshape(rows, n + 1)[:, :n], axis=1), n - 1)
     return np.take_along_axis(sun, source, axis=1)
 
 
-def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step_min: float, members: int,
-                  seed: int, cloud_cover=None) -> dict:
+def cloud_members(
+    ghi,
+    dhi,
+    clear_ghi,
+    cos_zenith,
+    steps_per_interval: int,
+    step_min: float,
+    members: int,
+    seed: int,
+    cloud_cover=None,
+) -> dict:
     """Members of light at every step with a weather file's interval means (module docstring).
 
     Parameters
@@ -317,12 +401,20 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
     cosz = np.nan_to_num(np.asarray(cos_zenith, dtype=float), nan=0.0)
     spi, members = int(steps_per_interval), int(members)
     if spi < 1 or members < 1 or not step_min > 0:
-        raise ValueError(f"steps_per_interval, members and step_min must be positive; got {spi}, {members}, "
-                         f"{step_min}")
-    if ghi.ndim != 2 or dhi.shape != ghi.shape or clear.shape != (ghi.shape[0], ghi.shape[1] * spi) \
-            or cosz.shape != clear.shape:
-        raise ValueError(f"ghi and dhi must be (n_days, n_intervals) and clear_ghi and cos_zenith (n_days, "
-                         f"n_intervals * {spi}); got {ghi.shape}, {dhi.shape}, {clear.shape}, {cosz.shape}")
+        raise ValueError(
+            f"steps_per_interval, members and step_min must be positive; got {spi}, {members}, "
+            f"{step_min}"
+        )
+    if (
+        ghi.ndim != 2
+        or dhi.shape != ghi.shape
+        or clear.shape != (ghi.shape[0], ghi.shape[1] * spi)
+        or cosz.shape != clear.shape
+    ):
+        raise ValueError(
+            f"ghi and dhi must be (n_days, n_intervals) and clear_ghi and cos_zenith (n_days, "
+            f"n_intervals * {spi}); got {ghi.shape}, {dhi.shape}, {clear.shape}, {cosz.shape}"
+        )
     n_days, n_int = ghi.shape
     clear = np.clip(clear, 0.0, None).reshape(n_days, n_int, spi)
     cosz = cosz.reshape(clear.shape)
@@ -345,38 +437,59 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
         if cover.shape != ghi.shape:
             raise ValueError(f"cloud_cover must be {ghi.shape}; got {cover.shape}")
         share = np.where(np.isfinite(cover), 1.0 - np.clip(np.nan_to_num(cover), 0.0, 1.0), share)
-    cos_mean = np.divide(np.where(eligible, cosz, 0.0).sum(axis=-1), eligible.sum(axis=-1),
-                         out=np.ones_like(glob), where=has_beam)
+    cos_mean = np.divide(
+        np.where(eligible, cosz, 0.0).sum(axis=-1),
+        eligible.sum(axis=-1),
+        out=np.ones_like(glob),
+        where=has_beam,
+    )
     most = beam / (SUNSHINE_DNI * cos_mean)
     room = bound * clear_mean - diffuse
     least = np.divide(beam, room, out=np.ones_like(beam), where=room > 0)
     share = np.where(beam > 0, np.clip(np.maximum(np.minimum(share, most), least), 0.0, 1.0), 0.0)
-    oktas = 8.0 * np.where(np.isfinite(cover), np.clip(np.nan_to_num(cover), 0.0, 1.0), 1.0 - share) \
-        if cover is not None else 8.0 * (1.0 - share)
+    oktas = (
+        8.0 * np.where(np.isfinite(cover), np.clip(np.nan_to_num(cover), 0.0, 1.0), 1.0 - share)
+        if cover is not None
+        else 8.0 * (1.0 - share)
+    )
     # The hour's chance of being overcast (no sunny state), from the file's cover where it gives one.
     elevation = np.degrees(np.arcsin(np.clip(cos_mean, 0.0, 1.0)))
     overcast = np.where((share > 0) & (share < 1), _overcast(index, elevation), 0.0)
     if cover is not None:
-        overcast = np.where(np.isfinite(cover), (np.nan_to_num(cover) >= 1.0) & (share < 1), overcast)
+        overcast = np.where(
+            np.isfinite(cover), (np.nan_to_num(cover) >= 1.0) & (share < 1), overcast
+        )
 
     # 2. The sky's state: a chain through the lit intervals in order, on sub-steps of at most
     # CHAIN_STEP_MIN; after a dark interval (an hour of night decorrelates it) it starts afresh.
-    sky = _envelope(np.divide(diffuse, clear_mean, out=np.zeros_like(diffuse), where=lit), lit, clear, spi)
-    on = np.divide(beam, np.maximum(share, 1e-9) * cos_mean, out=np.zeros_like(beam), where=(share > 0) & has_beam)
+    sky = _envelope(
+        np.divide(diffuse, clear_mean, out=np.zeros_like(diffuse), where=lit), lit, clear, spi
+    )
+    on = np.divide(
+        beam,
+        np.maximum(share, 1e-9) * cos_mean,
+        out=np.zeros_like(beam),
+        where=(share > 0) & has_beam,
+    )
     direct = _envelope(on, on > 0, np.where(eligible, cosz, 0.0), spi)  # the DNI along cos(zenith)
     rows = np.flatnonzero(lit)  # chronological
     if rows.size == 0:
         zeros = np.zeros((members, n_days, n_int * spi))
         return {"ghi": zeros, "dni": zeros.copy(), "dhi": zeros.copy()}
-    share, beam, diffuse, oktas, bound, overcast = (a.reshape(-1)[rows] for a in (share, beam, diffuse, oktas, bound,
-                                                                                   overcast))
-    clear, cosz, eligible, sky, direct = (a.reshape(-1, spi)[rows] for a in (clear, cosz, eligible, sky, direct))
+    share, beam, diffuse, oktas, bound, overcast = (
+        a.reshape(-1)[rows] for a in (share, beam, diffuse, oktas, bound, overcast)
+    )
+    clear, cosz, eligible, sky, direct = (
+        a.reshape(-1, spi)[rows] for a in (clear, cosz, eligible, sky, direct)
+    )
     fresh = np.ones(rows.size, dtype=bool)
     fresh[1:] = np.diff(rows) > 1
     sub = max(1, math.ceil(step_min / CHAIN_STEP_MIN - 1e-9))
     n, dt = spi * sub, step_min / sub
     rngs = [np.random.default_rng(child) for child in np.random.SeedSequence(seed).spawn(members)]
-    speed = np.clip(np.stack([rng.gamma(SPEED_SHAPE, SPEED_SCALE, rows.size) for rng in rngs]), *SPEED_RANGE)
+    speed = np.clip(
+        np.stack([rng.gamma(SPEED_SHAPE, SPEED_SCALE, rows.size) for rng in rngs]), *SPEED_RANGE
+    )
     # The chain redraws its state from (share, 1 - share) at the rate 2 u / MEAN_CHORD: its mean
     # run is then MEAN_CHORD / u when share is 1/2, as Bright et al.'s chords at speed u.
     redraw = 1.0 - np.exp(-2.0 * speed * 60.0 / MEAN_CHORD * dt)
@@ -391,13 +504,16 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
     noise = np.stack([rng.standard_normal((rows.size, spi)) for rng in rngs])
     covered = _overcast_hours(overcast, fresh, rngs)  # 3. (step 2 of the module docstring)
     hit = sun.mean(axis=-1)
-    uniform = (hit <= 0) | (hit >= 1) | covered  # no switch all interval, or overcast: the beam spread evenly
+    uniform = (
+        (hit <= 0) | (hit >= 1) | covered
+    )  # no switch all interval, or overcast: the beam spread evenly
     sun = np.where(uniform[..., None], np.broadcast_to(share, hit.shape)[..., None], sun)
 
     # 4. The light: smooth diffuse, the beam on and off, noise, then each interval's means.
     okta = np.where(covered, 8.0, oktas)[..., None]
-    sigma = sun * (NOISE_VISIBLE[0] + NOISE_VISIBLE[1] * okta) + (1 - sun) * (NOISE_OBSCURED[0]
-                                                                              + NOISE_OBSCURED[1] * okta)
+    sigma = sun * (NOISE_VISIBLE[0] + NOISE_VISIBLE[1] * okta) + (1 - sun) * (
+        NOISE_OBSCURED[0] + NOISE_OBSCURED[1] * okta
+    )
     factor = np.clip(1.0 + sigma * noise, 0.0, None)
     del noise, sigma
     cap = bound[:, None] * clear
@@ -410,14 +526,19 @@ def cloud_members(ghi, dhi, clear_ghi, cos_zenith, steps_per_interval: int, step
     # sunrise) goes to the interval's other steps, evenly along the beam's curve.
     short = beam - beam_out.mean(axis=-1)
     if (short > 1e-9 * (beam + 1.0)).any():
-        beam_out = beam_out + _fill(direct * factor, cap - dhi_out - beam_out, np.clip(short, 0.0, None))
+        beam_out = beam_out + _fill(
+            direct * factor, cap - dhi_out - beam_out, np.clip(short, 0.0, None)
+        )
         # What the beam's steps cannot hold at all (the sun just clear of the horizon) is diffuse.
         short = np.clip(beam - beam_out.mean(axis=-1), 0.0, None)
         if (short > 1e-9 * (beam + 1.0)).any():
             dhi_out = dhi_out + _fill(sky * factor, cap - dhi_out - beam_out, short)
     out = {}
-    for key, values in (("ghi", dhi_out + beam_out), ("dhi", dhi_out),
-                        ("dni", np.divide(beam_out, cosz, out=np.zeros_like(beam_out), where=eligible))):
+    for key, values in (
+        ("ghi", dhi_out + beam_out),
+        ("dhi", dhi_out),
+        ("dni", np.divide(beam_out, cosz, out=np.zeros_like(beam_out), where=eligible)),
+    ):
         full = np.zeros((members, n_days * n_int, spi))
         full[:, rows] = values
         out[key] = full.reshape(members, n_days, n_int * spi)

@@ -11,14 +11,33 @@ from pathlib import Path
 
 import pandas as pd
 
-from foldopt.inputs.weather.formats import (WeatherFormat, check_site_fields, header_fields, header_site, line_locator,
-                                            read_with_pvlib, refuse_february_29, table_index, table_rows)
+from foldopt.inputs.weather.formats import (
+    WeatherFormat,
+    check_site_fields,
+    header_fields,
+    header_site,
+    line_locator,
+    read_with_pvlib,
+    refuse_february_29,
+    table_index,
+    table_rows,
+)
 
 #: Lines before the first row.
 HEADER_LINES = 8
 #: The first header line's fields, as pvlib names them.
-HEADER_FIELDS = ("LOCATION", "city", "state-prov", "country", "data_type", "WMO_code", "latitude", "longitude", "TZ",
-                 "altitude")
+HEADER_FIELDS = (
+    "LOCATION",
+    "city",
+    "state-prov",
+    "country",
+    "data_type",
+    "WMO_code",
+    "latitude",
+    "longitude",
+    "TZ",
+    "altitude",
+)
 
 
 def check_header(fail, first_line: str) -> None:
@@ -32,7 +51,9 @@ def check_header(fail, first_line: str) -> None:
     """
     if first_line.rstrip("\r\n").split(",")[0].strip() != "LOCATION":
         raise fail(f"line 1: not an EPW header: it starts {first_line[:20]!r}, not 'LOCATION,'")
-    check_site_fields(fail, HEADER_FIELDS, header_fields(fail, FORMAT.label, HEADER_FIELDS, first_line))
+    check_site_fields(
+        fail, HEADER_FIELDS, header_fields(fail, FORMAT.label, HEADER_FIELDS, first_line)
+    )
 
 
 def read(path: str, text: str, year: int, fail):
@@ -57,20 +78,41 @@ def read(path: str, text: str, year: int, fail):
     line_of = table_rows(lines, HEADER_LINES, FORMAT.label, fail)
     # pvlib cannot coerce an EPW file's February 29 to a year without one.
     if not pd.Timestamp(year=year, month=1, day=1).is_leap_year:
-        refuse_february_29(fail, [n for n in line_of if [f.strip() for f in lines[n - 1].split(",", 3)[1:3]]
-                                  == ["2", "29"]], f"{year} has none")
+        refuse_february_29(
+            fail,
+            [
+                n
+                for n in line_of
+                if [f.strip() for f in lines[n - 1].split(",", 3)[1:3]] == ["2", "29"]
+            ],
+            f"{year} has none",
+        )
     data, meta = read_with_pvlib(fail, FORMAT.label, "read_epw", path, coerce_year=year)
     index = table_index(data, HEADER_LINES, fail)
     return data, meta, index, line_locator(line_of, len(data), HEADER_LINES)
 
 
 FORMAT = WeatherFormat(
-    name="epw", label="EPW", interval_label="start", suffixes=(".epw",), signature=r"\ALOCATION,",
-    columns={"ghi": "field 14", "dni": "field 15", "dhi": "field 16", "temp_air": "field 7", "wind_speed": "field 22"},
-    columns_at="its rows", read=read, site=partial(header_site, name="city"), stamp_lag=1.0,
+    name="epw",
+    label="EPW",
+    interval_label="start",
+    suffixes=(".epw",),
+    signature=r"\ALOCATION,",
+    columns={
+        "ghi": "field 14",
+        "dni": "field 15",
+        "dhi": "field 16",
+        "temp_air": "field 7",
+        "wind_speed": "field 22",
+    },
+    columns_at="its rows",
+    read=read,
+    site=partial(header_site, name="city"),
+    stamp_lag=1.0,
     cover=("total_sky_cover", 10.0),
     # Missing values of the columns used (EnergyPlus, "EnergyPlus Weather File (EPW) Data Dictionary").
-    missing={"ghi": 9999.0, "dni": 9999.0, "dhi": 9999.0, "temp_air": 99.9, "wind_speed": 999.0})
+    missing={"ghi": 9999.0, "dni": 9999.0, "dhi": 9999.0, "temp_air": 99.9, "wind_speed": 999.0},
+)
 
 
 def write_epw(path, hourly: pd.DataFrame, site: dict) -> None:
@@ -95,16 +137,56 @@ def write_epw(path, hourly: pd.DataFrame, site: dict) -> None:
     """
     offset = pd.Timestamp("2000-01-01", tz=hourly.index.tz).utcoffset().total_seconds() / 3600.0
     name = str(site.get("name") or "measured").replace(",", " ")
-    header = [f"LOCATION,{name},-,-,measured,000000,{site['latitude']},{site['longitude']},{offset:g},"
-              f"{site['altitude']}", "DESIGN CONDITIONS,0", "TYPICAL/EXTREME PERIODS,0", "GROUND TEMPERATURES,0",
-              "HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0", "COMMENTS 1,hourly means of a measured file written by foldopt",
-              "COMMENTS 2,", "DATA PERIODS,1,1,Data,Sunday, 1/1,12/31"]
+    header = [
+        f"LOCATION,{name},-,-,measured,000000,{site['latitude']},{site['longitude']},{offset:g},"
+        f"{site['altitude']}",
+        "DESIGN CONDITIONS,0",
+        "TYPICAL/EXTREME PERIODS,0",
+        "GROUND TEMPERATURES,0",
+        "HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0",
+        "COMMENTS 1,hourly means of a measured file written by foldopt",
+        "COMMENTS 2,",
+        "DATA PERIODS,1,1,Data,Sunday, 1/1,12/31",
+    ]
     rows = []
     for when, row in zip(hourly.index, hourly.itertuples(index=False), strict=True):
         start = when - pd.Timedelta(minutes=30)
-        fields = [start.year, start.month, start.day, start.hour + 1, 60, "?", round(row.temp_air, 2), 99.9, 999,
-                  999999, 9999, 9999, 9999, round(row.ghi, 3), round(row.dni, 3), round(row.dhi, 3), 999999,
-                  999999, 999999, 9999, 999, round(row.wind_speed, 2), 99, 99, 9999, 99999, 9, 999999999, 999, 0.999,
-                  999, 99, 999, 999, 99]
+        fields = [
+            start.year,
+            start.month,
+            start.day,
+            start.hour + 1,
+            60,
+            "?",
+            round(row.temp_air, 2),
+            99.9,
+            999,
+            999999,
+            9999,
+            9999,
+            9999,
+            round(row.ghi, 3),
+            round(row.dni, 3),
+            round(row.dhi, 3),
+            999999,
+            999999,
+            999999,
+            9999,
+            999,
+            round(row.wind_speed, 2),
+            99,
+            99,
+            9999,
+            99999,
+            9,
+            999999999,
+            999,
+            0.999,
+            999,
+            99,
+            999,
+            999,
+            99,
+        ]
         rows.append(",".join(str(field) for field in fields))
     Path(path).write_text("\n".join(header + rows) + "\n")

@@ -98,7 +98,13 @@ def check_file(path) -> None:
         One line naming the file and what it is.
     """
     try:
-        check_input(path, f"weather {Path(path).name}", MAX_WEATHER_BYTES, "MAX_WEATHER_BYTES", "weather file")
+        check_input(
+            path,
+            f"weather {Path(path).name}",
+            MAX_WEATHER_BYTES,
+            "MAX_WEATHER_BYTES",
+            "weather file",
+        )
     except ConfigError as error:
         raise WeatherError(error.errors[0]) from None
 
@@ -122,7 +128,9 @@ def reason(error: Exception) -> str:
     if isinstance(error, UnicodeDecodeError):
         return f"not text: byte {error.start + 1:,} is 0x{error.object[error.start]:02x}, no UTF-8 (a binary file?)"
     text = str(error).strip().splitlines()
-    text = text[0].split(" You might want to try")[0] if text else ""  # pandas' advice, on the next lines
+    text = (
+        text[0].split(" You might want to try")[0] if text else ""
+    )  # pandas' advice, on the next lines
     return f"{type(error).__name__}: {printable(text, 200)}" if text else type(error).__name__
 
 
@@ -152,7 +160,9 @@ def read_with_pvlib(fail, label: str, reader: str, *args, **kwargs):
         read = getattr(pvlib.iotools, reader)
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # pandas' warnings about pvlib's parsing: the checks follow
+            warnings.simplefilter(
+                "ignore"
+            )  # pandas' warnings about pvlib's parsing: the checks follow
             return read(*args, **kwargs)
     except Exception as error:  # any failure of pvlib's reader is an unreadable file
         raise fail(f"not a readable {label} file ({reason(error)})") from error
@@ -193,9 +203,13 @@ def header_site(meta: dict, name: str) -> dict:
         offset its timestamps keep (:func:`offset_zone`).
     """
     label = meta.get(name)
-    return {"name": str(label).strip('" ') if label else None, "latitude": float(meta["latitude"]),
-            "longitude": float(meta["longitude"]), "altitude": float(meta["altitude"]),
-            "timezone": offset_zone(float(meta["TZ"]))}
+    return {
+        "name": str(label).strip('" ') if label else None,
+        "latitude": float(meta["latitude"]),
+        "longitude": float(meta["longitude"]),
+        "altitude": float(meta["altitude"]),
+        "timezone": offset_zone(float(meta["TZ"])),
+    }
 
 
 _SITE_BOUNDS = {
@@ -230,7 +244,9 @@ def site_value(fail, where: str, key: str, raw) -> float:
     try:
         value = float(raw)
     except (TypeError, ValueError):
-        raise fail(f"{where}: {label} = '{printable(str(raw).strip(), 40)}': not a number") from None
+        raise fail(
+            f"{where}: {label} = '{printable(str(raw).strip(), 40)}': not a number"
+        ) from None
     if not math.isfinite(value):
         raise fail(f"{where}: {label} = {raw}: must be a finite number")
     if not lo <= value <= hi:
@@ -260,8 +276,10 @@ def header_fields(fail, label: str, names: tuple, first_line: str) -> list[str]:
     needed = ("TZ", "latitude", "longitude", "altitude")
     missing = [key for key in needed if names.index(key) >= len(fields)]
     if missing:
-        raise fail(f"line 1: the {label} header has no {', '.join(missing)} ({len(fields)} fields; "
-                   f"it holds {len(names)}: {', '.join(names)})")
+        raise fail(
+            f"line 1: the {label} header has no {', '.join(missing)} ({len(fields)} fields; "
+            f"it holds {len(names)}: {', '.join(names)})"
+        )
     return fields
 
 
@@ -304,8 +322,10 @@ def table_rows(lines: list[str], header: int, label: str, fail) -> list[int]:
     line_of = [n for n in range(header + 1, len(lines) + 1) if lines[n - 1].strip()]
     if not line_of:
         held = max((n for n in range(1, len(lines) + 1) if lines[n - 1].strip()), default=0)
-        raise fail(f"no data rows: a {label} file has {header} header lines, then one row per "
-                   f"hour; this one ends at line {held}")
+        raise fail(
+            f"no data rows: a {label} file has {header} header lines, then one row per "
+            f"hour; this one ends at line {held}"
+        )
     return line_of
 
 
@@ -322,8 +342,10 @@ def refuse_february_29(fail, leap: list[int], why: str) -> None:
         Why the day cannot be read.
     """
     if leap:
-        raise fail(f"line {leap[0]}: February 29 ({len(leap)} rows): {why}; a typical year has 365 days, "
-                   f"remove that day")
+        raise fail(
+            f"line {leap[0]}: February 29 ({len(leap)} rows): {why}; a typical year has 365 days, "
+            f"remove that day"
+        )
 
 
 def table_index(data: pd.DataFrame, header: int, fail) -> pd.DatetimeIndex:

@@ -81,11 +81,25 @@ from foldopt.names import DECOMPOSITIONS, INTERVAL_LABELS
 from foldopt.inputs.reading import MAX_MEASURED_STEPS
 from foldopt.inputs.weather.downscale import MIN_COS_ZENITH
 from foldopt.inputs.weather.formats import check_file, offset_zone, site_value
-from foldopt.inputs.weather.qc import (BEAM_TOLERANCE, COLUMNS, DEFAULT_TEMP_AIR, DEFAULT_WIND_SPEED, DHI_TOLERANCE,
-                                       TEMP_AIR_BOUNDS, WIND_SPEED_BOUNDS)
+from foldopt.inputs.weather.qc import (
+    BEAM_TOLERANCE,
+    COLUMNS,
+    DEFAULT_TEMP_AIR,
+    DEFAULT_WIND_SPEED,
+    DHI_TOLERANCE,
+    TEMP_AIR_BOUNDS,
+    WIND_SPEED_BOUNDS,
+)
 from foldopt.inputs.weather.stations import STATION_FORMATS, StationFormat, fixed_zone
 
-__all__ = ["STATION_FORMATS", "StationFormat", "MeasuredWeather", "read_measured", "DECOMPOSITIONS", "LABELS"]
+__all__ = [
+    "STATION_FORMATS",
+    "StationFormat",
+    "MeasuredWeather",
+    "read_measured",
+    "DECOMPOSITIONS",
+    "LABELS",
+]
 
 #: What a stamp may mark, and the decompositions of ``ghi`` alone into ``dni`` and ``dhi``
 #: (pvlib.irradiance): the registries of :mod:`foldopt.names`.
@@ -154,25 +168,35 @@ class MeasuredWeather:
         days = np.unique(index.tz_localize(None).to_numpy().astype("datetime64[D]"))
         site = self.site
         name = f"{site['name']} " if site.get("name") else ""
-        lines = [f"measured weather {self.frame.attrs.get('weather', '')}: {_minutes(self.step)} steps, "
-                 f"{_count(days.size, 'day')} ({days[0]} to {days[-1]}) at interval centres on {site['timezone']}, "
-                 f"site {name}{site['latitude']:.4f}, {site['longitude']:.4f} deg, {site['altitude']:g} m"]
+        lines = [
+            f"measured weather {self.frame.attrs.get('weather', '')}: {_minutes(self.step)} steps, "
+            f"{_count(days.size, 'day')} ({days[0]} to {days[-1]}) at interval centres on {site['timezone']}, "
+            f"site {name}{site['latitude']:.4f}, {site['longitude']:.4f} deg, {site['altitude']:g} m"
+        ]
         for how in dict.fromkeys(self.derived.values()):
             keys = " and ".join(key for key, value in self.derived.items() if value == how)
             if how == "closure":
-                lines.append(f"{keys} derived by closure ghi = dni cos(zenith) + dhi (where cos(zenith) < "
-                             f"{MIN_COS_ZENITH:g}, dni 0 and dhi = ghi)")
+                lines.append(
+                    f"{keys} derived by closure ghi = dni cos(zenith) + dhi (where cos(zenith) < "
+                    f"{MIN_COS_ZENITH:g}, dni 0 and dhi = ghi)"
+                )
             else:
-                lines.append(f"{keys} derived from ghi by the {how} decomposition (pvlib.irradiance.{how})")
+                lines.append(
+                    f"{keys} derived from ghi by the {how} decomposition (pvlib.irradiance.{how})"
+                )
         if self.gaps:
             minutes = [gap[2] for gap in self.gaps]
-            lines.append(f"{_count(len(self.gaps), 'daylight gap')} ({sum(minutes):g} min, the longest "
-                         f"{max(minutes):g} min); {_count(self.filled_steps, 'step')} filled along the clear-sky index")
+            lines.append(
+                f"{_count(len(self.gaps), 'daylight gap')} ({sum(minutes):g} min, the longest "
+                f"{max(minutes):g} min); {_count(self.filled_steps, 'step')} filled along the clear-sky index"
+            )
         else:
             lines.append("no daylight gaps")
         if self.flagged_days:
-            lines.append(f"{_count(len(self.flagged_days), 'day')} with a daylight gap too long to fill, left "
-                         "incomplete: " + ", ".join(str(day) for day in self.flagged_days))
+            lines.append(
+                f"{_count(len(self.flagged_days), 'day')} with a daylight gap too long to fill, left "
+                "incomplete: " + ", ".join(str(day) for day in self.flagged_days)
+            )
         return lines + list(self.notes)
 
 
@@ -198,11 +222,15 @@ def _site(entry: StationFormat, found: dict, given: dict | None, fail) -> dict:
     site = {key: value for key, value in found.items() if value is not None}
     if given is not None:
         if not isinstance(given, dict):
-            raise fail(f"site must be a mapping of latitude, longitude and altitude; got {type(given).__name__}")
+            raise fail(
+                f"site must be a mapping of latitude, longitude and altitude; got {type(given).__name__}"
+            )
         site.update({key: value for key, value in given.items() if value is not None})
     missing = [key for key in ("latitude", "longitude", "altitude") if key not in site]
     if missing and not found and given is None:
-        raise fail(f"the {entry.name} format holds no site; give site latitude, longitude and altitude")
+        raise fail(
+            f"the {entry.name} format holds no site; give site latitude, longitude and altitude"
+        )
     if missing:
         raise fail(f"site has no {', '.join(missing)}: give site latitude, longitude and altitude")
     for key in ("latitude", "longitude", "altitude"):
@@ -221,14 +249,20 @@ def _grid(frame: pd.DataFrame, label: str, zone, fail):
     spacing = np.diff(ns)
     same = np.flatnonzero(spacing == 0) + 1
     if same.size:
-        raise fail(f"{_count(same.size, 'duplicate stamp')}, the first {stamps[same[0]].isoformat(sep=' ')}")
+        raise fail(
+            f"{_count(same.size, 'duplicate stamp')}, the first {stamps[same[0]].isoformat(sep=' ')}"
+        )
     values, counts = np.unique(spacing, return_counts=True)
-    step = int(values[counts == counts.max()][-1])  # a tie: the longest (a stray stamp makes two short ones)
+    step = int(
+        values[counts == counts.max()][-1]
+    )  # a tie: the longest (a stray stamp makes two short ones)
     off = np.flatnonzero((ns - ns[0]) % step)
     step_td = pd.Timedelta(step, unit="ns")
     if off.size:
-        raise fail(f"{_count(off.size, 'stamp')} off the {_minutes(step_td)} grid of the others, the first "
-                   f"{stamps[off[0]].isoformat(sep=' ')}")
+        raise fail(
+            f"{_count(off.size, 'stamp')} off the {_minutes(step_td)} grid of the others, the first "
+            f"{stamps[off[0]].isoformat(sep=' ')}"
+        )
     if pd.Timedelta(hours=1).value % step:
         raise fail(f"step {_minutes(step_td)}: a measured file's step must divide an hour")
     shift = {"start": step_td / 2, "end": -step_td / 2, "centre": step_td * 0}[label]
@@ -237,11 +271,15 @@ def _grid(frame: pd.DataFrame, label: str, zone, fail):
     phase = (local[0] - first) % step
     days = (local[-1] - first) // _DAY.value + 1
     n = int(days * (_DAY.value // step))
-    if n > MAX_MEASURED_STEPS or (days > 31 and n > 100 * ns.size):  # beyond a limit, or a file 99 % gaps
+    if n > MAX_MEASURED_STEPS or (
+        days > 31 and n > 100 * ns.size
+    ):  # beyond a limit, or a file 99 % gaps
         span = " to ".join(stamps[i].isoformat(sep=" ") for i in (0, -1))
-        raise fail(f"the stamps span {span}, {_count(int(days), 'day')} at the file's {_minutes(step_td)} step: {n:,}"
-                   f" steps for {ns.size:,} rows; at most {MAX_MEASURED_STEPS:,} (FOLDOPT_MAX_MEASURED_STEPS) and 100 "
-                   "a row; check the stamps' years")
+        raise fail(
+            f"the stamps span {span}, {_count(int(days), 'day')} at the file's {_minutes(step_td)} step: {n:,}"
+            f" steps for {ns.size:,} rows; at most {MAX_MEASURED_STEPS:,} (FOLDOPT_MAX_MEASURED_STEPS) and 100 "
+            "a row; check the stamps' years"
+        )
     index = pd.DatetimeIndex(first + phase + step * np.arange(n, dtype=np.int64)).tz_localize(zone)
     rows = (local - first - phase) // step
     table = {key: np.full(n, np.nan) for key in frame.columns}
@@ -278,13 +316,23 @@ def _components(table, present, decomposition, index, zenith, cosz, pressure, fa
         if decomposition == "dirint":
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                dni = np.asarray(pvlib.irradiance.dirint(pd.Series(ghi, index), pd.Series(zenith, index), index,
-                                                         pressure=pressure), dtype=float)
-            dni, dhi, _ = _closure_dhi(ghi, np.where(np.isfinite(ghi), np.nan_to_num(dni), np.nan), cosz)
+                dni = np.asarray(
+                    pvlib.irradiance.dirint(
+                        pd.Series(ghi, index), pd.Series(zenith, index), index, pressure=pressure
+                    ),
+                    dtype=float,
+                )
+            dni, dhi, _ = _closure_dhi(
+                ghi, np.where(np.isfinite(ghi), np.nan_to_num(dni), np.nan), cosz
+            )
         else:
             with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
-                out = getattr(pvlib.irradiance, decomposition)(pd.Series(ghi, index), pd.Series(zenith, index), index)
+                warnings.simplefilter(
+                    "ignore"
+                )  # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
+                out = getattr(pvlib.irradiance, decomposition)(
+                    pd.Series(ghi, index), pd.Series(zenith, index), index
+                )
             dni, dhi = np.asarray(out["dni"], dtype=float), np.asarray(out["dhi"], dtype=float)
             flat = cosz < MIN_COS_ZENITH
             dni, dhi = np.where(flat & np.isfinite(ghi), 0.0, dni), np.where(flat, ghi, dhi)
@@ -300,7 +348,9 @@ def _components(table, present, decomposition, index, zenith, cosz, pressure, fa
         ghi = dni * np.maximum(cosz, 0.0) + dhi
         derived = {"ghi": "closure"}
     elif "ghi" not in present:
-        raise fail("no ghi column, nor dni and dhi to make it by closure ghi = dni cos(zenith) + dhi")
+        raise fail(
+            "no ghi column, nor dni and dhi to make it by closure ghi = dni cos(zenith) + dhi"
+        )
     else:
         derived = {}
     table.update(ghi=ghi, dni=dni, dhi=dhi)
@@ -310,7 +360,11 @@ def _components(table, present, decomposition, index, zenith, cosz, pressure, fa
 def _bounds(table, present, extra, cosz, dropped) -> None:
     """Clip night offsets and drop values out of physical bounds, in place (module docstring)."""
     mu = np.maximum(cosz, 0.0)
-    limits = {"ghi": 1.5 * extra * mu ** 1.2 + 100.0, "dni": extra, "dhi": 0.95 * extra * mu ** 1.2 + 50.0}
+    limits = {
+        "ghi": 1.5 * extra * mu**1.2 + 100.0,
+        "dni": extra,
+        "dhi": 0.95 * extra * mu**1.2 + 50.0,
+    }
     bad = {}
     for key in present & {"ghi", "dni", "dhi"}:
         values = table[key]
@@ -359,7 +413,10 @@ def _fill(table, day, clear, cosz, step_min, max_gap_min, index):
             ratio = np.clip(table[key] / clear, 0.0, GAP_FILL_MAX_INDEX)
             lo, hi = ratio[np.clip(left, 0, n - 1)][run], ratio[np.clip(right, 0, n - 1)][run]
             both = left_ok[run] & right_ok[run]
-            value = np.where(both, lo + (hi - lo) * fraction, np.where(left_ok[run], lo, hi)) * clear[at]
+            value = (
+                np.where(both, lo + (hi - lo) * fraction, np.where(left_ok[run], lo, hi))
+                * clear[at]
+            )
             keep = np.isfinite(table[key][at])
             table[key][at] = np.where(fillable[run] & ~keep, value, table[key][at])
     filled = at[fillable[run]]
@@ -368,8 +425,10 @@ def _fill(table, day, clear, cosz, step_min, max_gap_min, index):
     for key in ("ghi", "dni", "dhi"):
         table[key] = np.where(~day & ~np.isfinite(table[key]), 0.0, table[key])
     step = index[1] - index[0] if n > 1 else pd.Timedelta(0)
-    gaps = tuple((index[s] - step / 2, index[e - 1] + step / 2, float(length * step_min))
-                 for s, e, length in zip(starts, stops, lengths, strict=True))
+    gaps = tuple(
+        (index[s] - step / 2, index[e - 1] + step / 2, float(length * step_min))
+        for s, e, length in zip(starts, stops, lengths, strict=True)
+    )
     long_steps = at[~fillable[run]]
     for key in ("temp_air", "wind_speed"):
         values = table[key]
@@ -378,7 +437,9 @@ def _fill(table, day, clear, cosz, step_min, max_gap_min, index):
         a, b = _runs(~np.isfinite(values))
         spans = np.repeat((b - a) * step_min > max_gap_min, b - a)
         holes = np.flatnonzero(~np.isfinite(values))
-        table[key] = pd.Series(values).interpolate(limit_area="inside").ffill().bfill().to_numpy(copy=True)
+        table[key] = (
+            pd.Series(values).interpolate(limit_area="inside").ffill().bfill().to_numpy(copy=True)
+        )
         keep_missing = holes[spans & day[holes]]
         table[key][keep_missing] = np.nan
         long_steps = np.r_[long_steps, keep_missing]
@@ -386,8 +447,15 @@ def _fill(table, day, clear, cosz, step_min, max_gap_min, index):
     return gaps, int(filled.size), tuple(stamp.date() for stamp in dates)
 
 
-def read_measured(path, fmt: str, label: str | None = None, timezone: str | None = None, site: dict | None = None,
-                  decomposition: str = "erbs", max_gap_min: float = 60.0) -> MeasuredWeather:
+def read_measured(
+    path,
+    fmt: str,
+    label: str | None = None,
+    timezone: str | None = None,
+    site: dict | None = None,
+    decomposition: str = "erbs",
+    max_gap_min: float = 60.0,
+) -> MeasuredWeather:
     """A measured sub-hourly weather file as a study's weather (module docstring).
 
     Parameters
@@ -424,11 +492,15 @@ def read_measured(path, fmt: str, label: str | None = None, timezone: str | None
         without rows, ghi or site, with duplicate or off-grid stamps.
     """
     if fmt not in STATION_FORMATS:
-        raise ValueError(f"measured weather format must be one of {', '.join(STATION_FORMATS)}; got {fmt!r}")
+        raise ValueError(
+            f"measured weather format must be one of {', '.join(STATION_FORMATS)}; got {fmt!r}"
+        )
     if label is not None and label not in LABELS:
         raise ValueError(f"label must be one of {', '.join(LABELS)}; got {label!r}")
     if decomposition not in DECOMPOSITIONS:
-        raise ValueError(f"decomposition must be one of {', '.join(DECOMPOSITIONS)}; got {decomposition!r}")
+        raise ValueError(
+            f"decomposition must be one of {', '.join(DECOMPOSITIONS)}; got {decomposition!r}"
+        )
     if not float(max_gap_min) >= 0:
         raise ValueError(f"max_gap_min must be a number of minutes >= 0; got {max_gap_min!r}")
     entry, path = STATION_FORMATS[fmt], Path(path)
@@ -442,55 +514,97 @@ def read_measured(path, fmt: str, label: str | None = None, timezone: str | None
             raise fail("the file is empty")
     except OSError as error:
         raise fail(f"cannot be read ({error.strerror or error})") from None
-    given = timezone if timezone is not None else (site or {}).get("timezone") if isinstance(site, dict) else None
+    given = (
+        timezone
+        if timezone is not None
+        else (site or {}).get("timezone")
+        if isinstance(site, dict)
+        else None
+    )
     zone = None if given is None else _zone_hours(given, fail)
     raw = entry.reader(str(path), fail, zone)
     if len(raw.frame) == 0:
         raise fail("no data rows")
     where = _site(entry, raw.site, site, fail)
-    hours = zone if zone is not None else raw.zone if raw.zone is not None else round(where["longitude"] / 15.0)
+    hours = (
+        zone
+        if zone is not None
+        else raw.zone
+        if raw.zone is not None
+        else round(where["longitude"] / 15.0)
+    )
     where["timezone"] = offset_zone(hours)
     tz = fixed_zone(hours)
     step, index, table = _grid(raw.frame, label or entry.interval_label, tz, fail)
-    present = {key for key in ("ghi", "dni", "dhi") if key in table and np.isfinite(table[key]).any()}
+    present = {
+        key for key in ("ghi", "dni", "dhi") if key in table and np.isfinite(table[key]).any()
+    }
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
-        sun = pvlib.solarposition.get_solarposition(index, where["latitude"], where["longitude"], where["altitude"])
-        clear = pvlib.location.Location(where["latitude"], where["longitude"], altitude=where["altitude"]) \
-            .get_clearsky(index, model="ineichen", solar_position=sun)["ghi"].to_numpy(dtype=float)
+        sun = pvlib.solarposition.get_solarposition(
+            index, where["latitude"], where["longitude"], where["altitude"]
+        )
+        clear = (
+            pvlib.location.Location(
+                where["latitude"], where["longitude"], altitude=where["altitude"]
+            )
+            .get_clearsky(index, model="ineichen", solar_position=sun)["ghi"]
+            .to_numpy(dtype=float)
+        )
         extra = np.asarray(pvlib.irradiance.get_extra_radiation(index), dtype=float)
     zenith = sun["zenith"].to_numpy(dtype=float)
     cosz = np.cos(np.radians(zenith))
     dropped: dict = {}
     _bounds(table, present, extra, cosz, dropped)
     notes = list(raw.notes)
-    derived, lowered = _components(table, present, decomposition, index, zenith, cosz,
-                                   pvlib.atmosphere.alt2pres(where["altitude"]), fail)
+    derived, lowered = _components(
+        table,
+        present,
+        decomposition,
+        index,
+        zenith,
+        cosz,
+        pvlib.atmosphere.alt2pres(where["altitude"]),
+        fail,
+    )
     if lowered:
-        notes.append(f"measured dni lowered to ghi / cos(zenith) at {_count(lowered, 'step')} where its beam "
-                     f"exceeded ghi (within the {BEAM_TOLERANCE:g} W/m^2 tolerance)")
+        notes.append(
+            f"measured dni lowered to ghi / cos(zenith) at {_count(lowered, 'step')} where its beam "
+            f"exceeded ghi (within the {BEAM_TOLERANCE:g} W/m^2 tolerance)"
+        )
     day = clear > 0
     if not derived:
         residual = np.abs(table["ghi"] - table["dni"] * np.maximum(cosz, 0.0) - table["dhi"])[day]
         residual = residual[np.isfinite(residual)]
         if residual.size:
-            notes.append(f"ghi, dni and dhi all measured: ghi is their component sum dni cos(zenith) + dhi, the "
-                         f"best estimate of the global light (BSRN operations manual); the measured ghi differs by "
-                         f"{np.percentile(residual, 99):.1f} W/m^2 at the 99th percentile in daylight, "
-                         f"{residual.max():.1f} W/m^2 at most")
+            notes.append(
+                f"ghi, dni and dhi all measured: ghi is their component sum dni cos(zenith) + dhi, the "
+                f"best estimate of the global light (BSRN operations manual); the measured ghi differs by "
+                f"{np.percentile(residual, 99):.1f} W/m^2 at the 99th percentile in daylight, "
+                f"{residual.max():.1f} W/m^2 at most"
+            )
         # One light a study's steps can close: the component sum, where both components exist.
         both = np.isfinite(table["dni"]) & np.isfinite(table["dhi"]) & day
-        table["ghi"] = np.where(both, table["dni"] * np.maximum(cosz, 0.0) + table["dhi"], table["ghi"])
-    for key, default, unit in (("temp_air", DEFAULT_TEMP_AIR, "C"), ("wind_speed", DEFAULT_WIND_SPEED, "m/s")):
+        table["ghi"] = np.where(
+            both, table["dni"] * np.maximum(cosz, 0.0) + table["dhi"], table["ghi"]
+        )
+    for key, default, unit in (
+        ("temp_air", DEFAULT_TEMP_AIR, "C"),
+        ("wind_speed", DEFAULT_WIND_SPEED, "m/s"),
+    ):
         if key not in table or not np.isfinite(table[key]).any():
             table[key] = np.full(index.size, default)
             notes.append(f"no {_WORDS[key]} in the file: {default:g} {unit} throughout")
-    gaps, filled, flagged = _fill(table, day, clear, cosz, step / pd.Timedelta(minutes=1), float(max_gap_min), index)
+    gaps, filled, flagged = _fill(
+        table, day, clear, cosz, step / pd.Timedelta(minutes=1), float(max_gap_min), index
+    )
     if raw.dropped:
         notes.append(f"{raw.dropped} values flagged by the network's QC made missing")
     if dropped:
-        notes.append("values beyond physical bounds made missing: "
-                     + ", ".join(f"{key} {count}" for key, count in dropped.items()))
+        notes.append(
+            "values beyond physical bounds made missing: "
+            + ", ".join(f"{key} {count}" for key, count in dropped.items())
+        )
     # No light while the clear sky is dark (the sun below the horizon): a thermopile's night
     # offset would otherwise light a study's panels at night.
     for key in ("ghi", "dni", "dhi"):

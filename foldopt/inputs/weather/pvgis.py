@@ -37,15 +37,23 @@ def read(path: str, text: str, year: int, fail):
     try:
         source = json.loads(text)
     except json.JSONDecodeError as error:
-        raise fail(f"not valid JSON: {error.msg} at line {error.lineno} column {error.colno}") from None
+        raise fail(
+            f"not valid JSON: {error.msg} at line {error.lineno} column {error.colno}"
+        ) from None
     outputs = source.get("outputs") if isinstance(source, dict) else None
     hourly = outputs.get("tmy_hourly") if isinstance(outputs, dict) else None
     if not isinstance(hourly, list):
         raise fail("not a PVGIS TMY file: no outputs.tmy_hourly list of hourly records")
     if not hourly:
         raise fail("no data rows: outputs.tmy_hourly is empty")
-    data, meta = read_with_pvlib(fail, FORMAT.label, "read_pvgis_tmy", io.StringIO(text),
-                                 pvgis_format="json", map_variables=True)
+    data, meta = read_with_pvlib(
+        fail,
+        FORMAT.label,
+        "read_pvgis_tmy",
+        io.StringIO(text),
+        pvgis_format="json",
+        map_variables=True,
+    )
     inputs = meta.get("inputs") or {}
     location = inputs.get("location", inputs)
     for key in ("latitude", "longitude", "elevation"):
@@ -56,8 +64,10 @@ def read(path: str, text: str, year: int, fail):
     leap = (utc.month == 2) & (utc.day == 29)
     if leap.any() and not pd.Timestamp(year=year, month=1, day=1).is_leap_year:
         first = int(np.flatnonzero(leap)[0])
-        raise fail(f"record {first + 1} ({utc[first]:%Y-%m-%d %H:%M} UTC): February 29: {year} has none"
-                   + (f"; and {leap.sum() - 1} more rows" if leap.sum() > 1 else ""))
+        raise fail(
+            f"record {first + 1} ({utc[first]:%Y-%m-%d %H:%M} UTC): February 29: {year} has none"
+            + (f"; and {leap.sum() - 1} more rows" if leap.sum() > 1 else "")
+        )
     index = pd.DatetimeIndex(utc.map(lambda t: t.replace(year=year)))
 
     def where(i: int) -> str:
@@ -83,8 +93,13 @@ def site(meta: dict) -> dict:
     inputs = meta["inputs"]
     location = inputs.get("location", inputs)
     latitude, longitude = float(location["latitude"]), float(location["longitude"])
-    return {"name": None, "latitude": latitude, "longitude": longitude,
-            "altitude": float(location["elevation"]), "timezone": offset_zone(round(longitude / 15.0))}
+    return {
+        "name": None,
+        "latitude": latitude,
+        "longitude": longitude,
+        "altitude": float(location["elevation"]),
+        "timezone": offset_zone(round(longitude / 15.0)),
+    }
 
 
 def to_local(frame: pd.DataFrame, site: dict, year: int) -> pd.DataFrame:
@@ -110,7 +125,20 @@ def to_local(frame: pd.DataFrame, site: dict, year: int) -> pd.DataFrame:
 
 
 FORMAT = WeatherFormat(
-    name="pvgis", label="PVGIS TMY", interval_label="start", suffixes=(".json",),
+    name="pvgis",
+    label="PVGIS TMY",
+    interval_label="start",
+    suffixes=(".json",),
     signature=r'\A\s*\{\s*"(?:inputs|outputs|meta)"',
-    columns={"ghi": "G(h)", "dni": "Gb(n)", "dhi": "Gd(h)", "temp_air": "T2m", "wind_speed": "WS10m"},
-    columns_at="outputs.tmy_hourly", read=read, site=site, to_local=to_local)
+    columns={
+        "ghi": "G(h)",
+        "dni": "Gb(n)",
+        "dhi": "Gd(h)",
+        "temp_air": "T2m",
+        "wind_speed": "WS10m",
+    },
+    columns_at="outputs.tmy_hourly",
+    read=read,
+    site=site,
+    to_local=to_local,
+)

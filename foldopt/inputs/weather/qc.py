@@ -100,8 +100,9 @@ TEMP_AIR_BOUNDS = (-90.0, 65.0)
 WIND_SPEED_BOUNDS = (0.0, 120.0)
 
 
-def check_rows(data: pd.DataFrame, fmt: WeatherFormat, index: pd.DatetimeIndex, site: dict, where,
-               fail) -> pd.DataFrame:
+def check_rows(
+    data: pd.DataFrame, fmt: WeatherFormat, index: pd.DatetimeIndex, site: dict, where, fail
+) -> pd.DataFrame:
     """The rows' checks (module docstring).
 
     Parameters
@@ -143,27 +144,43 @@ def check_rows(data: pd.DataFrame, fmt: WeatherFormat, index: pd.DatetimeIndex, 
 
     for key in ("ghi", "dni", "dhi"):
         if key not in data.columns:
-            raise fail(f"column {key} missing: no {fmt.columns[key]!r} in {fmt.columns_at} of this {kind} file")
+            raise fail(
+                f"column {key} missing: no {fmt.columns[key]!r} in {fmt.columns_at} of this {kind} file"
+            )
     # Time: hourly and strictly increasing once the year is coerced.
     step = np.diff(index.as_unit("ns").asi8)
     hour = HOUR.value
-    refuse(index.duplicated(keep="first"), lambda i: f"the same hour as {where(int(np.argmax(index == index[i])))}")
+    refuse(
+        index.duplicated(keep="first"),
+        lambda i: f"the same hour as {where(int(np.argmax(index == index[i])))}",
+    )
     refuse(np.r_[False, step < 0], lambda i: f"before {at(i - 1)}: rows must run forward in time")
-    refuse(np.r_[False, step > hour], lambda i: f"{step[i - 1] / hour:g} h after {at(i - 1)}: rows must be hourly")
-    refuse(np.r_[False, (step > 0) & (step < hour)],
-           lambda i: f"{step[i - 1] / 6e10:g} min after {at(i - 1)}: rows must be hourly")
+    refuse(
+        np.r_[False, step > hour],
+        lambda i: f"{step[i - 1] / hour:g} h after {at(i - 1)}: rows must be hourly",
+    )
+    refuse(
+        np.r_[False, (step > 0) & (step < hour)],
+        lambda i: f"{step[i - 1] / 6e10:g} min after {at(i - 1)}: rows must be hourly",
+    )
     # Values: finite numbers; a column of air temperature or wind speed may be absent altogether.
     values = {}
     for key in COLUMNS:
         if key not in data.columns:
-            values[key] = np.full(len(data), DEFAULT_TEMP_AIR if key == "temp_air" else DEFAULT_WIND_SPEED)
+            values[key] = np.full(
+                len(data), DEFAULT_TEMP_AIR if key == "temp_air" else DEFAULT_WIND_SPEED
+            )
             continue
         raw = data[key]
         values[key] = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
 
         def not_finite(i, key=key, raw=raw):
             text = raw.iloc[i]
-            if text is None or (isinstance(text, float) and math.isnan(text)) or not str(text).strip():
+            if (
+                text is None
+                or (isinstance(text, float) and math.isnan(text))
+                or not str(text).strip()
+            ):
                 return f"{key} has no value (empty or NaN)"
             return f"{key} = {str(text).strip()[:20]}: not a finite number"
 
@@ -181,33 +198,56 @@ def check_rows(data: pd.DataFrame, fmt: WeatherFormat, index: pd.DatetimeIndex, 
     extra = np.asarray(pvlib.irradiance.get_extra_radiation(centres.day_of_year), dtype=float)
     for key in ("ghi", "dni", "dhi"):
         refuse(values[key] < 0, lambda i, key=key: f"{value(key, i)}: must be >= 0")
-    refuse(ghi > MAX_GHI_PER_EXTRA * extra,
-           lambda i: f"{value('ghi', i)}: must be <= {MAX_GHI_PER_EXTRA * extra[i]:.0f} W/m^2, "
-                     f"{MAX_GHI_PER_EXTRA:g} times the extraterrestrial normal irradiance that day")
-    refuse(dni > MAX_DNI_PER_EXTRA * extra,
-           lambda i: f"{value('dni', i)}: must be <= {MAX_DNI_PER_EXTRA * extra[i]:.0f} W/m^2, "
-                     f"the extraterrestrial normal irradiance that day")
+    refuse(
+        ghi > MAX_GHI_PER_EXTRA * extra,
+        lambda i: (
+            f"{value('ghi', i)}: must be <= {MAX_GHI_PER_EXTRA * extra[i]:.0f} W/m^2, "
+            f"{MAX_GHI_PER_EXTRA:g} times the extraterrestrial normal irradiance that day"
+        ),
+    )
+    refuse(
+        dni > MAX_DNI_PER_EXTRA * extra,
+        lambda i: (
+            f"{value('dni', i)}: must be <= {MAX_DNI_PER_EXTRA * extra[i]:.0f} W/m^2, "
+            f"the extraterrestrial normal irradiance that day"
+        ),
+    )
     for key, (lo, hi) in (("temp_air", TEMP_AIR_BOUNDS), ("wind_speed", WIND_SPEED_BOUNDS)):
-        refuse((values[key] < lo) | (values[key] > hi),
-               lambda i, key=key, lo=lo, hi=hi: f"{value(key, i)}: must be in [{lo:g}, {hi:g}] {_UNITS[key]}")
+        refuse(
+            (values[key] < lo) | (values[key] > hi),
+            lambda i, key=key, lo=lo, hi=hi: (
+                f"{value(key, i)}: must be in [{lo:g}, {hi:g}] {_UNITS[key]}"
+            ),
+        )
     fraction, absolute = DHI_TOLERANCE
-    refuse(dhi > (1.0 + fraction) * ghi + absolute,
-           lambda i: f"{value('dhi', i)} exceeds {value('ghi', i)}: the diffuse light is part of the global "
-                     f"(tolerance {fraction:.0%} + {absolute:g} W/m^2)")
+    refuse(
+        dhi > (1.0 + fraction) * ghi + absolute,
+        lambda i: (
+            f"{value('dhi', i)} exceeds {value('ghi', i)}: the diffuse light is part of the global "
+            f"(tolerance {fraction:.0%} + {absolute:g} W/m^2)"
+        ),
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
         zenith = pvlib.solarposition.get_solarposition(
-            centres, site["latitude"], site["longitude"], site["altitude"])["zenith"].to_numpy(dtype=float)
+            centres, site["latitude"], site["longitude"], site["altitude"]
+        )["zenith"].to_numpy(dtype=float)
     beam = dni * np.maximum(np.cos(np.radians(zenith)), 0.0)
-    refuse(beam > ghi + BEAM_TOLERANCE,
-           lambda i: f"{value('dni', i)} at solar zenith {zenith[i]:.1f} deg brings {beam[i]:.0f} W/m^2 to "
-                     f"the ground, more than {value('ghi', i)} (tolerance {BEAM_TOLERANCE:g} W/m^2): "
-                     f"is the file's site, clock or a column wrong?")
+    refuse(
+        beam > ghi + BEAM_TOLERANCE,
+        lambda i: (
+            f"{value('dni', i)} at solar zenith {zenith[i]:.1f} deg brings {beam[i]:.0f} W/m^2 to "
+            f"the ground, more than {value('ghi', i)} (tolerance {BEAM_TOLERANCE:g} W/m^2): "
+            f"is the file's site, clock or a column wrong?"
+        ),
+    )
     # The total sky cover, where the format has one: only a cloud ensemble reads it, so a value
     # out of [0, 1] (a missing-value marker: EPW's 99) is unknown, not a fault.
     cover = np.full(len(data), np.nan)
     if fmt.cover is not None and fmt.cover[0] in data.columns:
-        cover = pd.to_numeric(data[fmt.cover[0]], errors="coerce").to_numpy(dtype=float) / fmt.cover[1]
+        cover = (
+            pd.to_numeric(data[fmt.cover[0]], errors="coerce").to_numpy(dtype=float) / fmt.cover[1]
+        )
         cover = np.where((cover >= 0.0) & (cover <= 1.0), cover, np.nan)
     values["cloud_cover"] = cover
     return pd.DataFrame(values, index=index.rename(None))

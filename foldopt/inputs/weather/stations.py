@@ -132,7 +132,9 @@ class StationData:
     notes: tuple = ()
 
 
-def _columns(data: pd.DataFrame, names: dict, fail, flags: dict | None = None) -> tuple[pd.DataFrame, int]:
+def _columns(
+    data: pd.DataFrame, names: dict, fail, flags: dict | None = None
+) -> tuple[pd.DataFrame, int]:
     """``names`` (column -> pvlib's column) of ``data`` as floats, values whose ``flags``
     (column -> flag column) are not 0 made missing, and how many were; a cell that is no number
     (a word where a value or a flag belongs) is refused, as the generic CSV's reader refuses it."""
@@ -162,12 +164,17 @@ def _numbers(data: pd.DataFrame, source: str, key: str, fail) -> np.ndarray:
     numbers = pd.to_numeric(column, errors="coerce")
     if not pd.api.types.is_numeric_dtype(column):
         text = column.astype(str).str.strip()
-        bad = np.flatnonzero(numbers.isna().to_numpy() & column.notna().to_numpy()
-                             & ~text.str.lower().isin(_BLANK).to_numpy())
+        bad = np.flatnonzero(
+            numbers.isna().to_numpy()
+            & column.notna().to_numpy()
+            & ~text.str.lower().isin(_BLANK).to_numpy()
+        )
         if bad.size:
             more = f"; and {bad.size - 1} more rows" if bad.size > 1 else ""
             stamp = pd.Timestamp(data.index[bad[0]]).isoformat(sep=" ")
-            raise fail(f"row {bad[0] + 1} (stamped {stamp}): {key} = {text.iloc[bad[0]][:20]!r}: not a number{more}")
+            raise fail(
+                f"row {bad[0] + 1} (stamped {stamp}): {key} = {text.iloc[bad[0]][:20]!r}: not a number{more}"
+            )
     return numbers.to_numpy(dtype=float)
 
 
@@ -202,14 +209,22 @@ def read_surfrad(path: str, fail, zone=None) -> StationData:
         pick = np.flatnonzero(np.isfinite(zenith) & (zenith < 85.0))[::30]
         if pick.size:
             times = pd.DatetimeIndex(data.index[pick]) - pd.Timedelta(seconds=30)
-            error = [np.nanmean(np.abs(_zenith(times, latitude, lon) - zenith[pick]))
-                     for lon in (longitude, -longitude)]
+            error = [
+                np.nanmean(np.abs(_zenith(times, latitude, lon) - zenith[pick]))
+                for lon in (longitude, -longitude)
+            ]
             if error[1] < error[0]:
-                notes = (f"the file's longitude {longitude:g} is degrees west (its solar zenith column says so): "
-                         f"read as {-longitude:g}",)
+                notes = (
+                    f"the file's longitude {longitude:g} is degrees west (its solar zenith column says so): "
+                    f"read as {-longitude:g}",
+                )
                 longitude = -longitude
-    site = {"name": str(meta.get("name") or "").strip() or None, "latitude": latitude, "longitude": longitude,
-            "altitude": float(meta["elevation"])}
+    site = {
+        "name": str(meta.get("name") or "").strip() or None,
+        "latitude": latitude,
+        "longitude": longitude,
+        "altitude": float(meta["elevation"]),
+    }
     return StationData(frame, site, None, dropped, notes)
 
 
@@ -251,8 +266,9 @@ def read_midc(path: str, fail, zone=None) -> StationData:
         raise fail(f"not a readable MIDC file ({reason(error)})") from error
     raw = "DOY" in header and "Year" in header
     # A raw file's header may name fewer columns than its rows hold: read those it names.
-    data = read_with_pvlib(fail, "MIDC", "read_midc", path, raw_data=raw,
-                           usecols=range(len(header)) if raw else None)
+    data = read_with_pvlib(
+        fail, "MIDC", "read_midc", path, raw_data=raw, usecols=range(len(header)) if raw else None
+    )
     columns = [str(name) for name in data.columns]
     maps = pvlib.iotools.midc.MIDC_VARIABLE_MAP.values()
     best = max(maps, key=lambda names: sum(name in columns for name in names))
@@ -268,8 +284,13 @@ def read_midc(path: str, fail, zone=None) -> StationData:
     frame, _ = _columns(data, names, fail)
     frame = frame.where(frame > MIDC_MISSING)
     used = ", ".join(f"{key} {source!r}" for key, source in names.items())
-    return StationData(frame, {}, _hours(frame.index[0]) if len(frame) else None, 0,
-                       (f"MIDC columns read: {used or 'none of foldopt'}",))
+    return StationData(
+        frame,
+        {},
+        _hours(frame.index[0]) if len(frame) else None,
+        0,
+        (f"MIDC columns read: {used or 'none of foldopt'}",),
+    )
 
 
 def read_srml(path: str, fail, zone=None) -> StationData:
@@ -290,13 +311,20 @@ def read_srml(path: str, fail, zone=None) -> StationData:
     data = read_with_pvlib(fail, "SRML", "read_srml", path)
     names = {}
     for key in COLUMNS:
-        found = sorted((column for column in map(str, data.columns) if re.fullmatch(fr"{key}_\d+", column)),
-                       key=lambda column: int(column.rsplit("_", 1)[1]))
+        found = sorted(
+            (column for column in map(str, data.columns) if re.fullmatch(rf"{key}_\d+", column)),
+            key=lambda column: int(column.rsplit("_", 1)[1]),
+        )
         if found:
             names[key] = found[0]
     frame, _ = _columns(data, names, fail)
-    return StationData(frame, {}, _hours(frame.index[0]) if len(frame) else None, 0,
-                       (f"SRML columns read: {', '.join(f'{k} {v!r}' for k, v in names.items())}",))
+    return StationData(
+        frame,
+        {},
+        _hours(frame.index[0]) if len(frame) else None,
+        0,
+        (f"SRML columns read: {', '.join(f'{k} {v!r}' for k, v in names.items())}",),
+    )
 
 
 def read_bsrn(path: str, fail, zone=None) -> StationData:
@@ -316,11 +344,17 @@ def read_bsrn(path: str, fail, zone=None) -> StationData:
     """
     data, meta = read_with_pvlib(fail, "BSRN", "read_bsrn", path)
     if len(data) == 0 or "latitude" not in meta:
-        raise fail("no LR0100 record (basic measurements) and station LR0004: not a BSRN station-to-archive file")
+        raise fail(
+            "no LR0100 record (basic measurements) and station LR0004: not a BSRN station-to-archive file"
+        )
     frame, _ = _columns(data, {key: key for key in ("ghi", "dni", "dhi", "temp_air")}, fail)
     number = meta.get("station identification number")
-    site = {"name": f"BSRN station {number}" if number is not None else None, "latitude": float(meta["latitude"]),
-            "longitude": float(meta["longitude"]), "altitude": float(meta["altitude"])}
+    site = {
+        "name": f"BSRN station {number}" if number is not None else None,
+        "latitude": float(meta["latitude"]),
+        "longitude": float(meta["longitude"]),
+        "altitude": float(meta["altitude"]),
+    }
     return StationData(frame, site)
 
 
@@ -340,10 +374,18 @@ def read_solrad(path: str, fail, zone=None) -> StationData:
     StationData
     """
     data, meta = read_with_pvlib(fail, "SOLRAD", "read_solrad", path)
-    frame, dropped = _columns(data, {key: key for key in ("ghi", "dni", "dhi")}, fail,
-                              {key: f"{key}_flag" for key in ("ghi", "dni", "dhi")})
-    site = {"name": str(meta.get("station_name") or "").strip() or None, "latitude": float(meta["latitude"]),
-            "longitude": float(meta["longitude"]), "altitude": float(meta["altitude"])}
+    frame, dropped = _columns(
+        data,
+        {key: key for key in ("ghi", "dni", "dhi")},
+        fail,
+        {key: f"{key}_flag" for key in ("ghi", "dni", "dhi")},
+    )
+    site = {
+        "name": str(meta.get("station_name") or "").strip() or None,
+        "latitude": float(meta["latitude"]),
+        "longitude": float(meta["longitude"]),
+        "altitude": float(meta["altitude"]),
+    }
     return StationData(frame, site, float(meta["TZ"]), dropped)
 
 
@@ -365,19 +407,31 @@ def read_crn(path: str, fail, zone=None) -> StationData:
     data = read_with_pvlib(fail, "CRN", "read_crn", path)
     if len(data) == 0:
         raise fail("no data rows")
-    frame, dropped = _columns(data, {"ghi": "ghi", "temp_air": "temp_air", "wind_speed": "wind_speed"}, fail,
-                              {"ghi": "ghi_flag", "wind_speed": "wind_speed_flag"})
+    frame, dropped = _columns(
+        data,
+        {"ghi": "ghi", "temp_air": "temp_air", "wind_speed": "wind_speed"},
+        fail,
+        {"ghi": "ghi_flag", "wind_speed": "wind_speed_flag"},
+    )
     first = data.iloc[0]
     latitude, longitude = float(first["latitude"]), float(first["longitude"])
-    local = pd.to_datetime(f"{int(first['LST_DATE'])}{int(first['LST_TIME']):04d}", format="%Y%m%d%H%M")
+    local = pd.to_datetime(
+        f"{int(first['LST_DATE'])}{int(first['LST_TIME']):04d}", format="%Y%m%d%H%M"
+    )
     utc = pd.Timestamp(data.index[0]).tz_localize(None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         altitude = float(pvlib.location.lookup_altitude(latitude, longitude))
-    site = {"name": f"USCRN station {first['WBANNO']}", "latitude": latitude, "longitude": longitude,
-            "altitude": altitude}
-    notes = (f"altitude {altitude:g} m from pvlib location.lookup_altitude (a CRN file holds none); "
-             "wind speed measured 1.5 m above ground",)
+    site = {
+        "name": f"USCRN station {first['WBANNO']}",
+        "latitude": latitude,
+        "longitude": longitude,
+        "altitude": altitude,
+    }
+    notes = (
+        f"altitude {altitude:g} m from pvlib location.lookup_altitude (a CRN file holds none); "
+        "wind speed measured 1.5 m above ground",
+    )
     return StationData(frame, site, (local - utc).total_seconds() / 3600.0, dropped, notes)
 
 
@@ -401,14 +455,18 @@ def read_csv(path: str, fail, zone=None) -> StationData:
     StationData
     """
     try:
-        table = pd.read_csv(path, dtype=str, comment="#", skipinitialspace=True, keep_default_na=False)
+        table = pd.read_csv(
+            path, dtype=str, comment="#", skipinitialspace=True, keep_default_na=False
+        )
     except Exception as error:  # any failure of pandas is an unreadable file
         raise fail(f"not a readable CSV file ({reason(error)})") from error
     named = {str(column).strip().lower(): column for column in table.columns}
     if "timestamp" not in named:
         held = printable(", ".join(str(column) for column in table.columns[:8]), 120)
-        raise fail(f"no timestamp column: a measured CSV file's header names timestamp, ghi, dni, dhi and optionally "
-                   f"temp_air, wind_speed; this one names {held or 'nothing'}")
+        raise fail(
+            f"no timestamp column: a measured CSV file's header names timestamp, ghi, dni, dhi and optionally "
+            f"temp_air, wind_speed; this one names {held or 'nothing'}"
+        )
     if len(table) == 0:
         raise fail("no data rows after the header")
     text = table[named["timestamp"]].str.strip()
@@ -419,20 +477,32 @@ def read_csv(path: str, fail, zone=None) -> StationData:
             more = f"; and {bad.size - 1} more rows" if bad.size > 1 else ""
             raise fail(f"row {bad[0] + 1}: {describe(bad[0])}{more}")
 
-    refuse(~text.str.contains(_TIME), lambda i: f"timestamp = {text.iloc[i][:30]!r}: not an ISO 8601 date and time")
+    refuse(
+        ~text.str.contains(_TIME),
+        lambda i: f"timestamp = {text.iloc[i][:30]!r}: not an ISO 8601 date and time",
+    )
     # The offset: of a stamp's time, after its clock time (a date's own dashes are no offset).
     offset = text.str.split(r"[T ]", n=1, regex=True).str[-1].str.contains(_OFFSET)
     aware = bool(offset.iloc[0])
-    refuse(offset != aware, lambda i: f"timestamp {text.iloc[i][:40]!r} {'has no' if aware else 'has a'} UTC offset, "
-                                      f"unlike row 1's: give every stamp an offset or none")
+    refuse(
+        offset != aware,
+        lambda i: (
+            f"timestamp {text.iloc[i][:40]!r} {'has no' if aware else 'has a'} UTC offset, "
+            f"unlike row 1's: give every stamp an offset or none"
+        ),
+    )
     stamps = pd.to_datetime(text, format="ISO8601", utc=aware, errors="coerce")
-    refuse(stamps.isna(), lambda i: f"timestamp = {text.iloc[i][:30]!r}: not an ISO 8601 date and time")
+    refuse(
+        stamps.isna(), lambda i: f"timestamp = {text.iloc[i][:30]!r}: not an ISO 8601 date and time"
+    )
     if aware:
         file_zone = _hours(pd.Timestamp(text.iloc[0]))
         index = pd.DatetimeIndex(stamps).tz_convert(fixed_zone(file_zone))
     else:
         if zone is None:
-            raise fail("the timestamps carry no UTC offset: give timezone, a fixed offset like 'UTC-07:00'")
+            raise fail(
+                "the timestamps carry no UTC offset: give timezone, a fixed offset like 'UTC-07:00'"
+            )
         file_zone = zone
         index = pd.DatetimeIndex(stamps).tz_localize(fixed_zone(zone))
     values = {}
@@ -442,7 +512,10 @@ def read_csv(path: str, fail, zone=None) -> StationData:
         cells = table[named[key]].str.strip()
         numbers = pd.to_numeric(cells, errors="coerce")
         blank = cells.str.lower().isin(("", "nan", "na", "null"))
-        refuse(numbers.isna() & ~blank, lambda i, key=key, cells=cells: f"{key} = {cells.iloc[i][:20]!r}: not a number")
+        refuse(
+            numbers.isna() & ~blank,
+            lambda i, key=key, cells=cells: f"{key} = {cells.iloc[i][:20]!r}: not a number",
+        )
         values[key] = numbers.to_numpy(dtype=float)
     return StationData(pd.DataFrame(values, index=index), {}, file_zone)
 
@@ -464,15 +537,38 @@ def fixed_zone(hours: float) -> datetime.timezone:
 
 #: The measured weather formats by name, in the order of :data:`foldopt.names.WEATHER_FORMATS`
 #: (whose descriptions help and the docs print).
-STATION_FORMATS = {entry.name: entry for entry in (
-    # SURFRAD's and SOLRAD's second line: latitude, longitude, elevation (SURFRAD "m", SOLRAD its
-    # UTC offset), "version"; MIDC's header, daily or raw; SRML's: station, year, elements, by tabs;
-    # BSRN's first record; CRN's rows: WBAN, UTC date and time, local date and time.
-    StationFormat("surfrad", "end", read_surfrad, True, r"\A[^\n]*\n\s*-?[\d.]+\s+-?[\d.]+\s+\d+\s+m\s+version"),
-    StationFormat("midc", "end", read_midc, False, r"\A(?:DATE \(MM/DD/YYYY\),|[^\n]*\bYear,DOY,)"),
-    StationFormat("srml", "start", read_srml, False, r"\A\d+\t\d{4}\t"),
-    StationFormat("bsrn", "start", read_bsrn, True, r"\A\*[CU]0001"),
-    StationFormat("solrad", "end", read_solrad, True, r"\A[^\n]*\n\s*-?[\d.]+\s+-?[\d.]+\s+\d+\s+-?[\d.]+\s+version"),
-    StationFormat("crn", "end", read_crn, True, r"\A\d{5} \d{8} \d{4} \d{8} \d{4} "),
-    StationFormat("csv", "end", read_csv, False, r"(?i)\A(?:#[^\n]*\n|\s*\n)*(?:[^,\n]*,)*\s*timestamp\s*(?:,|\r?\n)"),
-)}
+STATION_FORMATS = {
+    entry.name: entry
+    for entry in (
+        # SURFRAD's and SOLRAD's second line: latitude, longitude, elevation (SURFRAD "m", SOLRAD its
+        # UTC offset), "version"; MIDC's header, daily or raw; SRML's: station, year, elements, by tabs;
+        # BSRN's first record; CRN's rows: WBAN, UTC date and time, local date and time.
+        StationFormat(
+            "surfrad",
+            "end",
+            read_surfrad,
+            True,
+            r"\A[^\n]*\n\s*-?[\d.]+\s+-?[\d.]+\s+\d+\s+m\s+version",
+        ),
+        StationFormat(
+            "midc", "end", read_midc, False, r"\A(?:DATE \(MM/DD/YYYY\),|[^\n]*\bYear,DOY,)"
+        ),
+        StationFormat("srml", "start", read_srml, False, r"\A\d+\t\d{4}\t"),
+        StationFormat("bsrn", "start", read_bsrn, True, r"\A\*[CU]0001"),
+        StationFormat(
+            "solrad",
+            "end",
+            read_solrad,
+            True,
+            r"\A[^\n]*\n\s*-?[\d.]+\s+-?[\d.]+\s+\d+\s+-?[\d.]+\s+version",
+        ),
+        StationFormat("crn", "end", read_crn, True, r"\A\d{5} \d{8} \d{4} \d{8} \d{4} "),
+        StationFormat(
+            "csv",
+            "end",
+            read_csv,
+            False,
+            r"(?i)\A(?:#[^\n]*\n|\s*\n)*(?:[^,\n]*,)*\s*timestamp\s*(?:,|\r?\n)",
+        ),
+    )
+}

@@ -10,8 +10,17 @@ from functools import partial
 
 import pandas as pd
 
-from foldopt.inputs.weather.formats import (WeatherFormat, check_site_fields, header_fields, header_site, line_locator,
-                                            read_with_pvlib, refuse_february_29, table_index, table_rows)
+from foldopt.inputs.weather.formats import (
+    WeatherFormat,
+    check_site_fields,
+    header_fields,
+    header_site,
+    line_locator,
+    read_with_pvlib,
+    refuse_february_29,
+    table_index,
+    table_rows,
+)
 
 #: Lines before the first row.
 HEADER_LINES = 2
@@ -31,8 +40,10 @@ def check_header(fail, first_line: str) -> None:
     fields = header_fields(fail, FORMAT.label, HEADER_FIELDS, first_line)
     usaf = fields[0].strip()
     if not usaf.lstrip("+-").isdigit():
-        raise fail(f"line 1: USAF = {usaf[:20]!r}: not a station number, so not a TMY3 header "
-                   f"({', '.join(HEADER_FIELDS)})")
+        raise fail(
+            f"line 1: USAF = {usaf[:20]!r}: not a station number, so not a TMY3 header "
+            f"({', '.join(HEADER_FIELDS)})"
+        )
     check_site_fields(fail, HEADER_FIELDS, fields)
 
 
@@ -57,10 +68,14 @@ def read(path: str, text: str, year: int, fail):
     check_header(fail, lines[0])
     line_of = table_rows(lines, HEADER_LINES, FORMAT.label, fail)
     # pvlib reads a TMY3 file's February 29 as March 1: a leap year's hours would collide.
-    refuse_february_29(fail, [n for n in line_of if lines[n - 1].lstrip('"').startswith("02/29/")],
-                       "pvlib reads a TMY3 file's February 29 as March 1")
-    data, meta = read_with_pvlib(fail, FORMAT.label, "read_tmy3", path, coerce_year=year,
-                                 map_variables=True)
+    refuse_february_29(
+        fail,
+        [n for n in line_of if lines[n - 1].lstrip('"').startswith("02/29/")],
+        "pvlib reads a TMY3 file's February 29 as March 1",
+    )
+    data, meta = read_with_pvlib(
+        fail, FORMAT.label, "read_tmy3", path, coerce_year=year, map_variables=True
+    )
     index = table_index(data, HEADER_LINES, fail)
     last = index[-1]
     if last.year == year + 1 and (last.month, last.day, last.hour, last.minute) != (1, 1, 0, 0):
@@ -71,9 +86,20 @@ def read(path: str, text: str, year: int, fail):
 
 
 FORMAT = WeatherFormat(
-    name="tmy3", label="TMY3", interval_label="end", suffixes=(".csv",),
+    name="tmy3",
+    label="TMY3",
+    interval_label="end",
+    suffixes=(".csv",),
     signature=r"\A[^\n]*\n\s*Date \(MM/DD/YYYY\),Time",
-    columns={"ghi": "GHI (W/m^2)", "dni": "DNI (W/m^2)", "dhi": "DHI (W/m^2)", "temp_air": "Dry-bulb (C)",
-             "wind_speed": "Wspd (m/s)"},
-    columns_at="line 2, the column names", read=read, site=partial(header_site, name="Name"),
-    cover=("TotCld (tenths)", 10.0))
+    columns={
+        "ghi": "GHI (W/m^2)",
+        "dni": "DNI (W/m^2)",
+        "dhi": "DHI (W/m^2)",
+        "temp_air": "Dry-bulb (C)",
+        "wind_speed": "Wspd (m/s)",
+    },
+    columns_at="line 2, the column names",
+    read=read,
+    site=partial(header_site, name="Name"),
+    cover=("TotCld (tenths)", 10.0),
+)

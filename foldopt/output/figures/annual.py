@@ -14,7 +14,12 @@ from foldopt.physics.connections import SWITCH_STATES
 
 MONTH_NAMES = ("J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D")
 #: The colour of each design in the month-by-month bars and the distribution's boxes.
-DESIGN_COLOURS = {"flat": "0.35", "twofold": "tab:blue", "tracker": "0.7", "tracker-net": "tab:orange"}
+DESIGN_COLOURS = {
+    "flat": "0.35",
+    "twofold": "tab:blue",
+    "tracker": "0.7",
+    "tracker-net": "tab:orange",
+}
 
 
 def _designs(table: pd.DataFrame) -> list[str]:
@@ -43,8 +48,20 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, study=None, ax=N
     fig, ax = new_axes(ax, (7, 4.5))
     colours = matplotlib.colormaps["viridis"](np.linspace(0, 0.85, 8))
     for (load, rows), colour in zip(by_angle.groupby("p_load_w"), colours, strict=False):
-        ax.plot(rows["fold_angle_deg"], rows["mean_t_solar_h"], color=colour, label=f"mean, {load_label(study, load)}")
-        ax.plot(rows["fold_angle_deg"], rows["objective_h"], color=colour, ls="--", lw=1, label="objective")
+        ax.plot(
+            rows["fold_angle_deg"],
+            rows["mean_t_solar_h"],
+            color=colour,
+            label=f"mean, {load_label(study, load)}",
+        )
+        ax.plot(
+            rows["fold_angle_deg"],
+            rows["objective_h"],
+            color=colour,
+            ls="--",
+            lw=1,
+            label="objective",
+        )
         chosen = rows[rows["chosen"]]
         ax.plot(chosen["fold_angle_deg"], chosen["objective_h"], "o", color=colour)
     ax.set_xlabel("fold angle Θ kept all year [deg] (180 = flat)")
@@ -83,11 +100,15 @@ def monthly_means(table: pd.DataFrame, loads_at_most: int = 4) -> pd.DataFrame:
     for column in ("site_name", "latitude", "longitude"):
         if column in table:
             # A grid point's site has no name: NaN, read from results.csv, is its own site.
-            same = table[column].isna() if pd.isna(first[column]) else table[column] == first[column]
+            same = (
+                table[column].isna() if pd.isna(first[column]) else table[column] == first[column]
+            )
             table = table[same]
     loads = sorted(table["p_load_w"].unique())[:loads_at_most]
     rows = table[table["p_load_w"].isin(loads) & table["design"].isin(_designs(table))]
-    means = rows.groupby(["p_load_w", "design", "month"])[["energy_harvested_wh", "t_solar_h"]].mean()
+    means = rows.groupby(["p_load_w", "design", "month"])[
+        ["energy_harvested_wh", "t_solar_h"]
+    ].mean()
     return means.assign(days=rows.groupby(["p_load_w", "design", "month"]).size()).reset_index()
 
 
@@ -125,7 +146,9 @@ def plot_monthly(table: pd.DataFrame, title: str, loads_at_most: int = 4, axes=N
         for i, design in enumerate(designs):
             monthly = means[(means["p_load_w"] == load) & (means["design"] == design)]
             x = monthly["month"].to_numpy() + (i - (len(designs) - 1) / 2) * width
-            energy_ax.bar(x, monthly["energy_harvested_wh"], width, color=DESIGN_COLOURS[design], label=design)
+            energy_ax.bar(
+                x, monthly["energy_harvested_wh"], width, color=DESIGN_COLOURS[design], label=design
+            )
             time_ax.bar(x, monthly["t_solar_h"], width, color=DESIGN_COLOURS[design], label=design)
         energy_ax.set_ylabel("energy harvested [Wh/day]")
         time_ax.set_ylabel(f"t_solar [h/day]\n{load_label(study, load)}", fontsize=8)
@@ -162,9 +185,14 @@ def plot_distribution(table: pd.DataFrame, title: str, ax=None, study=None):
     fig, ax = new_axes(ax, (max(6, 2.2 * len(loads) + 2), 4.5))
     width = 0.8 / len(designs)
     for i, design in enumerate(designs):
-        data = [table[(table.design == design) & (table.p_load_w == load)]["t_solar_h"].to_numpy() for load in loads]
+        data = [
+            table[(table.design == design) & (table.p_load_w == load)]["t_solar_h"].to_numpy()
+            for load in loads
+        ]
         positions = np.arange(len(loads)) + (i - (len(designs) - 1) / 2) * width
-        box = ax.boxplot(data, positions=positions, widths=width * 0.9, patch_artist=True, showfliers=False)
+        box = ax.boxplot(
+            data, positions=positions, widths=width * 0.9, patch_artist=True, showfliers=False
+        )
         for patch in box["boxes"]:
             patch.set_facecolor(DESIGN_COLOURS[design])
         ax.plot([], [], color=DESIGN_COLOURS[design], lw=6, label=design)
@@ -207,8 +235,12 @@ def plot_day_hour(extras: dict, key: str, title: str, label: str, ax=None):
     fig, ax = new_axes(ax, (9, 4.5))
     ax.set_facecolor("0.85")
     if key == "switch_state":
-        cmap = matplotlib.colors.ListedColormap(["0.15", "tab:orange", "tab:purple", "tab:green", "tab:brown"])
-        mesh = ax.pcolormesh(day_edges, hour_edges, shown, cmap=cmap, vmin=-1.5, vmax=3.5, shading="flat")
+        cmap = matplotlib.colors.ListedColormap(
+            ["0.15", "tab:orange", "tab:purple", "tab:green", "tab:brown"]
+        )
+        mesh = ax.pcolormesh(
+            day_edges, hour_edges, shown, cmap=cmap, vmin=-1.5, vmax=3.5, shading="flat"
+        )
         bar = ax.figure.colorbar(mesh, ax=ax, ticks=range(-1, 4))
         bar.ax.set_yticklabels(["off", *SWITCH_STATES])
     else:
@@ -241,11 +273,19 @@ def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
     matplotlib.axes.Axes
     """
     fig, ax = new_axes(ax, (7, 4.5))
-    first = values[(values["latitude"] == values["latitude"].iloc[0])
-                   & (values["longitude"] == values["longitude"].iloc[0])]
+    first = values[
+        (values["latitude"] == values["latitude"].iloc[0])
+        & (values["longitude"] == values["longitude"].iloc[0])
+    ]
     colours = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     for (load, rows), colour in zip(first.groupby("p_load_w"), colours, strict=False):
-        ax.plot(rows["settings"], rows["objective_h"], "o-", color=colour, label=f"twofold, {load_label(study, load)}")
+        ax.plot(
+            rows["settings"],
+            rows["objective_h"],
+            "o-",
+            color=colour,
+            label=f"twofold, {load_label(study, load)}",
+        )
         ax.axhline(rows["objective_flat_h"].iloc[0], color=colour, ls="--", lw=1)
         ax.axhline(rows["objective_tracker_h"].iloc[0], color=colour, ls=":", lw=1)
     ax.plot([], [], "k--", lw=1, label="flat panel")
@@ -262,14 +302,21 @@ def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
 #: An annual study's folder holds the first two, the next three where one fold angle is kept all
 #: year (an objective over the days) and the last where re-folding is valued.
 FIGURES = {
-    "daily_t_solar_distribution.png": FigureFile(plot_distribution, "daily t_solar of each design as box plots, per "
-                                                                    "load"),
-    "monthly_energy_t_solar.png": FigureFile(plot_monthly, "mean daily energy harvested and t_solar of every "
-                                                           "design, month by month"),
-    "annual_t_solar_vs_fold_angle.png": FigureFile(plot_annual_fold_angles, "the year's objective and mean daily "
-                                                                            "t_solar at each fold angle kept all year"),
+    "daily_t_solar_distribution.png": FigureFile(
+        plot_distribution, "daily t_solar of each design as box plots, per load"
+    ),
+    "monthly_energy_t_solar.png": FigureFile(
+        plot_monthly, "mean daily energy harvested and t_solar of every design, month by month"
+    ),
+    "annual_t_solar_vs_fold_angle.png": FigureFile(
+        plot_annual_fold_angles,
+        "the year's objective and mean daily t_solar at each fold angle kept all year",
+    ),
     "day_hour_power.png": FigureFile(plot_day_hour, "the twofold panel's power, day by hour"),
-    "day_hour_switch_state.png": FigureFile(plot_day_hour, "the connection the switch chooses, day by hour"),
-    "refold_value.png": FigureFile(plot_refold_value, "the objective of the best schedule of k fold settings a year "
-                                                      "against k"),
+    "day_hour_switch_state.png": FigureFile(
+        plot_day_hour, "the connection the switch chooses, day by hour"
+    ),
+    "refold_value.png": FigureFile(
+        plot_refold_value, "the objective of the best schedule of k fold settings a year against k"
+    ),
 }

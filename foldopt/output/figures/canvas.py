@@ -50,7 +50,9 @@ def for_files():
         _FOR_FILES.reset(token)
 
 
-def new_axes(ax, figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, squeeze: bool = True):
+def new_axes(
+    ax, figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, squeeze: bool = True
+):
     """The figure and Axes a plot draws on.
 
     Parameters

@@ -11,7 +11,12 @@ from foldopt.output.figures.canvas import FigureFile, new_axes
 from foldopt.studies.day import StudyResult
 
 #: The colour of each connection of the sub-panels (and of a switching state).
-STATE_COLOURS = {"east": "tab:orange", "parallel": "tab:green", "west": "tab:purple", "series": "tab:brown"}
+STATE_COLOURS = {
+    "east": "tab:orange",
+    "parallel": "tab:green",
+    "west": "tab:purple",
+    "series": "tab:brown",
+}
 
 
 def _clock_hours(result: StudyResult):
@@ -28,7 +33,9 @@ def _connection_label(study: Study, connection: str) -> str:
     sub-panel (and, with a load wired directly, that it is not wired so: Circuit.ignored_by)."""
     if connection != "independent":
         return connection
-    return f"{connection}, {study.circuit.ignored_by(connection) or 'with a converter per sub-panel'}"
+    return (
+        f"{connection}, {study.circuit.ignored_by(connection) or 'with a converter per sub-panel'}"
+    )
 
 
 def _draw_load(ax, hours, series, study) -> None:
@@ -38,7 +45,9 @@ def _draw_load(ax, hours, series, study) -> None:
     if study.load_profile is None:
         ax.axhline(study.p_load, color="tab:red", lw=1, label=f"P_load = {study.p_load:.3g} W")
     else:
-        ax.step(hours, series["p_load_w"], where="mid", color="tab:red", lw=1, label=load_text(study))
+        ax.step(
+            hours, series["p_load_w"], where="mid", color="tab:red", lw=1, label=load_text(study)
+        )
 
 
 def plot_power_curves(result: StudyResult, ax=None):
@@ -102,11 +111,18 @@ def plot_switching(result: StudyResult, ax=None):
     starts = np.flatnonzero(np.r_[True, state[1:] != state[:-1]])
     for start, stop in zip(starts, np.r_[starts[1:], state.size], strict=True):
         if state[start] != "off":
-            ax.axvspan(hours[start] - step / 2, hours[stop - 1] + step / 2, color=STATE_COLOURS[state[start]],
-                       alpha=0.12, lw=0)
+            ax.axvspan(
+                hours[start] - step / 2,
+                hours[stop - 1] + step / 2,
+                color=STATE_COLOURS[state[start]],
+                alpha=0.12,
+                lw=0,
+            )
     for name in ("east", "west", "parallel") + (("series",) if study.switch_series else ()):
         ax.plot(hours, series[f"p_{name}_w"], color=STATE_COLOURS[name], ls="--", label=name)
-    ax.plot(hours, series["p_switching_w"], color="k", lw=2, label="switching (shaded: state chosen)")
+    ax.plot(
+        hours, series["p_switching_w"], color="k", lw=2, label="switching (shaded: state chosen)"
+    )
     _draw_load(ax, hours, series, study)
     daylight = series["p_switching_w"].to_numpy() > 0
     if daylight.any():
@@ -140,18 +156,30 @@ def plot_t_solar_vs_fold_angle(result: StudyResult, ax=None):
     """
     summary = result.summary.set_index("design")
     fig, ax = new_axes(ax, (7, 4.5))
-    ax.plot(result.sweep["fold_angle_deg"], result.sweep["t_solar_h"], color="tab:blue",
-            label=f"twofold ({_connection_label(result.study, result.study.connection)})")
+    ax.plot(
+        result.sweep["fold_angle_deg"],
+        result.sweep["t_solar_h"],
+        color="tab:blue",
+        label=f"twofold ({_connection_label(result.study, result.study.connection)})",
+    )
     if result.study.pv_model != "ideal":
         for name in ("parallel", "series", "independent"):
             if name != result.study.connection:
-                ax.plot(result.sweep["fold_angle_deg"], result.sweep[f"t_solar_{name}_h"], lw=1, ls="--",
-                        color=STATE_COLOURS.get(name, "tab:gray"),
-                        label=f"twofold ({_connection_label(result.study, name)})")
+                ax.plot(
+                    result.sweep["fold_angle_deg"],
+                    result.sweep[f"t_solar_{name}_h"],
+                    lw=1,
+                    ls="--",
+                    color=STATE_COLOURS.get(name, "tab:gray"),
+                    label=f"twofold ({_connection_label(result.study, name)})",
+                )
     ax.axhline(summary.loc["flat", "t_solar_h"], color="k", ls="--", label="flat")
     ax.axhline(summary.loc["tracker", "t_solar_h"], color="0.5", ls=":", label="ideal tracker")
     ax.axvline(
-        result.optimal_fold_angle, color="tab:green", lw=1, label=f"sweep optimum {result.optimal_fold_angle:.2f}°"
+        result.optimal_fold_angle,
+        color="tab:green",
+        lw=1,
+        label=f"sweep optimum {result.optimal_fold_angle:.2f}°",
     )
     if np.isfinite(result.heuristic_fold_angle):
         ax.axvline(
@@ -164,7 +192,9 @@ def plot_t_solar_vs_fold_angle(result: StudyResult, ax=None):
     ax.set_xlabel("fold angle Θ [deg] (180 = flat)")
     ax.set_ylabel("t_solar [h]")
     ax.set_xlim(0, 180)
-    ax.set_title(f"{result.study.name}: t_solar vs fold angle ({_mode_label(result.study)})", fontsize=10)
+    ax.set_title(
+        f"{result.study.name}: t_solar vs fold angle ({_mode_label(result.study)})", fontsize=10
+    )
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     return ax
@@ -186,14 +216,23 @@ def plot_comparison(result: StudyResult, ax=None):
     matplotlib.axes.Axes
     """
     summary = result.summary.set_index("design")
-    names = ["flat", "twofold"] + [d for d in summary.index if d.startswith("tracker") and not d.endswith("-net")]
+    names = ["flat", "twofold"] + [
+        d for d in summary.index if d.startswith("tracker") and not d.endswith("-net")
+    ]
     labels = ["flat", f"twofold\n{summary.loc['twofold', 'fold_angle_deg']:.1f}°"] + [
-        (result.study.tracker.model if d == "tracker" else d.split(":", 1)[1]).replace("-", "-\n", 1)
+        (result.study.tracker.model if d == "tracker" else d.split(":", 1)[1]).replace(
+            "-", "-\n", 1
+        )
         for d in names[2:]
     ]
     x = np.arange(len(names))
     gross = summary.loc[names, "t_solar_h"].to_numpy()
-    net = np.array([summary.loc[f"{d}-net", "t_solar_h"] if f"{d}-net" in summary.index else np.nan for d in names])
+    net = np.array(
+        [
+            summary.loc[f"{d}-net", "t_solar_h"] if f"{d}-net" in summary.index else np.nan
+            for d in names
+        ]
+    )
     fig, ax = new_axes(ax, (max(6, 1.1 * len(names) + 2), 4.5))
     colours = ["0.3", "tab:blue"] + ["0.7"] * (len(names) - 2)
     ax.bar(x, gross, color=colours, label="gross")
@@ -227,14 +266,27 @@ def plot_standby(result: StudyResult, ax=None):
     table, break_even = result.standby
     study = result.study
     fig, ax = new_axes(ax, (7, 4.5))
-    ax.plot(table["standby_w"], table["t_solar_tracker_net_h"], color="0.4",
-            label=f"{study.tracker.model} tracker, net")
-    ax.axhline(table["t_solar_twofold_h"].iloc[0], color="tab:blue", label="optimal twofold (draws nothing)")
+    ax.plot(
+        table["standby_w"],
+        table["t_solar_tracker_net_h"],
+        color="0.4",
+        label=f"{study.tracker.model} tracker, net",
+    )
+    ax.axhline(
+        table["t_solar_twofold_h"].iloc[0],
+        color="tab:blue",
+        label="optimal twofold (draws nothing)",
+    )
     if np.isfinite(break_even):
-        ax.axvline(break_even, color="tab:red", ls="--", lw=1, label=f"break-even {break_even:.2f} W")
+        ax.axvline(
+            break_even, color="tab:red", ls="--", lw=1, label=f"break-even {break_even:.2f} W"
+        )
     ax.set_xlabel("tracker standby draw [W]")
     ax.set_ylabel("t_solar [h]")
-    ax.set_title(f"{study.name}: when does the tracker's own draw hand the day to the twofold panel?", fontsize=9)
+    ax.set_title(
+        f"{study.name}: when does the tracker's own draw hand the day to the twofold panel?",
+        fontsize=9,
+    )
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return ax
@@ -242,14 +294,23 @@ def plot_standby(result: StudyResult, ax=None):
 
 #: A day's results folder holds every one, in this order (each drawn from the StudyResult alone).
 FIGURES = {
-    "power_curves.png": FigureFile(plot_power_curves, "flat, east, west and twofold power over the day, with the "
-                                                      "load (Shin et al. Fig. 6)"),
-    "t_solar_vs_fold_angle.png": FigureFile(plot_t_solar_vs_fold_angle, "t_solar against the fold angle, with flat, "
-                                                                        "tracker and the paper's heuristic (Fig. 12a)"),
-    "comparison.png": FigureFile(plot_comparison, "t_solar of flat, optimal twofold and every tracker, gross and net "
-                                                  "(Fig. 12b)"),
-    "switching.png": FigureFile(plot_switching, "the sub-panels' connections and the one switching chooses over the "
-                                                "day (Fig. 9)"),
-    "tracker_standby.png": FigureFile(plot_standby, "the tracker's net t_solar against its standby draw, and the "
-                                                    "break-even draw"),
+    "power_curves.png": FigureFile(
+        plot_power_curves,
+        "flat, east, west and twofold power over the day, with the load (Shin et al. Fig. 6)",
+    ),
+    "t_solar_vs_fold_angle.png": FigureFile(
+        plot_t_solar_vs_fold_angle,
+        "t_solar against the fold angle, with flat, tracker and the paper's heuristic (Fig. 12a)",
+    ),
+    "comparison.png": FigureFile(
+        plot_comparison,
+        "t_solar of flat, optimal twofold and every tracker, gross and net (Fig. 12b)",
+    ),
+    "switching.png": FigureFile(
+        plot_switching,
+        "the sub-panels' connections and the one switching chooses over the day (Fig. 9)",
+    ),
+    "tracker_standby.png": FigureFile(
+        plot_standby, "the tracker's net t_solar against its standby draw, and the break-even draw"
+    ),
 }

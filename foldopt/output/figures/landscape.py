@@ -30,7 +30,9 @@ def plot_landscape(landscape: pd.DataFrame, designs: pd.DataFrame, title: str, a
     matplotlib.axes.Axes
     """
     fig, ax = new_axes(ax, (7, 5))
-    grid = landscape.pivot_table(index="surface_tilt", columns="fold_angle_deg", values="objective_h")
+    grid = landscape.pivot_table(
+        index="surface_tilt", columns="fold_angle_deg", values="objective_h"
+    )
     values = grid.to_numpy(dtype=float)
     mesh = ax.pcolormesh(grid.columns, grid.index, values, shading="nearest", cmap="viridis")
     fig.colorbar(mesh, ax=ax, label="objective [h]")
@@ -38,14 +40,25 @@ def plot_landscape(landscape: pd.DataFrame, designs: pd.DataFrame, title: str, a
     levels = [top - 0.5, top - 0.2, top - 0.1, top - 0.05]
     levels = [level for level in levels if np.nanmin(values) < level < top]
     if levels:
-        lines = ax.contour(grid.columns, grid.index, values, levels=levels, colors="white", linewidths=0.7)
+        lines = ax.contour(
+            grid.columns, grid.index, values, levels=levels, colors="white", linewidths=0.7
+        )
         ax.clabel(lines, fmt=lambda level: f"-{(top - level) * 60:.0f} min", fontsize=7)
     first = designs[designs["p_load_w"] == designs["p_load_w"].iloc[0]]
-    for design, marker, label in (("twofold", "*", "optimum"), ("twofold-default", "o", "default mounting")):
+    for design, marker, label in (
+        ("twofold", "*", "optimum"),
+        ("twofold-default", "o", "default mounting"),
+    ):
         row = first[first["design"] == design].iloc[0]
-        ax.plot(row["fold_angle_deg"], row["surface_tilt"], marker, color="red" if marker == "*" else "orange",
-                markersize=12 if marker == "*" else 7, markeredgecolor="black",
-                label=f"{label}: {row['objective_h']:.2f} h")
+        ax.plot(
+            row["fold_angle_deg"],
+            row["surface_tilt"],
+            marker,
+            color="red" if marker == "*" else "orange",
+            markersize=12 if marker == "*" else 7,
+            markeredgecolor="black",
+            label=f"{label}: {row['objective_h']:.2f} h",
+        )
     ax.set_xlabel("fold angle [deg]")
     ax.set_ylabel("base tilt [deg]")
     ax.set_title(title, fontsize=10)
@@ -54,6 +67,9 @@ def plot_landscape(landscape: pd.DataFrame, designs: pd.DataFrame, title: str, a
 
 
 FIGURES = {
-    "landscape.png": FigureFile(plot_landscape, "the objective over base tilt x fold angle at the optimum's azimuth, "
-                                                "the optimum and the default mounting marked"),
+    "landscape.png": FigureFile(
+        plot_landscape,
+        "the objective over base tilt x fold angle at the optimum's azimuth, "
+        "the optimum and the default mounting marked",
+    ),
 }

@@ -33,8 +33,13 @@ def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, title: str, ax=None):
         ax.plot(rows["area_m2"], rows["net_benefit_usd"], color=colour, label=design)
         top = best[best["design"] == design].iloc[0]
         ax.plot(top["area_m2"], top["net_benefit_usd"], "o", color=colour)
-        ax.annotate(f"{top['area_m2']:.3f} m², {top['t_solar_h']:.2f} h", (top["area_m2"], top["net_benefit_usd"]),
-                    textcoords="offset points", xytext=(5, 5), fontsize=8)
+        ax.annotate(
+            f"{top['area_m2']:.3f} m², {top['t_solar_h']:.2f} h",
+            (top["area_m2"], top["net_benefit_usd"]),
+            textcoords="offset points",
+            xytext=(5, 5),
+            fontsize=8,
+        )
     ax.axhline(0, color="0.6", lw=0.8)
     ax.set_xlabel("panel area [m²]")
     ax.set_ylabel("lifetime net benefit [$]")
@@ -45,6 +50,8 @@ def plot_sizing(table: pd.DataFrame, best: pd.DataFrame, title: str, ax=None):
 
 
 FIGURES = {
-    "net_benefit_vs_area.png": FigureFile(plot_sizing, "lifetime net benefit of flat and twofold panels against "
-                                                       "their area (Shin et al. Fig. 3a)"),
+    "net_benefit_vs_area.png": FigureFile(
+        plot_sizing,
+        "lifetime net benefit of flat and twofold panels against their area (Shin et al. Fig. 3a)",
+    ),
 }

@@ -85,8 +85,16 @@ def cells(centres, gap: float = np.inf):
     return np.array(edges), np.array(index)
 
 
-def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label: str, diverging: bool,
-             ax=None):
+def plot_map(
+    table: pd.DataFrame,
+    x: str,
+    y: str,
+    value: str,
+    title: str,
+    label: str,
+    diverging: bool,
+    ax=None,
+):
     """A heat map of ``value`` over ``x`` and ``y``, averaged over any other varied field.
 
     Parameters
@@ -112,10 +120,14 @@ def plot_map(table: pd.DataFrame, x: str, y: str, value: str, title: str, label:
     """
     grid = table.pivot_table(index=y, columns=x, values=value, aggfunc="mean")
     fig, ax = new_axes(ax, (8, 5))
-    (x_edges, x_cells), (y_edges, y_cells) = (cells(axis, DAY_GAP if name == "dayofyear" else np.inf)
-                                              for axis, name in ((grid.columns, x), (grid.index, y)))
+    (x_edges, x_cells), (y_edges, y_cells) = (
+        cells(axis, DAY_GAP if name == "dayofyear" else np.inf)
+        for axis, name in ((grid.columns, x), (grid.index, y))
+    )
     values = grid.to_numpy(dtype=float)[np.ix_(y_cells, x_cells)]
-    data = np.ma.masked_invalid(np.where((y_cells[:, None] >= 0) & (x_cells[None, :] >= 0), values, np.nan))
+    data = np.ma.masked_invalid(
+        np.where((y_cells[:, None] >= 0) & (x_cells[None, :] >= 0), values, np.nan)
+    )
     mesh = ax.pcolormesh(x_edges, y_edges, data, shading="flat", **colour_scale(data, diverging))
     ax.set_facecolor("0.85")
     ax.figure.colorbar(mesh, ax=ax, label=label)
@@ -156,9 +168,20 @@ def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = Non
             curve = rows[rows["design"] == design].groupby(x)["t_solar_h"].mean()
             name = "optimal twofold" if design == "twofold" else design
             label = name if split is None else f"{name}, {split} {value}"
-            xs, ys, alone = broken_at_gaps(curve.index, curve.to_numpy(), DAY_GAP if x == "dayofyear" else np.inf)
-            ax.plot(xs, ys, color=colour, ls=style, lw=2 if design == "twofold" else 1.3, label=label,
-                    marker="o" if alone.any() else None, ms=4, markevery=alone.tolist())
+            xs, ys, alone = broken_at_gaps(
+                curve.index, curve.to_numpy(), DAY_GAP if x == "dayofyear" else np.inf
+            )
+            ax.plot(
+                xs,
+                ys,
+                color=colour,
+                ls=style,
+                lw=2 if design == "twofold" else 1.3,
+                label=label,
+                marker="o" if alone.any() else None,
+                ms=4,
+                markevery=alone.tolist(),
+            )
     ax.set_xlabel(AXIS_LABELS.get(x, x))
     ax.set_ylabel("t_solar [h]")
     ax.set_title(title, fontsize=10)
@@ -169,15 +192,26 @@ def plot_curves(table: pd.DataFrame, x: str, title: str, split: str | None = Non
 
 #: A sweep's folder holds those its varied fields call for (:mod:`foldopt.output.folders`).
 FIGURES = {
-    "gain_map_latitude_load.png": FigureFile(plot_map, "t_solar gain of the optimal twofold panel over flat, by "
-                                                       "latitude and load"),
-    "fold_angle_map_latitude_load.png": FigureFile(plot_map, "optimal fold angle by latitude and load"),
-    "gain_map_day_latitude.png": FigureFile(plot_map, "t_solar gain of the optimal twofold panel over flat, by day "
-                                                      "of the year and latitude"),
-    "fold_angle_map_day_latitude.png": FigureFile(plot_map, "optimal fold angle by day of the year and latitude"),
-    "annual_t_solar.png": FigureFile(plot_curves, "t_solar of flat, optimal twofold and tracker over the days of "
-                                                  "the year"),
-    "t_solar_vs_load.png": FigureFile(plot_curves, "t_solar of flat, optimal twofold and tracker against the load"),
-    "t_solar_vs_latitude.png": FigureFile(plot_curves, "t_solar of flat, optimal twofold and tracker against the "
-                                                       "latitude"),
+    "gain_map_latitude_load.png": FigureFile(
+        plot_map, "t_solar gain of the optimal twofold panel over flat, by latitude and load"
+    ),
+    "fold_angle_map_latitude_load.png": FigureFile(
+        plot_map, "optimal fold angle by latitude and load"
+    ),
+    "gain_map_day_latitude.png": FigureFile(
+        plot_map,
+        "t_solar gain of the optimal twofold panel over flat, by day of the year and latitude",
+    ),
+    "fold_angle_map_day_latitude.png": FigureFile(
+        plot_map, "optimal fold angle by day of the year and latitude"
+    ),
+    "annual_t_solar.png": FigureFile(
+        plot_curves, "t_solar of flat, optimal twofold and tracker over the days of the year"
+    ),
+    "t_solar_vs_load.png": FigureFile(
+        plot_curves, "t_solar of flat, optimal twofold and tracker against the load"
+    ),
+    "t_solar_vs_latitude.png": FigureFile(
+        plot_curves, "t_solar of flat, optimal twofold and tracker against the latitude"
+    ),
 }

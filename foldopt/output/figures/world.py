@@ -19,7 +19,9 @@ def _grid_axes(sites: pd.DataFrame):
     return None if lats is None or lons is None or min(lats.size, lons.size) < 2 else (lats, lons)
 
 
-def plot_world_map(rows: pd.DataFrame, value: str, title: str, label: str, diverging: bool, ax=None):
+def plot_world_map(
+    rows: pd.DataFrame, value: str, title: str, label: str, diverging: bool, ax=None
+):
     """One value per site on a longitude x latitude map with coastlines
     (:func:`foldopt.inputs.land.draw_coastlines`): cells for a grid of sites, dots for named sites.
 
@@ -51,11 +53,23 @@ def plot_world_map(rows: pd.DataFrame, value: str, title: str, label: str, diver
         lats, lons = axes
         grid = rows.pivot_table(index="latitude", columns="longitude", values=value, aggfunc="mean")
         grid = grid.reindex(index=lats, columns=lons, method="nearest", tolerance=1e-6)
-        mesh = ax.pcolormesh(lons, lats, np.ma.masked_invalid(grid.to_numpy(dtype=float)), shading="nearest",
-                             **colours)
+        mesh = ax.pcolormesh(
+            lons,
+            lats,
+            np.ma.masked_invalid(grid.to_numpy(dtype=float)),
+            shading="nearest",
+            **colours,
+        )
     else:
-        mesh = ax.scatter(rows["longitude"], rows["latitude"], c=values, s=40, edgecolors="k", linewidths=0.4,
-                          **colours)
+        mesh = ax.scatter(
+            rows["longitude"],
+            rows["latitude"],
+            c=values,
+            s=40,
+            edgecolors="k",
+            linewidths=0.4,
+            **colours,
+        )
     coast = draw_coastlines(ax)
     ax.set_xlim(-180, 180)
     ax.set_ylim(-90, 90)
@@ -64,8 +78,12 @@ def plot_world_map(rows: pd.DataFrame, value: str, title: str, label: str, diver
     ax.figure.colorbar(mesh, ax=ax, label=label, shrink=0.8)
     ax.set_xlabel("longitude [deg]")
     ax.set_ylabel("latitude [deg]")
-    ax.set_title(title + _no_value(values) + ("" if coast else " (no coastlines: pip install global-land-mask)"),
-                 fontsize=10)
+    ax.set_title(
+        title
+        + _no_value(values)
+        + ("" if coast else " (no coastlines: pip install global-land-mask)"),
+        fontsize=10,
+    )
     return ax
 
 
@@ -101,18 +119,30 @@ def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, title: 
     matplotlib.axes.Axes
     """
     rows = table[table["period"] == period]
-    share = rows["p_load_fraction"].round(9) if relative else (rows["p_load_fraction"] / 0.05).round() * 0.05
+    share = (
+        rows["p_load_fraction"].round(9)
+        if relative
+        else (rows["p_load_fraction"] / 0.05).round() * 0.05
+    )
     # dropna=False: a latitude where no site carries a load (every gain NaN) keeps its grey cell.
-    grid = rows.assign(share=share).pivot_table(index="share", columns="latitude", values="gain_vs_flat_pct",
-                                                aggfunc="median", dropna=False)
+    grid = rows.assign(share=share).pivot_table(
+        index="share", columns="latitude", values="gain_vs_flat_pct", aggfunc="median", dropna=False
+    )
     fig, ax = new_axes(ax, (8, 4.5))
     data = np.ma.masked_invalid(grid.to_numpy(dtype=float))
-    mesh = ax.pcolormesh(_edges(grid.columns, 5.0), _edges(grid.index, 0.05), data, **colour_scale(data, True))
+    mesh = ax.pcolormesh(
+        _edges(grid.columns, 5.0), _edges(grid.index, 0.05), data, **colour_scale(data, True)
+    )
     if data.count() > 3 and grid.shape[0] > 1 and grid.shape[1] > 1:
-        ax.contour(grid.columns, grid.index, data.filled(np.nan), levels=[1.0], colors="k", linewidths=0.8)
+        ax.contour(
+            grid.columns, grid.index, data.filled(np.nan), levels=[1.0], colors="k", linewidths=0.8
+        )
     ax.set_facecolor("0.85")
-    ax.figure.colorbar(mesh, ax=ax,
-                       label="median gain over flat [%]" + (" (contour: +1 %)" if grid.shape[0] > 1 else ""))
+    ax.figure.colorbar(
+        mesh,
+        ax=ax,
+        label="median gain over flat [%]" + (" (contour: +1 %)" if grid.shape[0] > 1 else ""),
+    )
     ax.set_xlabel("latitude [deg]")
     ax.set_ylabel("P_load / flat peak [-]" + ("" if relative else " (bins of 0.05)"))
     ax.set_title(title + _no_value(data), fontsize=10)
@@ -121,33 +151,68 @@ def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, title: 
 
 def _no_value(values) -> str:
     """A title's note where no value is finite (no site carries the load), else nothing."""
-    return "" if np.isfinite(np.ma.filled(np.ma.masked_invalid(values), np.nan)).any() else \
-        " (no value: no site carries the load)"
+    return (
+        ""
+        if np.isfinite(np.ma.filled(np.ma.masked_invalid(values), np.nan)).any()
+        else " (no value: no site carries the load)"
+    )
 
 
 #: The world maps of one load and period: file, the column shown, what it shows, the colour bar's
 #: label and whether its colours diverge around 0.
 MAPS = (
-    ("map_fold_angle.png", "recommended_fold_angle_deg", "recommended fold angle (centre of the near-optimal range)",
-     "fold angle Θ [deg] (180 = flat)", False),
-    ("map_gain_vs_flat.png", "gain_vs_flat_pct", "t_solar gain of the twofold panel over flat",
-     "gain over flat [%]", True),
-    ("map_pct_of_tracker.png", "pct_of_tracker", "twofold panel's t_solar as a share of the tracker's",
-     "share of the tracker [%]", False),
-    ("map_near_optimal_width.png", "near_optimal_width_deg", "near-optimal fold-angle range's width",
-     "near-optimal range, hi - lo [deg]", False),
+    (
+        "map_fold_angle.png",
+        "recommended_fold_angle_deg",
+        "recommended fold angle (centre of the near-optimal range)",
+        "fold angle Θ [deg] (180 = flat)",
+        False,
+    ),
+    (
+        "map_gain_vs_flat.png",
+        "gain_vs_flat_pct",
+        "t_solar gain of the twofold panel over flat",
+        "gain over flat [%]",
+        True,
+    ),
+    (
+        "map_pct_of_tracker.png",
+        "pct_of_tracker",
+        "twofold panel's t_solar as a share of the tracker's",
+        "share of the tracker [%]",
+        False,
+    ),
+    (
+        "map_near_optimal_width.png",
+        "near_optimal_width_deg",
+        "near-optimal fold-angle range's width",
+        "near-optimal range, hi - lo [deg]",
+        False,
+    ),
 )
 
 #: The world maps a map that searches the base tilt adds (``foldopt map --optimize tilt``).
 TILT_MAPS = (
-    ("map_surface_tilt.png", "surface_tilt", "twofold panel's best base tilt", "base tilt [deg]", False),
+    (
+        "map_surface_tilt.png",
+        "surface_tilt",
+        "twofold panel's best base tilt",
+        "base tilt [deg]",
+        False,
+    ),
 )
 
 #: A map's folder holds every one (the tilt's where the map searched it).
 FIGURES = {
-    **{file: FigureFile(plot_world_map, f"world map of the {description}") for file, _, description, _, _ in MAPS},
-    **{file: FigureFile(plot_world_map, f"world map of the {description} (map --optimize tilt)")
-       for file, _, description, _, _ in TILT_MAPS},
-    "latitude_load_gain.png": FigureFile(plot_latitude_load, "median gain over flat by latitude and load (share of "
-                                                             "the flat peak)"),
+    **{
+        file: FigureFile(plot_world_map, f"world map of the {description}")
+        for file, _, description, _, _ in MAPS
+    },
+    **{
+        file: FigureFile(plot_world_map, f"world map of the {description} (map --optimize tilt)")
+        for file, _, description, _, _ in TILT_MAPS
+    },
+    "latitude_load_gain.png": FigureFile(
+        plot_latitude_load, "median gain over flat by latitude and load (share of the flat peak)"
+    ),
 }
