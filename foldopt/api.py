@@ -185,9 +185,8 @@ def sweep(
     if not changes and over is None:
         raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
     request = plan_request(_study_data(study), changes, axis=over)
-    return run(
-        request.plan, engine, progress, request=request
-    )  # as the command line runs a request
+    # as the command line runs a request
+    return run(request.plan, engine, progress, request=request)
 
 
 def optimize(

@@ -142,9 +142,8 @@ def _exit_code(error: BaseException) -> int:
                 )
             echo(f"error: {where}{message}", err=True)
         return 2
-    if isinstance(
-        error, (_Interrupted, typer.Abort)
-    ):  # Ctrl-C; typer's Abort: end of input at a prompt
+    # Ctrl-C; typer's Abort: end of input at a prompt
+    if isinstance(error, (_Interrupted, typer.Abort)):
         typer.echo("interrupted", err=True)
         return 130
     if _DEBUG["on"]:

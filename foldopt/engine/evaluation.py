@@ -232,9 +232,8 @@ def _unsort(values, order, row_loadset):
     if (order == np.arange(order.shape[1])).all():
         return values  # the caller's loads were in order
     if order.shape[0] == 1:
-        return np.take(
-            values, np.argsort(order[0]), axis=-1
-        )  # one set of loads: one permutation for every row
+        # one set of loads: one permutation for every row
+        return np.take(values, np.argsort(order[0]), axis=-1)
     out = np.empty_like(values)
     np.put_along_axis(
         out, np.broadcast_to(order[row_loadset][:, None, :], values.shape), values, axis=-1

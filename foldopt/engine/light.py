@@ -276,9 +276,8 @@ def member_light(
         for key in drawn:
             drawn[key][:, day] = one[key][:, 0]
     light = {key: values[member, inverse] for key, values in drawn.items()}
-    per_day = len(inverse) / len(
-        dates
-    )  # a day's members: all of them in every chunk (Blocks.chunks)
+    # a day's members: all of them in every chunk (Blocks.chunks)
+    per_day = len(inverse) / len(dates)
     balance = {
         key: (float(hourly[key].sum()), float(light[key].sum()) / per_interval / per_day)
         for key in ("dni", "ghi", "dhi")

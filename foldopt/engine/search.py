@@ -416,12 +416,13 @@ def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
     looked up per target, and 100,000 boxes of 40 loads held 5.5 GB at once."""
     n_targets = store.values.shape[1]
     per = max(1, BOX_VALUES // (len(_CORNER_LOOKUPS) * 2 ** lower.shape[1] * n_targets))
+    # one batch of none where none is left
     batches = [
         _box_terms(
             store, lower[first : first + per], upper[first : first + per], strides, steps, sizes
         )
         for first in range(0, max(lower.shape[0], 1), per)
-    ]  # one batch of none where none is left
+    ]
     terms = list(zip(*batches, strict=True))
     top, error, tent, concave = (np.concatenate(terms[k]) for k in (0, 1, 4, 5))
     unknown, width = (np.concatenate(terms[k], axis=1) for k in (2, 3))
@@ -453,9 +454,8 @@ def _box_terms(store, lower, upper, strides, steps, sizes):
         # The corners and their lattice neighbours along the axis, looked up in one call.
         offsets = np.array(_CORNER_LOOKUPS)[:, None, None, None] * shift  # (5, 1, 1, n_axes)
         beyond_below, below, here, above, beyond_above = store.lookup(corners[None] + offsets)
-        second = (
-            np.abs(above - 2.0 * here + below) / (strides[axis] * steps[axis]) ** 2
-        )  # (boxes, corners, targets)
+        # (boxes, corners, targets)
+        second = np.abs(above - 2.0 * here + below) / (strides[axis] * steps[axis]) ** 2
         known = np.isfinite(second)
         curvature = np.max(np.where(known, second, -np.inf), axis=1)  # (boxes, targets)
         largest[axis] = curvature.max(axis=0, initial=-np.inf)
@@ -500,9 +500,8 @@ def _concave(*values):
     turning up into a narrow peak) shows."""
     values = np.stack(values)
     second = values[2:] - 2.0 * values[1:-1] + values[:-2]
-    return np.all(
-        second <= 0.0, axis=0
-    )  # NaN (a point not evaluated or off the grid) compares False
+    # NaN (a point not evaluated or off the grid) compares False
+    return np.all(second <= 0.0, axis=0)
 
 
 def _tent(before, start, end, after, spacing, width):

@@ -57,9 +57,7 @@ class DiodeSpec(StrictModel):
     @classmethod
     def _known_part(cls, part):
         if part is not None:
-            from foldopt.physics.diodes import (
-                DIODE_PARTS,
-            )  # the parts' table, only when one is named
+            from foldopt.physics.diodes import DIODE_PARTS  # the parts' table, only when named
 
             if part not in DIODE_PARTS:
                 raise ValueError(f"must be one of {', '.join(DIODE_PARTS)}")

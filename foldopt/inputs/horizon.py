@@ -90,10 +90,8 @@ def _checked(pairs, labels) -> tuple[np.ndarray, np.ndarray]:
             )
         if elevation > 90.0:
             raise ValueError(f"{label}: elevation {elevation:g} deg is above 90")
-        azimuth, elevation = (
-            azimuth % 360.0,
-            max(elevation, 0.0),
-        )  # 360 is north again; see horizon_profile
+        # 360 is north again; see horizon_profile
+        azimuth, elevation = azimuth % 360.0, max(elevation, 0.0)
         if azimuth in points and points[azimuth][1] != elevation:
             other, seen = points[azimuth]
             raise ValueError(

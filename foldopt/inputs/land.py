@@ -50,9 +50,8 @@ def _build() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`land_fraction` from the full mask."""
     from global_land_mask import globe  # loads the full mask: seconds, once per cache
 
-    water = (
-        globe._mask
-    )  # (21600, 43200) True on water, latitude descending from 90, longitude from -180
+    # (21600, 43200) True on water, latitude descending from 90, longitude from -180
+    water = globe._mask
     rows, columns = water.shape[0] // _FACTOR, water.shape[1] // _FACTOR
     fraction = np.zeros((rows, columns), dtype=np.float32)
     for start in range(0, rows, 120):  # in bands, to keep the float copy small

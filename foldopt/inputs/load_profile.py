@@ -76,9 +76,8 @@ def _day(steps: dict, clock_hours, linear: bool):
         return np.interp(
             clock_hours, np.r_[times - 24.0, times, times + 24.0], np.r_[watts, watts, watts]
         )
-    index = (
-        np.searchsorted(times, clock_hours, side="right") - 1
-    )  # -1: before the first time, the last's load
+    # -1: before the first time, the last's load
+    index = np.searchsorted(times, clock_hours, side="right") - 1
     return watts[index]
 
 

@@ -214,11 +214,12 @@ class Optimize(StrictModel):
         designs = math.prod(counts.values())
         largest = max(counts, key=counts.get)
         bounds = getattr(self, largest)
+        # only the fold angle's default grid varies
         setting = (
             f"optimize.{largest} = {bounds.describe()}"
             if bounds is not None
             else f"fold_angles.step = {fold_angles.step:g}"
-        )  # only the fold angle's default grid varies
+        )
         nouns = {"fold_angle": "fold angles", "tilt": "tilts", "azimuth": "azimuths"}
         if counts[largest] > MAX_AXIS_VALUES:
             return (

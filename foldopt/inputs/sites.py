@@ -138,9 +138,8 @@ def read_sites(path: Path | str) -> list[dict]:
         )
     sites, errors, named = [], [], {}
     for line, cells in rows:
-        if len(cells) > len(
-            header
-        ):  # a cell more than the header names: a stray comma, or a shifted row
+        # a cell more than the header names: a stray comma, or a shifted row
+        if len(cells) > len(header):
             errors.append(
                 f"--sites {path}, line {line}: {len(cells)} fields; the header names {len(header)}"
             )

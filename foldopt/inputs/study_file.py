@@ -274,9 +274,8 @@ def default_study_path(name: str = DEFAULT_STUDY) -> Path:
     pathlib.Path
         In ``configs/`` of the wheel, or of the checkout.
     """
-    package = (
-        Path(__file__).resolve().parents[1]
-    )  # foldopt/, this module being foldopt/inputs/<name>.py
+    # foldopt/, this module being foldopt/inputs/<name>.py
+    package = Path(__file__).resolve().parents[1]
     packaged = package / "configs" / f"{name}.yaml"
     if packaged.exists():
         return packaged

@@ -40,9 +40,8 @@ def weather_read(weather, site=None) -> dict:
         return {}  # the study names the fault of an option that is not one value of its kind
     try:
         check_input(path, "weather", MAX_WEATHER_BYTES, "MAX_WEATHER_BYTES", "weather file")
-    except (
-        ConfigError
-    ) as error:  # missing, a folder, a device, a FIFO, too large: named before any read
+    # missing, a folder, a device, a FIFO, too large: named before any read
+    except ConfigError as error:
         return {"weather_missing": True, "weather_problem": error.errors[0]}
     try:
         fmt = canonical(spec.get("format"), WEATHER_FORMATS)
@@ -260,9 +259,8 @@ def weather_defaults(data: dict) -> dict:
     if read.get("weather_problem") is not None and (
         not read.get("weather_dates") or _varied_site(data.get("site"))
     ):
-        raise ConfigError(
-            [read["weather_problem"]]
-        )  # its days and step cannot be known: none to default
+        # its days and step cannot be known: none to default
+        raise ConfigError([read["weather_problem"]])
     if read.get("weather_dates") is None:
         return {"date": "year"}  # the file cannot be read: the study's validation names why
     return {"date": list(read["weather_dates"]), "step_min": read["weather_step_min"]}

@@ -269,9 +269,8 @@ def _isotropic(tilt, azimuth, lo, hi, h_lo, h_hi):
     classes = np.minimum((np.mod(azimuth, _TWO_PI) / width).astype(int), _AZIMUTH_BINS - 1)
     for k in np.unique(classes):
         members = np.flatnonzero(classes == k)
-        centre = (k + 0.5) * width + (
-            np.pi if facing_up else 0.0
-        )  # behind or in front of the plane
+        # behind or in front of the plane
+        centre = (k + 0.5) * width + (np.pi if facing_up else 0.0)
         cols = _window(lo, hi, centre - 0.5 * (np.pi + width), centre + 0.5 * (np.pi + width))
         c_cos, c_sin, c_h, c_p, c_q, c_w = (x[cols].ravel() for x in (cos_phi, sin_phi, h, p, q, w))
         step = max(1, _BLOCK // c_w.size)
@@ -315,9 +314,8 @@ def _band_pieces(profile_azimuth, profile_elevation, width):
         return x[:-1], x[1:], hidden, hidden
     # Within a segment the hidden share h / width is linear until the horizon passes the band's top.
     crossing = (h[:-1] - width) * (h[1:] - width) < 0
-    with np.errstate(
-        invalid="ignore", divide="ignore", over="ignore"
-    ):  # used only where the horizon crosses
+    # used only where the horizon crosses
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         at = x[:-1] + (width - h[:-1]) / (h[1:] - h[:-1]) * (x[1:] - x[:-1])
     points = np.concatenate([x, at[crossing]])
     heights = np.concatenate([h, np.full(np.count_nonzero(crossing), width)])

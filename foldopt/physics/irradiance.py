@@ -107,9 +107,8 @@ def _perez_brightness(dhi, dni, dni_extra, solar_zenith, airmass):
     NaN where there is no diffuse light."""
     z = np.radians(solar_zenith)
     delta = dhi * airmass / dni_extra
-    kappa_z3 = PEREZ_KAPPA * (
-        z * z * z
-    )  # products, not a power: a map's sky spent 1.5 ms a site in pow
+    # products, not a power: a map's sky spent 1.5 ms a site in pow
+    kappa_z3 = PEREZ_KAPPA * (z * z * z)
     with np.errstate(invalid="ignore", divide="ignore"):
         eps = ((dhi + dni) / dhi + kappa_z3) / (1.0 + kappa_z3)
     # The bin is the count of its lower edges at or below eps, less one (np.digitize's), -1 for NaN

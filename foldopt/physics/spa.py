@@ -348,9 +348,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     x, y = pvlib.spa.xterm(u, latitude, altitude), pvlib.spa.yterm(u, latitude, altitude)
     lam, phi = np.radians(longitude), np.radians(latitude)
     first, terms = _shared_terms(utc_ns)
-    vector = np.empty(
-        (shape[0], 3, shape[1])
-    )  # each component along the steps, as the engine reads it
+    # each component along the steps, as the engine reads it
+    vector = np.empty((shape[0], 3, shape[1]))
     apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
     pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
     _site_sun(

@@ -403,14 +403,12 @@ class TrackerDrive:
             return self.wh_per_degree * degrees
         if self.drive != "motor":
             raise ValueError(f"drive must be one of {', '.join(DRIVES)}; got {self.drive!r}")
-        speed = (
-            self.gain / self.counts_per_revolution * 360.0
-        )  # gear-motor output at steady state [deg/s]
+        # gear-motor output at steady state [deg/s]
+        speed = self.gain / self.counts_per_revolution * 360.0
         moved = degrees > 0
         energy = np.zeros(degrees.shape)
-        target = (
-            degrees[moved] * self.gear_ratio
-        )  # gear-motor output rotation [deg]; only the moves are solved
+        # gear-motor output rotation [deg]; only the moves are solved
+        target = degrees[moved] * self.gear_ratio
         duration = _time_to_turn(target, speed, self.tau_1, self.tau_2)
         # I(t) = I_stall - (I_stall - I_free) * omega(t) / omega_ss, so the charge is
         # I_stall * T - (I_stall - I_free) * angle / omega_ss.

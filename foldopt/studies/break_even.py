@@ -200,9 +200,8 @@ def _ladder_brackets(objectives, p_load, top, targets):
     for site in np.flatnonzero(count):
         rungs, load = sets[site, : count[site]], p_load[site][:, None]
         inside = (rungs >= load) & (rungs <= load + top[site])  # (loads, rungs): the draws 0 to top
-        above = (
-            value[site][:, None, :] - targets[site][:, :, None] > 0
-        ) & inside  # (periods, loads, rungs)
+        # (periods, loads, rungs)
+        above = (value[site][:, None, :] - targets[site][:, :, None] > 0) & inside
         first, last = (
             np.argmax(inside, axis=1),
             count[site] - 1 - np.argmax(inside[:, ::-1], axis=1),

@@ -528,9 +528,8 @@ def _compute(
     run = MapRun(spec, table, out, computed, tuple(sorted(done)), seconds, description, dashboard)
     if finish is not None:
         finish(run, complete)
-    _write_json(
-        out / "run.json", complete
-    )  # last: only a folder holding every promised file is complete
+    # last: only a folder holding every promised file is complete
+    _write_json(out / "run.json", complete)
     return run
 
 

@@ -204,7 +204,6 @@ def _identity(address: str, seconds: float):
     with ThreadPoolExecutor(1) as pool:
         try:
             return pool.submit(asyncio.run, asyncio.wait_for(ask(), seconds)).result()
-        except (
-            Exception
-        ):  # whatever a server that is not Dask's sends (garbage can fail in many ways)
+        # whatever a server that is not Dask's sends (garbage can fail in many ways)
+        except Exception:
             return None

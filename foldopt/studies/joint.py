@@ -190,9 +190,8 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
 
     days_of = daily_designs(parts, loads, engine)
     default = {
-        "twofold-default": objective_value(
-            days_of.twofold_h, months, statistic, season
-        ),  # (loads, angles)
+        # (loads, angles)
+        "twofold-default": objective_value(days_of.twofold_h, months, statistic, season),
         "flat-default": objective_value(days_of.flat_h, months, statistic, season),
         "tracker": objective_value(days_of.tracker_h, months, statistic, season),
     }

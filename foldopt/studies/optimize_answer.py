@@ -111,6 +111,7 @@ def of_optimize(result) -> Answer:
                 if fixed_fold
                 else (default.fold_angle_deg, default.objective_h)
             )
+            # + 0.0: no "-0.0" for a roundoff
             lines.append(
                 f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} "
                 f"h, folded to {folded[0]:g} deg {folded[1]:.2f} h): "
@@ -118,7 +119,7 @@ def of_optimize(result) -> Answer:
                     f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
                     for row in added.itertuples()
                 )
-            )  # + 0.0: no "-0.0" for a roundoff
+            )
         per_load.append(
             {
                 "p_load_w": load,

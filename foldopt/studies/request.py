@@ -149,9 +149,8 @@ def plan_request(
         and "objective" not in new
         and (ensemble or not ("date" in changes and policy.is_single(changes["date"])))
     ):
-        new["objective"] = {
-            "statistic": "mean"
-        }  # a year of weather (or a day's ensemble) at one fold angle
+        # a year of weather (or a day's ensemble) at one fold angle
+        new["objective"] = {"statistic": "mean"}
     study_year = _ISO_DATE.match(str(data.get("date", "")))
     if "year" not in new and study_year:
         new["year"] = int(study_year.group(1))  # days of year are the study's year's

@@ -164,9 +164,8 @@ def size_panel(
     fold_angles = np.asarray(study.fold_angles.grid())
     # Every curve against every load in one pass of the kernel, with no (areas x angles x steps) array.
     curves = np.vstack([day.flat_power()[None, :], day.combined_power(fold_angles)])
-    all_hours = engines.curve_metrics(curves, p_load, day.step_hours).t_solar[
-        :, 0, :
-    ]  # (1 + angles, areas)
+    # (1 + angles, areas)
+    all_hours = engines.curve_metrics(curves, p_load, day.step_hours).t_solar[:, 0, :]
     twofold_hours = all_hours[1:].T
     best = twofold_hours.shape[1] - 1 - np.argmax(twofold_hours[:, ::-1], axis=1)
     hours = {

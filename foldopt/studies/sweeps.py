@@ -43,9 +43,8 @@ class SweepResult:
 
     plan: Plan
     table: pd.DataFrame
-    extras: dict = dataclasses.field(
-        default_factory=dict
-    )  # day x hour curves of an annual objective
+    # day x hour curves of an annual objective
+    extras: dict = dataclasses.field(default_factory=dict)
     engine: str = "numba"
     weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
     request: object = None  # the foldopt.studies.request.Request the plan came from, if any
@@ -218,9 +217,8 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         advance(len(blocks[part]) // blocks.members)
     members = blocks.members
     months = [date.month for date in blocks.dates[::members]]
-    daily = np.concatenate(daily).transpose(
-        0, 2, 1
-    )  # (blocks, loads, angles): a day's members together
+    # (blocks, loads, angles): a day's members together
+    daily = np.concatenate(daily).transpose(0, 2, 1)
     study = blocks.study
     ensemble = None
     if members > 1:

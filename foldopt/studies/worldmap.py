@@ -270,9 +270,8 @@ def map_request(
         )
     if errors:
         raise ConfigError(errors)
-    field = (
-        f"--sites {sites}" if isinstance(sites, (str, Path)) else "sites"
-    )  # as read_sites names a file
+    # as read_sites names a file
+    field = f"--sites {sites}" if isinstance(sites, (str, Path)) else "sites"
     if isinstance(sites, (str, Path)):
         sites = read_sites(sites)
     elif sites is None and weather_dir is not None:
@@ -615,9 +614,8 @@ def _chosen(hours, energy, months, statistic: str, seasons, member):
     objective, (periods, loads, n)."""
     n_loads = hours.shape[1]
     every = period_values(hours, months, statistic, seasons)  # (periods, loads, n)
-    best = best_angle_index(
-        every
-    )  # (periods, loads); ties to the last (the least folded, the steepest)
+    # (periods, loads); ties to the last (the least folded, the steepest)
+    best = best_angle_index(every)
     at_best = hours[:, np.arange(n_loads)[None, :], best]  # (days, periods, loads)
     objective = np.stack(
         [

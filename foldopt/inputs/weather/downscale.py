@@ -181,9 +181,8 @@ def _ramped(means, weight, edges, bad, max_index):
     # The narrowest ramp spans two steps: its change at the interval's edge is then half its
     # largest inside (a one-step ramp would put half its change on the edge).
     widths = np.array(RAMP_WIDTHS + (min(2.0 / n, 0.5),))
-    rise = np.clip(
-        1.0 - u[None, :] / widths[:, None], 0.0, None
-    )  # (n_widths, n) from the left edge
+    # (n_widths, n) from the left edge
+    rise = np.clip(1.0 - u[None, :] / widths[:, None], 0.0, None)
     fall = rise[:, ::-1]  # from the right edge
     left, right = edges[:, :-1, None], edges[:, 1:, None]
     ramps = weight @ rise.T, weight @ fall.T  # (n_days, n_intervals, n_widths) weighted sums

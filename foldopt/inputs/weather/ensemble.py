@@ -504,9 +504,8 @@ def cloud_members(
     noise = np.stack([rng.standard_normal((rows.size, spi)) for rng in rngs])
     covered = _overcast_hours(overcast, fresh, rngs)  # 3. (step 2 of the module docstring)
     hit = sun.mean(axis=-1)
-    uniform = (
-        (hit <= 0) | (hit >= 1) | covered
-    )  # no switch all interval, or overcast: the beam spread evenly
+    # no switch all interval, or overcast: the beam spread evenly
+    uniform = (hit <= 0) | (hit >= 1) | covered
     sun = np.where(uniform[..., None], np.broadcast_to(share, hit.shape)[..., None], sun)
 
     # 4. The light: smooth diffuse, the beam on and off, noise, then each interval's means.

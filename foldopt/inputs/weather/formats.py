@@ -128,9 +128,8 @@ def reason(error: Exception) -> str:
     if isinstance(error, UnicodeDecodeError):
         return f"not text: byte {error.start + 1:,} is 0x{error.object[error.start]:02x}, no UTF-8 (a binary file?)"
     text = str(error).strip().splitlines()
-    text = (
-        text[0].split(" You might want to try")[0] if text else ""
-    )  # pandas' advice, on the next lines
+    # pandas' advice, on the next lines
+    text = text[0].split(" You might want to try")[0] if text else ""
     return f"{type(error).__name__}: {printable(text, 200)}" if text else type(error).__name__
 
 
@@ -160,9 +159,8 @@ def read_with_pvlib(fail, label: str, reader: str, *args, **kwargs):
         read = getattr(pvlib.iotools, reader)
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter(
-                "ignore"
-            )  # pandas' warnings about pvlib's parsing: the checks follow
+            # pandas' warnings about pvlib's parsing: the checks follow
+            warnings.simplefilter("ignore")
             return read(*args, **kwargs)
     except Exception as error:  # any failure of pvlib's reader is an unreadable file
         raise fail(f"not a readable {label} file ({reason(error)})") from error

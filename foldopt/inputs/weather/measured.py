@@ -253,9 +253,8 @@ def _grid(frame: pd.DataFrame, label: str, zone, fail):
             f"{_count(same.size, 'duplicate stamp')}, the first {stamps[same[0]].isoformat(sep=' ')}"
         )
     values, counts = np.unique(spacing, return_counts=True)
-    step = int(
-        values[counts == counts.max()][-1]
-    )  # a tie: the longest (a stray stamp makes two short ones)
+    # a tie: the longest (a stray stamp makes two short ones)
+    step = int(values[counts == counts.max()][-1])
     off = np.flatnonzero((ns - ns[0]) % step)
     step_td = pd.Timedelta(step, unit="ns")
     if off.size:
@@ -271,9 +270,8 @@ def _grid(frame: pd.DataFrame, label: str, zone, fail):
     phase = (local[0] - first) % step
     days = (local[-1] - first) // _DAY.value + 1
     n = int(days * (_DAY.value // step))
-    if n > MAX_MEASURED_STEPS or (
-        days > 31 and n > 100 * ns.size
-    ):  # beyond a limit, or a file 99 % gaps
+    # beyond a limit, or a file 99 % gaps
+    if n > MAX_MEASURED_STEPS or (days > 31 and n > 100 * ns.size):
         span = " to ".join(stamps[i].isoformat(sep=" ") for i in (0, -1))
         raise fail(
             f"the stamps span {span}, {_count(int(days), 'day')} at the file's {_minutes(step_td)} step: {n:,}"
@@ -327,9 +325,8 @@ def _components(table, present, decomposition, index, zenith, cosz, pressure, fa
             )
         else:
             with warnings.catch_warnings():
-                warnings.simplefilter(
-                    "ignore"
-                )  # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
+                # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
+                warnings.simplefilter("ignore")
                 out = getattr(pvlib.irradiance, decomposition)(
                     pd.Series(ghi, index), pd.Series(zenith, index), index
                 )

@@ -104,9 +104,8 @@ def plot_member_t_solar(table: pd.DataFrame, title: str, ax=None, study=None):
             for column in ("t_solar_p10_h", "t_solar_p50_h", "t_solar_p90_h")
         )
         ax.fill_between(days, p10, p90, where=~alone, color=colour, alpha=0.25, lw=0)
-        ax.vlines(
-            days[alone], p10[alone], p90[alone], color=colour, alpha=0.25, lw=4
-        )  # a lone day's band
+        # a lone day's band
+        ax.vlines(days[alone], p10[alone], p90[alone], color=colour, alpha=0.25, lw=4)
         ax.plot(
             days,
             p50,
