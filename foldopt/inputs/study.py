@@ -165,9 +165,8 @@ class Study(StrictModel):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9._-]*$", max_length=100)]
     description: str = ""
     mode: named(names.MODES) = "exact"
-    site: Site = Field(
-        description="default with a weather file: the file's own site"
-    )  # None: unread
+    # None: unread
+    site: Site = Field(description="default with a weather file: the file's own site")
     force_site: bool = Field(
         False, description="keep a site more than SITE_TOLERANCE_KM from the weather file's"
     )
@@ -284,6 +283,42 @@ class Study(StrictModel):
         return None if value is _UNREAD else handler(value)
 
     @model_validator(mode="after")
+    def _decide(self):
+        """Every default that depends on other fields, decided once (:attr:`_decided` says which),
+        before the checks of :meth:`_consistent` (pydantic runs after-validators in order)."""
+        decided = {}
+        if self.geometry is None:
+            decided["geometry"] = "azimuth-split" if self.mode == "paper" else "hinge"
+        if self.temperature_model is None:
+            decided["temperature_model"] = "fixed" if self.mode == "paper" else "sapm"
+        if self.sky is None:
+            decided["sky"] = MODE_SKIES[self.mode]
+        if self.site is not None:
+            from foldopt.physics.geometry import default_orientation
+
+            tilt, azimuth = default_orientation(self.site.latitude)
+            panel = {
+                key: value
+                for key, value in (("tilt", tilt), ("azimuth", azimuth))
+                if getattr(self.panel, key) is None
+            }
+            if panel:
+                decided["panel"] = self.panel.model_copy(update=panel)
+            if self.site.timezone is None:
+                decided["site"] = self.site.model_copy(
+                    update={"timezone": standard_timezone(self.site.longitude)}
+                )
+            paths = [f"panel.{key}" for key in panel] + ["site.timezone"] * ("site" in decided)
+        else:
+            paths = []
+        for name, value in decided.items():
+            object.__setattr__(self, name, value)  # frozen to users; decided here, once
+        self._decided = frozenset(
+            paths + [name for name in decided if name not in ("panel", "site")]
+        )
+        return self
+
+    @model_validator(mode="after")
     def _consistent(self, info: ValidationInfo):
         if self.mode == "paper" and self.transposition not in (None, "none"):
             raise ValueError(
@@ -350,41 +385,6 @@ class Study(StrictModel):
                 )
         return self
 
-    @model_validator(mode="after")
-    def _decide(self):
-        """Every default that depends on other fields, decided once (:attr:`_decided` says which)."""
-        decided = {}
-        if self.geometry is None:
-            decided["geometry"] = "azimuth-split" if self.mode == "paper" else "hinge"
-        if self.temperature_model is None:
-            decided["temperature_model"] = "fixed" if self.mode == "paper" else "sapm"
-        if self.sky is None:
-            decided["sky"] = MODE_SKIES[self.mode]
-        if self.site is not None:
-            from foldopt.physics.geometry import default_orientation
-
-            tilt, azimuth = default_orientation(self.site.latitude)
-            panel = {
-                key: value
-                for key, value in (("tilt", tilt), ("azimuth", azimuth))
-                if getattr(self.panel, key) is None
-            }
-            if panel:
-                decided["panel"] = self.panel.model_copy(update=panel)
-            if self.site.timezone is None:
-                decided["site"] = self.site.model_copy(
-                    update={"timezone": standard_timezone(self.site.longitude)}
-                )
-            paths = [f"panel.{key}" for key in panel] + ["site.timezone"] * ("site" in decided)
-        else:
-            paths = []
-        for name, value in decided.items():
-            object.__setattr__(self, name, value)  # frozen to users; decided here, once
-        self._decided = frozenset(
-            paths + [name for name in decided if name not in ("panel", "site")]
-        )
-        return self
-
     def idle_settings(self) -> list[str]:
         """Settings given a value that nothing in the study uses.
 
@@ -397,16 +397,15 @@ class Study(StrictModel):
         # What a resolved study fills in is no setting of the user's.
         defaults["temperature_model"] = (None, "fixed" if self.mode == "paper" else "sapm")
         defaults["sky"] = (None, MODE_SKIES[self.mode])
-        sky = self.sky or MODE_SKIES[self.mode]
         iv_model = self.pv_model != "ideal"
         series_used = self.connection == "series" or (
             self.connection == "switching" and self.switch_series
         )
         rules = [
-            ("climate", sky == "hottel", "is only used by sky hottel"),
+            ("climate", self.sky == "hottel", "is only used by sky hottel"),
             (
                 "linke_turbidity",
-                sky == "ineichen" or self.weather is not None,
+                self.sky == "ineichen" or self.weather is not None,
                 "is only used by sky ineichen and weather files",
             ),
             (
@@ -470,10 +469,9 @@ class Study(StrictModel):
         """
         if self.transposition is not None:
             return self.transposition
-        sky = self.sky or MODE_SKIES[self.mode]
         return (
             "none"
-            if self.mode == "paper" or (self.weather is None and sky in names.BEAM_SKIES)
+            if self.mode == "paper" or (self.weather is None and self.sky in names.BEAM_SKIES)
             else "perez"
         )
 
