@@ -237,6 +237,17 @@ ENGINES = Registry(
         "numpy": "the NumPy reference path the kernel is tested against",
     },
 )
+#: A buffer's chemistry, whose datasheet-typical values fill the ``storage`` fields a study leaves
+#: out (the values and their sources: :data:`foldopt.inputs.storage_section.PRESETS`).
+STORAGE_PRESETS = Registry(
+    "storage preset",
+    {
+        "supercapacitor": "an EDLC bank behind a converter: usable down to half its voltage (a quarter "
+        "of its energy), ~96 % round trip, ~2 %/day self-discharge",
+        "lifepo4": "a small LiFePO4 pack: cut off at 20 % (80 % depth of discharge), 92 % round trip, "
+        "~3 %/month self-discharge",
+    },
+)
 OUTPUT_FORMATS = Registry(
     "format",
     {
@@ -265,6 +276,7 @@ REGISTRIES = (
     ENGINES,
     OUTPUT_FORMATS,
     DIODE_MODELS,
+    STORAGE_PRESETS,
 )
 
 
@@ -352,6 +364,8 @@ FIELD_OPTIONS = (
     FieldOption("--converter", "circuit.converter.model"),
     FieldOption("--load-voltage", "circuit.load_voltage"),
     FieldOption("--switch-resistance", "circuit.switch_resistance"),
+    FieldOption("--storage-wh", "storage.capacity_wh"),
+    FieldOption("--min-soc", "storage.min_soc"),
 )
 #: Each option's parameter -> the field it sets.
 FIELD_OF_PARAMETER = {entry.parameter: entry.field for entry in FIELD_OPTIONS}
@@ -462,7 +476,8 @@ def canonical(value, names, field: str = "name"):
 
 def close_names(value: str, names) -> list[str]:
     """The names a misspelling most likely meant: those it begins (``singl`` for ``single-diode``),
-    then the closest by :mod:`difflib`, compared without case or separators.
+    then the closest by :mod:`difflib`, compared without case or separators; of more than two, the
+    two most similar (``st`` is ``set`` a letter short more likely than it begins ``storage-wh``).
 
     Parameters
     ----------
@@ -487,7 +502,12 @@ def close_names(value: str, names) -> list[str]:
     key = _squash(value)
     begun = [name for short, name in squashed.items() if len(key) >= 2 and short.startswith(key)]
     near = [squashed[short] for short in difflib.get_close_matches(key, squashed, n=2, cutoff=0.6)]
-    return list(dict.fromkeys(begun + near))[:2]
+    similarity = {
+        name: difflib.SequenceMatcher(None, key, _squash(name)).ratio()
+        for name in dict.fromkeys(begun + near)
+    }
+    likeliest = sorted(similarity, key=lambda name: -similarity[name])[:2]
+    return [name for name in similarity if name in likeliest]
 
 
 def did_you_mean(value: str, names) -> str:

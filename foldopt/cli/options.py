@@ -65,6 +65,22 @@ StepMin = Annotated[
     float | None,
     typer.Option("--step-min", help="Time step [min], a divisor of 1440 [default: the study's]."),
 ]
+StorageWh = Annotated[
+    float | None,
+    typer.Option(
+        "--storage-wh",
+        help="A buffer behind a charge controller: its usable energy [Wh] (0: storage-less); "
+        "--set storage.<field> for the rest [default: none].",
+    ),
+]
+MinSoc = Annotated[
+    float | None,
+    typer.Option(
+        "--min-soc",
+        help="The charge controller's cut-off: the state of charge [-] at which it disconnects "
+        "the load [default: the storage preset's, else 0].",
+    ),
+]
 Settings = Annotated[
     list[str] | None,
     typer.Option(

@@ -65,6 +65,72 @@ def profile_steps(value: dict) -> dict:
     return dict(sorted(steps.items()))
 
 
+#: How far PVGIS's 24 fractions of a day's energy may sum from 1 (values rounded to 3 decimals
+#: each may add up to 0.012 away); they are scaled to sum 1 exactly.
+HOURCONSUMPTION_TOLERANCE = 0.02
+
+
+def hourly_steps(fractions: list, consumptionday: float) -> dict:
+    """PVGIS's off-grid load as a day's loads: 24 fractions of a day's energy, hour by hour.
+
+    PVGIS's off-grid tool (SHScalc) takes the load as a daily energy, ``consumptionday`` [Wh],
+    and its ``hourconsumption``: the fraction of that energy used in each hour of the day, 24
+    values that sum to 1 [1]_. Hour ``h``'s energy ``consumptionday x fraction_h`` spread over
+    its hour is a load of that many watts from ``h:00`` to ``h+1:00`` of the study's local day,
+    so the day's energy is ``consumptionday`` exactly.
+
+    Parameters
+    ----------
+    fractions : list of float
+        24 fractions [-], each finite and >= 0, summing to 1 within
+        :data:`HOURCONSUMPTION_TOLERANCE` (scaled to sum 1).
+    consumptionday : float
+        The day's energy [Wh].
+
+    Returns
+    -------
+    dict
+        ``{"HH:00": watts}`` for the 24 hours, in time order (:func:`profile_steps`' form), held
+        over each hour.
+
+    Raises
+    ------
+    ValueError
+        For other than 24 values, a value that is not a finite number >= 0, or a sum away from 1.
+
+    References
+    ----------
+    .. [1] European Commission JRC, "PVGIS non-interactive service" (API): the SHScalc tool's
+       ``consumptionday`` and ``hourconsumption``; "Performance of off-grid PV systems".
+    """
+    if not isinstance(fractions, list) or len(fractions) != 24:
+        count = len(fractions) if isinstance(fractions, list) else "no list of"
+        raise ValueError(
+            f"hourconsumption: {count} values; PVGIS's form is 24 fractions of consumptionday, "
+            "one an hour from 00:00, summing to 1"
+        )
+    for hour, fraction in enumerate(fractions):
+        if (
+            isinstance(fraction, bool)
+            or not isinstance(fraction, (int, float))
+            or not math.isfinite(fraction)
+            or fraction < 0
+        ):
+            raise ValueError(
+                f"hourconsumption[{hour}] = {fraction!r}: is not a fraction of the day's energy >= 0"
+            )
+    total = math.fsum(fractions)
+    if abs(total - 1.0) > HOURCONSUMPTION_TOLERANCE:
+        raise ValueError(
+            f"hourconsumption: the 24 fractions sum to {total:g}; they are shares of "
+            f"consumptionday and must sum to 1 (within {HOURCONSUMPTION_TOLERANCE:g})"
+        )
+    return {
+        f"{hour:02d}:00": consumptionday * fraction / total
+        for hour, fraction in enumerate(fractions)
+    }
+
+
 def _day(steps: dict, clock_hours, linear: bool):
     """One day's profile at local clock hours [h]."""
     import numpy as np
@@ -135,7 +201,13 @@ def describe_load(study, p_load: float | None = None) -> dict:
         return {"p_load_w": scale}
     minutes = (np.arange(1440) + 0.5) / 60.0
     day = _day(profile.daily, minutes, profile.interpolation == "linear") * scale
-    name = Path(profile.file).stem if profile.file else "daily"
+    name = (
+        Path(profile.file).stem
+        if profile.file
+        else "hourconsumption"
+        if profile.hourconsumption is not None
+        else "daily"
+    )
     return {
         "profile": name,
         "scale": scale,

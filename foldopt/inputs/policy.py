@@ -31,7 +31,7 @@ from foldopt.names import HOURLY_WEATHER_FORMATS, OPTIMIZE_VARIABLES, WEATHER_FO
 
 #: Sections of a study whose fields a change merges into (a mapping changes the fields it names);
 #: any other field given a mapping (a load profile, a weather file) is replaced whole.
-SECTIONS = ("site", "panel", "tracker", "objective", "fold_angles", "near_optimal")
+SECTIONS = ("site", "panel", "tracker", "objective", "fold_angles", "near_optimal", "storage")
 #: Fields that take a paper-mode study away from the paper's site and day.
 AWAY_FROM_PAPER = ("site.latitude", "site.longitude", "site.altitude", "date", "weather")
 #: What the policy says where it switches a paper-mode study to exact mode.

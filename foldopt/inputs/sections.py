@@ -21,7 +21,7 @@ from pydantic import AfterValidator, Field, ValidationInfo, field_validator, mod
 from foldopt import names
 from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
 from foldopt.inputs.horizon_section import Horizon
-from foldopt.inputs.load_profile import profile_steps
+from foldopt.inputs.load_profile import hourly_steps, profile_steps
 from foldopt.inputs.optimize_section import grid_points
 from foldopt.inputs.reading import MAX_AXIS_VALUES
 from foldopt.names import ALEXANDRU_STEP_OFFSETS_H
@@ -307,6 +307,12 @@ class LoadProfile(StrictModel):
     file : str, optional
         A CSV of ``time,watts`` rows instead of ``daily``; its day becomes ``daily`` where its
         loader read it (:class:`FilesRead`).
+    hourconsumption : list of float, optional
+        Instead of ``daily``, PVGIS's off-grid form: 24 fractions of ``consumptionday``, one an
+        hour from 00:00, summing to 1; they become ``daily``
+        (:func:`foldopt.inputs.load_profile.hourly_steps`).
+    consumptionday : float, optional
+        With ``hourconsumption``: the day's energy [Wh] in (0, 1e7].
     interpolation : {'step', 'linear'}
     weekend : dict, optional
         The day of Saturdays and Sundays, as ``daily``.
@@ -316,15 +322,40 @@ class LoadProfile(StrictModel):
 
     daily: _ProfileSteps | None = None
     file: str | None = None
+    hourconsumption: list[float] | None = Field(
+        None, description="PVGIS's form: 24 fractions of consumptionday, hour by hour from 00:00"
+    )
+    consumptionday: interval(0, 1e7, lo_open=True, unit=" Wh") | None = Field(
+        None, description="with hourconsumption: the day's energy"
+    )
     interpolation: named(("step", "linear")) = "step"
     weekend: _ProfileSteps | None = None
     months: dict[Annotated[int, Field(ge=1, le=12)], _ProfileSteps] | None = None
 
     @model_validator(mode="after")
     def _one_day(self, info: ValidationInfo):
-        if (self.daily is None) == (self.file is None):
+        given = [
+            name for name in ("daily", "file", "hourconsumption") if getattr(self, name) is not None
+        ]
+        if len(given) != 1:
             raise ValueError(
-                "give the day's loads as daily (a mapping HH:MM: watts) or as file (a CSV), not both"
+                "give the day's loads as one of daily (a mapping HH:MM: watts), file (a CSV) or "
+                "hourconsumption (PVGIS's 24 fractions of consumptionday)"
+                + (f", not {' and '.join(given)}" if given else "")
+            )
+        if (self.hourconsumption is None) != (self.consumptionday is None):
+            raise ValueError(
+                "hourconsumption and consumptionday [Wh] go together: PVGIS's fractions of the "
+                "day's energy, and that energy"
+            )
+        if self.hourconsumption is not None:
+            if self.interpolation != "step":
+                raise ValueError(
+                    "interpolation: hourconsumption gives each hour's energy, held over the hour "
+                    "(step); linear would move energy between hours"
+                )
+            object.__setattr__(
+                self, "daily", hourly_steps(self.hourconsumption, self.consumptionday)
             )
         files = FilesRead.given(info)
         if self.file is not None and files is not None:
@@ -332,6 +363,11 @@ class LoadProfile(StrictModel):
                 raise ValueError(files.profile_problem)
             object.__setattr__(self, "daily", files.profile_daily)
         return self
+
+    @property
+    def read_daily(self) -> bool:
+        """Whether ``daily`` was worked out from ``file`` or ``hourconsumption``, not given."""
+        return self.file is not None or self.hourconsumption is not None
 
 
 class FoldAngles(StrictModel):

@@ -40,6 +40,7 @@ from foldopt.inputs.sections import (
     Tracker,
     standard_timezone,
 )
+from foldopt.inputs.storage_section import Storage
 from foldopt.inputs.weather_section import Weather
 
 #: Each mode's default clear sky: pvlib's Ineichen (with diffuse light, Perez transposition at the
@@ -111,6 +112,9 @@ class Study(StrictModel):
     p_load : float
         The load [W] in (0, 1e6]; with a ``load_profile``, the profile's scale [-] (default 1).
     load_profile : LoadProfile, optional
+    storage : Storage, optional
+        A buffer behind a charge controller; default none: the storage-less study, its answers
+        ``t_solar``'s.
     geometry : str, optional
         One of :data:`foldopt.names.GEOMETRIES`; default azimuth-split in paper mode, hinge in exact.
     fold_angles : FoldAngles
@@ -176,6 +180,9 @@ class Study(StrictModel):
         description="the load [W]; with a load_profile, the profile's scale [-]"
     )
     load_profile: LoadProfile | None = None
+    storage: Storage | None = Field(
+        None, description="a buffer behind a charge controller; default none (storage-less)"
+    )
     geometry: named(names.GEOMETRIES) | None = Field(
         None,
         description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact",
@@ -311,6 +318,8 @@ class Study(StrictModel):
             paths = [f"panel.{key}" for key in panel] + ["site.timezone"] * ("site" in decided)
         else:
             paths = []
+        if self.storage is not None:
+            paths += [f"storage.{name}" for name in self.storage.decided]
         for name, value in decided.items():
             object.__setattr__(self, name, value)  # frozen to users; decided here, once
         self._decided = frozenset(
@@ -541,7 +550,7 @@ class Study(StrictModel):
         for path in self._decided:
             section, _, name = path.rpartition(".")
             (data[section] if section else data).pop(name, None)
-        if self.load_profile is not None and self.load_profile.file is not None:
+        if self.load_profile is not None and self.load_profile.read_daily:
             data["load_profile"].pop("daily", None)
         if (
             self.site is not None

@@ -1,0 +1,197 @@
+"""The ``storage`` section of a study: a small buffer (a supercapacitor bank or a battery) behind a
+charge controller that cuts the load off at a low state of charge (:class:`Storage`). Like the
+other sections it only validates (:mod:`foldopt.inputs.sections`); the state of charge is
+simulated by :mod:`foldopt.engine.storage`.
+
+A study without the section is storage-less: every answer is the ``t_solar`` one. The module may
+import pydantic and :mod:`foldopt.names`.
+"""
+
+from __future__ import annotations
+
+from pydantic import Field, PrivateAttr, model_validator
+
+from foldopt import names
+from foldopt.inputs.fields import StrictModel, interval, named
+
+#: The buffer a study's storage is where it names no preset and leaves a field out: lossless, no
+#: self-discharge, usable down to empty and reconnected as soon as it holds energy again.
+IDEAL = {
+    "min_soc": 0.0,
+    "hysteresis": 0.0,
+    "charge_efficiency": 1.0,
+    "discharge_efficiency": 1.0,
+    "self_discharge": 0.0,
+}
+#: Each preset of :data:`foldopt.names.STORAGE_PRESETS`: the datasheet-typical values of the fields
+#: it fills, ``hysteresis`` being how far above ``min_soc`` the load is reconnected (``restart_soc
+#: = min_soc + hysteresis``, at most 1). Sources in :class:`Storage`'s References.
+PRESETS = {
+    # [1] an EDLC's energy is C V^2 / 2: a converter that works down to half the rated voltage
+    # leaves a quarter of the energy; a converter's under-voltage lockout releasing some 10 % of
+    # the voltage higher (0.55 V_r) reconnects at 0.30 of the energy. [2] ESR losses of a few %
+    # at moderate currents; [3] 100 % to 50 % stored energy in 30 to 40 days: 0.98^35 = 0.49.
+    "supercapacitor": {
+        "min_soc": 0.25,
+        "hysteresis": 0.05,
+        "charge_efficiency": 0.98,
+        "discharge_efficiency": 0.98,
+        "self_discharge": 0.02,
+    },
+    # [4] 92 % round trip (0.96 x 0.96), its cycle life rated at 80 % depth of discharge (a 20 %
+    # cut-off); [5] 2 to 5 %/month self-discharge: 3 %/month is 1 - 0.97^(1/30) = 0.001 a day.
+    # A controller's load output reconnects some 10 % of the capacity above its cut-off.
+    "lifepo4": {
+        "min_soc": 0.20,
+        "hysteresis": 0.10,
+        "charge_efficiency": 0.96,
+        "discharge_efficiency": 0.96,
+        "self_discharge": 0.001,
+    },
+}
+#: The fields a preset (or :data:`IDEAL`) fills where a study leaves them out, in the order they
+#: are filled (``restart_soc`` from the ``min_soc`` in force).
+FILLED = ("min_soc", "restart_soc", "charge_efficiency", "discharge_efficiency", "self_discharge")
+
+
+class Storage(StrictModel):
+    """A buffer behind a charge controller: what the load runs on when PV alone does not carry it.
+
+    Per time step, PV above the load serves it and charges the buffer (what does not fit is lost);
+    PV below the load is topped up from the buffer; below ``min_soc`` the controller cuts the
+    load off until the state of charge climbs back to ``restart_soc``, and while it is off all PV
+    charges the buffer (:mod:`foldopt.engine.storage`). A field left out takes its ``preset``'s
+    value (:data:`PRESETS`), or without a preset the ideal buffer's (:data:`IDEAL`); a field given
+    always wins. What was filled is no setting of the user's: the study's data leave it out, so a
+    variant with another preset fills its own.
+
+    Parameters
+    ----------
+    capacity_wh : float
+        The usable energy of the full buffer [Wh] in [0, 1e6]; 0 is the storage-less study, its
+        answer exactly the ``t_solar`` one.
+    min_soc : float, optional
+        The controller's cut-off: the state of charge [-] in [0, 1) at which it disconnects the
+        load. Default the preset's, else 0.
+    restart_soc : float, optional
+        The state of charge [-] in [min_soc, 1] at which it reconnects the load (hysteresis).
+        Default ``min_soc`` plus the preset's hysteresis (at most 1), else ``min_soc``.
+    charge_efficiency, discharge_efficiency : float, optional
+        [-] in (0, 1]: the energy stored of the energy put in, and the energy delivered of the
+        energy taken out. Default the preset's, else 1.
+    self_discharge : float, optional
+        The fraction of the stored energy lost a day [1/day] in [0, 1). Default the preset's,
+        else 0.
+    max_charge_w, max_discharge_w : float, optional
+        The most power the buffer takes in / gives out [W] in (0, 1e6]; default unlimited.
+    initial_soc : float, optional
+        The state of charge [-] in [0, 1] at the start of the study's first day; default the
+        periodic steady state (a repeated clear-sky day is run until its midnight state of charge
+        repeats; a weather year starts from the state at its own end). It may lie below
+        ``min_soc`` (a buffer delivered flat, or left to self-discharge): the load then starts
+        off and waits for ``restart_soc``; above ``min_soc`` it starts on.
+    preset : str, optional
+        One of :data:`foldopt.names.STORAGE_PRESETS`, whose values fill the fields above that
+        are left out.
+
+    Raises
+    ------
+    ValueError
+        For ``restart_soc`` below ``min_soc``, naming both and where each came from.
+
+    References
+    ----------
+    .. [1] Maxwell Technologies, "Ultracapacitor product guide", doc. 1014627: the energy
+       1/2 C V^2, and discharge to half the rated voltage using three quarters of it.
+    .. [2] Maxwell Technologies, "Datasheet HC series ultracapacitors", doc. 1013793: ESR DC
+       and leakage current of 1 to 150 F cells; the efficiency section of [1].
+    .. [3] Battery University, "BU-209: How does a supercapacitor work?": the stored energy
+       decreases from 100 to 50 % in 30 to 40 days.
+    .. [4] Victron Energy, "Lithium Battery Smart (LFP-Smart) technical data": round trip
+       efficiency 92 %, cycle life 2500 cycles at 80 % depth of discharge.
+    .. [5] LiFePO4 makers' stated self-discharge: 2 to 3 %/month (Redway, "What is the
+       self-discharge rate of LiFePO4 batteries?"), typically 5 %/month (Dakota Lithium, "How
+       long will my battery hold a charge?").
+    .. [6] PVGIS, "Performance of off-grid PV systems" (SHScalc): battery size [Wh], discharge
+       cut-off limit [%], days with the battery full / empty, energy lost / missing.
+    """
+
+    capacity_wh: interval(0, 1e6, unit=" Wh") = Field(
+        description="usable energy of the full buffer; 0 is storage-less"
+    )
+    min_soc: interval(0, 1, hi_open=True) | None = Field(
+        None, description="the controller's cut-off; default the preset's, else 0"
+    )
+    restart_soc: interval(0, 1) | None = Field(
+        None,
+        description="where the load is reconnected, >= min_soc; default min_soc plus the preset's "
+        "hysteresis, else min_soc",
+    )
+    charge_efficiency: interval(0, 1, lo_open=True) | None = Field(
+        None, description="default the preset's, else 1"
+    )
+    discharge_efficiency: interval(0, 1, lo_open=True) | None = Field(
+        None, description="default the preset's, else 1"
+    )
+    self_discharge: interval(0, 1, hi_open=True, unit=" per day") | None = Field(
+        None, description="fraction of the stored energy lost a day; default the preset's, else 0"
+    )
+    max_charge_w: interval(0, 1e6, lo_open=True, unit=" W") | None = Field(
+        None, description="default unlimited"
+    )
+    max_discharge_w: interval(0, 1e6, lo_open=True, unit=" W") | None = Field(
+        None, description="default unlimited"
+    )
+    initial_soc: interval(0, 1) | None = Field(
+        None, description="at the first day's start; default the periodic steady state"
+    )
+    preset: named(names.STORAGE_PRESETS) | None = Field(
+        None, description="fills the fields left out with a chemistry's typical values"
+    )
+    #: The fields the preset (or the ideal buffer) filled, not given (:meth:`_fill`).
+    _decided: frozenset = PrivateAttr(frozenset())
+
+    @model_validator(mode="after")
+    def _fill(self):
+        """The fields left out, from the preset or the ideal buffer, once; then the checks."""
+        values = PRESETS[self.preset] if self.preset is not None else IDEAL
+        source = f"the {self.preset} preset's" if self.preset is not None else "the default"
+        decided = [name for name in FILLED if getattr(self, name) is None]
+        for name in decided:
+            # Rounded: decimal fractions added in binary (0.2 + 0.1 is 0.30000000000000004).
+            value = (
+                round(min(1.0, self.min_soc + values["hysteresis"]), 12)
+                if name == "restart_soc"
+                else values[name]
+            )
+            object.__setattr__(self, name, value)  # frozen to users; filled here, once
+        self._decided = frozenset(decided)
+        if self.restart_soc < self.min_soc:
+            said = {name: "" if name not in decided else f", {source}" for name in FILLED}
+            raise ValueError(
+                f"restart_soc ({self.restart_soc:g}{said['restart_soc']}) is below min_soc "
+                f"({self.min_soc:g}{said['min_soc']}): the controller reconnects the load at or "
+                "above its cut-off; raise restart_soc or lower min_soc"
+            )
+        return self
+
+    @property
+    def decided(self) -> frozenset:
+        """The fields the preset, or the ideal buffer, filled: the study's data leave them out."""
+        return self._decided
+
+    def describe(self) -> str:
+        """The buffer in words: ``buffer 20 Wh (lifepo4; cut-off 20 %, reconnect 30 %, ...)``."""
+        limits = ", ".join(
+            f"{label} {value:g} W"
+            for label, value in (("charge", self.max_charge_w), ("discharge", self.max_discharge_w))
+            if value is not None
+        )
+        parts = [
+            self.preset,
+            f"cut-off {self.min_soc:.0%}, reconnect {self.restart_soc:.0%}",
+            f"efficiency {self.charge_efficiency:g} in, {self.discharge_efficiency:g} out",
+            f"self-discharge {self.self_discharge:g}/day" if self.self_discharge else None,
+            f"at most {limits}" if limits else None,
+        ]
+        return f"buffer {self.capacity_wh:g} Wh ({'; '.join(part for part in parts if part)})"
