@@ -6,15 +6,41 @@ A leaf: it imports nothing of foldopt.
 
 from __future__ import annotations
 
+import contextvars
 import hashlib
 import io
 import os
 import sys
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 #: Ends every cache file, followed by the SHA-256 (hex) of the bytes before it.
 _CHECKSUM = b"\nfoldopt-sha256:"
+#: Offline in this context (the command line's ``--offline``): what is fetched comes from the
+#: cache only (:func:`offline`).
+_OFFLINE: contextvars.ContextVar[bool] = contextvars.ContextVar("foldopt_offline", default=False)
+
+
+def offline() -> bool:
+    """Whether foldopt fetches nothing and reads fetched data from its cache only:
+    ``--offline`` (:func:`offline_mode`) or ``FOLDOPT_OFFLINE=1``."""
+    return _OFFLINE.get() or os.environ.get("FOLDOPT_OFFLINE", "") == "1"
+
+
+@contextmanager
+def offline_mode(on: bool = True):
+    """Offline (:func:`offline`) for the block where ``on``.
+
+    Parameters
+    ----------
+    on : bool, default True
+    """
+    token = _OFFLINE.set(bool(on) or _OFFLINE.get())
+    try:
+        yield
+    finally:
+        _OFFLINE.reset(token)
 
 
 def cache_dir() -> Path:
@@ -77,17 +103,40 @@ def store_cache(path: Path, arrays: dict, compress: bool = False) -> None:
     (np.savez_compressed if compress else np.savez)(buffer, **arrays)
     payload = buffer.getvalue()
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(
-            dir=path.parent, prefix=f".{path.name}.", suffix=".tmp"
+        write_atomically(
+            path,
+            lambda temporary: temporary.write_bytes(
+                payload + _CHECKSUM + hashlib.sha256(payload).hexdigest().encode()
+            ),
         )
     except OSError:
         return  # no cache where none can be written
+
+
+def write_atomically(path: Path, write) -> None:
+    """``write(temporary)`` to a new file beside ``path``, then rename it into ``path``: a reader
+    sees the old file or the whole new one, and a write that fails (or raises) leaves nothing.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file to write; its folder is made where missing.
+    write : callable
+        Writes the file whose path (a :class:`pathlib.Path`) it is given.
+
+    Raises
+    ------
+    OSError
+        Where the folder or the file cannot be written; whatever ``write`` raises.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(handle)
     try:
-        with os.fdopen(handle, "wb") as file:
-            file.write(payload + _CHECKSUM + hashlib.sha256(payload).hexdigest().encode())
+        write(Path(temporary))
         os.replace(temporary, path)  # atomic: readers see the old file or the whole new one
-    except OSError:
+    finally:
         Path(temporary).unlink(missing_ok=True)
 
 

@@ -205,6 +205,15 @@ WEATHER_FORMATS = Registry(
 #: The weather formats of hourly files (typical years), brought to the study's step; the others of
 #: :data:`WEATHER_FORMATS` are measured files, evaluated at their own step.
 HOURLY_WEATHER_FORMATS = ("tmy3", "epw", "pvgis")
+#: Weather fetched from a public service by name, cached and replayed offline
+#: (:data:`foldopt.inputs.weather.sources.SOURCES`): ``weather.source`` or ``--weather NAME``.
+WEATHER_SOURCES = Registry(
+    "weather source",
+    {
+        "pvgis-tmy": "PVGIS's typical meteorological year of the site (EU JRC, SARAH3 / ERA5 "
+        "satellite and reanalysis data; pvlib.iotools.get_pvgis_tmy's request)",
+    },
+)
 DECOMPOSITIONS = Registry(
     "decomposition",
     {
@@ -270,6 +279,7 @@ REGISTRIES = (
     TRACKERS,
     DRIVES,
     WEATHER_FORMATS,
+    WEATHER_SOURCES,
     DECOMPOSITIONS,
     INTERVAL_LABELS,
     HOTTEL_CLIMATES,
@@ -336,6 +346,7 @@ FIELD_OPTIONS = (
     FieldOption("--sky", "sky"),
     FieldOption("--climate", "climate"),
     FieldOption("--weather", "weather"),
+    FieldOption("--years", "weather.years"),
     FieldOption("--force-site", "force_site", flag=True),
     FieldOption("--transposition", "transposition"),
     FieldOption("--albedo", "albedo"),

@@ -76,7 +76,7 @@ def test_a_misspelt_option_gets_that_option_among_all_the_commands_options(capsy
 
 @pytest.mark.parametrize("path,args,end", [
     ("run", ["--bogus"], "No such option: --bogus (foldopt run --help lists its options)"),
-    ("run", ["--lat", "3"], "No such option: --lat (--lat is an option of foldopt map, optimize, sweep; foldopt run "
+    ("run", ["--lat", "3"], "No such option: --lat (--lat is an option of foldopt map, optimize, sweep, weather; foldopt run "
                             "--help lists its own)"),
     ("sweep angle", ["--p-laod", "3"], "No such option: --p-laod; did you mean --p-load?"),
     ("size", ["--cost", "3"], "No such option: --cost; did you mean --cost-per-m2 or --cost-per-w?"),

@@ -58,7 +58,7 @@ def test_help_lists_the_registries():
 
 #: Options of ``foldopt sweep`` and ``optimize`` that set no study field, by parameter.
 _OWN_OPTIONS = {"config", "settings", "out", "overwrite", "quiet", "output_format", "engine", "table", "vary",
-                "fold_range", "tilt_range", "azimuth_range", "tolerance"}
+                "fold_range", "tilt_range", "azimuth_range", "tolerance", "offline"}
 
 
 @pytest.mark.parametrize("path", [["sweep", "angle"], ["sweep", "load"], ["optimize"]], ids=" ".join)

@@ -24,7 +24,7 @@ from typing import Annotated
 import typer
 from typer.core import TyperCommand, TyperGroup
 
-from foldopt.cli import map as map_command, optimize, run, size, sweep
+from foldopt.cli import map as map_command, optimize, run, size, sweep, weather
 from foldopt.cli.output import INVOCATION, as_text, echo
 from foldopt.errors import ConfigError, OutputError, OutputExistsError
 from foldopt.names import close_names
@@ -46,6 +46,7 @@ Examples:
   foldopt reproduce                            Shin et al.'s numbers beside foldopt's
   foldopt sweep latitude                       the embedded study from 60 S to 60 N
   foldopt sweep angle --weather FILE.csv       a real year from a TMY3 / EPW / PVGIS file
+  foldopt sweep angle --lat 45.8 --lon 8.6 --weather pvgis-tmy   the site's year from PVGIS
   foldopt size --cost-per-w 0.9                panel sizing (Shin et al. Sec. IV-A)
   foldopt map --p-load 2 --area 0.108          many sites on Dask: where folding pays, worldwide
 
@@ -224,6 +225,7 @@ app = typer.Typer(
     help=HELP,
 )
 sweep_app = typer.Typer(rich_markup_mode=None, no_args_is_help=True, help=sweep.HELP)
+weather_app = typer.Typer(rich_markup_mode=None, no_args_is_help=True, help=weather.HELP)
 
 
 def _print_version(value: bool) -> None:
@@ -266,12 +268,14 @@ def _restore_environment(name: str, value: str | None) -> None:
 
 
 app.add_typer(sweep_app, name="sweep", short_help=sweep.SHORT_HELP)
+app.add_typer(weather_app, name="weather", short_help=weather.SHORT_HELP)
 for group, commands in (
     (app, run.COMMANDS),
     (sweep_app, sweep.COMMANDS),
     (app, map_command.COMMANDS),
     (app, size.COMMANDS),
     (app, optimize.COMMANDS),
+    (weather_app, weather.COMMANDS),
 ):
     for name, command, short_help in commands:
         group.command(name, cls=_OnceEach, short_help=short_help)(command)

@@ -127,9 +127,26 @@ def sweep_options(
             "--weather",
             help="Weather file: an hourly TMY3 / EPW / PVGIS TMY "
             "(its site and whole year) or a measured file (its days, at its "
-            "step).",
+            "step); or a source fetched for the site and cached: "
+            + _choices(names.WEATHER_SOURCES)
+            + ".",
         ),
     ] = None,
+    years: Annotated[
+        str | None,
+        typer.Option(
+            "--years",
+            help="A weather source's years START:END, e.g. 2005:2020 (PVGIS TMY: its months "
+            "chosen from them, at least 10) [default: the service's record].",
+        ),
+    ] = None,
+    offline: Annotated[
+        bool,
+        typer.Option(
+            "--offline",
+            help="Fetch nothing: a weather source from foldopt's cache only (FOLDOPT_OFFLINE=1).",
+        ),
+    ] = False,
     weather_format: Annotated[
         str | None,
         typer.Option(

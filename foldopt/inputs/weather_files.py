@@ -201,6 +201,68 @@ def _options_problem(spec: dict, keys=(*_NAMED_OPTIONS, *_NUMBER_OPTIONS)) -> st
     return None
 
 
+def with_fetched_weather(data):
+    """A study's data whose ``weather`` names a source (:data:`foldopt.names.WEATHER_SOURCES`),
+    with the source's answer for the study's site as its file: ``weather.path`` the cached
+    answer (fetched where it is not cached, :func:`foldopt.inputs.weather.sources.fetch`) and
+    ``weather.format`` the format it is read as; from there on it is a weather file like any.
+
+    Parameters
+    ----------
+    data : dict
+        A study's fields.
+
+    Returns
+    -------
+    dict
+        ``data`` itself where its weather names no source, or a source or option that is not
+        valid (the study's validation names the fault).
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        For a site that varies or is not given (a source is fetched for one site).
+    foldopt.errors.WeatherError
+        For an answer that cannot be had (:func:`~foldopt.inputs.weather.sources.fetch`).
+    """
+    weather = data.get("weather") if isinstance(data, dict) else None
+    if not isinstance(weather, dict) or weather.get("source") is None:
+        return data
+    from pydantic import ValidationError
+
+    from foldopt.inputs.weather_section import Weather
+
+    try:
+        spec = Weather.model_validate({**weather, "path": None})
+    except ValidationError:
+        return data  # the study names the fault
+    site = data.get("site")
+    varied = _varied_site(site)
+    if varied is not None:
+        raise ConfigError(
+            [
+                f"{varied}: varies, but weather.source {spec.source} is fetched for one site; give "
+                "one site (fetch several ahead with foldopt weather fetch, one site each)"
+            ]
+        )
+    place = site if isinstance(site, dict) else {}
+    if not all(
+        isinstance(place.get(key), (int, float)) and not isinstance(place.get(key), bool)
+        for key in ("latitude", "longitude")
+    ):
+        raise ConfigError(
+            [
+                f"weather.source {spec.source}: fetches the weather of the study's site; give its "
+                "latitude and longitude (--lat, --lon; site.latitude, site.longitude)"
+            ]
+        )
+    from foldopt.inputs.weather.sources import SOURCES, fetch  # requests: only to fetch
+
+    answer = fetch(spec.source, place["latitude"], place["longitude"], spec)
+    fetched = {**weather, "source": spec.source, "path": answer.file}
+    return {**data, "weather": {**fetched, "format": SOURCES[spec.source].format}}
+
+
 def weather_defaults(data: dict) -> dict:
     """What a study's fields take from its weather file where it leaves them out: the dates (an
     hourly file's whole ``year``; a measured file's days) and, for a measured file, the step.

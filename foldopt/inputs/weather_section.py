@@ -8,9 +8,10 @@ The module may import pydantic, :mod:`foldopt.names` and :mod:`foldopt.inputs.se
 from __future__ import annotations
 
 import datetime as dt
+import re
 from typing import Annotated
 
-from pydantic import AfterValidator, Field, ValidationInfo, field_validator
+from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
 
 from foldopt import names
 from foldopt.inputs.fields import StrictModel, interval, named
@@ -25,15 +26,36 @@ def _check_offset(name: str | None) -> str | None:
     return name
 
 
+def _check_years(years: str | None) -> str | None:
+    if years is None:
+        return None
+    found = re.fullmatch(r"\s*(\d{4})\s*:\s*(\d{4})\s*", str(years))
+    if found is None:
+        raise ValueError("the first and last year as START:END, e.g. 2005:2020")
+    start, end = int(found.group(1)), int(found.group(2))
+    if start > end:
+        raise ValueError("the first year comes after the last")
+    return f"{start}:{end}"
+
+
+def _check_url(url: str | None) -> str | None:
+    if url is not None and not re.match(r"https?://[^/\s]+", url):
+        raise ValueError("a base address http://... or https://..., e.g. a mirror's")
+    return url
+
+
 class Weather(StrictModel):
     """A weather file, read through pvlib.iotools (:mod:`foldopt.inputs.weather`): an hourly
     typical year (TMY3, EPW, PVGIS TMY), brought to the study's step, or a measured sub-hourly
-    file (SURFRAD, MIDC, SRML, BSRN, SOLRAD, CRN, a CSV), evaluated at its own.
+    file (SURFRAD, MIDC, SRML, BSRN, SOLRAD, CRN, a CSV), evaluated at its own; or a weather
+    source, a public service's answer for the study's site, fetched and cached
+    (:mod:`foldopt.inputs.weather.sources`), then read as the file it is.
 
     Parameters
     ----------
-    path : str
-        The file; a study file's relative path is relative to the study file.
+    path : str, optional
+        The file; a study file's relative path is relative to the study file. With a
+        ``source``, the cached answer (filled in when the study is planned).
     format : str, optional
         One of :data:`foldopt.names.WEATHER_FORMATS`; default from the extension (hourly formats;
         a measured file names its format).
@@ -53,9 +75,21 @@ class Weather(StrictModel):
         (:mod:`foldopt.inputs.weather.ensemble`), 2 to 200; default none (the smooth minutes).
     seed : int
         The ensemble's seed; the same seed gives the same members. Default 0.
+    source : str, optional
+        One of :data:`foldopt.names.WEATHER_SOURCES`: the site's weather from that service.
+    years : str, optional
+        A source's years ``START:END`` (PVGIS TMY: the years its months are chosen from, at
+        least 10); default the service's whole record.
+    usehorizon : bool
+        A source's light with the terrain's horizon shading it (PVGIS's DEM); default True.
+    url : str, optional
+        A source's base address (a mirror, a proxy); default ``FOLDOPT_PVGIS_URL``, else the
+        service's pinned versioned address.
+    timeout_s : float
+        Seconds a source's request waits for the service, in (0, 600]; default 30.
     """
 
-    path: str
+    path: str | None = Field(None, description="the file; with a source, its cached answer")
     format: named(names.WEATHER_FORMATS) | None = Field(
         None,
         description="default from the extension (hourly formats); a measured file names its format",
@@ -75,6 +109,17 @@ class Weather(StrictModel):
         None, description="an hourly file's cloud ensemble of this many members"
     )
     seed: Annotated[int, Field(ge=0)] = 0
+    source: named(names.WEATHER_SOURCES) | None = Field(
+        None, description="weather fetched for the site from a public service"
+    )
+    years: Annotated[str | None, AfterValidator(_check_years)] = Field(
+        None, description="a source's years START:END; default the service's record"
+    )
+    usehorizon: bool = True
+    url: Annotated[str | None, AfterValidator(_check_url)] = Field(
+        None, description="a source's base address; default FOLDOPT_PVGIS_URL or the pinned one"
+    )
+    timeout_s: interval(0, 600, lo_open=True, unit=" s") = 30.0
 
     @property
     def measured(self) -> bool:
@@ -110,3 +155,19 @@ class Weather(StrictModel):
         if value != 0 and info.data.get("members") is None:
             raise ValueError("is only used by a cloud ensemble (weather.members)")
         return value
+
+    @model_validator(mode="after")
+    def _file_or_source(self):
+        if self.path is None and self.source is None:
+            raise ValueError(
+                "give a weather file (weather.path, --weather FILE) or a source (weather.source, "
+                f"--weather NAME: {', '.join(names.WEATHER_SOURCES)})"
+            )
+        defaults = {"years": None, "usehorizon": True, "url": None, "timeout_s": 30.0}
+        given = [key for key, value in defaults.items() if getattr(self, key) != value]
+        if self.source is None and given:
+            raise ValueError(
+                f"weather.{given[0]} is only used by a weather source (weather.source: "
+                f"{', '.join(names.WEATHER_SOURCES)})"
+            )
+        return self

@@ -28,15 +28,40 @@ def run_metadata(study: Study, command: list[str] | None = None, **extra) -> dic
     Returns
     -------
     dict
-        ``study`` (the study as JSON), ``mode``, ``command``, ``versions`` and ``extra``.
+        ``study`` (the study as JSON), ``mode``, ``command``, ``versions``, for weather fetched
+        from a source ``weather_source`` (:func:`weather_source`), and ``extra``.
     """
+    fetched = weather_source(study)
     return {
         "study": study.model_dump(mode="json"),
         "mode": study.mode,
         "command": command if command is not None else sys.argv,
         "versions": versions(),
+        **({"weather_source": fetched} if fetched is not None else {}),
         **extra,
     }
+
+
+def weather_source(study: Study) -> dict | None:
+    """Where a study's fetched weather came from: the source, the request, when it was
+    retrieved and the SHA-256 of the cached answer the study read
+    (:class:`foldopt.inputs.weather.sources.WeatherProvenance`); None for a weather file.
+
+    Parameters
+    ----------
+    study : foldopt.Study
+
+    Returns
+    -------
+    dict or None
+    """
+    weather = study.weather
+    if weather is None or weather.source is None or weather.path is None:
+        return None
+    from foldopt.inputs.weather.sources import cached
+
+    found = cached(weather.path)
+    return found.to_dict() if found is not None else None
 
 
 def input_hash(data) -> str:

@@ -18,7 +18,9 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, replace
 
+from foldopt.cache import offline_mode
 from foldopt.inputs import policy
+from foldopt.names import WEATHER_SOURCES
 from foldopt.inputs.study_file import default_study_path, parse_study_text, read_study
 from foldopt.inputs.optimize_section import vary_names
 from foldopt.names import FIELD_OF_PARAMETER, FIELD_OPTIONS, OPTIMIZE_VARIABLES
@@ -385,7 +387,7 @@ def sweep_changes(options: dict, data: dict) -> dict:
             )
     lonely = [
         option
-        for option in ("weather_format", "members", "seed")
+        for option in ("weather_format", "members", "seed", "years")
         if options.get(option) is not None
     ]
     if lonely and options.get("weather") is None and data.get("weather") is None:
@@ -404,6 +406,8 @@ def sweep_changes(options: dict, data: dict) -> dict:
                 flag = "--" + option.replace("_", "-")
                 errors.append(f"{flag} = {options[option]!r}: {error}")
                 continue
+        elif option == "weather" and str(value) in WEATHER_SOURCES:
+            value = {"source": str(value)}  # a source's name: its answer for the site
         elif option == "weather":
             value = {"path": str(value)}  # a new file: none of the study's file's options
         elif option == "load_profile":
@@ -509,6 +513,12 @@ def sweep_request(
     foldopt.ConfigError
         One line per fault, naming the option or the field.
     """
+    options = dict(options)
+    with offline_mode(options.pop("offline", False)):  # --offline: a weather source's cache only
+        return _sweep_request(study, options, axis, source, section)
+
+
+def _sweep_request(study, options: dict, axis, source: str, section) -> Request:
     data = (
         study
         if isinstance(study, dict)

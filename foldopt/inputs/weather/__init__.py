@@ -154,6 +154,24 @@ def _read_checked(path: str, fmt: str, year: int):
     return frame, meta
 
 
+def check_answer(path, fmt: str) -> None:
+    """Check a service's answer as the weather file of format ``fmt`` it is, with every check a
+    file of that format gets (:mod:`~foldopt.inputs.weather.sources`, before it is cached).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    fmt : str
+        One of :data:`FORMATS`.
+
+    Raises
+    ------
+    foldopt.errors.WeatherError
+        Naming the file, where and why.
+    """
+    _read_checked(str(path), fmt, 2025)
+
+
 def weather_site(path, fmt: str | None = None, site: dict | None = None, **measured) -> dict | None:
     """The site a weather file describes, from its header.
 
