@@ -1,0 +1,524 @@
+"""A small buffer behind a charge controller: the state of charge step by step, and how long the
+load runs with it (issue 41). Arrays in, arrays out: power curves, a load and a buffer in; each
+day's powered time and energies, and the state of charge, out.
+
+The model is that of a charge controller with a low-voltage disconnect, as in PVGIS's off-grid
+calculator [1]_ and SAM's simple battery [2]_. The power curve is the one
+:mod:`foldopt.engine.metrics` integrates: sampled at step centres, linear between them and held for
+half a step at both ends of each day; a load profile is taken the same way. Each day is cut into
+those ``n_steps + 1`` segments, and each segment at the instant where the power crosses the load
+(where :func:`foldopt.engine.metrics.t_solar` cuts it) into a part with the power at or above the
+load and a part below it. Per part, while the load is on:
+
+- at or above the load, PV serves the load and the surplus charges the buffer through
+  ``charge_efficiency``, at most ``max_charge_w`` at each instant and at most the room left; what
+  does not fit is *lost*;
+- below it, the buffer covers the deficit through ``discharge_efficiency``. The part is powered
+  only if the buffer covers the whole of the part's deficit from its content above ``min_soc``,
+  and the deficit never exceeds ``max_discharge_w``; otherwise the load is off for the whole part
+  (its energy is *missing*) and stays off until the content reaches ``restart_soc`` (the
+  controller's hysteresis, checked at the start of each part). While the load is off, all the PV
+  charges the buffer.
+
+Self-discharge takes ``(1 - self_discharge) ** (tau / 24)`` of the content at the end of each
+segment of ``tau`` hours (``self_discharge`` a day).
+
+Conventions that follow from it:
+
+- With ``capacity_wh = 0`` the load is powered exactly in the parts at or above the load: the
+  powered time of a constant load is :func:`foldopt.engine.metrics.t_solar` of the same curve,
+  segment for segment (the sums may differ in the last bit). A load profile is compared by the
+  difference ``P - L`` of the two linear curves, where :func:`foldopt.engine.metrics.per_load`
+  compares the ratio ``P / shape`` with a scale: the two agree at step centres and wherever the
+  profile is constant over a segment, and differ inside segments over which the profile changes.
+- Powered time counts only segments in which the load demands power (a profile that is zero at
+  both ends of a segment runs nothing there, so neither powered nor missing time).
+- Every part is all or nothing: a load the buffer cannot carry to the end of a part (at most one
+  step) is off for all of it, so an outage starts up to a step early. Reconnection happens at a
+  part's start.
+- Power below zero (a tracker net of its drive) is run from the buffer while the load is on, as
+  part of the deficit; while the load is off the controller disconnects it too, and it is counted
+  nowhere. Energy is then conserved for curves that do not go below zero:
+  ``served + lost + delta stored + conversion losses + self-discharge = harvested``.
+- Days *full* and *empty* are PVGIS's [1]_: days on which the buffer was full at some instant
+  (never with no capacity), and days on which the controller cut the load off for lack of charge
+  (it reached its discharge cut-off).
+
+Initial state: ``initial_soc``, or by default the periodic steady state: the series is run from a
+full buffer, then from the state it ended in, until the state at its end is that at its start (the
+content within ``tolerance`` x the capacity, the load on or off alike); after
+:data:`~foldopt.engine.storage_kernel.PLAIN_ITERATIONS` passes the start is bisected between the
+contents that ended higher and lower, and after ``max_iterations`` passes, or once that bracket is
+narrower than the tolerance (the end state jumps over the start's: no periodic state), the last
+pass is kept and the series is flagged. One clear-sky day is thus repeated until its midnight
+state repeats; a weather year starts from the state at its own end.
+
+References
+----------
+.. [1] European Commission JRC, PVGIS, "Off-grid PV systems" (tool SHScalc): outputs f_f
+   (percentage of days with the battery fully charged), f_e (percentage of days it became fully
+   discharged), E_lost (energy not captured because the battery was full), E_miss (energy
+   missing), and a histogram of the battery's charge state.
+.. [2] NREL System Advisor Model, "Battery storage: simple battery model" (capacity, minimum state
+   of charge, charge and discharge efficiencies and power limits).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from foldopt.engine import storage_kernel as kern
+
+#: The engines :func:`simulate` runs on.
+STORAGE_ENGINES = ("numba", "numpy")
+#: State-of-charge bins of the histogram, as PVGIS reports it (0-10 %, ..., 90-100 %).
+SOC_BINS = 10
+
+
+class Buffer(NamedTuple):
+    """A buffer and its charge controller. Every field is a float, or an array with one value per
+    series (several capacities evaluated at once, as a sizing search does).
+
+    Attributes
+    ----------
+    capacity_wh : float
+        Usable capacity [Wh], 0 or more (0: no buffer).
+    min_soc : float, default 0
+        The controller's cut-off: the buffer is not drawn below it [-, 0..1].
+    restart_soc : float, optional
+        The state of charge at which the controller reconnects the load [-, ``min_soc``..1];
+        default ``min_soc`` (no hysteresis).
+    charge_efficiency, discharge_efficiency : float, default 1
+        Bus to buffer, buffer to bus [-, 0 excluded..1].
+    self_discharge : float, default 0
+        Fraction of the content lost a day [-, 0..1 excluded].
+    max_charge_w, max_discharge_w : float, optional
+        Power into the buffer (at the bus, before the charge efficiency) and out of it (at the
+        bus) [W]; default unlimited.
+    initial_soc : float, optional
+        State of charge at the start of the series [-, 0..1]; default the periodic steady state.
+    """
+
+    capacity_wh: float
+    min_soc: float = 0.0
+    restart_soc: float | None = None
+    charge_efficiency: float = 1.0
+    discharge_efficiency: float = 1.0
+    self_discharge: float = 0.0
+    max_charge_w: float | None = None
+    max_discharge_w: float | None = None
+    initial_soc: float | None = None
+
+
+class StorageResult(NamedTuple):
+    """Each series' days with a buffer. Energies in Wh a day, times in hours a day.
+
+    Attributes
+    ----------
+    powered_h : (n_series, n_days) float
+        Hours the load runs, from PV or from the buffer.
+    served_wh, missing_wh : (n_series, n_days) float
+        Load energy served, and not served while the load was off.
+    lost_wh : (n_series, n_days) float
+        PV energy neither served nor taken into the buffer (full, or over ``max_charge_w``).
+    harvested_wh : (n_series, n_days) float
+        The curve's energy (:func:`foldopt.engine.metrics.energy`).
+    charge_loss_wh, discharge_loss_wh, self_discharge_wh : (n_series, n_days) float
+        Conversion losses into and out of the buffer, and its leak.
+    full, empty : (n_series, n_days) bool
+        PVGIS's days full and empty (module docstring).
+    soc_hours : (n_series, n_days, SOC_BINS) float
+        Hours a day the state of charge spends in each tenth (0-10 %, ..., 90-100 %).
+    stored_wh : (n_series, n_days + 1) float
+        Content at each midnight, from the start of the first day to the end of the last.
+    soc : (n_series, n_days, n_steps) float or None
+        State of charge at every step centre, where asked (``soc_curves``).
+    passes : (n_series,) int
+        Passes over the series run; negative where no periodic state was found (module
+        docstring), 1 with an ``initial_soc``.
+    """
+
+    powered_h: np.ndarray
+    served_wh: np.ndarray
+    missing_wh: np.ndarray
+    lost_wh: np.ndarray
+    harvested_wh: np.ndarray
+    charge_loss_wh: np.ndarray
+    discharge_loss_wh: np.ndarray
+    self_discharge_wh: np.ndarray
+    full: np.ndarray
+    empty: np.ndarray
+    soc_hours: np.ndarray
+    stored_wh: np.ndarray
+    soc: np.ndarray | None
+    passes: np.ndarray
+
+    @property
+    def converged(self) -> np.ndarray:
+        """(n_series,) bool: the series started from its ``initial_soc`` or its periodic state."""
+        return self.passes > 0
+
+
+def simulate(
+    power,
+    load,
+    buffer: Buffer,
+    step_hours: float,
+    engine: str = "numba",
+    soc_curves: bool = False,
+    max_iterations: int = 60,
+    tolerance: float = 1e-6,
+) -> StorageResult:
+    """Simulate the state of charge of a buffer over power curves and a load.
+
+    Parameters
+    ----------
+    power : array_like
+        Power at step centres [W], (n_series, n_days, n_steps), or (n_series, n_steps) for one day
+        (repeated until periodic by default). Each series is sequential over its days.
+    load : float or array_like
+        Load [W], 0 or more: a float; (n_series,) one per series; (n_series or 1, n_steps) a daily
+        profile; or (n_series or 1, n_days or 1, n_steps or 1).
+    buffer : Buffer
+        The buffer (fields floats or arrays over the series).
+    step_hours : float
+        Step length [h]; ``n_steps x step_hours`` is a day.
+    engine : {'numba', 'numpy'}
+        The compiled loop, or the NumPy reference (vectorised over series, a Python loop over the
+        steps: for tests and small cases).
+    soc_curves : bool, default False
+        Also the state of charge at every step (memory of the power's size).
+    max_iterations : int, default 60
+        Passes allowed to find the periodic state.
+    tolerance : float, default 1e-6
+        The periodic state's content is that at the end within ``tolerance x capacity_wh``.
+
+    Returns
+    -------
+    StorageResult
+
+    Raises
+    ------
+    ValueError
+        An unknown ``engine``, a field of ``buffer`` out of range (named), power that is not
+        finite, a negative load, or shapes that do not fit.
+    """
+    if engine not in STORAGE_ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(STORAGE_ENGINES)}; got {engine!r}")
+    power = np.asarray(power, dtype=float)
+    if power.ndim == 2:
+        power = power[:, None, :]
+    if power.ndim != 3 or 0 in power.shape:
+        raise ValueError(
+            f"power must be (n_series, n_days, n_steps) or (n_series, n_steps); got {power.shape}"
+        )
+    if not np.isfinite(power).all():
+        raise ValueError("power must be finite")
+    power = np.ascontiguousarray(power)
+    n_series, n_days, n_steps = power.shape
+    load = _load_array(load, power.shape)
+    params = _parameter_rows(buffer, n_series, step_hours)
+    if max_iterations < 1 or not tolerance >= 0:
+        raise ValueError("max_iterations must be 1 or more and tolerance 0 or more")
+    out = np.zeros((n_series, n_days, kern.HISTOGRAM + SOC_BINS))
+    state = np.zeros((n_series, n_days + 1, 2))
+    soc = np.zeros(power.shape if soc_curves else (1, 1, 1))
+    passes = np.zeros(n_series, dtype=np.int64)
+    if engine == "numba":
+        kern.simulate_series(
+            power,
+            load,
+            params,
+            float(step_hours),
+            out,
+            state,
+            bool(soc_curves),
+            soc,
+            passes,
+            int(max_iterations),
+            float(tolerance),
+        )
+    else:
+        _simulate_numpy(
+            power, load, params, step_hours, out, state, soc_curves, soc, passes,
+            max_iterations, tolerance,
+        )  # fmt: skip
+    return StorageResult(
+        out[..., kern.POWERED],
+        out[..., kern.SERVED],
+        out[..., kern.MISSING],
+        out[..., kern.LOST],
+        out[..., kern.HARVESTED],
+        out[..., kern.CHARGE_LOSS],
+        out[..., kern.DISCHARGE_LOSS],
+        out[..., kern.SELF_DISCHARGE],
+        out[..., kern.FULL] > 0.5,
+        out[..., kern.EMPTY] > 0.5,
+        out[..., kern.HISTOGRAM :],
+        state[..., 0],
+        soc if soc_curves else None,
+        passes,
+    )
+
+
+def _load_array(load, shape):
+    """The load as (n_series or 1, n_days or 1, n_steps or 1), contiguous."""
+    n_series, n_days, n_steps = shape
+    load = np.asarray(load, dtype=float)
+    if load.ndim == 0:
+        load = load.reshape(1, 1, 1)
+    elif load.ndim == 1:
+        load = load[:, None, None]
+    elif load.ndim == 2:
+        load = load[:, None, :]
+    fits = load.ndim == 3 and all(
+        size in (1, full) for size, full in zip(load.shape, shape, strict=True)
+    )
+    if not fits:
+        raise ValueError(
+            f"load must be a float, (n_series,), (n_series, n_steps) or (n_series, n_days, "
+            f"n_steps), each size 1 or full, for power of {shape}; got {np.shape(load)}"
+        )
+    if not (np.isfinite(load).all() and (load >= 0).all()):
+        raise ValueError("load must be finite and 0 or more")
+    return np.ascontiguousarray(load)
+
+
+def _parameter_rows(buffer: Buffer, n_series: int, step_hours: float) -> np.ndarray:
+    """The buffer as (1 or n_series, N_PARAMETERS) rows, each field checked."""
+
+    def field(name, value, lo, hi, lo_open=False, hi_open=False, default=None):
+        value = np.asarray(default if value is None else value, dtype=float)
+        inside = (value > lo if lo_open else value >= lo) & (value < hi if hi_open else value <= hi)
+        if value.ndim > 1 or value.size not in (1, n_series) or not inside.all():
+            lower, upper = "(" if lo_open else "[", ")" if hi_open else "]"
+            raise ValueError(
+                f"buffer {name} must be a value in {lower}{lo:g}, {hi:g}{upper}, or one per series "
+                f"({n_series}); got {value.tolist()}"
+            )
+        return value
+
+    capacity = field("capacity_wh", buffer.capacity_wh, 0.0, np.inf, hi_open=True)
+    min_soc = field("min_soc", buffer.min_soc, 0.0, 1.0)
+    restart = field("restart_soc", buffer.restart_soc, 0.0, 1.0, default=min_soc)
+    if (restart < min_soc).any():
+        raise ValueError(f"buffer restart_soc must be at least min_soc; got {restart.tolist()}")
+    eta_c = field("charge_efficiency", buffer.charge_efficiency, 0.0, 1.0, lo_open=True)
+    eta_d = field("discharge_efficiency", buffer.discharge_efficiency, 0.0, 1.0, lo_open=True)
+    leak = field("self_discharge", buffer.self_discharge, 0.0, 1.0, hi_open=True)
+    max_c = field("max_charge_w", buffer.max_charge_w, 0.0, np.inf, default=np.inf)
+    max_d = field("max_discharge_w", buffer.max_discharge_w, 0.0, np.inf, default=np.inf)
+    initial = (
+        np.asarray(np.nan)
+        if buffer.initial_soc is None
+        else field("initial_soc", buffer.initial_soc, 0.0, 1.0)
+    )
+    columns = [None] * kern.N_PARAMETERS
+    columns[kern.CAPACITY], columns[kern.MIN_SOC], columns[kern.RESTART_SOC] = (
+        capacity,
+        min_soc,
+        restart,
+    )
+    columns[kern.ETA_CHARGE], columns[kern.ETA_DISCHARGE] = eta_c, eta_d
+    columns[kern.KEEP_STEP] = (1.0 - leak) ** (step_hours / 24.0)
+    columns[kern.KEEP_HALF] = (1.0 - leak) ** (step_hours / 48.0)
+    columns[kern.MAX_CHARGE], columns[kern.MAX_DISCHARGE] = max_c, max_d
+    columns[kern.INITIAL_SOC] = initial
+    rows = np.stack(np.broadcast_arrays(*(np.atleast_1d(c) for c in columns)), axis=-1)
+    return np.ascontiguousarray(rows, dtype=float)
+
+
+# The NumPy reference: the same model written over arrays of series, step by step.
+
+
+def _clipped_energy(a, b, tau, cap):
+    """:func:`foldopt.engine.storage_kernel.clipped_energy` over arrays."""
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+
+    def ramp(x):
+        return np.where(
+            x <= 0.0, 0.0, np.where(x <= cap, 0.5 * x * x, cap * (0.5 * cap + (x - cap)))
+        )
+
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        crossing = tau * (ramp(hi) - ramp(lo)) / (hi - lo)
+        return np.where(
+            (hi <= 0.0) | (tau <= 0.0),
+            0.0,
+            np.where(
+                lo >= cap,
+                tau * cap,
+                np.where((lo >= 0.0) & (hi <= cap), 0.5 * tau * (a + b), crossing),
+            ),
+        )
+
+
+def _charge_numpy(charging, stored, spare, limit, par, row):
+    capacity, eta = par[:, kern.CAPACITY], par[:, kern.ETA_CHARGE]
+    room = np.maximum(capacity - stored, 0.0) / eta
+    take = np.minimum(spare, limit)
+    fills = charging & (take >= room)
+    take = np.where(fills, room, take)
+    stored = np.where(fills, capacity, np.where(charging, stored + take * eta, stored))
+    row[:, kern.FULL] = np.where(fills & (capacity > 0.0), 1.0, row[:, kern.FULL])
+    row[:, kern.CHARGE_LOSS] += np.where(charging, take * (1.0 - eta), 0.0)
+    row[:, kern.LOST] += np.where(charging, spare - take, 0.0)
+    return stored
+
+
+def _part_numpy(pa, pb, la, lb, tau, surplus, demand, stored, on, par, row):
+    """:func:`foldopt.engine.storage_kernel._part` over arrays of series."""
+    active = tau > 0.0
+    capacity = par[:, kern.CAPACITY]
+    pv = 0.5 * tau * (pa + pb)
+    need = 0.5 * tau * (la + lb)
+    on = on | (active & (stored >= par[:, kern.RESTART_SOC] * capacity))
+    run = active & on & surplus
+    short = np.maximum(need - pv, 0.0)
+    usable = stored - par[:, kern.MIN_SOC] * capacity
+    eta_d = par[:, kern.ETA_DISCHARGE]
+    covered = (
+        active
+        & on
+        & ~surplus
+        & (usable > 0.0)
+        & (short <= eta_d * usable)
+        & (np.maximum(la - pa, lb - pb) <= par[:, kern.MAX_DISCHARGE])
+    )
+    cut = active & on & ~surplus & ~covered
+    off = active & ~on | cut
+    served = run | covered
+    row[:, kern.SERVED] += np.where(served, need, 0.0)
+    row[:, kern.POWERED] += np.where(served & demand, tau, 0.0)
+    drawn = short / eta_d
+    row[:, kern.DISCHARGE_LOSS] += np.where(covered, drawn - short, 0.0)
+    stored = np.where(covered, stored - drawn, stored)
+    on = on & ~cut
+    row[:, kern.EMPTY] = np.where(cut, 1.0, row[:, kern.EMPTY])
+    row[:, kern.MISSING] += np.where(off, need, 0.0)
+    max_c = par[:, kern.MAX_CHARGE]
+    spare = np.where(
+        run, np.maximum(pv - need, 0.0), np.where(off, _clipped_energy(pa, pb, tau, np.inf), 0.0)
+    )
+    limit = np.where(
+        run,
+        _clipped_energy(pa - la, pb - lb, tau, max_c),
+        np.where(off, _clipped_energy(pa, pb, tau, max_c), 0.0),
+    )
+    return _charge_numpy(run | off, stored, spare, limit, par, row), on
+
+
+def _segments(power, load, step_hours):
+    """Each day's segments and their two parts, over whole arrays (n_series, n_days, n_steps + 1):
+    the part with the power at or above the load and the one below it, in their order."""
+    load = np.broadcast_to(load, power.shape)
+    p0 = np.concatenate([power[..., :1], power], axis=-1)
+    p1 = np.concatenate([power, power[..., -1:]], axis=-1)
+    l0 = np.concatenate([load[..., :1], load], axis=-1)
+    l1 = np.concatenate([load, load[..., -1:]], axis=-1)
+    half = np.zeros(p0.shape[-1], dtype=bool)
+    half[[0, -1]] = True
+    tau = np.where(half, 0.5 * step_hours, step_hours)
+    e0, e1 = p0 - l0, p1 - l1
+    with np.errstate(invalid="ignore", divide="ignore"):
+        crossing = np.maximum(e0, e1) / np.abs(e0 - e1)
+    above = np.where((e0 >= 0) & (e1 >= 0), 1.0, np.where((e0 < 0) & (e1 < 0), 0.0, crossing))
+    rising = e0 < 0.0  # below the load first
+    split = np.where(rising, 1.0 - above, above)
+    ps, ls = p0 + split * (p1 - p0), l0 + split * (l1 - l0)
+    t_above, t_below = tau * above, tau * (1.0 - above)
+    first = (p0, ps, l0, ls, np.where(rising, t_below, t_above), ~rising)
+    second = (ps, p1, ls, l1, np.where(rising, t_above, t_below), rising)
+    return first, second, (l0 > 0.0) | (l1 > 0.0), half
+
+
+def _run_numpy(power, load, par, step_hours, stored, on, out, state, soc_curves, soc):
+    """One pass over the days of a set of series (:func:`foldopt.engine.storage_kernel._run`
+    without merging), the steps in turn and the series at once."""
+    n_days, n_steps = power.shape[1:]
+    first, second, demand, half = _segments(power, load, step_hours)
+    capacity = par[:, kern.CAPACITY]
+    n_bins = out.shape[-1] - kern.HISTOGRAM
+    with np.errstate(divide="ignore"):
+        per_bin = np.where(capacity > 0.0, n_bins / capacity, 0.0)
+    series = np.arange(power.shape[0])
+    restart = par[:, kern.RESTART_SOC] * capacity
+    for d in range(n_days):
+        on = on | (stored >= restart)
+        state[:, d, 0], state[:, d, 1] = stored, on
+        row = out[:, d]
+        row[:] = 0.0
+        row[:, kern.FULL] = np.where((capacity > 0.0) & (stored >= capacity), 1.0, 0.0)
+        for j in range(n_steps + 1):
+            for part in (first, second):
+                stored, on = _part_numpy(
+                    *(a[:, d, j] for a in part[:4]),
+                    part[4][:, d, j],
+                    part[5][:, d, j],
+                    demand[:, d, j],
+                    stored,
+                    on,
+                    par,
+                    row,
+                )
+            kept = stored * par[:, kern.KEEP_HALF if half[j] else kern.KEEP_STEP]
+            row[:, kern.SELF_DISCHARGE] += stored - kept
+            stored = kept
+            bins = np.minimum((stored * per_bin).astype(np.int64), n_bins - 1)
+            row[series, kern.HISTOGRAM + bins] += 0.5 * step_hours if half[j] else step_hours
+            if soc_curves and j < n_steps:
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    soc[:, d, j] = np.where(capacity > 0.0, stored / capacity, 0.0)
+        row[:, kern.HARVESTED] = np.cumsum(power[:, d], axis=-1)[:, -1] * step_hours
+    on = on | (stored >= restart)
+    state[:, n_days, 0], state[:, n_days, 1] = stored, on
+    return stored, on
+
+
+def _simulate_numpy(
+    power, load, params, step_hours, out, state, soc_curves, soc, passes, max_iterations, tolerance
+):
+    """:func:`foldopt.engine.storage_kernel.simulate_series` over arrays of series, each series's
+    passes as :func:`foldopt.engine.storage_kernel._series` runs them."""
+    n_series = power.shape[0]
+    par = np.broadcast_to(params, (n_series, params.shape[1]))
+    load = np.broadcast_to(load, (n_series, *load.shape[1:]))
+    capacity = par[:, kern.CAPACITY]
+    given = ~np.isnan(par[:, kern.INITIAL_SOC])
+    stored = np.where(given, par[:, kern.INITIAL_SOC] * capacity, capacity)
+    on = np.where(given, stored >= par[:, kern.RESTART_SOC] * capacity, True)
+    low, high = np.zeros(n_series), capacity.copy()
+    todo = np.ones(n_series, dtype=bool)
+    while todo.any():
+        pick = np.flatnonzero(todo)
+        sub_out, sub_state = out[pick], state[pick]
+        sub_soc = soc[pick] if soc_curves else soc
+        end, end_on = _run_numpy(
+            power[pick],
+            load[pick],
+            par[pick],
+            step_hours,
+            stored[pick],
+            on[pick],
+            sub_out,
+            sub_state,
+            soc_curves,
+            sub_soc,
+        )
+        out[pick], state[pick] = sub_out, sub_state
+        if soc_curves:
+            soc[pick] = sub_soc
+        passes[pick] += 1
+        tol = tolerance * capacity[pick]
+        done = given[pick] | ((np.abs(end - stored[pick]) <= tol) & (end_on == on[pick]))
+        lo = np.where(end > stored[pick], stored[pick], low[pick])
+        hi = np.where(end < stored[pick], stored[pick], high[pick])
+        stuck = ~done & ((hi - lo <= tol) | (passes[pick] >= max_iterations))
+        passes[pick[stuck]] *= -1
+        plain = (passes[pick] < kern.PLAIN_ITERATIONS) & (lo <= end) & (end <= hi)
+        low[pick], high[pick] = lo, hi
+        stored[pick] = np.where(plain, end, 0.5 * (lo + hi))
+        on[pick] = end_on
+        todo[pick[done | stuck]] = False

@@ -1,0 +1,281 @@
+"""Compiled state-of-charge simulation of a small buffer (numba): the loop over time that
+:func:`foldopt.engine.storage.simulate` runs with ``engine='numba'``; the model, its conventions and
+the layout of the arrays are documented there, and :func:`foldopt.engine.storage._simulate_numpy`
+is the reference it is tested against.
+
+One plain loop per series, the series spread over threads (:func:`simulate_series`). Every argument
+has the same type at every call (arrays of float64 laid out C-contiguous, a float, two ints, a
+bool), so that numba compiles one specialisation once and caches it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+# Columns of the parameter rows (:func:`foldopt.engine.storage._parameter_rows`).
+CAPACITY, MIN_SOC, RESTART_SOC, ETA_CHARGE, ETA_DISCHARGE = 0, 1, 2, 3, 4
+KEEP_STEP, KEEP_HALF, MAX_CHARGE, MAX_DISCHARGE, INITIAL_SOC = 5, 6, 7, 8, 9
+N_PARAMETERS = 10
+
+# Columns of a day's outputs; the state-of-charge histogram follows from HISTOGRAM on.
+POWERED, SERVED, MISSING, LOST, HARVESTED = 0, 1, 2, 3, 4
+CHARGE_LOSS, DISCHARGE_LOSS, SELF_DISCHARGE, FULL, EMPTY = 5, 6, 7, 8, 9
+HISTOGRAM = 10
+
+#: Plain fixed-point iterations (the buffer's own year after year) before the periodic state is
+#: bisected instead (a state that drifts by a little a day would take many plain ones).
+PLAIN_ITERATIONS = 4
+
+
+@njit(cache=True, error_model="numpy")
+def _ramp(x, cap):
+    """Antiderivative of ``clip(x, 0, cap)`` in ``x``, zero at ``x = 0``."""
+    if x <= 0.0:
+        return 0.0
+    if x <= cap:
+        return 0.5 * x * x
+    return cap * (0.5 * cap + (x - cap))
+
+
+@njit(cache=True, error_model="numpy")
+def clipped_energy(a, b, tau, cap):
+    """Energy [Wh] of a power running linearly from ``a`` to ``b`` [W] over ``tau`` [h], each
+    instant's power clipped to ``[0, cap]``."""
+    lo, hi = min(a, b), max(a, b)
+    if hi <= 0.0 or tau <= 0.0:
+        return 0.0
+    if lo >= cap:
+        return tau * cap
+    if lo >= 0.0 and hi <= cap:
+        return 0.5 * tau * (a + b)
+    return tau * (_ramp(hi, cap) - _ramp(lo, cap)) / (hi - lo)
+
+
+@njit(cache=True, error_model="numpy")
+def _charge(stored, spare, limit, capacity, eta):
+    """Charge ``spare`` [Wh] offered at the bus, at most ``limit``, into the buffer holding
+    ``stored`` [Wh]. Returns the new content, the charge loss and the energy lost [Wh], and
+    whether the buffer is full."""
+    room = max(capacity - stored, 0.0) / eta
+    take = min(spare, limit)
+    full = take >= room
+    if full:  # set exactly, so that a full buffer is recognised as such
+        take = room
+        stored = capacity
+    else:
+        stored += take * eta
+    return stored, take * (1.0 - eta), spare - take, full and capacity > 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
+    """One part of a segment, in which the power runs from ``pa`` to ``pb`` and the load from
+    ``la`` to ``lb`` [W] over ``tau`` [h] (``tau`` > 0), the power at or above the load
+    throughout (``surplus``) or below it.
+
+    Returns the buffer's content [Wh], whether the load is on, the part's energies [Wh] served,
+    missing, lost, lost in charging and in discharging, whether the load ran, whether the buffer
+    was full, and whether the controller cut the load off. Scalars only, so that the call moves
+    no array (numba counts references to arrays passed to a function)."""
+    capacity = par[CAPACITY]
+    pv = 0.5 * tau * (pa + pb)
+    need = 0.5 * tau * (la + lb)
+    if not on and stored >= par[RESTART_SOC] * capacity:
+        on = True
+    if on and surplus:
+        limit = clipped_energy(pa - la, pb - lb, tau, par[MAX_CHARGE])
+        stored, loss, lost, full = _charge(
+            stored, max(pv - need, 0.0), limit, capacity, par[ETA_CHARGE]
+        )
+        return stored, on, need, 0.0, lost, loss, 0.0, True, full, False
+    cut = False
+    if on:
+        short = max(need - pv, 0.0)
+        usable = stored - par[MIN_SOC] * capacity
+        eta = par[ETA_DISCHARGE]
+        if usable > 0.0 and short <= eta * usable and max(la - pa, lb - pb) <= par[MAX_DISCHARGE]:
+            drawn = short / eta
+            return stored - drawn, on, need, 0.0, 0.0, 0.0, drawn - short, True, False, False
+        on = False
+        cut = True
+    spare = clipped_energy(pa, pb, tau, math.inf)
+    limit = clipped_energy(pa, pb, tau, par[MAX_CHARGE])
+    stored, loss, lost, full = _charge(stored, spare, limit, capacity, par[ETA_CHARGE])
+    return stored, on, 0.0, need, lost, loss, 0.0, False, full, cut
+
+
+@njit(cache=True, error_model="numpy")
+def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, soc):
+    """One pass over a series' days from the content ``stored`` [Wh] and load state ``on``.
+
+    With ``merge``, a day that starts in the state the previous pass started it in (``state``)
+    ends the pass: from there on, the previous pass's outputs are this one's. The load's state is
+    kept as on wherever the content allows it to reconnect (the same state: the first part would
+    reconnect it). Returns the state at the end of the last day.
+    """
+    n_days, n_steps = power.shape
+    profile_days, profile_steps = load.shape[0] > 1, load.shape[1] > 1
+    capacity, restart = par[CAPACITY], par[RESTART_SOC] * par[CAPACITY]
+    n_bins = out.shape[1] - HISTOGRAM
+    per_bin = n_bins / capacity if capacity > 0.0 else 0.0
+    keep_half, keep_step = par[KEEP_HALF], par[KEEP_STEP]
+    for d in range(n_days):
+        on = on or stored >= restart
+        flag = 1.0 if on else 0.0
+        if merge and state[d, 0] == stored and state[d, 1] == flag:
+            return state[n_days, 0], state[n_days, 1] > 0.5
+        state[d, 0], state[d, 1] = stored, flag
+        row = out[d]
+        row[:] = 0.0
+        full = capacity > 0.0 and stored >= capacity
+        empty = False
+        powered = served = missing = lost = charge_loss = discharge_loss = leak = 0.0
+        harvested = 0.0
+        day_load = load[d if profile_days else 0]
+        for j in range(n_steps + 1):
+            # Segment j runs from the centre of step j - 1 to that of step j; the first and the
+            # last are the half steps held at the day's ends (foldopt.engine.metrics).
+            first, last = max(j - 1, 0), min(j, n_steps - 1)
+            p0, p1 = power[d, first], power[d, last]
+            l0 = day_load[first if profile_steps else 0]
+            l1 = day_load[last if profile_steps else 0]
+            half = j == 0 or j == n_steps
+            tau = 0.5 * step_hours if half else step_hours
+            if j < n_steps:
+                harvested += p1
+            e0, e1 = p0 - l0, p1 - l1
+            if e0 >= 0.0 and e1 >= 0.0:
+                above = 1.0
+            elif e0 < 0.0 and e1 < 0.0:
+                above = 0.0
+            else:
+                above = max(e0, e1) / abs(e0 - e1)
+            rising = e0 < 0.0  # below the load first
+            split = 1.0 - above if rising else above
+            ps, ls = p0 + split * (p1 - p0), l0 + split * (l1 - l0)
+            demand = l0 > 0.0 or l1 > 0.0
+            t_above, t_below = tau * above, tau * (1.0 - above)
+            for second in (False, True):
+                length = (
+                    (t_above if rising else t_below) if second else (t_below if rising else t_above)
+                )
+                if length <= 0.0:
+                    continue
+                if second:
+                    pa, pb, la, lb = ps, p1, ls, l1
+                else:
+                    pa, pb, la, lb = p0, ps, l0, ls
+                stored, on, s_wh, m_wh, l_wh, c_wh, d_wh, ran, was_full, cut = _part(
+                    pa, pb, la, lb, length, rising == second, stored, on, par
+                )
+                served += s_wh
+                missing += m_wh
+                lost += l_wh
+                charge_loss += c_wh
+                discharge_loss += d_wh
+                if ran and demand:
+                    powered += length
+                full = full or was_full
+                empty = empty or cut
+            kept = stored * (keep_half if half else keep_step)
+            leak += stored - kept
+            stored = kept
+            row[HISTOGRAM + min(int(stored * per_bin), n_bins - 1)] += tau
+            if keep_soc and j < n_steps:
+                soc[d, j] = stored / capacity if capacity > 0.0 else 0.0
+        row[POWERED], row[SERVED], row[MISSING], row[LOST] = powered, served, missing, lost
+        row[HARVESTED] = harvested * step_hours
+        row[CHARGE_LOSS], row[DISCHARGE_LOSS], row[SELF_DISCHARGE] = (
+            charge_loss,
+            discharge_loss,
+            leak,
+        )
+        row[FULL], row[EMPTY] = 1.0 if full else 0.0, 1.0 if empty else 0.0
+    on = on or stored >= restart
+    state[n_days, 0], state[n_days, 1] = stored, 1.0 if on else 0.0
+    return stored, on
+
+
+@njit(cache=True, error_model="numpy")
+def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterations, tolerance):
+    """A series from its initial state of charge, or in its periodic state: passes until the
+    state at the end of the series is that at its start (content within ``tolerance`` x the
+    capacity, the load on or off alike), first plainly from a full buffer, then by bisection on
+    the start's content. Returns the passes run, negative when none was periodic."""
+    capacity = par[CAPACITY]
+    if not math.isnan(par[INITIAL_SOC]):
+        stored = par[INITIAL_SOC] * capacity
+        on = stored >= par[RESTART_SOC] * capacity
+        _run(power, load, par, step_hours, stored, on, False, out, state, keep_soc, soc)
+        return 1
+    low, high = 0.0, capacity
+    stored, on = capacity, True
+    passes = 0
+    while passes < max_iterations:
+        passes += 1
+        end, end_on = _run(
+            power, load, par, step_hours, stored, on, passes > 1, out, state, keep_soc, soc
+        )
+        if abs(end - stored) <= tolerance * capacity and end_on == on:
+            return passes
+        if end > stored:
+            low = stored
+        elif end < stored:
+            high = stored
+        if high - low <= tolerance * capacity:
+            break  # the end state jumps across the start's: no periodic state
+        on = end_on
+        if passes < PLAIN_ITERATIONS and low <= end <= high:
+            stored = end
+        else:
+            stored = 0.5 * (low + high)
+    return -passes
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def simulate_series(
+    power, load, params, step_hours, out, state, keep_soc, soc, passes, max_iterations, tolerance
+):
+    """Every series, spread over threads (:func:`foldopt.engine.storage.simulate`).
+
+    Parameters
+    ----------
+    power : (n_series, n_days, n_steps) float
+        Power at step centres [W].
+    load : (n_series or 1, n_days or 1, n_steps or 1) float
+        Load at step centres [W].
+    params : (n_series or 1, N_PARAMETERS) float
+        The buffer of each series.
+    step_hours : float
+        Step length [h].
+    out : (n_series, n_days, HISTOGRAM + n_bins) float
+        Each day's outputs, written.
+    state : (n_series, n_days + 1, 2) float
+        Content [Wh] and load on (1) or off (0) at each midnight, written.
+    keep_soc : bool
+        Write the state of charge at each step centre into ``soc`` (else it is a placeholder).
+    soc : (n_series, n_days, n_steps) or (1, 1, 1) float
+    passes : (n_series,) int
+        Passes run, negative where no periodic state was found; written.
+    max_iterations : int
+    tolerance : float
+    """
+    for k in prange(power.shape[0]):
+        s = np.int64(
+            k
+        )  # prange's index is unsigned: with the literal 0 below it would unify to float
+        passes[s] = _series(
+            power[s],
+            load[s if load.shape[0] > 1 else 0],
+            params[s if params.shape[0] > 1 else 0],
+            step_hours,
+            out[s],
+            state[s],
+            keep_soc,
+            soc[s if keep_soc else 0],
+            max_iterations,
+            tolerance,
+        )
