@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 import foldopt
@@ -154,6 +156,43 @@ def test_a_bad_study_file_section_is_one_line_naming_it(tmp_path, monkeypatch, c
     (tmp_path / "bad.yaml").write_text(yaml.safe_dump({**data, **changes}, sort_keys=False))
     result = runner.invoke(app, ["run", "bad.yaml", "--out", "out"])
     _assert_one_line(result, words, tmp_path)
+
+
+#: Any value a storage field might be given: in range, beside it, of another type.
+_VALUE = st.one_of(st.floats(-0.5, 1.5), st.sampled_from([0, 1, 1e7, float("nan"), "x", None, True]))
+
+
+@settings(max_examples=200, deadline=None)
+@given(section=st.fixed_dictionaries({"capacity_wh": st.one_of(st.floats(-1, 50), st.just("x"))},
+                                     optional={name: _VALUE for name in (
+                                         "min_soc", "restart_soc", "charge_efficiency",
+                                         "discharge_efficiency", "self_discharge", "max_charge_w",
+                                         "max_discharge_w", "initial_soc")}
+                                     | {"preset": st.sampled_from([*PRESETS, "lead-acid", None])}))
+def test_any_storage_section_validates_within_its_limits_or_names_its_fault(section):
+    try:
+        storage = _study(section).storage
+    except foldopt.ConfigError as error:
+        assert error.errors and all(line.startswith("storage") for line in error.errors), error.errors
+        return
+    assert 0 <= storage.capacity_wh <= 1e6
+    assert 0 <= storage.min_soc <= storage.restart_soc <= 1 and storage.min_soc < 1
+    assert 0 < storage.charge_efficiency <= 1 and 0 < storage.discharge_efficiency <= 1
+    assert 0 <= storage.self_discharge < 1
+    for given_value in ("max_charge_w", "max_discharge_w"):
+        assert getattr(storage, given_value) is None or getattr(storage, given_value) > 0
+    assert {name: getattr(storage, name) for name in section if section[name] is not None} == {
+        name: value for name, value in section.items() if value is not None}
+
+
+def test_a_capacity_list_is_a_sweep_axis_each_value_checked():
+    from foldopt.studies.request import settings_plan
+
+    plan = settings_plan(default_study_path(), ["storage.capacity_wh=[0, 10, 20]",
+                                                "storage.preset=lifepo4"])
+    assert plan.axes == (("storage.capacity_wh", (0, 10, 20)),)
+    with pytest.raises(foldopt.ConfigError, match=r"storage.capacity_wh\[1\] = -10: must be in"):
+        settings_plan(default_study_path(), ["storage.capacity_wh=[0, -10]"])
 
 
 # ---- the section's values: presets, the ideal buffer, what the study's data keep ----------------
