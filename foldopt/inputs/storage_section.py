@@ -179,19 +179,3 @@ class Storage(StrictModel):
     def decided(self) -> frozenset:
         """The fields the preset, or the ideal buffer, filled: the study's data leave them out."""
         return self._decided
-
-    def describe(self) -> str:
-        """The buffer in words: ``buffer 20 Wh (lifepo4; cut-off 20 %, reconnect 30 %, ...)``."""
-        limits = ", ".join(
-            f"{label} {value:g} W"
-            for label, value in (("charge", self.max_charge_w), ("discharge", self.max_discharge_w))
-            if value is not None
-        )
-        parts = [
-            self.preset,
-            f"cut-off {self.min_soc:.0%}, reconnect {self.restart_soc:.0%}",
-            f"efficiency {self.charge_efficiency:g} in, {self.discharge_efficiency:g} out",
-            f"self-discharge {self.self_discharge:g}/day" if self.self_discharge else None,
-            f"at most {limits}" if limits else None,
-        ]
-        return f"buffer {self.capacity_wh:g} Wh ({'; '.join(part for part in parts if part)})"
