@@ -88,8 +88,9 @@ class Storage(StrictModel):
         The state of charge [-] in [0, 1] at the start of the study's first day; default the
         periodic steady state (a repeated clear-sky day is run until its midnight state of charge
         repeats; a weather year starts from the state at its own end). It may lie below
-        ``min_soc`` (a buffer delivered flat, or left to self-discharge): the load then starts
-        off and waits for ``restart_soc``; above ``min_soc`` it starts on.
+        ``min_soc`` (a buffer delivered flat, or left to self-discharge): the load starts on at
+        ``restart_soc`` or above, and below it off, waiting for ``restart_soc``
+        (:func:`foldopt.engine.storage.simulate`).
     preset : str, optional
         One of :data:`foldopt.names.STORAGE_PRESETS`, whose values fill the fields above that
         are left out.
