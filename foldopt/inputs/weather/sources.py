@@ -26,6 +26,7 @@ and its package's readers; ``requests`` loads on the first fetch.
 
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
 import email.utils
 import errno
@@ -466,7 +467,8 @@ def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> Wea
             lambda temporary: temporary.write_text(json.dumps(record, indent=2) + "\n"),
         )
     except OSError as error:
-        path.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):
+            path.unlink(missing_ok=True)  # an answer without its provenance is no cached copy
         full = error.errno in (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC))
         why = "the file system is full" if full else (error.strerror or str(error))
         raise WeatherError(

@@ -1,0 +1,289 @@
+"""Weather fetched by name (issue 42): ``--weather pvgis-tmy`` against a real HTTP server on
+127.0.0.1 that serves PVGIS's recorded answer (tests/data/pvgis/README.md), found through
+``FOLDOPT_PVGIS_URL`` as a mirror would be. The fetched year is the recorded file to the bit,
+a second run asks nothing, every fault of the service or the network is one line, exit 2, and
+leaves the cache as it was; ``--offline`` runs from the cache alone. No test reaches the internet.
+"""
+
+import hashlib
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from foldopt.cli.app import app
+from foldopt.inputs.study_file import default_study_path
+
+runner = CliRunner()
+RECORDED = Path(__file__).parent / "data" / "pvgis" / "tmy_45.000_8.000_2005_2023.json"
+#: A few days of the year at a 5-degree fold-angle grid: enough to compare the two paths.
+SWEEP = ["sweep", "angle", "--lat", "45", "--lon", "8", "--p-load", "4", "--engine", "numpy",
+         "--angle-step", "5", "--format", "json"]
+
+#: The server: PVGIS's route ``<mode>-<tag>/api/v5_3/tmy`` answered as ``mode`` says (``ok`` the
+#: recorded answer, the others a fault), ``/_count`` the requests of each ``<mode>-<tag>``. It ends
+#: itself after its lifetime whatever happens to the test.
+SERVER = r"""
+import json, os, socket, sys, threading, time
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from urllib.parse import urlsplit
+
+BODY = open(sys.argv[1], "rb").read()
+counts, lock = {}, threading.Lock()
+
+
+class Handler(BaseHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+
+    def do_GET(self):
+        parts = urlsplit(self.path).path.strip("/").split("/")
+        if parts == ["_count"]:
+            return self.send(200, json.dumps(counts).encode())
+        with lock:
+            counts[parts[0]] = n = counts.get(parts[0], 0) + 1
+        mode = parts[0].split("-")[0]
+        if parts[1:] != ["api", "v5_3", "tmy"]:
+            return self.send(404, b"")
+        if mode == "ok" or (mode == "rate" and n > 1):
+            return self.send(200, BODY)
+        if mode == "rate":
+            return self.send(429, b"", {"Retry-After": "1"})
+        if mode == "ratelong":
+            return self.send(429, b"", {"Retry-After": "3600"})
+        if mode == "e500":
+            return self.send(500, b"")
+        if mode == "cut":  # the headers promise the whole answer, half of it comes
+            self.send_response(200)
+            self.send_header("Content-Length", str(len(BODY)))
+            self.end_headers()
+            self.wfile.write(BODY[: len(BODY) // 2])
+            self.close_connection = True
+            return
+        if mode == "half":  # a whole answer of half the bytes
+            return self.send(200, BODY[: len(BODY) // 2])
+        if mode == "slow":
+            time.sleep(3)
+            return self.send(200, BODY)
+        if mode == "close":
+            self.close_connection = True
+            self.connection.shutdown(socket.SHUT_RDWR)
+            return
+        return self.send(404, b"")
+
+    def send(self, status, body, headers=()):
+        self.send_response(status)
+        self.send_header("Content-Type", "application/json")
+        self.send_header("Content-Length", str(len(body)))
+        for item in dict(headers).items():
+            self.send_header(*item)
+        self.end_headers()
+        try:
+            self.wfile.write(body)
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # a client that gave up waiting (the timeout's test)
+
+
+server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+server.daemon_threads = True
+print(server.server_address[1], flush=True)
+threading.Timer(float(sys.argv[2]), lambda: os._exit(0)).start()
+server.serve_forever()
+"""
+
+
+@pytest.fixture(scope="module")
+def server(request):
+    """The server's port, the server started on a free port and stopped by its pid."""
+    process = subprocess.Popen([sys.executable, "-c", SERVER, str(RECORDED), "120"],
+                               stdout=subprocess.PIPE, text=True)
+    request.addfinalizer(lambda: (os.kill(process.pid, signal.SIGTERM), process.wait(timeout=10)))
+    port = process.stdout.readline().strip()
+    assert port.isdigit(), "the server did not start"
+    return int(port)
+
+
+def requests_made(port: int, route: str) -> int:
+    with urllib.request.urlopen(f"http://127.0.0.1:{port}/_count", timeout=5) as answer:
+        return json.loads(answer.read()).get(route, 0)
+
+
+@pytest.fixture
+def pvgis(server, tmp_path, monkeypatch, request):
+    """Point foldopt at ``<mode>-<this test>`` on the server, in a cache folder of its own:
+    ``pvgis("ok")`` gives the route, whose requests :func:`requests_made` counts."""
+    monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.delenv("FOLDOPT_OFFLINE", raising=False)
+    monkeypatch.chdir(tmp_path)
+
+    def route(mode: str) -> str:
+        name = f"{mode}-" + re.sub(r"\W", "_", request.node.name)
+        monkeypatch.setenv("FOLDOPT_PVGIS_URL", f"http://127.0.0.1:{server}/{name}/api/v5_3/")
+        return name
+
+    return route
+
+
+def cache_files(tmp_path: Path) -> dict:
+    folder = tmp_path / "cache" / "weather"
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())} if folder.is_dir() else {}
+
+
+def csv_files(folder: Path) -> dict:
+    return {p.name: p.read_bytes() for p in sorted(folder.glob("*.csv"))}
+
+
+@pytest.mark.parametrize("days", ["2025-06-21", "2025-01-15,2025-06-21,2025-09-30"],
+                         ids=["a day, every angle", "three days, one angle"])
+def test_the_fetched_year_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, days):
+    route = pvgis("ok")
+    fetched = runner.invoke(app, [*SWEEP, "--days", days, "--weather", "pvgis-tmy", "--out", "fetched"])
+    assert fetched.exit_code == 0, fetched.output
+    read = runner.invoke(app, [*SWEEP, "--days", days, "--weather", str(RECORDED), "--out", "read"])
+    assert read.exit_code == 0, read.output
+    fetched, read = json.loads(fetched.stdout), json.loads(read.stdout)
+    assert fetched["rows"] == read["rows"]  # every design's t_solar (at every angle of a day)
+    assert fetched["answer"]["result"] == read["answer"]["result"]
+    tables = csv_files(tmp_path / "fetched")
+    assert tables == csv_files(tmp_path / "read") and tables  # sweep.csv, timeseries.csv ...
+    assert requests_made(server, route) == 1
+    # run.json says which data made it: the source, the request, the cached answer's hash
+    meta = json.loads((tmp_path / "fetched" / "run.json").read_text())
+    source = meta["weather_source"]
+    assert source["sha256"] == hashlib.sha256(RECORDED.read_bytes()).hexdigest()
+    assert source["url"].endswith("/api/v5_3/tmy?lat=45.0&lon=8.0&outputformat=json")
+    assert source["source"] == "pvgis-tmy" and source["service_version"] == "v5_3"
+    assert meta["study"]["weather"]["source"] == "pvgis-tmy"
+    assert "weather_source" not in json.loads((tmp_path / "read" / "run.json").read_text())
+
+
+def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    first = runner.invoke(app, ["weather", "fetch", "pvgis-tmy", "--lat", "45", "--lon", "8"])
+    assert first.exit_code == 0, first.output
+    # the site as PVGIS rounds it: 45.0001 is 45.000, the same answer
+    again = runner.invoke(app, ["weather", "fetch", "pvgis-tmy", "--lat", "45.0001", "--lon", "8"])
+    assert again.exit_code == 0, again.output
+    assert requests_made(server, route) == 1
+    assert cache_files(tmp_path)[next(iter(cache_files(tmp_path)))] == RECORDED.read_bytes()
+    dead = pvgis("e500")  # a service that would fail: offline never asks it
+    offline = runner.invoke(app, [*SWEEP, "--days", "2025-06-21", "--weather", "pvgis-tmy",
+                                  "--offline", "--out", "offline"])
+    assert offline.exit_code == 0, offline.output
+    assert requests_made(server, dead) == 0
+    listed = runner.invoke(app, ["weather", "list", "--format", "json"])
+    assert [entry["params"]["lat"] for entry in json.loads(listed.stdout)] == [45.0]
+    kept = runner.invoke(app, ["weather", "path", "--lat", "45", "--lon", "8", "--out", "site.json"])
+    assert kept.exit_code == 0, kept.output
+    assert (tmp_path / "site.json").read_bytes() == RECORDED.read_bytes()
+
+
+def test_offline_without_a_cached_copy_is_one_line(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    result = runner.invoke(app, [*SWEEP, "--weather", "pvgis-tmy", "--offline", "--out", "x"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        "error: --weather pvgis-tmy: no cached copy for (45, 8) with these options, and offline "
+        "(--offline, FOLDOPT_OFFLINE=1) nothing is fetched; fetch it first where there is a "
+        "network: foldopt weather fetch pvgis-tmy --lat 45 --lon 8"]
+    os.environ["FOLDOPT_OFFLINE"] = "1"  # the environment's word for it, restored by monkeypatch
+    try:
+        fetch = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
+    finally:
+        del os.environ["FOLDOPT_OFFLINE"]
+    assert fetch.exit_code == 2 and "no cached copy" in fetch.stderr
+    assert requests_made(server, route) == 0 and cache_files(tmp_path) == {}
+    assert not (tmp_path / "x").exists()
+
+
+#: Each fault the service or the network can make, and what its one line says.
+FAULTS = [
+    ("e500", [], "PVGIS answered 500 Internal Server Error; try again later"),
+    ("ratelong", [], "PVGIS limits the rate of requests and asks to wait 3600 s, longer than "
+                     "foldopt waits (60 s); try again later"),
+    ("cut", [], "PVGIS's answer was cut off after "),
+    ("half", [], "PVGIS's answer is not a readable PVGIS TMY (not valid JSON: "),
+    ("close", [], "closed the connection without an answer; nothing was cached, try again"),
+    ("slow", ["--timeout", "0.5"], "did not answer within 0.5 s (weather.timeout_s sets the wait)"),
+]
+
+
+@pytest.mark.parametrize(("mode", "options", "said"), FAULTS, ids=[f[0] for f in FAULTS])
+def test_a_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path, mode,
+                                                            options, said):
+    pvgis("ok")
+    kept = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8", "--no-horizon"])
+    assert kept.exit_code == 0, kept.output
+    before = cache_files(tmp_path)
+    route = pvgis(mode)
+    started = time.monotonic()
+    result = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8", *options])
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: weather pvgis-tmy: ") and said in lines[0]
+    assert cache_files(tmp_path) == before  # nothing new, nothing half-written, nothing lost
+    assert requests_made(server, route) == 1
+    assert time.monotonic() - started < 3  # bounded: the slow server sleeps 3 s
+
+
+def test_a_fault_through_a_sweep_is_the_same_line_and_exit_2(pvgis, tmp_path):
+    pvgis("e500")
+    result = runner.invoke(app, [*SWEEP, "--weather", "pvgis-tmy", "--out", "x"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        "error: --weather pvgis-tmy: PVGIS answered 500 Internal Server Error; try again later"]
+    assert not (tmp_path / "x").exists() and cache_files(tmp_path) == {}
+
+
+def test_a_rate_limit_waits_as_the_service_asks(pvgis, server, tmp_path):
+    route = pvgis("rate")
+    started = time.monotonic()
+    result = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
+    assert result.exit_code == 0, result.output
+    assert time.monotonic() - started >= 1.0  # Retry-After: 1
+    assert requests_made(server, route) == 2
+    assert list(cache_files(tmp_path).values())[0] == RECORDED.read_bytes()
+
+
+def test_a_cache_folder_that_cannot_be_written_is_one_line(pvgis, server, tmp_path, monkeypatch):
+    route = pvgis("ok")
+    (tmp_path / "file").write_text("not a folder")
+    monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path / "file" / "cache"))
+    result = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert lines == [f"error: weather pvgis-tmy: cannot cache the answer in {tmp_path / 'file' / 'cache' / 'weather'} "
+                     "(Not a directory); FOLDOPT_CACHE_DIR names another cache folder"]
+    assert requests_made(server, route) == 1
+
+
+def test_a_study_file_names_the_source_and_its_address(pvgis, server, tmp_path, monkeypatch):
+    route = pvgis("ok")
+    url = os.environ.pop("FOLDOPT_PVGIS_URL")  # the study's weather.url, not the environment's
+    monkeypatch.delenv("FOLDOPT_PVGIS_URL", raising=False)
+    embedded = {k: v for k, v in yaml.safe_load(default_study_path().read_text()).items() if k != "sky"}
+    study = {**embedded, "mode": "exact",
+             "site": {"latitude": 45.0, "longitude": 8.0}, "date": "2025-06-21", "p_load": 4,
+             "fold_angles": {"start": 30, "stop": 180, "step": 30}, "step_min": 10,
+             "weather": {"source": "pvgis-tmy", "url": url, "timeout_s": 10}}
+    (tmp_path / "site.yaml").write_text(yaml.safe_dump(study))
+    result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet", "--engine", "numpy"])
+    assert result.exit_code == 0, result.output
+    assert requests_made(server, route) == 1
+    meta = json.loads((tmp_path / "out" / "run.json").read_text())
+    assert meta["weather_source"]["url"].startswith(url)
+    bad = {**study, "weather": {"source": "pvgis-tmy", "years": "2020:2005"}}
+    (tmp_path / "bad.yaml").write_text(yaml.safe_dump(bad))
+    refused = runner.invoke(app, ["run", "bad.yaml", "--out", "bad"])
+    assert refused.exit_code == 2
+    assert "weather.years" in refused.stderr and "the first year comes after the last" in refused.stderr
+    assert requests_made(server, route) == 1
