@@ -24,6 +24,7 @@ from foldopt.inputs.study_file import default_study_path, with_files
 from foldopt.inputs.plan import Plan, load_plan
 from foldopt.inputs.study import Study
 from foldopt.errors import ConfigError
+from foldopt.names import DEFAULT_ENGINE
 
 
 def default_study() -> Study:
@@ -61,7 +62,7 @@ def load_study(path: str | Path) -> Study | Plan:
 
 def run(
     study: Study | Plan | str | Path,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
     progress: Callable[[float, int], None] | None = None,
     request=None,
 ):
@@ -72,8 +73,9 @@ def run(
     ----------
     study : Study, Plan, str or pathlib.Path
         A study, a plan, or a YAML file holding either.
-    engine : {'numba', 'numpy'}
-        The compiled kernel or the NumPy reference path it is tested against.
+    engine : {'auto', 'numba', 'numpy'}
+        :data:`foldopt.names.ENGINES`: by the size of each evaluation (``auto``), the compiled
+        kernel, or the NumPy reference path it is tested against.
     progress : callable, optional
         For a plan: ``progress(done, total)`` in days.
     request : foldopt.studies.request.Request, optional
@@ -94,8 +96,11 @@ def run(
     foldopt.ConfigError
         For a study file that cannot be read or a study that cannot be run.
     """
+    from foldopt.studies.request import request_engine
+
     if isinstance(study, (str, Path)):
         study = load_study(study)
+    engine = request_engine(engine, study)
     base = study.base if isinstance(study, Plan) else study
     if base.optimize is not None:
         from foldopt.studies.joint import optimize_plan
@@ -125,7 +130,7 @@ def sweep(
     over: str | None = None,
     *,
     axes: dict | None = None,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
     progress: Callable[[float, int], None] | None = None,
     **fields,
 ):
@@ -146,7 +151,7 @@ def sweep(
         -60:60:5, day 1:365:7, 20 loads up to the panel's rating); ``angle`` is one case.
     axes : dict, optional
         Dotted field paths to values, for any field (``{"panel.efficiency": [0.18, 0.21]}``).
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     progress : callable, optional
         ``progress(done, total)`` in days.
     **fields
@@ -197,7 +202,7 @@ def optimize(
     tilt=None,
     azimuth=None,
     tolerance_h: float | None = None,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
     **fields,
 ):
     """The best fold angle, base tilt and base azimuth together, as ``foldopt optimize`` finds them
@@ -218,7 +223,7 @@ def optimize(
         study's fold angles, tilt 0:90:1, azimuth the equator-facing one +-90 by 2.
     tolerance_h : float, optional
         What the search may miss [h] (default 0.01).
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     **fields
         As :func:`sweep`'s: ``date="year"`` and ``objective="worst-month"`` take the objective over
         the days, ``p_load=[1, 2, 4]`` several loads.
@@ -243,14 +248,14 @@ def optimize(
     (32.0, 31.0)
     """
     from foldopt.studies.joint import optimize_plan
-    from foldopt.studies.request import KEYWORDS, optimize_section, plan_request
+    from foldopt.studies.request import KEYWORDS, optimize_section, plan_request, request_engine
 
     section = optimize_section(vary, fold_angle, tilt, azimuth, tolerance_h)
     changes = {KEYWORDS.get(name, name): _plain_values(values) for name, values in fields.items()}
     data = _study_data(study)
     changes["optimize"] = {**(data.get("optimize") or {}), **section}
     request = plan_request(data, changes)
-    return optimize_plan(request.plan, engine, request)
+    return optimize_plan(request.plan, request_engine(engine, request.plan), request)
 
 
 def _study_data(study: Study | Plan) -> dict:
@@ -396,13 +401,13 @@ def size(
     return sizing.SizingResult(study, table, sizing.best_areas(table), parameters, request)
 
 
-def reproduce(engine: str = "numba"):
+def reproduce(engine: str = DEFAULT_ENGINE):
     """Shin et al.'s published values beside foldopt's, in paper and exact mode.
 
     Parameters
     ----------
-    engine : {'numba', 'numpy'}, default 'numba'
-        The compiled kernel or the NumPy reference path.
+    engine : {'auto', 'numba', 'numpy'}, default 'auto'
+        As :func:`run`'s.
 
     Returns
     -------
@@ -413,7 +418,10 @@ def reproduce(engine: str = "numba"):
     """
     from foldopt.studies.reproduce import REPRODUCTIONS, Reproduction, reproduce as reproduce_table
 
+    from foldopt.studies.request import request_engine
+
     study = default_study()
+    engine = request_engine(engine, study)
     tables = {
         name: reproduce_table(study, engine, **changes) for name, changes in REPRODUCTIONS.items()
     }
@@ -434,7 +442,7 @@ def world_map(
     sites_per_chunk: int = 0,
     resume: bool = False,
     overwrite: bool = False,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
     show_load: int = 0,
     show_period: str = "year",
     progress=None,
@@ -470,7 +478,7 @@ def world_map(
         Default about 5 s of work per chunk.
     resume, overwrite : bool
         Finish an interrupted map in ``out``; replace ``out``.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     show_load, show_period
         Which load (index) and period (``year``, ``DJF``...) the world maps show.
     progress, announce : callable, optional
@@ -496,6 +504,7 @@ def world_map(
     from foldopt.studies.result_answers import of_map
     from foldopt.output.folders import map_figures, write_map_report
     from foldopt.output.gridded import write_grid_netcdf
+    from foldopt.studies.request import request_engine
     from foldopt.studies.worldmap import map_request, map_study, searched_tilt
 
     if out is None:
@@ -509,7 +518,15 @@ def world_map(
     else:
         defaults = request.defaults
     study, relative, year = request.study, request.relative, request.year
-    spec = MapSpec(study, request.sites, request.loads, relative, year, sites_per_chunk, engine)
+    spec = MapSpec(
+        study,
+        request.sites,
+        request.loads,
+        relative,
+        year,
+        sites_per_chunk,
+        request_engine(engine, None),
+    )
     finished = {}
 
     def finish(run, metadata):

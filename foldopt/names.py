@@ -239,13 +239,21 @@ HOTTEL_CLIMATES = Registry(
         "midlatitude-winter": "Hottel's mid-latitude winter correction factors",
     },
 )
+#: Rows x time steps up to which the ``auto`` engine takes the NumPy reference path: some 0.4 s
+#: more than the warm kernel (the default study's month of days at 181 fold angles), against the
+#: kernel's first compile of some 30 s on 2 cores (bench/startup.py, issue 40).
+AUTO_NUMPY_ROW_STEPS = 10_000_000
 ENGINES = Registry(
     "engine",
     {
+        "auto": f"the NumPy reference path up to {AUTO_NUMPY_ROW_STEPS // 1_000_000} M rows x steps, "
+        "a day's study, with no compile wait; the compiled kernel above",
         "numba": "the compiled kernel",
         "numpy": "the NumPy reference path the kernel is tested against",
     },
 )
+#: The engine of every command and API call that names none.
+DEFAULT_ENGINE = "auto"
 #: A buffer's chemistry, whose datasheet-typical values fill the ``storage`` fields a study leaves
 #: out (the values and their sources: :data:`foldopt.inputs.storage_section.PRESETS`).
 STORAGE_PRESETS = Registry(

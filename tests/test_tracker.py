@@ -132,13 +132,14 @@ def test_trackers_over_many_days_at_once_equal_each_day_alone(model):
        st.sampled_from(["dual-axis", "equatorial", "dual-axis-steps", "single-axis"]),
        st.sampled_from([("ineichen", "perez"), ("ineichen", "isotropic"), ("meinel", "none")]))
 def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitude, day, model, sky_model):
-    """The compiled tracker irradiance of an open plain (sky_tracker_power's) is
-    foldopt.engine.evaluation.poa's NumPy expression to the bit, beam-only skies included."""
+    """The compiled tracker irradiance of an open plain (sky_tracker_poa's above the auto engine's
+    size) is foldopt.engine.evaluation.poa's NumPy expression to the bit, beam-only skies included."""
     import datetime as dt
 
     from foldopt.engine import evaluation as engines
+    from foldopt.engine.incidence import turning_poa
     from foldopt.engine.sky import build_sky
-    from foldopt.studies.designs import sky_tracker_orientation, sky_tracker_power
+    from foldopt.studies.designs import sky_tracker_orientation
 
     sky_name, transposition = sky_model
     study = load_study(default_study_path()).variant(mode="exact", step_min=5, sky=sky_name,
@@ -147,6 +148,8 @@ def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitu
     dates = [dt.date(2025, 1, 1) + dt.timedelta(days=(day + k * 121) % 365) for k in range(3)]
     sky = build_sky(study, [site] * 3, dates)
     orientation = sky_tracker_orientation(sky, study)
-    reference = engines.panel_power(sky, study, engines.poa(sky, orientation[0], orientation[1],
-                                                            normal=orientation[2]))
-    np.testing.assert_array_equal(sky_tracker_power(sky, study, orientation), reference)
+    reference = engines.poa(sky, orientation[0], orientation[1], normal=orientation[2])
+    sun, _, beam, terms, span = sky.kernel_layout(False)
+    compiled = np.empty(beam.shape)
+    turning_poa(np.ascontiguousarray(orientation[2], dtype=float), sun, beam, terms, span, compiled)
+    np.testing.assert_array_equal(compiled, reference)

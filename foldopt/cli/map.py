@@ -29,6 +29,7 @@ from foldopt.cli.options import (
 )
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError, WeatherError
+from foldopt.names import DEFAULT_ENGINE
 
 #: The map request's parameters as the options name them, beside the study's fields.
 _OPTION_OF_PARAMETER = {
@@ -172,7 +173,7 @@ def map_(
     overwrite: Overwrite = False,
     quiet: Quiet = False,
     output_format: OutputFormat = "table",
-    engine: Engine = "numba",
+    engine: Engine = DEFAULT_ENGINE,
 ):
     """Where folding pays: the best fold angle for the year and per season at every site of a grid,
     a CSV of sites or a folder of weather files, with flat, twofold and tracker t_solar and energy,

@@ -43,8 +43,8 @@ Engine = Annotated[
     str,
     typer.Option(
         "--engine",
-        help="numba (the compiled kernel) | numpy (the reference path it is "
-        "tested against, slower).",
+        help=" | ".join(f"{name} ({names.ENGINES.describe(name)})" for name in names.ENGINES)
+        + ".",
     ),
 ]
 Table = Annotated[

@@ -20,6 +20,7 @@ from foldopt.cli.options import (
 )
 from foldopt.cli.output import INVOCATION, Output
 from foldopt.files import check_output
+from foldopt.names import DEFAULT_ENGINE
 
 if TYPE_CHECKING:
     from foldopt.studies.request import Request
@@ -38,7 +39,7 @@ def run_request(
             The results folder.
         overwrite : bool
         output : Output
-        engine : {'numba', 'numpy'}
+        engine : {'auto', 'numba', 'numpy'}
         command : str
             The command's name, for the JSON document.
     """
@@ -78,7 +79,7 @@ def run(
     overwrite: Overwrite = False,
     quiet: Quiet = False,
     output_format: OutputFormat = "table",
-    engine: Engine = "numba",
+    engine: Engine = DEFAULT_ENGINE,
     table: Table = False,
     settings: Settings = None,
 ):
@@ -117,7 +118,7 @@ def reproduce(
     overwrite: Overwrite = False,
     quiet: Quiet = False,
     output_format: OutputFormat = "table",
-    engine: Engine = "numba",
+    engine: Engine = DEFAULT_ENGINE,
 ):
     """Reproduce Shin et al.'s study in paper and exact modes: their published values beside foldopt's.
 

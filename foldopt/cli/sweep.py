@@ -35,6 +35,7 @@ from foldopt.cli.options import (
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
 from foldopt.errors import ConfigError
+from foldopt.names import DEFAULT_ENGINE
 
 #: The sweep group's help and its line in the command list.
 HELP = "Sweep one design variable over a range, everything else from the study."
@@ -295,7 +296,7 @@ def sweep_options(
     overwrite: Overwrite = False,
     quiet: Quiet = False,
     output_format: OutputFormat = "table",
-    engine: Engine = "numba",
+    engine: Engine = DEFAULT_ENGINE,
     table: Table = False,
 ):
     """The options of every sweep (its signature is theirs, through :func:`signature`)."""

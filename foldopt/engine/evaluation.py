@@ -5,11 +5,13 @@ A *row* is one block of the sky (a day at a site) seen by one panel: the east an
 load, ``t_solar``, optionally its longest contiguous interval, and the energy and peak power, in one of two
 engines:
 
-- ``numba`` (default): :func:`foldopt.engine.kernel.fold_rows`, one compiled pass per row from the sun vector
+- ``numba``: :func:`foldopt.engine.kernel.fold_rows`, one compiled pass per row from the sun vector
   to the metrics, parallel over rows, without (rows x steps) arrays;
 - ``numpy``: the reference, block by block: plane-of-array irradiance, the electrical model's powers and
   :mod:`foldopt.engine.metrics` on whole arrays. Tests hold the kernel to it (equal ``t_solar`` within 1 s a
-  day and energy within 1e-9).
+  day and energy within 1e-9);
+- ``auto`` (the default): the reference for small work, the kernel for more
+  (:mod:`foldopt.engine.choice`).
 
 Studies that solve every step's I-V curves (``exact_electrical``) always take the reference path.
 """
@@ -27,7 +29,8 @@ from foldopt.inputs.study import Study
 from foldopt.physics.geometry import normal_vector, subpanel_orientation
 from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.engine.metrics import energy, per_load, t_solar, t_solar_contiguous
-from foldopt.names import ENGINES
+from foldopt.names import DEFAULT_ENGINE
+from foldopt.engine.choice import engine_for
 from foldopt.engine.as_built import PARTS, assemble
 from foldopt.engine.records import Loads, Rows, SkyArrays, Tables, allocate
 from foldopt.engine.sky import Sky, step_span
@@ -250,7 +253,7 @@ def row_metrics(
     row_loadset=None,
     outputs=("switching",),
     contiguous: bool = False,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
     row_orientation=None,
     curves=None,
 ) -> RowMetrics:
@@ -274,7 +277,7 @@ def row_metrics(
         Names of :data:`OUTPUTS` to evaluate.
     contiguous : bool
         Also the longest contiguous interval (costs O(n_loads) a step: for few loads).
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     row_orientation : array_like of int, optional
         (n_rows,) each row's orientation in ``orientation``: a few orientations over many blocks
         (the angles of a search over a year's days) are then worked out once each.
@@ -287,8 +290,7 @@ def row_metrics(
     RowMetrics
         An unknown ``engine`` or output raises ValueError.
     """
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
+    engine = engine_for(engine, np.size(row_block) * sky.n_steps)
     unknown = [name for name in outputs if name not in OUTPUTS]
     if unknown:
         raise ValueError(f"outputs must be among {', '.join(OUTPUTS)}; got {unknown}")
@@ -651,7 +653,7 @@ def curve_metrics(
     step_hours: float,
     row_loadset=None,
     contiguous: bool = False,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
     load_shape=None,
     span=None,
 ) -> RowMetrics:
@@ -669,7 +671,7 @@ def curve_metrics(
         (n_rows,) set of loads of each row; default the first.
     contiguous : bool, default False
         Also the longest contiguous interval.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     load_shape : array_like, optional
         (n_rows, n_steps) load profile [W]; the loads are then its scales (:func:`per_load`).
     span : array_like of int, optional
@@ -683,9 +685,8 @@ def curve_metrics(
         With one output: ``t_solar`` (n_rows, 1, n_loads) and so on; no irradiation. An unknown ``engine``
         raises ValueError.
     """
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
     power = np.ascontiguousarray(power, dtype=float)
+    engine = engine_for(engine, power.size)
     sorted_loads, order = _sorted_loads(loads)
     row_loadset = (
         np.zeros(power.shape[0], dtype=np.int64)

@@ -133,6 +133,11 @@ class Sky:
         return self.dni.shape[0]
 
     @property
+    def n_steps(self) -> int:
+        """Number of time steps of each block."""
+        return self.dni.shape[1]
+
+    @property
     def step_hours(self) -> float:
         """Step length [h]."""
         return self.grid.step_hours

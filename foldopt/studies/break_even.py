@@ -12,6 +12,7 @@ import numpy as np
 
 from foldopt.engine import evaluation as engines
 from foldopt.studies.objectives import period_values
+from foldopt.names import DEFAULT_ENGINE
 
 #: The break-even search's brackets close to this share of the largest power (a 20 W tracker's
 #: break-even to 2e-5 W), in at most so many passes of the engine.
@@ -28,7 +29,7 @@ def break_even_standby(
     statistic: str,
     seasons,
     step_hours: float,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
 ):
     """The tracker's standby draw [W] at which its objective over each period falls to ``targets``,
     at several sites of the same days at once.
@@ -59,7 +60,7 @@ def break_even_standby(
         Each period's months (None: every day).
     step_hours : float
         Step length [h].
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
 
     Returns
     -------

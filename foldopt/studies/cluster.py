@@ -48,6 +48,7 @@ from foldopt.files import (
 )
 from foldopt.studies.dask_client import CONNECT_TIMEOUT, connect
 from foldopt.tables import write_csv
+from foldopt.names import DEFAULT_ENGINE
 
 #: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
 #: about a millisecond), short enough that a lost worker loses little and progress moves.
@@ -77,7 +78,7 @@ class MapSpec:
     year : int, default 2025
     sites_per_chunk : int, default 0
         0: sized for about :data:`CHUNK_SECONDS` of one core's work (:func:`default_sites_per_chunk`).
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     """
 
     study: Study
@@ -86,7 +87,7 @@ class MapSpec:
     relative: bool = False
     year: int = 2025
     sites_per_chunk: int = 0
-    engine: str = "numba"
+    engine: str = DEFAULT_ENGINE
 
     def __post_init__(self):
         from foldopt.studies.worldmap import map_template

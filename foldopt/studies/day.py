@@ -42,6 +42,7 @@ from foldopt.studies.designs import (
 from foldopt.studies.objectives import near_optimal
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
+from foldopt.names import DEFAULT_ENGINE
 
 
 class Day:
@@ -258,7 +259,7 @@ class StudyResult:
     optimal_fold_angle: float
     heuristic_fold_angle: float
     standby: tuple  # (table, break-even standby draw [W]) of :func:`standby_sweep`
-    engine: str = "numba"
+    engine: str = DEFAULT_ENGINE
     near_optimal: dict = dataclasses.field(default_factory=dict)
     request: object = None  # the foldopt.studies.request.Request the study came from, if any
 
@@ -295,14 +296,14 @@ def _best_angle(day: Day, fold_angles, sweep_t_solar, connection, with_power: bo
     )
 
 
-def run_study(study: Study, engine: str = "numba", request=None) -> StudyResult:
+def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> StudyResult:
     """Sweep the fold angle and compare flat, twofold and tracker.
 
     Parameters
     ----------
     study : Study
         One site and date.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
         Evaluates the fold-angle sweep (:data:`foldopt.names.ENGINES`).
     request : Request, optional
         The :class:`foldopt.studies.request.Request` the study came from, kept on the result.

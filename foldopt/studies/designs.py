@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from foldopt.engine import evaluation as engines
+from foldopt.engine.choice import engine_for
 from foldopt.physics.connections import CONNECTIONS
-from foldopt.engine.incidence import turning_poa
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.engine.sky import Sky
@@ -33,6 +33,7 @@ from foldopt.engine.sky import Sky
 # Blocks and their setup are part of the designs' API (the studies take them from here).
 from foldopt.studies.blocks import CHUNK_ROW_LOADS, Blocks, setup_key  # noqa: F401
 from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
+from foldopt.names import DEFAULT_ENGINE
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
 
@@ -105,10 +106,14 @@ def sky_tracker_poa(sky: Sky, orientation) -> np.ndarray:
         The tracker's surface tilt and azimuth [deg] and normal (:func:`sky_tracker_orientation`).
     """
     tilt, azimuth, normal = orientation
-    if sky.horizon_of is not None or sky.iam != "none":
+    small = engine_for("auto", sky.n_blocks * sky.n_steps) == "numpy"
+    if sky.horizon_of is not None or sky.iam != "none" or small:
         return engines.poa(sky, tilt, azimuth, normal=normal)
     # An open plain without a modifier (every map's): the same sums compiled, over the lit spans
-    # alone (the reference path's to the bit, tests/test_tracker.py).
+    # alone (the reference path's to the bit, tests/test_tracker.py), where they save more than
+    # their compile costs.
+    from foldopt.engine.incidence import turning_poa
+
     sun, _, beam, terms, span = sky.kernel_layout(False)
     poa = np.empty(beam.shape)
     turning_poa(np.ascontiguousarray(normal, dtype=float), sun, beam, terms, span, poa)
@@ -211,7 +216,7 @@ def tracker_curves(
     )
 
 
-def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
+def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = DEFAULT_ENGINE):
     """t_solar [h] of every block's twofold panel at every angle of the grid, for every load.
 
     Parameters
@@ -221,7 +226,7 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = "numba"):
     blocks : Blocks
     loads : array_like
         (n_loads,) [W].
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
 
     Returns
     -------
@@ -275,7 +280,7 @@ def design_metrics(
         The fold-angle grid [deg].
     chosen : numpy.ndarray of int
         (n_blocks, n_loads) index into ``angles`` of the twofold panel's angle.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     tracker : TrackerCurves, optional
         The study's tracker over ``sky``, where the caller has it (a day's study draws it too);
         default worked out here (:func:`tracker_curves`).
@@ -487,7 +492,7 @@ class DailyDesigns:
     flat_tilted: tuple | None = None
 
 
-def daily_designs(parts, loads, engine: str = "numba", search=None) -> DailyDesigns:
+def daily_designs(parts, loads, engine: str = DEFAULT_ENGINE, search=None) -> DailyDesigns:
     """:class:`DailyDesigns` over chunks of days at one site (:func:`site_designs` of one site).
 
     Parameters
@@ -496,7 +501,7 @@ def daily_designs(parts, loads, engine: str = "numba", search=None) -> DailyDesi
         Each chunk of :class:`Blocks` with its sky.
     loads : array_like
         (n_loads,) [W]; an infinite load carries nothing.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     search : callable, optional
         As :func:`site_designs`' (one site); default every angle of the study's grid.
     """
@@ -506,7 +511,7 @@ def daily_designs(parts, loads, engine: str = "numba", search=None) -> DailyDesi
     )[0]
 
 
-def site_designs(parts, sites, loads, engine: str = "numba", search=None) -> list:
+def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None) -> list:
     """:class:`DailyDesigns` of many sites over chunks of their days, every engine call over all of
     them (a map's batch of sites).
 
@@ -518,7 +523,7 @@ def site_designs(parts, sites, loads, engine: str = "numba", search=None) -> lis
         Each site's blocks, consecutive over the chunks.
     loads : array_like
         (n_sites, n_loads) each site's loads [W]; an infinite load carries nothing.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     search : callable, optional
         ``search(parts, sites, loads, loadset, engine)`` -> per site ``(designs (n, 2) fold angle and
         base tilt, hours (days, loads, n), energy (days, n), flat)`` at the designs it chooses to
@@ -623,7 +628,12 @@ def _every_angle(parts, sites, loads, loadset, engine):
 
 
 def design_hours(
-    parts, points, loads, flat: bool = False, engine: str = "numba", with_energy: bool = False
+    parts,
+    points,
+    loads,
+    flat: bool = False,
+    engine: str = DEFAULT_ENGINE,
+    with_energy: bool = False,
 ):
     """Each day's t_solar [h] of arbitrary designs: a fold angle, base tilt and base azimuth each,
     for the search of :func:`foldopt.studies.joint.optimize_plan`.
@@ -638,7 +648,7 @@ def design_hours(
         (n_loads,) [W].
     flat : bool
         The flat panel (the fold angle unused) with no connection: as the ``flat`` design.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     with_energy : bool
         Also each day's harvested energy.
 
@@ -655,7 +665,7 @@ def design_hours(
 
 
 def requested_hours(
-    parts, requests, loads, loadset=None, flat: bool = False, engine: str = "numba"
+    parts, requests, loads, loadset=None, flat: bool = False, engine: str = DEFAULT_ENGINE
 ) -> list:
     """Each day's t_solar [h] and harvested energy [Wh] of designs, each request on days of its
     own, every request of a chunk in as few engine calls as its memory bound allows.
@@ -673,7 +683,7 @@ def requested_hours(
         (n_blocks,) each block's set of loads; default the first.
     flat : bool
         The flat panel (the fold angle unused) with no connection: as the ``flat`` design.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
 
     Returns
     -------

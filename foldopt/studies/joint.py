@@ -36,6 +36,7 @@ from foldopt.inputs.optimize_section import DEFAULT_TILT, MAX_DESIGNS
 from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
+from foldopt.names import DEFAULT_ENGINE
 from foldopt.studies.objectives import (
     best_angle_index,
     near_optimal,
@@ -114,7 +115,7 @@ def _axes(study: Study, vary, fold_angle: float = 180.0) -> dict[str, Axis]:
     return axes
 
 
-def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeResult:
+def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> OptimizeResult:
     """The best fold angle, tilt and azimuth of a study's panel, and the flat panel's own best.
 
     Parameters
@@ -122,7 +123,7 @@ def optimize_plan(plan: Plan, engine: str = "numba", request=None) -> OptimizeRe
     plan : Plan
         A study with an ``optimize`` section; its axes may be ``date`` (the days the objective
         is taken over) and ``p_load`` (the loads), no other.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
     request : foldopt.studies.request.Request, optional
 
     Returns

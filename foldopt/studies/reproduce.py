@@ -17,6 +17,7 @@ import pandas as pd
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import load_for_t_solar
 from foldopt.studies.day import Day, run_study, twofold_t_solar
+from foldopt.names import DEFAULT_ENGINE
 
 #: Shin et al. Sec. VI-VII and Fig. 12: (unit, published value); NaN where the paper is silent.
 PAPER_VALUES = {
@@ -44,7 +45,7 @@ class Reproduction:
 
     tables: dict
     study: Study
-    engine: str = "numba"
+    engine: str = DEFAULT_ENGINE
 
     @functools.cached_property
     def answer(self):
@@ -75,14 +76,14 @@ def infer_p_load(study: Study, t_solar_flat_h: float = PAPER_VALUES["t_solar_fla
     return load_for_t_solar(day.flat_power(), t_solar_flat_h, day.step_hours)
 
 
-def reproduction_values(study: Study, engine: str = "numba") -> dict[str, float]:
+def reproduction_values(study: Study, engine: str = DEFAULT_ENGINE) -> dict[str, float]:
     """The reproduced quantities of :data:`PAPER_VALUES` for one resolved study.
 
     Parameters
     ----------
     study : Study
         Mode, geometry and load already set (:func:`reproduce`).
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
 
     Returns
     -------
@@ -106,7 +107,7 @@ def reproduction_values(study: Study, engine: str = "numba") -> dict[str, float]
     }
 
 
-def reproduce(study: Study, engine: str = "numba", **changes) -> pd.DataFrame:
+def reproduce(study: Study, engine: str = DEFAULT_ENGINE, **changes) -> pd.DataFrame:
     """Paper value, paper-mode value and exact-mode value of each reproduced quantity.
 
     Parameters
@@ -114,7 +115,7 @@ def reproduce(study: Study, engine: str = "numba", **changes) -> pd.DataFrame:
     study : Study
         The paper's study (``configs/shin2015.yaml``); its mode, geometry and load are replaced:
         paper mode with the azimuth-split geometry, exact mode with the hinge, and the inferred load.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
         :data:`foldopt.engine.evaluation.ENGINES`.
     **changes
         Other fields to replace first, e.g. ``pv_model="single-diode"``.

@@ -15,6 +15,7 @@ sites and loads (:func:`map_request_from`), and a sizing's costs are checked aga
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, replace
 
@@ -23,6 +24,7 @@ from foldopt.inputs import policy
 from foldopt.names import WEATHER_SOURCES
 from foldopt.inputs.study_file import default_study_path, parse_study_text, read_study
 from foldopt.inputs.optimize_section import vary_names
+from foldopt.engine.choice import engine_for
 from foldopt.names import FIELD_OF_PARAMETER, FIELD_OPTIONS, OPTIMIZE_VARIABLES
 from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
 from foldopt.errors import ConfigError
@@ -641,3 +643,35 @@ def map_request_from(
         f"{made.step_min:g}-min steps" if step_min is None else None,
     ]
     return replace(request, source=source, taken=tuple(item for item in taken if item))
+
+
+def request_engine(engine: str, plan) -> str:
+    """The engine of every evaluation of one request (:data:`foldopt.names.ENGINES`), decided once
+    where the request enters the API (:func:`foldopt.run`, :func:`foldopt.optimize`,
+    :func:`foldopt.world_map`, :func:`foldopt.reproduce`): downstream every evaluation takes it,
+    so one request's numbers come from one engine, the same every time.
+
+    ``auto`` (:mod:`foldopt.engine.choice`) takes the NumPy reference path where the request's
+    clear-sky days at its fold angles come to at most
+    :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` rows x steps: a day's study, its sweeps of the
+    angle or the load, a few latitudes or days, a joint optimisation of one day (nothing to
+    compile). A weather file's or a cloud ensemble's days, more days, and a map (``plan`` None:
+    a year at every site) take the compiled kernel.
+
+    Parameters
+    ----------
+    engine : {'auto', 'numba', 'numpy'}
+    plan : foldopt.inputs.plan.Plan, foldopt.Study or None
+        The request's plan or study; None for a map's.
+
+    Returns
+    -------
+    str
+        ``'numba'`` or ``'numpy'``; an unknown ``engine`` raises ValueError naming the valid ones.
+    """
+    if plan is None:
+        return engine_for(engine, math.inf)
+    base, cases = (plan.base, plan.n_cases) if isinstance(plan, Plan) else (plan, 1)
+    if base.weather is not None:
+        return engine_for(engine, math.inf)
+    return engine_for(engine, cases * base.fold_angles.count() * round(24 * 60 / base.step_min))

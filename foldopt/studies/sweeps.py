@@ -35,6 +35,7 @@ from foldopt.studies.objectives import (
 )
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
+from foldopt.names import DEFAULT_ENGINE
 
 
 @dataclass(frozen=True)
@@ -45,7 +46,7 @@ class SweepResult:
     table: pd.DataFrame
     # day x hour curves of an annual objective
     extras: dict = dataclasses.field(default_factory=dict)
-    engine: str = "numba"
+    engine: str = DEFAULT_ENGINE
     weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
     request: object = None  # the foldopt.studies.request.Request the plan came from, if any
     weather_notes: tuple = ()  # what reading a measured weather file did (foldopt.engine.sky.Sky.weather_notes)
@@ -79,7 +80,7 @@ _AXIS_COLUMNS = frozenset(
 def run_plan(
     plan: Plan,
     progress: Callable[[int, int], None] | None = None,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
     request=None,
 ) -> SweepResult:
     """Evaluate every case of a plan: flat, optimal twofold and tracker per case.
@@ -90,7 +91,7 @@ def run_plan(
     progress : callable, optional
         Called as ``progress(done, total)`` with the days done so far, counted once per case
         (an annual objective passes over each day twice: halves count).
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
         :data:`foldopt.engine.evaluation.ENGINES`.
     request : foldopt.studies.request.Request, optional
         The request the plan was made from: what the answer says it took from the study.

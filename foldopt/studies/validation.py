@@ -32,6 +32,7 @@ from foldopt.inputs.weather import study_weather
 from foldopt.inputs.weather.epw import write_epw
 from foldopt.studies.designs import DESIGNS, Blocks, design_metrics, fold_hours
 from foldopt.studies.objectives import best_angle_index
+from foldopt.names import DEFAULT_ENGINE
 
 #: The designs compared and the ensemble's percentiles.
 COMPARED = ("flat", "twofold", "tracker")
@@ -70,7 +71,7 @@ def _design_hours(study: Study, date, loads, members: int = 1):
         loads,
         fold_angles,
         np.broadcast_to(chosen, (sky.n_blocks, loads.size)),
-        "numba",
+        DEFAULT_ENGINE,
     )
     return metrics["t_solar_h"], fold_angles[chosen]
 

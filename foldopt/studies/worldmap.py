@@ -22,6 +22,7 @@ the files.
 from __future__ import annotations
 
 import datetime as dt
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,6 +42,8 @@ from foldopt.errors import ConfigError
 from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
 from foldopt.studies.site_search import fold_search
+from foldopt.engine.choice import engine_for
+from foldopt.names import DEFAULT_ENGINE
 from foldopt.studies.objectives import (
     best_angle_index,
     near_optimal_on_grid,
@@ -409,7 +412,7 @@ def evaluate_sites(
     loads: Sequence[float],
     relative: bool = False,
     year: int = 2025,
-    engine: str = "numba",
+    engine: str = DEFAULT_ENGINE,
 ) -> pd.DataFrame:
     """The map's rows for some sites: per site, load and period (:data:`PERIODS`).
 
@@ -426,7 +429,9 @@ def evaluate_sites(
     relative : bool
     year : int
         The year of clear-sky days, or what a weather file's typical year stands for.
-    engine : {'numba', 'numpy'}
+    engine : {'auto', 'numba', 'numpy'}
+        ``auto`` is the compiled kernel: a site's numbers are then the same whichever sites share
+        its batch (:func:`foldopt.studies.request.request_engine`, a map's).
 
     Returns
     -------
@@ -447,6 +452,7 @@ def evaluate_sites(
         never carries the load).
     """
     loads = np.asarray(loads, dtype=float)
+    engine = engine_for(engine, math.inf)
     frames, batch, key = [], [], None
     study = map_data(study)  # once, not per site
     for site in sites:
