@@ -15,7 +15,7 @@ from typing import Annotated
 import typer
 
 from foldopt import names
-from foldopt.cli.options import Overwrite
+from foldopt.cli.options import OutputFormat, Overwrite
 from foldopt.cli.output import echo, fail
 from foldopt.errors import ConfigError
 
@@ -119,11 +119,7 @@ def fetch(
     echo(f"  from {found.url}")
 
 
-def list_cache(
-    output_format: Annotated[
-        str, typer.Option("--format", help="table | json: one JSON document of the entries.")
-    ] = "table",
-):
+def list_cache(output_format: OutputFormat = "table"):
     """List the cached weather: source, site, options, when it was retrieved, its file.
 
     \b
@@ -131,8 +127,10 @@ def list_cache(
       foldopt weather list
       foldopt weather list --format json
     """
-    if output_format not in ("table", "json"):
-        fail([f"--format = {output_format!r}: must be one of table, json"])
+    try:
+        output_format = names.canonical(output_format, names.OUTPUT_FORMATS)
+    except ValueError as error:
+        fail([f"--format = {output_format!r}: {error}"])
     from foldopt.inputs.weather.sources import cached_entries, weather_cache
 
     entries = cached_entries()

@@ -321,7 +321,7 @@ def _download(request: _Request, label: str) -> bytes:
                 params=request.params,
                 timeout=request.timeout_s,
                 stream=True,
-                headers={"User-Agent": "foldopt (https://github.com/foldopt)"},
+                headers={"User-Agent": "foldopt"},
             ) as response:
                 payload = _body(response, label, service)
         except requests.exceptions.Timeout:
