@@ -287,3 +287,39 @@ def test_a_study_file_names_the_source_and_its_address(pvgis, server, tmp_path, 
     assert refused.exit_code == 2
     assert "weather.years" in refused.stderr and "the first year comes after the last" in refused.stderr
     assert requests_made(server, route) == 1
+
+
+def test_a_full_cache_folder_is_one_line_and_leaves_nothing(pvgis, server, small_disk, monkeypatch):
+    route = pvgis("ok")
+    monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(small_disk / "cache"))
+    (small_disk / "filler").write_bytes(b"\0" * 1_000_000)  # 2 MB disk: the 1.4 MB answer cannot fit
+    result = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        f"error: weather pvgis-tmy: cannot cache the answer in {small_disk / 'cache' / 'weather'} (the file "
+        "system is full); FOLDOPT_CACHE_DIR names another cache folder"]
+    assert list((small_disk / "cache" / "weather").iterdir()) == []  # no partial file
+    assert requests_made(server, route) == 1
+
+
+def test_a_damaged_cached_answer_is_fetched_again(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    assert runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"]).exit_code == 0
+    answer = next(p for p in (tmp_path / "cache" / "weather").iterdir() if "provenance" not in p.name)
+    answer.write_bytes(answer.read_bytes().replace(b'"G(h)": 0.0', b'"G(h)": 9.0', 1))  # one flipped value
+    offline = runner.invoke(app, ["weather", "path", "--lat", "45", "--lon", "8"])
+    assert offline.exit_code == 2 and "no cached copy" in offline.stderr  # not read as if whole
+    assert runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"]).exit_code == 0
+    assert requests_made(server, route) == 2
+    assert answer.read_bytes() == RECORDED.read_bytes()
+
+
+def test_a_source_is_fetched_for_one_site(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    result = runner.invoke(app, ["sweep", "latitude", "--lat", "40,45", "--lon", "8", "--days", "2025-06-21",
+                                 "--weather", "pvgis-tmy", "--out", "x"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        "error: --lat = [40.0, 45.0]: varies, but weather.source pvgis-tmy is fetched for one site; give one site "
+        "(fetch several ahead with foldopt weather fetch, one site each)"]
+    assert requests_made(server, route) == 0
