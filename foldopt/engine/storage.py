@@ -13,45 +13,53 @@ load and a part below it. Per part, while the load is on:
 - at or above the load, PV serves the load and the surplus charges the buffer through
   ``charge_efficiency``, at most ``max_charge_w`` at each instant and at most the room left; what
   does not fit is *lost*;
-- below it, the buffer covers the deficit through ``discharge_efficiency``. The part is powered
-  only if the buffer covers the whole of the part's deficit from its content above ``min_soc``,
-  and the deficit never exceeds ``max_discharge_w``; otherwise the load is off for the whole part
-  (its energy is *missing*) and stays off until the content reaches ``restart_soc`` (the
-  controller's hysteresis, checked at the start of each part). While the load is off, all the PV
-  charges the buffer.
+- below it, the buffer covers the deficit through ``discharge_efficiency`` from its content above
+  ``min_soc``. When the content runs out part of the way, the load runs to that instant (found in
+  closed form: the deficit is linear) and is off for the rest of the part; a deficit above
+  ``max_discharge_w`` anywhere in the part turns the load off for the whole part. The energy of
+  the load while it is off is *missing*.
 
-Self-discharge takes ``(1 - self_discharge) ** (tau / 24)`` of the content at the end of each
-segment of ``tau`` hours (``self_discharge`` a day).
+Once off, the load stays off until the content reaches ``restart_soc`` (the controller's
+hysteresis), which is checked at the start of each part; while it is off, all the PV charges the
+buffer. Self-discharge takes ``(1 - self_discharge) ** (tau / 24)`` of the content at the end of
+each segment of ``tau`` hours (``self_discharge`` a day).
 
 Conventions that follow from it:
 
-- With ``capacity_wh = 0`` the load is powered exactly in the parts at or above the load: the
-  powered time of a constant load is :func:`foldopt.engine.metrics.t_solar` of the same curve,
-  segment for segment (the sums may differ in the last bit). A load profile is compared by the
-  difference ``P - L`` of the two linear curves, where :func:`foldopt.engine.metrics.per_load`
-  compares the ratio ``P / shape`` with a scale: the two agree at step centres and wherever the
-  profile is constant over a segment, and differ inside segments over which the profile changes.
+- With ``capacity_wh = 0`` the load runs exactly in the parts at or above the load: the powered
+  time of a constant load is :func:`foldopt.engine.metrics.t_solar` of the same curve, segment for
+  segment (the sums may differ in the last bit). A load profile is compared by the difference
+  ``P - L`` of the two linear curves, where :func:`foldopt.engine.metrics.per_load` compares the
+  ratio ``P / shape`` with a scale: the two agree at step centres and wherever the profile is
+  constant over a segment, and differ inside segments over which it changes.
 - Powered time counts only segments in which the load demands power (a profile that is zero at
-  both ends of a segment runs nothing there, so neither powered nor missing time).
-- Every part is all or nothing: a load the buffer cannot carry to the end of a part (at most one
-  step) is off for all of it, so an outage starts up to a step early. Reconnection happens at a
-  part's start.
+  both ends of a segment runs nothing there: neither powered nor missing time).
+- The load reconnects only at a part's start (at most a step apart), so a cut-off late in a part
+  keeps it off to the part's end.
 - Power below zero (a tracker net of its drive) is run from the buffer while the load is on, as
   part of the deficit; while the load is off the controller disconnects it too, and it is counted
-  nowhere. Energy is then conserved for curves that do not go below zero:
+  nowhere. Energy is therefore conserved for curves that do not go below zero:
   ``served + lost + delta stored + conversion losses + self-discharge = harvested``.
 - Days *full* and *empty* are PVGIS's [1]_: days on which the buffer was full at some instant
   (never with no capacity), and days on which the controller cut the load off for lack of charge
   (it reached its discharge cut-off).
+- Powered time does not fall as the capacity grows, or as the load falls, to within one step,
+  for a controller without hysteresis (``restart_soc = min_soc``) and a buffer that does not leak
+  (``tests/test_storage_engine.py``). With a hysteresis band or a leak it can: the band
+  ``(restart_soc - min_soc) x capacity`` that must be recharged before the load reconnects, and
+  the floor ``min_soc x capacity`` that leaks and is refilled, grow with the buffer.
 
 Initial state: ``initial_soc``, or by default the periodic steady state: the series is run from a
 full buffer, then from the state it ended in, until the state at its end is that at its start (the
-content within ``tolerance`` x the capacity, the load on or off alike); after
+content within ``tolerance`` x the capacity, the load on or off alike). After
 :data:`~foldopt.engine.storage_kernel.PLAIN_ITERATIONS` passes the start is bisected between the
-contents that ended higher and lower, and after ``max_iterations`` passes, or once that bracket is
-narrower than the tolerance (the end state jumps over the start's: no periodic state), the last
-pass is kept and the series is flagged. One clear-sky day is thus repeated until its midnight
-state repeats; a weather year starts from the state at its own end.
+contents that ended higher and lower. After ``max_iterations`` passes, or once that bracket is
+down to rounding (:data:`~foldopt.engine.storage_kernel.BRACKET`: the end state jumps over the
+start's, no periodic state), the last pass is kept and the series is flagged. One clear-sky day
+is thus repeated until its midnight state repeats; a weather year starts from the state at its
+own end. A pass stops early at the first midnight whose state the previous pass had too (from
+there on the two are the same), so that a year whose buffer fills at some point costs little more
+than one pass.
 
 References
 ----------
@@ -368,6 +376,19 @@ def _charge_numpy(charging, stored, spare, limit, par, row):
     return stored
 
 
+def _time_to_draw(da, db, tau, energy):
+    """:func:`foldopt.engine.storage_kernel.time_to_draw` over arrays."""
+    da, db = np.maximum(da, 0.0), np.maximum(db, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        slope = 0.5 * (db - da) / tau
+        root = np.sqrt(np.maximum(da * da + 4.0 * slope * energy, 0.0))
+        return np.where(
+            slope == 0.0,
+            np.minimum(energy / da, tau),
+            np.minimum(2.0 * energy / (da + root), tau),
+        )
+
+
 def _part_numpy(pa, pb, la, lb, tau, surplus, demand, stored, on, par, row):
     """:func:`foldopt.engine.storage_kernel._part` over arrays of series."""
     active = tau > 0.0
@@ -376,25 +397,37 @@ def _part_numpy(pa, pb, la, lb, tau, surplus, demand, stored, on, par, row):
     need = 0.5 * tau * (la + lb)
     on = on | (active & (stored >= par[:, kern.RESTART_SOC] * capacity))
     run = active & on & surplus
-    short = np.maximum(need - pv, 0.0)
-    usable = stored - par[:, kern.MIN_SOC] * capacity
+    floor = par[:, kern.MIN_SOC] * capacity
+    usable = stored - floor
     eta_d = par[:, kern.ETA_DISCHARGE]
-    covered = (
+    short = np.maximum(need - pv, 0.0)
+    able = (
         active
         & on
         & ~surplus
         & (usable > 0.0)
-        & (short <= eta_d * usable)
         & (np.maximum(la - pa, lb - pb) <= par[:, kern.MAX_DISCHARGE])
     )
+    covered = able & (short <= eta_d * usable)
+    partial = able & ~covered
     cut = active & on & ~surplus & ~covered
     off = active & ~on | cut
-    served = run | covered
-    row[:, kern.SERVED] += np.where(served, need, 0.0)
-    row[:, kern.POWERED] += np.where(served & demand, tau, 0.0)
+    whole = run | covered
     drawn = short / eta_d
-    row[:, kern.DISCHARGE_LOSS] += np.where(covered, drawn - short, 0.0)
-    stored = np.where(covered, stored - drawn, stored)
+    ran = _time_to_draw(la - pa, lb - pb, tau, eta_d * usable)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x = ran / tau
+    pm, lm = pa + x * (pb - pa), la + x * (lb - la)
+    row[:, kern.SERVED] += np.where(whole, need, np.where(partial, 0.5 * ran * (la + lm), 0.0))
+    ran = np.where(whole, tau, np.where(partial, ran, 0.0))
+    row[:, kern.POWERED] += np.where(demand, ran, 0.0)
+    row[:, kern.DISCHARGE_LOSS] += np.where(
+        covered, drawn - short, np.where(partial, usable - eta_d * usable, 0.0)
+    )
+    stored = np.where(covered, stored - drawn, np.where(partial, floor, stored))
+    pa, la = np.where(partial, pm, pa), np.where(partial, lm, la)
+    tau = np.where(partial, tau - ran, tau)
+    need = np.where(partial, 0.5 * tau * (la + lb), need)
     on = on & ~cut
     row[:, kern.EMPTY] = np.where(cut, 1.0, row[:, kern.EMPTY])
     row[:, kern.MISSING] += np.where(off, need, 0.0)
@@ -441,8 +474,6 @@ def _run_numpy(power, load, par, step_hours, stored, on, out, state, soc_curves,
     first, second, demand, half = _segments(power, load, step_hours)
     capacity = par[:, kern.CAPACITY]
     n_bins = out.shape[-1] - kern.HISTOGRAM
-    with np.errstate(divide="ignore"):
-        per_bin = np.where(capacity > 0.0, n_bins / capacity, 0.0)
     series = np.arange(power.shape[0])
     restart = par[:, kern.RESTART_SOC] * capacity
     for d in range(n_days):
@@ -466,11 +497,12 @@ def _run_numpy(power, load, par, step_hours, stored, on, out, state, soc_curves,
             kept = stored * par[:, kern.KEEP_HALF if half[j] else kern.KEEP_STEP]
             row[:, kern.SELF_DISCHARGE] += stored - kept
             stored = kept
-            bins = np.minimum((stored * per_bin).astype(np.int64), n_bins - 1)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                level = np.where(capacity > 0.0, stored / capacity, 0.0)
+            bins = np.clip((level * n_bins).astype(np.int64), 0, n_bins - 1)
             row[series, kern.HISTOGRAM + bins] += 0.5 * step_hours if half[j] else step_hours
             if soc_curves and j < n_steps:
-                with np.errstate(invalid="ignore", divide="ignore"):
-                    soc[:, d, j] = np.where(capacity > 0.0, stored / capacity, 0.0)
+                soc[:, d, j] = level
         row[:, kern.HARVESTED] = np.cumsum(power[:, d], axis=-1)[:, -1] * step_hours
     on = on | (stored >= restart)
     state[:, n_days, 0], state[:, n_days, 1] = stored, on
@@ -515,7 +547,9 @@ def _simulate_numpy(
         done = given[pick] | ((np.abs(end - stored[pick]) <= tol) & (end_on == on[pick]))
         lo = np.where(end > stored[pick], stored[pick], low[pick])
         hi = np.where(end < stored[pick], stored[pick], high[pick])
-        stuck = ~done & ((hi - lo <= tol) | (passes[pick] >= max_iterations))
+        stuck = ~done & (
+            (hi - lo <= kern.BRACKET * capacity[pick]) | (passes[pick] >= max_iterations)
+        )
         passes[pick[stuck]] *= -1
         plain = (passes[pick] < kern.PLAIN_ITERATIONS) & (lo <= end) & (end <= hi)
         low[pick], high[pick] = lo, hi

@@ -28,6 +28,9 @@ HISTOGRAM = 10
 #: Plain fixed-point iterations (the buffer's own year after year) before the periodic state is
 #: bisected instead (a state that drifts by a little a day would take many plain ones).
 PLAIN_ITERATIONS = 4
+#: Width, as a share of the capacity, below which the bisection stops: a few units in the last
+#: place of the content, where a start between its ends no longer exists.
+BRACKET = 1e-14
 
 
 @njit(cache=True, error_model="numpy")
@@ -71,15 +74,29 @@ def _charge(stored, spare, limit, capacity, eta):
 
 
 @njit(cache=True, error_model="numpy")
+def time_to_draw(da, db, tau, energy):
+    """Hours until a deficit running linearly from ``da`` to ``db`` [W] over ``tau`` [h] has
+    drawn ``energy`` [Wh] (less than the whole part's): the root in ``[0, tau]`` of
+    ``da t + (db - da) t^2 / (2 tau) = energy``, in the form that does not cancel. The rates are
+    taken as at least 0 (at the crossing that bounds a part, rounding can leave one below)."""
+    da, db = max(da, 0.0), max(db, 0.0)
+    slope = 0.5 * (db - da) / tau
+    if slope == 0.0:
+        return min(energy / da, tau)
+    root = math.sqrt(max(da * da + 4.0 * slope * energy, 0.0))
+    return min(2.0 * energy / (da + root), tau)
+
+
+@njit(cache=True, error_model="numpy")
 def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
     """One part of a segment, in which the power runs from ``pa`` to ``pb`` and the load from
     ``la`` to ``lb`` [W] over ``tau`` [h] (``tau`` > 0), the power at or above the load
     throughout (``surplus``) or below it.
 
     Returns the buffer's content [Wh], whether the load is on, the part's energies [Wh] served,
-    missing, lost, lost in charging and in discharging, whether the load ran, whether the buffer
-    was full, and whether the controller cut the load off. Scalars only, so that the call moves
-    no array (numba counts references to arrays passed to a function)."""
+    missing, lost, lost in charging and in discharging, the hours the load ran, whether the
+    buffer was full, and whether the controller cut the load off. Scalars only, so that the call
+    moves no array (numba counts references to arrays passed to a function)."""
     capacity = par[CAPACITY]
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
@@ -90,21 +107,33 @@ def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
         stored, loss, lost, full = _charge(
             stored, max(pv - need, 0.0), limit, capacity, par[ETA_CHARGE]
         )
-        return stored, on, need, 0.0, lost, loss, 0.0, True, full, False
+        return stored, on, need, 0.0, lost, loss, 0.0, tau, full, False
+    served = ran = discharge_loss = 0.0
     cut = False
     if on:
-        short = max(need - pv, 0.0)
-        usable = stored - par[MIN_SOC] * capacity
+        floor = par[MIN_SOC] * capacity
+        usable = stored - floor
         eta = par[ETA_DISCHARGE]
-        if usable > 0.0 and short <= eta * usable and max(la - pa, lb - pb) <= par[MAX_DISCHARGE]:
-            drawn = short / eta
-            return stored - drawn, on, need, 0.0, 0.0, 0.0, drawn - short, True, False, False
+        if usable > 0.0 and max(la - pa, lb - pb) <= par[MAX_DISCHARGE]:
+            short = max(need - pv, 0.0)
+            if short <= eta * usable:
+                drawn = short / eta
+                return stored - drawn, on, need, 0.0, 0.0, 0.0, drawn - short, tau, False, False
+            # The buffer carries the load part of the way, to its cut-off; the rest is off.
+            ran = time_to_draw(la - pa, lb - pb, tau, eta * usable)
+            x = ran / tau
+            pm, lm = pa + x * (pb - pa), la + x * (lb - la)
+            served = 0.5 * ran * (la + lm)
+            discharge_loss = usable - eta * usable
+            stored = floor
+            pa, la, tau = pm, lm, tau - ran
+            need = 0.5 * tau * (la + lb)
         on = False
         cut = True
     spare = clipped_energy(pa, pb, tau, math.inf)
     limit = clipped_energy(pa, pb, tau, par[MAX_CHARGE])
     stored, loss, lost, full = _charge(stored, spare, limit, capacity, par[ETA_CHARGE])
-    return stored, on, 0.0, need, lost, loss, 0.0, False, full, cut
+    return stored, on, served, need, lost, loss, discharge_loss, ran, full, cut
 
 
 @njit(cache=True, error_model="numpy")
@@ -120,7 +149,6 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
     profile_days, profile_steps = load.shape[0] > 1, load.shape[1] > 1
     capacity, restart = par[CAPACITY], par[RESTART_SOC] * par[CAPACITY]
     n_bins = out.shape[1] - HISTOGRAM
-    per_bin = n_bins / capacity if capacity > 0.0 else 0.0
     keep_half, keep_step = par[KEEP_HALF], par[KEEP_STEP]
     for d in range(n_days):
         on = on or stored >= restart
@@ -168,7 +196,7 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
                     pa, pb, la, lb = ps, p1, ls, l1
                 else:
                     pa, pb, la, lb = p0, ps, l0, ls
-                stored, on, s_wh, m_wh, l_wh, c_wh, d_wh, ran, was_full, cut = _part(
+                stored, on, s_wh, m_wh, l_wh, c_wh, d_wh, ran_h, was_full, cut = _part(
                     pa, pb, la, lb, length, rising == second, stored, on, par
                 )
                 served += s_wh
@@ -176,16 +204,17 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
                 lost += l_wh
                 charge_loss += c_wh
                 discharge_loss += d_wh
-                if ran and demand:
-                    powered += length
+                if demand:
+                    powered += ran_h
                 full = full or was_full
                 empty = empty or cut
             kept = stored * (keep_half if half else keep_step)
             leak += stored - kept
             stored = kept
-            row[HISTOGRAM + min(int(stored * per_bin), n_bins - 1)] += tau
+            level = stored / capacity if capacity > 0.0 else 0.0
+            row[HISTOGRAM + min(max(int(level * n_bins), 0), n_bins - 1)] += tau
             if keep_soc and j < n_steps:
-                soc[d, j] = stored / capacity if capacity > 0.0 else 0.0
+                soc[d, j] = level
         row[POWERED], row[SERVED], row[MISSING], row[LOST] = powered, served, missing, lost
         row[HARVESTED] = harvested * step_hours
         row[CHARGE_LOSS], row[DISCHARGE_LOSS], row[SELF_DISCHARGE] = (
@@ -225,7 +254,7 @@ def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterati
             low = stored
         elif end < stored:
             high = stored
-        if high - low <= tolerance * capacity:
+        if high - low <= BRACKET * capacity:
             break  # the end state jumps across the start's: no periodic state
         on = end_on
         if passes < PLAIN_ITERATIONS and low <= end <= high:

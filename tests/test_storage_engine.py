@@ -1,0 +1,341 @@
+"""The state-of-charge simulation of a small buffer (foldopt.engine.storage, issue 41 item 2).
+
+Each property is checked against a reference computed another way: metrics.t_solar for no
+buffer, the energy balance for an unlimited one, a plain-Python loop over a small case, and a
+two-day example worked by hand.
+"""
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from foldopt.engine import storage
+from foldopt.engine.metrics import t_solar
+from foldopt.engine.storage import Buffer, simulate
+
+ENGINES = storage.STORAGE_ENGINES
+FEW = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@st.composite
+def curves(draw, max_series=3, max_days=3, lowest=0.0):
+    """Power curves (n_series, n_days, n_steps) with dark stretches, and the step [h]."""
+    shape = (
+        draw(st.integers(1, max_series)),
+        draw(st.integers(1, max_days)),
+        draw(st.integers(3, 16)),
+    )
+    level = arrays(float, shape, elements=st.floats(lowest, 20.0))
+    lit = arrays(bool, shape)
+    return np.where(draw(lit), draw(level), 0.0), 24.0 / shape[2]
+
+
+@st.composite
+def buffers(draw, capacity=None, hysteresis=True, leak=True):
+    """A buffer with every option drawn (``capacity`` fixed where given)."""
+    min_soc = draw(st.floats(0.0, 0.5))
+    return Buffer(
+        capacity_wh=draw(st.floats(0.0, 60.0)) if capacity is None else capacity,
+        min_soc=min_soc,
+        restart_soc=min_soc + (draw(st.floats(0.0, 0.4)) if hysteresis else 0.0),
+        charge_efficiency=draw(st.floats(0.6, 1.0)),
+        discharge_efficiency=draw(st.floats(0.6, 1.0)),
+        self_discharge=draw(st.floats(0.0, 0.3)) if leak else 0.0,
+        max_charge_w=draw(st.one_of(st.none(), st.floats(0.5, 10.0))),
+        max_discharge_w=draw(st.one_of(st.none(), st.floats(0.5, 10.0))),
+        initial_soc=draw(st.one_of(st.none(), st.floats(0.0, 1.0))),
+    )
+
+
+def balance(result):
+    """served + lost + delta stored + losses - harvested, per series and day [Wh]."""
+    return (
+        result.served_wh
+        + result.lost_wh
+        + np.diff(result.stored_wh, axis=1)
+        + result.charge_loss_wh
+        + result.discharge_loss_wh
+        + result.self_discharge_wh
+        - result.harvested_wh
+    )
+
+
+@FEW
+@given(curves(lowest=-2.0), st.data())
+def test_no_capacity_is_t_solar(curve, data):
+    """With 0 Wh the load runs exactly while P_pv >= P_load (metrics.t_solar, the storage-less
+    answer), whatever the controller's other settings; a tracker's power below zero included."""
+    power, step = curve
+    loads = data.draw(arrays(float, power.shape[0], elements=st.floats(0.1, 15.0)))
+    buffer = data.draw(buffers(capacity=0.0))
+    expected = t_solar(power, loads[:, None], step)
+    for engine in ENGINES:
+        result = simulate(power, loads, buffer, step, engine=engine)
+        np.testing.assert_allclose(result.powered_h, expected, rtol=0, atol=1e-12)
+        assert not result.full.any()
+
+
+@FEW
+@given(curves(), st.data())
+def test_no_capacity_with_a_profile_compares_the_difference(curve, data):
+    """A load profile is compared by P - L, both linear between step centres: with 0 Wh the
+    powered time is t_solar of the difference against 0, and the served energy that of the load
+    over the parts above it (no buffer: never more than harvested)."""
+    power, step = curve
+    profile = data.draw(arrays(float, power.shape[::2], elements=st.floats(0.1, 15.0)))
+    result = simulate(power, profile, Buffer(0.0), step, engine="numba")
+    difference = power - profile[:, None, :]
+    np.testing.assert_allclose(result.powered_h, t_solar(difference, 0.0, step), atol=1e-12)
+    assert (result.served_wh <= result.harvested_wh + 1e-9).all()
+    np.testing.assert_allclose(result.served_wh + result.lost_wh, result.harvested_wh, atol=1e-9)
+
+
+@FEW
+@given(curves(max_series=2, max_days=1), st.floats(0.2, 12.0))
+def test_unlimited_lossless_buffer_meets_the_energy_balance(curve, load):
+    """An unlimited lossless buffer in its periodic state runs the load for the share of the day
+    the harvest can pay for: powered fraction = min(1, harvested / needed), to one step."""
+    power, step = curve
+    needed = load * 24.0
+    buffer = Buffer(capacity_wh=10 * needed)  # ten days: never full unless the harvest is ample
+    result = simulate(power, load, buffer, step)
+    harvested = power.sum(axis=-1) * step
+    expected = 24.0 * np.minimum(1.0, harvested / needed)
+    assert result.converged.all()
+    np.testing.assert_allclose(result.powered_h, expected, rtol=0, atol=step + 1e-9)
+
+
+@FEW
+@given(curves(max_series=1), st.data())
+def test_more_capacity_or_less_load_never_runs_less(curve, data):
+    """Powered time never falls as the capacity grows or the load falls, to within one step.
+
+    Holds for a controller without hysteresis (restart_soc = min_soc) and a buffer that does not
+    leak, from an empty buffer or in the periodic state. The step: the load reconnects at a part's
+    start, so a cut-off that falls elsewhere in a step can shift time by less than one. (With a
+    hysteresis band, or a leaking floor, the band and the floor grow with the buffer, and a larger
+    one can indeed run the load less: not asserted.)"""
+    power, step = curve
+    base = data.draw(buffers(hysteresis=False, leak=False))
+    start = data.draw(st.sampled_from([None, base.min_soc]))
+    capacities = np.sort(data.draw(arrays(float, 5, elements=st.floats(0.0, 80.0))))
+    bigger = simulate(
+        np.repeat(power, 5, axis=0),
+        data.draw(st.floats(0.2, 12.0)),
+        base._replace(capacity_wh=capacities, initial_soc=start),
+        step,
+    )
+    hours = bigger.powered_h.sum(axis=1)
+    assert (np.diff(hours) >= -step - 1e-9).all(), (capacities, hours)
+    loads = np.sort(data.draw(arrays(float, 5, elements=st.floats(0.2, 12.0))))[::-1]
+    lighter = simulate(np.repeat(power, 5, axis=0), loads, base._replace(initial_soc=start), step)
+    hours = lighter.powered_h.sum(axis=1)
+    assert (np.diff(hours) >= -step - 1e-9).all(), (loads, hours)
+
+
+@FEW
+@given(curves(), st.data())
+def test_energy_is_conserved(curve, data):
+    """served + lost + delta stored + conversion losses + self-discharge = harvested, each day."""
+    power, step = curve
+    loads = data.draw(arrays(float, power.shape[0], elements=st.floats(0.0, 15.0)))
+    buffer = data.draw(buffers())
+    for engine in ENGINES:
+        result = simulate(power, loads, buffer, step, engine=engine)
+        np.testing.assert_allclose(balance(result), 0.0, atol=1e-9 * (1 + power.sum()))
+        needed = np.broadcast_to(loads[:, None] * 24.0, result.served_wh.shape)
+        np.testing.assert_allclose(result.served_wh + result.missing_wh, needed, atol=1e-9)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(curves(lowest=-2.0), st.data())
+def test_compiled_loop_equals_the_numpy_reference(curve, data):
+    """The numba loop and the NumPy reference agree on every output, for constant loads and
+    profiles, buffers drawn with every option, and one buffer per series."""
+    power, step = curve
+    n_series, n_days, n_steps = power.shape
+    load_shape = data.draw(st.sampled_from([(), (n_series,), (1, n_steps), (n_series, n_days, 1)]))
+    load = data.draw(arrays(float, load_shape, elements=st.floats(0.0, 15.0)))
+    buffer = data.draw(buffers())
+    if data.draw(st.booleans()):  # one capacity per series, as a sizing search runs them
+        capacities = data.draw(arrays(float, n_series, elements=st.floats(0.0, 60.0)))
+        buffer = buffer._replace(capacity_wh=capacities)
+    compiled = simulate(power, load, buffer, step, engine="numba", soc_curves=True)
+    reference = simulate(power, load, buffer, step, engine="numpy", soc_curves=True)
+    for name in storage.StorageResult._fields:
+        np.testing.assert_array_equal(getattr(compiled, name), getattr(reference, name), name)
+
+
+def loop(power, load, step, capacity, min_soc, restart, eta_c, eta_d, leak, max_c, max_d, e):
+    """The model as the module docstring states it, written plainly for one series from a content
+    ``e`` [Wh]: segments between step centres, split where the power crosses the (constant) load,
+    integrals and the instant the buffer runs out found numerically. Returns per day
+    (powered h, served, missing, lost Wh) and the content at the end."""
+    fine = 4000  # sub-intervals of a part for the integrals
+
+    def integral(f, a, b, p):
+        t = a + (np.arange(fine) + 0.5) * (b - a) / fine
+        return float(np.sum(f(p(t)))) * (b - a) / fine
+
+    on = e >= restart * capacity
+    days = []
+    for day in power:
+        knots = np.concatenate([[0.0], (np.arange(day.size) + 0.5) * step, [day.size * step]])
+        values = np.concatenate([[day[0]], day, [day[-1]]])
+        powered = served = missing = lost = 0.0
+        for t0, t1, p0, p1 in zip(knots[:-1], knots[1:], values[:-1], values[1:], strict=True):
+
+            def p(t, t0=t0, t1=t1, p0=p0, p1=p1):
+                return p0 + (p1 - p0) * (t - t0) / (t1 - t0)
+
+            cuts = [t0, t1]
+            if (p0 - load) * (p1 - load) < 0:
+                cuts.insert(1, t0 + (t1 - t0) * (load - p0) / (p1 - p0))
+            for a, b in zip(cuts[:-1], cuts[1:], strict=False):
+                if not on and e >= restart * capacity:
+                    on = True
+                above = p(0.5 * (a + b)) >= load
+                if on and above:
+                    served += load * (b - a)
+                    powered += b - a
+                    spare = integral(lambda x: x - load, a, b, p)
+                    take = min(integral(lambda x: np.minimum(x - load, max_c), a, b, p), spare)
+                    take = min(take, (capacity - e) / eta_c)
+                    e, lost = e + take * eta_c, lost + spare - take
+                    continue
+                if on:
+                    usable = e - min_soc * capacity
+                    peak = max(load - p(a), load - p(b))
+                    if usable > 0 and peak <= max_d:
+                        deficit = integral(lambda x: load - x, a, b, p)
+                        if deficit <= eta_d * usable:
+                            e -= deficit / eta_d
+                            served += load * (b - a)
+                            powered += b - a
+                            continue
+                        lo, hi = a, b  # the instant the buffer reaches its cut-off
+                        for _ in range(60):
+                            mid = 0.5 * (lo + hi)
+                            drawn = integral(lambda x: load - x, a, mid, p)
+                            lo, hi = (mid, hi) if drawn < eta_d * usable else (lo, mid)
+                        served += load * (lo - a)
+                        powered += lo - a
+                        e, a = min_soc * capacity, lo
+                    on = False
+                missing += load * (b - a)
+                offered = integral(lambda x: np.maximum(x, 0.0), a, b, p)
+                take = min(integral(lambda x: np.clip(x, 0.0, max_c), a, b, p), offered)
+                take = min(take, (capacity - e) / eta_c)
+                e, lost = e + take * eta_c, lost + offered - take
+            e *= (1 - leak) ** ((t1 - t0) / 24)
+        days.append((powered, served, missing, lost))
+    return np.array(days), e
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_plain_python_loop(engine):
+    """A small case with every option on (hysteresis, losses, leak, both power limits), two
+    days from a given state, against the plain loop above."""
+    rng = np.random.default_rng(7)
+    power = np.where(rng.random((2, 12)) < 0.7, rng.uniform(0.0, 12.0, (2, 12)), 0.0)
+    options = dict(
+        capacity=15.0, min_soc=0.1, restart=0.35, eta_c=0.9, eta_d=0.85, leak=0.2, max_c=4.0
+    )
+    buffer = Buffer(
+        capacity_wh=15.0,
+        min_soc=0.1,
+        restart_soc=0.35,
+        charge_efficiency=0.9,
+        discharge_efficiency=0.85,
+        self_discharge=0.2,
+        max_charge_w=4.0,
+        max_discharge_w=3.2,
+        initial_soc=0.3,
+    )
+    result = simulate(power[None], 3.0, buffer, 2.0, engine=engine)
+    days, end = loop(power, 3.0, 2.0, **options, max_d=3.2, e=0.3 * 15.0)
+    assert result.empty.any() and result.full.any()  # the case reaches both ends of the buffer
+    got = np.stack([result.powered_h, result.served_wh, result.missing_wh, result.lost_wh], -1)
+    np.testing.assert_allclose(got[0], days, rtol=0, atol=1e-5)
+    np.testing.assert_allclose(result.stored_wh[0, -1], end, atol=1e-5)
+
+
+# The hand-checked example: 4 steps a day (6 h), centres at 3, 9, 15 and 21 h, power samples 0,
+# 10, 10 and 0 W, linear between centres and held to midnight; a 4 W load (96 Wh a day).
+# The power crosses 4 W at 5.4 h (rising 0 -> 10 W from 3 to 9 h) and at 18.6 h.
+# No buffer: t_solar = 3.6 + 6 + 3.6 = 13.2 h. Harvest = (0 + 10 + 10 + 0) x 6 = 120 Wh.
+# Surplus above 4 W: 5.4-9 h 0.5 x 3.6 x 6 = 10.8 Wh; 9-15 h 6 x 6 = 36 Wh; 15-18.6 h 10.8 Wh.
+# Deficit: 0-3 h 12 Wh; 3-5.4 h 0.5 x 2.4 x 4 = 4.8 Wh; 18.6-21 h 4.8 Wh; 21-24 h 12 Wh.
+# A 20 Wh lossless buffer, cut-off 0, no hysteresis, empty at the first midnight:
+# Day 1. 0-3 h: nothing stored, the load is off (missing 12 Wh). 3-5.4 h: still nothing to draw,
+#   off (missing 9.6 Wh); the PV (0.5 x 2.4 x 4 = 4.8 Wh) charges: 4.8 Wh. 5.4-9 h: on, served
+#   14.4 Wh, +10.8 Wh: 15.6 Wh. 9-15 h: served 24 Wh, +4.4 Wh fills the buffer, 31.6 Wh lost.
+#   15-18.6 h: served 14.4 Wh, 10.8 Wh lost. 18.6-21 h: 4.8 Wh drawn: 15.2 Wh. 21-24 h: 12 Wh
+#   drawn: 3.2 Wh. Powered 3.6 + 6 + 3.6 + 2.4 + 3 = 18.6 h; served 74.4, missing 21.6, lost
+#   42.4 Wh; 74.4 + 42.4 + 3.2 (stored) = 120 Wh harvested.
+# Day 2 from 3.2 Wh: 0-3 h: the 4 W load runs 0.8 h on 3.2 Wh, then off (missing 8.8 Wh);
+#   3-5.4 h as day 1 (off, missing 9.6, charged to 4.8 Wh); from 5.4 h as day 1. Powered
+#   0.8 + 18.6 = 19.4 h; served 3.2 + 74.4 = 77.6, missing 18.4, lost 42.4 Wh; ends at 3.2 Wh:
+#   day 2 is the periodic state of the repeated day.
+# With restart_soc 0.5 (10 Wh) on day 1: at 5.4 h only 4.8 Wh are stored, so the load stays off
+#   from 5.4 to 9 h too (missing 14.4 Wh more) while all the PV, 0.5 x 3.6 x (4 + 10) = 25.2 Wh,
+#   charges: 15.2 Wh fill the buffer, 10 Wh lost; from 9 h on as before: powered 15 h.
+HAND_POWER = np.array([[0.0, 10.0, 10.0, 0.0]] * 2)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_two_days_by_hand(engine):
+    """The example above, day by day, and the periodic state of its repeated day."""
+    assert t_solar(HAND_POWER[0], 4.0, 6.0) == pytest.approx(13.2)
+    empty = simulate(HAND_POWER[None], 4.0, Buffer(20.0, initial_soc=0.0), 6.0, engine=engine)
+    np.testing.assert_allclose(empty.powered_h[0], [18.6, 19.4])
+    np.testing.assert_allclose(empty.served_wh[0], [74.4, 77.6])
+    np.testing.assert_allclose(empty.missing_wh[0], [21.6, 18.4])
+    np.testing.assert_allclose(empty.lost_wh[0], [42.4, 42.4])
+    np.testing.assert_allclose(empty.harvested_wh[0], [120.0, 120.0])
+    np.testing.assert_allclose(empty.stored_wh[0], [0.0, 3.2, 3.2], atol=1e-12)
+    assert empty.full[0].all() and empty.empty[0].all()
+    periodic = simulate(HAND_POWER[:1], 4.0, Buffer(20.0), 6.0, engine=engine)
+    np.testing.assert_allclose(periodic.powered_h, [[19.4]])
+    np.testing.assert_allclose(periodic.stored_wh, [[3.2, 3.2]])
+    assert periodic.converged.all()
+    band = Buffer(20.0, restart_soc=0.5, initial_soc=0.0)
+    late = simulate(HAND_POWER[None, :1], 4.0, band, 6.0, engine=engine)
+    np.testing.assert_allclose(late.powered_h, [[15.0]])
+    np.testing.assert_allclose(late.missing_wh, [[21.6 + 14.4]])
+    np.testing.assert_allclose(late.lost_wh, [[10.0 + 31.6 + 10.8 + 4.4]])
+
+
+def test_state_of_charge_kept_where_asked():
+    """The state of charge at every step only with soc_curves; its histogram covers the day."""
+    power = HAND_POWER[None]
+    plain = simulate(power, 4.0, Buffer(20.0, initial_soc=0.0), 6.0)
+    assert plain.soc is None
+    kept = simulate(power, 4.0, Buffer(20.0, initial_soc=0.0), 6.0, soc_curves=True)
+    # Day 1 at the step centres 3, 9, 15 and 21 h (the example above): 0, 15.6 Wh, full, 15.2 Wh.
+    np.testing.assert_allclose(kept.soc[0, 0], [0.0, 15.6 / 20, 1.0, 15.2 / 20])
+    np.testing.assert_allclose(kept.soc_hours.sum(axis=-1), 24.0)
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        ({"capacity_wh": -1.0}, "capacity_wh"),
+        ({"min_soc": 1.5}, "min_soc"),
+        ({"min_soc": 0.5, "restart_soc": 0.2}, "restart_soc"),
+        ({"charge_efficiency": 0.0}, "charge_efficiency"),
+        ({"self_discharge": 1.0}, "self_discharge"),
+        ({"initial_soc": 2.0}, "initial_soc"),
+        ({"capacity_wh": [1.0, 2.0, 3.0]}, "capacity_wh"),
+    ],
+)
+def test_bad_buffer_names_the_field(change, field):
+    with pytest.raises(ValueError, match=field):
+        simulate(HAND_POWER[None], 4.0, Buffer(20.0)._replace(**change), 6.0)
+
+
+def test_unknown_engine_lists_the_engines():
+    with pytest.raises(ValueError, match="numba, numpy"):
+        simulate(HAND_POWER[None], 4.0, Buffer(20.0), 6.0, engine="fortran")
