@@ -27,7 +27,7 @@ runner = CliRunner()
 RECORDED = Path(__file__).parent / "data" / "pvgis" / "tmy_45.000_8.000_2005_2023.json"
 #: A few days of the year at a 5-degree fold-angle grid: enough to compare the two paths.
 SWEEP = ["sweep", "angle", "--lat", "45", "--lon", "8", "--p-load", "4", "--engine", "numpy",
-         "--angle-step", "5", "--format", "json"]
+         "--angle-step", "5", "--step-min", "5", "--format", "json"]
 
 #: The server: PVGIS's route ``<mode>-<tag>/api/v5_3/tmy`` answered as ``mode`` says (``ok`` the
 #: recorded answer, the others a fault), ``/_count`` the requests of each ``<mode>-<tag>``. It ends
@@ -54,13 +54,13 @@ class Handler(BaseHTTPRequestHandler):
         mode = parts[0].split("-")[0]
         if parts[1:] != ["api", "v5_3", "tmy"]:
             return self.send(404, b"")
-        if mode == "ok" or (mode == "rate" and n > 1):
+        if mode == "ok" or (mode == "rate" and n > 1) or (mode == "flaky" and n != 2):
             return self.send(200, BODY)
         if mode == "rate":
             return self.send(429, b"", {"Retry-After": "1"})
         if mode == "ratelong":
             return self.send(429, b"", {"Retry-After": "3600"})
-        if mode == "e500":
+        if mode in ("e500", "flaky"):
             return self.send(500, b"")
         if mode == "cut":  # the headers promise the whole answer, half of it comes
             self.send_response(200)
@@ -323,3 +323,49 @@ def test_a_source_is_fetched_for_one_site(pvgis, server, tmp_path):
         "error: --lat = [40.0, 45.0]: varies, but weather.source pvgis-tmy is fetched for one site; give one site "
         "(fetch several ahead with foldopt weather fetch, one site each)"]
     assert requests_made(server, route) == 0
+
+
+def test_a_map_fetches_each_site_once_and_a_stopped_fetch_resumes(pvgis, server, tmp_path):
+    """foldopt map --sites --weather pvgis-tmy: each site's answer is fetched before the map starts,
+    one request a site (two names of one site as PVGIS rounds it: one), each cached as it comes,
+    so that a fetch stopped by a fault resumes with the sites not yet fetched. (The server gives
+    the recorded 45 N, 8 E answer to every site: what is tested is the requests.)"""
+    from foldopt.studies.request import map_request_from
+
+    (tmp_path / "sites.csv").write_text("name,latitude,longitude\nturin,45,8\nturin-b,45.0001,8\n"
+                                        "asti,44.9,8.2\nalba,44.7,8.03\n")
+    flaky = pvgis("flaky")  # the second request fails: asti's
+    result = runner.invoke(app, ["map", "--sites", "sites.csv", "--weather", "pvgis-tmy", "--out", "map"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        "error: site asti: weather pvgis-tmy: PVGIS answered 500 Internal Server Error; try again later"]
+    assert requests_made(server, flaky) == 2 and not (tmp_path / "map").exists()
+    assert len(cache_files(tmp_path)) == 2  # turin's answer and its provenance
+    route = pvgis("ok")
+    request = map_request_from(None, source="test", objective="mean", sites=tmp_path / "sites.csv",
+                               weather={"source": "pvgis-tmy"})
+    assert requests_made(server, route) == 2  # asti and alba: turin's came from the cache
+    files = [Path(site["weather"]) for site in request.sites]
+    assert [site["name"] for site in request.sites] == ["turin", "turin-b", "asti", "alba"]
+    assert files[0] == files[1] and len(set(files)) == 3
+    assert all(path.read_bytes() == RECORDED.read_bytes() for path in files)
+
+
+def test_a_maps_weather_options_are_checked_before_anything_is_fetched(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    (tmp_path / "sites.csv").write_text("name,latitude,longitude\nturin,45,8\n")
+    for options, line in [
+        (["--weather", "pvgis-tmx"], "error: --weather = 'pvgis-tmx': must be one of pvgis-tmy; did you mean "
+                                     "'pvgis-tmy'?"),
+        (["--years", "2005:2020"], "error: --years: the years of a weather source; give one with --weather"),
+        (["--weather", "pvgis-tmy", "--years", "2005"], "error: --years = '2005': the first and last year as "
+                                                        "START:END, e.g. 2005:2020"),
+        (["--weather", "pvgis-tmy", "--offline"], "error: site turin: weather pvgis-tmy: no cached copy for (45, "
+                                                  "8) with these options, and offline (--offline, "
+                                                  "FOLDOPT_OFFLINE=1) nothing is fetched; fetch it first where "
+                                                  "there is a network: foldopt weather fetch pvgis-tmy --lat 45 "
+                                                  "--lon 8"),
+    ]:
+        result = runner.invoke(app, ["map", "--sites", "sites.csv", *options, "--out", "map"])
+        assert (result.exit_code, result.stderr.strip().splitlines()) == (2, [line]), options
+    assert requests_made(server, route) == 0 and cache_files(tmp_path) == {}

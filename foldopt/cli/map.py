@@ -27,6 +27,7 @@ from foldopt.cli.options import (
     rename_fields,
     StepMin,
 )
+from foldopt import names
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError, WeatherError
 from foldopt.names import DEFAULT_ENGINE
@@ -38,6 +39,8 @@ _OPTION_OF_PARAMETER = {
     "land_only": "--land-only",
     "show_period": "--show-period",
     "optimize": "--optimize",
+    "weather.source": "--weather",
+    "weather.years": "--years",
 }
 
 
@@ -75,6 +78,24 @@ def map_(
             "a grid.",
         ),
     ] = None,
+    weather: Annotated[
+        str | None,
+        typer.Option(
+            "--weather",
+            help="Each site's weather from a source, "
+            + ", ".join(names.WEATHER_SOURCES)
+            + ": fetched once a site before the map starts, and cached (a stopped fetch resumes "
+            "from the cache).",
+        ),
+    ] = None,
+    years: Annotated[
+        str | None,
+        typer.Option("--years", help="The weather source's years START:END, e.g. 2005:2020."),
+    ] = None,
+    offline: Annotated[
+        bool,
+        typer.Option("--offline", help="Fetch nothing: the weather source from the cache only."),
+    ] = False,
     p_load: Annotated[
         str | None,
         typer.Option(
@@ -201,6 +222,12 @@ def map_(
         errors.append("--land-only: only for a --lat/--lon grid")
     if p_load is not None and p_load_fraction is not None:
         errors.append("--p-load / --p-load-fraction: give loads one way")
+    if weather is not None and weather_dir is not None:
+        errors.append(
+            "--weather / --weather-dir: a folder's files are its sites' weather; give one"
+        )
+    if years is not None and weather is None:
+        errors.append("--years: the years of a weather source; give one with --weather")
     for option, value in (("--workers", workers), ("--chunk-sites", chunk_sites)):
         if value is not None and value < 1:
             errors.append(f"{option} = {value}: must be at least 1")
@@ -212,30 +239,34 @@ def map_(
         **_OPTION_OF_PARAMETER,
         "loads": "--p-load-fraction" if relative else "--p-load",
     }
+    from foldopt.cache import offline_mode
     from foldopt.studies.request import map_request_from
 
+    source = None if weather is None else {"source": weather, "years": years}
     try:
-        request = map_request_from(
-            config,
-            source=EMBEDDED if config is None else str(config),
-            objective=objective,
-            area=area,
-            efficiency=efficiency,
-            step_min=step_min,
-            angle_step=angle_step,
-            fold_search=fold_search,
-            optimize=optimize,
-            settings=settings or (),
-            loads=p_load_fraction if relative else p_load,
-            relative=relative,
-            year=year,
-            show_period=show_period,
-            sites=sites,
-            weather_dir=weather_dir,
-            latitudes=lat,
-            longitudes=lon,
-            land_only=land_only,
-        )
+        with offline_mode(offline):
+            request = map_request_from(
+                config,
+                source=EMBEDDED if config is None else str(config),
+                objective=objective,
+                area=area,
+                efficiency=efficiency,
+                step_min=step_min,
+                angle_step=angle_step,
+                fold_search=fold_search,
+                optimize=optimize,
+                settings=settings or (),
+                loads=p_load_fraction if relative else p_load,
+                relative=relative,
+                year=year,
+                show_period=show_period,
+                sites=sites,
+                weather_dir=weather_dir,
+                latitudes=lat,
+                longitudes=lon,
+                land_only=land_only,
+                weather=source,
+            )
     except WeatherError:
         raise  # a file of --weather-dir: its line names the file, as the reader says it (map has no --weather)
     except ConfigError as error:

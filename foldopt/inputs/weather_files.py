@@ -263,6 +263,54 @@ def with_fetched_weather(data):
     return {**data, "weather": {**fetched, "format": SOURCES[spec.source].format}}
 
 
+def with_fetched_sites(sites: list[dict], weather) -> list[dict]:
+    """A map's sites, each with its weather from a source: ``weather`` the cached answer for the
+    site (:func:`foldopt.inputs.weather.sources.fetch`), fetched one site after the other, each
+    answer cached as it comes, so that a fetch that stops (killed, a fault) resumes from the cache.
+
+    Parameters
+    ----------
+    sites : list of dict
+        ``latitude``, ``longitude`` [deg] and any of ``name``, ``altitude``, ``timezone``.
+    weather : dict
+        A ``weather`` section naming a ``source`` and its options (no ``path``).
+
+    Returns
+    -------
+    list of dict
+        The sites, each with ``weather``: its file, whose site and light the map takes.
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        For a section that is not a source's (one line per fault, ``weather.years = ...``).
+    foldopt.errors.WeatherError
+        For the first site whose answer cannot be had, named by the site.
+    """
+    from pydantic import ValidationError
+
+    from foldopt.inputs.study import format_errors
+    from foldopt.inputs.weather_section import Weather
+
+    try:
+        spec = Weather.model_validate({**weather, "path": None})
+    except ValidationError as error:
+        raise ConfigError([f"weather.{line}" for line in format_errors(error)]) from None
+    if spec.source is None:
+        raise ConfigError(["weather: a map's weather names a source (weather.source)"])
+    from foldopt.inputs.weather.sources import fetch  # requests: only to fetch
+
+    fetched = []
+    for site in sites:
+        try:
+            answer = fetch(spec.source, site["latitude"], site["longitude"], spec)
+        except WeatherError as error:
+            where = site.get("name") or f"{site['latitude']:g}, {site['longitude']:g}"
+            raise WeatherError(f"site {where}: {error.errors[0]}") from None
+        fetched.append({**site, "weather": answer.file})
+    return fetched
+
+
 def weather_defaults(data: dict) -> dict:
     """What a study's fields take from its weather file where it leaves them out: the dates (an
     hourly file's whole ``year``; a measured file's days) and, for a measured file, the step.

@@ -38,6 +38,7 @@ from foldopt.inputs.optimize_section import DEFAULT_TILT, Optimize, vary_names
 from foldopt.inputs.plan import check_distinct, parse_dates, parse_values, year_problem
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, make_study
+from foldopt.inputs.weather_files import with_fetched_sites
 from foldopt.errors import ConfigError
 from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
@@ -189,6 +190,7 @@ def map_request(
     relative: bool = False,
     year: int = 2025,
     show_period: str = "year",
+    weather: dict | None = None,
 ) -> MapRequest:
     """A map's sites, loads, year and period, each checked, with its study: what the command line
     and :func:`foldopt.world_map` both run.
@@ -216,6 +218,10 @@ def map_request(
         The year of clear-sky days, or what a weather file's typical year stands for.
     show_period : str
         The period the world maps show: one of :data:`PERIODS`.
+    weather : dict, optional
+        A weather source's section (``{"source": "pvgis-tmy", "years": ...}``): each site's
+        weather fetched (or taken from the cache) once, before the map starts
+        (:func:`~foldopt.inputs.weather_files.with_fetched_sites`).
 
     Returns
     -------
@@ -283,6 +289,12 @@ def map_request(
         sites = grid_sites(*grid_values, land_only)
         if not sites:
             raise ConfigError(["land_only: no grid point is on land"])
+    if weather is not None:
+        if weather_dir is not None:
+            raise ConfigError(
+                ["weather: a weather folder's files are its sites' weather; give one or the other"]
+            )
+        sites = with_fetched_sites(list(sites), weather)
     if len(sites) > MAX_CASES:
         raise ConfigError(
             [f"sites: {len(sites):,}; the limit is {MAX_CASES:,} (FOLDOPT_MAX_CASES raises it)"]

@@ -32,8 +32,10 @@ import email.utils
 import errno
 import hashlib
 import json
+import math
 import os
 import re
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -50,6 +52,10 @@ DEFAULT_TIMEOUT_S = 30.0
 MAX_ATTEMPTS = 3
 #: Seconds foldopt waits at most for one retry a rate limit asks for; a longer wait is refused.
 MAX_RETRY_WAIT_S = 60.0
+#: Requests a second foldopt sends at most, the rate PVGIS's API documents for one address (30).
+MAX_RATE = 30.0
+_LAST_REQUEST = {"at": -math.inf}
+_RATE_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -315,6 +321,7 @@ def _download(request: _Request, label: str) -> bytes:
 
     service, host = request.source.service, request.base
     for attempt in range(1, MAX_ATTEMPTS + 1):
+        _pace()
         try:
             with requests.get(
                 request.base + request.source.route,
@@ -344,6 +351,16 @@ def _download(request: _Request, label: str) -> bytes:
             raise WeatherError(f"{label}: {_refusal(response, payload, service, attempt)}")
         return payload
     raise AssertionError("unreachable: the last attempt returns or raises")
+
+
+def _pace() -> None:
+    """Wait, where needed, so that this process sends at most :data:`MAX_RATE` requests a second
+    (a map's sites are fetched one after the other)."""
+    with _RATE_LOCK:
+        wait = _LAST_REQUEST["at"] + 1.0 / MAX_RATE - time.monotonic()
+        if wait > 0:
+            time.sleep(wait)
+        _LAST_REQUEST["at"] = time.monotonic()
 
 
 def _body(response, label: str, service: str) -> bytes:
