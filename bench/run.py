@@ -11,6 +11,10 @@
   Also run at 1 and at 2 threads: the speed-up is measured, not assumed.
 - W2: a design map, 90 latitudes x 24 days x 180 angles x 50 loads, the same physics, each panel
   tilted at |latitude| toward the equator: t_solar for every case x angle x load, and the best angle.
+- W1 with a buffer (``storage``): the same year of 180 fold angles, each angle's power curves kept
+  from the kernel and run through the state-of-charge simulation of a small buffer
+  (:func:`foldopt.engine.storage.simulate`, periodic state of the year), angles a chunk at a time
+  so the curves' memory stays bounded; timed beside the storage-less W1 pass in the same process.
 - W3: an honest baseline. The same physics as W1 through a competent vectorised pvlib pipeline on
   a 14-day slice spread over the year: one solar-position call for the whole index, Kasten-Young
   and Meinel over arrays, and per fold angle pvlib's aoi_projection, SAPM cell temperature,
@@ -41,7 +45,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-TARGETS = {"W1": "<= 1.5 s", "W2": "<= 8 s", "W3": ">= 150x per point", "memory": "<= 1 GiB"}
+TARGETS = {"W1": "<= 1.5 s", "W2": "<= 8 s", "storage": "<= 3x W1", "W3": ">= 150x per point", "memory": "<= 1 GiB"}
 W3_AGREEMENT_S = 30.0  # [s] t_solar at the best angle, foldopt against the pvlib baseline (the tables' stated bound)
 W3_ANGLE_DEG = 1.0  # [deg] best angle (the grid step), where the best is clear (see _w3_agreement)
 
@@ -136,6 +140,74 @@ def workload_w1(days: int) -> dict:
     return {"seconds": seconds, "points": points, "days": days, "phases": phases,
             "kernel_1_thread": best[1][1]["kernel"], "kernel_2_threads": best[2][1]["kernel"],
             "mean_best_t_solar_h": float(hours[..., 0].max(axis=1).mean()), "mean_energy_wh": float(wh.mean())}
+
+
+#: The buffer of the storage row: a small pack behind a controller with a cut-off and hysteresis.
+BENCH_BUFFER = dict(capacity_wh=20.0, min_soc=0.1, restart_soc=0.3, charge_efficiency=0.95,
+                    discharge_efficiency=0.95, self_discharge=0.02)
+STORAGE_CHUNK = 20  # fold angles a chunk: a year of their minute curves is 84 MB
+
+
+def _storage_pass(base, sites, dates, loads):
+    """Sky, tables, the kernel keeping every row's power curve, and the buffer over each angle's
+    year, a chunk of angles at a time; per-phase times and the powered hours (n_angles, n_days)."""
+    from foldopt.engine import evaluation as engine
+    from foldopt.engine import storage
+    from foldopt.engine.sky import build_sky
+    from foldopt.physics.geometry import default_orientation
+
+    phases = {}
+    phases["sky"], sky = _timed(build_sky, base, sites, dates)
+    angles = np.asarray(base.fold_angles.grid())
+    panels = np.array([default_orientation(s.latitude) if base.panel.tilt is None else
+                       (base.panel.tilt, base.panel.azimuth) for s in sites])
+    orientation = engine.fold_orientations(base, panels[:, 0], panels[:, 1], angles).reshape(-1, 4)
+    n_days = len(dates)
+    buffer = storage.Buffer(**BENCH_BUFFER)
+    phases["kernel with curves"] = phases["buffer"] = 0.0
+    hours, passes = [], []
+    for first in range(0, angles.size, STORAGE_CHUNK):
+        chunk = np.arange(first, min(first + STORAGE_CHUNK, angles.size))
+        days, which = np.repeat(np.arange(n_days), chunk.size), np.tile(chunk, n_days)
+        # Curves kept angle by angle (each angle's year in order): the buffer's series as they are.
+        keep = np.arange(days.size).reshape(n_days, chunk.size).T.ravel()
+        seconds, metrics = _timed(engine.row_metrics, sky, base, days, orientation[which], loads,
+                                  outputs=(base.connection,), curves=keep)
+        phases["kernel with curves"] += seconds
+        start = time.perf_counter()
+        power = metrics.power.reshape(chunk.size, n_days, -1)
+        result = storage.simulate(power, float(loads[0]), buffer, sky.step_hours)
+        phases["buffer"] += time.perf_counter() - start
+        hours.append(result.powered_h)
+        passes.append(result.passes)
+    return phases, np.concatenate(hours), np.concatenate(passes)
+
+
+def workload_storage(days: int) -> dict:
+    """A year of 180 fold angles with a buffer, and the storage-less W1 pass beside it."""
+    from foldopt.engine import storage
+
+    base = _study()
+    dates = _w1_dates(days)
+    sites = [base.site] * len(dates)
+    loads = np.array([base.p_load])
+    _fold_pass(base, sites[:2], dates[:2], loads)  # kernel loaded from the disk cache, tables too
+    _storage_pass(base, sites[:2], dates[:2], loads)  # and the buffer's loop
+    plain, buffered = [], []
+    for _ in range(2):  # interleaved: the machine's load falls on both alike
+        start = time.perf_counter()
+        phases, t_solar, *_ = _fold_pass(base, sites, dates, loads)
+        plain.append(time.perf_counter() - start - phases["sun"])
+        start = time.perf_counter()
+        phases, hours, passes = _storage_pass(base, sites, dates, loads)
+        buffered.append((time.perf_counter() - start, phases))
+    seconds, phases = min(buffered, key=lambda item: item[0])
+    return {"seconds": seconds, "points": days * 1440 * 180, "days": days, "phases": phases,
+            "w1_seconds": min(plain), "ratio": seconds / min(plain), "buffer": BENCH_BUFFER,
+            "passes_max": int(np.abs(passes).max()), "periodic": bool((passes > 0).all()),
+            "mean_best_powered_h": float(hours.mean(axis=1).max()),
+            "mean_best_t_solar_h": float(t_solar[..., 0].mean(axis=0).max()),
+            "engine": storage.STORAGE_ENGINES[0]}
 
 
 def workload_w2(days: int, latitudes: int) -> dict:
@@ -288,6 +360,7 @@ def run_one(name: str, args) -> dict:
     result = {"W1": lambda: workload_w1(args.days),
               "W2": lambda: workload_w2(args.w2_days, args.w2_latitudes),
               "W3": lambda: workload_w3(args.w3_days, args.repeats),
+              "storage": lambda: workload_storage(args.days),
               "tables": workload_tables}[name]()
     result["peak_mib"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     return result
@@ -326,6 +399,16 @@ def report(results: dict) -> str:
                   f"the year); they agree on t_solar at the best angle within {r['agreement_t_solar_s']:.1f} s "
                   f"(bound {W3_AGREEMENT_S:g} s) and on clear best angles within {r['agreement_angle_deg']:.0f} deg "
                   f"(bound {W3_ANGLE_DEG:g} deg)"]
+    if "storage" in results:
+        r = results["storage"]
+        lines += ["", f"W1 with a buffer ({r['days']} days x 180 angles, periodic state of the year): "
+                  f"{r['seconds']:.2f} s against the storage-less W1 pass's {r['w1_seconds']:.2f} s in "
+                  f"the same process: {r['ratio']:.2f}x (target {TARGETS['storage']}); "
+                  + ", ".join(f"{k} {v:.3f} s" for k, v in r["phases"].items())
+                  + f"; at most {r['passes_max']} passes over the year"
+                  + ("" if r["periodic"] else " (some angles without a periodic state)")
+                  + f"; peak {r['peak_mib']:.0f} MiB; best angle's mean powered time "
+                  f"{r['mean_best_powered_h']:.2f} h against t_solar {r['mean_best_t_solar_h']:.2f} h"]
     if "tables" in results:
         r = results["tables"]
         lines.append(f"electrical tables built cold: {r['seconds']:.2f} s ("
@@ -336,7 +419,7 @@ def report(results: dict) -> str:
 
 def main():
     parser = argparse.ArgumentParser(description="foldopt benchmarks")
-    parser.add_argument("--only", default="W1,W2,W3,tables")
+    parser.add_argument("--only", default="W1,W2,W3,storage,tables")
     parser.add_argument("--days", type=int, default=365, help="W1 days")
     parser.add_argument("--w2-days", type=int, default=24)
     parser.add_argument("--w2-latitudes", type=int, default=90)
