@@ -279,6 +279,9 @@ def test_plain_python_loop(engine):
 #   3-5.4 h as day 1 (off, missing 9.6, charged to 4.8 Wh); from 5.4 h as day 1. Powered
 #   0.8 + 18.6 = 19.4 h; served 3.2 + 74.4 = 77.6, missing 18.4, lost 42.4 Wh; ends at 3.2 Wh:
 #   day 2 is the periodic state of the repeated day.
+# A dark day 3 (no power at all) from 3.2 Wh: the load runs 0.8 h and is off the rest of the day:
+#   served 3.2, missing 92.8, lost 0 Wh; the buffer is never full. A sunny day 4 from 0 Wh is day 1
+#   again. PVGIS's percentages of these four days: full 3/4 (days 1, 2, 4), empty 4/4.
 # With restart_soc 0.5 (10 Wh) on day 1: at 5.4 h only 4.8 Wh are stored, so the load stays off
 #   from 5.4 to 9 h too (missing 14.4 Wh more) while all the PV, 0.5 x 3.6 x (4 + 10) = 25.2 Wh,
 #   charges: 15.2 Wh fill the buffer, 10 Wh lost; from 9 h on as before: powered 15 h.
@@ -297,6 +300,12 @@ def test_two_days_by_hand(engine):
     np.testing.assert_allclose(empty.harvested_wh[0], [120.0, 120.0])
     np.testing.assert_allclose(empty.stored_wh[0], [0.0, 3.2, 3.2], atol=1e-12)
     assert empty.full[0].all() and empty.empty[0].all()
+    four = np.concatenate([HAND_POWER, np.zeros((1, 4)), HAND_POWER[:1]])
+    days = simulate(four[None], 4.0, Buffer(20.0, initial_soc=0.0), 6.0, engine=engine)
+    np.testing.assert_allclose(days.powered_h[0], [18.6, 19.4, 0.8, 18.6])
+    np.testing.assert_allclose(days.missing_wh[0], [21.6, 18.4, 92.8, 21.6])
+    np.testing.assert_allclose(days.lost_wh[0], [42.4, 42.4, 0.0, 42.4], atol=1e-12)
+    assert days.full[0].tolist() == [True, True, False, True] and days.empty[0].all()
     periodic = simulate(HAND_POWER[:1], 4.0, Buffer(20.0), 6.0, engine=engine)
     np.testing.assert_allclose(periodic.powered_h, [[19.4]])
     np.testing.assert_allclose(periodic.stored_wh, [[3.2, 3.2]])
