@@ -132,15 +132,18 @@ class StorageResult(NamedTuple):
     lost_wh : (n_series, n_days) float
         PV energy neither served nor taken into the buffer (full, or over ``max_charge_w``).
     harvested_wh : (n_series, n_days) float
-        The curve's energy (:func:`foldopt.engine.metrics.energy`).
+        The curve's energy (:func:`foldopt.engine.metrics.energy`, summed in step order).
     charge_loss_wh, discharge_loss_wh, self_discharge_wh : (n_series, n_days) float
         Conversion losses into and out of the buffer, and its leak.
     full, empty : (n_series, n_days) bool
         PVGIS's days full and empty (module docstring).
     soc_hours : (n_series, n_days, SOC_BINS) float
-        Hours a day the state of charge spends in each tenth (0-10 %, ..., 90-100 %).
+        Hours a day the state of charge spends in each tenth (0-10 %, ..., 90-100 %, a full buffer
+        in the last): the state at the end of each segment, for the segment's length. With no
+        capacity, all in the first.
     stored_wh : (n_series, n_days + 1) float
-        Content at each midnight, from the start of the first day to the end of the last.
+        Content at each midnight, from the start of the first day to the end of the last (their
+        difference is a day's delta stored).
     soc : (n_series, n_days, n_steps) float or None
         State of charge at every step centre, where asked (``soc_curves``).
     passes : (n_series,) int
@@ -228,6 +231,8 @@ def simulate(
     n_series, n_days, n_steps = power.shape
     load = _load_array(load, power.shape)
     params = _parameter_rows(buffer, n_series, step_hours)
+    if not (np.isfinite(step_hours) and step_hours > 0):
+        raise ValueError(f"step_hours must be above 0; got {step_hours}")
     if max_iterations < 1 or not tolerance >= 0:
         raise ValueError("max_iterations must be 1 or more and tolerance 0 or more")
     out = np.zeros((n_series, n_days, kern.HISTOGRAM + SOC_BINS))
@@ -250,9 +255,18 @@ def simulate(
         )
     else:
         _simulate_numpy(
-            power, load, params, step_hours, out, state, soc_curves, soc, passes,
-            max_iterations, tolerance,
-        )  # fmt: skip
+            power,
+            load,
+            params,
+            step_hours,
+            out,
+            state,
+            soc_curves,
+            soc,
+            passes,
+            max_iterations,
+            tolerance,
+        )  # fmt: skip: one call's arguments, not a list
     return StorageResult(
         out[..., kern.POWERED],
         out[..., kern.SERVED],
@@ -323,18 +337,20 @@ def _parameter_rows(buffer: Buffer, n_series: int, step_hours: float) -> np.ndar
         if buffer.initial_soc is None
         else field("initial_soc", buffer.initial_soc, 0.0, 1.0)
     )
-    columns = [None] * kern.N_PARAMETERS
-    columns[kern.CAPACITY], columns[kern.MIN_SOC], columns[kern.RESTART_SOC] = (
-        capacity,
-        min_soc,
-        restart,
-    )
-    columns[kern.ETA_CHARGE], columns[kern.ETA_DISCHARGE] = eta_c, eta_d
-    columns[kern.KEEP_STEP] = (1.0 - leak) ** (step_hours / 24.0)
-    columns[kern.KEEP_HALF] = (1.0 - leak) ** (step_hours / 48.0)
-    columns[kern.MAX_CHARGE], columns[kern.MAX_DISCHARGE] = max_c, max_d
-    columns[kern.INITIAL_SOC] = initial
-    rows = np.stack(np.broadcast_arrays(*(np.atleast_1d(c) for c in columns)), axis=-1)
+    columns = {
+        kern.CAPACITY: capacity,
+        kern.MIN_SOC: min_soc,
+        kern.RESTART_SOC: restart,
+        kern.ETA_CHARGE: eta_c,
+        kern.ETA_DISCHARGE: eta_d,
+        kern.KEEP_STEP: (1.0 - leak) ** (step_hours / 24.0),
+        kern.KEEP_HALF: (1.0 - leak) ** (step_hours / 48.0),
+        kern.MAX_CHARGE: max_c,
+        kern.MAX_DISCHARGE: max_d,
+        kern.INITIAL_SOC: initial,
+    }
+    ordered = (np.atleast_1d(columns[column]) for column in range(kern.N_PARAMETERS))
+    rows = np.stack(np.broadcast_arrays(*ordered), axis=-1)
     return np.ascontiguousarray(rows, dtype=float)
 
 
