@@ -168,6 +168,19 @@ def test_compiled_loop_equals_the_numpy_reference(curve, data):
         np.testing.assert_array_equal(getattr(compiled, name), getattr(reference, name), name)
 
 
+@pytest.mark.parametrize("engine", ENGINES)
+def test_one_curve_serves_many_capacities(engine):
+    """One power curve against several capacities (a sizing search) is the same as the curve
+    repeated once per capacity."""
+    power = np.where(np.arange(24) % 24 < 12, 8.0, 0.0)[None, None, :].repeat(3, axis=1)
+    buffer = Buffer(capacity_wh=np.array([0.0, 5.0, 20.0, 80.0]), min_soc=0.1, restart_soc=0.3)
+    shared = simulate(power, 3.0, buffer, 1.0, engine=engine)
+    repeated = simulate(np.repeat(power, 4, axis=0), 3.0, buffer, 1.0, engine=engine)
+    assert shared.powered_h.shape == (4, 3)
+    for name in storage.StorageResult._fields:
+        np.testing.assert_array_equal(getattr(shared, name), getattr(repeated, name), name)
+
+
 def loop(power, load, step, capacity, min_soc, restart, eta_c, eta_d, leak, max_c, max_d, e):
     """The model as the module docstring states it, written plainly for one series from a content
     ``e`` [Wh]: segments between step centres, split where the power crosses the (constant) load,
@@ -337,7 +350,8 @@ def test_state_of_charge_kept_where_asked():
         ({"charge_efficiency": 0.0}, "charge_efficiency"),
         ({"self_discharge": 1.0}, "self_discharge"),
         ({"initial_soc": 2.0}, "initial_soc"),
-        ({"capacity_wh": [1.0, 2.0, 3.0]}, "capacity_wh"),
+        ({"capacity_wh": [[1.0, 2.0]]}, "capacity_wh"),
+        ({"capacity_wh": [1.0, 2.0], "min_soc": [0.1, 0.2, 0.3]}, "same number of series"),
     ],
 )
 def test_bad_buffer_names_the_field(change, field):

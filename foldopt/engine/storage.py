@@ -188,7 +188,8 @@ def simulate(
     ----------
     power : array_like
         Power at step centres [W], (n_series, n_days, n_steps), or (n_series, n_steps) for one day
-        (repeated until periodic by default). Each series is sequential over its days.
+        (repeated until periodic by default). Each series is sequential over its days. One curve
+        (n_series 1) serves every series of the load or the buffer.
     load : float or array_like
         Load [W], 0 or more: a float; (n_series,) one per series; (n_series or 1, n_steps) a daily
         profile; or (n_series or 1, n_days or 1, n_steps or 1).
@@ -228,8 +229,15 @@ def simulate(
     if not np.isfinite(power).all():
         raise ValueError("power must be finite")
     power = np.ascontiguousarray(power)
-    n_series, n_days, n_steps = power.shape
     load = _load_array(load, power.shape)
+    # One power curve, load or buffer may serve every series (a sizing search's capacities).
+    sizes = [power.shape[0], load.shape[0]] + [np.size(v) for v in buffer if v is not None]
+    n_series = max(sizes)
+    if any(size not in (1, n_series) for size in sizes):
+        raise ValueError(
+            f"power, load and buffer fields must have 1 or the same number of series; got {sizes}"
+        )
+    n_days, n_steps = power.shape[1:]
     params = _parameter_rows(buffer, n_series, step_hours)
     if not (np.isfinite(step_hours) and step_hours > 0):
         raise ValueError(f"step_hours must be above 0; got {step_hours}")
@@ -237,7 +245,7 @@ def simulate(
         raise ValueError("max_iterations must be 1 or more and tolerance 0 or more")
     out = np.zeros((n_series, n_days, kern.HISTOGRAM + SOC_BINS))
     state = np.zeros((n_series, n_days + 1, 2))
-    soc = np.zeros(power.shape if soc_curves else (1, 1, 1))
+    soc = np.zeros((n_series, n_days, n_steps) if soc_curves else (1, 1, 1))
     passes = np.zeros(n_series, dtype=np.int64)
     if engine == "numba":
         kern.simulate_series(
@@ -286,8 +294,8 @@ def simulate(
 
 
 def _load_array(load, shape):
-    """The load as (n_series or 1, n_days or 1, n_steps or 1), contiguous."""
-    n_series, n_days, n_steps = shape
+    """The load as (n_series or 1, n_days or 1, n_steps or 1), contiguous (the series are checked
+    by the caller)."""
     load = np.asarray(load, dtype=float)
     if load.ndim == 0:
         load = load.reshape(1, 1, 1)
@@ -296,7 +304,7 @@ def _load_array(load, shape):
     elif load.ndim == 2:
         load = load[:, None, :]
     fits = load.ndim == 3 and all(
-        size in (1, full) for size, full in zip(load.shape, shape, strict=True)
+        size in (1, full) for size, full in zip(load.shape[1:], shape[1:], strict=True)
     )
     if not fits:
         raise ValueError(
@@ -530,7 +538,8 @@ def _simulate_numpy(
 ):
     """:func:`foldopt.engine.storage_kernel.simulate_series` over arrays of series, each series's
     passes as :func:`foldopt.engine.storage_kernel._series` runs them."""
-    n_series = power.shape[0]
+    n_series = out.shape[0]
+    power = np.broadcast_to(power, (n_series, *power.shape[1:]))
     par = np.broadcast_to(params, (n_series, params.shape[1]))
     load = np.broadcast_to(load, (n_series, *load.shape[1:]))
     capacity = par[:, kern.CAPACITY]

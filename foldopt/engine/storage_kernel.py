@@ -314,7 +314,7 @@ def simulate_series(
 
     Parameters
     ----------
-    power : (n_series, n_days, n_steps) float
+    power : (n_series or 1, n_days, n_steps) float
         Power at step centres [W].
     load : (n_series or 1, n_days or 1, n_steps or 1) float
         Load at step centres [W].
@@ -334,12 +334,12 @@ def simulate_series(
     max_iterations : int
     tolerance : float
     """
-    for k in prange(power.shape[0]):
+    for k in prange(out.shape[0]):
         s = np.int64(
             k
         )  # prange's index is unsigned: with the literal 0 below it would unify to float
         passes[s] = _series(
-            power[s],
+            power[s if power.shape[0] > 1 else 0],
             load[s if load.shape[0] > 1 else 0],
             params[s if params.shape[0] > 1 else 0],
             step_hours,
