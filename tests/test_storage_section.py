@@ -285,7 +285,7 @@ def test_the_options_and_set_reach_the_study(tmp_path, monkeypatch):
                        "charge_efficiency": lifepo4["charge_efficiency"],
                        "discharge_efficiency": lifepo4["discharge_efficiency"],
                        "self_discharge": lifepo4["self_discharge"], "max_charge_w": None,
-                       "max_discharge_w": None, "initial_soc": None}
+                       "max_discharge_w": None, "initial_soc": None, "target": None}
 
 
 # ---- PVGIS's hourconsumption: the watt profile it stands for --------------------------------------

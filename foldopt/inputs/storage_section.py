@@ -54,6 +54,27 @@ PRESETS = {
 FILLED = ("min_soc", "restart_soc", "charge_efficiency", "discharge_efficiency", "self_discharge")
 
 
+class StorageTarget(StrictModel):
+    """What the buffer is sized for: the load powered ``powered_h`` hours a day on ``days_pct`` of
+    the days (:mod:`foldopt.studies.storage_answer` finds each design's smallest buffer for it).
+
+    Parameters
+    ----------
+    powered_h : float
+        Hours a day the load must run [h] in (0, 24].
+    days_pct : float, default 100
+        The share of the days that must reach ``powered_h`` [%] in (0, 100] (a repeated clear-sky
+        day reaches it on every day or on none).
+    """
+
+    powered_h: interval(0, 24, lo_open=True, unit=" h") = Field(
+        description="hours a day the load must run"
+    )
+    days_pct: interval(0, 100, lo_open=True, unit=" %") = Field(
+        100.0, description="share of the days that must reach powered_h"
+    )
+
+
 class Storage(StrictModel):
     """A buffer behind a charge controller: what the load runs on when PV alone does not carry it.
 
@@ -94,6 +115,9 @@ class Storage(StrictModel):
     preset : str, optional
         One of :data:`foldopt.names.STORAGE_PRESETS`, whose values fill the fields above that
         are left out.
+    target : StorageTarget, optional
+        What to size the buffer for: the answer then gives each design's smallest capacity
+        reaching it.
 
     Raises
     ------
@@ -148,6 +172,9 @@ class Storage(StrictModel):
     )
     preset: named(names.STORAGE_PRESETS) | None = Field(
         None, description="fills the fields left out with a chemistry's typical values"
+    )
+    target: StorageTarget | None = Field(
+        None, description="size each design's buffer for it: {powered_h, days_pct}"
     )
     #: The fields the preset (or the ideal buffer) filled, not given (:meth:`_fill`).
     _decided: frozenset = PrivateAttr(frozenset())

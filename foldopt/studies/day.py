@@ -40,6 +40,7 @@ from foldopt.studies.designs import (
     tracker_curves,
 )
 from foldopt.studies.objectives import near_optimal
+from foldopt.studies.storage_answer import day_storage
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
 from foldopt.names import DEFAULT_ENGINE
@@ -246,6 +247,9 @@ class StudyResult:
         refined optimum, which it always holds) and the recommended angle at its centre
         (:func:`foldopt.studies.objectives.near_optimal`) [deg], its tolerance [h] and the
         recommended angle's ``recommended_t_solar_h`` [h].
+    storage : foldopt.studies.storage_answer.DayStorage or None
+        With the study's ``storage``: the load's powered time with the buffer per design and fold
+        angle, and each design's buffer for its target; None for a storage-less study.
     standby : tuple
         (table, break-even draw [W]) of :func:`standby_sweep`.
     engine : str
@@ -262,6 +266,7 @@ class StudyResult:
     engine: str = DEFAULT_ENGINE
     near_optimal: dict = dataclasses.field(default_factory=dict)
     request: object = None  # the foldopt.studies.request.Request the study came from, if any
+    storage: object = None  # the buffer's DayStorage (foldopt.studies.storage_answer), if any
 
     @functools.cached_property
     def answer(self):
@@ -481,6 +486,29 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
         summary["t_solar_h"].to_numpy(),
     )
     standby = standby_sweep(day, tracker.power[0], by_design["twofold"])
+    buffered = None
+    if study.storage is not None:
+        # Every row's curve, the one its t_solar was reduced from, through the study's buffer.
+        power_of = {
+            "flat": p_flat,
+            "twofold": drawn[study.connection][0, 0],
+            "tracker": tracker.power[0],
+            "tracker-net": tracker.net[0],
+            **{name: power for name, (_, power) in others.items()},
+        }
+        own_series = study.connection == "series" or study.switch_series
+        buffered = day_storage(
+            study,
+            step,
+            p_load if shape is None else (p_load * shape)[None, :],
+            fold_angles,
+            curves[study.connection] if series or not own_series else day.combined_power(fold_angles),
+            {name: (angle, power_of[name]) for name, angle in angle_of.items()},
+            summary["t_solar_h"].to_numpy(),
+            engine,
+        )
+        summary = pd.concat([summary, buffered.designs.iloc[:, 3:]], axis=1)
+        sweep["powered_h"] = buffered.powered_by_angle
 
     at_best = {connection: drawn[connection][0, 0] for connection in CONNECTIONS}
     # The state switching chose (no table's number comes from it) from the reference path's parts.
@@ -506,6 +534,11 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
             ),
             "p_tracker_w": tracker.power[0],
             "p_load_w": p_load if shape is None else p_load * shape,
+            **(
+                {}
+                if buffered is None
+                else {f"soc_{name}": soc for name, soc in buffered.soc.items()}
+            ),
         },
         index=pd.DatetimeIndex(day.times, name="time"),
     )
@@ -537,6 +570,7 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
         engine,
         near,
         request,
+        buffered,
     )
 
 

@@ -24,7 +24,7 @@ from foldopt.inputs import policy
 from foldopt.names import WEATHER_SOURCES
 from foldopt.inputs.study_file import default_study_path, parse_study_text, read_study
 from foldopt.inputs.optimize_section import vary_names
-from foldopt.engine.choice import engine_for
+from foldopt.engine.choice import STORAGE_STEP_WEIGHT, engine_for
 from foldopt.names import FIELD_OF_PARAMETER, FIELD_OPTIONS, OPTIMIZE_VARIABLES
 from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
 from foldopt.errors import ConfigError
@@ -674,4 +674,7 @@ def request_engine(engine: str, plan) -> str:
     base, cases = (plan.base, plan.n_cases) if isinstance(plan, Plan) else (plan, 1)
     if base.weather is not None:
         return engine_for(engine, math.inf)
-    return engine_for(engine, cases * base.fold_angles.count() * round(24 * 60 / base.step_min))
+    row_steps = cases * base.fold_angles.count() * round(24 * 60 / base.step_min)
+    # A buffer's state of charge is a pass per step on the reference path (engine.choice).
+    weight = 1 if getattr(base, "storage", None) is None else STORAGE_STEP_WEIGHT
+    return engine_for(engine, weight * row_steps)

@@ -1,0 +1,387 @@
+"""A day's study with a buffer (issue 41): how long the load runs with the study's ``storage``, per
+design and per fold angle, and how much buffer each design needs for a stated target.
+
+The day is the study's clear-sky day repeated until its midnight state of charge repeats (the
+periodic steady state of :func:`foldopt.engine.storage.simulate`), or started from the
+section's ``initial_soc``. Every curve simulated is the one the study's ``t_solar`` was reduced
+from, so that a buffer of 0 Wh gives each design's ``t_solar`` (to the last bit of a sum).
+
+The sizing (:func:`size_buffers`) is a bracketed search on the capacity, run for every design at
+once: a geometric grid of capacities (the one the figure of powered time against capacity
+draws), then the bracket between the largest capacity short of the target and the smallest
+reaching it cut into :data:`REFINE_POINTS` + 1 parts until it is within
+:data:`CAPACITY_RTOL` of its top. It takes powered time not to fall as the capacity grows, which
+holds for a controller without hysteresis and a buffer that does not leak
+(:mod:`foldopt.engine.storage`); with either, powered time may dip by a little over a grid step,
+and the capacity found is the least of the grid's and the bracket's that reaches the target.
+
+The module may import numpy, pandas, :mod:`foldopt.engine` and :mod:`foldopt.inputs`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from foldopt.engine.choice import STORAGE_STEP_WEIGHT, engine_for
+from foldopt.engine.storage import Buffer, StorageResult, simulate
+from foldopt.studies.objectives import best_angle_index, near_optimal
+
+#: The designs whose state of charge the day's figure draws and ``timeseries.csv`` holds.
+SOC_DESIGNS = ("flat", "twofold", "tracker")
+#: Capacities of the grid [-, times the day's load energy] (0 Wh first): the sizing's first
+#: bracket and the figure's curve of powered time against capacity.
+GRID = np.concatenate([[0.0], np.geomspace(1.0 / 64.0, 4.0, 25)])
+#: Interior points each refinement of a bracket evaluates.
+REFINE_POINTS = 8
+#: A capacity is found once its bracket is within this fraction of its top.
+CAPACITY_RTOL = 1e-3
+#: Twofold angles the sizing compares (the grid's, thinned to about this many, with the angle
+#: best for the study's own buffer).
+SIZING_ANGLES = 12
+#: How far below the target [h] a day's powered time may fall and still reach it (sums' rounding).
+TARGET_SLACK_H = 1e-9
+
+
+def buffer_of(storage, **changes) -> Buffer:
+    """The engine's :class:`~foldopt.engine.storage.Buffer` of a study's ``storage`` section.
+
+    Parameters
+    ----------
+    storage : foldopt.inputs.storage_section.Storage
+    **changes
+        Fields to replace (``capacity_wh`` as an array over series in a sizing).
+    """
+    fields = {name: getattr(storage, name) for name in Buffer._fields}
+    return Buffer(**{**fields, **changes})
+
+
+def storage_engine(engine: str, series: int, n_steps: int) -> str:
+    """The engine that simulates ``series`` buffered days of ``n_steps``: ``engine``, or for
+    ``auto`` the one :func:`foldopt.engine.choice.engine_for` takes for the work weighted by
+    :data:`foldopt.engine.choice.STORAGE_STEP_WEIGHT` (a request's engine is decided so already:
+    :func:`foldopt.studies.request.request_engine`).
+
+    Parameters
+    ----------
+    engine : {'auto', 'numba', 'numpy'}
+    series, n_steps : int
+    """
+    return engine_for(engine, STORAGE_STEP_WEIGHT * series * n_steps)
+
+
+def run_buffer(power, load, buffer: Buffer, step_hours: float, engine: str, soc_curves=False):
+    """:func:`foldopt.engine.storage.simulate` of a day's curves (periodic steady state, or from
+    ``initial_soc``) on ``engine`` ('numba' or 'numpy')."""
+    return simulate(power, load, buffer, step_hours, engine, soc_curves=soc_curves)
+
+
+def day_columns(result: StorageResult) -> dict:
+    """Per series, the day's (or the mean day's) buffered metrics, by the columns' names.
+
+    Parameters
+    ----------
+    result : foldopt.engine.storage.StorageResult
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        (n_series,) each: ``powered_h`` [h a day], ``availability_pct`` (the load's energy
+        served, of its demand), ``days_powered_24h_pct`` (days with no energy missing),
+        ``energy_missing_wh`` and ``energy_lost_wh`` [Wh a day], ``days_full_pct`` and
+        ``days_empty_pct`` (PVGIS's).
+    """
+    served, missing = result.served_wh, result.missing_wh
+    demand = served + missing
+    with np.errstate(invalid="ignore", divide="ignore"):
+        availability = np.where(
+            demand.sum(axis=1) > 0, served.sum(axis=1) / demand.sum(axis=1), 1.0
+        )
+    return {
+        "powered_h": result.powered_h.mean(axis=1),
+        "availability_pct": 100.0 * availability,
+        "days_powered_24h_pct": 100.0 * (missing <= 1e-12 * demand).mean(axis=1),
+        "energy_missing_wh": missing.mean(axis=1),
+        "energy_lost_wh": result.lost_wh.mean(axis=1),
+        "days_full_pct": 100.0 * result.full.mean(axis=1),
+        "days_empty_pct": 100.0 * result.empty.mean(axis=1),
+    }
+
+
+def reaches(result: StorageResult, target) -> np.ndarray:
+    """(n_series,) bool: whether each series runs the load ``target.powered_h`` on at least
+    ``target.days_pct`` of its days, from a periodic state (a series whose end state never
+    repeats its start's reaches nothing)."""
+    days = result.powered_h >= target.powered_h - TARGET_SLACK_H
+    return (100.0 * days.mean(axis=1) >= target.days_pct - 1e-9) & result.converged
+
+
+@dataclass(frozen=True)
+class Sizing:
+    """Each design's smallest buffer for a target (:func:`size_buffers`).
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        Per design (``flat``, ``twofold`` at the angle needing the least, ``tracker``,
+        ``tracker-net``): ``design``, ``fold_angle_deg``, ``capacity_wh`` (NaN where no buffer up
+        to the grid's top reaches the target) and ``capacity_vs_flat_pct``.
+    curve : pandas.DataFrame
+        ``capacity_wh`` and ``powered_{flat,twofold,tracker}_h``: powered time against capacity,
+        the twofold panel at each capacity's best of the angles compared.
+    folding_stops_paying_wh : float
+        The least capacity of the curve from which on the best twofold panel runs the load no
+        longer than flat's powered time plus the near-optimal tolerance; NaN where it always does.
+    """
+
+    table: pd.DataFrame
+    curve: pd.DataFrame
+    folding_stops_paying_wh: float
+
+
+def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engine, tolerance):
+    """Each design's smallest buffer for ``storage.target``, and powered time against capacity.
+
+    Parameters
+    ----------
+    curves : dict
+        ``flat``, ``tracker``, ``tracker-net`` -> power [W], (n_steps,); ``twofold`` -> power at
+        ``fold_angles``, (k, n_steps).
+    fold_angles : array_like
+        (k,) [deg].
+    own : float
+        The fold angle best for the study's own buffer [deg], one of ``fold_angles``.
+    load : float or numpy.ndarray
+        [W], or (1, n_steps).
+    storage : foldopt.inputs.storage_section.Storage
+        Its ``target`` (may be None: the curve only).
+    step_hours : float
+    engine : str
+    tolerance : foldopt.inputs.sections.NearOptimal
+
+    Returns
+    -------
+    Sizing
+    """
+    fold_angles = np.asarray(fold_angles, dtype=float)
+    names = ["flat", "tracker", "tracker-net"] + [f"twofold@{a:g}" for a in fold_angles]
+    power = np.vstack([curves["flat"], curves["tracker"], curves["tracker-net"], curves["twofold"]])
+    demand_wh = float(np.sum(np.broadcast_to(load, power.shape[-1:])) * step_hours)
+    scale = max(demand_wh, 1e-6) / ((1.0 - storage.min_soc) * storage.discharge_efficiency)
+    capacities = np.minimum(GRID * scale, 1e6)
+    n, m = len(names), capacities.size
+    result = run_buffer(
+        np.repeat(power, m, axis=0),
+        load,
+        buffer_of(storage, capacity_wh=np.tile(capacities, n)),
+        step_hours,
+        engine,
+    )
+    # A series with no periodic state has no powered time to draw (NaN: the figure leaves it out).
+    hours = np.where(result.converged, result.powered_h.mean(axis=1), np.nan).reshape(n, m)
+    twofold = hours[3:]
+    best = best_angle_index(np.nan_to_num(twofold.T, nan=-1.0))
+    curve = pd.DataFrame(
+        {
+            "capacity_wh": capacities,
+            "powered_flat_h": hours[0],
+            "powered_twofold_h": twofold[best, np.arange(m)],
+            "powered_tracker_h": hours[1],
+            "fold_angle_deg": fold_angles[best],
+        }
+    )
+    drawn = curve["powered_twofold_h"].to_numpy()
+    gain = drawn - curve["powered_flat_h"].to_numpy()
+    pays = gain > tolerance.tolerance_h(drawn)
+    pays_later = np.cumsum(pays[::-1])[::-1] > 0
+    known = np.isfinite(gain)
+    stops = np.flatnonzero(known & ~pays_later)
+    stops_wh = float(capacities[stops[0]]) if len(stops) and pays.any() else float("nan")
+    table = pd.DataFrame()
+    if storage.target is not None:
+        ok = reaches(result, storage.target).reshape(n, m)
+        first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)
+        # The twofold angle needing the least buffer on the grid is refined with flat and trackers.
+        need = np.where(first[3:] >= 0, capacities[first[3:]], np.inf)
+        # Where no angle reaches it, the row names the angle best for the study's own buffer.
+        pick = 3 + int(
+            np.argmin(need) if np.isfinite(need).any() else np.argmax(fold_angles == own)
+        )
+        keep = [0, pick, 1, 2]
+        found = _refine(power[keep], first[keep], capacities, load, storage, step_hours, engine)
+        table = pd.DataFrame(
+            {
+                "design": ["flat", "twofold", "tracker", "tracker-net"],
+                "fold_angle_deg": [180.0, fold_angles[pick - 3], np.nan, np.nan],
+                "capacity_wh": found,
+            }
+        )
+        with np.errstate(invalid="ignore", divide="ignore"):
+            table["capacity_vs_flat_pct"] = np.where(
+                np.isfinite(found) & (found[0] > 0), (found / found[0] - 1.0) * 100.0, np.nan
+            )
+    return Sizing(table, curve, stops_wh)
+
+
+def _refine(power, first, capacities, load, storage, step_hours, engine):
+    """The bracket of each series between the grid's capacity ``first`` (the least reaching the
+    target; -1: none does, NaN) and the one below it, cut until within :data:`CAPACITY_RTOL`."""
+    found = np.where(first >= 0, capacities[np.maximum(first, 0)], np.nan)
+    lo = np.where(first > 0, capacities[np.maximum(first - 1, 0)], found)
+    hi = found.copy()
+    while True:
+        open_ = np.flatnonzero(np.isfinite(hi) & (hi - lo > CAPACITY_RTOL * hi))
+        if not open_.size:
+            return hi
+        inner = lo[open_, None] + (hi - lo)[open_, None] * (
+            np.arange(1, REFINE_POINTS + 1) / (REFINE_POINTS + 1)
+        )
+        result = run_buffer(
+            np.repeat(power[open_], REFINE_POINTS, axis=0),
+            load,
+            buffer_of(storage, capacity_wh=inner.ravel()),
+            step_hours,
+            engine,
+        )
+        ok = reaches(result, storage.target).reshape(open_.size, REFINE_POINTS)
+        # The least interior capacity reaching the target tops the new bracket; the one below
+        # it (or the old bottom) is its floor.
+        at = np.where(ok.any(axis=1), np.argmax(ok, axis=1), REFINE_POINTS)
+        top = np.where(
+            at < REFINE_POINTS,
+            inner[np.arange(open_.size), np.minimum(at, REFINE_POINTS - 1)],
+            hi[open_],
+        )
+        floor = np.where(at > 0, inner[np.arange(open_.size), np.maximum(at - 1, 0)], lo[open_])
+        lo[open_], hi[open_] = floor, top
+
+
+@dataclass(frozen=True)
+class DayStorage:
+    """A day's study with its buffer (:func:`day_storage`).
+
+    Attributes
+    ----------
+    storage : foldopt.inputs.storage_section.Storage
+    designs : pandas.DataFrame
+        Per design of the summary, in its order: ``design``, ``fold_angle_deg``, ``t_solar_h``
+        and :func:`day_columns`' columns.
+    powered_by_angle : numpy.ndarray
+        Powered time [h] of the twofold panel at each fold angle of the grid.
+    fold_angle_deg : float
+        The grid's fold angle with the longest powered time (ties to the least folded).
+    near_optimal : dict
+        :func:`foldopt.studies.objectives.near_optimal` of powered time over the grid, with
+        ``recommended_powered_h``.
+    soc : dict
+        Design of :data:`SOC_DESIGNS` -> state of charge [-] at each step centre, (n_steps,).
+    sizing : Sizing
+    engine : str
+        The engine the buffer was simulated on ('numba' or 'numpy').
+    converged : bool
+        Whether every series reached its periodic state (or started from ``initial_soc``).
+    """
+
+    storage: object
+    designs: pd.DataFrame
+    powered_by_angle: np.ndarray
+    fold_angle_deg: float
+    near_optimal: dict
+    soc: dict
+    sizing: Sizing
+    engine: str
+    converged: bool
+
+
+def day_storage(
+    study, step_hours, load, fold_angles, grid_power, rows: dict, t_solar, engine
+) -> DayStorage:
+    """Simulate a day's study's buffer for every design it compares.
+
+    Parameters
+    ----------
+    study : foldopt.Study
+        With a ``storage`` section.
+    step_hours : float
+    load : float or numpy.ndarray
+        The load [W], or its curve (1, n_steps) under a load profile.
+    fold_angles : array_like
+        The grid's fold angles [deg], (k,).
+    grid_power : numpy.ndarray
+        The twofold panel's power at each, the study's connection [W], (k, n_steps).
+    rows : dict
+        The summary's designs, in its order -> (fold angle [deg], power [W], (n_steps,)).
+    t_solar : array_like
+        Each design's ``t_solar`` [h] without the buffer, in ``rows``' order.
+    engine : str
+
+    Returns
+    -------
+    DayStorage
+    """
+    storage = study.storage
+    fold_angles = np.asarray(fold_angles, dtype=float)
+    buffer = buffer_of(storage)
+    # One engine for every simulation of the day, decided on all of them: the designs, their
+    # state of charge, the grid of fold angles and the sizing's grid of capacities.
+    series = len(rows) + len(SOC_DESIGNS) + fold_angles.size + (4 + SIZING_ANGLES) * GRID.size
+    engine = storage_engine(engine, series, grid_power.shape[-1])
+    names = list(rows)
+    designs = run_buffer(
+        np.vstack([power for _, power in rows.values()]), load, buffer, step_hours, engine
+    )
+    soc = run_buffer(
+        np.vstack([rows[name][1] for name in SOC_DESIGNS]),
+        load,
+        buffer,
+        step_hours,
+        engine,
+        soc_curves=True,
+    )
+    grid = run_buffer(grid_power, load, buffer, step_hours, engine)
+    by_angle = grid.powered_h[:, 0]
+    near = {
+        key: float(value)
+        for key, value in near_optimal(fold_angles, by_angle, study.near_optimal).items()
+    }
+    best = int(best_angle_index(by_angle))
+    recommended = near["recommended_fold_angle_deg"]
+    near["recommended_powered_h"] = (
+        float(by_angle[fold_angles == recommended][0]) if recommended == recommended else np.nan
+    )
+    table = pd.DataFrame(
+        {
+            "design": names,
+            "fold_angle_deg": [angle for angle, _ in rows.values()],
+            "t_solar_h": np.asarray(t_solar, dtype=float),
+            **day_columns(designs),
+        }
+    )
+    step = max(1, -(-fold_angles.size // SIZING_ANGLES))
+    compared = np.union1d(fold_angles[::step], [fold_angles[best]])
+    sizing = size_buffers(
+        {
+            **{name: rows[name][1] for name in ("flat", "tracker", "tracker-net")},
+            "twofold": grid_power[np.searchsorted(fold_angles, compared)],
+        },
+        compared,
+        fold_angles[best],
+        load,
+        storage,
+        step_hours,
+        engine,
+        study.near_optimal,
+    )
+    return DayStorage(
+        storage,
+        table,
+        by_angle,
+        float(fold_angles[best]),
+        near,
+        {name: soc.soc[i, 0] for i, name in enumerate(SOC_DESIGNS)},
+        sizing,
+        engine,
+        bool(designs.converged.all() and grid.converged.all()),
+    )
