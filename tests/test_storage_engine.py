@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from foldopt.engine import storage
-from foldopt.engine.metrics import t_solar
+from foldopt.engine.metrics import per_load, t_solar
 from foldopt.engine.storage import Buffer, simulate
 
 ENGINES = storage.STORAGE_ENGINES
@@ -90,6 +90,23 @@ def test_no_capacity_with_a_profile_compares_the_difference(curve, data):
     np.testing.assert_allclose(result.powered_h, t_solar(difference, 0.0, step), atol=1e-12)
     assert (result.served_wh <= result.harvested_wh + 1e-9).all()
     np.testing.assert_allclose(result.served_wh + result.lost_wh, result.harvested_wh, atol=1e-9)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_load_window_counts_time_as_without_a_buffer(engine):
+    """A profile that is zero outside 06:00-18:00 counts powered time as the storage-less
+    t_solar of a profile does (metrics.per_load: the segments next to a step without load count
+    nothing), with no buffer and with one that never runs out; the load's energy is all served."""
+    hours = np.arange(24) + 0.5
+    window = np.where((hours > 6) & (hours < 18), 4.0, 0.0)
+    power = np.full((1, 24), 10.0)
+    expected = float(t_solar(per_load(power[0], window), 1.0, 1.0))
+    assert expected == pytest.approx(11.0)
+    for capacity in (0.0, 100.0):
+        result = simulate(power, window[None], Buffer(capacity), 1.0, engine=engine)
+        np.testing.assert_allclose(result.powered_h, [[expected]], atol=1e-12)
+        np.testing.assert_allclose(result.served_wh, [[48.0]])
+        assert result.missing_wh[0, 0] == 0.0
 
 
 @FEW

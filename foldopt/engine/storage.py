@@ -32,8 +32,10 @@ Conventions that follow from it:
   ``P - L`` of the two linear curves, where :func:`foldopt.engine.metrics.per_load` compares the
   ratio ``P / shape`` with a scale: the two agree at step centres and wherever the profile is
   constant over a segment, and differ inside segments over which it changes.
-- Powered time counts only segments in which the load demands power (a profile that is zero at
-  both ends of a segment runs nothing there: neither powered nor missing time).
+- Powered time counts only segments with load at both ends, as
+  :func:`foldopt.engine.metrics.per_load` counts them: a profile that is zero outside a window
+  counts no time outside it and loses half a step at each edge, with or without a buffer (the
+  energy of the load over those edge segments is served or missing all the same).
 - The load reconnects only at a part's start (at most a step apart), so a cut-off late in a part
   keeps it off to the part's end.
 - Power below zero (a tracker net of its drive) is run from the buffer while the load is on, as
@@ -488,7 +490,7 @@ def _segments(power, load, step_hours):
     t_above, t_below = tau * above, tau * (1.0 - above)
     first = (p0, ps, l0, ls, np.where(rising, t_below, t_above), ~rising)
     second = (ps, p1, ls, l1, np.where(rising, t_above, t_below), rising)
-    return first, second, (l0 > 0.0) | (l1 > 0.0), half
+    return first, second, (l0 > 0.0) & (l1 > 0.0), half
 
 
 def _run_numpy(power, load, par, step_hours, stored, on, out, state, soc_curves, soc):

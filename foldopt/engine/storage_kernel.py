@@ -181,7 +181,7 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
             if j < n_steps:
                 harvested += p1
             e0, e1 = p0 - l0, p1 - l1
-            demand = l0 > 0.0 or l1 > 0.0
+            demand = l0 > 0.0 and l1 > 0.0  # time counts where the load runs at both ends
             # Three common segments take a short cut, by the very operations _part would do (the
             # results are the same to the bit): a dark one the buffer carries, a dark one with the
             # load off, and one above the load with the buffer full.
