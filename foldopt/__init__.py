@@ -69,6 +69,10 @@ _PUBLIC = {
             "plot_standby",
         )
     },
+    **{
+        name: "foldopt.output.figures.storage"
+        for name in ("plot_state_of_charge", "plot_powered_vs_capacity")
+    },
     **{name: "foldopt.output.figures.sweep" for name in ("plot_map", "plot_curves")},
     **{
         name: "foldopt.output.figures.annual"

@@ -205,6 +205,27 @@ COLUMNS = (
     ("p_{design}_w", "W", "a design's power at the optimum (p_twofold_w: the study's connection)"),
     ("p_{connection}_w", "W", "a connection's power at the optimum"),
     ("switch_state", "", "the connection switching chose (off where no power)"),
+    # a buffer (a study's storage section)
+    (
+        "powered_h",
+        "h",
+        "hours a day the load runs with the buffer, from PV or from it (summary.csv per design; "
+        "sweep.csv at each fold angle)",
+    ),
+    ("availability_pct", "%", "the load's energy served, of its demand, with the buffer"),
+    ("days_powered_24h_pct", "%", "days on which the load ran all day (no energy missing)"),
+    ("energy_missing_wh", "Wh", "the load's energy not served a day (the load off)"),
+    ("energy_lost_wh", "Wh", "PV energy a day neither served nor stored (the buffer full)"),
+    ("days_full_pct", "%", "days on which the buffer was full at some time (PVGIS's)"),
+    ("days_empty_pct", "%", "days on which the controller cut the load off (PVGIS's)"),
+    ("soc_{design}", "-", "the buffer's state of charge at the step (timeseries.csv)"),
+    (
+        "capacity_wh",
+        "Wh",
+        "a buffer's usable energy: on the curve, or a design's least for the target",
+    ),
+    ("powered_{design}_h", "h", "powered time of one design at a capacity (storage_capacity.csv)"),
+    ("capacity_vs_flat_pct", "%", "the design's buffer for the target over flat's, less 100"),
     # sizing
     ("area_m2", "m^2", "the panel's area"),
     ("benefit_usd", "$", "lifetime benefit C_grid x t_solar x P_load (Shin et al. Eq. 7)"),

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from foldopt.files import staged_folder
-from foldopt.output.figures import day, world, write_figure
+from foldopt.output.figures import day, storage, world, write_figure
 from foldopt.output.html import write_html
 from foldopt.output.provenance import input_hash, run_metadata, write_run_json
 from foldopt.tables import write_csv
@@ -34,7 +34,8 @@ def _horizon_figure(study, dates, folder: Path, name: str) -> list[str]:
 def write_study(result: StudyResult, out: Path, overwrite: bool = False, command=None) -> Path:
     """Write a day's results folder: ``summary.csv``, ``sweep.csv``, ``timeseries.csv``,
     ``tracker_standby.csv``, the day's figures (:data:`foldopt.output.figures.day.FIGURES`),
-    ``run.json`` and ``report.html``.
+    ``run.json`` and ``report.html``; with a buffer also ``storage_capacity.csv``,
+    ``storage_sizing.csv`` (with a target) and :data:`foldopt.output.figures.storage.FIGURES`.
 
     Parameters
     ----------
@@ -55,6 +56,11 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
         write_csv(result.sweep, folder / "sweep.csv")
         write_csv(result.timeseries, folder / "timeseries.csv", index=True)
         figures = [write_figure(folder, file, result) for file in day.FIGURES]
+        if result.storage is not None:
+            write_csv(result.storage.sizing.curve, folder / "storage_capacity.csv")
+            if len(result.storage.sizing.table):
+                write_csv(result.storage.sizing.table, folder / "storage_sizing.csv")
+            figures += [write_figure(folder, file, result) for file in storage.FIGURES]
         figures += _horizon_figure(result.study, [result.study.date], folder, result.study.name)
         write_csv(result.standby[0], folder / "tracker_standby.csv")
         metadata = run_metadata(

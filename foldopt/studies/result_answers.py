@@ -285,6 +285,14 @@ def of_study(result) -> Answer:
         "pct_of_tracker",
         "note",
     ]
+    buffered = getattr(result, "storage", None)
+    if buffered is not None:
+        # The buffer's part, said once here for every view (studies.storage_answer).
+        from foldopt.studies.storage_answer import DESIGN_COLUMNS, answer_part
+
+        result_part["storage"], more = answer_part(buffered)
+        lines += more
+        columns[3:3] = DESIGN_COLUMNS
     return Answer(
         "study",
         study.name,

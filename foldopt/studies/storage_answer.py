@@ -385,3 +385,169 @@ def day_storage(
         engine,
         bool(designs.converged.all() and grid.converged.all()),
     )
+
+
+def _wh(value) -> str:
+    return "-" if value != value else f"{value:.3g} Wh"
+
+
+def buffer_text(storage) -> str:
+    """A buffer as an answer says it: ``5 Wh supercapacitor (cut-off 25 %, reconnect 30 %,
+    efficiencies 0.98/0.98, self-discharge 2 %/day)``."""
+    kind = storage.preset or "buffer"
+    limits = [
+        f"{name} {value:g} W"
+        for name, value in (
+            ("charge", storage.max_charge_w),
+            ("discharge", storage.max_discharge_w),
+        )
+        if value is not None
+    ]
+    start = (
+        "periodic steady state"
+        if storage.initial_soc is None
+        else f"from {100 * storage.initial_soc:g} %"
+    )
+    return (
+        f"{storage.capacity_wh:g} Wh {kind} (cut-off {100 * storage.min_soc:g} %, reconnect "
+        f"{100 * storage.restart_soc:g} %, efficiencies {storage.charge_efficiency:g}/"
+        f"{storage.discharge_efficiency:g}, self-discharge {100 * storage.self_discharge:g} %/day"
+        + (", max " + ", ".join(limits) if limits else "")
+        + f"; {start})"
+    )
+
+
+def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tracker-net")):
+    """What a day's answer says of its buffer: the part of its result and its lines.
+
+    Parameters
+    ----------
+    buffered : DayStorage
+    designs : tuple of str
+        The designs the result names one by one.
+
+    Returns
+    -------
+    result : dict
+        JSON-ready but for NaN (the answer's :func:`~foldopt.studies.answer.plain` makes it null).
+    lines : list of str
+    """
+    storage, sizing = buffered.storage, buffered.sizing
+    by = buffered.designs.set_index("design")
+    per = {
+        column: {d: float(by.loc[d, column]) for d in designs}
+        for column in (
+            "powered_h",
+            "t_solar_h",
+            "availability_pct",
+            "days_powered_24h_pct",
+            "energy_missing_wh",
+            "energy_lost_wh",
+            "days_full_pct",
+            "days_empty_pct",
+        )
+    }
+    best_h = float(buffered.powered_by_angle.max())
+    part = {
+        "buffer": buffer_text(storage),
+        **{name: getattr(storage, name) for name in Buffer._fields},
+        "preset": storage.preset,
+        "fold_angle_deg": buffered.fold_angle_deg,
+        "powered_h": best_h,
+        **buffered.near_optimal,
+        **{
+            f"{column[:-2] if column.endswith('_h') else column}_by_design": values
+            for column, values in per.items()
+        },
+        "folding_stops_paying_wh": sizing.folding_stops_paying_wh,
+        "engine": buffered.engine,
+        "converged": buffered.converged,
+    }
+    powered, t_solar = per["powered_h"], per["t_solar_h"]
+    lines = [
+        f"with the {buffer_text(storage)}: powered time "
+        + ", ".join(f"{d} {powered[d]:.2f} h (t_solar {t_solar[d]:.2f} h)" for d in designs)
+    ]
+    near = buffered.near_optimal
+    if best_h > 0:
+        lines.append(
+            f"best fold angle for the buffer {buffered.fold_angle_deg:g} deg: powered "
+            f"{best_h:.2f} h, {best_h - powered['flat']:+.2f} h over flat; near-optimal "
+            f"{near['near_optimal_lo_deg']:g} to {near['near_optimal_hi_deg']:g} deg, "
+            f"recommended {near['recommended_fold_angle_deg']:g} deg "
+            f"({near['recommended_powered_h']:.2f} h)"
+        )
+    lines.append(
+        "availability "
+        + ", ".join(f"{d} {per['availability_pct'][d]:.1f} %" for d in designs[:3])
+        + "; energy missing/lost a day "
+        + ", ".join(
+            f"{d} {per['energy_missing_wh'][d]:.3g}/{per['energy_lost_wh'][d]:.3g} Wh"
+            for d in designs[:3]
+        )
+        + "; days full/empty "
+        + ", ".join(
+            f"{d} {per['days_full_pct'][d]:.0f}/{per['days_empty_pct'][d]:.0f} %"
+            for d in designs[:3]
+        )
+    )
+    top = float(sizing.curve["capacity_wh"].iloc[-1])
+    stops = sizing.folding_stops_paying_wh
+    lines.append(
+        f"folding stops paying from {stops:.3g} Wh of buffer (flat within the near-optimal "
+        "tolerance of the best twofold angle)"
+        if stops == stops
+        else f"folding pays at every buffer up to {top:.3g} Wh"
+        if (sizing.curve["powered_twofold_h"] > sizing.curve["powered_flat_h"]).any()
+        else f"folding does not pay at any buffer up to {top:.3g} Wh"
+    )
+    if len(sizing.table):
+        target = storage.target
+        table = sizing.table.set_index("design")
+        need = table["capacity_wh"]
+        angle = float(table.loc["twofold", "fold_angle_deg"])
+        saving = float(table.loc["twofold", "capacity_vs_flat_pct"])
+        part["sizing"] = {
+            "target_powered_h": target.powered_h,
+            "target_days_pct": target.days_pct,
+            "capacity_by_design_wh": {d: float(need[d]) for d in table.index},
+            "fold_angle_twofold_deg": angle,
+            "capacity_twofold_vs_flat_pct": saving,
+            "searched_up_to_wh": top,
+        }
+        said = f"{target.powered_h:g} h" + (
+            f" on {target.days_pct:g} % of days" if target.days_pct < 100 else ""
+        )
+
+        def needs(value):
+            return (
+                f"needs {_wh(value)}"
+                if value == value
+                else f"reaches it with no buffer up to {top:.3g} Wh"
+            )
+
+        lines.append(
+            f"for {said}: flat {needs(need['flat'])}, folded at {angle:g} deg "
+            f"{needs(need['twofold'])}"
+            + (f" ({saving:+.0f} %)" if saving == saving else "")
+            + f", the tracker {needs(need['tracker'])}"
+            + f" (net of its drive {needs(need['tracker-net'])})"
+        )
+    if not buffered.converged:
+        lines.append(
+            "note: the buffer found no periodic state for some designs or angles (its end state "
+            "never repeats its start's): their powered time is the last pass's"
+        )
+    return part, lines
+
+
+#: The columns a buffer adds to a day's designs (summary.csv and the answer's table).
+DESIGN_COLUMNS = (
+    "powered_h",
+    "availability_pct",
+    "days_powered_24h_pct",
+    "energy_missing_wh",
+    "energy_lost_wh",
+    "days_full_pct",
+    "days_empty_pct",
+)

@@ -1,5 +1,5 @@
 """Figures: one module per kind of result (:mod:`~foldopt.output.figures.day`,
-:mod:`~foldopt.output.figures.sweep`, :mod:`~foldopt.output.figures.annual`,
+:mod:`~foldopt.output.figures.storage`, :mod:`~foldopt.output.figures.sweep`, :mod:`~foldopt.output.figures.annual`,
 :mod:`~foldopt.output.figures.weather`, :mod:`~foldopt.output.figures.horizon`,
 :mod:`~foldopt.output.figures.world`, :mod:`~foldopt.output.figures.sizing`,
 :mod:`~foldopt.output.figures.landscape`), each with the public
@@ -62,13 +62,14 @@ def _matplotlib_folder() -> None:
 # Every figure module imports matplotlib, and Python runs this package's __init__ before any of
 # them: the folder is set before matplotlib's first import.
 _matplotlib_folder()
-from foldopt.output.figures import annual, day, horizon, landscape, sizing, sweep, weather, world  # noqa: E402
+from foldopt.output.figures import annual, day, horizon, landscape, sizing, storage, sweep, weather, world  # noqa: E402
 from foldopt.output.figures.canvas import for_files, save_plot  # noqa: E402
 
 #: Every figure file a results folder can hold -> :class:`~foldopt.output.figures.canvas.FigureFile`
 #: (its plot function and what it shows), by kind of result.
 FIGURES = {
     **day.FIGURES,
+    **storage.FIGURES,
     **sweep.FIGURES,
     **annual.FIGURES,
     **weather.FIGURES,
@@ -117,6 +118,7 @@ def rst_table() -> str:
     """
     kinds = (
         (day, "one case"),
+        (storage, "one case with storage"),
         (sweep, "a sweep"),
         (annual, "a sweep of dates"),
         (weather, "a weather file's dates"),
