@@ -19,15 +19,6 @@ from __future__ import annotations
 from foldopt.names import AUTO_NUMPY_ROW_STEPS, ENGINES
 
 
-#: What a row step of a buffer's state of charge (:mod:`foldopt.engine.storage`) costs on the
-#: NumPy reference against the row step :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` counts: the
-#: reference walks the time steps in Python, some 0.9 s a pass over a day of 1-min steps however
-#: few the series, and a periodic state takes 2 to 60 passes (measured on 2 cores: 184 curves of
-#: a day, 0.8 s a pass; the compiled loop 0.016 s; a day's buffer sized for a target, 55 s on
-#: the reference, 0.4 s compiled).
-STORAGE_STEP_WEIGHT = 75
-
-
 def engine_for(engine: str, row_steps: float) -> str:
     """The engine that evaluates ``row_steps`` rows x time steps: ``engine`` itself, or for
     ``auto`` the NumPy reference up to :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` and the

@@ -20,12 +20,13 @@ The module may import numpy, pandas, :mod:`foldopt.engine` and :mod:`foldopt.inp
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from foldopt.engine.choice import STORAGE_STEP_WEIGHT, engine_for
+from foldopt.engine.choice import engine_for
 from foldopt.engine.storage import Buffer, StorageResult, simulate
 from foldopt.studies.objectives import best_angle_index, near_optimal
 
@@ -58,18 +59,15 @@ def buffer_of(storage, **changes) -> Buffer:
     return Buffer(**{**fields, **changes})
 
 
-def storage_engine(engine: str, series: int, n_steps: int) -> str:
-    """The engine that simulates ``series`` buffered days of ``n_steps``: ``engine``, or for
-    ``auto`` the one :func:`foldopt.engine.choice.engine_for` takes for the work weighted by
-    :data:`foldopt.engine.choice.STORAGE_STEP_WEIGHT` (a request's engine is decided so already:
-    :func:`foldopt.studies.request.request_engine`).
+def storage_engine(engine: str) -> str:
+    """The engine that simulates a buffer: ``engine``, or for ``auto`` the compiled loop (a
+    request's engine is decided so already: :func:`foldopt.studies.request.request_engine`).
 
     Parameters
     ----------
     engine : {'auto', 'numba', 'numpy'}
-    series, n_steps : int
     """
-    return engine_for(engine, STORAGE_STEP_WEIGHT * series * n_steps)
+    return engine_for(engine, math.inf)
 
 
 def run_buffer(power, load, buffer: Buffer, step_hours: float, engine: str, soc_curves=False):
@@ -324,10 +322,7 @@ def day_storage(
     storage = study.storage
     fold_angles = np.asarray(fold_angles, dtype=float)
     buffer = buffer_of(storage)
-    # One engine for every simulation of the day, decided on all of them: the designs, their
-    # state of charge, the grid of fold angles and the sizing's grid of capacities.
-    series = len(rows) + len(SOC_DESIGNS) + fold_angles.size + (4 + SIZING_ANGLES) * GRID.size
-    engine = storage_engine(engine, series, grid_power.shape[-1])
+    engine = storage_engine(engine)
     names = list(rows)
     designs = run_buffer(
         np.vstack([power for _, power in rows.values()]), load, buffer, step_hours, engine
