@@ -56,12 +56,14 @@ full buffer, then from the state it ended in, until the state at its end is that
 content within ``tolerance`` x the capacity, the load on or off alike). After
 :data:`~foldopt.engine.storage_kernel.PLAIN_ITERATIONS` passes the start is bisected between the
 contents that ended higher and lower. After ``max_iterations`` passes, or once that bracket is
-down to rounding (:data:`~foldopt.engine.storage_kernel.BRACKET`: the end state jumps over the
-start's, no periodic state), the last pass is kept and the series is flagged. One clear-sky day
-is thus repeated until its midnight state repeats; a weather year starts from the state at its
-own end. A pass stops early at the first midnight whose state the previous pass had too (from
-there on the two are the same), so that a year whose buffer fills at some point costs little more
-than one pass.
+narrower than the tolerance while the end still differs by more (the end jumps over the start: a
+cut-off or a reconnection a part earlier or later; or the end moves much faster than the start),
+the last pass is kept and the series is flagged (``passes`` < 0): its start is then within the
+tolerance of where the end crosses it, and its end differs from its start by about one part's
+energy. One clear-sky day is thus repeated until its midnight state repeats; a weather year
+starts from the state at its own end. A pass stops early at the first midnight whose state the
+previous pass had too (from there on the two are the same), so that a year whose buffer fills or
+empties at some point costs little more than one pass.
 
 References
 ----------
@@ -181,7 +183,7 @@ def simulate(
     step_hours: float,
     engine: str = "numba",
     soc_curves: bool = False,
-    max_iterations: int = 60,
+    max_iterations: int = 30,
     tolerance: float = 1e-6,
 ) -> StorageResult:
     """Simulate the state of charge of a buffer over power curves and a load.
@@ -204,7 +206,7 @@ def simulate(
         steps: for tests and small cases).
     soc_curves : bool, default False
         Also the state of charge at every step (memory of the power's size).
-    max_iterations : int, default 60
+    max_iterations : int, default 30
         Passes allowed to find the periodic state.
     tolerance : float, default 1e-6
         The periodic state's content is that at the end within ``tolerance x capacity_wh``.
@@ -574,9 +576,7 @@ def _simulate_numpy(
         done = given[pick] | ((np.abs(end - stored[pick]) <= tol) & (end_on == on[pick]))
         lo = np.where(end > stored[pick], stored[pick], low[pick])
         hi = np.where(end < stored[pick], stored[pick], high[pick])
-        stuck = ~done & (
-            (hi - lo <= kern.BRACKET * capacity[pick]) | (passes[pick] >= max_iterations)
-        )
+        stuck = ~done & ((hi - lo <= tol) | (passes[pick] >= max_iterations))
         passes[pick[stuck]] *= -1
         plain = (passes[pick] < kern.PLAIN_ITERATIONS) & (lo <= end) & (end <= hi)
         low[pick], high[pick] = lo, hi

@@ -32,9 +32,6 @@ HISTOGRAM = 10
 #: Plain fixed-point iterations (the buffer's own year after year) before the periodic state is
 #: bisected instead (a state that drifts by a little a day would take many plain ones).
 PLAIN_ITERATIONS = 4
-#: Width, as a share of the capacity, below which the bisection stops: a few units in the last
-#: place of the content, where a start between its ends no longer exists.
-BRACKET = 1e-14
 
 
 @njit(cache=True, error_model="numpy")
@@ -296,8 +293,8 @@ def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterati
             low = stored
         elif end < stored:
             high = stored
-        if high - low <= BRACKET * capacity:
-            break  # the end state jumps across the start's: no periodic state
+        if high - low <= tolerance * capacity:
+            break  # the start is known to the tolerance, the end is not: no periodic state
         on = end_on
         if passes < PLAIN_ITERATIONS and low <= end <= high:
             stored = end
