@@ -51,6 +51,7 @@ NOTEBOOK = textwrap.dedent("""
     result = foldopt.run(study)
     year = foldopt.sweep(study, "day", date="1:365:91", objective="mean", p_load=[2.0, 4.0])
     sized = foldopt.size(study, areas="0.05:0.2:0.05")
+    buffered = foldopt.run(study.variant(p_load=2.0, storage={"capacity_wh": 5, "target": {"powered_h": 24}}))
     foldopt.write(result, sys.argv[1] + "/day")
     foldopt.write(year, sys.argv[1] + "/year")
     after_writing = [matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules]
@@ -61,6 +62,7 @@ NOTEBOOK = textwrap.dedent("""
     calls = {
         "plot_power_curves": (result,), "plot_switching": (result,), "plot_t_solar_vs_fold_angle": (result,),
         "plot_comparison": (result,), "plot_standby": (result,),
+        "plot_state_of_charge": (buffered,), "plot_powered_vs_capacity": (buffered,),
         "plot_map": (year.table, "dayofyear", "p_load_w", "t_solar_h", "t", "t_solar [h]", False),
         "plot_curves": (year.table, "dayofyear", "t"),
         "plot_sizing": (sized.table, sized.best, "t"),

@@ -450,8 +450,9 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
         "fold_angle_deg": buffered.fold_angle_deg,
         "powered_h": best_h,
         **buffered.near_optimal,
+        # In the answer's pattern, <quantity>_by_design_<unit> (t_solar_by_design_h).
         **{
-            f"{column[:-2] if column.endswith('_h') else column}_by_design": values
+            "{}_by_design_{}".format(*column.rsplit("_", 1)): values
             for column, values in per.items()
         },
         "folding_stops_paying_wh": sizing.folding_stops_paying_wh,

@@ -1,0 +1,198 @@
+"""A day's study with a buffer (issue 41, 41c): the answer every view renders. A buffer of 0 Wh is
+the storage-less answer for every design; powered time does not fall as the buffer grows (an
+ideal controller); each design's buffer for a target reaches it where a smaller one does not;
+the command line's JSON is the API's answer to the bit; a bad target is one line, exit 2; a study
+without storage is the study it was."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+import foldopt
+from foldopt.cli.app import app
+from foldopt.engine.storage import simulate
+from foldopt.inputs.study import make_study
+from foldopt.inputs.study_file import default_study_path
+from foldopt.studies.answer import plain
+from foldopt.studies.storage_answer import DESIGN_COLUMNS, buffer_of, reaches
+
+ROOT = Path(__file__).resolve().parent.parent
+runner = CliRunner()
+EMBEDDED = yaml.safe_load(default_study_path().read_text())
+#: The paper's day on 5-min steps at every 10 deg: a day's study in well under a second.
+QUICK = {"step_min": 5, "fold_angles": {"start": 10, "stop": 180, "step": 10}}
+IDEAL_24H = {"capacity_wh": 10, "target": {"powered_h": 24}}
+#: A load the paper's panel can carry all day with a buffer (48 Wh a day; it harvests 102 Wh flat).
+CARRIED = 2.0
+
+
+def _run(storage=None, **changes):
+    data = {**EMBEDDED, **QUICK, **changes}
+    if storage is not None:
+        data["storage"] = storage
+    return foldopt.run(make_study(data), engine="numba")
+
+
+@pytest.fixture(scope="module")
+def storage_less():
+    return _run()
+
+
+@pytest.mark.parametrize("preset", [None, "supercapacitor", "lifepo4"])
+def test_an_empty_buffer_is_t_solar_for_every_design(storage_less, preset):
+    result = _run({"capacity_wh": 0, **({"preset": preset} if preset else {})})
+    summary = result.summary
+    # Every design, the trackers gross and net, the heuristic's angle and every other tracker.
+    assert len(summary) == len(storage_less.summary) >= 5
+    # Segment for segment the same time; the buffer's loop adds it up in time order, t_solar's
+    # sum pairwise: they differ in the last bits (1.8e-15 h at most here), nowhere more.
+    np.testing.assert_allclose(summary["powered_h"], summary["t_solar_h"], rtol=1e-14, atol=0)
+    np.testing.assert_array_equal(summary["t_solar_h"], storage_less.summary["t_solar_h"])
+    # At every fold angle of the grid, the same.
+    np.testing.assert_allclose(result.sweep["powered_h"], result.sweep["t_solar_h"], rtol=1e-14)
+    assert (summary["days_full_pct"] == 0).all()
+
+
+def test_a_study_without_storage_is_the_study_it_was(storage_less):
+    # The buffer only adds: its columns, its part of the answer, its lines after the others.
+    buffered = _run({"capacity_wh": 5, "preset": "supercapacitor"})
+    plain_summary = storage_less.summary
+    assert storage_less.storage is None
+    assert not set(DESIGN_COLUMNS) & set(plain_summary.columns)
+    assert "powered_h" not in storage_less.sweep
+    assert "storage" not in storage_less.answer.result
+    pd.testing.assert_frame_equal(buffered.summary[plain_summary.columns], plain_summary)
+    pd.testing.assert_frame_equal(
+        buffered.sweep[storage_less.sweep.columns], storage_less.sweep
+    )
+    lines = storage_less.answer.lines()
+    assert buffered.answer.lines()[: len(lines)] == lines
+    assert {k: v for k, v in buffered.answer.result.items() if k != "storage"} == (
+        storage_less.answer.result
+    )
+
+
+def test_powered_time_never_falls_as_the_buffer_grows():
+    # An ideal controller (no hysteresis, no leak): on the curve of every design, and on a finer
+    # independent sweep of the capacity through the engine for the flat panel.
+    result = _run(IDEAL_24H, p_load=CARRIED)
+    curve = result.storage.sizing.curve
+    assert len(curve) >= 20 and curve["capacity_wh"].is_monotonic_increasing
+    step = result.day.step_hours
+    for design in ("flat", "twofold", "tracker"):
+        hours = curve[f"powered_{design}_h"].to_numpy()
+        assert np.isfinite(hours).all()
+        # The periodic state is found to 1e-6 of the capacity: powered time to well below a step.
+        assert (np.diff(hours) >= -1e-3 * step).all(), design
+    capacities = np.linspace(0.0, 60.0, 61)
+    flat = result.timeseries["p_flat_w"].to_numpy()
+    swept = simulate(
+        np.repeat(flat[None], capacities.size, axis=0),
+        result.study.p_load,
+        buffer_of(result.study.storage, capacity_wh=capacities),
+        step,
+    )
+    assert (np.diff(swept.powered_h[:, 0]) >= -1e-3 * step).all()
+    # No buffer is worth more than the energy the panel harvests (the energy-balance bound), to
+    # within the periodic state's tolerance (1e-6 of the capacity, simulate's default).
+    harvested = result.summary.set_index("design").loc["flat", "energy_harvested_wh"]
+    slack = 1e-6 * capacities / result.study.p_load
+    assert (swept.powered_h[:, 0] <= min(24.0, harvested / result.study.p_load) + slack).all()
+
+
+def test_each_design_s_buffer_reaches_the_target_and_a_smaller_one_does_not():
+    result = _run(IDEAL_24H, p_load=CARRIED)
+    study, sizing = result.study, result.storage.sizing
+    table = sizing.table.set_index("design")
+    assert list(table.index) == ["flat", "twofold", "tracker", "tracker-net"]
+    need = table["capacity_wh"]
+    assert need.notna().all() and (need > 0).all()
+    curves = {
+        "flat": result.timeseries["p_flat_w"].to_numpy(),
+        "twofold": result.day.combined_power(np.array([table.loc["twofold", "fold_angle_deg"]]))[0],
+        "tracker": result.timeseries["p_tracker_w"].to_numpy(),
+    }
+    for design, power in curves.items():
+        capacities = need[design] * np.array([1.0, 1.0 - 2e-3])
+        run = simulate(
+            np.repeat(power[None], 2, axis=0),
+            study.p_load,
+            buffer_of(study.storage, capacity_wh=capacities),
+            result.day.step_hours,
+        )
+        assert reaches(run, study.storage.target).tolist() == [True, False], design
+    # The headline says the numbers of the table, and the saving is against flat's.
+    line = next(line for line in result.answer.lines() if line.startswith("for 24 h:"))
+    assert f"flat needs {need['flat']:.3g} Wh" in line
+    saving = (need["twofold"] / need["flat"] - 1.0) * 100.0
+    assert table.loc["twofold", "capacity_vs_flat_pct"] == pytest.approx(saving, rel=1e-12)
+    part = result.answer.result["storage"]["sizing"]
+    assert part["capacity_by_design_wh"] == {d: float(need[d]) for d in need.index}
+
+
+def test_a_target_out_of_reach_is_said_not_invented():
+    # 30 W around the clock is more than the paper's panel harvests in a day, whatever its buffer.
+    result = _run(IDEAL_24H, p_load=30.0)
+    need = result.storage.sizing.table.set_index("design")["capacity_wh"]
+    assert need.isna().all()
+    line = next(line for line in result.answer.lines() if line.startswith("for 24 h:"))
+    assert "flat reaches it with no buffer up to" in line
+    data = result.answer.to_dict()["result"]["storage"]["sizing"]
+    assert set(data["capacity_by_design_wh"].values()) == {None}  # no NaN reaches JSON
+
+
+def test_the_command_line_s_json_is_the_api_s_answer_to_the_bit(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    config = yaml.safe_load((ROOT / "configs" / "camera-buffer.yaml").read_text())
+    config.update(QUICK)
+    (tmp_path / "study.yaml").write_text(yaml.safe_dump(config))
+    result = runner.invoke(app, ["run", "study.yaml", "--format", "json", "--out", "out", "-q"])
+    assert result.exit_code == 0, result.output
+    printed = json.loads(result.output)["answer"]
+    api = foldopt.run(tmp_path / "study.yaml")
+    assert printed["result"]["storage"] == json.loads(json.dumps(plain(api.answer.result["storage"])))
+    assert printed["lines"] == api.answer.lines()
+    assert any(line.startswith("for 24 h: flat needs") for line in printed["lines"])
+    # The folder's tables are the answer's numbers.
+    summary = pd.read_csv(tmp_path / "out" / "summary.csv").set_index("design")
+    assert summary.loc["flat", "powered_h"] == pytest.approx(
+        printed["result"]["storage"]["powered_by_design_h"]["flat"], rel=1e-9
+    )
+    sizing = pd.read_csv(tmp_path / "out" / "storage_sizing.csv").set_index("design")
+    assert sizing.loc["tracker", "capacity_wh"] == pytest.approx(
+        printed["result"]["storage"]["sizing"]["capacity_by_design_wh"]["tracker"], rel=1e-9
+    )
+    timeseries = pd.read_csv(tmp_path / "out" / "timeseries.csv")
+    assert {"soc_flat", "soc_twofold", "soc_tracker"} <= set(timeseries.columns)
+    assert timeseries[["soc_flat", "soc_twofold", "soc_tracker"]].stack().between(0, 1).all()
+    html = (tmp_path / "out" / "report.html").read_text()
+    assert "state_of_charge.png" in html and "for 24 h: flat needs" in html
+
+
+@pytest.mark.parametrize(
+    "option, said",
+    [
+        ("storage.target.powered_h=25", ["storage.target.powered_h", "(0, 24] h"]),
+        ("storage.target.powered_h=0", ["storage.target.powered_h", "(0, 24] h"]),
+        ("storage.target.days_pct=120", ["storage.target.days_pct", "(0, 100] %"]),
+        ("storage.target.hours=24", ["storage.target.hours", "unknown field"]),
+    ],
+)
+def test_a_bad_target_is_one_line_and_exit_2(tmp_path, monkeypatch, option, said):
+    monkeypatch.chdir(tmp_path)
+    given = ["--set", "storage.target.powered_h=24"] if "powered_h" not in option else []
+    args = ["sweep", "angle", "--storage-wh", "10", *given, "--set", option, "--step-min", "60",
+            "--out", "out", "--quiet"]  # fmt: skip
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.output, result.output
+    assert all(part in lines[0] for part in said), lines[0]
+    assert not (tmp_path / "out").exists()
