@@ -338,6 +338,14 @@ def test_two_days_by_hand(engine):
     np.testing.assert_allclose(days.missing_wh[0], [21.6, 18.4, 92.8, 21.6])
     np.testing.assert_allclose(days.lost_wh[0], [42.4, 42.4, 0.0, 42.4], atol=1e-12)
     assert days.full[0].tolist() == [True, True, False, True] and days.empty[0].all()
+    summary = days.summary()
+    assert summary["days_full_pct"][0] == 75.0 and summary["days_empty_pct"][0] == 100.0
+    assert summary["days_without_outage_pct"][0] == 0.0
+    served = 74.4 + 77.6 + 3.2 + 74.4
+    np.testing.assert_allclose(summary["availability_pct"], [100 * served / (4 * 96)])
+    np.testing.assert_allclose(summary["powered_h"], [(18.6 + 19.4 + 0.8 + 18.6) / 4])
+    np.testing.assert_allclose(summary["missing_wh"], [(21.6 + 18.4 + 92.8 + 21.6) / 4])
+    np.testing.assert_allclose(summary["soc_pct"].sum(axis=1), [100.0])
     periodic = simulate(HAND_POWER[:1], 4.0, Buffer(20.0), 6.0, engine=engine)
     np.testing.assert_allclose(periodic.powered_h, [[19.4]])
     np.testing.assert_allclose(periodic.stored_wh, [[3.2, 3.2]])
@@ -358,6 +366,15 @@ def test_state_of_charge_kept_where_asked():
     # Day 1 at the step centres 3, 9, 15 and 21 h (the example above): 0, 15.6 Wh, full, 15.2 Wh.
     np.testing.assert_allclose(kept.soc[0, 0], [0.0, 15.6 / 20, 1.0, 15.2 / 20])
     np.testing.assert_allclose(kept.soc_hours.sum(axis=-1), 24.0)
+
+
+def test_summary_without_demand_or_capacity_has_no_nan():
+    """A load of 0 W demands nothing (availability 100 %), and a buffer of 0 Wh spends all its
+    time in the lowest tenth: the summary holds no NaN."""
+    result = simulate(HAND_POWER[None], 0.0, Buffer(0.0), 6.0)
+    summary = result.summary()
+    assert all(np.isfinite(value).all() for value in summary.values())
+    assert summary["availability_pct"][0] == 100.0 and summary["soc_pct"][0, 0] == 100.0
 
 
 @pytest.mark.parametrize(

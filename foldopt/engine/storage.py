@@ -175,6 +175,36 @@ class StorageResult(NamedTuple):
         """(n_series,) bool: the series started from its ``initial_soc`` or its periodic state."""
         return self.passes > 0
 
+    def summary(self) -> dict:
+        """Each series over its days, as PVGIS's off-grid tool reports a year [1]_.
+
+        Returns
+        -------
+        dict of numpy.ndarray
+            (n_series,) each: ``powered_h`` (mean hours a day), ``availability_pct`` (load
+            energy served, % of demanded; 100 without demand), ``days_without_outage_pct`` (days
+            with no energy missing: powered whenever the load demanded power),
+            ``missing_wh`` and ``lost_wh`` (means a day), ``days_full_pct`` and
+            ``days_empty_pct``; and ``soc_pct`` (n_series, SOC_BINS), the share of the time in
+            each tenth of the state of charge. No NaN.
+        """
+        demanded = (self.served_wh + self.missing_wh).sum(axis=1)
+        served = self.served_wh.sum(axis=1)
+        availability = np.divide(
+            100.0 * served, demanded, out=np.full(served.shape, 100.0), where=demanded > 0
+        )
+        hours = self.soc_hours.sum(axis=1)
+        return {
+            "powered_h": self.powered_h.mean(axis=1),
+            "availability_pct": availability,
+            "days_without_outage_pct": 100.0 * (self.missing_wh <= 0.0).mean(axis=1),
+            "missing_wh": self.missing_wh.mean(axis=1),
+            "lost_wh": self.lost_wh.mean(axis=1),
+            "days_full_pct": 100.0 * self.full.mean(axis=1),
+            "days_empty_pct": 100.0 * self.empty.mean(axis=1),
+            "soc_pct": 100.0 * hours / hours.sum(axis=1, keepdims=True),
+        }
+
 
 def simulate(
     power,
