@@ -185,6 +185,7 @@ def test_compiled_loop_equals_the_numpy_reference(curve, data):
     reference = simulate(power, load, buffer, step, engine="numpy", soc_curves=True)
     for name in storage.StorageResult._fields:
         np.testing.assert_array_equal(getattr(compiled, name), getattr(reference, name), name)
+        assert np.isfinite(getattr(compiled, name)).all(), name
 
 
 @pytest.mark.parametrize("engine", ENGINES)
