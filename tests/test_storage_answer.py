@@ -196,3 +196,14 @@ def test_a_bad_target_is_one_line_and_exit_2(tmp_path, monkeypatch, option, said
     assert len(lines) == 1 and "Traceback" not in result.output, result.output
     assert all(part in lines[0] for part in said), lines[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_a_sweep_of_days_says_its_buffer_is_not_simulated(tmp_path, monkeypatch):
+    # Days in sequence with a buffer are not answered yet: the answer says so, never silently.
+    monkeypatch.chdir(tmp_path)
+    args = ["sweep", "day", "--storage-wh", "10", "--days", "2025-06-21,2025-12-21", "--step-min",
+            "60", "--format", "json", "--out", "out", "-q"]  # fmt: skip
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    notes = [note["note"] for note in json.loads(result.output)["answer"]["notes"]]
+    assert any(note.startswith("storage: the buffer is simulated in a day's study only") for note in notes)

@@ -15,6 +15,7 @@ import pandas as pd
 
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
+from foldopt.studies.storage_answer import unsimulated_notes
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
 from foldopt.studies.worldmap import searched_tilt
 
@@ -414,7 +415,8 @@ def of_sweep(result) -> Answer:
         pd.DataFrame(),
         design_notes(table, plan.n_cases)
         + weather_notes(result)
-        + horizon_notes(plan.base, _dates(plan)),
+        + horizon_notes(plan.base, _dates(plan))
+        + unsimulated_notes(plan.base),
         tuple(lines),
     )
 
@@ -559,7 +561,8 @@ def _of_annual(result) -> Answer:
         schedule,
         design_notes(result.table, plan.n_cases)
         + weather_notes(result)
-        + horizon_notes(study, _dates(plan)),
+        + horizon_notes(study, _dates(plan))
+        + unsimulated_notes(study),
         tuple(lines),
     )
 

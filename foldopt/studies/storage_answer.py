@@ -547,3 +547,23 @@ DESIGN_COLUMNS = (
     "days_full_pct",
     "days_empty_pct",
 )
+
+
+def unsimulated_notes(study) -> list[dict]:
+    """The note of an answer that does not simulate its study's buffer (a plan of cases, an
+    annual objective): its numbers are storage-less. None without a buffer.
+
+    Parameters
+    ----------
+    study : foldopt.Study
+        The plan's base study.
+    """
+    if study.storage is None:
+        return []
+    return [
+        {
+            "note": "storage: the buffer is simulated in a day's study only (foldopt run, "
+            "foldopt sweep angle); these answers are storage-less",
+            "designs": [],
+        }
+    ]
