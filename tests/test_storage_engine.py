@@ -383,6 +383,21 @@ def test_a_vanishing_buffer_is_no_buffer(engine):
         np.testing.assert_allclose(balance(result), 0.0, atol=1e-9)
 
 
+@pytest.mark.parametrize("engine", ENGINES)
+def test_days_empty_are_days_at_the_cut_off(engine):
+    """PVGIS's days empty: the buffer at its cut-off at some instant. A load above
+    max_discharge_w is off all day with the buffer full (not empty); two dark days after a
+    sunny one are both empty, the second at the cut-off from its first instant."""
+    sunny_then_dark = np.concatenate([HAND_POWER[:1], np.zeros((2, 4))])
+    full = Buffer(20.0, initial_soc=1.0)
+    result = simulate(sunny_then_dark[None], 4.0, full, 6.0, engine=engine)
+    assert result.empty[0].tolist() == [False, True, True]
+    assert result.missing_wh[0, 2] == pytest.approx(96.0)
+    limited = Buffer(20.0, max_discharge_w=3.0, initial_soc=1.0)
+    result = simulate(np.zeros((1, 1, 4)), 4.0, limited, 6.0, engine=engine)
+    assert not result.empty.any() and result.full.all() and result.powered_h[0, 0] == 0.0
+
+
 def test_summary_without_demand_or_capacity_has_no_nan():
     """A load of 0 W demands nothing (availability 100 %), and a buffer of 0 Wh spends all its
     time in the lowest tenth: the summary holds no NaN."""

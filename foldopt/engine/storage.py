@@ -43,8 +43,8 @@ Conventions that follow from it:
   nowhere. Energy is therefore conserved for curves that do not go below zero:
   ``served + lost + delta stored + conversion losses + self-discharge = harvested``.
 - Days *full* and *empty* are PVGIS's [1]_: days on which the buffer was full at some instant
-  (never with no capacity), and days on which the controller cut the load off for lack of charge
-  (it reached its discharge cut-off).
+  (never with no capacity), and days on which it was down to its cut-off at some instant (at
+  midnight, or when it ran out under the load; with no capacity, every day).
 - Powered time does not fall as the capacity grows, or as the load falls, to within one step,
   for a controller without hysteresis (``restart_soc = min_soc``) and a buffer that does not leak
   (``tests/test_storage_engine.py``). With a hysteresis band or a leak it can: the band
@@ -96,7 +96,7 @@ class Buffer(NamedTuple):
     Attributes
     ----------
     capacity_wh : float
-        Usable capacity [Wh], 0 or more (0: no buffer).
+        Capacity [Wh], 0 or more (0: no buffer); the controller draws it down to ``min_soc``.
     min_soc : float, default 0
         The controller's cut-off: the buffer is not drawn below it [-, 0..1].
     restart_soc : float, optional
@@ -487,7 +487,7 @@ def _part_numpy(pa, pb, la, lb, tau, surplus, demand, stored, on, par, row):
     tau = np.where(partial, tau - ran, tau)
     need = np.where(partial, 0.5 * tau * (la + lb), need)
     on = on & ~cut
-    row[:, kern.EMPTY] = np.where(cut, 1.0, row[:, kern.EMPTY])
+    row[:, kern.EMPTY] = np.where(cut & (stored <= floor), 1.0, row[:, kern.EMPTY])
     row[:, kern.MISSING] += np.where(off, need, 0.0)
     max_c = par[:, kern.MAX_CHARGE]
     spare = np.where(
@@ -534,12 +534,14 @@ def _run_numpy(power, load, par, step_hours, stored, on, out, state, soc_curves,
     n_bins = out.shape[-1] - kern.HISTOGRAM
     series = np.arange(power.shape[0])
     restart = par[:, kern.RESTART_SOC] * capacity
+    floor = par[:, kern.MIN_SOC] * capacity
     for d in range(n_days):
         on = on | (stored >= restart)
         state[:, d, 0], state[:, d, 1] = stored, on
         row = out[:, d]
         row[:] = 0.0
         row[:, kern.FULL] = np.where((capacity > 0.0) & (stored >= capacity), 1.0, 0.0)
+        row[:, kern.EMPTY] = np.where(stored <= floor, 1.0, 0.0)
         for j in range(n_steps + 1):
             for part in (first, second):
                 stored, on = _part_numpy(

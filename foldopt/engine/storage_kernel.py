@@ -96,7 +96,7 @@ def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
 
     Returns the buffer's content [Wh], whether the load is on, the part's energies [Wh] served,
     missing, lost, lost in charging and in discharging, the hours the load ran, whether the
-    buffer was full, and whether the controller cut the load off. Scalars only, so that the call
+    buffer was full, and whether it ran down to its cut-off. Scalars only, so that the call
     moves no array (numba counts references to arrays passed to a function)."""
     capacity = par[CAPACITY]
     pv = 0.5 * tau * (pa + pb)
@@ -110,7 +110,7 @@ def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
         )
         return stored, on, need, 0.0, lost, loss, 0.0, tau, full, False
     served = ran = discharge_loss = 0.0
-    cut = False
+    empty = False
     if on:
         floor = par[MIN_SOC] * capacity
         usable = stored - floor
@@ -130,11 +130,11 @@ def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
             pa, la, tau = pm, lm, tau - ran
             need = 0.5 * tau * (la + lb)
         on = False
-        cut = True
+        empty = stored <= floor  # not when only max_discharge_w turned the load off
     spare = clipped_energy(pa, pb, tau, math.inf)
     limit = clipped_energy(pa, pb, tau, par[MAX_CHARGE])
     stored, loss, lost, full = _charge(stored, spare, limit, capacity, par[ETA_CHARGE])
-    return stored, on, served, need, lost, loss, discharge_loss, ran, full, cut
+    return stored, on, served, need, lost, loss, discharge_loss, ran, full, empty
 
 
 @njit(cache=True, error_model="numpy")
@@ -162,7 +162,7 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
         row = out[d]
         row[:] = 0.0
         full = capacity > 0.0 and stored >= capacity
-        empty = False
+        empty = stored <= floor
         powered = served = missing = lost = charge_loss = discharge_loss = leak = 0.0
         harvested = 0.0
         day_load = load[d if profile_days else 0]
@@ -235,7 +235,7 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
                         pa, pb, la, lb = ps, p1, ls, l1
                     else:
                         pa, pb, la, lb = p0, ps, l0, ls
-                    stored, on, s_wh, m_wh, l_wh, c_wh, d_wh, ran_h, was_full, cut = _part(
+                    stored, on, s_wh, m_wh, l_wh, c_wh, d_wh, ran_h, was_full, ran_out = _part(
                         pa, pb, la, lb, length, rising == second, stored, on, par
                     )
                     served += s_wh
@@ -246,7 +246,7 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
                     if demand:
                         powered += ran_h
                     full = full or was_full
-                    empty = empty or cut
+                    empty = empty or ran_out
             kept = stored * (keep_half if half else keep_step)
             leak += stored - kept
             stored = kept
