@@ -60,6 +60,18 @@ def test_an_empty_buffer_is_t_solar_for_every_design(storage_less, preset):
     assert (summary["days_full_pct"] == 0).all()
 
 
+def test_the_state_of_charge_distribution_fills_the_day():
+    result = _run({"capacity_wh": 5, "preset": "lifepo4"}, p_load=CARRIED)
+    hours = result.answer.result["storage"]["soc_hours_by_design_h"]
+    assert set(hours) == {"flat", "twofold", "tracker", "tracker-net"}
+    for design, tenths in hours.items():
+        assert len(tenths) == 10 and min(tenths) >= 0
+        assert sum(tenths) == pytest.approx(24.0, rel=1e-12), design
+    # A buffer full on its day spends time in its top tenth.
+    full = result.answer.result["storage"]["days_full_by_design_pct"]
+    assert all(hours[d][-1] > 0 for d in hours if full[d] == 100) and full["flat"] == 100
+
+
 def test_a_study_without_storage_is_the_study_it_was(storage_less):
     # The buffer only adds: its columns, its part of the answer, its lines after the others.
     buffered = _run({"capacity_wh": 5, "preset": "supercapacitor"})

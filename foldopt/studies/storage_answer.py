@@ -32,8 +32,9 @@ from foldopt.studies.objectives import best_angle_index, near_optimal
 
 #: The designs whose state of charge the day's figure draws and ``timeseries.csv`` holds.
 SOC_DESIGNS = ("flat", "twofold", "tracker")
-#: Capacities of the grid [-, times the day's load energy] (0 Wh first): the sizing's first
-#: bracket and the figure's curve of powered time against capacity.
+#: Capacities of the grid [-, times the day's load energy over the usable fraction] (0 Wh first),
+#: with the study's own: the sizing's first bracket and the figure's curve of powered time
+#: against capacity.
 GRID = np.concatenate([[0.0], np.geomspace(1.0 / 64.0, 4.0, 25)])
 #: Interior points each refinement of a bracket evaluates.
 REFINE_POINTS = 8
@@ -166,9 +167,10 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
     fold_angles = np.asarray(fold_angles, dtype=float)
     names = ["flat", "tracker", "tracker-net"] + [f"twofold@{a:g}" for a in fold_angles]
     power = np.vstack([curves["flat"], curves["tracker"], curves["tracker-net"], curves["twofold"]])
-    demand_wh = float(np.sum(np.broadcast_to(load, power.shape[-1:])) * step_hours)
+    demand_wh = float(np.sum(np.broadcast_to(load, (1, power.shape[-1]))) * step_hours)
     scale = max(demand_wh, 1e-6) / ((1.0 - storage.min_soc) * storage.discharge_efficiency)
-    capacities = np.minimum(GRID * scale, 1e6)
+    # The study's own buffer is a point of the curve.
+    capacities = np.unique(np.minimum(np.append(GRID * scale, storage.capacity_wh), 1e6))
     n, m = len(names), capacities.size
     result = run_buffer(
         np.repeat(power, m, axis=0),
@@ -275,6 +277,9 @@ class DayStorage:
         ``recommended_powered_h``.
     soc : dict
         Design of :data:`SOC_DESIGNS` -> state of charge [-] at each step centre, (n_steps,).
+    soc_hours : dict
+        Design -> hours a day [h] the state of charge spends in each tenth (0-10 %, ...,
+        90-100 %), as PVGIS's histogram, (10,).
     sizing : Sizing
     engine : str
         The engine the buffer was simulated on ('numba' or 'numpy').
@@ -288,6 +293,7 @@ class DayStorage:
     fold_angle_deg: float
     near_optimal: dict
     soc: dict
+    soc_hours: dict
     sizing: Sizing
     engine: str
     converged: bool
@@ -376,6 +382,7 @@ def day_storage(
         float(fold_angles[best]),
         near,
         {name: soc.soc[i, 0] for i, name in enumerate(SOC_DESIGNS)},
+        dict(zip(names, designs.soc_hours.mean(axis=1), strict=True)),
         sizing,
         engine,
         bool(designs.converged.all() and grid.converged.all()),
@@ -455,6 +462,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             "{}_by_design_{}".format(*column.rsplit("_", 1)): values
             for column, values in per.items()
         },
+        "soc_hours_by_design_h": {d: buffered.soc_hours[d].tolist() for d in designs},
         "folding_stops_paying_wh": sizing.folding_stops_paying_wh,
         "engine": buffered.engine,
         "converged": buffered.converged,
@@ -527,7 +535,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             f"{needs(need['twofold'])}"
             + (f" ({saving:+.0f} %)" if saving == saving else "")
             + f", the tracker {needs(need['tracker'])}"
-            + f" (net of its drive {needs(need['tracker-net'])})"
+            + f" (net of its drive: {needs(need['tracker-net'])})"
         )
     if not buffered.converged:
         lines.append(
