@@ -151,6 +151,7 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
     capacity, restart = par[CAPACITY], par[RESTART_SOC] * par[CAPACITY]
     n_bins = out.shape[1] - HISTOGRAM
     keep_half, keep_step = par[KEEP_HALF], par[KEEP_STEP]
+    leaks = keep_step < 1.0 or keep_half < 1.0
     floor, eta_discharge = par[MIN_SOC] * capacity, par[ETA_DISCHARGE]
     max_discharge = par[MAX_DISCHARGE]
     for d in range(n_days):
@@ -247,9 +248,10 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
                         powered += ran_h
                     full = full or was_full
                     empty = empty or ran_out
-            kept = stored * (keep_half if half else keep_step)
-            leak += stored - kept
-            stored = kept
+            if leaks:  # without a leak the product is the content itself: spared
+                kept = stored * (keep_half if half else keep_step)
+                leak += stored - kept
+                stored = kept
             level = stored / capacity if capacity > 0.0 else 0.0
             row[HISTOGRAM + min(max(int(level * n_bins), 0), n_bins - 1)] += tau
             if keep_soc and j < n_steps:
