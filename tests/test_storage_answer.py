@@ -219,3 +219,37 @@ def test_a_sweep_of_days_says_its_buffer_is_not_simulated(tmp_path, monkeypatch)
     assert result.exit_code == 0, result.output
     notes = [note["note"] for note in json.loads(result.output)["answer"]["notes"]]
     assert any(note.startswith("storage: the buffer is simulated in a day's study only") for note in notes)
+
+
+def test_a_load_profile_sizes_its_buffer():
+    # The day's load energy of a profile's curve scales the grid (it raised before).
+    profile = {"daily": {"00:00": 1.0, "07:00": 3.0, "19:00": 1.0}, "interpolation": "step"}
+    result = _run(IDEAL_24H, load_profile=profile, p_load=1.0)
+    need = result.storage.sizing.table.set_index("design")["capacity_wh"]
+    assert need.notna().all() and (need > 0).all()
+    assert result.storage.sizing.curve["powered_tracker_h"].iloc[-1] == pytest.approx(24.0)
+
+
+def test_size_storage_is_the_day_s_answer_with_its_target(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    quick = ["--set", "step_min=5", "--set", "fold_angles.step=10", "--set", "fold_angles.start=10"]
+    args = ["size", "--storage", "--target-h", "24", "--set", f"p_load={CARRIED}", *quick,
+            "--format", "json", "--out", "out", "-q"]  # fmt: skip
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    printed = json.loads(result.output)["answer"]["result"]["storage"]
+    # The study has no buffer: an ideal one of 0 Wh is sized, as the API sizes it.
+    api = _run(IDEAL_24H | {"capacity_wh": 0}, p_load=CARRIED)
+    assert printed == json.loads(json.dumps(plain(api.answer.result["storage"])))
+    assert (tmp_path / "out" / "storage_sizing.csv").exists()
+
+
+@pytest.mark.parametrize("args", [["--target-h", "20"], ["--storage"]])
+def test_size_storage_and_its_target_go_together(tmp_path, monkeypatch, args):
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["size", *args, "--out", "out", "-q"])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip() == (
+        "error: --storage and --target-h go together: --target-h is the hours a day, in (0, 24]"
+    )
+    assert not (tmp_path / "out").exists()

@@ -76,20 +76,38 @@ def size(
     output_format: OutputFormat = "table",
     table: Table = False,
     settings: Settings = None,
+    storage: Annotated[
+        bool,
+        typer.Option(
+            "--storage",
+            help="Size the study's buffer instead: each design's smallest capacity for the load "
+            "to run --target-h hours a day (its storage section, else an ideal buffer).",
+        ),
+    ] = False,
+    target_h: Annotated[
+        float | None,
+        typer.Option("--target-h", help="With --storage: hours a day the load runs, (0, 24]."),
+    ] = None,
 ):
     """Shin et al. Sec. IV-A panel sizing: the lifetime benefit C_grid x t_solar x P_load against the
-    panel's cost, for flat and twofold panels of every area.
+    panel's cost, for flat and twofold panels of every area; with --storage, the buffer each design
+    needs for a target.
 
     \b
     Examples:
       foldopt size
       foldopt size --cost-per-w 0.9 --areas 0.02:0.3:0.002
+      foldopt size --storage --target-h 24 --set p_load=2 --set storage.preset=supercapacitor
     """
     output_format, _ = check_choices(output_format, "numba")
     output = Output(quiet, output_format, table)
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
     from foldopt.inputs.study_file import default_study_path
     from foldopt.studies.request import settings_plan, size_request, sizing_problems
+
+    if storage or target_h is not None:
+        _size_buffer(config, target_h, storage, settings, out, overwrite, output)
+        return
 
     errors = sizing_problems(
         {
@@ -122,6 +140,28 @@ def size(
     except ConfigError as error:
         fail([_sizing_option(line) for line in error.errors])
     output.answer("size", out, result.answer, result.table, [f"wrote {out}"], result.table)
+
+
+def _size_buffer(config, target_h, storage, settings, out, overwrite, output):
+    """``foldopt size --storage --target-h H``: the day's study with its buffer sized for the load
+    to run ``H`` hours a day (``storage.target``), an ideal 0 Wh buffer where the study has
+    none; its answer is the day's (:mod:`foldopt.studies.storage_answer`)."""
+    from foldopt.cli.run import run_request
+    from foldopt.inputs.study_file import default_study_path
+    from foldopt.studies.request import Request, settings_plan
+
+    if not storage or target_h is None:
+        fail(["--storage and --target-h go together: --target-h is the hours a day, in (0, 24]"])
+    path = config if config is not None else default_study_path()
+    given = list(settings or ())
+    own = [setting for setting in given if not setting.startswith("storage")]
+    sized = any(s.startswith(("storage=", "storage.capacity_wh=")) for s in given)
+    if not sized and settings_plan(path, own).base.storage is None:
+        given.insert(0, "storage.capacity_wh=0")
+    plan = settings_plan(path, [*given, f"storage.target.powered_h={target_h!r}"])
+    request = Request(plan, EMBEDDED if config is None else str(config), ())
+    out = out or RESULTS / f"{plan.base.name}-buffer"
+    run_request(request, out, overwrite, output, "auto", "size")
 
 
 #: The commands of this module: name, function, and the line the command list shows.
