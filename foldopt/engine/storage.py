@@ -55,12 +55,12 @@ Initial state: ``initial_soc``, or by default the periodic steady state: the ser
 full buffer, then from the state it ended in, until the state at its end is that at its start (the
 content within ``tolerance`` x the capacity, the load on or off alike). After
 :data:`~foldopt.engine.storage_kernel.PLAIN_ITERATIONS` passes the start is bisected between the
-contents that ended higher and lower. After ``max_iterations`` passes, or once that bracket is
-narrower than the tolerance while the end still differs by more (the end jumps over the start: a
-cut-off or a reconnection a part earlier or later; or the end moves much faster than the start),
-the last pass is kept and the series is flagged (``passes`` < 0): its start is then within the
-tolerance of where the end crosses it, and its end differs from its start by about one part's
-energy. One clear-sky day is thus repeated until its midnight state repeats; a weather year
+contents that ended higher and lower, until the start is known to the tolerance. If the end
+still differs by more, it jumps over the start there (a cut-off or a reconnection a part earlier
+or later, or an end that moves much faster than the start): the state is periodic to the model's
+resolution if the jump is within one step's load energy (the largest load x ``step_hours``), and
+the series is flagged otherwise (``passes`` < 0), as it is after ``max_iterations`` passes; the
+last pass is kept. One clear-sky day is thus repeated until its midnight state repeats; a weather year
 starts from the state at its own end. A pass stops early at the first midnight whose state the
 previous pass had too (from there on the two are the same), so that a year whose buffer fills or
 empties at some point costs little more than one pass.
@@ -582,6 +582,7 @@ def _simulate_numpy(
     given = ~np.isnan(par[:, kern.INITIAL_SOC])
     stored = np.where(given, par[:, kern.INITIAL_SOC] * capacity, capacity)
     on = np.where(given, stored >= par[:, kern.RESTART_SOC] * capacity, True)
+    resolution = load.reshape(n_series, -1).max(axis=1) * step_hours
     low, high = np.zeros(n_series), capacity.copy()
     todo = np.ones(n_series, dtype=bool)
     while todo.any():
@@ -608,7 +609,9 @@ def _simulate_numpy(
         done = given[pick] | ((np.abs(end - stored[pick]) <= tol) & (end_on == on[pick]))
         lo = np.where(end > stored[pick], stored[pick], low[pick])
         hi = np.where(end < stored[pick], stored[pick], high[pick])
-        stuck = ~done & ((hi - lo <= tol) | (passes[pick] >= max_iterations))
+        located = ~done & (hi - lo <= tol)  # the end jumps over the start (kernel's _series)
+        done |= located & (np.abs(end - stored[pick]) <= resolution[pick])
+        stuck = ~done & (located | (passes[pick] >= max_iterations))
         passes[pick[stuck]] *= -1
         plain = (passes[pick] < kern.PLAIN_ITERATIONS) & (lo <= end) & (end <= hi)
         low[pick], high[pick] = lo, hi

@@ -274,13 +274,19 @@ def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterati
     """A series from its initial state of charge, or in its periodic state: passes until the
     state at the end of the series is that at its start (content within ``tolerance`` x the
     capacity, the load on or off alike), first plainly from a full buffer, then by bisection on
-    the start's content. Returns the passes run, negative when none was periodic."""
+    the start's content, until the start is known to the tolerance (then periodic if the end is
+    within one step's load energy of it). Returns the passes run, negative when none was
+    periodic."""
     capacity = par[CAPACITY]
     if not math.isnan(par[INITIAL_SOC]):
         stored = par[INITIAL_SOC] * capacity
         on = stored >= par[RESTART_SOC] * capacity
         _run(power, load, par, step_hours, stored, on, False, out, state, keep_soc, soc)
         return 1
+    resolution = 0.0  # one step's load energy [Wh], the largest of the series
+    for row in load:
+        for value in row:
+            resolution = max(resolution, value * step_hours)
     low, high = 0.0, capacity
     stored, on = capacity, True
     passes = 0
@@ -296,7 +302,10 @@ def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterati
         elif end < stored:
             high = stored
         if high - low <= tolerance * capacity:
-            break  # the start is known to the tolerance, the end is not: no periodic state
+            # The start is known to the tolerance and the end jumps over it (a cut-off or a
+            # reconnection a part earlier or later): periodic to the model's resolution if the
+            # jump is within one step's load energy.
+            return passes if abs(end - stored) <= resolution else -passes
         on = end_on
         if passes < PLAIN_ITERATIONS and low <= end <= high:
             stored = end
