@@ -14,9 +14,9 @@ only the loads inside the segment's range take a share. The position of the powe
 moves by a few loads a step, so it is walked from the previous step instead of searched. A day's
 cost is then O(steps + loads x crossings), not O(steps x loads).
 
-Rows are split into chunks, a few per thread, and each chunk has its own scratch, allocated by the
-caller outside the parallel loop (:func:`foldopt.engine.records.allocate`; arrays zero-filled inside
-a numba prange body have given wrong sums) and cleared per row.
+Rows are split into chunks, a few per thread (:func:`foldopt.engine.records.in_chunks`), and each
+chunk has its own scratch, allocated by the caller (:func:`foldopt.engine.records.allocate`) and
+cleared per row.
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from foldopt.engine.records import Scratch
+from foldopt.engine.records import in_chunks
 
 
 @njit(cache=True, inline="always")
@@ -183,23 +183,6 @@ def _day_steps(
     return harvested * step_hours, peak
 
 
-@njit(cache=True, inline="always")
-def chunk_scratch(scratch, k):
-    """Chunk ``k``'s own :class:`foldopt.engine.records.Scratch` of the scratch of every chunk."""
-    return Scratch(
-        scratch.east[k],
-        scratch.west[k],
-        scratch.incident[k],
-        scratch.diffuse_east[k],
-        scratch.diffuse_west[k],
-        scratch.power[k],
-        scratch.above[k],
-        scratch.whole[k],
-        scratch.run[k],
-    )
-
-
-@njit(cache=True, parallel=True)
 def curve_rows(power, span, row_loadset, loads, out, scratch):
     """Daily metrics of given power curves (a tracker's), as :func:`fold_rows` with one connection.
 
@@ -219,27 +202,13 @@ def curve_rows(power, span, row_loadset, loads, out, scratch):
     scratch : foldopt.engine.records.Scratch
         Per chunk (:func:`foldopt.engine.records.allocate`).
     """
-    n_rows = power.shape[0]
-    n_chunks = scratch.above.shape[0]
-    per_chunk = (n_rows + n_chunks - 1) // n_chunks
-    for k in prange(n_chunks):
-        _chunk_curves(
-            k * per_chunk,
-            min((k + 1) * per_chunk, n_rows),
-            power,
-            span,
-            row_loadset,
-            loads,
-            out,
-            chunk_scratch(scratch, k),
-        )
+    in_chunks(_chunk_curves, power.shape[0], scratch, power, span, row_loadset, loads, out)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
-    """Rows ``start .. stop - 1`` of :func:`curve_rows` with one chunk's scratch ``work``: a function
-    of its own, as :func:`foldopt.engine.kernel._chunk_rows`, because in a parallel loop's body the
-    writes through a named tuple's fields are lost (numba issue #7135, open in 0.68)."""
+    """Rows ``start .. stop - 1`` of :func:`curve_rows` with one chunk's scratch ``work`` (a thread
+    of :func:`foldopt.engine.records.in_chunks` calls it)."""
     for r in range(start, stop):
         out.energy[r, 0], out.peak[r, 0] = day_metrics(
             power[r],

@@ -31,10 +31,11 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-from numba import njit, prange, uint64
+from numba import njit, uint64
 
 from foldopt.engine.incidence import incidence, steps_sum
-from foldopt.engine.curve_reduction import chunk_scratch, day_metrics
+from foldopt.engine.curve_reduction import day_metrics
+from foldopt.engine.records import in_chunks
 
 # Connection codes; the order of foldopt.physics.connections.CONNECTIONS, plus the whole (unfolded) panel.
 EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
@@ -351,7 +352,6 @@ def _built_row(b, first, last, sky, tables, need_series, work):
             buffer[c, s] = _built_power(connections[c], parts, p_panel, tables)
 
 
-@njit(cache=True, parallel=True)
 def fold_rows(sky, rows, tables, loads, out, scratch):
     """Daily metrics of every row and connection, computing the power on the fly.
 
@@ -372,26 +372,13 @@ def fold_rows(sky, rows, tables, loads, out, scratch):
     scratch : foldopt.engine.records.Scratch
         Per-chunk scratch (:func:`foldopt.engine.records.allocate`).
     """
-    n_rows = rows.block.shape[0]
-    n_chunks = scratch.power.shape[0]
-    per_chunk = (n_rows + n_chunks - 1) // n_chunks
-    for k in prange(n_chunks):
-        _chunk_rows(
-            k * per_chunk,
-            min((k + 1) * per_chunk, n_rows),
-            sky,
-            rows,
-            tables,
-            loads,
-            out,
-            chunk_scratch(scratch, k),
-        )
+    in_chunks(_chunk_rows, rows.block.shape[0], scratch, sky, rows, tables, loads, out)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
-    """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work``: a function
-    of its own (the parallel loop's body calls it) so that the row's functions are inlined into it.
+    """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work``, the row's
+    functions inlined into it (a thread of :func:`foldopt.engine.records.in_chunks` calls it).
 
     Each row takes three loops over its lit steps. The first (:func:`foldopt.engine.incidence.incidence`)
     gives both sub-panels' irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) and

@@ -6,13 +6,14 @@
 last three. numba takes these module-level named tuples as arguments (and caches functions typed by
 them), so adding an input is a field here and the line of :mod:`foldopt.engine.evaluation` that fills it.
 Every field is an array, a float, an int or a bool, always of the same type, so that one compiled
-specialisation serves every call. A parallel loop hands the records to a function of its own
-(``_chunk_rows``, ``_chunk_curves``): in the loop's body itself, writes through a named tuple's
-fields are lost (numba issue #7135).
+specialisation serves every call. The rows go to threads in chunks (:func:`in_chunks`), each
+chunk a call of a compiled function that releases the GIL (``_chunk_rows``, ``_chunk_curves``)
+with its own :class:`Scratch`.
 """
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
 import numpy as np
@@ -197,9 +198,8 @@ class Outputs(NamedTuple):
 
 
 class Scratch(NamedTuple):
-    """Working arrays of each chunk of rows, allocated outside the parallel loop (arrays
-    zero-filled inside a numba prange body have given wrong sums): each field's first axis is the
-    chunk, and a chunk's own record (:func:`foldopt.engine.curve_reduction.chunk_scratch`) holds the rest.
+    """Working arrays of each chunk of rows, allocated once for the call (:func:`allocate`): each
+    field's first axis is the chunk, and a chunk's own record (:func:`in_chunks`) holds the rest.
 
     Attributes
     ----------
@@ -234,7 +234,7 @@ def allocate(
     n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: bool, n_curves: int = 0
 ) -> tuple[Outputs, Scratch]:
     """Outputs and per-chunk scratch of :func:`foldopt.engine.kernel.fold_rows` or
-    :func:`foldopt.engine.curve_reduction.curve_rows`, allocated here, outside the parallel loop.
+    :func:`foldopt.engine.curve_reduction.curve_rows`, allocated here, once for the call.
 
     Parameters
     ----------
@@ -274,3 +274,42 @@ def allocate(
         run=np.zeros((chunks, n_loads if contiguous else 1, 2)),
     )
     return out, scratch
+
+
+def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
+    """``body(start, stop, *records, work)`` over rows ``0 .. n_rows - 1`` in chunks, one chunk's
+    :class:`Scratch` each, on numba's number of threads.
+
+    ``body`` is compiled with ``nogil=True``, so the chunks run in parallel on Python threads.
+    They did in a numba ``prange`` loop, whose compile took a fifth of the kernel's (some 7 s
+    of ``fold_rows``' 25 s on 2 cores; ``python bench/startup.py --events sweep-weather``),
+    for nothing the chunks need: they share no writes.
+
+    Parameters
+    ----------
+    body : numba dispatcher
+        ``_chunk_rows`` or ``_chunk_curves``.
+    n_rows : int
+    scratch : Scratch
+        Of every chunk (:func:`allocate`): its first axis is the chunk.
+    *records
+        The arguments of ``body`` between ``stop`` and the chunk's scratch.
+    """
+    from numba import get_num_threads
+
+    n_chunks = scratch.above.shape[0]
+    per_chunk = (n_rows + n_chunks - 1) // n_chunks
+
+    def chunk(k: int) -> None:
+        stop = min((k + 1) * per_chunk, n_rows)
+        if k * per_chunk < stop:
+            body(k * per_chunk, stop, *records, Scratch(*(field[k] for field in scratch)))
+
+    threads = min(get_num_threads(), n_chunks)
+    if threads == 1:
+        for k in range(n_chunks):
+            chunk(k)
+        return
+    with ThreadPoolExecutor(threads, thread_name_prefix="foldopt-kernel") as pool:
+        for done in [pool.submit(chunk, k) for k in range(n_chunks)]:
+            done.result()  # a chunk's error, raised here
