@@ -21,7 +21,7 @@ from foldopt.engine.storage import simulate
 from foldopt.inputs.study import make_study
 from foldopt.inputs.study_file import default_study_path
 from foldopt.studies.answer import plain
-from foldopt.studies.storage_answer import DESIGN_COLUMNS, buffer_of, reaches
+from foldopt.studies.storage_answer import DESIGN_COLUMNS, buffer_of, reaches, sequential
 
 ROOT = Path(__file__).resolve().parent.parent
 runner = CliRunner()
@@ -218,7 +218,7 @@ def test_a_sweep_of_days_says_its_buffer_is_not_simulated(tmp_path, monkeypatch)
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     notes = [note["note"] for note in json.loads(result.output)["answer"]["notes"]]
-    assert any(note.startswith("storage: the buffer is simulated in a day's study only") for note in notes)
+    assert any(note.startswith("storage: the buffer is simulated in a day's study and over") for note in notes)
 
 
 def test_a_load_profile_sizes_its_buffer():
@@ -253,3 +253,37 @@ def test_size_storage_and_its_target_go_together(tmp_path, monkeypatch, args):
         "error: --storage and --target-h go together: --target-h is the hours a day, in (0, 24]"
     )
     assert not (tmp_path / "out").exists()
+
+
+def test_a_year_of_clear_days_is_each_day_s_buffer():
+    # Each clear-sky day of an annual objective is its own periodic day: flat's and the
+    # tracker's mean powered time over the days is the mean of each day's study.
+    storage = {"capacity_wh": 20, "preset": "lifepo4"}
+    dates = ["2014-06-21", "2014-12-21"]
+    study = make_study({**EMBEDDED, **QUICK, "p_load": CARRIED, "storage": storage})
+    year = foldopt.sweep(study, "day", date=dates, objective="mean")
+    table = year.extras["storage_annual"].set_index("design")
+    assert set(table.index) == {"flat", "twofold", "tracker", "tracker-net"}
+    days = [foldopt.run(year.plan.study({"date": d, "p_load": CARRIED})) for d in dates]
+    for design in ("flat", "tracker"):
+        each = [day.summary.set_index("design").loc[design, "powered_h"] for day in days]
+        assert table.loc[design, "mean_powered_h"] == pytest.approx(np.mean(each), rel=1e-9)
+        assert table.loc[design, "min_powered_h"] == pytest.approx(min(each), rel=1e-9)
+    # The 0 Wh run is the year's t_solar of the same designs.
+    objective = year.extras["annual_objective"].set_index("design")
+    for design in ("flat", "twofold", "tracker"):
+        assert table.loc[design, "mean_t_solar_h"] == pytest.approx(
+            objective.loc[design, "mean_t_solar_h"], rel=1e-12
+        )
+    lines = year.answer.lines()
+    assert any(line.startswith("with the 20 Wh lifepo4") for line in lines)
+    assert "storage" in year.answer.to_dict()["result"]
+
+
+def test_a_weather_file_s_days_carry_the_buffer_over_only_where_they_follow():
+    import datetime
+
+    days = [datetime.date(2025, 1, 1) + datetime.timedelta(n) for n in range(3)]
+    assert sequential(days, weather=True)
+    assert not sequential(days, weather=False)  # clear-sky days are each their own
+    assert not sequential(days[::2], weather=True)  # a gap: each day repeated

@@ -226,6 +226,13 @@ COLUMNS = (
     ),
     ("powered_{design}_h", "h", "powered time of one design at a capacity (storage_capacity.csv)"),
     ("capacity_vs_flat_pct", "%", "the design's buffer for the target over flat's, less 100"),
+    ("mean_powered_h", "h", "mean daily powered time with the buffer (storage_annual.csv)"),
+    ("min_powered_h", "h", "the least daily powered time with the buffer (storage_annual.csv)"),
+    (
+        "converged",
+        "",
+        "whether every series of the buffer found its periodic state (storage_annual.csv)",
+    ),
     # sizing
     ("area_m2", "m^2", "the panel's area"),
     ("benefit_usd", "$", "lifetime benefit C_grid x t_solar x P_load (Shin et al. Eq. 7)"),

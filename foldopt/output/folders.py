@@ -246,6 +246,9 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
     if "annual_objective" in extras:
         write_csv(extras["annual_objective"], folder / "annual_objective.csv")
         written.append("annual_objective.csv")
+    if "storage_annual" in extras:
+        write_csv(extras["storage_annual"], folder / "storage_annual.csv")
+        written.append("storage_annual.csv")
     if "weather_sample" in extras:
         kind = {
             "measured": "measured minutes",

@@ -502,7 +502,9 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
             step,
             p_load if shape is None else (p_load * shape)[None, :],
             fold_angles,
-            curves[study.connection] if series or not own_series else day.combined_power(fold_angles),
+            curves[study.connection]
+            if series or not own_series
+            else day.combined_power(fold_angles),
             {name: (angle, power_of[name]) for name, angle in angle_of.items()},
             summary["t_solar_h"].to_numpy(),
             engine,

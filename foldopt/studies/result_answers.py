@@ -15,7 +15,7 @@ import pandas as pd
 
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
-from foldopt.studies.storage_answer import unsimulated_notes
+from foldopt.studies.storage_answer import buffer_text, sequential, unsimulated_notes, year_lines
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
 from foldopt.studies.worldmap import searched_tilt
 
@@ -532,6 +532,17 @@ def _of_annual(result) -> Answer:
                 )
     if len(groups) > 8:
         lines.append(f"... and {len(groups) - 8} more cases (annual_objective.csv)")
+    buffered = result.extras.get("storage_annual")
+    if buffered is not None:
+        # The buffer over the days, said once here for every view (studies.storage_answer).
+        in_sequence = sequential(_dates(plan), study.weather is not None)
+        lines += year_lines(study.storage, buffered, result.extras["fold_angle"], in_sequence)
+        part["storage"] = {
+            "buffer": buffer_text(study.storage),
+            "days_in_sequence": in_sequence,
+            "fold_angle_twofold_deg": result.extras["fold_angle"],
+            "per_case": records(buffered),
+        }
     designs = objectives[
         [
             *keys,
@@ -562,7 +573,7 @@ def _of_annual(result) -> Answer:
         design_notes(result.table, plan.n_cases)
         + weather_notes(result)
         + horizon_notes(study, _dates(plan))
-        + unsimulated_notes(study),
+        + (unsimulated_notes(study) if buffered is None else []),
         tuple(lines),
     )
 

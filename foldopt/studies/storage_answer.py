@@ -558,8 +558,8 @@ DESIGN_COLUMNS = (
 
 
 def unsimulated_notes(study) -> list[dict]:
-    """The note of an answer that does not simulate its study's buffer (a plan of cases, an
-    annual objective): its numbers are storage-less. None without a buffer.
+    """The note of an answer that does not simulate its study's buffer (a plan of cases without
+    an annual objective, a cloud ensemble): its numbers are storage-less. None without a buffer.
 
     Parameters
     ----------
@@ -570,8 +570,137 @@ def unsimulated_notes(study) -> list[dict]:
         return []
     return [
         {
-            "note": "storage: the buffer is simulated in a day's study only (foldopt run, "
-            "foldopt sweep angle); these answers are storage-less",
+            "note": "storage: the buffer is simulated in a day's study and over the days of an "
+            "annual objective (not over a cloud ensemble's members); these answers are "
+            "storage-less",
             "designs": [],
         }
     ]
+
+
+#: The designs a year's buffer is simulated for (the twofold panel at the angle kept all year).
+YEAR_DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
+
+
+def year_storage(
+    storage, curves: dict, loads, load_shape, dates, step_hours, weather: bool, engine
+) -> pd.DataFrame:
+    """A buffer over an annual group's days, per load and design.
+
+    Parameters
+    ----------
+    storage : foldopt.inputs.storage_section.Storage
+    curves : dict
+        Design of :data:`YEAR_DESIGNS` -> power [W], (n_days, n_loads, n_steps) or, the same for
+        every load, (n_days, n_steps).
+    loads : array_like
+        (n_loads,) [W], or a load profile's scales.
+    load_shape : numpy.ndarray or None
+        A load profile's shape per day, (n_days, n_steps).
+    dates : sequence of datetime.date
+        (n_days,) the days, in order.
+    step_hours : float
+    weather : bool
+        The days are a weather file's: where they follow each other the buffer carries over from
+        day to day, starting from the state at the last one's end (:func:`sequential`); else
+        each day is a clear-sky day repeated to its own periodic state.
+    engine : str
+
+    Returns
+    -------
+    pandas.DataFrame
+        Per load and design: ``p_load_w``, ``design``, ``days``, ``mean_powered_h``,
+        ``min_powered_h``, ``mean_t_solar_h`` (of the same curves, with no buffer: the 0 Wh
+        run) and :func:`day_columns`' ``availability_pct``, ``days_powered_24h_pct``,
+        ``energy_missing_wh``, ``energy_lost_wh`` (a day, the days' mean), ``days_full_pct``,
+        ``days_empty_pct``; ``converged`` where every series found its periodic state.
+    """
+    engine = storage_engine(engine)
+    loads = np.asarray(loads, dtype=float)
+    in_sequence = sequential(dates, weather)
+    rows = []
+    for index, p_load in enumerate(loads):
+        power = np.stack(
+            [curves[d] if curves[d].ndim == 2 else curves[d][:, index] for d in YEAR_DESIGNS]
+        )  # (designs, days, steps)
+        load = p_load if load_shape is None else p_load * np.broadcast_to(load_shape, power.shape)
+        if not in_sequence:
+            power = power.reshape(-1, 1, power.shape[-1])
+            load = load if load_shape is None else load.reshape(power.shape)
+        result = simulate(power, load, buffer_of(storage), step_hours, engine)
+        bare = simulate(power, load, buffer_of(storage, capacity_wh=0.0), step_hours, engine)
+        shape = (len(YEAR_DESIGNS), -1)
+        if not in_sequence:
+            result = _by_design(result, len(YEAR_DESIGNS))
+            bare = _by_design(bare, len(YEAR_DESIGNS))
+        powered = result.powered_h.reshape(shape)
+        rows.append(
+            pd.DataFrame(
+                {
+                    "p_load_w": p_load,
+                    "design": YEAR_DESIGNS,
+                    "days": powered.shape[1],
+                    "mean_powered_h": powered.mean(axis=1),
+                    "min_powered_h": powered.min(axis=1),
+                    "mean_t_solar_h": bare.powered_h.reshape(shape).mean(axis=1),
+                    **{k: v for k, v in day_columns(result).items() if k != "powered_h"},
+                    "converged": result.converged.reshape(shape[0], -1).all(axis=1),
+                }
+            )
+        )
+    return pd.concat(rows, ignore_index=True)
+
+
+def sequential(dates, weather: bool) -> bool:
+    """Whether a buffer carries over from day to day: a weather file's days that follow each
+    other (a clear sky's days are each repeated to their own periodic state)."""
+    days = np.asarray([date.toordinal() for date in dates])
+    return bool(weather and (np.diff(days) == 1).all())
+
+
+def _by_design(result: StorageResult, designs: int) -> StorageResult:
+    """A result of (designs x days) one-day series as (designs, days) series of days."""
+    return result._replace(
+        **{
+            name: getattr(result, name).reshape(designs, -1, *getattr(result, name).shape[2:])
+            for name in ("powered_h", "served_wh", "missing_wh", "lost_wh", "full", "empty")
+        },
+        passes=np.where(
+            (result.passes.reshape(designs, -1) > 0).all(axis=1),
+            1,
+            -1,
+        ),
+    )
+
+
+def year_lines(storage, table: pd.DataFrame, fold_angle: float, in_sequence: bool) -> list[str]:
+    """What an annual answer says of its buffer, per load (at most 8)."""
+    how = (
+        "the days in sequence from the last one's end state"
+        if in_sequence
+        else "each day repeated to its periodic state"
+    )
+    lines = [f"with the {buffer_text(storage)}, {how}:"]
+    for p_load, rows in list(table.groupby("p_load_w", sort=False))[:8]:
+        by = rows.set_index("design")
+        lines.append(
+            f"  P_load {p_load:g}: mean powered time "
+            + ", ".join(
+                f"{d if d != 'twofold' else f'twofold {fold_angle:g} deg'} "
+                f"{by.loc[d, 'mean_powered_h']:.2f} h (t_solar {by.loc[d, 'mean_t_solar_h']:.2f} h)"
+                for d in ("flat", "twofold", "tracker")
+            )
+            + "; all 24 h on "
+            + ", ".join(f"{d} {by.loc[d, 'days_powered_24h_pct']:.0f} %" for d in YEAR_DESIGNS[:3])
+            + " of days; days full/empty "
+            + ", ".join(
+                f"{d} {by.loc[d, 'days_full_pct']:.0f}/{by.loc[d, 'days_empty_pct']:.0f} %"
+                for d in YEAR_DESIGNS[:3]
+            )
+        )
+    if not table["converged"].all():
+        lines.append(
+            "note: the buffer found no periodic state for some designs: their powered time is "
+            "the last pass's"
+        )
+    return lines

@@ -23,7 +23,14 @@ import pandas as pd
 
 from foldopt.engine import evaluation as engines
 from foldopt.inputs.plan import Plan
-from foldopt.studies.designs import DESIGNS, Blocks, design_metrics, fold_hours, setup_key
+from foldopt.studies.designs import (
+    DESIGNS,
+    Blocks,
+    design_metrics,
+    fold_hours,
+    setup_key,
+    tracker_curves,
+)
 from foldopt.studies.objectives import (
     ENSEMBLE_PERCENTILES,
     best_angle_index,
@@ -35,6 +42,7 @@ from foldopt.studies.objectives import (
 )
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
+from foldopt.studies.storage_answer import YEAR_DESIGNS, year_storage
 from foldopt.names import DEFAULT_ENGINE
 
 
@@ -232,6 +240,9 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         score = objective_value(daily, months, objective.statistic, objective.months)
         fixed = best_angle_index(score)  # (n_loads,)
     metrics, series = [], {"p_twofold_w": [], "switch_state": []}
+    # A buffer is run over the days on the curves each design's row is reduced from.
+    buffered = study.storage is not None and members == 1
+    drawn: dict = {name: [] for name in YEAR_DESIGNS} if buffered else {}
     for part, sky in zip(parts, skies, strict=True):
         chunk = blocks[part]
         # The day x hour maps of the first load's angle, every day at once.
@@ -245,6 +256,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         )
         series["p_twofold_w"].append(powers[study.connection])
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
+        tracker = tracker_curves(sky, study, study.tracker.model) if buffered else None
         metrics.append(
             design_metrics(
                 sky,
@@ -253,8 +265,19 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
                 fold_angles,
                 np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
                 engine,
+                tracker,
+                curves=buffered,
             )
         )
+        if buffered:
+            curves = metrics[-1].pop("curves")
+            for name, power in (
+                ("flat", curves["flat"]),
+                ("twofold", curves[study.connection]),
+                ("tracker", tracker.power),
+                ("tracker-net", tracker.net),
+            ):
+                drawn[name].append(power)
         advance(len(chunk) // members)
     clock = skies[0].grid.clock_hours[0]
     design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (blocks, loads, designs)
@@ -305,6 +328,18 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
             }
         ),
     }
+    if buffered:
+        shapes = [sky.load_shape for sky in skies]
+        extras["storage_annual"] = year_storage(
+            study.storage,
+            {name: np.concatenate(power) for name, power in drawn.items()},
+            loads,
+            None if shapes[0] is None else np.concatenate(shapes),
+            blocks.dates,
+            skies[0].step_hours,
+            study.weather is not None,
+            engine,
+        )
     group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
     if members > 1:
         group = _over_members(group, members)
@@ -504,7 +539,7 @@ def _plain(value):
 
 
 #: The tables of every annual group, one row per load (and design, setting or visit) and group.
-GROUP_TABLES = ("annual_objective", "refold_value", "refold_schedule")
+GROUP_TABLES = ("annual_objective", "refold_value", "refold_schedule", "storage_annual")
 
 
 def refold_tables(
