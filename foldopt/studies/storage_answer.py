@@ -77,36 +77,32 @@ def run_buffer(power, load, buffer: Buffer, step_hours: float, engine: str, soc_
     return simulate(power, load, buffer, step_hours, engine, soc_curves=soc_curves)
 
 
+#: The columns of a design's buffer (summary.csv, the answer), by the names of
+#: :meth:`foldopt.engine.storage.StorageResult.summary` they take.
+SUMMARY_COLUMNS = {
+    "powered_h": "powered_h",
+    "availability_pct": "availability_pct",
+    "days_without_outage_pct": "days_powered_24h_pct",
+    "missing_wh": "energy_missing_wh",
+    "lost_wh": "energy_lost_wh",
+    "days_full_pct": "days_full_pct",
+    "days_empty_pct": "days_empty_pct",
+}
+
+
 def day_columns(result: StorageResult) -> dict:
-    """Per series, the day's (or the mean day's) buffered metrics, by the columns' names.
+    """Per series, the day's (or the mean day's) buffered metrics by the columns' names
+    (:data:`SUMMARY_COLUMNS`): ``powered_h`` [h a day], ``availability_pct`` (the load's energy
+    served, of its demand), ``days_powered_24h_pct`` (days with no energy missing),
+    ``energy_missing_wh`` and ``energy_lost_wh`` [Wh a day], ``days_full_pct`` and
+    ``days_empty_pct`` (PVGIS's), each (n_series,).
 
     Parameters
     ----------
     result : foldopt.engine.storage.StorageResult
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        (n_series,) each: ``powered_h`` [h a day], ``availability_pct`` (the load's energy
-        served, of its demand), ``days_powered_24h_pct`` (days with no energy missing),
-        ``energy_missing_wh`` and ``energy_lost_wh`` [Wh a day], ``days_full_pct`` and
-        ``days_empty_pct`` (PVGIS's).
     """
-    served, missing = result.served_wh, result.missing_wh
-    demand = served + missing
-    with np.errstate(invalid="ignore", divide="ignore"):
-        availability = np.where(
-            demand.sum(axis=1) > 0, served.sum(axis=1) / demand.sum(axis=1), 1.0
-        )
-    return {
-        "powered_h": result.powered_h.mean(axis=1),
-        "availability_pct": 100.0 * availability,
-        "days_powered_24h_pct": 100.0 * (missing <= 1e-12 * demand).mean(axis=1),
-        "energy_missing_wh": missing.mean(axis=1),
-        "energy_lost_wh": result.lost_wh.mean(axis=1),
-        "days_full_pct": 100.0 * result.full.mean(axis=1),
-        "days_empty_pct": 100.0 * result.empty.mean(axis=1),
-    }
+    summary = result.summary()
+    return {column: summary[name] for name, column in SUMMARY_COLUMNS.items()}
 
 
 def reaches(result: StorageResult, target) -> np.ndarray:
@@ -546,15 +542,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
 
 
 #: The columns a buffer adds to a day's designs (summary.csv and the answer's table).
-DESIGN_COLUMNS = (
-    "powered_h",
-    "availability_pct",
-    "days_powered_24h_pct",
-    "energy_missing_wh",
-    "energy_lost_wh",
-    "days_full_pct",
-    "days_empty_pct",
-)
+DESIGN_COLUMNS = tuple(SUMMARY_COLUMNS.values())
 
 
 def unsimulated_notes(study) -> list[dict]:
@@ -663,7 +651,15 @@ def _by_design(result: StorageResult, designs: int) -> StorageResult:
     return result._replace(
         **{
             name: getattr(result, name).reshape(designs, -1, *getattr(result, name).shape[2:])
-            for name in ("powered_h", "served_wh", "missing_wh", "lost_wh", "full", "empty")
+            for name in (
+                "powered_h",
+                "served_wh",
+                "missing_wh",
+                "lost_wh",
+                "full",
+                "empty",
+                "soc_hours",
+            )
         },
         passes=np.where(
             (result.passes.reshape(designs, -1) > 0).all(axis=1),
