@@ -25,19 +25,21 @@ from foldopt.inputs.study_file import default_study_path
 
 runner = CliRunner()
 RECORDED = Path(__file__).parent / "data" / "pvgis" / "tmy_45.000_8.000_2005_2023.json"
+HORIZON = Path(__file__).parent / "data" / "pvgis" / "printhorizon_45.000_8.000.json"
 #: A few days of the year at a 5-degree fold-angle grid: enough to compare the two paths.
 SWEEP = ["sweep", "angle", "--lat", "45", "--lon", "8", "--p-load", "4", "--engine", "numpy",
          "--angle-step", "5", "--step-min", "5", "--format", "json"]
 
-#: The server: PVGIS's route ``<mode>-<tag>/api/v5_3/tmy`` answered as ``mode`` says (``ok`` the
-#: recorded answer, the others a fault), ``/_count`` the requests of each ``<mode>-<tag>``. It ends
+#: The server: PVGIS's routes ``<mode>-<tag>/api/v5_3/tmy`` and ``.../printhorizon`` answered as
+#: ``mode`` says (``ok`` the route's recorded answer, the others a fault), ``/_count`` the
+#: requests of each ``<mode>-<tag>``. It ends
 #: itself after its lifetime whatever happens to the test.
 SERVER = r"""
 import json, os, socket, sys, threading, time
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from urllib.parse import urlsplit
 
-BODY = open(sys.argv[1], "rb").read()
+BODIES = {"tmy": open(sys.argv[1], "rb").read(), "printhorizon": open(sys.argv[3], "rb").read()}
 counts, lock = {}, threading.Lock()
 
 
@@ -52,8 +54,9 @@ class Handler(BaseHTTPRequestHandler):
         with lock:
             counts[parts[0]] = n = counts.get(parts[0], 0) + 1
         mode = parts[0].split("-")[0]
-        if parts[1:] != ["api", "v5_3", "tmy"]:
+        if parts[1:3] != ["api", "v5_3"] or len(parts) != 4 or parts[3] not in BODIES:
             return self.send(404, b"")
+        BODY = BODIES[parts[3]]
         if mode == "ok" or (mode == "rate" and n > 1) or (mode == "flaky" and n != 2):
             return self.send(200, BODY)
         if mode == "rate":
@@ -104,7 +107,7 @@ server.serve_forever()
 @pytest.fixture(scope="module")
 def server(request):
     """The server's port, the server started on a free port and stopped by its pid."""
-    process = subprocess.Popen([sys.executable, "-c", SERVER, str(RECORDED), "120"],
+    process = subprocess.Popen([sys.executable, "-c", SERVER, str(RECORDED), "120", str(HORIZON)],
                                stdout=subprocess.PIPE, text=True)
     request.addfinalizer(lambda: (os.kill(process.pid, signal.SIGTERM), process.wait(timeout=10)))
     port = process.stdout.readline().strip()
@@ -368,4 +371,86 @@ def test_a_maps_weather_options_are_checked_before_anything_is_fetched(pvgis, se
     ]:
         result = runner.invoke(app, ["map", "--sites", "sites.csv", *options, "--out", "map"])
         assert (result.exit_code, result.stderr.strip().splitlines()) == (2, [line]), options
+    assert requests_made(server, route) == 0 and cache_files(tmp_path) == {}
+
+
+# --horizon pvgis: the site's horizon from PVGIS's printhorizon, recorded for 45 N, 8 E
+# (tests/data/pvgis/README.md), read as the horizon file it is.
+HORIZON_DAY = [*SWEEP, "--days", "2025-01-15"]  # a low winter sun, under the hills to the south
+
+
+def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    fetched = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "fetched"])
+    assert fetched.exit_code == 0, fetched.output
+    read = runner.invoke(app, [*HORIZON_DAY, "--horizon", str(HORIZON), "--out", "read"])
+    assert read.exit_code == 0, read.output
+    flat = runner.invoke(app, [*HORIZON_DAY, "--out", "flat"])
+    assert flat.exit_code == 0, flat.output
+    fetched, read, flat = (json.loads(r.stdout) for r in (fetched, read, flat))
+    assert fetched["rows"] == read["rows"]  # every angle's t_solar, to the bit
+    assert fetched["answer"]["result"] == read["answer"]["result"]
+    assert fetched["rows"] != flat["rows"]  # the horizon (up to 12.6 deg to the south) counts
+    assert requests_made(server, route) == 1
+    answer, = (p for p in (tmp_path / "cache" / "weather").iterdir() if "provenance" not in p.name)
+    assert answer.name.startswith("pvgis-horizon_v5_3_45.000_8.000_")
+    assert answer.read_bytes() == HORIZON.read_bytes()
+    provenance = json.loads(answer.with_name(answer.stem + ".provenance.json").read_text())
+    assert provenance["url"].endswith("/api/v5_3/printhorizon?lat=45.0&lon=8.0&outputformat=json")
+    assert provenance["sha256"] == hashlib.sha256(HORIZON.read_bytes()).hexdigest()
+    # a second run asks nothing; offline, a service that would fail is never asked
+    again = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "again"])
+    assert again.exit_code == 0 and json.loads(again.stdout)["rows"] == read["rows"]
+    assert requests_made(server, route) == 1
+    dead = pvgis("e500")
+    offline = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--offline", "--out", "off"])
+    assert offline.exit_code == 0, offline.output
+    assert json.loads(offline.stdout)["rows"] == read["rows"]
+    assert requests_made(server, dead) == 0
+
+
+def test_a_study_files_horizon_names_pvgis(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    embedded = {k: v for k, v in yaml.safe_load(default_study_path().read_text()).items() if k != "sky"}
+    study = {**embedded, "mode": "exact", "date": "2025-06-21", "p_load": 4, "step_min": 10,
+             "site": {"latitude": 45.0, "longitude": 8.0, "horizon": "pvgis"},
+             "fold_angles": {"start": 30, "stop": 180, "step": 30}}
+    (tmp_path / "site.yaml").write_text(yaml.safe_dump(study))
+    result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet", "--engine", "numpy"])
+    assert result.exit_code == 0, result.output
+    assert requests_made(server, route) == 1
+    horizon = json.loads((tmp_path / "out" / "run.json").read_text())["study"]["site"]["horizon"]
+    assert Path(horizon["file"]).read_bytes() == HORIZON.read_bytes()
+
+
+HORIZON_FAULTS = [
+    ("e500", "PVGIS answered 500 Internal Server Error; try again later"),
+    ("half", "PVGIS's answer is not a readable PVGIS horizon profile (not valid JSON: "),
+]
+
+
+@pytest.mark.parametrize(("mode", "said"), HORIZON_FAULTS, ids=[f[0] for f in HORIZON_FAULTS])
+def test_a_horizon_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path,
+                                                                    mode, said):
+    pvgis("ok")
+    kept = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
+    assert kept.exit_code == 0, kept.output
+    before = cache_files(tmp_path)
+    route = pvgis(mode)
+    result = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "x"])
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: horizon pvgis: ") and said in lines[0]
+    assert cache_files(tmp_path) == before and not (tmp_path / "x").exists()
+    assert requests_made(server, route) == 1
+
+
+def test_offline_without_a_cached_horizon_is_one_line(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    result = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--offline", "--out", "x"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        "error: horizon pvgis: no cached copy for (45, 8) with these options, and offline "
+        "(--offline, FOLDOPT_OFFLINE=1) nothing is fetched; fetch it first where there is a "
+        "network: run once with --horizon pvgis --lat 45 --lon 8"]
     assert requests_made(server, route) == 0 and cache_files(tmp_path) == {}

@@ -23,7 +23,11 @@ from foldopt.errors import ConfigError
 from foldopt.inputs.fields import list_depth, list_valued_fields
 from foldopt.inputs.study_file import read_study, resolve_files
 from foldopt.inputs.reading import MAX_AXIS_VALUES, size_limit
-from foldopt.inputs.weather_files import weather_defaults, with_fetched_weather
+from foldopt.inputs.weather_files import (
+    weather_defaults,
+    with_fetched_horizon,
+    with_fetched_weather,
+)
 from foldopt.inputs.policy import set_path
 from foldopt.inputs.study import Study, format_error
 
@@ -397,8 +401,9 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     lines = lines or {}
     if not isinstance(data, dict):
         raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
-    # A weather source is fetched (or taken from the cache) once, here: then it is a file.
-    data = dict(with_fetched_weather(data))
+    # A weather or horizon source is fetched (or taken from the cache) once, here: then it is a
+    # file.
+    data = dict(with_fetched_horizon(with_fetched_weather(data)))
     if data.get("weather") is not None and ("date" not in data or "step_min" not in data):
         # An hourly file is a year; a measured file its own days at its own step.
         data = {**weather_defaults(data), **data}

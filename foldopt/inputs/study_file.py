@@ -23,7 +23,7 @@ from foldopt.inputs.horizon import read_horizon
 from foldopt.inputs.load_profile import profile_steps
 from foldopt.inputs.reading import MAX_CSV_BYTES, MAX_STUDY_BYTES, read_input
 from foldopt.inputs.study import Study, make_study
-from foldopt.inputs.weather_files import weather_read, with_fetched_weather
+from foldopt.inputs.weather_files import weather_read, with_fetched_horizon, with_fetched_weather
 
 DEFAULT_STUDY = "shin2015"
 
@@ -409,5 +409,5 @@ def with_files(study: Study) -> Study:
         and (horizon is None or horizon.read)
     ):
         return study
-    data = with_fetched_weather(study.data())
+    data = with_fetched_horizon(with_fetched_weather(study.data()))
     return make_study(data, resolve_files(data))

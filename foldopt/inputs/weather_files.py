@@ -263,6 +263,62 @@ def with_fetched_weather(data):
     return {**data, "weather": {**fetched, "format": SOURCES[spec.source].format}}
 
 
+def with_fetched_horizon(data):
+    """A study's data whose ``site.horizon`` names a horizon source
+    (:data:`foldopt.inputs.weather.sources.HORIZON_SOURCES`: ``pvgis``) instead of a file, with
+    the source's answer for the study's site as its file (fetched where it is not cached,
+    :func:`foldopt.inputs.weather.sources.fetch_horizon`): from there on a horizon file like any.
+
+    Parameters
+    ----------
+    data : dict
+        A study's fields; a ``weather`` section's ``url`` and ``timeout_s`` are the horizon's too.
+
+    Returns
+    -------
+    dict
+        ``data`` itself where its horizon names no source.
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        For a site that varies or is not given (a horizon is fetched for one site).
+    foldopt.errors.WeatherError
+        For an answer that cannot be had.
+    """
+    from foldopt.inputs.weather.sources import HORIZON_SOURCES, fetch_horizon
+
+    site = data.get("site") if isinstance(data, dict) else None
+    horizon = site.get("horizon") if isinstance(site, dict) else None
+    name = horizon.get("file") if isinstance(horizon, dict) else horizon
+    if not isinstance(name, str) or name not in HORIZON_SOURCES:
+        return data
+    varied = _varied_site(site)
+    if varied is not None:
+        raise ConfigError(
+            [f"{varied}: varies, but site.horizon {name} is fetched for one site; give one site"]
+        )
+    if not all(
+        isinstance(site.get(key), (int, float)) and not isinstance(site.get(key), bool)
+        for key in ("latitude", "longitude")
+    ):
+        raise ConfigError(
+            [
+                f"site.horizon {name}: fetches the horizon of the study's site; give its latitude "
+                "and longitude (--lat, --lon; site.latitude, site.longitude)"
+            ]
+        )
+    weather = data.get("weather")
+    options = {
+        key: weather[key]
+        for key in ("url", "timeout_s")
+        if isinstance(weather, dict) and weather.get(key) is not None
+    }
+    answer = fetch_horizon(name, site["latitude"], site["longitude"], options)
+    fetched = {**horizon, "file": answer.file} if isinstance(horizon, dict) else answer.file
+    return {**data, "site": {**site, "horizon": fetched}}
+
+
 def with_fetched_sites(sites: list[dict], weather) -> list[dict]:
     """A map's sites, each with its weather from a source: ``weather`` the cached answer for the
     site (:func:`foldopt.inputs.weather.sources.fetch`), fetched one site after the other, each

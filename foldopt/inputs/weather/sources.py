@@ -10,6 +10,11 @@ fetchers return the parsed frame, not the answer, so the request is made here wi
 (pvlib's own dependency): the cached bytes are the service's, their SHA-256 names them, and the
 faults a fetcher leaves to a traceback (a rate limit, a cut answer, no network) are each one line.
 
+A horizon source (:data:`HORIZON_SOURCES`: ``--horizon pvgis``, PVGIS's ``printhorizon`` with
+``pvlib.iotools.get_pvgis_horizon``'s query) is fetched, checked and cached the same way
+(:func:`fetch_horizon`) and its answer read as the horizon file it is
+(:func:`foldopt.inputs.horizon.read_horizon`).
+
 Each answer is stored once under a key of the source, the service's version (from its base
 address, ``v5_3``), the site as the service rounds it and the request's options
 (:func:`cache_path`), written atomically beside its provenance (:class:`WeatherProvenance`:
@@ -75,7 +80,8 @@ class WeatherSource:
     route : str
         The route after the base address (``tmy``).
     format : str
-        The weather format its answer is read as (:data:`foldopt.inputs.weather.FORMATS`).
+        The weather format its answer is read as (:data:`foldopt.inputs.weather.FORMATS`), or
+        ``horizon`` for a horizon profile (:func:`foldopt.inputs.horizon.read_horizon`).
     decimals : int
         Decimals of latitude and longitude the service keeps: the site is rounded to them before
         it is asked for, so that sites the service does not tell apart share one answer.
@@ -106,6 +112,11 @@ def _pvgis_tmy_params(latitude: float, longitude: float, weather) -> dict:
     return params
 
 
+def _pvgis_horizon_params(latitude: float, longitude: float, weather) -> dict:
+    """``pvlib.iotools.get_pvgis_horizon``'s query: the site, JSON."""
+    return {"lat": latitude, "lon": longitude, "outputformat": "json"}
+
+
 #: The weather sources by name, in the order of :data:`foldopt.names.WEATHER_SOURCES`: a new
 #: source is its entry here (and its name and description there).
 SOURCES = {
@@ -125,6 +136,21 @@ SOURCES = {
             params=_pvgis_tmy_params,
         ),
     )
+}
+
+#: The horizon sources by the name ``--horizon`` / ``site.horizon`` gives them: the site's horizon
+#: profile, read as the horizon file it is (:func:`foldopt.inputs.horizon.read_horizon`).
+HORIZON_SOURCES = {
+    "pvgis": WeatherSource(
+        name="pvgis-horizon",
+        service="PVGIS",
+        url="https://re.jrc.ec.europa.eu/api/v5_3/",
+        url_variable="FOLDOPT_PVGIS_URL",
+        route="printhorizon",
+        format="horizon",
+        decimals=3,
+        params=_pvgis_horizon_params,
+    ),
 }
 
 
@@ -208,8 +234,7 @@ class _Request:
         return service_version(self.base)
 
 
-def _request(source_name: str, latitude: float, longitude: float, weather) -> _Request:
-    source = SOURCES[source_name]
+def _request(source: WeatherSource, latitude: float, longitude: float, weather) -> _Request:
     site = (round(float(latitude), source.decimals), round(float(longitude), source.decimals))
     timeout_s = float(_option(weather, "timeout_s", DEFAULT_TIMEOUT_S))
     return _Request(
@@ -295,19 +320,55 @@ def fetch(source: str, latitude: float, longitude: float, weather=None) -> Weath
         (its own message), a rate limit beyond :data:`MAX_RETRY_WAIT_S`, a cut or malformed
         answer, a cache folder that cannot be written. Nothing is cached then.
     """
+    return _fetch(SOURCES[source], latitude, longitude, weather, f"weather {source}")
+
+
+def fetch_horizon(
+    source: str, latitude: float, longitude: float, options=None
+) -> WeatherProvenance:
+    """A horizon source's answer for a site (:data:`HORIZON_SOURCES`), from the cache or else
+    from the service (then cached), as :func:`fetch` has a weather source's.
+
+    Parameters
+    ----------
+    source : str
+        One of :data:`HORIZON_SOURCES` (``pvgis``).
+    latitude, longitude : float
+        The site [deg], rounded as the service rounds it.
+    options : dict, optional
+        ``url``, ``timeout_s``.
+
+    Returns
+    -------
+    WeatherProvenance
+        Its ``file`` a horizon file (:func:`foldopt.inputs.horizon.read_horizon`).
+
+    Raises
+    ------
+    foldopt.errors.WeatherError
+        As :func:`fetch`: one line, ``horizon pvgis: ...``, nothing cached.
+    """
+    return _fetch(HORIZON_SOURCES[source], latitude, longitude, options, f"horizon {source}")
+
+
+def _fetch(source: WeatherSource, latitude, longitude, weather, label: str) -> WeatherProvenance:
     request = _request(source, latitude, longitude, weather)
     path = cache_path(request)
     found = cached(path)
     if found is not None:
         return found
-    label = f"weather {source}"
     if offline():
         params = request.params
+        site = f"--lat {params['lat']:g} --lon {params['lon']:g}"
+        how = (
+            f"foldopt weather fetch {source.name} {site}"
+            if source.name in SOURCES
+            else f"run once with --{label} {site}"
+        )
         raise WeatherError(
             f"{label}: no cached copy for ({params['lat']:g}, {params['lon']:g}) with these "
             "options, and offline (--offline, FOLDOPT_OFFLINE=1) nothing is fetched; fetch it "
-            f"first where there is a network: foldopt weather fetch {source} --lat "
-            f"{params['lat']:g} --lon {params['lon']:g}"
+            f"first where there is a network: {how}"
         )
     payload = _download(request, label)
     retrieved = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
@@ -467,14 +528,17 @@ def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> Wea
 
     def check(temporary: Path) -> None:
         temporary.write_bytes(payload)
-        try:
-            files.check_answer(temporary, source.format)
-        except WeatherError as error:
-            reason = error.errors[0].split(": ", 1)[-1]
+        reason = _unreadable(temporary, source.format)
+        if reason is not None:
+            what = (
+                "PVGIS horizon profile"
+                if source.format == "horizon"
+                else files.FORMATS[source.format].label
+            )
             raise WeatherError(
-                f"{label}: {source.service}'s answer is not a readable {files.FORMATS[source.format].label} "
-                f"({reason}); nothing was cached"
-            ) from None
+                f"{label}: {source.service}'s answer is not a readable {what} ({reason}); "
+                "nothing was cached"
+            )
 
     try:
         write_atomically(path, check)
@@ -493,3 +557,32 @@ def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> Wea
             "names another cache folder"
         ) from None
     return provenance
+
+
+def _unreadable(path: Path, fmt: str) -> str | None:
+    """Why an answer is not a readable file of its format (every check a file of it gets), or
+    None."""
+    if fmt != "horizon":
+        from foldopt.inputs import weather as files
+
+        try:
+            files.check_answer(path, fmt)
+        except WeatherError as error:
+            return error.errors[0].split(": ", 1)[-1]
+        return None
+    from foldopt.errors import ConfigError
+    from foldopt.inputs.horizon import ACCEPTS, FIELD, read_horizon
+
+    try:
+        read_horizon(path)
+    except ConfigError as error:
+        reason = error.errors[0].removeprefix(f"{FIELD}: ").removesuffix(f"; {ACCEPTS}")
+        for joint in (
+            " is ",
+            ": ",
+            ", ",
+            " ",
+        ):  # the temporary file's name says nothing to the user
+            reason = reason.replace(f"{path}{joint}", "")
+        return reason
+    return None
