@@ -238,7 +238,7 @@ def sweep_options(
         typer.Option(
             "--horizon",
             help="The site's horizon: a PVGIS horizon file (JSON "
-            "or CSV) or a CSV azimuth,elevation [deg].",
+            "or CSV), a CSV azimuth,elevation [deg], or pvgis (fetched from PVGIS for --lat/--lon).",
         ),
     ] = None,
     blocking_diode: Annotated[
