@@ -398,6 +398,9 @@ def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_
     provenance = json.loads(answer.with_name(answer.stem + ".provenance.json").read_text())
     assert provenance["url"].endswith("/api/v5_3/printhorizon?lat=45.0&lon=8.0&outputformat=json")
     assert provenance["sha256"] == hashlib.sha256(HORIZON.read_bytes()).hexdigest()
+    meta = json.loads((tmp_path / "fetched" / "run.json").read_text())
+    assert meta["horizon_source"]["sha256"] == provenance["sha256"]
+    assert "horizon_source" not in json.loads((tmp_path / "read" / "run.json").read_text())
     # a second run asks nothing; offline, a service that would fail is never asked
     again = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "again"])
     assert again.exit_code == 0 and json.loads(again.stdout)["rows"] == read["rows"]
@@ -419,8 +422,11 @@ def test_a_study_files_horizon_names_pvgis(pvgis, server, tmp_path):
     result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet", "--engine", "numpy"])
     assert result.exit_code == 0, result.output
     assert requests_made(server, route) == 1
-    horizon = json.loads((tmp_path / "out" / "run.json").read_text())["study"]["site"]["horizon"]
-    assert Path(horizon["file"]).read_bytes() == HORIZON.read_bytes()
+    meta = json.loads((tmp_path / "out" / "run.json").read_text())
+    assert Path(meta["study"]["site"]["horizon"]["file"]).read_bytes() == HORIZON.read_bytes()
+    source = meta["horizon_source"]  # which data made it: the request and the answer's hash
+    assert source["source"] == "pvgis-horizon" and source["service_version"] == "v5_3"
+    assert source["sha256"] == hashlib.sha256(HORIZON.read_bytes()).hexdigest()
 
 
 HORIZON_FAULTS = [

@@ -29,15 +29,18 @@ def run_metadata(study: Study, command: list[str] | None = None, **extra) -> dic
     -------
     dict
         ``study`` (the study as JSON), ``mode``, ``command``, ``versions``, for weather fetched
-        from a source ``weather_source`` (:func:`weather_source`), and ``extra``.
+        from a source ``weather_source`` (:func:`weather_source`), for a horizon fetched from one
+        ``horizon_source`` (:func:`horizon_source`), and ``extra``.
     """
     fetched = weather_source(study)
+    horizon = horizon_source(study)
     return {
         "study": study.model_dump(mode="json"),
         "mode": study.mode,
         "command": command if command is not None else sys.argv,
         "versions": versions(),
         **({"weather_source": fetched} if fetched is not None else {}),
+        **({"horizon_source": horizon} if horizon is not None else {}),
         **extra,
     }
 
@@ -62,6 +65,28 @@ def weather_source(study: Study) -> dict | None:
 
     found = cached(weather.path)
     return found.to_dict() if found is not None else None
+
+
+def horizon_source(study: Study) -> dict | None:
+    """Where a study's fetched horizon came from (``--horizon pvgis``), as :func:`weather_source`
+    says of its weather; None for a horizon given as points or as the user's file.
+
+    Parameters
+    ----------
+    study : foldopt.Study
+
+    Returns
+    -------
+    dict or None
+    """
+    horizon = study.site.horizon if study.site is not None else None
+    if horizon is None or horizon.file is None:
+        return None
+    from foldopt.inputs.weather.sources import HORIZON_SOURCES, cached
+
+    found = cached(horizon.file)
+    fetched = {source.name for source in HORIZON_SOURCES.values()}
+    return found.to_dict() if found is not None and found.source in fetched else None
 
 
 def input_hash(data) -> str:
