@@ -43,8 +43,7 @@ Engine = Annotated[
     str,
     typer.Option(
         "--engine",
-        help=" | ".join(f"{name} ({names.ENGINES.describe(name)})" for name in names.ENGINES)
-        + ".",
+        help=" | ".join(f"{name} ({names.ENGINES.describe(name)})" for name in names.ENGINES) + ".",
     ),
 ]
 Table = Annotated[

@@ -62,7 +62,17 @@ def _matplotlib_folder() -> None:
 # Every figure module imports matplotlib, and Python runs this package's __init__ before any of
 # them: the folder is set before matplotlib's first import.
 _matplotlib_folder()
-from foldopt.output.figures import annual, day, horizon, landscape, sizing, storage, sweep, weather, world  # noqa: E402
+from foldopt.output.figures import (  # noqa: E402
+    annual,
+    day,
+    horizon,
+    landscape,
+    sizing,
+    storage,
+    sweep,
+    weather,
+    world,
+)
 from foldopt.output.figures.canvas import for_files, save_plot  # noqa: E402
 
 #: Every figure file a results folder can hold -> :class:`~foldopt.output.figures.canvas.FigureFile`
