@@ -81,9 +81,7 @@ def test_a_study_without_storage_is_the_study_it_was(storage_less):
     assert "powered_h" not in storage_less.sweep
     assert "storage" not in storage_less.answer.result
     pd.testing.assert_frame_equal(buffered.summary[plain_summary.columns], plain_summary)
-    pd.testing.assert_frame_equal(
-        buffered.sweep[storage_less.sweep.columns], storage_less.sweep
-    )
+    pd.testing.assert_frame_equal(buffered.sweep[storage_less.sweep.columns], storage_less.sweep)
     lines = storage_less.answer.lines()
     assert buffered.answer.lines()[: len(lines)] == lines
     assert {k: v for k, v in buffered.answer.result.items() if k != "storage"} == (
@@ -169,7 +167,9 @@ def test_the_command_line_s_json_is_the_api_s_answer_to_the_bit(tmp_path, monkey
     assert result.exit_code == 0, result.output
     printed = json.loads(result.output)["answer"]
     api = foldopt.run(tmp_path / "study.yaml")
-    assert printed["result"]["storage"] == json.loads(json.dumps(plain(api.answer.result["storage"])))
+    assert printed["result"]["storage"] == json.loads(
+        json.dumps(plain(api.answer.result["storage"]))
+    )
     assert printed["lines"] == api.answer.lines()
     assert any(line.startswith("for 24 h: flat needs") for line in printed["lines"])
     # The folder's tables are the answer's numbers.
@@ -218,7 +218,10 @@ def test_a_sweep_of_days_says_its_buffer_is_not_simulated(tmp_path, monkeypatch)
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     notes = [note["note"] for note in json.loads(result.output)["answer"]["notes"]]
-    assert any(note.startswith("storage: the buffer is simulated in a day's study and over") for note in notes)
+    assert any(
+        note.startswith("storage: the buffer is simulated in a day's study and over")
+        for note in notes
+    )
 
 
 def test_a_load_profile_sizes_its_buffer():
@@ -263,7 +266,7 @@ def test_a_year_of_clear_days_is_each_day_s_buffer():
     study = make_study({**EMBEDDED, **QUICK, "p_load": CARRIED, "storage": storage})
     year = foldopt.sweep(study, "day", date=dates, objective="mean")
     table = year.extras["storage_annual"].set_index("design")
-    assert set(table.index) == {"flat", "twofold", "tracker", "tracker-net"}
+    assert set(table.index) == {"flat", "twofold", "twofold-buffer", "tracker", "tracker-net"}
     days = [foldopt.run(year.plan.study({"date": d, "p_load": CARRIED})) for d in dates]
     for design in ("flat", "tracker"):
         each = [day.summary.set_index("design").loc[design, "powered_h"] for day in days]
@@ -287,3 +290,30 @@ def test_a_weather_file_s_days_carry_the_buffer_over_only_where_they_follow():
     assert sequential(days, weather=True)
     assert not sequential(days, weather=False)  # clear-sky days are each their own
     assert not sequential(days[::2], weather=True)  # a gap: each day repeated
+
+
+def test_a_year_s_fold_angle_for_the_buffer_is_the_brute_force_best():
+    # Each clear-sky day is its own periodic day: the day's study simulates its buffer at every
+    # angle of the grid; the mean over the days per angle, and its argmax, is the year's choice.
+    storage = {"capacity_wh": 40, "preset": "supercapacitor"}
+    dates = ["2014-03-21", "2014-06-21", "2014-12-21"]
+    study = make_study({**EMBEDDED, **QUICK, "p_load": 3.0, "storage": storage})
+    year = foldopt.sweep(study, "day", date=dates, objective="mean")
+    table = year.extras["storage_annual"].set_index("design")
+    days = [foldopt.run(year.plan.study({"date": d, "p_load": 3.0})) for d in dates]
+    grid = np.asarray(study.fold_angles.grid())
+    mean = np.mean([day.storage.powered_by_angle for day in days], axis=0)
+    best = grid.size - 1 - np.argmax(mean[::-1])  # ties to the least folded
+    chosen = table.loc["twofold-buffer"]
+    assert chosen["fold_angle_deg"] == grid[best]
+    assert chosen["objective_powered_h"] == pytest.approx(mean[best], rel=1e-9)
+    # Here the buffer's choice is not t_solar's, and it runs the load longer.
+    assert table.loc["twofold", "fold_angle_deg"] != grid[best]
+    assert chosen["objective_powered_h"] > table.loc["twofold", "objective_powered_h"]
+    assert chosen["near_optimal_lo_deg"] <= grid[best] <= chosen["near_optimal_hi_deg"]
+    said = year.answer.to_dict()["result"]["storage"]
+    assert said["fold_angle_buffer_deg"] == grid[best]
+    assert any(
+        line.startswith(f"  best fold angle for the buffer (mean powered time): {grid[best]:g} deg")
+        for line in year.answer.lines()
+    )

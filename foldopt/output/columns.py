@@ -229,6 +229,11 @@ COLUMNS = (
     ("mean_powered_h", "h", "mean daily powered time with the buffer (storage_annual.csv)"),
     ("min_powered_h", "h", "the least daily powered time with the buffer (storage_annual.csv)"),
     (
+        "objective_powered_h",
+        "h",
+        "the objective's statistic of daily powered time with the buffer (storage_annual.csv)",
+    ),
+    (
         "converged",
         "",
         "whether every series of the buffer found its periodic state (storage_annual.csv)",

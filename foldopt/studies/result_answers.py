@@ -536,11 +536,14 @@ def _of_annual(result) -> Answer:
     if buffered is not None:
         # The buffer over the days, said once here for every view (studies.storage_answer).
         in_sequence = sequential(_dates(plan), study.weather is not None)
-        lines += year_lines(study.storage, buffered, result.extras["fold_angle"], in_sequence)
+        lines += year_lines(study.storage, buffered, in_sequence)
+        chosen = buffered.loc[buffered["design"] == "twofold-buffer", "fold_angle_deg"]
         part["storage"] = {
             "buffer": buffer_text(study.storage),
             "days_in_sequence": in_sequence,
             "fold_angle_twofold_deg": result.extras["fold_angle"],
+            # The first case's and load's (each case's and load's: per_case).
+            "fold_angle_buffer_deg": float(chosen.iloc[0]),
             "per_case": records(buffered),
         }
     designs = objectives[

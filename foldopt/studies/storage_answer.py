@@ -28,7 +28,7 @@ import pandas as pd
 
 from foldopt.engine.choice import engine_for
 from foldopt.engine.storage import Buffer, StorageResult, simulate
-from foldopt.studies.objectives import best_angle_index, near_optimal
+from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
 
 #: The designs whose state of charge the day's figure draws and ``timeseries.csv`` holds.
 SOC_DESIGNS = ("flat", "twofold", "tracker")
@@ -566,12 +566,66 @@ def unsimulated_notes(study) -> list[dict]:
     ]
 
 
-#: The designs a year's buffer is simulated for (the twofold panel at the angle kept all year).
-YEAR_DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
+#: The designs a year's buffer is simulated for: the twofold panel at the angle ``t_solar``'s
+#: objective keeps all year, and at the one the objective of powered time keeps
+#: (``twofold-buffer``, :func:`powered_by_angle`).
+YEAR_DESIGNS = ("flat", "twofold", "twofold-buffer", "tracker", "tracker-net")
+#: The designs a year's answer names one by one.
+YEAR_SAID = ("flat", "twofold", "twofold-buffer", "tracker")
+
+
+def _year_series(power, load, in_sequence: bool):
+    """Series of (rows, days, steps) curves and their load as :func:`simulate` takes them: the
+    days in sequence, or each day its own periodic series."""
+    if in_sequence:
+        return power, load
+    series = power.reshape(-1, 1, power.shape[-1])
+    return series, load if np.ndim(load) == 0 else load.reshape(series.shape)
+
+
+def powered_by_angle(storage, chunks, loads, load_shape, dates, step_hours, weather, engine):
+    """Daily powered time of the twofold panel at every fold angle of a grid over an annual group's
+    days, a chunk of angles at a time (their curves are the memory).
+
+    Parameters
+    ----------
+    storage : foldopt.inputs.storage_section.Storage
+    chunks : iterable of numpy.ndarray
+        The power [W] of consecutive angles of the grid, (k, n_days, n_steps) each.
+    loads, load_shape, dates, step_hours, weather, engine
+        As :func:`year_storage`'s.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_days, n_loads, n_angles) [h]; a series with no periodic state counts its last pass.
+    """
+    engine = storage_engine(engine)
+    in_sequence = sequential(dates, weather)
+    buffer = buffer_of(storage)
+    hours = []
+    for power in chunks:
+        per_load = []
+        for p_load in np.asarray(loads, dtype=float):
+            load = (
+                p_load if load_shape is None else p_load * np.broadcast_to(load_shape, power.shape)
+            )
+            result = simulate(*_year_series(power, load, in_sequence), buffer, step_hours, engine)
+            per_load.append(result.powered_h.reshape(power.shape[:2]))
+        hours.append(np.stack(per_load))  # (loads, k, days)
+    return np.concatenate(hours, axis=1).transpose(2, 0, 1)
 
 
 def year_storage(
-    storage, curves: dict, loads, load_shape, dates, step_hours, weather: bool, engine
+    storage,
+    curves: dict,
+    loads,
+    load_shape,
+    dates,
+    step_hours,
+    weather: bool,
+    engine,
+    choice: dict,
 ) -> pd.DataFrame:
     """A buffer over an annual group's days, per load and design.
 
@@ -593,30 +647,38 @@ def year_storage(
         day to day, starting from the state at the last one's end (:func:`sequential`); else
         each day is a clear-sky day repeated to its own periodic state.
     engine : str
+    choice : dict
+        ``site`` (the group's), ``objective`` (:class:`foldopt.inputs.sections.Objective`),
+        ``fold_angle_deg``: design -> (n_loads,) [deg] (NaN for a tracker), and ``near``:
+        :func:`foldopt.studies.objectives.near_optimal` of the objective of powered time over the
+        grid, (n_loads,) each, the ``twofold-buffer`` row's.
 
     Returns
     -------
     pandas.DataFrame
-        Per load and design: ``p_load_w``, ``design``, ``days``, ``mean_powered_h``,
+        Per load and design: ``site_name``, ``latitude``, ``longitude``, ``p_load_w``,
+        ``design``, ``fold_angle_deg``, ``days``, ``objective`` (the statistic),
+        ``objective_powered_h`` (of the daily powered time), ``mean_powered_h``,
         ``min_powered_h``, ``mean_t_solar_h`` (of the same curves, with no buffer: the 0 Wh
         run) and :func:`day_columns`' ``availability_pct``, ``days_powered_24h_pct``,
         ``energy_missing_wh``, ``energy_lost_wh`` (a day, the days' mean), ``days_full_pct``,
-        ``days_empty_pct``; ``converged`` where every series found its periodic state.
+        ``days_empty_pct``; ``converged`` where every series found its periodic state; the
+        near-optimal range of ``twofold-buffer`` (NaN in the other rows).
     """
     engine = storage_engine(engine)
     loads = np.asarray(loads, dtype=float)
     in_sequence = sequential(dates, weather)
+    objective, site = choice["objective"], choice["site"]
+    months = [date.month for date in dates]
     rows = []
     for index, p_load in enumerate(loads):
         power = np.stack(
             [curves[d] if curves[d].ndim == 2 else curves[d][:, index] for d in YEAR_DESIGNS]
         )  # (designs, days, steps)
         load = p_load if load_shape is None else p_load * np.broadcast_to(load_shape, power.shape)
-        if not in_sequence:
-            power = power.reshape(-1, 1, power.shape[-1])
-            load = load if load_shape is None else load.reshape(power.shape)
-        result = simulate(power, load, buffer_of(storage), step_hours, engine)
-        bare = simulate(power, load, buffer_of(storage, capacity_wh=0.0), step_hours, engine)
+        series, load = _year_series(power, load, in_sequence)
+        result = simulate(series, load, buffer_of(storage), step_hours, engine)
+        bare = simulate(series, load, buffer_of(storage, capacity_wh=0.0), step_hours, engine)
         shape = (len(YEAR_DESIGNS), -1)
         if not in_sequence:
             result = _by_design(result, len(YEAR_DESIGNS))
@@ -625,14 +687,28 @@ def year_storage(
         rows.append(
             pd.DataFrame(
                 {
+                    "site_name": site.name or "",
+                    "latitude": site.latitude,
+                    "longitude": site.longitude,
                     "p_load_w": p_load,
                     "design": YEAR_DESIGNS,
+                    "fold_angle_deg": [choice["fold_angle_deg"][d][index] for d in YEAR_DESIGNS],
                     "days": powered.shape[1],
+                    "objective": objective.statistic,
+                    "objective_powered_h": objective_value(
+                        powered.T, months, objective.statistic, objective.months
+                    ),
                     "mean_powered_h": powered.mean(axis=1),
                     "min_powered_h": powered.min(axis=1),
                     "mean_t_solar_h": bare.powered_h.reshape(shape).mean(axis=1),
                     **{k: v for k, v in day_columns(result).items() if k != "powered_h"},
                     "converged": result.converged.reshape(shape[0], -1).all(axis=1),
+                    **{
+                        key: np.where(
+                            np.asarray(YEAR_DESIGNS) == "twofold-buffer", value[index], np.nan
+                        )
+                        for key, value in choice["near"].items()
+                    },
                 }
             )
         )
@@ -669,8 +745,9 @@ def _by_design(result: StorageResult, designs: int) -> StorageResult:
     )
 
 
-def year_lines(storage, table: pd.DataFrame, fold_angle: float, in_sequence: bool) -> list[str]:
-    """What an annual answer says of its buffer, per load (at most 8)."""
+def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
+    """What an annual answer says of its buffer, per load (at most 8): powered time per design,
+    and the fold angle the objective of powered time keeps beside the one ``t_solar``'s keeps."""
     how = (
         "the days in sequence from the last one's end state"
         if in_sequence
@@ -679,20 +756,38 @@ def year_lines(storage, table: pd.DataFrame, fold_angle: float, in_sequence: boo
     lines = [f"with the {buffer_text(storage)}, {how}:"]
     for p_load, rows in list(table.groupby("p_load_w", sort=False))[:8]:
         by = rows.set_index("design")
+        angle = by["fold_angle_deg"]
+        named = {
+            "flat": "flat",
+            "twofold": f"twofold {angle['twofold']:g} deg",
+            "twofold-buffer": f"twofold {angle['twofold-buffer']:g} deg",
+            "tracker": "tracker",
+        }
         lines.append(
             f"  P_load {p_load:g}: mean powered time "
             + ", ".join(
-                f"{d if d != 'twofold' else f'twofold {fold_angle:g} deg'} "
-                f"{by.loc[d, 'mean_powered_h']:.2f} h (t_solar {by.loc[d, 'mean_t_solar_h']:.2f} h)"
-                for d in ("flat", "twofold", "tracker")
+                f"{named[d]} {by.loc[d, 'mean_powered_h']:.2f} h "
+                f"(t_solar {by.loc[d, 'mean_t_solar_h']:.2f} h)"
+                for d in YEAR_SAID
+                if d != "twofold-buffer" or angle[d] != angle["twofold"]
             )
             + "; all 24 h on "
-            + ", ".join(f"{d} {by.loc[d, 'days_powered_24h_pct']:.0f} %" for d in YEAR_DESIGNS[:3])
+            + ", ".join(f"{d} {by.loc[d, 'days_powered_24h_pct']:.0f} %" for d in SOC_DESIGNS)
             + " of days; days full/empty "
             + ", ".join(
                 f"{d} {by.loc[d, 'days_full_pct']:.0f}/{by.loc[d, 'days_empty_pct']:.0f} %"
-                for d in YEAR_DESIGNS[:3]
+                for d in SOC_DESIGNS
             )
+        )
+        best = by.loc["twofold-buffer"]
+        statistic = best["objective"]
+        lines.append(
+            f"  best fold angle for the buffer ({statistic} powered time): {angle['twofold-buffer']:g}"
+            f" deg, {best['objective_powered_h']:.2f} h (t_solar's {angle['twofold']:g} deg: "
+            f"{by.loc['twofold', 'objective_powered_h']:.2f} h; flat "
+            f"{by.loc['flat', 'objective_powered_h']:.2f} h); near-optimal "
+            f"{best['near_optimal_lo_deg']:g} to {best['near_optimal_hi_deg']:g} deg, recommended "
+            f"{best['recommended_fold_angle_deg']:g} deg"
         )
     if not table["converged"].all():
         lines.append(

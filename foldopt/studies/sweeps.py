@@ -42,7 +42,7 @@ from foldopt.studies.objectives import (
 )
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
-from foldopt.studies.storage_answer import YEAR_DESIGNS, year_storage
+from foldopt.studies.storage_answer import powered_by_angle, year_storage
 from foldopt.names import DEFAULT_ENGINE
 
 
@@ -242,7 +242,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     metrics, series = [], {"p_twofold_w": [], "switch_state": []}
     # A buffer is run over the days on the curves each design's row is reduced from.
     buffered = study.storage is not None and members == 1
-    drawn: dict = {name: [] for name in YEAR_DESIGNS} if buffered else {}
+    drawn: dict = {}
     for part, sky in zip(parts, skies, strict=True):
         chunk = blocks[part]
         # The day x hour maps of the first load's angle, every day at once.
@@ -277,7 +277,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
                 ("tracker", tracker.power),
                 ("tracker-net", tracker.net),
             ):
-                drawn[name].append(power)
+                drawn.setdefault(name, []).append(power)
         advance(len(chunk) // members)
     clock = skies[0].grid.clock_hours[0]
     design_hours = np.concatenate([m["t_solar_h"] for m in metrics])  # (blocks, loads, designs)
@@ -329,16 +329,8 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         ),
     }
     if buffered:
-        shapes = [sky.load_shape for sky in skies]
-        extras["storage_annual"] = year_storage(
-            study.storage,
-            {name: np.concatenate(power) for name, power in drawn.items()},
-            loads,
-            None if shapes[0] is None else np.concatenate(shapes),
-            blocks.dates,
-            skies[0].step_hours,
-            study.weather is not None,
-            engine,
+        extras["storage_annual"] = _year_buffer(
+            blocks, parts, skies, loads, objective, fold_angles, fixed, drawn, engine
         )
     group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
     if members > 1:
@@ -349,6 +341,91 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         )
     )
     return group, extras
+
+
+#: Bytes of the twofold curves a year's buffer holds at once (a chunk of fold angles' days).
+CURVE_BYTES = 100e6
+
+
+def _year_buffer(blocks, parts, skies, loads, objective, fold_angles, fixed, drawn, engine):
+    """storage_annual: the buffer over an annual group's days for each design, the twofold panel
+    at the angle t_solar's objective keeps and at the one the objective of daily powered time
+    keeps, simulated at every angle of the grid (a chunk of angles' curves at a time)."""
+    study = blocks.study
+    shapes = [sky.load_shape for sky in skies]
+    load_shape = None if shapes[0] is None else np.concatenate(shapes)
+    step_hours, weather = skies[0].step_hours, study.weather is not None
+    per_angle = len(blocks) * skies[0].n_steps * 8
+    size = max(1, int(CURVE_BYTES // per_angle))
+    powered = powered_by_angle(
+        study.storage,
+        (
+            _twofold_curves(blocks, parts, skies, fold_angles[first : first + size], engine)
+            for first in range(0, fold_angles.size, size)
+        ),
+        loads,
+        load_shape,
+        blocks.dates,
+        step_hours,
+        weather,
+        engine,
+    )  # (days, loads, angles)
+    months = [date.month for date in blocks.dates]
+    score = objective_value(powered, months, objective.statistic, objective.months)
+    # To the nanosecond-hour: powered time saturates at 24 h, where the sums' last bits would
+    # pick the angle (ties go to the least folded, as for t_solar).
+    best = best_angle_index(np.round(score, 9))  # (loads,)
+    chosen, which = np.unique(best, return_inverse=True)
+    curves = _twofold_curves(blocks, parts, skies, fold_angles[chosen], engine)
+    drawn = {name: np.concatenate(power) for name, power in drawn.items()}
+    drawn["twofold-buffer"] = curves[which].transpose(1, 0, 2)  # (days, loads, steps)
+    tracker = np.full(loads.size, np.nan)
+    return year_storage(
+        study.storage,
+        drawn,
+        loads,
+        load_shape,
+        blocks.dates,
+        step_hours,
+        weather,
+        engine,
+        {
+            "site": study.site,
+            "objective": objective,
+            "fold_angle_deg": {
+                "flat": np.full(loads.size, 180.0),
+                "twofold": fold_angles[fixed],
+                "twofold-buffer": fold_angles[best],
+                "tracker": tracker,
+                "tracker-net": tracker,
+            },
+            "near": near_optimal(fold_angles, score, study.near_optimal),
+        },
+    )
+
+
+def _twofold_curves(blocks: Blocks, parts, skies, angles, engine) -> np.ndarray:
+    """The twofold panel's power [W] (the study's connection) at ``angles`` over every block of an
+    annual group, angle by angle: (n_angles, n_blocks, n_steps)."""
+    study = blocks.study
+    power = []
+    for part, sky in zip(parts, skies, strict=True):
+        chunk = blocks[part]
+        orientation = engines.fold_orientations(study, chunk.tilt, chunk.azimuth, angles)
+        rows = np.repeat(np.arange(sky.n_blocks), angles.size)
+        metrics = engines.row_metrics(
+            sky,
+            study,
+            rows,
+            orientation.reshape(-1, 4),
+            np.ones(1),
+            outputs=(study.connection,),
+            engine=engine,
+            # Kept angle by angle, each angle's days in order.
+            curves=np.arange(rows.size).reshape(sky.n_blocks, angles.size).T.ravel(),
+        )
+        power.append(metrics.power.reshape(angles.size, sky.n_blocks, -1))
+    return np.concatenate(power, axis=1)
 
 
 def _keep_sample(sample: dict, sky: Sky, blocks: Blocks, members: int) -> None:
