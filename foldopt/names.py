@@ -200,6 +200,8 @@ WEATHER_FORMATS = Registry(
         "crn": "NOAA USCRN sub-hourly file: measured 5-min global light, air temperature, wind "
         "(pvlib.iotools.read_crn)",
         "csv": "a measured CSV: timestamp, ghi, dni, dhi [, temp_air, wind_speed] at any step; give the site",
+        "pvgis-hourly": "PVGIS hourly series of a horizontal plane, JSON: real hours of real years, "
+        "read at its hourly step (pvlib.iotools.read_pvgis_hourly)",
     },
 )
 #: The weather formats of hourly files (typical years), brought to the study's step; the others of
@@ -212,8 +214,13 @@ WEATHER_SOURCES = Registry(
     {
         "pvgis-tmy": "PVGIS's typical meteorological year of the site (EU JRC, SARAH3 / ERA5 "
         "satellite and reanalysis data; pvlib.iotools.get_pvgis_tmy's request)",
+        "pvgis-hourly": "PVGIS's hourly series of the site, real years (--years START:END, "
+        "2005 to 2023; pvlib.iotools.get_pvgis_hourly's request for a horizontal plane)",
     },
 )
+#: The :data:`WEATHER_SOURCES` whose answer is read as a measured file (its real days at its own
+#: step, :data:`foldopt.inputs.weather.sources.SOURCES`' ``format``), the others as a typical year.
+MEASURED_WEATHER_SOURCES = ("pvgis-hourly",)
 DECOMPOSITIONS = Registry(
     "decomposition",
     {

@@ -358,7 +358,7 @@ def test_a_maps_weather_options_are_checked_before_anything_is_fetched(pvgis, se
     route = pvgis("ok")
     (tmp_path / "sites.csv").write_text("name,latitude,longitude\nturin,45,8\n")
     for options, line in [
-        (["--weather", "pvgis-tmx"], "error: --weather = 'pvgis-tmx': must be one of pvgis-tmy; did you mean "
+        (["--weather", "pvgis-tmx"], "error: --weather = 'pvgis-tmx': must be one of pvgis-tmy, pvgis-hourly; did you mean "
                                      "'pvgis-tmy'?"),
         (["--years", "2005:2020"], "error: --years: the years of a weather source; give one with --weather"),
         (["--weather", "pvgis-tmy", "--years", "2005"], "error: --years = '2005': the first and last year as "

@@ -86,7 +86,8 @@ def _write_bsrn(path: Path, frame: pd.DataFrame, site: dict, station: int = 99) 
 
 
 def test_registry_names_every_format():
-    assert set(STATION_FORMATS) == {"surfrad", "midc", "srml", "bsrn", "solrad", "crn", "csv"}
+    assert set(STATION_FORMATS) == {"surfrad", "midc", "srml", "bsrn", "solrad", "crn", "csv",
+                                    "pvgis-hourly"}
     for name, entry in STATION_FORMATS.items():
         assert isinstance(entry, StationFormat) and entry.name == name
         assert entry.interval_label in ("start", "end") and callable(entry.reader)

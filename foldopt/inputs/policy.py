@@ -27,7 +27,13 @@ from __future__ import annotations
 import copy
 
 from foldopt.inputs.optimize_section import vary_names
-from foldopt.names import HOURLY_WEATHER_FORMATS, OPTIMIZE_VARIABLES, WEATHER_FORMATS, canonical
+from foldopt.names import (
+    HOURLY_WEATHER_FORMATS,
+    MEASURED_WEATHER_SOURCES,
+    OPTIMIZE_VARIABLES,
+    WEATHER_FORMATS,
+    canonical,
+)
 
 #: Sections of a study whose fields a change merges into (a mapping changes the fields it names);
 #: any other field given a mapping (a load profile, a weather file) is replaced whole.
@@ -206,6 +212,8 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
             )
         except ValueError:
             measured = False  # no format: the study's validation names it
+        if isinstance(weather, dict) and weather.get("source") in MEASURED_WEATHER_SOURCES:
+            measured = True  # a source read as a measured file: its own step
         if measured and not touched(given, "step_min"):
             data.pop("step_min", None)  # a measured file's own step
     old_mode = data.get("mode", "exact")

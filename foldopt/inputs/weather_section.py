@@ -38,6 +38,12 @@ def _check_years(years: str | None) -> str | None:
     return f"{start}:{end}"
 
 
+def _check_database(name: str | None) -> str | None:
+    if name is not None and not re.fullmatch(r"PVGIS-[A-Za-z0-9]+", name):
+        raise ValueError("a PVGIS radiation database, e.g. PVGIS-SARAH3 or PVGIS-ERA5")
+    return name
+
+
 def _check_url(url: str | None) -> str | None:
     if url is not None and not re.match(r"https?://[^/\s]+", url):
         raise ValueError("a base address http://... or https://..., e.g. a mirror's")
@@ -79,9 +85,12 @@ class Weather(StrictModel):
         One of :data:`foldopt.names.WEATHER_SOURCES`: the site's weather from that service.
     years : str, optional
         A source's years ``START:END`` (PVGIS TMY: the years its months are chosen from, at
-        least 10); default the service's whole record.
+        least 10; PVGIS hourly: the series' years); default the service's whole record.
     usehorizon : bool
         A source's light with the terrain's horizon shading it (PVGIS's DEM); default True.
+    raddatabase : str, optional
+        ``pvgis-hourly``'s radiation database (``PVGIS-SARAH3``, ``PVGIS-ERA5``); default the
+        service's for the site.
     url : str, optional
         A source's base address (a mirror, a proxy); default ``FOLDOPT_PVGIS_URL``, else the
         service's pinned versioned address.
@@ -116,6 +125,9 @@ class Weather(StrictModel):
         None, description="a source's years START:END; default the service's record"
     )
     usehorizon: bool = True
+    raddatabase: Annotated[str | None, AfterValidator(_check_database)] = Field(
+        None, description="pvgis-hourly's radiation database; default PVGIS's for the site"
+    )
     url: Annotated[str | None, AfterValidator(_check_url)] = Field(
         None, description="a source's base address; default FOLDOPT_PVGIS_URL or the pinned one"
     )
@@ -163,7 +175,13 @@ class Weather(StrictModel):
                 "give a weather file (weather.path, --weather FILE) or a source (weather.source, "
                 f"--weather NAME: {', '.join(names.WEATHER_SOURCES)})"
             )
-        defaults = {"years": None, "usehorizon": True, "url": None, "timeout_s": 30.0}
+        defaults = {
+            "years": None,
+            "usehorizon": True,
+            "raddatabase": None,
+            "url": None,
+            "timeout_s": 30.0,
+        }
         given = [key for key, value in defaults.items() if getattr(self, key) != value]
         if self.source is None and given:
             raise ValueError(

@@ -16,12 +16,13 @@ sites and loads (:func:`map_request_from`), and a sizing's costs are checked aga
 from __future__ import annotations
 
 import math
+import os
 import re
 from dataclasses import dataclass, replace
 
 from foldopt.cache import offline_mode
 from foldopt.inputs import policy
-from foldopt.names import WEATHER_SOURCES
+from foldopt.names import WEATHER_SOURCES, did_you_mean
 from foldopt.inputs.study_file import default_study_path, parse_study_text, read_study
 from foldopt.inputs.optimize_section import vary_names
 from foldopt.engine.choice import engine_for
@@ -411,6 +412,13 @@ def sweep_changes(options: dict, data: dict) -> dict:
         elif option == "weather" and str(value) in WEATHER_SOURCES:
             value = {"source": str(value)}  # a source's name: its answer for the site
         elif option == "weather":
+            hint = did_you_mean(str(value), WEATHER_SOURCES)
+            if hint and not os.path.lexists(str(value)):  # a misspelt source, not a file
+                errors.append(
+                    f"--weather = {str(value)!r}: no such file, nor a weather source "
+                    f"({', '.join(WEATHER_SOURCES)}){hint}"
+                )
+                continue
             value = {"path": str(value)}  # a new file: none of the study's file's options
         elif option == "load_profile":
             value = {"file": str(value)}

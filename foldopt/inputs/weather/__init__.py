@@ -162,14 +162,17 @@ def check_answer(path, fmt: str) -> None:
     ----------
     path : str or pathlib.Path
     fmt : str
-        One of :data:`FORMATS`.
+        One of :data:`FORMATS` or :data:`MEASURED_FORMATS`.
 
     Raises
     ------
     foldopt.errors.WeatherError
         Naming the file, where and why.
     """
-    _read_checked(str(path), fmt, 2025)
+    if fmt in MEASURED_FORMATS:
+        read_measured(path, fmt)
+    else:
+        _read_checked(str(path), fmt, 2025)
 
 
 def weather_site(path, fmt: str | None = None, site: dict | None = None, **measured) -> dict | None:

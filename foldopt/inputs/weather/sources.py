@@ -10,6 +10,14 @@ fetchers return the parsed frame, not the answer, so the request is made here wi
 (pvlib's own dependency): the cached bytes are the service's, their SHA-256 names them, and the
 faults a fetcher leaves to a traceback (a rate limit, a cut answer, no network) are each one line.
 
+``pvgis-hourly`` asks PVGIS's hourly series (``seriescalc``, ``pvlib.iotools.get_pvgis_hourly``'s
+request for a horizontal plane, with the beam and diffuse components) for the years given, and
+its answer is read as a measured file (format ``pvgis-hourly``,
+:mod:`foldopt.inputs.weather.stations`): real days at their hourly step, each day a block, the
+direct and diffuse light PVGIS's where the answer holds them, else estimated from the global
+light as for any measured file of ``ghi`` alone. Years outside those the service's version holds
+are refused before anything is asked (:attr:`WeatherSource.years`).
+
 A horizon source (:data:`HORIZON_SOURCES`: ``--horizon pvgis``, PVGIS's ``printhorizon`` with
 ``pvlib.iotools.get_pvgis_horizon``'s query) is fetched, checked and cached the same way
 (:func:`fetch_horizon`) and its answer read as the horizon file it is
@@ -43,7 +51,7 @@ import re
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from urllib.parse import urlencode
 
@@ -88,6 +96,11 @@ class WeatherSource:
     params : callable
         ``params(latitude, longitude, weather)``: the query's parameters, as pvlib's fetcher
         sends them, for the rounded site and a study's ``weather`` section (or its mapping).
+    label : str
+        What messages call its answer (``PVGIS TMY``).
+    years : dict
+        The years the service holds, by its version (``{'v5_3': (2005, 2023)}``): years asked
+        for outside them are refused before any request; empty where the service says.
     """
 
     name: str
@@ -98,6 +111,8 @@ class WeatherSource:
     format: str
     decimals: int
     params: Callable
+    label: str
+    years: dict = field(default_factory=dict)
 
 
 def _pvgis_tmy_params(latitude: float, longitude: float, weather) -> dict:
@@ -106,6 +121,25 @@ def _pvgis_tmy_params(latitude: float, longitude: float, weather) -> dict:
     params = {"lat": latitude, "lon": longitude, "outputformat": "json"}
     if not _option(weather, "usehorizon", True):
         params["usehorizon"] = 0
+    years = _option(weather, "years", None)
+    if years is not None:
+        params["startyear"], params["endyear"] = (int(year) for year in str(years).split(":"))
+    return params
+
+
+def _pvgis_hourly_params(latitude: float, longitude: float, weather) -> dict:
+    """``pvlib.iotools.get_pvgis_hourly``'s query for a horizontal plane (JSON): the site,
+    ``angle=0`` and ``components=1`` (the beam, diffuse and reflected light apart, so that the
+    direct and diffuse light are PVGIS's own), ``usehorizon=0`` where the horizon is left out,
+    ``raddatabase`` where one is named, ``startyear`` and ``endyear`` where the years are given
+    (else PVGIS's whole record)."""
+    params = {"lat": latitude, "lon": longitude, "outputformat": "json", "angle": 0}
+    params["components"] = 1
+    if not _option(weather, "usehorizon", True):
+        params["usehorizon"] = 0
+    database = _option(weather, "raddatabase", None)
+    if database is not None:
+        params["raddatabase"] = database
     years = _option(weather, "years", None)
     if years is not None:
         params["startyear"], params["endyear"] = (int(year) for year in str(years).split(":"))
@@ -134,6 +168,21 @@ SOURCES = {
             # PVGIS names its files and rows by the site to 3 decimals (tmy_45.000_8.000_...)
             decimals=3,
             params=_pvgis_tmy_params,
+            label="PVGIS TMY",
+        ),
+        WeatherSource(
+            name="pvgis-hourly",
+            service="PVGIS",
+            url="https://re.jrc.ec.europa.eu/api/v5_3/",
+            url_variable="FOLDOPT_PVGIS_URL",
+            route="seriescalc",
+            # real hours of real years: read as a measured file, at its own step, day by day
+            format="pvgis-hourly",
+            decimals=3,
+            params=_pvgis_hourly_params,
+            label="PVGIS hourly series",
+            # PVGIS 5.3's hourly series: PVGIS-SARAH3 and PVGIS-ERA5, 2005 to 2023
+            years={"v5_3": (2005, 2023)},
         ),
     )
 }
@@ -150,6 +199,7 @@ HORIZON_SOURCES = {
         format="horizon",
         decimals=3,
         params=_pvgis_horizon_params,
+        label="PVGIS horizon profile",
     ),
 }
 
@@ -306,7 +356,8 @@ def fetch(source: str, latitude: float, longitude: float, weather=None) -> Weath
     latitude, longitude : float
         The site [deg], rounded as the service rounds it.
     weather : foldopt.inputs.weather_section.Weather or dict, optional
-        The options: ``years`` (``START:END``), ``usehorizon``, ``url``, ``timeout_s``.
+        The options: ``years`` (``START:END``), ``usehorizon``, ``raddatabase`` (``pvgis-hourly``),
+        ``url``, ``timeout_s``.
 
     Returns
     -------
@@ -316,9 +367,10 @@ def fetch(source: str, latitude: float, longitude: float, weather=None) -> Weath
     Raises
     ------
     foldopt.errors.WeatherError
-        One line: offline without a cached copy, no network, a timeout, the service's refusal
-        (its own message), a rate limit beyond :data:`MAX_RETRY_WAIT_S`, a cut or malformed
-        answer, a cache folder that cannot be written. Nothing is cached then.
+        One line: years outside the service's, offline without a cached copy, no network, a
+        timeout, the service's refusal (its own message), a rate limit beyond
+        :data:`MAX_RETRY_WAIT_S`, a cut or malformed answer, a cache folder that cannot be
+        written. Nothing is cached then.
     """
     return _fetch(SOURCES[source], latitude, longitude, weather, f"weather {source}")
 
@@ -353,6 +405,7 @@ def fetch_horizon(
 
 def _fetch(source: WeatherSource, latitude, longitude, weather, label: str) -> WeatherProvenance:
     request = _request(source, latitude, longitude, weather)
+    _check_years(request, label)
     path = cache_path(request)
     found = cached(path)
     if found is not None:
@@ -360,6 +413,8 @@ def _fetch(source: WeatherSource, latitude, longitude, weather, label: str) -> W
     if offline():
         params = request.params
         site = f"--lat {params['lat']:g} --lon {params['lon']:g}"
+        if "startyear" in params:
+            site += f" --years {params['startyear']}:{params['endyear']}"
         how = (
             f"foldopt weather fetch {source.name} {site}"
             if source.name in SOURCES
@@ -373,6 +428,22 @@ def _fetch(source: WeatherSource, latitude, longitude, weather, label: str) -> W
     payload = _download(request, label)
     retrieved = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
     return _store(request, payload, retrieved, label)
+
+
+def _check_years(request: _Request, label: str) -> None:
+    """Refuse years outside those the service's version holds (:attr:`WeatherSource.years`)
+    before anything is asked: one line naming them."""
+    held = request.source.years.get(request.version)
+    params = request.params
+    if held is None or "startyear" not in params:
+        return
+    first, last = held
+    if params["startyear"] < first or params["endyear"] > last:
+        raise WeatherError(
+            f"{label}: years {params['startyear']}:{params['endyear']}: {request.source.service} "
+            f"{request.version.removeprefix('v').replace('_', '.')}'s {request.source.label} holds "
+            f"{first} to {last}; give years within them (--years, weather.years)"
+        )
 
 
 def _download(request: _Request, label: str) -> bytes:
@@ -501,8 +572,6 @@ def _refusal(response, payload: bytes, service: str, attempts: int) -> str:
 def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> WeatherProvenance:
     """Check the answer as the weather file it is, then cache it and its provenance atomically:
     an answer that fails a check is not stored."""
-    from foldopt.inputs import weather as files  # the format's reader and its checks
-
     path = cache_path(request)
     source = request.source
     try:
@@ -530,13 +599,8 @@ def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> Wea
         temporary.write_bytes(payload)
         reason = _unreadable(temporary, source.format)
         if reason is not None:
-            what = (
-                "PVGIS horizon profile"
-                if source.format == "horizon"
-                else files.FORMATS[source.format].label
-            )
             raise WeatherError(
-                f"{label}: {source.service}'s answer is not a readable {what} ({reason}); "
+                f"{label}: {source.service}'s answer is not a readable {source.label} ({reason}); "
                 "nothing was cached"
             )
 

@@ -33,6 +33,14 @@ study's weather. What each reader takes from its file:
   absent), optionally ``temp_air`` and ``wind_speed``, in any order and case, other columns
   ignored; empty or ``NaN`` cells are missing; lines starting with ``#`` are comments. Stamps mark
   interval ends unless ``label`` says otherwise. No site in the file.
+* ``pvgis-hourly``: PVGIS's hourly series (``seriescalc``, JSON) of a horizontal plane [8]_
+  through ``read_pvgis_hourly``: real hours of real years, the site in ``inputs.location``, UTC
+  stamps. An answer with the components (``components=1``): ``ghi`` their sum
+  ``Gb(i) + Gd(i) + Gr(i)`` (``Gr(i)`` is 0 on a horizontal plane), ``dhi`` ``Gd(i)``, so that
+  ``dni`` follows by closure from ``Gb(i)`` and the sun's elevation; an answer of ``G(i)``
+  alone (asked without components, or an older service): ``ghi`` only, ``dni`` and ``dhi`` then
+  by the decomposition a measured file of ``ghi`` alone gets (Erbs by default). ``T2m`` and
+  ``WS10m`` (10 m). A tilted or tracking plane's series is refused: its ``G(i)`` is no ``ghi``.
 
 What the stamps mark (``interval_label``): CRN, interval end (pvlib's ``read_crn``); BSRN, the
 start ("All time labels in the station-to-archive files denote the start of a time interval",
@@ -43,7 +51,12 @@ whose documents do not say, the end: their files' solar zenith column is pvlib's
 on ``surfrad-slv16001.dat`` and ``abq19056.dat``, 0.1 deg off at the stamp itself); MIDC, the
 end: its stations log on Campbell Scientific CR1000 loggers (``midc_raw_20181018.txt`` holds
 their temperature and battery columns), which stamp a table's record at the end of its
-interval; the generic CSV, the end, like most loggers. ``label`` overrides.
+interval; the generic CSV, the end, like most loggers; PVGIS's hourly series, the start of its
+hour: its satellite values (PVGIS-SARAH) are instantaneous at their stamp (HH:10 over Europe), as
+pvlib's ``get_pvgis_hourly`` notes (its ``H_sun`` is the sun's elevation then), and each stands
+for the hour it falls in, HH:00 to HH:60, as in PVGIS's own hourly PV energy: the reader moves
+the stamps to their hour's start (a study's steps are centred on the half hour), a note says so.
+``label`` overrides.
 
 References
 ----------
@@ -56,11 +69,15 @@ References
 .. [6] NOAA GML, "Description of SOLRAD daily data files" (README_SOLRAD.txt).
 .. [7] H. J. Diamond et al., "U.S. Climate Reference Network after one decade of operations",
    Bull. Amer. Meteor. Soc. 94, 489-498, 2013.
+.. [8] European Commission JRC, "PVGIS: hourly radiation" (``seriescalc``),
+   https://joint-research-centre.ec.europa.eu/pvgis-online-tool/pvgis-tools/hourly-radiation_en.
 """
 
 from __future__ import annotations
 
 import datetime
+import io
+import json
 import re
 import warnings
 from collections.abc import Callable
@@ -86,7 +103,7 @@ class StationFormat:
     ----------
     name : str
         As ``read_measured``'s ``fmt`` names it (``surfrad``).
-    interval_label : {'start', 'end'}
+    interval_label : {'start', 'end', 'centre'}
         Which edge of its interval a stamp marks, as the reader returns it (module docstring).
     reader : callable
         ``reader(path, fail, zone)``: the file as a :class:`StationData`; ``zone`` [h] is the UTC
@@ -520,6 +537,100 @@ def read_csv(path: str, fail, zone=None) -> StationData:
     return StationData(pd.DataFrame(values, index=index), {}, file_zone)
 
 
+def read_pvgis_hourly(path: str, fail, zone=None) -> StationData:
+    """A PVGIS hourly series of a horizontal plane, JSON (module docstring).
+
+    Parameters
+    ----------
+    path : str
+    fail : callable
+        ``fail(message)``: the error to raise.
+    zone : float, optional
+        Unused: the stamps are UTC.
+
+    Returns
+    -------
+    StationData
+    """
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        text = handle.read()
+    try:
+        source = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise fail(
+            f"not valid JSON: {error.msg} at line {error.lineno} column {error.colno}"
+        ) from None
+    outputs = source.get("outputs") if isinstance(source, dict) else None
+    hourly = outputs.get("hourly") if isinstance(outputs, dict) else None
+    if not isinstance(hourly, list) or not hourly:
+        raise fail("not a PVGIS hourly series: no outputs.hourly list of hourly records")
+    inputs = source.get("inputs") if isinstance(source.get("inputs"), dict) else {}
+    mounting = inputs.get("mounting_system") or {}
+    slope = (mounting.get("fixed") or {}).get("slope") if isinstance(mounting, dict) else None
+    tilt = slope.get("value") if isinstance(slope, dict) else None
+    if not isinstance(tilt, (int, float)) or tilt != 0:
+        plane = f"a plane tilted {tilt} deg" if isinstance(tilt, (int, float)) else "no fixed plane"
+        raise fail(
+            f"inputs.mounting_system: {plane}; foldopt reads the horizontal plane's series "
+            "(seriescalc with angle=0), whose G(i) is the global horizontal light"
+        )
+    data, _ = read_with_pvlib(
+        fail,
+        "PVGIS hourly series",
+        "read_pvgis_hourly",
+        io.StringIO(text),
+        pvgis_format="json",
+        map_variables=True,
+    )
+    parts = [key for key in ("poa_direct", "poa_sky_diffuse", "poa_ground_diffuse") if key in data]
+    if {"poa_direct", "poa_sky_diffuse"} <= set(parts):
+        columns = {"ghi": parts, "dhi": ["poa_sky_diffuse"]}
+        note = (
+            "PVGIS hourly series with its components: ghi = Gb(i) + Gd(i) + Gr(i), dhi = Gd(i), "
+            "dni by closure from Gb(i) and the sun's elevation"
+        )
+    elif "poa_global" in data:
+        columns = {"ghi": ["poa_global"]}
+        note = (
+            "PVGIS hourly series of G(i) alone (no beam and diffuse components in the answer): "
+            "dni and dhi are estimated from ghi by a decomposition model, not PVGIS's own"
+        )
+    else:
+        raise fail("outputs.hourly holds neither G(i) nor Gb(i) and Gd(i)")
+    frame = {}
+    for key, names in {**columns, "temp_air": ["temp_air"], "wind_speed": ["wind_speed"]}.items():
+        if all(name in data for name in names):
+            frame[key] = sum(_numbers(data, name, key, fail) for name in names)
+    location = inputs.get("location") if isinstance(inputs.get("location"), dict) else {}
+    missing = [key for key in ("latitude", "longitude", "elevation") if key not in location]
+    if missing:
+        raise fail(f"inputs.location has no {', '.join(missing)}")
+    site = {
+        "name": None,
+        "latitude": location["latitude"],
+        "longitude": location["longitude"],
+        "altitude": location["elevation"],
+    }
+    meteo = inputs.get("meteo_data") if isinstance(inputs.get("meteo_data"), dict) else {}
+    databases = ", ".join(
+        str(meteo[key]) for key in ("radiation_db", "meteo_db") if meteo.get(key) is not None
+    )
+    notes = [note + (f" ({printable(databases, 60)})" if databases else "")]
+    if "Int" in data and (data["Int"] != 0).any():
+        notes.append(
+            f"{int((data['Int'] != 0).sum())} hours of light PVGIS reconstructed (Int = 1)"
+        )
+    stamps = pd.DatetimeIndex(data.index)
+    if (stamps != stamps.floor("h")).any():
+        minute = int(stamps[0].minute)
+        notes.append(
+            f"PVGIS's stamps (:{minute:02d} past each hour, the satellite's instant) taken as the "
+            "hour they fall in, as PVGIS's own hourly sums take them"
+        )
+    frame = pd.DataFrame(frame, index=stamps.floor("h"))
+    return StationData(frame, site, notes=tuple(notes))
+
+
 def fixed_zone(hours: float) -> datetime.timezone:
     """The fixed-offset time zone of a UTC offset.
 
@@ -569,6 +680,14 @@ STATION_FORMATS = {
             read_csv,
             False,
             r"(?i)\A(?:#[^\n]*\n|\s*\n)*(?:[^,\n]*,)*\s*timestamp\s*(?:,|\r?\n)",
+        ),
+        # PVGIS's hourly answer: its inputs, then outputs.hourly's records
+        StationFormat(
+            "pvgis-hourly",
+            "start",
+            read_pvgis_hourly,
+            True,
+            r'\A\s*\{\s*"inputs"[\s\S]*"mounting_system"[\s\S]*"outputs"\s*:\s*\{\s*"hourly"',
         ),
     )
 }
