@@ -26,21 +26,23 @@ from foldopt.inputs.study_file import default_study_path
 runner = CliRunner()
 RECORDED = Path(__file__).parent / "data" / "pvgis" / "tmy_45.000_8.000_2005_2023.json"
 HORIZON = Path(__file__).parent / "data" / "pvgis" / "printhorizon_45.000_8.000.json"
+HOURLY = Path(__file__).parent / "data" / "pvgis" / "seriescalc_45.000_8.000_2020_2021.json"
 #: A few days of the year at a 5-degree fold-angle grid: enough to compare the two paths.
 SWEEP = ["sweep", "angle", "--lat", "45", "--lon", "8", "--p-load", "4", "--engine", "numpy",
          "--angle-step", "5", "--step-min", "5", "--format", "json"]
 
-#: The server: PVGIS's routes ``<mode>-<tag>/api/v5_3/tmy`` and ``.../printhorizon`` answered as
-#: ``mode`` says (``ok`` the route's recorded answer, the others a fault), ``/_count`` the
-#: requests of each ``<mode>-<tag>``. It ends
-#: itself after its lifetime whatever happens to the test.
+#: The server: PVGIS's routes ``<mode>-<tag>/api/v5_3/tmy``, ``.../printhorizon`` and
+#: ``.../seriescalc`` answered as ``mode`` says (``ok`` the route's recorded answer, the others a
+#: fault), ``/_count`` the requests of each ``<mode>-<tag>``, ``/_queries`` their routes and
+#: queries. It ends itself after its lifetime whatever happens to the test.
 SERVER = r"""
 import json, os, socket, sys, threading, time
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from urllib.parse import urlsplit
 
-BODIES = {"tmy": open(sys.argv[1], "rb").read(), "printhorizon": open(sys.argv[3], "rb").read()}
-counts, lock = {}, threading.Lock()
+BODIES = {"tmy": open(sys.argv[1], "rb").read(), "printhorizon": open(sys.argv[3], "rb").read(),
+          "seriescalc": open(sys.argv[4], "rb").read()}
+counts, queries, lock = {}, {}, threading.Lock()
 
 
 class Handler(BaseHTTPRequestHandler):
@@ -48,11 +50,15 @@ class Handler(BaseHTTPRequestHandler):
         pass
 
     def do_GET(self):
-        parts = urlsplit(self.path).path.strip("/").split("/")
+        url = urlsplit(self.path)
+        parts = url.path.strip("/").split("/")
         if parts == ["_count"]:
             return self.send(200, json.dumps(counts).encode())
+        if parts == ["_queries"]:
+            return self.send(200, json.dumps(queries).encode())
         with lock:
             counts[parts[0]] = n = counts.get(parts[0], 0) + 1
+            queries.setdefault(parts[0], []).append([parts[-1], url.query])
         mode = parts[0].split("-")[0]
         if parts[1:3] != ["api", "v5_3"] or len(parts) != 4 or parts[3] not in BODIES:
             return self.send(404, b"")
@@ -107,8 +113,8 @@ server.serve_forever()
 @pytest.fixture(scope="module")
 def server(request):
     """The server's port, the server started on a free port and stopped by its pid."""
-    process = subprocess.Popen([sys.executable, "-c", SERVER, str(RECORDED), "120", str(HORIZON)],
-                               stdout=subprocess.PIPE, text=True)
+    process = subprocess.Popen([sys.executable, "-c", SERVER, str(RECORDED), "120", str(HORIZON),
+                                str(HOURLY)], stdout=subprocess.PIPE, text=True)
     request.addfinalizer(lambda: (os.kill(process.pid, signal.SIGTERM), process.wait(timeout=10)))
     port = process.stdout.readline().strip()
     assert port.isdigit(), "the server did not start"
@@ -460,3 +466,126 @@ def test_offline_without_a_cached_horizon_is_one_line(pvgis, server, tmp_path):
         "(--offline, FOLDOPT_OFFLINE=1) nothing is fetched; fetch it first where there is a "
         "network: run once with --horizon pvgis --lat 45 --lon 8"]
     assert requests_made(server, route) == 0 and cache_files(tmp_path) == {}
+
+
+# --weather pvgis-hourly: PVGIS's hourly series (seriescalc) of a horizontal plane for real years,
+# recorded for 45 N, 8 E, 2020-2021 without components (G(i) alone; tests/data/pvgis/README.md),
+# read as a measured file of the pvgis-hourly format: each real day a block, at its hourly step.
+HOURLY_SWEEP = ["sweep", "angle", "--lat", "45", "--lon", "8", "--p-load", "4",
+                "--angle-step", "15", "--format", "json"]
+YEARS = ["--years", "2020:2021"]
+
+
+def queries_made(port: int, route: str) -> list:
+    with urllib.request.urlopen(f"http://127.0.0.1:{port}/_queries", timeout=5) as answer:
+        return json.loads(answer.read()).get(route, [])
+
+
+def read_as_a_users_file(*options) -> list:
+    """The recorded answer read the way a user's file is: ``--weather FILE --weather-format
+    pvgis-hourly``, the same sweep."""
+    return [*HOURLY_SWEEP, "--weather", str(HOURLY), "--weather-format", "pvgis-hourly", *options]
+
+
+def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path):
+    """The whole span, 731 real days each a block: the fetched series gives every fold angle's
+    mean t_solar to the bit as the recorded file read as a user's file; the request is
+    get_pvgis_hourly's for a horizontal plane with the components."""
+    route = pvgis("ok")
+    fetched = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, "--out", "fetched"])
+    assert fetched.exit_code == 0, fetched.output
+    read = runner.invoke(app, [*read_as_a_users_file(), "--out", "read"])
+    assert read.exit_code == 0, read.output
+    fetched, read = json.loads(fetched.stdout), json.loads(read.stdout)
+    assert fetched["rows"] == read["rows"]  # each day's t_solar at the chosen angle, to the bit
+    assert fetched["answer"]["result"] == read["answer"]["result"]
+    tables = csv_files(tmp_path / "fetched")
+    assert tables == csv_files(tmp_path / "read") and tables  # every angle's, every day's
+    days = sorted({row["date"] for row in fetched["rows"]})
+    assert (len(days), days[0], days[-1]) == (731, "2020-01-01", "2021-12-31")  # 2022-01-01: 1 h
+    notes = " ".join(note["note"] for note in fetched["answer"]["notes"])
+    assert "G(i) alone" in notes and "erbs decomposition" in notes  # PVGIS's DNI/DHI are not in it
+    (made,) = queries_made(server, route)
+    assert made[0] == "seriescalc"
+    assert dict(pair.split("=") for pair in made[1].split("&")) == {
+        "lat": "45.0", "lon": "8.0", "outputformat": "json", "angle": "0", "components": "1",
+        "startyear": "2020", "endyear": "2021"}
+    meta = json.loads((tmp_path / "fetched" / "run.json").read_text())
+    assert meta["weather_source"]["source"] == "pvgis-hourly"
+    assert meta["weather_source"]["sha256"] == hashlib.sha256(HOURLY.read_bytes()).hexdigest()
+
+
+def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    for _ in range(2):
+        result = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8", *YEARS])
+        assert result.exit_code == 0, result.output
+    assert requests_made(server, route) == 1
+    (cached,) = (p for p in (tmp_path / "cache" / "weather").iterdir() if "provenance" not in p.name)
+    assert cached.name.startswith("pvgis-hourly_v5_3_45.000_8.000_")
+    assert cached.read_bytes() == HOURLY.read_bytes()
+    days = ["--days", "2020-06-21,2021-01-15"]
+    dead = pvgis("e500")  # a service that would fail: offline never asks it
+    offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
+                                  "--out", "offline"])
+    assert offline.exit_code == 0, offline.output
+    read = runner.invoke(app, [*read_as_a_users_file(*days), "--out", "read"])
+    assert json.loads(offline.stdout)["rows"] == json.loads(read.stdout)["rows"]
+    assert requests_made(server, dead) == 0
+    other = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", "--years", "2019:2020", *days,
+                                "--offline", "--out", "x"])  # other years: no cached copy
+    assert other.exit_code == 2
+    assert other.stderr.strip().splitlines() == [
+        "error: --weather pvgis-hourly: no cached copy for (45, 8) with these options, and offline "
+        "(--offline, FOLDOPT_OFFLINE=1) nothing is fetched; fetch it first where there is a network: "
+        "foldopt weather fetch pvgis-hourly --lat 45 --lon 8 --years 2019:2020"]
+    assert requests_made(server, dead) == 0 and not (tmp_path / "x").exists()
+
+
+HOURLY_FAULTS = [
+    ("e500", "PVGIS answered 500 Internal Server Error; try again later"),
+    ("cut", "PVGIS's answer was cut off after "),
+    ("half", "PVGIS's answer is not a readable PVGIS hourly series (not valid JSON: "),
+]
+
+
+@pytest.mark.parametrize(("mode", "said"), HOURLY_FAULTS, ids=[f[0] for f in HOURLY_FAULTS])
+def test_an_hourly_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path, mode, said):
+    pvgis("ok")
+    kept = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8",
+                               "--years", "2019:2020"])
+    assert kept.exit_code == 0, kept.output
+    before = cache_files(tmp_path)
+    route = pvgis(mode)
+    result = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, "--out", "x"])
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: --weather pvgis-hourly: ") and said in lines[0]
+    assert cache_files(tmp_path) == before and not (tmp_path / "x").exists()
+    assert requests_made(server, route) == 1
+
+
+def test_years_outside_pvgis_record_are_refused_before_any_request(pvgis, server, tmp_path):
+    """PVGIS 5.3's hourly series holds 2005 to 2023 (no recorded refusal of PVGIS's own to quote):
+    foldopt's own line, nothing asked."""
+    route = pvgis("ok")
+    result = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", "--years", "2023:2024",
+                                 "--out", "x"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        "error: --weather pvgis-hourly: years 2023:2024 are outside PVGIS 5.3's record, 2005 to 2023; "
+        "give years within it (--years, weather.years)"]
+    fetch = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8",
+                                "--years", "2004:2010"])
+    assert fetch.exit_code == 2 and "years 2004:2010 are outside" in fetch.stderr
+    assert requests_made(server, route) == 0 and cache_files(tmp_path) == {}
+
+
+def test_a_source_read_as_a_measured_file_is_named_so():
+    """The sources read as measured files (real days at their own step) are those whose format
+    is a measured one: names.MEASURED_WEATHER_SOURCES is what the study's policy reads."""
+    from foldopt.inputs.weather.sources import SOURCES
+    from foldopt.names import HOURLY_WEATHER_FORMATS, MEASURED_WEATHER_SOURCES
+
+    assert {name for name, source in SOURCES.items() if source.format not in HOURLY_WEATHER_FORMATS} == set(
+        MEASURED_WEATHER_SOURCES)

@@ -439,10 +439,11 @@ def _check_years(request: _Request, label: str) -> None:
         return
     first, last = held
     if params["startyear"] < first or params["endyear"] > last:
+        version = request.version.removeprefix("v").replace("_", ".")
         raise WeatherError(
-            f"{label}: years {params['startyear']}:{params['endyear']}: {request.source.service} "
-            f"{request.version.removeprefix('v').replace('_', '.')}'s {request.source.label} holds "
-            f"{first} to {last}; give years within them (--years, weather.years)"
+            f"{label}: years {params['startyear']}:{params['endyear']} are outside "
+            f"{request.source.service} {version}'s record, {first} to {last}; give years within "
+            "it (--years, weather.years)"
         )
 
 
