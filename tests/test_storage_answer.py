@@ -317,3 +317,63 @@ def test_a_year_s_fold_angle_for_the_buffer_is_the_brute_force_best():
         line.startswith(f"  best fold angle for the buffer (mean powered time): {grid[best]:g} deg")
         for line in year.answer.lines()
     )
+
+
+@pytest.mark.parametrize("in_sequence", [True, False])
+def test_days_buffers_reach_the_target_and_smaller_ones_do_not(in_sequence):
+    # Four days of a sine of different heights (one cloudy), half-hour steps, 1 W all day: the
+    # smallest buffer for 24 h on 75 % of the days, the days in sequence or each periodic.
+    from foldopt.inputs.storage_section import Storage
+    from foldopt.studies.storage_answer import smallest_buffers
+
+    hours = (np.arange(48) + 0.5) / 2
+    sun = np.clip(np.sin((hours - 6) / 12 * np.pi), 0, None)
+    power = np.stack([np.outer(heights, sun) for heights in ([9, 8, 2, 9], [12, 10, 3, 11])])
+    storage = Storage(capacity_wh=1, min_soc=0.1, target={"powered_h": 24, "days_pct": 75})
+    need = smallest_buffers(power, 1.0, storage, 0.5, "numba", in_sequence)
+    assert np.isfinite(need).all() and (need > 0).all()
+    for curve, capacity in zip(power, need, strict=True):
+        capacities = capacity * np.array([1.0, 1.0 - 2e-3])
+        days = np.tile(curve, (2, 1, 1)) if in_sequence else np.tile(curve[:, None], (2, 1, 1))
+        run = simulate(
+            days,
+            1.0,
+            buffer_of(storage, capacity_wh=np.repeat(capacities, 1 if in_sequence else 4)),
+            0.5,
+        )
+        powered = run.powered_h.reshape(2, -1)
+        reached = (powered >= 24 - 1e-9).mean(axis=1) >= 0.75
+        assert reached.tolist() == [True, False]
+
+
+@pytest.mark.parametrize(
+    "option", [["--cost-per-m2", "100"], ["--areas", "0.1:0.2:0.01"], ["--years", "10"]]
+)
+def test_size_storage_refuses_the_panel_s_cost_options(tmp_path, monkeypatch, option):
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["size", "--storage", "--target-h", "24", *option, "--out", "out"])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip() == (
+        f"error: {option[0]}: an option of the panel's sizing; --storage sizes the buffer"
+    )
+    assert not (tmp_path / "out").exists()
+
+
+def test_size_storage_sizes_a_weather_file_s_days(tmp_path, monkeypatch):
+    # The measured file's days (three kept of five: each its own periodic day), one fold angle
+    # for them: each design's buffer for 24 h on 60 % of days, in the lines, JSON and CSV.
+    monkeypatch.chdir(tmp_path)
+    args = ["size", str(ROOT / "configs" / "measured-minutes.yaml"), "--storage", "--target-h",
+            "24", "--set", "storage.target.days_pct=60", "--set", "p_load=0.5", "--set",
+            "fold_angles.step=30", "--format", "json", "--out", "out", "-q"]  # fmt: skip
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    answer = json.loads(result.output)["answer"]
+    table = pd.read_csv(tmp_path / "out" / "storage_annual.csv").set_index("design")
+    assert table["capacity_wh"].notna().all() and (table["capacity_wh"] > 0).all()
+    line = next(line for line in answer["lines"] if line.startswith("  for 24 h on 60 % of days"))
+    assert f"flat needs {table.loc['flat', 'capacity_wh']:.3g} Wh" in line
+    cases = answer["result"]["storage"]["per_case"]
+    assert {case["design"]: case["capacity_wh"] for case in cases} == pytest.approx(
+        table["capacity_wh"].to_dict(), rel=1e-9
+    )

@@ -88,6 +88,14 @@ def size(
         float | None,
         typer.Option("--target-h", help="With --storage: hours a day the load runs, (0, 24]."),
     ] = None,
+    weather: Annotated[
+        Path | None,
+        typer.Option(
+            "--weather",
+            help="With --storage: a weather file (TMY3, EPW...): the buffer for the target over "
+            "its year's days, in sequence (its site; the study's objective, else mean).",
+        ),
+    ] = None,
 ):
     """Shin et al. Sec. IV-A panel sizing: the lifetime benefit C_grid x t_solar x P_load against the
     panel's cost, for flat and twofold panels of every area; with --storage, the buffer each design
@@ -98,6 +106,7 @@ def size(
       foldopt size
       foldopt size --cost-per-w 0.9 --areas 0.02:0.3:0.002
       foldopt size --storage --target-h 24 --set p_load=2 --set storage.preset=supercapacitor
+      foldopt size --storage --target-h 24 --set storage.target.days_pct=95 --weather configs/weather/723170TYA.CSV
     """
     output_format, _ = check_choices(output_format, "numba")
     output = Output(quiet, output_format, table)
@@ -105,8 +114,20 @@ def size(
     from foldopt.inputs.study_file import default_study_path
     from foldopt.studies.request import settings_plan, size_request, sizing_problems
 
-    if storage or target_h is not None:
-        _size_buffer(config, target_h, storage, settings, out, overwrite, output)
+    if storage or target_h is not None or weather is not None:
+        # The panel's costs size the panel, not its buffer: said, never ignored.
+        given = {
+            "--areas": areas != "0.01:0.5:0.005",
+            "--cost-per-m2": cost_per_m2 is not None,
+            "--cost-per-w": cost_per_w is not None,
+            "--c-grid": c_grid != C_GRID,
+            "--years": years != LIFETIME_YEARS,
+            "--days-per-year": days_per_year != DAYS_PER_YEAR,
+        }
+        if storage and any(given.values()):
+            option = next(name for name, set_ in given.items() if set_)
+            fail([f"{option}: an option of the panel's sizing; --storage sizes the buffer"])
+        _size_buffer(config, target_h, storage, settings, weather, out, overwrite, output)
         return
 
     errors = sizing_problems(
@@ -142,24 +163,43 @@ def size(
     output.answer("size", out, result.answer, result.table, [f"wrote {out}"], result.table)
 
 
-def _size_buffer(config, target_h, storage, settings, out, overwrite, output):
-    """``foldopt size --storage --target-h H``: the day's study with its buffer sized for the load
-    to run ``H`` hours a day (``storage.target``), an ideal 0 Wh buffer where the study has
-    none; its answer is the day's (:mod:`foldopt.studies.storage_answer`)."""
+def _size_buffer(config, target_h, storage, settings, weather, out, overwrite, output):
+    """``foldopt size --storage --target-h H``: the study with its buffer sized for the load to
+    run ``H`` hours a day (``storage.target``), an ideal 0 Wh buffer where the study has none;
+    its answer is the day's, or over a weather file's year (``--weather`` or the study's, with
+    its objective, else the mean) the annual one (:mod:`foldopt.studies.storage_answer`)."""
     from foldopt.cli.run import run_request
-    from foldopt.inputs.study_file import default_study_path
-    from foldopt.studies.request import Request, settings_plan
+    from foldopt.inputs.study_file import default_study_path, read_study
+    from foldopt.studies.request import Request, parse_setting, plan_request, settings_plan
 
+    if not storage and weather is not None:
+        fail(["--weather: sizes a buffer over the file's year; give --storage --target-h H"])
     if not storage or target_h is None:
         fail(["--storage and --target-h go together: --target-h is the hours a day, in (0, 24]"])
     path = config if config is not None else default_study_path()
+    source = EMBEDDED if config is None else str(config)
     given = list(settings or ())
     own = [setting for setting in given if not setting.startswith("storage")]
     sized = any(s.startswith(("storage=", "storage.capacity_wh=")) for s in given)
+    data = read_study(path)[0]
+    if weather is not None or data.get("weather") is not None:
+        # A weather year: the file's site and days, one fold angle for them (the annual group).
+        changes = dict(parse_setting(setting) for setting in given)
+        if weather is not None:
+            changes["weather"] = {"path": str(weather)}
+        if data.get("objective") is None and not any(k.startswith("objective") for k in changes):
+            changes["objective"] = {"statistic": "mean"}
+        if not sized and data.get("storage") is None:
+            changes["storage.capacity_wh"] = 0.0
+        changes["storage.target.powered_h"] = target_h
+        request = plan_request(data, changes, source=source, name=f"{data.get('name')}-buffer")
+        out = out or RESULTS / request.plan.base.name
+        run_request(request, out, overwrite, output, "auto", "size")
+        return
     if not sized and settings_plan(path, own).base.storage is None:
         given.insert(0, "storage.capacity_wh=0")
     plan = settings_plan(path, [*given, f"storage.target.powered_h={target_h!r}"])
-    request = Request(plan, EMBEDDED if config is None else str(config), ())
+    request = Request(plan, source, ())
     out = out or RESULTS / f"{plan.base.name}-buffer"
     run_request(request, out, overwrite, output, "auto", "size")
 

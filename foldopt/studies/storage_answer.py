@@ -109,8 +109,13 @@ def reaches(result: StorageResult, target) -> np.ndarray:
     """(n_series,) bool: whether each series runs the load ``target.powered_h`` on at least
     ``target.days_pct`` of its days, from a periodic state (a series whose end state never
     repeats its start's reaches nothing)."""
-    days = result.powered_h >= target.powered_h - TARGET_SLACK_H
-    return (100.0 * days.mean(axis=1) >= target.days_pct - 1e-9) & result.converged
+    return _reaching(result.powered_h, result.converged, target)
+
+
+def _reaching(powered_h, converged, target) -> np.ndarray:
+    """:func:`reaches` of daily powered time [h] (n, n_days) and (n,) periodic states."""
+    days = powered_h >= target.powered_h - TARGET_SLACK_H
+    return (100.0 * days.mean(axis=1) >= target.days_pct - 1e-9) & converged
 
 
 @dataclass(frozen=True)
@@ -161,22 +166,12 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
     Sizing
     """
     fold_angles = np.asarray(fold_angles, dtype=float)
-    names = ["flat", "tracker", "tracker-net"] + [f"twofold@{a:g}" for a in fold_angles]
     power = np.vstack([curves["flat"], curves["tracker"], curves["tracker-net"], curves["twofold"]])
-    demand_wh = float(np.sum(np.broadcast_to(load, (1, power.shape[-1]))) * step_hours)
-    scale = max(demand_wh, 1e-6) / ((1.0 - storage.min_soc) * storage.discharge_efficiency)
-    # The study's own buffer is a point of the curve.
-    capacities = np.unique(np.minimum(np.append(GRID * scale, storage.capacity_wh), 1e6))
-    n, m = len(names), capacities.size
-    result = run_buffer(
-        np.repeat(power, m, axis=0),
-        load,
-        buffer_of(storage, capacity_wh=np.tile(capacities, n)),
-        step_hours,
-        engine,
+    capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
+    n, m = power.shape[0], capacities.size
+    hours, ok = _at_capacities(
+        power, np.broadcast_to(capacities, (n, m)), load, storage, step_hours, engine, True
     )
-    # A series with no periodic state has no powered time to draw (NaN: the figure leaves it out).
-    hours = np.where(result.converged, result.powered_h.mean(axis=1), np.nan).reshape(n, m)
     twofold = hours[3:]
     best = best_angle_index(np.nan_to_num(twofold.T, nan=-1.0))
     curve = pd.DataFrame(
@@ -197,7 +192,6 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
     stops_wh = float(capacities[stops[0]]) if len(stops) and pays.any() else float("nan")
     table = pd.DataFrame()
     if storage.target is not None:
-        ok = reaches(result, storage.target).reshape(n, m)
         first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)
         # The twofold angle needing the least buffer on the grid is refined with flat and trackers.
         need = np.where(first[3:] >= 0, capacities[first[3:]], np.inf)
@@ -206,7 +200,9 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
             np.argmin(need) if np.isfinite(need).any() else np.argmax(fold_angles == own)
         )
         keep = [0, pick, 1, 2]
-        found = _refine(power[keep], first[keep], capacities, load, storage, step_hours, engine)
+        found = _refine(
+            power[keep], first[keep], capacities, load, storage, step_hours, engine, True
+        )
         table = pd.DataFrame(
             {
                 "design": ["flat", "twofold", "tracker", "tracker-net"],
@@ -221,7 +217,72 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
     return Sizing(table, curve, stops_wh)
 
 
-def _refine(power, first, capacities, load, storage, step_hours, engine):
+def capacity_grid(load, storage, step_hours, n_steps) -> np.ndarray:
+    """The sizing's grid of capacities [Wh]: :data:`GRID` times a day's load energy (the days'
+    mean) over the usable fraction, with the study's own capacity (a point of the curve)."""
+    daily = np.broadcast_to(load, (1, n_steps)) if np.ndim(load) < 2 else load
+    demand_wh = float(np.sum(daily) / (daily.size // n_steps) * step_hours)
+    scale = max(demand_wh, 1e-6) / ((1.0 - storage.min_soc) * storage.discharge_efficiency)
+    return np.unique(np.minimum(np.append(GRID * scale, storage.capacity_wh), 1e6))
+
+
+def _at_capacities(power, capacities, load, storage, step_hours, engine, in_sequence: bool):
+    """Each design's buffer at each of its capacities.
+
+    Parameters
+    ----------
+    power : numpy.ndarray
+        (n, n_steps) a day per design, or (n, n_days, n_steps) days.
+    capacities : numpy.ndarray
+        (n, m) [Wh].
+    load : float or numpy.ndarray
+        [W], or a profile (1, n_steps) or (1, n_days, n_steps).
+    in_sequence : bool
+        The days follow each other (a day repeated to its periodic state is in sequence); else
+        each day is its own periodic series.
+
+    Returns
+    -------
+    hours : numpy.ndarray
+        (n, m) mean powered time [h]; NaN where some series found no periodic state.
+    ok : numpy.ndarray
+        (n, m) bool: :func:`reaches` ``storage.target`` (all False without a target).
+    """
+    hours, ok = [], []
+    for curve, capacity in zip(power, capacities, strict=True):
+        days = curve.reshape(-1, curve.shape[-1])
+        if in_sequence:
+            # One curve serves every capacity, without a copy.
+            series, buffer = curve[None], buffer_of(storage, capacity_wh=capacity)
+            each = load
+        else:
+            # A series per capacity and day, capacity by capacity.
+            series = np.tile(days[:, None, :], (capacity.size, 1, 1))
+            buffer = buffer_of(storage, capacity_wh=np.repeat(capacity, len(days)))
+            each = (
+                load
+                if np.ndim(load) == 0
+                else np.tile(
+                    np.broadcast_to(np.reshape(load, (-1, days.shape[-1])), days.shape)[:, None],
+                    (capacity.size, 1, 1),
+                )
+            )
+        result = run_buffer(series, each, buffer, step_hours, engine)
+        powered = result.powered_h.reshape(capacity.size, -1)  # (m, days)
+        converged = result.converged.reshape(capacity.size, -1).all(axis=1)
+        # A series with no periodic state has no powered time to draw (NaN: the figure leaves
+        # it out).
+        hours.append(np.where(converged, powered.mean(axis=1), np.nan))
+        target = storage.target
+        ok.append(
+            _reaching(powered, converged, target)
+            if target is not None
+            else np.zeros(capacity.size, bool)
+        )
+    return np.array(hours), np.array(ok)
+
+
+def _refine(power, first, capacities, load, storage, step_hours, engine, in_sequence):
     """The bracket of each series between the grid's capacity ``first`` (the least reaching the
     target; -1: none does, NaN) and the one below it, cut until within :data:`CAPACITY_RTOL`."""
     found = np.where(first >= 0, capacities[np.maximum(first, 0)], np.nan)
@@ -234,14 +295,7 @@ def _refine(power, first, capacities, load, storage, step_hours, engine):
         inner = lo[open_, None] + (hi - lo)[open_, None] * (
             np.arange(1, REFINE_POINTS + 1) / (REFINE_POINTS + 1)
         )
-        result = run_buffer(
-            np.repeat(power[open_], REFINE_POINTS, axis=0),
-            load,
-            buffer_of(storage, capacity_wh=inner.ravel()),
-            step_hours,
-            engine,
-        )
-        ok = reaches(result, storage.target).reshape(open_.size, REFINE_POINTS)
+        _, ok = _at_capacities(power[open_], inner, load, storage, step_hours, engine, in_sequence)
         # The least interior capacity reaching the target tops the new bracket; the one below
         # it (or the old bottom) is its floor.
         at = np.where(ok.any(axis=1), np.argmax(ok, axis=1), REFINE_POINTS)
@@ -252,6 +306,26 @@ def _refine(power, first, capacities, load, storage, step_hours, engine):
         )
         floor = np.where(at > 0, inner[np.arange(open_.size), np.maximum(at - 1, 0)], lo[open_])
         lo[open_], hi[open_] = floor, top
+
+
+def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool) -> np.ndarray:
+    """Each design's smallest buffer [Wh] for ``storage.target`` over its days (NaN: none up to
+    the grid's top), by :func:`size_buffers`' search.
+
+    Parameters
+    ----------
+    power : numpy.ndarray
+        (n, n_days, n_steps) [W].
+    load, in_sequence
+        As :func:`_at_capacities`'.
+    """
+    capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
+    shape = (power.shape[0], capacities.size)
+    _, ok = _at_capacities(
+        power, np.broadcast_to(capacities, shape), load, storage, step_hours, engine, in_sequence
+    )
+    first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)
+    return _refine(power, first, capacities, load, storage, step_hours, engine, in_sequence)
 
 
 @dataclass(frozen=True)
@@ -662,8 +736,11 @@ def year_storage(
         ``min_powered_h``, ``mean_t_solar_h`` (of the same curves, with no buffer: the 0 Wh
         run) and :func:`day_columns`' ``availability_pct``, ``days_powered_24h_pct``,
         ``energy_missing_wh``, ``energy_lost_wh`` (a day, the days' mean), ``days_full_pct``,
-        ``days_empty_pct``; ``converged`` where every series found its periodic state; the
-        near-optimal range of ``twofold-buffer`` (NaN in the other rows).
+        ``days_empty_pct``; ``converged`` where every series found its periodic state; with
+        ``storage.target``, ``capacity_wh``, the smallest buffer reaching it over the days
+        (:func:`smallest_buffers`; NaN: none up to the grid's top), and
+        ``capacity_vs_flat_pct``; the near-optimal range of ``twofold-buffer`` (NaN in the other
+        rows).
     """
     engine = storage_engine(engine)
     loads = np.asarray(loads, dtype=float)
@@ -684,6 +761,21 @@ def year_storage(
             result = _by_design(result, len(YEAR_DESIGNS))
             bare = _by_design(bare, len(YEAR_DESIGNS))
         powered = result.powered_h.reshape(shape)
+        sized = {}
+        if storage.target is not None:
+            # Each design's smallest buffer for the target over the days (a load profile's day
+            # by day).
+            need = smallest_buffers(
+                power,
+                p_load if load_shape is None else p_load * load_shape[None],
+                storage,
+                step_hours,
+                engine,
+                in_sequence,
+            )
+            with np.errstate(invalid="ignore", divide="ignore"):
+                vs_flat = (need / need[0] - 1.0) * 100.0 if need[0] > 0 else np.nan * need
+            sized = {"capacity_wh": need, "capacity_vs_flat_pct": vs_flat}
         rows.append(
             pd.DataFrame(
                 {
@@ -703,6 +795,7 @@ def year_storage(
                     "mean_t_solar_h": bare.powered_h.reshape(shape).mean(axis=1),
                     **{k: v for k, v in day_columns(result).items() if k != "powered_h"},
                     "converged": result.converged.reshape(shape[0], -1).all(axis=1),
+                    **sized,
                     **{
                         key: np.where(
                             np.asarray(YEAR_DESIGNS) == "twofold-buffer", value[index], np.nan
@@ -789,6 +882,29 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
             f"{best['near_optimal_lo_deg']:g} to {best['near_optimal_hi_deg']:g} deg, recommended "
             f"{best['recommended_fold_angle_deg']:g} deg"
         )
+        if "capacity_wh" in by:
+            target = storage.target
+            said = f"{target.powered_h:g} h" + (
+                f" on {target.days_pct:g} % of days" if target.days_pct < 100 else " every day"
+            )
+            need, saving = by["capacity_wh"], by["capacity_vs_flat_pct"]
+            lines.append(
+                f"  for {said}: "
+                + ", ".join(
+                    (
+                        f"{named[d]} needs {need[d]:.3g} Wh"
+                        + (
+                            f" ({saving[d]:+.0f} %)"
+                            if d != "flat" and saving[d] == saving[d]
+                            else ""
+                        )
+                        if need[d] == need[d]
+                        else f"{named[d]}: no buffer up to the search's top reaches it"
+                    )
+                    for d in YEAR_SAID
+                    if d != "twofold-buffer" or angle[d] != angle["twofold"]
+                )
+            )
     if not table["converged"].all():
         lines.append(
             "note: the buffer found no periodic state for some designs: their powered time is "
