@@ -15,7 +15,7 @@ it is made. The rules, each said back to the user by :func:`apply`'s second valu
 - a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
   given; a new latitude or longitude drops the site's name, a new longitude its time zone;
 - a weather file brings its own site, year and light (the study's sky, site and day give way), and
-  a measured file its own days and step;
+  a measured file (or a source read as one, ``pvgis-hourly``) its own days and step;
 - a new tracker model keeps only the tracker's standby draw; a new fold-angle step starts the grid
   at that step; a load profile given without a scale runs as written (scale 1).
 
