@@ -589,3 +589,29 @@ def test_a_source_read_as_a_measured_file_is_named_so():
 
     assert {name for name, source in SOURCES.items() if source.format not in HOURLY_WEATHER_FORMATS} == set(
         MEASURED_WEATHER_SOURCES)
+
+
+def test_a_study_file_names_the_hourly_source_its_years_and_database(pvgis, server, tmp_path):
+    route = pvgis("ok")
+    embedded = {k: v for k, v in yaml.safe_load(default_study_path().read_text()).items()
+                if k not in ("sky", "step_min")}
+    study = {**embedded, "mode": "exact", "site": {"latitude": 45.0, "longitude": 8.0},
+             "date": "2021-06-21", "p_load": 4, "fold_angles": {"start": 30, "stop": 180, "step": 30},
+             "weather": {"source": "pvgis-hourly", "years": "2020:2021", "raddatabase": "PVGIS-SARAH3"}}
+    (tmp_path / "site.yaml").write_text(yaml.safe_dump(study))
+    result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet"])
+    assert result.exit_code == 0, result.output
+    ((where, query),) = queries_made(server, route)
+    assert where == "seriescalc" and "raddatabase=PVGIS-SARAH3" in query.split("&")
+    tmy = {**study, "weather": {"source": "pvgis-tmy", "raddatabase": "PVGIS-SARAH3"}}
+    (tmp_path / "tmy.yaml").write_text(yaml.safe_dump(tmy))
+    refused = runner.invoke(app, ["run", "tmy.yaml", "--out", "tmy"])
+    assert refused.exit_code == 2
+    assert "weather.raddatabase is only used by the pvgis-hourly source" in refused.stderr
+    (tmp_path / "sites.csv").write_text("name,latitude,longitude\nturin,45,8\n")
+    mapped = runner.invoke(app, ["map", "--sites", "sites.csv", "--weather", "pvgis-hourly", *YEARS,
+                                 "--out", "map"])
+    assert (mapped.exit_code, mapped.stderr.strip().splitlines()) == (2, [
+        "error: --weather pvgis-hourly: a map runs a typical year at each site; a series of real years "
+        "is studied one site at a time (foldopt sweep angle --weather pvgis-hourly --years START:END)"])
+    assert requests_made(server, route) == 1 and not (tmp_path / "map").exists()

@@ -138,7 +138,8 @@ def sweep_options(
         typer.Option(
             "--years",
             help="A weather source's years START:END, e.g. 2005:2020 (PVGIS TMY: its months "
-            "chosen from them, at least 10) [default: the service's record].",
+            "chosen from them, at least 10; PVGIS hourly: the series' years, each day a block) "
+            "[default: the service's record].",
         ),
     ] = None,
     offline: Annotated[

@@ -36,8 +36,8 @@ Years = Annotated[
     str | None,
     typer.Option(
         "--years",
-        help="The years START:END (PVGIS TMY: its months chosen from them, at least 10) "
-        "[default: the service's record].",
+        help="The years START:END (PVGIS TMY: its months chosen from them, at least 10; "
+        "PVGIS hourly: the series' years, 2005 to 2023) [default: the service's record].",
     ),
 ]
 NoHorizon = Annotated[
@@ -106,6 +106,7 @@ def fetch(
     Examples:
       foldopt weather fetch pvgis-tmy --lat 45.8 --lon 8.6
       foldopt weather fetch pvgis-tmy --lat 45.8 --lon 8.6 --years 2005:2020
+      foldopt weather fetch pvgis-hourly --lat 45.8 --lon 8.6 --years 2020:2021
     """
     spec = _options(source, years, no_horizon, url, timeout)
     from foldopt.inputs.weather.sources import fetch as fetch_source

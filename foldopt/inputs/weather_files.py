@@ -13,7 +13,12 @@ from pathlib import Path
 
 from foldopt.errors import ConfigError, WeatherError, printable
 from foldopt.inputs.reading import MAX_WEATHER_BYTES, check_input
-from foldopt.names import HOURLY_WEATHER_FORMATS, WEATHER_FORMATS, canonical
+from foldopt.names import (
+    HOURLY_WEATHER_FORMATS,
+    MEASURED_WEATHER_SOURCES,
+    WEATHER_FORMATS,
+    canonical,
+)
 
 
 def weather_read(weather, site=None) -> dict:
@@ -354,6 +359,14 @@ def with_fetched_sites(sites: list[dict], weather) -> list[dict]:
         raise ConfigError([f"weather.{line}" for line in format_errors(error)]) from None
     if spec.source is None:
         raise ConfigError(["weather: a map's weather names a source (weather.source)"])
+    if spec.source in MEASURED_WEATHER_SOURCES:
+        raise ConfigError(
+            [
+                f"weather.source {spec.source}: a map runs a typical year at each site; a series "
+                f"of real years is studied one site at a time (foldopt sweep angle --weather "
+                f"{spec.source} --years START:END)"
+            ]
+        )
     from foldopt.inputs.weather.sources import fetch  # requests: only to fetch
 
     fetched = []

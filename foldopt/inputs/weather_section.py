@@ -188,4 +188,6 @@ class Weather(StrictModel):
                 f"weather.{given[0]} is only used by a weather source (weather.source: "
                 f"{', '.join(names.WEATHER_SOURCES)})"
             )
+        if self.raddatabase is not None and self.source not in (None, "pvgis-hourly"):
+            raise ValueError("weather.raddatabase is only used by the pvgis-hourly source")
         return self
