@@ -123,8 +123,13 @@ def _measured_read(files, path: str, fmt: str, spec: dict, site) -> dict:
         raise  # foldopt.errors.WeatherError: what is wrong with the file
     except ValueError:
         return {}  # an option out of its range: the study's validation names it
+    import numpy as np  # with pandas: only when a file is named
+
     days = measured.frame.index.tz_localize(None).normalize().unique()
-    dates = tuple(str(day.date()) for day in days if day.date() not in measured.flagged_days)
+    # vectorised: a study checks its file once per day, and a series of years has hundreds
+    whole = days.to_numpy().astype("datetime64[D]")
+    flagged = np.array(measured.flagged_days, dtype="datetime64[D]")
+    dates = tuple(np.datetime_as_string(whole[~np.isin(whole, flagged)]).tolist())
     read = {
         "weather_site": measured.site,
         "weather_step_min": measured.step.total_seconds() / 60.0,
