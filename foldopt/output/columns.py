@@ -226,6 +226,12 @@ COLUMNS = (
     ),
     ("powered_{design}_h", "h", "powered time of one design at a capacity (storage_capacity.csv)"),
     ("capacity_vs_flat_pct", "%", "the design's buffer for the target over flat's, less 100"),
+    (
+        "monotone",
+        "",
+        "every larger capacity of the sizing's grid reaches the target too (False: hysteresis or "
+        "self-discharge; the capacity is the least evaluated that reaches it)",
+    ),
     ("mean_powered_h", "h", "mean daily powered time with the buffer (storage_annual.csv)"),
     ("min_powered_h", "h", "the least daily powered time with the buffer (storage_annual.csv)"),
     (

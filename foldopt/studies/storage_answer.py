@@ -6,14 +6,26 @@ periodic steady state of :func:`foldopt.engine.storage.simulate`), or started fr
 section's ``initial_soc``. Every curve simulated is the one the study's ``t_solar`` was reduced
 from, so that a buffer of 0 Wh gives each design's ``t_solar`` (to the last bit of a sum).
 
-The sizing (:func:`size_buffers`) is a bracketed search on the capacity, run for every design at
-once: a geometric grid of capacities (the one the figure of powered time against capacity
-draws), then the bracket between the largest capacity short of the target and the smallest
-reaching it cut into :data:`REFINE_POINTS` + 1 parts until it is within
-:data:`CAPACITY_RTOL` of its top. It takes powered time not to fall as the capacity grows, which
-holds for a controller without hysteresis and a buffer that does not leak
-(:mod:`foldopt.engine.storage`); with either, powered time may dip by a little over a grid step,
-and the capacity found is the least of the grid's and the bracket's that reaches the target.
+The sizing (:func:`size_buffers`, :func:`smallest_buffers`) is a bracketed search on the
+capacity, run for every design at once: a geometric grid of capacities (the one the figure of
+powered time against capacity draws), then the bracket between the least capacity of the grid
+reaching the target and the one below it (which does not) cut into :data:`REFINE_POINTS` + 1
+parts, the least part reaching it and the part below it the next bracket, until it is within
+:data:`CAPACITY_RTOL` of its top. The capacity given is therefore always one evaluated that
+reaches the target, every smaller capacity of the grid falls short of it, and so does an
+evaluated one within :data:`CAPACITY_RTOL` below it.
+
+That this is *the* smallest buffer rests on powered time not falling as the capacity grows. It
+holds, to within one step, only for a controller without hysteresis (``restart_soc`` =
+``min_soc``) and a buffer that does not leak (``self_discharge`` 0)
+(:mod:`foldopt.engine.storage`). With a hysteresis band or a leak it does not: the band that must
+be recharged before the load reconnects, and the floor that leaks, grow with the buffer, so that
+a larger buffer can run the load less (a band larger than a day's harvest never reconnects the
+load: it runs on PV alone), and some repeated days find no periodic state (a two-day cycle: such a
+capacity reaches nothing). The search then finds the least capacity reaching the target at the
+grid's resolution (a capacity that reaches it between two grid points that do not is missed),
+bisects only its bracket, and says, per design (``monotone``), whether every larger capacity of the
+grid reaches the target too; where one does not, the answer notes it.
 
 The module may import numpy, pandas, :mod:`foldopt.engine` and :mod:`foldopt.inputs`.
 """
@@ -127,7 +139,8 @@ class Sizing:
     table : pandas.DataFrame
         Per design (``flat``, ``twofold`` at the angle needing the least, ``tracker``,
         ``tracker-net``): ``design``, ``fold_angle_deg``, ``capacity_wh`` (NaN where no buffer up
-        to the grid's top reaches the target) and ``capacity_vs_flat_pct``.
+        to the grid's top reaches the target), ``monotone`` (every larger capacity of the grid
+        reaches it too; module docstring) and ``capacity_vs_flat_pct``.
     curve : pandas.DataFrame
         ``capacity_wh`` and ``powered_{flat,twofold,tracker}_h``: powered time against capacity,
         the twofold panel at each capacity's best of the angles compared.
@@ -208,6 +221,7 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
                 "design": ["flat", "twofold", "tracker", "tracker-net"],
                 "fold_angle_deg": [180.0, fold_angles[pick - 3], np.nan, np.nan],
                 "capacity_wh": found,
+                "monotone": _held_above(ok[keep], first[keep]),
             }
         )
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -308,9 +322,10 @@ def _refine(power, first, capacities, load, storage, step_hours, engine, in_sequ
         lo[open_], hi[open_] = floor, top
 
 
-def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool) -> np.ndarray:
+def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool):
     """Each design's smallest buffer [Wh] for ``storage.target`` over its days (NaN: none up to
-    the grid's top), by :func:`size_buffers`' search.
+    the grid's top), by :func:`size_buffers`' search, and whether every larger capacity of the
+    grid reaches it too (:func:`_held_above`).
 
     Parameters
     ----------
@@ -325,7 +340,15 @@ def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool
         power, np.broadcast_to(capacities, shape), load, storage, step_hours, engine, in_sequence
     )
     first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)
-    return _refine(power, first, capacities, load, storage, step_hours, engine, in_sequence)
+    found = _refine(power, first, capacities, load, storage, step_hours, engine, in_sequence)
+    return found, _held_above(ok, first)
+
+
+def _held_above(ok, first) -> np.ndarray:
+    """(n,) bool: every capacity of the grid from the least reaching the target on reaches it
+    too (the premise of a bracketed search; True where none reaches it)."""
+    index = np.arange(ok.shape[1])
+    return (ok | (index < first[:, None])).all(axis=1) | (first < 0)
 
 
 @dataclass(frozen=True)
@@ -459,6 +482,14 @@ def day_storage(
     )
 
 
+#: The note of a sizing whose target a larger capacity of the grid misses again.
+NOT_MONOTONE = (
+    "note: a larger buffer than the one given falls short of the target again for {designs} "
+    "(hysteresis or self-discharge: powered time is not monotone in capacity); each is the "
+    "least capacity evaluated that reaches it"
+)
+
+
 def _wh(value) -> str:
     return "-" if value != value else f"{value:.3g} Wh"
 
@@ -587,6 +618,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             "capacity_by_design_wh": {d: float(need[d]) for d in table.index},
             "fold_angle_twofold_deg": angle,
             "capacity_twofold_vs_flat_pct": saving,
+            "monotone_by_design": {d: bool(table.loc[d, "monotone"]) for d in table.index},
             "searched_up_to_wh": top,
         }
         said = f"{target.powered_h:g} h" + (
@@ -607,6 +639,10 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             + f", the tracker {needs(need['tracker'])}"
             + f" (net of its drive: {needs(need['tracker-net'])})"
         )
+        if not table["monotone"].all():
+            lines.append(
+                NOT_MONOTONE.format(designs=", ".join(table.index[~table["monotone"].to_numpy()]))
+            )
     if not buffered.converged:
         lines.append(
             "note: the buffer found no periodic state for some designs or angles (its end state "
@@ -738,8 +774,8 @@ def year_storage(
         ``energy_missing_wh``, ``energy_lost_wh`` (a day, the days' mean), ``days_full_pct``,
         ``days_empty_pct``; ``converged`` where every series found its periodic state; with
         ``storage.target``, ``capacity_wh``, the smallest buffer reaching it over the days
-        (:func:`smallest_buffers`; NaN: none up to the grid's top), and
-        ``capacity_vs_flat_pct``; the near-optimal range of ``twofold-buffer`` (NaN in the other
+        (:func:`smallest_buffers`; NaN: none up to the grid's top), ``capacity_vs_flat_pct``
+        and ``monotone``; the near-optimal range of ``twofold-buffer`` (NaN in the other
         rows).
     """
     engine = storage_engine(engine)
@@ -765,7 +801,7 @@ def year_storage(
         if storage.target is not None:
             # Each design's smallest buffer for the target over the days (a load profile's day
             # by day).
-            need = smallest_buffers(
+            need, monotone = smallest_buffers(
                 power,
                 p_load if load_shape is None else p_load * load_shape[None],
                 storage,
@@ -775,7 +811,7 @@ def year_storage(
             )
             with np.errstate(invalid="ignore", divide="ignore"):
                 vs_flat = (need / need[0] - 1.0) * 100.0 if need[0] > 0 else np.nan * need
-            sized = {"capacity_wh": need, "capacity_vs_flat_pct": vs_flat}
+            sized = {"capacity_wh": need, "capacity_vs_flat_pct": vs_flat, "monotone": monotone}
         rows.append(
             pd.DataFrame(
                 {
@@ -905,6 +941,12 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                     if d != "twofold-buffer" or angle[d] != angle["twofold"]
                 )
             )
+    if "monotone" in table and not table["monotone"].all():
+        lines.append(
+            NOT_MONOTONE.format(
+                designs=", ".join(dict.fromkeys(table.loc[~table["monotone"], "design"]))
+            )
+        )
     if not table["converged"].all():
         lines.append(
             "note: the buffer found no periodic state for some designs: their powered time is "
