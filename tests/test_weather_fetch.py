@@ -364,8 +364,8 @@ def test_a_maps_weather_options_are_checked_before_anything_is_fetched(pvgis, se
     route = pvgis("ok")
     (tmp_path / "sites.csv").write_text("name,latitude,longitude\nturin,45,8\n")
     for options, line in [
-        (["--weather", "pvgis-tmx"], "error: --weather = 'pvgis-tmx': must be one of pvgis-tmy, pvgis-hourly; did you mean "
-                                     "'pvgis-tmy'?"),
+        (["--weather", "pvgis-tmx"], "error: --weather = 'pvgis-tmx': must be one of pvgis-tmy, "
+                                     "pvgis-hourly; did you mean 'pvgis-tmy'?"),
         (["--years", "2005:2020"], "error: --years: the years of a weather source; give one with --weather"),
         (["--weather", "pvgis-tmy", "--years", "2005"], "error: --years = '2005': the first and last year as "
                                                         "START:END, e.g. 2005:2020"),
@@ -615,3 +615,15 @@ def test_a_study_file_names_the_hourly_source_its_years_and_database(pvgis, serv
         "error: --weather pvgis-hourly: a map runs a typical year at each site; a series of real years "
         "is studied one site at a time (foldopt sweep angle --weather pvgis-hourly --years START:END)"])
     assert requests_made(server, route) == 1 and not (tmp_path / "map").exists()
+
+
+def test_a_kept_hourly_series_read_without_its_format_says_which(tmp_path, monkeypatch):
+    """The recorded series read as a .json file (a PVGIS TMY by its extension): one line naming
+    the format it looks like."""
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["sweep", "angle", "--weather", str(HOURLY), "--p-load", "4", "--out", "x"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        f"error: --weather {HOURLY.name}: not a PVGIS TMY file: no outputs.tmy_hourly list of hourly records; "
+        "read as pvgis (by its extension .json), it looks like a pvgis-hourly file: give --weather-format "
+        "pvgis-hourly (weather.format: pvgis-hourly in a study)"]

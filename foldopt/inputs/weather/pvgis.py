@@ -129,7 +129,8 @@ FORMAT = WeatherFormat(
     label="PVGIS TMY",
     interval_label="start",
     suffixes=(".json",),
-    signature=r'\A\s*\{\s*"(?:inputs|outputs|meta)"',
+    # not an hourly series (``outputs.hourly``, the ``pvgis-hourly`` format's)
+    signature=r'\A\s*\{\s*"(?:inputs|outputs|meta)"(?![\s\S]*"outputs"\s*:\s*\{\s*"hourly")',
     columns={
         "ghi": "G(h)",
         "dni": "Gb(n)",
