@@ -167,8 +167,9 @@ def path(
         Path | None,
         typer.Option(
             "--out",
-            help="Copy the cached answer to this file: a standard weather file (PVGIS TMY JSON) "
-            "that --weather FILE reads, to keep beside the study.",
+            help="Copy the cached answer to this file: a standard weather file (PVGIS TMY JSON; "
+            "an hourly series with --weather-format pvgis-hourly) that --weather FILE reads, to "
+            "keep beside the study.",
         ),
     ] = None,
     overwrite: Overwrite = False,
