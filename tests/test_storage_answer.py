@@ -454,3 +454,23 @@ def test_the_sizing_is_the_least_capacity_evaluated_that_reaches_the_target(
     if band == 0 and leak == 0:
         known = hours[0][np.isfinite(hours[0])]
         assert (np.diff(known) >= -0.5 - 1e-9).all()
+
+
+def test_a_plan_of_sites_says_each_site_s_buffer():
+    # Two latitudes over two clear days: storage_annual.csv names each row's site, the answer each
+    # site's lines (it raised on the site's duplicate rows before).
+    study = make_study({**EMBEDDED, **QUICK, "p_load": CARRIED, "storage": {"capacity_wh": 10}})
+    year = foldopt.sweep(
+        study, "day", axes={"site.latitude": [10.0, 40.0]}, date=["2014-03-21", "2014-06-21"],
+        objective="mean",
+    )  # fmt: skip
+    table = year.extras["storage_annual"]
+    assert table.groupby("latitude")["design"].apply(list).to_dict() == {
+        latitude: ["flat", "twofold", "twofold-buffer", "tracker", "tracker-net"]
+        for latitude in (10.0, 40.0)
+    }
+    lines = year.answer.lines()
+    for latitude in (10, 40):
+        assert any(
+            line.startswith(f"  {latitude}, -118.25: P_load 2: mean powered") for line in lines
+        )

@@ -883,8 +883,20 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
         else "each day repeated to its periodic state"
     )
     lines = [f"with the {buffer_text(storage)}, {how}:"]
-    for p_load, rows in list(table.groupby("p_load_w", sort=False))[:8]:
+    cases = [
+        table.iloc[start : start + len(YEAR_DESIGNS)]
+        for start in range(0, len(table), len(YEAR_DESIGNS))
+    ]
+    sites = table[["latitude", "longitude"]].drop_duplicates()
+    for rows in cases[:8]:
         by = rows.set_index("design")
+        first = rows.iloc[0]
+        p_load = first["p_load_w"]
+        site = (
+            f"{first['site_name'] or f'{first.latitude:g}, {first.longitude:g}'}: "
+            if len(sites) > 1
+            else ""
+        )
         angle = by["fold_angle_deg"]
         named = {
             "flat": "flat",
@@ -893,7 +905,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
             "tracker": "tracker",
         }
         lines.append(
-            f"  P_load {p_load:g}: mean powered time "
+            f"  {site}P_load {p_load:g}: mean powered time "
             + ", ".join(
                 f"{named[d]} {by.loc[d, 'mean_powered_h']:.2f} h "
                 f"(t_solar {by.loc[d, 'mean_t_solar_h']:.2f} h)"
@@ -941,6 +953,8 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                     if d != "twofold-buffer" or angle[d] != angle["twofold"]
                 )
             )
+    if len(cases) > 8:
+        lines.append(f"  ... and {len(cases) - 8} more (storage_annual.csv)")
     if "monotone" in table and not table["monotone"].all():
         lines.append(
             NOT_MONOTONE.format(
