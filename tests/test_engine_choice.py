@@ -40,6 +40,12 @@ def test_a_request_decides_by_its_days_angles_and_steps():
     assert request_engine("auto", plan_request(study.data(), {"date": dates}).plan) == "numpy"
     more = [*dates, "2025-12-31"]
     assert request_engine("auto", plan_request(study.data(), {"date": more}).plan) == "numba"
+    # A joint search over the tilt or the azimuth evaluates some 10^4 designs: the kernel; a
+    # search of the fold angle alone is the day's grid.
+    joint = study.variant(optimize={"vary": ["fold_angle", "tilt"]})
+    assert request_engine("auto", joint) == "numba"
+    fold_only = study.variant(optimize={"vary": ["fold_angle"]})
+    assert request_engine("auto", fold_only) == "numpy"
     # A weather file's days are not known before it is read: the kernel; a map too.
     year = foldopt.load_study(ROOT / "configs" / "annual-weather.yaml")
     assert request_engine("auto", year) == "numba" and request_engine("auto", None) == "numba"

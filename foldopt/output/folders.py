@@ -442,6 +442,7 @@ def write_optimize(result, out: Path, overwrite: bool = False, command=None) -> 
             days=len(result.dates),
             search=result.answer.result["search"],
             input_sha256=input_hash(study.data()),
+            engine=result.engine,
         )
         write_run_json(folder, metadata)
         write_html(folder, result.answer, figures, result.table, "Designs (optimum.csv)", metadata)

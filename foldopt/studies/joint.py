@@ -78,6 +78,8 @@ class OptimizeResult:
     landscape : pandas.DataFrame
         The first load's objective over ``fold_angle_deg`` x ``surface_tilt`` at the optimum's azimuth.
     request : object, optional
+    engine : str
+        The engine the designs were evaluated by (``numba`` or ``numpy``).
     """
 
     study: Study
@@ -92,6 +94,7 @@ class OptimizeResult:
     added: pd.DataFrame
     landscape: pd.DataFrame
     request: object = None
+    engine: str = "numba"
 
     @functools.cached_property
     def answer(self):
@@ -253,6 +256,7 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
         added,
         landscape,
         request,
+        engine,
     )
 
 

@@ -662,10 +662,10 @@ def request_engine(engine: str, plan) -> str:
     ``auto`` (:mod:`foldopt.engine.choice`) takes the NumPy reference path where the request's
     clear-sky days at its fold angles come to at most
     :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` rows x steps: a day's study, its sweeps of the
-    angle or the load, a few latitudes or days, a joint optimisation of one day (nothing to
-    compile). A weather file's or a cloud ensemble's days, more days, a study with a buffer
-    (whose reference path walks the time steps in Python) and a map (``plan`` None: a year at
-    every site) take the compiled kernel.
+    angle or the load, a few latitudes or days (nothing to compile). A weather file's or a cloud
+    ensemble's days, more days, a joint search over the tilt or the azimuth (some 10^4 designs),
+    a study with a buffer (whose reference path walks the time steps in Python) and a map
+    (``plan`` None: a year at every site) take the compiled kernel.
 
     Parameters
     ----------
@@ -687,5 +687,9 @@ def request_engine(engine: str, plan) -> str:
         # The buffer's reference path walks the time steps in Python, 0.8 s a pass over a day of
         # 1-min steps however few the curves, and a periodic state takes 2 to 60 passes: a day's
         # buffer sized for a target took 55 s there, 0.23 s compiled (its first compile 6 s).
+        return engine_for(engine, math.inf)
+    if base.optimize is not None and set(base.optimize.vary) != {"fold_angle"}:
+        # A joint search over the tilt or the azimuth evaluates some 10^4 designs of a day (the
+        # embedded study's 15,915: results/examples/optimize/added.csv), 23 M rows x steps.
         return engine_for(engine, math.inf)
     return engine_for(engine, cases * base.fold_angles.count() * round(24 * 60 / base.step_min))
