@@ -16,6 +16,38 @@ import pandas as pd
 from foldopt.inputs.weather.formats import WeatherFormat, offset_zone, read_with_pvlib, site_value
 
 
+def answer_records(text: str, key: str, kind: str, fail) -> tuple[dict, list]:
+    """A PVGIS answer's JSON and its list of hourly records ``outputs[key]`` (a TMY's
+    ``tmy_hourly``, an hourly series' ``hourly``).
+
+    Parameters
+    ----------
+    text : str
+        The answer's text.
+    key : str
+    kind : str
+        What the answer is, for the message (``a PVGIS TMY file``).
+    fail : callable
+        ``fail(message)``: the error to raise.
+
+    Returns
+    -------
+    tuple
+        ``(answer, records)``: the decoded JSON and its records, possibly empty.
+    """
+    try:
+        answer = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise fail(
+            f"not valid JSON: {error.msg} at line {error.lineno} column {error.colno}"
+        ) from None
+    outputs = answer.get("outputs") if isinstance(answer, dict) else None
+    records = outputs.get(key) if isinstance(outputs, dict) else None
+    if not isinstance(records, list):
+        raise fail(f"not {kind}: no outputs.{key} list of hourly records")
+    return answer, records
+
+
 def read(path: str, text: str, year: int, fail):
     """A PVGIS TMY (JSON) file through pvlib, its stamps coerced to ``year`` (still UTC).
 
@@ -34,16 +66,7 @@ def read(path: str, text: str, year: int, fail):
         ``(data, meta, index, where)`` (:class:`~foldopt.inputs.weather.formats.WeatherFormat`);
         ``where(i)`` names the record (``record 5``).
     """
-    try:
-        source = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise fail(
-            f"not valid JSON: {error.msg} at line {error.lineno} column {error.colno}"
-        ) from None
-    outputs = source.get("outputs") if isinstance(source, dict) else None
-    hourly = outputs.get("tmy_hourly") if isinstance(outputs, dict) else None
-    if not isinstance(hourly, list):
-        raise fail("not a PVGIS TMY file: no outputs.tmy_hourly list of hourly records")
+    _, hourly = answer_records(text, "tmy_hourly", "a PVGIS TMY file", fail)
     if not hourly:
         raise fail("no data rows: outputs.tmy_hourly is empty")
     data, meta = read_with_pvlib(

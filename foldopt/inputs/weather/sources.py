@@ -151,6 +151,10 @@ def _pvgis_horizon_params(latitude: float, longitude: float, weather) -> dict:
     return {"lat": latitude, "lon": longitude, "outputformat": "json"}
 
 
+#: PVGIS's versioned API address, as pvlib's docs advise: its unversioned /api/ follows whatever
+#: version is current, and the answers with it.
+PVGIS_URL = "https://re.jrc.ec.europa.eu/api/v5_3/"
+
 #: The weather sources by name, in the order of :data:`foldopt.names.WEATHER_SOURCES`: a new
 #: source is its entry here (and its name and description there).
 SOURCES = {
@@ -159,9 +163,7 @@ SOURCES = {
         WeatherSource(
             name="pvgis-tmy",
             service="PVGIS",
-            # PVGIS's versioned address, as pvlib's docs advise: its unversioned /api/ follows
-            # whatever version is current, and the answers with it.
-            url="https://re.jrc.ec.europa.eu/api/v5_3/",
+            url=PVGIS_URL,
             url_variable="FOLDOPT_PVGIS_URL",
             route="tmy",
             format="pvgis",
@@ -173,7 +175,7 @@ SOURCES = {
         WeatherSource(
             name="pvgis-hourly",
             service="PVGIS",
-            url="https://re.jrc.ec.europa.eu/api/v5_3/",
+            url=PVGIS_URL,
             url_variable="FOLDOPT_PVGIS_URL",
             route="seriescalc",
             # real hours of real years: read as a measured file, at its own step, day by day
@@ -193,7 +195,7 @@ HORIZON_SOURCES = {
     "pvgis": WeatherSource(
         name="pvgis-horizon",
         service="PVGIS",
-        url="https://re.jrc.ec.europa.eu/api/v5_3/",
+        url=PVGIS_URL,
         url_variable="FOLDOPT_PVGIS_URL",
         route="printhorizon",
         format="horizon",

@@ -77,7 +77,6 @@ from __future__ import annotations
 
 import datetime
 import io
-import json
 import re
 import warnings
 from collections.abc import Callable
@@ -89,6 +88,7 @@ import pvlib
 
 from foldopt.errors import printable
 from foldopt.inputs.weather.formats import read_with_pvlib, reason
+from foldopt.inputs.weather.pvgis import answer_records
 from foldopt.inputs.weather.qc import COLUMNS
 
 #: MIDC's missing-value marker: values at or below it are missing.
@@ -554,15 +554,8 @@ def read_pvgis_hourly(path: str, fail, zone=None) -> StationData:
     """
     with open(path, encoding="utf-8", errors="replace") as handle:
         text = handle.read()
-    try:
-        source = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise fail(
-            f"not valid JSON: {error.msg} at line {error.lineno} column {error.colno}"
-        ) from None
-    outputs = source.get("outputs") if isinstance(source, dict) else None
-    hourly = outputs.get("hourly") if isinstance(outputs, dict) else None
-    if not isinstance(hourly, list) or not hourly:
+    source, hourly = answer_records(text, "hourly", "a PVGIS hourly series", fail)
+    if not hourly:
         raise fail("not a PVGIS hourly series: no outputs.hourly list of hourly records")
     inputs = source.get("inputs") if isinstance(source.get("inputs"), dict) else {}
     mounting = inputs.get("mounting_system") or {}
