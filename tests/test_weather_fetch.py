@@ -175,6 +175,20 @@ def test_the_fetched_year_is_the_recorded_file_to_the_bit(pvgis, server, tmp_pat
     assert "weather_source" not in json.loads((tmp_path / "read" / "run.json").read_text())
 
 
+def test_fetch_is_silent_quiet_and_one_json_document(pvgis, server, tmp_path):
+    """``weather fetch -q`` prints nothing; ``--format json`` one document, the cached answer's
+    provenance (its SHA-256 the recorded file's), the second time from the cache."""
+    pvgis("ok")
+    site = ["weather", "fetch", "pvgis-tmy", "--lat", "45", "--lon", "8"]
+    quiet = runner.invoke(app, [*site, "-q"])
+    assert quiet.exit_code == 0 and quiet.stdout == "", quiet.output
+    document = runner.invoke(app, [*site, "--format", "json"])
+    assert document.exit_code == 0, document.output
+    record = json.loads(document.stdout)
+    assert record["sha256"] == hashlib.sha256(RECORDED.read_bytes()).hexdigest()
+    assert record["source"] == "pvgis-tmy"
+
+
 def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path):
     route = pvgis("ok")
     first = runner.invoke(app, ["weather", "fetch", "pvgis-tmy", "--lat", "45", "--lon", "8"])

@@ -15,7 +15,7 @@ from typing import Annotated
 import typer
 
 from foldopt import names
-from foldopt.cli.options import OutputFormat, Overwrite
+from foldopt.cli.options import OutputFormat, Overwrite, Quiet
 from foldopt.cli.output import echo, fail
 from foldopt.errors import ConfigError
 
@@ -98,6 +98,8 @@ def fetch(
     no_horizon: NoHorizon = False,
     url: Url = None,
     timeout: Timeout = None,
+    quiet: Quiet = False,
+    output_format: OutputFormat = "table",
 ):
     """Fetch a site's weather into the cache (nothing is fetched where it is cached), and say
     which file holds it; a study or a sweep then runs offline with it.
@@ -107,7 +109,9 @@ def fetch(
       foldopt weather fetch pvgis-tmy --lat 45.8 --lon 8.6
       foldopt weather fetch pvgis-tmy --lat 45.8 --lon 8.6 --years 2005:2020
       foldopt weather fetch pvgis-hourly --lat 45.8 --lon 8.6 --years 2020:2021
+      foldopt weather fetch pvgis-tmy --lat 45.8 --lon 8.6 --format json
     """
+    output_format = _format(output_format)
     spec = _options(source, years, no_horizon, url, timeout)
     from foldopt.inputs.weather.sources import fetch as fetch_source
 
@@ -115,9 +119,12 @@ def fetch(
         found = fetch_source(spec.source, lat, lon, spec)
     except ConfigError as error:
         fail(error.errors)
-    echo(f"{found.source} ({found.params['lat']:g}, {found.params['lon']:g}): {found.file}")
-    echo(f"  {found.bytes:,} bytes, sha256 {found.sha256}, retrieved {found.retrieved}")
-    echo(f"  from {found.url}")
+    if output_format == "json":
+        echo(json.dumps(found.to_dict(), indent=2))
+    elif not quiet:
+        echo(f"{found.source} ({found.params['lat']:g}, {found.params['lon']:g}): {found.file}")
+        echo(f"  {found.bytes:,} bytes, sha256 {found.sha256}, retrieved {found.retrieved}")
+        echo(f"  from {found.url}")
 
 
 def list_cache(output_format: OutputFormat = "table"):
@@ -128,10 +135,7 @@ def list_cache(output_format: OutputFormat = "table"):
       foldopt weather list
       foldopt weather list --format json
     """
-    try:
-        output_format = names.canonical(output_format, names.OUTPUT_FORMATS)
-    except ValueError as error:
-        fail([f"--format = {output_format!r}: {error}"])
+    output_format = _format(output_format)
     from foldopt.inputs.weather.sources import cached_entries, weather_cache
 
     entries = cached_entries()
@@ -204,6 +208,14 @@ def path(
     except OSError as error:
         fail([f"--out {out}: cannot be written ({error.strerror or error})"])
     echo(f"wrote {out} ({found.source}, sha256 {found.sha256})")
+
+
+def _format(output_format: str) -> str:
+    """``--format`` as the registry names it; a bad one ends the command."""
+    try:
+        return names.canonical(output_format, names.OUTPUT_FORMATS)
+    except ValueError as error:
+        fail([f"--format = {output_format!r}: {error}"])
 
 
 def _copy(source: str, target: Path) -> None:
