@@ -96,7 +96,7 @@ _PUBLIC = {
     "Optimize": "foldopt.inputs.optimize_section",
     "best_schedules": "foldopt.engine.schedule",
     "Answer": "foldopt.studies.answer",
-    "plan_request": "foldopt.studies.request",
+    "make_request": "foldopt.studies.request",
     "Request": "foldopt.studies.request",
     "SizingResult": "foldopt.studies.sizing",
     "Reproduction": "foldopt.studies.reproduce",

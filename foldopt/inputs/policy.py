@@ -197,10 +197,10 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     weather = changes.get("weather")
     if weather is not None:
         data.pop("sky", None)  # the file's light is shaped by its own clear sky
-        if not (
-            touched(given, "site.latitude") or touched(given, "site.longitude") or "site" in given
-        ):
-            data.pop("site", None)  # the file's site
+        if "site" not in given:
+            # The file's site: the fields given complete or move it, the study's other place does
+            # not (its altitude, name or time zone are of another site).
+            data.pop("site", None)
         if not touched(given, "date"):
             data.pop("date", None)  # the file's year, or a measured file's days
         fmt = changes.get(
@@ -224,11 +224,14 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     ):
         data["mode"] = "exact"
         decided.append(EXACT_NOTE)
+    optimize = changes.get("optimize", data.get("optimize"))
+    if "optimize.vary" in changes:
+        optimize = {**(optimize if isinstance(optimize, dict) else {}), "vary": changes["optimize.vary"]}
     if (
         data.get("mode", "exact") == "paper"
         and "mode" not in given
         and touched(given, "optimize")
-        and {"tilt", "azimuth"} & set(_varied(changes.get("optimize", data.get("optimize"))))
+        and {"tilt", "azimuth"} & set(_varied(optimize))
     ):
         data["mode"] = "exact"
         decided.append(MOUNTING_NOTE)

@@ -238,6 +238,7 @@ def with_fetched_weather(data):
     weather = data.get("weather") if isinstance(data, dict) else None
     if not isinstance(weather, dict) or weather.get("source") is None:
         return data
+    _file_or_source(weather)
     from pydantic import ValidationError
 
     from foldopt.inputs.weather_section import Weather
@@ -271,6 +272,24 @@ def with_fetched_weather(data):
     answer = fetch(spec.source, place["latitude"], place["longitude"], spec)
     fetched = {**weather, "source": spec.source, "path": answer.file}
     return {**data, "weather": {**fetched, "format": SOURCES[spec.source].format}}
+
+
+def _file_or_source(weather: dict) -> None:
+    """Refuse a weather section that names both a file and a source: either would be the study's
+    light, and running one would ignore the other. A path inside the weather cache is the
+    source's own answer (a fetched study's data, :meth:`foldopt.Study.data`), not a second value."""
+    path = weather.get("path")
+    if path is None:
+        return
+    from foldopt.inputs.weather.sources import weather_cache
+
+    if Path(str(path)).resolve().parent != weather_cache().resolve():
+        raise ConfigError(
+            [
+                f"weather: names a file ({path}) and a source ({weather['source']}); give one: "
+                "weather.path (--weather FILE) or weather.source (--weather NAME)"
+            ]
+        )
 
 
 def with_fetched_horizon(data):

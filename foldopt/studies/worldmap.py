@@ -24,8 +24,8 @@ from __future__ import annotations
 import datetime as dt
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -52,6 +52,9 @@ from foldopt.studies.objectives import (
     period_values,
     season_days,
 )
+
+if TYPE_CHECKING:
+    from foldopt.studies.cluster import MapSpec
 
 #: Three-month seasons by their months' initials: the same months in both hemispheres.
 SEASONS = {"DJF": (12, 1, 2), "MAM": (3, 4, 5), "JJA": (6, 7, 8), "SON": (9, 10, 11)}
@@ -126,41 +129,6 @@ def map_study(data: dict, embedded: bool = True, **changes) -> dict:
     return study
 
 
-@dataclass(frozen=True)
-class MapRequest:
-    """A map's request made into what runs (:func:`map_request`).
-
-    Attributes
-    ----------
-    study : Study
-        The map's study, resolved at its first site (:func:`map_template`): every site's is this
-        one moved to the site (:func:`site_study`).
-    sites : tuple of dict
-        Each a site's fields or a weather file's site (:func:`evaluate_sites`).
-    loads : tuple of float
-        Loads [W], or with ``relative`` fractions [-] of each site's flat peak.
-    relative : bool
-    year : int
-    source : str
-        How the answer names the study the map took its panel and models from.
-    taken : tuple of str
-        What the answer took from that study or from defaults, not from the request.
-    """
-
-    study: Study
-    sites: tuple
-    loads: tuple
-    relative: bool = False
-    year: int = 2025
-    source: str = "the given study"
-    taken: tuple = ()
-
-    @property
-    def defaults(self) -> dict | None:
-        """``{"study": source, "taken": [...]}``, or None where nothing was taken."""
-        return {"study": self.source, "taken": list(self.taken)} if self.taken else None
-
-
 def _values(name: str, values) -> list:
     """A value, a sequence, or text (a value, a range start:stop:step or a list a,b,c:
     :func:`foldopt.inputs.plan.parse_values`, the parser of every sweep axis too) as a list."""
@@ -191,9 +159,10 @@ def map_request(
     year: int = 2025,
     show_period: str = "year",
     weather: dict | None = None,
-) -> MapRequest:
+) -> MapSpec:
     """A map's sites, loads, year and period, each checked, with its study: what the command line
-    and :func:`foldopt.world_map` both run.
+    and :func:`foldopt.world_map` both run (the front door's map,
+    :func:`foldopt.studies.request.make_request`).
 
     Parameters
     ----------
@@ -225,7 +194,7 @@ def map_request(
 
     Returns
     -------
-    MapRequest
+    foldopt.studies.cluster.MapSpec
 
     Raises
     ------
@@ -316,9 +285,11 @@ def map_request(
         raise ConfigError([f"{field}: {error}"]) from None
     if not len(sites):
         raise ConfigError(["sites: a map needs at least one site"])
+    from foldopt.studies.cluster import MapSpec
+
     study = map_template(study, sites[0], year)
     site_study(study, sites[0], year)  # a bad setting fails here, before any cluster starts
-    return MapRequest(study, tuple(sites), tuple(load_values), relative, year)
+    return MapSpec(study, tuple(sites), tuple(load_values), relative, year)
 
 
 def map_data(study: dict | Study) -> dict:
