@@ -151,21 +151,17 @@ def refusal(name: str, command: str, run: str) -> str:
 
 
 def matrix_rows() -> list[list[str]]:
-    """The capability matrix as table rows, for the docs: a header, then a row per capability
-    with ``yes`` or ``refused`` per run.
+    """The capability matrix as table rows, for the docs: a header, then a row per capability,
+    its name, what it is, and ``yes`` or ``refused`` per run of :data:`RUNS`.
 
     Returns
     -------
     list of list of str
     """
-    rows = [["capability", *RUNS]]
+    rows = [["capability", "what it is", *RUNS]]
     for capability in CAPABILITIES:
-        rows.append(
-            [
-                f"``{capability.name}``: {capability.describes}",
-                *("yes" if run in capability.honoured else "refused" for run in RUNS),
-            ]
-        )
+        marks = ("yes" if run in capability.honoured else "refused" for run in RUNS)
+        rows.append([capability.name, capability.describes, *marks])
     return rows
 
 

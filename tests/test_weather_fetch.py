@@ -353,7 +353,7 @@ def test_a_map_fetches_each_site_once_and_a_stopped_fetch_resumes(pvgis, server,
     one request a site (two names of one site as PVGIS rounds it: one), each cached as it comes,
     so that a fetch stopped by a fault resumes with the sites not yet fetched. (The server gives
     the recorded 45 N, 8 E answer to every site: what is tested is the requests.)"""
-    from foldopt.studies.request import map_request_from
+    from foldopt.studies.request import make_request
 
     (tmp_path / "sites.csv").write_text("name,latitude,longitude\nturin,45,8\nturin-b,45.0001,8\n"
                                         "asti,44.9,8.2\nalba,44.7,8.03\n")
@@ -365,8 +365,7 @@ def test_a_map_fetches_each_site_once_and_a_stopped_fetch_resumes(pvgis, server,
     assert requests_made(server, flaky) == 2 and not (tmp_path / "map").exists()
     assert len(cache_files(tmp_path)) == 2  # turin's answer and its provenance
     route = pvgis("ok")
-    request = map_request_from(None, source="test", objective="mean", sites=tmp_path / "sites.csv",
-                               weather={"source": "pvgis-tmy"})
+    request = make_request("map", where={"sites": tmp_path / "sites.csv", "weather": {"source": "pvgis-tmy"}}).plan
     assert requests_made(server, route) == 2  # asti and alba: turin's came from the cache
     files = [Path(site["weather"]) for site in request.sites]
     assert [site["name"] for site in request.sites] == ["turin", "turin-b", "asti", "alba"]
