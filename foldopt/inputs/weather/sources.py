@@ -713,9 +713,9 @@ def _download(request: _Request, label: str) -> bytes:
 
     service, host = request.source.service, request.base
     late = WeatherError(
-        f"{label}: {service} at {host} did not answer in full within {request.timeout_s:g} s "
-        "(weather.timeout_s, --timeout: the whole request's time); nothing was cached, try again "
-        "later"
+        f"{label}: {service} at {host} did not answer within {request.timeout_s:g} s "
+        "(weather.timeout_s sets the wait); its whole answer must come within it: nothing was "
+        "cached, try again later"
     )
     with _Deadline(request.timeout_s) as deadline, deadline.session() as session:
         for attempt in range(1, MAX_ATTEMPTS + 1):
