@@ -7,6 +7,8 @@ address's user, password or key is never written; every ``weather`` subcommand t
 answers, stopped by its pid): each fault one line, exit 2, no traceback, the cache byte for byte
 as it was, the server asked nothing where nothing should be asked. No test reaches the internet.
 """
+# ruff: noqa: F811 - the server's fixtures are imported from test_weather_fetch and taken by name
+
 
 import hashlib
 import json
@@ -21,7 +23,7 @@ import yaml
 from foldopt.cli.app import app
 from foldopt.errors import ConfigError
 from foldopt.inputs.study_file import default_study_path
-from test_weather_fetch import (  # noqa: F401 - the fixtures are used by name
+from test_weather_fetch import (  # noqa: F401 - pvgis and server: fixtures
     RECORDED,
     SWEEP,
     cache_files,
@@ -324,6 +326,12 @@ def test_a_study_files_address_with_a_password_is_not_written(pvgis, server, tmp
     assert requests_made(server, route) == 1
     meta = json.loads((tmp_path / "out" / "run.json").read_text())
     assert meta["study"]["weather"]["url"] == url.replace("user:secret@", "")
+    # the same address on the command line (run.json's command): asked as given, stored without
+    typed = runner.invoke(app, [*SWEEP, "--days", "2025-06-21", "--weather", "pvgis-tmy", "--set",
+                                f"weather.url={url}?token=t0ken", "--out", "typed"])
+    assert typed.exit_code == 0, typed.output
+    command = json.loads((tmp_path / "typed" / "run.json").read_text())["command"]
+    assert f"weather.url={url.replace('user:secret@', '')}" in command
     assert not [secret for secret in SECRETS if secret in written(tmp_path)]
 
 
