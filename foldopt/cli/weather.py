@@ -83,7 +83,17 @@ _LABELS = {
 }
 
 
-def _checked(output_format: str, source: str | None = None, lat=None, lon=None, **options):
+def _checked(
+    output_format: str,
+    source: str | None = None,
+    lat=None,
+    lon=None,
+    years=None,
+    no_horizon=False,
+    raddatabase=None,
+    url=None,
+    timeout=None,
+):
     """``--format``, the site and the source's options (where a source is given), each checked as
     a study's sections check them before anything is asked: every fault one line, then the
     command ends.
@@ -107,9 +117,15 @@ def _checked(output_format: str, source: str | None = None, lat=None, lon=None, 
         errors.append(f"--format = {output_format!r}: {error}")
     if source is not None:
         errors += site_problems(lat, lon)
-        given = {"source": source, **options}
+        given = {
+            "source": source,
+            "years": years,
+            "raddatabase": raddatabase,
+            "url": url,
+            "timeout_s": timeout,
+        }
         given = {key: value for key, value in given.items() if value is not None}
-        if given.pop("no_horizon", False):
+        if no_horizon:
             given["usehorizon"] = False
         try:
             spec = Weather.model_validate(given)
@@ -143,15 +159,7 @@ def fetch(
       foldopt weather fetch pvgis-tmy --lat 45.8 --lon 8.6 --format json
     """
     output_format, spec = _checked(
-        output_format,
-        source,
-        lat,
-        lon,
-        years=years,
-        no_horizon=no_horizon,
-        raddatabase=raddatabase,
-        url=url,
-        timeout_s=timeout,
+        output_format, source, lat, lon, years, no_horizon, raddatabase, url, timeout
     )
     output = Output(quiet, output_format)
     from foldopt.inputs.weather.sources import fetch as fetch_source
@@ -238,14 +246,7 @@ def path(
       foldopt weather path pvgis-tmy --lat 45.8 --lon 8.6 --out site-tmy.json
     """
     output_format, spec = _checked(
-        output_format,
-        source,
-        lat,
-        lon,
-        years=years,
-        no_horizon=no_horizon,
-        raddatabase=raddatabase,
-        url=url,
+        output_format, source, lat, lon, years, no_horizon, raddatabase, url
     )
     output = Output(quiet, output_format)
     from foldopt.inputs.weather.sources import lookup
