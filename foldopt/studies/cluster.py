@@ -31,7 +31,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from foldopt.errors import ConfigError, OutputError
+from foldopt.errors import ConfigError, OutputError, redacted
 from foldopt.inputs.study import Study
 from foldopt.files import (
     DiskFullError,
@@ -330,9 +330,8 @@ def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
 
 
 def _write_json(path: Path, data: dict) -> None:
-    write_atomically(
-        path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n")
-    )
+    text = json.dumps(redacted(data), indent=2, default=str) + "\n"  # no password in run.json
+    write_atomically(path, lambda temporary: temporary.write_text(text))
 
 
 def run_map(
