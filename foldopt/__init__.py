@@ -50,7 +50,7 @@ _PUBLIC = {
     "world_map": "foldopt.api",
     "StudyResult": "foldopt.studies.day",
     "SweepResult": "foldopt.studies.sweeps",
-    "MapSpec": "foldopt.studies.cluster",
+    "MapSpec": "foldopt.studies.worldmap",
     "MapRun": "foldopt.studies.cluster",
     "run_map": "foldopt.studies.cluster",
     "evaluate_sites": "foldopt.studies.worldmap",

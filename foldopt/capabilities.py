@@ -79,10 +79,10 @@ CAPABILITIES = (
     ),
     Capability(
         "weather",
-        "a weather file or source: the site's own light (--weather)",
-        ("day", "cases", "annual", "ensemble", "optimize", "map"),
-        "the panel's sizing is of one clear day (Shin et al. Sec. IV-A); a weather year's buffer "
-        "is sized by foldopt size --storage --weather FILE",
+        "a weather file or source: the site's own light (--weather); a map's sites each bring "
+        "their own (--weather-dir, or a source: --weather NAME)",
+        _ALL,
+        "",
     ),
     Capability(
         "weather.members",

@@ -118,7 +118,7 @@ class Request:
     ----------
     command : str
         One of :data:`foldopt.capabilities.COMMANDS`.
-    plan : Plan or foldopt.studies.cluster.MapSpec
+    plan : Plan or foldopt.studies.worldmap.MapSpec
         What runs: the validated studies and their sweep axes, or a map's study, sites and loads.
     source : str
         The study the request started from (a file, or ``the given study``).
@@ -176,7 +176,9 @@ def rename_field(line: str, labels: Mapping) -> str:
     parts = path.split(".")
     for cut in range(len(parts) - 1, 0, -1):
         label = labels.get(".".join(parts[:cut]))
-        if label is not None and not label.startswith("--set "):
+        if label is not None:
+            if not label.startswith("--") or label.startswith("--set "):
+                return line
             return f"{label} {' '.join(parts[cut:])}{line[end:]}"
     return line
 
@@ -406,8 +408,8 @@ def _merge(entries: list[tuple]) -> tuple[dict, dict]:
                     continue
                 owners[leaf] = (label, _value_at(path, value, leaf))
             changes[path] = value
-            if renames != [False] and label != path:
-                labels[path] = label
+            # a --set key, a field an option chose: messages keep the field's own name
+            labels[path] = label if renames != [False] else path
     if errors:
         raise ConfigError(list(dict.fromkeys(errors)))
     return changes, labels
@@ -553,6 +555,7 @@ def _plan_request(command, study, data, lines, changes, labels, source) -> Reque
             new = policy.set_path(
                 new, field, _default_loads(new) if field == "p_load" else DEFAULT_RANGES[field]
             )
+            labels[field] = f"sweep {axis}'s default range"  # not an option the user gave
         weather = new.get("weather")
         ensemble = isinstance(weather, dict) and weather.get("members") is not None
         if (
@@ -737,7 +740,7 @@ def _size_taken(command: str, plan: Plan, source: str, labels: Mapping) -> list[
 def _map_request(data, embedded, changes, labels, options, where, source) -> Request:
     """A map's request: its study (the study's panel and models, the map's options over them),
     sites and loads, checked once (:func:`foldopt.studies.worldmap.map_request`), as a
-    :class:`foldopt.studies.cluster.MapSpec`."""
+    :class:`foldopt.studies.worldmap.MapSpec`."""
     from foldopt.studies.worldmap import map_request, map_study
 
     flat = policy.flatten(changes)
