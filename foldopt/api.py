@@ -182,7 +182,9 @@ def sweep(
         raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
     both = sorted(set(fields) & set(axes))
     if both:
-        raise ConfigError([f"{name}: given twice, as a keyword and in axes; give one" for name in both])
+        raise ConfigError(
+            [f"{name}: given twice, as a keyword and in axes; give one" for name in both]
+        )
     command = "run" if over is None else f"sweep {over}"
     request = make_request(command, study, fields={**fields, **axes})
     return run(engine=engine, progress=progress, request=request)

@@ -221,18 +221,18 @@ def test_a_bad_target_is_one_line_and_exit_2(tmp_path, monkeypatch, option, said
     assert not (tmp_path / "out").exists()
 
 
-def test_a_sweep_of_days_says_its_buffer_is_not_simulated(tmp_path, monkeypatch):
-    # Days in sequence with a buffer are not answered yet: the answer says so, never silently.
+def test_a_sweep_of_days_refuses_the_buffer_it_does_not_simulate(tmp_path, monkeypatch):
+    # A plan of cases, each day its own best angle, has no buffer in its numbers: refused in one
+    # line that says where the buffer is simulated (it answered storage-less, with a note).
     monkeypatch.chdir(tmp_path)
     args = ["sweep", "day", "--storage-wh", "10", "--days", "2025-06-21,2025-12-21", "--step-min",
-            "60", "--format", "json", "--out", "out", "-q"]  # fmt: skip
+            "60", "--out", "out"]  # fmt: skip
     result = runner.invoke(app, args)
-    assert result.exit_code == 0, result.output
-    notes = [note["note"] for note in json.loads(result.output)["answer"]["notes"]]
-    assert any(
-        note.startswith("storage: the buffer is simulated in a day's study and over")
-        for note in notes
-    )
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: storage: foldopt sweep day ("), lines
+    assert "--objective" in lines[0] and "foldopt size --storage" in lines[0]
+    assert not (tmp_path / "out").exists()
 
 
 def test_a_load_profile_sizes_its_buffer():

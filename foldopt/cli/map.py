@@ -263,7 +263,10 @@ def map_(
     except WeatherError:
         raise  # a file of --weather-dir: its line names the file, as the reader says it
     except ConfigError as error:
-        labels = {**_OPTION_OF_PARAMETER, "loads": "--p-load-fraction" if p_load_fraction else "--p-load"}
+        labels = {
+            **_OPTION_OF_PARAMETER,
+            "loads": "--p-load-fraction" if p_load_fraction else "--p-load",
+        }
         fail(list(dict.fromkeys(rename_fields(line, labels) for line in error.errors)))
     spec = request.plan
     if not 1 <= show_load <= len(spec.loads):

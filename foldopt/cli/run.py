@@ -62,7 +62,9 @@ def run_request(
 
         try:
             result = run(engine=engine, progress=progress, request=request)
-        except ConfigError as error:  # a limit found as the work starts, said as the request gave it
+        except (
+            ConfigError
+        ) as error:  # a limit found as the work starts, said as the request gave it
             fail(list(dict.fromkeys(request.rename(line) for line in error.errors)))
     rows = result.summary if isinstance(result, StudyResult) else result.table
     output.answer(

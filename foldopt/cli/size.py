@@ -158,7 +158,9 @@ def size(
 
 def _parameters(costs: dict) -> dict:
     """The sizing's parameters as :func:`foldopt.size` names them."""
-    return {("c_grid" if name == "c_grid_usd_per_kwh" else name): value for name, value in costs.items()}
+    return {
+        ("c_grid" if name == "c_grid_usd_per_kwh" else name): value for name, value in costs.items()
+    }
 
 
 def _size_buffer(config, target_h, storage, settings, weather, out, overwrite, output):

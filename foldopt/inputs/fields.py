@@ -159,9 +159,7 @@ def _numeric(annotation) -> bool:
         member in (int, float)
         or (
             typing.get_origin(member) in (list, tuple)
-            and any(
-                _numeric(item) for item in typing.get_args(member) if item is not Ellipsis
-            )
+            and any(_numeric(item) for item in typing.get_args(member) if item is not Ellipsis)
         )
         for member in members
     )

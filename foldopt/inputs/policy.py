@@ -226,7 +226,10 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         decided.append(EXACT_NOTE)
     optimize = changes.get("optimize", data.get("optimize"))
     if "optimize.vary" in changes:
-        optimize = {**(optimize if isinstance(optimize, dict) else {}), "vary": changes["optimize.vary"]}
+        optimize = {
+            **(optimize if isinstance(optimize, dict) else {}),
+            "vary": changes["optimize.vary"],
+        }
     if (
         data.get("mode", "exact") == "paper"
         and "mode" not in given

@@ -650,9 +650,7 @@ def _where_it_belongs(field: str) -> str:
     elsewhere = [path for path in paths if path.rpartition(".")[2] == name and path != field]
     if elsewhere:
         return f"; did you mean {' or '.join(elsewhere)}?"
-    siblings = [
-        path.rpartition(".")[2] for path in paths if path.rpartition(".")[0] == section
-    ]
+    siblings = [path.rpartition(".")[2] for path in paths if path.rpartition(".")[0] == section]
     return names.did_you_mean(name, siblings)
 
 

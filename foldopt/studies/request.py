@@ -260,8 +260,10 @@ def make_request(
             raise ConfigError(
                 [rename_field(_missing_hint(line, labels), labels) for line in error.errors]
             ) from None
-    if command == "size" and not (costs or {}).get("cost_per_m2") and not (costs or {}).get(
-        "cost_per_w"
+    if (
+        command == "size"
+        and not (costs or {}).get("cost_per_m2")
+        and not (costs or {}).get("cost_per_w")
     ):
         from foldopt.inputs.costs import PAPER_COST_PER_M2
 
@@ -336,7 +338,9 @@ def _entries(command, data, options, settings, fields, optimize, target_h) -> li
         entries.append((name, {path: _plain(value)}))
     if optimize:
         labels = optimize.get("labels") or {}
-        section = optimize_section(**{k: v for k, v in optimize.items() if k != "labels"}, labels=labels)
+        section = optimize_section(
+            **{k: v for k, v in optimize.items() if k != "labels"}, labels=labels
+        )
         entries += [
             (labels.get(name, f"optimize.{name}"), {f"optimize.{name}": value})
             for name, value in section.items()
@@ -358,11 +362,17 @@ def _entries(command, data, options, settings, fields, optimize, target_h) -> li
 
 def _leaves(path: str, value) -> list[str]:
     """The field paths a change sets: a section's mapping sets only the fields it names."""
-    if isinstance(value, dict) and value and path.partition(".")[0] in policy.SECTIONS + (
-        "weather",
-        "circuit",
-        "optimize",
-        "load_profile",
+    if (
+        isinstance(value, dict)
+        and value
+        and path.partition(".")[0]
+        in policy.SECTIONS
+        + (
+            "weather",
+            "circuit",
+            "optimize",
+            "load_profile",
+        )
     ):
         return [leaf for key, item in value.items() for leaf in _leaves(f"{path}.{key}", item)]
     return [path]
@@ -392,7 +402,9 @@ def _merge(entries: list[tuple]) -> tuple[dict, dict]:
                     (
                         other
                         for other in owners
-                        if other == leaf or other.startswith(leaf + ".") or leaf.startswith(other + ".")
+                        if other == leaf
+                        or other.startswith(leaf + ".")
+                        or leaf.startswith(other + ".")
                     ),
                     None,
                 )
@@ -580,7 +592,9 @@ def _plan_request(command, study, data, lines, changes, labels, source) -> Reque
         raise ConfigError(_set_by_run(run, policy.flatten(changes)))
     if axis == "angle":
         varied = [
-            path for path, _ in plan.axes if not (path == "date" and plan.base.objective is not None)
+            path
+            for path, _ in plan.axes
+            if not (path == "date" and plan.base.objective is not None)
         ]
         if varied:
             raise ConfigError(
@@ -598,8 +612,10 @@ def _command_defaults(command: str, data: dict, changes: dict) -> dict:
     """What a command sets where neither the study nor the request does."""
     touched = set(policy.flatten(changes))
     defaults = {}
-    if command == "optimize" and data.get("optimize") is None and not policy.touched(
-        touched, "optimize"
+    if (
+        command == "optimize"
+        and data.get("optimize") is None
+        and not policy.touched(touched, "optimize")
     ):
         defaults["optimize"] = {}  # the search's own defaults: every variable
     if command == "size --storage":
@@ -656,8 +672,9 @@ def _run_of(command: str, plan: Plan) -> str:
 _HAS = {
     "storage": lambda study: study.storage is not None,
     "weather": lambda study: study.weather is not None,
-    "weather.members": lambda study: study.weather is not None
-    and study.weather.members is not None,
+    "weather.members": lambda study: (
+        study.weather is not None and study.weather.members is not None
+    ),
     "site.horizon": lambda study: study.site is not None and study.site.horizon is not None,
     "load_profile": lambda study: study.load_profile is not None,
     "optimize": lambda study: study.optimize is not None,
@@ -783,8 +800,11 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
     made, _ = policy.apply(map_study(data, embedded=embedded), study)
     # The study's load as its file gives it: a value, a list or a range text, checked like --p-load.
     spec = map_request(
-        made, (data.get("p_load") or 1.0) if loads is None else loads,
-        relative=relative, year=year, **where,
+        made,
+        (data.get("p_load") or 1.0) if loads is None else loads,
+        relative=relative,
+        year=year,
+        **where,
     )
     loads_taken = (
         f"P_load {spec.loads[0]:g} W"

@@ -381,7 +381,6 @@ def default_sites_per_chunk(study: Study, year: int) -> int:
     return count if count < SITES_PER_BATCH else SITES_PER_BATCH * round(count / SITES_PER_BATCH)
 
 
-
 def map_data(study: dict | Study) -> dict:
     """A map's study as data: a study's fields but those a map sets per site.
 
