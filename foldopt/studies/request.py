@@ -255,31 +255,11 @@ def make_request(
         try:
             if command == "map":
                 return _map_request(data, study is None, changes, labels, options, where, source)
-            request = _plan_request(command, study, data, lines, changes, labels, source)
+            return _plan_request(command, study, data, lines, changes, labels, source, costs)
         except ConfigError as error:
             raise ConfigError(
                 [rename_field(_missing_hint(line, labels), labels) for line in error.errors]
             ) from None
-    if (
-        command == "size"
-        and not (costs or {}).get("cost_per_m2")
-        and not (costs or {}).get("cost_per_w")
-    ):
-        from foldopt.inputs.costs import PAPER_COST_PER_M2
-
-        request = _with_taken(
-            request,
-            f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
-            "cost_per_m2 or cost_per_w)",
-        )
-    return request
-
-
-def _with_taken(request: Request, item: str) -> Request:
-    """A request whose answer also says it took ``item``."""
-    from dataclasses import replace
-
-    return replace(request, taken=(*request.taken, item))
 
 
 def _also_labels(options: Mapping, labels: Mapping) -> dict:
@@ -546,7 +526,7 @@ def _default_loads(data: dict) -> list[float]:
     ]
 
 
-def _plan_request(command, study, data, lines, changes, labels, source) -> Request:
+def _plan_request(command, study, data, lines, changes, labels, source, costs) -> Request:
     """Steps 2 to 4 of every request but a map's."""
     axis = command.partition(" ")[2] if command.startswith("sweep ") else None
     if isinstance(study, (Plan, Study)) and not changes:
@@ -604,7 +584,7 @@ def _plan_request(command, study, data, lines, changes, labels, source) -> Reque
                 ]
             )
     if command in ("size", "size --storage"):
-        taken = _size_taken(command, plan, source, labels)
+        taken = _size_taken(command, plan, source, costs or {})
     return Request(command, plan, source, tuple(taken), labels, run)
 
 
@@ -741,9 +721,10 @@ def _taken(plan: Plan, given: set, field: str | None, data: dict, decided: list[
     return taken
 
 
-def _size_taken(command: str, plan: Plan, source: str, labels: Mapping) -> list[str]:
-    """What a sizing took from its study: the site, day, load and efficiency; a panel sizing's
-    costs are its own parameters (:func:`foldopt.size` says where it took the paper's)."""
+def _size_taken(command: str, plan: Plan, source: str, costs: Mapping) -> list[str]:
+    """What a sizing took from its study (the site, day, load and efficiency) and, where the
+    request gives no panel cost, the paper's."""
+    from foldopt.inputs.costs import PAPER_COST_PER_M2
     from foldopt.inputs.load_profile import load_text
 
     if command == "size" and plan.axes:
@@ -751,7 +732,13 @@ def _size_taken(command: str, plan: Plan, source: str, labels: Mapping) -> list[
             [f"config: {source} sweeps {', '.join(p for p, _ in plan.axes)}; size takes one case"]
         )
     study = plan.base
-    return [f"site, day, {load_text(study)}, efficiency {study.panel.efficiency:g}"]
+    taken = [f"site, day, {load_text(study)}, efficiency {study.panel.efficiency:g}"]
+    if command == "size" and costs.get("cost_per_m2") is None and costs.get("cost_per_w") is None:
+        taken.append(
+            f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
+            "cost_per_m2 or cost_per_w)"
+        )
+    return taken
 
 
 def _map_request(data, embedded, changes, labels, options, where, source) -> Request:
