@@ -107,9 +107,17 @@ def test_weather_by_name_is_the_file_it_fetched(pvgis, server, tmp_path):  # noq
     alone, alone_meta = cli(tmp_path, "sweep", "angle", "--weather", "site.json", *QUICK)
     placed, placed_meta = cli(tmp_path, "sweep", "angle", "--weather", "site.json", "--lat", "45",
                               "--lon", "8", *QUICK)
-    assert numbers(fetched) == numbers(alone) == numbers(placed)
-    sites = [m["study"]["site"] for m in (meta, alone_meta, placed_meta)]
-    assert sites[0] == sites[1] == sites[2]
+    # A study at that place given a source: fetched for the study's site (it was refused: "give
+    # --lat/--lon", though the study holds them).
+    data = yaml.safe_load(default_study_path().read_text())
+    data["site"] = {"latitude": 45.0, "longitude": 8.0, "altitude": 999.0, "name": "elsewhere"}
+    data["panel"] = {key: data["panel"][key] for key in ("area", "efficiency")}  # |latitude| tilt
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(data))
+    studied, studied_meta = cli(tmp_path, "sweep", "angle", "--config", "s.yaml", "--weather",
+                                "pvgis-tmy", *QUICK)
+    assert numbers(fetched) == numbers(alone) == numbers(placed) == numbers(studied)
+    sites = [m["study"]["site"] for m in (meta, alone_meta, placed_meta, studied_meta)]
+    assert sites[0] == sites[1] == sites[2] == sites[3]  # the answer's altitude, not the study's
     assert sites[0]["altitude"] > 0  # the file's, as its answer gives it
     assert all(str(sites[0]["altitude"]).rstrip("0").rstrip(".") in note or "m" not in note
                for note in fetched["answer"]["lines"] if "altitude" in note)

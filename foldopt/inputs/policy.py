@@ -14,8 +14,10 @@ it is made. The rules, each said back to the user by :func:`apply`'s second valu
   sky in paper mode) unless the geometry or the sky is given;
 - a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
   given; a new latitude or longitude drops the site's name, a new longitude its time zone;
-- a weather file brings its own site, year and light (the study's sky, site and day give way), and
-  a measured file (or a source read as one, ``pvgis-hourly``) its own days and step;
+- a weather file brings its own site, year and light (the study's sky, site and day give way; the
+  site fields given complete the file's), and a measured file (or a source read as one,
+  ``pvgis-hourly``) its own days and step; a weather source is fetched for the study's latitude
+  and longitude unless others are given;
 - a new tracker model keeps only the tracker's standby draw; a new fold-angle step starts the grid
   at that step; a load profile given without a scale runs as written (scale 1).
 
@@ -166,6 +168,11 @@ def _varied(optimize) -> list[str]:
         return []
 
 
+def _source(weather) -> bool:
+    """Whether a ``weather`` change names a source (fetched for the site), not a file."""
+    return isinstance(weather, dict) and weather.get("source") is not None
+
+
 def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dict, list[str]]:
     """The study data that runs when ``changes`` are made to ``data``.
 
@@ -199,8 +206,12 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         data.pop("sky", None)  # the file's light is shaped by its own clear sky
         if "site" not in given:
             # The file's site: the fields given complete or move it, the study's other place does
-            # not (its altitude, name or time zone are of another site).
-            data.pop("site", None)
+            # not (its altitude, name or time zone are of another site). A source is fetched for
+            # the study's place: its latitude and longitude stay where none are given.
+            site = data.pop("site", None)
+            if _source(weather) and isinstance(site, dict):
+                place = {key: site[key] for key in ("latitude", "longitude") if key in site}
+                data["site"] = place
         if not touched(given, "date"):
             data.pop("date", None)  # the file's year, or a measured file's days
         fmt = changes.get(

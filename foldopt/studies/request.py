@@ -704,7 +704,8 @@ def _taken(plan: Plan, given: set, field: str | None, data: dict, decided: list[
             year = f" of {data['year']}" if field == "date" and data.get("year") else ""
             label = {"site.latitude": "latitude", "date": "day"}[field]
             taken.append(f"{label} {DEFAULT_RANGES[field]}{year} (default range)")
-    if not policy.touched(given, "site") and not weather and field != "site.latitude":
+    source = study.weather is not None and study.weather.source is not None
+    if not policy.touched(given, "site") and (source or not weather) and field != "site.latitude":
         taken.append(f"site {study.site.latitude:g}, {study.site.longitude:g}")
     if "date" not in given and not weather and field != "date":
         taken.append(f"date {study.date}")
