@@ -280,10 +280,9 @@ class FoldingPays:
 
     Attributes
     ----------
-    stops_wh : float
-        The least capacity from which on folding pays at no capacity evaluated: evaluated, and
-        within :data:`CAPACITY_RTOL` of ``pays_wh``; NaN where folding never pays or still pays
-        at ``top_wh``.
+    holds_from_wh : float
+        The least capacity evaluated from which on folding pays at no capacity evaluated, above
+        ``pays_wh``; NaN where folding never pays or still pays at ``top_wh``.
     pays_wh : float
         The largest capacity evaluated at which folding pays; NaN where it pays at none.
     top_wh : float
@@ -295,11 +294,42 @@ class FoldingPays:
         said).
     """
 
-    stops_wh: float
+    holds_from_wh: float
     pays_wh: float
     top_wh: float
     everywhere: bool
     known: bool
+
+    @property
+    def state(self) -> str:
+        """One of :data:`FOLDING_STATES`."""
+        if not self.known:
+            return "unknown"
+        if self.pays_wh != self.pays_wh:
+            return "never"
+        if self.holds_from_wh == self.holds_from_wh:
+            bracketed = self.holds_from_wh - self.pays_wh <= CAPACITY_RTOL * self.holds_from_wh
+            return "below_threshold" if bracketed else "between"
+        return "at_every_capacity" if self.everywhere else "at_largest_capacity"
+
+    @property
+    def stops_wh(self) -> float:
+        """The capacity from which folding stops paying [Wh], bracketed within
+        :data:`CAPACITY_RTOL`; NaN where the answer states none."""
+        return self.holds_from_wh if self.state == "below_threshold" else np.nan
+
+
+#: Where folding pays (:attr:`FoldingPays.state`): at no capacity evaluated; below a threshold
+#: found; at some capacity and at none evaluated from a larger one on, with no periodic state
+#: between them; at every capacity; at the largest whose periodic state is known; not known.
+FOLDING_STATES = (
+    "never",
+    "below_threshold",
+    "between",
+    "at_every_capacity",
+    "at_largest_capacity",
+    "unknown",
+)
 
 
 def _fold_gain(flat, twofold, tolerance):
@@ -719,29 +749,18 @@ def _signed(value: float, digits: int) -> str:
     return f"{round(value, digits) + 0.0:+.{digits}f}"
 
 
-#: What :func:`folding_part` says of where folding pays (``folding_pays``).
-FOLDING_STATES = ("never", "below_threshold", "at_every_capacity", "at_largest_capacity", "unknown")
-
-
-def _folding_state(folding: FoldingPays) -> str:
-    if not folding.known:
-        return "unknown"
-    if folding.pays_wh != folding.pays_wh:
-        return "never"
-    if folding.stops_wh == folding.stops_wh:
-        return "below_threshold"
-    return "at_every_capacity" if folding.everywhere else "at_largest_capacity"
-
-
 def folding_part(folding: FoldingPays) -> dict:
     """Where folding pays, as the answer's result holds it: ``folding_pays`` (one of
-    :data:`FOLDING_STATES`), ``folding_stops_paying_wh`` (the threshold; NaN but below one),
+    :data:`FOLDING_STATES`), ``folding_stops_paying_wh`` (the threshold, NaN but below one),
     ``folding_pays_up_to_wh`` (the largest capacity evaluated at which folding pays, NaN where
-    none: the bracket's bottom below a threshold) and ``folding_searched_up_to_wh``."""
+    none: a threshold's bracket's bottom), ``folding_does_not_pay_from_wh`` (the least capacity
+    from which on it pays at none evaluated, NaN where there is none above the largest at which
+    it pays: a threshold's bracket's top) and ``folding_searched_up_to_wh``, all [Wh]."""
     return {
-        "folding_pays": _folding_state(folding),
+        "folding_pays": folding.state,
         "folding_stops_paying_wh": folding.stops_wh,
         "folding_pays_up_to_wh": folding.pays_wh,
+        "folding_does_not_pay_from_wh": folding.holds_from_wh,
         "folding_searched_up_to_wh": folding.top_wh,
     }
 
@@ -757,9 +776,17 @@ def folding_line(folding: FoldingPays) -> str:
         "below_threshold": f"folding stops paying from {_wh(folding.stops_wh)} of buffer: from "
         f"there up to {top} flat runs the load within the near-optimal tolerance of the best "
         "twofold angle",
+        "between": f"folding pays at {_wh(folding.pays_wh)} of buffer and at none evaluated from "
+        f"{_wh(folding.holds_from_wh)} up to {top}; the buffers between found no periodic state "
+        "(no threshold is known)",
         "at_every_capacity": f"folding pays at every buffer evaluated up to {top}",
-        "at_largest_capacity": f"folding still pays at {top}, the largest buffer evaluated",
-    }[_folding_state(folding)]
+        "at_largest_capacity": f"folding still pays at {_wh(folding.pays_wh)}, the largest buffer "
+        + (
+            "evaluated"
+            if folding.pays_wh == folding.top_wh
+            else f"whose periodic state is known (none up to {top})"
+        ),
+    }[folding.state]
 
 
 def buffer_text(storage) -> str:
@@ -842,7 +869,9 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
         + ", ".join(f"{d} {powered[d]:.2f} h (t_solar {t_solar[d]:.2f} h)" for d in designs)
     ]
     near = buffered.near_optimal
-    if best_h > 0:
+    if best_h <= 0:
+        lines.append("no fold angle runs the load with the buffer: powered 0 h at every angle")
+    else:
         lines.append(
             f"best fold angle for the buffer {buffered.fold_angle_deg:g} deg: powered "
             f"{best_h:.2f} h, {_signed(best_h - powered['flat'], 2)} h over flat; near-optimal "
@@ -1150,6 +1179,28 @@ def _by_design(result: StorageResult, designs: int) -> StorageResult:
     )
 
 
+def _best_for_buffer(by: pd.DataFrame, angle) -> str:
+    """A year's line on the fold angle the objective of powered time keeps, of one load's rows
+    by design (:func:`year_lines`)."""
+    best = by.loc["twofold-buffer"]
+    statistic = best["objective"]
+    said = f"  best fold angle for the buffer ({statistic} powered time)"
+    if best["objective_powered_h"] != best["objective_powered_h"]:
+        return f"{said}: none, the objective's months hold none of the days"
+    return (
+        f"{said}: {angle['twofold-buffer']:g} deg, {best['objective_powered_h']:.2f} h (t_solar's "
+        f"{angle['twofold']:g} deg: {by.loc['twofold', 'objective_powered_h']:.2f} h; flat "
+        f"{by.loc['flat', 'objective_powered_h']:.2f} h); "
+        + (
+            f"near-optimal {best['near_optimal_lo_deg']:g} to {best['near_optimal_hi_deg']:g} deg, "
+            f"recommended {best['recommended_fold_angle_deg']:g} deg"
+            if best["near_optimal_lo_deg"] == best["near_optimal_lo_deg"]
+            else f"no fold angle runs the load ({statistic} powered time 0 h at every angle): no "
+            "near-optimal range"
+        )
+    )
+
+
 def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
     """What an annual answer says of its buffer, per load (at most 8): powered time per design,
     and the fold angle the objective of powered time keeps beside the one ``t_solar``'s keeps."""
@@ -1196,22 +1247,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                 for d in SOC_DESIGNS
             )
         )
-        best = by.loc["twofold-buffer"]
-        statistic = best["objective"]
-        lines.append(
-            f"  best fold angle for the buffer ({statistic} powered time): {angle['twofold-buffer']:g}"
-            f" deg, {best['objective_powered_h']:.2f} h (t_solar's {angle['twofold']:g} deg: "
-            f"{by.loc['twofold', 'objective_powered_h']:.2f} h; flat "
-            f"{by.loc['flat', 'objective_powered_h']:.2f} h); "
-            + (
-                f"near-optimal {best['near_optimal_lo_deg']:g} to "
-                f"{best['near_optimal_hi_deg']:g} deg, recommended "
-                f"{best['recommended_fold_angle_deg']:g} deg"
-                if best["near_optimal_lo_deg"] == best["near_optimal_lo_deg"]
-                else f"no fold angle runs the load ({statistic} powered time 0 h at every angle): "
-                "no near-optimal range"
-            )
-        )
+        lines.append(_best_for_buffer(by, angle))
         if "capacity_wh" in by:
             target = storage.target
             said = f"{target.powered_h:g} h" + (
