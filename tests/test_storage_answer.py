@@ -558,7 +558,9 @@ def test_folding_stops_paying_at_a_capacity_found_to_hold_with_one_just_below_th
         assert stops != stops and below < said["folding_does_not_pay_from_wh"]
         at = _gain(both, load, storage, np.array([below]), tolerance, 0.5)
         assert at[0][0] and not pays[grid >= said["folding_does_not_pay_from_wh"]].any()
-        assert not (pays | holds)[(grid > below) & (grid < said["folding_does_not_pay_from_wh"])].any()
+        assert not (pays | holds)[
+            (grid > below) & (grid < said["folding_does_not_pay_from_wh"])
+        ].any()
     elif state == "at_every_capacity":
         assert pays[pays | holds].all() and stops != stops
     else:
@@ -572,7 +574,10 @@ def test_folding_stops_paying_at_a_capacity_found_to_hold_with_one_just_below_th
         assert state == "never" or stops <= need["flat"]
     # The twofold row is the angle needing the least of those compared (ties to the least folded).
     each = np.array(
-        [smallest_buffers(curve[None, None], load, storage, 0.5, "numba", True)[0][0] for curve in twofold]
+        [
+            smallest_buffers(curve[None, None], load, storage, 0.5, "numba", True)[0][0]
+            for curve in twofold
+        ]
     )
     if np.isfinite(each).any():
         assert need["twofold"] == np.nanmin(each)
@@ -630,7 +635,9 @@ def test_where_flat_is_best_at_every_buffer_folding_never_pays():
     said = result.answer.to_dict()["result"]["storage"]
     assert said["folding_pays"] == "never" and said["folding_stops_paying_wh"] is None
     grid = result.storage.sizing.curve["capacity_wh"].to_numpy()
-    _, holds = _gain(_day_curves(result), study.p_load, study.storage, grid, study.near_optimal, step)
+    _, holds = _gain(
+        _day_curves(result), study.p_load, study.storage, grid, study.near_optimal, step
+    )
     assert holds.all()
     line = next(line for line in result.answer.lines() if line.startswith("folding"))
     assert line.startswith(f"folding never pays with a buffer up to {grid[-1]:.3g} Wh")
@@ -638,7 +645,7 @@ def test_where_flat_is_best_at_every_buffer_folding_never_pays():
     assert need["twofold"] <= need["flat"]
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=10, deadline=None)
 @given(
     st.floats(-66.0, 66.0),
     st.floats(-180.0, 180.0),

@@ -254,9 +254,10 @@ def size_buffers(
 class _Runs:
     """Designs' curves through a study's buffer at any capacities: each call
     :func:`_at_capacities` of some of the curves, ``(rows, capacities (r, m))`` ->
-    ``(hours, ok)``."""
+    ``(hours, ok)``; ``draws`` per curve as its (None: none)."""
 
     def __init__(self, power, draws, load, storage, step_hours, engine, in_sequence: bool):
+        draws = [None] * len(power) if draws is None else draws
         self.power, self.draws, self.load, self.storage = power, draws, load, storage
         self.step_hours, self.engine, self.in_sequence = step_hours, engine, in_sequence
 
@@ -456,7 +457,9 @@ def _at_capacities(
             each = (
                 load
                 if np.ndim(load) == 0
-                else per_capacity(np.broadcast_to(np.reshape(load, (-1, days.shape[-1])), days.shape))
+                else per_capacity(
+                    np.broadcast_to(np.reshape(load, (-1, days.shape[-1])), days.shape)
+                )
             )
             draw = None if own is None else per_capacity(own)
         result = run_buffer(series, each, buffer, step_hours, engine, draw=draw)
@@ -502,23 +505,24 @@ def _bracket(holds, lo, hi, after_last: bool):
         open_ = np.flatnonzero(cut & (hi - lo > CAPACITY_RTOL * hi))
         if not open_.size:
             return lo, hi
-        inner = lo[open_, None] + (hi - lo)[open_, None] * (
-            (index + 1) / (REFINE_POINTS + 1)
-        )
+        inner = lo[open_, None] + (hi - lo)[open_, None] * ((index + 1) / (REFINE_POINTS + 1))
         ok, fails = holds(open_, inner)
-        last = np.where(fails.any(axis=1), REFINE_POINTS - 1 - np.argmax(fails[:, ::-1], axis=1), -1)
-        tops = ok & (index > last[:, None]) if after_last else ok
+        tops = ok & (index > _last(fails)[:, None]) if after_last else ok
         at = np.where(tops.any(axis=1), np.argmax(tops, axis=1), REFINE_POINTS)
-        below = fails & (index < at[:, None])
-        under = np.where(
-            below.any(axis=1), REFINE_POINTS - 1 - np.argmax(below[:, ::-1], axis=1), -1
-        )
+        under = _last(fails & (index < at[:, None]))
         rows = np.arange(open_.size)
-        top = np.where(at < REFINE_POINTS, inner[rows, np.minimum(at, REFINE_POINTS - 1)], hi[open_])
+        top = np.where(
+            at < REFINE_POINTS, inner[rows, np.minimum(at, REFINE_POINTS - 1)], hi[open_]
+        )
         floor = np.where(under >= 0, inner[rows, np.maximum(under, 0)], lo[open_])
         # A bracket none of whose points is known cannot be cut further.
         cut[open_[~(ok | fails).any(axis=1)]] = False
         lo[open_], hi[open_] = floor, top
+
+
+def _last(mask) -> np.ndarray:
+    """(r,) the index of each row's last True in ``mask`` (r, k); -1 where none."""
+    return np.where(mask.any(axis=1), mask.shape[1] - 1 - np.argmax(mask[:, ::-1], axis=1), -1)
 
 
 def _smallest(run, rows, first, capacities) -> np.ndarray:
@@ -550,15 +554,7 @@ def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool
         As :func:`_at_capacities`'.
     """
     capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
-    run = _Runs(
-        power,
-        [None] * len(power) if draws is None else draws,
-        load,
-        storage,
-        step_hours,
-        engine,
-        in_sequence,
-    )
+    run = _Runs(power, draws, load, storage, step_hours, engine, in_sequence)
     rows = np.arange(power.shape[0])
     _, ok = run(rows, np.broadcast_to(capacities, (rows.size, capacities.size)))
     first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)
