@@ -304,36 +304,12 @@ def simulate(
     state = np.zeros((n_series, n_days + 1, 2))
     soc = np.zeros((n_series, n_days, n_steps) if soc_curves else (1, 1, 1))
     passes = np.zeros(n_series, dtype=np.int64)
-    if engine == "numba":
-        kern.simulate_series(
-            power,
-            load,
-            own,
-            params,
-            float(step_hours),
-            out,
-            state,
-            bool(soc_curves),
-            soc,
-            passes,
-            int(max_iterations),
-            float(tolerance),
-        )
-    else:
-        _simulate_numpy(
-            power,
-            load,
-            own,
-            params,
-            step_hours,
-            out,
-            state,
-            soc_curves,
-            soc,
-            passes,
-            max_iterations,
-            tolerance,
-        )  # fmt: skip: one call's arguments, not a list
+    # The compiled loop takes every argument with the one type it was compiled for.
+    run = kern.simulate_series if engine == "numba" else _simulate_numpy
+    run(
+        power, load, own, params, float(step_hours), out, state, bool(soc_curves), soc, passes,
+        int(max_iterations), float(tolerance),
+    )  # fmt: skip
     return StorageResult(
         out[..., kern.POWERED],
         out[..., kern.SERVED],
@@ -610,19 +586,9 @@ def _run_numpy(power, load, draw, par, step_hours, stored, on, out, state, soc_c
 
 
 def _simulate_numpy(
-    power,
-    load,
-    draw,
-    params,
-    step_hours,
-    out,
-    state,
-    soc_curves,
-    soc,
-    passes,
-    max_iterations,
+    power, load, draw, params, step_hours, out, state, soc_curves, soc, passes, max_iterations,
     tolerance,
-):
+):  # fmt: skip
     """:func:`foldopt.engine.storage_kernel.simulate_series` over arrays of series, each series's
     passes as :func:`foldopt.engine.storage_kernel._series` runs them."""
     n_series = out.shape[0]

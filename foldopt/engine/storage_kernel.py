@@ -357,19 +357,9 @@ def _series(
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def simulate_series(
-    power,
-    load,
-    draw,
-    params,
-    step_hours,
-    out,
-    state,
-    keep_soc,
-    soc,
-    passes,
-    max_iterations,
+    power, load, draw, params, step_hours, out, state, keep_soc, soc, passes, max_iterations,
     tolerance,
-):
+):  # fmt: skip
     """Every series, spread over threads (:func:`foldopt.engine.storage.simulate`).
 
     Parameters
