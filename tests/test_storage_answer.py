@@ -763,6 +763,7 @@ def test_an_answer_whose_load_never_runs_says_so_without_nan():
         )  # fmt: skip
     _says_no_nan(march.answer)
     assert any("the objective's months hold none of the days" in x for x in march.answer.lines())
+    assert march.answer.to_dict()["result"]["storage"]["fold_angle_buffer_deg"] is None
 
 
 def test_a_measured_day_s_buffer_writes_its_table(tmp_path, monkeypatch):

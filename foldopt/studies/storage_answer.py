@@ -1113,6 +1113,11 @@ def year_storage(
             with np.errstate(invalid="ignore", divide="ignore"):
                 vs_flat = (need / need[0] - 1.0) * 100.0 if need[0] > 0 else np.nan * need
             sized = {"capacity_wh": need, "capacity_vs_flat_pct": vs_flat, "monotone": monotone}
+        score = objective_value(powered.T, months, objective.statistic, objective.months)
+        angles = np.array([choice["fold_angle_deg"][d][index] for d in YEAR_DESIGNS])
+        # Without a statistic (the objective's months hold none of the days) no angle was chosen.
+        chosen = np.asarray(YEAR_DESIGNS) == "twofold-buffer"
+        angles[chosen & np.isnan(score)] = np.nan
         rows.append(
             pd.DataFrame(
                 {
@@ -1121,12 +1126,10 @@ def year_storage(
                     "longitude": site.longitude,
                     "p_load_w": p_load,
                     "design": YEAR_DESIGNS,
-                    "fold_angle_deg": [choice["fold_angle_deg"][d][index] for d in YEAR_DESIGNS],
+                    "fold_angle_deg": angles,
                     "days": powered.shape[1],
                     "objective": objective.statistic,
-                    "objective_powered_h": objective_value(
-                        powered.T, months, objective.statistic, objective.months
-                    ),
+                    "objective_powered_h": score,
                     "mean_powered_h": powered.mean(axis=1),
                     "min_powered_h": powered.min(axis=1),
                     "mean_t_solar_h": bare.powered_h.reshape(shape).mean(axis=1),
@@ -1134,9 +1137,7 @@ def year_storage(
                     "converged": result.converged.reshape(shape[0], -1).all(axis=1),
                     **sized,
                     **{
-                        key: np.where(
-                            np.asarray(YEAR_DESIGNS) == "twofold-buffer", value[index], np.nan
-                        )
+                        key: np.where(chosen, value[index], np.nan)
                         for key, value in choice["near"].items()
                     },
                 }
@@ -1173,6 +1174,13 @@ def _by_design(result: StorageResult, designs: int) -> StorageResult:
             -1,
         ),
     )
+
+
+def _another(angle) -> bool:
+    """Whether the angle the objective of powered time keeps was chosen and is not
+    ``t_solar``'s (the year's lines then name it apart)."""
+    chosen = angle["twofold-buffer"]
+    return chosen == chosen and chosen != angle["twofold"]
 
 
 def _best_for_buffer(by: pd.DataFrame, angle) -> str:
@@ -1233,7 +1241,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                 f"{named[d]} {by.loc[d, 'mean_powered_h']:.2f} h "
                 f"(t_solar {by.loc[d, 'mean_t_solar_h']:.2f} h)"
                 for d in YEAR_SAID
-                if d != "twofold-buffer" or angle[d] != angle["twofold"]
+                if d != "twofold-buffer" or _another(angle)
             )
             + "; all 24 h on "
             + ", ".join(f"{d} {by.loc[d, 'days_powered_24h_pct']:.0f} %" for d in SOC_DESIGNS)
@@ -1264,7 +1272,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                         else f"{named[d]}: no buffer up to the search's top reaches it"
                     )
                     for d in YEAR_SAID
-                    if d != "twofold-buffer" or angle[d] != angle["twofold"]
+                    if d != "twofold-buffer" or _another(angle)
                 )
             )
     if len(cases) > 8:
