@@ -438,12 +438,31 @@ def _at_capacities(
     ok : numpy.ndarray
         (n, m) bool: :func:`reaches` ``storage.target`` (all False without a target).
     """
-    hours, ok = [], []
     draws = [None] * len(power) if draws is None else draws
+    target = storage.target
+    if in_sequence and power.ndim == 2:
+        # A day per design: every design at every capacity in one call (a call's threads cost
+        # more than a few days' series).
+        n, m = capacities.shape
+        own = (
+            None
+            if all(draw is None for draw in draws)
+            else np.repeat([np.zeros(power.shape[-1]) if d is None else d for d in draws], m, 0)
+        )
+        buffer = buffer_of(storage, capacity_wh=capacities.ravel())
+        result = run_buffer(np.repeat(power, m, 0), load, buffer, step_hours, engine, draw=own)
+        converged = result.converged.reshape(n, m)
+        reached = (
+            _reaching(result.powered_h, result.converged, target).reshape(n, m)
+            if target is not None
+            else np.zeros((n, m), bool)
+        )
+        return np.where(converged, result.powered_h.reshape(n, m), np.nan), reached
+    hours, ok = [], []
     for curve, capacity, own in zip(power, capacities, draws, strict=True):
         days = curve.reshape(-1, curve.shape[-1])
         if in_sequence:
-            # One curve serves every capacity, without a copy.
+            # One curve of days serves every capacity, without a copy.
             series, buffer = curve[None], buffer_of(storage, capacity_wh=capacity)
             each = load
             draw = None if own is None else own[None]
@@ -468,7 +487,6 @@ def _at_capacities(
         # A series with no periodic state has no powered time to draw (NaN: the figure leaves
         # it out).
         hours.append(np.where(converged, powered.mean(axis=1), np.nan))
-        target = storage.target
         ok.append(
             _reaching(powered, converged, target)
             if target is not None
