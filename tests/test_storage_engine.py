@@ -482,3 +482,13 @@ def test_bad_buffer_names_the_field(change, field):
 def test_unknown_engine_lists_the_engines():
     with pytest.raises(ValueError, match="numba, numpy"):
         simulate(HAND_POWER[None], 4.0, Buffer(20.0), 6.0, engine="fortran")
+
+
+def test_power_below_zero_is_refused_a_design_s_own_draw_goes_in_draw():
+    """A net curve's negative part had nowhere to come from while the load was off (energy
+    created); a tracker's draw is a load of its own, and its net curve is refused."""
+    net = HAND_POWER[None] - 1.0
+    with pytest.raises(ValueError, match="0 or more .*draw"):
+        simulate(net, 4.0, Buffer(20.0), 6.0)
+    with pytest.raises(ValueError, match="draw must be finite and 0 or more"):
+        simulate(HAND_POWER[None], 4.0, Buffer(20.0), 6.0, draw=-1.0)

@@ -278,9 +278,7 @@ def simulate(
             f"power must be (n_series, n_days, n_steps) or (n_series, n_steps); got {power.shape}"
         )
     if not (np.isfinite(power).all() and (power >= 0).all()):
-        raise ValueError(
-            "power must be finite and 0 or more (a design's own draw is simulate's draw)"
-        )
+        raise ValueError("power must be finite and 0 or more (a design's own draw goes in draw)")
     load = _load_array(load, power.shape, "load")
     own = _load_array(0.0 if draw is None else draw, power.shape, "draw")
     # The kernel compares the power the design leaves after its own draw with the load (as

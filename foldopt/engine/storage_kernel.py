@@ -123,19 +123,8 @@ def _part(pa, pb, la, lb, da, db, tau, surplus, stored, on, par):
             short = max(need - pv, 0.0)
             if short <= eta * usable:
                 taken = short / eta
-                return (
-                    stored - taken,
-                    on,
-                    need,
-                    0.0,
-                    0.0,
-                    0.0,
-                    taken - short,
-                    tau,
-                    False,
-                    False,
-                    own,
-                )
+                left = stored - taken
+                return left, on, need, 0.0, 0.0, 0.0, taken - short, tau, False, False, own
             # The buffer carries the load part of the way, to its cut-off; the rest is off.
             ran = time_to_draw(la - pa, lb - pb, tau, eta * usable)
             x = ran / tau

@@ -13,7 +13,10 @@ reaching the target and the one below it (which does not) cut into :data:`REFINE
 parts, the least part reaching it and the part below it the next bracket, until it is within
 :data:`CAPACITY_RTOL` of its top. The capacity given is therefore always one evaluated that
 reaches the target, every smaller capacity of the grid falls short of it, and so does an
-evaluated one within :data:`CAPACITY_RTOL` below it.
+evaluated one within :data:`CAPACITY_RTOL` below it. The capacity from which folding stops
+paying is found by the same search (:func:`folding_pays`), at the capacities the sizing names too,
+so that every capacity the answer states is one evaluated and found to hold, and the lines hold
+against each other.
 
 That this is *the* smallest buffer rests on powered time not falling as the capacity grows. It
 holds, to within one step, only for a controller without hysteresis (``restart_soc`` =
