@@ -960,27 +960,6 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
 DESIGN_COLUMNS = tuple(SUMMARY_COLUMNS.values())
 
 
-def unsimulated_notes(study) -> list[dict]:
-    """The note of an answer that does not simulate its study's buffer (a plan of cases without
-    an annual objective, a cloud ensemble): its numbers are storage-less. None without a buffer.
-
-    Parameters
-    ----------
-    study : foldopt.Study
-        The plan's base study.
-    """
-    if study.storage is None:
-        return []
-    return [
-        {
-            "note": "storage: the buffer is simulated in a day's study and over the days of an "
-            "annual objective (not over a cloud ensemble's members); these answers are "
-            "storage-less",
-            "designs": [],
-        }
-    ]
-
-
 #: The designs a year's buffer is simulated for: the twofold panel at the angle ``t_solar``'s
 #: objective keeps all year, and at the one the objective of powered time keeps
 #: (``twofold-buffer``, :func:`powered_by_angle`).
