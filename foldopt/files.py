@@ -488,6 +488,42 @@ def discard(staged: Path) -> int:
 
 
 @contextmanager
+def writing(out: Path):
+    """Hold ``out``'s lock (:func:`writer_lock`) for the block, its parent folders made and what
+    ended writers left beside it cleared (:func:`clear_leftovers`). The parent folders it made
+    are removed again, deepest first, where the block fails and they are empty: a failed run
+    leaves nothing behind.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The results folder to be.
+
+    Raises
+    ------
+    foldopt.errors.OutputError
+        Where the parent folders cannot be made, or from :func:`writer_lock`.
+    """
+    out = Path(out)
+    made = [folder for folder in out.parents if not folder.exists() and not folder.is_symlink()]
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"--out {out}: cannot create it ({error.strerror or error})") from None
+    try:
+        with writer_lock(out):
+            clear_leftovers(out.parent)
+            yield
+    except BaseException:
+        for folder in made:
+            try:
+                folder.rmdir()
+            except OSError:  # not empty, or not ours to remove any more
+                break
+        raise
+
+
+@contextmanager
 def staged_folder(out: Path, overwrite: bool):
     """Yield a temporary folder that replaces ``out`` atomically when the block succeeds; while
     the block runs, ``out``'s lock is held.
@@ -499,12 +535,7 @@ def staged_folder(out: Path, overwrite: bool):
         Whether an existing results folder may be replaced (:func:`check_output`).
     """
     out = Path(out)
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise OutputError(f"--out {out}: cannot create it ({error.strerror or error})") from None
-    with writer_lock(out):
-        clear_leftovers(out.parent)
+    with writing(out):
         check_output(out, overwrite)
         try:
             staged = new_staging(out)

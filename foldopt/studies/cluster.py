@@ -36,7 +36,6 @@ from foldopt.inputs.study import Study
 from foldopt.files import (
     DiskFullError,
     check_output,
-    clear_leftovers,
     commit,
     discard,
     is_full,
@@ -44,7 +43,7 @@ from foldopt.files import (
     tree_size,
     versions,
     write_atomically,
-    writer_lock,
+    writing,
 )
 from foldopt.studies.dask_client import CONNECT_TIMEOUT, check_cluster, connect
 from foldopt.studies.worldmap import MapSpec
@@ -325,12 +324,7 @@ def run_map(
         "spec": spec.as_dict(),
         "chunks": len(chunks),
     }
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise OutputError(f"--out {out}: cannot create it ({error.strerror or error})") from None
-    with writer_lock(out):
-        clear_leftovers(out.parent)
+    with writing(out):
         in_place = map_folder(out, resume, overwrite)
         resuming = in_place and out.exists()
         done = chunks_on_disk(out, spec) if resuming else []
@@ -357,7 +351,7 @@ def run_map(
                 if missing:
                     _compute_parts(client, spec, folder, missing, done, scheduler, progress)
             finals = new_staging(out) if in_place else folder
-            run = _finish(
+            run = _assemble(
                 spec,
                 folder,
                 finals,
@@ -439,8 +433,8 @@ def _compute_parts(client, spec, folder, missing, done, scheduler, progress) -> 
         except KilledWorker as error:
             sites = chunks[index]
             raise RuntimeError(
-                f"a worker process died each time it computed chunk {index} (sites {sites[0]} to "
-                f"{sites[-1]}): a crash, or too little memory for it"
+                f"the map's worker processes died while computing it (chunk {index}, sites "
+                f"{sites[0]} to {sites[-1]}, was running each time): a crash, or too little memory"
             ) from error
         except CancelledError as error:
             if scheduler is None:
@@ -466,7 +460,7 @@ def _compute_parts(client, spec, folder, missing, done, scheduler, progress) -> 
             progress(finished_sites, len(spec.sites))
 
 
-def _finish(
+def _assemble(
     spec, folder, finals, metadata, computed, done, started, description, dashboard, finish
 ) -> MapRun:
     """Assemble the map's tables from the parts in ``folder`` and write them, ``finish``'s files

@@ -20,6 +20,7 @@ import re
 import socket
 import threading
 import time
+import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -36,6 +37,8 @@ SCHEMES = ("tcp", "tls", "ws", "wss")
 _HOST_PORT = re.compile(r"^(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):([0-9]{1,5})$")
 #: The loggers Dask writes through: its own, and tornado's and bokeh's, whose servers it runs.
 DASK_LOGGERS = ("distributed", "tornado", "bokeh")
+#: The modules whose warnings are Dask's.
+DASK_WARNINGS = r"distributed(\.|$)"
 #: A level above every record's: a logger set to it passes nothing on.
 SILENT = logging.CRITICAL + 1
 #: What ``--scheduler`` accepts, as the messages say it.
@@ -129,9 +132,10 @@ def connect(
 @contextmanager
 def quiet_dask():
     """No log record of Dask's (:data:`DASK_LOGGERS`) reaches a handler of this process while the
-    block runs: the embedded cluster's scheduler and nannies run here, and the client, whose
-    records of a lost scheduler or a slow event loop would otherwise reach the terminal. The
-    loggers' levels are put back afterwards, for a caller's own use of Dask."""
+    block runs, nor does a warning of Dask's: the embedded cluster's scheduler and nannies run
+    here, and the client, whose records of a lost scheduler or a slow event loop would otherwise
+    reach the terminal. The loggers' levels and the warnings' filters are put back afterwards, for
+    a caller's own use of Dask."""
     import distributed  # noqa: F401 - sets its loggers' levels as it is first imported: before they are kept
 
     loggers = _dask_loggers()
@@ -139,7 +143,10 @@ def quiet_dask():
     for logger in loggers:
         logger.setLevel(SILENT)
     try:
-        yield
+        with warnings.catch_warnings():
+            # and its warnings (a port in use, a large graph): the map works regardless
+            warnings.filterwarnings("ignore", module=DASK_WARNINGS)
+            yield
     finally:
         for logger, level in zip(loggers, levels, strict=True):
             logger.setLevel(level)
@@ -161,7 +168,8 @@ def _dask_loggers() -> list[logging.Logger]:
 
 def dask_setup(worker) -> None:
     """Dask's preload hook, run in each worker process of the embedded cluster as it starts
-    (:func:`connect`): the process's Dask loggers log nothing, for its whole life (a heartbeat that
+    (:func:`connect`): the process's Dask loggers log nothing and Dask warns of nothing, for its
+    whole life (a heartbeat that
     fails as the cluster shuts down, a task that raises: its error reaches the client).
 
     Parameters
@@ -170,6 +178,7 @@ def dask_setup(worker) -> None:
     """
     for logger in _dask_loggers():
         logger.setLevel(SILENT)
+    warnings.filterwarnings("ignore", module=DASK_WARNINGS)
 
 
 def check_cluster(scheduler: str | None, workers: int | None) -> None:
