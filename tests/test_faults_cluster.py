@@ -376,8 +376,9 @@ def test_the_connect_budget_is_stated_in_the_help():
     from foldopt.studies.dask_client import CONNECT_TIMEOUT, WORKER_TIMEOUT
 
     help_text = " ".join(CliRunner().invoke(app, ["map", "--help"]).output.split())
-    assert CONNECT_TIMEOUT <= 10 and f"gives up after {CONNECT_TIMEOUT:g} s where no scheduler answers" in help_text
-    assert f"after {WORKER_TIMEOUT:g} s more where it has no worker" in help_text
+    assert CONNECT_TIMEOUT <= 10
+    assert f"A scheduler that does not answer is given up after {CONNECT_TIMEOUT:g} s" in help_text
+    assert f"one without a worker after {WORKER_TIMEOUT:g} s more" in help_text
 
 
 def test_a_scheduler_file_holding_a_malformed_address_names_the_file(tmp_path):

@@ -163,9 +163,9 @@ def map_(
         typer.Option(
             "--scheduler",
             help="A Dask scheduler's address (tcp://host:8786; or tls://, ws://, wss://) or "
-            "scheduler file [default: an embedded cluster]. foldopt gives up after "
-            f"{CONNECT_TIMEOUT:g} s where no scheduler answers, and after {WORKER_TIMEOUT:g} s "
-            "more where it has no worker.",
+            "scheduler file [default: an embedded cluster]. A scheduler that does not answer is "
+            f"given up after {CONNECT_TIMEOUT:g} s, one without a worker after "
+            f"{WORKER_TIMEOUT:g} s more.",
         ),
     ] = None,
     workers: Annotated[
