@@ -404,8 +404,6 @@ def _compute_parts(client, spec, folder, missing, done, scheduler, progress) -> 
     it comes. A task's own error is raised as it is (a bad weather file's :class:`ConfigError`
     names it); a chunk that killed every worker that ran it, or a scheduler lost mid-run, is one
     error saying so."""
-    from concurrent.futures import CancelledError
-
     from distributed import KilledWorker, as_completed
 
     chunks = spec.chunks()
@@ -436,9 +434,10 @@ def _compute_parts(client, spec, folder, missing, done, scheduler, progress) -> 
                 f"the map's worker processes died while computing it (chunk {index}, sites "
                 f"{sites[0]} to {sites[-1]}, was running each time): a crash, or too little memory"
             ) from error
-        except CancelledError as error:
-            if scheduler is None:
-                raise
+        except Exception as error:
+            if future.status == "error" or scheduler is None:
+                raise  # the task's own error; or the embedded cluster's, an internal fault
+            # Cancelled as the client lost its scheduler, or the connection reset as it gathered.
             kept = len(done) + new_parts
             then = (
                 f"the {kept} of {len(chunks)} chunks done are kept: start it again and finish the "
@@ -449,7 +448,7 @@ def _compute_parts(client, spec, folder, missing, done, scheduler, progress) -> 
             raise ConfigError(
                 [
                     f"--scheduler = {scheduler!r}: the scheduler was lost mid-run "
-                    f"({getattr(error, 'reason', None) or 'its tasks were cancelled'}); {then}"
+                    f"({getattr(error, 'reason', None) or type(error).__name__}); {then}"
                 ]
             ) from None
         _write_parquet(frame, _part_path(folder, index), spec.key)
