@@ -89,10 +89,13 @@ def written_by_foldopt(folder: Path) -> bool:
     )
 
 
-def check_output(out: Path, overwrite: bool) -> None:
-    """Raise if ``out`` cannot take a results folder: :class:`OutputExistsError` if it exists and
-    ``overwrite`` is false, :class:`OutputError` if it is a file, the working folder or one of its
-    parents, a folder foldopt did not write, or in a place that cannot be written.
+def check_output(
+    out: Path, overwrite: bool, remedy: str = "pass --overwrite to replace it"
+) -> None:
+    """Raise if ``out`` cannot take a results folder: :class:`OutputError` if it is a file, a
+    symbolic link, the working folder or one of its parents, a folder foldopt did not write, or in
+    a place that cannot be written (no option changes that, so none is offered);
+    :class:`OutputExistsError` if it is an existing results folder and ``overwrite`` is false.
 
     Parameters
     ----------
@@ -100,6 +103,8 @@ def check_output(out: Path, overwrite: bool) -> None:
         The results folder to be.
     overwrite : bool
         Whether an existing results folder may be replaced.
+    remedy : str, default 'pass --overwrite to replace it'
+        What the message of an existing results folder offers.
     """
     out = Path(out)
     resolved = out.resolve()
@@ -110,14 +115,17 @@ def check_output(out: Path, overwrite: bool) -> None:
     if out.is_symlink():
         raise OutputError(f"--out {out}: is a symbolic link; name the folder itself")
     if out.exists() and not out.is_dir():
-        raise OutputError(f"--out {out}: is a file, not a folder")
-    if out.exists() and not overwrite:
-        raise OutputExistsError(f"{out} already exists; pass --overwrite to replace it")
+        raise OutputError(
+            f"--out {out}: is a file, not a results folder; foldopt will not replace it, so move "
+            "it or choose another --out"
+        )
     if out.exists() and any(out.iterdir()) and not written_by_foldopt(out):
         raise OutputError(
-            f"--out {out}: holds files foldopt did not write (no foldopt run.json); --overwrite "
-            "replaces only results folders, so move them or choose another folder"
+            f"--out {out}: holds files foldopt did not write (no foldopt run.json); foldopt "
+            "replaces only results folders, so move them or choose another --out"
         )
+    if out.exists() and not overwrite:
+        raise OutputExistsError(f"{out} already exists; {remedy}")
     ancestor = resolved.parent
     while not ancestor.exists():
         ancestor = ancestor.parent
@@ -480,6 +488,42 @@ def discard(staged: Path) -> int:
 
 
 @contextmanager
+def writing(out: Path):
+    """Hold ``out``'s lock (:func:`writer_lock`) for the block, its parent folders made and what
+    ended writers left beside it cleared (:func:`clear_leftovers`). The parent folders it made
+    are removed again, deepest first, where the block fails and they are empty: a failed run
+    leaves nothing behind.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The results folder to be.
+
+    Raises
+    ------
+    foldopt.errors.OutputError
+        Where the parent folders cannot be made, or from :func:`writer_lock`.
+    """
+    out = Path(out)
+    made = [folder for folder in out.parents if not folder.exists() and not folder.is_symlink()]
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"--out {out}: cannot create it ({error.strerror or error})") from None
+    try:
+        with writer_lock(out):
+            clear_leftovers(out.parent)
+            yield
+    except BaseException:
+        for folder in made:
+            try:
+                folder.rmdir()
+            except OSError:  # not empty, or not ours to remove any more
+                break
+        raise
+
+
+@contextmanager
 def staged_folder(out: Path, overwrite: bool):
     """Yield a temporary folder that replaces ``out`` atomically when the block succeeds; while
     the block runs, ``out``'s lock is held.
@@ -491,12 +535,7 @@ def staged_folder(out: Path, overwrite: bool):
         Whether an existing results folder may be replaced (:func:`check_output`).
     """
     out = Path(out)
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise OutputError(f"--out {out}: cannot create it ({error.strerror or error})") from None
-    with writer_lock(out):
-        clear_leftovers(out.parent)
+    with writing(out):
         check_output(out, overwrite)
         try:
             staged = new_staging(out)

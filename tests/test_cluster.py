@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -83,7 +84,8 @@ def embedded(tmp_path_factory) -> pd.DataFrame:
 @pytest.fixture
 def cluster(tmp_path):
     """A scheduler and two single-threaded workers on 127.0.0.1 (one without a nanny, so that
-    killing it kills the worker); yields the scheduler file and the workers' processes."""
+    killing it kills the worker); yields the scheduler file, the workers' processes and the
+    scheduler's."""
     scheduler_file = tmp_path / "scheduler.json"
     python = [sys.executable, "-m"]
     processes = [subprocess.Popen([*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
@@ -95,7 +97,7 @@ def cluster(tmp_path):
             processes.append(subprocess.Popen([*python, "distributed.cli.dask_worker", "--scheduler-file",
                                                str(scheduler_file), "--nthreads", "1", "--no-nanny", "--host",
                                                "127.0.0.1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        yield scheduler_file, processes[1:]
+        yield scheduler_file, processes[1:], processes[0]
     finally:
         for process in processes:
             _kill(process)
@@ -123,7 +125,7 @@ def test_embedded_map_equals_the_computation_without_dask(embedded):
 def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
     """A map on a hand-started cluster, one of whose two workers is killed once the first part is
     written: every site once, the same bits as the embedded cluster's map."""
-    scheduler_file, workers = cluster
+    scheduler_file, workers, _ = cluster
     out = tmp_path / "map"
     run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
     try:
@@ -135,7 +137,7 @@ def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
     finally:
         _kill(run)
     assert killed_at < N_SITES  # the worker died with work left
-    assert "Dask scheduler tcp://127.0.0.1:" in err
+    assert err.splitlines()[0].startswith("Dask scheduler tcp://127.0.0.1:") and len(err.splitlines()) == 1, err
     table = pd.read_parquet(out / "map.parquet")
     _every_site_once(table)
     pd.testing.assert_frame_equal(table, embedded, check_exact=True)
@@ -201,3 +203,106 @@ def test_no_scheduler_is_a_one_line_input_error(tmp_path):
     spec = MapSpec({"name": "x", "panel": {"area": 0.1}}, ({"latitude": 0.0, "longitude": 0.0},), (1.0,))
     with pytest.raises(ConfigError, match="no Dask scheduler answers there within 2 s"):
         run_map(spec, tmp_path / "map", scheduler="tcp://127.0.0.1:9", connect_timeout=2)
+
+
+# --- what a map prints ------------------------------------------------------------------------------------
+
+
+#: The command line, its map's task replaced by this script's (Dask pickles a function of __main__ by value,
+#: so the embedded cluster's workers run it). FAULT: raise (a RuntimeError, an internal fault), bad-input (a
+#: ConfigError, as a weather file broken mid-run raises), die (the worker's process ends), die-once (the
+#: first time only: it makes MARK).
+FAULTY_TASK = """
+import os, sys
+import foldopt.studies.cluster as cluster
+
+FAULT, MARK = os.environ["FAULT"], os.environ["MARK"]  # the task takes them with it, wherever it runs
+
+def task(study, sites, loads, relative, year, engine):
+    if FAULT == "raise":
+        raise RuntimeError("a fault in the task")
+    if FAULT == "bad-input":
+        from foldopt.errors import ConfigError
+        raise ConfigError(["weather: a file that broke mid-run"])
+    if FAULT == "die" or FAULT == "die-once" and not os.path.exists(MARK):
+        open(MARK, "w").close()
+        os._exit(1)
+    from foldopt.studies.worldmap import evaluate_sites
+    return evaluate_sites(study, sites, loads, relative, year, engine)
+
+cluster.evaluate_chunk = task
+from foldopt.cli.app import app
+app(sys.argv[1:], prog_name="foldopt")
+"""
+#: Two sites, a chunk each, at hourly steps and fold angles 90 and 180 deg.
+SMALL = ["--lat", "0,30", "--lon", "0", "--p-load", "1", "--area", "0.108", "--step-min", "60", "--angle-step",
+         "90", "--chunk-sites", "1"]
+EMBEDDED_ONE = r"embedded LocalCluster, 1 worker process; dashboard: http://127\.0\.0\.1:\d+/status"
+
+
+def _faulty_map(fault: str, tmp_path: Path, cluster: list[str], **environment) -> tuple[int, list[str]]:
+    """Run the small map with ``fault`` on ``cluster`` (its options) into ``tmp_path / "map"``; its exit
+    code and the lines of its stderr."""
+    env = {**os.environ, "FAULT": fault, "MARK": str(tmp_path / "died"), **environment}
+    process = subprocess.run([sys.executable, "-c", FAULTY_TASK, "map", *SMALL, *cluster, "--out",
+                              str(tmp_path / "map")], env=env, capture_output=True, text=True, timeout=SECONDS)
+    assert "distributed." not in process.stderr and "Traceback" not in process.stderr, process.stderr
+    return process.returncode, process.stderr.splitlines()
+
+
+def test_a_maps_terminal_holds_only_foldopts_lines(tmp_path):
+    """Dask's records stay off the terminal: the worker that computes the first chunk dies (its nanny
+    starts another, the scheduler reschedules), and the map is whole all the same."""
+    code, lines = _faulty_map("die-once", tmp_path, ["--workers", "1"])
+    assert code == 0 and (tmp_path / "died").exists()
+    assert len(lines) == 1 and re.fullmatch(EMBEDDED_ONE, lines[0]), lines
+    assert len(pd.read_parquet(tmp_path / "map" / "map.parquet")) == 2 * 5
+
+
+@pytest.mark.parametrize("fault, code, line", [
+    ("raise", 1, "error: internal error (RuntimeError: a fault in the task); run again as foldopt --debug ... "
+                 "for the traceback, and please report it"),
+    ("bad-input", 2, "error: "),
+    ("die", 1, "error: internal error (RuntimeError: the map's worker processes died while computing it (chunk "),
+], ids=["raise", "bad-input", "die"])
+def test_a_task_that_fails_is_one_line(tmp_path, scheduler, fault, code, line):
+    # The input's fault on a cluster of this process (the client's records are the point: its worker's
+    # are this process's), the others on an embedded one; Dask gives up on a task at the first worker
+    # that dies running it.
+    cluster = ["--scheduler", scheduler] if fault == "bad-input" else ["--workers", "1"]
+    returned, lines = _faulty_map(fault, tmp_path, cluster, DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES="0")
+    assert returned == code, lines
+    announced = f"Dask scheduler {re.escape(scheduler)}; .*" if fault == "bad-input" else EMBEDDED_ONE
+    assert len(lines) == 2 and re.fullmatch(announced, lines[0]) and lines[1].startswith(line), lines
+    assert fault != "bad-input" or lines[1].endswith("weather: a file that broke mid-run")  # as the field is named
+    assert sorted(path.name for path in tmp_path.iterdir()) == (["died"] if fault == "die" else [])
+
+
+def _snapshot(folder: Path) -> dict[str, tuple]:
+    return {str(path.relative_to(folder)): (path.read_bytes(), path.stat().st_mtime_ns)
+            for path in sorted(folder.rglob("*")) if path.is_file()}
+
+
+def test_a_scheduler_lost_mid_run_is_one_line_and_a_resume_that_cannot_connect_changes_nothing(cluster, tmp_path):
+    scheduler_file, _, scheduler = cluster
+    out = tmp_path / "map"
+    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
+    try:
+        _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
+        address = json.loads(scheduler_file.read_text())["address"]
+        scheduler.kill()
+        _, err = run.communicate(timeout=SECONDS)
+    finally:
+        _kill(run)
+    lines = err.splitlines()
+    assert run.returncode == 2 and len(lines) == 2, err
+    assert lines[0].startswith("Dask scheduler tcp://127.0.0.1:")
+    assert re.fullmatch(rf"error: --scheduler = '{re.escape(str(scheduler_file))}': the scheduler was lost mid-run "
+                        r"\((scheduler-connection-lost|CommClosedError)\); the \d+ of 16 chunks done are kept: "
+                        r"start it again and finish the map with --resume", lines[1]), lines[1]
+    before = _snapshot(out)
+    assert json.loads((out / "run.json").read_text())["status"] == "running" and before
+    refused = _foldopt("map", *MAP, "--out", str(out), "--resume", "--scheduler", address)
+    _, err = refused.communicate(timeout=SECONDS)
+    assert refused.returncode == 2 and err.startswith(f"error: --scheduler = '{address}': no Dask scheduler answers")
+    assert _snapshot(out) == before and not [path for path in tmp_path.iterdir() if path.name.startswith(".")]

@@ -39,8 +39,9 @@ def spec(loads=(1.0,), sites=SITES) -> MapSpec:
     return MapSpec(STUDY, sites, loads, sites_per_chunk=1, engine="numpy")
 
 
-def snapshot(folder: Path) -> dict[str, str]:
-    return {str(path.relative_to(folder)): hashlib.sha256(path.read_bytes()).hexdigest()
+def snapshot(folder: Path) -> dict[str, tuple]:
+    """Every file under ``folder``: its bytes' digest and the time it was last written [ns]."""
+    return {str(path.relative_to(folder)): (hashlib.sha256(path.read_bytes()).hexdigest(), path.stat().st_mtime_ns)
             for path in sorted(folder.rglob("*")) if path.is_file()}
 
 
@@ -213,3 +214,176 @@ def test_a_scheduler_file_without_an_address_is_one_line_naming_it(tmp_path, con
     errors, seconds = _connect_error(str(path))
     assert len(errors) == 1 and str(path) in errors[0] and reason in errors[0] and "\n" not in errors[0]
     assert seconds < 2, seconds
+
+
+# --- a failed run changes nothing that was there ------------------------------------------------------------
+
+
+def interrupted(finished: Path, folder: Path) -> dict[str, tuple]:
+    """A copy of :func:`finished` as a run killed after its first chunk leaves it: part 0, no tables,
+    ``running``."""
+    shutil.copytree(finished, folder)
+    for name in ("parts/part-00001.parquet", "map.parquet", "map.csv"):
+        (folder / name).unlink()
+    run_json = json.loads((folder / "run.json").read_text())
+    (folder / "run.json").write_text(json.dumps({**run_json, "status": "running"}))
+    return snapshot(folder)
+
+
+def assert_unchanged(out: Path, before: dict[str, tuple], new_parts: tuple[int, ...] = ()) -> None:
+    """Every earlier file of ``out`` byte for byte and untouched; the only new files are whole parts
+    of the map (``new_parts``) and nothing is staged beside it."""
+    after = snapshot(out)
+    assert {name: after.get(name) for name in before} == before
+    assert sorted(set(after) - set(before)) == [f"parts/part-{index:05d}.parquet" for index in new_parts]
+    for index in new_parts:
+        assert len(pd.read_parquet(out / "parts" / f"part-{index:05d}.parquet")) > 0
+    assert sorted(path.name for path in out.parent.iterdir()) == [out.name]
+
+
+def _broken_finish(run, metadata):
+    (run.out / "map_fold_angle.png").write_bytes(b"half a figure")
+    raise RuntimeError("a figure fails")
+
+
+@pytest.mark.parametrize("fault", ["unreachable", "malformed-address", "another-map", "figures-fail"])
+@pytest.mark.parametrize("state", ["interrupted", "complete"])
+def test_a_resume_that_fails_changes_nothing_that_was_there(finished, scheduler, tmp_path, fault, state):
+    out = tmp_path / "results" / "map"
+    out.parent.mkdir()
+    if state == "interrupted":
+        before = interrupted(finished, out)
+    else:  # complete, but a part was damaged: it is computed again
+        before = earlier_map(finished, out)
+        if fault != "figures-fail":
+            (out / "parts" / "part-00001.parquet").write_bytes(b"damaged")
+            before = snapshot(out)
+    keywords, error = {
+        "unreachable": ({"scheduler": _refused_address()}, ConfigError),
+        "malformed-address": ({"scheduler": "tcp://"}, ConfigError),
+        "another-map": ({"scheduler": scheduler, "spec": spec(loads=(2.0,))}, OutputError),
+        "figures-fail": ({"scheduler": scheduler, "finish": _broken_finish}, RuntimeError),
+    }[fault]
+    with pytest.raises(error):
+        run_map(keywords.pop("spec", spec()), out, resume=True, **keywords)
+    assert_unchanged(out, before, (1,) if fault == "figures-fail" and state == "interrupted" else ())
+
+
+@pytest.mark.parametrize("fault", ["unreachable", "figures-fail", "broken-weather"])
+def test_an_overwrite_that_fails_changes_nothing_that_was_there(finished, scheduler, tmp_path, fault):
+    out = tmp_path / "results" / "map"
+    out.parent.mkdir()
+    before = earlier_map(finished, out)
+    broken = tmp_path / "broken.epw"
+    broken.write_text("LOCATION,x\nnot a weather file\n")
+    sites = (SITES[0], {**SITES[1], "weather": str(broken)}) if fault == "broken-weather" else SITES
+    with pytest.raises((ConfigError, RuntimeError)):
+        run_map(spec(loads=(2.0,), sites=sites), out, overwrite=True,
+                scheduler=_refused_address() if fault == "unreachable" else scheduler,
+                finish=_broken_finish if fault == "figures-fail" else None)
+    assert_unchanged(out, before)
+
+
+def _cluster():
+    """A cluster of this process of its own, to be closed by a test."""
+    return distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://",
+                                    host="127.0.0.1", dashboard_address="127.0.0.1:0")
+
+
+def test_a_scheduler_lost_mid_resume_keeps_the_earlier_folder_and_the_new_parts(finished, tmp_path):
+    """The cluster's scheduler is closed once the resumed run has written a part of its own: one
+    line saying so, the earlier files as they were, the new part whole; a resume then finishes."""
+    sites = tuple({"latitude": float(latitude), "longitude": 10.0} for latitude in (-40, -20, 0, 20, 40))
+    whole, out = tmp_path / "whole" / "map", tmp_path / "resumed" / "map"
+    with _cluster() as cluster:
+        first = run_map(spec(sites=sites), whole, scheduler=cluster.scheduler_address)
+    shutil.copytree(whole, out)
+    for name in ("map.parquet", "map.csv", *(f"parts/part-{index:05d}.parquet" for index in range(1, 5))):
+        (out / name).unlink()
+    before = snapshot(out)
+    with _cluster() as doomed:
+        done = []
+
+        def progress(sites_done, total):
+            done.append(sites_done)
+            if len(done) == 2:  # the first part of this run is written
+                doomed.close()
+
+        with pytest.raises(ConfigError) as raised:
+            run_map(spec(sites=sites), out, resume=True, scheduler=doomed.scheduler_address, progress=progress)
+    (line,) = raised.value.errors
+    assert "the scheduler was lost mid-run" in line and "finish the map with --resume" in line
+    assert re.search(r"the \d of 5 chunks done are kept", line)
+    new_parts = tuple(sorted(int(path.name[5:10]) for path in (out / "parts").glob("part-*")))[1:]
+    assert 1 <= len(new_parts) < 4
+    assert_unchanged(out, before, new_parts)
+    with _cluster() as again:
+        resumed = run_map(spec(sites=sites), out, resume=True, scheduler=again.scheduler_address)
+    assert resumed.from_disk == (0, *new_parts)
+    pd.testing.assert_frame_equal(resumed.table, first.table, check_exact=True)
+
+
+def test_a_new_map_that_cannot_connect_leaves_nothing_not_even_its_parent_folders(tmp_path):
+    with pytest.raises(ConfigError, match="no Dask scheduler answers there"):
+        run_map(spec(), tmp_path / "new" / "deeper" / "map", scheduler=_refused_address())
+    assert list(tmp_path.iterdir()) == []
+
+
+# --- scheduler addresses on the command line ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("address, reason", [
+    ("foo", "neither an existing scheduler file nor an address"),
+    ("tcp://", "no host and port"),
+    ("tcp://127.0.0.1", "not a HOST:PORT"),
+    ("tcp://127.0.0.1:", "not a HOST:PORT"),
+    ("tcp://:8786", "not a HOST:PORT"),
+    ("tcp://127.0.0.1:8786/status", "not a HOST:PORT"),
+    ("tcp://127.0.0.1:99999", "port 99999 is not in [1, 65535]"),
+    ("http://127.0.0.1:8787", "http:// is not a protocol"),
+    ("inproc://x", "inproc:// is not a protocol"),
+    ("missing/scheduler.json", "no such scheduler file"),
+    ("scheduler.json", "no such scheduler file"),
+    ("a-folder", "a folder, not a scheduler file"),
+    ("", "empty"),
+])
+def test_a_malformed_scheduler_is_one_line_before_anything_is_touched(tmp_path, monkeypatch, address, reason):
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "a-folder").mkdir()
+    started = time.monotonic()
+    result = CliRunner().invoke(app, ["map", "--lat", "0", "--lon", "0", "--scheduler", address, "--out", "out/map"])
+    assert time.monotonic() - started < 10
+    assert result.exit_code == 2, result.output
+    (line,) = result.output.strip().splitlines()
+    assert line.startswith(f"error: --scheduler = {address!r}: {reason}") and "tcp://HOST:PORT" in line, line
+    assert [path.name for path in tmp_path.iterdir()] == ["a-folder"]
+
+
+def test_workers_with_a_scheduler_is_refused(tmp_path):
+    with pytest.raises(ConfigError, match="--workers: the embedded cluster's"):
+        run_map(spec(), tmp_path / "map", scheduler=_refused_address(), workers=2)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_connect_budget_is_stated_in_the_help():
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+    from foldopt.studies.dask_client import CONNECT_TIMEOUT, WORKER_TIMEOUT
+
+    help_text = " ".join(CliRunner().invoke(app, ["map", "--help"]).output.split())
+    assert CONNECT_TIMEOUT <= 10
+    assert f"A scheduler that does not answer is given up after {CONNECT_TIMEOUT:g} s" in help_text
+    assert f"one without a worker after {WORKER_TIMEOUT:g} s more" in help_text
+
+
+def test_a_scheduler_file_holding_a_malformed_address_names_the_file(tmp_path):
+    path = tmp_path / "scheduler.json"
+    path.write_text(json.dumps({"address": "tcp://127.0.0.1"}))
+    errors, seconds = _connect_error(str(path))
+    assert len(errors) == 1 and "not a Dask scheduler file" in errors[0] and "'tcp://127.0.0.1'" in errors[0]
+    assert seconds < 2

@@ -213,3 +213,44 @@ def test_a_full_disk_is_one_line_naming_the_folder_and_keeps_the_earlier_one(sma
     assert re.search(r"need more than [12]\.\d MB free there", message)  # what fitted before it filled
     assert snapshot(out) == before
     assert sorted(path.name for path in small_disk.iterdir()) == ["out"]
+
+
+# --- an --out that is a file ------------------------------------------------------------------------
+
+
+#: Every command that writes a results folder, with what it needs beside --out.
+WRITERS = [["run"], ["sweep", "angle"], ["sweep", "day"], ["sweep", "load"], ["sweep", "latitude"], ["size"],
+           ["optimize"], ["reproduce"], ["map", "--lat", "0", "--lon", "0"]]
+
+
+@pytest.mark.parametrize("args", [[*command, *flag] for command in WRITERS for flag in ([], ["--overwrite"])]
+                         + [["map", "--lat", "0", "--lon", "0", "--resume"]], ids=" ".join)
+def test_an_out_that_is_a_file_is_refused_by_every_command_and_left_alone(tmp_path, monkeypatch, args):
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    monkeypatch.chdir(tmp_path)
+    notes = tmp_path / "notes"
+    notes.write_text("the user's own notes\n")
+    os.utime(notes, ns=(1_000_000_000, 1_000_000_000))
+    result = CliRunner().invoke(app, [*args, "--out", "notes"])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip().splitlines() == [
+        "error: --out notes: is a file, not a results folder; foldopt will not replace it, so move it or choose "
+        "another --out"]
+    assert notes.read_text() == "the user's own notes\n" and notes.stat().st_mtime_ns == 1_000_000_000
+    assert [path.name for path in tmp_path.iterdir()] == ["notes"]
+
+
+def test_a_folder_of_other_files_is_not_offered_overwrite(tmp_path):
+    """--overwrite replaces only results folders: a folder of other files is refused with or without it,
+    never offered an option that would be refused in turn."""
+    from foldopt.files import check_output
+
+    (tmp_path / "thesis").mkdir()
+    (tmp_path / "thesis" / "thesis.tex").write_text("x")
+    for overwrite in (False, True):
+        with pytest.raises(OutputError, match="holds files foldopt did not write") as raised:
+            check_output(tmp_path / "thesis", overwrite)
+        assert "--overwrite" not in str(raised.value)

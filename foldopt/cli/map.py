@@ -30,6 +30,7 @@ from foldopt import names
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError, WeatherError
 from foldopt.names import DEFAULT_ENGINE
+from foldopt.studies.dask_client import CONNECT_TIMEOUT, WORKER_TIMEOUT, check_cluster
 
 #: The map request's parameters as the options name them, beside the study's fields.
 _OPTION_OF_PARAMETER = {
@@ -161,9 +162,10 @@ def map_(
         str | None,
         typer.Option(
             "--scheduler",
-            help="A Dask scheduler's address "
-            "(tcp://host:8786) or scheduler file [default: an embedded "
-            "cluster].",
+            help="A Dask scheduler's address (tcp://host:8786; or tls://, ws://, wss://) or "
+            "scheduler file [default: an embedded cluster]. A scheduler that does not answer is "
+            f"given up after {CONNECT_TIMEOUT:g} s, one without a worker after "
+            f"{WORKER_TIMEOUT:g} s more.",
         ),
     ] = None,
     workers: Annotated[
@@ -232,6 +234,10 @@ def map_(
     for option, value in (("--workers", workers), ("--chunk-sites", chunk_sites)):
         if value is not None and value < 1:
             errors.append(f"{option} = {value}: must be at least 1")
+    try:
+        check_cluster(scheduler, workers)  # before any site or weather is read
+    except ConfigError as error:
+        errors += error.errors
     if errors:
         fail(errors)
     from foldopt.studies.request import make_request

@@ -21,8 +21,10 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 import shutil
 import time
+from contextlib import ExitStack
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,7 +36,6 @@ from foldopt.inputs.study import Study
 from foldopt.files import (
     DiskFullError,
     check_output,
-    clear_leftovers,
     commit,
     discard,
     is_full,
@@ -42,9 +43,9 @@ from foldopt.files import (
     tree_size,
     versions,
     write_atomically,
-    writer_lock,
+    writing,
 )
-from foldopt.studies.dask_client import CONNECT_TIMEOUT, connect
+from foldopt.studies.dask_client import CONNECT_TIMEOUT, check_cluster, connect
 from foldopt.studies.worldmap import MapSpec
 from foldopt.tables import write_csv
 
@@ -124,7 +125,14 @@ def _write_parquet(frame: pd.DataFrame, path: Path, key: str) -> None:
 
     table = pa.Table.from_pandas(frame, preserve_index=False)
     table = table.replace_schema_metadata({**(table.schema.metadata or {}), MAP_KEY: key.encode()})
-    write_atomically(path, lambda temporary: pq.write_table(table, temporary))
+
+    def write(temporary: Path) -> None:
+        # pyarrow keeps a file it opened itself open in the error of a failed write (a full
+        # disk): a file of ours is closed as the write fails.
+        with open(temporary, "wb") as file:
+            pq.write_table(table, file)
+
+    write_atomically(path, write)
 
 
 def _read_part(path: Path, key: str) -> pd.DataFrame | None:
@@ -141,11 +149,11 @@ def _read_part(path: Path, key: str) -> pd.DataFrame | None:
     return table.to_pandas()
 
 
-def map_folder(out: Path, resume: bool, overwrite: bool) -> Path:
-    """The folder to build the map in: ``out`` itself to resume the map there or where there is none, so that a
-    killed run leaves a folder that a later ``resume`` recognises; a staging folder beside ``out`` where the map
-    replaces one (``overwrite``), so that the earlier folder stays whole until the new one is complete
-    (:func:`foldopt.files.commit`).
+def map_folder(out: Path, resume: bool, overwrite: bool) -> bool:
+    """Whether the map is built in ``out`` itself: to resume the map there, or where there is none,
+    so that a killed run leaves a folder that a later ``resume`` recognises; otherwise it replaces
+    ``out`` (``overwrite``) from a staging folder beside it, so that the earlier folder stays whole
+    until the new one is complete (:func:`foldopt.files.commit`). Nothing is written.
 
     Parameters
     ----------
@@ -158,65 +166,51 @@ def map_folder(out: Path, resume: bool, overwrite: bool) -> Path:
 
     Returns
     -------
-    pathlib.Path
-        ``out``, or a staging folder beside it.
+    bool
+        True to build the map in ``out``, False to replace it.
 
     Raises
     ------
     foldopt.errors.OutputError
         Where ``out`` exists and neither ``resume`` nor ``overwrite`` is given, or cannot take the
-        map (:func:`foldopt.files.check_output`).
+        map (:func:`foldopt.files.check_output`: a file, a folder of other files...).
     """
     out = Path(out)
     if resume and (out / "run.json").exists():
-        return out
-    if out.exists() and not overwrite and not resume:
-        raise OutputError(
-            f"{out} already exists; pass --resume to finish it or --overwrite to replace it"
-        )
-    check_output(out, overwrite=True)  # only a folder foldopt wrote is replaced
-    return new_staging(out) if out.exists() else out
+        return True
+    # only a folder foldopt wrote is replaced
+    check_output(
+        out, overwrite or resume, "pass --resume to finish it or --overwrite to replace it"
+    )
+    return not out.exists()
 
 
-def prepare_folder(folder: Path, spec: MapSpec, metadata: dict) -> list[int]:
-    """Make ``folder`` (:func:`map_folder`) ready for the map and return the chunks already done
-    there. A new map starts with ``run.json`` (status ``running``) and ``sites.csv``; a folder
-    with a ``run.json`` is resumed, and refused if it holds another map.
+def chunks_on_disk(out: Path, spec: MapSpec) -> list[int]:
+    """The chunks of the map ``spec`` whose parts ``out`` holds, read without writing anything;
+    a part that cannot be read (a disk fault) or is another map's is not one of them.
 
     Parameters
     ----------
-    folder : pathlib.Path
+    out : pathlib.Path
+        A map's folder (one with a ``run.json``).
     spec : MapSpec
-    metadata : dict
-        What ``run.json`` holds beside its status.
 
     Returns
     -------
     list of int
-        The indices of the chunks whose parts are on disk (none for a new map).
+        The chunks' indices.
 
     Raises
     ------
     foldopt.errors.OutputError
-        Where ``folder`` holds another map (its :attr:`MapSpec.key` differs).
+        Where ``out`` holds another map (its :attr:`MapSpec.key` differs).
     """
-    if (folder / "run.json").exists():
-        return _resumable(folder, spec, metadata)
-    (folder / PARTS).mkdir(parents=True)
-    pd.DataFrame(list(spec.sites)).to_csv(folder / "sites.csv", index=False)
-    _write_json(folder / "run.json", {**metadata, "status": "running"})
-    return []
-
-
-def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
-    """The chunks on disk in ``out`` if it holds the map ``spec`` (:func:`_compute` marks it
-    ``running`` again where it is not complete)."""
     try:
         previous = json.loads((out / "run.json").read_text())
-    except ValueError:
+    except (OSError, ValueError):
         previous = {}
-    if previous.get("map_key") != spec.key:
-        theirs = previous.get("spec", {})
+    if not isinstance(previous, dict) or previous.get("map_key") != spec.key:
+        theirs = previous.get("spec", {}) if isinstance(previous, dict) else {}
         differ = [
             name
             for name in ("study", "sites", "loads", "relative", "year", "sites_per_chunk", "engine")
@@ -227,10 +221,26 @@ def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
             f"--resume: {out} holds another map (its {', '.join(differ) or 'settings'} differ); "
             "run the same command to resume it, or choose another --out"
         )
-    (out / PARTS).mkdir(exist_ok=True)
-    for leftover in (out / PARTS).glob(".*.tmp-*"):
+    return [
+        index
+        for index in range(len(spec.chunks()))
+        if _read_part(_part_path(out, index), spec.key) is not None
+    ]
+
+
+def _start_folder(folder: Path, spec: MapSpec, metadata: dict) -> None:
+    """A new map's folder: ``parts/``, ``sites.csv`` and ``run.json`` (status ``running``)."""
+    (folder / PARTS).mkdir(parents=True)
+    pd.DataFrame(list(spec.sites)).to_csv(folder / "sites.csv", index=False)
+    _write_json(folder / "run.json", {**metadata, "status": "running"})
+
+
+def _clear_parts(folder: Path) -> None:
+    """Make a resumed map's ``parts/`` ready: the parts a killed writer left half-written go (one
+    writer at a time holds the folder: :func:`foldopt.files.writer_lock`)."""
+    (folder / PARTS).mkdir(exist_ok=True)
+    for leftover in (folder / PARTS).glob(".*.tmp-*"):
         leftover.unlink(missing_ok=True)
-    return [index for index in range(len(spec.chunks())) if _part_path(out, index).exists()]
 
 
 def _write_json(path: Path, data: dict) -> None:
@@ -254,6 +264,12 @@ def run_map(
 ) -> MapRun:
     """Compute a map on a Dask cluster into ``out`` and return its table.
 
+    A run that fails changes nothing that was there: the cluster is reached before anything is
+    written; a map replacing another is built beside it; a map finished in ``out`` (a new one, or
+    one resumed) gets its parts there as they come, each whole, and its tables, figures and
+    ``run.json`` (written last) from a staging folder once all are written. A resumed folder's
+    earlier files are never rewritten but by a run that completes.
+
     Parameters
     ----------
     spec : MapSpec
@@ -262,6 +278,8 @@ def run_map(
         done, ``map.parquet`` and ``map.csv``.
     scheduler : str, optional
         A scheduler's address or scheduler file; default an embedded cluster of ``workers``.
+    workers : int, optional
+        Worker processes of the embedded cluster; not with ``scheduler``.
     resume : bool
         Finish the map in ``out``, computing only the chunks it lacks.
     overwrite : bool
@@ -273,12 +291,13 @@ def run_map(
     metadata : dict, optional
         Written into ``run.json`` beside the spec.
     connect_timeout : float
-        Seconds to wait for ``scheduler`` and its first worker.
+        Seconds [s] to reach ``scheduler``
+        (:data:`foldopt.studies.dask_client.CONNECT_TIMEOUT`).
     finish : callable, optional
         ``finish(run, metadata)`` writes the rest of what the map promises (its figures, ``map.nc``,
         ``report.html``) in ``run.out``, given the ``run.json`` it is about to get. It runs before
         the map is marked complete and before it replaces an earlier one: a map whose figures fail
-        is no complete map, and an ``overwrite`` then leaves the earlier map as it was.
+        is no complete map, and leaves the earlier map as it was.
 
     Returns
     -------
@@ -288,11 +307,15 @@ def run_map(
 
     Raises
     ------
+    foldopt.errors.ConfigError
+        Where ``scheduler`` is no address or scheduler file (before any folder is touched), no Dask
+        scheduler with a worker answers there, or it is lost mid-run (the parts done are kept).
     foldopt.errors.OutputError
         Where ``out`` cannot take the map, another run writes it, or the file system fills.
     """
     started = time.perf_counter()
     out = Path(out)
+    check_cluster(scheduler, workers)
     chunks = spec.chunks()
     metadata = {
         **(metadata or {}),
@@ -301,42 +324,69 @@ def run_map(
         "spec": spec.as_dict(),
         "chunks": len(chunks),
     }
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise OutputError(f"--out {out}: cannot create it ({error.strerror or error})") from None
-    with writer_lock(out):
-        clear_leftovers(out.parent)
-        fresh, folder = not out.exists(), None
+    with writing(out):
+        in_place = map_folder(out, resume, overwrite)
+        resuming = in_place and out.exists()
+        done = chunks_on_disk(out, spec) if resuming else []
+        missing = [index for index in range(len(chunks)) if index not in done]
+        if progress is not None:
+            progress(sum(len(chunks[index]) for index in done), len(spec.sites))
+        folder = finals = None
         try:
-            folder = map_folder(out, resume, overwrite)
-            done = prepare_folder(folder, spec, metadata)
-            run = _compute(
+            with ExitStack() as cluster:
+                client, description, dashboard = None, NO_COMPUTATION, None
+                if missing:
+                    client, description = cluster.enter_context(
+                        connect(scheduler, workers, connect_timeout)
+                    )
+                    dashboard = client.dashboard_link if _has_dashboard(client) else None
+                    if announce is not None:
+                        announce(description, dashboard)
+                # Reached: only now is anything written.
+                folder = out if in_place else new_staging(out)
+                if resuming:
+                    _clear_parts(folder)
+                else:
+                    _start_folder(folder, spec, metadata)
+                if missing:
+                    _compute_parts(client, spec, folder, missing, done, scheduler, progress)
+            finals = new_staging(out) if in_place else folder
+            run = _assemble(
                 spec,
                 folder,
-                done,
-                chunks,
+                finals,
                 metadata,
+                missing,
+                done,
                 started,
-                scheduler,
-                workers,
-                progress,
-                announce,
-                connect_timeout,
+                description,
+                dashboard,
                 finish,
             )
-            if folder != out:
+            if in_place:
+                _move_into(finals, out)
+            else:
                 commit(folder, out)
         except BaseException as error:
-            raise _failed(error, out, folder, fresh) from None
+            raise _failed(error, out, folder, finals, fresh=not resuming) from None
+        if in_place:
+            discard(finals)
     return dataclasses.replace(run, out=out)
 
 
-def _failed(error: BaseException, out: Path, folder: Path | None, fresh: bool) -> BaseException:
-    """Clear up after a failed map and return the error to raise: a staging folder goes, and so does
-    a new folder in ``out`` with no part done; a full file system is
+#: A map's cluster where every chunk was on disk.
+NO_COMPUTATION = "no computation (every chunk was on disk)"
+
+
+def _failed(
+    error: BaseException, out: Path, folder: Path | None, finals: Path | None, fresh: bool
+) -> BaseException:
+    """Clear up after a failed map and return the error to raise: the staging folders go, and so
+    does a new folder in ``out`` with no part done; a full file system is
     :class:`~foldopt.files.DiskFullError` naming ``out``."""
     written, kept = getattr(error, "written", 0), False
+    if finals is not None and finals != folder:
+        written += discard(finals)
     if folder is not None and folder != out:
         written += discard(folder)
     elif folder is not None:
@@ -349,74 +399,80 @@ def _failed(error: BaseException, out: Path, folder: Path | None, fresh: bool) -
     return error
 
 
-def _compute(
-    spec,
-    out,
-    done,
-    chunks,
-    metadata,
-    started,
-    scheduler,
-    workers,
-    progress,
-    announce,
-    connect_timeout,
-    finish,
-) -> MapRun:
-    # A part that cannot be read (a disk fault) or is another map's is computed again.
-    done = [index for index in done if _read_part(_part_path(out, index), spec.key) is not None]
-    missing = [index for index in range(len(chunks)) if index not in done]
-    if missing or json.loads((out / "run.json").read_text()).get("status") != "complete":
-        # Until every file is written again the folder is no complete map; a complete map resumed with
-        # nothing to compute stays marked complete, its files replaced one atomic file at a time by the
-        # same map's (the same digest: the same numbers).
-        _write_json(out / "run.json", {**metadata, "status": "running"})
-    finished_sites = sum(len(chunks[index]) for index in done)
-    if progress is not None:
-        progress(finished_sites, len(spec.sites))
-    description, dashboard = "no computation (every chunk was on disk)", None
-    if missing:
-        from distributed import as_completed
+def _compute_parts(client, spec, folder, missing, done, scheduler, progress) -> None:
+    """Compute the chunks ``missing`` on ``client``'s cluster, writing each part in ``folder`` as
+    it comes. A task's own error is raised as it is (a bad weather file's :class:`ConfigError`
+    names it); a chunk that killed every worker that ran it, or a scheduler lost mid-run, is one
+    error saying so."""
+    from distributed import KilledWorker, as_completed
 
-        with connect(scheduler, workers, connect_timeout) as (client, description):
-            dashboard = client.dashboard_link if _has_dashboard(client) else None
-            if announce is not None:
-                announce(description, dashboard)
-            futures = [
-                client.submit(
-                    evaluate_chunk,
-                    spec.study,
-                    [spec.sites[i] for i in chunks[index]],
-                    list(spec.loads),
-                    spec.relative,
-                    spec.year,
-                    spec.engine,
-                    key=f"foldopt-map-{spec.key}-{index:05d}",
-                    pure=False,
-                )
-                for index in missing
-            ]
-            index_of = {future.key: index for future, index in zip(futures, missing, strict=True)}
-            for future in as_completed(futures):
-                index = index_of[future.key]
-                try:
-                    frame = future.result()
-                except ConfigError:
-                    client.cancel(futures)
-                    raise
-                _write_parquet(frame, _part_path(out, index), spec.key)
-                future.release()
-                finished_sites += len(chunks[index])
-                if progress is not None:
-                    progress(finished_sites, len(spec.sites))
+    chunks = spec.chunks()
+    finished_sites = sum(len(chunks[index]) for index in done)
+    futures = [
+        client.submit(
+            evaluate_chunk,
+            spec.study,
+            [spec.sites[i] for i in chunks[index]],
+            list(spec.loads),
+            spec.relative,
+            spec.year,
+            spec.engine,
+            key=f"foldopt-map-{spec.key}-{index:05d}",
+            pure=False,
+        )
+        for index in missing
+    ]
+    index_of = {future.key: index for future, index in zip(futures, missing, strict=True)}
+    new_parts = 0
+    for future in as_completed(futures):
+        index = index_of[future.key]
+        try:
+            frame = future.result()
+        except KilledWorker as error:
+            sites = chunks[index]
+            raise RuntimeError(
+                f"the map's worker processes died while computing it (chunk {index}, sites "
+                f"{sites[0]} to {sites[-1]}, was running each time): a crash, or too little memory"
+            ) from error
+        except Exception as error:
+            if future.status == "error" or scheduler is None:
+                raise  # the task's own error; or the embedded cluster's, an internal fault
+            # Cancelled as the client lost its scheduler, or the connection reset as it gathered.
+            kept = len(done) + new_parts
+            then = (
+                f"the {kept} of {len(chunks)} chunks done are kept: start it again and finish the "
+                "map with --resume"
+                if kept
+                else "no chunk was done: start it again and run the map again"
+            )
+            raise ConfigError(
+                [
+                    f"--scheduler = {scheduler!r}: the scheduler was lost mid-run "
+                    f"({getattr(error, 'reason', None) or type(error).__name__}); {then}"
+                ]
+            ) from None
+        _write_parquet(frame, _part_path(folder, index), spec.key)
+        future.release()
+        new_parts += 1
+        finished_sites += len(chunks[index])
+        if progress is not None:
+            progress(finished_sites, len(spec.sites))
+
+
+def _assemble(
+    spec, folder, finals, metadata, computed, done, started, description, dashboard, finish
+) -> MapRun:
+    """Assemble the map's tables from the parts in ``folder`` and write them, ``finish``'s files
+    and lastly ``run.json`` (status ``complete``) in ``finals``."""
+    chunks = spec.chunks()
     table = pd.concat(
-        [_read_part(_part_path(out, index), spec.key) for index in range(len(chunks))],
+        [_read_part(_part_path(folder, index), spec.key) for index in range(len(chunks))],
         ignore_index=True,
     )
     seconds = time.perf_counter() - started
-    _write_parquet(table, out / "map.parquet", spec.key)
-    write_atomically(out / "map.csv", lambda temporary: write_csv(table, temporary))
-    computed = tuple(missing)
+    _write_parquet(table, finals / "map.parquet", spec.key)
+    write_atomically(finals / "map.csv", lambda temporary: write_csv(table, temporary))
+    computed = tuple(computed)
     complete = {
         **metadata,
         "status": "complete",
@@ -429,12 +485,21 @@ def _compute(
         if computed
         else None,
     }
-    run = MapRun(spec, table, out, computed, tuple(sorted(done)), seconds, description, dashboard)
+    run = MapRun(
+        spec, table, finals, computed, tuple(sorted(done)), seconds, description, dashboard
+    )
     if finish is not None:
         finish(run, complete)
     # last: only a folder holding every promised file is complete
-    _write_json(out / "run.json", complete)
+    _write_json(finals / "run.json", complete)
     return run
+
+
+def _move_into(finals: Path, out: Path) -> None:
+    """Move the files of ``finals`` into ``out``, each by one atomic rename, ``run.json`` last."""
+    names = sorted(path.name for path in finals.iterdir() if path.name != "run.json")
+    for name in [*names, "run.json"]:
+        os.replace(finals / name, out / name)
 
 
 def _has_dashboard(client) -> bool:
