@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from foldopt.engine.metrics import t_solar
 from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
@@ -407,3 +409,78 @@ def test_loads_times_designs_beyond_the_limit_are_refused_at_once(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("error: --p-load: 14 loads x 1,490,580 designs")
     assert 14 * 1_490_580 > MAX_DESIGNS and f"the limit is {MAX_DESIGNS:,}" in lines[0]
     assert not (tmp_path / "out").exists()
+
+
+#: Small grids of the fold angle (one stopping short of the flat panel), tilt and azimuth.
+FLAT_FOLDS = ["10:180:10", "20:180:40", "10:170:20"]
+
+
+@settings(max_examples=25, deadline=None)
+@given(latitude=st.floats(-60.0, 60.0), longitude=st.floats(-180.0, 180.0),
+       days=st.sampled_from(["2014-06-21", "1:365:45", "1:365:30"]),
+       objective=st.sampled_from(["mean", "worst-month", "min", "p10"]),
+       loads=st.lists(st.floats(0.5, 12.0), min_size=1, max_size=2, unique=True),
+       vary=st.sampled_from(["fold_angle,tilt", "fold_angle,azimuth", "fold_angle,tilt,azimuth", "tilt"]),
+       folds=st.sampled_from(FLAT_FOLDS))
+def test_no_fold_of_180_deg_beats_the_flat_panel_at_its_own_best(latitude, longitude, days, objective, loads,
+                                                                  vary, folds):
+    """A 180 deg fold is the flat panel: the flat panel at its own best is at least every design with a
+    180 deg fold evaluated anywhere (the searches', the default mounting's), and the optimum at least
+    the flat panel's own best where its fold angles reach 180 deg; no line claims a gain for a 180 deg
+    fold (the flat search missed its own best, and the answer said '+0.1 % over the flat panel')."""
+    import foldopt
+
+    equator = 180.0 if latitude >= 0 else 0.0
+    fields = {"fold_angle": folds, "tilt": "0:90:10", "azimuth": f"{equator - 60:g}:{equator + 60:g}:20"}
+    fields = {name: value for name, value in fields.items() if name in vary}
+    several = days != "2014-06-21"
+    result = foldopt.optimize(foldopt.default_study(), vary=vary, latitude=latitude, longitude=longitude,
+                              date=days, p_load=loads, step_min=30, **fields,
+                              **({"objective": objective} if several else {}))
+    table = result.table.set_index(["p_load_w", "design"])
+    searches = [search for _, search in result.steps] + [result.flat]
+    unfolded = np.vstack([search.values[search.points[:, 0] == 180.0] for search in searches])
+    fold_hi = result.twofold.axes[0].hi
+    for index, load in enumerate(result.loads):
+        flat, best = table.loc[(load, "flat")], table.loc[(load, "twofold")]
+        assert flat["fold_angle_deg"] == 180.0
+        assert np.all(unfolded[:, index] <= flat["objective_h"])
+        assert table.loc[(load, "flat-default"), "objective_h"] <= flat["objective_h"]
+        # The optimum is the best design evaluated within its ranges.
+        assert result.twofold.values[:, index].max() <= best["objective_h"]
+        if fold_hi == 180.0:
+            assert best["objective_h"] >= flat["objective_h"]
+        if best["fold_angle_deg"] == 180.0:
+            assert best["objective_h"] == flat["objective_h"]
+            assert not best["gain_vs_flat_pct"] > 0.0
+    for line in result.answer.lines():
+        if "fold 180 deg" in line:
+            assert "% over" not in line, line
+    for load in result.answer.to_dict()["result"]["loads"]:
+        if load["fold_angle_deg"] == 180.0:
+            assert not (load["gain_vs_flat_pct"] or 0.0) > 0.0
+
+
+def test_the_flat_panel_at_its_own_best_holds_its_default_mounting(tmp_path):
+    """At 14.3 S the flat panel's search, on a 2-deg grid of tilts, missed the default mounting's tilt
+    of 14.3 deg: its 'own best' (7.7405 h at 14 deg) was short of the default (7.7407 h) and of the
+    180 deg designs evaluated.csv holds; optimum.csv's flat row is now the best of them all, and the
+    optimum is it."""
+    import pandas as pd
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    out = tmp_path / "out"
+    done = CliRunner().invoke(app, ["optimize", "--lat", "-14.3", "--lon", "76.8", "--days", "1:365:30",
+                                    "--objective", "mean", "--p-load", "9.47", "--vary", "fold_angle,tilt",
+                                    "--fold-range", "10:180:5", "--tilt-range", "0:90:2", "--step-min", "15",
+                                    "--out", str(out)])
+    assert done.exit_code == 0, done.output
+    optimum = pd.read_csv(out / "optimum.csv").set_index("design")
+    evaluated = pd.read_csv(out / "evaluated.csv")
+    flat = optimum.loc["flat", "objective_h"]
+    assert flat >= evaluated.loc[evaluated["fold_angle_deg"] == 180, "objective_h"].max()
+    assert flat >= optimum.loc["flat-default", "objective_h"]
+    assert optimum.loc["twofold", "objective_h"] == flat and optimum.loc["twofold", "fold_angle_deg"] == 180
+    assert "% over" not in done.stdout.splitlines()[2]
