@@ -45,9 +45,29 @@ def test_heuristic_bisection_finds_the_threshold():
         level = np.asarray(angles, dtype=float)[:, None] / 180.0 * np.ones((1, 5))
         return level, level, level
 
-    assert heuristic_fold_angle(subpanels, 0.25, tol=1e-4) == pytest.approx(45.0, abs=1e-3)
-    assert np.isnan(heuristic_fold_angle(subpanels, 2.0))
-    assert heuristic_fold_angle(subpanels, 0.0) == 1.0
+    angle, outside = heuristic_fold_angle(subpanels, 0.25, tol=1e-4)
+    assert angle == pytest.approx(45.0, abs=1e-3) and outside == ""
+    angle, outside = heuristic_fold_angle(subpanels, 2.0)
+    assert np.isnan(angle) and outside == "above"
+
+
+@pytest.mark.parametrize("p_load,lo,hi,outside", [
+    (0.0, 1.0, 180.0, "below"),  # every angle reaches a load of nothing: the bound is no answer
+    (0.25, 60.0, 180.0, "below"),  # the threshold, 45 deg, below the grid
+    (0.25, 1.0, 30.0, "above"),  # above it
+    (0.25, 45.5, 180.0, "below"),
+])
+def test_the_heuristic_gives_no_angle_outside_its_bounds(p_load, lo, hi, outside):
+    """The rule's angle is the threshold (45 deg for a 0.25 W load on a valley rising linearly to 1 W
+    flat): where it lies outside [lo, hi] the answer is no angle and the side it lies on, never the
+    clamped bound (it gave 1.0 deg, the search's lower bound, where the valley reached the load
+    everywhere)."""
+    def subpanels(angles):
+        level = np.asarray(angles, dtype=float)[:, None] / 180.0 * np.ones((1, 5))
+        return level, level, level
+
+    angle, side = heuristic_fold_angle(subpanels, p_load, lo=lo, hi=hi)
+    assert np.isnan(angle) and side == outside
 
 
 def test_the_heuristic_angle_reaches_the_load():
@@ -58,9 +78,60 @@ def test_the_heuristic_angle_reaches_the_load():
         return level, level, level
 
     for p_load in np.linspace(0.01, 0.99, 37):
-        angle = heuristic_fold_angle(subpanels, p_load)
+        angle, _ = heuristic_fold_angle(subpanels, p_load)
         assert (angle / 180.0) ** 1.7 >= p_load
         assert angle - 180.0 * p_load ** (1 / 1.7) <= 0.01 + 1e-9  # at most tol above the threshold
+
+
+@pytest.mark.parametrize("start,stop,p_load,outside", [
+    (1, 180, 4.398, ""),  # the paper's day: 28.5 deg
+    (60, 180, 4.398, "below"),  # the rule's 28.5 deg below the grid (it was printed)
+    (2, 180, 0.1, "below"),  # it printed the search's bound, 1.0 deg, off a grid from 2 deg
+    (1, 20, 4.398, "above"),
+    (1, 180, 30.0, "above"),  # beyond the flat panel's noon power
+    (20, 120, 8.0, ""),
+])
+def test_the_heuristic_is_stated_only_within_the_studys_fold_angles(tmp_path, shin_study, start, stop, p_load,
+                                                                    outside):
+    """The paper's heuristic is stated where its angle lies among the study's fold angles, and there it
+    reaches the load at noon where a hundredth of a degree less does not (Eq. 8, on the day's own
+    sub-panel curves); elsewhere the answer says why in one note (the noon valley checked at the grid's
+    edge) and states no angle: not a clamped bound, not an angle outside the grid (run.json, JSON and
+    the designs alike)."""
+    import json
+    import re
+
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+    from foldopt.engine.optimize import noon_valley
+
+    out = tmp_path / "out"
+    done = CliRunner().invoke(app, ["run", "--set", f"fold_angles.start={start}", "--set",
+                                    f"fold_angles.stop={stop}", "--set", f"p_load={p_load}", "--format", "json",
+                                    "--out", str(out)])
+    assert done.exit_code == 0, done.output
+    answer = json.loads(done.stdout)["answer"]
+    angle = answer["result"]["fold_angle_twofold_heuristic_deg"]
+    notes = [note["note"] for note in answer["notes"] if "heuristic" in note["note"]]
+    stated = [float(m) for line in answer["lines"] for m in re.findall(r"heuristic: ([\d.]+) deg", line)]
+    heuristic_rows = [row for row in answer["designs"] if row["design"] == "twofold-heuristic"]
+    assert json.loads((out / "run.json").read_text())["fold_angle_twofold_heuristic_deg"] == angle
+    day = Day(shin_study)  # the sub-panels' curves do not depend on the load or the grid
+
+    def valley(fold):
+        return float(noon_valley(*day.subpanel_power(np.array([fold])))[0])
+
+    if outside == "":
+        assert start < angle <= stop and stated == [pytest.approx(angle, abs=0.05)] and not notes
+        assert [row["fold_angle_deg"] for row in heuristic_rows] == [angle]
+        assert valley(angle) >= p_load > valley(angle - 0.011)
+    else:
+        assert angle is None and not stated and not heuristic_rows and len(notes) == 1
+        if outside == "below":
+            assert valley(start) >= p_load and f"at {start} deg" in notes[0]
+        else:
+            assert valley(stop) < p_load
 
 
 def test_the_paper_days_heuristic_angle_carries_the_load_through_noon(shin_study):

@@ -303,9 +303,42 @@ def of_study(result) -> Answer:
         summary[columns],
         near_table,
         pd.DataFrame(),
-        design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
+        design_notes(summary)
+        + weather_notes(result.day.sky)
+        + horizon_notes(study, [study.date])
+        + heuristic_notes(study, result.heuristic_outside),
         tuple(lines),
     )
+
+
+def heuristic_notes(study, outside: str) -> list[dict]:
+    """Where the paper's heuristic (Shin et al. Eq. 8) has no angle among the study's fold angles,
+    why, as one note; none where its angle is stated.
+
+    Parameters
+    ----------
+    study : Study
+    outside : str
+        :attr:`foldopt.studies.day.StudyResult.heuristic_outside`.
+    """
+    grid = study.fold_angles
+    rule = "the paper's heuristic (Shin et al. Eq. 8) gives no angle"
+    if outside == "below":
+        text = (
+            f"{rule} among the study's fold angles ({grid.start:g} to {grid.stop:g} deg): the noon "
+            f"valley reaches the load already at {grid.start:g} deg, so the rule's angle lies at or "
+            "below it"
+        )
+    elif outside == "above" and grid.stop < 180.0:
+        text = (
+            f"{rule} among the study's fold angles ({grid.start:g} to {grid.stop:g} deg): the noon "
+            f"valley falls short of the load even at {grid.stop:g} deg"
+        )
+    elif outside == "above":
+        text = f"{rule}: the load exceeds the flat panel's noon power"
+    else:
+        return []
+    return [{"note": text, "designs": []}]
 
 
 def request_defaults(result) -> dict | None:
