@@ -44,6 +44,7 @@ from foldopt.studies.objectives import (
     objective_quantum,
     objective_value,
     season_days,
+    season_problem,
 )
 
 #: Points of the landscape's grid along the fold angle and the tilt.
@@ -173,13 +174,8 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
     season = study.objective.months if study.objective is not None else None
     months = np.array([date.month for date in dates])
     counted = months[season_days(months, season)]  # the days the objective takes
-    if counted.size == 0:
-        raise ConfigError(
-            [
-                f"objective.months = {list(season)}: none of the {len(dates)} days ({dates[0]} to "
-                f"{dates[-1]}) is in these months; give days in them, or other months"
-            ]
-        )
+    if (problem := season_problem(dates, season)) is not None:
+        raise ConfigError([problem])
     blocks = Blocks.of_dates(study, dates)
     study = blocks.study
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
@@ -268,10 +264,7 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
     )
     added = _added(
         loads,
-        [
-            (name, search, _best_within(*evaluated, list(search.axes))[1])
-            for name, search in steps
-        ],
+        [(name, search, _best_within(*evaluated, list(search.axes))[1]) for name, search in steps],
         start,
     )
     landscape = _landscape(
@@ -388,9 +381,7 @@ def _near_optimal(study, loads, search: SearchResult, optimum) -> pd.DataFrame:
             np.maximum.at(profile, position, values[:, index])
             at = np.searchsorted(grid, optimum[0][index, axis_index] - 1e-9)
             profile[at] = max(profile[at], optimum[1][index])
-            ranges = near_optimal(
-                grid, profile, study.near_optimal, fold=axis.name == "fold_angle"
-            )
+            ranges = near_optimal(grid, profile, study.near_optimal, fold=axis.name == "fold_angle")
             rows.append(
                 {
                     "p_load_w": load,

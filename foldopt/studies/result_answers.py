@@ -16,7 +16,7 @@ import pandas as pd
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.storage_answer import buffer_text, sequential, unsimulated_notes, year_lines
-from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
+from foldopt.studies.objectives import ENSEMBLE_PERCENTILES, FLAT_FOLD_ANGLE
 from foldopt.studies.worldmap import searched_tilt
 
 #: The designs an answer compares, first the ones every study has.
@@ -39,6 +39,30 @@ def _pct(value, signed: bool = True) -> str:
         if value is None or value != value
         else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
     )
+
+
+def versus_flat(fold_angle, gain, flat_hours, flat_text: str = "") -> str:
+    """The twofold panel at its best against the flat panel, as a line gives it: the gain [%], or
+    where the best is the flat panel (a 180 deg fold) that no fold gains over it, or where the flat
+    panel carries none of the load (no ratio to give) that it does not.
+
+    Parameters
+    ----------
+    fold_angle : float
+        The best fold angle [deg].
+    gain : float
+        [%] over the flat panel.
+    flat_hours : float
+        The flat panel's objective [h].
+    flat_text : str, default ""
+        Said of the flat panel after its hours (its worst month).
+    """
+    if fold_angle == FLAT_FOLD_ANGLE:
+        return "the flat panel itself: no fold gains over it"
+    flat = f"{_hours(flat_hours)}{flat_text}"
+    if not flat_hours > 0:
+        return f"where the flat panel carries none of the load (flat {flat})"
+    return f"{_pct(gain)} over flat ({flat})"
 
 
 def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dict]:
@@ -262,9 +286,14 @@ def of_study(result) -> Answer:
         lines.append(
             f"best fold angle {result.optimal_fold_angle:.1f} deg"
             + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic == heuristic else "")
-            + f": t_solar {_hours(hours['twofold'])}, {_pct(twofold['gain_vs_flat_pct'])} over flat "
-            f"({_hours(hours['flat'])}), {_pct(twofold['pct_of_tracker'], False)} of the tracker's "
-            f"{_hours(hours['tracker'])}"
+            + f": t_solar {_hours(hours['twofold'])}, "
+            + versus_flat(result.optimal_fold_angle, twofold["gain_vs_flat_pct"], hours["flat"])
+            + (
+                f", {_pct(twofold['pct_of_tracker'], False)} of the tracker's "
+                f"{_hours(hours['tracker'])}"
+                if hours["tracker"] > 0
+                else ", where the tracker carries none of it (0.00 h)"
+            )
         )
         lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
     extras = []
@@ -521,14 +550,27 @@ def _of_annual(result) -> Answer:
             if len(groups) > 1 and "latitude" in where
             else ""
         )
-        lines.append(
-            f"{site + ': ' if site else ''}{label}: fold angle {twofold['fold_angle_deg']:g} deg "
-            f"{_period(count)}; "
-            f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, {_pct(gain)} over flat "
-            f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}"
-            + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}")
-        )
-        lines.append("  " + _range_text(twofold.to_dict()))
+        head = f"{site + ': ' if site else ''}{label}: "
+        if not twofold["objective_h"] > 0:
+            # Every angle ties at nothing: the tie-break is no choice, nor is there a gain to give.
+            lines.append(
+                f"{head}no fold angle carries the load: {statistic} t_solar 0.00 h (flat "
+                f"{_hours(flat['objective_h'])}); tracker {_hours(tracker['objective_h'])}"
+            )
+        else:
+            lines.append(
+                f"{head}fold angle {twofold['fold_angle_deg']:g} deg {_period(count)}; "
+                f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, "
+                + versus_flat(twofold["fold_angle_deg"], gain, flat["objective_h"], flat_month)
+                + f"; tracker {_hours(tracker['objective_h'])}"
+                + (
+                    ""
+                    if statistic == "mean"
+                    else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"
+                )
+            )
+        if twofold["objective_h"] > 0:
+            lines.append("  " + _range_text(twofold.to_dict()))
         if members:
             spread = {
                 d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in ENSEMBLE_PERCENTILES}
@@ -874,7 +916,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
             f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')}"
             f"{gains}; {rec_text}; "
             + (
-                "the tracker carries it at no site either"
+                f"the tracker carries it at no site{' either' if rec['min'] is None else ''}"
                 if load["median_pct_of_tracker"] is None
                 else f"median {_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}"
             )
