@@ -437,7 +437,7 @@ def of_sweep(result) -> Answer:
     rec = part["recommended_fold_angle_deg"]
     if rec["min"] == rec["min"]:
         lines.append(
-            f"recommended fold angles (centres of each case's near-optimal range) {rec['min']:g} to "
+            f"recommended fold angles (each case's near-optimal centre, flat where flat is best) {rec['min']:g} to "
             f"{rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the table)"
         )
     keys = [
