@@ -144,7 +144,8 @@ COLUMNS = (
     (
         "recommended_deg",
         "deg",
-        "the value at the centre of a variable's near-optimal range; a fold of 180 where flat is best",
+        "the value at the centre of a variable's near-optimal range; a fold of 180 where flat "
+        "is best",
     ),
     (
         "added_h",

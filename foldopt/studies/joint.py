@@ -8,7 +8,10 @@ coarse-to-fine search of :func:`foldopt.engine.search.grid_search` on the grid o
 variables. Alongside, for a fair comparison, the flat panel's own best tilt and azimuth (the same
 search without the fold), and the default mounting (tilt ``|latitude|``, facing the equator, or the
 study's panel) with its best fold angle on the study's grid, the flat panel and the tracker there
-(:func:`foldopt.studies.designs.daily_designs`, which every study shares).
+(:func:`foldopt.studies.designs.daily_designs`, which every study shares). The optimum, the flat
+panel's own best and each variable's step are the best design evaluated within their ranges, by any
+of these searches: a 180 deg fold is the flat panel, so the flat panel's own best is never beaten by
+an unfolded design the twofold search found, nor the optimum by one the flat search found.
 
 What each variable adds is the objective gained as the variables join the search in the order of
 :data:`foldopt.names.OPTIMIZE_VARIABLES`: the fold angle alone at the default mounting, then with
@@ -16,7 +19,8 @@ the tilt, then with the azimuth. The near-optimal region of each variable is eve
 some evaluated design comes within the study's near-optimal tolerance of the optimum
 (:func:`foldopt.studies.objectives.near_optimal` on the profile, the best over the other variables):
 the designs the search evaluated and the variable's whole grid with the others at the optimum,
-so its edges are on the grid and never narrower than at the optimum's own mounting. The landscape
+so its edges are on the grid (or at the optimum, where that is a default mounting off it) and never
+narrower than at the optimum's own mounting. The landscape
 is the objective over tilt x fold angle at the optimum's azimuth, on a grid of its own.
 """
 
@@ -70,7 +74,8 @@ class OptimizeResult:
     table : pandas.DataFrame
         Per load and design (``twofold``, ``flat``, ``twofold-default``, ``flat-default``,
         ``tracker``): ``fold_angle_deg``, ``surface_tilt``, ``surface_azimuth``, ``objective_h`` and
-        ``gain_vs_flat_pct`` (over the flat panel at its own best).
+        ``gain_vs_flat_pct`` (over the flat panel at its own best); ``twofold`` and ``flat`` are the
+        best designs evaluated within their ranges (:func:`_best_within`).
     near_optimal : pandas.DataFrame
         Per load and variable: ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_deg``,
         ``near_optimal_tolerance_h``.

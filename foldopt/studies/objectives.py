@@ -218,10 +218,10 @@ def near_optimal(fold_angles, values, tolerance: NearOptimal, fold: bool = True)
 
 
 def recommended_angle(angles, lo, hi, best=None):
-    """The angle to recommend of a near-optimal range: the one of ``angles`` inside the range nearest
-    its centre (ties to the less folded), so that a hinge set a few degrees off still lies on the
-    plateau; but the flat panel where the best fold angle is 180 deg, for a panel that is best
-    unfolded needs no hinge to set, and no fold gains over it.
+    """The angle to recommend of a near-optimal range: the one of ``angles`` inside the range
+    nearest its centre (ties to the less folded), so that a hinge set a few degrees off still lies
+    on the plateau; but the flat panel where the best fold angle is 180 deg, for a panel that is
+    best unfolded needs no hinge to set, and no fold gains over it.
 
     Parameters
     ----------

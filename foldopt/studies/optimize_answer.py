@@ -93,11 +93,13 @@ def of_optimize(result) -> Answer:
         else:
             # A 180 deg fold is the flat panel: there the optimum is the flat panel's own best.
             lines.append(
-                f"{label}: flat (fold 180 deg), {_mounting(best)}: {best.objective_h:.2f} h, the flat "
-                f"panel at its own best: no fold gains over it; tracker {tracker.objective_h:.2f} h"
+                f"{label}: flat (fold 180 deg), {_mounting(best)}: {best.objective_h:.2f} h, "
+                "the flat panel at its own best: no fold gains over it; tracker "
+                f"{tracker.objective_h:.2f} h"
                 if best.fold_angle_deg == FLAT_FOLD_ANGLE
                 else f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
-                f"{best.objective_h:.2f} h, {_over_flat(best, flat)}; tracker {tracker.objective_h:.2f} h"
+                f"{best.objective_h:.2f} h, {_over_flat(best, flat)}; tracker "
+                f"{tracker.objective_h:.2f} h"
             )
             if len(near):
                 lines.append(

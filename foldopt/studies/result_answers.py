@@ -41,6 +41,13 @@ def _pct(value, signed: bool = True) -> str:
     )
 
 
+def _fold_text(angle: float) -> str:
+    """A fold angle [deg] to a tenth of a degree, or to a thousandth where a fold short of the flat
+    panel would read 180.0 (a refined optimum a few hundredths below it is not the flat panel)."""
+    short = f"{angle:.1f}" == "180.0" and angle < FLAT_FOLD_ANGLE
+    return f"{angle:.3f}" if short else f"{angle:.1f}"
+
+
 def versus_flat(fold_angle, gain, flat_hours, flat_text: str = "") -> str:
     """The twofold panel at its best against the flat panel, as a line gives it: the gain [%], or
     where the best is the flat panel (a 180 deg fold) that no fold gains over it, or where the flat
@@ -284,7 +291,7 @@ def of_study(result) -> Answer:
         )
     else:
         lines.append(
-            f"best fold angle {result.optimal_fold_angle:.1f} deg"
+            f"best fold angle {_fold_text(result.optimal_fold_angle)} deg"
             + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic == heuristic else "")
             + f": t_solar {_hours(hours['twofold'])}, "
             + versus_flat(result.optimal_fold_angle, twofold["gain_vs_flat_pct"], hours["flat"])
@@ -355,10 +362,10 @@ def heuristic_notes(study, outside: str) -> list[dict]:
     if outside == "below":
         text = (
             f"{rule} among the study's fold angles ({grid.start:g} to {grid.stop:g} deg): the noon "
-            f"valley reaches the load already at {grid.start:g} deg, so the rule's angle lies at or "
-            "below it"
+            f"valley reaches the load already at {grid.start:g} deg, so the rule's angle lies at "
+            "or below it"
         )
-    elif outside == "above" and grid.stop < 180.0:
+    elif outside == "above" and grid.stop < FLAT_FOLD_ANGLE:
         text = (
             f"{rule} among the study's fold angles ({grid.start:g} to {grid.stop:g} deg): the noon "
             f"valley falls short of the load even at {grid.stop:g} deg"
@@ -437,8 +444,9 @@ def of_sweep(result) -> Answer:
     rec = part["recommended_fold_angle_deg"]
     if rec["min"] == rec["min"]:
         lines.append(
-            f"recommended fold angles (each case's near-optimal centre, flat where flat is best) {rec['min']:g} to "
-            f"{rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the table)"
+            "recommended fold angles (each case's near-optimal centre, flat where flat is best) "
+            f"{rec['min']:g} to {rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the "
+            "table)"
         )
     keys = [
         c
