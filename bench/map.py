@@ -39,7 +39,7 @@ TARGET_SPEEDUP = 1.8
 
 
 def _spec(n_sites: int):
-    from foldopt.studies.cluster import MapSpec
+    from foldopt.studies.worldmap import MapSpec
     from foldopt.inputs.study_file import default_study_path, read_study
     from foldopt.inputs.sites import grid_sites
     from foldopt.studies.worldmap import map_study
@@ -167,7 +167,8 @@ def w5(subset: int | None, check_sites: int = 200, step_min: float = 5.0) -> Non
     import pandas as pd
 
     from foldopt.inputs.study_file import default_study_path, read_study
-    from foldopt.studies.cluster import MapSpec, run_map
+    from foldopt.studies.cluster import run_map
+    from foldopt.studies.worldmap import MapSpec
     from foldopt.studies.worldmap import evaluate_sites, map_study
 
     land, sites = _land_sites(subset)

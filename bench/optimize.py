@@ -44,9 +44,9 @@ def main() -> None:
 
     base = foldopt.load_study(ROOT / "configs" / "optimize.yaml").base
     for name, (latitude, longitude, timezone) in SITES.items():
-        plan = foldopt.plan_request(base.data(), {"site": {"latitude": latitude, "longitude": longitude,
-                                                           "timezone": timezone},
-                                                  "date": args.days, "optimize": None}).plan
+        plan = foldopt.make_request("run", base.data(), fields={
+            "site": {"latitude": latitude, "longitude": longitude, "timezone": timezone},
+            "date": args.days, "optimize": None}).plan
         study = plan.base
         dates = dict(plan.axes)["date"]
         blocks = Blocks.of_dates(study, dates)

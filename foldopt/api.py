@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from foldopt.inputs.study_file import default_study_path, with_files
+from foldopt.inputs.study_file import default_study_path
 from foldopt.inputs.plan import Plan, load_plan
 from foldopt.inputs.study import Study
 from foldopt.errors import ConfigError
@@ -61,7 +61,7 @@ def load_study(path: str | Path) -> Study | Plan:
 
 
 def run(
-    study: Study | Plan | str | Path,
+    study: Study | Plan | str | Path | None = None,
     engine: str = DEFAULT_ENGINE,
     progress: Callable[[float, int], None] | None = None,
     request=None,
@@ -72,15 +72,15 @@ def run(
     Parameters
     ----------
     study : Study, Plan, str or pathlib.Path
-        A study, a plan, or a YAML file holding either.
+        A study, a plan, or a YAML file holding either; not with ``request``.
     engine : {'auto', 'numba', 'numpy'}
         :data:`foldopt.names.ENGINES`: by the size of each evaluation (``auto``), the compiled
         kernel, or the NumPy reference path it is tested against.
     progress : callable, optional
         For a plan: ``progress(done, total)`` in days.
     request : foldopt.studies.request.Request, optional
-        The request the study came from (:func:`foldopt.studies.request.plan_request`): what the answer
-        says it took from the study.
+        A request made already (:func:`foldopt.studies.request.make_request`, as the command line
+        makes it): its plan runs, and the answer says what it took from the study.
 
     Returns
     -------
@@ -94,35 +94,27 @@ def run(
     Raises
     ------
     foldopt.ConfigError
-        For a study file that cannot be read or a study that cannot be run.
+        For a study file that cannot be read, a study that cannot be run, or a section its run
+        does not honour (:mod:`foldopt.capabilities`).
     """
-    from foldopt.studies.request import request_engine
+    from foldopt.studies.request import make_request, request_engine
 
-    if isinstance(study, (str, Path)):
-        study = load_study(study)
-    engine = request_engine(engine, study)
-    base = study.base if isinstance(study, Plan) else study
-    if base.optimize is not None:
+    if request is None:
+        request = make_request("run", study)
+    plan = request.plan
+    engine = request_engine(engine, plan)
+    if request.run == "optimize":
         from foldopt.studies.joint import optimize_plan
 
-        return optimize_plan(
-            study if isinstance(study, Plan) else Plan(study.data(), ()), engine, request
-        )
-    if isinstance(study, Plan):
-        if study.axes:
-            from foldopt.studies.sweeps import run_plan
-
-            return run_plan(study, progress, engine, request)
-        study = study.base
-    if study.weather is not None and study.weather.members:
-        # A cloud ensemble over one day: the plan of that day runs the members (a case does not).
+        return optimize_plan(plan, engine, request)
+    if plan.axes or request.run == "ensemble":
+        # A cloud ensemble over one day too: one fold angle over its members (a case is one member).
         from foldopt.studies.sweeps import run_plan
 
-        day = Plan({**study.data(), "date": [study.date.isoformat()]}, (("date", (study.date,)),))
-        return run_plan(day, progress, engine, request)
+        return run_plan(plan, progress, engine, request)
     from foldopt.studies.day import run_study
 
-    return run_study(with_files(study), engine, request)
+    return run_study(plan.base, engine, request)
 
 
 def sweep(
@@ -136,11 +128,11 @@ def sweep(
 ):
     """Evaluate a study at every combination of the values of some fields, as ``foldopt sweep`` does.
 
-    The request goes through :func:`foldopt.studies.request.plan_request`, as the command line's does, so
-    ``foldopt.sweep(foldopt.default_study(), latitude=[0, 20])`` and ``foldopt sweep latitude
-    --lat 0,20`` give the same table to the bit: a paper-mode study given another site or day
-    runs in exact mode with the hinge geometry, and a new latitude tilts the panel at
-    ``|latitude|`` toward the equator, unless those fields are given.
+    The request goes through :func:`foldopt.studies.request.make_request`, as the command line's
+    does, so ``foldopt.sweep(foldopt.default_study(), "latitude", latitude=[0, 20])`` and
+    ``foldopt sweep latitude --lat 0,20`` give the same table to the bit: a paper-mode study given
+    another site or day runs in exact mode with the hinge geometry, and a new latitude tilts the
+    panel at ``|latitude|`` toward the equator, unless those fields are given.
 
     Parameters
     ----------
@@ -174,7 +166,7 @@ def sweep(
     Raises
     ------
     foldopt.ConfigError
-        One line per fault, naming the field.
+        One line per fault, naming the field (a field given twice, by a keyword and ``axes``, is one).
 
     Examples
     --------
@@ -183,15 +175,19 @@ def sweep(
     >>> len(result.table)
     16
     """
-    from foldopt.studies.request import KEYWORDS, plan_request
+    from foldopt.studies.request import make_request
 
-    changes = {KEYWORDS.get(name, name): _plain_values(values) for name, values in fields.items()}
-    changes.update({path: _plain_values(values) for path, values in (axes or {}).items()})
-    if not changes and over is None:
+    axes = axes or {}
+    if not fields and not axes and over is None:
         raise ConfigError(["sweep: name at least one field to sweep, e.g. p_load=[1, 2, 4]"])
-    request = plan_request(_study_data(study), changes, axis=over)
-    # as the command line runs a request
-    return run(request.plan, engine, progress, request=request)
+    both = sorted(set(fields) & set(axes))
+    if both:
+        raise ConfigError(
+            [f"{name}: given twice, as a keyword and in axes; give one" for name in both]
+        )
+    command = "run" if over is None else f"sweep {over}"
+    request = make_request(command, study, fields={**fields, **axes})
+    return run(engine=engine, progress=progress, request=request)
 
 
 def optimize(
@@ -209,7 +205,7 @@ def optimize(
     (:func:`foldopt.studies.joint.optimize_plan`), with the flat panel's own best tilt and azimuth,
     the default mounting and the tracker.
 
-    The request goes through :func:`foldopt.studies.request.plan_request`, as the command line's
+    The request goes through :func:`foldopt.studies.request.make_request`, as the command line's
     does, so both give the same answer to the bit.
 
     Parameters
@@ -247,31 +243,22 @@ def optimize(
     >>> float(best["fold_angle_deg"]), float(best["surface_tilt"])
     (32.0, 31.0)
     """
-    from foldopt.studies.joint import optimize_plan
-    from foldopt.studies.request import KEYWORDS, optimize_section, plan_request, request_engine
+    from foldopt.studies.request import make_request
 
-    section = optimize_section(vary, fold_angle, tilt, azimuth, tolerance_h)
-    changes = {KEYWORDS.get(name, name): _plain_values(values) for name, values in fields.items()}
-    data = _study_data(study)
-    changes["optimize"] = {**(data.get("optimize") or {}), **section}
-    request = plan_request(data, changes)
-    return optimize_plan(request.plan, request_engine(engine, request.plan), request)
-
-
-def _study_data(study: Study | Plan) -> dict:
-    """A study's fields as a study file holds them; a plan's (a file that sweeps, a year of dates)
-    with its lists."""
-    return study.data if isinstance(study, Plan) else study.data()
-
-
-def _plain_values(values):
-    """A sequence (a list, a tuple, an array) as a list of plain values; text and scalars as they are."""
-    if isinstance(values, (str, dict)) or not (
-        isinstance(values, Sequence) or hasattr(values, "tolist")
-    ):
-        return values.item() if hasattr(values, "item") else values
-    items = [item.item() if hasattr(item, "item") else item for item in values]
-    return [item.isoformat() if hasattr(item, "isoformat") else item for item in items]
+    search = {
+        "vary": vary,
+        "fold_angle": fold_angle,
+        "tilt": tilt,
+        "azimuth": azimuth,
+        "tolerance_h": tolerance_h,
+    }
+    request = make_request(
+        "optimize",
+        study,
+        fields=fields,
+        optimize={name: value for name, value in search.items() if value is not None},
+    )
+    return run(engine=engine, request=request)
 
 
 def write(
@@ -323,7 +310,7 @@ def write(
 
 
 def size(
-    study: Study,
+    study: Study | None = None,
     areas="0.01:0.5:0.005",
     cost_per_m2: float | None = None,
     cost_per_w: float | None = None,
@@ -337,8 +324,8 @@ def size(
 
     Parameters
     ----------
-    study : Study
-        One case: its site, day and load.
+    study : Study, optional
+        One case: its site, day and load; not with ``request``.
     areas : array_like or str
         Panel areas [m^2], or a range ``"start:stop:step"``.
     cost_per_m2, cost_per_w : float, optional
@@ -349,7 +336,8 @@ def size(
     years, days_per_year : float, optional
         Lifetime [years] (default Shin et al.'s 20) and days a year like the study's (365).
     request : foldopt.studies.request.Request, optional
-        The request the study came from: what the answer says it took from the study.
+        A ``size`` request made already (:func:`foldopt.studies.request.make_request`, as the
+        command line makes it, its costs checked): its study is sized.
 
     Returns
     -------
@@ -368,24 +356,29 @@ def size(
     from foldopt.studies import sizing
     from foldopt.inputs.plan import parse_range
     from foldopt.studies.day import Day
-    from foldopt.studies.request import sizing_problems
+    from foldopt.studies.request import make_request
 
     errors = []
     if cost_per_m2 is not None and cost_per_w is not None:
         errors.append("cost_per_m2 / cost_per_w: give one panel cost, not both")
-    if cost_per_m2 is None and cost_per_w is None:
-        cost_per_m2 = costs.PAPER_COST_PER_M2
-    c_grid = costs.C_GRID if c_grid is None else c_grid
-    years = costs.LIFETIME_YEARS if years is None else years
-    days_per_year = costs.DAYS_PER_YEAR if days_per_year is None else days_per_year
-    parameters = {
+    given = {
         "cost_per_m2": cost_per_m2,
         "cost_per_w": cost_per_w,
         "c_grid_usd_per_kwh": c_grid,
         "years": years,
         "days_per_year": days_per_year,
     }
-    errors += sizing_problems(parameters)
+    if request is None and not errors:
+        request = make_request("size", study, costs=given)
+    if cost_per_m2 is None and cost_per_w is None:
+        cost_per_m2 = costs.PAPER_COST_PER_M2
+    parameters = {
+        **given,
+        "cost_per_m2": cost_per_m2,
+        "c_grid_usd_per_kwh": costs.C_GRID if c_grid is None else c_grid,
+        "years": costs.LIFETIME_YEARS if years is None else years,
+        "days_per_year": costs.DAYS_PER_YEAR if days_per_year is None else days_per_year,
+    }
     try:
         grid = parse_range(areas) if isinstance(areas, str) else [float(a) for a in areas]
         if not grid or min(grid) <= 0 or max(grid) > 1000:
@@ -394,9 +387,15 @@ def size(
         errors.append(f"areas: {error}")
     if errors:
         raise ConfigError(errors)
-    study = with_files(study)  # a study built in Python has its files unread
+    study = request.plan.base
     table = sizing.size_panel(
-        Day(study), grid, cost_per_m2, cost_per_w, c_grid, years, days_per_year
+        Day(study),
+        grid,
+        parameters["cost_per_m2"],
+        parameters["cost_per_w"],
+        parameters["c_grid_usd_per_kwh"],
+        parameters["years"],
+        parameters["days_per_year"],
     )
     return sizing.SizingResult(study, table, sizing.best_areas(table), parameters, request)
 
@@ -468,10 +467,10 @@ def world_map(
         in exact mode (with its Ineichen clear sky).
     relative : bool
     year : int
-    request : foldopt.studies.worldmap.MapRequest, optional
+    request : foldopt.studies.request.Request, optional
         A map's request made and checked already (the command line's,
-        :func:`foldopt.studies.request.map_request_from`): its sites, loads, study, year and
-        defaults, instead of ``sites``, ``loads``, ``study``, ``relative``, ``year`` and ``defaults``.
+        :func:`foldopt.studies.request.make_request`): its sites, loads, study, year and
+        defaults, instead of ``sites``, ``loads``, ``study``, ``relative``, ``year`` and ``show_period``.
     scheduler : str, optional
         A Dask scheduler's address or file; default an embedded cluster of ``workers`` processes.
     sites_per_chunk : int
@@ -500,33 +499,26 @@ def world_map(
     foldopt.ConfigError
         For a bad site, load, year, period or study setting, before any cluster starts.
     """
-    from foldopt.studies.cluster import MapSpec, run_map
+    from dataclasses import replace
+
+    from foldopt.studies.cluster import run_map
     from foldopt.studies.result_answers import of_map
     from foldopt.output.folders import map_figures, write_map_report
     from foldopt.output.gridded import write_grid_netcdf
-    from foldopt.studies.request import request_engine
-    from foldopt.studies.worldmap import map_request, map_study, searched_tilt
+    from foldopt.studies.request import make_request, request_engine
+    from foldopt.studies.worldmap import searched_tilt
 
     if out is None:
         raise ConfigError(["out: give the map's results folder"])
     if request is None:
-        if study is None:
-            study = map_study(load_plan(default_study_path()).data)
-        request = map_request(
-            study, loads, sites=sites, relative=relative, year=year, show_period=show_period
-        )
-    else:
-        defaults = request.defaults
-    study, relative, year = request.study, request.relative, request.year
-    spec = MapSpec(
-        study,
-        request.sites,
-        request.loads,
-        relative,
-        year,
-        sites_per_chunk,
-        request_engine(engine, None),
+        fields = {"year": year, **({"p_load": loads} if loads is not None else {})}
+        where = {"sites": sites, "relative": relative, "show_period": show_period}
+        request = make_request("map", study, fields=fields, where=where)
+    defaults = request.defaults if defaults is None else defaults
+    spec = replace(
+        request.plan, sites_per_chunk=sites_per_chunk, engine=request_engine(engine, None)
     )
+    study, relative = spec.study, spec.relative
     finished = {}
 
     def finish(run, metadata):

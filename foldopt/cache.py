@@ -1,7 +1,8 @@
 """foldopt's cache folder and its files: where the electrical tables, the land mask and matplotlib's
 settings are kept between runs (:func:`cache_dir`), and cache files that carry a checksum
-(:func:`store_cache`, :func:`load_cache`), so that a damaged one is built again rather than read.
-A leaf: it imports nothing of foldopt.
+(:func:`store_cache`, :func:`load_cache`), so that a damaged one is built again rather than read;
+and foldopt's yes-or-no environment variables (:func:`env_flag`: ``FOLDOPT_OFFLINE``,
+``FOLDOPT_QUIET``). A leaf: it imports nothing of foldopt but the errors.
 """
 
 from __future__ import annotations
@@ -15,17 +16,59 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
+from foldopt.errors import ConfigError, printable
+
 #: Ends every cache file, followed by the SHA-256 (hex) of the bytes before it.
 _CHECKSUM = b"\nfoldopt-sha256:"
 #: Offline in this context (the command line's ``--offline``): what is fetched comes from the
 #: cache only (:func:`offline`).
 _OFFLINE: contextvars.ContextVar[bool] = contextvars.ContextVar("foldopt_offline", default=False)
+#: The spellings of a yes and of a no an environment variable of :func:`env_flag` takes, in any
+#: case; unset or empty is a no.
+_YES, _NO = ("1", "true", "yes", "on"), ("0", "false", "no", "off", "")
+
+
+def env_flag(name: str) -> bool:
+    """A yes-or-no environment variable of foldopt's (``FOLDOPT_OFFLINE``, ``FOLDOPT_QUIET``).
+
+    Parameters
+    ----------
+    name : str
+        The variable.
+
+    Returns
+    -------
+    bool
+        True for 1, true, yes or on; False for 0, false, no, off, empty or unset (any case, spaces
+        around ignored).
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        For any other value: one line naming the variable and what it takes.
+    """
+    value = os.environ.get(name, "")
+    word = value.strip().lower()
+    if word in _YES or word in _NO:
+        return word in _YES
+    raise ConfigError(
+        [
+            f"{name} = {printable(repr(value), 40)}: a yes or a no, one of {', '.join(_YES)} or "
+            f"{', '.join(_NO[:-1])} (any case)"
+        ]
+    )
 
 
 def offline() -> bool:
     """Whether foldopt fetches nothing and reads fetched data from its cache only:
-    ``--offline`` (:func:`offline_mode`) or ``FOLDOPT_OFFLINE=1``."""
-    return _OFFLINE.get() or os.environ.get("FOLDOPT_OFFLINE", "") == "1"
+    ``--offline`` (:func:`offline_mode`) or ``FOLDOPT_OFFLINE`` yes (:func:`env_flag`).
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        For a ``FOLDOPT_OFFLINE`` that is no yes or no.
+    """
+    return env_flag("FOLDOPT_OFFLINE") or _OFFLINE.get()
 
 
 @contextmanager
@@ -58,7 +101,7 @@ def load_cache(path: Path) -> dict | None:
     """The arrays of the cache file ``path`` (:func:`store_cache`), or None where it is absent or
     damaged: then the caller builds them again. The checksum is verified before anything is read,
     so that a truncated or bit-flipped file is caught whatever its bytes; a damaged file gets a
-    one-line notice on stderr (none with ``FOLDOPT_QUIET=1``).
+    one-line notice on stderr (:func:`notice`).
 
     Parameters
     ----------
@@ -69,14 +112,17 @@ def load_cache(path: Path) -> dict | None:
     except FileNotFoundError:
         return None
     except OSError as error:
-        _notice(path, f"cannot be read ({error.strerror or error})")
+        notice(f"the cache file {path} cannot be read ({error.strerror or error}); {_AGAIN}")
         return None
     payload, mark, digest = data.rpartition(_CHECKSUM)
     if not mark:
-        _notice(path, "has no checksum (written by an earlier foldopt, or truncated)")
+        notice(
+            f"the cache file {path} has no checksum (written by an earlier foldopt, or "
+            f"truncated); {_AGAIN}"
+        )
         return None
     if digest != hashlib.sha256(payload).hexdigest().encode():
-        _notice(path, "is damaged (its checksum does not match)")
+        notice(f"the cache file {path} is damaged (its checksum does not match); {_AGAIN}")
         return None
     import numpy as np
 
@@ -140,6 +186,17 @@ def write_atomically(path: Path, write) -> None:
         Path(temporary).unlink(missing_ok=True)
 
 
-def _notice(path: Path, problem: str) -> None:
-    if os.environ.get("FOLDOPT_QUIET") != "1":
-        print(f"foldopt: the cache file {path} {problem}; building it again", file=sys.stderr)
+_AGAIN = "building it again"
+
+
+def notice(message: str) -> None:
+    """One line on stderr, ``foldopt: <message>``, of something foldopt mended on its way (a
+    damaged cache file built or fetched again); none where ``FOLDOPT_QUIET`` is yes
+    (:func:`env_flag`: ``--quiet``).
+
+    Parameters
+    ----------
+    message : str
+    """
+    if not env_flag("FOLDOPT_QUIET"):
+        print(f"foldopt: {message}", file=sys.stderr)

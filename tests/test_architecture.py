@@ -17,7 +17,8 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "foldopt"
 #: Stage of each top-level name of the package, lowest first.
-STAGES = {"errors": 0, "names": 0, "files": 0, "cache": 0, "tables": 0, "physics": 1, "inputs": 2, "engine": 3,
+STAGES = {"errors": 0, "names": 0, "capabilities": 0, "files": 0, "cache": 0, "tables": 0,
+          "physics": 1, "inputs": 2, "engine": 3,
           "studies": 4, "output": 5, "api": 6, "cli": 7}
 
 
@@ -133,3 +134,32 @@ def test_cycle_finder_sees_a_cycle():
 
     visit("a", ["a"])
     assert cycles == [["a", "b", "c", "a"]]
+
+
+#: The front door's modules: a Plan is made by make_plan (and Plan.of), a Request by make_request.
+_MAKERS = {"Plan": {"foldopt.inputs.plan", "foldopt.studies.request"},
+           "Request": {"foldopt.studies.request"}}
+
+
+def _calls_of(module: str) -> list[tuple[str, int]]:
+    """``(name, line)`` of every call of ``Plan(...)``, ``Plan.of(...)`` or ``Request(...)``."""
+    found = []
+    for node in ast.walk(ast.parse(MODULES[module].read_text())):
+        if not isinstance(node, ast.Call):
+            continue
+        func = node.func
+        name = func.id if isinstance(func, ast.Name) else (
+            func.value.id if isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name)
+            and func.attr == "of" else None)
+        if name in _MAKERS:
+            found.append((name, node.lineno))
+    return found
+
+
+def test_only_the_front_door_makes_a_plan_or_a_request():
+    """Issue 47: every entry (a YAML study, options, --set, keywords, a map) becomes a plan through
+    foldopt.studies.request.make_request; nothing downstream builds one by hand."""
+    elsewhere = [f"{module}:{line} makes a {name}" for module in MODULES
+                 for name, line in _calls_of(module) if module not in _MAKERS[name]]
+    assert elsewhere == []
+    assert _calls_of("foldopt.studies.request"), "the finder sees the front door's own calls"

@@ -18,7 +18,8 @@ from typer.testing import CliRunner
 
 from foldopt.cli.app import app
 from foldopt.errors import ConfigError
-from foldopt.studies.cluster import MapSpec, run_map
+from foldopt.studies.cluster import run_map
+from foldopt.studies.worldmap import MapSpec
 from foldopt.errors import OutputError
 from foldopt.studies.worldmap import evaluate_sites
 

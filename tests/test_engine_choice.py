@@ -15,7 +15,7 @@ import pytest
 import foldopt
 from foldopt.engine.choice import engine_for
 from foldopt.names import AUTO_NUMPY_ROW_STEPS, DEFAULT_ENGINE, ENGINES
-from foldopt.studies.request import plan_request, request_engine
+from foldopt.studies.request import make_request, request_engine
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -37,9 +37,9 @@ def test_a_request_decides_by_its_days_angles_and_steps():
     # As many one-day cases as fit under the bound, and one more.
     fit = AUTO_NUMPY_ROW_STEPS // (angles * steps)
     dates = [(dt.date(2025, 1, 1) + dt.timedelta(days=day)).isoformat() for day in range(fit)]
-    assert request_engine("auto", plan_request(study.data(), {"date": dates}).plan) == "numpy"
+    assert request_engine("auto", make_request("run", study, fields={"date": dates}).plan) == "numpy"
     more = [*dates, "2025-12-31"]
-    assert request_engine("auto", plan_request(study.data(), {"date": more}).plan) == "numba"
+    assert request_engine("auto", make_request("run", study, fields={"date": more}).plan) == "numba"
     # A joint search over the tilt or the azimuth evaluates some 10^4 designs: the kernel; a
     # search of the fold angle alone is the day's grid.
     joint = study.variant(optimize={"vary": ["fold_angle", "tilt"]})

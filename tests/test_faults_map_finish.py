@@ -162,7 +162,7 @@ def test_a_misspelt_objective_is_named_beside_the_missing_dates(tmp_path, monkey
 
 
 @pytest.mark.parametrize("args, words", [
-    (["run", "--set", "fold_angles.step=1e-9"], ["fold_angles.step = '1e-9'", "179,000,000,001 fold angles"]),
+    (["run", "--set", "fold_angles.step=1e-9"], ["fold_angles.step = '1e-9'", "180,000,000,000 fold angles"]),
     (["sweep", "angle", "--angle-step", "1e-9"], ["--angle-step = 1e-09", "fold angles"]),
 ])
 def test_a_fold_angle_grid_too_fine_is_refused_at_once(tmp_path, monkeypatch, args, words):

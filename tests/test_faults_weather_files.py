@@ -344,7 +344,8 @@ def test_the_hourly_formats_are_told_by_their_content():
 @pytest.mark.parametrize("weather", [[TMY3], [MEASURED / "surfrad-slv16001.dat", "--weather-format", "surfrad"]],
                          ids=["tmy3", "surfrad"])
 def test_a_latitude_sweep_over_a_weather_file_of_one_site_is_one_line(here, weather):
-    refused(here, ["sweep", "latitude", "--weather", *weather], "--lat = '-60:60:5': varies",
+    refused(here, ["sweep", "latitude", "--weather", *weather],
+            "sweep latitude's default range = '-60:60:5': varies",
             "a weather file is of one site", "--force-site")
 
 

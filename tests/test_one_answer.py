@@ -196,22 +196,22 @@ def test_size_refuses_what_the_api_refuses(option, parameter, value):
 
 def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler):
     """A map of named sites at the study's load through the command line, and the same request
-    made with foldopt.studies.request.map_request_from and run by foldopt.world_map: the same rows
+    made with foldopt.studies.request.make_request and run by foldopt.world_map: the same rows
     to the bit, the same answer, the same things taken from the study; every view carries the
     near-optimal range and the recommended angle. world_map runs the request it is given: it does
     not build and check it again (it did, after the command line had). Both on the in-process
     cluster (conftest.scheduler): an embedded one (workers=1) started a process for each map,
     which imported foldopt and loaded its compiled code again."""
     import foldopt.studies.worldmap
-    from foldopt.studies.request import map_request_from
+    from foldopt.studies.request import make_request
 
     sites = tmp_path / "sites.csv"
     sites.write_text("name,latitude,longitude\nquito,-0.18,-78.47\noslo,59.91,10.75\nsydney,-33.87,151.21\n")
     document, folder, _ = cli(tmp_path, "map", "--sites", sites, "--scheduler", scheduler, "--step-min", "60",
                               "--angle-step", "10")
-    request = map_request_from(sites=str(sites), step_min=60.0, angle_step=10.0)
-    assert [site["name"] for site in request.sites] == ["quito", "oslo", "sydney"]
-    assert isinstance(request.study, foldopt.Study)  # what the map ships to its workers
+    request = make_request("map", options={"step_min": 60.0, "angle_step": 10.0}, where={"sites": str(sites)})
+    assert [site["name"] for site in request.plan.sites] == ["quito", "oslo", "sydney"]
+    assert isinstance(request.plan.study, foldopt.Study)  # what the map ships to its workers
     monkeypatch.setattr(foldopt.studies.worldmap, "map_request", None)  # a second build would fail
     result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", scheduler=scheduler)
     year = result.table[result.table["period"] == "year"].reset_index(drop=True)
@@ -234,15 +234,15 @@ def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler):
 def test_a_map_says_whose_step_it_takes():
     """A map takes the study's step, as every command does (the embedded study's 1 min; maps had
     their own 5 min), and says so; a study that names no step, and no mode, was a TypeError."""
-    from foldopt.studies.request import map_request_from
+    from foldopt.studies.request import make_request
 
-    embedded = map_request_from(latitudes=[0], longitudes=[0])
+    grid = {"latitudes": [0], "longitudes": [0]}
+    embedded = make_request("map", where=grid)
     assert "1-min steps" in embedded.defaults["taken"]
     assert "exact mode" in embedded.defaults["taken"]
-    own = map_request_from({"name": "own", "panel": {"area": 0.1}, "p_load": 1.0}, latitudes=[0], longitudes=[0])
+    own = make_request("map", {"name": "own", "panel": {"area": 0.1}, "p_load": 1.0}, where=grid)
     assert {"1-min steps", "exact mode", "ideal PV model"} <= set(own.defaults["taken"])
-    assert map_request_from(latitudes=[0], longitudes=[0], settings=["step_min=10"]).defaults["taken"][-1] == (
-        "10-min steps")
+    assert "10-min steps" not in make_request("map", where=grid, settings=["step_min=10"]).defaults["taken"]
 
 
 def test_variant_merges_sections_and_speaks_in_config_errors():

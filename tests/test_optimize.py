@@ -347,7 +347,9 @@ def test_a_bad_range_of_the_study_file_keeps_its_name(tmp_path):
                      + "\noptimize:\n  vary: [tilt]\n  tilt: {min: 0, max: 90, step: 0}\n", encoding="utf-8")
     result = CliRunner().invoke(app, ["optimize", "--config", str(study), "--out", str(tmp_path / "out")])
     assert result.exit_code == 2, result.output
-    assert result.stderr.strip().splitlines() == ["error: optimize.tilt.step = 0: must be in (0, 90] deg"]
+    # the study file's field, at its line: --tilt-range was not given
+    assert result.stderr.strip().splitlines() == [
+        "error: optimize.tilt.step = 0: must be in (0, 90] deg (line 44)"]
 
 
 def test_a_season_none_of_the_days_is_in_is_refused(tmp_path):

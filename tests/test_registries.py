@@ -78,11 +78,16 @@ def test_the_options_that_set_fields_are_one_table(path):
 
 
 def test_a_flag_sets_its_field_to_the_table_value():
-    from foldopt.studies.request import sweep_changes
+    from foldopt.studies.request import make_request
 
-    unset = {**dict.fromkeys(names.FIELD_OF_PARAMETER), "settings": None}
+    # what makes each flag's field used (an unused setting is refused)
+    context = {"no_bypass": ["connection=series"], "exact_electrical": ["pv_model=single-diode"]}
     for entry in names.FIELD_OPTIONS:
         if entry.flag is not None:
-            assert sweep_changes({**unset, entry.parameter: True}, {}) == {entry.field: entry.flag}
+            request = make_request("sweep angle", options={entry.parameter: True},
+                                   settings=context.get(entry.parameter, []))
+            study = request.plan.base
+            section, _, name = entry.field.rpartition(".")
+            assert getattr(getattr(study, section) if section else study, name) == entry.flag, entry
     assert names.option_labels()["fold_angles.start"] == "--angle-step"
     assert names.option_labels({"p_load_scale"})["p_load"] == "--p-load-scale"

@@ -225,15 +225,15 @@ def test_the_command_line_and_the_api_give_the_same_answer(tmp_path, joint):
 def test_a_mounting_search_leaves_paper_mode_and_a_fold_search_keeps_it():
     """Shin et al.'s Eq. 5 is the angle of incidence only for a surface facing the sun's azimuth: an
     optimisation that re-tilts or turns the paper's panel runs in exact mode, and says so."""
-    from foldopt.studies.request import plan_request
+    from foldopt.studies.request import make_request
 
     data = foldopt.default_study().data()
     assert data["mode"] == "paper"
-    mounting = plan_request(data, {"optimize": {"vary": ["fold_angle", "tilt"]}})
+    mounting = make_request("optimize", data, optimize={"vary": ["fold_angle", "tilt"]})
     assert mounting.plan.base.mode == "exact" and any("Eq. 5" in item for item in mounting.taken)
-    fold = plan_request(data, {"optimize": {"vary": ["fold_angle"]}})
+    fold = make_request("optimize", data, optimize={"vary": ["fold_angle"]})
     assert fold.plan.base.mode == "paper"
-    kept = plan_request(data, {"optimize": {"vary": ["tilt"]}, "mode": "paper"})
+    kept = make_request("optimize", data, optimize={"vary": ["tilt"]}, fields={"mode": "paper"})
     assert kept.plan.base.mode == "paper"
 
 

@@ -44,7 +44,8 @@ def _study(storage=None, **changes):
 BAD = [
     ("capacity-negative", ["--storage-wh", "-1"], ["--storage-wh = -1.0", "[0, 1e+06] Wh"]),
     ("capacity-text", ["--storage-wh", "lots"], ["--storage-wh", "number"]),
-    ("capacity-missing", ["--min-soc", "0.2"], ["--storage-wh", "required"]),
+    # the option given is named, not the one missing (--min-soc alone made a buffer with no capacity)
+    ("capacity-missing", ["--min-soc", "0.2"], ["error: --min-soc:", "capacity_wh", "--storage-wh"]),
     ("min-soc-one", ["--storage-wh", "10", "--min-soc", "1"], ["--min-soc = 1.0", "[0, 1)"]),
     ("min-soc-nan", ["--storage-wh", "10", "--min-soc", "nan"], ["--min-soc", "[0, 1)"]),
     (
@@ -186,13 +187,14 @@ def test_any_storage_section_validates_within_its_limits_or_names_its_fault(sect
 
 
 def test_a_capacity_list_is_a_sweep_axis_each_value_checked():
-    from foldopt.studies.request import settings_plan
+    from foldopt.inputs.plan import load_plan, make_plan
+    from foldopt.inputs.policy import set_path
 
-    plan = settings_plan(default_study_path(), ["storage.capacity_wh=[0, 10, 20]",
-                                                "storage.preset=lifepo4"])
-    assert plan.axes == (("storage.capacity_wh", (0, 10, 20)),)
+    data = set_path(set_path(load_plan(default_study_path()).data, "storage.capacity_wh", [0, 10, 20]),
+                    "storage.preset", "lifepo4")
+    assert make_plan(data).axes == (("storage.capacity_wh", (0, 10, 20)),)
     with pytest.raises(foldopt.ConfigError, match=r"storage.capacity_wh\[1\] = -10: must be in"):
-        settings_plan(default_study_path(), ["storage.capacity_wh=[0, -10]"])
+        make_plan(set_path(data, "storage.capacity_wh", [0, -10]))
 
 
 # ---- the section's values: presets, the ideal buffer, what the study's data keep ----------------

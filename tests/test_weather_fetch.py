@@ -63,6 +63,11 @@ class Handler(BaseHTTPRequestHandler):
         if parts[1:3] != ["api", "v5_3"] or len(parts) != 4 or parts[3] not in BODIES:
             return self.send(404, b"")
         BODY = BODIES[parts[3]]
+        if mode == "auth":  # a mirror behind a user and password: user:secret
+            good = self.headers.get("Authorization") == "Basic dXNlcjpzZWNyZXQ="
+            return self.send(200, BODY) if good else self.send(401, b"")
+        if mode in ("trickle", "tricklehead"):  # a byte every half second, each read in time
+            return self.trickle(BODY, mode == "trickle")
         if mode == "ok" or (mode == "rate" and n > 1) or (mode == "flaky" and n != 2):
             return self.send(200, BODY)
         if mode == "rate":
@@ -88,6 +93,24 @@ class Handler(BaseHTTPRequestHandler):
             self.connection.shutdown(socket.SHUT_RDWR)
             return
         return self.send(404, b"")
+
+    def trickle(self, body, headers_first):
+        if headers_first:  # the headers at once, promising the whole answer
+            self.send_response(200)
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.flush()
+            slow = body
+        else:  # not even the status line in one piece
+            slow = b"HTTP/1.0 200 OK\r\nContent-Length: %d\r\n\r\n" % len(body) + body
+        try:
+            for byte in slow[:120]:  # a minute at most, then the connection closes
+                self.wfile.write(bytes([byte]))
+                self.wfile.flush()
+                time.sleep(0.5)
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # the client gave up: what is tested
+        self.close_connection = True
 
     def send(self, status, body, headers=()):
         self.send_response(status)
@@ -236,7 +259,8 @@ FAULTS = [
     ("cut", [], "PVGIS's answer was cut off after "),
     ("half", [], "PVGIS's answer is not a readable PVGIS TMY (not valid JSON: "),
     ("close", [], "closed the connection without an answer; nothing was cached, try again"),
-    ("slow", ["--timeout", "0.5"], "did not answer within 0.5 s (weather.timeout_s sets the wait)"),
+    ("slow", ["--timeout", "0.5"], "did not answer within 0.5 s (weather.timeout_s sets the wait); its "
+                                   "whole answer must come within it: nothing was cached"),
 ]
 
 
@@ -331,7 +355,7 @@ def test_a_damaged_cached_answer_is_fetched_again(pvgis, server, tmp_path):
     answer = next(p for p in (tmp_path / "cache" / "weather").iterdir() if "provenance" not in p.name)
     answer.write_bytes(answer.read_bytes().replace(b'"G(h)": 0.0', b'"G(h)": 9.0', 1))  # one flipped value
     offline = runner.invoke(app, ["weather", "path", "--lat", "45", "--lon", "8"])
-    assert offline.exit_code == 2 and "no cached copy" in offline.stderr  # not read as if whole
+    assert offline.exit_code == 2 and "is damaged" in offline.stderr  # not read as if whole
     assert runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"]).exit_code == 0
     assert requests_made(server, route) == 2
     assert answer.read_bytes() == RECORDED.read_bytes()
@@ -353,7 +377,7 @@ def test_a_map_fetches_each_site_once_and_a_stopped_fetch_resumes(pvgis, server,
     one request a site (two names of one site as PVGIS rounds it: one), each cached as it comes,
     so that a fetch stopped by a fault resumes with the sites not yet fetched. (The server gives
     the recorded 45 N, 8 E answer to every site: what is tested is the requests.)"""
-    from foldopt.studies.request import map_request_from
+    from foldopt.studies.request import make_request
 
     (tmp_path / "sites.csv").write_text("name,latitude,longitude\nturin,45,8\nturin-b,45.0001,8\n"
                                         "asti,44.9,8.2\nalba,44.7,8.03\n")
@@ -365,8 +389,7 @@ def test_a_map_fetches_each_site_once_and_a_stopped_fetch_resumes(pvgis, server,
     assert requests_made(server, flaky) == 2 and not (tmp_path / "map").exists()
     assert len(cache_files(tmp_path)) == 2  # turin's answer and its provenance
     route = pvgis("ok")
-    request = map_request_from(None, source="test", objective="mean", sites=tmp_path / "sites.csv",
-                               weather={"source": "pvgis-tmy"})
+    request = make_request("map", where={"sites": tmp_path / "sites.csv", "weather": {"source": "pvgis-tmy"}}).plan
     assert requests_made(server, route) == 2  # asti and alba: turin's came from the cache
     files = [Path(site["weather"]) for site in request.sites]
     assert [site["name"] for site in request.sites] == ["turin", "turin-b", "asti", "alba"]

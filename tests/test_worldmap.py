@@ -235,7 +235,8 @@ def test_a_relative_maps_answer_has_one_line_per_load():
     """Loads as fractions of each site's peak: every site's row of a load is that load, however the
     division rounds, so the answer counts each load over every site."""
     from foldopt.studies.result_answers import of_map
-    from foldopt.studies.cluster import MapRun, MapSpec
+    from foldopt.studies.cluster import MapRun
+    from foldopt.studies.worldmap import MapSpec
 
     sites = grid_sites([-30.0, 0.0, 30.0], [0.0, 60.0], False)
     fractions = (0.1, 0.3)
@@ -277,7 +278,8 @@ def test_a_map_searching_the_tilt_finds_the_best_design_of_every_tilt():
 def test_a_map_searching_the_tilt_answers_with_the_tilts():
     """The answer of a map with --optimize tilt says what it searched and gives the tilts it found."""
     from foldopt.studies.result_answers import of_map
-    from foldopt.studies.cluster import MapRun, MapSpec
+    from foldopt.studies.cluster import MapRun
+    from foldopt.studies.worldmap import MapSpec
 
     study = {**COARSE, "optimize": {"vary": ["fold_angle", "tilt"], "tilt": {"min": 0, "max": 60, "step": 30}}}
     sites = grid_sites([-20.0, 45.0], [0.0], False)

@@ -389,6 +389,26 @@ class NamesReference(Directive):
         return [_table(["kind", "name", "what it is", "also accepted"], rows, [14, 16, 55, 15])]
 
 
+class CapabilityMatrix(Directive):
+    """The capability matrix (:mod:`foldopt.capabilities`): which run honours which section, and
+    which runs each command makes."""
+
+    def run(self):
+        from foldopt import capabilities
+
+        header, *rows = capabilities.matrix_rows()
+        width = (100 - 40) // (len(header) - 2)
+        matrix = _table(header, [[_literal(row[0]), *row[1:]] for row in rows],
+                        [15, 25, *[width] * (len(header) - 2)])
+        runs = [[_literal(command), ", ".join(runs)] for command, runs in capabilities.COMMAND_RUNS.items()]
+        described = [[_literal(run), capabilities.RUNS.describe(run)] for run in capabilities.RUNS]
+        set_by = [[_literal(run), _literal(field), why] for run, fields in capabilities.SET_BY_RUN.items()
+                  for field, why in fields.items()]
+        return [_table(["run", "what it evaluates"], described, [20, 80]), matrix,
+                _table(["command", "its runs"], runs, [30, 70]),
+                _table(["run", "field", "why a request may not give it"], set_by, [15, 20, 65])]
+
+
 class StudyFile(Directive):
     """A study file shipped with foldopt, verbatim."""
 
@@ -449,6 +469,7 @@ def setup(app):
     for name, directive in (("foldopt-cli", CliReference), ("foldopt-cli-shared", CliShared),
                             ("foldopt-study", StudyReference),
                             ("foldopt-names", NamesReference), ("foldopt-study-file", StudyFile),
+                            ("foldopt-capabilities", CapabilityMatrix),
                             ("foldopt-reproduction", ReproductionTable), ("foldopt-rst", GeneratedRst)):
         app.add_directive(name, directive)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

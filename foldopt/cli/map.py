@@ -12,7 +12,6 @@ import typer
 
 from foldopt.cli.options import (
     EMBEDDED,
-    OPTION_OF_FIELD,
     RESULTS,
     AngleStep,
     Area,
@@ -114,18 +113,20 @@ def map_(
     area: Area = None,
     efficiency: Efficiency = None,
     objective: Annotated[
-        str,
+        str | None,
         typer.Option(
             "--objective",
-            help="What each period's fold angle maximises: mean | min | worst-month | pNN.",
+            help="What each period's fold angle maximises: mean | min | worst-month | pNN "
+            "[default: the study's, else mean].",
         ),
-    ] = "mean",
+    ] = None,
     year: Annotated[
-        int,
+        int | None,
         typer.Option(
-            "--year", help="Year of the clear-sky days (or that a typical year stands for)."
+            "--year",
+            help="Year of the clear-sky days (or that a typical year stands for) [default: 2025].",
         ),
-    ] = 2025,
+    ] = None,
     step_min: StepMin = None,
     angle_step: AngleStep = None,
     fold_search: Annotated[
@@ -233,49 +234,46 @@ def map_(
             errors.append(f"{option} = {value}: must be at least 1")
     if errors:
         fail(errors)
-    relative = p_load_fraction is not None
-    options_of = {
-        **OPTION_OF_FIELD,
-        **_OPTION_OF_PARAMETER,
-        "loads": "--p-load-fraction" if relative else "--p-load",
-    }
-    from foldopt.cache import offline_mode
-    from foldopt.studies.request import map_request_from
+    from foldopt.studies.request import make_request
 
-    source = None if weather is None else {"source": weather, "years": years}
+    options = {
+        "area": area,
+        "efficiency": efficiency,
+        "step_min": step_min,
+        "objective": objective,
+        "year": year,
+        "p_load": p_load,
+        "p_load_fraction": p_load_fraction,
+        "angle_step": angle_step,
+        "fold_search": fold_search,
+        "optimize": optimize,
+        "offline": offline,
+    }
+    where = {
+        "sites": sites,
+        "weather_dir": weather_dir,
+        "latitudes": lat,
+        "longitudes": lon,
+        "land_only": land_only,
+        "show_period": show_period,
+        "weather": None if weather is None else {"source": weather, "years": years},
+    }
     try:
-        with offline_mode(offline):
-            request = map_request_from(
-                config,
-                source=EMBEDDED if config is None else str(config),
-                objective=objective,
-                area=area,
-                efficiency=efficiency,
-                step_min=step_min,
-                angle_step=angle_step,
-                fold_search=fold_search,
-                optimize=optimize,
-                settings=settings or (),
-                loads=p_load_fraction if relative else p_load,
-                relative=relative,
-                year=year,
-                show_period=show_period,
-                sites=sites,
-                weather_dir=weather_dir,
-                latitudes=lat,
-                longitudes=lon,
-                land_only=land_only,
-                weather=source,
-            )
+        request = make_request("map", config, options=options, settings=settings or (), where=where)
     except WeatherError:
-        raise  # a file of --weather-dir: its line names the file, as the reader says it (map has no --weather)
+        raise  # a file of --weather-dir: its line names the file, as the reader says it
     except ConfigError as error:
-        fail(list(dict.fromkeys(rename_fields(line, options_of) for line in error.errors)))
-    if not 1 <= show_load <= len(request.loads):
+        labels = {
+            **_OPTION_OF_PARAMETER,
+            "loads": "--p-load-fraction" if p_load_fraction else "--p-load",
+        }
+        fail(list(dict.fromkeys(rename_fields(line, labels) for line in error.errors)))
+    spec = request.plan
+    if not 1 <= show_load <= len(spec.loads):
         fail(
             [
-                f"--show-load = {show_load}: must be in [1, {len(request.loads)}] (the map has "
-                f"{len(request.loads)} load{'s' if len(request.loads) > 1 else ''})"
+                f"--show-load = {show_load}: must be in [1, {len(spec.loads)}] (the map has "
+                f"{len(spec.loads)} load{'s' if len(spec.loads) > 1 else ''})"
             ]
         )
 
@@ -284,7 +282,7 @@ def map_(
             typer.echo(f"{cluster}; dashboard: {dashboard or 'none (pip install bokeh)'}", err=True)
 
     with output.progress(
-        f"map: {len(request.sites)} sites", total=len(request.sites), unit="sites"
+        f"map: {len(spec.sites)} sites", total=len(spec.sites), unit="sites"
     ) as progress:
         from foldopt.api import world_map
 
@@ -305,7 +303,7 @@ def map_(
                 command=INVOCATION,
             )
         except ConfigError as error:
-            fail(list(dict.fromkeys(rename_fields(line) for line in error.errors)))
+            fail(list(dict.fromkeys(request.rename(line) for line in error.errors)))
     output.answer(
         "map",
         out,

@@ -1,7 +1,7 @@
 """``foldopt optimize``: the fold angle, base tilt and base azimuth together
 (:func:`foldopt.studies.joint.optimize_plan`), with every option of ``foldopt sweep`` for the
-site, days, loads and models; the request is :func:`foldopt.studies.request.sweep_request`'s with
-the ``optimize`` section of :func:`foldopt.studies.request.optimize_section`."""
+site, days, loads and models; the request is :func:`foldopt.studies.request.make_request`'s, the
+search's own options making its ``optimize`` section (:func:`foldopt.studies.request.optimize_section`)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from typing import Annotated
 import typer
 
 from foldopt import names
-from foldopt.cli.options import EMBEDDED, RESULTS, check_choices, rename_fields
+from foldopt.cli.options import RESULTS, check_choices
 from foldopt.cli.output import Output, fail
 from foldopt.cli.run import run_request
 from foldopt.cli.sweep import signature
@@ -25,19 +25,6 @@ _PARAMETER_OF_FIELD = {
     "azimuth": "azimuth_range",
     "tolerance_h": "tolerance",
 }
-
-
-def _optimize_labels(own: dict) -> dict:
-    """The optimize section's fields, and a range's parts (``optimize.tilt.step``), as the options
-    given name them: ``--tilt-range step``; a field the study file set keeps its name."""
-    from foldopt.studies.request import OPTIMIZE_OPTIONS
-
-    return {
-        f"optimize.{name}{part}": option + part.replace(".", " ")
-        for name, option in OPTIMIZE_OPTIONS.items()
-        if own[_PARAMETER_OF_FIELD[name]] is not None
-        for part in ("", ".min", ".max", ".step")
-    }
 
 
 def _optimize_options(
@@ -88,32 +75,24 @@ def optimize(**options):
     output_format, engine = check_choices(options.pop("output_format"), options.pop("engine"))
     output = Output(options.pop("quiet"), output_format, options.pop("table"))
     out, overwrite = options.pop("out"), options.pop("overwrite")
-    config = options.pop("config")
-    own = {
-        name: options.pop(name)
-        for name in ("vary", "fold_range", "tilt_range", "azimuth_range", "tolerance")
-    }
+    config, settings = options.pop("config"), options.pop("settings") or ()
+    search = {field: options.pop(parameter) for field, parameter in _PARAMETER_OF_FIELD.items()}
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
-    from foldopt.studies.request import OPTIMIZE_OPTIONS, optimize_section, sweep_request
+    from foldopt.studies.request import OPTIMIZE_OPTIONS, make_request
 
-    given = {name for name, value in options.items() if value is not None}
-    labels = {**names.option_labels(given), **_optimize_labels(own)}
+    search = {field: value for field, value in search.items() if value is not None}
     try:
-        section = optimize_section(
-            own["vary"],
-            own["fold_range"],
-            own["tilt_range"],
-            own["azimuth_range"],
-            own["tolerance"],
-            labels=OPTIMIZE_OPTIONS,
+        request = make_request(
+            "optimize",
+            config,
+            options=options,
+            settings=settings,
+            optimize={**search, "labels": OPTIMIZE_OPTIONS},
         )
-        request = sweep_request(
-            config, options, None, EMBEDDED if config is None else str(config), section
-        )
-        # The search's own limits (loads x designs) are checked as it starts, before any work.
-        run_request(request, out or RESULTS / "optimize", overwrite, output, engine, "optimize")
     except ConfigError as error:
-        fail(list(dict.fromkeys(rename_fields(line, labels) for line in error.errors)))
+        fail(list(dict.fromkeys(error.errors)))
+    # The search's own limits (loads x designs) are checked as it starts, before any work.
+    run_request(request, out or RESULTS / "optimize", overwrite, output, engine, "optimize")
 
 
 _SIGNATURE = signature("optimize", "results/optimize")

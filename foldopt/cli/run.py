@@ -6,7 +6,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 from foldopt.cli.options import (
-    EMBEDDED,
     RESULTS,
     Engine,
     OutputFormat,
@@ -18,7 +17,8 @@ from foldopt.cli.options import (
     out_option,
     study_argument,
 )
-from foldopt.cli.output import INVOCATION, Output
+from foldopt.cli.output import INVOCATION, Output, fail
+from foldopt.errors import ConfigError
 from foldopt.files import check_output
 from foldopt.names import DEFAULT_ENGINE
 
@@ -60,7 +60,12 @@ def run_request(
         from foldopt.api import run, write
         from foldopt.studies.day import StudyResult
 
-        result = run(plan, engine, progress, request=request)
+        try:
+            result = run(engine=engine, progress=progress, request=request)
+        except (
+            ConfigError
+        ) as error:  # a limit found as the work starts, said as the request gave it
+            fail(list(dict.fromkeys(request.rename(line) for line in error.errors)))
     rows = result.summary if isinstance(result, StudyResult) else result.table
     output.answer(
         command,
@@ -94,15 +99,9 @@ def run(
     """
     output_format, engine = check_choices(output_format, engine)
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
-    from foldopt.inputs.study_file import default_study_path
-    from foldopt.studies.request import Request, settings_plan
+    from foldopt.studies.request import make_request
 
-    source = EMBEDDED if config is None else str(config)
-    request = Request(
-        settings_plan(config if config is not None else default_study_path(), settings or ()),
-        source,
-        (),
-    )
+    request = make_request("run", config, settings=settings or ())
     run_request(
         request,
         out or RESULTS / request.plan.base.name,

@@ -9,7 +9,6 @@ from typing import Annotated
 import typer
 
 from foldopt.cli.options import (
-    EMBEDDED,
     RESULTS,
     OutputFormat,
     Overwrite,
@@ -111,8 +110,7 @@ def size(
     output_format, _ = check_choices(output_format, "numba")
     output = Output(quiet, output_format, table)
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
-    from foldopt.inputs.study_file import default_study_path
-    from foldopt.studies.request import settings_plan, size_request, sizing_problems
+    from foldopt.studies.request import make_request, sizing_problems
 
     if storage or target_h is not None or weather is not None:
         # The panel's costs size the panel, not its buffer: said, never ignored.
@@ -130,37 +128,39 @@ def size(
         _size_buffer(config, target_h, storage, settings, weather, out, overwrite, output)
         return
 
-    errors = sizing_problems(
-        {
-            "cost_per_m2": cost_per_m2,
-            "cost_per_w": cost_per_w,
-            "c_grid_usd_per_kwh": c_grid,
-            "years": years,
-            "days_per_year": days_per_year,
-        }
-    )
+    costs = {
+        "cost_per_m2": cost_per_m2,
+        "cost_per_w": cost_per_w,
+        "c_grid_usd_per_kwh": c_grid,
+        "years": years,
+        "days_per_year": days_per_year,
+    }
+    errors = sizing_problems(costs)
     if errors:
         fail([_sizing_option(line) for line in errors])
-    plan = settings_plan(config if config is not None else default_study_path(), settings or ())
-    request = size_request(
-        plan,
-        EMBEDDED if config is None else str(config),
-        cost_per_m2 is not None or cost_per_w is not None,
-    )
-    study = plan.base
+    try:
+        request = make_request("size", config, settings=settings or (), costs=costs)
+    except ConfigError as error:
+        fail(list(dict.fromkeys(error.errors)))
+    study = request.plan.base
     out = out or RESULTS / f"{study.name}-sizing"
     check_output(out, overwrite)
     from foldopt.api import size as size_panel, write
 
     try:
         with output.progress(f"sizing {study.name}"):
-            result = size_panel(
-                study, areas, cost_per_m2, cost_per_w, c_grid, years, days_per_year, request=request
-            )
+            result = size_panel(areas=areas, request=request, **_parameters(costs))
             write(result, out, overwrite, INVOCATION)
     except ConfigError as error:
         fail([_sizing_option(line) for line in error.errors])
     output.answer("size", out, result.answer, result.table, [f"wrote {out}"], result.table)
+
+
+def _parameters(costs: dict) -> dict:
+    """The sizing's parameters as :func:`foldopt.size` names them."""
+    return {
+        ("c_grid" if name == "c_grid_usd_per_kwh" else name): value for name, value in costs.items()
+    }
 
 
 def _size_buffer(config, target_h, storage, settings, weather, out, overwrite, output):
@@ -169,39 +169,23 @@ def _size_buffer(config, target_h, storage, settings, weather, out, overwrite, o
     its answer is the day's, or over a weather file's year (``--weather`` or the study's, with
     its objective, else the mean) the annual one (:mod:`foldopt.studies.storage_answer`)."""
     from foldopt.cli.run import run_request
-    from foldopt.inputs.study_file import default_study_path, read_study
-    from foldopt.studies.request import Request, parse_setting, plan_request, settings_plan
+    from foldopt.studies.request import make_request
 
     if not storage and weather is not None:
         fail(["--weather: sizes a buffer over the file's year; give --storage --target-h H"])
     if not storage or target_h is None:
         fail(["--storage and --target-h go together: --target-h is the hours a day, in (0, 24]"])
-    path = config if config is not None else default_study_path()
-    source = EMBEDDED if config is None else str(config)
-    given = list(settings or ())
-    own = [setting for setting in given if not setting.startswith("storage")]
-    sized = any(s.startswith(("storage=", "storage.capacity_wh=")) for s in given)
-    data = read_study(path)[0]
-    if weather is not None or data.get("weather") is not None:
-        # A weather year: the file's site and days, one fold angle for them (the annual group).
-        changes = dict(parse_setting(setting) for setting in given)
-        if weather is not None:
-            changes["weather"] = {"path": str(weather)}
-        if data.get("objective") is None and not any(k.startswith("objective") for k in changes):
-            changes["objective"] = {"statistic": "mean"}
-        if not sized and data.get("storage") is None:
-            changes["storage.capacity_wh"] = 0.0
-        changes["storage.target.powered_h"] = target_h
-        request = plan_request(data, changes, source=source, name=f"{data.get('name')}-buffer")
-        out = out or RESULTS / request.plan.base.name
-        run_request(request, out, overwrite, output, "auto", "size")
-        return
-    if not sized and settings_plan(path, own).base.storage is None:
-        given.insert(0, "storage.capacity_wh=0")
-    plan = settings_plan(path, [*given, f"storage.target.powered_h={target_h!r}"])
-    request = Request(plan, source, ())
-    out = out or RESULTS / f"{plan.base.name}-buffer"
-    run_request(request, out, overwrite, output, "auto", "size")
+    try:
+        request = make_request(
+            "size --storage",
+            config,
+            options={"weather": weather},
+            settings=settings or (),
+            target_h=target_h,
+        )
+    except ConfigError as error:
+        fail(list(dict.fromkeys(error.errors)))
+    run_request(request, out or RESULTS / request.plan.base.name, overwrite, output, "auto", "size")
 
 
 #: The commands of this module: name, function, and the line the command list shows.

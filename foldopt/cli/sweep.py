@@ -29,7 +29,6 @@ from foldopt.cli.options import (
     Table,
     check_choices,
     out_option,
-    rename_fields,
     StepMin,
 )
 from foldopt.cli.output import Output, fail
@@ -396,15 +395,13 @@ def _sweep(axis: str, options: dict) -> None:
     output_format, engine = check_choices(options.pop("output_format"), options.pop("engine"))
     output = Output(options.pop("quiet"), output_format, options.pop("table"))
     out, overwrite = options.pop("out"), options.pop("overwrite")
-    config = options.pop("config")
-    # Of the options that set one field (--p-load, --p-load-scale), a message names the one given.
-    options_of = names.option_labels({name for name, value in options.items() if value is not None})
-    from foldopt.studies.request import sweep_request  # the study's modules once a command runs
+    config, settings = options.pop("config"), options.pop("settings") or ()
+    from foldopt.studies.request import make_request  # the study's modules once a command runs
 
     try:
-        request = sweep_request(config, options, axis, EMBEDDED if config is None else str(config))
+        request = make_request(f"sweep {axis}", config, options=options, settings=settings)
     except ConfigError as error:
-        fail(list(dict.fromkeys(rename_fields(line, options_of) for line in error.errors)))
+        fail(list(dict.fromkeys(error.errors)))
     run_request(
         request, out or RESULTS / f"sweep-{axis}", overwrite, output, engine, f"sweep {axis}"
     )

@@ -1,13 +1,14 @@
 """``foldopt weather fetch | list | path``: the cache of weather fetched from public services
 (:mod:`foldopt.inputs.weather.sources`). Fetch a site ahead of a field trip, list what is cached,
 and give a cached answer's file (or a copy of it, a standard weather file to keep beside a study).
+Each takes ``--quiet`` and ``--format json`` as every command does, and checks the site and every
+option before anything is asked.
 """
 
 from __future__ import annotations
 
 import json
 import os
-import re
 import shutil
 from pathlib import Path
 from typing import Annotated
@@ -15,9 +16,9 @@ from typing import Annotated
 import typer
 
 from foldopt import names
-from foldopt.cli.options import OutputFormat, Overwrite, Quiet
-from foldopt.cli.output import echo, fail
-from foldopt.errors import ConfigError
+from foldopt.cli.options import OutputFormat, Overwrite, Quiet, rename_fields
+from foldopt.cli.output import Output, as_text, echo, fail
+from foldopt.errors import ConfigError, redacted
 
 #: The weather group's help and its line in the command list.
 HELP = (
@@ -54,26 +55,20 @@ Url = Annotated[
 ]
 Timeout = Annotated[
     float | None,
-    typer.Option("--timeout", help="Seconds to wait for the service [default: 30]."),
+    typer.Option(
+        "--timeout",
+        help="Seconds to wait at most for the service's whole answer (connecting, every read, "
+        "every retry) [default: 30].",
+    ),
 ]
-
-
-def _options(source, years, no_horizon, url, timeout) -> dict:
-    """The source's options, checked as a study's ``weather`` section checks them."""
-    from pydantic import ValidationError
-
-    from foldopt.inputs.study import format_errors
-    from foldopt.inputs.weather_section import Weather
-
-    given = {"source": source, "years": years, "url": url, "timeout_s": timeout}
-    given = {key: value for key, value in given.items() if value is not None}
-    if no_horizon:
-        given["usehorizon"] = False
-    try:
-        return Weather.model_validate(given)
-    except ValidationError as error:
-        fail(_labelled(format_errors(error)))
-
+Database = Annotated[
+    str | None,
+    typer.Option(
+        "--raddatabase",
+        help="pvgis-hourly's radiation database (PVGIS-SARAH3, PVGIS-ERA5) [default: PVGIS's "
+        "for the site].",
+    ),
+]
 
 #: A source's option as the commands name it.
 _LABELS = {
@@ -82,12 +77,63 @@ _LABELS = {
     "url": "--url",
     "timeout_s": "--timeout",
     "usehorizon": "--no-horizon",
+    "raddatabase": "--raddatabase",
+    "site.latitude": "--lat",
+    "site.longitude": "--lon",
 }
 
 
-def _labelled(lines: list[str]) -> list[str]:
-    """Validation's lines, each field named as the command's option."""
-    return [re.sub(r"^\w+", lambda found: _LABELS.get(found[0], found[0]), line) for line in lines]
+def _checked(
+    output_format: str,
+    source: str | None = None,
+    lat=None,
+    lon=None,
+    years=None,
+    no_horizon=False,
+    raddatabase=None,
+    url=None,
+    timeout=None,
+):
+    """``--format``, the site and the source's options (where a source is given), each checked as
+    a study's sections check them before anything is asked: every fault one line, then the
+    command ends.
+
+    Returns
+    -------
+    tuple
+        The canonical format and the ``weather`` section
+        (:class:`foldopt.inputs.weather_section.Weather`), or None without a source.
+    """
+    from pydantic import ValidationError
+
+    from foldopt.inputs.study import format_errors
+    from foldopt.inputs.weather.sources import site_problems
+    from foldopt.inputs.weather_section import Weather
+
+    errors, spec = [], None
+    try:
+        output_format = names.canonical(output_format, names.OUTPUT_FORMATS)
+    except ValueError as error:
+        errors.append(f"--format = {output_format!r}: {error}")
+    if source is not None:
+        errors += site_problems(lat, lon)
+        given = {
+            "source": source,
+            "years": years,
+            "raddatabase": raddatabase,
+            "url": url,
+            "timeout_s": timeout,
+        }
+        given = {key: value for key, value in given.items() if value is not None}
+        if no_horizon:
+            given["usehorizon"] = False
+        try:
+            spec = Weather.model_validate(given)
+        except ValidationError as error:
+            errors += format_errors(error)
+    if errors:
+        fail([redacted(rename_fields(line, _LABELS)) for line in errors])
+    return output_format, spec
 
 
 def fetch(
@@ -96,6 +142,7 @@ def fetch(
     lon: Lon = ...,
     years: Years = None,
     no_horizon: NoHorizon = False,
+    raddatabase: Database = None,
     url: Url = None,
     timeout: Timeout = None,
     quiet: Quiet = False,
@@ -111,15 +158,17 @@ def fetch(
       foldopt weather fetch pvgis-hourly --lat 45.8 --lon 8.6 --years 2020:2021
       foldopt weather fetch pvgis-tmy --lat 45.8 --lon 8.6 --format json
     """
-    output_format = _format(output_format)
-    spec = _options(source, years, no_horizon, url, timeout)
+    output_format, spec = _checked(
+        output_format, source, lat, lon, years, no_horizon, raddatabase, url, timeout
+    )
+    output = Output(quiet, output_format)
     from foldopt.inputs.weather.sources import fetch as fetch_source
 
     try:
         found = fetch_source(spec.source, lat, lon, spec)
     except ConfigError as error:
         fail(error.errors)
-    if output_format == "json":
+    if output.json:
         echo(json.dumps(found.to_dict(), indent=2))
     elif not quiet:
         echo(f"{found.source} ({found.params['lat']:g}, {found.params['lon']:g}): {found.file}")
@@ -127,20 +176,27 @@ def fetch(
         echo(f"  from {found.url}")
 
 
-def list_cache(output_format: OutputFormat = "table"):
-    """List the cached weather: source, site, options, when it was retrieved, its file.
+def list_cache(quiet: Quiet = False, output_format: OutputFormat = "table"):
+    """List the cached weather: source, site, options, when it was retrieved, its file. A
+    damaged cached answer is named on stderr (fetch it again to replace it).
 
     \b
     Examples:
       foldopt weather list
       foldopt weather list --format json
     """
-    output_format = _format(output_format)
-    from foldopt.inputs.weather.sources import cached_entries, weather_cache
+    output_format, _ = _checked(output_format)
+    output = Output(quiet, output_format)
+    from foldopt.cache import notice
+    from foldopt.inputs.weather.sources import cached_entries, damaged_entries, weather_cache
 
     entries = cached_entries()
-    if output_format == "json":
+    for path, why in damaged_entries():
+        notice(f"the cached copy {path} is damaged ({why}); foldopt weather fetch replaces it")
+    if output.json:
         echo(json.dumps([entry.to_dict() for entry in entries], indent=2))
+        return
+    if quiet:
         return
     if not entries:
         echo(f"no cached weather in {weather_cache()}")
@@ -166,6 +222,7 @@ def path(
     lon: Lon = ...,
     years: Years = None,
     no_horizon: NoHorizon = False,
+    raddatabase: Database = None,
     url: Url = None,
     out: Annotated[
         Path | None,
@@ -177,26 +234,43 @@ def path(
         ),
     ] = None,
     overwrite: Overwrite = False,
+    quiet: Quiet = False,
+    output_format: OutputFormat = "table",
 ):
-    """The cached file of a site's weather (nothing is fetched), or a copy of it with --out.
+    """The cached file of a site's weather (nothing is fetched), or a copy of it with --out;
+    --format json: the cached answer's provenance record (and ``out``, the copy).
 
     \b
     Examples:
       foldopt weather path pvgis-tmy --lat 45.8 --lon 8.6
       foldopt weather path pvgis-tmy --lat 45.8 --lon 8.6 --out site-tmy.json
     """
-    spec = _options(source, years, no_horizon, url, None)
-    from foldopt.cache import offline_mode
-    from foldopt.inputs.weather.sources import fetch as fetch_source
+    output_format, spec = _checked(
+        output_format, source, lat, lon, years, no_horizon, raddatabase, url
+    )
+    output = Output(quiet, output_format)
+    from foldopt.inputs.weather.sources import lookup
 
     try:
-        with offline_mode():
-            found = fetch_source(spec.source, lat, lon, spec)
+        found = lookup(spec.source, lat, lon, spec)
     except ConfigError as error:
         fail(error.errors)
-    if out is None:
-        echo(found.file)
+    record = found.to_dict()
+    if out is not None:
+        _copy_out(found.file, out, overwrite)
+        record["out"] = as_text(str(out))
+    if output.json:
+        echo(json.dumps(record, indent=2))
+    elif quiet:
         return
+    elif out is None:
+        echo(found.file)
+    else:
+        echo(f"wrote {out} ({found.source}, sha256 {found.sha256})")
+
+
+def _copy_out(file: str, out: Path, overwrite: bool) -> None:
+    """Copy a cached answer to ``--out``; a fault ends the command."""
     if out.exists() and not overwrite:
         fail([f"--out {out}: exists; pass --overwrite to replace it"])
     if out.exists() and not out.is_file():
@@ -204,18 +278,9 @@ def path(
     from foldopt.cache import write_atomically
 
     try:
-        write_atomically(out, lambda temporary: _copy(found.file, temporary))
+        write_atomically(out, lambda temporary: _copy(file, temporary))
     except OSError as error:
         fail([f"--out {out}: cannot be written ({error.strerror or error})"])
-    echo(f"wrote {out} ({found.source}, sha256 {found.sha256})")
-
-
-def _format(output_format: str) -> str:
-    """``--format`` as the registry names it; a bad one ends the command."""
-    try:
-        return names.canonical(output_format, names.OUTPUT_FORMATS)
-    except ValueError as error:
-        fail([f"--format = {output_format!r}: {error}"])
 
 
 def _copy(source: str, target: Path) -> None:

@@ -24,6 +24,13 @@ hysteresis), which is checked at the start of each part; while it is off, all th
 buffer. Self-discharge takes ``(1 - self_discharge) ** (tau / 24)`` of the content at the end of
 each segment of ``tau`` hours (``self_discharge`` a day).
 
+A design's own draw (``draw``: a tracker's standby and drive) is a load on the controller's
+output beside the device's: the power the design leaves after it is what is compared with the
+load (where :func:`foldopt.engine.metrics.t_solar` compares a tracker's net curve), the buffer
+covers its deficit with the load's, and the controller cuts it off and reconnects it with the
+load; while they are off, the design's whole power charges the buffer. (A tracker whose drive is
+off holds still; the power it would then lose is not modelled.)
+
 Conventions that follow from it:
 
 - With ``capacity_wh = 0`` the load runs exactly in the parts at or above the load: the powered
@@ -38,10 +45,10 @@ Conventions that follow from it:
   energy of the load over those edge segments is served or missing all the same).
 - The load reconnects only at a part's start (at most a step apart), so a cut-off late in a part
   keeps it off to the part's end.
-- Power below zero (a tracker net of its drive) is run from the buffer while the load is on, as
-  part of the deficit; while the load is off the controller disconnects it too, and it is counted
-  nowhere. Energy is therefore conserved for curves that do not go below zero:
-  ``served + lost + delta stored + conversion losses + self-discharge = harvested``.
+- Energy is conserved, each day of every series, to the sums' rounding: ``harvested = served +
+  drawn + lost + delta stored + conversion losses + self-discharge``, ``drawn`` the design's own
+  draw served. Power is never below zero: a design's own draw is ``draw``, not a curve's
+  negative part (which a controller with its load off would have nowhere to take from).
 - Days *full* and *empty* are PVGIS's [1]_: days on which the buffer was full at some instant
   (never with no capacity), and days on which it was down to its cut-off at some instant (at
   midnight, or when it ran out under the load; with no capacity, every day).
@@ -136,9 +143,12 @@ class StorageResult(NamedTuple):
     lost_wh : (n_series, n_days) float
         PV energy neither served nor taken into the buffer (full, or over ``max_charge_w``).
     harvested_wh : (n_series, n_days) float
-        The curve's energy (:func:`foldopt.engine.metrics.energy`, summed in step order).
+        The curve's energy (:func:`foldopt.engine.metrics.energy`, summed in step order), before
+        the design's own draw.
     charge_loss_wh, discharge_loss_wh, self_discharge_wh : (n_series, n_days) float
         Conversion losses into and out of the buffer, and its leak.
+    drawn_wh : (n_series, n_days) float
+        The design's own draw served (a tracker's drive; 0 without one).
     full, empty : (n_series, n_days) bool
         PVGIS's days full and empty (module docstring).
     soc_hours : (n_series, n_days, SOC_BINS) float
@@ -163,6 +173,7 @@ class StorageResult(NamedTuple):
     charge_loss_wh: np.ndarray
     discharge_loss_wh: np.ndarray
     self_discharge_wh: np.ndarray
+    drawn_wh: np.ndarray
     full: np.ndarray
     empty: np.ndarray
     soc_hours: np.ndarray
@@ -215,15 +226,17 @@ def simulate(
     soc_curves: bool = False,
     max_iterations: int = 30,
     tolerance: float = 1e-6,
+    draw=None,
 ) -> StorageResult:
     """Simulate the state of charge of a buffer over power curves and a load.
 
     Parameters
     ----------
     power : array_like
-        Power at step centres [W], (n_series, n_days, n_steps), or (n_series, n_steps) for one day
-        (repeated until periodic by default). Each series is sequential over its days. One curve
-        (n_series 1) serves every series of the load or the buffer.
+        Power at step centres [W], 0 or more, (n_series, n_days, n_steps), or (n_series, n_steps)
+        for one day (repeated until periodic by default): the design's whole power, before its own
+        ``draw``. Each series is sequential over its days. One curve (n_series 1) serves every
+        series of the load or the buffer.
     load : float or array_like
         Load [W], 0 or more: a float; (n_series,) one per series; (n_series or 1, n_steps) a daily
         profile; or (n_series or 1, n_days or 1, n_steps or 1).
@@ -240,6 +253,10 @@ def simulate(
         Passes allowed to find the periodic state.
     tolerance : float, default 1e-6
         The periodic state's content is that at the end within ``tolerance x capacity_wh``.
+    draw : float or array_like, optional
+        The design's own draw [W], 0 or more, shaped as ``load`` may be or as ``power``: a
+        tracker's standby and drive, a load on the controller's output beside ``load``
+        (module docstring). Default none.
 
     Returns
     -------
@@ -249,7 +266,7 @@ def simulate(
     ------
     ValueError
         An unknown ``engine``, a field of ``buffer`` out of range (named), power that is not
-        finite, a negative load, or shapes that do not fit.
+        finite or below 0, a negative load or draw, or shapes that do not fit.
     """
     if engine not in STORAGE_ENGINES:
         raise ValueError(f"engine must be one of {', '.join(STORAGE_ENGINES)}; got {engine!r}")
@@ -260,12 +277,16 @@ def simulate(
         raise ValueError(
             f"power must be (n_series, n_days, n_steps) or (n_series, n_steps); got {power.shape}"
         )
-    if not np.isfinite(power).all():
-        raise ValueError("power must be finite")
-    power = np.ascontiguousarray(power)
-    load = _load_array(load, power.shape)
+    if not (np.isfinite(power).all() and (power >= 0).all()):
+        raise ValueError("power must be finite and 0 or more (a design's own draw goes in draw)")
+    load = _load_array(load, power.shape, "load")
+    own = _load_array(0.0 if draw is None else draw, power.shape, "draw")
+    # The kernel compares the power the design leaves after its own draw with the load (as
+    # t_solar does a tracker's net curve: the same difference, to the bit).
+    power = np.ascontiguousarray(power if draw is None else power - own)
     # One power curve, load or buffer may serve every series (a sizing search's capacities).
-    sizes = [power.shape[0], load.shape[0]] + [np.size(v) for v in buffer if v is not None]
+    sizes = [power.shape[0], load.shape[0], own.shape[0]]
+    sizes += [np.size(v) for v in buffer if v is not None]
     n_series = max(sizes)
     if any(size not in (1, n_series) for size in sizes):
         raise ValueError(
@@ -281,34 +302,12 @@ def simulate(
     state = np.zeros((n_series, n_days + 1, 2))
     soc = np.zeros((n_series, n_days, n_steps) if soc_curves else (1, 1, 1))
     passes = np.zeros(n_series, dtype=np.int64)
-    if engine == "numba":
-        kern.simulate_series(
-            power,
-            load,
-            params,
-            float(step_hours),
-            out,
-            state,
-            bool(soc_curves),
-            soc,
-            passes,
-            int(max_iterations),
-            float(tolerance),
-        )
-    else:
-        _simulate_numpy(
-            power,
-            load,
-            params,
-            step_hours,
-            out,
-            state,
-            soc_curves,
-            soc,
-            passes,
-            max_iterations,
-            tolerance,
-        )  # fmt: skip: one call's arguments, not a list
+    # The compiled loop takes every argument with the one type it was compiled for.
+    run = kern.simulate_series if engine == "numba" else _simulate_numpy
+    run(
+        power, load, own, params, float(step_hours), out, state, bool(soc_curves), soc, passes,
+        int(max_iterations), float(tolerance),
+    )  # fmt: skip
     return StorageResult(
         out[..., kern.POWERED],
         out[..., kern.SERVED],
@@ -318,6 +317,7 @@ def simulate(
         out[..., kern.CHARGE_LOSS],
         out[..., kern.DISCHARGE_LOSS],
         out[..., kern.SELF_DISCHARGE],
+        out[..., kern.DRAWN],
         out[..., kern.FULL] > 0.5,
         out[..., kern.EMPTY] > 0.5,
         out[..., kern.HISTOGRAM :],
@@ -327,9 +327,9 @@ def simulate(
     )
 
 
-def _load_array(load, shape):
-    """The load as (n_series or 1, n_days or 1, n_steps or 1), contiguous (the series are checked
-    by the caller)."""
+def _load_array(load, shape, name):
+    """The load (or a design's own draw, ``name``) as (n_series or 1, n_days or 1, n_steps or 1),
+    contiguous (the series are checked by the caller)."""
     load = np.asarray(load, dtype=float)
     if load.ndim == 0:
         load = load.reshape(1, 1, 1)
@@ -342,11 +342,11 @@ def _load_array(load, shape):
     )
     if not fits:
         raise ValueError(
-            f"load must be a float, (n_series,), (n_series, n_steps) or (n_series, n_days, "
+            f"{name} must be a float, (n_series,), (n_series, n_steps) or (n_series, n_days, "
             f"n_steps), each size 1 or full, for power of {shape}; got {np.shape(load)}"
         )
     if not (np.isfinite(load).all() and (load >= 0).all()):
-        raise ValueError("load must be finite and 0 or more")
+        raise ValueError(f"{name} must be finite and 0 or more")
     return np.ascontiguousarray(load)
 
 
@@ -437,7 +437,8 @@ def _charge_numpy(charging, stored, spare, limit, par, row):
 def _time_to_draw(da, db, tau, energy):
     """:func:`foldopt.engine.storage_kernel.time_to_draw` over arrays."""
     da, db = np.maximum(da, 0.0), np.maximum(db, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    # Series whose part this is not (the caller's mask) may overflow or divide by zero.
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         slope = 0.5 * (db - da) / tau
         root = np.sqrt(np.maximum(da * da + 4.0 * slope * energy, 0.0))
         return np.where(
@@ -447,12 +448,13 @@ def _time_to_draw(da, db, tau, energy):
         )
 
 
-def _part_numpy(pa, pb, la, lb, tau, surplus, demand, stored, on, par, row):
+def _part_numpy(pa, pb, la, lb, da, db, tau, surplus, demand, stored, on, par, row):
     """:func:`foldopt.engine.storage_kernel._part` over arrays of series."""
     active = tau > 0.0
     capacity = par[:, kern.CAPACITY]
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
+    own = 0.5 * tau * (da + db)
     on = on | (active & (stored >= par[:, kern.RESTART_SOC] * capacity))
     run = active & on & surplus
     floor = par[:, kern.MIN_SOC] * capacity
@@ -471,44 +473,56 @@ def _part_numpy(pa, pb, la, lb, tau, surplus, demand, stored, on, par, row):
     cut = active & on & ~surplus & ~covered
     off = active & ~on | cut
     whole = run | covered
-    drawn = short / eta_d
+    taken = short / eta_d
     ran = _time_to_draw(la - pa, lb - pb, tau, eta_d * usable)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    # Only the series that run out part of the way (partial) keep what follows.
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         x = ran / tau
-    pm, lm = pa + x * (pb - pa), la + x * (lb - la)
-    row[:, kern.SERVED] += np.where(whole, need, np.where(partial, 0.5 * ran * (la + lm), 0.0))
+        pm, lm, dm = pa + x * (pb - pa), la + x * (lb - la), da + x * (db - da)
+        ran_served, ran_drawn = 0.5 * ran * (la + lm), 0.5 * ran * (da + dm)
+    row[:, kern.SERVED] += np.where(whole, need, np.where(partial, ran_served, 0.0))
+    row[:, kern.DRAWN] += np.where(whole, own, np.where(partial, ran_drawn, 0.0))
     ran = np.where(whole, tau, np.where(partial, ran, 0.0))
     row[:, kern.POWERED] += np.where(demand, ran, 0.0)
     row[:, kern.DISCHARGE_LOSS] += np.where(
-        covered, drawn - short, np.where(partial, usable - eta_d * usable, 0.0)
+        covered, taken - short, np.where(partial, usable - eta_d * usable, 0.0)
     )
-    stored = np.where(covered, stored - drawn, np.where(partial, floor, stored))
-    pa, la = np.where(partial, pm, pa), np.where(partial, lm, la)
+    stored = np.where(covered, stored - taken, np.where(partial, floor, stored))
+    pa, la, da = np.where(partial, pm, pa), np.where(partial, lm, la), np.where(partial, dm, da)
     tau = np.where(partial, tau - ran, tau)
     need = np.where(partial, 0.5 * tau * (la + lb), need)
     on = on & ~cut
     row[:, kern.EMPTY] = np.where(cut & (stored <= floor), 1.0, row[:, kern.EMPTY])
     row[:, kern.MISSING] += np.where(off, need, 0.0)
     max_c = par[:, kern.MAX_CHARGE]
+    # Off, the controller has the load and the design's own draw off: the whole power charges.
+    whole_a, whole_b = pa + da, pb + db
     spare = np.where(
-        run, np.maximum(pv - need, 0.0), np.where(off, _clipped_energy(pa, pb, tau, np.inf), 0.0)
+        run,
+        np.maximum(pv - need, 0.0),
+        np.where(off, _clipped_energy(whole_a, whole_b, tau, np.inf), 0.0),
     )
     limit = np.where(
         run,
         _clipped_energy(pa - la, pb - lb, tau, max_c),
-        np.where(off, _clipped_energy(pa, pb, tau, max_c), 0.0),
+        np.where(off, _clipped_energy(whole_a, whole_b, tau, max_c), 0.0),
     )
     return _charge_numpy(run | off, stored, spare, limit, par, row), on
 
 
-def _segments(power, load, step_hours):
+def _segments(power, load, draw, step_hours):
     """Each day's segments and their two parts, over whole arrays (n_series, n_days, n_steps + 1):
-    the part with the power at or above the load and the one below it, in their order."""
-    load = np.broadcast_to(load, power.shape)
-    p0 = np.concatenate([power[..., :1], power], axis=-1)
-    p1 = np.concatenate([power, power[..., -1:]], axis=-1)
-    l0 = np.concatenate([load[..., :1], load], axis=-1)
-    l1 = np.concatenate([load, load[..., -1:]], axis=-1)
+    the part with the power (less the design's own draw) at or above the load and the one below
+    it, in their order."""
+
+    def ends(curve):
+        curve = np.broadcast_to(curve, power.shape)
+        return (
+            np.concatenate([curve[..., :1], curve], axis=-1),
+            np.concatenate([curve, curve[..., -1:]], axis=-1),
+        )
+
+    (p0, p1), (l0, l1), (d0, d1) = ends(power), ends(load), ends(draw)
     half = np.zeros(p0.shape[-1], dtype=bool)
     half[[0, -1]] = True
     tau = np.where(half, 0.5 * step_hours, step_hours)
@@ -519,17 +533,18 @@ def _segments(power, load, step_hours):
     rising = e0 < 0.0  # below the load first
     split = np.where(rising, 1.0 - above, above)
     ps, ls = p0 + split * (p1 - p0), l0 + split * (l1 - l0)
+    ds = d0 + split * (d1 - d0)
     t_above, t_below = tau * above, tau * (1.0 - above)
-    first = (p0, ps, l0, ls, np.where(rising, t_below, t_above), ~rising)
-    second = (ps, p1, ls, l1, np.where(rising, t_above, t_below), rising)
+    first = (p0, ps, l0, ls, d0, ds, np.where(rising, t_below, t_above), ~rising)
+    second = (ps, p1, ls, l1, ds, d1, np.where(rising, t_above, t_below), rising)
     return first, second, (l0 > 0.0) & (l1 > 0.0), half
 
 
-def _run_numpy(power, load, par, step_hours, stored, on, out, state, soc_curves, soc):
+def _run_numpy(power, load, draw, par, step_hours, stored, on, out, state, soc_curves, soc):
     """One pass over the days of a set of series (:func:`foldopt.engine.storage_kernel._run`
     without merging), the steps in turn and the series at once."""
     n_days, n_steps = power.shape[1:]
-    first, second, demand, half = _segments(power, load, step_hours)
+    first, second, demand, half = _segments(power, load, draw, step_hours)
     capacity = par[:, kern.CAPACITY]
     n_bins = out.shape[-1] - kern.HISTOGRAM
     series = np.arange(power.shape[0])
@@ -545,9 +560,7 @@ def _run_numpy(power, load, par, step_hours, stored, on, out, state, soc_curves,
         for j in range(n_steps + 1):
             for part in (first, second):
                 stored, on = _part_numpy(
-                    *(a[:, d, j] for a in part[:4]),
-                    part[4][:, d, j],
-                    part[5][:, d, j],
+                    *(a[:, d, j] for a in part[:8]),
                     demand[:, d, j],
                     stored,
                     on,
@@ -563,21 +576,24 @@ def _run_numpy(power, load, par, step_hours, stored, on, out, state, soc_curves,
             row[series, kern.HISTOGRAM + bins] += 0.5 * step_hours if half[j] else step_hours
             if soc_curves and j < n_steps:
                 soc[:, d, j] = level
-        row[:, kern.HARVESTED] = np.cumsum(power[:, d], axis=-1)[:, -1] * step_hours
+        whole = power[:, d] + np.broadcast_to(draw, power.shape)[:, d]
+        row[:, kern.HARVESTED] = np.cumsum(whole, axis=-1)[:, -1] * step_hours
     on = on | (stored >= restart)
     state[:, n_days, 0], state[:, n_days, 1] = stored, on
     return stored, on
 
 
 def _simulate_numpy(
-    power, load, params, step_hours, out, state, soc_curves, soc, passes, max_iterations, tolerance
-):
+    power, load, draw, params, step_hours, out, state, soc_curves, soc, passes, max_iterations,
+    tolerance,
+):  # fmt: skip
     """:func:`foldopt.engine.storage_kernel.simulate_series` over arrays of series, each series's
     passes as :func:`foldopt.engine.storage_kernel._series` runs them."""
     n_series = out.shape[0]
     power = np.broadcast_to(power, (n_series, *power.shape[1:]))
     par = np.broadcast_to(params, (n_series, params.shape[1]))
     load = np.broadcast_to(load, (n_series, *load.shape[1:]))
+    draw = np.broadcast_to(draw, (n_series, *draw.shape[1:]))
     capacity = par[:, kern.CAPACITY]
     given = ~np.isnan(par[:, kern.INITIAL_SOC])
     stored = np.where(given, par[:, kern.INITIAL_SOC] * capacity, capacity)
@@ -592,6 +608,7 @@ def _simulate_numpy(
         end, end_on = _run_numpy(
             power[pick],
             load[pick],
+            draw[pick],
             par[pick],
             step_hours,
             stored[pick],

@@ -27,7 +27,8 @@ N_PARAMETERS = 10
 # Columns of a day's outputs; the state-of-charge histogram follows from HISTOGRAM on.
 POWERED, SERVED, MISSING, LOST, HARVESTED = 0, 1, 2, 3, 4
 CHARGE_LOSS, DISCHARGE_LOSS, SELF_DISCHARGE, FULL, EMPTY = 5, 6, 7, 8, 9
-HISTOGRAM = 10
+DRAWN = 10
+HISTOGRAM = 11
 
 #: Plain fixed-point iterations (the buffer's own year after year) before the periodic state is
 #: bisected instead (a state that drifts by a little a day would take many plain ones).
@@ -89,18 +90,21 @@ def time_to_draw(da, db, tau, energy):
 
 
 @njit(cache=True, error_model="numpy")
-def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
-    """One part of a segment, in which the power runs from ``pa`` to ``pb`` and the load from
-    ``la`` to ``lb`` [W] over ``tau`` [h] (``tau`` > 0), the power at or above the load
-    throughout (``surplus``) or below it.
+def _part(pa, pb, la, lb, da, db, tau, surplus, stored, on, par):
+    """One part of a segment, in which the power left after the design's own draw runs from
+    ``pa`` to ``pb``, the load from ``la`` to ``lb`` and that draw from ``da`` to ``db`` [W] over
+    ``tau`` [h] (``tau`` > 0), the power at or above the load throughout (``surplus``) or below
+    it.
 
     Returns the buffer's content [Wh], whether the load is on, the part's energies [Wh] served,
     missing, lost, lost in charging and in discharging, the hours the load ran, whether the
-    buffer was full, and whether it ran down to its cut-off. Scalars only, so that the call
-    moves no array (numba counts references to arrays passed to a function)."""
+    buffer was full, whether it ran down to its cut-off, and the design's own draw served [Wh].
+    Scalars only, so that the call moves no array (numba counts references to arrays passed to
+    a function)."""
     capacity = par[CAPACITY]
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
+    own = 0.5 * tau * (da + db)
     if not on and stored >= par[RESTART_SOC] * capacity:
         on = True
     if on and surplus:
@@ -108,8 +112,8 @@ def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
         stored, loss, lost, full = _charge(
             stored, max(pv - need, 0.0), limit, capacity, par[ETA_CHARGE]
         )
-        return stored, on, need, 0.0, lost, loss, 0.0, tau, full, False
-    served = ran = discharge_loss = 0.0
+        return stored, on, need, 0.0, lost, loss, 0.0, tau, full, False, own
+    served = ran = discharge_loss = drawn = 0.0
     empty = False
     if on:
         floor = par[MIN_SOC] * capacity
@@ -118,28 +122,32 @@ def _part(pa, pb, la, lb, tau, surplus, stored, on, par):
         if usable > 0.0 and max(la - pa, lb - pb) <= par[MAX_DISCHARGE]:
             short = max(need - pv, 0.0)
             if short <= eta * usable:
-                drawn = short / eta
-                return stored - drawn, on, need, 0.0, 0.0, 0.0, drawn - short, tau, False, False
+                taken = short / eta
+                left = stored - taken
+                return left, on, need, 0.0, 0.0, 0.0, taken - short, tau, False, False, own
             # The buffer carries the load part of the way, to its cut-off; the rest is off.
             ran = time_to_draw(la - pa, lb - pb, tau, eta * usable)
             x = ran / tau
-            pm, lm = pa + x * (pb - pa), la + x * (lb - la)
+            pm, lm, dm = pa + x * (pb - pa), la + x * (lb - la), da + x * (db - da)
             served = 0.5 * ran * (la + lm)
+            drawn = 0.5 * ran * (da + dm)
             discharge_loss = usable - eta * usable
             stored = floor
-            pa, la, tau = pm, lm, tau - ran
+            pa, la, da, tau = pm, lm, dm, tau - ran
             need = 0.5 * tau * (la + lb)
         on = False
         empty = stored <= floor  # not when only max_discharge_w turned the load off
-    spare = clipped_energy(pa, pb, tau, math.inf)
-    limit = clipped_energy(pa, pb, tau, par[MAX_CHARGE])
+    # The controller has the load and the design's own draw off: the whole power charges.
+    spare = clipped_energy(pa + da, pb + db, tau, math.inf)
+    limit = clipped_energy(pa + da, pb + db, tau, par[MAX_CHARGE])
     stored, loss, lost, full = _charge(stored, spare, limit, capacity, par[ETA_CHARGE])
-    return stored, on, served, need, lost, loss, discharge_loss, ran, full, empty
+    return stored, on, served, need, lost, loss, discharge_loss, ran, full, empty, drawn
 
 
 @njit(cache=True, error_model="numpy")
-def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, soc):
-    """One pass over a series' days from the content ``stored`` [Wh] and load state ``on``.
+def _run(power, load, draw, par, step_hours, stored, on, merge, out, state, keep_soc, soc):
+    """One pass over a series' days from the content ``stored`` [Wh] and load state ``on``;
+    ``power`` is what the design leaves after its own ``draw``.
 
     With ``merge``, a day that starts in the state the previous pass started it in (``state``)
     ends the pass: from there on, the previous pass's outputs are this one's. The load's state is
@@ -148,6 +156,7 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
     """
     n_days, n_steps = power.shape
     profile_days, profile_steps = load.shape[0] > 1, load.shape[1] > 1
+    draw_days, draw_steps = draw.shape[0] > 1, draw.shape[1] > 1
     capacity, restart = par[CAPACITY], par[RESTART_SOC] * par[CAPACITY]
     n_bins = out.shape[1] - HISTOGRAM
     keep_half, keep_step = par[KEEP_HALF], par[KEEP_STEP]
@@ -165,8 +174,9 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
         full = capacity > 0.0 and stored >= capacity
         empty = stored <= floor
         powered = served = missing = lost = charge_loss = discharge_loss = leak = 0.0
-        harvested = 0.0
+        harvested = drawn = 0.0
         day_load = load[d if profile_days else 0]
+        day_draw = draw[d if draw_days else 0]
         for j in range(n_steps + 1):
             # Segment j runs from the centre of step j - 1 to that of step j; the first and the
             # last are the half steps held at the day's ends (foldopt.engine.metrics).
@@ -174,40 +184,45 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
             p0, p1 = power[d, first], power[d, last]
             l0 = day_load[first if profile_steps else 0]
             l1 = day_load[last if profile_steps else 0]
+            d0 = day_draw[first if draw_steps else 0]
+            d1 = day_draw[last if draw_steps else 0]
             half = j == 0 or j == n_steps
             tau = 0.5 * step_hours if half else step_hours
             if j < n_steps:
-                harvested += p1
+                harvested += p1 + d1
             e0, e1 = p0 - l0, p1 - l1
             demand = l0 > 0.0 and l1 > 0.0  # time counts where the load runs at both ends
             # Three common segments take a short cut, by the very operations _part would do (the
             # results are the same to the bit): a dark one the buffer carries, a dark one with the
-            # load off, and one above the load with the buffer full.
+            # load off (neither with a draw of the design's own), and one above the load with the
+            # buffer full.
             need = 0.5 * tau * (l0 + l1)
             usable = stored - floor
+            dark = p0 == 0.0 and p1 == 0.0 and d0 == 0.0 and d1 == 0.0
             if (
                 on
-                and p0 == 0.0
-                and p1 == 0.0
+                and dark
                 and l0 == l1
                 and l0 > 0.0
                 and usable > 0.0
                 and l0 <= max_discharge
                 and need <= eta_discharge * usable
             ):
-                drawn = need / eta_discharge
-                stored = stored - drawn
+                taken = need / eta_discharge
+                stored = stored - taken
                 served += need
-                discharge_loss += drawn - need
+                discharge_loss += taken - need
                 if demand:
                     powered += tau
-            elif not on and p0 == 0.0 and p1 == 0.0 and l0 == l1 and stored < restart:
+            elif not on and dark and l0 == l1 and stored < restart:
                 missing += need  # dark and off: nothing to charge
             elif on and e0 >= 0.0 and e1 >= 0.0 and stored >= capacity:
-                # _part's one part above the load runs to p0 + 1.0 * (p1 - p0), and so the load.
+                # _part's one part above the load runs to p0 + 1.0 * (p1 - p0), and so the load
+                # and the draw.
                 ls = l0 + (l1 - l0)
                 need = 0.5 * tau * (l0 + ls)
                 served += need
+                drawn += 0.5 * tau * (d0 + (d0 + (d1 - d0)))
                 lost += max(0.5 * tau * (p0 + (p0 + (p1 - p0))) - need, 0.0)
                 if demand:
                     powered += tau
@@ -223,6 +238,7 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
                 rising = e0 < 0.0  # below the load first
                 split = 1.0 - above if rising else above
                 ps, ls = p0 + split * (p1 - p0), l0 + split * (l1 - l0)
+                ds = d0 + split * (d1 - d0)
                 t_above, t_below = tau * above, tau * (1.0 - above)
                 for second in (False, True):
                     length = (
@@ -233,17 +249,28 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
                     if length <= 0.0:
                         continue
                     if second:
-                        pa, pb, la, lb = ps, p1, ls, l1
+                        pa, pb, la, lb, da, db = ps, p1, ls, l1, ds, d1
                     else:
-                        pa, pb, la, lb = p0, ps, l0, ls
-                    stored, on, s_wh, m_wh, l_wh, c_wh, d_wh, ran_h, was_full, ran_out = _part(
-                        pa, pb, la, lb, length, rising == second, stored, on, par
-                    )
+                        pa, pb, la, lb, da, db = p0, ps, l0, ls, d0, ds
+                    (
+                        stored,
+                        on,
+                        s_wh,
+                        m_wh,
+                        l_wh,
+                        c_wh,
+                        d_wh,
+                        ran_h,
+                        was_full,
+                        ran_out,
+                        own_wh,
+                    ) = _part(pa, pb, la, lb, da, db, length, rising == second, stored, on, par)
                     served += s_wh
                     missing += m_wh
                     lost += l_wh
                     charge_loss += c_wh
                     discharge_loss += d_wh
+                    drawn += own_wh
                     if demand:
                         powered += ran_h
                     full = full or was_full
@@ -264,13 +291,16 @@ def _run(power, load, par, step_hours, stored, on, merge, out, state, keep_soc, 
             leak,
         )
         row[FULL], row[EMPTY] = 1.0 if full else 0.0, 1.0 if empty else 0.0
+        row[DRAWN] = drawn
     on = on or stored >= restart
     state[n_days, 0], state[n_days, 1] = stored, 1.0 if on else 0.0
     return stored, on
 
 
 @njit(cache=True, error_model="numpy")
-def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterations, tolerance):
+def _series(
+    power, load, draw, par, step_hours, out, state, keep_soc, soc, max_iterations, tolerance
+):
     """A series from its initial state of charge, or in its periodic state: passes until the
     state at the end of the series is that at its start (content within ``tolerance`` x the
     capacity, the load on or off alike), first plainly from a full buffer, then by bisection on
@@ -281,7 +311,7 @@ def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterati
     if not math.isnan(par[INITIAL_SOC]):
         stored = par[INITIAL_SOC] * capacity
         on = stored >= par[RESTART_SOC] * capacity
-        _run(power, load, par, step_hours, stored, on, False, out, state, keep_soc, soc)
+        _run(power, load, draw, par, step_hours, stored, on, False, out, state, keep_soc, soc)
         return 1
     resolution = 0.0  # one step's load energy [Wh], the largest of the series
     for row in load:
@@ -293,7 +323,7 @@ def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterati
     while passes < max_iterations:
         passes += 1
         end, end_on = _run(
-            power, load, par, step_hours, stored, on, passes > 1, out, state, keep_soc, soc
+            power, load, draw, par, step_hours, stored, on, passes > 1, out, state, keep_soc, soc
         )
         if abs(end - stored) <= tolerance * capacity and end_on == on:
             return passes
@@ -316,16 +346,17 @@ def _series(power, load, par, step_hours, out, state, keep_soc, soc, max_iterati
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def simulate_series(
-    power, load, params, step_hours, out, state, keep_soc, soc, passes, max_iterations, tolerance
-):
+    power, load, draw, params, step_hours, out, state, keep_soc, soc, passes, max_iterations,
+    tolerance,
+):  # fmt: skip
     """Every series, spread over threads (:func:`foldopt.engine.storage.simulate`).
 
     Parameters
     ----------
     power : (n_series or 1, n_days, n_steps) float
-        Power at step centres [W].
-    load : (n_series or 1, n_days or 1, n_steps or 1) float
-        Load at step centres [W].
+        Power at step centres [W], less the design's own draw.
+    load, draw : (n_series or 1, n_days or 1, n_steps or 1) float
+        Load and the design's own draw at step centres [W].
     params : (n_series or 1, N_PARAMETERS) float
         The buffer of each series.
     step_hours : float
@@ -349,6 +380,7 @@ def simulate_series(
         passes[s] = _series(
             power[s if power.shape[0] > 1 else 0],
             load[s if load.shape[0] > 1 else 0],
+            draw[s if draw.shape[0] > 1 else 0],
             params[s if params.shape[0] > 1 else 0],
             step_hours,
             out[s],

@@ -11,7 +11,14 @@ from dataclasses import dataclass
 from functools import partial
 from typing import Annotated
 
-from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, ValidationInfo
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    ValidationInfo,
+    field_validator,
+)
 
 from foldopt.names import canonical
 
@@ -119,9 +126,43 @@ class FilesRead:
 
 
 class StrictModel(BaseModel):
-    """A frozen model that refuses unknown fields: the base of a study and its parts."""
+    """A frozen model that refuses unknown fields, and ``true``/``false`` where a number is
+    expected: the base of a study and its parts.
+
+    pydantic's lax mode reads a boolean as 1 or 0 for a number field, so ``capacity_wh: true`` (a
+    slip in YAML, ``--set storage.capacity_wh=true``) would run a 1 Wh buffer without a word.
+    """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_boolean_for_number(cls, value, info: ValidationInfo):
+        if _holds_boolean(value) and _numeric(cls.model_fields[info.field_name].annotation):
+            raise ValueError("must be a number, not true or false")
+        return value
+
+
+def _holds_boolean(value) -> bool:
+    """Whether a value is a boolean, or a list (of lists) holding one."""
+    if isinstance(value, (list, tuple)):
+        return any(_holds_boolean(item) for item in value)
+    return isinstance(value, bool)
+
+
+def _numeric(annotation) -> bool:
+    """Whether a field's type takes numbers (or lists of them) and no boolean."""
+    members = _union(annotation)
+    if bool in members:
+        return False
+    return any(
+        member in (int, float)
+        or (
+            typing.get_origin(member) in (list, tuple)
+            and any(_numeric(item) for item in typing.get_args(member) if item is not Ellipsis)
+        )
+        for member in members
+    )
 
 
 def _unwrapped(annotation):
@@ -184,6 +225,29 @@ def list_valued_fields(model: type[BaseModel], prefix: str = "") -> dict[str, in
                 if shorthand is not None:
                     depths[path] = inner[f"{path}.{shorthand}"]
     return depths
+
+
+def field_paths(model: type[BaseModel], prefix: str = "") -> tuple[str, ...]:
+    """The dotted paths of a model's fields, its sections' fields included.
+
+    Parameters
+    ----------
+    model : type of pydantic.BaseModel
+    prefix : str
+        The model's own path, with its trailing dot.
+
+    Returns
+    -------
+    tuple of str
+        In the order the models declare them (``site``, ``site.name``, ``site.latitude``...).
+    """
+    paths = []
+    for name, field in model.model_fields.items():
+        paths.append(f"{prefix}{name}")
+        for member in _union(field.annotation):
+            if isinstance(member, type) and issubclass(member, BaseModel):
+                paths += field_paths(member, f"{prefix}{name}.")
+    return tuple(dict.fromkeys(paths))
 
 
 def list_depth(value) -> int:

@@ -11,16 +11,18 @@ the faults to one line per field and problem, and refuses a plan larger than the
 from __future__ import annotations
 
 import datetime as dt
+import functools
 import itertools
 import math
 import re
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
 from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
-from foldopt.inputs.fields import list_depth, list_valued_fields
+from foldopt.inputs.fields import field_paths, list_depth, list_valued_fields
 from foldopt.inputs.study_file import read_study, resolve_files
 from foldopt.inputs.reading import MAX_AXIS_VALUES, size_limit
 from foldopt.inputs.weather_files import (
@@ -35,6 +37,8 @@ DATE_KEYWORDS = ("year", "equinoxes-solstices")
 #: Fields that label a study rather than design it: a list of them is no sweep.
 UNSWEPT = ("name", "description")
 _LIST_VALUED = list_valued_fields(Study)
+#: Every field of a study: a list under any other key is no axis (the validation names the key).
+_FIELDS = frozenset(field_paths(Study))
 
 #: Cases of a plan: one row of results.csv per case and design.
 MAX_CASES = size_limit("MAX_CASES", 200_000)
@@ -224,6 +228,12 @@ def parse_dates(spec, year: int) -> list[dt.date]:
         if last < first:
             raise ValueError(f"empty range {spec!r}: stop is before start")
         return [first + dt.timedelta(days=d) for d in range(0, (last - first).days + 1, int(step))]
+    if isinstance(spec, str) and ":" in spec:
+        parts = spec.split(":")
+        example = ":".join([*parts[:2], "1"]) if len(parts) == 2 else "2025-12-25:2026-01-05:1"
+        raise ValueError(
+            f"{spec!r}: a range of dates is start:stop:step, the step in days (e.g. {example})"
+        )
     return [one(spec)]
 
 
@@ -231,9 +241,18 @@ def _leap(year: int) -> bool:
     return year % 4 == 0 and (year % 100 != 0 or year % 400 == 0)
 
 
+#: Validated studies a plan keeps (the first ones made; beyond, a case is validated when asked).
+KEPT_STUDIES = 4096
+
+
 @dataclass(frozen=True)
 class Plan:
     """A study and its sweep axes; the cases are the product of the axes' values.
+
+    A plan is made by :func:`make_plan` (the front door's validation,
+    :func:`foldopt.studies.request.make_request`), which validates every axis value; the studies
+    it validated are kept, so a case asked for again (the base above all) is not validated again,
+    and the files the study names are read once for all its cases.
 
     Parameters
     ----------
@@ -246,8 +265,26 @@ class Plan:
 
     data: dict
     axes: tuple
+    _studies: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
+    _files: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
-    @property
+    @classmethod
+    def of(cls, study: Study) -> Plan:
+        """A validated study (its files read) as a plan of one case, kept as it is.
+
+        Parameters
+        ----------
+        study : Study
+
+        Returns
+        -------
+        Plan
+        """
+        plan = cls(study.data(), ())
+        plan._studies[()] = study
+        return plan
+
+    @functools.cached_property
     def base(self) -> Study:
         """The study with every axis at its first value (:meth:`study`)."""
         return self.study({path: values[0] for path, values in self.axes})
@@ -273,10 +310,23 @@ class Plan:
         ------
         pydantic.ValidationError
         """
+        key = tuple(sorted((path, repr(value)) for path, value in choice.items()))
+        if key in self._studies:
+            return self._studies[key]
         data = self.data
         for path, value in choice.items():
             data = set_path(data, path, value)
-        return Study.model_validate(data, context=resolve_files(data))
+        study = Study.model_validate(data, context=self._read(data))
+        if len(self._studies) < KEPT_STUDIES:
+            self._studies[key] = study
+        return study
+
+    def _read(self, data: dict):
+        """What the files a case names hold, read once for every case that names the same."""
+        key = repr([data.get(name) for name in ("weather", "load_profile", "site")])
+        if key not in self._files:
+            self._files[key] = resolve_files(data)
+        return self._files[key]
 
     def cases(self):
         """Every case of the plan.
@@ -301,10 +351,12 @@ def _listed_leaves(data: dict, prefix: str = ""):
         if path == "date" and (
             isinstance(value, list)
             or value in DATE_KEYWORDS
-            or (isinstance(value, str) and _RANGE.match(value))
+            or (isinstance(value, str) and ":" in value)
         ):
             yield path, value
         elif isinstance(value, list) and list_depth(value) == _LIST_VALUED.get(path):
+            continue
+        elif path not in _FIELDS and path not in UNSWEPT:
             continue
         elif isinstance(value, list) or (isinstance(value, str) and _NUMERIC_RANGE.match(value)):
             yield path, value
@@ -535,9 +587,11 @@ def _validation_errors(plan: Plan, choice: dict, lines: dict, where: dict) -> li
             for message in format_error(item):
                 loc = tuple(str(part) for part in item["loc"])
                 for path, (label, yaml_path) in where.items():
-                    if ".".join(loc).startswith(path):
-                        message = message.replace(".".join(loc), label, 1)
-                        loc = tuple(str(part) for part in yaml_path)
+                    dotted = ".".join(loc)
+                    if dotted == path or dotted.startswith(path + "."):
+                        # circuit[1].switch_resistance: the case's value, then the field in it
+                        message = message.replace(dotted, label + dotted[len(path) :], 1)
+                        loc = tuple(str(part) for part in yaml_path) + loc[len(path.split(".")) :]
                         break
                 messages.append(_at(lines, loc, message))
         return messages

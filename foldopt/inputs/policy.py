@@ -14,8 +14,10 @@ it is made. The rules, each said back to the user by :func:`apply`'s second valu
   sky in paper mode) unless the geometry or the sky is given;
 - a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
   given; a new latitude or longitude drops the site's name, a new longitude its time zone;
-- a weather file brings its own site, year and light (the study's sky, site and day give way), and
-  a measured file (or a source read as one, ``pvgis-hourly``) its own days and step;
+- a weather file brings its own site, year and light (the study's sky, site and day give way; the
+  site fields given complete the file's), and a measured file (or a source read as one,
+  ``pvgis-hourly``) its own days and step; a weather source is fetched for the study's latitude
+  and longitude unless others are given;
 - a new tracker model keeps only the tracker's standby draw; a new fold-angle step starts the grid
   at that step; a load profile given without a scale runs as written (scale 1).
 
@@ -166,6 +168,11 @@ def _varied(optimize) -> list[str]:
         return []
 
 
+def _source(weather) -> bool:
+    """Whether a ``weather`` change names a source (fetched for the site), not a file."""
+    return isinstance(weather, dict) and weather.get("source") is not None
+
+
 def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dict, list[str]]:
     """The study data that runs when ``changes`` are made to ``data``.
 
@@ -197,10 +204,14 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     weather = changes.get("weather")
     if weather is not None:
         data.pop("sky", None)  # the file's light is shaped by its own clear sky
-        if not (
-            touched(given, "site.latitude") or touched(given, "site.longitude") or "site" in given
-        ):
-            data.pop("site", None)  # the file's site
+        if "site" not in given:
+            # The file's site: the fields given complete or move it, the study's other place does
+            # not (its altitude, name or time zone are of another site). A source is fetched for
+            # the study's place: its latitude and longitude stay where none are given.
+            site = data.pop("site", None)
+            if _source(weather) and isinstance(site, dict):
+                place = {key: site[key] for key in ("latitude", "longitude") if key in site}
+                data["site"] = place
         if not touched(given, "date"):
             data.pop("date", None)  # the file's year, or a measured file's days
         fmt = changes.get(
@@ -224,11 +235,17 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     ):
         data["mode"] = "exact"
         decided.append(EXACT_NOTE)
+    optimize = changes.get("optimize", data.get("optimize"))
+    if "optimize.vary" in changes:
+        optimize = {
+            **(optimize if isinstance(optimize, dict) else {}),
+            "vary": changes["optimize.vary"],
+        }
     if (
         data.get("mode", "exact") == "paper"
         and "mode" not in given
         and touched(given, "optimize")
-        and {"tilt", "azimuth"} & set(_varied(changes.get("optimize", data.get("optimize"))))
+        and {"tilt", "azimuth"} & set(_varied(optimize))
     ):
         data["mode"] = "exact"
         decided.append(MOUNTING_NOTE)

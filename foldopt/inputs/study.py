@@ -78,6 +78,31 @@ def great_circle_km(latitude_1, longitude_1, latitude_2, longitude_2) -> float:
     return 2 * EARTH_RADIUS_KM * math.asin(min(1.0, math.sqrt(a)))
 
 
+def _file_site(data: dict, info: ValidationInfo) -> dict | None:
+    """The site a study's weather file holds, as read for this validation; None where no file is
+    named or read, or where it holds none."""
+    weather = data.get("weather")
+    path = weather if isinstance(weather, str) else (weather or {}).get("path")
+    files = FilesRead.given(info) if isinstance(path, str) else None
+    return files.weather_site if files is not None else None
+
+
+def _near(site: dict, read: dict) -> bool:
+    """Whether a given site is the file's place: within :data:`SITE_TOLERANCE_KM` of it."""
+    try:
+        return (
+            great_circle_km(
+                float(site["latitude"]),
+                float(site["longitude"]),
+                float(read["latitude"]),
+                float(read["longitude"]),
+            )
+            <= SITE_TOLERANCE_KM
+        )
+    except (KeyError, TypeError, ValueError):
+        return False  # the site's own validation names what is wrong with it
+
+
 def _check_step_min(value: float) -> float:
     if not math.isclose(1440 / value, round(1440 / value)):
         raise ValueError("must divide the 1440 min of a day (e.g. 0.5, 1, 2, 5, 10, 15, 30, 60)")
@@ -259,10 +284,16 @@ class Study(StrictModel):
     @model_validator(mode="before")
     @classmethod
     def _site_from_weather(cls, data, info: ValidationInfo):
-        """A weather file brings its site, as its loader read it: the study's unless one is given. A
-        site of other fields only (a horizon, an altitude) is the file's with those fields."""
+        """A weather file brings its site, as its loader read it, and completes a site given in
+        part: the fields given win, the rest (the station's name, its altitude, its time zone) are
+        the file's. A site moved beyond :data:`SITE_TOLERANCE_KM` from the file's is another place,
+        none of whose fields the file knows (it is refused there, unless ``force_site``)."""
         site = data.get("site") if isinstance(data, dict) else None
         partial = isinstance(site, dict) and not {"latitude", "longitude"} & set(site)
+        if isinstance(data, dict) and isinstance(site, dict) and not partial:
+            read = _file_site(data, info)
+            if read is not None and _near(site, read):
+                data = {**data, "site": {**read, **site}}
         if isinstance(data, dict) and (site is None or partial) and data.get("weather") is not None:
             weather = data["weather"]
             path = (
@@ -603,10 +634,33 @@ def format_error(item: dict) -> list[str]:
     if item["type"] == "missing":
         return [f"{field}: required field is missing"]
     if item["type"] == "extra_forbidden":
-        return [f"{field}: unknown field"]
+        return [f"{field}: unknown field{_where_it_belongs(field)}"]
     if isinstance(item["input"], dict):
         return [f"{field}: {message}"]
-    return [f"{field} = {item['input']!r}: {message}"]
+    return [f"{field} = {_shown(item['input'])}: {message}"]
+
+
+def _where_it_belongs(field: str) -> str:
+    """For an unknown field, the known fields of that name elsewhere in a study
+    (``hourconsumption`` is ``load_profile.hourconsumption``), else the close names beside it."""
+    from foldopt.inputs.fields import field_paths
+
+    paths = field_paths(Study)
+    section, _, name = field.rpartition(".")
+    elsewhere = [path for path in paths if path.rpartition(".")[2] == name and path != field]
+    if elsewhere:
+        return f"; did you mean {' or '.join(elsewhere)}?"
+    siblings = [path.rpartition(".")[2] for path in paths if path.rpartition(".")[0] == section]
+    return names.did_you_mean(name, siblings)
+
+
+def _shown(value) -> str:
+    """A value as a study file writes it: YAML's ``true``/``false``, not Python's."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_shown(item) for item in value) + "]"
+    return repr(value)
 
 
 def format_errors(error: ValidationError) -> list[str]:

@@ -238,6 +238,7 @@ def with_fetched_weather(data):
     weather = data.get("weather") if isinstance(data, dict) else None
     if not isinstance(weather, dict) or weather.get("source") is None:
         return data
+    _file_or_source(weather)
     from pydantic import ValidationError
 
     from foldopt.inputs.weather_section import Weather
@@ -246,31 +247,36 @@ def with_fetched_weather(data):
         spec = Weather.model_validate({**weather, "path": None})
     except ValidationError:
         return data  # the study names the fault
-    site = data.get("site")
-    varied = _varied_site(site)
-    if varied is not None:
-        raise ConfigError(
-            [
-                f"{varied}: varies, but weather.source {spec.source} is fetched for one site; give "
-                "one site (fetch several ahead with foldopt weather fetch, one site each)"
-            ]
-        )
-    place = site if isinstance(site, dict) else {}
-    if not all(
-        isinstance(place.get(key), (int, float)) and not isinstance(place.get(key), bool)
-        for key in ("latitude", "longitude")
-    ):
-        raise ConfigError(
-            [
-                f"weather.source {spec.source}: fetches the weather of the study's site; give its "
-                "latitude and longitude (--lat, --lon; site.latitude, site.longitude)"
-            ]
-        )
+    what = f"weather.source {spec.source}"
+    latitude, longitude = _site_to_fetch(
+        data.get("site"),
+        what,
+        "weather",
+        " (fetch several ahead with foldopt weather fetch, one site each)",
+    )
     from foldopt.inputs.weather.sources import SOURCES, fetch  # requests: only to fetch
 
-    answer = fetch(spec.source, place["latitude"], place["longitude"], spec)
+    answer = fetch(spec.source, latitude, longitude, spec)
     fetched = {**weather, "source": spec.source, "path": answer.file}
     return {**data, "weather": {**fetched, "format": SOURCES[spec.source].format}}
+
+
+def _file_or_source(weather: dict) -> None:
+    """Refuse a weather section that names both a file and a source: either would be the study's
+    light, and running one would ignore the other. A path inside the weather cache is the
+    source's own answer (a fetched study's data, :meth:`foldopt.Study.data`), not a second value."""
+    path = weather.get("path")
+    if path is None:
+        return
+    from foldopt.inputs.weather.sources import weather_cache
+
+    if Path(str(path)).resolve().parent != weather_cache().resolve():
+        raise ConfigError(
+            [
+                f"weather: names a file ({path}) and a source ({weather['source']}); give one: "
+                "weather.path (--weather FILE) or weather.source (--weather NAME)"
+            ]
+        )
 
 
 def with_fetched_horizon(data):
@@ -303,30 +309,51 @@ def with_fetched_horizon(data):
     name = horizon.get("file") if isinstance(horizon, dict) else horizon
     if not isinstance(name, str) or name not in HORIZON_SOURCES:
         return data
-    varied = _varied_site(site)
-    if varied is not None:
-        raise ConfigError(
-            [f"{varied}: varies, but site.horizon {name} is fetched for one site; give one site"]
-        )
-    if not all(
-        isinstance(site.get(key), (int, float)) and not isinstance(site.get(key), bool)
-        for key in ("latitude", "longitude")
-    ):
-        raise ConfigError(
-            [
-                f"site.horizon {name}: fetches the horizon of the study's site; give its latitude "
-                "and longitude (--lat, --lon; site.latitude, site.longitude)"
-            ]
-        )
+    latitude, longitude = _site_to_fetch(site, f"site.horizon {name}", "horizon")
     weather = data.get("weather")
     options = {
         key: weather[key]
         for key in ("url", "timeout_s")
         if isinstance(weather, dict) and weather.get(key) is not None
     }
-    answer = fetch_horizon(name, site["latitude"], site["longitude"], options)
+    answer = fetch_horizon(name, latitude, longitude, options)
     fetched = {**horizon, "file": answer.file} if isinstance(horizon, dict) else answer.file
     return {**data, "site": {**site, "horizon": fetched}}
+
+
+def _site_to_fetch(site, what: str, kind: str, more: str = "") -> tuple[float, float]:
+    """The one site that ``what`` (``weather.source pvgis-tmy``) fetches the ``kind`` of
+    (``weather``), checked before anything is asked: its latitude and longitude [deg].
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        For a site that varies (``more`` ends the line), that is not given, or whose latitude or
+        longitude is out of range or not finite
+        (:func:`foldopt.inputs.weather.sources.site_problems`).
+    """
+    varied = _varied_site(site)
+    if varied is not None:
+        raise ConfigError(
+            [f"{varied}: varies, but {what} is fetched for one site; give one site{more}"]
+        )
+    place = site if isinstance(site, dict) else {}
+    if not all(
+        isinstance(place.get(key), (int, float)) and not isinstance(place.get(key), bool)
+        for key in ("latitude", "longitude")
+    ):
+        raise ConfigError(
+            [
+                f"{what}: fetches the {kind} of the study's site; give its latitude and longitude "
+                "(--lat, --lon; site.latitude, site.longitude)"
+            ]
+        )
+    from foldopt.inputs.weather.sources import site_problems
+
+    problems = site_problems(place["latitude"], place["longitude"])
+    if problems:
+        raise ConfigError(problems)
+    return place["latitude"], place["longitude"]
 
 
 def with_fetched_sites(sites: list[dict], weather) -> list[dict]:
@@ -372,17 +399,30 @@ def with_fetched_sites(sites: list[dict], weather) -> list[dict]:
                 f"{spec.source} --years START:END)"
             ]
         )
-    from foldopt.inputs.weather.sources import fetch  # requests: only to fetch
+    from foldopt.inputs.weather.sources import fetch, site_problems  # requests: only to fetch
 
+    problems = [
+        f"site {_site_name(site)}: {line}"
+        for site in sites
+        for line in site_problems(site.get("latitude"), site.get("longitude"))
+    ]
+    if problems:  # every site checked before any is fetched
+        raise ConfigError(problems)
     fetched = []
     for site in sites:
         try:
             answer = fetch(spec.source, site["latitude"], site["longitude"], spec)
         except WeatherError as error:
-            where = site.get("name") or f"{site['latitude']:g}, {site['longitude']:g}"
-            raise WeatherError(f"site {where}: {error.errors[0]}") from None
+            raise WeatherError(f"site {_site_name(site)}: {error.errors[0]}") from None
         fetched.append({**site, "weather": answer.file})
     return fetched
+
+
+def _site_name(site: dict) -> str:
+    """A map's site as messages name it: its name, else its latitude and longitude."""
+    where = [site.get(key) for key in ("latitude", "longitude")]
+    numbers = all(isinstance(value, (int, float)) for value in where)
+    return site.get("name") or ", ".join(f"{v:g}" if numbers else repr(v) for v in where)
 
 
 def weather_defaults(data: dict) -> dict:

@@ -2,7 +2,8 @@
 the options of each kind (:class:`Weather`). Like the other sections it validates and opens no
 file (:mod:`foldopt.inputs.sections`).
 
-The module may import pydantic, :mod:`foldopt.names` and :mod:`foldopt.inputs.sections`.
+The module may import pydantic, :mod:`foldopt.names` and :mod:`foldopt.inputs.sections`. It says
+which addresses a weather source is asked at (:func:`address_problem`).
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ from __future__ import annotations
 import datetime as dt
 import re
 from typing import Annotated
+from urllib.parse import urlsplit
 
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator, model_validator
 
@@ -44,9 +46,43 @@ def _check_database(name: str | None) -> str | None:
     return name
 
 
+#: The schemes a weather source is asked over.
+SCHEMES = ("http", "https")
+
+
+def address_problem(url: str) -> str | None:
+    """Why ``url`` is no base address a weather source can be asked at (a scheme of
+    :data:`SCHEMES`, a host, a port that is a number, no space or control character), or None.
+
+    Parameters
+    ----------
+    url : str
+
+    Returns
+    -------
+    str or None
+        One phrase, for a line that names where the address came from.
+    """
+    accepted = "give an http:// or https:// base address (a mirror's)"
+    try:
+        parts = urlsplit(url)
+        parts.port  # noqa: B018 - read for its check: a port that is no number raises
+    except ValueError as error:
+        return f"not an address ({error}); {accepted}"
+    if parts.scheme.lower() not in SCHEMES:
+        scheme = f"the scheme {parts.scheme}://" if parts.scheme else "an address without a scheme"
+        return f"{scheme} is not supported; {accepted}"
+    if not parts.hostname:
+        return f"names no host; {accepted}"
+    if re.search(r"[\s\x00-\x1f\x7f]", url):
+        return f"holds a space or a control character; {accepted}"
+    return None
+
+
 def _check_url(url: str | None) -> str | None:
-    if url is not None and not re.match(r"https?://[^/\s]+", url):
-        raise ValueError("a base address http://... or https://..., e.g. a mirror's")
+    problem = None if url is None else address_problem(url)
+    if problem is not None:
+        raise ValueError(problem)
     return url
 
 
@@ -95,7 +131,8 @@ class Weather(StrictModel):
         A source's base address (a mirror, a proxy); default ``FOLDOPT_PVGIS_URL``, else the
         service's pinned versioned address.
     timeout_s : float
-        Seconds a source's request waits for the service, in (0, 600]; default 30.
+        Seconds a source's fetch waits at most for the service's whole answer (connecting, every
+        read, every retry), in (0, 600]; default 30.
     """
 
     path: str | None = Field(None, description="the file; with a source, its cached answer")

@@ -311,7 +311,10 @@ def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Pat
     with staged_folder(out, overwrite) as folder:
         write_csv(result.table, folder / "results.csv")
         plots = _sweep_plots(result.table, result.varied, folder, plan.base.name)
-        if "date" in result.varied or "dayofyear" in result.varied:
+        # An annual objective's group (a weather file's days, one of them or many) writes its
+        # tables, as a sweep of dates does: what the answer says of it, its buffer's too.
+        annual = "date" in result.varied or "dayofyear" in result.varied
+        if annual or result.answer.kind == "annual":
             plots += _annual_outputs(result, folder, plan.base.name)
         plots += _horizon_figure(
             plan.base, dict(plan.axes).get("date", (plan.base.date,)), folder, plan.base.name

@@ -1,6 +1,8 @@
 """``run.json``: what a results folder was made from, so that it can be made again. The resolved
 study, its mode, the command line, the versions (:func:`foldopt.files.versions`), a digest of the
-inputs and what each kind of result adds (its engine, its answer's headline numbers)."""
+inputs and what each kind of result adds (its engine, its answer's headline numbers). An address
+it holds (a mirror's ``weather.url``, the request of fetched weather) is
+:func:`foldopt.errors.redacted`: ``run.json`` and the report never keep a password or a key."""
 
 from __future__ import annotations
 
@@ -9,6 +11,7 @@ import json
 import sys
 from pathlib import Path
 
+from foldopt.errors import redacted
 from foldopt.files import versions
 from foldopt.inputs.study import Study
 
@@ -30,19 +33,22 @@ def run_metadata(study: Study, command: list[str] | None = None, **extra) -> dic
     dict
         ``study`` (the study as JSON), ``mode``, ``command``, ``versions``, for weather fetched
         from a source ``weather_source`` (:func:`weather_source`), for a horizon fetched from one
-        ``horizon_source`` (:func:`horizon_source`), and ``extra``.
+        ``horizon_source`` (:func:`horizon_source`), and ``extra``; every address in it
+        :func:`foldopt.errors.redacted`.
     """
     fetched = weather_source(study)
     horizon = horizon_source(study)
-    return {
-        "study": study.model_dump(mode="json"),
-        "mode": study.mode,
-        "command": command if command is not None else sys.argv,
-        "versions": versions(),
-        **({"weather_source": fetched} if fetched is not None else {}),
-        **({"horizon_source": horizon} if horizon is not None else {}),
-        **extra,
-    }
+    return redacted(
+        {
+            "study": study.model_dump(mode="json"),
+            "mode": study.mode,
+            "command": command if command is not None else sys.argv,
+            "versions": versions(),
+            **({"weather_source": fetched} if fetched is not None else {}),
+            **({"horizon_source": horizon} if horizon is not None else {}),
+            **extra,
+        }
+    )
 
 
 def weather_source(study: Study) -> dict | None:
@@ -90,7 +96,8 @@ def horizon_source(study: Study) -> dict | None:
 
 
 def input_hash(data) -> str:
-    """SHA-256 of the canonical JSON of a study's inputs (keys sorted, no spaces).
+    """SHA-256 of the canonical JSON of a study's inputs (keys sorted, no spaces), their addresses
+    :func:`foldopt.errors.redacted` (a digest of a password is no place for it).
 
     Parameters
     ----------
@@ -102,7 +109,7 @@ def input_hash(data) -> str:
     str
         The digest, 64 hexadecimal characters.
     """
-    canonical = json.dumps(data, sort_keys=True, default=str, separators=(",", ":"))
+    canonical = json.dumps(redacted(data), sort_keys=True, default=str, separators=(",", ":"))
     return hashlib.sha256(canonical.encode()).hexdigest()
 
 

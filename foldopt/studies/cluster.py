@@ -20,8 +20,6 @@ kernel on one thread: the parallelism is Dask's.
 from __future__ import annotations
 
 import dataclasses
-import functools
-import hashlib
 import json
 import shutil
 import time
@@ -31,7 +29,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from foldopt.errors import ConfigError, OutputError
+from foldopt.errors import ConfigError, OutputError, redacted
 from foldopt.inputs.study import Study
 from foldopt.files import (
     DiskFullError,
@@ -47,106 +45,12 @@ from foldopt.files import (
     writer_lock,
 )
 from foldopt.studies.dask_client import CONNECT_TIMEOUT, connect
+from foldopt.studies.worldmap import MapSpec
 from foldopt.tables import write_csv
-from foldopt.names import DEFAULT_ENGINE
 
-#: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
-#: about a millisecond), short enough that a lost worker loses little and progress moves.
-CHUNK_SECONDS = 5.0
-#: Single-core seconds per site-day x fold angle x time step of a map, everything included (sky,
-#: trackers, break-even search), measured on W4 (``bench/map.py``).
-SECONDS_PER_EVALUATION = 13e-9
 PARTS = "parts"
 #: Key of the map's digest (:attr:`MapSpec.key`) in the metadata of its Parquet files.
 MAP_KEY = b"foldopt.map_key"
-
-
-@dataclass(frozen=True)
-class MapSpec:
-    """Everything that decides a map's numbers.
-
-    Parameters
-    ----------
-    study : Study
-        The map's study (:func:`foldopt.studies.worldmap.map_template`; a map study's fields,
-        :func:`foldopt.studies.worldmap.map_study`, are made into it at the first site).
-    sites : tuple of dict
-        ``latitude``, ``longitude`` and optionally ``name``, ``altitude``, ``timezone``; each gets a ``site_id``.
-    loads : tuple of float
-        Loads [W], or with ``relative`` fractions of each site's flat peak [-].
-    relative : bool, default False
-    year : int, default 2025
-    sites_per_chunk : int, default 0
-        0: sized for about :data:`CHUNK_SECONDS` of one core's work (:func:`default_sites_per_chunk`).
-    engine : {'auto', 'numba', 'numpy'}
-    """
-
-    study: Study
-    sites: tuple
-    loads: tuple
-    relative: bool = False
-    year: int = 2025
-    sites_per_chunk: int = 0
-    engine: str = DEFAULT_ENGINE
-
-    def __post_init__(self):
-        from foldopt.studies.worldmap import map_template
-
-        if not self.sites:
-            raise ConfigError(["sites: a map needs at least one site"])
-        object.__setattr__(self, "study", map_template(self.study, self.sites[0], self.year))
-        if self.sites_per_chunk <= 0:
-            object.__setattr__(
-                self, "sites_per_chunk", default_sites_per_chunk(self.study, self.year)
-            )
-        sites = tuple({**site, "site_id": index} for index, site in enumerate(self.sites))
-        object.__setattr__(self, "sites", sites)
-
-    def chunks(self) -> list[range]:
-        """The chunks' site indices, ``sites_per_chunk`` each (the last may be short)."""
-        size = self.sites_per_chunk
-        return [
-            range(start, min(start + size, len(self.sites)))
-            for start in range(0, len(self.sites), size)
-        ]
-
-    def as_dict(self) -> dict:
-        """The spec as plain data (``run.json``'s ``spec``): the study as the fields a map keeps for
-        every site (:func:`foldopt.studies.worldmap.map_data`)."""
-        from foldopt.studies.worldmap import map_data
-
-        return {
-            **{field.name: getattr(self, field.name) for field in dataclasses.fields(self)},
-            "study": map_data(self.study),
-        }
-
-    @functools.cached_property
-    def key(self) -> str:
-        """A digest of the spec: a resumed run must have the same. Worked out once: every part written
-        and read carries it, and the spec holds every site (the 1-degree land grid's 21,637 made it
-        0.3 s a time, some 900 chunks three times each: a third of the client's core through W5)."""
-        text = json.dumps(self.as_dict(), sort_keys=True, default=str)
-        return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-def default_sites_per_chunk(study: Study, year: int) -> int:
-    """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work (at least 1), in whole batches
-    of :data:`foldopt.studies.worldmap.SITES_PER_BATCH` where it holds one or more.
-
-    Parameters
-    ----------
-    study : Study
-        :attr:`MapSpec.study` (its fold angles and step).
-    year : int
-    """
-    from foldopt.studies.worldmap import SITES_PER_BATCH
-
-    angles = len(study.fold_angles.grid())
-    steps = 1440 / study.step_min
-    per_site = 365 * angles * steps * SECONDS_PER_EVALUATION
-    count = max(1, int(CHUNK_SECONDS / per_site))
-    # Whole batches of sites where a chunk holds one or more, so that no batch runs part-full.
-    return count if count < SITES_PER_BATCH else SITES_PER_BATCH * round(count / SITES_PER_BATCH)
 
 
 @dataclass(frozen=True)
@@ -330,9 +234,8 @@ def _resumable(out: Path, spec: MapSpec, metadata: dict) -> list[int]:
 
 
 def _write_json(path: Path, data: dict) -> None:
-    write_atomically(
-        path, lambda temporary: temporary.write_text(json.dumps(data, indent=2, default=str) + "\n")
-    )
+    text = json.dumps(redacted(data), indent=2, default=str) + "\n"  # no password in run.json
+    write_atomically(path, lambda temporary: temporary.write_text(text))
 
 
 def run_map(

@@ -496,13 +496,18 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
     standby = standby_sweep(day, tracker.power[0], by_design["twofold"])
     buffered = None
     if study.storage is not None:
-        # Every row's curve, the one its t_solar was reduced from, through the study's buffer.
+        # Every row's curve, the one its t_solar was reduced from, through the study's buffer; a
+        # net tracker's whole power, with its own draw a load beside the device's.
+        nets = {
+            "tracker-net": tracker,
+            **{f"tracker:{m}-net": day.tracker(m) for m in TRACKERS if m != study.tracker.model},
+        }
         power_of = {
             "flat": p_flat,
             "twofold": drawn[study.connection][0, 0],
             "tracker": tracker.power[0],
-            "tracker-net": tracker.net[0],
             **{name: power for name, (_, power) in others.items()},
+            **{name: net.power[0] for name, net in nets.items()},
         }
         own_series = study.connection == "series" or study.switch_series
         buffered = day_storage(
@@ -516,6 +521,7 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
             {name: (angle, power_of[name]) for name, angle in angle_of.items()},
             summary["t_solar_h"].to_numpy(),
             engine,
+            {name: net.draw[0] for name, net in nets.items()},
         )
         summary = pd.concat([summary, buffered.designs.iloc[:, 3:]], axis=1)
         sweep["powered_h"] = buffered.powered_by_angle

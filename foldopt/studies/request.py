@@ -1,35 +1,59 @@
-"""Requests: a study and the fields a user changed, turned into the plan that runs.
+"""The front door: every request becomes one validated plan here, by :func:`make_request`.
 
-:func:`plan_request` is the one place where a request becomes a study: the command line's
-``run``, ``sweep ...`` and ``size`` and the API's :func:`foldopt.sweep` and
-:meth:`foldopt.Study.variant` all call it (or its policy, :func:`foldopt.inputs.policy.apply`), so the
-same request gives the same plan, to the bit, whichever way it is made. It applies the study
-policy, each sweep axis's default range and the year of day-of-year ranges, and lists what the
-answer took from the study rather than from the request (:attr:`Request.taken`).
+A request is a command (:data:`foldopt.capabilities.COMMANDS`), the study it starts from (a YAML
+file, the embedded study, a mapping, a :class:`~foldopt.Study` or a :class:`~foldopt.Plan`) and
+what the user changed: the command line's options, ``--set KEY=VALUE`` texts, the API's
+keywords, a joint search's ranges, a sizing's target or a map's sites. The command line's
+``run``, ``sweep ...``, ``optimize``, ``size`` and ``map`` and the API's :func:`foldopt.run`,
+:func:`foldopt.sweep`, :func:`foldopt.optimize`, :func:`foldopt.size` and
+:func:`foldopt.world_map` all call :func:`make_request`, so one request gives one plan to the bit
+whichever way it is made. Its steps:
 
-The command line's options become requests here too, not in the command line: a sweep's options
-become field changes (:func:`sweep_changes`, :func:`sweep_request`), a map's become a map's study,
-sites and loads (:func:`map_request_from`), and a sizing's costs are checked against
-:data:`SIZING_LIMITS` (:func:`sizing_problems`), the same limits :func:`foldopt.size` keeps.
+1. **merge** (:func:`_merge`): each entry's field changes, one value per field: a field given
+   twice (``--storage-wh 20 --set storage.capacity_wh=30``, two ``--set`` of one key) is refused in
+   one line naming both;
+2. **decide** (:func:`foldopt.inputs.policy.apply`): the study policy, each sweep axis's default
+   range, the year of day-of-year ranges; what the answer took from the study is listed
+   (:attr:`Request.taken`);
+3. **validate** (:func:`foldopt.inputs.plan.make_plan`, or :func:`foldopt.studies.worldmap.map_request`
+   for a map), reading the files the study names once; a weather file completes a partial site
+   (given fields win, the rest is the file's);
+4. **refuse** what the request's run does not honour (:data:`foldopt.capabilities.CAPABILITIES`), so
+   that no command ignores a section silently.
+
+Messages name fields by what the user typed (:attr:`Request.labels`): ``--storage-wh`` where
+that option was given, ``--set storage.capacity_wh`` where that was, the keyword for the API.
 """
 
 from __future__ import annotations
 
+import copy
 import math
 import os
 import re
-from dataclasses import dataclass, replace
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
 
 from foldopt.cache import offline_mode
-from foldopt.inputs import policy
-from foldopt.names import WEATHER_SOURCES, did_you_mean
-from foldopt.inputs.study_file import default_study_path, parse_study_text, read_study
-from foldopt.inputs.optimize_section import vary_names
+from foldopt.capabilities import COMMAND_RUNS, COMMANDS, SET_BY_RUN, refusal
 from foldopt.engine.choice import engine_for
-from foldopt.names import FIELD_OF_PARAMETER, FIELD_OPTIONS, OPTIMIZE_VARIABLES
-from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
 from foldopt.errors import ConfigError
+from foldopt.inputs import policy
+from foldopt.inputs.optimize_section import vary_names
+from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
+from foldopt.inputs.study import Study
+from foldopt.inputs.study_file import default_study_path, parse_study_text, read_study
+from foldopt.names import (
+    FIELD_OF_PARAMETER,
+    FIELD_OPTIONS,
+    OPTIMIZE_VARIABLES,
+    WEATHER_SOURCES,
+    did_you_mean,
+)
 
+#: How answers and messages name the embedded study.
+EMBEDDED = "configs/shin2015.yaml"
 #: A sweep's axis -> the field it varies (``angle`` varies the fold angle of one case).
 SWEEP_AXES = {"angle": None, "latitude": "site.latitude", "day": "date", "load": "p_load"}
 #: Each sweep axis's range where the request leaves it out (``load``: see :func:`_default_loads`).
@@ -54,6 +78,8 @@ _ISO_DATE = re.compile(r"^(\d{4})-\d\d-\d\d$")
 _LISTED = ("lat", "lon", "p_load", "p_load_scale", "tilt", "days")
 #: Sweep flags and what each sets its field to.
 _FLAGS = {entry.parameter: entry.flag for entry in FIELD_OPTIONS if entry.flag is not None}
+#: Each field option's parameter -> how messages name it (``--days/--date``).
+_LABEL_OF_PARAMETER = {entry.parameter: entry.label for entry in FIELD_OPTIONS}
 #: The sizing's largest values and their units, by parameter (:attr:`foldopt.studies.sizing.SizingResult.parameters`).
 #: Within them every benefit, cost and net benefit over areas up to 1000 m^2 stays far below float
 #: overflow (the largest is some 1e13 $); beyond them a value is a slip, and 1e308 $/m^2 would print
@@ -65,30 +91,430 @@ SIZING_LIMITS = {
     "years": (1e3, " years"),
     "days_per_year": (366, " days"),
 }
+#: The joint optimisation's parameters, as :func:`optimize_section` and the command line name them.
+OPTIMIZE_OPTIONS = {
+    "vary": "--vary",
+    "fold_angle": "--fold-range",
+    "tilt": "--tilt-range",
+    "azimuth": "--azimuth-range",
+    "tolerance_h": "--tolerance",
+}
+#: A map's fields that its options set (the rest of its study is the study file's).
+MAP_OPTIONS = {
+    "area": "panel.area",
+    "efficiency": "panel.efficiency",
+    "step_min": "step_min",
+    "objective": "objective.statistic",
+    "p_load": "p_load",
+    "year": "year",
+}
 
 
 @dataclass(frozen=True)
 class Request:
-    """A request made into a plan.
+    """A request made into what runs (:func:`make_request`).
 
     Attributes
     ----------
-    plan : Plan
-        What runs: the study and its sweep axes.
+    command : str
+        One of :data:`foldopt.capabilities.COMMANDS`.
+    plan : Plan or foldopt.studies.worldmap.MapSpec
+        What runs: the validated studies and their sweep axes, or a map's study, sites and loads.
     source : str
         The study the request started from (a file, or ``the given study``).
     taken : tuple of str
         What the answer took from the study or from defaults, not from the request.
+    labels : dict
+        Field path -> how the request gave it (``--storage-wh``, ``--set storage.capacity_wh``,
+        a keyword): messages of later stages name fields so (:meth:`rename`).
+    run : str
+        The kind of run (:data:`foldopt.capabilities.RUNS`).
     """
 
-    plan: Plan
+    command: str
+    plan: object
     source: str
-    taken: tuple
+    taken: tuple = ()
+    labels: Mapping = field(default_factory=dict)
+    run: str = "day"
 
     @property
     def defaults(self) -> dict | None:
         """``{"study": source, "taken": [...]}``, or None where nothing was taken."""
         return {"study": self.source, "taken": list(self.taken)} if self.taken else None
+
+    def rename(self, line: str) -> str:
+        """A message's leading field as the request gave it (:func:`rename_field`)."""
+        return rename_field(line, self.labels)
+
+
+_FIELD = re.compile(r"^([A-Za-z_.]+)(\[[\d,]+\])?")
+
+
+def rename_field(line: str, labels: Mapping) -> str:
+    """A message's leading field path as the request gave it.
+
+    Parameters
+    ----------
+    line : str
+        ``field: problem`` or ``field = value: problem``.
+    labels : mapping
+        Field path -> label; the longest path that the line's field is or lies in is used.
+
+    Returns
+    -------
+    str
+        The line with its field renamed (``--storage-wh = nan: ...``), or as it was.
+    """
+    match = _FIELD.match(line)
+    if not match:
+        return line
+    path, end = match.group(1), match.end(1)
+    if path in labels:
+        return labels[path] + line[end:]
+    # A part of what an option gave: --tilt-range step (a --set names its own key's parts).
+    parts = path.split(".")
+    for cut in range(len(parts) - 1, 0, -1):
+        label = labels.get(".".join(parts[:cut]))
+        if label is not None:
+            if not label.startswith("--") or label.startswith("--set "):
+                return line
+            return f"{label} {' '.join(parts[cut:])}{line[end:]}"
+    return line
+
+
+def make_request(
+    command: str,
+    study=None,
+    *,
+    options: Mapping | None = None,
+    settings: Sequence[str] = (),
+    fields: Mapping | None = None,
+    optimize: Mapping | None = None,
+    target_h: float | None = None,
+    where: Mapping | None = None,
+    costs: Mapping | None = None,
+    source: str | None = None,
+) -> Request:
+    """The one front door: a request made into a validated plan, or refused in one line per fault.
+
+    Parameters
+    ----------
+    command : str
+        One of :data:`foldopt.capabilities.COMMANDS` (``run``, ``sweep angle``, ``optimize``,
+        ``size``, ``size --storage``, ``map``...).
+    study : None, str, pathlib.Path, dict, Study or Plan
+        The study the request starts from; None for the embedded study.
+    options : mapping, optional
+        The command line's options that set study fields, by parameter name (the keys of
+        :data:`foldopt.names.FIELD_OF_PARAMETER`; for a map, :data:`MAP_OPTIONS` and
+        ``angle_step``, ``fold_search``, ``optimize``, ``p_load_fraction``), and ``offline``;
+        None (or False) where not given.
+    settings : sequence of str
+        ``--set KEY=VALUE`` texts (:func:`parse_setting`).
+    fields : mapping, optional
+        The API's keywords: dotted field paths, or the short names of :data:`KEYWORDS`, to values;
+        a list or a range ``"start:stop:step"`` sweeps a field.
+    optimize : mapping, optional
+        A joint search's parameters (:func:`optimize_section`'s): ``vary``, ``fold_angle``,
+        ``tilt``, ``azimuth``, ``tolerance_h``, and ``labels``, how messages name them.
+    target_h : float, optional
+        ``size --storage``: the hours a day the load runs (``storage.target.powered_h``).
+    where : mapping, optional
+        A map's sites and how they are shown: ``sites``, ``weather_dir``, ``latitudes``,
+        ``longitudes``, ``land_only``, ``show_period``, ``weather`` (a source's section) of
+        :func:`foldopt.studies.worldmap.map_request`.
+    costs : mapping, optional
+        ``size``: the sizing's parameters (keys of :data:`SIZING_LIMITS`), None where not given:
+        each is checked, and the answer says where it took the paper's panel cost.
+    source : str, optional
+        How the answer names the study; default its file, or ``the given study``.
+
+    Returns
+    -------
+    Request
+
+    Raises
+    ------
+    foldopt.ConfigError
+        One line per fault, naming the field as the request gave it.
+    """
+    if command not in COMMANDS:
+        raise ValueError(
+            f"command must be one of {', '.join(COMMANDS)}{did_you_mean(command, COMMANDS)}"
+        )
+    options = dict(options or {})
+    if costs is not None and sizing_problems(costs):
+        raise ConfigError(sizing_problems(costs))
+    with offline_mode(options.pop("offline", False)):  # --offline: a weather source's cache only
+        data, lines, named = _study_data(study)
+        source = source or named
+        entries = _entries(command, data, options, settings, fields, optimize, target_h)
+        changes, labels = _merge(entries)
+        labels.update(_also_labels(options, labels))
+        try:
+            if command == "map":
+                return _map_request(data, study is None, changes, labels, options, where, source)
+            return _plan_request(command, study, data, lines, changes, labels, source, costs)
+        except ConfigError as error:
+            raise ConfigError(
+                [rename_field(_missing_hint(line, labels), labels) for line in error.errors]
+            ) from None
+
+
+def _also_labels(options: Mapping, labels: Mapping) -> dict:
+    """The fields an option sets beside its own (``--angle-step``: where the grid starts), named
+    by it where no entry names them."""
+    return {
+        also: entry.label
+        for entry in FIELD_OPTIONS
+        if options.get(entry.parameter) is not None and options.get(entry.parameter) is not False
+        for also in entry.also
+        if also not in labels
+    }
+
+
+def _missing_hint(line: str, labels: Mapping) -> str:
+    """A section's missing field said with what made the section: ``--min-soc`` alone makes a
+    buffer that has no capacity."""
+    path, _, problem = line.partition(": ")
+    if problem != "required field is missing":
+        return line
+    section = path.rpartition(".")[0]
+    makers = [label for given, label in labels.items() if policy.touched([given], section)]
+    if not makers:
+        return line
+    option = next((entry.label for entry in FIELD_OPTIONS if entry.field == path), None)
+    how = f"{option} (or {path})" if option else path
+    return f"{makers[0]}: {section} needs {path.rpartition('.')[2]} too; give {how}"
+
+
+def _study_data(study) -> tuple[dict, dict, str]:
+    """The fields of the study a request starts from, the YAML line of each key, and its name."""
+    if study is None or isinstance(study, (str, Path)):
+        data, lines = read_study(default_study_path() if study is None else study)
+        if not isinstance(data, dict):
+            raise ConfigError([f"study: expected a mapping of fields, got {type(data).__name__}"])
+        return data, lines, EMBEDDED if study is None else str(study)
+    if isinstance(study, Plan):
+        return study.data, {}, "the given study"
+    if isinstance(study, Study):
+        return study.data(), {}, "the given study"
+    if not isinstance(study, dict):
+        raise ConfigError([f"study: expected a mapping of fields, got {type(study).__name__}"])
+    return study, {}, "the given study"
+
+
+def _entries(command, data, options, settings, fields, optimize, target_h) -> list[tuple]:
+    """Each entry of a request as ``(label of a path, {path: value})`` pairs, in the order they
+    apply: the command's options, the API's keywords, the joint search's ranges, ``--set``."""
+    entries = []
+    if options and command == "map":
+        entries += _map_entries(options, data)
+    elif options:
+        entries += _option_entries(options, data)
+    for name, value in (fields or {}).items():
+        path = KEYWORDS.get(name, name)
+        entries.append((name, {path: _plain(value)}))
+    if optimize:
+        labels = optimize.get("labels") or {}
+        section = optimize_section(
+            **{k: v for k, v in optimize.items() if k != "labels"}, labels=labels
+        )
+        entries += [
+            (labels.get(name, f"optimize.{name}"), {f"optimize.{name}": value})
+            for name, value in section.items()
+        ]
+    if target_h is not None:
+        entries.append(("--target-h", {"storage.target.powered_h": target_h}))
+    errors = []
+    for setting in settings or ():
+        try:
+            key, value = parse_setting(setting)
+        except ConfigError as error:
+            errors += error.errors
+            continue
+        entries.append((f"--set {key}", {key: value}, False))  # its key is the field's name
+    if errors:
+        raise ConfigError(errors)
+    return entries
+
+
+def _leaves(path: str, value) -> list[str]:
+    """The field paths a change sets: a section's mapping sets only the fields it names."""
+    if (
+        isinstance(value, dict)
+        and value
+        and path.partition(".")[0]
+        in policy.SECTIONS
+        + (
+            "weather",
+            "circuit",
+            "optimize",
+            "load_profile",
+        )
+    ):
+        return [leaf for key, item in value.items() for leaf in _leaves(f"{path}.{key}", item)]
+    return [path]
+
+
+def _merge(entries: list[tuple]) -> tuple[dict, dict]:
+    """One value per field: the entries' changes in order, and the label of each field whose
+    entry names it otherwise (an option, a keyword: messages say it so).
+
+    Parameters
+    ----------
+    entries : list of tuple
+        ``(label, {path: value})``, or ``(label, {path: value}, False)`` for an entry whose
+        messages keep the field's own name (a ``--set`` key, a field an option chose).
+
+    Raises
+    ------
+    foldopt.ConfigError
+        For a field two entries set (or one inside a field another sets whole): one line naming
+        both and their values.
+    """
+    changes, labels, owners, errors = {}, {}, {}, []
+    for label, items, *renames in entries:
+        for path, value in items.items():
+            for leaf in _leaves(path, value):
+                clash = next(
+                    (
+                        other
+                        for other in owners
+                        if other == leaf
+                        or other.startswith(leaf + ".")
+                        or leaf.startswith(other + ".")
+                    ),
+                    None,
+                )
+                if clash is not None and owners[clash][0] != label:
+                    first, given = owners[clash]
+                    errors.append(
+                        f"{leaf}: given twice, as {first} = {_shown(given)} and {label} = "
+                        f"{_shown(_value_at(path, value, leaf))}; give one"
+                    )
+                    continue
+                if clash is not None:
+                    errors.append(f"{label}: given twice; give each setting once")
+                    continue
+                owners[leaf] = (label, _value_at(path, value, leaf))
+            changes[path] = value
+            # a --set key, a field an option chose: messages keep the field's own name
+            labels[path] = label if renames != [False] else path
+    if errors:
+        raise ConfigError(list(dict.fromkeys(errors)))
+    return changes, labels
+
+
+def _value_at(path: str, value, leaf: str):
+    """The value a change gives one of its leaves."""
+    for key in leaf[len(path) + 1 :].split(".") if leaf != path else ():
+        value = value.get(key) if isinstance(value, dict) else value
+    return value
+
+
+def _shown(value) -> str:
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, float):
+        return f"{value:g}"
+    return repr(value) if isinstance(value, str) else str(value)
+
+
+def _option_entries(options: dict, data: dict) -> list[tuple]:
+    """The command line's field options as entries (the option's label, its field's change)."""
+    errors, entries = [], []
+    if options.get("p_load_scale") is not None:
+        if options.get("p_load") is not None:
+            errors.append(
+                "--p-load / --p-load-scale: a constant load or a profile's scale, not both"
+            )
+        elif data.get("load_profile") is None and options.get("load_profile") is None:
+            errors.append(
+                "--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
+                "the study)"
+            )
+    lonely = [
+        option
+        for option in ("weather_format", "members", "seed", "years")
+        if options.get(option) is not None
+    ]
+    if lonely and options.get("weather") is None and data.get("weather") is None:
+        errors.append(
+            f"--{lonely[0].replace('_', '-')}: an option of a weather file; give one with --weather"
+        )
+    for option, value in options.items():
+        if value is None or value is False:
+            continue
+        path, label = FIELD_OF_PARAMETER[option], _LABEL_OF_PARAMETER[option]
+        if option in _FLAGS:
+            value = _FLAGS[option]
+        elif option in _LISTED:
+            try:
+                value = parse_values(value, numeric=option != "days")
+            except ValueError as error:
+                errors.append(f"{label} = {options[option]!r}: {error}")
+                continue
+        elif option == "weather" and str(value) in WEATHER_SOURCES:
+            value = {"source": str(value)}  # a source's name: its answer for the site
+        elif option == "weather":
+            hint = did_you_mean(str(value), WEATHER_SOURCES)
+            if hint and not os.path.lexists(str(value)):  # a misspelt source, not a file
+                errors.append(
+                    f"--weather = {str(value)!r}: no such file, nor a weather source "
+                    f"({', '.join(WEATHER_SOURCES)}){hint}"
+                )
+                continue
+            value = {"path": str(value)}  # a new file: none of the study's file's options
+        elif option in ("load_profile", "horizon"):
+            value = {"file": str(value)}
+        if option == "load_voltage":
+            # coupled directly: said as circuit.coupling, the field the option chose
+            entries.append((label, {"circuit.coupling": "direct"}, False))
+        entries.append((label, {path: value}))
+    if errors:
+        raise ConfigError(errors)
+    return entries
+
+
+def _map_entries(options: dict, data: dict) -> list[tuple]:
+    """A map's options that set its study's fields, as entries."""
+    entries = []
+    for option, path in MAP_OPTIONS.items():
+        if options.get(option) is not None:
+            entries.append((f"--{option.replace('_', '-')}", {path: options[option]}))
+    if options.get("p_load_fraction") is not None:
+        entries.append(("--p-load-fraction", {"p_load": options["p_load_fraction"]}))
+    if options.get("angle_step") is not None:
+        step = options["angle_step"]
+        entries.append(
+            ("--angle-step", {"fold_angles": {"start": step, "stop": 180.0, "step": step}})
+        )
+    searched = options.get("optimize")
+    if options.get("fold_search") or searched:
+        try:
+            varied = vary_names(searched or [])
+        except ValueError as error:
+            raise ConfigError([f"--optimize = {searched!r}: {error}"]) from None
+        if any(name not in OPTIMIZE_VARIABLES for name in varied):
+            raise ConfigError(
+                [f"--optimize = {searched!r}: must name some of {', '.join(OPTIMIZE_VARIABLES)}"]
+            )
+        extra = [name for name in varied if name != "fold_angle"]
+        label = "--optimize" if searched else "--fold-search"
+        entries.append((label, {"optimize.vary": ["fold_angle", *extra]}))
+    return entries
+
+
+def _plain(values):
+    """A sequence (a list, a tuple, an array) as a list of plain values; text and scalars as they are."""
+    if isinstance(values, (str, dict)) or not (
+        isinstance(values, Sequence) or hasattr(values, "tolist")
+    ):
+        return values.item() if hasattr(values, "item") else values
+    items = [item.item() if hasattr(item, "item") else item for item in values]
+    return [item.isoformat() if hasattr(item, "isoformat") else item for item in items]
 
 
 def _default_loads(data: dict) -> list[float]:
@@ -100,68 +526,50 @@ def _default_loads(data: dict) -> list[float]:
     ]
 
 
-def plan_request(
-    data: dict,
-    changes: dict | None = None,
-    *,
-    axis: str | None = None,
-    source: str = "the given study",
-    name: str | None = None,
-) -> Request:
-    """The plan of a study with some fields changed, and what it took from the study.
-
-    Parameters
-    ----------
-    data : dict
-        The study's fields (a YAML study's data, or :meth:`foldopt.Study.data`).
-    changes : dict, optional
-        Dotted field paths (or sections with mappings) to values: a value sets the field, a list or
-        a range ``"start:stop:step"`` makes it an axis; ``date`` also takes ``"year"`` and
-        ``"equinoxes-solstices"``, ``year`` the year of day-of-year ranges.
-    axis : {'angle', 'latitude', 'day', 'load'}, optional
-        A sweep's own axis: its field takes :data:`DEFAULT_RANGES` where ``changes`` leave it out,
-        and ``angle`` is one case (with a weather file, one fold angle for the file's year).
-    source : str
-        How the answer names the study the request started from.
-    name : str, optional
-        The plan's study name (default the study's).
-
-    Returns
-    -------
-    Request
-
-    Raises
-    ------
-    foldopt.ConfigError
-        One line per fault, naming the field.
-    """
-    if axis is not None and axis not in SWEEP_AXES:
-        raise ConfigError([f"sweep: unknown axis {axis!r}; one of {', '.join(SWEEP_AXES)}"])
-    changes = policy.flatten(dict(changes or {}))
-    field = SWEEP_AXES.get(axis)
-    if field is not None and field in changes and policy.is_single(changes[field]):
-        raise ConfigError([f"{field}: sweep {axis} needs a range start:stop:step or a list"])
-    new, decided = policy.apply(data, changes, field)
-    if field is not None and field not in changes:
-        new = policy.set_path(
-            new, field, _default_loads(new) if field == "p_load" else DEFAULT_RANGES[field]
-        )
-    weather = new.get("weather")
-    ensemble = isinstance(weather, dict) and weather.get("members") is not None
-    if (
-        axis == "angle"
-        and weather is not None
-        and "objective" not in new
-        and (ensemble or not ("date" in changes and policy.is_single(changes["date"])))
-    ):
-        # a year of weather (or a day's ensemble) at one fold angle
-        new["objective"] = {"statistic": "mean"}
-    study_year = _ISO_DATE.match(str(data.get("date", "")))
-    if "year" not in new and study_year:
-        new["year"] = int(study_year.group(1))  # days of year are the study's year's
-    if name is not None:
-        new["name"] = name
-    plan = make_plan(new)
+def _plan_request(command, study, data, lines, changes, labels, source, costs) -> Request:
+    """Steps 2 to 4 of every request but a map's."""
+    axis = command.partition(" ")[2] if command.startswith("sweep ") else None
+    if isinstance(study, (Plan, Study)) and not changes:
+        plan = study if isinstance(study, Plan) else _plan_of(study)
+        taken, decided = [], []
+    else:
+        given = set(changes)
+        changes = {**changes, **_command_defaults(command, data, changes)}
+        if axis is not None or command == "optimize":
+            description = f"foldopt {command} from {source} (see command)"
+            changes.setdefault("description", description)
+        field = SWEEP_AXES.get(axis)
+        flat = policy.flatten(changes)
+        if field is not None and field in flat and policy.is_single(flat[field]):
+            raise ConfigError([f"{field}: sweep {axis} needs a range start:stop:step or a list"])
+        new, decided = policy.apply(data, flat, field)
+        if field is not None and field not in flat:
+            new = policy.set_path(
+                new, field, _default_loads(new) if field == "p_load" else DEFAULT_RANGES[field]
+            )
+            labels[field] = f"sweep {axis}'s default range"  # not an option the user gave
+        weather = new.get("weather")
+        ensemble = isinstance(weather, dict) and weather.get("members") is not None
+        if (
+            axis == "angle"
+            and weather is not None
+            and "objective" not in new
+            and (ensemble or not ("date" in flat and policy.is_single(flat["date"])))
+        ):
+            new["objective"] = {"statistic": "mean"}  # a year of weather at one fold angle
+        study_year = _ISO_DATE.match(str(data.get("date", "")))
+        if "year" not in new and study_year:
+            new["year"] = int(study_year.group(1))  # days of year are the study's year's
+        if axis is not None or command == "optimize":
+            new["name"] = command.replace(" ", "-")
+        elif command == "size --storage" and "name" not in given:
+            new["name"] = f"{data.get('name')}-buffer"
+        plan = make_plan(new, _unchanged_lines(lines, data, new))
+        taken = _taken(plan, given, field, new, decided) if command != "run" else decided
+    run = _run_of(command, plan)
+    _refuse_unhonoured(command, run, plan.base)
+    if _set_by_run(run, policy.flatten(changes)):
+        raise ConfigError(_set_by_run(run, policy.flatten(changes)))
     if axis == "angle":
         varied = [
             path
@@ -171,22 +579,121 @@ def plan_request(
         if varied:
             raise ConfigError(
                 [
-                    f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep latitude, "
-                    "day or load)"
+                    f"sweep angle: one site, day and load; {', '.join(varied)} vary (use sweep "
+                    "latitude, day or load)"
                 ]
             )
-    return Request(plan, source, tuple(_taken(plan, changes, field, new, decided)))
+    if command in ("size", "size --storage"):
+        taken = _size_taken(command, plan, source, costs or {})
+    return Request(command, plan, source, tuple(taken), labels, run)
 
 
-def _taken(
-    plan: Plan, changes: dict, field: str | None, data: dict, decided: list[str]
-) -> list[str]:
+def _command_defaults(command: str, data: dict, changes: dict) -> dict:
+    """What a command sets where neither the study nor the request does."""
+    touched = set(policy.flatten(changes))
+    defaults = {}
+    if (
+        command == "optimize"
+        and data.get("optimize") is None
+        and not policy.touched(touched, "optimize")
+    ):
+        defaults["optimize"] = {}  # the search's own defaults: every variable
+    if command == "size --storage":
+        if data.get("storage") is None and not policy.touched(touched, "storage.capacity_wh"):
+            defaults["storage.capacity_wh"] = 0.0  # an ideal buffer, sized from nothing
+        weather = changes.get("weather", data.get("weather"))
+        if (
+            weather is not None
+            and data.get("objective") is None
+            and not policy.touched(touched, "objective")
+        ):
+            defaults["objective"] = {"statistic": "mean"}  # a weather year: one angle for it
+    return defaults
+
+
+def _unchanged_lines(lines: dict, data: dict, new: dict) -> dict:
+    """A study file's key lines less those whose values a request (or the policy) changed: a
+    message about such a field must not point at the file's line."""
+    missing = object()
+
+    def at(tree, loc):
+        for key in loc:
+            if not isinstance(tree, dict) or key not in tree:
+                return missing
+            tree = tree[key]
+        return tree
+
+    return {loc: line for loc, line in lines.items() if at(data, loc) == at(new, loc)}
+
+
+def _plan_of(study: Study) -> Plan:
+    """A study as a plan of one case, its validated self kept."""
+    from foldopt.inputs.study_file import with_files
+
+    return Plan.of(with_files(study))
+
+
+def _run_of(command: str, plan: Plan) -> str:
+    """The kind of run a plan is (:data:`foldopt.capabilities.RUNS`)."""
+    if command == "size":
+        return "sizing"
+    base = plan.base
+    if base.optimize is not None:
+        return "optimize"
+    if base.weather is not None and base.weather.members is not None:
+        return "ensemble"
+    axes = dict(plan.axes)
+    if base.objective is not None and "date" in axes:
+        return "annual"
+    return "cases" if axes else "day"
+
+
+#: Each capability's test on a validated study: whether the study has it.
+_HAS = {
+    "storage": lambda study: study.storage is not None,
+    "weather": lambda study: study.weather is not None,
+    "weather.members": lambda study: (
+        study.weather is not None and study.weather.members is not None
+    ),
+    "site.horizon": lambda study: study.site is not None and study.site.horizon is not None,
+    "load_profile": lambda study: study.load_profile is not None,
+    "optimize": lambda study: study.optimize is not None,
+}
+
+
+def _refuse_unhonoured(command: str, run: str, study) -> None:
+    """Refuse, one line each, the capabilities a study has that its run does not honour."""
+    from foldopt.capabilities import CAPABILITIES
+
+    if run not in COMMAND_RUNS[command]:
+        # A study's optimize section would make a sweep a joint search: refused, not followed.
+        run = COMMAND_RUNS[command][0]
+    errors = [
+        refusal(capability.name, command, run)
+        for capability in CAPABILITIES
+        if run not in capability.honoured and _HAS[capability.name](study)
+    ]
+    if errors:
+        raise ConfigError(errors)
+
+
+def _set_by_run(run: str, changes: dict) -> list[str]:
+    """The fields a request gives that its run sets itself or has no use for, one line each."""
+    return [
+        f"{path}: {why}"
+        for prefix, why in SET_BY_RUN.get(run, {}).items()
+        for path in changes
+        if policy.touched([path], prefix)
+    ]
+
+
+def _taken(plan: Plan, given: set, field: str | None, data: dict, decided: list[str]) -> list[str]:
     """What a request took from its study and its defaults, for the answer's "from" line."""
     from foldopt.inputs.load_profile import load_text
 
     study = plan.base
-    given = set(changes)
-    weather = "weather" in given
+    given = set(policy.flatten({path: None for path in given}))
+    weather = policy.touched(given, "weather")
     taken = []
     if field is not None and field not in given:
         if field == "p_load":
@@ -197,11 +704,12 @@ def _taken(
             year = f" of {data['year']}" if field == "date" and data.get("year") else ""
             label = {"site.latitude": "latitude", "date": "day"}[field]
             taken.append(f"{label} {DEFAULT_RANGES[field]}{year} (default range)")
-    if not policy.touched(given, "site") and not weather and field != "site.latitude":
+    source = study.weather is not None and study.weather.source is not None
+    if not policy.touched(given, "site") and (source or not weather) and field != "site.latitude":
         taken.append(f"site {study.site.latitude:g}, {study.site.longitude:g}")
     if "date" not in given and not weather and field != "date":
         taken.append(f"date {study.date}")
-    if "panel.area" not in given:
+    if not policy.touched(given, "panel.area") and not policy.touched(given, "panel"):
         taken.append(f"panel {study.panel.area:g} m^2")
     if "p_load" not in given and field != "p_load":
         taken.append(load_text(study))
@@ -214,44 +722,91 @@ def _taken(
     return taken
 
 
-def size_request(plan: Plan, source: str, cost_given: bool) -> Request:
-    """A sizing's request: the study's one case, and what the sizing took from it.
-
-    Parameters
-    ----------
-    plan : Plan
-        The study; a sizing takes one case, so a plan with sweep axes is refused.
-    source : str
-        How the answer (and an error) names the study.
-    cost_given : bool
-        Whether the request gives a panel cost; if not, the answer says it took the paper's.
-
-    Returns
-    -------
-    Request
-        ``taken``: the site, day, load and efficiency, and the paper's panel cost where no cost is
-        given.
-
-    Raises
-    ------
-    foldopt.ConfigError
-        For a plan that sweeps fields.
-    """
-    from foldopt.inputs.load_profile import load_text
+def _size_taken(command: str, plan: Plan, source: str, costs: Mapping) -> list[str]:
+    """What a sizing took from its study (the site, day, load and efficiency) and, where the
+    request gives no panel cost, the paper's."""
     from foldopt.inputs.costs import PAPER_COST_PER_M2
+    from foldopt.inputs.load_profile import load_text
 
-    if plan.axes:
+    if command == "size" and plan.axes:
         raise ConfigError(
             [f"config: {source} sweeps {', '.join(p for p, _ in plan.axes)}; size takes one case"]
         )
     study = plan.base
     taken = [f"site, day, {load_text(study)}, efficiency {study.panel.efficiency:g}"]
-    if not cost_given:
+    if command == "size" and costs.get("cost_per_m2") is None and costs.get("cost_per_w") is None:
         taken.append(
             f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
             "cost_per_m2 or cost_per_w)"
         )
-    return Request(plan, source, tuple(taken))
+    return taken
+
+
+def _map_request(data, embedded, changes, labels, options, where, source) -> Request:
+    """A map's request: its study (the study's panel and models, the map's options over them),
+    sites and loads, checked once (:func:`foldopt.studies.worldmap.map_request`), as a
+    :class:`foldopt.studies.worldmap.MapSpec`."""
+    from foldopt.studies.worldmap import map_request, map_study
+
+    flat = policy.flatten(changes)
+    errors = _set_by_run("map", flat)
+    # The study's and the request's weather: a source is fetched at each site; a file is one site's.
+    weather = copy.deepcopy(data.get("weather"))
+    for path, value in flat.items():
+        if policy.touched([path], "weather"):
+            weather = policy.set_path({"weather": weather}, path, value)["weather"]
+    if isinstance(weather, str) or (isinstance(weather, dict) and weather.get("path")):
+        errors.append(
+            "weather: a map's sites each bring their own weather: a folder of files "
+            f"(--weather-dir) or a source (--weather {' | '.join(WEATHER_SOURCES)})"
+        )
+    elif isinstance(weather, dict) and weather.get("members") is not None:
+        errors.append(refusal("weather.members", "map", "map"))
+    site = data.get("site")
+    horizon = site.get("horizon") if isinstance(site, dict) else None
+    for name, present in (
+        ("storage", data.get("storage") is not None or policy.touched(flat, "storage")),
+        ("load_profile", data.get("load_profile") is not None or "load_profile" in flat),
+        ("site.horizon", horizon is not None),
+    ):
+        if present:
+            errors.append(
+                refusal(name, "map", "map")
+                if name != "site.horizon"
+                else "site.horizon: a horizon is of one site; give each site its own in the "
+                "--sites CSV's horizon column"
+            )
+    if errors:
+        raise ConfigError(list(dict.fromkeys(errors)))
+    where = dict(where or {})
+    if isinstance(weather, dict) and weather.get("source") is not None:
+        where["weather"] = {**weather, **(where.get("weather") or {})}
+    relative = options.get("p_load_fraction") is not None or bool(where.pop("relative", False))
+    year = flat.pop("year", data.get("year", 2025))
+    loads = flat.pop("p_load", None)
+    study = {key: value for key, value in flat.items() if not policy.touched([key], "weather")}
+    made, _ = policy.apply(map_study(data, embedded=embedded), study)
+    # The study's load as its file gives it: a value, a list or a range text, checked like --p-load.
+    spec = map_request(
+        made,
+        (data.get("p_load") or 1.0) if loads is None else loads,
+        relative=relative,
+        year=year,
+        **where,
+    )
+    loads_taken = (
+        f"P_load {spec.loads[0]:g} W"
+        if len(spec.loads) == 1
+        else f"P_load {len(spec.loads)} loads, {min(spec.loads):g} to {max(spec.loads):g} W"
+    )
+    taken = [
+        f"panel {spec.study.panel.area:g} m^2" if "panel.area" not in flat else None,
+        loads_taken if loads is None and not relative else None,
+        f"{spec.study.pv_model} PV model",
+        f"{spec.study.mode} mode",
+        f"{spec.study.step_min:g}-min steps" if "step_min" not in flat else None,
+    ]
+    return Request("map", spec, source, tuple(item for item in taken if item), labels, "map")
 
 
 def sizing_problems(parameters: dict) -> list[str]:
@@ -273,7 +828,9 @@ def sizing_problems(parameters: dict) -> list[str]:
     problems = []
     for name, (largest, unit) in SIZING_LIMITS.items():
         value = parameters.get(name)
-        if value is None or (isinstance(value, (int, float)) and 0 < value <= largest):
+        if value is None or (
+            isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value <= largest
+        ):
             continue
         shown = f"{value:g}" if isinstance(value, (int, float)) else repr(value)
         problems.append(
@@ -311,137 +868,6 @@ def parse_setting(setting: str) -> tuple[str, object]:
         problem = re.sub(rf"^config: {re.escape(source)}(?: at line \d+)?: ", "", error.errors[0])
         raise ConfigError([f"--set {key} = {text!r}: not a YAML value ({problem})"]) from None
     return key.strip(), value
-
-
-def settings_plan(path, settings=()) -> Plan:
-    """A YAML study's plan with fields changed by ``--set``, as if its file said so.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The study file.
-    settings : sequence of str
-        ``KEY=VALUE`` texts (:func:`parse_setting`), applied in order.
-
-    Returns
-    -------
-    Plan
-
-    Raises
-    ------
-    foldopt.ConfigError
-        One line per fault: a setting that is no ``KEY=VALUE``, or the study's validation (a
-        field a setting changed without the file's line, which no longer holds it).
-    """
-    data, lines = read_study(path)
-    errors = []
-    for setting in settings:
-        try:
-            key, value = parse_setting(setting)
-        except ConfigError as error:
-            errors += error.errors
-            continue
-        if isinstance(data, dict):
-            data = policy.set_path(data, key, value)
-        parts = tuple(key.split("."))
-        # Neither the changed field's lines nor its sections' (whose line a message falls back on) hold it now.
-        lines = {
-            loc: line
-            for loc, line in lines.items()
-            if loc[: len(parts)] != parts and parts[: len(loc)] != loc
-        }
-    if errors:
-        raise ConfigError(errors)
-    return make_plan(data, lines)
-
-
-def sweep_changes(options: dict, data: dict) -> dict:
-    """The fields the command line's sweep options change, by field path; ``--set`` last.
-
-    Parameters
-    ----------
-    options : dict
-        Each option of ``foldopt sweep`` by its parameter name (the keys of
-        :data:`foldopt.names.FIELD_OF_PARAMETER` and ``settings``, the ``--set`` texts) -> its
-        value, None (or False) where not given.
-    data : dict
-        The study's fields the sweep starts from.
-
-    Returns
-    -------
-    dict
-        Field path -> value, a range or a list (:func:`plan_request`'s ``changes``).
-
-    Raises
-    ------
-    foldopt.ConfigError
-        One line per fault, naming the option.
-    """
-    changes, errors = {}, []
-    if options["p_load_scale"] is not None:
-        if options["p_load"] is not None:
-            errors.append(
-                "--p-load / --p-load-scale: a constant load or a profile's scale, not both"
-            )
-        elif data.get("load_profile") is None and options["load_profile"] is None:
-            errors.append(
-                "--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
-                "the study)"
-            )
-    lonely = [
-        option
-        for option in ("weather_format", "members", "seed", "years")
-        if options.get(option) is not None
-    ]
-    if lonely and options.get("weather") is None and data.get("weather") is None:
-        errors.append(
-            f"--{lonely[0].replace('_', '-')}: an option of a weather file; give one with --weather"
-        )
-    for option, value in options.items():
-        if option == "settings" or value is None or value is False:
-            continue
-        if option in _FLAGS:
-            value = _FLAGS[option]
-        elif option in _LISTED:
-            try:
-                value = parse_values(value, numeric=option != "days")
-            except ValueError as error:
-                flag = "--" + option.replace("_", "-")
-                errors.append(f"{flag} = {options[option]!r}: {error}")
-                continue
-        elif option == "weather" and str(value) in WEATHER_SOURCES:
-            value = {"source": str(value)}  # a source's name: its answer for the site
-        elif option == "weather":
-            hint = did_you_mean(str(value), WEATHER_SOURCES)
-            if hint and not os.path.lexists(str(value)):  # a misspelt source, not a file
-                errors.append(
-                    f"--weather = {str(value)!r}: no such file, nor a weather source "
-                    f"({', '.join(WEATHER_SOURCES)}){hint}"
-                )
-                continue
-            value = {"path": str(value)}  # a new file: none of the study's file's options
-        elif option == "load_profile":
-            value = {"file": str(value)}
-        elif option == "horizon":
-            value = {"file": str(value)}
-        elif option == "load_voltage":
-            changes["circuit.coupling"] = "direct"
-        changes[FIELD_OF_PARAMETER[option]] = value
-    if errors:
-        raise ConfigError(errors)
-    for setting in options["settings"] or ():
-        changes.update([parse_setting(setting)])
-    return changes
-
-
-#: The joint optimisation's parameters, as :func:`optimize_section` and the command line name them.
-OPTIMIZE_OPTIONS = {
-    "vary": "--vary",
-    "fold_angle": "--fold-range",
-    "tilt": "--tilt-range",
-    "azimuth": "--azimuth-range",
-    "tolerance_h": "--tolerance",
-}
 
 
 def optimize_section(
@@ -495,164 +921,6 @@ def optimize_section(
     return section
 
 
-def sweep_request(
-    study, options: dict, axis: str | None, source: str, section: dict | None = None
-) -> Request:
-    """The request of ``foldopt sweep AXIS``: the study, changed by the sweep's options.
-
-    Parameters
-    ----------
-    study : dict, str, pathlib.Path or None
-        The study's fields, or a YAML study to read them from; None for the embedded study.
-    options : dict
-        The sweep's options (:func:`sweep_changes`).
-    axis : {'angle', 'latitude', 'day', 'load'} or None
-        None for ``foldopt optimize``, which sweeps no axis of its own.
-    source : str
-        How the answer names the study.
-    section : dict, optional
-        ``foldopt optimize``'s ``optimize`` section (:func:`optimize_section`), over the study's own.
-
-    Returns
-    -------
-    Request
-        Its plan is named ``sweep-<axis>`` (or ``optimize``) and described as the command that made it.
-
-    Raises
-    ------
-    foldopt.ConfigError
-        One line per fault, naming the option or the field.
-    """
-    options = dict(options)
-    with offline_mode(options.pop("offline", False)):  # --offline: a weather source's cache only
-        return _sweep_request(study, options, axis, source, section)
-
-
-def _sweep_request(study, options: dict, axis, source: str, section) -> Request:
-    data = (
-        study
-        if isinstance(study, dict)
-        else read_study(default_study_path() if study is None else study)[0]
-    )
-    changes = sweep_changes(options, data)
-    command = "optimize" if section is not None else f"sweep {axis}"
-    changes["description"] = f"foldopt {command} from {source} (see command)"
-    if section is not None:
-        changes["optimize"] = {**(data.get("optimize") or {}), **section}
-    return plan_request(
-        data, changes, axis=axis, source=source, name=f"{command.replace(' ', '-')}"
-    )
-
-
-def map_request_from(
-    study=None,
-    *,
-    source: str = "the given study",
-    objective: str = "mean",
-    area=None,
-    efficiency=None,
-    step_min=None,
-    angle_step=None,
-    fold_search: bool = False,
-    optimize=None,
-    settings=(),
-    loads=None,
-    **where,
-):
-    """The request of ``foldopt map``: a study made into a map's study by the map's options, and
-    the map's sites and loads (:func:`foldopt.studies.worldmap.map_request`).
-
-    Parameters
-    ----------
-    study : dict, str, pathlib.Path or None
-        The study's fields, or a YAML study to read them from, that the map takes its panel, models
-        and load from; None for the embedded study, whose mode gives way to
-        :data:`foldopt.studies.worldmap.MAP_DEFAULTS` (its sky and geometry exact mode's).
-    source : str
-        How the answer names the study.
-    objective : str
-        What each period's fold angle maximises: ``mean``, ``min``, ``worst-month`` or ``pNN``.
-    area, efficiency : float, optional
-        The flat panel's area [m^2] and PV efficiency [-]; default the study's.
-    step_min : float, optional
-        Time step [min]; default the study's.
-    angle_step : float, optional
-        Fold-angle grid step [deg], the grid from it to 180; default the study's grid.
-    fold_search : bool
-        Search each site's fold angles (``optimize: {vary: [fold_angle]}``,
-        :func:`foldopt.studies.site_search.fold_search`) instead of evaluating every one.
-    optimize : str or sequence of str, optional
-        What the search varies with the fold angle: ``tilt`` (each site's best base tilt, the flat
-        panel's own beside it); names joined by commas or a list.
-    settings : sequence of str
-        ``KEY=VALUE`` texts (:func:`parse_setting`), set last.
-    loads : float, sequence of float or str, optional
-        Default the study's ``p_load`` [W].
-    **where
-        ``sites``, ``weather_dir``, ``latitudes``, ``longitudes``, ``land_only``, ``relative``,
-        ``year`` and ``show_period`` of :func:`foldopt.studies.worldmap.map_request`.
-
-    Returns
-    -------
-    foldopt.studies.worldmap.MapRequest
-        With ``taken``: the panel area, load and step the map took from the study, its PV model
-        and mode.
-
-    Raises
-    ------
-    foldopt.ConfigError
-        One line per fault, naming the field or the parameter.
-    """
-    from foldopt.studies.worldmap import map_request, map_study
-
-    data = (
-        study
-        if isinstance(study, dict)
-        else read_study(default_study_path() if study is None else study)[0]
-    )
-    changes = {"objective": {"statistic": objective}}
-    for field, value in (
-        ("panel.area", area),
-        ("panel.efficiency", efficiency),
-        ("step_min", step_min),
-    ):
-        if value is not None:
-            changes[field] = value
-    if angle_step is not None:
-        changes["fold_angles"] = {"start": angle_step, "stop": 180.0, "step": angle_step}
-    if fold_search or optimize:
-        try:
-            varied = vary_names(optimize or [])
-        except ValueError as error:
-            raise ConfigError([f"optimize = {optimize!r}: {error}"]) from None
-        if any(name not in OPTIMIZE_VARIABLES for name in varied):
-            raise ConfigError(
-                [f"optimize = {optimize!r}: must name some of {', '.join(OPTIMIZE_VARIABLES)}"]
-            )
-        extra = [name for name in varied if name != "fold_angle"]
-        changes["optimize"] = {**(data.get("optimize") or {}), "vary": ["fold_angle", *extra]}
-    made = map_study(data, embedded=study is None, **changes)
-    for setting in settings:
-        field, value = parse_setting(setting)
-        made = policy.set_path(made, field, value)
-    # The study's load as its file gives it: a value, a list or a range text, checked like --p-load.
-    request = map_request(made, (data.get("p_load") or 1.0) if loads is None else loads, **where)
-    study_loads = (
-        f"P_load {request.loads[0]:g} W"
-        if len(request.loads) == 1
-        else f"P_load {len(request.loads)} loads, {min(request.loads):g} to {max(request.loads):g} W"
-    )
-    made = request.study
-    taken = [
-        f"panel {made.panel.area:g} m^2" if area is None else None,
-        study_loads if loads is None and not request.relative else None,
-        f"{made.pv_model} PV model",
-        f"{made.mode} mode",
-        f"{made.step_min:g}-min steps" if step_min is None else None,
-    ]
-    return replace(request, source=source, taken=tuple(item for item in taken if item))
-
-
 def request_engine(engine: str, plan) -> str:
     """The engine of every evaluation of one request (:data:`foldopt.names.ENGINES`), decided once
     where the request enters the API (:func:`foldopt.run`, :func:`foldopt.optimize`,
@@ -685,11 +953,9 @@ def request_engine(engine: str, plan) -> str:
         return engine_for(engine, math.inf)
     if base.storage is not None:
         # The buffer's reference path walks the time steps in Python, 0.8 s a pass over a day of
-        # 1-min steps however few the curves, and a periodic state takes 2 to 60 passes: a day's
-        # buffer sized for a target took 55 s there, 0.23 s compiled (its first compile 6 s).
+        # 1-min steps however few the curves, and a periodic state takes 2 to 60 passes.
         return engine_for(engine, math.inf)
     if base.optimize is not None and set(base.optimize.vary) != {"fold_angle"}:
-        # A joint search over the tilt or the azimuth evaluates some 10^4 designs of a day (the
-        # embedded study's 15,915: results/examples/optimize/added.csv), 23 M rows x steps.
+        # A joint search over the tilt or the azimuth evaluates some 10^4 designs of a day.
         return engine_for(engine, math.inf)
     return engine_for(engine, cases * base.fold_angles.count() * round(24 * 60 / base.step_min))

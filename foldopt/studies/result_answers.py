@@ -15,7 +15,7 @@ import pandas as pd
 
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
-from foldopt.studies.storage_answer import buffer_text, sequential, unsimulated_notes, year_lines
+from foldopt.studies.storage_answer import buffer_text, sequential, year_lines
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES, FLAT_FOLD_ANGLE
 from foldopt.studies.worldmap import searched_tilt
 
@@ -485,8 +485,7 @@ def of_sweep(result) -> Answer:
         pd.DataFrame(),
         design_notes(table, plan.n_cases)
         + weather_notes(result)
-        + horizon_notes(plan.base, _dates(plan))
-        + unsimulated_notes(plan.base),
+        + horizon_notes(plan.base, _dates(plan)),
         tuple(lines),
     )
 
@@ -658,8 +657,7 @@ def _of_annual(result) -> Answer:
         schedule,
         design_notes(result.table, plan.n_cases)
         + weather_notes(result)
-        + horizon_notes(study, _dates(plan))
-        + (unsimulated_notes(study) if buffered is None else []),
+        + horizon_notes(study, _dates(plan)),
         tuple(lines),
     )
 

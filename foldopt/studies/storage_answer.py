@@ -13,7 +13,10 @@ reaching the target and the one below it (which does not) cut into :data:`REFINE
 parts, the least part reaching it and the part below it the next bracket, until it is within
 :data:`CAPACITY_RTOL` of its top. The capacity given is therefore always one evaluated that
 reaches the target, every smaller capacity of the grid falls short of it, and so does an
-evaluated one within :data:`CAPACITY_RTOL` below it.
+evaluated one within :data:`CAPACITY_RTOL` below it. The capacity from which folding stops
+paying is found by the same search (:func:`folding_pays`), at the capacities the sizing names too,
+so that every capacity the answer states is one evaluated and found to hold, and the lines hold
+against each other.
 
 That this is *the* smallest buffer rests on powered time not falling as the capacity grows. It
 holds, to within one step, only for a controller without hysteresis (``restart_soc`` =
@@ -83,10 +86,12 @@ def storage_engine(engine: str) -> str:
     return engine_for(engine, math.inf)
 
 
-def run_buffer(power, load, buffer: Buffer, step_hours: float, engine: str, soc_curves=False):
+def run_buffer(
+    power, load, buffer: Buffer, step_hours: float, engine: str, soc_curves=False, draw=None
+):
     """:func:`foldopt.engine.storage.simulate` of a day's curves (periodic steady state, or from
-    ``initial_soc``) on ``engine`` ('numba' or 'numpy')."""
-    return simulate(power, load, buffer, step_hours, engine, soc_curves=soc_curves)
+    ``initial_soc``) on ``engine`` ('numba' or 'numpy'), with the designs' own ``draw``."""
+    return simulate(power, load, buffer, step_hours, engine, soc_curves=soc_curves, draw=draw)
 
 
 #: The columns of a design's buffer (summary.csv, the answer), by the names of
@@ -132,7 +137,8 @@ def _reaching(powered_h, converged, target) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Sizing:
-    """Each design's smallest buffer for a target (:func:`size_buffers`).
+    """Each design's smallest buffer for a target, and the buffer from which folding stops paying
+    (:func:`size_buffers`).
 
     Attributes
     ----------
@@ -144,18 +150,28 @@ class Sizing:
     curve : pandas.DataFrame
         ``capacity_wh`` and ``powered_{flat,twofold,tracker}_h``: powered time against capacity,
         the twofold panel at each capacity's best of the angles compared.
-    folding_stops_paying_wh : float
-        The least capacity of the curve from which on the best twofold panel runs the load no
-        longer than flat's powered time plus the near-optimal tolerance; NaN where it always does.
+    folding : FoldingPays
+        Where folding pays (:func:`folding_pays`).
     """
 
     table: pd.DataFrame
     curve: pd.DataFrame
-    folding_stops_paying_wh: float
+    folding: FoldingPays
 
 
-def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engine, tolerance):
-    """Each design's smallest buffer for ``storage.target``, and powered time against capacity.
+def size_buffers(
+    curves: dict,
+    fold_angles,
+    own,
+    load,
+    storage,
+    step_hours,
+    engine,
+    tolerance,
+    draws=None,
+):
+    """Each design's smallest buffer for ``storage.target``, powered time against capacity, and
+    the buffer from which folding stops paying.
 
     Parameters
     ----------
@@ -173,6 +189,9 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
     step_hours : float
     engine : str
     tolerance : foldopt.inputs.sections.NearOptimal
+    draws : dict, optional
+        Design -> its own draw [W], (n_steps,): ``tracker-net``'s drive, whose power in
+        ``curves`` is then its whole power (:func:`foldopt.engine.storage.simulate`'s ``draw``).
 
     Returns
     -------
@@ -180,11 +199,11 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
     """
     fold_angles = np.asarray(fold_angles, dtype=float)
     power = np.vstack([curves["flat"], curves["tracker"], curves["tracker-net"], curves["twofold"]])
+    own_draws = [None, None, (draws or {}).get("tracker-net")] + [None] * len(fold_angles)
     capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
     n, m = power.shape[0], capacities.size
-    hours, ok = _at_capacities(
-        power, np.broadcast_to(capacities, (n, m)), load, storage, step_hours, engine, True
-    )
+    run = _Runs(power, own_draws, load, storage, step_hours, engine, in_sequence=True)
+    hours, ok = run(np.arange(n), np.broadcast_to(capacities, (n, m)))
     twofold = hours[3:]
     best = best_angle_index(np.nan_to_num(twofold.T, nan=-1.0))
     curve = pd.DataFrame(
@@ -196,26 +215,26 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
             "fold_angle_deg": fold_angles[best],
         }
     )
-    drawn = curve["powered_twofold_h"].to_numpy()
-    gain = drawn - curve["powered_flat_h"].to_numpy()
-    pays = gain > tolerance.tolerance_h(drawn)
-    pays_later = np.cumsum(pays[::-1])[::-1] > 0
-    known = np.isfinite(gain)
-    stops = np.flatnonzero(known & ~pays_later)
-    stops_wh = float(capacities[stops[0]]) if len(stops) and pays.any() else float("nan")
     table = pd.DataFrame()
     if storage.target is not None:
         first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)
-        # The twofold angle needing the least buffer on the grid is refined with flat and trackers.
-        need = np.where(first[3:] >= 0, capacities[first[3:]], np.inf)
-        # Where no angle reaches it, the row names the angle best for the study's own buffer.
-        pick = 3 + int(
-            np.argmin(need) if np.isfinite(need).any() else np.argmax(fold_angles == own)
+        # The twofold angles reaching the target at the grid's least capacity are refined with
+        # flat and the trackers (an angle reaching it only at a larger one needs more than
+        # each of them); where none reaches it, the row names the angle best for the study's
+        # own buffer.
+        angles = first[3:]
+        tied = 3 + (
+            np.flatnonzero(angles == angles[angles >= 0].min())
+            if (angles >= 0).any()
+            else np.flatnonzero(fold_angles == own)[:1]
         )
-        keep = [0, pick, 1, 2]
-        found = _refine(
-            power[keep], first[keep], capacities, load, storage, step_hours, engine, True
-        )
+        keep = np.concatenate([[0], tied, [1, 2]])
+        found = _smallest(run, keep, first[keep], capacities)
+        # The least of them, ties to the least folded.
+        least = tied.size - 1 - int(np.argmin(found[tied.size : 0 : -1]))
+        pick = int(tied[least])
+        keep = np.array([0, pick, 1, 2])
+        found = found[[0, 1 + least, -2, -1]]
         table = pd.DataFrame(
             {
                 "design": ["flat", "twofold", "tracker", "tracker-net"],
@@ -228,7 +247,163 @@ def size_buffers(curves: dict, fold_angles, own, load, storage, step_hours, engi
             table["capacity_vs_flat_pct"] = np.where(
                 np.isfinite(found) & (found[0] > 0), (found / found[0] - 1.0) * 100.0, np.nan
             )
-    return Sizing(table, curve, stops_wh)
+    # The capacities the sizing found are points of the search too, so that what the answer says
+    # of folding holds at the buffers it names beside it.
+    named = table["capacity_wh"].dropna().to_numpy() if len(table) else np.empty(0)
+    folding = folding_pays(run, capacities, hours, named, tolerance)
+    return Sizing(table, curve, folding)
+
+
+class _Runs:
+    """Designs' curves through a study's buffer at any capacities: each call
+    :func:`_at_capacities` of some of the curves, ``(rows, capacities (r, m))`` ->
+    ``(hours, ok)``; ``draws`` per curve as its (None: none)."""
+
+    def __init__(self, power, draws, load, storage, step_hours, engine, in_sequence: bool):
+        draws = [None] * len(power) if draws is None else draws
+        self.power, self.draws, self.load, self.storage = power, draws, load, storage
+        self.step_hours, self.engine, self.in_sequence = step_hours, engine, in_sequence
+
+    def __call__(self, rows, capacities):
+        return _at_capacities(
+            self.power[rows],
+            capacities,
+            self.load,
+            self.storage,
+            self.step_hours,
+            self.engine,
+            self.in_sequence,
+            [self.draws[row] for row in rows],
+        )
+
+
+@dataclass(frozen=True)
+class FoldingPays:
+    """Where the best twofold angle runs the load longer than flat by more than the near-optimal
+    tolerance ("folding pays"), over the capacities evaluated (:func:`folding_pays`).
+
+    Attributes
+    ----------
+    holds_from_wh : float
+        The least capacity evaluated from which on folding pays at no capacity evaluated, above
+        ``pays_wh``; NaN where folding never pays or still pays at ``top_wh``.
+    pays_wh : float
+        The largest capacity evaluated at which folding pays; NaN where it pays at none.
+    top_wh : float
+        The largest capacity evaluated [Wh].
+    everywhere : bool
+        Folding pays at every capacity evaluated.
+    known : bool
+        Some capacity found its periodic state for flat and a twofold angle (else nothing is
+        said).
+    """
+
+    holds_from_wh: float
+    pays_wh: float
+    top_wh: float
+    everywhere: bool
+    known: bool
+
+    @property
+    def state(self) -> str:
+        """One of :data:`FOLDING_STATES`."""
+        if not self.known:
+            return "unknown"
+        if self.pays_wh != self.pays_wh:
+            return "never"
+        if self.holds_from_wh == self.holds_from_wh:
+            bracketed = self.holds_from_wh - self.pays_wh <= CAPACITY_RTOL * self.holds_from_wh
+            return "below_threshold" if bracketed else "between"
+        return "at_every_capacity" if self.everywhere else "at_largest_capacity"
+
+    @property
+    def stops_wh(self) -> float:
+        """The capacity from which folding stops paying [Wh], bracketed within
+        :data:`CAPACITY_RTOL`; NaN where the answer states none."""
+        return self.holds_from_wh if self.state == "below_threshold" else np.nan
+
+
+#: Where folding pays (:attr:`FoldingPays.state`): at no capacity evaluated; below a threshold
+#: found; at some capacity and at none evaluated from a larger one on, with no periodic state
+#: between them; at every capacity; at the largest whose periodic state is known; not known.
+FOLDING_STATES = (
+    "never",
+    "below_threshold",
+    "between",
+    "at_every_capacity",
+    "at_largest_capacity",
+    "unknown",
+)
+
+
+def _fold_gain(flat, twofold, tolerance):
+    """Whether folding pays, and whether it does not, at each capacity: two (m,) bool arrays,
+    both False where no periodic state says.
+
+    Parameters
+    ----------
+    flat : numpy.ndarray
+        Flat's powered time [h], (m,).
+    twofold : numpy.ndarray
+        The twofold angles' compared, (k, m) [h].
+    tolerance : foldopt.inputs.sections.NearOptimal
+    """
+    known = np.isfinite(flat) & np.isfinite(twofold).any(axis=0)
+    best = np.where(known, np.max(np.nan_to_num(twofold, nan=-np.inf), axis=0), 0.0)
+    flat = np.where(known, flat, 0.0)
+    pays = known & (best - flat > tolerance.tolerance_h(best))
+    return pays, known & ~pays
+
+
+def folding_pays(run, capacities, hours, named, tolerance) -> FoldingPays:
+    """The buffer from which folding stops paying, a bracketed search on the capacity as the
+    sizing's (:func:`_bracket`): on the grid, and at the capacities the answer names beside it
+    (``named``), the largest capacity at which folding pays and the next at which it does not
+    are cut until within :data:`CAPACITY_RTOL` of the top, the top then the least capacity
+    evaluated from which on it pays at none.
+
+    Parameters
+    ----------
+    run : _Runs
+        Flat (row 0) and the twofold angles compared (rows 3 on).
+    capacities : numpy.ndarray
+        The grid (m,) [Wh], and ``hours``, (n, m) [h], powered time on it.
+    named : numpy.ndarray
+        Other capacities [Wh] to evaluate (the sizing's).
+    tolerance : foldopt.inputs.sections.NearOptimal
+    """
+    rows = np.concatenate([[0], np.arange(3, len(run.power))])
+
+    def gain(capacities):
+        # Flat and the twofold angles at capacities (m,): where folding pays, and where not.
+        hours, _ = run(rows, np.broadcast_to(capacities, (rows.size, capacities.size)))
+        return _fold_gain(hours[0], hours[1:], tolerance)
+
+    pays, holds = _fold_gain(hours[0], hours[3:], tolerance)
+    if named.size:
+        more = gain(named)
+        order = np.argsort(np.concatenate([capacities, named]), kind="stable")
+        capacities = np.concatenate([capacities, named])[order]
+        pays = np.concatenate([pays, more[0]])[order]
+        holds = np.concatenate([holds, more[1]])[order]
+    top = float(capacities[-1])
+    known = bool((pays | holds).any())
+    if not pays.any():
+        return FoldingPays(np.nan, np.nan, top, False, known)
+    last = int(np.flatnonzero(pays)[-1])
+    after = np.flatnonzero(holds & (np.arange(capacities.size) > last))
+    if not after.size:
+        everywhere = bool(pays[(pays | holds)].all())
+        return FoldingPays(np.nan, float(capacities[last]), top, everywhere, known)
+
+    def stops(_, inner):
+        pays, holds = gain(inner[0])
+        return holds[None], pays[None]
+
+    lo, hi = _bracket(
+        stops, np.array([capacities[last]]), np.array([capacities[after[0]]]), after_last=True
+    )
+    return FoldingPays(float(hi[0]), float(lo[0]), top, False, True)
 
 
 def capacity_grid(load, storage, step_hours, n_steps) -> np.ndarray:
@@ -240,7 +415,9 @@ def capacity_grid(load, storage, step_hours, n_steps) -> np.ndarray:
     return np.unique(np.minimum(np.append(GRID * scale, storage.capacity_wh), 1e6))
 
 
-def _at_capacities(power, capacities, load, storage, step_hours, engine, in_sequence: bool):
+def _at_capacities(
+    power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None
+):
     """Each design's buffer at each of its capacities.
 
     Parameters
@@ -254,6 +431,8 @@ def _at_capacities(power, capacities, load, storage, step_hours, engine, in_sequ
     in_sequence : bool
         The days follow each other (a day repeated to its periodic state is in sequence); else
         each day is its own periodic series.
+    draws : sequence, optional
+        Per design, its own draw [W] shaped as its curve, or None (none).
 
     Returns
     -------
@@ -262,32 +441,55 @@ def _at_capacities(power, capacities, load, storage, step_hours, engine, in_sequ
     ok : numpy.ndarray
         (n, m) bool: :func:`reaches` ``storage.target`` (all False without a target).
     """
+    draws = [None] * len(power) if draws is None else draws
+    target = storage.target
+    if in_sequence and power.ndim == 2:
+        # A day per design: every design at every capacity in one call (a call's threads cost
+        # more than a few days' series).
+        n, m = capacities.shape
+        own = (
+            None
+            if all(draw is None for draw in draws)
+            else np.repeat([np.zeros(power.shape[-1]) if d is None else d for d in draws], m, 0)
+        )
+        buffer = buffer_of(storage, capacity_wh=capacities.ravel())
+        result = run_buffer(np.repeat(power, m, 0), load, buffer, step_hours, engine, draw=own)
+        converged = result.converged.reshape(n, m)
+        reached = (
+            _reaching(result.powered_h, result.converged, target).reshape(n, m)
+            if target is not None
+            else np.zeros((n, m), bool)
+        )
+        return np.where(converged, result.powered_h.reshape(n, m), np.nan), reached
     hours, ok = [], []
-    for curve, capacity in zip(power, capacities, strict=True):
+    for curve, capacity, own in zip(power, capacities, draws, strict=True):
         days = curve.reshape(-1, curve.shape[-1])
         if in_sequence:
-            # One curve serves every capacity, without a copy.
+            # One curve of days serves every capacity, without a copy.
             series, buffer = curve[None], buffer_of(storage, capacity_wh=capacity)
             each = load
+            draw = None if own is None else own[None]
         else:
             # A series per capacity and day, capacity by capacity.
-            series = np.tile(days[:, None, :], (capacity.size, 1, 1))
+            def per_capacity(curves):
+                return np.tile(curves.reshape(days.shape)[:, None, :], (capacity.size, 1, 1))
+
+            series = per_capacity(days)
             buffer = buffer_of(storage, capacity_wh=np.repeat(capacity, len(days)))
             each = (
                 load
                 if np.ndim(load) == 0
-                else np.tile(
-                    np.broadcast_to(np.reshape(load, (-1, days.shape[-1])), days.shape)[:, None],
-                    (capacity.size, 1, 1),
+                else per_capacity(
+                    np.broadcast_to(np.reshape(load, (-1, days.shape[-1])), days.shape)
                 )
             )
-        result = run_buffer(series, each, buffer, step_hours, engine)
+            draw = None if own is None else per_capacity(own)
+        result = run_buffer(series, each, buffer, step_hours, engine, draw=draw)
         powered = result.powered_h.reshape(capacity.size, -1)  # (m, days)
         converged = result.converged.reshape(capacity.size, -1).all(axis=1)
         # A series with no periodic state has no powered time to draw (NaN: the figure leaves
         # it out).
         hours.append(np.where(converged, powered.mean(axis=1), np.nan))
-        target = storage.target
         ok.append(
             _reaching(powered, converged, target)
             if target is not None
@@ -296,33 +498,69 @@ def _at_capacities(power, capacities, load, storage, step_hours, engine, in_sequ
     return np.array(hours), np.array(ok)
 
 
-def _refine(power, first, capacities, load, storage, step_hours, engine, in_sequence):
-    """The bracket of each series between the grid's capacity ``first`` (the least reaching the
-    target; -1: none does, NaN) and the one below it, cut until within :data:`CAPACITY_RTOL`."""
-    found = np.where(first >= 0, capacities[np.maximum(first, 0)], np.nan)
-    lo = np.where(first > 0, capacities[np.maximum(first - 1, 0)], found)
-    hi = found.copy()
+def _bracket(holds, lo, hi, after_last: bool):
+    """Brackets on the capacity cut until within :data:`CAPACITY_RTOL` of their tops, each into
+    :data:`REFINE_POINTS` + 1 parts at a time: the bracket's bottom ``lo`` [Wh] does not hold
+    and its top ``hi`` does (NaN: no bracket), and so do the new ones.
+
+    Parameters
+    ----------
+    holds : callable
+        ``(rows, capacities (r, k))`` -> two (r, k) bool arrays: the capacities that hold, and
+        those that do not (neither where it is not known: such a point cuts nothing).
+    lo, hi : numpy.ndarray
+        (n,) [Wh].
+    after_last : bool
+        The new top is the least capacity that holds above the last that does not (the least
+        from which on every capacity evaluated holds); else the least that holds.
+
+    Returns
+    -------
+    lo, hi : numpy.ndarray
+        (n,) [Wh].
+    """
+    lo, hi = lo.astype(float), hi.astype(float)
+    cut = np.isfinite(hi)
+    index = np.arange(REFINE_POINTS)
     while True:
-        open_ = np.flatnonzero(np.isfinite(hi) & (hi - lo > CAPACITY_RTOL * hi))
+        open_ = np.flatnonzero(cut & (hi - lo > CAPACITY_RTOL * hi))
         if not open_.size:
-            return hi
-        inner = lo[open_, None] + (hi - lo)[open_, None] * (
-            np.arange(1, REFINE_POINTS + 1) / (REFINE_POINTS + 1)
-        )
-        _, ok = _at_capacities(power[open_], inner, load, storage, step_hours, engine, in_sequence)
-        # The least interior capacity reaching the target tops the new bracket; the one below
-        # it (or the old bottom) is its floor.
-        at = np.where(ok.any(axis=1), np.argmax(ok, axis=1), REFINE_POINTS)
+            return lo, hi
+        inner = lo[open_, None] + (hi - lo)[open_, None] * ((index + 1) / (REFINE_POINTS + 1))
+        ok, fails = holds(open_, inner)
+        tops = ok & (index > _last(fails)[:, None]) if after_last else ok
+        at = np.where(tops.any(axis=1), np.argmax(tops, axis=1), REFINE_POINTS)
+        under = _last(fails & (index < at[:, None]))
+        rows = np.arange(open_.size)
         top = np.where(
-            at < REFINE_POINTS,
-            inner[np.arange(open_.size), np.minimum(at, REFINE_POINTS - 1)],
-            hi[open_],
+            at < REFINE_POINTS, inner[rows, np.minimum(at, REFINE_POINTS - 1)], hi[open_]
         )
-        floor = np.where(at > 0, inner[np.arange(open_.size), np.maximum(at - 1, 0)], lo[open_])
+        floor = np.where(under >= 0, inner[rows, np.maximum(under, 0)], lo[open_])
+        # A bracket none of whose points is known cannot be cut further.
+        cut[open_[~(ok | fails).any(axis=1)]] = False
         lo[open_], hi[open_] = floor, top
 
 
-def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool):
+def _last(mask) -> np.ndarray:
+    """(r,) the index of each row's last True in ``mask`` (r, k); -1 where none."""
+    return np.where(mask.any(axis=1), mask.shape[1] - 1 - np.argmax(mask[:, ::-1], axis=1), -1)
+
+
+def _smallest(run, rows, first, capacities) -> np.ndarray:
+    """Each of ``rows``' least capacity reaching the target [Wh]: the bracket between the grid's
+    capacity ``first`` (the least reaching it; -1: none does, NaN) and the one below it, cut by
+    :func:`_bracket`."""
+    found = np.where(first >= 0, capacities[np.maximum(first, 0)], np.nan)
+    lo = np.where(first > 0, capacities[np.maximum(first - 1, 0)], found)
+
+    def reach(open_, inner):
+        _, ok = run(rows[open_], inner)
+        return ok, ~ok
+
+    return _bracket(reach, lo, found, after_last=False)[1]
+
+
+def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool, draws=None):
     """Each design's smallest buffer [Wh] for ``storage.target`` over its days (NaN: none up to
     the grid's top), by :func:`size_buffers`' search, and whether every larger capacity of the
     grid reaches it too (:func:`_held_above`).
@@ -333,15 +571,15 @@ def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool
         (n, n_days, n_steps) [W].
     load, in_sequence
         As :func:`_at_capacities`'.
+    draws : sequence, optional
+        As :func:`_at_capacities`'.
     """
     capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
-    shape = (power.shape[0], capacities.size)
-    _, ok = _at_capacities(
-        power, np.broadcast_to(capacities, shape), load, storage, step_hours, engine, in_sequence
-    )
+    run = _Runs(power, draws, load, storage, step_hours, engine, in_sequence)
+    rows = np.arange(power.shape[0])
+    _, ok = run(rows, np.broadcast_to(capacities, (rows.size, capacities.size)))
     first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)
-    found = _refine(power, first, capacities, load, storage, step_hours, engine, in_sequence)
-    return found, _held_above(ok, first)
+    return _smallest(run, rows, first, capacities), _held_above(ok, first)
 
 
 def _held_above(ok, first) -> np.ndarray:
@@ -378,6 +616,9 @@ class DayStorage:
         The engine the buffer was simulated on ('numba' or 'numpy').
     converged : bool
         Whether every series reached its periodic state (or started from ``initial_soc``).
+    series : foldopt.engine.storage.StorageResult
+        The designs' day with the buffer, in ``designs``' order: its energies, net trackers'
+        with their own draw served.
     """
 
     storage: object
@@ -390,10 +631,11 @@ class DayStorage:
     sizing: Sizing
     engine: str
     converged: bool
+    series: StorageResult
 
 
 def day_storage(
-    study, step_hours, load, fold_angles, grid_power, rows: dict, t_solar, engine
+    study, step_hours, load, fold_angles, grid_power, rows: dict, t_solar, engine, draws=None
 ) -> DayStorage:
     """Simulate a day's study's buffer for every design it compares.
 
@@ -413,6 +655,9 @@ def day_storage(
     t_solar : array_like
         Each design's ``t_solar`` [h] without the buffer, in ``rows``' order.
     engine : str
+    draws : dict, optional
+        Design -> its own draw [W], (n_steps,) (a net tracker's drive: its power in ``rows`` is
+        then its whole power, :func:`foldopt.engine.storage.simulate`'s ``draw``).
 
     Returns
     -------
@@ -423,8 +668,22 @@ def day_storage(
     buffer = buffer_of(storage)
     engine = storage_engine(engine)
     names = list(rows)
+    draws = draws or {}
+
+    def own(names):
+        # The designs' own draws, none for most (a draw of 0 W is none, to the bit).
+        if not any(name in draws for name in names):
+            return None
+        zero = np.zeros(np.shape(rows[names[0]][1]))
+        return np.vstack([draws.get(name, zero) for name in names])
+
     designs = run_buffer(
-        np.vstack([power for _, power in rows.values()]), load, buffer, step_hours, engine
+        np.vstack([power for _, power in rows.values()]),
+        load,
+        buffer,
+        step_hours,
+        engine,
+        draw=own(names),
     )
     soc = run_buffer(
         np.vstack([rows[name][1] for name in SOC_DESIGNS]),
@@ -433,6 +692,7 @@ def day_storage(
         step_hours,
         engine,
         soc_curves=True,
+        draw=own(SOC_DESIGNS),
     )
     grid = run_buffer(grid_power, load, buffer, step_hours, engine)
     by_angle = grid.powered_h[:, 0]
@@ -467,6 +727,7 @@ def day_storage(
         step_hours,
         engine,
         study.near_optimal,
+        {name: draw for name, draw in draws.items() if name == "tracker-net"},
     )
     return DayStorage(
         storage,
@@ -479,6 +740,7 @@ def day_storage(
         sizing,
         engine,
         bool(designs.converged.all() and grid.converged.all()),
+        designs,
     )
 
 
@@ -490,8 +752,58 @@ NOT_MONOTONE = (
 )
 
 
+def _digits(value) -> str:
+    """A value to 3 significant digits, written out (3840, not 3.84e+03)."""
+    return np.format_float_positional(float(f"{value:.3g}"), trim="-")
+
+
 def _wh(value) -> str:
-    return "-" if value != value else f"{value:.3g} Wh"
+    return "-" if value != value else f"{_digits(value)} Wh"
+
+
+def _signed(value: float, digits: int) -> str:
+    """``value`` with its sign to ``digits`` decimals, a rounded zero as +0 (never -0.00)."""
+    return f"{round(value, digits) + 0.0:+.{digits}f}"
+
+
+def folding_part(folding: FoldingPays) -> dict:
+    """Where folding pays, as the answer's result holds it: ``folding_pays`` (one of
+    :data:`FOLDING_STATES`), ``folding_stops_paying_wh`` (the threshold, NaN but below one),
+    ``folding_pays_up_to_wh`` (the largest capacity evaluated at which folding pays, NaN where
+    none: a threshold's bracket's bottom), ``folding_does_not_pay_from_wh`` (the least capacity
+    from which on it pays at none evaluated, NaN where there is none above the largest at which
+    it pays: a threshold's bracket's top) and ``folding_searched_up_to_wh``, all [Wh]."""
+    return {
+        "folding_pays": folding.state,
+        "folding_stops_paying_wh": folding.stops_wh,
+        "folding_pays_up_to_wh": folding.pays_wh,
+        "folding_does_not_pay_from_wh": folding.holds_from_wh,
+        "folding_searched_up_to_wh": folding.top_wh,
+    }
+
+
+def folding_line(folding: FoldingPays) -> str:
+    """The answer's line on where folding pays (:func:`folding_pays`)."""
+    top = _wh(folding.top_wh)
+    return {
+        "unknown": "whether folding pays with a buffer is not known: no capacity evaluated found "
+        "a periodic state",
+        "never": f"folding never pays with a buffer up to {top}: at every capacity evaluated flat "
+        "runs the load within the near-optimal tolerance of the best twofold angle",
+        "below_threshold": f"folding stops paying from {_wh(folding.stops_wh)} of buffer: from "
+        f"there up to {top} flat runs the load within the near-optimal tolerance of the best "
+        "twofold angle",
+        "between": f"folding pays at {_wh(folding.pays_wh)} of buffer and at none evaluated from "
+        f"{_wh(folding.holds_from_wh)} up to {top}; the buffers between found no periodic state "
+        "(no threshold is known)",
+        "at_every_capacity": f"folding pays at every buffer evaluated up to {top}",
+        "at_largest_capacity": f"folding still pays at {_wh(folding.pays_wh)}, the largest buffer "
+        + (
+            "evaluated"
+            if folding.pays_wh == folding.top_wh
+            else f"whose periodic state is known (none up to {top})"
+        ),
+    }[folding.state]
 
 
 def buffer_text(storage) -> str:
@@ -564,7 +876,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             for column, values in per.items()
         },
         "soc_hours_by_design_h": {d: buffered.soc_hours[d].tolist() for d in designs},
-        "folding_stops_paying_wh": sizing.folding_stops_paying_wh,
+        **folding_part(sizing.folding),
         "engine": buffered.engine,
         "converged": buffered.converged,
     }
@@ -574,10 +886,12 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
         + ", ".join(f"{d} {powered[d]:.2f} h (t_solar {t_solar[d]:.2f} h)" for d in designs)
     ]
     near = buffered.near_optimal
-    if best_h > 0:
+    if best_h <= 0:
+        lines.append("no fold angle runs the load with the buffer: powered 0 h at every angle")
+    else:
         lines.append(
             f"best fold angle for the buffer {buffered.fold_angle_deg:g} deg: powered "
-            f"{best_h:.2f} h, {best_h - powered['flat']:+.2f} h over flat; near-optimal "
+            f"{best_h:.2f} h, {_signed(best_h - powered['flat'], 2)} h over flat; near-optimal "
             f"{near['near_optimal_lo_deg']:g} to {near['near_optimal_hi_deg']:g} deg, "
             f"recommended {near['recommended_fold_angle_deg']:g} deg "
             f"({near['recommended_powered_h']:.2f} h)"
@@ -587,7 +901,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
         + ", ".join(f"{d} {per['availability_pct'][d]:.1f} %" for d in designs[:3])
         + "; energy missing/lost a day "
         + ", ".join(
-            f"{d} {per['energy_missing_wh'][d]:.3g}/{per['energy_lost_wh'][d]:.3g} Wh"
+            f"{d} {_digits(per['energy_missing_wh'][d])}/{_wh(per['energy_lost_wh'][d])}"
             for d in designs[:3]
         )
         + "; days full/empty "
@@ -596,16 +910,8 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             for d in designs[:3]
         )
     )
-    top = float(sizing.curve["capacity_wh"].iloc[-1])
-    stops = sizing.folding_stops_paying_wh
-    lines.append(
-        f"folding stops paying from {stops:.3g} Wh of buffer (flat within the near-optimal "
-        "tolerance of the best twofold angle)"
-        if stops == stops
-        else f"folding pays at every buffer up to {top:.3g} Wh"
-        if (sizing.curve["powered_twofold_h"] > sizing.curve["powered_flat_h"]).any()
-        else f"folding does not pay at any buffer up to {top:.3g} Wh"
-    )
+    top = sizing.folding.top_wh
+    lines.append(folding_line(sizing.folding))
     if len(sizing.table):
         target = storage.target
         table = sizing.table.set_index("design")
@@ -624,20 +930,19 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
         said = f"{target.powered_h:g} h" + (
             f" on {target.days_pct:g} % of days" if target.days_pct < 100 else ""
         )
+        none = f"no buffer up to {_wh(top)} reaches it"
 
-        def needs(value):
-            return (
-                f"needs {_wh(value)}"
-                if value == value
-                else f"reaches it with no buffer up to {top:.3g} Wh"
-            )
+        def needs(label, value):
+            return f"{label} needs {_wh(value)}" if value == value else f"{label}: {none}"
 
         lines.append(
-            f"for {said}: flat {needs(need['flat'])}, folded at {angle:g} deg "
-            f"{needs(need['twofold'])}"
-            + (f" ({saving:+.0f} %)" if saving == saving else "")
-            + f", the tracker {needs(need['tracker'])}"
-            + f" (net of its drive: {needs(need['tracker-net'])})"
+            f"for {said}: {none} (flat, folded at {angle:g} deg, the tracker gross or net)"
+            if need.isna().all()
+            else f"for {said}: {needs('flat', need['flat'])}, "
+            f"{needs(f'folded at {angle:g} deg', need['twofold'])}"
+            + (f" ({_signed(saving, 0)} %)" if saving == saving else "")
+            + f", {needs('the tracker', need['tracker'])}"
+            + f" ({needs('net of its drive', need['tracker-net'])})"
         )
         if not table["monotone"].all():
             lines.append(
@@ -655,27 +960,6 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
 DESIGN_COLUMNS = tuple(SUMMARY_COLUMNS.values())
 
 
-def unsimulated_notes(study) -> list[dict]:
-    """The note of an answer that does not simulate its study's buffer (a plan of cases without
-    an annual objective, a cloud ensemble): its numbers are storage-less. None without a buffer.
-
-    Parameters
-    ----------
-    study : foldopt.Study
-        The plan's base study.
-    """
-    if study.storage is None:
-        return []
-    return [
-        {
-            "note": "storage: the buffer is simulated in a day's study and over the days of an "
-            "annual objective (not over a cloud ensemble's members); these answers are "
-            "storage-less",
-            "designs": [],
-        }
-    ]
-
-
 #: The designs a year's buffer is simulated for: the twofold panel at the angle ``t_solar``'s
 #: objective keeps all year, and at the one the objective of powered time keeps
 #: (``twofold-buffer``, :func:`powered_by_angle`).
@@ -684,13 +968,17 @@ YEAR_DESIGNS = ("flat", "twofold", "twofold-buffer", "tracker", "tracker-net")
 YEAR_SAID = ("flat", "twofold", "twofold-buffer", "tracker")
 
 
-def _year_series(power, load, in_sequence: bool):
-    """Series of (rows, days, steps) curves and their load as :func:`simulate` takes them: the
-    days in sequence, or each day its own periodic series."""
+def _year_series(power, load, in_sequence: bool, draw=None):
+    """Series of (rows, days, steps) curves, their load and their own draw (or None) as
+    :func:`simulate` takes them: the days in sequence, or each day its own periodic series."""
     if in_sequence:
-        return power, load
+        return power, load, draw
     series = power.reshape(-1, 1, power.shape[-1])
-    return series, load if np.ndim(load) == 0 else load.reshape(series.shape)
+    return (
+        series,
+        load if np.ndim(load) == 0 else load.reshape(series.shape),
+        None if draw is None else draw.reshape(series.shape),
+    )
 
 
 def powered_by_angle(storage, chunks, loads, load_shape, dates, step_hours, weather, engine):
@@ -720,7 +1008,8 @@ def powered_by_angle(storage, chunks, loads, load_shape, dates, step_hours, weat
             load = (
                 p_load if load_shape is None else p_load * np.broadcast_to(load_shape, power.shape)
             )
-            result = simulate(*_year_series(power, load, in_sequence), buffer, step_hours, engine)
+            series, load, _ = _year_series(power, load, in_sequence)
+            result = simulate(series, load, buffer, step_hours, engine)
             per_load.append(result.powered_h.reshape(power.shape[:2]))
         hours.append(np.stack(per_load))  # (loads, k, days)
     return np.concatenate(hours, axis=1).transpose(2, 0, 1)
@@ -736,6 +1025,7 @@ def year_storage(
     weather: bool,
     engine,
     choice: dict,
+    draws=None,
 ) -> pd.DataFrame:
     """A buffer over an annual group's days, per load and design.
 
@@ -762,6 +1052,9 @@ def year_storage(
         ``fold_angle_deg``: design -> (n_loads,) [deg] (NaN for a tracker), and ``near``:
         :func:`foldopt.studies.objectives.near_optimal` of the objective of powered time over the
         grid, (n_loads,) each, the ``twofold-buffer`` row's.
+    draws : dict, optional
+        Design -> its own draw [W], (n_days, n_steps): ``tracker-net``'s drive, whose power in
+        ``curves`` is then its whole power (:func:`foldopt.engine.storage.simulate`'s ``draw``).
 
     Returns
     -------
@@ -788,10 +1081,17 @@ def year_storage(
         power = np.stack(
             [curves[d] if curves[d].ndim == 2 else curves[d][:, index] for d in YEAR_DESIGNS]
         )  # (designs, days, steps)
+        own = (
+            np.stack([draws.get(d, np.zeros(power.shape[1:])) for d in YEAR_DESIGNS])
+            if draws
+            else None
+        )
         load = p_load if load_shape is None else p_load * np.broadcast_to(load_shape, power.shape)
-        series, load = _year_series(power, load, in_sequence)
-        result = simulate(series, load, buffer_of(storage), step_hours, engine)
-        bare = simulate(series, load, buffer_of(storage, capacity_wh=0.0), step_hours, engine)
+        series, load, draw = _year_series(power, load, in_sequence, own)
+        result = simulate(series, load, buffer_of(storage), step_hours, engine, draw=draw)
+        bare = simulate(
+            series, load, buffer_of(storage, capacity_wh=0.0), step_hours, engine, draw=draw
+        )
         shape = (len(YEAR_DESIGNS), -1)
         if not in_sequence:
             result = _by_design(result, len(YEAR_DESIGNS))
@@ -808,10 +1108,16 @@ def year_storage(
                 step_hours,
                 engine,
                 in_sequence,
+                None if own is None else list(own),
             )
             with np.errstate(invalid="ignore", divide="ignore"):
                 vs_flat = (need / need[0] - 1.0) * 100.0 if need[0] > 0 else np.nan * need
             sized = {"capacity_wh": need, "capacity_vs_flat_pct": vs_flat, "monotone": monotone}
+        score = objective_value(powered.T, months, objective.statistic, objective.months)
+        angles = np.array([choice["fold_angle_deg"][d][index] for d in YEAR_DESIGNS])
+        # Without a statistic (the objective's months hold none of the days) no angle was chosen.
+        chosen = np.asarray(YEAR_DESIGNS) == "twofold-buffer"
+        angles[chosen & np.isnan(score)] = np.nan
         rows.append(
             pd.DataFrame(
                 {
@@ -820,12 +1126,10 @@ def year_storage(
                     "longitude": site.longitude,
                     "p_load_w": p_load,
                     "design": YEAR_DESIGNS,
-                    "fold_angle_deg": [choice["fold_angle_deg"][d][index] for d in YEAR_DESIGNS],
+                    "fold_angle_deg": angles,
                     "days": powered.shape[1],
                     "objective": objective.statistic,
-                    "objective_powered_h": objective_value(
-                        powered.T, months, objective.statistic, objective.months
-                    ),
+                    "objective_powered_h": score,
                     "mean_powered_h": powered.mean(axis=1),
                     "min_powered_h": powered.min(axis=1),
                     "mean_t_solar_h": bare.powered_h.reshape(shape).mean(axis=1),
@@ -833,9 +1137,7 @@ def year_storage(
                     "converged": result.converged.reshape(shape[0], -1).all(axis=1),
                     **sized,
                     **{
-                        key: np.where(
-                            np.asarray(YEAR_DESIGNS) == "twofold-buffer", value[index], np.nan
-                        )
+                        key: np.where(chosen, value[index], np.nan)
                         for key, value in choice["near"].items()
                     },
                 }
@@ -871,6 +1173,35 @@ def _by_design(result: StorageResult, designs: int) -> StorageResult:
             1,
             -1,
         ),
+    )
+
+
+def _another(angle) -> bool:
+    """Whether the angle the objective of powered time keeps was chosen and is not
+    ``t_solar``'s (the year's lines then name it apart)."""
+    chosen = angle["twofold-buffer"]
+    return chosen == chosen and chosen != angle["twofold"]
+
+
+def _best_for_buffer(by: pd.DataFrame, angle) -> str:
+    """A year's line on the fold angle the objective of powered time keeps, of one load's rows
+    by design (:func:`year_lines`)."""
+    best = by.loc["twofold-buffer"]
+    statistic = best["objective"]
+    said = f"  best fold angle for the buffer ({statistic} powered time)"
+    if best["objective_powered_h"] != best["objective_powered_h"]:
+        return f"{said}: none, the objective's months hold none of the days"
+    return (
+        f"{said}: {angle['twofold-buffer']:g} deg, {best['objective_powered_h']:.2f} h (t_solar's "
+        f"{angle['twofold']:g} deg: {by.loc['twofold', 'objective_powered_h']:.2f} h; flat "
+        f"{by.loc['flat', 'objective_powered_h']:.2f} h); "
+        + (
+            f"near-optimal {best['near_optimal_lo_deg']:g} to {best['near_optimal_hi_deg']:g} deg, "
+            f"recommended {best['recommended_fold_angle_deg']:g} deg"
+            if best["near_optimal_lo_deg"] == best["near_optimal_lo_deg"]
+            else f"no fold angle runs the load ({statistic} powered time 0 h at every angle): no "
+            "near-optimal range"
+        )
     )
 
 
@@ -910,7 +1241,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                 f"{named[d]} {by.loc[d, 'mean_powered_h']:.2f} h "
                 f"(t_solar {by.loc[d, 'mean_t_solar_h']:.2f} h)"
                 for d in YEAR_SAID
-                if d != "twofold-buffer" or angle[d] != angle["twofold"]
+                if d != "twofold-buffer" or _another(angle)
             )
             + "; all 24 h on "
             + ", ".join(f"{d} {by.loc[d, 'days_powered_24h_pct']:.0f} %" for d in SOC_DESIGNS)
@@ -920,16 +1251,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                 for d in SOC_DESIGNS
             )
         )
-        best = by.loc["twofold-buffer"]
-        statistic = best["objective"]
-        lines.append(
-            f"  best fold angle for the buffer ({statistic} powered time): {angle['twofold-buffer']:g}"
-            f" deg, {best['objective_powered_h']:.2f} h (t_solar's {angle['twofold']:g} deg: "
-            f"{by.loc['twofold', 'objective_powered_h']:.2f} h; flat "
-            f"{by.loc['flat', 'objective_powered_h']:.2f} h); near-optimal "
-            f"{best['near_optimal_lo_deg']:g} to {best['near_optimal_hi_deg']:g} deg, recommended "
-            f"{best['recommended_fold_angle_deg']:g} deg"
-        )
+        lines.append(_best_for_buffer(by, angle))
         if "capacity_wh" in by:
             target = storage.target
             said = f"{target.powered_h:g} h" + (
@@ -940,9 +1262,9 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                 f"  for {said}: "
                 + ", ".join(
                     (
-                        f"{named[d]} needs {need[d]:.3g} Wh"
+                        f"{named[d]} needs {_wh(need[d])}"
                         + (
-                            f" ({saving[d]:+.0f} %)"
+                            f" ({_signed(saving[d], 0)} %)"
                             if d != "flat" and saving[d] == saving[d]
                             else ""
                         )
@@ -950,7 +1272,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                         else f"{named[d]}: no buffer up to the search's top reaches it"
                     )
                     for d in YEAR_SAID
-                    if d != "twofold-buffer" or angle[d] != angle["twofold"]
+                    if d != "twofold-buffer" or _another(angle)
                 )
             )
     if len(cases) > 8:

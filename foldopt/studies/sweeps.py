@@ -275,11 +275,13 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         )
         if buffered:
             curves = metrics[-1].pop("curves")
+            # The net tracker's whole power, with its own draw a load beside the device's.
             for name, power in (
                 ("flat", curves["flat"]),
                 ("twofold", curves[study.connection]),
                 ("tracker", tracker.power),
-                ("tracker-net", tracker.net),
+                ("tracker-net", tracker.power),
+                ("tracker-net-draw", tracker.draw),
             ):
                 drawn.setdefault(name, []).append(power)
         advance(len(chunk) // members)
@@ -383,6 +385,7 @@ def _year_buffer(blocks, parts, skies, loads, objective, fold_angles, fixed, dra
     curves = _twofold_curves(blocks, parts, skies, fold_angles[chosen], engine)
     drawn = {name: np.concatenate(power) for name, power in drawn.items()}
     drawn["twofold-buffer"] = curves[which].transpose(1, 0, 2)  # (days, loads, steps)
+    own = {"tracker-net": drawn.pop("tracker-net-draw")}
     tracker = np.full(loads.size, np.nan)
     return year_storage(
         study.storage,
@@ -405,6 +408,7 @@ def _year_buffer(blocks, parts, skies, loads, objective, fold_angles, fixed, dra
             },
             "near": near_optimal(fold_angles, score, study.near_optimal),
         },
+        own,
     )
 
 

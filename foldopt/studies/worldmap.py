@@ -21,7 +21,11 @@ the files.
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as dt
+import functools
+import hashlib
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -127,41 +131,6 @@ def map_study(data: dict, embedded: bool = True, **changes) -> dict:
     return study
 
 
-@dataclass(frozen=True)
-class MapRequest:
-    """A map's request made into what runs (:func:`map_request`).
-
-    Attributes
-    ----------
-    study : Study
-        The map's study, resolved at its first site (:func:`map_template`): every site's is this
-        one moved to the site (:func:`site_study`).
-    sites : tuple of dict
-        Each a site's fields or a weather file's site (:func:`evaluate_sites`).
-    loads : tuple of float
-        Loads [W], or with ``relative`` fractions [-] of each site's flat peak.
-    relative : bool
-    year : int
-    source : str
-        How the answer names the study the map took its panel and models from.
-    taken : tuple of str
-        What the answer took from that study or from defaults, not from the request.
-    """
-
-    study: Study
-    sites: tuple
-    loads: tuple
-    relative: bool = False
-    year: int = 2025
-    source: str = "the given study"
-    taken: tuple = ()
-
-    @property
-    def defaults(self) -> dict | None:
-        """``{"study": source, "taken": [...]}``, or None where nothing was taken."""
-        return {"study": self.source, "taken": list(self.taken)} if self.taken else None
-
-
 def _values(name: str, values) -> list:
     """A value, a sequence, or text (a value, a range start:stop:step or a list a,b,c:
     :func:`foldopt.inputs.plan.parse_values`, the parser of every sweep axis too) as a list."""
@@ -192,9 +161,10 @@ def map_request(
     year: int = 2025,
     show_period: str = "year",
     weather: dict | None = None,
-) -> MapRequest:
+) -> MapSpec:
     """A map's sites, loads, year and period, each checked, with its study: what the command line
-    and :func:`foldopt.world_map` both run.
+    and :func:`foldopt.world_map` both run (the front door's map,
+    :func:`foldopt.studies.request.make_request`).
 
     Parameters
     ----------
@@ -226,7 +196,7 @@ def map_request(
 
     Returns
     -------
-    MapRequest
+    foldopt.studies.cluster.MapSpec
 
     Raises
     ------
@@ -319,7 +289,97 @@ def map_request(
         raise ConfigError(["sites: a map needs at least one site"])
     study = map_template(study, sites[0], year)
     site_study(study, sites[0], year)  # a bad setting fails here, before any cluster starts
-    return MapRequest(study, tuple(sites), tuple(load_values), relative, year)
+    return MapSpec(study, tuple(sites), tuple(load_values), relative, year)
+
+
+#: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
+#: about a millisecond), short enough that a lost worker loses little and progress moves.
+CHUNK_SECONDS = 5.0
+#: Single-core seconds per site-day x fold angle x time step of a map, everything included (sky,
+#: trackers, break-even search), measured on W4 (``bench/map.py``).
+SECONDS_PER_EVALUATION = 13e-9
+
+
+@dataclass(frozen=True)
+class MapSpec:
+    """Everything that decides a map's numbers.
+
+    Parameters
+    ----------
+    study : Study
+        The map's study (:func:`map_template`; a map study's fields,
+        :func:`map_study`, are made into it at the first site).
+    sites : tuple of dict
+        ``latitude``, ``longitude`` and optionally ``name``, ``altitude``, ``timezone``; each gets a ``site_id``.
+    loads : tuple of float
+        Loads [W], or with ``relative`` fractions of each site's flat peak [-].
+    relative : bool, default False
+    year : int, default 2025
+    sites_per_chunk : int, default 0
+        0: sized for about :data:`CHUNK_SECONDS` of one core's work (:func:`default_sites_per_chunk`).
+    engine : {'auto', 'numba', 'numpy'}
+    """
+
+    study: Study
+    sites: tuple
+    loads: tuple
+    relative: bool = False
+    year: int = 2025
+    sites_per_chunk: int = 0
+    engine: str = DEFAULT_ENGINE
+
+    def __post_init__(self):
+        if not self.sites:
+            raise ConfigError(["sites: a map needs at least one site"])
+        object.__setattr__(self, "study", map_template(self.study, self.sites[0], self.year))
+        if self.sites_per_chunk <= 0:
+            object.__setattr__(
+                self, "sites_per_chunk", default_sites_per_chunk(self.study, self.year)
+            )
+        sites = tuple({**site, "site_id": index} for index, site in enumerate(self.sites))
+        object.__setattr__(self, "sites", sites)
+
+    def chunks(self) -> list[range]:
+        """The chunks' site indices, ``sites_per_chunk`` each (the last may be short)."""
+        size = self.sites_per_chunk
+        return [
+            range(start, min(start + size, len(self.sites)))
+            for start in range(0, len(self.sites), size)
+        ]
+
+    def as_dict(self) -> dict:
+        """The spec as plain data (``run.json``'s ``spec``): the study as the fields a map keeps for
+        every site (:func:`map_data`)."""
+        return {
+            **{field.name: getattr(self, field.name) for field in dataclasses.fields(self)},
+            "study": map_data(self.study),
+        }
+
+    @functools.cached_property
+    def key(self) -> str:
+        """A digest of the spec: a resumed run must have the same. Worked out once: every part written
+        and read carries it, and the spec holds every site (the 1-degree land grid's 21,637 made it
+        0.3 s a time, some 900 chunks three times each: a third of the client's core through W5)."""
+        text = json.dumps(self.as_dict(), sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def default_sites_per_chunk(study: Study, year: int) -> int:
+    """Sites per chunk for about :data:`CHUNK_SECONDS` of one core's work (at least 1), in whole batches
+    of :data:`SITES_PER_BATCH` where it holds one or more.
+
+    Parameters
+    ----------
+    study : Study
+        :attr:`MapSpec.study` (its fold angles and step).
+    year : int
+    """
+    angles = len(study.fold_angles.grid())
+    steps = 1440 / study.step_min
+    per_site = 365 * angles * steps * SECONDS_PER_EVALUATION
+    count = max(1, int(CHUNK_SECONDS / per_site))
+    # Whole batches of sites where a chunk holds one or more, so that no batch runs part-full.
+    return count if count < SITES_PER_BATCH else SITES_PER_BATCH * round(count / SITES_PER_BATCH)
 
 
 def map_data(study: dict | Study) -> dict:

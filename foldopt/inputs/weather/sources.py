@@ -27,14 +27,22 @@ Each answer is stored once under a key of the source, the service's version (fro
 address, ``v5_3``), the site as the service rounds it and the request's options
 (:func:`cache_path`), written atomically beside its provenance (:class:`WeatherProvenance`:
 the request, the retrieval time, the answer's SHA-256); an answer that fails any check is not
-stored. Offline (:func:`foldopt.cache.offline`: ``--offline``, ``FOLDOPT_OFFLINE=1``) only the
+stored; a damaged cached answer is fetched again, and offline it is named with what is wrong
+with it. Offline (:func:`foldopt.cache.offline`: ``--offline``, ``FOLDOPT_OFFLINE=1``) only the
 cache is read.
+
+Before anything is asked, the site is checked (:func:`site_problems`) and the address: a scheme
+other than http or https is refused. A fetch has one deadline, ``weather.timeout_s``, for the
+whole answer (:class:`_Deadline`), not for each read. An address may carry a user and password
+or a key in its query: it is asked as given, but every address foldopt writes (a message, the
+provenance, ``run.json``) is :func:`foldopt.errors.redacted`.
 
 The base address of each service is its pinned versioned API address unless
 ``FOLDOPT_PVGIS_URL`` (or a study's ``weather.url``) names another, a mirror or a proxy.
 
-The module may import :mod:`foldopt.cache`, :mod:`foldopt.errors`, :mod:`foldopt.inputs.reading`
-and its package's readers; ``requests`` loads on the first fetch.
+The module may import :mod:`foldopt.cache`, :mod:`foldopt.errors`, :mod:`foldopt.inputs.reading`,
+:mod:`foldopt.inputs.weather_section` and its package's readers; ``requests`` loads on the first
+fetch.
 """
 
 from __future__ import annotations
@@ -48,18 +56,21 @@ import json
 import math
 import os
 import re
+import socket
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from urllib.parse import urlencode
+from urllib.parse import parse_qsl, urlencode
 
-from foldopt.cache import cache_dir, offline, write_atomically
-from foldopt.errors import WeatherError, printable
+from foldopt.cache import cache_dir, notice, offline, write_atomically
+from foldopt.errors import ConfigError, WeatherError, printable, redacted
 from foldopt.inputs.reading import MAX_WEATHER_BYTES
+from foldopt.inputs.weather_section import address_problem
 
-#: Seconds a request waits for the service to connect or to send more (``weather.timeout_s``).
+#: Seconds a fetch waits at most for the service's whole answer (``weather.timeout_s``):
+#: connecting, every read and every retry; a service that trickles its answer is given up on.
 DEFAULT_TIMEOUT_S = 30.0
 #: Requests of one fetch, the first and its retries after a rate limit (HTTP 429).
 MAX_ATTEMPTS = 3
@@ -258,42 +269,99 @@ def weather_cache() -> Path:
 def base_url(source: WeatherSource, url: str | None = None) -> str:
     """The base address a source is asked at: ``url`` (a study's ``weather.url``), else the
     source's environment variable (``FOLDOPT_PVGIS_URL``), else its pinned address; with a
-    trailing slash."""
+    trailing slash (before its query, where it has one)."""
     chosen = url or os.environ.get(source.url_variable) or source.url
-    return chosen if chosen.endswith("/") else chosen + "/"
+    address, question, query = chosen.partition("?")
+    slash = "" if address.endswith("/") else "/"
+    return f"{address}{slash}{question}{query}"
 
 
 def service_version(base: str) -> str:
     """The service's version a base address names (``.../api/v5_3/`` -> ``v5_3``), or ``url-``
-    and 8 hexadecimal digits of the address where it names none."""
-    found = re.findall(r"/(v\d+(?:_\d+)*)(?=/)", base)
+    and 8 hexadecimal digits of the address (:func:`foldopt.errors.redacted`) where it names
+    none."""
+    base = redacted(base)
+    found = re.findall(r"/(v\d+(?:_\d+)*)(?=/)", base.partition("?")[0])
     return found[-1] if found else "url-" + hashlib.sha256(base.encode()).hexdigest()[:8]
+
+
+#: A site's coordinates and their bounds [deg].
+_BOUNDS = {"latitude": 90.0, "longitude": 180.0}
+
+
+def site_problems(latitude, longitude) -> list[str]:
+    """Why a site cannot be asked for: one ``site.latitude = 91.0: ...`` line per coordinate
+    that is not a finite number within its bounds (latitude [-90, 90], longitude
+    [-180, 180] deg). Every path that fetches checks it before anything is asked.
+
+    Parameters
+    ----------
+    latitude, longitude : float
+        [deg]
+
+    Returns
+    -------
+    list of str
+        Empty for a site that can be asked for.
+    """
+    problems = []
+    for field_name, value in (("latitude", latitude), ("longitude", longitude)):
+        bound = _BOUNDS[field_name]
+        try:
+            number = None if isinstance(value, bool) else float(value)
+        except (TypeError, ValueError):
+            number = None
+        if number is None:
+            shown = printable(repr(value), 40)
+            problems.append(f"site.{field_name} = {shown}: a number of degrees is expected")
+        elif not math.isfinite(number) or abs(number) > bound:
+            problems.append(
+                f"site.{field_name} = {number!r}: must be a finite number in "
+                f"[-{bound:g}, {bound:g}] deg"
+            )
+    return problems
 
 
 @dataclass(frozen=True)
 class _Request:
     source: WeatherSource
-    base: str
+    base: str  # without its query
+    query: tuple  # the base address's own query parameters (a mirror's key), sent first
     params: dict
     timeout_s: float
 
     @property
     def url(self) -> str:
-        return f"{self.base}{self.source.route}?{urlencode(self.params)}"
+        """The request as foldopt shows and stores it (:func:`foldopt.errors.redacted`)."""
+        query = urlencode([*self.query, *self.params.items()])
+        return redacted(f"{self.base}{self.source.route}?{query}")
 
     @property
     def version(self) -> str:
         return service_version(self.base)
 
 
-def _request(source: WeatherSource, latitude: float, longitude: float, weather) -> _Request:
+def _request(
+    source: WeatherSource, latitude: float, longitude: float, weather, label: str
+) -> _Request:
+    """The request for a site, its site and base address checked before anything is asked."""
+    problems = site_problems(latitude, longitude)
+    if problems:
+        raise ConfigError([f"{label}: {line}" for line in problems])
+    given = _option(weather, "url", None)
+    base = base_url(source, given)
+    problem = address_problem(base)
+    if problem is not None:
+        where = "weather.url" if given else source.url_variable
+        raise WeatherError(f"{label}: {where} = {printable(repr(redacted(base)), 120)}: {problem}")
     site = (round(float(latitude), source.decimals), round(float(longitude), source.decimals))
-    timeout_s = float(_option(weather, "timeout_s", DEFAULT_TIMEOUT_S))
+    address, _, query = base.partition("?")
     return _Request(
         source,
-        base_url(source, _option(weather, "url", None)),
+        address,
+        tuple(parse_qsl(query, keep_blank_values=True)),
         source.params(*site, weather),
-        timeout_s,
+        float(_option(weather, "timeout_s", DEFAULT_TIMEOUT_S)),
     )
 
 
@@ -324,28 +392,80 @@ def cached(path) -> WeatherProvenance | None:
     Returns
     -------
     WeatherProvenance or None
-        None where the answer or its provenance is missing or unreadable, or where the answer's
-        SHA-256 is not the one recorded (a damaged file: fetched again, or refused offline).
+        None where the answer is not cached or is damaged (:func:`damage`: fetched again, or
+        named offline); its ``url`` redacted (:func:`foldopt.errors.redacted`), whatever an
+        earlier foldopt stored.
     """
-    path = Path(path)
+    return _examined(Path(path))[0]
+
+
+def damage(path) -> str | None:
+    """What is wrong with a cached answer that is there but cannot be used, or None (a whole
+    answer, or none at all).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A cached answer (:func:`cache_path`).
+
+    Returns
+    -------
+    str or None
+        One phrase: its provenance record missing or unreadable, its answer missing or
+        unreadable, or its bytes not those fetched (their SHA-256 not the one recorded).
+    """
+    return _examined(Path(path))[1]
+
+
+def _examined(path: Path) -> tuple[WeatherProvenance | None, str | None]:
+    """A cached answer's provenance where it is whole, else None and what is wrong with it
+    (None where neither the answer nor its record is there)."""
+    record_path = _provenance_path(path)
+    if not path.exists() and not record_path.exists():
+        return None, None
     try:
-        record = json.loads(_provenance_path(path).read_text())
-        provenance = WeatherProvenance(**{**record, "file": str(path)})
         payload = path.read_bytes()
-    except (OSError, ValueError, TypeError):
-        return None
-    return provenance if hashlib.sha256(payload).hexdigest() == provenance.sha256 else None
+    except FileNotFoundError:
+        return None, f"its answer is missing beside its provenance record {record_path.name}"
+    except OSError as error:
+        return None, f"it cannot be read ({error.strerror or error})"
+    try:
+        record = json.loads(record_path.read_text())
+        provenance = WeatherProvenance(**{**record, "file": str(path)})
+    except FileNotFoundError:
+        return None, f"its provenance record {record_path.name} is missing"
+    except OSError as error:
+        return None, f"its provenance record cannot be read ({error.strerror or error})"
+    except (ValueError, TypeError):
+        return None, f"its provenance record {record_path.name} is not one foldopt wrote"
+    if hashlib.sha256(payload).hexdigest() != provenance.sha256:
+        size = (
+            f"{len(payload):,} bytes where {provenance.bytes:,} were fetched"
+            if len(payload) != provenance.bytes
+            else "its bytes changed since it was fetched"
+        )
+        return None, f"{size}: its SHA-256 is not the one recorded"
+    return replace(provenance, url=redacted(str(provenance.url))), None
+
+
+def _answers() -> list[Path]:
+    folder = weather_cache()
+    if not folder.is_dir():
+        return []
+    return [path for path in sorted(folder.glob("*.json")) if ".provenance" not in path.name]
 
 
 def cached_entries() -> list[WeatherProvenance]:
     """Every whole answer in :func:`weather_cache`, by file name."""
-    folder = weather_cache()
-    if not folder.is_dir():
-        return []
-    found = (
-        cached(path) for path in sorted(folder.glob("*.json")) if ".provenance" not in path.name
-    )
+    found = (cached(path) for path in _answers())
     return [entry for entry in found if entry is not None]
+
+
+def damaged_entries() -> list[tuple[Path, str]]:
+    """Every damaged answer in :func:`weather_cache` (:func:`damage`), by file name: the file
+    and what is wrong with it."""
+    found = ((path, damage(path)) for path in _answers())
+    return [(path, why) for path, why in found if why is not None]
 
 
 def fetch(source: str, latitude: float, longitude: float, weather=None) -> WeatherProvenance:
@@ -359,7 +479,7 @@ def fetch(source: str, latitude: float, longitude: float, weather=None) -> Weath
         The site [deg], rounded as the service rounds it.
     weather : foldopt.inputs.weather_section.Weather or dict, optional
         The options: ``years`` (``START:END``), ``usehorizon``, ``raddatabase`` (``pvgis-hourly``),
-        ``url``, ``timeout_s``.
+        ``url``, ``timeout_s`` (the whole fetch's time: connecting, every read, every retry).
 
     Returns
     -------
@@ -368,13 +488,42 @@ def fetch(source: str, latitude: float, longitude: float, weather=None) -> Weath
 
     Raises
     ------
+    foldopt.errors.ConfigError
+        Before anything is asked, for a site out of range or not finite (:func:`site_problems`)
+        or a ``FOLDOPT_OFFLINE`` that is no yes or no.
     foldopt.errors.WeatherError
-        One line: years outside the service's, offline without a cached copy, no network, a
-        timeout, the service's refusal (its own message), a rate limit beyond
-        :data:`MAX_RETRY_WAIT_S`, a cut or malformed answer, a cache folder that cannot be
-        written. Nothing is cached then.
+        One line: an address that is not http or https (before anything is asked), years
+        outside the service's, offline without a cached copy or with a damaged one, no network,
+        no whole answer within ``timeout_s``, the service's refusal (its own message), a rate
+        limit beyond :data:`MAX_RETRY_WAIT_S`, a cut or malformed answer, a cache folder that
+        cannot be written. Nothing is cached then. A damaged cached copy is fetched again
+        online (a notice names it).
     """
     return _fetch(SOURCES[source], latitude, longitude, weather, f"weather {source}")
+
+
+def lookup(source: str, latitude: float, longitude: float, weather=None) -> WeatherProvenance:
+    """A source's cached answer for a site; nothing is fetched (``foldopt weather path``).
+
+    Parameters
+    ----------
+    source, latitude, longitude, weather
+        As :func:`fetch` takes them.
+
+    Returns
+    -------
+    WeatherProvenance
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        As :func:`fetch` before anything is asked.
+    foldopt.errors.WeatherError
+        One line: no cached copy, or a damaged one (named, with what is wrong), and the command
+        that fetches it.
+    """
+    label = f"weather {source}"
+    return _fetch(SOURCES[source], latitude, longitude, weather, label, fetching=False)
 
 
 def fetch_horizon(
@@ -399,37 +548,62 @@ def fetch_horizon(
 
     Raises
     ------
-    foldopt.errors.WeatherError
+    foldopt.errors.ConfigError, foldopt.errors.WeatherError
         As :func:`fetch`: one line, ``horizon pvgis: ...``, nothing cached.
     """
     return _fetch(HORIZON_SOURCES[source], latitude, longitude, options, f"horizon {source}")
 
 
-def _fetch(source: WeatherSource, latitude, longitude, weather, label: str) -> WeatherProvenance:
-    request = _request(source, latitude, longitude, weather)
+def _fetch(
+    source: WeatherSource, latitude, longitude, weather, label: str, fetching: bool = True
+) -> WeatherProvenance:
+    request = _request(source, latitude, longitude, weather, label)
     _check_years(request, label)
+    offline_now = offline()  # a FOLDOPT_OFFLINE that is no yes or no is refused on every path
     path = cache_path(request)
-    found = cached(path)
+    found, wrong = _examined(path)
     if found is not None:
         return found
-    if offline():
-        params = request.params
-        site = f"--lat {params['lat']:g} --lon {params['lon']:g}"
-        if "startyear" in params:
-            site += f" --years {params['startyear']}:{params['endyear']}"
-        how = (
-            f"foldopt weather fetch {source.name} {site}"
-            if source.name in SOURCES
-            else f"run once with --{label} {site}"
+    how = _fetch_command(request, weather, label)
+    if not fetching or offline_now:
+        offline_said = (
+            ", and offline (--offline, FOLDOPT_OFFLINE=1) nothing is fetched" if fetching else ""
         )
+        where = " where there is a network" if fetching else ""
+        if wrong is not None:
+            raise WeatherError(
+                f"{label}: the cached copy {path} is damaged ({wrong}){offline_said}; fetch it "
+                f"again{where}, which replaces it: {how}"
+            )
+        params = request.params
         raise WeatherError(
             f"{label}: no cached copy for ({params['lat']:g}, {params['lon']:g}) with these "
-            "options, and offline (--offline, FOLDOPT_OFFLINE=1) nothing is fetched; fetch it "
-            f"first where there is a network: {how}"
+            f"options{offline_said or ' in ' + str(weather_cache())}; fetch it first{where}: {how}"
         )
     payload = _download(request, label)
     retrieved = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
-    return _store(request, payload, retrieved, label)
+    stored = _store(request, payload, retrieved, label)
+    if wrong is not None:
+        notice(f"the cached copy {path} was damaged ({wrong}); fetched it again")
+    return stored
+
+
+def _fetch_command(request: _Request, weather, label: str) -> str:
+    """The command that fetches a request's answer into the cache."""
+    params = request.params
+    options = f"--lat {params['lat']:g} --lon {params['lon']:g}"
+    if "startyear" in params:
+        options += f" --years {params['startyear']}:{params['endyear']}"
+    if request.source.name not in SOURCES:
+        return f"run once with --{label} {options}"
+    if params.get("usehorizon") == 0:
+        options += " --no-horizon"
+    if "raddatabase" in params:
+        options += f" --raddatabase {params['raddatabase']}"
+    given = _option(weather, "url", None)
+    if given is not None:
+        options += f" --url {redacted(given)}"
+    return f"foldopt weather fetch {request.source.name} {options}"
 
 
 def _check_years(request: _Request, label: str) -> None:
@@ -449,42 +623,140 @@ def _check_years(request: _Request, label: str) -> None:
         )
 
 
+class _Deadline:
+    """A fetch's whole time [s] (``weather.timeout_s``): connecting, every read, every retry.
+    When it is spent the sockets the fetch opened are shut, so that a service that sends its
+    answer a byte at a time, each read within any per-read timeout, is given up on all the same.
+
+    Parameters
+    ----------
+    seconds : float
+    """
+
+    def __init__(self, seconds: float):
+        self.end = time.monotonic() + seconds
+        self.expired = False
+        self._sockets: list = []
+        self._lock = threading.Lock()
+        self._timer = threading.Timer(seconds, self._expire)
+        self._timer.daemon = True
+
+    def __enter__(self):
+        self._timer.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._timer.cancel()
+
+    def left(self) -> float:
+        """Seconds left [s], 0 once spent."""
+        return max(self.end - time.monotonic(), 0.0)
+
+    def watch(self, sock) -> None:
+        """Shut ``sock`` at the deadline (at once where it is spent)."""
+        with self._lock:
+            self._sockets.append(sock)
+            expired = self.expired
+        if expired:
+            _shut(sock)
+
+    def _expire(self) -> None:
+        with self._lock:
+            self.expired = True
+            sockets = list(self._sockets)
+        for sock in sockets:
+            _shut(sock)
+
+    def session(self):
+        """A ``requests`` session whose connections the deadline watches."""
+        import requests
+        from requests.adapters import HTTPAdapter
+
+        deadline = self
+
+        class Watched(HTTPAdapter):
+            def get_connection_with_tls_context(self, *args, **kwargs):
+                pool = super().get_connection_with_tls_context(*args, **kwargs)
+                if getattr(pool.ConnectionCls, "deadline", None) is not deadline:
+                    pool.ConnectionCls = _watched(pool.ConnectionCls, deadline)
+                return pool
+
+        session = requests.Session()
+        for prefix in ("http://", "https://"):
+            session.mount(prefix, Watched())
+        return session
+
+
+def _watched(connection_class, deadline: _Deadline):
+    """``connection_class`` (urllib3's) whose sockets ``deadline`` shuts when it is spent."""
+
+    class Watched(connection_class):
+        def connect(self):
+            super().connect()
+            deadline.watch(self.sock)
+
+    Watched.deadline = deadline
+    return Watched
+
+
+def _shut(sock) -> None:
+    # the plain socket's shutdown: it wakes a read blocked in another thread (an SSL socket's own
+    # would unwrap the socket under its reader)
+    with contextlib.suppress(OSError):
+        socket.socket.shutdown(sock, socket.SHUT_RDWR)
+
+
 def _download(request: _Request, label: str) -> bytes:
     """The answer's bytes, after at most :data:`MAX_ATTEMPTS` requests (a rate limit waits as
-    the service asks, up to :data:`MAX_RETRY_WAIT_S`)."""
+    the service asks, up to :data:`MAX_RETRY_WAIT_S`), all within ``request.timeout_s``."""
     import requests
 
     service, host = request.source.service, request.base
-    for attempt in range(1, MAX_ATTEMPTS + 1):
-        _pace()
-        try:
-            with requests.get(
-                request.base + request.source.route,
-                params=request.params,
-                timeout=request.timeout_s,
-                stream=True,
-                headers={"User-Agent": "foldopt"},
-            ) as response:
-                payload = _body(response, label, service)
-        except requests.exceptions.Timeout:
-            raise WeatherError(
-                f"{label}: {service} at {host} did not answer within {request.timeout_s:g} s "
-                "(weather.timeout_s sets the wait); try again later"
-            ) from None
-        except requests.exceptions.RequestException as error:
-            raise WeatherError(f"{label}: {_network_fault(error, service, host)}") from None
-        if response.status_code == 429 and attempt < MAX_ATTEMPTS:
-            wait = _retry_after(response.headers.get("Retry-After"))
-            if wait > MAX_RETRY_WAIT_S:
-                raise WeatherError(
-                    f"{label}: {service} limits the rate of requests and asks to wait {wait:g} s, "
-                    f"longer than foldopt waits ({MAX_RETRY_WAIT_S:g} s); try again later"
-                )
-            time.sleep(wait)
-            continue
-        if response.status_code != 200:
-            raise WeatherError(f"{label}: {_refusal(response, payload, service, attempt)}")
-        return payload
+    late = WeatherError(
+        f"{label}: {service} at {host} did not answer within {request.timeout_s:g} s "
+        "(weather.timeout_s sets the wait); its whole answer must come within it: nothing was "
+        "cached, try again later"
+    )
+    with _Deadline(request.timeout_s) as deadline, deadline.session() as session:
+        for attempt in range(1, MAX_ATTEMPTS + 1):
+            _pace()
+            if deadline.left() == 0:
+                raise late
+            try:
+                with session.get(
+                    request.base + request.source.route,
+                    params=[*request.query, *request.params.items()],
+                    timeout=deadline.left(),
+                    stream=True,
+                    headers={"User-Agent": "foldopt"},
+                ) as response:
+                    payload = _body(response, label, service)
+            except Exception as error:
+                # a read the deadline cut short fails as a cut answer or a closed connection
+                if deadline.expired or isinstance(error, requests.exceptions.Timeout):
+                    raise late from None
+                if isinstance(error, requests.exceptions.RequestException):
+                    raise WeatherError(f"{label}: {_network_fault(error, service, host)}") from None
+                raise
+            if deadline.expired:
+                raise late
+            if response.status_code == 429 and attempt < MAX_ATTEMPTS:
+                wait = _retry_after(response.headers.get("Retry-After"))
+                if wait > MAX_RETRY_WAIT_S or wait >= deadline.left():
+                    limit = (
+                        f"longer than foldopt waits ({MAX_RETRY_WAIT_S:g} s)"
+                        if wait > MAX_RETRY_WAIT_S
+                        else f"past the request's {request.timeout_s:g} s (weather.timeout_s)"
+                    )
+                    raise WeatherError(
+                        f"{label}: {service} limits the rate of requests and asks to wait "
+                        f"{wait:g} s, {limit}; try again later"
+                    )
+                time.sleep(wait)
+                continue
+            if response.status_code != 200:
+                raise WeatherError(f"{label}: {_refusal(response, payload, service, attempt)}")
+            return payload
     raise AssertionError("unreachable: the last attempt returns or raises")
 
 

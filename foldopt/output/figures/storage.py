@@ -94,7 +94,7 @@ def plot_powered_vs_capacity(result: StudyResult, ax=None):
             color=colour,
             label=label,
         )
-    stops = sizing.folding_stops_paying_wh
+    stops = sizing.folding.stops_wh
     if stops == stops:
         ax.axvline(stops, color="tab:green", lw=1, label=f"folding stops paying: {stops:.3g} Wh")
     ax.axvline(storage.capacity_wh, color="0.6", lw=0.8, ls=":", label="the study's buffer")
