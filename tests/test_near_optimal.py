@@ -25,14 +25,19 @@ def reference(angles, values, fraction, minutes):
         hi += 1
     centre = (angles[lo] + angles[hi]) / 2
     recommended = min(range(lo, hi + 1), key=lambda i: (abs(angles[i] - centre), -i))
+    # A panel best unfolded is the flat panel: no hinge to set, so no fold to recommend.
+    if angles[best] == 180.0:
+        recommended = best
     return angles[lo], angles[hi], angles[recommended], tolerance
 
 
 @settings(max_examples=200, deadline=None)
 @given(values=st.lists(st.floats(0.0, 14.0), min_size=1, max_size=40), fraction=st.floats(0.0, 0.2),
-       minutes=st.floats(0.0, 30.0), step=st.sampled_from([1.0, 2.5, 10.0]))
-def test_the_range_is_the_best_angles_plateau(values, fraction, minutes, step):
-    angles = 1.0 + step * np.arange(len(values))
+       minutes=st.floats(0.0, 30.0), step=st.sampled_from([1.0, 2.5, 10.0]), to_flat=st.booleans())
+def test_the_range_is_the_best_angles_plateau(values, fraction, minutes, step, to_flat):
+    """On grids from 1 deg, and on grids ending at the flat panel (180 deg), where a best at 180 deg
+    is recommended unfolded."""
+    angles = (180.0 - step * np.arange(len(values))[::-1]) if to_flat else 1.0 + step * np.arange(len(values))
     found = near_optimal(angles, np.array(values), NearOptimal(fraction=fraction, minutes=minutes))
     if max(values) <= 0:  # no angle carries the load: no range
         assert np.isnan(found["recommended_fold_angle_deg"])
@@ -41,6 +46,20 @@ def test_the_range_is_the_best_angles_plateau(values, fraction, minutes, step):
     assert found["near_optimal_lo_deg"] == lo and found["near_optimal_hi_deg"] == hi
     assert found["recommended_fold_angle_deg"] == recommended
     assert found["near_optimal_tolerance_h"] == pytest.approx(tolerance, rel=1e-12)
+
+
+def test_a_plateau_up_to_the_flat_panel_best_flat_recommends_flat():
+    """A plateau 176 to 180 deg whose best is 180 deg (ties to the least folded): the flat panel is
+    recommended (it was 178 deg, the centre: a fold no better than not folding); a plateau whose
+    best is folded keeps its centre."""
+    angles = np.arange(170.0, 181.0, 2.0)
+    values = np.array([[1, 1, 1, 5, 5, 5], [1, 1, 5, 6, 5, 5]], dtype=float)
+    found = near_optimal(angles, values, NearOptimal(fraction=0.0, minutes=0.0))
+    assert found["near_optimal_lo_deg"].tolist() == [176.0, 176.0]
+    assert found["recommended_fold_angle_deg"].tolist() == [180.0, 176.0]
+    loose = near_optimal(angles, values, NearOptimal(fraction=0.0, minutes=60.0))
+    assert loose["near_optimal_lo_deg"].tolist() == [176.0, 174.0]
+    assert loose["recommended_fold_angle_deg"].tolist() == [180.0, 178.0]
 
 
 def test_rows_are_independent():
@@ -179,3 +198,49 @@ def test_foldopt_run_prints_a_range_that_holds_its_best_angle(tmp_path):
     lo, hi, recommended = map(float, re.search(r"near-optimal ([\d.]+) to ([\d.]+) deg .*recommended ([\d.]+) deg",
                                                done.stdout).groups())
     assert lo <= best <= hi and lo <= recommended <= hi
+
+
+@settings(max_examples=150, deadline=None)
+@given(values=st.lists(st.floats(0, 12), min_size=1, max_size=14), data=st.data(),
+       fraction=st.floats(0, 0.1), minutes=st.floats(0, 30), off_grid=st.floats(120.01, 179.99))
+def test_the_recommended_angle_lies_in_its_range_and_is_flat_where_flat_is_best(values, data, fraction, minutes,
+                                                                              off_grid):
+    """Over a grid reaching 180 deg, with an evaluated angle off it (a refined optimum): the recommended
+    angle always lies within the range found (a range of one angle off the grid was recommended the
+    nearest grid angle, outside it), and is 180 deg, the flat panel, wherever the best angle is."""
+    from foldopt.studies.objectives import best_angle_index, near_optimal_on_grid
+
+    grid = np.arange(120.0, 181.0, 5.0)
+    angles = np.array(sorted(data.draw(st.lists(st.sampled_from([*grid, off_grid]), min_size=len(values),
+                                                max_size=len(values), unique=True))))
+    tolerance = NearOptimal(fraction=fraction, minutes=minutes)
+    for found in (near_optimal_on_grid(angles, np.array([values]), tolerance, grid),
+                  {key: value[None] for key, value in near_optimal(angles, np.array(values), tolerance).items()}):
+        lo, hi, recommended = (found[key][0] for key in ("near_optimal_lo_deg", "near_optimal_hi_deg",
+                                                          "recommended_fold_angle_deg"))
+        if max(values) <= 0:
+            assert np.isnan(recommended)
+            continue
+        assert lo <= recommended <= hi
+        assert recommended in angles or recommended in grid
+        if angles[best_angle_index(np.array(values))] == 180.0:
+            assert recommended == 180.0
+
+
+def test_a_day_best_flat_is_recommended_flat(tmp_path):
+    """The paper's day at 17 W: the flat panel is the best design (no fold reaches further), and the
+    answer recommends it, not a fold at the range's centre (it recommended 177 deg), nor does it claim
+    a gain over flat for it."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    done = CliRunner().invoke(app, ["run", "--set", "p_load=17", "--format", "json", "--out", str(tmp_path / "o")])
+    assert done.exit_code == 0, done.output
+    answer = json.loads(done.stdout)["answer"]
+    result = answer["result"]
+    assert result["fold_angle_deg"] == 180.0 and result["recommended_fold_angle_deg"] == 180.0
+    assert result["near_optimal_lo_deg"] < 180.0
+    assert "recommended 180 deg" in answer["lines"][2] and "% over" not in answer["lines"][1]

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from foldopt.engine.metrics import t_solar
 from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
@@ -43,9 +45,29 @@ def test_heuristic_bisection_finds_the_threshold():
         level = np.asarray(angles, dtype=float)[:, None] / 180.0 * np.ones((1, 5))
         return level, level, level
 
-    assert heuristic_fold_angle(subpanels, 0.25, tol=1e-4) == pytest.approx(45.0, abs=1e-3)
-    assert np.isnan(heuristic_fold_angle(subpanels, 2.0))
-    assert heuristic_fold_angle(subpanels, 0.0) == 1.0
+    angle, outside = heuristic_fold_angle(subpanels, 0.25, tol=1e-4)
+    assert angle == pytest.approx(45.0, abs=1e-3) and outside == ""
+    angle, outside = heuristic_fold_angle(subpanels, 2.0)
+    assert np.isnan(angle) and outside == "above"
+
+
+@pytest.mark.parametrize("p_load,lo,hi,outside", [
+    (0.0, 1.0, 180.0, "below"),  # every angle reaches a load of nothing: the bound is no answer
+    (0.25, 60.0, 180.0, "below"),  # the threshold, 45 deg, below the grid
+    (0.25, 1.0, 30.0, "above"),  # above it
+    (0.25, 45.5, 180.0, "below"),
+])
+def test_the_heuristic_gives_no_angle_outside_its_bounds(p_load, lo, hi, outside):
+    """The rule's angle is the threshold (45 deg for a 0.25 W load on a valley rising linearly to 1 W
+    flat): where it lies outside [lo, hi] the answer is no angle and the side it lies on, never the
+    clamped bound (it gave 1.0 deg, the search's lower bound, where the valley reached the load
+    everywhere)."""
+    def subpanels(angles):
+        level = np.asarray(angles, dtype=float)[:, None] / 180.0 * np.ones((1, 5))
+        return level, level, level
+
+    angle, side = heuristic_fold_angle(subpanels, p_load, lo=lo, hi=hi)
+    assert np.isnan(angle) and side == outside
 
 
 def test_the_heuristic_angle_reaches_the_load():
@@ -56,9 +78,60 @@ def test_the_heuristic_angle_reaches_the_load():
         return level, level, level
 
     for p_load in np.linspace(0.01, 0.99, 37):
-        angle = heuristic_fold_angle(subpanels, p_load)
+        angle, _ = heuristic_fold_angle(subpanels, p_load)
         assert (angle / 180.0) ** 1.7 >= p_load
         assert angle - 180.0 * p_load ** (1 / 1.7) <= 0.01 + 1e-9  # at most tol above the threshold
+
+
+@pytest.mark.parametrize("start,stop,p_load,outside", [
+    (1, 180, 4.398, ""),  # the paper's day: 28.5 deg
+    (60, 180, 4.398, "below"),  # the rule's 28.5 deg below the grid (it was printed)
+    (2, 180, 0.1, "below"),  # it printed the search's bound, 1.0 deg, off a grid from 2 deg
+    (1, 20, 4.398, "above"),
+    (1, 180, 30.0, "above"),  # beyond the flat panel's noon power
+    (20, 120, 8.0, ""),
+])
+def test_the_heuristic_is_stated_only_within_the_studys_fold_angles(tmp_path, shin_study, start, stop, p_load,
+                                                                    outside):
+    """The paper's heuristic is stated where its angle lies among the study's fold angles, and there it
+    reaches the load at noon where a hundredth of a degree less does not (Eq. 8, on the day's own
+    sub-panel curves); elsewhere the answer says why in one note (the noon valley checked at the grid's
+    edge) and states no angle: not a clamped bound, not an angle outside the grid (run.json, JSON and
+    the designs alike)."""
+    import json
+    import re
+
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+    from foldopt.engine.optimize import noon_valley
+
+    out = tmp_path / "out"
+    done = CliRunner().invoke(app, ["run", "--set", f"fold_angles.start={start}", "--set",
+                                    f"fold_angles.stop={stop}", "--set", f"p_load={p_load}", "--format", "json",
+                                    "--out", str(out)])
+    assert done.exit_code == 0, done.output
+    answer = json.loads(done.stdout)["answer"]
+    angle = answer["result"]["fold_angle_twofold_heuristic_deg"]
+    notes = [note["note"] for note in answer["notes"] if "heuristic" in note["note"]]
+    stated = [float(m) for line in answer["lines"] for m in re.findall(r"heuristic: ([\d.]+) deg", line)]
+    heuristic_rows = [row for row in answer["designs"] if row["design"] == "twofold-heuristic"]
+    assert json.loads((out / "run.json").read_text())["fold_angle_twofold_heuristic_deg"] == angle
+    day = Day(shin_study)  # the sub-panels' curves do not depend on the load or the grid
+
+    def valley(fold):
+        return float(noon_valley(*day.subpanel_power(np.array([fold])))[0])
+
+    if outside == "":
+        assert start < angle <= stop and stated == [pytest.approx(angle, abs=0.05)] and not notes
+        assert [row["fold_angle_deg"] for row in heuristic_rows] == [angle]
+        assert valley(angle) >= p_load > valley(angle - 0.011)
+    else:
+        assert angle is None and not stated and not heuristic_rows and len(notes) == 1
+        if outside == "below":
+            assert valley(start) >= p_load and f"at {start} deg" in notes[0]
+        else:
+            assert valley(stop) < p_load
 
 
 def test_the_paper_days_heuristic_angle_carries_the_load_through_noon(shin_study):
@@ -409,3 +482,78 @@ def test_loads_times_designs_beyond_the_limit_are_refused_at_once(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("error: --p-load: 14 loads x 1,490,580 designs")
     assert 14 * 1_490_580 > MAX_DESIGNS and f"the limit is {MAX_DESIGNS:,}" in lines[0]
     assert not (tmp_path / "out").exists()
+
+
+#: Small grids of the fold angle (one stopping short of the flat panel), tilt and azimuth.
+FLAT_FOLDS = ["10:180:10", "20:180:40", "10:170:20"]
+
+
+@settings(max_examples=25, deadline=None)
+@given(latitude=st.floats(-60.0, 60.0), longitude=st.floats(-180.0, 180.0),
+       days=st.sampled_from(["2014-06-21", "1:365:45", "1:365:30"]),
+       objective=st.sampled_from(["mean", "worst-month", "min", "p10"]),
+       loads=st.lists(st.floats(0.5, 12.0), min_size=1, max_size=2, unique=True),
+       vary=st.sampled_from(["fold_angle,tilt", "fold_angle,azimuth", "fold_angle,tilt,azimuth", "tilt"]),
+       folds=st.sampled_from(FLAT_FOLDS))
+def test_no_fold_of_180_deg_beats_the_flat_panel_at_its_own_best(latitude, longitude, days, objective, loads,
+                                                                  vary, folds):
+    """A 180 deg fold is the flat panel: the flat panel at its own best is at least every design with a
+    180 deg fold evaluated anywhere (the searches', the default mounting's), and the optimum at least
+    the flat panel's own best where its fold angles reach 180 deg; no line claims a gain for a 180 deg
+    fold (the flat search missed its own best, and the answer said '+0.1 % over the flat panel')."""
+    import foldopt
+
+    equator = 180.0 if latitude >= 0 else 0.0
+    fields = {"fold_angle": folds, "tilt": "0:90:10", "azimuth": f"{equator - 60:g}:{equator + 60:g}:20"}
+    fields = {name: value for name, value in fields.items() if name in vary}
+    several = days != "2014-06-21"
+    result = foldopt.optimize(foldopt.default_study(), vary=vary, latitude=latitude, longitude=longitude,
+                              date=days, p_load=loads, step_min=30, **fields,
+                              **({"objective": objective} if several else {}))
+    table = result.table.set_index(["p_load_w", "design"])
+    searches = [search for _, search in result.steps] + [result.flat]
+    unfolded = np.vstack([search.values[search.points[:, 0] == 180.0] for search in searches])
+    fold_hi = result.twofold.axes[0].hi
+    for index, load in enumerate(result.loads):
+        flat, best = table.loc[(load, "flat")], table.loc[(load, "twofold")]
+        assert flat["fold_angle_deg"] == 180.0
+        assert np.all(unfolded[:, index] <= flat["objective_h"])
+        assert table.loc[(load, "flat-default"), "objective_h"] <= flat["objective_h"]
+        # The optimum is the best design evaluated within its ranges.
+        assert result.twofold.values[:, index].max() <= best["objective_h"]
+        if fold_hi == 180.0:
+            assert best["objective_h"] >= flat["objective_h"]
+        if best["fold_angle_deg"] == 180.0:
+            assert best["objective_h"] == flat["objective_h"]
+            assert not best["gain_vs_flat_pct"] > 0.0
+    for line in result.answer.lines():
+        if "fold 180 deg" in line:
+            assert "% over" not in line, line
+    for load in result.answer.to_dict()["result"]["loads"]:
+        if load["fold_angle_deg"] == 180.0:
+            assert not (load["gain_vs_flat_pct"] or 0.0) > 0.0
+
+
+def test_the_flat_panel_at_its_own_best_holds_its_default_mounting(tmp_path):
+    """At 14.3 S the flat panel's search, on a 2-deg grid of tilts, missed the default mounting's tilt
+    of 14.3 deg: its 'own best' (7.7405 h at 14 deg) was short of the default (7.7407 h) and of the
+    180 deg designs evaluated.csv holds; optimum.csv's flat row is now the best of them all, and the
+    optimum is it."""
+    import pandas as pd
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    out = tmp_path / "out"
+    done = CliRunner().invoke(app, ["optimize", "--lat", "-14.3", "--lon", "76.8", "--days", "1:365:30",
+                                    "--objective", "mean", "--p-load", "9.47", "--vary", "fold_angle,tilt",
+                                    "--fold-range", "10:180:5", "--tilt-range", "0:90:2", "--step-min", "15",
+                                    "--out", str(out)])
+    assert done.exit_code == 0, done.output
+    optimum = pd.read_csv(out / "optimum.csv").set_index("design")
+    evaluated = pd.read_csv(out / "evaluated.csv")
+    flat = optimum.loc["flat", "objective_h"]
+    assert flat >= evaluated.loc[evaluated["fold_angle_deg"] == 180, "objective_h"].max()
+    assert flat >= optimum.loc["flat-default", "objective_h"]
+    assert optimum.loc["twofold", "objective_h"] == flat and optimum.loc["twofold", "fold_angle_deg"] == 180
+    assert "% over" not in done.stdout.splitlines()[2]

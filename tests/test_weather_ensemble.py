@@ -222,3 +222,34 @@ def test_clear_hours_above_the_clear_sky_follow_a_curve_not_a_staircase():
     kc = out["ghi"][:, 0] / np.where(clear[0] > 0, clear[0], 1.0)
     edges = np.arange(8, 12) * spi
     assert np.abs(kc[:, edges] - kc[:, edges - 1]).max() < 0.03  # the hours' indices step by 0.1
+
+
+def test_an_ensemble_whose_every_member_is_best_flat_recommends_flat(tmp_path):
+    """Greensboro's TMY3 year as three cloud members, an 8 W load: the flat panel is every member's own
+    best (their objectives at every fold angle, annual_fold_angles.csv, independently of the answer's
+    choice); the answer recommends it, 180 deg, not the centre of the near-optimal range (it
+    recommended 170 deg), its recommendation lies in that range, and no line claims a gain over flat
+    for the flat panel; no warning reaches stderr."""
+    import json
+    from pathlib import Path
+
+    import pandas as pd
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    weather = Path(__file__).resolve().parent.parent / "configs" / "weather" / "723170TYA.CSV"
+    out = tmp_path / "out"
+    done = CliRunner().invoke(app, ["sweep", "angle", "--weather", str(weather), "--members", "3", "--days",
+                                    "1:365:20", "--objective", "mean", "--step-min", "15", "--p-load", "8",
+                                    "--angle-step", "10", "--format", "json", "--out", str(out)])
+    assert done.exit_code == 0, done.output
+    assert done.stderr == ""
+    by_angle = pd.read_csv(out / "annual_fold_angles.csv")
+    assert by_angle.loc[by_angle["fold_angle_deg"] == 180, "wins_pct"].tolist() == [100.0]
+    answer = json.loads(done.stdout)["answer"]
+    (near,) = answer["near_optimal"]
+    assert near["fold_angle_deg"] == 180.0 == near["recommended_fold_angle_deg"]
+    assert near["near_optimal_lo_deg"] < 180.0
+    assert any("recommended 180 deg" in line for line in answer["lines"])
+    assert not any("% over" in line for line in answer["lines"])

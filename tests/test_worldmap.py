@@ -291,3 +291,23 @@ def test_a_map_searching_the_tilt_answers_with_the_tilts():
     assert answer.result["loads"][0]["surface_tilt_flat"]["min"] == year["surface_tilt_flat"].min()
     assert "base tilts" in answer.summary[1] and "0 to 60 by 30 deg" in answer.question["panel"]
     assert list(answer.near_optimal["surface_tilt"]) == list(year["surface_tilt"])
+
+
+@settings(max_examples=5, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(latitude=st.floats(-60, 60), longitude=st.floats(-180, 180),
+       loads=st.lists(st.floats(1.0, 12.0), min_size=2, max_size=3, unique=True))
+def test_a_map_searching_the_tilt_holds_the_flat_panel_to_its_own_best(latitude, longitude, loads):
+    """--optimize tilt: a 180 deg fold is the flat panel, so the twofold panel's best is never short of
+    the flat panel's own best (its grid reaches 180 deg); where its best is 180 deg it is the flat
+    panel's, with no gain, and the recommended angle is 180 deg (it was the range's centre); every
+    recommended angle lies in its range."""
+    study = {**COARSE, "fold_angles": {"start": 20, "stop": 180, "step": 20},
+             "optimize": {"vary": ["fold_angle", "tilt"], "tilt": {"min": 0, "max": 90, "step": 10}}}
+    table = evaluate_sites(study, [{"latitude": latitude, "longitude": longitude}], loads)
+    assert (table["objective_twofold_h"] >= table["objective_flat_h"]).all()
+    unfolded = table[(table["fold_angle_deg"] == 180) & (table["objective_twofold_h"] > 0)]
+    assert (unfolded["objective_twofold_h"] == unfolded["objective_flat_h"]).all()
+    assert (unfolded["gain_vs_flat_pct"] == 0).all() and (unfolded["recommended_fold_angle_deg"] == 180).all()
+    ranged = table.dropna(subset=["recommended_fold_angle_deg"])
+    assert ranged["recommended_fold_angle_deg"].between(ranged["near_optimal_lo_deg"],
+                                                        ranged["near_optimal_hi_deg"]).all()

@@ -111,14 +111,16 @@ def heuristic_fold_angle(
     lo: float = 1.0,
     hi: float = 180.0,
     tol: float = 0.01,
-):
+) -> tuple[float, str]:
     """The paper's optimum: the smallest fold angle whose noon valley still reaches the load.
 
     Shin et al. [1]_ Sec. VI, Eq. 8: ``Min(P_pv,parallel) = P_load``. The valley deepens as the
     panel folds (it rises with the fold angle), so the angle is the root of
     ``noon_valley(angle) - p_load`` in ``[lo, hi]``, found by Brent's method
     (:func:`scipy.optimize.brentq`): on the paper's study it evaluates the day 9 or 10 times where
-    bisection to the same tolerance takes 17.
+    bisection to the same tolerance takes 17. Where the valley reaches the load already at ``lo``
+    the rule's angle lies at or below ``lo``, which is no angle of ``[lo, hi]``: ``lo`` is only the
+    search's bound, not returned as the rule's answer.
 
     Parameters
     ----------
@@ -127,16 +129,20 @@ def heuristic_fold_angle(
     p_load : float
         Load power [W].
     lo, hi : float, default 1 and 180
-        Search interval [deg].
+        Search interval [deg]: a study's fold angles.
     tol : float, default 0.01
         Absolute tolerance on the angle [deg] (``xtol`` of :func:`scipy.optimize.brentq`).
 
     Returns
     -------
-    float
-        Fold angle [deg] whose valley reaches the load, at most ``tol`` above the threshold;
-        ``lo`` if even the most folded panel
-        reaches the load, NaN if even the flat one does not (the load exceeds the noon power).
+    angle : float
+        Fold angle [deg] in ``(lo, hi]`` whose valley reaches the load, at most ``tol`` above the
+        threshold; NaN where the rule's angle is not in ``(lo, hi]``.
+    outside : str
+        Where the rule's angle lies when it is not in ``(lo, hi]``: ``"below"`` (even the most
+        folded panel, at ``lo``, reaches the load), ``"above"`` (the valley falls short of the
+        load even at ``hi``; at 180 deg the load exceeds the flat panel's noon power); ``""``
+        where ``angle`` is the rule's.
 
     References
     ----------
@@ -151,18 +157,21 @@ def heuristic_fold_angle(
     >>> def subpanels(angles):
     ...     level = np.asarray(angles)[:, None] / 180.0 * np.ones((1, 5))
     ...     return level, level, level
-    >>> round(heuristic_fold_angle(subpanels, 0.25), 2)
-    45.0
+    >>> angle, outside = heuristic_fold_angle(subpanels, 0.25)
+    >>> round(angle, 1), outside
+    (45.0, '')
+    >>> heuristic_fold_angle(subpanels, 0.25, lo=60.0)
+    (nan, 'below')
     """
 
     def shortfall(angle):
         return float(noon_valley(*subpanel_power(np.array([angle])))[0]) - p_load
 
     if shortfall(hi) < 0.0:
-        return float("nan")
+        return float("nan"), "above"
     if shortfall(lo) >= 0.0:
-        return float(lo)
+        return float("nan"), "below"
     angle = float(scipy.optimize.brentq(shortfall, lo, hi, xtol=tol))
     # Brent's estimate may fall just short of the threshold; the answer must reach the load (the
     # valley rises with the fold angle, and the threshold lies within ``tol`` of the estimate).
-    return angle if shortfall(angle) >= 0.0 else min(angle + tol, hi)
+    return (angle if shortfall(angle) >= 0.0 else min(angle + tol, hi)), ""

@@ -119,7 +119,11 @@ COLUMNS = (
     # the near-optimal range
     ("near_optimal_lo_deg", "deg", "the least fold angle on the best one's plateau"),
     ("near_optimal_hi_deg", "deg", "the largest fold angle on the best one's plateau"),
-    ("recommended_fold_angle_deg", "deg", "the grid angle at the centre of the near-optimal range"),
+    (
+        "recommended_fold_angle_deg",
+        "deg",
+        "the angle at the centre of the near-optimal range; 180 where the flat panel is best",
+    ),
     (
         "near_optimal_tolerance_h",
         "h",
@@ -137,7 +141,12 @@ COLUMNS = (
         "fold_angle, tilt or azimuth: the variable a row of near_optimal.csv or added.csv is of; "
         "its near-optimal range is then in that variable's degrees",
     ),
-    ("recommended_deg", "deg", "the value at the centre of a variable's near-optimal range"),
+    (
+        "recommended_deg",
+        "deg",
+        "the value at the centre of a variable's near-optimal range; a fold of 180 where flat "
+        "is best",
+    ),
     (
         "added_h",
         "h",

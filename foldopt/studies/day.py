@@ -241,7 +241,11 @@ class StudyResult:
         Indexed by the day's tz-aware step centres (``time``): sun [deg], ``dni`` [W/m^2], the power
         [W] of every design at the optimum and the ``switch_state``.
     optimal_fold_angle, heuristic_fold_angle : float
-        [deg]; the heuristic is NaN where the paper's rule has no answer.
+        [deg]; the heuristic is NaN where the paper's rule has no angle among the study's fold
+        angles (:func:`foldopt.engine.optimize.heuristic_fold_angle`).
+    heuristic_outside : str
+        Where the rule's angle lies then: ``below`` the study's first fold angle (its noon valley
+        reaches the load even there) or ``above`` its last; ``""`` where the angle is stated.
     near_optimal : dict
         The near-optimal range of the fold angle over the angles evaluated (the sweep's grid and the
         refined optimum, which it always holds) and the recommended angle at its centre
@@ -267,6 +271,7 @@ class StudyResult:
     near_optimal: dict = dataclasses.field(default_factory=dict)
     request: object = None  # the foldopt.studies.request.Request the study came from, if any
     storage: object = None  # the buffer's DayStorage (foldopt.studies.storage_answer), if any
+    heuristic_outside: str = ""  # where the heuristic's angle lies off the study's fold angles
 
     @functools.cached_property
     def answer(self):
@@ -403,7 +408,10 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
             else day.subpanel_power(fold)
         )
 
-    paper_angle = heuristic_fold_angle(subpanels, noon_load) if noon_load > 0 else np.nan
+    # The rule's angle among the study's fold angles: one outside them is no design of the study.
+    paper_angle, paper_outside = heuristic_fold_angle(
+        subpanels, noon_load, lo=fold_angles[0], hi=fold_angles[-1]
+    )
 
     others = {}
     if np.isfinite(paper_angle):
@@ -579,6 +587,7 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
         near,
         request,
         buffered,
+        paper_outside,
     )
 
 

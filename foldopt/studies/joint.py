@@ -8,7 +8,10 @@ coarse-to-fine search of :func:`foldopt.engine.search.grid_search` on the grid o
 variables. Alongside, for a fair comparison, the flat panel's own best tilt and azimuth (the same
 search without the fold), and the default mounting (tilt ``|latitude|``, facing the equator, or the
 study's panel) with its best fold angle on the study's grid, the flat panel and the tracker there
-(:func:`foldopt.studies.designs.daily_designs`, which every study shares).
+(:func:`foldopt.studies.designs.daily_designs`, which every study shares). The optimum, the flat
+panel's own best and each variable's step are the best design evaluated within their ranges, by any
+of these searches: a 180 deg fold is the flat panel, so the flat panel's own best is never beaten by
+an unfolded design the twofold search found, nor the optimum by one the flat search found.
 
 What each variable adds is the objective gained as the variables join the search in the order of
 :data:`foldopt.names.OPTIMIZE_VARIABLES`: the fold angle alone at the default mounting, then with
@@ -16,7 +19,8 @@ the tilt, then with the azimuth. The near-optimal region of each variable is eve
 some evaluated design comes within the study's near-optimal tolerance of the optimum
 (:func:`foldopt.studies.objectives.near_optimal` on the profile, the best over the other variables):
 the designs the search evaluated and the variable's whole grid with the others at the optimum,
-so its edges are on the grid and never narrower than at the optimum's own mounting. The landscape
+so its edges are on the grid (or at the optimum, where that is a default mounting off it) and never
+narrower than at the optimum's own mounting. The landscape
 is the objective over tilt x fold angle at the optimum's azimuth, on a grid of its own.
 """
 
@@ -38,11 +42,13 @@ from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
 from foldopt.names import DEFAULT_ENGINE
 from foldopt.studies.objectives import (
+    FLAT_FOLD_ANGLE,
     best_angle_index,
     near_optimal,
     objective_quantum,
     objective_value,
     season_days,
+    season_problem,
 )
 
 #: Points of the landscape's grid along the fold angle and the tilt.
@@ -68,7 +74,8 @@ class OptimizeResult:
     table : pandas.DataFrame
         Per load and design (``twofold``, ``flat``, ``twofold-default``, ``flat-default``,
         ``tracker``): ``fold_angle_deg``, ``surface_tilt``, ``surface_azimuth``, ``objective_h`` and
-        ``gain_vs_flat_pct`` (over the flat panel at its own best).
+        ``gain_vs_flat_pct`` (over the flat panel at its own best); ``twofold`` and ``flat`` are the
+        best designs evaluated within their ranges (:func:`_best_within`).
     near_optimal : pandas.DataFrame
         Per load and variable: ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_deg``,
         ``near_optimal_tolerance_h``.
@@ -104,7 +111,7 @@ class OptimizeResult:
         return of_optimize(self)
 
 
-def _axes(study: Study, vary, fold_angle: float = 180.0) -> dict[str, Axis]:
+def _axes(study: Study, vary, fold_angle: float = FLAT_FOLD_ANGLE) -> dict[str, Axis]:
     """The search's axes by variable; a variable not varied is a one-point axis at the default
     mounting (the study's panel, folded to ``fold_angle``)."""
     spec = study.optimize
@@ -172,13 +179,8 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
     season = study.objective.months if study.objective is not None else None
     months = np.array([date.month for date in dates])
     counted = months[season_days(months, season)]  # the days the objective takes
-    if counted.size == 0:
-        raise ConfigError(
-            [
-                f"objective.months = {list(season)}: none of the {len(dates)} days ({dates[0]} to "
-                f"{dates[-1]}) is in these months; give days in them, or other months"
-            ]
-        )
+    if (problem := season_problem(dates, season)) is not None:
+        raise ConfigError([problem])
     blocks = Blocks.of_dates(study, dates)
     study = blocks.study
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
@@ -219,19 +221,45 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
         )
         steps.append((vary[count - 1], search))
         seeds = search.best_point
-    # Each variable's near-optimal region walks its whole grid through the optimum.
-    twofold = steps[-1][1].with_lines(objective(False))
-    steps[-1] = (steps[-1][0], twofold)
     flat_axes = _axes(study, [name for name in vary if name != "fold_angle"])
     flat = grid_search(
         objective(True),
         list(flat_axes.values()),
         spec.tolerance_h,
         quantum,
-        seeds=[[180.0, study.panel.tilt, study.panel.azimuth]],
+        seeds=[[FLAT_FOLD_ANGLE, study.panel.tilt, study.panel.azimuth]],
     )
-    table = _table(study, loads, twofold, flat, days_of.angles, best_default, default)
-    near = _near_optimal(study, loads, twofold)
+    # Each variable's near-optimal region walks its whole grid through the optimum.
+    twofold = steps[-1][1].with_lines(objective(False))
+    steps[-1] = (steps[-1][0], twofold)
+    mounting = [study.panel.tilt, study.panel.azimuth]
+    # Every design evaluated: the searches' and the default mounting's, folded and flat.
+    evaluated = _designs(
+        [(search.points, search.values) for _, search in steps]
+        + [
+            (flat.points, flat.values),
+            (
+                np.column_stack([days_of.angles, np.tile(mounting, (days_of.angles.size, 1))]),
+                default["twofold-default"].T,
+            ),
+            (np.array([[FLAT_FOLD_ANGLE, *mounting]]), default["flat-default"][None]),
+        ]
+    )
+    # The optimum, the flat panel's own best and each step's: the best design evaluated within each
+    # one's ranges, so that none is beaten by a design the answer holds. A 180 deg fold is the flat
+    # panel: the flat search's designs are the twofold panel's where its fold angles reach 180 deg,
+    # and the twofold search's at 180 deg are the flat panel's.
+    optimum = _best_within(*evaluated, list(twofold.axes))
+    table = _table(
+        study,
+        loads,
+        optimum,
+        _best_within(*evaluated, list(flat_axes.values())),
+        days_of.angles,
+        best_default,
+        default,
+    )
+    near = _near_optimal(study, loads, twofold, optimum)
     # What the first variable adds is over the default mounting as it stands: flat where the fold
     # angle joins the search, else folded to the fixed angle (the tilt alone took the fold's gain).
     start = (
@@ -239,9 +267,13 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
         if "fold_angle" in vary
         else default["twofold-default"][:, best_default[0]]
     )
-    added = _added(study, loads, steps, start)
+    added = _added(
+        loads,
+        [(name, search, _best_within(*evaluated, list(search.axes))[1]) for name, search in steps],
+        start,
+    )
     landscape = _landscape(
-        parts, study, all_axes, twofold.best_point[0], loads[:1], months, statistic, season, engine
+        parts, study, all_axes, optimum[0][0], loads[:1], months, statistic, season, engine
     )
     return OptimizeResult(
         study,
@@ -260,13 +292,47 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
     )
 
 
-def _table(study, loads, twofold, flat, fold_angles, best_default, default) -> pd.DataFrame:
+def _designs(evaluated) -> tuple:
+    """``(points (n, 3) [deg], values (n, n_targets))`` of the designs ``evaluated``, a sequence of
+    such pairs, together (a design evaluated twice, by two searches, is there twice)."""
+    return (
+        np.vstack([np.asarray(points, dtype=float) for points, _ in evaluated]),
+        np.vstack([np.asarray(values, dtype=float) for _, values in evaluated]),
+    )
+
+
+def _best_within(points, values, axes) -> tuple:
+    """Per target, the best of the designs ``points`` (n, 3) [deg], of ``values`` (n, n_targets),
+    that lie within the ranges of ``axes`` (a variable not varied at its value; an azimuth modulo
+    360 deg); ties to the least folded, then the steepest, then the largest azimuth, as
+    :class:`SearchResult` breaks them.
+
+    Returns
+    -------
+    point : numpy.ndarray
+        (n_targets, 3) fold angle, tilt and azimuth [deg].
+    value : numpy.ndarray
+        (n_targets,) [h].
+    """
+    inside = np.ones(points.shape[0], bool)
+    for column, axis in enumerate(axes):
+        offset = points[:, column] - axis.lo + 1e-9
+        if axis.name == "azimuth":
+            offset %= 360.0
+        inside &= (offset >= 0.0) & (offset <= axis.hi - axis.lo + 2e-9)
+    order = np.flatnonzero(inside)[np.lexsort(points[inside].T[::-1])]
+    ranked = values[order]
+    best = order[ranked.shape[0] - 1 - np.argmax(ranked[::-1], axis=0)]
+    return points[best], values[best, np.arange(values.shape[1])]
+
+
+def _table(study, loads, optimum, flat, fold_angles, best_default, default) -> pd.DataFrame:
     rows = []
-    flat_best = flat.best_value
+    flat_point, flat_best = flat
     for index, load in enumerate(loads):
         designs = [
-            ("twofold", *twofold.best_point[index], twofold.best_value[index]),
-            ("flat", 180.0, *flat.best_point[index][1:], flat_best[index]),
+            ("twofold", *optimum[0][index], optimum[1][index]),
+            ("flat", FLAT_FOLD_ANGLE, *flat_point[index][1:], flat_best[index]),
             (
                 "twofold-default",
                 fold_angles[best_default[index]],
@@ -276,7 +342,7 @@ def _table(study, loads, twofold, flat, fold_angles, best_default, default) -> p
             ),
             (
                 "flat-default",
-                180.0,
+                FLAT_FOLD_ANGLE,
                 study.panel.tilt,
                 study.panel.azimuth,
                 default["flat-default"][index],
@@ -300,43 +366,47 @@ def _table(study, loads, twofold, flat, fold_angles, best_default, default) -> p
     return pd.DataFrame(rows)
 
 
-def _near_optimal(study, loads, search: SearchResult) -> pd.DataFrame:
+def _near_optimal(study, loads, search: SearchResult, optimum) -> pd.DataFrame:
     """Per load and varied variable, the range of values within the near-optimal tolerance, on the
     profile of the best design evaluated at each value: the search's, which holds every value of each
-    variable with the others at each load's optimum (:meth:`SearchResult.with_lines`). The search
-    alone refines only where the optimum may be: its sparse profile, interpolated, gave a fold angle
-    of 29 to 31 deg where the optimum's own azimuth and tilt keep 29 to 60 deg near-optimal."""
+    variable with the others at each load's optimum (:meth:`SearchResult.with_lines`), and the
+    optimum ``(points, values)`` itself where it lies off the grid (a default mounting), so that
+    every range holds it. The search alone refines only where the optimum may be: its sparse
+    profile, interpolated, gave a fold angle of 29 to 31 deg where the optimum's own azimuth and
+    tilt keep 29 to 60 deg near-optimal."""
     rows = []
     points, values = search.points, search.values
     for axis_index, axis in enumerate(search.axes):
         if axis.size == 1:
             continue
-        grid = axis.values()
-        profile = np.full((loads.size, grid.size), -np.inf)
-        position = np.searchsorted(grid, points[:, axis_index] - 1e-9)
-        for target in range(loads.size):
-            np.maximum.at(profile[target], position, values[:, target])
-        ranges = near_optimal(grid, profile, study.near_optimal)
         for index, load in enumerate(loads):
+            grid = np.union1d(axis.values(), optimum[0][index, axis_index])
+            profile = np.full(grid.size, -np.inf)
+            position = np.searchsorted(grid, points[:, axis_index] - 1e-9)
+            np.maximum.at(profile, position, values[:, index])
+            at = np.searchsorted(grid, optimum[0][index, axis_index] - 1e-9)
+            profile[at] = max(profile[at], optimum[1][index])
+            ranges = near_optimal(grid, profile, study.near_optimal, fold=axis.name == "fold_angle")
             rows.append(
                 {
                     "p_load_w": load,
                     "variable": axis.name,
-                    "near_optimal_lo_deg": ranges["near_optimal_lo_deg"][index],
-                    "near_optimal_hi_deg": ranges["near_optimal_hi_deg"][index],
-                    "recommended_deg": ranges["recommended_fold_angle_deg"][index],
-                    "near_optimal_tolerance_h": ranges["near_optimal_tolerance_h"][index],
+                    "near_optimal_lo_deg": float(ranges["near_optimal_lo_deg"]),
+                    "near_optimal_hi_deg": float(ranges["near_optimal_hi_deg"]),
+                    "recommended_deg": float(ranges["recommended_fold_angle_deg"]),
+                    "near_optimal_tolerance_h": float(ranges["near_optimal_tolerance_h"]),
                 }
             )
     return pd.DataFrame(rows)
 
 
-def _added(study, loads, steps, start) -> pd.DataFrame:
+def _added(loads, steps, start) -> pd.DataFrame:
     """What each variable adds as it joins the search, over ``start`` (per load, the default
-    mounting's objective before any joins): the fold angle, then the tilt, then the azimuth [h]."""
+    mounting's objective before any joins): the fold angle, then the tilt, then the azimuth [h].
+    ``steps`` holds per variable its search and its objective [h], (n_loads,): the best design
+    evaluated within the search's ranges."""
     rows, before = [], np.asarray(start, dtype=float)
-    for name, search in steps:
-        value = search.best_value
+    for name, search, value in steps:
         for index, load in enumerate(loads):
             rows.append(
                 {

@@ -17,6 +17,10 @@ from foldopt.engine.curve_reduction import period_means
 from foldopt.inputs.sections import NearOptimal
 
 
+#: The fold angle of the flat panel [deg]: a twofold panel unfolded is the flat panel.
+FLAT_FOLD_ANGLE = 180.0
+
+
 def best_angle_index(hours):
     """Index (...) of the longest t_solar along the last axis; ties go to the least folded angle.
 
@@ -47,6 +51,24 @@ def season_days(months, season=None) -> np.ndarray:
     return table[months]
 
 
+def season_problem(dates, season) -> str | None:
+    """Why an objective's season takes no day of ``dates`` (a statistic over no days has no value),
+    as one line naming ``objective.months``; None where it takes some.
+
+    Parameters
+    ----------
+    dates : sequence of datetime.date
+    season : sequence of int or None
+        ``objective.months`` [1-12].
+    """
+    if not season or season_days([date.month for date in dates], season).any():
+        return None
+    return (
+        f"objective.months = {list(season)}: none of the {len(dates)} days ({dates[0]} to "
+        f"{dates[-1]}) is in these months; give days in them, or other months"
+    )
+
+
 def objective_value(hours, months, statistic: str, season=None):
     """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
 
@@ -65,12 +87,14 @@ def objective_value(hours, months, statistic: str, season=None):
     Returns
     -------
     numpy.ndarray
-        The statistic [h], (...).
+        The statistic [h], (...); NaN where ``season`` holds none of the days.
     """
     hours, months = np.asarray(hours, dtype=float), np.asarray(months)
     if season:
         keep = season_days(months, season)
         hours, months = hours[keep], months[keep]
+    if hours.shape[0] == 0:  # a season none of the days is in: no statistic
+        return np.full(hours.shape[1:], np.nan)
     if statistic == "mean":
         return hours.mean(axis=0)
     if statistic == "min":
@@ -143,7 +167,7 @@ def worst_month(hours, months):
     return present[np.argmin(means, axis=0)]
 
 
-def near_optimal(fold_angles, values, tolerance: NearOptimal) -> dict:
+def near_optimal(fold_angles, values, tolerance: NearOptimal, fold: bool = True) -> dict:
     """The plateau of fold angles around the best: every grid angle on the best one's side of the
     first angles that fall short, and the recommended angle at its centre.
 
@@ -151,7 +175,8 @@ def near_optimal(fold_angles, values, tolerance: NearOptimal) -> dict:
     (:meth:`foldopt.inputs.sections.NearOptimal.tolerance_h`: 1 % or 1 min by default, whichever is
     larger). The range is the contiguous run of such angles that holds the best one
     (:func:`best_angle_index`); the recommended angle is the grid angle nearest its centre (ties to
-    the less folded), so that a hinge set a few degrees off still lies on the plateau.
+    the less folded), so that a hinge set a few degrees off still lies on the plateau, except
+    where the best is the flat panel (:func:`recommended_angle`).
 
     Parameters
     ----------
@@ -162,6 +187,9 @@ def near_optimal(fold_angles, values, tolerance: NearOptimal) -> dict:
     values : array_like
         t_solar or an objective [h] at each angle, (..., n_angles).
     tolerance : foldopt.inputs.sections.NearOptimal
+    fold : bool, default True
+        The values are of the fold angle (a best at 180 deg is the flat panel); False for another
+        variable (a tilt, an azimuth) ranged the same way.
 
     Returns
     -------
@@ -179,20 +207,48 @@ def near_optimal(fold_angles, values, tolerance: NearOptimal) -> dict:
     below, above = short & (index < best[..., None]), short & (index > best[..., None])
     lo = np.where(below.any(axis=-1), fold_angles.size - np.argmax(below[..., ::-1], axis=-1), 0)
     hi = np.where(above.any(axis=-1), np.argmax(above, axis=-1) - 1, fold_angles.size - 1)
-    centre = (fold_angles[lo] + fold_angles[hi]) / 2.0
-    distance = np.where(
-        (index >= lo[..., None]) & (index <= hi[..., None]),
-        np.abs(fold_angles - centre[..., None]),
-        np.inf,
-    )
-    recommended = best_angle_index(-distance)
     carried = top > 0
+    lo, hi = np.where(carried, fold_angles[lo], np.nan), np.where(carried, fold_angles[hi], np.nan)
     return {
-        "near_optimal_lo_deg": np.where(carried, fold_angles[lo], np.nan),
-        "near_optimal_hi_deg": np.where(carried, fold_angles[hi], np.nan),
-        "recommended_fold_angle_deg": np.where(carried, fold_angles[recommended], np.nan),
+        "near_optimal_lo_deg": lo,
+        "near_optimal_hi_deg": hi,
+        "recommended_fold_angle_deg": recommended_angle(
+            fold_angles, lo, hi, fold_angles[best] if fold else None
+        ),
         "near_optimal_tolerance_h": np.where(carried, tol, np.nan),
     }
+
+
+def recommended_angle(angles, lo, hi, best=None):
+    """The angle to recommend of a near-optimal range: the one of ``angles`` inside the range
+    nearest its centre (ties to the less folded), so that a hinge set a few degrees off still lies
+    on the plateau; but the flat panel where the best fold angle is 180 deg, for a panel that is
+    best unfolded needs no hinge to set, and no fold gains over it.
+
+    Parameters
+    ----------
+    angles : array_like
+        The candidates [deg], ascending, (n,): the grid, and any angle evaluated off it.
+    lo, hi : array_like
+        The range's edges [deg], (...); NaN where no angle carries the load.
+    best : array_like, optional
+        The best fold angle [deg], (...); None where the angles are not fold angles.
+
+    Returns
+    -------
+    numpy.ndarray
+        [deg], (...), always within ``lo`` to ``hi``; NaN where the range is.
+    """
+    angles = np.asarray(angles, dtype=float)
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    centre = (lo + hi) / 2.0
+    with np.errstate(invalid="ignore"):
+        inside = (angles >= lo[..., None]) & (angles <= hi[..., None])
+    distance = np.where(inside, np.abs(angles - centre[..., None]), np.inf)
+    chosen = np.where(inside.any(axis=-1), angles[best_angle_index(-distance)], np.nan)
+    if best is not None:
+        chosen = np.where(np.asarray(best) == FLAT_FOLD_ANGLE, FLAT_FOLD_ANGLE, chosen)
+    return np.where(np.isfinite(centre), chosen, np.nan)
 
 
 def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> dict:
@@ -200,8 +256,8 @@ def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> d
     edge lies between the evaluated angle inside the range and the one outside, at the last grid
     angle before the monotone cubic through the values [1]_ (SciPy's ``PchipInterpolator``) falls
     below the threshold (the best less the tolerance); the recommended angle is the grid angle nearest the
-    range's centre (ties to the less folded). Where every grid angle is evaluated, it is
-    :func:`near_optimal`.
+    range's centre (:func:`recommended_angle`; an evaluated angle where the range holds no grid
+    angle). Where every grid angle is evaluated, it is :func:`near_optimal`.
 
     Parameters
     ----------
@@ -258,14 +314,12 @@ def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> d
             kept = gap & (place > stop[:, None])
             last = np.argmax(kept, axis=1)
         ranges[name] = np.where(kept.any(axis=1), grid[last], edge)
-    centre = (ranges["near_optimal_lo_deg"] + ranges["near_optimal_hi_deg"]) / 2.0
-    finite = np.isfinite(centre)
-    nearest = np.full(centre.shape, np.nan)
-    # Ties go to the less folded angle, as near_optimal breaks them.
-    nearest[finite] = grid[
-        grid.size - 1 - np.argmin(np.abs(grid[::-1][None, :] - centre[finite, None]), axis=1)
-    ]
-    ranges["recommended_fold_angle_deg"] = nearest
+    ranges["recommended_fold_angle_deg"] = recommended_angle(
+        np.union1d(grid, fold_angles),
+        ranges["near_optimal_lo_deg"],
+        ranges["near_optimal_hi_deg"],
+        fold_angles[best],
+    )
     return ranges
 
 

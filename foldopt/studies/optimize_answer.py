@@ -6,6 +6,7 @@ adds, and how much of the grid the search evaluated."""
 from __future__ import annotations
 
 from foldopt.studies.answer import Answer, records
+from foldopt.studies.objectives import FLAT_FOLD_ANGLE
 from foldopt.studies.result_answers import request_defaults, study_question
 
 #: How the answer names each variable and its unit.
@@ -90,9 +91,15 @@ def of_optimize(result) -> Answer:
                 f"(and the flat panel's); tracker {tracker.objective_h:.2f} h"
             )
         else:
+            # A 180 deg fold is the flat panel: there the optimum is the flat panel's own best.
             lines.append(
-                f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: {best.objective_h:.2f} h, "
-                f"{_over_flat(best, flat)}; tracker {tracker.objective_h:.2f} h"
+                f"{label}: flat (fold 180 deg), {_mounting(best)}: {best.objective_h:.2f} h, "
+                "the flat panel at its own best: no fold gains over it; tracker "
+                f"{tracker.objective_h:.2f} h"
+                if best.fold_angle_deg == FLAT_FOLD_ANGLE
+                else f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
+                f"{best.objective_h:.2f} h, {_over_flat(best, flat)}; tracker "
+                f"{tracker.objective_h:.2f} h"
             )
             if len(near):
                 lines.append(

@@ -16,7 +16,7 @@ import pandas as pd
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.storage_answer import buffer_text, sequential, year_lines
-from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
+from foldopt.studies.objectives import ENSEMBLE_PERCENTILES, FLAT_FOLD_ANGLE
 from foldopt.studies.worldmap import searched_tilt
 
 #: The designs an answer compares, first the ones every study has.
@@ -39,6 +39,37 @@ def _pct(value, signed: bool = True) -> str:
         if value is None or value != value
         else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
     )
+
+
+def _fold_text(angle: float) -> str:
+    """A fold angle [deg] to a tenth of a degree, or to a thousandth where a fold short of the flat
+    panel would read 180.0 (a refined optimum a few hundredths below it is not the flat panel)."""
+    short = f"{angle:.1f}" == "180.0" and angle < FLAT_FOLD_ANGLE
+    return f"{angle:.3f}" if short else f"{angle:.1f}"
+
+
+def versus_flat(fold_angle, gain, flat_hours, flat_text: str = "") -> str:
+    """The twofold panel at its best against the flat panel, as a line gives it: the gain [%], or
+    where the best is the flat panel (a 180 deg fold) that no fold gains over it, or where the flat
+    panel carries none of the load (no ratio to give) that it does not.
+
+    Parameters
+    ----------
+    fold_angle : float
+        The best fold angle [deg].
+    gain : float
+        [%] over the flat panel.
+    flat_hours : float
+        The flat panel's objective [h].
+    flat_text : str, default ""
+        Said of the flat panel after its hours (its worst month).
+    """
+    if fold_angle == FLAT_FOLD_ANGLE:
+        return "the flat panel itself: no fold gains over it"
+    flat = f"{_hours(flat_hours)}{flat_text}"
+    if not flat_hours > 0:
+        return f"where the flat panel carries none of the load (flat {flat})"
+    return f"{_pct(gain)} over flat ({flat})"
 
 
 def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dict]:
@@ -260,11 +291,16 @@ def of_study(result) -> Answer:
         )
     else:
         lines.append(
-            f"best fold angle {result.optimal_fold_angle:.1f} deg"
+            f"best fold angle {_fold_text(result.optimal_fold_angle)} deg"
             + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic == heuristic else "")
-            + f": t_solar {_hours(hours['twofold'])}, {_pct(twofold['gain_vs_flat_pct'])} over flat "
-            f"({_hours(hours['flat'])}), {_pct(twofold['pct_of_tracker'], False)} of the tracker's "
-            f"{_hours(hours['tracker'])}"
+            + f": t_solar {_hours(hours['twofold'])}, "
+            + versus_flat(result.optimal_fold_angle, twofold["gain_vs_flat_pct"], hours["flat"])
+            + (
+                f", {_pct(twofold['pct_of_tracker'], False)} of the tracker's "
+                f"{_hours(hours['tracker'])}"
+                if hours["tracker"] > 0
+                else ", where the tracker carries none of it (0.00 h)"
+            )
         )
         lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
     extras = []
@@ -303,9 +339,42 @@ def of_study(result) -> Answer:
         summary[columns],
         near_table,
         pd.DataFrame(),
-        design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
+        design_notes(summary)
+        + weather_notes(result.day.sky)
+        + horizon_notes(study, [study.date])
+        + heuristic_notes(study, result.heuristic_outside),
         tuple(lines),
     )
+
+
+def heuristic_notes(study, outside: str) -> list[dict]:
+    """Where the paper's heuristic (Shin et al. Eq. 8) has no angle among the study's fold angles,
+    why, as one note; none where its angle is stated.
+
+    Parameters
+    ----------
+    study : Study
+    outside : str
+        :attr:`foldopt.studies.day.StudyResult.heuristic_outside`.
+    """
+    grid = study.fold_angles
+    rule = "the paper's heuristic (Shin et al. Eq. 8) gives no angle"
+    if outside == "below":
+        text = (
+            f"{rule} among the study's fold angles ({grid.start:g} to {grid.stop:g} deg): the noon "
+            f"valley reaches the load already at {grid.start:g} deg, so the rule's angle lies at "
+            "or below it"
+        )
+    elif outside == "above" and grid.stop < FLAT_FOLD_ANGLE:
+        text = (
+            f"{rule} among the study's fold angles ({grid.start:g} to {grid.stop:g} deg): the noon "
+            f"valley falls short of the load even at {grid.stop:g} deg"
+        )
+    elif outside == "above":
+        text = f"{rule}: the load exceeds the flat panel's noon power"
+    else:
+        return []
+    return [{"note": text, "designs": []}]
 
 
 def request_defaults(result) -> dict | None:
@@ -375,8 +444,9 @@ def of_sweep(result) -> Answer:
     rec = part["recommended_fold_angle_deg"]
     if rec["min"] == rec["min"]:
         lines.append(
-            f"recommended fold angles (centres of each case's near-optimal range) {rec['min']:g} to "
-            f"{rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the table)"
+            "recommended fold angles (each case's near-optimal centre, flat where flat is best) "
+            f"{rec['min']:g} to {rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the "
+            "table)"
         )
     keys = [
         c
@@ -466,8 +536,10 @@ def _of_annual(result) -> Answer:
             "mean_t_solar_h": {d: by.loc[d, "mean_t_solar_h"] for d in MAIN_DESIGNS},
             **{k: twofold[k] for k in NEAR_OPTIMAL},
         }
+        # No day in the objective's months: no statistic, no month, no angle chosen.
+        counted = twofold["objective_h"] == twofold["objective_h"]
         month = ""
-        if statistic == "worst-month":
+        if statistic == "worst-month" and counted:
             case["worst_month"] = {d: int(by.loc[d, "worst_month"]) for d in MAIN_DESIGNS}
             month = f" (in {calendar.month_name[case['worst_month']['twofold']]})"
         part["per_case"].append(case)
@@ -478,7 +550,7 @@ def _of_annual(result) -> Answer:
         )
         flat_month = (
             f" in {calendar.month_name[case['worst_month']['flat']]}"
-            if statistic == "worst-month"
+            if "worst_month" in case
             else ""
         )
         label = load_text(study, load)
@@ -487,15 +559,33 @@ def _of_annual(result) -> Answer:
             if len(groups) > 1 and "latitude" in where
             else ""
         )
-        lines.append(
-            f"{site + ': ' if site else ''}{label}: fold angle {twofold['fold_angle_deg']:g} deg "
-            f"{_period(count)}; "
-            f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, {_pct(gain)} over flat "
-            f"({_hours(flat['objective_h'])}{flat_month}); tracker {_hours(tracker['objective_h'])}"
-            + ("" if statistic == "mean" else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}")
-        )
-        lines.append("  " + _range_text(twofold.to_dict()))
-        if members:
+        head = f"{site + ': ' if site else ''}{label}: "
+        if not counted:
+            lines.append(
+                f"{head}no {statistic} t_solar: the objective's months "
+                f"({', '.join(map(str, objective.months))}) hold none of the {count} days"
+            )
+        elif not twofold["objective_h"] > 0:
+            # Every angle ties at nothing: the tie-break is no choice, nor is there a gain to give.
+            lines.append(
+                f"{head}no fold angle carries the load: {statistic} t_solar 0.00 h (flat "
+                f"{_hours(flat['objective_h'])}); tracker {_hours(tracker['objective_h'])}"
+            )
+        else:
+            lines.append(
+                f"{head}fold angle {twofold['fold_angle_deg']:g} deg {_period(count)}; "
+                f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, "
+                + versus_flat(twofold["fold_angle_deg"], gain, flat["objective_h"], flat_month)
+                + f"; tracker {_hours(tracker['objective_h'])}"
+                + (
+                    ""
+                    if statistic == "mean"
+                    else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"
+                )
+            )
+        if twofold["objective_h"] > 0:
+            lines.append("  " + _range_text(twofold.to_dict()))
+        if members and counted:
             spread = {
                 d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in ENSEMBLE_PERCENTILES}
                 for d in MAIN_DESIGNS
@@ -839,7 +929,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
             f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')}"
             f"{gains}; {rec_text}; "
             + (
-                "the tracker carries it at no site either"
+                f"the tracker carries it at no site{' either' if rec['min'] is None else ''}"
                 if load["median_pct_of_tracker"] is None
                 else f"median {_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}"
             )

@@ -533,9 +533,11 @@ def objective_table(
             for pct in ENSEMBLE_PERCENTILES
         }
     season = season_days(months, objective.months)
+    # A season none of the days is in has no statistic, no month and no angle chosen.
+    counted = bool(season.any())
     month = (
         worst_month(design_hours[season], np.asarray(months)[season])
-        if statistic == "worst-month"
+        if statistic == "worst-month" and counted
         else None
     )
     site = blocks.study.site
@@ -553,8 +555,10 @@ def objective_table(
                     "objective": statistic,
                     "objective_h": float(values[index, d]),
                     "worst_month": int(month[index, d]) if month is not None else np.nan,
-                    "mean_t_solar_h": float(design_hours[season][:, index, d].mean()),
-                    "fold_angle_deg": float(fold_angles[index])
+                    "mean_t_solar_h": float(design_hours[season][:, index, d].mean())
+                    if counted
+                    else np.nan,
+                    "fold_angle_deg": (float(fold_angles[index]) if counted else np.nan)
                     if twofold
                     else (180.0 if design == "flat" else np.nan),
                     **{

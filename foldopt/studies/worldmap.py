@@ -50,6 +50,7 @@ from foldopt.studies.site_search import fold_search
 from foldopt.engine.choice import engine_for
 from foldopt.names import DEFAULT_ENGINE
 from foldopt.studies.objectives import (
+    FLAT_FOLD_ANGLE,
     best_angle_index,
     near_optimal_on_grid,
     objective_value,
@@ -712,12 +713,14 @@ def _site_rows(
     days_of, months, statistic: str, seasons, p_load_evaluated, study, surface_tilt: float
 ) -> dict:
     """One site's columns, per period and load (periods slowest), from its :class:`DailyDesigns`."""
-    angles = days_of.angles
+    angles, tilts, twofold_h, twofold_energy = (
+        days_of.angles,
+        days_of.tilts,
+        days_of.twofold_h,
+        days_of.twofold_wh,
+    )
     n_loads = p_load_evaluated.size
     member = np.stack([season_days(months, season) for season in seasons])
-    best, twofold, twofold_mean, twofold_wh, objective = _chosen(
-        days_of.twofold_h, days_of.twofold_wh, months, statistic, seasons, member
-    )
     # The flat panel at the site's mounting, or at each period's and load's own best tilt.
     flat_hours, flat_energy, flat_tilts = (
         days_of.flat_h[..., None],
@@ -726,6 +729,28 @@ def _site_rows(
     )
     if days_of.flat_tilted is not None:
         flat_tilts, flat_hours, flat_energy = days_of.flat_tilted
+        # A 180 deg fold is the flat panel: each search's designs are the other's too (the
+        # twofold panel's where its fold angles reach 180 deg), so that neither's best misses one
+        # the other evaluated.
+        unfolded = angles == FLAT_FOLD_ANGLE
+        flat_tilts = np.concatenate([flat_tilts, tilts[unfolded]])
+        order = np.argsort(flat_tilts, kind="stable")  # ties to the steepest, as the search's
+        flat_tilts, flat_hours, flat_energy = (
+            flat_tilts[order],
+            np.concatenate([flat_hours, twofold_h[..., unfolded]], axis=-1)[..., order],
+            np.concatenate([flat_energy, twofold_energy[:, unfolded]], axis=-1)[:, order],
+        )
+        if study.fold_angles.stop == FLAT_FOLD_ANGLE:
+            angles = np.concatenate([angles, np.full(flat_tilts.size, FLAT_FOLD_ANGLE)])
+            tilts = np.concatenate([tilts, flat_tilts])
+            # In ascending order of the fold angle, then the tilt, as the search's designs are.
+            order = np.lexsort((tilts, angles))
+            angles, tilts = angles[order], tilts[order]
+            twofold_h = np.concatenate([twofold_h, flat_hours], axis=-1)[..., order]
+            twofold_energy = np.concatenate([twofold_energy, flat_energy], axis=-1)[:, order]
+    best, twofold, twofold_mean, twofold_wh, objective = _chosen(
+        twofold_h, twofold_energy, months, statistic, seasons, member
+    )
     flat_best, flat, flat_mean, flat_wh, _ = _chosen(
         flat_hours, flat_energy, months, statistic, seasons, member
     )
@@ -736,7 +761,7 @@ def _site_rows(
     tracker_wh = np.stack([days_of.tracker_wh[days].sum() for days in member])
     # The fold angle's near-optimal range: over the tilts too (the best of them at each angle) where searched.
     fold_angles, profile = angles, objective.reshape(-1, angles.size)
-    if days_of.tilts is not None:
+    if tilts is not None:
         fold_angles, column = np.unique(angles, return_inverse=True)
         profile = np.full((profile.shape[0], fold_angles.size), -np.inf)
         np.maximum.at(profile, (slice(None), column.ravel()), objective.reshape(-1, angles.size))
@@ -750,7 +775,7 @@ def _site_rows(
         "fold_angle_deg": np.where(carried, angles[best], np.nan).ravel(),
         "surface_tilt": np.where(
             carried,
-            days_of.tilts[best] if days_of.tilts is not None else np.full(best.shape, surface_tilt),
+            tilts[best] if tilts is not None else np.full(best.shape, surface_tilt),
             np.nan,
         ).ravel(),
         "surface_tilt_flat": np.where(carried, flat_tilts[flat_best], np.nan).ravel(),

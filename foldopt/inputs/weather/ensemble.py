@@ -258,7 +258,8 @@ def _overcast(index, elevation):
     log_x = np.log(x / scale)
     burr = np.log(c * k / scale) - (c + 1) * log_x - (k + 1) * np.logaddexp(0.0, -c * log_x)
     gamma_fn = np.vectorize(math.lgamma)(k / c)
-    gen = np.log(c / scale) + (k - 1) * log_x - np.exp(c * log_x) - gamma_fn
+    with np.errstate(over="ignore"):  # far in a density's tail: its log -inf, its limit (zero)
+        gen = np.log(c / scale) + (k - 1) * log_x - np.exp(c * log_x) - gamma_fn
     log_f = np.where(np.arange(9).reshape(-1, *([1] * x.ndim)[1:]) < 4, burr, gen)
     return np.exp(log_f[8] - np.logaddexp.reduce(log_f, axis=0))
 

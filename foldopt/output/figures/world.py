@@ -164,7 +164,7 @@ MAPS = (
     (
         "map_fold_angle.png",
         "recommended_fold_angle_deg",
-        "recommended fold angle (centre of the near-optimal range)",
+        "recommended fold angle (the near-optimal range's centre; 180 where flat is best)",
         "fold angle Θ [deg] (180 = flat)",
         False,
     ),
