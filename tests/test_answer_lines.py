@@ -1,7 +1,7 @@
 """Answers that hold against themselves where a design carries nothing: no NaN or 'nan' in any line or
 JSON, a line that says why where there is no ratio to give (a gain over a flat panel that carries none of
-the load, a share of a tracker that carries none), and a line that says why where an objective has no day
-to take."""
+the load, a share of a tracker that carries none), and one clear line where an objective has no day to
+take."""
 
 from __future__ import annotations
 
@@ -61,21 +61,14 @@ def test_an_annual_objective_no_angle_carries_says_so_once(tmp_path):
 
 
 @pytest.mark.parametrize("statistic", ["p10", "worst-month", "mean", "min"])
-def test_an_objective_over_months_none_of_the_days_is_in_says_so(tmp_path, statistic):
+def test_a_season_none_of_the_days_is_in_is_refused_by_a_sweep(tmp_path, statistic):
     """An objective over June of January's days has no day to take: it was an internal error (a
-    percentile, a minimum of nothing) or NaN; the line says why, no angle is chosen (null in the
-    JSON), nothing reaches stderr, and no file holds a 'nan'."""
+    percentile, a minimum of nothing); one line naming objective.months, as foldopt optimize says it,
+    nothing written."""
     out = tmp_path / "out"
     done = CliRunner().invoke(app, ["sweep", "angle", "--days", "1:31:5", "--objective", statistic, "--set",
-                                    "objective.months=[6]", "--step-min", "15", "--format", "json",
-                                    "--out", str(out)])
-    assert done.exit_code == 0, done.output
-    assert done.stderr == ""
-    answer = json.loads(done.stdout)["answer"]
-    assert f"no {statistic} t_solar: the objective's months (6) hold none of the 7 days" in answer["lines"][2]
-    (case,) = answer["result"]["per_case"]
-    assert case["fold_angle_deg"] is None and set(case["objective_h"].values()) == {None}
-    assert not any(re.search(r"\bnan\b", line) for line in answer["lines"])
-    for path in out.iterdir():
-        if path.suffix in (".html", ".json"):
-            assert re.search(r"\bnan\b", path.read_text(encoding="utf-8")) is None, path.name
+                                    "objective.months=[6]", "--out", str(out)])
+    assert done.exit_code == 2, done.output
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: objective.months = [6]: none of the 7 days")
+    assert not out.exists()

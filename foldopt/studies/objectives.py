@@ -87,14 +87,12 @@ def objective_value(hours, months, statistic: str, season=None):
     Returns
     -------
     numpy.ndarray
-        The statistic [h], (...); NaN where ``season`` holds none of the days.
+        The statistic [h], (...).
     """
     hours, months = np.asarray(hours, dtype=float), np.asarray(months)
     if season:
         keep = season_days(months, season)
         hours, months = hours[keep], months[keep]
-    if hours.shape[0] == 0:  # a season none of the days is in: no statistic
-        return np.full(hours.shape[1:], np.nan)
     if statistic == "mean":
         return hours.mean(axis=0)
     if statistic == "min":

@@ -536,10 +536,8 @@ def _of_annual(result) -> Answer:
             "mean_t_solar_h": {d: by.loc[d, "mean_t_solar_h"] for d in MAIN_DESIGNS},
             **{k: twofold[k] for k in NEAR_OPTIMAL},
         }
-        # No day in the objective's months: no statistic, no month, no angle chosen.
-        counted = twofold["objective_h"] == twofold["objective_h"]
         month = ""
-        if statistic == "worst-month" and counted:
+        if statistic == "worst-month":
             case["worst_month"] = {d: int(by.loc[d, "worst_month"]) for d in MAIN_DESIGNS}
             month = f" (in {calendar.month_name[case['worst_month']['twofold']]})"
         part["per_case"].append(case)
@@ -550,7 +548,7 @@ def _of_annual(result) -> Answer:
         )
         flat_month = (
             f" in {calendar.month_name[case['worst_month']['flat']]}"
-            if "worst_month" in case
+            if statistic == "worst-month"
             else ""
         )
         label = load_text(study, load)
@@ -560,12 +558,7 @@ def _of_annual(result) -> Answer:
             else ""
         )
         head = f"{site + ': ' if site else ''}{label}: "
-        if not counted:
-            lines.append(
-                f"{head}no {statistic} t_solar: the objective's months "
-                f"({', '.join(map(str, objective.months))}) hold none of the {count} days"
-            )
-        elif not twofold["objective_h"] > 0:
+        if not twofold["objective_h"] > 0:
             # Every angle ties at nothing: the tie-break is no choice, nor is there a gain to give.
             lines.append(
                 f"{head}no fold angle carries the load: {statistic} t_solar 0.00 h (flat "
@@ -585,7 +578,7 @@ def _of_annual(result) -> Answer:
             )
         if twofold["objective_h"] > 0:
             lines.append("  " + _range_text(twofold.to_dict()))
-        if members and counted:
+        if members:
             spread = {
                 d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in ENSEMBLE_PERCENTILES}
                 for d in MAIN_DESIGNS

@@ -38,10 +38,12 @@ from foldopt.studies.objectives import (
     near_optimal,
     objective_value,
     season_days,
+    season_problem,
     worst_month,
 )
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
+from foldopt.errors import ConfigError
 from foldopt.studies.storage_answer import powered_by_angle, year_storage
 from foldopt.names import DEFAULT_ENGINE
 
@@ -119,6 +121,8 @@ def run_plan(
     weather = plan.base.weather
     if objective is not None and dates is None and weather is not None and weather.members:
         dates = (plan.base.date,)  # one day's cloud ensemble: one fold angle over its members
+    if dates and (problem := season_problem(dates, objective.months)) is not None:
+        raise ConfigError([problem])
     paths = list(axes)
     choices = [
         dict(zip(paths, values, strict=True)) for values in itertools.product(*axes.values())
@@ -533,11 +537,9 @@ def objective_table(
             for pct in ENSEMBLE_PERCENTILES
         }
     season = season_days(months, objective.months)
-    # A season none of the days is in has no statistic, no month and no angle chosen.
-    counted = bool(season.any())
     month = (
         worst_month(design_hours[season], np.asarray(months)[season])
-        if statistic == "worst-month" and counted
+        if statistic == "worst-month"
         else None
     )
     site = blocks.study.site
@@ -555,10 +557,8 @@ def objective_table(
                     "objective": statistic,
                     "objective_h": float(values[index, d]),
                     "worst_month": int(month[index, d]) if month is not None else np.nan,
-                    "mean_t_solar_h": float(design_hours[season][:, index, d].mean())
-                    if counted
-                    else np.nan,
-                    "fold_angle_deg": (float(fold_angles[index]) if counted else np.nan)
+                    "mean_t_solar_h": float(design_hours[season][:, index, d].mean()),
+                    "fold_angle_deg": float(fold_angles[index])
                     if twofold
                     else (180.0 if design == "flat" else np.nan),
                     **{
