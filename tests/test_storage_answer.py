@@ -7,7 +7,6 @@ without storage is the study it was."""
 from __future__ import annotations
 
 import json
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -752,18 +751,14 @@ def test_an_answer_whose_load_never_runs_says_so_without_nan():
     (case,) = [c for c in year.answer.to_dict()["result"]["storage"]["per_case"]
                if c["design"] == "twofold-buffer"]  # fmt: skip
     assert case["near_optimal_lo_deg"] is None and case["capacity_wh"] is None
-    # An objective over months that hold none of the days: no statistic, said so (the empty
-    # means warn).
+    # An objective over months that hold none of the days has no statistic: refused before any
+    # work, by the front door, for a buffer as for t_solar.
     study = make_study({**EMBEDDED, **QUICK, "p_load": CARRIED, "storage": {"capacity_wh": 20}})
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        march = foldopt.sweep(
+    with pytest.raises(foldopt.ConfigError, match=r"^objective.months = \[3\]: none of the 2 days"):
+        foldopt.sweep(
             study, "day", date=["2014-06-21", "2014-12-21"],
             objective={"statistic": "mean", "months": [3]},
         )  # fmt: skip
-    _says_no_nan(march.answer)
-    assert any("the objective's months hold none of the days" in x for x in march.answer.lines())
-    assert march.answer.to_dict()["result"]["storage"]["fold_angle_buffer_deg"] is None
 
 
 def test_a_measured_day_s_buffer_writes_its_table(tmp_path, monkeypatch):

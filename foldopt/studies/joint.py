@@ -48,7 +48,6 @@ from foldopt.studies.objectives import (
     objective_quantum,
     objective_value,
     season_days,
-    season_problem,
 )
 
 #: Points of the landscape's grid along the fold angle and the tilt.
@@ -179,8 +178,6 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
     season = study.objective.months if study.objective is not None else None
     months = np.array([date.month for date in dates])
     counted = months[season_days(months, season)]  # the days the objective takes
-    if (problem := season_problem(dates, season)) is not None:
-        raise ConfigError([problem])
     blocks = Blocks.of_dates(study, dates)
     study = blocks.study
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]

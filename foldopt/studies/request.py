@@ -568,6 +568,7 @@ def _plan_request(command, study, data, lines, changes, labels, source, costs) -
         taken = _taken(plan, given, field, new, decided) if command != "run" else decided
     run = _run_of(command, plan)
     _refuse_unhonoured(command, run, plan.base)
+    _refuse_empty_season(plan)
     if _set_by_run(run, policy.flatten(changes)):
         raise ConfigError(_set_by_run(run, policy.flatten(changes)))
     if axis == "angle":
@@ -675,6 +676,19 @@ def _refuse_unhonoured(command: str, run: str, study) -> None:
     ]
     if errors:
         raise ConfigError(errors)
+
+
+def _refuse_empty_season(plan: Plan) -> None:
+    """Refuse an objective whose months hold none of the plan's days: a statistic over no days
+    has no value, so no fold angle can be chosen for it."""
+    from foldopt.studies.objectives import season_problem
+
+    objective = plan.base.objective
+    if objective is not None and objective.months:
+        dates = dict(plan.axes).get("date", (plan.base.date,))
+        problem = season_problem(dates, objective.months)
+        if problem is not None:
+            raise ConfigError([problem])
 
 
 def _set_by_run(run: str, changes: dict) -> list[str]:

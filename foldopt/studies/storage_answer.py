@@ -1115,9 +1115,7 @@ def year_storage(
             sized = {"capacity_wh": need, "capacity_vs_flat_pct": vs_flat, "monotone": monotone}
         score = objective_value(powered.T, months, objective.statistic, objective.months)
         angles = np.array([choice["fold_angle_deg"][d][index] for d in YEAR_DESIGNS])
-        # Without a statistic (the objective's months hold none of the days) no angle was chosen.
         chosen = np.asarray(YEAR_DESIGNS) == "twofold-buffer"
-        angles[chosen & np.isnan(score)] = np.nan
         rows.append(
             pd.DataFrame(
                 {
@@ -1189,8 +1187,6 @@ def _best_for_buffer(by: pd.DataFrame, angle) -> str:
     best = by.loc["twofold-buffer"]
     statistic = best["objective"]
     said = f"  best fold angle for the buffer ({statistic} powered time)"
-    if best["objective_powered_h"] != best["objective_powered_h"]:
-        return f"{said}: none, the objective's months hold none of the days"
     return (
         f"{said}: {angle['twofold-buffer']:g} deg, {best['objective_powered_h']:.2f} h (t_solar's "
         f"{angle['twofold']:g} deg: {by.loc['twofold', 'objective_powered_h']:.2f} h; flat "

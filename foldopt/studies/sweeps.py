@@ -38,12 +38,10 @@ from foldopt.studies.objectives import (
     near_optimal,
     objective_value,
     season_days,
-    season_problem,
     worst_month,
 )
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
-from foldopt.errors import ConfigError
 from foldopt.studies.storage_answer import powered_by_angle, year_storage
 from foldopt.names import DEFAULT_ENGINE
 
@@ -121,8 +119,6 @@ def run_plan(
     weather = plan.base.weather
     if objective is not None and dates is None and weather is not None and weather.members:
         dates = (plan.base.date,)  # one day's cloud ensemble: one fold angle over its members
-    if dates and (problem := season_problem(dates, objective.months)) is not None:
-        raise ConfigError([problem])
     paths = list(axes)
     choices = [
         dict(zip(paths, values, strict=True)) for values in itertools.product(*axes.values())
