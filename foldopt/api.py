@@ -228,7 +228,7 @@ def optimize(
     -------
     foldopt.studies.joint.OptimizeResult
         ``table`` per load and design (``twofold``, ``flat``, ``twofold-default``, ``flat-default``,
-        ``tracker``), ``near_optimal``, ``added``, ``landscape``, ``answer``.
+        ``tracker``, ``tracker-net``), ``near_optimal``, ``added``, ``landscape``, ``answer``.
 
     Raises
     ------

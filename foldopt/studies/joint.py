@@ -72,7 +72,7 @@ class OptimizeResult:
         The searches as the variables join (the last is ``twofold``).
     table : pandas.DataFrame
         Per load and design (``twofold``, ``flat``, ``twofold-default``, ``flat-default``,
-        ``tracker``): ``fold_angle_deg``, ``surface_tilt``, ``surface_azimuth``, ``objective_h`` and
+        ``tracker``, ``tracker-net``): ``fold_angle_deg``, ``surface_tilt``, ``surface_azimuth``, ``objective_h`` and
         ``gain_vs_flat_pct`` (over the flat panel at its own best); ``twofold`` and ``flat`` are the
         best designs evaluated within their ranges (:func:`_best_within`).
     near_optimal : pandas.DataFrame
@@ -197,6 +197,8 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
         "twofold-default": objective_value(days_of.twofold_h, months, statistic, season),
         "flat-default": objective_value(days_of.flat_h, months, statistic, season),
         "tracker": objective_value(days_of.tracker_h, months, statistic, season),
+        # net of its own draw (standby, drive): what the study's tracker section sets
+        "tracker-net": objective_value(days_of.tracker_net_h, months, statistic, season),
     }
     best_default = best_angle_index(default["twofold-default"])
     # A fold angle that does not vary stays at the default mounting's best (the first load's).
@@ -345,6 +347,7 @@ def _table(study, loads, optimum, flat, fold_angles, best_default, default) -> p
                 default["flat-default"][index],
             ),
             ("tracker", np.nan, np.nan, np.nan, default["tracker"][index]),
+            ("tracker-net", np.nan, np.nan, np.nan, default["tracker-net"][index]),
         ]
         for design, fold, tilt, azimuth, value in designs:
             rows.append(

@@ -13,6 +13,14 @@ from foldopt.studies.result_answers import request_defaults, study_question
 _LABELS = {"fold_angle": ("fold", "deg"), "tilt": ("tilt", "deg"), "azimuth": ("azimuth", "deg")}
 
 
+def _tracker_text(gross, net) -> str:
+    """The tracker's objective, and net of its own draw (standby, drive) where that costs any."""
+    text = f"tracker {gross.objective_h:.2f} h"
+    if net.objective_h < gross.objective_h:
+        text += f" ({net.objective_h:.2f} h net of its own draw)"
+    return text
+
+
 def _row(table, load, design):
     return table[(table["p_load_w"] == load) & (table["design"] == design)].iloc[0]
 
@@ -75,7 +83,7 @@ def of_optimize(result) -> Answer:
             _row(table, load, "twofold-default"),
             _row(table, load, "flat-default"),
         )
-        tracker = _row(table, load, "tracker")
+        tracker = _tracker_text(_row(table, load, "tracker"), _row(table, load, "tracker-net"))
         near = result.near_optimal[result.near_optimal["p_load_w"] == load]
         added = result.added[result.added["p_load_w"] == load]
         label = (
@@ -88,18 +96,16 @@ def of_optimize(result) -> Answer:
             near = near.iloc[:0]
             lines.append(
                 f"{label}: no design carries the load: the {objective} is 0.00 h at every design searched "
-                f"(and the flat panel's); tracker {tracker.objective_h:.2f} h"
+                f"(and the flat panel's); {tracker}"
             )
         else:
             # A 180 deg fold is the flat panel: there the optimum is the flat panel's own best.
             lines.append(
                 f"{label}: flat (fold 180 deg), {_mounting(best)}: {best.objective_h:.2f} h, "
-                "the flat panel at its own best: no fold gains over it; tracker "
-                f"{tracker.objective_h:.2f} h"
+                f"the flat panel at its own best: no fold gains over it; {tracker}"
                 if best.fold_angle_deg == FLAT_FOLD_ANGLE
                 else f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
-                f"{best.objective_h:.2f} h, {_over_flat(best, flat)}; tracker "
-                f"{tracker.objective_h:.2f} h"
+                f"{best.objective_h:.2f} h, {_over_flat(best, flat)}; {tracker}"
             )
             if len(near):
                 lines.append(
@@ -146,7 +152,8 @@ def of_optimize(result) -> Answer:
                     "objective_h": default.objective_h,
                     "flat_objective_h": flat_default.objective_h,
                 },
-                "tracker_objective_h": tracker.objective_h,
+                "tracker_objective_h": _row(table, load, "tracker").objective_h,
+                "tracker_net_objective_h": _row(table, load, "tracker-net").objective_h,
                 "added_h": dict(zip(added["variable"], added["added_h"], strict=True)),
                 "near_optimal": records(near.drop(columns="p_load_w")),
             }

@@ -292,7 +292,7 @@ def of_study(result) -> Answer:
     else:
         lines.append(
             f"best fold angle {_fold_text(result.optimal_fold_angle)} deg"
-            + (f" (the paper's heuristic: {heuristic:.1f} deg)" if heuristic == heuristic else "")
+            + heuristic_text(study, heuristic, result.heuristic_outside)
             + f": t_solar {_hours(hours['twofold'])}, "
             + versus_flat(result.optimal_fold_angle, twofold["gain_vs_flat_pct"], hours["flat"])
             + (
@@ -339,42 +339,36 @@ def of_study(result) -> Answer:
         summary[columns],
         near_table,
         pd.DataFrame(),
-        design_notes(summary)
-        + weather_notes(result.day.sky)
-        + horizon_notes(study, [study.date])
-        + heuristic_notes(study, result.heuristic_outside),
+        design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
         tuple(lines),
     )
 
 
-def heuristic_notes(study, outside: str) -> list[dict]:
-    """Where the paper's heuristic (Shin et al. Eq. 8) has no angle among the study's fold angles,
-    why, as one note; none where its angle is stated.
+def heuristic_text(study, heuristic: float, outside: str) -> str:
+    """The paper's heuristic (Shin et al. Eq. 8) beside the best fold angle: its angle where it was
+    evaluated among the study's fold angles, else where the rule's angle lies and why (never a
+    clamped bound as if it were the rule's).
 
     Parameters
     ----------
     study : Study
+    heuristic : float
+        Its fold angle [deg], NaN where it has none among the study's.
     outside : str
-        :attr:`foldopt.studies.day.StudyResult.heuristic_outside`.
+        :attr:`foldopt.studies.day.StudyResult.heuristic_outside`: ``below``, ``above`` or empty.
     """
     grid = study.fold_angles
-    rule = "the paper's heuristic (Shin et al. Eq. 8) gives no angle"
-    if outside == "below":
-        text = (
-            f"{rule} among the study's fold angles ({grid.start:g} to {grid.stop:g} deg): the noon "
-            f"valley reaches the load already at {grid.start:g} deg, so the rule's angle lies at "
-            "or below it"
-        )
+    if heuristic == heuristic:
+        where = f"{heuristic:.1f} deg"
+    elif outside == "below":
+        where = f"at or below {grid.start:g} deg, the grid's first: the noon valley reaches the load there"
     elif outside == "above" and grid.stop < FLAT_FOLD_ANGLE:
-        text = (
-            f"{rule} among the study's fold angles ({grid.start:g} to {grid.stop:g} deg): the noon "
-            f"valley falls short of the load even at {grid.stop:g} deg"
-        )
+        where = f"above {grid.stop:g} deg, the grid's last: the noon valley falls short of the load there"
     elif outside == "above":
-        text = f"{rule}: the load exceeds the flat panel's noon power"
+        where = "none, the load exceeds the flat panel's noon power"
     else:
-        return []
-    return [{"note": text, "designs": []}]
+        return ""
+    return f" (the paper's heuristic: {where})"
 
 
 def request_defaults(result) -> dict | None:
