@@ -194,6 +194,21 @@ def _list_depth(annotation) -> int:
     return max(depths, default=0)
 
 
+def _walk(model: type[BaseModel], prefix: str = ""):
+    """Every field of a model and of its sections, parents first: ``(dotted path, field, the
+    section models its type holds)``."""
+    for name, field in model.model_fields.items():
+        path = f"{prefix}{name}"
+        sections = [
+            member
+            for member in _union(field.annotation)
+            if isinstance(member, type) and issubclass(member, BaseModel)
+        ]
+        yield path, field, sections
+        for section in sections:
+            yield from _walk(section, f"{path}.")
+
+
 def list_valued_fields(model: type[BaseModel], prefix: str = "") -> dict[str, int]:
     """The dotted paths of a model's fields whose value is itself a list, with the lists' depth.
 
@@ -212,18 +227,14 @@ def list_valued_fields(model: type[BaseModel], prefix: str = "") -> dict[str, in
     -------
     dict of str to int
     """
-    depths = {}
-    for name, field in model.model_fields.items():
-        path = f"{prefix}{name}"
-        if depth := _list_depth(field.annotation):
-            depths[path] = depth
-        for member in _union(field.annotation):
-            if isinstance(member, type) and issubclass(member, BaseModel):
-                inner = list_valued_fields(member, f"{path}.")
-                depths.update(inner)
-                shorthand = getattr(member, "LIST_SHORTHAND", None)
-                if shorthand is not None:
-                    depths[path] = inner[f"{path}.{shorthand}"]
+    walked = list(_walk(model, prefix))
+    depths = {path: _list_depth(field.annotation) for path, field, _ in walked}
+    depths = {path: depth for path, depth in depths.items() if depth}
+    for path, _, sections in walked:
+        for section in sections:
+            shorthand = getattr(section, "LIST_SHORTHAND", None)
+            if shorthand is not None:
+                depths[path] = depths[f"{path}.{shorthand}"]
     return depths
 
 
@@ -241,13 +252,7 @@ def field_paths(model: type[BaseModel], prefix: str = "") -> tuple[str, ...]:
     tuple of str
         In the order the models declare them (``site``, ``site.name``, ``site.latitude``...).
     """
-    paths = []
-    for name, field in model.model_fields.items():
-        paths.append(f"{prefix}{name}")
-        for member in _union(field.annotation):
-            if isinstance(member, type) and issubclass(member, BaseModel):
-                paths += field_paths(member, f"{prefix}{name}.")
-    return tuple(dict.fromkeys(paths))
+    return tuple(dict.fromkeys(path for path, _, _ in _walk(model, prefix)))
 
 
 def list_depth(value) -> int:
