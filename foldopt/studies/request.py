@@ -531,7 +531,7 @@ def _plan_request(command, study, data, lines, changes, labels, source, costs) -
     axis = command.partition(" ")[2] if command.startswith("sweep ") else None
     if isinstance(study, (Plan, Study)) and not changes:
         plan = study if isinstance(study, Plan) else _plan_of(study)
-        taken, decided = [], []
+        taken = _taken(plan, set(), None, plan.data, []) if command != "run" else []
     else:
         given = set(changes)
         changes = {**changes, **_command_defaults(command, data, changes)}
@@ -584,8 +584,8 @@ def _plan_request(command, study, data, lines, changes, labels, source, costs) -
                     "latitude, day or load)"
                 ]
             )
-    if command in ("size", "size --storage"):
-        taken = _size_taken(command, plan, source, costs or {})
+    if command == "size":
+        taken = _size_taken(plan, source, taken, costs or {})
     return Request(command, plan, source, tuple(taken), labels, run)
 
 
@@ -736,19 +736,21 @@ def _taken(plan: Plan, given: set, field: str | None, data: dict, decided: list[
     return taken
 
 
-def _size_taken(command: str, plan: Plan, source: str, costs: Mapping) -> list[str]:
-    """What a sizing took from its study (the site, day, load and efficiency) and, where the
-    request gives no panel cost, the paper's."""
+def _size_taken(plan: Plan, source: str, taken: list[str], costs: Mapping) -> list[str]:
+    """What a panel sizing took from its study: the site, day, load and efficiency where the
+    request does not give them (every area's panel has the study's efficiency) and, where it gives
+    no panel cost, the paper's."""
     from foldopt.inputs.costs import PAPER_COST_PER_M2
-    from foldopt.inputs.load_profile import load_text
 
-    if command == "size" and plan.axes:
+    if plan.axes:
         raise ConfigError(
             [f"config: {source} sweeps {', '.join(p for p, _ in plan.axes)}; size takes one case"]
         )
     study = plan.base
-    taken = [f"site, day, {load_text(study)}, efficiency {study.panel.efficiency:g}"]
-    if command == "size" and costs.get("cost_per_m2") is None and costs.get("cost_per_w") is None:
+    # the areas are the sizing's own: the study's panel area is not taken
+    taken = [item for item in taken if not item.startswith("panel ")]
+    taken.append(f"efficiency {study.panel.efficiency:g}")
+    if costs.get("cost_per_m2") is None and costs.get("cost_per_w") is None:
         taken.append(
             f"panel cost {PAPER_COST_PER_M2:g} $/m^2 (what Shin et al.'s 0.108 m^2 optimum implies; "
             "cost_per_m2 or cost_per_w)"
