@@ -384,7 +384,7 @@ def size(
         if not grid or min(grid) <= 0 or max(grid) > 1000:
             errors.append(f"areas = {areas!r}: areas must be in (0, 1000] m^2")
     except (TypeError, ValueError) as error:
-        errors.append(f"areas: {error}")
+        errors.append(f"areas = {areas!r}: {error}")
     if errors:
         raise ConfigError(errors)
     study = request.plan.base

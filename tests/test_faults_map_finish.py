@@ -149,7 +149,7 @@ def test_the_same_place_under_two_names_or_two_weather_files_is_two_sites():
 def test_a_study_files_axis_given_twice_is_one_line():
     with pytest.raises(ConfigError) as raised:
         make_plan({**yaml.safe_load(default_study_path().read_text()), "p_load": [2, 3, 2]})
-    assert raised.value.errors == ["p_load: 2 is given twice (values 1 and 3); give each value once"]
+    assert raised.value.errors == ["p_load = [2, 3, 2]: 2 is given twice (values 1 and 3); give each value once"]
 
 
 def test_a_misspelt_objective_is_named_beside_the_missing_dates(tmp_path, monkeypatch):

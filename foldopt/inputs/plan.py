@@ -79,11 +79,11 @@ def range_parts(text: str) -> tuple[float, float, float]:
     """The three numbers of ``"start:stop:step"``, unchecked; ValueError for any other text."""
     match = _RANGE.match(str(text))
     if not match:
-        raise ValueError(f"expected start:stop:step, got {text!r}")
+        raise ValueError("expected start:stop:step")
     try:
         return tuple(float(part) for part in match.groups())
     except ValueError:
-        raise ValueError(f"expected numbers in start:stop:step, got {text!r}") from None
+        raise ValueError("expected numbers in start:stop:step") from None
 
 
 def parse_range(text: str) -> list[float]:
@@ -106,13 +106,13 @@ def parse_range(text: str) -> list[float]:
     """
     start, stop, step = range_parts(text)
     if step <= 0 or not all(map(math.isfinite, (start, stop, step))):
-        raise ValueError(f"step must be a positive number, got {text!r}")
+        raise ValueError("step must be a positive number")
     if stop < start:
-        raise ValueError(f"empty range {text!r}: stop is below start")
+        raise ValueError("empty range: stop is below start")
     count = math.floor((stop - start) / step + 1e-9) + 1
     if count > MAX_AXIS_VALUES:
         raise ValueError(
-            f"{text!r} has {count:,} values; at most {MAX_AXIS_VALUES:,} per axis "
+            f"{count:,} values; at most {MAX_AXIS_VALUES:,} per axis "
             "(FOLDOPT_MAX_AXIS_VALUES raises it)"
         )
     return [round(start + i * step, 12) for i in range(count)]
@@ -147,7 +147,7 @@ def parse_values(text: str, numeric: bool = True):
         raise ValueError("no value; give a value, a range start:stop:step or a list a,b,c")
     items = [item.strip() for item in text.split(",")]
     if any(not item for item in items):
-        raise ValueError(f"{text!r} has an empty item; a list is a,b,c")
+        raise ValueError("an empty item; a list is a,b,c")
     if len(items) > MAX_AXIS_VALUES:
         raise ValueError(
             f"a list of {len(items):,} values; at most {MAX_AXIS_VALUES:,} per axis "
@@ -160,11 +160,9 @@ def parse_values(text: str, numeric: bool = True):
     try:
         values = [float(item) for item in items]
     except ValueError:
-        raise ValueError(
-            f"{text!r}: expected a number, a range start:stop:step or a list a,b,c"
-        ) from None
+        raise ValueError("expected a number, a range start:stop:step or a list a,b,c") from None
     if not all(math.isfinite(value) for value in values):
-        raise ValueError(f"{text!r}: values must be finite numbers")
+        raise ValueError("values must be finite numbers")
     return values if len(values) > 1 else values[0]
 
 
@@ -226,14 +224,12 @@ def parse_dates(spec, year: int) -> list[dt.date]:
             one(int(stop) if stop.isdigit() else stop),
         )
         if last < first:
-            raise ValueError(f"empty range {spec!r}: stop is before start")
+            raise ValueError("empty range: stop is before start")
         return [first + dt.timedelta(days=d) for d in range(0, (last - first).days + 1, int(step))]
     if isinstance(spec, str) and ":" in spec:
         parts = spec.split(":")
         example = ":".join([*parts[:2], "1"]) if len(parts) == 2 else "2025-12-25:2026-01-05:1"
-        raise ValueError(
-            f"{spec!r}: a range of dates is start:stop:step, the step in days (e.g. {example})"
-        )
+        raise ValueError(f"a range of dates is start:stop:step, the step in days (e.g. {example})")
     return [one(spec)]
 
 
@@ -409,6 +405,12 @@ def check_distinct(values, noun: str = "value", label=None) -> list:
     return values
 
 
+def _value_text(spec) -> str:
+    """An axis's value as a message shows it: short, as typed."""
+    text = repr(spec)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _axis_values(path: str, spec, year: int) -> list:
     if path == "date":
         return check_distinct(parse_dates(spec, year))
@@ -489,7 +491,7 @@ def make_plan(data, lines: dict | None = None) -> Plan:
         try:
             values = _axis_values(path, spec, year)
         except ValueError as error:
-            errors.append(_at(lines, yaml_path, f"{source}: {error}"))
+            errors.append(_at(lines, yaml_path, f"{source} = {_value_text(spec)}: {error}"))
             continue
         axes.append((path, tuple(values)))
     if errors:
