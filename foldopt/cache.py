@@ -26,6 +26,8 @@ _OFFLINE: contextvars.ContextVar[bool] = contextvars.ContextVar("foldopt_offline
 #: The spellings of a yes and of a no an environment variable of :func:`env_flag` takes, in any
 #: case; unset or empty is a no.
 _YES, _NO = ("1", "true", "yes", "on"), ("0", "false", "no", "off", "")
+#: foldopt's yes-or-no environment variables, each read by :func:`env_flag`.
+YES_OR_NO_VARIABLES = ("FOLDOPT_OFFLINE", "FOLDOPT_QUIET")
 
 
 def env_flag(name: str) -> bool:

@@ -253,6 +253,12 @@ def _options(
     ] = False,
 ):
     _DEBUG["on"] = debug
+    # A yes-or-no variable that is neither is refused before any command works, not only where a
+    # fetch or a notice would read it.
+    from foldopt.cache import YES_OR_NO_VARIABLES, env_flag
+
+    for name in YES_OR_NO_VARIABLES:
+        env_flag(name)
     # --quiet silences the caches' notices for this command only: an in-process caller's
     # environment is as it was once the command ends.
     ctx.call_on_close(

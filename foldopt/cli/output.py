@@ -15,7 +15,7 @@ from typing import NoReturn
 
 import typer
 
-from foldopt.errors import printable
+from foldopt.errors import printable, redacted
 
 #: The command line as typed, for run.json (``sys.argv`` holds the script's path, or pytest's); set
 #: by the app for each command.
@@ -61,7 +61,7 @@ def fail(lines: list[str]) -> NoReturn:
         The faults, each naming the option or field.
     """
     for line in lines:
-        echo(f"error: {line}", err=True)
+        echo(f"error: {redacted(line)}", err=True)  # an address's password is never shown
     raise typer.Exit(2)
 
 

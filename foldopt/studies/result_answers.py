@@ -700,13 +700,15 @@ def of_sizing(
     parameters, defaults : dict
         ``defaults``: what was taken from the study (:attr:`Answer.defaults`), or None.
     """
+    from foldopt.inputs.load_profile import load_text
+
     cost = (
         f"{parameters['cost_per_m2']:g} $/m^2"
         if parameters.get("cost_per_w") is None
         else f"{parameters['cost_per_w']:g} $/W"
     )
     lines = [
-        f"{study.name}: the area with the largest lifetime net benefit at {cost}, C_grid "
+        f"{study.name} ({load_text(study)}): the area with the largest lifetime net benefit at {cost}, C_grid "
         f"{parameters['c_grid_usd_per_kwh']:g} $/kWh over {parameters['years']:g} years"
     ]
     for row in best.itertuples():
