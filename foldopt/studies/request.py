@@ -258,7 +258,10 @@ def make_request(
             return _plan_request(command, study, data, lines, changes, labels, source, costs)
         except ConfigError as error:
             raise ConfigError(
-                [rename_field(_missing_hint(line, labels), labels) for line in error.errors]
+                [
+                    rename_field(_missing_hint(line, labels, bool(options)), labels)
+                    for line in error.errors
+                ]
             ) from None
 
 
@@ -274,9 +277,10 @@ def _also_labels(options: Mapping, labels: Mapping) -> dict:
     }
 
 
-def _missing_hint(line: str, labels: Mapping) -> str:
+def _missing_hint(line: str, labels: Mapping, has_options: bool) -> str:
     """A section's missing field said with what made the section: ``--min-soc`` alone makes a
-    buffer that has no capacity."""
+    buffer that has no capacity. The option that gives the field is named where the command
+    takes options (``has_options``)."""
     path, _, problem = line.partition(": ")
     if problem != "required field is missing":
         return line
@@ -285,7 +289,7 @@ def _missing_hint(line: str, labels: Mapping) -> str:
     if not makers:
         return line
     option = next((entry.label for entry in FIELD_OPTIONS if entry.field == path), None)
-    how = f"{option} (or {path})" if option else path
+    how = f"{option} (or {path})" if option and has_options else path
     return f"{makers[0]}: {section} needs {path.rpartition('.')[2]} too; give {how}"
 
 
