@@ -91,11 +91,23 @@ class Site(StrictModel):
     longitude: interval(-180, 180, unit=" deg")
     altitude: interval(-500, 9000, unit=" m") = 0.0
     timezone: Annotated[str | None, AfterValidator(_check_timezone)] = Field(
-        None, description="IANA name or UTC offset; default: the longitude's standard offset"
+        None,
+        validate_default=True,
+        description="IANA name or UTC offset; default: the longitude's standard offset",
     )
     horizon: Horizon | None = Field(
         None, description="(azimuth, elevation) points or a file; default an open plain"
     )
+
+    @field_validator("timezone", mode="after")
+    @classmethod
+    def _standard_by_default(cls, timezone, info: ValidationInfo):
+        """The longitude's standard offset where none is given: decided, not given (the site's
+        fields set say so, and a study's data leave it out)."""
+        longitude = info.data.get("longitude")
+        return (
+            standard_timezone(longitude) if timezone is None and longitude is not None else timezone
+        )
 
 
 def standard_timezone(longitude: float) -> str:

@@ -9,7 +9,7 @@ import pydantic and :mod:`foldopt.names`.
 
 from __future__ import annotations
 
-from pydantic import Field, PrivateAttr, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from foldopt import names
 from foldopt.inputs.fields import StrictModel, interval, named
@@ -144,22 +144,31 @@ class Storage(StrictModel):
     capacity_wh: interval(0, 1e6, unit=" Wh") = Field(
         description="usable energy of the full buffer; 0 is storage-less"
     )
+    # before the fields it fills: their validators read it
+    preset: named(names.STORAGE_PRESETS) | None = Field(
+        None, description="fills the fields left out with a chemistry's typical values"
+    )
     min_soc: interval(0, 1, hi_open=True) | None = Field(
-        None, description="the controller's cut-off; default the preset's, else 0"
+        None,
+        validate_default=True,
+        description="the controller's cut-off; default the preset's, else 0",
     )
     restart_soc: interval(0, 1) | None = Field(
         None,
+        validate_default=True,
         description="where the load is reconnected, >= min_soc; default min_soc plus the preset's "
         "hysteresis, else min_soc",
     )
     charge_efficiency: interval(0, 1, lo_open=True) | None = Field(
-        None, description="default the preset's, else 1"
+        None, validate_default=True, description="default the preset's, else 1"
     )
     discharge_efficiency: interval(0, 1, lo_open=True) | None = Field(
-        None, description="default the preset's, else 1"
+        None, validate_default=True, description="default the preset's, else 1"
     )
     self_discharge: interval(0, 1, hi_open=True, unit=" per day") | None = Field(
-        None, description="fraction of the stored energy lost a day; default the preset's, else 0"
+        None,
+        validate_default=True,
+        description="fraction of the stored energy lost a day; default the preset's, else 0",
     )
     max_charge_w: interval(0, 1e6, lo_open=True, unit=" W") | None = Field(
         None, description="default unlimited"
@@ -170,32 +179,30 @@ class Storage(StrictModel):
     initial_soc: interval(0, 1) | None = Field(
         None, description="at the first day's start; default the periodic steady state"
     )
-    preset: named(names.STORAGE_PRESETS) | None = Field(
-        None, description="fills the fields left out with a chemistry's typical values"
-    )
     target: StorageTarget | None = Field(
         None, description="size each design's buffer for it: {powered_h, days_pct}"
     )
-    #: The fields the preset (or the ideal buffer) filled, not given (:meth:`_fill`).
-    _decided: frozenset = PrivateAttr(frozenset())
+
+    @field_validator(*FILLED, mode="after")
+    @classmethod
+    def _fill(cls, value, info: ValidationInfo):
+        """A field left out, from the preset or the ideal buffer (``restart_soc`` from the
+        ``min_soc`` in force, validated before it): filled, not given (the fields set say so)."""
+        if value is not None or "preset" not in info.data:
+            return value  # given; or a preset that is no preset, which its own validation names
+        preset = info.data["preset"]
+        values = PRESETS[preset] if preset is not None else IDEAL
+        if info.field_name != "restart_soc":
+            return values[info.field_name]
+        min_soc = info.data.get("min_soc")
+        # Rounded: decimal fractions added in binary (0.2 + 0.1 is 0.30000000000000004).
+        return None if min_soc is None else round(min(1.0, min_soc + values["hysteresis"]), 12)
 
     @model_validator(mode="after")
-    def _fill(self):
-        """The fields left out, from the preset or the ideal buffer, once; then the checks."""
-        values = PRESETS[self.preset] if self.preset is not None else IDEAL
-        source = f"the {self.preset} preset's" if self.preset is not None else "the default"
-        decided = [name for name in FILLED if getattr(self, name) is None]
-        for name in decided:
-            # Rounded: decimal fractions added in binary (0.2 + 0.1 is 0.30000000000000004).
-            value = (
-                round(min(1.0, self.min_soc + values["hysteresis"]), 12)
-                if name == "restart_soc"
-                else values[name]
-            )
-            object.__setattr__(self, name, value)  # frozen to users; filled here, once
-        self._decided = frozenset(decided)
+    def _reconnected_above_cut_off(self):
         if self.restart_soc < self.min_soc:
-            said = {name: "" if name not in decided else f", {source}" for name in FILLED}
+            source = f"the {self.preset} preset's" if self.preset is not None else "the default"
+            said = {name: "" if name not in self.decided else f", {source}" for name in FILLED}
             raise ValueError(
                 f"restart_soc ({self.restart_soc:g}{said['restart_soc']}) is below min_soc "
                 f"({self.min_soc:g}{said['min_soc']}): the controller reconnects the load at or "
@@ -206,4 +213,4 @@ class Storage(StrictModel):
     @property
     def decided(self) -> frozenset:
         """The fields the preset, or the ideal buffer, filled: the study's data leave them out."""
-        return self._decided
+        return frozenset(name for name in FILLED if name not in self.model_fields_set)

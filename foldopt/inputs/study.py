@@ -17,7 +17,6 @@ from typing import Annotated
 from pydantic import (
     AfterValidator,
     Field,
-    PrivateAttr,
     ValidationError,
     ValidationInfo,
     field_validator,
@@ -38,7 +37,6 @@ from foldopt.inputs.sections import (
     Panel,
     Site,
     Tracker,
-    standard_timezone,
 )
 from foldopt.inputs.storage_section import Storage
 from foldopt.inputs.weather_section import Weather
@@ -46,6 +44,12 @@ from foldopt.inputs.weather_section import Weather
 #: Each mode's default clear sky: pvlib's Ineichen (with diffuse light, Perez transposition at the
 #: site's Linke turbidity) in exact mode, the paper's beam-only Meinel sky in paper mode.
 MODE_SKIES = {"exact": "ineichen", "paper": "meinel"}
+#: What each mode decides where a study gives none: its sky, geometry and temperature model.
+MODE_DEFAULTS = {
+    "sky": MODE_SKIES,
+    "geometry": {"paper": "azimuth-split", "exact": "hinge"},
+    "temperature_model": {"paper": "fixed", "exact": "sapm"},
+}
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
 EARTH_RADIUS_KM = 6371.0
 #: The site of a study whose weather file is not read yet (built in Python): None until
@@ -210,12 +214,14 @@ class Study(StrictModel):
     )
     geometry: named(names.GEOMETRIES) | None = Field(
         None,
+        validate_default=True,
         description="twofold parametrisation; default azimuth-split in paper mode, hinge in exact",
     )
     fold_angles: FoldAngles = FoldAngles()
     near_optimal: NearOptimal = NearOptimal()
     sky: named(names.SKIES) | None = Field(
         None,
+        validate_default=True,
         description="clear sky; default ineichen in exact mode, meinel (the paper's beam-only) in paper",
     )
     linke_turbidity: interval(0, 10, lo_open=True) | None = Field(
@@ -243,7 +249,9 @@ class Study(StrictModel):
         None, description="the fold angle, tilt and azimuth optimised together (foldopt optimize)"
     )
     temperature_model: named(names.TEMPERATURE_MODELS) | None = Field(
-        None, description="default fixed (cells at temp_air) in paper mode, sapm in exact"
+        None,
+        validate_default=True,
+        description="default fixed (cells at temp_air) in paper mode, sapm in exact",
     )
     temp_air: interval(-60, 60, unit=" C") = 25.0
     wind_speed: interval(0, 60, unit=" m/s") = 1.0
@@ -255,8 +263,6 @@ class Study(StrictModel):
     step_min: Annotated[
         interval(0, 60, lo_open=True, unit=" min"), AfterValidator(_check_step_min)
     ] = 1.0
-    #: The dotted paths of the fields the validation decided (:meth:`_decide`), not given.
-    _decided: frozenset = PrivateAttr(frozenset())
 
     @model_validator(mode="before")
     @classmethod
@@ -320,43 +326,44 @@ class Study(StrictModel):
         """None for a weather file's site not read yet; a missing or null site is still refused."""
         return None if value is _UNREAD else handler(value)
 
-    @model_validator(mode="after")
-    def _decide(self):
-        """Every default that depends on other fields, decided once (:attr:`_decided` says which),
-        before the checks of :meth:`_consistent` (pydantic runs after-validators in order)."""
-        decided = {}
-        if self.geometry is None:
-            decided["geometry"] = "azimuth-split" if self.mode == "paper" else "hinge"
-        if self.temperature_model is None:
-            decided["temperature_model"] = "fixed" if self.mode == "paper" else "sapm"
-        if self.sky is None:
-            decided["sky"] = MODE_SKIES[self.mode]
-        if self.site is not None:
-            from foldopt.physics.geometry import default_orientation
+    @field_validator("geometry", "sky", "temperature_model", mode="after")
+    @classmethod
+    def _mode_default(cls, value, info: ValidationInfo):
+        """The mode's own geometry, sky and temperature model where the study gives none."""
+        mode = info.data.get("mode")
+        return value if value is not None or mode is None else MODE_DEFAULTS[info.field_name][mode]
 
-            tilt, azimuth = default_orientation(self.site.latitude)
-            panel = {
-                key: value
-                for key, value in (("tilt", tilt), ("azimuth", azimuth))
-                if getattr(self.panel, key) is None
-            }
-            if panel:
-                decided["panel"] = self.panel.model_copy(update=panel)
-            if self.site.timezone is None:
-                decided["site"] = self.site.model_copy(
-                    update={"timezone": standard_timezone(self.site.longitude)}
-                )
-            paths = [f"panel.{key}" for key in panel] + ["site.timezone"] * ("site" in decided)
-        else:
-            paths = []
+    @field_validator("panel", mode="after")
+    @classmethod
+    def _facing_the_equator(cls, panel, info: ValidationInfo):
+        """The panel at ``|latitude|`` toward the equator where the study gives no tilt or azimuth:
+        decided from the site (validated before the panel), not given (its fields set say so)."""
+        site = info.data.get("site")
+        if site is None:
+            return panel  # a weather file's site not read yet: decided when it is
+        from foldopt.physics.geometry import default_orientation
+
+        facing = dict(zip(("tilt", "azimuth"), default_orientation(site.latitude), strict=True))
+        missing = {key: value for key, value in facing.items() if getattr(panel, key) is None}
+        if not missing:
+            return panel
+        return Panel.model_construct(panel.model_fields_set, **{**dict(panel), **missing})
+
+    @property
+    def decided(self) -> tuple[str, ...]:
+        """The dotted paths of the fields the validation decided, not given: :meth:`data` leaves
+        them out, so a variant (another latitude, another mode) decides its own."""
+        paths = [name for name in MODE_DEFAULTS if name not in self.model_fields_set]
+        if self.site is not None:
+            paths += [
+                f"panel.{key}"
+                for key in ("tilt", "azimuth")
+                if key not in self.panel.model_fields_set
+            ]
+            paths += ["site.timezone"] * ("timezone" not in self.site.model_fields_set)
         if self.storage is not None:
             paths += [f"storage.{name}" for name in self.storage.decided]
-        for name, value in decided.items():
-            object.__setattr__(self, name, value)  # frozen to users; decided here, once
-        self._decided = frozenset(
-            paths + [name for name in decided if name not in ("panel", "site")]
-        )
-        return self
+        return tuple(paths)
 
     @model_validator(mode="after")
     def _consistent(self, info: ValidationInfo):
@@ -435,8 +442,8 @@ class Study(StrictModel):
         """
         defaults = {name: field.default for name, field in Study.model_fields.items()}
         # What a resolved study fills in is no setting of the user's.
-        defaults["temperature_model"] = (None, "fixed" if self.mode == "paper" else "sapm")
-        defaults["sky"] = (None, MODE_SKIES[self.mode])
+        for name, by_mode in MODE_DEFAULTS.items():
+            defaults[name] = (None, by_mode[self.mode])
         iv_model = self.pv_model != "ideal"
         series_used = self.connection == "series" or (
             self.connection == "switching" and self.switch_series
@@ -578,7 +585,7 @@ class Study(StrictModel):
             from a file keeps its file, not what was read from it.
         """
         data = self.model_dump(mode="json", exclude_none=True)
-        for path in self._decided:
+        for path in self.decided:
             section, _, name = path.rpartition(".")
             (data[section] if section else data).pop(name, None)
         if self.load_profile is not None and self.load_profile.read_daily:
