@@ -1,8 +1,11 @@
 """foldopt's cache folder and its files: where the electrical tables, the land mask and matplotlib's
 settings are kept between runs (:func:`cache_dir`), and cache files that carry a checksum
 (:func:`store_cache`, :func:`load_cache`), so that a damaged one is built again rather than read;
-and foldopt's yes-or-no environment variables (:func:`env_flag`: ``FOLDOPT_OFFLINE``,
-``FOLDOPT_QUIET``). A leaf: it imports nothing of foldopt but the errors.
+and foldopt's two switches, offline (:func:`offline`) and quiet (:func:`quiet`): each on where its
+yes-or-no environment variable says yes (:func:`env_flag`: ``FOLDOPT_OFFLINE``, ``FOLDOPT_QUIET``)
+or for a block that turns it on (:func:`offline_mode`, :func:`quiet_mode`: the command line's
+``--offline`` and ``--quiet``), in a context variable: foldopt writes no environment variable. A leaf:
+it imports nothing of foldopt but the errors.
 """
 
 from __future__ import annotations
@@ -23,6 +26,8 @@ _CHECKSUM = b"\nfoldopt-sha256:"
 #: Offline in this context (the command line's ``--offline``): what is fetched comes from the
 #: cache only (:func:`offline`).
 _OFFLINE: contextvars.ContextVar[bool] = contextvars.ContextVar("foldopt_offline", default=False)
+#: Quiet in this context (the command line's ``--quiet``): no notice (:func:`quiet`).
+_QUIET: contextvars.ContextVar[bool] = contextvars.ContextVar("foldopt_quiet", default=False)
 #: The spellings of a yes and of a no an environment variable of :func:`env_flag` takes, in any
 #: case; unset or empty is a no.
 _YES, _NO = ("1", "true", "yes", "on"), ("0", "false", "no", "off", "")
@@ -73,7 +78,6 @@ def offline() -> bool:
     return env_flag("FOLDOPT_OFFLINE") or _OFFLINE.get()
 
 
-@contextmanager
 def offline_mode(on: bool = True):
     """Offline (:func:`offline`) for the block where ``on``.
 
@@ -81,11 +85,40 @@ def offline_mode(on: bool = True):
     ----------
     on : bool, default True
     """
-    token = _OFFLINE.set(bool(on) or _OFFLINE.get())
+    return _turned_on(_OFFLINE, on)
+
+
+def quiet() -> bool:
+    """Whether foldopt's notices (:func:`notice`) are silent: ``--quiet`` (:func:`quiet_mode`) or
+    ``FOLDOPT_QUIET`` yes (:func:`env_flag`).
+
+    Raises
+    ------
+    foldopt.errors.ConfigError
+        For a ``FOLDOPT_QUIET`` that is no yes or no.
+    """
+    return env_flag("FOLDOPT_QUIET") or _QUIET.get()
+
+
+def quiet_mode(on: bool = True):
+    """Quiet (:func:`quiet`) for the block where ``on``: the command line's ``--quiet``, for the
+    command's run.
+
+    Parameters
+    ----------
+    on : bool, default True
+    """
+    return _turned_on(_QUIET, on)
+
+
+@contextmanager
+def _turned_on(switch: contextvars.ContextVar, on: bool):
+    """``switch`` on for the block where ``on`` (an outer block's on stays on), as it was after."""
+    token = switch.set(bool(on) or switch.get())
     try:
         yield
     finally:
-        _OFFLINE.reset(token)
+        switch.reset(token)
 
 
 def cache_dir() -> Path:
@@ -193,12 +226,11 @@ _AGAIN = "building it again"
 
 def notice(message: str) -> None:
     """One line on stderr, ``foldopt: <message>``, of something foldopt mended on its way (a
-    damaged cache file built or fetched again); none where ``FOLDOPT_QUIET`` is yes
-    (:func:`env_flag`: ``--quiet``).
+    damaged cache file built or fetched again); none where foldopt is quiet (:func:`quiet`).
 
     Parameters
     ----------
     message : str
     """
-    if not env_flag("FOLDOPT_QUIET"):
+    if not quiet():
         print(f"foldopt: {message}", file=sys.stderr)

@@ -13,8 +13,6 @@ This module is the app: its error path, its global options and the commands of
 from __future__ import annotations
 
 import codecs
-import functools
-import os
 import signal
 import sys
 import threading
@@ -191,7 +189,16 @@ class _OneLineErrors(TyperGroup):
 
 class _OnceEach(TyperCommand):
     """A command whose options are each given at most once: a repeated option (``--days a --days
-    b``) is an error, not a silent last-wins. Options that collect values (``--set``) repeat."""
+    b``) is an error, not a silent last-wins. Options that collect values (``--set``) repeat.
+    Its ``--quiet`` silences foldopt's notices (:func:`foldopt.cache.quiet_mode`) while it runs."""
+
+    def invoke(self, ctx):
+        # click's documented hook, where the options are parsed: the command's run, and no longer
+        # (an in-process caller's later work is as loud as it was).
+        from foldopt.cache import quiet_mode
+
+        with quiet_mode(bool(ctx.params.get("quiet"))):
+            return super().invoke(ctx)
 
     def parse_args(self, ctx, args):
         # No documented hook sees a repeat: click's parser keeps the last value, a parameter's
@@ -238,7 +245,6 @@ def _print_version(value: bool) -> None:
 
 @app.callback()
 def _options(
-    ctx: typer.Context,
     debug: Annotated[
         bool, typer.Option("--debug", help="Show the traceback of an internal error.")
     ] = False,
@@ -259,18 +265,6 @@ def _options(
 
     for name in YES_OR_NO_VARIABLES:
         env_flag(name)
-    # --quiet silences the caches' notices for this command only: an in-process caller's
-    # environment is as it was once the command ends.
-    ctx.call_on_close(
-        functools.partial(_restore_environment, "FOLDOPT_QUIET", os.environ.get("FOLDOPT_QUIET"))
-    )
-
-
-def _restore_environment(name: str, value: str | None) -> None:
-    if value is None:
-        os.environ.pop(name, None)
-    else:
-        os.environ[name] = value
 
 
 app.add_typer(sweep_app, name="sweep", short_help=sweep.SHORT_HELP)

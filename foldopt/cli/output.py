@@ -8,7 +8,6 @@ The view decides nothing: every number and word of an answer is the
 from __future__ import annotations
 
 import json
-import os
 from contextlib import contextmanager
 from pathlib import Path
 from typing import NoReturn
@@ -71,7 +70,9 @@ class Output:
     Parameters
     ----------
     quiet : bool
-        Print nothing but errors (and, with JSON, the document).
+        Print nothing but errors (and, with JSON, the document); the command's ``--quiet``, which
+        silences foldopt's notices while the command runs (the app's commands:
+        :func:`foldopt.cache.quiet_mode`).
     output_format : {'table', 'json'}
     table : bool
         Also print the full table.
@@ -79,10 +80,6 @@ class Output:
 
     def __init__(self, quiet: bool, output_format: str, table: bool = False):
         self.quiet, self.json, self.table = quiet, output_format == "json", table
-        if quiet:
-            os.environ["FOLDOPT_QUIET"] = (
-                "1"  # the caches' rebuild notices too; embedded workers inherit it
-            )
 
     @contextmanager
     def progress(self, label: str, total: float | None = None, unit: str = "days"):

@@ -1,4 +1,5 @@
-"""``foldopt run`` and ``foldopt reproduce``, and the running of a request that ``sweep`` shares."""
+"""``foldopt run`` and ``foldopt reproduce``, and the running of a request that ``sweep`` and
+``optimize`` share."""
 
 from __future__ import annotations
 
@@ -76,6 +77,38 @@ def run_request(
         rows,
         write=lambda: write(result, out, overwrite, INVOCATION),
     )
+
+
+def run_options(command: str, options: dict, folder: str, **request) -> None:
+    """Run a command whose parameters are the options of every sweep (:mod:`foldopt.cli.sweep`,
+    ``optimize``): its request made of them (:func:`foldopt.studies.request.make_request`), run
+    and printed (:func:`run_request`).
+
+    Parameters
+    ----------
+    command : str
+        ``sweep angle``, ``sweep latitude``, ``sweep day``, ``sweep load`` or ``optimize``.
+    options : dict
+        The command's parameters by name: those that set study fields, and ``config``,
+        ``settings``, ``out``, ``overwrite``, ``quiet``, ``output_format``, ``engine``, ``table``.
+    folder : str
+        The results folder under ``results/`` where ``out`` is None.
+    **request
+        More of :func:`~foldopt.studies.request.make_request`'s keywords (``optimize``).
+    """
+    options = dict(options)
+    output_format, engine = check_choices(options.pop("output_format"), options.pop("engine"))
+    output = Output(options.pop("quiet"), output_format, options.pop("table"))
+    out, overwrite = options.pop("out"), options.pop("overwrite")
+    config, settings = options.pop("config"), options.pop("settings") or ()
+    # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
+    from foldopt.studies.request import make_request
+
+    try:
+        request = make_request(command, config, options=options, settings=settings, **request)
+    except ConfigError as error:
+        fail(list(dict.fromkeys(error.errors)))
+    run_request(request, out or RESULTS / folder, overwrite, output, engine, command)
 
 
 def run(

@@ -24,6 +24,7 @@ import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
+from foldopt.cache import quiet
 from foldopt.errors import ConfigError
 
 #: Seconds [s] foldopt waits for a scheduler to answer, every step of reaching it counted (the name
@@ -97,6 +98,8 @@ def connect(
                 dashboard_address="127.0.0.1:0",
                 silence_logs=SILENT,
                 preload=[__name__],  # dask_setup: the workers' processes log nothing either
+                # --quiet reaches the worker processes' notices (a cache built again) too
+                env={"FOLDOPT_QUIET": "1"} if quiet() else {},
             )
             try:
                 with Client(cluster) as client:
