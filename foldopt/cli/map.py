@@ -1,6 +1,7 @@
 """``foldopt map``: many sites on Dask. The request is
-:func:`foldopt.studies.request.map_request_from`'s, the run :func:`foldopt.world_map`'s; the command
-checks how its options combine and prints.
+:func:`foldopt.studies.request.make_request`'s (which checks how the sites, loads and weather
+combine, naming the options by :data:`_OPTION_OF_PARAMETER`), the run :func:`foldopt.world_map`'s;
+the command checks how it asks for its cluster, and prints.
 """
 
 from __future__ import annotations
@@ -23,12 +24,11 @@ from foldopt.cli.options import (
     Settings,
     check_choices,
     out_option,
-    rename_fields,
     StepMin,
 )
 from foldopt import names
 from foldopt.cli.output import INVOCATION, Output, fail
-from foldopt.errors import ConfigError, WeatherError
+from foldopt.errors import ConfigError
 from foldopt.names import DEFAULT_ENGINE
 from foldopt.studies.dask_client import CONNECT_TIMEOUT, WORKER_TIMEOUT, check_cluster
 
@@ -36,6 +36,8 @@ from foldopt.studies.dask_client import CONNECT_TIMEOUT, WORKER_TIMEOUT, check_c
 _OPTION_OF_PARAMETER = {
     "latitudes": "--lat",
     "longitudes": "--lon",
+    "sites": "--sites",
+    "weather_dir": "--weather-dir",
     "land_only": "--land-only",
     "show_period": "--show-period",
     "optimize": "--optimize",
@@ -214,28 +216,15 @@ def map_(
     """
     output_format, engine = check_choices(output_format, engine)
     output = Output(quiet, output_format)
-    errors = []
-    if (
-        sum(source is not None for source in (sites, weather_dir))
-        + (lat is not None or lon is not None)
-        > 1
-    ):
-        errors.append("--lat/--lon, --sites, --weather-dir: give one source of sites")
-    if land_only and (sites is not None or weather_dir is not None):
-        errors.append("--land-only: only for a --lat/--lon grid")
-    if p_load is not None and p_load_fraction is not None:
-        errors.append("--p-load / --p-load-fraction: give loads one way")
-    if weather is not None and weather_dir is not None:
-        errors.append(
-            "--weather / --weather-dir: a folder's files are its sites' weather; give one"
-        )
-    if years is not None and weather is None:
-        errors.append("--years: the years of a weather source; give one with --weather")
-    for option, value in (("--workers", workers), ("--chunk-sites", chunk_sites)):
-        if value is not None and value < 1:
-            errors.append(f"{option} = {value}: must be at least 1")
+    # How the run asks for its cluster, before any site or weather is read (the request's own
+    # checks are make_request's).
+    errors = [
+        f"{option} = {value}: must be at least 1"
+        for option, value in (("--workers", workers), ("--chunk-sites", chunk_sites))
+        if value is not None and value < 1
+    ]
     try:
-        check_cluster(scheduler, workers)  # before any site or weather is read
+        check_cluster(scheduler, workers)
     except ConfigError as error:
         errors += error.errors
     if errors:
@@ -262,18 +251,21 @@ def map_(
         "longitudes": lon,
         "land_only": land_only,
         "show_period": show_period,
-        "weather": None if weather is None else {"source": weather, "years": years},
+        "weather": {
+            key: value
+            for key, value in (("source", weather), ("years", years))
+            if value is not None
+        }
+        or None,
+        "labels": {
+            **_OPTION_OF_PARAMETER,
+            "loads": "--p-load-fraction" if p_load_fraction is not None else "--p-load",
+        },
     }
     try:
         request = make_request("map", config, options=options, settings=settings or (), where=where)
-    except WeatherError:
-        raise  # a file of --weather-dir: its line names the file, as the reader says it
     except ConfigError as error:
-        labels = {
-            **_OPTION_OF_PARAMETER,
-            "loads": "--p-load-fraction" if p_load_fraction else "--p-load",
-        }
-        fail(list(dict.fromkeys(rename_fields(line, labels) for line in error.errors)))
+        fail(list(dict.fromkeys(error.errors)))
     spec = request.plan
     if not 1 <= show_load <= len(spec.loads):
         fail(

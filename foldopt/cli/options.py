@@ -157,9 +157,7 @@ Timezone = Annotated[
 #: (:func:`foldopt.studies.request.make_request`'s ``sweep angle``).
 Date = Annotated[
     str | None,
-    typer.Option(
-        "--days", "--date", help=_several(_DATE, _DAYS, "with --objective or --weather")
-    ),
+    typer.Option("--days", "--date", help=_several(_DATE, _DAYS, "with --objective or --weather")),
 ]
 #: ``--days``: one day or several.
 Days = Annotated[str | None, typer.Option("--days", "--date", help=_several(_DATE, _DAYS))]
@@ -205,7 +203,8 @@ Geometry = Annotated[
     str | None,
     typer.Option(
         "--geometry",
-        help=_choices(names.GEOMETRIES) + " [default: azimuth-split in paper mode, hinge in exact].",
+        help=_choices(names.GEOMETRIES)
+        + " [default: azimuth-split in paper mode, hinge in exact].",
     ),
 ]
 Sky = Annotated[str | None, typer.Option("--sky", help=_choices(names.SKIES) + ".")]

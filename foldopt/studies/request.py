@@ -223,7 +223,9 @@ def make_request(
     where : mapping, optional
         A map's sites and how they are shown: ``sites``, ``weather_dir``, ``latitudes``,
         ``longitudes``, ``land_only``, ``show_period``, ``weather`` (a source's section) of
-        :func:`foldopt.studies.worldmap.map_request`.
+        :func:`foldopt.studies.worldmap.map_request`, one source of sites among the grid,
+        ``sites`` and ``weather_dir`` (:func:`_where_problems`); and ``labels``, how messages
+        name them (the command line's options: ``{"latitudes": "--lat", ...}``).
     costs : mapping, optional
         ``size``: the sizing's parameters (keys of :data:`SIZING_LIMITS`), None where not given:
         each is checked, and the answer says where it took the paper's panel cost.
@@ -489,6 +491,13 @@ def _map_entries(options: dict, data: dict) -> list[tuple]:
         if options.get(option) is not None:
             entries.append((f"--{option.replace('_', '-')}", {path: options[option]}))
     if options.get("p_load_fraction") is not None:
+        if options.get("p_load") is not None:
+            raise ConfigError(
+                [
+                    "--p-load / --p-load-fraction: give loads one way, in watts or as fractions "
+                    "of each site's flat peak"
+                ]
+            )
         entries.append(("--p-load-fraction", {"p_load": options["p_load_fraction"]}))
     if options.get("angle_step") is not None:
         step = options["angle_step"]
@@ -765,9 +774,13 @@ def _size_taken(plan: Plan, source: str, taken: list[str], costs: Mapping) -> li
 def _map_request(data, embedded, changes, labels, options, where, source) -> Request:
     """A map's request: its study (the study's panel and models, the map's options over them),
     sites and loads, checked once (:func:`foldopt.studies.worldmap.map_request`), as a
-    :class:`foldopt.studies.worldmap.MapSpec`."""
+    :class:`foldopt.studies.worldmap.MapSpec`. Its messages name ``where``'s parameters by
+    ``where["labels"]`` (the command line's options), later stages' too (:attr:`Request.labels`)."""
     from foldopt.studies.worldmap import map_request, map_study
 
+    where = dict(where or {})
+    # a field's own label wins: --set weather.years is named so, not --years
+    labels = {**(where.pop("labels", None) or {}), **labels}
     flat = policy.flatten(changes)
     errors = _set_by_run("map", flat)
     # The study's and the request's weather: a source is fetched at each site; a file is one site's.
@@ -775,10 +788,12 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
     for path, value in flat.items():
         if policy.touched([path], "weather"):
             weather = policy.set_path({"weather": weather}, path, value)["weather"]
+    errors += _where_problems(where, weather, set(flat), labels)
     if isinstance(weather, str) or (isinstance(weather, dict) and weather.get("path")):
         errors.append(
             "weather: a map's sites each bring their own weather: a folder of files "
-            f"(--weather-dir) or a source (--weather {' | '.join(WEATHER_SOURCES)})"
+            f"({_name('weather_dir', labels)}) or a source ({_name('weather.source', labels)} "
+            f"{' | '.join(WEATHER_SOURCES)})"
         )
     elif isinstance(weather, dict) and weather.get("members") is not None:
         errors.append(refusal("weather.members", "map", "map"))
@@ -798,22 +813,28 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
             )
     if errors:
         raise ConfigError(list(dict.fromkeys(errors)))
-    where = dict(where or {})
-    if isinstance(weather, dict) and weather.get("source") is not None:
-        where["weather"] = {**weather, **(where.get("weather") or {})}
+    weather = {
+        **(weather if isinstance(weather, dict) else {}),
+        **(where.pop("weather", None) or {}),
+    }
+    if weather.get("source") is not None:
+        where["weather"] = weather
     relative = options.get("p_load_fraction") is not None or bool(where.pop("relative", False))
     year = flat.pop("year", data.get("year", 2025))
     loads = flat.pop("p_load", None)
     study = {key: value for key, value in flat.items() if not policy.touched([key], "weather")}
     made, _ = policy.apply(map_study(data, embedded=embedded), study)
     # The study's load as its file gives it: a value, a list or a range text, checked like --p-load.
-    spec = map_request(
-        made,
-        (data.get("p_load") or 1.0) if loads is None else loads,
-        relative=relative,
-        year=year,
-        **where,
-    )
+    try:
+        spec = map_request(
+            made,
+            (data.get("p_load") or 1.0) if loads is None else loads,
+            relative=relative,
+            year=year,
+            **where,
+        )
+    except ConfigError as error:
+        raise ConfigError([rename_field(line, labels) for line in error.errors]) from None
     loads_taken = (
         f"P_load {spec.loads[0]:g} W"
         if len(spec.loads) == 1
@@ -827,6 +848,71 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
         f"{spec.study.step_min:g}-min steps" if "step_min" not in flat else None,
     ]
     return Request("map", spec, source, tuple(item for item in taken if item), labels, "map")
+
+
+def _name(parameter: str, labels: Mapping) -> str:
+    """A map's parameter as the request names it (``latitudes``, or the command line's ``--lat``)."""
+    return labels.get(parameter, parameter)
+
+
+def _where_problems(where: Mapping, weather, changed: set, labels: Mapping) -> list[str]:
+    """What a map's ``where`` cannot have together: one source of sites (a grid of latitudes and
+    longitudes, a CSV of sites, a folder of weather files), ``land_only`` of a grid alone, and a
+    weather source neither with a folder's files nor, for its years alone, missing.
+
+    Parameters
+    ----------
+    where : mapping
+        :func:`make_request`'s ``where``.
+    weather : dict, str or None
+        The study's weather section, the request's field changes made.
+    changed : set of str
+        The fields the request changes.
+    labels : mapping
+        How messages name ``where``'s parameters and the fields (``--lat``, ``--set weather.years``).
+
+    Returns
+    -------
+    list of str
+        One line per fault.
+    """
+    given = {key for key, value in where.items() if value is not None}
+    grid = "/".join(_name(key, labels) for key in ("latitudes", "longitudes") if key in given)
+    sources = [grid] if grid else []
+    sources += [_name(key, labels) for key in ("sites", "weather_dir") if key in given]
+    errors = []
+    if len(sources) > 1:
+        errors.append(
+            f"{', '.join(sources)}: give one source of sites: a grid "
+            f"({_name('latitudes', labels)}/{_name('longitudes', labels)}), a CSV of sites "
+            f"({_name('sites', labels)}) or a folder of weather files ({_name('weather_dir', labels)})"
+        )
+    if where.get("land_only") and sources and not grid:
+        errors.append(
+            f"{_name('land_only', labels)}: only for a {_name('latitudes', labels)}/"
+            f"{_name('longitudes', labels)} grid, not {sources[0]}"
+        )
+    asked = where.get("weather") or {}
+    study = weather if isinstance(weather, dict) else {}
+    # The source and its years each named as what gave it: the request, a field change, the study.
+    by = {
+        key: _name(f"weather.{key}", labels)
+        if asked.get(key) is not None or f"weather.{key}" in changed
+        else f"weather.{key} (the study's)"
+        for key in ("source", "years")
+    }
+    merged = {**study, **asked}
+    if merged.get("source") is not None and "weather_dir" in given:
+        errors.append(
+            f"{by['source']} / {_name('weather_dir', labels)}: a folder's files are its sites' "
+            "weather; give one"
+        )
+    if merged.get("years") is not None and merged.get("source") is None:
+        errors.append(
+            f"{by['years']}: the years of a weather source; give one with "
+            f"{_name('weather.source', labels)}"
+        )
+    return errors
 
 
 def sizing_problems(parameters: dict) -> list[str]:
