@@ -19,7 +19,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "foldopt"
 #: Stage of each top-level name of the package, lowest first.
 STAGES = {"errors": 0, "names": 0, "capabilities": 0, "files": 0, "cache": 0, "tables": 0,
           "physics": 1, "inputs": 2, "engine": 3,
-          "studies": 4, "output": 5, "api": 6, "cli": 7}
+          "studies": 4, "output": 5, "api": 6, "cli": 7, "__main__": 7}
 
 
 def _module_name(path: Path) -> str:
@@ -163,3 +163,59 @@ def test_only_the_front_door_makes_a_plan_or_a_request():
                  for name, line in _calls_of(module) if module not in _MAKERS[name]]
     assert elsewhere == []
     assert _calls_of("foldopt.studies.request"), "the finder sees the front door's own calls"
+
+
+#: What changes ``os.environ``: a call of one of its methods, or of ``os``'s own.
+_ENVIRONMENT_WRITERS = {"pop", "popitem", "clear", "update", "setdefault", "__setitem__", "__delitem__"}
+#: The one place foldopt writes the environment, and why: matplotlib reads ``MPLCONFIGDIR`` once as
+#: it is first imported, and has no other way to be given a folder; it is deleted at once after.
+_SET_AND_UNDONE = {("foldopt.output.figures", "_matplotlib_imported")}
+
+
+def _environment_writes(module: str) -> list[tuple[int, str | None]]:
+    """(line, enclosing function) of every write to the process's environment in ``module``:
+    ``os.environ[...] =``, ``del os.environ[...]``, ``os.environ.pop(...)``..., ``os.putenv``,
+    ``os.unsetenv``."""
+    tree = ast.parse(MODULES[module].read_text())
+
+    def environ(node) -> bool:
+        return (isinstance(node, ast.Attribute) and node.attr == "environ"
+                and isinstance(node.value, ast.Name) and node.value.id == "os") or \
+            (isinstance(node, ast.Name) and node.id == "environ")
+
+    spans = [(node.lineno, node.end_lineno, node.name) for node in ast.walk(tree)
+             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))]
+    found = []
+    for node in ast.walk(tree):
+        targets = node.targets if isinstance(node, (ast.Assign, ast.Delete)) else \
+            [node.target] if isinstance(node, (ast.AugAssign, ast.AnnAssign)) else []
+        writes = any(isinstance(target, ast.Subscript) and environ(target.value) for target in targets)
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+            writes |= (node.func.attr in _ENVIRONMENT_WRITERS and environ(node.func.value)) or (
+                node.func.attr in ("putenv", "unsetenv") and isinstance(node.func.value, ast.Name)
+                and node.func.value.id == "os")
+        if writes:
+            inside = [name for start, end, name in spans if start <= node.lineno <= end]
+            found.append((node.lineno, inside[-1] if inside else None))
+    return found
+
+
+def test_foldopt_sets_no_environment_variable():
+    """No state set behind the caller's back (issue 48): --quiet and --offline are context
+    variables of foldopt.cache, and no module writes ``os.environ``, but the moment matplotlib is
+    first imported (output.figures), which sets MPLCONFIGDIR and deletes it at once after
+    (tests/test_faults_inputs.py: the environment is as it was)."""
+    writes = [(module, line, function) for module in MODULES for line, function in _environment_writes(module)]
+    assert [f"{module}:{line}" for module, line, function in writes
+            if (module, function) not in _SET_AND_UNDONE] == []
+    assert {(module, function) for module, _, function in writes} == _SET_AND_UNDONE
+
+
+def test_the_environment_finder_sees_every_kind_of_write(tmp_path, monkeypatch):
+    """The finder can fail: a made-up module with each kind of write is caught, a read is not."""
+    source = tmp_path / "made_up.py"
+    source.write_text("import os\nfrom os import environ\nos.environ['A'] = '1'\ndel os.environ['A']\n"
+                      "os.environ.pop('B', None)\nenviron.update(C='1')\nos.putenv('D', '1')\n"
+                      "def f():\n    os.environ.setdefault('E', '1')\n    return os.environ.get('F')\n")
+    monkeypatch.setitem(MODULES, "made_up", source)
+    assert _environment_writes("made_up") == [(3, None), (4, None), (5, None), (6, None), (7, None), (9, "f")]

@@ -437,3 +437,95 @@ def test_generated_studies_run_or_fail_cleanly(tmp_path, changes):
         lines = result.stderr.strip().splitlines()
         assert lines and all(line.startswith("error: ") for line in lines), result.stderr
         assert not (folder / "out").exists()
+
+
+#: A map's request that cannot be, as the API gives it (make_request's where, --set, a study) and as
+#: the command line does: (id, where, settings, study, the API's lines, options, the command line's
+#: lines). Nothing is read: none of the files named exists, and the conflict is the only line.
+_SOURCES = "give one source of sites: a grid ({}/{}), a CSV of sites ({}) or a folder of weather files ({})"
+_API_SOURCES = _SOURCES.format("latitudes", "longitudes", "sites", "weather_dir")
+_CLI_SOURCES = _SOURCES.format("--lat", "--lon", "--sites", "--weather-dir")
+_FOLDER = "a folder's files are its sites' weather; give one"
+_YEARS = "the years of a weather source; give one with {}"
+MAP_CONFLICTS = [
+    ("grid-and-sites", {"latitudes": "0", "sites": "s.csv"}, [], None, [f"latitudes, sites: {_API_SOURCES}"],
+     ["--lat", "0", "--sites", "s.csv"], [f"--lat, --sites: {_CLI_SOURCES}"]),
+    ("longitudes-and-folder", {"longitudes": "0", "weather_dir": "w"}, [], None,
+     [f"longitudes, weather_dir: {_API_SOURCES}"], ["--lon", "0", "--weather-dir", "w"],
+     [f"--lon, --weather-dir: {_CLI_SOURCES}"]),
+    ("all-three", {"latitudes": "0", "longitudes": "0", "sites": "s.csv", "weather_dir": "w"}, [], None,
+     [f"latitudes/longitudes, sites, weather_dir: {_API_SOURCES}"],
+     ["--lat", "0", "--lon", "0", "--sites", "s.csv", "--weather-dir", "w"],
+     [f"--lat/--lon, --sites, --weather-dir: {_CLI_SOURCES}"]),
+    ("land-of-sites", {"sites": "s.csv", "land_only": True}, [], None,
+     ["land_only: only for a latitudes/longitudes grid, not sites"], ["--sites", "s.csv", "--land-only"],
+     ["--land-only: only for a --lat/--lon grid, not --sites"]),
+    ("land-of-a-folder", {"weather_dir": "w", "land_only": True}, [], None,
+     ["land_only: only for a latitudes/longitudes grid, not weather_dir"], ["--weather-dir", "w", "--land-only"],
+     ["--land-only: only for a --lat/--lon grid, not --weather-dir"]),
+    ("source-and-folder", {"weather_dir": "w", "weather": {"source": "pvgis-tmy"}}, [], None,
+     [f"weather.source / weather_dir: {_FOLDER}"], ["--weather-dir", "w", "--weather", "pvgis-tmy"],
+     [f"--weather / --weather-dir: {_FOLDER}"]),
+    ("set-source-and-folder", {"weather_dir": "w"}, ["weather.source=pvgis-tmy"], None,
+     [f"weather.source / weather_dir: {_FOLDER}"], ["--weather-dir", "w", "--set", "weather.source=pvgis-tmy"],
+     [f"weather.source / --weather-dir: {_FOLDER}"]),
+    ("study-source-and-folder", {"weather_dir": "w"}, [], {"weather": {"source": "pvgis-tmy"}},
+     [f"weather.source (the study's) / weather_dir: {_FOLDER}"], ["--weather-dir", "w"],
+     [f"weather.source (the study's) / --weather-dir: {_FOLDER}"]),
+    ("years-alone", {"sites": "s.csv", "weather": {"years": "2005:2020"}}, [], None,
+     [f"weather.years: {_YEARS.format('weather.source')}"], ["--sites", "s.csv", "--years", "2005:2020"],
+     [f"--years: {_YEARS.format('--weather')}"]),
+    ("set-years-alone", {"sites": "s.csv"}, ["weather.years=2005:2020"], None,
+     [f"weather.years: {_YEARS.format('weather.source')}"], ["--sites", "s.csv", "--set", "weather.years=2005:2020"],
+     [f"weather.years: {_YEARS.format('--weather')}"]),
+    ("study-years-alone", {"sites": "s.csv"}, [], {"weather": {"years": "2005:2020"}},
+     [f"weather.years (the study's): {_YEARS.format('weather.source')}"], ["--sites", "s.csv"],
+     [f"weather.years (the study's): {_YEARS.format('--weather')}"]),
+    ("two-sources-and-land", {"sites": "s.csv", "weather_dir": "w", "land_only": True}, [], None,
+     [f"sites, weather_dir: {_API_SOURCES}", "land_only: only for a latitudes/longitudes grid, not sites"],
+     ["--sites", "s.csv", "--weather-dir", "w", "--land-only"],
+     [f"--sites, --weather-dir: {_CLI_SOURCES}", "--land-only: only for a --lat/--lon grid, not --sites"]),
+]
+
+
+@pytest.mark.parametrize("where,settings,study,api,options,cli", [case[1:] for case in MAP_CONFLICTS],
+                         ids=[case[0] for case in MAP_CONFLICTS])
+def test_a_maps_sites_and_weather_are_checked_at_the_front_door(place, where, settings, study, api, options, cli):
+    """The front door refuses what a map's sites and weather cannot be together, for the API in its
+    parameters' names and for ``foldopt map`` in its options' (the command line checks only how it
+    asks for its cluster), each before any site or weather file is read."""
+    from foldopt.errors import ConfigError
+    from foldopt.studies.request import make_request
+
+    data = {**FAST, **study} if study else None
+    with pytest.raises(ConfigError) as refused:
+        make_request("map", data, settings=settings, where=where)
+    assert refused.value.errors == api
+    if study:
+        study_file(place, "study.yaml", fast_yaml(**study))
+        options = [*options, "--config", "study.yaml"]
+    before = snapshot(place / "prior")
+    result = runner.invoke(app, ["map", *options, "--out", "prior", "--overwrite"])
+    assert (result.exit_code, result.stdout) == (2, "")
+    assert result.stderr.splitlines() == [f"error: {line}" for line in cli]
+    assert snapshot(place / "prior") == before
+
+
+def test_a_maps_loads_are_given_one_way():
+    """--p-load and --p-load-fraction both give a map's loads: one of them, said in one line."""
+    result = runner.invoke(app, ["map", "--p-load", "1", "--p-load-fraction", "0.5", "--out", "never"])
+    assert (result.exit_code, result.stderr.splitlines()) == (2, [
+        "error: --p-load / --p-load-fraction: give loads one way, in watts or as fractions of each site's flat peak"])
+
+
+def test_world_map_refuses_a_studys_years_without_a_source(tmp_path):
+    """foldopt.world_map makes its request at the same front door: a study's weather years with no
+    source to take them from are refused, not ignored, before any site is read."""
+    import foldopt
+    from foldopt.errors import ConfigError
+
+    with pytest.raises(ConfigError) as refused:
+        foldopt.world_map(sites=str(tmp_path / "none.csv"), out=tmp_path / "map",
+                          study={**FAST, "weather": {"years": "2005:2020"}})
+    assert refused.value.errors == [f"weather.years (the study's): {_YEARS.format('weather.source')}"]
+    assert not (tmp_path / "map").exists()

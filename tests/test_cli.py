@@ -259,14 +259,48 @@ def test_an_option_given_twice_is_refused(tmp_path, args, words):
 
 
 @pytest.mark.parametrize("before", [None, "0"])
-def test_quiet_leaves_an_in_process_callers_environment_as_it_was(monkeypatch, before):
-    """--quiet sets FOLDOPT_QUIET for the command (the caches' notices, the workers); the caller's
-    environment is restored when the command ends, here on a refusal after the output was set up."""
+def test_quiet_silences_notices_for_the_command_only_and_sets_no_variable(monkeypatch, capsys, before):
+    """--quiet silences foldopt's notices (a damaged cache entry, here weather list's) while the
+    command runs, through a context variable: the caller's environment is untouched, and its own
+    notices are heard again once the command ends, on a refusal as on a success."""
     import os
+
+    import foldopt.inputs.weather.sources as sources
+    from foldopt.cache import notice, quiet
 
     if before is None:
         monkeypatch.delenv("FOLDOPT_QUIET", raising=False)
     else:
         monkeypatch.setenv("FOLDOPT_QUIET", before)
+    monkeypatch.setattr(sources, "damaged_entries", lambda: [("entry.json", "truncated")])
+    environment = dict(os.environ)
+    loud = invoke("weather", "list")
+    assert "foldopt: the cached copy entry.json is damaged (truncated)" in loud.stderr
+    hushed = invoke("weather", "list", "--quiet")
+    assert (hushed.exit_code, hushed.stderr, hushed.stdout) == (0, "", "")
     assert_one_line_error(invoke("sweep", "angle", "--quiet", "--lat", "95"), "--lat")
-    assert os.environ.get("FOLDOPT_QUIET") == before
+    assert dict(os.environ) == environment and not quiet()
+    capsys.readouterr()
+    notice("heard")  # in this process, after the commands: not silenced
+    assert capsys.readouterr().err == "foldopt: heard\n"
+    monkeypatch.setenv("FOLDOPT_QUIET", "yes")  # the environment's word for it still holds
+    assert invoke("weather", "list").stderr == "" and quiet()
+
+
+def test_quiet_reaches_the_embedded_clusters_workers(monkeypatch):
+    """The embedded cluster's worker processes take --quiet as their environment (their notices
+    of a cache built again reach the terminal), given to them explicitly."""
+    from foldopt.cache import quiet_mode
+
+    monkeypatch.delenv("FOLDOPT_QUIET", raising=False)
+    from foldopt.studies.dask_client import connect
+
+    def worker_quiet():
+        from foldopt.cache import quiet
+
+        return quiet()
+
+    with quiet_mode(), connect(workers=1) as (client, _):
+        assert list(client.run(worker_quiet).values()) == [True]
+    with connect(workers=1) as (client, _):
+        assert list(client.run(worker_quiet).values()) == [False]

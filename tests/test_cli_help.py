@@ -235,3 +235,93 @@ def test_help_loads_none_of_the_studys_modules():
     heavy = ("numpy", "pandas", "pvlib", "matplotlib", "numba", "yaml", "pydantic")
     code = f"import sys, foldopt.cli.app; print(sorted(m for m in {heavy!r} if m in sys.modules))"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "[]"
+
+
+#: The options of every sweep, as --help lists them; ``*`` marks those whose help says they take a
+#: range or a list. Recorded from main (7ff6a51) before each command became a function of its own.
+_SWEEP = ("--config --lat{o} --lon{o} --altitude --timezone --days/--date* --year --p-load{v} --load-profile "
+          "--p-load-scale{v} --area --efficiency --tilt{o} --azimuth --mode --geometry --sky --climate --weather "
+          "--years --offline --weather-format --members --seed --force-site --transposition --albedo --iam "
+          "--objective --visits --tracker --tracker-standby --pv-model --module --connection --switch-series "
+          "--no-bypass --converter-efficiency --horizon --blocking-diode --bypass-diode --converter --load-voltage "
+          "--switch-resistance --temp-air --exact-electrical --step-min --angle-step --storage-wh --min-soc --set "
+          "--out --overwrite --quiet/-q --format --engine --table")
+#: Every command's options (``/`` joins an option's spellings; an argument in capitals), recorded so.
+RECORDED = {
+    "map": "--lat* --lon* --land-only --sites --weather-dir --weather --years --offline --p-load* "
+           "--p-load-fraction* --area --efficiency --objective --year --step-min --angle-step --fold-search "
+           "--optimize --config --set --scheduler --workers --chunk-sites --show-load --show-period --resume "
+           "--out --overwrite --quiet/-q --format --engine",
+    "optimize": "--vary --fold-range --tilt-range --azimuth-range --tolerance "
+                + _SWEEP.format(o="", v="*"),
+    "reproduce": "--out --overwrite --quiet/-q --format --engine",
+    "run": "CONFIG --out --overwrite --quiet/-q --format --engine --table --set",
+    "size": "CONFIG --areas --cost-per-m2 --cost-per-w --c-grid --years --days-per-year --out --overwrite "
+            "--quiet/-q --format --table --set --storage --target-h --weather",
+    "sweep angle": _SWEEP.format(o="", v=""),
+    "sweep day": _SWEEP.format(o="*", v="*"),
+    "sweep latitude": _SWEEP.format(o="*", v="*"),
+    "sweep load": _SWEEP.format(o="*", v="*"),
+    "weather fetch": "SOURCE --lat --lon --years --no-horizon --raddatabase --url --timeout --quiet/-q --format",
+    "weather list": "--quiet/-q --format",
+    "weather path": "SOURCE --lat --lon --years --no-horizon --raddatabase --url --out --overwrite --quiet/-q "
+                    "--format",
+}
+
+
+def test_every_command_takes_the_options_it_took_before_its_options_were_shared():
+    """Each command is a function of its own whose options are the shared types of cli/options.py
+    (one value, or several where the command sweeps the field): the same options, spellings and
+    order as the generated signature gave, and a range or a list said of the same ones."""
+    found = {}
+    for path, command in LEAVES.items():
+        ctx = command.make_context(" ".join(path), [], resilient_parsing=True)
+        words = []
+        for param in command.get_params(ctx):
+            if param.name == "help":
+                continue
+            word = "/".join([*param.opts, *param.secondary_opts]) if param.param_type_name == "option" else \
+                param.name.upper()
+            words.append(word + ("*" if _SAYS_SEVERAL.search(" ".join((param.help or "").split())) else ""))
+        found[" ".join(path)] = " ".join(words)
+    assert found == RECORDED
+
+
+def test_no_command_rewrites_a_signature_or_a_docstring():
+    """Typer reads each command's own signature and docstring: nothing in foldopt/cli assigns a
+    function's ``__signature__`` or ``__doc__`` (nor through setattr)."""
+    import ast
+
+    rewrites, modules = [], sorted((Path(__file__).resolve().parent.parent / "foldopt" / "cli").glob("*.py"))
+    assert len(modules) > 5
+    for path in modules:
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            targets = node.targets if isinstance(node, ast.Assign) else \
+                [node.target] if isinstance(node, (ast.AugAssign, ast.AnnAssign)) else []
+            names = [target.attr for target in targets if isinstance(target, ast.Attribute)]
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "setattr" and len(node.args) > 1:
+                names.append(getattr(node.args[1], "value", None))
+            rewrites += [f"{path.name}:{node.lineno} {name}" for name in names
+                         if name in ("__signature__", "__doc__")]
+    assert rewrites == []
+
+
+def test_python_m_foldopt_runs_the_command_line(tmp_path):
+    """``python -m foldopt`` is the ``foldopt`` command: its help, its version, and a refusal as
+    one line with exit code 2, nothing written."""
+    import subprocess
+    import sys
+
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "foldopt", *args], capture_output=True, text=True,
+                              cwd=tmp_path, timeout=120)
+
+    shown = run("--help")
+    assert shown.returncode == 0 and "sweep" in shown.stdout and "Usage: python -m foldopt" in shown.stdout
+    import foldopt
+
+    assert run("--version").stdout.strip() == f"foldopt {foldopt.__version__}"
+    refused = run("sweep", "angle", "--lat", "95")
+    assert (refused.returncode, refused.stdout) == (2, "")
+    assert refused.stderr.splitlines() == ["error: --lat = 95.0: must be in [-90, 90] deg"]
+    assert list(tmp_path.iterdir()) == []

@@ -246,6 +246,22 @@ def test_a_unicode_folder_under_the_c_locale_with_an_unusable_home(tmp_path):
     assert (cache / "matplotlib").is_dir()
 
 
+def test_matplotlib_gets_a_folder_and_the_environment_is_as_it_was(tmp_path):
+    """With HOME unusable, importing foldopt's figures gives matplotlib foldopt's cache folder for
+    its configuration and fonts (it reads MPLCONFIGDIR once, as it is imported) and leaves the
+    process's environment as it was: no MPLCONFIGDIR behind the caller's back."""
+    (tmp_path / "a-file").write_text("")
+    cache = tmp_path / "cache"
+    env = foldopt_env(HOME=str(tmp_path / "a-file" / "home"), XDG_CONFIG_HOME=None, XDG_CACHE_HOME=None,
+                      MPLCONFIGDIR=None, FOLDOPT_CACHE_DIR=str(cache))
+    code = ("import os; before = dict(os.environ); import foldopt.output.figures, matplotlib; "
+            "print(dict(os.environ) == before, matplotlib.get_configdir(), matplotlib.get_cachedir())")
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=TIMEOUT)
+    assert (done.returncode, done.stderr) == (0, "")
+    assert done.stdout.split() == ["True", str(cache / "matplotlib"), str(cache / "matplotlib")]
+
+
 def _interrupt_while_writing(folder):
     """A sweep in ``folder``, sent SIGINT once its staging folder appears: its return code, stdout
     and stderr.

@@ -61,7 +61,8 @@ _OWN_OPTIONS = {"config", "settings", "out", "overwrite", "quiet", "output_forma
                 "fold_range", "tilt_range", "azimuth_range", "tolerance", "offline"}
 
 
-@pytest.mark.parametrize("path", [["sweep", "angle"], ["sweep", "load"], ["optimize"]], ids=" ".join)
+@pytest.mark.parametrize("path", [["sweep", axis] for axis in ("angle", "latitude", "day", "load")] + [["optimize"]],
+                         ids=" ".join)
 def test_the_options_that_set_fields_are_one_table(path):
     """Every option of the command that sets a study field is an entry of names.FIELD_OPTIONS,
     spelt as the command declares it, and every entry is such an option: the options become field

@@ -18,6 +18,7 @@ import atexit
 import os
 import shutil
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 from foldopt.cache import cache_dir
@@ -32,14 +33,13 @@ def _writable(folder: Path) -> bool:
     return folder.is_dir() and os.access(folder, os.W_OK)
 
 
-def _matplotlib_folder() -> None:
-    """Give matplotlib a writable folder for its configuration and font cache (``MPLCONFIGDIR``)
-    where its own under HOME is not (HOME read-only, missing or no folder): matplotlib would warn
-    on stderr, which ``--quiet`` keeps empty. foldopt's cache folder is taken where it is
-    writable (the font cache is then kept), else a temporary folder removed at exit. Run before
-    matplotlib is imported, which reads the variable once."""
+def _matplotlib_folder() -> Path | None:
+    """A writable folder for matplotlib's configuration and font cache where its own under HOME
+    is not (HOME read-only, missing or no folder), or None where it is or ``MPLCONFIGDIR`` names
+    one: matplotlib would warn on stderr, which ``--quiet`` keeps empty. foldopt's cache folder
+    where it is writable (the font cache is then kept), else a temporary folder removed at exit."""
     if os.environ.get("MPLCONFIGDIR"):
-        return
+        return None
     try:
         own = [
             Path(os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config") / "matplotlib",
@@ -48,7 +48,7 @@ def _matplotlib_folder() -> None:
     except RuntimeError:  # no home folder at all
         own = []
     if own and all(_writable(folder) for folder in own):
-        return
+        return None
     try:
         folder = cache_dir() / "matplotlib"
     except RuntimeError:
@@ -56,24 +56,42 @@ def _matplotlib_folder() -> None:
     if folder is None or not _writable(folder):
         folder = Path(tempfile.mkdtemp(prefix="foldopt-matplotlib-"))
         atexit.register(shutil.rmtree, folder, ignore_errors=True)
-    os.environ["MPLCONFIGDIR"] = str(folder)
+    return folder
+
+
+@contextmanager
+def _matplotlib_imported():
+    """matplotlib imported and its folders chosen (:func:`_matplotlib_folder`), which it does once,
+    reading ``MPLCONFIGDIR``: the variable is set for that moment only, and the environment is the
+    caller's again after (the one write of foldopt's to the environment, undone at once)."""
+    folder = _matplotlib_folder()
+    if folder is not None:
+        os.environ["MPLCONFIGDIR"] = str(folder)
+    try:
+        import matplotlib
+
+        matplotlib.get_configdir(), matplotlib.get_cachedir()  # each read once, then kept
+        yield
+    finally:
+        if folder is not None:
+            del os.environ["MPLCONFIGDIR"]
 
 
 # Every figure module imports matplotlib, and Python runs this package's __init__ before any of
-# them: the folder is set before matplotlib's first import.
-_matplotlib_folder()
-from foldopt.output.figures import (  # noqa: E402
-    annual,
-    day,
-    horizon,
-    landscape,
-    sizing,
-    storage,
-    sweep,
-    weather,
-    world,
-)
-from foldopt.output.figures.canvas import for_files, save_plot  # noqa: E402
+# them: its folders are chosen before anything draws.
+with _matplotlib_imported():
+    from foldopt.output.figures import (
+        annual,
+        day,
+        horizon,
+        landscape,
+        sizing,
+        storage,
+        sweep,
+        weather,
+        world,
+    )
+    from foldopt.output.figures.canvas import for_files, save_plot
 
 #: Every figure file a results folder can hold -> :class:`~foldopt.output.figures.canvas.FigureFile`
 #: (its plot function and what it shows), by kind of result.
