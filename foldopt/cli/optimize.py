@@ -5,8 +5,6 @@ of ``foldopt sweep`` for the site, days, loads and models (its days and loads se
 search's options making its ``optimize`` section (:func:`foldopt.studies.request.optimize_section`).
 """
 
-from __future__ import annotations
-
 from pathlib import Path
 from typing import Annotated
 

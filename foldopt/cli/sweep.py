@@ -5,8 +5,6 @@ several values (``Latitudes``, ``Days``...) where ``sweep angle``'s take one. Th
 is :func:`foldopt.studies.request.make_request`'s (:func:`foldopt.cli.run.run_options`).
 """
 
-from __future__ import annotations
-
 from pathlib import Path
 from typing import Annotated
 
