@@ -70,9 +70,8 @@ class Output:
     Parameters
     ----------
     quiet : bool
-        Print nothing but errors (and, with JSON, the document); the command's ``--quiet``, which
-        silences foldopt's notices while the command runs (the app's commands:
-        :func:`foldopt.cache.quiet_mode`).
+        Print nothing but errors (and, with JSON, the document): the command's ``--quiet``, which
+        the command itself turns into silent notices for its run (:func:`foldopt.cache.quiet_mode`).
     output_format : {'table', 'json'}
     table : bool
         Also print the full table.
