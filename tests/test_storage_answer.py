@@ -25,16 +25,14 @@ from foldopt.inputs.storage_section import Storage
 from foldopt.inputs.study import make_study
 from foldopt.inputs.study_file import default_study_path
 from foldopt.studies.answer import plain
-from foldopt.studies.storage_answer import (
+from foldopt.studies.storage_answer import folding_line, folding_part
+from foldopt.studies.storage_days import DESIGN_COLUMNS, sequential
+from foldopt.studies.storage_sizing import (
     CAPACITY_RTOL,
-    DESIGN_COLUMNS,
     _at_capacities,
     buffer_of,
     capacity_grid,
-    folding_line,
-    folding_part,
     reaches,
-    sequential,
     size_buffers,
     smallest_buffers,
 )
@@ -534,7 +532,16 @@ def test_folding_stops_paying_at_a_capacity_found_to_hold_with_one_just_below_th
     twofold = np.array([peak * scale * SINE**width for scale, width in shapes])
     curves = {"flat": flat, "tracker": flat, "tracker-net": flat, "twofold": twofold}
     angles = 180.0 - 10.0 * np.arange(len(shapes))[::-1]
-    sizing = size_buffers(curves, angles, angles[-1], load, storage, 0.5, "numba", tolerance)
+    sizing = size_buffers(
+        curves,
+        angles,
+        own=angles[-1],
+        load=load,
+        storage=storage,
+        step_hours=0.5,
+        engine="numba",
+        tolerance=tolerance,
+    )
     said, line = folding_part(sizing.folding), folding_line(sizing.folding)
     both = np.vstack([flat, twofold])
     grid = sizing.curve["capacity_wh"].to_numpy()

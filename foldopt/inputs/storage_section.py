@@ -56,7 +56,7 @@ FILLED = ("min_soc", "restart_soc", "charge_efficiency", "discharge_efficiency",
 
 class StorageTarget(StrictModel):
     """What the buffer is sized for: the load powered ``powered_h`` hours a day on ``days_pct`` of
-    the days (:mod:`foldopt.studies.storage_answer` finds each design's smallest buffer for it).
+    the days (:mod:`foldopt.studies.storage_sizing` finds each design's smallest buffer for it).
 
     Parameters
     ----------

@@ -2,9 +2,14 @@
 
 :class:`Day` is a view of one day of a :class:`foldopt.engine.sky.Sky` (times, sun, light, the electrical
 model) that gives the power of each design as arrays over fold angles x time, for reports and for
-the paper's heuristic; :func:`run_study` sweeps the fold angle through the engine, applies the
-heuristic and tabulates the comparison, for the study's connection and for the others. The
-tracker functions work on whole skies (every day at once).
+the paper's heuristic. :func:`run_study` is the day's named steps, each a function returning a
+small named result: the sweep of the fold angle through the engine (:class:`FoldSweep`), the
+refined optimum (:class:`Optimum`), every design evaluated once with the paper's heuristic
+(:class:`Designs`, :class:`Heuristic`), the summary and its notes, the tracker's standby
+(:class:`Standby`), the buffer (:class:`foldopt.studies.storage_days.DayStorage`), the
+near-optimal range and the time series. The searches they call live in the modules named for
+them (:mod:`foldopt.engine.optimize`, :mod:`foldopt.studies.storage_sizing`); what the answer says
+of the result, in :mod:`foldopt.studies.result_answers`.
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -40,7 +46,7 @@ from foldopt.studies.designs import (
     tracker_curves,
 )
 from foldopt.studies.objectives import near_optimal
-from foldopt.studies.storage_answer import day_storage
+from foldopt.studies.storage_days import BufferedDesigns, DayStorage, day_storage
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
 from foldopt.names import DEFAULT_ENGINE
@@ -70,6 +76,11 @@ class Day:
         self.ghi = None if sky.ghi is None else sky.ghi[0]
         self.dhi = None if sky.dhi is None else sky.dhi[0]
         self.transposition = study.sky_transposition()
+        #: A load profile's shape over the day, (n_time,) (P_load(t) = p_load x shape(t)); None
+        #: for a constant load.
+        self.load_shape = None if sky.load_shape is None else sky.load_shape[0]
+        #: The load [W]: the study's ``p_load``, or its curve under a load profile, (n_time,).
+        self.load_w = study.p_load if self.load_shape is None else study.p_load * self.load_shape
         self._trackers: dict = {}
         self._one_angle: dict = {}
 
@@ -222,6 +233,21 @@ class Day:
         return self.connections(fold_angles, series, with_state=False)[0][connection]
 
 
+class Standby(NamedTuple):
+    """The study's tracker's net ``t_solar`` as its standby draw grows (:func:`standby_sweep`).
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        ``standby_w``, ``t_solar_tracker_net_h``, ``t_solar_twofold_h``.
+    break_even_w : float
+        Standby draw [W] above which the twofold panel runs longer; NaN if it never does.
+    """
+
+    table: pd.DataFrame
+    break_even_w: float
+
+
 @dataclass(frozen=True)
 class StudyResult:
     """One study's results (:func:`foldopt.run`).
@@ -251,11 +277,11 @@ class StudyResult:
         refined optimum, which it always holds) and the recommended angle at its centre
         (:func:`foldopt.studies.objectives.near_optimal`) [deg], its tolerance [h] and the
         recommended angle's ``recommended_t_solar_h`` [h].
-    storage : foldopt.studies.storage_answer.DayStorage or None
+    storage : foldopt.studies.storage_days.DayStorage or None
         With the study's ``storage``: the load's powered time with the buffer per design and fold
         angle, and each design's buffer for its target; None for a storage-less study.
-    standby : tuple
-        (table, break-even draw [W]) of :func:`standby_sweep`.
+    standby : Standby
+        :func:`standby_sweep`.
     engine : str
     """
 
@@ -266,11 +292,11 @@ class StudyResult:
     timeseries: pd.DataFrame
     optimal_fold_angle: float
     heuristic_fold_angle: float
-    standby: tuple  # (table, break-even standby draw [W]) of :func:`standby_sweep`
+    standby: Standby
     engine: str = DEFAULT_ENGINE
     near_optimal: dict = dataclasses.field(default_factory=dict)
     request: object = None  # the foldopt.studies.request.Request the study came from, if any
-    storage: object = None  # the buffer's DayStorage (foldopt.studies.storage_answer), if any
+    storage: object = None  # the buffer's DayStorage (foldopt.studies.storage_days), if any
     heuristic_outside: str = ""  # where the heuristic's angle lies off the study's fold angles
 
     @functools.cached_property
@@ -281,33 +307,12 @@ class StudyResult:
         return of_study(self)
 
 
-def _best_angle(day: Day, fold_angles, sweep_t_solar, connection, with_power: bool = False):
-    """The best fold angle [deg] and its t_solar [h]: the sweep's best, refined between its
-    neighbours; ``with_power``, also its power [W], (n_time,), the refinement's curve where the
-    angle is one of the refinement's."""
-    shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
-    evaluated = {}
-
-    def compared(fold):
-        power = day.combined_power(fold, connection)
-        evaluated.update(zip(fold.tolist(), power))
-        return per_load(power, shape)
-
-    angle, hours = optimal_fold_angle(
-        compared, fold_angles, sweep_t_solar, day.study.p_load, day.step_hours
-    )
-    if not with_power:
-        return angle, hours
-    power = evaluated.get(angle)
-    return (
-        angle,
-        hours,
-        day.combined_power(np.array([angle]), connection)[0] if power is None else power,
-    )
-
-
 def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> StudyResult:
-    """Sweep the fold angle and compare flat, twofold and tracker.
+    """Sweep the fold angle and compare flat, twofold and tracker, in the day's named steps.
+
+    :func:`sweep_fold_angles` -> :func:`refine_optimum` -> :func:`compare_designs` (with
+    :func:`paper_heuristic`) -> :func:`summarise` -> :func:`standby_sweep` -> :func:`buffer_designs`
+    (with a ``storage`` section) -> :func:`near_optimal_range` -> :func:`day_timeseries`.
 
     Parameters
     ----------
@@ -329,11 +334,76 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
         switching chose.
     """
     day = Day(study)
+    sweep = sweep_fold_angles(day, engine)
+    optimum = refine_optimum(day, sweep, day.study.connection)
+    designs = compare_designs(day, sweep, optimum, engine)
+    summary = summarise(day, designs)
+    twofold = summary.loc[summary["design"] == "twofold", "t_solar_h"].iloc[0]
+    standby = standby_sweep(day, designs.tracker.power[0], twofold)
+    buffered = None
+    table = sweep.table
+    if day.study.storage is not None:
+        buffered = buffer_designs(day, sweep, designs, summary, engine)
+        summary = pd.concat([summary, buffered.designs.iloc[:, 3:]], axis=1)
+        table = table.assign(powered_h=buffered.powered_by_angle)
+    return StudyResult(
+        study=day.study,
+        day=day,
+        sweep=table,
+        summary=summary,
+        timeseries=day_timeseries(day, optimum, designs, buffered),
+        optimal_fold_angle=optimum.fold_angle_deg,
+        heuristic_fold_angle=designs.heuristic.fold_angle_deg,
+        standby=standby,
+        engine=engine,
+        near_optimal=near_optimal_range(day, sweep, optimum),
+        request=request,
+        storage=buffered,
+        heuristic_outside=designs.heuristic.outside,
+    )
+
+
+class FoldSweep(NamedTuple):
+    """The twofold panel at every fold angle of the study's grid (:func:`sweep_fold_angles`).
+
+    Attributes
+    ----------
+    fold_angles : numpy.ndarray
+        The grid [deg], (k,), ascending.
+    table : pandas.DataFrame
+        ``sweep.csv``: the metrics of the study's connection, every connection's t_solar and
+        energy, and the noon valley of the parallel curve, per fold angle.
+    t_solar_h : dict
+        Connection of :data:`foldopt.physics.connections.CONNECTIONS` -> t_solar [h], (k,).
+    curves : dict
+        ``east``, ``west`` and each connection -> power [W], (k, n_time) (:meth:`Day.connections`);
+        the series connection NaN where :attr:`series` is False.
+    series : bool
+        Whether ``curves`` hold the series connection (a load profile's served energy of a
+        series-wired study needs it).
+    """
+
+    fold_angles: np.ndarray
+    table: pd.DataFrame
+    t_solar_h: dict
+    curves: dict
+    series: bool
+
+
+def sweep_fold_angles(day: Day, engine: str) -> FoldSweep:
+    """The study's fold-angle grid through the engine, every connection at once.
+
+    Parameters
+    ----------
+    day : Day
+    engine : {'auto', 'numba', 'numpy'}
+
+    Returns
+    -------
+    FoldSweep
+    """
     study = day.study
-    p_load, step = study.p_load, day.step_hours
-    # A load profile: P_load(t) = p_load x shape(t). The flat-area multiple and the standby
-    # break-even are defined for a constant load and are left out.
-    shape = None if day.sky.load_shape is None else day.sky.load_shape[0]
+    p_load, shape = study.p_load, day.load_shape
     fold_angles = np.asarray(study.fold_angles.grid())
     metrics = engines.row_metrics(
         day.sky,
@@ -354,10 +424,10 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
         None
         if shape is None
         else energy_served(
-            curves[study.connection], p_load, shape, step, metrics.t_solar[:, own, 0]
+            curves[study.connection], p_load, shape, day.step_hours, metrics.t_solar[:, own, 0]
         )
     )
-    sweep = pd.DataFrame(
+    table = pd.DataFrame(
         {
             "fold_angle_deg": fold_angles,
             **metric_columns(
@@ -370,34 +440,102 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
             ),
         }
     )
-    sweep["noon_valley_w"] = noon_valley(curves["east"], curves["west"], curves["parallel"])
+    table["noon_valley_w"] = noon_valley(curves["east"], curves["west"], curves["parallel"])
     for index, connection in enumerate(CONNECTIONS):
-        sweep[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
-        sweep[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
+        table[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
+        table[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
+    t_solar_h = {connection: metrics.t_solar[:, i, 0] for i, connection in enumerate(CONNECTIONS)}
+    return FoldSweep(fold_angles, table, t_solar_h, curves, series)
 
-    best_angle, best_hours = _best_angle(
-        day, fold_angles, sweep["t_solar_h"].to_numpy(), study.connection
+
+class Optimum(NamedTuple):
+    """A connection's best fold angle (:func:`refine_optimum`).
+
+    Attributes
+    ----------
+    fold_angle_deg : float
+        [deg]: the sweep's best, or a better angle between its neighbours.
+    t_solar_h : float
+        [h].
+    power : numpy.ndarray
+        The connection's power at the angle [W], (n_time,): the refinement's curve where the angle
+        is one of the refinement's.
+    """
+
+    fold_angle_deg: float
+    t_solar_h: float
+    power: np.ndarray
+
+
+def refine_optimum(day: Day, sweep: FoldSweep, connection: str) -> Optimum:
+    """A connection's best fold angle, the sweep's best refined between its neighbours
+    (:func:`foldopt.engine.optimize.optimal_fold_angle`).
+
+    Parameters
+    ----------
+    day : Day
+    sweep : FoldSweep
+    connection : str
+        One of :data:`foldopt.names.CONNECTIONS`.
+
+    Returns
+    -------
+    Optimum
+    """
+    evaluated = {}
+
+    def compared(fold):
+        power = day.combined_power(fold, connection)
+        evaluated.update(zip(fold.tolist(), power))
+        return per_load(power, day.load_shape)
+
+    angle, hours = optimal_fold_angle(
+        compared,
+        sweep.fold_angles,
+        sweep.t_solar_h[connection],
+        day.study.p_load,
+        day.step_hours,
     )
-    # The designs every study compares, each evaluated once, as for sweeps, annual studies and maps
-    # (the study's tracker from the curve the figures draw); the others (the heuristic's angle, the
-    # other connections, the other trackers) from their curves. The figures and the time series
-    # draw the curves the flat and twofold rows were reduced from.
-    tracker = day.tracker()
-    main = design_metrics(
-        day.sky,
-        Blocks.of([study]),
-        np.array([p_load]),
-        np.array([best_angle]),
-        np.zeros((1, 1), dtype=int),
-        engine,
-        tracker,
-        curves=True,
-    )
-    drawn = main.pop("curves")
-    p_flat = drawn["flat"][0]
-    # Eq. 8 sets the parallel curve's noon valley to the load: with a profile, the load at solar
-    # noon (the flat panel's peak).
+    power = evaluated.get(angle)
+    if power is None:
+        power = day.combined_power(np.array([angle]), connection)[0]
+    return Optimum(angle, hours, power)
+
+
+class Heuristic(NamedTuple):
+    """The paper's fold angle (:func:`paper_heuristic`).
+
+    Attributes
+    ----------
+    fold_angle_deg : float
+        [deg]; NaN where the rule's angle lies outside the study's fold angles.
+    outside : str
+        Where it lies then: ``below`` the first fold angle or ``above`` the last; ``""`` else.
+    """
+
+    fold_angle_deg: float
+    outside: str
+
+
+def paper_heuristic(day: Day, sweep: FoldSweep, p_flat) -> Heuristic:
+    """The paper's rule (Eq. 8): the fold angle whose parallel curve's noon valley meets the load,
+    among the study's fold angles (:func:`foldopt.engine.optimize.heuristic_fold_angle`).
+
+    Parameters
+    ----------
+    day : Day
+    sweep : FoldSweep
+    p_flat : numpy.ndarray
+        The flat panel's power [W], (n_time,): under a load profile its peak is solar noon, whose
+        load the valley is set to.
+
+    Returns
+    -------
+    Heuristic
+    """
+    p_load, shape = day.study.p_load, day.load_shape
     noon_load = p_load if shape is None else p_load * shape[int(np.argmax(p_flat))]
+    fold_angles, curves = sweep.fold_angles, sweep.curves
 
     def subpanels(fold):
         # An angle of the grid (the root search's bracket) from the grid's curves.
@@ -409,29 +547,72 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
         )
 
     # The rule's angle among the study's fold angles: one outside them is no design of the study.
-    paper_angle, paper_outside = heuristic_fold_angle(
+    angle, outside = heuristic_fold_angle(
         subpanels, noon_load, lo=fold_angles[0], hi=fold_angles[-1]
     )
+    return Heuristic(angle, outside)
 
-    others = {}
-    if np.isfinite(paper_angle):
-        others["twofold-heuristic"] = (paper_angle, day.combined_power(np.array([paper_angle]))[0])
-    if day.electrical.pv.has_iv:
-        for connection in ("parallel", "series", "independent", "switching"):
-            if connection != study.connection:
-                angle, _, power = _best_angle(
-                    day,
-                    fold_angles,
-                    sweep[f"t_solar_{connection}_h"].to_numpy(),
-                    connection,
-                    with_power=True,
-                )
-                others[f"twofold-{connection}"] = (angle, power)
-    # Every other tracker model follows the study's as "tracker:<model>"; each net row is what is
-    # left for the load after the tracker's own draw.
-    for model in (m for m in TRACKERS if m != study.tracker.model):
-        others[f"tracker:{model}"] = (np.nan, day.tracker(model).power[0])
-        others[f"tracker:{model}-net"] = (np.nan, day.tracker(model).net[0])
+
+class Designs(NamedTuple):
+    """Every design a day compares, evaluated once (:func:`compare_designs`).
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        One row per design as the report shows them (flat, the twofold panels, the trackers):
+        ``design``, ``fold_angle_deg`` and :func:`foldopt.engine.metrics.metric_columns`.
+    power : dict
+        Design -> the curve its row was reduced from [W], (n_time,).
+    at_optimum : dict
+        Connection of :data:`foldopt.physics.connections.CONNECTIONS` -> the twofold panel's power
+        at the optimum [W], (n_time,).
+    tracker : foldopt.studies.designs.TrackerCurves
+        The study's tracker.
+    heuristic : Heuristic
+    """
+
+    table: pd.DataFrame
+    power: dict
+    at_optimum: dict
+    tracker: TrackerCurves
+    heuristic: Heuristic
+
+
+def compare_designs(day: Day, sweep: FoldSweep, optimum: Optimum, engine: str) -> Designs:
+    """Every design at its angle: flat, twofold at the optimum and the trackers gross and
+    net (:func:`foldopt.studies.designs.design_metrics`, as for sweeps, annual studies and maps),
+    the paper's heuristic, each other connection at its own optimum and every other tracker.
+
+    Parameters
+    ----------
+    day : Day
+    sweep : FoldSweep
+    optimum : Optimum
+        The study's connection's.
+    engine : {'auto', 'numba', 'numpy'}
+
+    Returns
+    -------
+    Designs
+    """
+    study, shape = day.study, day.load_shape
+    p_load, step = study.p_load, day.step_hours
+    # The study's tracker from the curve the figures draw; the figures and the time series draw
+    # the curves the flat and twofold rows were reduced from.
+    tracker = day.tracker()
+    main = design_metrics(
+        day.sky,
+        Blocks.of([study]),
+        np.array([p_load]),
+        np.array([optimum.fold_angle_deg]),
+        np.zeros((1, 1), dtype=int),
+        engine,
+        tracker,
+        curves=True,
+    )
+    drawn = main.pop("curves")
+    heuristic = paper_heuristic(day, sweep, drawn["flat"][0])
+    others = _other_designs(day, sweep, heuristic)
     power = np.stack([power for _, power in others.values()])
     curve = engines.curve_metrics(
         power, [p_load], step, contiguous=True, engine=engine, load_shape=shape
@@ -450,14 +631,14 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
     # The rows as the report shows them: flat, the twofold panels, then the trackers.
     angle_of = {
         "flat": 180.0,
-        "twofold": best_angle,
+        "twofold": optimum.fold_angle_deg,
         **{name: angle for name, (angle, _) in others.items() if name.startswith("twofold")},
         "tracker": np.nan,
         "tracker-net": np.nan,
         **{name: angle for name, (angle, _) in others.items() if name.startswith("tracker")},
     }
     order = [[*DESIGNS, *others].index(name) for name in angle_of]
-    summary = pd.DataFrame(
+    table = pd.DataFrame(
         {
             "design": list(angle_of),
             "fold_angle_deg": list(angle_of.values()),
@@ -467,12 +648,63 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
             },
         }
     )
+    at_optimum = {connection: drawn[connection][0, 0] for connection in CONNECTIONS}
+    power = {
+        "flat": drawn["flat"][0],
+        "twofold": at_optimum[study.connection],
+        "tracker": tracker.power[0],
+        "tracker-net": tracker.net[0],
+        **{name: power for name, (_, power) in others.items()},
+    }
+    return Designs(table, power, at_optimum, tracker, heuristic)
+
+
+def _other_designs(day: Day, sweep: FoldSweep, heuristic: Heuristic) -> dict:
+    """The designs :func:`foldopt.studies.designs.design_metrics` leaves out: name -> (fold angle
+    [deg], NaN for a tracker; power [W], (n_time,)): the paper's heuristic, with I-V models each
+    other connection at its own optimum, and every other tracker model as ``tracker:<model>``,
+    gross and net of its own draw."""
+    study = day.study
+    others = {}
+    if np.isfinite(heuristic.fold_angle_deg):
+        angle = heuristic.fold_angle_deg
+        others["twofold-heuristic"] = (angle, day.combined_power(np.array([angle]))[0])
+    if day.electrical.pv.has_iv:
+        for connection in ("parallel", "series", "independent", "switching"):
+            if connection != study.connection:
+                best = refine_optimum(day, sweep, connection)
+                others[f"twofold-{connection}"] = (best.fold_angle_deg, best.power)
+    for model in (m for m in TRACKERS if m != study.tracker.model):
+        others[f"tracker:{model}"] = (np.nan, day.tracker(model).power[0])
+        others[f"tracker:{model}-net"] = (np.nan, day.tracker(model).net[0])
+    return others
+
+
+def summarise(day: Day, designs: Designs) -> pd.DataFrame:
+    """The day's summary: each design against flat and the tracker, the flat panel's area
+    that would run the load as long, and each row's note.
+
+    Parameters
+    ----------
+    day : Day
+    designs : Designs
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``designs.table`` with ``gain_vs_flat_pct``, ``pct_of_tracker``, ``flat_area_multiple``
+        (NaN under a load profile: it is defined for a constant load) and ``note``.
+    """
+    study = day.study
+    summary = designs.table.copy()
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
     summary["pct_of_tracker"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
     summary["flat_area_multiple"] = [
-        flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 and shape is None else np.nan
+        flat_area_multiple(designs.power["flat"], study.p_load, hours, day.step_hours)
+        if hours > 0 and day.load_shape is None
+        else np.nan
         for hours in summary["t_solar_h"]
     ]
     # Each row's circuit first: a connection the study's circuit cannot wire (independent's
@@ -493,105 +725,10 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
         design_condition(condition, summary["energy_harvested_wh"].to_numpy(float)),
         summary["t_solar_h"].to_numpy(),
     )
-    standby = standby_sweep(day, tracker.power[0], by_design["twofold"])
-    buffered = None
-    if study.storage is not None:
-        # Every row's curve, the one its t_solar was reduced from, through the study's buffer; a
-        # net tracker's whole power, with its own draw a load beside the device's.
-        nets = {
-            "tracker-net": tracker,
-            **{f"tracker:{m}-net": day.tracker(m) for m in TRACKERS if m != study.tracker.model},
-        }
-        power_of = {
-            "flat": p_flat,
-            "twofold": drawn[study.connection][0, 0],
-            "tracker": tracker.power[0],
-            **{name: power for name, (_, power) in others.items()},
-            **{name: net.power[0] for name, net in nets.items()},
-        }
-        own_series = study.connection == "series" or study.switch_series
-        buffered = day_storage(
-            study,
-            step,
-            p_load if shape is None else (p_load * shape)[None, :],
-            fold_angles,
-            curves[study.connection]
-            if series or not own_series
-            else day.combined_power(fold_angles),
-            {name: (angle, power_of[name]) for name, angle in angle_of.items()},
-            summary["t_solar_h"].to_numpy(),
-            engine,
-            {name: net.draw[0] for name, net in nets.items()},
-        )
-        summary = pd.concat([summary, buffered.designs.iloc[:, 3:]], axis=1)
-        sweep["powered_h"] = buffered.powered_by_angle
-
-    at_best = {connection: drawn[connection][0, 0] for connection in CONNECTIONS}
-    # The state switching chose (no table's number comes from it) from the reference path's parts.
-    state = day.connections(np.array([best_angle]))[1][0]
-    timeseries = pd.DataFrame(
-        {
-            "solar_zenith": day.solar_zenith,
-            "solar_azimuth": day.solar_azimuth,
-            "dni": day.dni,
-            # The light and air every step of the day used (the weather's, or the clear sky's).
-            **({"ghi": day.ghi, "dhi": day.dhi} if day.ghi is not None else {}),
-            "temp_air": (
-                day.sky.temp_steps[0]
-                if day.sky.temp_steps is not None
-                else np.full(day.dni.shape, day.sky.temp_air[0])
-            ),
-            **({"wind_speed": day.sky.wind_speed[0]} if day.sky.wind_speed is not None else {}),
-            "p_flat_w": p_flat,
-            **{f"p_{connection}_w": at_best[connection] for connection in CONNECTIONS},
-            "p_twofold_w": at_best[study.connection],
-            "switch_state": np.where(
-                at_best["switching"] > 0, np.array(SWITCH_STATES)[state], "off"
-            ),
-            "p_tracker_w": tracker.power[0],
-            "p_load_w": p_load if shape is None else p_load * shape,
-            **(
-                {}
-                if buffered is None
-                else {f"soc_{name}": soc for name, soc in buffered.soc.items()}
-            ),
-        },
-        index=pd.DatetimeIndex(day.times, name="time"),
-    )
-    # The range is taken over every angle evaluated, the refined optimum among the grid's, so that it
-    # holds the best angle (the grid's own range may end on the far side of a refined optimum).
-    evaluated = sweep.set_index("fold_angle_deg")["t_solar_h"]
-    evaluated = pd.concat(
-        [evaluated[evaluated.index != best_angle], pd.Series({best_angle: best_hours})]
-    ).sort_index()
-    near = {
-        key: float(value)
-        for key, value in near_optimal(
-            evaluated.index, evaluated.to_numpy(), study.near_optimal
-        ).items()
-    }
-    recommended = near["recommended_fold_angle_deg"]
-    near["recommended_t_solar_h"] = (
-        float(evaluated[recommended]) if recommended == recommended else float("nan")
-    )
-    return StudyResult(
-        study,
-        day,
-        sweep,
-        summary,
-        timeseries,
-        best_angle,
-        paper_angle,
-        standby,
-        engine,
-        near,
-        request,
-        buffered,
-        paper_outside,
-    )
+    return summary
 
 
-def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101):
+def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101) -> Standby:
     """The study's tracker's net ``t_solar`` as its standby draw grows, and the break-even draw.
 
     A standby draw ``s`` while the sun is up leaves the load ``P_pv - drive - s``; over daylight
@@ -611,20 +748,20 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
 
     Returns
     -------
-    table : pandas.DataFrame
-        ``standby_w``, ``t_solar_tracker_net_h``, ``t_solar_twofold_h``.
-    break_even_w : float
-        Standby draw [W] above which the twofold panel runs longer; NaN if it never does.
+    Standby
     """
     study, step = day.study, day.step_hours
     if day.sky.load_shape is not None:  # a standby draw is a load shift only for a constant load
-        return pd.DataFrame(
-            {
-                "standby_w": [0.0],
-                "t_solar_tracker_net_h": [np.nan],
-                "t_solar_twofold_h": [twofold_t_solar],
-            }
-        ), float("nan")
+        return Standby(
+            pd.DataFrame(
+                {
+                    "standby_w": [0.0],
+                    "t_solar_tracker_net_h": [np.nan],
+                    "t_solar_twofold_h": [twofold_t_solar],
+                }
+            ),
+            float("nan"),
+        )
     available = standby_available(
         p_tracker, day.tracker_draw(), day.sky.lit[0], study.tracker.standby_w
     )
@@ -635,7 +772,142 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
     table = pd.DataFrame(
         {"standby_w": draws, "t_solar_tracker_net_h": hours, "t_solar_twofold_h": twofold_t_solar}
     )
-    return table, break_even
+    return Standby(table, break_even)
+
+
+def buffer_designs(
+    day: Day, sweep: FoldSweep, designs: Designs, summary: pd.DataFrame, engine: str
+) -> DayStorage:
+    """With the study's ``storage``: Every row's curve, the one its t_solar was reduced
+    from, and the twofold panel at every angle of the grid through the study's buffer
+    (:func:`foldopt.studies.storage_days.day_storage`); a net tracker's whole power, with its own
+    draw a load beside the device's.
+
+    Parameters
+    ----------
+    day : Day
+    sweep : FoldSweep
+    designs : Designs
+    summary : pandas.DataFrame
+        :func:`summarise`'s: each row's fold angle and t_solar without the buffer.
+    engine : {'auto', 'numba', 'numpy'}
+
+    Returns
+    -------
+    foldopt.studies.storage_days.DayStorage
+    """
+    study = day.study
+    nets = {
+        "tracker-net": designs.tracker,
+        **{f"tracker:{m}-net": day.tracker(m) for m in TRACKERS if m != study.tracker.model},
+    }
+    power = {**designs.power, **{name: net.power[0] for name, net in nets.items()}}
+    own_series = study.connection == "series" or study.switch_series
+    return day_storage(
+        study,
+        BufferedDesigns(
+            fold_angle_deg=dict(zip(summary["design"], summary["fold_angle_deg"], strict=True)),
+            power={name: power[name] for name in summary["design"]},
+            t_solar_h=summary["t_solar_h"].to_numpy(),
+            draws={name: net.draw[0] for name, net in nets.items()},
+        ),
+        fold_angles=sweep.fold_angles,
+        grid_power=(
+            sweep.curves[study.connection]
+            if sweep.series or not own_series
+            else day.combined_power(sweep.fold_angles)
+        ),
+        load=day.load_w if day.load_shape is None else day.load_w[None, :],
+        step_hours=day.step_hours,
+        engine=engine,
+    )
+
+
+def near_optimal_range(day: Day, sweep: FoldSweep, optimum: Optimum) -> dict:
+    """The near-optimal range of the fold angle and the recommended angle at its centre,
+    over every angle evaluated: the grid's and the refined optimum, so that it holds the best
+    angle (the grid's own range may end on the far side of a refined optimum).
+
+    Parameters
+    ----------
+    day : Day
+    sweep : FoldSweep
+    optimum : Optimum
+
+    Returns
+    -------
+    dict
+        :func:`foldopt.studies.objectives.near_optimal`'s [deg] and [h], as floats, and the
+        recommended angle's ``recommended_t_solar_h`` [h].
+    """
+    best = optimum.fold_angle_deg
+    evaluated = pd.Series(sweep.t_solar_h[day.study.connection], index=sweep.fold_angles)
+    evaluated = pd.concat(
+        [evaluated[evaluated.index != best], pd.Series({best: optimum.t_solar_h})]
+    ).sort_index()
+    near = {
+        key: float(value)
+        for key, value in near_optimal(
+            evaluated.index, evaluated.to_numpy(), day.study.near_optimal
+        ).items()
+    }
+    recommended = near["recommended_fold_angle_deg"]
+    near["recommended_t_solar_h"] = (
+        float(evaluated[recommended]) if recommended == recommended else float("nan")
+    )
+    return near
+
+
+def day_timeseries(
+    day: Day, optimum: Optimum, designs: Designs, buffered: DayStorage | None
+) -> pd.DataFrame:
+    """Step 8: ``timeseries.csv``: the day's sun, light and air, and the curves of flat, every
+    connection at the optimum and the tracker, with the state switching chose (no table's number
+    comes from it: it is the reference path's) and the buffer's state of charge.
+
+    Parameters
+    ----------
+    day : Day
+    optimum : Optimum
+    designs : Designs
+    buffered : foldopt.studies.storage_days.DayStorage or None
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by the day's tz-aware step centres (``time``).
+    """
+    at_best = designs.at_optimum
+    state = day.connections(np.array([optimum.fold_angle_deg]))[1][0]
+    return pd.DataFrame(
+        {
+            "solar_zenith": day.solar_zenith,
+            "solar_azimuth": day.solar_azimuth,
+            "dni": day.dni,
+            # The light and air every step of the day used (the weather's, or the clear sky's).
+            **({"ghi": day.ghi, "dhi": day.dhi} if day.ghi is not None else {}),
+            "temp_air": (
+                day.sky.temp_steps[0]
+                if day.sky.temp_steps is not None
+                else np.full(day.dni.shape, day.sky.temp_air[0])
+            ),
+            **({"wind_speed": day.sky.wind_speed[0]} if day.sky.wind_speed is not None else {}),
+            "p_flat_w": designs.power["flat"],
+            **{f"p_{connection}_w": at_best[connection] for connection in CONNECTIONS},
+            "p_twofold_w": at_best[day.study.connection],
+            "switch_state": np.where(
+                at_best["switching"] > 0, np.array(SWITCH_STATES)[state], "off"
+            ),
+            "p_tracker_w": designs.tracker.power[0],
+            "p_load_w": day.load_w,
+            **(
+                {}
+                if buffered is None
+                else {f"soc_{name}": soc for name, soc in buffered.soc.items()}
+            ),
+        },
+        index=pd.DatetimeIndex(day.times, name="time"),
+    )
 
 
 def twofold_t_solar(day: Day, fold_angle: float, connection=None) -> float:

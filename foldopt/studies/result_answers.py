@@ -15,7 +15,8 @@ import pandas as pd
 
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
-from foldopt.studies.storage_answer import buffer_text, sequential, year_lines
+from foldopt.studies.storage_answer import answer_part, buffer_text, year_lines
+from foldopt.studies.storage_days import DESIGN_COLUMNS, sequential
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES, FLAT_FOLD_ANGLE
 from foldopt.studies.worldmap import searched_tilt
 
@@ -273,7 +274,7 @@ def of_study(result) -> Answer:
         "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
         "pct_of_tracker": float(twofold["pct_of_tracker"]),
         "flat_area_multiple": float(twofold["flat_area_multiple"]),
-        "break_even_standby_tracker_w": float(result.standby[1]),
+        "break_even_standby_tracker_w": float(result.standby.break_even_w),
         **near,
         "t_solar_by_design_h": {d: float(by.loc[d, "t_solar_h"]) for d in MAIN_DESIGNS},
     }
@@ -306,10 +307,10 @@ def of_study(result) -> Answer:
     extras = []
     if twofold["flat_area_multiple"] == twofold["flat_area_multiple"]:
         extras.append(f"a flat panel would need {twofold['flat_area_multiple']:.2f}x the area")
-    if result.standby[1] == result.standby[1]:
+    if result.standby.break_even_w == result.standby.break_even_w:
         extras.append(
             f"the twofold panel outlasts the tracker once its standby draw exceeds "
-            f"{result.standby[1]:.2f} W"
+            f"{result.standby.break_even_w:.2f} W"
         )
     if extras:
         lines.append("; ".join(extras))
@@ -325,8 +326,6 @@ def of_study(result) -> Answer:
     buffered = getattr(result, "storage", None)
     if buffered is not None:
         # The buffer's part, said once here for every view (studies.storage_answer).
-        from foldopt.studies.storage_answer import DESIGN_COLUMNS, answer_part
-
         result_part["storage"], more = answer_part(buffered)
         lines += more
         columns[3:3] = DESIGN_COLUMNS

@@ -42,7 +42,7 @@ from foldopt.studies.objectives import (
 )
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
-from foldopt.studies.storage_answer import powered_by_angle, year_storage
+from foldopt.studies.storage_days import YearChoice, YearDays, powered_by_angle, year_storage
 from foldopt.names import DEFAULT_ENGINE
 
 
@@ -332,7 +332,15 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
     }
     if buffered:
         extras["storage_annual"] = _year_buffer(
-            blocks, parts, skies, loads, objective, fold_angles, fixed, drawn, engine
+            blocks,
+            parts,
+            skies,
+            loads,
+            objective=objective,
+            fold_angles=fold_angles,
+            fixed=fixed,
+            drawn=drawn,
+            engine=engine,
         )
     group = {name: np.concatenate([m[name] for m in metrics]) for name in metrics[0]}
     if members > 1:
@@ -349,28 +357,29 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
 CURVE_BYTES = 100e6
 
 
-def _year_buffer(blocks, parts, skies, loads, objective, fold_angles, fixed, drawn, engine):
+def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, drawn, engine):
     """storage_annual: the buffer over an annual group's days for each design, the twofold panel
     at the angle t_solar's objective keeps and at the one the objective of daily powered time
     keeps, simulated at every angle of the grid (a chunk of angles' curves at a time)."""
     study = blocks.study
     shapes = [sky.load_shape for sky in skies]
-    load_shape = None if shapes[0] is None else np.concatenate(shapes)
-    step_hours, weather = skies[0].step_hours, study.weather is not None
+    days = YearDays(
+        loads=loads,
+        load_shape=None if shapes[0] is None else np.concatenate(shapes),
+        dates=blocks.dates,
+        step_hours=skies[0].step_hours,
+        weather=study.weather is not None,
+    )
     per_angle = len(blocks) * skies[0].n_steps * 8
     size = max(1, int(CURVE_BYTES // per_angle))
     powered = powered_by_angle(
         study.storage,
+        days,
         (
             _twofold_curves(blocks, parts, skies, fold_angles[first : first + size], engine)
             for first in range(0, fold_angles.size, size)
         ),
-        loads,
-        load_shape,
-        blocks.dates,
-        step_hours,
-        weather,
-        engine,
+        engine=engine,
     )  # (days, loads, angles)
     months = [date.month for date in blocks.dates]
     score = objective_value(powered, months, objective.statistic, objective.months)
@@ -383,29 +392,19 @@ def _year_buffer(blocks, parts, skies, loads, objective, fold_angles, fixed, dra
     drawn["twofold-buffer"] = curves[which].transpose(1, 0, 2)  # (days, loads, steps)
     own = {"tracker-net": drawn.pop("tracker-net-draw")}
     tracker = np.full(loads.size, np.nan)
-    return year_storage(
-        study.storage,
-        drawn,
-        loads,
-        load_shape,
-        blocks.dates,
-        step_hours,
-        weather,
-        engine,
-        {
-            "site": study.site,
-            "objective": objective,
-            "fold_angle_deg": {
-                "flat": np.full(loads.size, 180.0),
-                "twofold": fold_angles[fixed],
-                "twofold-buffer": fold_angles[best],
-                "tracker": tracker,
-                "tracker-net": tracker,
-            },
-            "near": near_optimal(fold_angles, score, study.near_optimal),
+    choice = YearChoice(
+        site=study.site,
+        objective=objective,
+        fold_angle_deg={
+            "flat": np.full(loads.size, 180.0),
+            "twofold": fold_angles[fixed],
+            "twofold-buffer": fold_angles[best],
+            "tracker": tracker,
+            "tracker-net": tracker,
         },
-        own,
+        near=near_optimal(fold_angles, score, study.near_optimal),
     )
+    return year_storage(study.storage, days, drawn, choice, engine=engine, draws=own)
 
 
 def _twofold_curves(blocks: Blocks, parts, skies, angles, engine) -> np.ndarray:
