@@ -103,6 +103,27 @@ def test_a_study_without_storage_is_the_study_it_was(storage_less):
     )
 
 
+def _keys(value):
+    """Every key of the dicts in ``value``, however deep (lists of dicts included)."""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            yield key
+            yield from _keys(item)
+    elif isinstance(value, list):
+        for item in value:
+            yield from _keys(item)
+
+
+def test_every_key_of_a_buffer_s_answer_is_written_in_the_source():
+    # Issue 48: a key of the answer is found by searching the package for it, in quotes (a key
+    # built at run time from its parts is found by no search).
+    part = _run(IDEAL_24H, p_load=CARRIED).answer.result["storage"]
+    source = "\n".join(path.read_text() for path in (ROOT / "foldopt").rglob("*.py"))
+    keys = set(_keys(part))
+    assert {"powered_by_design_h", "capacity_by_design_wh", "capacity_wh"} <= keys
+    assert sorted(key for key in keys if f'"{key}"' not in source) == []
+
+
 def test_powered_time_never_falls_as_the_buffer_grows():
     # An ideal controller (no hysteresis, no leak): on the curve of every design, and on a finer
     # independent sweep of the capacity through the engine for the flat panel.

@@ -356,12 +356,12 @@ def run_map(
                 folder,
                 finals,
                 metadata,
-                missing,
-                done,
-                started,
-                description,
-                dashboard,
-                finish,
+                computed=missing,
+                done=done,
+                started=started,
+                description=description,
+                dashboard=dashboard,
+                finish=finish,
             )
             if in_place:
                 _move_into(finals, out)
@@ -460,7 +460,7 @@ def _compute_parts(client, spec, folder, missing, done, scheduler, progress) -> 
 
 
 def _assemble(
-    spec, folder, finals, metadata, computed, done, started, description, dashboard, finish
+    spec, folder, finals, metadata, *, computed, done, started, description, dashboard, finish
 ) -> MapRun:
     """Assemble the map's tables from the parts in ``folder`` and write them, ``finish``'s files
     and lastly ``run.json`` (status ``complete``) in ``finals``."""

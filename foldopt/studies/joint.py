@@ -272,7 +272,15 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
         start,
     )
     landscape = _landscape(
-        parts, study, all_axes, optimum[0][0], loads[:1], months, statistic, season, engine
+        parts,
+        study,
+        all_axes,
+        optimum[0][0],
+        loads[:1],
+        months=months,
+        statistic=statistic,
+        season=season,
+        engine=engine,
     )
     return OptimizeResult(
         study,
@@ -422,8 +430,11 @@ def _added(loads, steps, start) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _landscape(parts, study, axes, best, loads, months, statistic, season, engine) -> pd.DataFrame:
-    """The objective over fold angle x tilt at the optimum's azimuth, on :data:`LANDSCAPE_POINTS`."""
+def _landscape(
+    parts, study, axes, best, loads, *, months, statistic, season, engine
+) -> pd.DataFrame:
+    """The objective over fold angle x tilt at the optimum's azimuth, on :data:`LANDSCAPE_POINTS`
+    (the objective of ``statistic`` over the days' ``months`` in ``season``)."""
     fold_axis = (
         axes["fold_angle"]
         if axes["fold_angle"].size > 1
