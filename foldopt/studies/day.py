@@ -46,7 +46,12 @@ from foldopt.studies.designs import (
     tracker_curves,
 )
 from foldopt.studies.objectives import near_optimal
-from foldopt.studies.storage_days import BufferedDesigns, DayStorage, day_storage
+from foldopt.studies.storage_days import (
+    DESIGN_COLUMNS,
+    BufferedDesigns,
+    DayStorage,
+    day_storage,
+)
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
 from foldopt.names import DEFAULT_ENGINE
@@ -344,7 +349,7 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
     table = sweep.table
     if day.study.storage is not None:
         buffered = buffer_designs(day, sweep, designs, summary, engine)
-        summary = pd.concat([summary, buffered.designs.iloc[:, 3:]], axis=1)
+        summary = pd.concat([summary, buffered.designs[list(DESIGN_COLUMNS)]], axis=1)
         table = table.assign(powered_h=buffered.powered_by_angle)
     return StudyResult(
         study=day.study,
