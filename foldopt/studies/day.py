@@ -567,7 +567,7 @@ class Designs(NamedTuple):
         One row per design as the report shows them (flat, the twofold panels, the trackers):
         ``design``, ``fold_angle_deg`` and :func:`foldopt.engine.metrics.metric_columns`.
     power : dict
-        Design -> the curve its row was reduced from [W], (n_time,).
+        Design -> its power [W], (n_time,); a net tracker's net of its own draw.
     at_optimum : dict
         Connection of :data:`foldopt.physics.connections.CONNECTIONS` -> the twofold panel's power
         at the optimum [W], (n_time,).
@@ -618,12 +618,14 @@ def compare_designs(day: Day, sweep: FoldSweep, optimum: Optimum, engine: str) -
     drawn = main.pop("curves")
     heuristic = paper_heuristic(day, sweep, drawn["flat"][0])
     others = _other_designs(day, sweep, heuristic)
-    power = np.stack([power for _, power in others.values()])
+    stacked = np.stack([power for _, power in others.values()])
     curve = engines.curve_metrics(
-        power, [p_load], step, contiguous=True, engine=engine, load_shape=shape
+        stacked, [p_load], step, contiguous=True, engine=engine, load_shape=shape
     )
     served = (
-        None if shape is None else energy_served(power, p_load, shape, step, curve.t_solar[:, 0, 0])
+        None
+        if shape is None
+        else energy_served(stacked, p_load, shape, step, curve.t_solar[:, 0, 0])
     )
     columns = metric_columns(
         curve.t_solar[:, 0, 0],
@@ -756,7 +758,7 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
     Standby
     """
     study, step = day.study, day.step_hours
-    if day.sky.load_shape is not None:  # a standby draw is a load shift only for a constant load
+    if day.load_shape is not None:  # a standby draw is a load shift only for a constant load
         return Standby(
             pd.DataFrame(
                 {
@@ -783,8 +785,8 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
 def buffer_designs(
     day: Day, sweep: FoldSweep, designs: Designs, summary: pd.DataFrame, engine: str
 ) -> DayStorage:
-    """With the study's ``storage``: Every row's curve, the one its t_solar was reduced
-    from, and the twofold panel at every angle of the grid through the study's buffer
+    """With the study's ``storage``: every row's curve, the one its t_solar was reduced from,
+    and the twofold panel at every angle of the grid through the study's buffer
     (:func:`foldopt.studies.storage_days.day_storage`); a net tracker's whole power, with its own
     draw a load beside the device's.
 

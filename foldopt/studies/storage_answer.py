@@ -42,11 +42,12 @@ def _signed(value: float, digits: int) -> str:
 
 def folding_part(folding: FoldingPays) -> dict:
     """Where folding pays, as the answer's result holds it: ``folding_pays`` (one of
-    :data:`FOLDING_STATES`), ``folding_stops_paying_wh`` (the threshold, NaN but below one),
-    ``folding_pays_up_to_wh`` (the largest capacity evaluated at which folding pays, NaN where
-    none: a threshold's bracket's bottom), ``folding_does_not_pay_from_wh`` (the least capacity
-    from which on it pays at none evaluated, NaN where there is none above the largest at which
-    it pays: a threshold's bracket's top) and ``folding_searched_up_to_wh``, all [Wh]."""
+    :data:`~foldopt.studies.storage_sizing.FOLDING_STATES`), ``folding_stops_paying_wh`` (the
+    threshold, NaN but below one), ``folding_pays_up_to_wh`` (the largest capacity evaluated at
+    which folding pays, NaN where none: a threshold's bracket's bottom),
+    ``folding_does_not_pay_from_wh`` (the least capacity from which on it pays at none evaluated,
+    NaN where there is none above the largest at which it pays: a threshold's bracket's top) and
+    ``folding_searched_up_to_wh``, all [Wh]."""
     return {
         "folding_pays": folding.state,
         "folding_stops_paying_wh": folding.stops_wh,
@@ -57,7 +58,8 @@ def folding_part(folding: FoldingPays) -> dict:
 
 
 def folding_line(folding: FoldingPays) -> str:
-    """The answer's line on where folding pays (:func:`folding_pays`)."""
+    """The answer's line on where folding pays
+    (:func:`~foldopt.studies.storage_sizing.folding_pays`)."""
     top = _wh(folding.top_wh)
     return {
         "unknown": "whether folding pays with a buffer is not known: no capacity evaluated found "

@@ -259,7 +259,7 @@ YEAR_DESIGNS = ("flat", "twofold", "twofold-buffer", "tracker", "tracker-net")
 
 def _year_series(power, load, in_sequence: bool, draw=None):
     """Series of (rows, days, steps) curves, their load and their own draw (or None) as
-    :func:`simulate` takes them: the days in sequence, or each day its own periodic series."""
+    :func:`~foldopt.engine.storage.simulate` takes them: the days in sequence, or each day its own periodic series."""
     if in_sequence:
         return power, load, draw
     series = power.reshape(-1, 1, power.shape[-1])
@@ -389,9 +389,9 @@ def year_storage(
         ``energy_missing_wh``, ``energy_lost_wh`` (a day, the days' mean), ``days_full_pct``,
         ``days_empty_pct``; ``converged`` where every series found its periodic state; with
         ``storage.target``, ``capacity_wh``, the smallest buffer reaching it over the days
-        (:func:`smallest_buffers`; NaN: none up to the grid's top), ``capacity_vs_flat_pct``
-        and ``monotone``; the near-optimal range of ``twofold-buffer`` (NaN in the other
-        rows).
+        (:func:`~foldopt.studies.storage_sizing.smallest_buffers`; NaN: none up to the grid's
+        top), ``capacity_vs_flat_pct`` and ``monotone``; the near-optimal range of
+        ``twofold-buffer`` (NaN in the other rows).
     """
     engine = storage_engine(engine)
     loads = np.asarray(days.loads, dtype=float)
