@@ -4,7 +4,7 @@
 key of a part is written here as it is read. The numbers are
 :mod:`foldopt.studies.storage_days`' and :mod:`foldopt.studies.storage_sizing`'s.
 
-The module may import numpy, pandas, :mod:`foldopt.engine` and :mod:`foldopt.inputs`.
+The module may import numpy, pandas and the storage modules whose numbers it says.
 """
 
 from __future__ import annotations

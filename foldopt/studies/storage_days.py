@@ -11,7 +11,8 @@ from, so that a buffer of 0 Wh gives each design's ``t_solar`` (to the last bit 
 year's days are each such a day, or, a weather file's days that follow each other, one series
 carried over from day to day (:func:`sequential`).
 
-The module may import numpy, pandas, :mod:`foldopt.engine` and :mod:`foldopt.inputs`.
+The module may import numpy, pandas, :mod:`foldopt.engine`, :mod:`foldopt.inputs` and the
+studies it builds on (:mod:`~foldopt.studies.objectives`, :mod:`~foldopt.studies.storage_sizing`).
 """
 
 from __future__ import annotations
@@ -259,7 +260,8 @@ YEAR_DESIGNS = ("flat", "twofold", "twofold-buffer", "tracker", "tracker-net")
 
 def _year_series(power, load, in_sequence: bool, draw=None):
     """Series of (rows, days, steps) curves, their load and their own draw (or None) as
-    :func:`~foldopt.engine.storage.simulate` takes them: the days in sequence, or each day its own periodic series."""
+    :func:`~foldopt.engine.storage.simulate` takes them: the days in sequence, or each day its
+    own periodic series."""
     if in_sequence:
         return power, load, draw
     series = power.reshape(-1, 1, power.shape[-1])

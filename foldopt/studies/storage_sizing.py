@@ -3,12 +3,11 @@ once: each design's smallest buffer for a stated target (:func:`size_buffers` fo
 :func:`smallest_buffers` for a year's days) and the buffer from which folding stops paying
 (:func:`folding_pays`).
 
-The sizing is a bracketed search on the
-capacity: a geometric grid of capacities (the one the figure of
-powered time against capacity draws), then the bracket between the least capacity of the grid
-reaching the target and the one below it (which does not) cut into :data:`REFINE_POINTS` + 1
-parts, the least part reaching it and the part below it the next bracket, until it is within
-:data:`CAPACITY_RTOL` of its top. The capacity given is therefore always one evaluated that
+The sizing is a bracketed search on the capacity: a geometric grid of capacities (the one the
+figure of powered time against capacity draws), then the bracket between the least capacity of
+the grid reaching the target and the one below it (which does not) cut into
+:data:`REFINE_POINTS` + 1 parts, the least part reaching it and the part below it the next
+bracket, until it is within :data:`CAPACITY_RTOL` of its top. The capacity given is therefore always one evaluated that
 reaches the target, every smaller capacity of the grid falls short of it, and so does an
 evaluated one within :data:`CAPACITY_RTOL` below it. The capacity from which folding stops
 paying is found by the same search (:func:`folding_pays`), at the capacities the sizing names too,
@@ -27,7 +26,8 @@ grid's resolution (a capacity that reaches it between two grid points that do no
 bisects only its bracket, and says, per design (``monotone``), whether every larger capacity of the
 grid reaches the target too; where one does not, the answer notes it.
 
-The module may import numpy, pandas, :mod:`foldopt.engine` and :mod:`foldopt.inputs`.
+The module may import numpy, pandas, :mod:`foldopt.engine`, :mod:`foldopt.inputs` and
+:mod:`foldopt.studies.objectives`.
 """
 
 from __future__ import annotations
