@@ -274,7 +274,7 @@ def of_study(result) -> Answer:
         "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
         "pct_of_tracker": float(twofold["pct_of_tracker"]),
         "flat_area_multiple": float(twofold["flat_area_multiple"]),
-        "break_even_standby_tracker_w": float(result.standby.break_even_w),
+        "break_even_standby_tracker_w": float(result.standby[1]),
         **near,
         "t_solar_by_design_h": {d: float(by.loc[d, "t_solar_h"]) for d in MAIN_DESIGNS},
     }
@@ -307,10 +307,10 @@ def of_study(result) -> Answer:
     extras = []
     if twofold["flat_area_multiple"] == twofold["flat_area_multiple"]:
         extras.append(f"a flat panel would need {twofold['flat_area_multiple']:.2f}x the area")
-    if result.standby.break_even_w == result.standby.break_even_w:
+    if result.standby[1] == result.standby[1]:
         extras.append(
             f"the twofold panel outlasts the tracker once its standby draw exceeds "
-            f"{result.standby.break_even_w:.2f} W"
+            f"{result.standby[1]:.2f} W"
         )
     if extras:
         lines.append("; ".join(extras))
