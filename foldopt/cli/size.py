@@ -167,7 +167,7 @@ def _size_buffer(config, target_h, storage, settings, weather, out, overwrite, o
     """``foldopt size --storage --target-h H``: the study with its buffer sized for the load to
     run ``H`` hours a day (``storage.target``), an ideal 0 Wh buffer where the study has none;
     its answer is the day's, or over a weather file's year (``--weather`` or the study's, with
-    its objective, else the mean) the annual one (:mod:`foldopt.studies.storage_answer`)."""
+    its objective, else the mean) the annual one (:mod:`foldopt.studies.storage_days`)."""
     from foldopt.cli.run import run_request
     from foldopt.studies.request import make_request
 
