@@ -43,7 +43,7 @@ from foldopt.studies.objectives import near_optimal
 from foldopt.studies.storage_answer import day_storage
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
 
 class Day:
@@ -449,7 +449,7 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
     )
     # The rows as the report shows them: flat, the twofold panels, then the trackers.
     angle_of = {
-        "flat": 180.0,
+        "flat": FLAT_FOLD_ANGLE,
         "twofold": best_angle,
         **{name: angle for name, (angle, _) in others.items() if name.startswith("twofold")},
         "tracker": np.nan,

@@ -33,7 +33,7 @@ from foldopt.engine.sky import Sky
 # Blocks and their setup are part of the designs' API (the studies take them from here).
 from foldopt.studies.blocks import CHUNK_ROW_LOADS, Blocks, setup_key  # noqa: F401
 from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
 
@@ -390,7 +390,7 @@ def design_metrics(
         )
     fold = np.stack(
         [
-            np.full((n_blocks, n_loads), 180.0),
+            np.full((n_blocks, n_loads), FLAT_FOLD_ANGLE),
             fold_angles[chosen],
             np.full((n_blocks, n_loads), np.nan),
             np.full((n_blocks, n_loads), np.nan),

@@ -40,9 +40,8 @@ from foldopt.inputs.optimize_section import DEFAULT_TILT, MAX_DESIGNS
 from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 from foldopt.studies.objectives import (
-    FLAT_FOLD_ANGLE,
     best_angle_index,
     near_optimal,
     objective_quantum,

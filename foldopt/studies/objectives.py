@@ -15,10 +15,7 @@ from scipy.interpolate import PchipInterpolator
 
 from foldopt.engine.curve_reduction import period_means
 from foldopt.inputs.sections import NearOptimal
-
-
-#: The fold angle of the flat panel [deg]: a twofold panel unfolded is the flat panel.
-FLAT_FOLD_ANGLE = 180.0
+from foldopt.names import FLAT_FOLD_ANGLE
 
 
 def best_angle_index(hours):

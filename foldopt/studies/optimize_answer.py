@@ -6,7 +6,7 @@ adds, and how much of the grid the search evaluated."""
 from __future__ import annotations
 
 from foldopt.studies.answer import Answer, records
-from foldopt.studies.objectives import FLAT_FOLD_ANGLE
+from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.result_answers import request_defaults, study_question
 
 #: How the answer names each variable and its unit.

@@ -16,7 +16,8 @@ import pandas as pd
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.storage_answer import buffer_text, sequential, year_lines
-from foldopt.studies.objectives import ENSEMBLE_PERCENTILES, FLAT_FOLD_ANGLE
+from foldopt.names import FLAT_FOLD_ANGLE
+from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
 from foldopt.studies.worldmap import searched_tilt
 
 #: The designs an answer compares, first the ones every study has.
@@ -44,7 +45,7 @@ def _pct(value, signed: bool = True) -> str:
 def _fold_text(angle: float) -> str:
     """A fold angle [deg] to a tenth of a degree, or to a thousandth where a fold short of the flat
     panel would read 180.0 (a refined optimum a few hundredths below it is not the flat panel)."""
-    short = f"{angle:.1f}" == "180.0" and angle < FLAT_FOLD_ANGLE
+    short = f"{angle:.1f}" == f"{FLAT_FOLD_ANGLE:.1f}" and angle < FLAT_FOLD_ANGLE
     return f"{angle:.3f}" if short else f"{angle:.1f}"
 
 

@@ -43,6 +43,7 @@ import pandas as pd
 
 from foldopt.engine.choice import engine_for
 from foldopt.engine.storage import Buffer, StorageResult, simulate
+from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
 
 #: The designs whose state of charge the day's figure draws and ``timeseries.csv`` holds.
@@ -238,7 +239,7 @@ def size_buffers(
         table = pd.DataFrame(
             {
                 "design": ["flat", "twofold", "tracker", "tracker-net"],
-                "fold_angle_deg": [180.0, fold_angles[pick - 3], np.nan, np.nan],
+                "fold_angle_deg": [FLAT_FOLD_ANGLE, fold_angles[pick - 3], np.nan, np.nan],
                 "capacity_wh": found,
                 "monotone": _held_above(ok[keep], first[keep]),
             }

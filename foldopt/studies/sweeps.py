@@ -43,7 +43,7 @@ from foldopt.studies.objectives import (
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 from foldopt.studies.storage_answer import powered_by_angle, year_storage
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
 
 @dataclass(frozen=True)
@@ -396,7 +396,7 @@ def _year_buffer(blocks, parts, skies, loads, objective, fold_angles, fixed, dra
             "site": study.site,
             "objective": objective,
             "fold_angle_deg": {
-                "flat": np.full(loads.size, 180.0),
+                "flat": np.full(loads.size, FLAT_FOLD_ANGLE),
                 "twofold": fold_angles[fixed],
                 "twofold-buffer": fold_angles[best],
                 "tracker": tracker,
@@ -556,7 +556,7 @@ def objective_table(
                     "mean_t_solar_h": float(design_hours[season][:, index, d].mean()),
                     "fold_angle_deg": float(fold_angles[index])
                     if twofold
-                    else (180.0 if design == "flat" else np.nan),
+                    else (FLAT_FOLD_ANGLE if design == "flat" else np.nan),
                     **{
                         key: float(value[index]) if twofold else np.nan
                         for key, value in near.items()

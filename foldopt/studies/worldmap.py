@@ -48,9 +48,8 @@ from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
 from foldopt.studies.site_search import fold_search
 from foldopt.engine.choice import engine_for
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 from foldopt.studies.objectives import (
-    FLAT_FOLD_ANGLE,
     best_angle_index,
     near_optimal_on_grid,
     objective_value,

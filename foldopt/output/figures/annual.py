@@ -10,6 +10,7 @@ import pandas as pd
 
 from foldopt.output.figures.canvas import FigureFile, load_label, new_axes
 from foldopt.output.figures.sweep import DAY_GAP, cells
+from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.physics.connections import SWITCH_STATES
 
 MONTH_NAMES = ("J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D")
@@ -66,7 +67,7 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, study=None, ax=N
         ax.plot(chosen["fold_angle_deg"], chosen["objective_h"], "o", color=colour)
     ax.set_xlabel("fold angle Θ kept all year [deg] (180 = flat)")
     ax.set_ylabel("daily t_solar [h]")
-    ax.set_xlim(0, 180)
+    ax.set_xlim(0, FLAT_FOLD_ANGLE)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
