@@ -355,7 +355,7 @@ def _table(study, loads, optimum, flat, fold_angles, best_default, default) -> p
                     "design": design,
                     "fold_angle_deg": fold,
                     "surface_tilt": tilt,
-                    "surface_azimuth": azimuth % 360.0 if azimuth == azimuth else azimuth,
+                    "surface_azimuth": azimuth % 360.0,
                     "objective_h": value,
                     "gain_vs_flat_pct": 100.0 * (value / flat_best[index] - 1.0)
                     if flat_best[index] > 0

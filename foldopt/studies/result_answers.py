@@ -9,6 +9,7 @@ summary in words. Views only render what these build.
 from __future__ import annotations
 
 import calendar
+import math
 from pathlib import Path
 
 import pandas as pd
@@ -31,13 +32,13 @@ NEAR_OPTIMAL = (
 
 
 def _hours(value) -> str:
-    return "-" if value is None or value != value else f"{value:.2f} h"
+    return "-" if pd.isna(value) else f"{value:.2f} h"
 
 
 def _pct(value, signed: bool = True) -> str:
     return (
         "-"
-        if value is None or value != value
+        if pd.isna(value)
         else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
     )
 
@@ -236,7 +237,7 @@ def _turbidity_text(study, varied: tuple) -> str:
 
 def _range_text(row) -> str:
     lo, hi, recommended = (row.get(key) for key in NEAR_OPTIMAL[:3])
-    if lo is None or lo != lo:
+    if pd.isna(lo):
         return "near-optimal: no fold angle carries the load"
     return (
         f"near-optimal {lo:g} to {hi:g} deg (within {60 * row['near_optimal_tolerance_h']:.1f} min); "
@@ -305,9 +306,9 @@ def of_study(result) -> Answer:
         )
         lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
     extras = []
-    if twofold["flat_area_multiple"] == twofold["flat_area_multiple"]:
+    if not math.isnan(twofold["flat_area_multiple"]):
         extras.append(f"a flat panel would need {twofold['flat_area_multiple']:.2f}x the area")
-    if result.standby[1] == result.standby[1]:
+    if not math.isnan(result.standby[1]):
         extras.append(
             f"the twofold panel outlasts the tracker once its standby draw exceeds "
             f"{result.standby[1]:.2f} W"
@@ -359,7 +360,7 @@ def heuristic_text(study, heuristic: float, outside: str) -> str:
         :attr:`foldopt.studies.day.StudyResult.heuristic_outside`: ``below``, ``above`` or empty.
     """
     grid = study.fold_angles
-    if heuristic == heuristic:
+    if not math.isnan(heuristic):
         where = f"{heuristic:.1f} deg"
     elif outside == "below":
         where = f"at or below {grid.start:g} deg, the grid's first: the noon valley reaches the load there"
@@ -437,7 +438,7 @@ def of_sweep(result) -> Answer:
             f"fold angles {part['fold_angle_deg']['min']:g} to {part['fold_angle_deg']['max']:g} deg"
         )
     rec = part["recommended_fold_angle_deg"]
-    if rec["min"] == rec["min"]:
+    if not math.isnan(rec["min"]):
         lines.append(
             "recommended fold angles (each case's near-optimal centre, flat where flat is best) "
             f"{rec['min']:g} to {rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the "
@@ -760,7 +761,7 @@ def of_reproduction(tables: dict, study) -> Answer:
         )
         lines.append(f"Shin et al. ({model}): paper value | paper mode | exact mode")
         for row in table.itertuples():
-            paper = "-" if row.paper != row.paper else f"{row.paper:g}"
+            paper = "-" if math.isnan(row.paper) else f"{row.paper:g}"
             lines.append(
                 f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  "
                 f"{row.unit}"
