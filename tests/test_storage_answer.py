@@ -158,7 +158,7 @@ def test_each_design_s_buffer_reaches_the_target_and_a_smaller_one_does_not():
     line = next(line for line in result.answer.lines() if line.startswith("for 24 h:"))
     assert f"flat needs {need['flat']:.3g} Wh" in line
     saving = (need["twofold"] / need["flat"] - 1.0) * 100.0
-    assert table.loc["twofold", "capacity_vs_flat_pct"] == pytest.approx(saving, rel=1e-12)
+    assert table.loc["twofold", "capacity_gain_vs_flat_pct"] == pytest.approx(saving, rel=1e-12)
     part = result.answer.result["storage"]["sizing"]
     assert part["capacity_by_design_wh"] == {d: float(need[d]) for d in need.index}
 
@@ -199,8 +199,8 @@ def test_the_command_line_s_json_is_the_api_s_answer_to_the_bit(tmp_path, monkey
         printed["result"]["storage"]["sizing"]["capacity_by_design_wh"]["tracker"], rel=1e-9
     )
     timeseries = pd.read_csv(tmp_path / "out" / "timeseries.csv")
-    assert {"soc_flat", "soc_twofold", "soc_tracker"} <= set(timeseries.columns)
-    assert timeseries[["soc_flat", "soc_twofold", "soc_tracker"]].stack().between(0, 1).all()
+    assert {"soc_flat_frac", "soc_twofold_frac", "soc_tracker_frac"} <= set(timeseries.columns)
+    assert timeseries[["soc_flat_frac", "soc_twofold_frac", "soc_tracker_frac"]].stack().between(0, 1).all()
     html = (tmp_path / "out" / "report.html").read_text()
     assert "state_of_charge.png" in html and "for 24 h: flat needs" in html
 
@@ -287,13 +287,13 @@ def test_a_year_of_clear_days_is_each_day_s_buffer():
     days = [foldopt.run(year.plan.study({"date": d, "p_load": CARRIED})) for d in dates]
     for design in ("flat", "tracker"):
         each = [day.summary.set_index("design").loc[design, "powered_h"] for day in days]
-        assert table.loc[design, "mean_powered_h"] == pytest.approx(np.mean(each), rel=1e-9)
-        assert table.loc[design, "min_powered_h"] == pytest.approx(min(each), rel=1e-9)
+        assert table.loc[design, "powered_mean_h"] == pytest.approx(np.mean(each), rel=1e-9)
+        assert table.loc[design, "powered_min_h"] == pytest.approx(min(each), rel=1e-9)
     # The 0 Wh run is the year's t_solar of the same designs.
     objective = year.extras["annual_objective"].set_index("design")
     for design in ("flat", "twofold", "tracker"):
-        assert table.loc[design, "mean_t_solar_h"] == pytest.approx(
-            objective.loc[design, "mean_t_solar_h"], rel=1e-12
+        assert table.loc[design, "t_solar_mean_h"] == pytest.approx(
+            objective.loc[design, "t_solar_mean_h"], rel=1e-12
         )
     lines = year.answer.lines()
     assert any(line.startswith("with the 20 Wh lifepo4") for line in lines)
@@ -323,10 +323,10 @@ def test_a_year_s_fold_angle_for_the_buffer_is_the_brute_force_best():
     best = grid.size - 1 - np.argmax(mean[::-1])  # ties to the least folded
     chosen = table.loc["twofold-buffer"]
     assert chosen["fold_angle_deg"] == grid[best]
-    assert chosen["objective_powered_h"] == pytest.approx(mean[best], rel=1e-9)
+    assert chosen["powered_objective_h"] == pytest.approx(mean[best], rel=1e-9)
     # Here the buffer's choice is not t_solar's, and it runs the load longer.
     assert table.loc["twofold", "fold_angle_deg"] != grid[best]
-    assert chosen["objective_powered_h"] > table.loc["twofold", "objective_powered_h"]
+    assert chosen["powered_objective_h"] > table.loc["twofold", "powered_objective_h"]
     assert chosen["near_optimal_lo_deg"] <= grid[best] <= chosen["near_optimal_hi_deg"]
     said = year.answer.to_dict()["result"]["storage"]
     assert said["fold_angle_buffer_deg"] == grid[best]
@@ -778,9 +778,9 @@ def test_a_measured_day_s_buffer_writes_its_table(tmp_path, monkeypatch):
     cases = json.loads(result.output)["answer"]["result"]["storage"]["per_case"]
     assert [case["design"] for case in cases] == table["design"].tolist()
     for case, (_, row) in zip(cases, table.iterrows(), strict=True):
-        assert case["mean_powered_h"] == pytest.approx(row["mean_powered_h"], rel=1e-9)
+        assert case["powered_mean_h"] == pytest.approx(row["powered_mean_h"], rel=1e-9)
     line = next(
         line for line in json.loads(result.output)["answer"]["lines"] if "mean powered time" in line
     )
-    flat = table.set_index("design").loc["flat", "mean_powered_h"]
+    flat = table.set_index("design").loc["flat", "powered_mean_h"]
     assert f"flat {flat:.2f} h" in line

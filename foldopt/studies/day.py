@@ -30,7 +30,7 @@ from foldopt.engine.metrics import (
     t_solar,
 )
 from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
-from foldopt.studies.sizing import flat_area_multiple
+from foldopt.studies.sizing import flat_area_ratio
 from foldopt.studies.designs import (
     DESIGNS,
     Blocks,
@@ -236,7 +236,7 @@ class StudyResult:
     summary : pandas.DataFrame
         Per design (``flat``, ``twofold``, ``twofold-heuristic``, ``tracker``, ``tracker-net``...):
         ``fold_angle_deg``, ``t_solar_h``, ``t_solar_contiguous_h``, ``energy_harvested_wh``, ``peak_power_w``,
-        ``gain_vs_flat_pct``, ``pct_of_tracker``, ``flat_area_multiple``, ``note``.
+        ``gain_vs_flat_pct``, ``share_of_tracker_pct``, ``flat_area_ratio``, ``note``.
     timeseries : pandas.DataFrame
         Indexed by the day's tz-aware step centres (``time``): sun [deg], ``dni`` [W/m^2], the power
         [W] of every design at the optimum and the ``switch_state``.
@@ -470,9 +470,9 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
-    summary["pct_of_tracker"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
-    summary["flat_area_multiple"] = [
-        flat_area_multiple(p_flat, p_load, hours, step) if hours > 0 and shape is None else np.nan
+    summary["share_of_tracker_pct"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
+    summary["flat_area_ratio"] = [
+        flat_area_ratio(p_flat, p_load, hours, step) if hours > 0 and shape is None else np.nan
         for hours in summary["t_solar_h"]
     ]
     # Each row's circuit first: a connection the study's circuit cannot wire (independent's
@@ -553,7 +553,7 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
             **(
                 {}
                 if buffered is None
-                else {f"soc_{name}": soc for name, soc in buffered.soc.items()}
+                else {f"soc_{name}_frac": soc for name, soc in buffered.soc.items()}
             ),
         },
         index=pd.DatetimeIndex(day.times, name="time"),
@@ -570,7 +570,7 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
             evaluated.index, evaluated.to_numpy(), study.near_optimal
         ).items()
     }
-    recommended = near["recommended_fold_angle_deg"]
+    recommended = near["recommended_deg"]
     near["recommended_t_solar_h"] = (
         float(evaluated[recommended]) if recommended == recommended else float("nan")
     )

@@ -291,8 +291,8 @@ def design_metrics(
     Returns
     -------
     dict of numpy.ndarray
-        ``fold_angle_deg``, the :func:`foldopt.engine.metrics.metric_columns`, ``poa_kwh_m2`` (incident
-        irradiation [kWh/m^2]) and ``condition`` (:func:`foldopt.engine.metrics.design_condition`), each
+        ``fold_angle_deg``, the :func:`foldopt.engine.metrics.metric_columns`, ``poa_global_wh_m2`` (incident
+        irradiation [Wh/m^2]) and ``condition`` (:func:`foldopt.engine.metrics.design_condition`), each
         (n_blocks, n_loads, 4) in the order of :data:`DESIGNS`; with ``curves``, also ``curves``: a
         dict of ``flat``, (n_blocks, n_steps), and of each name of
         :data:`foldopt.physics.connections.CONNECTIONS`, (n_blocks, n_loads, n_steps).
@@ -438,12 +438,11 @@ def design_metrics(
     return {
         "fold_angle_deg": fold,
         **columns,
-        "poa_kwh_m2": per_design(
+        "poa_global_wh_m2": per_design(
             twofold.irradiation,
             np.repeat(flat.irradiation[:, None], n_loads, axis=1),
             np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1),
-        )
-        / 1000.0,
+        ),
         # A tracker whose drive costs more than it harvests says so where every table's note starts.
         "condition": design_condition(condition[:, None, None], columns["energy_harvested_wh"]),
         **drawn,

@@ -503,7 +503,10 @@ def _map_entries(options: dict, data: dict) -> list[tuple]:
     if options.get("angle_step") is not None:
         step = options["angle_step"]
         entries.append(
-            ("--angle-step", {"fold_angles": {"start": step, "stop": FLAT_FOLD_ANGLE, "step": step}})
+            (
+                "--angle-step",
+                {"fold_angles": {"start": step, "stop": FLAT_FOLD_ANGLE, "step": step}},
+            )
         )
     searched = options.get("optimize")
     if options.get("fold_search") or searched:

@@ -21,7 +21,7 @@ from foldopt.engine.metrics import load_for_t_solar
 from foldopt.names import FLAT_FOLD_ANGLE
 
 
-def flat_area_multiple(p_flat, p_load, target_t_solar, step_hours):
+def flat_area_ratio(p_flat, p_load, target_t_solar, step_hours):
     """Factor by which the flat panel's area must grow to reach ``target_t_solar``.
 
     Parameters

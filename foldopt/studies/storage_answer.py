@@ -100,7 +100,7 @@ def run_buffer(
 SUMMARY_COLUMNS = {
     "powered_h": "powered_h",
     "availability_pct": "availability_pct",
-    "days_without_outage_pct": "days_powered_24h_pct",
+    "days_without_outage_pct": "powered_days_ge24h_pct",
     "missing_wh": "energy_missing_wh",
     "lost_wh": "energy_lost_wh",
     "days_full_pct": "days_full_pct",
@@ -111,7 +111,7 @@ SUMMARY_COLUMNS = {
 def day_columns(result: StorageResult) -> dict:
     """Per series, the day's (or the mean day's) buffered metrics by the columns' names
     (:data:`SUMMARY_COLUMNS`): ``powered_h`` [h a day], ``availability_pct`` (the load's energy
-    served, of its demand), ``days_powered_24h_pct`` (days with no energy missing),
+    served, of its demand), ``powered_days_ge24h_pct`` (days with no energy missing),
     ``energy_missing_wh`` and ``energy_lost_wh`` [Wh a day], ``days_full_pct`` and
     ``days_empty_pct`` (PVGIS's), each (n_series,).
 
@@ -147,7 +147,7 @@ class Sizing:
         Per design (``flat``, ``twofold`` at the angle needing the least, ``tracker``,
         ``tracker-net``): ``design``, ``fold_angle_deg``, ``capacity_wh`` (NaN where no buffer up
         to the grid's top reaches the target), ``monotone`` (every larger capacity of the grid
-        reaches it too; module docstring) and ``capacity_vs_flat_pct``.
+        reaches it too; module docstring) and ``capacity_gain_vs_flat_pct``.
     curve : pandas.DataFrame
         ``capacity_wh`` and ``powered_{flat,twofold,tracker}_h``: powered time against capacity,
         the twofold panel at each capacity's best of the angles compared.
@@ -245,7 +245,7 @@ def size_buffers(
             }
         )
         with np.errstate(invalid="ignore", divide="ignore"):
-            table["capacity_vs_flat_pct"] = np.where(
+            table["capacity_gain_vs_flat_pct"] = np.where(
                 np.isfinite(found) & (found[0] > 0), (found / found[0] - 1.0) * 100.0, np.nan
             )
     # The capacities the sizing found are points of the search too, so that what the answer says
@@ -702,7 +702,7 @@ def day_storage(
         for key, value in near_optimal(fold_angles, by_angle, study.near_optimal).items()
     }
     best = int(best_angle_index(by_angle))
-    recommended = near["recommended_fold_angle_deg"]
+    recommended = near["recommended_deg"]
     near["recommended_powered_h"] = (
         float(by_angle[fold_angles == recommended][0]) if recommended == recommended else np.nan
     )
@@ -856,7 +856,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             "powered_h",
             "t_solar_h",
             "availability_pct",
-            "days_powered_24h_pct",
+            "powered_days_ge24h_pct",
             "energy_missing_wh",
             "energy_lost_wh",
             "days_full_pct",
@@ -894,7 +894,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             f"best fold angle for the buffer {buffered.fold_angle_deg:g} deg: powered "
             f"{best_h:.2f} h, {_signed(best_h - powered['flat'], 2)} h over flat; near-optimal "
             f"{near['near_optimal_lo_deg']:g} to {near['near_optimal_hi_deg']:g} deg, "
-            f"recommended {near['recommended_fold_angle_deg']:g} deg "
+            f"recommended {near['recommended_deg']:g} deg "
             f"({near['recommended_powered_h']:.2f} h)"
         )
     lines.append(
@@ -918,7 +918,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
         table = sizing.table.set_index("design")
         need = table["capacity_wh"]
         angle = float(table.loc["twofold", "fold_angle_deg"])
-        saving = float(table.loc["twofold", "capacity_vs_flat_pct"])
+        saving = float(table.loc["twofold", "capacity_gain_vs_flat_pct"])
         part["sizing"] = {
             "target_powered_h": target.powered_h,
             "target_days_pct": target.days_pct,
@@ -1062,13 +1062,13 @@ def year_storage(
     pandas.DataFrame
         Per load and design: ``site_name``, ``latitude``, ``longitude``, ``p_load_w``,
         ``design``, ``fold_angle_deg``, ``days``, ``objective`` (the statistic),
-        ``objective_powered_h`` (of the daily powered time), ``mean_powered_h``,
-        ``min_powered_h``, ``mean_t_solar_h`` (of the same curves, with no buffer: the 0 Wh
-        run) and :func:`day_columns`' ``availability_pct``, ``days_powered_24h_pct``,
+        ``powered_objective_h`` (of the daily powered time), ``powered_mean_h``,
+        ``powered_min_h``, ``t_solar_mean_h`` (of the same curves, with no buffer: the 0 Wh
+        run) and :func:`day_columns`' ``availability_pct``, ``powered_days_ge24h_pct``,
         ``energy_missing_wh``, ``energy_lost_wh`` (a day, the days' mean), ``days_full_pct``,
         ``days_empty_pct``; ``converged`` where every series found its periodic state; with
         ``storage.target``, ``capacity_wh``, the smallest buffer reaching it over the days
-        (:func:`smallest_buffers`; NaN: none up to the grid's top), ``capacity_vs_flat_pct``
+        (:func:`smallest_buffers`; NaN: none up to the grid's top), ``capacity_gain_vs_flat_pct``
         and ``monotone``; the near-optimal range of ``twofold-buffer`` (NaN in the other
         rows).
     """
@@ -1113,7 +1113,11 @@ def year_storage(
             )
             with np.errstate(invalid="ignore", divide="ignore"):
                 vs_flat = (need / need[0] - 1.0) * 100.0 if need[0] > 0 else np.nan * need
-            sized = {"capacity_wh": need, "capacity_vs_flat_pct": vs_flat, "monotone": monotone}
+            sized = {
+                "capacity_wh": need,
+                "capacity_gain_vs_flat_pct": vs_flat,
+                "monotone": monotone,
+            }
         score = objective_value(powered.T, months, objective.statistic, objective.months)
         angles = np.array([choice["fold_angle_deg"][d][index] for d in YEAR_DESIGNS])
         chosen = np.asarray(YEAR_DESIGNS) == "twofold-buffer"
@@ -1126,12 +1130,12 @@ def year_storage(
                     "p_load_w": p_load,
                     "design": YEAR_DESIGNS,
                     "fold_angle_deg": angles,
-                    "days": powered.shape[1],
+                    "days_n": powered.shape[1],
                     "objective": objective.statistic,
-                    "objective_powered_h": score,
-                    "mean_powered_h": powered.mean(axis=1),
-                    "min_powered_h": powered.min(axis=1),
-                    "mean_t_solar_h": bare.powered_h.reshape(shape).mean(axis=1),
+                    "powered_objective_h": score,
+                    "powered_mean_h": powered.mean(axis=1),
+                    "powered_min_h": powered.min(axis=1),
+                    "t_solar_mean_h": bare.powered_h.reshape(shape).mean(axis=1),
                     **{k: v for k, v in day_columns(result).items() if k != "powered_h"},
                     "converged": result.converged.reshape(shape[0], -1).all(axis=1),
                     **sized,
@@ -1189,12 +1193,12 @@ def _best_for_buffer(by: pd.DataFrame, angle) -> str:
     statistic = best["objective"]
     said = f"  best fold angle for the buffer ({statistic} powered time)"
     return (
-        f"{said}: {angle['twofold-buffer']:g} deg, {best['objective_powered_h']:.2f} h (t_solar's "
-        f"{angle['twofold']:g} deg: {by.loc['twofold', 'objective_powered_h']:.2f} h; flat "
-        f"{by.loc['flat', 'objective_powered_h']:.2f} h); "
+        f"{said}: {angle['twofold-buffer']:g} deg, {best['powered_objective_h']:.2f} h (t_solar's "
+        f"{angle['twofold']:g} deg: {by.loc['twofold', 'powered_objective_h']:.2f} h; flat "
+        f"{by.loc['flat', 'powered_objective_h']:.2f} h); "
         + (
             f"near-optimal {best['near_optimal_lo_deg']:g} to {best['near_optimal_hi_deg']:g} deg, "
-            f"recommended {best['recommended_fold_angle_deg']:g} deg"
+            f"recommended {best['recommended_deg']:g} deg"
             if best["near_optimal_lo_deg"] == best["near_optimal_lo_deg"]
             else f"no fold angle runs the load ({statistic} powered time 0 h at every angle): no "
             "near-optimal range"
@@ -1235,13 +1239,13 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
         lines.append(
             f"  {site}P_load {p_load:g}: mean powered time "
             + ", ".join(
-                f"{named[d]} {by.loc[d, 'mean_powered_h']:.2f} h "
-                f"(t_solar {by.loc[d, 'mean_t_solar_h']:.2f} h)"
+                f"{named[d]} {by.loc[d, 'powered_mean_h']:.2f} h "
+                f"(t_solar {by.loc[d, 't_solar_mean_h']:.2f} h)"
                 for d in YEAR_SAID
                 if d != "twofold-buffer" or _another(angle)
             )
             + "; all 24 h on "
-            + ", ".join(f"{d} {by.loc[d, 'days_powered_24h_pct']:.0f} %" for d in SOC_DESIGNS)
+            + ", ".join(f"{d} {by.loc[d, 'powered_days_ge24h_pct']:.0f} %" for d in SOC_DESIGNS)
             + " of days; days full/empty "
             + ", ".join(
                 f"{d} {by.loc[d, 'days_full_pct']:.0f}/{by.loc[d, 'days_empty_pct']:.0f} %"
@@ -1254,7 +1258,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
             said = f"{target.powered_h:g} h" + (
                 f" on {target.days_pct:g} % of days" if target.days_pct < 100 else " every day"
             )
-            need, saving = by["capacity_wh"], by["capacity_vs_flat_pct"]
+            need, saving = by["capacity_wh"], by["capacity_gain_vs_flat_pct"]
             lines.append(
                 f"  for {said}: "
                 + ", ".join(

@@ -24,7 +24,7 @@ def plot_state_of_charge(result: StudyResult, ax=None):
     Parameters
     ----------
     result : foldopt.StudyResult
-        With a buffer: its time series' ``soc_flat``, ``soc_twofold``, ``soc_tracker`` [-].
+        With a buffer: its time series' ``soc_flat_frac``, ``soc_twofold_frac``, ``soc_tracker_frac`` [-].
     ax : matplotlib.axes.Axes, optional
         Axes to draw on; default a new figure (8 x 4.5 in).
 
@@ -46,7 +46,7 @@ def plot_state_of_charge(result: StudyResult, ax=None):
         powered = summary.loc[design, "powered_h"]
         ax.plot(
             hours,
-            100.0 * series[f"soc_{design}"],
+            100.0 * series[f"soc_{design}_frac"],
             color=colour,
             label=f"{label}: powered {powered:.2f} h",
         )
