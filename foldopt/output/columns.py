@@ -491,9 +491,9 @@ def rst_table() -> str:
     words = ", ".join(DESIGN_WORDS + CONNECTION_WORDS)
     grammar = (
         "the quantity first (``t_solar``, ``energy_harvested``, ``poa_global``...), then the design "
-        f"or connection it is of ({words}), then the statistic over days or sites (``mean``, ``median``, ``min``, "
-        "``max``, ``p10``; ``objective``: the study's own; ``days_ge10h``: the days reaching 10 h; "
-        "``month01_mean``) or over a cloud ensemble's members (``members_p10``, after the "
+        f"or connection it is of ({words}), then the statistic over days or sites (``mean``, "
+        "``median``, ``min``, ``max``, ``p10``; ``objective``: the study's own; ``days_ge10h``: "
+        "the days reaching 10 h; ``month01_mean``) or over a cloud ensemble's members (``members_p10``, after the "
         "statistic over days if any), and last, always, the unit: ``t_solar_flat_mean_h`` is the "
         "flat panel's mean daily t_solar in hours. A quantity pvlib names (``latitude``, "
         "``surface_tilt``, ``dni``, ``temp_air``...) is written as pvlib writes it, in pvlib's "

@@ -8,7 +8,8 @@ import pandas as pd
 
 from foldopt.engine.metrics import relative_to
 
-#: The daily t_solar thresholds [h] whose days :func:`annual_summary` counts (``t_solar_days_ge<x>h_n``).
+#: The daily t_solar thresholds [h] whose days :func:`annual_summary` counts
+#: (``t_solar_days_ge<x>h_n``).
 THRESHOLDS_H = (2, 4, 6, 8, 10, 12)
 
 

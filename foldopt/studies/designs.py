@@ -291,11 +291,12 @@ def design_metrics(
     Returns
     -------
     dict of numpy.ndarray
-        ``fold_angle_deg``, the :func:`foldopt.engine.metrics.metric_columns`, ``poa_global_wh_m2`` (incident
-        irradiation [Wh/m^2]) and ``condition`` (:func:`foldopt.engine.metrics.design_condition`), each
-        (n_blocks, n_loads, 4) in the order of :data:`DESIGNS`; with ``curves``, also ``curves``: a
-        dict of ``flat``, (n_blocks, n_steps), and of each name of
-        :data:`foldopt.physics.connections.CONNECTIONS`, (n_blocks, n_loads, n_steps).
+        ``fold_angle_deg``, the :func:`foldopt.engine.metrics.metric_columns`,
+        ``poa_global_wh_m2`` (incident irradiation [Wh/m^2]) and ``condition``
+        (:func:`foldopt.engine.metrics.design_condition`), each (n_blocks, n_loads, 4) in the
+        order of :data:`DESIGNS`; with ``curves``, also ``curves``: a dict of ``flat``, (n_blocks,
+        n_steps), and of each name of :data:`foldopt.physics.connections.CONNECTIONS`, (n_blocks,
+        n_loads, n_steps).
     """
     study, blocks_of = blocks.study, blocks
     n_blocks, n_loads = sky.n_blocks, loads.size

@@ -101,8 +101,9 @@ def of_optimize(result) -> Answer:
         else:
             # A 180 deg fold is the flat panel: there the optimum is the flat panel's own best.
             lines.append(
-                f"{label}: flat (fold 180 deg), {_mounting(best)}: {best.t_solar_objective_h:.2f} h, "
-                f"the flat panel at its own best: no fold gains over it; {tracker}"
+                f"{label}: flat (fold 180 deg), {_mounting(best)}: "
+                f"{best.t_solar_objective_h:.2f} h, the flat panel at its own best: no fold gains "
+                f"over it; {tracker}"
                 if best.fold_angle_deg == FLAT_FOLD_ANGLE
                 else f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
                 f"{best.t_solar_objective_h:.2f} h, {_over_flat(best, flat)}; {tracker}"
@@ -126,8 +127,8 @@ def of_optimize(result) -> Answer:
             )
             # + 0.0: no "-0.0" for a roundoff
             lines.append(
-                f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.t_solar_objective_h:.2f} "
-                f"h, folded to {folded[0]:g} deg {folded[1]:.2f} h): "
+                f"  over the default mounting ({_mounting(flat_default)}: flat "
+                f"{flat_default.t_solar_objective_h:.2f} h, folded to {folded[0]:g} deg {folded[1]:.2f} h): "
                 + ", ".join(
                     f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
                     for row in added.itertuples()

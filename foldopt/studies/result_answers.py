@@ -554,7 +554,8 @@ def _of_annual(result) -> Answer:
             # Every angle ties at nothing: the tie-break is no choice, nor is there a gain to give.
             lines.append(
                 f"{head}no fold angle carries the load: {statistic} t_solar 0.00 h (flat "
-                f"{_hours(flat['t_solar_objective_h'])}); tracker {_hours(tracker['t_solar_objective_h'])}"
+                f"{_hours(flat['t_solar_objective_h'])}); tracker "
+                f"{_hours(tracker['t_solar_objective_h'])}"
             )
         else:
             lines.append(
@@ -924,7 +925,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
             + (
                 f"the tracker carries it at no site{' either' if rec['min'] is None else ''}"
                 if load["share_of_tracker_median_pct"] is None
-                else f"median {_pct(load['share_of_tracker_median_pct'], False)} of the tracker{tracker}"
+                else f"median {_pct(load['share_of_tracker_median_pct'], False)} of the "
+                f"tracker{tracker}"
             )
         )
     rate = len(spec.sites) / part["seconds"] if part["seconds"] else 0

@@ -509,11 +509,12 @@ def evaluate_sites(
     -------
     pandas.DataFrame
         One row per site, load and period: ``site_id``, ``site_name``, ``latitude``,
-        ``longitude``, ``weather``, ``peak_power_flat_w``, ``p_load_w``, ``p_load_frac``, ``period``,
-        ``days_n``, ``fold_angle_deg``; the objective [h] of each design (``t_solar_flat_objective_h``,
-        ``t_solar_twofold_objective_h``, ``t_solar_tracker_objective_h``); mean daily t_solar [h]
-        (``t_solar_flat_mean_h``, ``t_solar_twofold_mean_h``, ``t_solar_tracker_mean_h``, the tracker's net of its
-        own draw ``t_solar_tracker_net_mean_h``); harvested energy [Wh] (``energy_harvested_flat_wh``,
+        ``longitude``, ``weather``, ``peak_power_flat_w``, ``p_load_w``, ``p_load_frac``,
+        ``period``, ``days_n``, ``fold_angle_deg``; the objective [h] of each design
+        (``t_solar_flat_objective_h``, ``t_solar_twofold_objective_h``,
+        ``t_solar_tracker_objective_h``); mean daily t_solar [h] (``t_solar_flat_mean_h``,
+        ``t_solar_twofold_mean_h``, ``t_solar_tracker_mean_h``, the tracker's net of its own draw
+        ``t_solar_tracker_net_mean_h``); harvested energy [Wh] (``energy_harvested_flat_wh``,
         ``energy_harvested_twofold_wh``, ``energy_harvested_tracker_wh``); ``gain_vs_flat_pct`` and
         ``share_of_tracker_pct`` (of the objective), ``energy_harvested_gain_vs_flat_pct``; and
         the near-optimal range of the fold angle and the recommended angle at its centre

@@ -35,7 +35,8 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, study=None, ax=N
     ----------
     by_angle : pandas.DataFrame
         A row per load and fold angle: ``p_load_w`` [W], ``fold_angle_deg`` [deg],
-        ``t_solar_mean_h`` and ``t_solar_objective_h`` [h] and ``chosen`` (bool), as ``annual_fold_angles.csv``.
+        ``t_solar_mean_h`` and ``t_solar_objective_h`` [h] and ``chosen`` (bool), as
+        ``annual_fold_angles.csv``.
     title : str
     study : foldopt.Study, optional
         Names a load profile's loads in the legend.
@@ -260,8 +261,8 @@ def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
     Parameters
     ----------
     values : pandas.DataFrame
-        As ``refold_value.csv``: ``latitude``, ``longitude`` [deg], ``p_load_w`` [W], ``settings_n``,
-        ``objective`` (its statistic), ``t_solar_objective_h``, ``t_solar_flat_objective_h`` and
+        As ``refold_value.csv``: ``latitude``, ``longitude`` [deg], ``p_load_w`` [W],
+        ``settings_n``, ``objective`` (its statistic), ``t_solar_objective_h``, ``t_solar_flat_objective_h`` and
         ``t_solar_tracker_objective_h`` [h].
     title : str
     study : foldopt.Study, optional

@@ -24,7 +24,8 @@ def plot_state_of_charge(result: StudyResult, ax=None):
     Parameters
     ----------
     result : foldopt.StudyResult
-        With a buffer: its time series' ``soc_flat_frac``, ``soc_twofold_frac``, ``soc_tracker_frac`` [-].
+        With a buffer: its time series' ``soc_flat_frac``, ``soc_twofold_frac``,
+        ``soc_tracker_frac`` [0-1].
     ax : matplotlib.axes.Axes, optional
         Axes to draw on; default a new figure (8 x 4.5 in).
 

@@ -82,7 +82,8 @@ def plot_member_t_solar(table: pd.DataFrame, title: str, ax=None, study=None):
     Parameters
     ----------
     table : pandas.DataFrame
-        A sweep's tidy table with ``t_solar_members_p10_h``, ``t_solar_members_p50_h`` and ``t_solar_members_p90_h``.
+        A sweep's tidy table with ``t_solar_members_p10_h``, ``t_solar_members_p50_h`` and
+        ``t_solar_members_p90_h``.
     title : str
     ax : matplotlib.axes.Axes, optional
     study : foldopt.Study, optional
