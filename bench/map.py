@@ -206,11 +206,11 @@ def w5(subset: int | None, check_sites: int = 200, step_min: float = 5.0) -> Non
     reference = evaluate_sites(full, chosen, loads, relative=True)
     ids = [site["site_id"] for site in chosen]
     mine = result.table[result.table["site_id"].isin(ids)].reset_index(drop=True)
-    keys = ["site_id", "p_load_fraction", "period"]
-    merged = pd.merge(mine.assign(p_load_fraction=mine["p_load_fraction"].round(12)),
-                      reference.assign(p_load_fraction=reference["p_load_fraction"].round(12)), on=keys,
+    keys = ["site_id", "p_load_frac", "period"]
+    merged = pd.merge(mine.assign(p_load_frac=mine["p_load_frac"].round(12)),
+                      reference.assign(p_load_frac=reference["p_load_frac"].round(12)), on=keys,
                       suffixes=("_search", "_full"))
-    short = merged["objective_twofold_h_full"] - merged["objective_twofold_h_search"]
+    short = merged["t_solar_twofold_objective_h_full"] - merged["t_solar_twofold_objective_h_search"]
     print(f"check on {len(chosen)} sites ({len(merged):,} rows): the search short of the full sweep by at most "
           f"{short.max():.5f} h, never above it by more than {max(0.0, -short.min()):.2e} h (tolerance 0.01 h)")
 

@@ -427,6 +427,10 @@ def option_labels(given=()) -> dict[str, str]:
 #: Study fields as the options that set them name them (:func:`option_labels`, none given).
 OPTION_OF_FIELD = option_labels()
 
+#: The fold angle of the flat panel [deg]: a twofold panel unfolded is the flat panel. (An azimuth
+#: of 180 deg is south, another quantity: it keeps its number.)
+FLAT_FOLD_ANGLE = 180.0
+
 #: Alexandru's half law as offsets of the afternoon moves from solar noon [h] (foldopt.physics.trackers).
 #: His 12 actuating times (local time) pair up symmetrically about 13.319 h: 8.839/17.799,
 #: 9.819/16.819, 10.619/16.019, 11.489/15.149, 12.189/14.449, 12.919/13.719. (He gives solar noon

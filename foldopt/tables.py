@@ -15,6 +15,7 @@ uses too. ``tests/test_tables.py`` holds the bytes to pandas'.
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 
 import numpy as np
@@ -97,4 +98,4 @@ def _fields(table: pd.DataFrame) -> list[list[str]]:
 
 def _missing(item) -> bool:
     """None, NaN or pandas' NA: an empty field."""
-    return item is None or item is pd.NA or (isinstance(item, float) and item != item)
+    return item is None or item is pd.NA or (isinstance(item, float) and math.isnan(item))

@@ -161,7 +161,7 @@ def test_the_annual_summary_says_what_its_angle_and_totals_stand_for(tmp_path, d
     assert set(summary.index) == set(days["design"])
     for design, rows in days.groupby("design"):
         angles_of_days, row = rows["fold_angle_deg"], summary.loc[design]
-        assert row["days"] == len(rows)
+        assert row["days_n"] == len(rows)
         assert row["energy_harvested_wh"] == pytest.approx(rows["energy_harvested_wh"].sum(), rel=1e-9)
         if angles_of_days.isna().all():  # a tracker: no angle
             assert np.isnan(row[["fold_angle_deg", "fold_angle_min_deg", "fold_angle_max_deg"]].astype(float)).all()

@@ -41,7 +41,7 @@ def test_a_gain_over_a_flat_panel_that_carries_nothing_says_so(tmp_path, days):
     profile = tmp_path / "morning.csv"
     profile.write_text(MORNING, encoding="utf-8")
     answer = _answer(tmp_path, "sweep", "angle", "--load-profile", str(profile), "--mode", "exact", *days)
-    hours = {row["design"]: row.get("t_solar_h", row.get("objective_h")) for row in answer["designs"]}
+    hours = {row["design"]: row.get("t_solar_h", row.get("t_solar_objective_h")) for row in answer["designs"]}
     assert hours["flat"] == 0.0 < hours["twofold"]
     best = answer["lines"][2]
     assert "where the flat panel carries none of the load (flat 0.00 h)" in best and "% over" not in best
@@ -57,7 +57,7 @@ def test_an_annual_objective_no_angle_carries_says_so_once(tmp_path):
     said = [line for line in answer["lines"] if "carries the load" in line]
     assert len(said) == 1 and said[0].endswith("no fold angle carries the load: mean t_solar 0.00 h (flat 0.00 h);"
                                                 " tracker 0.00 h")
-    assert all(row["recommended_fold_angle_deg"] is None for row in answer["near_optimal"])
+    assert all(row["recommended_deg"] is None for row in answer["near_optimal"])
 
 
 @pytest.mark.parametrize("statistic", ["p10", "worst-month", "mean", "min"])

@@ -135,8 +135,9 @@ def test_a_weather_file_alone_runs_a_year(tmp_path):
     assert (study["albedo"], study["iam"], study["tracker"]["model"]) == (0.3, "ashrae", "single-axis")
     assert study["objective"]["statistic"] == "mean"
     summary = pd.read_csv(out / "annual_summary.csv")
-    assert set(summary["design"]) == {"flat", "twofold", "tracker", "tracker-net"} and (summary["days"] == 365).all()
-    for column in ("energy_harvested_wh", "poa_kwh_m2", "energy_gain_vs_flat_pct", "pct_of_tracker"):
+    assert set(summary["design"]) == {"flat", "twofold", "tracker", "tracker-net"} and (summary["days_n"] == 365).all()
+    for column in ("energy_harvested_wh", "poa_global_wh_m2", "energy_harvested_gain_vs_flat_pct",
+                   "share_of_tracker_pct"):
         assert summary[column].notna().all(), column
     # A site far from the file's is refused with both sites named; --force-site keeps it.
     far = invoke("sweep", "angle", "--weather", tmy3, "--lat", "0", "--lon", "0", "--p-load", "2", "--area", "0.108",

@@ -58,7 +58,7 @@ NOTEBOOK = textwrap.dedent("""
 
     import matplotlib.pyplot as plt
     sites = pd.DataFrame({"site_name": ["a", "b"], "latitude": [0.0, 40.0], "longitude": [0.0, 10.0],
-                          "gain_vs_flat_pct": [1.0, -2.0], "period": "year", "p_load_fraction": [0.2, 0.3]})
+                          "gain_vs_flat_pct": [1.0, -2.0], "period": "year", "p_load_frac": [0.2, 0.3]})
     calls = {
         "plot_power_curves": (result,), "plot_switching": (result,), "plot_t_solar_vs_fold_angle": (result,),
         "plot_comparison": (result,), "plot_standby": (result,),
@@ -69,25 +69,26 @@ NOTEBOOK = textwrap.dedent("""
         "plot_annual_fold_angles": (year.extras["by_angle"], "t"),
         "plot_distribution": (year.table, "t"),
         "plot_day_hour": (year.extras, "switch_state", "t", ""),
-        "plot_refold_value": (pd.DataFrame({"latitude": 0.0, "longitude": 0.0, "p_load_w": 2.0, "settings": [1, 2],
-                                            "objective": "mean", "objective_h": [5.0, 6.0],
-                                            "objective_flat_h": 4.0, "objective_tracker_h": 7.0}), "t"),
+        "plot_refold_value": (pd.DataFrame({"latitude": 0.0, "longitude": 0.0, "p_load_w": 2.0, "settings_n": [1, 2],
+                                            "objective": "mean", "t_solar_objective_h": [5.0, 6.0],
+                                            "t_solar_flat_objective_h": 4.0, "t_solar_tracker_objective_h": 7.0}), "t"),
         "plot_weather_minutes": ({"date": "2025-06-01", "hours": np.arange(96) / 4 + 0.125, "kind": "members",
                                   "ghi": np.random.default_rng(0).uniform(0, 900, (5, 96)),
                                   "hourly_ghi": np.full(24, 300.0)}, "t"),
-        "plot_member_t_solar": (year.table.assign(t_solar_p10_h=year.table.t_solar_h - 0.1,
-                                                  t_solar_p50_h=year.table.t_solar_h,
-                                                  t_solar_p90_h=year.table.t_solar_h + 0.1), "t"),
+        "plot_member_t_solar": (year.table.assign(t_solar_members_p10_h=year.table.t_solar_h - 0.1,
+                                                  t_solar_members_p50_h=year.table.t_solar_h,
+                                                  t_solar_members_p90_h=year.table.t_solar_h + 0.1), "t"),
         "plot_world_map": (sites, "gain_vs_flat_pct", "t", "gain [%]", True),
         "plot_latitude_load": (sites, "year", True, "t"),
         "plot_sun_paths": ({"dates": ["2025-06-21"], "azimuth": np.array([[90.0, 180.0, 270.0]]),
                             "elevation": np.array([[10.0, 60.0, 10.0]]), "horizon_azimuth": np.array([0.0, 180.0]),
                             "horizon_elevation": np.array([20.0, 5.0]), "hidden_pct": 12.0}, "t"),
         "plot_landscape": (pd.DataFrame({"fold_angle_deg": [90.0, 180.0, 90.0, 180.0],
-                                         "surface_tilt": [0.0, 0.0, 30.0, 30.0], "objective_h": [9.0, 8.0, 9.5, 8.2]}),
+                                         "surface_tilt": [0.0, 0.0, 30.0, 30.0],
+                                         "t_solar_objective_h": [9.0, 8.0, 9.5, 8.2]}),
                            pd.DataFrame({"p_load_w": 2.0, "design": ["twofold", "twofold-default"],
                                          "fold_angle_deg": [90.0, 90.0], "surface_tilt": [30.0, 0.0],
-                                         "objective_h": [9.5, 9.0]}), "t"),
+                                         "t_solar_objective_h": [9.5, 9.0]}), "t"),
     }
     drawn = []
     for name, args in calls.items():
@@ -211,7 +212,8 @@ def test_an_ensembles_line_and_band_join_only_near_days(days, joined):
 
     rng = np.random.default_rng(0)
     table = pd.DataFrame([{"dayofyear": day, "p_load_w": load, "design": design,
-                           "t_solar_p10_h": low, "t_solar_p50_h": low + 1.0, "t_solar_p90_h": low + 2.5}
+                           "t_solar_members_p10_h": low, "t_solar_members_p50_h": low + 1.0,
+                           "t_solar_members_p90_h": low + 2.5}
                           for day in days for load in (2.0, 4.0) for design in ("flat", "twofold", "tracker")
                           for low in rng.uniform(3.0, 9.0, 1)])
     ax = weather.plot_member_t_solar(table, "t", ax=Figure().subplots())
@@ -227,16 +229,16 @@ def test_an_ensembles_line_and_band_join_only_near_days(days, joined):
             assert bool(stretches) == joined and bool(marked) != joined
         for stretch in stretches:
             assert np.diff(stretch).max() <= sweep.DAY_GAP
-        np.testing.assert_array_equal(line.get_ydata()[np.isfinite(line.get_xdata())], rows["t_solar_p50_h"])
+        np.testing.assert_array_equal(line.get_ydata()[np.isfinite(line.get_xdata())], rows["t_solar_members_p50_h"])
         polygons = [path.vertices for path in band.get_paths()]
         assert [sorted(set(vertices[:, 0])) for vertices in polygons] == [list(part) for part in stretches]
         for vertices in polygons:
             for x, y in vertices:
-                assert y in (rows.loc[x, "t_solar_p10_h"], rows.loc[x, "t_solar_p90_h"])
+                assert y in (rows.loc[x, "t_solar_members_p10_h"], rows.loc[x, "t_solar_members_p90_h"])
         drawn_bars = {segment[0, 0]: (segment[0, 1], segment[1, 1]) for bars in ax.collections
                       if isinstance(bars, LineCollection) and to_rgb(bars.get_color()[0]) == to_rgb(line.get_color())
                       for segment in bars.get_segments()}
-        assert drawn_bars == {day: (rows.loc[day, "t_solar_p10_h"], rows.loc[day, "t_solar_p90_h"])
+        assert drawn_bars == {day: (rows.loc[day, "t_solar_members_p10_h"], rows.loc[day, "t_solar_members_p90_h"])
                               for day in marked}
 
 

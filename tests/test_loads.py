@@ -31,9 +31,9 @@ def test_a_constant_profile_is_the_constant_load_bit_for_bit():
     # A profile given without a scale runs as written (foldopt.inputs.policy): the scale is the constant load.
     profiled = run(EXACT.variant(load_profile={"daily": {"00:00": 1.0}}, p_load=EXACT.p_load))
     # The flat-area multiple is for constant loads: a profile has none.
-    columns = [c for c in constant.summary.columns if c != "flat_area_multiple"]
+    columns = [c for c in constant.summary.columns if c != "flat_area_ratio"]
     assert constant.summary[columns].equals(profiled.summary[columns])
-    assert profiled.summary["flat_area_multiple"].isna().all()
+    assert profiled.summary["flat_area_ratio"].isna().all()
     assert constant.sweep.equals(profiled.sweep)
     assert constant.timeseries.equals(profiled.timeseries)
     # Over several days, every angle and load, both engines.

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from foldopt.engine.metrics import daily_metrics, load_for_t_solar, relative_to, t_solar, t_solar_contiguous
-from foldopt.studies.sizing import flat_area_multiple
+from foldopt.studies.sizing import flat_area_ratio
 
 P_MAX = 10.0
 
@@ -85,7 +85,7 @@ def test_load_for_t_solar_and_flat_area_multiple_invert_the_sine():
     target = 8.0
     expected_load = P_MAX * np.sin(np.pi * (12 - target) / 24)
     assert load_for_t_solar(sine_day(hours), target, step) == pytest.approx(expected_load, rel=1e-4)
-    assert flat_area_multiple(sine_day(hours), 2 * expected_load, target, step) == pytest.approx(2.0, rel=1e-4)
+    assert flat_area_ratio(sine_day(hours), 2 * expected_load, target, step) == pytest.approx(2.0, rel=1e-4)
     assert np.isnan(load_for_t_solar(sine_day(hours), 12.5, step))  # longer than daylight
 
 

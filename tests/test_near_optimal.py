@@ -40,11 +40,11 @@ def test_the_range_is_the_best_angles_plateau(values, fraction, minutes, step, t
     angles = (180.0 - step * np.arange(len(values))[::-1]) if to_flat else 1.0 + step * np.arange(len(values))
     found = near_optimal(angles, np.array(values), NearOptimal(fraction=fraction, minutes=minutes))
     if max(values) <= 0:  # no angle carries the load: no range
-        assert np.isnan(found["recommended_fold_angle_deg"])
+        assert np.isnan(found["recommended_deg"])
         return
     lo, hi, recommended, tolerance = reference(angles, values, fraction, minutes)
     assert found["near_optimal_lo_deg"] == lo and found["near_optimal_hi_deg"] == hi
-    assert found["recommended_fold_angle_deg"] == recommended
+    assert found["recommended_deg"] == recommended
     assert found["near_optimal_tolerance_h"] == pytest.approx(tolerance, rel=1e-12)
 
 
@@ -56,10 +56,10 @@ def test_a_plateau_up_to_the_flat_panel_best_flat_recommends_flat():
     values = np.array([[1, 1, 1, 5, 5, 5], [1, 1, 5, 6, 5, 5]], dtype=float)
     found = near_optimal(angles, values, NearOptimal(fraction=0.0, minutes=0.0))
     assert found["near_optimal_lo_deg"].tolist() == [176.0, 176.0]
-    assert found["recommended_fold_angle_deg"].tolist() == [180.0, 176.0]
+    assert found["recommended_deg"].tolist() == [180.0, 176.0]
     loose = near_optimal(angles, values, NearOptimal(fraction=0.0, minutes=60.0))
     assert loose["near_optimal_lo_deg"].tolist() == [176.0, 174.0]
-    assert loose["recommended_fold_angle_deg"].tolist() == [180.0, 178.0]
+    assert loose["recommended_deg"].tolist() == [180.0, 178.0]
 
 
 def test_rows_are_independent():
@@ -67,7 +67,7 @@ def test_rows_are_independent():
     values = np.array([[1, 2, 5, 2, 1], [5, 5, 5, 5, 5], [0, 0, 0, 0, 0.0]], dtype=float)
     found = near_optimal(angles, values, NearOptimal(fraction=0.0, minutes=0.0))
     assert found["near_optimal_lo_deg"].tolist()[:2] == [3.0, 1.0]
-    assert found["recommended_fold_angle_deg"].tolist()[:2] == [3.0, 3.0]
+    assert found["recommended_deg"].tolist()[:2] == [3.0, 3.0]
     assert np.isnan(found["near_optimal_lo_deg"][2])
 
 
@@ -83,7 +83,7 @@ def test_the_papers_plateau_holds_its_optimum_and_the_recommended_angle_keeps_th
     assert near["near_optimal_lo_deg"] == result.optimal_fold_angle <= near["near_optimal_hi_deg"]
     inside = sweep.loc[near["near_optimal_lo_deg"]:near["near_optimal_hi_deg"]]
     assert (inside >= best_hours - near["near_optimal_tolerance_h"]).all()
-    assert near["recommended_t_solar_h"] == sweep.loc[near["recommended_fold_angle_deg"]]
+    assert near["recommended_t_solar_h"] == sweep.loc[near["recommended_deg"]]
     # 1 % of the best t_solar (9.44 h: 5.7 min) is more than 1 min here.
     assert near["near_optimal_tolerance_h"] == pytest.approx(0.01 * best_hours, rel=1e-9)
     wider = foldopt.run(foldopt.default_study().variant(near_optimal={"fraction": 0.05}))
@@ -103,7 +103,7 @@ def test_the_range_on_a_grid_is_the_plain_range_where_every_angle_is_known(value
     got = near_optimal_on_grid(angles, np.array([values]), tolerance, angles)
     expected = reference(angles, values, fraction, minutes)
     carried = max(values) > 0
-    for name, value in zip(("near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg",
+    for name, value in zip(("near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_deg",
                             "near_optimal_tolerance_h"), expected, strict=True):
         assert got[name][0] == (value if carried else pytest.approx(np.nan, nan_ok=True))
 
@@ -151,10 +151,10 @@ def test_a_days_range_always_holds_its_best_angle(latitude, longitude, day, load
     near, best = result.near_optimal, result.optimal_fold_angle
     best_hours = result.summary.set_index("design").loc["twofold", "t_solar_h"]
     if not best_hours > 0:  # no angle carries the load: no range
-        assert np.isnan(near["near_optimal_lo_deg"]) and np.isnan(near["recommended_fold_angle_deg"])
+        assert np.isnan(near["near_optimal_lo_deg"]) and np.isnan(near["recommended_deg"])
         return
     assert near["near_optimal_lo_deg"] <= best <= near["near_optimal_hi_deg"]
-    assert near["near_optimal_lo_deg"] <= near["recommended_fold_angle_deg"] <= near["near_optimal_hi_deg"]
+    assert near["near_optimal_lo_deg"] <= near["recommended_deg"] <= near["near_optimal_hi_deg"]
     # The twofold row's t_solar comes from the designs' own pass, which sums the day in another
     # order than the sweep: the same time to a few ulp (1e-9 h is 4 us).
     line = best_hours - near["near_optimal_tolerance_h"] - 1e-9
@@ -180,7 +180,7 @@ def test_a_range_on_a_grid_holds_the_best_evaluated_angle(values, data, fraction
         return
     best = angles[best_angle_index(np.array(values))]
     assert got["near_optimal_lo_deg"][0] <= best <= got["near_optimal_hi_deg"][0]
-    assert got["near_optimal_lo_deg"][0] <= got["recommended_fold_angle_deg"][0] <= got["near_optimal_hi_deg"][0]
+    assert got["near_optimal_lo_deg"][0] <= got["recommended_deg"][0] <= got["near_optimal_hi_deg"][0]
 
 
 def test_foldopt_run_prints_a_range_that_holds_its_best_angle(tmp_path):
@@ -217,7 +217,7 @@ def test_the_recommended_angle_lies_in_its_range_and_is_flat_where_flat_is_best(
     for found in (near_optimal_on_grid(angles, np.array([values]), tolerance, grid),
                   {key: value[None] for key, value in near_optimal(angles, np.array(values), tolerance).items()}):
         lo, hi, recommended = (found[key][0] for key in ("near_optimal_lo_deg", "near_optimal_hi_deg",
-                                                          "recommended_fold_angle_deg"))
+                                                          "recommended_deg"))
         if max(values) <= 0:
             assert np.isnan(recommended)
             continue
@@ -241,6 +241,6 @@ def test_a_day_best_flat_is_recommended_flat(tmp_path):
     assert done.exit_code == 0, done.output
     answer = json.loads(done.stdout)["answer"]
     result = answer["result"]
-    assert result["fold_angle_deg"] == 180.0 and result["recommended_fold_angle_deg"] == 180.0
+    assert result["fold_angle_deg"] == 180.0 and result["recommended_deg"] == 180.0
     assert result["near_optimal_lo_deg"] < 180.0
     assert "recommended 180 deg" in answer["lines"][2] and "% over" not in answer["lines"][1]

@@ -27,7 +27,7 @@ runner = CliRunner()
 #: Berlin, a 2 W load: the issue's own example.
 BERLIN = ("--lat", "52.5", "--lon", "13.4", "--p-load", "2")
 #: What the answers say at their rounding: angles to the degree, t_solar to 0.01 h, gain to 0.1 %.
-ANGLES = ("fold_angle_deg", "near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_fold_angle_deg")
+ANGLES = ("fold_angle_deg", "near_optimal_lo_deg", "near_optimal_hi_deg", "recommended_deg")
 #: Exact mode's sky over a year's days (or many sites), as a question says it.
 SKY = "Ineichen clear sky at Linke turbidity from pvlib climatology for each site and day, Perez diffuse, albedo 0.2"
 
@@ -42,7 +42,7 @@ def sweep_answer(out, *options) -> dict:
     """``foldopt sweep angle`` over the year of one site, as the map's answer reads."""
     answer = _answer("sweep", "angle", *BERLIN, "--days", "year", "--objective", "mean", *options, "--out", out)
     near = answer["near_optimal"][0]
-    t_solar = {row["design"]: row["mean_t_solar_h"] for row in answer["designs"]}
+    t_solar = {row["design"]: row["t_solar_mean_h"] for row in answer["designs"]}
     return {**{key: near[key] for key in ANGLES}, **{f"t_solar_{design}_h": t_solar[design]
                                                      for design in ("flat", "twofold", "tracker")},
             "gain_vs_flat_pct": 100 * (t_solar["twofold"] / t_solar["flat"] - 1),
@@ -55,7 +55,7 @@ def map_answer(out, scheduler, *options) -> dict:
     near, = answer["near_optimal"]
     row, = answer["designs"]
     return {**{key: near[key] for key in ANGLES},
-            **{f"t_solar_{design}_h": row[f"mean_t_solar_{design}_h"] for design in ("flat", "twofold", "tracker")},
+            **{f"t_solar_{design}_h": row[f"t_solar_{design}_mean_h"] for design in ("flat", "twofold", "tracker")},
             "gain_vs_flat_pct": row["gain_vs_flat_pct"], "models": answer["question"]["models"]}
 
 
@@ -72,7 +72,7 @@ def test_a_sweep_and_a_map_of_a_site_agree_at_the_same_step(tmp_path, scheduler)
     sweep = sweep_answer(tmp_path / "sweep", "--step-min", "5")
     world = map_answer(tmp_path / "map", scheduler, "--step-min", "5")
     assert_same_answer(sweep, world)
-    assert sweep["recommended_fold_angle_deg"] == 40 and round(sweep["gain_vs_flat_pct"], 1) == 11.4
+    assert sweep["recommended_deg"] == 40 and round(sweep["gain_vs_flat_pct"], 1) == 11.4
     # And both say so: the same sky in their questions.
     for answer in (sweep, world):
         assert answer["models"].startswith("exact mode") and answer["models"].endswith(SKY), answer["models"]

@@ -206,7 +206,7 @@ def test_a_landscape_of_zeros_is_answered_at_once(fields, polar_night):
     100 s with the default grids)."""
     result = polar_night if fields is POLAR else _optimize(**fields)
     search = result.twofold
-    assert np.all(search.values == 0.0) and np.all(result.table["objective_h"] == 0.0)
+    assert np.all(search.values == 0.0) and np.all(result.table["t_solar_objective_h"] == 0.0)
     # No refinement past the coarse lattice; the last level is each variable's line through the optimum.
     assert all(count == 0 for _, count in search.levels[1:-1])
     assert search.levels[-1][1] <= sum(axis.size for axis in search.axes)
@@ -253,7 +253,7 @@ def test_no_gain_is_claimed_over_a_flat_panel_that_carries_nothing():
     result = _optimize(p_load=[2.0])
     table = result.table.copy()
     flat = table["design"] == "flat"
-    table.loc[flat, "objective_h"] = 0.0
+    table.loc[flat, "t_solar_objective_h"] = 0.0
     table["gain_vs_flat_pct"] = np.nan  # as the table holds it where the flat panel gives 0 h
     lines = of_optimize(dataclasses.replace(result, table=table)).lines()
     assert all(_no_nan(line) for line in lines)
@@ -396,7 +396,7 @@ def test_what_the_tilt_adds_is_over_the_folded_default_where_the_fold_is_fixed()
 
     result = foldopt.optimize(foldopt.default_study(), vary="tilt,azimuth", mode="exact", step_min=15,
                               tilt="0:90:5", azimuth="150:210:5")
-    table = result.table.set_index("design")["objective_h"]
+    table = result.table.set_index("design")["t_solar_objective_h"]
     assert result.added["added_h"].sum() == pytest.approx(table["twofold"] - table["twofold-default"], abs=1e-12)
     assert np.all(result.added["added_h"] >= 0.0)
     assert table["twofold-default"] > table["flat-default"] + 0.5  # folding alone gains here (the fault's size)
@@ -413,7 +413,7 @@ def test_the_optimum_is_the_best_design_evaluated():
     result = foldopt.run(Path(__file__).resolve().parent.parent / "configs" / "optimize.yaml")
     search = result.twofold
     assert np.array_equal(search.best_value, search.values.max(axis=0))
-    best = result.table[result.table["design"] == "twofold"].set_index("p_load_w")["objective_h"]
+    best = result.table[result.table["design"] == "twofold"].set_index("p_load_w")["t_solar_objective_h"]
     for load, rows in result.near_optimal.groupby("p_load_w"):
         tolerance = max(0.01 * best[load], 1 / 60)  # the study's near-optimal: 1 % or 1 min
         assert np.allclose(rows["near_optimal_tolerance_h"], tolerance, rtol=0, atol=1e-12)
@@ -519,14 +519,14 @@ def test_no_fold_of_180_deg_beats_the_flat_panel_at_its_own_best(latitude, longi
     for index, load in enumerate(result.loads):
         flat, best = table.loc[(load, "flat")], table.loc[(load, "twofold")]
         assert flat["fold_angle_deg"] == 180.0
-        assert np.all(unfolded[:, index] <= flat["objective_h"])
-        assert table.loc[(load, "flat-default"), "objective_h"] <= flat["objective_h"]
+        assert np.all(unfolded[:, index] <= flat["t_solar_objective_h"])
+        assert table.loc[(load, "flat-default"), "t_solar_objective_h"] <= flat["t_solar_objective_h"]
         # The optimum is the best design evaluated within its ranges.
-        assert result.twofold.values[:, index].max() <= best["objective_h"]
+        assert result.twofold.values[:, index].max() <= best["t_solar_objective_h"]
         if fold_hi == 180.0:
-            assert best["objective_h"] >= flat["objective_h"]
+            assert best["t_solar_objective_h"] >= flat["t_solar_objective_h"]
         if best["fold_angle_deg"] == 180.0:
-            assert best["objective_h"] == flat["objective_h"]
+            assert best["t_solar_objective_h"] == flat["t_solar_objective_h"]
             assert not best["gain_vs_flat_pct"] > 0.0
     for line in result.answer.lines():
         if "fold 180 deg" in line:
@@ -554,8 +554,8 @@ def test_the_flat_panel_at_its_own_best_holds_its_default_mounting(tmp_path):
     assert done.exit_code == 0, done.output
     optimum = pd.read_csv(out / "optimum.csv").set_index("design")
     evaluated = pd.read_csv(out / "evaluated.csv")
-    flat = optimum.loc["flat", "objective_h"]
-    assert flat >= evaluated.loc[evaluated["fold_angle_deg"] == 180, "objective_h"].max()
-    assert flat >= optimum.loc["flat-default", "objective_h"]
-    assert optimum.loc["twofold", "objective_h"] == flat and optimum.loc["twofold", "fold_angle_deg"] == 180
+    flat = optimum.loc["flat", "t_solar_objective_h"]
+    assert flat >= evaluated.loc[evaluated["fold_angle_deg"] == 180, "t_solar_objective_h"].max()
+    assert flat >= optimum.loc["flat-default", "t_solar_objective_h"]
+    assert optimum.loc["twofold", "t_solar_objective_h"] == flat and optimum.loc["twofold", "fold_angle_deg"] == 180
     assert "% over" not in done.stdout.splitlines()[2]

@@ -106,16 +106,16 @@ def test_a_weather_year_schedule_agrees_with_the_annual_sweep():
     table = result.table
     for load, rows in values.groupby("p_load_w"):
         designs = table[table["p_load_w"] == load].groupby("design")["t_solar_h"].mean()
-        one = rows[rows["settings"] == 1].iloc[0]
-        assert one["objective_h"] == pytest.approx(designs["twofold"], abs=1e-9)
+        one = rows[rows["settings_n"] == 1].iloc[0]
+        assert one["t_solar_objective_h"] == pytest.approx(designs["twofold"], abs=1e-9)
         fixed = table[(table["p_load_w"] == load) & (table["design"] == "twofold")]["fold_angle_deg"].iloc[0]
-        assert visits[(visits["p_load_w"] == load) & (visits["settings"] == 1)]["fold_angle_deg"].iloc[0] == fixed
-        assert one["objective_flat_h"] == pytest.approx(designs["flat"], abs=1e-9)
-        assert one["objective_tracker_h"] == pytest.approx(designs["tracker"], abs=1e-9)
-        assert (np.diff(rows["objective_h"]) >= -1e-12).all()
+        assert visits[(visits["p_load_w"] == load) & (visits["settings_n"] == 1)]["fold_angle_deg"].iloc[0] == fixed
+        assert one["t_solar_flat_objective_h"] == pytest.approx(designs["flat"], abs=1e-9)
+        assert one["t_solar_tracker_objective_h"] == pytest.approx(designs["tracker"], abs=1e-9)
+        assert (np.diff(rows["t_solar_objective_h"]) >= -1e-12).all()
     # Re-folding every day is the bound: the best angle of each day.
     plan = make_plan({**data, "p_load": 1.0})
     blocks = Blocks.of_dates(plan.base, list(dict(plan.axes)["date"]))
     _, daily, _ = fold_hours(blocks.sky(), blocks, np.array([1.0]))
     every_day = daily[:, :, 0].max(axis=1).mean()
-    assert values[values["p_load_w"] == 1.0]["objective_h"].max() <= every_day + 1e-12
+    assert values[values["p_load_w"] == 1.0]["t_solar_objective_h"].max() <= every_day + 1e-12

@@ -184,7 +184,7 @@ def test_the_twofold_optimum_is_never_below_the_flat_panels(joint):
     panel's search varies the same tilts: the twofold optimum cannot fall below it by more than
     the tolerance, nor below the default mounting's fold-only optimum (on the study's own 1 deg
     grid, the search's is 5 deg)."""
-    table = joint.table.set_index(["p_load_w", "design"])["objective_h"]
+    table = joint.table.set_index(["p_load_w", "design"])["t_solar_objective_h"]
     for load in joint.loads:
         assert table[(load, "twofold")] >= table[(load, "flat")] - 0.01
         assert table[(load, "twofold")] >= table[(load, "twofold-default")] - 0.01
@@ -192,7 +192,7 @@ def test_the_twofold_optimum_is_never_below_the_flat_panels(joint):
 
 
 def test_what_each_variable_adds_sums_to_the_gain_over_the_default_flat(joint):
-    table = joint.table.set_index(["p_load_w", "design"])["objective_h"]
+    table = joint.table.set_index(["p_load_w", "design"])["t_solar_objective_h"]
     for load in joint.loads:
         added = joint.added[joint.added["p_load_w"] == load]["added_h"].sum()
         assert added == pytest.approx(table[(load, "twofold")] - table[(load, "flat-default")], abs=1e-12)
@@ -247,7 +247,7 @@ def test_a_weather_year_with_a_load_profile_is_optimised():
     result = foldopt.optimize(foldopt.default_study(), vary="fold_angle,tilt", weather=str(weather), step_min=30,
                               panel={"area": 0.3}, objective="worst-month",
                               load_profile={"daily": {"00:00": 1.5, "07:00": 6, "19:00": 1.5}})
-    table = result.table.set_index("design")["objective_h"]
+    table = result.table.set_index("design")["t_solar_objective_h"]
     assert table["twofold"] >= table["flat"] - 0.01 and table["twofold"] >= table["flat-default"] - 1e-12
     assert len(result.dates) == 365 and result.statistic == "worst-month"
     assert result.answer.summary[1].startswith("load profile x 1:")

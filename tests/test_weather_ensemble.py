@@ -249,7 +249,7 @@ def test_an_ensemble_whose_every_member_is_best_flat_recommends_flat(tmp_path):
     assert by_angle.loc[by_angle["fold_angle_deg"] == 180, "wins_pct"].tolist() == [100.0]
     answer = json.loads(done.stdout)["answer"]
     (near,) = answer["near_optimal"]
-    assert near["fold_angle_deg"] == 180.0 == near["recommended_fold_angle_deg"]
+    assert near["fold_angle_deg"] == 180.0 == near["recommended_deg"]
     assert near["near_optimal_lo_deg"] < 180.0
     assert any("recommended 180 deg" in line for line in answer["lines"])
     assert not any("% over" in line for line in answer["lines"])

@@ -120,14 +120,14 @@ def test_the_ensemble_answer_has_its_spread(ensemble_plan):
     objective = result.extras["annual_objective"]
     # The objective is the members' mean; its P10 <= P50 <= P90; the twofold panel says how sure.
     for _, row in objective.iterrows():
-        assert row["objective_p10_h"] <= row["objective_p50_h"] <= row["objective_p90_h"]
-        assert row["objective_p10_h"] - 1e-9 <= row["objective_h"] <= row["objective_p90_h"] + 1e-9
+        p10, p50, p90 = (row[f"t_solar_objective_members_p{pct}_h"] for pct in (10, 50, 90))
+        assert p10 <= p50 <= p90 and p10 - 1e-9 <= row["t_solar_objective_h"] <= p90 + 1e-9
     twofold = objective[objective["design"] == "twofold"]
     assert twofold["chosen_wins_pct"].between(0, 100).all() and twofold["within_tolerance_pct"].between(0, 100).all()
     table = result.table
     assert len(table) == 3 * 2 * 4  # a row per day, load and design: the members' mean day
-    assert (table["t_solar_p10_h"] <= table["t_solar_p50_h"] + 1e-12).all()
-    assert (table["t_solar_p50_h"] <= table["t_solar_p90_h"] + 1e-12).all()
+    assert (table["t_solar_members_p10_h"] <= table["t_solar_members_p50_h"] + 1e-12).all()
+    assert (table["t_solar_members_p50_h"] <= table["t_solar_members_p90_h"] + 1e-12).all()
     lines = result.answer.lines()
     assert any("over 6 cloud members" in line for line in lines)
     assert any("best angle of" in line and "near-optimal tolerance" in line for line in lines)

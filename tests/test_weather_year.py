@@ -241,13 +241,13 @@ def test_annual_summary_has_the_years_totals(tmp_path):
         assert row.energy_harvested_wh == pytest.approx(rows.energy_harvested_wh.sum())
         assert row.energy_served_wh == pytest.approx(load * rows.t_solar_h.sum())
         assert row.energy_harvested_wh == pytest.approx(row.energy_served_wh + row.energy_wasted_wh)
-        assert row.poa_kwh_m2 == pytest.approx(rows.poa_kwh_m2.sum())
+        assert row.poa_global_wh_m2 == pytest.approx(rows.poa_global_wh_m2.sum())
         flat, tracker = summary.loc[(load, "flat")], summary.loc[(load, "tracker")]
         gain = (row.energy_harvested_wh / flat.energy_harvested_wh - 1) * 100
-        assert row.energy_gain_vs_flat_pct == pytest.approx(gain)
-        assert row.pct_of_tracker == pytest.approx(row.mean_t_solar_h / tracker.mean_t_solar_h * 100)
+        assert row.energy_harvested_gain_vs_flat_pct == pytest.approx(gain)
+        assert row.share_of_tracker_pct == pytest.approx(row.t_solar_mean_h / tracker.t_solar_mean_h * 100)
     # The flat panel's year on the plane of its array: the tilted Perez sum of the file.
-    assert summary.loc[(2.0, "flat"), "poa_kwh_m2"] == pytest.approx(1776, abs=5)
-    assert summary.loc[(2.0, "flat"), "energy_gain_vs_flat_pct"] == 0
+    assert summary.loc[(2.0, "flat"), "poa_global_wh_m2"] == pytest.approx(1776e3, abs=5e3)
+    assert summary.loc[(2.0, "flat"), "energy_harvested_gain_vs_flat_pct"] == 0
     for name in ("monthly_energy_t_solar.png", "annual_fold_angles.csv", "annual_t_solar_vs_fold_angle.png"):
         assert (tmp_path / "out" / name).stat().st_size > 0

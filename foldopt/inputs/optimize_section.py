@@ -14,7 +14,7 @@ from pydantic import Field, field_validator, model_validator
 from foldopt import names
 from foldopt.inputs.fields import StrictModel, interval
 from foldopt.inputs.reading import MAX_AXIS_VALUES, size_limit
-from foldopt.names import canonical
+from foldopt.names import FLAT_FOLD_ANGLE, canonical
 
 #: Each variable's bounds where a study gives none: the fold angle the study's own grid; the tilt
 #: from horizontal to vertical; the azimuth within 90 deg either side of the equator-facing one.
@@ -135,7 +135,7 @@ class Optimize(StrictModel):
     @field_validator("fold_angle")
     @classmethod
     def _fold_bounds(cls, bounds):
-        if bounds is not None and not (0 < bounds.min and bounds.max <= 180):
+        if bounds is not None and not (0 < bounds.min and bounds.max <= FLAT_FOLD_ANGLE):
             raise ValueError(f"{bounds.describe()}: min and max must be in (0, 180] deg")
         return bounds
 

@@ -30,6 +30,7 @@ import copy
 
 from foldopt.inputs.optimize_section import vary_names
 from foldopt.names import (
+    FLAT_FOLD_ANGLE,
     HOURLY_WEATHER_FORMATS,
     MEASURED_WEATHER_SOURCES,
     OPTIMIZE_VARIABLES,
@@ -281,7 +282,7 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         step = changes["fold_angles.step"]
         data["fold_angles"] = {
             "start": step,
-            "stop": changes.get("fold_angles.stop", 180.0),
+            "stop": changes.get("fold_angles.stop", FLAT_FOLD_ANGLE),
             "step": step,
         }
     if (

@@ -24,7 +24,7 @@ from foldopt.inputs.horizon_section import Horizon
 from foldopt.inputs.load_profile import hourly_steps, profile_steps
 from foldopt.inputs.optimize_section import grid_points
 from foldopt.inputs.reading import MAX_AXIS_VALUES
-from foldopt.names import ALEXANDRU_STEP_OFFSETS_H
+from foldopt.names import ALEXANDRU_STEP_OFFSETS_H, FLAT_FOLD_ANGLE
 
 _OFFSET = re.compile(r"^(?:UTC)?([+-])(\d{1,2})(?::?(\d{2}))?$")
 
@@ -391,9 +391,9 @@ class FoldAngles(StrictModel):
         [deg], each in (0, 180]; default 1 to 180 by 1.
     """
 
-    start: interval(0, 180, lo_open=True, unit=" deg") = 1.0
-    stop: interval(0, 180, lo_open=True, unit=" deg") = 180.0
-    step: interval(0, 180, lo_open=True, unit=" deg") = 1.0
+    start: interval(0, FLAT_FOLD_ANGLE, lo_open=True, unit=" deg") = 1.0
+    stop: interval(0, FLAT_FOLD_ANGLE, lo_open=True, unit=" deg") = FLAT_FOLD_ANGLE
+    step: interval(0, FLAT_FOLD_ANGLE, lo_open=True, unit=" deg") = 1.0
 
     @model_validator(mode="after")
     def _ordered(self):

@@ -263,7 +263,7 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
                 f"{name}: {kind}, the day most variable within its hours",
             )
         )
-    if "t_solar_p10_h" in table:
+    if "t_solar_members_p10_h" in table:
         written.append(
             write_figure(
                 folder,
@@ -417,7 +417,7 @@ def write_optimize(result, out: Path, overwrite: bool = False, command=None) -> 
     points["surface_azimuth"] %= 360.0
     evaluated = pd.concat(
         [
-            points.assign(p_load_w=load, objective_h=search.values[:, index])
+            points.assign(p_load_w=load, t_solar_objective_h=search.values[:, index])
             for index, load in enumerate(result.loads)
         ],
         ignore_index=True,
@@ -473,7 +473,7 @@ def map_figures(
     name : str
         Begins each title.
     relative : bool
-        Whether the map's loads are fractions of each site's flat peak (``p_load_fraction``) rather
+        Whether the map's loads are fractions of each site's flat peak (``p_load_frac``) rather
         than watts (``p_load_w``).
     load_index : int, default 0
         The load the maps show, by its index among the map's loads (sorted).
@@ -487,7 +487,7 @@ def map_figures(
     list of str
         The file names written.
     """
-    loads = table["p_load_fraction"] if relative else table["p_load_w"]
+    loads = table["p_load_frac"] if relative else table["p_load_w"]
     values = np.unique(loads.round(12))
     shown = table[(np.isclose(loads, values[load_index])) & (table["period"] == period)]
     shown = shown.assign(

@@ -25,21 +25,16 @@ import pandas as pd
 
 from foldopt.files import versions, write_atomically
 from foldopt.inputs.sites import lattice
-from foldopt.output.columns import describe
+from foldopt.output.columns import UNITS, describe
 from foldopt.studies.worldmap import PERIODS
 
-#: The registry's units in UDUNITS spelling, as CF asks.
-_UNITS = {
-    "h": "h",
-    "W": "W",
-    "Wh": "W h",
-    "%": "percent",
-    "deg": "degree",
-    "-": "1",
-    "kWh/m^2": "kW h m-2",
-}
 #: Columns that are coordinates or labels, not variables.
 _NOT_VARIABLES = ("site_id", "site_name", "weather", "latitude", "longitude", "period")
+
+
+def _udunits(unit: str) -> str:
+    """A registry unit in UDUNITS spelling, as CF asks (``1`` for a label's number)."""
+    return UNITS[unit][1] if unit in UNITS else "1"
 
 
 def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"):
@@ -51,7 +46,7 @@ def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"
         A map's table (:attr:`foldopt.MapRun.table`): a row per site, load and period.
     relative : bool
         Whether the loads are fractions of each site's flat peak: the ``load`` dimension is then
-        ``p_load_fraction`` (and ``p_load_w`` a variable), else ``p_load_w``.
+        ``p_load_frac`` (and ``p_load_w`` a variable), else ``p_load_w``.
     title : str
 
     Returns
@@ -65,7 +60,7 @@ def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"
     latitudes, longitudes = lattice(table["latitude"]), lattice(table["longitude"])
     if latitudes is None or longitudes is None:
         return None
-    load = "p_load_fraction" if relative else "p_load_w"
+    load = "p_load_frac" if relative else "p_load_w"
     # A fraction is watts over the site's peak: the same load to 12 digits at every site.
     frame = (
         table.assign(load=table[load].round(12))
@@ -86,7 +81,7 @@ def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"
     for name in variables:
         entry = describe(name)
         if entry is not None:
-            data[name].attrs.update(units=_UNITS.get(entry[1], entry[1] or "1"), long_name=entry[2])
+            data[name].attrs.update(units=_udunits(entry[1]), long_name=entry[2])
     data["latitude"].attrs.update(
         units="degrees_north", standard_name="latitude", long_name="latitude", axis="Y"
     )
@@ -95,7 +90,7 @@ def grid_dataset(table: pd.DataFrame, relative: bool, title: str = "foldopt map"
     )
     entry = describe(load)
     data = data.assign_coords(load=data["load"])
-    data["load"].attrs.update(units=_UNITS.get(entry[1], "1"), long_name=f"{load}: {entry[2]}")
+    data["load"].attrs.update(units=_udunits(entry[1]), long_name=f"{load}: {entry[2]}")
     data["period"].attrs.update(long_name="year, or the season DJF, MAM, JJA, SON")
     data.attrs.update(
         Conventions="CF-1.8",

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import base64
 import json
+import math
 from pathlib import Path
 
 import pandas as pd
@@ -42,7 +43,7 @@ def _image(path: Path) -> str:
 
 def _cell(value) -> tuple[str, str]:
     """Text of a cell and its class (numbers right-aligned, text left)."""
-    if value is None or (isinstance(value, float) and value != value):
+    if value is None or (isinstance(value, float) and math.isnan(value)):
         return "-", ""
     if isinstance(value, float):
         return f"{value:.4g}" if abs(value) < 1e5 else f"{value:.6g}", ""

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from foldopt.names import GEOMETRIES
+from foldopt.names import FLAT_FOLD_ANGLE, GEOMETRIES
 
 
 def default_orientation(latitude: float) -> tuple[float, float]:
@@ -159,7 +159,7 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
     90.0
     """
     fold_angle = np.asarray(fold_angle, dtype=float)
-    turn = (180.0 - fold_angle) / 2.0 * _east_sign(surface_azimuth)
+    turn = (FLAT_FOLD_ANGLE - fold_angle) / 2.0 * _east_sign(surface_azimuth)
     if geometry == "azimuth-split":
         tilt = np.full_like(fold_angle, surface_tilt)
         return {

@@ -13,7 +13,7 @@ import math
 from pvlib.pvsystem import Array, FixedMount
 
 from foldopt.physics.geometry import subpanel_orientation
-from foldopt.names import GEOMETRIES, canonical
+from foldopt.names import FLAT_FOLD_ANGLE, GEOMETRIES, canonical
 
 
 def twofold_arrays(
@@ -96,7 +96,7 @@ def twofold_arrays(
     >>> east, west = mc.results.total_irrad  # per sub-panel; mc.results.ac is the panel's
     """
     fold = float(fold_angle)
-    if not 0.0 < fold <= 180.0:
+    if not 0.0 < fold <= FLAT_FOLD_ANGLE:
         raise ValueError(f"fold_angle must be in (0, 180] deg (180 is flat); got {fold_angle!r}")
     try:
         name = canonical(geometry, GEOMETRIES)

@@ -36,7 +36,7 @@ from foldopt.engine.metrics import (
     t_solar,
 )
 from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_fold_angle
-from foldopt.studies.sizing import flat_area_multiple
+from foldopt.studies.sizing import flat_area_ratio
 from foldopt.studies.designs import (
     DESIGNS,
     Blocks,
@@ -54,7 +54,7 @@ from foldopt.studies.storage_days import (
 )
 from foldopt.engine.sky import build_sky
 from foldopt.physics.trackers import TRACKERS
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
 
 class Day:
@@ -267,7 +267,7 @@ class StudyResult:
     summary : pandas.DataFrame
         Per design (``flat``, ``twofold``, ``twofold-heuristic``, ``tracker``, ``tracker-net``...):
         ``fold_angle_deg``, ``t_solar_h``, ``t_solar_contiguous_h``, ``energy_harvested_wh``, ``peak_power_w``,
-        ``gain_vs_flat_pct``, ``pct_of_tracker``, ``flat_area_multiple``, ``note``.
+        ``gain_vs_flat_pct``, ``share_of_tracker_pct``, ``flat_area_ratio``, ``note``.
     timeseries : pandas.DataFrame
         Indexed by the day's tz-aware step centres (``time``): sun [deg], ``dni`` [W/m^2], the power
         [W] of every design at the optimum and the ``switch_state``.
@@ -637,7 +637,7 @@ def compare_designs(day: Day, sweep: FoldSweep, optimum: Optimum, engine: str) -
     )
     # The rows as the report shows them: flat, the twofold panels, then the trackers.
     angle_of = {
-        "flat": 180.0,
+        "flat": FLAT_FOLD_ANGLE,
         "twofold": optimum.fold_angle_deg,
         **{name: angle for name, (angle, _) in others.items() if name.startswith("twofold")},
         "tracker": np.nan,
@@ -699,7 +699,7 @@ def summarise(day: Day, designs: Designs) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        ``designs.table`` with ``gain_vs_flat_pct``, ``pct_of_tracker``, ``flat_area_multiple``
+        ``designs.table`` with ``gain_vs_flat_pct``, ``share_of_tracker_pct``, ``flat_area_ratio``
         (NaN under a load profile: it is defined for a constant load) and ``note``.
     """
     study = day.study
@@ -707,9 +707,9 @@ def summarise(day: Day, designs: Designs) -> pd.DataFrame:
     by_design = summary.set_index("design")["t_solar_h"]
     flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
     summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
-    summary["pct_of_tracker"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
-    summary["flat_area_multiple"] = [
-        flat_area_multiple(designs.power["flat"], study.p_load, hours, day.step_hours)
+    summary["share_of_tracker_pct"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
+    summary["flat_area_ratio"] = [
+        flat_area_ratio(designs.power["flat"], study.p_load, hours, day.step_hours)
         if hours > 0 and day.load_shape is None
         else np.nan
         for hours in summary["t_solar_h"]
@@ -858,7 +858,7 @@ def near_optimal_range(day: Day, sweep: FoldSweep, optimum: Optimum) -> dict:
             evaluated.index, evaluated.to_numpy(), day.study.near_optimal
         ).items()
     }
-    recommended = near["recommended_fold_angle_deg"]
+    recommended = near["recommended_deg"]
     near["recommended_t_solar_h"] = (
         float(evaluated[recommended]) if recommended == recommended else float("nan")
     )
@@ -910,7 +910,7 @@ def day_timeseries(
             **(
                 {}
                 if buffered is None
-                else {f"soc_{name}": soc for name, soc in buffered.soc.items()}
+                else {f"soc_{name}_frac": soc for name, soc in buffered.soc.items()}
             ),
         },
         index=pd.DatetimeIndex(day.times, name="time"),

@@ -33,7 +33,7 @@ from foldopt.engine.sky import Sky
 # Blocks and their setup are part of the designs' API (the studies take them from here).
 from foldopt.studies.blocks import CHUNK_ROW_LOADS, Blocks, setup_key  # noqa: F401
 from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw, tracker_orientation
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
 
@@ -291,11 +291,12 @@ def design_metrics(
     Returns
     -------
     dict of numpy.ndarray
-        ``fold_angle_deg``, the :func:`foldopt.engine.metrics.metric_columns`, ``poa_kwh_m2`` (incident
-        irradiation [kWh/m^2]) and ``condition`` (:func:`foldopt.engine.metrics.design_condition`), each
-        (n_blocks, n_loads, 4) in the order of :data:`DESIGNS`; with ``curves``, also ``curves``: a
-        dict of ``flat``, (n_blocks, n_steps), and of each name of
-        :data:`foldopt.physics.connections.CONNECTIONS`, (n_blocks, n_loads, n_steps).
+        ``fold_angle_deg``, the :func:`foldopt.engine.metrics.metric_columns`,
+        ``poa_global_wh_m2`` (incident irradiation [Wh/m^2]) and ``condition``
+        (:func:`foldopt.engine.metrics.design_condition`), each (n_blocks, n_loads, 4) in the
+        order of :data:`DESIGNS`; with ``curves``, also ``curves``: a dict of ``flat``, (n_blocks,
+        n_steps), and of each name of :data:`foldopt.physics.connections.CONNECTIONS`, (n_blocks,
+        n_loads, n_steps).
     """
     study, blocks_of = blocks.study, blocks
     n_blocks, n_loads = sky.n_blocks, loads.size
@@ -390,7 +391,7 @@ def design_metrics(
         )
     fold = np.stack(
         [
-            np.full((n_blocks, n_loads), 180.0),
+            np.full((n_blocks, n_loads), FLAT_FOLD_ANGLE),
             fold_angles[chosen],
             np.full((n_blocks, n_loads), np.nan),
             np.full((n_blocks, n_loads), np.nan),
@@ -438,12 +439,11 @@ def design_metrics(
     return {
         "fold_angle_deg": fold,
         **columns,
-        "poa_kwh_m2": per_design(
+        "poa_global_wh_m2": per_design(
             twofold.irradiation,
             np.repeat(flat.irradiation[:, None], n_loads, axis=1),
             np.repeat(np.r_[tracker_poa, tracker_poa][:, None], n_loads, axis=1),
-        )
-        / 1000.0,
+        ),
         # A tracker whose drive costs more than it harvests says so where every table's note starts.
         "condition": design_condition(condition[:, None, None], columns["energy_harvested_wh"]),
         **drawn,

@@ -40,9 +40,8 @@ from foldopt.inputs.optimize_section import DEFAULT_TILT, MAX_DESIGNS
 from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 from foldopt.studies.objectives import (
-    FLAT_FOLD_ANGLE,
     best_angle_index,
     near_optimal,
     objective_quantum,
@@ -72,7 +71,8 @@ class OptimizeResult:
         The searches as the variables join (the last is ``twofold``).
     table : pandas.DataFrame
         Per load and design (``twofold``, ``flat``, ``twofold-default``, ``flat-default``,
-        ``tracker``, ``tracker-net``): ``fold_angle_deg``, ``surface_tilt``, ``surface_azimuth``, ``objective_h`` and
+        ``tracker``, ``tracker-net``): ``fold_angle_deg``, ``surface_tilt``, ``surface_azimuth``,
+        ``t_solar_objective_h`` and
         ``gain_vs_flat_pct`` (over the flat panel at its own best); ``twofold`` and ``flat`` are the
         best designs evaluated within their ranges (:func:`_best_within`).
     near_optimal : pandas.DataFrame
@@ -364,8 +364,8 @@ def _table(study, loads, optimum, flat, fold_angles, best_default, default) -> p
                     "design": design,
                     "fold_angle_deg": fold,
                     "surface_tilt": tilt,
-                    "surface_azimuth": azimuth % 360.0 if azimuth == azimuth else azimuth,
-                    "objective_h": value,
+                    "surface_azimuth": azimuth % 360.0,
+                    "t_solar_objective_h": value,
                     "gain_vs_flat_pct": 100.0 * (value / flat_best[index] - 1.0)
                     if flat_best[index] > 0
                     else np.nan,
@@ -401,7 +401,7 @@ def _near_optimal(study, loads, search: SearchResult, optimum) -> pd.DataFrame:
                     "variable": axis.name,
                     "near_optimal_lo_deg": float(ranges["near_optimal_lo_deg"]),
                     "near_optimal_hi_deg": float(ranges["near_optimal_hi_deg"]),
-                    "recommended_deg": float(ranges["recommended_fold_angle_deg"]),
+                    "recommended_deg": float(ranges["recommended_deg"]),
                     "near_optimal_tolerance_h": float(ranges["near_optimal_tolerance_h"]),
                 }
             )
@@ -420,10 +420,10 @@ def _added(loads, steps, start) -> pd.DataFrame:
                 {
                     "p_load_w": load,
                     "variable": name,
-                    "objective_h": value[index],
+                    "t_solar_objective_h": value[index],
                     "added_h": value[index] - before[index],
-                    "evaluated_designs": search.index.shape[0],
-                    "grid_designs": search.grid_size,
+                    "designs_evaluated_n": search.index.shape[0],
+                    "designs_grid_n": search.grid_size,
                 }
             )
         before = value
@@ -453,6 +453,6 @@ def _landscape(
             "fold_angle_deg": fold,
             "surface_tilt": tilt,
             "surface_azimuth": best[2] % 360.0,
-            "objective_h": value,
+            "t_solar_objective_h": value,
         }
     )

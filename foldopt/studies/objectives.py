@@ -15,10 +15,7 @@ from scipy.interpolate import PchipInterpolator
 
 from foldopt.engine.curve_reduction import period_means
 from foldopt.inputs.sections import NearOptimal
-
-
-#: The fold angle of the flat panel [deg]: a twofold panel unfolded is the flat panel.
-FLAT_FOLD_ANGLE = 180.0
+from foldopt.names import FLAT_FOLD_ANGLE
 
 
 def best_angle_index(hours):
@@ -192,7 +189,7 @@ def near_optimal(fold_angles, values, tolerance: NearOptimal, fold: bool = True)
     Returns
     -------
     dict of numpy.ndarray
-        ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg`` [deg] and
+        ``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_deg`` [deg] and
         ``near_optimal_tolerance_h`` [h], each (...); NaN where no angle carries the load.
     """
     fold_angles = np.asarray(fold_angles, dtype=float)
@@ -210,7 +207,7 @@ def near_optimal(fold_angles, values, tolerance: NearOptimal, fold: bool = True)
     return {
         "near_optimal_lo_deg": lo,
         "near_optimal_hi_deg": hi,
-        "recommended_fold_angle_deg": recommended_angle(
+        "recommended_deg": recommended_angle(
             fold_angles, lo, hi, fold_angles[best] if fold else None
         ),
         "near_optimal_tolerance_h": np.where(carried, tol, np.nan),
@@ -312,7 +309,7 @@ def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> d
             kept = gap & (place > stop[:, None])
             last = np.argmax(kept, axis=1)
         ranges[name] = np.where(kept.any(axis=1), grid[last], edge)
-    ranges["recommended_fold_angle_deg"] = recommended_angle(
+    ranges["recommended_deg"] = recommended_angle(
         np.union1d(grid, fold_angles),
         ranges["near_optimal_lo_deg"],
         ranges["near_optimal_hi_deg"],
@@ -322,7 +319,7 @@ def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> d
 
 
 #: The percentiles over a cloud ensemble's members that the answer gives of each day's t_solar and
-#: of the objective (``t_solar_p10_h``..., ``objective_p10_h``...).
+#: of the objective (``t_solar_members_p10_h``..., ``t_solar_objective_members_p10_h``...).
 ENSEMBLE_PERCENTILES = (10, 50, 90)
 
 

@@ -6,7 +6,7 @@ adds, and how much of the grid the search evaluated."""
 from __future__ import annotations
 
 from foldopt.studies.answer import Answer, records
-from foldopt.studies.objectives import FLAT_FOLD_ANGLE
+from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.result_answers import request_defaults, study_question
 
 #: How the answer names each variable and its unit.
@@ -15,9 +15,9 @@ _LABELS = {"fold_angle": ("fold", "deg"), "tilt": ("tilt", "deg"), "azimuth": ("
 
 def _tracker_text(gross, net) -> str:
     """The tracker's objective, and net of its own draw (standby, drive) where that costs any."""
-    text = f"tracker {gross.objective_h:.2f} h"
-    if net.objective_h < gross.objective_h:
-        text += f" ({net.objective_h:.2f} h net of its own draw)"
+    text = f"tracker {gross.t_solar_objective_h:.2f} h"
+    if net.t_solar_objective_h < gross.t_solar_objective_h:
+        text += f" ({net.t_solar_objective_h:.2f} h net of its own draw)"
     return text
 
 
@@ -32,8 +32,8 @@ def _mounting(row) -> str:
 def _over_flat(best, flat) -> str:
     """The optimum against the flat panel at its own best: a gain in per cent, or where the flat
     panel carries nothing (no ratio to give), its hours."""
-    where = f"the flat panel at its own best ({_mounting(flat)}: {flat.objective_h:.2f} h)"
-    if flat.objective_h > 0:
+    where = f"the flat panel at its own best ({_mounting(flat)}: {flat.t_solar_objective_h:.2f} h)"
+    if flat.t_solar_objective_h > 0:
         return f"{best.gain_vs_flat_pct:+.1f} % over {where}"
     return f"where {where} carries none of it"
 
@@ -89,7 +89,7 @@ def of_optimize(result) -> Answer:
         label = (
             f"load profile x {load:g}" if study.load_profile is not None else f"P_load {load:g} W"
         )
-        carried = best.objective_h > 0
+        carried = best.t_solar_objective_h > 0
         if not carried:
             # Every design ties at nothing: the search's tie-break is no optimum, nor is there a gain
             # or a near-optimal region to give.
@@ -101,11 +101,12 @@ def of_optimize(result) -> Answer:
         else:
             # A 180 deg fold is the flat panel: there the optimum is the flat panel's own best.
             lines.append(
-                f"{label}: flat (fold 180 deg), {_mounting(best)}: {best.objective_h:.2f} h, "
-                f"the flat panel at its own best: no fold gains over it; {tracker}"
+                f"{label}: flat (fold 180 deg), {_mounting(best)}: "
+                f"{best.t_solar_objective_h:.2f} h, the flat panel at its own best: no fold gains "
+                f"over it; {tracker}"
                 if best.fold_angle_deg == FLAT_FOLD_ANGLE
                 else f"{label}: fold {best.fold_angle_deg:g} deg, {_mounting(best)}: "
-                f"{best.objective_h:.2f} h, {_over_flat(best, flat)}; {tracker}"
+                f"{best.t_solar_objective_h:.2f} h, {_over_flat(best, flat)}; {tracker}"
             )
             if len(near):
                 lines.append(
@@ -120,14 +121,14 @@ def of_optimize(result) -> Answer:
             # What the variables add starts from the default mounting folded as the search holds it.
             first = added.iloc[0]
             folded = (
-                (best.fold_angle_deg, first.objective_h - first.added_h)
+                (best.fold_angle_deg, first.t_solar_objective_h - first.added_h)
                 if fixed_fold
-                else (default.fold_angle_deg, default.objective_h)
+                else (default.fold_angle_deg, default.t_solar_objective_h)
             )
             # + 0.0: no "-0.0" for a roundoff
             lines.append(
-                f"  over the default mounting ({_mounting(flat_default)}: flat {flat_default.objective_h:.2f} "
-                f"h, folded to {folded[0]:g} deg {folded[1]:.2f} h): "
+                f"  over the default mounting ({_mounting(flat_default)}: flat "
+                f"{flat_default.t_solar_objective_h:.2f} h, folded to {folded[0]:g} deg {folded[1]:.2f} h): "
                 + ", ".join(
                     f"{_LABELS[row.variable][0]} {round(row.added_h * 60, 1) + 0.0:+.1f} min"
                     for row in added.itertuples()
@@ -140,20 +141,22 @@ def of_optimize(result) -> Answer:
                 "fold_angle_deg": best.fold_angle_deg,
                 "surface_tilt": best.surface_tilt,
                 "surface_azimuth": best.surface_azimuth,
-                "objective_h": best.objective_h,
+                "t_solar_objective_h": best.t_solar_objective_h,
                 "gain_vs_flat_pct": best.gain_vs_flat_pct,
                 "flat": {
                     "surface_tilt": flat.surface_tilt,
                     "surface_azimuth": flat.surface_azimuth,
-                    "objective_h": flat.objective_h,
+                    "t_solar_objective_h": flat.t_solar_objective_h,
                 },
                 "default": {
                     "fold_angle_deg": default.fold_angle_deg,
-                    "objective_h": default.objective_h,
-                    "flat_objective_h": flat_default.objective_h,
+                    "t_solar_objective_h": default.t_solar_objective_h,
+                    "t_solar_flat_objective_h": flat_default.t_solar_objective_h,
                 },
-                "tracker_objective_h": _row(table, load, "tracker").objective_h,
-                "tracker_net_objective_h": _row(table, load, "tracker-net").objective_h,
+                "t_solar_tracker_objective_h": _row(table, load, "tracker").t_solar_objective_h,
+                "t_solar_tracker_net_objective_h": _row(
+                    table, load, "tracker-net"
+                ).t_solar_objective_h,
                 "added_h": dict(zip(added["variable"], added["added_h"], strict=True)),
                 "near_optimal": records(near.drop(columns="p_load_w")),
             }
@@ -177,8 +180,8 @@ def of_optimize(result) -> Answer:
         "days": days,
         "loads": per_load,
         "search": {
-            "evaluated": int(search.index.shape[0]),
-            "grid": search.grid_size,
+            "designs_evaluated_n": int(search.index.shape[0]),
+            "designs_grid_n": search.grid_size,
             "levels": [list(level) for level in search.levels],
             "tolerance_h": search.tolerance,
         },

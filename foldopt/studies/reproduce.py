@@ -27,9 +27,9 @@ PAPER_VALUES = {
     "fold_angle_twofold_deg": ("deg", 29.8),
     "t_solar_twofold_h": ("h", 9.49),
     "gain_vs_flat_twofold_pct": ("%", 23.0),
-    "pct_of_tracker_twofold": ("%", 85.4),
+    "share_of_tracker_twofold_pct": ("%", 85.4),
     "gain_vs_flat_twofold90_pct": ("%", 15.5),
-    "flat_area_multiple_twofold": ("-", 2.61),
+    "flat_area_twofold_ratio": ("-", 2.61),
 }
 GEOMETRY_OF_MODE = {"paper": "azimuth-split", "exact": "hinge"}
 #: The reproduction tables `foldopt reproduce` writes: file stem -> changes to the paper study.
@@ -101,9 +101,9 @@ def reproduction_values(study: Study, engine: str = DEFAULT_ENGINE) -> dict[str,
         "fold_angle_twofold_deg": twofold["fold_angle_deg"],
         "t_solar_twofold_h": twofold["t_solar_h"],
         "gain_vs_flat_twofold_pct": twofold["gain_vs_flat_pct"],
-        "pct_of_tracker_twofold": twofold["pct_of_tracker"],
+        "share_of_tracker_twofold_pct": twofold["share_of_tracker_pct"],
         "gain_vs_flat_twofold90_pct": (t_solar_twofold90 / flat["t_solar_h"] - 1.0) * 100.0,
-        "flat_area_multiple_twofold": twofold["flat_area_multiple"],
+        "flat_area_twofold_ratio": twofold["flat_area_ratio"],
     }
 
 

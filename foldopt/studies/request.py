@@ -47,6 +47,7 @@ from foldopt.inputs.study_file import default_study_path, parse_study_text, read
 from foldopt.names import (
     FIELD_OF_PARAMETER,
     FIELD_OPTIONS,
+    FLAT_FOLD_ANGLE,
     OPTIMIZE_VARIABLES,
     WEATHER_SOURCES,
     did_you_mean,
@@ -502,7 +503,10 @@ def _map_entries(options: dict, data: dict) -> list[tuple]:
     if options.get("angle_step") is not None:
         step = options["angle_step"]
         entries.append(
-            ("--angle-step", {"fold_angles": {"start": step, "stop": 180.0, "step": step}})
+            (
+                "--angle-step",
+                {"fold_angles": {"start": step, "stop": FLAT_FOLD_ANGLE, "step": step}},
+            )
         )
     searched = options.get("optimize")
     if options.get("fold_search") or searched:

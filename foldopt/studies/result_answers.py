@@ -9,6 +9,7 @@ summary in words. Views only render what these build.
 from __future__ import annotations
 
 import calendar
+import math
 from pathlib import Path
 
 import pandas as pd
@@ -17,7 +18,8 @@ from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.storage_answer import answer_part, buffer_text, year_lines
 from foldopt.studies.storage_days import DESIGN_COLUMNS, sequential
-from foldopt.studies.objectives import ENSEMBLE_PERCENTILES, FLAT_FOLD_ANGLE
+from foldopt.names import FLAT_FOLD_ANGLE
+from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
 from foldopt.studies.worldmap import searched_tilt
 
 #: The designs an answer compares, first the ones every study has.
@@ -25,27 +27,23 @@ MAIN_DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
 NEAR_OPTIMAL = (
     "near_optimal_lo_deg",
     "near_optimal_hi_deg",
-    "recommended_fold_angle_deg",
+    "recommended_deg",
     "near_optimal_tolerance_h",
 )
 
 
 def _hours(value) -> str:
-    return "-" if value is None or value != value else f"{value:.2f} h"
+    return "-" if pd.isna(value) else f"{value:.2f} h"
 
 
 def _pct(value, signed: bool = True) -> str:
-    return (
-        "-"
-        if value is None or value != value
-        else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
-    )
+    return "-" if pd.isna(value) else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
 
 
 def _fold_text(angle: float) -> str:
     """A fold angle [deg] to a tenth of a degree, or to a thousandth where a fold short of the flat
     panel would read 180.0 (a refined optimum a few hundredths below it is not the flat panel)."""
-    short = f"{angle:.1f}" == "180.0" and angle < FLAT_FOLD_ANGLE
+    short = f"{angle:.1f}" == f"{FLAT_FOLD_ANGLE:.1f}" and angle < FLAT_FOLD_ANGLE
     return f"{angle:.3f}" if short else f"{angle:.1f}"
 
 
@@ -236,7 +234,7 @@ def _turbidity_text(study, varied: tuple) -> str:
 
 def _range_text(row) -> str:
     lo, hi, recommended = (row.get(key) for key in NEAR_OPTIMAL[:3])
-    if lo is None or lo != lo:
+    if pd.isna(lo):
         return "near-optimal: no fold angle carries the load"
     return (
         f"near-optimal {lo:g} to {hi:g} deg (within {60 * row['near_optimal_tolerance_h']:.1f} min); "
@@ -272,8 +270,8 @@ def of_study(result) -> Answer:
         "t_solar_h": float(twofold["t_solar_h"]),
         "fold_angle_twofold_heuristic_deg": heuristic,
         "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
-        "pct_of_tracker": float(twofold["pct_of_tracker"]),
-        "flat_area_multiple": float(twofold["flat_area_multiple"]),
+        "share_of_tracker_pct": float(twofold["share_of_tracker_pct"]),
+        "flat_area_ratio": float(twofold["flat_area_ratio"]),
         "break_even_standby_tracker_w": float(result.standby[1]),
         **near,
         "t_solar_by_design_h": {d: float(by.loc[d, "t_solar_h"]) for d in MAIN_DESIGNS},
@@ -297,7 +295,7 @@ def of_study(result) -> Answer:
             + f": t_solar {_hours(hours['twofold'])}, "
             + versus_flat(result.optimal_fold_angle, twofold["gain_vs_flat_pct"], hours["flat"])
             + (
-                f", {_pct(twofold['pct_of_tracker'], False)} of the tracker's "
+                f", {_pct(twofold['share_of_tracker_pct'], False)} of the tracker's "
                 f"{_hours(hours['tracker'])}"
                 if hours["tracker"] > 0
                 else ", where the tracker carries none of it (0.00 h)"
@@ -305,9 +303,9 @@ def of_study(result) -> Answer:
         )
         lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
     extras = []
-    if twofold["flat_area_multiple"] == twofold["flat_area_multiple"]:
-        extras.append(f"a flat panel would need {twofold['flat_area_multiple']:.2f}x the area")
-    if result.standby[1] == result.standby[1]:
+    if not math.isnan(twofold["flat_area_ratio"]):
+        extras.append(f"a flat panel would need {twofold['flat_area_ratio']:.2f}x the area")
+    if not math.isnan(result.standby[1]):
         extras.append(
             f"the twofold panel outlasts the tracker once its standby draw exceeds "
             f"{result.standby[1]:.2f} W"
@@ -320,7 +318,7 @@ def of_study(result) -> Answer:
         "t_solar_h",
         "energy_harvested_wh",
         "gain_vs_flat_pct",
-        "pct_of_tracker",
+        "share_of_tracker_pct",
         "note",
     ]
     buffered = getattr(result, "storage", None)
@@ -357,7 +355,7 @@ def heuristic_text(study, heuristic: float, outside: str) -> str:
         :attr:`foldopt.studies.day.StudyResult.heuristic_outside`: ``below``, ``above`` or empty.
     """
     grid = study.fold_angles
-    if heuristic == heuristic:
+    if not math.isnan(heuristic):
         where = f"{heuristic:.1f} deg"
     elif outside == "below":
         where = f"at or below {grid.start:g} deg, the grid's first: the noon valley reaches the load there"
@@ -413,9 +411,9 @@ def of_sweep(result) -> Answer:
             "min": twofold["fold_angle_deg"].min(),
             "max": twofold["fold_angle_deg"].max(),
         },
-        "recommended_fold_angle_deg": {
-            "min": twofold["recommended_fold_angle_deg"].min(),
-            "max": twofold["recommended_fold_angle_deg"].max(),
+        "recommended_deg": {
+            "min": twofold["recommended_deg"].min(),
+            "max": twofold["recommended_deg"].max(),
         },
     }
     if len(gains):
@@ -434,8 +432,8 @@ def of_sweep(result) -> Answer:
             f"twofold over flat: median {_pct(gains.median())}, best {_pct(gains.max())} ({where}); "
             f"fold angles {part['fold_angle_deg']['min']:g} to {part['fold_angle_deg']['max']:g} deg"
         )
-    rec = part["recommended_fold_angle_deg"]
-    if rec["min"] == rec["min"]:
+    rec = part["recommended_deg"]
+    if not math.isnan(rec["min"]):
         lines.append(
             "recommended fold angles (each case's near-optimal centre, flat where flat is best) "
             f"{rec['min']:g} to {rec['max']:g} deg (near_optimal_lo_deg, near_optimal_hi_deg in the "
@@ -459,7 +457,7 @@ def of_sweep(result) -> Answer:
                 "t_solar_h",
                 "energy_harvested_wh",
                 "gain_vs_flat_pct",
-                "pct_of_tracker",
+                "share_of_tracker_pct",
                 "note",
             )
             if c in table
@@ -500,9 +498,9 @@ def _of_annual(result) -> Answer:
         not in (
             "design",
             "objective",
-            "objective_h",
+            "t_solar_objective_h",
             "worst_month",
-            "mean_t_solar_h",
+            "t_solar_mean_h",
             "fold_angle_deg",
             *NEAR_OPTIMAL,
             *ENSEMBLE_COLUMNS,
@@ -525,8 +523,8 @@ def _of_annual(result) -> Answer:
         case = {
             **where,
             "fold_angle_deg": twofold["fold_angle_deg"],
-            "objective_h": {d: by.loc[d, "objective_h"] for d in MAIN_DESIGNS},
-            "mean_t_solar_h": {d: by.loc[d, "mean_t_solar_h"] for d in MAIN_DESIGNS},
+            "t_solar_objective_h": {d: by.loc[d, "t_solar_objective_h"] for d in MAIN_DESIGNS},
+            "t_solar_mean_h": {d: by.loc[d, "t_solar_mean_h"] for d in MAIN_DESIGNS},
             **{k: twofold[k] for k in NEAR_OPTIMAL},
         }
         month = ""
@@ -535,8 +533,8 @@ def _of_annual(result) -> Answer:
             month = f" (in {calendar.month_name[case['worst_month']['twofold']]})"
         part["per_case"].append(case)
         gain = (
-            100.0 * (twofold["objective_h"] / flat["objective_h"] - 1.0)
-            if flat["objective_h"] > 0
+            100.0 * (twofold["t_solar_objective_h"] / flat["t_solar_objective_h"] - 1.0)
+            if flat["t_solar_objective_h"] > 0
             else float("nan")
         )
         flat_month = (
@@ -551,32 +549,37 @@ def _of_annual(result) -> Answer:
             else ""
         )
         head = f"{site + ': ' if site else ''}{label}: "
-        if not twofold["objective_h"] > 0:
+        if not twofold["t_solar_objective_h"] > 0:
             # Every angle ties at nothing: the tie-break is no choice, nor is there a gain to give.
             lines.append(
                 f"{head}no fold angle carries the load: {statistic} t_solar 0.00 h (flat "
-                f"{_hours(flat['objective_h'])}); tracker {_hours(tracker['objective_h'])}"
+                f"{_hours(flat['t_solar_objective_h'])}); tracker "
+                f"{_hours(tracker['t_solar_objective_h'])}"
             )
         else:
             lines.append(
                 f"{head}fold angle {twofold['fold_angle_deg']:g} deg {_period(count)}; "
-                f"{statistic} t_solar {_hours(twofold['objective_h'])}{month}, "
-                + versus_flat(twofold["fold_angle_deg"], gain, flat["objective_h"], flat_month)
-                + f"; tracker {_hours(tracker['objective_h'])}"
+                f"{statistic} t_solar {_hours(twofold['t_solar_objective_h'])}{month}, "
+                + versus_flat(
+                    twofold["fold_angle_deg"], gain, flat["t_solar_objective_h"], flat_month
+                )
+                + f"; tracker {_hours(tracker['t_solar_objective_h'])}"
                 + (
                     ""
                     if statistic == "mean"
-                    else f"; mean t_solar {_hours(twofold['mean_t_solar_h'])}"
+                    else f"; mean t_solar {_hours(twofold['t_solar_mean_h'])}"
                 )
             )
-        if twofold["objective_h"] > 0:
+        if twofold["t_solar_objective_h"] > 0:
             lines.append("  " + _range_text(twofold.to_dict()))
         if members:
             spread = {
-                d: {f"p{pct}": by.loc[d, f"objective_p{pct}_h"] for pct in ENSEMBLE_PERCENTILES}
-                for d in MAIN_DESIGNS
+                column: {d: by.loc[d, column] for d in MAIN_DESIGNS}
+                for column in (
+                    f"t_solar_objective_members_p{pct}_h" for pct in ENSEMBLE_PERCENTILES
+                )
             }
-            case["objective_spread_h"] = spread
+            case.update(spread)
             case["members"] = members
             case.update({key: twofold[key] for key in ("chosen_wins_pct", "within_tolerance_pct")})
             lines.append(
@@ -584,7 +587,7 @@ def _of_annual(result) -> Answer:
                 + "/".join(f"P{pct}" for pct in ENSEMBLE_PERCENTILES)
                 + " "
                 + "; ".join(
-                    f"{d} " + "/".join(_hours(value) for value in spread[d].values())
+                    f"{d} " + "/".join(_hours(values[d]) for values in spread.values())
                     for d in MAIN_DESIGNS
                 )
             )
@@ -595,7 +598,7 @@ def _of_annual(result) -> Answer:
             )
         if len(schedule):
             mine = schedule[(schedule["p_load_w"] == load)] if load is not None else schedule
-            for settings, visits in mine.groupby("settings", sort=True):
+            for settings, visits in mine.groupby("settings_n", sort=True):
                 first = visits.iloc[0]
                 when = ", ".join(
                     f"{v.date} at {v.fold_angle_deg:g} deg" for v in visits.itertuples()
@@ -603,7 +606,7 @@ def _of_annual(result) -> Answer:
                 added = "" if settings == 1 else f" (+{first['added_by_setting_h'] * 60:.1f} min)"
                 lines.append(
                     f"  {settings} setting{'s' if settings > 1 else ''}: {statistic} t_solar "
-                    f"{_hours(first['objective_h'])}{added}: {when}"
+                    f"{_hours(first['t_solar_objective_h'])}{added}: {when}"
                 )
     if len(groups) > 8:
         lines.append(f"... and {len(groups) - 8} more cases (annual_objective.csv)")
@@ -626,9 +629,9 @@ def _of_annual(result) -> Answer:
             *keys,
             "design",
             "objective",
-            "objective_h",
+            "t_solar_objective_h",
             "worst_month",
-            "mean_t_solar_h",
+            "t_solar_mean_h",
             "fold_angle_deg",
             *[c for c in ENSEMBLE_COLUMNS if c in objectives],
         ]
@@ -657,7 +660,7 @@ def _of_annual(result) -> Answer:
 
 #: The annual objective's columns over a cloud ensemble (foldopt.studies.sweeps.objective_table).
 ENSEMBLE_COLUMNS = (
-    *(f"objective_p{pct}_h" for pct in ENSEMBLE_PERCENTILES),
+    *(f"t_solar_objective_members_p{pct}_h" for pct in ENSEMBLE_PERCENTILES),
     "chosen_wins_pct",
     "within_tolerance_pct",
 )
@@ -679,7 +682,9 @@ def _schedule(extras: dict) -> pd.DataFrame:
     visits, values = extras["refold_schedule"], extras["refold_value"]
     keys = [c for c in visits.columns if c not in ("visit", "date", "fold_angle_deg")]
     merged = visits.merge(
-        values[[*keys, "objective", "objective_h", "added_by_setting_h", "gain_vs_fixed_pct"]],
+        values[
+            [*keys, "objective", "t_solar_objective_h", "added_by_setting_h", "gain_vs_fixed_pct"]
+        ],
         on=keys,
         how="left",
     )
@@ -758,7 +763,7 @@ def of_reproduction(tables: dict, study) -> Answer:
         )
         lines.append(f"Shin et al. ({model}): paper value | paper mode | exact mode")
         for row in table.itertuples():
-            paper = "-" if row.paper != row.paper else f"{row.paper:g}"
+            paper = "-" if math.isnan(row.paper) else f"{row.paper:g}"
             lines.append(
                 f"  {row.quantity:28s} {paper:>7s} | {row.paper_mode:8.3f} | {row.exact_mode:8.3f}  "
                 f"{row.unit}"
@@ -792,14 +797,14 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
     ----------
     result : foldopt.studies.cluster.MapRun
     relative : bool
-        Loads as fractions of each site's flat peak (``p_load_fraction``), else in W.
+        Loads as fractions of each site's flat peak (``p_load_frac``), else in W.
     defaults : dict, optional
     """
     table, spec = result.table, result.spec
     study = spec.study
     tilts = searched_tilt(study)
     year = table[table["period"] == "year"]
-    key = "p_load_fraction" if relative else "p_load_w"
+    key = "p_load_frac" if relative else "p_load_w"
     per_load = []
     # A fraction is watts over each site's peak: the same load to 12 digits at every site.
     for load, rows in year.groupby(year[key].round(12), sort=True):
@@ -810,8 +815,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                 key: float(load),
                 "sites": int(len(rows)),
                 "sites_folding_pays": int((gain > 0.05).sum()),
-                "median_gain_vs_flat_pct": gain.median(),
-                "best_gain_vs_flat_pct": gain.max(),
+                "gain_vs_flat_median_pct": gain.median(),
+                "gain_vs_flat_max_pct": gain.max(),
                 "best_site": None
                 if best is None
                 else {
@@ -824,12 +829,12 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                     "median": rows["fold_angle_deg"].median(),
                     "max": rows["fold_angle_deg"].max(),
                 },
-                "recommended_fold_angle_deg": {
-                    "min": rows["recommended_fold_angle_deg"].min(),
-                    "median": rows["recommended_fold_angle_deg"].median(),
-                    "max": rows["recommended_fold_angle_deg"].max(),
+                "recommended_deg": {
+                    "min": rows["recommended_deg"].min(),
+                    "median": rows["recommended_deg"].median(),
+                    "max": rows["recommended_deg"].max(),
                 },
-                "median_near_optimal_width_deg": (
+                "near_optimal_width_median_deg": (
                     rows["near_optimal_hi_deg"] - rows["near_optimal_lo_deg"]
                 ).median(),
                 **{
@@ -838,10 +843,10 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
                         "median": rows[column].median(),
                         "max": rows[column].max(),
                     }
-                    for column in ("surface_tilt", "surface_tilt_flat")
+                    for column in ("surface_tilt", "surface_tilt_flat_deg")
                 },
-                "median_pct_of_tracker": rows["pct_of_tracker"].median(),
-                "median_break_even_standby_tracker_w": rows[
+                "share_of_tracker_median_pct": rows["share_of_tracker_pct"].median(),
+                "break_even_standby_tracker_median_w": rows[
                     "break_even_standby_tracker_w"
                 ].median(),
             }
@@ -873,7 +878,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
     ]
     for load in part["loads"]:
         what = (
-            f"P_load {load['p_load_fraction']:g} x flat peak"
+            f"P_load {load['p_load_frac']:g} x flat peak"
             if relative
             else f"P_load {load['p_load_w']:g} W"
         )
@@ -883,8 +888,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
             if best is None
             else (best["site_name"] or f"{best['latitude']:g}, {best['longitude']:g}")
         )
-        rec = load["recommended_fold_angle_deg"]
-        standby = load["median_break_even_standby_tracker_w"]
+        rec = load["recommended_deg"]
+        standby = load["break_even_standby_tracker_median_w"]
         tracker = (
             ""
             if standby is None
@@ -898,10 +903,10 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
             if rec["min"] is None
             else f"best fold angles {best_angles['min']:g} to {best_angles['max']:g} deg, recommended "
             f"{rec['min']:g} to {rec['max']:g} deg (median {rec['median']:g}, near-optimal ranges a median "
-            f"{load['median_near_optimal_width_deg']:g} deg wide)"
+            f"{load['near_optimal_width_median_deg']:g} deg wide)"
         )
         if tilts is not None and rec["min"] is not None:
-            tilt, flat = load["surface_tilt"], load["surface_tilt_flat"]
+            tilt, flat = load["surface_tilt"], load["surface_tilt_flat_deg"]
             rec_text += (
                 f", at base tilts {tilt['min']:g} to {tilt['max']:g} deg (median {tilt['median']:g}; "
                 f"the flat panel's own best {flat['min']:g} to {flat['max']:g}, median {flat['median']:g})"
@@ -910,16 +915,17 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         gains = (
             ""
             if best is None
-            else f" (median {_pct(load['median_gain_vs_flat_pct'])}, best "
-            f"{_pct(load['best_gain_vs_flat_pct'])} at {where})"
+            else f" (median {_pct(load['gain_vs_flat_median_pct'])}, best "
+            f"{_pct(load['gain_vs_flat_max_pct'])} at {where})"
         )
         lines.append(
             f"{what}: folding beats flat at {load['sites_folding_pays']} of {_count(load['sites'], 'site')}"
             f"{gains}; {rec_text}; "
             + (
                 f"the tracker carries it at no site{' either' if rec['min'] is None else ''}"
-                if load["median_pct_of_tracker"] is None
-                else f"median {_pct(load['median_pct_of_tracker'], False)} of the tracker{tracker}"
+                if load["share_of_tracker_median_pct"] is None
+                else f"median {_pct(load['share_of_tracker_median_pct'], False)} of the "
+                f"tracker{tracker}"
             )
         )
     rate = len(spec.sites) / part["seconds"] if part["seconds"] else 0
@@ -954,7 +960,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         key,
         "fold_angle_deg",
         "surface_tilt",
-        "surface_tilt_flat",
+        "surface_tilt_flat_deg",
         *NEAR_OPTIMAL,
     ]
     return Answer(

@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from foldopt.engine.search import Axis, GridSearch
+from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.designs import requested_hours
 from foldopt.studies.objectives import objective_quantum, period_values
 
@@ -163,7 +164,7 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis 
                 requests = []
                 for site, points in asked.items():
                     first = sites[site][0]
-                    angle = np.full(points.shape[0], 180.0) if flat else points[:, 0]
+                    angle = np.full(points.shape[0], FLAT_FOLD_ANGLE) if flat else points[:, 0]
                     tilt_of = (
                         points[:, -1]
                         if tilt is not None

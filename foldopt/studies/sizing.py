@@ -18,9 +18,10 @@ import pandas as pd
 from foldopt.engine import evaluation as engines
 from foldopt.inputs.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2  # noqa: F401 (re-exported)
 from foldopt.engine.metrics import load_for_t_solar
+from foldopt.names import FLAT_FOLD_ANGLE
 
 
-def flat_area_multiple(p_flat, p_load, target_t_solar, step_hours):
+def flat_area_ratio(p_flat, p_load, target_t_solar, step_hours):
     """Factor by which the flat panel's area must grow to reach ``target_t_solar``.
 
     Parameters
@@ -169,7 +170,7 @@ def size_panel(
     twofold_hours = all_hours[1:].T
     best = twofold_hours.shape[1] - 1 - np.argmax(twofold_hours[:, ::-1], axis=1)
     hours = {
-        "flat": (np.full(areas.size, 180.0), all_hours[0]),
+        "flat": (np.full(areas.size, FLAT_FOLD_ANGLE), all_hours[0]),
         "twofold": (fold_angles[best], twofold_hours[np.arange(areas.size), best]),
     }
     unit_cost = (

@@ -134,7 +134,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
         "powered_by_design_h": per_design("powered_h"),
         "t_solar_by_design_h": per_design("t_solar_h"),
         "availability_by_design_pct": per_design("availability_pct"),
-        "days_powered_24h_by_design_pct": per_design("days_powered_24h_pct"),
+        "powered_days_ge24h_by_design_pct": per_design("powered_days_ge24h_pct"),
         "energy_missing_by_design_wh": per_design("energy_missing_wh"),
         "energy_lost_by_design_wh": per_design("energy_lost_wh"),
         "days_full_by_design_pct": per_design("days_full_pct"),
@@ -176,7 +176,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             f"best fold angle for the buffer {buffered.fold_angle_deg:g} deg: powered "
             f"{best_h:.2f} h, {_signed(best_h - powered['flat'], 2)} h over flat; near-optimal "
             f"{near['near_optimal_lo_deg']:g} to {near['near_optimal_hi_deg']:g} deg, "
-            f"recommended {near['recommended_fold_angle_deg']:g} deg "
+            f"recommended {near['recommended_deg']:g} deg "
             f"({near['recommended_powered_h']:.2f} h)"
         )
     lines.append(
@@ -202,7 +202,7 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
         table = sizing.table.set_index("design")
         need = table["capacity_wh"]
         angle = float(table.loc["twofold", "fold_angle_deg"])
-        saving = float(table.loc["twofold", "capacity_vs_flat_pct"])
+        saving = float(table.loc["twofold", "capacity_gain_vs_flat_pct"])
         part["sizing"] = {
             "target_powered_h": target.powered_h,
             "target_days_pct": target.days_pct,
@@ -257,12 +257,12 @@ def _best_for_buffer(by: pd.DataFrame, angle) -> str:
     statistic = best["objective"]
     said = f"  best fold angle for the buffer ({statistic} powered time)"
     return (
-        f"{said}: {angle['twofold-buffer']:g} deg, {best['objective_powered_h']:.2f} h (t_solar's "
-        f"{angle['twofold']:g} deg: {by.loc['twofold', 'objective_powered_h']:.2f} h; flat "
-        f"{by.loc['flat', 'objective_powered_h']:.2f} h); "
+        f"{said}: {angle['twofold-buffer']:g} deg, {best['powered_objective_h']:.2f} h (t_solar's "
+        f"{angle['twofold']:g} deg: {by.loc['twofold', 'powered_objective_h']:.2f} h; flat "
+        f"{by.loc['flat', 'powered_objective_h']:.2f} h); "
         + (
             f"near-optimal {best['near_optimal_lo_deg']:g} to {best['near_optimal_hi_deg']:g} deg, "
-            f"recommended {best['recommended_fold_angle_deg']:g} deg"
+            f"recommended {best['recommended_deg']:g} deg"
             if best["near_optimal_lo_deg"] == best["near_optimal_lo_deg"]
             else f"no fold angle runs the load ({statistic} powered time 0 h at every angle): no "
             "near-optimal range"
@@ -303,13 +303,13 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
         lines.append(
             f"  {site}P_load {p_load:g}: mean powered time "
             + ", ".join(
-                f"{named[d]} {by.loc[d, 'mean_powered_h']:.2f} h "
-                f"(t_solar {by.loc[d, 'mean_t_solar_h']:.2f} h)"
+                f"{named[d]} {by.loc[d, 'powered_mean_h']:.2f} h "
+                f"(t_solar {by.loc[d, 't_solar_mean_h']:.2f} h)"
                 for d in YEAR_SAID
                 if d != "twofold-buffer" or _another(angle)
             )
             + "; all 24 h on "
-            + ", ".join(f"{d} {by.loc[d, 'days_powered_24h_pct']:.0f} %" for d in SOC_DESIGNS)
+            + ", ".join(f"{d} {by.loc[d, 'powered_days_ge24h_pct']:.0f} %" for d in SOC_DESIGNS)
             + " of days; days full/empty "
             + ", ".join(
                 f"{d} {by.loc[d, 'days_full_pct']:.0f}/{by.loc[d, 'days_empty_pct']:.0f} %"
@@ -322,7 +322,7 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
             said = f"{target.powered_h:g} h" + (
                 f" on {target.days_pct:g} % of days" if target.days_pct < 100 else " every day"
             )
-            need, saving = by["capacity_wh"], by["capacity_vs_flat_pct"]
+            need, saving = by["capacity_wh"], by["capacity_gain_vs_flat_pct"]
             lines.append(
                 f"  for {said}: "
                 + ", ".join(

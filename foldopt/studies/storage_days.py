@@ -52,7 +52,7 @@ def storage_engine(engine: str) -> str:
 SUMMARY_COLUMNS = {
     "powered_h": "powered_h",
     "availability_pct": "availability_pct",
-    "days_without_outage_pct": "days_powered_24h_pct",
+    "days_without_outage_pct": "powered_days_ge24h_pct",
     "missing_wh": "energy_missing_wh",
     "lost_wh": "energy_lost_wh",
     "days_full_pct": "days_full_pct",
@@ -63,7 +63,7 @@ SUMMARY_COLUMNS = {
 def day_columns(result: StorageResult) -> dict:
     """Per series, the day's (or the mean day's) buffered metrics by the columns' names
     (:data:`SUMMARY_COLUMNS`): ``powered_h`` [h a day], ``availability_pct`` (the load's energy
-    served, of its demand), ``days_powered_24h_pct`` (days with no energy missing),
+    served, of its demand), ``powered_days_ge24h_pct`` (days with no energy missing),
     ``energy_missing_wh`` and ``energy_lost_wh`` [Wh a day], ``days_full_pct`` and
     ``days_empty_pct`` (PVGIS's), each (n_series,).
 
@@ -209,7 +209,7 @@ def day_storage(
         for key, value in near_optimal(fold_angles, by_angle, study.near_optimal).items()
     }
     best = int(best_angle_index(by_angle))
-    recommended = near["recommended_fold_angle_deg"]
+    recommended = near["recommended_deg"]
     near["recommended_powered_h"] = (
         float(by_angle[fold_angles == recommended][0]) if recommended == recommended else np.nan
     )
@@ -385,14 +385,14 @@ def year_storage(
     pandas.DataFrame
         Per load and design: ``site_name``, ``latitude``, ``longitude``, ``p_load_w``,
         ``design``, ``fold_angle_deg``, ``days``, ``objective`` (the statistic),
-        ``objective_powered_h`` (of the daily powered time), ``mean_powered_h``,
-        ``min_powered_h``, ``mean_t_solar_h`` (of the same curves, with no buffer: the 0 Wh
-        run) and :func:`day_columns`' ``availability_pct``, ``days_powered_24h_pct``,
+        ``powered_objective_h`` (of the daily powered time), ``powered_mean_h``,
+        ``powered_min_h``, ``t_solar_mean_h`` (of the same curves, with no buffer: the 0 Wh
+        run) and :func:`day_columns`' ``availability_pct``, ``powered_days_ge24h_pct``,
         ``energy_missing_wh``, ``energy_lost_wh`` (a day, the days' mean), ``days_full_pct``,
         ``days_empty_pct``; ``converged`` where every series found its periodic state; with
         ``storage.target``, ``capacity_wh``, the smallest buffer reaching it over the days
         (:func:`~foldopt.studies.storage_sizing.smallest_buffers`; NaN: none up to the grid's
-        top), ``capacity_vs_flat_pct`` and ``monotone``; the near-optimal range of
+        top), ``capacity_gain_vs_flat_pct`` and ``monotone``; the near-optimal range of
         ``twofold-buffer`` (NaN in the other rows).
     """
     engine = storage_engine(engine)
@@ -435,7 +435,11 @@ def year_storage(
             )
             with np.errstate(invalid="ignore", divide="ignore"):
                 vs_flat = (need / need[0] - 1.0) * 100.0 if need[0] > 0 else np.nan * need
-            sized = {"capacity_wh": need, "capacity_vs_flat_pct": vs_flat, "monotone": monotone}
+            sized = {
+                "capacity_wh": need,
+                "capacity_gain_vs_flat_pct": vs_flat,
+                "monotone": monotone,
+            }
         score = objective_value(powered.T, months, objective.statistic, objective.months)
         angles = np.array([choice.fold_angle_deg[d][index] for d in YEAR_DESIGNS])
         chosen = np.asarray(YEAR_DESIGNS) == "twofold-buffer"
@@ -448,12 +452,12 @@ def year_storage(
                     "p_load_w": p_load,
                     "design": YEAR_DESIGNS,
                     "fold_angle_deg": angles,
-                    "days": powered.shape[1],
+                    "days_n": powered.shape[1],
                     "objective": objective.statistic,
-                    "objective_powered_h": score,
-                    "mean_powered_h": powered.mean(axis=1),
-                    "min_powered_h": powered.min(axis=1),
-                    "mean_t_solar_h": bare.powered_h.reshape(shape).mean(axis=1),
+                    "powered_objective_h": score,
+                    "powered_mean_h": powered.mean(axis=1),
+                    "powered_min_h": powered.min(axis=1),
+                    "t_solar_mean_h": bare.powered_h.reshape(shape).mean(axis=1),
                     **{k: v for k, v in day_columns(result).items() if k != "powered_h"},
                     "converged": result.converged.reshape(shape[0], -1).all(axis=1),
                     **sized,

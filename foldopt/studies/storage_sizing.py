@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.engine.storage import Buffer, StorageResult, simulate
 from foldopt.studies.objectives import best_angle_index
 
@@ -89,7 +90,7 @@ class Sizing:
         Per design (``flat``, ``twofold`` at the angle needing the least, ``tracker``,
         ``tracker-net``): ``design``, ``fold_angle_deg``, ``capacity_wh`` (NaN where no buffer up
         to the grid's top reaches the target), ``monotone`` (every larger capacity of the grid
-        reaches it too; module docstring) and ``capacity_vs_flat_pct``.
+        reaches it too; module docstring) and ``capacity_gain_vs_flat_pct``.
     curve : pandas.DataFrame
         ``capacity_wh`` and ``powered_{flat,twofold,tracker}_h``: powered time against capacity,
         the twofold panel at each capacity's best of the angles compared.
@@ -182,13 +183,13 @@ def size_buffers(
         table = pd.DataFrame(
             {
                 "design": ["flat", "twofold", "tracker", "tracker-net"],
-                "fold_angle_deg": [180.0, fold_angles[pick - 3], np.nan, np.nan],
+                "fold_angle_deg": [FLAT_FOLD_ANGLE, fold_angles[pick - 3], np.nan, np.nan],
                 "capacity_wh": found,
                 "monotone": _held_above(ok[keep], first[keep]),
             }
         )
         with np.errstate(invalid="ignore", divide="ignore"):
-            table["capacity_vs_flat_pct"] = np.where(
+            table["capacity_gain_vs_flat_pct"] = np.where(
                 np.isfinite(found) & (found[0] > 0), (found / found[0] - 1.0) * 100.0, np.nan
             )
     # The capacities the sizing found are points of the search too, so that what the answer says

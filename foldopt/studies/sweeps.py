@@ -43,7 +43,7 @@ from foldopt.studies.objectives import (
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 from foldopt.studies.storage_days import YearChoice, YearDays, powered_by_angle, year_storage
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
 
 @dataclass(frozen=True)
@@ -109,7 +109,7 @@ def run_plan(
     SweepResult
         Columns: the case (``site_name``, ``latitude``, ``longitude``, ``date``, ``dayofyear``,
         ``p_load_w`` and any other swept field by its path), ``design``, ``fold_angle_deg`` and the
-        daily metrics, ``gain_vs_flat_pct``, ``pct_of_tracker`` and ``note``
+        daily metrics, ``gain_vs_flat_pct``, ``share_of_tracker_pct`` and ``note``
         (:func:`foldopt.engine.metrics.notes`: polar night, polar day, overcast, load above peak).
     """
     axes = dict(plan.axes)
@@ -322,9 +322,9 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
             {
                 "p_load_w": np.repeat(loads, fold_angles.size),
                 "fold_angle_deg": np.tile(fold_angles, loads.size),
-                "objective_h": score.ravel(),
-                "mean_t_solar_h": daily.mean(axis=0).ravel(),
-                "min_t_solar_h": daily.min(axis=0).ravel(),
+                "t_solar_objective_h": score.ravel(),
+                "t_solar_mean_h": daily.mean(axis=0).ravel(),
+                "t_solar_min_h": daily.min(axis=0).ravel(),
                 "chosen": np.ravel(np.arange(fold_angles.size) == fixed[:, None]),
                 **({"wins_pct": ensemble["wins_pct"].ravel()} if ensemble is not None else {}),
             }
@@ -396,7 +396,7 @@ def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, 
         site=study.site,
         objective=objective,
         fold_angle_deg={
-            "flat": np.full(loads.size, 180.0),
+            "flat": np.full(loads.size, FLAT_FOLD_ANGLE),
             "twofold": fold_angles[fixed],
             "twofold-buffer": fold_angles[best],
             "tracker": tracker,
@@ -465,7 +465,7 @@ def _over_members(group: dict, members: int) -> dict:
         )
     hours = group["t_solar_h"].reshape(-1, members, *group["t_solar_h"].shape[1:])
     for pct in ENSEMBLE_PERCENTILES:
-        out[f"t_solar_p{pct}_h"] = np.percentile(hours, pct, axis=1)
+        out[f"t_solar_members_p{pct}_h"] = np.percentile(hours, pct, axis=1)
     return out
 
 
@@ -550,12 +550,12 @@ def objective_table(
                     "p_load_w": float(load),
                     "design": design,
                     "objective": statistic,
-                    "objective_h": float(values[index, d]),
+                    "t_solar_objective_h": float(values[index, d]),
                     "worst_month": int(month[index, d]) if month is not None else np.nan,
-                    "mean_t_solar_h": float(design_hours[season][:, index, d].mean()),
+                    "t_solar_mean_h": float(design_hours[season][:, index, d].mean()),
                     "fold_angle_deg": float(fold_angles[index])
                     if twofold
-                    else (180.0 if design == "flat" else np.nan),
+                    else (FLAT_FOLD_ANGLE if design == "flat" else np.nan),
                     **{
                         key: float(value[index]) if twofold else np.nan
                         for key, value in near.items()
@@ -564,7 +564,10 @@ def objective_table(
             )
             if spread is not None:
                 rows[-1].update(
-                    {f"objective_p{pct}_h": float(q[index, d]) for pct, q in quantiles.items()}
+                    {
+                        f"t_solar_objective_members_p{pct}_h": float(q[index, d])
+                        for pct, q in quantiles.items()
+                    }
                 )
                 rows[-1].update(
                     {
@@ -591,7 +594,7 @@ def _table(cases, loads, metrics) -> pd.DataFrame:
         if name not in ("fold_angle_deg", "condition"):
             columns[name] = metrics[name].ravel()
     columns["gain_vs_flat_pct"] = ((relative_to(hours, hours[..., :1]) - 1.0) * 100.0).ravel()
-    columns["pct_of_tracker"] = (relative_to(hours, hours[..., 2:3]) * 100.0).ravel()
+    columns["share_of_tracker_pct"] = (relative_to(hours, hours[..., 2:3]) * 100.0).ravel()
     columns["note"] = notes(metrics["condition"], hours).ravel()
     table = pd.DataFrame(columns)
     for name in case_rows[0]:
@@ -673,18 +676,18 @@ def refold_tables(
                 {
                     **where,
                     "p_load_w": float(load),
-                    "settings": k,
+                    "settings_n": k,
                     "objective": statistic,
-                    "objective_h": schedule.objective_h,
-                    "mean_t_solar_h": float(chosen.mean()),
+                    "t_solar_objective_h": schedule.objective_h,
+                    "t_solar_mean_h": float(chosen.mean()),
                     "gain_vs_fixed_pct": 100.0 * (schedule.objective_h / fixed - 1.0)
                     if fixed > 0
                     else np.nan,
                     "added_by_setting_h": np.nan
                     if previous is None
                     else schedule.objective_h - previous,
-                    "objective_flat_h": float(flat),
-                    "objective_tracker_h": float(tracker),
+                    "t_solar_flat_objective_h": float(flat),
+                    "t_solar_tracker_objective_h": float(tracker),
                 }
             )
             previous = schedule.objective_h
@@ -695,7 +698,7 @@ def refold_tables(
                     {
                         **where,
                         "p_load_w": float(load),
-                        "settings": k,
+                        "settings_n": k,
                         "visit": visit,
                         "date": blocks.dates[start].isoformat(),
                         "fold_angle_deg": float(fold_angles[angle]),

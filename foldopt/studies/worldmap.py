@@ -48,9 +48,8 @@ from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
 from foldopt.studies.site_search import fold_search
 from foldopt.engine.choice import engine_for
-from foldopt.names import DEFAULT_ENGINE
+from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 from foldopt.studies.objectives import (
-    FLAT_FOLD_ANGLE,
     best_angle_index,
     near_optimal_on_grid,
     objective_value,
@@ -510,15 +509,16 @@ def evaluate_sites(
     -------
     pandas.DataFrame
         One row per site, load and period: ``site_id``, ``site_name``, ``latitude``,
-        ``longitude``, ``weather``, ``peak_power_flat_w``, ``p_load_w``, ``p_load_fraction``, ``period``,
-        ``days``, ``fold_angle_deg``; the objective [h] of each design (``objective_flat_h``,
-        ``objective_twofold_h``, ``objective_tracker_h``); mean daily t_solar [h]
-        (``mean_t_solar_flat_h``, ``mean_t_solar_twofold_h``, ``mean_t_solar_tracker_h``, the tracker's net of its
-        own draw ``mean_t_solar_tracker_net_h``); harvested energy [Wh] (``energy_harvested_flat_wh``,
+        ``longitude``, ``weather``, ``peak_power_flat_w``, ``p_load_w``, ``p_load_frac``,
+        ``period``, ``days_n``, ``fold_angle_deg``; the objective [h] of each design
+        (``t_solar_flat_objective_h``, ``t_solar_twofold_objective_h``,
+        ``t_solar_tracker_objective_h``); mean daily t_solar [h] (``t_solar_flat_mean_h``,
+        ``t_solar_twofold_mean_h``, ``t_solar_tracker_mean_h``, the tracker's net of its own draw
+        ``t_solar_tracker_net_mean_h``); harvested energy [Wh] (``energy_harvested_flat_wh``,
         ``energy_harvested_twofold_wh``, ``energy_harvested_tracker_wh``); ``gain_vs_flat_pct`` and
-        ``pct_of_tracker`` (of the objective), ``energy_gain_vs_flat_pct``; and
+        ``share_of_tracker_pct`` (of the objective), ``energy_harvested_gain_vs_flat_pct``; and
         the near-optimal range of the fold angle and the recommended angle at its centre
-        (``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_fold_angle_deg``,
+        (``near_optimal_lo_deg``, ``near_optimal_hi_deg``, ``recommended_deg``,
         ``near_optimal_tolerance_h``: :func:`foldopt.studies.objectives.near_optimal`);
         ``break_even_standby_tracker_w``, the standby draw [W] above which the twofold panel's
         objective exceeds the tracker's (0 where it already does; NaN where the twofold panel
@@ -614,9 +614,11 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
             )
         columns.setdefault("p_load_w", []).append(np.tile(site_p_load, len(PERIODS)))
         fraction = site_p_load / peak_w if peak_w > 0 else np.full(loads.size, np.nan)
-        columns.setdefault("p_load_fraction", []).append(np.tile(fraction, len(PERIODS)))
+        columns.setdefault("p_load_frac", []).append(np.tile(fraction, len(PERIODS)))
     # The tracker's break-even standby of every site of the same days at once (their sites' own else).
-    targets = np.stack(columns["objective_twofold_h"]).reshape(len(batch), len(PERIODS), loads.size)
+    targets = np.stack(columns["t_solar_twofold_objective_h"]).reshape(
+        len(batch), len(PERIODS), loads.size
+    )
     same_days = all(np.array_equal(site_months, months[0]) for site_months in months)
     groups = [list(range(len(batch)))] if same_days else [[site] for site in range(len(batch))]
     standby = np.empty(targets.shape)
@@ -640,16 +642,16 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
         "weather",
         "peak_power_flat_w",
         "p_load_w",
-        "p_load_fraction",
+        "p_load_frac",
         "period",
-        "days",
+        "days_n",
         "fold_angle_deg",
         "surface_tilt",
-        "surface_tilt_flat",
+        "surface_tilt_flat_deg",
         *ROW_VALUES,
         "gain_vs_flat_pct",
-        "energy_gain_vs_flat_pct",
-        "pct_of_tracker",
+        "energy_harvested_gain_vs_flat_pct",
+        "share_of_tracker_pct",
         "break_even_standby_tracker_w",
     ]
     return pd.DataFrame({name: np.concatenate(columns[name]) for name in order})
@@ -668,20 +670,20 @@ def _tilt_axis(search: Optimize) -> Axis | None:
 
 #: The values of a map's row from the designs (in the order of its table).
 ROW_VALUES = (
-    "objective_flat_h",
-    "objective_twofold_h",
-    "objective_tracker_h",
-    "objective_tracker_net_h",
-    "mean_t_solar_flat_h",
-    "mean_t_solar_twofold_h",
-    "mean_t_solar_tracker_h",
-    "mean_t_solar_tracker_net_h",
+    "t_solar_flat_objective_h",
+    "t_solar_twofold_objective_h",
+    "t_solar_tracker_objective_h",
+    "t_solar_tracker_net_objective_h",
+    "t_solar_flat_mean_h",
+    "t_solar_twofold_mean_h",
+    "t_solar_tracker_mean_h",
+    "t_solar_tracker_net_mean_h",
     "energy_harvested_flat_wh",
     "energy_harvested_twofold_wh",
     "energy_harvested_tracker_wh",
     "near_optimal_lo_deg",
     "near_optimal_hi_deg",
-    "recommended_fold_angle_deg",
+    "recommended_deg",
     "near_optimal_tolerance_h",
 )
 
@@ -771,34 +773,36 @@ def _site_rows(
     carried = np.isfinite(p_load_evaluated)
     rows = {
         "period": np.repeat(np.array(PERIODS, dtype=object), n_loads),
-        "days": np.repeat(member.sum(axis=1), n_loads),
+        "days_n": np.repeat(member.sum(axis=1), n_loads),
         "fold_angle_deg": np.where(carried, angles[best], np.nan).ravel(),
         "surface_tilt": np.where(
             carried,
             tilts[best] if tilts is not None else np.full(best.shape, surface_tilt),
             np.nan,
         ).ravel(),
-        "surface_tilt_flat": np.where(carried, flat_tilts[flat_best], np.nan).ravel(),
-        "objective_flat_h": flat.ravel(),
-        "objective_twofold_h": twofold.ravel(),
-        "objective_tracker_h": tracker[:, 0].ravel(),
-        "objective_tracker_net_h": tracker[:, 1].ravel(),
-        "mean_t_solar_flat_h": flat_mean.ravel(),
-        "mean_t_solar_twofold_h": twofold_mean.ravel(),
-        "mean_t_solar_tracker_h": tracker_mean[:, 0].ravel(),
-        "mean_t_solar_tracker_net_h": tracker_mean[:, 1].ravel(),
+        "surface_tilt_flat_deg": np.where(carried, flat_tilts[flat_best], np.nan).ravel(),
+        "t_solar_flat_objective_h": flat.ravel(),
+        "t_solar_twofold_objective_h": twofold.ravel(),
+        "t_solar_tracker_objective_h": tracker[:, 0].ravel(),
+        "t_solar_tracker_net_objective_h": tracker[:, 1].ravel(),
+        "t_solar_flat_mean_h": flat_mean.ravel(),
+        "t_solar_twofold_mean_h": twofold_mean.ravel(),
+        "t_solar_tracker_mean_h": tracker_mean[:, 0].ravel(),
+        "t_solar_tracker_net_mean_h": tracker_mean[:, 1].ravel(),
         "energy_harvested_flat_wh": flat_wh.ravel(),
         "energy_harvested_twofold_wh": twofold_wh.ravel(),
         "energy_harvested_tracker_wh": np.repeat(tracker_wh, n_loads),
         **ranges,
     }
     with np.errstate(divide="ignore", invalid="ignore"):
-        gain = 100.0 * (rows["objective_twofold_h"] / rows["objective_flat_h"] - 1.0)
+        gain = 100.0 * (
+            rows["t_solar_twofold_objective_h"] / rows["t_solar_flat_objective_h"] - 1.0
+        )
         energy_gain = 100.0 * (
             rows["energy_harvested_twofold_wh"] / rows["energy_harvested_flat_wh"] - 1.0
         )
-        share = 100.0 * rows["objective_twofold_h"] / rows["objective_tracker_h"]
-    rows["gain_vs_flat_pct"] = np.where(rows["objective_flat_h"] > 0, gain, np.nan)
-    rows["energy_gain_vs_flat_pct"] = energy_gain
-    rows["pct_of_tracker"] = np.where(rows["objective_tracker_h"] > 0, share, np.nan)
+        share = 100.0 * rows["t_solar_twofold_objective_h"] / rows["t_solar_tracker_objective_h"]
+    rows["gain_vs_flat_pct"] = np.where(rows["t_solar_flat_objective_h"] > 0, gain, np.nan)
+    rows["energy_harvested_gain_vs_flat_pct"] = energy_gain
+    rows["share_of_tracker_pct"] = np.where(rows["t_solar_tracker_objective_h"] > 0, share, np.nan)
     return rows

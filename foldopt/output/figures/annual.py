@@ -10,6 +10,7 @@ import pandas as pd
 
 from foldopt.output.figures.canvas import FigureFile, load_label, new_axes
 from foldopt.output.figures.sweep import DAY_GAP, cells
+from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.physics.connections import SWITCH_STATES
 
 MONTH_NAMES = ("J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D")
@@ -34,7 +35,8 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, study=None, ax=N
     ----------
     by_angle : pandas.DataFrame
         A row per load and fold angle: ``p_load_w`` [W], ``fold_angle_deg`` [deg],
-        ``mean_t_solar_h`` and ``objective_h`` [h] and ``chosen`` (bool), as ``annual_fold_angles.csv``.
+        ``t_solar_mean_h`` and ``t_solar_objective_h`` [h] and ``chosen`` (bool), as
+        ``annual_fold_angles.csv``.
     title : str
     study : foldopt.Study, optional
         Names a load profile's loads in the legend.
@@ -50,23 +52,23 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, study=None, ax=N
     for (load, rows), colour in zip(by_angle.groupby("p_load_w"), colours, strict=False):
         ax.plot(
             rows["fold_angle_deg"],
-            rows["mean_t_solar_h"],
+            rows["t_solar_mean_h"],
             color=colour,
             label=f"mean, {load_label(study, load)}",
         )
         ax.plot(
             rows["fold_angle_deg"],
-            rows["objective_h"],
+            rows["t_solar_objective_h"],
             color=colour,
             ls="--",
             lw=1,
             label="objective",
         )
         chosen = rows[rows["chosen"]]
-        ax.plot(chosen["fold_angle_deg"], chosen["objective_h"], "o", color=colour)
+        ax.plot(chosen["fold_angle_deg"], chosen["t_solar_objective_h"], "o", color=colour)
     ax.set_xlabel("fold angle Θ kept all year [deg] (180 = flat)")
     ax.set_ylabel("daily t_solar [h]")
-    ax.set_xlim(0, 180)
+    ax.set_xlim(0, FLAT_FOLD_ANGLE)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
@@ -259,9 +261,9 @@ def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
     Parameters
     ----------
     values : pandas.DataFrame
-        As ``refold_value.csv``: ``latitude``, ``longitude`` [deg], ``p_load_w`` [W], ``settings``,
-        ``objective`` (its statistic), ``objective_h``, ``objective_flat_h`` and
-        ``objective_tracker_h`` [h].
+        As ``refold_value.csv``: ``latitude``, ``longitude`` [deg], ``p_load_w`` [W],
+        ``settings_n``, ``objective`` (its statistic), ``t_solar_objective_h``, ``t_solar_flat_objective_h`` and
+        ``t_solar_tracker_objective_h`` [h].
     title : str
     study : foldopt.Study, optional
         Names a load profile's loads.
@@ -280,19 +282,19 @@ def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
     colours = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     for (load, rows), colour in zip(first.groupby("p_load_w"), colours, strict=False):
         ax.plot(
-            rows["settings"],
-            rows["objective_h"],
+            rows["settings_n"],
+            rows["t_solar_objective_h"],
             "o-",
             color=colour,
             label=f"twofold, {load_label(study, load)}",
         )
-        ax.axhline(rows["objective_flat_h"].iloc[0], color=colour, ls="--", lw=1)
-        ax.axhline(rows["objective_tracker_h"].iloc[0], color=colour, ls=":", lw=1)
+        ax.axhline(rows["t_solar_flat_objective_h"].iloc[0], color=colour, ls="--", lw=1)
+        ax.axhline(rows["t_solar_tracker_objective_h"].iloc[0], color=colour, ls=":", lw=1)
     ax.plot([], [], "k--", lw=1, label="flat panel")
     ax.plot([], [], "k:", lw=1, label="tracker")
     ax.set_xlabel("fold settings a year (1 = one fixed angle)")
     ax.set_ylabel(f"{values['objective'].iloc[0]} daily t_solar [h]")
-    ax.set_xticks(sorted(first["settings"].unique()))
+    ax.set_xticks(sorted(first["settings_n"].unique()))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title, fontsize=10)

@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 
 from foldopt.inputs.study import Study
+from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.output.figures.canvas import FigureFile, new_axes
 from foldopt.studies.day import StudyResult
 
@@ -191,7 +192,7 @@ def plot_t_solar_vs_fold_angle(result: StudyResult, ax=None):
         )
     ax.set_xlabel("fold angle Θ [deg] (180 = flat)")
     ax.set_ylabel("t_solar [h]")
-    ax.set_xlim(0, 180)
+    ax.set_xlim(0, FLAT_FOLD_ANGLE)
     ax.set_title(
         f"{result.study.name}: t_solar vs fold angle ({_mode_label(result.study)})", fontsize=10
     )

@@ -17,10 +17,10 @@ def plot_landscape(landscape: pd.DataFrame, designs: pd.DataFrame, title: str, a
     Parameters
     ----------
     landscape : pandas.DataFrame
-        ``fold_angle_deg``, ``surface_tilt``, ``objective_h`` on a grid (``landscape.csv``).
+        ``fold_angle_deg``, ``surface_tilt``, ``t_solar_objective_h`` on a grid (``landscape.csv``).
     designs : pandas.DataFrame
         The optimum's designs of the first load: ``design`` (``twofold``, ``twofold-default``...),
-        ``fold_angle_deg``, ``surface_tilt``, ``objective_h`` (``optimum.csv``).
+        ``fold_angle_deg``, ``surface_tilt``, ``t_solar_objective_h`` (``optimum.csv``).
     title : str
     ax : matplotlib.axes.Axes, optional
         Axes to draw on; default a new figure (7 x 5 in).
@@ -31,7 +31,7 @@ def plot_landscape(landscape: pd.DataFrame, designs: pd.DataFrame, title: str, a
     """
     fig, ax = new_axes(ax, (7, 5))
     grid = landscape.pivot_table(
-        index="surface_tilt", columns="fold_angle_deg", values="objective_h"
+        index="surface_tilt", columns="fold_angle_deg", values="t_solar_objective_h"
     )
     values = grid.to_numpy(dtype=float)
     mesh = ax.pcolormesh(grid.columns, grid.index, values, shading="nearest", cmap="viridis")
@@ -57,7 +57,7 @@ def plot_landscape(landscape: pd.DataFrame, designs: pd.DataFrame, title: str, a
             color="red" if marker == "*" else "orange",
             markersize=12 if marker == "*" else 7,
             markeredgecolor="black",
-            label=f"{label}: {row['objective_h']:.2f} h",
+            label=f"{label}: {row['t_solar_objective_h']:.2f} h",
         )
     ax.set_xlabel("fold angle [deg]")
     ax.set_ylabel("base tilt [deg]")

@@ -4,6 +4,8 @@ capacity with the capacity at which folding stops paying."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
 
@@ -22,7 +24,8 @@ def plot_state_of_charge(result: StudyResult, ax=None):
     Parameters
     ----------
     result : foldopt.StudyResult
-        With a buffer: its time series' ``soc_flat``, ``soc_twofold``, ``soc_tracker`` [-].
+        With a buffer: its time series' ``soc_flat_frac``, ``soc_twofold_frac``,
+        ``soc_tracker_frac`` [0-1].
     ax : matplotlib.axes.Axes, optional
         Axes to draw on; default a new figure (8 x 4.5 in).
 
@@ -44,7 +47,7 @@ def plot_state_of_charge(result: StudyResult, ax=None):
         powered = summary.loc[design, "powered_h"]
         ax.plot(
             hours,
-            100.0 * series[f"soc_{design}"],
+            100.0 * series[f"soc_{design}_frac"],
             color=colour,
             label=f"{label}: powered {powered:.2f} h",
         )
@@ -95,13 +98,13 @@ def plot_powered_vs_capacity(result: StudyResult, ax=None):
             label=label,
         )
     stops = sizing.folding.stops_wh
-    if stops == stops:
+    if not math.isnan(stops):
         ax.axvline(stops, color="tab:green", lw=1, label=f"folding stops paying: {stops:.3g} Wh")
     ax.axvline(storage.capacity_wh, color="0.6", lw=0.8, ls=":", label="the study's buffer")
     if len(sizing.table):
         ax.axhline(storage.target.powered_h, color="tab:red", lw=0.8, ls="--", label="target")
         for _, row in sizing.table.iterrows():
-            if row["design"] in COLOURS and row["capacity_wh"] == row["capacity_wh"]:
+            if row["design"] in COLOURS and not math.isnan(row["capacity_wh"]):
                 ax.plot(
                     row["capacity_wh"],
                     storage.target.powered_h,

@@ -82,7 +82,8 @@ def plot_member_t_solar(table: pd.DataFrame, title: str, ax=None, study=None):
     Parameters
     ----------
     table : pandas.DataFrame
-        A sweep's tidy table with ``t_solar_p10_h``, ``t_solar_p50_h`` and ``t_solar_p90_h``.
+        A sweep's tidy table with ``t_solar_members_p10_h``, ``t_solar_members_p50_h`` and
+        ``t_solar_members_p90_h``.
     title : str
     ax : matplotlib.axes.Axes, optional
     study : foldopt.Study, optional
@@ -101,7 +102,11 @@ def plot_member_t_solar(table: pd.DataFrame, title: str, ax=None, study=None):
         # Line and band stop where nothing was evaluated between two days (solstices, months).
         (days, p10, alone), (_, p50, _), (_, p90, _) = (
             broken_at_gaps(rows["dayofyear"], rows[column], DAY_GAP)
-            for column in ("t_solar_p10_h", "t_solar_p50_h", "t_solar_p90_h")
+            for column in (
+                "t_solar_members_p10_h",
+                "t_solar_members_p50_h",
+                "t_solar_members_p90_h",
+            )
         )
         ax.fill_between(days, p10, p90, where=~alone, color=colour, alpha=0.25, lw=0)
         # a lone day's band

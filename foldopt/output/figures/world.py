@@ -30,7 +30,7 @@ def plot_world_map(
     rows : pandas.DataFrame
         A row per site: ``site_name``, ``latitude``, ``longitude`` [deg] and ``value``.
     value : str
-        The column shown in colour (e.g. ``recommended_fold_angle_deg`` [deg],
+        The column shown in colour (e.g. ``recommended_deg`` [deg],
         ``gain_vs_flat_pct`` [%]).
     title, label : str
         The Axes' title and the colour bar's label.
@@ -103,7 +103,7 @@ def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, title: 
     Parameters
     ----------
     table : pandas.DataFrame
-        A map's table: ``period``, ``latitude`` [deg], ``p_load_fraction`` [-] and
+        A map's table: ``period``, ``latitude`` [deg], ``p_load_frac`` [-] and
         ``gain_vs_flat_pct`` [%].
     period : str
         The period shown (``year``, ``DJF``...).
@@ -120,9 +120,7 @@ def plot_latitude_load(table: pd.DataFrame, period: str, relative: bool, title: 
     """
     rows = table[table["period"] == period]
     share = (
-        rows["p_load_fraction"].round(9)
-        if relative
-        else (rows["p_load_fraction"] / 0.05).round() * 0.05
+        rows["p_load_frac"].round(9) if relative else (rows["p_load_frac"] / 0.05).round() * 0.05
     )
     # dropna=False: a latitude where no site carries a load (every gain NaN) keeps its grey cell.
     grid = rows.assign(share=share).pivot_table(
@@ -163,7 +161,7 @@ def _no_value(values) -> str:
 MAPS = (
     (
         "map_fold_angle.png",
-        "recommended_fold_angle_deg",
+        "recommended_deg",
         "recommended fold angle (the near-optimal range's centre; 180 where flat is best)",
         "fold angle Θ [deg] (180 = flat)",
         False,
@@ -177,7 +175,7 @@ MAPS = (
     ),
     (
         "map_pct_of_tracker.png",
-        "pct_of_tracker",
+        "share_of_tracker_pct",
         "twofold panel's t_solar as a share of the tracker's",
         "share of the tracker [%]",
         False,
