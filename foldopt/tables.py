@@ -25,9 +25,8 @@ import pandas as pd
 FLOAT_FORMAT = "%.10g"
 #: How a time index is written: ISO 8601 with the UTC offset (``2014-09-23T12:00:30-0700``).
 TIME_FORMAT = "%Y-%m-%dT%H:%M:%S%z"
-#: Rows formatted at a time: their strings, not the whole table's, are held at once (some 100 MB
-#: for a map's 32 columns; the 1-degree land grid's 1.08 M rows at once raised W5's peak from 1.2
-#: to 3.0 GB).
+#: Rows formatted at a time: their strings, not the whole table's, are held at once, so that a map
+#: of a million rows is written in bounded memory (docs/performance.rst, "Memory").
 ROWS_AT_ONCE = 50_000
 
 

@@ -42,8 +42,8 @@ _FIELDS = frozenset(field_paths(Study))
 
 #: Cases of a plan: one row of results.csv per case and design.
 MAX_CASES = size_limit("MAX_CASES", 200_000)
-#: Site-days x fold angles x time steps of a plan: about 6 ns each on one core (README,
-#: "Performance"), so the default is a few minutes of work at most.
+#: Site-days x fold angles x time steps of a plan: the default is a few minutes of work at most
+#: (docs/performance.rst gives what one costs).
 MAX_EVALUATIONS = size_limit("MAX_EVALUATIONS", 20_000_000_000)
 #: Days x fold angles x loads of one annual group (a fixed angle chosen over the days), held at
 #: once: 8 bytes each.

@@ -6,9 +6,9 @@ points) at every call and interpolates the month values to the UTC day of year o
 stamp. :func:`linke_turbidity` gives the same values, to the bit (tests/test_atmosphere.py holds
 it to pvlib's own lookup on random sites and days), for a whole clock grid at once: the file is
 kept open in the process, so that its chunk cache serves the neighbouring sites of a map, and the
-interpolation runs once per UTC day, not per step. A map's site took 7.8 ms in pvlib's lookup
-(the file's opening, the chunk's decompression and a pandas index of every step); it takes a few
-tenths of a millisecond here.
+interpolation runs once per UTC day, not per step: pvlib's lookup opens the file, decompresses a
+chunk and builds a pandas index of every step at each call, a cost per site that a map pays at
+every site (docs/performance.rst).
 
 References
 ----------

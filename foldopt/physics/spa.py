@@ -9,23 +9,9 @@ per site and step, in vector form (:func:`spa_solar_position`), and the refracti
 every step: the sun's direction stays within 2e-6 deg of ``pvlib.solarposition.spa_python``
 (except at SPA's refraction cut-off, 0.83 deg below the horizon).
 
-Why not ``pvlib.solarposition.get_solarposition``: ``bench/solarposition.py`` (2-core x86_64,
-pvlib 0.16.1, 2026-12-02) times a year of steps per site, in seconds, ``*`` scaled per site from
-a measured run:
-
-=====  ======  ========  =================  ==============================
-step   sites   split     get_solarposition  get_solarposition every 10 min
-                                            and foldopt's interpolation
-=====  ======  ========  =================  ==============================
-1 min  1       0.18      2.6                0.26
-1 min  100     7.4       260 *              25.9 *
-1 min  10 000  578 *     26 008 *           2 590 *
-5 min  2 000   19.7 *    899 *              457 *
-=====  ======  ========  =================  ==============================
-
-(``spa_python(how='numba')`` on 2 threads: 1.8 s a site-year at 1 min.) The public call would
-make the sun 15-46 times dearer; at a map's 5-minute steps it would cost 0.45 s a site-year,
-against the split's 0.01 s. The price of the split is a dependence on ``pvlib.spa``'s step
+Why not ``pvlib.solarposition.get_solarposition``: it evaluates every term of SPA at every step
+of every site, so over many sites the sun would cost an order of magnitude more than the split
+(``bench/solarposition.py``; its figures in docs/performance.rst, "The sun's position"). The price of the split is a dependence on ``pvlib.spa``'s step
 functions, which are not pvlib's public API: pyproject.toml pins pvlib to the releases in which
 they are unchanged (0.11 to 0.16, by pvlib's source history; tested with 0.16.1), and
 tests/test_solarposition.py holds the split to ``spa_python`` on random sites. A process that has

@@ -153,8 +153,7 @@ def _ladder_brackets(objectives, p_load, top, targets):
     power among them (the draws 0 and ``top``). A target's draw lies between the last rung of its
     own range (its load to its load plus ``top``) where the objective is still above the target
     and the next, so the false position starts on a bracket some 1/60 of the range wide instead
-    of the whole range (W5's sites: 17 passes of the engine a batch from the whole range, 10.5
-    with the ladder).
+    of the whole range, and needs fewer passes of the engine (docs/performance.rst).
 
     Parameters
     ----------

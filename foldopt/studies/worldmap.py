@@ -74,9 +74,9 @@ LOAD_BOUNDS = {
 #: What a map's search may vary (``optimize.vary``): the fold angle, and the base tilt with it.
 MAP_VARIABLES = ("fold_angle", "tilt")
 #: Sites evaluated together at most: their days one set of blocks, every engine call and search
-#: round over all of them (within the chunk bounds of foldopt.studies.blocks). Twelve rather than
-#: six share more of each call's fixed cost: W5's sites 93 -> 85 ms a site on one core, at most
-#: 706 MB in the process against 589 MB.
+#: round over all of them (within the chunk bounds of foldopt.studies.blocks). More sites share more
+#: of each call's fixed cost and hold more memory; twelve is where the first stops paying for the
+#: second (docs/performance.rst, "Maps at scale").
 SITES_PER_BATCH = 12
 
 
@@ -295,7 +295,7 @@ def map_request(
 #: about a millisecond), short enough that a lost worker loses little and progress moves.
 CHUNK_SECONDS = 5.0
 #: Single-core seconds per site-day x fold angle x time step of a map, everything included (sky,
-#: trackers, break-even search), measured on W4 (``bench/map.py``).
+#: trackers, break-even search): the chunk size's estimate, calibrated by ``bench/map.py``'s W4.
 SECONDS_PER_EVALUATION = 13e-9
 
 
@@ -357,8 +357,7 @@ class MapSpec:
     @functools.cached_property
     def key(self) -> str:
         """A digest of the spec: a resumed run must have the same. Worked out once: every part written
-        and read carries it, and the spec holds every site (the 1-degree land grid's 21,637 made it
-        0.3 s a time, some 900 chunks three times each: a third of the client's core through W5)."""
+        and read carries it, and the spec holds every site, so a large grid's digest is dear."""
         text = json.dumps(self.as_dict(), sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
