@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from pydantic import ValidationInfo, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from foldopt.inputs.horizon import horizon_profile
 from foldopt.inputs.fields import FilesRead, StrictModel
@@ -34,8 +34,9 @@ class Horizon(StrictModel):
 
     LIST_SHORTHAND: ClassVar[str] = "points"  # foldopt.inputs.fields.list_valued_fields
 
-    points: list[tuple[float, float]] | None = None
+    # The file first: its points are read from it (:meth:`_read_points`).
     file: str | None = None
+    points: list[tuple[float, float]] | None = Field(None, validate_default=True)
 
     @model_validator(mode="before")
     @classmethod
@@ -46,6 +47,16 @@ class Horizon(StrictModel):
             return {"points": value}
         return value
 
+    @field_validator("points", mode="after")
+    @classmethod
+    def _read_points(cls, points, info: ValidationInfo):
+        """A file's points, as its loader read them, where the file is read: they stand for the
+        points (a study's data keep the file, not what was read from it)."""
+        files = FilesRead.given(info)
+        if info.data.get("file") is None or files is None or files.horizon_points is None:
+            return points
+        return [tuple(point) for point in files.horizon_points]
+
     @model_validator(mode="after")
     def _one_profile(self, info: ValidationInfo):
         if self.points is None and self.file is None:
@@ -53,10 +64,8 @@ class Horizon(StrictModel):
                 "give the horizon as points (a list of [azimuth, elevation] in degrees) or as file"
             )
         files = FilesRead.given(info)
-        if self.file is not None and files is not None:
-            if files.horizon_problem is not None:
-                raise ValueError(files.horizon_problem)
-            object.__setattr__(self, "points", [tuple(point) for point in files.horizon_points])
+        if self.file is not None and files is not None and files.horizon_problem is not None:
+            raise ValueError(files.horizon_problem)
         if self.points is not None:
             horizon_profile(self.points)  # ValueError: one line of what is wrong
         return self

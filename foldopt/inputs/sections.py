@@ -332,7 +332,7 @@ class LoadProfile(StrictModel):
         Month numbers 1 to 12 to a day, as ``daily``.
     """
 
-    daily: _ProfileSteps | None = None
+    # What gives the day comes first: the day is read from it where not given (:meth:`_read_day`).
     file: str | None = None
     hourconsumption: list[float] | None = Field(
         None, description="PVGIS's form: 24 fractions of consumptionday, hour by hour from 00:00"
@@ -341,13 +341,39 @@ class LoadProfile(StrictModel):
         None, description="with hourconsumption: the day's energy"
     )
     interpolation: named(("step", "linear")) = "step"
+    daily: _ProfileSteps | None = Field(None, validate_default=True)
     weekend: _ProfileSteps | None = None
     months: dict[Annotated[int, Field(ge=1, le=12)], _ProfileSteps] | None = None
+
+    @field_validator("daily", mode="after")
+    @classmethod
+    def _read_day(cls, daily, info: ValidationInfo):
+        """The day a file (as its loader read it) or PVGIS's fractions give, where ``daily`` is not
+        given: read, not given (the fields set say so); where they cannot give one,
+        :meth:`_one_day` says why."""
+        if daily is not None:
+            return daily
+        files = FilesRead.given(info)
+        if info.data.get("file") is not None and files is not None:
+            return files.profile_daily
+        fractions, energy = info.data.get("hourconsumption"), info.data.get("consumptionday")
+        if fractions is None or energy is None:
+            return None
+        try:
+            return hourly_steps(fractions, energy)
+        except ValueError:
+            return None
 
     @model_validator(mode="after")
     def _one_day(self, info: ValidationInfo):
         given = [
-            name for name in ("daily", "file", "hourconsumption") if getattr(self, name) is not None
+            name
+            for name in ("daily", "file", "hourconsumption")
+            if (
+                name in self.model_fields_set
+                if name == "daily"
+                else getattr(self, name) is not None
+            )
         ]
         if len(given) != 1:
             raise ValueError(
@@ -366,14 +392,10 @@ class LoadProfile(StrictModel):
                     "interpolation: hourconsumption gives each hour's energy, held over the hour "
                     "(step); linear would move energy between hours"
                 )
-            object.__setattr__(
-                self, "daily", hourly_steps(self.hourconsumption, self.consumptionday)
-            )
+            hourly_steps(self.hourconsumption, self.consumptionday)  # ValueError: what is wrong
         files = FilesRead.given(info)
-        if self.file is not None and files is not None:
-            if files.profile_problem is not None:
-                raise ValueError(files.profile_problem)
-            object.__setattr__(self, "daily", files.profile_daily)
+        if self.file is not None and files is not None and files.profile_problem is not None:
+            raise ValueError(files.profile_problem)
         return self
 
     @property

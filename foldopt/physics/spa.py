@@ -11,12 +11,12 @@ every step: the sun's direction stays within 2e-6 deg of ``pvlib.solarposition.s
 
 Why not ``pvlib.solarposition.get_solarposition``: it evaluates every term of SPA at every step
 of every site, so over many sites the sun would cost an order of magnitude more than the split
-(``bench/solarposition.py``; its figures in docs/performance.rst, "The sun's position"). The price of the split is a dependence on ``pvlib.spa``'s step
-functions, which are not pvlib's public API: pyproject.toml pins pvlib to the releases in which
-they are unchanged (0.11 to 0.16, by pvlib's source history; tested with 0.16.1), and
-tests/test_solarposition.py holds the split to ``spa_python`` on random sites. A process that has
-called ``spa_python(how='numba')`` has ``pvlib.spa`` reloaded as scalar numba functions, and the
-split then raises ``TypeError``.
+(``bench/solarposition.py``; its figures in docs/performance.rst, "The sun's position"). The
+price of the split is a dependence on ``pvlib.spa``'s step functions, which are not pvlib's
+public API: pyproject.toml pins pvlib to the releases in which they are unchanged (0.11 to 0.16,
+by pvlib's source history; tested with 0.16.1), and tests/test_solarposition.py holds the split
+to ``spa_python`` on random sites. A process that has called ``spa_python(how='numba')`` has
+``pvlib.spa`` reloaded as scalar numba functions, and the split then raises ``TypeError``.
 
 References
 ----------
