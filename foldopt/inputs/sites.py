@@ -176,7 +176,10 @@ def read_sites(path: Path | str) -> list[dict]:
                 )
                 continue
             named[site.name] = line
-        sites.append(site.model_dump(exclude_none=True))
+        given = site.model_dump(exclude_none=True)
+        if "timezone" not in site.model_fields_set:
+            given.pop("timezone")  # the longitude's standard offset: each site's study decides it
+        sites.append(given)
     if not sites and not errors:
         errors.append(f"--sites {path}: no sites (a header and one row per site)")
     if errors:

@@ -259,11 +259,7 @@ def map_request(
         sites = grid_sites(*grid_values, land_only)
         if not sites:
             raise ConfigError(["land_only: no grid point is on land"])
-    if weather is not None:
-        if weather_dir is not None:
-            raise ConfigError(
-                ["weather: a weather folder's files are its sites' weather; give one or the other"]
-            )
+    if weather is not None:  # not with a weather folder: the front door refuses the pair
         sites = with_fetched_sites(list(sites), weather)
     if len(sites) > MAX_CASES:
         raise ConfigError(
