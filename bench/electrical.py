@@ -30,16 +30,19 @@ from foldopt.engine import evaluation as engine  # noqa: E402
 from foldopt.inputs.study_file import default_study_path
 from foldopt.api import load_study  # noqa: E402
 from foldopt.engine.sky import build_sky  # noqa: E402
+from foldopt.studies.engine_options import engine_options  # noqa: E402
 
 
 def _t_solar(study, dates, angles):
     """t_solar [h] of every date x angle, (n_dates, n_angles), and the seconds it took."""
     start = time.perf_counter()
-    sky = build_sky(study, [study.site] * len(dates), dates)
+    options = engine_options(study)
+    sky = build_sky(options.sky, [study.site] * len(dates), dates)
     panel = study.panel
-    orientation = engine.fold_orientations(study, [panel.tilt] * len(dates), [panel.azimuth] * len(dates), angles)
-    rows = np.repeat(np.arange(len(dates)), angles.size)
-    hours = engine.row_metrics(sky, study, rows, orientation.reshape(-1, 4), [study.p_load]).t_solar
+    orientation = engine.fold_orientations(study.geometry, [panel.tilt] * len(dates), [panel.azimuth] * len(dates),
+                                           angles)
+    rows = engine.PanelRows(np.repeat(np.arange(len(dates)), angles.size), orientation.reshape(-1, 4))
+    hours = engine.row_metrics(sky, rows=rows, loads=[study.p_load], electrical=options.electrical).t_solar
     return hours.reshape(len(dates), angles.size), time.perf_counter() - start
 
 

@@ -79,6 +79,7 @@ def _fold_pass(base, sites, dates, loads, threads=None):
     from foldopt.physics.geometry import default_orientation
     from foldopt.engine.sky import build_sky
     from foldopt.physics.solarposition import clock_grid, solar_position_grid
+    from foldopt.studies.engine_options import engine_options
 
     if threads:
         numba.set_num_threads(threads)
@@ -89,17 +90,18 @@ def _fold_pass(base, sites, dates, loads, threads=None):
     phases["sun"], _ = _timed(lambda: solar_position_grid(
         clock_grid(dates, zones.pop(), base.step_min), np.array([[s.latitude] for s in sites]),
         np.array([[s.longitude] for s in sites]), np.array([[s.altitude] for s in sites]), base.mode))
-    seconds, sky = _timed(build_sky, base, sites, dates)
+    options = engine_options(base)
+    seconds, sky = _timed(build_sky, options.sky, sites, dates)
     phases["irradiance"] = max(seconds - phases["sun"], 0.0)
-    phases["tables"], _ = _timed(lambda: [engine.electrical_for(base, t)._table(n)
+    phases["tables"], _ = _timed(lambda: [engine.electrical_for(options.electrical, t)._table(n)
                                           for t in np.unique(sky.temp_air) for n in ("subpanel", "parallel")])
     angles = np.asarray(base.fold_angles.grid())
     panels = np.array([default_orientation(s.latitude) if base.panel.tilt is None else
                        (base.panel.tilt, base.panel.azimuth) for s in sites])
-    orientation = engine.fold_orientations(base, panels[:, 0], panels[:, 1], angles).reshape(-1, 4)
+    orientation = engine.fold_orientations(base.geometry, panels[:, 0], panels[:, 1], angles).reshape(-1, 4)
     rows = np.repeat(np.arange(len(dates)), angles.size)
-    phases["kernel"], metrics = _timed(engine.row_metrics, sky, base, rows, orientation, loads,
-                                       outputs=(base.connection,))
+    phases["kernel"], metrics = _timed(engine.row_metrics, sky, rows=engine.PanelRows(rows, orientation), loads=loads,
+                                       electrical=options.electrical, outputs=(base.connection,))
     hours = metrics.t_solar.reshape(len(dates), angles.size, -1)
     return phases, hours, metrics.energy.reshape(len(dates), angles.size), sky, orientation, rows
 
@@ -108,9 +110,12 @@ def _metrics_share(sky, base, orientation, rows, loads, sample: int = 2000):
     """Time per point of the metrics alone (curve_rows on power curves that already exist),
     measured on a sample of rows."""
     from foldopt.engine import evaluation as engine
+    from foldopt.studies.engine_options import engine_options
 
+    electrical = engine_options(base).electrical
     pick = np.linspace(0, rows.size - 1, min(sample, rows.size)).astype(int)
-    curves = np.concatenate([engine.powers(sky, base, orientation[i:i + 1], [rows[i]], series=False)[0]["switching"]
+    curves = np.concatenate([engine.powers(sky, orientation=orientation[i:i + 1], electrical=electrical,
+                                           blocks=[rows[i]], series=False)[0]["switching"]
                              for i in pick])
     engine.curve_metrics(curves[:2], loads, sky.step_hours)  # compiled and loaded before timing
     seconds, _ = _timed(engine.curve_metrics, curves, loads, sky.step_hours)
@@ -155,13 +160,15 @@ def _storage_pass(base, sites, dates, loads):
     from foldopt.engine import storage
     from foldopt.engine.sky import build_sky
     from foldopt.physics.geometry import default_orientation
+    from foldopt.studies.engine_options import engine_options
 
     phases = {}
-    phases["sky"], sky = _timed(build_sky, base, sites, dates)
+    options = engine_options(base)
+    phases["sky"], sky = _timed(build_sky, options.sky, sites, dates)
     angles = np.asarray(base.fold_angles.grid())
     panels = np.array([default_orientation(s.latitude) if base.panel.tilt is None else
                        (base.panel.tilt, base.panel.azimuth) for s in sites])
-    orientation = engine.fold_orientations(base, panels[:, 0], panels[:, 1], angles).reshape(-1, 4)
+    orientation = engine.fold_orientations(base.geometry, panels[:, 0], panels[:, 1], angles).reshape(-1, 4)
     n_days = len(dates)
     buffer = storage.Buffer(**BENCH_BUFFER)
     phases["kernel with curves"] = phases["buffer"] = 0.0
@@ -171,8 +178,9 @@ def _storage_pass(base, sites, dates, loads):
         days, which = np.repeat(np.arange(n_days), chunk.size), np.tile(chunk, n_days)
         # Curves kept angle by angle (each angle's year in order): the buffer's series as they are.
         keep = np.arange(days.size).reshape(n_days, chunk.size).T.ravel()
-        seconds, metrics = _timed(engine.row_metrics, sky, base, days, orientation[which], loads,
-                                  outputs=(base.connection,), curves=keep)
+        seconds, metrics = _timed(engine.row_metrics, sky, rows=engine.PanelRows(days, orientation[which]),
+                                  loads=loads, electrical=options.electrical, outputs=(base.connection,),
+                                  curves=keep)
         phases["kernel with curves"] += seconds
         start = time.perf_counter()
         power = metrics.power.reshape(chunk.size, n_days, -1)
@@ -350,8 +358,9 @@ def workload_tables() -> dict:
     with tempfile.TemporaryDirectory() as folder:
         os.environ["FOLDOPT_CACHE_DIR"] = folder
         from foldopt.engine.evaluation import electrical_for
+        from foldopt.studies.engine_options import engine_options
 
-        electrical = electrical_for(_study(), 25.0)
+        electrical = electrical_for(engine_options(_study()).electrical, 25.0)
         seconds = {name: _timed(electrical._table, name)[0] for name in ("subpanel", "parallel", "series")}
     return {"seconds": sum(seconds.values()), "points": 1, "phases": seconds}
 

@@ -221,9 +221,9 @@ def test_the_environment_finder_sees_every_kind_of_write(tmp_path, monkeypatch):
     assert _environment_writes("made_up") == [(3, None), (4, None), (5, None), (6, None), (7, None), (9, "f")]
 
 
-#: The most positional parameters a function of the studies takes (issue 48): past it a call is
-#: a row of bare values whose meaning hangs on their order; the rest go keyword-only or into a
-#: named record.
+#: The most positional parameters a function of the engine or the studies takes (issue 48): past
+#: it a call is a row of bare values whose meaning hangs on their order; the rest go keyword-only
+#: or into a named record (foldopt.engine.records, foldopt.engine.options).
 MAX_POSITIONAL = 8
 
 
@@ -235,9 +235,9 @@ def _positional_counts(tree: ast.AST) -> list[tuple[str, int, int]]:
             for node in ast.walk(tree) if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))]
 
 
-def test_no_function_of_the_studies_takes_more_than_eight_positional_parameters():
+def test_no_function_of_the_engine_or_the_studies_takes_more_than_eight_positional_parameters():
     too_many = [f"{module}:{line} {name} takes {count}" for module, path in MODULES.items()
-                if module.startswith("foldopt.studies")
+                if module.startswith(("foldopt.engine", "foldopt.studies"))
                 for name, line, count in _positional_counts(ast.parse(path.read_text()))
                 if count > MAX_POSITIONAL]
     assert too_many == []
@@ -268,3 +268,12 @@ def test_no_answer_module_builds_a_key_with_format():
              for line in _format_calls(ast.parse(MODULES[module].read_text()))]
     assert built == []
     assert _format_calls(ast.parse('"{}_by_design_{}".format(*column.rsplit("_", 1))')) == [1]
+
+
+def test_the_engine_never_sees_a_study():
+    """Issue 48: the engine reads its options groups (foldopt.engine.options), made of a study once,
+    outside it (foldopt.studies.engine_options); no engine module imports the study."""
+    offenders = [f"{module}:{line} imports {target}" for module in MODULES if module.startswith("foldopt.engine")
+                 for target, _, line in _imports(module) if _resolve(target) == "foldopt.inputs.study"]
+    assert offenders == []
+    assert _imports("foldopt.studies.engine_options"), "the finder sees the builder's imports"

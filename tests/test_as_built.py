@@ -9,6 +9,7 @@ import foldopt
 from foldopt.engine.cell_tables import electrical_for
 from foldopt.engine.evaluation import poa
 from foldopt.engine.sky import build_sky
+from foldopt.studies.engine_options import engine_options
 
 
 def _study(**changes):
@@ -41,7 +42,7 @@ def test_horizon_above_the_sun_path_leaves_only_diffuse_and_reflected_light():
     """A horizon at 89 deg all around hides the sun all day: a surface gets its ground-reflected light
     (pvlib's get_ground_diffuse on the same GHI) and a sliver of sky (cos^2(89 deg) of the dome)."""
     study = _study(site={"horizon": [[0, 89], [120, 89], [240, 89]]})
-    sky = build_sky(study, [study.site], [study.date])
+    sky = build_sky(engine_options(study).sky, [study.site], [study.date])
     assert not sky.dni.any()
     tilt = 30.0
     light = poa(sky, np.array([[tilt]]), np.array([[180.0]]))[0]
@@ -79,7 +80,7 @@ def test_flat_panel_is_wired_for_its_load(load_voltage, wiring):
     """At STC the flat panel delivers the better of its halves in parallel behind the diodes'
     0.45 V drop and its one string, each from pvlib's i_from_v at the load's voltage."""
     study = _direct(load_voltage)
-    electrical = electrical_for(study, study.temp_air, study.wind_speed)
+    electrical = electrical_for(engine_options(study).electrical, study.temp_air, study.wind_speed)
     poa_stc = np.array([1000.0])
     temp = electrical._temperature(poa_stc)
     half = electrical.pv.curves(poa_stc, temp, study.panel.area / 2)

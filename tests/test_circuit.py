@@ -18,6 +18,7 @@ import foldopt
 from foldopt import names
 from foldopt.cli.app import app
 from foldopt.engine.cell_tables import electrical_for
+from foldopt.studies.engine_options import engine_options
 from foldopt.physics import circuit, connections
 from foldopt.physics.diodes import DEFAULT_DIODE_PART, DIODE_PARTS, Diode, diode
 from foldopt.physics.pvmodel import PVModel
@@ -370,13 +371,13 @@ def test_a_load_is_called_beyond_reach_only_where_no_wiring_reaches_it(model):
     def study(load):
         return foldopt.default_study().variant(pv_model=model, circuit={"coupling": "direct", "load_voltage": load})
 
-    pv = electrical_for(study(5.0), 25.0).pv  # the paper's panel, its halves of AREA
+    pv = electrical_for(engine_options(study(5.0)).electrical, 25.0).pv  # the paper's panel, its halves of AREA
     highest = float(pv.curves(np.array([2000.0]), -70.0, 2 * AREA).v_oc[0])
     poa, temp = (grid.ravel() for grid in np.meshgrid([50.0, 1000.0, 2000.0], [-70.0, 25.0, 85.0]))
     half, whole = pv.curves(poa, temp, AREA), pv.curves(poa, temp, 2 * AREA)
     for factor, beyond in ((1.001, True), (0.999, False)):
         load = factor * highest
-        assert bool(electrical_for(study(load), 25.0).beyond_reach) == beyond
+        assert bool(electrical_for(engine_options(study(load)).electrical, 25.0).beyond_reach) == beyond
         delivered = [circuit.alone_power(half, load), circuit.alone_power(whole, load),
                      circuit.parallel_power(half, half, Diode("ideal"), load),
                      circuit.series_power(half, half, Diode("ideal"), load)]

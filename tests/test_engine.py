@@ -24,6 +24,7 @@ from foldopt.inputs.sections import Site
 from foldopt.inputs.study import make_study
 from foldopt.engine.metrics import t_solar, t_solar_contiguous
 from foldopt.engine.sky import build_sky
+from foldopt.studies.engine_options import engine_options
 
 SECOND = 1 / 3600  # [h]
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
@@ -70,8 +71,13 @@ def cases(draw):
 
 def _rows(study, sites, angles):
     resolved = [study.variant(site=site.model_dump()).panel for site in sites]
-    orientation = engine.fold_orientations(study, [p.tilt for p in resolved], [p.azimuth for p in resolved], angles)
-    return np.repeat(np.arange(len(sites)), angles.size), orientation.reshape(-1, 4)
+    orientation = engine.fold_orientations(study.geometry, [p.tilt for p in resolved], [p.azimuth for p in resolved],
+                                           angles)
+    return engine.PanelRows(np.repeat(np.arange(len(sites)), angles.size), orientation.reshape(-1, 4))
+
+
+def _sky(study, sites, dates):
+    return build_sky(engine_options(study).sky, sites, dates)
 
 
 def assert_engines_agree(compiled, reference):
@@ -86,11 +92,11 @@ def assert_engines_agree(compiled, reference):
 @given(case=cases())
 def test_kernel_equals_the_reference_path(case):
     study, sites, dates, angles, loads = case
-    sky = build_sky(study, sites, dates)
-    rows, orientation = _rows(study, sites, angles)
-    peak = engine.row_metrics(sky, study, rows, orientation, [1.0], outputs=("independent",), engine="numpy").peak
+    sky, rows, electrical = _sky(study, sites, dates), _rows(study, sites, angles), engine_options(study).electrical
+    peak = engine.row_metrics(sky, rows=rows, loads=[1.0], electrical=electrical, outputs=("independent",),
+                              engine="numpy").peak
     loads = loads / 60 * max(peak.max(), 1e-3)  # from a sliver of the peak to above it
-    results = {name: engine.row_metrics(sky, study, rows, orientation, loads, outputs=engine.OUTPUTS,
+    results = {name: engine.row_metrics(sky, rows=rows, loads=loads, electrical=electrical, outputs=engine.OUTPUTS,
                                         contiguous=True, engine=name) for name in ("numba", "numpy")}
     assert_engines_agree(results["numba"], results["numpy"])
 
@@ -123,10 +129,11 @@ def test_kernel_equals_the_reference_on_a_weather_year_slice(pv_model, outputs):
                         "altitude": 273, "timezone": "UTC-05:00"}, "weather": str(TMY3), "date": "2025-01-01",
                         "panel": {"area": 0.108}, "p_load": 2.0, "pv_model": pv_model, "iam": "physical"})
     dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 365, 45)]
-    sky = build_sky(study, [study.site] * len(dates), dates)
+    sky = _sky(study, [study.site] * len(dates), dates)
     assert np.unique(sky.temp_air).size > 2
-    rows, orientation = _rows(study, [study.site] * len(dates), np.array([30.0, 90.0, 150.0]))
-    results = {name: engine.row_metrics(sky, study, rows, orientation, [0.5, 2.0, 4.4], outputs=outputs,
+    rows = _rows(study, [study.site] * len(dates), np.array([30.0, 90.0, 150.0]))
+    electrical = engine_options(study).electrical
+    results = {name: engine.row_metrics(sky, rows=rows, loads=[0.5, 2.0, 4.4], electrical=electrical, outputs=outputs,
                                         contiguous=True, engine=name) for name in ("numba", "numpy")}
     assert_engines_agree(results["numba"], results["numpy"])
 
@@ -172,9 +179,8 @@ def test_curves_sharing_a_chunk_each_get_their_own_metrics():
 @given(case=cases())
 def test_t_solar_never_rises_when_the_load_rises(case):
     study, sites, dates, angles, _ = case
-    sky = build_sky(study, sites, dates)
-    rows, orientation = _rows(study, sites, angles)
-    hours = engine.row_metrics(sky, study, rows, orientation, np.linspace(0.01, 30, 50),
+    hours = engine.row_metrics(_sky(study, sites, dates), rows=_rows(study, sites, angles),
+                               loads=np.linspace(0.01, 30, 50), electrical=engine_options(study).electrical,
                                outputs=engine.OUTPUTS).t_solar
     assert np.all(np.diff(hours, axis=-1) <= 1e-12)
     assert np.all((hours >= 0) & (hours <= 24 + 1e-9))
@@ -183,17 +189,19 @@ def test_t_solar_never_rises_when_the_load_rises(case):
 def test_loads_of_each_row_and_unknown_names():
     study = make_study({"name": "k", "site": {"latitude": 34.05, "longitude": -118.25}, "date": "2025-06-21",
                         "panel": {"area": 0.108}, "p_load": 4.0, "pv_model": "single-diode"})
-    sky = build_sky(study, [study.site], [study.date])
-    rows, orientation = _rows(study, [study.site], np.array([40.0, 120.0]))
+    sky, electrical = _sky(study, [study.site], [study.date]), engine_options(study).electrical
+    rows = _rows(study, [study.site], np.array([40.0, 120.0]))
     sets = np.array([[9.0, 2.0], [2.0, 9.0]])
-    one = engine.row_metrics(sky, study, rows, orientation, sets, row_loadset=[0, 1]).t_solar[:, 0]
-    both = engine.row_metrics(sky, study, rows, orientation, [2.0, 9.0]).t_solar[:, 0]
+    one = engine.row_metrics(sky, rows=rows._replace(loadset=[0, 1]), loads=sets, electrical=electrical).t_solar[:, 0]
+    both = engine.row_metrics(sky, rows=rows, loads=[2.0, 9.0], electrical=electrical).t_solar[:, 0]
     np.testing.assert_array_equal(one[0], both[0, ::-1])
     np.testing.assert_array_equal(one[1], both[1])
     with pytest.raises(ValueError, match="numba, numpy"):
-        engine.row_metrics(sky, study, rows, orientation, [2.0], engine="fortran")
+        engine.row_metrics(sky, rows=rows, loads=[2.0], electrical=electrical, engine="fortran")
     with pytest.raises(ValueError, match="outputs must be among"):
-        engine.row_metrics(sky, study, rows, orientation, [2.0], outputs=("diagonal",))
+        engine.row_metrics(sky, rows=rows, loads=[2.0], electrical=electrical, outputs=("diagonal",))
+    with pytest.raises(ValueError, match="1 orientations for 2 rows"):
+        engine.row_metrics(sky, rows=rows._replace(orientation_of=[0]), loads=[2.0], electrical=electrical)
 
 
 @pytest.mark.parametrize("model", ["ashrae", "physical"])
@@ -215,9 +223,9 @@ def test_blocks_of_many_sites_and_time_zones_equal_their_own_skies():
              Site(latitude=34.05, longitude=-118.25, timezone="America/Los_Angeles"),
              Site(latitude=-33.9, longitude=151.2, timezone="Australia/Sydney")]
     dates = [dt.date(2025, 3, 9), dt.date(2025, 6, 21), dt.date(2025, 11, 2), dt.date(2025, 12, 21)]
-    together = build_sky(study, sites, dates)
+    together = _sky(study, sites, dates)
     for index, (site, date) in enumerate(zip(sites, dates, strict=True)):
-        alone = build_sky(study, [site], [date])
+        alone = _sky(study, [site], [date])
         for name in ("solar_zenith", "solar_azimuth", "hour_angle", "dni", "terms"):
             np.testing.assert_allclose(getattr(together, name)[index], getattr(alone, name)[0], rtol=1e-12, atol=1e-9)
         assert together.grid.times(index).equals(alone.grid.times(0))

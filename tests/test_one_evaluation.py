@@ -46,9 +46,9 @@ def test_no_angle_is_evaluated_twice(monkeypatch):
     result = run_study(study, "numba")
     assert {"twofold-heuristic", "twofold-parallel", "twofold-series"} <= set(result.summary["design"])
     seen = set()
-    for args, kwargs in calls:
-        orientation, series = np.asarray(args[2]), args[4] if len(args) > 4 else kwargs.get("series", True)
-        state = args[5] if len(args) > 5 else kwargs.get("with_state", False)
+    for _, kwargs in calls:
+        orientation = np.asarray(kwargs["orientation"])
+        series, state = kwargs.get("series", True), kwargs.get("with_state", False)
         rows = {(row.tobytes(), series, state) for row in orientation}
         if len(orientation) == 1:
             assert not rows & seen, "one fold angle's curves worked out twice"

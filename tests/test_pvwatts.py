@@ -12,6 +12,7 @@ import pytest
 from foldopt.engine import evaluation as engine
 from foldopt.inputs.plan import make_plan
 from foldopt.engine.sky import build_sky
+from foldopt.studies.engine_options import engine_options
 from foldopt.studies.designs import sky_tracker_orientation
 
 pvwatts = pytest.importorskip("PySAM.Pvwattsv8", reason="nrel-pysam is a test dependency ('.[test]')")
@@ -38,7 +39,7 @@ def test_tracker_gain_on_the_plane_of_array_is_pvwatts():
     study = make_plan({"name": "pvwatts", "weather": str(TMY3), "panel": {"area": 1.0, "tilt": TILT, "azimuth": 180},
                        "p_load": 1.0, "albedo": 0.2, "transposition": "perez"}).base
     year = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(365)]
-    sky = build_sky(study, [study.site] * 365, year)
+    sky = build_sky(engine_options(study).sky, [study.site] * 365, year)
     tilt, azimuth, normal = sky_tracker_orientation(sky, study, "dual-axis")
     hourly = {  # foldopt's minutes, hour by hour [W/m^2]
         "fixed": engine.poa(sky, np.full((365, 1), TILT), np.full((365, 1), 180.0), incident=True),

@@ -113,11 +113,12 @@ def test_trackers_over_many_days_at_once_equal_each_day_alone(model):
 
     from foldopt.engine.sky import build_sky
     from foldopt.studies.designs import sky_tracker_draw, sky_tracker_orientation
+    from foldopt.studies.engine_options import engine_options
 
     study = load_study(default_study_path()).variant(mode="exact", geometry="hinge", step_min=5,
                                                      tracker={"model": model, "standby_w": 0.3})
     dates = [dt.date(2025, 3, 1), dt.date(2025, 6, 21), dt.date(2025, 12, 21)]
-    sky = build_sky(study, [study.site] * 3, dates)
+    sky = build_sky(engine_options(study).sky, [study.site] * 3, dates)
     orientation = sky_tracker_orientation(sky, study)
     draw = sky_tracker_draw(sky, study, orientation)
     for index, date in enumerate(dates):
@@ -140,13 +141,14 @@ def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitu
     from foldopt.engine.incidence import turning_poa
     from foldopt.engine.sky import build_sky
     from foldopt.studies.designs import sky_tracker_orientation
+    from foldopt.studies.engine_options import engine_options
 
     sky_name, transposition = sky_model
     study = load_study(default_study_path()).variant(mode="exact", step_min=5, sky=sky_name,
                                                      transposition=transposition, tracker={"model": model})
     site = study.site.model_copy(update={"latitude": latitude, "longitude": longitude, "timezone": "UTC"})
     dates = [dt.date(2025, 1, 1) + dt.timedelta(days=(day + k * 121) % 365) for k in range(3)]
-    sky = build_sky(study, [site] * 3, dates)
+    sky = build_sky(engine_options(study).sky, [site] * 3, dates)
     orientation = sky_tracker_orientation(sky, study)
     reference = engines.poa(sky, orientation[0], orientation[1], normal=orientation[2])
     sun, _, beam, terms, span = sky.kernel_layout(False)

@@ -111,7 +111,7 @@ def test_members_are_reproducible_and_a_days_own(ensemble_plan):
     np.testing.assert_array_equal(alone.ghi, together.ghi[6:])  # the same seed, the same day: the same bits
     reseeded = Blocks.of_dates(with_files(study.variant(weather={"path": str(TMY3), "members": 6, "seed": 5},
                                                         date="2025-06-04")), [day])
-    assert not np.array_equal(alone.ghi, build_sky(reseeded.study, reseeded.sites, reseeded.dates,
+    assert not np.array_equal(alone.ghi, build_sky(reseeded.options.sky, reseeded.sites, reseeded.dates,
                                                    reseeded.member).ghi)
 
 

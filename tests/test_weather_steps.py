@@ -11,6 +11,7 @@ import pytest
 
 from foldopt.engine import evaluation as engine
 from foldopt.engine.sky import build_sky
+from foldopt.studies.engine_options import engine_options
 from foldopt.inputs.plan import make_plan
 from foldopt.physics.pvmodel import A300_CELL
 
@@ -23,7 +24,7 @@ def weather_day():
     plan = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": 2.0,
                       "pv_model": "single-diode", "step_min": 5, "transposition": "perez"})
     study = plan.base
-    return study, build_sky(study, [study.site] * len(DAYS), DAYS)
+    return study, build_sky(engine_options(study).sky, [study.site] * len(DAYS), DAYS)
 
 
 def test_flat_panel_power_follows_each_steps_cell_temperature(weather_day):
@@ -36,7 +37,7 @@ def test_flat_panel_power_follows_each_steps_cell_temperature(weather_day):
     study, sky = weather_day
     tilt, azimuth = study.panel.tilt, study.panel.azimuth
     poa = engine.poa(sky, np.full((len(DAYS), 1), tilt), np.full((len(DAYS), 1), azimuth))
-    power = engine.panel_power(sky, study, poa)
+    power = engine.panel_power(sky, poa_global=poa, electrical=engine_options(study).electrical)
     params = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_polymer"]
     # The cells' temperature the engine means: SAPM at the step's equivalent air temperature and
     # the tables' wind (foldopt.physics.temperature.equivalent_temp_air)...
@@ -77,14 +78,14 @@ def test_kernel_matches_the_reference_between_temperatures(weather_day):
     # The compiled kernel and the NumPy reference take the same two tables a step and the same
     # weights: t_solar within 1 s a day, energy within 1e-9 (tests/test_engine.py's bound).
     study, sky = weather_day
-    orientation = engine.fold_orientations(study, [study.panel.tilt], [study.panel.azimuth],
+    orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth],
                                            np.array([40.0, 90.0, 150.0, 180.0]))[0]
-    row_block = np.repeat(np.arange(len(DAYS)), len(orientation))
-    rows = np.tile(orientation, (len(DAYS), 1))
+    rows = engine.PanelRows(np.repeat(np.arange(len(DAYS)), len(orientation)), np.tile(orientation, (len(DAYS), 1)))
     loads = np.array([0.2, 1.0, 3.0, 6.0])
     outputs = ("east", "parallel", "series", "switching", "independent", "panel")
-    fast = engine.row_metrics(sky, study, row_block, rows, loads, outputs=outputs)
-    slow = engine.row_metrics(sky, study, row_block, rows, loads, outputs=outputs, engine="numpy")
+    electrical = engine_options(study).electrical
+    fast = engine.row_metrics(sky, rows=rows, loads=loads, electrical=electrical, outputs=outputs)
+    slow = engine.row_metrics(sky, rows=rows, loads=loads, electrical=electrical, outputs=outputs, engine="numpy")
     np.testing.assert_allclose(fast.t_solar, slow.t_solar, atol=1 / 3600)
     np.testing.assert_allclose(fast.energy, slow.energy, rtol=1e-9)
     nodes, table, weight = engine.temperature_nodes(sky)

@@ -15,6 +15,7 @@ from foldopt.engine import evaluation as engine
 from foldopt.inputs.plan import make_plan
 from foldopt.errors import ConfigError
 from foldopt.engine.sky import build_sky
+from foldopt.studies.engine_options import engine_options
 from foldopt.studies.designs import sky_tracker_orientation
 from foldopt.studies.sweeps import run_plan
 from foldopt.inputs.weather import read_weather, weather_site
@@ -28,7 +29,7 @@ YEAR = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(365)]
 def greensboro():
     """The Greensboro TMY3 year on 1-minute steps, Perez diffuse light."""
     study = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": 2.0}).base
-    return study, build_sky(study, [study.site] * len(YEAR), YEAR)
+    return study, build_sky(engine_options(study).sky, [study.site] * len(YEAR), YEAR)
 
 
 def write_epw_year(path, frame, site):
@@ -102,8 +103,8 @@ def test_a_real_year_keeps_its_hours_continuous_and_closed(greensboro):
     # closure.
     study, sky = greensboro
     frame = read_weather(TMY3)
-    clear = build_sky(study.variant(weather=None, sky="ineichen", transposition="perez", site=study.site.model_dump()),
-                      [study.site] * len(YEAR), YEAR)
+    clear_study = study.variant(weather=None, sky="ineichen", transposition="perez", site=study.site.model_dump())
+    clear = build_sky(engine_options(clear_study).sky, [study.site] * len(YEAR), YEAR)
     high_sun = (sky.solar_zenith.reshape(365, 24, 60) < 89).all(axis=-1)
     for key, shape in (("dni", clear.dni), ("dhi", clear.ghi)):
         file = frame[key].to_numpy().reshape(365, 24)
@@ -194,7 +195,8 @@ def test_the_file_gives_the_site_the_clock_and_the_year():
     # A site a few hundred metres off is the same place; its own clock does not move the file's.
     near = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": 2.0,
                       "site": {"latitude": 36.102, "longitude": -79.951, "timezone": "America/New_York"}}).base
-    assert build_sky(near, [near.site], [dt.date(2025, 7, 1)]).grid.times(0)[0].strftime("%H:%M %z") == "00:00 -0500"
+    first = build_sky(engine_options(near).sky, [near.site], [dt.date(2025, 7, 1)]).grid.times(0)[0]
+    assert first.strftime("%H:%M %z") == "00:00 -0500"
     with pytest.raises(ConfigError, match=r"site \(0, 0\) is 9,106 km from the weather file's site GREENSBORO"):
         make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": 2.0,
                    "site": {"latitude": 0, "longitude": 0}})

@@ -4,7 +4,7 @@ connection delivers to the load.
 Shin et al.'s parts are ideal: diodes without a forward drop, no switch resistance, converters
 that deliver their input at the maximum power point. A study's ``circuit`` may change each
 (:class:`foldopt.inputs.circuit_section.Circuit`); :func:`circuit_parts` gives the engine's
-:class:`CircuitParts`, None for the ideal circuit, whose path through the engine is unchanged.
+:class:`CircuitParts` of it, None for the ideal circuit, whose path through the engine is unchanged.
 
 As built, a connection's power has two stages. The panel side: each sub-panel's maximum power
 (``m_east``, ``m_west``, the bound of every connection), what it delivers alone (``a_*``: its
@@ -17,7 +17,7 @@ for one sub-panel. The tables hold the panel side as the ideal circuit's do (pai
 the two maxima); :func:`assemble` is the load side, the NumPy mirror of the kernel's
 ``_built_power``.
 
-The module may import numpy, :mod:`foldopt.physics` and :mod:`foldopt.inputs.study`.
+The module may import numpy, :mod:`foldopt.physics` and :mod:`foldopt.inputs`' circuit section.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from foldopt.inputs.study import Study
+from foldopt.inputs.circuit_section import Circuit
 from foldopt.physics import circuit as built
 from foldopt.physics.converter import Converter, delivered_table, table_delivered
 from foldopt.physics.diodes import Diode
@@ -86,12 +86,13 @@ class CircuitParts:
         return 0.0 if self.converter.ideal else float(self.converter.p_rated)
 
 
-def circuit_parts(study: Study, p_rated: float) -> CircuitParts | None:
+def circuit_parts(circuit: Circuit | None, p_rated: float) -> CircuitParts | None:
     """A study's circuit for the engine, None where every part is ideal.
 
     Parameters
     ----------
-    study : Study
+    circuit : foldopt.inputs.circuit_section.Circuit or None
+        The circuit as built (:attr:`foldopt.engine.options.ElectricalOptions.circuit`).
     p_rated : float
         The converter's default rating [W]: the panel's maximum power at STC.
 
@@ -99,8 +100,7 @@ def circuit_parts(study: Study, p_rated: float) -> CircuitParts | None:
     -------
     CircuitParts or None
     """
-    circuit = study.circuit
-    if circuit.ideal:
+    if circuit is None or circuit.ideal:
         return None
     spec = circuit.converter
     converter = Converter(

@@ -1,13 +1,13 @@
 """The cells' electrical model at their air temperature: which tables a sky's steps take.
 
-A study's :class:`~foldopt.engine.electrical.Electrical` holds one air temperature (its tables are
+An :class:`~foldopt.engine.electrical.Electrical` holds one air temperature (its tables are
 built for it). Without a weather file every block of a sky has one; with one, every step has its
 own (:attr:`foldopt.engine.sky.Sky.temp_steps`), and each step takes the powers of the two tables
 whose air temperatures enclose its own, linearly between them (:func:`temperature_nodes`), in the
 kernel and in the reference path alike.
 
-The module may import numpy, :mod:`foldopt.inputs.study`, :mod:`foldopt.physics` and
-:mod:`foldopt.engine.electrical` and :mod:`foldopt.engine.sky`.
+The module may import numpy, :mod:`foldopt.physics` and :mod:`foldopt.engine.electrical`,
+:mod:`foldopt.engine.options` and :mod:`foldopt.engine.sky`.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ import numpy as np
 
 from foldopt.engine.as_built import circuit_parts
 from foldopt.engine.electrical import Electrical
+from foldopt.engine.options import ElectricalOptions
 from foldopt.engine.sky import Sky
-from foldopt.inputs.study import Study
 from foldopt.physics.pvmodel import IRRADIANCE_REF, TEMPERATURE_REF, PVModel
 
 
@@ -36,32 +36,35 @@ def rated_power(pv: PVModel, area: float) -> float:
     return float(pv.max_power(np.array([IRRADIANCE_REF]), TEMPERATURE_REF, area)[0])
 
 
-def electrical_settings(study: Study, temp_air: float, wind_speed: float | None = None) -> dict:
-    """The keyword arguments (dict) of a study's :class:`Electrical` whose cells see ``temp_air``.
+def electrical_settings(
+    options: ElectricalOptions, temp_air: float, wind_speed: float | None = None
+) -> dict:
+    """The keyword arguments (dict) of the :class:`Electrical` of ``options`` whose cells see
+    ``temp_air``.
 
     Parameters
     ----------
-    study : Study
+    options : ElectricalOptions
     temp_air : float
         Air temperature of the cells [C].
     wind_speed : float, optional
-        Wind speed of the tables [m/s]; default the study's (a weather study's sky gives its own,
+        Wind speed of the tables [m/s]; default the options' (a weather study's sky gives its own,
         :attr:`foldopt.engine.sky.Sky.wind_ref`).
     """
-    pv = PVModel(study.pv_model, study.panel.efficiency, study.module)
+    pv = PVModel(options.pv_model, options.efficiency, options.module)
     return dict(
         pv=pv,
-        subpanel_area=study.panel.area / 2.0,
+        subpanel_area=options.area / 2.0,
         temp_air=float(temp_air),
-        wind_speed=study.wind_speed if wind_speed is None else float(wind_speed),
-        temperature_model=study.temperature_model,
-        bypass=study.bypass_diodes,
-        switch_series=study.switch_series,
-        converter_efficiency=study.converter_efficiency,
-        exact=study.exact_electrical,
+        wind_speed=options.wind_speed if wind_speed is None else float(wind_speed),
+        temperature_model=options.temperature_model,
+        bypass=options.bypass,
+        switch_series=options.switch_series,
+        converter_efficiency=options.converter_efficiency,
+        exact=options.exact,
         circuit=None
-        if study.circuit.ideal
-        else circuit_parts(study, rated_power(pv, study.panel.area)),
+        if options.circuit is None
+        else circuit_parts(options.circuit, rated_power(pv, options.area)),
     )
 
 
@@ -70,42 +73,44 @@ def _electrical(settings_items: tuple) -> Electrical:
     return Electrical(**dict(settings_items))
 
 
-def electrical_for(study: Study, temp_air: float, wind_speed: float | None = None) -> Electrical:
-    """The study's :class:`Electrical` at an air temperature, shared by every caller in this process (and
-    its tables by every process, through the disk cache).
+def electrical_for(
+    options: ElectricalOptions, temp_air: float, wind_speed: float | None = None
+) -> Electrical:
+    """The :class:`Electrical` of ``options`` at an air temperature, shared by every caller in this
+    process (and its tables by every process, through the disk cache).
 
     Parameters
     ----------
-    study, temp_air, wind_speed
+    options, temp_air, wind_speed
         As :func:`electrical_settings`.
     """
-    return _electrical(tuple(electrical_settings(study, temp_air, wind_speed).items()))
+    return _electrical(tuple(electrical_settings(options, temp_air, wind_speed).items()))
 
 
-def panel_power(sky: Sky, study: Study, poa_global, area: float | None = None):
+def panel_power(sky: Sky, *, poa_global, electrical: ElectricalOptions, area: float | None = None):
     """Power panels deliver to the load over the blocks of a sky (their maximum power, or as the
-    study's circuit is built: :meth:`Electrical.panel_power`), at their cells' air temperature
+    circuit is built: :meth:`Electrical.panel_power`), at their cells' air temperature
     (:func:`temperature_nodes`).
 
     Parameters
     ----------
     sky : Sky
-    study : Study
     poa_global : numpy.ndarray
         (n_blocks, n_steps) plane-of-array irradiance [W/m^2].
+    electrical : ElectricalOptions
     area : float, optional
-        Panel area [m^2]; default the study's.
+        Panel area [m^2]; default the options'.
 
     Returns
     -------
     numpy.ndarray
         (n_blocks, n_steps) [W].
     """
-    area = study.panel.area if area is None else area
+    area = electrical.area if area is None else area
     power = np.zeros_like(poa_global)
     for temp, weight in node_weights(sky, slice(None), poa_global.shape):
         take = weight > 0
-        power[take] += weight[take] * electrical_for(study, temp, sky.wind_ref).panel_power(
+        power[take] += weight[take] * electrical_for(electrical, temp, sky.wind_ref).panel_power(
             poa_global[take], area
         )
     return power

@@ -41,8 +41,10 @@ def _walk(loads, position, power):
 
 
 @njit(cache=True, inline="always")
-def _shares(loads, lo, hi, lo_at, hi_at, length, above, run, contiguous):
-    """Shares of a segment from ``lo`` to ``hi`` for the loads strictly inside its range."""
+def _shares(loads, lo, hi, lo_at, hi_at, length, work, contiguous):
+    """Shares of a segment from ``lo`` to ``hi`` for the loads strictly inside its range, into
+    ``work.above`` (and ``work.run``)."""
+    above, run = work.above, work.run
     for j in range(lo_at, hi_at):
         share = length * (hi - loads[j]) / (hi - lo)
         above[j] += share
@@ -84,10 +86,10 @@ def _per_load(p, shape, s, use_shape):
 
 
 @njit(cache=True, inline="always")
-def day_metrics(power, first, last, p_load, profile, loads, work, t_out, cont_out):
+def day_metrics(power, span, p_load, profile, loads, work, t_out, cont_out):
     """Daily metrics of one power curve [W] sampled at step centres, of which only steps
-    ``first..last`` need walking: the power before and after them is that of the first and the
-    last (zero, or the day's end). Writes t_solar (and its longest run) per load of ``p_load``
+    ``first..last`` (``span``) need walking: the power before and after them is that of the first
+    and the last (zero, or the day's end). Writes t_solar (and its longest run) per load of ``p_load``
     (one set of :class:`foldopt.engine.records.Loads`, ascending) into ``t_out`` (and
     ``cont_out``); returns the energy [Wh] and the peak [W]. With ``loads.use_profile`` the loads
     are scales of the load profile ``profile`` (n_steps) [W] (:func:`_per_load`); steps outside
@@ -100,39 +102,19 @@ def day_metrics(power, first, last, p_load, profile, loads, work, t_out, cont_ou
     # Constant loads without runs (every map's) with the flags as constants, so that no step tests
     # them; the other cases read them at run time.
     if not loads.contiguous and not loads.use_profile:
-        return _day_steps(
-            power,
-            first,
-            last,
-            p_load,
-            profile,
-            loads.step_hours,
-            False,
-            False,
-            work,
-            t_out,
-            cont_out,
-        )
-    return _day_steps(
-        power,
-        first,
-        last,
-        p_load,
-        profile,
-        loads.step_hours,
-        loads.contiguous,
-        loads.use_profile,
-        work,
-        t_out,
-        cont_out,
-    )
+        held = (loads.step_hours, False, False)
+        return _day_steps(power, span, p_load, profile, held, work, t_out, cont_out)
+    held = (loads.step_hours, loads.contiguous, loads.use_profile)
+    return _day_steps(power, span, p_load, profile, held, work, t_out, cont_out)
 
 
 @njit(cache=True, inline="always")
-def _day_steps(
-    power, first, last, p_load, profile, step_hours, contiguous, use_profile, work, t_out, cont_out
-):
-    """:func:`day_metrics`' walk over the steps."""
+def _day_steps(power, span, p_load, profile, held, work, t_out, cont_out):
+    """:func:`day_metrics`' walk over the steps; ``held`` is how the curve is held against the
+    loads: the step [h] and the flags ``contiguous`` and ``use_profile`` of
+    :class:`foldopt.engine.records.Loads`."""
+    first, last = span
+    step_hours, contiguous, use_profile = held
     above, whole, run = work.above, work.whole, work.run
     n_steps, n_loads = power.shape[0], p_load.shape[0]
     above[:] = 0.0
@@ -163,8 +145,7 @@ def _day_steps(
                 lo_at,
                 hi_at,
                 step_hours,
-                above,
-                run,
+                work,
                 contiguous,
             )
         previous, position = p, at
@@ -212,8 +193,7 @@ def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
     for r in range(start, stop):
         out.energy[r, 0], out.peak[r, 0] = day_metrics(
             power[r],
-            span[r, 0],
-            span[r, 1],
+            (span[r, 0], span[r, 1]),
             loads.p_load[row_loadset[r]],
             loads.profile[r if loads.use_profile else 0],
             loads,

@@ -1,9 +1,10 @@
 """The engine: daily metrics of many panel orientations over a :class:`foldopt.engine.sky.Sky`.
 
 A *row* is one block of the sky (a day at a site) seen by one panel: the east and west sub-panel orientations
-(a fold angle; both the same for the flat panel). :func:`row_metrics` gives, for every row, connection and
-load, ``t_solar``, optionally its longest contiguous interval, and the energy and peak power, in one of two
-engines:
+(a fold angle; both the same for the flat panel), the rows named by a :class:`PanelRows`. :func:`row_metrics`
+gives, for every row, connection and load, ``t_solar``, optionally its longest contiguous interval, and the
+energy and peak power of the electrical model of an :class:`foldopt.engine.options.ElectricalOptions`, in one
+of two engines:
 
 - ``numba``: :func:`foldopt.engine.kernel.fold_rows`, one compiled pass per row from the sun vector
   to the metrics, parallel over rows, without (rows x steps) arrays;
@@ -13,25 +14,26 @@ engines:
 - ``auto`` (the default): the reference for small work, the kernel for more
   (:mod:`foldopt.engine.choice`).
 
-Studies that solve every step's I-V curves (``exact_electrical``) always take the reference path.
+Options that solve every step's I-V curves (``exact``) always take the reference path.
 """
 
 from __future__ import annotations
 
 import inspect
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import pvlib
 
 from foldopt.physics.connections import CONNECTIONS, connection_powers
-from foldopt.inputs.study import Study
 from foldopt.physics.geometry import normal_vector, subpanel_orientation
 from foldopt.physics.irradiance import beam_incidence_factor, plane_of_array
 from foldopt.engine.metrics import energy, per_load, t_solar, t_solar_contiguous
 from foldopt.names import DEFAULT_ENGINE
 from foldopt.engine.choice import engine_for
 from foldopt.engine.as_built import PARTS, assemble
+from foldopt.engine.options import ElectricalOptions
 from foldopt.engine.records import Loads, Rows, SkyArrays, Tables, allocate
 from foldopt.engine.sky import Sky, step_span
 from foldopt.engine.sky_view import row_views, surface_views
@@ -79,13 +81,38 @@ class RowMetrics:
     power: np.ndarray | None = None
 
 
-def fold_orientations(study: Study, surface_tilt, surface_azimuth, fold_angles) -> np.ndarray:
+class PanelRows(NamedTuple):
+    """The rows :func:`row_metrics` evaluates: each a block of the sky seen by one panel's two
+    sub-panels, against one set of loads.
+
+    Attributes
+    ----------
+    block : array_like of int
+        (n_rows,) each row's block.
+    orientation : array_like
+        (k, 4) the orientations the rows take: east tilt, east azimuth, west tilt, west azimuth
+        [deg] (:func:`fold_orientations`, :func:`flat_orientation`).
+    orientation_of : array_like of int, optional
+        (n_rows,) each row's orientation in ``orientation``; default the row's own (row ``i``
+        takes the ``i``-th, k = n_rows). A few orientations over many blocks (the angles of a
+        search over a year's days) are so worked out once each.
+    loadset : array_like of int, optional
+        (n_rows,) each row's set of loads; default the first.
+    """
+
+    block: np.ndarray
+    orientation: np.ndarray
+    orientation_of: np.ndarray | None = None
+    loadset: np.ndarray | None = None
+
+
+def fold_orientations(geometry: str, surface_tilt, surface_azimuth, fold_angles) -> np.ndarray:
     """Sub-panel orientations of every block's panel at every fold angle.
 
     Parameters
     ----------
-    study : Study
-        Gives the geometry.
+    geometry : str
+        How the panel folds, one of :data:`foldopt.names.GEOMETRIES`.
     surface_tilt, surface_azimuth : array_like
         The flat panel of each block [deg], (n_blocks,).
     fold_angles : array_like
@@ -96,7 +123,6 @@ def fold_orientations(study: Study, surface_tilt, surface_azimuth, fold_angles) 
     numpy.ndarray
         (n_blocks, n_angles, 4): tilt and azimuth of the east, then of the west sub-panel [deg].
     """
-    geometry = study.geometry
     fold_angles = np.asarray(fold_angles, dtype=float)
     panels = np.stack(
         [np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)], axis=-1
@@ -246,15 +272,13 @@ def _unsort(values, order, row_loadset):
 
 def row_metrics(
     sky: Sky,
-    study: Study,
-    row_block,
-    orientation,
+    *,
+    rows: PanelRows,
     loads,
-    row_loadset=None,
+    electrical: ElectricalOptions,
     outputs=("switching",),
     contiguous: bool = False,
     engine: str = DEFAULT_ENGINE,
-    row_orientation=None,
     curves=None,
 ) -> RowMetrics:
     """Daily metrics of rows of panel orientations over a sky.
@@ -262,25 +286,19 @@ def row_metrics(
     Parameters
     ----------
     sky : Sky
-    study : Study
-        The electrical model, connection options and mode (paper-mode incidence by Eq. 5).
-    row_block : array_like of int
-        (n_rows,) block of each row.
-    orientation : array_like
-        (n_rows, 4) east tilt, east azimuth, west tilt, west azimuth [deg]; with ``row_orientation``,
-        (k, 4) orientations that the rows take by index.
+        The light, and how the beam is taken (paper mode: Eq. 5).
+    rows : PanelRows
+        Each row's block, orientation and set of loads.
     loads : array_like
-        (n_loads,) loads [W] shared by every row, or (n_sets, n_loads) sets chosen by ``row_loadset``.
-    row_loadset : array_like of int, optional
-        (n_rows,) set of loads of each row; default the first.
+        (n_loads,) loads [W] shared by every row, or (n_sets, n_loads) sets chosen by
+        ``rows.loadset``.
+    electrical : ElectricalOptions
+        The electrical model and the connections' options.
     outputs : sequence of str
         Names of :data:`OUTPUTS` to evaluate.
     contiguous : bool
         Also the longest contiguous interval (costs O(n_loads) a step: for few loads).
     engine : {'auto', 'numba', 'numpy'}
-    row_orientation : array_like of int, optional
-        (n_rows,) each row's orientation in ``orientation``: a few orientations over many blocks
-        (the angles of a search over a year's days) are then worked out once each.
     curves : array_like of int, optional
         Rows whose power curves to keep (``RowMetrics.power``, in this order): the curves their
         metrics were reduced from, for a report to draw.
@@ -290,50 +308,34 @@ def row_metrics(
     RowMetrics
         An unknown ``engine`` or output raises ValueError.
     """
-    engine = engine_for(engine, np.size(row_block) * sky.n_steps)
+    engine = engine_for(engine, np.size(rows.block) * sky.n_steps)
     unknown = [name for name in outputs if name not in OUTPUTS]
     if unknown:
         raise ValueError(f"outputs must be among {', '.join(OUTPUTS)}; got {unknown}")
-    row_block = np.asarray(row_block, dtype=np.int64)
-    orientation = np.asarray(orientation, dtype=float).reshape(-1, 4)
-    row_orientation = (
-        np.arange(row_block.size)
-        if row_orientation is None
-        else np.asarray(row_orientation, dtype=np.int64)
+    block = np.asarray(rows.block, dtype=np.int64)
+    orientation_of = (
+        np.arange(block.size)
+        if rows.orientation_of is None
+        else np.asarray(rows.orientation_of, dtype=np.int64)
     )
-    if row_orientation.size != row_block.size:
-        raise ValueError(f"{row_orientation.size} orientations for {row_block.size} rows")
+    if orientation_of.size != block.size:
+        raise ValueError(f"{orientation_of.size} orientations for {block.size} rows")
+    rows = PanelRows(
+        block,
+        np.asarray(rows.orientation, dtype=float).reshape(-1, 4),
+        orientation_of,
+        np.zeros(block.size, dtype=np.int64)
+        if rows.loadset is None
+        else np.asarray(rows.loadset, dtype=np.int64),
+    )
     sorted_loads, order = _sorted_loads(loads)
-    row_loadset = (
-        np.zeros(row_block.size, dtype=np.int64)
-        if row_loadset is None
-        else np.asarray(row_loadset, dtype=np.int64)
-    )
-    loads = _loads(sorted_loads, sky.load_shape, contiguous, sky.step_hours)
-    curve = np.full(row_block.size, -1, dtype=np.int64)
+    held = _loads(sorted_loads, sky.load_shape, contiguous, sky.step_hours)
+    curve = np.full(block.size, -1, dtype=np.int64)
     if curves is not None:
         curve[np.asarray(curves, dtype=np.int64)] = np.arange(np.size(curves))
-    if engine == "numpy" or study.exact_electrical:
-        result = _reference(
-            sky, study, row_block, orientation[row_orientation], loads, row_loadset, outputs, curve
-        )
-    else:
-        nodes, table, weight = temperature_nodes(sky)
-        electricals = [electrical_for(study, temp, sky.wind_ref) for temp in nodes]
-        result = _compiled(
-            sky,
-            study,
-            electricals,
-            (table, weight),
-            row_block,
-            orientation,
-            row_orientation,
-            loads,
-            row_loadset,
-            outputs,
-            curve,
-        )
-    return _in_caller_order(result, order, row_loadset)
+    run = _reference if engine == "numpy" or electrical.exact else _compiled
+    result = run(sky, rows, held, outputs, curve, electrical)
+    return _in_caller_order(result, order, rows.loadset)
 
 
 def _in_caller_order(result: RowMetrics, order, row_loadset) -> RowMetrics:
@@ -368,8 +370,9 @@ def _curve_reference(power, row_loads, profile, loads: Loads):
 
 def powers(
     sky: Sky,
-    study: Study,
+    *,
     orientation,
+    electrical: ElectricalOptions,
     blocks=slice(None),
     series: bool = True,
     with_state: bool = False,
@@ -380,10 +383,11 @@ def powers(
     Parameters
     ----------
     sky : Sky
-    study : Study
-        The electrical model, connection options and mode.
+        The light, and how the beam is taken (paper mode: Eq. 5).
     orientation : array_like
         (k, 4) sub-panel orientations over one selected block, or (n_blocks, 4), one per selected block.
+    electrical : ElectricalOptions
+        The electrical model and the connections' options.
     blocks : slice or list of int, default all
         The selected blocks (an index that keeps the block axis).
     series : bool, default True
@@ -400,7 +404,7 @@ def powers(
         The state switching chose (``with_state``).
     """
     orientation = np.asarray(orientation, dtype=float)
-    paper = study.mode == "paper"
+    paper = sky.mode == "paper"
     poa_east = poa(sky, orientation[:, 0, None], orientation[:, 1, None], blocks, paper)
     poa_west = poa(sky, orientation[:, 2, None], orientation[:, 3, None], blocks, paper)
     out = {}
@@ -421,13 +425,13 @@ def powers(
         )
     )
     weights = node_weights(sky, blocks, poa_east.shape)
-    circuit = electrical_for(study, weights[0][0], sky.wind_ref).circuit
+    circuit = electrical_for(electrical, weights[0][0], sky.wind_ref).circuit
     if circuit is not None:
         # As built, the panel side is taken linearly between tables and the converter acts on that.
         side = {name: np.zeros(poa_east.shape) for name in PARTS}
         for temp, weight in weights:
             take = weight > 0
-            part = electrical_for(study, temp, sky.wind_ref).parts(
+            part = electrical_for(electrical, temp, sky.wind_ref).parts(
                 poa_east[take], poa_west[take], series
             )
             for name, values in side.items():
@@ -435,15 +439,15 @@ def powers(
         connected, state = assemble(
             circuit,
             side,
-            switch_series=study.switch_series,
-            converter_efficiency=study.converter_efficiency,
+            switch_series=electrical.switch_series,
+            converter_efficiency=electrical.converter_efficiency,
             with_state=with_state,
         )
         return {**out, **connected}, state
     if len(weights) == 1:
-        electrical = electrical_for(study, weights[0][0], sky.wind_ref)
-        part, state = electrical.connections(poa_east, poa_west, series, with_state)
-        part["panel"] = electrical.panel_power(poa_east, study.panel.area)
+        cells = electrical_for(electrical, weights[0][0], sky.wind_ref)
+        part, state = cells.connections(poa_east, poa_west, series, with_state)
+        part["panel"] = cells.panel_power(poa_east, electrical.area)
         return {**out, **part}, state
     # Steps between two tables' air temperatures take each sub-panel's and each pair's power
     # linearly between them, and the connections from those, as the kernel does.
@@ -452,9 +456,9 @@ def powers(
     }
     for temp, weight in weights:
         take = weight > 0
-        electrical = electrical_for(study, temp, sky.wind_ref)
-        part, _ = electrical.connections(poa_east[take], poa_west[take], series, with_state=False)
-        part["panel"] = electrical.panel_power(poa_east[take], study.panel.area)
+        cells = electrical_for(electrical, temp, sky.wind_ref)
+        part, _ = cells.connections(poa_east[take], poa_west[take], series, with_state=False)
+        part["panel"] = cells.panel_power(poa_east[take], electrical.area)
         for name, values in parts.items():
             values[take] += weight[take] * part[name]
     connected, state = connection_powers(
@@ -462,15 +466,17 @@ def powers(
         parts["west"],
         parts["parallel"],
         parts["series"],
-        switch_series=study.switch_series,
-        converter_efficiency=study.converter_efficiency,
+        switch_series=electrical.switch_series,
+        converter_efficiency=electrical.converter_efficiency,
         with_state=with_state,
     )
     return {**out, **connected, "panel": parts["panel"]}, state
 
 
-def _reference(sky, study, row_block, orientation, loads: Loads, row_loadset, outputs, curve):
-    n_rows, n_loads, contiguous = row_block.size, loads.p_load.shape[1], loads.contiguous
+def _reference(sky, rows: PanelRows, loads: Loads, outputs, curve, electrical) -> RowMetrics:
+    """:func:`row_metrics` by the NumPy reference path, block by block (``rows`` complete)."""
+    n_rows, n_loads, contiguous = rows.block.size, loads.p_load.shape[1], loads.contiguous
+    orientation = rows.orientation[rows.orientation_of]
     shape = (n_rows, len(outputs))
     kept = int((curve >= 0).sum())
     out = RowMetrics(
@@ -481,36 +487,39 @@ def _reference(sky, study, row_block, orientation, loads: Loads, row_loadset, ou
         np.zeros(n_rows),
         np.zeros((kept, len(outputs), sky.dni.shape[1])) if kept else None,
     )
-    series = "series" in outputs or study.switch_series
+    series = "series" in outputs or electrical.switch_series
     step = sky.step_hours
-    for block in np.unique(row_block):
-        rows = np.flatnonzero(row_block == block)
-        curves, _ = powers(sky, study, orientation[rows], [block], series)
-        out.irradiation[rows] = energy(curves["poa"], step)
+    for block in np.unique(rows.block):
+        take = np.flatnonzero(rows.block == block)
+        curves, _ = powers(
+            sky, orientation=orientation[take], electrical=electrical, blocks=[block], series=series
+        )
+        out.irradiation[take] = energy(curves["poa"], step)
         profile = loads.profile[block] if loads.use_profile else None
         for index, name in enumerate(outputs):
             hours, runs, harvested, peak = _curve_reference(
-                curves[name], loads.p_load[row_loadset[rows]], profile, loads
+                curves[name], loads.p_load[rows.loadset[take]], profile, loads
             )
-            out.t_solar[rows, index], out.energy[rows, index], out.peak[rows, index] = (
+            out.t_solar[take, index], out.energy[take, index], out.peak[take, index] = (
                 hours,
                 harvested,
                 peak,
             )
             if contiguous:
-                out.t_solar_contiguous[rows, index] = runs
-            keep = curve[rows] >= 0
+                out.t_solar_contiguous[take, index] = runs
+            keep = curve[take] >= 0
             if keep.any():
-                out.power[curve[rows][keep], index] = curves[name][keep]
+                out.power[curve[take][keep], index] = curves[name][keep]
     return out
 
 
-def _tables(electricals, outputs, study, codes) -> Tables:
+def _tables(electricals, outputs, area: float) -> Tables:
     """The kernel's electrical side: the stacked tables (one per cell temperature), the ideal
-    model's linear power, and the circuit as built: its flags, tables and converter."""
+    model's linear power, the circuit as built (its flags, tables and converter) and the codes of
+    the ``outputs``; ``area`` the panel's [m^2]."""
     first, count = electricals[0], len(electricals)
     parts = first.circuit
-    # Tables a study does not use are placeholders, one per cell temperature all the same.
+    # Tables the options do not use are placeholders, one per cell temperature all the same.
     placeholder_1d, placeholder = np.zeros((count, 2)), np.zeros((count, 2, 2))
     subpanel, parallel, series, linear_power = placeholder_1d, placeholder, placeholder, 0.0
     alone, panel, switching = placeholder_1d, placeholder_1d, placeholder
@@ -519,7 +528,7 @@ def _tables(electricals, outputs, study, codes) -> Tables:
     else:
         subpanel = np.stack([e._table("subpanel")[1] for e in electricals])
         parallel = np.stack([e._table("parallel") for e in electricals])
-        if "series" in outputs or study.switch_series:
+        if "series" in outputs or first.switch_series:
             series = np.stack([e._table("series") for e in electricals])
         if parts is not None and parts.direct:
             alone = np.stack([e._table("alone")[1] for e in electricals])
@@ -531,11 +540,11 @@ def _tables(electricals, outputs, study, codes) -> Tables:
         parallel=parallel,
         series=series,
         linear_power=float(linear_power),
-        panel_scale=float(study.panel.area / first.subpanel_area),
+        panel_scale=float(area / first.subpanel_area),
         bypass=bool(first.bypass),
         switch_series=bool(first.switch_series),
         converter_efficiency=float(first.converter_efficiency),
-        connections=codes,
+        connections=np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64),
         as_built=parts is not None,
         direct=parts is not None and bool(parts.direct),
         switch_table=parts is not None and bool(parts.switch_table),
@@ -549,24 +558,30 @@ def _tables(electricals, outputs, study, codes) -> Tables:
     )
 
 
-def _compiled(
-    sky,
-    study,
-    electricals,
-    step_tables,
-    row_block,
-    orientation,
-    row_orientation,
-    loads,
-    row_loadset,
-    outputs,
-    curve,
-):
-    from foldopt.engine import kernel
+def _sky_arrays(sky: Sky, paper: bool, table, weight) -> SkyArrays:
+    """The kernel's light: the sky along its steps, each step's (or block's) table set and weight
+    (:func:`temperature_nodes`), and how the beam is taken."""
+    iam_model, iam_params = _iam_code(sky.iam)
+    sun, paper_sun, beam, terms, span = (np.ascontiguousarray(a) for a in sky.kernel_layout(paper))
+    # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
+    return SkyArrays(
+        sun=sun,
+        paper_sun=paper_sun,
+        beam=beam,
+        terms=terms,
+        span=span,
+        step_table=np.ascontiguousarray(table, dtype=np.int64),
+        step_weight=np.ascontiguousarray(weight, dtype=float),
+        paper=paper,
+        iam_model=int(iam_model),
+        iam_params=iam_params,
+    )
 
-    codes = np.array([OUTPUTS.index(name) for name in outputs], dtype=np.int64)
-    # Each orientation's normals (and Eq. 5 factors) once, then per row; the exact incidence reads
-    # no Eq. 5 factors (zeros stand in).
+
+def _kernel_rows(sky: Sky, rows: PanelRows, curve, paper: bool) -> Rows:
+    """The kernel's rows: each orientation's normals (and Eq. 5 factors) worked out once, then
+    taken per row; the exact incidence reads no Eq. 5 factors (zeros stand in)."""
+    orientation, orientation_of = rows.orientation, rows.orientation_of
     normals = np.stack(
         [
             normal_vector(orientation[:, 0], orientation[:, 1]),
@@ -574,43 +589,49 @@ def _compiled(
         ],
         axis=1,
     )
-    paper = study.mode == "paper"
-    row_paper = np.zeros((row_block.size, 2, 4))
+    row_paper = np.zeros((rows.block.size, 2, 4))
     if paper:
         tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])
         row_paper = np.stack(
             [np.cos(tilt), np.sin(tilt), np.cos(azimuth), np.sin(azimuth)], axis=-1
-        )[row_orientation]
-    iam_model, iam_params = _iam_code(sky.iam)
-    sun, paper_sun, beam, terms, span = (np.ascontiguousarray(a) for a in sky.kernel_layout(paper))
-    # One layout for every call, so that one compiled specialisation (cached on disk) serves all.
-    light = SkyArrays(
-        sun=sun,
-        paper_sun=paper_sun,
-        beam=beam,
-        terms=terms,
-        span=span,
-        step_table=np.ascontiguousarray(step_tables[0], dtype=np.int64),
-        step_weight=np.ascontiguousarray(step_tables[1], dtype=float),
-        paper=paper,
-        iam_model=int(iam_model),
-        iam_params=iam_params,
-    )
-    rows = Rows(
-        block=np.ascontiguousarray(row_block),
-        normal=np.ascontiguousarray(normals[row_orientation]),
+        )[orientation_of]
+    return Rows(
+        block=np.ascontiguousarray(rows.block),
+        normal=np.ascontiguousarray(normals[orientation_of]),
         paper=np.ascontiguousarray(row_paper),
         sky_view=np.ascontiguousarray(
-            row_views(sky, row_block, normals, orientation, row_orientation)
+            row_views(sky, rows.block, normals, orientation, orientation_of)
         ),
-        loadset=np.ascontiguousarray(row_loadset),
+        loadset=np.ascontiguousarray(rows.loadset),
         curve=curve,
     )
+
+
+def _compiled(sky, rows: PanelRows, loads: Loads, outputs, curve, electrical) -> RowMetrics:
+    """:func:`row_metrics` by the compiled kernel (``rows`` complete): the records of
+    :mod:`foldopt.engine.records` filled, then one pass of :func:`foldopt.engine.kernel.fold_rows`."""
+    from foldopt.engine import kernel
+
+    nodes, table, weight = temperature_nodes(sky)
+    electricals = [electrical_for(electrical, temp, sky.wind_ref) for temp in nodes]
+    paper = sky.mode == "paper"
     kept = int((curve >= 0).sum())
     out, scratch = allocate(
-        row_block.size, codes.size, loads.p_load.shape[1], sky.dni.shape[1], loads.contiguous, kept
+        rows.block.size,
+        len(outputs),
+        loads.p_load.shape[1],
+        sky.dni.shape[1],
+        loads.contiguous,
+        kept,
     )
-    kernel.fold_rows(light, rows, _tables(electricals, outputs, study, codes), loads, out, scratch)
+    kernel.fold_rows(
+        _sky_arrays(sky, paper, table, weight),
+        _kernel_rows(sky, rows, curve, paper),
+        _tables(electricals, outputs, electrical.area),
+        loads,
+        out,
+        scratch,
+    )
     return RowMetrics(
         out.t_solar,
         out.t_solar_contiguous if loads.contiguous else None,

@@ -71,8 +71,10 @@ def iam_factor(cos_aoi, model, params):
 
 
 @njit(cache=True, inline="always")
-def _incidence_steps(r, b, start, count, sky, rows, paper, has_terms, modified, work):
-    """:func:`incidence`'s main loop, inlined once per case with the case's flags as constants."""
+def _incidence_steps(r, b, start, count, sky, rows, case, work):
+    """:func:`incidence`'s main loop, inlined once per case with the case's flags (``case``:
+    ``paper``, ``has_terms``, ``modified``) as constants."""
+    paper, has_terms, modified = case
     sun, paper_sun, beam, terms = sky.sun, sky.paper_sun, sky.beam, sky.terms
     east, west, incident, diffuse_east, diffuse_west = (
         work.east,
@@ -154,11 +156,11 @@ def incidence(r, b, first, n, sky, rows, tables, work):
     # Exact incidence without the modifier, with or without diffuse terms, as constants (every
     # study of a year or a map); paper mode and the modifier read their flags at run time.
     if not paper and not modified and has_terms:
-        _incidence_steps(r, b, start, count, sky, rows, False, True, False, work)
+        _incidence_steps(r, b, start, count, sky, rows, (False, True, False), work)
     elif not paper and not modified:
-        _incidence_steps(r, b, start, count, sky, rows, False, False, False, work)
+        _incidence_steps(r, b, start, count, sky, rows, (False, False, False), work)
     else:
-        _incidence_steps(r, b, start, count, sky, rows, paper, has_terms, modified, work)
+        _incidence_steps(r, b, start, count, sky, rows, (paper, has_terms, modified), work)
     east, west = work.east, work.west
     if modified:
         sun, normal = sky.sun, rows.normal

@@ -416,8 +416,7 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         for c in range(n_conn):
             out.energy[r, c], out.peak[r, c] = day_metrics(
                 work.power[c],
-                first,
-                last,
+                (first, last),
                 p_load,
                 profile,
                 loads,

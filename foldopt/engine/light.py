@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from foldopt.engine.options import SkyOptions
 from foldopt.errors import WeatherError
-from foldopt.inputs.study import Study
 from foldopt.inputs.turbidity import linke_turbidity as climatology_turbidity
 from foldopt.inputs.weather import (
     FORMATS,
@@ -159,12 +159,12 @@ def diffuse_terms(
     return np.moveaxis(layout, 1, -1)
 
 
-def weather_light(study: Study, grid: ClockGrid, dates, clear: dict, solar_zenith, dni_extra):
-    """Light at every step of the grid from the study's weather file
-    (:func:`foldopt.inputs.weather.downscale.hourly_light` along the clear sky), the air
-    temperature and wind at every step (:func:`foldopt.inputs.weather.downscale.interpolate_points`),
-    and how much of the file's irradiation the steps keep."""
-    weather = study.weather
+def weather_light(weather, grid: ClockGrid, dates, clear: dict, solar_zenith, dni_extra):
+    """Light at every step of the grid from an hourly weather file (``weather``, a
+    :class:`foldopt.inputs.weather_section.Weather`) drawn along the clear sky
+    (:func:`foldopt.inputs.weather.downscale.hourly_light`), the air temperature and wind at every
+    step (:func:`foldopt.inputs.weather.downscale.interpolate_points`), and how much of the file's
+    irradiation the steps keep."""
     columns = ("dni", "ghi", "dhi", "temp_air", "wind_speed", "cloud_cover")
     hourly = {key: np.empty((len(dates), 0)) for key in columns}
     starts = np.empty((len(dates), 0), dtype=np.int64)
@@ -216,21 +216,22 @@ def weather_light(study: Study, grid: ClockGrid, dates, clear: dict, solar_zenit
     return light, temp_air, wind_speed, balance, (hourly, per_interval)
 
 
-def measured_light(study: Study, grid: ClockGrid, dates):
-    """Light, air temperature and wind at every step of the grid from the study's measured weather
-    file, at its own step (:func:`foldopt.inputs.weather.study_weather`)."""
-    measured = study_weather(study.weather, study.site)
+def measured_light(options: SkyOptions, grid: ClockGrid, dates):
+    """Light, air temperature and wind at every step of the grid from the options' measured
+    weather file, at its own step (:func:`foldopt.inputs.weather.study_weather`)."""
+    weather = options.weather
+    measured = study_weather(weather, options.weather_site)
     frame = measured.frame
     flagged = sorted(set(dates) & set(measured.flagged_days))
     if flagged:
         gaps = [
             f"{start:%H:%M}-{stop:%H:%M}"
             for start, stop, minutes in measured.gaps
-            if start.date() in flagged and minutes > study.weather.max_gap_min
+            if start.date() in flagged and minutes > weather.max_gap_min
         ]
         raise WeatherError(
             f"weather {frame.attrs['weather']}: {flagged[0]} has a daylight gap too long to fill "
-            f"({', '.join(gaps[:3])}; weather.max_gap_min {study.weather.max_gap_min:g} min)"
+            f"({', '.join(gaps[:3])}; weather.max_gap_min {weather.max_gap_min:g} min)"
             + (f", and {len(flagged) - 1} more dates" if len(flagged) > 1 else "")
             + "; leave those dates out"
         )
@@ -249,7 +250,7 @@ def measured_light(study: Study, grid: ClockGrid, dates):
 
 
 def member_light(
-    study: Study, hourly: dict, per_interval: int, clear: dict, solar_zenith, dates, share
+    options: SkyOptions, hourly: dict, per_interval: int, clear: dict, solar_zenith, dates, share
 ):
     """Each block's light drawn as its member of the cloud ensemble of its day
     (:func:`foldopt.inputs.weather.ensemble.cloud_members`), and how much of the file's light the
@@ -268,9 +269,9 @@ def member_light(
             clear["ghi"][day : day + 1],
             cos_zenith[day : day + 1],
             per_interval,
-            study.step_min,
+            options.step_min,
             count,
-            [study.weather.seed, date.toordinal()],
+            [options.weather.seed, date.toordinal()],
             hourly["cloud_cover"][day : day + 1],
         )
         for key in drawn:

@@ -6,8 +6,8 @@ orientation-free diffuse terms of :func:`foldopt.physics.irradiance.sky_diffuse_
 one array program over all blocks (:func:`build_sky`): one clock grid, one solar-position
 evaluation, and the light of :mod:`foldopt.engine.light` (a clear sky and its diffuse terms in one
 compiled pass, or a weather file's light). The engine then evaluates any number of panel
-orientations against it. Blocks may be different sites and days; they share the study's settings
-(mode, sky model, step...).
+orientations against it. Blocks may be different sites and days; they share one set of settings
+(:class:`foldopt.engine.options.SkyOptions`: mode, sky model, step...).
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ from foldopt.engine.light import (
     member_light,
     weather_light,
 )
+from foldopt.engine.options import SkyOptions
 from foldopt.inputs.load_profile import load_shape
 from foldopt.inputs.sections import parse_timezone
-from foldopt.inputs.study import Study
 from foldopt.inputs.weather import study_weather, weather_site
 from foldopt.names import CLEAR_SKIES
 from foldopt.physics.atmosphere import clear_sky_dni
@@ -69,7 +69,7 @@ class Sky:
     ghi, dhi : numpy.ndarray or None
         Global and diffuse horizontal irradiance [W/m^2], where the sky has them.
     terms : numpy.ndarray or None
-        (n_blocks, n_steps, 4) diffuse terms; None when the study is beam only.
+        (n_blocks, n_steps, 4) diffuse terms; None for a beam-only sky.
     temp_air : numpy.ndarray
         (n_blocks,) the air temperature the cells of each block see [C]; with a weather file, its
         mean over the block's lit steps (``temp_steps`` holds every step's).
@@ -331,14 +331,14 @@ def _clock(sites, dates, step_min) -> ClockGrid:
     )
 
 
-def build_sky(study: Study, sites, dates, member=None) -> Sky:
-    """The sky of a study's settings over blocks, one per (site, date), as one array program.
+def build_sky(options: SkyOptions, sites, dates, member=None) -> Sky:
+    """The sky of one set of settings over blocks, one per (site, date), as one array program.
 
     Parameters
     ----------
-    study : Study
-        Mode, sky model, weather file, step, transposition, albedo, incidence-angle modifier, air
-        temperature (its site and date are not used).
+    options : SkyOptions
+        Mode, sky model, weather file (read), step, transposition, albedo, incidence-angle
+        modifier, air temperature.
     sites : sequence of foldopt.inputs.sections.Site
         One per block: latitude, longitude, altitude and time zone.
     dates : sequence of datetime.date
@@ -353,25 +353,23 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
 
     Raises
     ------
-    foldopt.ConfigError
-        If the study's files are unread (:meth:`foldopt.inputs.study.Study.require_files`).
     ValueError
         If ``sites`` and ``dates`` differ in length, or a weather file's intervals do not fit the
-        study's step.
+        step.
     """
-    study.require_files()
     if len(sites) != len(dates):
         raise ValueError(f"{len(sites)} sites for {len(dates)} dates")
-    if study.weather is not None:
+    weather = options.weather
+    if weather is not None:
         # A weather file's days are on its own clock, whatever time zone the site names.
         zone = (
-            study_weather(study.weather, study.site).site
-            if study.weather.measured
-            else weather_site(study.weather.path, study.weather.format)
+            study_weather(weather, options.weather_site).site
+            if weather.measured
+            else weather_site(weather.path, weather.format)
         )["timezone"]
         sites = [site.model_copy(update={"timezone": zone}) for site in sites]
     share = None
-    if member is not None and study.weather is not None and study.weather.members:
+    if member is not None and weather is not None and weather.members:
         # The members of a day share its sun, clear sky and air: they are worked out once a day
         # and a site, and only the light is drawn per member.
         keys = [
@@ -387,30 +385,30 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
     latitude = np.array([site.latitude for site in sites], dtype=float)[:, None]
     longitude = np.array([site.longitude for site in sites], dtype=float)[:, None]
     altitude = np.array([site.altitude for site in sites], dtype=float)[:, None]
-    grid = _clock(sites, dates, study.step_min)
-    sun = solar_position_grid(grid, latitude, longitude, altitude, study.mode)
+    grid = _clock(sites, dates, options.step_min)
+    sun = solar_position_grid(grid, latitude, longitude, altitude, options.mode)
     solar_zenith = sun["solar_zenith"]
     dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[
         grid.dayofyear
     ]
-    temp_air, balance = np.full(len(sites), float(study.temp_air)), None
+    temp_air, balance = np.full(len(sites), float(options.temp_air)), None
     temp_steps = wind_speed = wind_ref = terms = None
     notes = ()
-    transposition = study.sky_transposition()
-    if study.weather is not None and study.weather.measured:
-        light, measured = measured_light(study, grid, dates)
+    transposition = options.transposition
+    if weather is not None and weather.measured:
+        light, measured = measured_light(options, grid, dates)
         temp_steps, wind_speed = light.pop("temp_air"), light.pop("wind_speed")
         notes = tuple(measured.report())
-    elif study.weather is not None:
+    elif weather is not None:
         clear, _ = clear_light(
-            grid, solar_zenith, dni_extra, sites, "ineichen", study.linke_turbidity
+            grid, solar_zenith, dni_extra, sites, "ineichen", options.linke_turbidity
         )
         light, temp_steps, wind_speed, balance, (hourly, per_interval) = weather_light(
-            study, grid, dates, clear, solar_zenith, dni_extra
+            weather, grid, dates, clear, solar_zenith, dni_extra
         )
         if share is not None:
             light, balance = member_light(
-                study, hourly, per_interval, clear, solar_zenith, dates, share
+                options, hourly, per_interval, clear, solar_zenith, dates, share
             )
     sun_vector = sun.pop("sun_vector")
     if share is not None:
@@ -427,15 +425,15 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         dni_extra = dni_extra[inverse]
         temp_steps, wind_speed = temp_steps[inverse], wind_speed[inverse]
         dates = [dates[i] for i in inverse]
-    if study.weather is not None:
+    if weather is not None:
         lit = light["ghi"] > 0
         wind_ref = (
             float(np.round(2.0 * wind_speed[lit].mean()) / 2.0)
             if lit.any()
-            else float(study.wind_speed)
+            else float(options.wind_speed)
         )
         temp_steps = equivalent_temp_air(
-            temp_steps, wind_speed, wind_ref, light["ghi"], study.temperature_model
+            temp_steps, wind_speed, wind_ref, light["ghi"], options.temperature_model
         )
         # The block's representative temperature: its lit steps' mean (its whole day's if dark).
         temp_air = np.where(
@@ -443,39 +441,39 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
             (temp_steps * lit).sum(axis=1) / np.maximum(lit.sum(axis=1), 1),
             temp_steps.mean(axis=1),
         )
-    elif study.sky in CLEAR_SKIES:
+    elif options.model in CLEAR_SKIES:
         light, terms = clear_light(
             grid,
             solar_zenith,
             dni_extra,
             sites,
-            study.sky,
-            study.linke_turbidity,
+            options.model,
+            options.linke_turbidity,
             transposition,
-            study.albedo,
+            options.albedo,
         )
     else:
-        beam_altitude = altitude if study.mode == "exact" else 0.0
+        beam_altitude = altitude if options.mode == "exact" else 0.0
         light = {
             "dni": clear_sky_dni(
                 solar_zenith,
                 beam_altitude,
-                study.sky,
+                options.model,
                 dayofyear=grid.dayofyear,
-                climate=study.climate,
+                climate=options.climate,
             )
         }
     dni = light["dni"]
     ghi, dhi = light.get("ghi"), light.get("dhi")
     if transposition != "none" and terms is None:
-        terms = diffuse_terms(transposition, solar_zenith, dni, ghi, dhi, dni_extra, study.albedo)
+        terms = diffuse_terms(transposition, solar_zenith, dni, ghi, dhi, dni_extra, options.albedo)
     if horizons:
         dni, terms = block_behind_horizon(
             horizons, horizon_of, solar_zenith, sun["solar_azimuth"], dni, terms
         )
     return Sky(
         grid=grid,
-        mode=study.mode,
+        mode=options.mode,
         solar_zenith=solar_zenith,
         solar_azimuth=sun["solar_azimuth"],
         hour_angle=sun["hour_angle"],
@@ -487,11 +485,11 @@ def build_sky(study: Study, sites, dates, member=None) -> Sky:
         terms=terms,
         temp_air=temp_air,
         latitude=latitude[:, 0],
-        iam=study.iam,
+        iam=options.iam,
         weather_balance=balance,
         load_shape=None
-        if study.load_profile is None
-        else load_shape(study.load_profile, grid.clock_hours, dates),
+        if options.load_profile is None
+        else load_shape(options.load_profile, grid.clock_hours, dates),
         temp_steps=temp_steps,
         wind_speed=wind_speed,
         wind_ref=wind_ref,

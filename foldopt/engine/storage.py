@@ -223,6 +223,7 @@ def simulate(
     buffer: Buffer,
     step_hours: float,
     engine: str = "numba",
+    *,
     soc_curves: bool = False,
     max_iterations: int = 30,
     tolerance: float = 1e-6,
@@ -293,7 +294,7 @@ def simulate(
             f"power, load and buffer fields must have 1 or the same number of series; got {sizes}"
         )
     n_days, n_steps = power.shape[1:]
-    params = _parameter_rows(buffer, n_series, step_hours)
+    params = _parameters(buffer, n_series, step_hours)
     if not (np.isfinite(step_hours) and step_hours > 0):
         raise ValueError(f"step_hours must be above 0; got {step_hours}")
     if max_iterations < 1 or not tolerance >= 0:
@@ -305,9 +306,13 @@ def simulate(
     # The compiled loop takes every argument with the one type it was compiled for.
     run = kern.simulate_series if engine == "numba" else _simulate_numpy
     run(
-        power, load, own, params, float(step_hours), out, state, bool(soc_curves), soc, passes,
-        int(max_iterations), float(tolerance),
-    )  # fmt: skip
+        kern.Curves(power, load, own, float(step_hours)),
+        params,
+        kern.Days(out, state, soc, bool(soc_curves)),
+        passes,
+        int(max_iterations),
+        float(tolerance),
+    )
     return StorageResult(
         out[..., kern.POWERED],
         out[..., kern.SERVED],
@@ -350,8 +355,8 @@ def _load_array(load, shape, name):
     return np.ascontiguousarray(load)
 
 
-def _parameter_rows(buffer: Buffer, n_series: int, step_hours: float) -> np.ndarray:
-    """The buffer as (1 or n_series, N_PARAMETERS) rows, each field checked."""
+def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> kern.Parameters:
+    """The buffer as the loops read it, each field checked: (1 or n_series,) arrays."""
 
     def field(name, value, lo, hi, lo_open=False, hi_open=False, default=None):
         value = np.asarray(default if value is None else value, dtype=float)
@@ -379,21 +384,20 @@ def _parameter_rows(buffer: Buffer, n_series: int, step_hours: float) -> np.ndar
         if buffer.initial_soc is None
         else field("initial_soc", buffer.initial_soc, 0.0, 1.0)
     )
-    columns = {
-        kern.CAPACITY: capacity,
-        kern.MIN_SOC: min_soc,
-        kern.RESTART_SOC: restart,
-        kern.ETA_CHARGE: eta_c,
-        kern.ETA_DISCHARGE: eta_d,
-        kern.KEEP_STEP: (1.0 - leak) ** (step_hours / 24.0),
-        kern.KEEP_HALF: (1.0 - leak) ** (step_hours / 48.0),
-        kern.MAX_CHARGE: max_c,
-        kern.MAX_DISCHARGE: max_d,
-        kern.INITIAL_SOC: initial,
-    }
-    ordered = (np.atleast_1d(columns[column]) for column in range(kern.N_PARAMETERS))
-    rows = np.stack(np.broadcast_arrays(*ordered), axis=-1)
-    return np.ascontiguousarray(rows, dtype=float)
+    fields = kern.Parameters(
+        capacity=capacity,
+        min_soc=min_soc,
+        restart_soc=restart,
+        eta_charge=eta_c,
+        eta_discharge=eta_d,
+        keep_step=(1.0 - leak) ** (step_hours / 24.0),
+        keep_half=(1.0 - leak) ** (step_hours / 48.0),
+        max_charge=max_c,
+        max_discharge=max_d,
+        initial_soc=initial,
+    )
+    together = np.broadcast_arrays(*(np.atleast_1d(field) for field in fields))
+    return kern.Parameters(*(np.ascontiguousarray(field, dtype=float) for field in together))
 
 
 # The NumPy reference: the same model written over arrays of series, step by step.
@@ -422,7 +426,7 @@ def _clipped_energy(a, b, tau, cap):
 
 
 def _charge_numpy(charging, stored, spare, limit, par, row):
-    capacity, eta = par[:, kern.CAPACITY], par[:, kern.ETA_CHARGE]
+    capacity, eta = par.capacity, par.eta_charge
     room = np.maximum(capacity - stored, 0.0) / eta
     take = np.minimum(spare, limit)
     fills = charging & (take >= room)
@@ -448,25 +452,28 @@ def _time_to_draw(da, db, tau, energy):
         )
 
 
-def _part_numpy(pa, pb, la, lb, da, db, tau, surplus, demand, stored, on, par, row):
-    """:func:`foldopt.engine.storage_kernel._part` over arrays of series."""
+def _part_numpy(ends, tau, surplus, demand, stored, on, par, row):
+    """:func:`foldopt.engine.storage_kernel._part` over arrays of series (``demand``: whether the
+    load runs at both ends of the segment, where its time counts), writing into the day's ``row``;
+    returns the content and the load's state."""
+    pa, pb, la, lb, da, db = ends
     active = tau > 0.0
-    capacity = par[:, kern.CAPACITY]
+    capacity = par.capacity
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
     own = 0.5 * tau * (da + db)
-    on = on | (active & (stored >= par[:, kern.RESTART_SOC] * capacity))
+    on = on | (active & (stored >= par.restart_soc * capacity))
     run = active & on & surplus
-    floor = par[:, kern.MIN_SOC] * capacity
+    floor = par.min_soc * capacity
     usable = stored - floor
-    eta_d = par[:, kern.ETA_DISCHARGE]
+    eta_d = par.eta_discharge
     short = np.maximum(need - pv, 0.0)
     able = (
         active
         & on
         & ~surplus
         & (usable > 0.0)
-        & (np.maximum(la - pa, lb - pb) <= par[:, kern.MAX_DISCHARGE])
+        & (np.maximum(la - pa, lb - pb) <= par.max_discharge)
     )
     covered = able & (short <= eta_d * usable)
     partial = able & ~covered
@@ -494,7 +501,7 @@ def _part_numpy(pa, pb, la, lb, da, db, tau, surplus, demand, stored, on, par, r
     on = on & ~cut
     row[:, kern.EMPTY] = np.where(cut & (stored <= floor), 1.0, row[:, kern.EMPTY])
     row[:, kern.MISSING] += np.where(off, need, 0.0)
-    max_c = par[:, kern.MAX_CHARGE]
+    max_c = par.max_charge
     # Off, the controller has the load and the design's own draw off: the whole power charges.
     whole_a, whole_b = pa + da, pb + db
     spare = np.where(
@@ -510,10 +517,11 @@ def _part_numpy(pa, pb, la, lb, da, db, tau, surplus, demand, stored, on, par, r
     return _charge_numpy(run | off, stored, spare, limit, par, row), on
 
 
-def _segments(power, load, draw, step_hours):
+def _segments(curves: kern.Curves):
     """Each day's segments and their two parts, over whole arrays (n_series, n_days, n_steps + 1):
     the part with the power (less the design's own draw) at or above the load and the one below
-    it, in their order."""
+    it, in their order, each ``(ends, tau, surplus)`` as :func:`_part_numpy` takes them."""
+    power, load, draw, step_hours = curves
 
     def ends(curve):
         curve = np.broadcast_to(curve, power.shape)
@@ -535,21 +543,23 @@ def _segments(power, load, draw, step_hours):
     ps, ls = p0 + split * (p1 - p0), l0 + split * (l1 - l0)
     ds = d0 + split * (d1 - d0)
     t_above, t_below = tau * above, tau * (1.0 - above)
-    first = (p0, ps, l0, ls, d0, ds, np.where(rising, t_below, t_above), ~rising)
-    second = (ps, p1, ls, l1, ds, d1, np.where(rising, t_above, t_below), rising)
+    first = ((p0, ps, l0, ls, d0, ds), np.where(rising, t_below, t_above), ~rising)
+    second = ((ps, p1, ls, l1, ds, d1), np.where(rising, t_above, t_below), rising)
     return first, second, (l0 > 0.0) & (l1 > 0.0), half
 
 
-def _run_numpy(power, load, draw, par, step_hours, stored, on, out, state, soc_curves, soc):
+def _run_numpy(curves: kern.Curves, par: kern.Parameters, stored, on, days: kern.Days):
     """One pass over the days of a set of series (:func:`foldopt.engine.storage_kernel._run`
     without merging), the steps in turn and the series at once."""
+    power, _, draw, step_hours = curves
+    out, state, soc, soc_curves = days
     n_days, n_steps = power.shape[1:]
-    first, second, demand, half = _segments(power, load, draw, step_hours)
-    capacity = par[:, kern.CAPACITY]
+    first, second, demand, half = _segments(curves)
+    capacity = par.capacity
     n_bins = out.shape[-1] - kern.HISTOGRAM
     series = np.arange(power.shape[0])
-    restart = par[:, kern.RESTART_SOC] * capacity
-    floor = par[:, kern.MIN_SOC] * capacity
+    restart = par.restart_soc * capacity
+    floor = par.min_soc * capacity
     for d in range(n_days):
         on = on | (stored >= restart)
         state[:, d, 0], state[:, d, 1] = stored, on
@@ -558,16 +568,18 @@ def _run_numpy(power, load, draw, par, step_hours, stored, on, out, state, soc_c
         row[:, kern.FULL] = np.where((capacity > 0.0) & (stored >= capacity), 1.0, 0.0)
         row[:, kern.EMPTY] = np.where(stored <= floor, 1.0, 0.0)
         for j in range(n_steps + 1):
-            for part in (first, second):
+            for ends, tau, surplus in (first, second):
                 stored, on = _part_numpy(
-                    *(a[:, d, j] for a in part[:8]),
+                    tuple(a[:, d, j] for a in ends),
+                    tau[:, d, j],
+                    surplus[:, d, j],
                     demand[:, d, j],
                     stored,
                     on,
                     par,
                     row,
                 )
-            kept = stored * par[:, kern.KEEP_HALF if half[j] else kern.KEEP_STEP]
+            kept = stored * (par.keep_half if half[j] else par.keep_step)
             row[:, kern.SELF_DISCHARGE] += stored - kept
             stored = kept
             with np.errstate(invalid="ignore", divide="ignore"):
@@ -583,21 +595,18 @@ def _run_numpy(power, load, draw, par, step_hours, stored, on, out, state, soc_c
     return stored, on
 
 
-def _simulate_numpy(
-    power, load, draw, params, step_hours, out, state, soc_curves, soc, passes, max_iterations,
-    tolerance,
-):  # fmt: skip
+def _simulate_numpy(curves, params, days, passes, max_iterations, tolerance):
     """:func:`foldopt.engine.storage_kernel.simulate_series` over arrays of series, each series's
     passes as :func:`foldopt.engine.storage_kernel._series` runs them."""
+    out, state, soc, soc_curves = days
     n_series = out.shape[0]
-    power = np.broadcast_to(power, (n_series, *power.shape[1:]))
-    par = np.broadcast_to(params, (n_series, params.shape[1]))
-    load = np.broadcast_to(load, (n_series, *load.shape[1:]))
-    draw = np.broadcast_to(draw, (n_series, *draw.shape[1:]))
-    capacity = par[:, kern.CAPACITY]
-    given = ~np.isnan(par[:, kern.INITIAL_SOC])
-    stored = np.where(given, par[:, kern.INITIAL_SOC] * capacity, capacity)
-    on = np.where(given, stored >= par[:, kern.RESTART_SOC] * capacity, True)
+    power, load, draw = (np.broadcast_to(a, (n_series, *a.shape[1:])) for a in curves[:3])
+    step_hours = curves.step_hours
+    par = kern.Parameters(*(np.broadcast_to(field, n_series) for field in params))
+    capacity = par.capacity
+    given = ~np.isnan(par.initial_soc)
+    stored = np.where(given, par.initial_soc * capacity, capacity)
+    on = np.where(given, stored >= par.restart_soc * capacity, True)
     resolution = load.reshape(n_series, -1).max(axis=1) * step_hours
     low, high = np.zeros(n_series), capacity.copy()
     todo = np.ones(n_series, dtype=bool)
@@ -606,17 +615,11 @@ def _simulate_numpy(
         sub_out, sub_state = out[pick], state[pick]
         sub_soc = soc[pick] if soc_curves else soc
         end, end_on = _run_numpy(
-            power[pick],
-            load[pick],
-            draw[pick],
-            par[pick],
-            step_hours,
+            kern.Curves(power[pick], load[pick], draw[pick], step_hours),
+            kern.Parameters(*(field[pick] for field in par)),
             stored[pick],
             on[pick],
-            sub_out,
-            sub_state,
-            soc_curves,
-            sub_soc,
+            kern.Days(sub_out, sub_state, sub_soc, soc_curves),
         )
         out[pick], state[pick] = sub_out, sub_state
         if soc_curves:

@@ -3,11 +3,12 @@
 the layout of the arrays are documented there, and :func:`foldopt.engine.storage._simulate_numpy`
 is the reference it is tested against.
 
-One plain loop per series, the series spread over threads (:func:`simulate_series`). Every argument
-has the same type at every call (arrays of float64 laid out C-contiguous, a float, two ints, a
-bool), so that numba compiles one specialisation once and caches it (about 5 s on the 2-core
-machine, once). NumPy's error model spares every division Python's check for a zero divisor (the
-model divides by efficiencies, lengths and the capacity only where they are above zero). Dark
+One plain loop per series, the series spread over threads (:func:`simulate_series`). The arguments
+are named records, module-level named tuples numba takes (:class:`Curves`, :class:`Parameters`,
+:class:`Days`), each field with the same type at every call (arrays of float64 laid out
+C-contiguous, a float, a bool), so that numba compiles one specialisation once and caches it.
+NumPy's error model spares every division Python's check for a zero divisor (the model divides
+by efficiencies, lengths and the capacity only where they are above zero). Dark
 steps and steps with the buffer full, most of a day, take short cuts through the same
 operations as the general part (:func:`_run`), so the two paths agree to the bit.
 """
@@ -15,14 +16,85 @@ operations as the general part (:func:`_run`), so the two paths agree to the bit
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
 
-# Columns of the parameter rows (:func:`foldopt.engine.storage._parameter_rows`).
-CAPACITY, MIN_SOC, RESTART_SOC, ETA_CHARGE, ETA_DISCHARGE = 0, 1, 2, 3, 4
-KEEP_STEP, KEEP_HALF, MAX_CHARGE, MAX_DISCHARGE, INITIAL_SOC = 5, 6, 7, 8, 9
-N_PARAMETERS = 10
+
+class Curves(NamedTuple):
+    """What a buffer runs over: for every series, (n_series or 1, ...) arrays; in the loops over
+    one series, that series' (the first axis taken).
+
+    Attributes
+    ----------
+    power : (n_series or 1, n_days, n_steps) float
+        Power at step centres [W], less the design's own draw.
+    load, draw : (n_series or 1, n_days or 1, n_steps or 1) float
+        The load and the design's own draw at step centres [W].
+    step_hours : float
+        Step length [h].
+    """
+
+    power: np.ndarray
+    load: np.ndarray
+    draw: np.ndarray
+    step_hours: float
+
+
+class Parameters(NamedTuple):
+    """A buffer and its charge controller as the loops read them
+    (:func:`foldopt.engine.storage.parameters`): for every series, each field a (n_series or 1,)
+    float array; in the loops over one series, that series' float.
+
+    Attributes
+    ----------
+    capacity : float
+        [Wh].
+    min_soc, restart_soc : float
+        The controller's cut-off and reconnection [-].
+    eta_charge, eta_discharge : float
+        Charge and discharge efficiencies [-].
+    keep_step, keep_half : float
+        The share of the content a step and a half step keep against self-discharge [-].
+    max_charge, max_discharge : float
+        Power limits into and out of the buffer [W] (inf: none).
+    initial_soc : float
+        State of charge at the start [-]; NaN: the periodic state.
+    """
+
+    capacity: np.ndarray
+    min_soc: np.ndarray
+    restart_soc: np.ndarray
+    eta_charge: np.ndarray
+    eta_discharge: np.ndarray
+    keep_step: np.ndarray
+    keep_half: np.ndarray
+    max_charge: np.ndarray
+    max_discharge: np.ndarray
+    initial_soc: np.ndarray
+
+
+class Days(NamedTuple):
+    """What the loops write: for every series, (n_series, ...) arrays; in the loops over one
+    series, that series' (the first axis taken).
+
+    Attributes
+    ----------
+    out : (n_series, n_days, HISTOGRAM + n_bins) float
+        Each day's outputs (the columns below).
+    state : (n_series, n_days + 1, 2) float
+        Content [Wh] and load on (1) or off (0) at each midnight.
+    soc : (n_series, n_days, n_steps) or (1, 1, 1) float
+        The state of charge at each step centre where ``keep_soc`` (else a placeholder).
+    keep_soc : bool
+    """
+
+    out: np.ndarray
+    state: np.ndarray
+    soc: np.ndarray
+    keep_soc: bool
+
 
 # Columns of a day's outputs; the state-of-charge histogram follows from HISTOGRAM on.
 POWERED, SERVED, MISSING, LOST, HARVESTED = 0, 1, 2, 3, 4
@@ -90,36 +162,38 @@ def time_to_draw(da, db, tau, energy):
 
 
 @njit(cache=True, error_model="numpy")
-def _part(pa, pb, la, lb, da, db, tau, surplus, stored, on, par):
-    """One part of a segment, in which the power left after the design's own draw runs from
-    ``pa`` to ``pb``, the load from ``la`` to ``lb`` and that draw from ``da`` to ``db`` [W] over
-    ``tau`` [h] (``tau`` > 0), the power at or above the load throughout (``surplus``) or below
-    it.
+def _part(ends, tau, surplus, stored, on, par):
+    """One part of a segment over ``tau`` [h] (``tau`` > 0), in which the power left after the
+    design's own draw runs from ``pa`` to ``pb``, the load from ``la`` to ``lb`` and that draw
+    from ``da`` to ``db`` [W] (``ends``, the six in that order), the power at or above the load
+    throughout (``surplus``) or below it; ``stored`` [Wh] and ``on`` the buffer's content and
+    the load's state at its start, ``par`` the series' :class:`Parameters`.
 
     Returns the buffer's content [Wh], whether the load is on, the part's energies [Wh] served,
     missing, lost, lost in charging and in discharging, the hours the load ran, whether the
     buffer was full, whether it ran down to its cut-off, and the design's own draw served [Wh].
     Scalars only, so that the call moves no array (numba counts references to arrays passed to
     a function)."""
-    capacity = par[CAPACITY]
+    pa, pb, la, lb, da, db = ends
+    capacity = par.capacity
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
     own = 0.5 * tau * (da + db)
-    if not on and stored >= par[RESTART_SOC] * capacity:
+    if not on and stored >= par.restart_soc * capacity:
         on = True
     if on and surplus:
-        limit = clipped_energy(pa - la, pb - lb, tau, par[MAX_CHARGE])
+        limit = clipped_energy(pa - la, pb - lb, tau, par.max_charge)
         stored, loss, lost, full = _charge(
-            stored, max(pv - need, 0.0), limit, capacity, par[ETA_CHARGE]
+            stored, max(pv - need, 0.0), limit, capacity, par.eta_charge
         )
         return stored, on, need, 0.0, lost, loss, 0.0, tau, full, False, own
     served = ran = discharge_loss = drawn = 0.0
     empty = False
     if on:
-        floor = par[MIN_SOC] * capacity
+        floor = par.min_soc * capacity
         usable = stored - floor
-        eta = par[ETA_DISCHARGE]
-        if usable > 0.0 and max(la - pa, lb - pb) <= par[MAX_DISCHARGE]:
+        eta = par.eta_discharge
+        if usable > 0.0 and max(la - pa, lb - pb) <= par.max_discharge:
             short = max(need - pv, 0.0)
             if short <= eta * usable:
                 taken = short / eta
@@ -139,30 +213,32 @@ def _part(pa, pb, la, lb, da, db, tau, surplus, stored, on, par):
         empty = stored <= floor  # not when only max_discharge_w turned the load off
     # The controller has the load and the design's own draw off: the whole power charges.
     spare = clipped_energy(pa + da, pb + db, tau, math.inf)
-    limit = clipped_energy(pa + da, pb + db, tau, par[MAX_CHARGE])
-    stored, loss, lost, full = _charge(stored, spare, limit, capacity, par[ETA_CHARGE])
+    limit = clipped_energy(pa + da, pb + db, tau, par.max_charge)
+    stored, loss, lost, full = _charge(stored, spare, limit, capacity, par.eta_charge)
     return stored, on, served, need, lost, loss, discharge_loss, ran, full, empty, drawn
 
 
 @njit(cache=True, error_model="numpy")
-def _run(power, load, draw, par, step_hours, stored, on, merge, out, state, keep_soc, soc):
-    """One pass over a series' days from the content ``stored`` [Wh] and load state ``on``;
-    ``power`` is what the design leaves after its own ``draw``.
+def _run(curves, par, stored, on, merge, days):
+    """One pass over a series' days (its :class:`Curves`, :class:`Parameters` and :class:`Days`)
+    from the content ``stored`` [Wh] and load state ``on``.
 
-    With ``merge``, a day that starts in the state the previous pass started it in (``state``)
-    ends the pass: from there on, the previous pass's outputs are this one's. The load's state is
-    kept as on wherever the content allows it to reconnect (the same state: the first part would
-    reconnect it). Returns the state at the end of the last day.
+    With ``merge``, a day that starts in the state the previous pass started it in
+    (``days.state``) ends the pass: from there on, the previous pass's outputs are this one's. The
+    load's state is kept as on wherever the content allows it to reconnect (the same state: the
+    first part would reconnect it). Returns the state at the end of the last day.
     """
+    power, load, draw, step_hours = curves
+    out, state, soc, keep_soc = days
     n_days, n_steps = power.shape
     profile_days, profile_steps = load.shape[0] > 1, load.shape[1] > 1
     draw_days, draw_steps = draw.shape[0] > 1, draw.shape[1] > 1
-    capacity, restart = par[CAPACITY], par[RESTART_SOC] * par[CAPACITY]
+    capacity, restart = par.capacity, par.restart_soc * par.capacity
     n_bins = out.shape[1] - HISTOGRAM
-    keep_half, keep_step = par[KEEP_HALF], par[KEEP_STEP]
+    keep_half, keep_step = par.keep_half, par.keep_step
     leaks = keep_step < 1.0 or keep_half < 1.0
-    floor, eta_discharge = par[MIN_SOC] * capacity, par[ETA_DISCHARGE]
-    max_discharge = par[MAX_DISCHARGE]
+    floor, eta_discharge = par.min_soc * capacity, par.eta_discharge
+    max_discharge = par.max_discharge
     for d in range(n_days):
         on = on or stored >= restart
         flag = 1.0 if on else 0.0
@@ -248,10 +324,7 @@ def _run(power, load, draw, par, step_hours, stored, on, merge, out, state, keep
                     )
                     if length <= 0.0:
                         continue
-                    if second:
-                        pa, pb, la, lb, da, db = ps, p1, ls, l1, ds, d1
-                    else:
-                        pa, pb, la, lb, da, db = p0, ps, l0, ls, d0, ds
+                    ends = (ps, p1, ls, l1, ds, d1) if second else (p0, ps, l0, ls, d0, ds)
                     (
                         stored,
                         on,
@@ -264,7 +337,7 @@ def _run(power, load, draw, par, step_hours, stored, on, merge, out, state, keep
                         was_full,
                         ran_out,
                         own_wh,
-                    ) = _part(pa, pb, la, lb, da, db, length, rising == second, stored, on, par)
+                    ) = _part(ends, length, rising == second, stored, on, par)
                     served += s_wh
                     missing += m_wh
                     lost += l_wh
@@ -298,33 +371,29 @@ def _run(power, load, draw, par, step_hours, stored, on, merge, out, state, keep
 
 
 @njit(cache=True, error_model="numpy")
-def _series(
-    power, load, draw, par, step_hours, out, state, keep_soc, soc, max_iterations, tolerance
-):
-    """A series from its initial state of charge, or in its periodic state: passes until the
-    state at the end of the series is that at its start (content within ``tolerance`` x the
-    capacity, the load on or off alike), first plainly from a full buffer, then by bisection on
-    the start's content, until the start is known to the tolerance (then periodic if the end is
-    within one step's load energy of it). Returns the passes run, negative when none was
-    periodic."""
-    capacity = par[CAPACITY]
-    if not math.isnan(par[INITIAL_SOC]):
-        stored = par[INITIAL_SOC] * capacity
-        on = stored >= par[RESTART_SOC] * capacity
-        _run(power, load, draw, par, step_hours, stored, on, False, out, state, keep_soc, soc)
+def _series(curves, par, days, max_iterations, tolerance):
+    """A series (its :class:`Curves`, :class:`Parameters` and :class:`Days`) from its initial
+    state of charge, or in its periodic state: passes until the state at the end of the series is
+    that at its start (content within ``tolerance`` x the capacity, the load on or off alike),
+    first plainly from a full buffer, then by bisection on the start's content, until the start is
+    known to the tolerance (then periodic if the end is within one step's load energy of it).
+    Returns the passes run, negative when none was periodic."""
+    capacity = par.capacity
+    if not math.isnan(par.initial_soc):
+        stored = par.initial_soc * capacity
+        on = stored >= par.restart_soc * capacity
+        _run(curves, par, stored, on, False, days)
         return 1
     resolution = 0.0  # one step's load energy [Wh], the largest of the series
-    for row in load:
+    for row in curves.load:
         for value in row:
-            resolution = max(resolution, value * step_hours)
+            resolution = max(resolution, value * curves.step_hours)
     low, high = 0.0, capacity
     stored, on = capacity, True
     passes = 0
     while passes < max_iterations:
         passes += 1
-        end, end_on = _run(
-            power, load, draw, par, step_hours, stored, on, passes > 1, out, state, keep_soc, soc
-        )
+        end, end_on = _run(curves, par, stored, on, passes > 1, days)
         if abs(end - stored) <= tolerance * capacity and end_on == on:
             return passes
         if end > stored:
@@ -344,49 +413,64 @@ def _series(
     return -passes
 
 
+@njit(cache=True, inline="always")
+def _one(values, s):
+    """Series ``s`` of per-series ``values`` (the only one where there is one)."""
+    return values[s if values.shape[0] > 1 else 0]
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
-def simulate_series(
-    power, load, draw, params, step_hours, out, state, keep_soc, soc, passes, max_iterations,
-    tolerance,
-):  # fmt: skip
+def simulate_series(curves, params, days, passes, max_iterations, tolerance):
     """Every series, spread over threads (:func:`foldopt.engine.storage.simulate`).
 
     Parameters
     ----------
-    power : (n_series or 1, n_days, n_steps) float
-        Power at step centres [W], less the design's own draw.
-    load, draw : (n_series or 1, n_days or 1, n_steps or 1) float
-        Load and the design's own draw at step centres [W].
-    params : (n_series or 1, N_PARAMETERS) float
-        The buffer of each series.
-    step_hours : float
-        Step length [h].
-    out : (n_series, n_days, HISTOGRAM + n_bins) float
-        Each day's outputs, written.
-    state : (n_series, n_days + 1, 2) float
-        Content [Wh] and load on (1) or off (0) at each midnight, written.
-    keep_soc : bool
-        Write the state of charge at each step centre into ``soc`` (else it is a placeholder).
-    soc : (n_series, n_days, n_steps) or (1, 1, 1) float
+    curves : Curves
+        Of every series (or one that serves all).
+    params : Parameters
+        The buffer of each series (or one that serves all).
+    days : Days
+        Of every series, written.
     passes : (n_series,) int
         Passes run, negative where no periodic state was found; written.
     max_iterations : int
     tolerance : float
     """
+    # The records' arrays are taken out before the parallel loop: a write through a named tuple's
+    # field inside a parallel loop is lost (numba issues 5872 and 7135).
+    power, load, draw, step_hours = curves
+    out, state, soc, keep_soc = days
+    (
+        capacity,
+        min_soc,
+        restart_soc,
+        eta_charge,
+        eta_discharge,
+        keep_step,
+        keep_half,
+        max_charge,
+        max_discharge,
+        initial_soc,
+    ) = params
     for k in prange(out.shape[0]):
         s = np.int64(
             k
         )  # prange's index is unsigned: with the literal 0 below it would unify to float
         passes[s] = _series(
-            power[s if power.shape[0] > 1 else 0],
-            load[s if load.shape[0] > 1 else 0],
-            draw[s if draw.shape[0] > 1 else 0],
-            params[s if params.shape[0] > 1 else 0],
-            step_hours,
-            out[s],
-            state[s],
-            keep_soc,
-            soc[s if keep_soc else 0],
+            Curves(_one(power, s), _one(load, s), _one(draw, s), step_hours),
+            Parameters(
+                _one(capacity, s),
+                _one(min_soc, s),
+                _one(restart_soc, s),
+                _one(eta_charge, s),
+                _one(eta_discharge, s),
+                _one(keep_step, s),
+                _one(keep_half, s),
+                _one(max_charge, s),
+                _one(max_discharge, s),
+                _one(initial_soc, s),
+            ),
+            Days(out[s], state[s], soc[s if keep_soc else 0], keep_soc),
             max_iterations,
             tolerance,
         )

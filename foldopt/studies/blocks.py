@@ -2,9 +2,10 @@
 
 A :class:`Blocks` is what the engine evaluates as one: days at sites whose studies differ in
 nothing but the site, the date, the load and the panel's orientation (:func:`setup_key`), with each
-block's flat panel orientation; it builds its :class:`foldopt.engine.sky.Sky` and cuts itself into
-chunks that bound an engine call's memory. :mod:`foldopt.studies.designs` evaluates the designs
-over them.
+block's flat panel orientation and the study's engine options, made once
+(:func:`foldopt.studies.engine_options.engine_options`); it builds its
+:class:`foldopt.engine.sky.Sky` and cuts itself into chunks that bound an engine call's memory.
+:mod:`foldopt.studies.designs` evaluates the designs over them.
 
 The module may import :mod:`foldopt.engine` and :mod:`foldopt.inputs`.
 """
@@ -16,8 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from foldopt.engine.options import EngineOptions
 from foldopt.engine.sky import Sky, build_sky
 from foldopt.inputs.study import Study
+from foldopt.studies.engine_options import engine_options
 
 #: Rows (blocks x fold angles) x loads of one engine call: bounds the memory of a chunk.
 CHUNK_ROW_LOADS = 4_000_000
@@ -51,6 +54,8 @@ class Blocks:
         Each block's site and local date.
     tilt, azimuth : numpy.ndarray
         Each block's flat panel [deg], (n_blocks,).
+    options : EngineOptions
+        What the engine reads of ``study`` (:func:`foldopt.studies.engine_options.engine_options`).
     member : numpy.ndarray, optional
         With a cloud ensemble (``weather.members``), each block's member (n_blocks,): a day's
         members are consecutive blocks.
@@ -61,6 +66,7 @@ class Blocks:
     dates: tuple
     tilt: np.ndarray
     azimuth: np.ndarray
+    options: EngineOptions
     member: np.ndarray | None = None
 
     @property
@@ -86,6 +92,7 @@ class Blocks:
             tuple(s.date for s in studies),
             np.array([s.panel.tilt for s in studies]),
             np.array([s.panel.azimuth for s in studies]),
+            engine_options(studies[0]),
         )
 
     @classmethod
@@ -97,7 +104,6 @@ class Blocks:
         study : Study
         dates : sequence of datetime.date
         """
-        study.require_files()
         members = (
             study.weather.members if study.weather is not None and study.weather.members else 1
         )
@@ -110,6 +116,7 @@ class Blocks:
             dates,
             np.full(count, study.panel.tilt),
             np.full(count, study.panel.azimuth),
+            engine_options(study),
             member,
         )
 
@@ -128,6 +135,7 @@ class Blocks:
             sum((part.dates for part in parts), ()),
             np.concatenate([part.tilt for part in parts]),
             np.concatenate([part.azimuth for part in parts]),
+            parts[0].options,
             None if any(member is None for member in members) else np.concatenate(members),
         )
 
@@ -141,12 +149,13 @@ class Blocks:
             self.dates[part],
             self.tilt[part],
             self.azimuth[part],
+            self.options,
             None if self.member is None else self.member[part],
         )
 
     def sky(self) -> Sky:
         """The blocks' :class:`foldopt.engine.sky.Sky` (:func:`foldopt.engine.sky.build_sky`)."""
-        return build_sky(self.study, self.sites, self.dates, self.member)
+        return build_sky(self.options.sky, self.sites, self.dates, self.member)
 
     def chunks(self, n_loads: int):
         """Slices of blocks whose rows x loads and time steps stay within the chunk bounds.

@@ -53,6 +53,7 @@ from foldopt.studies.storage_days import (
     day_storage,
 )
 from foldopt.engine.sky import build_sky
+from foldopt.studies.engine_options import engine_options
 from foldopt.physics.trackers import TRACKERS
 from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
@@ -71,8 +72,9 @@ class Day:
 
     def __init__(self, study: Study):
         self.study = study
-        self.sky = sky = build_sky(study, [study.site], [study.date])
-        self.electrical = engines.electrical_for(study, sky.temp_air[0], sky.wind_ref)
+        self.options = options = engine_options(study)
+        self.sky = sky = build_sky(options.sky, [study.site], [study.date])
+        self.electrical = engines.electrical_for(options.electrical, sky.temp_air[0], sky.wind_ref)
         self.times = sky.grid.times(0)
         self.step_hours = sky.step_hours
         self.solar_zenith, self.solar_azimuth = sky.solar_zenith[0], sky.solar_azimuth[0]
@@ -107,9 +109,9 @@ class Day:
         panel = self.study.panel
         return engines.panel_power(
             self.sky,
-            self.study,
-            self._poa(np.array([panel.tilt]), np.array([panel.azimuth])),
-            panel.area,
+            poa_global=self._poa(np.array([panel.tilt]), np.array([panel.azimuth])),
+            electrical=self.options.electrical,
+            area=panel.area,
         )[0]
 
     def tracker_orientation(self, model=None):
@@ -176,7 +178,7 @@ class Day:
         """
         panel = self.study.panel
         return engines.fold_orientations(
-            self.study, [panel.tilt], [panel.azimuth], np.atleast_1d(fold_angles)
+            self.study.geometry, [panel.tilt], [panel.azimuth], np.atleast_1d(fold_angles)
         )[0]
 
     def connections(self, fold_angles, series: bool = True, with_state: bool = True):
@@ -203,7 +205,12 @@ class Day:
         if key in self._one_angle:
             return self._one_angle[key]
         powers, state = engines.powers(
-            self.sky, self.study, self.orientation(fold_angles), [0], series, with_state
+            self.sky,
+            orientation=self.orientation(fold_angles),
+            electrical=self.options.electrical,
+            blocks=[0],
+            series=series,
+            with_state=with_state,
         )
         powers.pop("panel")
         if fold_angles.size == 1:
@@ -412,10 +419,9 @@ def sweep_fold_angles(day: Day, engine: str) -> FoldSweep:
     fold_angles = np.asarray(study.fold_angles.grid())
     metrics = engines.row_metrics(
         day.sky,
-        study,
-        np.zeros(fold_angles.size),
-        day.orientation(fold_angles),
-        [p_load],
+        rows=engines.PanelRows(np.zeros(fold_angles.size), day.orientation(fold_angles)),
+        loads=[p_load],
+        electrical=day.options.electrical,
         outputs=CONNECTIONS,
         contiguous=True,
         engine=engine,

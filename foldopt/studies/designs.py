@@ -29,6 +29,7 @@ from foldopt.physics.connections import CONNECTIONS
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.engine.sky import Sky
+from foldopt.studies.engine_options import engine_options
 
 # Blocks and their setup are part of the designs' API (the studies take them from here).
 from foldopt.studies.blocks import CHUNK_ROW_LOADS, Blocks, setup_key  # noqa: F401
@@ -92,7 +93,11 @@ def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
     numpy.ndarray
         (n_blocks, n_steps) [W].
     """
-    return engines.panel_power(sky, study, sky_tracker_poa(sky, orientation))
+    return engines.panel_power(
+        sky,
+        poa_global=sky_tracker_poa(sky, orientation),
+        electrical=engine_options(study).electrical,
+    )
 
 
 def sky_tracker_poa(sky: Sky, orientation) -> np.ndarray:
@@ -211,9 +216,8 @@ def tracker_curves(
     orientation = sky_tracker_orientation(sky, study, model)
     poa = sky_tracker_poa(sky, orientation)
     draw = sky_tracker_draw(sky, study, orientation, every)
-    return TrackerCurves(
-        orientation, engines.panel_power(sky, study, poa), draw, poa if sky.iam == "none" else None
-    )
+    power = engines.panel_power(sky, poa_global=poa, electrical=engine_options(study).electrical)
+    return TrackerCurves(orientation, power, draw, poa if sky.iam == "none" else None)
 
 
 def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = DEFAULT_ENGINE):
@@ -239,14 +243,16 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = DEFAULT_ENGINE):
     """
     study = blocks.study
     fold_angles = np.asarray(study.fold_angles.grid())
-    orientation = engines.fold_orientations(study, blocks.tilt, blocks.azimuth, fold_angles)
-    rows = np.repeat(np.arange(sky.n_blocks), fold_angles.size)
+    orientation = engines.fold_orientations(
+        study.geometry, blocks.tilt, blocks.azimuth, fold_angles
+    )
     metrics = engines.row_metrics(
         sky,
-        study,
-        rows,
-        orientation.reshape(-1, 4),
-        loads,
+        rows=engines.PanelRows(
+            np.repeat(np.arange(sky.n_blocks), fold_angles.size), orientation.reshape(-1, 4)
+        ),
+        loads=loads,
+        electrical=blocks.options.electrical,
         outputs=(study.connection,),
         engine=engine,
     )
@@ -299,9 +305,10 @@ def design_metrics(
         n_loads, n_steps).
     """
     study, blocks_of = blocks.study, blocks
+    electrical = blocks.options.electrical
     n_blocks, n_loads = sky.n_blocks, loads.size
     tilt, azimuth = blocks.tilt, blocks.azimuth
-    every = engines.fold_orientations(study, tilt, azimuth, fold_angles)
+    every = engines.fold_orientations(study.geometry, tilt, azimuth, fold_angles)
     blocks = np.repeat(np.arange(n_blocks), n_loads)
     shape = sky.load_shape
     # One row per block and load, at that load's angle, with the load alone; the curves kept where
@@ -314,11 +321,13 @@ def design_metrics(
     keep = curves or shape is not None
     twofold = engines.row_metrics(
         sky,
-        study,
-        blocks,
-        every[blocks, chosen.ravel()],
-        loads[:, None],
-        np.tile(np.arange(n_loads), n_blocks),
+        rows=engines.PanelRows(
+            blocks,
+            every[blocks, chosen.ravel()],
+            loadset=np.tile(np.arange(n_loads), n_blocks),
+        ),
+        loads=loads[:, None],
+        electrical=electrical,
         outputs=outputs,
         contiguous=True,
         engine=engine,
@@ -326,10 +335,9 @@ def design_metrics(
     )
     flat = engines.row_metrics(
         sky,
-        study,
-        np.arange(n_blocks),
-        engines.flat_orientation(tilt, azimuth),
-        loads,
+        rows=engines.PanelRows(np.arange(n_blocks), engines.flat_orientation(tilt, azimuth)),
+        loads=loads,
+        electrical=electrical,
         outputs=("panel",),
         contiguous=True,
         engine=engine,
@@ -419,7 +427,7 @@ def design_metrics(
         served,
     )
     # Every design here is wired as the study's circuit says: a load beyond the panel's reach, every one.
-    reach = engines.electrical_for(study, sky.temp_air[0], sky.wind_ref).beyond_reach
+    reach = engines.electrical_for(electrical, sky.temp_air[0], sky.wind_ref).beyond_reach
     condition = np.array(
         ["; ".join(filter(None, (reach, day))) for day in sky.conditions()], dtype=object
     )
@@ -548,11 +556,13 @@ def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None)
         start = rows.stop
         metrics = engines.row_metrics(
             sky,
-            study,
-            np.arange(sky.n_blocks),
-            engines.flat_orientation(chunk.tilt, chunk.azimuth),
-            loads,
-            loadset[rows],
+            rows=engines.PanelRows(
+                np.arange(sky.n_blocks),
+                engines.flat_orientation(chunk.tilt, chunk.azimuth),
+                loadset=loadset[rows],
+            ),
+            loads=loads,
+            electrical=chunk.options.electrical,
             outputs=("panel",),
             engine=engine,
         )
@@ -691,7 +701,7 @@ def requested_hours(
         Per request, ``hours`` (blocks, n, n_loads) and ``energy`` (blocks, n).
     """
     loads = np.atleast_2d(np.asarray(loads, dtype=float))
-    study = parts[0][0].study
+    study, options = parts[0][0].study, parts[0][0].options
     output = "panel" if flat else study.connection
     requests = [
         (np.asarray(blocks, dtype=np.int64), np.asarray(points, dtype=float).reshape(-1, 3))
@@ -707,7 +717,7 @@ def requested_hours(
     table = (
         engines.flat_orientation(every[:, 1], every[:, 2] % 360.0)
         if flat
-        else _orientations(study, every[:, 0], every[:, 1], every[:, 2] % 360.0)
+        else _orientations(study.geometry, every[:, 0], every[:, 1], every[:, 2] % 360.0)
     )
     tables = np.split(table, np.cumsum([points.shape[0] for _, points in requests])[:-1])
     out = [
@@ -750,14 +760,13 @@ def requested_hours(
             )
             metrics = engines.row_metrics(
                 sky,
-                study,
-                row_block,
-                orientation,
-                loads,
-                loadset[start + row_block],
+                rows=engines.PanelRows(
+                    row_block, orientation, row_orientation, loadset[start + row_block]
+                ),
+                loads=loads,
+                electrical=options.electrical,
                 outputs=(output,),
                 engine=engine,
-                row_orientation=row_orientation,
             )
             position = 0
             for (k, inside, piece), b, n in zip(call, blocks, counts, strict=True):
@@ -769,7 +778,7 @@ def requested_hours(
     return out
 
 
-def _orientations(study: Study, fold_angle, tilt, azimuth) -> np.ndarray:
+def _orientations(geometry: str, fold_angle, tilt, azimuth) -> np.ndarray:
     """(n, 4) the sub-panels' orientation of each design: one geometry call per distinct base."""
     bases = np.stack([tilt, azimuth], axis=-1)
     unique, inverse = np.unique(bases, axis=0, return_inverse=True)
@@ -778,6 +787,6 @@ def _orientations(study: Study, fold_angle, tilt, azimuth) -> np.ndarray:
     for index, (base_tilt, base_azimuth) in enumerate(unique):
         take = inverse == index
         orientation[take] = engines.fold_orientations(
-            study, [base_tilt], [base_azimuth], fold_angle[take]
+            geometry, [base_tilt], [base_azimuth], fold_angle[take]
         )[0]
     return orientation

@@ -249,10 +249,15 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
         # The maps show the first member of each day.
         first = list(range(0, len(chunk), members))
         orientation = engines.fold_orientations(
-            study, chunk.tilt[first], chunk.azimuth[first], fold_angles[fixed[:1]]
+            study.geometry, chunk.tilt[first], chunk.azimuth[first], fold_angles[fixed[:1]]
         )
         powers, state = engines.powers(
-            sky, study, orientation[:, 0], first, series=study.switch_series, with_state=True
+            sky,
+            orientation=orientation[:, 0],
+            electrical=chunk.options.electrical,
+            blocks=first,
+            series=study.switch_series,
+            with_state=True,
         )
         series["p_twofold_w"].append(powers[study.connection])
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
@@ -414,14 +419,13 @@ def _twofold_curves(blocks: Blocks, parts, skies, angles, engine) -> np.ndarray:
     power = []
     for part, sky in zip(parts, skies, strict=True):
         chunk = blocks[part]
-        orientation = engines.fold_orientations(study, chunk.tilt, chunk.azimuth, angles)
+        orientation = engines.fold_orientations(study.geometry, chunk.tilt, chunk.azimuth, angles)
         rows = np.repeat(np.arange(sky.n_blocks), angles.size)
         metrics = engines.row_metrics(
             sky,
-            study,
-            rows,
-            orientation.reshape(-1, 4),
-            np.ones(1),
+            rows=engines.PanelRows(rows, orientation.reshape(-1, 4)),
+            loads=np.ones(1),
+            electrical=chunk.options.electrical,
             outputs=(study.connection,),
             engine=engine,
             # Kept angle by angle, each angle's days in order.

@@ -555,10 +555,11 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
             [
                 engines.row_metrics(
                     sky,
-                    study,
-                    np.arange(sky.n_blocks),
-                    engines.flat_orientation(chunk.tilt, chunk.azimuth),
-                    [1.0],
+                    rows=engines.PanelRows(
+                        np.arange(sky.n_blocks), engines.flat_orientation(chunk.tilt, chunk.azimuth)
+                    ),
+                    loads=[1.0],
+                    electrical=chunk.options.electrical,
                     outputs=("panel",),
                     engine=engine,
                 ).peak[:, 0]
