@@ -41,18 +41,6 @@ def _walk(loads, position, power):
 
 
 @njit(cache=True, inline="always")
-def _shares(loads, lo, hi, lo_at, hi_at, length, work, contiguous):
-    """Shares of a segment from ``lo`` to ``hi`` for the loads strictly inside its range, into
-    ``work.above`` (and ``work.run``)."""
-    above, run = work.above, work.run
-    for j in range(lo_at, hi_at):
-        share = length * (hi - loads[j]) / (hi - lo)
-        above[j] += share
-        if contiguous:
-            run[j, 0] += share
-
-
-@njit(cache=True, inline="always")
 def _runs(start_at, lo_at, length, run):
     """Longest runs: a sample below a load ends that load's run (the segment starts a new one);
     loads below the segment's low end run on through it."""
@@ -89,8 +77,8 @@ def _per_load(p, shape, s, use_shape):
 def day_metrics(power, span, p_load, profile, loads, work, t_out, cont_out):
     """Daily metrics of one power curve [W] sampled at step centres, of which only steps
     ``first..last`` (``span``) need walking: the power before and after them is that of the first
-    and the last (zero, or the day's end). Writes t_solar (and its longest run) per load of ``p_load``
-    (one set of :class:`foldopt.engine.records.Loads`, ascending) into ``t_out`` (and
+    and the last (zero, or the day's end). Writes t_solar (and its longest run) per load of
+    ``p_load`` (one set of :class:`foldopt.engine.records.Loads`, ascending) into ``t_out`` (and
     ``cont_out``); returns the energy [Wh] and the peak [W]. With ``loads.use_profile`` the loads
     are scales of the load profile ``profile`` (n_steps) [W] (:func:`_per_load`); steps outside
     ``first..last`` hold the power of the first and last, and the profile there is taken as the
@@ -138,16 +126,13 @@ def _day_steps(power, span, p_load, profile, held, work, t_out, cont_out):
             _runs(position, lo_at, step_hours, run)
         pending_at, pending = _gather(whole, pending_at, pending, lo_at, step_hours)
         if hi_at > lo_at:
-            _shares(
-                p_load,
-                min(previous, p),
-                max(previous, p),
-                lo_at,
-                hi_at,
-                step_hours,
-                work,
-                contiguous,
-            )
+            # The loads strictly inside the segment's range take a share of it.
+            lo, hi = min(previous, p), max(previous, p)
+            for j in range(lo_at, hi_at):
+                share = step_hours * (hi - p_load[j]) / (hi - lo)
+                above[j] += share
+                if contiguous:
+                    run[j, 0] += share
         previous, position = p, at
     # The last sample held to the end of the day.
     tail = (n_steps - last - 0.5) * step_hours
