@@ -356,7 +356,7 @@ def _load_array(load, shape, name):
 
 
 def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> kern.Parameters:
-    """The buffer as the loops read it, each field checked: (1 or n_series,) arrays."""
+    """The buffer as the loops read it, each field checked: (n_series,) arrays."""
 
     def field(name, value, lo, hi, lo_open=False, hi_open=False, default=None):
         value = np.asarray(default if value is None else value, dtype=float)
@@ -396,8 +396,9 @@ def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> kern.Parame
         max_discharge=max_d,
         initial_soc=initial,
     )
-    together = np.broadcast_arrays(*(np.atleast_1d(field) for field in fields))
-    return kern.Parameters(*(np.ascontiguousarray(field, dtype=float) for field in together))
+    return kern.Parameters(
+        *(np.ascontiguousarray(np.broadcast_to(field, n_series), dtype=float) for field in fields)
+    )
 
 
 # The NumPy reference: the same model written over arrays of series, step by step.
@@ -601,8 +602,7 @@ def _simulate_numpy(curves, params, days, passes, max_iterations, tolerance):
     out, state, soc, soc_curves = days
     n_series = out.shape[0]
     power, load, draw = (np.broadcast_to(a, (n_series, *a.shape[1:])) for a in curves[:3])
-    step_hours = curves.step_hours
-    par = kern.Parameters(*(np.broadcast_to(field, n_series) for field in params))
+    step_hours, par = curves.step_hours, params
     capacity = par.capacity
     given = ~np.isnan(par.initial_soc)
     stored = np.where(given, par.initial_soc * capacity, capacity)

@@ -44,8 +44,8 @@ class Curves(NamedTuple):
 
 class Parameters(NamedTuple):
     """A buffer and its charge controller as the loops read them
-    (:func:`foldopt.engine.storage.parameters`): for every series, each field a (n_series or 1,)
-    float array; in the loops over one series, that series' float.
+    (:func:`foldopt.engine.storage.simulate`): for every series, each field a (n_series,) float
+    array; in the loops over one series, that series' float.
 
     Attributes
     ----------
@@ -428,7 +428,7 @@ def simulate_series(curves, params, days, passes, max_iterations, tolerance):
     curves : Curves
         Of every series (or one that serves all).
     params : Parameters
-        The buffer of each series (or one that serves all).
+        The buffer of each series.
     days : Days
         Of every series, written.
     passes : (n_series,) int
@@ -459,16 +459,16 @@ def simulate_series(curves, params, days, passes, max_iterations, tolerance):
         passes[s] = _series(
             Curves(_one(power, s), _one(load, s), _one(draw, s), step_hours),
             Parameters(
-                _one(capacity, s),
-                _one(min_soc, s),
-                _one(restart_soc, s),
-                _one(eta_charge, s),
-                _one(eta_discharge, s),
-                _one(keep_step, s),
-                _one(keep_half, s),
-                _one(max_charge, s),
-                _one(max_discharge, s),
-                _one(initial_soc, s),
+                capacity[s],
+                min_soc[s],
+                restart_soc[s],
+                eta_charge[s],
+                eta_discharge[s],
+                keep_step[s],
+                keep_half[s],
+                max_charge[s],
+                max_discharge[s],
+                initial_soc[s],
             ),
             Days(out[s], state[s], soc[s if keep_soc else 0], keep_soc),
             max_iterations,
