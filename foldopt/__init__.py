@@ -107,7 +107,7 @@ __all__ = ["__version__", *_PUBLIC]
 
 class _OnFirstUse(MetaPathFinder):
     """Loads pvlib's subpackages that a study does not use when first used rather than when pvlib
-    is imported, which imports all of them: ``pvlib.iotools`` (requests, ssl: 0.07 s), read only for a
+    is imported, which imports all of them: ``pvlib.iotools`` (requests and ssl), read only for a
     weather file, and ``pvlib.spectrum`` (scipy.integrate), used by none of foldopt's models.
 
     :class:`importlib.util.LazyLoader` is not thread-safe before Python 3.12: foldopt's readers

@@ -246,9 +246,9 @@ HOTTEL_CLIMATES = Registry(
         "midlatitude-winter": "Hottel's mid-latitude winter correction factors",
     },
 )
-#: Rows x time steps up to which the ``auto`` engine takes the NumPy reference path: some 0.4 s
-#: more than the warm kernel (the default study's month of days at 181 fold angles), against the
-#: kernel's first compile of some 30 s on 2 cores (bench/startup.py, issue 40).
+#: Rows x time steps up to which the ``auto`` engine takes the NumPy reference path (the default
+#: study's month of days at 181 fold angles): below it the reference path's extra time is well
+#: under the kernel's first compile (figures in docs/performance.rst, from bench/startup.py).
 AUTO_NUMPY_ROW_STEPS = 10_000_000
 ENGINES = Registry(
     "engine",

@@ -5,9 +5,8 @@ it). A leaf, so that a map's table (:mod:`foldopt.studies.cluster`) and a result
 
 pandas' ``DataFrame.to_csv`` is the reference. A table of plain columns (NumPy floats, integers and
 booleans, and strings) is written by :func:`write_csv` itself, to the same bytes, in about half
-the time: 108,000 rows of a map (32 columns) take 2.1-2.4 s, where pandas, which formats each float through its own
-machinery, takes 4.9 s; the 1-degree land grid's 1.08 million rows 22.4 s against 41.4 s, the
-rows formatted :data:`ROWS_AT_ONCE` at a time (90 MB at most above the table). Here each
+the time (pandas formats each float through its own machinery; figures in
+``docs/performance.rst``), the rows formatted :data:`ROWS_AT_ONCE` at a time. Here each
 column is formatted by one ``%`` per value and the rows go to Python's ``csv`` writer, which pandas
 uses too. ``tests/test_tables.py`` holds the bytes to pandas'.
 """

@@ -1,14 +1,13 @@
 """Which engine evaluates a request or a call: the ``auto`` rule of :data:`foldopt.names.ENGINES`.
 
 The compiled kernel (:mod:`foldopt.engine.kernel`) is the faster the more rows and steps it
-walks, but its first compile after an install takes some 30 s on 2 cores; the NumPy reference
-path compiles nothing and takes some 40 ns a row step more than the warm kernel (issue 40,
-``bench/startup.py``). ``auto`` takes the reference path up to
-:data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` rows x steps (some 0.4 s more than the warm kernel)
-and the kernel above. A request decides once where it enters the API
-(:func:`foldopt.studies.request.request_engine`), so that every evaluation of one request takes
-one engine and the same request gives the same numbers every time; a library call given ``auto``
-decides by its own size (:func:`engine_for`).
+walks, but its first compile after an install costs far more than a small request's work; the
+NumPy reference path compiles nothing and is slower a row step than the warm kernel (the figures
+are in ``docs/performance.rst``, from ``bench/startup.py``). ``auto`` takes the reference path up
+to :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` rows x steps and the kernel above. A request
+decides once where it enters the API (:func:`foldopt.studies.request.request_engine`), so that
+every evaluation of one request takes one engine and the same request gives the same numbers
+every time; a library call given ``auto`` decides by its own size (:func:`engine_for`).
 
 A leaf: it imports only :mod:`foldopt.names`, so that the command line's requests decide without
 numpy.

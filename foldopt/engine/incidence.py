@@ -5,8 +5,8 @@ modifier.
 sub-panel normals against the sun vector give the beam's incidence (or Shin et al.'s Eq. 5 in paper
 mode), and the beam with the optional incidence-angle modifier (:func:`iam_factor`) and the diffuse
 terms of :func:`foldopt.physics.irradiance.sky_diffuse_terms` give each sub-panel's irradiance.
-It is where a map's time went (5 ns of 21 a row step on one core, unvectorised); written so that
-LLVM vectorises it (see :func:`incidence`), it takes about 1 ns.
+It was where a map's time went while unvectorised; it is written so that LLVM vectorises it (see
+:func:`incidence`; the figures are in ``docs/performance.rst``).
 
 The module may import numpy and numba; ``tests/test_engine.py`` holds it, through the kernel, to
 the NumPy reference path.

@@ -18,9 +18,8 @@ time. So the loops are written once and inlined once per case, each case's setti
 constants (the incidence per mode, diffuse terms and modifier; the ideal model's power per
 connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
 (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
-loop, not called. On a map's year (the ideal model, 10 loads) a row step cost about 5 ns on one
-core on a fast day, against 21 ns before (the kernel's share of ``bench/map.py --w5 --phases``);
-8.8 ns on the slower machine of 2026-12-03, of which some 5.9 ns the walk over the loads.
+loop, not called (what each choice was worth: ``docs/performance.rst``, from ``bench/map.py --w5
+--phases``).
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -387,8 +386,8 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     model from :func:`_linear_connections`, or with the circuit as built from :func:`_built_row`,
     through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
     third reduces each power curve to the daily metrics. The row's work is inlined here rather than
-    called: a call with the kernel's some thirty arrays cost about 190 ns a row, a quarter of a map
-    row's time at 30-min steps (some 12 % at 5-min steps)."""
+    called: a call that passes the kernel's some thirty arrays is a large share of a short row's
+    time (``docs/performance.rst``)."""
     connections = tables.connections
     n_conn = connections.shape[0]
     with_tables = tables.linear_power == 0.0

@@ -12,6 +12,7 @@ import numpy as np
 import scipy.optimize
 
 from foldopt.engine.metrics import t_solar
+from foldopt.names import FLAT_FOLD_ANGLE
 
 PowerOfAngles = Callable[[np.ndarray], np.ndarray]
 
@@ -109,7 +110,7 @@ def heuristic_fold_angle(
     subpanel_power: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
     p_load: float,
     lo: float = 1.0,
-    hi: float = 180.0,
+    hi: float = FLAT_FOLD_ANGLE,
     tol: float = 0.01,
 ) -> tuple[float, str]:
     """The paper's optimum: the smallest fold angle whose noon valley still reaches the load.

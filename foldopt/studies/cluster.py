@@ -98,9 +98,9 @@ def _keep_freed_memory() -> None:
 
     A Dask nanny starts its worker with ``MALLOC_TRIM_THRESHOLD_=65536``, which also fixes glibc's mmap threshold
     at its default: every array above 128 KiB is then a fresh mmap whose pages fault in one by one. A map
-    allocates many such arrays per site and ran at half speed (0.49 against 0.25 s a site, the difference all
-    system time). Thresholds of 32 MiB (mmap) and 128 MiB (trim) keep a site's arrays on the heap and bound
-    what a worker holds back. Elsewhere than glibc, nothing is done."""
+    allocates many such arrays per site and ran at half speed, the difference all system time
+    (``docs/performance.rst``). Thresholds of 32 MiB (mmap) and 128 MiB (trim) keep a site's
+    arrays on the heap and bound what a worker holds back. Elsewhere than glibc, nothing is done."""
     import ctypes
     import ctypes.util
 

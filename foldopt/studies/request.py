@@ -1062,8 +1062,8 @@ def request_engine(engine: str, plan) -> str:
     if base.weather is not None:
         return engine_for(engine, math.inf)
     if base.storage is not None:
-        # The buffer's reference path walks the time steps in Python, 0.8 s a pass over a day of
-        # 1-min steps however few the curves, and a periodic state takes 2 to 60 passes.
+        # The buffer's reference path walks the time steps in Python, slow however few the curves,
+        # and a periodic state takes 2 to 60 passes.
         return engine_for(engine, math.inf)
     if base.optimize is not None and set(base.optimize.vary) != {"fold_angle"}:
         # A joint search over the tilt or the azimuth evaluates some 10^4 designs of a day.
