@@ -138,12 +138,12 @@ def test_exact_hour_angle_is_pvlibs_and_zero_at_solar_noon():
 
 
 def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
-    from foldopt.physics.spa import _geocentric_hourly, spa_geocentric
+    from foldopt.physics.spa import SunTerms, _geocentric_hourly, spa_geocentric
 
     # Random instants from 1990 to 2060: linear interpolation between whole UTC hours.
     unix = np.sort(np.random.default_rng(5).uniform(6.3e8, 2.9e9, 5000))
     exact = spa_geocentric(unix)
-    interpolated = _geocentric_hourly((unix * 1e9).astype(np.int64))
+    interpolated = _geocentric_hourly((unix * 1e9).astype(np.int64), SunTerms())
     for name, values in exact.items():
         difference = values - interpolated[name]
         if name in ("alpha", "v"):
@@ -196,40 +196,60 @@ def test_split_spa_equals_pvlib_spa_python_on_random_sites():
         assert angle.max() < 1e-5, (latitude[block, 0], longitude[block, 0], dates[block])
 
 
-def test_hours_evaluated_once_per_process_are_the_same_bits():
-    """The time-only SPA terms kept per UTC hour (a map's sites share them) are the bits a direct
-    evaluation gives, whichever calls filled the store first."""
+def test_hours_kept_for_a_run_are_the_same_bits():
+    """The time-only SPA terms a run keeps per UTC hour (a map's sites share them) are the bits a
+    direct evaluation gives, whichever calls filled the store first."""
     import foldopt.physics.spa as spa
 
     hours = np.arange(482_000, 482_000 + 9_000, dtype=np.int64)
     direct = spa.spa_geocentric(hours * 3600.0)
-    kept = spa._AT_HOURS
-    try:
-        spa._AT_HOURS = (np.zeros(0, dtype=np.int64), {})
-        spa._geocentric_at_hours(hours[1000:3000])
-        spa._geocentric_at_hours(hours[::7])
-        again = spa._geocentric_at_hours(hours)
-    finally:
-        spa._AT_HOURS = kept
+    kept = spa.SunTerms()
+    kept.at_hours(hours[1000:3000])
+    kept.at_hours(hours[::7])
+    again = kept.at_hours(hours)
     for name, values in direct.items():
         np.testing.assert_array_equal(again[name], values)
+    # Past its bound a store starts again, and still answers with the same bits.
+    small = spa.SunTerms(hours_kept=2_500)
+    small.at_hours(hours[:2_000])
+    again = small.at_hours(hours[4_000:6_000])
+    assert small._hours[0].size == 2_000
+    for name, values in direct.items():
+        np.testing.assert_array_equal(again[name], values[4_000:6_000])
 
 
 def test_steps_kept_per_lattice_are_the_same_bits():
-    """The time-only terms kept per UTC step (a map's sites of one year share them whatever their
-    time zone) are the bits a direct evaluation gives, whichever calls filled the store first."""
+    """The time-only terms a run keeps per UTC step (a map's sites of one year share them whatever
+    their time zone) are the bits a direct evaluation gives, whichever calls filled the store
+    first, and the sun a shared store gives is the sun each call's own store gives."""
     import foldopt.physics.spa as spa
-    from foldopt.physics.solarposition import clock_grid
+    from foldopt.physics.solarposition import clock_grid, solar_position_grid
 
     grid = clock_grid([dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 40, 3)], "UTC+03:00", 5)
-    direct = spa._equatorial(grid.utc_ns)
-    kept = spa._ON_LATTICE
-    try:
-        spa._ON_LATTICE = {}
-        spa._shared_terms(grid.utc_ns[5:9])
-        spa._shared_terms(grid.utc_ns[::4])
-        first, terms = spa._shared_terms(grid.utc_ns)
-    finally:
-        spa._ON_LATTICE = kept
+    direct = spa._equatorial(grid.utc_ns, spa.SunTerms())
+    kept = spa.SunTerms()
+    kept.on_lattice(grid.utc_ns[5:9])
+    kept.on_lattice(grid.utc_ns[::4])
+    first, terms = kept.on_lattice(grid.utc_ns)
     again = np.stack([terms[:, start:start + grid.utc_ns.shape[1]] for start in first], axis=1)
     np.testing.assert_array_equal(again, direct)
+    other = clock_grid([dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 40, 3)], "UTC-07:00", 5)
+    shared = solar_position_grid(other, 40.0, -105.0, 1600.0, "exact", kept)
+    alone = solar_position_grid(other, 40.0, -105.0, 1600.0, "exact")
+    for name in ("solar_zenith", "solar_azimuth", "hour_angle", "sun_vector"):
+        np.testing.assert_array_equal(shared[name], alone[name])
+
+
+def test_the_sun_keeps_nothing_between_calls():
+    """Issue 48: no hidden state. A call given no store leaves the module as it found it (no
+    module-level store of SPA's terms), and a store lives as long as the run that made it."""
+    import foldopt.physics.spa as spa
+    from foldopt.physics.solarposition import clock_grid, solar_position_grid
+
+    before = {name: id(value) for name, value in vars(spa).items()}
+    grid = clock_grid([dt.date(2025, 6, 1)], "UTC", 10)
+    solar_position_grid(grid, 10.0, 20.0, 0.0, "exact")
+    assert {name: id(value) for name, value in vars(spa).items()} == before
+    mutable = [name for name, value in vars(spa).items()
+               if isinstance(value, (dict, list, set, tuple)) and not name.startswith("__")]
+    assert mutable == ["_WRAPPED"], mutable  # a constant tuple of names

@@ -33,6 +33,7 @@ from foldopt.names import CLEAR_SKIES
 from foldopt.physics.atmosphere import clear_sky_dni
 from foldopt.physics.horizon import sun_visible
 from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
+from foldopt.physics.spa import SunTerms
 from foldopt.physics.temperature import equivalent_temp_air
 
 
@@ -331,7 +332,9 @@ def _clock(sites, dates, step_min) -> ClockGrid:
     )
 
 
-def build_sky(options: SkyOptions, sites, dates, member=None) -> Sky:
+def build_sky(
+    options: SkyOptions, sites, dates, member=None, *, sun_terms: SunTerms | None = None
+) -> Sky:
     """The sky of one set of settings over blocks, one per (site, date), as one array program.
 
     Parameters
@@ -346,6 +349,9 @@ def build_sky(options: SkyOptions, sites, dates, member=None) -> Sky:
     member : array_like of int, optional
         With a cloud ensemble (``weather.members``), the member of each block: its light is that
         member's draw (:func:`foldopt.inputs.weather.ensemble.cloud_members`) of its day.
+    sun_terms : foldopt.physics.spa.SunTerms, optional
+        SPA's time-only terms shared by the run's skies (a year's chunks, a map's sites); default:
+        this sky's own.
 
     Returns
     -------
@@ -386,7 +392,7 @@ def build_sky(options: SkyOptions, sites, dates, member=None) -> Sky:
     longitude = np.array([site.longitude for site in sites], dtype=float)[:, None]
     altitude = np.array([site.altitude for site in sites], dtype=float)[:, None]
     grid = _clock(sites, dates, options.step_min)
-    sun = solar_position_grid(grid, latitude, longitude, altitude, options.mode)
+    sun = solar_position_grid(grid, latitude, longitude, altitude, options.mode, sun_terms)
     solar_zenith = sun["solar_zenith"]
     dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[
         grid.dayofyear

@@ -41,7 +41,7 @@ import pvlib
 
 from foldopt.names import MODES
 from foldopt.physics.geometry import normal_vector
-from foldopt.physics.spa import NS_PER_HOUR, spa_solar_position
+from foldopt.physics.spa import NS_PER_HOUR, SunTerms, spa_solar_position
 
 _NS_PER_DAY = 24 * NS_PER_HOUR
 
@@ -337,7 +337,12 @@ def sun_from_angles(declination, hour_angle, latitude):
 
 
 def solar_position_grid(
-    grid: ClockGrid, latitude, longitude, altitude=0.0, model: str = "exact"
+    grid: ClockGrid,
+    latitude,
+    longitude,
+    altitude=0.0,
+    model: str = "exact",
+    sun_terms: SunTerms | None = None,
 ) -> dict:
     """Solar position at every step of a grid of days.
 
@@ -352,6 +357,9 @@ def solar_position_grid(
         ``paper``: Shin et al. Eq. 3, 4, 6 (repaired), geometric, no refraction.
         ``exact``: NREL SPA; the *apparent* (refracted) zenith is returned, as pvlib's
         ModelChain uses it for air mass and incidence.
+    sun_terms : foldopt.physics.spa.SunTerms, optional
+        ``exact``: SPA's time-only terms a run shares between its calls (its chunks, a map's
+        sites); default: this call's own.
 
     Returns
     -------
@@ -373,7 +381,7 @@ def solar_position_grid(
         vector = normal_vector(solar_zenith, solar_azimuth)
     elif model == "exact":
         solar_zenith, solar_azimuth, equation_of_time, vector = spa_solar_position(
-            grid.utc_ns, latitude, longitude, altitude
+            grid.utc_ns, latitude, longitude, altitude, sun_terms
         )
         utc_hours = (grid.utc_ns % _NS_PER_DAY) / NS_PER_HOUR
         hour_angle = (

@@ -100,44 +100,85 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
 _WRAPPED = ("alpha", "v")  # angles that wrap at 360 deg
 
 
-#: The time-only terms at whole UTC hours this process has evaluated: (hours, terms), replaced
-#: whole (one assignment, so a thread reads one state or the other). A map's sites of one year
-#: share every hour; :data:`HOURS_KEPT` bounds it (about 80 MB).
-_AT_HOURS: tuple = (np.zeros(0, dtype=np.int64), {})
-HOURS_KEPT = 2_000_000
+class SunTerms:
+    """SPA's time-only terms at the instants one run has asked for, so that its sites and chunks
+    share them: at whole UTC hours (:meth:`at_hours`) and at the steps of each UTC lattice
+    (:meth:`on_lattice`). The terms are elementwise in time, so an instant's are the same bits
+    whichever call first asked for it (tested); a run that passes none evaluates its own.
+
+    The owner is the run: a sweep over a year's chunks, a map's chunk of sites. Each store is
+    replaced whole (one assignment), so that threads of one run read one state or the other.
+
+    Attributes
+    ----------
+    hours_kept, steps_kept : int
+        Bounds of each store (about 80 MB and 60 MB at the defaults): past them a store starts
+        again, or a lattice is not kept.
+    """
+
+    def __init__(self, hours_kept: int = 2_000_000, steps_kept: int = 1_500_000):
+        self.hours_kept, self.steps_kept = hours_kept, steps_kept
+        self._hours: tuple = (np.zeros(0, dtype=np.int64), {})
+        self._lattices: dict = {}
+
+    def at_hours(self, nodes: np.ndarray) -> dict:
+        """:func:`spa_geocentric` at whole UTC hours ``nodes`` (sorted, unique), each evaluated
+        once for the run."""
+        hours, terms = self._hours
+        missing = nodes[~np.isin(nodes, hours)]
+        if missing.size:
+            found = spa_geocentric(missing * 3600.0)
+            if hours.size + missing.size > self.hours_kept:
+                hours, terms = missing[:0], {name: values[:0] for name, values in found.items()}
+            order = np.argsort(np.concatenate([hours, missing]), kind="stable")
+            hours = np.concatenate([hours, missing])[order]
+            terms = {
+                name: np.concatenate([terms.get(name, values[:0]), values])[order]
+                for name, values in found.items()
+            }
+            self._hours = (hours, terms)
+        index = np.searchsorted(hours, nodes)
+        return {name: values[index] for name, values in terms.items()}
+
+    def on_lattice(self, utc_ns: np.ndarray) -> tuple:
+        """:func:`_equatorial` at ``utc_ns`` (n_blocks, n_steps) as ``(first, terms)``: block
+        ``b``'s step ``i`` is ``terms[:, first[b] + i]``. Where every day is of equal steps on one
+        lattice of UTC instants (a map's sites of one year and step, whatever their time zone),
+        each instant is evaluated once for the run however many sites and days share it."""
+        n_blocks, n_steps = utc_ns.shape
+        step = int(utc_ns[0, 1] - utc_ns[0, 0]) if n_steps > 1 else 0
+        phase = int(utc_ns[0, 0] % step) if step > 0 else 0
+        # A day of equal steps spans them; a clock's change (a DST day) does not.
+        lattice = (
+            step > 0
+            and np.all(utc_ns[:, 0] % step == phase)
+            and np.all(utc_ns[:, -1] - utc_ns[:, 0] == step * (n_steps - 1))
+        )
+        if not lattice:
+            return np.arange(n_blocks) * n_steps, _equatorial(utc_ns, self).reshape(5, -1)
+        start = (utc_ns[:, 0] - phase) // step
+        low, high = int(start.min()), int(start.max()) + n_steps - 1
+        first, terms = self._lattices.get((step, phase), (low, np.zeros((5, 0))))
+        if low < first or high >= first + terms.shape[1]:
+            # A day more either side: the same dates in every other time zone are then kept.
+            margin = -(-24 * NS_PER_HOUR // step)
+            low, high = min(low - margin, first), max(high + margin, first + terms.shape[1] - 1)
+            if high - low + 1 > self.steps_kept:
+                return np.arange(n_blocks) * n_steps, _equatorial(utc_ns, self).reshape(5, -1)
+            first, terms = low, _equatorial(np.arange(low, high + 1) * step + phase, self)
+            self._lattices = {**self._lattices, (step, phase): (first, terms)}
+        return start - first, terms
 
 
-def _geocentric_at_hours(nodes: np.ndarray) -> dict:
-    """:func:`spa_geocentric` at whole UTC hours (sorted, unique), each hour evaluated once per
-    process. The terms are elementwise in time, so an hour's are the same bits whichever call
-    first asked for it (tested)."""
-    global _AT_HOURS
-    hours, terms = _AT_HOURS
-    missing = nodes[~np.isin(nodes, hours)]
-    if missing.size:
-        found = spa_geocentric(missing * 3600.0)
-        if hours.size + missing.size > HOURS_KEPT:
-            hours, terms = missing[:0], {name: values[:0] for name, values in found.items()}
-        order = np.argsort(np.concatenate([hours, missing]), kind="stable")
-        hours = np.concatenate([hours, missing])[order]
-        terms = {
-            name: np.concatenate([terms.get(name, values[:0]), values])[order]
-            for name, values in found.items()
-        }
-        _AT_HOURS = (hours, terms)
-    index = np.searchsorted(hours, nodes)
-    return {name: values[index] for name, values in terms.items()}
-
-
-def _geocentric_hourly(utc_ns: np.ndarray) -> dict:
+def _geocentric_hourly(utc_ns: np.ndarray, sun_terms: SunTerms) -> dict:
     """:func:`spa_geocentric` at ``utc_ns`` (any shape), interpolated linearly between whole UTC
     hours, each hour evaluated once however many sites and days share it
-    (:func:`_geocentric_at_hours`).
+    (:meth:`SunTerms.at_hours`).
 
     Over an hour the geocentric terms are smooth to within 1e-5 deg of linear (tested)."""
     hours = np.floor_divide(utc_ns, NS_PER_HOUR)
     nodes = np.unique(np.concatenate([hours.ravel(), hours.ravel() + 1]))
-    at_nodes = _geocentric_at_hours(nodes)
+    at_nodes = sun_terms.at_hours(nodes)
     index = np.searchsorted(nodes, hours)
     weight = (utc_ns - hours * NS_PER_HOUR) / NS_PER_HOUR
     out = {}
@@ -150,13 +191,13 @@ def _geocentric_hourly(utc_ns: np.ndarray) -> dict:
     return out
 
 
-def _equatorial(utc_ns) -> np.ndarray:
+def _equatorial(utc_ns, sun_terms: SunTerms) -> np.ndarray:
     """The time-only terms of a site's sun at UTC instants ``utc_ns`` (any shape), from SPA's
     geocentric terms (:func:`_geocentric_hourly`): the sun's direction in the frame of the
     Greenwich meridian and the celestial pole, ``cos(delta) cos(H_G)``, ``cos(delta) sin(H_G)``
     and ``sin(delta)`` with ``H_G = v - alpha`` its Greenwich hour angle [1]_ (Eq. 34 at longitude
     0); ``sin(xi)``, the scale of the parallax; and the equation of time [min]. (5, ...)."""
-    geo = _geocentric_hourly(utc_ns)
+    geo = _geocentric_hourly(utc_ns, sun_terms)
     greenwich = np.radians(geo["v"] - geo["alpha"])
     delta = np.radians(geo["delta"])
     cos_delta = np.cos(delta)
@@ -169,46 +210,6 @@ def _equatorial(utc_ns) -> np.ndarray:
             geo["eot"],
         ]
     )
-
-
-#: The terms of :func:`_equatorial` at the steps of UTC lattices this process has evaluated,
-#: {(step [ns], phase [ns]): (first step's index, terms (5, n))}, replaced whole (one assignment,
-#: so that a thread reads one state or the other). A map's sites of one year and step lie on one
-#: lattice whatever their time zone; :data:`STEPS_KEPT` bounds each (about 60 MB).
-_ON_LATTICE: dict = {}
-STEPS_KEPT = 1_500_000
-
-
-def _shared_terms(utc_ns: np.ndarray) -> tuple:
-    """:func:`_equatorial` at ``utc_ns`` (n_blocks, n_steps) as ``(first, terms)``: block ``b``'s
-    step ``i`` is ``terms[:, first[b] + i]``. Where every day is of equal steps on one lattice of
-    UTC instants, each instant is evaluated once per process however many sites and days share it;
-    the terms are elementwise in time, so an instant's are the same bits whichever call first
-    asked for it."""
-    global _ON_LATTICE
-    n_blocks, n_steps = utc_ns.shape
-    step = int(utc_ns[0, 1] - utc_ns[0, 0]) if n_steps > 1 else 0
-    phase = int(utc_ns[0, 0] % step) if step > 0 else 0
-    # A day of equal steps spans them; a clock's change (a DST day) does not.
-    lattice = (
-        step > 0
-        and np.all(utc_ns[:, 0] % step == phase)
-        and np.all(utc_ns[:, -1] - utc_ns[:, 0] == step * (n_steps - 1))
-    )
-    if not lattice:
-        return np.arange(n_blocks) * n_steps, _equatorial(utc_ns).reshape(5, -1)
-    start = (utc_ns[:, 0] - phase) // step
-    low, high = int(start.min()), int(start.max()) + n_steps - 1
-    first, terms = _ON_LATTICE.get((step, phase), (low, np.zeros((5, 0))))
-    if low < first or high >= first + terms.shape[1]:
-        # A day more either side: the same dates in every other time zone are then kept already.
-        margin = -(-24 * NS_PER_HOUR // step)
-        low, high = min(low - margin, first), max(high + margin, first + terms.shape[1] - 1)
-        if high - low + 1 > STEPS_KEPT:
-            return np.arange(n_blocks) * n_steps, _equatorial(utc_ns).reshape(5, -1)
-        first, terms = low, _equatorial(np.arange(low, high + 1) * step + phase)
-        _ON_LATTICE = {**_ON_LATTICE, (step, phase): (first, terms)}
-    return start - first, terms
 
 
 @njit(cache=True, inline="always")
@@ -242,7 +243,7 @@ def _site_sun(
     solar_azimuth,
 ):
     """Every step of every block in one pass: the geometric topocentric unit vector toward the sun
-    (east, north, up), from ``terms[:, first[b] + i]`` (:func:`_shared_terms`) and the site's
+    (east, north, up), from ``terms[:, first[b] + i]`` (:meth:`SunTerms.on_lattice`) and the site's
     arguments per block; its elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s
     formula and switch, at ``pressure`` [hPa] per block and :data:`SPA_TEMPERATURE`), which raises
     the vector in its vertical plane (:func:`_raised`) and the elevation. Writes ``direction``
@@ -280,21 +281,22 @@ def _site_sun(
             apparent_zenith[b, i] = 90.0 - elevation
 
 
-def spa_solar_position(utc_ns, latitude, longitude, altitude):
+def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerms | None = None):
     """Apparent zenith, azimuth, equation of time and the sun's apparent unit vector by SPA [1]_
     at every step of days of steps.
 
     SPA's geocentric terms depend on time alone: kept per UTC hour and interpolated
     (:func:`_geocentric_hourly`), they give the sun's direction in the frame of the Greenwich
     meridian and the celestial pole (:func:`_equatorial`), the same for every site at an instant
-    and kept per step (:func:`_shared_terms`). A site's topocentric direction is that vector turned
+    and kept per step (:meth:`SunTerms.on_lattice`). A site's topocentric direction is that vector turned
     by the site's longitude and latitude, less the site's own position seen from the Earth's centre
     (``x`` and ``y`` of [1]_ Eq. 38-39, scaled by ``sin(xi)``): the vector form of SPA's parallax in
     right ascension and declination (Eq. 40-41, 43-45), exact, with no trigonometry per step but
     the elevation's and the azimuth's. SPA's refraction correction (Eq. 42, pvlib's formula, with
     pvlib's default pressure for the altitude and 12 C) raises it at every step; all of it one
-    compiled pass over the steps (:func:`_site_sun`). Against pvlib's ``spa_python`` on random sites and days at
-    1-min steps, the sun's direction is within 2e-6 deg (tests/test_solarposition.py).
+    compiled pass over the steps (:func:`_site_sun`). Against pvlib's ``spa_python`` on random
+    sites and days at 1-min steps, the sun's direction is within 2e-6 deg
+    (tests/test_solarposition.py).
 
     Parameters
     ----------
@@ -305,6 +307,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
         [deg north], [deg east]; one value, or one per block, shape (n_blocks, 1).
     altitude : float or array_like
         [m], as ``latitude``.
+    sun_terms : SunTerms, optional
+        The run's time-only terms, shared with its other calls; default: this call's own.
 
     Returns
     -------
@@ -333,7 +337,7 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude):
     u = pvlib.spa.uterm(latitude)
     x, y = pvlib.spa.xterm(u, latitude, altitude), pvlib.spa.yterm(u, latitude, altitude)
     lam, phi = np.radians(longitude), np.radians(latitude)
-    first, terms = _shared_terms(utc_ns)
+    first, terms = (SunTerms() if sun_terms is None else sun_terms).on_lattice(utc_ns)
     # each component along the steps, as the engine reads it
     vector = np.empty((shape[0], 3, shape[1]))
     apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)

@@ -7,7 +7,7 @@ block's flat panel orientation and the study's engine options, made once
 :class:`foldopt.engine.sky.Sky` and cuts itself into chunks that bound an engine call's memory.
 :mod:`foldopt.studies.designs` evaluates the designs over them.
 
-The module may import :mod:`foldopt.engine` and :mod:`foldopt.inputs`.
+The module may import :mod:`foldopt.engine`, :mod:`foldopt.inputs` and :mod:`foldopt.physics`.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import numpy as np
 from foldopt.engine.options import EngineOptions
 from foldopt.engine.sky import Sky, build_sky
 from foldopt.inputs.study import Study
+from foldopt.physics.spa import SunTerms
 from foldopt.studies.engine_options import engine_options
 
 #: Rows (blocks x fold angles) x loads of one engine call: bounds the memory of a chunk.
@@ -153,9 +154,10 @@ class Blocks:
             None if self.member is None else self.member[part],
         )
 
-    def sky(self) -> Sky:
-        """The blocks' :class:`foldopt.engine.sky.Sky` (:func:`foldopt.engine.sky.build_sky`)."""
-        return build_sky(self.options.sky, self.sites, self.dates, self.member)
+    def sky(self, sun_terms: SunTerms | None = None) -> Sky:
+        """The blocks' :class:`foldopt.engine.sky.Sky` (:func:`foldopt.engine.sky.build_sky`),
+        sharing SPA's time-only terms with the run's other skies through ``sun_terms``."""
+        return build_sky(self.options.sky, self.sites, self.dates, self.member, sun_terms=sun_terms)
 
     def chunks(self, n_loads: int):
         """Slices of blocks whose rows x loads and time steps stay within the chunk bounds.

@@ -41,6 +41,7 @@ from foldopt.inputs.plan import Plan
 from foldopt.inputs.study import Study
 from foldopt.studies.designs import Blocks, daily_designs, design_hours
 from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
+from foldopt.physics.spa import SunTerms
 from foldopt.studies.objectives import (
     best_angle_index,
     near_optimal,
@@ -180,7 +181,8 @@ def optimize_plan(plan: Plan, engine: str = DEFAULT_ENGINE, request=None) -> Opt
     counted = months[season_days(months, season)]  # the days the objective takes
     blocks = Blocks.of_dates(study, dates)
     study = blocks.study
-    parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
+    sun_terms = SunTerms()  # the chunks' skies share SPA's time-only terms
+    parts = [(blocks[part], blocks[part].sky(sun_terms)) for part in blocks.chunks(loads.size)]
     quantum = objective_quantum(statistic, parts[0][1].step_hours, counted.size, counted)
 
     def objective(flat):

@@ -42,6 +42,7 @@ from foldopt.studies.objectives import (
 )
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
+from foldopt.physics.spa import SunTerms
 from foldopt.studies.storage_days import YearChoice, YearDays, powered_by_angle, year_storage
 from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
@@ -144,7 +145,11 @@ def run_plan(
 
     weather_notes: dict = {}
 
-    def counted(sky: Sky) -> Sky:
+    sun_terms = SunTerms()  # the run's skies share SPA's time-only terms
+
+    def sky_of(blocks: Blocks) -> Sky:
+        """The blocks' sky, its weather's balance and notes counted for the run."""
+        sky = blocks.sky(sun_terms)
         for key, (total, kept) in (sky.weather_balance or {}).items():
             light[key] = np.add(light.get(key, (0.0, 0.0)), (total, kept))
         weather_notes.update(dict.fromkeys(sky.weather_notes))
@@ -154,7 +159,7 @@ def run_plan(
         refolds: dict[str, list] = {}
         for index, study in enumerate(studies):
             results[index], group_extras = _annual_group(
-                Blocks.of_dates(study, dates), loads, objective, advance, engine, counted
+                Blocks.of_dates(study, dates), loads, objective, advance, engine, sky_of
             )
             extras = extras or group_extras
             for key in GROUP_TABLES:
@@ -185,7 +190,7 @@ def run_plan(
             blocks = Blocks.of([studies[i] for i in members])
             for part in blocks.chunks(loads.size):
                 chunk = blocks[part]
-                sky = counted(chunk.sky())
+                sky = sky_of(chunk)
                 fold_angles, hours, _ = fold_hours(sky, chunk, loads, engine)
                 hours = hours.transpose(0, 2, 1)  # (blocks, loads, angles)
                 metrics = design_metrics(
@@ -212,14 +217,14 @@ def run_plan(
     return SweepResult(plan, table, extras, engine, kept, request, tuple(weather_notes))
 
 
-def _annual_group(blocks: Blocks, loads, objective, advance, engine, counted):
+def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
     """One fold angle per load for all the days of a group: the one that maximises the objective
     over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves."""
     parts = blocks.chunks(loads.size)
     skies, daily = [], []
     sample: dict = {}
     for part in parts:
-        skies.append(counted(blocks[part].sky()))
+        skies.append(sky_of(blocks[part]))
         _keep_sample(sample, skies[-1], blocks[part], blocks.members)
         fold_angles, hours, _ = fold_hours(skies[-1], blocks[part], loads, engine)
         daily.append(hours)

@@ -44,6 +44,7 @@ from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_s
 from foldopt.inputs.study import Study, make_study
 from foldopt.inputs.weather_files import with_fetched_sites
 from foldopt.errors import ConfigError
+from foldopt.physics.spa import SunTerms
 from foldopt.studies.break_even import break_even_standby
 from foldopt.studies.designs import Blocks, setup_key, site_designs
 from foldopt.studies.site_search import fold_search
@@ -523,20 +524,21 @@ def evaluate_sites(
     engine = engine_for(engine, math.inf)
     frames, batch, key = [], [], None
     study = map_data(study)  # once, not per site
+    sun_terms = SunTerms()  # the sites of one year share every instant of SPA's time-only terms
     for site in sites:
         here, dates = site_study(study, site, year)
         this = setup_key(here)
         if batch and (this != key or len(batch) == SITES_PER_BATCH):
-            frames.append(_evaluate_batch(batch, loads, relative, engine))
+            frames.append(_evaluate_batch(batch, loads, relative, engine, sun_terms))
             batch = []
         batch.append((site, here, dates))
         key = this
     if batch:
-        frames.append(_evaluate_batch(batch, loads, relative, engine))
+        frames.append(_evaluate_batch(batch, loads, relative, engine, sun_terms))
     return pd.concat(frames, ignore_index=True)
 
 
-def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
+def _evaluate_batch(batch, loads, relative: bool, engine: str, sun_terms: SunTerms) -> pd.DataFrame:
     """The rows of sites that share a setup (:func:`foldopt.studies.designs.setup_key`), their days
     one set of blocks: every engine call runs over all of them (:func:`site_designs`)."""
     blocks = Blocks.join([Blocks.of_dates(study, dates) for _, study, dates in batch])
@@ -545,7 +547,7 @@ def _evaluate_batch(batch, loads, relative: bool, engine: str) -> pd.DataFrame:
     statistic = objective.statistic if objective is not None else "mean"
     starts = np.cumsum([0, *(len(dates) for _, _, dates in batch)])
     sites = [range(first, stop) for first, stop in zip(starts[:-1], starts[1:], strict=True)]
-    parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(loads.size)]
+    parts = [(blocks[part], blocks[part].sky(sun_terms)) for part in blocks.chunks(loads.size)]
     step_hours = parts[0][1].step_hours
     flat_peak = None
     if relative:
