@@ -277,3 +277,28 @@ def test_the_engine_never_sees_a_study():
                  for target, _, line in _imports(module) if _resolve(target) == "foldopt.inputs.study"]
     assert offenders == []
     assert _imports("foldopt.studies.engine_options"), "the finder sees the builder's imports"
+
+
+def test_an_engine_option_is_the_study_field_of_its_name_unless_derived():
+    """Issue 48: a field the engine comes to read is a field of the study and of its options group,
+    named alike, and no line of the builder: every option not in DERIVED is a study field, and each
+    option the builder makes is the study's value (the field's own, or its derivation's)."""
+    import dataclasses
+
+    from foldopt.inputs.study import Study
+    from foldopt.studies.engine_options import DERIVED, engine_options
+    from foldopt.studies.request import make_request
+
+    for kind, derived in DERIVED.items():
+        names = {field.name for field in dataclasses.fields(kind)}
+        assert set(derived) <= names, f"{kind.__name__}: derived options it does not have"
+        assert sorted(names - set(derived) - set(Study.model_fields)) == [], kind.__name__
+        # Derived though named as a field: the value in force (the transposition a beam-only sky
+        # drops, the circuit None when ideal), not the field as given.
+        in_force = {"circuit", "transposition"}
+        assert sorted(set(derived) & set(Study.model_fields) - in_force) == [], (
+            f"{kind.__name__}: an option named as a study field takes that field")
+    study = make_request("run", None, settings=["mode=exact", "panel.area=0.2"]).plan.base
+    options = engine_options(study)
+    assert options.electrical.area == 0.2 and options.sky.mode == "exact"
+    assert options.sky.temp_air == study.temp_air and options.electrical.pv_model == study.pv_model
