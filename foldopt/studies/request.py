@@ -1037,14 +1037,15 @@ def request_engine(engine: str, plan) -> str:
     :func:`foldopt.world_map`, :func:`foldopt.reproduce`): downstream every evaluation takes it,
     so one request's numbers come from one engine, the one its answer records.
 
-    ``auto`` (:mod:`foldopt.engine.choice`) counts the request's rows x steps: its clear-sky cases
-    but the loads at its fold angles and steps. A day's study takes the NumPy reference path; more takes the compiled kernel
-    where numba's cache holds it (:func:`foldopt.engine.choice.kernel_cached`), and before its
-    first compile only above :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` (a day's sweeps of the
-    angle or the load, a few latitudes or days compile nothing). A weather file's or a cloud
-    ensemble's days, a joint search over the tilt or the azimuth (some 10^4 designs), a study
-    with a buffer (whose reference path walks the time steps in Python) and a map (``plan``
-    None: a year at every site) take the compiled kernel.
+    ``auto`` (:mod:`foldopt.engine.choice`) counts the request's clear-sky cases (its loads among
+    them: the reference path's cost grows with them) at its fold angles and steps. A day's study
+    takes the NumPy reference path; more takes the compiled kernel where numba's cache holds it
+    (:func:`foldopt.engine.choice.kernel_cached`), and before its first compile only above
+    :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` (a day's sweeps of the angle or the load, a few
+    latitudes or days compile nothing). A weather file's or a cloud ensemble's days, a joint
+    search over the tilt or the azimuth (some 10^4 designs), a study with a buffer (whose
+    reference path walks the time steps in Python) and a map (``plan`` None: a year at every
+    site) take the compiled kernel.
 
     Parameters
     ----------
@@ -1060,8 +1061,6 @@ def request_engine(engine: str, plan) -> str:
     if plan is None:
         return engine_for(engine, math.inf)
     base, cases = (plan.base, plan.n_cases) if isinstance(plan, Plan) else (plan, 1)
-    if isinstance(plan, Plan):  # the loads share a row: each row's one pass evaluates them all
-        cases //= len(dict(plan.axes).get("p_load", (None,)))
     if base.weather is not None:
         return engine_for(engine, math.inf)
     if base.storage is not None:
