@@ -85,7 +85,9 @@ def kernel_cached() -> bool:
         if _compiled_here(module, function):
             continue
         version = version or _numba_version()
-        if version is None or not in_cache(Path(__file__).with_name(f"{module}.py"), function, version):
+        if version is None or not in_cache(
+            Path(__file__).with_name(f"{module}.py"), function, version
+        ):
             return False
     return True
 
