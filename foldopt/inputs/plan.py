@@ -36,6 +36,10 @@ from foldopt.inputs.study import Study, format_error
 DATE_KEYWORDS = ("year", "equinoxes-solstices")
 #: Fields that label a study rather than design it: a list of them is no sweep.
 UNSWEPT = ("name", "description")
+#: Axes whose parser already made each value what the study's field holds (a date), and whose
+#: value no other field's validation reads: the first case validates the rest of the study, so a
+#: study per value would validate nothing more, and a measured file's days are thousands.
+_PARSED_AXES = ("date",)
 _LIST_VALUED = list_valued_fields(Study)
 #: Every field of a study: a list under any other key is no axis (the validation names the key).
 _FIELDS = frozenset(field_paths(Study))
@@ -541,12 +545,6 @@ def make_plan(data, lines: dict | None = None) -> Plan:
         raise ConfigError(_collapse(list(dict.fromkeys(errors))))
     _check_size(plan)
     return plan
-
-
-#: Axes whose parser already made each value what the study's field holds (a date), and whose
-#: value no other field's validation reads: the first case validates the rest of the study, so a
-#: study per value would validate nothing more, and a measured file's days are thousands.
-_PARSED_AXES = ("date",)
 
 
 def _check_size(plan: Plan) -> None:
