@@ -1,41 +1,59 @@
-"""The ``auto`` engine (issue 40): small work in NumPy, where the kernel's first compile costs more
-than it saves, decided once per request (foldopt.engine.choice, foldopt.studies.request)."""
+"""The ``auto`` engine (issues 40, 49): the compiled kernel where numba's cache holds it, small work
+in NumPy, where loading the kernel, or its first compile, costs more than it saves; decided once
+per request (foldopt.engine.choice, foldopt.studies.request)."""
 
 from __future__ import annotations
 
 import datetime as dt
 import json
 import os
+import pickle
 import subprocess
 import sys
+import textwrap
 from pathlib import Path
 
 import pytest
 
 import foldopt
+from foldopt.engine import choice
 from foldopt.engine.choice import engine_for
-from foldopt.names import AUTO_NUMPY_ROW_STEPS, DEFAULT_ENGINE, ENGINES
+from foldopt.names import (
+    AUTO_CACHED_NUMPY_ROW_STEPS,
+    AUTO_NUMPY_ROW_STEPS,
+    DEFAULT_ENGINE,
+    ENGINES,
+)
 from foldopt.studies.request import make_request, request_engine
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def test_auto_takes_numpy_up_to_its_bound_and_the_kernel_above():
+@pytest.fixture(params=[False, True], ids=["not-compiled", "cached"])
+def cached(request, monkeypatch):
+    """The kernel's compile cache empty, then holding it."""
+    monkeypatch.setattr(choice, "kernel_cached", lambda: request.param)
+    return request.param
+
+
+def test_auto_takes_numpy_up_to_its_bound_and_the_kernel_above(cached):
     assert DEFAULT_ENGINE == "auto" and set(ENGINES) == {"auto", "numba", "numpy"}
-    assert engine_for("auto", AUTO_NUMPY_ROW_STEPS) == "numpy"
-    assert engine_for("auto", AUTO_NUMPY_ROW_STEPS + 1) == "numba"
+    bound = AUTO_CACHED_NUMPY_ROW_STEPS if cached else AUTO_NUMPY_ROW_STEPS
+    assert AUTO_CACHED_NUMPY_ROW_STEPS < AUTO_NUMPY_ROW_STEPS
+    assert engine_for("auto", bound) == "numpy"
+    assert engine_for("auto", bound + 1) == "numba"
     for named in ("numba", "numpy"):  # a named engine is taken whatever the size
         assert engine_for(named, 1) == engine_for(named, 10 * AUTO_NUMPY_ROW_STEPS) == named
     with pytest.raises(ValueError, match="auto, numba, numpy; got 'fast'"):
         engine_for("fast", 1)
 
 
-def test_a_request_decides_by_its_days_angles_and_steps():
+def test_a_request_decides_by_its_days_angles_and_steps(cached):
     study = foldopt.default_study()
     angles, steps = study.fold_angles.count(), round(24 * 60 / study.step_min)
-    assert request_engine("auto", study) == "numpy"  # one day: 181 x 1,440
+    assert request_engine("auto", study) == "numpy"  # one day: 181 x 1,440, cached or not
     # As many one-day cases as fit under the bound, and one more.
-    fit = AUTO_NUMPY_ROW_STEPS // (angles * steps)
+    fit = (AUTO_CACHED_NUMPY_ROW_STEPS if cached else AUTO_NUMPY_ROW_STEPS) // (angles * steps)
     dates = [(dt.date(2025, 1, 1) + dt.timedelta(days=day)).isoformat() for day in range(fit)]
     assert request_engine("auto", make_request("run", study, fields={"date": dates}).plan) == "numpy"
     more = [*dates, "2025-12-31"]
@@ -50,6 +68,88 @@ def test_a_request_decides_by_its_days_angles_and_steps():
     year = foldopt.load_study(ROOT / "configs" / "annual-weather.yaml")
     assert request_engine("auto", year) == "numba" and request_engine("auto", None) == "numba"
     assert request_engine("numpy", year) == "numpy" and request_engine("numba", study) == "numba"
+
+
+#: A module of one cached compiled function, and a process that says whether
+#: foldopt.engine.choice.in_cache finds it cached, then calls it and says whether numba loaded it
+#: from its cache (numba's own count of cache hits).
+_MODULE = "from numba import njit\n\n\n@njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n"
+_PROCESS = textwrap.dedent(
+    """
+    import json, sys
+    from pathlib import Path
+    sys.path.insert(0, sys.argv[1])
+    from foldopt.engine.choice import _numba_version, in_cache
+    import tiny
+    said = in_cache(Path(tiny.__file__), "twice", _numba_version())
+    tiny.twice(1.0)
+    print(json.dumps([said, sum(tiny.twice.stats.cache_hits.values()) > 0]))
+    """
+)
+
+
+def test_the_cache_is_found_held_exactly_where_numba_loads_from_it(tmp_path):
+    """foldopt.engine.choice's reading of numba's cache, held to numba's own behaviour: in each
+    state of the cache (empty, filled, the source edited, the index of another numba, in the
+    source's __pycache__ or NUMBA_CACHE_DIR), it finds the function cached exactly where numba
+    then loads it from the cache rather than compiling it."""
+    source = tmp_path / "tiny.py"
+    source.write_text(_MODULE)
+
+    def loaded(**environment) -> list:
+        done = subprocess.run(
+            [sys.executable, "-c", _PROCESS, str(tmp_path)],
+            capture_output=True, text=True, timeout=300,
+            env={**os.environ, "PYTHONPATH": str(ROOT), **environment},
+        )
+        assert done.returncode == 0, done.stderr
+        said, hit = json.loads(done.stdout)
+        assert said == hit
+        return said
+
+    assert loaded() is False  # compiled, and written to tiny's __pycache__
+    assert loaded() is True
+    source.write_text(_MODULE + "# edited\n")
+    assert loaded() is False
+    assert loaded() is True
+    (index,) = (tmp_path / "__pycache__").glob("tiny.twice-*.nbi")
+    with open(index, "rb") as file:
+        pickle.load(file)  # numba's version, then the stamp and the compiles
+        rest = file.read()
+    index.write_bytes(pickle.dumps("0.0.1") + rest)
+    assert loaded() is False  # another numba's index
+    elsewhere = str(tmp_path / "numba-cache")
+    assert loaded(NUMBA_CACHE_DIR=elsewhere) is False
+    assert loaded(NUMBA_CACHE_DIR=elsewhere) is True
+
+
+def test_the_kernels_cache_is_looked_for_where_numba_keeps_it():
+    """Each of the kernel's entry points is a cached compiled function whose cache folder and
+    index name numba's own locator gives as foldopt.engine.choice looks for them."""
+    import importlib
+    from fnmatch import fnmatch
+
+    python = f"py{sys.version_info[0]}{sys.version_info[1]}{getattr(sys, 'abiflags', '')}"
+    for module, function in choice.KERNEL_FUNCTIONS:
+        dispatcher = getattr(importlib.import_module(f"foldopt.engine.{module}"), function)
+        source = Path(choice.__file__).with_name(f"{module}.py")
+        assert dispatcher.py_func.__qualname__ == function
+        assert Path(dispatcher.py_func.__code__.co_filename).resolve() == source.resolve()
+        cache = dispatcher._cache  # numba's FunctionCache (a NullCache without cache=True)
+        assert Path(cache.cache_path) == choice._cache_folder(source)
+        assert fnmatch(cache._cache_file._index_name, f"{module}.{function}-*.{python}.nbi")
+
+
+def test_looking_for_the_kernel_imports_neither_numba_nor_numpy():
+    code = (
+        "import sys; from foldopt.engine.choice import kernel_cached; kernel_cached(); "
+        "print(sorted({'numba', 'numpy', 'foldopt.engine.kernel'} & set(sys.modules)))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
+    assert done.returncode == 0 and done.stdout.strip() == "[]", done.stderr
 
 
 def test_the_first_run_after_an_install_compiles_nothing(tmp_path):

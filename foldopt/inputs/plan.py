@@ -36,6 +36,10 @@ from foldopt.inputs.study import Study, format_error
 DATE_KEYWORDS = ("year", "equinoxes-solstices")
 #: Fields that label a study rather than design it: a list of them is no sweep.
 UNSWEPT = ("name", "description")
+#: Axes whose parser already made each value what the study's field holds (a date), and whose
+#: value no other field's validation reads: the first case validates the rest of the study, so a
+#: study per value would validate nothing more, and a measured file's days are thousands.
+_PARSED_AXES = ("date",)
 _LIST_VALUED = list_valued_fields(Study)
 #: Every field of a study: a list under any other key is no axis (the validation names the key).
 _FIELDS = frozenset(field_paths(Study))
@@ -296,7 +300,8 @@ class Plan:
         Parameters
         ----------
         choice : dict
-            Dotted field paths to their values in this case.
+            Dotted field paths to their values in this case; an axis it leaves out is at its
+            first value.
 
         Returns
         -------
@@ -309,13 +314,23 @@ class Plan:
         key = tuple(sorted((path, repr(value)) for path, value in choice.items()))
         if key in self._studies:
             return self._studies[key]
-        data = self.data
+        data = self._skeleton
         for path, value in choice.items():
             data = set_path(data, path, value)
         study = Study.model_validate(data, context=self._read(data))
         if len(self._studies) < KEPT_STUDIES:
             self._studies[key] = study
         return study
+
+    @functools.cached_property
+    def _skeleton(self) -> dict:
+        """The study's fields with every axis at its first value: what a case's data is copied
+        from, so that a case copies one value of each axis, not every value (a measured file's
+        days are thousands, and a copy of them per case made a plan quadratic in its days)."""
+        data = self.data
+        for path, values in self.axes:
+            data = set_path(data, path, values[0])
+        return data
 
     def _read(self, data: dict):
         """What the files a case names hold, read once for every case that names the same."""
@@ -520,6 +535,8 @@ def make_plan(data, lines: dict | None = None) -> Plan:
     labels = {path: (f"{specs[path][0]}[0]", specs[path][1] + (0,)) for path in first}
     errors += _validation_errors(plan, first, lines, labels)
     for path, values in axes:
+        if path in _PARSED_AXES:
+            continue
         source, yaml_path, _ = specs[path]
         for index, value in enumerate(values[1:], start=1):
             where = {**labels, path: (f"{source}[{index}]", yaml_path + (index,))}

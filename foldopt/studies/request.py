@@ -1035,15 +1035,17 @@ def request_engine(engine: str, plan) -> str:
     """The engine of every evaluation of one request (:data:`foldopt.names.ENGINES`), decided once
     where the request enters the API (:func:`foldopt.run`, :func:`foldopt.optimize`,
     :func:`foldopt.world_map`, :func:`foldopt.reproduce`): downstream every evaluation takes it,
-    so one request's numbers come from one engine, the same every time.
+    so one request's numbers come from one engine, the one its answer records.
 
-    ``auto`` (:mod:`foldopt.engine.choice`) takes the NumPy reference path where the request's
-    clear-sky days at its fold angles come to at most
-    :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` rows x steps: a day's study, its sweeps of the
-    angle or the load, a few latitudes or days (nothing to compile). A weather file's or a cloud
-    ensemble's days, more days, a joint search over the tilt or the azimuth (some 10^4 designs),
-    a study with a buffer (whose reference path walks the time steps in Python) and a map
-    (``plan`` None: a year at every site) take the compiled kernel.
+    ``auto`` (:mod:`foldopt.engine.choice`) counts the request's clear-sky cases (its loads among
+    them: the reference path's cost grows with them) at its fold angles and steps. A day's study
+    takes the NumPy reference path; more takes the compiled kernel where numba's cache holds it
+    (:func:`foldopt.engine.choice.kernel_cached`), and before its first compile only above
+    :data:`foldopt.names.AUTO_NUMPY_ROW_STEPS` (a day's sweeps of the angle or the load, a few
+    latitudes or days compile nothing). A weather file's or a cloud ensemble's days, a joint
+    search over the tilt or the azimuth (some 10^4 designs), a study with a buffer (whose
+    reference path walks the time steps in Python) and a map (``plan`` None: a year at every
+    site) take the compiled kernel.
 
     Parameters
     ----------
