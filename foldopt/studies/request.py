@@ -698,10 +698,11 @@ def _refuse_unhonoured(command: str, run: str, study) -> None:
 def _refuse_empty_season(plan: Plan) -> None:
     """Refuse an objective whose months hold none of the plan's days: a statistic over no days
     has no value, so no fold angle can be chosen for it."""
-    from foldopt.studies.objectives import season_problem
-
     objective = plan.base.objective
     if objective is not None and objective.months:
+        # objectives' module loads scipy and numba: only for a study that names a season
+        from foldopt.studies.objectives import season_problem
+
         dates = dict(plan.axes).get("date", (plan.base.date,))
         problem = season_problem(dates, objective.months)
         if problem is not None:
