@@ -154,8 +154,16 @@ class Row:
     cache: str = "warm"
     expect: int = 0
     events: bool = False
-    #: Also time its first line on stdout (a row ``<name>: first answer line``).
+    #: Also time its first line on stdout (the row :attr:`first_line_name`).
     first_line: bool = False
+
+    @property
+    def first_line_name(self) -> str:
+        return f"{self.name}: first answer line"
+
+    def names(self) -> list[str]:
+        """The rows its runs time: its own, and its first line's."""
+        return [self.name, *([self.first_line_name] * self.first_line)]
 
 
 @dataclass
@@ -193,7 +201,7 @@ class Tree:
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as done:
             first = done.stdout.readline()
             first_seconds = time.perf_counter() - start
-            rest, stderr = done.communicate()
+            _, stderr = done.communicate()
         seconds = time.perf_counter() - start
         if done.returncode != row.expect:
             sys.exit(f"{row.name} [{self.label}]: exit code {done.returncode}, expected "
@@ -272,8 +280,7 @@ def report(trees: list[Tree], measured: list[Row], runs: int, cold_runs: int, lo
           f"python {sys.version.split()[0]}, numba {_numba()}, {time.strftime('%Y-%m-%d %H:%M %Z')}")
     print(f"load average (1, 5, 15 min): {load} at the start, "
           f"{', '.join(f'{value:.2f}' for value in os.getloadavg())} at the end")
-    names = [name for row in measured if not row.events
-             for name in (row.name, *([f"{row.name}: first answer line"] * row.first_line))]
+    names = [name for row in measured if not row.events for name in row.names()]
     if names:
         heads = "".join(f" {tree.label + ' min':>12s} {'median':>7s}" for tree in trees)
         print(f"\n{'command [s]':52s}{heads}  target")
@@ -370,8 +377,7 @@ def main() -> None:
         for tree in trees:
             tree.work.mkdir()
             print(describe(tree))
-            tree.times = {name: [] for row in measured
-                          for name in (row.name, *([f"{row.name}: first answer line"] * row.first_line))}
+            tree.times = {name: [] for row in measured for name in row.names()}
         warm = [row for row in measured if row.cache == "warm"]
         cold = [row for row in measured if row.cache == "cold" and not row.events]
         for tree in trees:  # fills the warm caches (compiles once) and the bytecode
@@ -384,7 +390,7 @@ def main() -> None:
                     for tree in (trees if count % 2 == 0 else trees[::-1]):
                         tree.times[row.name].append(tree.run(row, count))
                         if row.first_line:
-                            tree.times[f"{row.name}: first answer line"].append(tree.first_line)
+                            tree.times[row.first_line_name].append(tree.first_line)
                         if row.cache == "cold":
                             print(f"  {row.name} [{tree.label}]: {tree.times[row.name][-1]:.1f} s",
                                   file=sys.stderr)
