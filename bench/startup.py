@@ -313,7 +313,8 @@ def _target(trees: list[Tree], name: str) -> str:
     if name not in TARGETS:
         return ""
     limit, source = TARGETS[name]
-    return f"<= {limit:g} s ({source}) {' -> '.join(verdict(name, tree.times[name]) for tree in trees)}"
+    verdicts = " -> ".join(verdict(name, tree.times[name]) for tree in trees)
+    return f"<= {limit:g} s ({source}) {verdicts}"
 
 
 def compiles(name: str, tree: Tree) -> None:

@@ -99,7 +99,8 @@ def test_the_answer_prints_before_matplotlib_loads(tmp_path):
     assert code == 0, stderr
     assert MARKER.format("matplotlib") in lines and "matplotlib" in imported
     before = lines[: lines.index(MARKER.format("matplotlib"))]
-    assert before and before[0].startswith("shin2015: ") and any("best fold angle" in line for line in before)
+    assert before and before[0].startswith("shin2015: ")
+    assert any("best fold angle" in line for line in before)
     assert (tmp_path / "out" / "power_curves.png").is_file()
 
 

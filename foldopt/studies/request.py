@@ -706,7 +706,8 @@ def _refuse_empty_season(plan: Plan) -> None:
         raise ConfigError(
             [
                 f"objective.months = {list(objective.months)}: none of the {len(dates)} days "
-                f"({dates[0]} to {dates[-1]}) is in these months; give days in them, or other months"
+                f"({dates[0]} to {dates[-1]}) is in these months; give days in them, or other "
+                "months"
             ]
         )
 
