@@ -81,7 +81,7 @@ def _fold_pass(base, sites, dates, loads, threads=None, engine_name="numba"):
     import numba
 
     from foldopt.engine import evaluation as engine
-    from foldopt.physics.geometry import default_orientation
+    from foldopt.inputs.sections import default_orientation
     from foldopt.engine.sky import build_sky
     from foldopt.physics.solarposition import clock_grid, solar_position_grid
     from foldopt.studies.engine_options import engine_options
@@ -165,7 +165,7 @@ def _storage_pass(base, sites, dates, loads):
     from foldopt.engine import evaluation as engine
     from foldopt.engine import storage
     from foldopt.engine.sky import build_sky
-    from foldopt.physics.geometry import default_orientation
+    from foldopt.inputs.sections import default_orientation
     from foldopt.studies.engine_options import engine_options
 
     phases = {}

@@ -13,8 +13,11 @@ Each command runs in a fresh process (``python -m foldopt.cli.app ...``, and the
 minimum and the median of the runs are printed. The rows, measured side by side in one run:
 
 - ``python -c pass``, the interpreter alone; ``foldopt --help``, ``foldopt sweep angle --help``
-  (its options built from the name registry), a validation error (``--lat 95``: refused before
-  pvlib, pandas or matplotlib are imported), each warm;
+  (its options built from the name registry), two refusals (``sweep angle --lat 95`` and
+  ``run --set p_load=abc``: refused before pvlib, pandas, scipy, numba, numpy or matplotlib are
+  imported), each warm;
+- ``foldopt run`` printing its answer (warm, not ``-q``): the seconds to its first answer line on
+  stdout (printed before the figures are drawn) and to its end;
 - ``import foldopt`` and the studies ``foldopt run`` (the embedded study: the day, its five
   figures, report.html), ``foldopt sweep angle``, ``foldopt sweep angle --weather`` (the TMY3
   file of configs/weather), ``foldopt optimize`` (fold angle, tilt and azimuth on coarse grids)
@@ -39,9 +42,11 @@ imports is printed), and with caches of their own. This machine's environment se
 ``PYTHONDONTWRITEBYTECODE``; it is dropped for the children, whose modules are then read
 from their bytecode as after an install, rather than compiled by every process.
 
-The targets on the 2-core machine (issue 40): the first ``foldopt run`` after an install (an
-empty compile cache) 10 s, a warm ``foldopt run`` 1.5 s, ``foldopt --help`` 0.3 s; the
-validation error 0.5 s (issue 13). The other rows have none.
+The targets on the 2-core machine: the first ``foldopt run`` after an install (an empty compile
+cache) 10 s, a warm ``foldopt run`` 1.5 s, ``foldopt --help`` 0.3 s (issue 40); a warm
+``foldopt run``'s first answer line 0.5 s and its whole command 1.5 s, a refusal 0.3 s (issue 49).
+The other rows have none. The last table is issue 49's startup rows (the answer's first line, the
+whole command, the refusals), the minimum of the runs against each target.
 """
 
 from __future__ import annotations
@@ -73,6 +78,13 @@ STUDIES = {
     "map": ("foldopt map (2 sites, 1 worker)",
             ["map", "--lat", "35,40", "--lon", "-80", "--workers", "1"]),
 }
+#: The row of ``foldopt run`` printing its answer: its first line and its end are timed.
+ANSWER = "foldopt run, answer printed (warm)"
+#: The refusals' rows.
+REFUSALS = {
+    "refusal: sweep angle --lat 95": ["sweep", "angle", "--lat", "95"],
+    "refusal: run --set p_load=abc": ["run", "--set", "p_load=abc"],
+}
 #: Row name: (seconds, where the target is set).
 TARGETS = {
     "foldopt run (cold)": (10.0, "issue 40"),
@@ -80,8 +92,16 @@ TARGETS = {
     "foldopt --help": (0.3, "issue 40"),
     "foldopt --help (the script)": (0.3, "issue 40"),
     "foldopt sweep angle --help": (0.3, "issue 40"),
-    "validation error (--lat 95)": (0.5, "issue 13"),
+    ANSWER: (1.5, "issue 49"),
+    f"{ANSWER}: first answer line": (0.5, "issue 49"),
+    **{name: (0.3, "issue 49") for name in REFUSALS},
 }
+#: Issue 49's startup rows: (its words, the row name timed).
+ISSUE_49 = (
+    ("warm foldopt run: first answer line", f"{ANSWER}: first answer line"),
+    ("warm foldopt run: whole command", ANSWER),
+    *((f"a refusal ({name.split(': ')[1]})", name) for name in REFUSALS),
+)
 
 #: Run in the compile-events process: ``python -c EVENTS <json out> <foldopt arguments...>``.
 EVENTS = r'''
@@ -134,6 +154,16 @@ class Row:
     cache: str = "warm"
     expect: int = 0
     events: bool = False
+    #: Also time its first line on stdout (the row :attr:`first_line_name`).
+    first_line: bool = False
+
+    @property
+    def first_line_name(self) -> str:
+        return f"{self.name}: first answer line"
+
+    def names(self) -> list[str]:
+        """The rows its runs time: its own, and its first line's."""
+        return [self.name, *([self.first_line_name] * self.first_line)]
 
 
 @dataclass
@@ -145,6 +175,7 @@ class Tree:
     work: Path
     times: dict = field(default_factory=dict)
     left: dict = field(default_factory=dict)  # row name: what the first cold run left in the caches
+    first_line: float = 0.0  # seconds to the last run's first line on stdout
     compiles: dict = field(default_factory=dict)  # events row name: the child's JSON
 
     def environment(self, caches: Path) -> dict:
@@ -155,7 +186,8 @@ class Tree:
         return env
 
     def run(self, row: Row, count: int) -> float:
-        """Run ``row`` once in this tree; its seconds (or the compile events' file)."""
+        """Run ``row`` once in this tree; its seconds (or the compile events' file); those to its
+        first line on stdout are kept in :attr:`first_line`."""
         cold = row.cache == "cold"
         caches = Path(tempfile.mkdtemp(dir=self.work, prefix="cold-")) if cold else self.work / "warm"
         for folder in ("numba", "foldopt"):
@@ -165,12 +197,18 @@ class Tree:
         if row.events:
             command = [sys.executable, "-c", EVENTS, str(caches / "events.json"), *command[3:]]
         start = time.perf_counter()
-        done = subprocess.run(command, cwd=self.path, env=self.environment(caches),
-                              capture_output=True, text=True)
+        with subprocess.Popen(command, cwd=self.path, env=self.environment(caches),
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as done:
+            first = done.stdout.readline()
+            first_seconds = time.perf_counter() - start
+            _, stderr = done.communicate()
         seconds = time.perf_counter() - start
         if done.returncode != row.expect:
             sys.exit(f"{row.name} [{self.label}]: exit code {done.returncode}, expected "
-                     f"{row.expect}:\n{done.stderr.strip()[-2000:]}")
+                     f"{row.expect}:\n{stderr.strip()[-2000:]}")
+        if row.first_line and not first:
+            sys.exit(f"{row.name} [{self.label}]: printed nothing on stdout")
+        self.first_line = first_seconds
         if row.events:
             self.compiles[row.name] = json.loads((caches / "events.json").read_text())
         if cold:
@@ -195,7 +233,8 @@ def rows(events: list[str], script: str | None) -> list[Row]:
     found = [Row("python -c pass", [sys.executable, "-c", "pass"]),
              Row("foldopt --help", [*CLI, "--help"]),
              Row("foldopt sweep angle --help", [*CLI, "sweep", "angle", "--help"]),
-             Row("validation error (--lat 95)", [*CLI, "sweep", "angle", "--lat", "95"], expect=2)]
+             *(Row(name, [*CLI, *arguments], expect=2) for name, arguments in REFUSALS.items()),
+             Row(ANSWER, [*CLI, "run", "--out", "{out}", "--overwrite"], first_line=True)]
     if script:  # the installed script, with its entry-point lookup
         found.append(Row("foldopt --help (the script)", [script, "--help"]))
     for cache in ("warm", "cold"):
@@ -241,21 +280,19 @@ def report(trees: list[Tree], measured: list[Row], runs: int, cold_runs: int, lo
           f"python {sys.version.split()[0]}, numba {_numba()}, {time.strftime('%Y-%m-%d %H:%M %Z')}")
     print(f"load average (1, 5, 15 min): {load} at the start, "
           f"{', '.join(f'{value:.2f}' for value in os.getloadavg())} at the end")
-    timed = [row for row in measured if not row.events]
-    if timed:
+    names = [name for row in measured if not row.events for name in row.names()]
+    if names:
         heads = "".join(f" {tree.label + ' min':>12s} {'median':>7s}" for tree in trees)
-        print(f"\n{'command [s]':40s}{heads}  target")
-    for row in timed:
-        cells, verdicts = "", []
-        for tree in trees:
-            values = tree.times[row.name]
-            cells += f" {min(values):12.3f} {statistics.median(values):7.3f}"
-            verdicts.append(verdict(row.name, values))
-        target = ""
-        if row.name in TARGETS:
-            limit, source = TARGETS[row.name]
-            target = f"<= {limit:g} s ({source}) {' -> '.join(verdicts)}"
-        print(f"{row.name:40s}{cells}  {target}")
+        print(f"\n{'command [s]':52s}{heads}  target")
+    for name in names:
+        print(f"{name:52s}{_cells(trees, name)}  {_target(trees, name)}")
+    issue = [(words, name) for words, name in ISSUE_49 if name in names]
+    if issue:
+        heads = "".join(f" {tree.label + ' min':>12s} {'':7s}" for tree in trees)
+        print(f"\n{'issue 49, startup [s]':52s}{heads}  target")
+        for words, name in issue:
+            cells = "".join(f" {min(tree.times[name]):12.3f} {'':7s}" for tree in trees)
+            print(f"{words:52s}{cells}  {_target(trees, name)}")
     for tree in trees:
         if tree.left:
             print(f"\nleft in the empty caches by a cold run [{tree.label}]:")
@@ -264,6 +301,20 @@ def report(trees: list[Tree], measured: list[Row], runs: int, cold_runs: int, lo
     for row in (row for row in measured if row.events):
         for tree in trees:
             compiles(row.name, tree)
+
+
+def _cells(trees: list[Tree], name: str) -> str:
+    return "".join(f" {min(tree.times[name]):12.3f} {statistics.median(tree.times[name]):7.3f}"
+                   for tree in trees)
+
+
+def _target(trees: list[Tree], name: str) -> str:
+    """``<= limit s (source) ok`` (each tree's verdict), or nothing for a row without a target."""
+    if name not in TARGETS:
+        return ""
+    limit, source = TARGETS[name]
+    verdicts = " -> ".join(verdict(name, tree.times[name]) for tree in trees)
+    return f"<= {limit:g} s ({source}) {verdicts}"
 
 
 def compiles(name: str, tree: Tree) -> None:
@@ -327,7 +378,7 @@ def main() -> None:
         for tree in trees:
             tree.work.mkdir()
             print(describe(tree))
-            tree.times = {row.name: [] for row in measured}
+            tree.times = {name: [] for row in measured for name in row.names()}
         warm = [row for row in measured if row.cache == "warm"]
         cold = [row for row in measured if row.cache == "cold" and not row.events]
         for tree in trees:  # fills the warm caches (compiles once) and the bytecode
@@ -339,6 +390,8 @@ def main() -> None:
                 for row in group:
                     for tree in (trees if count % 2 == 0 else trees[::-1]):
                         tree.times[row.name].append(tree.run(row, count))
+                        if row.first_line:
+                            tree.times[row.first_line_name].append(tree.first_line)
                         if row.cache == "cold":
                             print(f"  {row.name} [{tree.label}]: {tree.times[row.name][-1]:.1f} s",
                                   file=sys.stderr)

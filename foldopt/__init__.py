@@ -1,7 +1,8 @@
 """foldopt: design-space optimiser for twofold photovoltaic panels powering storage-less loads.
 
 The public interface (``foldopt.__all__``) loads on first use, so that ``import foldopt`` and the
-command line's help stay fast.
+command line's help stay fast; ``__version__`` too (:mod:`importlib.metadata`, which reads the
+installed distributions, takes longer than the rest of this module).
 
 >>> import foldopt
 >>> result = foldopt.run(foldopt.default_study())
@@ -9,15 +10,10 @@ command line's help stay fast.
 """
 
 import sys
-from importlib import import_module, metadata
+from importlib import import_module
 from importlib.abc import MetaPathFinder
 from importlib.machinery import PathFinder
 from importlib.util import LazyLoader
-
-try:
-    __version__ = metadata.version("foldopt")
-except metadata.PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0+unknown"
 
 #: Public name -> the module that defines it.
 _PUBLIC = {
@@ -131,7 +127,19 @@ if "pvlib" not in sys.modules and not any(
     sys.meta_path.insert(0, _OnFirstUse())
 
 
+def _version() -> str:
+    from importlib import metadata
+
+    try:
+        return metadata.version("foldopt")
+    except metadata.PackageNotFoundError:  # running from a source tree that is not installed
+        return "0+unknown"
+
+
 def __getattr__(name: str):
+    if name == "__version__":
+        globals()[name] = _version()
+        return globals()[name]
     if name in _PUBLIC:
         value = getattr(import_module(_PUBLIC[name]), name)
         globals()[name] = value
@@ -140,4 +148,4 @@ def __getattr__(name: str):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_PUBLIC))
+    return sorted(set(globals()) | set(__all__))

@@ -120,7 +120,7 @@ def test_a_weather_file_of_a_study_that_is_a_folder_is_not_called_missing(here):
 
 @pytest.mark.parametrize("fmt", [None, "surfrad", "csv"])
 def test_the_library_refuses_a_folder_as_a_weather_file(tmp_path, fmt):
-    from foldopt.inputs.weather import measured_weather, read_weather
+    from foldopt.inputs.weather.reader import measured_weather, read_weather
 
     with pytest.raises(WeatherError, match="is a folder, not a file"):
         if fmt is None:
@@ -324,7 +324,7 @@ def test_binary_bytes_reach_no_message_raw(here, fmt):
                                       ("SRML-day-EUPO1801.txt", "srml"), ("midc_20181014.txt", "midc"),
                                       ("midc_raw_20181018.txt", "midc"), ("five_minute.csv", "csv")])
 def test_a_station_file_read_as_tmy3_names_its_likely_format(here, name, fmt):
-    from foldopt.inputs.weather import sniff_format
+    from foldopt.inputs.weather.reader import sniff_format
 
     assert sniff_format(MEASURED / name) == fmt
     (here / "station.csv").write_bytes((MEASURED / name).read_bytes())  # .csv: read as TMY3 by its extension
@@ -335,7 +335,7 @@ def test_a_station_file_read_as_tmy3_names_its_likely_format(here, name, fmt):
 
 
 def test_the_hourly_formats_are_told_by_their_content():
-    from foldopt.inputs.weather import sniff_format
+    from foldopt.inputs.weather.reader import sniff_format
 
     assert sniff_format(TMY3) == "tmy3"
     assert sniff_format(ROOT / "tests" / "data" / "horizon" / "street_canyon.csv") is None

@@ -5,7 +5,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from foldopt.physics.geometry import default_orientation, normal_vector, subpanel_orientation
+from foldopt.inputs.sections import default_orientation
+from foldopt.physics.geometry import normal_vector, subpanel_orientation
 
 tilts = st.floats(0, 90)
 azimuths = st.floats(0, 359.999)

@@ -11,7 +11,8 @@ import pytest
 import foldopt
 from foldopt.physics.atmosphere import relative_airmass
 from foldopt.engine.evaluation import poa
-from foldopt.physics.geometry import default_orientation, normal_vector, subpanel_orientation
+from foldopt.inputs.sections import default_orientation
+from foldopt.physics.geometry import normal_vector, subpanel_orientation
 from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.engine.sky import Sky
 

@@ -11,7 +11,7 @@ from foldopt.inputs.study import make_study
 from foldopt.physics.geometry import subpanel_orientation
 from foldopt.studies.day import Day
 from foldopt.studies.sweeps import objective_value
-from foldopt.inputs.weather import read_weather, weather_day
+from foldopt.inputs.weather.reader import read_weather, weather_day
 
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"  # NREL TMY3 sample pvlib ships
 SITE = {"latitude": 36.1, "longitude": -79.95, "altitude": 273, "timezone": "UTC-05:00"}
@@ -141,7 +141,7 @@ def test_epw_timestamps_move_to_interval_centres(tmp_path):
 def test_the_formats_registry_is_the_names_a_study_accepts():
     """A format is one module and one entry of FORMATS; validation and help read the names'."""
     from foldopt import names
-    from foldopt.inputs.weather import FORMATS, MEASURED_FORMATS, weather_format
+    from foldopt.inputs.weather.reader import FORMATS, MEASURED_FORMATS, weather_format
 
     assert tuple(FORMATS) + tuple(MEASURED_FORMATS) == tuple(names.WEATHER_FORMATS)
     assert tuple(FORMATS) == names.HOURLY_WEATHER_FORMATS

@@ -15,7 +15,7 @@ import pvlib
 import pytest
 
 from foldopt.errors import WeatherError
-from foldopt.inputs.weather import weather_days
+from foldopt.inputs.weather.reader import weather_days
 from foldopt import names
 from foldopt.inputs.weather.measured import STATION_FORMATS, MeasuredWeather, StationFormat, read_measured
 

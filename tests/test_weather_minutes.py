@@ -16,7 +16,7 @@ import foldopt
 from foldopt.engine.sky import build_sky
 from foldopt.inputs.study_file import with_files
 from foldopt.inputs.plan import make_plan
-from foldopt.inputs.weather import read_weather
+from foldopt.inputs.weather.reader import read_weather
 from foldopt.studies.designs import Blocks
 from foldopt.studies.sweeps import run_plan
 from test_cli import assert_one_line_error, invoke

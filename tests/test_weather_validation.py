@@ -15,7 +15,7 @@ from test_weather_year import write_epw_year
 from foldopt.inputs.plan import make_plan
 from foldopt.errors import ConfigError
 from foldopt.studies.sweeps import run_plan
-from foldopt.inputs.weather import read_weather, weather_days, weather_site
+from foldopt.inputs.weather.reader import read_weather, weather_days, weather_site
 from foldopt.errors import WeatherError
 
 DATA = Path(pvlib.__file__).parent / "data"

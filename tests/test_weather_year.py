@@ -18,7 +18,7 @@ from foldopt.engine.sky import build_sky
 from foldopt.studies.engine_options import engine_options
 from foldopt.studies.designs import sky_tracker_orientation
 from foldopt.studies.sweeps import run_plan
-from foldopt.inputs.weather import read_weather, weather_site
+from foldopt.inputs.weather.reader import read_weather, weather_site
 from foldopt.inputs.weather.downscale import interpolate_points, mean_preserving
 
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"  # NREL TMY3 sample pvlib ships

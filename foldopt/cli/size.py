@@ -150,10 +150,17 @@ def size(
     try:
         with output.progress(f"sizing {study.name}"):
             result = size_panel(areas=areas, request=request, **_parameters(costs))
-            write(result, out, overwrite, INVOCATION)
     except ConfigError as error:
         fail([_sizing_option(line) for line in error.errors])
-    output.answer("size", out, result.answer, result.table, [f"wrote {out}"], result.table)
+    output.answer(
+        "size",
+        out,
+        result.answer,
+        result.table,
+        [f"wrote {out}"],
+        result.table,
+        write=lambda: write(result, out, overwrite, INVOCATION),
+    )
 
 
 def _parameters(costs: dict) -> dict:

@@ -15,7 +15,7 @@ import pandas as pd
 from foldopt.engine.options import SkyOptions
 from foldopt.errors import WeatherError
 from foldopt.inputs.turbidity import linke_turbidity as climatology_turbidity
-from foldopt.inputs.weather import (
+from foldopt.inputs.weather.reader import (
     FORMATS,
     read_weather,
     study_weather,
@@ -218,7 +218,7 @@ def weather_light(weather, grid: ClockGrid, dates, clear: dict, solar_zenith, dn
 
 def measured_light(options: SkyOptions, grid: ClockGrid, dates):
     """Light, air temperature and wind at every step of the grid from the options' measured
-    weather file, at its own step (:func:`foldopt.inputs.weather.study_weather`)."""
+    weather file, at its own step (:func:`foldopt.inputs.weather.reader.study_weather`)."""
     weather = options.weather
     measured = study_weather(weather, options.weather_site)
     frame = measured.frame

@@ -28,7 +28,7 @@ from foldopt.engine.light import (
 from foldopt.engine.options import SkyOptions
 from foldopt.inputs.load_profile import load_shape
 from foldopt.inputs.sections import parse_timezone
-from foldopt.inputs.weather import study_weather, weather_site
+from foldopt.inputs.weather.reader import study_weather, weather_site
 from foldopt.names import CLEAR_SKIES
 from foldopt.physics.atmosphere import clear_sky_dni
 from foldopt.physics.horizon import sun_visible

@@ -79,7 +79,7 @@ class FilesRead:
     Parameters
     ----------
     weather_site : dict, optional
-        The site in the weather file's header (:func:`foldopt.inputs.weather.weather_site`).
+        The site in the weather file's header (:func:`foldopt.inputs.weather.reader.weather_site`).
     weather_problem : str, optional
         Why the weather file cannot be used: one line naming the file (and the line, the field).
     weather_missing : bool

@@ -193,12 +193,12 @@ def describe_load(study, p_load: float | None = None) -> dict:
         ``daily``), ``scale`` [-] and the ``mean_w`` and ``peak_w`` [W] of P_load(t) = scale x
         profile(t) over its daily day (weekend and monthly days aside).
     """
-    import numpy as np
-
     profile = study.load_profile
     scale = float(study.p_load if p_load is None else p_load)
     if profile is None:
         return {"p_load_w": scale}
+    import numpy as np
+
     minutes = (np.arange(1440) + 0.5) / 60.0
     day = _day(profile.daily, minutes, profile.interpolation == "linear") * scale
     name = (

@@ -150,6 +150,27 @@ class Panel(StrictModel):
     )
 
 
+def default_orientation(latitude: float) -> tuple[float, float]:
+    """The panel's orientation where a study gives none: facing the equator, tilted by |latitude|.
+
+    Parameters
+    ----------
+    latitude : float
+        Site latitude [deg north].
+
+    Returns
+    -------
+    surface_tilt, surface_azimuth : float
+        [deg]; azimuth 180 on the northern hemisphere (and the equator), 0 on the southern.
+
+    Examples
+    --------
+    >>> default_orientation(-33.9)
+    (33.9, 0.0)
+    """
+    return abs(latitude), 180.0 if latitude >= 0 else 0.0
+
+
 class Tracker(StrictModel):
     """The tracker compared against, and the energy it spends (see :mod:`foldopt.physics.trackers`).
 

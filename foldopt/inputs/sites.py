@@ -189,7 +189,7 @@ def read_sites(path: Path | str) -> list[dict]:
 
 def weather_sites(folder: Path | str) -> list[dict]:
     """One site per weather file of ``folder`` (TMY3, EPW, PVGIS JSON/CSV), in name order, each with
-    its site read from the file (:func:`foldopt.inputs.weather.weather_site`).
+    its site read from the file (:func:`foldopt.inputs.weather.reader.weather_site`).
 
     Parameters
     ----------
@@ -209,7 +209,7 @@ def weather_sites(folder: Path | str) -> list[dict]:
     foldopt.errors.WeatherError
         Where a weather file fails its checks.
     """
-    from foldopt.inputs.weather import weather_site
+    from foldopt.inputs.weather.reader import weather_site
 
     folder = Path(folder)
     if not folder.is_dir():

@@ -37,6 +37,7 @@ from foldopt.inputs.sections import (
     Panel,
     Site,
     Tracker,
+    default_orientation,
 )
 from foldopt.inputs.storage_section import Storage
 from foldopt.inputs.weather_section import Weather
@@ -341,8 +342,6 @@ class Study(StrictModel):
         site = info.data.get("site")
         if site is None:
             return panel  # a weather file's site not read yet: decided when it is
-        from foldopt.physics.geometry import default_orientation
-
         facing = dict(zip(("tilt", "azimuth"), default_orientation(site.latitude), strict=True))
         missing = {key: value for key, value in facing.items() if getattr(panel, key) is None}
         if not missing:

@@ -343,9 +343,10 @@ def resolve_files(data) -> FilesRead:
     Returns
     -------
     FilesRead
-        The weather file's site (:func:`foldopt.inputs.weather.weather_site`) and the profile's
-        day (:func:`read_profile`), or why each cannot be read; the study's validation reports
-        that where the file is needed, in the words it always used (the field, the file, the line).
+        The weather file's site (:func:`foldopt.inputs.weather.reader.weather_site`) and the
+        profile's day (:func:`read_profile`), or why each cannot be read; the study's validation
+        reports that where the file is needed, in the words it always used (the field, the file,
+        the line).
     """
     if not isinstance(data, dict):
         return FilesRead()

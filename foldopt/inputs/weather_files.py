@@ -52,7 +52,8 @@ def weather_read(weather, site=None) -> dict:
         fmt = canonical(spec.get("format"), WEATHER_FORMATS)
     except ValueError:
         return {}  # the study names the format's fault
-    from foldopt.inputs import weather as files  # pandas and pvlib: only when a file is named
+    # pandas and pvlib: only when a file is named
+    from foldopt.inputs.weather import reader as files
 
     try:
         if fmt in files.MEASURED_FORMATS:

@@ -23,27 +23,6 @@ import numpy as np
 from foldopt.names import FLAT_FOLD_ANGLE, GEOMETRIES
 
 
-def default_orientation(latitude: float) -> tuple[float, float]:
-    """Equator-facing orientation with tilt equal to |latitude|.
-
-    Parameters
-    ----------
-    latitude : float
-        Site latitude [deg north].
-
-    Returns
-    -------
-    surface_tilt, surface_azimuth : float
-        [deg]; azimuth 180 on the northern hemisphere (and the equator), 0 on the southern.
-
-    Examples
-    --------
-    >>> default_orientation(-33.9)
-    (33.9, 0.0)
-    """
-    return abs(latitude), 180.0 if latitude >= 0 else 0.0
-
-
 def _east_sign(surface_azimuth):
     # Turning toward azimuth - 90 faces east for panels facing the southern half of the sky and
     # west for those facing the northern half, so the east sub-panel turns the other way there.

@@ -48,24 +48,6 @@ def season_days(months, season=None) -> np.ndarray:
     return table[months]
 
 
-def season_problem(dates, season) -> str | None:
-    """Why an objective's season takes no day of ``dates`` (a statistic over no days has no value),
-    as one line naming ``objective.months``; None where it takes some.
-
-    Parameters
-    ----------
-    dates : sequence of datetime.date
-    season : sequence of int or None
-        ``objective.months`` [1-12].
-    """
-    if not season or season_days([date.month for date in dates], season).any():
-        return None
-    return (
-        f"objective.months = {list(season)}: none of the {len(dates)} days ({dates[0]} to "
-        f"{dates[-1]}) is in these months; give days in them, or other months"
-    )
-
-
 def objective_value(hours, months, statistic: str, season=None):
     """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
 

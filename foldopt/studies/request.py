@@ -698,14 +698,18 @@ def _refuse_unhonoured(command: str, run: str, study) -> None:
 def _refuse_empty_season(plan: Plan) -> None:
     """Refuse an objective whose months hold none of the plan's days: a statistic over no days
     has no value, so no fold angle can be chosen for it."""
-    from foldopt.studies.objectives import season_problem
-
     objective = plan.base.objective
-    if objective is not None and objective.months:
-        dates = dict(plan.axes).get("date", (plan.base.date,))
-        problem = season_problem(dates, objective.months)
-        if problem is not None:
-            raise ConfigError([problem])
+    if objective is None or not objective.months:
+        return
+    dates = dict(plan.axes).get("date", (plan.base.date,))
+    if not any(date.month in objective.months for date in dates):
+        raise ConfigError(
+            [
+                f"objective.months = {list(objective.months)}: none of the {len(dates)} days "
+                f"({dates[0]} to {dates[-1]}) is in these months; give days in them, or other "
+                "months"
+            ]
+        )
 
 
 def _set_by_run(run: str, changes: dict) -> list[str]:

@@ -1,7 +1,7 @@
 """Measured minutes against their hourly means: what a study gains or loses when it sees only a
 file's hours.
 
-For each day of a measured file (:data:`foldopt.inputs.weather.MEASURED_FORMATS`),
+For each day of a measured file (:data:`foldopt.inputs.weather.reader.MEASURED_FORMATS`),
 :func:`minute_validation` gives each design's t_solar (the flat panel, the twofold panel at its
 own best fold angle, the tracker) for every load, from three skies of the same site and day:
 
@@ -28,7 +28,7 @@ import pandas as pd
 
 from foldopt.inputs.study_file import with_files
 from foldopt.inputs.study import Study
-from foldopt.inputs.weather import study_weather
+from foldopt.inputs.weather.reader import study_weather
 from foldopt.inputs.weather.epw import write_epw
 from foldopt.studies.designs import DESIGNS, Blocks, design_metrics, fold_hours
 from foldopt.studies.objectives import best_angle_index

@@ -3,7 +3,7 @@
 Each format's module (:mod:`~foldopt.inputs.weather.tmy3`, :mod:`~foldopt.inputs.weather.epw`,
 :mod:`~foldopt.inputs.weather.pvgis`) declares one :class:`WeatherFormat`: its name, what messages
 call it, what its timestamps mark, the extensions it is detected by, where its columns come from
-and its reader. :data:`foldopt.inputs.weather.FORMATS` lists them.
+and its reader. :data:`foldopt.inputs.weather.reader.FORMATS` lists them.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ HOUR = pd.Timedelta(hours=1)
 
 @dataclass(frozen=True)
 class WeatherFormat:
-    """One weather format of :data:`foldopt.inputs.weather.FORMATS`.
+    """One weather format of :data:`foldopt.inputs.weather.reader.FORMATS`.
 
     Parameters
     ----------
@@ -66,7 +66,7 @@ class WeatherFormat:
         (tenths: 10), for a cloud ensemble (:mod:`foldopt.inputs.weather.ensemble`).
     signature : str
         A regular expression its files' first lines match, to tell the format of a file read as
-        another (:func:`foldopt.inputs.weather.sniff_format`).
+        another (:func:`foldopt.inputs.weather.reader.sniff_format`).
     """
 
     name: str

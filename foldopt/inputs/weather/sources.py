@@ -4,7 +4,7 @@ A source (:class:`WeatherSource`) asks a service for a site's weather with the r
 fetcher makes (``pvlib.iotools.get_pvgis_tmy``: the same route and parameters) and keeps the
 service's answer as it came, byte for byte, in foldopt's cache folder (``weather/`` in
 :func:`foldopt.cache.cache_dir`), so that the answer is then read as a weather file of the
-source's format (:data:`foldopt.inputs.weather.FORMATS`: ``pvgis`` for ``pvgis-tmy``) by the
+source's format (:data:`foldopt.inputs.weather.reader.FORMATS`: ``pvgis`` for ``pvgis-tmy``) by the
 reader every file takes: same checks, same frame, same site, elevation and time zone. pvlib's
 fetchers return the parsed frame, not the answer, so the request is made here with ``requests``
 (pvlib's own dependency): the cached bytes are the service's, their SHA-256 names them, and the
@@ -99,7 +99,7 @@ class WeatherSource:
     route : str
         The route after the base address (``tmy``).
     format : str
-        The weather format its answer is read as (:data:`foldopt.inputs.weather.FORMATS`), or
+        The weather format its answer is read as (:data:`foldopt.inputs.weather.reader.FORMATS`), or
         ``horizon`` for a horizon profile (:func:`foldopt.inputs.horizon.read_horizon`).
     decimals : int
         Decimals of latitude and longitude the service keeps: the site is rounded to them before
@@ -902,7 +902,7 @@ def _unreadable(path: Path, fmt: str) -> str | None:
     """Why an answer is not a readable file of its format (every check a file of it gets), or
     None."""
     if fmt != "horizon":
-        from foldopt.inputs import weather as files
+        from foldopt.inputs.weather import reader as files
 
         try:
             files.check_answer(path, fmt)

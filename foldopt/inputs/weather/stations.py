@@ -112,7 +112,7 @@ class StationFormat:
         Whether the file holds its site's latitude and longitude.
     signature : str
         A regular expression its files' first lines match, to tell the format of a file read as
-        another (:func:`foldopt.inputs.weather.sniff_format`).
+        another (:func:`foldopt.inputs.weather.reader.sniff_format`).
     """
 
     name: str

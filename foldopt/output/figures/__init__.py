@@ -111,9 +111,9 @@ FIGURES = {
 def write_figure(folder: Path, file: str, *args, **kwargs) -> str:
     """Draw the figure ``file`` with its plot function (:data:`FIGURES`) and write it in ``folder``.
 
-    The figure is a bare :class:`matplotlib.figure.Figure` (no pyplot, no backend), saved by
-    :func:`~foldopt.output.figures.canvas.save_plot` under a temporary name and renamed into place
-    (:func:`foldopt.files.write_atomically`).
+    The figure is a bare :class:`matplotlib.figure.Figure` (no pyplot, no backend), laid out by
+    its entry's margins and saved by :func:`~foldopt.output.figures.canvas.save_plot` under a
+    temporary name, then renamed into place (:func:`foldopt.files.write_atomically`).
 
     Parameters
     ----------
@@ -129,9 +129,12 @@ def write_figure(folder: Path, file: str, *args, **kwargs) -> str:
     str
         ``file``.
     """
+    figure = FIGURES[file]
     with for_files():
-        ax = FIGURES[file].plot(*args, **kwargs)
-    write_atomically(Path(folder) / file, lambda temporary: save_plot(ax, temporary))
+        ax = figure.plot(*args, **kwargs)
+    write_atomically(
+        Path(folder) / file, lambda temporary: save_plot(ax, temporary, figure.margins)
+    )
     return file
 
 

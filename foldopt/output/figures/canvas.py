@@ -5,6 +5,11 @@ A plot function draws on the ``ax`` it is given (a notebook's, with the user's b
 its own figure: a pyplot figure, which a notebook shows, or inside :func:`for_files` a bare
 :class:`matplotlib.figure.Figure`, which needs no backend and no pyplot (a PNG is drawn by Agg
 whatever backend the user chose), so that writing a results folder changes nothing of theirs.
+
+A file's figure is made at the file's resolution (:data:`DPI`) on its own Agg canvas, so that its
+layout and its draw measure text with one renderer. Its layout is the fixed :class:`Margins` its
+registry entry gives, where they serve (one Axes whose labels' size is known: a figure of one day);
+otherwise ``tight_layout``, which measures every label once more before the draw.
 """
 
 from __future__ import annotations
@@ -16,7 +21,26 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+
+#: Dots per inch of a figure file.
+DPI = 110
+
+
+class Margins(NamedTuple):
+    """A fixed layout: the space [in] between the Axes and each edge of the figure, room for the
+    tick labels, the axis labels and the title."""
+
+    left: float
+    right: float
+    bottom: float
+    top: float
+
+
+#: The margins of a figure of one Axes with a title, an axis label each side and tick labels of
+#: up to six characters (the widest a number takes before matplotlib writes an offset: 800000).
+ONE_AXES = Margins(left=0.95, right=0.3, bottom=0.65, top=0.4)
 
 
 class FigureFile(NamedTuple):
@@ -26,6 +50,8 @@ class FigureFile(NamedTuple):
     plot: Callable
     #: What it shows, in one line.
     description: str
+    #: Its fixed layout, where one serves; None lays it out by its labels (``tight_layout``).
+    margins: Margins | None = None
 
 
 #: Whether the figures made now are for files (:func:`for_files`); a context variable, so that a
@@ -76,15 +102,16 @@ def new_axes(
     if ax is not None:
         return ax.figure, ax
     if _FOR_FILES.get():
-        fig = Figure(figsize=figsize)
+        fig = Figure(figsize=figsize, dpi=DPI)
+        FigureCanvasAgg(fig)
         return fig, fig.subplots(nrows, ncols, squeeze=squeeze)
     import matplotlib.pyplot as plt
 
     return plt.subplots(nrows, ncols, figsize=figsize, squeeze=squeeze)
 
 
-def save_plot(ax, path: Path) -> Path:
-    """Save the figure that holds ``ax`` as the file ``path`` (110 dpi, tight layout) and close it.
+def save_plot(ax, path: Path, margins: Margins | None = None) -> Path:
+    """Save the figure that holds ``ax`` as the file ``path`` (:data:`DPI`) and close it.
 
     Parameters
     ----------
@@ -92,6 +119,8 @@ def save_plot(ax, path: Path) -> Path:
         An Axes of the figure, as the ``plot_*`` functions return it.
     path : pathlib.Path
         The file; its suffix gives the format (``.png``).
+    margins : Margins, optional
+        A fixed layout; default a tight layout.
 
     Returns
     -------
@@ -99,8 +128,17 @@ def save_plot(ax, path: Path) -> Path:
         ``path``.
     """
     fig = np.ravel(ax)[0].figure
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    if margins is None:
+        fig.tight_layout()
+    else:
+        width, height = fig.get_size_inches()
+        fig.subplots_adjust(
+            left=margins.left / width,
+            right=1 - margins.right / width,
+            bottom=margins.bottom / height,
+            top=1 - margins.top / height,
+        )
+    fig.savefig(path, dpi=DPI)
     if fig.canvas.manager is not None:  # a pyplot figure: pyplot keeps it until it is closed
         import matplotlib.pyplot as plt
 

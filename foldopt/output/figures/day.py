@@ -8,7 +8,7 @@ import pandas as pd
 
 from foldopt.inputs.study import Study
 from foldopt.names import FLAT_FOLD_ANGLE
-from foldopt.output.figures.canvas import FigureFile, new_axes
+from foldopt.output.figures.canvas import ONE_AXES, FigureFile, new_axes
 from foldopt.studies.day import StudyResult
 
 #: The colour of each connection of the sub-panels (and of a switching state).
@@ -293,25 +293,32 @@ def plot_standby(result: StudyResult, ax=None):
     return ax
 
 
-#: A day's results folder holds every one, in this order (each drawn from the StudyResult alone).
+#: A day's results folder holds every one, in this order (each drawn from the StudyResult alone, one
+#: Axes laid out by fixed margins).
 FIGURES = {
     "power_curves.png": FigureFile(
         plot_power_curves,
         "flat, east, west and twofold power over the day, with the load (Shin et al. Fig. 6)",
+        ONE_AXES,
     ),
     "t_solar_vs_fold_angle.png": FigureFile(
         plot_t_solar_vs_fold_angle,
         "t_solar against the fold angle, with flat, tracker and the paper's heuristic (Fig. 12a)",
+        ONE_AXES,
     ),
     "comparison.png": FigureFile(
         plot_comparison,
         "t_solar of flat, optimal twofold and every tracker, gross and net (Fig. 12b)",
+        ONE_AXES,
     ),
     "switching.png": FigureFile(
         plot_switching,
         "the sub-panels' connections and the one switching chooses over the day (Fig. 9)",
+        ONE_AXES,
     ),
     "tracker_standby.png": FigureFile(
-        plot_standby, "the tracker's net t_solar against its standby draw, and the break-even draw"
+        plot_standby,
+        "the tracker's net t_solar against its standby draw, and the break-even draw",
+        ONE_AXES,
     ),
 }

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from foldopt.output.figures.canvas import FigureFile, new_axes
+from foldopt.output.figures.canvas import ONE_AXES, FigureFile, new_axes
 from foldopt.studies.day import StudyResult
 
 #: Each design's colour, as the day's comparison draws them.
@@ -127,10 +127,12 @@ FIGURES = {
         plot_state_of_charge,
         "the buffer's state of charge over the day for flat, optimal twofold and tracker "
         "(a study with storage)",
+        ONE_AXES,
     ),
     "powered_vs_capacity.png": FigureFile(
         plot_powered_vs_capacity,
         "powered time against the buffer's capacity for flat, best twofold and tracker, where "
         "folding stops paying and each design's buffer for the target (a study with storage)",
+        ONE_AXES,
     ),
 }

@@ -1,0 +1,119 @@
+"""The import graph of a command as it runs (issue 49): a refused request and ``foldopt --help``
+load none of the heavy libraries (each of which alone costs the 0.3 s a refusal may take), and
+``foldopt run`` prints its answer before matplotlib loads for the figures.
+
+Each command runs in a fresh interpreter (``python -c PROBE``) that runs the command line as the
+``foldopt`` script does and, as it ends, prints the heavy modules it imported; a meta-path hook
+writes a marker to the process's stdout the moment a watched module is first imported, after
+flushing what the command printed before, so the order of answer and import is the order of the
+lines read back.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+#: Libraries a request's validation needs none of.
+HEAVY = ("pvlib", "pandas", "matplotlib", "scipy", "numba", "numpy")
+#: The line the probe prints where a watched module is first imported.
+MARKER = "<<imported {}>>"
+
+PROBE = r"""
+import atexit, json, runpy, sys
+
+heavy, watched, preload, args = json.loads(sys.argv[1])
+
+
+class Watch:
+    '''Marks the first import of each watched module on stdout, after what was printed before.'''
+
+    def find_spec(self, name, path=None, target=None):
+        if name in watched:
+            watched.remove(name)
+            sys.stdout.flush()
+            sys.stdout.write("<<imported %s>>\n" % name)
+            sys.stdout.flush()
+        return None
+
+
+sys.meta_path.insert(0, Watch())
+for name in preload:
+    __import__(name)
+atexit.register(lambda: print(json.dumps(sorted(m for m in heavy if m in sys.modules))))
+sys.argv = ["foldopt", *args]
+runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
+"""
+
+
+def _run(args: list[str], watched=(), preload=(), cwd=None):
+    """Run ``foldopt args`` in the probe: (exit code, stdout lines before the last, the heavy
+    modules imported, stderr)."""
+    done = subprocess.run(
+        [sys.executable, "-c", PROBE, json.dumps([HEAVY, list(watched), list(preload), args])],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=cwd,
+    )
+    lines = done.stdout.splitlines()
+    assert lines, done.stderr
+    return done.returncode, lines[:-1], json.loads(lines[-1]), done.stderr
+
+
+REFUSALS = [
+    (["sweep", "angle", "--lat", "95"], "--lat = 95.0: must be in [-90, 90] deg"),
+    (["run", "--set", "p_load=abc"], "p_load = 'abc': Input should be a valid number"),
+    (["run", "configs/camera-buffer.yaml", "--set", "storage.capacity_wh=-1"], "capacity_wh"),
+    (["sweep", "latitude", "--lat", "100:0:-5"], "--lat"),
+    (["optimize", "--tilt-range", "0:200:5"], "--tilt-range"),
+    (["sweep", "day", "--days", "1:60:7", "--set", "objective.months=[7]"], "objective.months"),
+    (["weather", "fetch", "pvgis-tmy", "--lat", "95", "--lon", "0"], "--lat = 95.0"),
+]
+
+
+@pytest.mark.parametrize(("args", "says"), REFUSALS, ids=[" ".join(a) for a, _ in REFUSALS])
+def test_a_refused_request_imports_no_heavy_library(args, says):
+    """Validating a request (the command line, the front door make_request, the study's models)
+    is refused before pvlib, pandas, matplotlib, scipy, numba or numpy load."""
+    code, _, imported, stderr = _run(args, cwd=_repository())
+    assert code == 2 and says in stderr, stderr
+    assert imported == [], f"foldopt {' '.join(args)} imported {imported}"
+
+
+@pytest.mark.parametrize("args", [["--help"], ["sweep", "angle", "--help"], ["run", "--help"]])
+def test_help_imports_no_heavy_library(args):
+    code, lines, imported, stderr = _run(args)
+    assert code == 0 and any("Usage" in line for line in lines), stderr
+    assert imported == []
+
+
+def test_the_answer_prints_before_matplotlib_loads(tmp_path):
+    """``foldopt run`` prints its answer, then loads matplotlib and draws its figures."""
+    code, lines, imported, stderr = _run(
+        ["run", "--out", str(tmp_path / "out")], watched=("matplotlib",), cwd=_repository()
+    )
+    assert code == 0, stderr
+    assert MARKER.format("matplotlib") in lines and "matplotlib" in imported
+    before = lines[: lines.index(MARKER.format("matplotlib"))]
+    assert before and before[0].startswith("shin2015: ")
+    assert any("best fold angle" in line for line in before)
+    assert (tmp_path / "out" / "power_curves.png").is_file()
+
+
+def test_the_probe_sees_an_import():
+    """The checks can fail: a module imported before the command (as a command that imported it
+    would) is reported, and its marker comes before the answer."""
+    _, _, imported, _ = _run(["sweep", "angle", "--lat", "95"], preload=("numpy",))
+    assert "numpy" in imported
+    code, lines, _, _ = _run(["--version"], watched=("matplotlib",), preload=("matplotlib",))
+    assert code == 0 and lines[0] == MARKER.format("matplotlib") and lines[1].startswith("foldopt ")
+
+
+def _repository():
+    from pathlib import Path
+
+    return Path(__file__).resolve().parents[1]
