@@ -258,10 +258,11 @@ AUTO_CACHED_NUMPY_ROW_STEPS = 1_000_000
 ENGINES = Registry(
     "engine",
     {
-        "auto": "the compiled kernel where numba's cache holds it, above "
-        f"{AUTO_CACHED_NUMPY_ROW_STEPS // 1_000_000} M rows x steps (a day's study takes the NumPy "
-        f"reference path); before its first compile, the reference path up to "
-        f"{AUTO_NUMPY_ROW_STEPS // 1_000_000} M rows x steps, with no compile wait",
+        "auto": "the compiled kernel above "
+        f"{AUTO_CACHED_NUMPY_ROW_STEPS // 1_000_000} M rows x steps where numba's cache holds it, "
+        "a day's study on the NumPy reference path; before the kernel's first compile, the "
+        f"reference path up to {AUTO_NUMPY_ROW_STEPS // 1_000_000} M rows x steps, with no "
+        "compile wait",
         "numba": "the compiled kernel",
         "numpy": "the NumPy reference path the kernel is tested against",
     },
