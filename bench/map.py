@@ -39,10 +39,9 @@ TARGET_SPEEDUP = 1.8
 
 
 def _spec(n_sites: int):
-    from foldopt.studies.worldmap import MapSpec
     from foldopt.inputs.study_file import default_study_path, read_study
     from foldopt.inputs.sites import grid_sites
-    from foldopt.studies.worldmap import map_study
+    from foldopt.studies.map_request import MapSpec, map_study
 
     n_lat = max(1, round(np.sqrt(n_sites * 0.8)))
     n_lon = -(-n_sites // n_lat)
@@ -168,8 +167,8 @@ def w5(subset: int | None, check_sites: int = 200, step_min: float = 5.0) -> Non
 
     from foldopt.inputs.study_file import default_study_path, read_study
     from foldopt.studies.cluster import run_map
-    from foldopt.studies.worldmap import MapSpec
-    from foldopt.studies.worldmap import evaluate_sites, map_study
+    from foldopt.studies.map_request import MapSpec, map_study
+    from foldopt.studies.worldmap import evaluate_sites
 
     land, sites = _land_sites(subset)
     loads = tuple(np.round(np.arange(1, 11) * 0.05, 6))
@@ -227,7 +226,7 @@ def main() -> None:
     args = parser.parse_args()
     if args.w5 and args.phases:
         from foldopt.inputs.study_file import default_study_path, read_study
-        from foldopt.studies.worldmap import map_study
+        from foldopt.studies.map_request import map_study
 
         land, sites = _land_sites(25)
         searched = {**map_study(read_study(default_study_path())[0]), "optimize": {"vary": ["fold_angle"]},

@@ -13,9 +13,9 @@ Each command runs in a fresh process (``python -m foldopt.cli.app ...``, and the
 minimum and the median of the runs are printed. The rows, measured side by side in one run:
 
 - ``python -c pass``, the interpreter alone; ``foldopt --help``, ``foldopt sweep angle --help``
-  (its options built from the name registry), two refusals (``sweep angle --lat 95`` and
-  ``run --set p_load=abc``: refused before pvlib, pandas, scipy, numba, numpy or matplotlib are
-  imported), each warm;
+  (its options built from the name registry), three refusals (``sweep angle --lat 95``,
+  ``run --set p_load=abc`` and ``map --lat 95 --lon 0``: refused before pvlib, pandas, scipy,
+  numba, numpy or matplotlib are imported), each warm;
 - ``foldopt run`` printing its answer (warm, not ``-q``): the seconds to its first answer line on
   stdout (printed before the figures are drawn) and to its end;
 - ``import foldopt`` and the studies ``foldopt run`` (the embedded study: the day, its five
@@ -84,6 +84,7 @@ ANSWER = "foldopt run, answer printed (warm)"
 REFUSALS = {
     "refusal: sweep angle --lat 95": ["sweep", "angle", "--lat", "95"],
     "refusal: run --set p_load=abc": ["run", "--set", "p_load=abc"],
+    "refusal: map --lat 95 --lon 0": ["map", "--lat", "95", "--lon", "0"],
 }
 #: Row name: (seconds, where the target is set).
 TARGETS = {

@@ -459,7 +459,7 @@ def world_map(
     loads : float, sequence of float or str
         Loads [W], or with ``relative`` fractions of each site's flat peak; text is a value, a range
         ``start:stop:step`` or a list. Checked as the command line's are
-        (:func:`foldopt.studies.worldmap.map_request`).
+        (:func:`foldopt.studies.map_request.map_request`).
     out : str or pathlib.Path
         The results folder (``map.parquet``, ``map.csv``, figures, ``report.html``, ``run.json``).
     study : dict, optional

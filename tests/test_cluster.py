@@ -20,7 +20,7 @@ from typer.testing import CliRunner
 from foldopt.cli.app import app
 from foldopt.errors import ConfigError
 from foldopt.studies.cluster import run_map
-from foldopt.studies.worldmap import MapSpec
+from foldopt.studies.map_request import MapSpec
 from foldopt.errors import OutputError
 from foldopt.studies.worldmap import evaluate_sites
 
@@ -113,7 +113,7 @@ def test_embedded_map_equals_the_computation_without_dask(embedded):
     spec_sites = [{"latitude": lat, "longitude": lon, "site_id": i}
                   for i, (lat, lon) in enumerate(zip(sites["latitude"], sites["longitude"], strict=True))]
     from foldopt.inputs.study_file import default_study_path, read_study
-    from foldopt.studies.worldmap import map_study
+    from foldopt.studies.map_request import map_study
 
     study = map_study(read_study(default_study_path())[0], step_min=15.0,
                       **{"panel.area": 0.108, "objective": {"statistic": "mean"}})

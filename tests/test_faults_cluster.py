@@ -22,7 +22,7 @@ import pandas as pd
 import pytest
 
 from foldopt.studies.cluster import run_map
-from foldopt.studies.worldmap import MapSpec
+from foldopt.studies.map_request import MapSpec
 from foldopt.studies.dask_client import connect
 from foldopt.errors import ConfigError
 from foldopt.errors import OutputError

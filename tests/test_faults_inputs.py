@@ -87,7 +87,7 @@ def test_a_csv_over_the_limit_is_refused_unread(here, args, field):
 
 
 def test_a_maps_year_is_checked_by_the_library_too():
-    from foldopt.studies.worldmap import map_study, site_study
+    from foldopt.studies.map_request import map_study, site_study
 
     study = map_study(FAST)
     with pytest.raises(ConfigError, match=r"year = 10000: must be a whole year in \[1901, 2099\]"):

@@ -143,7 +143,9 @@ def test_a_site_given_twice_in_a_sites_file_is_one_line(tmp_path, monkeypatch):
 
 def test_the_same_place_under_two_names_or_two_weather_files_is_two_sites():
     sites = [{"latitude": 30.0, "longitude": 0.0, "name": "a"}, {"latitude": 30.0, "longitude": 0.0, "name": "b"}]
-    assert len(foldopt.studies.worldmap.map_request(STUDY, 2.0, sites=sites).sites) == 2
+    from foldopt.studies.map_request import map_request
+
+    assert len(map_request(STUDY, 2.0, sites=sites).sites) == 2
 
 
 def test_a_study_files_axis_given_twice_is_one_line():

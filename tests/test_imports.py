@@ -72,6 +72,22 @@ REFUSALS = [
     (["optimize", "--tilt-range", "0:200:5"], "--tilt-range"),
     (["sweep", "day", "--days", "1:60:7", "--set", "objective.months=[7]"], "objective.months"),
     (["weather", "fetch", "pvgis-tmy", "--lat", "95", "--lon", "0"], "--lat = 95.0"),
+    # A map's request: its grid, loads, period, year, search and study, each checked before the
+    # map's evaluation (numpy, pandas, the engine) loads.
+    (["map", "--lat", "95", "--lon", "0"], "--lat: must be in [-90, 90] deg"),
+    (["map", "--lon", "200"], "--lon: must be in [-180, 180] deg"),
+    (["map", "--lat", "10:0:5"], "--lat = '10:0:5': empty range"),
+    (["map", "--lat", "abc"], "--lat = 'abc'"),
+    (["map", "--p-load", "2e7"], "--p-load = '2e7': loads must be in (0, 1e+06] W"),
+    (["map", "--p-load-fraction", "3"], "--p-load-fraction = '3': fractions must be in (0, 2]"),
+    (["map", "--show-period", "XYZ"], "--show-period = 'XYZ'"),
+    (["map", "--objective", "foo"], "--objective = 'foo'"),
+    (["map", "--year", "1000"], "--year = 1000"),
+    (["map", "--optimize", "azimuth"], "a map searches the fold angle"),
+    (["map", "--lat", "0", "--lon", "0", "--set", "panel.area=-1"], "panel.area = -1"),
+    (["map", "--lat", "0", "--lon", "0", "--set", "step_min=7"], "step_min = 7"),
+    (["map", "--sites", "no-such-sites.csv"], "--sites: file not found"),
+    (["map", "--weather-dir", "no-such-folder"], "--weather-dir: not a folder"),
 ]
 
 

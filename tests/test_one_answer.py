@@ -202,7 +202,7 @@ def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler):
     not build and check it again (it did, after the command line had). Both on the in-process
     cluster (conftest.scheduler): an embedded one (workers=1) started a process for each map,
     which imported foldopt and loaded its compiled code again."""
-    import foldopt.studies.worldmap
+    import foldopt.studies.map_request
     from foldopt.studies.request import make_request
 
     sites = tmp_path / "sites.csv"
@@ -212,7 +212,7 @@ def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler):
     request = make_request("map", options={"step_min": 60.0, "angle_step": 10.0}, where={"sites": str(sites)})
     assert [site["name"] for site in request.plan.sites] == ["quito", "oslo", "sydney"]
     assert isinstance(request.plan.study, foldopt.Study)  # what the map ships to its workers
-    monkeypatch.setattr(foldopt.studies.worldmap, "map_request", None)  # a second build would fail
+    monkeypatch.setattr(foldopt.studies.map_request, "map_request", None)  # a second build would fail
     result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", scheduler=scheduler)
     year = result.table[result.table["period"] == "year"].reset_index(drop=True)
     same_rows(document, year)

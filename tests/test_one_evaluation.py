@@ -9,7 +9,8 @@ from foldopt.engine import evaluation as engines
 from foldopt.names import TRACKERS
 from foldopt.studies import designs
 from foldopt.studies.day import run_study
-from foldopt.studies.worldmap import evaluate_sites, map_study
+from foldopt.studies.map_request import map_study
+from foldopt.studies.worldmap import evaluate_sites
 
 
 def _recorded(monkeypatch, module, name):

@@ -15,7 +15,8 @@ from foldopt.inputs.plan import make_plan
 from foldopt.inputs.sites import grid_sites, read_sites
 from foldopt.errors import ConfigError
 from foldopt.studies.sweeps import run_plan
-from foldopt.studies.worldmap import PERIODS, SEASONS, evaluate_sites, map_study
+from foldopt.studies.map_request import PERIODS, SEASONS, map_study
+from foldopt.studies.worldmap import evaluate_sites
 
 #: A coarse study keeps a year's evaluation to tens of milliseconds.
 COARSE = map_study({"name": "shin2015", "panel": {"area": 0.108, "efficiency": 0.1905}, "p_load": 2.0,
@@ -223,7 +224,7 @@ def test_a_searched_map_equals_the_full_sweep_within_the_tolerance(latitude, lon
 
 
 def test_a_map_searches_the_fold_angle_and_the_tilt_not_the_azimuth():
-    from foldopt.studies.worldmap import map_request
+    from foldopt.studies.map_request import map_request
 
     with pytest.raises(ConfigError, match="a map searches the fold angle, or the fold angle and the tilt"):
         map_request({**COARSE, "optimize": {"vary": ["fold_angle", "azimuth"]}}, [1.0], latitudes=[0], longitudes=[0])
@@ -237,7 +238,7 @@ def test_a_relative_maps_answer_has_one_line_per_load():
     division rounds, so the answer counts each load over every site."""
     from foldopt.studies.result_answers import of_map
     from foldopt.studies.cluster import MapRun
-    from foldopt.studies.worldmap import MapSpec
+    from foldopt.studies.map_request import MapSpec
 
     sites = grid_sites([-30.0, 0.0, 30.0], [0.0, 60.0], False)
     fractions = (0.1, 0.3)
@@ -280,7 +281,7 @@ def test_a_map_searching_the_tilt_answers_with_the_tilts():
     """The answer of a map with --optimize tilt says what it searched and gives the tilts it found."""
     from foldopt.studies.result_answers import of_map
     from foldopt.studies.cluster import MapRun
-    from foldopt.studies.worldmap import MapSpec
+    from foldopt.studies.map_request import MapSpec
 
     study = {**COARSE, "optimize": {"vary": ["fold_angle", "tilt"], "tilt": {"min": 0, "max": 60, "step": 30}}}
     sites = grid_sites([-20.0, 45.0], [0.0], False)

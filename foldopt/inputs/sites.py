@@ -2,7 +2,8 @@
 or not (:func:`grid_sites`, the land mask of :mod:`foldopt.inputs.land`), a table of named sites
 (:func:`read_sites`, every bad value or row reported at once) or a folder of weather files, each
 file a site (:func:`weather_sites`). Each site is what :class:`foldopt.inputs.sections.Site` takes
-(or a weather file's path and the site read from it); :mod:`foldopt.studies.worldmap` evaluates them.
+(or a weather file's path and the site read from it); :mod:`foldopt.studies.map_request` checks
+them and :mod:`foldopt.studies.worldmap` evaluates them.
 """
 
 from __future__ import annotations
@@ -11,8 +12,8 @@ import csv
 import io
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
 from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
@@ -20,6 +21,9 @@ from foldopt.inputs.horizon import read_horizon
 from foldopt.inputs.reading import MAX_CSV_BYTES, read_input
 from foldopt.inputs.sections import Site
 from foldopt.inputs.study import format_errors
+
+if TYPE_CHECKING:
+    import numpy as np
 
 #: Weather files a folder of sites may hold, by extension (pvlib's readers).
 WEATHER_SUFFIXES = (".csv", ".epw", ".json")
@@ -80,6 +84,8 @@ def lattice(values) -> np.ndarray | None:
         Ascending, from the least value to the largest by the smallest spacing; a single value is
         its own lattice.
     """
+    import numpy as np  # a map's figures and files, not its request
+
     values = np.unique(values)
     if values.size < 2:
         return values
@@ -209,8 +215,6 @@ def weather_sites(folder: Path | str) -> list[dict]:
     foldopt.errors.WeatherError
         Where a weather file fails its checks.
     """
-    from foldopt.inputs.weather.reader import weather_site
-
     folder = Path(folder)
     if not folder.is_dir():
         raise ConfigError([f"--weather-dir: not a folder: {folder}"])
@@ -223,6 +227,8 @@ def weather_sites(folder: Path | str) -> list[dict]:
         raise ConfigError(
             [f"--weather-dir {folder}: no weather files ({', '.join(WEATHER_SUFFIXES)})"]
         )
+    from foldopt.inputs.weather.reader import weather_site  # pandas and pvlib: files to read
+
     sites = []
     for path in files:
         site = weather_site(str(path), None)

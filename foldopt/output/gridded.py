@@ -26,7 +26,7 @@ import pandas as pd
 from foldopt.files import versions, write_atomically
 from foldopt.inputs.sites import lattice
 from foldopt.output.columns import UNITS, describe
-from foldopt.studies.worldmap import PERIODS
+from foldopt.studies.map_request import PERIODS
 
 #: Columns that are coordinates or labels, not variables.
 _NOT_VARIABLES = ("site_id", "site_name", "weather", "latitude", "longitude", "period")

@@ -46,7 +46,7 @@ from foldopt.files import (
     writing,
 )
 from foldopt.studies.dask_client import CONNECT_TIMEOUT, check_cluster, connect
-from foldopt.studies.worldmap import MapSpec
+from foldopt.studies.map_request import MapSpec
 from foldopt.tables import write_csv
 
 PARTS = "parts"

@@ -15,9 +15,9 @@ whichever way it is made. Its steps:
 2. **decide** (:func:`foldopt.inputs.policy.apply`): the study policy, each sweep axis's default
    range, the year of day-of-year ranges; what the answer took from the study is listed
    (:attr:`Request.taken`);
-3. **validate** (:func:`foldopt.inputs.plan.make_plan`, or :func:`foldopt.studies.worldmap.map_request`
-   for a map), reading the files the study names once; a weather file completes a partial site
-   (given fields win, the rest is the file's);
+3. **validate** (:func:`foldopt.inputs.plan.make_plan`, or
+   :func:`foldopt.studies.map_request.map_request` for a map), reading the files the study names
+   once; a weather file completes a partial site (given fields win, the rest is the file's);
 4. **refuse** what the request's run does not honour (:data:`foldopt.capabilities.CAPABILITIES`), so
    that no command ignores a section silently.
 
@@ -119,7 +119,7 @@ class Request:
     ----------
     command : str
         One of :data:`foldopt.capabilities.COMMANDS`.
-    plan : Plan or foldopt.studies.worldmap.MapSpec
+    plan : Plan or foldopt.studies.map_request.MapSpec
         What runs: the validated studies and their sweep axes, or a map's study, sites and loads.
     source : str
         The study the request started from (a file, or ``the given study``).
@@ -224,7 +224,7 @@ def make_request(
     where : mapping, optional
         A map's sites and how they are shown: ``sites``, ``weather_dir``, ``latitudes``,
         ``longitudes``, ``land_only``, ``show_period``, ``weather`` (a source's section) of
-        :func:`foldopt.studies.worldmap.map_request`, one source of sites among the grid,
+        :func:`foldopt.studies.map_request.map_request`, one source of sites among the grid,
         ``sites`` and ``weather_dir`` (:func:`_where_problems`); and ``labels``, how messages
         name them (the command line's options: ``{"latitudes": "--lat", ...}``).
     costs : mapping, optional
@@ -781,10 +781,10 @@ def _size_taken(plan: Plan, source: str, taken: list[str], costs: Mapping) -> li
 
 def _map_request(data, embedded, changes, labels, options, where, source) -> Request:
     """A map's request: its study (the study's panel and models, the map's options over them),
-    sites and loads, checked once (:func:`foldopt.studies.worldmap.map_request`), as a
-    :class:`foldopt.studies.worldmap.MapSpec`. Its messages name ``where``'s parameters by
+    sites and loads, checked once (:func:`foldopt.studies.map_request.map_request`), as a
+    :class:`foldopt.studies.map_request.MapSpec`. Its messages name ``where``'s parameters by
     ``where["labels"]`` (the command line's options), later stages' too (:attr:`Request.labels`)."""
-    from foldopt.studies.worldmap import map_request, map_study
+    from foldopt.studies.map_request import map_request, map_study
 
     where = dict(where or {})
     # a field's own label wins: --set weather.years is named so, not --years
