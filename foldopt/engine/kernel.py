@@ -43,18 +43,23 @@ ZETA_MAX = 4.0  # top of a converter's table in input / rating (foldopt.physics.
 
 @njit(cache=True, inline="always")
 def _linear(values, position):
-    index = min(int(position), values.shape[0] - 2)
+    """``values`` linear between nodes at ``position`` >= 0 [nodes]. The index is unsigned: no
+    index can wrap around, so the compiled look-up tests no sign."""
+    index = min(uint64(position), uint64(values.shape[0] - 2))
     weight = position - index
-    return values[index] * (1.0 - weight) + values[index + 1] * weight
+    return values[index] * (1.0 - weight) + values[index + uint64(1)] * weight
 
 
 @njit(cache=True, inline="always")
 def _bilinear(values, first, second):
-    i = min(int(first), values.shape[0] - 2)
-    j = min(int(second), values.shape[1] - 2)
+    """``values`` bilinear between nodes at ``first``, ``second`` >= 0 [nodes] (unsigned indices,
+    as :func:`_linear`'s)."""
+    i = min(uint64(first), uint64(values.shape[0] - 2))
+    j = min(uint64(second), uint64(values.shape[1] - 2))
     fi, fj = first - i, second - j
-    return (values[i, j] * (1.0 - fj) + values[i, j + 1] * fj) * (1.0 - fi) + (
-        values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj
+    one = uint64(1)
+    return (values[i, j] * (1.0 - fj) + values[i, j + one] * fj) * (1.0 - fi) + (
+        values[i + one, j] * (1.0 - fj) + values[i + one, j + one] * fj
     ) * fi
 
 
@@ -215,24 +220,24 @@ def _linear_connections(first, n, tables, work):
 
 
 @njit(cache=True, inline="always")
-def _table_row(b, first, last, sky, tables, need_series, work):
-    """Every asked connection's power [W] at steps ``first..last`` into ``work.power`` from the
-    electrical tables at both sub-panels' irradiance (as sqrt(E / E_max), ``work.east`` and
-    ``work.west``): table set ``sky.step_table[b, s]`` and, with weight ``sky.step_weight[b, s]``,
-    the next (both (n_blocks, n_steps)), or one set a block ((n_blocks, 1))."""
+def _table_steps(b, start, count, sky, tables, case, work):
+    """:func:`_table_row`'s loop, inlined once per case with its flags (``case``: ``per_step``,
+    ``need_series``, ``bypass`` and ``only_switching``, switching the one connection asked)
+    constants."""
+    per_step, need_series, bypass, only_switching = case
     step_table, step_weight = sky.step_table, sky.step_weight
     table_1d, table_parallel, table_series = tables.subpanel, tables.parallel, tables.series
-    bypass, panel_scale, switch_series = tables.bypass, tables.panel_scale, tables.switch_series
+    panel_scale, switch_series = tables.panel_scale, tables.switch_series
     converter_efficiency, connections = tables.converter_efficiency, tables.connections
     east, west, buffer = work.east, work.west, work.power
-    per_step = step_table.shape[1] > 1
     # One table set a block (no weather file): its tables are taken once a row.
     row_1d, row_parallel, row_series = (
         table_1d[step_table[b, 0]],
         table_parallel[step_table[b, 0]],
         table_series[step_table[b, 0]],
     )
-    for s in range(first, last + 1):
+    for i in range(count):
+        s = start + i
         root_east, root_west = east[s], west[s]
         if not per_step:
             p_east, p_west, p_parallel, p_series = _pair_powers(
@@ -264,6 +269,10 @@ def _table_row(b, first, last, sky, tables, need_series, work):
                 p_west += w * (q_west - p_west)
                 p_parallel += w * (q_parallel - p_parallel)
                 p_series += w * (q_series - p_series)
+        if only_switching:
+            # _connection_power's switching without the series pair.
+            buffer[0, s] = max(max(p_east, p_west), p_parallel)
+            continue
         p_panel = panel_scale * p_east
         for c in range(connections.shape[0]):
             buffer[c, s] = _connection_power(
@@ -276,6 +285,28 @@ def _table_row(b, first, last, sky, tables, need_series, work):
                 converter_efficiency,
                 switch_series,
             )
+
+
+@njit(cache=True, inline="always")
+def _table_row(b, first, n, sky, tables, need_series, work):
+    """Every asked connection's power [W] at steps ``first .. first + n - 1`` into ``work.power``
+    from the electrical tables at both sub-panels' irradiance (as sqrt(E / E_max), ``work.east``
+    and ``work.west``): table set ``sky.step_table[b, s]`` and, with weight
+    ``sky.step_weight[b, s]``, the next (both (n_blocks, n_steps)), or one set a block
+    ((n_blocks, 1)).
+
+    The steps are indexed as unsigned integers and the loop (:func:`_table_steps`) is inlined
+    once for switching alone from one table set a block without the series pair (every clear-sky
+    sweep's and map's), its flags constants, so that no step tests them; the other cases read
+    them at run time."""
+    start, count = uint64(first), uint64(n)
+    connections = tables.connections
+    per_step = sky.step_table.shape[1] > 1
+    if not per_step and not need_series and connections.shape[0] == 1 and connections[0] == SWITCHING:
+        _table_steps(b, start, count, sky, tables, (False, False, False, True), work)
+    else:
+        case = (per_step, need_series, tables.bypass, False)
+        _table_steps(b, start, count, sky, tables, case, work)
 
 
 @njit(cache=True, inline="always")
@@ -405,7 +436,7 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         elif not with_tables:
             _linear_connections(first, n, tables, work)
         else:
-            _table_row(b, first, last, sky, tables, need_series, work)
+            _table_row(b, first, n, sky, tables, need_series, work)
         if rows.curve[r] >= 0:
             out.power[rows.curve[r], :, first : last + 1] = work.power[:, first : last + 1]
         p_load, profile = (
