@@ -220,24 +220,24 @@ def _linear_connections(first, n, tables, work):
 
 
 @njit(cache=True, inline="always")
-def _table_steps(b, start, count, sky, tables, case, work):
-    """:func:`_table_row`'s loop, inlined once per case with its flags (``case``: ``per_step``,
-    ``need_series``, ``bypass`` and ``only_switching``, switching the one connection asked)
-    constants."""
-    per_step, need_series, bypass, only_switching = case
+def _table_row(b, first, last, sky, tables, need_series, work):
+    """Every asked connection's power [W] at steps ``first..last`` into ``work.power`` from the
+    electrical tables at both sub-panels' irradiance (as sqrt(E / E_max), ``work.east`` and
+    ``work.west``): table set ``sky.step_table[b, s]`` and, with weight ``sky.step_weight[b, s]``,
+    the next (both (n_blocks, n_steps)), or one set a block ((n_blocks, 1))."""
     step_table, step_weight = sky.step_table, sky.step_weight
     table_1d, table_parallel, table_series = tables.subpanel, tables.parallel, tables.series
-    panel_scale, switch_series = tables.panel_scale, tables.switch_series
+    bypass, panel_scale, switch_series = tables.bypass, tables.panel_scale, tables.switch_series
     converter_efficiency, connections = tables.converter_efficiency, tables.connections
     east, west, buffer = work.east, work.west, work.power
+    per_step = step_table.shape[1] > 1
     # One table set a block (no weather file): its tables are taken once a row.
     row_1d, row_parallel, row_series = (
         table_1d[step_table[b, 0]],
         table_parallel[step_table[b, 0]],
         table_series[step_table[b, 0]],
     )
-    for i in range(count):
-        s = start + i
+    for s in range(first, last + 1):
         root_east, root_west = east[s], west[s]
         if not per_step:
             p_east, p_west, p_parallel, p_series = _pair_powers(
@@ -269,10 +269,6 @@ def _table_steps(b, start, count, sky, tables, case, work):
                 p_west += w * (q_west - p_west)
                 p_parallel += w * (q_parallel - p_parallel)
                 p_series += w * (q_series - p_series)
-        if only_switching:
-            # _connection_power's switching without the series pair.
-            buffer[0, s] = max(max(p_east, p_west), p_parallel)
-            continue
         p_panel = panel_scale * p_east
         for c in range(connections.shape[0]):
             buffer[c, s] = _connection_power(
@@ -288,25 +284,51 @@ def _table_steps(b, start, count, sky, tables, case, work):
 
 
 @njit(cache=True, inline="always")
-def _table_row(b, first, n, sky, tables, need_series, work):
-    """Every asked connection's power [W] at steps ``first .. first + n - 1`` into ``work.power``
-    from the electrical tables at both sub-panels' irradiance (as sqrt(E / E_max), ``work.east``
-    and ``work.west``): table set ``sky.step_table[b, s]`` and, with weight
-    ``sky.step_weight[b, s]``, the next (both (n_blocks, n_steps)), or one set a block
-    ((n_blocks, 1)).
+def _switching_row(b, first, n, sky, tables, work):
+    """Switching's power [W] at steps ``first .. first + n - 1`` into ``work.power[0]`` from one
+    table set a block, without the series pair (every clear-sky study's and map's): the values
+    of :func:`_pair_powers` and :func:`_connection_power` by the same operations, so the same
+    bits.
 
-    The steps are indexed as unsigned integers and the loop (:func:`_table_steps`) is inlined
-    once for switching alone from one table set a block without the series pair (every clear-sky
-    sweep's and map's), its flags constants, so that no step tests them; the other cases read
-    them at run time."""
-    start, count = uint64(first), uint64(n)
-    connections = tables.connections
-    per_step = sky.step_table.shape[1] > 1
-    if not per_step and not need_series and connections.shape[0] == 1 and connections[0] == SWITCHING:
-        _table_steps(b, start, count, sky, tables, (False, False, False, True), work)
-    else:
-        case = (per_step, need_series, tables.bypass, False)
-        _table_steps(b, start, count, sky, tables, case, work)
+    :data:`foldopt.engine.records.TABLE_BLOCK` steps at a time, in two loops: the first works out
+    each step's coordinates in the tables (its nodes and the weights between them, the pair's
+    ratio a division) and vectorises; the second looks them up, which LLVM leaves a value at a
+    time (a gather a value costs it more), with nothing else left to do there."""
+    table = sky.step_table[b, 0]
+    table_1d, table_pair = tables.subpanel[table], tables.parallel[table]
+    pair = table_pair.reshape(table_pair.size)
+    n1 = table_1d.shape[0] - 1
+    n2, nr = table_pair.shape[0] - 1, table_pair.shape[1] - 1
+    top_1d, top_strong, top_ratio = uint64(n1 - 1), uint64(n2 - 1), uint64(nr - 1)
+    one, stride = uint64(1), uint64(nr + 1)
+    east, west, buffer = work.east, work.west, work.power
+    nodes, weights = work.nodes, work.weights
+    block, end = uint64(nodes.shape[1]), uint64(first + n)
+    for begin in range(uint64(first), end, block):
+        count = min(block, end - begin)
+        for i in range(count):
+            root_east, root_west = east[begin + i], west[begin + i]
+            at_east, at_west = root_east * n1, root_west * n1
+            node_east, node_west = min(uint64(at_east), top_1d), min(uint64(at_west), top_1d)
+            strong, weak = max(root_east, root_west), min(root_east, root_west)
+            root_ratio = weak / strong if strong > 0.0 else 1.0
+            at_strong, at_ratio = strong * n2, root_ratio * nr
+            node_strong = min(uint64(at_strong), top_strong)
+            node_ratio = min(uint64(at_ratio), top_ratio)
+            nodes[0, i], nodes[1, i] = node_east, node_west
+            nodes[2, i] = node_strong * stride + node_ratio
+            weights[0, i], weights[1, i] = at_east - node_east, at_west - node_west
+            weights[2, i], weights[3, i] = at_strong - node_strong, at_ratio - node_ratio
+        for i in range(count):
+            node_east, node_west, node_pair = nodes[0, i], nodes[1, i], nodes[2, i]
+            w_east, w_west, fi, fj = weights[0, i], weights[1, i], weights[2, i], weights[3, i]
+            p_east = table_1d[node_east] * (1.0 - w_east) + table_1d[node_east + one] * w_east
+            p_west = table_1d[node_west] * (1.0 - w_west) + table_1d[node_west + one] * w_west
+            fraction = (pair[node_pair] * (1.0 - fj) + pair[node_pair + one] * fj) * (1.0 - fi) + (
+                pair[node_pair + stride] * (1.0 - fj) + pair[node_pair + stride + one] * fj
+            ) * fi
+            p_parallel = min(max(fraction, 0.0), 1.0) * (p_east + p_west)
+            buffer[0, begin + i] = max(max(p_east, p_west), p_parallel)
 
 
 @njit(cache=True, inline="always")
@@ -425,6 +447,13 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     need_series = tables.switch_series
     for c in range(n_conn):
         need_series = need_series or connections[c] == SERIES
+    # Switching alone from one table set a block (every clear-sky study's and map's).
+    switching_alone = (
+        not need_series
+        and n_conn == 1
+        and connections[0] == SWITCHING
+        and sky.step_table.shape[1] == 1
+    )
     for r in range(start, stop):
         b = rows.block[r]
         first, last = sky.span[b, 0], sky.span[b, 1]
@@ -435,8 +464,10 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
             _built_row(b, first, last, sky, tables, need_series, work)
         elif not with_tables:
             _linear_connections(first, n, tables, work)
+        elif switching_alone:
+            _switching_row(b, first, n, sky, tables, work)
         else:
-            _table_row(b, first, n, sky, tables, need_series, work)
+            _table_row(b, first, last, sky, tables, need_series, work)
         if rows.curve[r] >= 0:
             out.power[rows.curve[r], :, first : last + 1] = work.power[:, first : last + 1]
         p_load, profile = (
