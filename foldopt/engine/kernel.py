@@ -33,8 +33,8 @@ from typing import NamedTuple
 from numba import njit, uint64
 
 from foldopt.engine.incidence import incidence, steps_sum
-from foldopt.engine.curve_reduction import day_metrics
-from foldopt.engine.records import in_chunks
+from foldopt.engine.curve_reduction import blocked_day, day_metrics
+from foldopt.engine.records import WALK_BLOCK, in_chunks
 
 # Connection codes; the order of foldopt.physics.connections.CONNECTIONS, plus the whole (unfolded) panel.
 EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
@@ -284,27 +284,49 @@ def _table_row(b, first, last, sky, tables, need_series, work):
 
 
 @njit(cache=True, inline="always")
+def _switching_power(i, table_1d, pair, stride, work):
+    """Switching's power [W] at the ``i``-th step of a block of :func:`_switching_row`, from its
+    coordinates in the tables (``work.nodes`` and ``work.weights``)."""
+    one, nodes, weights = uint64(1), work.nodes, work.weights
+    node_east, node_west, node_pair = nodes[0, i], nodes[1, i], nodes[2, i]
+    w_east, w_west, fi, fj = weights[0, i], weights[1, i], weights[2, i], weights[3, i]
+    p_east = table_1d[node_east] * (1.0 - w_east) + table_1d[node_east + one] * w_east
+    p_west = table_1d[node_west] * (1.0 - w_west) + table_1d[node_west + one] * w_west
+    fraction = (pair[node_pair] * (1.0 - fj) + pair[node_pair + one] * fj) * (1.0 - fi) + (
+        pair[node_pair + stride] * (1.0 - fj) + pair[node_pair + stride + one] * fj
+    ) * fi
+    p_parallel = min(max(fraction, 0.0), 1.0) * (p_east + p_west)
+    return max(max(p_east, p_west), p_parallel)
+
+
+@njit(cache=True, inline="always")
 def _switching_row(b, first, n, sky, tables, work):
     """Switching's power [W] at steps ``first .. first + n - 1`` into ``work.power[0]`` from one
     table set a block, without the series pair (every clear-sky study's and map's): the values
     of :func:`_pair_powers` and :func:`_connection_power` by the same operations, so the same
-    bits.
+    bits. Returns the sum of the steps' power [W] and its peak [W], the bits of
+    :func:`day_metrics`' (the same operations in the same order), and writes each walking
+    block's lowest and highest power to ``work.low`` and ``work.high``
+    (:func:`foldopt.engine.curve_reduction.blocked_day`).
 
     :data:`foldopt.engine.records.TABLE_BLOCK` steps at a time, in two loops: the first works out
     each step's coordinates in the tables (its nodes and the weights between them, the pair's
     ratio a division) and vectorises; the second looks them up, which LLVM leaves a value at a
-    time (a gather a value costs it more), with nothing else left to do there."""
+    time (a gather a value costs it more), with the sums that wait on each addition beside it."""
     table = sky.step_table[b, 0]
     table_1d, table_pair = tables.subpanel[table], tables.parallel[table]
     pair = table_pair.reshape(table_pair.size)
     n1 = table_1d.shape[0] - 1
     n2, nr = table_pair.shape[0] - 1, table_pair.shape[1] - 1
     top_1d, top_strong, top_ratio = uint64(n1 - 1), uint64(n2 - 1), uint64(nr - 1)
-    one, stride = uint64(1), uint64(nr + 1)
+    stride = uint64(nr + 1)
     east, west, buffer = work.east, work.west, work.power
-    nodes, weights = work.nodes, work.weights
-    block, end = uint64(nodes.shape[1]), uint64(first + n)
-    for begin in range(uint64(first), end, block):
+    nodes, weights, low, high = work.nodes, work.weights, work.low, work.high
+    block, end, walk = uint64(nodes.shape[1]), uint64(first + n), uint64(WALK_BLOCK)
+    start = uint64(first)
+    # -0.0 adds nothing to any value, so the sum is the first step's power plus the others'.
+    harvested, peak = -0.0, 0.0
+    for begin in range(start, end, block):
         count = min(block, end - begin)
         for i in range(count):
             root_east, root_west = east[begin + i], west[begin + i]
@@ -319,16 +341,19 @@ def _switching_row(b, first, n, sky, tables, work):
             nodes[2, i] = node_strong * stride + node_ratio
             weights[0, i], weights[1, i] = at_east - node_east, at_west - node_west
             weights[2, i], weights[3, i] = at_strong - node_strong, at_ratio - node_ratio
-        for i in range(count):
-            node_east, node_west, node_pair = nodes[0, i], nodes[1, i], nodes[2, i]
-            w_east, w_west, fi, fj = weights[0, i], weights[1, i], weights[2, i], weights[3, i]
-            p_east = table_1d[node_east] * (1.0 - w_east) + table_1d[node_east + one] * w_east
-            p_west = table_1d[node_west] * (1.0 - w_west) + table_1d[node_west + one] * w_west
-            fraction = (pair[node_pair] * (1.0 - fj) + pair[node_pair + one] * fj) * (1.0 - fi) + (
-                pair[node_pair + stride] * (1.0 - fj) + pair[node_pair + stride + one] * fj
-            ) * fi
-            p_parallel = min(max(fraction, 0.0), 1.0) * (p_east + p_west)
-            buffer[0, begin + i] = max(max(p_east, p_west), p_parallel)
+        if begin == start:
+            peak = _switching_power(0, table_1d, pair, stride, work)
+        for part in range(uint64(0), count, walk):
+            lowest, highest = math.inf, -math.inf
+            for i in range(part, min(part + walk, count)):
+                power = _switching_power(i, table_1d, pair, stride, work)
+                buffer[0, begin + i] = power
+                lowest, highest = min(lowest, power), max(highest, power)
+                harvested += power
+                peak = max(peak, power)
+            low[(begin - start + part) // walk] = lowest
+            high[(begin - start + part) // walk] = highest
+    return harvested, peak
 
 
 @njit(cache=True, inline="always")
@@ -449,11 +474,21 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         need_series = need_series or connections[c] == SERIES
     # Switching alone from one table set a block (every clear-sky study's and map's).
     switching_alone = (
-        not need_series
+        with_tables
+        and not tables.as_built
+        and not need_series
         and n_conn == 1
         and connections[0] == SWITCHING
         and sky.step_table.shape[1] == 1
     )
+    # ... and its walk over the loads by blocks, for constant loads without their longest runs.
+    blocked = switching_alone and not loads.contiguous and not loads.use_profile
+    held = work.held
+    if held.shape[0] > 0:
+        held[0] = loads.step_hours
+        for k in range(1, held.shape[0]):
+            held[k] = held[k - 1] + loads.step_hours
+    harvested = peak = 0.0
     for r in range(start, stop):
         b = rows.block[r]
         first, last = sky.span[b, 0], sky.span[b, 1]
@@ -465,7 +500,7 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         elif not with_tables:
             _linear_connections(first, n, tables, work)
         elif switching_alone:
-            _switching_row(b, first, n, sky, tables, work)
+            harvested, peak = _switching_row(b, first, n, sky, tables, work)
         else:
             _table_row(b, first, last, sky, tables, need_series, work)
         if rows.curve[r] >= 0:
@@ -474,6 +509,10 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
             loads.p_load[rows.loadset[r]],
             loads.profile[b if loads.use_profile else 0],
         )
+        if blocked:
+            out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
+            blocked_day(work.power[0], (first, last), p_load, loads.step_hours, work, out.t_solar[r, 0])
+            continue
         for c in range(n_conn):
             out.energy[r, c], out.peak[r, c] = day_metrics(
                 work.power[c],
