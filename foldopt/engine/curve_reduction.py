@@ -159,15 +159,6 @@ def _bounds(loads, position):
 
 
 @njit(cache=True, inline="always")
-def _shares(p_load, lo_at, hi_at, previous, p, step_hours, above):
-    """The loads ``lo_at .. hi_at - 1``, strictly inside the range of the segment from
-    ``previous`` to ``p``, each take a share of it."""
-    lo, hi = min(previous, p), max(previous, p)
-    for j in range(lo_at, hi_at):
-        above[j] += step_hours * (hi - p_load[j]) / (hi - lo)
-
-
-@njit(cache=True, inline="always")
 def _run_length(start, count, step_hours, held):
     """A run's length [h]: ``count`` steps added one by one to its first length ``start``, or
     (``start`` < 0) to one step, which ``held`` has summed already (:attr:`Scratch.held`)."""
@@ -218,21 +209,15 @@ def blocked_day(power, span, p_load, step_hours, work, t_out):
         for s in range(begin, end):
             p = power[s]
             lo_at = position
-            if p >= upper and position < n_loads:
-                # Up across a load or more (_walk's first loop): they take a share of the segment.
-                at = position + 1
-                while at < n_loads and p_load[at] <= p:
-                    at += 1
-                _shares(p_load, position, at, previous, p, step_hours, above)
+            if not (lower <= p and p < upper):
+                at = _walk(p_load, position, p)
+                lo_at, hi_at = min(position, at), max(position, at)
+                if hi_at > lo_at:
+                    # The loads strictly inside the segment's range take a share of it.
+                    lo, hi = min(previous, p), max(previous, p)
+                    for j in range(lo_at, hi_at):
+                        above[j] += step_hours * (hi - p_load[j]) / (hi - lo)
                 position = at
-                lower, upper = _bounds(p_load, position)
-            elif p < lower:
-                # Down across a load or more (its second).
-                at = position - 1
-                while at > 0 and p_load[at - 1] > p:
-                    at -= 1
-                _shares(p_load, at, position, previous, p, step_hours, above)
-                lo_at = position = at
                 lower, upper = _bounds(p_load, position)
             if lo_at == run_at:
                 count += 1
