@@ -284,10 +284,10 @@ def _table_row(b, first, last, sky, tables, need_series, work):
 
 
 @njit(cache=True, inline="always")
-def _switching_power(i, table_1d, pair, stride, work):
+def _switching_power(i, table_1d, pair, stride, nodes, weights):
     """Switching's power [W] at the ``i``-th step of a block of :func:`_switching_row`, from its
-    coordinates in the tables (``work.nodes`` and ``work.weights``)."""
-    one, nodes, weights = uint64(1), work.nodes, work.weights
+    coordinates in the tables (``nodes`` and ``weights``)."""
+    one = uint64(1)
     node_east, node_west, node_pair = nodes[0, i], nodes[1, i], nodes[2, i]
     w_east, w_west, fi, fj = weights[0, i], weights[1, i], weights[2, i], weights[3, i]
     p_east = table_1d[node_east] * (1.0 - w_east) + table_1d[node_east + one] * w_east
@@ -342,11 +342,11 @@ def _switching_row(b, first, n, sky, tables, work):
             weights[0, i], weights[1, i] = at_east - node_east, at_west - node_west
             weights[2, i], weights[3, i] = at_strong - node_strong, at_ratio - node_ratio
         if begin == start:
-            peak = _switching_power(0, table_1d, pair, stride, work)
+            peak = _switching_power(0, table_1d, pair, stride, nodes, weights)
         for part in range(uint64(0), count, walk):
             lowest, highest = math.inf, -math.inf
             for i in range(part, min(part + walk, count)):
-                power = _switching_power(i, table_1d, pair, stride, work)
+                power = _switching_power(i, table_1d, pair, stride, nodes, weights)
                 buffer[0, begin + i] = power
                 lowest, highest = min(lowest, power), max(highest, power)
                 harvested += power
