@@ -511,7 +511,19 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         )
         if blocked:
             out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
-            blocked_day(work.power[0], (first, last), p_load, loads.step_hours, work, out.t_solar[r, 0])
+            blocked_day(
+                work.power[0],
+                first,
+                last,
+                p_load,
+                loads.step_hours,
+                work.above,
+                work.whole,
+                held,
+                work.low,
+                work.high,
+                out.t_solar[r, 0],
+            )
             continue
         for c in range(n_conn):
             out.energy[r, c], out.peak[r, c] = day_metrics(
