@@ -12,7 +12,9 @@ segment from ``lo`` to ``hi`` of length ``dt`` is above a load ``L`` for
 ``lo`` take the whole segment: one entry of a difference array, summed from the top at the end;
 only the loads inside the segment's range take a share. The position of the power among the loads
 moves by a few loads a step, so it is walked from the previous step instead of searched. A day's
-cost is then O(steps + loads x crossings), not O(steps x loads).
+cost is then O(steps + loads x crossings), not O(steps x loads). Given each block of steps' lowest
+and highest power (the kernel's switching pass notes them), :func:`blocked_day` walks only the
+blocks that cross a load.
 
 Rows are split into chunks, a few per thread (:func:`foldopt.engine.records.in_chunks`), and each
 chunk has its own scratch, allocated by the caller (:func:`foldopt.engine.records.allocate`) and

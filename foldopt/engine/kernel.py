@@ -7,10 +7,13 @@ beam's incidence (or Shin et al.'s Eq. 5 in paper mode), and the beam with the o
 incidence-angle modifier and the diffuse terms give each sub-panel's plane-of-array irradiance.
 The second looks up the electrical tables (or, for the ideal model, scales the irradiance) and
 writes every asked connection's power to a buffer of one day, reused by the next row (with the
-circuit as built, :func:`_built_row`). The third reduces each power curve to the daily metrics of
-every load at once (:func:`foldopt.engine.curve_reduction.day_metrics`). The inputs come as the named
-records of :mod:`foldopt.engine.records` (the sky, the rows, the tables, the loads, the outputs and
-the per-chunk scratch of :func:`foldopt.engine.records.allocate`).
+circuit as built, :func:`_built_row`; switching alone from one table set a block, the common case,
+in two loops of its own, :func:`_switching_row`). The third reduces each power curve to the daily
+metrics of every load at once (:func:`foldopt.engine.curve_reduction.day_metrics`; after
+:func:`_switching_row`, :func:`foldopt.engine.curve_reduction.blocked_day`, which skips the blocks
+of steps that cross no load). The inputs come as the named records of
+:mod:`foldopt.engine.records` (the sky, the rows, the tables, the loads, the outputs and the
+per-chunk scratch of :func:`foldopt.engine.records.allocate`).
 
 Where the time goes: a loop vectorises only if LLVM can see that no index wraps around (the steps
 are indexed as unsigned integers) and that nothing in it depends on a setting known only at run
@@ -18,8 +21,9 @@ time. So the loops are written once and inlined once per case, each case's setti
 constants (the incidence per mode, diffuse terms and modifier; the ideal model's power per
 connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
 (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
-loop, not called (what each choice was worth: ``docs/performance.rst``, from ``bench/map.py --w5
---phases``).
+loop, not called. A function run at every step takes arrays, not records: each array of a record
+handed to it would be counted and released at every step. (What each choice was worth:
+``docs/performance.rst``.)
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -311,8 +315,9 @@ def _switching_row(b, first, n, sky, tables, work):
 
     :data:`foldopt.engine.records.TABLE_BLOCK` steps at a time, in two loops: the first works out
     each step's coordinates in the tables (its nodes and the weights between them, the pair's
-    ratio a division) and vectorises; the second looks them up, which LLVM leaves a value at a
-    time (a gather a value costs it more), with the sums that wait on each addition beside it."""
+    ratio a division) and vectorises; the second looks them up a value at a time (LLVM prices a
+    gather on this CPU above the loads it replaces) with the sums that wait on each addition
+    beside them, where they cost nothing more."""
     table = sky.step_table[b, 0]
     table_1d, table_pair = tables.subpanel[table], tables.parallel[table]
     pair = table_pair.reshape(table_pair.size)
@@ -484,11 +489,10 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     # ... and its walk over the loads by blocks, for constant loads without their longest runs.
     blocked = switching_alone and not loads.contiguous and not loads.use_profile
     held = work.held
-    if held.shape[0] > 0:
-        held[0] = loads.step_hours
-        for k in range(1, held.shape[0]):
-            held[k] = held[k - 1] + loads.step_hours
-    harvested = peak = 0.0
+    held[0] = loads.step_hours
+    for k in range(1, held.shape[0]):
+        held[k] = held[k - 1] + loads.step_hours
+    harvested = peak = 0.0  # the day's sum and peak of switching's pass, when it is taken
     for r in range(start, stop):
         b = rows.block[r]
         first, last = sky.span[b, 0], sky.span[b, 1]
