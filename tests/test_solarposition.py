@@ -293,3 +293,22 @@ def test_hour_nodes_are_uniques_and_their_places(spread_ns):
     expected = np.unique(np.concatenate([hours.ravel(), hours.ravel() + 1]))
     np.testing.assert_array_equal(nodes, expected)
     np.testing.assert_array_equal(index, np.searchsorted(expected, hours))
+
+
+def test_the_per_site_pass_on_threads_has_the_bits_of_one(monkeypatch):
+    """SPA's per-site pass over many blocks runs on numba's threads, a slice of the blocks each: the
+    same bits as one pass (each block's steps are its own)."""
+    import numba
+
+    import foldopt.physics.spa as spa
+    from foldopt.physics.solarposition import clock_grid
+
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 365, 30)]
+    grid = clock_grid(dates, "UTC", 30)
+    latitude = np.linspace(-80, 80, len(dates))[:, None]
+    one = spa.spa_solar_position(grid.utc_ns, latitude, 20.0, 100.0)
+    monkeypatch.setattr(spa, "SITE_STEPS_A_THREAD", 1)
+    monkeypatch.setattr(numba, "get_num_threads", lambda: 3)
+    threads = spa.spa_solar_position(grid.utc_ns, latitude, 20.0, 100.0)
+    for a, b in zip(one, threads, strict=True):
+        np.testing.assert_array_equal(a, b)

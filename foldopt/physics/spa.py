@@ -264,7 +264,7 @@ def _raised(east, north, up, t):
     return east * along, north * along, up * cos_t + level * sin_t
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _site_sun(
     terms,
     first,
@@ -316,6 +316,27 @@ def _site_sun(
                 elevation += refraction
             direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
             apparent_zenith[b, i] = 90.0 - elevation
+
+
+SITE_STEPS_A_THREAD = 100_000  # blocks x steps below which the per-site pass keeps one thread
+
+
+def _by_blocks(run, shape) -> None:
+    """``run(part)`` over slices of the blocks of ``shape`` (n_blocks, n_steps), on numba's
+    threads: :func:`_site_sun` releases the GIL, and its blocks are independent."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from numba import get_num_threads
+
+    threads = min(get_num_threads(), shape[0], max(1, shape[0] * shape[1] // SITE_STEPS_A_THREAD))
+    edges = np.linspace(0, shape[0], threads + 1).astype(int)
+    parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    if threads == 1:
+        run(parts[0])
+        return
+    with ThreadPoolExecutor(threads, thread_name_prefix="foldopt-sun") as pool:
+        for done in [pool.submit(run, part) for part in parts]:
+            done.result()  # a part's error, raised here
 
 
 def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerms | None = None):
@@ -379,19 +400,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     vector = np.empty((shape[0], 3, shape[1]))
     apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
     pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
-    _site_sun(
-        terms,
-        first,
-        np.sin(lam),
-        np.cos(lam),
-        np.sin(phi),
-        np.cos(phi),
-        x,
-        y,
-        pressure,
-        vector,
-        apparent_zenith,
-        solar_azimuth,
-    )
+    per_site = (first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure)
+    outputs = (vector, apparent_zenith, solar_azimuth)
+    _by_blocks(lambda part: _site_sun(terms, *(a[part] for a in per_site + outputs)), shape)
     equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
     return apparent_zenith, solar_azimuth, equation_of_time, np.moveaxis(vector, 1, -1)
