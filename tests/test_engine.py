@@ -246,3 +246,27 @@ def test_run_plan_is_the_same_on_both_engines():
     # No design carries 40 W: every angle ties at zero and the flat panel is reported.
     high = tables["numba"][(tables["numba"].p_load_w == 40.0) & (tables["numba"].design == "twofold")]
     assert (high["fold_angle_deg"] == 180.0).all() and (high["t_solar_h"] == 0).all()
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=cases(), tie=st.integers(0, 10**6))
+def test_each_output_alone_has_its_bits_among_all(case, tie):
+    """The kernel's loops for one output (switching from one table set a block; its walk over
+    the loads by blocks of steps, without the longest runs) do the general loops' operations in
+    their order: an output asked alone, with or without its longest runs, has the bits it has
+    among every output. Some loads are the curve's own samples, so that the power ties a load."""
+    study, sites, dates, angles, loads = case
+    sky, rows, electrical = _sky(study, sites, dates), _rows(study, sites, angles), engine_options(study).electrical
+    every = engine.row_metrics(sky, rows=rows, loads=[1.0], electrical=electrical, outputs=engine.OUTPUTS,
+                               contiguous=True, engine="numba", curves=[0])
+    curve = every.power[0].ravel()
+    loads = np.r_[loads / 60 * max(every.peak.max(), 1e-3), curve[tie % curve.size], every.peak[0, -2]]
+    every = engine.row_metrics(sky, rows=rows, loads=loads, electrical=electrical, outputs=engine.OUTPUTS,
+                               contiguous=True, engine="numba")
+    for index, name in enumerate(engine.OUTPUTS):
+        for contiguous in (False, True):
+            alone = engine.row_metrics(sky, rows=rows, loads=loads, electrical=electrical, outputs=(name,),
+                                       contiguous=contiguous, engine="numba")
+            for field in ("t_solar", "energy", "peak"):
+                np.testing.assert_array_equal(getattr(alone, field)[:, 0], getattr(every, field)[:, index])
+            np.testing.assert_array_equal(alone.irradiation, every.irradiation)

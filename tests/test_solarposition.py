@@ -253,3 +253,62 @@ def test_the_sun_keeps_nothing_between_calls():
     mutable = [name for name, value in vars(spa).items()
                if isinstance(value, (dict, list, set, tuple)) and not name.startswith("__")]
     assert mutable == ["_WRAPPED"], mutable  # a constant tuple of names
+
+
+def test_a_lattice_evaluates_only_the_instants_its_days_span(monkeypatch):
+    """Days spread over a year on one lattice (a sweep's 24 days, W2's sites) evaluate SPA's
+    time-only terms at their own instants, not at every step between the first and the last; a
+    later call evaluates only what no call has, and every answer is the direct evaluation's bits."""
+    import foldopt.physics.spa as spa
+    from foldopt.physics.solarposition import clock_grid
+
+    evaluated = []
+
+    def counted(utc_ns, sun_terms):
+        evaluated.append(np.size(utc_ns))
+        return direct_equatorial(utc_ns, sun_terms)
+
+    direct_equatorial = spa._equatorial
+    monkeypatch.setattr(spa, "_equatorial", counted)
+    dates = [dt.date(2025, m, d) for m in range(1, 13) for d in (1, 15)]
+    grid = clock_grid(dates, "UTC", 10)
+    kept = spa.SunTerms()
+    first, terms = kept.on_lattice(grid.utc_ns[::2])
+    assert evaluated == [12 * 144]
+    first, terms = kept.on_lattice(grid.utc_ns)
+    assert evaluated == [12 * 144, 12 * 144]
+    again = np.stack([terms[:, start:start + 144] for start in first], axis=1)
+    np.testing.assert_array_equal(again, direct_equatorial(grid.utc_ns, spa.SunTerms()))
+
+
+@pytest.mark.parametrize("spread_ns", [3.6e12 * 24 * 400, 3.6e12 * 24 * 365 * 200])
+def test_hour_nodes_are_uniques_and_their_places(spread_ns):
+    """The hours an interpolation reads (SPA's geocentric terms): those of np.unique and
+    np.searchsorted, for instants over a year and over centuries (the two ways they are found)."""
+    from foldopt.physics.spa import NS_PER_HOUR, _hour_nodes
+
+    utc_ns = np.random.default_rng(3).integers(0, int(spread_ns), (40, 30))
+    hours = np.floor_divide(utc_ns, NS_PER_HOUR)
+    nodes, index = _hour_nodes(hours)
+    expected = np.unique(np.concatenate([hours.ravel(), hours.ravel() + 1]))
+    np.testing.assert_array_equal(nodes, expected)
+    np.testing.assert_array_equal(index, np.searchsorted(expected, hours))
+
+
+def test_the_per_site_pass_on_threads_has_the_bits_of_one(monkeypatch):
+    """SPA's per-site pass over many blocks runs on numba's threads, a slice of the blocks each: the
+    same bits as one pass (each block's steps are its own)."""
+    import numba
+
+    import foldopt.physics.spa as spa
+    from foldopt.physics.solarposition import clock_grid
+
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in range(0, 365, 30)]
+    grid = clock_grid(dates, "UTC", 30)
+    latitude = np.linspace(-80, 80, len(dates))[:, None]
+    one = spa.spa_solar_position(grid.utc_ns, latitude, 20.0, 100.0)
+    monkeypatch.setattr(spa, "SITE_STEPS_A_THREAD", 1)
+    monkeypatch.setattr(numba, "get_num_threads", lambda: 3)
+    threads = spa.spa_solar_position(grid.utc_ns, latitude, 20.0, 100.0)
+    for a, b in zip(one, threads, strict=True):
+        np.testing.assert_array_equal(a, b)

@@ -12,7 +12,9 @@ segment from ``lo`` to ``hi`` of length ``dt`` is above a load ``L`` for
 ``lo`` take the whole segment: one entry of a difference array, summed from the top at the end;
 only the loads inside the segment's range take a share. The position of the power among the loads
 moves by a few loads a step, so it is walked from the previous step instead of searched. A day's
-cost is then O(steps + loads x crossings), not O(steps x loads).
+cost is then O(steps + loads x crossings), not O(steps x loads). Given each block of steps' lowest
+and highest power (the kernel's switching pass notes them), :func:`blocked_day` walks only the
+blocks that cross a load.
 
 Rows are split into chunks, a few per thread (:func:`foldopt.engine.records.in_chunks`), and each
 chunk has its own scratch, allocated by the caller (:func:`foldopt.engine.records.allocate`) and
@@ -26,7 +28,7 @@ import math
 import numpy as np
 from numba import njit
 
-from foldopt.engine.records import in_chunks
+from foldopt.engine.records import WALK_BLOCK, in_chunks
 
 
 @njit(cache=True, inline="always")
@@ -147,6 +149,98 @@ def _day_steps(power, span, p_load, profile, held, work, t_out, cont_out):
         if contiguous:
             cont_out[j] = max(run[j, 0], run[j, 1])
     return harvested * step_hours, peak
+
+
+@njit(cache=True, inline="always")
+def _bounds(loads, position):
+    """The loads either side of ``position`` (:func:`_walk`'s): the power stays at it while
+    ``lower <= power < upper``."""
+    lower = loads[position - 1] if position > 0 else -math.inf
+    upper = loads[position] if position < loads.shape[0] else math.inf
+    return lower, upper
+
+
+@njit(cache=True, inline="always")
+def _run_length(start, count, step_hours, held):
+    """A run's length [h]: ``count`` steps added one by one to its first length ``start``, or
+    (``start`` < 0) to one step, which ``held`` has summed already (:attr:`Scratch.held`)."""
+    if start < 0.0:
+        return held[count]
+    for _ in range(count):
+        start += step_hours
+    return start
+
+
+@njit(cache=True, nogil=True)
+def blocked_day(power, first, last, p_load, step_hours, above, whole, held, low, high, t_out):
+    """t_solar of every load of ``p_load`` (ascending) of one power curve [W] into ``t_out``, as
+    :func:`day_metrics` for constant loads without their longest runs, walking steps
+    ``first..last`` (its ``span``), given the lowest and the highest power (``low``, ``high``)
+    of each block of :data:`foldopt.engine.records.WALK_BLOCK` steps from ``first`` and the
+    lengths of runs of steps (``held``); ``above`` and ``whole`` are scratch, as the rest of a
+    chunk's :class:`foldopt.engine.records.Scratch`.
+
+    A block whose power stays between the same two loads adds whole steps to the run at its
+    place among them and is not walked: a clear day's curve spends most of its steps above
+    every load, below them all, or between two, and only the blocks where it crosses a load are
+    walked step by step. A run's steps are counted and its length taken from ``held``: the same
+    additions of the step in the same order as :func:`_day_steps`' pending sum, so that every
+    value is the same bits. It is called, not inlined, with arrays rather than records: the
+    kernel compiles faster, and the call costs less than the machine's noise."""
+    n_steps, n_loads, size = power.shape[0], p_load.shape[0], low.shape[0]
+    above[:] = 0.0
+    whole[:] = 0.0
+    previous = power[first]
+    position = _walk(p_load, 0, previous)
+    lower, upper = _bounds(p_load, position)
+    # The run: where it is among the loads, its first length and the steps added to it since.
+    run_at, run_start, count = position, (first + 0.5) * step_hours, 0
+    begin = first + 1
+    for k in range(size):
+        end = min(first + (k + 1) * WALK_BLOCK, last + 1)
+        if begin >= end:
+            break
+        if lower <= low[k] and high[k] < upper:
+            # Each of the block's segments lies at ``position``, the first joining the run there.
+            if run_at != position:
+                whole[run_at] += _run_length(run_start, count, step_hours, held)
+                run_at, run_start, count = position, -1.0, end - begin - 1
+            else:
+                count += end - begin
+            previous, begin = power[end - 1], end
+            continue
+        for s in range(begin, end):
+            p = power[s]
+            lo_at = position
+            if not (lower <= p and p < upper):
+                at = _walk(p_load, position, p)
+                lo_at, hi_at = min(position, at), max(position, at)
+                if hi_at > lo_at:
+                    # The loads strictly inside the segment's range take a share of it.
+                    lo, hi = min(previous, p), max(previous, p)
+                    for j in range(lo_at, hi_at):
+                        above[j] += step_hours * (hi - p_load[j]) / (hi - lo)
+                position = at
+                lower, upper = _bounds(p_load, position)
+            if lo_at == run_at:
+                count += 1
+            else:
+                whole[run_at] += _run_length(run_start, count, step_hours, held)
+                run_at, run_start, count = lo_at, -1.0, 0
+            previous = p
+        begin = end
+    # The last sample held to the end of the day.
+    tail = (n_steps - last - 0.5) * step_hours
+    length = _run_length(run_start, count, step_hours, held)
+    if run_at == position:
+        whole[run_at] += length + tail
+    else:
+        whole[run_at] += length
+        whole[position] += tail
+    total = 0.0
+    for j in range(n_loads - 1, -1, -1):
+        total += whole[j + 1]
+        t_out[j] = above[j] + total
 
 
 def curve_rows(power, span, row_loadset, loads, out, scratch):

@@ -7,10 +7,13 @@ beam's incidence (or Shin et al.'s Eq. 5 in paper mode), and the beam with the o
 incidence-angle modifier and the diffuse terms give each sub-panel's plane-of-array irradiance.
 The second looks up the electrical tables (or, for the ideal model, scales the irradiance) and
 writes every asked connection's power to a buffer of one day, reused by the next row (with the
-circuit as built, :func:`_built_row`). The third reduces each power curve to the daily metrics of
-every load at once (:func:`foldopt.engine.curve_reduction.day_metrics`). The inputs come as the named
-records of :mod:`foldopt.engine.records` (the sky, the rows, the tables, the loads, the outputs and
-the per-chunk scratch of :func:`foldopt.engine.records.allocate`).
+circuit as built, :func:`_built_row`; switching alone from one table set a block, the common case,
+in two loops of its own, :func:`_switching_row`). The third reduces each power curve to the daily
+metrics of every load at once (:func:`foldopt.engine.curve_reduction.day_metrics`; after
+:func:`_switching_row`, :func:`foldopt.engine.curve_reduction.blocked_day`, which skips the blocks
+of steps that cross no load). The inputs come as the named records of
+:mod:`foldopt.engine.records` (the sky, the rows, the tables, the loads, the outputs and the
+per-chunk scratch of :func:`foldopt.engine.records.allocate`).
 
 Where the time goes: a loop vectorises only if LLVM can see that no index wraps around (the steps
 are indexed as unsigned integers) and that nothing in it depends on a setting known only at run
@@ -18,8 +21,9 @@ time. So the loops are written once and inlined once per case, each case's setti
 constants (the incidence per mode, diffuse terms and modifier; the ideal model's power per
 connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
 (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
-loop, not called (what each choice was worth: ``docs/performance.rst``, from ``bench/map.py --w5
---phases``).
+loop, not called. A function run at every step takes arrays, not records: each array of a record
+handed to it would be counted and released at every step. (What each choice was worth:
+``docs/performance.rst``.)
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -33,8 +37,8 @@ from typing import NamedTuple
 from numba import njit, uint64
 
 from foldopt.engine.incidence import incidence, steps_sum
-from foldopt.engine.curve_reduction import day_metrics
-from foldopt.engine.records import in_chunks
+from foldopt.engine.curve_reduction import blocked_day, day_metrics
+from foldopt.engine.records import WALK_BLOCK, in_chunks
 
 # Connection codes; the order of foldopt.physics.connections.CONNECTIONS, plus the whole (unfolded) panel.
 EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
@@ -43,18 +47,23 @@ ZETA_MAX = 4.0  # top of a converter's table in input / rating (foldopt.physics.
 
 @njit(cache=True, inline="always")
 def _linear(values, position):
-    index = min(int(position), values.shape[0] - 2)
+    """``values`` linear between nodes at ``position`` >= 0 [nodes]. The index is unsigned: no
+    index can wrap around, so the compiled look-up tests no sign."""
+    index = min(uint64(position), uint64(values.shape[0] - 2))
     weight = position - index
-    return values[index] * (1.0 - weight) + values[index + 1] * weight
+    return values[index] * (1.0 - weight) + values[index + uint64(1)] * weight
 
 
 @njit(cache=True, inline="always")
 def _bilinear(values, first, second):
-    i = min(int(first), values.shape[0] - 2)
-    j = min(int(second), values.shape[1] - 2)
+    """``values`` bilinear between nodes at ``first``, ``second`` >= 0 [nodes] (unsigned indices,
+    as :func:`_linear`'s)."""
+    i = min(uint64(first), uint64(values.shape[0] - 2))
+    j = min(uint64(second), uint64(values.shape[1] - 2))
     fi, fj = first - i, second - j
-    return (values[i, j] * (1.0 - fj) + values[i, j + 1] * fj) * (1.0 - fi) + (
-        values[i + 1, j] * (1.0 - fj) + values[i + 1, j + 1] * fj
+    one = uint64(1)
+    return (values[i, j] * (1.0 - fj) + values[i, j + one] * fj) * (1.0 - fi) + (
+        values[i + one, j] * (1.0 - fj) + values[i + one, j + one] * fj
     ) * fi
 
 
@@ -279,6 +288,80 @@ def _table_row(b, first, last, sky, tables, need_series, work):
 
 
 @njit(cache=True, inline="always")
+def _switching_power(i, table_1d, pair, stride, nodes, weights):
+    """Switching's power [W] at the ``i``-th step of a block of :func:`_switching_row`, from its
+    coordinates in the tables (``nodes`` and ``weights``)."""
+    one = uint64(1)
+    node_east, node_west, node_pair = nodes[0, i], nodes[1, i], nodes[2, i]
+    w_east, w_west, fi, fj = weights[0, i], weights[1, i], weights[2, i], weights[3, i]
+    p_east = table_1d[node_east] * (1.0 - w_east) + table_1d[node_east + one] * w_east
+    p_west = table_1d[node_west] * (1.0 - w_west) + table_1d[node_west + one] * w_west
+    fraction = (pair[node_pair] * (1.0 - fj) + pair[node_pair + one] * fj) * (1.0 - fi) + (
+        pair[node_pair + stride] * (1.0 - fj) + pair[node_pair + stride + one] * fj
+    ) * fi
+    p_parallel = min(max(fraction, 0.0), 1.0) * (p_east + p_west)
+    return max(max(p_east, p_west), p_parallel)
+
+
+@njit(cache=True, inline="always")
+def _switching_row(b, first, n, sky, tables, work):
+    """Switching's power [W] at steps ``first .. first + n - 1`` into ``work.power[0]`` from one
+    table set a block, without the series pair (every clear-sky study's and map's): the values
+    of :func:`_pair_powers` and :func:`_connection_power` by the same operations, so the same
+    bits. Returns the sum of the steps' power [W] and its peak [W], the bits of
+    :func:`day_metrics`' (the same operations in the same order), and writes each walking
+    block's lowest and highest power to ``work.low`` and ``work.high``
+    (:func:`foldopt.engine.curve_reduction.blocked_day`).
+
+    :data:`foldopt.engine.records.TABLE_BLOCK` steps at a time, in two loops: the first works out
+    each step's coordinates in the tables (its nodes and the weights between them, the pair's
+    ratio a division) and vectorises; the second looks them up a value at a time (LLVM prices a
+    gather on this CPU above the loads it replaces) with the sums that wait on each addition
+    beside them, where they cost nothing more."""
+    table = sky.step_table[b, 0]
+    table_1d, table_pair = tables.subpanel[table], tables.parallel[table]
+    pair = table_pair.reshape(table_pair.size)
+    n1 = table_1d.shape[0] - 1
+    n2, nr = table_pair.shape[0] - 1, table_pair.shape[1] - 1
+    top_1d, top_strong, top_ratio = uint64(n1 - 1), uint64(n2 - 1), uint64(nr - 1)
+    stride = uint64(nr + 1)
+    east, west, buffer = work.east, work.west, work.power
+    nodes, weights, low, high = work.nodes, work.weights, work.low, work.high
+    block, end, walk = uint64(nodes.shape[1]), uint64(first + n), uint64(WALK_BLOCK)
+    start = uint64(first)
+    # -0.0 adds nothing to any value, so the sum is the first step's power plus the others'.
+    harvested, peak = -0.0, 0.0
+    for begin in range(start, end, block):
+        count = min(block, end - begin)
+        for i in range(count):
+            root_east, root_west = east[begin + i], west[begin + i]
+            at_east, at_west = root_east * n1, root_west * n1
+            node_east, node_west = min(uint64(at_east), top_1d), min(uint64(at_west), top_1d)
+            strong, weak = max(root_east, root_west), min(root_east, root_west)
+            root_ratio = weak / strong if strong > 0.0 else 1.0
+            at_strong, at_ratio = strong * n2, root_ratio * nr
+            node_strong = min(uint64(at_strong), top_strong)
+            node_ratio = min(uint64(at_ratio), top_ratio)
+            nodes[0, i], nodes[1, i] = node_east, node_west
+            nodes[2, i] = node_strong * stride + node_ratio
+            weights[0, i], weights[1, i] = at_east - node_east, at_west - node_west
+            weights[2, i], weights[3, i] = at_strong - node_strong, at_ratio - node_ratio
+        if begin == start:
+            peak = _switching_power(0, table_1d, pair, stride, nodes, weights)
+        for part in range(uint64(0), count, walk):
+            lowest, highest = math.inf, -math.inf
+            for i in range(part, min(part + walk, count)):
+                power = _switching_power(i, table_1d, pair, stride, nodes, weights)
+                buffer[0, begin + i] = power
+                lowest, highest = min(lowest, power), max(highest, power)
+                harvested += power
+                peak = max(peak, power)
+            low[(begin - start + part) // walk] = lowest
+            high[(begin - start + part) // walk] = highest
+    return harvested, peak
+
+
+@njit(cache=True, inline="always")
 def _built_power(code, parts, p_panel, tables):
     """The power a connection delivers to the load [W] from the :class:`Parts` of
     :func:`_built_parts` (and the whole panel's ``p_panel``): through the converter, or the
@@ -394,6 +477,22 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     need_series = tables.switch_series
     for c in range(n_conn):
         need_series = need_series or connections[c] == SERIES
+    # Switching alone from one table set a block (every clear-sky study's and map's).
+    switching_alone = (
+        with_tables
+        and not tables.as_built
+        and not need_series
+        and n_conn == 1
+        and connections[0] == SWITCHING
+        and sky.step_table.shape[1] == 1
+    )
+    # ... and its walk over the loads by blocks, for constant loads without their longest runs.
+    blocked = switching_alone and not loads.contiguous and not loads.use_profile
+    held = work.held
+    held[0] = loads.step_hours
+    for k in range(1, held.shape[0]):
+        held[k] = held[k - 1] + loads.step_hours
+    harvested = peak = 0.0  # the day's sum and peak of switching's pass, when it is taken
     for r in range(start, stop):
         b = rows.block[r]
         first, last = sky.span[b, 0], sky.span[b, 1]
@@ -404,6 +503,8 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
             _built_row(b, first, last, sky, tables, need_series, work)
         elif not with_tables:
             _linear_connections(first, n, tables, work)
+        elif switching_alone:
+            harvested, peak = _switching_row(b, first, n, sky, tables, work)
         else:
             _table_row(b, first, last, sky, tables, need_series, work)
         if rows.curve[r] >= 0:
@@ -412,6 +513,22 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
             loads.p_load[rows.loadset[r]],
             loads.profile[b if loads.use_profile else 0],
         )
+        if blocked:
+            out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
+            blocked_day(
+                work.power[0],
+                first,
+                last,
+                p_load,
+                loads.step_hours,
+                work.above,
+                work.whole,
+                held,
+                work.low,
+                work.high,
+                out.t_solar[r, 0],
+            )
+            continue
         for c in range(n_conn):
             out.energy[r, c], out.peak[r, c] = day_metrics(
                 work.power[c],

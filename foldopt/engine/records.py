@@ -19,6 +19,8 @@ from typing import NamedTuple
 import numpy as np
 
 CHUNKS_PER_THREAD = 8  # rows are handed out in chunks: enough for balance, few scratch buffers
+TABLE_BLOCK = 256  # steps whose tables' coordinates are worked out at once: they stay in L1
+WALK_BLOCK = 16  # steps a block of a day's walk over its loads (a multiple of it is TABLE_BLOCK)
 
 
 class SkyArrays(NamedTuple):
@@ -217,6 +219,15 @@ class Scratch(NamedTuple):
         lengths by how many loads lie below them (:func:`foldopt.engine.curve_reduction.day_metrics`).
     run : (n_loads or 1, 2) float
         The current and the longest run of each load (``contiguous``).
+    nodes, weights : (3, TABLE_BLOCK) uint64 and (4, TABLE_BLOCK) float
+        The tables' coordinates of a block of steps (:func:`foldopt.engine.kernel._switching_row`):
+        each sub-panel's node below its irradiance and the pair table's node below both, and
+        where each lies between its node and the next.
+    low, high : (n_steps // WALK_BLOCK + 1,) float
+        The lowest and the highest power [W] of each block of :data:`WALK_BLOCK` steps from the
+        first step walked (:func:`foldopt.engine.curve_reduction.blocked_day`).
+    held : (n_steps + 1,) float
+        ``held[k]``: the length of ``k + 1`` steps [h], as ``k`` additions of the step to itself.
     """
 
     east: np.ndarray
@@ -228,6 +239,11 @@ class Scratch(NamedTuple):
     above: np.ndarray
     whole: np.ndarray
     run: np.ndarray
+    nodes: np.ndarray
+    weights: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    held: np.ndarray
 
 
 def allocate(
@@ -272,6 +288,11 @@ def allocate(
         above=np.zeros((chunks, n_loads)),
         whole=np.zeros((chunks, n_loads + 1)),
         run=np.zeros((chunks, n_loads if contiguous else 1, 2)),
+        nodes=np.zeros((chunks, 3, TABLE_BLOCK if n_steps else 0), dtype=np.uint64),
+        weights=np.zeros((chunks, 4, TABLE_BLOCK if n_steps else 0)),
+        low=np.zeros((chunks, n_steps // WALK_BLOCK + 1)),
+        high=np.zeros((chunks, n_steps // WALK_BLOCK + 1)),
+        held=np.zeros((chunks, n_steps + 1)),
     )
     return out, scratch
 

@@ -144,7 +144,8 @@ class SunTerms:
         """:func:`_equatorial` at ``utc_ns`` (n_blocks, n_steps) as ``(first, terms)``: block
         ``b``'s step ``i`` is ``terms[:, first[b] + i]``. Where every day is of equal steps on one
         lattice of UTC instants (a map's sites of one year and step, whatever their time zone),
-        each instant is evaluated once for the run however many sites and days share it."""
+        each instant is evaluated once for the run however many sites and days share it, and only
+        the instants the days span: a sweep's days spread over a year evaluate those days alone."""
         n_blocks, n_steps = utc_ns.shape
         step = int(utc_ns[0, 1] - utc_ns[0, 0]) if n_steps > 1 else 0
         phase = int(utc_ns[0, 0] % step) if step > 0 else 0
@@ -158,15 +159,34 @@ class SunTerms:
             return np.arange(n_blocks) * n_steps, _equatorial(utc_ns, self).reshape(5, -1)
         start = (utc_ns[:, 0] - phase) // step
         low, high = int(start.min()), int(start.max()) + n_steps - 1
-        first, terms = self._lattices.get((step, phase), (low, np.zeros((5, 0))))
-        if low < first or high >= first + terms.shape[1]:
-            # A day more either side: the same dates in every other time zone are then kept.
+        first, terms, known = self._lattices.get(
+            (step, phase), (low, np.zeros((5, 0)), np.zeros(0, dtype=bool))
+        )
+        size = terms.shape[1]
+        grown = low < first or high >= first + size
+        if grown:
+            # A day more either side: the same dates in every other time zone then fit.
             margin = -(-24 * NS_PER_HOUR // step)
-            low, high = min(low - margin, first), max(high + margin, first + terms.shape[1] - 1)
+            low, high = min(low - margin, first), max(high + margin, first + size - 1)
             if high - low + 1 > self.steps_kept:
                 return np.arange(n_blocks) * n_steps, _equatorial(utc_ns, self).reshape(5, -1)
-            first, terms = low, _equatorial(np.arange(low, high + 1) * step + phase, self)
-            self._lattices = {**self._lattices, (step, phase): (first, terms)}
+            kept = slice(first - low, first - low + size)
+            old_terms, old_known = terms, known
+            terms, known = np.zeros((5, high - low + 1)), np.zeros(high - low + 1, dtype=bool)
+            terms[:, kept], known[kept] = old_terms, old_known
+            first = low
+        # The instants the blocks span (where each begins and ends, summed along the lattice)
+        # that no call has evaluated yet.
+        edges = np.zeros(terms.shape[1] + 1, dtype=np.int64)
+        np.add.at(edges, start - first, 1)
+        np.add.at(edges, start - first + n_steps, -1)
+        missing = np.flatnonzero((np.cumsum(edges[:-1]) > 0) & ~known)
+        if missing.size:
+            if not grown:  # the run's other calls may hold the store: a copy is filled
+                terms, known = terms.copy(), known.copy()
+            terms[:, missing] = _equatorial((missing + first) * step + phase, self)
+            known[missing] = True
+            self._lattices = {**self._lattices, (step, phase): (first, terms, known)}
         return start - first, terms
 
 
@@ -177,18 +197,35 @@ def _geocentric_hourly(utc_ns: np.ndarray, sun_terms: SunTerms) -> dict:
 
     Over an hour the geocentric terms are smooth to within 1e-5 deg of linear (tested)."""
     hours = np.floor_divide(utc_ns, NS_PER_HOUR)
-    nodes = np.unique(np.concatenate([hours.ravel(), hours.ravel() + 1]))
+    nodes, index = _hour_nodes(hours)
     at_nodes = sun_terms.at_hours(nodes)
-    index = np.searchsorted(nodes, hours)
     weight = (utc_ns - hours * NS_PER_HOUR) / NS_PER_HOUR
     out = {}
     for name, values in at_nodes.items():
-        start, end = values[index], values[index + 1]
-        change = end - start
+        # Each hour's change, worked out once an hour rather than once a step (the same
+        # subtraction of the same two values); an hour's next node is always its own next hour.
+        change = values[1:] - values[:-1]
         if name in _WRAPPED:
             change = (change + 180.0) % 360.0 - 180.0
-        out[name] = start + weight * change
+        out[name] = values[index] + weight * change[index]
     return out
+
+
+def _hour_nodes(hours: np.ndarray) -> tuple:
+    """The sorted whole hours that ``hours`` (any shape) and the hours after them touch, and where
+    each of ``hours`` is among them: ``np.unique`` of both and ``np.searchsorted``, by marks on
+    the range of hours (a year of 1-min steps has half a million instants but 9,000 hours)."""
+    flat = hours.ravel()
+    low = int(flat.min()) if flat.size else 0
+    width = int(flat.max()) - low + 2 if flat.size else 0
+    if width > 8 * flat.size + 1_000_000:  # instants spread over centuries: sorting is cheaper
+        nodes = np.unique(np.concatenate([flat, flat + 1]))
+        return nodes, np.searchsorted(nodes, hours)
+    touched = np.zeros(width, dtype=bool)
+    touched[flat - low] = True
+    touched[flat - low + 1] = True
+    nodes = np.flatnonzero(touched) + low
+    return nodes, (np.cumsum(touched) - 1)[hours - low]
 
 
 def _equatorial(utc_ns, sun_terms: SunTerms) -> np.ndarray:
@@ -227,7 +264,7 @@ def _raised(east, north, up, t):
     return east * along, north * along, up * cos_t + level * sin_t
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _site_sun(
     terms,
     first,
@@ -279,6 +316,27 @@ def _site_sun(
                 elevation += refraction
             direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
             apparent_zenith[b, i] = 90.0 - elevation
+
+
+SITE_STEPS_A_THREAD = 100_000  # blocks x steps below which the per-site pass keeps one thread
+
+
+def _by_blocks(run, shape) -> None:
+    """``run(part)`` over slices of the blocks of ``shape`` (n_blocks, n_steps), on numba's
+    threads: :func:`_site_sun` releases the GIL, and its blocks are independent."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from numba import get_num_threads
+
+    threads = min(get_num_threads(), shape[0], max(1, shape[0] * shape[1] // SITE_STEPS_A_THREAD))
+    edges = np.linspace(0, shape[0], threads + 1).astype(int)
+    parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    if threads == 1:
+        run(parts[0])
+        return
+    with ThreadPoolExecutor(threads, thread_name_prefix="foldopt-sun") as pool:
+        for done in [pool.submit(run, part) for part in parts]:
+            done.result()  # a part's error, raised here
 
 
 def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerms | None = None):
@@ -342,19 +400,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     vector = np.empty((shape[0], 3, shape[1]))
     apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
     pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
-    _site_sun(
-        terms,
-        first,
-        np.sin(lam),
-        np.cos(lam),
-        np.sin(phi),
-        np.cos(phi),
-        x,
-        y,
-        pressure,
-        vector,
-        apparent_zenith,
-        solar_azimuth,
-    )
+    per_site = (first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure)
+    outputs = (vector, apparent_zenith, solar_azimuth)
+    _by_blocks(lambda part: _site_sun(terms, *(a[part] for a in per_site + outputs)), shape)
     equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
     return apparent_zenith, solar_azimuth, equation_of_time, np.moveaxis(vector, 1, -1)
