@@ -92,6 +92,7 @@ def test_a_new_map_whose_last_files_fail_is_not_complete_and_resumes(scheduler, 
     ([{"latitude": 45.0, "longitude": 8.0}], [2.0]),
     ([{"latitude": 45.0, "longitude": 8.0}], [1.0, 3.0]),
 ], ids=["no-site-carries", "all-equal", "one-site-one-load", "one-site-two-loads"])
+@pytest.mark.figure_pixels  # the figures of tables at their edges, drawn whole
 def test_every_figure_and_writer_copes_with_a_legal_table(scheduler, tmp_path, sites, loads):
     out = tmp_path / "map"
     run, figures, answer = world_map(scheduler, out, sites, loads)
