@@ -160,8 +160,9 @@ BEFORE_THE_WARM_UP = ("test_docs.py", "test_report_html.py")
 #: the next unit when it has two tests left, so that the long ones start early and the end is made
 #: of short tests, and the two workers finish together.
 LONG_FIRST = (*BEFORE_THE_WARM_UP, "test_cluster.py", "test_cli_readme.py", "test_cli_studies.py",
-              "test_faults_map_finish.py", "test_weather_validation_minutes.py", "test_one_answer.py",
-              "test_bad_input.py", "test_weather_year.py")
+              "test_weather_year.py", "test_weather_validation_minutes.py", "test_engine.py", "test_figures.py",
+              "test_columns.py", "test_search.py", "test_faults_map_finish.py", "test_one_answer.py",
+              "test_bad_input.py")
 
 
 def pytest_collection_modifyitems(items):

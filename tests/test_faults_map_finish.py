@@ -44,10 +44,11 @@ def world_map(scheduler, out, sites, loads, **keywords):
 
 
 @pytest.fixture(scope="module")
-def earlier(scheduler, tmp_path_factory) -> Path:
+def earlier(scheduler, tmp_path_factory, without_pixels) -> Path:
     """A complete map of two sites at 2 W."""
     out = tmp_path_factory.mktemp("earlier") / "map"
-    world_map(scheduler, out, [{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [2.0])
+    with without_pixels():
+        world_map(scheduler, out, [{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [2.0])
     return out
 
 
