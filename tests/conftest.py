@@ -152,10 +152,10 @@ _warmed_up = False
 
 # --- the order of the suite -------------------------------------------------------------------------
 
-#: Modules that run little compiled code (the sun's and the clear sky's, a second's compile: the docs
-#: build's and the reports' requests are under ``auto``'s bound, the kernel's is not): the first two
-#: units of work, which the workers run while the warm-up compiles.
-BEFORE_THE_WARM_UP = ("test_docs.py", "test_report_html.py")
+#: Modules that run little compiled code (the sun's and the clear sky's, a second's compile: the
+#: requests of the docs build, the reports and the help are under ``auto``'s bound, the kernel's is
+#: not): the first units of work, which the workers run while the warm-up compiles.
+BEFORE_THE_WARM_UP = ("test_docs.py", "test_report_html.py", "test_cli_help.py", "test_architecture.py")
 #: The longest units of work (an xdist group, a module, or a test), longest first: each worker takes
 #: the next unit when it has two tests left, so that the long ones start early and the end is made
 #: of short tests, and the two workers finish together.
