@@ -179,10 +179,10 @@ def _one_pixel_png() -> bytes:
     return png.getvalue()
 
 
-def _drawn_without_pixels(ax, path):
+def _drawn_without_pixels(ax, path, margins=None):
     """foldopt's save_plot but for the pixels: every artist of the figure is drawn (matplotlib's
-    ``draw_without_rendering``: a plot that fails on its data fails here), nothing is laid out or
-    rasterised, and the file is a PNG of one pixel."""
+    ``draw_without_rendering``: a plot that fails on its data fails here), nothing is laid out
+    (``margins`` unused) or rasterised, and the file is a PNG of one pixel."""
     import numpy as np
 
     np.ravel(ax)[0].figure.draw_without_rendering()
