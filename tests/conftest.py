@@ -61,11 +61,12 @@ def pytest_configure(config):
 # --- the compiled code, compiled once ---------------------------------------------------------------
 
 #: The environment variable that names the warm-up's folder to the workers.
-WARM_UP = "FOLDOPT_TESTS_WARM_UP"
-#: What each warm-up process runs (``python -c``): every numba function the suite calls, in the
-#: argument types the suite calls it with, compiled into numba's cache. Each of the two workers
-#: compiled them for itself on a fresh clone (some 40 s of CPU each), and again the Dask worker of
-#: the first map; the two parts run beside the workers, which start with :data:`BEFORE_THE_WARM_UP`.
+WARM_UP = "SUITE_WARM_UP_FOLDER"
+#: What each warm-up process runs (``python -c``): the numba functions the suite calls, in the
+#: argument types it calls them with, compiled into numba's cache. On a fresh clone each worker
+#: compiled them for itself, and again the Dask worker of the first map, the compile costing more
+#: than most modules' tests; the two parts run beside the workers, which start with
+#: :data:`BEFORE_THE_WARM_UP`.
 WARM_UP_PARTS = {
     "fold": """
 import foldopt
@@ -202,10 +203,10 @@ def _figures_without_pixels():
 @pytest.fixture(autouse=True)
 def _no_pixels_unless_marked(request):
     """Every test's figures without pixels (:func:`_figures_without_pixels`), unless it is marked
-    ``figure_pixels``: laying out and rasterising took two thirds of writing a folder, some 0.4 s a
-    figure, in the tests that write folders for their tables, answers and refusals and never look
-    at a figure. Those that look at them (the figures' own tests, the reports a browser opens, every
-    shipped study's folder) are marked, and draw them whole."""
+    ``figure_pixels``: laying out and rasterising are most of writing a folder, in the tests that
+    write folders for their tables, answers and refusals and never look at a figure. Those that
+    look at them (the figures' own tests, the reports a browser opens, every shipped study's
+    folder) are marked, and draw them whole."""
     with contextlib.nullcontext() if request.node.get_closest_marker("figure_pixels") else _figures_without_pixels():
         yield
 

@@ -170,8 +170,7 @@ SINGLE_DIODE_YEAR = {"name": "g", "panel": {"area": 0.108}, "p_load": [0.02, 1.0
 
 @pytest.fixture(scope="session")
 def single_diode_year():
-    """:data:`SINGLE_DIODE_YEAR` on the TMY3 file, run: the year both tests below read (each ran its
-    own, some 5 s)."""
+    """:data:`SINGLE_DIODE_YEAR` on the TMY3 file, run once: the year both tests below read."""
     return run_plan(make_plan({**SINGLE_DIODE_YEAR, "weather": str(TMY3)}))
 
 
