@@ -64,9 +64,9 @@ def pytest_configure(config):
 WARM_UP = "SUITE_WARM_UP_FOLDER"
 #: What each warm-up process runs (``python -c``): the numba functions the suite calls, in the
 #: argument types it calls them with, compiled into numba's cache. On a fresh clone each worker
-#: compiled them for itself, and again the Dask worker of the first map, the compile costing more
-#: than most modules' tests; the two parts run beside the workers, which start with
-#: :data:`BEFORE_THE_WARM_UP`.
+#: compiled them for itself, and again the Dask worker of the first map and the docs build, the
+#: compile costing more than most modules' tests; the two parts run beside the workers, which
+#: start with :data:`BEFORE_THE_WARM_UP`.
 WARM_UP_PARTS = {
     "fold": """
 import foldopt
@@ -135,9 +135,10 @@ def pytest_terminal_summary(terminalreporter):
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_runtest_setup(item):
-    """In a worker, before the fixtures of its first test that may run compiled code (here, in a
-    command line or in a Dask worker it starts), wait until every warm-up process has ended: numba's
-    cache then holds what they compiled, and nothing is compiled twice."""
+    """In a worker, before the fixtures of its first test that evaluates a study (here, in a command
+    line or in a Dask worker it starts), wait until every warm-up process has ended: numba's cache
+    then holds what they compiled, nothing is compiled twice, and ``auto`` finds the kernel
+    compiled whole or not at all."""
     global _warmed_up
     folder = os.environ.get(WARM_UP)
     if folder and fcntl is not None and not _warmed_up and item.path.name not in BEFORE_THE_WARM_UP:
@@ -153,17 +154,20 @@ _warmed_up = False
 
 # --- the order of the suite -------------------------------------------------------------------------
 
-#: Modules that run little compiled code (the sun's and the clear sky's, a second's compile: the
-#: requests of the docs build, the reports and the help are under ``auto``'s bound, the kernel's is
-#: not): the first units of work, which the workers run while the warm-up compiles.
-BEFORE_THE_WARM_UP = ("test_docs.py", "test_report_html.py", "test_cli_help.py", "test_architecture.py")
-#: The longest units of work (an xdist group, a module, or a test), longest first: each worker takes
-#: the next unit when it has two tests left, so that the long ones start early and the end is made
-#: of short tests, and the two workers finish together.
-LONG_FIRST = (*BEFORE_THE_WARM_UP, "test_cluster.py", "test_cli_readme.py", "test_cli_studies.py",
-              "test_weather_year.py", "test_weather_validation_minutes.py", "test_engine.py", "test_figures.py",
-              "test_columns.py", "test_search.py", "test_faults_map_finish.py", "test_one_answer.py",
-              "test_bad_input.py")
+#: Modules that evaluate no study (physics against its references, the code's layout): what they
+#: compute does not hang on how far the warm-up has got (``auto`` takes the kernel for a smaller
+#: request once it is compiled), so the workers run them first, while the warm-up compiles.
+BEFORE_THE_WARM_UP = ("test_architecture.py", "test_atmosphere.py", "test_clearsky.py", "test_converter.py",
+                      "test_electrical.py", "test_geometry.py", "test_horizon.py", "test_irradiance.py",
+                      "test_metrics.py", "test_plan.py", "test_pvmodel.py", "test_pvsystem.py", "test_pvwatts.py",
+                      "test_solarposition.py", "test_tables.py", "test_tracker.py", "test_weather_measured.py")
+#: Then the longest units of work (an xdist group, a module, or a test), longest first: each worker
+#: takes the next unit when it has two tests left, so that the long ones start early and the end is
+#: made of short tests, and the two workers finish together.
+LONG_FIRST = (*BEFORE_THE_WARM_UP, "test_docs.py", "test_report_html.py", "test_cluster.py", "test_cli_readme.py",
+              "test_cli_studies.py", "test_weather_year.py", "test_weather_validation_minutes.py", "test_engine.py",
+              "test_figures.py", "test_columns.py", "test_search.py", "test_faults_map_finish.py",
+              "test_one_answer.py", "test_bad_input.py")
 
 
 def pytest_collection_modifyitems(items):
