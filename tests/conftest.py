@@ -1,11 +1,23 @@
-"""Shared fixtures: the paper's study as shipped, a cheap variant for fast tests, and a small tmpfs for full disks."""
+"""Shared fixtures: the paper's study as shipped, a small tmpfs for full disks, an in-process Dask
+cluster and figures drawn without their pixels; the suite's order on its two workers, and the
+compiled code compiled once for both."""
 
 import contextlib
+import functools
+import io
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
+from pathlib import Path
 
 import pytest
+
+try:
+    import fcntl
+except ImportError:  # Windows: each worker compiles what it needs, as with -n 0
+    fcntl = None
 
 from foldopt.inputs.study_file import default_study_path
 from foldopt.api import load_study
@@ -38,15 +50,176 @@ def pytest_configure(config):
         # tested by tests/test_engine.py::test_the_kernel_on_two_threads.
         for name in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
             os.environ.setdefault(name, "1")
+    if config.getoption("dist", "no") != "no" and not config.getoption("collectonly"):
+        # The scopes in the order pytest_collection_modifyitems gives them, not pytest-xdist's
+        # (the groups of most tests first, whatever they cost); the option is pytest-xdist 3.8's.
+        config.option.loadscopereorder = False
+        if not hasattr(config, "workerinput") and _whole_suite(config):
+            _start_the_warm_up(config)
 
 
-#: Modules whose tests take longest (Dask clusters, the docs build, whole years): run first, so that
-#: the two workers do not end on one long test while the other idles.
-LONG_FIRST = ("test_cluster.py", "test_docs.py", "test_one_answer.py", "test_report_html.py", "test_faults_cluster.py")
+# --- the compiled code, compiled once ---------------------------------------------------------------
+
+#: The environment variable that names the warm-up's folder to the workers.
+WARM_UP = "SUITE_WARM_UP_FOLDER"
+#: What each warm-up process runs (``python -c``): the numba functions the suite calls, in the
+#: argument types it calls them with, compiled into numba's cache. On a fresh clone each worker
+#: compiled them for itself, and again the Dask worker of the first map and the docs build, the
+#: compile costing more than most modules' tests; the two parts run beside the workers, which
+#: start with :data:`BEFORE_THE_WARM_UP`.
+WARM_UP_PARTS = {
+    "fold": """
+import foldopt
+from foldopt.inputs.study_file import default_study_path
+
+# The fold kernel and the curves' reduction; the circuit as built; a load profile's loads (read-only).
+for name in ("shin2015", "site-as-built", "camera-profile"):
+    foldopt.sweep(foldopt.load_study(default_study_path().parent / f"{name}.yaml"), step_min=15, engine="numba")
+""",
+    "storage": """
+import foldopt
+from foldopt.inputs.study_file import default_study_path
+
+# The buffer's simulation, the clear sky's and the sun's compiled terms.
+foldopt.run(foldopt.load_study(default_study_path().parent / "camera-buffer.yaml"), engine="numba")
+""",
+}
+#: The warm-up's processes (the controller's), to wait for or end at the session's end.
+_warm_up_processes: dict[str, subprocess.Popen] = {}
+
+
+def _whole_suite(config) -> bool:
+    """Whether the run collects the whole suite (no narrower path given): what the warm-up is for."""
+    here = Path(__file__).resolve().parent
+    return all(here.is_relative_to(Path(arg.split("::")[0]).resolve()) for arg in config.args)
+
+
+def _start_the_warm_up(config) -> None:
+    """Start the warm-up's processes, each holding an exclusive lock on ``<part>.lock`` in a folder
+    of its own until it ends (the lock is taken here and handed over, so that no worker can find it
+    free before the process has it); the workers learn the folder from :data:`WARM_UP`."""
+    if fcntl is None:
+        return
+    import foldopt
+
+    folder = Path(tempfile.mkdtemp(prefix="foldopt-warm-up-"))
+    os.environ[WARM_UP] = str(folder)
+    # The foldopt the suite imports (a checkout's or an install's): numba's cache is per source file.
+    path = [str(Path(foldopt.__file__).parent.parent), *filter(None, [os.environ.get("PYTHONPATH")])]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(path), "NUMBA_NUM_THREADS": "1",
+           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    for part, code in WARM_UP_PARTS.items():
+        with open(folder / f"{part}.lock", "w") as lock, open(folder / f"{part}.log", "w") as log:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            _warm_up_processes[part] = subprocess.Popen(
+                [sys.executable, "-c", code], cwd=folder, env=env, stdout=log, stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL, pass_fds=(lock.fileno(),))
+    config.add_cleanup(_end_the_warm_up)
+
+
+def _end_the_warm_up() -> None:
+    for process in _warm_up_processes.values():
+        if process.poll() is None:
+            process.kill()
+        process.wait()
+    shutil.rmtree(os.environ.pop(WARM_UP), ignore_errors=True)
+
+
+def pytest_terminal_summary(terminalreporter):
+    failed = [(part, process) for part, process in _warm_up_processes.items() if process.poll() not in (0, None)]
+    for part, process in failed:
+        log = (Path(os.environ[WARM_UP]) / f"{part}.log").read_text(errors="replace").strip().splitlines()
+        terminalreporter.write_line(f"the compiled code's warm-up ({part}) failed, exit {process.returncode}; each "
+                                    f"worker compiled it for itself: {log[-1] if log else ''}", yellow=True)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtest_setup(item):
+    """In a worker, before the fixtures of its first test that evaluates a study (here, in a command
+    line or in a Dask worker it starts), wait until every warm-up process has ended: numba's cache
+    then holds what they compiled, nothing is compiled twice, and ``auto`` finds the kernel
+    compiled whole or not at all."""
+    global _warmed_up
+    folder = os.environ.get(WARM_UP)
+    if folder and fcntl is not None and not _warmed_up and item.path.name not in BEFORE_THE_WARM_UP:
+        for path in sorted(Path(folder).glob("*.lock")):
+            with open(path) as held:
+                fcntl.flock(held, fcntl.LOCK_SH)  # free once its process has ended
+        _warmed_up = True
+
+
+#: Whether this worker has waited for the warm-up.
+_warmed_up = False
+
+
+# --- the order of the suite -------------------------------------------------------------------------
+
+#: Modules that evaluate no study (physics against its references, the code's layout): what they
+#: compute does not hang on how far the warm-up has got (``auto`` takes the kernel for a smaller
+#: request once it is compiled), so the workers run them first, while the warm-up compiles.
+BEFORE_THE_WARM_UP = ("test_architecture.py", "test_atmosphere.py", "test_clearsky.py", "test_converter.py",
+                      "test_electrical.py", "test_geometry.py", "test_horizon.py", "test_irradiance.py",
+                      "test_metrics.py", "test_plan.py", "test_pvmodel.py", "test_pvsystem.py", "test_pvwatts.py",
+                      "test_solarposition.py", "test_tables.py", "test_tracker.py", "test_weather_measured.py")
+#: Then the longest units of work (an xdist group, a module, or a test), longest first: each worker
+#: takes the next unit when it has two tests left, so that the long ones start early and the end is
+#: made of short tests, and the two workers finish together.
+LONG_FIRST = (*BEFORE_THE_WARM_UP, "test_docs.py", "test_report_html.py", "test_cluster.py", "test_cli_readme.py",
+              "test_cli_studies.py", "test_weather_year.py", "test_weather_validation_minutes.py", "test_engine.py",
+              "test_figures.py", "test_columns.py", "test_search.py", "test_faults_map_finish.py",
+              "test_one_answer.py", "test_bad_input.py")
 
 
 def pytest_collection_modifyitems(items):
-    items.sort(key=lambda item: item.path.name not in LONG_FIRST)  # stable: the order within each part is kept
+    rank = {name: index for index, name in enumerate(LONG_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: each part's order is kept
+
+
+@functools.cache
+def _one_pixel_png() -> bytes:
+    from matplotlib.figure import Figure
+
+    png = io.BytesIO()
+    Figure(figsize=(0.01, 0.01)).savefig(png, dpi=100, format="png")
+    return png.getvalue()
+
+
+def _drawn_without_pixels(ax, path, margins=None):
+    """foldopt's save_plot but for the pixels: every artist of the figure is drawn (matplotlib's
+    ``draw_without_rendering``: a plot that fails on its data fails here), nothing is laid out
+    (``margins`` unused) or rasterised, and the file is a PNG of one pixel."""
+    import numpy as np
+
+    np.ravel(ax)[0].figure.draw_without_rendering()
+    Path(path).write_bytes(_one_pixel_png())
+    return path
+
+
+@contextlib.contextmanager
+def _figures_without_pixels():
+    """Within the block, a results folder's figures are drawn but not rasterised
+    (:func:`_drawn_without_pixels`)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr("foldopt.output.figures.save_plot", _drawn_without_pixels)
+        yield
+
+
+@pytest.fixture(autouse=True)
+def _no_pixels_unless_marked(request):
+    """Every test's figures without pixels (:func:`_figures_without_pixels`), unless it is marked
+    ``figure_pixels``: laying out and rasterising are most of writing a folder, in the tests that
+    write folders for their tables, answers and refusals and never look at a figure. Those that
+    look at them (the figures' own tests, the reports a browser opens, every shipped study's
+    folder) are marked, and draw them whole."""
+    with contextlib.nullcontext() if request.node.get_closest_marker("figure_pixels") else _figures_without_pixels():
+        yield
+
+
+@pytest.fixture(scope="session")
+def without_pixels():
+    """For module- and session-scoped fixtures that write folders (set up before a test's own
+    fixtures): the context manager :func:`_no_pixels_unless_marked` enters."""
+    return _figures_without_pixels
 
 
 @pytest.fixture

@@ -26,6 +26,7 @@ def one_line_error(result, *words):
     assert all(word in lines[0] for word in words), lines[0]
 
 
+@pytest.mark.figure_pixels  # every shipped study's folder as a user gets it, its figures drawn whole
 @pytest.mark.parametrize("config", CONFIGS, ids=[c.stem for c in CONFIGS])
 def test_every_shipped_config_runs(tmp_path, config):
     out = tmp_path / config.stem

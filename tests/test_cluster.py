@@ -24,10 +24,10 @@ from foldopt.studies.map_request import MapSpec
 from foldopt.errors import OutputError
 from foldopt.studies.worldmap import evaluate_sites
 
-#: One worker runs this module (the embedded map, every test's reference, is computed once; --dist loadgroup).
-#: Its fixtures are session-scoped: the worker may run other modules' tests between these, which
-#: would tear a module-scoped fixture down and build it again.
-pytestmark = pytest.mark.xdist_group("cluster")
+#: One worker runs the tests of the embedded map, their reference, which is computed once (--dist
+#: loadgroup); the others go to either. The map is session-scoped: the worker may run other
+#: modules' tests between these, which would tear a module-scoped fixture down and build it again.
+EMBEDDED_MAP = pytest.mark.xdist_group("cluster")
 
 pytest.importorskip("distributed")
 
@@ -71,12 +71,13 @@ def _parts(folder: Path) -> dict[str, tuple]:
 
 
 @pytest.fixture(scope="session")
-def embedded(tmp_path_factory) -> pd.DataFrame:
+def embedded(tmp_path_factory, without_pixels) -> pd.DataFrame:
     """The reference: the map on the embedded cluster, uninterrupted. The command line runs in
     this process (its cluster's worker is a process of its own still): the runs below that are
     killed, refused and resumed are the ones whose process is the point."""
     out = tmp_path_factory.mktemp("embedded") / "map"
-    done = CliRunner().invoke(app, ["map", *EMBEDDED, "--out", str(out), "-q"])
+    with without_pixels():
+        done = CliRunner().invoke(app, ["map", *EMBEDDED, "--out", str(out), "-q"])
     assert done.exit_code == 0, done.output
     return pd.read_parquet(out / "map.parquet")
 
@@ -108,6 +109,7 @@ def _every_site_once(table: pd.DataFrame) -> None:
     assert len(counts) == N_SITES * N_LOADS * 5 and (counts == 1).all()
 
 
+@EMBEDDED_MAP
 def test_embedded_map_equals_the_computation_without_dask(embedded):
     sites = embedded.drop_duplicates("site_id")
     spec_sites = [{"latitude": lat, "longitude": lon, "site_id": i}
@@ -122,6 +124,7 @@ def test_embedded_map_equals_the_computation_without_dask(embedded):
     _every_site_once(embedded)
 
 
+@EMBEDDED_MAP
 def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
     """A map on a hand-started cluster, one of whose two workers is killed once the first part is
     written: every site once, the same bits as the embedded cluster's map."""
@@ -145,6 +148,7 @@ def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
     assert meta["status"] == "complete" and meta["cluster"].startswith("Dask scheduler tcp://127.0.0.1:")
 
 
+@EMBEDDED_MAP
 def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):
     out = tmp_path / "map"
     run = _foldopt("map", *EMBEDDED, "--out", str(out), "-q", start_new_session=True)

@@ -138,13 +138,13 @@ def test_every_committed_example_follows_the_grammar():
 
 
 @pytest.fixture(scope="module")
-def written(tmp_path_factory):
+def written(tmp_path_factory, without_pixels):
     """Each command of :data:`COMMANDS` run through the command line with ``--format json``: the
     CSV files' columns, by file name, and the JSON document's row and table columns."""
     out = tmp_path_factory.mktemp("columns")
     runner = CliRunner(env={"COLUMNS": "200"})
     files, documents = {}, {}
-    with contextlib.chdir(out):
+    with contextlib.chdir(out), without_pixels():
         for name, args in COMMANDS.items():
             done = runner.invoke(app, [*map(str, args), "--format", "json", "--out", name, "-q"])
             assert done.exit_code == 0, (name, done.output)

@@ -17,10 +17,11 @@ from pathlib import Path
 
 import pytest
 
-#: One worker runs this module (the manual is built once, by one worker; pytest-xdist --dist loadgroup).
-#: The build is session-scoped: the worker may run other modules' tests between these, which would
-#: tear a module-scoped fixture down and build the manual again (it was, 20 s each time).
-pytestmark = pytest.mark.xdist_group("docs")
+#: One worker runs the tests of the built manual (it is built once, by one worker; pytest-xdist --dist
+#: loadgroup); the others go to either. The build is session-scoped: the worker may run other
+#: modules' tests between these, which would tear a module-scoped fixture down and build the manual
+#: again (it was, 20 s each time).
+BUILT = pytest.mark.xdist_group("docs")
 
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text(encoding="utf-8")
@@ -71,6 +72,7 @@ def _fields(model, prefix=""):
                 pending += [arg for arg in typing.get_args(annotation) if not isinstance(arg, (str, int))]
 
 
+@BUILT
 def test_every_page_builds_and_the_examples_run(built):
     for page in PAGES:
         assert (built / f"{page}.html").exists(), page
@@ -79,6 +81,7 @@ def test_every_page_builds_and_the_examples_run(built):
     assert "4.398" in reproduction and "4.693" in reproduction  # foldopt.reproduce() ran at build time
 
 
+@BUILT
 def test_the_cli_reference_holds_every_command_and_option(built):
     import typer.main
 
@@ -195,6 +198,7 @@ def test_the_api_page_lists_every_public_name():
     assert len(shown) == len(set(shown))
 
 
+@BUILT
 def test_the_study_file_reference_holds_every_field(built):
     import foldopt
 

@@ -46,10 +46,11 @@ def snapshot(folder: Path) -> dict[str, tuple]:
 
 
 @pytest.fixture(scope="module")
-def finished(scheduler, tmp_path_factory) -> Path:
+def finished(scheduler, tmp_path_factory, without_pixels) -> Path:
     """A complete map of :func:`spec`, two chunks."""
     out = tmp_path_factory.mktemp("finished") / "map"
-    run_map(spec(), out, scheduler=scheduler)
+    with without_pixels():
+        run_map(spec(), out, scheduler=scheduler)
     return out
 
 

@@ -44,10 +44,11 @@ def world_map(scheduler, out, sites, loads, **keywords):
 
 
 @pytest.fixture(scope="module")
-def earlier(scheduler, tmp_path_factory) -> Path:
+def earlier(scheduler, tmp_path_factory, without_pixels) -> Path:
     """A complete map of two sites at 2 W."""
     out = tmp_path_factory.mktemp("earlier") / "map"
-    world_map(scheduler, out, [{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [2.0])
+    with without_pixels():
+        world_map(scheduler, out, [{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [2.0])
     return out
 
 
@@ -92,6 +93,7 @@ def test_a_new_map_whose_last_files_fail_is_not_complete_and_resumes(scheduler, 
     ([{"latitude": 45.0, "longitude": 8.0}], [2.0]),
     ([{"latitude": 45.0, "longitude": 8.0}], [1.0, 3.0]),
 ], ids=["no-site-carries", "all-equal", "one-site-one-load", "one-site-two-loads"])
+@pytest.mark.figure_pixels  # the figures of tables at their edges, drawn whole
 def test_every_figure_and_writer_copes_with_a_legal_table(scheduler, tmp_path, sites, loads):
     out = tmp_path / "map"
     run, figures, answer = world_map(scheduler, out, sites, loads)

@@ -19,6 +19,8 @@ import foldopt
 from foldopt.output.figures import FIGURES, annual, day, horizon, landscape, sizing, storage, sweep, weather, world
 
 ROOT = Path(__file__).resolve().parent.parent
+#: The figures themselves: drawn whole, pixels and all (tests/conftest.py draws others' without).
+pytestmark = pytest.mark.figure_pixels
 
 
 def test_the_registry_is_the_figures_of_the_examples():

@@ -17,7 +17,8 @@ from foldopt.cli.app import app
 #: One worker runs this module (the results folders are written once, by one worker; pytest-xdist --dist loadgroup).
 #: The folders are session-scoped: the worker may run other modules' tests between these, which
 #: would tear a module-scoped fixture down and write them again.
-pytestmark = pytest.mark.xdist_group("reports")
+#: Each report's images are the folder's PNGs, which a browser decodes: drawn whole (figure_pixels).
+pytestmark = [pytest.mark.xdist_group("reports"), pytest.mark.figure_pixels]
 
 runner = CliRunner()
 QUICK = ["--step-min", "30", "--angle-step", "30"]

@@ -161,24 +161,35 @@ def test_cells_follow_the_air_temperature_through_the_day(greensboro):
     np.testing.assert_allclose(sky.temp_air, (sky.temp_steps * lit).sum(axis=1) / lit.sum(axis=1))
 
 
+#: A year's study of single-diode panels on the TMY3 file or an EPW copy of it: three loads, from one
+#: that runs most of the day to one near the peak, and (the annual summary's) 2 and 4.4 W.
+SINGLE_DIODE_YEAR = {"name": "g", "panel": {"area": 0.108}, "p_load": [0.02, 1.0, 2.0, 4.0, 4.4],
+                     "pv_model": "single-diode", "objective": {"statistic": "mean"},
+                     "fold_angles": {"start": 10, "stop": 180, "step": 10}, "tracker": {"model": "single-axis"}}
+
+
+@pytest.fixture(scope="session")
+def single_diode_year():
+    """:data:`SINGLE_DIODE_YEAR` on the TMY3 file, run once: the year both tests below read."""
+    return run_plan(make_plan({**SINGLE_DIODE_YEAR, "weather": str(TMY3)}))
+
+
 @pytest.mark.parametrize("source", ["tmy3", "epw"])
-def test_t_solar_never_exceeds_daylight(tmp_path, greensboro, source):
+def test_t_solar_never_exceeds_daylight(tmp_path, greensboro, single_diode_year, source):
     # The light starts at sunrise and ends at sunset, so no design runs longer than the day: the
     # steps whose apparent sun is up, plus one step for the power's linear run into the first dark
     # step on either side.
-    path = TMY3
+    result = single_diode_year
     if source == "epw":
         path = tmp_path / "greensboro.epw"
         write_epw_year(path, read_weather(TMY3), weather_site(TMY3))
-    plan = make_plan({"name": "g", "weather": str(path), "panel": {"area": 0.108}, "p_load": [0.02, 1.0, 4.0],
-                      "pv_model": "single-diode", "fold_angles": {"start": 10, "stop": 180, "step": 10},
-                      "tracker": {"model": "single-axis"}})
-    table = run_plan(plan).table
+        result = run_plan(make_plan({**SINGLE_DIODE_YEAR, "weather": str(path)}))
+    table = result.table
     _, sky = greensboro
     daylight = (sky.solar_zenith < 90).sum(axis=1) * sky.step_hours
     day_of = dict(zip([d.isoformat() for d in YEAR], daylight, strict=True))
     allowed = table["date"].map(day_of).to_numpy() + sky.step_hours
-    assert len(table) == 365 * 3 * 4
+    assert len(table) == 365 * 5 * 4
     hours = table["t_solar_h"].to_numpy()
     assert np.all(hours <= allowed + 1e-9)
     tiny = (table["p_load_w"] == 0.02).to_numpy()
@@ -228,13 +239,10 @@ def test_trackers_park_while_the_sun_is_down(greensboro):
     np.testing.assert_allclose(poa.ravel()[low], np.nan_to_num(expected), rtol=1e-9, atol=1e-9)
 
 
-def test_annual_summary_has_the_years_totals(tmp_path):
+def test_annual_summary_has_the_years_totals(tmp_path, single_diode_year):
     from foldopt.output.folders import write_sweep
 
-    plan = make_plan({"name": "g", "weather": str(TMY3), "panel": {"area": 0.108}, "p_load": [2.0, 4.4],
-                      "pv_model": "single-diode", "objective": {"statistic": "mean"},
-                      "fold_angles": {"start": 10, "stop": 180, "step": 10}})
-    result = run_plan(plan)
+    result = single_diode_year
     write_sweep(result, tmp_path / "out")
     summary = pd.read_csv(tmp_path / "out" / "annual_summary.csv").set_index(["p_load_w", "design"])
     table = result.table
