@@ -172,13 +172,13 @@ def _run_length(start, count, step_hours, held):
 
 
 @njit(cache=True, nogil=True)
-def blocked_day(power, first, last, p_load, step_hours, above, whole, held, low, high, t_out):
+def blocked_day(power, span, p_load, step_hours, held, extremes, scratch, t_out):
     """t_solar of every load of ``p_load`` (ascending) of one power curve [W] into ``t_out``, as
     :func:`day_metrics` for constant loads without their longest runs, walking steps
-    ``first..last`` (its ``span``), given the lowest and the highest power (``low``, ``high``)
-    of each block of :data:`foldopt.engine.records.WALK_BLOCK` steps from ``first`` and the
-    lengths of runs of steps (``held``); ``above`` and ``whole`` are scratch, as the rest of a
-    chunk's :class:`foldopt.engine.records.Scratch`.
+    ``first..last`` (its ``span``), given the lowest and the highest power (``extremes``: low,
+    high) of each block of :data:`foldopt.engine.records.WALK_BLOCK` steps from ``first`` and
+    the lengths of runs of steps (``held``); ``scratch`` (above, whole) is the chunk's, as the
+    rest of its :class:`foldopt.engine.records.Scratch`.
 
     A block whose power stays between the same two loads adds whole steps to the run at its
     place among them and is not walked: a clear day's curve spends most of its steps above
@@ -187,6 +187,9 @@ def blocked_day(power, first, last, p_load, step_hours, above, whole, held, low,
     additions of the step in the same order as :func:`_day_steps`' pending sum, so that every
     value is the same bits. It is called, not inlined, with arrays rather than records: the
     kernel compiles faster, and the call costs less than the machine's noise."""
+    first, last = span
+    low, high = extremes
+    above, whole = scratch
     n_steps, n_loads, size = power.shape[0], p_load.shape[0], low.shape[0]
     above[:] = 0.0
     whole[:] = 0.0

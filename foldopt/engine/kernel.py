@@ -517,15 +517,12 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
             out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
             blocked_day(
                 work.power[0],
-                first,
-                last,
+                (first, last),
                 p_load,
                 loads.step_hours,
-                work.above,
-                work.whole,
                 held,
-                work.low,
-                work.high,
+                (work.low, work.high),
+                (work.above, work.whole),
                 out.t_solar[r, 0],
             )
             continue
