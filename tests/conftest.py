@@ -65,23 +65,50 @@ WARM_UP = "SUITE_WARM_UP_FOLDER"
 #: What each warm-up process runs (``python -c``): the numba functions the suite calls, in the
 #: argument types it calls them with, compiled into numba's cache. On a fresh clone each worker
 #: compiled them for itself, and again the Dask worker of the first map and the docs build, the
-#: compile costing more than most modules' tests; the two parts run beside the workers, which
-#: start with :data:`BEFORE_THE_WARM_UP`.
+#: compile costing more than most modules' tests. Three parts, each compiling what no other does,
+#: run beside the workers, which start with :data:`BEFORE_THE_WARM_UP`: the fold kernel's compile,
+#: the longest, alone in its process.
 WARM_UP_PARTS = {
-    "fold": """
+    "rows": """
+import numpy as np
 import foldopt
+from foldopt.engine import evaluation as engine
+from foldopt.engine.sky import build_sky
 from foldopt.inputs.study_file import default_study_path
+from foldopt.studies.engine_options import engine_options
 
-# The fold kernel and the curves' reduction; the circuit as built; a load profile's loads (read-only).
-for name in ("shin2015", "site-as-built", "camera-profile"):
-    foldopt.sweep(foldopt.load_study(default_study_path().parent / f"{name}.yaml"), step_min=15, engine="numba")
+# The fold kernel's rows: the ideal circuit's (the paper's study) and the circuit as built.
+for name in ("shin2015", "site-as-built"):
+    study = foldopt.load_study(default_study_path().parent / f"{name}.yaml")
+    options = engine_options(study)
+    orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth], [90.0, 180.0])
+    engine.row_metrics(build_sky(options.sky, [study.site], [study.date]), rows=engine.PanelRows(
+        np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)), loads=[1.0], electrical=options.electrical,
+        outputs=engine.OUTPUTS, contiguous=True, engine="numba")
+""",
+    "curves": """
+import numpy as np
+from foldopt.engine import evaluation as engine
+from foldopt.engine.curve_reduction import period_means
+from foldopt.engine.incidence import turning_poa
+
+# The reduction of given curves (a tracker's, a design's), a load profile's loads read-only; the
+# means over periods of days; a tracker's irradiance.
+power = np.zeros((2, 96))
+for shape in (None, np.ones(power.shape)):
+    engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba", load_shape=shape)
+period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))
+turning_poa(np.zeros((1, 1, 3)), np.zeros((1, 3, 1)), np.zeros((1, 1)), np.zeros((1, 1, 1)),
+            np.zeros((1, 2), dtype=np.int64), np.zeros((1, 1)))
 """,
     "storage": """
-import foldopt
-from foldopt.inputs.study_file import default_study_path
+import numpy as np
+from foldopt.engine.storage import Buffer, simulate
 
-# The buffer's simulation, the clear sky's and the sun's compiled terms.
-foldopt.run(foldopt.load_study(default_study_path().parent / "camera-buffer.yaml"), engine="numba")
+# The buffer's simulation: its parameters one per series (several series of one buffer), shared
+# (one series), or a capacity per series.
+for series, capacity in ((1, 1.0), (2, 1.0), (1, np.array([1.0, 2.0]))):
+    simulate(np.ones((series, 96)), 0.5, Buffer(capacity), 0.25, engine="numba")
 """,
 }
 #: The warm-up's processes (the controller's), to wait for or end at the session's end.
@@ -154,13 +181,17 @@ _warmed_up = False
 
 # --- the order of the suite -------------------------------------------------------------------------
 
-#: Modules that evaluate no study (physics against its references, the code's layout): what they
-#: compute does not hang on how far the warm-up has got (``auto`` takes the kernel for a smaller
-#: request once it is compiled), so the workers run them first, while the warm-up compiles.
-BEFORE_THE_WARM_UP = ("test_architecture.py", "test_atmosphere.py", "test_clearsky.py", "test_converter.py",
-                      "test_electrical.py", "test_geometry.py", "test_horizon.py", "test_irradiance.py",
-                      "test_metrics.py", "test_plan.py", "test_pvmodel.py", "test_pvsystem.py", "test_pvwatts.py",
-                      "test_solarposition.py", "test_tables.py", "test_tracker.py", "test_weather_measured.py")
+#: Modules that evaluate no study above ``auto``'s bound for a compiled kernel (physics against its
+#: references, the code's layout, days on the NumPy path): what they compute does not hang on how far
+#: the warm-up has got (``auto`` takes the kernel for a smaller request once it is compiled), so the
+#: workers run them first, while the warm-up compiles.
+BEFORE_THE_WARM_UP = ("test_weather_validation.py", "test_architecture.py", "test_aggregation.py",
+                      "test_near_optimal.py", "test_storage_section.py", "test_atmosphere.py", "test_clearsky.py",
+                      "test_converter.py", "test_electrical.py", "test_geometry.py", "test_horizon.py",
+                      "test_invariants.py", "test_irradiance.py", "test_metrics.py", "test_plan.py", "test_pvmodel.py",
+                      "test_pvsystem.py", "test_pvwatts.py", "test_registries.py", "test_reproduce.py",
+                      "test_solarposition.py", "test_sweep.py", "test_tables.py", "test_tracker.py", "test_weather.py",
+                      "test_weather_measured.py")
 #: Then the longest units of work (an xdist group, a module, or a test), longest first: each worker
 #: takes the next unit when it has two tests left, so that the long ones start early and the end is
 #: made of short tests, and the two workers finish together.
