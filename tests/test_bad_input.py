@@ -98,6 +98,9 @@ VALUES = [
     ("set-no-value", ["sweep", "angle", "--set", "albedo"], ["--set", "KEY=VALUE"]),
     ("set-unknown", ["sweep", "angle", "--set", "panel.colour=red"], ["panel.colour", "unknown field"]),
     ("set-bad-date", ["sweep", "angle", "--set", "date=2025-02-30"], ["date", "valid date"]),
+    # A study's date is held to the years a study's year is (inputs.fields.YEARS).
+    ("set-date-1800", ["sweep", "angle", "--set", "date=1800-06-21"], ["date", "[1901, 2099]"]),
+    ("run-date-2100", ["run", "--set", "date=2100-01-01"], ["date", "[1901, 2099]"]),
     ("set-alias", ["sweep", "angle", "--set", "p_load=*x"], ["--set p_load"]),
     ("blocking-diode", ["sweep", "angle", "--blocking-diode", "zener"], ["--blocking-diode", "shockley"]),
     ("bypass-diode", ["sweep", "angle", "--bypass-diode", "shockly"], ["--bypass-diode", "did you mean 'shockley'"]),
@@ -211,6 +214,7 @@ YAML_FILES = [
      ["objective", "FOLDOPT_MAX_ANNUAL_CELLS"]),
     ("site-text", fast_yaml(site="Los Angeles"), ["site"]),
     ("year-1800", fast_yaml(year=1800, date="1:365:7"), ["year", "[1901, 2099]"]),
+    ("date-1800", fast_yaml(date="1800-06-21"), ["date", "[1901, 2099]"]),
     ("objective-one-day", fast_yaml(objective={"statistic": "mean"}), ["objective", "several dates"]),
     ("weather-missing", fast_yaml(weather="nope.csv"), ["weather", "file not found"]),
     ("tags", "name: !!python/object:os.system x\n", ["config", "line 1"]),

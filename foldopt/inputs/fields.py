@@ -4,6 +4,7 @@ what a study's files hold (:class:`FilesRead`), which the models judge and never
 
 from __future__ import annotations
 
+import datetime as dt
 import math
 import types
 import typing
@@ -21,6 +22,39 @@ from pydantic import (
 )
 
 from foldopt.names import canonical
+
+
+#: Years of a study's days, checked alike for study files, sweeps, maps and a study's ``date``:
+#: well inside Python's calendar (years 1 to 9999; a year 0 or 10000 was a traceback) and pvlib's
+#: solar position.
+YEARS = (1901, 2099)
+
+
+def year_problem(year) -> str | None:
+    """Why a value cannot be a study's year.
+
+    Parameters
+    ----------
+    year : object
+
+    Returns
+    -------
+    str or None
+        The problem, or None for a whole year of :data:`YEARS`.
+    """
+    if isinstance(year, bool) or not isinstance(year, int) or not YEARS[0] <= year <= YEARS[1]:
+        return f"must be a whole year in [{YEARS[0]}, {YEARS[1]}]"
+    return None
+
+
+def _in_years(day: dt.date) -> dt.date:
+    if year_problem(day.year):
+        raise ValueError(f"must be a date of a year in [{YEARS[0]}, {YEARS[1]}]")
+    return day
+
+
+#: A study's day: a date of :data:`YEARS`.
+StudyDate = Annotated[dt.date, AfterValidator(_in_years)]
 
 
 def interval(lo, hi, *, lo_open=False, hi_open=False, unit=""):

@@ -22,7 +22,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from foldopt.errors import ConfigError
-from foldopt.inputs.fields import field_paths, list_depth, list_valued_fields
+from foldopt.inputs.fields import field_paths, list_depth, list_valued_fields, year_problem
 from foldopt.inputs.study_file import read_study, resolve_files
 from foldopt.inputs.reading import MAX_AXIS_VALUES, size_limit
 from foldopt.inputs.weather_files import (
@@ -52,28 +52,6 @@ MAX_EVALUATIONS = size_limit("MAX_EVALUATIONS", 20_000_000_000)
 #: Days x fold angles x loads of one annual group (a fixed angle chosen over the days), held at
 #: once: 8 bytes each.
 MAX_ANNUAL_CELLS = size_limit("MAX_ANNUAL_CELLS", 100_000_000)
-#: Years of a study's days, checked alike for study files, sweeps and maps: well inside Python's
-#: calendar (years 1 to 9999; a year 0 or 10000 was a traceback) and pvlib's solar position.
-YEARS = (1901, 2099)
-
-
-def year_problem(year) -> str | None:
-    """Why a value cannot be a study's year.
-
-    Parameters
-    ----------
-    year : object
-
-    Returns
-    -------
-    str or None
-        The problem, or None for a whole year of :data:`YEARS`.
-    """
-    if isinstance(year, bool) or not isinstance(year, int) or not YEARS[0] <= year <= YEARS[1]:
-        return f"must be a whole year in [{YEARS[0]}, {YEARS[1]}]"
-    return None
-
-
 _RANGE = re.compile(r"^\s*([^:\s]+)\s*:\s*([^:\s]+)\s*:\s*([^:\s]+)\s*$")
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _NUMERIC_RANGE = re.compile(rf"^\s*{_NUMBER}\s*:\s*{_NUMBER}\s*:\s*{_NUMBER}\s*$")

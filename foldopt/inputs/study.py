@@ -10,7 +10,6 @@ file's day are read by :func:`foldopt.inputs.study_file.resolve_files` and hande
 
 from __future__ import annotations
 
-import datetime as dt
 import math
 from typing import Annotated
 
@@ -27,7 +26,7 @@ from foldopt import names
 from foldopt.errors import ConfigError
 from foldopt.inputs import policy
 from foldopt.inputs.circuit_section import Circuit
-from foldopt.inputs.fields import FilesRead, StrictModel, interval, named
+from foldopt.inputs.fields import FilesRead, StrictModel, StudyDate, interval, named
 from foldopt.inputs.optimize_section import Optimize
 from foldopt.inputs.sections import (
     FoldAngles,
@@ -204,7 +203,7 @@ class Study(StrictModel):
     force_site: bool = Field(
         False, description="keep a site more than SITE_TOLERANCE_KM from the weather file's"
     )
-    date: dt.date
+    date: StudyDate
     panel: Panel
     p_load: interval(0, 1e6, lo_open=True, unit=" W") = Field(
         description="the load [W]; with a load_profile, the profile's scale [-]"

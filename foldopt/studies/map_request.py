@@ -22,7 +22,8 @@ from pathlib import Path
 from foldopt import names
 from foldopt.errors import ConfigError
 from foldopt.inputs.optimize_section import vary_names
-from foldopt.inputs.plan import check_distinct, parse_dates, parse_values, year_problem
+from foldopt.inputs.fields import year_problem
+from foldopt.inputs.plan import check_distinct, parse_dates, parse_values
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
 from foldopt.inputs.study import Study, make_study
 from foldopt.inputs.study_file import resolve_files

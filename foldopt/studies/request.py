@@ -40,6 +40,7 @@ from foldopt.capabilities import COMMAND_RUNS, COMMANDS, SET_BY_RUN, refusal
 from foldopt.engine.choice import engine_for
 from foldopt.errors import ConfigError
 from foldopt.inputs import policy
+from foldopt.inputs.fields import year_problem
 from foldopt.inputs.optimize_section import vary_names
 from foldopt.inputs.plan import Plan, make_plan, parse_values, range_parts
 from foldopt.inputs.study import Study
@@ -575,7 +576,7 @@ def _plan_request(command, study, data, lines, changes, labels, source, costs) -
         ):
             new["objective"] = {"statistic": "mean"}  # a year of weather at one fold angle
         study_year = _ISO_DATE.match(str(data.get("date", "")))
-        if "year" not in new and study_year:
+        if "year" not in new and study_year and not year_problem(int(study_year.group(1))):
             new["year"] = int(study_year.group(1))  # days of year are the study's year's
         if axis is not None or command == "optimize":
             new["name"] = command.replace(" ", "-")
