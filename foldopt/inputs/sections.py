@@ -246,7 +246,7 @@ def planes_panel(planes, geometry: str, tilt=None, azimuth=None) -> tuple[float,
             by = {key: float(value) for key, value in found[other].items()}
             hint = (
                 f"; the {other} geometry makes them (base tilt {by['surface_tilt']:.4g}, azimuth "
-                f"{by['surface_azimuth']:.4g}, fold {by['fold_angle']:.4g} deg): set geometry {other}"
+                f"{by['surface_azimuth']:.4g}, fold {by['fold_angle']:.4g} deg)"
             )
         raise ValueError(
             f"panel.planes: no {geometry} panel makes them within {PLANES_TOLERANCE_DEG:g} deg: "
@@ -259,12 +259,12 @@ def planes_panel(planes, geometry: str, tilt=None, azimuth=None) -> tuple[float,
     residual, first_east = planes_residual(flat, panel["fold_angle"], *given, geometry)
     if not float(residual) <= PLANES_TOLERANCE_DEG:
         keys = {key: value for key, value in (("tilt", tilt), ("azimuth", azimuth)) if value is not None}
-        named = " and ".join(f"panel.{key} {value:g} deg" for key, value in keys.items())
+        named = " and ".join(f"{key} {value:g} deg" for key, value in keys.items())
         raise ValueError(
             f"panel.planes: the planes are a {geometry} panel of base tilt "
             f"{panel['surface_tilt']:.4g}, azimuth {panel['surface_azimuth']:.4g} deg folded to "
-            f"{panel['fold_angle']:.4g} deg, not of the given {named}; leave "
-            f"{' and '.join(f'panel.{key}' for key in keys)} out"
+            f"{panel['fold_angle']:.4g} deg, not of the given {named}; leave the "
+            f"{' and '.join(keys)} out"
         )
     return float(given[0]), float(given[1]), panel["fold_angle"], bool(first_east)
 

@@ -70,6 +70,7 @@ KEYWORDS = {
     "efficiency": "panel.efficiency",
     "tilt": "panel.tilt",
     "azimuth": "panel.azimuth",
+    "planes": "panel.planes",
     "standby_w": "tracker.standby_w",
     "visits": "objective.visits",
 }
@@ -322,6 +323,12 @@ def _entries(command, data, options, settings, fields, optimize, target_h) -> li
     elif options:
         entries += _option_entries(options, data)
     for name, value in (fields or {}).items():
+        if name == "fold_angle":  # one angle, as --fold-angle gives it
+            try:
+                entries.append((name, {"fold_angles": one_fold_angle(value)}))
+            except ValueError as error:
+                raise ConfigError([f"fold_angle = {value!r}: {error}"]) from None
+            continue
         path = KEYWORDS.get(name, name)
         entries.append((name, {path: _plain(value)}))
     if optimize:
@@ -443,6 +450,8 @@ def _option_entries(options: dict, data: dict) -> list[tuple]:
                 "--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
                 "the study)"
             )
+    if options.get("fold_angle") is not None and options.get("angle_step") is not None:
+        errors.append("--fold-angle / --angle-step: one fold angle or a grid's step, not both")
     lonely = [
         option
         for option in ("weather_format", "members", "seed", "years")
@@ -477,6 +486,18 @@ def _option_entries(options: dict, data: dict) -> list[tuple]:
             value = {"path": str(value)}  # a new file: none of the study's file's options
         elif option in ("load_profile", "horizon"):
             value = {"file": str(value)}
+        elif option == "planes":
+            try:
+                value = parse_planes(value)
+            except ValueError as error:
+                errors.append(f"{label} = {options[option]!r}: {error}")
+                continue
+        elif option == "fold_angle":
+            try:
+                value = one_fold_angle(value)
+            except ValueError as error:
+                errors.append(f"{label} = {options[option]!r}: {error}")
+                continue
         if option == "load_voltage":
             # coupled directly: said as circuit.coupling, the field the option chose
             entries.append((label, {"circuit.coupling": "direct"}, False))
@@ -484,6 +505,48 @@ def _option_entries(options: dict, data: dict) -> list[tuple]:
     if errors:
         raise ConfigError(errors)
     return entries
+
+
+def parse_planes(text: str) -> list[list[float]]:
+    """``--planes``: two planes ``TILT/AZIMUTH,TILT/AZIMUTH`` [deg] as ``panel.planes`` takes them.
+
+    Parameters
+    ----------
+    text : str
+        ``9/14,9/194``.
+
+    Returns
+    -------
+    list of list of float
+        ``[[9.0, 14.0], [9.0, 194.0]]``; the ranges are the study's to check.
+
+    Raises
+    ------
+    ValueError
+        For anything but two pairs of numbers.
+    """
+    planes = [plane.split("/") for plane in str(text).split(",")]
+    try:
+        if len(planes) == 2 and all(len(plane) == 2 for plane in planes):
+            return [[float(part) for part in plane] for plane in planes]
+    except ValueError:
+        pass  # not numbers: said below
+    raise ValueError("expected two planes TILT/AZIMUTH,TILT/AZIMUTH [deg], e.g. 9/14,9/194")
+
+
+def one_fold_angle(angle) -> dict:
+    """``--fold-angle``: the fold-angle grid of that one angle [deg], as
+    ``--set fold_angles={start: X, stop: X, step: 1}`` gives it.
+
+    Raises
+    ------
+    ValueError
+        For anything but a number in (0, 180].
+    """
+    number = isinstance(angle, (int, float)) and not isinstance(angle, bool)
+    if not (number and 0.0 < angle <= FLAT_FOLD_ANGLE):
+        raise ValueError("must be one fold angle in (0, 180] deg")
+    return {"start": angle, "stop": angle, "step": 1}
 
 
 def _map_entries(options: dict, data: dict) -> list[tuple]:
@@ -586,6 +649,15 @@ def _plan_request(command, study, data, lines, changes, labels, source, costs) -
         taken = _taken(plan, given, field, new, decided) if command != "run" else decided
     run = _run_of(command, plan)
     _refuse_unhonoured(command, run, plan.base)
+    pinned = labels.get("fold_angles")
+    if pinned in ("--fold-angle", "fold_angle") and command == "optimize":
+        if "fold_angle" in plan.base.optimize.vary:
+            raise ConfigError(
+                [
+                    f"{pinned}: foldopt optimize searches the fold angle (its range: "
+                    "--fold-range); to hold one, leave fold_angle out of --vary"
+                ]
+            )
     _refuse_empty_season(plan)
     if _set_by_run(run, policy.flatten(changes)):
         raise ConfigError(_set_by_run(run, policy.flatten(changes)))
