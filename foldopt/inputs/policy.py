@@ -13,9 +13,10 @@ it is made. The rules, each said back to the user by :func:`apply`'s second valu
   exact) and its own sky (Ineichen with diffuse light in exact mode, the paper's beam-only Meinel
   sky in paper mode) unless the geometry or the sky is given;
 - a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
-  given; the planes of an existing array (``panel.planes``) bring their own base orientation (the
-  study's tilt and azimuth give way, each unless given) and, like an optimisation that turns the panel,
-  take a paper-mode study to exact mode unless the mode is given; a new latitude or longitude drops the site's name, a new longitude its time zone;
+  given; a new latitude or longitude drops the site's name, a new longitude its time zone;
+- the planes of an existing array (``panel.planes``) bring their own base orientation (the
+  study's tilt and azimuth give way, each unless given) and, like an optimisation that turns the
+  panel, take a paper-mode study to exact mode unless the mode is given;
 - a weather file brings its own site, year and light (the study's sky, site and day give way; the
   site fields given complete the file's), and a measured file (or a source read as one,
   ``pvgis-hourly``) its own days and step; a weather source is fetched for the study's latitude
@@ -249,8 +250,7 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         data.get("mode", "exact") == "paper"
         and "mode" not in given
         and (
-            (touched(given, "optimize") and {"tilt", "azimuth"} & set(_varied(optimize)))
-            or planes
+            (touched(given, "optimize") and {"tilt", "azimuth"} & set(_varied(optimize))) or planes
         )
     ):
         data["mode"] = "exact"

@@ -192,7 +192,9 @@ class Panel(StrictModel):
 PLANES_TOLERANCE_DEG = 0.1
 
 
-def planes_panel(planes, geometry: str, tilt=None, azimuth=None) -> tuple[float, float, float, bool]:
+def planes_panel(
+    planes, geometry: str, tilt=None, azimuth=None
+) -> tuple[float, float, float, bool]:
     """The twofold panel of a geometry that makes two given planes
     (:func:`foldopt.physics.geometry.fold_from_planes`), within :data:`PLANES_TOLERANCE_DEG`.
 
@@ -258,7 +260,9 @@ def planes_panel(planes, geometry: str, tilt=None, azimuth=None) -> tuple[float,
     )
     residual, first_east = planes_residual(flat, panel["fold_angle"], *given, geometry)
     if not float(residual) <= PLANES_TOLERANCE_DEG:
-        keys = {key: value for key, value in (("tilt", tilt), ("azimuth", azimuth)) if value is not None}
+        keys = {
+            key: value for key, value in (("tilt", tilt), ("azimuth", azimuth)) if value is not None
+        }
         named = " and ".join(f"{key} {value:g} deg" for key, value in keys.items())
         raise ValueError(
             f"panel.planes: the planes are a {geometry} panel of base tilt "

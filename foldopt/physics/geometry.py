@@ -224,8 +224,10 @@ def fold_from_planes(
     if geometry not in GEOMETRIES:
         raise ValueError(f"geometry must be one of {', '.join(GEOMETRIES)}; got {geometry!r}")
     tilt_1, azimuth_1, tilt_2, azimuth_2 = np.broadcast_arrays(
-        *(np.asarray(value, dtype=float) for value in
-          (surface_tilt_1, surface_azimuth_1, surface_tilt_2, surface_azimuth_2))
+        *(
+            np.asarray(value, dtype=float)
+            for value in (surface_tilt_1, surface_azimuth_1, surface_tilt_2, surface_azimuth_2)
+        )
     )
     first, second = normal_vector(tilt_1, azimuth_1), normal_vector(tilt_2, azimuth_2)
     between = _angle_between(first, second)

@@ -651,13 +651,12 @@ def _plan_request(command, study, data, lines, changes, labels, source, costs) -
     _refuse_unhonoured(command, run, plan.base)
     pinned = labels.get("fold_angles")
     if pinned in ("--fold-angle", "fold_angle") and command == "optimize":
-        if "fold_angle" in plan.base.optimize.vary:
-            raise ConfigError(
-                [
-                    f"{pinned}: foldopt optimize searches the fold angle (its range: "
-                    "--fold-range); to hold one, leave fold_angle out of --vary"
-                ]
-            )
+        raise ConfigError(
+            [
+                f"{pinned}: foldopt optimize searches the mounting over a grid of fold angles "
+                "(--fold-range); one fold angle is evaluated by foldopt sweep angle --fold-angle"
+            ]
+        )
     _refuse_empty_season(plan)
     if _set_by_run(run, policy.flatten(changes)):
         raise ConfigError(_set_by_run(run, policy.flatten(changes)))
@@ -749,6 +748,7 @@ _HAS = {
     "site.horizon": lambda study: study.site is not None and study.site.horizon is not None,
     "load_profile": lambda study: study.load_profile is not None,
     "optimize": lambda study: study.optimize is not None,
+    "panel.planes": lambda study: study.panel.planes is not None,
 }
 
 

@@ -135,7 +135,13 @@ def study_question(study, varied: tuple = ()) -> dict:
         "day": "varies (see the table)" if "date" in varied else study.date.isoformat(),
         "load": "varies (see the table)" if "p_load" in varied else load_text(study),
         "panel": f"{panel.area:g} m^2, efficiency {panel.efficiency:g}, tilt {panel.tilt:g} deg, azimuth "
-        f"{panel.azimuth:g} deg" + (" (per latitude)" if "site.latitude" in varied else ""),
+        f"{panel.azimuth:g} deg"
+        + (" (per latitude)" if "site.latitude" in varied else "")
+        + (
+            f" (the base of the planes {', '.join('/'.join(f'{v:g}' for v in p) for p in panel.planes)})"
+            if panel.planes is not None
+            else ""
+        ),
         "models": f"{study.mode} mode, {study.geometry} geometry, {study.pv_model} PV model, {study.connection}, "
         + sky_text(study, varied),
         "fold angles": f"{study.fold_angles.start:g} to {study.fold_angles.stop:g} deg by {study.fold_angles.step:g}",
@@ -302,6 +308,10 @@ def of_study(result) -> Answer:
             )
         )
         lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
+    planes = planes_part(study, by)
+    if planes is not None:
+        result_part["planes"] = planes
+        lines.append(planes_text(planes, hours["twofold"]))
     extras = []
     if not math.isnan(twofold["flat_area_ratio"]):
         extras.append(f"a flat panel would need {twofold['flat_area_ratio']:.2f}x the area")
@@ -338,6 +348,59 @@ def of_study(result) -> Answer:
         pd.DataFrame(),
         design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
         tuple(lines),
+    )
+
+
+def planes_part(study, by: pd.DataFrame) -> dict | None:
+    """The existing array's planes as they stand (``panel.planes``): which plane is which half,
+    the base and fold angle that make them, and the design's row of the summary; None without
+    planes.
+
+    Parameters
+    ----------
+    study : Study
+    by : pandas.DataFrame
+        The summary indexed by design.
+    """
+    from foldopt.studies.day import PLANES_DESIGN
+
+    design = study.planes_design()
+    if design is None:
+        return None
+    first, second = ([list(plane) for plane in study.panel.planes])[
+        :: 1 if design["first_east"] else -1
+    ]
+    row = by.loc[PLANES_DESIGN]
+    return {
+        "design": PLANES_DESIGN,
+        "plane_east": first,
+        "plane_west": second,
+        "surface_tilt": study.panel.tilt,
+        "surface_azimuth": study.panel.azimuth,
+        "geometry": study.geometry,
+        "fold_angle_deg": design["fold_angle"],
+        **{
+            column: float(row[column])
+            for column in ("t_solar_h", "energy_harvested_wh", "gain_vs_flat_pct")
+        },
+    }
+
+
+def planes_text(planes: dict, best_hours: float) -> str:
+    """The answer's line for the planes as they stand, against the best fold's t_solar [h]."""
+    east, west = (
+        "/".join(f"{value:g}" for value in planes[side]) for side in ("plane_east", "plane_west")
+    )
+    against = (
+        f", {_pct(100.0 * (planes['t_solar_h'] / best_hours - 1.0))} against the best fold"
+        if best_hours > 0
+        else ""
+    )
+    return (
+        f"the planes as they stand ({east} east, {west} west: base tilt "
+        f"{planes['surface_tilt']:.4g} deg, azimuth {planes['surface_azimuth']:.4g} deg, "
+        f"{planes['geometry']} folded to {_fold_text(planes['fold_angle_deg'])} deg): t_solar "
+        f"{_hours(planes['t_solar_h'])}, {planes['energy_harvested_wh']:.2f} Wh{against}"
     )
 
 
