@@ -97,8 +97,8 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
     ----------
     fold_angle : array_like
         Dihedral angle between the sub-panels [deg], in (0, 180]; 180 is flat.
-    surface_tilt, surface_azimuth : float
-        Orientation of the unfolded (flat) panel [deg].
+    surface_tilt, surface_azimuth : array_like
+        Orientation of the unfolded (flat) panel [deg], broadcast against ``fold_angle``.
     geometry : {'hinge', 'azimuth-split'}
         Parametrisation, see the module docstring.
 
@@ -140,7 +140,9 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
     fold_angle = np.asarray(fold_angle, dtype=float)
     turn = (FLAT_FOLD_ANGLE - fold_angle) / 2.0 * _east_sign(surface_azimuth)
     if geometry == "azimuth-split":
-        tilt = np.full_like(fold_angle, surface_tilt)
+        shape = np.broadcast_shapes(turn.shape, np.shape(surface_tilt))
+        tilt = np.broadcast_to(np.asarray(surface_tilt, dtype=float), shape).copy()
+        turn = np.broadcast_to(turn, shape)
         return {
             "surface_tilt_east": tilt,
             "surface_azimuth_east": (surface_azimuth - turn) % 360.0,
@@ -153,8 +155,11 @@ def subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry="hi
         # Rodrigues' rotation of the normal about the up-slope unit vector u, which is
         # perpendicular to it: n' = n cos(a) + (u x n) sin(a). u x n is horizontal and points to
         # azimuth - 90; the limit tilt -> 0 keeps u along the base azimuth's back direction.
-        up_slope = np.array(
-            [-np.cos(tilt) * np.sin(azimuth), -np.cos(tilt) * np.cos(azimuth), np.sin(tilt)]
+        up_slope = np.stack(
+            np.broadcast_arrays(
+                -np.cos(tilt) * np.sin(azimuth), -np.cos(tilt) * np.cos(azimuth), np.sin(tilt)
+            ),
+            axis=-1,
         )
         side = np.cross(up_slope, normal)
         angle = np.radians(turn)[..., None]
