@@ -107,10 +107,10 @@ CAPABILITIES = (
         "panel.planes",
         "an existing array's two halves as they stand (--planes): the base orientation and fold "
         "angle that make them, evaluated beside the best fold",
-        ("day",),
-        "an existing array is evaluated as it stands over one site and day (foldopt run, sweep "
-        "angle); elsewhere give the base and fold its planes make (--tilt, --azimuth, "
-        "--fold-angle), or leave panel.planes out",
+        ("day", "annual"),
+        "an existing array is evaluated as it stands at one site, over a day or the days of an "
+        "objective (foldopt run, sweep angle); elsewhere give the base and fold its planes make "
+        "(--tilt, --azimuth, --fold-angle), or leave panel.planes out",
     ),
     Capability(
         "optimize",

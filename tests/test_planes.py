@@ -16,7 +16,8 @@ import foldopt
 from foldopt.cli.app import app
 from foldopt.inputs.sections import PLANES_TOLERANCE_DEG
 from foldopt.physics.geometry import fold_from_planes, normal_vector, subpanel_orientation
-from foldopt.studies.day import PLANES_DESIGN, Day
+from foldopt.studies.day import Day
+from foldopt.studies.designs import PLANES_DESIGN
 from foldopt.studies.request import make_request
 
 runner = CliRunner()
@@ -330,3 +331,28 @@ def test_planes_given_to_a_run_of_many_days_say_the_design_to_give_instead():
     with pytest.raises(foldopt.ConfigError) as error:
         make_request("sweep day", settings=["panel.planes=[[9, 14], [9, 194]]"])
     assert "--tilt, --azimuth, --fold-angle" in error.value.errors[0]
+
+
+def test_over_the_days_of_an_objective_the_planes_are_the_one_angle_design_they_make():
+    """An annual run: the planes' row is the twofold panel pinned at their base and fold angle (the
+    refusal elsewhere says to give exactly that), by another path (design_metrics)."""
+    days = {"date": "2025-03-01:2025-09-30:30", "objective": "worst-month", "p_load": [1.0, 3.0],
+            "step_min": 30, "site.latitude": 47.0, "site.longitude": 8.0}
+    planes = foldopt.run(request=make_request("sweep day", fields={**days, "planes": [[9, 14], [9, 194]]}))
+    pinned = foldopt.run(request=make_request("sweep day", fields={**days, "tilt": 0.0, "azimuth": 104.0,
+                                                                   "fold_angle": 162.0, "mode": "exact"}))
+    table = planes.extras["annual_objective"].set_index(["p_load_w", "design"])
+    same = pinned.extras["annual_objective"].set_index(["p_load_w", "design"])
+    for load in (1.0, 3.0):
+        row, twofold = table.loc[(load, PLANES_DESIGN)], same.loc[(load, "twofold")]
+        assert row["fold_angle_deg"] == pytest.approx(162.0)
+        for column in ("t_solar_objective_h", "t_solar_mean_h"):
+            assert row[column] == pytest.approx(twofold[column], abs=1e-9)
+        assert row["worst_month"] == twofold["worst_month"]
+        # the flat panel at the planes' base is the pinned study's flat panel
+        assert table.loc[(load, "flat"), "t_solar_objective_h"] == same.loc[(load, "flat"), "t_solar_objective_h"]
+    part = planes.answer.result["planes"]
+    assert [case["p_load_w"] for case in part["per_case"]] == [1.0, 3.0]
+    assert part["fold_angle_deg"] == pytest.approx(162.0)
+    assert sum(line.count("the planes as they stand") for line in planes.answer.lines()) == 2
+    assert PLANES_DESIGN in set(planes.answer.designs["design"])

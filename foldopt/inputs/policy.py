@@ -274,7 +274,11 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     ):
         site.pop("timezone", None)  # the new longitude's standard offset
     new_latitude = touched(given, "site.latitude") or (weather is not None and "site" not in data)
-    if new_latitude and not (touched(given, "panel.tilt") or touched(given, "panel.azimuth")):
+    if (
+        new_latitude
+        and not planes
+        and not (touched(given, "panel.tilt") or touched(given, "panel.azimuth"))
+    ):
         panel = _section(data, "panel")
         dropped = [panel.pop(key, None) for key in ("tilt", "azimuth")]
         if any(value is not None for value in dropped):

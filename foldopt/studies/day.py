@@ -39,6 +39,7 @@ from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_f
 from foldopt.studies.sizing import flat_area_ratio
 from foldopt.studies.designs import (
     DESIGNS,
+    PLANES_DESIGN,
     Blocks,
     TrackerCurves,
     design_metrics,
@@ -56,9 +57,6 @@ from foldopt.engine.sky import build_sky
 from foldopt.studies.engine_options import engine_options
 from foldopt.physics.trackers import TRACKERS
 from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
-
-#: The design of an existing array's planes as they stand (``panel.planes``).
-PLANES_DESIGN = "twofold-planes"
 
 
 class Day:

@@ -884,6 +884,12 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
         ("storage", data.get("storage") is not None or policy.touched(flat, "storage")),
         ("load_profile", data.get("load_profile") is not None or "load_profile" in flat),
         ("site.horizon", horizon is not None),
+        (
+            "panel.planes",
+            isinstance(data.get("panel"), dict)
+            and data["panel"].get("planes") is not None
+            or flat.get("panel.planes") is not None,
+        ),
     ):
         if present:
             errors.append(
