@@ -196,9 +196,9 @@ Planes = Annotated[
     typer.Option(
         "--planes",
         metavar="TILT/AZIMUTH,TILT/AZIMUTH",
-        help="An existing array's two halves as they stand [deg], e.g. 9/14,9/194: foldopt finds "
-        "the base tilt, azimuth and fold angle that make them (--geometry) and evaluates that "
-        "design beside the best fold.",
+        help="An existing array's two halves as they stand [deg], e.g. 9/14,9/194: the base "
+        "tilt, azimuth and fold angle that make them (--geometry) are found and that design "
+        "evaluated beside the best fold.",
     ),
 ]
 FoldAngle = Annotated[

@@ -522,6 +522,7 @@ def objective_table(
     objective,
     near,
     spread: dict | None = None,
+    *,
     designs=DESIGNS,
 ) -> pd.DataFrame:
     """The objective of one annual group in its own terms, per load and design: the statistic, its
