@@ -257,11 +257,11 @@ def fold_from_planes(
         azimuth = np.where(opposite, np.nan, azimuth)
         fold_angle = np.where(opposite, 0.0, fold_angle)
     else:
+        # Level planes are parallel whatever their azimuths: the flat panel.
         arc = (azimuth_2 - azimuth_1 + 180.0) % 360.0 - 180.0  # in [-180, 180)
-        level = (tilt_1 == 0.0) & (tilt_2 == 0.0)
         tilt = (tilt_1 + tilt_2) / 2.0
-        azimuth = np.where(parallel | level, azimuth_1, (azimuth_1 + arc / 2.0) % 360.0)
-        fold_angle = np.where(parallel | level, FLAT_FOLD_ANGLE, FLAT_FOLD_ANGLE - np.abs(arc))
+        azimuth = np.where(parallel, azimuth_1, (azimuth_1 + arc / 2.0) % 360.0)
+        fold_angle = np.where(parallel, FLAT_FOLD_ANGLE, FLAT_FOLD_ANGLE - np.abs(arc))
     residual, first_east = planes_residual(
         (tilt_1, azimuth_1, tilt_2, azimuth_2), fold_angle, tilt, azimuth, geometry
     )

@@ -217,7 +217,8 @@ def make_request(
         ``--set KEY=VALUE`` texts (:func:`parse_setting`).
     fields : mapping, optional
         The API's keywords: dotted field paths, or the short names of :data:`KEYWORDS`, to values;
-        a list or a range ``"start:stop:step"`` sweeps a field.
+        a list or a range ``"start:stop:step"`` sweeps a field; ``fold_angle``, one fold angle
+        [deg] (:func:`one_fold_angle`, as ``--fold-angle``).
     optimize : mapping, optional
         A joint search's parameters (:func:`optimize_section`'s): ``vary``, ``fold_angle``,
         ``tilt``, ``azimuth``, ``tolerance_h``, and ``labels``, how messages name them.
@@ -486,15 +487,9 @@ def _option_entries(options: dict, data: dict) -> list[tuple]:
             value = {"path": str(value)}  # a new file: none of the study's file's options
         elif option in ("load_profile", "horizon"):
             value = {"file": str(value)}
-        elif option == "planes":
+        elif option in ("planes", "fold_angle"):
             try:
-                value = parse_planes(value)
-            except ValueError as error:
-                errors.append(f"{label} = {options[option]!r}: {error}")
-                continue
-        elif option == "fold_angle":
-            try:
-                value = one_fold_angle(value)
+                value = parse_planes(value) if option == "planes" else one_fold_angle(value)
             except ValueError as error:
                 errors.append(f"{label} = {options[option]!r}: {error}")
                 continue
