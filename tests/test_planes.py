@@ -186,6 +186,10 @@ def test_the_study_runs_at_the_base_the_planes_make():
          "panel folded shut (0 deg); the hinge geometry makes them (base tilt 0, azimuth 104, fold 162 deg)"),
         (["panel.planes=[[9, 14], [9, 194]]", "panel.tilt=5"], "not of the given tilt 5 deg; leave the tilt out"),
         (["panel.planes=[[9, 14], [9, 194]]", "panel.azimuth=180"], "not of the given azimuth 180 deg"),
+        (["panel.planes=[[9, 14], [9, 194]]", "panel.tilt=0", "panel.azimuth=280"],
+         "not of the given azimuth 280 deg; leave the azimuth out"),
+        (["panel.planes=[[9, 14], [9, 194]]", "panel.tilt=5", "panel.azimuth=200"],
+         "not of the given tilt 5 deg and azimuth 200 deg; leave the tilt and azimuth out"),
     ],
 )
 def test_planes_no_twofold_panel_makes_are_refused_in_one_line(settings_, words):

@@ -263,6 +263,25 @@ def planes_panel(
         keys = {
             key: value for key, value in (("tilt", tilt), ("azimuth", azimuth)) if value is not None
         }
+        # Name the one that misses alone, where one does (a tent's level tilt given is no fault).
+        alone = {
+            key: value
+            for key, value in keys.items()
+            if len(keys) == 2
+            and not float(
+                planes_residual(
+                    flat,
+                    panel["fold_angle"],
+                    *(
+                        value if key == name else panel[f"surface_{name}"]
+                        for name in ("tilt", "azimuth")
+                    ),
+                    geometry,
+                )[0]
+            )
+            <= PLANES_TOLERANCE_DEG
+        }
+        keys = alone or keys
         named = " and ".join(f"{key} {value:g} deg" for key, value in keys.items())
         raise ValueError(
             f"panel.planes: the planes are a {geometry} panel of base tilt "
