@@ -150,7 +150,9 @@ def sweep(
         Field names (``p_load``, ``date``, ``pv_model``...) or the short names of
         :data:`foldopt.studies.request.KEYWORDS` (``latitude``, ``area``, ``tilt``, ``visits``...): a
         value sets the field, a sequence or a range ``"start:stop:step"`` sweeps it; ``date``
-        also takes ``"year"``, ``objective`` a statistic (``"worst-month"``).
+        also takes ``"year"``, ``objective`` a statistic (``"worst-month"``); ``planes`` an
+        existing array's two ``[surface_tilt, surface_azimuth]`` [deg] (``panel.planes``), and
+        ``fold_angle`` one fold angle [deg], as ``--planes`` and ``--fold-angle``.
 
     Returns
     -------

@@ -104,6 +104,15 @@ CAPABILITIES = (
         "the panel's sizing and a map scale constant loads; give p_load (--p-load)",
     ),
     Capability(
+        "panel.planes",
+        "an existing array's two halves as they stand (--planes): the base orientation and fold "
+        "angle that make them, evaluated beside the best fold",
+        ("day", "annual"),
+        "an existing array is evaluated as it stands at one site, over a day or the days of an "
+        "objective (foldopt run, sweep angle); elsewhere give the base and fold its planes make "
+        "(--tilt, --azimuth, --fold-angle), or leave panel.planes out",
+    ),
+    Capability(
         "optimize",
         "the fold angle, tilt and azimuth searched together (foldopt optimize)",
         ("optimize", "map"),

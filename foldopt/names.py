@@ -364,6 +364,8 @@ FIELD_OPTIONS = (
     FieldOption("--efficiency", "panel.efficiency"),
     FieldOption("--tilt", "panel.tilt"),
     FieldOption("--azimuth", "panel.azimuth"),
+    FieldOption("--planes", "panel.planes"),
+    FieldOption("--fold-angle", "fold_angles"),
     FieldOption("--mode", "mode"),
     FieldOption("--geometry", "geometry"),
     FieldOption("--sky", "sky"),

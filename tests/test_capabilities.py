@@ -44,6 +44,7 @@ GIVEN = {
     "load_profile": {"load_profile": {"daily": {"00:00": 0.5, "12:00": 6.0}}},
     "optimize": {"optimize": {"vary": ["fold_angle", "tilt"], "tilt": {"min": 0, "max": 60,
                                                                        "step": 30}}},
+    "panel.planes": {"panel": {"area": 0.1, "efficiency": 0.2, "planes": [[9, 14], [9, 194]]}},
     # not a capability of the registry (every run but the sizing has a tracker): its own draw
     "tracker": {"tracker": {"standby_w": 0.5}},
 }

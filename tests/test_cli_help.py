@@ -238,13 +238,16 @@ def test_help_loads_none_of_the_studys_modules():
 
 
 #: The options of every sweep, as --help lists them; ``*`` marks those whose help says they take a
-#: range or a list. Recorded from main (7ff6a51) before each command became a function of its own.
+#: range or a list. Recorded from main (7ff6a51) before each command became a function of its own;
+#: --planes and --fold-angle added with issue 51.
 _SWEEP = ("--config --lat{o} --lon{o} --altitude --timezone --days/--date* --year --p-load{v} --load-profile "
-          "--p-load-scale{v} --area --efficiency --tilt{o} --azimuth --mode --geometry --sky --climate --weather "
+          "--p-load-scale{v} --area --efficiency --tilt{o} --azimuth --planes --mode --geometry --sky --climate "
+          "--weather "
           "--years --offline --weather-format --members --seed --force-site --transposition --albedo --iam "
           "--objective --visits --tracker --tracker-standby --pv-model --module --connection --switch-series "
           "--no-bypass --converter-efficiency --horizon --blocking-diode --bypass-diode --converter --load-voltage "
-          "--switch-resistance --temp-air --exact-electrical --step-min --angle-step --storage-wh --min-soc --set "
+          "--switch-resistance --temp-air --exact-electrical --step-min --angle-step --fold-angle --storage-wh "
+          "--min-soc --set "
           "--out --overwrite --quiet/-q --format --engine --table")
 #: Every command's options (``/`` joins an option's spellings; an argument in capitals), recorded so.
 RECORDED = {

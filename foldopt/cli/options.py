@@ -191,6 +191,24 @@ Azimuth = Annotated[
         "the latitude changes].",
     ),
 ]
+Planes = Annotated[
+    str | None,
+    typer.Option(
+        "--planes",
+        metavar="TILT/AZIMUTH,TILT/AZIMUTH",
+        help="An existing array's two halves as they stand [deg], e.g. 9/14,9/194: the base "
+        "tilt, azimuth and fold angle that make them (--geometry) are found and that design "
+        "evaluated beside the best fold.",
+    ),
+]
+FoldAngle = Annotated[
+    float | None,
+    typer.Option(
+        "--fold-angle",
+        help="Evaluate this one fold angle [deg] in (0, 180] (the grid "
+        "fold_angles={start: X, stop: X, step: 1}) [default: the study's grid].",
+    ),
+]
 Mode = Annotated[
     str | None,
     typer.Option(

@@ -14,6 +14,9 @@ it is made. The rules, each said back to the user by :func:`apply`'s second valu
   sky in paper mode) unless the geometry or the sky is given;
 - a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
   given; a new latitude or longitude drops the site's name, a new longitude its time zone;
+- the planes of an existing array (``panel.planes``) bring their own base orientation (the
+  study's tilt and azimuth give way, each unless given) and, like an optimisation that turns the
+  panel, take a paper-mode study to exact mode unless the mode is given;
 - a weather file brings its own site, year and light (the study's sky, site and day give way; the
   site fields given complete the file's), and a measured file (or a source read as one,
   ``pvgis-hourly``) its own days and step; a weather source is fetched for the study's latitude
@@ -242,11 +245,13 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
             **(optimize if isinstance(optimize, dict) else {}),
             "vary": changes["optimize.vary"],
         }
+    planes = touched(given, "panel.planes") and changes.get("panel.planes") is not None
     if (
         data.get("mode", "exact") == "paper"
         and "mode" not in given
-        and touched(given, "optimize")
-        and {"tilt", "azimuth"} & set(_varied(optimize))
+        and (
+            (touched(given, "optimize") and {"tilt", "azimuth"} & set(_varied(optimize))) or planes
+        )
     ):
         data["mode"] = "exact"
         decided.append(MOUNTING_NOTE)
@@ -269,11 +274,25 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     ):
         site.pop("timezone", None)  # the new longitude's standard offset
     new_latitude = touched(given, "site.latitude") or (weather is not None and "site" not in data)
-    if new_latitude and not (touched(given, "panel.tilt") or touched(given, "panel.azimuth")):
+    if (
+        new_latitude
+        and not planes
+        and not (touched(given, "panel.tilt") or touched(given, "panel.azimuth"))
+    ):
         panel = _section(data, "panel")
         dropped = [panel.pop(key, None) for key in ("tilt", "azimuth")]
         if any(value is not None for value in dropped):
             decided.append("panel tilted at |latitude| toward the equator")
+        data["panel"] = panel
+    if planes:
+        panel = _section(data, "panel")
+        dropped = [
+            panel.pop(key, None)
+            for key in ("tilt", "azimuth")
+            if not touched(given, f"panel.{key}")
+        ]
+        if any(value is not None for value in dropped):
+            decided.append("the panel's base orientation from the planes")
         data["panel"] = panel
     if "tracker.model" in given:
         tracker = _section(data, "tracker")

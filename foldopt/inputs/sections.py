@@ -140,6 +140,10 @@ class Panel(StrictModel):
         [deg] in [0, 90]; default |latitude|.
     azimuth : float, optional
         [deg] in [0, 360), clockwise from north; default facing the equator.
+    planes : tuple of two (surface_tilt, surface_azimuth) pairs, optional
+        [deg]: the two halves of an existing array as they stand, each tilt in [0, 90] and
+        azimuth in [0, 360); the study finds the base orientation and fold angle that make them
+        (:func:`planes_panel`) and evaluates that design beside the best fold.
     """
 
     area: interval(0, 1000, lo_open=True, unit=" m^2")
@@ -148,6 +152,144 @@ class Panel(StrictModel):
     azimuth: interval(0, 360, hi_open=True, unit=" deg") | None = Field(
         None, description="default: facing the equator"
     )
+    planes: tuple[tuple[float, float], tuple[float, float]] | None = Field(
+        None, description="the two halves' [surface_tilt, surface_azimuth] as built [deg]"
+    )
+
+    @field_validator("planes", mode="before")
+    @classmethod
+    def _two_planes(cls, planes):
+        """Two [tilt, azimuth] pairs of numbers, each in its range: one line for any fault."""
+        if planes is None:
+            return planes
+        pairs = planes if isinstance(planes, (list, tuple)) else ()
+        numbers = [
+            pair
+            for pair in pairs
+            if isinstance(pair, (list, tuple))
+            and len(pair) == 2
+            and all(
+                isinstance(value, (int, float))
+                and not isinstance(value, bool)
+                and math.isfinite(value)
+                for value in pair
+            )
+        ]
+        if len(pairs) != 2 or len(numbers) != 2:
+            raise ValueError(
+                "expected two [surface_tilt, surface_azimuth] pairs [deg], e.g. [[9, 14], [9, 194]]"
+            )
+        for index, (tilt, azimuth) in enumerate(numbers, start=1):
+            if not 0.0 <= tilt <= 90.0:
+                raise ValueError(f"plane {index}'s tilt {tilt:g} must be in [0, 90] deg")
+            if not 0.0 <= azimuth < 360.0:
+                raise ValueError(f"plane {index}'s azimuth {azimuth:g} must be in [0, 360) deg")
+        return tuple((float(tilt), float(azimuth)) for tilt, azimuth in numbers)
+
+
+#: How near [deg] a twofold panel must make the given planes (:func:`planes_panel`): the angle
+#: between each given plane's normal and the half made for it.
+PLANES_TOLERANCE_DEG = 0.1
+
+
+def planes_panel(
+    planes, geometry: str, tilt=None, azimuth=None
+) -> tuple[float, float, float, bool]:
+    """The twofold panel of a geometry that makes two given planes
+    (:func:`foldopt.physics.geometry.fold_from_planes`), within :data:`PLANES_TOLERANCE_DEG`.
+
+    Parameters
+    ----------
+    planes : tuple of two (surface_tilt, surface_azimuth) pairs
+        [deg].
+    geometry : str
+        One of :data:`foldopt.names.GEOMETRIES`.
+    tilt, azimuth : float, optional
+        A base orientation given beside the planes [deg]: kept where the panel it makes at the
+        planes' fold angle makes them too (a ridge tent's two ends), refused otherwise.
+
+    Returns
+    -------
+    surface_tilt, surface_azimuth, fold_angle : float
+        The flat panel's orientation and the fold angle [deg].
+    first_east : bool
+        Whether the first plane is the east half.
+
+    Raises
+    ------
+    ValueError
+        One line naming ``panel.planes``: no twofold panel of the geometry makes the planes (and
+        which geometry would), or the given tilt or azimuth is not the planes' base.
+    """
+    from foldopt.physics.geometry import fold_from_planes, planes_residual
+
+    flat = [value for plane in planes for value in plane]
+    found = {name: fold_from_planes(*flat, geometry=name) for name in names.GEOMETRIES}
+    panel = {key: float(value) for key, value in found[geometry].items()}
+    made = panel["residual"] <= PLANES_TOLERANCE_DEG
+    if not made:
+        tilts = f"tilts {flat[0]:g} and {flat[2]:g} deg"
+        other = next(
+            (
+                name
+                for name, other in found.items()
+                if name != geometry and float(other["residual"]) <= PLANES_TOLERANCE_DEG
+            ),
+            None,
+        )
+        if abs(flat[0] - flat[2]) > PLANES_TOLERANCE_DEG:
+            why = f"{tilts} differ: both halves of a twofold panel have one tilt"
+        elif panel["fold_angle"] == 0.0 and geometry == "azimuth-split":
+            why = "azimuths 180 deg apart would be an azimuth-split panel folded shut (0 deg)"
+        else:
+            why = "the halves face opposite ways, a panel folded shut (0 deg)"
+        hint = ""
+        if other is not None:
+            by = {key: float(value) for key, value in found[other].items()}
+            hint = (
+                f"; the {other} geometry makes them (base tilt {by['surface_tilt']:.4g}, azimuth "
+                f"{by['surface_azimuth']:.4g}, fold {by['fold_angle']:.4g} deg)"
+            )
+        raise ValueError(
+            f"panel.planes: no {geometry} panel makes them within {PLANES_TOLERANCE_DEG:g} deg: "
+            f"{why}{hint}"
+        )
+    given = (
+        panel["surface_tilt"] if tilt is None else tilt,
+        panel["surface_azimuth"] if azimuth is None else azimuth,
+    )
+    residual, first_east = planes_residual(flat, panel["fold_angle"], *given, geometry)
+    if not float(residual) <= PLANES_TOLERANCE_DEG:
+        keys = {
+            key: value for key, value in (("tilt", tilt), ("azimuth", azimuth)) if value is not None
+        }
+        # Name the one that misses alone, where one does (a tent's level tilt given is no fault).
+        alone = {
+            key: value
+            for key, value in keys.items()
+            if len(keys) == 2
+            and not float(
+                planes_residual(
+                    flat,
+                    panel["fold_angle"],
+                    *(
+                        value if key == name else panel[f"surface_{name}"]
+                        for name in ("tilt", "azimuth")
+                    ),
+                    geometry,
+                )[0]
+            )
+            <= PLANES_TOLERANCE_DEG
+        }
+        keys = alone or keys
+        named = " and ".join(f"{key} {value:g} deg" for key, value in keys.items())
+        raise ValueError(
+            f"panel.planes: the planes are a {geometry} panel of base tilt "
+            f"{panel['surface_tilt']:.4g}, azimuth {panel['surface_azimuth']:.4g} deg folded to "
+            f"{panel['fold_angle']:.4g} deg, not of the given {named}; leave the "
+            f"{' and '.join(keys)} out"
+        )
+    return float(given[0]), float(given[1]), panel["fold_angle"], bool(first_east)
 
 
 def default_orientation(latitude: float) -> tuple[float, float]:

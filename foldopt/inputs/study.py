@@ -37,6 +37,7 @@ from foldopt.inputs.sections import (
     Site,
     Tracker,
     default_orientation,
+    planes_panel,
 )
 from foldopt.inputs.storage_section import Storage
 from foldopt.inputs.weather_section import Weather
@@ -339,13 +340,47 @@ class Study(StrictModel):
         """The panel at ``|latitude|`` toward the equator where the study gives no tilt or azimuth:
         decided from the site (validated before the panel), not given (its fields set say so)."""
         site = info.data.get("site")
-        if site is None:
-            return panel  # a weather file's site not read yet: decided when it is
+        if site is None or panel.planes is not None:
+            # a weather file's site not read yet: decided when it is; planes make their own
+            return panel
         facing = dict(zip(("tilt", "azimuth"), default_orientation(site.latitude), strict=True))
         missing = {key: value for key, value in facing.items() if getattr(panel, key) is None}
         if not missing:
             return panel
         return Panel.model_construct(panel.model_fields_set, **{**dict(panel), **missing})
+
+    @model_validator(mode="after")
+    def _base_from_planes(self):
+        """The base orientation the panel's planes make under the study's geometry, decided, not
+        given (the panel's fields set say so); a tilt or azimuth given beside them must make the
+        planes too (:func:`foldopt.inputs.sections.planes_panel`)."""
+        panel = self.panel
+        if panel.planes is None:
+            return self
+        given = {key: getattr(panel, key) for key in ("tilt", "azimuth")}
+        tilt, azimuth, _, _ = planes_panel(panel.planes, self.geometry, **given)
+        base = Panel.model_construct(
+            panel.model_fields_set, **{**dict(panel), "tilt": tilt, "azimuth": azimuth}
+        )
+        object.__setattr__(self, "panel", base)  # frozen: the validation decides it once
+        return self
+
+    def planes_design(self) -> dict | None:
+        """The twofold design the panel's planes are, as it stands; None without planes.
+
+        Returns
+        -------
+        dict or None
+            ``fold_angle`` [deg] and ``first_east`` (the first plane is the east half), at the
+            panel's base orientation (:func:`foldopt.inputs.sections.planes_panel`).
+        """
+        panel = self.panel
+        if panel.planes is None:
+            return None
+        _, _, fold_angle, first_east = planes_panel(
+            panel.planes, self.geometry, panel.tilt, panel.azimuth
+        )
+        return {"fold_angle": fold_angle, "first_east": first_east}
 
     @property
     def decided(self) -> tuple[str, ...]:

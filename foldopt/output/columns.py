@@ -136,7 +136,8 @@ COLUMNS = (
     (
         "design",
         "",
-        "flat, twofold (at the optimum), twofold-heuristic, twofold-<connection>, tracker, "
+        "flat, twofold (at the optimum), twofold-heuristic, twofold-planes (an existing "
+        "array's planes as they stand, panel.planes), twofold-<connection>, tracker, "
         "tracker-net (net of its own draw), tracker:<model> and tracker:<model>-net",
     ),
     # the design's settings and its daily metrics

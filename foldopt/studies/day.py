@@ -39,6 +39,7 @@ from foldopt.engine.optimize import heuristic_fold_angle, noon_valley, optimal_f
 from foldopt.studies.sizing import flat_area_ratio
 from foldopt.studies.designs import (
     DESIGNS,
+    PLANES_DESIGN,
     Blocks,
     TrackerCurves,
     design_metrics,
@@ -674,7 +675,8 @@ def compare_designs(day: Day, sweep: FoldSweep, optimum: Optimum, engine: str) -
 
 def _other_designs(day: Day, sweep: FoldSweep, heuristic: Heuristic) -> dict:
     """The designs :func:`foldopt.studies.designs.design_metrics` leaves out: name -> (fold angle
-    [deg], NaN for a tracker; power [W], (n_time,)): the paper's heuristic, with I-V models each
+    [deg], NaN for a tracker; power [W], (n_time,)): the paper's heuristic, the planes of an
+    existing array as they stand (:data:`PLANES_DESIGN`), with I-V models each
     other connection at its own optimum, and every other tracker model as ``tracker:<model>``,
     gross and net of its own draw."""
     study = day.study
@@ -682,6 +684,10 @@ def _other_designs(day: Day, sweep: FoldSweep, heuristic: Heuristic) -> dict:
     if np.isfinite(heuristic.fold_angle_deg):
         angle = heuristic.fold_angle_deg
         others["twofold-heuristic"] = (angle, day.combined_power(np.array([angle]))[0])
+    planes = study.planes_design()
+    if planes is not None:  # the existing array's planes, as they stand
+        angle = planes["fold_angle"]
+        others[PLANES_DESIGN] = (angle, day.combined_power(np.array([angle]))[0])
     if day.electrical.pv.has_iv:
         for connection in ("parallel", "series", "independent", "switching"):
             if connection != study.connection:

@@ -37,6 +37,9 @@ from foldopt.physics.trackers import TrackerDrive, TrackerOptions, tracker_draw,
 from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
 DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
+#: The design of an existing array's planes as they stand (``panel.planes``), which a day's study
+#: and an annual group evaluate beside :data:`DESIGNS`.
+PLANES_DESIGN = "twofold-planes"
 
 
 def sky_tracker_orientation(sky: Sky, study: Study, model: str | None = None):
@@ -220,7 +223,7 @@ def tracker_curves(
     return TrackerCurves(orientation, power, draw, poa if sky.iam == "none" else None)
 
 
-def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = DEFAULT_ENGINE):
+def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = DEFAULT_ENGINE, fold_angles=None):
     """t_solar [h] of every block's twofold panel at every angle of the grid, for every load.
 
     Parameters
@@ -231,18 +234,21 @@ def fold_hours(sky: Sky, blocks: Blocks, loads, engine: str = DEFAULT_ENGINE):
     loads : array_like
         (n_loads,) [W].
     engine : {'auto', 'numba', 'numpy'}
+    fold_angles : array_like, optional
+        [deg]; default the study's grid.
 
     Returns
     -------
     fold_angles : numpy.ndarray
-        The study's fold-angle grid [deg], (n_angles,).
+        The fold angles [deg], (n_angles,).
     hours : numpy.ndarray
         (n_blocks, n_angles, n_loads).
     energy : numpy.ndarray
         Harvested energy [Wh], (n_blocks, n_angles).
     """
     study = blocks.study
-    fold_angles = np.asarray(study.fold_angles.grid())
+    grid = study.fold_angles.grid() if fold_angles is None else fold_angles
+    fold_angles = np.asarray(grid, dtype=float)
     orientation = engines.fold_orientations(
         study.geometry, blocks.tilt, blocks.azimuth, fold_angles
     )

@@ -70,6 +70,7 @@ KEYWORDS = {
     "efficiency": "panel.efficiency",
     "tilt": "panel.tilt",
     "azimuth": "panel.azimuth",
+    "planes": "panel.planes",
     "standby_w": "tracker.standby_w",
     "visits": "objective.visits",
 }
@@ -216,7 +217,8 @@ def make_request(
         ``--set KEY=VALUE`` texts (:func:`parse_setting`).
     fields : mapping, optional
         The API's keywords: dotted field paths, or the short names of :data:`KEYWORDS`, to values;
-        a list or a range ``"start:stop:step"`` sweeps a field.
+        a list or a range ``"start:stop:step"`` sweeps a field; ``fold_angle``, one fold angle
+        [deg] (:func:`one_fold_angle`, as ``--fold-angle``).
     optimize : mapping, optional
         A joint search's parameters (:func:`optimize_section`'s): ``vary``, ``fold_angle``,
         ``tilt``, ``azimuth``, ``tolerance_h``, and ``labels``, how messages name them.
@@ -322,6 +324,12 @@ def _entries(command, data, options, settings, fields, optimize, target_h) -> li
     elif options:
         entries += _option_entries(options, data)
     for name, value in (fields or {}).items():
+        if name == "fold_angle":  # one angle, as --fold-angle gives it
+            try:
+                entries.append((name, {"fold_angles": one_fold_angle(value)}))
+            except ValueError as error:
+                raise ConfigError([f"fold_angle = {value!r}: {error}"]) from None
+            continue
         path = KEYWORDS.get(name, name)
         entries.append((name, {path: _plain(value)}))
     if optimize:
@@ -443,6 +451,8 @@ def _option_entries(options: dict, data: dict) -> list[tuple]:
                 "--p-load-scale: scales a load profile; give one with --load-profile (or load_profile in "
                 "the study)"
             )
+    if options.get("fold_angle") is not None and options.get("angle_step") is not None:
+        errors.append("--fold-angle / --angle-step: one fold angle or a grid's step, not both")
     lonely = [
         option
         for option in ("weather_format", "members", "seed", "years")
@@ -477,6 +487,12 @@ def _option_entries(options: dict, data: dict) -> list[tuple]:
             value = {"path": str(value)}  # a new file: none of the study's file's options
         elif option in ("load_profile", "horizon"):
             value = {"file": str(value)}
+        elif option in ("planes", "fold_angle"):
+            try:
+                value = parse_planes(value) if option == "planes" else one_fold_angle(value)
+            except ValueError as error:
+                errors.append(f"{label} = {options[option]!r}: {error}")
+                continue
         if option == "load_voltage":
             # coupled directly: said as circuit.coupling, the field the option chose
             entries.append((label, {"circuit.coupling": "direct"}, False))
@@ -484,6 +500,48 @@ def _option_entries(options: dict, data: dict) -> list[tuple]:
     if errors:
         raise ConfigError(errors)
     return entries
+
+
+def parse_planes(text: str) -> list[list[float]]:
+    """``--planes``: two planes ``TILT/AZIMUTH,TILT/AZIMUTH`` [deg] as ``panel.planes`` takes them.
+
+    Parameters
+    ----------
+    text : str
+        ``9/14,9/194``.
+
+    Returns
+    -------
+    list of list of float
+        ``[[9.0, 14.0], [9.0, 194.0]]``; the ranges are the study's to check.
+
+    Raises
+    ------
+    ValueError
+        For anything but two pairs of numbers.
+    """
+    planes = [plane.split("/") for plane in str(text).split(",")]
+    try:
+        if len(planes) == 2 and all(len(plane) == 2 for plane in planes):
+            return [[float(part) for part in plane] for plane in planes]
+    except ValueError:
+        pass  # not numbers: said below
+    raise ValueError("expected two planes TILT/AZIMUTH,TILT/AZIMUTH [deg], e.g. 9/14,9/194")
+
+
+def one_fold_angle(angle) -> dict:
+    """``--fold-angle``: the fold-angle grid of that one angle [deg], as
+    ``--set fold_angles={start: X, stop: X, step: 1}`` gives it.
+
+    Raises
+    ------
+    ValueError
+        For anything but a number in (0, 180].
+    """
+    number = isinstance(angle, (int, float)) and not isinstance(angle, bool)
+    if not (number and 0.0 < angle <= FLAT_FOLD_ANGLE):
+        raise ValueError("must be one fold angle in (0, 180] deg")
+    return {"start": angle, "stop": angle, "step": 1}
 
 
 def _map_entries(options: dict, data: dict) -> list[tuple]:
@@ -586,6 +644,14 @@ def _plan_request(command, study, data, lines, changes, labels, source, costs) -
         taken = _taken(plan, given, field, new, decided) if command != "run" else decided
     run = _run_of(command, plan)
     _refuse_unhonoured(command, run, plan.base)
+    pinned = labels.get("fold_angles")
+    if pinned in ("--fold-angle", "fold_angle") and command == "optimize":
+        raise ConfigError(
+            [
+                f"{pinned}: foldopt optimize searches the mounting over a grid of fold angles "
+                "(--fold-range); one fold angle is evaluated by foldopt sweep angle --fold-angle"
+            ]
+        )
     _refuse_empty_season(plan)
     if _set_by_run(run, policy.flatten(changes)):
         raise ConfigError(_set_by_run(run, policy.flatten(changes)))
@@ -677,6 +743,7 @@ _HAS = {
     "site.horizon": lambda study: study.site is not None and study.site.horizon is not None,
     "load_profile": lambda study: study.load_profile is not None,
     "optimize": lambda study: study.optimize is not None,
+    "panel.planes": lambda study: study.panel.planes is not None,
 }
 
 
@@ -812,6 +879,12 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
         ("storage", data.get("storage") is not None or policy.touched(flat, "storage")),
         ("load_profile", data.get("load_profile") is not None or "load_profile" in flat),
         ("site.horizon", horizon is not None),
+        (
+            "panel.planes",
+            isinstance(data.get("panel"), dict)
+            and data["panel"].get("planes") is not None
+            or flat.get("panel.planes") is not None,
+        ),
     ):
         if present:
             errors.append(

@@ -15,6 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 from foldopt.studies.answer import Answer, plain, records
+from foldopt.studies.designs import PLANES_DESIGN
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.storage_answer import answer_part, buffer_text, year_lines
 from foldopt.studies.storage_days import DESIGN_COLUMNS, sequential
@@ -135,7 +136,13 @@ def study_question(study, varied: tuple = ()) -> dict:
         "day": "varies (see the table)" if "date" in varied else study.date.isoformat(),
         "load": "varies (see the table)" if "p_load" in varied else load_text(study),
         "panel": f"{panel.area:g} m^2, efficiency {panel.efficiency:g}, tilt {panel.tilt:g} deg, azimuth "
-        f"{panel.azimuth:g} deg" + (" (per latitude)" if "site.latitude" in varied else ""),
+        f"{panel.azimuth:g} deg"
+        + (" (per latitude)" if "site.latitude" in varied else "")
+        + (
+            f" (the base of the planes {', '.join('/'.join(f'{v:g}' for v in p) for p in panel.planes)})"
+            if panel.planes is not None
+            else ""
+        ),
         "models": f"{study.mode} mode, {study.geometry} geometry, {study.pv_model} PV model, {study.connection}, "
         + sky_text(study, varied),
         "fold angles": f"{study.fold_angles.start:g} to {study.fold_angles.stop:g} deg by {study.fold_angles.step:g}",
@@ -302,6 +309,17 @@ def of_study(result) -> Answer:
             )
         )
         lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
+    planes = planes_part(study)
+    if planes is not None:
+        row = by.loc[PLANES_DESIGN]
+        planes.update(
+            {
+                key: float(row[key])
+                for key in ("t_solar_h", "energy_harvested_wh", "gain_vs_flat_pct")
+            }
+        )
+        result_part["planes"] = planes
+        lines.append(planes_text(planes, "t_solar", hours["twofold"]))
     extras = []
     if not math.isnan(twofold["flat_area_ratio"]):
         extras.append(f"a flat panel would need {twofold['flat_area_ratio']:.2f}x the area")
@@ -338,6 +356,60 @@ def of_study(result) -> Answer:
         pd.DataFrame(),
         design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
         tuple(lines),
+    )
+
+
+def planes_part(study) -> dict | None:
+    """The existing array's planes as they stand (``panel.planes``): which plane is which half
+    and the base and fold angle that make them; None without planes.
+
+    Parameters
+    ----------
+    study : Study
+    """
+    design = study.planes_design()
+    if design is None:
+        return None
+    planes = [list(plane) for plane in study.panel.planes]
+    east, west = planes if design["first_east"] else planes[::-1]
+    return {
+        "design": PLANES_DESIGN,
+        "plane_east": east,
+        "plane_west": west,
+        "surface_tilt": study.panel.tilt,
+        "surface_azimuth": study.panel.azimuth,
+        "geometry": study.geometry,
+        "fold_angle_deg": design["fold_angle"],
+    }
+
+
+def planes_text(planes: dict, t_solar: str, best_hours: float) -> str:
+    """The answer's line for the planes as they stand (:func:`planes_part`).
+
+    Parameters
+    ----------
+    planes : dict
+        :func:`planes_part`'s, with the design's ``t_solar_h`` (a day's) or
+        ``t_solar_objective_h`` (over days) [h] and ``energy_harvested_wh`` [Wh].
+    t_solar : str
+        What its t_solar is: ``t_solar``, ``mean t_solar``.
+    best_hours : float
+        The best fold's, in the same terms [h].
+    """
+    east, west = (
+        "/".join(f"{value:g}" for value in planes[side]) for side in ("plane_east", "plane_west")
+    )
+    hours = planes.get("t_solar_h", planes.get("t_solar_objective_h"))
+    against = (
+        f", {_pct(100.0 * (hours / best_hours - 1.0))} against the best fold"
+        if best_hours > 0
+        else ""
+    )
+    return (
+        f"the planes as they stand ({east} east, {west} west: base tilt "
+        f"{planes['surface_tilt']:.4g} deg, azimuth {planes['surface_azimuth']:.4g} deg, "
+        f"{planes['geometry']} folded to {_fold_text(planes['fold_angle_deg'])} deg): {t_solar} "
+        f"{_hours(hours)}, {planes['energy_harvested_wh']:.2f} Wh{against}"
     )
 
 
@@ -502,6 +574,7 @@ def _of_annual(result) -> Answer:
             "worst_month",
             "t_solar_mean_h",
             "fold_angle_deg",
+            "energy_harvested_wh",
             *NEAR_OPTIMAL,
             *ENSEMBLE_COLUMNS,
         )
@@ -610,6 +683,20 @@ def _of_annual(result) -> Answer:
                 )
     if len(groups) > 8:
         lines.append(f"... and {len(groups) - 8} more cases (annual_objective.csv)")
+    planes = planes_part(study)
+    if planes is not None:
+        # The planes' rows of every case and load; the lines, of the first case's loads.
+        rows = objectives[objectives["design"] == PLANES_DESIGN]
+        best = objectives[objectives["design"] == "twofold"]["t_solar_objective_h"].to_numpy()
+        planes["per_case"] = records(
+            rows[[*keys, "t_solar_objective_h", "t_solar_mean_h", "energy_harvested_wh"]]
+        )
+        for case, best_hours in list(zip(planes["per_case"], best, strict=True))[:8]:
+            label = load_text(study, case.get("p_load_w")) + ": " if len(best) > 1 else ""
+            lines.append(
+                label + planes_text({**planes, **case}, f"{statistic} t_solar", best_hours)
+            )
+        part["planes"] = planes
     buffered = result.extras.get("storage_annual")
     if buffered is not None:
         # The buffer over the days, said once here for every view (studies.storage_answer).

@@ -24,6 +24,7 @@ import pandas as pd
 from foldopt.engine import evaluation as engines
 from foldopt.inputs.plan import Plan
 from foldopt.studies.designs import (
+    PLANES_DESIGN,
     DESIGNS,
     Blocks,
     design_metrics,
@@ -223,11 +224,18 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
     parts = blocks.chunks(loads.size)
     skies, daily = [], []
     sample: dict = {}
+    # The existing array's planes as they stand (panel.planes), beside the grid's angles.
+    planes = blocks.study.planes_design()
+    planes_days = []
     for part in parts:
         skies.append(sky_of(blocks[part]))
         _keep_sample(sample, skies[-1], blocks[part], blocks.members)
         fold_angles, hours, _ = fold_hours(skies[-1], blocks[part], loads, engine)
         daily.append(hours)
+        if planes is not None:
+            planes_days.append(
+                fold_hours(skies[-1], blocks[part], loads, engine, [planes["fold_angle"]])[1:]
+            )
         advance(len(blocks[part]) // blocks.members)
     members = blocks.members
     months = [date.month for date in blocks.dates[::members]]
@@ -317,6 +325,22 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
             blocks, loads, fold_angles[fixed], design_hours, months, objective, near, spread
         )
     }
+    if planes is not None:
+        hours = np.concatenate([chunk[0] for chunk in planes_days]).transpose(0, 2, 1)
+        table = objective_table(
+            blocks,
+            loads,
+            np.full(loads.size, planes["fold_angle"]),
+            hours,
+            months,
+            objective,
+            {},
+            designs=(PLANES_DESIGN,),
+        )
+        table["energy_harvested_wh"] = sum(float(chunk[1].sum()) for chunk in planes_days)
+        refold["annual_objective"] = pd.concat(
+            [refold["annual_objective"], table], ignore_index=True
+        )
     if objective.visits:
         refold.update(
             refold_tables(blocks, loads, fold_angles, daily, months, objective, design_hours)
@@ -498,6 +522,8 @@ def objective_table(
     objective,
     near,
     spread: dict | None = None,
+    *,
+    designs=DESIGNS,
 ) -> pd.DataFrame:
     """The objective of one annual group in its own terms, per load and design: the statistic, its
     value [h], for ``worst-month`` the month it is found in, the mean daily t_solar [h], the fold
@@ -513,7 +539,7 @@ def objective_table(
     fold_angles : array_like
         (n_loads,) the twofold panel's fold angle kept all year [deg].
     design_hours : numpy.ndarray
-        (days, loads, designs) daily t_solar [h] in :data:`DESIGNS` order.
+        (days, loads, designs) daily t_solar [h] in the order of ``designs``.
     months : array_like
         (days,) month of each day.
     objective : Objective
@@ -526,6 +552,9 @@ def objective_table(
         twofold panel's ``chosen_wins_pct`` and ``within_tolerance_pct`` (loads,)
         (:func:`foldopt.studies.objectives.ensemble_choice`). ``design_hours`` is then the
         members' mean day.
+    designs : sequence of str, default :data:`DESIGNS`
+        The designs of ``design_hours``; a twofold one (the planes of an existing array,
+        :data:`foldopt.studies.designs.PLANES_DESIGN`) kept at ``fold_angles``.
 
     Returns
     -------
@@ -549,7 +578,7 @@ def objective_table(
     site = blocks.study.site
     rows = []
     for index, load in enumerate(loads):
-        for d, design in enumerate(DESIGNS):
+        for d, design in enumerate(designs):
             twofold = design == "twofold"
             rows.append(
                 {
@@ -563,7 +592,7 @@ def objective_table(
                     "worst_month": int(month[index, d]) if month is not None else np.nan,
                     "t_solar_mean_h": float(design_hours[season][:, index, d].mean()),
                     "fold_angle_deg": float(fold_angles[index])
-                    if twofold
+                    if design.startswith("twofold")
                     else (FLAT_FOLD_ANGLE if design == "flat" else np.nan),
                     **{
                         key: float(value[index]) if twofold else np.nan
