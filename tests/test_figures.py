@@ -320,3 +320,25 @@ def test_the_independent_curve_says_it_runs_through_a_converter_per_sub_panel(ci
         assert ("not the load wired directly" in label) == (wired is not None)
         assert wired is None or wired in label
     assert not any("converter" in label for label in labels if label not in independent)
+
+
+@pytest.mark.parametrize("fixed", ["fold_angle_deg", "surface_tilt"])
+def test_a_landscape_of_one_fold_angle_or_one_tilt_is_the_objectives_line(fixed):
+    """optimize with one fold angle (or one tilt) searched: no surface to colour (pcolormesh and
+    contour need 2 x 2; it was an internal error), the objective along the other variable."""
+    import matplotlib.pyplot as plt
+
+    other = "surface_tilt" if fixed == "fold_angle_deg" else "fold_angle_deg"
+    along = np.array([0.0, 15.0, 30.0, 45.0])
+    objective = np.array([9.0, 9.4, 9.5, 9.1])
+    landscape_table = pd.DataFrame({fixed: 100.0, other: along, "t_solar_objective_h": objective})
+    designs = pd.DataFrame({"p_load_w": 2.0, "design": ["twofold", "twofold-default"], fixed: 100.0,
+                            other: [30.0, 15.0], "t_solar_objective_h": [9.5, 9.4]})
+    fig, ax = plt.subplots()
+    landscape.plot_landscape(landscape_table, designs, "t", ax=ax)
+    line, optimum, default = ax.get_lines()
+    assert np.array_equal(line.get_xdata(), along) and np.array_equal(line.get_ydata(), objective)
+    assert (optimum.get_xdata()[0], optimum.get_ydata()[0]) == (30.0, 9.5)
+    assert (default.get_xdata()[0], default.get_ydata()[0]) == (15.0, 9.4)
+    assert ax.get_ylabel() == "objective [h]"
+    plt.close(fig)

@@ -34,6 +34,42 @@ def plot_landscape(landscape: pd.DataFrame, designs: pd.DataFrame, title: str, a
         index="surface_tilt", columns="fold_angle_deg", values="t_solar_objective_h"
     )
     values = grid.to_numpy(dtype=float)
+    # One fold angle (or one tilt) searched leaves a line, not a surface: the objective along the
+    # other variable, the markers where they stand on it.
+    single = None if min(values.shape) > 1 else ("tilt" if values.shape[1] == 1 else "fold")
+    if single is None:
+        _draw_surface(fig, ax, grid, values)
+    elif single == "tilt":
+        ax.plot(grid.index, values[:, 0], color="tab:blue", label="objective [h]")
+    elif single == "fold":
+        ax.plot(grid.columns, values[0], color="tab:blue", label="objective [h]")
+    first = designs[designs["p_load_w"] == designs["p_load_w"].iloc[0]]
+    for design, marker, label in (
+        ("twofold", "*", "optimum"),
+        ("twofold-default", "o", "default mounting"),
+    ):
+        row = first[first["design"] == design].iloc[0]
+        x, y = row["fold_angle_deg"], row["surface_tilt"]
+        if single is not None:
+            x, y = (y if single == "tilt" else x), row["t_solar_objective_h"]
+        ax.plot(
+            x,
+            y,
+            marker,
+            color="red" if marker == "*" else "orange",
+            markersize=12 if marker == "*" else 7,
+            markeredgecolor="black",
+            label=f"{label}: {row['t_solar_objective_h']:.2f} h",
+        )
+    ax.set_xlabel("base tilt [deg]" if single == "tilt" else "fold angle [deg]")
+    ax.set_ylabel("objective [h]" if single is not None else "base tilt [deg]")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8, loc="lower right")
+    return ax
+
+
+def _draw_surface(fig, ax, grid: pd.DataFrame, values: np.ndarray):
+    """The objective's colours over tilt x fold angle, contours a few minutes below its top."""
     mesh = ax.pcolormesh(grid.columns, grid.index, values, shading="nearest", cmap="viridis")
     fig.colorbar(mesh, ax=ax, label="objective [h]")
     top = np.nanmax(values)
@@ -44,26 +80,6 @@ def plot_landscape(landscape: pd.DataFrame, designs: pd.DataFrame, title: str, a
             grid.columns, grid.index, values, levels=levels, colors="white", linewidths=0.7
         )
         ax.clabel(lines, fmt=lambda level: f"-{(top - level) * 60:.0f} min", fontsize=7)
-    first = designs[designs["p_load_w"] == designs["p_load_w"].iloc[0]]
-    for design, marker, label in (
-        ("twofold", "*", "optimum"),
-        ("twofold-default", "o", "default mounting"),
-    ):
-        row = first[first["design"] == design].iloc[0]
-        ax.plot(
-            row["fold_angle_deg"],
-            row["surface_tilt"],
-            marker,
-            color="red" if marker == "*" else "orange",
-            markersize=12 if marker == "*" else 7,
-            markeredgecolor="black",
-            label=f"{label}: {row['t_solar_objective_h']:.2f} h",
-        )
-    ax.set_xlabel("fold angle [deg]")
-    ax.set_ylabel("base tilt [deg]")
-    ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=8, loc="lower right")
-    return ax
 
 
 FIGURES = {
