@@ -143,7 +143,7 @@ def test_a_days_time_series_carries_the_light_and_air_it_used(tmp_path):
     series = pd.read_csv(tmp_path / "d" / "timeseries.csv")
     for column in ("ghi", "dni", "dhi", "temp_air", "wind_speed"):
         assert column in series, column
-    beam = series["dni"] * np.clip(np.cos(np.radians(series["solar_zenith"])), 0, None)
+    beam = series["dni"] * np.clip(np.cos(np.radians(series["apparent_zenith"])), 0, None)
     np.testing.assert_allclose(series["ghi"], beam + series["dhi"], atol=1e-6)
     assert series["temp_air"].nunique() > 100  # the cells follow the air through the day
 

@@ -321,7 +321,9 @@ def _file_days(index: pd.DatetimeIndex, held: np.ndarray, day: np.ndarray, step:
     per_day = int(pd.Timedelta(days=1) / step)
     days = held.size // per_day
     lit = (held & day).reshape(days, per_day).any(axis=1)
-    first, last = (int(np.argmax(lit)), days - 1 - int(np.argmax(lit[::-1]))) if lit.any() else (0, days - 1)
+    first, last = (
+        (int(np.argmax(lit)), days - 1 - int(np.argmax(lit[::-1]))) if lit.any() else (0, days - 1)
+    )
     notes = []
     dates = index[::per_day].tz_localize(None).date
     for lo, hi in ((0, first), (last + 1, days)):
