@@ -51,11 +51,18 @@ def pvgis_years():
     return foldopt.run(request=request)
 
 
-@pytest.mark.parametrize("name", ["measured", "pvgis_years"])
+@pytest.fixture(scope="module")
+def days_at_sites():
+    """configs/annual.yaml on every 91st day: clear days at three latitudes, each at its own best
+    fold angle (no objective)."""
+    return foldopt.run(request=make_request("run", ROOT / "configs" / "annual.yaml", fields={"date": "1:365:91"}))
+
+
+@pytest.mark.parametrize("name", ["measured", "pvgis_years", "days_at_sites"])
 def test_the_series_is_the_evaluation_the_answer_comes_from(request, name):
-    """Every day, load and design: the series' power re-integrated (the reference above) is the
-    table's t_solar, and its solar_powered steps times the step are within half a step of it at
-    each crossing of the load; the twofold panel's fold angle is the table's."""
+    """Every site, day, load and design: the series' power re-integrated (the reference above) is
+    the table's t_solar, and its solar_powered steps times the step are within half a step of it
+    at each crossing of the load; the twofold panel's fold angle is the table's."""
     result = request.getfixturevalue(name)
     series, table = result.timeseries, result.table
     step_h = result.plan.base.step_min / 60 if result.plan.base.step_min else None
@@ -64,8 +71,11 @@ def test_the_series_is_the_evaluation_the_answer_comes_from(request, name):
     assert set(np.unique(series["p_load_w"])) == set(table["p_load_w"])
     assert len(series) == len(table) // 4 * round(24 / step_h)  # every step of every case's day
     checked = 0
-    for (load, day), rows in series.groupby([series["p_load_w"].to_numpy(), days.date]):
-        case = table[(table["p_load_w"] == load) & (table["date"] == day.isoformat())].set_index("design")
+    keys = [series["latitude"].to_numpy(), series["p_load_w"].to_numpy(), days.date]
+    for (latitude, load, day), rows in series.groupby(keys):
+        case = table[(table["latitude"] == latitude) & (table["p_load_w"] == load)
+                     & (table["date"] == day.isoformat())].set_index("design")
+        assert len(case) == 4
         assert rows["fold_angle_deg"].nunique() == 1
         assert rows["fold_angle_deg"].iloc[0] == case.loc["twofold", "fold_angle_deg"]
         for design in DESIGNS:

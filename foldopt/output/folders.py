@@ -18,7 +18,7 @@ from foldopt.tables import write_csv
 from foldopt.studies.annual import annual_cases, annual_summary
 from foldopt.studies.day import StudyResult
 from foldopt.studies.horizon_paths import sun_paths
-from foldopt.studies.series import series_file
+from foldopt.studies.series import parquet_options, series_file
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -298,7 +298,7 @@ def write_series(series: pd.DataFrame, folder: Path) -> str:
     (pyarrow) above :data:`foldopt.studies.series.PARQUET_ROWS` rows; return the file's name."""
     name = series_file(series)
     if name.endswith(".parquet"):
-        series.to_parquet(folder / name, engine="pyarrow", compression="zstd")
+        series.to_parquet(folder / name, engine="pyarrow", **parquet_options(series))
     else:
         write_csv(series, folder / name, index=True)
     return name

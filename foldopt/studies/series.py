@@ -24,6 +24,10 @@ from foldopt.engine.sky import Sky
 
 #: Rows of a study's series above which it is written as ``timeseries.parquet``, not ``.csv``.
 PARQUET_ROWS = 20_000
+#: Columns of a series that hold one value a case (or a site): a parquet file keeps them as a
+#: dictionary; the other numbers byte-stream-split, which makes a year of minutes a fifth
+#: smaller than plain zstd, and faster to write.
+CASE_COLUMNS = ("latitude", "p_load_w", "fold_angle_deg")
 #: The zenith a mode's sun gives, by pvlib's names: exact mode's SPA refracted (the apparent
 #: zenith), paper mode's geometric (Shin et al.'s Eq. 3-6, no refraction).
 ZENITH = {"exact": "apparent_zenith", "paper": "zenith"}
@@ -190,19 +194,45 @@ def year_series(pieces: list, timezone) -> pd.DataFrame:
         ``solar_powered_flat``, ``_twofold``, ``_tracker``.
     """
     n_loads = pieces[0]["p_load_w"].shape[1]
-    whole = {name: np.concatenate([piece[name] for piece in pieces]) for name in pieces[0]}
+    sizes = [piece["utc_ns"].shape[0] for piece in pieces]
+    starts = np.cumsum([0, *sizes])
+    n_steps = pieces[0]["utc_ns"].shape[1]
 
-    def per_load(values):
-        # (days, steps) repeats for each load; (days, loads, steps) is taken load by load.
-        if values.ndim == 2:
-            return np.tile(values.ravel(), n_loads)
-        return np.moveaxis(values, 1, 0).ravel()
+    def per_load(name, out):
+        # Written in place, a load after another: (days, steps) repeats for each load,
+        # (days, loads, steps) is taken load by load.
+        laid = out.reshape(n_loads, starts[-1], n_steps)
+        for piece, first, last in zip(pieces, starts[:-1], starts[1:], strict=True):
+            values = piece[name]
+            laid[:, first:last] = values[None] if values.ndim == 2 else np.moveaxis(values, 1, 0)
+        return out
 
-    time = pd.DatetimeIndex(per_load(whole.pop("utc_ns")).astype("datetime64[ns]"), tz="UTC")
-    return pd.DataFrame(
-        {name: per_load(values) for name, values in whole.items()},
-        index=time.tz_convert(timezone).rename("time"),
-    )
+    rows = n_loads * starts[-1] * n_steps
+    utc = per_load("utc_ns", np.empty(rows, dtype=np.int64))
+    time = pd.DatetimeIndex(utc.astype("datetime64[ns]"), tz="UTC").tz_convert(timezone)
+    names = [name for name in pieces[0] if name != "utc_ns"]
+    floats = [name for name in names if pieces[0][name].dtype.kind == "f"]
+    # The numbers as one block, column by column, that the frame takes as it is (no copy).
+    block = np.empty((len(floats), rows))
+    for index, name in enumerate(floats):
+        per_load(name, block[index])
+    frame = pd.DataFrame(block.T, columns=floats, index=time.rename("time"), copy=False)
+    for name in (name for name in names if name not in floats):
+        frame[name] = per_load(name, np.empty(rows, dtype=pieces[0][name].dtype))
+    return frame
+
+
+def parquet_options(series: pd.DataFrame) -> dict:
+    """pyarrow's ``write_table`` options for a series (:data:`CASE_COLUMNS`)."""
+    cases = [name for name in CASE_COLUMNS if name in series]
+    numbers = [
+        name for name, dtype in series.dtypes.items() if dtype.kind == "f" and name not in cases
+    ]
+    return {
+        "compression": "zstd",
+        "use_dictionary": cases,
+        "column_encoding": dict.fromkeys(numbers, "BYTE_STREAM_SPLIT"),
+    }
 
 
 def series_file(series: pd.DataFrame) -> str:

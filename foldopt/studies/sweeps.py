@@ -255,7 +255,10 @@ def run_plan(
             (study.site, study.date, choice) for study, choice in zip(studies, choices, strict=True)
         ]
         if over_days:
-            series.append(year_series(pieces, zones[0]))
+            # Local times where the sites share a time zone; UTC where they do not.
+            series.append(
+                year_series(pieces, zones[0] if len(set(map(str, zones))) == 1 else "UTC")
+            )
     table = _table(
         cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]}
     )
