@@ -6,6 +6,7 @@ are known: ``DAYS`` whole local days from ``FIRST``."""
 
 from __future__ import annotations
 
+import json
 import re
 
 import numpy as np
@@ -16,6 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from foldopt.inputs.weather.measured import read_measured
+from test_cli import invoke
 
 SITE = {"latitude": 39.74, "longitude": -105.18, "altitude": 1829.0, "timezone": "UTC-07:00"}
 ZONE = "Etc/GMT+7"  # UTC-07:00
@@ -101,3 +103,25 @@ def test_start_or_end_labels_of_the_same_light_give_the_same_days_and_energy(
              for label, weather in read.items()}
     pd.testing.assert_series_equal(daily["start"], daily["end"])
     assert _filled_minutes(read["start"].report()) == _filled_minutes(read["end"].report())
+
+
+def test_the_answer_counts_the_files_days_and_says_what_was_filled(tmp_path):
+    """Through the command line: an end-labelled 10-min file beginning at 00:00 is a study of its
+    three days from the first, and the answer says the day before is not counted and the last
+    period's 10 min were filled; its series holds those days' steps."""
+    path = tmp_path / "end.csv"
+    _file(path, f"{FIRST:%Y-%m-%d} 00:00", 10, "end", DAYS * 144)
+    out = tmp_path / "s"
+    result = invoke("sweep", "angle", "--weather", path, "--weather-format", "csv", "--lat", SITE["latitude"],
+                    "--lon", SITE["longitude"], "--altitude", SITE["altitude"], "--timezone", SITE["timezone"],
+                    "--p-load", "2", "--angle-step", "30", "--out", out, "--format", "json")
+    assert result.exit_code == 0, result.output
+    answer = json.loads(result.stdout)["answer"]
+    notes = [note["note"] for note in answer["notes"]]
+    assert notes[0].split(": ", 1)[1].startswith("10-min steps, 3 days (2022-10-01 to 2022-10-03)")
+    assert "2022-09-30 not counted: the file holds only 10 min of it, all at night" in notes
+    assert any(note.startswith("10 min after the file's last period filled (2022-10-03 23:50 to 00:00; night")
+               for note in notes)
+    assert not any("daylight gap" in note and "no daylight gaps" not in note for note in notes)
+    series = pd.read_csv(out / "timeseries.csv")
+    assert sorted({stamp[:10] for stamp in series["time"]}) == ["2022-10-01", "2022-10-02", "2022-10-03"]
