@@ -277,6 +277,7 @@ def design_metrics(
     chosen,
     engine: str,
     tracker: TrackerCurves | None = None,
+    *,
     curves: bool = False,
     curve_outputs: tuple = CONNECTIONS,
 ) -> dict:

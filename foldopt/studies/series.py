@@ -5,8 +5,8 @@ each design runs the load (``timeseries.csv`` of a day's study and of a study ov
 Every column comes from the evaluation the study's numbers come from: the power curves its
 rows' ``t_solar`` were reduced from (:func:`foldopt.studies.designs.design_metrics`' ``curves``),
 the tracker its rows were reduced from and the sky they saw, so that a design's
-``solar_powered_<design>`` steps, times the step, are its ``t_solar`` to within a step at each
-crossing of the load (``t_solar`` takes the power as linear between step centres). Whole arrays,
+``solar_powered_<design>`` steps, times the step, are its ``t_solar`` to within half a step at
+each crossing of the load (``t_solar`` takes the power as linear between step centres). Whole arrays,
 (blocks, steps) or (blocks, loads, steps): no loop over the steps.
 
 A study over many days writes its series as ``timeseries.csv`` up to :data:`PARQUET_ROWS` rows and

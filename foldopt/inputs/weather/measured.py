@@ -13,7 +13,10 @@ what was derived, filled and left out. In this order, vectorised over the steps:
 2. The step is the modal spacing of the stamps; a duplicate stamp or one off that grid is
    refused. Each stamp moves to its interval's centre (``label``, else the format's convention),
    on the site's standard time; the steps of whole local days are laid out, and the file's values
-   placed on them: steps the file lacks are missing.
+   placed on them: steps the file lacks are missing. An edge day of which the file holds no
+   daylight step is no day of the file (an end-labelled file beginning at 00:00 holds of the day
+   before only the night period that ends at midnight): it is left out, and the minutes the file
+   leaves of its first and last days are reported filled (``_file_days``).
 3. Physical bounds, QCRad's "physically possible" limits [1]_ [2]_ with the extraterrestrial
    normal irradiance ``E0`` and the cosine of the solar zenith ``mu0`` at the interval centre:
    ``ghi <= 1.5 E0 mu0^1.2 + 100``, ``dni <= E0``, ``dhi <= 0.95 E0 mu0^1.2 + 50`` W/m^2; where two
