@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from foldopt.inputs.weather.measured import read_measured
-from test_cli import invoke
+from test_cli import assert_one_line_error, invoke
 
 SITE = {"latitude": 39.74, "longitude": -105.18, "altitude": 1829.0, "timezone": "UTC-07:00"}
 ZONE = "Etc/GMT+7"  # UTC-07:00
@@ -125,3 +125,20 @@ def test_the_answer_counts_the_files_days_and_says_what_was_filled(tmp_path):
     assert not any("daylight gap" in note and "no daylight gaps" not in note for note in notes)
     series = pd.read_csv(out / "timeseries.csv")
     assert sorted({stamp[:10] for stamp in series["time"]}) == ["2022-10-01", "2022-10-02", "2022-10-03"]
+
+
+def test_a_day_with_a_long_daylight_gap_asked_for_is_one_line(tmp_path):
+    """A gap inside the file is no edge: 150 daylight minutes missing on its second day leave that
+    day in the file, flagged, and a study of it is refused in one line."""
+    path = tmp_path / "gap.csv"
+    _file(path, f"{FIRST:%Y-%m-%d} 00:10", 10, "end", DAYS * 144)
+    lines = path.read_text().splitlines(keepends=True)
+    gap = {f"2022-10-02T{hour:02d}:{minute:02d}" for hour in (10, 11, 12) for minute in range(0, 60, 10)}
+    path.write_text("".join(line for line in lines if line[:16] not in gap))
+    weather = read_measured(path, "csv", label="end", site=SITE)
+    assert [str(day) for day in weather.flagged_days] == ["2022-10-02"] and len(weather.frame) == DAYS * 144
+    assert_one_line_error(
+        invoke("sweep", "angle", "--weather", path, "--weather-format", "csv", "--lat", SITE["latitude"], "--lon",
+               SITE["longitude"], "--altitude", SITE["altitude"], "--timezone", SITE["timezone"], "--days",
+               "2022-10-02", "--out", tmp_path / "b"),
+        "2022-10-02", "daylight gap too long to fill")
