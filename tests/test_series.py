@@ -154,3 +154,19 @@ def test_a_days_series_names_its_zenith_and_integrates_to_its_t_solar(mode):
         flag = series[f"solar_powered_{design}"].to_numpy()
         assert flag.sum() * step_h == pytest.approx(summary.loc[design, "t_solar_h"], abs=step_h)
     assert (series["poa_global_east_w_m2"] >= 0).all() and series["poa_global_west_w_m2"].max() > 0
+
+
+def test_a_series_too_long_to_hold_is_not_made_and_the_answer_says_so(monkeypatch):
+    """Above MAX_ROWS rows (days x loads x steps) no series is made; the answer says why and how to
+    get one; the table is the same."""
+    monkeypatch.setattr(series_module, "MAX_ROWS", 1727)  # measured-minutes: 3 days x 2 loads x 288 steps
+    result = foldopt.run(MEASURED)
+    assert result.timeseries is None
+    notes = [note["note"] for note in result.answer.to_dict()["notes"]]
+    assert ("no timeseries: its 1,728 rows (days x loads x steps) are above 1,727; fewer days or loads, "
+            "or a longer step_min, write it") in notes
+    monkeypatch.setattr(series_module, "MAX_ROWS", 1728)
+    kept = foldopt.run(MEASURED)
+    assert len(kept.timeseries) == 1728 and not any(note["note"].startswith("no timeseries")
+                                                    for note in kept.answer.to_dict()["notes"])
+    pd.testing.assert_frame_equal(result.table, kept.table)

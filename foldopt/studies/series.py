@@ -24,6 +24,9 @@ from foldopt.engine.sky import Sky
 
 #: Rows of a study's series above which it is written as ``timeseries.parquet``, not ``.csv``.
 PARQUET_ROWS = 20_000
+#: Rows of a study's series above which it is not made: some 20 numbers a row, a few GB held at
+#: once (a year of minutes for 19 loads is 10 M rows); the answer says so and how to get it.
+MAX_ROWS = 10_000_000
 #: Columns of a series that hold one value a case (or a site): a parquet file keeps them as a
 #: dictionary; the other numbers byte-stream-split, which makes a year of minutes a fifth
 #: smaller than plain zstd, and faster to write.
@@ -220,6 +223,16 @@ def year_series(pieces: list, timezone) -> pd.DataFrame:
     for name in (name for name in names if name not in floats):
         frame[name] = per_load(name, np.empty(rows, dtype=pieces[0][name].dtype))
     return frame
+
+
+def series_refused(rows: int) -> str:
+    """Why a study's series of ``rows`` rows is not made (above :data:`MAX_ROWS`), or ``""``."""
+    if rows <= MAX_ROWS:
+        return ""
+    return (
+        f"no timeseries: its {rows:,} rows (days x loads x steps) are above {MAX_ROWS:,}; fewer "
+        "days or loads, or a longer step_min, write it"
+    )
 
 
 def parquet_options(series: pd.DataFrame) -> dict:

@@ -44,7 +44,7 @@ from foldopt.studies.objectives import (
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 from foldopt.physics.spa import SunTerms
-from foldopt.studies.series import year_piece, year_series
+from foldopt.studies.series import series_refused, year_piece, year_series
 from foldopt.studies.storage_days import YearChoice, YearDays, powered_by_angle, year_storage
 from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
@@ -63,6 +63,7 @@ class SweepResult:
     weather_notes: tuple = ()  # what reading a measured weather file did (foldopt.engine.sky.Sky.weather_notes)
     # Every step of a study over many days at each case's fold angle (foldopt.studies.series)
     timeseries: pd.DataFrame | None = None
+    timeseries_note: str = ""  # why a study over many days has none (foldopt.studies.series)
 
     @functools.cached_property
     def answer(self):
@@ -159,12 +160,23 @@ def run_plan(
         weather_notes.update(dict.fromkeys(sky.weather_notes))
         return sky
 
+    # A study over many days (a cloud ensemble's members have no series of their own) has its
+    # series, if not too long to hold.
     series: list = []
+    many_days = bool(dates or "date" in axes) and not (weather is not None and weather.members)
+    refused = series_refused(total * loads.size * round(1440 / plan.base.step_min))
+    with_series = many_days and not refused
     if dates:
         refolds: dict[str, list] = {}
         for index, study in enumerate(studies):
             results[index], group_extras = _annual_group(
-                Blocks.of_dates(study, dates), loads, objective, advance, engine, sky_of
+                Blocks.of_dates(study, dates),
+                loads,
+                objective,
+                advance,
+                engine,
+                sky_of,
+                with_series,
             )
             if "series" in group_extras:
                 series.append(
@@ -199,7 +211,7 @@ def run_plan(
     else:
         # Cases of one setup share skies and engine calls, whatever their order in the plan. A
         # sweep of days writes their series, each day at its own best angle.
-        over_days = "date" in axes and not (weather is not None and weather.members)
+        over_days = with_series
         pieces: list = [None] * len(choices)
         zones = []
         setups: dict[str, list[int]] = {}
@@ -275,12 +287,14 @@ def run_plan(
         request,
         tuple(weather_notes),
         timeseries=pd.concat(series) if series else None,
+        timeseries_note=refused if many_days else "",
     )
 
 
-def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
+def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of, with_series=True):
     """One fold angle per load for all the days of a group: the one that maximises the objective
-    over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves."""
+    over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves
+    (and, ``with_series``, its time series)."""
     parts = blocks.chunks(loads.size)
     skies, daily = [], []
     sample: dict = {}
@@ -318,9 +332,10 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
     buffered = study.storage is not None and members == 1
     drawn: dict = {}
     pieces: list = []
+    with_series = with_series and members == 1
     every = (
         engines.fold_orientations(study.geometry, blocks.tilt, blocks.azimuth, fold_angles)
-        if members == 1
+        if with_series
         else None
     )
     for part, sky in zip(parts, skies, strict=True):
@@ -351,12 +366,13 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
                 np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
                 engine,
                 tracker,
-                curves=members == 1,
+                curves=with_series or buffered,
                 curve_outputs=("east", "west"),
             )
         )
-        if members == 1:
+        if with_series or buffered:
             curves = metrics[-1].pop("curves")
+        if with_series:
             pieces.append(
                 year_piece(
                     sky,
