@@ -71,6 +71,8 @@ def test_a_file_holds_its_days_and_says_what_its_edges_filled(tmp_path, step_min
     assert _filled_minutes(weather.report()) == expected, weather.report()
     if expected:
         assert any("not counted: the file holds only" in line for line in weather.report())
+    # No air in the file: its default throughout (said so), nothing taken from a nearest step.
+    assert not any("nearest step" in line for line in weather.report())
     assert not weather.frame.isna().any().any()
 
 

@@ -444,8 +444,8 @@ def test_label_and_timezone_arguments():
     assert utc.frame.index[0] == pd.Timestamp("2016-01-01 00:00:30Z")
     assert utc.flagged_days == () and utc.gaps == ()
     assert "2015-12-31 not counted: the file holds only 1 min of it, all at night" in utc.report()
-    assert any(line.startswith("1 min after the file's last period filled (2016-01-01 23:59 to 00:00; night")
-               for line in utc.report())
+    assert ("1 min after the file's last period filled (2016-01-01 23:59 to 00:00; night: light 0; air "
+            "temperature and wind speed the nearest step's)") in utc.report()
 
 
 def test_report_and_the_studys_days():

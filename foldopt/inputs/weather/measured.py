@@ -292,7 +292,7 @@ def _grid(frame: pd.DataFrame, label: str, zone, fail):
     return step_td, index, table, held
 
 
-def _file_days(index: pd.DatetimeIndex, held: np.ndarray, day: np.ndarray, step: pd.Timedelta):
+def _file_days(index: pd.DatetimeIndex, held: np.ndarray, day: np.ndarray, step: pd.Timedelta, air):
     """The steps of the days the file holds light of, and what its edges leave to fill.
 
     An edge day of which the file holds no daylight step is no day of the file: a file whose
@@ -313,6 +313,9 @@ def _file_days(index: pd.DatetimeIndex, held: np.ndarray, day: np.ndarray, step:
     day : numpy.ndarray of bool
         (n,) daylight steps (the clear sky's ``ghi`` above 0).
     step : pandas.Timedelta
+    air : list of str
+        The air's columns the file holds (``temp_air``, ``wind_speed``), taken from the nearest
+        step where the edges leave them.
 
     Returns
     -------
@@ -341,6 +344,8 @@ def _file_days(index: pd.DatetimeIndex, held: np.ndarray, day: np.ndarray, step:
     at = np.flatnonzero(inside)
     lead, trail = at[0], inside.size - 1 - at[-1]
     step_min = step / pd.Timedelta(minutes=1)
+    nearest = " and ".join(_WORDS[key] for key in air)
+    nearest = f"; {nearest} the nearest step's" if nearest else ""
     for count, where, span in (
         (lead, "before the file's first period", (0, lead)),
         (trail, "after the file's last period", (inside.size - trail, inside.size)),
@@ -356,7 +361,7 @@ def _file_days(index: pd.DatetimeIndex, held: np.ndarray, day: np.ndarray, step:
             )
             notes.append(
                 f"{count * step_min:g} min {where} filled ({start:%Y-%m-%d %H:%M} to "
-                f"{stop:%H:%M}; {how}; air temperature and wind speed the nearest step's)"
+                f"{stop:%H:%M}; {how}{nearest})"
             )
     return keep, notes
 
@@ -624,7 +629,8 @@ def read_measured(
             .to_numpy(dtype=float)
         )
         extra = np.asarray(pvlib.irradiance.get_extra_radiation(index), dtype=float)
-    keep, edges = _file_days(index, held, clear > 0, step)
+    air = [key for key in _WORDS if key in table and np.isfinite(table[key]).any()]
+    keep, edges = _file_days(index, held, clear > 0, step, air)
     index, clear, extra = index[keep], clear[keep], extra[keep]
     table = {key: values[keep] for key, values in table.items()}
     zenith = sun["zenith"].to_numpy(dtype=float)[keep]
