@@ -87,7 +87,8 @@ def run(
     StudyResult, SweepResult or OptimizeResult
         :class:`foldopt.studies.day.StudyResult` for one case (``summary``, ``sweep``, ``timeseries``
         with a tz-aware index, ``optimal_fold_angle`` [deg]...), :class:`foldopt.studies.sweeps.SweepResult`
-        for a plan (``table``: one row per case and design), :class:`foldopt.studies.joint.OptimizeResult`
+        for a plan (``table``: one row per case and design; ``timeseries``: every step of a study
+        over many days, :mod:`foldopt.studies.series`), :class:`foldopt.studies.joint.OptimizeResult`
         for a study with an ``optimize`` section (:func:`optimize`); each with ``answer``, the
         :class:`foldopt.studies.answer.Answer` the command line prints.
 

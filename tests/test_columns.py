@@ -117,6 +117,8 @@ def test_a_pvlib_name_is_a_parameter_pvlib_takes():
         pvlib.location.Location,
         pvlib.irradiance.get_total_irradiance,
         pvlib.temperature.sapm_cell,
+        pvlib.clearsky.ineichen,  # apparent_zenith: the refracted zenith
+        pvlib.irradiance.erbs,  # zenith: the geometric one
     ):
         taken |= set(inspect.signature(function).parameters)
     assert set(PVLIB_NAMES) <= taken

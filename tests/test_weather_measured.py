@@ -52,6 +52,18 @@ def _lit(frame: pd.DataFrame, site: dict) -> np.ndarray:
     return location.get_clearsky(frame.index, model="ineichen")["ghi"].to_numpy() > 0
 
 
+def _of_the_files_days(weather: MeasuredWeather, raw: pd.DataFrame, centres: pd.DatetimeIndex):
+    """The rows of ``raw`` (centred at ``centres``) on the days the file counts: a MIDC day's file
+    begins with the stamp 00:00, which ends the minute before midnight, the night of a day the file
+    holds nothing else of (not counted, and said so)."""
+    held = centres.isin(weather.frame.index)
+    assert (~held).sum() == 1 and centres[0].strftime("%H:%M:%S") == "23:59:30"
+    assert f"{centres[0].date()} not counted: the file holds only 1 min of it, all at night" in (
+        weather.report()
+    )
+    return raw[held], centres[held]
+
+
 def _drop_lines(source: Path, target: Path, header: int, rows: slice) -> Path:
     """``source`` without data rows ``rows`` (0-based after ``header`` lines), as ``target``."""
     lines = source.read_text().splitlines(keepends=True)
@@ -113,10 +125,17 @@ def test_surfrad_values_are_pvlibs_at_the_interval_centres():
     data, meta = pvlib.iotools.read_surfrad(SURFRAD)
     zone = datetime.timezone(datetime.timedelta(hours=-7))
     centres = (data.index - pd.Timedelta(seconds=30)).tz_convert(zone)  # stamps end their minute
-    frame = weather.frame.loc[centres]
+    # The UTC day's file holds the evening of 31 December, local time, and none of its daylight:
+    # no day of the file (the notes say so).
+    held = centres >= pd.Timestamp("2016-01-01", tz=zone)
+    assert (centres[~held] >= pd.Timestamp("2015-12-31 16:59", tz=zone)).all() and (~held).sum() == 421
+    assert "2015-12-31 not counted: the file holds only 421 min of it, all at night" in weather.report()
     site = weather.site
-    clear = pvlib.location.Location(site["latitude"], site["longitude"], altitude=site["altitude"]).get_clearsky(
-        centres, model="ineichen")["ghi"].to_numpy() > 0
+    location = pvlib.location.Location(site["latitude"], site["longitude"], altitude=site["altitude"])
+    assert not (location.get_clearsky(centres[~held], model="ineichen")["ghi"] > 0).any()  # night indeed
+    data, centres = data[held], centres[held]
+    frame = weather.frame.loc[centres]
+    clear = location.get_clearsky(centres, model="ineichen")["ghi"].to_numpy() > 0
     for key in ("dni", "dhi", "temp_air", "wind_speed"):
         expected = data[key].to_numpy()
         if key in ("dni", "dhi"):
@@ -147,7 +166,7 @@ def test_surfrad_stamps_end_their_minute_as_its_zenith_column_says():
                                                            2317)["apparent_zenith"].to_numpy() for shift in (-30, 0)}
     assert np.abs(at[-30] - data["solar_zenith"].to_numpy())[low].max() < 0.05
     assert np.abs(at[0] - data["solar_zenith"].to_numpy())[low].max() > 0.09
-    assert (weather.frame.index.isin(centres)).sum() == len(data)
+    assert (weather.frame.index.isin(centres)).sum() == len(data) - 421  # 31 Dec's night: no day
 
 
 def test_a_one_day_file_gives_1440_steps_of_one_minute():
@@ -181,6 +200,7 @@ def test_midc_ghi_alone_gives_erbs_dni_and_dhi():
     assert np.nanmax(np.abs(_closure(weather))) <= 1.0
     raw = pvlib.iotools.read_midc(MIDC_GHI)  # stamps end their minute
     centres = (raw.index - pd.Timedelta(seconds=30)).tz_convert(frame.index.tz)
+    raw, centres = _of_the_files_days(weather, raw, centres)
     np.testing.assert_allclose(weather.frame.temp_air.loc[centres], raw["Temperature @ 2m [deg C]"])
     np.testing.assert_allclose(weather.frame.ghi.loc[centres], raw["Global PSP [W/m^2]"].clip(lower=0))
     assert "no wind speed in the file: 1 m/s throughout" in weather.report()
@@ -201,6 +221,7 @@ def test_midc_raw_all_three_measured_are_kept():
     weather = read_measured(MIDC_UAT, "midc", site=UAT)
     raw = pvlib.iotools.read_midc(MIDC_UAT, raw_data=True)
     centres = (raw.index - pd.Timedelta(seconds=30)).tz_convert(weather.frame.index.tz)
+    raw, centres = _of_the_files_days(weather, raw, centres)
     frame = weather.frame.loc[centres]
     lit = _lit(frame, weather.site)
     np.testing.assert_allclose(frame.dni[lit], raw["Direct Normal [W/m^2]"].clip(lower=0)[lit])
@@ -416,16 +437,21 @@ def test_label_and_timezone_arguments():
     assert both.sum() > 400
     np.testing.assert_allclose(end.frame.dni.loc[common][both][1:-1], shifted.loc[common][both][1:-1])
     utc = read_measured(SURFRAD, "surfrad", timezone="UTC")
-    # On UTC the file's minutes run from 23:59-00:00 on December 31 (the stamp 00:00 ends it) to 23:58-23:59.
-    assert utc.site["timezone"] == "UTC+00:00" and len(utc.frame) == 2880
-    assert utc.frame.index[1439] == pd.Timestamp("2015-12-31 23:59:30Z")
-    assert utc.flagged_days == (datetime.date(2015, 12, 31),)
+    # On UTC the file's minutes run from 23:59-00:00 on December 31 (the stamp 00:00 ends it) to
+    # 23:58-23:59: December 31 is no day of the file, and the minute it leaves on January 1 is
+    # filled and said so.
+    assert utc.site["timezone"] == "UTC+00:00" and len(utc.frame) == 1440
+    assert utc.frame.index[0] == pd.Timestamp("2016-01-01 00:00:30Z")
+    assert utc.flagged_days == () and utc.gaps == ()
+    assert "2015-12-31 not counted: the file holds only 1 min of it, all at night" in utc.report()
+    assert ("1 min after the file's last period filled (2016-01-01 23:59 to 00:00; night: light 0; air "
+            "temperature and wind speed the nearest step's)") in utc.report()
 
 
 def test_report_and_the_studys_days():
     weather = read_measured(SURFRAD, "surfrad")
     lines = weather.report()
-    assert lines[0].startswith("measured weather surfrad-slv16001.dat: 1-min steps, 2 days (2015-12-31 to 2016-01-01)")
+    assert lines[0].startswith("measured weather surfrad-slv16001.dat: 1-min steps, 1 day (2016-01-01 to 2016-01-01)")
     assert all(isinstance(line, str) and "\n" not in line for line in lines)
     assert (weather.frame[["ghi", "dni", "dhi"]].dropna() >= 0).all().all()
     rows = weather_days(weather.frame, [datetime.date(2016, 1, 1)])

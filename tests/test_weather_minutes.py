@@ -37,7 +37,8 @@ def test_a_measured_day_through_the_cli_and_the_api_gives_the_same_answer(tmp_pa
     cli = json.loads(result.stdout)["answer"]
     notes = [note["note"] for note in cli["notes"]]
     assert notes[0].startswith("measured weather surfrad-slv16001.dat: 1-min steps")
-    assert any("2015-12-31" in note and "too long to fill" in note for note in notes)  # the UTC day's evening
+    # the UTC day's evening: night, no day of the file
+    assert any(note.startswith("2015-12-31 not counted") for note in notes)
     study = json.loads((out / "run.json").read_text())["study"]
     assert study["step_min"] == 1.0 and study["site"]["name"] == "Alamosa"
     api = foldopt.sweep(foldopt.default_study(), "angle", weather={"path": str(SURFRAD), "format": "surfrad"},
@@ -61,7 +62,7 @@ def test_a_five_minute_csv_runs_at_its_own_step(tmp_path):
     (["--weather", FIVE, "--weather-format", "csv", "--lat", "32.2", "--lon", "-110.9", "--altitude", "786",
       "--step-min", "1"], ["--step-min", "its own step, 5 min"]),
     (["--weather", SURFRAD, "--weather-format", "surfrad", "--days", "2015-12-31"],
-     ["2015-12-31", "daylight gap too long to fill"]),
+     ["2015-12-31", "the file holds 2016-01-01 to 2016-01-01"]),
     (["--weather", SURFRAD, "--weather-format", "surfrad", "--members", "5"], ["--members", "hourly file"]),
     (["--weather", TMY3, "--seed", "3"], ["--seed", "only used by a cloud ensemble"]),
     (["--weather", TMY3, "--members", "1"], ["--members", "greater than or equal to 2"]),
@@ -142,7 +143,7 @@ def test_a_days_time_series_carries_the_light_and_air_it_used(tmp_path):
     series = pd.read_csv(tmp_path / "d" / "timeseries.csv")
     for column in ("ghi", "dni", "dhi", "temp_air", "wind_speed"):
         assert column in series, column
-    beam = series["dni"] * np.clip(np.cos(np.radians(series["solar_zenith"])), 0, None)
+    beam = series["dni"] * np.clip(np.cos(np.radians(series["apparent_zenith"])), 0, None)
     np.testing.assert_allclose(series["ghi"], beam + series["dhi"], atol=1e-6)
     assert series["temp_air"].nunique() > 100  # the cells follow the air through the day
 

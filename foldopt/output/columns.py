@@ -19,9 +19,10 @@ A column is one of three kinds, and :data:`COLUMNS` lists each once with its uni
 - a label, which says which row this is or what it is (a site's name, a date, a design, a note,
   a flag): no unit.
 
-A name with ``{design}``, ``{connection}``, ``{pct}``, ``{hours}`` or ``{month}`` stands for one
-column per design (``flat``, ``twofold``, ``tracker``, ``tracker_net``), connection, percentile of
-a cloud ensemble (10, 50, 90), threshold or month. A sweep's other varied fields are columns
+A name with ``{design}``, ``{connection}``, ``{half}``, ``{pct}``, ``{hours}`` or ``{month}``
+stands for one column per design (``flat``, ``twofold``, ``tracker``, ``tracker_net``),
+connection, half of the panel (``east``, ``west``), percentile of a cloud ensemble (10, 50, 90),
+threshold or month. A sweep's other varied fields are columns
 named by their dotted path in a study file (``tracker.standby_w``). The manual's table
 (``docs/columns.rst``) is :func:`rst_table`, and a test checks every command's columns against
 :func:`describe` and :func:`parse`.
@@ -99,7 +100,8 @@ PVLIB_NAMES = {
     "altitude": "m",
     "surface_tilt": "deg",
     "surface_azimuth": "deg",
-    "solar_zenith": "deg",
+    "apparent_zenith": "deg",
+    "zenith": "deg",
     "solar_azimuth": "deg",
     "dni": "w_m2",
     "ghi": "w_m2",
@@ -311,9 +313,20 @@ COLUMNS = (
         "of their own best",
     ),
     ("wins_pct", "pct", "the members whose own best fold angle is this one"),
-    # the day's time series
-    ("time", "", "the step's centre, local time with its offset"),
-    ("solar_zenith", "deg", "solar zenith angle"),
+    # the time series (a day's, or every day's of a study over many days)
+    ("time", "", "the step's centre, local time with its UTC offset"),
+    (
+        "apparent_zenith",
+        "deg",
+        "the sun's zenith angle with atmospheric refraction (pvlib's apparent_zenith, NREL SPA): "
+        "exact mode's sun",
+    ),
+    (
+        "zenith",
+        "deg",
+        "the sun's geometric zenith angle, no refraction (pvlib's zenith): paper mode's sun "
+        "(Shin et al. Eq. 3-6)",
+    ),
     ("solar_azimuth", "deg", "solar azimuth, clockwise from north"),
     ("dni", "w_m2", "direct normal irradiance"),
     ("ghi", "w_m2", "global horizontal irradiance (with diffuse light)"),
@@ -324,8 +337,24 @@ COLUMNS = (
         "the air temperature the cells see (a weather file's, with its wind folded in)",
     ),
     ("wind_speed", "m_s", "a weather file's wind speed"),
+    (
+        "poa_global_{half}_w_m2",
+        "w_m2",
+        "plane-of-array irradiance incident on a half at the fold angle "
+        "(pvlib's poa_global, before an incidence-angle modifier)",
+    ),
     ("p_{design}_w", "w", "a design's power at the optimum (p_twofold_w: the study's connection)"),
-    ("p_{connection}_w", "w", "a connection's power at the optimum"),
+    (
+        "p_{connection}_w",
+        "w",
+        "a connection's power at the optimum; p_east_w and p_west_w: each half's alone",
+    ),
+    (
+        "solar_powered_{design}",
+        "",
+        "whether the design runs the load at the step (P_pv >= P_load): its steps times the step "
+        "length are its t_solar to within a step at each crossing of the load",
+    ),
     ("switch_state", "", "the connection switching chose (off where no power)"),
     # a buffer (a study's storage section)
     (
@@ -396,6 +425,7 @@ COLUMNS = (
 WORDS = {
     "design": DESIGN_WORDS,
     "connection": CONNECTION_WORDS,
+    "half": ("east", "west"),
     "pct": tuple(str(pct) for pct in ENSEMBLE_PERCENTILES),
     "hours": tuple(str(hours) for hours in THRESHOLDS_H),
     "month": tuple(f"{month:02d}" for month in range(1, 13)),
@@ -500,9 +530,10 @@ def rst_table() -> str:
         "``surface_tilt``, ``dni``, ``temp_air``...) is written as pvlib writes it, in pvlib's "
         "unit: a weather file and a map's ``--sites`` file are read by those names. A label "
         "(which site, day or design; a note; a flag) has no unit. A name with ``{design}``, "
-        "``{connection}``, ``{pct}``, ``{hours}`` or ``{month}`` stands for one column per design, "
-        "connection, percentile, threshold or month. A sweep's other varied fields are columns "
-        "named by their dotted path (``tracker.standby_w``)."
+        "``{connection}``, ``{half}``, ``{pct}``, ``{hours}`` or ``{month}`` stands for one column "
+        "per design, connection, half of the panel (east, west), percentile, threshold or month. "
+        "A sweep's other varied fields are columns named by their dotted path "
+        "(``tracker.standby_w``)."
     )
     lines = [
         "Columns",

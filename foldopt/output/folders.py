@@ -18,6 +18,7 @@ from foldopt.tables import write_csv
 from foldopt.studies.annual import annual_cases, annual_summary
 from foldopt.studies.day import StudyResult
 from foldopt.studies.horizon_paths import sun_paths
+from foldopt.studies.series import parquet_options, series_file
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -213,6 +214,8 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
             study=study,
         ),
     ]
+    if result.timeseries is not None:
+        written.append(write_series(result.timeseries, folder))
     extras = result.extras
     if extras:
         write_csv(extras["by_angle"], folder / "annual_fold_angles.csv")
@@ -288,6 +291,17 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
             ),
         ]
     return written
+
+
+def write_series(series: pd.DataFrame, folder: Path) -> str:
+    """Write a study's series over many days as ``timeseries.csv``, or ``timeseries.parquet``
+    (pyarrow) above :data:`foldopt.studies.series.PARQUET_ROWS` rows; return the file's name."""
+    name = series_file(series)
+    if name.endswith(".parquet"):
+        series.to_parquet(folder / name, engine="pyarrow", **parquet_options(series))
+    else:
+        write_csv(series, folder / name, index=True)
+    return name
 
 
 def write_sweep(result, out: Path, overwrite: bool = False, command=None) -> Path:

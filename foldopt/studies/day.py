@@ -47,6 +47,7 @@ from foldopt.studies.designs import (
     tracker_curves,
 )
 from foldopt.studies.objectives import near_optimal
+from foldopt.studies.series import half_poa, sky_columns, solar_powered
 from foldopt.studies.storage_days import (
     DESIGN_COLUMNS,
     BufferedDesigns,
@@ -880,9 +881,11 @@ def near_optimal_range(day: Day, sweep: FoldSweep, optimum: Optimum) -> dict:
 def day_timeseries(
     day: Day, optimum: Optimum, designs: Designs, buffered: DayStorage | None
 ) -> pd.DataFrame:
-    """Step 8: ``timeseries.csv``: the day's sun, light and air, and the curves of flat, every
-    connection at the optimum and the tracker, with the state switching chose (no table's number
-    comes from it: it is the reference path's) and the buffer's state of charge.
+    """Step 8: ``timeseries.csv``: the day's sun, light and air, each half's plane-of-array
+    irradiance at the optimum, the curves of flat, every connection at the optimum and the
+    tracker, with the state switching chose (no table's number comes from it: it is the
+    reference path's), whether each design runs the load, and the buffer's state of charge
+    (:mod:`foldopt.studies.series`).
 
     Parameters
     ----------
@@ -898,27 +901,28 @@ def day_timeseries(
     """
     at_best = designs.at_optimum
     state = day.connections(np.array([optimum.fold_angle_deg]))[1][0]
+    sky, load, shape = day.sky, day.study.p_load, day.load_shape
+    powered = {"flat": designs.power["flat"], "twofold": at_best[day.study.connection]}
+    powered["tracker"] = designs.tracker.power[0]
     return pd.DataFrame(
         {
-            "solar_zenith": day.solar_zenith,
-            "solar_azimuth": day.solar_azimuth,
-            "dni": day.dni,
-            # The light and air every step of the day used (the weather's, or the clear sky's).
-            **({"ghi": day.ghi, "dhi": day.dhi} if day.ghi is not None else {}),
-            "temp_air": (
-                day.sky.temp_steps[0]
-                if day.sky.temp_steps is not None
-                else np.full(day.dni.shape, day.sky.temp_air[0])
-            ),
-            **({"wind_speed": day.sky.wind_speed[0]} if day.sky.wind_speed is not None else {}),
+            **{name: values[0] for name, values in sky_columns(sky).items()},
+            **{
+                name: values[0]
+                for name, values in half_poa(sky, day.orientation([optimum.fold_angle_deg])).items()
+            },
             "p_flat_w": designs.power["flat"],
             **{f"p_{connection}_w": at_best[connection] for connection in CONNECTIONS},
-            "p_twofold_w": at_best[day.study.connection],
+            "p_twofold_w": powered["twofold"],
             "switch_state": np.where(
                 at_best["switching"] > 0, np.array(SWITCH_STATES)[state], "off"
             ),
-            "p_tracker_w": designs.tracker.power[0],
+            "p_tracker_w": powered["tracker"],
             "p_load_w": day.load_w,
+            **{
+                f"solar_powered_{design}": solar_powered(power, load, shape)
+                for design, power in powered.items()
+            },
             **(
                 {}
                 if buffered is None

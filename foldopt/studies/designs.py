@@ -277,7 +277,9 @@ def design_metrics(
     chosen,
     engine: str,
     tracker: TrackerCurves | None = None,
+    *,
     curves: bool = False,
+    curve_outputs: tuple = CONNECTIONS,
 ) -> dict:
     """Metrics of every design per block and load, each (n_blocks, n_loads, 4 designs): the twofold
     panel at grid index ``chosen`` (n_blocks, n_loads), the flat panel, the tracker gross and net.
@@ -298,7 +300,9 @@ def design_metrics(
         default worked out here (:func:`tracker_curves`).
     curves : bool, default False
         Also the power curves [W] the flat and twofold rows were reduced from, for a report to
-        draw: the twofold panel's then of every connection at its chosen angle.
+        draw: the twofold panel's then of each of ``curve_outputs`` at its chosen angle.
+    curve_outputs : tuple of str, default every connection
+        With ``curves``, the connections whose curves to keep beside the study's own.
 
     Returns
     -------
@@ -307,7 +311,7 @@ def design_metrics(
         ``poa_global_wh_m2`` (incident irradiation [Wh/m^2]) and ``condition``
         (:func:`foldopt.engine.metrics.design_condition`), each (n_blocks, n_loads, 4) in the
         order of :data:`DESIGNS`; with ``curves``, also ``curves``: a dict of ``flat``, (n_blocks,
-        n_steps), and of each name of :data:`foldopt.physics.connections.CONNECTIONS`, (n_blocks,
+        n_steps), and of the study's connection and each of ``curve_outputs``, (n_blocks,
         n_loads, n_steps).
     """
     study, blocks_of = blocks.study, blocks
@@ -322,7 +326,9 @@ def design_metrics(
     # angle was in fold_hours' pass too, but without the longest runs, which would cost that pass
     # 1.4x (one load) to 4.5x (50 loads), some 3 to 10 times this pass; its t_solar, of every load
     # at once, differs from this row's in the last bits (the loads' bins are summed in another order).
-    outputs = CONNECTIONS if curves else (study.connection,)
+    outputs = (
+        tuple(dict.fromkeys((study.connection, *curve_outputs))) if curves else (study.connection,)
+    )
     own = outputs.index(study.connection)
     keep = curves or shape is not None
     twofold = engines.row_metrics(

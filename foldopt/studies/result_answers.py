@@ -115,6 +115,12 @@ def weather_notes(result) -> list[dict]:
     return [{"note": note, "designs": []} for note in getattr(result, "weather_notes", ())]
 
 
+def series_notes(result) -> list[dict]:
+    """Why a study over many days writes no time series (:mod:`foldopt.studies.series`)."""
+    note = getattr(result, "timeseries_note", "")
+    return [{"note": note, "designs": []}] if note else []
+
+
 def study_question(study, varied: tuple = ()) -> dict:
     """What a study asks, label to text; the config paths in ``varied`` are said to vary.
 
@@ -548,6 +554,7 @@ def of_sweep(result) -> Answer:
         pd.DataFrame(),
         design_notes(table, plan.n_cases)
         + weather_notes(result)
+        + series_notes(result)
         + horizon_notes(plan.base, _dates(plan)),
         tuple(lines),
     )
@@ -740,6 +747,7 @@ def _of_annual(result) -> Answer:
         schedule,
         design_notes(result.table, plan.n_cases)
         + weather_notes(result)
+        + series_notes(result)
         + horizon_notes(study, _dates(plan)),
         tuple(lines),
     )

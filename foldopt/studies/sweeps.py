@@ -44,6 +44,7 @@ from foldopt.studies.objectives import (
 from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 from foldopt.physics.spa import SunTerms
+from foldopt.studies.series import series_refused, year_piece, year_series
 from foldopt.studies.storage_days import YearChoice, YearDays, powered_by_angle, year_storage
 from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
@@ -60,6 +61,9 @@ class SweepResult:
     weather_light: dict | None = None  # a weather file's irradiation and what the steps keep of it
     request: object = None  # the foldopt.studies.request.Request the plan came from, if any
     weather_notes: tuple = ()  # what reading a measured weather file did (foldopt.engine.sky.Sky.weather_notes)
+    # Every step of a study over many days at each case's fold angle (foldopt.studies.series)
+    timeseries: pd.DataFrame | None = None
+    timeseries_note: str = ""  # why a study over many days has none (foldopt.studies.series)
 
     @functools.cached_property
     def answer(self):
@@ -156,12 +160,34 @@ def run_plan(
         weather_notes.update(dict.fromkeys(sky.weather_notes))
         return sky
 
+    # A study over many days (a cloud ensemble's members have no series of their own) has its
+    # series, if not too long to hold.
+    series: list = []
+    many_days = bool(dates or "date" in axes) and not (weather is not None and weather.members)
+    refused = series_refused(total * loads.size * round(1440 / plan.base.step_min))
+    with_series = many_days and not refused
     if dates:
         refolds: dict[str, list] = {}
         for index, study in enumerate(studies):
             results[index], group_extras = _annual_group(
-                Blocks.of_dates(study, dates), loads, objective, advance, engine, sky_of
+                Blocks.of_dates(study, dates),
+                loads,
+                objective,
+                advance,
+                engine,
+                sky_of,
+                with_series,
             )
+            if "series" in group_extras:
+                series.append(
+                    group_extras.pop("series").assign(
+                        **{
+                            path: _plain(value)
+                            for path, value in choices[index].items()
+                            if path not in _AXIS_COLUMNS
+                        }
+                    )
+                )
             extras = extras or group_extras
             for key in GROUP_TABLES:
                 if key in group_extras:
@@ -183,7 +209,11 @@ def run_plan(
             for date in dates
         ]
     else:
-        # Cases of one setup share skies and engine calls, whatever their order in the plan.
+        # Cases of one setup share skies and engine calls, whatever their order in the plan. A
+        # sweep of days writes their series, each day at its own best angle.
+        over_days = with_series
+        pieces: list = [None] * len(choices)
+        zones = []
         setups: dict[str, list[int]] = {}
         for index, study in enumerate(studies):
             setups.setdefault(setup_key(study), []).append(index)
@@ -194,9 +224,37 @@ def run_plan(
                 sky = sky_of(chunk)
                 fold_angles, hours, _ = fold_hours(sky, chunk, loads, engine)
                 hours = hours.transpose(0, 2, 1)  # (blocks, loads, angles)
+                best = best_angle_index(hours)
+                tracker = tracker_curves(sky, chunk.study, every=chunk.members)
                 metrics = design_metrics(
-                    sky, chunk, loads, fold_angles, best_angle_index(hours), engine
+                    sky,
+                    chunk,
+                    loads,
+                    fold_angles,
+                    best,
+                    engine,
+                    tracker,
+                    curves=over_days,
+                    curve_outputs=("east", "west"),
                 )
+                if over_days:
+                    zones.append(sky.grid.timezones[0])
+                    curves = metrics.pop("curves")
+                    every = engines.fold_orientations(
+                        chunk.study.geometry, chunk.tilt, chunk.azimuth, fold_angles
+                    )
+                    piece = year_piece(
+                        sky,
+                        np.take_along_axis(every, best[..., None], axis=1),
+                        loads,
+                        fold_angles[best],
+                        {**curves, "twofold": curves[chunk.study.connection]},
+                        tracker.power,
+                    )
+                    for offset, index in enumerate(members[part]):
+                        pieces[index] = {
+                            name: values[offset : offset + 1] for name, values in piece.items()
+                        }
                 metrics.update(
                     _twofold_only(near_optimal(fold_angles, hours, chunk.study.near_optimal))
                 )
@@ -208,6 +266,11 @@ def run_plan(
         cases = [
             (study.site, study.date, choice) for study, choice in zip(studies, choices, strict=True)
         ]
+        if over_days:
+            # Local times where the sites share a time zone; UTC where they do not.
+            series.append(
+                year_series(pieces, zones[0] if len(set(map(str, zones))) == 1 else "UTC")
+            )
     table = _table(
         cases, loads, {name: np.concatenate([r[name] for r in results]) for name in results[0]}
     )
@@ -215,12 +278,23 @@ def run_plan(
         key: {"file_wh_m2": float(total), "kept_pct": float(100 * kept / total) if total else 100.0}
         for key, (total, kept) in light.items()
     } or None
-    return SweepResult(plan, table, extras, engine, kept, request, tuple(weather_notes))
+    return SweepResult(
+        plan,
+        table,
+        extras,
+        engine,
+        kept,
+        request,
+        tuple(weather_notes),
+        timeseries=pd.concat(series) if series else None,
+        timeseries_note=refused if many_days else "",
+    )
 
 
-def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
+def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of, with_series=True):
     """One fold angle per load for all the days of a group: the one that maximises the objective
-    over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves."""
+    over the days' t_solar at every angle. Returns the group's metrics and its day x hour curves
+    (and, ``with_series``, its time series)."""
     parts = blocks.chunks(loads.size)
     skies, daily = [], []
     sample: dict = {}
@@ -253,9 +327,17 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
         score = objective_value(daily, months, objective.statistic, objective.months)
         fixed = best_angle_index(score)  # (n_loads,)
     metrics, series = [], {"p_twofold_w": [], "switch_state": []}
-    # A buffer is run over the days on the curves each design's row is reduced from.
+    # A buffer is run over the days on the curves each design's row is reduced from, and the
+    # days' time series is drawn from them (a cloud ensemble's members have none of their own).
     buffered = study.storage is not None and members == 1
     drawn: dict = {}
+    pieces: list = []
+    with_series = with_series and members == 1
+    every = (
+        engines.fold_orientations(study.geometry, blocks.tilt, blocks.azimuth, fold_angles)
+        if with_series
+        else None
+    )
     for part, sky in zip(parts, skies, strict=True):
         chunk = blocks[part]
         # The day x hour maps of the first load's angle, every day at once.
@@ -274,7 +356,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
         )
         series["p_twofold_w"].append(powers[study.connection])
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
-        tracker = tracker_curves(sky, study, study.tracker.model) if buffered else None
+        tracker = tracker_curves(sky, study, study.tracker.model, every=members)
         metrics.append(
             design_metrics(
                 sky,
@@ -284,11 +366,24 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
                 np.broadcast_to(fixed, (sky.n_blocks, loads.size)),
                 engine,
                 tracker,
-                curves=buffered,
+                curves=with_series or buffered,
+                curve_outputs=("east", "west"),
             )
         )
-        if buffered:
+        if with_series or buffered:
             curves = metrics[-1].pop("curves")
+        if with_series:
+            pieces.append(
+                year_piece(
+                    sky,
+                    every[part][:, fixed],
+                    loads,
+                    np.broadcast_to(fold_angles[fixed], (sky.n_blocks, loads.size)),
+                    {**curves, "twofold": curves[study.connection]},
+                    tracker.power,
+                )
+            )
+        if buffered:
             # The net tracker's whole power, with its own draw a load beside the device's.
             for name, power in (
                 ("flat", curves["flat"]),
@@ -346,6 +441,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of):
             refold_tables(blocks, loads, fold_angles, daily, months, objective, design_hours)
         )
     extras = {
+        **({"series": year_series(pieces, skies[0].grid.timezones[0])} if pieces else {}),
         "dates": list(blocks.dates[::members]),
         "hours": clock,
         "fold_angle": float(fold_angles[fixed[0]]),

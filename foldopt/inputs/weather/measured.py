@@ -13,7 +13,10 @@ what was derived, filled and left out. In this order, vectorised over the steps:
 2. The step is the modal spacing of the stamps; a duplicate stamp or one off that grid is
    refused. Each stamp moves to its interval's centre (``label``, else the format's convention),
    on the site's standard time; the steps of whole local days are laid out, and the file's values
-   placed on them: steps the file lacks are missing.
+   placed on them: steps the file lacks are missing. An edge day of which the file holds no
+   daylight step is no day of the file (an end-labelled file beginning at 00:00 holds of the day
+   before only the night period that ends at midnight): it is left out, and the minutes the file
+   leaves of its first and last days are reported filled (``_file_days``).
 3. Physical bounds, QCRad's "physically possible" limits [1]_ [2]_ with the extraterrestrial
    normal irradiance ``E0`` and the cosine of the solar zenith ``mu0`` at the interval centre:
    ``ghi <= 1.5 E0 mu0^1.2 + 100``, ``dni <= E0``, ``dhi <= 0.95 E0 mu0^1.2 + 50`` W/m^2; where two
@@ -240,7 +243,8 @@ def _site(entry: StationFormat, found: dict, given: dict | None, fail) -> dict:
 
 
 def _grid(frame: pd.DataFrame, label: str, zone, fail):
-    """The file's step, the whole local days' interval centres, and the file's rows on them."""
+    """The file's step, the whole local days' interval centres, the file's rows on them, and
+    which steps the file has a row for."""
     frame = frame.iloc[np.argsort(frame.index.as_unit("ns").asi8, kind="stable")]
     stamps = frame.index.as_unit("ns")
     ns = stamps.asi8
@@ -283,7 +287,83 @@ def _grid(frame: pd.DataFrame, label: str, zone, fail):
     table = {key: np.full(n, np.nan) for key in frame.columns}
     for key in frame.columns:
         table[key][rows] = frame[key].to_numpy(dtype=float)
-    return step_td, index, table
+    held = np.zeros(n, dtype=bool)
+    held[rows] = True
+    return step_td, index, table, held
+
+
+def _file_days(index: pd.DatetimeIndex, held: np.ndarray, day: np.ndarray, step: pd.Timedelta, air):
+    """The steps of the days the file holds light of, and what its edges leave to fill.
+
+    An edge day of which the file holds no daylight step is no day of the file: a file whose
+    stamps end their periods and begins at 00:00 holds of the day before only its last period,
+    at night; one whose stamps start their periods and ends at 00:00 holds the first period of
+    the day after; a UTC day's file holds the evening of a western site's local day before.
+    Such a day would be all gap. The file's first and last days are then laid out
+    whole: the steps before its first period and after its last are filled as any other (light
+    0 at night, along the clear-sky index in daylight, the air and wind from the nearest step),
+    and said so.
+
+    Parameters
+    ----------
+    index : pandas.DatetimeIndex
+        Interval centres of whole local days, (n,).
+    held : numpy.ndarray of bool
+        (n,) the steps the file has a row for.
+    day : numpy.ndarray of bool
+        (n,) daylight steps (the clear sky's ``ghi`` above 0).
+    step : pandas.Timedelta
+    air : list of str
+        The air's columns the file holds (``temp_air``, ``wind_speed``), taken from the nearest
+        step where the edges leave them.
+
+    Returns
+    -------
+    keep : slice
+        The steps of the days kept, whole days.
+    notes : list of str
+        The days left out, and each edge's filled minutes and how.
+    """
+    per_day = int(pd.Timedelta(days=1) / step)
+    days = held.size // per_day
+    lit = (held & day).reshape(days, per_day).any(axis=1)
+    first, last = (
+        (int(np.argmax(lit)), days - 1 - int(np.argmax(lit[::-1]))) if lit.any() else (0, days - 1)
+    )
+    notes = []
+    dates = index[::per_day].tz_localize(None).date
+    for lo, hi in ((0, first), (last + 1, days)):
+        if hi > lo:
+            minutes = held.reshape(days, per_day)[lo:hi].sum() * step / pd.Timedelta(minutes=1)
+            notes.append(
+                f"{', '.join(str(d) for d in dates[lo:hi])} not counted: the file holds only "
+                f"{minutes:g} min of it, all at night"
+            )
+    keep = slice(first * per_day, (last + 1) * per_day)
+    inside = held[keep]
+    at = np.flatnonzero(inside)
+    lead, trail = at[0], inside.size - 1 - at[-1]
+    step_min = step / pd.Timedelta(minutes=1)
+    nearest = " and ".join(_WORDS[key] for key in air)
+    nearest = f"; {nearest} the nearest step's" if nearest else ""
+    for count, where, span in (
+        (lead, "before the file's first period", (0, lead)),
+        (trail, "after the file's last period", (inside.size - trail, inside.size)),
+    ):
+        if count:
+            steps = slice(keep.start + span[0], keep.start + span[1])
+            lit_steps = int(day[steps].sum())
+            start, stop = index[steps][0] - step / 2, index[steps][-1] + step / 2
+            how = (
+                "night: light 0"
+                if not lit_steps
+                else f"{lit_steps * step_min:g} min of it in daylight, a daylight gap"
+            )
+            notes.append(
+                f"{count * step_min:g} min {where} filled ({start:%Y-%m-%d %H:%M} to "
+                f"{stop:%H:%M}; {how}{nearest})"
+            )
+    return keep, notes
 
 
 def _closure_dni(ghi, dhi, cosz):
@@ -532,7 +612,7 @@ def read_measured(
     )
     where["timezone"] = offset_zone(hours)
     tz = fixed_zone(hours)
-    step, index, table = _grid(raw.frame, label or entry.interval_label, tz, fail)
+    step, index, table, held = _grid(raw.frame, label or entry.interval_label, tz, fail)
     present = {
         key for key in ("ghi", "dni", "dhi") if key in table and np.isfinite(table[key]).any()
     }
@@ -549,11 +629,15 @@ def read_measured(
             .to_numpy(dtype=float)
         )
         extra = np.asarray(pvlib.irradiance.get_extra_radiation(index), dtype=float)
-    zenith = sun["zenith"].to_numpy(dtype=float)
+    air = [key for key in _WORDS if key in table and np.isfinite(table[key]).any()]
+    keep, edges = _file_days(index, held, clear > 0, step, air)
+    index, clear, extra = index[keep], clear[keep], extra[keep]
+    table = {key: values[keep] for key, values in table.items()}
+    zenith = sun["zenith"].to_numpy(dtype=float)[keep]
     cosz = np.cos(np.radians(zenith))
     dropped: dict = {}
     _bounds(table, present, extra, cosz, dropped)
-    notes = list(raw.notes)
+    notes = list(raw.notes) + edges
     derived, lowered = _components(
         table,
         present,
