@@ -154,9 +154,7 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis 
         grid_orientations = (
             None
             if tilt is not None
-            else fold_orientations(
-                study.geometry, tilts[firsts], azimuth[firsts] % 360.0, angles
-            )
+            else fold_orientations(study.geometry, tilts[firsts], azimuth[firsts] % 360.0, angles)
         )
 
         def run(axes, flat):
