@@ -33,6 +33,7 @@ References
 from __future__ import annotations
 
 import datetime as dt
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,15 +111,18 @@ class ClockGrid:
         """Local clock minus UTC [h]."""
         return self.utc_offset_ns / NS_PER_HOUR
 
-    @property
+    @functools.cached_property
     def dayofyear(self) -> np.ndarray:
-        """Local day of year of each step (1 on 1 January)."""
+        """Local day of year of each step (1 on 1 January); worked out once a grid (a sky reads it
+        for the sun and again for the light: a division of every step's instant)."""
         days = np.floor_divide(self.local_ns, _NS_PER_DAY)
         # Converted once per calendar day in the grid's range, then looked up.
         first = days.min()
         calendar = np.arange(first, days.max() + 1).astype("datetime64[D]")
         table = (calendar - calendar.astype("datetime64[Y]")).astype(np.int64) + 1
-        return table[days - first]
+        dayofyear = table[days - first]
+        dayofyear.flags.writeable = False  # shared by every reader of the grid
+        return dayofyear
 
     def times(self, block: int) -> pd.DatetimeIndex:
         """The tz-aware times of one block.

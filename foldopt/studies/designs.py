@@ -687,7 +687,13 @@ def design_hours(
 
 
 def requested_hours(
-    parts, requests, loads, loadset=None, flat: bool = False, engine: str = DEFAULT_ENGINE
+    parts,
+    requests,
+    loads,
+    loadset=None,
+    flat: bool = False,
+    engine: str = DEFAULT_ENGINE,
+    orientations=None,
 ) -> list:
     """Each day's t_solar [h] and harvested energy [Wh] of designs, each request on days of its
     own, every request of a chunk in as few engine calls as its memory bound allows.
@@ -706,6 +712,10 @@ def requested_hours(
     flat : bool
         The flat panel (the fold angle unused) with no connection: as the ``flat`` design.
     engine : {'auto', 'numba', 'numpy'}
+    orientations : sequence of array_like, optional
+        Per request, its designs' sub-panel orientations, (n, 4) as
+        :func:`foldopt.engine.evaluation.fold_orientations` gives them, where the caller has them
+        (a search's grid, worked out once); default worked out here.
 
     Returns
     -------
@@ -726,11 +736,12 @@ def requested_hours(
     )
     # Every request's orientations in one call (one geometry call per distinct base).
     every = np.concatenate([points for _, points in requests])
-    table = (
-        engines.flat_orientation(every[:, 1], every[:, 2] % 360.0)
-        if flat
-        else _orientations(study.geometry, every[:, 0], every[:, 1], every[:, 2] % 360.0)
-    )
+    if orientations is not None:
+        table = np.concatenate([np.asarray(given, dtype=float) for given in orientations])
+    elif flat:
+        table = engines.flat_orientation(every[:, 1], every[:, 2] % 360.0)
+    else:
+        table = _orientations(study.geometry, every[:, 0], every[:, 1], every[:, 2] % 360.0)
     tables = np.split(table, np.cumsum([points.shape[0] for _, points in requests])[:-1])
     out = [
         (

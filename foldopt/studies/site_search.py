@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from foldopt.engine.evaluation import fold_orientations
 from foldopt.engine.search import Axis, GridSearch
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.designs import requested_hours
@@ -146,6 +147,15 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis 
         step_hours = parts[0][1].step_hours
         tilts = np.concatenate([chunk.tilt for chunk, _ in parts])
         azimuth = np.concatenate([chunk.azimuth for chunk, _ in parts])
+        firsts = [blocks[0] for blocks in sites]
+        # At the site's tilt, each site's sub-panels at every angle of the grid, worked out once
+        # for all its rounds (each design's the same bits as on its own: elementwise).
+        angles = fold_axis.values()
+        grid_orientations = (
+            None
+            if tilt is not None
+            else fold_orientations(study.geometry, tilts[firsts], azimuth[firsts] % 360.0, angles)
+        )
 
         def run(axes, flat):
             searches = [
@@ -161,7 +171,7 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis 
             ]
 
             def evaluate(asked):
-                requests = []
+                requests, orientations = [], []
                 for site, points in asked.items():
                     first = sites[site][0]
                     angle = np.full(points.shape[0], FLAT_FOLD_ANGLE) if flat else points[:, 0]
@@ -178,7 +188,19 @@ def fold_search(months, statistic: str, seasons, tolerance_h: float, tilt: Axis 
                             ),
                         )
                     )
-                done = requested_hours(parts, requests, loads, loadset, flat=flat, engine=engine)
+                    if grid_orientations is not None:
+                        orientations.append(
+                            grid_orientations[site, np.searchsorted(angles, points[:, 0])]
+                        )
+                done = requested_hours(
+                    parts,
+                    requests,
+                    loads,
+                    loadset,
+                    flat=flat,
+                    engine=engine,
+                    orientations=orientations or None,
+                )
                 return dict(zip(asked, done, strict=True))
 
             return search_sites(searches, evaluate)
