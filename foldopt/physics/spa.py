@@ -106,9 +106,8 @@ class SunTerms:
     (:meth:`on_lattice`). The terms are elementwise in time, so an instant's are the same bits
     whichever call first asked for it (tested); a run that passes none evaluates its own.
 
-    The owner is the run: a sweep over a year's chunks; for maps, the process, so that a worker's
-    chunks share it (:mod:`foldopt.studies.worldmap`). Each store is replaced whole (one
-    assignment), so that threads read one state or the other.
+    The owner is the run: a sweep over a year's chunks, a map's chunk of sites. Each store is
+    replaced whole (one assignment), so that threads of one run read one state or the other.
 
     Attributes
     ----------
