@@ -315,20 +315,14 @@ def test_a_map_searching_the_tilt_holds_the_flat_panel_to_its_own_best(latitude,
                                                         ranged["near_optimal_hi_deg"]).all()
 
 
-def test_a_searched_sites_answer_is_the_same_whatever_the_process_evaluated_before(monkeypatch):
-    """A worker keeps SPA's time-only terms over its chunks (foldopt.studies.worldmap's store) and a
-    searched site's designs are taken from its grid's orientations, worked out once a batch: a site
-    evaluated after other sites, in a batch with them, gives the same bits as the site alone in a
-    fresh process (its store empty)."""
-    from foldopt.physics.spa import SunTerms
-    from foldopt.studies import worldmap
-
+def test_a_searched_sites_answer_is_the_same_whatever_the_batch_it_shares():
+    """A chunk's sites share SPA's time-only terms and a searched site's designs are taken from its
+    grid's orientations, worked out once a batch: a site evaluated in a batch with another gives
+    the same bits as the site alone."""
     searched = {**COARSE, "optimize": {"vary": ["fold_angle"]}}
     sites = [{"latitude": -33.9, "longitude": 18.4, "site_id": 0},
              {"latitude": 64.1, "longitude": -21.9, "site_id": 1}]
-    evaluate_sites(searched, sites[1:], [0.1, 0.3], relative=True)  # the store now holds its year
-    after = evaluate_sites(searched, sites, [0.1, 0.3], relative=True)
-    monkeypatch.setattr(worldmap, "_SUN_TERMS", SunTerms())
+    after = evaluate_sites(searched, sites[::-1], [0.1, 0.3], relative=True)
     alone = evaluate_sites(searched, sites[:1], [0.1, 0.3], relative=True)
     pd.testing.assert_frame_equal(after[after["site_id"] == 0].reset_index(drop=True), alone,
                                   check_exact=True)

@@ -99,24 +99,18 @@ def evaluate_sites(
     engine = engine_for(engine, math.inf)
     frames, batch, key = [], [], None
     study = map_data(study)  # once, not per site
+    sun_terms = SunTerms()  # the sites of one year share every instant of SPA's time-only terms
     for site in sites:
         here, dates = site_study(study, site, year)
         this = setup_key(here)
         if batch and (this != key or len(batch) == SITES_PER_BATCH):
-            frames.append(_evaluate_batch(batch, loads, relative, engine, _SUN_TERMS))
+            frames.append(_evaluate_batch(batch, loads, relative, engine, sun_terms))
             batch = []
         batch.append((site, here, dates))
         key = this
     if batch:
-        frames.append(_evaluate_batch(batch, loads, relative, engine, _SUN_TERMS))
+        frames.append(_evaluate_batch(batch, loads, relative, engine, sun_terms))
     return pd.concat(frames, ignore_index=True)
-
-
-#: SPA's time-only terms of every map this process evaluates: the sites of one year share every
-#: instant, and so do a worker's chunks, which would otherwise each work out the year's lattice
-#: again (the terms are elementwise in time, the same bits whichever call asked first; the store
-#: is bounded, and replaced whole as threads read it: :class:`~foldopt.physics.spa.SunTerms`).
-_SUN_TERMS = SunTerms()
 
 
 def _evaluate_batch(batch, loads, relative: bool, engine: str, sun_terms: SunTerms) -> pd.DataFrame:
