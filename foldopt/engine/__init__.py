@@ -10,7 +10,7 @@ It reads no study: what it needs of one comes as small frozen options groups
 (:mod:`~foldopt.engine.options`: the sky's :class:`~foldopt.engine.options.SkyOptions` and the
 cells' :class:`~foldopt.engine.options.ElectricalOptions`), made once by
 :func:`foldopt.studies.engine_options.engine_options`, and its arrays as named records
-(:mod:`~foldopt.engine.records`, the storage kernel's in :mod:`~foldopt.engine.storage_kernel`).
+(:mod:`~foldopt.engine.records`, the storage kernel's in :mod:`~foldopt.engine.storage_records`).
 Its entry points take the sky first, then those groups keyword-only. It may import
 :mod:`foldopt.inputs` (but the study), :mod:`foldopt.physics` and the leaves, never a study or a
 view.

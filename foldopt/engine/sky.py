@@ -16,7 +16,6 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-import pvlib
 
 from foldopt.engine.light import (
     clear_light,
@@ -394,6 +393,8 @@ def build_sky(
     grid = _clock(sites, dates, options.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, options.mode, sun_terms)
     solar_zenith = sun["solar_zenith"]
+    import pvlib
+
     dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[
         grid.dayofyear
     ]

@@ -20,7 +20,6 @@ References
 from __future__ import annotations
 
 import numpy as np
-import pvlib
 
 from foldopt.names import BEAM_SKIES
 
@@ -64,6 +63,8 @@ def relative_airmass(solar_zenith):
     [0.9997 1.9943    nan]
     """
     solar_zenith = np.asarray(solar_zenith, dtype=float)
+    import pvlib
+
     return np.asarray(pvlib.atmosphere.get_relative_airmass(solar_zenith, model="kastenyoung1989"))
 
 
@@ -173,6 +174,8 @@ def extraterrestrial_normal(dayofyear):
     .. [1] J. A. Duffie, W. A. Beckman, "Solar Engineering of Thermal Processes", 4th ed., Wiley,
        2013, Eq. 1.4.1a.
     """
+    import pvlib
+
     return np.asarray(
         pvlib.irradiance.get_extra_radiation(
             np.asarray(dayofyear), solar_constant=SOLAR_CONSTANT_HOTTEL, method="asce"
