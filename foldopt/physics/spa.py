@@ -30,8 +30,6 @@ import numpy as np
 
 NS_PER_HOUR = 3_600_000_000_000  # [ns]
 SPA_DELTA_T = 67.0  # [s], TT - UT1, pvlib's default for spa_python
-SPA_TEMPERATURE = 12.0  # [C], pvlib's default for the refraction correction
-SPA_ATMOS_REFRACT = 0.5667  # [deg], SPA's refraction at sunrise and sunset
 
 
 def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:

@@ -10,7 +10,8 @@ import math
 
 from numba import njit, uint64
 
-from foldopt.physics.spa import SPA_ATMOS_REFRACT, SPA_TEMPERATURE
+SPA_TEMPERATURE = 12.0  # [C], pvlib's default for the refraction correction
+SPA_ATMOS_REFRACT = 0.5667  # [deg], SPA's refraction at sunrise and sunset
 
 
 @njit(cache=True, inline="always")
@@ -46,7 +47,7 @@ def site_sun(
     """Every step of every block in one pass: the geometric topocentric unit vector toward the sun
     (east, north, up), from ``terms[:, first[b] + i]`` (:meth:`foldopt.physics.spa.SunTerms.on_lattice`) and the site's
     arguments per block; its elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s
-    formula and switch, at ``pressure`` [hPa] per block and :data:`~foldopt.physics.spa.SPA_TEMPERATURE`), which raises
+    formula and switch, at ``pressure`` [hPa] per block and :data:`SPA_TEMPERATURE`), which raises
     the vector in its vertical plane (:func:`_raised`) and the elevation. Writes ``direction``
     (n_blocks, 3, n_steps), ``apparent_zenith`` and ``solar_azimuth`` [deg] (n_blocks, n_steps),
     each value by the operations of the NumPy expressions this pass replaced, in their order."""
