@@ -333,7 +333,7 @@ def singleaxis_orientation(
         surface_tilt = np.degrees(np.arccos(_cosd(rotation) * _cosd(axis_tilt)))
     # The rotated surface's unit normal, projected on the ground for its azimuth.
     cos_a, sin_a = _cosd(-axis_azimuth), _sind(-axis_azimuth)
-    cos_t, sin_t = _cosd(-axis_tilt), _sind(-axis_tilt)
+    sin_t = _sind(-axis_tilt)
     east = sin_a * sin_t * _cosd(rotation) + cos_a * _sind(rotation)
     north = sin_a * _sind(rotation) - cos_a * sin_t * _cosd(rotation)
     surface_azimuth = np.degrees(np.arctan2(east, north))
