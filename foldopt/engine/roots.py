@@ -23,6 +23,15 @@ from collections.abc import Callable
 XTOL, RTOL, MAXITER = 2e-12, 4 * 2.220446049250313e-16, 100
 
 
+def _divide(a: float, b: float) -> float:
+    """``a / b`` as C divides doubles (IEEE 754): by zero an infinity or NaN, where Python raises."""
+    if b != 0:
+        return a / b
+    if a == 0 or math.isnan(a):
+        return math.nan
+    return math.copysign(math.inf, a) * math.copysign(1.0, b)
+
+
 def brentq(
     f: Callable[[float], float],
     a: float,
@@ -95,11 +104,11 @@ def brentq(
             return xcur
         if abs(spre) > delta and abs(fcur) < abs(fpre):
             if xpre == xblk:  # interpolate (secant)
-                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+                stry = _divide(-fcur * (xcur - xpre), fcur - fpre)
             else:  # extrapolate (inverse quadratic)
-                dpre = (fpre - fcur) / (xpre - xcur)
-                dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+                dpre = _divide(fpre - fcur, xpre - xcur)
+                dblk = _divide(fblk - fcur, xblk - xcur)
+                stry = _divide(-fcur * (fblk * dblk - fpre * dpre), dblk * dpre * (fblk - fpre))
             limit = 3 * abs(sbis) - delta
             if 2 * abs(stry) < (abs(spre) if abs(spre) < limit else limit):  # a good short step
                 spre, scur = scur, stry
