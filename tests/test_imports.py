@@ -144,7 +144,9 @@ def test_the_apis_run_of_the_embedded_study_imports_no_numba_scipy_pvlib_or_matp
         "import json, sys, foldopt; result = foldopt.run(); lines = result.answer.lines(); "
         f"print(json.dumps([bool(lines), sorted(m for m in {HEAVY!r} if m in sys.modules)]))"
     )
-    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, timeout=300
+    )
     assert done.returncode == 0, done.stderr
     answered, imported = json.loads(done.stdout.splitlines()[-1])
     assert answered and imported == ["numpy", "pandas"]

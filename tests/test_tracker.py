@@ -67,8 +67,10 @@ def test_single_axis_is_pvlibs_to_the_bit(sun, axis_tilt, axis_azimuth, max_angl
     expected = pvlib.tracking.singleaxis(zenith, azimuth, axis_tilt=axis_tilt,
                                          axis_azimuth=np.full(zenith.shape, axis_azimuth),
                                          max_angle=max_angle, backtrack=backtrack, gcr=gcr)
-    tilt, surface_azimuth = singleaxis_orientation(zenith, azimuth, axis_tilt, np.full(zenith.shape, axis_azimuth),
-                                                   max_angle, backtrack, gcr)
+    axis_azimuths = np.full(zenith.shape, axis_azimuth)
+    tilt, surface_azimuth = singleaxis_orientation(
+        zenith, azimuth, axis_tilt, axis_azimuths, max_angle, backtrack, gcr
+    )
     np.testing.assert_array_equal(tilt, expected["surface_tilt"])
     np.testing.assert_array_equal(surface_azimuth, expected["surface_azimuth"])
 

@@ -118,8 +118,8 @@ def heuristic_fold_angle(
     Shin et al. [1]_ Sec. VI, Eq. 8: ``Min(P_pv,parallel) = P_load``. The valley deepens as the
     panel folds (it rises with the fold angle), so the angle is the root of
     ``noon_valley(angle) - p_load`` in ``[lo, hi]``, found by Brent's method
-    (:func:`foldopt.engine.roots.brentq`, SciPy's): on the paper's study it evaluates the day 9 or 10 times where
-    bisection to the same tolerance takes 17. Where the valley reaches the load already at ``lo``
+    (:func:`foldopt.engine.roots.brentq`, SciPy's): on the paper's study it evaluates the day 9
+    or 10 times where bisection to the same tolerance takes 17. Where the valley reaches the load already at ``lo``
     the rule's angle lies at or below ``lo``, which is no angle of ``[lo, hi]``: ``lo`` is only the
     search's bound, not returned as the rule's answer.
 

@@ -24,7 +24,8 @@ XTOL, RTOL, MAXITER = 2e-12, 4 * 2.220446049250313e-16, 100
 
 
 def _divide(a: float, b: float) -> float:
-    """``a / b`` as C divides doubles (IEEE 754): by zero an infinity or NaN, where Python raises."""
+    """``a / b`` as C divides doubles (IEEE 754): by zero an infinity or NaN, where Python
+    raises."""
     if b != 0:
         return a / b
     if a == 0 or math.isnan(a):

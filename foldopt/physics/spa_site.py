@@ -45,12 +45,13 @@ def site_sun(
     solar_azimuth,
 ):
     """Every step of every block in one pass: the geometric topocentric unit vector toward the sun
-    (east, north, up), from ``terms[:, first[b] + i]`` (:meth:`foldopt.physics.spa.SunTerms.on_lattice`) and the site's
-    arguments per block; its elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s
-    formula and switch, at ``pressure`` [hPa] per block and :data:`SPA_TEMPERATURE`), which raises
-    the vector in its vertical plane (:func:`_raised`) and the elevation. Writes ``direction``
-    (n_blocks, 3, n_steps), ``apparent_zenith`` and ``solar_azimuth`` [deg] (n_blocks, n_steps),
-    each value by the operations of the NumPy expressions this pass replaced, in their order."""
+    (east, north, up), from ``terms[:, first[b] + i]``
+    (:meth:`foldopt.physics.spa.SunTerms.on_lattice`) and the site's arguments per block; its
+    elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s formula and switch, at
+    ``pressure`` [hPa] per block and :data:`SPA_TEMPERATURE`), which raises the vector in its
+    vertical plane (:func:`_raised`) and the elevation. Writes ``direction`` (n_blocks, 3,
+    n_steps), ``apparent_zenith`` and ``solar_azimuth`` [deg] (n_blocks, n_steps), each value by
+    the operations of the NumPy expressions this pass replaced, in their order."""
     n_blocks, n_steps = direction.shape[0], direction.shape[2]
     to_degrees, to_radians = 180.0 / math.pi, math.pi / 180.0
     cut = -1.0 * (0.26667 + SPA_ATMOS_REFRACT)
