@@ -75,6 +75,16 @@ def test_single_axis_is_pvlibs_to_the_bit(sun, axis_tilt, axis_azimuth, max_angl
     np.testing.assert_array_equal(surface_azimuth, expected["surface_azimuth"])
 
 
+@pytest.mark.parametrize("zenith", [30.0, 95.0])
+def test_single_axis_of_one_instant_is_pvlibs(zenith):
+    """Scalars in, 0-d arrays out, by day and (NaN) by night."""
+    expected = pvlib.tracking.singleaxis(zenith, 120.0, 0.0, 180.0, 60.0, True, 0.4)
+    tilt, surface_azimuth = singleaxis_orientation(zenith, 120.0, 0.0, 180.0, 60.0, True, 0.4)
+    assert np.shape(tilt) == np.shape(surface_azimuth) == ()
+    np.testing.assert_array_equal([tilt, surface_azimuth],
+                                  [expected["surface_tilt"][0], expected["surface_azimuth"][0]])
+
+
 @pytest.fixture(scope="session")
 def day():
     study = load_study(default_study_path())

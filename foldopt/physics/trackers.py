@@ -253,7 +253,7 @@ def _single_axis(
         gcr=options.gcr,
     )
     # At night the tracker's angles are NaN; the panel then rests flat along the axis.
-    surface_tilt = np.nan_to_num(surface_tilt, nan=options.axis_tilt)
+    surface_tilt = np.asarray(np.nan_to_num(surface_tilt, nan=options.axis_tilt))
     surface_azimuth = np.where(np.isnan(surface_azimuth), axis_azimuth, surface_azimuth)
     return surface_tilt, surface_azimuth, normal_vector(surface_tilt, surface_azimuth)
 
@@ -317,9 +317,8 @@ def singleaxis_orientation(
         + sy * sin_axis_tilt * cos_axis_azimuth
         + sz * _cosd(axis_tilt)
     )
-    ideal = np.degrees(np.arctan2(sx_prime, sz_prime))
-    down = apparent_zenith > 90
-    ideal[down] = np.nan
+    down = np.asarray(apparent_zenith) > 90
+    ideal = np.where(down, np.nan, np.degrees(np.arctan2(sx_prime, sz_prime)))
     rotation = ideal
     if backtrack:
         # The rows' spacing in panel widths; where the cosine is out of arccos's range at midday
