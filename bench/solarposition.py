@@ -140,7 +140,7 @@ def _agreement(sites, dates, step_min: float, reference: list) -> tuple[float, f
     the number of steps left out at SPA's refraction switch."""
     from foldopt.physics.geometry import normal_vector
     from foldopt.physics.solarposition import clock_grid, solar_position_grid
-    from foldopt.physics.spa import SPA_ATMOS_REFRACT
+    from foldopt.physics.spa_site import SPA_ATMOS_REFRACT
 
     grid = clock_grid(dates, "UTC", step_min)
     switch = -(0.26667 + SPA_ATMOS_REFRACT)  # [deg] SPA Eq. 42's limit: the sun's radius below the horizon

@@ -1,9 +1,18 @@
-"""Air mass and the Meinel beam against the papers' formulas and physical identities."""
+"""Air mass and the Meinel beam against the papers' formulas, physical identities and pvlib."""
 
 import numpy as np
+import pvlib
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 
-from foldopt.physics.atmosphere import beam_meinel, clear_sky_dni, relative_airmass
+from foldopt.physics.atmosphere import (
+    beam_meinel,
+    clear_sky_dni,
+    extraterrestrial_spencer,
+    relative_airmass,
+)
 
 
 def shin_eq1(zenith):
@@ -60,3 +69,26 @@ def test_linke_turbidity_is_pvlibs_lookup_to_the_bit():
         expected = pvlib.clearsky.lookup_linke_turbidity(times, latitude, longitude).to_numpy()
         np.testing.assert_array_equal(linke_turbidity(latitude, longitude, stamps), expected)
     assert linke_turbidity(0.0, 0.0, np.zeros((2, 0), dtype=np.int64)).shape == (2, 0)  # no step with the sun up
+
+
+@settings(max_examples=50, deadline=None)
+@given(zenith=arrays(np.float64, st.integers(1, 50), elements=st.floats(-10.0, 180.0)))
+def test_airmass_is_pvlibs_kasten_young_to_the_bit(zenith):
+    """pvlib's expression, operation for operation: the same bits, NaN below the horizon."""
+    expected = pvlib.atmosphere.get_relative_airmass(zenith, model="kastenyoung1989")
+    np.testing.assert_array_equal(relative_airmass(zenith), expected)
+
+
+def test_spencer_extraterrestrial_irradiance_is_pvlibs_to_the_bit():
+    """Every day of the year and a leap year's last: pvlib's get_extra_radiation (Spencer)."""
+    days = np.arange(367)
+    np.testing.assert_array_equal(
+        extraterrestrial_spencer(days), np.asarray(pvlib.irradiance.get_extra_radiation(days))
+    )
+    np.testing.assert_array_equal(
+        extraterrestrial_spencer(days, 1361.0),
+        np.asarray(pvlib.irradiance.get_extra_radiation(days, solar_constant=1361.0)),
+    )
+    # The Earth is nearest the Sun in early January, farthest in early July (+-3.3 %).
+    january, july = extraterrestrial_spencer([3, 185])
+    assert january > 1366.1 * 1.03 > 1366.1 * 0.97 > july

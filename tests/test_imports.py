@@ -1,6 +1,7 @@
 """The import graph of a command as it runs (issue 49): a refused request and ``foldopt --help``
-load none of the heavy libraries (each of which alone costs the 0.3 s a refusal may take), and
-``foldopt run`` prints its answer before matplotlib loads for the figures.
+load none of the heavy libraries (each of which alone costs the 0.3 s a refusal may take),
+``foldopt run`` prints its answer before matplotlib loads for the figures, and the embedded
+study's answer (the command's, the API's) loads none of numba, scipy or pvlib.
 
 Each command runs in a fresh interpreter (``python -c PROBE``) that runs the command line as the
 ``foldopt`` script does and, as it ends, prints the heavy modules it imported; a meta-path hook
@@ -19,6 +20,10 @@ import pytest
 
 #: Libraries a request's validation needs none of.
 HEAVY = ("pvlib", "pandas", "matplotlib", "scipy", "numba", "numpy")
+#: What the embedded study's answer imports none of: numba (the day runs on the NumPy path), scipy
+#: (its two roots are :func:`foldopt.engine.roots.brentq`), pvlib (the formulas of it the day calls
+#: are foldopt's, held to pvlib's bits) and matplotlib (the figures come after the answer).
+NOT_FOR_THE_ANSWER = ("numba", "scipy", "pvlib", "matplotlib")
 #: The line the probe prints where a watched module is first imported.
 MARKER = "<<imported {}>>"
 
@@ -118,6 +123,33 @@ def test_the_answer_prints_before_matplotlib_loads(tmp_path):
     assert before and before[0].startswith("shin2015: ")
     assert any("best fold angle" in line for line in before)
     assert (tmp_path / "out" / "power_curves.png").is_file()
+
+
+def test_the_embedded_studys_answer_imports_no_numba_scipy_pvlib_or_matplotlib(tmp_path):
+    """``foldopt run`` computes and prints the embedded study's whole answer with numpy and pandas
+    alone; writing its folder then adds matplotlib (for the figures) and nothing else heavy."""
+    code, lines, imported, stderr = _run(
+        ["run", "--out", str(tmp_path / "out")], watched=NOT_FOR_THE_ANSWER, cwd=_repository()
+    )
+    assert code == 0, stderr
+    answer = lines[: lines.index(MARKER.format("matplotlib"))]
+    assert answer[0].startswith("shin2015: ") and "a flat panel would need" in answer[-1]
+    assert [line for line in answer if line.startswith("<<imported")] == []
+    assert imported == ["matplotlib", "numpy", "pandas"]
+
+
+def test_the_apis_run_of_the_embedded_study_imports_no_numba_scipy_pvlib_or_matplotlib():
+    """``foldopt.run()`` and its answer, as a notebook asks for them: numpy and pandas alone."""
+    probe = (
+        "import json, sys, foldopt; result = foldopt.run(); lines = result.answer.lines(); "
+        f"print(json.dumps([bool(lines), sorted(m for m in {HEAVY!r} if m in sys.modules)]))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    answered, imported = json.loads(done.stdout.splitlines()[-1])
+    assert answered and imported == ["numpy", "pandas"]
 
 
 def test_the_probe_sees_an_import():

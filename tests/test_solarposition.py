@@ -176,7 +176,7 @@ def test_split_spa_equals_pvlib_spa_python_on_random_sites():
     # the geometric elevation can move across a step: those steps are left out.
     from foldopt.physics.geometry import normal_vector
     from foldopt.physics.solarposition import clock_grid, solar_position_grid
-    from foldopt.physics.spa import SPA_ATMOS_REFRACT
+    from foldopt.physics.spa_site import SPA_ATMOS_REFRACT
 
     rng = np.random.default_rng(2024)
     n = 12

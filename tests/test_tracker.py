@@ -11,7 +11,13 @@ from foldopt.inputs.study_file import default_study_path
 from foldopt.api import load_study
 from foldopt.engine.metrics import t_solar
 from foldopt.studies.day import Day
-from foldopt.physics.trackers import ALEXANDRU_STEP_OFFSETS_H, TrackerDrive, step_law, tracker_orientation
+from foldopt.physics.trackers import (
+    ALEXANDRU_STEP_OFFSETS_H,
+    TrackerDrive,
+    singleaxis_orientation,
+    step_law,
+    tracker_orientation,
+)
 
 
 @settings(max_examples=100)
@@ -43,6 +49,40 @@ def test_single_axis_matches_pvlib():
                                          backtrack=False, gcr=0.35)
     np.testing.assert_allclose(tilt, expected["surface_tilt"], atol=1e-9)
     np.testing.assert_allclose(surface_azimuth, expected["surface_azimuth"], atol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    sun=st.lists(st.tuples(st.floats(0.0, 120.0), st.floats(0.0, 360.0)), min_size=1, max_size=40),
+    axis_tilt=st.sampled_from([0.0, 10.0, 35.5]),
+    axis_azimuth=st.one_of(st.floats(0.0, 360.0), st.just(180.0)),
+    max_angle=st.floats(5.0, 90.0),
+    backtrack=st.booleans(),
+    gcr=st.floats(0.05, 0.95),
+)
+def test_single_axis_is_pvlibs_to_the_bit(sun, axis_tilt, axis_azimuth, max_angle, backtrack, gcr):
+    """pvlib's operations in pvlib's order: the same surface angles, bit for bit (NaN at night),
+    an axis azimuth per step as the tracker passes it."""
+    zenith, azimuth = np.array(sun).T
+    expected = pvlib.tracking.singleaxis(zenith, azimuth, axis_tilt=axis_tilt,
+                                         axis_azimuth=np.full(zenith.shape, axis_azimuth),
+                                         max_angle=max_angle, backtrack=backtrack, gcr=gcr)
+    axis_azimuths = np.full(zenith.shape, axis_azimuth)
+    tilt, surface_azimuth = singleaxis_orientation(
+        zenith, azimuth, axis_tilt, axis_azimuths, max_angle, backtrack, gcr
+    )
+    np.testing.assert_array_equal(tilt, expected["surface_tilt"])
+    np.testing.assert_array_equal(surface_azimuth, expected["surface_azimuth"])
+
+
+@pytest.mark.parametrize("zenith", [30.0, 95.0])
+def test_single_axis_of_one_instant_is_pvlibs(zenith):
+    """Scalars in, 0-d arrays out, by day and (NaN) by night."""
+    expected = pvlib.tracking.singleaxis(zenith, 120.0, 0.0, 180.0, 60.0, True, 0.4)
+    tilt, surface_azimuth = singleaxis_orientation(zenith, 120.0, 0.0, 180.0, 60.0, True, 0.4)
+    assert np.shape(tilt) == np.shape(surface_azimuth) == ()
+    np.testing.assert_array_equal([tilt, surface_azimuth],
+                                  [expected["surface_tilt"][0], expected["surface_azimuth"][0]])
 
 
 @pytest.fixture(scope="session")

@@ -28,7 +28,6 @@ import hashlib
 from dataclasses import dataclass
 
 import numpy as np
-import pvlib
 
 from foldopt.cache import cache_dir, load_cache, store_cache
 from foldopt.engine.as_built import PARTS, CircuitParts, alone_power, assemble, pair_power
@@ -144,6 +143,8 @@ class Electrical:
         str
             32 hexadecimal digits.
         """
+        import pvlib
+
         settings = (
             TABLE_FORMAT,
             name,

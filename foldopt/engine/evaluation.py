@@ -24,7 +24,6 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-import pvlib
 
 from foldopt.physics.connections import CONNECTIONS, connection_powers
 from foldopt.physics.geometry import normal_vector, subpanel_orientation
@@ -228,6 +227,8 @@ def iam_modifier(model: str, surface_tilt, surface_azimuth, solar_zenith, solar_
     """
     if model == "none":
         return 1.0
+    import pvlib
+
     aoi = pvlib.irradiance.aoi(surface_tilt, surface_azimuth, solar_zenith, solar_azimuth)
     modifier = pvlib.iam.ashrae(aoi) if model == "ashrae" else pvlib.iam.physical(aoi)
     return np.nan_to_num(np.asarray(modifier, dtype=float))
@@ -239,6 +240,8 @@ def _iam_code(model: str):
 
     if model == "none":
         return incidence.IAM_NONE, np.zeros(3)
+    import pvlib
+
     function = pvlib.iam.ashrae if model == "ashrae" else pvlib.iam.physical
     defaults = [
         p.default

@@ -25,7 +25,6 @@ from foldopt.inputs.weather.reader import (
 from foldopt.inputs.weather.downscale import clear_sky, hourly_light, interpolate_points
 from foldopt.inputs.weather.ensemble import cloud_members
 from foldopt.physics.atmosphere import relative_airmass
-from foldopt.physics.clearsky import ineichen_terms
 from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.physics.solarposition import ClockGrid
 
@@ -91,6 +90,8 @@ def clear_light(
                     latitude, longitude, grid.utc_ns[members]
                 )
         altitude = np.array([site.altitude for site in sites], dtype=float)
+        from foldopt.physics.clearsky import ineichen_terms  # numba's compiled pass
+
         dni, ghi, dhi, layout = ineichen_terms(
             solar_zenith, dni_extra, turbidity, altitude, transposition, albedo
         )

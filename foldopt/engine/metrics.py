@@ -12,7 +12,8 @@ one call serves many fold angles and loads.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
+
+from foldopt.engine.roots import brentq
 
 
 def _time_above_per_segment(p_pv, p_load, step_hours):

@@ -9,9 +9,9 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-import scipy.optimize
 
 from foldopt.engine.metrics import t_solar
+from foldopt.engine.roots import brentq
 from foldopt.names import FLAT_FOLD_ANGLE
 
 PowerOfAngles = Callable[[np.ndarray], np.ndarray]
@@ -118,8 +118,8 @@ def heuristic_fold_angle(
     Shin et al. [1]_ Sec. VI, Eq. 8: ``Min(P_pv,parallel) = P_load``. The valley deepens as the
     panel folds (it rises with the fold angle), so the angle is the root of
     ``noon_valley(angle) - p_load`` in ``[lo, hi]``, found by Brent's method
-    (:func:`scipy.optimize.brentq`): on the paper's study it evaluates the day 9 or 10 times where
-    bisection to the same tolerance takes 17. Where the valley reaches the load already at ``lo``
+    (:func:`foldopt.engine.roots.brentq`, SciPy's): on the paper's study it evaluates the day 9
+    or 10 times where bisection to the same tolerance takes 17. Where the valley reaches the load already at ``lo``
     the rule's angle lies at or below ``lo``, which is no angle of ``[lo, hi]``: ``lo`` is only the
     search's bound, not returned as the rule's answer.
 
@@ -132,7 +132,7 @@ def heuristic_fold_angle(
     lo, hi : float, default 1 and 180
         Search interval [deg]: a study's fold angles.
     tol : float, default 0.01
-        Absolute tolerance on the angle [deg] (``xtol`` of :func:`scipy.optimize.brentq`).
+        Absolute tolerance on the angle [deg] (``xtol`` of :func:`foldopt.engine.roots.brentq`).
 
     Returns
     -------
@@ -172,7 +172,7 @@ def heuristic_fold_angle(
         return float("nan"), "above"
     if shortfall(lo) >= 0.0:
         return float("nan"), "below"
-    angle = float(scipy.optimize.brentq(shortfall, lo, hi, xtol=tol))
+    angle = float(brentq(shortfall, lo, hi, xtol=tol))
     # Brent's estimate may fall just short of the threshold; the answer must reach the load (the
     # valley rises with the fold angle, and the threshold lies within ``tol`` of the estimate).
     return (angle if shortfall(angle) >= 0.0 else min(angle + tol, hi)), ""

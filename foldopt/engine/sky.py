@@ -16,7 +16,6 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-import pvlib
 
 from foldopt.engine.light import (
     clear_light,
@@ -30,7 +29,7 @@ from foldopt.inputs.load_profile import load_shape
 from foldopt.inputs.sections import parse_timezone
 from foldopt.inputs.weather.reader import study_weather, weather_site
 from foldopt.names import CLEAR_SKIES
-from foldopt.physics.atmosphere import clear_sky_dni
+from foldopt.physics.atmosphere import clear_sky_dni, extraterrestrial_spencer
 from foldopt.physics.horizon import sun_visible
 from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
 from foldopt.physics.spa import SunTerms
@@ -394,9 +393,7 @@ def build_sky(
     grid = _clock(sites, dates, options.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, options.mode, sun_terms)
     solar_zenith = sun["solar_zenith"]
-    dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(np.arange(367)), dtype=float)[
-        grid.dayofyear
-    ]
+    dni_extra = extraterrestrial_spencer(np.arange(367))[grid.dayofyear]
     temp_air, balance = np.full(len(sites), float(options.temp_air)), None
     temp_steps = wind_speed = wind_ref = terms = None
     notes = ()

@@ -61,7 +61,7 @@ Conventions that follow from it:
 Initial state: ``initial_soc``, or by default the periodic steady state: the series is run from a
 full buffer, then from the state it ended in, until the state at its end is that at its start (the
 content within ``tolerance`` x the capacity, the load on or off alike). After
-:data:`~foldopt.engine.storage_kernel.PLAIN_ITERATIONS` passes the start is bisected between the
+:data:`~foldopt.engine.storage_records.PLAIN_ITERATIONS` passes the start is bisected between the
 contents that ended higher and lower, until the start is known to the tolerance. If the end
 still differs by more, it jumps over the start there (a cut-off or a reconnection a part earlier
 or later, or an end that moves much faster than the start): the state is periodic to the model's
@@ -88,7 +88,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from foldopt.engine import storage_kernel as kern
+from foldopt.engine import storage_records as layout
 
 #: The engines :func:`simulate` runs on.
 STORAGE_ENGINES = ("numba", "numpy")
@@ -299,33 +299,36 @@ def simulate(
         raise ValueError(f"step_hours must be above 0; got {step_hours}")
     if max_iterations < 1 or not tolerance >= 0:
         raise ValueError("max_iterations must be 1 or more and tolerance 0 or more")
-    out = np.zeros((n_series, n_days, kern.HISTOGRAM + SOC_BINS))
+    out = np.zeros((n_series, n_days, layout.HISTOGRAM + SOC_BINS))
     state = np.zeros((n_series, n_days + 1, 2))
     soc = np.zeros((n_series, n_days, n_steps) if soc_curves else (1, 1, 1))
     passes = np.zeros(n_series, dtype=np.int64)
     # The compiled loop takes every argument with the one type it was compiled for.
-    run = kern.simulate_series if engine == "numba" else _simulate_numpy
+    if engine == "numba":  # numba loads with the compiled loop, not for the NumPy path
+        from foldopt.engine.storage_kernel import simulate_series as run
+    else:
+        run = _simulate_numpy
     run(
-        kern.Curves(power, load, own, float(step_hours)),
+        layout.Curves(power, load, own, float(step_hours)),
         params,
-        kern.Days(out, state, soc, bool(soc_curves)),
+        layout.Days(out, state, soc, bool(soc_curves)),
         passes,
         int(max_iterations),
         float(tolerance),
     )
     return StorageResult(
-        out[..., kern.POWERED],
-        out[..., kern.SERVED],
-        out[..., kern.MISSING],
-        out[..., kern.LOST],
-        out[..., kern.HARVESTED],
-        out[..., kern.CHARGE_LOSS],
-        out[..., kern.DISCHARGE_LOSS],
-        out[..., kern.SELF_DISCHARGE],
-        out[..., kern.DRAWN],
-        out[..., kern.FULL] > 0.5,
-        out[..., kern.EMPTY] > 0.5,
-        out[..., kern.HISTOGRAM :],
+        out[..., layout.POWERED],
+        out[..., layout.SERVED],
+        out[..., layout.MISSING],
+        out[..., layout.LOST],
+        out[..., layout.HARVESTED],
+        out[..., layout.CHARGE_LOSS],
+        out[..., layout.DISCHARGE_LOSS],
+        out[..., layout.SELF_DISCHARGE],
+        out[..., layout.DRAWN],
+        out[..., layout.FULL] > 0.5,
+        out[..., layout.EMPTY] > 0.5,
+        out[..., layout.HISTOGRAM :],
         state[..., 0],
         soc if soc_curves else None,
         passes,
@@ -355,7 +358,7 @@ def _load_array(load, shape, name):
     return np.ascontiguousarray(load)
 
 
-def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> kern.Parameters:
+def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> layout.Parameters:
     """The buffer as the loops read it, each field checked: (n_series,) arrays."""
 
     def field(name, value, lo, hi, lo_open=False, hi_open=False, default=None):
@@ -384,7 +387,7 @@ def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> kern.Parame
         if buffer.initial_soc is None
         else field("initial_soc", buffer.initial_soc, 0.0, 1.0)
     )
-    fields = kern.Parameters(
+    fields = layout.Parameters(
         capacity=capacity,
         min_soc=min_soc,
         restart_soc=restart,
@@ -396,7 +399,7 @@ def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> kern.Parame
         max_discharge=max_d,
         initial_soc=initial,
     )
-    return kern.Parameters(
+    return layout.Parameters(
         *(np.ascontiguousarray(np.broadcast_to(field, n_series), dtype=float) for field in fields)
     )
 
@@ -433,9 +436,9 @@ def _charge_numpy(charging, stored, spare, limit, par, row):
     fills = charging & (take >= room)
     take = np.where(fills, room, take)
     stored = np.where(fills, capacity, np.where(charging, stored + take * eta, stored))
-    row[:, kern.FULL] = np.where(fills & (capacity > 0.0), 1.0, row[:, kern.FULL])
-    row[:, kern.CHARGE_LOSS] += np.where(charging, take * (1.0 - eta), 0.0)
-    row[:, kern.LOST] += np.where(charging, spare - take, 0.0)
+    row[:, layout.FULL] = np.where(fills & (capacity > 0.0), 1.0, row[:, layout.FULL])
+    row[:, layout.CHARGE_LOSS] += np.where(charging, take * (1.0 - eta), 0.0)
+    row[:, layout.LOST] += np.where(charging, spare - take, 0.0)
     return stored
 
 
@@ -488,11 +491,11 @@ def _part_numpy(ends, tau, surplus, demand, stored, on, par, row):
         x = ran / tau
         pm, lm, dm = pa + x * (pb - pa), la + x * (lb - la), da + x * (db - da)
         ran_served, ran_drawn = 0.5 * ran * (la + lm), 0.5 * ran * (da + dm)
-    row[:, kern.SERVED] += np.where(whole, need, np.where(partial, ran_served, 0.0))
-    row[:, kern.DRAWN] += np.where(whole, own, np.where(partial, ran_drawn, 0.0))
+    row[:, layout.SERVED] += np.where(whole, need, np.where(partial, ran_served, 0.0))
+    row[:, layout.DRAWN] += np.where(whole, own, np.where(partial, ran_drawn, 0.0))
     ran = np.where(whole, tau, np.where(partial, ran, 0.0))
-    row[:, kern.POWERED] += np.where(demand, ran, 0.0)
-    row[:, kern.DISCHARGE_LOSS] += np.where(
+    row[:, layout.POWERED] += np.where(demand, ran, 0.0)
+    row[:, layout.DISCHARGE_LOSS] += np.where(
         covered, taken - short, np.where(partial, usable - eta_d * usable, 0.0)
     )
     stored = np.where(covered, stored - taken, np.where(partial, floor, stored))
@@ -500,8 +503,8 @@ def _part_numpy(ends, tau, surplus, demand, stored, on, par, row):
     tau = np.where(partial, tau - ran, tau)
     need = np.where(partial, 0.5 * tau * (la + lb), need)
     on = on & ~cut
-    row[:, kern.EMPTY] = np.where(cut & (stored <= floor), 1.0, row[:, kern.EMPTY])
-    row[:, kern.MISSING] += np.where(off, need, 0.0)
+    row[:, layout.EMPTY] = np.where(cut & (stored <= floor), 1.0, row[:, layout.EMPTY])
+    row[:, layout.MISSING] += np.where(off, need, 0.0)
     max_c = par.max_charge
     # Off, the controller has the load and the design's own draw off: the whole power charges.
     whole_a, whole_b = pa + da, pb + db
@@ -518,7 +521,7 @@ def _part_numpy(ends, tau, surplus, demand, stored, on, par, row):
     return _charge_numpy(run | off, stored, spare, limit, par, row), on
 
 
-def _segments(curves: kern.Curves):
+def _segments(curves: layout.Curves):
     """Each day's segments and their two parts, over whole arrays (n_series, n_days, n_steps + 1):
     the part with the power (less the design's own draw) at or above the load and the one below
     it, in their order, each ``(ends, tau, surplus)`` as :func:`_part_numpy` takes them."""
@@ -549,7 +552,7 @@ def _segments(curves: kern.Curves):
     return first, second, (l0 > 0.0) & (l1 > 0.0), half
 
 
-def _run_numpy(curves: kern.Curves, par: kern.Parameters, stored, on, days: kern.Days):
+def _run_numpy(curves: layout.Curves, par: layout.Parameters, stored, on, days: layout.Days):
     """One pass over the days of a set of series (:func:`foldopt.engine.storage_kernel._run`
     without merging), the steps in turn and the series at once."""
     power, _, draw, step_hours = curves
@@ -557,7 +560,7 @@ def _run_numpy(curves: kern.Curves, par: kern.Parameters, stored, on, days: kern
     n_days, n_steps = power.shape[1:]
     first, second, demand, half = _segments(curves)
     capacity = par.capacity
-    n_bins = out.shape[-1] - kern.HISTOGRAM
+    n_bins = out.shape[-1] - layout.HISTOGRAM
     series = np.arange(power.shape[0])
     restart = par.restart_soc * capacity
     floor = par.min_soc * capacity
@@ -566,8 +569,8 @@ def _run_numpy(curves: kern.Curves, par: kern.Parameters, stored, on, days: kern
         state[:, d, 0], state[:, d, 1] = stored, on
         row = out[:, d]
         row[:] = 0.0
-        row[:, kern.FULL] = np.where((capacity > 0.0) & (stored >= capacity), 1.0, 0.0)
-        row[:, kern.EMPTY] = np.where(stored <= floor, 1.0, 0.0)
+        row[:, layout.FULL] = np.where((capacity > 0.0) & (stored >= capacity), 1.0, 0.0)
+        row[:, layout.EMPTY] = np.where(stored <= floor, 1.0, 0.0)
         for j in range(n_steps + 1):
             for ends, tau, surplus in (first, second):
                 stored, on = _part_numpy(
@@ -581,16 +584,16 @@ def _run_numpy(curves: kern.Curves, par: kern.Parameters, stored, on, days: kern
                     row,
                 )
             kept = stored * (par.keep_half if half[j] else par.keep_step)
-            row[:, kern.SELF_DISCHARGE] += stored - kept
+            row[:, layout.SELF_DISCHARGE] += stored - kept
             stored = kept
             with np.errstate(invalid="ignore", divide="ignore"):
                 level = np.where(capacity > 0.0, stored / capacity, 0.0)
             bins = np.clip((level * n_bins).astype(np.int64), 0, n_bins - 1)
-            row[series, kern.HISTOGRAM + bins] += 0.5 * step_hours if half[j] else step_hours
+            row[series, layout.HISTOGRAM + bins] += 0.5 * step_hours if half[j] else step_hours
             if soc_curves and j < n_steps:
                 soc[:, d, j] = level
         whole = power[:, d] + np.broadcast_to(draw, power.shape)[:, d]
-        row[:, kern.HARVESTED] = np.cumsum(whole, axis=-1)[:, -1] * step_hours
+        row[:, layout.HARVESTED] = np.cumsum(whole, axis=-1)[:, -1] * step_hours
     on = on | (stored >= restart)
     state[:, n_days, 0], state[:, n_days, 1] = stored, on
     return stored, on
@@ -615,11 +618,11 @@ def _simulate_numpy(curves, params, days, passes, max_iterations, tolerance):
         sub_out, sub_state = out[pick], state[pick]
         sub_soc = soc[pick] if soc_curves else soc
         end, end_on = _run_numpy(
-            kern.Curves(power[pick], load[pick], draw[pick], step_hours),
-            kern.Parameters(*(field[pick] for field in par)),
+            layout.Curves(power[pick], load[pick], draw[pick], step_hours),
+            layout.Parameters(*(field[pick] for field in par)),
             stored[pick],
             on[pick],
-            kern.Days(sub_out, sub_state, sub_soc, soc_curves),
+            layout.Days(sub_out, sub_state, sub_soc, soc_curves),
         )
         out[pick], state[pick] = sub_out, sub_state
         if soc_curves:
@@ -633,7 +636,7 @@ def _simulate_numpy(curves, params, days, passes, max_iterations, tolerance):
         done |= located & (np.abs(end - stored[pick]) <= resolution[pick])
         stuck = ~done & (located | (passes[pick] >= max_iterations))
         passes[pick[stuck]] *= -1
-        plain = (passes[pick] < kern.PLAIN_ITERATIONS) & (lo <= end) & (end <= hi)
+        plain = (passes[pick] < layout.PLAIN_ITERATIONS) & (lo <= end) & (end <= hi)
         low[pick], high[pick] = lo, hi
         stored[pick] = np.where(plain, end, 0.5 * (lo + hi))
         on[pick] = end_on

@@ -5,8 +5,9 @@ is the reference it is tested against.
 
 One plain loop per series, the series spread over threads (:func:`simulate_series`). The arguments
 are named records, module-level named tuples numba takes (:class:`Curves`, :class:`Parameters`,
-:class:`Days`), each field with the same type at every call (arrays of float64 laid out
-C-contiguous, a float, a bool), so that numba compiles one specialisation once and caches it.
+:class:`Days`, of :mod:`foldopt.engine.storage_records`), each field with the same type at every
+call (arrays of float64 laid out C-contiguous, a float, a bool), so that numba compiles one
+specialisation once and caches it.
 NumPy's error model spares every division Python's check for a zero divisor (the model divides
 by efficiencies, lengths and the capacity only where they are above zero). Dark
 steps and steps with the buffer full, most of a day, take short cuts through the same
@@ -16,95 +17,28 @@ operations as the general part (:func:`_run`), so the two paths agree to the bit
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
 
-
-class Curves(NamedTuple):
-    """What a buffer runs over: for every series, (n_series or 1, ...) arrays; in the loops over
-    one series, that series' (the first axis taken).
-
-    Attributes
-    ----------
-    power : (n_series or 1, n_days, n_steps) float
-        Power at step centres [W], less the design's own draw.
-    load, draw : (n_series or 1, n_days or 1, n_steps or 1) float
-        The load and the design's own draw at step centres [W].
-    step_hours : float
-        Step length [h].
-    """
-
-    power: np.ndarray
-    load: np.ndarray
-    draw: np.ndarray
-    step_hours: float
-
-
-class Parameters(NamedTuple):
-    """A buffer and its charge controller as the loops read them
-    (:func:`foldopt.engine.storage.simulate`): for every series, each field a (n_series,) float
-    array; in the loops over one series, that series' float.
-
-    Attributes
-    ----------
-    capacity : float
-        [Wh].
-    min_soc, restart_soc : float
-        The controller's cut-off and reconnection [-].
-    eta_charge, eta_discharge : float
-        Charge and discharge efficiencies [-].
-    keep_step, keep_half : float
-        The share of the content a step and a half step keep against self-discharge [-].
-    max_charge, max_discharge : float
-        Power limits into and out of the buffer [W] (inf: none).
-    initial_soc : float
-        State of charge at the start [-]; NaN: the periodic state.
-    """
-
-    capacity: np.ndarray
-    min_soc: np.ndarray
-    restart_soc: np.ndarray
-    eta_charge: np.ndarray
-    eta_discharge: np.ndarray
-    keep_step: np.ndarray
-    keep_half: np.ndarray
-    max_charge: np.ndarray
-    max_discharge: np.ndarray
-    initial_soc: np.ndarray
-
-
-class Days(NamedTuple):
-    """What the loops write: for every series, (n_series, ...) arrays; in the loops over one
-    series, that series' (the first axis taken).
-
-    Attributes
-    ----------
-    out : (n_series, n_days, HISTOGRAM + n_bins) float
-        Each day's outputs (the columns below).
-    state : (n_series, n_days + 1, 2) float
-        Content [Wh] and load on (1) or off (0) at each midnight.
-    soc : (n_series, n_days, n_steps) or (1, 1, 1) float
-        The state of charge at each step centre where ``keep_soc`` (else a placeholder).
-    keep_soc : bool
-    """
-
-    out: np.ndarray
-    state: np.ndarray
-    soc: np.ndarray
-    keep_soc: bool
-
-
-# Columns of a day's outputs; the state-of-charge histogram follows from HISTOGRAM on.
-POWERED, SERVED, MISSING, LOST, HARVESTED = 0, 1, 2, 3, 4
-CHARGE_LOSS, DISCHARGE_LOSS, SELF_DISCHARGE, FULL, EMPTY = 5, 6, 7, 8, 9
-DRAWN = 10
-HISTOGRAM = 11
-
-#: Plain fixed-point iterations (the buffer's own year after year) before the periodic state is
-#: bisected instead (a state that drifts by a little a day would take many plain ones).
-PLAIN_ITERATIONS = 4
+from foldopt.engine.storage_records import (
+    CHARGE_LOSS,
+    DISCHARGE_LOSS,
+    DRAWN,
+    EMPTY,
+    FULL,
+    HARVESTED,
+    HISTOGRAM,
+    LOST,
+    MISSING,
+    PLAIN_ITERATIONS,
+    POWERED,
+    SELF_DISCHARGE,
+    SERVED,
+    Curves,
+    Days,
+    Parameters,
+)
 
 
 @njit(cache=True, error_model="numpy")

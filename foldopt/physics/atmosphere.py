@@ -15,12 +15,14 @@ References
    W. A. Beckman, "Solar Engineering of Thermal Processes", Sec. 2.8, Eq. 2.8.1 and Table 2.8.1.
    Robles Algarin et al. Eq. 4-7 quote it with OCR damage: a1* has "+ 0.00595 (6.5 - A)^2" and k*
    "+ 0.01858 (2.5 - A)^2" (the seed text reads "- 0.005958 (6 - A)^2" and "- 0.01858").
+.. [5] J. W. Spencer, "Fourier series representation of the position of the sun", Search 2(5),
+   172, 1971; as given by M. Iqbal, "An Introduction to Solar Radiation", Academic Press, 1983,
+   Eq. 1.2.1 (pvlib ``irradiance.get_extra_radiation``, method ``spencer``).
 """
 
 from __future__ import annotations
 
 import numpy as np
-import pvlib
 
 from foldopt.names import BEAM_SKIES
 
@@ -35,6 +37,7 @@ HOTTEL_CLIMATES = {
 SOLAR_CONSTANT_HOTTEL = 1367.0  # [W/m^2], Duffie & Beckman
 
 SOLAR_CONSTANT_MEINEL = 1353.0  # [W/m^2], the constant of Meinel & Meinel [2]
+SOLAR_CONSTANT_PVLIB = 1366.1  # [W/m^2], pvlib's default for get_extra_radiation
 LAUE_ALTITUDE_COEFFICIENT = 0.14  # [1/km], [3]
 
 
@@ -63,8 +66,11 @@ def relative_airmass(solar_zenith):
     >>> print(relative_airmass([0.0, 60.0, 95.0]).round(4))
     [0.9997 1.9943    nan]
     """
-    solar_zenith = np.asarray(solar_zenith, dtype=float)
-    return np.asarray(pvlib.atmosphere.get_relative_airmass(solar_zenith, model="kastenyoung1989"))
+    # pvlib's expression, operation for operation: the two agree to the bit
+    # (tests/test_atmosphere.py), without importing pvlib (and the scipy it loads) for a formula.
+    zenith = np.asarray(solar_zenith, dtype=float)
+    zenith = np.where(zenith > 90, np.nan, zenith)
+    return 1.0 / (np.cos(np.radians(zenith)) + 0.50572 * ((6.07995 + (90 - zenith)) ** -1.6364))
 
 
 def beam_meinel(airmass, altitude=0.0):
@@ -154,6 +160,39 @@ def hottel_transmittance(solar_zenith, altitude=0.0, climate="midlatitude-summer
     return np.where(cos_zenith > 0, tau, 0.0)
 
 
+def extraterrestrial_spencer(dayofyear, solar_constant: float = SOLAR_CONSTANT_PVLIB):
+    """Extraterrestrial normal irradiance by Spencer's series for the Earth-Sun distance [5]_, as
+    pvlib's ``irradiance.get_extra_radiation`` (its default ``spencer``) writes it, operation for
+    operation: the two agree to the bit (tests/test_atmosphere.py).
+
+    Parameters
+    ----------
+    dayofyear : array_like
+        Day of year, 1 on January 1 [-].
+    solar_constant : float, default :data:`SOLAR_CONSTANT_PVLIB`
+        [W/m^2].
+
+    Returns
+    -------
+    numpy.ndarray
+        Irradiance on a surface normal to the sun above the atmosphere [W/m^2].
+
+    Examples
+    --------
+    >>> extraterrestrial_spencer([1, 182]).round(1).tolist()
+    [1414.0, 1320.5]
+    """
+    day_angle = (2.0 * np.pi / 365.0) * (np.asarray(dayofyear) - 1)
+    distance = (
+        1.00011
+        + 0.034221 * np.cos(day_angle)
+        + 0.00128 * np.sin(day_angle)
+        + 0.000719 * np.cos(2 * day_angle)
+        + 7.7e-05 * np.sin(2 * day_angle)
+    )
+    return np.asarray(solar_constant * distance, dtype=float)
+
+
 def extraterrestrial_normal(dayofyear):
     """Extraterrestrial normal irradiance, Duffie & Beckman Eq. 1.4.1a [1]_ (pvlib ``asce``).
 
@@ -173,6 +212,8 @@ def extraterrestrial_normal(dayofyear):
     .. [1] J. A. Duffie, W. A. Beckman, "Solar Engineering of Thermal Processes", 4th ed., Wiley,
        2013, Eq. 1.4.1a.
     """
+    import pvlib
+
     return np.asarray(
         pvlib.irradiance.get_extra_radiation(
             np.asarray(dayofyear), solar_constant=SOLAR_CONSTANT_HOTTEL, method="asce"

@@ -34,7 +34,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pvlib
 
 from foldopt.names import CONVERTER_MODELS
 
@@ -105,6 +104,8 @@ class Converter:
         if self.model == "ideal":
             return p_in
         if self.model == "pvwatts":
+            import pvlib
+
             return pvlib.inverter.pvwatts(p_in, self.p_rated, self.efficiency)
         fraction = np.array([0.0] + [point[0] for point in self.curve])
         efficiency = np.array([0.0] + [point[1] for point in self.curve])

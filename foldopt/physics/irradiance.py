@@ -30,7 +30,6 @@ References
 from __future__ import annotations
 
 import numpy as np
-import pvlib
 
 from foldopt import names
 
@@ -47,6 +46,8 @@ HAYDAVIES_COS_FLOOR, PEREZ_COS_FLOOR = 0.01745, float(np.cos(np.radians(85.0)))
 def perez_coefficients() -> tuple[np.ndarray, np.ndarray]:
     """Perez et al.'s F1 and F2 coefficients [5]_ Table 6 per clearness bin, (8, 3) each, as pvlib's
     ``allsitescomposite1990`` set."""
+    import pvlib
+
     f1, f2 = pvlib.irradiance._get_perez_coefficients("allsitescomposite1990")
     return np.ascontiguousarray(f1, dtype=float), np.ascontiguousarray(f2, dtype=float)
 
@@ -89,6 +90,8 @@ def beam_incidence_factor(
     paper 0.7071
     """
     if model == "exact":
+        import pvlib
+
         projection = pvlib.irradiance.aoi_projection(
             surface_tilt, surface_azimuth, solar_zenith, solar_azimuth
         )

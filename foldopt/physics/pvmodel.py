@@ -34,8 +34,6 @@ import re
 from dataclasses import dataclass
 
 import numpy as np
-import pvlib
-from scipy.special import lambertw
 
 from foldopt.names import PV_MODELS
 
@@ -85,6 +83,8 @@ A300_CELL = DiodeUnit(
 
 @functools.cache
 def _cec_modules():
+    import pvlib
+
     return pvlib.pvsystem.retrieve_sam("CECMod")
 
 
@@ -268,6 +268,8 @@ class IVCurve:
             Current [A]; negative beyond open circuit.
         """
         if self.model == "single-diode":
+            import pvlib
+
             return pvlib.pvsystem.i_from_v(voltage, *self._params(voltage))
         v_x, i_x, b = self._params(voltage)
         scale = i_x / -np.expm1(-1.0 / b)
@@ -290,6 +292,8 @@ class IVCurve:
         if self.model == "single-diode":
             # pvlib's Lambert-W overflows for practically dark cells; `lit` handles those.
             with np.errstate(over="ignore", invalid="ignore"):
+                import pvlib
+
                 return pvlib.pvsystem.v_from_i(current, *self._params(current))
         v_x, i_x, b = self._params(current)
         scale = i_x / -np.expm1(-1.0 / b)
@@ -318,6 +322,8 @@ class IVCurve:
     def mpp(self):
         """Maximum power [W] and its voltage [V] of each curve (both 0 for a dark curve)."""
         if self.model == "single-diode":
+            import pvlib
+
             mpp = pvlib.pvsystem.max_power_point(*self.params, method="newton")
             lit = self.lit
             power = np.clip(np.nan_to_num(np.asarray(mpp["p_mp"], dtype=float)), 0.0, None)
@@ -339,6 +345,8 @@ class IVCurve:
 def _lambertw_exp(x):
     """W(e^x) for large x, by Newton iteration on w + ln w = x."""
     x = np.asarray(x, dtype=float)
+    from scipy.special import lambertw
+
     w = np.where(x < 50, np.real(lambertw(np.exp(np.minimum(x, 50)))), x - np.log(x))
     for _ in range(4):
         w = w - (w + np.log(w) - x) / (1.0 + 1.0 / w)
@@ -425,6 +433,8 @@ class PVModel:
         if self.model == "single-diode":
             args = (poa, temp_cell, u.alpha_sc, u.a_ref, u.I_L_ref, u.I_o_ref, u.R_sh_ref, u.R_s)
             # R_sh scales as 1/irradiance: at vanishing irradiance it overflows to inf, harmlessly.
+            import pvlib
+
             with np.errstate(over="ignore", divide="ignore"):
                 if u.adjust is None:
                     il, io, rs, rsh, nnsvth = pvlib.pvsystem.calcparams_desoto(

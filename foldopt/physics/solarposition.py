@@ -38,7 +38,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-import pvlib
 
 from foldopt.names import MODES
 from foldopt.physics.geometry import normal_vector
@@ -391,6 +390,8 @@ def solar_position_grid(
         hour_angle = (
             15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0
         ) % 360.0 - 180.0
+        import pvlib
+
         declination = _by_dayofyear(
             lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), dayofyear
         )

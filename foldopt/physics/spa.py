@@ -26,16 +26,10 @@ References
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-import pvlib
-from numba import njit, uint64
 
 NS_PER_HOUR = 3_600_000_000_000  # [ns]
 SPA_DELTA_T = 67.0  # [s], TT - UT1, pvlib's default for spa_python
-SPA_TEMPERATURE = 12.0  # [C], pvlib's default for the refraction correction
-SPA_ATMOS_REFRACT = 0.5667  # [deg], SPA's refraction at sunrise and sunset
 
 
 def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
@@ -62,6 +56,8 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
     .. [1] I. Reda, A. Andreas, "Solar position algorithm for solar radiation applications",
        Solar Energy 76(5), 577-589, 2004.
     """
+    import pvlib
+
     spa = pvlib.spa
     unixtime = np.asarray(unixtime, dtype=float)
     jd = spa.julian_day(unixtime)
@@ -249,81 +245,13 @@ def _equatorial(utc_ns, sun_terms: SunTerms) -> np.ndarray:
     )
 
 
-@njit(cache=True, inline="always")
-def _raised(east, north, up, t):
-    """The unit vector (east, north, up) raised by ``t`` [rad] toward the zenith in its vertical
-    plane. The turn is SPA's refraction, under 0.011 rad: its sine and cosine by their series to the
-    9th and 10th power, exact in double precision (the next terms are below 1e-21)."""
-    t2 = t * t
-    sin_t = t * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0))))
-    cos_t = 1.0 - t2 / 2.0 * (
-        1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0)))
-    )
-    level = math.sqrt(east * east + north * north)
-    along = (level * cos_t - up * sin_t) / level if level > 0.0 else 0.0
-    return east * along, north * along, up * cos_t + level * sin_t
-
-
-@njit(cache=True, nogil=True)
-def _site_sun(
-    terms,
-    first,
-    sin_lam,
-    cos_lam,
-    sin_phi,
-    cos_phi,
-    x,
-    y,
-    pressure,
-    direction,
-    apparent_zenith,
-    solar_azimuth,
-):
-    """Every step of every block in one pass: the geometric topocentric unit vector toward the sun
-    (east, north, up), from ``terms[:, first[b] + i]`` (:meth:`SunTerms.on_lattice`) and the site's
-    arguments per block; its elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s
-    formula and switch, at ``pressure`` [hPa] per block and :data:`SPA_TEMPERATURE`), which raises
-    the vector in its vertical plane (:func:`_raised`) and the elevation. Writes ``direction``
-    (n_blocks, 3, n_steps), ``apparent_zenith`` and ``solar_azimuth`` [deg] (n_blocks, n_steps),
-    each value by the operations of the NumPy expressions this pass replaced, in their order."""
-    n_blocks, n_steps = direction.shape[0], direction.shape[2]
-    to_degrees, to_radians = 180.0 / math.pi, math.pi / 180.0
-    cut = -1.0 * (0.26667 + SPA_ATMOS_REFRACT)
-    for b in range(n_blocks):
-        start = uint64(first[b])
-        # Eq. 42's factor of pressure and temperature, as pvlib groups it.
-        scale = (pressure[b] / 1010.0) * (283.0 / (273 + SPA_TEMPERATURE)) * 1.02
-        for i in range(uint64(n_steps)):
-            k = start + i
-            # cos(delta) cos(H) and cos(delta) sin(H) at the site's hour angle H = H_G + longitude.
-            cos_h = terms[0, k] * cos_lam[b] - terms[1, k] * sin_lam[b]
-            sin_h = terms[1, k] * cos_lam[b] + terms[0, k] * sin_lam[b]
-            # Less the site's position: toward the meridian on the equator, and toward the pole.
-            meridian, pole = cos_h - x[b] * terms[3, k], terms[2, k] - y[b] * terms[3, k]
-            east = -sin_h
-            north = pole * cos_phi[b] - meridian * sin_phi[b]
-            up = pole * sin_phi[b] + meridian * cos_phi[b]
-            norm = 1.0 / math.sqrt(east * east + north * north + up * up)
-            east, north, up = east * norm, north * norm, up * norm
-            elevation = math.asin(min(max(up, -1.0), 1.0)) * to_degrees
-            heading = math.atan2(east, north) * to_degrees
-            solar_azimuth[b, i] = heading + 360.0 if heading < 0.0 else heading
-            if elevation >= cut:
-                refraction = scale / (
-                    60 * math.tan((elevation + 10.3 / (elevation + 5.11)) * to_radians)
-                )
-                east, north, up = _raised(east, north, up, refraction * to_radians)
-                elevation += refraction
-            direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
-            apparent_zenith[b, i] = 90.0 - elevation
-
-
 SITE_STEPS_A_THREAD = 100_000  # blocks x steps below which the per-site pass keeps one thread
 
 
 def _by_blocks(run, shape) -> None:
     """``run(part)`` over slices of the blocks of ``shape`` (n_blocks, n_steps), on numba's
-    threads: :func:`_site_sun` releases the GIL, and its blocks are independent."""
+    threads: :func:`foldopt.physics.spa_site.site_sun` releases the GIL, and its blocks are
+    independent."""
     from concurrent.futures import ThreadPoolExecutor
 
     from numba import get_num_threads
@@ -352,8 +280,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     right ascension and declination (Eq. 40-41, 43-45), exact, with no trigonometry per step but
     the elevation's and the azimuth's. SPA's refraction correction (Eq. 42, pvlib's formula, with
     pvlib's default pressure for the altitude and 12 C) raises it at every step; all of it one
-    compiled pass over the steps (:func:`_site_sun`). Against pvlib's ``spa_python`` on random
-    sites and days at 1-min steps, the sun's direction is within 2e-6 deg
+    compiled pass over the steps (:func:`foldopt.physics.spa_site.site_sun`). Against pvlib's
+    ``spa_python`` on random sites and days at 1-min steps, the sun's direction is within 2e-6 deg
     (tests/test_solarposition.py).
 
     Parameters
@@ -392,6 +320,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
         )
 
     latitude, longitude, altitude = per_block(latitude), per_block(longitude), per_block(altitude)
+    import pvlib
+
     u = pvlib.spa.uterm(latitude)
     x, y = pvlib.spa.xterm(u, latitude, altitude), pvlib.spa.yterm(u, latitude, altitude)
     lam, phi = np.radians(longitude), np.radians(latitude)
@@ -402,6 +332,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
     per_site = (first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure)
     outputs = (vector, apparent_zenith, solar_azimuth)
-    _by_blocks(lambda part: _site_sun(terms, *(a[part] for a in per_site + outputs)), shape)
+    from foldopt.physics.spa_site import site_sun  # numba's compiled pass
+
+    _by_blocks(lambda part: site_sun(terms, *(a[part] for a in per_site + outputs)), shape)
     equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
     return apparent_zenith, solar_azimuth, equation_of_time, np.moveaxis(vector, 1, -1)

@@ -7,7 +7,6 @@ The module may import numpy, pvlib and :mod:`foldopt.names`.
 from __future__ import annotations
 
 import numpy as np
-import pvlib
 
 from foldopt.names import TEMPERATURE_MODELS
 
@@ -42,6 +41,8 @@ def cell_temperature(poa_global, temp_air, wind_speed, model="fixed"):
     if model == "fixed":
         return np.broadcast_to(np.asarray(temp_air, dtype=float), np.shape(poa_global)).copy()
     if model == "sapm":
+        import pvlib
+
         params = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_polymer"]
         return np.asarray(pvlib.temperature.sapm_cell(poa_global, temp_air, wind_speed, **params))
     raise ValueError(
@@ -83,6 +84,8 @@ def equivalent_temp_air(temp_air, wind_speed, wind_ref, irradiance, model="fixed
         return np.broadcast_to(
             temp_air, np.broadcast_shapes(temp_air.shape, np.shape(irradiance))
         ).copy()
+    import pvlib
+
     params = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_polymer"]
     a, b = params["a"], params["b"]
     return temp_air + np.asarray(irradiance, dtype=float) * (

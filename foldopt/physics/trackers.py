@@ -11,7 +11,7 @@ for a panel facing the sun in both cases):
   equal moves of the daily axis a day, symmetric about solar noon, over a given angular field;
   back to the morning position at night.
 - ``single-axis``: pvlib's single-axis tracker (horizontal N-S axis by default, optionally
-  tilted, with optional backtracking).
+  tilted, with optional backtracking), by pvlib's formulas (:func:`singleaxis_orientation`).
 
 Energy: a controller's standby power, drawn while the sun is up, plus a drive energy per move,
 from Robles Algarin et al.'s DC motor model or a fixed Wh per degree (:class:`TrackerDrive`).
@@ -238,29 +238,108 @@ def _dual_axis_steps(
 def _single_axis(
     solar_zenith, solar_azimuth, hour_angle, declination, latitude, options, sun_vector
 ):
-    """pvlib's single-axis tracker, flat along its axis at night."""
-    import pvlib  # seconds to import: where a single-axis tracker runs, not where a study reads the registry
-
+    """pvlib's single-axis tracker (:func:`singleaxis_orientation`), flat along its axis at
+    night."""
     solar_zenith, _, level_azimuth = _resting(solar_zenith, latitude)
     axis_azimuth = options.axis_azimuth if options.axis_azimuth is not None else level_azimuth
-    shape = solar_zenith.shape
-    axis_azimuth = np.broadcast_to(axis_azimuth, shape)
-    result = pvlib.tracking.singleaxis(
-        solar_zenith.ravel(),
-        np.asarray(solar_azimuth, dtype=float).ravel(),
+    axis_azimuth = np.broadcast_to(np.asarray(axis_azimuth, dtype=float), solar_zenith.shape)
+    surface_tilt, surface_azimuth = singleaxis_orientation(
+        solar_zenith,
+        np.asarray(solar_azimuth, dtype=float),
         axis_tilt=options.axis_tilt,
-        axis_azimuth=axis_azimuth.ravel(),
+        axis_azimuth=axis_azimuth,
         max_angle=options.max_angle,
         backtrack=options.backtrack,
         gcr=options.gcr,
     )
-    # At night pvlib returns NaN; the panel then rests flat along the axis.
-    surface_tilt = np.nan_to_num(
-        np.asarray(result["surface_tilt"], dtype=float), nan=options.axis_tilt
-    ).reshape(shape)
-    surface_azimuth = np.asarray(result["surface_azimuth"], dtype=float).reshape(shape)
+    # At night the tracker's angles are NaN; the panel then rests flat along the axis.
+    surface_tilt = np.asarray(np.nan_to_num(surface_tilt, nan=options.axis_tilt))
     surface_azimuth = np.where(np.isnan(surface_azimuth), axis_azimuth, surface_azimuth)
     return surface_tilt, surface_azimuth, normal_vector(surface_tilt, surface_azimuth)
+
+
+def _sind(angle):
+    return np.sin(np.radians(angle))
+
+
+def _cosd(angle):
+    return np.cos(np.radians(angle))
+
+
+def singleaxis_orientation(
+    apparent_zenith, solar_azimuth, axis_tilt, axis_azimuth, max_angle, backtrack, gcr
+):
+    """The surface of a single-axis tracker, as ``pvlib.tracking.singleaxis`` orients it [3]_ (no
+    cross-axis slope): the rotation that puts the sun in the plane normal to the panel through
+    the axis, turned back against the next row's shade where ``backtrack`` (Anderson & Mikofski
+    Eq. 14), clipped to ``max_angle``.
+
+    pvlib's operations in pvlib's order (``shading.projected_solar_zenith_angle``,
+    ``tracking.calc_surface_orientation``), so that the two agree to the bit
+    (tests/test_trackers.py): a study with a single-axis tracker then imports no pvlib, whose
+    import (with the scipy it loads) takes longer than the day's whole computation.
+
+    Parameters
+    ----------
+    apparent_zenith, solar_azimuth : numpy.ndarray
+        [deg], any shape.
+    axis_tilt : float
+        [deg].
+    axis_azimuth : float or numpy.ndarray
+        [deg], broadcast against the sun's angles.
+    max_angle : float
+        The largest rotation either way [deg].
+    backtrack : bool
+    gcr : float
+        Ground coverage ratio [-].
+
+    Returns
+    -------
+    surface_tilt, surface_azimuth : numpy.ndarray
+        [deg], azimuth in [0, 360); NaN with the sun below the horizon (zenith above 90 deg).
+
+    References
+    ----------
+    .. [3] pvlib ``tracking.singleaxis`` (BSD-3-Clause); K. Anderson, M. Mikofski, "Slope-Aware
+       Backtracking for Single-Axis Trackers", NREL/TP-5K00-76626, 2020; W. F. Marion,
+       A. P. Dobos, "Rotation Angle for the Optimum Tracking of One-Axis Trackers",
+       NREL/TP-6A20-58891, 2013, Eq. 1.
+    """
+    sin_zenith = _sind(apparent_zenith)
+    cos_axis_azimuth, sin_axis_azimuth = _cosd(axis_azimuth), _sind(axis_azimuth)
+    sin_axis_tilt = _sind(axis_tilt)
+    sx = sin_zenith * _sind(solar_azimuth)
+    sy = sin_zenith * _cosd(solar_azimuth)
+    sz = _cosd(apparent_zenith)
+    sx_prime = sx * cos_axis_azimuth - sy * sin_axis_azimuth
+    sz_prime = (
+        sx * sin_axis_azimuth * sin_axis_tilt
+        + sy * sin_axis_tilt * cos_axis_azimuth
+        + sz * _cosd(axis_tilt)
+    )
+    down = np.asarray(apparent_zenith) > 90
+    ideal = np.where(down, np.nan, np.degrees(np.arctan2(sx_prime, sz_prime)))
+    rotation = ideal
+    if backtrack:
+        # The rows' spacing in panel widths; where the cosine is out of arccos's range at midday
+        # no row shades the next and nothing is turned back.
+        spread = np.abs(1 / gcr * _cosd(ideal))
+        with np.errstate(invalid="ignore"):
+            correction = np.degrees(-np.sign(ideal) * np.arccos(spread))
+            rotation = ideal + np.where(spread < 1, correction, 0)
+    rotation = np.clip(rotation, -max_angle, max_angle)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        surface_tilt = np.degrees(np.arccos(_cosd(rotation) * _cosd(axis_tilt)))
+    # The rotated surface's unit normal, projected on the ground for its azimuth.
+    cos_a, sin_a = _cosd(-axis_azimuth), _sind(-axis_azimuth)
+    sin_t = _sind(-axis_tilt)
+    east = sin_a * sin_t * _cosd(rotation) + cos_a * _sind(rotation)
+    north = sin_a * _sind(rotation) - cos_a * sin_t * _cosd(rotation)
+    surface_azimuth = np.degrees(np.arctan2(east, north))
+    surface_azimuth = np.mod(
+        np.where(surface_tilt == 0.0, axis_azimuth - 90.0, surface_azimuth), 360.0
+    )
+    return np.where(down, np.nan, surface_tilt), np.where(down, np.nan, surface_azimuth)
 
 
 @dataclass(frozen=True)

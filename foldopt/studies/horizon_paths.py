@@ -10,7 +10,6 @@ import datetime as dt
 
 import numpy as np
 import pandas as pd
-import pvlib
 
 from foldopt.inputs.sections import parse_timezone
 from foldopt.physics.horizon import horizon_elevation_at
@@ -53,6 +52,8 @@ def sun_paths(study, dates) -> dict | None:
     times = pd.DatetimeIndex(
         (start.values[:, None] + steps[None, :].astype("timedelta64[m]")).ravel(), tz="UTC"
     )
+    import pvlib
+
     position = pvlib.solarposition.get_solarposition(
         times, site.latitude, site.longitude, site.altitude
     )

@@ -11,9 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
-from foldopt.engine.curve_reduction import period_means
 from foldopt.inputs.sections import NearOptimal
 from foldopt.names import FLAT_FOLD_ANGLE
 
@@ -109,6 +107,8 @@ def period_values(hours, months, statistic: str, seasons):
         return np.stack([objective_value(hours, months, statistic, season) for season in seasons])
     # The same bits as objective_value's, the means summed in one pass over the days (no copy of a
     # period's days): a period's mean, or the lowest of its months' means (a season keeps whole months).
+    from foldopt.engine.curve_reduction import period_means  # compiled (numba)
+
     flat = np.ascontiguousarray(hours.reshape(hours.shape[0], -1))
     if statistic == "mean":
         value = period_means(flat, np.stack([season_days(months, season) for season in seasons]))
@@ -265,6 +265,8 @@ def near_optimal_on_grid(fold_angles, values, tolerance: NearOptimal, grid) -> d
     line = top - tolerance.tolerance_h(top)
     # A slope of a few ulp overflows in the harmonic mean of the slopes; it then goes to 0, as it should.
     with np.errstate(over="ignore"):
+        from scipy.interpolate import PchipInterpolator
+
         cubic_at = PchipInterpolator(fold_angles, values, axis=-1)(grid)  # (targets, grid)
     place = np.arange(grid.size)
     for name, outward in {"near_optimal_lo_deg": -1, "near_optimal_hi_deg": 1}.items():

@@ -41,7 +41,6 @@ from __future__ import annotations
 
 
 import numpy as np
-import pvlib
 
 from foldopt.names import CLEAR_SKIES
 
@@ -132,6 +131,8 @@ def mean_preserving(means, clear, steps_per_interval: int, max_index: float = MA
     clear_mean = weight.mean(axis=-1)
     lit = clear_mean > 0
     with np.errstate(invalid="ignore", divide="ignore"):
+        import pvlib
+
         index = np.asarray(
             pvlib.irradiance.clearsky_index(means, clear_mean, max_index), dtype=float
         )
@@ -303,6 +304,8 @@ def clear_sky(
         For a model that is not one of :data:`foldopt.names.CLEAR_SKIES`.
     """
     if model == "ineichen":
+        import pvlib
+
         absolute = pvlib.atmosphere.get_absolute_airmass(
             airmass, pvlib.atmosphere.alt2pres(altitude)
         )
@@ -311,6 +314,8 @@ def clear_sky(
                 apparent_zenith, absolute, linke_turbidity, altitude, dni_extra
             )
     elif model == "simplified-solis":
+        import pvlib
+
         sky = pvlib.clearsky.simplified_solis(
             90.0 - np.asarray(apparent_zenith), pressure=pvlib.atmosphere.alt2pres(altitude)
         )

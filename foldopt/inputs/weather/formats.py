@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pvlib
 
 from foldopt.errors import ConfigError, WeatherError, printable
 from foldopt.inputs.reading import MAX_WEATHER_BYTES, check_input
@@ -156,6 +155,8 @@ def read_with_pvlib(fail, label: str, reader: str, *args, **kwargs):
         ``(data, meta)`` as pvlib returns them.
     """
     with _IOTOOLS:
+        import pvlib
+
         read = getattr(pvlib.iotools, reader)
     try:
         with warnings.catch_warnings():

@@ -77,7 +77,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pvlib
 
 from foldopt.errors import WeatherError
 from foldopt.names import DECOMPOSITIONS, INTERVAL_LABELS
@@ -394,6 +393,8 @@ def _components(table, present, decomposition, index, zenith, cosz, pressure, fa
         if decomposition == "dirint":
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
+                import pvlib
+
                 dni = np.asarray(
                     pvlib.irradiance.dirint(
                         pd.Series(ghi, index), pd.Series(zenith, index), index, pressure=pressure
@@ -407,6 +408,8 @@ def _components(table, present, decomposition, index, zenith, cosz, pressure, fa
             with warnings.catch_warnings():
                 # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
                 warnings.simplefilter("ignore")
+                import pvlib
+
                 out = getattr(pvlib.irradiance, decomposition)(
                     pd.Series(ghi, index), pd.Series(zenith, index), index
                 )
@@ -618,6 +621,8 @@ def read_measured(
     }
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
+        import pvlib
+
         sun = pvlib.solarposition.get_solarposition(
             index, where["latitude"], where["longitude"], where["altitude"]
         )

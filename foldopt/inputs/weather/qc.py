@@ -74,7 +74,6 @@ import warnings
 
 import numpy as np
 import pandas as pd
-import pvlib
 
 from foldopt.inputs.weather.formats import HOUR, WeatherFormat
 
@@ -195,6 +194,8 @@ def check_rows(
 
     # Physical bounds, at the interval centres of the file's own convention.
     centres = index + (HOUR / 2 if label == "start" else -HOUR / 2)
+    import pvlib
+
     extra = np.asarray(pvlib.irradiance.get_extra_radiation(centres.day_of_year), dtype=float)
     for key in ("ghi", "dni", "dhi"):
         refuse(values[key] < 0, lambda i, key=key: f"{value(key, i)}: must be >= 0")

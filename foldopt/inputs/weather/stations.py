@@ -84,7 +84,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-import pvlib
 
 from foldopt.errors import printable
 from foldopt.inputs.weather.formats import read_with_pvlib, reason
@@ -248,6 +247,8 @@ def read_surfrad(path: str, fail, zone=None) -> StationData:
 def _zenith(times, latitude, longitude) -> np.ndarray:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
+        import pvlib
+
         position = pvlib.solarposition.get_solarposition(times, latitude, longitude)
     return position["apparent_zenith"].to_numpy(dtype=float)
 
@@ -287,6 +288,8 @@ def read_midc(path: str, fail, zone=None) -> StationData:
         fail, "MIDC", "read_midc", path, raw_data=raw, usecols=range(len(header)) if raw else None
     )
     columns = [str(name) for name in data.columns]
+    import pvlib
+
     maps = pvlib.iotools.midc.MIDC_VARIABLE_MAP.values()
     best = max(maps, key=lambda names: sum(name in columns for name in names))
     names = {}
@@ -438,6 +441,8 @@ def read_crn(path: str, fail, zone=None) -> StationData:
     utc = pd.Timestamp(data.index[0]).tz_localize(None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
+        import pvlib
+
         altitude = float(pvlib.location.lookup_altitude(latitude, longitude))
     site = {
         "name": f"USCRN station {first['WBANNO']}",
