@@ -152,6 +152,31 @@ def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
         assert np.abs(difference).max() < bound, name
 
 
+def test_geocentric_periodic_terms_are_pvlib_spa_bits():
+    """SPA's periodic series (the Earth's heliocentric longitude, latitude and radius, and the
+    nutation), summed over all their terms at once, are the bits of pvlib.spa's loops over the
+    terms, at instants from 1900 to 2100 and around the present."""
+    from foldopt.physics import spa as split
+
+    spa = pvlib.spa
+    rng = np.random.default_rng(11)
+    unix = np.concatenate([rng.uniform(-2.2e9, 4.1e9, 20_000), 1.7e9 + 3600.0 * np.arange(9_000)])
+    jce = spa.julian_ephemeris_century(spa.julian_ephemeris_day(spa.julian_day(unix), split.SPA_DELTA_T))
+    jme = spa.julian_ephemeris_millennium(jce)
+    np.testing.assert_array_equal(split._heliocentric("R", jme), spa.heliocentric_radius_vector(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric("L", jme)) % 360,
+                                  spa.heliocentric_longitude(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric("B", jme)),
+                                  spa.heliocentric_latitude(jme))
+    args = (spa.mean_elongation(jce), spa.mean_anomaly_sun(jce), spa.mean_anomaly_moon(jce),
+            spa.moon_argument_latitude(jce), spa.moon_ascending_longitude(jce))
+    nutation = np.empty((2, unix.size))
+    spa.longitude_obliquity_nutation(jce, *args, nutation)
+    psi, epsilon = split._nutation(jce, args)
+    np.testing.assert_array_equal(psi, nutation[0])
+    np.testing.assert_array_equal(epsilon, nutation[1])
+
+
 def test_many_sites_at_once_equal_pvlib_at_each():
     from foldopt.physics.solarposition import clock_grid, solar_position_grid
 
