@@ -265,6 +265,17 @@ def test_steps_kept_per_lattice_are_the_same_bits():
         np.testing.assert_array_equal(shared[name], alone[name])
 
 
+@pytest.mark.parametrize("starts", [[0, 1440, 4320], [4320, 0], [0, 700, 1440, 9000], [5, 5, 1445], [3]])
+def test_instants_blocks_span_are_the_union_of_their_days(starts):
+    """The lattice's instants a run's blocks span: apart (days of one time zone) or overlapping
+    (days of several zones, a block twice), the sorted union of every block's own instants."""
+    from foldopt.physics.spa import _spanned
+
+    starts = np.array(starts)
+    union = np.unique(np.concatenate([start + np.arange(1440) for start in starts]))
+    np.testing.assert_array_equal(_spanned(starts, 1440, starts.max() + 1440), union)
+
+
 def test_the_sun_keeps_nothing_between_calls():
     """Issue 48: no hidden state. A call given no store leaves the module as it found it (no
     module-level store of SPA's terms), and a store lives as long as the run that made it."""

@@ -216,12 +216,9 @@ class SunTerms:
             terms, known = np.zeros((5, high - low + 1)), np.zeros(high - low + 1, dtype=bool)
             terms[:, kept], known[kept] = old_terms, old_known
             first = low
-        # The instants the blocks span (where each begins and ends, summed along the lattice)
-        # that no call has evaluated yet.
-        edges = np.zeros(terms.shape[1] + 1, dtype=np.int64)
-        np.add.at(edges, start - first, 1)
-        np.add.at(edges, start - first + n_steps, -1)
-        missing = np.flatnonzero((np.cumsum(edges[:-1]) > 0) & ~known)
+        # The instants the blocks span that no call has evaluated yet.
+        spanned = _spanned(start - first, n_steps, terms.shape[1])
+        missing = spanned[~known[spanned]]
         if missing.size:
             if not grown:  # the run's other calls may hold the store: a copy is filled
                 terms, known = terms.copy(), known.copy()
@@ -229,6 +226,20 @@ class SunTerms:
             known[missing] = True
             self._lattices = {**self._lattices, (step, phase): (first, terms, known)}
         return start - first, terms
+
+
+def _spanned(starts, n_steps: int, size: int) -> np.ndarray:
+    """The sorted instants of a lattice of ``size`` that blocks of ``n_steps`` beginning at
+    ``starts`` span: each block's own where no two overlap (days apart, as a run's days in one time
+    zone are), else where the blocks begin and end, summed along the lattice (a pass over the
+    whole lattice, which costs a short run more than its days)."""
+    begins = np.unique(starts)
+    if begins.size < 2 or np.diff(begins).min() >= n_steps:
+        return (begins[:, None] + np.arange(n_steps)).ravel()
+    edges = np.zeros(size + 1, dtype=np.int64)
+    np.add.at(edges, starts, 1)
+    np.add.at(edges, starts + n_steps, -1)
+    return np.flatnonzero(np.cumsum(edges[:-1]) > 0)
 
 
 def _geocentric_hourly(utc_ns: np.ndarray, sun_terms: SunTerms) -> dict:
