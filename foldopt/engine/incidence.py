@@ -146,23 +146,30 @@ def incidence(r, b, first, n, sky, rows, tables, work):
 
     The steps are indexed as unsigned integers, so that no index can wrap around, and the main
     loop (:func:`_incidence_steps`) is inlined once per case, its flags constants: LLVM then
-    vectorises each. The incidence-angle modifier, a call per step, has a loop of its own (the beam
-    waits for it in ``work.east`` and ``work.west``, the diffuse light in ``work.diffuse_east``
-    and ``work.diffuse_west``), as has the tables' coordinate."""
-    start, count = uint64(first), uint64(n)
-    iam_model, iam_params, paper = sky.iam_model, sky.iam_params, sky.paper
-    has_terms = sky.terms.shape[1] == 4
-    modified = iam_model != IAM_NONE
+    vectorises each (:func:`incidence_case`)."""
+    paper, has_terms = sky.paper, sky.terms.shape[1] == 4
+    modified = sky.iam_model != IAM_NONE
     # Exact incidence without the modifier, with or without diffuse terms, as constants (every
     # study of a year or a map); paper mode and the modifier read their flags at run time.
     if not paper and not modified and has_terms:
-        _incidence_steps(r, b, start, count, sky, rows, (False, True, False), work)
+        incidence_case(r, b, first, n, sky, rows, tables, work, (False, True, False))
     elif not paper and not modified:
-        _incidence_steps(r, b, start, count, sky, rows, (False, False, False), work)
+        incidence_case(r, b, first, n, sky, rows, tables, work, (False, False, False))
     else:
-        _incidence_steps(r, b, start, count, sky, rows, (paper, has_terms, modified), work)
+        incidence_case(r, b, first, n, sky, rows, tables, work, (paper, has_terms, modified))
+
+
+@njit(cache=True, inline="always")
+def incidence_case(r, b, first, n, sky, rows, tables, work, case):
+    """:func:`incidence` of one case (``case``: ``paper``, ``has_terms``, ``modified``, constants
+    where the caller knows them). The incidence-angle modifier, a call per step, has a loop of its
+    own (the beam waits for it in ``work.east`` and ``work.west``, the diffuse light in
+    ``work.diffuse_east`` and ``work.diffuse_west``), as has the tables' coordinate."""
+    start, count = uint64(first), uint64(n)
+    _incidence_steps(r, b, start, count, sky, rows, case, work)
     east, west = work.east, work.west
-    if modified:
+    if case[2]:
+        iam_model, iam_params = sky.iam_model, sky.iam_params
         sun, normal = sky.sun, rows.normal
         ex, ey, ez = normal[r, 0, 0], normal[r, 0, 1], normal[r, 0, 2]
         wx, wy, wz = normal[r, 1, 0], normal[r, 1, 1], normal[r, 1, 2]
