@@ -22,8 +22,9 @@ constants (the incidence per mode, diffuse terms and modifier; the ideal model's
 connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
 (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
 loop, not called. A function run at every step takes arrays, not records: each array of a record
-handed to it would be counted and released at every step. (What each choice was worth:
-``docs/performance.rst``.)
+handed to it would be counted and released at every step; likewise a case chosen once a row costs
+the row its arrays' counts around the branch, so the common case (:func:`_switching_rows`) has a
+row loop of its own, chosen once a chunk. (What each choice was worth: ``docs/performance.rst``.)
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
