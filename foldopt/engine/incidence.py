@@ -144,19 +144,13 @@ def incidence(r, b, first, n, sky, rows, tables, work):
     before the incidence-angle modifier into ``work.incident`` [W/m^2] (``work`` a chunk's
     :class:`foldopt.engine.records.Scratch`).
 
-    The steps are indexed as unsigned integers, so that no index can wrap around, and the main
-    loop (:func:`_incidence_steps`) is inlined once per case, its flags constants: LLVM then
-    vectorises each (:func:`incidence_case`)."""
-    paper, has_terms = sky.paper, sky.terms.shape[1] == 4
-    modified = sky.iam_model != IAM_NONE
-    # Exact incidence without the modifier, with or without diffuse terms, as constants (every
-    # study of a year or a map); paper mode and the modifier read their flags at run time.
-    if not paper and not modified and has_terms:
-        incidence_case(r, b, first, n, sky, rows, tables, work, (False, True, False))
-    elif not paper and not modified:
-        incidence_case(r, b, first, n, sky, rows, tables, work, (False, False, False))
-    else:
-        incidence_case(r, b, first, n, sky, rows, tables, work, (paper, has_terms, modified))
+    The steps are indexed as unsigned integers, so that no index can wrap around. The case's
+    flags (paper mode, diffuse terms, the modifier) are read at run time here; the kernel's common
+    case passes them to :func:`incidence_case` as constants, in a row loop of its own, and LLVM
+    then vectorises its loop (a case chosen per row among copies of the loop cost each row its
+    arrays' reference counts around the branch, and every copy its compile)."""
+    case = (sky.paper, sky.terms.shape[1] == 4, sky.iam_model != IAM_NONE)
+    incidence_case(r, b, first, n, sky, rows, tables, work, case)
 
 
 @njit(cache=True, inline="always")

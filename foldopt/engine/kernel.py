@@ -18,8 +18,9 @@ per-chunk scratch of :func:`foldopt.engine.records.allocate`).
 Where the time goes: a loop vectorises only if LLVM can see that no index wraps around (the steps
 are indexed as unsigned integers) and that nothing in it depends on a setting known only at run
 time. So the loops are written once and inlined once per case, each case's settings passed as
-constants (the incidence per mode, diffuse terms and modifier; the ideal model's power per
-connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
+constants (the common case's incidence, exact without a modifier, with diffuse terms or not;
+the ideal model's power per connection; the metrics per flag); the parallel loop hands each
+thread a chunk of rows
 (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
 loop, not called. A function run at every step takes arrays, not records: each array of a record
 handed to it would be counted and released at every step; likewise a case chosen once a row costs
