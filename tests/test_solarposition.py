@@ -163,16 +163,16 @@ def test_geocentric_periodic_terms_are_pvlib_spa_bits():
     unix = np.concatenate([rng.uniform(-2.2e9, 4.1e9, 20_000), 1.7e9 + 3600.0 * np.arange(9_000)])
     jce = spa.julian_ephemeris_century(spa.julian_ephemeris_day(spa.julian_day(unix), split.SPA_DELTA_T))
     jme = spa.julian_ephemeris_millennium(jce)
-    np.testing.assert_array_equal(split._heliocentric("R", jme), spa.heliocentric_radius_vector(jme))
-    np.testing.assert_array_equal(np.rad2deg(split._heliocentric("L", jme)) % 360,
+    np.testing.assert_array_equal(split._heliocentric(spa, "R", jme), spa.heliocentric_radius_vector(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(spa, "L", jme)) % 360,
                                   spa.heliocentric_longitude(jme))
-    np.testing.assert_array_equal(np.rad2deg(split._heliocentric("B", jme)),
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(spa, "B", jme)),
                                   spa.heliocentric_latitude(jme))
     args = (spa.mean_elongation(jce), spa.mean_anomaly_sun(jce), spa.mean_anomaly_moon(jce),
             spa.moon_argument_latitude(jce), spa.moon_ascending_longitude(jce))
     nutation = np.empty((2, unix.size))
     spa.longitude_obliquity_nutation(jce, *args, nutation)
-    psi, epsilon = split._nutation(jce, args)
+    psi, epsilon = split._nutation(spa, jce, args)
     np.testing.assert_array_equal(psi, nutation[0])
     np.testing.assert_array_equal(epsilon, nutation[1])
 

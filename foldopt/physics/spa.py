@@ -65,9 +65,9 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
     jc = spa.julian_century(jd)
     jce = spa.julian_ephemeris_century(jde)
     jme = spa.julian_ephemeris_millennium(jce)
-    radius = _heliocentric("R", jme)
-    theta = spa.geocentric_longitude(np.rad2deg(_heliocentric("L", jme)) % 360)
-    beta = spa.geocentric_latitude(np.rad2deg(_heliocentric("B", jme)))
+    radius = _heliocentric(spa, "R", jme)
+    theta = spa.geocentric_longitude(np.rad2deg(_heliocentric(spa, "L", jme)) % 360)
+    beta = spa.geocentric_latitude(np.rad2deg(_heliocentric(spa, "B", jme)))
     args = (
         spa.mean_elongation(jce),
         spa.mean_anomaly_sun(jce),
@@ -75,7 +75,7 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
         spa.moon_argument_latitude(jce),
         spa.moon_ascending_longitude(jce),
     )
-    delta_psi, delta_epsilon = _nutation(jce, args)
+    delta_psi, delta_epsilon = _nutation(spa, jce, args)
     epsilon = spa.true_ecliptic_obliquity(spa.mean_ecliptic_obliquity(jme), delta_epsilon)
     lamd = spa.apparent_sun_longitude(theta, delta_psi, spa.aberration_correction(radius))
     v = spa.apparent_sidereal_time(spa.mean_sidereal_time(jd, jc), delta_psi, epsilon)
@@ -100,17 +100,15 @@ def _rows_in_order(terms):
     return total
 
 
-def _heliocentric(series: str, jme):
+def _heliocentric(spa, series: str, jme):
     """``pvlib.spa``'s heliocentric longitude, latitude or radius [1]_ (Eq. 9-11, before its
     conversion to degrees) from its tables of periodic terms (Table A4.2: ``series`` ``'L'``,
-    ``'B'`` or ``'R'``, the tables ``pvlib.spa.L0``, ``L1``...), each table's terms at every
-    instant at once: its ``sum_mult_cos_add_mult`` loops over the terms of a table in Python, a
-    NumPy call per term, which costs a short run's sun more than its steps do. Each element takes
-    the same operations in the same order as pvlib's (the polynomial in ``jme`` as pvlib writes
-    it), so the same bits (tests/test_solarposition.py)."""
-    tables = [
-        getattr(pvlib.spa, f"{series}{k}") for k in range(6) if hasattr(pvlib.spa, f"{series}{k}")
-    ]
+    ``'B'`` or ``'R'``, the tables ``L0``, ``L1``... of ``spa``, the module ``pvlib.spa``), each
+    table's terms at every instant at once: its ``sum_mult_cos_add_mult`` loops over the terms of
+    a table in Python, a NumPy call per term, which costs a short run's sun more than its steps
+    do. Each element takes the same operations in the same order as pvlib's (the polynomial in
+    ``jme`` as pvlib writes it), so the same bits (tests/test_solarposition.py)."""
+    tables = [getattr(spa, f"{series}{k}") for k in range(6) if hasattr(spa, f"{series}{k}")]
     sums = [
         _rows_in_order(t[:, 0, None] * np.cos(t[:, 1, None] + t[:, 2, None] * jme)) for t in tables
     ]
@@ -121,10 +119,11 @@ def _heliocentric(series: str, jme):
     return total / 10**8
 
 
-def _nutation(jce, args):
+def _nutation(spa, jce, args):
     """``pvlib.spa.longitude_obliquity_nutation`` [1]_ (Eq. 15-22): the nutation in longitude and
-    in obliquity [deg], every periodic term at every instant at once, summed in pvlib's order."""
-    abcd, y = pvlib.spa.NUTATION_ABCD_ARRAY, pvlib.spa.NUTATION_YTERM_ARRAY
+    in obliquity [deg], every periodic term at every instant at once, summed in pvlib's order
+    (``spa``: the module ``pvlib.spa``)."""
+    abcd, y = spa.NUTATION_ABCD_ARRAY, spa.NUTATION_YTERM_ARRAY
     x0, x1, x2, x3, x4 = args
     arg = np.radians(
         y[:, 0, None] * x0
