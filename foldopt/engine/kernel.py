@@ -20,12 +20,12 @@ are indexed as unsigned integers) and that nothing in it depends on a setting kn
 time. So the loops are written once and inlined once per case, each case's settings passed as
 constants (the common case's incidence, exact without a modifier, with diffuse terms or not;
 the ideal model's power per connection; the metrics per flag); the parallel loop hands each
-thread a chunk of rows
-(:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
-loop, not called. A function run at every step takes arrays, not records: each array of a record
-handed to it would be counted and released at every step; likewise a case chosen once a row costs
-the row its arrays' counts around the branch, so the common case (:func:`_switching_rows`) has a
-row loop of its own, chosen once a chunk. (What each choice was worth: ``docs/performance.rst``.)
+thread a chunk of rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is
+inlined into that chunk's loop, not called. A function run at every step takes arrays, not
+records: each array of a record handed to it would be counted and released at every step;
+likewise a case chosen once a row costs the row its arrays' counts around the branch, so the
+common case (:func:`_switching_rows`) has a row loop of its own, chosen once a chunk. (What each
+choice was worth: ``docs/performance.rst``.)
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).

@@ -112,10 +112,9 @@ def _heliocentric(spa, series: str, jme):
     sums = [
         _rows_in_order(t[:, 0, None] * np.cos(t[:, 1, None] + t[:, 2, None] * jme)) for t in tables
     ]
-    powers = (1.0, jme, jme**2, jme**3, jme**4, jme**5)
     total = sums[0]
     for k in range(1, len(sums)):
-        total = total + sums[k] * powers[k]
+        total = total + sums[k] * jme**k
     return total / 10**8
 
 
