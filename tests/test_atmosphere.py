@@ -51,6 +51,22 @@ def test_clear_sky_dni_zero_at_night_and_falls_with_zenith():
         clear_sky_dni(np.array([0.0]), model="ineichen")
 
 
+def test_meinel_sky_is_its_formula_at_every_step_with_the_sun_up_and_zero_else():
+    """The Meinel sky (worked out only where the sun is up) is Eq. 1-2 with Laue's altitude term to
+    the bit at every step up, 0 at every step down (the horizon and NaN included), per block's
+    altitude."""
+    zenith = np.random.default_rng(3).uniform(-5.0, 180.0, (40, 300))
+    zenith[0, :4] = [90.0, np.nextafter(90.0, 100.0), np.nextafter(90.0, 0.0), np.nan]
+    altitude = np.linspace(0.0, 3000.0, 40)[:, None]
+    dni = clear_sky_dni(zenith, altitude, "meinel")
+    up = zenith <= 90.0
+    airmass = shin_eq1(zenith[up])
+    term = 0.14 * np.broadcast_to(altitude, zenith.shape)[up] / 1000.0
+    np.testing.assert_allclose(dni[up], 1353.0 * ((1.0 - term) * 0.7 ** (airmass**0.678) + term), rtol=1e-12)
+    np.testing.assert_array_equal(dni[up], beam_meinel(relative_airmass(zenith), altitude)[up])
+    np.testing.assert_array_equal(dni[~up], 0.0)
+
+
 @pytest.mark.filterwarnings("ignore:DatetimeIndex.dayofyear is deprecated")  # in pvlib's lookup, not ours to fix
 def test_linke_turbidity_is_pvlibs_lookup_to_the_bit():
     """foldopt reads pvlib's climatology once per site and interpolates once per UTC day

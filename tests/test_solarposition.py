@@ -152,6 +152,31 @@ def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
         assert np.abs(difference).max() < bound, name
 
 
+def test_geocentric_periodic_terms_are_pvlib_spa_bits():
+    """SPA's periodic series (the Earth's heliocentric longitude, latitude and radius, and the
+    nutation), summed over all their terms at once, are the bits of pvlib.spa's loops over the
+    terms, at instants from 1900 to 2100 and around the present."""
+    from foldopt.physics import spa as split
+
+    spa = pvlib.spa
+    rng = np.random.default_rng(11)
+    unix = np.concatenate([rng.uniform(-2.2e9, 4.1e9, 20_000), 1.7e9 + 3600.0 * np.arange(9_000)])
+    jce = spa.julian_ephemeris_century(spa.julian_ephemeris_day(spa.julian_day(unix), split.SPA_DELTA_T))
+    jme = spa.julian_ephemeris_millennium(jce)
+    np.testing.assert_array_equal(split._heliocentric(spa, "R", jme), spa.heliocentric_radius_vector(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(spa, "L", jme)) % 360,
+                                  spa.heliocentric_longitude(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(spa, "B", jme)),
+                                  spa.heliocentric_latitude(jme))
+    args = (spa.mean_elongation(jce), spa.mean_anomaly_sun(jce), spa.mean_anomaly_moon(jce),
+            spa.moon_argument_latitude(jce), spa.moon_ascending_longitude(jce))
+    nutation = np.empty((2, unix.size))
+    spa.longitude_obliquity_nutation(jce, *args, nutation)
+    psi, epsilon = split._nutation(spa, jce, args)
+    np.testing.assert_array_equal(psi, nutation[0])
+    np.testing.assert_array_equal(epsilon, nutation[1])
+
+
 def test_many_sites_at_once_equal_pvlib_at_each():
     from foldopt.physics.solarposition import clock_grid, solar_position_grid
 
@@ -238,6 +263,17 @@ def test_steps_kept_per_lattice_are_the_same_bits():
     alone = solar_position_grid(other, 40.0, -105.0, 1600.0, "exact")
     for name in ("solar_zenith", "solar_azimuth", "hour_angle", "sun_vector"):
         np.testing.assert_array_equal(shared[name], alone[name])
+
+
+@pytest.mark.parametrize("starts", [[0, 1440, 4320], [4320, 0], [0, 700, 1440, 9000], [5, 5, 1445], [3]])
+def test_instants_blocks_span_are_the_union_of_their_days(starts):
+    """The lattice's instants a run's blocks span: apart (days of one time zone) or overlapping
+    (days of several zones, a block twice), the sorted union of every block's own instants."""
+    from foldopt.physics.spa import _spanned
+
+    starts = np.array(starts)
+    union = np.unique(np.concatenate([start + np.arange(1440) for start in starts]))
+    np.testing.assert_array_equal(_spanned(starts, 1440, starts.max() + 1440), union)
 
 
 def test_the_sun_keeps_nothing_between_calls():

@@ -252,7 +252,15 @@ def clear_sky_dni(
         If ``model`` or ``climate`` is unknown.
     """
     if model == "meinel":
-        return beam_meinel(relative_airmass(solar_zenith), altitude)
+        zenith = np.asarray(solar_zenith, dtype=float)
+        shape = np.broadcast_shapes(zenith.shape, np.shape(altitude))
+        zenith = np.broadcast_to(zenith, shape)
+        # The air mass and the beam at the steps with the sun up alone (the others have neither):
+        # the same values, at half the cost over whole days.
+        up = zenith <= 90.0
+        dni = np.zeros(shape)
+        dni[up] = beam_meinel(relative_airmass(zenith[up]), np.broadcast_to(altitude, shape)[up])
+        return dni
     if model == "hottel":
         return extraterrestrial_normal(dayofyear) * hottel_transmittance(
             solar_zenith, altitude, climate

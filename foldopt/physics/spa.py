@@ -65,9 +65,9 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
     jc = spa.julian_century(jd)
     jce = spa.julian_ephemeris_century(jde)
     jme = spa.julian_ephemeris_millennium(jce)
-    radius = spa.heliocentric_radius_vector(jme)
-    theta = spa.geocentric_longitude(spa.heliocentric_longitude(jme))
-    beta = spa.geocentric_latitude(spa.heliocentric_latitude(jme))
+    radius = _heliocentric(spa, "R", jme)
+    theta = spa.geocentric_longitude(np.rad2deg(_heliocentric(spa, "L", jme)) % 360)
+    beta = spa.geocentric_latitude(np.rad2deg(_heliocentric(spa, "B", jme)))
     args = (
         spa.mean_elongation(jce),
         spa.mean_anomaly_sun(jce),
@@ -75,9 +75,7 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
         spa.moon_argument_latitude(jce),
         spa.moon_ascending_longitude(jce),
     )
-    nutation = np.empty((2, unixtime.size))
-    spa.longitude_obliquity_nutation(jce, *args, nutation)
-    delta_psi, delta_epsilon = nutation
+    delta_psi, delta_epsilon = _nutation(spa, jce, args)
     epsilon = spa.true_ecliptic_obliquity(spa.mean_ecliptic_obliquity(jme), delta_epsilon)
     lamd = spa.apparent_sun_longitude(theta, delta_psi, spa.aberration_correction(radius))
     v = spa.apparent_sidereal_time(spa.mean_sidereal_time(jd, jc), delta_psi, epsilon)
@@ -91,6 +89,51 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
         "xi": spa.equatorial_horizontal_parallax(radius),
         "eot": eot,
     }
+
+
+def _rows_in_order(terms):
+    """The sum over the first axis of ``terms``, from 0.0 and row after row: the order of
+    ``pvlib.spa``'s loops, so the same bits."""
+    total = 0.0
+    for term in terms:
+        total = total + term
+    return total
+
+
+def _heliocentric(spa, series: str, jme):
+    """``pvlib.spa``'s heliocentric longitude, latitude or radius [1]_ (Eq. 9-11, before its
+    conversion to degrees) from its tables of periodic terms (Table A4.2: ``series`` ``'L'``,
+    ``'B'`` or ``'R'``, the tables ``L0``, ``L1``... of ``spa``, the module ``pvlib.spa``), each
+    table's terms at every instant at once: its ``sum_mult_cos_add_mult`` loops over the terms of
+    a table in Python, a NumPy call per term, which costs a short run's sun more than its steps
+    do. Each element takes the same operations in the same order as pvlib's (the polynomial in
+    ``jme`` as pvlib writes it), so the same bits (tests/test_solarposition.py)."""
+    tables = [getattr(spa, f"{series}{k}") for k in range(6) if hasattr(spa, f"{series}{k}")]
+    sums = [
+        _rows_in_order(t[:, 0, None] * np.cos(t[:, 1, None] + t[:, 2, None] * jme)) for t in tables
+    ]
+    total = sums[0]
+    for k in range(1, len(sums)):
+        total = total + sums[k] * jme**k
+    return total / 10**8
+
+
+def _nutation(spa, jce, args):
+    """``pvlib.spa.longitude_obliquity_nutation`` [1]_ (Eq. 15-22): the nutation in longitude and
+    in obliquity [deg], every periodic term at every instant at once, summed in pvlib's order
+    (``spa``: the module ``pvlib.spa``)."""
+    abcd, y = spa.NUTATION_ABCD_ARRAY, spa.NUTATION_YTERM_ARRAY
+    x0, x1, x2, x3, x4 = args
+    arg = np.radians(
+        y[:, 0, None] * x0
+        + y[:, 1, None] * x1
+        + y[:, 2, None] * x2
+        + y[:, 3, None] * x3
+        + y[:, 4, None] * x4
+    )
+    psi = _rows_in_order((abcd[:, 0, None] + abcd[:, 1, None] * jce) * np.sin(arg))
+    epsilon = _rows_in_order((abcd[:, 2, None] + abcd[:, 3, None] * jce) * np.cos(arg))
+    return psi * 1.0 / 36000000, epsilon * 1.0 / 36000000
 
 
 _WRAPPED = ("alpha", "v")  # angles that wrap at 360 deg
@@ -171,12 +214,9 @@ class SunTerms:
             terms, known = np.zeros((5, high - low + 1)), np.zeros(high - low + 1, dtype=bool)
             terms[:, kept], known[kept] = old_terms, old_known
             first = low
-        # The instants the blocks span (where each begins and ends, summed along the lattice)
-        # that no call has evaluated yet.
-        edges = np.zeros(terms.shape[1] + 1, dtype=np.int64)
-        np.add.at(edges, start - first, 1)
-        np.add.at(edges, start - first + n_steps, -1)
-        missing = np.flatnonzero((np.cumsum(edges[:-1]) > 0) & ~known)
+        # The instants the blocks span that no call has evaluated yet.
+        spanned = _spanned(start - first, n_steps, terms.shape[1])
+        missing = spanned[~known[spanned]]
         if missing.size:
             if not grown:  # the run's other calls may hold the store: a copy is filled
                 terms, known = terms.copy(), known.copy()
@@ -184,6 +224,20 @@ class SunTerms:
             known[missing] = True
             self._lattices = {**self._lattices, (step, phase): (first, terms, known)}
         return start - first, terms
+
+
+def _spanned(starts, n_steps: int, size: int) -> np.ndarray:
+    """The sorted instants of a lattice of ``size`` that blocks of ``n_steps`` beginning at
+    ``starts`` span: each block's own where no two overlap (days apart, as a run's days in one time
+    zone are), else where the blocks begin and end, summed along the lattice (a pass over the
+    whole lattice, which costs a short run more than its days)."""
+    begins = np.unique(starts)
+    if begins.size < 2 or np.diff(begins).min() >= n_steps:
+        return (begins[:, None] + np.arange(n_steps)).ravel()
+    edges = np.zeros(size + 1, dtype=np.int64)
+    np.add.at(edges, starts, 1)
+    np.add.at(edges, starts + n_steps, -1)
+    return np.flatnonzero(np.cumsum(edges[:-1]) > 0)
 
 
 def _geocentric_hourly(utc_ns: np.ndarray, sun_terms: SunTerms) -> dict:
