@@ -144,26 +144,25 @@ def incidence(r, b, first, n, sky, rows, tables, work):
     before the incidence-angle modifier into ``work.incident`` [W/m^2] (``work`` a chunk's
     :class:`foldopt.engine.records.Scratch`).
 
-    The steps are indexed as unsigned integers, so that no index can wrap around. The case's
-    flags (paper mode, diffuse terms, the modifier) are read at run time here; the kernel's common
-    case passes them to :func:`incidence_case` as constants, in a row loop of its own, and LLVM
-    then vectorises its loop (a case chosen per row among copies of the loop cost each row its
-    arrays' reference counts around the branch, and every copy its compile)."""
-    case = (sky.paper, sky.terms.shape[1] == 4, sky.iam_model != IAM_NONE)
-    incidence_case(r, b, first, n, sky, rows, tables, work, case)
-
-
-@njit(cache=True, inline="always")
-def incidence_case(r, b, first, n, sky, rows, tables, work, case):
-    """:func:`incidence` of one case (``case``: ``paper``, ``has_terms``, ``modified``, constants
-    where the caller knows them). The incidence-angle modifier, a call per step, has a loop of its
-    own (the beam waits for it in ``work.east`` and ``work.west``, the diffuse light in
-    ``work.diffuse_east`` and ``work.diffuse_west``), as has the tables' coordinate."""
+    The steps are indexed as unsigned integers, so that no index can wrap around, and the main
+    loop (:func:`_incidence_steps`) is inlined once per case, its flags constants: LLVM then
+    vectorises each. The incidence-angle modifier, a call per step, has a loop of its own (the beam
+    waits for it in ``work.east`` and ``work.west``, the diffuse light in ``work.diffuse_east``
+    and ``work.diffuse_west``), as has the tables' coordinate."""
     start, count = uint64(first), uint64(n)
-    _incidence_steps(r, b, start, count, sky, rows, case, work)
+    iam_model, iam_params, paper = sky.iam_model, sky.iam_params, sky.paper
+    has_terms = sky.terms.shape[1] == 4
+    modified = iam_model != IAM_NONE
+    # Exact incidence without the modifier, with or without diffuse terms, as constants (every
+    # study of a year or a map); paper mode and the modifier read their flags at run time.
+    if not paper and not modified and has_terms:
+        _incidence_steps(r, b, start, count, sky, rows, (False, True, False), work)
+    elif not paper and not modified:
+        _incidence_steps(r, b, start, count, sky, rows, (False, False, False), work)
+    else:
+        _incidence_steps(r, b, start, count, sky, rows, (paper, has_terms, modified), work)
     east, west = work.east, work.west
-    if case[2]:
-        iam_model, iam_params = sky.iam_model, sky.iam_params
+    if modified:
         sun, normal = sky.sun, rows.normal
         ex, ey, ez = normal[r, 0, 0], normal[r, 0, 1], normal[r, 0, 2]
         wx, wy, wz = normal[r, 1, 0], normal[r, 1, 1], normal[r, 1, 2]

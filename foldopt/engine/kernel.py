@@ -18,14 +18,12 @@ per-chunk scratch of :func:`foldopt.engine.records.allocate`).
 Where the time goes: a loop vectorises only if LLVM can see that no index wraps around (the steps
 are indexed as unsigned integers) and that nothing in it depends on a setting known only at run
 time. So the loops are written once and inlined once per case, each case's settings passed as
-constants (the common case's incidence, exact without a modifier, with diffuse terms or not;
-the ideal model's power per connection; the metrics per flag); the parallel loop hands each
-thread a chunk of rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is
-inlined into that chunk's loop, not called. A function run at every step takes arrays, not
-records: each array of a record handed to it would be counted and released at every step;
-likewise a case chosen once a row costs the row its arrays' counts around the branch, so the
-common case (:func:`_switching_rows`) has a row loop of its own, chosen once a chunk. (What each
-choice was worth: ``docs/performance.rst``.)
+constants (the incidence per mode, diffuse terms and modifier; the ideal model's power per
+connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
+(:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
+loop, not called. A function run at every step takes arrays, not records: each array of a record
+handed to it would be counted and released at every step. (What each choice was worth:
+``docs/performance.rst``.)
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -38,7 +36,7 @@ from typing import NamedTuple
 
 from numba import njit, uint64
 
-from foldopt.engine.incidence import IAM_NONE, incidence, incidence_case, steps_sum
+from foldopt.engine.incidence import incidence, steps_sum
 from foldopt.engine.curve_reduction import blocked_day, day_metrics
 from foldopt.engine.records import WALK_BLOCK, in_chunks
 
@@ -494,15 +492,6 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     held[0] = loads.step_hours
     for k in range(1, held.shape[0]):
         held[k] = held[k - 1] + loads.step_hours
-    if blocked and not sky.paper and sky.iam_model == IAM_NONE:
-        # Every clear-sky year's, sweep's and map's rows, in loops of their own with the case a
-        # constant: chosen once a chunk, not once a row (the choice costs a row more than its
-        # branch: each case's arrays counted and released around it).
-        if sky.terms.shape[1] == 4:
-            _switching_rows(start, stop, sky, rows, tables, loads, out, work, True)
-        else:
-            _switching_rows(start, stop, sky, rows, tables, loads, out, work, False)
-        return
     harvested = peak = 0.0  # the day's sum and peak of switching's pass, when it is taken
     for r in range(start, stop):
         b = rows.block[r]
@@ -525,7 +514,17 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
             loads.profile[b if loads.use_profile else 0],
         )
         if blocked:
-            _switching_day(r, (first, last), (harvested, peak), p_load, loads, out, work)
+            out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
+            blocked_day(
+                work.power[0],
+                (first, last),
+                p_load,
+                loads.step_hours,
+                held,
+                (work.low, work.high),
+                (work.above, work.whole),
+                out.t_solar[r, 0],
+            )
             continue
         for c in range(n_conn):
             out.energy[r, c], out.peak[r, c] = day_metrics(
@@ -538,40 +537,3 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
                 out.t_solar[r, c],
                 out.t_solar_contiguous[r if loads.contiguous else 0, c],
             )
-
-
-@njit(cache=True, inline="always")
-def _switching_day(r, span, sums, p_load, loads, out, work):
-    """Row ``r``'s metrics from switching's curve in ``work.power[0]`` (:func:`_switching_row`,
-    which gave ``sums``, the curve's sum and peak [W]): energy and peak, and t_solar of every load
-    of ``p_load`` by :func:`foldopt.engine.curve_reduction.blocked_day`."""
-    harvested, peak = sums
-    out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
-    blocked_day(
-        work.power[0],
-        span,
-        p_load,
-        loads.step_hours,
-        work.held,
-        (work.low, work.high),
-        (work.above, work.whole),
-        out.t_solar[r, 0],
-    )
-
-
-@njit(cache=True, inline="always")
-def _switching_rows(start, stop, sky, rows, tables, loads, out, work, has_terms):
-    """Rows ``start .. stop - 1`` of :func:`_chunk_rows` in its common case: the exact incidence
-    without a modifier (with diffuse terms or not: ``has_terms``, a constant), switching alone from
-    one table set a block, constant loads without their longest runs; the same operations as
-    :func:`_chunk_rows`' loop takes for them, so the same bits."""
-    for r in range(start, stop):
-        b = rows.block[r]
-        first, last = sky.span[b, 0], sky.span[b, 1]
-        n = last + 1 - first
-        incidence_case(r, b, first, n, sky, rows, True, work, (False, has_terms, False))
-        out.irradiation[r] = steps_sum(work.incident, first, n) * loads.step_hours
-        sums = _switching_row(b, first, n, sky, tables, work)
-        if rows.curve[r] >= 0:
-            out.power[rows.curve[r], :, first : last + 1] = work.power[:, first : last + 1]
-        _switching_day(r, (first, last), sums, loads.p_load[rows.loadset[r]], loads, out, work)
