@@ -136,3 +136,15 @@ def test_warmer_cells_and_more_loss_never_lengthen_t_solar(temp_air, wind, gamma
     hours = [_t_solar(s, "numpy", [load]).t_solar for s in (base, warmer, dirtier)]
     assert np.all(hours[1] <= hours[0] + 1e-12)
     assert np.all(hours[2] <= hours[0] + 1e-12)
+
+
+def test_the_rating_is_the_nameplate_before_the_losses():
+    """A converter and a price per watt are sized on the nameplate, pdc0, not on the power left
+    after the system losses; the other models' rating is their STC power."""
+    from foldopt.studies.sizing import stc_power_per_area
+
+    pvwatts = PVModel("pvwatts", efficiency=0.19, losses=0.0868)
+    assert pvwatts.rating(0.108) == pytest.approx(0.19 * 0.108 * 1000, rel=1e-12)
+    assert stc_power_per_area(pvwatts) == pytest.approx(190.0, rel=1e-12)
+    assert pvwatts.max_power(np.array([1000.0]), 25.0, 0.108)[0] == pytest.approx(0.19 * 108 * (1 - 0.0868))
+    assert PVModel("ideal", efficiency=0.2).rating(0.5) == pytest.approx(100.0, rel=1e-12)

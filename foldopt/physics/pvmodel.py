@@ -411,6 +411,20 @@ class PVModel:
     def has_iv(self) -> bool:
         return self.model in IV_MODELS
 
+    def rating(self, area) -> float:
+        """A panel's rated power [W]: its maximum power at STC (1000 W/m^2, cells at 25 C); for
+        PVWatts its nameplate ``pdc0``, before the system losses (a converter and a price per
+        watt are sized on it).
+
+        Parameters
+        ----------
+        area : float
+            Panel area [m^2].
+        """
+        if self.model == "pvwatts":
+            return self.efficiency * area * IRRADIANCE_REF
+        return float(self.max_power(np.array([IRRADIANCE_REF]), TEMPERATURE_REF, area)[0])
+
     def power_terms(self, temp_air, wind_speed, temperature_model, area):
         """The maximum power of a model without I-V curve as ``a E + b E^2`` of the irradiance E.
 
