@@ -46,10 +46,13 @@ from foldopt.inputs.weather_section import Weather
 #: Each mode's default clear sky: pvlib's Ineichen (with diffuse light, Perez transposition at the
 #: site's Linke turbidity) in exact mode, the paper's beam-only Meinel sky in paper mode.
 MODE_SKIES = {"exact": "ineichen", "paper": "meinel"}
-#: What each mode decides where a study gives none: its sky, geometry and temperature model.
+#: What each mode decides where a study gives none: its sky, geometry, PV model and temperature
+#: model. Exact mode's PV model is PVWatts' with SAPM cells and a small panel's system losses: the
+#: power a real panel gives (docs/validation.rst); paper mode's the paper's ideal one.
 MODE_DEFAULTS = {
     "sky": MODE_SKIES,
     "geometry": {"paper": "azimuth-split", "exact": "hinge"},
+    "pv_model": {"paper": "ideal", "exact": "pvwatts"},
     "temperature_model": {"paper": "fixed", "exact": "sapm"},
 }
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
@@ -166,8 +169,9 @@ class Study(StrictModel):
         A weather file (or its path): its site, year and light.
     objective : Objective, optional
         One fold angle for all of the study's days, chosen for this statistic.
-    pv_model : str
-        One of :data:`foldopt.names.PV_MODELS`; default ``ideal``.
+    pv_model : str, optional
+        One of :data:`foldopt.names.PV_MODELS`; default ``pvwatts`` in exact mode, ``ideal`` (the
+        paper's) in paper mode.
     module : str, optional
         ``single-diode``: a CEC module name; default the A-300 cell.
     pvwatts : PVWatts
@@ -239,7 +243,9 @@ class Study(StrictModel):
     iam: named(names.IAMS) = "none"
     weather: Weather | None = None
     objective: Objective | None = None
-    pv_model: named(names.PV_MODELS) = "ideal"
+    pv_model: named(names.PV_MODELS) | None = Field(
+        None, validate_default=True, description="default pvwatts in exact mode, ideal in paper"
+    )
     module: str | None = Field(
         None, description="single-diode: CEC module name; default the A-300 cell"
     )
@@ -334,10 +340,11 @@ class Study(StrictModel):
         """None for a weather file's site not read yet; a missing or null site is still refused."""
         return None if value is _UNREAD else handler(value)
 
-    @field_validator("geometry", "sky", "temperature_model", mode="after")
+    @field_validator("geometry", "sky", "pv_model", "temperature_model", mode="after")
     @classmethod
     def _mode_default(cls, value, info: ValidationInfo):
-        """The mode's own geometry, sky and temperature model where the study gives none."""
+        """The mode's own geometry, sky, PV model and temperature model where the study gives
+        none."""
         mode = info.data.get("mode")
         return value if value is not None or mode is None else MODE_DEFAULTS[info.field_name][mode]
 
