@@ -518,8 +518,8 @@ def _reference(sky, rows: PanelRows, loads: Loads, outputs, curve, electrical) -
 
 def _tables(electricals, outputs, area: float) -> Tables:
     """The kernel's electrical side: the stacked tables (one per cell temperature), the power
-    terms of a model without I-V curve, the circuit as built (its flags, tables and converter) and the codes of
-    the ``outputs``; ``area`` the panel's [m^2]."""
+    terms of a model without I-V curve, the circuit as built (its flags, tables and converter)
+    and the codes of the ``outputs``; ``area`` the panel's [m^2]."""
     first, count = electricals[0], len(electricals)
     parts = first.circuit
     # Tables the options do not use are placeholders, one per cell temperature all the same.

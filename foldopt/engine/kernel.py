@@ -20,8 +20,8 @@ Where the time goes: a loop vectorises only if LLVM can see that no index wraps 
 are indexed as unsigned integers) and that nothing in it depends on a setting known only at run
 time. So the loops are written once and inlined once per case, each case's settings passed as
 constants (the incidence per mode, diffuse terms and modifier; the power of a model without
-I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
-(:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
+I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
+rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
 loop, not called. A function run at every step takes arrays, not records: each array of a record
 handed to it would be counted and released at every step. (What each choice was worth:
 ``docs/performance.rst``.)
@@ -473,8 +473,8 @@ def fold_rows(sky, rows, tables, loads, out, scratch):
     rows : foldopt.engine.records.Rows
         Each row's block, sub-panel normals, Eq. 5 factors, sky-view factors and set of loads.
     tables : foldopt.engine.records.Tables
-        The electrical tables (or the power terms of a model without I-V curve), the circuit as built and the
-        connections to evaluate.
+        The electrical tables (or the power terms of a model without I-V curve), the circuit as
+        built and the connections to evaluate.
     loads : foldopt.engine.records.Loads
         The loads (and load profiles) and the step length.
     out : foldopt.engine.records.Outputs
@@ -495,8 +495,8 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     gives both sub-panels' irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) and
     their mean incident irradiance before the incidence-angle modifier. The second writes every asked
     connection's power to ``work.power[c, step]``: from the tables (:func:`_table_row`), for a model
-    without I-V curve from :func:`_linear_connections`, or with the circuit as built from :func:`_built_row`,
-    through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
+    without I-V curve from :func:`_linear_connections`, or with the circuit as built from
+    :func:`_built_row`, through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
     third reduces each power curve to the daily metrics. The row's work is inlined here rather than
     called: a call that passes the kernel's some thirty arrays is a large share of a short row's
     time (``docs/performance.rst``)."""

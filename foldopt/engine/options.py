@@ -84,7 +84,8 @@ class ElectricalOptions:
     pv_model : str
         One of :data:`foldopt.names.PV_MODELS`.
     efficiency : float
-        The ideal and the PVWatts model's efficiency [-] (PVWatts: its rating per area / 1000 W/m^2).
+        The ideal and the PVWatts model's efficiency [-] (PVWatts': its rating per area / 1000
+        W/m^2).
     module : str or None
         The single-diode model's module of pvlib's CEC database; None: the paper's A-300 cells.
     gamma_pdc : float

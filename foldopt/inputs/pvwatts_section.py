@@ -92,8 +92,10 @@ class PVWatts(StrictModel):
         ``panel.efficiency x panel.area x 1000 W/m^2``. Each sub-panel has half of it.
     gamma_pdc : float
         Temperature coefficient of power [1/C] in [-0.01, 0.01]; default -0.0037.
-    soiling, shading, snow, mismatch, wiring, connections, lid, nameplate_rating, age, availability : float
+    soiling, shading, snow, mismatch, wiring, connections, lid, nameplate_rating : float
         PVWatts' system losses [%], each in [0, 100); defaults in :data:`LOSSES`.
+    age, availability : float
+        As those.
     """
 
     pdc0: interval(0, 1e6, lo_open=True, unit=" W") | None = Field(

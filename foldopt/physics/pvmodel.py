@@ -1,6 +1,6 @@
 """Electrical models of one (sub-)panel: its I-V curve and maximum power.
 
-Three models (foldopt SPEC, "PV electrical model"):
+Four models (foldopt SPEC, "PV electrical model"):
 
 - ``ideal``: P = efficiency * area * irradiance; no I-V curve.
 - ``single-diode``: the five-parameter model of De Soto et al. [1]_ through pvlib
