@@ -547,6 +547,8 @@ class PVModel:
         if self.model == "ideal":
             return self.efficiency * area * np.asarray(poa_global, dtype=float)
         if self.model == "pvwatts":
+            import pvlib
+
             pdc0 = self.efficiency * area * IRRADIANCE_REF
             poa = np.asarray(poa_global, dtype=float)
             dc = pvlib.pvsystem.pvwatts_dc(poa, temp_cell, pdc0, self.gamma_pdc, TEMPERATURE_REF)

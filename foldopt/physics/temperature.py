@@ -70,6 +70,8 @@ def irradiance_coefficient(wind_speed, model="fixed"):
     if model == "fixed":
         return np.zeros_like(np.asarray(wind_speed, dtype=float))
     if model == "sapm":
+        import pvlib
+
         params = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_polymer"]
         return np.exp(params["a"] + params["b"] * np.asarray(wind_speed, dtype=float)) + (
             params["deltaT"] / 1000.0
