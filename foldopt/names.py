@@ -116,8 +116,13 @@ PV_MODELS = Registry(
         "ideal": "P = efficiency x area x irradiance, no I-V curve (the paper's)",
         "single-diode": "De Soto et al.'s five-parameter single-diode model of a CEC module, through pvlib",
         "b-model": "Robles Algarin et al.'s empirical I-V model of a 200 W panel (Eq. 8-11, b = 0.068)",
+        "pvwatts": "PVWatts DC: rating x irradiance / 1000 x (1 + gamma_pdc (T_cell - 25 C)), less "
+        "system losses (pvlib.pvsystem.pvwatts_dc), no I-V curve",
     },
 )
+#: The :data:`PV_MODELS` with an I-V curve: the pairs' connections, the circuit as built and the
+#: electrical tables are theirs; the others' sub-panels deliver their sum in any connection.
+IV_MODELS = ("single-diode", "b-model")
 TEMPERATURE_MODELS = Registry(
     "temperature_model",
     {

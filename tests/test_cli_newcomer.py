@@ -60,7 +60,8 @@ def test_the_summary_says_which_values_were_defaults(tmp_path):
     lines = result.stdout.splitlines()
     assert lines[1] == ("  from configs/shin2015.yaml: day 1:365:7 of 2014 (default range), site 34.05, -118.25, "
                         "panel 0.108 m^2, P_load 4.398 W, exact mode (paper mode is for the paper's own site and "
-                        "day: set mode paper to keep it), ideal PV model")
+                        "day: set mode paper to keep it), pvwatts PV model (SAPM cells, -0.37 %/C, 8.7 % "
+                        "losses)")
     assert "(--table prints the full table)" in lines and len(lines) < 8
     study = json.loads((tmp_path / "o" / "run.json").read_text())["study"]
     assert (study["mode"], study["geometry"]) == ("exact", "hinge")  # the geometry follows the mode
@@ -118,7 +119,9 @@ def test_one_json_document_and_quiet_silence(tmp_path, command):
         (["--lat", "80", "--date", "2025-12-21"], ["polar night"], "no fold angle reaches the load"),
         (["--lat", "80", "--date", "2025-06-21"], ["polar day"], "best fold angle"),
         (["--p-load", "30"], ["load above peak"], "no fold angle reaches the load"),
-        (["--weather", TMY3, "--days", "2025-11-27", "--p-load", "2"], ["overcast"], "best fold angle"),
+        # The paper's ideal model: PVWatts' power, 8.7 % less, stays below 2 W that day.
+        (["--weather", TMY3, "--days", "2025-11-27", "--p-load", "2", "--pv-model", "ideal"], ["overcast"],
+         "best fold angle"),
         (["--weather", TMY3, "--days", "2025-06-21", "--p-load", "2"], [], "best fold angle"),
     ],
     ids=["polar-night", "polar-day", "above-peak", "overcast", "clear"],
@@ -135,9 +138,9 @@ def test_notes_name_the_day(tmp_path, args, note, line):
 
 def test_overcast_is_no_polar_night_in_a_year(tmp_path):
     # 2.25 W: above the peak of the tracker net of its drive on 3 days that are not overcast, below
-    # every other design's peak on those days.
-    result = invoke("sweep", "angle", "--weather", TMY3, "--p-load", "2.25", "--angle-step", "30", "--out",
-                    tmp_path / "y", "--format", "json")
+    # every other design's peak on those days (the paper's ideal model's peaks).
+    result = invoke("sweep", "angle", "--weather", TMY3, "--p-load", "2.25", "--angle-step", "30",
+                    "--pv-model", "ideal", "--out", tmp_path / "y", "--format", "json")
     assert result.exit_code == 0, result.output
     notes = {entry["note"]: entry for entry in json.loads(result.stdout)["answer"]["notes"]}
     assert "polar night" not in notes and 0 < notes["overcast"]["cases"] < 30
@@ -168,7 +171,7 @@ def test_pvlib_spellings_and_cec_names(tmp_path):
         (["--converter-efficiency", "0.9"], ["--converter-efficiency", "only used by connection independent"]),
         (["--switch-series", "--connection", "east"], ["--switch-series", "only used by connection switching"]),
         (["--albedo", "0.3"], ["--albedo", "only used with a transposition"]),
-        (["--temp-air", "30"], ["--temp-air", "single-diode or b-model"]),
+        (["--temp-air", "30"], ["--temp-air", "single-diode, b-model, pvwatts"]),
     ],
 )
 def test_options_that_do_nothing_are_refused(tmp_path, args, words):

@@ -47,7 +47,7 @@ def cases(draw):
         "transposition": draw(st.sampled_from(["isotropic", "haydavies", "perez"])) if diffuse else "none",
         "albedo": draw(st.floats(0, 0.5)) if diffuse else 0.2,
         "iam": draw(st.sampled_from(["none", "ashrae", "physical"])),
-        "pv_model": draw(st.sampled_from(["ideal", "single-diode", "b-model"])),
+        "pv_model": draw(st.sampled_from(["ideal", "single-diode", "b-model", "pvwatts"])),
         "connection": connection, "switch_series": switch_series,
         "bypass_diodes": draw(st.booleans()) if series_used else True,
         "converter_efficiency": draw(st.floats(0.8, 1.0)) if connection == "independent" else 1.0,
@@ -122,7 +122,7 @@ def test_kernel_threads():
 
 
 @pytest.mark.parametrize("pv_model,outputs", [("single-diode", engine.OUTPUTS), ("ideal", engine.OUTPUTS),
-                                              ("b-model", ("switching", "panel"))])
+                                              ("b-model", ("switching", "panel")), ("pvwatts", engine.OUTPUTS)])
 def test_kernel_equals_the_reference_on_a_weather_year_slice(pv_model, outputs):
     # Real weather: Perez diffuse light, cells at each day's air temperature (several tables).
     study = make_study({"name": "w", "mode": "exact", "site": {"latitude": 36.1, "longitude": -79.95,

@@ -69,8 +69,9 @@ def assert_same_answer(sweep: dict, world: dict) -> None:
 def test_a_sweep_and_a_map_of_a_site_agree_at_the_same_step(tmp_path, scheduler):
     # Before exact mode had one sky, the sweep ran under the paper's beam-only Meinel sky and the
     # map under Ineichen's: another fold angle, another gain.
-    sweep = sweep_answer(tmp_path / "sweep", "--step-min", "5")
-    world = map_answer(tmp_path / "map", scheduler, "--step-min", "5")
+    # The paper's ideal PV model in both, as before exact mode's default became PVWatts'.
+    sweep = sweep_answer(tmp_path / "sweep", "--step-min", "5", "--pv-model", "ideal")
+    world = map_answer(tmp_path / "map", scheduler, "--step-min", "5", "--set", "pv_model=ideal")
     assert_same_answer(sweep, world)
     assert sweep["recommended_deg"] == 40 and round(sweep["gain_vs_flat_pct"], 1) == 11.4
     # And both say so: the same sky in their questions.

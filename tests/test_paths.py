@@ -68,7 +68,7 @@ def test_a_weather_file_completes_the_site_it_is_given(tmp_path, monkeypatch):
         assert site_of(meta) == GREENSBORO, name
     # The embedded study with the file, as a YAML study the user wrote: run, not sweep angle.
     data = yaml.safe_load(default_study_path().read_text())
-    for key in ("site", "sky", "geometry"):
+    for key in ("site", "sky", "geometry", "pv_model"):  # exact mode's own, as the policy gives it
         data.pop(key)
     data["panel"] = {key: data["panel"][key] for key in ("area", "efficiency")}  # |latitude| tilt
     data.update(mode="exact", weather=WEATHER, name="sweep-angle",

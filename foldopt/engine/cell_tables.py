@@ -20,12 +20,12 @@ from foldopt.engine.as_built import circuit_parts
 from foldopt.engine.electrical import Electrical
 from foldopt.engine.options import ElectricalOptions
 from foldopt.engine.sky import Sky
-from foldopt.physics.pvmodel import IRRADIANCE_REF, TEMPERATURE_REF, PVModel
+from foldopt.physics.pvmodel import PVModel
 
 
 @functools.lru_cache(maxsize=64)
 def rated_power(pv: PVModel, area: float) -> float:
-    """A panel's maximum power at STC (1000 W/m^2, cells at 25 C) [W]: a converter's default rating.
+    """A panel's rated power (:meth:`PVModel.rating`) [W]: a converter's default rating.
 
     Parameters
     ----------
@@ -33,7 +33,7 @@ def rated_power(pv: PVModel, area: float) -> float:
     area : float
         Panel area [m^2].
     """
-    return float(pv.max_power(np.array([IRRADIANCE_REF]), TEMPERATURE_REF, area)[0])
+    return pv.rating(area)
 
 
 def electrical_settings(
@@ -51,7 +51,9 @@ def electrical_settings(
         Wind speed of the tables [m/s]; default the options' (a weather study's sky gives its own,
         :attr:`foldopt.engine.sky.Sky.wind_ref`).
     """
-    pv = PVModel(options.pv_model, options.efficiency, options.module)
+    pv = PVModel(
+        options.pv_model, options.efficiency, options.module, options.gamma_pdc, options.losses
+    )
     return dict(
         pv=pv,
         subpanel_area=options.area / 2.0,

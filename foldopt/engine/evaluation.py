@@ -517,17 +517,23 @@ def _reference(sky, rows: PanelRows, loads: Loads, outputs, curve, electrical) -
 
 
 def _tables(electricals, outputs, area: float) -> Tables:
-    """The kernel's electrical side: the stacked tables (one per cell temperature), the ideal
-    model's linear power, the circuit as built (its flags, tables and converter) and the codes of
-    the ``outputs``; ``area`` the panel's [m^2]."""
+    """The kernel's electrical side: the stacked tables (one per cell temperature), the power
+    terms of a model without I-V curve, the circuit as built (its flags, tables and converter)
+    and the codes of the ``outputs``; ``area`` the panel's [m^2]."""
     first, count = electricals[0], len(electricals)
     parts = first.circuit
     # Tables the options do not use are placeholders, one per cell temperature all the same.
     placeholder_1d, placeholder = np.zeros((count, 2)), np.zeros((count, 2, 2))
-    subpanel, parallel, series, linear_power = placeholder_1d, placeholder, placeholder, 0.0
+    subpanel, parallel, series, power_terms = placeholder_1d, placeholder, placeholder, None
     alone, panel, switching = placeholder_1d, placeholder_1d, placeholder
     if not first.pv.has_iv:
-        linear_power = first.pv.efficiency * first.subpanel_area
+        power_terms = np.array(
+            [
+                e.pv.power_terms(e.temp_air, e.wind_speed, e.temperature_model, e.subpanel_area)
+                for e in electricals
+            ],
+            dtype=float,
+        )
     else:
         subpanel = np.stack([e._table("subpanel")[1] for e in electricals])
         parallel = np.stack([e._table("parallel") for e in electricals])
@@ -542,7 +548,7 @@ def _tables(electricals, outputs, area: float) -> Tables:
         subpanel=subpanel,
         parallel=parallel,
         series=series,
-        linear_power=float(linear_power),
+        power_terms=np.zeros((0, 2)) if power_terms is None else power_terms,
         panel_scale=float(area / first.subpanel_area),
         bypass=bool(first.bypass),
         switch_series=bool(first.switch_series),

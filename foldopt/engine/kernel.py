@@ -5,7 +5,8 @@ the two sub-panels (a fold angle). :func:`fold_rows` takes each row in three loo
 steps. In the first (:func:`foldopt.engine.incidence.incidence`), both sub-panel normals against the sun vector give the
 beam's incidence (or Shin et al.'s Eq. 5 in paper mode), and the beam with the optional
 incidence-angle modifier and the diffuse terms give each sub-panel's plane-of-array irradiance.
-The second looks up the electrical tables (or, for the ideal model, scales the irradiance) and
+The second looks up the electrical tables (or, for a model without I-V curve, takes its power
+as a polynomial of the irradiance, :func:`_powers_of_irradiance`) and
 writes every asked connection's power to a buffer of one day, reused by the next row (with the
 circuit as built, :func:`_built_row`; switching alone from one table set a block, the common case,
 in two loops of its own, :func:`_switching_row`). The third reduces each power curve to the daily
@@ -18,9 +19,9 @@ per-chunk scratch of :func:`foldopt.engine.records.allocate`).
 Where the time goes: a loop vectorises only if LLVM can see that no index wraps around (the steps
 are indexed as unsigned integers) and that nothing in it depends on a setting known only at run
 time. So the loops are written once and inlined once per case, each case's settings passed as
-constants (the incidence per mode, diffuse terms and modifier; the ideal model's power per
-connection; the metrics per flag); the parallel loop hands each thread a chunk of rows
-(:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
+constants (the incidence per mode, diffuse terms and modifier; the power of a model without
+I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
+rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
 loop, not called. A function run at every step takes arrays, not records: each array of a record
 handed to it would be counted and released at every step. (What each choice was worth:
 ``docs/performance.rst``.)
@@ -184,14 +185,40 @@ def _connection_power(
 
 
 @njit(cache=True, inline="always")
+def _powers_of_irradiance(b, start, count, sky, tables, work):
+    """Each sub-panel's power [W] in place of its irradiance in ``work.east`` and ``work.west`` at
+    steps ``start .. start + count - 1`` of block ``b``, for a model without I-V curve:
+    ``(a + q E) E`` of the table set's terms ``tables.power_terms[t] = (a, q)``
+    (:meth:`foldopt.physics.pvmodel.PVModel.power_terms`), linear between two sets where a step's
+    air temperature lies between them (the power is linear in the air temperature)."""
+    terms, step_table, step_weight = tables.power_terms, sky.step_table, sky.step_weight
+    east, west = work.east, work.west
+    if step_table.shape[1] == 1:
+        t = step_table[b, 0]
+        a, q = terms[t, 0], terms[t, 1]
+        for i in range(count):
+            s = start + i
+            east[s] = (a + q * east[s]) * east[s]
+            west[s] = (a + q * west[s]) * west[s]
+        return
+    for i in range(count):
+        s = start + i
+        t, w = step_table[b, s], step_weight[b, s]
+        a = terms[t, 0] + w * (terms[t + 1, 0] - terms[t, 0])
+        q = terms[t, 1] + w * (terms[t + 1, 1] - terms[t, 1])
+        east[s] = (a + q * east[s]) * east[s]
+        west[s] = (a + q * west[s]) * west[s]
+
+
+@njit(cache=True, inline="always")
 def _linear_steps(c, code, start, count, tables, work):
     """:func:`_linear_connections`' loop, inlined once per connection with its code a constant."""
-    linear_power, panel_scale = tables.linear_power, tables.panel_scale
+    panel_scale = tables.panel_scale
     converter_efficiency = tables.converter_efficiency
     east, west, buffer = work.east, work.west, work.power
     for i in range(count):
         s = start + i
-        p_east, p_west = linear_power * east[s], linear_power * west[s]
+        p_east, p_west = east[s], west[s]
         if code == SWITCHING:
             # The pairs lose nothing: the parallel (and series) pair's power is the sum.
             buffer[c, s] = max(max(p_east, p_west), p_east + p_west)
@@ -208,12 +235,14 @@ def _linear_steps(c, code, start, count, tables, work):
 
 
 @njit(cache=True, inline="always")
-def _linear_connections(first, n, tables, work):
-    """Every asked connection's power [W] of the ideal PV model (power proportional to
-    irradiance, so that the pairs lose nothing) into ``work.power[c]`` at steps ``first ..
-    first + n - 1``: one loop a connection, free of branches, so that each vectorises (the values
-    are :func:`_connection_power`'s)."""
+def _linear_connections(b, first, n, sky, tables, work):
+    """Every asked connection's power [W] of a PV model without I-V curve (the ideal model's and
+    PVWatts': the pairs lose nothing) into ``work.power[c]`` at steps ``first .. first + n - 1``
+    of block ``b``: each sub-panel's power (:func:`_powers_of_irradiance`), then one loop a
+    connection, free of branches, so that each vectorises (the values are
+    :func:`_connection_power`'s)."""
     start, count = uint64(first), uint64(n)
+    _powers_of_irradiance(b, start, count, sky, tables, work)
     connections = tables.connections
     for c in range(connections.shape[0]):
         # Switching (every map's) with its code a constant; the others read it at run time.
@@ -395,22 +424,22 @@ def _built_power(code, parts, p_panel, tables):
 def _built_row(b, first, last, sky, tables, need_series, work):
     """:func:`_chunk_rows`' second loop for the circuit as built: the parts at each step (linear
     between two table sets where the step's air temperature lies between them), then what each
-    connection delivers. With the ideal PV model (``tables.linear_power`` > 0, no tables), only the
-    converter is as built: ``work.east`` and ``work.west`` hold the irradiance itself."""
+    connection delivers. With a PV model without I-V curve (no tables), only the converter is
+    as built: ``work.east`` and ``work.west`` hold the irradiance, turned into each sub-panel's
+    power first (:func:`_powers_of_irradiance`)."""
     step_table, step_weight = sky.step_table, sky.step_weight
-    linear_power, panel_scale, connections = (
-        tables.linear_power,
-        tables.panel_scale,
-        tables.connections,
-    )
+    panel_scale, connections = tables.panel_scale, tables.connections
     east, west, buffer = work.east, work.west, work.power
     per_step = step_table.shape[1] > 1
+    with_tables = tables.power_terms.shape[0] == 0
+    if not with_tables:
+        _powers_of_irradiance(b, uint64(first), uint64(last + 1 - first), sky, tables, work)
     for s in range(first, last + 1):
         root_east, root_west = east[s], west[s]
         t = step_table[b, s] if per_step else step_table[b, 0]
         w = step_weight[b, s] if per_step else 0.0
-        if linear_power > 0.0:
-            m_east, m_west = linear_power * root_east, linear_power * root_west
+        if not with_tables:
+            m_east, m_west = root_east, root_west
             pair = m_east + m_west
             parts = Parts(
                 m_east,
@@ -444,8 +473,8 @@ def fold_rows(sky, rows, tables, loads, out, scratch):
     rows : foldopt.engine.records.Rows
         Each row's block, sub-panel normals, Eq. 5 factors, sky-view factors and set of loads.
     tables : foldopt.engine.records.Tables
-        The electrical tables (or the ideal model's linear power), the circuit as built and the
-        connections to evaluate.
+        The electrical tables (or the power terms of a model without I-V curve), the circuit as
+        built and the connections to evaluate.
     loads : foldopt.engine.records.Loads
         The loads (and load profiles) and the step length.
     out : foldopt.engine.records.Outputs
@@ -465,15 +494,15 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     Each row takes three loops over its lit steps. The first (:func:`foldopt.engine.incidence.incidence`)
     gives both sub-panels' irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) and
     their mean incident irradiance before the incidence-angle modifier. The second writes every asked
-    connection's power to ``work.power[c, step]``: from the tables (:func:`_table_row`), for the ideal
-    model from :func:`_linear_connections`, or with the circuit as built from :func:`_built_row`,
-    through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
+    connection's power to ``work.power[c, step]``: from the tables (:func:`_table_row`), for a model
+    without I-V curve from :func:`_linear_connections`, or with the circuit as built from
+    :func:`_built_row`, through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
     third reduces each power curve to the daily metrics. The row's work is inlined here rather than
     called: a call that passes the kernel's some thirty arrays is a large share of a short row's
     time (``docs/performance.rst``)."""
     connections = tables.connections
     n_conn = connections.shape[0]
-    with_tables = tables.linear_power == 0.0
+    with_tables = tables.power_terms.shape[0] == 0
     need_series = tables.switch_series
     for c in range(n_conn):
         need_series = need_series or connections[c] == SERIES
@@ -502,7 +531,7 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         if tables.as_built:
             _built_row(b, first, last, sky, tables, need_series, work)
         elif not with_tables:
-            _linear_connections(first, n, tables, work)
+            _linear_connections(b, first, n, sky, tables, work)
         elif switching_alone:
             harvested, peak = _switching_row(b, first, n, sky, tables, work)
         else:

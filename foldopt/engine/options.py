@@ -84,9 +84,14 @@ class ElectricalOptions:
     pv_model : str
         One of :data:`foldopt.names.PV_MODELS`.
     efficiency : float
-        The ideal model's efficiency [-].
+        The ideal and the PVWatts model's efficiency [-] (PVWatts': its rating per area / 1000
+        W/m^2).
     module : str or None
         The single-diode model's module of pvlib's CEC database; None: the paper's A-300 cells.
+    gamma_pdc : float
+        The PVWatts model's temperature coefficient of power [1/C].
+    losses : float
+        The PVWatts model's system losses [-] (a fraction of its DC power).
     area : float
         The flat panel's area [m^2] (each sub-panel half of it).
     temperature_model : str
@@ -108,6 +113,8 @@ class ElectricalOptions:
     pv_model: str
     efficiency: float
     module: str | None
+    gamma_pdc: float
+    losses: float
     area: float
     temperature_model: str
     wind_speed: float

@@ -102,10 +102,12 @@ class Tables(NamedTuple):
     subpanel, parallel, series : float arrays
         Per set: a sub-panel's power [W] on sqrt-spaced irradiance nodes, and the parallel and
         series pairs as fractions of the two maxima over the stronger irradiance and the
-        weaker/stronger ratio (:class:`foldopt.engine.electrical.Electrical`); placeholders for the
-        ideal model (and ``series`` where no series power is asked).
-    linear_power : float
-        ``efficiency * sub-panel area`` [m^2] for the ideal model (no tables); 0 with tables.
+        weaker/stronger ratio (:class:`foldopt.engine.electrical.Electrical`); placeholders for a
+        model without I-V curve (and ``series`` where no series power is asked).
+    power_terms : (n_sets, 2) float
+        Per set, a model without I-V curve's sub-panel power ``a E + q E^2`` as ``(a, q)``
+        [W/(W/m^2)], [W/(W/m^2)^2] (:meth:`foldopt.physics.pvmodel.PVModel.power_terms`); (0, 2)
+        with tables.
     panel_scale : float
         Panel area / sub-panel area.
     bypass, switch_series : bool
@@ -133,7 +135,7 @@ class Tables(NamedTuple):
     subpanel: np.ndarray
     parallel: np.ndarray
     series: np.ndarray
-    linear_power: float
+    power_terms: np.ndarray
     panel_scale: float
     bypass: bool
     switch_series: bool

@@ -10,8 +10,9 @@ it is made. The rules, each said back to the user by :func:`apply`'s second valu
   paper's beam-only Eq. 5 gives a level panel at the equator almost no beam, and it has no
   altitude term and no diffuse light;
 - a change of mode gives the new mode its own geometry (azimuth-split in paper mode, hinge in
-  exact) and its own sky (Ineichen with diffuse light in exact mode, the paper's beam-only Meinel
-  sky in paper mode) unless the geometry or the sky is given;
+  exact), its own sky (Ineichen with diffuse light in exact mode, the paper's beam-only Meinel
+  sky in paper mode) and its own PV model (PVWatts' in exact mode, the paper's ideal one in paper
+  mode) unless the geometry, the sky or the PV model is given;
 - a new latitude tilts the panel at ``|latitude|`` toward the equator unless tilt or azimuth are
   given; a new latitude or longitude drops the site's name, a new longitude its time zone;
 - the planes of an existing array (``panel.planes``) bring their own base orientation (the
@@ -256,7 +257,7 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
         data["mode"] = "exact"
         decided.append(MOUNTING_NOTE)
     new_mode = changes.get("mode", data.get("mode", "exact"))
-    for field in ("geometry", "sky"):
+    for field in ("geometry", "sky", "pv_model"):
         if new_mode != old_mode and field not in given:
             data.pop(field, None)  # the new mode's own
     site = data.get("site")

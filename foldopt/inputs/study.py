@@ -28,6 +28,7 @@ from foldopt.inputs import policy
 from foldopt.inputs.circuit_section import Circuit
 from foldopt.inputs.fields import FilesRead, StrictModel, StudyDate, interval, named
 from foldopt.inputs.optimize_section import Optimize
+from foldopt.inputs.pvwatts_section import PVWatts
 from foldopt.inputs.sections import (
     FoldAngles,
     LoadProfile,
@@ -45,10 +46,13 @@ from foldopt.inputs.weather_section import Weather
 #: Each mode's default clear sky: pvlib's Ineichen (with diffuse light, Perez transposition at the
 #: site's Linke turbidity) in exact mode, the paper's beam-only Meinel sky in paper mode.
 MODE_SKIES = {"exact": "ineichen", "paper": "meinel"}
-#: What each mode decides where a study gives none: its sky, geometry and temperature model.
+#: What each mode decides where a study gives none: its sky, geometry, PV model and temperature
+#: model. Exact mode's PV model is PVWatts' with SAPM cells and a small panel's system losses: the
+#: power a real panel gives (docs/validation.rst); paper mode's the paper's ideal one.
 MODE_DEFAULTS = {
     "sky": MODE_SKIES,
     "geometry": {"paper": "azimuth-split", "exact": "hinge"},
+    "pv_model": {"paper": "ideal", "exact": "pvwatts"},
     "temperature_model": {"paper": "fixed", "exact": "sapm"},
 }
 SITE_TOLERANCE_KM = 5.0  # [km] a study's site may lie this far from its weather file's
@@ -165,10 +169,14 @@ class Study(StrictModel):
         A weather file (or its path): its site, year and light.
     objective : Objective, optional
         One fold angle for all of the study's days, chosen for this statistic.
-    pv_model : str
-        One of :data:`foldopt.names.PV_MODELS`; default ``ideal``.
+    pv_model : str, optional
+        One of :data:`foldopt.names.PV_MODELS`; default ``pvwatts`` in exact mode, ``ideal`` (the
+        paper's) in paper mode.
     module : str, optional
         ``single-diode``: a CEC module name; default the A-300 cell.
+    pvwatts : PVWatts
+        ``pvwatts``: the rating, temperature coefficient and system losses; default PVWatts'
+        losses for one small panel (:data:`foldopt.inputs.pvwatts_section.LOSSES`).
     connection : str
         One of :data:`foldopt.names.CONNECTIONS`; default ``switching``.
     switch_series, bypass_diodes, exact_electrical : bool
@@ -235,9 +243,14 @@ class Study(StrictModel):
     iam: named(names.IAMS) = "none"
     weather: Weather | None = None
     objective: Objective | None = None
-    pv_model: named(names.PV_MODELS) = "ideal"
+    pv_model: named(names.PV_MODELS) | None = Field(
+        None, validate_default=True, description="default pvwatts in exact mode, ideal in paper"
+    )
     module: str | None = Field(
         None, description="single-diode: CEC module name; default the A-300 cell"
+    )
+    pvwatts: PVWatts = Field(
+        PVWatts(), description="pvwatts: rating, temperature coefficient and system losses"
     )
     connection: named(names.CONNECTIONS) = "switching"
     switch_series: bool = Field(False, description="switching may also select series")
@@ -327,10 +340,11 @@ class Study(StrictModel):
         """None for a weather file's site not read yet; a missing or null site is still refused."""
         return None if value is _UNREAD else handler(value)
 
-    @field_validator("geometry", "sky", "temperature_model", mode="after")
+    @field_validator("geometry", "sky", "pv_model", "temperature_model", mode="after")
     @classmethod
     def _mode_default(cls, value, info: ValidationInfo):
-        """The mode's own geometry, sky and temperature model where the study gives none."""
+        """The mode's own geometry, sky, PV model and temperature model where the study gives
+        none."""
         mode = info.data.get("mode")
         return value if value is not None or mode is None else MODE_DEFAULTS[info.field_name][mode]
 
@@ -477,7 +491,9 @@ class Study(StrictModel):
         # What a resolved study fills in is no setting of the user's.
         for name, by_mode in MODE_DEFAULTS.items():
             defaults[name] = (None, by_mode[self.mode])
-        iv_model = self.pv_model != "ideal"
+        iv_model = self.pv_model in names.IV_MODELS
+        warm_cells = self.pv_model != "ideal"
+        cells = ", ".join(name for name in names.PV_MODELS if name != "ideal")
         series_used = self.connection == "series" or (
             self.connection == "switching" and self.switch_series
         )
@@ -518,13 +534,13 @@ class Study(StrictModel):
                 self.circuit.converter.model == "ideal",
                 "is the ideal converters' efficiency; circuit.converter sets every converter's",
             ),
-            ("temperature_model", iv_model, "is only used by pv_model single-diode or b-model"),
+            ("temperature_model", warm_cells, f"is only used by pv_model {cells}"),
             (
                 "temp_air",
-                iv_model and self.weather is None,
-                "is only used by pv_model single-diode or b-model, without a weather file (which brings its own)",
+                warm_cells and self.weather is None,
+                f"is only used by pv_model {cells}, without a weather file (which brings its own)",
             ),
-            ("wind_speed", iv_model, "is only used by pv_model single-diode or b-model"),
+            ("wind_speed", warm_cells, f"is only used by pv_model {cells}"),
             ("exact_electrical", iv_model, "is only used by pv_model single-diode or b-model"),
         ]
         idle = [
@@ -532,11 +548,36 @@ class Study(StrictModel):
             for name, used, why in rules
             if not used and getattr(self, name) not in _as_tuple(defaults[name])
         ]
+        if self.pv_model != "pvwatts":
+            idle += [
+                f"pvwatts.{name} = {value!r}: is only used by pv_model pvwatts"
+                for name, value in self.pvwatts.model_dump(exclude_defaults=True).items()
+            ]
         circuit = self.circuit.idle_settings(
             self.connection, series_used and self.bypass_diodes, iv_model
         )
         optimize = self.optimize.idle_settings() if self.optimize is not None else []
         return idle + circuit + self.tracker.idle_settings() + optimize
+
+    def pv_model_text(self) -> str:
+        """The PV model as an answer's question names it: PVWatts' with its cells, temperature
+        coefficient and losses (``pvwatts PV model (SAPM cells, -0.37 %/C, 8.7 % losses)``).
+
+        Returns
+        -------
+        str
+        """
+        if self.pv_model != "pvwatts":
+            return f"{self.pv_model} PV model"
+        cells = (
+            "SAPM cells" if self.temperature_model == "sapm" else "cells at the air's temperature"
+        )
+        pvwatts = self.pvwatts
+        rating = "" if pvwatts.pdc0 is None else f"{pvwatts.pdc0:g} W, "
+        return (
+            f"pvwatts PV model ({rating}{cells}, {100 * pvwatts.gamma_pdc:.3g} %/C, "
+            f"{pvwatts.losses:.2g} % losses)"
+        )
 
     def sky_transposition(self) -> str:
         """The diffuse model in force.

@@ -1,6 +1,6 @@
 """Electrical models of one (sub-)panel: its I-V curve and maximum power.
 
-Three models (foldopt SPEC, "PV electrical model"):
+Four models (foldopt SPEC, "PV electrical model"):
 
 - ``ideal``: P = efficiency * area * irradiance; no I-V curve.
 - ``single-diode``: the five-parameter model of De Soto et al. [1]_ through pvlib
@@ -8,6 +8,8 @@ Three models (foldopt SPEC, "PV electrical model"):
   default unit is the SunPower A-300 cell that Shin et al. name; any CEC module can be chosen.
 - ``b-model``: the empirical model of Robles Algarin et al. [3]_ Eq. 8-11 (after Ortiz-Rivera
   [4]_), with the 200 W panel of their Table 1.
+- ``pvwatts``: PVWatts' DC model [5]_ through ``pvlib.pvsystem.pvwatts_dc``, the rating
+  efficiency x area x 1000 W/m^2, less a system loss; no I-V curve.
 
 A panel of a given area is ``m = area / unit_area`` identical units (cells or modules) in series,
 ``m`` kept fractional so that power scales exactly with area: a series string multiplies the
@@ -24,6 +26,8 @@ References
    in Photovoltaic Systems", Eq. 8 (I-V curve), 9 (V_x), 10 (I_x), 11 (fit of b), Table 1.
 .. [4] E. I. Ortiz-Rivera, F. Z. Peng, "Analytical model for a photovoltaic module using the
    electrical characteristics provided by the manufacturer data sheet", IEEE PESC 2005.
+.. [5] A. P. Dobos, "PVWatts Version 5 Manual", NREL/TP-6A20-62641, 2014, Eq. 1 (DC power) and
+   Eq. 3 (system losses).
 """
 
 from __future__ import annotations
@@ -35,7 +39,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from foldopt.names import PV_MODELS
+from foldopt.names import IV_MODELS, PV_MODELS
+from foldopt.physics.temperature import irradiance_coefficient
 
 IRRADIANCE_REF = 1000.0  # [W/m^2], STC
 TEMPERATURE_REF = 25.0  # [C], STC
@@ -359,12 +364,17 @@ class PVModel:
 
     Parameters
     ----------
-    model : {'ideal', 'single-diode', 'b-model'}
+    model : {'ideal', 'single-diode', 'b-model', 'pvwatts'}
     efficiency : float
-        ``ideal``: conversion efficiency [-]. ``b-model``: sets the 200 W panel's area, which
-        Robles Algarin et al. do not give, as ``p_mp / (efficiency * 1000 W/m^2)``.
+        ``ideal``: conversion efficiency [-]. ``pvwatts``: the rating per area at 1000 W/m^2 and
+        25 C, / 1000 W/m^2 [-]. ``b-model``: sets the 200 W panel's area, which Robles Algarin et
+        al. do not give, as ``p_mp / (efficiency * 1000 W/m^2)``.
     module : str or None
         ``single-diode``: a CEC module name; None is the A-300 cell.
+    gamma_pdc : float, default -0.0037
+        ``pvwatts``: temperature coefficient of power [1/C].
+    losses : float, default 0
+        ``pvwatts``: system losses [-], a fraction of the DC power.
 
     Raises
     ------
@@ -375,6 +385,8 @@ class PVModel:
     model: str = "ideal"
     efficiency: float = 0.2
     module: str | None = None
+    gamma_pdc: float = -0.0037
+    losses: float = 0.0
 
     def __post_init__(self):
         if self.model not in PV_MODELS:
@@ -397,7 +409,58 @@ class PVModel:
 
     @property
     def has_iv(self) -> bool:
-        return self.model != "ideal"
+        return self.model in IV_MODELS
+
+    def rating(self, area) -> float:
+        """A panel's rated power [W]: its maximum power at STC (1000 W/m^2, cells at 25 C); for
+        PVWatts its nameplate ``pdc0``, before the system losses (a converter and a price per
+        watt are sized on it).
+
+        Parameters
+        ----------
+        area : float
+            Panel area [m^2].
+        """
+        if self.model == "pvwatts":
+            return self.efficiency * area * IRRADIANCE_REF
+        return float(self.max_power(np.array([IRRADIANCE_REF]), TEMPERATURE_REF, area)[0])
+
+    def power_terms(self, temp_air, wind_speed, temperature_model, area):
+        """The maximum power of a model without I-V curve as ``a E + b E^2`` of the irradiance E.
+
+        Exact for the ideal model (``a = efficiency area``, ``b = 0``) and for PVWatts with a cell
+        temperature linear in the irradiance, ``T_cell = T_air + c E``
+        (:func:`foldopt.physics.temperature.irradiance_coefficient`): with ``k = efficiency area
+        (1 - losses)``, ``a = k (1 + gamma_pdc (T_air - 25 C))`` and ``b = k gamma_pdc c``. The
+        compiled kernel evaluates the power so, without tables.
+
+        Parameters
+        ----------
+        temp_air, wind_speed : float
+            [C], [m/s].
+        temperature_model : str
+            One of :data:`foldopt.names.TEMPERATURE_MODELS`.
+        area : float
+            Panel area [m^2].
+
+        Returns
+        -------
+        a, b : float
+            [W / (W/m^2)], [W / (W/m^2)^2].
+
+        Raises
+        ------
+        ValueError
+            For a model with an I-V curve.
+        """
+        if self.model == "ideal":
+            return self.efficiency * area, 0.0
+        if self.model != "pvwatts":
+            raise ValueError(f"the {self.model} model's power is not a polynomial")
+        k = self.efficiency * area * (1.0 - self.losses)
+        c = irradiance_coefficient(wind_speed, temperature_model)
+        a = k * (1.0 + self.gamma_pdc * (temp_air - TEMPERATURE_REF))
+        return a, float(k * self.gamma_pdc * c)
 
     def curves(self, poa_global, temp_cell, area) -> IVCurve:
         """I-V curves of panels of a given area.
@@ -483,4 +546,11 @@ class PVModel:
         """
         if self.model == "ideal":
             return self.efficiency * area * np.asarray(poa_global, dtype=float)
+        if self.model == "pvwatts":
+            import pvlib
+
+            pdc0 = self.efficiency * area * IRRADIANCE_REF
+            poa = np.asarray(poa_global, dtype=float)
+            dc = pvlib.pvsystem.pvwatts_dc(poa, temp_cell, pdc0, self.gamma_pdc, TEMPERATURE_REF)
+            return np.asarray(dc, dtype=float) * (1.0 - self.losses)
         return self.curves(poa_global, temp_cell, area).max_power()

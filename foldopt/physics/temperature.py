@@ -50,6 +50,37 @@ def cell_temperature(poa_global, temp_air, wind_speed, model="fixed"):
     )
 
 
+def irradiance_coefficient(wind_speed, model="fixed"):
+    """How much warmer than the air a cell is per irradiance, ``c`` in ``T_cell = T_air + c E``.
+
+    ``fixed``: 0. ``sapm``: ``exp(a + b WS) + dT / 1000 W/m^2`` (King et al. 2004, SAND2004-3535,
+    Eq. 11 and 12; open rack glass/polymer), :func:`cell_temperature`'s.
+
+    Parameters
+    ----------
+    wind_speed : float or array_like
+        Wind speed [m/s].
+    model : {'fixed', 'sapm'}
+
+    Returns
+    -------
+    float or numpy.ndarray
+        [C / (W/m^2)].
+    """
+    if model == "fixed":
+        return np.zeros_like(np.asarray(wind_speed, dtype=float))
+    if model == "sapm":
+        import pvlib
+
+        params = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]["open_rack_glass_polymer"]
+        return np.exp(params["a"] + params["b"] * np.asarray(wind_speed, dtype=float)) + (
+            params["deltaT"] / 1000.0
+        )
+    raise ValueError(
+        f"temperature_model must be one of {', '.join(TEMPERATURE_MODELS)}; got {model!r}"
+    )
+
+
 def equivalent_temp_air(temp_air, wind_speed, wind_ref, irradiance, model="fixed"):
     """The air temperature at which a cell in wind ``wind_ref`` is as warm as in ``wind_speed``.
 

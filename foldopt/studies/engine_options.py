@@ -23,7 +23,15 @@ DERIVED = {
         "weather_site": lambda study: study.site,
     },
     ElectricalOptions: {
-        "efficiency": lambda study: study.panel.efficiency,
+        "efficiency": lambda study: (
+            study.pvwatts.efficiency(study.panel.area, study.panel.efficiency)
+            if study.pv_model == "pvwatts"
+            else study.panel.efficiency
+        ),
+        "gamma_pdc": lambda study: study.pvwatts.gamma_pdc,
+        "losses": lambda study: (
+            study.pvwatts.losses / 100.0 if study.pv_model == "pvwatts" else 0.0
+        ),
         "area": lambda study: study.panel.area,
         "bypass": lambda study: study.bypass_diodes,
         "exact": lambda study: study.exact_electrical,

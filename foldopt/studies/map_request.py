@@ -55,9 +55,9 @@ SITES_PER_BATCH = 12
 
 #: What a map changes in the embedded study (the paper's): its beam-only sky and Eq. 5 are for the
 #: paper's own site and day, the world runs in exact mode (whose own sky, as everywhere, is
-#: Ineichen's with diffuse light). Its step is the study's, as in every command, so that a map and a
-#: sweep of one site give one answer; ``--step-min 5`` keeps a year's mean t_solar within 0.005 h of
-#: 1-min steps (README, "Maps") at a fifth of the work.
+#: Ineichen's with diffuse light, and whose PV model PVWatts'). Its step is the study's, as in
+#: every command, so that a map and a sweep of one site give one answer; ``--step-min 5`` keeps a
+#: year's mean t_solar within 0.005 h of 1-min steps (README, "Maps") at a fifth of the work.
 MAP_DEFAULTS = {"mode": "exact"}
 #: A study's fields that a map sets per site or not at all.
 _PER_SITE = ("site", "date", "p_load", "year", "sweep", "weather", "force_site")
@@ -75,7 +75,7 @@ def map_study(data: dict, embedded: bool = True, **changes) -> dict:
         A study's fields.
     embedded : bool, default True
         The data is the embedded paper study, whose mode gives way to :data:`MAP_DEFAULTS` (and
-        its sky and geometry to exact mode's); a user's own study keeps its own.
+        its sky, geometry and PV model to exact mode's); a user's own study keeps its own.
     **changes
         Field paths (dotted, ``panel.area``) to values, set last.
 
@@ -96,6 +96,7 @@ def map_study(data: dict, embedded: bool = True, **changes) -> dict:
     if embedded:
         study.pop("geometry", None)  # exact mode's own geometry and sky
         study.pop("sky", None)
+        study.pop("pv_model", None)
         study.update(MAP_DEFAULTS)
     study.setdefault("objective", {"statistic": "mean"})
     for path, value in changes.items():

@@ -129,7 +129,10 @@ def reproduce(study: Study, engine: str = DEFAULT_ENGINE, **changes) -> pd.DataF
     p_load = infer_p_load(study)
     columns = {}
     for mode, geometry in GEOMETRY_OF_MODE.items():
-        variant = study.variant(mode=mode, geometry=geometry, p_load=p_load)
+        # Both modes with the study's PV model: the columns differ by the modes' physics alone.
+        variant = study.variant(
+            mode=mode, geometry=geometry, p_load=p_load, pv_model=study.pv_model
+        )
         columns[f"{mode}_mode"] = reproduction_values(variant, engine)
     return pd.DataFrame(
         [

@@ -820,7 +820,7 @@ def _taken(plan: Plan, given: set, field: str | None, data: dict, decided: list[
     if "mode" not in given:
         taken.append(notes[0] if notes else f"{study.mode} mode")
     if "pv_model" not in given:
-        taken.append(f"{study.pv_model} PV model")
+        taken.append(study.pv_model_text())
     taken += [item for item in decided if item not in notes]
     return taken
 
@@ -925,7 +925,7 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
     taken = [
         f"panel {spec.study.panel.area:g} m^2" if "panel.area" not in flat else None,
         loads_taken if loads is None and not relative else None,
-        f"{spec.study.pv_model} PV model",
+        spec.study.pv_model_text(),
         f"{spec.study.mode} mode",
         f"{spec.study.step_min:g}-min steps" if "step_min" not in flat else None,
     ]

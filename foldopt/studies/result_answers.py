@@ -149,7 +149,7 @@ def study_question(study, varied: tuple = ()) -> dict:
             if panel.planes is not None
             else ""
         ),
-        "models": f"{study.mode} mode, {study.geometry} geometry, {study.pv_model} PV model, {study.connection}, "
+        "models": f"{study.mode} mode, {study.geometry} geometry, {study.pv_model_text()}, {study.connection}, "
         + sky_text(study, varied),
         "fold angles": f"{study.fold_angles.start:g} to {study.fold_angles.stop:g} deg by {study.fold_angles.step:g}",
         "near-optimal": f"within {100 * tolerance.fraction:g} % or {tolerance.minutes:g} min of the best, "
@@ -1044,7 +1044,7 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
             "(the flat panel's own)"
         ),
         "objective": part["objective"],
-        "models": f"{study.mode} mode, {study.pv_model} PV model, "
+        "models": f"{study.mode} mode, {study.pv_model_text()}, "
         + (sky if weather else sky_text(study, ("site", "date"))),
     }
     columns = [

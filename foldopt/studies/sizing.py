@@ -87,15 +87,14 @@ def best_areas(table: pd.DataFrame) -> pd.DataFrame:
     )
 
 
-def stc_power_per_area(pv, temp_ref: float = 25.0) -> float:
-    """Rated power per panel area at STC (1000 W/m^2, 25 C).
+def stc_power_per_area(pv) -> float:
+    """Rated power per panel area (:meth:`foldopt.physics.pvmodel.PVModel.rating`): at STC
+    (1000 W/m^2, 25 C), PVWatts' before its system losses.
 
     Parameters
     ----------
     pv : PVModel
         :class:`foldopt.physics.pvmodel.PVModel`.
-    temp_ref : float, default 25
-        Cell temperature [C].
 
     Returns
     -------
@@ -108,7 +107,7 @@ def stc_power_per_area(pv, temp_ref: float = 25.0) -> float:
     >>> stc_power_per_area(PVModel("ideal", efficiency=0.2))
     200.0
     """
-    return float(np.asarray(pv.max_power(np.array([1000.0]), temp_ref, 1.0))[0])
+    return pv.rating(1.0)
 
 
 def size_panel(

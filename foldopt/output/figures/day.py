@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 
 from foldopt.inputs.study import Study
-from foldopt.names import FLAT_FOLD_ANGLE
+from foldopt.names import FLAT_FOLD_ANGLE, IV_MODELS
 from foldopt.output.figures.canvas import ONE_AXES, FigureFile, new_axes
 from foldopt.studies.day import StudyResult
 
@@ -163,7 +163,7 @@ def plot_t_solar_vs_fold_angle(result: StudyResult, ax=None):
         color="tab:blue",
         label=f"twofold ({_connection_label(result.study, result.study.connection)})",
     )
-    if result.study.pv_model != "ideal":
+    if result.study.pv_model in IV_MODELS:  # without I-V curve, every pair delivers the sum
         for name in ("parallel", "series", "independent"):
             if name != result.study.connection:
                 ax.plot(
