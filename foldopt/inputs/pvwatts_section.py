@@ -12,8 +12,9 @@ References
 ----------
 .. [1] A. P. Dobos, "PVWatts Version 5 Manual", NREL/TP-6A20-62641, 2014, Table 2 (default
    system losses) and Eq. 1 to 3; pvlib.pvsystem.pvwatts_losses holds the same defaults.
-.. [2] NREL, PVWatts Version 8 help, "Module type": standard modules -0.37 %/C (premium
-   -0.35, thin film -0.32), the crystalline-silicon modules a small panel is made of.
+.. [2] NREL, SAM Simulation Core, ``ssc/cmod_pvwattsv8.cpp`` (PVWatts Version 8), module types:
+   standard -0.0037 /C (premium -0.0035, thin film -0.0032); the standard (crystalline-silicon)
+   module is what a small panel is made of.
 """
 
 from __future__ import annotations
