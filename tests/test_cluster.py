@@ -149,7 +149,7 @@ def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
 
 
 @EMBEDDED_MAP
-def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):
+def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path, scheduler):
     out = tmp_path / "map"
     run = _foldopt("map", *EMBEDDED, "--out", str(out), "-q", start_new_session=True)
     try:
@@ -159,11 +159,14 @@ def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path):
         run.wait(timeout=30)
     before = _parts(out)
     assert 3 <= len(before) < N_SITES and not (out / "map.parquet").exists()
-    refused = _foldopt("map", *EMBEDDED, "--out", str(out))
-    _, err = refused.communicate(timeout=SECONDS)
-    assert refused.returncode == 2 and "pass --resume to finish it" in err
-    out_text, _ = _finish(_foldopt("map", *EMBEDDED, "--out", str(out), "--resume", "--format", "json", "-q"))
-    answer = json.loads(out_text)  # one JSON document: the year's rows
+    # The killed process is the point; the refusal and the resume are the folder's, run in this
+    # process (the resume on conftest's in-process cluster: a map's cluster is not part of it).
+    refused = CliRunner().invoke(app, ["map", *EMBEDDED, "--out", str(out)])
+    assert refused.exit_code == 2 and "pass --resume to finish it" in refused.stderr, refused.output
+    resumed = CliRunner().invoke(app, ["map", *MAP, "--scheduler", scheduler, "--out", str(out), "--resume",
+                                       "--format", "json", "-q"])
+    assert resumed.exit_code == 0, resumed.output
+    answer = json.loads(resumed.stdout)  # one JSON document: the year's rows
     assert answer["command"] == "map" and answer["answer"]["result"]["sites"] == N_SITES
     assert len(answer["rows"]) == N_SITES * N_LOADS and answer["answer"]["result"]["chunks_from_disk"] == len(before)
     meta = json.loads((out / "run.json").read_text())
@@ -306,7 +309,7 @@ def test_a_scheduler_lost_mid_run_is_one_line_and_a_resume_that_cannot_connect_c
                         r"start it again and finish the map with --resume", lines[1]), lines[1]
     before = _snapshot(out)
     assert json.loads((out / "run.json").read_text())["status"] == "running" and before
-    refused = _foldopt("map", *MAP, "--out", str(out), "--resume", "--scheduler", address)
-    _, err = refused.communicate(timeout=SECONDS)
-    assert refused.returncode == 2 and err.startswith(f"error: --scheduler = '{address}': no Dask scheduler answers")
+    refused = CliRunner().invoke(app, ["map", *MAP, "--out", str(out), "--resume", "--scheduler", address])
+    assert refused.exit_code == 2, refused.output
+    assert refused.stderr.startswith(f"error: --scheduler = '{address}': no Dask scheduler answers"), refused.stderr
     assert _snapshot(out) == before and not [path for path in tmp_path.iterdir() if path.name.startswith(".")]

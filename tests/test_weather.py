@@ -6,6 +6,8 @@ from pathlib import Path
 import numpy as np
 import pvlib
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 from foldopt.inputs.study import make_study
 from foldopt.physics.geometry import subpanel_orientation
@@ -148,3 +150,30 @@ def test_the_formats_registry_is_the_names_a_study_accepts():
     assert {entry.interval_label for entry in FORMATS.values()} <= set(names.INTERVAL_LABELS)
     assert [weather_format(Path(f"x{suffix.upper()}")) for suffix in (".csv", ".epw", ".json", ".txt")] == [
         "tmy3", "epw", "pvgis", "tmy3"]
+
+
+@settings(max_examples=60, deadline=None)
+@given(start=st.datetimes(dt.datetime(1999, 12, 31), dt.datetime(2101, 1, 1)).map(lambda t: t.replace(microsecond=0)),
+       hours=st.integers(1, 80), offset_min=st.integers(-14 * 60, 14 * 60), year=st.integers(1970, 2200),
+       unit=st.sampled_from(["s", "us", "ns"]))
+@example(start=dt.datetime(2024, 2, 28, 20), hours=3, offset_min=-300, year=2025, unit="us")  # February 29
+@example(start=dt.datetime(2024, 12, 31, 20), hours=3, offset_min=840, year=2025, unit="ns")  # the next year
+def test_a_pvgis_years_stamps_take_the_year_as_timestamp_replace_gives_them(start, hours, offset_min, year, unit):
+    """PVGIS's stamps moved to the study's year in one step are, stamp by stamp, pandas'
+    ``Timestamp.replace(year=year)`` (the reference), on a fixed offset or none; a February 29
+    and a year without one are refused as it refuses them."""
+    import pandas as pd
+
+    from foldopt.inputs.weather.formats import offset_zone
+    from foldopt.inputs.weather.pvgis import in_year
+
+    utc = pd.date_range(start, periods=hours, freq="7h", tz="UTC", unit=unit)
+    for stamps in (utc.tz_convert(offset_zone(offset_min / 60)), utc.tz_localize(None)):
+        try:
+            expected = pd.DatetimeIndex([stamp.replace(year=year) for stamp in stamps])
+        except ValueError:
+            with pytest.raises(ValueError):
+                in_year(stamps, year)
+            continue
+        moved = in_year(stamps, year)
+        assert moved.equals(expected) and moved.dtype == expected.dtype and moved.freq is None
