@@ -4,7 +4,7 @@ paper's site and three others.
     python bench/optimize.py              # four sites, printed
     python bench/optimize.py --days 1:365:7
 
-Per site: configs/optimize.yaml's study (exact mode, Ineichen clear sky, ideal cells, the 4.398 W
+Per site: configs/optimize.yaml's study (exact mode, Ineichen clear sky, its PV model, the 4.398 W
 camera, mean daily t_solar over the days) with the fold angle (10 to 180 by 2 deg), base tilt (0 to
 90 by 2) and base azimuth (the equator-facing one +-60 by 4) varied together; the search
 (:func:`foldopt.engine.search.grid_search`) and every point of the same grid, each timed in this
