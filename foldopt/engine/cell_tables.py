@@ -149,12 +149,15 @@ def temperature_nodes(sky: Sky, blocks=slice(None)):
         nodes, table = np.unique(np.atleast_1d(sky.temp_air[blocks]), return_inverse=True)
         return nodes, table.reshape(-1, 1).astype(np.int64), np.zeros((table.size, 1))
     temps = np.atleast_2d(sky.temp_steps[blocks])
-    low = np.floor(temps.min() / TEMPERATURE_NODE_STEP) * TEMPERATURE_NODE_STEP
-    count = int(np.floor((temps.max() - low) / TEMPERATURE_NODE_STEP)) + 2
-    nodes = low + TEMPERATURE_NODE_STEP * np.arange(count)
-    position = (temps - low) / TEMPERATURE_NODE_STEP
-    table = np.minimum(np.floor(position), count - 2).astype(np.int64)
-    return nodes, table, position - table
+    # A step's weight is its place on the lattice of nodes from 0 C, not from the run's coldest
+    # node: the same step weighs its two tables to the bit whatever other days the run holds.
+    position = temps / TEMPERATURE_NODE_STEP
+    lattice = np.floor(position)
+    first = int(lattice.min())
+    count = int(lattice.max()) - first + 2
+    nodes = TEMPERATURE_NODE_STEP * (first + np.arange(count))
+    table = (lattice - first).astype(np.int64)
+    return nodes, table, position - lattice
 
 
 def node_weights(sky: Sky, blocks, shape):

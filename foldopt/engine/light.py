@@ -160,6 +160,21 @@ def diffuse_terms(
     return np.moveaxis(layout, 1, -1)
 
 
+def file_wind_ref(frame: pd.DataFrame, default: float) -> float:
+    """The wind speed of the electrical tables [m/s] for a weather file: the file's mean wind over
+    its lit rows, to 0.5 m/s (``default``, the study's, where it has none).
+
+    A property of the file, not of the days a run takes from it: the step's wind is folded into
+    an equivalent air temperature about it with the horizontal light standing for the sub-panels'
+    (:func:`foldopt.physics.temperature.equivalent_temp_air`), whose small error depends on it, so
+    a day's answer is the same alone and among the file's other days.
+    """
+    lit = frame["ghi"].to_numpy(dtype=float) > 0
+    wind = frame["wind_speed"].to_numpy(dtype=float)[lit]
+    wind = wind[np.isfinite(wind)]
+    return float(np.round(2.0 * wind.mean()) / 2.0) if wind.size else float(default)
+
+
 def weather_light(weather, grid: ClockGrid, dates, clear: dict, solar_zenith, dni_extra):
     """Light at every step of the grid from an hourly weather file (``weather``, a
     :class:`foldopt.inputs.weather_section.Weather`) drawn along the clear sky

@@ -20,6 +20,7 @@ import numpy as np
 from foldopt.engine.light import (
     clear_light,
     diffuse_terms,
+    file_wind_ref,
     measured_light,
     member_light,
     weather_light,
@@ -27,7 +28,7 @@ from foldopt.engine.light import (
 from foldopt.engine.options import SkyOptions
 from foldopt.inputs.load_profile import load_shape
 from foldopt.inputs.sections import parse_timezone
-from foldopt.inputs.weather.reader import study_weather, weather_site
+from foldopt.inputs.weather.reader import read_weather, study_weather, weather_site
 from foldopt.names import CLEAR_SKIES
 from foldopt.physics.atmosphere import clear_sky_dni, extraterrestrial_spencer
 from foldopt.physics.horizon import sun_visible
@@ -91,7 +92,8 @@ class Sky:
         With a weather file, (n_blocks, n_steps) the file's wind speed at each step [m/s].
     wind_ref : float or None
         With a weather file, the wind speed of the electrical tables [m/s]: the file's mean over
-        the lit steps, to 0.5 m/s, so that the wind folded into ``temp_steps`` stays small.
+        its lit rows, to 0.5 m/s, so that the wind folded into ``temp_steps`` stays small
+        (:func:`foldopt.engine.light.file_wind_ref`: the file's, whichever of its days a run takes).
     weather_notes : tuple of str
         With a measured weather file, what reading it did (its step, derived components, gaps:
         :meth:`foldopt.inputs.weather.measured.MeasuredWeather.report`).
@@ -402,7 +404,11 @@ def build_sky(
         light, measured = measured_light(options, grid, dates)
         temp_steps, wind_speed = light.pop("temp_air"), light.pop("wind_speed")
         notes = tuple(measured.report())
+        wind_ref = file_wind_ref(measured.frame, options.wind_speed)
     elif weather is not None:
+        # The file as read for the first date's year (cached): its rows' values are every year's.
+        frame = read_weather(weather.path, weather.format, dates[0].year, weather.label)
+        wind_ref = file_wind_ref(frame, options.wind_speed)
         clear, _ = clear_light(
             grid, solar_zenith, dni_extra, sites, "ineichen", options.linke_turbidity
         )
@@ -430,11 +436,6 @@ def build_sky(
         dates = [dates[i] for i in inverse]
     if weather is not None:
         lit = light["ghi"] > 0
-        wind_ref = (
-            float(np.round(2.0 * wind_speed[lit].mean()) / 2.0)
-            if lit.any()
-            else float(options.wind_speed)
-        )
         temp_steps = equivalent_temp_air(
             temp_steps, wind_speed, wind_ref, light["ghi"], options.temperature_model
         )
