@@ -426,12 +426,12 @@ class PVModel:
         return float(self.max_power(np.array([IRRADIANCE_REF]), TEMPERATURE_REF, area)[0])
 
     def power_terms(self, temp_air, wind_speed, temperature_model, area):
-        """The maximum power of a model without I-V curve as ``a E + b E^2`` of the irradiance E.
+        """The maximum power of a model without I-V curve as ``a E + q E^2`` of the irradiance E.
 
-        Exact for the ideal model (``a = efficiency area``, ``b = 0``) and for PVWatts with a cell
+        Exact for the ideal model (``a = efficiency area``, ``q = 0``) and for PVWatts with a cell
         temperature linear in the irradiance, ``T_cell = T_air + c E``
         (:func:`foldopt.physics.temperature.irradiance_coefficient`): with ``k = efficiency area
-        (1 - losses)``, ``a = k (1 + gamma_pdc (T_air - 25 C))`` and ``b = k gamma_pdc c``. The
+        (1 - losses)``, ``a = k (1 + gamma_pdc (T_air - 25 C))`` and ``q = k gamma_pdc c``. The
         compiled kernel evaluates the power so, without tables.
 
         Parameters
@@ -445,7 +445,7 @@ class PVModel:
 
         Returns
         -------
-        a, b : float
+        a, q : float
             [W / (W/m^2)], [W / (W/m^2)^2].
 
         Raises

@@ -276,7 +276,7 @@ def singleaxis_orientation(
 
     pvlib's operations in pvlib's order (``shading.projected_solar_zenith_angle``,
     ``tracking.calc_surface_orientation``), so that the two agree to the bit
-    (tests/test_trackers.py): a study with a single-axis tracker then imports no pvlib, whose
+    (tests/test_tracker.py): a study with a single-axis tracker then imports no pvlib, whose
     import (with the scipy it loads) takes longer than the day's whole computation.
 
     Parameters
