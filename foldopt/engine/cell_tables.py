@@ -51,9 +51,7 @@ def electrical_settings(
         Wind speed of the tables [m/s]; default the options' (a weather study's sky gives its own,
         :attr:`foldopt.engine.sky.Sky.wind_ref`).
     """
-    pv = PVModel(
-        options.pv_model, options.efficiency, options.module, options.gamma_pdc, options.losses
-    )
+    pv = options.pv()
     return dict(
         pv=pv,
         subpanel_area=options.area / 2.0,

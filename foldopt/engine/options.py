@@ -19,6 +19,7 @@ from typing import NamedTuple
 from foldopt.inputs.circuit_section import Circuit
 from foldopt.inputs.sections import LoadProfile, Site
 from foldopt.inputs.weather_section import Weather
+from foldopt.physics.pvmodel import PVModel
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,10 @@ class ElectricalOptions:
     converter_efficiency: float
     exact: bool
     circuit: Circuit | None
+
+    def pv(self) -> PVModel:
+        """The PV model these options name, with its settings."""
+        return PVModel(self.pv_model, self.efficiency, self.module, self.gamma_pdc, self.losses)
 
 
 class EngineOptions(NamedTuple):

@@ -57,9 +57,7 @@ def predicted_power(study: Study, poa_global, temp_air) -> np.ndarray:
         [W], shaped as ``poa_global``.
     """
     options = engine_options(study).electrical
-    pv = PVModel(
-        options.pv_model, options.efficiency, options.module, options.gamma_pdc, options.losses
-    )
+    pv = options.pv()
     poa = np.clip(np.asarray(poa_global, dtype=float), 0.0, None)
     temp_cell = cell_temperature(poa, temp_air, study.wind_speed, options.temperature_model)
     return pv.max_power(poa, temp_cell, options.area)
