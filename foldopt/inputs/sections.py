@@ -254,32 +254,25 @@ def planes_panel(
             f"panel.planes: no {geometry} panel makes them within {PLANES_TOLERANCE_DEG:g} deg: "
             f"{why}{hint}"
         )
-    given = (
-        panel["surface_tilt"] if tilt is None else tilt,
-        panel["surface_azimuth"] if azimuth is None else azimuth,
-    )
-    residual, first_east = planes_residual(flat, panel["fold_angle"], *given, geometry)
+
+    def made(orientation: dict):
+        """(residual [deg], first_east) of the planes' fold at a base orientation."""
+        return planes_residual(
+            flat, panel["fold_angle"], orientation["tilt"], orientation["azimuth"], geometry
+        )
+
+    base = {"tilt": panel["surface_tilt"], "azimuth": panel["surface_azimuth"]}
+    keys = {
+        key: value for key, value in (("tilt", tilt), ("azimuth", azimuth)) if value is not None
+    }
+    given = {**base, **keys}
+    residual, first_east = made(given)
     if not float(residual) <= PLANES_TOLERANCE_DEG:
-        keys = {
-            key: value for key, value in (("tilt", tilt), ("azimuth", azimuth)) if value is not None
-        }
         # Name the one that misses alone, where one does (a tent's level tilt given is no fault).
         alone = {
             key: value
             for key, value in keys.items()
-            if len(keys) == 2
-            and not float(
-                planes_residual(
-                    flat,
-                    panel["fold_angle"],
-                    *(
-                        value if key == name else panel[f"surface_{name}"]
-                        for name in ("tilt", "azimuth")
-                    ),
-                    geometry,
-                )[0]
-            )
-            <= PLANES_TOLERANCE_DEG
+            if len(keys) == 2 and not float(made({**base, key: value})[0]) <= PLANES_TOLERANCE_DEG
         }
         keys = alone or keys
         named = " and ".join(f"{key} {value:g} deg" for key, value in keys.items())
@@ -289,7 +282,7 @@ def planes_panel(
             f"{panel['fold_angle']:.4g} deg, not of the given {named}; leave the "
             f"{' and '.join(keys)} out"
         )
-    return float(given[0]), float(given[1]), panel["fold_angle"], bool(first_east)
+    return float(given["tilt"]), float(given["azimuth"]), panel["fold_angle"], bool(first_east)
 
 
 def default_orientation(latitude: float) -> tuple[float, float]:
