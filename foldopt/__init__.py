@@ -88,6 +88,8 @@ _PUBLIC = {
     "plot_sizing": "foldopt.output.figures.sizing",
     "plot_sun_paths": "foldopt.output.figures.horizon",
     "plot_landscape": "foldopt.output.figures.landscape",
+    "plot_design_space": "foldopt.output.figures.least_cost",
+    "Costs": "foldopt.inputs.costs_section",
     "OptimizeResult": "foldopt.studies.joint",
     "Optimize": "foldopt.inputs.optimize_section",
     "best_schedules": "foldopt.engine.schedule",

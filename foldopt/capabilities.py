@@ -78,6 +78,14 @@ CAPABILITIES = (
         "objective (--objective) and sized by foldopt size --storage (--set storage=null drops it)",
     ),
     Capability(
+        "costs",
+        "prices of panel, buffer, hinge and tracker drive: the cheapest panel and buffer of each "
+        "kind meeting storage.target (design_space.csv)",
+        ("annual",),
+        "the least-cost search runs over the days of an objective (foldopt run, sweep angle with "
+        "--objective, a buffer with a target) (--set costs=null drops it)",
+    ),
+    Capability(
         "weather",
         "a weather file or source: the site's own light (--weather); a map's sites each bring "
         "their own (--weather-dir, or a source: --weather NAME)",

@@ -40,6 +40,7 @@ from foldopt.inputs.sections import (
     default_orientation,
     planes_panel,
 )
+from foldopt.inputs.costs_section import Costs, costs_problem
 from foldopt.inputs.storage_section import Storage
 from foldopt.inputs.weather_section import Weather
 
@@ -149,6 +150,9 @@ class Study(StrictModel):
     storage : Storage, optional
         A buffer behind a charge controller; default none: the storage-less study, its answers
         ``t_solar``'s.
+    costs : Costs, optional
+        Prices [USD] of panel, buffer, hinge and tracker drive: the cheapest panel and buffer of
+        each kind meeting ``storage.target`` (:mod:`foldopt.studies.least_cost`); default none.
     geometry : str, optional
         One of :data:`foldopt.names.GEOMETRIES`; default azimuth-split in paper mode, hinge in exact.
     fold_angles : FoldAngles
@@ -220,6 +224,9 @@ class Study(StrictModel):
     load_profile: LoadProfile | None = None
     storage: Storage | None = Field(
         None, description="a buffer behind a charge controller; default none (storage-less)"
+    )
+    costs: Costs | None = Field(
+        None, description="prices [USD] for the least-cost panel and buffer; default none"
     )
     geometry: named(names.GEOMETRIES) | None = Field(
         None,
@@ -418,6 +425,9 @@ class Study(StrictModel):
             raise ValueError(
                 "transposition: paper mode is beam-only (Shin et al. Eq. 5): transposition must be none"
             )
+        problem = costs_problem(self.costs, self.storage, self.pv_model, names.IV_MODELS)
+        if problem:
+            raise ValueError(problem)
         idle = self.idle_settings()
         if idle:
             raise ValueError("\n".join(idle))  # one error line each

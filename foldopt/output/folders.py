@@ -252,6 +252,18 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
     if "storage_annual" in extras:
         write_csv(extras["storage_annual"], folder / "storage_annual.csv")
         written.append("storage_annual.csv")
+    if "design_space" in extras:
+        write_csv(extras["design_space"], folder / "design_space.csv")
+        written += [
+            "design_space.csv",
+            write_figure(
+                folder,
+                "design_space.png",
+                extras["design_space"],
+                f"{name}: the smallest buffer meeting the target against the panel's area",
+                study.costs,
+            ),
+        ]
     if "weather_sample" in extras:
         kind = {
             "measured": "measured minutes",

@@ -744,6 +744,7 @@ _HAS = {
     "load_profile": lambda study: study.load_profile is not None,
     "optimize": lambda study: study.optimize is not None,
     "panel.planes": lambda study: study.panel.planes is not None,
+    "costs": lambda study: study.costs is not None,
 }
 
 

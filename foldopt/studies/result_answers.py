@@ -17,6 +17,7 @@ import pandas as pd
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.designs import PLANES_DESIGN
 from foldopt.studies.horizon_paths import horizon_notes
+from foldopt.studies.least_cost import least_cost_answer
 from foldopt.studies.storage_answer import answer_part, buffer_text, year_lines
 from foldopt.studies.storage_days import DESIGN_COLUMNS, sequential
 from foldopt.names import FLAT_FOLD_ANGLE
@@ -718,6 +719,12 @@ def _of_annual(result) -> Answer:
             "fold_angle_buffer_deg": float(chosen.iloc[0]),
             "per_case": records(buffered),
         }
+    space = result.extras.get("design_space")
+    if space is not None:
+        said, part["least_cost"] = least_cost_answer(
+            space, study.costs, study.storage.target, study.tracker.model
+        )
+        lines += said
     designs = objectives[
         [
             *keys,

@@ -45,7 +45,14 @@ from foldopt.engine.metrics import notes, relative_to
 from foldopt.engine.sky import Sky
 from foldopt.physics.spa import SunTerms
 from foldopt.studies.series import series_refused, year_piece, year_series
-from foldopt.studies.storage_days import YearChoice, YearDays, powered_by_angle, year_storage
+from foldopt.studies.least_cost import search_angles, year_design_space
+from foldopt.studies.storage_days import (
+    YearChoice,
+    YearDays,
+    powered_by_angle,
+    storage_engine,
+    year_storage,
+)
 from foldopt.names import DEFAULT_ENGINE, FLAT_FOLD_ANGLE
 
 
@@ -461,7 +468,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of, wit
         ),
     }
     if buffered:
-        extras["storage_annual"] = _year_buffer(
+        extras |= _year_buffer(
             blocks,
             parts,
             skies,
@@ -490,7 +497,8 @@ CURVE_BYTES = 100e6
 def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, drawn, engine):
     """storage_annual: the buffer over an annual group's days for each design, the twofold panel
     at the angle t_solar's objective keeps and at the one the objective of daily powered time
-    keeps, simulated at every angle of the grid (a chunk of angles' curves at a time)."""
+    keeps, simulated at every angle of the grid (a chunk of angles' curves at a time); with the
+    study's costs, design_space (:func:`foldopt.studies.least_cost.year_design_space`)."""
     study = blocks.study
     shapes = [sky.load_shape for sky in skies]
     days = YearDays(
@@ -534,7 +542,24 @@ def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, 
         },
         near=near_optimal(fold_angles, score, study.near_optimal),
     )
-    return year_storage(study.storage, days, drawn, choice, engine=engine, draws=own)
+    tables = {
+        "storage_annual": year_storage(study.storage, days, drawn, choice, engine=engine, draws=own)
+    }
+    if study.costs is not None:
+        angles = search_angles(fold_angles, np.concatenate([fold_angles[best], fold_angles[fixed]]))
+        tables["design_space"] = year_design_space(
+            study.storage,
+            study.costs,
+            days,
+            {name: drawn[name] for name in ("flat", "tracker-net")},
+            _twofold_curves(blocks, parts, skies, angles, engine),
+            angles,
+            area_m2=study.panel.area,
+            tracker_model=study.tracker.model,
+            engine=storage_engine(engine),
+            draw=own["tracker-net"],
+        )
+    return tables
 
 
 def _twofold_curves(blocks: Blocks, parts, skies, angles, engine) -> np.ndarray:
@@ -756,7 +781,13 @@ def _plain(value):
 
 
 #: The tables of every annual group, one row per load (and design, setting or visit) and group.
-GROUP_TABLES = ("annual_objective", "refold_value", "refold_schedule", "storage_annual")
+GROUP_TABLES = (
+    "annual_objective",
+    "refold_value",
+    "refold_schedule",
+    "storage_annual",
+    "design_space",
+)
 
 
 def refold_tables(

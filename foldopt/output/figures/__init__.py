@@ -2,7 +2,7 @@
 :mod:`~foldopt.output.figures.storage`, :mod:`~foldopt.output.figures.sweep`, :mod:`~foldopt.output.figures.annual`,
 :mod:`~foldopt.output.figures.weather`, :mod:`~foldopt.output.figures.horizon`,
 :mod:`~foldopt.output.figures.world`, :mod:`~foldopt.output.figures.sizing`,
-:mod:`~foldopt.output.figures.landscape`), each with the public
+:mod:`~foldopt.output.figures.landscape`, :mod:`~foldopt.output.figures.least_cost`), each with the public
 ``plot_*`` functions that draw on an ``ax`` (a notebook's, with its own backend) and its
 ``FIGURES``: file name -> the plot function and what it shows. :data:`FIGURES` gathers them: every
 figure file a results folder can hold, the one list the folder writers draw through
@@ -85,6 +85,7 @@ with _matplotlib_imported():
         day,
         horizon,
         landscape,
+        least_cost,
         sizing,
         storage,
         sweep,
@@ -105,6 +106,7 @@ FIGURES = {
     **world.FIGURES,
     **sizing.FIGURES,
     **landscape.FIGURES,
+    **least_cost.FIGURES,
 }
 
 
@@ -156,6 +158,7 @@ def rst_table() -> str:
         (horizon, "a site with a horizon"),
         (world, "a map"),
         (sizing, "a sizing"),
+        (least_cost, "a weather file's dates with costs"),
     )
     lines = [
         "Figures",

@@ -1,0 +1,371 @@
+"""The cheapest panel and buffer that meet the buffer's target (issue 50), per kind of design:
+panel area, fold angle and buffer capacity chosen together at a study's prices
+(:class:`foldopt.inputs.costs_section.Costs`), as HOMER's optimizer chooses a PV array's and a
+battery bank's sizes for the least net present cost among those meeting a capacity-shortage
+constraint [1]_, here with the fold angle beside them and the buffer simulated on the study's
+own steps.
+
+The search (:func:`design_space`): for each kind (``flat``; ``twofold`` at each fold angle the
+day's sizing compares, :data:`~foldopt.studies.storage_days.SIZING_ANGLES` of the study's grid
+and the best for powered time; ``tracker-net``, the study's tracker with its drive's draw served
+by the buffer, where its drive has a price) and each panel area of a geometric grid around the
+study's (:data:`AREA_FACTORS`, a quarter to four times it), the smallest buffer reaching
+``storage.target`` (:func:`foldopt.studies.storage_sizing.smallest_buffers`, within its
+:data:`~foldopt.studies.storage_sizing.CAPACITY_RTOL`; none above its grid's top, four days' load
+energy over the usable fraction). An area's power is the study's power curve scaled by the area's
+ratio: exact where the PV model's power is proportional to the area, as ``ideal``'s and
+``pvwatts``' are (their rating is efficiency x area x 1000 W/m^2; a given ``pvwatts.pdc0`` is
+scaled at its W/m^2), and the study refuses the section for a model with an I-V curve
+(:func:`foldopt.inputs.costs_section.costs_problem`); a tracker's drive draws what it draws at
+any area. A design's cost is ``area x panel_usd_per_m2 + capacity x buffer_usd_per_wh``, plus the
+hinge (twofold) or the drive (tracker), plus ``fixed_usd``. The least-cost design of a kind is the
+cheapest of its areas' and angles' (ties to the smallest area, then the least folded): the answer
+is as fine as the area grid (steps of 2^(1/4), 19 %), and exact in the capacity at each area.
+
+What rests on the sizing's premise rests here too: where a larger buffer can run the load less (a
+hysteresis band or a leak, :mod:`foldopt.studies.storage_sizing`), the capacity is the least
+evaluated that reaches the target, and ``monotone`` says whether every larger one of the grid
+does too.
+
+The module may import numpy, pandas, :mod:`foldopt.inputs` and
+:mod:`foldopt.studies.storage_sizing`.
+
+References
+----------
+.. [1] UL Solutions (HOMER Energy), "HOMER Pro 3.16 User Manual": "How HOMER calculates ... the
+   optimal system" (the optimizer's search space of component sizes, ranked by net present cost)
+   and "Maximum Annual Capacity Shortage" (the reliability constraint a feasible system meets).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from foldopt.inputs.costs_section import DRIVE_FIELD
+from foldopt.names import FLAT_FOLD_ANGLE
+from foldopt.studies.storage_sizing import smallest_buffers
+
+#: The panel areas searched, as multiples of the study's [-]: a quarter to four times it in
+#: steps of 2^(1/4).
+AREA_FACTORS = 2.0 ** np.arange(-2.0, 2.0 + 1e-9, 0.25)
+#: The kinds of design searched, in the answer's order (a tracker where its drive has a price).
+KINDS = ("flat", "twofold", "tracker-net")
+#: design_space.csv's columns, in order.
+COLUMNS = (
+    "design",
+    "fold_angle_deg",
+    "area_m2",
+    "capacity_wh",
+    "cost_usd",
+    "meets",
+    "frontier",
+    "least_cost",
+    "monotone",
+)
+
+
+def design_space(
+    curves: dict,
+    fold_angles,
+    *,
+    area_m2: float,
+    load,
+    storage,
+    costs,
+    tracker_model: str,
+    step_hours: float,
+    engine: str,
+    in_sequence: bool,
+    draw=None,
+) -> pd.DataFrame:
+    """Each kind's smallest buffer for ``storage.target`` at each area of the grid, its cost and
+    the least-cost design (module docstring).
+
+    Parameters
+    ----------
+    curves : dict
+        ``flat`` and ``tracker-net`` -> power [W] at the study's area, (n_days, n_steps);
+        ``twofold`` -> at ``fold_angles``, (k, n_days, n_steps). A net tracker's is its whole
+        power, its drive's draw ``draw``.
+    fold_angles : array_like
+        (k,) [deg].
+    area_m2 : float
+        The study's panel area [m^2].
+    load : float or numpy.ndarray
+        [W], or a profile (1, n_days, n_steps).
+    storage : foldopt.inputs.storage_section.Storage
+        With a ``target``.
+    costs : foldopt.inputs.costs_section.Costs
+    tracker_model : str
+        The study's ``tracker.model``: which drive's price the tracker takes.
+    step_hours : float
+    engine : str
+        The storage engine (``numba`` or ``numpy``).
+    in_sequence : bool
+        The days follow each other (:func:`foldopt.studies.storage_days.sequential`).
+    draw : numpy.ndarray, optional
+        The tracker's own draw [W], (n_days, n_steps).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :data:`COLUMNS`, a row per kind, fold angle and area: ``capacity_wh`` and ``cost_usd``
+        NaN where no buffer up to the sizing grid's top meets the target (``meets`` False);
+        ``frontier``, the kind's least capacity at its area (a twofold panel's best angle
+        there); ``least_cost``, the kind's cheapest row.
+    """
+    fold_angles = np.asarray(fold_angles, dtype=float)
+    drive = costs.drive_usd(tracker_model)
+    kinds = [("flat", FLAT_FOLD_ANGLE, curves["flat"], 0.0, None)]
+    kinds += [
+        ("twofold", angle, curve, costs.hinge_usd, None)
+        for angle, curve in zip(fold_angles, curves["twofold"], strict=True)
+    ]
+    if drive is not None:
+        kinds.append(("tracker-net", np.nan, curves["tracker-net"], drive, draw))
+    power = np.stack([kind[2] for kind in kinds])  # (r, n_days, n_steps)
+    n, m = len(kinds), AREA_FACTORS.size
+    # Every kind at every area at once: rows kind-major, the areas' curves the kind's scaled.
+    scaled = (power[:, None] * AREA_FACTORS[None, :, None, None]).reshape(n * m, *power.shape[1:])
+    draws = [kind[4] for kind in kinds for _ in range(m)]
+    need, monotone = smallest_buffers(
+        scaled,
+        load,
+        storage,
+        step_hours,
+        engine,
+        in_sequence,
+        None if drive is None or draw is None else draws,
+    )
+    areas = np.tile(AREA_FACTORS * area_m2, n)
+    extra = np.repeat([kind[3] for kind in kinds], m)
+    cost = areas * costs.panel_usd_per_m2 + need * costs.buffer_usd_per_wh + extra
+    table = pd.DataFrame(
+        {
+            "design": np.repeat([kind[0] for kind in kinds], m),
+            "fold_angle_deg": np.repeat([kind[1] for kind in kinds], m),
+            "area_m2": areas,
+            "capacity_wh": need,
+            "cost_usd": cost + costs.fixed_usd,
+            "meets": np.isfinite(need),
+            "monotone": monotone,
+        }
+    )
+    meets = table["meets"]
+    least_at_area = table[meets].groupby(["design", "area_m2"])["capacity_wh"].transform("min")
+    table["frontier"] = False
+    table.loc[meets, "frontier"] = table.loc[meets, "capacity_wh"] == least_at_area
+    table["least_cost"] = False
+    # Ties to the smallest area, then the least folded (rows are angle-major, areas ascending).
+    order = table[meets].sort_values(
+        ["design", "cost_usd", "area_m2", "fold_angle_deg"],
+        ascending=[True, True, True, False],
+        kind="stable",
+    )
+    table.loc[order.groupby("design").head(1).index, "least_cost"] = True
+    return table[list(COLUMNS)]
+
+
+#: Twofold angles the search compares: the grid's, thinned to about this many, with the angle
+#: best for powered time with the study's own buffer.
+SEARCH_ANGLES = 6
+
+
+def search_angles(fold_angles, best) -> np.ndarray:
+    """The fold angles [deg] the search compares (:data:`SEARCH_ANGLES`): the grid's
+    ``fold_angles`` thinned, with ``best`` (array_like of angles of the grid)."""
+    fold_angles = np.asarray(fold_angles, dtype=float)
+    step = max(1, -(-fold_angles.size // SEARCH_ANGLES))
+    return np.union1d(fold_angles[::step], np.asarray(best, dtype=float))
+
+
+def year_design_space(
+    storage, costs, days, curves: dict, twofold, angles, *, area_m2, tracker_model, engine, draw
+) -> pd.DataFrame:
+    """:func:`design_space` per load of an annual group's days, with its ``p_load_w``.
+
+    Parameters
+    ----------
+    storage, costs
+        The study's sections.
+    days : foldopt.studies.storage_days.YearDays
+    curves : dict
+        ``flat`` and ``tracker-net`` -> power [W], (n_days, n_steps).
+    twofold : numpy.ndarray
+        The twofold panel's power at ``angles`` [W], (k, n_days, n_steps).
+    angles : numpy.ndarray
+        (k,) [deg], :func:`search_angles`.
+    area_m2 : float
+    tracker_model : str
+    engine : str
+        The storage engine.
+    draw : numpy.ndarray
+        The tracker's own draw [W], (n_days, n_steps).
+    """
+    tables = []
+    for p_load in np.asarray(days.loads, dtype=float):
+        table = design_space(
+            {**curves, "twofold": twofold},
+            angles,
+            area_m2=area_m2,
+            load=p_load if days.load_shape is None else p_load * days.load_shape[None],
+            storage=storage,
+            costs=costs,
+            tracker_model=tracker_model,
+            step_hours=days.step_hours,
+            engine=engine,
+            in_sequence=days.in_sequence,
+            draw=draw,
+        )
+        tables.append(table.assign(p_load_w=p_load))
+    columns = ["p_load_w", *COLUMNS]
+    return pd.concat(tables, ignore_index=True)[columns]
+
+
+#: How the answer names each kind.
+KIND_WORDS = {"flat": "flat", "twofold": "folded", "tracker-net": "tracker"}
+#: Groups of design_space.csv the answer's lines show (the rest are in the file).
+LINES_SHOWN = 8
+
+
+def least_cost_answer(space: pd.DataFrame, costs, target, tracker_model: str):
+    """What the answer says of the least-cost search: its lines and its part of the answer.
+
+    Parameters
+    ----------
+    space : pandas.DataFrame
+        design_space.csv: :func:`design_space`'s rows with ``p_load_w`` and a sweep's case
+        columns.
+    costs : foldopt.inputs.costs_section.Costs
+    target : foldopt.inputs.storage_section.StorageTarget
+    tracker_model : str
+
+    Returns
+    -------
+    lines : list of str
+    part : dict
+        ``costs`` (the prices, ``currency``), ``areas_m2`` (the grid's least and largest, the first
+        group's), ``tracker_searched`` and ``least_cost`` (a row per group and kind: the least-cost
+        design, ``cost_vs_flat_pct`` and ``at_grid_edge``; NaN where none meets the target).
+    """
+    keys = [c for c in space.columns if c not in COLUMNS]
+    said = f"{target.powered_h:g} h" + (
+        f" on {target.days_pct:g} % of days" if target.days_pct < 100 else " every day"
+    )
+    prices = [f"panel ${costs.panel_usd_per_m2:g}/m^2", f"buffer ${costs.buffer_usd_per_wh:g}/Wh"]
+    drive = costs.drive_usd(tracker_model)
+    for price, text in (
+        (costs.hinge_usd, "hinge"),
+        (drive, f"{tracker_model} drive"),
+        (costs.fixed_usd, "fixed"),
+    ):
+        if price:
+            prices.append(f"{text} ${price:g}")
+    areas = space["area_m2"]
+    lines = [
+        f"the cheapest panel and buffer for {said} ({', '.join(prices)}; panel areas "
+        f"{areas.min():.3g} to {areas.max():.3g} m^2):"
+    ]
+    rows = []
+    groups = list(space.groupby(keys, sort=False)) if keys else [((), space)]
+    for index, (key, group) in enumerate(groups):
+        best = _least_per_kind(group)
+        rows += [{**dict(zip(keys, np.atleast_1d(key), strict=True)), **row} for row in best]
+        if index < LINES_SHOWN:
+            label = ", ".join(
+                f"P_load {v:g}" if k == "p_load_w" else f"{k} {v}"
+                for k, v in zip(keys, np.atleast_1d(key), strict=True)
+            )
+            lines.append(f"  {label}: " + _headline(best))
+    if len(groups) > LINES_SHOWN:
+        lines.append(f"  ... and {len(groups) - LINES_SHOWN} more (design_space.csv)")
+    if drive is None:
+        lines.append(
+            f"  the {tracker_model} tracker is not searched: its drive has no price "
+            f"(costs.{DRIVE_FIELD[tracker_model]})"
+        )
+    edge = [r for r in rows if r["at_grid_edge"]]
+    if edge:
+        lines.append(
+            "note: the least cost of "
+            + ", ".join(sorted({KIND_WORDS[r['design']] for r in edge}))
+            + " lies at an end of the area grid: a panel beyond it may cost less (design_space.csv)"
+        )
+    part = {
+        "costs": {**costs.model_dump(), "currency": "USD"},
+        "areas_m2": [float(areas.min()), float(areas.max())],
+        "tracker_searched": drive is not None,
+        "least_cost": rows,
+    }
+    return lines, part
+
+
+def _least_per_kind(group: pd.DataFrame) -> list[dict]:
+    """Each kind's least-cost row of one group (NaN where none meets the target), with
+    ``cost_vs_flat_pct`` and ``at_grid_edge`` (its area the grid's least or largest)."""
+    out = []
+    flat = group[(group["design"] == "flat") & group["least_cost"]]
+    flat_cost = float(flat["cost_usd"].iloc[0]) if len(flat) else np.nan
+    for kind in dict.fromkeys(group["design"]):
+        chosen = group[(group["design"] == kind) & group["least_cost"]]
+        if not len(chosen):
+            out.append(
+                {"design": kind, "meets": False, "at_grid_edge": False}
+                | dict.fromkeys(("fold_angle_deg", "area_m2", "capacity_wh", "cost_usd"), np.nan)
+                | {"cost_vs_flat_pct": np.nan}
+            )
+            continue
+        row = chosen.iloc[0]
+        edge = row["area_m2"] in (group["area_m2"].min(), group["area_m2"].max())
+        out.append(
+            {
+                "design": kind,
+                "meets": True,
+                "fold_angle_deg": float(row["fold_angle_deg"]),
+                "area_m2": float(row["area_m2"]),
+                "capacity_wh": float(row["capacity_wh"]),
+                "cost_usd": float(row["cost_usd"]),
+                "cost_vs_flat_pct": (float(row["cost_usd"]) / flat_cost - 1.0) * 100.0,
+                "at_grid_edge": bool(edge),
+            }
+        )
+    return out
+
+
+def _design_words(row: dict) -> str:
+    """``0.12 m^2 and 31 Wh for $X`` of a least-cost row."""
+    return f"{row['area_m2']:.3g} m^2 and {row['capacity_wh']:.3g} Wh for ${row['cost_usd']:.4g}"
+
+
+def _headline(best: list[dict]) -> str:
+    """One group's line: the cheapest kind against flat's, then the other kinds'."""
+    meeting = [r for r in best if r["meets"]]
+    if not meeting:
+        return "no kind meets the target at any area of the grid with a buffer up to the search's top"
+    cheapest = min(meeting, key=lambda r: r["cost_usd"])
+    parts = []
+    for row in [cheapest] + [r for r in best if r is not cheapest]:
+        name = KIND_WORDS[row["design"]]
+        if row["design"] == "twofold" and row["meets"]:
+            name += f" at {row['fold_angle_deg']:g} deg"
+        if not row["meets"]:
+            parts.append(f"{name}: meets it at no area of the grid")
+            continue
+        text = f"{name}: {_design_words(row)}"
+        flat = best[0]  # design_space's first kind
+        if row["design"] != "flat" and flat["meets"]:
+            pct = row["cost_vs_flat_pct"]
+            # Flat's own design is said once: here where it is not said first.
+            than = (
+                f"flat's {flat['area_m2']:.3g} m^2 and {flat['capacity_wh']:.3g} Wh"
+                if row is cheapest
+                else "flat"
+            )
+            text += (
+                ", as dear as " + than
+                if pct == 0
+                else f", {abs(pct):.0f} % {'cheaper' if pct < 0 else 'dearer'} than {than}"
+            )
+        parts.append(text)
+    return "; ".join(parts)
