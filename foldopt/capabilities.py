@@ -59,12 +59,16 @@ class Capability(typing.NamedTuple):
         The runs of :data:`RUNS` that take it into their numbers.
     instead : str
         The end of a refusal: where it is honoured, and how to leave it out.
+    needs : str
+        The capability it refines (``costs`` price a ``storage``'s buffer): where that one is
+        refused, its own refusal says it all.
     """
 
     name: str
     describes: str
     honoured: tuple
     instead: str
+    needs: str = ""
 
 
 _ALL = tuple(RUNS)
@@ -84,6 +88,7 @@ CAPABILITIES = (
         ("annual",),
         "the least-cost search runs over the days of an objective (foldopt run, sweep angle with "
         "--objective, a buffer with a target) (--set costs=null drops it)",
+        needs="storage",
     ),
     Capability(
         "weather",
@@ -167,6 +172,32 @@ def refusal(name: str, command: str, run: str) -> str:
     return f"{name}: foldopt {command} ({RUNS.describe(run)}) answers without it; {CAPABILITY[name].instead}"
 
 
+def refusals(names, command: str, run: str) -> list[str]:
+    """The lines that refuse the capabilities ``names`` a run does not honour: one each, but a
+    capability whose :attr:`~Capability.needs` is refused too is said in that one's line.
+
+    Parameters
+    ----------
+    names : iterable of str
+        Capabilities of :data:`CAPABILITIES` the request gives and its run does not honour.
+    command, run : str
+        As :func:`refusal`'s.
+
+    Returns
+    -------
+    list of str
+    """
+    names = list(dict.fromkeys(names))
+    lines = {
+        name: refusal(name, command, run) for name in names if CAPABILITY[name].needs not in names
+    }
+    for name in names:
+        needs = CAPABILITY[name].needs
+        if needs in lines:
+            lines[needs] += f"; and {name}, which goes with it"
+    return list(lines.values())
+
+
 def matrix_rows() -> list[list[str]]:
     """The capability matrix as table rows, for the docs: a header, then a row per capability,
     its name, what it is, and ``yes`` or ``refused`` per run of :data:`RUNS`.
@@ -190,4 +221,5 @@ __all__ = [
     "RUNS",
     "SET_BY_RUN",
     "refusal",
+    "refusals",
 ]

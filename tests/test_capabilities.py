@@ -37,6 +37,8 @@ TINY = {
 #: Each capability as the fields that give it: chosen so that it moves every run's numbers.
 GIVEN = {
     "storage": {"storage": {"capacity_wh": 20.0}},
+    "costs": {"storage": {"capacity_wh": 20.0, "target": {"powered_h": 12.0}},
+              "costs": {"panel_usd_per_m2": 150.0, "buffer_usd_per_wh": 0.5}},
     "weather": {"weather": WEATHER},
     "weather.members": {"weather": {"path": WEATHER, "members": 2}, "objective": "mean"},
     "site.horizon": {"site": {"latitude": 36.1, "longitude": -79.95,

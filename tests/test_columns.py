@@ -41,7 +41,7 @@ COMMANDS = {
     "size": ["size", "--cost-per-m2", "164", "--areas", "0.02:0.3:0.05"],
     "size-storage": ["size", CONFIGS / "measured-minutes.yaml", "--storage", "--target-h", "24", "--set",
                      "storage.target.days_pct=60", "--set", "p_load=0.5", "--set", "fold_angles.step=30", "--set",
-                     "pv_model=ideal"],
+                     "pv_model=ideal", "--set", "costs.panel_usd_per_m2=150", "--set", "costs.buffer_usd_per_wh=0.5"],
     "reproduce": ["reproduce"],
     "optimize": ["run", CONFIGS / "optimize.yaml", "--set", "date='1:365:120'", "--set",
                  "optimize.tilt={min: 0, max: 90, step: 10}", "--set",

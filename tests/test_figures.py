@@ -16,7 +16,8 @@ import pandas as pd
 import pytest
 
 import foldopt
-from foldopt.output.figures import FIGURES, annual, day, horizon, landscape, sizing, storage, sweep, weather, world
+from foldopt.output.figures import (FIGURES, annual, day, horizon, landscape, least_cost, sizing, storage, sweep,
+                                    weather, world)
 
 ROOT = Path(__file__).resolve().parent.parent
 #: The figures themselves: drawn whole, pixels and all (tests/conftest.py draws others' without).
@@ -32,7 +33,7 @@ def test_the_registry_is_the_figures_of_the_examples():
 
 def test_the_registry_is_every_kind_once_and_draws_with_public_functions():
     kinds = [day.FIGURES, storage.FIGURES, sweep.FIGURES, annual.FIGURES, weather.FIGURES, horizon.FIGURES,
-             world.FIGURES, sizing.FIGURES, landscape.FIGURES]
+             world.FIGURES, sizing.FIGURES, landscape.FIGURES, least_cost.FIGURES]
     assert sum(len(kind) for kind in kinds) == len(FIGURES)  # no file name in two kinds
     for file, figure in FIGURES.items():
         assert file.endswith(".png") and figure.description

@@ -410,7 +410,20 @@ COLUMNS = (
     # sizing
     ("area_m2", "m2", "the panel's area"),
     ("benefit_usd", "usd", "lifetime benefit C_grid x t_solar x P_load (Shin et al. Eq. 7)"),
-    ("cost_usd", "usd", "the panel's cost"),
+    (
+        "cost_usd",
+        "usd",
+        "the panel's cost (foldopt size); a design's, panel, buffer, hinge or drive and fixed "
+        "costs (design_space.csv)",
+    ),
+    # the least-cost search (design_space.csv)
+    ("meets", "", "some buffer up to the sizing grid's top meets storage.target at this area"),
+    (
+        "frontier",
+        "",
+        "the design's least buffer at this area (a twofold panel's best fold angle there)",
+    ),
+    ("least_cost", "", "the design's cheapest row that meets the target"),
     ("net_benefit_usd", "usd", "benefit less cost"),
     # reproduction
     ("quantity", "", "a reproduced quantity of Shin et al., named by this grammar"),

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from foldopt.cache import offline_mode
-from foldopt.capabilities import COMMAND_RUNS, COMMANDS, SET_BY_RUN, refusal
+from foldopt.capabilities import COMMAND_RUNS, COMMANDS, SET_BY_RUN, refusal, refusals
 from foldopt.engine.choice import engine_for
 from foldopt.errors import ConfigError
 from foldopt.inputs import policy
@@ -755,11 +755,15 @@ def _refuse_unhonoured(command: str, run: str, study) -> None:
     if run not in COMMAND_RUNS[command]:
         # A study's optimize section would make a sweep a joint search: refused, not followed.
         run = COMMAND_RUNS[command][0]
-    errors = [
-        refusal(capability.name, command, run)
-        for capability in CAPABILITIES
-        if run not in capability.honoured and _HAS[capability.name](study)
-    ]
+    errors = refusals(
+        (
+            capability.name
+            for capability in CAPABILITIES
+            if run not in capability.honoured and _HAS[capability.name](study)
+        ),
+        command,
+        run,
+    )
     if errors:
         raise ConfigError(errors)
 
@@ -876,8 +880,10 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
         errors.append(refusal("weather.members", "map", "map"))
     site = data.get("site")
     horizon = site.get("horizon") if isinstance(site, dict) else None
+    given = []
     for name, present in (
         ("storage", data.get("storage") is not None or policy.touched(flat, "storage")),
+        ("costs", data.get("costs") is not None or policy.touched(flat, "costs")),
         ("load_profile", data.get("load_profile") is not None or "load_profile" in flat),
         ("site.horizon", horizon is not None),
         (
@@ -887,13 +893,14 @@ def _map_request(data, embedded, changes, labels, options, where, source) -> Req
             or flat.get("panel.planes") is not None,
         ),
     ):
-        if present:
+        if present and name == "site.horizon":
             errors.append(
-                refusal(name, "map", "map")
-                if name != "site.horizon"
-                else "site.horizon: a horizon is of one site; give each site its own in the "
+                "site.horizon: a horizon is of one site; give each site its own in the "
                 "--sites CSV's horizon column"
             )
+        elif present:
+            given.append(name)
+    errors += refusals(given, "map", "map")
     if errors:
         raise ConfigError(list(dict.fromkeys(errors)))
     weather = {
