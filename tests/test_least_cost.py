@@ -153,6 +153,21 @@ def test_the_least_cost_design_is_the_brute_force_grid_s_of_each_kind():
         assert not _meets(scaled, [row["capacity_wh"] * 0.995], draw)[0], kind
 
 
+def test_every_row_s_capacity_meets_the_target_and_its_bracket_s_bottom_does_not():
+    # The frontier's rows not refined are the sizing grid's capacities: each meets the target
+    # at its area, and the grid's capacity below it does not.
+    space, curves = _search(), _curves()
+    rows = {"flat": [curves["flat"]], "tracker-net": [curves["tracker-net"]],
+            "twofold": list(curves["twofold"])}  # fmt: skip
+    for row in space[space["meets"]].itertuples():
+        index = 0 if row.design != "twofold" else list(ANGLES).index(row.fold_angle_deg)
+        scaled = rows[row.design][index] * row.area_m2 / AREA
+        draw = DRAW if row.design == "tracker-net" else None
+        below = row.capacity_wh * (1 - row.capacity_bracket_frac) * (1 - 1e-9)
+        said = [True, row.capacity_wh == 0]  # no buffer at all: nothing below it
+        assert _meets(scaled, [row.capacity_wh, below], draw).tolist() == said, row
+
+
 def test_a_free_buffer_makes_the_least_cost_the_smallest_area_that_meets_with_any_buffer():
     free = Costs(panel_usd_per_m2=150, buffer_usd_per_wh=0, drive_dual_axis_usd=10)
     space = _search(free)

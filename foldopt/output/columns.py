@@ -419,6 +419,12 @@ COLUMNS = (
     # the least-cost search (design_space.csv)
     ("meets", "", "some buffer up to the sizing grid's top meets storage.target at this area"),
     (
+        "capacity_bracket_frac",
+        "frac",
+        "how far below capacity_wh the least buffer meeting the target may lie: the sizing's "
+        "tolerance where the search refined the row, else its grid's step (design_space.csv)",
+    ),
+    (
         "frontier",
         "",
         "the design's least buffer at this area (a twofold panel's best fold angle there)",

@@ -5,36 +5,48 @@ battery bank's sizes for the least net present cost among those meeting a capaci
 constraint [1]_, here with the fold angle beside them and the buffer simulated on the study's
 own steps.
 
-The search (:func:`design_space`): for each kind (``flat``; ``twofold`` at each fold angle the
-day's sizing compares, :data:`~foldopt.studies.storage_days.SIZING_ANGLES` of the study's grid
-and the best for powered time; ``tracker-net``, the study's tracker with its drive's draw served
+The search (:func:`design_space`): for each kind (``flat``; ``twofold`` at each fold angle of
+:func:`search_angles`, :data:`SEARCH_ANGLES` of the study's grid with the angles best for
+``t_solar`` and for powered time; ``tracker-net``, the study's tracker with its drive's draw served
 by the buffer, where its drive has a price) and each panel area of a geometric grid around the
-study's (:data:`AREA_FACTORS`, a quarter to four times it), the smallest buffer reaching
-``storage.target`` (:func:`foldopt.studies.storage_sizing.smallest_buffers`, within its
-:data:`~foldopt.studies.storage_sizing.CAPACITY_RTOL`; none above its grid's top, four days' load
-energy over the usable fraction). An area's power is the study's power curve scaled by the area's
-ratio: exact where the PV model's power is proportional to the area, as ``ideal``'s and
-``pvwatts``' are (their rating is efficiency x area x 1000 W/m^2; a given ``pvwatts.pdc0`` is
-scaled at its W/m^2), and the study refuses the section for a model with an I-V curve
-(:func:`foldopt.inputs.costs_section.costs_problem`); a tracker's drive draws what it draws at
-any area. A design's cost is ``area x panel_usd_per_m2 + capacity x buffer_usd_per_wh``, plus the
-hinge (twofold) or the drive (tracker), plus ``fixed_usd``. The least-cost design of a kind is the
-cheapest of its areas' and angles' (ties to the smallest area, then the least folded): the answer
-is as fine as the area grid (steps of 2^(1/4), 19 %), and exact in the capacity at each area.
+study's (:data:`AREA_FACTORS`: a quarter to four times it, steps of 2^(1/4), 19 %), the smallest
+buffer meeting ``storage.target``; none above the sizing grid's top, four days' load energy over
+the usable fraction (:func:`foldopt.studies.storage_sizing.capacity_grid`). An area's power is
+the study's power curve scaled by the area's ratio: exact where the PV model's power is
+proportional to the area, as ``ideal``'s and ``pvwatts``' are (their rating is efficiency x area x
+1000 W/m^2; a given ``pvwatts.pdc0`` is scaled at its W/m^2), and the study refuses the section for
+a model with an I-V curve (:func:`foldopt.inputs.costs_section.costs_problem`) rather than scale
+what does not scale; a tracker's drive draws what it draws at any area. A design's cost is ``area
+x panel_usd_per_m2 + capacity x buffer_usd_per_wh``, plus the hinge (twofold) or the drive
+(tracker), plus ``fixed_usd``.
 
-What rests on the sizing's premise rests here too: where a larger buffer can run the load less (a
-hysteresis band or a leak, :mod:`foldopt.studies.storage_sizing`), the capacity is the least
-evaluated that reaches the target, and ``monotone`` says whether every larger one of the grid
-does too.
+It runs in two steps, every design's curves through the engine together:
+
+1. **the frontier on the grids** (:func:`_grid_bounds`): for each capacity of the sizing's grid,
+   the least area meeting the target, bisected over the areas (a capacity that meets the target at
+   an area meets it at every larger one); at each area, the least capacity of the grid meeting
+   it and the one below it, which does not, bound the least capacity between them;
+2. **branch and bound**: a row whose cost at its lower bound is below its kind's least cost at
+   an upper bound is sized exactly (:func:`foldopt.studies.storage_sizing.smallest_buffers`,
+   within its :data:`~foldopt.studies.storage_sizing.CAPACITY_RTOL`); the others cannot be the
+   least. The least-cost design of a kind is the cheapest row sized (ties to the smallest area,
+   then the least folded): exact in the capacity, and as fine as the area grid.
+
+Both steps rest on the sizing's premise, powered time not falling as the buffer or the panel
+grows: it holds for a controller without hysteresis and a buffer that does not leak
+(:mod:`foldopt.studies.storage_sizing`); with a hysteresis band or a leak a larger design can run
+the load less, and the search may miss a design meeting the target between two that do not.
 
 The module may import numpy, pandas, :mod:`foldopt.inputs` and
 :mod:`foldopt.studies.storage_sizing`.
 
 References
 ----------
-.. [1] UL Solutions (HOMER Energy), "HOMER Pro 3.16 User Manual": "How HOMER calculates ... the
-   optimal system" (the optimizer's search space of component sizes, ranked by net present cost)
-   and "Maximum Annual Capacity Shortage" (the reliability constraint a feasible system meets).
+.. [1] UL Solutions (HOMER Energy), "HOMER Pro 3.16 User Manual": Design > Project tab >
+   Optimization (support.ul-renewables.com/homer-manuals-pro/optimization.html): the systems
+   simulated over a search space of component sizes (PV, storage) between a lower and an upper
+   bound, ranked by net present cost; Constraints: the maximum annual capacity shortage a
+   feasible system meets (0 % by default, the load fully supplied).
 """
 
 from __future__ import annotations
@@ -44,11 +56,18 @@ import pandas as pd
 
 from foldopt.inputs.costs_section import DRIVE_FIELD
 from foldopt.names import FLAT_FOLD_ANGLE
-from foldopt.studies.storage_sizing import smallest_buffers
+from foldopt.studies.storage_sizing import (
+    CAPACITY_RTOL,
+    capacity_grid,
+    reaching,
+    smallest_buffers,
+)
 
 #: The panel areas searched, as multiples of the study's [-]: a quarter to four times it in
 #: steps of 2^(1/4).
 AREA_FACTORS = 2.0 ** np.arange(-2.0, 2.0 + 1e-9, 0.25)
+#: Bytes of the curves one evaluation of the search holds at once.
+CURVE_BYTES = 100e6
 #: The kinds of design searched, in the answer's order (a tracker where its drive has a price).
 KINDS = ("flat", "twofold", "tracker-net")
 #: design_space.csv's columns, in order.
@@ -57,11 +76,11 @@ COLUMNS = (
     "fold_angle_deg",
     "area_m2",
     "capacity_wh",
+    "capacity_bracket_frac",
     "cost_usd",
     "meets",
     "frontier",
     "least_cost",
-    "monotone",
 )
 
 
@@ -112,6 +131,8 @@ def design_space(
     pandas.DataFrame
         :data:`COLUMNS`, a row per kind, fold angle and area: ``capacity_wh`` and ``cost_usd``
         NaN where no buffer up to the sizing grid's top meets the target (``meets`` False);
+        ``capacity_bracket_frac``, how far below ``capacity_wh`` the least capacity meeting it
+        may lie (the sizing's tolerance where the row was refined, else the grid's step);
         ``frontier``, the kind's least capacity at its area (a twofold panel's best angle
         there); ``least_cost``, the kind's cheapest row.
     """
@@ -126,30 +147,41 @@ def design_space(
         kinds.append(("tracker-net", np.nan, curves["tracker-net"], drive, draw))
     power = np.stack([kind[2] for kind in kinds])  # (r, n_days, n_steps)
     n, m = len(kinds), AREA_FACTORS.size
-    # Every kind at every area at once: rows kind-major, the areas' curves the kind's scaled.
+    # Every kind at every area: rows kind-major, the areas' curves the kind's scaled.
     scaled = (power[:, None] * AREA_FACTORS[None, :, None, None]).reshape(n * m, *power.shape[1:])
     draws = [kind[4] for kind in kinds for _ in range(m)]
-    need, monotone = smallest_buffers(
-        scaled,
-        load,
-        storage,
-        step_hours,
-        engine,
-        in_sequence,
-        None if drive is None or draw is None else draws,
-    )
+    if drive is None or draw is None:
+        draws = None
+    run = (load, storage, step_hours, engine, in_sequence)
+    grid = capacity_grid(load, storage, step_hours, power.shape[-1])
+    upper, lower = _grid_bounds(scaled, draws, grid, n, run)  # (n * m,) each
     areas = np.tile(AREA_FACTORS * area_m2, n)
-    extra = np.repeat([kind[3] for kind in kinds], m)
-    cost = areas * costs.panel_usd_per_m2 + need * costs.buffer_usd_per_wh + extra
+    extra = np.repeat([kind[3] for kind in kinds], m) + costs.fixed_usd
+    names = np.repeat([kind[0] for kind in kinds], m)
+
+    def cost(capacity):
+        return areas * costs.panel_usd_per_m2 + capacity * costs.buffer_usd_per_wh + extra
+
+    # Branch and bound: a row is refined where its cost with the least capacity it may need is
+    # below its kind's least cost with the capacity known to meet.
+    high = np.where(np.isfinite(upper), cost(upper), np.inf)
+    bound = pd.Series(high).groupby(names).transform("min").to_numpy()
+    refine = np.flatnonzero(np.isfinite(upper) & (cost(lower) <= bound))
+    need, bracket = upper.copy(), np.where(upper > 0, (upper - lower) / upper, 0.0)
+    if refine.size:
+        found, _ = smallest_buffers(
+            scaled[refine], *run, None if draws is None else [draws[i] for i in refine]
+        )
+        need[refine], bracket[refine] = found, np.where(found > 0, CAPACITY_RTOL, 0.0)
     table = pd.DataFrame(
         {
-            "design": np.repeat([kind[0] for kind in kinds], m),
+            "design": names,
             "fold_angle_deg": np.repeat([kind[1] for kind in kinds], m),
             "area_m2": areas,
             "capacity_wh": need,
-            "cost_usd": cost + costs.fixed_usd,
+            "capacity_bracket_frac": np.where(np.isfinite(need), bracket, np.nan),
+            "cost_usd": cost(need),
             "meets": np.isfinite(need),
-            "monotone": monotone,
         }
     )
     meets = table["meets"]
@@ -157,14 +189,66 @@ def design_space(
     table["frontier"] = False
     table.loc[meets, "frontier"] = table.loc[meets, "capacity_wh"] == least_at_area
     table["least_cost"] = False
-    # Ties to the smallest area, then the least folded (rows are angle-major, areas ascending).
-    order = table[meets].sort_values(
+    # Ties to the smallest area, then the least folded; only refined rows can be the least.
+    chosen = table.iloc[refine][meets.iloc[refine].to_numpy()]
+    order = chosen.sort_values(
         ["design", "cost_usd", "area_m2", "fold_angle_deg"],
         ascending=[True, True, True, False],
         kind="stable",
     )
     table.loc[order.groupby("design").head(1).index, "least_cost"] = True
     return table[list(COLUMNS)]
+
+
+def _grid_bounds(scaled, draws, grid, n_kinds, run):
+    """Each row's least capacity of the sizing's ``grid`` [Wh] meeting the target (NaN: none)
+    and the grid's capacity below it (which does not; 0 where the least is the grid's first),
+    found per capacity by bisecting the areas of each kind: a capacity that meets the target at
+    an area meets it at every larger one (the premise of the sizing, with the area for the
+    capacity), so that each capacity's least area takes log2(areas) evaluations.
+
+    Parameters
+    ----------
+    scaled : numpy.ndarray
+        (n_kinds x n_areas, n_days, n_steps) [W], kind-major.
+    draws : list or None
+        Per row, its own draw (or None).
+    grid : numpy.ndarray
+        (g,) ascending [Wh].
+    n_kinds : int
+    run : tuple
+        ``(load, storage, step_hours, engine, in_sequence)``.
+    """
+    n_areas = scaled.shape[0] // n_kinds
+    # Per kind and capacity: the least area index meeting the target lies in [lo, hi] (n_areas:
+    # none does).
+    lo = np.zeros((n_kinds, grid.size), dtype=int)
+    hi = np.full((n_kinds, grid.size), n_areas)
+    while (open_ := lo < hi).any():
+        mid = (lo + hi) // 2
+        k, j = np.nonzero(open_)
+        rows = k * n_areas + mid[k, j]
+        # A chunk of rows' curves at a time (their copies are the memory).
+        size = max(1, int(CURVE_BYTES // scaled[0].nbytes))
+        ok = np.concatenate(
+            [
+                reaching(
+                    scaled[rows[at : at + size]],
+                    grid[j[at : at + size]],
+                    *run,
+                    None if draws is None else [draws[row] for row in rows[at : at + size]],
+                )
+                for at in range(0, rows.size, size)
+            ]
+        )
+        hi[k[ok], j[ok]] = mid[k[ok], j[ok]]
+        lo[k[~ok], j[~ok]] = mid[k[~ok], j[~ok]] + 1
+    # At each area, the least capacity whose least area is at or below it.
+    meets = lo[:, None, :] <= np.arange(n_areas)[None, :, None]  # (kinds, areas, grid)
+    first = np.where(meets.any(axis=2), np.argmax(meets, axis=2), -1).ravel()
+    upper = np.where(first >= 0, grid[np.maximum(first, 0)], np.nan)
+    lower = np.where(first > 0, grid[np.maximum(first - 1, 0)], np.where(first == 0, 0.0, np.nan))
+    return upper, lower
 
 
 #: Twofold angles the search compares: the grid's, thinned to about this many, with the angle
@@ -289,7 +373,7 @@ def least_cost_answer(space: pd.DataFrame, costs, target, tracker_model: str):
     if edge:
         lines.append(
             "note: the least cost of "
-            + ", ".join(sorted({KIND_WORDS[r['design']] for r in edge}))
+            + ", ".join(sorted({KIND_WORDS[r["design"]] for r in edge}))
             + " lies at an end of the area grid: a panel beyond it may cost less (design_space.csv)"
         )
     part = {
@@ -342,7 +426,9 @@ def _headline(best: list[dict]) -> str:
     """One group's line: the cheapest kind against flat's, then the other kinds'."""
     meeting = [r for r in best if r["meets"]]
     if not meeting:
-        return "no kind meets the target at any area of the grid with a buffer up to the search's top"
+        return (
+            "no kind meets the target at any area of the grid with a buffer up to the search's top"
+        )
     cheapest = min(meeting, key=lambda r: r["cost_usd"])
     parts = []
     for row in [cheapest] + [r for r in best if r is not cheapest]:

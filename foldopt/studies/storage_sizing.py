@@ -532,3 +532,41 @@ def _held_above(ok, first) -> np.ndarray:
     too (the premise of a bracketed search; True where none reaches it)."""
     index = np.arange(ok.shape[1])
     return (ok | (index < first[:, None])).all(axis=1) | (first < 0)
+
+
+def reaching(power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None):
+    """(n,) bool: whether each of ``power``'s curves (n, n_days, n_steps) [W] reaches
+    ``storage.target`` at its own capacity (n,) [Wh] (:func:`reaches`), every curve in one call
+    of the engine (a call's threads cost more than a year's series).
+
+    Parameters
+    ----------
+    power : numpy.ndarray
+        (n, n_days, n_steps) [W].
+    capacities : numpy.ndarray
+        (n,) [Wh].
+    load, in_sequence
+        As :func:`_at_capacities`'.
+    draws : sequence, optional
+        Per curve, its own draw [W], (n_days, n_steps), or None (none: a draw of 0 W).
+    """
+    n, days, steps = power.shape
+    draw = (
+        None
+        if draws is None
+        else np.stack([np.zeros((days, steps)) if d is None else d for d in draws])
+    )
+    load = load if np.ndim(load) == 0 else np.broadcast_to(load, power.shape)
+    if not in_sequence:
+        # Each day its own periodic series.
+        power, capacities = power.reshape(-1, 1, steps), np.repeat(capacities, days)
+        load = load if np.ndim(load) == 0 else load.reshape(power.shape)
+        draw = None if draw is None else draw.reshape(power.shape)
+    result = simulate(
+        power, load, buffer_of(storage, capacity_wh=capacities), step_hours, engine, draw=draw
+    )
+    return _reaching(
+        result.powered_h.reshape(n, days),
+        result.converged.reshape(n, -1).all(axis=1),
+        storage.target,
+    )
