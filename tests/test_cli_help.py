@@ -258,7 +258,7 @@ RECORDED = {
     "optimize": "--vary --fold-range --tilt-range --azimuth-range --tolerance "
                 + _SWEEP.format(o="", v="*"),
     "reproduce": "--out --overwrite --quiet/-q --format --engine",
-    "run": "CONFIG --out --overwrite --quiet/-q --format --engine --table --set",
+    "run": "CONFIG --out --overwrite --quiet/-q --format --engine --table --set --target-h",
     "size": "CONFIG --areas --cost-per-m2 --cost-per-w --c-grid --years --days-per-year --out --overwrite "
             "--quiet/-q --format --table --set --storage --target-h --weather",
     "sweep angle": _SWEEP.format(o="", v=""),

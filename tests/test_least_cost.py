@@ -303,3 +303,20 @@ def test_costs_where_they_cannot_be_searched_are_refused_in_one_line(
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and said in lines[0], result.output
     assert not (tmp_path / "out").exists()
+
+
+def test_target_h_is_the_storage_target_s_hours_and_says_so_when_out_of_range(
+    tmp_path, monkeypatch
+):
+    study = ROOT / "configs" / "measured-minutes.yaml"
+    given = [f"{k}={v}" for k, v in SETTINGS.items()]
+    without = [f"{k}={v}" for k, v in SETTINGS.items() if k != "storage.target.powered_h"]
+    by_option = make_request("run", study, settings=without, target_h=24.0)
+    assert by_option.plan.base == make_request("run", study, settings=given).plan.base
+    monkeypatch.chdir(tmp_path)
+    args = _study("--target-h", "25", "--out", "out", "-q", **{"storage.target.powered_h": None})
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "--target-h" in lines[0] and "(0, 24] h" in lines[0], lines
+    assert not (tmp_path / "out").exists()

@@ -76,6 +76,13 @@ StorageWh = Annotated[
         "--set storage.<field> for the rest [default: none].",
     ),
 ]
+TargetH = Annotated[
+    float | None,
+    typer.Option(
+        "--target-h",
+        help="Hours a day the buffer must run the load, (0, 24] (storage.target.powered_h).",
+    ),
+]
 MinSoc = Annotated[
     float | None,
     typer.Option(

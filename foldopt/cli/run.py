@@ -14,6 +14,7 @@ from foldopt.cli.options import (
     Quiet,
     Settings,
     Table,
+    TargetH,
     check_choices,
     out_option,
     study_argument,
@@ -120,6 +121,7 @@ def run(
     engine: Engine = DEFAULT_ENGINE,
     table: Table = False,
     settings: Settings = None,
+    target_h: TargetH = None,
 ):
     """Run a YAML study: one case (fold-angle sweep, the paper's heuristic, flat and trackers
     compared) or a sweep of cases (a row per case x design).
@@ -134,7 +136,7 @@ def run(
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
     from foldopt.studies.request import make_request
 
-    request = make_request("run", config, settings=settings or ())
+    request = make_request("run", config, settings=settings or (), target_h=target_h)
     run_request(
         request,
         out or RESULTS / request.plan.base.name,

@@ -15,6 +15,7 @@ from foldopt.cli.options import (
     Quiet,
     Settings,
     Table,
+    TargetH,
     check_choices,
     out_option,
     study_argument,
@@ -83,10 +84,7 @@ def size(
             "to run --target-h hours a day (its storage section, else an ideal buffer).",
         ),
     ] = False,
-    target_h: Annotated[
-        float | None,
-        typer.Option("--target-h", help="With --storage: hours a day the load runs, (0, 24]."),
-    ] = None,
+    target_h: TargetH = None,
     weather: Annotated[
         Path | None,
         typer.Option(

@@ -223,7 +223,8 @@ def make_request(
         A joint search's parameters (:func:`optimize_section`'s): ``vary``, ``fold_angle``,
         ``tilt``, ``azimuth``, ``tolerance_h``, and ``labels``, how messages name them.
     target_h : float, optional
-        ``size --storage``: the hours a day the load runs (``storage.target.powered_h``).
+        ``run``, ``size --storage``: the hours a day the load runs (``storage.target.powered_h``,
+        ``--target-h``).
     where : mapping, optional
         A map's sites and how they are shown: ``sites``, ``weather_dir``, ``latitudes``,
         ``longitudes``, ``land_only``, ``show_period``, ``weather`` (a source's section) of
