@@ -35,7 +35,8 @@ def plot_design_space(space: pd.DataFrame, title: str, costs, ax=None):
     fig, ax = new_axes(ax, (7, 4.5))
     first = space[space["p_load_w"] == space["p_load_w"].iloc[0]]
     for design, colour in COLOURS.items():
-        rows = first[(first["design"] == design) & first["frontier"]].drop_duplicates("area_m2")
+        rows = first[(first["design"] == design) & first["frontier"]]
+        rows = rows.drop_duplicates("area_m2").sort_values("area_m2")
         if not len(rows):
             continue
         ax.plot(rows["area_m2"], rows["capacity_wh"], "o-", ms=3, color=colour, label=design)
