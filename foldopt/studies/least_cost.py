@@ -25,7 +25,8 @@ It runs in two steps, every design's curves through the engine together:
 1. **the frontier on the grids** (:func:`_grid_bounds`): for each capacity of the sizing's grid,
    the least area meeting the target, bisected over the areas (a capacity that meets the target at
    an area meets it at every larger one); at each area, the least capacity of the grid meeting
-   it and the one below it, which does not, bound the least capacity between them;
+   it and the one below it, which does not, bound the least capacity between them (both
+   evaluated at the area: a row where either is not what the premise says is sized exactly);
 2. **branch and bound**: a row whose cost at its lower bound is below its kind's least cost at
    an upper bound is sized exactly (:func:`foldopt.studies.storage_sizing.smallest_buffers`,
    within its :data:`~foldopt.studies.storage_sizing.CAPACITY_RTOL`); the others cannot be the
@@ -36,6 +37,7 @@ Both steps rest on the sizing's premise, powered time not falling as the buffer 
 grows: it holds for a controller without hysteresis and a buffer that does not leak
 (:mod:`foldopt.studies.storage_sizing`); with a hysteresis band or a leak a larger design can run
 the load less, and the search may miss a design meeting the target between two that do not.
+Every capacity the table gives was evaluated at its area and meets the target.
 
 The module may import numpy, pandas, :mod:`foldopt.inputs` and
 :mod:`foldopt.studies.storage_sizing`.
@@ -147,14 +149,18 @@ def design_space(
         kinds.append(("tracker-net", np.nan, curves["tracker-net"], drive, draw))
     power = np.stack([kind[2] for kind in kinds])  # (r, n_days, n_steps)
     n, m = len(kinds), AREA_FACTORS.size
-    # Every kind at every area: rows kind-major, the areas' curves the kind's scaled.
-    scaled = (power[:, None] * AREA_FACTORS[None, :, None, None]).reshape(n * m, *power.shape[1:])
+
+    def scaled(rows):
+        # Rows kind-major, each an area's curve: its kind's scaled (made when evaluated, a
+        # chunk at a time: every row's at once would hold n x m curves).
+        return power[rows // m] * AREA_FACTORS[rows % m, None, None]
+
     draws = [kind[4] for kind in kinds for _ in range(m)]
     if drive is None or draw is None:
         draws = None
     run = (load, storage, step_hours, engine, in_sequence)
     grid = capacity_grid(load, storage, step_hours, power.shape[-1])
-    upper, lower = _grid_bounds(scaled, draws, grid, n, run)  # (n * m,) each
+    upper, lower = _grid_bounds(scaled, draws, grid, (n, m), run)  # (n * m,) each
     areas = np.tile(AREA_FACTORS * area_m2, n)
     extra = np.repeat([kind[3] for kind in kinds], m) + costs.fixed_usd
     names = np.repeat([kind[0] for kind in kinds], m)
@@ -166,11 +172,18 @@ def design_space(
     # below its kind's least cost with the capacity known to meet.
     high = np.where(np.isfinite(upper), cost(upper), np.inf)
     bound = pd.Series(high).groupby(names).transform("min").to_numpy()
-    refine = np.flatnonzero(np.isfinite(upper) & (cost(lower) <= bound))
+    refine = np.isfinite(upper) & (cost(lower) <= bound)
+    # The bounds are the premise's: a row whose upper bound does not meet the target at its own
+    # area, or whose lower one does, is sized too, so that every capacity said was evaluated.
+    known = np.flatnonzero(np.isfinite(upper))
+    below = known[lower[known] > 0]
+    refine[known[~_reach(scaled, draws, known, upper[known], run)]] = True
+    refine[below[_reach(scaled, draws, below, lower[below], run)]] = True
+    refine = np.flatnonzero(refine)
     need, bracket = upper.copy(), np.where(upper > 0, (upper - lower) / upper, 0.0)
     if refine.size:
         found, _ = smallest_buffers(
-            scaled[refine], *run, None if draws is None else [draws[i] for i in refine]
+            scaled(refine), *run, None if draws is None else [draws[i] for i in refine]
         )
         need[refine], bracket[refine] = found, np.where(found > 0, CAPACITY_RTOL, 0.0)
     table = pd.DataFrame(
@@ -200,7 +213,26 @@ def design_space(
     return table[list(COLUMNS)]
 
 
-def _grid_bounds(scaled, draws, grid, n_kinds, run):
+def _reach(scaled, draws, rows, capacities, run) -> np.ndarray:
+    """(r,) bool: whether each of ``rows`` meets the target at its capacity (r,) [Wh]
+    (:func:`foldopt.studies.storage_sizing.reaching`), a chunk of rows' curves at a time (their
+    copies are the memory); ``scaled``, ``draws`` and ``run`` as :func:`_grid_bounds`'."""
+    size = max(1, int(CURVE_BYTES // scaled(np.zeros(1, int)).nbytes))
+    return np.concatenate(
+        [np.zeros(0, bool)]
+        + [
+            reaching(
+                scaled(rows[at : at + size]),
+                capacities[at : at + size],
+                *run,
+                None if draws is None else [draws[row] for row in rows[at : at + size]],
+            )
+            for at in range(0, rows.size, size)
+        ]
+    )
+
+
+def _grid_bounds(scaled, draws, grid, shape, run):
     """Each row's least capacity of the sizing's ``grid`` [Wh] meeting the target (NaN: none)
     and the grid's capacity below it (which does not; 0 where the least is the grid's first),
     found per capacity by bisecting the areas of each kind: a capacity that meets the target at
@@ -209,17 +241,18 @@ def _grid_bounds(scaled, draws, grid, n_kinds, run):
 
     Parameters
     ----------
-    scaled : numpy.ndarray
-        (n_kinds x n_areas, n_days, n_steps) [W], kind-major.
+    scaled : callable
+        Rows (r,) of the kinds' areas, kind-major -> their curves (r, n_days, n_steps) [W].
     draws : list or None
         Per row, its own draw (or None).
     grid : numpy.ndarray
         (g,) ascending [Wh].
-    n_kinds : int
+    shape : tuple
+        ``(n_kinds, n_areas)``.
     run : tuple
         ``(load, storage, step_hours, engine, in_sequence)``.
     """
-    n_areas = scaled.shape[0] // n_kinds
+    n_kinds, n_areas = shape
     # Per kind and capacity: the least area index meeting the target lies in [lo, hi] (n_areas:
     # none does).
     lo = np.zeros((n_kinds, grid.size), dtype=int)
@@ -227,20 +260,7 @@ def _grid_bounds(scaled, draws, grid, n_kinds, run):
     while (open_ := lo < hi).any():
         mid = (lo + hi) // 2
         k, j = np.nonzero(open_)
-        rows = k * n_areas + mid[k, j]
-        # A chunk of rows' curves at a time (their copies are the memory).
-        size = max(1, int(CURVE_BYTES // scaled[0].nbytes))
-        ok = np.concatenate(
-            [
-                reaching(
-                    scaled[rows[at : at + size]],
-                    grid[j[at : at + size]],
-                    *run,
-                    None if draws is None else [draws[row] for row in rows[at : at + size]],
-                )
-                for at in range(0, rows.size, size)
-            ]
-        )
+        ok = _reach(scaled, draws, k * n_areas + mid[k, j], grid[j], run)
         hi[k[ok], j[ok]] = mid[k[ok], j[ok]]
         lo[k[~ok], j[~ok]] = mid[k[~ok], j[~ok]] + 1
     # At each area, the least capacity whose least area is at or below it.
