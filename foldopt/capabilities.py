@@ -85,9 +85,9 @@ CAPABILITIES = (
         "costs",
         "prices of panel, buffer, hinge and tracker drive: the cheapest panel and buffer of each "
         "kind meeting storage.target (design_space.csv)",
-        ("annual",),
-        "the least-cost search runs over the days of an objective (foldopt run, sweep angle with "
-        "--objective, a buffer with a target) (--set costs=null drops it)",
+        ("day", "annual"),
+        "the least-cost search sizes a buffer with a target over one day or the days of an "
+        "objective (foldopt run, sweep angle) (--set costs=null drops it)",
         needs="storage",
     ),
     Capability(

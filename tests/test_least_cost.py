@@ -295,9 +295,9 @@ def test_bad_costs_are_one_line_and_exit_2(tmp_path, monkeypatch, setting, said)
 @pytest.mark.parametrize(
     "changes, said",
     [
-        # a clear day: the search runs over an objective's days
-        ({"objective": "null", "weather": "null", "date": "2019-02-10"},
-         "costs: foldopt run (one site and day)"),
+        # a plan of clear days, each its own best angle: no buffer over days, said in one line
+        ({"objective": "null", "weather": "null", "date": "'2019-02-10:2019-02-12:1'"},
+         "and costs, which goes with it"),
         ({"storage.target.powered_h": None, "storage.target.days_pct": None},
          "costs: the least-cost search sizes the buffer for"),
         ({"pv_model": "single-diode"}, "pv_model single-diode's I-V curve"),
@@ -329,3 +329,23 @@ def test_target_h_is_the_storage_target_s_hours_and_says_so_when_out_of_range(
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and "--target-h" in lines[0] and "(0, 24] h" in lines[0], lines
     assert not (tmp_path / "out").exists()
+
+
+def test_a_day_s_study_searches_its_clear_day_and_writes_the_table(tmp_path, monkeypatch):
+    # camera-buffer's clear day repeated to its periodic state: the least-cost line, the table
+    # and the figure, the JSON's part the API's to the bit.
+    monkeypatch.chdir(tmp_path)
+    args = ["run", str(ROOT / "configs" / "camera-buffer.yaml"), "--set", "step_min=10",
+            "--set", "fold_angles.step=20", "--set", "costs.panel_usd_per_m2=150",
+            "--set", "costs.buffer_usd_per_wh=0.5", "--set", "costs.hinge_usd=1"]  # fmt: skip
+    result = runner.invoke(app, [*args, "--format", "json", "--out", "out", "-q"])
+    assert result.exit_code == 0, result.output
+    printed = json.loads(result.output)["answer"]
+    api = foldopt.run(request=make_request("run", args[1], settings=args[3::2]))
+    assert printed["result"]["least_cost"] == json.loads(
+        json.dumps(plain(api.answer.result["least_cost"]))
+    )
+    assert any(line.startswith("the cheapest panel and buffer for 24 h") for line in printed["lines"])
+    written = pd.read_csv(tmp_path / "out" / "design_space.csv")
+    assert written["least_cost"].sum() == 2  # flat and twofold: the tracker's drive has no price
+    assert (tmp_path / "out" / "design_space.png").exists()

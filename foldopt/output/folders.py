@@ -36,7 +36,8 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
     """Write a day's results folder: ``summary.csv``, ``sweep.csv``, ``timeseries.csv``,
     ``tracker_standby.csv``, the day's figures (:data:`foldopt.output.figures.day.FIGURES`),
     ``run.json`` and ``report.html``; with a buffer also ``storage_capacity.csv``,
-    ``storage_sizing.csv`` (with a target) and :data:`foldopt.output.figures.storage.FIGURES`.
+    ``storage_sizing.csv`` (with a target) and :data:`foldopt.output.figures.storage.FIGURES`;
+    with costs, ``design_space.csv`` and ``design_space.png``.
 
     Parameters
     ----------
@@ -62,6 +63,7 @@ def write_study(result: StudyResult, out: Path, overwrite: bool = False, command
             if len(result.storage.sizing.table):
                 write_csv(result.storage.sizing.table, folder / "storage_sizing.csv")
             figures += [write_figure(folder, file, result) for file in storage.FIGURES]
+            figures += _design_space(result.storage.design_space, folder, result.study)[1:]
         figures += _horizon_figure(result.study, [result.study.date], folder, result.study.name)
         write_csv(result.standby[0], folder / "tracker_standby.csv")
         metadata = run_metadata(
@@ -252,18 +254,7 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
     if "storage_annual" in extras:
         write_csv(extras["storage_annual"], folder / "storage_annual.csv")
         written.append("storage_annual.csv")
-    if "design_space" in extras:
-        write_csv(extras["design_space"], folder / "design_space.csv")
-        written += [
-            "design_space.csv",
-            write_figure(
-                folder,
-                "design_space.png",
-                extras["design_space"],
-                f"{name}: the smallest buffer meeting the target against the panel's area",
-                study.costs,
-            ),
-        ]
+    written += _design_space(extras.get("design_space"), folder, study)
     if "weather_sample" in extras:
         kind = {
             "measured": "measured minutes",
@@ -303,6 +294,16 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
             ),
         ]
     return written
+
+
+def _design_space(space, folder: Path, study) -> list[str]:
+    """The least-cost search's ``design_space.csv`` and ``design_space.png``, where the study has
+    costs; the files written, the table first."""
+    if space is None:
+        return []
+    write_csv(space, folder / "design_space.csv")
+    title = f"{study.name}: the smallest buffer meeting the target against the panel's area"
+    return ["design_space.csv", write_figure(folder, "design_space.png", space, title, study.costs)]
 
 
 def write_series(series: pd.DataFrame, folder: Path) -> str:

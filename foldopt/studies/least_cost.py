@@ -3,7 +3,8 @@ panel area, fold angle and buffer capacity chosen together at a study's prices
 (:class:`foldopt.inputs.costs_section.Costs`), as HOMER's optimizer chooses a PV array's and a
 battery bank's sizes for the least net present cost among those meeting a capacity-shortage
 constraint [1]_, here with the fold angle beside them and the buffer simulated on the study's
-own steps.
+own steps: over a weather file's days in sequence (:func:`year_design_space`), a year of clear
+days, or a day's clear sky repeated to its periodic state (:func:`day_design_space`).
 
 The search (:func:`design_space`): for each kind (``flat``; ``twofold`` at each fold angle of
 :func:`search_angles`, :data:`SEARCH_ANGLES` of the study's grid with the angles best for
@@ -325,6 +326,48 @@ def year_design_space(
         tables.append(table.assign(p_load_w=p_load))
     columns = ["p_load_w", *COLUMNS]
     return pd.concat(tables, ignore_index=True)[columns]
+
+
+def day_design_space(study, power: dict, grid: tuple, load, *, step_hours, engine, draw):
+    """:func:`design_space` of a day's study: its clear-sky day repeated to its periodic state.
+
+    Parameters
+    ----------
+    study : foldopt.Study
+        With ``storage.target`` and ``costs``.
+    power : dict
+        ``flat`` and ``tracker-net`` -> the day's power [W], (n_steps,).
+    grid : tuple
+        The fold-angle grid [deg] (k,), the twofold panel's power at each (k, n_steps) [W] and
+        the angle best for powered time with the study's buffer.
+    load : float or numpy.ndarray
+        [W], or a profile (1, n_steps).
+    step_hours : float
+    engine : str
+        The storage engine.
+    draw : numpy.ndarray or None
+        The tracker's own draw [W], (n_steps,).
+    """
+    fold_angles, grid_power, best = grid
+    angles = search_angles(fold_angles, [best])
+    table = design_space(
+        {
+            "flat": power["flat"][None],
+            "tracker-net": power["tracker-net"][None],
+            "twofold": grid_power[np.searchsorted(fold_angles, angles), None],
+        },
+        angles,
+        area_m2=study.panel.area,
+        load=load if np.ndim(load) == 0 else np.reshape(load, (1, 1, -1)),
+        storage=study.storage,
+        costs=study.costs,
+        tracker_model=study.tracker.model,
+        step_hours=step_hours,
+        engine=engine,
+        in_sequence=True,
+        draw=None if draw is None else draw[None],
+    )
+    return table.assign(p_load_w=study.p_load)[["p_load_w", *COLUMNS]]
 
 
 #: How the answer names each kind.

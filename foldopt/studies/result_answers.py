@@ -351,6 +351,11 @@ def of_study(result) -> Answer:
         # The buffer's part, said once here for every view (studies.storage_answer).
         result_part["storage"], more = answer_part(buffered)
         lines += more
+        if buffered.design_space is not None:
+            said, result_part["least_cost"] = least_cost_answer(
+                buffered.design_space, study.costs, study.storage.target, study.tracker.model
+            )
+            lines += said
         columns[3:3] = DESIGN_COLUMNS
     return Answer(
         "study",

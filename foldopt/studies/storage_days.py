@@ -26,6 +26,7 @@ import pandas as pd
 
 from foldopt.engine.choice import engine_for
 from foldopt.engine.storage import StorageResult, simulate
+from foldopt.studies.least_cost import day_design_space
 from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
 from foldopt.studies.storage_sizing import Sizing, buffer_of, size_buffers, smallest_buffers
 
@@ -109,6 +110,9 @@ class DayStorage:
     series : foldopt.engine.storage.StorageResult
         The designs' day with the buffer, in ``designs``' order: its energies, net trackers'
         with their own draw served.
+    design_space : pandas.DataFrame or None
+        With the study's ``costs``: the least-cost search's table
+        (:func:`foldopt.studies.least_cost.day_design_space`).
     """
 
     storage: object
@@ -122,6 +126,7 @@ class DayStorage:
     engine: str
     converged: bool
     series: StorageResult
+    design_space: pd.DataFrame | None = None
 
 
 class BufferedDesigns(NamedTuple):
@@ -237,6 +242,17 @@ def day_storage(
         tolerance=study.near_optimal,
         draws={name: draw for name, draw in draws.items() if name == "tracker-net"},
     )
+    space = None
+    if study.costs is not None:
+        space = day_design_space(
+            study,
+            power,
+            (fold_angles, grid_power, fold_angles[best]),
+            load,
+            step_hours=step_hours,
+            engine=engine,
+            draw=draws.get("tracker-net"),
+        )
     return DayStorage(
         storage=storage,
         designs=table,
@@ -249,6 +265,7 @@ def day_storage(
         engine=engine,
         converged=bool(result.converged.all() and grid.converged.all()),
         series=result,
+        design_space=space,
     )
 
 
