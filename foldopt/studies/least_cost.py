@@ -71,8 +71,6 @@ from foldopt.studies.storage_sizing import (
 AREA_FACTORS = 2.0 ** np.arange(-2.0, 2.0 + 1e-9, 0.25)
 #: Bytes of the curves one evaluation of the search holds at once.
 CURVE_BYTES = 100e6
-#: The kinds of design searched, in the answer's order (a tracker where its drive has a price).
-KINDS = ("flat", "twofold", "tracker-net")
 #: design_space.csv's columns, in order.
 COLUMNS = (
     "design",
@@ -177,7 +175,7 @@ def design_space(
     # The bounds are the premise's: a row whose upper bound does not meet the target at its own
     # area, or whose lower one does, is sized too, so that every capacity said was evaluated.
     known = np.flatnonzero(np.isfinite(upper))
-    below = known[lower[known] > 0]
+    below = known[upper[known] > 0]
     refine[known[~_reach(scaled, draws, known, upper[known], run)]] = True
     refine[below[_reach(scaled, draws, below, lower[below], run)]] = True
     refine = np.flatnonzero(refine)
