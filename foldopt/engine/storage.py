@@ -31,6 +31,17 @@ covers its deficit with the load's, and the controller cuts it off and reconnect
 load; while they are off, the design's whole power charges the buffer. (A tracker whose drive is
 off holds still; the power it would then lose is not modelled.)
 
+The buffer's temperature (``cold``, :class:`ColdSteps`: its effects at each step) acts per
+segment at the segment's coldest end, the temperature being linear between step centres as the
+power is (a charger blocked at some instant of a segment is taken as blocked over all of it): the
+buffer charges over a segment only where it may at both its ends, and so discharges; the share of
+the usable range the cold puts out of reach is the larger of the two ends', and raises the cut-off
+and the reconnection (:func:`foldopt.physics.buffer_temperature.cold_cut_off`: the energy is still
+stored, out of reach until warm); the self-discharge's factor is the mean of the two ends'. A
+blocked charge loses the surplus (*lost*, as over a full buffer; with the load off, all the power);
+a blocked discharge turns the load off where PV alone does not carry it, as ``max_discharge_w``
+does. Without ``cold`` (or with effects that change nothing) every answer is the same to the bit.
+
 Conventions that follow from it:
 
 - With ``capacity_wh = 0`` the load runs exactly in the parts at or above the load: the powered
@@ -52,6 +63,11 @@ Conventions that follow from it:
 - Days *full* and *empty* are PVGIS's [1]_: days on which the buffer was full at some instant
   (never with no capacity), and days on which it was down to its cut-off at some instant (at
   midnight, or when it ran out under the load; with no capacity, every day).
+- A colder series does not power more, other things equal, where the self-discharge does not
+  depend on the temperature and the controller has no hysteresis: a blocked charge or discharge
+  and a raised cut-off only take energy away. A leak that slows in the cold can leave more
+  stored, and a raised reconnection level can reconnect the load later or (a band refilled)
+  earlier.
 - Powered time does not fall as the capacity grows, or as the load falls, to within one step,
   for a controller without hysteresis (``restart_soc = min_soc``) and a buffer that does not leak
   (``tests/test_storage_engine.py``). With a hysteresis band or a leak it can: the band
@@ -129,6 +145,28 @@ class Buffer(NamedTuple):
     max_charge_w: float | None = None
     max_discharge_w: float | None = None
     initial_soc: float | None = None
+
+
+class ColdSteps(NamedTuple):
+    """What the buffer's temperature does at each step
+    (:mod:`foldopt.physics.buffer_temperature` makes them from a chemistry's data). Each field an
+    array broadcastable to (n_series or 1, n_days, n_steps) (a size 1 serves every series, day or
+    step).
+
+    Attributes
+    ----------
+    charge, discharge : array_like of bool
+        Where the buffer may charge / discharge.
+    capacity : array_like of float
+        The usable share of the capacity [-] in (0, 1].
+    leak : array_like of float
+        The self-discharge as a multiple of ``Buffer.self_discharge`` [-], 0 or more.
+    """
+
+    charge: np.ndarray
+    discharge: np.ndarray
+    capacity: np.ndarray
+    leak: np.ndarray
 
 
 class StorageResult(NamedTuple):
@@ -228,6 +266,7 @@ def simulate(
     max_iterations: int = 30,
     tolerance: float = 1e-6,
     draw=None,
+    cold: ColdSteps | None = None,
 ) -> StorageResult:
     """Simulate the state of charge of a buffer over power curves and a load.
 
@@ -258,6 +297,9 @@ def simulate(
         The design's own draw [W], 0 or more, shaped as ``load`` may be or as ``power``: a
         tracker's standby and drive, a load on the controller's output beside ``load``
         (module docstring). Default none.
+    cold : ColdSteps, optional
+        The buffer's temperature's effects at each step (module docstring); default none (a
+        buffer at a temperature that changes nothing).
 
     Returns
     -------
@@ -294,9 +336,10 @@ def simulate(
             f"power, load and buffer fields must have 1 or the same number of series; got {sizes}"
         )
     n_days, n_steps = power.shape[1:]
-    params = _parameters(buffer, n_series, step_hours)
     if not (np.isfinite(step_hours) and step_hours > 0):
         raise ValueError(f"step_hours must be above 0; got {step_hours}")
+    params = _parameters(buffer, n_series, step_hours)
+    segments = _cold_segments(cold, power.shape, n_series, params)
     if max_iterations < 1 or not tolerance >= 0:
         raise ValueError("max_iterations must be 1 or more and tolerance 0 or more")
     out = np.zeros((n_series, n_days, layout.HISTOGRAM + SOC_BINS))
@@ -311,6 +354,7 @@ def simulate(
     run(
         layout.Curves(power, load, own, float(step_hours)),
         params,
+        segments,
         layout.Days(out, state, soc, bool(soc_curves)),
         passes,
         int(max_iterations),
@@ -356,6 +400,72 @@ def _load_array(load, shape, name):
     if not (np.isfinite(load).all() and (load >= 0).all()):
         raise ValueError(f"{name} must be finite and 0 or more")
     return np.ascontiguousarray(load)
+
+
+def _cold_segments(cold, shape, n_series, params) -> layout.Cold:
+    """The steps' :class:`ColdSteps` per segment of each day, as the loops read them
+    (:class:`foldopt.engine.storage_records.Cold`; module docstring): at each segment the colder
+    end's charge, discharge and capacity, the mean of the two ends' leak factors."""
+    if cold is None:
+        nothing = np.ones((1, 1, 1))
+        return layout.Cold(nothing, nothing, 0.0 * nothing, np.full((1, 1, 1), np.nan))
+    n_days, n_steps = shape[1:]
+
+    def per_step(name, values):
+        values = np.asarray(values, dtype=float)
+        values = (
+            values.reshape((1,) * (3 - values.ndim) + values.shape) if values.ndim < 3 else values
+        )
+        if values.ndim != 3 or values.shape[0] not in (1, n_series):
+            raise ValueError(
+                f"cold {name} must broadcast to (n_series or 1, n_days, n_steps) for power of "
+                f"{shape} and {n_series} series; got {np.shape(values)}"
+            )
+        try:
+            return np.broadcast_to(values, (values.shape[0], n_days, n_steps))
+        except ValueError:
+            raise ValueError(
+                f"cold {name} must broadcast to (n_series or 1, n_days, n_steps) for power of "
+                f"{shape}; got {values.shape}"
+            ) from None
+
+    def ends(values):
+        return (
+            np.concatenate([values[..., :1], values], axis=-1),
+            np.concatenate([values, values[..., -1:]], axis=-1),
+        )
+
+    charge, discharge = (
+        np.minimum(*ends(per_step(name, getattr(cold, name)) > 0.0))
+        for name in ("charge", "discharge")
+    )
+    capacity = per_step("capacity", cold.capacity)
+    leak = per_step("leak", cold.leak)
+    if (
+        not ((capacity > 0.0) & (capacity <= 1.0)).all()
+        or not ((leak >= 0.0) & np.isfinite(leak)).all()
+    ):
+        raise ValueError("cold capacity must be in (0, 1] and cold leak 0 or more (finite)")
+    cut = 1.0 - np.minimum(*ends(capacity))
+    a, b = ends(leak)
+    factor = 0.5 * (a + b)
+    if (factor == 1.0).all():
+        keep = np.full((1, 1, 1), np.nan)
+    else:
+        # The buffer's own share kept over each segment, raised to the factor (the rate's
+        # multiple); where the factor is 1, the buffer's own to the bit.
+        half = np.zeros(n_steps + 1, dtype=bool)
+        half[[0, -1]] = True
+        one = (params.keep_step == params.keep_step[0]).all() and (
+            params.keep_half == params.keep_half[0]
+        ).all()
+        rows = slice(0, 1) if one else slice(None)
+        own = np.where(half, params.keep_half[rows, None, None], params.keep_step[rows, None, None])
+        with np.errstate(invalid="ignore"):
+            keep = np.where(factor == 1.0, own, own**factor)
+    return layout.Cold(
+        *(np.ascontiguousarray(field, dtype=float) for field in (charge, discharge, cut, keep))
+    )
 
 
 def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> layout.Parameters:
@@ -430,6 +540,8 @@ def _clipped_energy(a, b, tau, cap):
 
 
 def _charge_numpy(charging, stored, spare, limit, par, row):
+    """:func:`foldopt.engine.storage_kernel._charge` over arrays, writing into the day's
+    ``row``."""
     capacity, eta = par.capacity, par.eta_charge
     room = np.maximum(capacity - stored, 0.0) / eta
     take = np.minimum(spare, limit)
@@ -456,19 +568,20 @@ def _time_to_draw(da, db, tau, energy):
         )
 
 
-def _part_numpy(ends, tau, surplus, demand, stored, on, par, row):
+def _part_numpy(ends, tau, surplus, demand, stored, on, par, cold, row):
     """:func:`foldopt.engine.storage_kernel._part` over arrays of series (``demand``: whether the
-    load runs at both ends of the segment, where its time counts), writing into the day's ``row``;
-    returns the content and the load's state."""
+    load runs at both ends of the segment, where its time counts; ``cold`` the segment's cut-off
+    and reconnection [Wh] and whether the buffer may charge and discharge), writing into the
+    day's ``row``; returns the content and the load's state."""
     pa, pb, la, lb, da, db = ends
+    floor, restart, charge, discharge = cold
     active = tau > 0.0
     capacity = par.capacity
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
     own = 0.5 * tau * (da + db)
-    on = on | (active & (stored >= par.restart_soc * capacity))
+    on = on | (active & (stored >= restart))
     run = active & on & surplus
-    floor = par.min_soc * capacity
     usable = stored - floor
     eta_d = par.eta_discharge
     short = np.maximum(need - pv, 0.0)
@@ -476,6 +589,7 @@ def _part_numpy(ends, tau, surplus, demand, stored, on, par, row):
         active
         & on
         & ~surplus
+        & discharge
         & (usable > 0.0)
         & (np.maximum(la - pa, lb - pb) <= par.max_discharge)
     )
@@ -514,9 +628,9 @@ def _part_numpy(ends, tau, surplus, demand, stored, on, par, row):
         np.where(off, _clipped_energy(whole_a, whole_b, tau, np.inf), 0.0),
     )
     limit = np.where(
-        run,
+        run & charge,
         _clipped_energy(pa - la, pb - lb, tau, max_c),
-        np.where(off, _clipped_energy(whole_a, whole_b, tau, max_c), 0.0),
+        np.where(off & charge, _clipped_energy(whole_a, whole_b, tau, max_c), 0.0),
     )
     return _charge_numpy(run | off, stored, spare, limit, par, row), on
 
@@ -552,7 +666,23 @@ def _segments(curves: layout.Curves):
     return first, second, (l0 > 0.0) & (l1 > 0.0), half
 
 
-def _run_numpy(curves: layout.Curves, par: layout.Parameters, stored, on, days: layout.Days):
+def _cold_at(cold: layout.Cold, par: layout.Parameters, d: int, j: int):
+    """Day ``d``'s segment ``j`` of every series: the cut-off and the reconnection [Wh], whether
+    the buffer may charge and discharge, and the share kept (NaN: the buffer's own), as
+    :func:`foldopt.engine.storage_kernel._levels` and ``_at`` read them."""
+
+    def at(values):
+        return values[:, d if values.shape[1] > 1 else 0, j if values.shape[2] > 1 else 0]
+
+    cut = at(cold.cut)
+    floor = (par.min_soc + cut * (1.0 - par.min_soc)) * par.capacity
+    restart = (par.restart_soc + cut * (1.0 - par.restart_soc)) * par.capacity
+    return floor, restart, at(cold.charge) > 0.0, at(cold.discharge) > 0.0, at(cold.keep)
+
+
+def _run_numpy(
+    curves: layout.Curves, par: layout.Parameters, cold: layout.Cold, stored, on, days: layout.Days
+):
     """One pass over the days of a set of series (:func:`foldopt.engine.storage_kernel._run`
     without merging), the steps in turn and the series at once."""
     power, _, draw, step_hours = curves
@@ -562,9 +692,8 @@ def _run_numpy(curves: layout.Curves, par: layout.Parameters, stored, on, days: 
     capacity = par.capacity
     n_bins = out.shape[-1] - layout.HISTOGRAM
     series = np.arange(power.shape[0])
-    restart = par.restart_soc * capacity
-    floor = par.min_soc * capacity
     for d in range(n_days):
+        floor, restart = _cold_at(cold, par, d, 0)[:2]
         on = on | (stored >= restart)
         state[:, d, 0], state[:, d, 1] = stored, on
         row = out[:, d]
@@ -572,6 +701,7 @@ def _run_numpy(curves: layout.Curves, par: layout.Parameters, stored, on, days: 
         row[:, layout.FULL] = np.where((capacity > 0.0) & (stored >= capacity), 1.0, 0.0)
         row[:, layout.EMPTY] = np.where(stored <= floor, 1.0, 0.0)
         for j in range(n_steps + 1):
+            *limits, keep = _cold_at(cold, par, d, j)
             for ends, tau, surplus in (first, second):
                 stored, on = _part_numpy(
                     tuple(a[:, d, j] for a in ends),
@@ -581,9 +711,11 @@ def _run_numpy(curves: layout.Curves, par: layout.Parameters, stored, on, days: 
                     stored,
                     on,
                     par,
+                    limits,
                     row,
                 )
-            kept = stored * (par.keep_half if half[j] else par.keep_step)
+            keep = np.where(np.isnan(keep), par.keep_half if half[j] else par.keep_step, keep)
+            kept = np.where(keep < 1.0, stored * keep, stored)
             row[:, layout.SELF_DISCHARGE] += stored - kept
             stored = kept
             with np.errstate(invalid="ignore", divide="ignore"):
@@ -594,22 +726,23 @@ def _run_numpy(curves: layout.Curves, par: layout.Parameters, stored, on, days: 
                 soc[:, d, j] = level
         whole = power[:, d] + np.broadcast_to(draw, power.shape)[:, d]
         row[:, layout.HARVESTED] = np.cumsum(whole, axis=-1)[:, -1] * step_hours
-    on = on | (stored >= restart)
+    on = on | (stored >= _cold_at(cold, par, 0, 0)[1])
     state[:, n_days, 0], state[:, n_days, 1] = stored, on
     return stored, on
 
 
-def _simulate_numpy(curves, params, days, passes, max_iterations, tolerance):
+def _simulate_numpy(curves, params, cold, days, passes, max_iterations, tolerance):
     """:func:`foldopt.engine.storage_kernel.simulate_series` over arrays of series, each series's
     passes as :func:`foldopt.engine.storage_kernel._series` runs them."""
     out, state, soc, soc_curves = days
     n_series = out.shape[0]
     power, load, draw = (np.broadcast_to(a, (n_series, *a.shape[1:])) for a in curves[:3])
+    cold = layout.Cold(*(np.broadcast_to(a, (n_series, *a.shape[1:])) for a in cold))
     step_hours, par = curves.step_hours, params
     capacity = par.capacity
     given = ~np.isnan(par.initial_soc)
     stored = np.where(given, par.initial_soc * capacity, capacity)
-    on = np.where(given, stored >= par.restart_soc * capacity, True)
+    on = np.where(given, stored >= _cold_at(cold, par, 0, 0)[1], True)
     resolution = load.reshape(n_series, -1).max(axis=1) * step_hours
     low, high = np.zeros(n_series), capacity.copy()
     todo = np.ones(n_series, dtype=bool)
@@ -620,6 +753,7 @@ def _simulate_numpy(curves, params, days, passes, max_iterations, tolerance):
         end, end_on = _run_numpy(
             layout.Curves(power[pick], load[pick], draw[pick], step_hours),
             layout.Parameters(*(field[pick] for field in par)),
+            layout.Cold(*(field[pick] for field in cold)),
             stored[pick],
             on[pick],
             layout.Days(sub_out, sub_state, sub_soc, soc_curves),

@@ -35,6 +35,7 @@ from foldopt.engine.storage_records import (
     POWERED,
     SELF_DISCHARGE,
     SERVED,
+    Cold,
     Curves,
     Days,
     Parameters,
@@ -96,12 +97,14 @@ def time_to_draw(da, db, tau, energy):
 
 
 @njit(cache=True, error_model="numpy")
-def _part(ends, tau, surplus, stored, on, par):
+def _part(ends, tau, surplus, stored, on, par, cold):
     """One part of a segment over ``tau`` [h] (``tau`` > 0), in which the power left after the
     design's own draw runs from ``pa`` to ``pb``, the load from ``la`` to ``lb`` and that draw
     from ``da`` to ``db`` [W] (``ends``, the six in that order), the power at or above the load
     throughout (``surplus``) or below it; ``stored`` [Wh] and ``on`` the buffer's content and
-    the load's state at its start, ``par`` the series' :class:`Parameters`.
+    the load's state at its start, ``par`` the series' :class:`Parameters`, ``cold`` the
+    segment's cut-off and reconnection [Wh] and whether the buffer may charge and discharge
+    (:class:`Cold`'s, the levels as contents).
 
     Returns the buffer's content [Wh], whether the load is on, the part's energies [Wh] served,
     missing, lost, lost in charging and in discharging, the hours the load ran, whether the
@@ -109,14 +112,16 @@ def _part(ends, tau, surplus, stored, on, par):
     Scalars only, so that the call moves no array (numba counts references to arrays passed to
     a function)."""
     pa, pb, la, lb, da, db = ends
+    floor, restart, charge, discharge = cold
     capacity = par.capacity
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
     own = 0.5 * tau * (da + db)
-    if not on and stored >= par.restart_soc * capacity:
+    if not on and stored >= restart:
         on = True
     if on and surplus:
-        limit = clipped_energy(pa - la, pb - lb, tau, par.max_charge)
+        # A blocked charger takes nothing: the surplus is lost as over a full buffer.
+        limit = clipped_energy(pa - la, pb - lb, tau, par.max_charge) if charge else 0.0
         stored, loss, lost, full = _charge(
             stored, max(pv - need, 0.0), limit, capacity, par.eta_charge
         )
@@ -124,10 +129,9 @@ def _part(ends, tau, surplus, stored, on, par):
     served = ran = discharge_loss = drawn = 0.0
     empty = False
     if on:
-        floor = par.min_soc * capacity
         usable = stored - floor
         eta = par.eta_discharge
-        if usable > 0.0 and max(la - pa, lb - pb) <= par.max_discharge:
+        if discharge and usable > 0.0 and max(la - pa, lb - pb) <= par.max_discharge:
             short = max(need - pv, 0.0)
             if short <= eta * usable:
                 taken = short / eta
@@ -144,36 +148,54 @@ def _part(ends, tau, surplus, stored, on, par):
             pa, la, da, tau = pm, lm, dm, tau - ran
             need = 0.5 * tau * (la + lb)
         on = False
-        empty = stored <= floor  # not when only max_discharge_w turned the load off
+        # not when only max_discharge_w or the cold turned the load off
+        empty = stored <= floor
     # The controller has the load and the design's own draw off: the whole power charges.
     spare = clipped_energy(pa + da, pb + db, tau, math.inf)
-    limit = clipped_energy(pa + da, pb + db, tau, par.max_charge)
+    limit = clipped_energy(pa + da, pb + db, tau, par.max_charge) if charge else 0.0
     stored, loss, lost, full = _charge(stored, spare, limit, capacity, par.eta_charge)
     return stored, on, served, need, lost, loss, discharge_loss, ran, full, empty, drawn
 
 
+@njit(cache=True, inline="always")
+def _at(values, d, j):
+    """Day ``d``'s segment ``j`` of one series' :class:`Cold` field (a size 1 serves all)."""
+    return values[d if values.shape[0] > 1 else 0, j if values.shape[1] > 1 else 0]
+
+
 @njit(cache=True, error_model="numpy")
-def _run(curves, par, stored, on, merge, days):
-    """One pass over a series' days (its :class:`Curves`, :class:`Parameters` and :class:`Days`)
-    from the content ``stored`` [Wh] and load state ``on``.
+def _levels(par, cold, d, j):
+    """Day ``d``'s segment ``j``: the cut-off and the reconnection [Wh] the cold raises
+    (:func:`foldopt.physics.buffer_temperature.cold_cut_off`; the buffer's own without it)."""
+    cut = _at(cold.cut, d, j)
+    floor = (par.min_soc + cut * (1.0 - par.min_soc)) * par.capacity
+    restart = (par.restart_soc + cut * (1.0 - par.restart_soc)) * par.capacity
+    return floor, restart
+
+
+@njit(cache=True, error_model="numpy")
+def _run(curves, par, cold, stored, on, merge, days):
+    """One pass over a series' days (its :class:`Curves`, :class:`Parameters`, :class:`Cold` and
+    :class:`Days`) from the content ``stored`` [Wh] and load state ``on``.
 
     With ``merge``, a day that starts in the state the previous pass started it in
     (``days.state``) ends the pass: from there on, the previous pass's outputs are this one's. The
     load's state is kept as on wherever the content allows it to reconnect (the same state: the
-    first part would reconnect it). Returns the state at the end of the last day.
+    first part would reconnect it; after the last day, as the first day's first part would).
+    Returns the state at the end of the last day.
     """
     power, load, draw, step_hours = curves
     out, state, soc, keep_soc = days
     n_days, n_steps = power.shape
     profile_days, profile_steps = load.shape[0] > 1, load.shape[1] > 1
     draw_days, draw_steps = draw.shape[0] > 1, draw.shape[1] > 1
-    capacity, restart = par.capacity, par.restart_soc * par.capacity
+    capacity = par.capacity
     n_bins = out.shape[1] - HISTOGRAM
     keep_half, keep_step = par.keep_half, par.keep_step
-    leaks = keep_step < 1.0 or keep_half < 1.0
-    floor, eta_discharge = par.min_soc * capacity, par.eta_discharge
+    eta_discharge = par.eta_discharge
     max_discharge = par.max_discharge
     for d in range(n_days):
+        floor, restart = _levels(par, cold, d, 0)
         on = on or stored >= restart
         flag = 1.0 if on else 0.0
         if merge and state[d, 0] == stored and state[d, 1] == flag:
@@ -198,6 +220,9 @@ def _run(curves, par, stored, on, merge, days):
             d1 = day_draw[last if draw_steps else 0]
             half = j == 0 or j == n_steps
             tau = 0.5 * step_hours if half else step_hours
+            floor, restart = _levels(par, cold, d, j)
+            charge = _at(cold.charge, d, j) > 0.0
+            discharge = _at(cold.discharge, d, j) > 0.0
             if j < n_steps:
                 harvested += p1 + d1
             e0, e1 = p0 - l0, p1 - l1
@@ -211,6 +236,7 @@ def _run(curves, par, stored, on, merge, days):
             dark = p0 == 0.0 and p1 == 0.0 and d0 == 0.0 and d1 == 0.0
             if (
                 on
+                and discharge
                 and dark
                 and l0 == l1
                 and l0 > 0.0
@@ -271,7 +297,15 @@ def _run(curves, par, stored, on, merge, days):
                         was_full,
                         ran_out,
                         own_wh,
-                    ) = _part(ends, length, rising == second, stored, on, par)
+                    ) = _part(
+                        ends,
+                        length,
+                        rising == second,
+                        stored,
+                        on,
+                        par,
+                        (floor, restart, charge, discharge),
+                    )
                     served += s_wh
                     missing += m_wh
                     lost += l_wh
@@ -282,8 +316,11 @@ def _run(curves, par, stored, on, merge, days):
                         powered += ran_h
                     full = full or was_full
                     empty = empty or ran_out
-            if leaks:  # without a leak the product is the content itself: spared
-                kept = stored * (keep_half if half else keep_step)
+            keep = _at(cold.keep, d, j)
+            if math.isnan(keep):
+                keep = keep_half if half else keep_step
+            if keep < 1.0:  # without a leak the product is the content itself: spared
+                kept = stored * keep
                 leak += stored - kept
                 stored = kept
             level = stored / capacity if capacity > 0.0 else 0.0
@@ -299,14 +336,15 @@ def _run(curves, par, stored, on, merge, days):
         )
         row[FULL], row[EMPTY] = 1.0 if full else 0.0, 1.0 if empty else 0.0
         row[DRAWN] = drawn
-    on = on or stored >= restart
+    on = on or stored >= _levels(par, cold, 0, 0)[1]
     state[n_days, 0], state[n_days, 1] = stored, 1.0 if on else 0.0
     return stored, on
 
 
 @njit(cache=True, error_model="numpy")
-def _series(curves, par, days, max_iterations, tolerance):
-    """A series (its :class:`Curves`, :class:`Parameters` and :class:`Days`) from its initial
+def _series(curves, par, cold, days, max_iterations, tolerance):
+    """A series (its :class:`Curves`, :class:`Parameters`, :class:`Cold` and :class:`Days`) from
+    its initial
     state of charge, or in its periodic state: passes until the state at the end of the series is
     that at its start (content within ``tolerance`` x the capacity, the load on or off alike),
     first plainly from a full buffer, then by bisection on the start's content, until the start is
@@ -315,8 +353,8 @@ def _series(curves, par, days, max_iterations, tolerance):
     capacity = par.capacity
     if not math.isnan(par.initial_soc):
         stored = par.initial_soc * capacity
-        on = stored >= par.restart_soc * capacity
-        _run(curves, par, stored, on, False, days)
+        on = stored >= _levels(par, cold, 0, 0)[1]
+        _run(curves, par, cold, stored, on, False, days)
         return 1
     resolution = 0.0  # one step's load energy [Wh], the largest of the series
     for row in curves.load:
@@ -327,7 +365,7 @@ def _series(curves, par, days, max_iterations, tolerance):
     passes = 0
     while passes < max_iterations:
         passes += 1
-        end, end_on = _run(curves, par, stored, on, passes > 1, days)
+        end, end_on = _run(curves, par, cold, stored, on, passes > 1, days)
         if abs(end - stored) <= tolerance * capacity and end_on == on:
             return passes
         if end > stored:
@@ -354,7 +392,7 @@ def _one(values, s):
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def simulate_series(curves, params, days, passes, max_iterations, tolerance):
+def simulate_series(curves, params, cold, days, passes, max_iterations, tolerance):
     """Every series, spread over threads (:func:`foldopt.engine.storage.simulate`).
 
     Parameters
@@ -363,6 +401,8 @@ def simulate_series(curves, params, days, passes, max_iterations, tolerance):
         Of every series (or one that serves all).
     params : Parameters
         The buffer of each series.
+    cold : Cold
+        Its temperature's effects per segment, of every series (or one that serves all).
     days : Days
         Of every series, written.
     passes : (n_series,) int
@@ -374,6 +414,7 @@ def simulate_series(curves, params, days, passes, max_iterations, tolerance):
     # field inside a parallel loop is lost (numba issues 5872 and 7135).
     power, load, draw, step_hours = curves
     out, state, soc, keep_soc = days
+    charge, discharge, cut, keep = cold
     (
         capacity,
         min_soc,
@@ -404,6 +445,7 @@ def simulate_series(curves, params, days, passes, max_iterations, tolerance):
                 max_discharge[s],
                 initial_soc[s],
             ),
+            Cold(_one(charge, s), _one(discharge, s), _one(cut, s), _one(keep, s)),
             Days(out[s], state[s], soc[s if keep_soc else 0], keep_soc),
             max_iterations,
             tolerance,

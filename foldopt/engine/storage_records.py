@@ -65,6 +65,32 @@ class Parameters(NamedTuple):
     initial_soc: np.ndarray
 
 
+class Cold(NamedTuple):
+    """The buffer's temperature as the loops take it, per segment of a day (the ``n_steps + 1``
+    segments between step centres, :func:`foldopt.engine.storage.simulate`): for every series,
+    (n_series or 1, n_days or 1, n_steps + 1 or 1) arrays, each of its own shape (a size 1 serves
+    every series, day or segment); in the loops over one series, that series' (the first axis
+    taken).
+
+    Attributes
+    ----------
+    charge, discharge : float
+        1 where the buffer may charge / discharge over the segment, 0 where it is blocked.
+    cut : float
+        The share of the usable range ``[min_soc, 1]`` the cold puts out of reach [-] (0: none):
+        the cut-off and the reconnection are raised by it
+        (:func:`foldopt.physics.buffer_temperature.cold_cut_off`).
+    keep : float
+        The share of the content the segment keeps against self-discharge [-]; NaN: the
+        buffer's own (:class:`Parameters`' ``keep_step`` or ``keep_half``).
+    """
+
+    charge: np.ndarray
+    discharge: np.ndarray
+    cut: np.ndarray
+    keep: np.ndarray
+
+
 class Days(NamedTuple):
     """What the loops write: for every series, (n_series, ...) arrays; in the loops over one
     series, that series' (the first axis taken).
