@@ -282,7 +282,9 @@ STORAGE_PRESETS = Registry(
         "supercapacitor": "an EDLC bank behind a converter: usable down to half its voltage (a quarter "
         "of its energy), ~96 % round trip, ~2 %/day self-discharge",
         "lifepo4": "a small LiFePO4 pack: cut off at 20 % (80 % depth of discharge), 92 % round trip, "
-        "~3 %/month self-discharge",
+        "~3 %/month self-discharge; not charged below 0 C, 70 % of its capacity at -20 C",
+        "nmc": "a small Li-ion (NMC) pack: cut off at 20 %, not charged below 0 C nor discharged "
+        "below -20 C, 70 % of its capacity at -18 C, ~5 %/month self-discharge",
     },
 )
 OUTPUT_FORMATS = Registry(

@@ -90,6 +90,9 @@ class Sky:
         file's wind folded in as an equivalent air temperature (:func:`equivalent_temp_air`).
     wind_speed : numpy.ndarray or None
         With a weather file, (n_blocks, n_steps) the file's wind speed at each step [m/s].
+    air_steps : numpy.ndarray or None
+        With a weather file, (n_blocks, n_steps) the file's air temperature at each step [C],
+        linear between its stamps (no wind folded in: a buffer's, issue 50).
     wind_ref : float or None
         With a weather file, the wind speed of the electrical tables [m/s]: the file's mean over
         its lit rows, to 0.5 m/s, so that the wind folded into ``temp_steps`` stays small
@@ -128,6 +131,7 @@ class Sky:
     weather_notes: tuple = ()
     horizons: tuple = ()
     horizon_of: np.ndarray | None = None
+    air_steps: np.ndarray | None = None
 
     @property
     def n_blocks(self) -> int:
@@ -246,6 +250,7 @@ class Sky:
                 "latitude",
                 "temp_steps",
                 "wind_speed",
+                "air_steps",
             )
         }
         shape = None if self.load_shape is None else self.load_shape[keep]
@@ -434,6 +439,7 @@ def build_sky(
         dni_extra = dni_extra[inverse]
         temp_steps, wind_speed = temp_steps[inverse], wind_speed[inverse]
         dates = [dates[i] for i in inverse]
+    air_steps = temp_steps
     if weather is not None:
         lit = light["ghi"] > 0
         temp_steps = equivalent_temp_air(
@@ -498,6 +504,7 @@ def build_sky(
         wind_speed=wind_speed,
         wind_ref=wind_ref,
         weather_notes=notes,
+        air_steps=air_steps,
         horizons=horizons,
         horizon_of=horizon_of,
     )

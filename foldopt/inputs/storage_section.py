@@ -10,6 +10,7 @@ import pydantic and :mod:`foldopt.names`.
 from __future__ import annotations
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic.types import confloat
 
 from foldopt import names
 from foldopt.inputs.fields import StrictModel, interval, named
@@ -22,6 +23,11 @@ IDEAL = {
     "charge_efficiency": 1.0,
     "discharge_efficiency": 1.0,
     "self_discharge": 0.0,
+    # a buffer the temperature does nothing to
+    "charge_min_c": None,
+    "discharge_min_c": None,
+    "capacity_curve": None,
+    "self_discharge_doubling_c": None,
 }
 #: Each preset of :data:`foldopt.names.STORAGE_PRESETS`: the datasheet-typical values of the fields
 #: it fills, ``hysteresis`` being how far above ``min_soc`` the load is reconnected (``restart_soc
@@ -37,6 +43,13 @@ PRESETS = {
         "charge_efficiency": 0.98,
         "discharge_efficiency": 0.98,
         "self_discharge": 0.02,
+        # [2] operating range -40 to 65 C (cell case): charged and discharged down to -40 C; its
+        # capacitance is stated at 25 C only, so no cold capacity curve. [7] leakage below 1 uA
+        # at -55 C and below 30 uA at 85 C: a doubling every 140 / log2(30) = 28.5 C.
+        "charge_min_c": -40.0,
+        "discharge_min_c": -40.0,
+        "capacity_curve": None,
+        "self_discharge_doubling_c": 28.5,
     },
     # [4] 92 % round trip (0.96 x 0.96), its cycle life rated at 80 % depth of discharge (a 20 %
     # cut-off); [5] 2 to 5 %/month self-discharge: 3 %/month is 1 - 0.97^(1/30) = 0.001 a day.
@@ -47,11 +60,45 @@ PRESETS = {
         "charge_efficiency": 0.96,
         "discharge_efficiency": 0.96,
         "self_discharge": 0.001,
+        # [8] charging prohibited below 0 C, discharge -20 to 60 C (a BMS stops both outside:
+        # [9]); [10] a 100 Ah pack gives about 80 Ah at 0 C and 70 Ah at -20 C, all of it again
+        # when warm (its rated capacity at 25 C).
+        "charge_min_c": 0.0,
+        "discharge_min_c": -20.0,
+        "capacity_curve": ((-20.0, 0.70), (0.0, 0.80), (25.0, 1.0)),
+        "self_discharge_doubling_c": None,
+    },
+    # [11] a Li-ion (NMC/LCO) 18650 cell: charge 0 to 45 C, discharge -20 to 60 C, more than 95 %
+    # of its charge left after 30 days at 25 C (5 %/month: 1 - 0.95^(1/30) = 0.0017 a day);
+    # [12] lithium at -18 C (0 F) delivers 70 % of its rated capacity. The cut-off, reconnection
+    # and efficiencies as the LiFePO4 preset's [4] (no sourced figure of NMC's own).
+    "nmc": {
+        "min_soc": 0.20,
+        "hysteresis": 0.10,
+        "charge_efficiency": 0.96,
+        "discharge_efficiency": 0.96,
+        "self_discharge": 0.0017,
+        "charge_min_c": 0.0,
+        "discharge_min_c": -20.0,
+        "capacity_curve": ((-18.0, 0.70), (25.0, 1.0)),
+        "self_discharge_doubling_c": None,
     },
 }
 #: The fields a preset (or :data:`IDEAL`) fills where a study leaves them out, in the order they
 #: are filled (``restart_soc`` from the ``min_soc`` in force).
-FILLED = ("min_soc", "restart_soc", "charge_efficiency", "discharge_efficiency", "self_discharge")
+FILLED = (
+    "min_soc",
+    "restart_soc",
+    "charge_efficiency",
+    "discharge_efficiency",
+    "self_discharge",
+    "charge_min_c",
+    "discharge_min_c",
+    "capacity_curve",
+    "self_discharge_doubling_c",
+)
+#: The temperatures the cold's fields take [C] (a buffer's datasheet range, and the air's).
+COLD_RANGE_C = (-60.0, 60.0)
 
 
 class StorageTarget(StrictModel):
@@ -112,6 +159,27 @@ class Storage(StrictModel):
         ``min_soc`` (a buffer delivered flat, or left to self-discharge): the load starts on at
         ``restart_soc`` or above, and below it off, waiting for ``restart_soc``
         (:func:`foldopt.engine.storage.simulate`).
+    enclosure_offset_c : float, default 0
+        How much warmer the buffer is than the air [C] in [-30, 60] (its box in the sun, or
+        buried); the buffer's temperature is the weather's air temperature at each step plus it
+        (a clear-sky day: the study's ``temp_air``).
+    cold : bool, default True
+        Whether the buffer's temperature acts (the four fields below); false: a buffer the
+        temperature does nothing to, every answer as without them.
+    charge_min_c, discharge_min_c : float, optional
+        The buffer is not charged / discharged below these temperatures [C] in [-60, 60] (a
+        charger's or a battery management system's block). Default the preset's, else none.
+    capacity_curve : list of [float, float], optional
+        The usable share of the capacity at the buffer's temperature: ``[temperature C, share]``
+        points, temperatures in [-60, 60] increasing, shares in (0, 1] not falling as the
+        temperature rises, linear between them and held beyond them. The cold puts the bottom
+        of the usable range out of reach: it raises the cut-off to ``min_soc + (1 - share) (1 -
+        min_soc)`` and the reconnection alike, the energy staying stored until warm
+        (:mod:`foldopt.physics.buffer_temperature`). Default the preset's, else all usable.
+    self_discharge_doubling_c : float, optional
+        The rise in temperature that doubles the self-discharge [C] in (0, 100]; the
+        ``self_discharge`` is the one at 25 C. Default the preset's, else the same at every
+        temperature.
     preset : str, optional
         One of :data:`foldopt.names.STORAGE_PRESETS`, whose values fill the fields above that
         are left out.
@@ -139,6 +207,18 @@ class Storage(StrictModel):
        long will my battery hold a charge?").
     .. [6] PVGIS, "Performance of off-grid PV systems" (SHScalc): battery size [Wh], discharge
        cut-off limit [%], days with the battery full / empty, energy lost / missing.
+    .. [7] Nanoramic, "FastCAP low temperature ultracapacitor" (FAQ): expected leakage current
+       below 1 uA at -55 C and below 30 uA at 85 C.
+    .. [8] Sunland Power, IFR10440 3.2 V 200 mAh LiFePO4 cell specification: charge 0 to 45 C
+       ("prohibited to charge below 0 C"), discharge -20 to 60 C.
+    .. [9] EPEVER, "How does the system perform in extreme weather conditions?": the battery
+       stops charging below 0 C and discharging below -20 C.
+    .. [10] Canbat CLI100-12 LiFePO4 (12 V 100 Ah), as quoted by Funsong Battery, "How to store
+       LiFePO4 batteries": about 80 Ah at 0 C and 70 Ah at -20 C, full capacity again when warm.
+    .. [11] Yok Energy, "Lithium ion cylindrical 18650 standard cell specification summary":
+       charge 0 to 45 C, discharge -20 to 60 C, residual capacity > 95 % after 30 days at 25 C.
+    .. [12] X2Power, quoted by Class Cycles, "Lithium iron phosphate batteries in cold weather":
+       at 0 F lithium discharges at 70 % of its rated capacity.
     """
 
     capacity_wh: interval(0, 1e6, unit=" Wh") = Field(
@@ -182,6 +262,28 @@ class Storage(StrictModel):
     target: StorageTarget | None = Field(
         None, description="size each design's buffer for it: {powered_h, days_pct}"
     )
+    enclosure_offset_c: interval(-30, 60, unit=" C") = Field(
+        0.0, description="the buffer's temperature above the air's"
+    )
+    cold: bool = Field(True, description="false: the buffer's temperature does nothing")
+    charge_min_c: interval(*COLD_RANGE_C, unit=" C") | None = Field(
+        None, validate_default=True, description="no charge below it; default the preset's"
+    )
+    discharge_min_c: interval(*COLD_RANGE_C, unit=" C") | None = Field(
+        None, validate_default=True, description="no discharge below it; default the preset's"
+    )
+    capacity_curve: (
+        tuple[tuple[interval(*COLD_RANGE_C, unit=" C"), confloat(gt=0.0, le=1.0)], ...] | None
+    ) = Field(
+        None,
+        validate_default=True,
+        description="[[temperature C, usable share], ...]; default the preset's",
+    )
+    self_discharge_doubling_c: interval(0, 100, lo_open=True, unit=" C") | None = Field(
+        None,
+        validate_default=True,
+        description="the rise that doubles the self-discharge; default the preset's",
+    )
 
     @field_validator(*FILLED, mode="after")
     @classmethod
@@ -197,6 +299,20 @@ class Storage(StrictModel):
         min_soc = info.data.get("min_soc")
         # Rounded: decimal fractions added in binary (0.2 + 0.1 is 0.30000000000000004).
         return None if min_soc is None else round(min(1.0, min_soc + values["hysteresis"]), 12)
+
+    @field_validator("capacity_curve", mode="after")
+    @classmethod
+    def _curve_rises(cls, curve):
+        if curve is None:
+            return curve
+        temperatures, shares = [t for t, _ in curve], [k for _, k in curve]
+        if not curve or any(b <= a for a, b in zip(temperatures, temperatures[1:])):
+            raise ValueError(
+                "the points' temperatures must increase (at least one [temperature C, share])"
+            )
+        if any(b < a for a, b in zip(shares, shares[1:])):
+            raise ValueError("the usable share must not fall as the temperature rises")
+        return curve
 
     @model_validator(mode="after")
     def _reconnected_above_cut_off(self):

@@ -28,6 +28,12 @@ from foldopt.engine.choice import engine_for
 from foldopt.engine.storage import StorageResult, simulate
 from foldopt.studies.least_cost import day_design_space
 from foldopt.studies.objectives import best_angle_index, near_optimal, objective_value
+from foldopt.studies.storage_cold import (
+    charge_blocked,
+    cold_columns,
+    cold_steps,
+    per_series,
+)
 from foldopt.studies.storage_sizing import Sizing, buffer_of, size_buffers, smallest_buffers
 
 #: The designs whose state of charge the day's figure draws and ``timeseries.csv`` holds.
@@ -275,17 +281,19 @@ def day_storage(
 YEAR_DESIGNS = ("flat", "twofold", "twofold-buffer", "tracker", "tracker-net")
 
 
-def _year_series(power, load, in_sequence: bool, draw=None):
-    """Series of (rows, days, steps) curves, their load and their own draw (or None) as
+def _year_series(power, load, in_sequence: bool, draw=None, cold=None):
+    """Series of (rows, days, steps) curves, their load, their own draw (or None) and the days'
+    :class:`~foldopt.engine.storage.ColdSteps` (fields (days, steps) of every row, or None) as
     :func:`~foldopt.engine.storage.simulate` takes them: the days in sequence, or each day its
     own periodic series."""
     if in_sequence:
-        return power, load, draw
+        return power, load, draw, cold
     series = power.reshape(-1, 1, power.shape[-1])
     return (
         series,
         load if np.ndim(load) == 0 else load.reshape(series.shape),
         None if draw is None else draw.reshape(series.shape),
+        per_series(cold, lambda field: np.broadcast_to(field, power.shape).reshape(series.shape)),
     )
 
 
@@ -327,7 +335,9 @@ class YearDays(NamedTuple):
         )
 
 
-def powered_by_angle(storage, days: YearDays, chunks, *, engine: str) -> np.ndarray:
+def powered_by_angle(
+    storage, days: YearDays, chunks, *, engine: str, temp_air=None
+) -> np.ndarray:
     """Daily powered time of the twofold panel at every fold angle of a grid over an annual group's
     days, a chunk of angles at a time (their curves are the memory).
 
@@ -338,6 +348,9 @@ def powered_by_angle(storage, days: YearDays, chunks, *, engine: str) -> np.ndar
     chunks : iterable of numpy.ndarray
         The power [W] of consecutive angles of the grid, (k, n_days, n_steps) each.
     engine : str
+    temp_air : numpy.ndarray, optional
+        The air temperature [C] of the days' steps, (n_days, n_steps): the buffer's temperature
+        acts (:func:`foldopt.studies.storage_cold.cold_steps`); default none.
 
     Returns
     -------
@@ -347,12 +360,15 @@ def powered_by_angle(storage, days: YearDays, chunks, *, engine: str) -> np.ndar
     engine = storage_engine(engine)
     in_sequence = days.in_sequence
     buffer = buffer_of(storage)
+    cold = None if temp_air is None else cold_steps(storage, temp_air)
     hours = []
     for power in chunks:
         per_load = []
         for p_load in np.asarray(days.loads, dtype=float):
-            series, load, _ = _year_series(power, days.load(p_load, power.shape), in_sequence)
-            result = simulate(series, load, buffer, days.step_hours, engine)
+            series, load, _, steps = _year_series(
+                power, days.load(p_load, power.shape), in_sequence, cold=cold
+            )
+            result = simulate(series, load, buffer, days.step_hours, engine, cold=steps)
             per_load.append(result.powered_h.reshape(power.shape[:2]))
         hours.append(np.stack(per_load))  # (loads, k, days)
     return np.concatenate(hours, axis=1).transpose(2, 0, 1)
@@ -380,7 +396,14 @@ class YearChoice(NamedTuple):
 
 
 def year_storage(
-    storage, days: YearDays, curves: dict, choice: YearChoice, *, engine: str, draws=None
+    storage,
+    days: YearDays,
+    curves: dict,
+    choice: YearChoice,
+    *,
+    engine: str,
+    draws=None,
+    temp_air=None,
 ) -> pd.DataFrame:
     """A buffer over an annual group's days, per load and design.
 
@@ -396,6 +419,9 @@ def year_storage(
     draws : dict, optional
         Design -> its own draw [W], (n_days, n_steps): ``tracker-net``'s drive, whose power in
         ``curves`` is then its whole power (:func:`foldopt.engine.storage.simulate`'s ``draw``).
+    temp_air : numpy.ndarray, optional
+        The air temperature [C] of the days' steps, (n_days, n_steps): the buffer's temperature
+        acts (:func:`foldopt.studies.storage_cold.cold_steps`); default none.
 
     Returns
     -------
@@ -410,13 +436,18 @@ def year_storage(
         ``storage.target``, ``capacity_wh``, the smallest buffer reaching it over the days
         (:func:`~foldopt.studies.storage_sizing.smallest_buffers`; NaN: none up to the grid's
         top), ``capacity_gain_vs_flat_pct`` and ``monotone``; the near-optimal range of
-        ``twofold-buffer`` (NaN in the other rows).
+        ``twofold-buffer`` (NaN in the other rows). Where the buffer's temperature acts, what
+        the cold costs: ``charge_blocked_h`` and ``charge_blocked_days_n`` (the days', every
+        row's), :func:`~foldopt.studies.storage_cold.cold_columns` beside the same run with the
+        cold off, and with ``storage.target`` ``capacity_cold_off_wh`` (the smallest buffer with
+        the cold off).
     """
     engine = storage_engine(engine)
     loads = np.asarray(days.loads, dtype=float)
     in_sequence, step_hours = days.in_sequence, days.step_hours
     objective, site = choice.objective, choice.site
     months = [date.month for date in days.dates]
+    cold = None if temp_air is None else cold_steps(storage, temp_air)
     rows = []
     for index, p_load in enumerate(loads):
         power = np.stack(
@@ -427,8 +458,12 @@ def year_storage(
             if draws
             else None
         )
-        series, load, draw = _year_series(power, days.load(p_load, power.shape), in_sequence, own)
-        result = simulate(series, load, buffer_of(storage), step_hours, engine, draw=draw)
+        series, load, draw, steps = _year_series(
+            power, days.load(p_load, power.shape), in_sequence, own, cold
+        )
+        result = simulate(
+            series, load, buffer_of(storage), step_hours, engine, draw=draw, cold=steps
+        )
         bare = simulate(
             series, load, buffer_of(storage, capacity_wh=0.0), step_hours, engine, draw=draw
         )
@@ -437,19 +472,34 @@ def year_storage(
             result = _by_design(result, len(YEAR_DESIGNS))
             bare = _by_design(bare, len(YEAR_DESIGNS))
         powered = result.powered_h.reshape(shape)
+        costs = {}
+        if cold is not None:
+            warm = simulate(series, load, buffer_of(storage), step_hours, engine, draw=draw)
+            if not in_sequence:
+                warm = _by_design(warm, len(YEAR_DESIGNS))
+            costs = {
+                **charge_blocked(storage, temp_air, step_hours),
+                **cold_columns(powered, warm.powered_h.reshape(shape), months),
+            }
         sized = {}
         if storage.target is not None:
             # Each design's smallest buffer for the target over the days (a load profile's day
-            # by day).
-            need, monotone = smallest_buffers(
-                power,
-                p_load if days.load_shape is None else p_load * days.load_shape[None],
-                storage,
-                step_hours,
-                engine,
-                in_sequence,
-                None if own is None else list(own),
-            )
+            # by day), and with the cold off where it acts.
+            def smallest(steps):
+                return smallest_buffers(
+                    power,
+                    p_load if days.load_shape is None else p_load * days.load_shape[None],
+                    storage,
+                    step_hours,
+                    engine,
+                    in_sequence,
+                    None if own is None else list(own),
+                    steps,
+                )
+
+            need, monotone = smallest(cold)
+            if cold is not None:
+                costs["capacity_cold_off_wh"] = smallest(None)[0]
             with np.errstate(invalid="ignore", divide="ignore"):
                 vs_flat = (need / need[0] - 1.0) * 100.0 if need[0] > 0 else np.nan * need
             sized = {
@@ -478,6 +528,7 @@ def year_storage(
                     **{k: v for k, v in day_columns(result).items() if k != "powered_h"},
                     "converged": result.converged.reshape(shape[0], -1).all(axis=1),
                     **sized,
+                    **costs,
                     **{
                         key: np.where(chosen, value[index], np.nan)
                         for key, value in choice.near.items()

@@ -40,6 +40,7 @@ import pandas as pd
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.engine.storage import Buffer, StorageResult, simulate
 from foldopt.studies.objectives import best_angle_index
+from foldopt.studies.storage_cold import per_series
 
 #: Capacities of the grid [-, times the day's load energy over the usable fraction] (0 Wh first),
 #: with the study's own: the sizing's first bracket and the figure's curve of powered time
@@ -114,6 +115,7 @@ def size_buffers(
     engine: str,
     tolerance,
     draws=None,
+    cold=None,
 ) -> Sizing:
     """Each design's smallest buffer for ``storage.target``, powered time against capacity, and
     the buffer from which folding stops paying.
@@ -137,6 +139,9 @@ def size_buffers(
     draws : dict, optional
         Design -> its own draw [W], (n_steps,): ``tracker-net``'s drive, whose power in
         ``curves`` is then its whole power (:func:`foldopt.engine.storage.simulate`'s ``draw``).
+    cold : foldopt.engine.storage.ColdSteps, optional
+        The buffer's temperature's effects at each step of the day, (n_steps,) fields; default
+        none.
 
     Returns
     -------
@@ -147,7 +152,7 @@ def size_buffers(
     own_draws = [None, None, (draws or {}).get("tracker-net")] + [None] * len(fold_angles)
     capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
     n, m = power.shape[0], capacities.size
-    run = _Runs(power, own_draws, load, storage, step_hours, engine, in_sequence=True)
+    run = _Runs(power, own_draws, load, storage, step_hours, engine, in_sequence=True, cold=cold)
     hours, ok = run(np.arange(n), np.broadcast_to(capacities, (n, m)))
     twofold = hours[3:]
     best = best_angle_index(np.nan_to_num(twofold.T, nan=-1.0))
@@ -202,12 +207,16 @@ def size_buffers(
 class _Runs:
     """Designs' curves through a study's buffer at any capacities: each call
     :func:`_at_capacities` of some of the curves, ``(rows, capacities (r, m))`` ->
-    ``(hours, ok)``; ``draws`` per curve as its (None: none)."""
+    ``(hours, ok)``; ``draws`` per curve as its (None: none), ``cold`` the days' (one for every
+    curve)."""
 
-    def __init__(self, power, draws, load, storage, step_hours, engine, in_sequence: bool):
+    def __init__(
+        self, power, draws, load, storage, step_hours, engine, in_sequence: bool, cold=None
+    ):
         draws = [None] * len(power) if draws is None else draws
         self.power, self.draws, self.load, self.storage = power, draws, load, storage
         self.step_hours, self.engine, self.in_sequence = step_hours, engine, in_sequence
+        self.cold = cold
 
     def __call__(self, rows, capacities):
         return _at_capacities(
@@ -219,6 +228,7 @@ class _Runs:
             self.engine,
             self.in_sequence,
             [self.draws[row] for row in rows],
+            self.cold,
         )
 
 
@@ -361,7 +371,7 @@ def capacity_grid(load, storage, step_hours, n_steps) -> np.ndarray:
 
 
 def _at_capacities(
-    power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None
+    power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None, cold=None
 ):
     """Each design's buffer at each of its capacities.
 
@@ -378,6 +388,9 @@ def _at_capacities(
         each day is its own periodic series.
     draws : sequence, optional
         Per design, its own draw [W] shaped as its curve, or None (none).
+    cold : foldopt.engine.storage.ColdSteps, optional
+        The buffer's temperature's effects at each step of the days (fields (n_steps,) or
+        (n_days, n_steps), every design's), default none.
 
     Returns
     -------
@@ -398,7 +411,9 @@ def _at_capacities(
             else np.repeat([np.zeros(power.shape[-1]) if d is None else d for d in draws], m, 0)
         )
         buffer = buffer_of(storage, capacity_wh=capacities.ravel())
-        result = simulate(np.repeat(power, m, 0), load, buffer, step_hours, engine, draw=own)
+        result = simulate(
+            np.repeat(power, m, 0), load, buffer, step_hours, engine, draw=own, cold=cold
+        )
         converged = result.converged.reshape(n, m)
         reached = (
             _reaching(result.powered_h, result.converged, target).reshape(n, m)
@@ -414,6 +429,7 @@ def _at_capacities(
             series, buffer = curve[None], buffer_of(storage, capacity_wh=capacity)
             each = load
             draw = None if own is None else own[None]
+            steps = cold
         else:
             # A series per capacity and day, capacity by capacity.
             def per_capacity(curves):
@@ -429,7 +445,8 @@ def _at_capacities(
                 )
             )
             draw = None if own is None else per_capacity(own)
-        result = simulate(series, each, buffer, step_hours, engine, draw=draw)
+            steps = per_series(cold, lambda field: per_capacity(np.broadcast_to(field, days.shape)))
+        result = simulate(series, each, buffer, step_hours, engine, draw=draw, cold=steps)
         powered = result.powered_h.reshape(capacity.size, -1)  # (m, days)
         converged = result.converged.reshape(capacity.size, -1).all(axis=1)
         # A series with no periodic state has no powered time to draw (NaN: the figure leaves
@@ -505,7 +522,9 @@ def _smallest(run, rows, first, capacities) -> np.ndarray:
     return _bracket(reach, lo, found, after_last=False)[1]
 
 
-def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool, draws=None):
+def smallest_buffers(
+    power, load, storage, step_hours, engine, in_sequence: bool, draws=None, cold=None
+):
     """Each design's smallest buffer [Wh] for ``storage.target`` over its days (NaN: none up to
     the grid's top), by :func:`size_buffers`' search, and whether every larger capacity of the
     grid reaches it too (:func:`_held_above`).
@@ -516,11 +535,11 @@ def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool
         (n, n_days, n_steps) [W].
     load, in_sequence
         As :func:`_at_capacities`'.
-    draws : sequence, optional
+    draws, cold : optional
         As :func:`_at_capacities`'.
     """
     capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
-    run = _Runs(power, draws, load, storage, step_hours, engine, in_sequence)
+    run = _Runs(power, draws, load, storage, step_hours, engine, in_sequence, cold)
     rows = np.arange(power.shape[0])
     _, ok = run(rows, np.broadcast_to(capacities, (rows.size, capacities.size)))
     first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)

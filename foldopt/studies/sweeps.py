@@ -46,6 +46,7 @@ from foldopt.engine.sky import Sky
 from foldopt.physics.spa import SunTerms
 from foldopt.studies.series import series_refused, year_piece, year_series
 from foldopt.studies.least_cost import search_angles, year_design_space
+from foldopt.studies.storage_cold import sky_air_temperature
 from foldopt.studies.storage_days import (
     YearChoice,
     YearDays,
@@ -508,6 +509,7 @@ def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, 
         step_hours=skies[0].step_hours,
         weather=study.weather is not None,
     )
+    temp_air = np.concatenate([sky_air_temperature(sky) for sky in skies])  # the buffer's air
     per_angle = len(blocks) * skies[0].n_steps * 8
     size = max(1, int(CURVE_BYTES // per_angle))
     powered = powered_by_angle(
@@ -518,6 +520,7 @@ def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, 
             for first in range(0, fold_angles.size, size)
         ),
         engine=engine,
+        temp_air=temp_air,
     )  # (days, loads, angles)
     months = [date.month for date in blocks.dates]
     score = objective_value(powered, months, objective.statistic, objective.months)
@@ -543,7 +546,9 @@ def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, 
         near=near_optimal(fold_angles, score, study.near_optimal),
     )
     tables = {
-        "storage_annual": year_storage(study.storage, days, drawn, choice, engine=engine, draws=own)
+        "storage_annual": year_storage(
+            study.storage, days, drawn, choice, engine=engine, draws=own, temp_air=temp_air
+        )
     }
     if study.costs is not None:
         angles = search_angles(fold_angles, np.concatenate([fold_angles[best], fold_angles[fixed]]))
