@@ -407,6 +407,29 @@ COLUMNS = (
         "",
         "whether every series of the buffer found its periodic state (storage_annual.csv)",
     ),
+    ("cold_lost_h", "h", "powered time the cold takes (beside the same day with the cold off)"),
+    ("charge_blocked_h", "h", "hours the buffer's charger is blocked by the cold, over the days"),
+    (
+        "charge_blocked_days_n",
+        "n",
+        "days on which the cold blocks the buffer's charger at some step",
+    ),
+    (
+        "cold_lost_mean_h",
+        "h",
+        "powered time the cold takes a day (beside the same run with the cold off), the mean",
+    ),
+    (
+        "cold_lost_worst_month_h",
+        "h",
+        "powered time the cold takes a day in the month it takes most, that month's mean",
+    ),
+    ("cold_worst_month", "", "the month the cold takes most powered time in (1-12; 0: none)"),
+    (
+        "capacity_cold_off_wh",
+        "wh",
+        "a design's least buffer for the target with the cold off (storage_annual.csv)",
+    ),
     # sizing
     ("area_m2", "m2", "the panel's area"),
     ("benefit_usd", "usd", "lifetime benefit C_grid x t_solar x P_load (Shin et al. Eq. 7)"),

@@ -48,6 +48,7 @@ from foldopt.studies.designs import (
 )
 from foldopt.studies.objectives import near_optimal
 from foldopt.studies.series import half_poa, sky_columns, solar_powered
+from foldopt.studies.storage_cold import sky_air_temperature
 from foldopt.studies.storage_days import (
     DESIGN_COLUMNS,
     BufferedDesigns,
@@ -840,6 +841,7 @@ def buffer_designs(
         load=day.load_w if day.load_shape is None else day.load_w[None, :],
         step_hours=day.step_hours,
         engine=engine,
+        temp_air=sky_air_temperature(day.sky)[0],
     )
 
 

@@ -195,6 +195,18 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             for d in designs[:3]
         )
     )
+    if "cold_lost_h" in by:
+        first = by.iloc[0]
+        part["cold"] = {
+            "charge_blocked_h": float(first["charge_blocked_h"]),
+            "charge_blocked_days_n": int(first["charge_blocked_days_n"]),
+            "cold_lost_by_design_h": per_design("cold_lost_h"),
+        }
+        lines.append(
+            f"the cold: charge blocked {first['charge_blocked_h']:g} h of the day; powered time "
+            "lost "
+            + ", ".join(f"{d} {part['cold']['cold_lost_by_design_h'][d]:.2f} h" for d in designs)
+        )
     top = sizing.folding.top_wh
     lines.append(folding_line(sizing.folding))
     if len(sizing.table):
@@ -212,6 +224,10 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             "monotone_by_design": {d: bool(table.loc[d, "monotone"]) for d in table.index},
             "searched_up_to_wh": top,
         }
+        if "capacity_cold_off_wh" in table:
+            part["sizing"]["capacity_cold_off_by_design_wh"] = {
+                d: float(table.loc[d, "capacity_cold_off_wh"]) for d in table.index
+            }
         said = f"{target.powered_h:g} h" + (
             f" on {target.days_pct:g} % of days" if target.days_pct < 100 else ""
         )
@@ -229,6 +245,11 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             + f", {needs('the tracker', need['tracker'])}"
             + f" ({needs('net of its drive', need['tracker-net'])})"
         )
+        if "capacity_cold_off_wh" in table:
+            lines.append(
+                "buffer needed with the cold off: "
+                + ", ".join(f"{d} {_wh(table.loc[d, 'capacity_cold_off_wh'])}" for d in table.index)
+            )
         if not table["monotone"].all():
             lines.append(not_monotone_note(table.index[~table["monotone"].to_numpy()]))
     if not buffered.converged:
@@ -237,6 +258,36 @@ def answer_part(buffered: DayStorage, designs=("flat", "twofold", "tracker", "tr
             "never repeats its start's): their powered time is the last pass's"
         )
     return part, lines
+
+
+_MONTHS = "Jan Feb Mar Apr May Jun Jul Aug Sep Oct Nov Dec".split()
+
+
+def cold_line(by: pd.DataFrame, named: dict, designs) -> str:
+    """A year's line on what the cold costs, of one load's rows by design (:func:`year_lines`):
+    the charger blocked (hours, days), the powered time lost beside the same run with the cold
+    off (a day, and in the worst month), and the buffer needed with and without the cold."""
+    first = by.iloc[0]
+    lost = ", ".join(
+        f"{named[d]} {by.loc[d, 'cold_lost_mean_h']:.2f} h"
+        + (
+            f" ({by.loc[d, 'cold_lost_worst_month_h']:.2f} h in "
+            f"{_MONTHS[int(by.loc[d, 'cold_worst_month']) - 1]})"
+            if by.loc[d, "cold_worst_month"] > 0
+            else ""
+        )
+        for d in designs
+    )
+    line = (
+        f"  the cold: charge blocked {first['charge_blocked_h']:g} h on "
+        f"{first['charge_blocked_days_n']:g} days; powered time lost a day {lost}"
+    )
+    if "capacity_cold_off_wh" in by:
+        line += "; buffer needed with/without the cold " + ", ".join(
+            f"{named[d]} {_wh(by.loc[d, 'capacity_wh'])}/{_wh(by.loc[d, 'capacity_cold_off_wh'])}"
+            for d in designs
+        )
+    return line
 
 
 #: The designs a year's answer names one by one.
@@ -338,6 +389,12 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
                     )
                     for d in YEAR_SAID
                     if d != "twofold-buffer" or _another(angle)
+                )
+            )
+        if "cold_lost_mean_h" in by:
+            lines.append(
+                cold_line(
+                    by, named, [d for d in YEAR_SAID if d != "twofold-buffer" or _another(angle)]
                 )
             )
     if len(cases) > 8:

@@ -167,6 +167,7 @@ def day_storage(
     load,
     step_hours: float,
     engine: str,
+    temp_air=None,
 ) -> DayStorage:
     """Simulate a day's study's buffer for every design it compares, and size it.
 
@@ -183,6 +184,9 @@ def day_storage(
         The load [W], or its curve (1, n_steps) under a load profile.
     step_hours : float
     engine : str
+    temp_air : numpy.ndarray, optional
+        The air temperature of the day's steps [C], (n_steps,): the buffer's temperature acts
+        (:func:`foldopt.studies.storage_cold.cold_steps`); default none.
 
     Returns
     -------
@@ -193,6 +197,7 @@ def day_storage(
     buffer = buffer_of(storage)
     engine = storage_engine(engine)
     names, power, draws = list(designs.power), designs.power, designs.draws
+    cold = None if temp_air is None else cold_steps(storage, temp_air)
 
     def own(names):
         # The designs' own draws, none for most (a draw of 0 W is none, to the bit).
@@ -201,9 +206,8 @@ def day_storage(
         zero = np.zeros(np.shape(power[names[0]]))
         return np.vstack([draws.get(name, zero) for name in names])
 
-    result = simulate(
-        np.vstack(list(power.values())), load, buffer, step_hours, engine, draw=own(names)
-    )
+    every = np.vstack(list(power.values()))
+    result = simulate(every, load, buffer, step_hours, engine, draw=own(names), cold=cold)
     soc = simulate(
         np.vstack([power[name] for name in SOC_DESIGNS]),
         load,
@@ -212,8 +216,9 @@ def day_storage(
         engine,
         soc_curves=True,
         draw=own(SOC_DESIGNS),
+        cold=cold,
     )
-    grid = simulate(grid_power, load, buffer, step_hours, engine)
+    grid = simulate(grid_power, load, buffer, step_hours, engine, cold=cold)
     by_angle = grid.powered_h[:, 0]
     near = {
         key: float(value)
@@ -232,22 +237,35 @@ def day_storage(
             **day_columns(result),
         }
     )
+    if cold is not None:
+        # What the cold costs each design, beside the same day with the cold off.
+        warm = simulate(every, load, buffer, step_hours, engine, draw=own(names))
+        table["cold_lost_h"] = warm.powered_h[:, 0] - result.powered_h[:, 0]
+        for key, value in charge_blocked(storage, temp_air, step_hours).items():
+            table[key] = value
     step = max(1, -(-fold_angles.size // SIZING_ANGLES))
     compared = np.union1d(fold_angles[::step], [fold_angles[best]])
-    sizing = size_buffers(
-        {
-            **{name: power[name] for name in ("flat", "tracker", "tracker-net")},
-            "twofold": grid_power[np.searchsorted(fold_angles, compared)],
-        },
-        compared,
-        own=fold_angles[best],
-        load=load,
-        storage=storage,
-        step_hours=step_hours,
-        engine=engine,
-        tolerance=study.near_optimal,
-        draws={name: draw for name, draw in draws.items() if name == "tracker-net"},
-    )
+
+    def sized(steps):
+        return size_buffers(
+            {
+                **{name: power[name] for name in ("flat", "tracker", "tracker-net")},
+                "twofold": grid_power[np.searchsorted(fold_angles, compared)],
+            },
+            compared,
+            own=fold_angles[best],
+            load=load,
+            storage=storage,
+            step_hours=step_hours,
+            engine=engine,
+            tolerance=study.near_optimal,
+            draws={name: draw for name, draw in draws.items() if name == "tracker-net"},
+            cold=steps,
+        )
+
+    sizing = sized(cold)
+    if cold is not None and len(sizing.table):
+        sizing.table["capacity_cold_off_wh"] = sized(None).table["capacity_wh"].to_numpy()
     space = None
     if study.costs is not None:
         space = day_design_space(
@@ -335,9 +353,7 @@ class YearDays(NamedTuple):
         )
 
 
-def powered_by_angle(
-    storage, days: YearDays, chunks, *, engine: str, temp_air=None
-) -> np.ndarray:
+def powered_by_angle(storage, days: YearDays, chunks, *, engine: str, temp_air=None) -> np.ndarray:
     """Daily powered time of the twofold panel at every fold angle of a grid over an annual group's
     days, a chunk of angles at a time (their curves are the memory).
 
