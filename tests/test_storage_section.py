@@ -287,7 +287,12 @@ def test_the_options_and_set_reach_the_study(tmp_path, monkeypatch):
                        "charge_efficiency": lifepo4["charge_efficiency"],
                        "discharge_efficiency": lifepo4["discharge_efficiency"],
                        "self_discharge": lifepo4["self_discharge"], "max_charge_w": None,
-                       "max_discharge_w": None, "initial_soc": None, "target": None}
+                       "max_discharge_w": None, "initial_soc": None, "target": None,
+                       "enclosure_offset_c": None, "cold": None,
+                       "charge_min_c": lifepo4["charge_min_c"],
+                       "discharge_min_c": lifepo4["discharge_min_c"],
+                       "capacity_curve": [list(point) for point in lifepo4["capacity_curve"]],
+                       "self_discharge_doubling_c": None}
 
 
 # ---- PVGIS's hourconsumption: the watt profile it stands for --------------------------------------

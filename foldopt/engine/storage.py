@@ -568,7 +568,7 @@ def _time_to_draw(da, db, tau, energy):
         )
 
 
-def _part_numpy(ends, tau, surplus, demand, stored, on, par, cold, row):
+def _part_numpy(ends, tau, surplus, demand, stored, on, par, cold, *, row):
     """:func:`foldopt.engine.storage_kernel._part` over arrays of series (``demand``: whether the
     load runs at both ends of the segment, where its time counts; ``cold`` the segment's cut-off
     and reconnection [Wh] and whether the buffer may charge and discharge), writing into the
@@ -576,7 +576,6 @@ def _part_numpy(ends, tau, surplus, demand, stored, on, par, cold, row):
     pa, pb, la, lb, da, db = ends
     floor, restart, charge, discharge = cold
     active = tau > 0.0
-    capacity = par.capacity
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
     own = 0.5 * tau * (da + db)
@@ -712,7 +711,7 @@ def _run_numpy(
                     on,
                     par,
                     limits,
-                    row,
+                    row=row,
                 )
             keep = np.where(np.isnan(keep), par.keep_half if half[j] else par.keep_step, keep)
             kept = np.where(keep < 1.0, stored * keep, stored)

@@ -159,13 +159,13 @@ class Storage(StrictModel):
         ``min_soc`` (a buffer delivered flat, or left to self-discharge): the load starts on at
         ``restart_soc`` or above, and below it off, waiting for ``restart_soc``
         (:func:`foldopt.engine.storage.simulate`).
-    enclosure_offset_c : float, default 0
+    enclosure_offset_c : float, optional
         How much warmer the buffer is than the air [C] in [-30, 60] (its box in the sun, or
         buried); the buffer's temperature is the weather's air temperature at each step plus it
-        (a clear-sky day: the study's ``temp_air``).
-    cold : bool, default True
+        (a clear-sky day: the study's ``temp_air``). Default 0.
+    cold : bool, optional
         Whether the buffer's temperature acts (the four fields below); false: a buffer the
-        temperature does nothing to, every answer as without them.
+        temperature does nothing to, every answer as without them. Default true.
     charge_min_c, discharge_min_c : float, optional
         The buffer is not charged / discharged below these temperatures [C] in [-60, 60] (a
         charger's or a battery management system's block). Default the preset's, else none.
@@ -262,10 +262,12 @@ class Storage(StrictModel):
     target: StorageTarget | None = Field(
         None, description="size each design's buffer for it: {powered_h, days_pct}"
     )
-    enclosure_offset_c: interval(-30, 60, unit=" C") = Field(
-        0.0, description="the buffer's temperature above the air's"
+    enclosure_offset_c: interval(-30, 60, unit=" C") | None = Field(
+        None, description="the buffer's temperature above the air's; default 0"
     )
-    cold: bool = Field(True, description="false: the buffer's temperature does nothing")
+    cold: bool | None = Field(
+        None, description="false: the buffer's temperature does nothing; default true"
+    )
     charge_min_c: interval(*COLD_RANGE_C, unit=" C") | None = Field(
         None, validate_default=True, description="no charge below it; default the preset's"
     )

@@ -50,7 +50,7 @@ from foldopt.studies.objectives import near_optimal
 from foldopt.studies.series import half_poa, sky_columns, solar_powered
 from foldopt.studies.storage_cold import sky_air_temperature
 from foldopt.studies.storage_days import (
-    DESIGN_COLUMNS,
+    design_columns,
     BufferedDesigns,
     DayStorage,
     day_storage,
@@ -359,7 +359,7 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
     table = sweep.table
     if day.study.storage is not None:
         buffered = buffer_designs(day, sweep, designs, summary, engine)
-        summary = pd.concat([summary, buffered.designs[list(DESIGN_COLUMNS)]], axis=1)
+        summary = pd.concat([summary, buffered.designs[design_columns(buffered.designs)]], axis=1)
         table = table.assign(powered_h=buffered.powered_by_angle)
     return StudyResult(
         study=day.study,

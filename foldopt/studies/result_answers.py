@@ -19,7 +19,7 @@ from foldopt.studies.designs import PLANES_DESIGN
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.least_cost import least_cost_answer
 from foldopt.studies.storage_answer import answer_part, buffer_text, year_lines
-from foldopt.studies.storage_days import DESIGN_COLUMNS, sequential
+from foldopt.studies.storage_days import design_columns, sequential
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
 from foldopt.studies.worldmap import searched_tilt
@@ -356,7 +356,7 @@ def of_study(result) -> Answer:
                 buffered.design_space, study.costs, study.storage.target, study.tracker.model
             )
             lines += said
-        columns[3:3] = DESIGN_COLUMNS
+        columns[3:3] = design_columns(buffered.designs)
     return Answer(
         "study",
         study.name,

@@ -28,7 +28,7 @@ def acts(storage) -> bool:
     leak's dependence set (its own or its preset's)."""
     return (
         storage is not None
-        and storage.cold
+        and storage.cold is not False
         and any(getattr(storage, name) is not None for name in COLD_FIELDS)
     )
 
@@ -65,7 +65,7 @@ def cold_steps(storage, temp_air) -> ColdSteps | None:
     """
     if not acts(storage):
         return None
-    temperature = buffer_temperature(temp_air, storage.enclosure_offset_c)
+    temperature = buffer_temperature(temp_air, storage.enclosure_offset_c or 0.0)
     return ColdSteps(
         charge=allowed(temperature, storage.charge_min_c),
         discharge=allowed(temperature, storage.discharge_min_c),

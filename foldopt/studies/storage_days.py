@@ -84,6 +84,14 @@ def day_columns(result: StorageResult) -> dict:
 
 #: The columns a buffer adds to a day's designs (summary.csv and the answer's table).
 DESIGN_COLUMNS = tuple(SUMMARY_COLUMNS.values())
+#: The columns the cold adds to them where it acts (:func:`day_storage`).
+COLD_COLUMNS = ("cold_lost_h", "charge_blocked_h", "charge_blocked_days_n")
+
+
+def design_columns(designs: pd.DataFrame) -> list:
+    """The columns a buffer adds to a day's designs (``DayStorage.designs``): :data:`DESIGN_COLUMNS`
+    and, where the cold acts, :data:`COLD_COLUMNS`."""
+    return [*DESIGN_COLUMNS, *(c for c in COLD_COLUMNS if c in designs)]
 
 
 @dataclass(frozen=True)

@@ -227,8 +227,8 @@ class _Runs:
             self.step_hours,
             self.engine,
             self.in_sequence,
-            [self.draws[row] for row in rows],
-            self.cold,
+            draws=[self.draws[row] for row in rows],
+            cold=self.cold,
         )
 
 
@@ -371,7 +371,16 @@ def capacity_grid(load, storage, step_hours, n_steps) -> np.ndarray:
 
 
 def _at_capacities(
-    power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None, cold=None
+    power,
+    capacities,
+    load,
+    storage,
+    step_hours,
+    engine,
+    in_sequence: bool,
+    *,
+    draws=None,
+    cold=None,
 ):
     """Each design's buffer at each of its capacities.
 
