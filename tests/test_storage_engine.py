@@ -41,6 +41,19 @@ def own_draws(data, power):
     return np.where(data.draw(arrays(bool, power.shape)), level, 0.0)
 
 
+def cold_steps_drawn(data, power):
+    """A buffer's temperature's effects at each step (issue 50), every field drawn: charge and
+    discharge blocked at some steps, a usable share and a leak factor, for every series or one
+    per series."""
+    shape = power.shape if data.draw(st.booleans()) else (1, *power.shape[1:])
+    return storage.ColdSteps(
+        data.draw(arrays(bool, shape)),
+        data.draw(arrays(bool, shape)),
+        data.draw(arrays(float, shape, elements=st.floats(0.05, 1.0))),
+        data.draw(arrays(float, shape, elements=st.floats(0.0, 8.0))),
+    )
+
+
 @st.composite
 def buffers(draw, capacity=None, hysteresis=True, leak=True):
     """A buffer with every option drawn (``capacity`` fixed where given)."""
@@ -192,7 +205,8 @@ def test_energy_is_conserved(curve, data):
 @given(curves(), st.data())
 def test_compiled_loop_equals_the_numpy_reference(curve, data):
     """The numba loop and the NumPy reference agree on every output, for constant loads and
-    profiles, buffers drawn with every option, one buffer per series, and a design's own draw."""
+    profiles, buffers drawn with every option, one buffer per series, a design's own draw and a
+    buffer's temperature."""
     power, step = curve
     n_series, n_days, n_steps = power.shape
     load_shape = data.draw(st.sampled_from([(), (n_series,), (1, n_steps), (n_series, n_days, 1)]))
@@ -202,8 +216,13 @@ def test_compiled_loop_equals_the_numpy_reference(curve, data):
         capacities = data.draw(arrays(float, n_series, elements=st.floats(0.0, 60.0)))
         buffer = buffer._replace(capacity_wh=capacities)
     draw = own_draws(data, power)
-    compiled = simulate(power, load, buffer, step, engine="numba", soc_curves=True, draw=draw)
-    reference = simulate(power, load, buffer, step, engine="numpy", soc_curves=True, draw=draw)
+    cold = cold_steps_drawn(data, power) if data.draw(st.booleans()) else None
+    compiled = simulate(
+        power, load, buffer, step, engine="numba", soc_curves=True, draw=draw, cold=cold
+    )
+    reference = simulate(
+        power, load, buffer, step, engine="numpy", soc_curves=True, draw=draw, cold=cold
+    )
     for name in storage.StorageResult._fields:
         np.testing.assert_array_equal(getattr(compiled, name), getattr(reference, name), name)
         assert np.isfinite(getattr(compiled, name)).all(), name

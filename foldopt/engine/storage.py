@@ -63,11 +63,12 @@ Conventions that follow from it:
 - Days *full* and *empty* are PVGIS's [1]_: days on which the buffer was full at some instant
   (never with no capacity), and days on which it was down to its cut-off at some instant (at
   midnight, or when it ran out under the load; with no capacity, every day).
-- A colder series does not power more, other things equal, where the self-discharge does not
-  depend on the temperature and the controller has no hysteresis: a blocked charge or discharge
-  and a raised cut-off only take energy away. A leak that slows in the cold can leave more
-  stored, and a raised reconnection level can reconnect the load later or (a band refilled)
-  earlier.
+- A colder series does not power more, to within one step, where the cold blocks the charge
+  only, for a controller without hysteresis and a buffer that does not leak, from an empty
+  buffer: less is stored at every instant. Where it blocks the discharge or raises the cut-off it
+  can: the energy kept for a later, warmer step runs the load longer then (a colder night can
+  power the next evening more); so can a leak that slows in the cold, and a periodic state the
+  cold makes another.
 - Powered time does not fall as the capacity grows, or as the load falls, to within one step,
   for a controller without hysteresis (``restart_soc = min_soc``) and a buffer that does not leak
   (``tests/test_storage_engine.py``). With a hysteresis band or a leak it can: the band
