@@ -49,8 +49,10 @@ def sky_air_temperature(sky) -> np.ndarray:
 
 def cold_steps(storage, temp_air) -> ColdSteps | None:
     """What the buffer's temperature does at each step, as
-    :func:`foldopt.engine.storage.simulate` takes it; None where it does nothing (:func:`acts`),
-    so that the run is the one without it, to the bit.
+    :func:`foldopt.engine.storage.simulate` takes it; None where it does nothing (:func:`acts`
+    false, or a temperature at which every charge and discharge is allowed, all the capacity
+    usable and the leak the stated one), so that the run is the one without it, to the bit, and
+    the answer says nothing of a cold that costs nothing.
 
     Parameters
     ----------
@@ -66,12 +68,19 @@ def cold_steps(storage, temp_air) -> ColdSteps | None:
     if not acts(storage):
         return None
     temperature = buffer_temperature(temp_air, storage.enclosure_offset_c or 0.0)
-    return ColdSteps(
+    steps = ColdSteps(
         charge=allowed(temperature, storage.charge_min_c),
         discharge=allowed(temperature, storage.discharge_min_c),
         capacity=capacity_fraction(temperature, storage.capacity_curve),
         leak=leak_factor(temperature, storage.self_discharge_doubling_c),
     )
+    warm = (
+        steps.charge.all()
+        and steps.discharge.all()
+        and (steps.capacity == 1.0).all()
+        and (steps.leak == 1.0).all()
+    )
+    return None if warm else steps
 
 
 def charge_blocked(storage, temp_air, step_hours: float) -> dict:
