@@ -244,6 +244,7 @@ def test_cold_columns_say_the_worst_month():
     assert said["cold_lost_mean_h"][0] == 1.0
     assert said["cold_lost_worst_month_h"][0] == 2.0
     assert said["cold_worst_month"][0] == 1
+    assert (said["cold_lost_month01_mean_h"][0], said["cold_lost_month02_mean_h"][0]) == (2.0, 0.0)
     assert cold_columns(powered, powered, [1, 1, 2, 2])["cold_worst_month"][0] == 0
 
 

@@ -331,10 +331,12 @@ def simulate(
     # One power curve, load or buffer may serve every series (a sizing search's capacities).
     sizes = [power.shape[0], load.shape[0], own.shape[0]]
     sizes += [np.size(v) for v in buffer if v is not None]
+    sizes += [np.shape(field)[0] for field in cold or () if np.ndim(field) == 3]
     n_series = max(sizes)
     if any(size not in (1, n_series) for size in sizes):
         raise ValueError(
-            f"power, load and buffer fields must have 1 or the same number of series; got {sizes}"
+            "power, load, buffer fields and cold must have 1 or the same number of series; got "
+            f"{sizes}"
         )
     n_days, n_steps = power.shape[1:]
     if not (np.isfinite(step_hours) and step_hours > 0):

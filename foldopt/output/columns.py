@@ -419,6 +419,7 @@ COLUMNS = (
         "h",
         "powered time the cold takes a day (beside the same run with the cold off), the mean",
     ),
+    ("cold_lost_month{month}_mean_h", "h", "powered time the cold takes a day in that month"),
     (
         "cold_lost_worst_month_h",
         "h",

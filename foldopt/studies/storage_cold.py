@@ -120,6 +120,7 @@ def cold_columns(powered, warm, months) -> dict:
     rows = np.arange(lost.shape[0])
     return {
         "cold_lost_mean_h": lost.mean(axis=1),
+        **{f"cold_lost_month{month:02d}_mean_h": by_month[:, i] for i, month in enumerate(present)},
         "cold_lost_worst_month_h": by_month[rows, worst],
         "cold_worst_month": np.where(by_month[rows, worst] > 0.0, present[worst], 0),
     }
