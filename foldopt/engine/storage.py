@@ -405,13 +405,12 @@ def _load_array(load, shape, name):
     return np.ascontiguousarray(load)
 
 
-def _cold_segments(cold, shape, n_series, params) -> layout.Cold:
-    """The steps' :class:`ColdSteps` per segment of each day, as the loops read them
-    (:class:`foldopt.engine.storage_records.Cold`; module docstring): at each segment the colder
-    end's charge, discharge and capacity, the mean of the two ends' leak factors."""
+def _cold_segments(cold, shape, n_series, params) -> np.ndarray:
+    """The steps' :class:`ColdSteps` per segment of each day, as the loops read them (one array,
+    :mod:`foldopt.engine.storage_records`' ``COLD_*`` columns; module docstring): at each segment
+    the colder end's charge, discharge and capacity, the mean of the two ends' leak factors."""
     if cold is None:
-        nothing = np.ones((1, 1, 1))
-        return layout.Cold(nothing, nothing, 0.0 * nothing, np.full((1, 1, 1), np.nan))
+        return np.array([1.0, 1.0, 0.0, np.nan]).reshape(1, 1, 1, 4)
     n_days, n_steps = shape[1:]
 
     def per_step(name, values):
@@ -466,8 +465,10 @@ def _cold_segments(cold, shape, n_series, params) -> layout.Cold:
         own = np.where(half, params.keep_half[rows, None, None], params.keep_step[rows, None, None])
         with np.errstate(invalid="ignore"):
             keep = np.where(factor == 1.0, own, own**factor)
-    return layout.Cold(
-        *(np.ascontiguousarray(field, dtype=float) for field in (charge, discharge, cut, keep))
+    fields = (charge, discharge, cut, keep)
+    common = np.broadcast_shapes(*(np.shape(field) for field in fields))
+    return np.ascontiguousarray(
+        np.stack([np.broadcast_to(field, common) for field in fields], axis=-1), dtype=float
     )
 
 
@@ -668,22 +669,21 @@ def _segments(curves: layout.Curves):
     return first, second, (l0 > 0.0) & (l1 > 0.0), half
 
 
-def _cold_at(cold: layout.Cold, par: layout.Parameters, d: int, j: int):
+def _cold_at(cold: np.ndarray, par: layout.Parameters, d: int, j: int):
     """Day ``d``'s segment ``j`` of every series: the cut-off and the reconnection [Wh], whether
     the buffer may charge and discharge, and the share kept (NaN: the buffer's own), as
     :func:`foldopt.engine.storage_kernel._levels` and ``_at`` read them."""
 
-    def at(values):
-        return values[:, d if values.shape[1] > 1 else 0, j if values.shape[2] > 1 else 0]
-
-    cut = at(cold.cut)
+    at = cold[:, d if cold.shape[1] > 1 else 0, j if cold.shape[2] > 1 else 0]
+    cut = at[:, layout.COLD_CUT]
     floor = (par.min_soc + cut * (1.0 - par.min_soc)) * par.capacity
     restart = (par.restart_soc + cut * (1.0 - par.restart_soc)) * par.capacity
-    return floor, restart, at(cold.charge) > 0.0, at(cold.discharge) > 0.0, at(cold.keep)
+    charge, discharge = at[:, layout.COLD_CHARGE] > 0.0, at[:, layout.COLD_DISCHARGE] > 0.0
+    return floor, restart, charge, discharge, at[:, layout.COLD_KEEP]
 
 
 def _run_numpy(
-    curves: layout.Curves, par: layout.Parameters, cold: layout.Cold, stored, on, days: layout.Days
+    curves: layout.Curves, par: layout.Parameters, cold: np.ndarray, stored, on, days: layout.Days
 ):
     """One pass over the days of a set of series (:func:`foldopt.engine.storage_kernel._run`
     without merging), the steps in turn and the series at once."""
@@ -739,7 +739,7 @@ def _simulate_numpy(curves, params, cold, days, passes, max_iterations, toleranc
     out, state, soc, soc_curves = days
     n_series = out.shape[0]
     power, load, draw = (np.broadcast_to(a, (n_series, *a.shape[1:])) for a in curves[:3])
-    cold = layout.Cold(*(np.broadcast_to(a, (n_series, *a.shape[1:])) for a in cold))
+    cold = np.broadcast_to(cold, (n_series, *cold.shape[1:]))
     step_hours, par = curves.step_hours, params
     capacity = par.capacity
     given = ~np.isnan(par.initial_soc)
@@ -755,7 +755,7 @@ def _simulate_numpy(curves, params, cold, days, passes, max_iterations, toleranc
         end, end_on = _run_numpy(
             layout.Curves(power[pick], load[pick], draw[pick], step_hours),
             layout.Parameters(*(field[pick] for field in par)),
-            layout.Cold(*(field[pick] for field in cold)),
+            cold[pick],
             stored[pick],
             on[pick],
             layout.Days(sub_out, sub_state, sub_soc, soc_curves),

@@ -23,6 +23,10 @@ from numba import njit, prange
 
 from foldopt.engine.storage_records import (
     CHARGE_LOSS,
+    COLD_CHARGE,
+    COLD_CUT,
+    COLD_DISCHARGE,
+    COLD_KEEP,
     DISCHARGE_LOSS,
     DRAWN,
     EMPTY,
@@ -35,7 +39,6 @@ from foldopt.engine.storage_records import (
     POWERED,
     SELF_DISCHARGE,
     SERVED,
-    Cold,
     Curves,
     Days,
     Parameters,
@@ -104,7 +107,7 @@ def _part(ends, tau, surplus, stored, on, par, cold):
     throughout (``surplus``) or below it; ``stored`` [Wh] and ``on`` the buffer's content and
     the load's state at its start, ``par`` the series' :class:`Parameters`, ``cold`` the
     segment's cut-off and reconnection [Wh] and whether the buffer may charge and discharge
-    (:class:`Cold`'s, the levels as contents).
+    (the series' cold array's, the levels as contents).
 
     Returns the buffer's content [Wh], whether the load is on, the part's energies [Wh] served,
     missing, lost, lost in charging and in discharging, the hours the load ran, whether the
@@ -158,16 +161,17 @@ def _part(ends, tau, surplus, stored, on, par, cold):
 
 
 @njit(cache=True, inline="always")
-def _at(values, d, j):
-    """Day ``d``'s segment ``j`` of one series' :class:`Cold` field (a size 1 serves all)."""
-    return values[d if values.shape[0] > 1 else 0, j if values.shape[1] > 1 else 0]
+def _at(cold, d, j, column):
+    """Day ``d``'s segment ``j`` of one series' cold array, its ``COLD_*`` ``column`` (a size 1
+    serves every day or segment)."""
+    return cold[d if cold.shape[0] > 1 else 0, j if cold.shape[1] > 1 else 0, column]
 
 
 @njit(cache=True, error_model="numpy")
 def _levels(par, cold, d, j):
     """Day ``d``'s segment ``j``: the cut-off and the reconnection [Wh] the cold raises
     (:func:`foldopt.physics.buffer_temperature.cold_cut_off`; the buffer's own without it)."""
-    cut = _at(cold.cut, d, j)
+    cut = _at(cold, d, j, COLD_CUT)
     floor = (par.min_soc + cut * (1.0 - par.min_soc)) * par.capacity
     restart = (par.restart_soc + cut * (1.0 - par.restart_soc)) * par.capacity
     return floor, restart
@@ -175,7 +179,7 @@ def _levels(par, cold, d, j):
 
 @njit(cache=True, error_model="numpy")
 def _run(curves, par, cold, stored, on, merge, days):
-    """One pass over a series' days (its :class:`Curves`, :class:`Parameters`, :class:`Cold` and
+    """One pass over a series' days (its :class:`Curves`, :class:`Parameters`, cold array and
     :class:`Days`) from the content ``stored`` [Wh] and load state ``on``.
 
     With ``merge``, a day that starts in the state the previous pass started it in
@@ -221,8 +225,8 @@ def _run(curves, par, cold, stored, on, merge, days):
             half = j == 0 or j == n_steps
             tau = 0.5 * step_hours if half else step_hours
             floor, restart = _levels(par, cold, d, j)
-            charge = _at(cold.charge, d, j) > 0.0
-            discharge = _at(cold.discharge, d, j) > 0.0
+            charge = _at(cold, d, j, COLD_CHARGE) > 0.0
+            discharge = _at(cold, d, j, COLD_DISCHARGE) > 0.0
             if j < n_steps:
                 harvested += p1 + d1
             e0, e1 = p0 - l0, p1 - l1
@@ -316,7 +320,7 @@ def _run(curves, par, cold, stored, on, merge, days):
                         powered += ran_h
                     full = full or was_full
                     empty = empty or ran_out
-            keep = _at(cold.keep, d, j)
+            keep = _at(cold, d, j, COLD_KEEP)
             if math.isnan(keep):
                 keep = keep_half if half else keep_step
             if keep < 1.0:  # without a leak the product is the content itself: spared
@@ -343,7 +347,7 @@ def _run(curves, par, cold, stored, on, merge, days):
 
 @njit(cache=True, error_model="numpy")
 def _series(curves, par, cold, days, max_iterations, tolerance):
-    """A series (its :class:`Curves`, :class:`Parameters`, :class:`Cold` and :class:`Days`) from
+    """A series (its :class:`Curves`, :class:`Parameters`, cold array and :class:`Days`) from
     its initial
     state of charge, or in its periodic state: passes until the state at the end of the series is
     that at its start (content within ``tolerance`` x the capacity, the load on or off alike),
@@ -401,8 +405,9 @@ def simulate_series(curves, params, cold, days, passes, max_iterations, toleranc
         Of every series (or one that serves all).
     params : Parameters
         The buffer of each series.
-    cold : Cold
-        Its temperature's effects per segment, of every series (or one that serves all).
+    cold : (n_series or 1, n_days or 1, n_steps + 1 or 1, 4) float
+        The buffer's temperature's effects per segment (``COLD_*`` columns), of every series (or
+        one that serves all).
     days : Days
         Of every series, written.
     passes : (n_series,) int
@@ -414,7 +419,6 @@ def simulate_series(curves, params, cold, days, passes, max_iterations, toleranc
     # field inside a parallel loop is lost (numba issues 5872 and 7135).
     power, load, draw, step_hours = curves
     out, state, soc, keep_soc = days
-    charge, discharge, cut, keep = cold
     (
         capacity,
         min_soc,
@@ -445,7 +449,7 @@ def simulate_series(curves, params, cold, days, passes, max_iterations, toleranc
                 max_discharge[s],
                 initial_soc[s],
             ),
-            Cold(_one(charge, s), _one(discharge, s), _one(cut, s), _one(keep, s)),
+            _one(cold, s),
             Days(out[s], state[s], soc[s if keep_soc else 0], keep_soc),
             max_iterations,
             tolerance,

@@ -65,32 +65,6 @@ class Parameters(NamedTuple):
     initial_soc: np.ndarray
 
 
-class Cold(NamedTuple):
-    """The buffer's temperature as the loops take it, per segment of a day (the ``n_steps + 1``
-    segments between step centres, :func:`foldopt.engine.storage.simulate`): for every series,
-    (n_series or 1, n_days or 1, n_steps + 1 or 1) arrays, each of its own shape (a size 1 serves
-    every series, day or segment); in the loops over one series, that series' (the first axis
-    taken).
-
-    Attributes
-    ----------
-    charge, discharge : float
-        1 where the buffer may charge / discharge over the segment, 0 where it is blocked.
-    cut : float
-        The share of the usable range ``[min_soc, 1]`` the cold puts out of reach [-] (0: none):
-        the cut-off and the reconnection are raised by it
-        (:func:`foldopt.physics.buffer_temperature.cold_cut_off`).
-    keep : float
-        The share of the content the segment keeps against self-discharge [-]; NaN: the
-        buffer's own (:class:`Parameters`' ``keep_step`` or ``keep_half``).
-    """
-
-    charge: np.ndarray
-    discharge: np.ndarray
-    cut: np.ndarray
-    keep: np.ndarray
-
-
 class Days(NamedTuple):
     """What the loops write: for every series, (n_series, ...) arrays; in the loops over one
     series, that series' (the first axis taken).
@@ -117,6 +91,16 @@ POWERED, SERVED, MISSING, LOST, HARVESTED = 0, 1, 2, 3, 4
 CHARGE_LOSS, DISCHARGE_LOSS, SELF_DISCHARGE, FULL, EMPTY = 5, 6, 7, 8, 9
 DRAWN = 10
 HISTOGRAM = 11
+
+# The buffer's temperature as the loops take it, per segment of a day (the ``n_steps + 1``
+# segments between step centres, foldopt.engine.storage.simulate): one array (n_series or 1,
+# n_days or 1, n_steps + 1 or 1, 4) (a size 1 serves every series, day or segment), in the loops
+# over one series that series'. Its last axis: 1 where the buffer may charge (COLD_CHARGE) and
+# discharge (COLD_DISCHARGE) over the segment, 0 where blocked; the share of the usable range
+# [min_soc, 1] the cold puts out of reach (COLD_CUT: the cut-off and the reconnection are raised
+# by it, foldopt.physics.buffer_temperature.cold_cut_off); and the share of the content the
+# segment keeps against self-discharge (COLD_KEEP; NaN: the buffer's own keep_step or keep_half).
+COLD_CHARGE, COLD_DISCHARGE, COLD_CUT, COLD_KEEP = 0, 1, 2, 3
 
 #: Plain fixed-point iterations (the buffer's own year after year) before the periodic state is
 #: bisected instead (a state that drifts by a little a day would take many plain ones).
