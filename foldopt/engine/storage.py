@@ -41,7 +41,8 @@ stored, out of reach until warm); the self-discharge's factor is the mean of the
 blocked charge loses the surplus (*lost*, as over a full buffer; with the load off, all the power);
 a blocked discharge turns the load off where PV alone does not carry it, as ``max_discharge_w``
 does. A load cut off waits for ``restart_soc`` as ever: below it, with the charger blocked, it
-stays off even where PV alone would carry it, until the buffer may charge. Without ``cold`` (or with effects that change nothing) every answer is the same to the bit.
+stays off even where PV alone would carry it, until the buffer may charge. Without ``cold``
+(or with effects that change nothing) every answer is the same to the bit.
 
 Conventions that follow from it:
 
