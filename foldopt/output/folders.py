@@ -251,9 +251,10 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
     if "annual_objective" in extras:
         write_csv(extras["annual_objective"], folder / "annual_objective.csv")
         written.append("annual_objective.csv")
-    if "storage_annual" in extras:
-        write_csv(extras["storage_annual"], folder / "storage_annual.csv")
-        written.append("storage_annual.csv")
+    for file in ("storage_annual.csv", "storage_years.csv", "storage_monthly.csv"):
+        if file.removesuffix(".csv") in extras:
+            write_csv(extras[file.removesuffix(".csv")], folder / file)
+            written.append(file)
     written += _design_space(extras.get("design_space"), folder, study)
     if "weather_sample" in extras:
         kind = {

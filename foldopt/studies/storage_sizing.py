@@ -27,7 +27,7 @@ bisects only its bracket, and says, per design (``monotone``), whether every lar
 grid reaches the target too; where one does not, the answer notes it.
 
 The module may import numpy, pandas, :mod:`foldopt.engine`, :mod:`foldopt.inputs` and
-:mod:`foldopt.studies.objectives`.
+:mod:`foldopt.studies.objectives` and :mod:`foldopt.studies.storage_periods`.
 """
 
 from __future__ import annotations
@@ -40,6 +40,7 @@ import pandas as pd
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.engine.storage import Buffer, StorageResult, simulate
 from foldopt.studies.objectives import best_angle_index
+from foldopt.studies.storage_periods import years_meeting
 
 #: Capacities of the grid [-, times the day's load energy over the usable fraction] (0 Wh first),
 #: with the study's own: the sizing's first bracket and the figure's curve of powered time
@@ -73,10 +74,14 @@ def reaches(result: StorageResult, target) -> np.ndarray:
     return _reaching(result.powered_h, result.converged, target)
 
 
-def _reaching(powered_h, converged, target) -> np.ndarray:
-    """:func:`reaches` of daily powered time [h] (n, n_days) and (n,) periodic states."""
+def _reaching(powered_h, converged, target, years=None) -> np.ndarray:
+    """:func:`reaches` of daily powered time [h] (n, n_days) and (n,) periodic states; with
+    ``years``, each day's year (n_days,), in ``target.years_pct`` of the years
+    (:func:`~foldopt.studies.storage_periods.years_meeting`)."""
     days = powered_h >= target.powered_h - TARGET_SLACK_H
-    return (100.0 * days.mean(axis=1) >= target.days_pct - 1e-9) & converged
+    if years is None:
+        return (100.0 * days.mean(axis=1) >= target.days_pct - 1e-9) & converged
+    return years_meeting(days, years, target.days_pct, target.years_pct) & converged
 
 
 @dataclass(frozen=True)
@@ -204,10 +209,13 @@ class _Runs:
     :func:`_at_capacities` of some of the curves, ``(rows, capacities (r, m))`` ->
     ``(hours, ok)``; ``draws`` per curve as its (None: none)."""
 
-    def __init__(self, power, draws, load, storage, step_hours, engine, in_sequence: bool):
+    def __init__(
+        self, power, draws, load, storage, step_hours, engine, in_sequence: bool, years=None
+    ):
         draws = [None] * len(power) if draws is None else draws
         self.power, self.draws, self.load, self.storage = power, draws, load, storage
         self.step_hours, self.engine, self.in_sequence = step_hours, engine, in_sequence
+        self.years = years
 
     def __call__(self, rows, capacities):
         return _at_capacities(
@@ -219,6 +227,7 @@ class _Runs:
             self.engine,
             self.in_sequence,
             [self.draws[row] for row in rows],
+            self.years,
         )
 
 
@@ -361,7 +370,7 @@ def capacity_grid(load, storage, step_hours, n_steps) -> np.ndarray:
 
 
 def _at_capacities(
-    power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None
+    power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None, years=None
 ):
     """Each design's buffer at each of its capacities.
 
@@ -378,6 +387,9 @@ def _at_capacities(
         each day is its own periodic series.
     draws : sequence, optional
         Per design, its own draw [W] shaped as its curve, or None (none).
+    years : array_like, optional
+        (n_days,) each day's year: the target is met in ``target.years_pct`` of the years
+        (:func:`_reaching`); default over the days as one.
 
     Returns
     -------
@@ -436,7 +448,7 @@ def _at_capacities(
         # it out).
         hours.append(np.where(converged, powered.mean(axis=1), np.nan))
         ok.append(
-            _reaching(powered, converged, target)
+            _reaching(powered, converged, target, years)
             if target is not None
             else np.zeros(capacity.size, bool)
         )
@@ -505,7 +517,9 @@ def _smallest(run, rows, first, capacities) -> np.ndarray:
     return _bracket(reach, lo, found, after_last=False)[1]
 
 
-def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool, draws=None):
+def smallest_buffers(
+    power, load, storage, step_hours, engine, in_sequence: bool, draws=None, years=None
+):
     """Each design's smallest buffer [Wh] for ``storage.target`` over its days (NaN: none up to
     the grid's top), by :func:`size_buffers`' search, and whether every larger capacity of the
     grid reaches it too (:func:`_held_above`).
@@ -516,11 +530,11 @@ def smallest_buffers(power, load, storage, step_hours, engine, in_sequence: bool
         (n, n_days, n_steps) [W].
     load, in_sequence
         As :func:`_at_capacities`'.
-    draws : sequence, optional
+    draws, years : optional
         As :func:`_at_capacities`'.
     """
     capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
-    run = _Runs(power, draws, load, storage, step_hours, engine, in_sequence)
+    run = _Runs(power, draws, load, storage, step_hours, engine, in_sequence, years)
     rows = np.arange(power.shape[0])
     _, ok = run(rows, np.broadcast_to(capacities, (rows.size, capacities.size)))
     first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)

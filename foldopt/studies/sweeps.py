@@ -495,10 +495,11 @@ CURVE_BYTES = 100e6
 
 
 def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, drawn, engine):
-    """storage_annual: the buffer over an annual group's days for each design, the twofold panel
-    at the angle t_solar's objective keeps and at the one the objective of daily powered time
-    keeps, simulated at every angle of the grid (a chunk of angles' curves at a time); with the
-    study's costs, design_space (:func:`foldopt.studies.least_cost.year_design_space`)."""
+    """storage_annual, storage_years and storage_monthly: the buffer over an annual group's days
+    for each design, the twofold panel at the angle t_solar's objective keeps and at the one the
+    objective of daily powered time keeps, simulated at every angle of the grid (a chunk of
+    angles' curves at a time); with the study's costs, design_space
+    (:func:`foldopt.studies.least_cost.year_design_space`)."""
     study = blocks.study
     shapes = [sky.load_shape for sky in skies]
     days = YearDays(
@@ -542,9 +543,7 @@ def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, 
         },
         near=near_optimal(fold_angles, score, study.near_optimal),
     )
-    tables = {
-        "storage_annual": year_storage(study.storage, days, drawn, choice, engine=engine, draws=own)
-    }
+    tables = year_storage(study.storage, days, drawn, choice, engine=engine, draws=own)._asdict()
     if study.costs is not None:
         angles = search_angles(fold_angles, np.concatenate([fold_angles[best], fold_angles[fixed]]))
         tables["design_space"] = year_design_space(
@@ -787,6 +786,8 @@ GROUP_TABLES = (
     "refold_schedule",
     "storage_annual",
     "design_space",
+    "storage_years",
+    "storage_monthly",
 )
 
 
