@@ -256,6 +256,16 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
             write_csv(extras[file.removesuffix(".csv")], folder / file)
             written.append(file)
     written += _design_space(extras.get("design_space"), folder, study)
+    if "storage_years" in extras and extras["storage_years"]["year"].nunique() > 1:
+        written.append(
+            write_figure(
+                folder,
+                "storage_years.png",
+                extras["storage_years"],
+                f"{name}: powered time with the buffer, year by year",
+                study=study,
+            )
+        )
     if "weather_sample" in extras:
         kind = {
             "measured": "measured minutes",

@@ -500,9 +500,7 @@ def year_storage(
             }
         )
         per_year.append(storage_years(keys, result, days.dates))
-        per_month.append(
-            storage_monthly(keys, result, days.dates, storage.min_soc, step_hours)
-        )
+        per_month.append(storage_monthly(keys, result, days.dates, storage.min_soc, step_hours))
         rows.append(
             keys.assign(
                 **{

@@ -68,8 +68,9 @@ def by_period(result: StorageResult, labels) -> tuple[np.ndarray, dict]:
         "days_n": lambda days: np.full(len(result.powered_h), days.sum()),
         "powered_mean_h": lambda days: result.powered_h[:, days].mean(axis=1),
         "powered_min_h": lambda days: result.powered_h[:, days].min(axis=1),
-        "powered_days_ge24h_pct": lambda days: 100.0
-        * (result.missing_wh[:, days] <= 0.0).mean(axis=1),
+        "powered_days_ge24h_pct": lambda days: (
+            100.0 * (result.missing_wh[:, days] <= 0.0).mean(axis=1)
+        ),
         "energy_served_wh": lambda days: result.served_wh[:, days].mean(axis=1),
         "energy_missing_wh": lambda days: result.missing_wh[:, days].mean(axis=1),
         "energy_missing_total_wh": lambda days: result.missing_wh[:, days].sum(axis=1),
