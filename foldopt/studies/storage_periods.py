@@ -64,25 +64,37 @@ def by_period(result: StorageResult, labels) -> tuple[np.ndarray, dict]:
     """
     labels = np.asarray(labels)
     periods = np.unique(labels)
-    reductions = {
-        "days_n": lambda days: np.full(len(result.powered_h), days.sum()),
-        "powered_mean_h": lambda days: result.powered_h[:, days].mean(axis=1),
-        "powered_min_h": lambda days: result.powered_h[:, days].min(axis=1),
-        "powered_days_ge24h_pct": lambda days: (
-            100.0 * (result.missing_wh[:, days] <= 0.0).mean(axis=1)
-        ),
-        "energy_served_wh": lambda days: result.served_wh[:, days].mean(axis=1),
-        "energy_missing_wh": lambda days: result.missing_wh[:, days].mean(axis=1),
-        "energy_missing_total_wh": lambda days: result.missing_wh[:, days].sum(axis=1),
-        "energy_lost_wh": lambda days: result.lost_wh[:, days].mean(axis=1),
-        "days_full_pct": lambda days: 100.0 * result.full[:, days].mean(axis=1),
-        "days_empty_pct": lambda days: 100.0 * result.empty[:, days].mean(axis=1),
-    }
-    masks = [labels == period for period in periods]
-    return periods, {
-        name: np.stack([reduce(days) for days in masks], axis=-1)
-        for name, reduce in reductions.items()
-    }
+    n_series = len(result.powered_h)
+
+    def over(days) -> dict:
+        # compress keeps each series' days contiguous, as the series' own arrays (a boolean
+        # index lays them out by columns): over a period of every day, the same sums to the bit.
+        powered, served, missing, lost, full, empty = (
+            values.compress(days, axis=1)
+            for values in (
+                result.powered_h,
+                result.served_wh,
+                result.missing_wh,
+                result.lost_wh,
+                result.full,
+                result.empty,
+            )
+        )
+        return {
+            "days_n": np.full(n_series, powered.shape[1]),
+            "powered_mean_h": powered.mean(axis=1),
+            "powered_min_h": powered.min(axis=1),
+            "powered_days_ge24h_pct": 100.0 * (missing <= 0.0).mean(axis=1),
+            "energy_served_wh": served.mean(axis=1),
+            "energy_missing_wh": missing.mean(axis=1),
+            "energy_missing_total_wh": missing.sum(axis=1),
+            "energy_lost_wh": lost.mean(axis=1),
+            "days_full_pct": 100.0 * full.mean(axis=1),
+            "days_empty_pct": 100.0 * empty.mean(axis=1),
+        }
+
+    each = [over(labels == period) for period in periods]
+    return periods, {name: np.stack([one[name] for one in each], axis=-1) for name in each[0]}
 
 
 def cs_hours(soc: np.ndarray, labels, min_soc: float, step_hours: float) -> np.ndarray:
