@@ -315,3 +315,20 @@ def test_a_bad_share_of_years_is_one_line_and_exit_2(two_years, tmp_path, monkey
     assert len(lines) == 1 and "Traceback" not in done.output, done.output
     assert "storage.target.years" in lines[0] and "every or a share" in lines[0], lines[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_the_figure_draws_each_design_s_years(two_years):
+    # The lines' points are the table's powered time per year, per design; the worst ringed.
+    _, result = two_years
+    years = result.extras["storage_years"]
+    ax = foldopt.plot_powered_by_year(years, "t")
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    rows = years[years["design"] == "flat"]
+    assert list(lines["flat"].get_xdata()) == rows["year"].tolist()
+    assert list(lines["flat"].get_ydata()) == rows["powered_mean_h"].tolist()
+    ringed = [
+        line for line in ax.get_lines() if line.get_markersize() == 12 and line.get_color() == "0.35"
+    ]
+    assert [list(line.get_ydata()) for line in ringed] == [
+        rows.loc[rows["worst_year"], "powered_mean_h"].tolist()
+    ]
