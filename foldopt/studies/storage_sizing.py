@@ -227,7 +227,7 @@ class _Runs:
             self.engine,
             self.in_sequence,
             [self.draws[row] for row in rows],
-            self.years,
+            years=self.years,
         )
 
 
@@ -370,7 +370,16 @@ def capacity_grid(load, storage, step_hours, n_steps) -> np.ndarray:
 
 
 def _at_capacities(
-    power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None, years=None
+    power,
+    capacities,
+    load,
+    storage,
+    step_hours,
+    engine,
+    in_sequence: bool,
+    draws=None,
+    *,
+    years=None,
 ):
     """Each design's buffer at each of its capacities.
 
