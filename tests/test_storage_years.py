@@ -327,7 +327,9 @@ def test_the_figure_draws_each_design_s_years(two_years):
     assert list(lines["flat"].get_xdata()) == rows["year"].tolist()
     assert list(lines["flat"].get_ydata()) == rows["powered_mean_h"].tolist()
     ringed = [
-        line for line in ax.get_lines() if line.get_markersize() == 12 and line.get_color() == "0.35"
+        line
+        for line in ax.get_lines()
+        if line.get_markersize() == 12 and line.get_color() == "0.35"
     ]
     assert [list(line.get_ydata()) for line in ringed] == [
         rows.loc[rows["worst_year"], "powered_mean_h"].tolist()

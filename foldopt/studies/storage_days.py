@@ -422,8 +422,8 @@ def year_storage(
     Returns
     -------
     YearStorage
-        Its ``storage_annual``, per load and design: ``site_name``, ``latitude``, ``longitude``, ``p_load_w``,
-        ``design``, ``fold_angle_deg``, ``days``, ``objective`` (the statistic),
+        Its ``storage_annual``, per load and design: ``site_name``, ``latitude``, ``longitude``,
+        ``p_load_w``, ``design``, ``fold_angle_deg``, ``days``, ``objective`` (the statistic),
         ``powered_objective_h`` (of the daily powered time), ``powered_mean_h``,
         ``powered_min_h``, ``t_solar_mean_h`` (of the same curves, with no buffer: the 0 Wh
         run) and :func:`day_columns`' ``availability_pct``, ``powered_days_ge24h_pct``,
@@ -477,7 +477,8 @@ def year_storage(
                 engine,
                 in_sequence,
                 None if own is None else list(own),
-                years,
+                # A clear sky's days are no real years: the days as one, whatever their dates.
+                years if days.weather else None,
             )
             with np.errstate(invalid="ignore", divide="ignore"):
                 vs_flat = (need / need[0] - 1.0) * 100.0 if need[0] > 0 else np.nan * need
