@@ -445,7 +445,7 @@ COLUMNS = (
     (
         "f_CS_{bin}",
         "pct",
-        "PVGIS's: the end-of-step states of charge in the bin-th tenth from the cut-off to full",
+        "PVGIS's: the steps whose state of charge is in the bin-th tenth from the cut-off to full",
     ),
     ("E_miss", "wh", "PVGIS's total: average energy a day missing, over every day (Wh/d)"),
     ("E_lost", "wh", "PVGIS's total: average energy a day not captured, over every day (Wh/d)"),

@@ -99,18 +99,19 @@ def by_period(result: StorageResult, labels) -> tuple[np.ndarray, dict]:
 
 def cs_hours(soc: np.ndarray, labels, min_soc: float, step_hours: float) -> np.ndarray:
     """Hours each series' charge state spends in each of PVGIS's ten bins from the cut-off to
-    full, per period: the state at the end of each step, for the step's length (a state below the
-    cut-off, the floor leaking, counts in the lowest bin; a full buffer in the highest).
+    full, per period: one state a step, the engine's at the step's centre, for the step's length
+    (PVGIS's is the state at the end of each hour, half an hour later on hourly steps); a state
+    below the cut-off, the floor leaking, counts in the lowest bin, a full buffer in the highest.
 
     Parameters
     ----------
     soc : numpy.ndarray
-        (n_series, n_days, n_steps) the state of charge [-] at the end of each step
+        (n_series, n_days, n_steps) the state of charge [-] at each step's centre
         (:func:`foldopt.engine.storage.simulate`'s ``soc_curves``).
     labels : array_like
         (n_days,) each day's period.
     min_soc : float
-        The cut-off [-].
+        The cut-off [-] in [0, 1).
     step_hours : float
 
     Returns
@@ -122,11 +123,7 @@ def cs_hours(soc: np.ndarray, labels, min_soc: float, step_hours: float) -> np.n
     labels = np.asarray(labels)
     periods, index = np.unique(labels, return_inverse=True)
     width = (1.0 - min_soc) / SOC_BINS
-    bins = np.clip(
-        np.floor((soc - min_soc) / width if width > 0 else np.zeros(soc.shape)),
-        0,
-        SOC_BINS - 1,
-    ).astype(np.int64)
+    bins = np.clip(np.floor((soc - min_soc) / width), 0, SOC_BINS - 1).astype(np.int64)
     n_series = soc.shape[0]
     cell = (np.arange(n_series)[:, None, None] * periods.size + index[None, :, None]) * SOC_BINS
     counts = np.bincount(
@@ -202,8 +199,8 @@ def storage_monthly(
         Per series and month: ``keys``' columns, ``month`` (1-12), ``d_total`` (days), ``E_d``
         (energy delivered to the load, Wh a day), ``E_lost_d`` (PV energy not captured, the
         battery full, Wh a day), ``f_f`` and ``f_e`` (days the battery became full, empty [%]),
-        :data:`CS_COLUMNS` (the share of the month's end-of-step charge states in each tenth of
-        the range from the cut-off to full [%]); and the series' totals, the same on each of its
+        :data:`CS_COLUMNS` (the share of the month's steps whose charge state lies in each tenth
+        of the range from the cut-off to full [%], :func:`cs_hours`); and the series' totals, the same on each of its
         months: ``E_miss`` and ``E_lost`` (energy missing, not captured, Wh a day over every
         day).
     """
