@@ -557,7 +557,18 @@ def _held_above(ok, first) -> np.ndarray:
     return (ok | (index < first[:, None])).all(axis=1) | (first < 0)
 
 
-def reaching(power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None):
+def reaching(
+    power,
+    capacities,
+    load,
+    storage,
+    step_hours,
+    engine,
+    in_sequence: bool,
+    draws=None,
+    *,
+    years=None,
+):
     """(n,) bool: whether each of ``power``'s curves (n, n_days, n_steps) [W] reaches
     ``storage.target`` at its own capacity (n,) [Wh] (:func:`reaches`), every curve in one call
     of the engine (a call's threads cost more than a year's series).
@@ -572,6 +583,8 @@ def reaching(power, capacities, load, storage, step_hours, engine, in_sequence: 
         As :func:`_at_capacities`'.
     draws : sequence, optional
         Per curve, its own draw [W], (n_days, n_steps), or None (none: a draw of 0 W).
+    years : array_like, optional
+        As :func:`_at_capacities`'.
     """
     n, days, steps = power.shape
     draw = (
@@ -592,4 +605,5 @@ def reaching(power, capacities, load, storage, step_hours, engine, in_sequence: 
         result.powered_h.reshape(n, days),
         result.converged.reshape(n, -1).all(axis=1),
         storage.target,
+        years,
     )
