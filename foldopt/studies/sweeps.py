@@ -126,7 +126,8 @@ def run_plan(
         (:func:`foldopt.engine.metrics.notes`: polar night, polar day, overcast, load above peak).
     """
     axes = dict(plan.axes)
-    loads = np.asarray(axes.pop("p_load", (plan.data.get("p_load"),)), dtype=float)
+    # The validated study's load: a load profile's scale defaults to 1 where the data leave it out.
+    loads = np.asarray(axes.pop("p_load", (plan.base.p_load,)), dtype=float)
     objective = plan.base.objective
     dates = axes.pop("date", None) if objective is not None else None
     weather = plan.base.weather
