@@ -39,7 +39,8 @@ PVCALC = json.loads((PVGIS / "pvcalc_45.000_8.000.json").read_text())
 MRCALC = json.loads((PVGIS / "mrcalc_45.000_8.000_2005_2023.json").read_text())
 TMY = json.loads((PVGIS / "tmy_45.000_8.000_2005_2023.json").read_text())
 MONTHS = np.arange(1, 13)
-YEARS = range(SHSCALC["inputs"]["meteo_data"]["year_min"], SHSCALC["inputs"]["meteo_data"]["year_max"] + 1)
+METEO = SHSCALC["inputs"]["meteo_data"]
+YEARS = range(METEO["year_min"], METEO["year_max"] + 1)
 #: Each month's days over every year of PVGIS's series (February's 28 or 29).
 DAYS = np.array([sum(calendar.monthrange(year, month)[1] for year in YEARS) for month in MONTHS])
 #: The loss terms PVGIS reports for the plane's PV yield (angle of incidence, spectral, temperature
