@@ -1,10 +1,10 @@
 """The command line's own process and Python's cyclic garbage collector.
 
-A command loads some 130,000 objects that live as long as its process (the modules of typer,
+A command loads some 100,000 objects that live as long as its process (the modules of typer,
 pydantic, numpy, pandas, matplotlib... with their classes and functions). The collector walks
 every object it tracks at each full pass, and starts a pass every few thousand new objects:
 loading them set off passes over all that came before, and the interpreter's exit walks them all
-again (most of a second of a warm ``foldopt run`` on the 2-core machine, docs/performance.rst).
+again (what that cost a warm ``foldopt run`` is in docs/performance.rst).
 
 In the command line's own process (the ``foldopt`` script, ``python -m foldopt``) a command's
 modules load with the collector paused and are then frozen (:func:`gc.freeze`: its later passes
