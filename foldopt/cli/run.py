@@ -61,7 +61,7 @@ def run_request(
     with output.progress(label, total=total, unit=unit) as progress:
         # The studies' modules (pvlib, pandas, numba) only once there is work: help and a bad value stay quick.
         with loading():
-            from foldopt.api import run, write
+            from foldopt.api import run
             from foldopt.studies.day import StudyResult
 
         try:
@@ -78,25 +78,24 @@ def run_request(
         rows,
         [f"wrote {out}"],
         rows,
-        write=lambda: write_folder(write, result, out, overwrite),
+        write=lambda: write_folder(result, out, overwrite),
     )
 
 
-def write_folder(write, result, out: Path, overwrite: bool) -> None:
-    """Write a result's folder with :func:`foldopt.api.write`, its writers' modules (matplotlib,
+def write_folder(result, out: Path, overwrite: bool) -> None:
+    """Write a result's folder (:func:`foldopt.api.write`), its writers' modules (matplotlib,
     jinja2) loaded first (:func:`foldopt.cli.process.loading`).
 
     Parameters
     ----------
-    write : callable
-        :func:`foldopt.api.write`.
     result : object
         What :func:`foldopt.api.run` or :func:`~foldopt.api.reproduce` returned.
     out : pathlib.Path
     overwrite : bool
     """
     with loading():
-        import foldopt.output.folders  # noqa: F401 - what write imports, loaded here
+        from foldopt.api import write
+        from foldopt.output import folders  # noqa: F401 - what write imports when it writes
     write(result, out, overwrite, INVOCATION)
 
 
@@ -186,7 +185,7 @@ def reproduce(
     check_output(out, overwrite)
     with output.progress("reproducing Shin et al. (two PV models x two modes)"):
         with loading():
-            from foldopt.api import reproduce as reproduce_paper, write
+            from foldopt.api import reproduce as reproduce_paper
 
         result = reproduce_paper(engine)
     output.answer(
@@ -195,7 +194,7 @@ def reproduce(
         result.answer,
         None,
         [f"wrote {out}"],
-        write=lambda: write_folder(write, result, out, overwrite),
+        write=lambda: write_folder(result, out, overwrite),
     )
 
 
