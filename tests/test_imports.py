@@ -1,7 +1,9 @@
 """The import graph of a command as it runs (issue 49): a refused request and ``foldopt --help``
 load none of the heavy libraries (each of which alone costs the 0.3 s a refusal may take),
 ``foldopt run`` prints its answer before matplotlib loads for the figures, and the embedded
-study's answer (the command's, the API's) loads none of numba, scipy or pvlib.
+study's answer (the command's, the API's) loads none of numba, scipy or pvlib. The command line's
+own process freezes the modules a command loads (the collector's passes then leave them out) and
+an in-process caller's collector is left as it was.
 
 Each command runs in a fresh interpreter (``python -c PROBE``) that runs the command line as the
 ``foldopt`` script does and, as it ends, prints the heavy modules it imported; a meta-path hook
@@ -179,7 +181,7 @@ runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
 def test_the_command_lines_process_freezes_what_it_loads(tmp_path):
     """In the command line's own process a command's modules are frozen once loaded (the
     collector's passes leave them out, issue 49) while the collector still collects the work's
-    garbage, and the process exits with nothing left for the exit's passes to walk."""
+    garbage, and the process exits with next to nothing left for the exit's passes to walk."""
     done = subprocess.run(
         [sys.executable, "-c", COLLECTOR_PROBE, "run", "--out", str(tmp_path / "out"), "-q"],
         capture_output=True,
@@ -192,8 +194,9 @@ def test_the_command_lines_process_freezes_what_it_loads(tmp_path):
     # Passes ran during the work, with the 100,000-odd objects of typer, pydantic, numpy, pandas
     # and matplotlib frozen.
     assert state["passes"] > 0 and state["frozen"] > 50_000
+    # As it exits, all but what its last handlers made is frozen (none, today).
     frozen_at_exit, unfrozen_at_exit = state["exit"]
-    assert frozen_at_exit >= state["frozen"] and unfrozen_at_exit == 0
+    assert frozen_at_exit >= state["frozen"] and unfrozen_at_exit < 1_000
 
 
 def test_an_in_process_caller_keeps_its_collector():
