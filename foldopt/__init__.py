@@ -78,6 +78,7 @@ _PUBLIC = {
             "plot_distribution",
             "plot_day_hour",
             "plot_refold_value",
+            "plot_powered_by_year",
         )
     },
     **{

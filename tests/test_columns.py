@@ -21,7 +21,16 @@ import pytest
 from typer.testing import CliRunner
 
 from foldopt.cli.app import app
-from foldopt.output.columns import COLUMNS, PVLIB_NAMES, ROW_UNIT, WORDS, describe, parse, rst_table
+from foldopt.output.columns import (
+    COLUMNS,
+    PVGIS_NAMES,
+    PVLIB_NAMES,
+    ROW_UNIT,
+    WORDS,
+    describe,
+    parse,
+    rst_table,
+)
 from foldopt.studies.reproduce import REPRODUCTIONS
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -69,6 +78,8 @@ def problem(column: str) -> str | None:
         return None  # a study file's own name for the field
     if column in PVLIB_NAMES:
         return None if PVLIB_NAMES[column] == unit else f"pvlib's unit is {PVLIB_NAMES[column]}"
+    if column in PVGIS_NAMES:
+        return None if PVGIS_NAMES[column] == unit else f"PVGIS's unit is {PVGIS_NAMES[column]}"
     parts = parse(column)
     if unit in ("", ROW_UNIT):
         return None if parts is None else "a label named as a quantity"

@@ -1,7 +1,9 @@
 """The import graph of a command as it runs (issue 49): a refused request and ``foldopt --help``
 load none of the heavy libraries (each of which alone costs the 0.3 s a refusal may take),
 ``foldopt run`` prints its answer before matplotlib loads for the figures, and the embedded
-study's answer (the command's, the API's) loads none of numba, scipy or pvlib.
+study's answer (the command's, the API's) loads none of numba, scipy or pvlib. The command line's
+own process freezes the modules a command loads (the collector's passes then leave them out) and
+an in-process caller's collector is left as it was.
 
 Each command runs in a fresh interpreter (``python -c PROBE``) that runs the command line as the
 ``foldopt`` script does and, as it ends, prints the heavy modules it imported; a meta-path hook
@@ -150,6 +152,71 @@ def test_the_apis_run_of_the_embedded_study_imports_no_numba_scipy_pvlib_or_matp
     assert done.returncode == 0, done.stderr
     answered, imported = json.loads(done.stdout.splitlines()[-1])
     assert answered and imported == ["numpy", "pandas"]
+
+
+#: Runs the command line as the script does and reports the collector's passes that ran with
+#: objects frozen (and the most frozen then), and, as the process exits, what is frozen and not.
+COLLECTOR_PROBE = r"""
+import atexit, gc, json, runpy, sys
+
+seen = {"passes": 0, "frozen": 0}
+
+
+def watch(phase, info):
+    if phase == "start" and gc.get_freeze_count():
+        seen["passes"] += 1
+        seen["frozen"] = max(seen["frozen"], gc.get_freeze_count())
+
+
+gc.callbacks.append(watch)
+# Registered first, so run last: after the command and every exit handler of its libraries.
+atexit.register(
+    lambda: print(json.dumps({**seen, "exit": [gc.get_freeze_count(), len(gc.get_objects())]}))
+)
+sys.argv = ["foldopt", *sys.argv[1:]]
+runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
+"""
+
+
+def test_the_command_lines_process_freezes_what_it_loads(tmp_path):
+    """In the command line's own process a command's modules are frozen once loaded (the
+    collector's passes leave them out, issue 49) while the collector still collects the work's
+    garbage, and the process exits with next to nothing left for the exit's passes to walk."""
+    done = subprocess.run(
+        [sys.executable, "-c", COLLECTOR_PROBE, "run", "--out", str(tmp_path / "out"), "-q"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=_repository(),
+    )
+    assert done.returncode == 0, done.stderr
+    state = json.loads(done.stdout.splitlines()[-1])
+    # Passes ran during the work, with the 100,000-odd objects of typer, pydantic, numpy, pandas
+    # and matplotlib frozen.
+    assert state["passes"] > 0 and state["frozen"] > 50_000
+    # As it exits, all but what its last handlers made is frozen (none, today).
+    frozen_at_exit, unfrozen_at_exit = state["exit"]
+    assert frozen_at_exit >= state["frozen"] and unfrozen_at_exit < 1_000
+
+
+def test_an_in_process_caller_keeps_its_collector():
+    """A command run in the caller's process (a test's CliRunner, as a notebook would) freezes
+    nothing and leaves the collector as it found it, on or off."""
+    import gc
+
+    from typer.testing import CliRunner
+
+    from foldopt.cli.app import app
+
+    before = gc.get_freeze_count()
+    for enabled in (True, False):
+        (gc.enable if enabled else gc.disable)()
+        try:
+            done = CliRunner().invoke(app, ["run", "--set", "p_load=abc"])
+            assert done.exit_code == 2 and gc.isenabled() is enabled
+        finally:
+            gc.enable()
+    assert gc.get_freeze_count() == before
 
 
 def test_the_probe_sees_an_import():

@@ -22,7 +22,7 @@ from typing import Annotated
 import typer
 from typer.core import TyperCommand, TyperGroup
 
-from foldopt.cli import map as map_command, optimize, run, size, sweep, weather
+from foldopt.cli import map as map_command, optimize, process, run, size, sweep, weather
 from foldopt.cli.output import INVOCATION, as_text, echo
 from foldopt.errors import ConfigError, OutputError, OutputExistsError
 from foldopt.names import close_names
@@ -165,6 +165,8 @@ class _OneLineErrors(TyperGroup):
         # typer.testing.CliRunner calls this main directly, so only here do both take the one error
         # path. The rest is click's documented standalone_mode=False: exceptions come to the caller.
         INVOCATION[:] = ["foldopt", *map(as_text, sys.argv[1:] if args is None else args)]
+        if args is None:  # the process's own command line (the script, python -m): its alone
+            process.own_process()
         for stream in (sys.stdout, sys.stderr):
             # A terminal that cannot show a character (a site's name under LANG=C) gets an escape, not an error.
             if codecs.lookup(
@@ -177,6 +179,8 @@ class _OneLineErrors(TyperGroup):
             code = super().main(args, *rest, **{**kwargs, "standalone_mode": False})
         except Exception as error:
             sys.exit(_exit_code(error))
+        finally:
+            process.ending()
         sys.exit(code if isinstance(code, int) else 0)
 
     def invoke(self, ctx):

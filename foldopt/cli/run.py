@@ -20,6 +20,7 @@ from foldopt.cli.options import (
     study_argument,
 )
 from foldopt.cli.output import INVOCATION, Output, fail
+from foldopt.cli.process import loading
 from foldopt.errors import ConfigError
 from foldopt.files import check_output
 from foldopt.names import DEFAULT_ENGINE
@@ -59,8 +60,9 @@ def run_request(
         label, total = f"{base.name}: {days} {unit}", days
     with output.progress(label, total=total, unit=unit) as progress:
         # The studies' modules (pvlib, pandas, numba) only once there is work: help and a bad value stay quick.
-        from foldopt.api import run, write
-        from foldopt.studies.day import StudyResult
+        with loading():
+            from foldopt.api import run
+            from foldopt.studies.day import StudyResult
 
         try:
             result = run(engine=engine, progress=progress, request=request)
@@ -76,8 +78,25 @@ def run_request(
         rows,
         [f"wrote {out}"],
         rows,
-        write=lambda: write(result, out, overwrite, INVOCATION),
+        write=lambda: write_folder(result, out, overwrite),
     )
+
+
+def write_folder(result, out: Path, overwrite: bool) -> None:
+    """Write a result's folder (:func:`foldopt.api.write`), its writers' modules (matplotlib,
+    jinja2) loaded first (:func:`foldopt.cli.process.loading`).
+
+    Parameters
+    ----------
+    result : object
+        What :func:`foldopt.api.run` or :func:`~foldopt.api.reproduce` returned.
+    out : pathlib.Path
+    overwrite : bool
+    """
+    with loading():
+        from foldopt.api import write
+        from foldopt.output import folders  # noqa: F401 - what write imports when it writes
+    write(result, out, overwrite, INVOCATION)
 
 
 def run_options(command: str, options: dict, folder: str, **request) -> None:
@@ -103,7 +122,8 @@ def run_options(command: str, options: dict, folder: str, **request) -> None:
     out, overwrite = options.pop("out"), options.pop("overwrite")
     config, settings = options.pop("config"), options.pop("settings") or ()
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
-    from foldopt.studies.request import make_request
+    with loading():
+        from foldopt.studies.request import make_request
 
     try:
         request = make_request(command, config, options=options, settings=settings, **request)
@@ -134,7 +154,8 @@ def run(
     """
     output_format, engine = check_choices(output_format, engine)
     # The study's modules (yaml, pydantic, numpy) once a command runs: --help stays quick.
-    from foldopt.studies.request import make_request
+    with loading():
+        from foldopt.studies.request import make_request
 
     request = make_request("run", config, settings=settings or (), target_h=target_h)
     run_request(
@@ -163,7 +184,8 @@ def reproduce(
     output = Output(quiet, output_format)
     check_output(out, overwrite)
     with output.progress("reproducing Shin et al. (two PV models x two modes)"):
-        from foldopt.api import reproduce as reproduce_paper, write
+        with loading():
+            from foldopt.api import reproduce as reproduce_paper
 
         result = reproduce_paper(engine)
     output.answer(
@@ -172,7 +194,7 @@ def reproduce(
         result.answer,
         None,
         [f"wrote {out}"],
-        write=lambda: write(result, out, overwrite, INVOCATION),
+        write=lambda: write_folder(result, out, overwrite),
     )
 
 

@@ -112,6 +112,13 @@ class StorageTarget(StrictModel):
     days_pct : float, default 100
         The share of the days that must reach ``powered_h`` [%] in (0, 100] (a repeated clear-sky
         day reaches it on every day or on none).
+    years : 'every' or float, default 'every'
+        Over a series of several calendar years, the share of the years [%] in (0, 100] that must
+        meet the target, a year meeting it where ``days_pct`` of its days reach ``powered_h``;
+        ``every`` is 100. The default asks the question a device's designer asks, whether it
+        survives the bad year, not the typical one (the days' share over the series as a whole
+        would let a good year make up for a bad one). Over one year, or a clear-sky study's
+        days, any value is the same target.
     """
 
     powered_h: interval(0, 24, lo_open=True, unit=" h") = Field(
@@ -120,6 +127,25 @@ class StorageTarget(StrictModel):
     days_pct: interval(0, 100, lo_open=True, unit=" %") = Field(
         100.0, description="share of the days that must reach powered_h"
     )
+    years: str | float = Field(
+        "every",
+        description="share of the years that must meet the target [%], or every",
+    )
+
+    @field_validator("years", mode="before")
+    @classmethod
+    def _every_or_share(cls, value):
+        if isinstance(value, str) and value.strip().lower() == "every":
+            return "every"
+        share = value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+        if share is None or not 0.0 < share <= 100.0:
+            raise ValueError("must be every or a share of the years in (0, 100] %")
+        return float(share)
+
+    @property
+    def years_pct(self) -> float:
+        """The share of the years that must meet the target [%] (``every``: 100)."""
+        return 100.0 if self.years == "every" else float(self.years)
 
 
 class Storage(StrictModel):

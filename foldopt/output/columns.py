@@ -16,13 +16,16 @@ A column is one of three kinds, and :data:`COLUMNS` lists each once with its uni
   weather file or a map's ``--sites`` file is read with, so what is written back is read the
   same way; extended by a design or a statistic, a pvlib word is foldopt's name and takes its
   unit (``surface_tilt_flat_deg``, ``poa_global_wh_m2``);
+- a quantity PVGIS's off-grid calculator names (:data:`PVGIS_NAMES`), in ``storage_monthly.csv``
+  only, as its response writes it (``E_d``, ``f_f``, ``f_CS_01``), so that the table reads as
+  PVGIS's answer does;
 - a label, which says which row this is or what it is (a site's name, a date, a design, a note,
   a flag): no unit.
 
-A name with ``{design}``, ``{connection}``, ``{half}``, ``{pct}``, ``{hours}`` or ``{month}``
-stands for one column per design (``flat``, ``twofold``, ``tracker``, ``tracker_net``),
+A name with ``{design}``, ``{connection}``, ``{half}``, ``{pct}``, ``{hours}``, ``{month}`` or
+``{bin}`` stands for one column per design (``flat``, ``twofold``, ``tracker``, ``tracker_net``),
 connection, half of the panel (``east``, ``west``), percentile of a cloud ensemble (10, 50, 90),
-threshold or month. A sweep's other varied fields are columns
+threshold, month or bin of a histogram. A sweep's other varied fields are columns
 named by their dotted path in a study file (``tracker.standby_w``). The manual's table
 (``docs/columns.rst``) is :func:`rst_table`, and a test checks every command's columns against
 :func:`describe` and :func:`parse`.
@@ -108,6 +111,18 @@ PVLIB_NAMES = {
     "dhi": "w_m2",
     "temp_air": "c",
     "wind_speed": "m_s",
+}
+#: Quantities PVGIS's off-grid calculator (``SHScalc``) names, in its units (an energy a day as
+#: ``wh``): written as its response writes them, for a table compared with its answer.
+PVGIS_NAMES = {
+    "d_total": "n",
+    "E_d": "wh",
+    "E_lost_d": "wh",
+    "f_f": "pct",
+    "f_e": "pct",
+    **{f"f_CS_{index:02d}": "pct" for index in range(1, 11)},
+    "E_miss": "wh",
+    "E_lost": "wh",
 }
 #: The unit of a value whose unit is its row's ``unit`` column (the reproduction's tables).
 ROW_UNIT = "row"
@@ -431,6 +446,33 @@ COLUMNS = (
         "wh",
         "a design's least buffer for the target with the cold off (storage_annual.csv)",
     ),
+    # the buffer by calendar year (storage_years.csv) and month (storage_monthly.csv)
+    ("year", "", "the calendar year of a row (storage_years.csv)"),
+    ("month", "", "the calendar month of a row, 1-12, over every year (storage_monthly.csv)"),
+    ("energy_missing_total_wh", "wh", "the load's energy not served over the period"),
+    (
+        "powered_worst_month_h",
+        "h",
+        "the least of the year's months' mean daily powered time (storage_years.csv)",
+    ),
+    (
+        "powered_vs_typical_h",
+        "h",
+        "the year's mean daily powered time less the median year's (storage_years.csv)",
+    ),
+    ("worst_year", "", "the design's year of least mean daily powered time (storage_years.csv)"),
+    ("d_total", "n", "PVGIS's: the days of the month over every year (storage_monthly.csv)"),
+    ("E_d", "wh", "PVGIS's: average energy a day delivered to the load (Wh/d)"),
+    ("E_lost_d", "wh", "PVGIS's: average PV energy a day not captured, the buffer full (Wh/d)"),
+    ("f_f", "pct", "PVGIS's: the days on which the buffer became full"),
+    ("f_e", "pct", "PVGIS's: the days on which the buffer became empty (the cut-off)"),
+    (
+        "f_CS_{bin}",
+        "pct",
+        "PVGIS's: the steps whose state of charge is in the bin-th tenth from the cut-off to full",
+    ),
+    ("E_miss", "wh", "PVGIS's total: average energy a day missing, over every day (Wh/d)"),
+    ("E_lost", "wh", "PVGIS's total: average energy a day not captured, over every day (Wh/d)"),
     # sizing
     ("area_m2", "m2", "the panel's area"),
     ("benefit_usd", "usd", "lifetime benefit C_grid x t_solar x P_load (Shin et al. Eq. 7)"),
@@ -472,6 +514,7 @@ WORDS = {
     "pct": tuple(str(pct) for pct in ENSEMBLE_PERCENTILES),
     "hours": tuple(str(hours) for hours in THRESHOLDS_H),
     "month": tuple(f"{month:02d}" for month in range(1, 13)),
+    "bin": tuple(f"{index:02d}" for index in range(1, 11)),
 }
 _PATTERNS = [
     (
@@ -571,10 +614,13 @@ def rst_table() -> str:
         "statistic over days if any), and last, always, the unit: ``t_solar_flat_mean_h`` is the "
         "flat panel's mean daily t_solar in hours. A quantity pvlib names (``latitude``, "
         "``surface_tilt``, ``dni``, ``temp_air``...) is written as pvlib writes it, in pvlib's "
-        "unit: a weather file and a map's ``--sites`` file are read by those names. A label "
+        "unit: a weather file and a map's ``--sites`` file are read by those names. A quantity "
+        "PVGIS's off-grid calculator names (``E_d``, ``E_lost_d``, ``f_f``, ``f_e``, ``f_CS_01``"
+        "...) is written as its response writes it, in ``storage_monthly.csv``. A label "
         "(which site, day or design; a note; a flag) has no unit. A name with ``{design}``, "
-        "``{connection}``, ``{half}``, ``{pct}``, ``{hours}`` or ``{month}`` stands for one column "
-        "per design, connection, half of the panel (east, west), percentile, threshold or month. "
+        "``{connection}``, ``{half}``, ``{pct}``, ``{hours}``, ``{month}`` or ``{bin}`` stands for "
+        "one column per design, connection, half of the panel (east, west), percentile, "
+        "threshold, month or bin of a histogram. "
         "A sweep's other varied fields are columns named by their dotted path "
         "(``tracker.standby_w``)."
     )

@@ -251,10 +251,21 @@ def _annual_outputs(result, folder: Path, name: str) -> list[str]:
     if "annual_objective" in extras:
         write_csv(extras["annual_objective"], folder / "annual_objective.csv")
         written.append("annual_objective.csv")
-    if "storage_annual" in extras:
-        write_csv(extras["storage_annual"], folder / "storage_annual.csv")
-        written.append("storage_annual.csv")
+    for file in ("storage_annual.csv", "storage_years.csv", "storage_monthly.csv"):
+        if file.removesuffix(".csv") in extras:
+            write_csv(extras[file.removesuffix(".csv")], folder / file)
+            written.append(file)
     written += _design_space(extras.get("design_space"), folder, study)
+    if "storage_years" in extras and extras["storage_years"]["year"].nunique() > 1:
+        written.append(
+            write_figure(
+                folder,
+                "storage_years.png",
+                extras["storage_years"],
+                f"{name}: powered time with the buffer, year by year",
+                study=study,
+            )
+        )
     if "weather_sample" in extras:
         kind = {
             "measured": "measured minutes",

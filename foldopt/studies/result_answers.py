@@ -18,7 +18,7 @@ from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.designs import PLANES_DESIGN
 from foldopt.studies.horizon_paths import horizon_notes
 from foldopt.studies.least_cost import least_cost_answer
-from foldopt.studies.storage_answer import answer_part, buffer_text, year_lines
+from foldopt.studies.storage_answer import answer_part, buffer_text, worst_years, year_lines
 from foldopt.studies.storage_days import design_columns, sequential
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
@@ -714,9 +714,13 @@ def _of_annual(result) -> Answer:
     if buffered is not None:
         # The buffer over the days, said once here for every view (studies.storage_answer).
         in_sequence = sequential(_dates(plan), study.weather is not None)
-        lines += year_lines(study.storage, buffered, in_sequence)
+        # Real years, a weather file's (a clear sky's days are no real years).
+        worst = worst_years(result.extras["storage_years"]) if study.weather is not None else None
+        lines += year_lines(study.storage, buffered, in_sequence, worst)
         chosen = buffered.loc[buffered["design"] == "twofold-buffer", "fold_angle_deg"]
         part["storage"] = {
+            # Over several calendar years, each case's, load's and design's worst.
+            **({"worst_years": records(worst)} if worst is not None and len(worst) else {}),
             "buffer": buffer_text(study.storage),
             "days_in_sequence": in_sequence,
             "fold_angle_twofold_deg": result.extras["fold_angle"],

@@ -321,9 +321,43 @@ def _best_for_buffer(by: pd.DataFrame, angle) -> str:
     )
 
 
-def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
+def worst_years(years: pd.DataFrame) -> pd.DataFrame:
+    """Each load's and design's worst calendar year, where the days span several
+    (``storage_years.csv``' flagged rows; none over one year), with ``powered_typical_h``, the
+    median year's mean daily powered time [h].
+
+    Parameters
+    ----------
+    years : pandas.DataFrame
+        :func:`foldopt.studies.storage_periods.storage_years`' rows, case after case.
+    """
+    block = (years["design"] != years["design"].shift()).cumsum()
+    several = block.map(block.value_counts()) > 1
+    rows = years[years["worst_year"] & several].copy()
+    rows["powered_typical_h"] = rows["powered_mean_h"] - rows["powered_vs_typical_h"]
+    return rows.reset_index(drop=True)
+
+
+def _worst_year_line(named: dict, worst: pd.DataFrame) -> str:
+    """A load's line on its designs' worst years (:func:`worst_years`' rows by design)."""
+    return "  worst year: " + "; ".join(
+        f"{named[d]} {row['year']:d}: {row['powered_mean_h']:.2f} h a day "
+        f"({_signed(row['powered_vs_typical_h'], 2)} h on the typical year's "
+        f"{row['powered_typical_h']:.2f} h; worst month {row['worst_month']:d} "
+        f"{row['powered_worst_month_h']:.2f} h), all 24 h on "
+        f"{row['powered_days_ge24h_pct']:.0f} % of its days"
+        for d, row in worst.iterrows()
+        if d in named
+    )
+
+
+def year_lines(
+    storage, table: pd.DataFrame, in_sequence: bool, worst: pd.DataFrame | None = None
+) -> list[str]:
     """What an annual answer says of its buffer, per load (at most 8): powered time per design,
-    and the fold angle the objective of powered time keeps beside the one ``t_solar``'s keeps."""
+    the fold angle the objective of powered time keeps beside the one ``t_solar``'s keeps, and
+    over several calendar years each design's worst year (``worst``: :func:`worst_years`, in
+    the table's order) and the sizing for the target in ``storage.target.years`` of them."""
     how = (
         "the days in sequence from the last one's end state"
         if in_sequence
@@ -335,7 +369,8 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
         for start in range(0, len(table), len(YEAR_DESIGNS))
     ]
     sites = table[["latitude", "longitude"]].drop_duplicates()
-    for rows in cases[:8]:
+    worst = worst if worst is not None and len(worst) else None
+    for case, rows in enumerate(cases[:8]):
         by = rows.set_index("design")
         first = rows.iloc[0]
         p_load = first["p_load_w"]
@@ -368,11 +403,29 @@ def year_lines(storage, table: pd.DataFrame, in_sequence: bool) -> list[str]:
             )
         )
         lines.append(_best_for_buffer(by, angle))
+        if worst is not None:
+            shown = {
+                d: text for d, text in named.items() if d != "twofold-buffer" or _another(angle)
+            }
+            lines.append(
+                _worst_year_line(
+                    shown,
+                    worst.iloc[case * len(YEAR_DESIGNS) : (case + 1) * len(YEAR_DESIGNS)].set_index(
+                        "design"
+                    ),
+                )
+            )
         if "capacity_wh" in by:
             target = storage.target
             said = f"{target.powered_h:g} h" + (
                 f" on {target.days_pct:g} % of days" if target.days_pct < 100 else " every day"
             )
+            if worst is not None:
+                said += (
+                    " in every year"
+                    if target.years_pct >= 100
+                    else f" in {target.years_pct:g} % of the years"
+                )
             need, saving = by["capacity_wh"], by["capacity_gain_vs_flat_pct"]
             lines.append(
                 f"  for {said}: "

@@ -12,7 +12,8 @@ year's days are each such a day, or, a weather file's days that follow each othe
 carried over from day to day (:func:`sequential`).
 
 The module may import numpy, pandas, :mod:`foldopt.engine`, :mod:`foldopt.inputs` and the
-studies it builds on (:mod:`~foldopt.studies.objectives`, :mod:`~foldopt.studies.storage_sizing`).
+studies it builds on (:mod:`~foldopt.studies.objectives`, :mod:`~foldopt.studies.storage_sizing`,
+:mod:`~foldopt.studies.storage_periods`).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from foldopt.studies.storage_cold import (
     cold_steps,
     per_series,
 )
+from foldopt.studies.storage_periods import storage_monthly, storage_years
 from foldopt.studies.storage_sizing import Sizing, buffer_of, size_buffers, smallest_buffers
 
 #: The designs whose state of charge the day's figure draws and ``timeseries.csv`` holds.
@@ -419,6 +421,26 @@ class YearChoice(NamedTuple):
     near: dict
 
 
+class YearStorage(NamedTuple):
+    """A buffer over an annual group's days (:func:`year_storage`): the tables of the run.
+
+    Attributes
+    ----------
+    storage_annual : pandas.DataFrame
+        Per load and design, over every day.
+    storage_years : pandas.DataFrame
+        Per load, design and calendar year
+        (:func:`~foldopt.studies.storage_periods.storage_years`).
+    storage_monthly : pandas.DataFrame
+        Per load, design and calendar month, in PVGIS's names
+        (:func:`~foldopt.studies.storage_periods.storage_monthly`).
+    """
+
+    storage_annual: pd.DataFrame
+    storage_years: pd.DataFrame
+    storage_monthly: pd.DataFrame
+
+
 def year_storage(
     storage,
     days: YearDays,
@@ -428,7 +450,7 @@ def year_storage(
     engine: str,
     draws=None,
     temp_air=None,
-) -> pd.DataFrame:
+) -> YearStorage:
     """A buffer over an annual group's days, per load and design.
 
     Parameters
@@ -449,9 +471,9 @@ def year_storage(
 
     Returns
     -------
-    pandas.DataFrame
-        Per load and design: ``site_name``, ``latitude``, ``longitude``, ``p_load_w``,
-        ``design``, ``fold_angle_deg``, ``days``, ``objective`` (the statistic),
+    YearStorage
+        Its ``storage_annual``, per load and design: ``site_name``, ``latitude``, ``longitude``,
+        ``p_load_w``, ``design``, ``fold_angle_deg``, ``days``, ``objective`` (the statistic),
         ``powered_objective_h`` (of the daily powered time), ``powered_mean_h``,
         ``powered_min_h``, ``t_solar_mean_h`` (of the same curves, with no buffer: the 0 Wh
         run) and :func:`day_columns`' ``availability_pct``, ``powered_days_ge24h_pct``,
@@ -459,12 +481,14 @@ def year_storage(
         ``days_empty_pct``; ``converged`` where every series found its periodic state; with
         ``storage.target``, ``capacity_wh``, the smallest buffer reaching it over the days
         (:func:`~foldopt.studies.storage_sizing.smallest_buffers`; NaN: none up to the grid's
-        top), ``capacity_gain_vs_flat_pct`` and ``monotone``; the near-optimal range of
+        top; over several calendar years, in ``storage.target.years`` of them),
+        ``capacity_gain_vs_flat_pct`` and ``monotone``; the near-optimal range of
         ``twofold-buffer`` (NaN in the other rows). Where the buffer's temperature acts, what
         the cold costs: ``charge_blocked_h`` and ``charge_blocked_days_n`` (the days', every
         row's), :func:`~foldopt.studies.storage_cold.cold_columns` beside the same run with the
         cold off, and with ``storage.target`` ``capacity_cold_off_wh`` (the smallest buffer with
-        the cold off).
+        the cold off). Its ``storage_years`` and ``storage_monthly``, the same days' simulation
+        by period.
     """
     engine = storage_engine(engine)
     loads = np.asarray(days.loads, dtype=float)
@@ -472,7 +496,8 @@ def year_storage(
     objective, site = choice.objective, choice.site
     months = [date.month for date in days.dates]
     cold = None if temp_air is None else cold_steps(storage, temp_air)
-    rows = []
+    years = [date.year for date in days.dates]
+    rows, per_year, per_month = [], [], []
     for index, p_load in enumerate(loads):
         power = np.stack(
             [curves[d] if curves[d].ndim == 2 else curves[d][:, index] for d in YEAR_DESIGNS]
@@ -485,8 +510,16 @@ def year_storage(
         series, load, draw, steps = _year_series(
             power, days.load(p_load, power.shape), in_sequence, own, cold
         )
+        # The state of charge at every step is the monthly table's histogram.
         result = simulate(
-            series, load, buffer_of(storage), step_hours, engine, draw=draw, cold=steps
+            series,
+            load,
+            buffer_of(storage),
+            step_hours,
+            engine,
+            draw=draw,
+            cold=steps,
+            soc_curves=True,
         )
         bare = simulate(
             series, load, buffer_of(storage, capacity_wh=0.0), step_hours, engine, draw=draw
@@ -518,7 +551,9 @@ def year_storage(
                     engine,
                     in_sequence,
                     None if own is None else list(own),
-                    steps,
+                    cold=steps,
+                    # A clear sky's days are no real years: the days as one, whatever their dates.
+                    years=years if days.weather else None,
                 )
 
             need, monotone = smallest(cold)
@@ -534,15 +569,21 @@ def year_storage(
         score = objective_value(powered.T, months, objective.statistic, objective.months)
         angles = np.array([choice.fold_angle_deg[d][index] for d in YEAR_DESIGNS])
         chosen = np.asarray(YEAR_DESIGNS) == "twofold-buffer"
+        keys = pd.DataFrame(
+            {
+                "site_name": site.name or "",
+                "latitude": site.latitude,
+                "longitude": site.longitude,
+                "p_load_w": p_load,
+                "design": YEAR_DESIGNS,
+                "fold_angle_deg": angles,
+            }
+        )
+        per_year.append(storage_years(keys, result, days.dates))
+        per_month.append(storage_monthly(keys, result, days.dates, storage.min_soc, step_hours))
         rows.append(
-            pd.DataFrame(
-                {
-                    "site_name": site.name or "",
-                    "latitude": site.latitude,
-                    "longitude": site.longitude,
-                    "p_load_w": p_load,
-                    "design": YEAR_DESIGNS,
-                    "fold_angle_deg": angles,
+            keys.assign(
+                **{
                     "days_n": powered.shape[1],
                     "objective": objective.statistic,
                     "powered_objective_h": score,
@@ -560,7 +601,9 @@ def year_storage(
                 }
             )
         )
-    return pd.concat(rows, ignore_index=True)
+    return YearStorage(
+        *(pd.concat(frames, ignore_index=True) for frames in (rows, per_year, per_month))
+    )
 
 
 def sequential(dates, weather: bool) -> bool:
@@ -583,6 +626,7 @@ def _by_design(result: StorageResult, designs: int) -> StorageResult:
                 "full",
                 "empty",
                 "soc_hours",
+                *(("soc",) if result.soc is not None else ()),
             )
         },
         passes=np.where(

@@ -27,7 +27,7 @@ bisects only its bracket, and says, per design (``monotone``), whether every lar
 grid reaches the target too; where one does not, the answer notes it.
 
 The module may import numpy, pandas, :mod:`foldopt.engine`, :mod:`foldopt.inputs` and
-:mod:`foldopt.studies.objectives`.
+:mod:`foldopt.studies.objectives` and :mod:`foldopt.studies.storage_periods`.
 """
 
 from __future__ import annotations
@@ -41,6 +41,7 @@ from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.engine.storage import Buffer, StorageResult, simulate
 from foldopt.studies.objectives import best_angle_index
 from foldopt.studies.storage_cold import per_series
+from foldopt.studies.storage_periods import years_meeting
 
 #: Capacities of the grid [-, times the day's load energy over the usable fraction] (0 Wh first),
 #: with the study's own: the sizing's first bracket and the figure's curve of powered time
@@ -74,10 +75,14 @@ def reaches(result: StorageResult, target) -> np.ndarray:
     return _reaching(result.powered_h, result.converged, target)
 
 
-def _reaching(powered_h, converged, target) -> np.ndarray:
-    """:func:`reaches` of daily powered time [h] (n, n_days) and (n,) periodic states."""
+def _reaching(powered_h, converged, target, years=None) -> np.ndarray:
+    """:func:`reaches` of daily powered time [h] (n, n_days) and (n,) periodic states; with
+    ``years``, each day's year (n_days,), in ``target.years_pct`` of the years
+    (:func:`~foldopt.studies.storage_periods.years_meeting`)."""
     days = powered_h >= target.powered_h - TARGET_SLACK_H
-    return (100.0 * days.mean(axis=1) >= target.days_pct - 1e-9) & converged
+    if years is None:
+        return (100.0 * days.mean(axis=1) >= target.days_pct - 1e-9) & converged
+    return years_meeting(days, years, target.days_pct, target.years_pct) & converged
 
 
 @dataclass(frozen=True)
@@ -211,12 +216,22 @@ class _Runs:
     curve)."""
 
     def __init__(
-        self, power, draws, load, storage, step_hours, engine, in_sequence: bool, cold=None
+        self,
+        power,
+        draws,
+        load,
+        storage,
+        step_hours,
+        engine,
+        in_sequence: bool,
+        *,
+        cold=None,
+        years=None,
     ):
         draws = [None] * len(power) if draws is None else draws
         self.power, self.draws, self.load, self.storage = power, draws, load, storage
         self.step_hours, self.engine, self.in_sequence = step_hours, engine, in_sequence
-        self.cold = cold
+        self.cold, self.years = cold, years
 
     def __call__(self, rows, capacities):
         return _at_capacities(
@@ -229,6 +244,7 @@ class _Runs:
             self.in_sequence,
             draws=[self.draws[row] for row in rows],
             cold=self.cold,
+            years=self.years,
         )
 
 
@@ -381,6 +397,7 @@ def _at_capacities(
     *,
     draws=None,
     cold=None,
+    years=None,
 ):
     """Each design's buffer at each of its capacities.
 
@@ -400,6 +417,9 @@ def _at_capacities(
     cold : foldopt.engine.storage.ColdSteps, optional
         The buffer's temperature's effects at each step of the days (fields (n_steps,) or
         (n_days, n_steps), every design's), default none.
+    years : array_like, optional
+        (n_days,) each day's year: the target is met in ``target.years_pct`` of the years
+        (:func:`_reaching`); default over the days as one.
 
     Returns
     -------
@@ -462,7 +482,7 @@ def _at_capacities(
         # it out).
         hours.append(np.where(converged, powered.mean(axis=1), np.nan))
         ok.append(
-            _reaching(powered, converged, target)
+            _reaching(powered, converged, target, years)
             if target is not None
             else np.zeros(capacity.size, bool)
         )
@@ -532,7 +552,7 @@ def _smallest(run, rows, first, capacities) -> np.ndarray:
 
 
 def smallest_buffers(
-    power, load, storage, step_hours, engine, in_sequence: bool, draws=None, cold=None
+    power, load, storage, step_hours, engine, in_sequence: bool, draws=None, cold=None, years=None
 ):
     """Each design's smallest buffer [Wh] for ``storage.target`` over its days (NaN: none up to
     the grid's top), by :func:`size_buffers`' search, and whether every larger capacity of the
@@ -544,11 +564,13 @@ def smallest_buffers(
         (n, n_days, n_steps) [W].
     load, in_sequence
         As :func:`_at_capacities`'.
-    draws, cold : optional
+    draws, cold, years : optional
         As :func:`_at_capacities`'.
     """
     capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
-    run = _Runs(power, draws, load, storage, step_hours, engine, in_sequence, cold)
+    run = _Runs(
+        power, draws, load, storage, step_hours, engine, in_sequence, cold=cold, years=years
+    )
     rows = np.arange(power.shape[0])
     _, ok = run(rows, np.broadcast_to(capacities, (rows.size, capacities.size)))
     first = np.where(ok.any(axis=1), np.argmax(ok, axis=1), -1)
@@ -562,7 +584,19 @@ def _held_above(ok, first) -> np.ndarray:
     return (ok | (index < first[:, None])).all(axis=1) | (first < 0)
 
 
-def reaching(power, capacities, load, storage, step_hours, engine, in_sequence: bool, draws=None):
+def reaching(
+    power,
+    capacities,
+    load,
+    storage,
+    step_hours,
+    engine,
+    in_sequence: bool,
+    draws=None,
+    *,
+    cold=None,
+    years=None,
+):
     """(n,) bool: whether each of ``power``'s curves (n, n_days, n_steps) [W] reaches
     ``storage.target`` at its own capacity (n,) [Wh] (:func:`reaches`), every curve in one call
     of the engine (a call's threads cost more than a year's series).
@@ -577,6 +611,8 @@ def reaching(power, capacities, load, storage, step_hours, engine, in_sequence: 
         As :func:`_at_capacities`'.
     draws : sequence, optional
         Per curve, its own draw [W], (n_days, n_steps), or None (none: a draw of 0 W).
+    cold, years : optional
+        As :func:`_at_capacities`'.
     """
     n, days, steps = power.shape
     draw = (
@@ -590,11 +626,14 @@ def reaching(power, capacities, load, storage, step_hours, engine, in_sequence: 
         power, capacities = power.reshape(-1, 1, steps), np.repeat(capacities, days)
         load = load if np.ndim(load) == 0 else load.reshape(power.shape)
         draw = None if draw is None else draw.reshape(power.shape)
-    result = simulate(
-        power, load, buffer_of(storage, capacity_wh=capacities), step_hours, engine, draw=draw
-    )
+        cold = per_series(
+            cold, lambda field: np.broadcast_to(field, (n, days, steps)).reshape(power.shape)
+        )
+    buffer = buffer_of(storage, capacity_wh=capacities)
+    result = simulate(power, load, buffer, step_hours, engine, draw=draw, cold=cold)
     return _reaching(
         result.powered_h.reshape(n, days),
         result.converged.reshape(n, -1).all(axis=1),
         storage.target,
+        years,
     )

@@ -127,7 +127,8 @@ def run_plan(
         (:func:`foldopt.engine.metrics.notes`: polar night, polar day, overcast, load above peak).
     """
     axes = dict(plan.axes)
-    loads = np.asarray(axes.pop("p_load", (plan.data.get("p_load"),)), dtype=float)
+    # The validated study's load: a load profile's scale defaults to 1 where the data leave it out.
+    loads = np.asarray(axes.pop("p_load", (plan.base.p_load,)), dtype=float)
     objective = plan.base.objective
     dates = axes.pop("date", None) if objective is not None else None
     weather = plan.base.weather
@@ -496,10 +497,11 @@ CURVE_BYTES = 100e6
 
 
 def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, drawn, engine):
-    """storage_annual: the buffer over an annual group's days for each design, the twofold panel
-    at the angle t_solar's objective keeps and at the one the objective of daily powered time
-    keeps, simulated at every angle of the grid (a chunk of angles' curves at a time); with the
-    study's costs, design_space (:func:`foldopt.studies.least_cost.year_design_space`)."""
+    """storage_annual, storage_years and storage_monthly: the buffer over an annual group's days
+    for each design, the twofold panel at the angle t_solar's objective keeps and at the one the
+    objective of daily powered time keeps, simulated at every angle of the grid (a chunk of
+    angles' curves at a time); with the study's costs, design_space
+    (:func:`foldopt.studies.least_cost.year_design_space`)."""
     study = blocks.study
     shapes = [sky.load_shape for sky in skies]
     days = YearDays(
@@ -545,11 +547,9 @@ def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, 
         },
         near=near_optimal(fold_angles, score, study.near_optimal),
     )
-    tables = {
-        "storage_annual": year_storage(
-            study.storage, days, drawn, choice, engine=engine, draws=own, temp_air=temp_air
-        )
-    }
+    tables = year_storage(
+        study.storage, days, drawn, choice, engine=engine, draws=own, temp_air=temp_air
+    )._asdict()
     if study.costs is not None:
         angles = search_angles(fold_angles, np.concatenate([fold_angles[best], fold_angles[fixed]]))
         tables["design_space"] = year_design_space(
@@ -792,6 +792,8 @@ GROUP_TABLES = (
     "refold_schedule",
     "storage_annual",
     "design_space",
+    "storage_years",
+    "storage_monthly",
 )
 
 

@@ -301,8 +301,55 @@ def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
     return ax
 
 
+#: The colour of each design of a buffer's years (``storage_years.csv``).
+YEAR_COLOURS = {**DESIGN_COLOURS, "twofold-buffer": "tab:green"}
+
+
+def plot_powered_by_year(years: pd.DataFrame, title: str, study=None, ax=None):
+    """Mean daily powered time with the buffer in each calendar year, per design (the first
+    case's first load), each design's worst year ringed and its worst month's mean beneath.
+
+    Parameters
+    ----------
+    years : pandas.DataFrame
+        ``storage_years.csv``: ``p_load_w``, ``design``, ``fold_angle_deg``, ``year``,
+        ``powered_mean_h``, ``powered_worst_month_h`` [h] and ``worst_year``.
+    title : str
+    study : foldopt.Study, optional
+        Names a load profile's load.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on; default a new figure (8 x 4.5 in).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    fig, ax = new_axes(ax, (8, 4.5))
+    block = (years["design"] != years["design"].shift()).cumsum()
+    first = years[block <= len(set(years["design"]))]
+    for design, rows in first.groupby("design", sort=False):
+        colour = YEAR_COLOURS.get(design, "k")
+        angle = rows["fold_angle_deg"].iloc[0]
+        label = design if angle != angle or design == "flat" else f"{design} {angle:g} deg"
+        ax.plot(rows["year"], rows["powered_mean_h"], "o-", color=colour, label=label)
+        ax.plot(rows["year"], rows["powered_worst_month_h"], ":", color=colour, lw=1)
+        worst = rows[rows["worst_year"]]
+        ax.plot(worst["year"], worst["powered_mean_h"], "o", ms=12, mfc="none", color=colour)
+    ax.plot([], [], "k:", lw=1, label="worst month's mean")
+    ax.set_xlabel("year")
+    ax.set_ylabel(
+        f"powered time [h a day], {load_label(study, first['p_load_w'].iloc[0])}", fontsize=9
+    )
+    ax.xaxis.get_major_locator().set_params(integer=True)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(title, fontsize=10)
+    return ax
+
+
 #: An annual study's folder holds the first two, the next three where one fold angle is kept all
-#: year (an objective over the days) and the last where re-folding is valued.
+#: year (an objective over the days), the next where re-folding is valued and the last where a
+#: buffer runs over several calendar years.
 FIGURES = {
     "daily_t_solar_distribution.png": FigureFile(
         plot_distribution, "daily t_solar of each design as box plots, per load"
@@ -320,5 +367,10 @@ FIGURES = {
     ),
     "refold_value.png": FigureFile(
         plot_refold_value, "the objective of the best schedule of k fold settings a year against k"
+    ),
+    "storage_years.png": FigureFile(
+        plot_powered_by_year,
+        "mean daily powered time with the buffer in each calendar year per design, the worst "
+        "year ringed (a buffer over two years or more)",
     ),
 }
