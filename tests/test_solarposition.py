@@ -265,6 +265,35 @@ def test_steps_kept_per_lattice_are_the_same_bits():
         np.testing.assert_array_equal(shared[name], alone[name])
 
 
+@pytest.mark.parametrize(
+    "days, zones",
+    [
+        (range(0, 365, 28), ["UTC-08:00"]),  # days spread over a year, apart
+        (range(0, 6), ["UTC+03:00", "UTC-07:00", "UTC+05:30"]),  # consecutive, overlapping in UTC
+        ([0, 0, 3], ["UTC"]),  # a block twice
+        ([68, 69, 70], ["America/Los_Angeles"]),  # 10 March, a DST day: off the lattice
+    ],
+)
+def test_a_call_alone_evaluates_the_instants_it_spans_to_the_bit(days, zones):
+    """A sky built with no run's store evaluates SPA's time-only terms at the instants its blocks
+    span alone (not a year's lattice for days spread over it): each block's terms are the bits a
+    direct evaluation at its own instants gives, and so is the sun."""
+    import foldopt.physics.spa as spa
+    from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
+
+    dates = [dt.date(2024, 1, 1) + dt.timedelta(days=d) for d in days]
+    grid = ClockGrid.stack([clock_grid(dates, zone, 5) for zone in zones])
+    direct = spa._equatorial(grid.utc_ns, spa.SunTerms())
+    first, terms = spa.equatorial_once(grid.utc_ns)
+    assert terms.shape[1] <= grid.utc_ns.size
+    again = np.stack([terms[:, start:start + grid.utc_ns.shape[1]] for start in first], axis=1)
+    np.testing.assert_array_equal(again, direct)
+    kept = solar_position_grid(grid, 40.0, -105.0, 1600.0, "exact", spa.SunTerms())
+    alone = solar_position_grid(grid, 40.0, -105.0, 1600.0, "exact")
+    for name in ("solar_zenith", "solar_azimuth", "hour_angle", "sun_vector"):
+        np.testing.assert_array_equal(alone[name], kept[name])
+
+
 @pytest.mark.parametrize("starts", [[0, 1440, 4320], [4320, 0], [0, 700, 1440, 9000], [5, 5, 1445], [3]])
 def test_instants_blocks_span_are_the_union_of_their_days(starts):
     """The lattice's instants a run's blocks span: apart (days of one time zone) or overlapping

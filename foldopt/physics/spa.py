@@ -186,15 +186,8 @@ class SunTerms:
         each instant is evaluated once for the run however many sites and days share it, and only
         the instants the days span: a sweep's days spread over a year evaluate those days alone."""
         n_blocks, n_steps = utc_ns.shape
-        step = int(utc_ns[0, 1] - utc_ns[0, 0]) if n_steps > 1 else 0
-        phase = int(utc_ns[0, 0] % step) if step > 0 else 0
-        # A day of equal steps spans them; a clock's change (a DST day) does not.
-        lattice = (
-            step > 0
-            and np.all(utc_ns[:, 0] % step == phase)
-            and np.all(utc_ns[:, -1] - utc_ns[:, 0] == step * (n_steps - 1))
-        )
-        if not lattice:
+        step, phase = _lattice(utc_ns)
+        if not step:
             return np.arange(n_blocks) * n_steps, _equatorial(utc_ns, self).reshape(5, -1)
         start = (utc_ns[:, 0] - phase) // step
         low, high = int(start.min()), int(start.max()) + n_steps - 1
@@ -224,6 +217,50 @@ class SunTerms:
             known[missing] = True
             self._lattices = {**self._lattices, (step, phase): (first, terms, known)}
         return start - first, terms
+
+
+def _lattice(utc_ns) -> tuple[int, int]:
+    """``(step, phase)`` [ns] of the UTC lattice on which every block of ``utc_ns`` (n_blocks,
+    n_steps) lies, its days of equal steps; ``(0, 0)`` where none does (a clock's change, a DST
+    day, breaks a day's steps)."""
+    n_steps = utc_ns.shape[1]
+    step = int(utc_ns[0, 1] - utc_ns[0, 0]) if n_steps > 1 else 0
+    phase = int(utc_ns[0, 0] % step) if step > 0 else 0
+    on_it = (
+        step > 0
+        and np.all(utc_ns[:, 0] % step == phase)
+        and np.all(utc_ns[:, -1] - utc_ns[:, 0] == step * (n_steps - 1))
+    )
+    return (step, phase) if on_it else (0, 0)
+
+
+def equatorial_once(utc_ns) -> tuple:
+    """:meth:`SunTerms.on_lattice` for a call that shares its terms with no other (a sky built
+    alone): the instants its blocks span, each once, in a store of those instants alone, not of
+    the lattice from the first to the last (a year's for days spread over it).
+
+    Parameters
+    ----------
+    utc_ns : numpy.ndarray of int64
+        (n_blocks, n_steps) UTC instants [ns].
+
+    Returns
+    -------
+    first, terms : numpy.ndarray
+        As :meth:`SunTerms.on_lattice`'s: block ``b``'s step ``i`` is ``terms[:, first[b] + i]``.
+    """
+    n_blocks, n_steps = utc_ns.shape
+    step, phase = _lattice(utc_ns)
+    if not step:
+        return np.arange(n_blocks) * n_steps, _equatorial(utc_ns, SunTerms()).reshape(5, -1)
+    start = (utc_ns[:, 0] - phase) // step
+    low = int(start.min())
+    spanned = _spanned(start - low, n_steps, int(start.max()) - low + n_steps)
+    # A block's instants are consecutive on the lattice, so they are consecutive among the
+    # spanned ones too.
+    return np.searchsorted(spanned, start - low), _equatorial(
+        (spanned + low) * step + phase, SunTerms()
+    )
 
 
 def _spanned(starts, n_steps: int, size: int) -> np.ndarray:
@@ -379,7 +416,9 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     u = pvlib.spa.uterm(latitude)
     x, y = pvlib.spa.xterm(u, latitude, altitude), pvlib.spa.yterm(u, latitude, altitude)
     lam, phi = np.radians(longitude), np.radians(latitude)
-    first, terms = (SunTerms() if sun_terms is None else sun_terms).on_lattice(utc_ns)
+    first, terms = (
+        equatorial_once(utc_ns) if sun_terms is None else sun_terms.on_lattice(utc_ns)
+    )
     # each component along the steps, as the engine reads it
     vector = np.empty((shape[0], 3, shape[1]))
     apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
