@@ -252,9 +252,10 @@ def test_run_plan_is_the_same_on_both_engines():
 @given(case=cases(), tie=st.integers(0, 10**6))
 def test_each_output_alone_has_its_bits_among_all(case, tie):
     """The kernel's loops for one output (switching from one table set a block; its walk over
-    the loads by blocks of steps, without the longest runs) do the general loops' operations in
-    their order: an output asked alone, with or without its longest runs, has the bits it has
-    among every output. Some loads are the curve's own samples, so that the power ties a load."""
+    the loads by blocks of steps, without the longest runs; the common case's chunk loop,
+    ``_chunk_switching``) do the general loops' operations in their order: an output asked
+    alone, with or without its longest runs, has the bits it has among every output. Some loads
+    are the curve's own samples, so that the power ties a load."""
     study, sites, dates, angles, loads = case
     sky, rows, electrical = _sky(study, sites, dates), _rows(study, sites, angles), engine_options(study).electrical
     every = engine.row_metrics(sky, rows=rows, loads=[1.0], electrical=electrical, outputs=engine.OUTPUTS,
@@ -270,3 +271,33 @@ def test_each_output_alone_has_its_bits_among_all(case, tie):
             for field in ("t_solar", "energy", "peak"):
                 np.testing.assert_array_equal(getattr(alone, field)[:, 0], getattr(every, field)[:, index])
             np.testing.assert_array_equal(alone.irradiation, every.irradiation)
+
+
+@pytest.mark.parametrize("sky", ["meinel", "ineichen"])
+def test_the_common_cases_loop_has_the_general_loops_bits(sky):
+    """Switching alone from one table set a block, the exact incidence without the modifier and
+    constant loads (W1-W3's case) run in a chunk loop of their own (``_chunk_switching``, its
+    square roots in the incidence's loop): every metric and every kept curve has the bits of the
+    general loop, which takes switching beside another output. Loads include a curve's own
+    sample and its peak, so that the power ties them."""
+    from foldopt.engine import kernel
+
+    study = make_study({"name": "common", "mode": "exact", "sky": sky, "pv_model": "single-diode",
+                        "connection": "switching", "site": {"latitude": 34.05, "longitude": -118.25},
+                        "date": "2025-01-01", "panel": {"area": 0.108, "efficiency": 0.19}, "p_load": 1.0,
+                        "step_min": 5})
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in (0, 95, 172, 300)]
+    sites = [study.site] * len(dates)
+    sky_, rows = _sky(study, sites, dates), _rows(study, sites, np.array([1.0, 37.0, 90.0, 145.0, 180.0]))
+    electrical = engine_options(study).electrical
+    general = engine.row_metrics(sky_, rows=rows, loads=[1.0], electrical=electrical, outputs=("switching", "east"),
+                                 engine="numba", curves=np.arange(rows.block.size))
+    loads = np.r_[0.05, general.power[3, 0, 150], general.peak[7, 0], 3.0]
+    general = engine.row_metrics(sky_, rows=rows, loads=loads, electrical=electrical, outputs=("switching", "east"),
+                                 engine="numba", curves=np.arange(rows.block.size))
+    common = engine.row_metrics(sky_, rows=rows, loads=loads, electrical=electrical, outputs=("switching",),
+                                engine="numba", curves=np.arange(rows.block.size))
+    assert kernel._chunk_switching.signatures  # the common case's loop ran
+    for field in ("t_solar", "energy", "peak", "power"):
+        np.testing.assert_array_equal(getattr(common, field)[:, 0], getattr(general, field)[:, 0])
+    np.testing.assert_array_equal(common.irradiation, general.irradiation)

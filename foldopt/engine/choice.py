@@ -27,10 +27,15 @@ from pathlib import Path
 from foldopt.names import AUTO_CACHED_NUMPY_ROW_STEPS, AUTO_NUMPY_ROW_STEPS, ENGINES
 
 #: The kernel's compiled entry points, by module of :mod:`foldopt.engine` and function: the rows
-#: (:func:`foldopt.engine.kernel.fold_rows`) and the curves (a tracker's, a design's:
+#: (:func:`foldopt.engine.kernel.fold_rows`: its common case's loop and the general one, each
+#: compiled at its first call) and the curves (a tracker's, a design's:
 #: :func:`foldopt.engine.curve_reduction.curve_rows`) every evaluation on the kernel runs through;
 #: their compile is the kernel's (the functions they call are compiled and cached with them).
-KERNEL_FUNCTIONS = (("kernel", "_chunk_rows"), ("curve_reduction", "_chunk_curves"))
+KERNEL_FUNCTIONS = (
+    ("kernel", "_chunk_rows"),
+    ("kernel", "_chunk_switching"),
+    ("curve_reduction", "_chunk_curves"),
+)
 
 
 def engine_for(engine: str, row_steps: float) -> str:

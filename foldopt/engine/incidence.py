@@ -73,8 +73,10 @@ def iam_factor(cos_aoi, model, params):
 @njit(cache=True, inline="always")
 def _incidence_steps(r, b, start, count, sky, rows, case, work):
     """:func:`incidence`'s main loop, inlined once per case with the case's flags (``case``:
-    ``paper``, ``has_terms``, ``modified``) as constants."""
-    paper, has_terms, modified = case
+    ``paper``, ``has_terms``, ``modified``, ``root``) as constants; ``root``: each sub-panel's
+    irradiance as the tables' coordinate, sqrt(E / E_max), taken in this loop (without the
+    modifier: :func:`foldopt.engine.kernel._chunk_switching`)."""
+    paper, has_terms, modified, root = case
     sun, paper_sun, beam, terms = sky.sun, sky.paper_sun, sky.beam, sky.terms
     east, west, incident, diffuse_east, diffuse_west = (
         work.east,
@@ -102,6 +104,7 @@ def _incidence_steps(r, b, start, count, sky, rows, case, work):
         row_paper[r, 1, 2],
         row_paper[r, 1, 3],
     )
+    to_root = 1.0 / IRRADIANCE_MAX
     for i in range(count):
         s = start + i
         cos_east = ex * sun[b, 0, s] + ey * sun[b, 1, s] + ez * sun[b, 2, s]
@@ -132,6 +135,9 @@ def _incidence_steps(r, b, start, count, sky, rows, case, work):
         incident[s] = 0.5 * (g_east + d_east + g_west + d_west)
         if modified:
             east[s], west[s], diffuse_east[s], diffuse_west[s] = g_east, g_west, d_east, d_west
+        elif root:
+            east[s] = math.sqrt(min(max(g_east + d_east, 0.0), IRRADIANCE_MAX) * to_root)
+            west[s] = math.sqrt(min(max(g_west + d_west, 0.0), IRRADIANCE_MAX) * to_root)
         else:
             east[s], west[s] = g_east + d_east, g_west + d_west
 
@@ -156,11 +162,11 @@ def incidence(r, b, first, n, sky, rows, tables, work):
     # Exact incidence without the modifier, with or without diffuse terms, as constants (every
     # study of a year or a map); paper mode and the modifier read their flags at run time.
     if not paper and not modified and has_terms:
-        _incidence_steps(r, b, start, count, sky, rows, (False, True, False), work)
+        _incidence_steps(r, b, start, count, sky, rows, (False, True, False, False), work)
     elif not paper and not modified:
-        _incidence_steps(r, b, start, count, sky, rows, (False, False, False), work)
+        _incidence_steps(r, b, start, count, sky, rows, (False, False, False, False), work)
     else:
-        _incidence_steps(r, b, start, count, sky, rows, (paper, has_terms, modified), work)
+        _incidence_steps(r, b, start, count, sky, rows, (paper, has_terms, modified, False), work)
     east, west = work.east, work.west
     if modified:
         sun, normal = sky.sun, rows.normal

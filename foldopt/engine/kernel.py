@@ -23,8 +23,10 @@ constants (the incidence per mode, diffuse terms and modifier; the power of a mo
 I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
 rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
 loop, not called. A function run at every step takes arrays, not records: each array of a record
-handed to it would be counted and released at every step. (What each choice was worth:
-``docs/performance.rst``.)
+handed to it would be counted and released at every step. The common case (switching alone from
+one table set a block, the exact incidence without the modifier, constant loads) has a chunk's
+loop of its own, :func:`_chunk_switching`, chosen before numba sees the call, so that a request
+compiles only the loop it runs. (What each choice was worth: ``docs/performance.rst``.)
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -37,7 +39,7 @@ from typing import NamedTuple
 
 from numba import njit, uint64
 
-from foldopt.engine.incidence import incidence, steps_sum
+from foldopt.engine.incidence import IAM_NONE, _incidence_steps, incidence, steps_sum
 from foldopt.engine.curve_reduction import blocked_day, day_metrics
 from foldopt.engine.records import WALK_BLOCK, in_chunks
 
@@ -483,7 +485,61 @@ def fold_rows(sky, rows, tables, loads, out, scratch):
     scratch : foldopt.engine.records.Scratch
         Per-chunk scratch (:func:`foldopt.engine.records.allocate`).
     """
-    in_chunks(_chunk_rows, rows.block.shape[0], scratch, sky, rows, tables, loads, out)
+    # Decided here, in Python: numba compiles a chunk's loop at its first call, so a request
+    # whose rows are all of the common case never compiles the general one, and the reverse.
+    common = (
+        tables.power_terms.shape[0] == 0
+        and not tables.as_built
+        and not tables.switch_series
+        and list(tables.connections) == [SWITCHING]
+        and sky.step_table.shape[1] == 1
+        and not sky.paper
+        and sky.iam_model == IAM_NONE
+        and not loads.contiguous
+        and not loads.use_profile
+    )
+    body = _chunk_switching if common else _chunk_rows
+    in_chunks(body, rows.block.shape[0], scratch, sky, rows, tables, loads, out)
+
+
+@njit(cache=True, nogil=True)
+def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
+    """:func:`_chunk_rows` for the common case, apart: switching alone from one table set a block,
+    the exact incidence without the modifier, constant loads without their longest runs (W1-W3,
+    a single-diode study's clear days). Its incidence takes the tables' coordinate in its main
+    loop (a pass over the steps less), and the row's other cases are not compiled into it: the
+    two make its row step cheaper than :func:`_chunk_rows`' (``docs/performance.rst``). The same
+    operations in the same order as :func:`_chunk_rows`', so the same bits
+    (``tests/test_engine.py``)."""
+    has_terms = sky.terms.shape[1] == 4
+    held = work.held
+    held[0] = loads.step_hours
+    for k in range(1, held.shape[0]):
+        held[k] = held[k - 1] + loads.step_hours
+    for r in range(start, stop):
+        b = rows.block[r]
+        first, last = sky.span[b, 0], sky.span[b, 1]
+        n = last + 1 - first
+        at, count = uint64(first), uint64(n)
+        if has_terms:
+            _incidence_steps(r, b, at, count, sky, rows, (False, True, False, True), work)
+        else:
+            _incidence_steps(r, b, at, count, sky, rows, (False, False, False, True), work)
+        out.irradiation[r] = steps_sum(work.incident, first, n) * loads.step_hours
+        harvested, peak = _switching_row(b, first, n, sky, tables, work)
+        if rows.curve[r] >= 0:
+            out.power[rows.curve[r], :, first : last + 1] = work.power[:, first : last + 1]
+        out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
+        blocked_day(
+            work.power[0],
+            (first, last),
+            loads.p_load[rows.loadset[r]],
+            loads.step_hours,
+            held,
+            (work.low, work.high),
+            (work.above, work.whole),
+            out.t_solar[r, 0],
+        )
 
 
 @njit(cache=True, nogil=True)

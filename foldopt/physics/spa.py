@@ -416,9 +416,7 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     u = pvlib.spa.uterm(latitude)
     x, y = pvlib.spa.xterm(u, latitude, altitude), pvlib.spa.yterm(u, latitude, altitude)
     lam, phi = np.radians(longitude), np.radians(latitude)
-    first, terms = (
-        equatorial_once(utc_ns) if sun_terms is None else sun_terms.on_lattice(utc_ns)
-    )
+    first, terms = equatorial_once(utc_ns) if sun_terms is None else sun_terms.on_lattice(utc_ns)
     # each component along the steps, as the engine reads it
     vector = np.empty((shape[0], 3, shape[1]))
     apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
