@@ -147,6 +147,20 @@ class StorageTarget(StrictModel):
         """The share of the years that must meet the target [%] (``every``: 100)."""
         return 100.0 if self.years == "every" else float(self.years)
 
+    def said(self, over_years: bool) -> str:
+        """The target as the answer says it, ``24 h every day`` (``over_years``: the days span
+        several calendar years, and the share of them is said too)."""
+        text = f"{self.powered_h:g} h" + (
+            f" on {self.days_pct:g} % of days" if self.days_pct < 100 else " every day"
+        )
+        if over_years:
+            text += (
+                " in every year"
+                if self.years_pct >= 100
+                else f" in {self.years_pct:g} % of the years"
+            )
+        return text
+
 
 class Storage(StrictModel):
     """A buffer behind a charge controller: what the load runs on when PV alone does not carry it.

@@ -54,6 +54,8 @@ References
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import pandas as pd
 
@@ -98,6 +100,8 @@ def design_space(
     engine: str,
     in_sequence: bool,
     draw=None,
+    cold=None,
+    years=None,
 ) -> pd.DataFrame:
     """Each kind's smallest buffer for ``storage.target`` at each area of the grid, its cost and
     the least-cost design (module docstring).
@@ -126,6 +130,11 @@ def design_space(
         The days follow each other (:func:`foldopt.studies.storage_days.sequential`).
     draw : numpy.ndarray, optional
         The tracker's own draw [W], (n_days, n_steps).
+    cold : foldopt.engine.storage.ColdSteps, optional
+        The buffer's temperature's effects at each step of the days (the same at every area:
+        the buffer's temperature is the air's, whatever the panel).
+    years : array_like, optional
+        (n_days,) each day's year, for a target met in ``storage.target.years`` of them.
 
     Returns
     -------
@@ -157,7 +166,7 @@ def design_space(
     draws = [kind[4] for kind in kinds for _ in range(m)]
     if drive is None or draw is None:
         draws = None
-    run = (load, storage, step_hours, engine, in_sequence)
+    run = _Run((load, storage, step_hours, engine, in_sequence), {"cold": cold, "years": years})
     grid = capacity_grid(load, storage, step_hours, power.shape[-1])
     upper, lower = _grid_bounds(scaled, draws, grid, (n, m), run)  # (n * m,) each
     areas = np.tile(AREA_FACTORS * area_m2, n)
@@ -182,7 +191,10 @@ def design_space(
     need, bracket = upper.copy(), np.where(upper > 0, (upper - lower) / upper, 0.0)
     if refine.size:
         found, _ = smallest_buffers(
-            scaled(refine), *run, None if draws is None else [draws[i] for i in refine]
+            scaled(refine),
+            *run.given,
+            None if draws is None else [draws[i] for i in refine],
+            **run.keywords,
         )
         need[refine], bracket[refine] = found, np.where(found > 0, CAPACITY_RTOL, 0.0)
     table = pd.DataFrame(
@@ -212,7 +224,16 @@ def design_space(
     return table[list(COLUMNS)]
 
 
-def _reach(scaled, draws, rows, capacities, run) -> np.ndarray:
+class _Run(NamedTuple):
+    """The sizing's arguments every evaluation of the search passes on: ``given``, ``(load,
+    storage, step_hours, engine, in_sequence)``, and ``keywords``, the days' ``cold`` and
+    ``years`` (:func:`foldopt.studies.storage_sizing.reaching`)."""
+
+    given: tuple
+    keywords: dict
+
+
+def _reach(scaled, draws, rows, capacities, run: _Run) -> np.ndarray:
     """(r,) bool: whether each of ``rows`` meets the target at its capacity (r,) [Wh]
     (:func:`foldopt.studies.storage_sizing.reaching`), a chunk of rows' curves at a time (their
     copies are the memory); ``scaled``, ``draws`` and ``run`` as :func:`_grid_bounds`'."""
@@ -223,8 +244,9 @@ def _reach(scaled, draws, rows, capacities, run) -> np.ndarray:
             reaching(
                 scaled(rows[at : at + size]),
                 capacities[at : at + size],
-                *run,
+                *run.given,
                 None if draws is None else [draws[row] for row in rows[at : at + size]],
+                **run.keywords,
             )
             for at in range(0, rows.size, size)
         ]
@@ -248,8 +270,8 @@ def _grid_bounds(scaled, draws, grid, shape, run):
         (g,) ascending [Wh].
     shape : tuple
         ``(n_kinds, n_areas)``.
-    run : tuple
-        ``(load, storage, step_hours, engine, in_sequence)``.
+    run : _Run
+        The sizing's arguments.
     """
     n_kinds, n_areas = shape
     # Per kind and capacity: the least area index meeting the target lies in [lo, hi] (n_areas:
@@ -284,7 +306,18 @@ def search_angles(fold_angles, best) -> np.ndarray:
 
 
 def year_design_space(
-    storage, costs, days, curves: dict, twofold, angles, *, area_m2, tracker_model, engine, draw
+    storage,
+    costs,
+    days,
+    curves: dict,
+    twofold,
+    angles,
+    *,
+    area_m2,
+    tracker_model,
+    engine,
+    draw,
+    cold=None,
 ) -> pd.DataFrame:
     """:func:`design_space` per load of an annual group's days, with its ``p_load_w``.
 
@@ -305,6 +338,8 @@ def year_design_space(
         The storage engine.
     draw : numpy.ndarray
         The tracker's own draw [W], (n_days, n_steps).
+    cold : foldopt.engine.storage.ColdSteps, optional
+        The days' (:func:`foldopt.studies.storage_cold.cold_steps`).
     """
     tables = []
     for p_load in np.asarray(days.loads, dtype=float):
@@ -320,13 +355,16 @@ def year_design_space(
             engine=engine,
             in_sequence=days.in_sequence,
             draw=draw,
+            cold=cold,
+            # A clear sky's days are no real years: the days as one, whatever their dates.
+            years=[date.year for date in days.dates] if days.weather else None,
         )
         tables.append(table.assign(p_load_w=p_load))
     columns = ["p_load_w", *COLUMNS]
     return pd.concat(tables, ignore_index=True)[columns]
 
 
-def day_design_space(study, power: dict, grid: tuple, load, *, step_hours, engine, draw):
+def day_design_space(study, power: dict, grid: tuple, load, *, step_hours, engine, draw, cold=None):
     """:func:`design_space` of a day's study: its clear-sky day repeated to its periodic state.
 
     Parameters
@@ -345,6 +383,8 @@ def day_design_space(study, power: dict, grid: tuple, load, *, step_hours, engin
         The storage engine.
     draw : numpy.ndarray or None
         The tracker's own draw [W], (n_steps,).
+    cold : foldopt.engine.storage.ColdSteps, optional
+        The day's (:func:`foldopt.studies.storage_cold.cold_steps`).
     """
     fold_angles, grid_power, best = grid
     angles = search_angles(fold_angles, [best])
@@ -364,6 +404,7 @@ def day_design_space(study, power: dict, grid: tuple, load, *, step_hours, engin
         engine=engine,
         in_sequence=True,
         draw=None if draw is None else draw[None],
+        cold=cold,
     )
     return table.assign(p_load_w=study.p_load)[["p_load_w", *COLUMNS]]
 
@@ -374,7 +415,9 @@ KIND_WORDS = {"flat": "flat", "twofold": "folded", "tracker-net": "tracker"}
 LINES_SHOWN = 8
 
 
-def least_cost_answer(space: pd.DataFrame, costs, target, tracker_model: str):
+def least_cost_answer(
+    space: pd.DataFrame, costs, target, tracker_model: str, over_years: bool = False
+):
     """What the answer says of the least-cost search: its lines and its part of the answer.
 
     Parameters
@@ -385,6 +428,9 @@ def least_cost_answer(space: pd.DataFrame, costs, target, tracker_model: str):
     costs : foldopt.inputs.costs_section.Costs
     target : foldopt.inputs.storage_section.StorageTarget
     tracker_model : str
+    over_years : bool, default False
+        The days span several calendar years (:meth:`StorageTarget.said
+        <foldopt.inputs.storage_section.StorageTarget.said>`).
 
     Returns
     -------
@@ -395,9 +441,7 @@ def least_cost_answer(space: pd.DataFrame, costs, target, tracker_model: str):
         design, ``cost_vs_flat_pct`` and ``at_grid_edge``; NaN where none meets the target).
     """
     keys = [c for c in space.columns if c not in COLUMNS]
-    said = f"{target.powered_h:g} h" + (
-        f" on {target.days_pct:g} % of days" if target.days_pct < 100 else " every day"
-    )
+    said = target.said(over_years)
     prices = [f"panel ${costs.panel_usd_per_m2:g}/m^2", f"buffer ${costs.buffer_usd_per_wh:g}/Wh"]
     drive = costs.drive_usd(tracker_model)
     for price, text in (

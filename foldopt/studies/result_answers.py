@@ -731,7 +731,12 @@ def _of_annual(result) -> Answer:
     space = result.extras.get("design_space")
     if space is not None:
         said, part["least_cost"] = least_cost_answer(
-            space, study.costs, study.storage.target, study.tracker.model
+            space,
+            study.costs,
+            study.storage.target,
+            study.tracker.model,
+            # Several calendar years, as the buffer's lines say them.
+            over_years="worst_years" in part.get("storage", {}),
         )
         lines += said
     designs = objectives[

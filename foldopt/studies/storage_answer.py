@@ -416,16 +416,7 @@ def year_lines(
                 )
             )
         if "capacity_wh" in by:
-            target = storage.target
-            said = f"{target.powered_h:g} h" + (
-                f" on {target.days_pct:g} % of days" if target.days_pct < 100 else " every day"
-            )
-            if worst is not None:
-                said += (
-                    " in every year"
-                    if target.years_pct >= 100
-                    else f" in {target.years_pct:g} % of the years"
-                )
+            said = storage.target.said(worst is not None)
             need, saving = by["capacity_wh"], by["capacity_gain_vs_flat_pct"]
             lines.append(
                 f"  for {said}: "

@@ -286,6 +286,7 @@ def day_storage(
             step_hours=step_hours,
             engine=engine,
             draw=draws.get("tracker-net"),
+            cold=cold,
         )
     return DayStorage(
         storage=storage,

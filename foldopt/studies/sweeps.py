@@ -46,7 +46,7 @@ from foldopt.engine.sky import Sky
 from foldopt.physics.spa import SunTerms
 from foldopt.studies.series import series_refused, year_piece, year_series
 from foldopt.studies.least_cost import search_angles, year_design_space
-from foldopt.studies.storage_cold import sky_air_temperature
+from foldopt.studies.storage_cold import cold_steps, sky_air_temperature
 from foldopt.studies.storage_days import (
     YearChoice,
     YearDays,
@@ -563,6 +563,7 @@ def _year_buffer(blocks, parts, skies, loads, *, objective, fold_angles, fixed, 
             tracker_model=study.tracker.model,
             engine=storage_engine(engine),
             draw=own["tracker-net"],
+            cold=cold_steps(study.storage, temp_air),
         )
     return tables
 
