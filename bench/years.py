@@ -1,6 +1,7 @@
 """A buffer over 19 real years in sequence (issue 50): the whole run of a study like
-``configs/camera-winter.yaml`` (a 2 W camera at 45 N 8 E, a LiFePO4 buffer sized for 24 h on
-every day of every year) over an hourly series of 2005-2023, and where its time goes.
+``configs/camera-winter.yaml`` (a 2 W camera at 45 N 8 E, a LiFePO4 buffer in the cold sized
+for 24 h on every day of every year, and the cheapest panel and buffer) over an hourly series of
+2005-2023, and where its time goes.
 
     python bench/years.py                 # 19 years, 3 runs
     python bench/years.py --years 2,19 --runs 5
@@ -44,18 +45,17 @@ from weather_years import write_series  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 #: The whole run of 19 years [s] (issue 50).
 TARGET_S = 20.0
-STUDY = """name: camera-years
-mode: exact
-site: {{latitude: 45.0, longitude: 8.0}}
-weather: {{path: {path}, format: pvgis-hourly}}
-panel: {{area: 0.4, efficiency: 0.1905}}
-p_load: 2.0
-objective: {{statistic: mean}}
-storage:
-  preset: lifepo4
-  capacity_wh: 200
-  target: {{powered_h: 24, days_pct: 100, years: every}}
-"""
+#: The study: configs/camera-winter.yaml (its cold and costs too), its weather the series.
+STUDY = (
+    (ROOT / "configs" / "camera-winter.yaml")
+    .read_text()
+    .replace("{", "{{")
+    .replace("}", "}}")
+    .replace(
+        "weather: {{path: ../tests/data/pvgis/seriescalc_45.000_8.000_2020_2021.json, ",
+        "weather: {{path: {path}, ",
+    )
+)
 
 
 def _environment() -> dict:

@@ -343,7 +343,7 @@ def _worst_year_line(named: dict, worst: pd.DataFrame) -> str:
     return "  worst year: " + "; ".join(
         f"{named[d]} {row['year']:d}: {row['powered_mean_h']:.2f} h a day "
         f"({_signed(row['powered_vs_typical_h'], 2)} h on the typical year's "
-        f"{row['powered_typical_h']:.2f} h; worst month {row['worst_month']:d} "
+        f"{row['powered_typical_h']:.2f} h; worst month {_MONTHS[row['worst_month'] - 1]} "
         f"{row['powered_worst_month_h']:.2f} h), all 24 h on "
         f"{row['powered_days_ge24h_pct']:.0f} % of its days"
         for d, row in worst.iterrows()
