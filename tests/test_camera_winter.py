@@ -1,0 +1,98 @@
+"""Issue 50's example, ``configs/camera-winter.yaml`` (a 2 W camera at 45 N 8 E over PVGIS's
+recorded hourly 2020-2021, a LiFePO4 in the cold sized for 24 h on every day of every year, costs
+given): its per-year, cold and least-cost lines through every view (the terminal, ``--format
+json``, report.html and the API say the same lines and write the same tables), and the same
+request with its buffer emptied reduces to the storage-less answer."""
+
+from __future__ import annotations
+
+import html
+import json
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+import foldopt
+from foldopt.cli.app import app
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDY = ROOT / "configs" / "camera-winter.yaml"
+#: The lines each part of the issue adds, by the words that open them.
+PARTS = ("  worst year: ", "  the cold: charge blocked ", "the cheapest panel and buffer for ")
+TABLES = ("storage_annual", "storage_years", "storage_monthly", "design_space")
+
+
+@pytest.fixture(scope="module")
+def views(tmp_path_factory):
+    """The study through the command line (terminal and JSON) and through the API."""
+    folder = tmp_path_factory.mktemp("camera-winter")
+    runner = CliRunner()
+    terminal = runner.invoke(app, ["run", str(STUDY), "--out", str(folder / "cli")])
+    assert terminal.exit_code == 0, terminal.output
+    done = runner.invoke(
+        app, ["run", str(STUDY), "--out", str(folder / "json"), "--format", "json"]
+    )
+    assert done.exit_code == 0, done.output
+    result = foldopt.run(STUDY)
+    foldopt.write(result, folder / "api")
+    return {
+        "terminal": terminal.stdout.splitlines(),
+        "json": json.loads(done.stdout)["answer"],
+        "api": result,
+        "folder": folder,
+    }
+
+
+def test_every_view_says_the_years_the_cold_and_the_least_cost(views):
+    lines = views["json"]["lines"]
+    for opening in PARTS:
+        said = [line for line in lines if line.startswith(opening)]
+        assert len(said) == 1, (opening, lines)
+        assert said[0] in views["terminal"]
+        assert said[0] in views["api"].answer.lines()
+        page = (views["folder"] / "cli" / "report.html").read_text(encoding="utf-8")
+        assert said[0].strip() in html.unescape(page)
+    assert views["api"].answer.lines() == lines
+    # The JSON's parts the lines come from.
+    part = views["json"]["result"]
+    assert part["storage"]["worst_years"] and part["least_cost"]["least_cost"]
+
+
+def test_the_command_line_and_the_api_write_the_same_tables(views):
+    for name in TABLES:
+        cli = (views["folder"] / "cli" / f"{name}.csv").read_bytes()
+        assert cli == (views["folder"] / "api" / f"{name}.csv").read_bytes(), name
+
+
+def test_the_worst_year_and_the_least_cost_hold_against_their_tables(views):
+    """The worst year flagged is the year of least mean powered time, for every design; the
+    least-cost design of each kind meets the target and is its kind's cheapest meeting row."""
+    years = pd.read_csv(views["folder"] / "cli" / "storage_years.csv")
+    for _, rows in years.groupby("design"):
+        flagged = rows[rows["worst_year"]]
+        assert len(flagged) == 1
+        assert flagged["powered_mean_h"].iloc[0] == rows["powered_mean_h"].min()
+    space = pd.read_csv(views["folder"] / "cli" / "design_space.csv")
+    for _, rows in space.groupby("design"):
+        least = rows[rows["least_cost"]]
+        assert len(least) == 1 and least["meets"].iloc[0]
+        assert least["cost_usd"].iloc[0] == rows.loc[rows["meets"], "cost_usd"].min()
+
+
+def test_an_empty_buffer_is_the_storage_less_answer(tmp_path):
+    """A buffer of 0 Wh (the cold and the target kept): each design's powered time is its t_solar,
+    day by day, as the storage-less run's annual table gives it."""
+    out = tmp_path / "empty"
+    done = CliRunner().invoke(
+        app,
+        ["run", str(STUDY), "--out", str(out), "--set", "storage.capacity_wh=0",
+         "--set", "storage.target=null", "--set", "costs=null"],
+    )  # fmt: skip
+    assert done.exit_code == 0, done.output
+    annual = pd.read_csv(out / "storage_annual.csv").set_index("design")
+    assert (annual["powered_mean_h"] == annual["t_solar_mean_h"]).all()
+    summary = pd.read_csv(out / "annual_summary.csv")
+    flat = summary.loc[summary["design"] == "flat", "t_solar_mean_h"].iloc[0]
+    assert annual.loc["flat", "powered_mean_h"] == pytest.approx(flat, abs=1e-12)
