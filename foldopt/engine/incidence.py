@@ -71,7 +71,7 @@ def iam_factor(cos_aoi, model, params):
 
 
 @njit(cache=True, inline="always")
-def _incidence_steps(r, b, start, count, sky, rows, case, work):
+def incidence_steps(r, b, start, count, sky, rows, case, work):
     """:func:`incidence`'s main loop, inlined once per case with the case's flags (``case``:
     ``paper``, ``has_terms``, ``modified``, ``root``) as constants; ``root``: each sub-panel's
     irradiance as the tables' coordinate, sqrt(E / E_max), taken in this loop (without the
@@ -151,7 +151,7 @@ def incidence(r, b, first, n, sky, rows, tables, work):
     :class:`foldopt.engine.records.Scratch`).
 
     The steps are indexed as unsigned integers, so that no index can wrap around, and the main
-    loop (:func:`_incidence_steps`) is inlined once per case, its flags constants: LLVM then
+    loop (:func:`incidence_steps`) is inlined once per case, its flags constants: LLVM then
     vectorises each. The incidence-angle modifier, a call per step, has a loop of its own (the beam
     waits for it in ``work.east`` and ``work.west``, the diffuse light in ``work.diffuse_east``
     and ``work.diffuse_west``), as has the tables' coordinate."""
@@ -162,11 +162,11 @@ def incidence(r, b, first, n, sky, rows, tables, work):
     # Exact incidence without the modifier, with or without diffuse terms, as constants (every
     # study of a year or a map); paper mode and the modifier read their flags at run time.
     if not paper and not modified and has_terms:
-        _incidence_steps(r, b, start, count, sky, rows, (False, True, False, False), work)
+        incidence_steps(r, b, start, count, sky, rows, (False, True, False, False), work)
     elif not paper and not modified:
-        _incidence_steps(r, b, start, count, sky, rows, (False, False, False, False), work)
+        incidence_steps(r, b, start, count, sky, rows, (False, False, False, False), work)
     else:
-        _incidence_steps(r, b, start, count, sky, rows, (paper, has_terms, modified, False), work)
+        incidence_steps(r, b, start, count, sky, rows, (paper, has_terms, modified, False), work)
     east, west = work.east, work.west
     if modified:
         sun, normal = sky.sun, rows.normal

@@ -39,7 +39,7 @@ from typing import NamedTuple
 
 from numba import njit, uint64
 
-from foldopt.engine.incidence import IAM_NONE, _incidence_steps, incidence, steps_sum
+from foldopt.engine.incidence import IAM_NONE, incidence_steps, incidence, steps_sum
 from foldopt.engine.curve_reduction import blocked_day, day_metrics
 from foldopt.engine.records import WALK_BLOCK, in_chunks
 
@@ -522,9 +522,9 @@ def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
         n = last + 1 - first
         at, count = uint64(first), uint64(n)
         if has_terms:
-            _incidence_steps(r, b, at, count, sky, rows, (False, True, False, True), work)
+            incidence_steps(r, b, at, count, sky, rows, (False, True, False, True), work)
         else:
-            _incidence_steps(r, b, at, count, sky, rows, (False, False, False, True), work)
+            incidence_steps(r, b, at, count, sky, rows, (False, False, False, True), work)
         out.irradiation[r] = steps_sum(work.incident, first, n) * loads.step_hours
         harvested, peak = _switching_row(b, first, n, sky, tables, work)
         if rows.curve[r] >= 0:

@@ -552,7 +552,16 @@ def _smallest(run, rows, first, capacities) -> np.ndarray:
 
 
 def smallest_buffers(
-    power, load, storage, step_hours, engine, in_sequence: bool, draws=None, cold=None, years=None
+    power,
+    load,
+    storage,
+    step_hours,
+    engine,
+    in_sequence: bool,
+    draws=None,
+    *,
+    cold=None,
+    years=None,
 ):
     """Each design's smallest buffer [Wh] for ``storage.target`` over its days (NaN: none up to
     the grid's top), by :func:`size_buffers`' search, and whether every larger capacity of the
