@@ -23,6 +23,19 @@ from foldopt.inputs.study_file import default_study_path
 from foldopt.api import load_study
 
 
+def _build_the_command_line_once() -> None:
+    """typer's CliRunner builds the click command tree again at every invoke (the signatures and
+    type hints of every command and option): a tenth of a command-line test's time. The tree is
+    built once a process, as the ``foldopt`` script builds it once a run; what each invoke runs
+    (click's parsing, the commands, their contexts) is made anew each time."""
+    import typer.testing
+
+    typer.testing._get_command = functools.cache(typer.testing._get_command)
+
+
+_build_the_command_line_once()
+
+
 @pytest.fixture(scope="session")
 def shin_study():
     """configs/shin2015.yaml, resolved (paper mode, azimuth-split, 1-min steps)."""
