@@ -1,6 +1,6 @@
 """Shared fixtures: the paper's study as shipped, a small tmpfs for full disks, an in-process Dask
-cluster and figures drawn without their pixels; the suite's order on its two workers, and the
-compiled code compiled once for both."""
+cluster and figures drawn without their pixels; the suite's order on its two workers, the
+compiled code compiled once for both, and the command line's click tree built once a worker."""
 
 import contextlib
 import functools
@@ -24,10 +24,11 @@ from foldopt.api import load_study
 
 
 def _build_the_command_line_once() -> None:
-    """typer's CliRunner builds the click command tree again at every invoke (the signatures and
-    type hints of every command and option): a tenth of a command-line test's time. The tree is
-    built once a process, as the ``foldopt`` script builds it once a run; what each invoke runs
-    (click's parsing, the commands, their contexts) is made anew each time."""
+    """typer's CliRunner builds the click command tree again at every invoke (it reads the
+    signature and type hints of every command and option), which cost more than the refusal
+    most command-line tests check. The tree is built once a process, as the ``foldopt`` script
+    builds it once a run; what each invoke runs (click's parsing, the commands, their contexts)
+    is made anew each time."""
     import typer.testing
 
     typer.testing._get_command = functools.cache(typer.testing._get_command)
