@@ -16,12 +16,16 @@ from typer.testing import CliRunner
 
 import foldopt
 from foldopt.cli.app import app
+from test_cli_studies import assert_a_users_folder
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = ROOT / "configs" / "camera-winter.yaml"
 #: The lines each part of the issue adds, by the words that open them.
 PARTS = ("  worst year: ", "  the cold: charge blocked ", "the cheapest panel and buffer for ")
 TABLES = ("storage_annual", "storage_years", "storage_monthly", "design_space")
+#: The folder as a user gets it, its figures drawn whole (it stands in test_cli_studies' run of
+#: every shipped study).
+pytestmark = pytest.mark.figure_pixels
 
 
 @pytest.fixture(scope="module")
@@ -55,6 +59,7 @@ def test_every_view_says_the_years_the_cold_and_the_least_cost(views):
         page = (views["folder"] / "cli" / "report.html").read_text(encoding="utf-8")
         assert said[0].strip() in html.unescape(page)
     assert views["api"].answer.lines() == lines
+    assert_a_users_folder(views["folder"] / "cli")
     # The JSON's parts the lines come from.
     part = views["json"]["result"]
     assert part["storage"]["worst_years"] and part["least_cost"]["least_cost"]

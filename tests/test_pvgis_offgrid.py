@@ -30,6 +30,7 @@ from foldopt.cli.app import app
 from foldopt.inputs.load_profile import hourly_steps
 from foldopt.inputs.plan import load_plan
 from foldopt.tables import write_csv
+from test_cli_studies import assert_a_users_folder
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDY = ROOT / "configs" / "pvgis-offgrid.yaml"
@@ -50,6 +51,10 @@ TOTALS = PVCALC["outputs"]["totals"]["fixed"]
 TOLERANCE = sum(abs(float(TOTALS[term])) for term in ("l_aoi", "l_spec", "l_tg")) / 100.0
 runner = CliRunner()
 
+
+#: The folder as a user gets it, its figures drawn whole (it stands in test_cli_studies' run of
+#: every shipped study).
+pytestmark = pytest.mark.figure_pixels
 
 def pvgis_monthly(answer: dict, name: str) -> np.ndarray:
     """A monthly column of SHScalc's answer, month 1 first."""
@@ -78,6 +83,7 @@ def folder(tmp_path_factory):
     out = tmp_path_factory.mktemp("pvgis-offgrid") / "run"
     result = runner.invoke(app, ["run", str(STUDY), "--out", str(out), "--quiet"])
     assert result.exit_code == 0, result.output
+    assert_a_users_folder(out)  # test_cli_studies' check of every shipped study
     return out
 
 
