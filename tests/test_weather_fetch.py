@@ -664,3 +664,22 @@ def test_a_kept_hourly_series_read_without_its_format_says_which(tmp_path, monke
         f"error: --weather {HOURLY.name}: not a PVGIS TMY file: no outputs.tmy_hourly list of hourly records; "
         "read as pvgis (by its extension .json), it looks like a pvgis-hourly file: give --weather-format "
         "pvgis-hourly (weather.format: pvgis-hourly in a study)"]
+
+
+def test_camera_winter_by_its_live_source_is_its_committed_answer(pvgis, server, tmp_path):
+    """configs/camera-winter.yaml as a user without the recorded file writes it (``weather:
+    {source: pvgis-hourly, years: "2020:2021"}``): the fetched real years, their air temperature
+    through the cold, give the committed example's buffer tables to the bit (per year, per month,
+    the cold's columns and the least-cost search)."""
+    route = pvgis("ok")
+    config = Path(__file__).resolve().parents[1] / "configs" / "camera-winter.yaml"
+    live = re.sub(r"(?m)^weather: .*$", 'weather: {source: pvgis-hourly, years: "2020:2021"}',
+                  config.read_text())
+    assert "source: pvgis-hourly" in live
+    (tmp_path / "camera-winter.yaml").write_text(live)
+    done = runner.invoke(app, ["run", "camera-winter.yaml", "--out", "live", "--quiet"])
+    assert done.exit_code == 0, done.output
+    example = config.parents[1] / "results" / "examples" / "camera-winter"
+    for name in ("storage_annual", "storage_years", "storage_monthly", "design_space"):
+        assert (tmp_path / "live" / f"{name}.csv").read_bytes() == (example / f"{name}.csv").read_bytes()
+    assert requests_made(server, route) == 1
