@@ -63,6 +63,7 @@ from foldopt.inputs.costs_section import DRIVE_FIELD
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.storage_sizing import (
     CAPACITY_RTOL,
+    bracketed_buffers,
     capacity_grid,
     reaching,
     smallest_buffers,
@@ -168,7 +169,8 @@ def design_space(
         draws = None
     run = _Run((load, storage, step_hours, engine, in_sequence), {"cold": cold, "years": years})
     grid = capacity_grid(load, storage, step_hours, power.shape[-1])
-    upper, lower = _grid_bounds(scaled, draws, grid, (n, m), run)  # (n * m,) each
+    known = _Known(scaled, draws, run)
+    upper, lower = _grid_bounds(known, grid, (n, m))  # (n * m,) each
     areas = np.tile(AREA_FACTORS * area_m2, n)
     extra = np.repeat([kind[3] for kind in kinds], m) + costs.fixed_usd
     names = np.repeat([kind[0] for kind in kinds], m)
@@ -182,21 +184,29 @@ def design_space(
     bound = pd.Series(high).groupby(names).transform("min").to_numpy()
     refine = np.isfinite(upper) & (cost(lower) <= bound)
     # The bounds are the premise's: a row whose upper bound does not meet the target at its own
-    # area, or whose lower one does, is sized too, so that every capacity said was evaluated.
-    known = np.flatnonzero(np.isfinite(upper))
-    below = known[upper[known] > 0]
-    refine[known[~_reach(scaled, draws, known, upper[known], run)]] = True
-    refine[below[_reach(scaled, draws, below, lower[below], run)]] = True
-    refine = np.flatnonzero(refine)
+    # area, or whose lower one does, is sized on the whole grid, so that every capacity said was
+    # evaluated; the others' brackets are the grid's.
+    rows = np.flatnonzero(np.isfinite(upper))
+    below = rows[upper[rows] > 0]
+    whole = np.zeros(n * m, bool)
+    whole[rows[~known.reach(rows, upper[rows])]] = True
+    whole[below[known.reach(below, lower[below])]] = True
+    refine |= whole
     need, bracket = upper.copy(), np.where(upper > 0, (upper - lower) / upper, 0.0)
-    if refine.size:
-        found, _ = smallest_buffers(
-            scaled(refine),
-            *run.given,
-            None if draws is None else [draws[i] for i in refine],
-            **run.keywords,
-        )
-        need[refine], bracket[refine] = found, np.where(found > 0, CAPACITY_RTOL, 0.0)
+    for chosen, sized in (
+        (np.flatnonzero(refine & ~whole), _bracketed(np.searchsorted(grid, upper))),
+        (np.flatnonzero(whole), _whole),
+    ):
+        if chosen.size:
+            found = sized(
+                scaled(chosen),
+                chosen,
+                *run.given,
+                None if draws is None else [draws[i] for i in chosen],
+                **run.keywords,
+            )
+            need[chosen], bracket[chosen] = found, np.where(found > 0, CAPACITY_RTOL, 0.0)
+    refine = np.flatnonzero(refine)
     table = pd.DataFrame(
         {
             "design": names,
@@ -233,32 +243,26 @@ class _Run(NamedTuple):
     keywords: dict
 
 
-def _reach(scaled, draws, rows, capacities, run: _Run) -> np.ndarray:
-    """(r,) bool: whether each of ``rows`` meets the target at its capacity (r,) [Wh]
-    (:func:`foldopt.studies.storage_sizing.reaching`), a chunk of rows' curves at a time (their
-    copies are the memory); ``scaled``, ``draws`` and ``run`` as :func:`_grid_bounds`'."""
-    size = max(1, int(CURVE_BYTES // scaled(np.zeros(1, int)).nbytes))
-    return np.concatenate(
-        [np.zeros(0, bool)]
-        + [
-            reaching(
-                scaled(rows[at : at + size]),
-                capacities[at : at + size],
-                *run.given,
-                None if draws is None else [draws[row] for row in rows[at : at + size]],
-                **run.keywords,
-            )
-            for at in range(0, rows.size, size)
-        ]
-    )
+def _bracketed(first):
+    """A row's sizing from its least capacity of the grid meeting the target, ``first`` (n,)
+    (indices of the grid, per row of the search): its bracket cut
+    (:func:`foldopt.studies.storage_sizing.bracketed_buffers`)."""
+
+    def sized(power, rows, *given, **keywords):
+        return bracketed_buffers(power, first[rows], *given, **keywords)
+
+    return sized
 
 
-def _grid_bounds(scaled, draws, grid, shape, run):
-    """Each row's least capacity of the sizing's ``grid`` [Wh] meeting the target (NaN: none)
-    and the grid's capacity below it (which does not; 0 where the least is the grid's first),
-    found per capacity by bisecting the areas of each kind: a capacity that meets the target at
-    an area meets it at every larger one (the premise of the sizing, with the area for the
-    capacity), so that each capacity's least area takes log2(areas) evaluations.
+def _whole(power, rows, *given, **keywords):
+    """Rows' sizing on the whole grid (:func:`foldopt.studies.storage_sizing.smallest_buffers`)."""
+    return smallest_buffers(power, *given, **keywords)[0]
+
+
+class _Known:
+    """Whether rows of the search meet the target at capacities, each (row, capacity) evaluated
+    once (:func:`foldopt.studies.storage_sizing.reaching`), a chunk of rows' curves at a time
+    (their copies are the memory).
 
     Parameters
     ----------
@@ -266,29 +270,69 @@ def _grid_bounds(scaled, draws, grid, shape, run):
         Rows (r,) of the kinds' areas, kind-major -> their curves (r, n_days, n_steps) [W].
     draws : list or None
         Per row, its own draw (or None).
+    run : _Run
+        The sizing's arguments.
+    """
+
+    def __init__(self, scaled, draws, run: _Run):
+        self.scaled, self.draws, self.run = scaled, draws, run
+        self.size = max(1, int(CURVE_BYTES // scaled(np.zeros(1, int)).nbytes))
+        self.found = {}
+
+    def reach(self, rows, capacities) -> np.ndarray:
+        """(r,) bool: whether each of ``rows`` (r,) meets the target at its capacity (r,) [Wh]."""
+        pairs = list(zip(rows.tolist(), np.asarray(capacities, dtype=float).tolist()))
+        new = list(dict.fromkeys(pair for pair in pairs if pair not in self.found))
+        for at in range(0, len(new), self.size):
+            chunk = new[at : at + self.size]
+            index = np.array([row for row, _ in chunk], dtype=int)
+            ok = reaching(
+                self.scaled(index),
+                np.array([capacity for _, capacity in chunk]),
+                *self.run.given,
+                None if self.draws is None else [self.draws[row] for row in index],
+                **self.run.keywords,
+            )
+            self.found.update(zip(chunk, ok.tolist()))
+        return np.array([self.found[pair] for pair in pairs], dtype=bool)
+
+
+def _grid_bounds(known: _Known, grid, shape):
+    """Each row's least capacity of the sizing's ``grid`` [Wh] meeting the target (NaN: none)
+    and the grid's capacity below it (which does not; 0 where the least is the grid's first),
+    found by a walk along each kind's frontier: from the largest area down, each area's least
+    capacity is at least the next larger area's (a capacity that meets the target at an area
+    meets it at every larger one, the premise of the sizing with the area for the capacity), so
+    that the walk steps up the capacities or down the areas, each kind at most n_areas + the
+    grid's size evaluations.
+
+    Parameters
+    ----------
+    known : _Known
+        The search's evaluations.
     grid : numpy.ndarray
         (g,) ascending [Wh].
     shape : tuple
         ``(n_kinds, n_areas)``.
-    run : _Run
-        The sizing's arguments.
     """
     n_kinds, n_areas = shape
-    # Per kind and capacity: the least area index meeting the target lies in [lo, hi] (n_areas:
-    # none does).
-    lo = np.zeros((n_kinds, grid.size), dtype=int)
-    hi = np.full((n_kinds, grid.size), n_areas)
-    while (open_ := lo < hi).any():
-        mid = (lo + hi) // 2
-        k, j = np.nonzero(open_)
-        ok = _reach(scaled, draws, k * n_areas + mid[k, j], grid[j], run)
-        hi[k[ok], j[ok]] = mid[k[ok], j[ok]]
-        lo[k[~ok], j[~ok]] = mid[k[~ok], j[~ok]] + 1
-    # At each area, the least capacity whose least area is at or below it.
-    meets = lo[:, None, :] <= np.arange(n_areas)[None, :, None]  # (kinds, areas, grid)
-    first = np.where(meets.any(axis=2), np.argmax(meets, axis=2), -1).ravel()
-    upper = np.where(first >= 0, grid[np.maximum(first, 0)], np.nan)
-    lower = np.where(first > 0, grid[np.maximum(first - 1, 0)], np.where(first == 0, 0.0, np.nan))
+    # Per kind and area: the index of its least capacity meeting the target (grid.size: none).
+    first = np.full((n_kinds, n_areas), grid.size)
+    area, step = np.full(n_kinds, n_areas - 1), np.zeros(n_kinds, dtype=int)
+    # A kind whose largest capacity fails at an area fails at every smaller one: done.
+    while (open_ := np.flatnonzero((area >= 0) & (step < grid.size))).size:
+        ok = known.reach(open_ * n_areas + area[open_], grid[step[open_]])
+        met, missed = open_[ok], open_[~ok]
+        first[met, area[met]] = step[met]
+        area[met] -= 1
+        step[missed] += 1
+    first = first.ravel()
+    upper = np.where(first < grid.size, grid[np.minimum(first, grid.size - 1)], np.nan)
+    lower = np.where(
+        (first > 0) & (first < grid.size),
+        grid[np.clip(first - 1, 0, grid.size - 1)],
+        np.where(first == 0, 0.0, np.nan),
+    )
     return upper, lower
 
 

@@ -586,6 +586,38 @@ def smallest_buffers(
     return _smallest(run, rows, first, capacities), _held_above(ok, first)
 
 
+def bracketed_buffers(
+    power,
+    first,
+    load,
+    storage,
+    step_hours,
+    engine,
+    in_sequence: bool,
+    draws=None,
+    cold=None,
+    years=None,
+):
+    """:func:`smallest_buffers`' capacities [Wh] where each design's least capacity of the grid
+    reaching the target is known (``first``, its index in :func:`capacity_grid`; -1: none, NaN):
+    its bracket cut alone, the grid not evaluated again.
+
+    Parameters
+    ----------
+    power : numpy.ndarray
+        (n, n_days, n_steps) [W].
+    first : numpy.ndarray
+        (n,) int.
+    load, in_sequence, draws, cold, years
+        As :func:`smallest_buffers`'.
+    """
+    capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
+    run = _Runs(
+        power, draws, load, storage, step_hours, engine, in_sequence, cold=cold, years=years
+    )
+    return _smallest(run, np.arange(power.shape[0]), np.asarray(first), capacities)
+
+
 def _held_above(ok, first) -> np.ndarray:
     """(n,) bool: every capacity of the grid from the least reaching the target on reaches it
     too (the premise of a bracketed search; True where none reaches it)."""
