@@ -304,7 +304,7 @@ def _grid_bounds(known: _Known, grid, shape):
     capacity is at least the next larger area's (a capacity that meets the target at an area
     meets it at every larger one, the premise of the sizing with the area for the capacity), so
     that the walk steps up the capacities or down the areas, each kind at most n_areas + the
-    grid's size evaluations.
+    grid's size evaluations (its first step a bisection).
 
     Parameters
     ----------
@@ -318,7 +318,17 @@ def _grid_bounds(known: _Known, grid, shape):
     n_kinds, n_areas = shape
     # Per kind and area: the index of its least capacity meeting the target (grid.size: none).
     first = np.full((n_kinds, n_areas), grid.size)
-    area, step = np.full(n_kinds, n_areas - 1), np.zeros(n_kinds, dtype=int)
+    area = np.full(n_kinds, n_areas - 1)
+    kinds = np.arange(n_kinds)
+    # The largest area's least capacity bisected (a capacity that meets the target there is
+    # followed by larger ones that do: the premise with the capacity): the walk's first column
+    # takes log2 of the grid's size evaluations rather than its size.
+    step, top = np.zeros(n_kinds, dtype=int), np.full(n_kinds, grid.size)
+    while (open_ := kinds[step < top]).size:
+        mid = (step[open_] + top[open_]) // 2
+        ok = known.reach(open_ * n_areas + area[open_], grid[mid])
+        top[open_[ok]] = mid[ok]
+        step[open_[~ok]] = mid[~ok] + 1
     # A kind whose largest capacity fails at an area fails at every smaller one: done.
     while (open_ := np.flatnonzero((area >= 0) & (step < grid.size))).size:
         ok = known.reach(open_ * n_areas + area[open_], grid[step[open_]])
