@@ -177,6 +177,37 @@ def test_geocentric_periodic_terms_are_pvlib_spa_bits():
     np.testing.assert_array_equal(epsilon, nutation[1])
 
 
+def test_geocentric_terms_of_a_long_series_are_pvlib_spa_s_bits_chunk_by_chunk():
+    """A series longer than a chunk of instants (and shaped, not a multiple of the chunk): its
+    right ascension and declination are the bits of pvlib.spa's own steps at every instant."""
+    from foldopt.physics import spa as split
+
+    spa = pvlib.spa
+    unix = (1.1e9 + 3600.0 * np.arange(3 * split.GEOCENTRIC_CHUNK + 7)).reshape(-1, 1)
+    found = split.spa_geocentric(unix)
+    flat = unix.ravel()
+    jd = spa.julian_day(flat)
+    jde = spa.julian_ephemeris_day(jd, split.SPA_DELTA_T)
+    jce = spa.julian_ephemeris_century(jde)
+    jme = spa.julian_ephemeris_millennium(jce)
+    radius = spa.heliocentric_radius_vector(jme)
+    theta = spa.geocentric_longitude(spa.heliocentric_longitude(jme))
+    beta = spa.geocentric_latitude(spa.heliocentric_latitude(jme))
+    args = (spa.mean_elongation(jce), spa.mean_anomaly_sun(jce), spa.mean_anomaly_moon(jce),
+            spa.moon_argument_latitude(jce), spa.moon_ascending_longitude(jce))
+    nutation = np.empty((2, flat.size))
+    spa.longitude_obliquity_nutation(jce, *args, nutation)
+    epsilon = spa.true_ecliptic_obliquity(spa.mean_ecliptic_obliquity(jme), nutation[1])
+    lamd = spa.apparent_sun_longitude(theta, nutation[0], spa.aberration_correction(radius))
+    assert found["alpha"].shape == unix.shape
+    np.testing.assert_array_equal(
+        found["alpha"].ravel(), spa.geocentric_sun_right_ascension(lamd, epsilon, beta)
+    )
+    np.testing.assert_array_equal(
+        found["delta"].ravel(), spa.geocentric_sun_declination(lamd, epsilon, beta)
+    )
+
+
 def test_many_sites_at_once_equal_pvlib_at_each():
     from foldopt.physics.solarposition import clock_grid, solar_position_grid
 

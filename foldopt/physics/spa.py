@@ -30,6 +30,9 @@ import numpy as np
 
 NS_PER_HOUR = 3_600_000_000_000  # [ns]
 SPA_DELTA_T = 67.0  # [s], TT - UT1, pvlib's default for spa_python
+#: Instants whose time-only terms are evaluated at once: the periodic terms' arrays (terms x
+#: instants, a few MB) then stay in the processor's caches, which a long series' would not.
+GEOCENTRIC_CHUNK = 8192
 
 
 def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
@@ -56,10 +59,25 @@ def spa_geocentric(unixtime, delta_t: float = SPA_DELTA_T) -> dict:
     .. [1] I. Reda, A. Andreas, "Solar position algorithm for solar radiation applications",
        Solar Energy 76(5), 577-589, 2004.
     """
+    unixtime = np.asarray(unixtime, dtype=float)
+    if unixtime.size <= GEOCENTRIC_CHUNK:
+        return _geocentric(unixtime, delta_t)
+    # Elementwise in time: a chunk's terms are its instants' bits whatever the chunk.
+    parts = [
+        _geocentric(unixtime.ravel()[at : at + GEOCENTRIC_CHUNK], delta_t)
+        for at in range(0, unixtime.size, GEOCENTRIC_CHUNK)
+    ]
+    return {
+        name: np.concatenate([part[name] for part in parts]).reshape(unixtime.shape)
+        for name in parts[0]
+    }
+
+
+def _geocentric(unixtime: np.ndarray, delta_t: float) -> dict:
+    """:func:`spa_geocentric` at instants ``unixtime`` [s], at once."""
     import pvlib
 
     spa = pvlib.spa
-    unixtime = np.asarray(unixtime, dtype=float)
     jd = spa.julian_day(unixtime)
     jde = spa.julian_ephemeris_day(jd, delta_t)
     jc = spa.julian_century(jd)
