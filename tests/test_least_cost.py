@@ -177,6 +177,37 @@ def test_every_row_s_capacity_meets_the_target_and_its_bracket_s_bottom_does_not
         assert _meets(scaled, [row.capacity_wh, below], draw, storage=storage).tolist() == said
 
 
+@pytest.mark.parametrize("load", [LOAD, 0.4, 3.0], ids=["1W", "0.4W", "3W"])
+def test_the_walk_s_grid_bounds_are_every_area_and_capacity_evaluated(load):
+    # The frontier on the grids (least_cost._grid_bounds) against the whole grid of area x
+    # capacity evaluated by the engine's simulate alone: at each area the least capacity of the
+    # sizing's grid that meets the target and the one below it; each kind's walk evaluates at
+    # most n_areas + the grid's size of them.
+    from foldopt.studies.least_cost import _grid_bounds, _Known, _Run
+    from foldopt.studies.storage_sizing import capacity_grid
+
+    curves = _curves()
+    power = np.concatenate([curves["flat"][None], curves["twofold"]])
+    m = AREA_FACTORS.size
+    grid = capacity_grid(load, STORAGE, 1.0, power.shape[-1])
+
+    def scaled(rows):
+        return power[rows // m] * AREA_FACTORS[rows % m, None, None]
+
+    known = _Known(scaled, None, _Run((load, STORAGE, 1.0, "numba", True), {}))
+    upper, lower = _grid_bounds(known, grid, (len(power), m))
+    assert len(known.found) <= len(power) * (m + grid.size)
+    for row in range(len(power) * m):
+        ok = _meets(scaled(np.array([row]))[0], grid, load=load)
+        if not ok.any():
+            assert np.isnan(upper[row]) and np.isnan(lower[row])
+            continue
+        first = int(np.argmax(ok))
+        assert ok[first:].all()  # the premise, here
+        assert upper[row] == grid[first]
+        assert lower[row] == (grid[first - 1] if first else 0.0)
+
+
 def test_a_free_buffer_makes_the_least_cost_the_smallest_area_that_meets_with_any_buffer():
     free = Costs(panel_usd_per_m2=150, buffer_usd_per_wh=0, drive_dual_axis_usd=10)
     space = _search(free)

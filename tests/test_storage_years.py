@@ -37,7 +37,13 @@ from foldopt.studies.storage_periods import (
     storage_years,
     years_meeting,
 )
-from foldopt.studies.storage_sizing import CAPACITY_RTOL, smallest_buffers
+from foldopt.studies.storage_sizing import (
+    CAPACITY_RTOL,
+    bracketed_buffers,
+    buffer_of,
+    capacity_grid,
+    smallest_buffers,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 HOURLY = ROOT / "tests" / "data" / "pvgis" / "seriescalc_45.000_8.000_2020_2021.json"
@@ -125,6 +131,30 @@ def test_one_year_sizes_the_same_buffer_whatever_the_share_of_years():
             years=labels,
         )  # fmt: skip
         assert np.array_equal(need, plain_need, equal_nan=True), share
+
+
+def test_a_bracket_known_on_the_grid_sizes_the_buffer_the_grid_s_search_sizes():
+    # bracketed_buffers, given each design's least capacity of the grid meeting the target
+    # (found here by simulate over the whole grid), gives smallest_buffers' capacities to the
+    # bit, and NaN where none meets.
+    power, dates = _days(years=2, seed=5)
+    power = np.stack([power[0] * factor for factor in (0.3, 0.8, 1.0, 1.6)])
+    target = StorageTarget(powered_h=24, days_pct=90, years="every")
+    storage = Storage(capacity_wh=5, target=target)
+    labels = [date.year for date in dates]
+    grid = capacity_grid(1.0, storage, 0.5, power.shape[-1])
+    first = []
+    for curve in power:
+        series = np.repeat(curve[None], grid.size, 0)
+        result = simulate(series, 1.0, buffer_of(storage, capacity_wh=grid), 0.5, "numba")
+        days = result.powered_h >= 24 - 1e-9
+        ok = years_meeting(days, labels, 90, target.years_pct) & result.converged
+        first.append(int(np.argmax(ok)) if ok.any() else -1)
+    need, _ = smallest_buffers(power, 1.0, storage, 0.5, "numba", True, years=labels)
+    found = bracketed_buffers(power, np.array(first), 1.0, storage, 0.5, "numba", True,
+                              years=labels)  # fmt: skip
+    assert np.array_equal(found, need, equal_nan=True)
+    assert np.isnan(need).any() and np.isfinite(need).any()
 
 
 def test_the_years_partition_the_series(two_years):

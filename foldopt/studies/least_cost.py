@@ -23,16 +23,19 @@ x panel_usd_per_m2 + capacity x buffer_usd_per_wh``, plus the hinge (twofold) or
 
 It runs in two steps, every design's curves through the engine together:
 
-1. **the frontier on the grids** (:func:`_grid_bounds`): for each capacity of the sizing's grid,
-   the least area meeting the target, bisected over the areas (a capacity that meets the target at
-   an area meets it at every larger one); at each area, the least capacity of the grid meeting
-   it and the one below it, which does not, bound the least capacity between them (both
-   evaluated at the area: a row where either is not what the premise says is sized exactly);
+1. **the frontier on the grids** (:func:`_grid_bounds`): at each area, the least capacity of the
+   sizing's grid meeting the target, by a walk along each kind's frontier from the largest area
+   down (a capacity that meets the target at an area meets it at every larger one, and a larger
+   capacity at the same area: each area's least capacity is at least the next larger area's);
+   the least capacity and the one below it, which does not meet the target, bound the least
+   capacity between them (both evaluated at the area, each area and capacity once: a row where
+   either is not what the premise says is sized on the whole grid);
 2. **branch and bound**: a row whose cost at its lower bound is below its kind's least cost at
-   an upper bound is sized exactly (:func:`foldopt.studies.storage_sizing.smallest_buffers`,
-   within its :data:`~foldopt.studies.storage_sizing.CAPACITY_RTOL`); the others cannot be the
-   least. The least-cost design of a kind is the cheapest row sized (ties to the smallest area,
-   then the least folded): exact in the capacity, and as fine as the area grid.
+   an upper bound is sized exactly, its bracket on the grid cut as the sizing cuts it
+   (:func:`foldopt.studies.storage_sizing.bracketed_buffers`, within its
+   :data:`~foldopt.studies.storage_sizing.CAPACITY_RTOL`); the others cannot be the least. The
+   least-cost design of a kind is the cheapest row sized (ties to the smallest area, then the
+   least folded): exact in the capacity, and as fine as the area grid.
 
 Both steps rest on the sizing's premise, powered time not falling as the buffer or the panel
 grows: it holds for a controller without hysteresis and a buffer that does not leak
