@@ -196,19 +196,17 @@ def design_space(
     whole[below[known.reach(below, lower[below])]] = True
     refine |= whole
     need, bracket = upper.copy(), np.where(upper > 0, (upper - lower) / upper, 0.0)
-    for chosen, sized in (
-        (np.flatnonzero(refine & ~whole), _bracketed(np.searchsorted(grid, upper))),
-        (np.flatnonzero(whole), _whole),
-    ):
-        if chosen.size:
-            found = sized(
-                scaled(chosen),
-                chosen,
-                *run.given,
-                None if draws is None else [draws[i] for i in chosen],
-                **run.keywords,
-            )
-            need[chosen], bracket[chosen] = found, np.where(found > 0, CAPACITY_RTOL, 0.0)
+    first = np.searchsorted(grid, upper)
+    for chosen in (np.flatnonzero(refine & ~whole), np.flatnonzero(whole)):
+        if not chosen.size:
+            continue
+        given = (*run.given, None if draws is None else [draws[i] for i in chosen])
+        found = (
+            smallest_buffers(scaled(chosen), *given, **run.keywords)[0]
+            if whole[chosen[0]]
+            else bracketed_buffers(scaled(chosen), first[chosen], *given, **run.keywords)
+        )
+        need[chosen], bracket[chosen] = found, np.where(found > 0, CAPACITY_RTOL, 0.0)
     refine = np.flatnonzero(refine)
     table = pd.DataFrame(
         {
@@ -244,22 +242,6 @@ class _Run(NamedTuple):
 
     given: tuple
     keywords: dict
-
-
-def _bracketed(first):
-    """A row's sizing from its least capacity of the grid meeting the target, ``first`` (n,)
-    (indices of the grid, per row of the search): its bracket cut
-    (:func:`foldopt.studies.storage_sizing.bracketed_buffers`)."""
-
-    def sized(power, rows, *given, **keywords):
-        return bracketed_buffers(power, first[rows], *given, **keywords)
-
-    return sized
-
-
-def _whole(power, rows, *given, **keywords):
-    """Rows' sizing on the whole grid (:func:`foldopt.studies.storage_sizing.smallest_buffers`)."""
-    return smallest_buffers(power, *given, **keywords)[0]
 
 
 class _Known:

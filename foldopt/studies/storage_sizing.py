@@ -576,9 +576,8 @@ def smallest_buffers(
     draws, cold, years : optional
         As :func:`_at_capacities`'.
     """
-    capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
-    run = _Runs(
-        power, draws, load, storage, step_hours, engine, in_sequence, cold=cold, years=years
+    run, capacities = _on_grid(
+        power, load, storage, step_hours, engine, in_sequence, draws, cold, years
     )
     rows = np.arange(power.shape[0])
     _, ok = run(rows, np.broadcast_to(capacities, (rows.size, capacities.size)))
@@ -586,18 +585,7 @@ def smallest_buffers(
     return _smallest(run, rows, first, capacities), _held_above(ok, first)
 
 
-def bracketed_buffers(
-    power,
-    first,
-    load,
-    storage,
-    step_hours,
-    engine,
-    in_sequence: bool,
-    draws=None,
-    cold=None,
-    years=None,
-):
+def bracketed_buffers(power, first, *given, **keywords) -> np.ndarray:
     """:func:`smallest_buffers`' capacities [Wh] where each design's least capacity of the grid
     reaching the target is known (``first``, its index in :func:`capacity_grid`; -1: none, NaN):
     its bracket cut alone, the grid not evaluated again.
@@ -608,14 +596,21 @@ def bracketed_buffers(
         (n, n_days, n_steps) [W].
     first : numpy.ndarray
         (n,) int.
-    load, in_sequence, draws, cold, years
-        As :func:`smallest_buffers`'.
+    *given, **keywords
+        :func:`smallest_buffers`' arguments after ``power``.
     """
-    capacities = capacity_grid(load, storage, step_hours, power.shape[-1])
+    run, capacities = _on_grid(power, *given, **keywords)
+    return _smallest(run, np.arange(power.shape[0]), np.asarray(first), capacities)
+
+
+def _on_grid(
+    power, load, storage, step_hours, engine, in_sequence, draws=None, cold=None, years=None
+):
+    """A sizing's runs (:class:`_Runs`) and its grid of capacities [Wh] (:func:`capacity_grid`)."""
     run = _Runs(
         power, draws, load, storage, step_hours, engine, in_sequence, cold=cold, years=years
     )
-    return _smallest(run, np.arange(power.shape[0]), np.asarray(first), capacities)
+    return run, capacity_grid(load, storage, step_hours, power.shape[-1])
 
 
 def _held_above(ok, first) -> np.ndarray:
