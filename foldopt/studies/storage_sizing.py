@@ -577,7 +577,7 @@ def smallest_buffers(
         As :func:`_at_capacities`'.
     """
     run, capacities = _on_grid(
-        power, load, storage, step_hours, engine, in_sequence, draws, cold, years
+        power, load, storage, step_hours, engine, in_sequence, draws, cold=cold, years=years
     )
     rows = np.arange(power.shape[0])
     _, ok = run(rows, np.broadcast_to(capacities, (rows.size, capacities.size)))
@@ -604,7 +604,7 @@ def bracketed_buffers(power, first, *given, **keywords) -> np.ndarray:
 
 
 def _on_grid(
-    power, load, storage, step_hours, engine, in_sequence, draws=None, cold=None, years=None
+    power, load, storage, step_hours, engine, in_sequence, draws=None, *, cold=None, years=None
 ):
     """A sizing's runs (:class:`_Runs`) and its grid of capacities [Wh] (:func:`capacity_grid`)."""
     run = _Runs(
