@@ -511,3 +511,31 @@ def test_power_below_zero_is_refused_a_design_s_own_draw_goes_in_draw():
         simulate(net, 4.0, Buffer(20.0), 6.0)
     with pytest.raises(ValueError, match="draw must be finite and 0 or more"):
         simulate(HAND_POWER[None], 4.0, Buffer(20.0), 6.0, draw=-1.0)
+
+
+@pytest.mark.parametrize("energy", [5e-324, 1e-310, 1e-300])
+def test_a_buffer_next_to_nothing_runs_a_part_next_to_no_time(energy):
+    """From a crossing (no deficit at the part's start) a buffer of a denormal energy ran the whole
+    part (4 slope energy underflowed to 0 and the root was 2 energy / 0): found by
+    tests/test_storage_answer.py's energy balance (capacity 5e-324 Wh at 65 N). The time is the
+    root of slope t^2 = energy (slope 0.5 db / tau), written here with Python's decimals, and the
+    energy balances with the smallest capacities as with none."""
+    from decimal import Decimal, getcontext
+
+    from foldopt.engine.storage_kernel import time_to_draw
+
+    getcontext().prec = 50
+    db, tau = 0.0177, 0.0725  # [W], [h]: a part leaving the load at sunrise
+    exact = float((Decimal(energy) * Decimal(2) * Decimal(tau) / Decimal(db)).sqrt())
+    for ran in (time_to_draw(0.0, db, tau, energy), storage._time_to_draw(0.0, db, tau, energy)):
+        assert float(ran) == pytest.approx(exact, rel=1e-6)
+    hours = (np.arange(288) + 0.5) / 12
+    power = np.clip(0.5 * np.sin((hours - 6.0) / 12.0 * np.pi), 0.0, None)[None]
+    load = float(power[0, 80])  # the power at a step centre: a part starts at a crossing
+    for engine in ("numba", "numpy"):
+        run = simulate(power, load, Buffer(capacity_wh=energy), 1 / 12, engine)
+        went = (run.served_wh + run.lost_wh + np.diff(run.stored_wh, axis=1) + run.charge_loss_wh
+                + run.discharge_loss_wh + run.self_discharge_wh)  # fmt: skip
+        np.testing.assert_allclose(run.harvested_wh - went, 0.0, atol=1e-12)
+        none = simulate(power, load, Buffer(capacity_wh=0.0), 1 / 12, engine)
+        assert run.served_wh[0, 0] == pytest.approx(none.served_wh[0, 0], abs=1e-12)

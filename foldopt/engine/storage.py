@@ -570,7 +570,11 @@ def _time_to_draw(da, db, tau, energy):
         return np.where(
             slope == 0.0,
             np.minimum(energy / da, tau),
-            np.minimum(2.0 * energy / (da + root), tau),
+            np.where(
+                da + root == 0.0,
+                np.minimum(np.sqrt(energy / slope), tau),
+                np.minimum(2.0 * energy / (da + root), tau),
+            ),
         )
 
 

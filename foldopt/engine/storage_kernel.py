@@ -96,6 +96,10 @@ def time_to_draw(da, db, tau, energy):
     if slope == 0.0:
         return min(energy / da, tau)
     root = math.sqrt(max(da * da + 4.0 * slope * energy, 0.0))
+    if da + root == 0.0:
+        # From a crossing (da 0) with an energy so small that 4 slope energy underflows: the
+        # root of slope t^2 = energy, which does not (2 energy / 0 would run the whole part).
+        return min(math.sqrt(energy / slope), tau)
     return min(2.0 * energy / (da + root), tau)
 
 
