@@ -80,8 +80,8 @@ def _phase_timers():
 
     spent: dict[str, float] = {}
     wrapped = [(blocks.Blocks, "sky", "sky"), (kernel, "fold_rows", "kernel: twofold and flat"),
-               (designs, "sky_tracker_orientation", "trackers"), (designs, "sky_tracker_power", "trackers"),
-               (designs, "sky_tracker_draw", "trackers"), (worldmap, "break_even_standby", "break-even")]
+               (designs, "tracker_curves", "trackers"), (designs, "standby_available", "trackers"),
+               (worldmap, "break_even_standby", "break-even")]
     originals = [(owner, name, getattr(owner, name)) for owner, name, _ in wrapped]
 
     def timed(phase, function):
