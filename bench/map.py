@@ -71,7 +71,8 @@ def _run(spec, workers: int, folder: Path) -> dict:
 def _phase_timers():
     """Wrap the functions a site's evaluation spends its time in with timers: ``{phase: seconds}``
     accumulating while they run, and a function that unwraps them. Each phase is the wall time of
-    its functions' calls (nested calls are counted once, in the outer)."""
+    its functions' calls (nested calls are counted once, in the outer), and ``phase (CPU)`` the
+    process's CPU time over them."""
     import functools
 
     from foldopt.engine import kernel
@@ -79,18 +80,19 @@ def _phase_timers():
 
     spent: dict[str, float] = {}
     wrapped = [(blocks.Blocks, "sky", "sky"), (kernel, "fold_rows", "kernel: twofold and flat"),
-               (designs, "sky_tracker_orientation", "trackers"), (designs, "sky_tracker_power", "trackers"),
-               (designs, "sky_tracker_draw", "trackers"), (worldmap, "break_even_standby", "break-even")]
+               (designs, "tracker_curves", "trackers"), (designs, "standby_available", "trackers"),
+               (worldmap, "break_even_standby", "break-even")]
     originals = [(owner, name, getattr(owner, name)) for owner, name, _ in wrapped]
 
     def timed(phase, function):
         @functools.wraps(function)
         def wrapper(*args, **kwargs):
-            started = time.perf_counter()
+            started, cpu = time.perf_counter(), time.process_time()
             try:
                 return function(*args, **kwargs)
             finally:
                 spent[phase] = spent.get(phase, 0.0) + time.perf_counter() - started
+                spent[f"{phase} (CPU)"] = spent.get(f"{phase} (CPU)", 0.0) + time.process_time() - cpu
         return wrapper
 
     for owner, name, phase in wrapped:
@@ -130,7 +132,8 @@ def phases(study: dict, sites: list, loads, relative: bool, year: int = 2025, re
         numba.set_num_threads(threads)
     per_site = {phase: value / (len(sites) - 1) for phase, value in best.items()}
     per_site["rest"] = per_site["per_site_s"] - sum(
-        v for k, v in per_site.items() if k not in ("per_site_s", "cpu_s"))
+        v for k, v in per_site.items() if k not in ("per_site_s", "cpu_s") and not k.endswith("(CPU)"))
+    per_site["rest (CPU)"] = per_site["cpu_s"] - sum(v for k, v in per_site.items() if k.endswith("(CPU)"))
     return per_site
 
 
@@ -138,8 +141,10 @@ def _print_phases(cost: dict) -> None:
     """The phases' wall time, and the process's CPU time beside it: on a machine shared with other
     work, the CPU time is the steadier measure of the code (the wall time counts the waits)."""
     print(f"per site on one core: {cost['per_site_s'] * 1e3:.0f} ms (CPU {cost['cpu_s'] * 1e3:.0f} ms); "
-          + ", ".join(f"{phase} {value * 1e3:.0f} ms" for phase, value in cost.items()
-                      if phase not in ("per_site_s", "cpu_s")))
+          + ", ".join(f"{phase} {value * 1e3:.0f} ms" + (f" ({cost[f'{phase} (CPU)'] * 1e3:.0f})"
+                                                       if f"{phase} (CPU)" in cost else "")
+                      for phase, value in cost.items()
+                      if phase not in ("per_site_s", "cpu_s") and not phase.endswith("(CPU)")))
 
 
 def _land_sites(subset: int | None) -> tuple[list, list]:

@@ -50,6 +50,48 @@ def test_sums_of_broad_bumps_match_the_grid(centres, widths, tolerance):
     assert result.best_value[0] <= brute + 1e-12  # it is a grid point's value
 
 
+@settings(max_examples=25, deadline=None)
+@given(landscapes=st.lists(st.tuples(st.floats(0, 100), st.floats(0, 60), st.floats(2, 40), st.integers(0, 3)),
+                           min_size=2, max_size=5),
+       two_axes=st.booleans(), quantum=st.sampled_from([0.0, 0.004]))
+def test_searches_told_together_evaluate_and_find_what_each_does_alone(landscapes, two_axes, quantum):
+    """A map's sites' searches advance together (tell_together: one pass over every search's boxes);
+    each evaluates the points, level by level, and finds the best it does on its own, to the bit:
+    landscapes of a bump with a kink or plateau beside it, some ending their search early (an
+    objective flat at its lattice), of one or two axes and two targets each."""
+    from foldopt.engine.search import GridSearch, tell_together
+
+    axes = [Axis("x", 0, 100, 1), *([Axis("y", 0, 60, 2)] if two_axes else [])]
+
+    def landscape(cx, cy, width, kind):
+        def values(points):
+            x = points[:, 0]
+            y = points[:, 1] if two_axes else cy
+            bump = np.exp(-(((x - cx) / width) ** 2 + ((y - cy) / width) ** 2))
+            second = [bump, np.minimum(bump, 0.5), np.abs(x - cx) * 0.0, -np.abs(x - cx) / width][kind]
+            return np.stack([bump, second], axis=1)
+        return values
+
+    functions = [landscape(*parameters) for parameters in landscapes]
+    alone = []
+    for function in functions:
+        search = GridSearch(axes, 1e-3, quantum)
+        while (points := search.ask()) is not None:
+            search.tell(function(points))
+        alone.append(search.result())
+    searches = [GridSearch(axes, 1e-3, quantum) for _ in functions]
+    asked = {k: search.ask() for k, search in enumerate(searches)}
+    while asked := {k: points for k, points in asked.items() if points is not None}:
+        tell_together([searches[k] for k in asked], [functions[k](points) for k, points in asked.items()])
+        asked = {k: searches[k].ask() for k in asked}
+    for own, search in zip(alone, searches, strict=True):
+        together = search.result()
+        assert together.levels == own.levels
+        np.testing.assert_array_equal(together.index, own.index)
+        np.testing.assert_array_equal(together.values, own.values)
+        np.testing.assert_array_equal(together.best, own.best)
+
+
 def test_it_evaluates_a_small_share_of_a_smooth_3d_grid():
     axes = [Axis("fold", 2, 180, 1), Axis("tilt", 0, 90, 1), Axis("azimuth", 90, 270, 2)]
 

@@ -174,13 +174,14 @@ def test_trackers_over_many_days_at_once_equal_each_day_alone(model):
        st.sampled_from([("ineichen", "perez"), ("ineichen", "isotropic"), ("meinel", "none")]))
 def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitude, day, model, sky_model):
     """The compiled tracker irradiance of an open plain (sky_tracker_poa's above the auto engine's
-    size) is foldopt.engine.evaluation.poa's NumPy expression to the bit, beam-only skies included."""
+    size, or for a request that decided on the kernel: a map's worker) is
+    foldopt.engine.evaluation.poa's NumPy expression to the bit, beam-only skies included."""
     import datetime as dt
 
     from foldopt.engine import evaluation as engines
     from foldopt.engine.incidence import turning_poa
     from foldopt.engine.sky import build_sky
-    from foldopt.studies.designs import sky_tracker_orientation
+    from foldopt.studies.designs import sky_tracker_orientation, sky_tracker_poa
     from foldopt.studies.engine_options import engine_options
 
     sky_name, transposition = sky_model
@@ -195,3 +196,4 @@ def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitu
     compiled = np.empty(beam.shape)
     turning_poa(np.ascontiguousarray(orientation[2], dtype=float), sun, beam, terms, span, compiled)
     np.testing.assert_array_equal(compiled, reference)
+    np.testing.assert_array_equal(sky_tracker_poa(sky, orientation, "numba"), reference)

@@ -309,35 +309,11 @@ class GridSearch:
 
     def tell(self, values) -> None:
         """The values of the points :meth:`ask` gave, (n, n_targets)."""
-        self.store.add(
-            self._asked, np.asarray(values, dtype=float).reshape(self._asked.shape[0], -1)
-        )
-        self._advance()
+        tell_together([self], [values])
 
     def _advance(self) -> None:
         """The next level's new corners, or None once the last level's are known."""
-        self.levels.append((int(self.strides.max()), int(self._asked.shape[0])))
-        if self.strides.max() <= 1:
-            self._asked = None
-            return
-        best = self.store.best_values()
-        bound = (
-            _box_bounds(
-                self.store,
-                self.lower,
-                self.upper,
-                self.strides,
-                self.steps,
-                self.sizes,
-                self.safety,
-            )
-            + self.quantum
-        )
-        keep = np.any(bound > best + self.tolerance, axis=1)
-        self.strides = np.maximum(self.strides // 2, 1)
-        self.lower, self.upper = _split(self.lower[keep], self.upper[keep], self.strides)
-        corners = _corners(self.lower, self.upper)
-        self._asked = self.store.missing(corners.reshape(-1, len(self.axes)))
+        _advance_together([self])
 
     def result(self) -> SearchResult:
         """What the search evaluated and found (once :meth:`ask` gives None)."""
@@ -350,6 +326,85 @@ class GridSearch:
             tuple(self.levels),
             self.tolerance,
         )
+
+
+def tell_together(searches, values) -> None:
+    """:meth:`GridSearch.tell` of many searches (a map's sites), each told the values of the points
+    it asked for, (n, n_targets), and their next levels worked out together
+    (:func:`_advance_together`).
+
+    Parameters
+    ----------
+    searches : sequence of GridSearch
+    values : sequence of array_like
+        Each search's values.
+    """
+    for search, found in zip(searches, values, strict=True):
+        search.store.add(
+            search._asked, np.asarray(found, dtype=float).reshape(search._asked.shape[0], -1)
+        )
+    _advance_together(searches)
+
+
+def _advance_together(searches) -> None:
+    """Each search's next level's new corners, or None once its last level's are known. The boxes
+    of searches of one grid, level and number of targets are bounded in one pass, as the boxes of
+    one search over a grid with the search as one more axis, along which no box extends: every
+    box's bound the bits its own search's would be (each value's operations are its own, and
+    where an axis's largest second difference stands in, it is its own search's)."""
+    groups: dict = {}
+    for search in searches:
+        search.levels.append((int(search.strides.max()), int(search._asked.shape[0])))
+        if search.strides.max() <= 1:
+            search._asked = None
+            continue
+        key = (
+            tuple(search.sizes),
+            tuple(search.steps),
+            tuple(search.strides),
+            search.safety,
+            search.store.values.shape[1],
+        )
+        groups.setdefault(key, []).append(search)
+    for group in groups.values():
+        first = group[0]
+        own = np.concatenate([np.full(search.lower.shape[0], k) for k, search in enumerate(group)])
+        store = _Store(np.array([len(group), *first.sizes]))
+        store.add(
+            np.concatenate(
+                [
+                    np.column_stack([np.full(search.store.index.shape[0], k), search.store.index])
+                    for k, search in enumerate(group)
+                ]
+            ),
+            np.concatenate([search.store.values for search in group]),
+        )
+        lower, upper = (
+            np.column_stack([own, np.concatenate([getattr(search, end) for search in group])])
+            for end in ("lower", "upper")
+        )
+        bound = _box_bounds(
+            store,
+            lower,
+            upper,
+            np.array([0, *first.strides]),
+            np.array([0.0, *first.steps]),
+            np.array([1, *first.sizes]),
+            first.safety,
+            own,
+        )
+        for k, search in enumerate(group):
+            mine = own == k
+            keep = np.any(
+                bound[mine] + search.quantum > search.store.best_values() + search.tolerance,
+                axis=1,
+            )
+            search.strides = np.maximum(search.strides // 2, 1)
+            search.lower, search.upper = _split(
+                search.lower[keep], search.upper[keep], search.strides
+            )
+            corners = _corners(search.lower, search.upper)
+            search._asked = search.store.missing(corners.reshape(-1, len(search.axes)))
 
 
 class _Store:
@@ -405,15 +460,16 @@ def _corners(lower, upper):
     return np.where(picks[None].astype(bool), upper[:, None, :], lower[:, None, :])
 
 
-def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
+def _box_bounds(store, lower, upper, strides, steps, sizes, safety, group=None):
     """(n_boxes, n_targets) what a box may hold at most: its largest corner plus ``safety`` times
     the multilinear interpolant's error bound, ``sum_i M_i h_i^2 / 8`` (``h_i`` the box's width).
     ``M_i`` is the largest second difference per unit^2 along axis ``i`` at the box's corners, on
     the lattice of ``strides``; where none is evaluated there (a neighbour dropped, an axis of two
-    points), the axis's largest second difference anywhere stands in. On a grid of one variable, a
-    box where the lattice shows the objective concave (:func:`_concave`) is bounded by its tent
-    alone. The boxes go a batch at a time (:data:`BOX_VALUES`): their corners and neighbours are
-    looked up per target, and 100,000 boxes of 40 loads held 5.5 GB at once."""
+    points), the axis's largest second difference anywhere (in the box's ``group``, (n_boxes,)
+    int, where given: its search's, :func:`_advance_together`) stands in. On a grid of one
+    variable, a box where the lattice shows the objective concave (:func:`_concave`) is bounded
+    by its tent alone. The boxes go a batch at a time (:data:`BOX_VALUES`): their corners and
+    neighbours are looked up per target, and 100,000 boxes of 40 loads held 5.5 GB at once."""
     n_targets = store.values.shape[1]
     per = max(1, BOX_VALUES // (len(_CORNER_LOOKUPS) * 2 ** lower.shape[1] * n_targets))
     # one batch of none where none is left
@@ -425,10 +481,16 @@ def _box_bounds(store, lower, upper, strides, steps, sizes, safety):
     ]
     terms = list(zip(*batches, strict=True))
     top, error, tent, concave = (np.concatenate(terms[k]) for k in (0, 1, 4, 5))
-    unknown, width = (np.concatenate(terms[k], axis=1) for k in (2, 3))
-    largest = np.max(terms[6], axis=0)  # (n_axes, n_targets), -inf where none is known anywhere
+    unknown, width, curvature = (np.concatenate(terms[k], axis=1) for k in (2, 3, 6))
+    group = np.zeros(lower.shape[0], dtype=int) if group is None else group
+    # (n_axes, n_groups, n_targets), -inf where none is known anywhere in the group
+    largest = np.full((lower.shape[1], group.max(initial=0) + 1, top.shape[1]), -np.inf)
+    for axis, axis_curvature in enumerate(curvature):
+        np.maximum.at(largest[axis], group, axis_curvature)
     for axis, axis_largest in enumerate(np.maximum(largest, 0.0)):
-        error += np.where(unknown[axis], axis_largest, 0.0) * (width[axis] ** 2 / 8.0)[:, None]
+        error += (
+            np.where(unknown[axis], axis_largest[group], 0.0) * (width[axis] ** 2 / 8.0)[:, None]
+        )
     return np.where(concave, np.maximum(top, tent), np.maximum(top + safety * error, tent))
 
 
@@ -436,14 +498,14 @@ def _box_terms(store, lower, upper, strides, steps, sizes):
     """The parts of :func:`_box_bounds` of a batch of boxes: the largest corner, the error term of
     the axes with a second difference known at the box, per axis where none is (n_axes, n_boxes,
     n_targets, bool) and the box's width (n_axes, n_boxes), the tent, whether concave, and per axis
-    the batch's largest second difference (n_axes, n_targets; -inf where none is known)."""
+    the box's largest second difference (n_axes, n_boxes, n_targets; -inf where none is known)."""
     corners = _corners(lower, upper)
     top = np.nanmax(store.lookup(corners), axis=1)
     n_axes = lower.shape[1]
     error = np.zeros_like(top)
     unknown = np.zeros((n_axes, *top.shape), bool)
     widths = np.zeros((n_axes, top.shape[0]))
-    largest = np.full((n_axes, top.shape[1]), -np.inf)
+    largest = np.full((n_axes, *top.shape), -np.inf)
     tent = np.full(top.shape, -np.inf)
     concave = np.zeros(top.shape, bool)
     for axis in range(n_axes):
@@ -458,7 +520,7 @@ def _box_terms(store, lower, upper, strides, steps, sizes):
         second = np.abs(above - 2.0 * here + below) / (strides[axis] * steps[axis]) ** 2
         known = np.isfinite(second)
         curvature = np.max(np.where(known, second, -np.inf), axis=1)  # (boxes, targets)
-        largest[axis] = curvature.max(axis=0, initial=-np.inf)
+        largest[axis] = curvature
         unknown[axis] = ~known.any(axis=1)
         widths[axis] = (upper[:, axis] - lower[:, axis]) * steps[axis]
         error += (

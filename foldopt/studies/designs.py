@@ -103,7 +103,7 @@ def sky_tracker_power(sky: Sky, study: Study, orientation) -> np.ndarray:
     )
 
 
-def sky_tracker_poa(sky: Sky, orientation) -> np.ndarray:
+def sky_tracker_poa(sky: Sky, orientation, engine: str = "auto") -> np.ndarray:
     """Irradiance [W/m^2] reaching a tracker's cells (after the sky's incidence-angle modifier)
     over every block, (n_blocks, n_steps).
 
@@ -112,9 +112,12 @@ def sky_tracker_poa(sky: Sky, orientation) -> np.ndarray:
     sky : Sky
     orientation : tuple of numpy.ndarray
         The tracker's surface tilt and azimuth [deg] and normal (:func:`sky_tracker_orientation`).
+    engine : {'auto', 'numba', 'numpy'}
+        ``auto`` decides by the sky's size; a request that has decided its engine (a map's
+        worker, whose chunk's skies are each under ``auto``'s bound) passes it.
     """
     tilt, azimuth, normal = orientation
-    small = engine_for("auto", sky.n_blocks * sky.n_steps) == "numpy"
+    small = engine_for(engine, sky.n_blocks * sky.n_steps) == "numpy"
     if sky.horizon_of is not None or sky.iam != "none" or small:
         return engines.poa(sky, tilt, azimuth, normal=normal)
     # An open plain without a modifier (every map's): the same sums compiled, over the lit spans
@@ -202,7 +205,7 @@ class TrackerCurves:
 
 
 def tracker_curves(
-    sky: Sky, study: Study, model: str | None = None, every: int = 1
+    sky: Sky, study: Study, model: str | None = None, every: int = 1, engine: str = "auto"
 ) -> TrackerCurves:
     """A tracker's orientation, power and own draw over every block of a sky.
 
@@ -215,9 +218,11 @@ def tracker_curves(
         One of :data:`foldopt.names.TRACKERS`; default the study's.
     every : int, default 1
         As :func:`sky_tracker_draw`'s (a cloud ensemble's members share their day's draw).
+    engine : {'auto', 'numba', 'numpy'}
+        As :func:`sky_tracker_poa`'s.
     """
     orientation = sky_tracker_orientation(sky, study, model)
-    poa = sky_tracker_poa(sky, orientation)
+    poa = sky_tracker_poa(sky, orientation, engine)
     draw = sky_tracker_draw(sky, study, orientation, every)
     power = engines.panel_power(sky, poa_global=poa, electrical=engine_options(study).electrical)
     return TrackerCurves(orientation, power, draw, poa if sky.iam == "none" else None)
@@ -581,7 +586,7 @@ def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None)
         flat.append(metrics.t_solar[:, 0])
         flat_energy.append(metrics.energy[:, 0])
         flat_peak.append(metrics.peak[:, 0])
-        curves = tracker_curves(sky, study)
+        curves = tracker_curves(sky, study, engine=engine)
         both = engines.curve_metrics(
             np.concatenate([curves.power, curves.net]),
             loads,

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from foldopt.engine.evaluation import fold_orientations
-from foldopt.engine.search import Axis, GridSearch
+from foldopt.engine.search import Axis, GridSearch, tell_together
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.designs import requested_hours
 from foldopt.studies.objectives import objective_quantum, period_values
@@ -66,11 +66,13 @@ class DesignSearch:
         self._asked = self.grid.ask()
         return self._asked
 
-    def tell(self, hours, energy) -> None:
-        """The asked designs' daily t_solar [h], (days, n, loads), and harvested energy [Wh], (days, n)."""
+    def objectives(self, hours, energy):
+        """Keep the asked designs' daily t_solar [h], (days, n, loads), and harvested energy [Wh],
+        (days, n), and give what the grid search is told: every period's and load's objective,
+        (n, periods x loads)."""
         hours, energy = np.asarray(hours, dtype=float), np.asarray(energy, dtype=float)
         self.found.append((self._asked, hours, energy))
-        self.grid.tell(
+        return (
             period_values(hours, self.months, self.statistic, self.seasons)
             .transpose(1, 0, 2)
             .reshape(self._asked.shape[0], -1)
@@ -107,8 +109,12 @@ def search_sites(searches, evaluate) -> list:
     asked = {site: search.ask() for site, search in enumerate(searches)}
     asked = {site: designs for site, designs in asked.items() if designs is not None}
     while asked:
-        for site, (hours, energy) in evaluate(asked).items():
-            searches[site].tell(hours, energy)
+        told = evaluate(asked)
+        # The grid searches' next levels worked out together: one pass over every site's boxes.
+        tell_together(
+            [searches[site].grid for site in told],
+            [searches[site].objectives(hours, energy) for site, (hours, energy) in told.items()],
+        )
         asked = {site: searches[site].ask() for site in asked}
         asked = {site: designs for site, designs in asked.items() if designs is not None}
     return [search.result() for search in searches]
