@@ -138,18 +138,51 @@ def test_exact_hour_angle_is_pvlibs_and_zero_at_solar_noon():
 
 
 def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
-    from foldopt.physics.spa import SunTerms, _geocentric_hourly, spa_geocentric
+    from foldopt.physics.spa import _GEOCENTRIC, SunTerms, _geocentric_hourly, spa_geocentric
 
     # Random instants from 1990 to 2060: linear interpolation between whole UTC hours.
     unix = np.sort(np.random.default_rng(5).uniform(6.3e8, 2.9e9, 5000))
     exact = spa_geocentric(unix)
-    interpolated = _geocentric_hourly((unix * 1e9).astype(np.int64), SunTerms())
-    for name, values in exact.items():
-        difference = values - interpolated[name]
+    utc_ns = (unix * 1e9).astype(np.int64)
+    at_nodes, change, index = _geocentric_hourly(utc_ns, SunTerms())
+    weight = (utc_ns % 3_600_000_000_000) / 3.6e12
+    for row, name in enumerate(_GEOCENTRIC):
+        difference = exact[name] - (at_nodes[row, index] + weight * change[row, index])
         if name in ("alpha", "v"):
             difference = (difference + 180.0) % 360.0 - 180.0
         bound = 4e-5 if name == "eot" else 1e-5  # 1e-5 deg; the equation of time in minutes (4 min a degree)
         assert np.abs(difference).max() < bound, name
+
+
+def _equatorial_by_numpy(utc_ns):
+    """SPA's time-only terms at instants (:func:`foldopt.physics.spa._equatorial`) as NumPy
+    expressions: the interpolation of each geocentric term between its hours, and its trigonometry."""
+    from foldopt.physics.spa import _GEOCENTRIC, NS_PER_HOUR, SunTerms, _geocentric_hourly
+
+    at_nodes, change, index = _geocentric_hourly(utc_ns, SunTerms())
+    index = index.reshape(utc_ns.shape)
+    hours = np.floor_divide(utc_ns, NS_PER_HOUR)
+    weight = (utc_ns - hours * NS_PER_HOUR) / NS_PER_HOUR
+    geo = {name: at_nodes[row][index] + weight * change[row][index] for row, name in enumerate(_GEOCENTRIC)}
+    greenwich, delta = np.radians(geo["v"] - geo["alpha"]), np.radians(geo["delta"])
+    return np.stack([np.cos(delta) * np.cos(greenwich), np.cos(delta) * np.sin(greenwich), np.sin(delta),
+                     np.sin(np.radians(geo["xi"])), geo["eot"]])
+
+
+@pytest.mark.parametrize("least", [1_000_000, 1])
+def test_equatorial_terms_in_a_compiled_pass_are_numpys_bits(monkeypatch, least):
+    """The compiled pass of SPA's time-only terms at every instant, on one thread or three, gives
+    the bits of their NumPy expressions (the C library's sines and cosines, which NumPy's float64
+    ones call), at 2-min steps over days from 1950 to 2090."""
+    import numba
+
+    import foldopt.physics.spa as spa
+
+    monkeypatch.setattr(spa, "EQUATORIAL_STEPS_A_THREAD", least)
+    monkeypatch.setattr(numba, "get_num_threads", lambda: 3)
+    days = np.random.default_rng(3).integers(-7_300, 43_800, 40)
+    utc_ns = (days[:, None] * 86_400 + np.arange(0, 86_400, 120)[None, :]) * 1_000_000_000
+    np.testing.assert_array_equal(spa._equatorial(utc_ns, spa.SunTerms()), _equatorial_by_numpy(utc_ns))
 
 
 def test_geocentric_periodic_terms_are_pvlib_spa_bits():
@@ -163,16 +196,16 @@ def test_geocentric_periodic_terms_are_pvlib_spa_bits():
     unix = np.concatenate([rng.uniform(-2.2e9, 4.1e9, 20_000), 1.7e9 + 3600.0 * np.arange(9_000)])
     jce = spa.julian_ephemeris_century(spa.julian_ephemeris_day(spa.julian_day(unix), split.SPA_DELTA_T))
     jme = spa.julian_ephemeris_millennium(jce)
-    np.testing.assert_array_equal(split._heliocentric(spa, "R", jme), spa.heliocentric_radius_vector(jme))
-    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(spa, "L", jme)) % 360,
-                                  spa.heliocentric_longitude(jme))
-    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(spa, "B", jme)),
-                                  spa.heliocentric_latitude(jme))
     args = (spa.mean_elongation(jce), spa.mean_anomaly_sun(jce), spa.mean_anomaly_moon(jce),
             spa.moon_argument_latitude(jce), spa.moon_ascending_longitude(jce))
+    sums, (psi, epsilon) = split._periodic(spa, jme, jce, args)
+    np.testing.assert_array_equal(split._heliocentric(sums["R"], jme), spa.heliocentric_radius_vector(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(sums["L"], jme)) % 360,
+                                  spa.heliocentric_longitude(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(sums["B"], jme)),
+                                  spa.heliocentric_latitude(jme))
     nutation = np.empty((2, unix.size))
     spa.longitude_obliquity_nutation(jce, *args, nutation)
-    psi, epsilon = split._nutation(spa, jce, args)
     np.testing.assert_array_equal(psi, nutation[0])
     np.testing.assert_array_equal(epsilon, nutation[1])
 
@@ -348,7 +381,7 @@ def test_the_sun_keeps_nothing_between_calls():
     assert {name: id(value) for name, value in vars(spa).items()} == before
     mutable = [name for name, value in vars(spa).items()
                if isinstance(value, (dict, list, set, tuple)) and not name.startswith("__")]
-    assert mutable == ["_WRAPPED"], mutable  # a constant tuple of names
+    assert sorted(mutable) == ["_GEOCENTRIC", "_SERIES", "_WRAPPED"], mutable  # constant tuples of names
 
 
 def test_a_lattice_evaluates_only_the_instants_its_days_span(monkeypatch):

@@ -10,6 +10,8 @@ import math
 
 from numba import njit, uint64
 
+from foldopt.physics.spa import NS_PER_HOUR
+
 SPA_TEMPERATURE = 12.0  # [C], pvlib's default for the refraction correction
 SPA_ATMOS_REFRACT = 0.5667  # [deg], SPA's refraction at sunrise and sunset
 
@@ -82,3 +84,67 @@ def site_sun(
                 elevation += refraction
             direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
             apparent_zenith[b, i] = 90.0 - elevation
+
+
+@njit(cache=True, nogil=True)
+def equatorial_steps(utc_ns, index, at_nodes, change, out):
+    """SPA's time-only terms of the sun at every instant in one pass, for
+    :func:`foldopt.physics.spa._equatorial`, which documents them: the geocentric terms
+    ``at_nodes`` (5, n_nodes) at whole UTC hours, interpolated by their hourly ``change`` (5,
+    n_nodes - 1) at each instant ``utc_ns`` [ns] (its hour the node ``index``), and of them the
+    sun's direction in the Greenwich frame, ``sin(xi)`` and the equation of time, written to
+    ``out`` (5, n_instants).
+
+    Each value by the operations of the NumPy expressions this pass replaced, in their order (a
+    true division of the hour's fraction, ``np.radians``' product by pi / 180, no fused
+    multiply-add), and its sines and cosines by the C library's ``sin`` and ``cos``, which NumPy's
+    float64 ``sin`` and ``cos`` call (NumPy 2 takes no vectorised ones for them): NumPy's bits
+    (tests/test_solarposition.py)."""
+    to_radians = math.pi / 180.0
+    for i in range(utc_ns.shape[0]):
+        hour = utc_ns[i] // NS_PER_HOUR
+        weight = (utc_ns[i] - hour * NS_PER_HOUR) / NS_PER_HOUR
+        k = index[i]
+        alpha = at_nodes[0, k] + weight * change[0, k]
+        delta = (at_nodes[1, k] + weight * change[1, k]) * to_radians
+        v = at_nodes[2, k] + weight * change[2, k]
+        xi = at_nodes[3, k] + weight * change[3, k]
+        greenwich = (v - alpha) * to_radians
+        cos_delta = math.cos(delta)
+        out[0, i] = cos_delta * math.cos(greenwich)
+        out[1, i] = cos_delta * math.sin(greenwich)
+        out[2, i] = math.sin(delta)
+        out[3, i] = math.sin(xi * to_radians)
+        out[4, i] = at_nodes[4, k] + weight * change[4, k]
+
+
+@njit(cache=True, nogil=True)
+def periodic_sums(terms, bounds, jme, abcd, y, jce, x, sums, nutation):
+    """SPA's periodic series at every instant in one pass, for
+    :func:`foldopt.physics.spa._periodic`, which documents them: the sum of table ``t``'s terms
+    (rows ``bounds[t]`` to ``bounds[t + 1]`` of ``terms``, ``A cos(B + C jme)``) in ``sums[t]``,
+    and the nutation's two sums (``(a + b jce) sin(arg)`` and ``(c + d jce) cos(arg)`` with ``arg``
+    the radians of ``y . x``, before their scale) in ``nutation`` (2, n_instants).
+
+    Each value by the operations of ``pvlib.spa``'s NumPy loops in their order, and its sines and
+    cosines by the C library's, which NumPy's float64 ``sin`` and ``cos`` call: their bits
+    (tests/test_solarposition.py)."""
+    to_radians = math.pi / 180.0
+    for i in range(jme.shape[0]):
+        for t in range(bounds.shape[0] - 1):
+            total = 0.0
+            for j in range(bounds[t], bounds[t + 1]):
+                total = total + terms[j, 0] * math.cos(terms[j, 1] + terms[j, 2] * jme[i])
+            sums[t, i] = total
+        psi, epsilon = 0.0, 0.0
+        for j in range(y.shape[0]):
+            arg = (
+                y[j, 0] * x[0, i]
+                + y[j, 1] * x[1, i]
+                + y[j, 2] * x[2, i]
+                + y[j, 3] * x[3, i]
+                + y[j, 4] * x[4, i]
+            ) * to_radians
+            psi = psi + (abcd[j, 0] + abcd[j, 1] * jce[i]) * math.sin(arg)
+            epsilon = epsilon + (abcd[j, 2] + abcd[j, 3] * jce[i]) * math.cos(arg)
+        nutation[0, i], nutation[1, i] = psi, epsilon
