@@ -137,6 +137,26 @@ def test_exact_hour_angle_is_pvlibs_and_zero_at_solar_noon():
     assert abs(exact["hour_angle"].iloc[noon]) < 0.3
 
 
+def test_exact_hour_angle_of_the_compiled_pass_is_pvlibs_formula_in_numpy():
+    """The per-site pass works out the hour angle, ``15 (UTC hours - 12) + longitude + EoT / 4``
+    wrapped to [-180, 180), with the bits of the NumPy expression (a float's remainder by Python's
+    rule in both) at sites of every longitude, days from 1950 to 2080."""
+    import foldopt.physics.spa as spa
+    from foldopt.physics.solarposition import clock_grid, solar_position_grid
+
+    rng = np.random.default_rng(8)
+    n = 16
+    dates = [dt.date(1950, 1, 1) + dt.timedelta(days=int(d)) for d in rng.integers(0, 130 * 365, n)]
+    grid = clock_grid(dates, "UTC", 7.5)
+    longitude = rng.uniform(-180, 180, (n, 1))
+    sun = solar_position_grid(grid, rng.uniform(-80, 80, (n, 1)), longitude, 10.0, "exact")
+    first, terms = spa.equatorial_once(grid.utc_ns)
+    eot = terms[4][first[:, None] + np.arange(grid.utc_ns.shape[1])]
+    utc_hours = (grid.utc_ns % (24 * spa.NS_PER_HOUR)) / spa.NS_PER_HOUR
+    expected = (15.0 * (utc_hours - 12.0) + longitude + eot / 4.0 + 180.0) % 360.0 - 180.0
+    np.testing.assert_array_equal(sun["hour_angle"], expected)
+
+
 def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
     from foldopt.physics.spa import _GEOCENTRIC, SunTerms, _geocentric_hourly, spa_geocentric
 

@@ -383,13 +383,9 @@ def solar_position_grid(
         solar_zenith, solar_azimuth = sun_from_angles(declination, hour_angle, latitude)
         vector = normal_vector(solar_zenith, solar_azimuth)
     elif model == "exact":
-        solar_zenith, solar_azimuth, equation_of_time, vector = spa_solar_position(
+        solar_zenith, solar_azimuth, hour_angle, vector = spa_solar_position(
             grid.utc_ns, latitude, longitude, altitude, sun_terms
         )
-        utc_hours = (grid.utc_ns % _NS_PER_DAY) / NS_PER_HOUR
-        hour_angle = (
-            15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0
-        ) % 360.0 - 180.0
         import pvlib
 
         declination = _by_dayofyear(

@@ -426,8 +426,8 @@ def _on_threads(run, n: int, steps: int, least: int) -> None:
 
 
 def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerms | None = None):
-    """Apparent zenith, azimuth, equation of time and the sun's apparent unit vector by SPA [1]_
-    at every step of days of steps.
+    """Apparent zenith, azimuth, hour angle and the sun's apparent unit vector by SPA [1]_ at every
+    step of days of steps.
 
     SPA's geocentric terms depend on time alone: kept per UTC hour and interpolated
     (:func:`_geocentric_hourly`), they give the sun's direction in the frame of the Greenwich
@@ -458,8 +458,10 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     -------
     apparent_zenith, solar_azimuth : numpy.ndarray
         [deg], azimuth clockwise from north, (n_blocks, n_steps).
-    equation_of_time : numpy.ndarray
-        [min], (n_blocks, n_steps).
+    hour_angle : numpy.ndarray
+        [deg] in [-180, 180), (n_blocks, n_steps): pvlib's formula ``15 (UTC hours - 12) +
+        longitude + EoT / 4`` with SPA's equation of time (EoT, [min]), worked out from UTC (so DST
+        days need no care).
     sun_vector : numpy.ndarray
         (n_blocks, n_steps, 3) the apparent direction's east, north and up components [-] (a view of
         an array laid out (n_blocks, 3, n_steps), each component contiguous along the steps).
@@ -469,7 +471,7 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     .. [1] I. Reda, A. Andreas, "Solar position algorithm for solar radiation applications",
        Solar Energy 76(5), 577-589, 2004, Sec. 3.10-3.14 and A.1.
     """
-    utc_ns = np.asarray(utc_ns)
+    utc_ns = np.ascontiguousarray(utc_ns, dtype=np.int64)
     shape = utc_ns.shape
 
     def per_block(values):
@@ -486,10 +488,11 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     first, terms = equatorial_once(utc_ns) if sun_terms is None else sun_terms.on_lattice(utc_ns)
     # each component along the steps, as the engine reads it
     vector = np.empty((shape[0], 3, shape[1]))
-    apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
+    apparent_zenith, solar_azimuth, hour_angle = np.empty(shape), np.empty(shape), np.empty(shape)
     pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
-    per_site = (first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure)
-    outputs = (vector, apparent_zenith, solar_azimuth)
+    per_site = (utc_ns, first, longitude, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi))
+    per_site += (x, y, pressure)
+    outputs = (vector, apparent_zenith, solar_azimuth, hour_angle)
     from foldopt.physics.spa_site import site_sun  # numba's compiled pass
 
     _on_threads(
@@ -498,5 +501,4 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
         shape[0] * shape[1],
         SITE_STEPS_A_THREAD,
     )
-    equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
-    return apparent_zenith, solar_azimuth, equation_of_time, np.moveaxis(vector, 1, -1)
+    return apparent_zenith, solar_azimuth, hour_angle, np.moveaxis(vector, 1, -1)

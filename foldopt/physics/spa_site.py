@@ -12,6 +12,8 @@ from numba import njit, uint64
 
 from foldopt.physics.spa import NS_PER_HOUR
 
+NS_PER_DAY = 24 * NS_PER_HOUR  # [ns]
+
 SPA_TEMPERATURE = 12.0  # [C], pvlib's default for the refraction correction
 SPA_ATMOS_REFRACT = 0.5667  # [deg], SPA's refraction at sunrise and sunset
 
@@ -34,7 +36,9 @@ def _raised(east, north, up, t):
 @njit(cache=True, nogil=True)
 def site_sun(
     terms,
+    utc_ns,
     first,
+    longitude,
     sin_lam,
     cos_lam,
     sin_phi,
@@ -45,15 +49,19 @@ def site_sun(
     direction,
     apparent_zenith,
     solar_azimuth,
+    hour_angle,
 ):
     """Every step of every block in one pass: the geometric topocentric unit vector toward the sun
     (east, north, up), from ``terms[:, first[b] + i]``
     (:meth:`foldopt.physics.spa.SunTerms.on_lattice`) and the site's arguments per block; its
     elevation and azimuth; SPA's refraction (Eq. 42, ``pvlib.spa``'s formula and switch, at
     ``pressure`` [hPa] per block and :data:`SPA_TEMPERATURE`), which raises the vector in its
-    vertical plane (:func:`_raised`) and the elevation. Writes ``direction`` (n_blocks, 3,
-    n_steps), ``apparent_zenith`` and ``solar_azimuth`` [deg] (n_blocks, n_steps), each value by
-    the operations of the NumPy expressions this pass replaced, in their order."""
+    vertical plane (:func:`_raised`) and the elevation; the hour angle from the UTC instant
+    ``utc_ns`` [ns], the ``longitude`` [deg] and the equation of time (``terms[4]``) by pvlib's
+    formula. Writes ``direction`` (n_blocks, 3, n_steps), ``apparent_zenith``, ``solar_azimuth``
+    and ``hour_angle`` [deg] (n_blocks, n_steps), each value by the operations of the NumPy
+    expressions this pass replaced, in their order (a float's ``%`` by Python's rule, as NumPy's
+    remainder)."""
     n_blocks, n_steps = direction.shape[0], direction.shape[2]
     to_degrees, to_radians = 180.0 / math.pi, math.pi / 180.0
     cut = -1.0 * (0.26667 + SPA_ATMOS_REFRACT)
@@ -63,6 +71,10 @@ def site_sun(
         scale = (pressure[b] / 1010.0) * (283.0 / (273 + SPA_TEMPERATURE)) * 1.02
         for i in range(uint64(n_steps)):
             k = start + i
+            utc_hours = (utc_ns[b, i] % NS_PER_DAY) / NS_PER_HOUR
+            hour_angle[b, i] = (
+                15.0 * (utc_hours - 12.0) + longitude[b] + terms[4, k] / 4.0 + 180.0
+            ) % 360.0 - 180.0
             # cos(delta) cos(H) and cos(delta) sin(H) at the site's hour angle H = H_G + longitude.
             cos_h = terms[0, k] * cos_lam[b] - terms[1, k] * sin_lam[b]
             sin_h = terms[1, k] * cos_lam[b] + terms[0, k] * sin_lam[b]
