@@ -154,15 +154,7 @@ def _periodic(spa, jme, jce, args) -> tuple:
     sums, nutation = np.empty((len(bounds) - 1, jme.size)), np.empty((2, jme.size))
     _on_threads(
         lambda part: periodic_sums(
-            terms,
-            bounds,
-            jme[part],
-            abcd,
-            y,
-            jce[part],
-            x[:, part],
-            sums[:, part],
-            nutation[:, part],
+            terms, bounds, jme, abcd, y, jce, x, sums, nutation, part.start, part.stop
         ),
         jme.size,
         jme.size,
@@ -388,7 +380,7 @@ def _equatorial(utc_ns, sun_terms: SunTerms) -> np.ndarray:
     flat = np.ascontiguousarray(utc_ns.ravel())
     out = np.empty((5, flat.size))
     _on_threads(
-        lambda part: equatorial_steps(flat[part], index[part], at_nodes, change, out[:, part]),
+        lambda part: equatorial_steps(flat, index, at_nodes, change, out, part.start, part.stop),
         flat.size,
         flat.size,
         EQUATORIAL_STEPS_A_THREAD,
@@ -475,9 +467,8 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     shape = utc_ns.shape
 
     def per_block(values):
-        return np.ascontiguousarray(
-            np.broadcast_to(np.asarray(values, dtype=float), (shape[0], 1))[:, 0]
-        )
+        # a copy: one type (writable, contiguous) for the compiled pass whatever the caller's
+        return np.array(np.broadcast_to(np.asarray(values, dtype=float), (shape[0], 1))[:, 0])
 
     latitude, longitude, altitude = per_block(latitude), per_block(longitude), per_block(altitude)
     import pvlib

@@ -99,13 +99,13 @@ def site_sun(
 
 
 @njit(cache=True, nogil=True)
-def equatorial_steps(utc_ns, index, at_nodes, change, out):
+def equatorial_steps(utc_ns, index, at_nodes, change, out, start, stop):
     """SPA's time-only terms of the sun at every instant in one pass, for
     :func:`foldopt.physics.spa._equatorial`, which documents them: the geocentric terms
     ``at_nodes`` (5, n_nodes) at whole UTC hours, interpolated by their hourly ``change`` (5,
     n_nodes - 1) at each instant ``utc_ns`` [ns] (its hour the node ``index``), and of them the
     sun's direction in the Greenwich frame, ``sin(xi)`` and the equation of time, written to
-    ``out`` (5, n_instants).
+    ``out`` (5, n_instants), instants ``start`` to ``stop - 1`` (a thread's share).
 
     Each value by the operations of the NumPy expressions this pass replaced, in their order (a
     true division of the hour's fraction, ``np.radians``' product by pi / 180, no fused
@@ -113,7 +113,7 @@ def equatorial_steps(utc_ns, index, at_nodes, change, out):
     float64 ``sin`` and ``cos`` call (NumPy 2 takes no vectorised ones for them): NumPy's bits
     (tests/test_solarposition.py)."""
     to_radians = math.pi / 180.0
-    for i in range(utc_ns.shape[0]):
+    for i in range(start, stop):
         hour = utc_ns[i] // NS_PER_HOUR
         weight = (utc_ns[i] - hour * NS_PER_HOUR) / NS_PER_HOUR
         k = index[i]
@@ -131,18 +131,19 @@ def equatorial_steps(utc_ns, index, at_nodes, change, out):
 
 
 @njit(cache=True, nogil=True)
-def periodic_sums(terms, bounds, jme, abcd, y, jce, x, sums, nutation):
+def periodic_sums(terms, bounds, jme, abcd, y, jce, x, sums, nutation, start, stop):
     """SPA's periodic series at every instant in one pass, for
     :func:`foldopt.physics.spa._periodic`, which documents them: the sum of table ``t``'s terms
     (rows ``bounds[t]`` to ``bounds[t + 1]`` of ``terms``, ``A cos(B + C jme)``) in ``sums[t]``,
     and the nutation's two sums (``(a + b jce) sin(arg)`` and ``(c + d jce) cos(arg)`` with ``arg``
-    the radians of ``y . x``, before their scale) in ``nutation`` (2, n_instants).
+    the radians of ``y . x``, before their scale) in ``nutation`` (2, n_instants); instants
+    ``start`` to ``stop - 1`` (a thread's share).
 
     Each value by the operations of ``pvlib.spa``'s NumPy loops in their order, and its sines and
     cosines by the C library's, which NumPy's float64 ``sin`` and ``cos`` call: their bits
     (tests/test_solarposition.py)."""
     to_radians = math.pi / 180.0
-    for i in range(jme.shape[0]):
+    for i in range(start, stop):
         for t in range(bounds.shape[0] - 1):
             total = 0.0
             for j in range(bounds[t], bounds[t + 1]):
