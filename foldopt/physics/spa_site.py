@@ -1,7 +1,16 @@
-"""The compiled pass of SPA's topocentric step (numba): the sun's direction, elevation and azimuth
-of every step of every block from the time-only terms, for
-:func:`foldopt.physics.spa.spa_solar_position`, which documents the method. Apart from
-:mod:`foldopt.physics.spa` so that the paper's sun and the terms' tables import no numba.
+"""The compiled passes of SPA (numba), each on numba's threads, for :mod:`foldopt.physics.spa`,
+which documents the method: the periodic series of its time-only part (:func:`periodic_sums`), its
+time-only terms at every instant (:func:`equatorial_steps`), and its topocentric step, the sun's
+direction, elevation, azimuth and hour angle of every step of every block (:func:`site_sun`).
+Apart from :mod:`foldopt.physics.spa` so that the paper's sun imports no numba.
+
+Their sines and cosines are the C library's (numba's ``math.sin`` and ``math.cos``), which
+NumPy's float64 ``sin`` and ``cos`` call on x86-64 Linux (2 M arguments compared; NumPy 2.4 takes
+vectorised, other bits for its ``arcsin``, ``tan``, ``arctan2`` and ``power``, which these passes
+take only where they were compiled already): so the passes give the bits of the NumPy and
+``pvlib.spa`` expressions they replaced, as tests/test_solarposition.py holds. A numba built with
+Intel's SVML (``numba.config.USING_SVML``) would vectorise their loops by other bits; those
+tests would show it.
 """
 
 from __future__ import annotations
@@ -109,9 +118,7 @@ def equatorial_steps(utc_ns, index, at_nodes, change, out, start, stop):
 
     Each value by the operations of the NumPy expressions this pass replaced, in their order (a
     true division of the hour's fraction, ``np.radians``' product by pi / 180, no fused
-    multiply-add), and its sines and cosines by the C library's ``sin`` and ``cos``, which NumPy's
-    float64 ``sin`` and ``cos`` call (NumPy 2 takes no vectorised ones for them): NumPy's bits
-    (tests/test_solarposition.py)."""
+    multiply-add): their bits (see the module's docstring)."""
     to_radians = math.pi / 180.0
     for i in range(start, stop):
         hour = utc_ns[i] // NS_PER_HOUR
@@ -139,9 +146,8 @@ def periodic_sums(terms, bounds, jme, abcd, y, jce, x, sums, nutation, start, st
     the radians of ``y . x``, before their scale) in ``nutation`` (2, n_instants); instants
     ``start`` to ``stop - 1`` (a thread's share).
 
-    Each value by the operations of ``pvlib.spa``'s NumPy loops in their order, and its sines and
-    cosines by the C library's, which NumPy's float64 ``sin`` and ``cos`` call: their bits
-    (tests/test_solarposition.py)."""
+    Each value by the operations of ``pvlib.spa``'s NumPy loops in their order: their bits (see
+    the module's docstring)."""
     to_radians = math.pi / 180.0
     for i in range(start, stop):
         for t in range(bounds.shape[0] - 1):
