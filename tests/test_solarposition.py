@@ -157,6 +157,30 @@ def test_exact_hour_angle_of_the_compiled_pass_is_pvlibs_formula_in_numpy():
     np.testing.assert_array_equal(sun["hour_angle"], expected)
 
 
+@pytest.mark.parametrize("zone", ["America/Los_Angeles", "Australia/Lord_Howe", "Pacific/Apia",
+                                  "Africa/Casablanca", "Antarctica/Troll", "Asia/Kolkata"])
+@pytest.mark.parametrize("step_min", [1, 7.5, 240])
+def test_the_clock_grid_is_pandas_shift_of_the_whole_grid(zone, step_min):
+    """The clock grid localises every step and shifts only the clock times a DST change skips
+    (Lord Howe's half hour, Apia's lost 30 December 2011, Casablanca's Ramadan breaks, Troll's two
+    hours): the bits of pandas shifting the whole grid forward and converting it back, over every
+    day of 2011 and 2024."""
+    from foldopt.physics.solarposition import clock_grid
+
+    for year in (2011, 2024):
+        dates = [dt.date(year, 1, 1) + dt.timedelta(days=d) for d in range(365)]
+        grid = clock_grid(dates, zone, step_min)
+        offsets = np.round((np.arange(round(1440 / step_min)) + 0.5) * step_min * 60e9).astype(np.int64)
+        naive = (np.array(dates, dtype="datetime64[D]").astype("datetime64[ns]").astype(np.int64)[:, None]
+                 + offsets[None, :])
+        flat = pd.DatetimeIndex(naive.ravel().astype("datetime64[ns]")).tz_localize(
+            zone, ambiguous=np.ones(naive.size, dtype=bool), nonexistent="shift_forward")
+        utc = flat.tz_convert("UTC").tz_localize(None).as_unit("ns").asi8.reshape(naive.shape)
+        local = flat.tz_localize(None).as_unit("ns").asi8.reshape(naive.shape)
+        np.testing.assert_array_equal(grid.utc_ns, utc)
+        np.testing.assert_array_equal(grid.utc_offset_ns, local - utc)
+
+
 def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
     from foldopt.physics.spa import _GEOCENTRIC, SunTerms, _geocentric_hourly, spa_geocentric
 
