@@ -137,19 +137,96 @@ def test_exact_hour_angle_is_pvlibs_and_zero_at_solar_noon():
     assert abs(exact["hour_angle"].iloc[noon]) < 0.3
 
 
+def test_exact_hour_angle_of_the_compiled_pass_is_pvlibs_formula_in_numpy():
+    """The per-site pass works out the hour angle, ``15 (UTC hours - 12) + longitude + EoT / 4``
+    wrapped to [-180, 180), with the bits of the NumPy expression (a float's remainder by Python's
+    rule in both) at sites of every longitude, days from 1950 to 2080."""
+    import foldopt.physics.spa as spa
+    from foldopt.physics.solarposition import clock_grid, solar_position_grid
+
+    rng = np.random.default_rng(8)
+    n = 16
+    dates = [dt.date(1950, 1, 1) + dt.timedelta(days=int(d)) for d in rng.integers(0, 130 * 365, n)]
+    grid = clock_grid(dates, "UTC", 7.5)
+    longitude = rng.uniform(-180, 180, (n, 1))
+    sun = solar_position_grid(grid, rng.uniform(-80, 80, (n, 1)), longitude, 10.0, "exact")
+    first, terms = spa.equatorial_once(grid.utc_ns)
+    eot = terms[4][first[:, None] + np.arange(grid.utc_ns.shape[1])]
+    utc_hours = (grid.utc_ns % (24 * spa.NS_PER_HOUR)) / spa.NS_PER_HOUR
+    expected = (15.0 * (utc_hours - 12.0) + longitude + eot / 4.0 + 180.0) % 360.0 - 180.0
+    np.testing.assert_array_equal(sun["hour_angle"], expected)
+
+
+@pytest.mark.parametrize("zone", ["America/Los_Angeles", "Australia/Lord_Howe", "Pacific/Apia",
+                                  "Africa/Casablanca", "Antarctica/Troll", "Asia/Kolkata"])
+@pytest.mark.parametrize("step_min", [1, 7.5, 240])
+def test_the_clock_grid_is_pandas_shift_of_the_whole_grid(zone, step_min):
+    """The clock grid localises every step and shifts only the clock times a DST change skips
+    (Lord Howe's half hour, Apia's lost 30 December 2011, Casablanca's Ramadan breaks, Troll's two
+    hours): the bits of pandas shifting the whole grid forward and converting it back, over every
+    day of 2011 and 2024."""
+    from foldopt.physics.solarposition import clock_grid
+
+    for year in (2011, 2024):
+        dates = [dt.date(year, 1, 1) + dt.timedelta(days=d) for d in range(365)]
+        grid = clock_grid(dates, zone, step_min)
+        offsets = np.round((np.arange(round(1440 / step_min)) + 0.5) * step_min * 60e9).astype(np.int64)
+        naive = (np.array(dates, dtype="datetime64[D]").astype("datetime64[ns]").astype(np.int64)[:, None]
+                 + offsets[None, :])
+        flat = pd.DatetimeIndex(naive.ravel().astype("datetime64[ns]")).tz_localize(
+            zone, ambiguous=np.ones(naive.size, dtype=bool), nonexistent="shift_forward")
+        utc = flat.tz_convert("UTC").tz_localize(None).as_unit("ns").asi8.reshape(naive.shape)
+        local = flat.tz_localize(None).as_unit("ns").asi8.reshape(naive.shape)
+        np.testing.assert_array_equal(grid.utc_ns, utc)
+        np.testing.assert_array_equal(grid.utc_offset_ns, local - utc)
+
+
 def test_geocentric_terms_interpolated_between_hours_stay_on_spa():
-    from foldopt.physics.spa import SunTerms, _geocentric_hourly, spa_geocentric
+    from foldopt.physics.spa import _GEOCENTRIC, SunTerms, _geocentric_hourly, spa_geocentric
 
     # Random instants from 1990 to 2060: linear interpolation between whole UTC hours.
     unix = np.sort(np.random.default_rng(5).uniform(6.3e8, 2.9e9, 5000))
     exact = spa_geocentric(unix)
-    interpolated = _geocentric_hourly((unix * 1e9).astype(np.int64), SunTerms())
-    for name, values in exact.items():
-        difference = values - interpolated[name]
+    utc_ns = (unix * 1e9).astype(np.int64)
+    at_nodes, change, index = _geocentric_hourly(utc_ns, SunTerms())
+    weight = (utc_ns % 3_600_000_000_000) / 3.6e12
+    for row, name in enumerate(_GEOCENTRIC):
+        difference = exact[name] - (at_nodes[row, index] + weight * change[row, index])
         if name in ("alpha", "v"):
             difference = (difference + 180.0) % 360.0 - 180.0
         bound = 4e-5 if name == "eot" else 1e-5  # 1e-5 deg; the equation of time in minutes (4 min a degree)
         assert np.abs(difference).max() < bound, name
+
+
+def _equatorial_by_numpy(utc_ns):
+    """SPA's time-only terms at instants (:func:`foldopt.physics.spa._equatorial`) as NumPy
+    expressions: the interpolation of each geocentric term between its hours, and its trigonometry."""
+    from foldopt.physics.spa import _GEOCENTRIC, NS_PER_HOUR, SunTerms, _geocentric_hourly
+
+    at_nodes, change, index = _geocentric_hourly(utc_ns, SunTerms())
+    index = index.reshape(utc_ns.shape)
+    hours = np.floor_divide(utc_ns, NS_PER_HOUR)
+    weight = (utc_ns - hours * NS_PER_HOUR) / NS_PER_HOUR
+    geo = {name: at_nodes[row][index] + weight * change[row][index] for row, name in enumerate(_GEOCENTRIC)}
+    greenwich, delta = np.radians(geo["v"] - geo["alpha"]), np.radians(geo["delta"])
+    return np.stack([np.cos(delta) * np.cos(greenwich), np.cos(delta) * np.sin(greenwich), np.sin(delta),
+                     np.sin(np.radians(geo["xi"])), geo["eot"]])
+
+
+@pytest.mark.parametrize("least", [1_000_000, 1])
+def test_equatorial_terms_in_a_compiled_pass_are_numpys_bits(monkeypatch, least):
+    """The compiled pass of SPA's time-only terms at every instant, on one thread or three, gives
+    the bits of their NumPy expressions (the C library's sines and cosines, which NumPy's float64
+    ones call), at 2-min steps over days from 1950 to 2090."""
+    import numba
+
+    import foldopt.physics.spa as spa
+
+    monkeypatch.setattr(spa, "EQUATORIAL_STEPS_A_THREAD", least)
+    monkeypatch.setattr(numba, "get_num_threads", lambda: 3)
+    days = np.random.default_rng(3).integers(-7_300, 43_800, 40)
+    utc_ns = (days[:, None] * 86_400 + np.arange(0, 86_400, 120)[None, :]) * 1_000_000_000
+    np.testing.assert_array_equal(spa._equatorial(utc_ns, spa.SunTerms()), _equatorial_by_numpy(utc_ns))
 
 
 def test_geocentric_periodic_terms_are_pvlib_spa_bits():
@@ -163,16 +240,16 @@ def test_geocentric_periodic_terms_are_pvlib_spa_bits():
     unix = np.concatenate([rng.uniform(-2.2e9, 4.1e9, 20_000), 1.7e9 + 3600.0 * np.arange(9_000)])
     jce = spa.julian_ephemeris_century(spa.julian_ephemeris_day(spa.julian_day(unix), split.SPA_DELTA_T))
     jme = spa.julian_ephemeris_millennium(jce)
-    np.testing.assert_array_equal(split._heliocentric(spa, "R", jme), spa.heliocentric_radius_vector(jme))
-    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(spa, "L", jme)) % 360,
-                                  spa.heliocentric_longitude(jme))
-    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(spa, "B", jme)),
-                                  spa.heliocentric_latitude(jme))
     args = (spa.mean_elongation(jce), spa.mean_anomaly_sun(jce), spa.mean_anomaly_moon(jce),
             spa.moon_argument_latitude(jce), spa.moon_ascending_longitude(jce))
+    sums, (psi, epsilon) = split._periodic(spa, jme, jce, args)
+    np.testing.assert_array_equal(split._heliocentric(sums["R"], jme), spa.heliocentric_radius_vector(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(sums["L"], jme)) % 360,
+                                  spa.heliocentric_longitude(jme))
+    np.testing.assert_array_equal(np.rad2deg(split._heliocentric(sums["B"], jme)),
+                                  spa.heliocentric_latitude(jme))
     nutation = np.empty((2, unix.size))
     spa.longitude_obliquity_nutation(jce, *args, nutation)
-    psi, epsilon = split._nutation(spa, jce, args)
     np.testing.assert_array_equal(psi, nutation[0])
     np.testing.assert_array_equal(epsilon, nutation[1])
 
@@ -348,7 +425,7 @@ def test_the_sun_keeps_nothing_between_calls():
     assert {name: id(value) for name, value in vars(spa).items()} == before
     mutable = [name for name, value in vars(spa).items()
                if isinstance(value, (dict, list, set, tuple)) and not name.startswith("__")]
-    assert mutable == ["_WRAPPED"], mutable  # a constant tuple of names
+    assert sorted(mutable) == ["_GEOCENTRIC", "_SERIES", "_WRAPPED"], mutable  # constant tuples of names
 
 
 def test_a_lattice_evaluates_only_the_instants_its_days_span(monkeypatch):

@@ -233,12 +233,22 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
         utc = naive - int(timezone.utcoffset(None).total_seconds() * 1e9)
     else:
         # One localisation for the whole grid; a DST jump makes some clock times ambiguous or
-        # absent: shift, never drop.
-        flat = pd.DatetimeIndex(naive.ravel().astype("datetime64[ns]")).tz_localize(
-            timezone, ambiguous=np.ones(naive.size, dtype=bool), nonexistent="shift_forward"
-        )
-        utc = flat.tz_convert("UTC").tz_localize(None).as_unit("ns").asi8.reshape(naive.shape)
-        naive = flat.tz_localize(None).as_unit("ns").asi8.reshape(naive.shape)
+        # absent: shift, never drop. The absent ones come back NaT and are shifted forward
+        # alone, their clock times with them: pandas localises each time on its own (given an
+        # array for ``ambiguous``), so these are the bits of shifting the whole grid, and a grid
+        # with no absent time (most) needs no conversion back to clock times.
+        index = pd.DatetimeIndex(naive.ravel().astype("datetime64[ns]"))
+        ambiguous = np.ones(naive.size, dtype=bool)
+        flat = index.tz_localize(timezone, ambiguous=ambiguous, nonexistent="NaT")
+        utc = flat.as_unit("ns").asi8.reshape(naive.shape)  # UTC, NaT where absent
+        absent = np.flatnonzero(flat.isna())
+        if absent.size:
+            shifted = index[absent].tz_localize(
+                timezone, ambiguous=ambiguous[absent], nonexistent="shift_forward"
+            )
+            utc, naive = utc.copy(), naive.copy()
+            utc.ravel()[absent] = shifted.as_unit("ns").asi8
+            naive.ravel()[absent] = shifted.tz_localize(None).as_unit("ns").asi8
     return ClockGrid(utc, naive - utc, (timezone,) * len(dates), step_min / 60.0)
 
 
@@ -383,13 +393,9 @@ def solar_position_grid(
         solar_zenith, solar_azimuth = sun_from_angles(declination, hour_angle, latitude)
         vector = normal_vector(solar_zenith, solar_azimuth)
     elif model == "exact":
-        solar_zenith, solar_azimuth, equation_of_time, vector = spa_solar_position(
+        solar_zenith, solar_azimuth, hour_angle, vector = spa_solar_position(
             grid.utc_ns, latitude, longitude, altitude, sun_terms
         )
-        utc_hours = (grid.utc_ns % _NS_PER_DAY) / NS_PER_HOUR
-        hour_angle = (
-            15.0 * (utc_hours - 12.0) + longitude + equation_of_time / 4.0 + 180.0
-        ) % 360.0 - 180.0
         import pvlib
 
         declination = _by_dayofyear(

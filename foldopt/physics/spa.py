@@ -83,9 +83,6 @@ def _geocentric(unixtime: np.ndarray, delta_t: float) -> dict:
     jc = spa.julian_century(jd)
     jce = spa.julian_ephemeris_century(jde)
     jme = spa.julian_ephemeris_millennium(jce)
-    radius = _heliocentric(spa, "R", jme)
-    theta = spa.geocentric_longitude(np.rad2deg(_heliocentric(spa, "L", jme)) % 360)
-    beta = spa.geocentric_latitude(np.rad2deg(_heliocentric(spa, "B", jme)))
     args = (
         spa.mean_elongation(jce),
         spa.mean_anomaly_sun(jce),
@@ -93,7 +90,10 @@ def _geocentric(unixtime: np.ndarray, delta_t: float) -> dict:
         spa.moon_argument_latitude(jce),
         spa.moon_ascending_longitude(jce),
     )
-    delta_psi, delta_epsilon = _nutation(spa, jce, args)
+    sums, (delta_psi, delta_epsilon) = _periodic(spa, jme, jce, args)
+    radius = _heliocentric(sums["R"], jme)
+    theta = spa.geocentric_longitude(np.rad2deg(_heliocentric(sums["L"], jme)) % 360)
+    beta = spa.geocentric_latitude(np.rad2deg(_heliocentric(sums["B"], jme)))
     epsilon = spa.true_ecliptic_obliquity(spa.mean_ecliptic_obliquity(jme), delta_epsilon)
     lamd = spa.apparent_sun_longitude(theta, delta_psi, spa.aberration_correction(radius))
     v = spa.apparent_sidereal_time(spa.mean_sidereal_time(jd, jc), delta_psi, epsilon)
@@ -109,52 +109,76 @@ def _geocentric(unixtime: np.ndarray, delta_t: float) -> dict:
     }
 
 
-def _rows_in_order(terms):
-    """The sum over the first axis of ``terms``, from 0.0 and row after row: the order of
-    ``pvlib.spa``'s loops, so the same bits."""
-    total = 0.0
-    for term in terms:
-        total = total + term
-    return total
+_SERIES = ("L", "B", "R")  # the Earth's heliocentric longitude, latitude and radius
 
 
-def _heliocentric(spa, series: str, jme):
+def _periodic_tables(spa) -> tuple:
+    """``pvlib.spa``'s tables of the heliocentric series' periodic terms (Table A4.2: ``L0``,
+    ``L1``..., ``B0``..., ``R0``... of ``spa``, the module ``pvlib.spa``) one after the other, (n,
+    3), the bounds of each table's rows, and the tables of each series, as
+    :func:`foldopt.physics.spa_site.periodic_sums` reads them."""
+    tables = {
+        series: [getattr(spa, f"{series}{k}") for k in range(6) if hasattr(spa, f"{series}{k}")]
+        for series in _SERIES
+    }
+    rows = [table for series in _SERIES for table in tables[series]]
+    bounds = np.cumsum([0] + [table.shape[0] for table in rows])
+    counts = [len(tables[series]) for series in _SERIES]
+    return np.ascontiguousarray(np.concatenate(rows), dtype=float), bounds, counts
+
+
+def _periodic(spa, jme, jce, args) -> tuple:
+    """SPA's periodic series [1]_ at every instant: each table's sum of the Earth's heliocentric
+    terms (Eq. 9-10: ``sum A cos(B + C jme)``), ``{'L': [L0, L1...], 'B': [...], 'R': [...]}``,
+    and the nutation in longitude and obliquity [deg] (Eq. 15-22). One compiled pass over the
+    instants on numba's threads (:func:`foldopt.physics.spa_site.periodic_sums`): each element by
+    the operations of ``pvlib.spa``'s loops over the terms in their order, so its bits
+    (tests/test_solarposition.py; pvlib's ``sum_mult_cos_add_mult`` costs a NumPy call a term).
+
+    Parameters
+    ----------
+    spa : module
+        ``pvlib.spa``.
+    jme, jce : numpy.ndarray
+        The Julian ephemeris millennium and century of each instant, 1-D.
+    args : tuple of numpy.ndarray
+        The nutation's five arguments ``X0`` to ``X4`` [deg] (Eq. 15-19).
+    """
+    from foldopt.physics.spa_site import periodic_sums  # numba's compiled pass
+
+    terms, bounds, counts = _periodic_tables(spa)
+    jme, jce = np.ascontiguousarray(jme, dtype=float), np.ascontiguousarray(jce, dtype=float)
+    x = np.ascontiguousarray(np.stack(np.broadcast_arrays(*args)), dtype=float)
+    abcd = np.ascontiguousarray(spa.NUTATION_ABCD_ARRAY, dtype=float)
+    y = np.ascontiguousarray(spa.NUTATION_YTERM_ARRAY, dtype=float)
+    sums, nutation = np.empty((len(bounds) - 1, jme.size)), np.empty((2, jme.size))
+    _on_threads(
+        lambda part: periodic_sums(
+            terms, bounds, jme, abcd, y, jce, x, sums, nutation, part.start, part.stop
+        ),
+        jme.size,
+        jme.size,
+        PERIODIC_INSTANTS_A_THREAD,
+    )
+    tables = np.split(sums, np.cumsum(counts)[:-1])
+    return dict(zip(_SERIES, tables, strict=True)), (
+        nutation[0] * 1.0 / 36000000,
+        nutation[1] * 1.0 / 36000000,
+    )
+
+
+def _heliocentric(sums, jme):
     """``pvlib.spa``'s heliocentric longitude, latitude or radius [1]_ (Eq. 9-11, before its
-    conversion to degrees) from its tables of periodic terms (Table A4.2: ``series`` ``'L'``,
-    ``'B'`` or ``'R'``, the tables ``L0``, ``L1``... of ``spa``, the module ``pvlib.spa``), each
-    table's terms at every instant at once: its ``sum_mult_cos_add_mult`` loops over the terms of
-    a table in Python, a NumPy call per term, which costs a short run's sun more than its steps
-    do. Each element takes the same operations in the same order as pvlib's (the polynomial in
-    ``jme`` as pvlib writes it), so the same bits (tests/test_solarposition.py)."""
-    tables = [getattr(spa, f"{series}{k}") for k in range(6) if hasattr(spa, f"{series}{k}")]
-    sums = [
-        _rows_in_order(t[:, 0, None] * np.cos(t[:, 1, None] + t[:, 2, None] * jme)) for t in tables
-    ]
+    conversion to degrees) from its tables' sums (:func:`_periodic`), the polynomial in ``jme`` as
+    pvlib writes it, so its bits (tests/test_solarposition.py)."""
     total = sums[0]
     for k in range(1, len(sums)):
         total = total + sums[k] * jme**k
     return total / 10**8
 
 
-def _nutation(spa, jce, args):
-    """``pvlib.spa.longitude_obliquity_nutation`` [1]_ (Eq. 15-22): the nutation in longitude and
-    in obliquity [deg], every periodic term at every instant at once, summed in pvlib's order
-    (``spa``: the module ``pvlib.spa``)."""
-    abcd, y = spa.NUTATION_ABCD_ARRAY, spa.NUTATION_YTERM_ARRAY
-    x0, x1, x2, x3, x4 = args
-    arg = np.radians(
-        y[:, 0, None] * x0
-        + y[:, 1, None] * x1
-        + y[:, 2, None] * x2
-        + y[:, 3, None] * x3
-        + y[:, 4, None] * x4
-    )
-    psi = _rows_in_order((abcd[:, 0, None] + abcd[:, 1, None] * jce) * np.sin(arg))
-    epsilon = _rows_in_order((abcd[:, 2, None] + abcd[:, 3, None] * jce) * np.cos(arg))
-    return psi * 1.0 / 36000000, epsilon * 1.0 / 36000000
-
-
 _WRAPPED = ("alpha", "v")  # angles that wrap at 360 deg
+_GEOCENTRIC = ("alpha", "delta", "v", "xi", "eot")  # the terms the sun takes, in their order
 
 
 class SunTerms:
@@ -295,25 +319,33 @@ def _spanned(starts, n_steps: int, size: int) -> np.ndarray:
     return np.flatnonzero(np.cumsum(edges[:-1]) > 0)
 
 
-def _geocentric_hourly(utc_ns: np.ndarray, sun_terms: SunTerms) -> dict:
-    """:func:`spa_geocentric` at ``utc_ns`` (any shape), interpolated linearly between whole UTC
-    hours, each hour evaluated once however many sites and days share it
-    (:meth:`SunTerms.at_hours`).
+def _geocentric_hourly(utc_ns: np.ndarray, sun_terms: SunTerms) -> tuple:
+    """:func:`spa_geocentric` at the whole UTC hours that ``utc_ns`` (any shape) touch, each hour
+    evaluated once however many sites and days share it (:meth:`SunTerms.at_hours`), to be
+    interpolated linearly between them (:func:`foldopt.physics.spa_site.equatorial_steps`).
 
-    Over an hour the geocentric terms are smooth to within 1e-5 deg of linear (tested)."""
+    Over an hour the geocentric terms are smooth to within 1e-5 deg of linear (tested).
+
+    Returns
+    -------
+    at_nodes : numpy.ndarray
+        (5, n_nodes) the terms ``alpha``, ``delta``, ``v``, ``xi`` and ``eot`` at the hours.
+    change : numpy.ndarray
+        (5, n_nodes - 1) each hour's change to the next (``alpha`` and ``v`` wrapped to
+        [-180, 180) deg), worked out once an hour rather than once a step.
+    index : numpy.ndarray of int64
+        The hour of each instant among the nodes, ``utc_ns`` flattened.
+    """
     hours = np.floor_divide(utc_ns, NS_PER_HOUR)
     nodes, index = _hour_nodes(hours)
     at_nodes = sun_terms.at_hours(nodes)
-    weight = (utc_ns - hours * NS_PER_HOUR) / NS_PER_HOUR
-    out = {}
-    for name, values in at_nodes.items():
-        # Each hour's change, worked out once an hour rather than once a step (the same
-        # subtraction of the same two values); an hour's next node is always its own next hour.
-        change = values[1:] - values[:-1]
+    values = np.stack([at_nodes[name] for name in _GEOCENTRIC])
+    # An hour's next node is always its own next hour.
+    change = values[:, 1:] - values[:, :-1]
+    for row, name in enumerate(_GEOCENTRIC):
         if name in _WRAPPED:
-            change = (change + 180.0) % 360.0 - 180.0
-        out[name] = values[index] + weight * change[index]
-    return out
+            change[row] = (change[row] + 180.0) % 360.0 - 180.0
+    return values, change, np.ascontiguousarray(index.ravel())
 
 
 def _hour_nodes(hours: np.ndarray) -> tuple:
@@ -335,50 +367,59 @@ def _hour_nodes(hours: np.ndarray) -> tuple:
 
 def _equatorial(utc_ns, sun_terms: SunTerms) -> np.ndarray:
     """The time-only terms of a site's sun at UTC instants ``utc_ns`` (any shape), from SPA's
-    geocentric terms (:func:`_geocentric_hourly`): the sun's direction in the frame of the
-    Greenwich meridian and the celestial pole, ``cos(delta) cos(H_G)``, ``cos(delta) sin(H_G)``
-    and ``sin(delta)`` with ``H_G = v - alpha`` its Greenwich hour angle [1]_ (Eq. 34 at longitude
-    0); ``sin(xi)``, the scale of the parallax; and the equation of time [min]. (5, ...)."""
-    geo = _geocentric_hourly(utc_ns, sun_terms)
-    greenwich = np.radians(geo["v"] - geo["alpha"])
-    delta = np.radians(geo["delta"])
-    cos_delta = np.cos(delta)
-    return np.stack(
-        [
-            cos_delta * np.cos(greenwich),
-            cos_delta * np.sin(greenwich),
-            np.sin(delta),
-            np.sin(np.radians(geo["xi"])),
-            geo["eot"],
-        ]
+    geocentric terms interpolated between whole UTC hours (:func:`_geocentric_hourly`): the sun's
+    direction in the frame of the Greenwich meridian and the celestial pole, ``cos(delta)
+    cos(H_G)``, ``cos(delta) sin(H_G)`` and ``sin(delta)`` with ``H_G = v - alpha`` its Greenwich
+    hour angle [1]_ (Eq. 34 at longitude 0); ``sin(xi)``, the scale of the parallax; and the
+    equation of time [min]. (5, ...). Every step in one compiled pass on numba's threads
+    (:func:`foldopt.physics.spa_site.equatorial_steps`, which says why its bits are NumPy's)."""
+    from foldopt.physics.spa_site import equatorial_steps  # numba's compiled pass
+
+    utc_ns = np.asarray(utc_ns)
+    at_nodes, change, index = _geocentric_hourly(utc_ns, sun_terms)
+    flat = np.ascontiguousarray(utc_ns.ravel())
+    out = np.empty((5, flat.size))
+    _on_threads(
+        lambda part: equatorial_steps(flat, index, at_nodes, change, out, part.start, part.stop),
+        flat.size,
+        flat.size,
+        EQUATORIAL_STEPS_A_THREAD,
     )
+    return out.reshape((5, *utc_ns.shape))
 
 
-SITE_STEPS_A_THREAD = 100_000  # blocks x steps below which the per-site pass keeps one thread
+#: The work of a thread of the compiled passes below which it is not worth its start (some 0.05
+#: to 0.1 ms; each pass 0.2-0.3 ms of work): blocks x steps of the per-site pass (some 50 ns a
+#: step), instants of the equatorial terms (some 65 ns) and of SPA's periodic series (4 us).
+SITE_STEPS_A_THREAD = 5_000
+EQUATORIAL_STEPS_A_THREAD = 4_000
+PERIODIC_INSTANTS_A_THREAD = 60
 
 
-def _by_blocks(run, shape) -> None:
-    """``run(part)`` over slices of the blocks of ``shape`` (n_blocks, n_steps), on numba's
-    threads: :func:`foldopt.physics.spa_site.site_sun` releases the GIL, and its blocks are
-    independent."""
+def _on_threads(run, n: int, steps: int, least: int) -> None:
+    """``run(part)`` over slices ``part`` of ``range(n)`` (of ``steps`` steps in all), on numba's
+    threads, each thread ``least`` steps or more: the compiled passes release the GIL, and their
+    items (blocks, instants) are independent. The last part runs in the calling thread."""
     from concurrent.futures import ThreadPoolExecutor
 
     from numba import get_num_threads
 
-    threads = min(get_num_threads(), shape[0], max(1, shape[0] * shape[1] // SITE_STEPS_A_THREAD))
-    edges = np.linspace(0, shape[0], threads + 1).astype(int)
+    threads = min(get_num_threads(), n, max(1, steps // least))
+    edges = np.linspace(0, n, threads + 1).astype(int)
     parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
     if threads == 1:
         run(parts[0])
         return
-    with ThreadPoolExecutor(threads, thread_name_prefix="foldopt-sun") as pool:
-        for done in [pool.submit(run, part) for part in parts]:
+    with ThreadPoolExecutor(threads - 1, thread_name_prefix="foldopt-sun") as pool:
+        others = [pool.submit(run, part) for part in parts[:-1]]
+        run(parts[-1])
+        for done in others:
             done.result()  # a part's error, raised here
 
 
 def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerms | None = None):
-    """Apparent zenith, azimuth, equation of time and the sun's apparent unit vector by SPA [1]_
-    at every step of days of steps.
+    """Apparent zenith, azimuth, hour angle and the sun's apparent unit vector by SPA [1]_ at every
+    step of days of steps.
 
     SPA's geocentric terms depend on time alone: kept per UTC hour and interpolated
     (:func:`_geocentric_hourly`), they give the sun's direction in the frame of the Greenwich
@@ -409,8 +450,10 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     -------
     apparent_zenith, solar_azimuth : numpy.ndarray
         [deg], azimuth clockwise from north, (n_blocks, n_steps).
-    equation_of_time : numpy.ndarray
-        [min], (n_blocks, n_steps).
+    hour_angle : numpy.ndarray
+        [deg] in [-180, 180), (n_blocks, n_steps): pvlib's formula ``15 (UTC hours - 12) +
+        longitude + EoT / 4`` with SPA's equation of time (EoT, [min]), worked out from UTC (so DST
+        days need no care).
     sun_vector : numpy.ndarray
         (n_blocks, n_steps, 3) the apparent direction's east, north and up components [-] (a view of
         an array laid out (n_blocks, 3, n_steps), each component contiguous along the steps).
@@ -420,13 +463,12 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     .. [1] I. Reda, A. Andreas, "Solar position algorithm for solar radiation applications",
        Solar Energy 76(5), 577-589, 2004, Sec. 3.10-3.14 and A.1.
     """
-    utc_ns = np.asarray(utc_ns)
+    utc_ns = np.ascontiguousarray(utc_ns, dtype=np.int64)
     shape = utc_ns.shape
 
     def per_block(values):
-        return np.ascontiguousarray(
-            np.broadcast_to(np.asarray(values, dtype=float), (shape[0], 1))[:, 0]
-        )
+        # a copy: one type (writable, contiguous) for the compiled pass whatever the caller's
+        return np.array(np.broadcast_to(np.asarray(values, dtype=float), (shape[0], 1))[:, 0])
 
     latitude, longitude, altitude = per_block(latitude), per_block(longitude), per_block(altitude)
     import pvlib
@@ -437,12 +479,17 @@ def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerm
     first, terms = equatorial_once(utc_ns) if sun_terms is None else sun_terms.on_lattice(utc_ns)
     # each component along the steps, as the engine reads it
     vector = np.empty((shape[0], 3, shape[1]))
-    apparent_zenith, solar_azimuth = np.empty(shape), np.empty(shape)
+    apparent_zenith, solar_azimuth, hour_angle = np.empty(shape), np.empty(shape), np.empty(shape)
     pressure = np.ascontiguousarray(pvlib.atmosphere.alt2pres(altitude) / 100.0)
-    per_site = (first, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi), x, y, pressure)
-    outputs = (vector, apparent_zenith, solar_azimuth)
+    per_site = (utc_ns, first, longitude, np.sin(lam), np.cos(lam), np.sin(phi), np.cos(phi))
+    per_site += (x, y, pressure)
+    outputs = (vector, apparent_zenith, solar_azimuth, hour_angle)
     from foldopt.physics.spa_site import site_sun  # numba's compiled pass
 
-    _by_blocks(lambda part: site_sun(terms, *(a[part] for a in per_site + outputs)), shape)
-    equation_of_time = np.lib.stride_tricks.sliding_window_view(terms[4], shape[1])[first]
-    return apparent_zenith, solar_azimuth, equation_of_time, np.moveaxis(vector, 1, -1)
+    _on_threads(
+        lambda part: site_sun(terms, *(a[part] for a in per_site + outputs)),
+        shape[0],
+        shape[0] * shape[1],
+        SITE_STEPS_A_THREAD,
+    )
+    return apparent_zenith, solar_azimuth, hour_angle, np.moveaxis(vector, 1, -1)
