@@ -763,12 +763,9 @@ def summarise(day: Day, designs: Designs) -> Columns:
     wired = {
         f"twofold-{connection}": study.circuit.ignored_by(connection) for connection in CONNECTIONS
     }
+    sky = day.sky.conditions()[0]
     condition = [
-        "; ".join(
-            filter(
-                None, (wired.get(design) or day.electrical.beyond_reach, day.sky.conditions()[0])
-            )
-        )
+        "; ".join(filter(None, (wired.get(design) or day.electrical.beyond_reach, sky)))
         for design in table["design"]
     ]
     return table.assign(
