@@ -279,11 +279,11 @@ def _wall(local_ns: int, fold: int = 0) -> dt.datetime:
     return (_EPOCH + dt.timedelta(microseconds=local_ns // 1000)).replace(fold=fold)
 
 
-def _localised(naive: np.ndarray, zone: zoneinfo.ZoneInfo) -> np.ndarray:
-    """UTC [ns] of local clock times of whole days in an IANA zone, as pandas' ``tz_localize``
-    with ``ambiguous=True`` and ``nonexistent="shift_forward"``: a repeated clock time is taken
-    at its first instant (before the clocks go back), a skipped one moved to the instant the
-    clocks jump.
+def _localised(naive: np.ndarray, zone: zoneinfo.ZoneInfo) -> tuple[np.ndarray, np.ndarray]:
+    """Local clock times of whole days in an IANA zone localised as pandas' ``tz_localize`` with
+    ``ambiguous=True`` and ``nonexistent="shift_forward"`` does it, with the standard library: a
+    repeated clock time is taken at its first instant (before the clocks go back), a skipped one
+    moved forward (:func:`_localised_step`).
 
     Parameters
     ----------
