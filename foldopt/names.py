@@ -572,3 +572,11 @@ def did_you_mean(value: str, names) -> str:
     """
     close = close_names(value, names)
     return f"; did you mean {' or '.join(repr(name) for name in close)}?" if close else ""
+
+
+#: Seconds [s] foldopt waits for a Dask scheduler to answer, every step of reaching it counted (the
+#: name looked up, the port connected, Dask's greeting, the client's connection)
+#: (:mod:`foldopt.studies.dask_client`; here for the map's help, which then loads none of it).
+CONNECT_TIMEOUT = 5.0
+#: Seconds [s] foldopt then waits for the scheduler's first worker (a worker starting takes seconds).
+WORKER_TIMEOUT = 30.0

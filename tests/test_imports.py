@@ -1,7 +1,8 @@
 """The import graph of a command as it runs (issue 49): a refused request and ``foldopt --help``
 load none of the heavy libraries (each of which alone costs the 0.3 s a refusal may take),
 ``foldopt run`` prints its answer before matplotlib loads for the figures, and the embedded
-study's answer (the command's, the API's) loads none of numba, scipy or pvlib. The command line's
+study's answer (the command's, the API's) loads none of numba, scipy, pvlib or pandas (its
+tables are NumPy columns until the folder is written or a user asks for a DataFrame). The command line's
 own process freezes the modules a command loads (the collector's passes then leave them out) and
 an in-process caller's collector is left as it was.
 
@@ -24,8 +25,10 @@ import pytest
 HEAVY = ("pvlib", "pandas", "matplotlib", "scipy", "numba", "numpy")
 #: What the embedded study's answer imports none of: numba (the day runs on the NumPy path), scipy
 #: (its two roots are :func:`foldopt.engine.roots.brentq`), pvlib (the formulas of it the day calls
-#: are foldopt's, held to pvlib's bits) and matplotlib (the figures come after the answer).
-NOT_FOR_THE_ANSWER = ("numba", "scipy", "pvlib", "matplotlib")
+#: are foldopt's, held to pvlib's bits), pandas (the day's tables are
+#: :class:`foldopt.columnar.Columns` until written) and matplotlib (the figures come after the
+#: answer).
+NOT_FOR_THE_ANSWER = ("numba", "scipy", "pvlib", "pandas", "matplotlib")
 #: The line the probe prints where a watched module is first imported.
 MARKER = "<<imported {}>>"
 
@@ -127,31 +130,40 @@ def test_the_answer_prints_before_matplotlib_loads(tmp_path):
     assert (tmp_path / "out" / "power_curves.png").is_file()
 
 
-def test_the_embedded_studys_answer_imports_no_numba_scipy_pvlib_or_matplotlib(tmp_path):
-    """``foldopt run`` computes and prints the embedded study's whole answer with numpy and pandas
-    alone; writing its folder then adds matplotlib (for the figures) and nothing else heavy."""
+def test_the_embedded_studys_answer_imports_numpy_alone(tmp_path):
+    """``foldopt run`` computes and prints the embedded study's whole answer with numpy alone;
+    writing its folder then adds pandas (its tables) and matplotlib (its figures), nothing else
+    heavy."""
     code, lines, imported, stderr = _run(
         ["run", "--out", str(tmp_path / "out")], watched=NOT_FOR_THE_ANSWER, cwd=_repository()
     )
     assert code == 0, stderr
-    answer = lines[: lines.index(MARKER.format("matplotlib"))]
+    markers = [line for line in lines if line.startswith("<<imported")]
+    assert sorted(markers) == [MARKER.format("matplotlib"), MARKER.format("pandas")]
+    answer = lines[: lines.index(markers[0])]
     assert answer[0].startswith("shin2015: ") and "a flat panel would need" in answer[-1]
-    assert [line for line in answer if line.startswith("<<imported")] == []
     assert imported == ["matplotlib", "numpy", "pandas"]
+    assert (tmp_path / "out" / "summary.csv").is_file()
 
 
-def test_the_apis_run_of_the_embedded_study_imports_no_numba_scipy_pvlib_or_matplotlib():
-    """``foldopt.run()`` and its answer, as a notebook asks for them: numpy and pandas alone."""
+def test_the_apis_run_of_the_embedded_study_imports_numpy_alone_until_a_table_is_asked():
+    """``foldopt.run()`` and its answer, as a notebook asks for them: numpy alone; the result's
+    and the answer's tables are DataFrames when asked for, and pandas loads then."""
     probe = (
         "import json, sys, foldopt; result = foldopt.run(); lines = result.answer.lines(); "
-        f"print(json.dumps([bool(lines), sorted(m for m in {HEAVY!r} if m in sys.modules)]))"
+        f"before = sorted(m for m in {HEAVY!r} if m in sys.modules); "
+        "tables = [type(t).__name__ for t in (result.summary, result.sweep, result.timeseries, "
+        "result.standby.table, result.answer.designs, result.answer.near_optimal, "
+        "result.answer.schedule)]; "
+        "print(json.dumps([bool(lines), before, tables, str(result.timeseries.index.tz)]))"
     )
     done = subprocess.run(
         [sys.executable, "-c", probe], capture_output=True, text=True, timeout=300
     )
     assert done.returncode == 0, done.stderr
-    answered, imported = json.loads(done.stdout.splitlines()[-1])
-    assert answered and imported == ["numpy", "pandas"]
+    answered, imported, tables, zone = json.loads(done.stdout.splitlines()[-1])
+    assert answered and imported == ["numpy"]
+    assert tables == ["DataFrame"] * 7 and zone == "America/Los_Angeles"
 
 
 #: Runs the command line as the script does and reports the collector's passes that ran with

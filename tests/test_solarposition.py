@@ -9,6 +9,7 @@ import pvlib
 import pytest
 
 from foldopt.physics.solarposition import (
+    clock_grid,
     day_times,
     declination_paper,
     equation_of_time_paper,
@@ -94,6 +95,55 @@ def test_day_times_are_interval_centred_over_the_local_day():
     assert times[-1] == pd.Timestamp("2014-09-23 23:59:30", tz="America/Los_Angeles")
     with pytest.raises(ValueError, match="1440"):
         day_times(dt.date(2014, 9, 23), "UTC", 7)
+
+
+#: Zones whose clocks jump: forward and back by an hour (both hemispheres), by half an hour (Lord
+#: Howe), at midnight (Havana, Santiago, Beirut), on a half-hour offset (St John's), none (Kolkata).
+JUMPING_ZONES = (
+    "America/Los_Angeles",
+    "Europe/Berlin",
+    "Australia/Sydney",
+    "Australia/Lord_Howe",
+    "America/Havana",
+    "America/Santiago",
+    "Asia/Beirut",
+    "America/St_Johns",
+    "Asia/Kolkata",
+)
+
+
+def _pandas_grid(dates, zone, step_min):
+    """UTC [ns] and UTC offset [ns] of the clock grid's steps as pandas localises them."""
+    n_steps = round(1440 / step_min)
+    offsets = np.round((np.arange(n_steps) + 0.5) * step_min * 60e9).astype(np.int64)
+    midnights = np.array(dates, dtype="datetime64[D]").astype("datetime64[ns]").astype(np.int64)
+    naive = (midnights[:, None] + offsets[None, :]).ravel().astype("datetime64[ns]")
+    local = pd.DatetimeIndex(naive).tz_localize(
+        zone, ambiguous=np.ones(naive.size, dtype=bool), nonexistent="shift_forward"
+    )
+    utc = local.tz_convert("UTC").tz_localize(None).as_unit("ns").asi8
+    clock = local.tz_localize(None).as_unit("ns").asi8
+    return utc.reshape(len(dates), -1), (clock - utc).reshape(len(dates), -1)
+
+
+@pytest.mark.parametrize("name", JUMPING_ZONES)
+def test_the_clock_grid_of_a_zone_is_pandas_localisation_to_the_bit(name):
+    """The clock grid of an IANA zone (localised with the standard library, no pandas) gives
+    every step the instant and offset pandas' ``tz_localize`` gives it (a repeated clock time at
+    its first instant, a skipped one shifted forward), every day of years whose rules differ,
+    DST days included, for steps of a minute, 7.5 min and an hour."""
+    import zoneinfo
+
+    zone = zoneinfo.ZoneInfo(name)
+    for year in (1995, 2014, 2024):
+        start = dt.date(year, 1, 1)
+        dates = [start + dt.timedelta(days=i) for i in range(365)]
+        for step_min in (1.0, 7.5, 60.0):
+            grid = clock_grid(dates, zone, step_min)
+            utc, offset = _pandas_grid(dates, zone, step_min)
+            assert np.array_equal(grid.utc_ns, utc), (name, year, step_min)
+            assert np.array_equal(grid.utc_offset_ns, offset), (name, year, step_min)
+            assert grid.timezones[0] is zone
 
 
 def test_unknown_model_lists_valid_names():

@@ -29,8 +29,7 @@ from foldopt.cli.options import (
 from foldopt import names
 from foldopt.cli.output import INVOCATION, Output, fail
 from foldopt.errors import ConfigError
-from foldopt.names import DEFAULT_ENGINE
-from foldopt.studies.dask_client import CONNECT_TIMEOUT, WORKER_TIMEOUT, check_cluster
+from foldopt.names import CONNECT_TIMEOUT, DEFAULT_ENGINE, WORKER_TIMEOUT
 
 #: The map request's parameters as the options name them, beside the study's fields.
 _OPTION_OF_PARAMETER = {
@@ -223,6 +222,9 @@ def map_(
         for option, value in (("--workers", workers), ("--chunk-sites", chunk_sites))
         if value is not None and value < 1
     ]
+    # The cluster's client (logging, sockets) loads with a map: other commands need none of it.
+    from foldopt.studies.dask_client import check_cluster
+
     try:
         check_cluster(scheduler, workers)
     except ConfigError as error:

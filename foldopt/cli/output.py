@@ -145,11 +145,11 @@ class Output:
         out : pathlib.Path
             The results folder written.
         answer : foldopt.studies.answer.Answer
-        rows : pandas.DataFrame, optional
+        rows : pandas.DataFrame or foldopt.columnar.Columns, optional
             The rows the JSON document holds.
         lines_after : sequence of str
             Lines printed after the answer's (``wrote <folder>``).
-        table : pandas.DataFrame, optional
+        table : pandas.DataFrame or foldopt.columnar.Columns, optional
             The table ``--table`` prints.
         write : callable, optional
             Writes the folder ``out``, with no argument.
@@ -178,6 +178,12 @@ class Output:
         for line in lines_after:
             echo(line)
         if table is not None and self.table:
-            typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"))
+            from foldopt.columnar import as_frame
+
+            typer.echo(
+                as_frame(table).to_string(
+                    index=False, float_format=lambda v: f"{v:.3f}", na_rep="-"
+                )
+            )
         elif table is not None:
             typer.echo("(--table prints the full table)")

@@ -70,7 +70,8 @@ def run_request(
             ConfigError
         ) as error:  # a limit found as the work starts, said as the request gave it
             fail(list(dict.fromkeys(request.rename(line) for line in error.errors)))
-    rows = result.summary if isinstance(result, StudyResult) else result.table
+    # A day's rows as the study holds them: its answer is printed before pandas loads.
+    rows = result.summary_columns if isinstance(result, StudyResult) else result.table
     output.answer(
         command,
         out,

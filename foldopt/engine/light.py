@@ -9,24 +9,21 @@ weather) is one compiled pass over the lit steps that gives the diffuse terms wi
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 
 from foldopt.engine.options import SkyOptions
 from foldopt.errors import WeatherError
 from foldopt.inputs.turbidity import linke_turbidity as climatology_turbidity
-from foldopt.inputs.weather.reader import (
-    FORMATS,
-    read_weather,
-    study_weather,
-    weather_days,
-    weather_format,
-)
 from foldopt.inputs.weather.downscale import clear_sky, hourly_light, interpolate_points
 from foldopt.inputs.weather.ensemble import cloud_members
 from foldopt.physics.atmosphere import relative_airmass
 from foldopt.physics.irradiance import sky_diffuse_terms
 from foldopt.physics.solarposition import ClockGrid
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def _airmass(solar_zenith) -> np.ndarray:
@@ -181,6 +178,11 @@ def weather_light(weather, grid: ClockGrid, dates, clear: dict, solar_zenith, dn
     (:func:`foldopt.inputs.weather.downscale.hourly_light`), the air temperature and wind at every
     step (:func:`foldopt.inputs.weather.downscale.interpolate_points`), and how much of the file's
     irradiation the steps keep."""
+    # The file's readers (and pandas) load with a weather file: a clear sky needs neither.
+    import pandas as pd
+
+    from foldopt.inputs.weather.reader import FORMATS, read_weather, weather_days, weather_format
+
     columns = ("dni", "ghi", "dhi", "temp_air", "wind_speed", "cloud_cover")
     hourly = {key: np.empty((len(dates), 0)) for key in columns}
     starts = np.empty((len(dates), 0), dtype=np.int64)
@@ -235,6 +237,10 @@ def weather_light(weather, grid: ClockGrid, dates, clear: dict, solar_zenith, dn
 def measured_light(options: SkyOptions, grid: ClockGrid, dates):
     """Light, air temperature and wind at every step of the grid from the options' measured
     weather file, at its own step (:func:`foldopt.inputs.weather.reader.study_weather`)."""
+    import pandas as pd
+
+    from foldopt.inputs.weather.reader import study_weather, weather_days
+
     weather = options.weather
     measured = study_weather(weather, options.weather_site)
     frame = measured.frame

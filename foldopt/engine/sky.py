@@ -28,7 +28,6 @@ from foldopt.engine.light import (
 from foldopt.engine.options import SkyOptions
 from foldopt.inputs.load_profile import load_shape
 from foldopt.inputs.sections import parse_timezone
-from foldopt.inputs.weather.reader import read_weather, study_weather, weather_site
 from foldopt.names import CLEAR_SKIES
 from foldopt.physics.atmosphere import clear_sky_dni, extraterrestrial_spencer
 from foldopt.physics.horizon import sun_visible
@@ -373,6 +372,9 @@ def build_sky(
         raise ValueError(f"{len(sites)} sites for {len(dates)} dates")
     weather = options.weather
     if weather is not None:
+        # The file's readers (and pandas) load with a weather file: a clear sky needs neither.
+        from foldopt.inputs.weather.reader import read_weather, study_weather, weather_site
+
         # A weather file's days are on its own clock, whatever time zone the site names.
         zone = (
             study_weather(weather, options.weather_site).site

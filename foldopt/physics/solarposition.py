@@ -34,14 +34,18 @@ from __future__ import annotations
 
 import datetime as dt
 import functools
+import zoneinfo
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from foldopt.names import MODES
 from foldopt.physics.geometry import normal_vector
 from foldopt.physics.spa import NS_PER_HOUR, SunTerms, spa_solar_position
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 _NS_PER_DAY = 24 * NS_PER_HOUR
 
@@ -136,6 +140,8 @@ class ClockGrid:
         pandas.DatetimeIndex
             The block's steps in its own time zone.
         """
+        import pandas as pd
+
         utc = pd.DatetimeIndex(self.utc_ns[block].astype("datetime64[ns]"), tz="UTC")
         return utc.tz_convert(self.timezones[block])
 
@@ -184,6 +190,8 @@ class ClockGrid:
         -------
         ClockGrid
         """
+        import pandas as pd
+
         utc = np.stack(
             [
                 np.asarray(
@@ -231,12 +239,17 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
     if isinstance(timezone, dt.tzinfo) and not hasattr(timezone, "key"):
         # A fixed offset: no DST, so no localisation is needed.
         utc = naive - int(timezone.utcoffset(None).total_seconds() * 1e9)
+    elif isinstance(timezone, zoneinfo.ZoneInfo):
+        utc, naive = _localised(naive, timezone)
     else:
-        # One localisation for the whole grid; a DST jump makes some clock times ambiguous or
-        # absent: shift, never drop. The absent ones come back NaT and are shifted forward
-        # alone, their clock times with them: pandas localises each time on its own (given an
-        # array for ``ambiguous``), so these are the bits of shifting the whole grid, and a grid
-        # with no absent time (most) needs no conversion back to clock times.
+        # A zone by name or of another library: pandas localises it, the whole grid at once; a
+        # DST jump makes some clock times ambiguous or absent: shift, never drop. The absent ones
+        # come back NaT and are shifted forward alone, their clock times with them: pandas
+        # localises each time on its own (given an array for ``ambiguous``), so these are the
+        # bits of shifting the whole grid, and a grid with no absent time (most) needs no
+        # conversion back to clock times.
+        import pandas as pd
+
         index = pd.DatetimeIndex(naive.ravel().astype("datetime64[ns]"))
         ambiguous = np.ones(naive.size, dtype=bool)
         flat = index.tz_localize(timezone, ambiguous=ambiguous, nonexistent="NaT")
@@ -250,6 +263,76 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
             utc.ravel()[absent] = shifted.as_unit("ns").asi8
             naive.ravel()[absent] = shifted.tz_localize(None).as_unit("ns").asi8
     return ClockGrid(utc, naive - utc, (timezone,) * len(dates), step_min / 60.0)
+
+
+_EPOCH = dt.datetime(1970, 1, 1)
+
+
+def _offset_ns(offset: dt.timedelta) -> int:
+    """A UTC offset [ns], exactly."""
+    return (offset.days * 86_400 + offset.seconds) * 1_000_000_000 + offset.microseconds * 1000
+
+
+def _wall(local_ns: int, fold: int = 0) -> dt.datetime:
+    """A local clock time [ns since 1970-01-01 00:00 local] as a naive datetime (to the
+    microsecond below: a zone's transitions fall on whole seconds)."""
+    return (_EPOCH + dt.timedelta(microseconds=local_ns // 1000)).replace(fold=fold)
+
+
+def _localised(naive: np.ndarray, zone: zoneinfo.ZoneInfo) -> tuple[np.ndarray, np.ndarray]:
+    """Local clock times of whole days in an IANA zone localised as pandas' ``tz_localize`` with
+    ``ambiguous=True`` and ``nonexistent="shift_forward"`` does it, with the standard library: a
+    repeated clock time is taken at its first instant (before the clocks go back), a skipped one
+    moved forward (:func:`_localised_step`).
+
+    Parameters
+    ----------
+    naive : numpy.ndarray of int64, (n_days, n_steps)
+        Local clock times [ns since 1970-01-01 00:00 local], each row within one local day.
+    zone : zoneinfo.ZoneInfo
+
+    Returns
+    -------
+    utc, local : numpy.ndarray of int64
+        Same shape: each step's instant [ns since the epoch, UTC] and its clock time as the zone
+        reads it [ns since 1970-01-01 00:00 local] (a skipped clock time moved forward).
+    """
+    utc, local = np.empty_like(naive), naive.copy()
+    for row, times in enumerate(naive):
+        midnight = int(times[0]) // _NS_PER_DAY * _NS_PER_DAY
+        # The offsets at each whole hour of the day, both sides of any fold: one offset for all
+        # of them is a day with no transition (zones change their clocks on whole hours or half
+        # hours, at most once in an hour), whose steps are one subtraction.
+        hours = {
+            _offset_ns(zone.utcoffset(_wall(midnight + hour * NS_PER_HOUR, fold)))
+            for hour in range(25)
+            for fold in (0, 1)
+        }
+        if len(hours) == 1:
+            utc[row] = times - hours.pop()
+            continue
+        utc[row] = [_localised_step(int(t), zone) for t in times]
+        local[row] = utc[row] + [
+            _offset_s(zone, int(t) // 1_000_000_000) * 1_000_000_000 for t in utc[row]
+        ]
+    return utc, local
+
+
+def _localised_step(local_ns: int, zone: zoneinfo.ZoneInfo) -> int:
+    """UTC [ns] of one local clock time (:func:`_localised`)."""
+    before = _offset_ns(zone.utcoffset(_wall(local_ns, 0)))
+    after = _offset_ns(zone.utcoffset(_wall(local_ns, 1)))
+    if before >= after:  # an ordinary time, or a repeated one at its first instant
+        return local_ns - before
+    # Skipped by the clocks: pandas' rule, the clock's next whole hour read with the offset after
+    # the jump (the first time after it where the jump is an hour or half an hour on a whole hour).
+    return local_ns + NS_PER_HOUR - local_ns % NS_PER_HOUR - after
+
+
+def _offset_s(zone: zoneinfo.ZoneInfo, utc_s: int) -> int:
+    """A zone's UTC offset [s] at a UTC instant [s since the epoch]."""
+    moment = dt.datetime.fromtimestamp(utc_s, dt.timezone.utc).astimezone(zone)
+    return int(moment.utcoffset().total_seconds())
 
 
 def declination_paper(dayofyear):
@@ -437,6 +520,8 @@ def get_solar_position(
         Columns ``solar_zenith``, ``solar_azimuth``, ``hour_angle`` and ``declination`` [deg],
         indexed by ``times``.
     """
+    import pandas as pd
+
     sun = solar_position_grid(
         ClockGrid.from_times([times], times.tz), latitude, longitude, altitude, model
     )

@@ -12,10 +12,11 @@ of each kind of result.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
-import pandas as pd
+from foldopt.columnar import Columns, as_frame
 
 
 def plain(value):
@@ -45,18 +46,21 @@ def plain(value):
     return value
 
 
-def records(table: pd.DataFrame | None) -> list[dict]:
+def records(table) -> list[dict]:
     """A table's rows as JSON-ready records (NaN as null, numbers exact); none for None.
 
     Parameters
     ----------
-    table : pandas.DataFrame or None
+    table : pandas.DataFrame, foldopt.columnar.Columns or None
 
     Returns
     -------
     list of dict
         One :func:`plain` dict per row, column to value.
     """
+    if isinstance(table, Columns):
+        names = table.columns
+        return [plain(dict(zip(names, row))) for row in zip(*(table[n] for n in names))]
     return [] if table is None else [plain(row) for row in table.to_dict(orient="records")]
 
 
@@ -76,13 +80,15 @@ class Answer:
         ``{"study": source, "taken": [...]}``: what was taken from the study, not asked for.
     result : dict
         The answer in the objective's own terms.
-    designs : pandas.DataFrame
-        The designs compared (one row per design, or per case/load and design).
-    near_optimal : pandas.DataFrame
-        Per case and load: the near-optimal range of the fold angle and the recommended angle.
-    schedule : pandas.DataFrame
+    design_rows : pandas.DataFrame or foldopt.columnar.Columns
+        The designs compared (one row per design, or per case/load and design); ``designs`` is
+        it as a DataFrame.
+    near_optimal_rows : pandas.DataFrame or foldopt.columnar.Columns
+        Per case and load: the near-optimal range of the fold angle and the recommended angle;
+        ``near_optimal`` is it as a DataFrame.
+    schedule_rows : pandas.DataFrame or foldopt.columnar.Columns
         Re-fold schedules: per load, number of settings and visit, the date and fold angle, with the schedule's
-        objective and what its last setting adds.
+        objective and what its last setting adds; ``schedule`` is it as a DataFrame.
     notes : list of dict
         ``{"note": ..., "designs": [...], "cases": n}``: each note and the designs it concerns.
     summary : list of str
@@ -94,11 +100,28 @@ class Answer:
     question: dict
     defaults: dict | None
     result: dict
-    designs: pd.DataFrame = field(default_factory=pd.DataFrame)
-    near_optimal: pd.DataFrame = field(default_factory=pd.DataFrame)
-    schedule: pd.DataFrame = field(default_factory=pd.DataFrame)
+    design_rows: object = field(default_factory=lambda: Columns({}))
+    near_optimal_rows: object = field(default_factory=lambda: Columns({}))
+    schedule_rows: object = field(default_factory=lambda: Columns({}))
     notes: list = field(default_factory=list)
     summary: tuple = ()
+
+    # The tables as DataFrames on first use: the terminal's lines need none of them, and a day's
+    # study holds its rows as Columns until then, so that its answer is printed before pandas loads.
+    @functools.cached_property
+    def designs(self):
+        """pandas.DataFrame: the designs compared (``design_rows``)."""
+        return as_frame(self.design_rows)
+
+    @functools.cached_property
+    def near_optimal(self):
+        """pandas.DataFrame: the near-optimal fold angles (``near_optimal_rows``)."""
+        return as_frame(self.near_optimal_rows)
+
+    @functools.cached_property
+    def schedule(self):
+        """pandas.DataFrame: the re-fold schedules (``schedule_rows``)."""
+        return as_frame(self.schedule_rows)
 
     def lines(self) -> list[str]:
         """The terminal's words: the summary, with the "from" line second."""
@@ -118,14 +141,14 @@ class Answer:
             "question": plain(self.question),
             "defaults": self.defaults,
             "result": plain(self.result),
-            "designs": records(self.designs),
-            "near_optimal": records(self.near_optimal),
-            "schedule": records(self.schedule),
+            "designs": records(self.design_rows),
+            "near_optimal": records(self.near_optimal_rows),
+            "schedule": records(self.schedule_rows),
             "notes": plain(self.notes),
             "lines": self.lines(),
         }
 
-    def tables(self) -> list[tuple[str, pd.DataFrame]]:
+    def tables(self) -> list[tuple[str, object]]:
         """The answer's tables with their titles, for a report."""
         return [
             (title, table)

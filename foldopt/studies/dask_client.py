@@ -26,12 +26,8 @@ from pathlib import Path
 
 from foldopt.cache import quiet
 from foldopt.errors import ConfigError
+from foldopt.names import CONNECT_TIMEOUT, WORKER_TIMEOUT
 
-#: Seconds [s] foldopt waits for a scheduler to answer, every step of reaching it counted (the name
-#: looked up, the port connected, Dask's greeting, the client's connection).
-CONNECT_TIMEOUT = 5.0
-#: Seconds [s] foldopt then waits for the scheduler's first worker (a worker starting takes seconds).
-WORKER_TIMEOUT = 30.0
 #: Dask's protocols whose addresses are ``host:port`` and can be asked in bounded time.
 SCHEMES = ("tcp", "tls", "ws", "wss")
 #: ``host:port``: a name or IPv4 address, or an IPv6 one in brackets, and a port number.

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-import pandas as pd
 
+from foldopt.columnar import Columns, TimeIndex, as_frame
 from foldopt.engine import evaluation as engines
 from foldopt.physics.connections import CONNECTIONS, SWITCH_STATES
 from foldopt.inputs.study import Study
@@ -78,7 +78,6 @@ class Day:
         self.options = options = engine_options(study)
         self.sky = sky = build_sky(options.sky, [study.site], [study.date])
         self.electrical = engines.electrical_for(options.electrical, sky.temp_air[0], sky.wind_ref)
-        self.times = sky.grid.times(0)
         self.step_hours = sky.step_hours
         self.solar_zenith, self.solar_azimuth = sky.solar_zenith[0], sky.solar_azimuth[0]
         self.hour_angle, self.declination = sky.hour_angle[0], sky.declination[0]
@@ -93,6 +92,11 @@ class Day:
         self.load_w = study.p_load if self.load_shape is None else study.p_load * self.load_shape
         self._trackers: dict = {}
         self._one_angle: dict = {}
+
+    @property
+    def times(self):
+        """The day's tz-aware step centres, a :class:`pandas.DatetimeIndex`."""
+        return self.sky.grid.times(0)
 
     def _poa(self, surface_tilt, surface_azimuth, per_step=False):
         """Irradiance on surfaces [W/m^2]: one orientation per row, (k,) -> (k, n_time), or, with
@@ -253,19 +257,25 @@ class Standby(NamedTuple):
 
     Attributes
     ----------
-    table : pandas.DataFrame
-        ``standby_w``, ``t_solar_tracker_net_h``, ``t_solar_twofold_h``.
+    table : foldopt.columnar.Columns or pandas.DataFrame
+        ``standby_w``, ``t_solar_tracker_net_h``, ``t_solar_twofold_h``: the day's steps hold
+        :class:`~foldopt.columnar.Columns`, :attr:`StudyResult.standby` a DataFrame.
     break_even_w : float
         Standby draw [W] above which the twofold panel runs longer; NaN if it never does.
     """
 
-    table: pd.DataFrame
+    table: object
     break_even_w: float
 
 
 @dataclass(frozen=True)
 class StudyResult:
     """One study's results (:func:`foldopt.run`).
+
+    The day's tables are held as :class:`foldopt.columnar.Columns` (``sweep_columns``,
+    ``summary_columns``, ``timeseries_columns``, ``standby_columns``), which the answer reads
+    without pandas; ``sweep``, ``summary``, ``timeseries`` and ``standby`` are them as pandas
+    objects, made on first use (the folder's writers, the figures, a user of the API).
 
     Attributes
     ----------
@@ -302,17 +312,38 @@ class StudyResult:
 
     study: Study
     day: Day
-    sweep: pd.DataFrame
-    summary: pd.DataFrame
-    timeseries: pd.DataFrame
+    sweep_columns: Columns
+    summary_columns: Columns
+    timeseries_columns: Columns
     optimal_fold_angle: float
     heuristic_fold_angle: float
-    standby: Standby
+    standby_columns: Standby
     engine: str = DEFAULT_ENGINE
     near_optimal: dict = dataclasses.field(default_factory=dict)
     request: object = None  # the foldopt.studies.request.Request the study came from, if any
     storage: object = None  # the buffer's DayStorage (foldopt.studies.storage_days), if any
     heuristic_outside: str = ""  # where the heuristic's angle lies off the study's fold angles
+
+    @functools.cached_property
+    def sweep(self):
+        """pandas.DataFrame: the sweep's table (the class's Attributes)."""
+        return self.sweep_columns.to_frame()
+
+    @functools.cached_property
+    def summary(self):
+        """pandas.DataFrame: the summary's table (the class's Attributes)."""
+        return self.summary_columns.to_frame()
+
+    @functools.cached_property
+    def timeseries(self):
+        """pandas.DataFrame: the time series (the class's Attributes)."""
+        return self.timeseries_columns.to_frame()
+
+    @functools.cached_property
+    def standby(self) -> Standby:
+        """The tracker's standby, its table a pandas.DataFrame (the class's Attributes)."""
+        table, break_even = self.standby_columns
+        return Standby(as_frame(table), break_even)
 
     @functools.cached_property
     def answer(self):
@@ -353,23 +384,24 @@ def run_study(study: Study, engine: str = DEFAULT_ENGINE, request=None) -> Study
     optimum = refine_optimum(day, sweep, day.study.connection)
     designs = compare_designs(day, sweep, optimum, engine)
     summary = summarise(day, designs)
-    twofold = summary.loc[summary["design"] == "twofold", "t_solar_h"].iloc[0]
+    twofold = summary.row("design", "twofold")["t_solar_h"]
     standby = standby_sweep(day, designs.tracker.power[0], twofold)
     buffered = None
     table = sweep.table
     if day.study.storage is not None:
         buffered = buffer_designs(day, sweep, designs, summary, engine)
-        summary = pd.concat([summary, buffered.designs[design_columns(buffered.designs)]], axis=1)
+        columns = design_columns(buffered.designs)
+        summary = summary.join(Columns({c: buffered.designs[c].to_numpy() for c in columns}))
         table = table.assign(powered_h=buffered.powered_by_angle)
     return StudyResult(
         study=day.study,
         day=day,
-        sweep=table,
-        summary=summary,
-        timeseries=day_timeseries(day, optimum, designs, buffered),
+        sweep_columns=table,
+        summary_columns=summary,
+        timeseries_columns=day_timeseries(day, optimum, designs, buffered),
         optimal_fold_angle=optimum.fold_angle_deg,
         heuristic_fold_angle=designs.heuristic.fold_angle_deg,
-        standby=standby,
+        standby_columns=standby,
         engine=engine,
         near_optimal=near_optimal_range(day, sweep, optimum),
         request=request,
@@ -385,7 +417,7 @@ class FoldSweep(NamedTuple):
     ----------
     fold_angles : numpy.ndarray
         The grid [deg], (k,), ascending.
-    table : pandas.DataFrame
+    table : foldopt.columnar.Columns
         ``sweep.csv``: the metrics of the study's connection, every connection's t_solar and
         energy, and the noon valley of the parallel curve, per fold angle.
     t_solar_h : dict
@@ -399,7 +431,7 @@ class FoldSweep(NamedTuple):
     """
 
     fold_angles: np.ndarray
-    table: pd.DataFrame
+    table: Columns
     t_solar_h: dict
     curves: dict
     series: bool
@@ -441,7 +473,7 @@ def sweep_fold_angles(day: Day, engine: str) -> FoldSweep:
             curves[study.connection], p_load, shape, day.step_hours, metrics.t_solar[:, own, 0]
         )
     )
-    table = pd.DataFrame(
+    table = Columns(
         {
             "fold_angle_deg": fold_angles,
             **metric_columns(
@@ -452,12 +484,17 @@ def sweep_fold_angles(day: Day, engine: str) -> FoldSweep:
                 p_load,
                 served,
             ),
+            "noon_valley_w": noon_valley(curves["east"], curves["west"], curves["parallel"]),
+            **{
+                name: values
+                for index, connection in enumerate(CONNECTIONS)
+                for name, values in (
+                    (f"t_solar_{connection}_h", metrics.t_solar[:, index, 0]),
+                    (f"energy_harvested_{connection}_wh", metrics.energy[:, index]),
+                )
+            },
         }
     )
-    table["noon_valley_w"] = noon_valley(curves["east"], curves["west"], curves["parallel"])
-    for index, connection in enumerate(CONNECTIONS):
-        table[f"t_solar_{connection}_h"] = metrics.t_solar[:, index, 0]
-        table[f"energy_harvested_{connection}_wh"] = metrics.energy[:, index]
     t_solar_h = {connection: metrics.t_solar[:, i, 0] for i, connection in enumerate(CONNECTIONS)}
     return FoldSweep(fold_angles, table, t_solar_h, curves, series)
 
@@ -572,7 +609,7 @@ class Designs(NamedTuple):
 
     Attributes
     ----------
-    table : pandas.DataFrame
+    table : foldopt.columnar.Columns
         One row per design as the report shows them (flat, the twofold panels, the trackers):
         ``design``, ``fold_angle_deg`` and :func:`foldopt.engine.metrics.metric_columns`.
     power : dict
@@ -585,7 +622,7 @@ class Designs(NamedTuple):
     heuristic : Heuristic
     """
 
-    table: pd.DataFrame
+    table: Columns
     power: dict
     at_optimum: dict
     tracker: TrackerCurves
@@ -654,9 +691,9 @@ def compare_designs(day: Day, sweep: FoldSweep, optimum: Optimum, engine: str) -
         **{name: angle for name, (angle, _) in others.items() if name.startswith("tracker")},
     }
     order = [[*DESIGNS, *others].index(name) for name in angle_of]
-    table = pd.DataFrame(
+    table = Columns(
         {
-            "design": list(angle_of),
+            "design": np.array(list(angle_of), dtype=object),
             "fold_angle_deg": list(angle_of.values()),
             **{
                 name: np.concatenate([main[name][0, 0], values])[order]
@@ -701,7 +738,7 @@ def _other_designs(day: Day, sweep: FoldSweep, heuristic: Heuristic) -> dict:
     return others
 
 
-def summarise(day: Day, designs: Designs) -> pd.DataFrame:
+def summarise(day: Day, designs: Designs) -> Columns:
     """The day's summary: each design against flat and the tracker, the flat panel's area
     that would run the load as long, and each row's note.
 
@@ -712,41 +749,39 @@ def summarise(day: Day, designs: Designs) -> pd.DataFrame:
 
     Returns
     -------
-    pandas.DataFrame
+    foldopt.columnar.Columns
         ``designs.table`` with ``gain_vs_flat_pct``, ``share_of_tracker_pct``, ``flat_area_ratio``
         (NaN under a load profile: it is defined for a constant load) and ``note``.
     """
-    study = day.study
-    summary = designs.table.copy()
-    by_design = summary.set_index("design")["t_solar_h"]
-    flat_hours, tracker_hours = by_design["flat"], by_design["tracker"]
-    summary["gain_vs_flat_pct"] = (relative_to(summary["t_solar_h"], flat_hours) - 1.0) * 100.0
-    summary["share_of_tracker_pct"] = relative_to(summary["t_solar_h"], tracker_hours) * 100.0
-    summary["flat_area_ratio"] = [
-        flat_area_ratio(designs.power["flat"], study.p_load, hours, day.step_hours)
-        if hours > 0 and day.load_shape is None
-        else np.nan
-        for hours in summary["t_solar_h"]
-    ]
+    study, table = day.study, designs.table
+    hours = table["t_solar_h"]
+    flat_hours = table.row("design", "flat")["t_solar_h"]
+    tracker_hours = table.row("design", "tracker")["t_solar_h"]
     # Each row's circuit first: a connection the study's circuit cannot wire (independent's
     # converters, a load wired directly) is compared as it is built and says so; every other design
     # is wired as the circuit says, and says so where its load is beyond the panel's reach.
     wired = {
         f"twofold-{connection}": study.circuit.ignored_by(connection) for connection in CONNECTIONS
     }
+    sky = day.sky.conditions()[0]
     condition = [
-        "; ".join(
-            filter(
-                None, (wired.get(design) or day.electrical.beyond_reach, day.sky.conditions()[0])
-            )
-        )
-        for design in summary["design"]
+        "; ".join(filter(None, (wired.get(design) or day.electrical.beyond_reach, sky)))
+        for design in table["design"]
     ]
-    summary["note"] = notes(
-        design_condition(condition, summary["energy_harvested_wh"].to_numpy(float)),
-        summary["t_solar_h"].to_numpy(),
+    return table.assign(
+        gain_vs_flat_pct=(relative_to(hours, flat_hours) - 1.0) * 100.0,
+        share_of_tracker_pct=relative_to(hours, tracker_hours) * 100.0,
+        flat_area_ratio=np.array(
+            [
+                flat_area_ratio(designs.power["flat"], study.p_load, row_hours, day.step_hours)
+                if row_hours > 0 and day.load_shape is None
+                else np.nan
+                for row_hours in hours
+            ],
+            dtype=float,
+        ),
+        note=notes(design_condition(condition, table["energy_harvested_wh"].astype(float)), hours),
     )
-    return summary
 
 
 def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101) -> Standby:
@@ -774,7 +809,7 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
     study, step = day.study, day.step_hours
     if day.load_shape is not None:  # a standby draw is a load shift only for a constant load
         return Standby(
-            pd.DataFrame(
+            Columns(
                 {
                     "standby_w": [0.0],
                     "t_solar_tracker_net_h": [np.nan],
@@ -790,14 +825,14 @@ def standby_sweep(day: Day, p_tracker, twofold_t_solar: float, points: int = 101
     hours = t_solar(available, study.p_load + draws, step)
     load = load_for_t_solar(available, twofold_t_solar, step) if twofold_t_solar > 0 else np.nan
     break_even = max(load - study.p_load, 0.0) if np.isfinite(load) else float("nan")
-    table = pd.DataFrame(
+    table = Columns(
         {"standby_w": draws, "t_solar_tracker_net_h": hours, "t_solar_twofold_h": twofold_t_solar}
     )
     return Standby(table, break_even)
 
 
 def buffer_designs(
-    day: Day, sweep: FoldSweep, designs: Designs, summary: pd.DataFrame, engine: str
+    day: Day, sweep: FoldSweep, designs: Designs, summary: Columns, engine: str
 ) -> DayStorage:
     """With the study's ``storage``: every row's curve, the one its t_solar was reduced from,
     and the twofold panel at every angle of the grid through the study's buffer
@@ -809,7 +844,7 @@ def buffer_designs(
     day : Day
     sweep : FoldSweep
     designs : Designs
-    summary : pandas.DataFrame
+    summary : foldopt.columnar.Columns
         :func:`summarise`'s: each row's fold angle and t_solar without the buffer.
     engine : {'auto', 'numba', 'numpy'}
 
@@ -829,7 +864,7 @@ def buffer_designs(
         BufferedDesigns(
             fold_angle_deg=dict(zip(summary["design"], summary["fold_angle_deg"], strict=True)),
             power={name: power[name] for name in summary["design"]},
-            t_solar_h=summary["t_solar_h"].to_numpy(),
+            t_solar_h=summary["t_solar_h"],
             draws={name: net.draw[0] for name, net in nets.items()},
         ),
         fold_angles=sweep.fold_angles,
@@ -863,26 +898,25 @@ def near_optimal_range(day: Day, sweep: FoldSweep, optimum: Optimum) -> dict:
         recommended angle's ``recommended_t_solar_h`` [h].
     """
     best = optimum.fold_angle_deg
-    evaluated = pd.Series(sweep.t_solar_h[day.study.connection], index=sweep.fold_angles)
-    evaluated = pd.concat(
-        [evaluated[evaluated.index != best], pd.Series({best: optimum.t_solar_h})]
-    ).sort_index()
+    others = sweep.fold_angles != best
+    angles = np.append(sweep.fold_angles[others], best)
+    hours = np.append(sweep.t_solar_h[day.study.connection][others], optimum.t_solar_h)
+    order = np.argsort(angles)
+    angles, hours = angles[order], hours[order]
     near = {
         key: float(value)
-        for key, value in near_optimal(
-            evaluated.index, evaluated.to_numpy(), day.study.near_optimal
-        ).items()
+        for key, value in near_optimal(angles, hours, day.study.near_optimal).items()
     }
     recommended = near["recommended_deg"]
     near["recommended_t_solar_h"] = (
-        float(evaluated[recommended]) if recommended == recommended else float("nan")
+        float(hours[angles == recommended][0]) if recommended == recommended else float("nan")
     )
     return near
 
 
 def day_timeseries(
     day: Day, optimum: Optimum, designs: Designs, buffered: DayStorage | None
-) -> pd.DataFrame:
+) -> Columns:
     """Step 8: ``timeseries.csv``: the day's sun, light and air, each half's plane-of-array
     irradiance at the optimum, the curves of flat, every connection at the optimum and the
     tracker, with the state switching chose (no table's number comes from it: it is the
@@ -898,7 +932,7 @@ def day_timeseries(
 
     Returns
     -------
-    pandas.DataFrame
+    foldopt.columnar.Columns
         Indexed by the day's tz-aware step centres (``time``).
     """
     at_best = designs.at_optimum
@@ -906,7 +940,7 @@ def day_timeseries(
     sky, load, shape = day.sky, day.study.p_load, day.load_shape
     powered = {"flat": designs.power["flat"], "twofold": at_best[day.study.connection]}
     powered["tracker"] = designs.tracker.power[0]
-    return pd.DataFrame(
+    return Columns(
         {
             **{name: values[0] for name, values in sky_columns(sky).items()},
             **{
@@ -931,7 +965,7 @@ def day_timeseries(
                 else {f"soc_{name}_frac": soc for name, soc in buffered.soc.items()}
             ),
         },
-        index=pd.DatetimeIndex(day.times, name="time"),
+        index=TimeIndex(sky.grid.utc_ns[0], sky.grid.timezones[0], name="time"),
     )
 
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 import datetime as dt
 
 import numpy as np
-import pandas as pd
 
 from foldopt.inputs.sections import parse_timezone
 from foldopt.physics.horizon import horizon_elevation_at
@@ -44,6 +43,8 @@ def sun_paths(study, dates) -> dict | None:
     site = study.site
     if site.horizon is None:
         return None
+    import pandas as pd
+
     days = sorted({dt.date.fromisoformat(str(day)[:10]) for day in dates})
     days = [days[i] for i in _spread(len(days), MAX_COUNTED_DAYS)]
     zone = parse_timezone(site.timezone)

@@ -57,10 +57,9 @@ References
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-import pandas as pd
 
 from foldopt.inputs.costs_section import DRIVE_FIELD
 from foldopt.names import FLAT_FOLD_ANGLE
@@ -71,6 +70,9 @@ from foldopt.studies.storage_sizing import (
     reaching,
     smallest_buffers,
 )
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: The panel areas searched, as multiples of the study's [-]: a quarter to four times it in
 #: steps of 2^(1/4).
@@ -150,6 +152,8 @@ def design_space(
         ``frontier``, the kind's least capacity at its area (a twofold panel's best angle
         there); ``least_cost``, the kind's cheapest row.
     """
+    import pandas as pd
+
     fold_angles = np.asarray(fold_angles, dtype=float)
     drive = costs.drive_usd(tracker_model)
     kinds = [("flat", FLAT_FOLD_ANGLE, curves["flat"], 0.0, None)]
@@ -380,6 +384,8 @@ def year_design_space(
     cold : foldopt.engine.storage.ColdSteps, optional
         The days' (:func:`foldopt.studies.storage_cold.cold_steps`).
     """
+    import pandas as pd
+
     tables = []
     for p_load in np.asarray(days.loads, dtype=float):
         table = design_space(

@@ -11,9 +11,9 @@ from __future__ import annotations
 import calendar
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import pandas as pd
-
+from foldopt.columnar import Columns
 from foldopt.studies.answer import Answer, plain, records
 from foldopt.studies.designs import PLANES_DESIGN
 from foldopt.studies.horizon_paths import horizon_notes
@@ -24,6 +24,8 @@ from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.objectives import ENSEMBLE_PERCENTILES
 from foldopt.studies.worldmap import searched_tilt
 
+if TYPE_CHECKING:
+    import pandas as pd
 #: The designs an answer compares, first the ones every study has.
 MAIN_DESIGNS = ("flat", "twofold", "tracker", "tracker-net")
 NEAR_OPTIMAL = (
@@ -34,12 +36,17 @@ NEAR_OPTIMAL = (
 )
 
 
+def _missing(value) -> bool:
+    """Whether a number is missing: None or NaN (as ``pandas.isna`` of a scalar)."""
+    return value is None or value != value
+
+
 def _hours(value) -> str:
-    return "-" if pd.isna(value) else f"{value:.2f} h"
+    return "-" if _missing(value) else f"{value:.2f} h"
 
 
 def _pct(value, signed: bool = True) -> str:
-    return "-" if pd.isna(value) else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
+    return "-" if _missing(value) else (f"{value:+.1f} %" if signed else f"{value:.1f} %")
 
 
 def _fold_text(angle: float) -> str:
@@ -73,34 +80,42 @@ def versus_flat(fold_angle, gain, flat_hours, flat_text: str = "") -> str:
     return f"{_pct(gain)} over flat ({flat})"
 
 
-def design_notes(table: pd.DataFrame, case_count: int | None = None) -> list[dict]:
+def design_notes(table, case_count: int | None = None) -> list[dict]:
     """Each note of a table's ``note`` column with the designs it concerns (none where it concerns
     them all) and, for sweeps, in how many cases.
 
     Parameters
     ----------
-    table : pandas.DataFrame
+    table : pandas.DataFrame or foldopt.columnar.Columns
         With ``design`` and ``note`` columns.
     case_count : int, optional
         A sweep's number of cases; None for one case.
     """
     if "note" not in table or not len(table):
         return []
-    exploded = table.assign(note=table["note"].astype(str).str.split("; ")).explode("note")
-    exploded = exploded[exploded["note"] != ""]
-    every = set(table["design"])
+    designs_of = list(table["design"])
+    # A case is a row's values of these columns, NaN one value (as pandas' drop_duplicates).
+    keys = [
+        c for c in table.columns if c in ("site_name", "latitude", "longitude", "date", "p_load_w")
+    ]
+    case_of = list(
+        zip(*([None if _missing(v) else v for v in table[c]] for c in keys), strict=True)
+    )
+    # Each note's rows, a row once per time its note text holds it.
+    rows_of: dict = {}
+    for row, text in enumerate(table["note"]):
+        for note in str(text).split("; "):
+            if note != "":
+                rows_of.setdefault(note, []).append(row)
+    every = set(designs_of)
     notes = []
-    for note, rows in exploded.groupby("note", sort=True):
-        designs = list(dict.fromkeys(rows["design"]))
+    for note in sorted(rows_of):
+        rows = rows_of[note]
+        designs = list(dict.fromkeys(designs_of[row] for row in rows))
         entry = {"note": note, "designs": [] if set(designs) == every else designs}
         if case_count is not None:
-            keys = [
-                c
-                for c in rows.columns
-                if c in ("site_name", "latitude", "longitude", "date", "p_load_w")
-            ]
             entry.update(
-                cases=int(len(rows.drop_duplicates(keys))) if keys else len(rows), of=case_count
+                cases=len({case_of[row] for row in rows}) if keys else len(rows), of=case_count
             )
         notes.append(entry)
     return notes
@@ -248,7 +263,7 @@ def _turbidity_text(study, varied: tuple) -> str:
 
 def _range_text(row) -> str:
     lo, hi, recommended = (row.get(key) for key in NEAR_OPTIMAL[:3])
-    if pd.isna(lo):
+    if _missing(lo):
         return "near-optimal: no fold angle carries the load"
     return (
         f"near-optimal {lo:g} to {hi:g} deg (within {60 * row['near_optimal_tolerance_h']:.1f} min); "
@@ -271,12 +286,12 @@ def of_study(result) -> Answer:
     """
     from foldopt.inputs.load_profile import describe_load, load_text
 
-    study, summary = result.study, result.summary
-    by = summary.set_index("design")
-    twofold = by.loc["twofold"]
+    study, summary = result.study, result.summary_columns
+    twofold = summary.row("design", "twofold")
     near = dict(result.near_optimal)
-    near_table = pd.DataFrame([near])
+    near_table = Columns({key: [value] for key, value in near.items()})
     heuristic = result.heuristic_fold_angle
+    break_even = result.standby_columns.break_even_w
     result_part = {
         "objective": "t_solar of the day",
         "load": describe_load(study),
@@ -286,9 +301,11 @@ def of_study(result) -> Answer:
         "gain_vs_flat_pct": float(twofold["gain_vs_flat_pct"]),
         "share_of_tracker_pct": float(twofold["share_of_tracker_pct"]),
         "flat_area_ratio": float(twofold["flat_area_ratio"]),
-        "break_even_standby_tracker_w": float(result.standby[1]),
+        "break_even_standby_tracker_w": float(break_even),
         **near,
-        "t_solar_by_design_h": {d: float(by.loc[d, "t_solar_h"]) for d in MAIN_DESIGNS},
+        "t_solar_by_design_h": {
+            d: float(summary.row("design", d)["t_solar_h"]) for d in MAIN_DESIGNS
+        },
     }
     site = study.site
     where = site.name or f"{site.latitude:g}, {site.longitude:g}"
@@ -318,7 +335,7 @@ def of_study(result) -> Answer:
         lines.append(_range_text(near) + f" (t_solar {_hours(near['recommended_t_solar_h'])})")
     planes = planes_part(study)
     if planes is not None:
-        row = by.loc[PLANES_DESIGN]
+        row = summary.row("design", PLANES_DESIGN)
         planes.update(
             {
                 key: float(row[key])
@@ -330,10 +347,10 @@ def of_study(result) -> Answer:
     extras = []
     if not math.isnan(twofold["flat_area_ratio"]):
         extras.append(f"a flat panel would need {twofold['flat_area_ratio']:.2f}x the area")
-    if not math.isnan(result.standby[1]):
+    if not math.isnan(break_even):
         extras.append(
             f"the twofold panel outlasts the tracker once its standby draw exceeds "
-            f"{result.standby[1]:.2f} W"
+            f"{break_even:.2f} W"
         )
     if extras:
         lines.append("; ".join(extras))
@@ -365,7 +382,7 @@ def of_study(result) -> Answer:
         result_part,
         summary[columns],
         near_table,
-        pd.DataFrame(),
+        Columns({}),
         design_notes(summary) + weather_notes(result.day.sky) + horizon_notes(study, [study.date]),
         tuple(lines),
     )
@@ -478,6 +495,8 @@ def of_sweep(result) -> Answer:
         Of kind ``annual`` where ``result.extras`` holds ``annual_objective`` (one fold angle over
         many days), else ``sweep``: the gain over flat [%] and the fold angles [deg] over the cases.
     """
+    import pandas as pd
+
     if "annual_objective" in result.extras:
         return _of_annual(result)
     from foldopt.inputs.load_profile import describe_load
@@ -793,6 +812,8 @@ def _dates(plan) -> tuple:
 
 def _schedule(extras: dict) -> pd.DataFrame:
     """Each re-fold visit with its schedule's objective and what its last setting adds."""
+    import pandas as pd
+
     if "refold_schedule" not in extras:
         return pd.DataFrame()
     visits, values = extras["refold_schedule"], extras["refold_value"]
@@ -820,6 +841,7 @@ def of_sizing(
     parameters, defaults : dict
         ``defaults``: what was taken from the study (:attr:`Answer.defaults`), or None.
     """
+    import pandas as pd
     from foldopt.inputs.load_profile import load_text
 
     cost = (
@@ -870,6 +892,8 @@ def of_reproduction(tables: dict, study) -> Answer:
     foldopt.studies.answer.Answer
         Of kind ``reproduce``: each quantity's paper value beside the paper and exact modes.
     """
+    import pandas as pd
+
     lines = []
     for name, table in tables.items():
         model = (
@@ -916,6 +940,8 @@ def of_map(result, relative: bool, defaults: dict | None = None) -> Answer:
         Loads as fractions of each site's flat peak (``p_load_frac``), else in W.
     defaults : dict, optional
     """
+    import pandas as pd
+
     table, spec = result.table, result.spec
     study = spec.study
     tilts = searched_tilt(study)

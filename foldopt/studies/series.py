@@ -15,12 +15,16 @@ as ``timeseries.parquet`` (pyarrow) above: a year of 1-min steps for two loads i
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 
 from foldopt.engine import evaluation as engines
 from foldopt.engine.metrics import per_load
 from foldopt.engine.sky import Sky
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Rows of a study's series above which it is written as ``timeseries.parquet``, not ``.csv``.
 PARQUET_ROWS = 20_000
@@ -196,6 +200,8 @@ def year_series(pieces: list, timezone) -> pd.DataFrame:
         ``p_twofold_w`` (the study's connection), ``p_tracker_w`` [W] and
         ``solar_powered_flat``, ``_twofold``, ``_tracker``.
     """
+    import pandas as pd
+
     n_loads = pieces[0]["p_load_w"].shape[1]
     sizes = [piece["utc_ns"].shape[0] for piece in pieces]
     starts = np.cumsum([0, *sizes])

@@ -11,14 +11,17 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from foldopt.engine import evaluation as engines
 from foldopt.inputs.costs import C_GRID, DAYS_PER_YEAR, LIFETIME_YEARS, PAPER_COST_PER_M2  # noqa: F401 (re-exported)
 from foldopt.engine.metrics import load_for_t_solar
 from foldopt.names import FLAT_FOLD_ANGLE
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def flat_area_ratio(p_flat, p_load, target_t_solar, step_hours):
@@ -146,6 +149,8 @@ def size_panel(
         One row per area and design (``flat``, ``twofold``): ``area_m2``, ``fold_angle_deg``,
         ``t_solar_h``, ``benefit_usd``, ``cost_usd``, ``net_benefit_usd``.
     """
+    import pandas as pd
+
     if (cost_per_m2 is None) == (cost_per_w is None):
         raise ValueError("give exactly one of cost_per_m2 and cost_per_w")
     study = day.study

@@ -9,11 +9,15 @@ The module may import numpy, pandas and the storage modules whose numbers it say
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 
 from foldopt.studies.storage_days import SOC_DESIGNS, YEAR_DESIGNS, DayStorage
 from foldopt.studies.storage_sizing import FoldingPays
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def not_monotone_note(designs) -> str:

@@ -21,9 +21,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from foldopt.engine.choice import engine_for
 from foldopt.engine.storage import StorageResult, simulate
@@ -37,6 +37,9 @@ from foldopt.studies.storage_cold import (
 )
 from foldopt.studies.storage_periods import storage_monthly, storage_years
 from foldopt.studies.storage_sizing import Sizing, buffer_of, size_buffers, smallest_buffers
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: The designs whose state of charge the day's figure draws and ``timeseries.csv`` holds.
 SOC_DESIGNS = ("flat", "twofold", "tracker")
@@ -202,6 +205,8 @@ def day_storage(
     -------
     DayStorage
     """
+    import pandas as pd
+
     storage = study.storage
     fold_angles = np.asarray(fold_angles, dtype=float)
     buffer = buffer_of(storage)
@@ -491,6 +496,8 @@ def year_storage(
         the cold off). Its ``storage_years`` and ``storage_monthly``, the same days' simulation
         by period.
     """
+    import pandas as pd
+
     engine = storage_engine(engine)
     loads = np.asarray(days.loads, dtype=float)
     in_sequence, step_hours = days.in_sequence, days.step_hours

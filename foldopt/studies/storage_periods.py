@@ -31,10 +31,14 @@ References
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 
 from foldopt.engine.storage import SOC_BINS, StorageResult
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Histogram columns of ``storage_monthly.csv``: PVGIS's ``f_CS`` of each of the ten bins of the
 #: charge state from the cut-off (``min_soc``) to full, the lowest first.

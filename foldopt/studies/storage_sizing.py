@@ -33,15 +33,18 @@ The module may import numpy, pandas, :mod:`foldopt.engine`, :mod:`foldopt.inputs
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.engine.storage import Buffer, StorageResult, simulate
 from foldopt.studies.objectives import best_angle_index
 from foldopt.studies.storage_cold import per_series
 from foldopt.studies.storage_periods import years_meeting
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Capacities of the grid [-, times the day's load energy over the usable fraction] (0 Wh first),
 #: with the study's own: the sizing's first bracket and the figure's curve of powered time
@@ -152,6 +155,8 @@ def size_buffers(
     -------
     Sizing
     """
+    import pandas as pd
+
     fold_angles = np.asarray(fold_angles, dtype=float)
     power = np.vstack([curves["flat"], curves["tracker"], curves["tracker-net"], curves["twofold"]])
     own_draws = [None, None, (draws or {}).get("tracker-net")] + [None] * len(fold_angles)

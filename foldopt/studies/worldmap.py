@@ -25,9 +25,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from foldopt.engine import evaluation as engines
 from foldopt.engine.choice import engine_for
@@ -47,6 +47,9 @@ from foldopt.studies.objectives import (
     season_days,
 )
 from foldopt.studies.site_search import fold_search
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def evaluate_sites(
@@ -95,6 +98,8 @@ def evaluate_sites(
         objective exceeds the tracker's (0 where it already does; NaN where the twofold panel
         never carries the load).
     """
+    import pandas as pd
+
     loads = np.asarray(loads, dtype=float)
     engine = engine_for(engine, math.inf)
     frames, batch, key = [], [], None
@@ -116,6 +121,8 @@ def evaluate_sites(
 def _evaluate_batch(batch, loads, relative: bool, engine: str, sun_terms: SunTerms) -> pd.DataFrame:
     """The rows of sites that share a setup (:func:`foldopt.studies.designs.setup_key`), their days
     one set of blocks: every engine call runs over all of them (:func:`site_designs`)."""
+    import pandas as pd
+
     blocks = Blocks.join([Blocks.of_dates(study, dates) for _, study, dates in batch])
     study = blocks.study
     objective = study.objective
