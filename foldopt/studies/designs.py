@@ -360,7 +360,7 @@ def design_metrics(
         engine=engine,
         curves=np.arange(n_blocks) if keep else None,
     )
-    tracker = tracker or tracker_curves(sky, study, every=blocks_of.members)
+    tracker = tracker or tracker_curves(sky, study, every=blocks_of.members, engine=engine)
     orientation, gross, net = tracker.orientation, tracker.power, tracker.net
     incident = tracker.incident
     if incident is None:

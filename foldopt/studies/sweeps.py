@@ -234,7 +234,7 @@ def run_plan(
                 fold_angles, hours, _ = fold_hours(sky, chunk, loads, engine)
                 hours = hours.transpose(0, 2, 1)  # (blocks, loads, angles)
                 best = best_angle_index(hours)
-                tracker = tracker_curves(sky, chunk.study, every=chunk.members)
+                tracker = tracker_curves(sky, chunk.study, every=chunk.members, engine=engine)
                 metrics = design_metrics(
                     sky,
                     chunk,
@@ -365,7 +365,7 @@ def _annual_group(blocks: Blocks, loads, objective, advance, engine, sky_of, wit
         )
         series["p_twofold_w"].append(powers[study.connection])
         series["switch_state"].append(np.where(powers["switching"] > 0, state, -1))
-        tracker = tracker_curves(sky, study, study.tracker.model, every=members)
+        tracker = tracker_curves(sky, study, study.tracker.model, every=members, engine=engine)
         metrics.append(
             design_metrics(
                 sky,
