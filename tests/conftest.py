@@ -212,8 +212,7 @@ BEFORE_THE_WARM_UP = ("test_weather_validation.py", "test_architecture.py", "tes
 LONG_FIRST = (*BEFORE_THE_WARM_UP, "test_docs.py", "test_report_html.py", "test_cluster.py", "test_cli_readme.py",
               "test_cli_studies.py", "test_weather_year.py", "test_weather_validation_minutes.py",
               "test_weather_fetch.py", "test_weather_faults.py", "test_camera_winter.py", "test_faults_cluster.py",
-              "test_engine.py",
-              "test_figures.py", "test_columns.py", "test_search.py", "test_faults_map_finish.py",
+              "test_engine.py", "test_figures.py", "test_columns.py", "test_search.py", "test_faults_map_finish.py",
               "test_one_answer.py", "test_bad_input.py")
 
 

@@ -101,8 +101,9 @@ def test_kernel_equals_the_reference_path(case):
     assert_engines_agree(results["numba"], results["numpy"])
 
 
-#: The two tests below, called in a process of their own (numba reads its number of threads once,
-#: as it is imported); hypothesis runs the comparison's examples as under pytest.
+#: The comparison above and test_kernel_threads below, called in a process of their own (numba
+#: reads its number of threads once, as it is imported); hypothesis runs the comparison's examples
+#: as under pytest.
 ON_TWO_THREADS = f"""
 import sys
 sys.path.insert(0, {str(Path(__file__).parent)!r})
