@@ -210,14 +210,35 @@ BEFORE_THE_WARM_UP = ("test_weather_validation.py", "test_architecture.py", "tes
 #: takes the next unit when it has two tests left, so that the long ones start early and the end is
 #: made of short tests, and the two workers finish together.
 LONG_FIRST = (*BEFORE_THE_WARM_UP, "test_docs.py", "test_report_html.py", "test_cluster.py", "test_cli_readme.py",
-              "test_cli_studies.py", "test_weather_year.py", "test_weather_validation_minutes.py", "test_engine.py",
-              "test_figures.py", "test_columns.py", "test_search.py", "test_faults_map_finish.py",
+              "test_cli_studies.py", "test_weather_year.py", "test_weather_validation_minutes.py",
+              "test_weather_fetch.py", "test_weather_faults.py", "test_camera_winter.py", "test_faults_cluster.py",
+              "test_engine.py", "test_figures.py", "test_columns.py", "test_search.py", "test_faults_map_finish.py",
               "test_one_answer.py", "test_bad_input.py")
 
 
+#: conftest's module-scoped fixtures that cost a process's time to set up (a Dask cluster).
+SHARED_HERE = ("scheduler",)
+
+
+def _shares_a_fixture(item) -> bool:
+    """Whether the test reads a module- or session-scoped fixture its own module defines (a study's
+    run, a folder, a server), or one of :data:`SHARED_HERE`."""
+    module, info = item.nodeid.split("::")[0], getattr(item, "_fixtureinfo", None)
+    return info is not None and any(
+        definition.scope in ("module", "session") and (definition.baseid == module or name in SHARED_HERE)
+        for name, definitions in info.name2fixturedefs.items() for definition in definitions)
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist names the groups in the node ids
 def pytest_collection_modifyitems(items):
     rank = {name: index for index, name in enumerate(LONG_FIRST)}
     items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: each part's order is kept
+    # pytest-xdist's --dist loadgroup gives a test outside a group to either worker: the tests of a
+    # module that share a fixture built once a module (or a session) went to both, and each worker
+    # built it (a year's study run twice). They are one group, the module's, run by one worker.
+    for item in items:
+        if not any(item.iter_markers("xdist_group")) and _shares_a_fixture(item):
+            item.add_marker(pytest.mark.xdist_group(item.path.stem))
 
 
 @functools.cache

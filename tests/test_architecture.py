@@ -11,6 +11,7 @@ those inside functions too: a lazy import that climbs is still a climb.
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -37,9 +38,16 @@ def _resolve(name: str) -> str | None:
     return name or None
 
 
-def _imports(module: str) -> list[tuple[str, list[str], int]]:
+@functools.cache
+def _tree(module: str) -> ast.Module:
+    """The syntax tree of ``module``, parsed once for every test (none changes it)."""
+    return ast.parse(MODULES[module].read_text())
+
+
+@functools.cache
+def _imports(module: str) -> tuple[tuple[str, list[str], int], ...]:
     """(imported module, names taken from it, line) for every import of ``module``."""
-    tree = ast.parse(MODULES[module].read_text())
+    tree = _tree(module)
     found = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -52,7 +60,7 @@ def _imports(module: str) -> list[tuple[str, list[str], int]]:
                     found.append((target, [], node.lineno))
                 else:
                     found.append((node.module, [alias.name], node.lineno))
-    return [(target, names, line) for target, names, line in found if _resolve(target)]
+    return tuple((target, names, line) for target, names, line in found if _resolve(target))
 
 
 def _stage(module: str) -> int | None:
@@ -112,7 +120,7 @@ def test_no_module_imports_a_private_name():
 
 @pytest.mark.parametrize("package", [m for m, p in MODULES.items() if p.name == "__init__.py"])
 def test_every_package_says_what_it_owns(package):
-    doc = ast.get_docstring(ast.parse(MODULES[package].read_text())) or ""
+    doc = ast.get_docstring(_tree(package)) or ""
     assert len(doc) > 200, f"{package}: a one-paragraph docstring of what it owns and may import"
     if package != "foldopt":
         assert "import" in doc, f"{package}: the docstring says what the stage may import"
@@ -144,7 +152,7 @@ _MAKERS = {"Plan": {"foldopt.inputs.plan", "foldopt.studies.request"},
 def _calls_of(module: str) -> list[tuple[str, int]]:
     """``(name, line)`` of every call of ``Plan(...)``, ``Plan.of(...)`` or ``Request(...)``."""
     found = []
-    for node in ast.walk(ast.parse(MODULES[module].read_text())):
+    for node in ast.walk(_tree(module)):
         if not isinstance(node, ast.Call):
             continue
         func = node.func
@@ -176,7 +184,7 @@ def _environment_writes(module: str) -> list[tuple[int, str | None]]:
     """(line, enclosing function) of every write to the process's environment in ``module``:
     ``os.environ[...] =``, ``del os.environ[...]``, ``os.environ.pop(...)``..., ``os.putenv``,
     ``os.unsetenv``."""
-    tree = ast.parse(MODULES[module].read_text())
+    tree = _tree(module)
 
     def environ(node) -> bool:
         return (isinstance(node, ast.Attribute) and node.attr == "environ"
@@ -236,9 +244,9 @@ def _positional_counts(tree: ast.AST) -> list[tuple[str, int, int]]:
 
 
 def test_no_function_of_the_engine_or_the_studies_takes_more_than_eight_positional_parameters():
-    too_many = [f"{module}:{line} {name} takes {count}" for module, path in MODULES.items()
+    too_many = [f"{module}:{line} {name} takes {count}" for module in MODULES
                 if module.startswith(("foldopt.engine", "foldopt.studies"))
-                for name, line, count in _positional_counts(ast.parse(path.read_text()))
+                for name, line, count in _positional_counts(_tree(module))
                 if count > MAX_POSITIONAL]
     assert too_many == []
 
@@ -265,7 +273,7 @@ def test_no_answer_module_builds_a_key_with_format():
                if module.startswith("foldopt.studies.") and "answer" in path.stem]
     assert "foldopt.studies.storage_answer" in answers
     built = [f"{module}:{line}" for module in answers
-             for line in _format_calls(ast.parse(MODULES[module].read_text()))]
+             for line in _format_calls(_tree(module))]
     assert built == []
     assert _format_calls(ast.parse('"{}_by_design_{}".format(*column.rsplit("_", 1))')) == [1]
 

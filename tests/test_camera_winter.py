@@ -23,24 +23,25 @@ STUDY = ROOT / "configs" / "camera-winter.yaml"
 #: The lines each part of the issue adds, by the words that open them.
 PARTS = ("  worst year: ", "  the cold: charge blocked ", "the cheapest panel and buffer for ")
 TABLES = ("storage_annual", "storage_years", "storage_monthly", "design_space")
-#: The folder as a user gets it, its figures drawn whole (it stands in test_cli_studies' run of
-#: every shipped study).
-pytestmark = pytest.mark.figure_pixels
 
 
 @pytest.fixture(scope="module")
-def views(tmp_path_factory):
-    """The study through the command line (terminal and JSON) and through the API."""
+def views(tmp_path_factory, without_pixels):
+    """The study through the command line (terminal and JSON) and through the API. The terminal's
+    folder is the one a user gets, its figures drawn whole (set up before any test's own fixtures,
+    it is drawn outside conftest's patch; it stands in test_cli_studies' run of every shipped
+    study); the JSON's and the API's folders are read for their tables and answers only."""
     folder = tmp_path_factory.mktemp("camera-winter")
     runner = CliRunner()
     terminal = runner.invoke(app, ["run", str(STUDY), "--out", str(folder / "cli")])
     assert terminal.exit_code == 0, terminal.output
-    done = runner.invoke(
-        app, ["run", str(STUDY), "--out", str(folder / "json"), "--format", "json"]
-    )
-    assert done.exit_code == 0, done.output
-    result = foldopt.run(STUDY)
-    foldopt.write(result, folder / "api")
+    with without_pixels():
+        done = runner.invoke(
+            app, ["run", str(STUDY), "--out", str(folder / "json"), "--format", "json"]
+        )
+        assert done.exit_code == 0, done.output
+        result = foldopt.run(STUDY)
+        foldopt.write(result, folder / "api")
     return {
         "terminal": terminal.stdout.splitlines(),
         "json": json.loads(done.stdout)["answer"],

@@ -83,22 +83,27 @@ def embedded(tmp_path_factory, without_pixels) -> pd.DataFrame:
 
 
 @pytest.fixture
-def cluster(tmp_path):
-    """A scheduler and two single-threaded workers on 127.0.0.1 (one without a nanny, so that
-    killing it kills the worker); yields the scheduler file, the workers' processes and the
-    scheduler's."""
-    scheduler_file = tmp_path / "scheduler.json"
-    python = [sys.executable, "-m"]
-    processes = [subprocess.Popen([*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
-                                   "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)],
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
-    try:
+def start_cluster(tmp_path):
+    """Start a scheduler and ``workers`` single-threaded workers on 127.0.0.1 (without a nanny, so
+    that killing one kills the worker): the scheduler file, the workers' processes and the
+    scheduler's. Each process a test's own, killed at its end."""
+    processes = []
+
+    def start(workers: int) -> tuple[Path, list[subprocess.Popen], subprocess.Popen]:
+        scheduler_file = tmp_path / "scheduler.json"
+        python = [sys.executable, "-m"]
+        processes.append(subprocess.Popen([*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port",
+                                           "0", "--dashboard-address", "127.0.0.1:0", "--scheduler-file",
+                                           str(scheduler_file)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         _wait_for(scheduler_file.exists, "the scheduler's file", 60)
-        for _ in range(2):
+        for _ in range(workers):
             processes.append(subprocess.Popen([*python, "distributed.cli.dask_worker", "--scheduler-file",
                                                str(scheduler_file), "--nthreads", "1", "--no-nanny", "--host",
                                                "127.0.0.1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        yield scheduler_file, processes[1:], processes[0]
+        return scheduler_file, processes[1:], processes[0]
+
+    try:
+        yield start
     finally:
         for process in processes:
             _kill(process)
@@ -125,10 +130,10 @@ def test_embedded_map_equals_the_computation_without_dask(embedded):
 
 
 @EMBEDDED_MAP
-def test_a_worker_killed_mid_run_loses_nothing(embedded, cluster, tmp_path):
+def test_a_worker_killed_mid_run_loses_nothing(embedded, start_cluster, tmp_path):
     """A map on a hand-started cluster, one of whose two workers is killed once the first part is
     written: every site once, the same bits as the embedded cluster's map."""
-    scheduler_file, workers, _ = cluster
+    scheduler_file, workers, _ = start_cluster(2)
     out = tmp_path / "map"
     run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
     try:
@@ -290,8 +295,10 @@ def _snapshot(folder: Path) -> dict[str, tuple]:
             for path in sorted(folder.rglob("*")) if path.is_file()}
 
 
-def test_a_scheduler_lost_mid_run_is_one_line_and_a_resume_that_cannot_connect_changes_nothing(cluster, tmp_path):
-    scheduler_file, _, scheduler = cluster
+def test_a_scheduler_lost_mid_run_is_one_line_and_a_resume_that_cannot_connect_changes_nothing(start_cluster,
+                                                                                                tmp_path):
+    # One worker: what is lost is the scheduler, not a worker.
+    scheduler_file, _, scheduler = start_cluster(1)
     out = tmp_path / "map"
     run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
     try:
