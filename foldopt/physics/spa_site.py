@@ -19,8 +19,9 @@ import math
 
 from numba import njit, uint64
 
-from foldopt.physics.spa import NS_PER_HOUR
-
+# The unit, not imported from foldopt.physics.spa: spa imports this module where its compiled
+# passes run, and importing it back would make a cycle.
+NS_PER_HOUR = 3_600_000_000_000  # [ns]
 NS_PER_DAY = 24 * NS_PER_HOUR  # [ns]
 
 SPA_TEMPERATURE = 12.0  # [C], pvlib's default for the refraction correction
