@@ -358,8 +358,10 @@ class IVCurve:
 
 
 def _kept(values):
-    """``values`` made read-only: an :class:`IVCurve` keeps it for every later reader."""
-    values.flags.writeable = False
+    """``values`` made read-only (a NumPy scalar is already): an :class:`IVCurve` keeps it for every
+    later reader."""
+    if isinstance(values, np.ndarray):
+        values.flags.writeable = False
     return values
 
 
