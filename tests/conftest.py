@@ -106,11 +106,10 @@ from foldopt.engine import evaluation as engine
 from foldopt.engine.curve_reduction import period_means
 from foldopt.engine.incidence import turning_poa
 
-# The reduction of given curves (a tracker's, a design's), a load profile's loads read-only; the
-# means over periods of days; a tracker's irradiance.
+# The reduction of given curves (a tracker's, a design's: constant loads and a load profile's
+# alike); the means over periods of days; a tracker's irradiance.
 power = np.zeros((2, 96))
-for shape in (None, np.ones(power.shape)):
-    engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba", load_shape=shape)
+engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba")
 period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))
 turning_poa(np.zeros((1, 1, 3)), np.zeros((1, 3, 1)), np.zeros((1, 1)), np.zeros((1, 1, 1)),
             np.zeros((1, 2), dtype=np.int64), np.zeros((1, 1)))
@@ -119,10 +118,8 @@ turning_poa(np.zeros((1, 1, 3)), np.zeros((1, 3, 1)), np.zeros((1, 1)), np.zeros
 import numpy as np
 from foldopt.engine.storage import Buffer, simulate
 
-# The buffer's simulation: its parameters one per series (several series of one buffer), shared
-# (one series), or a capacity per series.
-for series, capacity in ((1, 1.0), (2, 1.0), (1, np.array([1.0, 2.0]))):
-    simulate(np.ones((series, 96)), 0.5, Buffer(capacity), 0.25, engine="numba")
+# The buffer's simulation (one series or several, one buffer or one a series alike).
+simulate(np.ones((1, 96)), 0.5, Buffer(1.0), 0.25, engine="numba")
 """,
 }
 #: The warm-up's processes (the controller's), to wait for or end at the session's end.

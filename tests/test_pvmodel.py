@@ -80,3 +80,21 @@ def test_cell_temperature_models():
         cell_temperature(np.array([800.0]), 20.0, 1.0, "noct")
     with pytest.raises(ValueError, match="ideal, single-diode, b-model"):
         PVModel("two-diode")
+
+
+@pytest.mark.parametrize("model", ["single-diode", "b-model"])
+@pytest.mark.parametrize("poa", [500.0, np.array([0.0, 250.0, 1000.0])])
+def test_a_curves_points_are_kept_and_its_maximum_power_is_the_callers(model, poa):
+    """A curve works out its maximum-power point once (an electrical table's pair asks twice): the
+    same values however often it is asked, pvlib's own maximum for the single diode, and
+    max_power a new array the caller may write."""
+    pv = PVModel(model=model)
+    curve = pv.curves(poa, 25.0, 0.054)
+    first, again = curve.mpp(), curve.mpp()
+    assert all(np.array_equal(a, b) for a, b in zip(first, again, strict=True))
+    if model == "single-diode":
+        expected = pvlib.pvsystem.max_power_point(*curve.params, method="newton")["p_mp"]
+        np.testing.assert_allclose(first[0], np.where(np.asarray(poa) > 0, expected, 0.0), rtol=1e-12)
+    power = pv.max_power(poa, 25.0, 0.054)
+    power += 1.0  # the caller's own array
+    assert np.array_equal(curve.mpp()[0], first[0]) and np.array_equal(pv.max_power(poa, 25.0, 0.054), first[0])

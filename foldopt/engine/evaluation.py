@@ -665,10 +665,15 @@ def power_span(power) -> np.ndarray:
 
 
 def _loads(sorted_loads, load_shape, contiguous: bool, step_hours: float) -> Loads:
-    """The engine's :class:`Loads`: one placeholder row (1, 1) of profile for constant loads."""
+    """The engine's :class:`Loads`: one placeholder row (1, 1) of profile for constant loads.
+
+    The profile is always read-only (a broadcast load shape is, a copied one or the placeholder
+    would not be): numba compiles a loop again for each array type it is called with, read-only
+    or not, and the compiled loops only read it."""
     profile = (
         np.zeros((1, 1)) if load_shape is None else np.ascontiguousarray(load_shape, dtype=float)
-    )
+    ).view()
+    profile.flags.writeable = False
     return Loads(
         p_load=np.ascontiguousarray(sorted_loads, dtype=float),
         profile=profile,

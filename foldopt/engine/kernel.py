@@ -465,6 +465,18 @@ def _built_row(b, first, last, sky, tables, need_series, work):
             buffer[c, s] = _built_power(connections[c], parts, p_panel, tables)
 
 
+@njit(cache=True)
+def _keep_curves(kept, power, first, last):
+    """Every connection's power [W] at steps ``first..last`` of a row (``power``, (n_conn,
+    n_steps)) into ``kept``, the row's curves of :attr:`foldopt.engine.records.Outputs.power`.
+    A loop, not a slice assignment: numba compiles the message of a slice's mismatched shapes
+    (its string formatting) into every function that assigns one, seconds of the kernel's
+    compile."""
+    for c in range(power.shape[0]):
+        for s in range(first, last + 1):
+            kept[c, s] = power[c, s]
+
+
 def fold_rows(sky, rows, tables, loads, out, scratch):
     """Daily metrics of every row and connection, computing the power on the fly.
 
@@ -528,7 +540,7 @@ def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
         out.irradiation[r] = steps_sum(work.incident, first, n) * loads.step_hours
         harvested, peak = _switching_row(b, first, n, sky, tables, work)
         if rows.curve[r] >= 0:
-            out.power[rows.curve[r], :, first : last + 1] = work.power[:, first : last + 1]
+            _keep_curves(out.power[rows.curve[r]], work.power, first, last)
         out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
         blocked_day(
             work.power[0],
@@ -593,7 +605,7 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         else:
             _table_row(b, first, last, sky, tables, need_series, work)
         if rows.curve[r] >= 0:
-            out.power[rows.curve[r], :, first : last + 1] = work.power[:, first : last + 1]
+            _keep_curves(out.power[rows.curve[r]], work.power, first, last)
         p_load, profile = (
             loads.p_load[rows.loadset[r]],
             loads.profile[b if loads.use_profile else 0],

@@ -515,8 +515,10 @@ def _parameters(buffer: Buffer, n_series: int, step_hours: float) -> layout.Para
         max_discharge=max_d,
         initial_soc=initial,
     )
+    # Each a fresh writable array, whether one value serves every series or each has its own (a
+    # broadcast is read-only): the compiled loop is compiled for one type of each.
     return layout.Parameters(
-        *(np.ascontiguousarray(np.broadcast_to(field, n_series), dtype=float) for field in fields)
+        *(np.array(np.broadcast_to(field, n_series), dtype=float) for field in fields)
     )
 
 

@@ -362,14 +362,16 @@ def _series(curves, par, cold, days, max_iterations, tolerance):
     if not math.isnan(par.initial_soc):
         stored = par.initial_soc * capacity
         on = stored >= _levels(par, cold, 0, 0)[1]
-        _run(curves, par, cold, stored, on, False, days)
+        # np.bool_, not a literal: numba compiles a function again for a literal argument's type.
+        _run(curves, par, cold, stored, on, np.bool_(False), days)
         return 1
     resolution = 0.0  # one step's load energy [Wh], the largest of the series
     for row in curves.load:
         for value in row:
             resolution = max(resolution, value * curves.step_hours)
     low, high = 0.0, capacity
-    stored, on = capacity, True
+    # np.bool_, not a literal: numba would compile ``_run`` once more for the first pass's types.
+    stored, on = capacity, np.bool_(True)
     passes = 0
     while passes < max_iterations:
         passes += 1

@@ -184,20 +184,24 @@ def ineichen_terms(
         )
     apparent_zenith = np.ascontiguousarray(apparent_zenith, dtype=float)
     shape = apparent_zenith.shape
-    arrays = [
-        np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=float), shape))
-        for values in (dni_extra, linke_turbidity)
+    inputs = [
+        np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=float), full)).view()
+        for values, full in (
+            (apparent_zenith, shape),
+            (dni_extra, shape),
+            (linke_turbidity, shape),
+            (np.reshape(altitude, -1), shape[:1]),
+        )
     ]
-    heights = np.ascontiguousarray(
-        np.broadcast_to(np.asarray(altitude, dtype=float).reshape(-1), shape[:1])
-    )
+    for array in inputs:
+        # Read-only whether given, broadcast or copied: numba compiles the pass again for each
+        # array type it is called with, and the pass only reads them.
+        array.flags.writeable = False
     dni, ghi, dhi = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     code = TRANSPOSITION_CODES[transposition]
     terms = np.zeros((shape[0], 4 if code else 0, shape[1]))
     _ineichen_terms(
-        apparent_zenith,
-        *arrays,
-        heights,
+        *inputs,
         code,
         float(albedo),
         *perez_coefficients(),

@@ -305,9 +305,9 @@ class IVCurve:
         with np.errstate(divide="ignore", invalid="ignore"):
             return v_x * (1.0 + b * np.log1p(-current / scale))
 
-    @property
+    @functools.cached_property
     def i_sc(self):
-        return np.nan_to_num(self.current(np.zeros_like(self.params[0])))
+        return _kept(np.nan_to_num(self.current(np.zeros_like(self.params[0]))))
 
     @property
     def lit(self):
@@ -318,33 +318,51 @@ class IVCurve:
         """
         return self.i_sc > 1e-9
 
-    @property
+    @functools.cached_property
     def v_oc(self):
         if self.model == "b-model":
             return self.params[0]
-        return np.where(self.lit, np.nan_to_num(self.voltage(np.zeros_like(self.params[0]))), 0.0)
+        return _kept(
+            np.where(self.lit, np.nan_to_num(self.voltage(np.zeros_like(self.params[0]))), 0.0)
+        )
 
     def mpp(self):
-        """Maximum power [W] and its voltage [V] of each curve (both 0 for a dark curve)."""
+        """Maximum power [W] and its voltage [V] of each curve (both 0 for a dark curve), worked
+        out once a curve (read-only arrays: an electrical table's pair asks for them twice, its
+        bound and its connection)."""
+        return self._mpp
+
+    @functools.cached_property
+    def _mpp(self):
         if self.model == "single-diode":
             import pvlib
 
             mpp = pvlib.pvsystem.max_power_point(*self.params, method="newton")
             lit = self.lit
             power = np.clip(np.nan_to_num(np.asarray(mpp["p_mp"], dtype=float)), 0.0, None)
-            return np.where(lit, power, 0.0), np.where(
-                lit, np.nan_to_num(np.asarray(mpp["v_mp"], dtype=float)), 0.0
+            return _kept(np.where(lit, power, 0.0)), _kept(
+                np.where(lit, np.nan_to_num(np.asarray(mpp["v_mp"], dtype=float)), 0.0)
             )
         # Eq. 8: dP/dV = 0 has the closed form v = b (W(e^(1 + 1/b)) - 1), v = V / V_x, for all
         # irradiances; Lambert's W of the log-argument avoids overflow for small b.
         v_x, i_x, b = self.params
         w = _lambertw_exp(1.0 + 1.0 / b)
         v_mp = v_x * b * (w - 1.0)
-        return np.where(v_x > 0, v_mp * self.current(v_mp), 0.0), np.where(v_x > 0, v_mp, 0.0)
+        return _kept(np.where(v_x > 0, v_mp * self.current(v_mp), 0.0)), _kept(
+            np.where(v_x > 0, v_mp, 0.0)
+        )
 
     def max_power(self):
-        """Maximum power [W] of each curve."""
-        return self.mpp()[0]
+        """Maximum power [W] of each curve (a new array)."""
+        return self.mpp()[0].copy()
+
+
+def _kept(values):
+    """``values`` made read-only (a NumPy scalar is already): an :class:`IVCurve` keeps it for every
+    later reader."""
+    if isinstance(values, np.ndarray):
+        values.flags.writeable = False
+    return values
 
 
 def _lambertw_exp(x):
