@@ -21,19 +21,27 @@ the command's process, however it ends (``PR_SET_PDEATHSIG``).
 from __future__ import annotations
 
 import os
+import pickle
 import signal
 import sys
+import traceback
 from pathlib import Path
 
-#: The most workers a command starts: a folder holds a handful of figures, and each worker's
-#: imports cost 0.4 s of CPU.
+#: The most workers a command starts: a folder holds a handful of figures.
 MAX_WORKERS = 2
 
-#: The pool, where one runs, and the figures handed to it and not yet written: (path, future).
-_POOL: dict = {"executor": None, "pending": []}
+#: The pool where one runs: its queues, its first worker (a child of the command's process), the
+#: others (its children, forked once it has imported matplotlib) and the figures handed to it and
+#: not yet written (task number -> path).
+_POOL: dict = {"leader": None, "pending": {}}
 
 #: Linux's prctl option: the signal a process gets when its parent ends.
 _PR_SET_PDEATHSIG = 1
+
+
+class WorkerTraceback(Exception):
+    """Where a figure worker's error was raised: its traceback, the cause of the error raised in
+    the command (``foldopt --debug`` prints it)."""
 
 
 def workers() -> int:
@@ -52,43 +60,81 @@ def workers() -> int:
 
 
 def start(count: int) -> None:
-    """Fork ``count`` workers that draw the figures of this process from now on (none where
-    ``count`` is 0 or a pool runs already). Called where no other thread runs: a forked child holds
-    only the forking thread, and any lock another thread held stays locked in it.
+    """Start ``count`` workers that draw this process's figures from now on (none where ``count``
+    is 0 or a pool runs already). The first is forked now and imports matplotlib and the figure
+    modules; it then forks the others, which find them imported. Called where no other thread
+    runs: a forked child holds only the forking thread, and a lock another thread held stays
+    locked in it.
 
     Parameters
     ----------
     count : int
         From :func:`workers`.
     """
-    if count < 1 or _POOL["executor"] is not None:
+    if count < 1 or _POOL["leader"] is not None:
         return
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
 
-    executor = ProcessPoolExecutor(
-        count,
-        mp_context=multiprocessing.get_context("fork"),
-        initializer=_worker,
-        initargs=(os.getpid(),),
+    context = multiprocessing.get_context("fork")
+    # Tasks go through a queue's feeder thread: a task larger than the pipe never blocks the
+    # command while a worker waits for it to read a result.
+    tasks, results = context.Queue(), context.SimpleQueue()
+    leader = context.Process(
+        target=_lead, args=(tasks, results, count, os.getpid()), name="foldopt-figures"
     )
-    executor.submit(os.getpid)  # forks the workers now, before the command's work
-    _POOL["executor"] = executor
+    leader.start()
+    _POOL.update(leader=leader, tasks=tasks, results=results, helpers=None, tasks_sent=0)
 
 
-def _worker(parent: int) -> None:
-    """A worker's start: Ctrl-C and SIGTERM left to the command, death with it, then matplotlib and
-    the figure modules imported."""
+def _detach(parent: int) -> None:
+    """A worker's signals: Ctrl-C and SIGTERM are the command's (which ends its workers), and the
+    worker dies with its parent however that ends."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     import ctypes
 
     ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
-    if os.getppid() != parent:  # the command ended before the line above
+    if os.getppid() != parent:  # the parent ended before the line above
         os._exit(1)
+
+
+def _lead(tasks, results, count: int, parent: int) -> None:
+    """The first worker: matplotlib and the figure modules imported, the other workers forked
+    (their ids sent to the command), then figures drawn as the others do."""
+    _detach(parent)
     from foldopt.output.figures import canvas
 
     canvas.load_matplotlib()
+    helpers = []
+    for _ in range(count - 1):
+        pid = os.fork()
+        if pid == 0:
+            try:
+                _detach(os.getppid())
+                _serve(tasks, results)
+            finally:
+                os._exit(0)
+        helpers.append(pid)
+    results.put(("helpers", helpers, None))
+    _serve(tasks, results)
+    for pid in helpers:
+        os.waitpid(pid, 0)
+
+
+def _serve(tasks, results) -> None:
+    """Draw figures until the command says there are no more: each result, or the error raised
+    with its traceback, sent back under its task's number."""
+    while (task := tasks.get()) is not None:
+        number, function, args = task
+        try:
+            results.put((number, function(*args), None))
+        except BaseException as error:  # sent back, raised in the command
+            text = "".join(traceback.format_exception(error))
+            try:
+                pickle.dumps(error)
+            except Exception:  # an error that cannot travel: its type and first line do
+                error = RuntimeError(f"{type(error).__name__}: {str(error).splitlines()[0]}")
+            results.put((number, error, text))
 
 
 def draw(path: Path, function, *args) -> None:
@@ -105,11 +151,13 @@ def draw(path: Path, function, *args) -> None:
     *args
         Its arguments (pickled to a worker).
     """
-    executor = _POOL["executor"]
-    if executor is None:
+    if _POOL["leader"] is None:
         _write(path, function(*args))
-    else:
-        _POOL["pending"].append((Path(path), executor.submit(function, *args)))
+        return
+    number = _POOL["tasks_sent"]
+    _POOL["tasks_sent"] += 1
+    _POOL["pending"][number] = Path(path)
+    _POOL["tasks"].put((number, function, args))
 
 
 def _write(path: Path, data: bytes) -> None:
@@ -119,23 +167,52 @@ def _write(path: Path, data: bytes) -> None:
 
 
 def written() -> None:
-    """Write every file handed to the pool and not yet written, as each worker returns it; the
-    first error a worker raised is raised here (the files not yet drawn are dropped). Without a
-    pool, or with nothing handed to it, nothing to do."""
-    pending, _POOL["pending"] = _POOL["pending"], []
+    """Write every file handed to the pool and not yet written, as the workers return them; the
+    first error a worker raised is raised here, and the pool is ended (the figures not yet drawn
+    are dropped). Without a pool, or with nothing handed to it, nothing to do."""
+    if not _POOL["pending"]:
+        return
+    from multiprocessing.connection import wait
+
+    results, pending = _POOL["results"], _POOL["pending"]
     try:
-        for path, future in pending:
-            _write(path, future.result())
+        while pending:
+            if results._reader not in wait([results._reader, *_ended()]):
+                raise RuntimeError("a figure worker ended before drawing its figures")
+            number, data, text = results.get()
+            if number == "helpers":
+                _POOL["helpers"] = {pid: os.pidfd_open(pid) for pid in data}
+            elif text is not None:
+                data.__cause__ = WorkerTraceback(text)
+                raise data
+            else:
+                _write(pending.pop(number), data)
     except BaseException:
-        for _, future in pending:
-            future.cancel()
+        stop()
         raise
 
 
+def _ended() -> list:
+    """What a worker's end makes ready: the first worker's sentinel, the others' pidfds."""
+    return [_POOL["leader"].sentinel, *(_POOL["helpers"] or {}).values()]
+
+
 def stop() -> None:
-    """End the pool, where one runs: the figures not yet drawn dropped, the workers ended and
-    waited for (none outlives the command)."""
-    executor, _POOL["executor"] = _POOL["executor"], None
-    _POOL["pending"] = []
-    if executor is not None:
-        executor.shutdown(wait=True, cancel_futures=True)
+    """End the pool, where one runs, and wait for its workers to end (none outlives the
+    command): a pool that drew all it was given is told to end, any other is killed (its first
+    worker, and the others die with it)."""
+    leader = _POOL["leader"]
+    if leader is None:
+        return
+    helpers, tasks = _POOL["helpers"] or {}, _POOL["tasks"]
+    if _POOL["pending"] or helpers is None or not _POOL["tasks_sent"]:
+        leader.kill()
+        tasks.cancel_join_thread()  # what the killed workers did not read is dropped
+    else:
+        for _ in range(1 + len(helpers)):
+            tasks.put(None)
+    tasks.close()
+    leader.join()
+    for pidfd in helpers.values():
+        os.close(pidfd)
+    _POOL.update(leader=None, pending={}, helpers=None)

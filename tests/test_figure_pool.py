@@ -1,0 +1,254 @@
+"""The command line's figure workers (:mod:`foldopt.output.drawing`, issue 49): the command line's
+own process on more than one core has its figures drawn by worker processes beside it, and what
+it writes and says is what it writes and says when it draws them itself (one core, or a caller in
+its own process): the same bytes, the same error and exit code with nothing written, no worker
+left once the command ends, however it ends.
+
+Each command runs in a fresh interpreter that runs the command line as the ``foldopt`` script
+does (:data:`PROBE`), on the cores it is given (``os.sched_setaffinity``): one core draws in the
+command's process, two in the workers. The probe records the process that drew each figure.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.figure_pixels
+
+CORES = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
+needs_two_cores = pytest.mark.skipif(
+    sys.platform != "linux" or len(CORES) < 2, reason="the workers need Linux and two cores"
+)
+
+#: Runs the command line as the script does. Each figure drawn appends the drawing process's id
+#: to the file ``drawn`` (by the module's one drawing function, wrapped); with ``fail`` set, the
+#: figure of that name raises. As it ends it prints its id and whether it imported matplotlib.
+PROBE = r"""
+import atexit, json, os, runpy, sys
+
+import foldopt.output.figures as figures
+from foldopt.output.figures.canvas import FigureFile
+
+drawn, fail, args = json.loads(sys.argv[1])
+draw = figures.figure_bytes
+
+
+def recorded(file, args, kwargs):
+    with open(drawn, "a") as log:
+        log.write(f"{os.getpid()}\n")
+    return draw(file, args, kwargs)
+
+
+def failing(*args, **kwargs):
+    raise ValueError("a figure that cannot be drawn\nits second line")
+
+
+figures.figure_bytes = recorded
+if fail:
+    figures.FIGURES[fail] = FigureFile(failing, "fails")
+atexit.register(lambda: print(json.dumps([os.getpid(), "matplotlib" in sys.modules])))
+sys.argv = ["foldopt", *args]
+runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
+"""
+
+
+def _command(args, folder: Path, cores: int, fail: str | None = None) -> list[str]:
+    """The probe's command line for ``foldopt args`` in ``folder``."""
+    return [sys.executable, "-c", PROBE, json.dumps([str(folder / "drawn"), fail, args])]
+
+
+def _on(cores: int):
+    """A child's start on the first ``cores`` cores, with Ctrl-C at its default (a pytest-xdist
+    worker may hold it ignored, which a child keeps)."""
+
+    def start():
+        os.sched_setaffinity(0, CORES[:cores])
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+    return start
+
+
+def _run(args, folder: Path, cores: int, fail: str | None = None):
+    """Run ``foldopt args`` in ``folder`` on ``cores`` cores: (exit code, stdout lines but the
+    probe's, stderr, the command's process id, whether it imported matplotlib, the ids of the
+    processes that drew the figures)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    done = subprocess.run(
+        _command(args, folder, cores, fail),
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        preexec_fn=_on(cores),
+    )
+    lines = done.stdout.splitlines()
+    pid, matplotlib = json.loads(lines[-1])
+    drawn = folder / "drawn"
+    drawers = [int(line) for line in drawn.read_text().split()] if drawn.exists() else []
+    drawn.unlink(missing_ok=True)
+    return done.returncode, lines[:-1], done.stderr, pid, matplotlib, drawers
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {path.name: path.read_bytes() for path in sorted(folder.iterdir())}
+
+
+@needs_two_cores
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["run", "-q"],
+        ["run", "configs/camera-buffer.yaml"],
+        ["sweep", "angle", "--step-min", "10", "--format", "json"],
+    ],
+)
+def test_the_workers_write_the_bytes_the_command_draws_itself(tmp_path, args):
+    """Every file (PNG, CSV, run.json, report.html) and what the command prints are the same
+    whether the figures are drawn by the workers (two cores: drawn in other processes than the
+    command's, which never imports matplotlib) or by the command itself (one core)."""
+    repository = Path(__file__).resolve().parents[1]
+    seen = {}
+    for cores in (1, 2):
+        folder = tmp_path / str(cores)
+        folder.mkdir()
+        (folder / "configs").symlink_to(repository / "configs")
+        code, lines, stderr, pid, matplotlib, drawers = _run([*args, "--out", "out"], folder, cores)
+        assert code == 0, stderr
+        assert drawers and (set(drawers) == {pid}) is (cores == 1)
+        assert matplotlib is (cores == 1)
+        seen[cores] = (lines, stderr, _files(folder / "out"))
+    assert any(name.endswith(".png") for name in seen[1][2])
+    assert seen[1] == seen[2]
+
+
+@needs_two_cores
+def test_a_figure_that_fails_fails_the_command_as_it_does_without_workers(tmp_path):
+    """A figure that raises in a worker ends the command with the one line and the exit code it
+    ends with when the command draws it itself, and nothing is written: no folder, no staging
+    folder, nothing beside."""
+    said = {}
+    for cores in (1, 2):
+        folder = tmp_path / str(cores)
+        code, lines, stderr, pid, _, drawers = _run(
+            ["run", "--out", "out"], folder, cores, fail="switching.png"
+        )
+        assert sorted(path.name for path in folder.iterdir()) == []
+        said[cores] = (code, stderr)
+        assert lines[0].startswith("shin2015: ")  # the answer, printed before the figures
+    assert said[1] == said[2]
+    code, stderr = said[2]
+    assert code == 1 and stderr.splitlines() == [
+        "error: internal error (ValueError: a figure that cannot be drawn); run again as "
+        "foldopt --debug ... for the traceback, and please report it"
+    ]
+
+
+def _children(pid: int) -> set[int]:
+    """The ids of the live processes whose parent is ``pid``."""
+    found = set()
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                status = (entry / "status").read_text()
+            except OSError:
+                continue
+            fields = dict(line.split(":\t", 1) for line in status.splitlines() if ":\t" in line)
+            if fields.get("PPid", "").strip() == str(pid) and not fields["State"].startswith("Z"):
+                found.add(int(entry.name))
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return not (Path("/proc") / str(pid) / "status").read_text().split("State:\t")[1].startswith(
+            "Z"
+        )
+    except (OSError, IndexError):
+        return False
+
+
+def _workers_of(process: subprocess.Popen) -> set[int]:
+    """The command's workers, once it has forked them (within a minute)."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and process.poll() is None:
+        workers = _children(process.pid)
+        if len(workers) >= 2:
+            return workers
+        time.sleep(0.01)
+    raise AssertionError("the command forked no workers")
+
+
+def _gone(workers: set[int], within: float = 10) -> bool:
+    deadline = time.monotonic() + within
+    while any(_alive(pid) for pid in workers):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.02)
+    return True
+
+
+@needs_two_cores
+@pytest.mark.parametrize("ending", ["completes", signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
+def test_no_worker_outlives_the_command(tmp_path, ending):
+    """Whether the command completes, is interrupted (Ctrl-C), terminated or killed, its workers
+    end with it; an interrupted or terminated command says so as it does without workers and
+    leaves no folder."""
+    process = subprocess.Popen(
+        _command(["sweep", "angle", "--step-min", "5", "--out", "out"], tmp_path, 2),
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_on(2),
+    )
+    try:
+        workers = _workers_of(process)
+        if ending != "completes":
+            process.send_signal(ending)
+        stdout, stderr = process.communicate(timeout=300)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert _gone(workers), "a worker outlived the command"
+    if ending == "completes":
+        assert process.returncode == 0 and (tmp_path / "out" / "report.html").is_file(), stderr
+    elif ending == signal.SIGINT:
+        assert (process.returncode, stderr) == (130, "interrupted\n")
+    else:
+        assert process.returncode in (-ending, 128 + ending)
+    if ending != "completes":
+        assert not (tmp_path / "out").exists()
+
+
+def test_an_in_process_caller_draws_in_its_own_process(tmp_path, monkeypatch):
+    """A command run in the caller's process (a test's CliRunner, as a notebook would call it)
+    starts no worker: every figure is drawn in the caller's process."""
+    from typer.testing import CliRunner
+
+    import foldopt.output.figures as figures
+    from foldopt.cli.app import app
+    from foldopt.output import drawing
+
+    drawers = []
+    draw = figures.figure_bytes
+
+    def recorded(file, args, kwargs):
+        drawers.append(os.getpid())
+        return draw(file, args, kwargs)
+
+    monkeypatch.setattr(figures, "figure_bytes", recorded)
+    done = CliRunner().invoke(app, ["run", "--out", str(tmp_path / "out"), "-q"])
+    assert done.exit_code == 0, done.output
+    assert drawers == [os.getpid()] * 5
+    assert drawing._POOL["leader"] is None
+    assert sorted(path.name for path in (tmp_path / "out").glob("*.png")) == sorted(
+        figures.day.FIGURES
+    )
