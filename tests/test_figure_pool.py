@@ -29,19 +29,21 @@ needs_two_cores = pytest.mark.skipif(
 )
 
 #: Runs the command line as the script does. Each figure drawn appends the drawing process's id
-#: to the file ``drawn`` (by the module's one drawing function, wrapped); with ``fail`` set, the
-#: figure of that name raises. As it ends it prints its id and whether it imported matplotlib.
+#: to the file ``drawn`` (by the module's one drawing function, wrapped), after ``slow`` seconds;
+#: with ``fail`` set, the figure of that name raises. As it ends it prints its id and whether it
+#: imported matplotlib.
 PROBE = r"""
-import atexit, json, os, runpy, sys
+import atexit, json, os, runpy, sys, time
 
 import foldopt.output.figures as figures
 from foldopt.output.figures.canvas import FigureFile
 
-drawn, fail, args = json.loads(sys.argv[1])
+drawn, fail, slow, args = json.loads(sys.argv[1])
 draw = figures.figure_bytes
 
 
 def recorded(file, args, kwargs):
+    time.sleep(slow)
     with open(drawn, "a") as log:
         log.write(f"{os.getpid()}\n")
     return draw(file, args, kwargs)
@@ -51,6 +53,8 @@ def failing(*args, **kwargs):
     raise ValueError("a figure that cannot be drawn\nits second line")
 
 
+# A worker finds the function by its name, as it finds the one it stands for.
+recorded.__module__, recorded.__qualname__ = figures.__name__, "figure_bytes"
 figures.figure_bytes = recorded
 if fail:
     figures.FIGURES[fail] = FigureFile(failing, "fails")
@@ -60,9 +64,9 @@ runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
 """
 
 
-def _command(args, folder: Path, cores: int, fail: str | None = None) -> list[str]:
+def _command(args, folder: Path, fail: str | None = None, slow: float = 0) -> list[str]:
     """The probe's command line for ``foldopt args`` in ``folder``."""
-    return [sys.executable, "-c", PROBE, json.dumps([str(folder / "drawn"), fail, args])]
+    return [sys.executable, "-c", PROBE, json.dumps([str(folder / "drawn"), fail, slow, args])]
 
 
 def _on(cores: int):
@@ -82,7 +86,7 @@ def _run(args, folder: Path, cores: int, fail: str | None = None):
     processes that drew the figures)."""
     folder.mkdir(parents=True, exist_ok=True)
     done = subprocess.run(
-        _command(args, folder, cores, fail),
+        _command(args, folder, fail),
         cwd=folder,
         capture_output=True,
         text=True,
@@ -168,20 +172,25 @@ def _children(pid: int) -> set[int]:
 
 def _alive(pid: int) -> bool:
     try:
-        return not (Path("/proc") / str(pid) / "status").read_text().split("State:\t")[1].startswith(
-            "Z"
+        return (
+            not (Path("/proc") / str(pid) / "status")
+            .read_text()
+            .split("State:\t")[1]
+            .startswith("Z")
         )
     except (OSError, IndexError):
         return False
 
 
 def _workers_of(process: subprocess.Popen) -> set[int]:
-    """The command's workers, once it has forked them (within a minute)."""
+    """The command's workers, once it has them all (within a minute): its child, and the one that
+    child forks once it has imported matplotlib."""
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and process.poll() is None:
-        workers = _children(process.pid)
-        if len(workers) >= 2:
-            return workers
+        for first in _children(process.pid):
+            others = _children(first)
+            if others:
+                return {first, *others}
         time.sleep(0.01)
     raise AssertionError("the command forked no workers")
 
@@ -198,26 +207,34 @@ def _gone(workers: set[int], within: float = 10) -> bool:
 @needs_two_cores
 @pytest.mark.parametrize("ending", ["completes", signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
 def test_no_worker_outlives_the_command(tmp_path, ending):
-    """Whether the command completes, is interrupted (Ctrl-C), terminated or killed, its workers
-    end with it; an interrupted or terminated command says so as it does without workers and
-    leaves no folder."""
-    process = subprocess.Popen(
-        _command(["sweep", "angle", "--step-min", "5", "--out", "out"], tmp_path, 2),
-        cwd=tmp_path,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        preexec_fn=_on(2),
-    )
+    """Whether the command completes, is interrupted (Ctrl-C), terminated or killed while its
+    workers draw, they end with it; an interrupted or terminated command says so as it does
+    without workers and leaves no folder."""
+    # Its output to files, not pipes: a worker left behind would hold a pipe open.
+    with open(tmp_path / "stdout", "w") as stdout, open(tmp_path / "stderr", "w") as stderr:
+        process = subprocess.Popen(
+            # A command still drawing when the signal comes: each figure takes a minute more.
+            _command(["run", "--out", "out"], tmp_path, slow=0 if ending == "completes" else 60),
+            cwd=tmp_path,
+            stdout=stdout,
+            stderr=stderr,
+            preexec_fn=_on(2),
+        )
+    workers = set()
     try:
         workers = _workers_of(process)
         if ending != "completes":
             process.send_signal(ending)
-        stdout, stderr = process.communicate(timeout=300)
+        process.wait(timeout=300)
+        assert _gone(workers), "a worker outlived the command"
     finally:
-        if process.poll() is None:
-            process.kill()
-    assert _gone(workers), "a worker outlived the command"
+        for pid in (process.pid, *workers):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        process.wait()
+    stderr = (tmp_path / "stderr").read_text()
     if ending == "completes":
         assert process.returncode == 0 and (tmp_path / "out" / "report.html").is_file(), stderr
     elif ending == signal.SIGINT:

@@ -20,6 +20,7 @@ the command's process, however it ends (``PR_SET_PDEATHSIG``).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pickle
 import signal
@@ -125,7 +126,7 @@ def _serve(tasks, results) -> None:
     """Draw figures until the command says there are no more: each result, or the error raised
     with its traceback, sent back under its task's number."""
     while (task := tasks.get()) is not None:
-        number, function, args = task
+        number, function, args = pickle.loads(task)
         try:
             results.put((number, function(*args), None))
         except BaseException as error:  # sent back, raised in the command
@@ -149,15 +150,18 @@ def draw(path: Path, function, *args) -> None:
     function : callable
         A module's function (a worker finds it by name), returning bytes.
     *args
-        Its arguments (pickled to a worker).
+        Its arguments (pickled to a worker; where they cannot be, the file is drawn here).
     """
-    if _POOL["leader"] is None:
+    task = None
+    if _POOL["leader"] is not None:
+        with contextlib.suppress(Exception):  # what cannot travel to a worker is drawn here
+            task = pickle.dumps((_POOL["tasks_sent"], function, args), pickle.HIGHEST_PROTOCOL)
+    if task is None:
         _write(path, function(*args))
         return
-    number = _POOL["tasks_sent"]
+    _POOL["pending"][_POOL["tasks_sent"]] = Path(path)
     _POOL["tasks_sent"] += 1
-    _POOL["pending"][number] = Path(path)
-    _POOL["tasks"].put((number, function, args))
+    _POOL["tasks"].put(task)
 
 
 def _write(path: Path, data: bytes) -> None:
@@ -205,7 +209,10 @@ def stop() -> None:
     if leader is None:
         return
     helpers, tasks = _POOL["helpers"] or {}, _POOL["tasks"]
-    if _POOL["pending"] or helpers is None or not _POOL["tasks_sent"]:
+    if _POOL["pending"] or not helpers or not _POOL["tasks_sent"]:
+        for pidfd in helpers.values():
+            with contextlib.suppress(ProcessLookupError):  # one that has ended already
+                signal.pidfd_send_signal(pidfd, signal.SIGKILL)
         leader.kill()
         tasks.cancel_join_thread()  # what the killed workers did not read is dropped
     else:

@@ -28,6 +28,7 @@ import numpy as np
 
 from foldopt.cache import cache_dir
 
+
 def _writable(folder: Path) -> bool:
     try:
         folder.mkdir(parents=True, exist_ok=True)
