@@ -217,12 +217,13 @@ def test_the_command_lines_process_freezes_what_it_loads(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     state = json.loads(done.stdout.splitlines()[-1])
-    # Passes ran during the work, with the 100,000-odd objects of typer, pydantic, numpy, pandas
-    # and matplotlib frozen.
+    # Passes ran during the work, with the 100,000-odd objects of typer, pydantic, numpy and
+    # pandas (and matplotlib, where the command draws its figures itself) frozen.
     assert state["passes"] > 0 and state["frozen"] > 50_000
-    # As it exits, all but what its last handlers made is frozen (none, today).
+    # As it exits, all but what its last handlers made is frozen (none, today); the figure
+    # workers' pool, ended as the command ends, has freed what it held, frozen with the rest.
     frozen_at_exit, unfrozen_at_exit = state["exit"]
-    assert frozen_at_exit >= state["frozen"] and unfrozen_at_exit < 1_000
+    assert frozen_at_exit > 50_000 and unfrozen_at_exit < 1_000
 
 
 def test_an_in_process_caller_keeps_its_collector():
