@@ -38,7 +38,11 @@ import atexit, json, os, runpy, sys, time
 import foldopt.output.figures as figures
 from foldopt.output.figures.canvas import FigureFile
 
-drawn, fail, slow, args = json.loads(sys.argv[1])
+drawn, fail, slow, workers, args = json.loads(sys.argv[1])
+if workers is not None:  # as many as the cores, however busy the machine is
+    from foldopt.output import drawing
+
+    drawing.workers = lambda: workers
 draw = figures.figure_bytes
 
 
@@ -64,9 +68,13 @@ runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
 """
 
 
-def _command(args, folder: Path, fail: str | None = None, slow: float = 0) -> list[str]:
-    """The probe's command line for ``foldopt args`` in ``folder``."""
-    return [sys.executable, "-c", PROBE, json.dumps([str(folder / "drawn"), fail, slow, args])]
+def _command(
+    args, folder: Path, fail: str | None = None, slow: float = 0, workers: int | None = None
+) -> list[str]:
+    """The probe's command line for ``foldopt args`` in ``folder``, with ``workers`` workers
+    where given (else :func:`foldopt.output.drawing.workers`'s)."""
+    payload = [str(folder / "drawn"), fail, slow, workers, args]
+    return [sys.executable, "-c", PROBE, json.dumps(payload)]
 
 
 def _on(cores: int):
@@ -86,7 +94,8 @@ def _run(args, folder: Path, cores: int, fail: str | None = None):
     processes that drew the figures)."""
     folder.mkdir(parents=True, exist_ok=True)
     done = subprocess.run(
-        _command(args, folder, fail),
+        # One core: workers() says none; two: two, however busy the machine.
+        _command(args, folder, fail, workers=None if cores == 1 else 2),
         cwd=folder,
         capture_output=True,
         text=True,
@@ -214,7 +223,12 @@ def test_no_worker_outlives_the_command(tmp_path, ending):
     with open(tmp_path / "stdout", "w") as stdout, open(tmp_path / "stderr", "w") as stderr:
         process = subprocess.Popen(
             # A command still drawing when the signal comes: each figure takes a minute more.
-            _command(["run", "--out", "out"], tmp_path, slow=0 if ending == "completes" else 60),
+            _command(
+                ["run", "--out", "out"],
+                tmp_path,
+                slow=0 if ending == "completes" else 60,
+                workers=2,
+            ),
             cwd=tmp_path,
             stdout=stdout,
             stderr=stderr,
@@ -269,3 +283,26 @@ def test_an_in_process_caller_draws_in_its_own_process(tmp_path, monkeypatch):
     assert sorted(path.name for path in (tmp_path / "out").glob("*.png")) == sorted(
         figures.day.FIGURES
     )
+
+
+@pytest.mark.parametrize(
+    ("platform", "cores", "load", "expected"),
+    [
+        ("linux", {0}, 0.0, 0),
+        ("linux", {0, 1}, 0.5, 2),
+        ("linux", {0, 1}, 2.0, 2),
+        ("linux", {0, 1}, 2.5, 0),
+        ("linux", set(range(8)), 3.0, 2),
+        ("darwin", {0, 1}, 0.0, 0),
+    ],
+)
+def test_workers_where_a_core_is_to_spare(monkeypatch, platform, cores, load, expected):
+    """Workers only on Linux, with more than one core to run on and a machine no busier than its
+    cores (the last minute's load), at most two."""
+    from foldopt.output import drawing
+
+    monkeypatch.setattr(drawing.sys, "platform", platform)
+    monkeypatch.setattr(drawing.os, "sched_getaffinity", lambda pid: cores, raising=False)
+    monkeypatch.setattr(drawing.os, "cpu_count", lambda: max(len(cores), 2))
+    monkeypatch.setattr(drawing.os, "getloadavg", lambda: (load, load, load))
+    assert drawing.workers() == expected

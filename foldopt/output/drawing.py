@@ -1,21 +1,22 @@
 """Where a results folder's figures are drawn: in the process that writes the folder, or by a small
 pool of worker processes beside it.
 
-A figure is some 0.1 s of matplotlib's work on one core, and matplotlib's import 0.4 s more. The
-command line's own process (:mod:`foldopt.cli.process`) on Linux with more than one core starts
-the pool (:func:`start`) before it computes its answer: the workers are forked then, before the
-command starts a thread of its own (a progress bar, numba's), and import matplotlib and the figure
-modules while the command computes; the command itself never imports matplotlib. Elsewhere (an
-in-process caller such as a notebook or a test's ``CliRunner``, one core, no ``fork``) nothing
-starts and every figure is drawn in the caller's process as it is asked for.
+A figure is some 0.1 s of matplotlib's work on one core, and matplotlib's import 0.3-0.4 s more.
+The command line's own process (:mod:`foldopt.cli.process`) on Linux with a core to spare
+(:func:`workers`) starts the pool (:func:`start`) before it computes its answer, before it starts
+a thread of its own (a progress bar, numba's): its first worker, forked then, imports matplotlib
+and the figure modules at the lowest priority while the command computes, then forks the others,
+which find them imported. The command itself never imports matplotlib. Elsewhere (an in-process
+caller such as a notebook or a test's ``CliRunner``, one core, a busy machine, no ``fork``)
+nothing starts and every figure is drawn in the caller's process as it is asked for.
 
 Wherever it runs, a figure is drawn by the one function the writer gives (:func:`draw`): it
 returns the file's bytes, and the writing process writes them into the folder
 (:func:`foldopt.files.write_atomically`). The workers touch no file: a folder that fails is
 discarded whole by its writer, as ever. A worker's error comes back as it was raised (its type and
-message), when the writer collects the figures (:func:`written`), before ``report.html`` embeds
-them and the folder is committed. The workers ignore Ctrl-C (the command ends them) and die with
-the command's process, however it ends (``PR_SET_PDEATHSIG``).
+message, its traceback as the cause), when the writer collects the figures (:func:`written`),
+before ``report.html`` embeds them and the folder is committed. The workers ignore Ctrl-C (the
+command ends them) and die with their parent, however it ends (``PR_SET_PDEATHSIG``).
 """
 
 from __future__ import annotations
@@ -47,8 +48,9 @@ class WorkerTraceback(Exception):
 
 def workers() -> int:
     """The workers a command may start: the cores this process may run on, up to
-    :data:`MAX_WORKERS`; 0 with one core (a worker would only share it) or where processes are
-    not forked (not Linux).
+    :data:`MAX_WORKERS`; none with one core, where the machine's load (the last minute's
+    average of runnable processes) exceeds its cores (a worker would only share a busy core and
+    add its own work), or where processes are not forked (not Linux).
 
     Returns
     -------
@@ -57,7 +59,9 @@ def workers() -> int:
     if sys.platform != "linux":
         return 0
     cores = len(os.sched_getaffinity(0))
-    return min(cores, MAX_WORKERS) if cores > 1 else 0
+    if cores < 2 or os.getloadavg()[0] > os.cpu_count():
+        return 0
+    return min(cores, MAX_WORKERS)
 
 
 def start(count: int) -> None:
@@ -105,7 +109,13 @@ def _lead(tasks, results, count: int, parent: int) -> None:
     _detach(parent)
     from foldopt.output.figures import canvas
 
+    # Imported at the lowest priority: the command computing its answer beside it comes first
+    # where the cores are shared; where one is free, it changes nothing.
+    priority = os.getpriority(os.PRIO_PROCESS, 0)
+    os.setpriority(os.PRIO_PROCESS, 0, 19)
     canvas.load_matplotlib()
+    with contextlib.suppress(PermissionError):  # only a privileged process may raise it again
+        os.setpriority(os.PRIO_PROCESS, 0, priority)
     helpers = []
     for _ in range(count - 1):
         pid = os.fork()
