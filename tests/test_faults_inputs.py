@@ -248,8 +248,9 @@ def test_a_unicode_folder_under_the_c_locale_with_an_unusable_home(tmp_path):
 
 def test_matplotlib_gets_a_folder_and_the_environment_is_as_it_was(tmp_path):
     """With HOME unusable, loading matplotlib for foldopt's figures (as the first figure drawn
-    does) gives it foldopt's cache folder for its configuration and fonts (it reads MPLCONFIGDIR once, as it is imported) and leaves the
-    process's environment as it was: no MPLCONFIGDIR behind the caller's back."""
+    does) gives it foldopt's cache folder for its configuration and fonts (it reads MPLCONFIGDIR
+    once, as it is imported) and leaves the process's environment as it was: no MPLCONFIGDIR
+    behind the caller's back."""
     (tmp_path / "a-file").write_text("")
     cache = tmp_path / "cache"
     env = foldopt_env(HOME=str(tmp_path / "a-file" / "home"), XDG_CONFIG_HOME=None, XDG_CACHE_HOME=None,

@@ -52,9 +52,9 @@ def loading():
 
 def drawing_aside() -> None:
     """In the command line's own process, a command that will draw figures has them drawn by
-    worker processes beside it (:func:`foldopt.output.drawing.start`, where there is more than one
-    core); elsewhere they are drawn in the caller's process. Called before the command's work
-    starts a thread (its progress bar)."""
+    worker processes beside it (:func:`foldopt.output.drawing.start`, where a core is to spare:
+    :func:`~foldopt.output.drawing.workers`); elsewhere they are drawn in the caller's process.
+    Called before the command's work starts a thread (its progress bar)."""
     if _OWN["process"]:
         from foldopt.output import drawing
 

@@ -113,7 +113,8 @@ def _lead(tasks, results, count: int, parent: int) -> None:
     # where the cores are shared; where one is free, it changes nothing.
     priority = os.getpriority(os.PRIO_PROCESS, 0)
     os.setpriority(os.PRIO_PROCESS, 0, 19)
-    canvas.load_matplotlib()
+    with contextlib.suppress(Exception):  # else each figure raises it, as it would in the command
+        canvas.load_matplotlib()
     with contextlib.suppress(PermissionError):  # only a privileged process may raise it again
         os.setpriority(os.PRIO_PROCESS, 0, priority)
     helpers = []
@@ -142,7 +143,7 @@ def _serve(tasks, results) -> None:
         except BaseException as error:  # sent back, raised in the command
             text = "".join(traceback.format_exception(error))
             try:
-                pickle.dumps(error)
+                pickle.loads(pickle.dumps(error))
             except Exception:  # an error that cannot travel: its type and first line do
                 error = RuntimeError(f"{type(error).__name__}: {str(error).splitlines()[0]}")
             results.put((number, error, text))

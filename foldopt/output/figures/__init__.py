@@ -7,9 +7,11 @@
 ``FIGURES``: file name -> the plot function and what it shows. :data:`FIGURES` gathers them: every
 figure file a results folder can hold, the one list the folder writers draw through
 (:func:`write_figure`) and the manual's table (:func:`rst_table`, ``python -m
-foldopt.output.figures``). Importing this package chooses no backend: files are drawn on bare
-:class:`matplotlib.figure.Figure` objects (:func:`~foldopt.output.figures.canvas.for_files`). It
-may import :mod:`foldopt.studies` and everything below it.
+foldopt.output.figures``). Importing this package chooses no backend and loads no matplotlib
+(the first figure made does: :func:`~foldopt.output.figures.canvas.load_matplotlib`): files are
+drawn on bare :class:`matplotlib.figure.Figure` objects
+(:func:`~foldopt.output.figures.canvas.for_files`), wherever :mod:`foldopt.output.drawing` has
+them drawn. It may import :mod:`foldopt.studies` and everything below it.
 """
 
 from __future__ import annotations
@@ -18,8 +20,6 @@ import io
 from pathlib import Path
 
 from foldopt.output import drawing
-
-
 from foldopt.output.figures import (
     annual,
     day,
