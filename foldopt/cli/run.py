@@ -85,8 +85,9 @@ def run_request(
 
 
 def write_folder(result, out: Path, overwrite: bool) -> None:
-    """Write a result's folder (:func:`foldopt.api.write`), its writers' modules (matplotlib,
-    jinja2) loaded first (:func:`foldopt.cli.process.loading`).
+    """Write a result's folder (:func:`foldopt.api.write`), its writers' modules (jinja2, and
+    matplotlib where the figures are drawn in this process) loaded first
+    (:func:`foldopt.cli.process.loading`).
 
     Parameters
     ----------
@@ -97,7 +98,9 @@ def write_folder(result, out: Path, overwrite: bool) -> None:
     """
     with loading():
         from foldopt.api import write
-        from foldopt.output import folders  # noqa: F401 - what write imports when it writes
+        from foldopt.output import drawing, folders  # noqa: F401 - what write imports
+
+        drawing.prepare()
     write(result, out, overwrite, INVOCATION)
 
 

@@ -22,6 +22,7 @@ command ends them) and die with their parent, however it ends (``PR_SET_PDEATHSI
 from __future__ import annotations
 
 import contextlib
+import gc
 import os
 import pickle
 import signal
@@ -91,6 +92,15 @@ def start(count: int) -> None:
     _POOL.update(leader=leader, tasks=tasks, results=results, helpers=None, tasks_sent=0)
 
 
+def prepare() -> None:
+    """Load what drawing needs where the figures are drawn in this process (no pool): matplotlib
+    (:func:`foldopt.output.figures.canvas.load_matplotlib`), which the first figure would load."""
+    if _POOL["leader"] is None:
+        from foldopt.output.figures import canvas
+
+        canvas.load_matplotlib()
+
+
 def _detach(parent: int) -> None:
     """A worker's signals: Ctrl-C and SIGTERM are the command's (which ends its workers), and the
     worker dies with its parent however that ends."""
@@ -111,10 +121,15 @@ def _lead(tasks, results, count: int, parent: int) -> None:
 
     # Imported at the lowest priority: the command computing its answer beside it comes first
     # where the cores are shared; where one is free, it changes nothing.
+    # Its modules load with the collector paused and are then frozen, as the command's do
+    # (foldopt.cli.process): its passes would walk them again and again.
     priority = os.getpriority(os.PRIO_PROCESS, 0)
     os.setpriority(os.PRIO_PROCESS, 0, 19)
+    gc.disable()
     with contextlib.suppress(Exception):  # else each figure raises it, as it would in the command
         canvas.load_matplotlib()
+    gc.freeze()
+    gc.enable()
     with contextlib.suppress(PermissionError):  # only a privileged process may raise it again
         os.setpriority(os.PRIO_PROCESS, 0, priority)
     helpers = []

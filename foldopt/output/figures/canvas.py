@@ -86,9 +86,16 @@ def load_matplotlib() -> None:
     folders chosen (:func:`_matplotlib_imported`): the first figure made does, and a figure worker
     as it starts (:mod:`foldopt.output.drawing`). Importing the figure modules loads no
     matplotlib, so that a process that has its figures drawn elsewhere never does."""
+    if _LOADED["matplotlib"]:  # its folders are chosen once, as matplotlib reads them
+        return
     with _matplotlib_imported():
         import matplotlib.backends.backend_agg  # noqa: F401
         import matplotlib.figure  # noqa: F401
+    _LOADED["matplotlib"] = True
+
+
+#: Whether :func:`load_matplotlib` has loaded matplotlib in this process.
+_LOADED = {"matplotlib": False}
 
 
 #: Dots per inch of a figure file.
