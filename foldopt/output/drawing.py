@@ -117,16 +117,16 @@ def _lead(tasks, results, count: int, parent: int) -> None:
     """The first worker: matplotlib and the figure modules imported, the other workers forked
     (their ids sent to the command), then figures drawn as the others do."""
     _detach(parent)
-    from foldopt.output.figures import canvas
-
-    # Imported at the lowest priority: the command computing its answer beside it comes first
-    # where the cores are shared; where one is free, it changes nothing.
-    # Its modules load with the collector paused and are then frozen, as the command's do
-    # (foldopt.cli.process): its passes would walk them again and again.
+    # Its modules (the figure modules, with pandas, and matplotlib) load at the lowest priority,
+    # so that the command computing its answer beside it comes first where the cores are shared
+    # (where one is free, it changes nothing), and with the collector paused, then frozen, as the
+    # command's do (foldopt.cli.process): its passes would walk them again and again.
     priority = os.getpriority(os.PRIO_PROCESS, 0)
     os.setpriority(os.PRIO_PROCESS, 0, 19)
     gc.disable()
     with contextlib.suppress(Exception):  # else each figure raises it, as it would in the command
+        from foldopt.output.figures import canvas
+
         canvas.load_matplotlib()
     gc.freeze()
     gc.enable()
