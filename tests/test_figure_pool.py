@@ -290,15 +290,15 @@ def test_an_in_process_caller_draws_in_its_own_process(tmp_path, monkeypatch):
     [
         ("linux", {0}, 0.0, 0),
         ("linux", {0, 1}, 0.5, 2),
-        ("linux", {0, 1}, 2.0, 2),
-        ("linux", {0, 1}, 2.5, 0),
+        ("linux", {0, 1}, 3.0, 2),
+        ("linux", {0, 1}, 3.5, 0),
         ("linux", set(range(8)), 3.0, 2),
         ("darwin", {0, 1}, 0.0, 0),
     ],
 )
 def test_workers_where_a_core_is_to_spare(monkeypatch, platform, cores, load, expected):
     """Workers only on Linux, with more than one core to run on and a machine no busier than its
-    cores (the last minute's load), at most two."""
+    cores and the command (the last minute's load), at most two."""
     from foldopt.output import drawing
 
     monkeypatch.setattr(drawing.sys, "platform", platform)

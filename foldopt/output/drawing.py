@@ -50,8 +50,9 @@ class WorkerTraceback(Exception):
 def workers() -> int:
     """The workers a command may start: the cores this process may run on, up to
     :data:`MAX_WORKERS`; none with one core, where the machine's load (the last minute's
-    average of runnable processes) exceeds its cores (a worker would only share a busy core and
-    add its own work), or where processes are not forked (not Linux).
+    average of runnable processes) exceeds its cores by more than one, the command's own (a
+    worker would only share a busy core and add its own work), or where processes are not forked
+    (not Linux).
 
     Returns
     -------
@@ -60,7 +61,7 @@ def workers() -> int:
     if sys.platform != "linux":
         return 0
     cores = len(os.sched_getaffinity(0))
-    if cores < 2 or os.getloadavg()[0] > os.cpu_count():
+    if cores < 2 or os.getloadavg()[0] > os.cpu_count() + 1:
         return 0
     return min(cores, MAX_WORKERS)
 
