@@ -247,15 +247,15 @@ def _one_pixel_png() -> bytes:
     return png.getvalue()
 
 
-def _drawn_without_pixels(ax, path, margins=None):
+def _drawn_without_pixels(ax, file, margins=None, file_format=None):
     """foldopt's save_plot but for the pixels: every artist of the figure is drawn (matplotlib's
     ``draw_without_rendering``: a plot that fails on its data fails here), nothing is laid out
-    (``margins`` unused) or rasterised, and the file is a PNG of one pixel."""
+    (``margins`` unused) or rasterised, and the file (the figure's bytes) is a PNG of one pixel."""
     import numpy as np
 
     np.ravel(ax)[0].figure.draw_without_rendering()
-    Path(path).write_bytes(_one_pixel_png())
-    return path
+    file.write(_one_pixel_png())
+    return file
 
 
 @contextlib.contextmanager

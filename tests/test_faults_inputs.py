@@ -247,14 +247,16 @@ def test_a_unicode_folder_under_the_c_locale_with_an_unusable_home(tmp_path):
 
 
 def test_matplotlib_gets_a_folder_and_the_environment_is_as_it_was(tmp_path):
-    """With HOME unusable, importing foldopt's figures gives matplotlib foldopt's cache folder for
-    its configuration and fonts (it reads MPLCONFIGDIR once, as it is imported) and leaves the
-    process's environment as it was: no MPLCONFIGDIR behind the caller's back."""
+    """With HOME unusable, loading matplotlib for foldopt's figures (as the first figure drawn
+    does) gives it foldopt's cache folder for its configuration and fonts (it reads MPLCONFIGDIR
+    once, as it is imported) and leaves the process's environment as it was: no MPLCONFIGDIR
+    behind the caller's back."""
     (tmp_path / "a-file").write_text("")
     cache = tmp_path / "cache"
     env = foldopt_env(HOME=str(tmp_path / "a-file" / "home"), XDG_CONFIG_HOME=None, XDG_CACHE_HOME=None,
                       MPLCONFIGDIR=None, FOLDOPT_CACHE_DIR=str(cache))
-    code = ("import os; before = dict(os.environ); import foldopt.output.figures, matplotlib; "
+    code = ("import os; before = dict(os.environ); from foldopt.output.figures import canvas; "
+            "canvas.load_matplotlib(); import matplotlib; "
             "print(dict(os.environ) == before, matplotlib.get_configdir(), matplotlib.get_cachedir())")
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
                           timeout=TIMEOUT)

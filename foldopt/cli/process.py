@@ -50,8 +50,23 @@ def loading():
             gc.enable()
 
 
-def ending() -> None:
-    """Before the command line's own process exits: every object frozen, so that the exit's passes
-    of the collector walk none (the process's memory goes back whole); elsewhere nothing."""
+def drawing_aside() -> None:
+    """In the command line's own process, a command that will draw figures has them drawn by
+    worker processes beside it (:func:`foldopt.output.drawing.start`, where a core is to spare:
+    :func:`~foldopt.output.drawing.workers`); elsewhere they are drawn in the caller's process.
+    Called before the command's work starts a thread (its progress bar)."""
     if _OWN["process"]:
+        from foldopt.output import drawing
+
+        drawing.start(drawing.workers())
+
+
+def ending() -> None:
+    """Before the command line's own process exits: its figure workers ended
+    (:func:`foldopt.output.drawing.stop`) and every object frozen, so that the exit's passes of
+    the collector walk none (the process's memory goes back whole); elsewhere nothing."""
+    if _OWN["process"]:
+        from foldopt.output import drawing
+
+        drawing.stop()
         gc.freeze()

@@ -20,7 +20,7 @@ from foldopt.cli.options import (
     study_argument,
 )
 from foldopt.cli.output import INVOCATION, Output, fail
-from foldopt.cli.process import loading
+from foldopt.cli.process import drawing_aside, loading
 from foldopt.errors import ConfigError
 from foldopt.files import check_output
 from foldopt.names import DEFAULT_ENGINE
@@ -58,12 +58,13 @@ def run_request(
         days = plan.n_cases // max(len(dict(plan.axes).get("p_load", (1,))), 1)
         unit = "site-days" if any(path.startswith("site") for path, _ in plan.axes) else "days"
         label, total = f"{base.name}: {days} {unit}", days
+    # The studies' modules (pvlib, pandas, numba) only once there is work: help and a bad value stay
+    # quick. The figure workers fork then, with those modules and before the progress bar's thread.
+    with loading():
+        from foldopt.api import run
+        from foldopt.studies.day import StudyResult
+    drawing_aside()
     with output.progress(label, total=total, unit=unit) as progress:
-        # The studies' modules (pvlib, pandas, numba) only once there is work: help and a bad value stay quick.
-        with loading():
-            from foldopt.api import run
-            from foldopt.studies.day import StudyResult
-
         try:
             result = run(engine=engine, progress=progress, request=request)
         except (
@@ -84,8 +85,9 @@ def run_request(
 
 
 def write_folder(result, out: Path, overwrite: bool) -> None:
-    """Write a result's folder (:func:`foldopt.api.write`), its writers' modules (matplotlib,
-    jinja2) loaded first (:func:`foldopt.cli.process.loading`).
+    """Write a result's folder (:func:`foldopt.api.write`), its writers' modules (jinja2, and
+    matplotlib where the figures are drawn in this process) loaded first
+    (:func:`foldopt.cli.process.loading`).
 
     Parameters
     ----------
@@ -96,7 +98,9 @@ def write_folder(result, out: Path, overwrite: bool) -> None:
     """
     with loading():
         from foldopt.api import write
-        from foldopt.output import folders  # noqa: F401 - what write imports when it writes
+        from foldopt.output import drawing, folders  # noqa: F401 - what write imports
+
+        drawing.prepare()
     write(result, out, overwrite, INVOCATION)
 
 

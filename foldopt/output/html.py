@@ -20,6 +20,7 @@ import pandas as pd
 from jinja2 import Environment, PackageLoader, StrictUndefined
 
 from foldopt.files import write_atomically
+from foldopt.output import drawing
 
 #: Rows of a table that a page shows; the CSV beside it has them all.
 MAX_ROWS = 2000
@@ -96,7 +97,8 @@ def write_html(
     Parameters
     ----------
     folder : pathlib.Path
-        The results folder; ``figures`` are PNG files in it.
+        The results folder; ``figures`` are PNG files in it, those drawn by figure workers
+        written first (:func:`foldopt.output.drawing.written`).
     answer : foldopt.Answer
         The question, the answer's lines (the terminal's words, notes included), its near-optimal
         range and re-fold schedule (and with ``designs`` its designs compared), first on the page.
@@ -117,6 +119,7 @@ def write_html(
         The page written.
     """
     folder = Path(folder)
+    drawing.written()
     page = _TEMPLATES.get_template("report.html.j2").render(
         title=f"foldopt: {answer.title}",
         question=list(answer.question.items()),

@@ -7,92 +7,32 @@
 ``FIGURES``: file name -> the plot function and what it shows. :data:`FIGURES` gathers them: every
 figure file a results folder can hold, the one list the folder writers draw through
 (:func:`write_figure`) and the manual's table (:func:`rst_table`, ``python -m
-foldopt.output.figures``). Importing this package chooses no backend: files are drawn on bare
-:class:`matplotlib.figure.Figure` objects (:func:`~foldopt.output.figures.canvas.for_files`). It
-may import :mod:`foldopt.studies` and everything below it.
+foldopt.output.figures``). Importing this package chooses no backend and loads no matplotlib
+(the first figure made does: :func:`~foldopt.output.figures.canvas.load_matplotlib`): files are
+drawn on bare :class:`matplotlib.figure.Figure` objects
+(:func:`~foldopt.output.figures.canvas.for_files`), wherever :mod:`foldopt.output.drawing` has
+them drawn. It may import :mod:`foldopt.studies` and everything below it.
 """
 
 from __future__ import annotations
 
-import atexit
-import os
-import shutil
-import tempfile
-from contextlib import contextmanager
+import io
 from pathlib import Path
 
-from foldopt.cache import cache_dir
-from foldopt.files import write_atomically
-
-
-def _writable(folder: Path) -> bool:
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        return False
-    return folder.is_dir() and os.access(folder, os.W_OK)
-
-
-def _matplotlib_folder() -> Path | None:
-    """A writable folder for matplotlib's configuration and font cache where its own under HOME
-    is not (HOME read-only, missing or no folder), or None where it is or ``MPLCONFIGDIR`` names
-    one: matplotlib would warn on stderr, which ``--quiet`` keeps empty. foldopt's cache folder
-    where it is writable (the font cache is then kept), else a temporary folder removed at exit."""
-    if os.environ.get("MPLCONFIGDIR"):
-        return None
-    try:
-        own = [
-            Path(os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config") / "matplotlib",
-            Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "matplotlib",
-        ]
-    except RuntimeError:  # no home folder at all
-        own = []
-    if own and all(_writable(folder) for folder in own):
-        return None
-    try:
-        folder = cache_dir() / "matplotlib"
-    except RuntimeError:
-        folder = None
-    if folder is None or not _writable(folder):
-        folder = Path(tempfile.mkdtemp(prefix="foldopt-matplotlib-"))
-        atexit.register(shutil.rmtree, folder, ignore_errors=True)
-    return folder
-
-
-@contextmanager
-def _matplotlib_imported():
-    """matplotlib imported and its folders chosen (:func:`_matplotlib_folder`), which it does once,
-    reading ``MPLCONFIGDIR``: the variable is set for that moment only, and the environment is the
-    caller's again after (the one write of foldopt's to the environment, undone at once)."""
-    folder = _matplotlib_folder()
-    if folder is not None:
-        os.environ["MPLCONFIGDIR"] = str(folder)
-    try:
-        import matplotlib
-
-        matplotlib.get_configdir(), matplotlib.get_cachedir()  # each read once, then kept
-        yield
-    finally:
-        if folder is not None:
-            del os.environ["MPLCONFIGDIR"]
-
-
-# Every figure module imports matplotlib, and Python runs this package's __init__ before any of
-# them: its folders are chosen before anything draws.
-with _matplotlib_imported():
-    from foldopt.output.figures import (
-        annual,
-        day,
-        horizon,
-        landscape,
-        least_cost,
-        sizing,
-        storage,
-        sweep,
-        weather,
-        world,
-    )
-    from foldopt.output.figures.canvas import for_files, save_plot
+from foldopt.output import drawing
+from foldopt.output.figures import (
+    annual,
+    day,
+    horizon,
+    landscape,
+    least_cost,
+    sizing,
+    storage,
+    sweep,
+    weather,
+    world,
+)
+from foldopt.output.figures.canvas import for_files, save_plot
 
 #: Every figure file a results folder can hold -> :class:`~foldopt.output.figures.canvas.FigureFile`
 #: (its plot function and what it shows), by kind of result.
@@ -111,11 +51,9 @@ FIGURES = {
 
 
 def write_figure(folder: Path, file: str, *args, **kwargs) -> str:
-    """Draw the figure ``file`` with its plot function (:data:`FIGURES`) and write it in ``folder``.
-
-    The figure is a bare :class:`matplotlib.figure.Figure` (no pyplot, no backend), laid out by
-    its entry's margins and saved by :func:`~foldopt.output.figures.canvas.save_plot` under a
-    temporary name, then renamed into place (:func:`foldopt.files.write_atomically`).
+    """Have the figure ``file`` drawn (:func:`figure_bytes`) and written in ``folder``: here and now,
+    or by the command line's figure workers, whose files its writer collects before
+    ``report.html`` (:mod:`foldopt.output.drawing`).
 
     Parameters
     ----------
@@ -131,13 +69,34 @@ def write_figure(folder: Path, file: str, *args, **kwargs) -> str:
     str
         ``file``.
     """
+    drawing.draw(Path(folder) / file, figure_bytes, file, args, kwargs)
+    return file
+
+
+def figure_bytes(file: str, args: tuple, kwargs: dict) -> bytes:
+    """The figure file ``file`` drawn by its plot function (:data:`FIGURES`): a bare
+    :class:`matplotlib.figure.Figure` (no pyplot, no backend), laid out by its entry's margins and
+    saved by :func:`~foldopt.output.figures.canvas.save_plot` in the file's format.
+
+    Parameters
+    ----------
+    file : str
+        A file name of :data:`FIGURES`.
+    args : tuple
+    kwargs : dict
+        The plot function's arguments, but ``ax``.
+
+    Returns
+    -------
+    bytes
+        The file's content.
+    """
     figure = FIGURES[file]
     with for_files():
         ax = figure.plot(*args, **kwargs)
-    write_atomically(
-        Path(folder) / file, lambda temporary: save_plot(ax, temporary, figure.margins)
-    )
-    return file
+    image = io.BytesIO()
+    save_plot(ax, image, figure.margins, file_format=Path(file).suffix[1:])
+    return image.getvalue()
 
 
 def rst_table() -> str:

@@ -4,7 +4,6 @@ re-fold visit is worth."""
 
 from __future__ import annotations
 
-import matplotlib
 import numpy as np
 import pandas as pd
 
@@ -48,6 +47,8 @@ def plot_annual_fold_angles(by_angle: pd.DataFrame, title: str, study=None, ax=N
     matplotlib.axes.Axes
     """
     fig, ax = new_axes(ax, (7, 4.5))
+    import matplotlib  # loaded by new_axes
+
     colours = matplotlib.colormaps["viridis"](np.linspace(0, 0.85, 8))
     for (load, rows), colour in zip(by_angle.groupby("p_load_w"), colours, strict=False):
         ax.plot(
@@ -237,6 +238,8 @@ def plot_day_hour(extras: dict, key: str, title: str, label: str, ax=None):
     fig, ax = new_axes(ax, (9, 4.5))
     ax.set_facecolor("0.85")
     if key == "switch_state":
+        import matplotlib  # loaded by new_axes
+
         cmap = matplotlib.colors.ListedColormap(
             ["0.15", "tab:orange", "tab:purple", "tab:green", "tab:brown"]
         )
@@ -275,6 +278,8 @@ def plot_refold_value(values: pd.DataFrame, title: str, study=None, ax=None):
     matplotlib.axes.Axes
     """
     fig, ax = new_axes(ax, (7, 4.5))
+    import matplotlib  # loaded by new_axes
+
     first = values[
         (values["latitude"] == values["latitude"].iloc[0])
         & (values["longitude"] == values["longitude"].iloc[0])

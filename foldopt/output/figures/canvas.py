@@ -14,15 +14,89 @@ otherwise ``tight_layout``, which measures every label once more before the draw
 
 from __future__ import annotations
 
+import atexit
 import contextvars
+import os
+import shutil
+import tempfile
 from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
+
+from foldopt.cache import cache_dir
+
+
+def _writable(folder: Path) -> bool:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return False
+    return folder.is_dir() and os.access(folder, os.W_OK)
+
+
+def _matplotlib_folder() -> Path | None:
+    """A writable folder for matplotlib's configuration and font cache where its own under HOME
+    is not (HOME read-only, missing or no folder), or None where it is or ``MPLCONFIGDIR`` names
+    one: matplotlib would warn on stderr, which ``--quiet`` keeps empty. foldopt's cache folder
+    where it is writable (the font cache is then kept), else a temporary folder removed at exit."""
+    if os.environ.get("MPLCONFIGDIR"):
+        return None
+    try:
+        own = [
+            Path(os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config") / "matplotlib",
+            Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "matplotlib",
+        ]
+    except RuntimeError:  # no home folder at all
+        own = []
+    if own and all(_writable(folder) for folder in own):
+        return None
+    try:
+        folder = cache_dir() / "matplotlib"
+    except RuntimeError:
+        folder = None
+    if folder is None or not _writable(folder):
+        folder = Path(tempfile.mkdtemp(prefix="foldopt-matplotlib-"))
+        atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    return folder
+
+
+@contextmanager
+def _matplotlib_imported():
+    """matplotlib imported and its folders chosen (:func:`_matplotlib_folder`), which it does once,
+    reading ``MPLCONFIGDIR``: the variable is set for that moment only, and the environment is the
+    caller's again after (the one write of foldopt's to the environment, undone at once)."""
+    folder = _matplotlib_folder()
+    if folder is not None:
+        os.environ["MPLCONFIGDIR"] = str(folder)
+    try:
+        import matplotlib
+
+        matplotlib.get_configdir(), matplotlib.get_cachedir()  # each read once, then kept
+        yield
+    finally:
+        if folder is not None:
+            del os.environ["MPLCONFIGDIR"]
+
+
+def load_matplotlib() -> None:
+    """Import what a figure file is drawn with (matplotlib, its bare Figure and Agg canvas), its
+    folders chosen (:func:`_matplotlib_imported`): the first figure made does, and a figure worker
+    as it starts (:mod:`foldopt.output.drawing`). Importing the figure modules loads no
+    matplotlib, so that a process that has its figures drawn elsewhere never does."""
+    if _LOADED["matplotlib"]:  # its folders are chosen once, as matplotlib reads them
+        return
+    with _matplotlib_imported():
+        import matplotlib.backends.backend_agg  # noqa: F401
+        import matplotlib.figure  # noqa: F401
+    _LOADED["matplotlib"] = True
+
+
+#: Whether :func:`load_matplotlib` has loaded matplotlib in this process.
+_LOADED = {"matplotlib": False}
+
 
 #: Dots per inch of a figure file.
 DPI = 110
@@ -101,7 +175,11 @@ def new_axes(
     """
     if ax is not None:
         return ax.figure, ax
+    load_matplotlib()
     if _FOR_FILES.get():
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
         fig = Figure(figsize=figsize, dpi=DPI)
         FigureCanvasAgg(fig)
         return fig, fig.subplots(nrows, ncols, squeeze=squeeze)
@@ -110,21 +188,23 @@ def new_axes(
     return plt.subplots(nrows, ncols, figsize=figsize, squeeze=squeeze)
 
 
-def save_plot(ax, path: Path, margins: Margins | None = None) -> Path:
+def save_plot(ax, path, margins: Margins | None = None, file_format: str | None = None):
     """Save the figure that holds ``ax`` as the file ``path`` (:data:`DPI`) and close it.
 
     Parameters
     ----------
     ax : matplotlib.axes.Axes or array of Axes
         An Axes of the figure, as the ``plot_*`` functions return it.
-    path : pathlib.Path
-        The file; its suffix gives the format (``.png``).
+    path : pathlib.Path or file object
+        The file; a path's suffix gives the format (``.png``) where ``file_format`` does not.
     margins : Margins, optional
         A fixed layout; default a tight layout.
+    file_format : str, optional
+        The format (``png``...).
 
     Returns
     -------
-    pathlib.Path
+    pathlib.Path or file object
         ``path``.
     """
     fig = np.ravel(ax)[0].figure
@@ -138,7 +218,7 @@ def save_plot(ax, path: Path, margins: Margins | None = None) -> Path:
             bottom=margins.bottom / height,
             top=1 - margins.top / height,
         )
-    fig.savefig(path, dpi=DPI)
+    fig.savefig(path, dpi=DPI, format=file_format)
     if fig.canvas.manager is not None:  # a pyplot figure: pyplot keeps it until it is closed
         import matplotlib.pyplot as plt
 

@@ -1,0 +1,308 @@
+"""The command line's figure workers (:mod:`foldopt.output.drawing`, issue 49): the command line's
+own process on more than one core has its figures drawn by worker processes beside it, and what
+it writes and says is what it writes and says when it draws them itself (one core, or a caller in
+its own process): the same bytes, the same error and exit code with nothing written, no worker
+left once the command ends, however it ends.
+
+Each command runs in a fresh interpreter that runs the command line as the ``foldopt`` script
+does (:data:`PROBE`), on the cores it is given (``os.sched_setaffinity``): one core draws in the
+command's process, two in the workers. The probe records the process that drew each figure.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.figure_pixels
+
+CORES = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
+needs_two_cores = pytest.mark.skipif(
+    sys.platform != "linux" or len(CORES) < 2, reason="the workers need Linux and two cores"
+)
+
+#: Runs the command line as the script does. Each figure drawn appends the drawing process's id
+#: to the file ``drawn`` (by the module's one drawing function, wrapped), after ``slow`` seconds;
+#: with ``fail`` set, the figure of that name raises. As it ends it prints its id and whether it
+#: imported matplotlib.
+PROBE = r"""
+import atexit, json, os, runpy, sys, time
+
+import foldopt.output.figures as figures
+from foldopt.output.figures.canvas import FigureFile
+
+drawn, fail, slow, workers, args = json.loads(sys.argv[1])
+if workers is not None:  # as many as the cores, however busy the machine is
+    from foldopt.output import drawing
+
+    drawing.workers = lambda: workers
+draw = figures.figure_bytes
+
+
+def recorded(file, args, kwargs):
+    time.sleep(slow)
+    with open(drawn, "a") as log:
+        log.write(f"{os.getpid()}\n")
+    return draw(file, args, kwargs)
+
+
+def failing(*args, **kwargs):
+    raise ValueError("a figure that cannot be drawn\nits second line")
+
+
+# A worker finds the function by its name, as it finds the one it stands for.
+recorded.__module__, recorded.__qualname__ = figures.__name__, "figure_bytes"
+figures.figure_bytes = recorded
+if fail:
+    figures.FIGURES[fail] = FigureFile(failing, "fails")
+atexit.register(lambda: print(json.dumps([os.getpid(), "matplotlib" in sys.modules])))
+sys.argv = ["foldopt", *args]
+runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
+"""
+
+
+def _command(
+    args, folder: Path, fail: str | None = None, slow: float = 0, workers: int | None = None
+) -> list[str]:
+    """The probe's command line for ``foldopt args`` in ``folder``, with ``workers`` workers
+    where given (else :func:`foldopt.output.drawing.workers`'s)."""
+    payload = [str(folder / "drawn"), fail, slow, workers, args]
+    return [sys.executable, "-c", PROBE, json.dumps(payload)]
+
+
+def _on(cores: int):
+    """A child's start on the first ``cores`` cores, with Ctrl-C at its default (a pytest-xdist
+    worker may hold it ignored, which a child keeps)."""
+
+    def start():
+        os.sched_setaffinity(0, CORES[:cores])
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+    return start
+
+
+def _run(args, folder: Path, cores: int, fail: str | None = None):
+    """Run ``foldopt args`` in ``folder`` on ``cores`` cores: (exit code, stdout lines but the
+    probe's, stderr, the command's process id, whether it imported matplotlib, the ids of the
+    processes that drew the figures)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    done = subprocess.run(
+        # One core: workers() says none; two: two, however busy the machine.
+        _command(args, folder, fail, workers=None if cores == 1 else 2),
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        preexec_fn=_on(cores),
+    )
+    lines = done.stdout.splitlines()
+    pid, matplotlib = json.loads(lines[-1])
+    drawn = folder / "drawn"
+    drawers = [int(line) for line in drawn.read_text().split()] if drawn.exists() else []
+    drawn.unlink(missing_ok=True)
+    return done.returncode, lines[:-1], done.stderr, pid, matplotlib, drawers
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {path.name: path.read_bytes() for path in sorted(folder.iterdir())}
+
+
+@needs_two_cores
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["run", "-q"],
+        ["run", "configs/camera-buffer.yaml"],
+        ["sweep", "angle", "--step-min", "10", "--format", "json"],
+    ],
+)
+def test_the_workers_write_the_bytes_the_command_draws_itself(tmp_path, args):
+    """Every file (PNG, CSV, run.json, report.html) and what the command prints are the same
+    whether the figures are drawn by the workers (two cores: drawn in other processes than the
+    command's, which never imports matplotlib) or by the command itself (one core)."""
+    repository = Path(__file__).resolve().parents[1]
+    seen = {}
+    for cores in (1, 2):
+        folder = tmp_path / str(cores)
+        folder.mkdir()
+        (folder / "configs").symlink_to(repository / "configs")
+        code, lines, stderr, pid, matplotlib, drawers = _run([*args, "--out", "out"], folder, cores)
+        assert code == 0, stderr
+        assert drawers and (set(drawers) == {pid}) is (cores == 1)
+        assert matplotlib is (cores == 1)
+        seen[cores] = (lines, stderr, _files(folder / "out"))
+    assert any(name.endswith(".png") for name in seen[1][2])
+    assert seen[1] == seen[2]
+
+
+@needs_two_cores
+def test_a_figure_that_fails_fails_the_command_as_it_does_without_workers(tmp_path):
+    """A figure that raises in a worker ends the command with the one line and the exit code it
+    ends with when the command draws it itself, and nothing is written: no folder, no staging
+    folder, nothing beside."""
+    said = {}
+    for cores in (1, 2):
+        folder = tmp_path / str(cores)
+        code, lines, stderr, pid, _, drawers = _run(
+            ["run", "--out", "out"], folder, cores, fail="switching.png"
+        )
+        assert sorted(path.name for path in folder.iterdir()) == []
+        said[cores] = (code, stderr)
+        assert lines[0].startswith("shin2015: ")  # the answer, printed before the figures
+    assert said[1] == said[2]
+    code, stderr = said[2]
+    assert code == 1 and stderr.splitlines() == [
+        "error: internal error (ValueError: a figure that cannot be drawn); run again as "
+        "foldopt --debug ... for the traceback, and please report it"
+    ]
+
+
+def _children(pid: int) -> set[int]:
+    """The ids of the live processes whose parent is ``pid``."""
+    found = set()
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                status = (entry / "status").read_text()
+            except OSError:
+                continue
+            fields = dict(line.split(":\t", 1) for line in status.splitlines() if ":\t" in line)
+            if fields.get("PPid", "").strip() == str(pid) and not fields["State"].startswith("Z"):
+                found.add(int(entry.name))
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return (
+            not (Path("/proc") / str(pid) / "status")
+            .read_text()
+            .split("State:\t")[1]
+            .startswith("Z")
+        )
+    except (OSError, IndexError):
+        return False
+
+
+def _workers_of(process: subprocess.Popen) -> set[int]:
+    """The command's workers, once it has them all (within a minute): its child, and the one that
+    child forks once it has imported matplotlib."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and process.poll() is None:
+        for first in _children(process.pid):
+            others = _children(first)
+            if others:
+                return {first, *others}
+        time.sleep(0.01)
+    raise AssertionError("the command forked no workers")
+
+
+def _gone(workers: set[int], within: float = 10) -> bool:
+    deadline = time.monotonic() + within
+    while any(_alive(pid) for pid in workers):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.02)
+    return True
+
+
+@needs_two_cores
+@pytest.mark.parametrize("ending", ["completes", signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
+def test_no_worker_outlives_the_command(tmp_path, ending):
+    """Whether the command completes, is interrupted (Ctrl-C), terminated or killed while its
+    workers draw, they end with it; an interrupted or terminated command says so as it does
+    without workers and leaves no folder."""
+    # Its output to files, not pipes: a worker left behind would hold a pipe open.
+    with open(tmp_path / "stdout", "w") as stdout, open(tmp_path / "stderr", "w") as stderr:
+        process = subprocess.Popen(
+            # A command still drawing when the signal comes: each figure takes a minute more.
+            _command(
+                ["run", "--out", "out"],
+                tmp_path,
+                slow=0 if ending == "completes" else 60,
+                workers=2,
+            ),
+            cwd=tmp_path,
+            stdout=stdout,
+            stderr=stderr,
+            preexec_fn=_on(2),
+        )
+    workers = set()
+    try:
+        workers = _workers_of(process)
+        if ending != "completes":
+            process.send_signal(ending)
+        process.wait(timeout=300)
+        assert _gone(workers), "a worker outlived the command"
+    finally:
+        for pid in (process.pid, *workers):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        process.wait()
+    stderr = (tmp_path / "stderr").read_text()
+    if ending == "completes":
+        assert process.returncode == 0 and (tmp_path / "out" / "report.html").is_file(), stderr
+    elif ending == signal.SIGINT:
+        assert (process.returncode, stderr) == (130, "interrupted\n")
+    else:
+        assert process.returncode in (-ending, 128 + ending)
+    if ending != "completes":
+        assert not (tmp_path / "out").exists()
+
+
+def test_an_in_process_caller_draws_in_its_own_process(tmp_path, monkeypatch):
+    """A command run in the caller's process (a test's CliRunner, as a notebook would call it)
+    starts no worker: every figure is drawn in the caller's process."""
+    from typer.testing import CliRunner
+
+    import foldopt.output.figures as figures
+    from foldopt.cli.app import app
+    from foldopt.output import drawing
+
+    drawers = []
+    draw = figures.figure_bytes
+
+    def recorded(file, args, kwargs):
+        drawers.append(os.getpid())
+        return draw(file, args, kwargs)
+
+    monkeypatch.setattr(figures, "figure_bytes", recorded)
+    done = CliRunner().invoke(app, ["run", "--out", str(tmp_path / "out"), "-q"])
+    assert done.exit_code == 0, done.output
+    assert drawers == [os.getpid()] * 5
+    assert drawing._POOL["leader"] is None
+    assert sorted(path.name for path in (tmp_path / "out").glob("*.png")) == sorted(
+        figures.day.FIGURES
+    )
+
+
+@pytest.mark.parametrize(
+    ("platform", "cores", "load", "expected"),
+    [
+        ("linux", {0}, 0.0, 0),
+        ("linux", {0, 1}, 0.5, 2),
+        ("linux", {0, 1}, 3.0, 2),
+        ("linux", {0, 1}, 3.5, 0),
+        ("linux", set(range(8)), 3.0, 2),
+        ("darwin", {0, 1}, 0.0, 0),
+    ],
+)
+def test_workers_where_a_core_is_to_spare(monkeypatch, platform, cores, load, expected):
+    """Workers only on Linux, with more than one core to run on and a machine no busier than its
+    cores and the command (the last minute's load), at most two."""
+    from foldopt.output import drawing
+
+    monkeypatch.setattr(drawing.sys, "platform", platform)
+    monkeypatch.setattr(drawing.os, "sched_getaffinity", lambda pid: cores, raising=False)
+    monkeypatch.setattr(drawing.os, "cpu_count", lambda: max(len(cores), 2))
+    monkeypatch.setattr(drawing.os, "getloadavg", lambda: (load, load, load))
+    assert drawing.workers() == expected
