@@ -298,24 +298,33 @@ def _localised(naive: np.ndarray, zone: zoneinfo.ZoneInfo) -> tuple[np.ndarray, 
         reads it [ns since 1970-01-01 00:00 local] (a skipped clock time moved forward).
     """
     utc, local = np.empty_like(naive), naive.copy()
+    # A day's one offset (or None), once a day: a sweep repeats its dates at every site of a zone.
+    day_offsets: dict[int, int | None] = {}
     for row, times in enumerate(naive):
         midnight = int(times[0]) // _NS_PER_DAY * _NS_PER_DAY
-        # The offsets at each whole hour of the day, both sides of any fold: one offset for all
-        # of them is a day with no transition (zones change their clocks on whole hours or half
-        # hours, at most once in an hour), whose steps are one subtraction.
-        hours = {
-            _offset_ns(zone.utcoffset(_wall(midnight + hour * NS_PER_HOUR, fold)))
-            for hour in range(25)
-            for fold in (0, 1)
-        }
-        if len(hours) == 1:
-            utc[row] = times - hours.pop()
+        if midnight not in day_offsets:
+            day_offsets[midnight] = _day_offset(midnight, zone)
+        if day_offsets[midnight] is not None:
+            utc[row] = times - day_offsets[midnight]
             continue
         utc[row] = [_localised_step(int(t), zone) for t in times]
         local[row] = utc[row] + [
             _offset_s(zone, int(t) // 1_000_000_000) * 1_000_000_000 for t in utc[row]
         ]
     return utc, local
+
+
+def _day_offset(midnight: int, zone: zoneinfo.ZoneInfo) -> int | None:
+    """The UTC offset [ns] of a local day [its midnight, ns since 1970-01-01 00:00 local] in which
+    the zone's clocks do not change, None where they do: the offsets at each whole hour of the
+    day, both sides of any fold, are one offset on a day with no transition (zones change their
+    clocks on whole hours or half hours, at most once in an hour)."""
+    hours = {
+        _offset_ns(zone.utcoffset(_wall(midnight + hour * NS_PER_HOUR, fold)))
+        for hour in range(25)
+        for fold in (0, 1)
+    }
+    return hours.pop() if len(hours) == 1 else None
 
 
 def _localised_step(local_ns: int, zone: zoneinfo.ZoneInfo) -> int:
