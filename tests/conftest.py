@@ -43,6 +43,21 @@ def shin_study():
     return load_study(default_study_path())
 
 
+def _every_process_imports_this_foldopt() -> None:
+    """Put the foldopt this suite imports (a checkout's, or an install's) first on the
+    ``PYTHONPATH`` of every process a test starts (command lines, the warm-up, Sphinx, Dask's
+    workers). A process started in another folder would otherwise import the installed copy, which
+    on a fresh clone (``.ci/run`` installs with ``pip install .``) is another set of source files:
+    numba's cache is kept per source file, and each such process compiled the kernel again for
+    itself (some 30 s of CPU each), and tested other files than the suite's."""
+    import foldopt
+
+    here = str(Path(foldopt.__file__).resolve().parent.parent)
+    paths = [path for path in os.environ.get("PYTHONPATH", "").split(os.pathsep) if path]
+    if paths[:1] != [here]:
+        os.environ["PYTHONPATH"] = os.pathsep.join([here, *paths])
+
+
 def pytest_configure(config):
     # Electrical tables are cached on disk; tests keep theirs in pytest's own cache folder (kept
     # between runs, ignored by git) rather than in the user's ~/.cache.
@@ -55,6 +70,7 @@ def pytest_configure(config):
         # bytecode of its own runs, in the __pycache__ folders git ignores, as Python does by default.
         sys.dont_write_bytecode = False
         os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+    _every_process_imports_this_foldopt()
     if hasattr(config, "workerinput") and "numba" not in sys.modules:
         # Each pytest-xdist worker has a core of its own: numba's threads (OpenMP, which spins while
         # it waits) and OpenBLAS's would fight the other worker for it. One thread each, here and in
@@ -138,14 +154,10 @@ def _start_the_warm_up(config) -> None:
     free before the process has it); the workers learn the folder from :data:`WARM_UP`."""
     if fcntl is None:
         return
-    import foldopt
-
     folder = Path(tempfile.mkdtemp(prefix="foldopt-warm-up-"))
     os.environ[WARM_UP] = str(folder)
-    # The foldopt the suite imports (a checkout's or an install's): numba's cache is per source file.
-    path = [str(Path(foldopt.__file__).parent.parent), *filter(None, [os.environ.get("PYTHONPATH")])]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(path), "NUMBA_NUM_THREADS": "1",
-           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    # The suite's foldopt is on PYTHONPATH (_every_process_imports_this_foldopt).
+    env = {**os.environ, "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
     for part, code in WARM_UP_PARTS.items():
         with open(folder / f"{part}.lock", "w") as lock, open(folder / f"{part}.log", "w") as log:
             fcntl.flock(lock, fcntl.LOCK_EX)

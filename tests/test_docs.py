@@ -8,7 +8,6 @@ from __future__ import annotations
 import csv
 import filecmp
 import html
-import os
 import re
 import shutil
 import subprocess
@@ -34,20 +33,15 @@ PAGES = ("index", "quickstart", "cli", "study-file", "outputs", "api", "reproduc
 @pytest.fixture(scope="session")
 def built(tmp_path_factory):
     """The HTML manual, built from a copy of docs/ with the working folder outside the source tree,
-    by the foldopt the suite tests: a copy installed elsewhere (``.ci/run``'s ``pip install .``)
-    would be another source to numba, whose cache is per source file, and the build compiled the
-    kernel again for its examples (40 s of CPU time on a fresh clone)."""
+    by the foldopt the suite tests (on every started process's ``PYTHONPATH``: tests/conftest.py)."""
     pytest.importorskip("sphinx")
     pytest.importorskip("numpydoc")
-    import foldopt
 
     work = tmp_path_factory.mktemp("docs")
     shutil.copytree(ROOT / "docs", work / "docs", ignore=shutil.ignore_patterns("_build", "generated"))
-    path = [str(Path(foldopt.__file__).parent.parent), *filter(None, [os.environ.get("PYTHONPATH")])]
     result = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
                              "-d", str(work / "doctrees"), str(work / "docs"), str(work / "html")],
-                            cwd=work, capture_output=True, text=True, timeout=900,
-                            env={**os.environ, "PYTHONPATH": os.pathsep.join(path)})
+                            cwd=work, capture_output=True, text=True, timeout=900)
     assert result.returncode == 0, result.stderr[-3000:]
     return work / "html"
 
