@@ -181,3 +181,15 @@ def test_a_fold_angle_grid_too_fine_is_refused_at_once(tmp_path, monkeypatch, ar
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and all(word in lines[0] for word in words) and "(line" not in lines[0], result.output
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("value", ["-1", "200", "abc", "0", "true"])
+def test_a_fold_angle_step_out_of_range_is_one_line_naming_the_step(tmp_path, monkeypatch, value):
+    # A step given alone starts the grid at the step; a bad one was refused twice, the second time
+    # as a start the user never gave ("fold_angles.start = -1").
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["run", "--set", f"fold_angles.step={value}", "--out", "out"])
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: fold_angles.step = "), result.output
+    assert list(tmp_path.iterdir()) == []

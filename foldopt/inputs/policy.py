@@ -173,6 +173,17 @@ def _varied(optimize) -> list[str]:
         return []
 
 
+def _angle(value) -> bool:
+    """Whether ``value`` is a fold angle step a grid can start at: a number in (0, 180] deg (YAML
+    reads ``1e-9`` as a string, which the study's field reads as a number)."""
+    if isinstance(value, bool):
+        return False
+    try:
+        return 0 < float(value) <= FLAT_FOLD_ANGLE
+    except (TypeError, ValueError):
+        return False
+
+
 def _source(weather) -> bool:
     """Whether a ``weather`` change names a source (fetched for the site), not a file."""
     return isinstance(weather, dict) and weather.get("source") is not None
@@ -298,8 +309,14 @@ def apply(data: dict, changes: dict, axis_field: str | None = None) -> tuple[dic
     if "tracker.model" in given:
         tracker = _section(data, "tracker")
         data["tracker"] = {key: tracker[key] for key in ("standby_w",) if key in tracker}
-    if "fold_angles.step" in given and "fold_angles.start" not in given:
-        step = changes["fold_angles.step"]
+    step = changes.get("fold_angles.step")
+    if (
+        "fold_angles.step" in given
+        and "fold_angles.start" not in given
+        and (_angle(step) or not is_single(step))
+    ):
+        # A single step out of range is refused as the step alone, not again as the start it
+        # would give.
         data["fold_angles"] = {
             "start": step,
             "stop": changes.get("fold_angles.stop", FLAT_FOLD_ANGLE),
