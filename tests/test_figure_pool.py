@@ -306,3 +306,18 @@ def test_workers_where_a_core_is_to_spare(monkeypatch, platform, cores, load, ex
     monkeypatch.setattr(drawing.os, "cpu_count", lambda: max(len(cores), 2))
     monkeypatch.setattr(drawing.os, "getloadavg", lambda: (load, load, load))
     assert drawing.workers() == expected
+
+
+def test_no_workers_where_the_kernel_gives_no_process_file_descriptors(monkeypatch):
+    """A kernel before Linux 5.3 has no pidfd_open, by which the command sees a worker end: the
+    figures are drawn in the command's process, as on one core."""
+    from foldopt.output import drawing
+
+    def unsupported(pid, flags=0):
+        raise OSError(38, "Function not implemented")
+
+    monkeypatch.setattr(drawing.sys, "platform", "linux")
+    monkeypatch.setattr(drawing.os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    monkeypatch.setattr(drawing.os, "getloadavg", lambda: (0.0, 0.0, 0.0))
+    monkeypatch.setattr(drawing.os, "pidfd_open", unsupported, raising=False)
+    assert drawing.workers() == 0

@@ -58,12 +58,22 @@ def workers() -> int:
     -------
     int
     """
-    if sys.platform != "linux":
+    if sys.platform != "linux" or not _pidfd_works():
         return 0
     cores = len(os.sched_getaffinity(0))
     if cores < 2 or os.getloadavg()[0] > os.cpu_count() + 1:
         return 0
     return min(cores, MAX_WORKERS)
+
+
+def _pidfd_works() -> bool:
+    """Whether the kernel gives process file descriptors (Linux 5.3 and later), by which the
+    command sees a worker end (:func:`written`)."""
+    try:
+        os.close(os.pidfd_open(os.getpid()))
+    except (AttributeError, OSError):
+        return False
+    return True
 
 
 def start(count: int) -> None:
