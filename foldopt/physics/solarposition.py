@@ -316,14 +316,17 @@ def _localised(naive: np.ndarray, zone: zoneinfo.ZoneInfo) -> tuple[np.ndarray, 
 
 def _day_offset(midnight: int, zone: zoneinfo.ZoneInfo) -> int | None:
     """The UTC offset [ns] of a local day [its midnight, ns since 1970-01-01 00:00 local] in which
-    the zone's clocks do not change, None where they do: the offsets at each whole hour of the
-    day, both sides of any fold, are one offset on a day with no transition (zones change their
-    clocks on whole hours or half hours, at most once in an hour)."""
-    hours = {
-        _offset_ns(zone.utcoffset(_wall(midnight + hour * NS_PER_HOUR, fold)))
-        for hour in range(25)
-        for fold in (0, 1)
-    }
+    the zone's clocks do not change, None where they do.
+
+    The offsets read at each whole hour of the day (zones change their clocks on whole hours or
+    half hours, at most once in an hour) are one offset on a day with no transition: a repeated
+    or skipped clock time reads the offset before the change (``fold=0``, PEP 495), the next
+    whole hour the offset after it. Where the change comes after the day's last hour (a gap or a
+    repetition that runs into the next day), the end of the day read after it (``fold=1``)
+    differs; a repetition then is read at its first instant either way, as pandas reads it."""
+    start = _wall(midnight)
+    hours = {_offset_ns(zone.utcoffset(start + dt.timedelta(hours=hour))) for hour in range(25)}
+    hours.add(_offset_ns(zone.utcoffset(_wall(midnight + 24 * NS_PER_HOUR, 1))))
     return hours.pop() if len(hours) == 1 else None
 
 
