@@ -41,3 +41,19 @@ html_theme = "alabaster"
 html_static_path = ["_static"]
 html_theme_options = {"description": "Design-space optimiser for twofold PV panels", "page_width": "1200px"}
 nitpicky = False
+
+
+def setup(app):
+    """numpydoc (1.x) builds a template environment and compiles its docstring template anew for
+    every object it documents; the template never changes within a build, so it is compiled once."""
+    from numpydoc import docscrape_sphinx
+
+    class OneTemplate(docscrape_sphinx.SandboxedEnvironment):
+        compiled = {}
+
+        def get_template(self, name, *args, **kwargs):
+            if name not in self.compiled:
+                self.compiled[name] = super().get_template(name, *args, **kwargs)
+            return self.compiled[name]
+
+    docscrape_sphinx.SandboxedEnvironment = OneTemplate
