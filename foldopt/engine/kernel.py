@@ -23,7 +23,10 @@ constants (the incidence per mode, diffuse terms and modifier; the power of a mo
 I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
 rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
 loop, not called. A function run at every step takes arrays, not records: each array of a record
-handed to it would be counted and released at every step. The common case (switching alone from
+handed to it would be counted and released at every step. So do a row's functions: the chunk's
+loop takes the records' arrays once, into tuples (:func:`foldopt.engine.incidence.row_arrays`),
+since a record handed to an inlined function is counted and released at every row, an atomic
+operation an array (a fifth of a map site's kernel did that). The common case (switching alone from
 one table set a block, the exact incidence without the modifier, constant loads) has a chunk's
 loop of its own, :func:`_chunk_switching`, chosen before numba sees the call, so that a request
 compiles only the loop it runs. (What each choice was worth: ``docs/performance.rst``.)
