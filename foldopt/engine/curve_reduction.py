@@ -85,8 +85,9 @@ def day_metrics(power, span, p_load, profile, how, scratch, t_out, cont_out):
     ``contiguous`` and ``use_profile``; with ``use_profile`` the loads are scales of the load
     profile ``profile`` (n_steps) [W] (:func:`_per_load`); steps outside ``first..last`` hold the
     power of the first and last, and the profile there is taken as the first's and the last's.
-    ``scratch`` is a chunk's ``above``, ``whole`` and ``run`` (:class:`foldopt.engine.records.Scratch`):
-    arrays, not the records, which an inlined function would count and release at every call.
+    ``scratch`` is a chunk's ``above``, ``whole`` and ``run``
+    (:class:`foldopt.engine.records.Scratch`): arrays, not the records, which an inlined function
+    would count and release at every call.
 
     A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
     (summed from the top at the end), and shares to the loads inside its range. Consecutive

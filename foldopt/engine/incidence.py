@@ -77,8 +77,9 @@ def row_arrays(sky, rows, work):
     ``rows``) and ``lit`` (east, west, incident, diffuse_east, diffuse_west of ``work``).
 
     A chunk of rows takes them once, before its loop over the rows: a record handed to an
-    inlined function is counted and released, each of its arrays an atomic operation, at every
-    row, where a tuple of arrays is not (numba's pruning of reference counts removes those)."""
+    inlined function is counted and released at every row, each of its arrays an atomic
+    operation, whether the function reads it or not; a tuple of the arrays it reads is counted
+    less, and not at all where numba's pruning of reference counts finds the pairs."""
     return (
         (sky.sun, sky.paper_sun, sky.beam, sky.terms),
         (rows.normal, rows.sky_view, rows.paper),

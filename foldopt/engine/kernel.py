@@ -24,12 +24,11 @@ I-V curve per connection; the metrics per flag); the parallel loop hands each th
 rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
 loop, not called. A function run at every step takes arrays, not records: each array of a record
 handed to it would be counted and released at every step. So do a row's functions: the chunk's
-loop takes the records' arrays once, into tuples (:func:`foldopt.engine.incidence.row_arrays`),
-since a record handed to an inlined function is counted and released at every row, an atomic
-operation an array (a fifth of a map site's kernel did that). The common case (switching alone from
-one table set a block, the exact incidence without the modifier, constant loads) has a chunk's
-loop of its own, :func:`_chunk_switching`, chosen before numba sees the call, so that a request
-compiles only the loop it runs. (What each choice was worth: ``docs/performance.rst``.)
+loop takes the records' arrays once, into tuples of the arrays each reads
+(:func:`foldopt.engine.incidence.row_arrays`). The common case (switching alone from one table
+set a block, the exact incidence without the modifier, constant loads) has a chunk's loop of its
+own, :func:`_chunk_switching`, chosen before numba sees the call, so that a request compiles only
+the loop it runs. (What each choice was worth: ``docs/performance.rst``.)
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -243,9 +242,9 @@ def _linear_connections(b, first, n, sets, terms, connections, scales, curves):
     """Every asked connection's power [W] of a PV model without I-V curve (the ideal model's and
     PVWatts': the pairs lose nothing) into ``power[c]`` at steps ``first .. first + n - 1`` of
     block ``b`` from each sub-panel's irradiance (``curves``: east, west, power): each
-    sub-panel's power (:func:`_powers_of_irradiance`, ``sets`` and ``terms``), then one loop a connection
-    (``connections``, ``scales`` :func:`_linear_steps`'), free of branches, so that each
-    vectorises (the values are :func:`_connection_power`'s)."""
+    sub-panel's power (:func:`_powers_of_irradiance`, ``sets`` and ``terms``), then one loop a
+    connection (``connections``; ``scales``: :func:`_linear_steps`'), free of branches, so that
+    each vectorises (the values are :func:`_connection_power`'s)."""
     east, west, buffer = curves
     start, count = uint64(first), uint64(n)
     _powers_of_irradiance(b, start, count, sets, terms, east, west)
@@ -258,17 +257,17 @@ def _linear_connections(b, first, n, sets, terms, connections, scales, curves):
 
 
 @njit(cache=True, inline="always")
-def _table_row(b, first, last, sets, pair_tables, connections, settings, need_series, curves):
+def _table_row(b, first, last, sets, pair_tables, connections, settings, curves):
     """Every asked connection's power [W] at steps ``first..last`` into ``power`` from the
     electrical tables (``pair_tables``: the tables' subpanel, parallel and series) at both
     sub-panels' irradiance (as sqrt(E / E_max), ``east`` and ``west``; ``curves``: east, west,
     power): table set ``step_table[b, s]`` and, with weight ``step_weight[b, s]``, the next (both
     (n_blocks, n_steps)), or one set a block ((n_blocks, 1)) (``sets``: the sky's step_table and
     step_weight). ``settings``: the tables' bypass, panel_scale, switch_series and
-    converter_efficiency."""
+    converter_efficiency, and whether the series pair is asked."""
     step_table, step_weight = sets
     table_1d, table_parallel, table_series = pair_tables
-    bypass, panel_scale, switch_series, converter_efficiency = settings
+    bypass, panel_scale, switch_series, converter_efficiency, need_series = settings
     east, west, buffer = curves
     per_step = step_table.shape[1] > 1
     # One table set a block (no weather file): its tables are taken once a row.
@@ -342,8 +341,8 @@ def _switching_power(i, table_1d, pair, stride, nodes, weights):
 @njit(cache=True, inline="always")
 def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
     """Switching's power [W] at steps ``first .. first + n - 1`` into ``power[0]`` from one table
-    set a block (``step_table[b, 0]`` of ``pair_tables``, the tables' subpanel, parallel and
-    series), without the series pair (every clear-sky study's and map's): the values
+    set a block (``step_table[b, 0]`` of ``pair_tables``, the tables' subpanel and parallel
+    first), without the series pair (every clear-sky study's and map's): the values
     of :func:`_pair_powers` and :func:`_connection_power` by the same operations, so the same
     bits. Returns the sum of the steps' power [W] and its peak [W], the bits of
     :func:`day_metrics`' (the same operations in the same order), and writes each walking
@@ -619,7 +618,7 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     sets, curves = (sky.step_table, sky.step_weight), (work.east, work.west, work.power)
     pair_tables = (tables.subpanel, tables.parallel, tables.series)
     terms, scales = tables.power_terms, (tables.panel_scale, tables.converter_efficiency)
-    settings = (tables.bypass, tables.panel_scale, tables.switch_series, scales[1])
+    settings = (tables.bypass, scales[0], tables.switch_series, scales[1], need_series)
     coordinates = (work.nodes, work.weights, work.low, work.high)
     load_how = (step_hours, loads.contiguous, loads.use_profile)
     reduction = (work.above, work.whole, work.run)
@@ -648,9 +647,7 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         elif switching_alone:
             harvested, peak = _switching_row(b, first, n, sets[0], pair_tables, curves, coordinates)
         else:
-            _table_row(
-                b, first, last, sets, pair_tables, connections, settings, need_series, curves
-            )
+            _table_row(b, first, last, sets, pair_tables, connections, settings, curves)
         if curve[r] >= 0:
             _keep_curves(kept[curve[r]], power, first, last)
         row_loads, profile = p_load[loadset[r]], profiles[b if use_profile else 0]
