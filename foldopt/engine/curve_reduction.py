@@ -76,36 +76,39 @@ def _per_load(p, shape, s, use_shape):
 
 
 @njit(cache=True, inline="always")
-def day_metrics(power, span, p_load, profile, loads, work, t_out, cont_out):
+def day_metrics(power, span, p_load, profile, how, scratch, t_out, cont_out):
     """Daily metrics of one power curve [W] sampled at step centres, of which only steps
     ``first..last`` (``span``) need walking: the power before and after them is that of the first
     and the last (zero, or the day's end). Writes t_solar (and its longest run) per load of
     ``p_load`` (one set of :class:`foldopt.engine.records.Loads`, ascending) into ``t_out`` (and
-    ``cont_out``); returns the energy [Wh] and the peak [W]. With ``loads.use_profile`` the loads
-    are scales of the load profile ``profile`` (n_steps) [W] (:func:`_per_load`); steps outside
-    ``first..last`` hold the power of the first and last, and the profile there is taken as the
-    first's and the last's. ``work`` is a chunk's :class:`foldopt.engine.records.Scratch`.
+    ``cont_out``); returns the energy [Wh] and the peak [W]. ``how``: the loads' ``step_hours``,
+    ``contiguous`` and ``use_profile``; with ``use_profile`` the loads are scales of the load
+    profile ``profile`` (n_steps) [W] (:func:`_per_load`); steps outside ``first..last`` hold the
+    power of the first and last, and the profile there is taken as the first's and the last's.
+    ``scratch`` is a chunk's ``above``, ``whole`` and ``run``
+    (:class:`foldopt.engine.records.Scratch`): arrays, not the records, which an inlined function
+    would count and release at every call.
 
     A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
     (summed from the top at the end), and shares to the loads inside its range. Consecutive
     segments mostly share k, so their lengths gather in a local sum first."""
     # Constant loads without runs (every map's) with the flags as constants, so that no step tests
     # them; the other cases read them at run time.
-    if not loads.contiguous and not loads.use_profile:
-        held = (loads.step_hours, False, False)
-        return _day_steps(power, span, p_load, profile, held, work, t_out, cont_out)
-    held = (loads.step_hours, loads.contiguous, loads.use_profile)
-    return _day_steps(power, span, p_load, profile, held, work, t_out, cont_out)
+    step_hours, contiguous, use_profile = how
+    if not contiguous and not use_profile:
+        held = (step_hours, False, False)
+        return _day_steps(power, span, p_load, profile, held, scratch, t_out, cont_out)
+    return _day_steps(power, span, p_load, profile, how, scratch, t_out, cont_out)
 
 
 @njit(cache=True, inline="always")
-def _day_steps(power, span, p_load, profile, held, work, t_out, cont_out):
+def _day_steps(power, span, p_load, profile, held, scratch, t_out, cont_out):
     """:func:`day_metrics`' walk over the steps; ``held`` is how the curve is held against the
     loads: the step [h] and the flags ``contiguous`` and ``use_profile`` of
     :class:`foldopt.engine.records.Loads`."""
     first, last = span
     step_hours, contiguous, use_profile = held
-    above, whole, run = work.above, work.whole, work.run
+    above, whole, run = scratch
     n_steps, n_loads = power.shape[0], p_load.shape[0]
     above[:] = 0.0
     whole[:] = 0.0
@@ -272,14 +275,16 @@ def curve_rows(power, span, row_loadset, loads, out, scratch):
 def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
     """Rows ``start .. stop - 1`` of :func:`curve_rows` with one chunk's scratch ``work`` (a thread
     of :func:`foldopt.engine.records.in_chunks` calls it)."""
+    how = (loads.step_hours, loads.contiguous, loads.use_profile)
+    scratch = (work.above, work.whole, work.run)
     for r in range(start, stop):
         out.energy[r, 0], out.peak[r, 0] = day_metrics(
             power[r],
             (span[r, 0], span[r, 1]),
             loads.p_load[row_loadset[r]],
             loads.profile[r if loads.use_profile else 0],
-            loads,
-            work,
+            how,
+            scratch,
             out.t_solar[r, 0],
             out.t_solar_contiguous[r if loads.contiguous else 0, 0],
         )

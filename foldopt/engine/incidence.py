@@ -71,21 +71,33 @@ def iam_factor(cos_aoi, model, params):
 
 
 @njit(cache=True, inline="always")
-def incidence_steps(r, b, start, count, sky, rows, case, work):
+def row_arrays(sky, rows, work):
+    """The arrays of the records that :func:`incidence` reads and writes, as tuples of arrays:
+    ``light`` (sun, paper_sun, beam, terms of ``sky``), ``panels`` (normal, sky_view, paper of
+    ``rows``) and ``lit`` (east, west, incident, diffuse_east, diffuse_west of ``work``).
+
+    A chunk of rows takes them once, before its loop over the rows: a record handed to an
+    inlined function is counted and released at every row, each of its arrays an atomic
+    operation, whether the function reads it or not; a tuple of the arrays it reads is counted
+    less, and not at all where numba's pruning of reference counts finds the pairs."""
+    return (
+        (sky.sun, sky.paper_sun, sky.beam, sky.terms),
+        (rows.normal, rows.sky_view, rows.paper),
+        (work.east, work.west, work.incident, work.diffuse_east, work.diffuse_west),
+    )
+
+
+@njit(cache=True, inline="always")
+def incidence_steps(r, b, start, count, light, panels, case, lit):
     """:func:`incidence`'s main loop, inlined once per case with the case's flags (``case``:
     ``paper``, ``has_terms``, ``modified``, ``root``) as constants; ``root``: each sub-panel's
     irradiance as the tables' coordinate, sqrt(E / E_max), taken in this loop (without the
-    modifier: :func:`foldopt.engine.kernel._chunk_switching`)."""
+    modifier: :func:`foldopt.engine.kernel._chunk_switching`). ``light``, ``panels`` and ``lit``
+    are :func:`row_arrays`'."""
     paper, has_terms, modified, root = case
-    sun, paper_sun, beam, terms = sky.sun, sky.paper_sun, sky.beam, sky.terms
-    east, west, incident, diffuse_east, diffuse_west = (
-        work.east,
-        work.west,
-        work.incident,
-        work.diffuse_east,
-        work.diffuse_west,
-    )
-    normal, view, row_paper = rows.normal, rows.sky_view, rows.paper
+    sun, paper_sun, beam, terms = light
+    east, west, incident, diffuse_east, diffuse_west = lit
+    normal, view, row_paper = panels
     ex, ey, ez = normal[r, 0, 0], normal[r, 0, 1], normal[r, 0, 2]
     wx, wy, wz = normal[r, 1, 0], normal[r, 1, 1], normal[r, 1, 2]
     # Each sub-panel's view of the isotropic sky and of the horizon band: (1 + cos tilt) / 2 and
@@ -143,41 +155,45 @@ def incidence_steps(r, b, start, count, sky, rows, case, work):
 
 
 @njit(cache=True, inline="always")
-def incidence(r, b, first, n, sky, rows, tables, work):
-    """Both sub-panels' irradiance at steps ``first .. first + n - 1`` of row ``r`` of ``rows``
-    (over block ``b`` of ``sky``, a :class:`foldopt.engine.records.SkyArrays`) into ``work.east``
-    and ``work.west`` (as sqrt(E / E_max) with ``tables``), and their mean incident irradiance
-    before the incidence-angle modifier into ``work.incident`` [W/m^2] (``work`` a chunk's
-    :class:`foldopt.engine.records.Scratch`).
+def incidence(r, b, first, n, arrays, how, tables):
+    """Both sub-panels' irradiance at steps ``first .. first + n - 1`` of row ``r`` (over block
+    ``b``) into ``east`` and ``west`` (as sqrt(E / E_max) with ``tables``), and their mean incident
+    irradiance before the incidence-angle modifier into ``incident`` [W/m^2]: ``arrays`` is
+    :func:`row_arrays`' (``light``, ``panels``, ``lit``) of a
+    :class:`foldopt.engine.records.SkyArrays`, its rows and a chunk's
+    :class:`foldopt.engine.records.Scratch`, ``how`` the sky's ``paper``, ``iam_model`` and
+    ``iam_params``.
 
     The steps are indexed as unsigned integers, so that no index can wrap around, and the main
     loop (:func:`incidence_steps`) is inlined once per case, its flags constants: LLVM then
     vectorises each. The incidence-angle modifier, a call per step, has a loop of its own (the beam
-    waits for it in ``work.east`` and ``work.west``, the diffuse light in ``work.diffuse_east``
-    and ``work.diffuse_west``), as has the tables' coordinate."""
+    waits for it in ``east`` and ``west``, the diffuse light in ``diffuse_east`` and
+    ``diffuse_west``), as has the tables' coordinate."""
+    light, panels, lit = arrays
+    paper, iam_model, iam_params = how
     start, count = uint64(first), uint64(n)
-    iam_model, iam_params, paper = sky.iam_model, sky.iam_params, sky.paper
-    has_terms = sky.terms.shape[1] == 4
+    has_terms = light[3].shape[1] == 4
     modified = iam_model != IAM_NONE
     # Exact incidence without the modifier, with or without diffuse terms, as constants (every
     # study of a year or a map); paper mode and the modifier read their flags at run time.
     if not paper and not modified and has_terms:
-        incidence_steps(r, b, start, count, sky, rows, (False, True, False, False), work)
+        incidence_steps(r, b, start, count, light, panels, (False, True, False, False), lit)
     elif not paper and not modified:
-        incidence_steps(r, b, start, count, sky, rows, (False, False, False, False), work)
+        incidence_steps(r, b, start, count, light, panels, (False, False, False, False), lit)
     else:
-        incidence_steps(r, b, start, count, sky, rows, (paper, has_terms, modified, False), work)
-    east, west = work.east, work.west
+        case = (paper, has_terms, modified, False)
+        incidence_steps(r, b, start, count, light, panels, case, lit)
+    east, west, _, diffuse_east, diffuse_west = lit
     if modified:
-        sun, normal = sky.sun, rows.normal
+        sun, normal = light[0], panels[0]
         ex, ey, ez = normal[r, 0, 0], normal[r, 0, 1], normal[r, 0, 2]
         wx, wy, wz = normal[r, 1, 0], normal[r, 1, 1], normal[r, 1, 2]
         for i in range(count):
             s = start + i
             cos_east = ex * sun[b, 0, s] + ey * sun[b, 1, s] + ez * sun[b, 2, s]
             cos_west = wx * sun[b, 0, s] + wy * sun[b, 1, s] + wz * sun[b, 2, s]
-            east[s] = east[s] * iam_factor(cos_east, iam_model, iam_params) + work.diffuse_east[s]
-            west[s] = west[s] * iam_factor(cos_west, iam_model, iam_params) + work.diffuse_west[s]
+            east[s] = east[s] * iam_factor(cos_east, iam_model, iam_params) + diffuse_east[s]
+            west[s] = west[s] * iam_factor(cos_west, iam_model, iam_params) + diffuse_west[s]
     if tables:
         to_root = 1.0 / IRRADIANCE_MAX
         for i in range(count):

@@ -23,10 +23,12 @@ constants (the incidence per mode, diffuse terms and modifier; the power of a mo
 I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
 rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
 loop, not called. A function run at every step takes arrays, not records: each array of a record
-handed to it would be counted and released at every step. The common case (switching alone from
-one table set a block, the exact incidence without the modifier, constant loads) has a chunk's
-loop of its own, :func:`_chunk_switching`, chosen before numba sees the call, so that a request
-compiles only the loop it runs. (What each choice was worth: ``docs/performance.rst``.)
+handed to it would be counted and released at every step. So do a row's functions: the chunk's
+loop takes the records' arrays once, into tuples of the arrays each reads
+(:func:`foldopt.engine.incidence.row_arrays`). The common case (switching alone from one table
+set a block, the exact incidence without the modifier, constant loads) has a chunk's loop of its
+own, :func:`_chunk_switching`, chosen before numba sees the call, so that a request compiles only
+the loop it runs. (What each choice was worth: ``docs/performance.rst``.)
 
 Every function here is checked against the NumPy reference path of :mod:`foldopt.engine.evaluation` by
 ``tests/test_engine.py`` (hypothesis: random sites, days, loads, angles and models).
@@ -39,7 +41,7 @@ from typing import NamedTuple
 
 from numba import njit, uint64
 
-from foldopt.engine.incidence import IAM_NONE, incidence_steps, incidence, steps_sum
+from foldopt.engine.incidence import IAM_NONE, incidence, incidence_steps, row_arrays, steps_sum
 from foldopt.engine.curve_reduction import blocked_day, day_metrics
 from foldopt.engine.records import WALK_BLOCK, in_chunks
 
@@ -187,14 +189,14 @@ def _connection_power(
 
 
 @njit(cache=True, inline="always")
-def _powers_of_irradiance(b, start, count, sky, tables, work):
-    """Each sub-panel's power [W] in place of its irradiance in ``work.east`` and ``work.west`` at
-    steps ``start .. start + count - 1`` of block ``b``, for a model without I-V curve:
-    ``(a + q E) E`` of the table set's terms ``tables.power_terms[t] = (a, q)``
+def _powers_of_irradiance(b, start, count, sets, terms, east, west):
+    """Each sub-panel's power [W] in place of its irradiance in ``east`` and ``west`` at steps
+    ``start .. start + count - 1`` of block ``b``, for a model without I-V curve: ``(a + q E) E``
+    of the table set's terms ``power_terms[t] = (a, q)``
     (:meth:`foldopt.physics.pvmodel.PVModel.power_terms`), linear between two sets where a step's
-    air temperature lies between them (the power is linear in the air temperature)."""
-    terms, step_table, step_weight = tables.power_terms, sky.step_table, sky.step_weight
-    east, west = work.east, work.west
+    air temperature lies between them (the power is linear in the air temperature). ``sets``:
+    the sky's ``step_table`` and ``step_weight``; ``terms``: the tables' ``power_terms``."""
+    step_table, step_weight = sets
     if step_table.shape[1] == 1:
         t = step_table[b, 0]
         a, q = terms[t, 0], terms[t, 1]
@@ -213,11 +215,10 @@ def _powers_of_irradiance(b, start, count, sky, tables, work):
 
 
 @njit(cache=True, inline="always")
-def _linear_steps(c, code, start, count, tables, work):
-    """:func:`_linear_connections`' loop, inlined once per connection with its code a constant."""
-    panel_scale = tables.panel_scale
-    converter_efficiency = tables.converter_efficiency
-    east, west, buffer = work.east, work.west, work.power
+def _linear_steps(c, code, start, count, scales, east, west, buffer):
+    """:func:`_linear_connections`' loop, inlined once per connection with its code a constant
+    (``scales``: the tables' ``panel_scale`` and ``converter_efficiency``)."""
+    panel_scale, converter_efficiency = scales
     for i in range(count):
         s = start + i
         p_east, p_west = east[s], west[s]
@@ -237,34 +238,37 @@ def _linear_steps(c, code, start, count, tables, work):
 
 
 @njit(cache=True, inline="always")
-def _linear_connections(b, first, n, sky, tables, work):
+def _linear_connections(b, first, n, sets, terms, connections, scales, curves):
     """Every asked connection's power [W] of a PV model without I-V curve (the ideal model's and
-    PVWatts': the pairs lose nothing) into ``work.power[c]`` at steps ``first .. first + n - 1``
-    of block ``b``: each sub-panel's power (:func:`_powers_of_irradiance`), then one loop a
-    connection, free of branches, so that each vectorises (the values are
-    :func:`_connection_power`'s)."""
+    PVWatts': the pairs lose nothing) into ``power[c]`` at steps ``first .. first + n - 1`` of
+    block ``b`` from each sub-panel's irradiance (``curves``: east, west, power): each
+    sub-panel's power (:func:`_powers_of_irradiance`, ``sets`` and ``terms``), then one loop a
+    connection (``connections``; ``scales``: :func:`_linear_steps`'), free of branches, so that
+    each vectorises (the values are :func:`_connection_power`'s)."""
+    east, west, buffer = curves
     start, count = uint64(first), uint64(n)
-    _powers_of_irradiance(b, start, count, sky, tables, work)
-    connections = tables.connections
+    _powers_of_irradiance(b, start, count, sets, terms, east, west)
     for c in range(connections.shape[0]):
         # Switching (every map's) with its code a constant; the others read it at run time.
         if connections[c] == SWITCHING:
-            _linear_steps(c, SWITCHING, start, count, tables, work)
+            _linear_steps(c, SWITCHING, start, count, scales, east, west, buffer)
         else:
-            _linear_steps(c, connections[c], start, count, tables, work)
+            _linear_steps(c, connections[c], start, count, scales, east, west, buffer)
 
 
 @njit(cache=True, inline="always")
-def _table_row(b, first, last, sky, tables, need_series, work):
-    """Every asked connection's power [W] at steps ``first..last`` into ``work.power`` from the
-    electrical tables at both sub-panels' irradiance (as sqrt(E / E_max), ``work.east`` and
-    ``work.west``): table set ``sky.step_table[b, s]`` and, with weight ``sky.step_weight[b, s]``,
-    the next (both (n_blocks, n_steps)), or one set a block ((n_blocks, 1))."""
-    step_table, step_weight = sky.step_table, sky.step_weight
-    table_1d, table_parallel, table_series = tables.subpanel, tables.parallel, tables.series
-    bypass, panel_scale, switch_series = tables.bypass, tables.panel_scale, tables.switch_series
-    converter_efficiency, connections = tables.converter_efficiency, tables.connections
-    east, west, buffer = work.east, work.west, work.power
+def _table_row(b, first, last, sets, pair_tables, connections, settings, curves):
+    """Every asked connection's power [W] at steps ``first..last`` into ``power`` from the
+    electrical tables (``pair_tables``: the tables' subpanel, parallel and series) at both
+    sub-panels' irradiance (as sqrt(E / E_max), ``east`` and ``west``; ``curves``: east, west,
+    power): table set ``step_table[b, s]`` and, with weight ``step_weight[b, s]``, the next (both
+    (n_blocks, n_steps)), or one set a block ((n_blocks, 1)) (``sets``: the sky's step_table and
+    step_weight). ``settings``: the tables' bypass, panel_scale, switch_series and
+    converter_efficiency, and whether the series pair is asked."""
+    step_table, step_weight = sets
+    table_1d, table_parallel, table_series = pair_tables
+    bypass, panel_scale, switch_series, converter_efficiency, need_series = settings
+    east, west, buffer = curves
     per_step = step_table.shape[1] > 1
     # One table set a block (no weather file): its tables are taken once a row.
     row_1d, row_parallel, row_series = (
@@ -335,29 +339,32 @@ def _switching_power(i, table_1d, pair, stride, nodes, weights):
 
 
 @njit(cache=True, inline="always")
-def _switching_row(b, first, n, sky, tables, work):
-    """Switching's power [W] at steps ``first .. first + n - 1`` into ``work.power[0]`` from one
-    table set a block, without the series pair (every clear-sky study's and map's): the values
+def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
+    """Switching's power [W] at steps ``first .. first + n - 1`` into ``power[0]`` from one table
+    set a block (``step_table[b, 0]`` of ``pair_tables``, the tables' subpanel and parallel
+    first), without the series pair (every clear-sky study's and map's): the values
     of :func:`_pair_powers` and :func:`_connection_power` by the same operations, so the same
     bits. Returns the sum of the steps' power [W] and its peak [W], the bits of
     :func:`day_metrics`' (the same operations in the same order), and writes each walking
-    block's lowest and highest power to ``work.low`` and ``work.high``
-    (:func:`foldopt.engine.curve_reduction.blocked_day`).
+    block's lowest and highest power to ``low`` and ``high``
+    (:func:`foldopt.engine.curve_reduction.blocked_day`). ``curves``: a chunk's east, west and
+    power; ``coordinates``: its nodes, weights, low and high
+    (:class:`foldopt.engine.records.Scratch`).
 
     :data:`foldopt.engine.records.TABLE_BLOCK` steps at a time, in two loops: the first works out
     each step's coordinates in the tables (its nodes and the weights between them, the pair's
     ratio a division) and vectorises; the second looks them up a value at a time (LLVM prices a
     gather on this CPU above the loads it replaces) with the sums that wait on each addition
     beside them, where they cost nothing more."""
-    table = sky.step_table[b, 0]
-    table_1d, table_pair = tables.subpanel[table], tables.parallel[table]
+    table = step_table[b, 0]
+    table_1d, table_pair = pair_tables[0][table], pair_tables[1][table]
     pair = table_pair.reshape(table_pair.size)
     n1 = table_1d.shape[0] - 1
     n2, nr = table_pair.shape[0] - 1, table_pair.shape[1] - 1
     top_1d, top_strong, top_ratio = uint64(n1 - 1), uint64(n2 - 1), uint64(nr - 1)
     stride = uint64(nr + 1)
-    east, west, buffer = work.east, work.west, work.power
-    nodes, weights, low, high = work.nodes, work.weights, work.low, work.high
+    east, west, buffer = curves
+    nodes, weights, low, high = coordinates
     block, end, walk = uint64(nodes.shape[1]), uint64(first + n), uint64(WALK_BLOCK)
     start = uint64(first)
     # -0.0 adds nothing to any value, so the sum is the first step's power plus the others'.
@@ -435,7 +442,9 @@ def _built_row(b, first, last, sky, tables, need_series, work):
     per_step = step_table.shape[1] > 1
     with_tables = tables.power_terms.shape[0] == 0
     if not with_tables:
-        _powers_of_irradiance(b, uint64(first), uint64(last + 1 - first), sky, tables, work)
+        count = uint64(last + 1 - first)
+        sets = (step_table, step_weight)
+        _powers_of_irradiance(b, uint64(first), count, sets, tables.power_terms, east, west)
     for s in range(first, last + 1):
         root_east, root_west = east[s], west[s]
         t = step_table[b, s] if per_step else step_table[b, 0]
@@ -514,6 +523,16 @@ def fold_rows(sky, rows, tables, loads, out, scratch):
     in_chunks(body, rows.block.shape[0], scratch, sky, rows, tables, loads, out)
 
 
+@njit(cache=True, inline="always")
+def _held(held, step_hours):
+    """``held[k]``, the length of ``k + 1`` steps [h], as ``k`` additions of the step
+    (:attr:`foldopt.engine.records.Scratch.held`)."""
+    held[0] = step_hours
+    for k in range(1, held.shape[0]):
+        held[k] = held[k - 1] + step_hours
+    return held
+
+
 @njit(cache=True, nogil=True)
 def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
     """:func:`_chunk_rows` for the common case, apart: switching alone from one table set a block,
@@ -524,33 +543,39 @@ def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
     operations in the same order as :func:`_chunk_rows`', so the same bits
     (``tests/test_engine.py``)."""
     has_terms = sky.terms.shape[1] == 4
-    held = work.held
-    held[0] = loads.step_hours
-    for k in range(1, held.shape[0]):
-        held[k] = held[k - 1] + loads.step_hours
+    held = _held(work.held, loads.step_hours)
+    # The records' arrays taken once: see foldopt.engine.incidence.row_arrays.
+    light, panels, lit = row_arrays(sky, rows, work)
+    block, span, step_hours = rows.block, sky.span, loads.step_hours
+    step_table, power = sky.step_table, work.power
+    pair_tables, curves = (tables.subpanel, tables.parallel), (work.east, work.west, power)
+    coordinates = (work.nodes, work.weights, work.low, work.high)
+    extremes, reduction = (work.low, work.high), (work.above, work.whole)
+    curve, loadset, p_load, kept = rows.curve, rows.loadset, loads.p_load, out.power
+    irradiation, energy, peaks, t_solar = out.irradiation, out.energy, out.peak, out.t_solar
     for r in range(start, stop):
-        b = rows.block[r]
-        first, last = sky.span[b, 0], sky.span[b, 1]
+        b = block[r]
+        first, last = span[b, 0], span[b, 1]
         n = last + 1 - first
         at, count = uint64(first), uint64(n)
         if has_terms:
-            incidence_steps(r, b, at, count, sky, rows, (False, True, False, True), work)
+            incidence_steps(r, b, at, count, light, panels, (False, True, False, True), lit)
         else:
-            incidence_steps(r, b, at, count, sky, rows, (False, False, False, True), work)
-        out.irradiation[r] = steps_sum(work.incident, first, n) * loads.step_hours
-        harvested, peak = _switching_row(b, first, n, sky, tables, work)
-        if rows.curve[r] >= 0:
-            _keep_curves(out.power[rows.curve[r]], work.power, first, last)
-        out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
+            incidence_steps(r, b, at, count, light, panels, (False, False, False, True), lit)
+        irradiation[r] = steps_sum(lit[2], first, n) * step_hours
+        harvested, peak = _switching_row(b, first, n, step_table, pair_tables, curves, coordinates)
+        if curve[r] >= 0:
+            _keep_curves(kept[curve[r]], power, first, last)
+        energy[r, 0], peaks[r, 0] = harvested * step_hours, peak
         blocked_day(
-            work.power[0],
+            power[0],
             (first, last),
-            loads.p_load[rows.loadset[r]],
-            loads.step_hours,
+            p_load[loadset[r]],
+            step_hours,
             held,
-            (work.low, work.high),
-            (work.above, work.whole),
-            out.t_solar[r, 0],
+            extremes,
+            reduction,
+            t_solar[r, 0],
         )
 
 
@@ -585,52 +610,68 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     )
     # ... and its walk over the loads by blocks, for constant loads without their longest runs.
     blocked = switching_alone and not loads.contiguous and not loads.use_profile
-    held = work.held
-    held[0] = loads.step_hours
-    for k in range(1, held.shape[0]):
-        held[k] = held[k - 1] + loads.step_hours
+    held = _held(work.held, loads.step_hours)
+    # The records' arrays taken once: see foldopt.engine.incidence.row_arrays.
+    arrays = row_arrays(sky, rows, work)
+    how = (sky.paper, sky.iam_model, sky.iam_params)
+    block, span, step_hours = rows.block, sky.span, loads.step_hours
+    sets, curves = (sky.step_table, sky.step_weight), (work.east, work.west, work.power)
+    pair_tables = (tables.subpanel, tables.parallel, tables.series)
+    terms, scales = tables.power_terms, (tables.panel_scale, tables.converter_efficiency)
+    settings = (tables.bypass, scales[0], tables.switch_series, scales[1], need_series)
+    coordinates = (work.nodes, work.weights, work.low, work.high)
+    load_how = (step_hours, loads.contiguous, loads.use_profile)
+    reduction = (work.above, work.whole, work.run)
+    extremes, power, incident = (work.low, work.high), work.power, work.incident
+    curve, loadset, p_load, profiles, kept = (
+        rows.curve,
+        rows.loadset,
+        loads.p_load,
+        loads.profile,
+        out.power,
+    )
+    irradiation, energy, peaks = out.irradiation, out.energy, out.peak
+    t_solar, t_solar_contiguous = out.t_solar, out.t_solar_contiguous
+    as_built, contiguous, use_profile = tables.as_built, loads.contiguous, loads.use_profile
     harvested = peak = 0.0  # the day's sum and peak of switching's pass, when it is taken
     for r in range(start, stop):
-        b = rows.block[r]
-        first, last = sky.span[b, 0], sky.span[b, 1]
+        b = block[r]
+        first, last = span[b, 0], span[b, 1]
         n = last + 1 - first
-        incidence(r, b, first, n, sky, rows, with_tables, work)
-        out.irradiation[r] = steps_sum(work.incident, first, n) * loads.step_hours
-        if tables.as_built:
+        incidence(r, b, first, n, arrays, how, with_tables)
+        irradiation[r] = steps_sum(incident, first, n) * step_hours
+        if as_built:
             _built_row(b, first, last, sky, tables, need_series, work)
         elif not with_tables:
-            _linear_connections(b, first, n, sky, tables, work)
+            _linear_connections(b, first, n, sets, terms, connections, scales, curves)
         elif switching_alone:
-            harvested, peak = _switching_row(b, first, n, sky, tables, work)
+            harvested, peak = _switching_row(b, first, n, sets[0], pair_tables, curves, coordinates)
         else:
-            _table_row(b, first, last, sky, tables, need_series, work)
-        if rows.curve[r] >= 0:
-            _keep_curves(out.power[rows.curve[r]], work.power, first, last)
-        p_load, profile = (
-            loads.p_load[rows.loadset[r]],
-            loads.profile[b if loads.use_profile else 0],
-        )
+            _table_row(b, first, last, sets, pair_tables, connections, settings, curves)
+        if curve[r] >= 0:
+            _keep_curves(kept[curve[r]], power, first, last)
+        row_loads, profile = p_load[loadset[r]], profiles[b if use_profile else 0]
         if blocked:
-            out.energy[r, 0], out.peak[r, 0] = harvested * loads.step_hours, peak
+            energy[r, 0], peaks[r, 0] = harvested * step_hours, peak
             blocked_day(
-                work.power[0],
+                power[0],
                 (first, last),
-                p_load,
-                loads.step_hours,
+                row_loads,
+                step_hours,
                 held,
-                (work.low, work.high),
-                (work.above, work.whole),
-                out.t_solar[r, 0],
+                extremes,
+                reduction[:2],
+                t_solar[r, 0],
             )
             continue
         for c in range(n_conn):
-            out.energy[r, c], out.peak[r, c] = day_metrics(
-                work.power[c],
+            energy[r, c], peaks[r, c] = day_metrics(
+                power[c],
                 (first, last),
-                p_load,
+                row_loads,
                 profile,
-                loads,
-                work,
-                out.t_solar[r, c],
-                out.t_solar_contiguous[r if loads.contiguous else 0, c],
+                load_how,
+                reduction,
+                t_solar[r, c],
+                t_solar_contiguous[r if contiguous else 0, c],
             )
