@@ -3,8 +3,10 @@
 import numpy as np
 import pvlib
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from foldopt.physics.pvmodel import A300_CELL, ROBLES_200W, PVModel, cec_module, fit_b
+from foldopt.physics.pvmodel import A300_CELL, ROBLES_200W, IVCurve, PVModel, cec_module, fit_b
 from foldopt.physics.temperature import cell_temperature
 
 
@@ -98,3 +100,64 @@ def test_a_curves_points_are_kept_and_its_maximum_power_is_the_callers(model, po
     power = pv.max_power(poa, 25.0, 0.054)
     power += 1.0  # the caller's own array
     assert np.array_equal(curve.mpp()[0], first[0]) and np.array_equal(pv.max_power(poa, 25.0, 0.054), first[0])
+
+
+def _diode_curves(poa, temp_cell, module):
+    """Single-diode curves of the A-300 cell or a CEC module, with dark ones (R_sh infinite, where
+    pvlib's v_from_i takes its explicit form) among them."""
+    pv = PVModel("single-diode", module=module)
+    return pv.curves(np.asarray(poa), temp_cell, 3.0 * pv.unit_area)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    poa=st.lists(st.sampled_from([0.0, 1e-9, 1e-3]) | st.floats(0.0, 2000.0), min_size=1, max_size=12),
+    temp_cell=st.floats(-70.0, 90.0),
+    module=st.sampled_from([None, "CS5P-220M"]),
+    fractions=st.lists(st.floats(-0.5, 1.5), min_size=3, max_size=3),
+)
+def test_current_and_voltage_are_pvlibs_to_the_bit(poa, temp_cell, module, fractions):
+    """A curve's current and voltage (its terms of the parameters alone worked out once) are
+    pvlib's i_from_v and v_from_i to the bit, inside and beyond the curve, dark curves included,
+    at the curves' shape and with a trailing axis of operating points."""
+    curve = _diode_curves(poa, temp_cell, module)
+    with np.errstate(all="ignore"):
+        v_oc = np.nan_to_num(pvlib.pvsystem.v_from_i(0.0, *curve.params))
+        i_sc = np.nan_to_num(pvlib.pvsystem.i_from_v(0.0, *curve.params))
+    for scale, ours, theirs in ((v_oc, curve.current, pvlib.pvsystem.i_from_v),
+                                (i_sc, curve.voltage, pvlib.pvsystem.v_from_i)):
+        for point in (fractions[0] * scale, np.asarray(fractions) * scale[:, None]):
+            params = [np.reshape(p, p.shape + (1,) * (point.ndim - p.ndim)) for p in curve.params]
+            with np.errstate(all="ignore"):
+                expected = theirs(point, *params)
+            assert np.array_equal(ours(point), expected, equal_nan=True)
+
+
+def test_current_and_voltage_without_series_or_shunt_resistance_are_pvlibs():
+    """Where R_s = 0 (pvlib's i_from_v explicit) or R_sh is infinite (v_from_i explicit), mixed with
+    curves that take Lambert W, the values are still pvlib's to the bit."""
+    curve = _diode_curves(np.array([800.0, 300.0, 0.0]), 25.0, None)
+    il, io, rs, rsh, a = (np.array(p, dtype=float) for p in curve.params)
+    rs[0], rsh[1] = 0.0, np.inf
+    mixed = IVCurve("single-diode", (il, io, rs, rsh, a))
+    points = np.array([0.0, 0.3, 0.9])
+    with np.errstate(all="ignore"):
+        currents, voltages = (f(points, il, io, rs, rsh, a) for f in (pvlib.pvsystem.i_from_v, pvlib.pvsystem.v_from_i))
+    assert np.array_equal(mixed.current(points), currents, equal_nan=True)
+    assert np.array_equal(mixed.voltage(points), voltages, equal_nan=True)
+
+
+@pytest.mark.parametrize("model", ["single-diode", "b-model"])
+def test_repeated_curves_are_the_curves_at_repeated_irradiance(model):
+    """Repeated curves (their points worked out once a curve) are, to the bit, the curves of the
+    repeated irradiances with every point worked out again."""
+    pv = PVModel(model=model)
+    poa = np.array([0.0, 1e-6, 120.0, 640.0, 1500.0])
+    once = pv.curves(poa, cell_temperature(poa, 30.0, 1.0, "sapm"), 0.054).repeated(3)
+    again = pv.curves(np.repeat(poa, 3), cell_temperature(np.repeat(poa, 3), 30.0, 1.0, "sapm"), 0.054)
+    assert all(np.array_equal(a, b) for a, b in zip(once.params, again.params, strict=True))
+    for name in ("i_sc", "v_oc"):
+        assert np.array_equal(getattr(once, name), getattr(again, name))
+    assert all(np.array_equal(a, b) for a, b in zip(once.mpp(), again.mpp(), strict=True))
+    points = np.linspace(0.0, 1.0, poa.size * 3) * again.v_oc
+    assert np.array_equal(once.current(points), again.current(points), equal_nan=True)

@@ -220,12 +220,15 @@ class Electrical:
         As built, the table holds the pair as built, bypass diodes and all
         (:func:`foldopt.engine.as_built.pair_power`).
         """
+        nodes = _nodes(TABLE_NODES_2D)
         strong, ratio = (
-            grid.ravel()
-            for grid in np.meshgrid(_nodes(TABLE_NODES_2D), _ratio_nodes(connection), indexing="ij")
+            grid.ravel() for grid in np.meshgrid(nodes, _ratio_nodes(connection), indexing="ij")
         )
         weak = strong * ratio
-        east = self.pv.curves(strong, self._temperature(strong), self.subpanel_area)
+        # The stronger sub-panel's curve is one per irradiance node, paired with every ratio.
+        east = self.pv.curves(nodes, self._temperature(nodes), self.subpanel_area).repeated(
+            TABLE_NODES_RATIO
+        )
         west = self.pv.curves(weak, self._temperature(weak), self.subpanel_area)
         bound = east.max_power() + west.max_power()
         if self._panel_side_built:
