@@ -148,16 +148,18 @@ def test_current_and_voltage_without_series_or_shunt_resistance_are_pvlibs():
 
 
 @pytest.mark.parametrize("model", ["single-diode", "b-model"])
-def test_repeated_curves_are_the_curves_at_repeated_irradiance(model):
-    """Repeated curves (their points worked out once a curve) are, to the bit, the curves of the
-    repeated irradiances with every point worked out again."""
+def test_taken_curves_are_the_curves_at_the_taken_irradiances(model):
+    """Curves taken at indices, a curve many times (their points worked out once a curve), are, to
+    the bit, the curves of the irradiances so taken with every point worked out again."""
     pv = PVModel(model=model)
     poa = np.array([0.0, 1e-6, 120.0, 640.0, 1500.0])
-    once = pv.curves(poa, cell_temperature(poa, 30.0, 1.0, "sapm"), 0.054).repeated(3)
-    again = pv.curves(np.repeat(poa, 3), cell_temperature(np.repeat(poa, 3), 30.0, 1.0, "sapm"), 0.054)
-    assert all(np.array_equal(a, b) for a, b in zip(once.params, again.params, strict=True))
+    index = np.array([4, 0, 2, 2, 1, 4, 3, 3, 0, 2])
+    taken = pv.curves(poa, cell_temperature(poa, 30.0, 1.0, "sapm"), 0.054).taken(index)
+    again = pv.curves(poa[index], cell_temperature(poa[index], 30.0, 1.0, "sapm"), 0.054)
+    assert all(np.array_equal(a, b) for a, b in zip(taken.params, again.params, strict=True))
     for name in ("i_sc", "v_oc"):
-        assert np.array_equal(getattr(once, name), getattr(again, name))
-    assert all(np.array_equal(a, b) for a, b in zip(once.mpp(), again.mpp(), strict=True))
-    points = np.linspace(0.0, 1.0, poa.size * 3) * again.v_oc
-    assert np.array_equal(once.current(points), again.current(points), equal_nan=True)
+        assert np.array_equal(getattr(taken, name), getattr(again, name))
+    assert all(np.array_equal(a, b) for a, b in zip(taken.mpp(), again.mpp(), strict=True))
+    points = np.linspace(0.0, 1.0, index.size) * again.v_oc
+    assert np.array_equal(taken.current(points), again.current(points), equal_nan=True)
+    assert np.array_equal(taken.voltage(points / 10), again.voltage(points / 10), equal_nan=True)

@@ -385,29 +385,30 @@ class IVCurve:
         with np.errstate(divide="ignore", invalid="ignore"):
             return v_x * (1.0 + b * np.log1p(-current / scale))
 
-    def repeated(self, count: int) -> IVCurve:
-        """Each curve ``count`` times over, in order (as ``numpy.repeat``), with the derived values
-        it holds (short-circuit current, open-circuit voltage, maximum-power point) worked out once
-        a curve rather than once a copy: an electrical table pairs each stronger sub-panel's curve
-        with every ratio.
+    def taken(self, indices) -> IVCurve:
+        """The curves at ``indices`` (as ``numpy.take``, a curve as often as it is indexed), with
+        the derived values it holds (short-circuit current, open-circuit voltage, maximum-power
+        point) worked out once a curve rather than once a copy: an electrical table pairs each
+        stronger sub-panel's curve with every ratio, and many weaker sub-panels share an
+        irradiance.
 
         Parameters
         ----------
-        count : int
-            Copies of each curve.
+        indices : array_like of int
+            Into the curves (flat).
 
         Returns
         -------
         IVCurve
-            Of ``count`` times as many curves, flat.
+            Shaped as ``indices``.
         """
-        copies = IVCurve(self.model, tuple(np.repeat(p, count) for p in self.params))
+        copies = IVCurve(self.model, tuple(np.take(p, indices) for p in self.params))
         for name in ("i_sc", "v_oc", "_mpp"):
             value = getattr(self, name)
             vars(copies)[name] = (
-                tuple(_kept(np.repeat(v, count)) for v in value)
+                tuple(_kept(np.take(v, indices)) for v in value)
                 if isinstance(value, tuple)
-                else _kept(np.repeat(value, count))
+                else _kept(np.take(value, indices))
             )
         return copies
 
