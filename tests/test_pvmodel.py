@@ -163,3 +163,9 @@ def test_taken_curves_are_the_curves_at_the_taken_irradiances(model):
     points = np.linspace(0.0, 1.0, index.size) * again.v_oc
     assert np.array_equal(taken.current(points), again.current(points), equal_nan=True)
     assert np.array_equal(taken.voltage(points / 10), again.voltage(points / 10), equal_nan=True)
+    # A function of each curve alone, worked out once a distinct curve, is the same.
+    def half_voc_current(curve):
+        return curve.current(0.5 * curve.v_oc), curve.v_oc
+
+    assert all(np.array_equal(a, b, equal_nan=True)
+               for a, b in zip(taken.per_curve(half_voc_current), half_voc_current(again), strict=True))

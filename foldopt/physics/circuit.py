@@ -171,19 +171,25 @@ def _branch_mpp(side: _Explicit, diode: Diode, switch_resistance):
     ``P(I) = I V_pv(I) - I V_d(I) - I^2 R_sw`` is concave in ``I``: ``I V_pv(I)`` is (``V_pv`` is
     concave and decreasing) and ``I V_d(I)`` is convex for every diode model (``I`` times a
     constant; for Shockley's, ``d^2/dI^2 [I ln(1 + I/I_s)] = (I + 2 I_s)/(I + I_s)^2 > 0``). ``I``
-    is monotonic in ``x``, so the power is unimodal in ``x`` and golden-section search finds it.
+    is monotonic in ``x``, so the power is unimodal in ``x`` and golden-section search finds it,
+    once per distinct curve (:meth:`foldopt.physics.pvmodel.IVCurve.per_curve`).
     """
 
-    def power(x):
+    def search(curve):
+        side = _Explicit(curve)
+
+        def power(x):
+            current, voltage, _, _ = side(x)
+            current = np.maximum(current, 0.0)
+            return current * (voltage - diode.drop(current) - current * switch_resistance)
+
+        best, x = connections.golden_section(power, np.zeros_like(side.x_oc), side.x_oc)
         current, voltage, _, _ = side(x)
         current = np.maximum(current, 0.0)
-        return current * (voltage - diode.drop(current) - current * switch_resistance)
+        lit = best > 0
+        return np.where(lit, best, 0.0), voltage - diode.drop(current) - current * switch_resistance
 
-    best, x = connections.golden_section(power, np.zeros_like(side.x_oc), side.x_oc)
-    current, voltage, _, _ = side(x)
-    current = np.maximum(current, 0.0)
-    lit = best > 0
-    return np.where(lit, best, 0.0), voltage - diode.drop(current) - current * switch_resistance
+    return side.curve.per_curve(search)
 
 
 def _load(load_voltage, like):

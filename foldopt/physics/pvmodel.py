@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import operator
 import re
 from dataclasses import dataclass
 
@@ -403,14 +404,35 @@ class IVCurve:
             Shaped as ``indices``.
         """
         copies = IVCurve(self.model, tuple(np.take(p, indices) for p in self.params))
+        vars(copies)["_taken_from"] = (self, indices)
         for name in ("i_sc", "v_oc", "_mpp"):
-            value = getattr(self, name)
+            value = copies.per_curve(operator.attrgetter(name))
             vars(copies)[name] = (
-                tuple(_kept(np.take(v, indices)) for v in value)
-                if isinstance(value, tuple)
-                else _kept(np.take(value, indices))
+                tuple(map(_kept, value)) if isinstance(value, tuple) else _kept(value)
             )
         return copies
+
+    def per_curve(self, function):
+        """``function(curves)``, an array of one value per curve or a tuple of such arrays, worked
+        out once per distinct curve where these curves were taken from fewer (:meth:`taken`).
+
+        Parameters
+        ----------
+        function : callable
+            Of an :class:`IVCurve`, each curve's values independent of the others'.
+
+        Returns
+        -------
+        numpy.ndarray or tuple of numpy.ndarray
+            Shaped as the curves.
+        """
+        if "_taken_from" not in vars(self):
+            return function(self)
+        curves, indices = vars(self)["_taken_from"]
+        value = function(curves)
+        if isinstance(value, tuple):
+            return tuple(np.take(v, indices) for v in value)
+        return np.take(value, indices)
 
     @functools.cached_property
     def i_sc(self):
