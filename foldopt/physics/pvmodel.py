@@ -28,6 +28,8 @@ References
    electrical characteristics provided by the manufacturer data sheet", IEEE PESC 2005.
 .. [5] A. P. Dobos, "PVWatts Version 5 Manual", NREL/TP-6A20-62641, 2014, Eq. 1 (DC power) and
    Eq. 3 (system losses).
+.. [6] A. Jain, A. Kapoor, "Exact analytical solutions of the parameters of real solar cells using
+   Lambert W-function", Solar Energy Materials and Solar Cells 81(2), 269-277, 2004.
 """
 
 from __future__ import annotations
