@@ -169,3 +169,19 @@ def test_taken_curves_are_the_curves_at_the_taken_irradiances(model):
 
     assert all(np.array_equal(a, b, equal_nan=True)
                for a, b in zip(taken.per_curve(half_voc_current), half_voc_current(again), strict=True))
+
+
+def test_a_pvlib_without_its_own_lambert_w_is_called_itself(monkeypatch):
+    """Where pvlib does not solve by its own Lambert W (older releases), the curve calls pvlib's
+    i_from_v and v_from_i: their values whatever they are."""
+    import types
+
+    curve = _diode_curves(np.array([0.0, 300.0, 1000.0]), 25.0, None)
+    # pvlib's own functions keep the module they imported; the curve finds no Lambert W in it.
+    monkeypatch.setattr(pvlib, "singlediode", types.SimpleNamespace())
+    points = np.array([0.1, 0.5, 0.9])
+    with np.errstate(all="ignore"):
+        currents, voltages = (f(points, *curve.params) for f in (pvlib.pvsystem.i_from_v, pvlib.pvsystem.v_from_i))
+    # Were the terms used, the Lambert W hidden above would be called and fail.
+    assert np.array_equal(curve.current(points), currents, equal_nan=True)
+    assert np.array_equal(curve.voltage(points), voltages, equal_nan=True)
