@@ -372,10 +372,11 @@ class IVCurve:
                 t, (il, io, rs, _, a) = self._diode_terms(current)
                 exponent = (-current + il + io) / t["v_scale"]
                 argument = t["v_factor"] * np.exp(exponent)
-                w = np.zeros_like(argument)
                 # Where the argument overflows, Lambert W from its logarithm.
                 overflow = np.isinf(argument)
-                w[~overflow] = pvlib.singlediode._lambertw_pvlib(argument[~overflow])
+                finite = ~overflow
+                w = np.empty_like(argument)
+                w[finite] = pvlib.singlediode._lambertw_pvlib(argument[finite])
                 if np.any(overflow):
                     w[overflow] = pvlib.singlediode._log_lambertw((t["v_log"] + exponent)[overflow])
                 voltage = (t["i_offset"] - current) / t["gsh"] - current * rs - a * w
