@@ -3,8 +3,10 @@
 import numpy as np
 import pvlib
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from foldopt.physics.pvmodel import A300_CELL, ROBLES_200W, PVModel, cec_module, fit_b
+from foldopt.physics.pvmodel import A300_CELL, ROBLES_200W, IVCurve, PVModel, cec_module, fit_b
 from foldopt.physics.temperature import cell_temperature
 
 
@@ -98,3 +100,88 @@ def test_a_curves_points_are_kept_and_its_maximum_power_is_the_callers(model, po
     power = pv.max_power(poa, 25.0, 0.054)
     power += 1.0  # the caller's own array
     assert np.array_equal(curve.mpp()[0], first[0]) and np.array_equal(pv.max_power(poa, 25.0, 0.054), first[0])
+
+
+def _diode_curves(poa, temp_cell, module):
+    """Single-diode curves of the A-300 cell or a CEC module, with dark ones (R_sh infinite, where
+    pvlib's v_from_i takes its explicit form) among them."""
+    pv = PVModel("single-diode", module=module)
+    return pv.curves(np.asarray(poa), temp_cell, 3.0 * pv.unit_area)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    poa=st.lists(st.sampled_from([0.0, 1e-9, 1e-3]) | st.floats(0.0, 2000.0), min_size=1, max_size=12),
+    temp_cell=st.floats(-70.0, 90.0),
+    module=st.sampled_from([None, "CS5P-220M"]),
+    fractions=st.lists(st.floats(-0.5, 1.5), min_size=3, max_size=3),
+)
+def test_current_and_voltage_are_pvlibs_to_the_bit(poa, temp_cell, module, fractions):
+    """A curve's current and voltage (its terms of the parameters alone worked out once) are
+    pvlib's i_from_v and v_from_i to the bit, inside and beyond the curve, dark curves included,
+    at the curves' shape and with a trailing axis of operating points."""
+    curve = _diode_curves(poa, temp_cell, module)
+    with np.errstate(all="ignore"):
+        v_oc = np.nan_to_num(pvlib.pvsystem.v_from_i(0.0, *curve.params))
+        i_sc = np.nan_to_num(pvlib.pvsystem.i_from_v(0.0, *curve.params))
+    for scale, ours, theirs in ((v_oc, curve.current, pvlib.pvsystem.i_from_v),
+                                (i_sc, curve.voltage, pvlib.pvsystem.v_from_i)):
+        for point in (fractions[0] * scale, np.asarray(fractions) * scale[:, None]):
+            params = [np.reshape(p, p.shape + (1,) * (point.ndim - p.ndim)) for p in curve.params]
+            with np.errstate(all="ignore"):
+                expected = theirs(point, *params)
+            assert np.array_equal(ours(point), expected, equal_nan=True)
+
+
+def test_current_and_voltage_without_series_or_shunt_resistance_are_pvlibs():
+    """Where R_s = 0 (pvlib's i_from_v explicit) or R_sh is infinite (v_from_i explicit), mixed with
+    curves that take Lambert W, the values are still pvlib's to the bit."""
+    curve = _diode_curves(np.array([800.0, 300.0, 0.0]), 25.0, None)
+    il, io, rs, rsh, a = (np.array(p, dtype=float) for p in curve.params)
+    rs[0], rsh[1] = 0.0, np.inf
+    mixed = IVCurve("single-diode", (il, io, rs, rsh, a))
+    points = np.array([0.0, 0.3, 0.9])
+    with np.errstate(all="ignore"):
+        currents, voltages = (f(points, il, io, rs, rsh, a) for f in (pvlib.pvsystem.i_from_v, pvlib.pvsystem.v_from_i))
+    assert np.array_equal(mixed.current(points), currents, equal_nan=True)
+    assert np.array_equal(mixed.voltage(points), voltages, equal_nan=True)
+
+
+@pytest.mark.parametrize("model", ["single-diode", "b-model"])
+def test_taken_curves_are_the_curves_at_the_taken_irradiances(model):
+    """Curves taken at indices, a curve many times (their points worked out once a curve), are, to
+    the bit, the curves of the irradiances so taken with every point worked out again."""
+    pv = PVModel(model=model)
+    poa = np.array([0.0, 1e-6, 120.0, 640.0, 1500.0])
+    index = np.array([4, 0, 2, 2, 1, 4, 3, 3, 0, 2])
+    taken = pv.curves(poa, cell_temperature(poa, 30.0, 1.0, "sapm"), 0.054).taken(index)
+    again = pv.curves(poa[index], cell_temperature(poa[index], 30.0, 1.0, "sapm"), 0.054)
+    assert all(np.array_equal(a, b) for a, b in zip(taken.params, again.params, strict=True))
+    for name in ("i_sc", "v_oc"):
+        assert np.array_equal(getattr(taken, name), getattr(again, name))
+    assert all(np.array_equal(a, b) for a, b in zip(taken.mpp(), again.mpp(), strict=True))
+    points = np.linspace(0.0, 1.0, index.size) * again.v_oc
+    assert np.array_equal(taken.current(points), again.current(points), equal_nan=True)
+    assert np.array_equal(taken.voltage(points / 10), again.voltage(points / 10), equal_nan=True)
+    # A function of each curve alone, worked out once a distinct curve, is the same.
+    def half_voc_current(curve):
+        return curve.current(0.5 * curve.v_oc), curve.v_oc
+
+    assert all(np.array_equal(a, b, equal_nan=True)
+               for a, b in zip(taken.per_curve(half_voc_current), half_voc_current(again), strict=True))
+
+
+def test_a_pvlib_without_its_own_lambert_w_is_called_itself(monkeypatch):
+    """Where pvlib does not solve by its own Lambert W (older releases), the curve calls pvlib's
+    i_from_v and v_from_i: their values whatever they are."""
+    import types
+
+    curve = _diode_curves(np.array([0.0, 300.0, 1000.0]), 25.0, None)
+    # pvlib's own functions keep the module they imported; the curve finds no Lambert W in it.
+    monkeypatch.setattr(pvlib, "singlediode", types.SimpleNamespace())
+    points = np.array([0.1, 0.5, 0.9])
+    with np.errstate(all="ignore"):
+        currents, voltages = (f(points, *curve.params) for f in (pvlib.pvsystem.i_from_v, pvlib.pvsystem.v_from_i))
+    # Were the terms used, the Lambert W hidden above would be called and fail.
+    assert np.array_equal(curve.current(points), currents, equal_nan=True)
+    assert np.array_equal(curve.voltage(points), voltages, equal_nan=True)

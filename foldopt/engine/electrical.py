@@ -224,9 +224,7 @@ class Electrical:
             grid.ravel()
             for grid in np.meshgrid(_nodes(TABLE_NODES_2D), _ratio_nodes(connection), indexing="ij")
         )
-        weak = strong * ratio
-        east = self.pv.curves(strong, self._temperature(strong), self.subpanel_area)
-        west = self.pv.curves(weak, self._temperature(weak), self.subpanel_area)
+        east, west = self._curves(strong), self._curves(strong * ratio)
         bound = east.max_power() + west.max_power()
         if self._panel_side_built:
             power = pair_power(
@@ -245,6 +243,15 @@ class Electrical:
                 1.0  # identical sub-panels at equal irradiance deliver exactly their sum
             )
         return fraction
+
+    def _curves(self, poa):
+        """Sub-panels' I-V curves at irradiances ``poa`` (flat), each distinct irradiance's worked
+        out once: a pair table's stronger sub-panel takes each of its nodes once a ratio, and half
+        the weaker ones' irradiances repeat (products of the nodes)."""
+        distinct, index = np.unique(poa, return_inverse=True)
+        return self.pv.curves(distinct, self._temperature(distinct), self.subpanel_area).taken(
+            index
+        )
 
     def subpanel_power(self, poa):
         """Maximum power of one sub-panel.

@@ -89,28 +89,47 @@ class _Explicit:
     def x_oc(self):
         return self.curve.v_oc  # u = V at I = 0; the b-model's parameter is V itself
 
-    def __call__(self, x):
-        """Current, voltage and their derivatives in ``x``: ``I, V, dI/dx, dV/dx``."""
+    @functools.cached_property
+    def _terms(self):
+        """The parameters and the terms of :meth:`__call__` that depend on them alone, worked out
+        once: a Newton solve calls it some ten times at each of some 50 operating points."""
         if self.curve.model == "single-diode":
-            # I = I_L - I_0 (exp(u / a) - 1) - u / R_sh and V = u - I R_s (Bishop [1]_).
-            il, io, rs, rsh, a = (_expand(p, x) for p in self.curve.params)
-            current = il - io * np.expm1(x / a) - x / rsh
-            slope = -io / a * np.exp(x / a) - 1.0 / rsh
-            return current, x - current * rs, slope, 1.0 - rs * slope
+            il, io, rs, rsh, a = self.curve.params
+            return il, io, rs, rsh, a, -io / a, 1.0 / rsh
         if self.curve.model == "b-model":
-            v_x, i_x, b = (_expand(p, x) for p in self.curve.params)
+            v_x, i_x, b = self.curve.params
             lit = v_x > 0
             v_x = np.where(lit, v_x, 1.0)  # a dark curve sources nothing; avoid 0/0
             scale = i_x / -np.expm1(-1.0 / b)
-            growth = np.exp((x / v_x - 1.0) / b)
-            current = np.where(lit, scale * (1.0 - growth), 0.0)
-            return (
-                current,
-                x,
-                np.where(lit, -scale * growth / (v_x * b), 0.0),
-                np.ones_like(current),
-            )
+            return lit, v_x, b, scale, -scale, v_x * b
         raise ValueError(f"no I-V curve of model {self.curve.model!r}")
+
+    @functools.cached_property
+    def _by_rank(self):
+        return {}
+
+    def __call__(self, x):
+        """Current, voltage and their derivatives in ``x``: ``I, V, dI/dx, dV/dx``."""
+        rank = np.ndim(x)
+        if rank not in self._by_rank:
+            self._by_rank[rank] = tuple(_expand(p, x) for p in self._terms)
+        terms = self._by_rank[rank]
+        if self.curve.model == "single-diode":
+            # I = I_L - I_0 (exp(u / a) - 1) - u / R_sh and V = u - I R_s (Bishop [1]_).
+            il, io, rs, rsh, a, slope_factor, conductance = terms
+            scaled = x / a
+            current = il - io * np.expm1(scaled) - x / rsh
+            slope = slope_factor * np.exp(scaled) - conductance
+            return current, x - current * rs, slope, 1.0 - rs * slope
+        lit, v_x, b, scale, slope_factor, slope_scale = terms
+        growth = np.exp((x / v_x - 1.0) / b)
+        current = np.where(lit, scale * (1.0 - growth), 0.0)
+        return (
+            current,
+            x,
+            np.where(lit, slope_factor * growth / slope_scale, 0.0),
+            np.ones_like(current),
+        )
 
 
 def _output_current(side: _Explicit, voltage, diode: Diode, switch_resistance):
@@ -152,19 +171,25 @@ def _branch_mpp(side: _Explicit, diode: Diode, switch_resistance):
     ``P(I) = I V_pv(I) - I V_d(I) - I^2 R_sw`` is concave in ``I``: ``I V_pv(I)`` is (``V_pv`` is
     concave and decreasing) and ``I V_d(I)`` is convex for every diode model (``I`` times a
     constant; for Shockley's, ``d^2/dI^2 [I ln(1 + I/I_s)] = (I + 2 I_s)/(I + I_s)^2 > 0``). ``I``
-    is monotonic in ``x``, so the power is unimodal in ``x`` and golden-section search finds it.
+    is monotonic in ``x``, so the power is unimodal in ``x`` and golden-section search finds it,
+    once per distinct curve (:meth:`foldopt.physics.pvmodel.IVCurve.per_curve`).
     """
 
-    def power(x):
+    def search(curve):
+        side = _Explicit(curve)
+
+        def power(x):
+            current, voltage, _, _ = side(x)
+            current = np.maximum(current, 0.0)
+            return current * (voltage - diode.drop(current) - current * switch_resistance)
+
+        best, x = connections.golden_section(power, np.zeros_like(side.x_oc), side.x_oc)
         current, voltage, _, _ = side(x)
         current = np.maximum(current, 0.0)
-        return current * (voltage - diode.drop(current) - current * switch_resistance)
+        lit = best > 0
+        return np.where(lit, best, 0.0), voltage - diode.drop(current) - current * switch_resistance
 
-    best, x = connections.golden_section(power, np.zeros_like(side.x_oc), side.x_oc)
-    current, voltage, _, _ = side(x)
-    current = np.maximum(current, 0.0)
-    lit = best > 0
-    return np.where(lit, best, 0.0), voltage - diode.drop(current) - current * switch_resistance
+    return side.curve.per_curve(search)
 
 
 def _load(load_voltage, like):

@@ -28,12 +28,15 @@ References
    electrical characteristics provided by the manufacturer data sheet", IEEE PESC 2005.
 .. [5] A. P. Dobos, "PVWatts Version 5 Manual", NREL/TP-6A20-62641, 2014, Eq. 1 (DC power) and
    Eq. 3 (system losses).
+.. [6] A. Jain, A. Kapoor, "Exact analytical solutions of the parameters of real solar cells using
+   Lambert W-function", Solar Energy Materials and Solar Cells 81(2), 269-277, 2004.
 """
 
 from __future__ import annotations
 
 import difflib
 import functools
+import operator
 import re
 from dataclasses import dataclass
 
@@ -256,8 +259,59 @@ class IVCurve:
     params: tuple
 
     def _params(self, x):
-        extra = np.ndim(x) - np.ndim(self.params[0])
-        return [np.reshape(p, np.shape(p) + (1,) * extra) for p in self.params]
+        return _trailing(self.params, x)
+
+    @functools.cached_property
+    def _terms(self):
+        """The terms of :meth:`current` and :meth:`voltage` that depend on the parameters alone,
+        worked out once a curve: a pair's golden-section search calls both some 40 times on the
+        same curves (:func:`foldopt.physics.connections.parallel_power`).
+
+        For the single-diode model these are the terms of pvlib's Lambert-W solutions
+        (``pvlib.pvsystem.i_from_v`` and ``v_from_i``, method ``lambertw``: Jain and Kapoor [6]_
+        Eq. 2 and 3, in the shunt conductance ``G_sh = 1 / R_sh``), each computed as pvlib computes
+        it; :meth:`current` and :meth:`voltage` do pvlib's remaining operations in its order, so
+        they return pvlib's values to the bit. None where this pvlib solves otherwise (it does
+        not expose its Lambert W): pvlib's functions are called then.
+        """
+        if self.model == "b-model":
+            v_x, i_x, b = self.params
+            return {"scale": i_x / -np.expm1(-1.0 / b)}
+        import pvlib.singlediode
+
+        if not hasattr(pvlib.singlediode, "_lambertw_pvlib"):
+            return None
+        # Contiguous, as pvlib's masked copies are: NumPy may take another loop (and other last
+        # bits) for its transcendental functions on strided arrays.
+        il, io, rs, rsh, a = (np.ascontiguousarray(p, dtype=float) for p in self.params)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            gsh = 1.0 / rsh
+            denominator = rs * gsh + 1.0
+            i_scale, v_scale = a * denominator, gsh * a
+            return {
+                # i_from_v: Lambert W where R_s > 0, explicit where R_s = 0.
+                "i_lambert": 0.0 < rs,
+                "i_explicit": 0.0 == rs,
+                "i_factor": rs * io / i_scale,
+                "i_shift": rs * (il + io),
+                "i_scale": i_scale,
+                "i_offset": il + io,
+                "denominator": denominator,
+                "a_over_rs": a / rs,
+                # v_from_i: Lambert W where G_sh > 0, explicit where G_sh = 0 (R_sh infinite).
+                "v_lambert": 0.0 < gsh,
+                "v_explicit": 0.0 == gsh,
+                "v_factor": io / v_scale,
+                "v_scale": v_scale,
+                "v_log": np.log(io) - np.log(gsh) - np.log(a),
+                "gsh": gsh,
+            }
+
+    def _diode_terms(self, x):
+        """:attr:`_terms` and the parameters, shaped to broadcast against ``x``."""
+        names = tuple(self._terms)
+        shaped = _trailing(tuple(self._terms.values()) + tuple(self.params), x)
+        return dict(zip(names, shaped)), shaped[len(names) :]
 
     def current(self, voltage):
         """Current of each curve at a voltage.
@@ -275,9 +329,23 @@ class IVCurve:
         if self.model == "single-diode":
             import pvlib
 
-            return pvlib.pvsystem.i_from_v(voltage, *self._params(voltage))
+            if self._terms is None:
+                return pvlib.pvsystem.i_from_v(voltage, *self._params(voltage))
+            t, (il, io, _, _, a) = self._diode_terms(voltage)
+            # The Lambert-W argument may overflow to inf where the explicit form holds instead.
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                w = pvlib.singlediode._lambertw_pvlib(
+                    t["i_factor"] * np.exp((t["i_shift"] + voltage) / t["i_scale"])
+                )
+                current = (t["i_offset"] - voltage * t["gsh"]) / t["denominator"] - t[
+                    "a_over_rs"
+                ] * w
+                if np.all(t["i_lambert"]):
+                    return current
+                explicit = il - io * np.expm1(voltage / a) - t["gsh"] * voltage
+            return np.where(t["i_lambert"], current, np.where(t["i_explicit"], explicit, np.nan))
         v_x, i_x, b = self._params(voltage)
-        scale = i_x / -np.expm1(-1.0 / b)
+        scale = _trailing((self._terms["scale"],), voltage)[0]
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(v_x > 0, scale * -np.expm1((voltage / v_x - 1.0) / b), 0.0)
 
@@ -296,14 +364,78 @@ class IVCurve:
         """
         if self.model == "single-diode":
             # pvlib's Lambert-W overflows for practically dark cells; `lit` handles those.
-            with np.errstate(over="ignore", invalid="ignore"):
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
                 import pvlib
 
-                return pvlib.pvsystem.v_from_i(current, *self._params(current))
+                if self._terms is None:
+                    return pvlib.pvsystem.v_from_i(current, *self._params(current))
+                t, (il, io, rs, _, a) = self._diode_terms(current)
+                exponent = (-current + il + io) / t["v_scale"]
+                argument = t["v_factor"] * np.exp(exponent)
+                # Where the argument overflows, Lambert W from its logarithm.
+                overflow = np.isinf(argument)
+                finite = ~overflow
+                w = np.empty_like(argument)
+                w[finite] = pvlib.singlediode._lambertw_pvlib(argument[finite])
+                if np.any(overflow):
+                    w[overflow] = pvlib.singlediode._log_lambertw((t["v_log"] + exponent)[overflow])
+                voltage = (t["i_offset"] - current) / t["gsh"] - current * rs - a * w
+                if np.all(t["v_lambert"]):
+                    return voltage
+                explicit = a * np.log1p((il - current) / io) - current * rs
+            return np.where(t["v_lambert"], voltage, np.where(t["v_explicit"], explicit, np.nan))
         v_x, i_x, b = self._params(current)
-        scale = i_x / -np.expm1(-1.0 / b)
+        scale = _trailing((self._terms["scale"],), current)[0]
         with np.errstate(divide="ignore", invalid="ignore"):
             return v_x * (1.0 + b * np.log1p(-current / scale))
+
+    def taken(self, indices) -> IVCurve:
+        """The curves at ``indices`` (as ``numpy.take``, a curve as often as it is indexed), with
+        the derived values it holds (short-circuit current, open-circuit voltage, maximum-power
+        point) worked out once a curve rather than once a copy: an electrical table pairs each
+        stronger sub-panel's curve with every ratio, and many weaker sub-panels share an
+        irradiance.
+
+        Parameters
+        ----------
+        indices : array_like of int
+            Into the curves (flat).
+
+        Returns
+        -------
+        IVCurve
+            Shaped as ``indices``.
+        """
+        copies = IVCurve(self.model, tuple(np.take(p, indices) for p in self.params))
+        vars(copies)["_taken_from"] = (self, indices)
+        for name in ("i_sc", "v_oc", "_mpp"):
+            value = copies.per_curve(operator.attrgetter(name))
+            vars(copies)[name] = (
+                tuple(map(_kept, value)) if isinstance(value, tuple) else _kept(value)
+            )
+        return copies
+
+    def per_curve(self, function):
+        """``function(curves)``, an array of one value per curve or a tuple of such arrays, worked
+        out once per distinct curve where these curves were taken from fewer (:meth:`taken`).
+
+        Parameters
+        ----------
+        function : callable
+            Of an :class:`IVCurve`, each curve's values independent of the others'.
+
+        Returns
+        -------
+        numpy.ndarray or tuple of numpy.ndarray
+            Shaped as the curves.
+        """
+        if "_taken_from" not in vars(self):
+            return function(self)
+        curves, indices = vars(self)["_taken_from"]
+        value = function(curves)
+        if isinstance(value, tuple):
+            return tuple(np.take(v, indices) for v in value)
+        return np.take(value, indices)
 
     @functools.cached_property
     def i_sc(self):
@@ -355,6 +487,12 @@ class IVCurve:
     def max_power(self):
         """Maximum power [W] of each curve (a new array)."""
         return self.mpp()[0].copy()
+
+
+def _trailing(arrays, x):
+    """``arrays`` (of the curves' shape) with trailing axes of 1 to broadcast against ``x``."""
+    extra = np.ndim(x) - np.ndim(arrays[0])
+    return [np.reshape(p, np.shape(p) + (1,) * extra) for p in arrays]
 
 
 def _kept(values):
