@@ -9,6 +9,7 @@ import hashlib
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -165,6 +166,31 @@ def pvgis(server, tmp_path, monkeypatch, request):
     return route
 
 
+@pytest.fixture(scope="module")
+def cached(server, tmp_path_factory):
+    """``cached(tmp_path, *options)``: the cache of ``weather fetch *options`` in the test's own
+    cache folder, as the fetch leaves it (the answer and its provenance record), for tests that
+    start from a cached answer (a fault must leave it as it was; a damaged copy). Each fetch is
+    made once a module, from the server's recorded answers, and copied; returns the test's
+    :func:`cache_files`."""
+    made = {}
+
+    def copy(tmp_path: Path, *options) -> dict:
+        if options not in made:
+            folder = tmp_path_factory.mktemp("cached")
+            with pytest.MonkeyPatch.context() as patch:
+                patch.setenv("FOLDOPT_CACHE_DIR", str(folder))
+                patch.setenv("FOLDOPT_PVGIS_URL", f"http://127.0.0.1:{server}/ok-cached/api/v5_3/")
+                patch.delenv("FOLDOPT_OFFLINE", raising=False)
+                done = runner.invoke(app, ["weather", "fetch", *options])
+            assert done.exit_code == 0, done.output
+            made[options] = folder / "weather"
+        shutil.copytree(made[options], tmp_path / "cache" / "weather", dirs_exist_ok=True)
+        return cache_files(tmp_path)
+
+    return copy
+
+
 def cache_files(tmp_path: Path) -> dict:
     folder = tmp_path / "cache" / "weather"
     return {p.name: p.read_bytes() for p in sorted(folder.iterdir())} if folder.is_dir() else {}
@@ -265,12 +291,10 @@ FAULTS = [
 
 
 @pytest.mark.parametrize(("mode", "options", "said"), FAULTS, ids=[f[0] for f in FAULTS])
-def test_a_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path, mode,
+def test_a_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, cached, tmp_path, mode,
                                                             options, said):
-    pvgis("ok")
-    kept = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8", "--no-horizon"])
-    assert kept.exit_code == 0, kept.output
-    before = cache_files(tmp_path)
+    before = cached(tmp_path, "--lat", "45", "--lon", "8", "--no-horizon")
+    assert before
     route = pvgis(mode)
     started = time.monotonic()
     result = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8", *options])
@@ -479,12 +503,10 @@ HORIZON_FAULTS = [
 
 
 @pytest.mark.parametrize(("mode", "said"), HORIZON_FAULTS, ids=[f[0] for f in HORIZON_FAULTS])
-def test_a_horizon_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path,
+def test_a_horizon_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, cached, tmp_path,
                                                                     mode, said):
-    pvgis("ok")
-    kept = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
-    assert kept.exit_code == 0, kept.output
-    before = cache_files(tmp_path)
+    before = cached(tmp_path, "--lat", "45", "--lon", "8")
+    assert before
     route = pvgis(mode)
     result = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "x"])
     assert result.exit_code == 2, result.output
@@ -587,12 +609,10 @@ HOURLY_FAULTS = [
 
 
 @pytest.mark.parametrize(("mode", "said"), HOURLY_FAULTS, ids=[f[0] for f in HOURLY_FAULTS])
-def test_an_hourly_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path, mode, said):
-    pvgis("ok")
-    kept = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8",
-                               "--years", "2019:2020"])
-    assert kept.exit_code == 0, kept.output
-    before = cache_files(tmp_path)
+def test_an_hourly_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, cached, tmp_path, mode,
+                                                                    said):
+    before = cached(tmp_path, "pvgis-hourly", "--lat", "45", "--lon", "8", "--years", "2019:2020")
+    assert before
     route = pvgis(mode)
     result = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, "--out", "x"])
     assert result.exit_code == 2, result.output
