@@ -202,11 +202,13 @@ def csv_files(folder: Path) -> dict:
 
 @pytest.mark.parametrize("days", ["2025-06-21", "2025-01-15,2025-06-21,2025-09-30"],
                          ids=["a day, every angle", "three days, one angle"])
-def test_the_fetched_year_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, days):
+def test_the_fetched_year_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, figures_drawn_elsewhere,
+                                                           days):
     route = pvgis("ok")
     fetched = runner.invoke(app, [*SWEEP, "--days", days, "--weather", "pvgis-tmy", "--out", "fetched"])
     assert fetched.exit_code == 0, fetched.output
-    read = runner.invoke(app, [*SWEEP, "--days", days, "--weather", str(RECORDED), "--out", "read"])
+    with figures_drawn_elsewhere():  # the fetched run's, of the same data
+        read = runner.invoke(app, [*SWEEP, "--days", days, "--weather", str(RECORDED), "--out", "read"])
     assert read.exit_code == 0, read.output
     fetched, read = json.loads(fetched.stdout), json.loads(read.stdout)
     assert fetched["rows"] == read["rows"]  # every design's t_solar (at every angle of a day)
@@ -446,11 +448,12 @@ def test_a_maps_weather_options_are_checked_before_anything_is_fetched(pvgis, se
 HORIZON_DAY = [*SWEEP, "--days", "2025-01-15"]  # a low winter sun, under the hills to the south
 
 
-def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path):
+def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, figures_drawn_elsewhere):
     route = pvgis("ok")
     fetched = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "fetched"])
     assert fetched.exit_code == 0, fetched.output
-    read = runner.invoke(app, [*HORIZON_DAY, "--horizon", str(HORIZON), "--out", "read"])
+    with figures_drawn_elsewhere():  # the fetched run's, of the same data
+        read = runner.invoke(app, [*HORIZON_DAY, "--horizon", str(HORIZON), "--out", "read"])
     assert read.exit_code == 0, read.output
     flat = runner.invoke(app, [*HORIZON_DAY, "--out", "flat"])
     assert flat.exit_code == 0, flat.output
@@ -469,11 +472,12 @@ def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_
     assert meta["horizon_source"]["sha256"] == provenance["sha256"]
     assert "horizon_source" not in json.loads((tmp_path / "read" / "run.json").read_text())
     # a second run asks nothing; offline, a service that would fail is never asked
-    again = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "again"])
-    assert again.exit_code == 0 and json.loads(again.stdout)["rows"] == read["rows"]
-    assert requests_made(server, route) == 1
-    dead = pvgis("e500")
-    offline = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--offline", "--out", "off"])
+    with figures_drawn_elsewhere():  # the first run's, of the same data
+        again = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "again"])
+        assert again.exit_code == 0 and json.loads(again.stdout)["rows"] == read["rows"]
+        assert requests_made(server, route) == 1
+        dead = pvgis("e500")
+        offline = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--offline", "--out", "off"])
     assert offline.exit_code == 0, offline.output
     assert json.loads(offline.stdout)["rows"] == read["rows"]
     assert requests_made(server, dead) == 0
@@ -546,14 +550,15 @@ def read_as_a_users_file(*options) -> list:
     return [*HOURLY_SWEEP, "--weather", str(HOURLY), "--weather-format", "pvgis-hourly", *options]
 
 
-def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path):
+def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, figures_drawn_elsewhere):
     """The whole span, 731 real days each a block: the fetched series gives every fold angle's
     mean t_solar to the bit as the recorded file read as a user's file; the request is
     get_pvgis_hourly's for a horizontal plane with the components."""
     route = pvgis("ok")
     fetched = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, "--out", "fetched"])
     assert fetched.exit_code == 0, fetched.output
-    read = runner.invoke(app, [*read_as_a_users_file(), "--out", "read"])
+    with figures_drawn_elsewhere():  # the fetched run's, of the same data
+        read = runner.invoke(app, [*read_as_a_users_file(), "--out", "read"])
     assert read.exit_code == 0, read.output
     fetched, read = json.loads(fetched.stdout), json.loads(read.stdout)
     assert fetched["rows"] == read["rows"]  # each day's t_solar at the chosen angle, to the bit
@@ -574,7 +579,8 @@ def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_p
     assert meta["weather_source"]["sha256"] == hashlib.sha256(HOURLY.read_bytes()).hexdigest()
 
 
-def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path):
+def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path,
+                                                                          figures_drawn_elsewhere):
     route = pvgis("ok")
     for _ in range(2):
         result = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8", *YEARS])
@@ -588,7 +594,8 @@ def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis,
     offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
                                   "--out", "offline"])
     assert offline.exit_code == 0, offline.output
-    read = runner.invoke(app, [*read_as_a_users_file(*days), "--out", "read"])
+    with figures_drawn_elsewhere():  # the offline run's, of the same data
+        read = runner.invoke(app, [*read_as_a_users_file(*days), "--out", "read"])
     assert json.loads(offline.stdout)["rows"] == json.loads(read.stdout)["rows"]
     assert requests_made(server, dead) == 0
     other = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", "--years", "2019:2020", *days,
