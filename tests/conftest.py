@@ -342,3 +342,21 @@ def in_process_scheduler():
     """For session-scoped fixtures that run a map: the context manager :func:`scheduler` enters,
     to enter for as long as the map runs."""
     return _in_process_cluster
+
+
+@contextlib.contextmanager
+def _figures_not_drawn():
+    """Within the block, a results folder's figures are written as a PNG of one pixel without
+    being drawn at all."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr("foldopt.output.figures.figure_bytes", lambda file, args, kwargs: _one_pixel_png())
+        yield
+
+
+@pytest.fixture(scope="session")
+def figures_drawn_elsewhere():
+    """For a run whose figures the test draws in another run from the same data (another view of
+    one answer, one weather fetched and read from its file), whose folder is read for its tables
+    and answers only: the context manager :func:`_figures_not_drawn`. Drawing a figure, even
+    without its pixels, costs a few tenths of a second."""
+    return _figures_not_drawn

@@ -26,16 +26,17 @@ TABLES = ("storage_annual", "storage_years", "storage_monthly", "design_space")
 
 
 @pytest.fixture(scope="module")
-def views(tmp_path_factory, without_pixels):
+def views(tmp_path_factory, figures_drawn_elsewhere):
     """The study through the command line (terminal and JSON) and through the API. The terminal's
     folder is the one a user gets, its figures drawn whole (set up before any test's own fixtures,
     it is drawn outside conftest's patch; it stands in test_cli_studies' run of every shipped
-    study); the JSON's and the API's folders are read for their tables and answers only."""
+    study); the JSON's and the API's folders, of the same answer, are read for their tables and
+    answers only: their figures are the terminal's, not drawn again."""
     folder = tmp_path_factory.mktemp("camera-winter")
     runner = CliRunner()
     terminal = runner.invoke(app, ["run", str(STUDY), "--out", str(folder / "cli")])
     assert terminal.exit_code == 0, terminal.output
-    with without_pixels():
+    with figures_drawn_elsewhere():
         done = runner.invoke(
             app, ["run", str(STUDY), "--out", str(folder / "json"), "--format", "json"]
         )

@@ -23,10 +23,11 @@ import yaml
 from foldopt.cli.app import app
 from foldopt.errors import ConfigError
 from foldopt.inputs.study_file import default_study_path
-from test_weather_fetch import (  # noqa: F401 - pvgis and server: fixtures
+from test_weather_fetch import (  # noqa: F401 - cached, pvgis and server: fixtures
     RECORDED,
     SWEEP,
     cache_files,
+    cached,
     pvgis,
     queries_made,
     requests_made,
@@ -47,10 +48,9 @@ def one_error_line(result) -> str:
     return lines[0].removeprefix("error: ")
 
 
-def kept_entry(tmp_path) -> dict:
+def kept_entry(cached, tmp_path) -> dict:
     """A cached answer of other options (without the horizon) that a fault must leave as it is."""
-    assert runner.invoke(app, [*FETCH, "--no-horizon"]).exit_code == 0
-    before = cache_files(tmp_path)
+    before = cached(tmp_path, *FETCH[2:], "--no-horizon")
     assert len(before) == 2
     return before
 
@@ -69,9 +69,8 @@ def study_file(tmp_path, name: str, site: dict, weather: dict | None = None) -> 
 #    half second (its headers at once, or not even the status line whole) is given up on.
 
 @pytest.mark.parametrize("mode", ["trickle", "tricklehead"])
-def test_a_trickling_service_is_given_up_on_at_the_deadline(pvgis, server, tmp_path, mode):
-    pvgis("ok")
-    before = kept_entry(tmp_path)
+def test_a_trickling_service_is_given_up_on_at_the_deadline(pvgis, server, cached, tmp_path, mode):
+    before = kept_entry(cached, tmp_path)
     route = pvgis(mode)
     started = time.monotonic()
     line = one_error_line(runner.invoke(app, [*FETCH, "--timeout", "1"]))
@@ -221,17 +220,17 @@ DAMAGES = {"a flipped value": (_flip, "its SHA-256 is not the one recorded"),
            "no answer": (_no_answer, "its answer is missing")}
 
 
-def damaged_cache(tmp_path, damage) -> tuple[Path, dict]:
-    assert runner.invoke(app, FETCH).exit_code == 0
+def damaged_cache(cached, tmp_path, damage) -> tuple[Path, dict]:
+    cached(tmp_path, *FETCH[2:])
     answer = next(p for p in (tmp_path / "cache" / "weather").iterdir() if "provenance" not in p.name)
     damage(answer)
     return answer, cache_files(tmp_path)
 
 
 @pytest.mark.parametrize("damage", list(DAMAGES))
-def test_a_damaged_cached_copy_is_named_offline_and_by_weather_path(pvgis, server, tmp_path, damage):
-    pvgis("ok")
-    answer, before = damaged_cache(tmp_path, DAMAGES[damage][0])
+def test_a_damaged_cached_copy_is_named_offline_and_by_weather_path(pvgis, server, cached, tmp_path,
+                                                                     damage):
+    answer, before = damaged_cache(cached, tmp_path, DAMAGES[damage][0])
     dead = pvgis("e500")
     for command in ([*SWEEP, "--days", "2025-06-21", "--weather", "pvgis-tmy", "--offline", "--out", "x"],
                     ["weather", "path", *SITE]):
@@ -244,31 +243,30 @@ def test_a_damaged_cached_copy_is_named_offline_and_by_weather_path(pvgis, serve
 
 
 @pytest.mark.parametrize("damage", list(DAMAGES))
-def test_a_damaged_cached_copy_is_fetched_again_online(pvgis, server, tmp_path, damage):
+def test_a_damaged_cached_copy_is_fetched_again_online(pvgis, server, cached, tmp_path, damage):
     route = pvgis("ok")
-    answer, _ = damaged_cache(tmp_path, DAMAGES[damage][0])
+    answer, _ = damaged_cache(cached, tmp_path, DAMAGES[damage][0])
     result = runner.invoke(app, [*SWEEP, "--days", "2025-06-21", "--weather", "pvgis-tmy", "--out", "x"])
     assert result.exit_code == 0, result.output
     (said,) = result.stderr.strip().splitlines()  # named, once
     assert said.startswith(f"foldopt: the cached copy {answer} was damaged (")
     assert said.endswith("); fetched it again") and DAMAGES[damage][1] in said
-    assert answer.read_bytes() == RECORDED.read_bytes() and requests_made(server, route) == 2
+    assert answer.read_bytes() == RECORDED.read_bytes() and requests_made(server, route) == 1  # again
     meta = json.loads((tmp_path / "x" / "run.json").read_text())
     assert meta["weather_source"]["sha256"] == hashlib.sha256(RECORDED.read_bytes()).hexdigest()
 
 
-def test_a_damaged_copy_whose_refetch_fails_is_left_as_it_was(pvgis, server, tmp_path):
-    pvgis("ok")
-    _, before = damaged_cache(tmp_path, _flip)
+def test_a_damaged_copy_whose_refetch_fails_is_left_as_it_was(pvgis, server, cached, tmp_path):
+    _, before = damaged_cache(cached, tmp_path, _flip)
     route = pvgis("e500")
     line = one_error_line(runner.invoke(app, FETCH))
     assert line == "weather pvgis-tmy: PVGIS answered 500 Internal Server Error; try again later"
     assert cache_files(tmp_path) == before and requests_made(server, route) == 1
 
 
-def test_weather_list_names_a_damaged_copy_and_lists_the_whole_ones(pvgis, server, tmp_path):
+def test_weather_list_names_a_damaged_copy_and_lists_the_whole_ones(pvgis, server, cached, tmp_path):
     pvgis("ok")
-    answer, _ = damaged_cache(tmp_path, _flip)
+    answer, _ = damaged_cache(cached, tmp_path, _flip)
     assert runner.invoke(app, [*FETCH, "--no-horizon"]).exit_code == 0
     listed = runner.invoke(app, ["weather", "list", "--format", "json"])
     assert listed.exit_code == 0
@@ -354,10 +352,9 @@ def test_a_fault_at_a_mirror_with_a_password_does_not_show_it(pvgis, server, tmp
     ("http:///api/v5_3/", "names no host"),
     ("http://127.0.0.1:port/api/v5_3/", "not an address"),
 ])
-def test_an_address_that_is_not_http_is_refused_by_its_scheme(pvgis, tmp_path, monkeypatch, address,
+def test_an_address_that_is_not_http_is_refused_by_its_scheme(pvgis, cached, tmp_path, monkeypatch, address,
                                                               said):
-    pvgis("ok")
-    before = kept_entry(tmp_path)
+    before = kept_entry(cached, tmp_path)
     monkeypatch.setenv("FOLDOPT_PVGIS_URL", address)
     for command, label in [(FETCH, "weather pvgis-tmy: FOLDOPT_PVGIS_URL = "),
                            ([*SWEEP, "--weather", "pvgis-tmy", "--out", "x"],
@@ -394,16 +391,16 @@ def test_foldopt_offline_no_is_online(pvgis, server, tmp_path, monkeypatch, valu
 
 
 @pytest.mark.parametrize("value", ["maybe", "2", "ja", "1.0", "true!"])
-def test_foldopt_offline_that_is_no_yes_or_no_is_refused(pvgis, server, tmp_path, monkeypatch, value):
+def test_foldopt_offline_that_is_no_yes_or_no_is_refused(pvgis, server, cached, tmp_path, monkeypatch, value):
     route = pvgis("ok")
-    before = kept_entry(tmp_path)
+    before = kept_entry(cached, tmp_path)
     monkeypatch.setenv("FOLDOPT_OFFLINE", value)
     for command in (FETCH, [*SWEEP, "--weather", "pvgis-tmy", "--out", "x"],
                     [*SWEEP, "--weather", "pvgis-tmy", "--offline", "--out", "x"], ["weather", "path", *SITE]):
         line = one_error_line(runner.invoke(app, command))
         assert line == (f"FOLDOPT_OFFLINE = {value!r}: a yes or a no, one of 1, true, yes, on or 0, "
                         "false, no, off (any case)")
-    assert requests_made(server, route) == 1 and cache_files(tmp_path) == before  # the kept one
+    assert requests_made(server, route) == 0 and cache_files(tmp_path) == before  # nothing asked
 
 
 def test_every_foldopt_yes_or_no_variable_has_one_parser(monkeypatch):
@@ -418,9 +415,9 @@ def test_every_foldopt_yes_or_no_variable_has_one_parser(monkeypatch):
         notice("anything")
 
 
-def test_foldopt_quiet_yes_silences_a_notice(pvgis, server, tmp_path, monkeypatch):
+def test_foldopt_quiet_yes_silences_a_notice(pvgis, server, cached, tmp_path, monkeypatch):
     pvgis("ok")
-    damaged_cache(tmp_path, _flip)
+    damaged_cache(cached, tmp_path, _flip)
     monkeypatch.setenv("FOLDOPT_QUIET", "true")
     result = runner.invoke(app, FETCH)
     assert result.exit_code == 0 and result.stderr == ""

@@ -9,6 +9,7 @@ import hashlib
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -165,6 +166,31 @@ def pvgis(server, tmp_path, monkeypatch, request):
     return route
 
 
+@pytest.fixture(scope="module")
+def cached(server, tmp_path_factory):
+    """``cached(tmp_path, *options)``: the cache of ``weather fetch *options`` in the test's own
+    cache folder, as the fetch leaves it (the answer and its provenance record), for tests that
+    start from a cached answer (a fault must leave it as it was; a damaged copy). Each fetch is
+    made once a module, from the server's recorded answers, and copied; returns the test's
+    :func:`cache_files`."""
+    made = {}
+
+    def copy(tmp_path: Path, *options) -> dict:
+        if options not in made:
+            folder = tmp_path_factory.mktemp("cached")
+            with pytest.MonkeyPatch.context() as patch:
+                patch.setenv("FOLDOPT_CACHE_DIR", str(folder))
+                patch.setenv("FOLDOPT_PVGIS_URL", f"http://127.0.0.1:{server}/ok-cached/api/v5_3/")
+                patch.delenv("FOLDOPT_OFFLINE", raising=False)
+                done = runner.invoke(app, ["weather", "fetch", *options])
+            assert done.exit_code == 0, done.output
+            made[options] = folder / "weather"
+        shutil.copytree(made[options], tmp_path / "cache" / "weather", dirs_exist_ok=True)
+        return cache_files(tmp_path)
+
+    return copy
+
+
 def cache_files(tmp_path: Path) -> dict:
     folder = tmp_path / "cache" / "weather"
     return {p.name: p.read_bytes() for p in sorted(folder.iterdir())} if folder.is_dir() else {}
@@ -176,11 +202,13 @@ def csv_files(folder: Path) -> dict:
 
 @pytest.mark.parametrize("days", ["2025-06-21", "2025-01-15,2025-06-21,2025-09-30"],
                          ids=["a day, every angle", "three days, one angle"])
-def test_the_fetched_year_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, days):
+def test_the_fetched_year_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, figures_drawn_elsewhere,
+                                                           days):
     route = pvgis("ok")
     fetched = runner.invoke(app, [*SWEEP, "--days", days, "--weather", "pvgis-tmy", "--out", "fetched"])
     assert fetched.exit_code == 0, fetched.output
-    read = runner.invoke(app, [*SWEEP, "--days", days, "--weather", str(RECORDED), "--out", "read"])
+    with figures_drawn_elsewhere():  # the fetched run's, of the same data
+        read = runner.invoke(app, [*SWEEP, "--days", days, "--weather", str(RECORDED), "--out", "read"])
     assert read.exit_code == 0, read.output
     fetched, read = json.loads(fetched.stdout), json.loads(read.stdout)
     assert fetched["rows"] == read["rows"]  # every design's t_solar (at every angle of a day)
@@ -265,12 +293,10 @@ FAULTS = [
 
 
 @pytest.mark.parametrize(("mode", "options", "said"), FAULTS, ids=[f[0] for f in FAULTS])
-def test_a_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path, mode,
+def test_a_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, cached, tmp_path, mode,
                                                             options, said):
-    pvgis("ok")
-    kept = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8", "--no-horizon"])
-    assert kept.exit_code == 0, kept.output
-    before = cache_files(tmp_path)
+    before = cached(tmp_path, "--lat", "45", "--lon", "8", "--no-horizon")
+    assert before
     route = pvgis(mode)
     started = time.monotonic()
     result = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8", *options])
@@ -422,11 +448,12 @@ def test_a_maps_weather_options_are_checked_before_anything_is_fetched(pvgis, se
 HORIZON_DAY = [*SWEEP, "--days", "2025-01-15"]  # a low winter sun, under the hills to the south
 
 
-def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path):
+def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, figures_drawn_elsewhere):
     route = pvgis("ok")
     fetched = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "fetched"])
     assert fetched.exit_code == 0, fetched.output
-    read = runner.invoke(app, [*HORIZON_DAY, "--horizon", str(HORIZON), "--out", "read"])
+    with figures_drawn_elsewhere():  # the fetched run's, of the same data
+        read = runner.invoke(app, [*HORIZON_DAY, "--horizon", str(HORIZON), "--out", "read"])
     assert read.exit_code == 0, read.output
     flat = runner.invoke(app, [*HORIZON_DAY, "--out", "flat"])
     assert flat.exit_code == 0, flat.output
@@ -445,11 +472,12 @@ def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_
     assert meta["horizon_source"]["sha256"] == provenance["sha256"]
     assert "horizon_source" not in json.loads((tmp_path / "read" / "run.json").read_text())
     # a second run asks nothing; offline, a service that would fail is never asked
-    again = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "again"])
-    assert again.exit_code == 0 and json.loads(again.stdout)["rows"] == read["rows"]
-    assert requests_made(server, route) == 1
-    dead = pvgis("e500")
-    offline = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--offline", "--out", "off"])
+    with figures_drawn_elsewhere():  # the first run's, of the same data
+        again = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "again"])
+        assert again.exit_code == 0 and json.loads(again.stdout)["rows"] == read["rows"]
+        assert requests_made(server, route) == 1
+        dead = pvgis("e500")
+        offline = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--offline", "--out", "off"])
     assert offline.exit_code == 0, offline.output
     assert json.loads(offline.stdout)["rows"] == read["rows"]
     assert requests_made(server, dead) == 0
@@ -479,12 +507,10 @@ HORIZON_FAULTS = [
 
 
 @pytest.mark.parametrize(("mode", "said"), HORIZON_FAULTS, ids=[f[0] for f in HORIZON_FAULTS])
-def test_a_horizon_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path,
+def test_a_horizon_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, cached, tmp_path,
                                                                     mode, said):
-    pvgis("ok")
-    kept = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
-    assert kept.exit_code == 0, kept.output
-    before = cache_files(tmp_path)
+    before = cached(tmp_path, "--lat", "45", "--lon", "8")
+    assert before
     route = pvgis(mode)
     result = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "x"])
     assert result.exit_code == 2, result.output
@@ -524,14 +550,15 @@ def read_as_a_users_file(*options) -> list:
     return [*HOURLY_SWEEP, "--weather", str(HOURLY), "--weather-format", "pvgis-hourly", *options]
 
 
-def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path):
+def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, figures_drawn_elsewhere):
     """The whole span, 731 real days each a block: the fetched series gives every fold angle's
     mean t_solar to the bit as the recorded file read as a user's file; the request is
     get_pvgis_hourly's for a horizontal plane with the components."""
     route = pvgis("ok")
     fetched = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, "--out", "fetched"])
     assert fetched.exit_code == 0, fetched.output
-    read = runner.invoke(app, [*read_as_a_users_file(), "--out", "read"])
+    with figures_drawn_elsewhere():  # the fetched run's, of the same data
+        read = runner.invoke(app, [*read_as_a_users_file(), "--out", "read"])
     assert read.exit_code == 0, read.output
     fetched, read = json.loads(fetched.stdout), json.loads(read.stdout)
     assert fetched["rows"] == read["rows"]  # each day's t_solar at the chosen angle, to the bit
@@ -552,7 +579,8 @@ def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_p
     assert meta["weather_source"]["sha256"] == hashlib.sha256(HOURLY.read_bytes()).hexdigest()
 
 
-def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path):
+def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path,
+                                                                          figures_drawn_elsewhere):
     route = pvgis("ok")
     for _ in range(2):
         result = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8", *YEARS])
@@ -566,7 +594,8 @@ def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis,
     offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
                                   "--out", "offline"])
     assert offline.exit_code == 0, offline.output
-    read = runner.invoke(app, [*read_as_a_users_file(*days), "--out", "read"])
+    with figures_drawn_elsewhere():  # the offline run's, of the same data
+        read = runner.invoke(app, [*read_as_a_users_file(*days), "--out", "read"])
     assert json.loads(offline.stdout)["rows"] == json.loads(read.stdout)["rows"]
     assert requests_made(server, dead) == 0
     other = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", "--years", "2019:2020", *days,
@@ -587,12 +616,10 @@ HOURLY_FAULTS = [
 
 
 @pytest.mark.parametrize(("mode", "said"), HOURLY_FAULTS, ids=[f[0] for f in HOURLY_FAULTS])
-def test_an_hourly_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, tmp_path, mode, said):
-    pvgis("ok")
-    kept = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8",
-                               "--years", "2019:2020"])
-    assert kept.exit_code == 0, kept.output
-    before = cache_files(tmp_path)
+def test_an_hourly_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, cached, tmp_path, mode,
+                                                                    said):
+    before = cached(tmp_path, "pvgis-hourly", "--lat", "45", "--lon", "8", "--years", "2019:2020")
+    assert before
     route = pvgis(mode)
     result = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, "--out", "x"])
     assert result.exit_code == 2, result.output
