@@ -99,7 +99,7 @@ def test_help_keeps_units_and_lists_every_accepted_name():
      ["sweep", "load", "--p-load", "2:6:2", "--step-min", "10"]],
     ids=["run", "reproduce", "size", "sweep"],
 )
-def test_one_json_document_and_quiet_silence(tmp_path, command):
+def test_one_json_document_and_quiet_silence(tmp_path, command, figures_drawn_elsewhere):
     result = invoke(*command, "--out", tmp_path / "j", "--format", "json")
     assert result.exit_code == 0, result.output
     document = json.loads(result.stdout)
@@ -107,7 +107,8 @@ def test_one_json_document_and_quiet_silence(tmp_path, command):
     assert set(document) == {"command", "out", "answer", "rows"}
     assert document["answer"]["lines"] and document["answer"]["question"]
     assert result.stderr == ""  # no progress, no status line in the document's way
-    quiet = invoke(*command, "--out", tmp_path / "q", "--quiet")
+    with figures_drawn_elsewhere():  # the same answer's figures again
+        quiet = invoke(*command, "--out", tmp_path / "q", "--quiet")
     assert quiet.exit_code == 0, quiet.output
     assert quiet.stdout == "" and quiet.stderr == ""
     assert (tmp_path / "q" / "run.json").exists()
@@ -126,13 +127,14 @@ def test_one_json_document_and_quiet_silence(tmp_path, command):
     ],
     ids=["polar-night", "polar-day", "above-peak", "overcast", "clear"],
 )
-def test_notes_name_the_day(tmp_path, args, note, line):
+def test_notes_name_the_day(tmp_path, args, note, line, figures_drawn_elsewhere):
     result = invoke("sweep", "angle", *args, "--angle-step", "10", "--out", tmp_path / "o", "--format", "json")
     assert result.exit_code == 0, result.output
     document = json.loads(result.stdout)
     assert [entry["note"] for entry in document["answer"]["notes"]] == note
     assert {row["note"] for row in document["rows"]} == {"; ".join(note)}
-    text = invoke("sweep", "angle", *args, "--angle-step", "10", "--out", tmp_path / "t").stdout
+    with figures_drawn_elsewhere():  # the same answer's figures again
+        text = invoke("sweep", "angle", *args, "--angle-step", "10", "--out", tmp_path / "t").stdout
     assert line in text and (f"note: {note[0]}" in text if note else "note:" not in text)
 
 

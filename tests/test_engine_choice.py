@@ -70,20 +70,23 @@ def test_a_request_decides_by_its_days_angles_and_steps(cached):
     assert request_engine("numpy", year) == "numpy" and request_engine("numba", study) == "numba"
 
 
-#: A module of one cached compiled function, and a process that says whether
-#: foldopt.engine.choice.in_cache finds it cached, then calls it and says whether numba loaded it
-#: from its cache (numba's own count of cache hits).
+#: A module of one cached compiled function, and a process that, for each line on its stdin,
+#: executes the module anew (a new dispatcher, which knows nothing the last one compiled, as in a
+#: new process), says whether foldopt.engine.choice.in_cache finds it cached, then calls it and
+#: says whether numba loaded it from its cache (numba's own count of cache hits).
 _MODULE = "from numba import njit\n\n\n@njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n"
 _PROCESS = textwrap.dedent(
     """
-    import json, sys
+    import importlib.util, json, sys
     from pathlib import Path
-    sys.path.insert(0, sys.argv[1])
     from foldopt.engine.choice import _numba_version, in_cache
-    import tiny
-    said = in_cache(Path(tiny.__file__), "twice", _numba_version())
-    tiny.twice(1.0)
-    print(json.dumps([said, sum(tiny.twice.stats.cache_hits.values()) > 0]))
+    for _ in sys.stdin:
+        spec = importlib.util.spec_from_file_location("tiny", Path(sys.argv[1]) / "tiny.py")
+        tiny = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(tiny)
+        said = in_cache(Path(tiny.__file__), "twice", _numba_version())
+        tiny.twice(1.0)
+        print(json.dumps([said, sum(tiny.twice.stats.cache_hits.values()) > 0]), flush=True)
     """
 )
 
@@ -92,37 +95,56 @@ def test_the_cache_is_found_held_exactly_where_numba_loads_from_it(tmp_path):
     """foldopt.engine.choice's reading of numba's cache, held to numba's own behaviour: in each
     state of the cache (empty, filled, the source edited, the index of another numba, in the
     source's __pycache__ or NUMBA_CACHE_DIR), it finds the function cached exactly where numba
-    then loads it from the cache rather than compiling it."""
+    then loads it from the cache rather than compiling it. One process per cache folder (numba
+    reads NUMBA_CACHE_DIR once), the module loaded anew in it for each state."""
     source = tmp_path / "tiny.py"
     source.write_text(_MODULE)
 
-    def loaded(**environment) -> list:
-        done = subprocess.run(
+    def process(**environment) -> subprocess.Popen:
+        return subprocess.Popen(
             [sys.executable, "-c", _PROCESS, str(tmp_path)],
-            capture_output=True, text=True, timeout=300,
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
             # numba's cache where each state puts it: not the one this suite may run with.
             env={**{k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}, "PYTHONPATH": str(ROOT),
                  **environment},
         )
-        assert done.returncode == 0, done.stderr
-        said, hit = json.loads(done.stdout)
+
+    def loaded(running: subprocess.Popen) -> bool:
+        running.stdin.write("load\n")
+        running.stdin.flush()
+        line = running.stdout.readline()
+        assert line, f"the process ended, exit {running.wait(timeout=60)}"
+        said, hit = json.loads(line)
         assert said == hit
         return said
 
-    assert loaded() is False  # compiled, and written to tiny's __pycache__
-    assert loaded() is True
-    source.write_text(_MODULE + "# edited\n")
-    assert loaded() is False
-    assert loaded() is True
-    (index,) = (tmp_path / "__pycache__").glob("tiny.twice-*.nbi")
-    with open(index, "rb") as file:
-        pickle.load(file)  # numba's version, then the stamp and the compiles
-        rest = file.read()
-    index.write_bytes(pickle.dumps("0.0.1") + rest)
-    assert loaded() is False  # another numba's index
-    elsewhere = str(tmp_path / "numba-cache")
-    assert loaded(NUMBA_CACHE_DIR=elsewhere) is False
-    assert loaded(NUMBA_CACHE_DIR=elsewhere) is True
+    def ended(running: subprocess.Popen) -> None:
+        running.stdin.close()
+        assert running.wait(timeout=300) == 0
+
+    here = process()
+    try:
+        assert loaded(here) is False  # compiled, and written to tiny's __pycache__
+        assert loaded(here) is True
+        source.write_text(_MODULE + "# edited\n")
+        assert loaded(here) is False
+        assert loaded(here) is True
+        (index,) = (tmp_path / "__pycache__").glob("tiny.twice-*.nbi")
+        with open(index, "rb") as file:
+            pickle.load(file)  # numba's version, then the stamp and the compiles
+            rest = file.read()
+        index.write_bytes(pickle.dumps("0.0.1") + rest)
+        assert loaded(here) is False  # another numba's index
+        ended(here)
+    finally:
+        here.kill()
+    elsewhere = process(NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
+    try:
+        assert loaded(elsewhere) is False
+        assert loaded(elsewhere) is True
+        ended(elsewhere)
+    finally:
+        elsewhere.kill()
 
 
 def test_the_kernels_cache_is_looked_for_where_numba_keeps_it():

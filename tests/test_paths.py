@@ -7,6 +7,7 @@ boolean where a number is expected are refused in one line, by every path.
 
 from __future__ import annotations
 
+import contextlib
 import json
 from pathlib import Path
 
@@ -31,10 +32,11 @@ GREENSBORO = {"name": "GREENSBORO PIEDMONT TRIAD INT", "latitude": 36.1, "longit
 QUICK = ["--days", "2025-06-21", "--step-min", "10", "--angle-step", "5", "--engine", "numpy"]
 
 
-def cli(tmp_path: Path, *args) -> tuple[dict, dict]:
-    """A command's JSON document and its run.json."""
+def cli(tmp_path: Path, *args, figures=contextlib.nullcontext) -> tuple[dict, dict]:
+    """A command's JSON document and its run.json (its figures made within ``figures()``)."""
     out = tmp_path / f"out{len(list(tmp_path.glob('out*')))}"
-    result = runner.invoke(app, [*map(str, args), "--format", "json", "--out", str(out)])
+    with figures():
+        result = runner.invoke(app, [*map(str, args), "--format", "json", "--out", str(out)])
     assert result.exit_code == 0, result.output
     return json.loads(result.stdout), json.loads((out / "run.json").read_text())
 
@@ -49,10 +51,10 @@ def site_of(meta: dict) -> dict:
     return {key: meta["study"]["site"][key] for key in GREENSBORO}
 
 
-def test_a_weather_file_completes_the_site_it_is_given(tmp_path, monkeypatch):
+def test_a_weather_file_completes_the_site_it_is_given(tmp_path, monkeypatch, figures_drawn_elsewhere):
     """--weather FILE alone, with the file's --lat/--lon, by --set and from a YAML study: one
     answer, at the file's altitude and with its station's name (with --lat/--lon it ran at 0 m,
-    nameless)."""
+    nameless). The answer's figures are drawn once, by the first path."""
     monkeypatch.chdir(tmp_path)
     alone, meta = cli(tmp_path, "sweep", "angle", "--weather", WEATHER, *QUICK)
     assert site_of(meta) == GREENSBORO
@@ -63,7 +65,7 @@ def test_a_weather_file_completes_the_site_it_is_given(tmp_path, monkeypatch):
                   "site={latitude: 36.1, longitude: -79.95}", *QUICK],
     }
     for name, args in paths.items():
-        document, meta = cli(tmp_path, *args)
+        document, meta = cli(tmp_path, *args, figures=figures_drawn_elsewhere)
         assert numbers(document) == numbers(alone), name
         assert site_of(meta) == GREENSBORO, name
     # The embedded study with the file, as a YAML study the user wrote: run, not sweep angle.
@@ -76,7 +78,7 @@ def test_a_weather_file_completes_the_site_it_is_given(tmp_path, monkeypatch):
     (tmp_path / "study.yaml").write_text(yaml.safe_dump(data))
     document, meta = cli(tmp_path, "run", "study.yaml", "--set", "date=2025-06-21", "--set",
                          "step_min=10", "--set", "fold_angles={start: 5, stop: 180, step: 5}",
-                         "--engine", "numpy")
+                         "--engine", "numpy", figures=figures_drawn_elsewhere)
     assert numbers(document)[0] == numbers(alone)[0]
     assert site_of(meta) == GREENSBORO
     # The API's keywords.
@@ -96,17 +98,19 @@ def test_a_site_moved_away_from_its_file_keeps_none_of_the_files_site(tmp_path, 
     assert meta["study"]["site"]["altitude"] == 0.0 and meta["study"]["site"]["name"] is None
 
 
-def test_weather_by_name_is_the_file_it_fetched(pvgis, server, tmp_path):  # noqa: F811
+def test_weather_by_name_is_the_file_it_fetched(pvgis, server, tmp_path, figures_drawn_elsewhere):  # noqa: F811
     """--weather pvgis-tmy at a site, the answer read back with weather path --out alone, and
-    with the site given: one answer (the fetched run said 250 m in its note and ran at 0 m)."""
+    with the site given: one answer (the fetched run said 250 m in its note and ran at 0 m). Its
+    figures are drawn once, by the fetched run."""
     pvgis("ok")
     fetched, meta = cli(tmp_path, "sweep", "angle", "--lat", "45", "--lon", "8", "--weather",
                         "pvgis-tmy", *QUICK)
     kept = runner.invoke(app, ["weather", "path", "--lat", "45", "--lon", "8", "--out", "site.json"])
     assert kept.exit_code == 0, kept.output
-    alone, alone_meta = cli(tmp_path, "sweep", "angle", "--weather", "site.json", *QUICK)
+    alone, alone_meta = cli(tmp_path, "sweep", "angle", "--weather", "site.json", *QUICK,
+                            figures=figures_drawn_elsewhere)
     placed, placed_meta = cli(tmp_path, "sweep", "angle", "--weather", "site.json", "--lat", "45",
-                              "--lon", "8", *QUICK)
+                              "--lon", "8", *QUICK, figures=figures_drawn_elsewhere)
     # A study at that place given a source: fetched for the study's site (it was refused: "give
     # --lat/--lon", though the study holds them).
     data = yaml.safe_load(default_study_path().read_text())
@@ -114,7 +118,7 @@ def test_weather_by_name_is_the_file_it_fetched(pvgis, server, tmp_path):  # noq
     data["panel"] = {key: data["panel"][key] for key in ("area", "efficiency")}  # |latitude| tilt
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(data))
     studied, studied_meta = cli(tmp_path, "sweep", "angle", "--config", "s.yaml", "--weather",
-                                "pvgis-tmy", *QUICK)
+                                "pvgis-tmy", *QUICK, figures=figures_drawn_elsewhere)
     assert numbers(fetched) == numbers(alone) == numbers(placed) == numbers(studied)
     sites = [m["study"]["site"] for m in (meta, alone_meta, placed_meta, studied_meta)]
     assert sites[0] == sites[1] == sites[2] == sites[3]  # the answer's altitude, not the study's
@@ -123,19 +127,20 @@ def test_weather_by_name_is_the_file_it_fetched(pvgis, server, tmp_path):  # noq
                for note in fetched["answer"]["lines"] if "altitude" in note)
 
 
-def test_a_buffer_by_every_path_is_one_answer(tmp_path, monkeypatch):
-    """--storage-wh/--min-soc, --set, a YAML study's storage section, and the API's keyword."""
+def test_a_buffer_by_every_path_is_one_answer(tmp_path, monkeypatch, figures_drawn_elsewhere):
+    """--storage-wh/--min-soc, --set, a YAML study's storage section, and the API's keyword (the
+    answer's figures drawn once, by the first)."""
     monkeypatch.chdir(tmp_path)
     fast = ["--step-min", "10", "--angle-step", "10"]
     options, _ = cli(tmp_path, "sweep", "angle", "--storage-wh", "20", "--min-soc", "0.2", *fast)
     settings_, _ = cli(tmp_path, "sweep", "angle", "--set", "storage.capacity_wh=20", "--set",
-                       "storage.min_soc=0.2", *fast)
+                       "storage.min_soc=0.2", *fast, figures=figures_drawn_elsewhere)
     assert numbers(options) == numbers(settings_)
     data = yaml.safe_load(default_study_path().read_text())
     data.update(storage={"capacity_wh": 20, "min_soc": 0.2}, step_min=10,
                 fold_angles={"start": 10, "stop": 180, "step": 10})
     (tmp_path / "buffer.yaml").write_text(yaml.safe_dump(data))
-    study_file, _ = cli(tmp_path, "run", "buffer.yaml")
+    study_file, _ = cli(tmp_path, "run", "buffer.yaml", figures=figures_drawn_elsewhere)
     assert numbers(study_file)[0] == numbers(options)[0]
     api = foldopt.sweep(foldopt.default_study(), "angle", storage={"capacity_wh": 20, "min_soc": 0.2},
                         step_min=10, fold_angles={"step": 10})
