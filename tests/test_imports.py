@@ -2,9 +2,9 @@
 load none of the heavy libraries (each of which alone costs the 0.3 s a refusal may take),
 ``foldopt run`` prints its answer before matplotlib loads for the figures, and the embedded
 study's answer (the command's, the API's) loads none of numba, scipy, pvlib or pandas (its
-tables are NumPy columns until the folder is written or a user asks for a DataFrame). The command line's
-own process freezes the modules a command loads (the collector's passes then leave them out) and
-an in-process caller's collector is left as it was.
+tables are NumPy columns until the folder is written or a user asks for a DataFrame). An
+in-process caller's collector is left as it was (the command line's own process freezes the
+modules a command loads: tests/test_figure_pool.py).
 
 Each command runs in a process of its own that runs the command line as the ``foldopt`` script
 does and, as it ends, prints the heavy modules it imported; a meta-path hook writes a marker to
@@ -258,52 +258,6 @@ def test_the_apis_run_of_the_embedded_study_imports_numpy_alone_until_a_table_is
     answered, imported, tables, zone = json.loads(done.stdout.splitlines()[-1])
     assert answered and imported == ["numpy"]
     assert tables == ["DataFrame"] * 7 and zone == "America/Los_Angeles"
-
-
-#: Runs the command line as the script does and reports the collector's passes that ran with
-#: objects frozen (and the most frozen then), and, as the process exits, what is frozen and not.
-COLLECTOR_PROBE = r"""
-import atexit, gc, json, runpy, sys
-
-seen = {"passes": 0, "frozen": 0}
-
-
-def watch(phase, info):
-    if phase == "start" and gc.get_freeze_count():
-        seen["passes"] += 1
-        seen["frozen"] = max(seen["frozen"], gc.get_freeze_count())
-
-
-gc.callbacks.append(watch)
-# Registered first, so run last: after the command and every exit handler of its libraries.
-atexit.register(
-    lambda: print(json.dumps({**seen, "exit": [gc.get_freeze_count(), len(gc.get_objects())]}))
-)
-sys.argv = ["foldopt", *sys.argv[1:]]
-runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
-"""
-
-
-def test_the_command_lines_process_freezes_what_it_loads(tmp_path):
-    """In the command line's own process a command's modules are frozen once loaded (the
-    collector's passes leave them out, issue 49) while the collector still collects the work's
-    garbage, and the process exits with next to nothing left for the exit's passes to walk."""
-    done = subprocess.run(
-        [sys.executable, "-c", COLLECTOR_PROBE, "run", "--out", str(tmp_path / "out"), "-q"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=REPOSITORY,
-    )
-    assert done.returncode == 0, done.stderr
-    state = json.loads(done.stdout.splitlines()[-1])
-    # Passes ran during the work, with the 100,000-odd objects of typer, pydantic, numpy and
-    # pandas (and matplotlib, where the command draws its figures itself) frozen.
-    assert state["passes"] > 0 and state["frozen"] > 50_000
-    # As it exits, all but what its last handlers made is frozen (none, today); the figure
-    # workers' pool, ended as the command ends, has freed what it held, frozen with the rest.
-    frozen_at_exit, unfrozen_at_exit = state["exit"]
-    assert frozen_at_exit > 50_000 and unfrozen_at_exit < 1_000
 
 
 def test_an_in_process_caller_keeps_its_collector():
