@@ -20,8 +20,9 @@ from foldopt.output.figures import (FIGURES, annual, day, horizon, landscape, le
                                     weather, world)
 
 ROOT = Path(__file__).resolve().parent.parent
-#: The figures themselves: drawn whole, pixels and all (tests/conftest.py draws others' without).
-pytestmark = pytest.mark.figure_pixels
+# No test here reads a PNG's pixels: the figures' artists are read from their Axes, and the folders
+# written in a process of their own (the notebook's) are drawn whole, pixels and all;
+# tests/conftest.py draws the others' files without them.
 
 
 def test_the_registry_is_the_figures_of_the_examples():

@@ -2,23 +2,27 @@
 load none of the heavy libraries (each of which alone costs the 0.3 s a refusal may take),
 ``foldopt run`` prints its answer before matplotlib loads for the figures, and the embedded
 study's answer (the command's, the API's) loads none of numba, scipy, pvlib or pandas (its
-tables are NumPy columns until the folder is written or a user asks for a DataFrame). The command line's
-own process freezes the modules a command loads (the collector's passes then leave them out) and
-an in-process caller's collector is left as it was.
+tables are NumPy columns until the folder is written or a user asks for a DataFrame). An
+in-process caller's collector is left as it was (the command line's own process freezes the
+modules a command loads: tests/test_figure_pool.py).
 
-Each command runs in a fresh interpreter (``python -c PROBE``) that runs the command line as the
-``foldopt`` script does and, as it ends, prints the heavy modules it imported; a meta-path hook
-writes a marker to the process's stdout the moment a watched module is first imported, after
-flushing what the command printed before, so the order of answer and import is the order of the
-lines read back.
+Each command runs in a process of its own that runs the command line as the ``foldopt`` script
+does and, as it ends, prints the heavy modules it imported; a meta-path hook writes a marker to
+the process's stdout the moment a watched module is first imported, after flushing what the
+command printed before, so the order of answer and import is the order of the lines read back.
+The processes are forked, one a command, from one interpreter (:data:`PROBE`) that has imported
+what the ``foldopt`` script imports before it runs a command and, for the refusals, the request's
+front door (:data:`FRONT_DOOR`): none of it heavy (:func:`test_the_probes_own_imports_are_light`),
+so a command's child imports each heavy library a fresh ``foldopt`` would, and an interpreter's
+start and the command line's light imports are paid once, not once a command.
 """
 
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -32,11 +36,45 @@ HEAVY = ("pvlib", "pandas", "matplotlib", "scipy", "numba", "numpy")
 NOT_FOR_THE_ANSWER = ("numba", "scipy", "pvlib", "pandas", "matplotlib")
 #: The line the probe prints where a watched module is first imported.
 MARKER = "<<imported {}>>"
+#: What the ``foldopt`` script imports before it runs a command (its entry point), and the front
+#: door every command's request goes through (:func:`foldopt.studies.request.make_request`, a
+#: map's too): the modules the refusals' server imports once for all of them.
+SCRIPT = ("foldopt.cli.app",)
+FRONT_DOOR = (*SCRIPT, "foldopt.studies.request", "foldopt.studies.map_request")
+REPOSITORY = Path(__file__).resolve().parents[1]
 
+#: Imports ``preload``, prints the heavy modules it then holds, and runs each request in a child
+#: forked from it (one at a time), as the ``foldopt`` script runs a command: the child's stdout and
+#: stderr go to ``<folder>/<index>.out`` and ``.err``; it ends as the script does (the exit code,
+#: the exit handlers), having printed the heavy modules it imported. The server prints the
+#: children's exit codes.
 PROBE = r"""
-import atexit, json, os, runpy, sys
+import json, os, sys
 
-heavy, watched, preload, args = json.loads(sys.argv[1])
+heavy, preload, requests, folder = json.loads(sys.argv[1])
+for name in preload:
+    __import__(name)
+print(json.dumps(sorted(m for m in heavy if m in sys.modules)))
+codes = []
+for index, (args, watched, imports, cwd, one_core) in enumerate(requests):
+    sys.stdout.flush()
+    sys.stderr.flush()
+    child = os.fork()
+    if child == 0:
+        break
+    codes.append(os.waitstatus_to_exitcode(os.waitpid(child, 0)[1]))
+else:
+    print(json.dumps(codes))
+    sys.exit()
+
+import atexit
+
+for fd, name in ((0, os.devnull), (1, f"{folder}/{index}.out"), (2, f"{folder}/{index}.err")):
+    os.dup2(os.open(name, os.O_RDWR | os.O_CREAT | os.O_TRUNC if fd else os.O_RDONLY), fd)
+if cwd:
+    os.chdir(cwd)
+if one_core:
+    os.sched_setaffinity(0, [min(os.sched_getaffinity(0))])
 command = os.getpid()
 
 
@@ -54,31 +92,47 @@ class Watch:
 
 
 sys.meta_path.insert(0, Watch())
-for name in preload:
+for name in imports:
     __import__(name)
 atexit.register(lambda: print(json.dumps(sorted(m for m in heavy if m in sys.modules))))
 sys.argv = ["foldopt", *args]
-runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
+from foldopt.cli.app import app
+
+sys.exit(app())
 """
 
 
-def _run(args: list[str], watched=(), preload=(), cwd=None, one_core=False):
-    """Run ``foldopt args`` in the probe: (exit code, stdout lines before the last, the heavy
-    modules imported, stderr). With ``one_core`` the process runs on one core, where the command
-    draws its figures itself (on more, its workers do: tests/test_figure_pool.py)."""
+class Done:
+    """What a command's child did: ``code`` (its exit code), ``lines`` (its stdout's lines before
+    the last), ``imported`` (the heavy modules it held as it ended) and ``stderr``."""
+
+    def __init__(self, code: int, stdout: str, stderr: str):
+        lines = stdout.splitlines()
+        assert lines, stderr
+        self.code, self.lines, self.imported = code, lines[:-1], json.loads(lines[-1])
+        self.stderr = stderr
+
+
+def _probe(folder: Path, preload, requests) -> tuple[list[str], list[Done]]:
+    """Run ``requests`` (each ``(args, watched, imports, cwd, one_core)``: ``foldopt args`` in
+    ``cwd``, ``watched`` modules marked, ``imports`` imported before it, on one core where
+    ``one_core``, where the command draws its figures itself; on more, its workers do:
+    tests/test_figure_pool.py) in the children of a server that has imported ``preload``: (the
+    heavy modules the server held, what each child did)."""
+    payload = [HEAVY, preload, requests, str(folder)]
     done = subprocess.run(
-        [sys.executable, "-c", PROBE, json.dumps([HEAVY, list(watched), list(preload), args])],
+        [sys.executable, "-c", PROBE, json.dumps(payload)],
         capture_output=True,
         text=True,
         timeout=300,
-        cwd=cwd,
-        preexec_fn=(lambda: os.sched_setaffinity(0, [min(os.sched_getaffinity(0))]))
-        if one_core
-        else None,
     )
-    lines = done.stdout.splitlines()
-    assert lines, done.stderr
-    return done.returncode, lines[:-1], json.loads(lines[-1]), done.stderr
+    assert done.returncode == 0, done.stderr
+    server, codes = map(json.loads, done.stdout.splitlines())
+    children = [
+        Done(code, (folder / f"{i}.out").read_text(), (folder / f"{i}.err").read_text())
+        for i, code in enumerate(codes)
+    ]
+    return server, children
 
 
 REFUSALS = [
@@ -108,56 +162,82 @@ REFUSALS = [
 ]
 
 
+HELP = [["--help"], ["sweep", "angle", "--help"], ["run", "--help"]]
+#: The checks' own check: a module imported before the command (as a command that imported it
+#: would) is reported, and its marker comes before what the command prints.
+SEEN = [
+    (["sweep", "angle", "--lat", "95"], [], ["numpy"]),
+    (["--version"], ["matplotlib"], ["matplotlib"]),
+]
+
+
+@pytest.fixture(scope="module")
+def light(tmp_path_factory) -> dict:
+    """The refusals, the helps and the probe's own checks, each in a child of one server that has
+    imported the script's and the front door's modules, and none of the heavy libraries (else
+    none of these would say what a fresh command imports): what each did, by its arguments and the
+    modules imported before it."""
+    requests = [
+        *((args, [], [], str(REPOSITORY), False) for args, _ in REFUSALS),
+        *((args, [], [], None, False) for args in HELP),
+        *((args, watched, imports, None, False) for args, watched, imports in SEEN),
+    ]
+    server, children = _probe(tmp_path_factory.mktemp("light"), FRONT_DOOR, requests)
+    assert server == [], f"importing {FRONT_DOOR} imported {server}"
+    return {(tuple(r[0]), tuple(r[2])): done for r, done in zip(requests, children, strict=True)}
+
+
 @pytest.mark.parametrize(("args", "says"), REFUSALS, ids=[" ".join(a) for a, _ in REFUSALS])
-def test_a_refused_request_imports_no_heavy_library(args, says):
+def test_a_refused_request_imports_no_heavy_library(light, args, says):
     """Validating a request (the command line, the front door make_request, the study's models)
     is refused before pvlib, pandas, matplotlib, scipy, numba or numpy load."""
-    code, _, imported, stderr = _run(args, cwd=_repository())
-    assert code == 2 and says in stderr, stderr
-    assert imported == [], f"foldopt {' '.join(args)} imported {imported}"
+    done = light[tuple(args), ()]
+    assert done.code == 2 and says in done.stderr, done.stderr
+    assert done.imported == [], f"foldopt {' '.join(args)} imported {done.imported}"
 
 
-@pytest.mark.parametrize("args", [["--help"], ["sweep", "angle", "--help"], ["run", "--help"]])
-def test_help_imports_no_heavy_library(args):
-    code, lines, imported, stderr = _run(args)
-    assert code == 0 and any("Usage" in line for line in lines), stderr
-    assert imported == []
+@pytest.mark.parametrize("args", HELP)
+def test_help_imports_no_heavy_library(light, args):
+    done = light[tuple(args), ()]
+    assert done.code == 0 and any("Usage" in line for line in done.lines), done.stderr
+    assert done.imported == []
 
 
-def test_the_answer_prints_before_matplotlib_loads(tmp_path):
+@pytest.fixture(scope="module")
+def answered(tmp_path_factory) -> tuple[Done, Path]:
+    """``foldopt run`` on one core, where it draws its figures itself, in the child of an
+    interpreter that has imported nothing of foldopt's, every heavy module the answer needs none
+    of watched: what it did, and its folder."""
+    folder = tmp_path_factory.mktemp("run")
+    request = (["run", "--out", str(folder / "out")], NOT_FOR_THE_ANSWER, [], str(REPOSITORY), True)
+    _, (done,) = _probe(folder, [], [request])
+    return done, folder / "out"
+
+
+def test_the_answer_prints_before_matplotlib_loads(answered):
     """``foldopt run`` drawing its figures itself prints its answer, then loads matplotlib and
     draws them."""
-    code, lines, imported, stderr = _run(
-        ["run", "--out", str(tmp_path / "out")],
-        watched=("matplotlib",),
-        cwd=_repository(),
-        one_core=True,
-    )
-    assert code == 0, stderr
-    assert MARKER.format("matplotlib") in lines and "matplotlib" in imported
-    before = lines[: lines.index(MARKER.format("matplotlib"))]
+    done, out = answered
+    assert done.code == 0, done.stderr
+    assert MARKER.format("matplotlib") in done.lines and "matplotlib" in done.imported
+    before = done.lines[: done.lines.index(MARKER.format("matplotlib"))]
     assert before and before[0].startswith("shin2015: ")
     assert any("best fold angle" in line for line in before)
-    assert (tmp_path / "out" / "power_curves.png").is_file()
+    assert (out / "power_curves.png").is_file()
 
 
-def test_the_embedded_studys_answer_imports_numpy_alone(tmp_path):
+def test_the_embedded_studys_answer_imports_numpy_alone(answered):
     """``foldopt run`` computes and prints the embedded study's whole answer with numpy alone;
     writing its folder then adds pandas (its tables) and matplotlib (its figures, which it draws
     itself on one core), nothing else heavy."""
-    code, lines, imported, stderr = _run(
-        ["run", "--out", str(tmp_path / "out")],
-        watched=NOT_FOR_THE_ANSWER,
-        cwd=_repository(),
-        one_core=True,
-    )
-    assert code == 0, stderr
-    markers = [line for line in lines if line.startswith("<<imported")]
+    done, out = answered
+    assert done.code == 0, done.stderr
+    markers = [line for line in done.lines if line.startswith("<<imported")]
     assert sorted(markers) == [MARKER.format("matplotlib"), MARKER.format("pandas")]
-    answer = lines[: lines.index(markers[0])]
+    answer = done.lines[: done.lines.index(markers[0])]
     assert answer[0].startswith("shin2015: ") and "a flat panel would need" in answer[-1]
-    assert imported == ["matplotlib", "numpy", "pandas"]
-    assert (tmp_path / "out" / "summary.csv").is_file()
+    assert done.imported == ["matplotlib", "numpy", "pandas"]
+    assert (out / "summary.csv").is_file()
 
 
 def test_the_apis_run_of_the_embedded_study_imports_numpy_alone_until_a_table_is_asked():
@@ -180,52 +260,6 @@ def test_the_apis_run_of_the_embedded_study_imports_numpy_alone_until_a_table_is
     assert tables == ["DataFrame"] * 7 and zone == "America/Los_Angeles"
 
 
-#: Runs the command line as the script does and reports the collector's passes that ran with
-#: objects frozen (and the most frozen then), and, as the process exits, what is frozen and not.
-COLLECTOR_PROBE = r"""
-import atexit, gc, json, runpy, sys
-
-seen = {"passes": 0, "frozen": 0}
-
-
-def watch(phase, info):
-    if phase == "start" and gc.get_freeze_count():
-        seen["passes"] += 1
-        seen["frozen"] = max(seen["frozen"], gc.get_freeze_count())
-
-
-gc.callbacks.append(watch)
-# Registered first, so run last: after the command and every exit handler of its libraries.
-atexit.register(
-    lambda: print(json.dumps({**seen, "exit": [gc.get_freeze_count(), len(gc.get_objects())]}))
-)
-sys.argv = ["foldopt", *sys.argv[1:]]
-runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
-"""
-
-
-def test_the_command_lines_process_freezes_what_it_loads(tmp_path):
-    """In the command line's own process a command's modules are frozen once loaded (the
-    collector's passes leave them out, issue 49) while the collector still collects the work's
-    garbage, and the process exits with next to nothing left for the exit's passes to walk."""
-    done = subprocess.run(
-        [sys.executable, "-c", COLLECTOR_PROBE, "run", "--out", str(tmp_path / "out"), "-q"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=_repository(),
-    )
-    assert done.returncode == 0, done.stderr
-    state = json.loads(done.stdout.splitlines()[-1])
-    # Passes ran during the work, with the 100,000-odd objects of typer, pydantic, numpy and
-    # pandas (and matplotlib, where the command draws its figures itself) frozen.
-    assert state["passes"] > 0 and state["frozen"] > 50_000
-    # As it exits, all but what its last handlers made is frozen (none, today); the figure
-    # workers' pool, ended as the command ends, has freed what it held, frozen with the rest.
-    frozen_at_exit, unfrozen_at_exit = state["exit"]
-    assert frozen_at_exit > 50_000 and unfrozen_at_exit < 1_000
-
-
 def test_an_in_process_caller_keeps_its_collector():
     """A command run in the caller's process (a test's CliRunner, as a notebook would) freezes
     nothing and leaves the collector as it found it, on or off."""
@@ -246,16 +280,10 @@ def test_an_in_process_caller_keeps_its_collector():
     assert gc.get_freeze_count() == before
 
 
-def test_the_probe_sees_an_import():
+def test_the_probe_sees_an_import(light):
     """The checks can fail: a module imported before the command (as a command that imported it
     would) is reported, and its marker comes before the answer."""
-    _, _, imported, _ = _run(["sweep", "angle", "--lat", "95"], preload=("numpy",))
-    assert "numpy" in imported
-    code, lines, _, _ = _run(["--version"], watched=("matplotlib",), preload=("matplotlib",))
-    assert code == 0 and lines[0] == MARKER.format("matplotlib") and lines[1].startswith("foldopt ")
-
-
-def _repository():
-    from pathlib import Path
-
-    return Path(__file__).resolve().parents[1]
+    assert "numpy" in light[("sweep", "angle", "--lat", "95"), ("numpy",)].imported
+    done = light[("--version",), ("matplotlib",)]
+    assert done.code == 0 and done.lines[0] == MARKER.format("matplotlib")
+    assert done.lines[1].startswith("foldopt ")
