@@ -241,7 +241,7 @@ LONG_FIRST = (*BEFORE_THE_WARM_UP, "test_docs.py", "test_report_html.py", "test_
               "test_cli_studies.py", "test_weather_year.py", "test_weather_validation_minutes.py",
               "test_weather_fetch.py", "test_weather_faults.py", "test_camera_winter.py", "test_faults_cluster.py",
               "test_engine.py", "test_figures.py", "test_columns.py", "test_search.py", "test_faults_map_finish.py",
-              "test_one_answer.py", "test_bad_input.py")
+              "test_one_answer.py", "test_bad_input.py", "test_figure_pool.py")
 
 
 #: conftest's module-scoped fixtures that cost a process's time to set up (a Dask cluster).
