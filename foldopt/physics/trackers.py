@@ -543,18 +543,19 @@ TURN_BATCH = 1 << 14
 def _newton(angle, t, speed, tau_1, tau_2, bend):
     """:func:`_time_to_turn`'s Newton steps on a batch of moves, ``t`` (their starts) updated in
     place. Each move stops on its own (its answer the same bits whatever other moves it is solved
-    with)."""
+    with): the steps go over the whole batch, nearly every move taking as many, and are kept for
+    the moves still going alone."""
     span = tau_1 - tau_2
-    now, target, active = t, angle, None  # None: every move of the batch
+    going = np.ones(t.shape, dtype=bool)
     for _ in range(50):
-        if now.size == 0:
+        if not going.any():
             break
-        decay_1, decay_2 = np.expm1(-now / tau_1), np.expm1(-now / tau_2)
-        # turned = speed * (now + (tau_1^2 decay_1 - tau_2^2 decay_2) / span), the angle turned
+        decay_1, decay_2 = np.expm1(-t / tau_1), np.expm1(-t / tau_2)
+        # turned = speed * (t + (tau_1^2 decay_1 - tau_2^2 decay_2) / span), the angle turned
         turned = tau_1**2 * decay_1
         turned -= tau_2**2 * decay_2
         turned /= span
-        turned += now
+        turned += t
         turned *= speed
         # rate = speed * (1 - (tau_1 (decay_1 + 1) - tau_2 (decay_2 + 1)) / span), its derivative
         decay_1 += 1.0
@@ -565,25 +566,20 @@ def _newton(angle, t, speed, tau_1, tau_2, bend):
         decay_1 /= span
         rate = np.subtract(1.0, decay_1, out=decay_1)
         rate *= speed
-        # step = max(now - (turned - angle) / rate, 1e-9)
-        turned -= target
+        # step = max(t - (turned - angle) / rate, 1e-9)
+        turned -= angle
         turned /= rate
-        step = np.subtract(now, turned, out=turned)
+        step = np.subtract(t, turned, out=turned)
         np.maximum(step, 1e-9, out=step)
-        moved = np.subtract(step, now, out=decay_2)
+        moved = np.subtract(step, t, out=decay_2)
         np.abs(moved, out=moved)
-        if active is None:
-            t[:] = step
-        else:
-            t[active] = step
+        np.copyto(t, step, where=going)
         # left = bend / (2 rate) * (2 moved)^2, at most what the step left
         rate *= 2.0
         left = np.divide(bend, rate, out=rate)
         square = moved * 2.0
         left *= np.square(square, out=square)
-        going = np.minimum(moved, left, out=left) > TURN_TOLERANCE_S
-        active = np.flatnonzero(going) if active is None else active[going]
-        now, target = t[active], angle[active]
+        going &= np.minimum(moved, left, out=left) > TURN_TOLERANCE_S
 
 
 def moved_degrees(normal):
