@@ -502,6 +502,9 @@ class TrackerDrive:
 #: [s] Newton's last step for a move's time (:func:`_time_to_turn`): its energy then to 1e-11 Wh.
 TURN_TOLERANCE_S = 1e-12
 
+#: Moves solved together by :func:`_time_to_turn` (some 130 kB an array: within a core's cache).
+TURN_BATCH = 1 << 14
+
 
 def _time_to_turn(angle, speed, tau_1, tau_2):
     """Time [s] to turn each ``angle`` [deg] of a 1-D array from rest, by Newton's method on the angle turned by ``t``
@@ -519,12 +522,13 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     their last bits (some moves never settle on a fixed point: they change in their last bit, back
     and forth).
 
+    The moves go :data:`TURN_BATCH` at a time, each step's arithmetic in place: the same operations
+    on each move as on its own, over arrays that stay in the core's cache.
+
     References
     ----------
     .. [1] E. Süli, D. Mayers, "An Introduction to Numerical Analysis", Cambridge University Press,
        2003, Sec. 1.4: Newton's error ``e_{n+1} = f''(xi) / (2 f'(x_n)) e_n^2``.
-    The moves go :data:`TURN_BATCH` at a time, each step's arithmetic in place: the same operations
-    on each move as on its own, over arrays that stay in the core's cache.
     """
     angle = np.asarray(angle, dtype=float)
     t = angle / speed + tau_1 + tau_2
@@ -534,10 +538,6 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
         batch = slice(first, first + TURN_BATCH)
         _newton(angle[batch], t[batch], speed, tau_1, tau_2, bend)
     return t
-
-
-#: Moves solved together by :func:`_time_to_turn` (some 130 kB an array: within a core's cache).
-TURN_BATCH = 1 << 14
 
 
 def _newton(angle, t, speed, tau_1, tau_2, bend):
