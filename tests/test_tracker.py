@@ -13,7 +13,11 @@ from foldopt.engine.metrics import t_solar
 from foldopt.studies.day import Day
 from foldopt.physics.trackers import (
     ALEXANDRU_STEP_OFFSETS_H,
+    TURN_BATCH,
+    TURN_TOLERANCE_S,
     TrackerDrive,
+    _time_to_turn,
+    moved_degrees,
     singleaxis_orientation,
     step_law,
     tracker_orientation,
@@ -125,6 +129,45 @@ def test_motor_drive_energy_grows_with_the_move():
     assert energy[3] > 12 * 0.3 * (653 * 90 / speed) / 3600
     drive = TrackerDrive(drive="wh-per-degree", wh_per_degree=0.01)
     assert drive.move_energy_wh(np.array([10.0]))[0] == pytest.approx(0.1)
+
+
+def test_a_moves_energy_is_the_same_bits_among_many_as_alone_and_its_time_turns_the_angle():
+    # More moves than one batch of the Newton steps, standstills among them: each move's time
+    # is its own (the same bits alone), and in it the motor turns the move's angle, to within
+    # what it turns at full speed in the time's tolerance.
+    rng = np.random.default_rng(7)
+    degrees = rng.choice([0.0, 1.0], 2 * TURN_BATCH + 5) * np.concatenate(
+        [rng.exponential(1.5, TURN_BATCH), rng.uniform(0.0, 180.0, TURN_BATCH + 5)]
+    )
+    drive = TrackerDrive()
+    together = drive.move_energy_wh(degrees)
+    picked = np.r_[0:3, TURN_BATCH - 3 : TURN_BATCH + 3, rng.integers(0, degrees.size, 50)]
+    for k in picked:
+        assert drive.move_energy_wh(degrees[k : k + 1])[0] == together[k]
+    speed = drive.gain / drive.counts_per_revolution * 360.0
+    tau_1, tau_2 = drive.tau_1, drive.tau_2
+    target = degrees[degrees > 0] * drive.gear_ratio
+    t = _time_to_turn(target, speed, tau_1, tau_2)
+    lag = (tau_1**2 * -np.expm1(-t / tau_1) - tau_2**2 * -np.expm1(-t / tau_2)) / (tau_1 - tau_2)
+    np.testing.assert_allclose(speed * (t - lag), target, rtol=0, atol=speed * TURN_TOLERANCE_S)
+
+
+@settings(max_examples=50)
+@given(seed=st.integers(0, 2**32 - 1), still=st.floats(0.0, 1.0))
+def test_moved_degrees_is_the_angle_between_consecutive_normals(seed, still):
+    # The angle between unit vectors by atan2(|a x b|, a . b), accurate at every angle; the
+    # steps that hold still turn exactly 0.
+    rng = np.random.default_rng(seed)
+    normal = rng.normal(size=(3, 40, 3))
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    hold = rng.random((3, 40)) < still
+    for step in range(1, 40):
+        normal[:, step][hold[:, step]] = normal[:, step - 1][hold[:, step]]
+    a, b = normal[:, :-1], normal[:, 1:]
+    expected = np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), (a * b).sum(-1)))
+    turn = moved_degrees(normal)
+    assert np.all(turn[:, 0] == 0) and np.all(turn[:, 1:][hold[:, 1:]] == 0)
+    np.testing.assert_allclose(turn[:, 1:], np.where(expected > 1e-6, expected, 0.0), atol=1e-6)
 
 
 def test_hottel_against_duffie_beckman_example_2_8_1():

@@ -109,10 +109,13 @@ def panel_power(sky: Sky, *, poa_global, electrical: ElectricalOptions, area: fl
     area = electrical.area if area is None else area
     power = np.zeros_like(poa_global)
     for temp, weight in node_weights(sky, slice(None), poa_global.shape):
+        cells = electrical_for(electrical, temp, sky.wind_ref)
         take = weight > 0
-        power[take] += weight[take] * electrical_for(electrical, temp, sky.wind_ref).panel_power(
-            poa_global[take], area
-        )
+        if take.all():
+            # One table at every step (a sky of one air temperature): no copy of the steps.
+            power += weight * cells.panel_power(poa_global, area)
+        else:
+            power[take] += weight[take] * cells.panel_power(poa_global[take], area)
     return power
 
 

@@ -502,6 +502,9 @@ class TrackerDrive:
 #: [s] Newton's last step for a move's time (:func:`_time_to_turn`): its energy then to 1e-11 Wh.
 TURN_TOLERANCE_S = 1e-12
 
+#: Moves solved together by :func:`_time_to_turn` (some 130 kB an array: within a core's cache).
+TURN_BATCH = 1 << 14
+
 
 def _time_to_turn(angle, speed, tau_1, tau_2):
     """Time [s] to turn each ``angle`` [deg] of a 1-D array from rest, by Newton's method on the angle turned by ``t``
@@ -519,6 +522,9 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     their last bits (some moves never settle on a fixed point: they change in their last bit, back
     and forth).
 
+    The moves go :data:`TURN_BATCH` at a time, each step's arithmetic in place: the same operations
+    on each move as on its own, over arrays that stay in the core's cache.
+
     References
     ----------
     .. [1] E. Süli, D. Mayers, "An Introduction to Numerical Analysis", Cambridge University Press,
@@ -528,21 +534,52 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     t = angle / speed + tau_1 + tau_2
     peak = math.log(tau_1 / tau_2) * tau_1 * tau_2 / (tau_1 - tau_2)
     bend = speed * (math.exp(-peak / tau_1) - math.exp(-peak / tau_2)) / (tau_1 - tau_2)  # max f''
-    # Each move stops on its own (its answer the same bits whatever other moves it is solved with).
-    active = np.arange(t.size)
-    for _ in range(50):
-        if active.size == 0:
-            break
-        now = t[active]
-        decay_1, decay_2 = np.expm1(-now / tau_1), np.expm1(-now / tau_2)
-        turned = speed * (now + (tau_1**2 * decay_1 - tau_2**2 * decay_2) / (tau_1 - tau_2))
-        rate = speed * (1 - (tau_1 * (decay_1 + 1.0) - tau_2 * (decay_2 + 1.0)) / (tau_1 - tau_2))
-        step = np.maximum(now - (turned - angle[active]) / rate, 1e-9)
-        t[active] = step
-        moved = np.abs(step - now)
-        left = bend / (2.0 * rate) * (2.0 * moved) ** 2  # at most what the step left
-        active = active[np.minimum(moved, left) > TURN_TOLERANCE_S]
+    for first in range(0, t.size, TURN_BATCH):
+        batch = slice(first, first + TURN_BATCH)
+        _newton(angle[batch], t[batch], speed, tau_1, tau_2, bend)
     return t
+
+
+def _newton(angle, t, speed, tau_1, tau_2, bend):
+    """:func:`_time_to_turn`'s Newton steps on a batch of moves, ``t`` (their starts) updated in
+    place. Each move stops on its own (its answer the same bits whatever other moves it is solved
+    with): the steps go over the whole batch, nearly every move taking as many, and are kept for
+    the moves still going alone."""
+    span = tau_1 - tau_2
+    going = np.ones(t.shape, dtype=bool)
+    for _ in range(50):
+        if not going.any():
+            break
+        decay_1, decay_2 = np.expm1(-t / tau_1), np.expm1(-t / tau_2)
+        # turned = speed * (t + (tau_1^2 decay_1 - tau_2^2 decay_2) / span), the angle turned
+        turned = tau_1**2 * decay_1
+        turned -= tau_2**2 * decay_2
+        turned /= span
+        turned += t
+        turned *= speed
+        # rate = speed * (1 - (tau_1 (decay_1 + 1) - tau_2 (decay_2 + 1)) / span), its derivative
+        decay_1 += 1.0
+        decay_1 *= tau_1
+        decay_2 += 1.0
+        decay_2 *= tau_2
+        decay_1 -= decay_2
+        decay_1 /= span
+        rate = np.subtract(1.0, decay_1, out=decay_1)
+        rate *= speed
+        # step = max(t - (turned - angle) / rate, 1e-9)
+        turned -= angle
+        turned /= rate
+        step = np.subtract(t, turned, out=turned)
+        np.maximum(step, 1e-9, out=step)
+        moved = np.subtract(step, t, out=decay_2)
+        np.abs(moved, out=moved)
+        np.copyto(t, step, where=going)
+        # left = bend / (2 rate) * (2 moved)^2, at most what the step left
+        rate *= 2.0
+        left = np.divide(bend, rate, out=rate)
+        square = moved * 2.0
+        left *= np.square(square, out=square)
+        going &= np.minimum(moved, left, out=left) > TURN_TOLERANCE_S
 
 
 def moved_degrees(normal):
@@ -566,11 +603,20 @@ def moved_degrees(normal):
     normal = np.asarray(normal, dtype=float)
     turn = np.zeros(normal.shape[:-1])
     # The chord between unit vectors is 2 sin(angle / 2): exact from a standstill to a half turn.
-    east, north, up = (np.diff(normal[..., axis], axis=-1) for axis in range(3))
-    chord = np.sqrt(east * east + north * north + up * up)
-    turn[..., 1:] = np.degrees(2.0 * np.arcsin(np.minimum(chord / 2.0, 1.0)))
+    # Its arithmetic in place over the steps' differences, the normals' axes side by side.
+    chord = np.diff(normal, axis=-2)
+    np.multiply(chord, chord, out=chord)
+    length = chord[..., 0] + chord[..., 1]
+    length += chord[..., 2]
+    np.sqrt(length, out=length)
+    length /= 2.0
+    np.minimum(length, 1.0, out=length)
+    angle = np.arcsin(length)
+    angle *= 2.0
+    np.degrees(angle, out=turn[..., 1:])
     # A panel that holds still must not be charged a motor start: drop rounding-level turns.
-    return np.where(turn > 1e-6, turn, 0.0)
+    turn[~(turn > 1e-6)] = 0.0
+    return turn
 
 
 def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive):

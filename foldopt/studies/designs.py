@@ -587,8 +587,12 @@ def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None)
         flat_energy.append(metrics.energy[:, 0])
         flat_peak.append(metrics.peak[:, 0])
         curves = tracker_curves(sky, study, engine=engine)
+        # The gross and the net curves side by side, the net written in place (TrackerCurves.net)
+        curves_both = np.empty((2 * sky.n_blocks, sky.n_steps))
+        curves_both[: sky.n_blocks] = curves.power
+        np.subtract(curves.power, curves.draw, out=curves_both[sky.n_blocks :])
         both = engines.curve_metrics(
-            np.concatenate([curves.power, curves.net]),
+            curves_both,
             loads,
             sky.step_hours,
             np.concatenate([loadset[rows], loadset[rows]]),
@@ -606,7 +610,8 @@ def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None)
         )
     gross_h, net_h, gross_wh = (np.concatenate(values) for values in zip(*tracker, strict=True))
     flat, flat_energy, flat_peak, available = (
-        np.concatenate(values) for values in (flat, flat_energy, flat_peak, available)
+        values[0] if len(values) == 1 else np.concatenate(values)
+        for values in (flat, flat_energy, flat_peak, available)
     )
     tilted = any(flat_tilted is not None for *_, flat_tilted in searched)
     return [
@@ -619,13 +624,20 @@ def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None)
             gross_h[blocks],
             net_h[blocks],
             gross_wh[blocks],
-            available[blocks],
+            available[_days(blocks)],
             flat_peak[blocks],
             points[:, 1] if tilted else None,
             flat_tilted,
         )
         for blocks, (points, hours, energy, flat_tilted) in zip(sites, searched, strict=True)
     ]
+
+
+def _days(blocks):
+    """A site's blocks as a slice where consecutive: a view of the days' arrays, not a copy."""
+    if isinstance(blocks, range) and blocks.step == 1:
+        return slice(blocks.start, blocks.stop)
+    return blocks
 
 
 def _every_angle(parts, sites, loads, loadset, engine):
