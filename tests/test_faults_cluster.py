@@ -36,10 +36,9 @@ SITES = ({"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 10
 
 
 def spec(loads=(1.0,), sites=SITES) -> MapSpec:
-    """A map of a chunk a site on the compiled kernel: a site's year in some 0.1 s, the NumPy
-    path's in 0.3-0.6 s (what a fault leaves does not hang on the engine), and named, not
-    ``auto``, so that every map of the module has the same bits whatever numba's cache holds."""
-    return MapSpec(STUDY, sites, loads, sites_per_chunk=1, engine="numba")
+    """A map of a chunk a site, on a map's engine (``auto``: the compiled kernel, a site's year in
+    some 0.1 s; the NumPy path took 0.3-0.6 s, and what a fault leaves does not hang on it)."""
+    return MapSpec(STUDY, sites, loads, sites_per_chunk=1)
 
 
 def snapshot(folder: Path) -> dict[str, tuple]:
