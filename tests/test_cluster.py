@@ -241,18 +241,19 @@ def test_a_task_that_fails_is_one_line(tmp_path, scheduler, fault, code, line):
 def hand_started(tmp_path_factory):
     """A scheduler and two single-threaded workers on 127.0.0.1 (without a nanny, so that killing
     one kills the worker): the scheduler file, the workers' processes and the scheduler's. Each
-    process the module's own, killed at its end."""
+    process the module's own, killed at its end. The workers start with the scheduler: they wait
+    for its file."""
     scheduler_file = tmp_path_factory.mktemp("cluster") / "scheduler.json"
     python = [sys.executable, "-m"]
-    processes = [subprocess.Popen([*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
-                                   "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)],
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    commands = [[*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)]]
+    commands += 2 * [[*python, "distributed.cli.dask_worker", "--scheduler-file", str(scheduler_file), "--nthreads",
+                      "1", "--no-nanny", "--host", "127.0.0.1"]]
+    processes = []
     try:
+        for command in commands:
+            processes.append(subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         _wait_for(scheduler_file.exists, "the scheduler's file", 60)
-        for _ in range(2):
-            processes.append(subprocess.Popen([*python, "distributed.cli.dask_worker", "--scheduler-file",
-                                               str(scheduler_file), "--nthreads", "1", "--no-nanny", "--host",
-                                               "127.0.0.1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         yield scheduler_file, processes[1:], processes[0]
     finally:
         for process in processes:
