@@ -1,6 +1,13 @@
 """Maps on real Dask clusters: an embedded one, and a scheduler and workers started here on
 127.0.0.1, bounded in time and stopped by process id; faults (a worker killed, the client killed)
-must lose nothing and change nothing."""
+must lose nothing and change nothing.
+
+Every map of :data:`MAP` is held to the bit to its rows computed here without Dask
+(:func:`direct`). The processes are what the tests are about and what they cost (each imports Dask
+and foldopt, and a worker loads the compiled code: 2-3 s of CPU a process), so tests that check one
+run share it: the killed map is finished by the run whose worker dies and whose terminal is checked
+(:func:`resumed`), and the scheduler lost is that of the cluster whose worker was killed
+(:func:`worker_killed`)."""
 
 from __future__ import annotations
 
@@ -11,6 +18,7 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -19,21 +27,19 @@ from typer.testing import CliRunner
 
 from foldopt.cli.app import app
 from foldopt.errors import ConfigError
+from foldopt.inputs.sites import grid_sites
 from foldopt.studies.cluster import run_map
 from foldopt.studies.map_request import MapSpec
 from foldopt.errors import OutputError
 from foldopt.studies.worldmap import evaluate_sites
-
-#: One worker runs the tests of the embedded map, their reference, which is computed once (--dist
-#: loadgroup); the others go to either. The map is session-scoped: the worker may run other
-#: modules' tests between these, which would tear a module-scoped fixture down and build it again.
-EMBEDDED_MAP = pytest.mark.xdist_group("cluster")
 
 pytest.importorskip("distributed")
 
 #: 16 sites, a chunk each, at 15-min steps: about 0.1 s of work per chunk, long enough to be killed mid-run.
 MAP = ["--lat", "-60:60:40", "--lon", "-180:90:90", "--p-load", "1,2", "--area", "0.108", "--chunk-sites", "1",
        "--step-min", "15"]
+#: MAP's grid.
+LATITUDES, LONGITUDES = (-60.0, -20.0, 20.0, 60.0), (-180.0, -90.0, 0.0, 90.0)
 #: The embedded cluster of one worker: one process to start, not two, on a machine whose two cores the
 #: other tests share (the hand-started cluster below has two, so that one can be killed).
 EMBEDDED = [*MAP, "--workers", "1"]
@@ -70,107 +76,132 @@ def _parts(folder: Path) -> dict[str, tuple]:
     return {path.name: (path.stat().st_ino, path.stat().st_mtime_ns) for path in (folder / "parts").glob("part-*")}
 
 
-@pytest.fixture(scope="session")
-def embedded(tmp_path_factory, without_pixels) -> pd.DataFrame:
-    """The reference: the map on the embedded cluster, uninterrupted. The command line runs in
-    this process (its cluster's worker is a process of its own still): the runs below that are
-    killed, refused and resumed are the ones whose process is the point."""
-    out = tmp_path_factory.mktemp("embedded") / "map"
-    with without_pixels():
-        done = CliRunner().invoke(app, ["map", *EMBEDDED, "--out", str(out), "-q"])
-    assert done.exit_code == 0, done.output
-    return pd.read_parquet(out / "map.parquet")
-
-
-@pytest.fixture
-def start_cluster(tmp_path):
-    """Start a scheduler and ``workers`` single-threaded workers on 127.0.0.1 (without a nanny, so
-    that killing one kills the worker): the scheduler file, the workers' processes and the
-    scheduler's. Each process a test's own, killed at its end."""
-    processes = []
-
-    def start(workers: int) -> tuple[Path, list[subprocess.Popen], subprocess.Popen]:
-        scheduler_file = tmp_path / "scheduler.json"
-        python = [sys.executable, "-m"]
-        processes.append(subprocess.Popen([*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port",
-                                           "0", "--dashboard-address", "127.0.0.1:0", "--scheduler-file",
-                                           str(scheduler_file)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        _wait_for(scheduler_file.exists, "the scheduler's file", 60)
-        for _ in range(workers):
-            processes.append(subprocess.Popen([*python, "distributed.cli.dask_worker", "--scheduler-file",
-                                               str(scheduler_file), "--nthreads", "1", "--no-nanny", "--host",
-                                               "127.0.0.1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        return scheduler_file, processes[1:], processes[0]
-
-    try:
-        yield start
-    finally:
-        for process in processes:
-            _kill(process)
-
-
 def _every_site_once(table: pd.DataFrame) -> None:
     counts = table.groupby(["site_id", "p_load_w", "period"]).size()
     assert len(counts) == N_SITES * N_LOADS * 5 and (counts == 1).all()
 
 
-@EMBEDDED_MAP
-def test_embedded_map_equals_the_computation_without_dask(embedded):
-    sites = embedded.drop_duplicates("site_id")
-    spec_sites = [{"latitude": lat, "longitude": lon, "site_id": i}
-                  for i, (lat, lon) in enumerate(zip(sites["latitude"], sites["longitude"], strict=True))]
+@pytest.fixture(scope="session")
+def direct() -> pd.DataFrame:
+    """The reference: MAP's rows computed here without Dask, its sites in one batch (a site's rows
+    are the same bits whatever batch it shares; the map's chunks hold one site each)."""
     from foldopt.inputs.study_file import default_study_path, read_study
     from foldopt.studies.map_request import map_study
 
     study = map_study(read_study(default_study_path())[0], step_min=15.0,
                       **{"panel.area": 0.108, "objective": {"statistic": "mean"}})
-    direct = evaluate_sites(study, spec_sites[:2], [1.0, 2.0])
-    pd.testing.assert_frame_equal(embedded[embedded["site_id"] < 2].reset_index(drop=True), direct, check_exact=True)
-    _every_site_once(embedded)
+    sites = [{**site, "site_id": index} for index, site in enumerate(grid_sites(LATITUDES, LONGITUDES))]
+    return evaluate_sites(study, sites, [1.0, 2.0])
 
 
-@EMBEDDED_MAP
-def test_a_worker_killed_mid_run_loses_nothing(embedded, start_cluster, tmp_path):
-    """A map on a hand-started cluster, one of whose two workers is killed once the first part is
-    written: every site once, the same bits as the embedded cluster's map."""
-    scheduler_file, workers, _ = start_cluster(2)
-    out = tmp_path / "map"
-    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
-    try:
-        _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
-        assert workers[0].poll() is None
-        os.kill(workers[0].pid, signal.SIGKILL)
-        killed_at = len(_parts(out))
-        _, err = _finish(run)
-    finally:
-        _kill(run)
-    assert killed_at < N_SITES  # the worker died with work left
-    assert err.splitlines()[0].startswith("Dask scheduler tcp://127.0.0.1:") and len(err.splitlines()) == 1, err
-    table = pd.read_parquet(out / "map.parquet")
-    _every_site_once(table)
-    pd.testing.assert_frame_equal(table, embedded, check_exact=True)
-    meta = json.loads((out / "run.json").read_text())
-    assert meta["status"] == "complete" and meta["cluster"].startswith("Dask scheduler tcp://127.0.0.1:")
+# --- the embedded cluster: a run killed, a worker that dies, what a map prints ----------------------------
 
 
-@EMBEDDED_MAP
-def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path, scheduler):
-    out = tmp_path / "map"
+#: The command line, its map's task replaced by this script's (Dask pickles a function of __main__ by value,
+#: so the embedded cluster's workers run it): foldopt's task but for the FAULT, raise (a RuntimeError, an
+#: internal fault), bad-input (a ConfigError, as a weather file broken mid-run raises), die (the worker's
+#: process ends), die-once (the first time only: it makes MARK).
+FAULTY_TASK = """
+import os, sys
+import foldopt.studies.cluster as cluster
+
+FAULT, MARK = os.environ["FAULT"], os.environ["MARK"]  # the task takes them with it, wherever it runs
+evaluate_chunk = cluster.evaluate_chunk
+
+def task(study, sites, loads, relative, year, engine):
+    if FAULT == "raise":
+        raise RuntimeError("a fault in the task")
+    if FAULT == "bad-input":
+        from foldopt.errors import ConfigError
+        raise ConfigError(["weather: a file that broke mid-run"])
+    if FAULT == "die" or FAULT == "die-once" and not os.path.exists(MARK):
+        open(MARK, "w").close()
+        os._exit(1)
+    return evaluate_chunk(study, sites, loads, relative, year, engine)
+
+cluster.evaluate_chunk = task
+from foldopt.cli.app import app
+app(sys.argv[1:], prog_name="foldopt")
+"""
+#: Two sites, a chunk each, at hourly steps and fold angles 90 and 180 deg.
+SMALL = ["--lat", "0,30", "--lon", "0", "--p-load", "1", "--area", "0.108", "--step-min", "60", "--angle-step",
+         "90", "--chunk-sites", "1"]
+EMBEDDED_ONE = r"embedded LocalCluster, 1 worker process; dashboard: http://127\.0\.0\.1:\d+/status"
+
+
+def _faulty_map(fault: str, folder: Path, args: list[str], **environment) -> tuple[int, list[str], str]:
+    """Run the map of ``args`` (its cluster's options too) with ``fault`` into ``folder / "map"``: its
+    exit code, the lines of its stderr and its stdout."""
+    env = {**os.environ, "FAULT": fault, "MARK": str(folder / "died"), **environment}
+    process = subprocess.run([sys.executable, "-c", FAULTY_TASK, "map", *args, "--out", str(folder / "map")],
+                             env=env, capture_output=True, text=True, timeout=SECONDS)
+    assert "distributed." not in process.stderr and "Traceback" not in process.stderr, process.stderr
+    return process.returncode, process.stderr.splitlines(), process.stdout
+
+
+@dataclass
+class Resumed:
+    """:func:`resumed`'s runs."""
+
+    #: The map's folder.
+    out: Path
+    #: The parts the killed run left, and whether it left a table.
+    before: dict[str, tuple]
+    table_before: bool
+    #: The same map without --resume (typer's result).
+    refused: object
+    #: The resuming run's exit code, stderr's lines and stdout; whether its worker died.
+    code: int
+    lines: list[str]
+    stdout: str
+    died: bool
+
+
+@pytest.fixture(scope="session")
+def resumed(tmp_path_factory) -> Resumed:
+    """A map on the embedded cluster killed with its client, the process group at once, once it has
+    written three parts; the same map refused without --resume (run in this process: what is tested
+    is the folder); then resumed with --format json by a process of its own on an embedded cluster,
+    whose worker dies on the first chunk it is given (the nanny starts another, the scheduler
+    reschedules the chunk)."""
+    folder = tmp_path_factory.mktemp("resumed")
+    out = folder / "map"
     run = _foldopt("map", *EMBEDDED, "--out", str(out), "-q", start_new_session=True)
     try:
         _wait_for(lambda: len(_parts(out)) >= 3 if out.exists() else False, "three parts")
     finally:
         os.killpg(run.pid, signal.SIGKILL)  # the client and its embedded cluster, at once
         run.wait(timeout=30)
-    before = _parts(out)
-    assert 3 <= len(before) < N_SITES and not (out / "map.parquet").exists()
-    # The killed process is the point; the refusal and the resume are the folder's, run in this
-    # process (the resume on conftest's in-process cluster: a map's cluster is not part of it).
+    before, table_before = _parts(out), (out / "map.parquet").exists()
     refused = CliRunner().invoke(app, ["map", *EMBEDDED, "--out", str(out)])
+    code, lines, stdout = _faulty_map("die-once", folder, [*EMBEDDED, "--resume", "--format", "json"])
+    return Resumed(out, before, table_before, refused, code, lines, stdout, (folder / "died").exists())
+
+
+def test_a_maps_terminal_holds_only_foldopts_lines(resumed):
+    """Dask's records stay off the terminal: the worker that computes the first chunk dies (its
+    nanny starts another, the scheduler reschedules), and the map is whole all the same. With
+    --format json, stdout is the one document and stderr holds nothing (the cluster's line in
+    table format: test_a_task_that_fails_is_one_line)."""
+    assert resumed.code == 0 and resumed.died, resumed.lines
+    assert resumed.lines == []
+    assert json.loads(resumed.stdout)["command"] == "map"
+    _every_site_once(pd.read_parquet(resumed.out / "map.parquet"))
+
+
+def test_embedded_map_equals_the_computation_without_dask(resumed, direct):
+    """The map of the embedded clusters: the killed run's parts and the resumed run's chunks."""
+    table = pd.read_parquet(resumed.out / "map.parquet")
+    pd.testing.assert_frame_equal(table, direct, check_exact=True)
+    _every_site_once(table)
+
+
+def test_a_killed_run_resumes_without_recomputing(resumed):
+    before, out = resumed.before, resumed.out
+    assert 3 <= len(before) < N_SITES and not resumed.table_before
+    refused = resumed.refused
     assert refused.exit_code == 2 and "pass --resume to finish it" in refused.stderr, refused.output
-    resumed = CliRunner().invoke(app, ["map", *MAP, "--scheduler", scheduler, "--out", str(out), "--resume",
-                                       "--format", "json", "-q"])
-    assert resumed.exit_code == 0, resumed.output
+    assert resumed.code == 0, resumed.lines
     answer = json.loads(resumed.stdout)  # one JSON document: the year's rows
     assert answer["command"] == "map" and answer["answer"]["result"]["sites"] == N_SITES
     assert len(answer["rows"]) == N_SITES * N_LOADS and answer["answer"]["result"]["chunks_from_disk"] == len(before)
@@ -180,8 +211,119 @@ def test_a_killed_run_resumes_without_recomputing(embedded, tmp_path, scheduler)
     assert meta["chunks_computed"] == [index for index in range(N_SITES) if index not in finished]
     after = _parts(out)
     assert {name: after[name] for name in before} == before  # the same files, untouched
-    pd.testing.assert_frame_equal(pd.read_parquet(out / "map.parquet"), embedded, check_exact=True)
     assert not list(out.rglob(".*tmp*"))
+
+
+@pytest.mark.parametrize("fault, code, line", [
+    ("raise", 1, "error: internal error (RuntimeError: a fault in the task); run again as foldopt --debug ... "
+                 "for the traceback, and please report it"),
+    ("bad-input", 2, "error: "),
+    ("die", 1, "error: internal error (RuntimeError: the map's worker processes died while computing it (chunk "),
+], ids=["raise", "bad-input", "die"])
+def test_a_task_that_fails_is_one_line(tmp_path, scheduler, fault, code, line):
+    # The input's fault on a cluster of this process (the client's records are the point: its worker's
+    # are this process's), the others on an embedded one; Dask gives up on a task at the first worker
+    # that dies running it.
+    cluster = ["--scheduler", scheduler] if fault == "bad-input" else ["--workers", "1"]
+    returned, lines, _ = _faulty_map(fault, tmp_path, [*SMALL, *cluster],
+                                     DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES="0")
+    assert returned == code, lines
+    announced = f"Dask scheduler {re.escape(scheduler)}; .*" if fault == "bad-input" else EMBEDDED_ONE
+    assert len(lines) == 2 and re.fullmatch(announced, lines[0]) and lines[1].startswith(line), lines
+    assert fault != "bad-input" or lines[1].endswith("weather: a file that broke mid-run")  # as the field is named
+    assert sorted(path.name for path in tmp_path.iterdir()) == (["died"] if fault == "die" else [])
+
+
+# --- a cluster started here: a worker killed, then its scheduler --------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def hand_started(tmp_path_factory):
+    """A scheduler and two single-threaded workers on 127.0.0.1 (without a nanny, so that killing
+    one kills the worker): the scheduler file, the workers' processes and the scheduler's. Each
+    process the module's own, killed at its end. The workers start with the scheduler: they wait
+    for its file."""
+    scheduler_file = tmp_path_factory.mktemp("cluster") / "scheduler.json"
+    python = [sys.executable, "-m"]
+    commands = [[*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)]]
+    commands += 2 * [[*python, "distributed.cli.dask_worker", "--scheduler-file", str(scheduler_file), "--nthreads",
+                      "1", "--no-nanny", "--host", "127.0.0.1"]]
+    processes = []
+    try:
+        for command in commands:
+            processes.append(subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        _wait_for(scheduler_file.exists, "the scheduler's file", 60)
+        yield scheduler_file, processes[1:], processes[0]
+    finally:
+        for process in processes:
+            _kill(process)
+
+
+@pytest.fixture(scope="module")
+def worker_killed(hand_started, tmp_path_factory) -> tuple[Path, int, str]:
+    """A map on :func:`hand_started`, one of whose two workers is killed once the first part is
+    written: its folder, the parts there when the worker was killed, and the run's stderr."""
+    scheduler_file, workers, _ = hand_started
+    out = tmp_path_factory.mktemp("worker-killed") / "map"
+    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
+    try:
+        _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
+        assert workers[0].poll() is None
+        os.kill(workers[0].pid, signal.SIGKILL)
+        killed_at = len(_parts(out))
+        _, err = _finish(run)
+    finally:
+        _kill(run)
+    return out, killed_at, err
+
+
+def test_a_worker_killed_mid_run_loses_nothing(worker_killed, direct):
+    """Every site once, the same bits as the computation without Dask."""
+    out, killed_at, err = worker_killed
+    assert killed_at < N_SITES  # the worker died with work left
+    assert err.splitlines()[0].startswith("Dask scheduler tcp://127.0.0.1:") and len(err.splitlines()) == 1, err
+    table = pd.read_parquet(out / "map.parquet")
+    _every_site_once(table)
+    pd.testing.assert_frame_equal(table, direct, check_exact=True)
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["status"] == "complete" and meta["cluster"].startswith("Dask scheduler tcp://127.0.0.1:")
+
+
+def _snapshot(folder: Path) -> dict[str, tuple]:
+    return {str(path.relative_to(folder)): (path.read_bytes(), path.stat().st_mtime_ns)
+            for path in sorted(folder.rglob("*")) if path.is_file()}
+
+
+def test_a_scheduler_lost_mid_run_is_one_line_and_a_resume_that_cannot_connect_changes_nothing(
+        hand_started, worker_killed, tmp_path):
+    # The cluster whose worker was killed, once that map is whole (worker_killed): one worker left,
+    # and what is lost is the scheduler.
+    scheduler_file, _, scheduler = hand_started
+    out = tmp_path / "map"
+    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
+    try:
+        _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
+        address = json.loads(scheduler_file.read_text())["address"]
+        scheduler.kill()
+        _, err = run.communicate(timeout=SECONDS)
+    finally:
+        _kill(run)
+    lines = err.splitlines()
+    assert run.returncode == 2 and len(lines) == 2, err
+    assert lines[0].startswith("Dask scheduler tcp://127.0.0.1:")
+    assert re.fullmatch(rf"error: --scheduler = '{re.escape(str(scheduler_file))}': the scheduler was lost mid-run "
+                        r"\((scheduler-connection-lost|CommClosedError)\); the \d+ of 16 chunks done are kept: "
+                        r"start it again and finish the map with --resume", lines[1]), lines[1]
+    before = _snapshot(out)
+    assert json.loads((out / "run.json").read_text())["status"] == "running" and before
+    refused = CliRunner().invoke(app, ["map", *MAP, "--out", str(out), "--resume", "--scheduler", address])
+    assert refused.exit_code == 2, refused.output
+    assert refused.stderr.startswith(f"error: --scheduler = '{address}': no Dask scheduler answers"), refused.stderr
+    assert _snapshot(out) == before and not [path for path in tmp_path.iterdir() if path.name.startswith(".")]
+
+
+# --- in this process --------------------------------------------------------------------------------------
 
 
 def test_the_maps_digest_is_worked_out_once(monkeypatch):
@@ -215,108 +357,3 @@ def test_no_scheduler_is_a_one_line_input_error(tmp_path):
     spec = MapSpec({"name": "x", "panel": {"area": 0.1}}, ({"latitude": 0.0, "longitude": 0.0},), (1.0,))
     with pytest.raises(ConfigError, match="no Dask scheduler answers there within 2 s"):
         run_map(spec, tmp_path / "map", scheduler="tcp://127.0.0.1:9", connect_timeout=2)
-
-
-# --- what a map prints ------------------------------------------------------------------------------------
-
-
-#: The command line, its map's task replaced by this script's (Dask pickles a function of __main__ by value,
-#: so the embedded cluster's workers run it). FAULT: raise (a RuntimeError, an internal fault), bad-input (a
-#: ConfigError, as a weather file broken mid-run raises), die (the worker's process ends), die-once (the
-#: first time only: it makes MARK).
-FAULTY_TASK = """
-import os, sys
-import foldopt.studies.cluster as cluster
-
-FAULT, MARK = os.environ["FAULT"], os.environ["MARK"]  # the task takes them with it, wherever it runs
-
-def task(study, sites, loads, relative, year, engine):
-    if FAULT == "raise":
-        raise RuntimeError("a fault in the task")
-    if FAULT == "bad-input":
-        from foldopt.errors import ConfigError
-        raise ConfigError(["weather: a file that broke mid-run"])
-    if FAULT == "die" or FAULT == "die-once" and not os.path.exists(MARK):
-        open(MARK, "w").close()
-        os._exit(1)
-    from foldopt.studies.worldmap import evaluate_sites
-    return evaluate_sites(study, sites, loads, relative, year, engine)
-
-cluster.evaluate_chunk = task
-from foldopt.cli.app import app
-app(sys.argv[1:], prog_name="foldopt")
-"""
-#: Two sites, a chunk each, at hourly steps and fold angles 90 and 180 deg.
-SMALL = ["--lat", "0,30", "--lon", "0", "--p-load", "1", "--area", "0.108", "--step-min", "60", "--angle-step",
-         "90", "--chunk-sites", "1"]
-EMBEDDED_ONE = r"embedded LocalCluster, 1 worker process; dashboard: http://127\.0\.0\.1:\d+/status"
-
-
-def _faulty_map(fault: str, tmp_path: Path, cluster: list[str], **environment) -> tuple[int, list[str]]:
-    """Run the small map with ``fault`` on ``cluster`` (its options) into ``tmp_path / "map"``; its exit
-    code and the lines of its stderr."""
-    env = {**os.environ, "FAULT": fault, "MARK": str(tmp_path / "died"), **environment}
-    process = subprocess.run([sys.executable, "-c", FAULTY_TASK, "map", *SMALL, *cluster, "--out",
-                              str(tmp_path / "map")], env=env, capture_output=True, text=True, timeout=SECONDS)
-    assert "distributed." not in process.stderr and "Traceback" not in process.stderr, process.stderr
-    return process.returncode, process.stderr.splitlines()
-
-
-def test_a_maps_terminal_holds_only_foldopts_lines(tmp_path):
-    """Dask's records stay off the terminal: the worker that computes the first chunk dies (its nanny
-    starts another, the scheduler reschedules), and the map is whole all the same."""
-    code, lines = _faulty_map("die-once", tmp_path, ["--workers", "1"])
-    assert code == 0 and (tmp_path / "died").exists()
-    assert len(lines) == 1 and re.fullmatch(EMBEDDED_ONE, lines[0]), lines
-    assert len(pd.read_parquet(tmp_path / "map" / "map.parquet")) == 2 * 5
-
-
-@pytest.mark.parametrize("fault, code, line", [
-    ("raise", 1, "error: internal error (RuntimeError: a fault in the task); run again as foldopt --debug ... "
-                 "for the traceback, and please report it"),
-    ("bad-input", 2, "error: "),
-    ("die", 1, "error: internal error (RuntimeError: the map's worker processes died while computing it (chunk "),
-], ids=["raise", "bad-input", "die"])
-def test_a_task_that_fails_is_one_line(tmp_path, scheduler, fault, code, line):
-    # The input's fault on a cluster of this process (the client's records are the point: its worker's
-    # are this process's), the others on an embedded one; Dask gives up on a task at the first worker
-    # that dies running it.
-    cluster = ["--scheduler", scheduler] if fault == "bad-input" else ["--workers", "1"]
-    returned, lines = _faulty_map(fault, tmp_path, cluster, DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES="0")
-    assert returned == code, lines
-    announced = f"Dask scheduler {re.escape(scheduler)}; .*" if fault == "bad-input" else EMBEDDED_ONE
-    assert len(lines) == 2 and re.fullmatch(announced, lines[0]) and lines[1].startswith(line), lines
-    assert fault != "bad-input" or lines[1].endswith("weather: a file that broke mid-run")  # as the field is named
-    assert sorted(path.name for path in tmp_path.iterdir()) == (["died"] if fault == "die" else [])
-
-
-def _snapshot(folder: Path) -> dict[str, tuple]:
-    return {str(path.relative_to(folder)): (path.read_bytes(), path.stat().st_mtime_ns)
-            for path in sorted(folder.rglob("*")) if path.is_file()}
-
-
-def test_a_scheduler_lost_mid_run_is_one_line_and_a_resume_that_cannot_connect_changes_nothing(start_cluster,
-                                                                                                tmp_path):
-    # One worker: what is lost is the scheduler, not a worker.
-    scheduler_file, _, scheduler = start_cluster(1)
-    out = tmp_path / "map"
-    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
-    try:
-        _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
-        address = json.loads(scheduler_file.read_text())["address"]
-        scheduler.kill()
-        _, err = run.communicate(timeout=SECONDS)
-    finally:
-        _kill(run)
-    lines = err.splitlines()
-    assert run.returncode == 2 and len(lines) == 2, err
-    assert lines[0].startswith("Dask scheduler tcp://127.0.0.1:")
-    assert re.fullmatch(rf"error: --scheduler = '{re.escape(str(scheduler_file))}': the scheduler was lost mid-run "
-                        r"\((scheduler-connection-lost|CommClosedError)\); the \d+ of 16 chunks done are kept: "
-                        r"start it again and finish the map with --resume", lines[1]), lines[1]
-    before = _snapshot(out)
-    assert json.loads((out / "run.json").read_text())["status"] == "running" and before
-    refused = CliRunner().invoke(app, ["map", *MAP, "--out", str(out), "--resume", "--scheduler", address])
-    assert refused.exit_code == 2, refused.output
-    assert refused.stderr.startswith(f"error: --scheduler = '{address}': no Dask scheduler answers"), refused.stderr
-    assert _snapshot(out) == before and not [path for path in tmp_path.iterdir() if path.name.startswith(".")]

@@ -31,11 +31,18 @@ def la_map():
     return evaluate_sites(COARSE, [LA], [1.0, 4.0, 8.0])
 
 
-def test_year_rows_equal_the_annual_sweep(la_map):
-    """The map's year row is the annual sweep (`foldopt run` with a fixed angle over the year) of the
-    same site: same fold angle, same daily t_solar of every design, same energy."""
-    plan = make_plan({**{k: v for k, v in COARSE.items()}, "site": LA, "date": "year", "p_load": [1.0, 4.0, 8.0]})
-    table = run_plan(plan).table
+@pytest.fixture(scope="session")
+def la_sweep() -> pd.DataFrame:
+    """The reference of :func:`la_map`: the annual sweep (`foldopt run` with a fixed angle over the
+    year) of the same site and loads, its daily rows."""
+    plan = make_plan({**COARSE, "site": LA, "date": "year", "p_load": [1.0, 4.0, 8.0]})
+    return run_plan(plan).table
+
+
+def test_year_rows_equal_the_annual_sweep(la_map, la_sweep):
+    """The map's year row is the annual sweep of the same site: same fold angle, same daily
+    t_solar of every design, same energy."""
+    table = la_sweep
     means = table.groupby(["p_load_w", "design"])[["t_solar_h", "energy_harvested_wh", "fold_angle_deg"]].agg(
         {"t_solar_h": "mean", "energy_harvested_wh": "sum", "fold_angle_deg": "first"})
     year = la_map[la_map["period"] == "year"].set_index("p_load_w")
@@ -53,15 +60,13 @@ def test_year_rows_equal_the_annual_sweep(la_map):
         assert row["peak_power_flat_w"] == pytest.approx(flat_peak, rel=1e-12)
 
 
-def test_each_period_is_its_own_optimum(la_map):
+def test_each_period_is_its_own_optimum(la_map, la_sweep):
     """A season's fold angle maximises the objective over that season's days: the year's angle does
     no better there (the sweep at the year's angle, restricted to the season, is the reference)."""
     assert list(la_map["period"].unique()) == list(PERIODS)
     assert la_map.groupby("period")["days_n"].first().to_dict() == {"year": 365, "DJF": 90, "MAM": 92, "JJA": 92,
                                                                   "SON": 91}
-    plan = make_plan({**COARSE, "site": LA, "date": "year", "p_load": 4.0})
-    table = run_plan(plan).table
-    twofold = table[table["design"] == "twofold"]
+    twofold = la_sweep[(la_sweep["design"] == "twofold") & (la_sweep["p_load_w"] == 4.0)]
     months = pd.to_datetime(twofold["date"]).dt.month.to_numpy()
     for period, season in SEASONS.items():
         at_year_angle = twofold["t_solar_h"].to_numpy()[np.isin(months, season)].mean()
@@ -167,7 +172,13 @@ def test_a_sites_horizon_column_names_each_sites_file(tmp_path):
     assert (rows.loc["walls", hidden] < rows.loc["open", hidden]).all().all()
 
 
-def test_a_grid_map_is_a_cf_netcdf_dataset(tmp_path):
+@pytest.fixture(scope="session")
+def grid_map() -> pd.DataFrame:
+    """Six sites of a grid, at two loads relative to each site's flat peak."""
+    return evaluate_sites(COARSE, grid_sites([-30.0, 0.0, 30.0], [0.0, 60.0], False), [0.1, 0.3], relative=True)
+
+
+def test_a_grid_map_is_a_cf_netcdf_dataset(grid_map, tmp_path):
     """map.nc holds every row of the table at its latitude, longitude, load and period (a missing
     site, as a sea point of a land grid, is fill), with CF's coordinate metadata; xarray reads it
     back through its SciPy backend."""
@@ -175,8 +186,7 @@ def test_a_grid_map_is_a_cf_netcdf_dataset(tmp_path):
 
     from foldopt.output.gridded import grid_dataset, write_grid_netcdf
 
-    sites = grid_sites([-30.0, 0.0, 30.0], [0.0, 60.0], False)
-    table = evaluate_sites(COARSE, sites, [0.1, 0.3], relative=True)
+    table = grid_map
     land = table[~((table["latitude"] == 0.0) & (table["longitude"] == 60.0))]  # one point "at sea"
     assert write_grid_netcdf(land, tmp_path, relative=True) == "map.nc"
     data = xr.open_dataset(tmp_path / "map.nc", engine="scipy")
@@ -233,7 +243,7 @@ def test_a_map_searches_the_fold_angle_and_the_tilt_not_the_azimuth():
     map_request({**COARSE, "optimize": {"vary": ["fold_angle", "tilt"]}}, [1.0], latitudes=[0], longitudes=[0])
 
 
-def test_a_relative_maps_answer_has_one_line_per_load():
+def test_a_relative_maps_answer_has_one_line_per_load(grid_map):
     """Loads as fractions of each site's peak: every site's row of a load is that load, however the
     division rounds, so the answer counts each load over every site."""
     from foldopt.studies.result_answers import of_map
@@ -242,9 +252,8 @@ def test_a_relative_maps_answer_has_one_line_per_load():
 
     sites = grid_sites([-30.0, 0.0, 30.0], [0.0, 60.0], False)
     fractions = (0.1, 0.3)
-    table = evaluate_sites(COARSE, sites, list(fractions), relative=True)
     spec = MapSpec(COARSE, tuple(sites), fractions, relative=True)
-    answer = of_map(MapRun(spec, table, Path("."), (0,), (), 1.0, "test", None), relative=True)
+    answer = of_map(MapRun(spec, grid_map, Path("."), (0,), (), 1.0, "test", None), relative=True)
     assert [load["p_load_frac"] for load in answer.result["loads"]] == list(fractions)
     assert [load["sites"] for load in answer.result["loads"]] == [6, 6]
 
