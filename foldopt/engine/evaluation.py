@@ -722,8 +722,9 @@ def curve_metrics(
         raises ValueError.
     """
     power = np.ascontiguousarray(power, dtype=float)
-    engine = engine_for(engine, power.size)
     sorted_loads, order = _sorted_loads(loads)
+    # The reference path walks every step once a load; the kernel walks the loads along the curve.
+    engine = engine_for(engine, power.size * sorted_loads.shape[1])
     row_loadset = (
         np.zeros(power.shape[0], dtype=np.int64)
         if row_loadset is None
