@@ -4,11 +4,12 @@ pvlib's ``clearsky.lookup_linke_turbidity`` [1]_ opens ``LinkeTurbidities.h5`` (
 values on a 5-arcminute grid, as 20 x the turbidity, gzip-compressed in chunks of 135 x 270 grid
 points) at every call and interpolates the month values to the UTC day of year of every time
 stamp. :func:`linke_turbidity` gives the same values, to the bit (tests/test_atmosphere.py holds
-it to pvlib's own lookup on random sites and days), for a whole clock grid at once: the file is
-kept open in the process, so that its chunk cache serves the neighbouring sites of a map, and the
-interpolation runs once per UTC day, not per step: pvlib's lookup opens the file, decompresses a
-chunk and builds a pandas index of every step at each call, a cost per site that a map pays at
-every site (docs/performance.rst).
+it to pvlib's own lookup on random sites and days, one site or many in a call), for a whole
+clock grid of many sites at once: the file is kept open in the process with a chunk cache that
+holds the neighbouring sites of a map's chunks (a site's 12 months are 6 chunks), and the
+interpolation runs once per site and UTC day, not per step: pvlib's lookup opens the file,
+decompresses the chunks and builds a pandas index of every step at each call, a cost per site
+that a map pays at every site (docs/performance.rst). A one-site study reads its 6 chunks only.
 
 References
 ----------
@@ -32,12 +33,14 @@ GRID_SHAPE = (2160, 4320)
 
 
 #: The file's chunk cache [bytes]: 460 of its 1,536 chunks of 135 x 270 points x 2 months
-#: (73 kB decompressed), the neighbouring sites of a map's chunks on a worker, whose 12 months
-#: are 6 chunks a site (h5py's default of 1 MiB holds two sites' tiles, and a map going round a
-#: latitude row came back to a tile after 16 others). Filled only as sites are read.
+#: (73 kB decompressed), the neighbouring sites of a map's chunks on a worker, a site's 12 months
+#: being 6 chunks (h5py's default of 1 MiB holds two sites' tiles, where a map going round a
+#: latitude row meets 16 tiles before it comes back to one). Filled only as sites are read.
 CHUNK_CACHE_BYTES = 32 << 20
 #: Hash slots of the chunk cache: a prime, about 100 times the chunks it holds (as HDF5 advises).
 CHUNK_CACHE_SLOTS = 49_999
+#: Rows of steps given their turbidity at a time (256 rows of 288 steps: 0.6 MB of instants).
+ROWS_AT_ONCE = 256
 
 
 @functools.lru_cache(maxsize=1)
@@ -110,12 +113,15 @@ def linke_turbidity(latitude, longitude, utc_ns) -> np.ndarray:
     table = _daily_values(places, first, int(high.max()))
     if np.all(high - low <= 1):
         # A row (a day's block) spans at most two UTC days: its steps before the second day's
-        # midnight take the first day's value, the rest the second's (no division per step).
-        turbidity = np.where(
-            steps < ((low + 1) * NS_PER_DAY)[:, None],
-            table[site, low - first][:, None],
-            table[site, high - first][:, None],
-        )
+        # midnight take the first day's value, the rest the second's (no division per step),
+        # ROWS_AT_ONCE rows at a time so that a map's many rows pass through the CPU's cache.
+        turbidity = np.empty(steps.shape)
+        midnight = ((low + 1) * NS_PER_DAY)[:, None]
+        before, after = table[site, low - first][:, None], table[site, high - first][:, None]
+        for rows in range(0, len(steps), ROWS_AT_ONCE):
+            part = slice(rows, rows + ROWS_AT_ONCE)
+            np.copyto(turbidity[part], after[part])
+            np.copyto(turbidity[part], before[part], where=steps[part] < midnight[part])
     else:
         turbidity = table[site[:, None], np.floor_divide(steps, NS_PER_DAY) - first]
     return turbidity.reshape(utc_ns.shape)
@@ -139,9 +145,7 @@ def _daily_values(places: np.ndarray, first: int, last: int) -> np.ndarray:
             ]
         )
         around = np.concatenate([[monthly[-1]], monthly, [monthly[0]]])
-        table[index] = np.where(
-            leap,
-            np.interp(dayofyear, _month_middles(True), around),
-            np.interp(dayofyear, _month_middles(False), around),
-        )
+        table[index] = np.interp(dayofyear, _month_middles(False), around)
+        if leap.any():
+            table[index, leap] = np.interp(dayofyear[leap], _month_middles(True), around)
     return table / 20.0
