@@ -87,6 +87,38 @@ def test_linke_turbidity_is_pvlibs_lookup_to_the_bit():
     assert linke_turbidity(0.0, 0.0, np.zeros((2, 0), dtype=np.int64)).shape == (2, 0)  # no step with the sun up
 
 
+@pytest.mark.filterwarnings("ignore:DatetimeIndex.dayofyear is deprecated")  # in pvlib's lookup, not ours to fix
+@settings(max_examples=40, deadline=None)
+@given(
+    places=st.lists(st.tuples(st.floats(-90.0, 90.0), st.floats(-180.0, 180.0)), min_size=1, max_size=4),
+    data=st.data(),
+)
+def test_linke_turbidity_of_many_sites_is_pvlibs_lookup_to_the_bit(places, data):
+    """A map's chunk asks for many sites at once, a site per row of steps (the engine's blocks):
+    each row is pvlib's lookup at its own site, to the bit, whether the rows are a day's steps
+    (across a UTC midnight or not) or instants spread over 40 years, and whichever sites share
+    the call (repeated, interleaved)."""
+    import pandas as pd
+
+    from foldopt.inputs.turbidity import linke_turbidity
+
+    which = data.draw(st.lists(st.integers(0, len(places) - 1), min_size=1, max_size=6))
+    seconds = st.integers(0, 40 * 365 * 86_400)
+    if data.draw(st.booleans(), label="a day's steps a row"):
+        starts = data.draw(arrays(np.int64, len(which), elements=seconds), label="starts [s]")
+        step = data.draw(st.sampled_from([60, 300, 1_800]), label="step [s]")
+        stamps = (starts[:, None] + np.arange(48) * step) * 10**9 + 10**18 // 2
+    else:
+        stamps = data.draw(arrays(np.int64, (len(which), 30), elements=seconds)) * 10**9 + 10**18 // 2
+    latitude = np.array([places[i][0] for i in which])
+    longitude = np.array([places[i][1] for i in which])
+    turbidity = linke_turbidity(latitude, longitude, stamps)
+    for row, (lat, lon) in enumerate(zip(latitude, longitude, strict=True)):
+        times = pd.DatetimeIndex(stamps[row]).tz_localize("UTC")
+        expected = pvlib.clearsky.lookup_linke_turbidity(times, lat, lon).to_numpy()
+        np.testing.assert_array_equal(turbidity[row], expected)
+
+
 @settings(max_examples=50, deadline=None)
 @given(zenith=arrays(np.float64, st.integers(1, 50), elements=st.floats(-10.0, 180.0)))
 def test_airmass_is_pvlibs_kasten_young_to_the_bit(zenith):

@@ -81,11 +81,11 @@ def clear_light(
     if model == "ineichen":
         turbidity = linke_turbidity
         if turbidity is None:
-            turbidity = np.empty(solar_zenith.shape)
-            for (latitude, longitude, _), members in groups.items():
-                turbidity[members] = climatology_turbidity(
-                    latitude, longitude, grid.utc_ns[members]
-                )
+            turbidity = climatology_turbidity(
+                np.array([site.latitude for site in sites], dtype=float),
+                np.array([site.longitude for site in sites], dtype=float),
+                grid.utc_ns,
+            )
         altitude = np.array([site.altitude for site in sites], dtype=float)
         from foldopt.physics.clearsky import ineichen_terms  # numba's compiled pass
 
