@@ -174,7 +174,7 @@ def _run_length(start, count, step_hours, held):
     return start
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def blocked_day(power, span, p_load, step_hours, held, extremes, scratch, t_out):
     """t_solar of every load of ``p_load`` (ascending) of one power curve [W] into ``t_out``, as
     :func:`day_metrics` for constant loads without their longest runs, walking steps
@@ -271,7 +271,7 @@ def curve_rows(power, span, row_loadset, loads, out, scratch):
     in_chunks(_chunk_curves, power.shape[0], scratch, power, span, row_loadset, loads, out)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
     """Rows ``start .. stop - 1`` of :func:`curve_rows` with one chunk's scratch ``work`` (a thread
     of :func:`foldopt.engine.records.in_chunks` calls it)."""

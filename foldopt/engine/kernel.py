@@ -429,7 +429,7 @@ def _built_power(code, parts, p_panel, tables):
     return _delivered(power, conv_table, conv_rated)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _built_row(b, first, last, sky, tables, need_series, work):
     """:func:`_chunk_rows`' second loop for the circuit as built: the parts at each step (linear
     between two table sets where the step's air temperature lies between them), then what each
@@ -474,7 +474,7 @@ def _built_row(b, first, last, sky, tables, need_series, work):
             buffer[c, s] = _built_power(connections[c], parts, p_panel, tables)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _keep_curves(kept, power, first, last):
     """Every connection's power [W] at steps ``first..last`` of a row (``power``, (n_conn,
     n_steps)) into ``kept``, the row's curves of :attr:`foldopt.engine.records.Outputs.power`.
@@ -533,7 +533,7 @@ def _held(held, step_hours):
     return held
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
     """:func:`_chunk_rows` for the common case, apart: switching alone from one table set a block,
     the exact incidence without the modifier, constant loads without their longest runs (W1-W3,
@@ -579,7 +579,7 @@ def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
         )
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work``, the row's
     functions inlined into it (a thread of :func:`foldopt.engine.records.in_chunks` calls it).
