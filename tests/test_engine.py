@@ -332,7 +332,8 @@ def test_the_kernels_loops_count_no_references():
         curve_reduction._chunk_curves,
     )
     assert [f.py_func.__name__ for f in called if f.targetoptions.get("_nrt") is not False] == []
-    options = {k: v for k, v in curve_reduction.blocked_day.targetoptions.items() if k != "cache"}
+    options = curve_reduction.blocked_day.targetoptions
+    options = {k: v for k, v in options.items() if k not in ("cache", "nopython")}
     fresh = numba.njit(**options)(curve_reduction.blocked_day.py_func)
     power, loads, held = np.linspace(0.0, 5.0, 48), np.array([1.0, 2.0]), np.arange(49) * 0.5
     t_out = np.zeros(2)
