@@ -312,3 +312,32 @@ def test_the_common_cases_loop_has_the_general_loops_bits(sky):
     for field in ("t_solar", "energy", "peak", "power"):
         np.testing.assert_array_equal(getattr(common, field)[:, 0], getattr(general, field)[:, 0])
     np.testing.assert_array_equal(common.irradiation, general.irradiation)
+
+
+def test_the_kernels_loops_count_no_references():
+    """The chunk loops and the functions they call rather than inline are compiled without numba's
+    reference counting: a count of each array they hand on is an atomic operation at every row
+    or step (``foldopt.engine.kernel``). One of them compiled afresh (numba's cache keeps no IR)
+    holds no call to NRT_incref or NRT_decref."""
+    import numba
+
+    from foldopt.engine import curve_reduction, kernel
+
+    called = (
+        kernel._chunk_switching,
+        kernel._chunk_rows,
+        kernel._built_row,
+        kernel._keep_curves,
+        curve_reduction.blocked_day,
+        curve_reduction._chunk_curves,
+    )
+    assert [f.py_func.__name__ for f in called if f.targetoptions.get("_nrt") is not False] == []
+    options = curve_reduction.blocked_day.targetoptions
+    options = {k: v for k, v in options.items() if k not in ("cache", "nopython")}
+    fresh = numba.njit(**options)(curve_reduction.blocked_day.py_func)
+    power, loads, held = np.linspace(0.0, 5.0, 48), np.array([1.0, 2.0]), np.arange(49) * 0.5
+    t_out = np.zeros(2)
+    extremes, scratch = (np.zeros(2), np.full(2, 5.0)), (np.zeros(2), np.zeros(3))
+    fresh(power, (1, 40), loads, 0.5, held, extremes, scratch, t_out)
+    ir = fresh.inspect_llvm(fresh.signatures[0])
+    assert "call void @NRT_incref" not in ir and "call void @NRT_decref" not in ir

@@ -18,7 +18,8 @@ blocks that cross a load.
 
 Rows are split into chunks, a few per thread (:func:`foldopt.engine.records.in_chunks`), and each
 chunk has its own scratch, allocated by the caller (:func:`foldopt.engine.records.allocate`) and
-cleared per row.
+cleared per row. A chunk's loop allocates nothing and is compiled without numba's reference
+counting, as the kernel's (:mod:`foldopt.engine.kernel`).
 """
 
 from __future__ import annotations
@@ -86,8 +87,7 @@ def day_metrics(power, span, p_load, profile, how, scratch, t_out, cont_out):
     profile ``profile`` (n_steps) [W] (:func:`_per_load`); steps outside ``first..last`` hold the
     power of the first and last, and the profile there is taken as the first's and the last's.
     ``scratch`` is a chunk's ``above``, ``whole`` and ``run``
-    (:class:`foldopt.engine.records.Scratch`): arrays, not the records, which an inlined function
-    would count and release at every call.
+    (:class:`foldopt.engine.records.Scratch`).
 
     A segment adds its length to ``whole[k]`` when the k lowest loads lie at or below its low end
     (summed from the top at the end), and shares to the loads inside its range. Consecutive
@@ -174,7 +174,7 @@ def _run_length(start, count, step_hours, held):
     return start
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def blocked_day(power, span, p_load, step_hours, held, extremes, scratch, t_out):
     """t_solar of every load of ``p_load`` (ascending) of one power curve [W] into ``t_out``, as
     :func:`day_metrics` for constant loads without their longest runs, walking steps
@@ -188,8 +188,10 @@ def blocked_day(power, span, p_load, step_hours, held, extremes, scratch, t_out)
     every load, below them all, or between two, and only the blocks where it crosses a load are
     walked step by step. A run's steps are counted and its length taken from ``held``: the same
     additions of the step in the same order as :func:`_day_steps`' pending sum, so that every
-    value is the same bits. It is called, not inlined, with arrays rather than records: the
-    kernel compiles faster, and the call costs less than the machine's noise."""
+    value is the same bits. It is called, not inlined: the kernel compiles faster, and the call
+    costs less than the machine's noise. Like the kernel's chunk loops that call it, it counts no
+    references (``_nrt=False``, :mod:`foldopt.engine.kernel`): it allocates nothing, and a count
+    of each array handed to it would be an atomic operation at every call."""
     first, last = span
     low, high = extremes
     above, whole = scratch
@@ -271,7 +273,7 @@ def curve_rows(power, span, row_loadset, loads, out, scratch):
     in_chunks(_chunk_curves, power.shape[0], scratch, power, span, row_loadset, loads, out)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
     """Rows ``start .. stop - 1`` of :func:`curve_rows` with one chunk's scratch ``work`` (a thread
     of :func:`foldopt.engine.records.in_chunks` calls it)."""

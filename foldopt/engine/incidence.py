@@ -76,10 +76,9 @@ def row_arrays(sky, rows, work):
     ``light`` (sun, paper_sun, beam, terms of ``sky``), ``panels`` (normal, sky_view, paper of
     ``rows``) and ``lit`` (east, west, incident, diffuse_east, diffuse_west of ``work``).
 
-    A chunk of rows takes them once, before its loop over the rows: a record handed to an
-    inlined function is counted and released at every row, each of its arrays an atomic
-    operation, whether the function reads it or not; a tuple of the arrays it reads is counted
-    less, and not at all where numba's pruning of reference counts finds the pairs."""
+    A chunk of rows takes them once, before its loop over the rows, so that each function sees
+    the arrays it reads and no record (the chunk's loops count no references:
+    :mod:`foldopt.engine.kernel`)."""
     return (
         (sky.sun, sky.paper_sun, sky.beam, sky.terms),
         (rows.normal, rows.sky_view, rows.paper),

@@ -22,10 +22,13 @@ time. So the loops are written once and inlined once per case, each case's setti
 constants (the incidence per mode, diffuse terms and modifier; the power of a model without
 I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
 rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
-loop, not called. A function run at every step takes arrays, not records: each array of a record
-handed to it would be counted and released at every step. So do a row's functions: the chunk's
-loop takes the records' arrays once, into tuples of the arrays each reads
-(:func:`foldopt.engine.incidence.row_arrays`). The common case (switching alone from one table
+loop, not called. The chunk's loops, and the functions they call rather than inline, are compiled
+without numba's reference counting (``_nrt=False``): they allocate nothing, every array they see is
+the caller's and lives through the call, and numba would otherwise count each array handed to an
+inlined function, or each view taken (``power[0]``, ``t_solar[r, 0]``), and release it at every
+row, an atomic operation each, which its pruning of the counts does not remove from loops this
+large. The chunk's loop takes the records' arrays once, into tuples of the arrays each function
+reads (:func:`foldopt.engine.incidence.row_arrays`). The common case (switching alone from one table
 set a block, the exact incidence without the modifier, constant loads) has a chunk's loop of its
 own, :func:`_chunk_switching`, chosen before numba sees the call, so that a request compiles only
 the loop it runs. (What each choice was worth: ``docs/performance.rst``.)
@@ -429,7 +432,7 @@ def _built_power(code, parts, p_panel, tables):
     return _delivered(power, conv_table, conv_rated)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _built_row(b, first, last, sky, tables, need_series, work):
     """:func:`_chunk_rows`' second loop for the circuit as built: the parts at each step (linear
     between two table sets where the step's air temperature lies between them), then what each
@@ -474,7 +477,7 @@ def _built_row(b, first, last, sky, tables, need_series, work):
             buffer[c, s] = _built_power(connections[c], parts, p_panel, tables)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _keep_curves(kept, power, first, last):
     """Every connection's power [W] at steps ``first..last`` of a row (``power``, (n_conn,
     n_steps)) into ``kept``, the row's curves of :attr:`foldopt.engine.records.Outputs.power`.
@@ -533,7 +536,7 @@ def _held(held, step_hours):
     return held
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
     """:func:`_chunk_rows` for the common case, apart: switching alone from one table set a block,
     the exact incidence without the modifier, constant loads without their longest runs (W1-W3,
@@ -579,7 +582,7 @@ def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
         )
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work``, the row's
     functions inlined into it (a thread of :func:`foldopt.engine.records.in_chunks` calls it).
