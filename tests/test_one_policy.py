@@ -66,12 +66,13 @@ def assert_same_answer(sweep: dict, world: dict) -> None:
     assert sweep["gain_vs_flat_pct"] == pytest.approx(world["gain_vs_flat_pct"], abs=0.05)
 
 
-def test_a_sweep_and_a_map_of_a_site_agree_at_the_same_step(tmp_path, scheduler):
+def test_a_sweep_and_a_map_of_a_site_agree_at_the_same_step(tmp_path, scheduler, figures_drawn_elsewhere):
     # Before exact mode had one sky, the sweep ran under the paper's beam-only Meinel sky and the
     # map under Ineichen's: another fold angle, another gain.
     # The paper's ideal PV model in both, as before exact mode's default became PVWatts'.
-    sweep = sweep_answer(tmp_path / "sweep", "--step-min", "5", "--pv-model", "ideal")
-    world = map_answer(tmp_path / "map", scheduler, "--step-min", "5", "--set", "pv_model=ideal")
+    with figures_drawn_elsewhere():  # the answers are the point; a sweep's and a map's figures are drawn elsewhere
+        sweep = sweep_answer(tmp_path / "sweep", "--step-min", "5", "--pv-model", "ideal")
+        world = map_answer(tmp_path / "map", scheduler, "--step-min", "5", "--set", "pv_model=ideal")
     assert_same_answer(sweep, world)
     assert sweep["recommended_deg"] == 40 and round(sweep["gain_vs_flat_pct"], 1) == 11.4
     # And both say so: the same sky in their questions.
@@ -79,8 +80,10 @@ def test_a_sweep_and_a_map_of_a_site_agree_at_the_same_step(tmp_path, scheduler)
         assert answer["models"].startswith("exact mode") and answer["models"].endswith(SKY), answer["models"]
 
 
-def test_a_sweep_and_a_map_of_a_site_agree_with_no_option(tmp_path, scheduler):
-    assert_same_answer(sweep_answer(tmp_path / "sweep"), map_answer(tmp_path / "map", scheduler))
+def test_a_sweep_and_a_map_of_a_site_agree_with_no_option(tmp_path, scheduler, figures_drawn_elsewhere):
+    with figures_drawn_elsewhere():
+        sweep, world = sweep_answer(tmp_path / "sweep"), map_answer(tmp_path / "map", scheduler)
+    assert_same_answer(sweep, world)
 
 
 @pytest.mark.filterwarnings("ignore:DatetimeIndex.dayofyear is deprecated")  # in pvlib's lookup, not ours to fix

@@ -116,18 +116,26 @@ def draw_coastlines(ax, color: str = "0.3", linewidth: float = 0.5) -> bool:
         Whether they were drawn: False, drawing nothing, without the mask package.
     """
     try:
-        latitude, longitude, fraction = land_fraction()
+        longitude, latitude, coarse = _coastline_grid()
     except ImportError:
         return False
-    coarse = fraction.reshape(fraction.shape[0] // 3, 3, fraction.shape[1] // 3, 3).mean(
-        axis=(1, 3)
-    )
-    ax.contour(
-        longitude.reshape(-1, 3).mean(axis=1),
-        latitude.reshape(-1, 3).mean(axis=1),
-        coarse,
-        levels=[0.5],
-        colors=color,
-        linewidths=linewidth,
-    )
+    ax.contour(longitude, latitude, coarse, levels=[0.5], colors=color, linewidths=linewidth)
     return True
+
+
+#: The coastlines' grid and the land fraction it was made of (:func:`_coastline_grid`).
+_COASTLINE_GRID = {}
+
+
+def _coastline_grid() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The land fraction at 15 arc minutes (the mean of 3 x 3 cells) and its cell centres [deg]:
+    made once per land fraction (:func:`land_fraction`), as a map draws it on each of its figures
+    and the mean over its 9 million cells costs more than the contour."""
+    latitude, longitude, fraction = land_fraction()
+    if _COASTLINE_GRID.get("of") is not fraction:
+        coarse = fraction.reshape(fraction.shape[0] // 3, 3, fraction.shape[1] // 3, 3).mean(
+            axis=(1, 3)
+        )
+        grid = (longitude.reshape(-1, 3).mean(axis=1), latitude.reshape(-1, 3).mean(axis=1), coarse)
+        _COASTLINE_GRID.update(of=fraction, grid=grid)
+    return _COASTLINE_GRID["grid"]
