@@ -116,8 +116,21 @@ print("both passed")
 
 def test_the_kernel_on_two_threads():
     """The kernel's rows go to threads in chunks, each with its own scratch (arrays zero-filled
-    inside a prange body have given wrong sums): the comparison above on two threads, in a process
-    of its own, as pytest-xdist's workers run the suite on one thread each (tests/conftest.py)."""
+    inside a prange body have given wrong sums): the comparison above on two threads. numba
+    launches its threads once, as it is imported, and can then run on fewer but never on more:
+    where this process launched two or more (``-n 0``) the comparison runs here on two; a
+    pytest-xdist worker launched one (tests/conftest.py), and runs it in a process of its own."""
+    import numba
+
+    if numba.config.NUMBA_NUM_THREADS >= 2:
+        before = numba.get_num_threads()
+        numba.set_num_threads(2)
+        try:
+            assert numba.get_num_threads() == 2
+            test_kernel_equals_the_reference_path()
+        finally:
+            numba.set_num_threads(before)
+        return
     environment = {**os.environ, "NUMBA_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"}
     done = subprocess.run([sys.executable, "-c", ON_TWO_THREADS], env=environment, capture_output=True, text=True,
                           timeout=600)
