@@ -75,9 +75,6 @@ def clear_light(
     terms : numpy.ndarray or None
         (n_blocks, n_steps, 4) diffuse terms, None for ``'none'``.
     """
-    groups: dict[tuple, list[int]] = {}
-    for index, site in enumerate(sites):
-        groups.setdefault((site.latitude, site.longitude, site.altitude), []).append(index)
     if model == "ineichen":
         turbidity = linke_turbidity
         if turbidity is None:
@@ -95,6 +92,9 @@ def clear_light(
         return {"dni": dni, "ghi": ghi, "dhi": dhi}, None if layout is None else np.moveaxis(
             layout, 1, -1
         )
+    groups: dict[tuple, list[int]] = {}
+    for index, site in enumerate(sites):
+        groups.setdefault((site.latitude, site.longitude, site.altitude), []).append(index)
     light = {key: np.zeros_like(solar_zenith) for key in ("dni", "ghi", "dhi")}
     airmass = _airmass(solar_zenith)
     for (_, _, altitude), members in groups.items():
