@@ -51,7 +51,7 @@ import numpy as np
 
 from foldopt.physics import connections
 from foldopt.physics.diodes import Diode
-from foldopt.physics.pvmodel import IVCurve
+from foldopt.physics.pvmodel import IVCurve, trailing_axes
 
 SWITCH_STATES = connections.SWITCH_STATES
 IDEAL_DIODE = Diode("ideal")
@@ -71,12 +71,6 @@ def _bracketed(evaluate, lo, hi, count=_GRID):
     left = np.take_along_axis(nodes, np.maximum(best - 1, 0), axis=-1)[..., 0]
     right = np.take_along_axis(nodes, np.minimum(best + 1, count - 1), axis=-1)[..., 0]
     return np.maximum(connections.golden_section(evaluate, left, right)[0], values.max(axis=-1))
-
-
-def _expand(value, like):
-    """``value`` (of the curves' shape) with trailing axes to broadcast against ``like``."""
-    value = np.asarray(value, dtype=float)
-    return np.reshape(value, value.shape + (1,) * (np.ndim(like) - value.ndim))
 
 
 @dataclass(frozen=True)
@@ -112,7 +106,7 @@ class _Explicit:
         """Current, voltage and their derivatives in ``x``: ``I, V, dI/dx, dV/dx``."""
         rank = np.ndim(x)
         if rank not in self._by_rank:
-            self._by_rank[rank] = tuple(_expand(p, x) for p in self._terms)
+            self._by_rank[rank] = tuple(trailing_axes(p, x) for p in self._terms)
         terms = self._by_rank[rank]
         if self.curve.model == "single-diode":
             # I = I_L - I_0 (exp(u / a) - 1) - u / R_sh and V = u - I R_s (Bishop [1]_).
@@ -139,7 +133,7 @@ def _output_current(side: _Explicit, voltage, diode: Diode, switch_resistance):
     the module's Method); 0 where the output voltage is above the branch's reach.
     """
     voltage = np.asarray(voltage, dtype=float)
-    x_oc = _expand(side.x_oc, voltage)
+    x_oc = trailing_axes(side.x_oc, voltage)
     x = np.broadcast_to(x_oc, np.broadcast_shapes(voltage.shape, x_oc.shape))
 
     def residual(x):
@@ -303,7 +297,10 @@ def _string_voltage(east: IVCurve, west: IVCurve, bypass: Diode | None, current,
     """Voltage [V] of the series string at ``current`` (a trailing axis allowed)."""
     total = -current * switch_resistance
     for curve in (east, west):
-        isc, voc = _expand(np.maximum(curve.i_sc, 0.0), current), _expand(curve.v_oc, current)
+        isc, voc = (
+            trailing_axes(np.maximum(curve.i_sc, 0.0), current),
+            trailing_axes(curve.v_oc, current),
+        )
         # Up to Isc a sub-panel's voltage lies in [0, Voc]; clipping also removes pvlib's absurd
         # voltages of practically dark cells (connections.series_power does the same).
         inside = np.clip(np.nan_to_num(curve.voltage(np.minimum(current, isc))), 0.0, voc)

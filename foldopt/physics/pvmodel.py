@@ -259,7 +259,7 @@ class IVCurve:
     params: tuple
 
     def _params(self, x):
-        return _trailing(self.params, x)
+        return [trailing_axes(p, x) for p in self.params]
 
     @functools.cached_property
     def _terms(self):
@@ -310,7 +310,7 @@ class IVCurve:
     def _diode_terms(self, x):
         """:attr:`_terms` and the parameters, shaped to broadcast against ``x``."""
         names = tuple(self._terms)
-        shaped = _trailing(tuple(self._terms.values()) + tuple(self.params), x)
+        shaped = [trailing_axes(p, x) for p in (*self._terms.values(), *self.params)]
         return dict(zip(names, shaped)), shaped[len(names) :]
 
     def current(self, voltage):
@@ -345,7 +345,7 @@ class IVCurve:
                 explicit = il - io * np.expm1(voltage / a) - t["gsh"] * voltage
             return np.where(t["i_lambert"], current, np.where(t["i_explicit"], explicit, np.nan))
         v_x, i_x, b = self._params(voltage)
-        scale = _trailing((self._terms["scale"],), voltage)[0]
+        scale = trailing_axes(self._terms["scale"], voltage)
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(v_x > 0, scale * -np.expm1((voltage / v_x - 1.0) / b), 0.0)
 
@@ -385,7 +385,7 @@ class IVCurve:
                 explicit = a * np.log1p((il - current) / io) - current * rs
             return np.where(t["v_lambert"], voltage, np.where(t["v_explicit"], explicit, np.nan))
         v_x, i_x, b = self._params(current)
-        scale = _trailing((self._terms["scale"],), current)[0]
+        scale = trailing_axes(self._terms["scale"], current)
         with np.errstate(divide="ignore", invalid="ignore"):
             return v_x * (1.0 + b * np.log1p(-current / scale))
 
@@ -489,10 +489,10 @@ class IVCurve:
         return self.mpp()[0].copy()
 
 
-def _trailing(arrays, x):
-    """``arrays`` (of the curves' shape) with trailing axes of 1 to broadcast against ``x``."""
-    extra = np.ndim(x) - np.ndim(arrays[0])
-    return [np.reshape(p, np.shape(p) + (1,) * extra) for p in arrays]
+def trailing_axes(value, like):
+    """``value`` (of the curves' shape) with trailing axes of 1 to broadcast against ``like``."""
+    value = np.asarray(value)
+    return np.reshape(value, value.shape + (1,) * (np.ndim(like) - value.ndim))
 
 
 def _kept(values):
