@@ -201,7 +201,16 @@ class TrackerCurves:
     @property
     def net(self) -> np.ndarray:
         """What is left for the load after the tracker's own draw [W], (n_blocks, n_steps)."""
-        return self.power - self.draw
+        return np.subtract(self.power, self.draw)
+
+    def gross_and_net(self) -> np.ndarray:
+        """:attr:`power` above :attr:`net`, (2 n_blocks, n_steps) [W], for one engine call over
+        both: the net written into its place, not made and copied."""
+        n_blocks = self.power.shape[0]
+        both = np.empty((2 * n_blocks, self.power.shape[1]))
+        both[:n_blocks] = self.power
+        np.subtract(self.power, self.draw, out=both[n_blocks:])
+        return both
 
 
 def tracker_curves(
@@ -587,12 +596,8 @@ def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None)
         flat_energy.append(metrics.energy[:, 0])
         flat_peak.append(metrics.peak[:, 0])
         curves = tracker_curves(sky, study, engine=engine)
-        # The gross and the net curves side by side, the net written in place (TrackerCurves.net)
-        curves_both = np.empty((2 * sky.n_blocks, sky.n_steps))
-        curves_both[: sky.n_blocks] = curves.power
-        np.subtract(curves.power, curves.draw, out=curves_both[sky.n_blocks :])
         both = engines.curve_metrics(
-            curves_both,
+            curves.gross_and_net(),
             loads,
             sky.step_hours,
             np.concatenate([loadset[rows], loadset[rows]]),
