@@ -334,11 +334,17 @@ def _switching_power(i, table_1d, pair, stride, nodes, weights):
     w_east, w_west, fi, fj = weights[0, i], weights[1, i], weights[2, i], weights[3, i]
     p_east = table_1d[node_east] * (1.0 - w_east) + table_1d[node_east + one] * w_east
     p_west = table_1d[node_west] * (1.0 - w_west) + table_1d[node_west + one] * w_west
+    best = max(p_east, p_west)
+    if min(p_east, p_west) == 0.0 and best >= 0.0:
+        # One sub-panel gives nothing (half the steps of a fold-angle sweep): the parallel
+        # pair's power, a fraction <= 1 of ``best``, is no more than ``best``, which the maximum
+        # below keeps whatever the pair table holds, so its look-up is skipped.
+        return best
     fraction = (pair[node_pair] * (1.0 - fj) + pair[node_pair + one] * fj) * (1.0 - fi) + (
         pair[node_pair + stride] * (1.0 - fj) + pair[node_pair + stride + one] * fj
     ) * fi
     p_parallel = min(max(fraction, 0.0), 1.0) * (p_east + p_west)
-    return max(max(p_east, p_west), p_parallel)
+    return max(best, p_parallel)
 
 
 @njit(cache=True, inline="always")
@@ -396,7 +402,8 @@ def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
                 buffer[0, begin + i] = power
                 lowest, highest = min(lowest, power), max(highest, power)
                 harvested += power
-                peak = max(peak, power)
+            # The day's peak from each walking block's highest: the same maximum.
+            peak = max(peak, highest)
             low[(begin - start + part) // walk] = lowest
             high[(begin - start + part) // walk] = highest
     return harvested, peak
