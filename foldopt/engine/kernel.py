@@ -336,9 +336,9 @@ def _switching_power(i, table_1d, pair, stride, nodes, weights):
     p_west = table_1d[node_west] * (1.0 - w_west) + table_1d[node_west + one] * w_west
     best = max(p_east, p_west)
     if min(p_east, p_west) == 0.0 and best >= 0.0:
-        # One sub-panel gives nothing (half the steps of a fold-angle sweep): the parallel
-        # pair's power, a fraction <= 1 of ``best``, is no more than ``best``, which the maximum
-        # below keeps whatever the pair table holds, so its look-up is skipped.
+        # One sub-panel gives nothing (the sun behind it): the pair's sum is then ``best``, a
+        # fraction of it in [0, 1] rounds to no more than ``best``, and the maximum below keeps
+        # ``best`` on a tie (or a NaN), whatever the pair table holds: its look-up is skipped.
         return best
     fraction = (pair[node_pair] * (1.0 - fj) + pair[node_pair + one] * fj) * (1.0 - fi) + (
         pair[node_pair + stride] * (1.0 - fj) + pair[node_pair + stride + one] * fj
@@ -353,9 +353,10 @@ def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
     set a block (``step_table[b, 0]`` of ``pair_tables``, the tables' subpanel and parallel
     first), without the series pair (every clear-sky study's and map's): the values
     of :func:`_pair_powers` and :func:`_connection_power` by the same operations, so the same
-    bits. Returns the sum of the steps' power [W] and its peak [W], the bits of
-    :func:`day_metrics`' (the same operations in the same order), and writes each walking
-    block's lowest and highest power to ``low`` and ``high``
+    bits (where one sub-panel gives nothing, without the pair's look-up, which cannot change
+    them: :func:`_switching_power`). Returns the sum of the steps' power [W] and its peak [W],
+    the bits of :func:`day_metrics`' (the same operations in the same order), and writes each
+    walking block's lowest and highest power to ``low`` and ``high``
     (:func:`foldopt.engine.curve_reduction.blocked_day`). ``curves``: a chunk's east, west and
     power; ``coordinates``: its nodes, weights, low and high
     (:class:`foldopt.engine.records.Scratch`).
