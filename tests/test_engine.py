@@ -383,8 +383,8 @@ def test_a_dark_sub_panel_adds_nothing_to_switching(name):
 
 
 def test_chunks_are_each_taken_once_and_their_errors_raised():
-    """:func:`foldopt.engine.records.in_chunks` hands every row to one chunk call, the calling
-    thread and the others taking chunks from one list, and raises a chunk's error."""
+    """:func:`foldopt.engine.records.in_chunks` hands every row to one chunk call on numba's
+    threads, each chunk with its own scratch, and raises a chunk's error."""
     import threading
 
     import numba
