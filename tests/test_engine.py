@@ -354,3 +354,63 @@ def test_the_kernels_loops_count_no_references():
     fresh(power, (1, 40), loads, 0.5, held, extremes, scratch, t_out)
     ir = fresh.inspect_llvm(fresh.signatures[0])
     assert "call void @NRT_incref" not in ir and "call void @NRT_decref" not in ir
+
+
+@pytest.mark.parametrize("name", ["numba", "numpy"])
+def test_a_dark_sub_panel_adds_nothing_to_switching(name):
+    """Where one sub-panel gets no light (the sun behind it, a beam-only sky), switching's power
+    is the other's alone, to the bit: a parallel pair with a dark member gives at most the lit
+    one's power. The kernel's common loop skips the pair table there (``_switching_power``); the
+    reference path looks it up. The curves of switching alone and of each sub-panel, kept."""
+    study = make_study({"name": "dark", "mode": "exact", "sky": "meinel", "pv_model": "single-diode",
+                        "connection": "switching", "site": {"latitude": 34.05, "longitude": -118.25},
+                        "date": "2025-01-01", "panel": {"area": 0.108, "efficiency": 0.19}, "p_load": 1.0,
+                        "step_min": 5})
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in (0, 172)]
+    sky, rows = _sky(study, [study.site] * 2, dates), _rows(study, [study.site] * 2, np.array([20.0, 90.0, 160.0]))
+    every = np.arange(rows.block.size)
+    electrical = engine_options(study).electrical
+    switching = engine.row_metrics(sky, rows=rows, loads=[1.0], electrical=electrical, outputs=("switching",),
+                                   engine=name, curves=every).power[:, 0]
+    east, west = engine.row_metrics(sky, rows=rows, loads=[1.0], electrical=electrical, outputs=("east", "west"),
+                                    engine=name, curves=every).power.transpose(1, 0, 2)
+    dark_west, dark_east = (west == 0) & (east > 0), (east == 0) & (west > 0)
+    assert dark_west.sum() > 100 and dark_east.sum() > 100  # the sun behind each side for hours
+    np.testing.assert_array_equal(switching[dark_west], east[dark_west])
+    np.testing.assert_array_equal(switching[dark_east], west[dark_east])
+    both = (east > 0) & (west > 0)
+    assert (switching[both] >= np.maximum(east, west)[both]).all()
+
+
+def test_chunks_are_each_taken_once_and_their_errors_raised():
+    """:func:`foldopt.engine.records.in_chunks` hands every row to one chunk call on numba's
+    threads, each chunk with its own scratch, and raises a chunk's error."""
+    import threading
+
+    import numba
+
+    from foldopt.engine.records import allocate, in_chunks
+
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    try:
+        _, scratch = allocate(1000, 1, 1, 10, False)
+        seen, lock = np.zeros(1000, dtype=int), threading.Lock()
+
+        def body(start, stop, work):
+            with lock:
+                seen[start:stop] += 1
+            work.east[:] = start  # each chunk its own scratch
+
+        in_chunks(body, 1000, scratch)
+        np.testing.assert_array_equal(seen, 1)
+        assert len(set(scratch.east[:, 0])) == scratch.east.shape[0]
+
+        def failing(start, stop, work):
+            if start > 0:
+                raise ValueError(f"chunk at {start}")
+
+        with pytest.raises(ValueError, match="chunk at"):
+            in_chunks(failing, 1000, scratch)
+    finally:
+        numba.set_num_threads(before)

@@ -334,11 +334,17 @@ def _switching_power(i, table_1d, pair, stride, nodes, weights):
     w_east, w_west, fi, fj = weights[0, i], weights[1, i], weights[2, i], weights[3, i]
     p_east = table_1d[node_east] * (1.0 - w_east) + table_1d[node_east + one] * w_east
     p_west = table_1d[node_west] * (1.0 - w_west) + table_1d[node_west + one] * w_west
+    best = max(p_east, p_west)
+    if min(p_east, p_west) == 0.0 and best >= 0.0:
+        # One sub-panel gives nothing (the sun behind it): the pair's sum is then ``best``, a
+        # fraction of it in [0, 1] rounds to no more than ``best``, and the maximum below keeps
+        # ``best`` on a tie (or a NaN), whatever the pair table holds: its look-up is skipped.
+        return best
     fraction = (pair[node_pair] * (1.0 - fj) + pair[node_pair + one] * fj) * (1.0 - fi) + (
         pair[node_pair + stride] * (1.0 - fj) + pair[node_pair + stride + one] * fj
     ) * fi
     p_parallel = min(max(fraction, 0.0), 1.0) * (p_east + p_west)
-    return max(max(p_east, p_west), p_parallel)
+    return max(best, p_parallel)
 
 
 @njit(cache=True, inline="always")
@@ -347,9 +353,10 @@ def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
     set a block (``step_table[b, 0]`` of ``pair_tables``, the tables' subpanel and parallel
     first), without the series pair (every clear-sky study's and map's): the values
     of :func:`_pair_powers` and :func:`_connection_power` by the same operations, so the same
-    bits. Returns the sum of the steps' power [W] and its peak [W], the bits of
-    :func:`day_metrics`' (the same operations in the same order), and writes each walking
-    block's lowest and highest power to ``low`` and ``high``
+    bits (where one sub-panel gives nothing, without the pair's look-up, which cannot change
+    them: :func:`_switching_power`). Returns the sum of the steps' power [W] and its peak [W],
+    the bits of :func:`day_metrics`' (the same operations in the same order), and writes each
+    walking block's lowest and highest power to ``low`` and ``high``
     (:func:`foldopt.engine.curve_reduction.blocked_day`). ``curves``: a chunk's east, west and
     power; ``coordinates``: its nodes, weights, low and high
     (:class:`foldopt.engine.records.Scratch`).
@@ -396,7 +403,8 @@ def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
                 buffer[0, begin + i] = power
                 lowest, highest = min(lowest, power), max(highest, power)
                 harvested += power
-                peak = max(peak, power)
+            # The day's peak from each walking block's highest: the same maximum.
+            peak = max(peak, highest)
             low[(begin - start + part) // walk] = lowest
             high[(begin - start + part) // walk] = highest
     return harvested, peak
