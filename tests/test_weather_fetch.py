@@ -77,6 +77,9 @@ class Handler(BaseHTTPRequestHandler):
             return self.send(429, b"", {"Retry-After": "3600"})
         if mode in ("e500", "flaky"):
             return self.send(500, b"")
+        if mode in ("refuse", "refuseescaped"):  # a refusal with status 200, its key as JSON allows
+            key = b"message" if mode == "refuse" else b"\\u006dessage"
+            return self.send(200, b'{"%s": "Location over the sea", "status": 400}' % key)
         if mode == "cut":  # the headers promise the whole answer, half of it comes
             self.send_response(200)
             self.send_header("Content-Length", str(len(BODY)))
@@ -308,6 +311,16 @@ def test_a_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, cache
     assert cache_files(tmp_path) == before  # nothing new, nothing half-written, nothing lost
     assert requests_made(server, route) == 1
     assert time.monotonic() - started < 3  # bounded: the slow server sleeps 3 s
+
+
+@pytest.mark.parametrize("mode", ["refuse", "refuseescaped"])
+def test_a_refusal_with_status_200_is_one_line_and_caches_nothing(pvgis, server, tmp_path, mode):
+    """PVGIS's ``{"message": ...}`` with status 200, its key spelled plainly or with a \\u escape."""
+    route = pvgis(mode)
+    result = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
+    assert (result.exit_code, result.stderr.strip().splitlines()) == (2, [
+        "error: weather pvgis-tmy: PVGIS refused the request: Location over the sea"])
+    assert cache_files(tmp_path) == {} and requests_made(server, route) == 1
 
 
 def test_a_fault_through_a_sweep_is_the_same_line_and_exit_2(pvgis, tmp_path):
