@@ -67,7 +67,7 @@ class Handler(BaseHTTPRequestHandler):
         if mode == "auth":  # a mirror behind a user and password: user:secret
             good = self.headers.get("Authorization") == "Basic dXNlcjpzZWNyZXQ="
             return self.send(200, BODY) if good else self.send(401, b"")
-        if mode in ("trickle", "tricklehead"):  # a byte every half second, each read in time
+        if mode in ("trickle", "tricklehead"):  # a byte every 0.2 s, each read in time
             return self.trickle(BODY, mode == "trickle")
         if mode == "ok" or (mode == "rate" and n > 1) or (mode == "flaky" and n != 2):
             return self.send(200, BODY)
@@ -77,6 +77,9 @@ class Handler(BaseHTTPRequestHandler):
             return self.send(429, b"", {"Retry-After": "3600"})
         if mode in ("e500", "flaky"):
             return self.send(500, b"")
+        if mode in ("refuse", "refuseescaped"):  # a refusal with status 200, its key as JSON allows
+            key = b"message" if mode == "refuse" else b"\\u006dessage"
+            return self.send(200, b'{"%s": "Location over the sea", "status": 400}' % key)
         if mode == "cut":  # the headers promise the whole answer, half of it comes
             self.send_response(200)
             self.send_header("Content-Length", str(len(BODY)))
@@ -105,10 +108,10 @@ class Handler(BaseHTTPRequestHandler):
         else:  # not even the status line in one piece
             slow = b"HTTP/1.0 200 OK\r\nContent-Length: %d\r\n\r\n" % len(body) + body
         try:
-            for byte in slow[:120]:  # a minute at most, then the connection closes
+            for byte in slow[:120]:  # 24 s at most, then the connection closes
                 self.wfile.write(bytes([byte]))
                 self.wfile.flush()
-                time.sleep(0.5)
+                time.sleep(0.2)
         except (BrokenPipeError, ConnectionResetError):
             pass  # the client gave up: what is tested
         self.close_connection = True
@@ -240,7 +243,8 @@ def test_fetch_is_silent_quiet_and_one_json_document(pvgis, server, tmp_path):
     assert record["source"] == "pvgis-tmy"
 
 
-def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path):
+def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path,
+                                                                 figures_drawn_elsewhere):
     route = pvgis("ok")
     first = runner.invoke(app, ["weather", "fetch", "pvgis-tmy", "--lat", "45", "--lon", "8"])
     assert first.exit_code == 0, first.output
@@ -250,8 +254,9 @@ def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server
     assert requests_made(server, route) == 1
     assert cache_files(tmp_path)[next(iter(cache_files(tmp_path)))] == RECORDED.read_bytes()
     dead = pvgis("e500")  # a service that would fail: offline never asks it
-    offline = runner.invoke(app, [*SWEEP, "--days", "2025-06-21", "--weather", "pvgis-tmy",
-                                  "--offline", "--out", "offline"])
+    with figures_drawn_elsewhere():  # test_the_fetched_year's [a day, every angle]: this sweep
+        offline = runner.invoke(app, [*SWEEP, "--days", "2025-06-21", "--weather", "pvgis-tmy",
+                                      "--offline", "--out", "offline"])
     assert offline.exit_code == 0, offline.output
     assert requests_made(server, dead) == 0
     listed = runner.invoke(app, ["weather", "list", "--format", "json"])
@@ -287,7 +292,7 @@ FAULTS = [
     ("cut", [], "PVGIS's answer was cut off after "),
     ("half", [], "PVGIS's answer is not a readable PVGIS TMY (not valid JSON: "),
     ("close", [], "closed the connection without an answer; nothing was cached, try again"),
-    ("slow", ["--timeout", "0.5"], "did not answer within 0.5 s (weather.timeout_s sets the wait); its "
+    ("slow", ["--timeout", "0.2"], "did not answer within 0.2 s (weather.timeout_s sets the wait); its "
                                    "whole answer must come within it: nothing was cached"),
 ]
 
@@ -306,6 +311,16 @@ def test_a_fault_is_one_line_and_leaves_the_cache_as_it_was(pvgis, server, cache
     assert cache_files(tmp_path) == before  # nothing new, nothing half-written, nothing lost
     assert requests_made(server, route) == 1
     assert time.monotonic() - started < 3  # bounded: the slow server sleeps 3 s
+
+
+@pytest.mark.parametrize("mode", ["refuse", "refuseescaped"])
+def test_a_refusal_with_status_200_is_one_line_and_caches_nothing(pvgis, server, tmp_path, mode):
+    """PVGIS's ``{"message": ...}`` with status 200, its key spelled plainly or with a \\u escape."""
+    route = pvgis(mode)
+    result = runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"])
+    assert (result.exit_code, result.stderr.strip().splitlines()) == (2, [
+        "error: weather pvgis-tmy: PVGIS refused the request: Location over the sea"])
+    assert cache_files(tmp_path) == {} and requests_made(server, route) == 1
 
 
 def test_a_fault_through_a_sweep_is_the_same_line_and_exit_2(pvgis, tmp_path):
@@ -455,7 +470,8 @@ def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_
     with figures_drawn_elsewhere():  # the fetched run's, of the same data
         read = runner.invoke(app, [*HORIZON_DAY, "--horizon", str(HORIZON), "--out", "read"])
     assert read.exit_code == 0, read.output
-    flat = runner.invoke(app, [*HORIZON_DAY, "--out", "flat"])
+    with figures_drawn_elsewhere():  # the fetched run's sweep, the horizon left out: its rows alone
+        flat = runner.invoke(app, [*HORIZON_DAY, "--out", "flat"])
     assert flat.exit_code == 0, flat.output
     fetched, read, flat = (json.loads(r.stdout) for r in (fetched, read, flat))
     assert fetched["rows"] == read["rows"]  # every angle's t_solar, to the bit
@@ -693,7 +709,8 @@ def test_a_kept_hourly_series_read_without_its_format_says_which(tmp_path, monke
         "pvgis-hourly (weather.format: pvgis-hourly in a study)"]
 
 
-def test_camera_winter_by_its_live_source_is_its_committed_answer(pvgis, server, tmp_path):
+def test_camera_winter_by_its_live_source_is_its_committed_answer(pvgis, server, tmp_path,
+                                                                  figures_drawn_elsewhere):
     """configs/camera-winter.yaml as a user without the recorded file writes it (``weather:
     {source: pvgis-hourly, years: "2020:2021"}``): the fetched real years, their air temperature
     through the cold, give the committed example's buffer tables to the bit (per year, per month,
@@ -704,7 +721,8 @@ def test_camera_winter_by_its_live_source_is_its_committed_answer(pvgis, server,
                   config.read_text())
     assert "source: pvgis-hourly" in live
     (tmp_path / "camera-winter.yaml").write_text(live)
-    done = runner.invoke(app, ["run", "camera-winter.yaml", "--out", "live", "--quiet"])
+    with figures_drawn_elsewhere():  # test_camera_winter's, whole, of these same tables
+        done = runner.invoke(app, ["run", "camera-winter.yaml", "--out", "live", "--quiet"])
     assert done.exit_code == 0, done.output
     example = config.parents[1] / "results" / "examples" / "camera-winter"
     for name in ("storage_annual", "storage_years", "storage_monthly", "design_space"):

@@ -851,7 +851,13 @@ def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> Wea
     source = request.source
     try:
         text = payload.decode("utf-8")
-        refusal = json.loads(text).get("message") if text.lstrip().startswith("{") else None
+        # A key that reads "message" is spelled so in the text, or with a \u escape: an answer
+        # with neither (a whole TMY or series, 1-3 MB) holds none, and is not decoded for it (some
+        # 20 ms) before its check below decodes it.
+        spelled = "message" in text or "\\u" in text
+        refusal = (
+            json.loads(text).get("message") if spelled and text.lstrip().startswith("{") else None
+        )
     except (UnicodeDecodeError, ValueError, AttributeError):
         refusal = None
     if refusal:  # a refusal with status 200
