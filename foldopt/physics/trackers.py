@@ -522,8 +522,8 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     their last bits (some moves never settle on a fixed point: they change in their last bit, back
     and forth).
 
-    The moves go :data:`TURN_BATCH` at a time, each step's arithmetic in place: the same operations
-    on each move as on its own, over arrays that stay in the core's cache.
+    The moves go :data:`TURN_BATCH` at a time, each step's arithmetic one compiled pass (:func:`_newton`):
+    the same operations on each move as on its own, over arrays that stay in the core's cache.
 
     References
     ----------
@@ -543,43 +543,18 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
 def _newton(angle, t, speed, tau_1, tau_2, bend):
     """:func:`_time_to_turn`'s Newton steps on a batch of moves, ``t`` (their starts) updated in
     place. Each move stops on its own (its answer the same bits whatever other moves it is solved
-    with): the steps go over the whole batch, nearly every move taking as many, and are kept for
-    the moves still going alone."""
-    span = tau_1 - tau_2
+    with): each step's two ``expm1`` go over the batch, and the step's arithmetic is one compiled
+    pass that keeps the step where the move still goes
+    (:func:`foldopt.physics.tracker_moves.newton_step`)."""
+    from foldopt.physics.tracker_moves import newton_step  # numba's compiled pass
+
+    drive = tuple(float(v) for v in (speed, tau_1, tau_2, tau_1**2, tau_2**2, tau_1 - tau_2))
     going = np.ones(t.shape, dtype=bool)
+    decay = np.stack([-t / tau_1, -t / tau_2])
     for _ in range(50):
-        if not going.any():
+        np.expm1(decay, out=decay)
+        if not newton_step(decay, t, angle, going, drive, bend, TURN_TOLERANCE_S):
             break
-        decay_1, decay_2 = np.expm1(-t / tau_1), np.expm1(-t / tau_2)
-        # turned = speed * (t + (tau_1^2 decay_1 - tau_2^2 decay_2) / span), the angle turned
-        turned = tau_1**2 * decay_1
-        turned -= tau_2**2 * decay_2
-        turned /= span
-        turned += t
-        turned *= speed
-        # rate = speed * (1 - (tau_1 (decay_1 + 1) - tau_2 (decay_2 + 1)) / span), its derivative
-        decay_1 += 1.0
-        decay_1 *= tau_1
-        decay_2 += 1.0
-        decay_2 *= tau_2
-        decay_1 -= decay_2
-        decay_1 /= span
-        rate = np.subtract(1.0, decay_1, out=decay_1)
-        rate *= speed
-        # step = max(t - (turned - angle) / rate, 1e-9)
-        turned -= angle
-        turned /= rate
-        step = np.subtract(t, turned, out=turned)
-        np.maximum(step, 1e-9, out=step)
-        moved = np.subtract(step, t, out=decay_2)
-        np.abs(moved, out=moved)
-        np.copyto(t, step, where=going)
-        # left = bend / (2 rate) * (2 moved)^2, at most what the step left
-        rate *= 2.0
-        left = np.divide(bend, rate, out=rate)
-        square = moved * 2.0
-        left *= np.square(square, out=square)
-        going &= np.minimum(moved, left, out=left) > TURN_TOLERANCE_S
 
 
 def moved_degrees(normal):
@@ -600,23 +575,23 @@ def moved_degrees(normal):
         Turn into each step [deg], shaped as the normals' leading axes; 0 at the first step and
         where the panel holds still (turns below 1e-6 deg).
     """
+    from foldopt.physics.tracker_moves import half_chords, turns  # numba's compiled passes
+
     normal = np.asarray(normal, dtype=float)
-    turn = np.zeros(normal.shape[:-1])
+    n_steps = normal.shape[-2]
+    if n_steps == 0:
+        return np.zeros(normal.shape[:-1])
+    # Each component along the steps: a view of the sky's own layout (a dual-axis tracker's
+    # normal is the sun's vector), a copy of any other.
+    series = np.ascontiguousarray(np.moveaxis(normal.reshape(-1, n_steps, 3), -1, 1))
     # The chord between unit vectors is 2 sin(angle / 2): exact from a standstill to a half turn.
-    # Its arithmetic in place over the steps' differences, the normals' axes side by side.
-    chord = np.diff(normal, axis=-2)
-    np.multiply(chord, chord, out=chord)
-    length = chord[..., 0] + chord[..., 1]
-    length += chord[..., 2]
-    np.sqrt(length, out=length)
-    length /= 2.0
-    np.minimum(length, 1.0, out=length)
-    angle = np.arcsin(length)
-    angle *= 2.0
-    np.degrees(angle, out=turn[..., 1:])
+    half_angle = np.empty((series.shape[0], n_steps - 1))
+    half_chords(series, half_angle)
+    np.arcsin(half_angle, out=half_angle)
+    turn = np.empty(series.shape[::2])
     # A panel that holds still must not be charged a motor start: drop rounding-level turns.
-    turn[~(turn > 1e-6)] = 0.0
-    return turn
+    turns(half_angle, 1e-6, turn)
+    return turn.reshape(normal.shape[:-1])
 
 
 def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive):
