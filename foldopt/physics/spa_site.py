@@ -43,6 +43,21 @@ def _raised(east, north, up, t):
     return east * along, north * along, up * cos_t + level * sin_t
 
 
+@njit(cache=True, inline="always")
+def _turn_mod(angle):
+    """``angle % 360.0`` by Python's rule (NumPy's remainder), the same bits without ``fmod`` on
+    the hour angle's range: from 360 to 720 the difference is exact (Sterbenz), from -360 to 0
+    the sum is the one the rule rounds (its ``fmod`` gives the angle itself); -360 and -0.0 give
+    0.0 and -0.0, which the hour angle's ``- 180`` makes the same."""
+    if 0.0 <= angle < 360.0:
+        return angle
+    if 360.0 <= angle < 720.0:
+        return angle - 360.0
+    if -360.0 <= angle < 0.0:
+        return angle + 360.0
+    return angle % 360.0
+
+
 @njit(cache=True, nogil=True)
 def site_sun(
     terms,
@@ -79,12 +94,19 @@ def site_sun(
         start = uint64(first[b])
         # Eq. 42's factor of pressure and temperature, as pvlib groups it.
         scale = (pressure[b] / 1010.0) * (283.0 / (273 + SPA_TEMPERATURE)) * 1.02
+        midnight = 0  # [ns] of the UTC day of the step before
         for i in range(uint64(n_steps)):
             k = start + i
-            utc_hours = (utc_ns[b, i] % NS_PER_DAY) / NS_PER_HOUR
+            # utc_ns % NS_PER_DAY, without a division but where a step crosses a UTC midnight
+            since = utc_ns[b, i] - midnight
+            if since < 0 or since >= NS_PER_DAY:
+                midnight = utc_ns[b, i] // NS_PER_DAY * NS_PER_DAY
+                since = utc_ns[b, i] - midnight
+            utc_hours = since / NS_PER_HOUR
             hour_angle[b, i] = (
-                15.0 * (utc_hours - 12.0) + longitude[b] + terms[4, k] / 4.0 + 180.0
-            ) % 360.0 - 180.0
+                _turn_mod(15.0 * (utc_hours - 12.0) + longitude[b] + terms[4, k] / 4.0 + 180.0)
+                - 180.0
+            )
             # cos(delta) cos(H) and cos(delta) sin(H) at the site's hour angle H = H_G + longitude.
             cos_h = terms[0, k] * cos_lam[b] - terms[1, k] * sin_lam[b]
             sin_h = terms[1, k] * cos_lam[b] + terms[0, k] * sin_lam[b]
