@@ -77,3 +77,30 @@ def newton_step(decay, t, angle, going, drive, bend, tolerance):
         decay[0, i] = -now / tau_1
         decay[1, i] = -now / tau_2
     return left_going
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def gather_moves(degrees, gear_ratio, moves, target):
+    """The moves among turns ``degrees`` [deg] (1-D; a turn's sign ignored, 0 or NaN no move):
+    their places into ``moves`` and the gear-motor's angle of each, ``|turn| gear_ratio``, into
+    ``target``. Returns how many there are."""
+    count = 0
+    for i in range(degrees.size):
+        turn = abs(degrees[i])
+        if turn > 0.0:
+            moves[count] = i
+            target[count] = turn * gear_ratio
+            count += 1
+    return count
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def spread_energy(moves, duration, target, motor, energy):
+    """Each move's drive energy [Wh] into ``energy`` at its place ``moves``, from its time
+    ``duration`` [s] and gear-motor angle ``target`` [deg]: the charge ``I_stall T - (I_stall -
+    I_free) angle / omega_ss`` at the motor's voltage; ``motor`` is ``(I_stall, I_free,
+    omega_ss, voltage)``."""
+    stall, free, speed, voltage = motor
+    for m in range(moves.size):
+        charge = stall * duration[m] - (stall - free) * target[m] / speed
+        energy[moves[m]] = voltage * charge / 3600.0

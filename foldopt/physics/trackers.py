@@ -477,26 +477,29 @@ class TrackerDrive:
         >>> print(TrackerDrive(drive="wh-per-degree", wh_per_degree=0.01).move_energy_wh([-15.0, 0.0]))
         [0.15 0.  ]
         """
-        degrees = np.abs(np.asarray(degrees, dtype=float))
+        degrees = np.asarray(degrees, dtype=float)
         if self.drive == "wh-per-degree":
-            return self.wh_per_degree * degrees
+            return self.wh_per_degree * np.abs(degrees)
         if self.drive != "motor":
             raise ValueError(f"drive must be one of {', '.join(DRIVES)}; got {self.drive!r}")
+        from foldopt.physics.tracker_moves import gather_moves, spread_energy  # compiled passes
+
         # gear-motor output at steady state [deg/s]
         speed = self.gain / self.counts_per_revolution * 360.0
-        moved = degrees > 0
-        energy = np.zeros(degrees.shape)
+        turns = np.ascontiguousarray(degrees.ravel())
+        moves, target = np.empty(turns.size, dtype=np.int64), np.empty(turns.size)
         # gear-motor output rotation [deg]; only the moves are solved
-        target = degrees[moved] * self.gear_ratio
+        count = gather_moves(turns, float(self.gear_ratio), moves, target)
+        moves, target = moves[:count], target[:count]
         duration = _time_to_turn(target, speed, self.tau_1, self.tau_2)
         # I(t) = I_stall - (I_stall - I_free) * omega(t) / omega_ss, so the charge is
         # I_stall * T - (I_stall - I_free) * angle / omega_ss.
-        charge = (
-            self.stall_current * duration
-            - (self.stall_current - self.free_current) * target / speed
+        motor = tuple(
+            float(v) for v in (self.stall_current, self.free_current, speed, self.motor_voltage)
         )
-        energy[moved] = self.motor_voltage * charge / 3600.0
-        return energy
+        energy = np.zeros(turns.size)
+        spread_energy(moves, duration, target, motor, energy)
+        return energy.reshape(degrees.shape)
 
 
 #: [s] Newton's last step for a move's time (:func:`_time_to_turn`): its energy then to 1e-11 Wh.
@@ -616,6 +619,7 @@ def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive):
     numpy.ndarray
         Draw [W] per step.
     """
-    sun_up = np.asarray(sun_up, dtype=bool)
-    moves = drive.move_energy_wh(moved_degrees(normal))
-    return np.where(sun_up, drive.standby_w, 0.0) + moves / step_hours
+    draw = drive.move_energy_wh(moved_degrees(normal))
+    draw /= step_hours  # each step's moves spread over it
+    draw += np.where(np.asarray(sun_up, dtype=bool), drive.standby_w, 0.0)
+    return draw

@@ -149,7 +149,8 @@ def standby_available(gross, draw, lit, standby_w: float):
     standby_w : float
         The standby part of ``draw`` [W].
     """
-    return np.where(lit, gross - (draw - np.where(lit, standby_w, 0.0)), 0.0)
+    left = np.subtract(draw, standby_w)
+    return np.where(lit, np.subtract(gross, left, out=left), 0.0)
 
 
 def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.ndarray:
