@@ -234,7 +234,10 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
     if not np.isclose(n_steps, round(n_steps)):
         raise ValueError(f"step_min must divide 1440 min exactly, got {step_min}")
     offsets = np.round((np.arange(round(n_steps)) + 0.5) * step_min * 60e9).astype(np.int64)
-    midnights = np.array(dates, dtype="datetime64[D]").astype("datetime64[ns]").astype(np.int64)
+    # Days since 1970-01-01 from each date's ordinal: NumPy converts date objects one at a time,
+    # and slowly.
+    days = np.fromiter((date.toordinal() for date in dates), np.int64, len(dates))
+    midnights = (days - _EPOCH.toordinal()) * _NS_PER_DAY
     naive = midnights[:, None] + offsets[None, :]
     if isinstance(timezone, dt.tzinfo) and not hasattr(timezone, "key"):
         # A fixed offset: no DST, so no localisation is needed.
