@@ -552,3 +552,22 @@ def test_the_per_site_pass_on_threads_has_the_bits_of_one(monkeypatch):
     threads = spa.spa_solar_position(grid.utc_ns, latitude, 20.0, 100.0)
     for a, b in zip(one, threads, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_a_grids_day_of_year_is_the_calendars(seed, across):
+    """Each step's local day of year is the calendar's (pandas'), for blocks of one local day
+    (looked up once a block) and blocks whose steps a clock's change carries over midnight."""
+    from foldopt.physics.solarposition import ClockGrid
+
+    rng = np.random.default_rng(seed)
+    n_blocks, n_steps = int(rng.integers(1, 6)), int(rng.integers(1, 40))
+    day = 86_400 * 10**9
+    start = rng.integers(-80 * 365, 80 * 365, (n_blocks, 1)) * day
+    spread = day if across else day // n_steps
+    utc = start + np.cumsum(rng.integers(0, spread, (n_blocks, n_steps)), axis=1)
+    offset = np.zeros((n_blocks, n_steps), dtype=np.int64)
+    grid = ClockGrid(utc, offset, ("UTC",) * n_blocks, 24.0 / n_steps)
+    expected = pd.DatetimeIndex(grid.local_ns.ravel().astype("datetime64[ns]")).dayofyear
+    np.testing.assert_array_equal(grid.dayofyear, np.reshape(expected, grid.shape))

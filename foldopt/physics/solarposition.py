@@ -118,12 +118,22 @@ class ClockGrid:
     def dayofyear(self) -> np.ndarray:
         """Local day of year of each step (1 on 1 January); worked out once a grid (a sky reads it
         for the sun and again for the light: a division of every step's instant)."""
-        days = np.floor_divide(self.local_ns, _NS_PER_DAY)
+        local = self.local_ns
+        # A block's steps lie in one local day but where a clock's change moves some: its first
+        # and last step's day, not every step's.
+        low, high = (
+            np.floor_divide(extreme(local, axis=-1, keepdims=True), _NS_PER_DAY)
+            for extreme in (np.min, np.max)
+        )
+        one_day = np.array_equal(low, high)
+        days = low if one_day else np.floor_divide(local, _NS_PER_DAY)
         # Converted once per calendar day in the grid's range, then looked up.
         first = days.min()
-        calendar = np.arange(first, days.max() + 1).astype("datetime64[D]")
+        calendar = np.arange(first, high.max() + 1).astype("datetime64[D]")
         table = (calendar - calendar.astype("datetime64[Y]")).astype(np.int64) + 1
         dayofyear = table[days - first]
+        if one_day:
+            dayofyear = np.repeat(dayofyear, local.shape[-1], axis=-1)
         dayofyear.flags.writeable = False  # shared by every reader of the grid
         return dayofyear
 
