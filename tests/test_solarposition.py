@@ -569,5 +569,5 @@ def test_a_grids_day_of_year_is_the_calendars(seed, across):
     utc = start + np.cumsum(rng.integers(0, spread, (n_blocks, n_steps)), axis=1)
     offset = np.zeros((n_blocks, n_steps), dtype=np.int64)
     grid = ClockGrid(utc, offset, ("UTC",) * n_blocks, 24.0 / n_steps)
-    expected = pd.DatetimeIndex(grid.local_ns.ravel().astype("datetime64[ns]")).dayofyear
+    expected = pd.DatetimeIndex(grid.local_ns.ravel().astype("datetime64[ns]")).day_of_year
     np.testing.assert_array_equal(grid.dayofyear, np.reshape(expected, grid.shape))
