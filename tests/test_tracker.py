@@ -1,7 +1,5 @@
 """Trackers as built: the step law, single-axis against pvlib, tracker energy, and Hottel's sky."""
 
-import math
-
 import numpy as np
 import pvlib
 import pytest
@@ -22,6 +20,7 @@ from foldopt.physics.trackers import (
     moved_degrees,
     singleaxis_orientation,
     step_law,
+    tracker_draw,
     tracker_orientation,
 )
 
@@ -154,42 +153,13 @@ def test_a_moves_energy_is_the_same_bits_among_many_as_alone_and_its_time_turns_
     np.testing.assert_allclose(speed * (t - lag), target, rtol=0, atol=speed * TURN_TOLERANCE_S)
 
 
-def _turns_by_numpy(normal):
-    """The turn into each step [deg] by NumPy's expressions: 2 arcsin of half the chord between
-    consecutive normals, 0 for turns not above 1e-6 deg."""
-    chord = np.diff(normal, axis=-2)
-    chord = chord * chord
-    half = np.minimum(np.sqrt(chord[..., 0] + chord[..., 1] + chord[..., 2]) / 2.0, 1.0)
-    turn = np.zeros(normal.shape[:-1])
-    turn[..., 1:] = np.degrees(np.arcsin(half) * 2.0)
-    turn[~(turn > 1e-6)] = 0.0
-    return turn
-
-
-def _times_by_numpy(angle, speed, tau_1, tau_2, bend):
-    """Newton's steps on the moves' times by NumPy's expressions, each move's step kept while it
-    goes (its step and the bound on what the step left above TURN_TOLERANCE_S)."""
-    t = angle / speed + tau_1 + tau_2
-    going = np.ones(t.shape, dtype=bool)
-    span = tau_1 - tau_2
-    while going.any():
-        decay_1, decay_2 = np.expm1(-t / tau_1), np.expm1(-t / tau_2)
-        turned = ((tau_1**2 * decay_1 - tau_2**2 * decay_2) / span + t) * speed
-        rate = (1.0 - ((decay_1 + 1.0) * tau_1 - (decay_2 + 1.0) * tau_2) / span) * speed
-        step = np.maximum(t - (turned - angle) / rate, 1e-9)
-        moved = np.abs(step - t)
-        t = np.where(going, step, t)
-        left = bend / (rate * 2.0) * np.square(moved * 2.0)
-        going &= np.minimum(moved, left) > TURN_TOLERANCE_S
-    return t
-
-
 @settings(max_examples=30, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), still=st.floats(0.0, 1.0))
 def test_the_moves_compiled_passes_are_numpys_bits(seed, still):
     # The turns and the moves' times in compiled passes around NumPy's arcsin and expm1 (SVML's
     # on some CPUs, not the C library's): the bits of NumPy's expressions, whatever the normals'
-    # layout (a dual-axis tracker's is the sky's, each component along the steps).
+    # layout (a dual-axis tracker's is the sky's, each component along the steps), with moves
+    # that hold still or nearly.
     rng = np.random.default_rng(seed)
     normal = rng.normal(size=(4, 60, 3))
     normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
@@ -198,17 +168,18 @@ def test_the_moves_compiled_passes_are_numpys_bits(seed, still):
         nudge = rng.normal(scale=1e-9, size=(4, 3)) * rng.integers(0, 2, (4, 1))
         normal[:, step][hold[:, step]] = (normal[:, step - 1] + nudge)[hold[:, step]]
     along_steps = np.moveaxis(np.ascontiguousarray(np.moveaxis(normal, -1, 1)), 1, -1)
-    for given_normal in (normal, along_steps, normal[0], normal[:, :1]):
-        np.testing.assert_array_equal(moved_degrees(given_normal), _turns_by_numpy(given_normal))
-    drive = TrackerDrive()
-    speed = drive.gain / drive.counts_per_revolution * 360.0
-    tau_1, tau_2 = drive.tau_1, drive.tau_2
-    peak = math.log(tau_1 / tau_2) * tau_1 * tau_2 / (tau_1 - tau_2)
-    bend = speed * (math.exp(-peak / tau_1) - math.exp(-peak / tau_2)) / (tau_1 - tau_2)
-    angle = np.concatenate([moved_degrees(normal).ravel(), rng.exponential(2.0, 50)])
-    angle = angle[angle > 0] * drive.gear_ratio
+    for given_normal in (normal, along_steps, normal[0], normal[:, :1], normal[:, :0]):
+        np.testing.assert_array_equal(
+            moved_degrees(given_normal, "numba"), moved_degrees(given_normal, "numpy")
+        )
+    drive = TrackerDrive(standby_w=0.3)
+    degrees = np.concatenate([moved_degrees(normal).ravel(), rng.exponential(2.0, 50), [0.0]])
     np.testing.assert_array_equal(
-        _time_to_turn(angle, speed, tau_1, tau_2), _times_by_numpy(angle, speed, tau_1, tau_2, bend)
+        drive.move_energy_wh(degrees, "numba"), drive.move_energy_wh(degrees, "numpy")
+    )
+    np.testing.assert_array_equal(
+        tracker_draw(along_steps, hold, 1 / 12, drive, "numba"),
+        tracker_draw(along_steps, hold, 1 / 12, drive, "numpy"),
     )
 
 

@@ -1,11 +1,12 @@
 """The compiled passes of a tracker's moves (numba), for :mod:`foldopt.physics.trackers`, which
 documents the method: the half chords between consecutive normals (:func:`half_chords`), the turns
 they make (:func:`turns`), and a Newton step of the moves' times (:func:`newton_step`). Apart
-from :mod:`foldopt.physics.trackers` so that a study's tracker imports numba only where it moves.
+from :mod:`foldopt.physics.trackers` so that a day's study, which takes its NumPy expressions
+(``engine="numpy"``), imports no numba; a sky of many steps (a map's) takes these.
 
-Each pass does the elementwise arithmetic of the NumPy expressions it replaced, in their order
-(no fused multiply-add; a square root is exact either way), one step at a time where NumPy went
-over every step once per operation. The transcendental functions stay NumPy's calls between the
+Each pass does the elementwise arithmetic of those NumPy expressions, in their order (no fused
+multiply-add; a square root is exact either way), one step at a time where NumPy goes over every
+step once per operation. The transcendental functions stay NumPy's calls between the
 passes (its ``arcsin`` and ``expm1`` are SVML's on x86-64 CPUs with AVX-512, other bits than the C
 library's that numba calls): so the moves' turns and times keep their bits, as
 tests/test_tracker.py holds. ``error_model="numpy"``: no division here can be by zero (a
@@ -77,30 +78,3 @@ def newton_step(decay, t, angle, going, drive, bend, tolerance):
         decay[0, i] = -now / tau_1
         decay[1, i] = -now / tau_2
     return left_going
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def gather_moves(degrees, gear_ratio, moves, target):
-    """The moves among turns ``degrees`` [deg] (1-D; a turn's sign ignored, 0 or NaN no move):
-    their places into ``moves`` and the gear-motor's angle of each, ``|turn| gear_ratio``, into
-    ``target``. Returns how many there are."""
-    count = 0
-    for i in range(degrees.size):
-        turn = abs(degrees[i])
-        if turn > 0.0:
-            moves[count] = i
-            target[count] = turn * gear_ratio
-            count += 1
-    return count
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def spread_energy(moves, duration, target, motor, energy):
-    """Each move's drive energy [Wh] into ``energy`` at its place ``moves``, from its time
-    ``duration`` [s] and gear-motor angle ``target`` [deg]: the charge ``I_stall T - (I_stall -
-    I_free) angle / omega_ss`` at the motor's voltage; ``motor`` is ``(I_stall, I_free,
-    omega_ss, voltage)``."""
-    stall, free, speed, voltage = motor
-    for m in range(moves.size):
-        charge = stall * duration[m] - (stall - free) * target[m] / speed
-        energy[moves[m]] = voltage * charge / 3600.0

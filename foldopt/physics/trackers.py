@@ -454,13 +454,15 @@ class TrackerDrive:
     tau_1: float = 0.37138  # [s]
     tau_2: float = 0.09175  # [s]
 
-    def move_energy_wh(self, degrees):
+    def move_energy_wh(self, degrees, engine: str = "numpy"):
         """Drive energy of moves of the panel, each from rest.
 
         Parameters
         ----------
         degrees : array_like
             Angle of each move of the panel [deg]; the sign is ignored.
+        engine : {'numpy', 'numba'}
+            How the moves' times are solved (:func:`_time_to_turn`): the same bits either way.
 
         Returns
         -------
@@ -477,29 +479,26 @@ class TrackerDrive:
         >>> print(TrackerDrive(drive="wh-per-degree", wh_per_degree=0.01).move_energy_wh([-15.0, 0.0]))
         [0.15 0.  ]
         """
-        degrees = np.asarray(degrees, dtype=float)
+        degrees = np.abs(np.asarray(degrees, dtype=float))
         if self.drive == "wh-per-degree":
-            return self.wh_per_degree * np.abs(degrees)
+            return self.wh_per_degree * degrees
         if self.drive != "motor":
             raise ValueError(f"drive must be one of {', '.join(DRIVES)}; got {self.drive!r}")
-        from foldopt.physics.tracker_moves import gather_moves, spread_energy  # compiled passes
-
         # gear-motor output at steady state [deg/s]
         speed = self.gain / self.counts_per_revolution * 360.0
-        turns = np.ascontiguousarray(degrees.ravel())
-        moves, target = np.empty(turns.size, dtype=np.int64), np.empty(turns.size)
+        moved = degrees > 0
+        energy = np.zeros(degrees.shape)
         # gear-motor output rotation [deg]; only the moves are solved
-        count = gather_moves(turns, float(self.gear_ratio), moves, target)
-        moves, target = moves[:count], target[:count]
-        duration = _time_to_turn(target, speed, self.tau_1, self.tau_2)
+        target = degrees[moved] * self.gear_ratio
+        duration = _time_to_turn(target, speed, self.tau_1, self.tau_2, engine)
         # I(t) = I_stall - (I_stall - I_free) * omega(t) / omega_ss, so the charge is
         # I_stall * T - (I_stall - I_free) * angle / omega_ss.
-        motor = tuple(
-            float(v) for v in (self.stall_current, self.free_current, speed, self.motor_voltage)
+        charge = (
+            self.stall_current * duration
+            - (self.stall_current - self.free_current) * target / speed
         )
-        energy = np.zeros(turns.size)
-        spread_energy(moves, duration, target, motor, energy)
-        return energy.reshape(degrees.shape)
+        energy[moved] = self.motor_voltage * charge / 3600.0
+        return energy
 
 
 #: [s] Newton's last step for a move's time (:func:`_time_to_turn`): its energy then to 1e-11 Wh.
@@ -509,7 +508,7 @@ TURN_TOLERANCE_S = 1e-12
 TURN_BATCH = 1 << 14
 
 
-def _time_to_turn(angle, speed, tau_1, tau_2):
+def _time_to_turn(angle, speed, tau_1, tau_2, engine: str = "numpy"):
     """Time [s] to turn each ``angle`` [deg] of a 1-D array from rest, by Newton's method on the angle turned by ``t``
     [s] after a voltage step, for the two-pole speed response,
     ``speed (t - (tau_1^2 (1 - exp(-t / tau_1)) - tau_2^2 (1 - exp(-t / tau_2))) / (tau_1 - tau_2))``.
@@ -525,8 +524,10 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     their last bits (some moves never settle on a fixed point: they change in their last bit, back
     and forth).
 
-    The moves go :data:`TURN_BATCH` at a time, each step's arithmetic one compiled pass (:func:`_newton`):
-    the same operations on each move as on its own, over arrays that stay in the core's cache.
+    The moves go :data:`TURN_BATCH` at a time, each step's arithmetic in place: the same operations
+    on each move as on its own, over arrays that stay in the core's cache. With ``engine="numba"``
+    each step's arithmetic is one compiled pass (:func:`_newton_compiled`), the same bits: a
+    sky's many moves (a map's); ``numpy`` imports no numba (a day's study).
 
     References
     ----------
@@ -537,18 +538,58 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     t = angle / speed + tau_1 + tau_2
     peak = math.log(tau_1 / tau_2) * tau_1 * tau_2 / (tau_1 - tau_2)
     bend = speed * (math.exp(-peak / tau_1) - math.exp(-peak / tau_2)) / (tau_1 - tau_2)  # max f''
+    solve = _newton_compiled if engine == "numba" else _newton
     for first in range(0, t.size, TURN_BATCH):
         batch = slice(first, first + TURN_BATCH)
-        _newton(angle[batch], t[batch], speed, tau_1, tau_2, bend)
+        solve(angle[batch], t[batch], speed, tau_1, tau_2, bend)
     return t
 
 
 def _newton(angle, t, speed, tau_1, tau_2, bend):
     """:func:`_time_to_turn`'s Newton steps on a batch of moves, ``t`` (their starts) updated in
     place. Each move stops on its own (its answer the same bits whatever other moves it is solved
-    with): each step's two ``expm1`` go over the batch, and the step's arithmetic is one compiled
-    pass that keeps the step where the move still goes
-    (:func:`foldopt.physics.tracker_moves.newton_step`)."""
+    with): the steps go over the whole batch, nearly every move taking as many, and are kept for
+    the moves still going alone."""
+    span = tau_1 - tau_2
+    going = np.ones(t.shape, dtype=bool)
+    for _ in range(50):
+        if not going.any():
+            break
+        decay_1, decay_2 = np.expm1(-t / tau_1), np.expm1(-t / tau_2)
+        # turned = speed * (t + (tau_1^2 decay_1 - tau_2^2 decay_2) / span), the angle turned
+        turned = tau_1**2 * decay_1
+        turned -= tau_2**2 * decay_2
+        turned /= span
+        turned += t
+        turned *= speed
+        # rate = speed * (1 - (tau_1 (decay_1 + 1) - tau_2 (decay_2 + 1)) / span), its derivative
+        decay_1 += 1.0
+        decay_1 *= tau_1
+        decay_2 += 1.0
+        decay_2 *= tau_2
+        decay_1 -= decay_2
+        decay_1 /= span
+        rate = np.subtract(1.0, decay_1, out=decay_1)
+        rate *= speed
+        # step = max(t - (turned - angle) / rate, 1e-9)
+        turned -= angle
+        turned /= rate
+        step = np.subtract(t, turned, out=turned)
+        np.maximum(step, 1e-9, out=step)
+        moved = np.subtract(step, t, out=decay_2)
+        np.abs(moved, out=moved)
+        np.copyto(t, step, where=going)
+        # left = bend / (2 rate) * (2 moved)^2, at most what the step left
+        rate *= 2.0
+        left = np.divide(bend, rate, out=rate)
+        square = moved * 2.0
+        left *= np.square(square, out=square)
+        going &= np.minimum(moved, left, out=left) > TURN_TOLERANCE_S
+
+
+def _newton_compiled(angle, t, speed, tau_1, tau_2, bend):
+    """:func:`_newton` with each step's arithmetic one compiled pass
+    (:func:`foldopt.physics.tracker_moves.newton_step`) between the batch's two ``expm1``."""
     from foldopt.physics.tracker_moves import newton_step  # numba's compiled pass
 
     drive = tuple(float(v) for v in (speed, tau_1, tau_2, tau_1**2, tau_2**2, tau_1 - tau_2))
@@ -556,11 +597,11 @@ def _newton(angle, t, speed, tau_1, tau_2, bend):
     decay = np.stack([-t / tau_1, -t / tau_2])
     for _ in range(50):
         np.expm1(decay, out=decay)
-        if not newton_step(decay, t, angle, going, drive, bend, TURN_TOLERANCE_S):
+        if not newton_step(decay, t, angle, going, drive, float(bend), TURN_TOLERANCE_S):
             break
 
 
-def moved_degrees(normal):
+def moved_degrees(normal, engine: str = "numpy"):
     """Angle the panel normal turns between consecutive steps.
 
     Tracking by day, and the moves into and out of the stow position at sunset and sunrise
@@ -571,6 +612,10 @@ def moved_degrees(normal):
     normal : array_like
         The panel's unit normal per step (east, north, up on the last axis), time on the one
         before, any leading axes.
+    engine : {'numpy', 'numba'}
+        ``numba``: the chords and turns in compiled passes around NumPy's ``arcsin``
+        (:mod:`foldopt.physics.tracker_moves`), the same bits, for a sky's many steps; ``numpy``
+        imports no numba.
 
     Returns
     -------
@@ -578,26 +623,44 @@ def moved_degrees(normal):
         Turn into each step [deg], shaped as the normals' leading axes; 0 at the first step and
         where the panel holds still (turns below 1e-6 deg).
     """
+    normal = np.asarray(normal, dtype=float)
+    if engine == "numba" and normal.shape[-2] > 0:
+        return _moved_degrees_compiled(normal)
+    turn = np.zeros(normal.shape[:-1])
+    # The chord between unit vectors is 2 sin(angle / 2): exact from a standstill to a half turn.
+    # Its arithmetic in place over the steps' differences, the normals' axes side by side.
+    chord = np.diff(normal, axis=-2)
+    np.multiply(chord, chord, out=chord)
+    length = chord[..., 0] + chord[..., 1]
+    length += chord[..., 2]
+    np.sqrt(length, out=length)
+    length /= 2.0
+    np.minimum(length, 1.0, out=length)
+    angle = np.arcsin(length)
+    angle *= 2.0
+    np.degrees(angle, out=turn[..., 1:])
+    # A panel that holds still must not be charged a motor start: drop rounding-level turns.
+    turn[~(turn > 1e-6)] = 0.0
+    return turn
+
+
+def _moved_degrees_compiled(normal):
+    """:func:`moved_degrees` by :mod:`foldopt.physics.tracker_moves`' passes."""
     from foldopt.physics.tracker_moves import half_chords, turns  # numba's compiled passes
 
-    normal = np.asarray(normal, dtype=float)
     n_steps = normal.shape[-2]
-    if n_steps == 0:
-        return np.zeros(normal.shape[:-1])
     # Each component along the steps: a view of the sky's own layout (a dual-axis tracker's
     # normal is the sun's vector), a copy of any other.
     series = np.ascontiguousarray(np.moveaxis(normal.reshape(-1, n_steps, 3), -1, 1))
-    # The chord between unit vectors is 2 sin(angle / 2): exact from a standstill to a half turn.
     half_angle = np.empty((series.shape[0], n_steps - 1))
     half_chords(series, half_angle)
     np.arcsin(half_angle, out=half_angle)
     turn = np.empty(series.shape[::2])
-    # A panel that holds still must not be charged a motor start: drop rounding-level turns.
     turns(half_angle, 1e-6, turn)
     return turn.reshape(normal.shape[:-1])
 
 
-def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive):
+def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive, engine: str = "numpy"):
     """The tracker's own power draw per step: standby while the sun is up, plus moves.
 
     Each step's moves are spread over the step (their energy / step length).
@@ -613,13 +676,15 @@ def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive):
         Step length [h].
     drive : TrackerDrive
         Standby and drive energy.
+    engine : {'numpy', 'numba'}
+        How the turns and the moves' times are worked out (:func:`moved_degrees`): the same bits.
 
     Returns
     -------
     numpy.ndarray
         Draw [W] per step.
     """
-    draw = drive.move_energy_wh(moved_degrees(normal))
+    draw = drive.move_energy_wh(moved_degrees(normal, engine), engine)
     draw /= step_hours  # each step's moves spread over it
     draw += np.where(np.asarray(sun_up, dtype=bool), drive.standby_w, 0.0)
     return draw
