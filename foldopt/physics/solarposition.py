@@ -117,7 +117,7 @@ class ClockGrid:
     @functools.cached_property
     def dayofyear(self) -> np.ndarray:
         """Local day of year of each step (1 on 1 January); worked out once a grid (a sky reads it
-        for the sun and again for the light: a division of every step's instant)."""
+        for the sun and again for the light)."""
         local = self.local_ns
         # A block's steps lie in one local day but where a clock's change moves some: its first
         # and last step's day, not every step's.
