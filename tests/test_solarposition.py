@@ -7,6 +7,8 @@ import numpy as np
 import pandas as pd
 import pvlib
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from foldopt.physics.solarposition import (
     clock_grid,
@@ -197,14 +199,29 @@ def test_exact_hour_angle_of_the_compiled_pass_is_pvlibs_formula_in_numpy():
     rng = np.random.default_rng(8)
     n = 16
     dates = [dt.date(1950, 1, 1) + dt.timedelta(days=int(d)) for d in rng.integers(0, 130 * 365, n)]
-    grid = clock_grid(dates, "UTC", 7.5)
-    longitude = rng.uniform(-180, 180, (n, 1))
-    sun = solar_position_grid(grid, rng.uniform(-80, 80, (n, 1)), longitude, 10.0, "exact")
-    first, terms = spa.equatorial_once(grid.utc_ns)
-    eot = terms[4][first[:, None] + np.arange(grid.utc_ns.shape[1])]
-    utc_hours = (grid.utc_ns % (24 * spa.NS_PER_HOUR)) / spa.NS_PER_HOUR
-    expected = (15.0 * (utc_hours - 12.0) + longitude + eot / 4.0 + 180.0) % 360.0 - 180.0
-    np.testing.assert_array_equal(sun["hour_angle"], expected)
+    # Local days that cross a UTC midnight (the pass carries the UTC day from step to step).
+    for zone in ("UTC", "Pacific/Kiritimati", "America/St_Johns", "Asia/Kathmandu"):
+        grid = clock_grid(dates, zone, 7.5)
+        longitude = rng.uniform(-180, 180, (n, 1))
+        sun = solar_position_grid(grid, rng.uniform(-80, 80, (n, 1)), longitude, 10.0, "exact")
+        first, terms = spa.equatorial_once(grid.utc_ns)
+        eot = terms[4][first[:, None] + np.arange(grid.utc_ns.shape[1])]
+        utc_hours = (grid.utc_ns % (24 * spa.NS_PER_HOUR)) / spa.NS_PER_HOUR
+        expected = (15.0 * (utc_hours - 12.0) + longitude + eot / 4.0 + 180.0) % 360.0 - 180.0
+        np.testing.assert_array_equal(sun["hour_angle"], expected)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.one_of(st.floats(-2000.0, 2000.0), st.sampled_from([-720.0, -360.0, -0.0, 0.0, 360.0,
+                                                                 720.0, 359.99999999999994,
+                                                                 -1e-300, np.nan])))
+def test_the_hour_angles_wrap_is_pythons_remainder(angle):
+    """The per-site pass's wrap of the hour angle takes no ``fmod`` on its usual range: the same
+    bits as Python's ``% 360.0`` once the pass's ``- 180`` is taken (which makes -0.0 and 0.0
+    alike)."""
+    from foldopt.physics.spa_site import _turn_mod
+
+    np.testing.assert_array_equal(_turn_mod(angle) - 180.0, angle % 360.0 - 180.0)
 
 
 @pytest.mark.parametrize("zone", ["America/Los_Angeles", "Australia/Lord_Howe", "Pacific/Apia",
@@ -535,3 +552,22 @@ def test_the_per_site_pass_on_threads_has_the_bits_of_one(monkeypatch):
     threads = spa.spa_solar_position(grid.utc_ns, latitude, 20.0, 100.0)
     for a, b in zip(one, threads, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_a_grids_day_of_year_is_the_calendars(seed, across):
+    """Each step's local day of year is the calendar's (pandas'), for blocks of one local day
+    (looked up once a block) and blocks whose steps a clock's change carries over midnight."""
+    from foldopt.physics.solarposition import ClockGrid
+
+    rng = np.random.default_rng(seed)
+    n_blocks, n_steps = int(rng.integers(1, 6)), int(rng.integers(1, 40))
+    day = 86_400 * 10**9
+    start = rng.integers(-80 * 365, 80 * 365, (n_blocks, 1)) * day
+    spread = day if across else day // n_steps
+    utc = start + np.cumsum(rng.integers(0, spread, (n_blocks, n_steps)), axis=1)
+    offset = np.zeros((n_blocks, n_steps), dtype=np.int64)
+    grid = ClockGrid(utc, offset, ("UTC",) * n_blocks, 24.0 / n_steps)
+    expected = pd.DatetimeIndex(grid.local_ns.ravel().astype("datetime64[ns]")).day_of_year
+    np.testing.assert_array_equal(grid.dayofyear, np.reshape(expected, grid.shape))

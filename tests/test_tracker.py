@@ -20,6 +20,7 @@ from foldopt.physics.trackers import (
     moved_degrees,
     singleaxis_orientation,
     step_law,
+    tracker_draw,
     tracker_orientation,
 )
 
@@ -152,17 +153,49 @@ def test_a_moves_energy_is_the_same_bits_among_many_as_alone_and_its_time_turns_
     np.testing.assert_allclose(speed * (t - lag), target, rtol=0, atol=speed * TURN_TOLERANCE_S)
 
 
+def _normals(rng, shape, still, nudge=0.0):
+    """Random unit normals, ``shape`` + (3,), each step holding the one before with probability
+    ``still`` (where held, half of them moved by some ``nudge``), and where they hold."""
+    normal = rng.normal(size=(*shape, 3))
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    hold = rng.random(shape) < still
+    for step in range(1, shape[1]):
+        moved = rng.normal(scale=nudge, size=(shape[0], 3)) * rng.integers(0, 2, (shape[0], 1))
+        normal[:, step][hold[:, step]] = (normal[:, step - 1] + moved)[hold[:, step]]
+    return normal, hold
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), still=st.floats(0.0, 1.0))
+def test_the_moves_compiled_passes_are_numpys_bits(seed, still):
+    # The turns and the moves' times in compiled passes around NumPy's arcsin and expm1 (SVML's
+    # on some CPUs, not the C library's): the bits of NumPy's expressions, whatever the normals'
+    # layout (a dual-axis tracker's is the sky's, each component along the steps), with moves
+    # that hold still or nearly.
+    normal, hold = _normals(np.random.default_rng(seed), (4, 60), still, nudge=1e-9)
+    rng = np.random.default_rng(seed + 1)
+    along_steps = np.moveaxis(np.ascontiguousarray(np.moveaxis(normal, -1, 1)), 1, -1)
+    for given_normal in (normal, along_steps, normal[0], normal[:, :1], normal[:, :0]):
+        np.testing.assert_array_equal(
+            moved_degrees(given_normal, "numba"), moved_degrees(given_normal, "numpy")
+        )
+    drive = TrackerDrive(standby_w=0.3)
+    degrees = np.concatenate([moved_degrees(normal).ravel(), rng.exponential(2.0, 50), [0.0]])
+    np.testing.assert_array_equal(
+        drive.move_energy_wh(degrees, "numba"), drive.move_energy_wh(degrees, "numpy")
+    )
+    np.testing.assert_array_equal(
+        tracker_draw(along_steps, hold, 1 / 12, drive, "numba"),
+        tracker_draw(along_steps, hold, 1 / 12, drive, "numpy"),
+    )
+
+
 @settings(max_examples=50)
 @given(seed=st.integers(0, 2**32 - 1), still=st.floats(0.0, 1.0))
 def test_moved_degrees_is_the_angle_between_consecutive_normals(seed, still):
     # The angle between unit vectors by atan2(|a x b|, a . b), accurate at every angle; the
     # steps that hold still turn exactly 0.
-    rng = np.random.default_rng(seed)
-    normal = rng.normal(size=(3, 40, 3))
-    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
-    hold = rng.random((3, 40)) < still
-    for step in range(1, 40):
-        normal[:, step][hold[:, step]] = normal[:, step - 1][hold[:, step]]
+    normal, hold = _normals(np.random.default_rng(seed), (3, 40), still)
     a, b = normal[:, :-1], normal[:, 1:]
     expected = np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), (a * b).sum(-1)))
     turn = moved_degrees(normal)

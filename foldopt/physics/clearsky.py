@@ -64,7 +64,7 @@ STANDARD_PRESSURE = 101325.0  # [Pa]
 _EDGES = np.array(CLEARNESS_EDGES)  # an array, as the compiled loop takes a global
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _ineichen_terms(
     apparent_zenith,
     dni_extra,
@@ -79,7 +79,9 @@ def _ineichen_terms(
     dhi,
     terms,
 ):
-    """The loop of :func:`ineichen_terms` over blocks and steps; writes only steps with the sun up."""
+    """The loop of :func:`ineichen_terms` over blocks and steps; writes only steps with the sun up.
+    ``error_model="numpy"``: no division or power of the lit steps is by zero (their cosine is
+    positive, their air mass finite), and Python's check of each would cost the loop a branch."""
     n_blocks, n_steps = apparent_zenith.shape
     for b in range(n_blocks):
         h = altitude[b]

@@ -117,13 +117,23 @@ class ClockGrid:
     @functools.cached_property
     def dayofyear(self) -> np.ndarray:
         """Local day of year of each step (1 on 1 January); worked out once a grid (a sky reads it
-        for the sun and again for the light: a division of every step's instant)."""
-        days = np.floor_divide(self.local_ns, _NS_PER_DAY)
+        for the sun and again for the light)."""
+        local = self.local_ns
+        # A block's steps lie in one local day but where a clock's change moves some: its first
+        # and last step's day, not every step's.
+        low, high = (
+            np.floor_divide(extreme(local, axis=-1, keepdims=True), _NS_PER_DAY)
+            for extreme in (np.min, np.max)
+        )
+        one_day = np.array_equal(low, high)
+        days = low if one_day else np.floor_divide(local, _NS_PER_DAY)
         # Converted once per calendar day in the grid's range, then looked up.
         first = days.min()
-        calendar = np.arange(first, days.max() + 1).astype("datetime64[D]")
+        calendar = np.arange(first, high.max() + 1).astype("datetime64[D]")
         table = (calendar - calendar.astype("datetime64[Y]")).astype(np.int64) + 1
         dayofyear = table[days - first]
+        if one_day:
+            dayofyear = np.repeat(dayofyear, local.shape[-1], axis=-1)
         dayofyear.flags.writeable = False  # shared by every reader of the grid
         return dayofyear
 
@@ -234,7 +244,10 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
     if not np.isclose(n_steps, round(n_steps)):
         raise ValueError(f"step_min must divide 1440 min exactly, got {step_min}")
     offsets = np.round((np.arange(round(n_steps)) + 0.5) * step_min * 60e9).astype(np.int64)
-    midnights = np.array(dates, dtype="datetime64[D]").astype("datetime64[ns]").astype(np.int64)
+    # Days since 1970-01-01 from each date's ordinal: NumPy converts date objects one at a time,
+    # and slowly.
+    days = np.fromiter((date.toordinal() for date in dates), np.int64, len(dates))
+    midnights = (days - _EPOCH.toordinal()) * _NS_PER_DAY
     naive = midnights[:, None] + offsets[None, :]
     if isinstance(timezone, dt.tzinfo) and not hasattr(timezone, "key"):
         # A fixed offset: no DST, so no localisation is needed.

@@ -43,7 +43,22 @@ def _raised(east, north, up, t):
     return east * along, north * along, up * cos_t + level * sin_t
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, inline="always")
+def _turn_mod(angle):
+    """``angle % 360.0`` by Python's rule (NumPy's remainder), the same bits without ``fmod`` on
+    the hour angle's range: from 360 to 720 the difference is exact (Sterbenz), from -360 to 0
+    the sum is the one the rule rounds (its ``fmod`` gives the angle itself); -360 and -0.0 give
+    0.0 and -0.0, which the hour angle's ``- 180`` makes the same."""
+    if 0.0 <= angle < 360.0:
+        return angle
+    if 360.0 <= angle < 720.0:
+        return angle - 360.0
+    if -360.0 <= angle < 0.0:
+        return angle + 360.0
+    return angle % 360.0
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
 def site_sun(
     terms,
     utc_ns,
@@ -71,7 +86,9 @@ def site_sun(
     formula. Writes ``direction`` (n_blocks, 3, n_steps), ``apparent_zenith``, ``solar_azimuth``
     and ``hour_angle`` [deg] (n_blocks, n_steps), each value by the operations of the NumPy
     expressions this pass replaced, in their order (a float's ``%`` by Python's rule, as NumPy's
-    remainder)."""
+    remainder). ``error_model="numpy"``: no division here is by zero (a unit vector's norm, the
+    refraction's tangent above its cut), and Python's check of each would keep the vectors' loop
+    from being vectorised."""
     n_blocks, n_steps = direction.shape[0], direction.shape[2]
     to_degrees, to_radians = 180.0 / math.pi, math.pi / 180.0
     cut = -1.0 * (0.26667 + SPA_ATMOS_REFRACT)
@@ -79,22 +96,37 @@ def site_sun(
         start = uint64(first[b])
         # Eq. 42's factor of pressure and temperature, as pvlib groups it.
         scale = (pressure[b] / 1010.0) * (283.0 / (273 + SPA_TEMPERATURE)) * 1.02
+        cos_l, sin_l, cos_p, sin_p = cos_lam[b], sin_lam[b], cos_phi[b], sin_phi[b]
+        x_b, y_b = x[b], y[b]
+        # The block's geometric unit vectors first: arithmetic alone, which the compiler
+        # vectorises (a loop that calls the C library's asin and atan2 it does not).
         for i in range(uint64(n_steps)):
             k = start + i
-            utc_hours = (utc_ns[b, i] % NS_PER_DAY) / NS_PER_HOUR
-            hour_angle[b, i] = (
-                15.0 * (utc_hours - 12.0) + longitude[b] + terms[4, k] / 4.0 + 180.0
-            ) % 360.0 - 180.0
             # cos(delta) cos(H) and cos(delta) sin(H) at the site's hour angle H = H_G + longitude.
-            cos_h = terms[0, k] * cos_lam[b] - terms[1, k] * sin_lam[b]
-            sin_h = terms[1, k] * cos_lam[b] + terms[0, k] * sin_lam[b]
+            cos_h = terms[0, k] * cos_l - terms[1, k] * sin_l
+            sin_h = terms[1, k] * cos_l + terms[0, k] * sin_l
             # Less the site's position: toward the meridian on the equator, and toward the pole.
-            meridian, pole = cos_h - x[b] * terms[3, k], terms[2, k] - y[b] * terms[3, k]
+            meridian, pole = cos_h - x_b * terms[3, k], terms[2, k] - y_b * terms[3, k]
             east = -sin_h
-            north = pole * cos_phi[b] - meridian * sin_phi[b]
-            up = pole * sin_phi[b] + meridian * cos_phi[b]
+            north = pole * cos_p - meridian * sin_p
+            up = pole * sin_p + meridian * cos_p
             norm = 1.0 / math.sqrt(east * east + north * north + up * up)
-            east, north, up = east * norm, north * norm, up * norm
+            direction[b, 0, i], direction[b, 1, i] = east * norm, north * norm
+            direction[b, 2, i] = up * norm
+        midnight = 0  # [ns] of the UTC day of the step before
+        for i in range(uint64(n_steps)):
+            k = start + i
+            # utc_ns % NS_PER_DAY, without a division but where a step crosses a UTC midnight
+            since = utc_ns[b, i] - midnight
+            if since < 0 or since >= NS_PER_DAY:
+                midnight = utc_ns[b, i] // NS_PER_DAY * NS_PER_DAY
+                since = utc_ns[b, i] - midnight
+            utc_hours = since / NS_PER_HOUR
+            hour_angle[b, i] = (
+                _turn_mod(15.0 * (utc_hours - 12.0) + longitude[b] + terms[4, k] / 4.0 + 180.0)
+                - 180.0
+            )
+            east, north, up = direction[b, 0, i], direction[b, 1, i], direction[b, 2, i]
             elevation = math.asin(min(max(up, -1.0), 1.0)) * to_degrees
             heading = math.atan2(east, north) * to_degrees
             solar_azimuth[b, i] = heading + 360.0 if heading < 0.0 else heading
@@ -104,7 +136,7 @@ def site_sun(
                 )
                 east, north, up = _raised(east, north, up, refraction * to_radians)
                 elevation += refraction
-            direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
+                direction[b, 0, i], direction[b, 1, i], direction[b, 2, i] = east, north, up
             apparent_zenith[b, i] = 90.0 - elevation
 
 

@@ -454,13 +454,15 @@ class TrackerDrive:
     tau_1: float = 0.37138  # [s]
     tau_2: float = 0.09175  # [s]
 
-    def move_energy_wh(self, degrees):
+    def move_energy_wh(self, degrees, engine: str = "numpy"):
         """Drive energy of moves of the panel, each from rest.
 
         Parameters
         ----------
         degrees : array_like
             Angle of each move of the panel [deg]; the sign is ignored.
+        engine : {'numpy', 'numba'}
+            How the moves' times are solved (:func:`_time_to_turn`): the same bits either way.
 
         Returns
         -------
@@ -488,7 +490,7 @@ class TrackerDrive:
         energy = np.zeros(degrees.shape)
         # gear-motor output rotation [deg]; only the moves are solved
         target = degrees[moved] * self.gear_ratio
-        duration = _time_to_turn(target, speed, self.tau_1, self.tau_2)
+        duration = _time_to_turn(target, speed, self.tau_1, self.tau_2, engine)
         # I(t) = I_stall - (I_stall - I_free) * omega(t) / omega_ss, so the charge is
         # I_stall * T - (I_stall - I_free) * angle / omega_ss.
         charge = (
@@ -506,7 +508,7 @@ TURN_TOLERANCE_S = 1e-12
 TURN_BATCH = 1 << 14
 
 
-def _time_to_turn(angle, speed, tau_1, tau_2):
+def _time_to_turn(angle, speed, tau_1, tau_2, engine: str = "numpy"):
     """Time [s] to turn each ``angle`` [deg] of a 1-D array from rest, by Newton's method on the angle turned by ``t``
     [s] after a voltage step, for the two-pole speed response,
     ``speed (t - (tau_1^2 (1 - exp(-t / tau_1)) - tau_2^2 (1 - exp(-t / tau_2))) / (tau_1 - tau_2))``.
@@ -523,7 +525,9 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     and forth).
 
     The moves go :data:`TURN_BATCH` at a time, each step's arithmetic in place: the same operations
-    on each move as on its own, over arrays that stay in the core's cache.
+    on each move as on its own, over arrays that stay in the core's cache. With ``engine="numba"``
+    each step's arithmetic is one compiled pass (:func:`_newton_compiled`), the same bits: a
+    sky's many moves (a map's); ``numpy`` imports no numba (a day's study).
 
     References
     ----------
@@ -534,9 +538,10 @@ def _time_to_turn(angle, speed, tau_1, tau_2):
     t = angle / speed + tau_1 + tau_2
     peak = math.log(tau_1 / tau_2) * tau_1 * tau_2 / (tau_1 - tau_2)
     bend = speed * (math.exp(-peak / tau_1) - math.exp(-peak / tau_2)) / (tau_1 - tau_2)  # max f''
+    solve = _newton_compiled if engine == "numba" else _newton
     for first in range(0, t.size, TURN_BATCH):
         batch = slice(first, first + TURN_BATCH)
-        _newton(angle[batch], t[batch], speed, tau_1, tau_2, bend)
+        solve(angle[batch], t[batch], speed, tau_1, tau_2, bend)
     return t
 
 
@@ -582,7 +587,21 @@ def _newton(angle, t, speed, tau_1, tau_2, bend):
         going &= np.minimum(moved, left, out=left) > TURN_TOLERANCE_S
 
 
-def moved_degrees(normal):
+def _newton_compiled(angle, t, speed, tau_1, tau_2, bend):
+    """:func:`_newton` with each step's arithmetic one compiled pass
+    (:func:`foldopt.physics.tracker_moves.newton_step`) between the batch's two ``expm1``."""
+    from foldopt.physics.tracker_moves import newton_step  # numba's compiled pass
+
+    drive = tuple(float(v) for v in (speed, tau_1, tau_2, tau_1**2, tau_2**2, tau_1 - tau_2))
+    going = np.ones(t.shape, dtype=bool)
+    decay = np.stack([-t / tau_1, -t / tau_2])
+    for _ in range(50):
+        np.expm1(decay, out=decay)
+        if not newton_step(decay, t, angle, going, drive, float(bend), TURN_TOLERANCE_S):
+            break
+
+
+def moved_degrees(normal, engine: str = "numpy"):
     """Angle the panel normal turns between consecutive steps.
 
     Tracking by day, and the moves into and out of the stow position at sunset and sunrise
@@ -593,6 +612,10 @@ def moved_degrees(normal):
     normal : array_like
         The panel's unit normal per step (east, north, up on the last axis), time on the one
         before, any leading axes.
+    engine : {'numpy', 'numba'}
+        ``numba``: the chords and turns in compiled passes around NumPy's ``arcsin``
+        (:mod:`foldopt.physics.tracker_moves`), the same bits, for a sky's many steps; ``numpy``
+        imports no numba.
 
     Returns
     -------
@@ -601,6 +624,8 @@ def moved_degrees(normal):
         where the panel holds still (turns below 1e-6 deg).
     """
     normal = np.asarray(normal, dtype=float)
+    if engine == "numba" and normal.shape[-2] > 0:
+        return _moved_degrees_compiled(normal)
     turn = np.zeros(normal.shape[:-1])
     # The chord between unit vectors is 2 sin(angle / 2): exact from a standstill to a half turn.
     # Its arithmetic in place over the steps' differences, the normals' axes side by side.
@@ -619,7 +644,23 @@ def moved_degrees(normal):
     return turn
 
 
-def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive):
+def _moved_degrees_compiled(normal):
+    """:func:`moved_degrees` by :mod:`foldopt.physics.tracker_moves`' passes."""
+    from foldopt.physics.tracker_moves import half_chords, turns  # numba's compiled passes
+
+    n_steps = normal.shape[-2]
+    # Each component along the steps: a view of the sky's own layout (a dual-axis tracker's
+    # normal is the sun's vector), a copy of any other.
+    series = np.ascontiguousarray(np.moveaxis(normal.reshape(-1, n_steps, 3), -1, 1))
+    half_angle = np.empty((series.shape[0], n_steps - 1))
+    half_chords(series, half_angle)
+    np.arcsin(half_angle, out=half_angle)
+    turn = np.empty(series.shape[::2])
+    turns(half_angle, 1e-6, turn)
+    return turn.reshape(normal.shape[:-1])
+
+
+def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive, engine: str = "numpy"):
     """The tracker's own power draw per step: standby while the sun is up, plus moves.
 
     Each step's moves are spread over the step (their energy / step length).
@@ -635,12 +676,15 @@ def tracker_draw(normal, sun_up, step_hours, drive: TrackerDrive):
         Step length [h].
     drive : TrackerDrive
         Standby and drive energy.
+    engine : {'numpy', 'numba'}
+        How the turns and the moves' times are worked out (:func:`moved_degrees`): the same bits.
 
     Returns
     -------
     numpy.ndarray
         Draw [W] per step.
     """
-    sun_up = np.asarray(sun_up, dtype=bool)
-    moves = drive.move_energy_wh(moved_degrees(normal))
-    return np.where(sun_up, drive.standby_w, 0.0) + moves / step_hours
+    draw = drive.move_energy_wh(moved_degrees(normal, engine), engine)
+    draw /= step_hours  # each step's moves spread over it
+    draw += np.where(np.asarray(sun_up, dtype=bool), drive.standby_w, 0.0)
+    return draw

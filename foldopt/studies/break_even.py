@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from foldopt.engine import evaluation as engines
-from foldopt.studies.objectives import period_values
+from foldopt.studies.objectives import period_days, period_values
 from foldopt.names import DEFAULT_ENGINE
 
 #: The break-even search's brackets close to this share of the largest power (a 20 W tracker's
@@ -79,6 +79,7 @@ def break_even_standby(
     period = np.broadcast_to(np.arange(n_periods)[:, None], (n_periods, n_loads))
 
     site_of_day = np.repeat(np.arange(n_sites), n_days)
+    member = period_days(months, seasons)  # every pass's periods
     span = engines.power_span(available)
 
     def objectives(sets, count):
@@ -97,7 +98,11 @@ def break_even_standby(
         value = np.full((n_sites, n_periods, sets.shape[1]), np.nan)
         for site in np.flatnonzero(count):
             value[site, :, : count[site]] = period_values(
-                np.ascontiguousarray(daily[site, :, : count[site]]), months, statistic, seasons
+                np.ascontiguousarray(daily[site, :, : count[site]]),
+                months,
+                statistic,
+                seasons,
+                member,
             )
         return value
 

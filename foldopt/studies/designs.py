@@ -127,7 +127,10 @@ def sky_tracker_poa(sky: Sky, orientation, engine: str = "auto") -> np.ndarray:
 
     sun, _, beam, terms, span = sky.kernel_layout(False)
     poa = np.empty(beam.shape)
-    turning_poa(np.ascontiguousarray(normal, dtype=float), sun, beam, terms, span, poa)
+    # The normal's components each along the steps, as the sun's: a view of a dual-axis
+    # tracker's (the sun's vector), a copy of any other; one array type for the compiled pass.
+    along = np.ascontiguousarray(np.moveaxis(normal, -1, 1), dtype=float)
+    turning_poa(np.moveaxis(along, 1, -1), sun, beam, terms, span, poa)
     return poa
 
 
@@ -146,10 +149,13 @@ def standby_available(gross, draw, lit, standby_w: float):
     standby_w : float
         The standby part of ``draw`` [W].
     """
-    return np.where(lit, gross - (draw - np.where(lit, standby_w, 0.0)), 0.0)
+    left = np.subtract(draw, standby_w)
+    return np.where(lit, np.subtract(gross, left, out=left), 0.0)
 
 
-def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.ndarray:
+def sky_tracker_draw(
+    sky: Sky, study: Study, orientation, every: int = 1, engine: str = "auto"
+) -> np.ndarray:
     """The tracker's own draw [W] per step over every block: standby while there is light (the sun up,
     clouds or not), plus its moves.
 
@@ -164,13 +170,17 @@ def sky_tracker_draw(sky: Sky, study: Study, orientation, every: int = 1) -> np.
         Work out every ``every``-th block's draw and give it to the next ``every``: a cloud
         ensemble's members share their day's sun, so the tracker moves alike, and some light
         reaches every member while the sun is up.
+    engine : {'auto', 'numba', 'numpy'}
+        The moves' passes (:func:`foldopt.physics.trackers.tracker_draw`), the same bits either
+        way; ``auto`` decides by the sky's size, a request that has decided its engine passes it.
     """
     tracker = study.tracker
     drive = TrackerDrive(
         standby_w=tracker.standby_w, drive=tracker.drive, wh_per_degree=tracker.wh_per_degree
     )
     shared = slice(None, None, every)
-    draw = tracker_draw(orientation[2][shared], sky.lit[shared], sky.step_hours, drive)
+    engine = engine_for(engine, sky.n_blocks * sky.n_steps)
+    draw = tracker_draw(orientation[2][shared], sky.lit[shared], sky.step_hours, drive, engine)
     return np.repeat(draw, every, axis=0) if every > 1 else draw
 
 
@@ -228,11 +238,11 @@ def tracker_curves(
     every : int, default 1
         As :func:`sky_tracker_draw`'s (a cloud ensemble's members share their day's draw).
     engine : {'auto', 'numba', 'numpy'}
-        As :func:`sky_tracker_poa`'s.
+        As :func:`sky_tracker_poa`'s and :func:`sky_tracker_draw`'s.
     """
     orientation = sky_tracker_orientation(sky, study, model)
     poa = sky_tracker_poa(sky, orientation, engine)
-    draw = sky_tracker_draw(sky, study, orientation, every)
+    draw = sky_tracker_draw(sky, study, orientation, every, engine)
     power = engines.panel_power(sky, poa_global=poa, electrical=engine_options(study).electrical)
     return TrackerCurves(orientation, power, draw, poa if sky.iam == "none" else None)
 

@@ -46,6 +46,19 @@ def season_days(months, season=None) -> np.ndarray:
     return table[months]
 
 
+def period_days(months, seasons) -> np.ndarray:
+    """(periods, days) bool: each period's days (:func:`season_days` of each of ``seasons``).
+
+    Parameters
+    ----------
+    months : array_like of int
+        (days,) month of each day [1-12].
+    seasons : sequence
+        Each period's months (None: every day).
+    """
+    return np.stack([season_days(months, season) for season in seasons])
+
+
 def objective_value(hours, months, statistic: str, season=None):
     """A study-wide statistic of daily t_solar: ``hours`` (days, ...) -> (...).
 
@@ -79,7 +92,7 @@ def objective_value(hours, months, statistic: str, season=None):
     return np.percentile(hours, float(statistic[1:]), axis=0)
 
 
-def period_values(hours, months, statistic: str, seasons):
+def period_values(hours, months, statistic: str, seasons, member=None):
     """:func:`objective_value` of ``hours`` (days, ...) over several periods, (periods, ...).
 
     Each value is its own period's reduction over its days alone, so that it is the same bits
@@ -96,6 +109,9 @@ def period_values(hours, months, statistic: str, seasons):
         :func:`objective_value`'s.
     seasons : sequence
         Each period's months (None: every day).
+    member : numpy.ndarray, optional
+        (periods, days) bool, each period's days (:func:`period_days`), where the caller has them
+        (a search asks at every level for the same days).
     """
     hours, months = np.asarray(hours, dtype=float), np.asarray(months)
     if (
@@ -111,7 +127,7 @@ def period_values(hours, months, statistic: str, seasons):
 
     flat = np.ascontiguousarray(hours.reshape(hours.shape[0], -1))
     if statistic == "mean":
-        value = period_means(flat, np.stack([season_days(months, season) for season in seasons]))
+        value = period_means(flat, period_days(months, seasons) if member is None else member)
     else:
         present = np.unique(months)
         monthly = period_means(flat, months[None, :] == present[:, None])

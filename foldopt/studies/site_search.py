@@ -31,7 +31,7 @@ from foldopt.engine.evaluation import fold_orientations
 from foldopt.engine.search import Axis, GridSearch, tell_together
 from foldopt.names import FLAT_FOLD_ANGLE
 from foldopt.studies.designs import requested_hours
-from foldopt.studies.objectives import objective_quantum, period_values
+from foldopt.studies.objectives import objective_quantum, period_days, period_values
 
 
 class DesignSearch:
@@ -56,6 +56,7 @@ class DesignSearch:
 
     def __init__(self, axes, months, statistic: str, seasons, tolerance_h: float, quantum: float):
         self.months, self.statistic, self.seasons = np.asarray(months), statistic, list(seasons)
+        self.member = period_days(self.months, self.seasons)  # told at every level
         self.grid = GridSearch(axes, tolerance_h, quantum)
         self.found: list = []  # (points (n, axes), hours (days, n, loads), energy (days, n)) as told
         self._asked = None
@@ -73,7 +74,7 @@ class DesignSearch:
         hours, energy = np.asarray(hours, dtype=float), np.asarray(energy, dtype=float)
         self.found.append((self._asked, hours, energy))
         return (
-            period_values(hours, self.months, self.statistic, self.seasons)
+            period_values(hours, self.months, self.statistic, self.seasons, self.member)
             .transpose(1, 0, 2)
             .reshape(self._asked.shape[0], -1)
         )

@@ -43,8 +43,8 @@ from foldopt.studies.objectives import (
     best_angle_index,
     near_optimal_on_grid,
     objective_value,
+    period_days,
     period_values,
-    season_days,
 )
 from foldopt.studies.site_search import fold_search
 
@@ -274,7 +274,7 @@ def _chosen(hours, energy, months, statistic: str, seasons, member):
     ``objective``, ``mean_h`` and ``energy_wh``, each (periods, loads); also every design's
     objective, (periods, loads, n)."""
     n_loads = hours.shape[1]
-    every = period_values(hours, months, statistic, seasons)  # (periods, loads, n)
+    every = period_values(hours, months, statistic, seasons, member)  # (periods, loads, n)
     # (periods, loads); ties to the last (the least folded, the steepest)
     best = best_angle_index(every)
     at_best = hours[:, np.arange(n_loads)[None, :], best]  # (days, periods, loads)
@@ -302,7 +302,7 @@ def _site_rows(
         days_of.twofold_wh,
     )
     n_loads = p_load_evaluated.size
-    member = np.stack([season_days(months, season) for season in seasons])
+    member = period_days(months, seasons)
     # The flat panel at the site's mounting, or at each period's and load's own best tilt.
     flat_hours, flat_energy, flat_tilts = (
         days_of.flat_h[..., None],
@@ -338,7 +338,7 @@ def _site_rows(
     )
     trackers = np.stack([days_of.tracker_h, days_of.tracker_net_h], axis=1)  # (days, 2, loads)
     tracker, tracker_mean = (
-        period_values(trackers, months, kind, seasons) for kind in (statistic, "mean")
+        period_values(trackers, months, kind, seasons, member) for kind in (statistic, "mean")
     )
     tracker_wh = np.stack([days_of.tracker_wh[days].sum() for days in member])
     # The fold angle's near-optimal range: over the tilts too (the best of them at each angle) where searched.
