@@ -119,9 +119,11 @@ SERVER = (
     WATCH
     + r"""
 import multiprocessing, pvlib
-import foldopt.api, foldopt.cli.run, foldopt.cli.sweep, foldopt.engine.kernel
-import foldopt.engine.storage_kernel, foldopt.output.folders, foldopt.output.figures
-import foldopt.studies.day, foldopt.studies.request
+import foldopt.api, foldopt.engine.kernel, foldopt.engine.storage_kernel, foldopt.output.folders
+import foldopt.output.figures, foldopt.physics.spa_site, foldopt.studies.day
+import foldopt.studies.request, foldopt.studies.result_answers
+import foldopt.cli.map, foldopt.cli.optimize, foldopt.cli.run, foldopt.cli.size, foldopt.cli.sweep
+import foldopt.cli.weather
 
 assert "matplotlib" not in sys.modules and "foldopt.cli.app" not in sys.modules
 for request in sys.stdin:
