@@ -5,12 +5,12 @@ its own process): the same bytes, the same error and exit code with nothing writ
 left once the command ends, however it ends.
 
 Each command runs in a process of its own that runs the command line as the ``foldopt`` script
-does (:data:`WATCH`, :data:`COMMAND`), on the cores it is given (``os.sched_setaffinity``): one core draws in the
-command's process, two in the workers. The probe records the process that drew each figure, and
-the collector's work (the command line's process freezes what it loads, issue 49). The processes
-are forked by one interpreter a module (:data:`SERVER`) that has imported what a command loads
-before its figures, as a fresh one would (not matplotlib); a command that completes is run once
-a module (:func:`commands`) for every check of its run.
+does (:data:`WATCH`, :data:`COMMAND`), on the cores it is given (``os.sched_setaffinity``): one
+core draws in the command's process, two in the workers. The probe records the process that drew
+each figure, and the collector's work (the command line's process freezes what it loads, issue
+49). The processes are forked by one interpreter a module (:data:`SERVER`) that has imported what
+a command loads before its figures, as a fresh one would (not matplotlib); a command that
+completes is run once a module (:func:`commands`) for every check of its run.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ needs_two_cores = pytest.mark.skipif(
 #: matplotlib, and the collector's passes that ran with objects frozen (and the most frozen then)
 #: and what is frozen and not as it exits.
 WATCH = r"""
-import atexit, gc, json, os, runpy, sys, time
+import atexit, gc, json, os, sys
 
 seen = {"passes": 0, "frozen": 0, "now": 0}
 
