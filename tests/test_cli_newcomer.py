@@ -54,8 +54,9 @@ def test_every_command_runs_with_no_option(tmp_path, command, check):
         assert "(default range)" in taken[0] and "panel 0.108 m^2" in taken
 
 
-def test_the_summary_says_which_values_were_defaults(tmp_path):
-    result = invoke("sweep", "day", "--out", tmp_path / "o")
+def test_the_summary_says_which_values_were_defaults(tmp_path, figures_drawn_elsewhere):
+    with figures_drawn_elsewhere():  # the answer of test_every_command_runs_with_no_option[day]
+        result = invoke("sweep", "day", "--out", tmp_path / "o")
     assert result.exit_code == 0, result.output
     lines = result.stdout.splitlines()
     assert lines[1] == ("  from configs/shin2015.yaml: day 1:365:7 of 2014 (default range), site 34.05, -118.25, "

@@ -43,13 +43,39 @@ def world_map(scheduler, out, sites, loads, **keywords):
     return foldopt.world_map(sites, loads, out, STUDY, scheduler=scheduler, engine="numpy", **keywords)
 
 
+#: Tables a map can legally hold, at their edges: the sites and loads of each.
+LEGAL = {
+    # No site carries 25 W on a 0.108 m^2 panel (its flat peak is about 21 W): every gain is NaN.
+    "no-site-carries": ([{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [25.0]),
+    # Two sites on the equator 90 deg apart under a clear sky: every value equal.
+    "all-equal": ([{"latitude": 0.0, "longitude": 0.0}, {"latitude": 0.0, "longitude": 90.0}], [2.0]),
+    # A single site and a single load; then a single site and two loads.
+    "one-site-one-load": ([{"latitude": 45.0, "longitude": 8.0}], [2.0]),
+    "one-site-two-loads": ([{"latitude": 45.0, "longitude": 8.0}], [1.0, 3.0]),
+}
+
+
 @pytest.fixture(scope="module")
-def earlier(scheduler, tmp_path_factory, without_pixels) -> Path:
-    """A complete map of two sites at 2 W."""
-    out = tmp_path_factory.mktemp("earlier") / "map"
-    with without_pixels():
-        world_map(scheduler, out, [{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [2.0])
-    return out
+def legal_maps(scheduler, tmp_path_factory):
+    """``drawn(case)``: the map of a :data:`LEGAL` case, made once a module for every test that
+    reads it, its figures drawn whole (where no test's fixture draws them without pixels: in a
+    module fixture's setup, or a test marked ``figure_pixels``): its folder and what the map
+    returned."""
+    made = {}
+
+    def drawn(case: str):
+        if case not in made:
+            out = tmp_path_factory.mktemp(case) / "map"
+            made[case] = out, world_map(scheduler, out, *LEGAL[case])
+        return made[case]
+
+    return drawn
+
+
+@pytest.fixture(scope="module")
+def earlier(legal_maps) -> Path:
+    """A complete map of two sites at 2 W (the legal table whose values are all equal)."""
+    return legal_maps("all-equal")[0]
 
 
 def _broken(*args, **kwargs):
@@ -84,19 +110,11 @@ def test_a_new_map_whose_last_files_fail_is_not_complete_and_resumes(scheduler, 
     assert PROMISED <= {path.name for path in out.iterdir()}
 
 
-@pytest.mark.parametrize("sites, loads", [
-    # No site carries 25 W on a 0.108 m^2 panel (its flat peak is about 21 W): every gain is NaN.
-    ([{"latitude": 0.0, "longitude": 0.0}, {"latitude": 30.0, "longitude": 0.0}], [25.0]),
-    # Two sites on the equator 90 deg apart under a clear sky: every value equal.
-    ([{"latitude": 0.0, "longitude": 0.0}, {"latitude": 0.0, "longitude": 90.0}], [2.0]),
-    # A single site and a single load; then a single site and two loads.
-    ([{"latitude": 45.0, "longitude": 8.0}], [2.0]),
-    ([{"latitude": 45.0, "longitude": 8.0}], [1.0, 3.0]),
-], ids=["no-site-carries", "all-equal", "one-site-one-load", "one-site-two-loads"])
+@pytest.mark.parametrize("case", list(LEGAL))
 @pytest.mark.figure_pixels  # the figures of tables at their edges, drawn whole
-def test_every_figure_and_writer_copes_with_a_legal_table(scheduler, tmp_path, sites, loads):
-    out = tmp_path / "map"
-    run, figures, answer = world_map(scheduler, out, sites, loads)
+def test_every_figure_and_writer_copes_with_a_legal_table(legal_maps, case):
+    sites, loads = LEGAL[case]
+    out, (run, figures, answer) = legal_maps(case)
     assert PROMISED <= {path.name for path in out.iterdir()}
     assert json.loads((out / "run.json").read_text())["status"] == "complete"
     assert set(figures) <= PROMISED

@@ -4,10 +4,12 @@ it writes and says is what it writes and says when it draws them itself (one cor
 its own process): the same bytes, the same error and exit code with nothing written, no worker
 left once the command ends, however it ends.
 
-Each command runs in a fresh interpreter that runs the command line as the ``foldopt`` script
-does (:data:`PROBE`), on the cores it is given (``os.sched_setaffinity``): one core draws in the
-command's process, two in the workers. The probe records the process that drew each figure, and
-the collector's work (the command line's process freezes what it loads, issue 49). A command that
+Each command runs in a process of its own that runs the command line as the ``foldopt`` script
+does (:data:`WATCH`, :data:`COMMAND`), on the cores it is given (``os.sched_setaffinity``): one
+core draws in the command's process, two in the workers. The probe records the process that drew
+each figure, and the collector's work (the command line's process freezes what it loads, issue
+49). The processes are forked by one interpreter a module (:data:`SERVER`) that has imported what
+a command loads before its figures, as a fresh one would (not matplotlib); a command that
 completes is run once a module (:func:`commands`) for every check of its run.
 """
 
@@ -16,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -30,13 +33,11 @@ needs_two_cores = pytest.mark.skipif(
     sys.platform != "linux" or len(CORES) < 2, reason="the workers need Linux and two cores"
 )
 
-#: Runs the command line as the script does. Each figure drawn appends the drawing process's id
-#: to the file ``drawn`` (by the module's one drawing function, wrapped), after ``slow`` seconds;
-#: with ``fail`` set, the figure of that name raises. As it ends it prints its id, whether it
-#: imported matplotlib, and the collector's passes that ran with objects frozen (and the most
-#: frozen then) and what is frozen and not as it exits.
-PROBE = r"""
-import atexit, gc, json, os, runpy, sys, time
+#: The probe's watch: as a command's process ends it prints its id, whether it imported
+#: matplotlib, and the collector's passes that ran with objects frozen (and the most frozen then)
+#: and what is frozen and not as it exits.
+WATCH = r"""
+import atexit, gc, json, os, sys
 
 seen = {"passes": 0, "frozen": 0, "now": 0}
 
@@ -69,6 +70,14 @@ def report():
 gc.callbacks.append(watch)
 # Registered first, so run last: after the command and every exit handler of its libraries.
 atexit.register(report)
+"""
+
+#: The probe's command, in a process that ran :data:`WATCH`: runs the command line as the script
+#: does. Each figure drawn appends the drawing process's id to the file ``drawn`` (by the module's
+#: one drawing function, wrapped), after ``slow`` seconds; with ``fail`` set, the figure of that
+#: name raises.
+COMMAND = r"""
+import json, os, runpy, sys, time
 import foldopt.output.figures as figures
 from foldopt.output.figures.canvas import FigureFile
 
@@ -100,47 +109,103 @@ sys.argv = ["foldopt", *args]
 runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
 """
 
+#: Forks each command (:func:`_start`): :data:`WATCH` (which sees no pass of the collector
+#: before a command freezes), then the modules a command loads before its figures, which a
+#: command's own interpreter spends 0.8-1.5 s CPU importing; not matplotlib (a command on two
+#: cores never imports it), nor the command line's (run as ``__main__``, as the script runs it).
+#: It reads a command a line (its folder, cores and probe's argument) and answers with its
+#: process id, then its exit code (as ``Popen``'s).
+SERVER = (
+    WATCH
+    + r"""
+import multiprocessing, pvlib
+import foldopt.api, foldopt.engine.kernel, foldopt.engine.storage_kernel, foldopt.output.folders
+import foldopt.output.figures, foldopt.physics.spa_site, foldopt.studies.day
+import foldopt.studies.request, foldopt.studies.result_answers
+import foldopt.cli.map, foldopt.cli.optimize, foldopt.cli.run, foldopt.cli.size, foldopt.cli.sweep
+import foldopt.cli.weather
 
-def _command(
-    args, folder: Path, fail: str | None = None, slow: float = 0, workers: int | None = None
-) -> list[str]:
-    """The probe's command line for ``foldopt args`` in ``folder``, with ``workers`` workers
-    where given (else :func:`foldopt.output.drawing.workers`'s)."""
-    payload = [str(folder / "drawn"), fail, slow, workers, args]
-    return [sys.executable, "-c", PROBE, json.dumps(payload)]
+assert "matplotlib" not in sys.modules and "foldopt.cli.app" not in sys.modules
+for request in sys.stdin:
+    folder, cores, argument = json.loads(request)
+    pid = os.fork()
+    if pid == 0:
+        break
+    print(pid, flush=True)
+    print(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]), flush=True)
+else:
+    sys.exit()
+os.sched_setaffinity(0, cores)
+os.chdir(folder)
+for fd, name, flags in ((0, os.devnull, os.O_RDONLY), (1, folder + ".stdout", os.O_WRONLY),
+                        (2, folder + ".stderr", os.O_WRONLY)):
+    os.dup2(os.open(name, flags | (os.O_CREAT | os.O_TRUNC if fd else 0)), fd)
+sys.argv = ["-c", argument]
+"""
+    + COMMAND
+)
 
 
-def _on(cores: int):
-    """A child's start on the first ``cores`` cores, with Ctrl-C at its default (a pytest-xdist
-    worker may hold it ignored, which a child keeps)."""
+class Forked:
+    """A command the server forked (:data:`SERVER`), as a ``subprocess.Popen`` of it: its id,
+    exit code, and its end awaited or signalled."""
 
-    def start():
-        os.sched_setaffinity(0, CORES[:cores])
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
+    def __init__(self, server: subprocess.Popen):
+        self._answers = server.stdout  # unbuffered: a line read takes no more
+        self.pid, self.returncode = int(self._answers.readline()), None
 
-    return start
+    def poll(self) -> int | None:
+        return self.wait(timeout=0) if self.returncode is None else self.returncode
+
+    def wait(self, timeout: float | None = None) -> int | None:
+        if self.returncode is None:
+            if not select.select([self._answers], [], [], timeout)[0]:
+                if timeout == 0:
+                    return None
+                raise subprocess.TimeoutExpired(f"command {self.pid}", timeout)
+            self.returncode = int(self._answers.readline())
+        return self.returncode
+
+    def send_signal(self, sig: int) -> None:
+        os.kill(self.pid, sig)
 
 
-def _start(args, folder: Path, cores: int, fail: str | None = None, slow: float = 0):
-    """Start ``foldopt args`` in ``folder`` on ``cores`` cores (one: :func:`workers` says none;
-    two: two workers, however busy the machine), its stdout and stderr to the files
-    ``folder.stdout`` and ``folder.stderr`` beside it: files, not pipes, which a worker left
-    behind would hold open."""
-    folder.mkdir(parents=True, exist_ok=True)
-    with open(f"{folder}.stdout", "w") as stdout, open(f"{folder}.stderr", "w") as stderr:
-        return subprocess.Popen(
-            _command(args, folder, fail, slow, workers=None if cores == 1 else 2),
-            cwd=folder,
-            stdout=stdout,
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    """The interpreter that forks the module's commands (:data:`SERVER`), with Ctrl-C at its
+    default (a pytest-xdist worker may hold it ignored, which a child keeps); its own errors in
+    a file."""
+    errors = tmp_path_factory.mktemp("server") / "stderr"
+    with open(errors, "w") as stderr:
+        forking = subprocess.Popen(
+            [sys.executable, "-c", SERVER],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
             stderr=stderr,
-            preexec_fn=_on(cores),
+            bufsize=0,
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
         )
+    yield forking
+    forking.stdin.close()
+    assert forking.wait(timeout=60) == 0, errors.read_text()
+
+
+def _start(server, args, folder: Path, cores: int, fail: str | None = None, slow: float = 0):
+    """Start ``foldopt args`` in ``folder`` on the first ``cores`` cores (one: :func:`workers`
+    says none; two: two workers, however busy the machine), forked by ``server``, its stdout
+    and stderr to the files ``folder.stdout`` and ``folder.stderr`` beside it: files, not pipes,
+    which a worker left behind would hold open."""
+    folder.mkdir(parents=True, exist_ok=True)
+    payload = [str(folder / "drawn"), fail, slow, None if cores == 1 else 2, args]
+    request = [str(folder), CORES[:cores], json.dumps(payload)]
+    server.stdin.write(f"{json.dumps(request)}\n".encode())
+    return Forked(server)
 
 
 class Ran(NamedTuple):
     """What a command did: its exit code, its stdout's lines but the probe's, its stderr, its
     process id, whether it imported matplotlib, the ids of the processes that drew its figures,
-    the collector's work (:data:`PROBE`), its workers (two cores) and whether one outlived it."""
+    the collector's work (:data:`WATCH`), its workers (two cores) and whether one outlived it."""
 
     code: int
     lines: list[str]
@@ -153,10 +218,10 @@ class Ran(NamedTuple):
     outlived: bool
 
 
-def _run(args, folder: Path, cores: int, fail: str | None = None) -> Ran:
+def _run(server, args, folder: Path, cores: int, fail: str | None = None) -> Ran:
     """Run ``foldopt args`` in ``folder`` on ``cores`` cores (:func:`_start`) to its end, its
     workers seen while it runs where it has them."""
-    process = _start(args, folder, cores, fail)
+    process = _start(server, args, folder, cores, fail)
     workers = set()
     try:
         workers = _workers_of(process) if cores > 1 else set()
@@ -183,7 +248,7 @@ def _run(args, folder: Path, cores: int, fail: str | None = None) -> Ran:
     )
 
 
-def _end(process: subprocess.Popen, workers: set[int]) -> None:
+def _end(process: Forked, workers: set[int]) -> None:
     """Kill what is left of a command and its workers, and reap the command."""
     for pid in (process.pid, *workers):
         try:
@@ -198,7 +263,7 @@ def _files(folder: Path) -> dict[str, bytes]:
 
 
 @pytest.fixture(scope="module")
-def commands(tmp_path_factory):
+def commands(server, tmp_path_factory):
     """``run(args, cores)``: ``foldopt args --out out`` run on ``cores`` cores (:func:`_run`), once
     a module for every check of its run, in a folder that has the repository's configs: (what it
     did, its results folder)."""
@@ -209,7 +274,10 @@ def commands(tmp_path_factory):
         if (tuple(args), cores) not in ran:
             folder = tmp_path_factory.mktemp("command")
             (folder / "configs").symlink_to(repository / "configs")
-            ran[tuple(args), cores] = _run([*args, "--out", "out"], folder, cores), folder / "out"
+            ran[tuple(args), cores] = (
+                _run(server, [*args, "--out", "out"], folder, cores),
+                folder / "out",
+            )
         return ran[tuple(args), cores]
 
     return run
@@ -240,14 +308,14 @@ def test_the_workers_write_the_bytes_the_command_draws_itself(commands, args):
 
 
 @needs_two_cores
-def test_a_figure_that_fails_fails_the_command_as_it_does_without_workers(tmp_path):
+def test_a_figure_that_fails_fails_the_command_as_it_does_without_workers(server, tmp_path):
     """A figure that raises in a worker ends the command with the one line and the exit code it
     ends with when the command draws it itself, and nothing is written: no folder, no staging
     folder, nothing beside."""
     said = {}
     for cores in (1, 2):
         folder = tmp_path / str(cores)
-        ran = _run(["run", "--out", "out"], folder, cores, fail="switching.png")
+        ran = _run(server, ["run", "--out", "out"], folder, cores, fail="switching.png")
         assert sorted(path.name for path in folder.iterdir()) == []
         said[cores] = (ran.code, ran.stderr)
         assert ran.lines[0].startswith("shin2015: ")  # the answer, printed before the figures
@@ -282,7 +350,7 @@ def _alive(pid: int) -> bool:
         return False
 
 
-def _workers_of(process: subprocess.Popen) -> set[int]:
+def _workers_of(process: Forked) -> set[int]:
     """The command's workers, once it has them all (within a minute): its child, and the one that
     child forks once it has imported matplotlib."""
     deadline = time.monotonic() + 60
@@ -314,13 +382,13 @@ def test_no_worker_outlives_a_command_that_completes(commands):
 
 @needs_two_cores
 @pytest.mark.parametrize("ending", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
-def test_no_worker_outlives_the_command(tmp_path, ending):
+def test_no_worker_outlives_the_command(server, tmp_path, ending):
     """Whether the command is interrupted (Ctrl-C), terminated or killed while its workers draw,
     they end with it; an interrupted or terminated command says so as it does without workers
     and leaves no folder."""
     # A command still drawing when the signal comes: each figure takes a minute more.
     folder = tmp_path / "command"
-    process = _start(["run", "--out", "out"], folder, 2, slow=60)
+    process = _start(server, ["run", "--out", "out"], folder, 2, slow=60)
     workers = set()
     try:
         workers = _workers_of(process)
