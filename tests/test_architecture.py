@@ -18,7 +18,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "foldopt"
 #: Stage of each top-level name of the package, lowest first.
-STAGES = {"errors": 0, "names": 0, "capabilities": 0, "files": 0, "cache": 0, "tables": 0, "columnar": 0,
+STAGES = {"errors": 0, "names": 0, "capabilities": 0, "files": 0, "cache": 0, "tables": 0, "columnar": 0, "threads": 0,
           "physics": 1, "inputs": 2, "engine": 3,
           "studies": 4, "output": 5, "api": 6, "cli": 7, "__main__": 7}
 

@@ -13,10 +13,12 @@ with its own :class:`Scratch`.
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+import functools
 from typing import NamedTuple
 
 import numpy as np
+
+from foldopt.threads import submit
 
 CHUNKS_PER_THREAD = 8  # rows are handed out in chunks: enough for balance, few scratch buffers
 TABLE_BLOCK = 256  # steps whose tables' coordinates are worked out at once: they stay in L1
@@ -333,6 +335,5 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
         for k in range(n_chunks):
             chunk(k)
         return
-    with ThreadPoolExecutor(threads, thread_name_prefix="foldopt-kernel") as pool:
-        for done in [pool.submit(chunk, k) for k in range(n_chunks)]:
-            done.result()  # a chunk's error, raised here
+    for done in submit(threads, [functools.partial(chunk, k) for k in range(n_chunks)]):
+        done.result()  # a chunk's error, raised here

@@ -26,7 +26,11 @@ References
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
+
+from foldopt.threads import submit
 
 NS_PER_HOUR = 3_600_000_000_000  # [ns]
 SPA_DELTA_T = 67.0  # [s], TT - UT1, pvlib's default for spa_python
@@ -400,8 +404,6 @@ def _on_threads(run, n: int, steps: int, least: int) -> None:
     """``run(part)`` over slices ``part`` of ``range(n)`` (of ``steps`` steps in all), on numba's
     threads, each thread ``least`` steps or more: the compiled passes release the GIL, and their
     items (blocks, instants) are independent. The last part runs in the calling thread."""
-    from concurrent.futures import ThreadPoolExecutor
-
     from numba import get_num_threads
 
     threads = min(get_num_threads(), n, max(1, steps // least))
@@ -410,11 +412,10 @@ def _on_threads(run, n: int, steps: int, least: int) -> None:
     if threads == 1:
         run(parts[0])
         return
-    with ThreadPoolExecutor(threads - 1, thread_name_prefix="foldopt-sun") as pool:
-        others = [pool.submit(run, part) for part in parts[:-1]]
-        run(parts[-1])
-        for done in others:
-            done.result()  # a part's error, raised here
+    others = submit(threads - 1, [functools.partial(run, part) for part in parts[:-1]])
+    run(parts[-1])
+    for done in others:
+        done.result()  # a part's error, raised here
 
 
 def spa_solar_position(utc_ns, latitude, longitude, altitude, sun_terms: SunTerms | None = None):

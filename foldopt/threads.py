@@ -1,0 +1,53 @@
+"""The process's threads for compiled passes that release the GIL (the kernel's chunks, the sun's
+parts): one pool, started at its first use and kept, so that a pass does not start and join its
+threads again at every call (some 50-100 us a call against passes of a few ms). A leaf: it imports
+nothing of foldopt.
+
+A forked child (a Dask worker, a test's forked command) inherits the pool's object but not its
+threads: the pool is forgotten in the child, which starts its own at its first use.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from typing import TYPE_CHECKING, Callable
+
+if TYPE_CHECKING:  # concurrent.futures is imported at the first pass that needs threads
+    from concurrent.futures import Future, ThreadPoolExecutor
+
+_pool: ThreadPoolExecutor | None = None
+_size = 0
+_lock = threading.Lock()
+
+
+def _forget_in_child() -> None:
+    global _pool, _size, _lock
+    _pool, _size, _lock = None, 0, threading.Lock()
+
+
+os.register_at_fork(after_in_child=_forget_in_child)
+
+
+def submit(workers: int, tasks: list[Callable[[], None]]) -> list[Future]:
+    """Run ``tasks`` on the process's pool, which holds ``workers`` threads or more; their futures,
+    in order (``future.result()`` raises a task's error).
+
+    Parameters
+    ----------
+    workers : int
+        The threads the caller means to keep busy (numba's number of threads, or fewer).
+    tasks : list of callables
+        Each called with no argument.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    global _pool, _size
+    with _lock:
+        if _pool is None or _size < workers:
+            # A larger pool replaces a smaller one: the old one's threads end with its queue.
+            if _pool is not None:
+                _pool.shutdown(wait=False)
+            _pool, _size = ThreadPoolExecutor(workers, thread_name_prefix="foldopt"), workers
+        pool = _pool
+    return [pool.submit(task) for task in tasks]
