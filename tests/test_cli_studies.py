@@ -154,8 +154,9 @@ def test_a_weather_file_alone_runs_a_year(tmp_path):
 
     tmy3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
     out = tmp_path / "year"
-    # 15-min steps: what is checked is the study the file completes and the year's table, not the steps.
-    result = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--angle-step", "10",
+    # 15-min steps and 30 deg between fold angles: what is checked is the study the file completes and
+    # the year's table, not the steps or the angles.
+    result = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--angle-step", "30",
                     "--step-min", "15", "--albedo", "0.3", "--iam", "ashrae", "--set", "tracker.model=single-axis",
                     "--out", out, "-q", "--format", "json")
     assert result.exit_code == 0, result.output
