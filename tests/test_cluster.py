@@ -6,8 +6,10 @@ Every map of :data:`MAP` is held to the bit to its rows computed here without Da
 (:func:`direct`). The processes are what the tests are about and what they cost (each imports Dask
 and foldopt, and a worker loads the compiled code: 2-3 s of CPU a process), so tests that check one
 run share it: the killed map is finished by the run whose worker dies and whose terminal is checked
-(:func:`resumed`), and the scheduler lost is that of the cluster whose worker was killed
-(:func:`worker_killed`)."""
+(:func:`resumed`), both runs' tasks say whether --quiet reached their workers, and the scheduler
+lost is that of the cluster whose worker was killed (:func:`worker_killed`). The maps on that
+cluster run their client in this process (:func:`_map_on`): what is killed there is a worker and
+the scheduler, processes of their own."""
 
 from __future__ import annotations
 
@@ -52,12 +54,6 @@ N_SITES, N_LOADS = 8, 2
 SECONDS = 240  # any one run or cluster start
 
 
-def _finish(process) -> tuple[str, str]:
-    out, err = process.communicate(timeout=SECONDS)
-    assert process.returncode == 0, err
-    return out, err
-
-
 def _kill(process) -> None:
     if process.poll() is None:
         process.kill()
@@ -100,10 +96,10 @@ def direct() -> pd.DataFrame:
 #: The command line, its map's task replaced by this script's (Dask pickles a function of __main__ by value,
 #: so the embedded cluster's workers run it): foldopt's task but for the FAULT, raise (a RuntimeError, an
 #: internal fault), bad-input (a ConfigError, as a weather file broken mid-run raises), die (the worker's
-#: process ends), die-once (the first time only: it makes MARK), none. Where SEEN names a file, each
-#: task first adds a line to it: whether foldopt is quiet in its worker. The map's figures are a PNG of one pixel,
-#: not drawn (matplotlib's import and five figures, some 2 s of the client's core): they are
-#: tests/test_figures.py's, and what is tested here is the cluster's processes, the terminal and the table.
+#: process ends), die-once (the first time only: it makes MARK), none. Where SEEN names a file, each task
+#: first adds a line to it: whether foldopt is quiet in its worker. The map's figures are a PNG of one
+#: pixel, not drawn (matplotlib's import and five figures, some 2 s of the client's core): they are
+#: tests/test_figures.py's; what is tested here is the cluster's processes, the terminal and the table.
 FAULTY_TASK = """
 import base64, os, sys
 import foldopt.output.figures as figures
