@@ -320,9 +320,10 @@ def _map_on(scheduler_file: Path, out: Path):
 
 
 @pytest.fixture(scope="module")
-def worker_killed(hand_started, tmp_path_factory) -> tuple[Path, int, str]:
+def worker_killed(hand_started, tmp_path_factory, figures_drawn_elsewhere) -> tuple[Path, int, str]:
     """A map on :func:`hand_started`, one of whose two workers is killed once the first part is
-    written: its folder, the parts there when the worker was killed, and the run's stderr."""
+    written: its folder, the parts there when the worker was killed, and the run's stderr. Its
+    figures are not drawn (conftest.figures_drawn_elsewhere): what is tested is its table."""
     scheduler_file, workers, _ = hand_started
     out = tmp_path_factory.mktemp("worker-killed") / "map"
 
@@ -331,7 +332,7 @@ def worker_killed(hand_started, tmp_path_factory) -> tuple[Path, int, str]:
         workers[0].kill()
         return alive, len(_parts(out))
 
-    with _once_written(out, 1, kill) as killed:
+    with figures_drawn_elsewhere(), _once_written(out, 1, kill) as killed:
         run = _map_on(scheduler_file, out)
     assert run.exit_code == 0, run.output
     [(alive, killed_at)] = killed
