@@ -285,22 +285,3 @@ def test_quiet_silences_notices_for_the_command_only_and_sets_no_variable(monkey
     assert capsys.readouterr().err == "foldopt: heard\n"
     monkeypatch.setenv("FOLDOPT_QUIET", "yes")  # the environment's word for it still holds
     assert invoke("weather", "list").stderr == "" and quiet()
-
-
-def test_quiet_reaches_the_embedded_clusters_workers(monkeypatch):
-    """The embedded cluster's worker processes take --quiet as their environment (their notices
-    of a cache built again reach the terminal), given to them explicitly."""
-    from foldopt.cache import quiet_mode
-
-    monkeypatch.delenv("FOLDOPT_QUIET", raising=False)
-    from foldopt.studies.dask_client import connect
-
-    def worker_quiet():
-        from foldopt.cache import quiet
-
-        return quiet()
-
-    with quiet_mode(), connect(workers=1) as (client, _):
-        assert list(client.run(worker_quiet).values()) == [True]
-    with connect(workers=1) as (client, _):
-        assert list(client.run(worker_quiet).values()) == [False]

@@ -6,8 +6,10 @@ Every map of :data:`MAP` is held to the bit to its rows computed here without Da
 (:func:`direct`). The processes are what the tests are about and what they cost (each imports Dask
 and foldopt, and a worker loads the compiled code: 2-3 s of CPU a process), so tests that check one
 run share it: the killed map is finished by the run whose worker dies and whose terminal is checked
-(:func:`resumed`), and the scheduler lost is that of the cluster whose worker was killed
-(:func:`worker_killed`)."""
+(:func:`resumed`), both runs' tasks say whether --quiet reached their workers, and the scheduler
+lost is that of the cluster whose worker was killed (:func:`worker_killed`). The maps on that
+cluster run their client in this process (:func:`_map_on`): what is killed there is a worker and
+the scheduler, processes of their own."""
 
 from __future__ import annotations
 
@@ -17,7 +19,9 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -35,27 +39,19 @@ from foldopt.studies.worldmap import evaluate_sites
 
 pytest.importorskip("distributed")
 
-#: 16 sites, a chunk each, at 15-min steps: about 0.1 s of work per chunk, long enough to be killed mid-run.
-MAP = ["--lat", "-60:60:40", "--lon", "-180:90:90", "--p-load", "1,2", "--area", "0.108", "--chunk-sites", "1",
+#: 8 sites, a chunk each, at 15-min steps: about 0.1 s of work per chunk, long enough to be killed mid-run
+#: with chunks left (a worker's first chunk, its compiled code loaded, takes some 0.4 s more). Each run
+#: computes every chunk it is given again: 16 sites were 2-3 s more of the workers' cores, and checked no
+#: more.
+MAP = ["--lat", "-60:60:40", "--lon", "-90,90", "--p-load", "1,2", "--area", "0.108", "--chunk-sites", "1",
        "--step-min", "15"]
 #: MAP's grid.
-LATITUDES, LONGITUDES = (-60.0, -20.0, 20.0, 60.0), (-180.0, -90.0, 0.0, 90.0)
+LATITUDES, LONGITUDES = (-60.0, -20.0, 20.0, 60.0), (-90.0, 90.0)
 #: The embedded cluster of one worker: one process to start, not two, on a machine whose two cores the
 #: other tests share (the hand-started cluster below has two, so that one can be killed).
 EMBEDDED = [*MAP, "--workers", "1"]
-N_SITES, N_LOADS = 16, 2
+N_SITES, N_LOADS = 8, 2
 SECONDS = 240  # any one run or cluster start
-
-
-def _foldopt(*args, **popen):
-    return subprocess.Popen([sys.executable, "-m", "foldopt.cli.app", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, **popen)
-
-
-def _finish(process) -> tuple[str, str]:
-    out, err = process.communicate(timeout=SECONDS)
-    assert process.returncode == 0, err
-    return out, err
 
 
 def _kill(process) -> None:
@@ -100,15 +96,26 @@ def direct() -> pd.DataFrame:
 #: The command line, its map's task replaced by this script's (Dask pickles a function of __main__ by value,
 #: so the embedded cluster's workers run it): foldopt's task but for the FAULT, raise (a RuntimeError, an
 #: internal fault), bad-input (a ConfigError, as a weather file broken mid-run raises), die (the worker's
-#: process ends), die-once (the first time only: it makes MARK).
+#: process ends), die-once (the first time only: it makes MARK), none. Where SEEN names a file, each task
+#: first adds a line to it: whether foldopt is quiet in its worker. The map's figures are a PNG of one
+#: pixel, not drawn (matplotlib's import and five figures, some 2 s of the client's core): they are
+#: tests/test_figures.py's; what is tested here is the cluster's processes, the terminal and the table.
 FAULTY_TASK = """
-import os, sys
+import base64, os, sys
+import foldopt.output.figures as figures
 import foldopt.studies.cluster as cluster
 
-FAULT, MARK = os.environ["FAULT"], os.environ["MARK"]  # the task takes them with it, wherever it runs
+figures.figure_bytes = lambda file, args, kwargs: base64.b64decode(
+    "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mNkYPhfDwAChwGA60e6kgAAAABJRU5ErkJggg==")
+
+FAULT, MARK, SEEN = os.environ["FAULT"], os.environ["MARK"], os.environ.get("SEEN")  # the task takes them along
 evaluate_chunk = cluster.evaluate_chunk
 
 def task(study, sites, loads, relative, year, engine):
+    if SEEN:
+        from foldopt.cache import quiet
+        with open(SEEN, "a") as seen:
+            print(quiet(), file=seen)
     if FAULT == "raise":
         raise RuntimeError("a fault in the task")
     if FAULT == "bad-input":
@@ -129,14 +136,22 @@ SMALL = ["--lat", "0,30", "--lon", "0", "--p-load", "1", "--area", "0.108", "--s
 EMBEDDED_ONE = r"embedded LocalCluster, 1 worker process; dashboard: http://127\.0\.0\.1:\d+/status"
 
 
+def _faulty_run(fault: str, folder: Path, args: list[str], **popen) -> subprocess.Popen:
+    """Start the map of ``args`` (its cluster's options too) with ``fault`` into ``folder / "map"``
+    (:data:`FAULTY_TASK`); ``popen["env"]``'s variables are added to this process's but for
+    ``FOLDOPT_QUIET``: the map's own options say whether it is quiet."""
+    env = {**os.environ, "FAULT": fault, "MARK": str(folder / "died"), **popen.pop("env", {})}
+    env.pop("FOLDOPT_QUIET", None)
+    return subprocess.Popen([sys.executable, "-c", FAULTY_TASK, "map", *args, "--out", str(folder / "map")], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen)
+
+
 def _faulty_map(fault: str, folder: Path, args: list[str], **environment) -> tuple[int, list[str], str]:
-    """Run the map of ``args`` (its cluster's options too) with ``fault`` into ``folder / "map"``: its
-    exit code, the lines of its stderr and its stdout."""
-    env = {**os.environ, "FAULT": fault, "MARK": str(folder / "died"), **environment}
-    process = subprocess.run([sys.executable, "-c", FAULTY_TASK, "map", *args, "--out", str(folder / "map")],
-                             env=env, capture_output=True, text=True, timeout=SECONDS)
-    assert "distributed." not in process.stderr and "Traceback" not in process.stderr, process.stderr
-    return process.returncode, process.stderr.splitlines(), process.stdout
+    """Run :func:`_faulty_run` to its end: its exit code, the lines of its stderr and its stdout."""
+    process = _faulty_run(fault, folder, args, env=environment)
+    stdout, stderr = process.communicate(timeout=SECONDS)
+    assert "distributed." not in stderr and "Traceback" not in stderr, stderr
+    return process.returncode, stderr.splitlines(), stdout
 
 
 @dataclass
@@ -155,6 +170,10 @@ class Resumed:
     lines: list[str]
     stdout: str
     died: bool
+    #: Whether foldopt was quiet in the workers, each task's word: the killed run's (--quiet), the
+    #: resuming run's (not).
+    quiet_killed: list[str]
+    quiet_resuming: list[str]
 
 
 @pytest.fixture(scope="session")
@@ -163,19 +182,22 @@ def resumed(tmp_path_factory) -> Resumed:
     written three parts; the same map refused without --resume (run in this process: what is tested
     is the folder); then resumed with --format json by a process of its own on an embedded cluster,
     whose worker dies on the first chunk it is given (the nanny starts another, the scheduler
-    reschedules the chunk)."""
+    reschedules the chunk). Both runs' tasks say whether foldopt is quiet in their workers."""
     folder = tmp_path_factory.mktemp("resumed")
-    out = folder / "map"
-    run = _foldopt("map", *EMBEDDED, "--out", str(out), "-q", start_new_session=True)
+    out, seen_killed, seen_resuming = folder / "map", folder / "quiet-killed", folder / "quiet-resuming"
+    run = _faulty_run("none", folder, [*EMBEDDED, "-q"], env={"SEEN": str(seen_killed)}, start_new_session=True)
     try:
-        _wait_for(lambda: len(_parts(out)) >= 3 if out.exists() else False, "three parts")
+        # or its end: a run that failed is the tests' to show
+        _wait_for(lambda: run.poll() is not None or out.exists() and len(_parts(out)) >= 3, "three parts")
     finally:
         os.killpg(run.pid, signal.SIGKILL)  # the client and its embedded cluster, at once
-        run.wait(timeout=30)
+        run.communicate(timeout=30)
     before, table_before = _parts(out), (out / "map.parquet").exists()
     refused = CliRunner().invoke(app, ["map", *EMBEDDED, "--out", str(out)])
-    code, lines, stdout = _faulty_map("die-once", folder, [*EMBEDDED, "--resume", "--format", "json"])
-    return Resumed(out, before, table_before, refused, code, lines, stdout, (folder / "died").exists())
+    code, lines, stdout = _faulty_map("die-once", folder, [*EMBEDDED, "--resume", "--format", "json"],
+                                      SEEN=str(seen_resuming))
+    return Resumed(out, before, table_before, refused, code, lines, stdout, (folder / "died").exists(),
+                   seen_killed.read_text().split(), seen_resuming.read_text().split())
 
 
 def test_a_maps_terminal_holds_only_foldopts_lines(resumed):
@@ -187,6 +209,14 @@ def test_a_maps_terminal_holds_only_foldopts_lines(resumed):
     assert resumed.lines == []
     assert json.loads(resumed.stdout)["command"] == "map"
     _every_site_once(pd.read_parquet(resumed.out / "map.parquet"))
+
+
+def test_quiet_reaches_the_embedded_clusters_workers(resumed):
+    """The embedded cluster's worker processes take --quiet as their environment (their notices
+    of a cache built again reach the terminal), given to them explicitly: foldopt sets no
+    environment variable of its own, and these runs do not inherit FOLDOPT_QUIET."""
+    assert resumed.quiet_killed and set(resumed.quiet_killed) == {"True"}
+    assert resumed.quiet_resuming and set(resumed.quiet_resuming) == {"False"}
 
 
 def test_embedded_map_equals_the_computation_without_dask(resumed, direct):
@@ -245,7 +275,8 @@ def hand_started(tmp_path_factory):
     for its file."""
     scheduler_file = tmp_path_factory.mktemp("cluster") / "scheduler.json"
     python = [sys.executable, "-m"]
-    commands = [[*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+    # Without the dashboard (bokeh's import): nothing looks at it. Its HTTP server on a free port.
+    commands = [[*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
                  "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)]]
     commands += 2 * [[*python, "distributed.cli.dask_worker", "--scheduler-file", str(scheduler_file), "--nthreads",
                       "1", "--no-nanny", "--host", "127.0.0.1"]]
@@ -260,22 +291,53 @@ def hand_started(tmp_path_factory):
             _kill(process)
 
 
+@contextmanager
+def _once_written(out: Path, parts: int, act):
+    """While the block runs, ``act()`` on a thread of this process once ``out`` holds ``parts``
+    parts (:func:`_parts`), at most once; yields the list that gets ``act``'s result."""
+    done, stop = [], threading.Event()
+
+    def watch():
+        while not stop.wait(0.02):
+            if out.exists() and len(_parts(out)) >= parts:
+                done.append(act())
+                return
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    watcher.start()
+    try:
+        yield done
+    finally:
+        stop.set()
+        watcher.join(timeout=SECONDS)
+
+
+def _map_on(scheduler_file: Path, out: Path):
+    """``foldopt map MAP --scheduler scheduler_file --out out`` run in this process, the map's client
+    (its cluster's processes are what these tests are about; a process of its own imported foldopt
+    and drew the map's figures again)."""
+    return CliRunner().invoke(app, ["map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file)])
+
+
 @pytest.fixture(scope="module")
-def worker_killed(hand_started, tmp_path_factory) -> tuple[Path, int, str]:
+def worker_killed(hand_started, tmp_path_factory, figures_drawn_elsewhere) -> tuple[Path, int, str]:
     """A map on :func:`hand_started`, one of whose two workers is killed once the first part is
-    written: its folder, the parts there when the worker was killed, and the run's stderr."""
+    written: its folder, the parts there when the worker was killed, and the run's stderr. Its
+    figures are not drawn (conftest.figures_drawn_elsewhere): what is tested is its table."""
     scheduler_file, workers, _ = hand_started
     out = tmp_path_factory.mktemp("worker-killed") / "map"
-    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
-    try:
-        _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
-        assert workers[0].poll() is None
-        os.kill(workers[0].pid, signal.SIGKILL)
-        killed_at = len(_parts(out))
-        _, err = _finish(run)
-    finally:
-        _kill(run)
-    return out, killed_at, err
+
+    def kill():
+        alive = workers[0].poll() is None
+        workers[0].kill()
+        return alive, len(_parts(out))
+
+    with figures_drawn_elsewhere(), _once_written(out, 1, kill) as killed:
+        run = _map_on(scheduler_file, out)
+    assert run.exit_code == 0, run.output
+    [(alive, killed_at)] = killed
+    assert alive
+    return out, killed_at, run.stderr
 
 
 def test_a_worker_killed_mid_run_loses_nothing(worker_killed, direct):
@@ -301,19 +363,14 @@ def test_a_scheduler_lost_mid_run_is_one_line_and_a_resume_that_cannot_connect_c
     # and what is lost is the scheduler.
     scheduler_file, _, scheduler = hand_started
     out = tmp_path / "map"
-    run = _foldopt("map", *MAP, "--out", str(out), "--scheduler", str(scheduler_file))
-    try:
-        _wait_for(lambda: len(_parts(out)) >= 1 if out.exists() else False, "the first part")
-        address = json.loads(scheduler_file.read_text())["address"]
-        scheduler.kill()
-        _, err = run.communicate(timeout=SECONDS)
-    finally:
-        _kill(run)
-    lines = err.splitlines()
-    assert run.returncode == 2 and len(lines) == 2, err
+    address = json.loads(scheduler_file.read_text())["address"]
+    with _once_written(out, 1, scheduler.kill):
+        run = _map_on(scheduler_file, out)
+    lines = run.stderr.splitlines()
+    assert run.exit_code == 2 and len(lines) == 2, run.output
     assert lines[0].startswith("Dask scheduler tcp://127.0.0.1:")
     assert re.fullmatch(rf"error: --scheduler = '{re.escape(str(scheduler_file))}': the scheduler was lost mid-run "
-                        r"\((scheduler-connection-lost|CommClosedError)\); the \d+ of 16 chunks done are kept: "
+                        rf"\((scheduler-connection-lost|CommClosedError)\); the \d+ of {N_SITES} chunks done are kept: "
                         r"start it again and finish the map with --resume", lines[1]), lines[1]
     before = _snapshot(out)
     assert json.loads((out / "run.json").read_text())["status"] == "running" and before
