@@ -4,6 +4,7 @@ compiled code compiled once for both, and the command line's click tree built on
 
 import contextlib
 import functools
+import gc
 import io
 import os
 import shutil
@@ -192,6 +193,14 @@ def _end_the_warm_up() -> None:
             process.kill()
         process.wait()
     shutil.rmtree(os.environ.pop(WARM_UP), ignore_errors=True)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_unconfigure(config):
+    # Every object frozen as the process ends (a worker, the controller), as the command line's own
+    # process does (foldopt.cli.process.ending): the exit's passes of the collector walked the
+    # objects of half the suite, some 1-3 s a process, which the controller waited for.
+    gc.freeze()
 
 
 def pytest_terminal_summary(terminalreporter):
