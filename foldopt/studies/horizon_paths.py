@@ -51,7 +51,10 @@ def sun_paths(study, dates) -> dict | None:
     steps = np.arange(0, 1440, PATH_STEP_MIN)
     start = pd.DatetimeIndex([dt.datetime.combine(day, dt.time(), zone) for day in days])
     times = pd.DatetimeIndex(
-        (start.values[:, None] + steps[None, :].astype("timedelta64[m]")).ravel(), tz="UTC"
+        (
+            start.tz_convert(None).to_numpy()[:, None] + steps[None, :].astype("timedelta64[m]")
+        ).ravel(),
+        tz="UTC",
     )
     import pvlib
 

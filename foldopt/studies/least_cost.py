@@ -199,7 +199,9 @@ def design_space(
     whole[rows[~known.reach(rows, upper[rows])]] = True
     whole[below[known.reach(below, lower[below])]] = True
     refine |= whole
-    need, bracket = upper.copy(), np.where(upper > 0, (upper - lower) / upper, 0.0)
+    # A row that meets nowhere on the grid (an infinite upper bound) has no bracket to say.
+    need, bracket = upper.copy(), np.zeros_like(upper)
+    np.divide(upper - lower, upper, out=bracket, where=np.isfinite(upper) & (upper > 0))
     first = np.searchsorted(grid, upper)
     for chosen in (np.flatnonzero(refine & ~whole), np.flatnonzero(whole)):
         if not chosen.size:
