@@ -337,10 +337,15 @@ def _day_offset(midnight: int, zone: zoneinfo.ZoneInfo) -> int | None:
     whole hour the offset after it. Where the change comes after the day's last hour (a gap or a
     repetition that runs into the next day), the end of the day read after it (``fold=1``)
     differs; a repetition then is read at its first instant either way, as pandas reads it."""
-    start = _wall(midnight)
-    hours = {_offset_ns(zone.utcoffset(start + dt.timedelta(hours=hour))) for hour in range(25)}
-    hours.add(_offset_ns(zone.utcoffset(_wall(midnight + 24 * NS_PER_HOUR, 1))))
-    return hours.pop() if len(hours) == 1 else None
+    start, utcoffset = _wall(midnight), zone.utcoffset
+    # The offsets as the zone gives them (timedeltas), converted once: a sweep's year reads 26 a day.
+    hours = {utcoffset(start + hour) for hour in _DAY_HOURS}
+    hours.add(utcoffset(_wall(midnight + 24 * NS_PER_HOUR, 1)))
+    return _offset_ns(hours.pop()) if len(hours) == 1 else None
+
+
+#: The whole hours of a local day, its end included (:func:`_day_offset`).
+_DAY_HOURS = tuple(dt.timedelta(hours=hour) for hour in range(25))
 
 
 def _localised_step(local_ns: int, zone: zoneinfo.ZoneInfo) -> int:
