@@ -18,8 +18,8 @@ blocks that cross a load.
 
 Rows are split into chunks, a few per thread (:func:`foldopt.engine.records.in_chunks`), and each
 chunk has its own scratch, in the calling thread's workspace
-(:func:`foldopt.engine.records.allocate`), cleared per row. A chunk's loop allocates nothing and is compiled without numba's reference
-counting, as the kernel's (:mod:`foldopt.engine.kernel`).
+(:func:`foldopt.engine.records.allocate`), cleared per row. A chunk's loop allocates nothing and
+is compiled without numba's reference counting, as the kernel's (:mod:`foldopt.engine.kernel`).
 """
 
 from __future__ import annotations
