@@ -420,7 +420,7 @@ def report(results: dict) -> str:
                   f"(bound {W3_ANGLE_DEG:g} deg)"]
         if r.get("passes"):
             # Each pass of the kernel's in the order run (wall less the sun's phase, the process's CPU
-            # over both threads, the sun, sky, tables and kernel phases, minor page faults): a
+            # over both threads, the sun, irradiance, tables and kernel phases, minor page faults): a
             # process's two modes told apart by where the time went.
             lines += ["", "W3 kernel's passes in order (ms; faults): " + "; ".join(
                 f"{1e3 * p['pass']:.1f} (cpu {1e3 * p['cpu']:.1f}, sun {1e3 * p['sun']:.1f}, "
