@@ -330,6 +330,7 @@ def workload_w3(days: int, repeats: int) -> dict:
     loads = np.array([base.p_load])
     ours: dict = {name: [] for name in W3_ENGINES}
     hours: dict = {}
+    passes: list = []
     for name in W3_ENGINES:
         _fold_pass(base, sites[:2], dates[:2], loads, engine_name=name)  # loaded before timing
     theirs = []
@@ -338,10 +339,14 @@ def workload_w3(days: int, repeats: int) -> dict:
             # foldopt's pass is short, so a moment's load on the other core weighs on it more:
             # three tries a round.
             for _ in range(3):
+                faults, cpu = resource.getrusage(resource.RUSAGE_SELF).ru_minflt, time.process_time()
                 start = time.perf_counter()
                 phases, hours[name], *_ = _fold_pass(base, sites, dates, loads, engine_name=name)
                 # the sun is timed twice, counted once
                 ours[name].append(time.perf_counter() - start - phases["sun"])
+                if name == "numba":  # what each pass of the kernel's was made of, untimed
+                    passes.append({"pass": ours[name][-1], "cpu": time.process_time() - cpu, **phases,
+                                   "faults": resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults})
         seconds, (baseline_hours, _) = _timed(pvlib_baseline, base, dates)
         theirs.append(seconds)
     angles = np.asarray(base.fold_angles.grid())
@@ -351,7 +356,7 @@ def workload_w3(days: int, repeats: int) -> dict:
             "numpy_seconds": min(ours["numpy"]), "points": points, "days": days, "rounds": repeats,
             "ratio": min(theirs) / min(ours["numba"]), "numpy_ratio": min(theirs) / min(ours["numpy"]),
             "agreement_t_solar_s": max(t for t, _ in agreement),
-            "agreement_angle_deg": max(angle for _, angle in agreement)}
+            "agreement_angle_deg": max(angle for _, angle in agreement), "passes": passes}
 
 
 def workload_tables() -> dict:
@@ -413,6 +418,14 @@ def report(results: dict) -> str:
                   f"the year); both agree with it on t_solar at the best angle within {r['agreement_t_solar_s']:.1f} s "
                   f"(bound {W3_AGREEMENT_S:g} s) and on clear best angles within {r['agreement_angle_deg']:.0f} deg "
                   f"(bound {W3_ANGLE_DEG:g} deg)"]
+        if r.get("passes"):
+            # Each pass of the kernel's in the order run (wall less the sun's phase, the process's CPU
+            # over both threads, the sun, irradiance, tables and kernel phases, minor page faults): a
+            # process's two modes told apart by where the time went.
+            lines += ["", "W3 kernel's passes in order (ms; faults): " + "; ".join(
+                f"{1e3 * p['pass']:.1f} (cpu {1e3 * p['cpu']:.1f}, sun {1e3 * p['sun']:.1f}, "
+                f"irradiance {1e3 * p['irradiance']:.1f}, tables {1e3 * p['tables']:.1f}, "
+                f"kernel {1e3 * p['kernel']:.1f}; {p['faults']})" for p in r["passes"])]
     if "storage" in results:
         r = results["storage"]
         lines += ["", f"W1 with a buffer ({r['days']} days x 180 angles, periodic state of the year): "

@@ -414,3 +414,92 @@ def test_chunks_are_each_taken_once_and_their_errors_raised():
             in_chunks(failing, 1000, scratch)
     finally:
         numba.set_num_threads(before)
+
+
+def test_a_chunk_error_is_raised_after_every_chunk_ended():
+    """A chunk's scratch is the calling thread's workspace, which its next call takes again: the
+    error of one chunk reaches the caller only once the others have ended."""
+    import threading
+    import time
+
+    import numba
+
+    from foldopt.engine.records import allocate, in_chunks
+
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    try:
+        _, scratch = allocate(1000, 1, 1, 10, False)
+        ended, lock = [], threading.Lock()
+
+        def body(start, stop, work):
+            if start == 0:
+                raise ValueError("the first chunk")
+            time.sleep(0.02)
+            with lock:
+                ended.append(start)
+
+        with pytest.raises(ValueError, match="the first chunk"):
+            in_chunks(body, 1000, scratch)
+        assert len(ended) == scratch.east.shape[0] - 1
+    finally:
+        numba.set_num_threads(before)
+
+
+def _poison_workspaces():
+    """Every byte of this thread's workspace set to 0xff (a NaN in each float, the largest
+    integer): what a call left there must not reach the next call's answer."""
+    from foldopt import threads
+
+    buffer = getattr(threads._local, "buffer", None)
+    if buffer is not None:
+        buffer[:] = 0xFF
+
+
+@pytest.mark.parametrize("common", [True, False])
+def test_a_reused_scratch_changes_no_answer_and_no_earlier_result(common):
+    """The kernel's scratch lives in the calling thread's workspace, reused by its next call: the
+    same rows give the same bits whatever the workspace held (each call after it was filled
+    with NaNs), a result stays as it was after later calls over other rows, and curves given to
+    :func:`curve_metrics` (the same scratch's other layout) too. Both the common case's loop and
+    the general one (all outputs, the longest runs, kept curves)."""
+    study = make_study({"name": "reuse", "mode": "exact", "sky": "meinel", "pv_model": "single-diode",
+                        "site": {"latitude": 40.0, "longitude": 10.0}, "date": "2025-06-01",
+                        "panel": {"area": 0.108, "efficiency": 0.19}, "p_load": 1.0, "step_min": 5})
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=d) for d in (0, 90, 180, 270)]
+    sky = _sky(study, [study.site] * 4, dates)
+    rows = _rows(study, [study.site] * 4, np.arange(10.0, 181.0, 10.0))
+    electrical = engine_options(study).electrical
+    ask = dict(outputs=("switching",)) if common else dict(outputs=engine.OUTPUTS, contiguous=True, curves=[0, 5])
+    loads = np.array([0.5, 2.0, 8.0])
+
+    def run(which):
+        picked = engine.PanelRows(rows.block[which], rows.orientation[which])
+        return engine.row_metrics(sky, rows=picked, loads=loads, electrical=electrical, engine="numba", **ask)
+
+    fields = ("t_solar", "t_solar_contiguous", "energy", "peak", "irradiation", "power")
+
+    def arrays(result):
+        return [getattr(result, name) for name in fields]
+
+    everything = np.arange(rows.block.size)
+    first = arrays(run(everything))
+    kept = [None if a is None else a.copy() for a in first]
+    _poison_workspaces()
+    again = arrays(run(everything))
+    run(everything[::-1])  # other rows, the same shapes
+    run(everything[:7])  # fewer rows
+    for value, copy, repeated in zip(first, kept, again, strict=True):
+        if value is not None:
+            np.testing.assert_array_equal(value, copy)  # untouched by the later calls
+            np.testing.assert_array_equal(repeated, copy)  # the same bits from a poisoned workspace
+    power = np.abs(np.sin(np.linspace(0, 3 * np.pi, 4 * 288))).reshape(4, 288) * 5.0
+    curves = arrays(engine.curve_metrics(power, loads, 1 / 12, contiguous=not common))
+    curves_kept = [None if a is None else a.copy() for a in curves]
+    _poison_workspaces()
+    again = arrays(engine.curve_metrics(power, loads, 1 / 12, contiguous=not common))
+    run(everything)
+    for value, copy, repeated in zip(curves, curves_kept, again, strict=True):
+        if value is not None:
+            np.testing.assert_array_equal(value, copy)
+            np.testing.assert_array_equal(repeated, copy)

@@ -17,9 +17,9 @@ and highest power (the kernel's switching pass notes them), :func:`blocked_day` 
 blocks that cross a load.
 
 Rows are split into chunks, a few per thread (:func:`foldopt.engine.records.in_chunks`), and each
-chunk has its own scratch, allocated by the caller (:func:`foldopt.engine.records.allocate`) and
-cleared per row. A chunk's loop allocates nothing and is compiled without numba's reference
-counting, as the kernel's (:mod:`foldopt.engine.kernel`).
+chunk has its own scratch, in the calling thread's workspace
+(:func:`foldopt.engine.records.allocate`), cleared per row. A chunk's loop allocates nothing and
+is compiled without numba's reference counting, as the kernel's (:mod:`foldopt.engine.kernel`).
 """
 
 from __future__ import annotations

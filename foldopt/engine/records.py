@@ -204,8 +204,12 @@ class Outputs(NamedTuple):
 
 
 class Scratch(NamedTuple):
-    """Working arrays of each chunk of rows, allocated once for the call (:func:`allocate`): each
-    field's first axis is the chunk, and a chunk's own record (:func:`in_chunks`) holds the rest.
+    """Working arrays of each chunk of rows (:func:`allocate`): each field's first axis is the
+    chunk, and a chunk's own record (:func:`in_chunks`) holds the rest. Every value is written
+    before it is read (a row clears or overwrites what it uses), so a chunk's arrays hold
+    whatever the last call left: they live in the calling thread's workspace
+    (:func:`foldopt.threads.workspace`), each chunk's fields together on cache lines of their
+    own, so that two threads' chunks never write to one line.
 
     Attributes
     ----------
@@ -253,8 +257,9 @@ class Scratch(NamedTuple):
 def allocate(
     n_rows: int, n_conn: int, n_loads: int, n_steps: int, contiguous: bool, n_curves: int = 0
 ) -> tuple[Outputs, Scratch]:
-    """Outputs and per-chunk scratch of :func:`foldopt.engine.kernel.fold_rows` or
-    :func:`foldopt.engine.curve_reduction.curve_rows`, allocated here, once for the call.
+    """Outputs (new arrays, the caller's) and per-chunk scratch (the calling thread's workspace,
+    reused by its next call) of :func:`foldopt.engine.kernel.fold_rows` or
+    :func:`foldopt.engine.curve_reduction.curve_rows`.
 
     Parameters
     ----------
@@ -270,6 +275,7 @@ def allocate(
     Returns
     -------
     Outputs, Scratch
+        The scratch is valid until the calling thread's next call of this function.
     """
     from numba import get_num_threads
 
@@ -285,20 +291,47 @@ def allocate(
         irradiation=np.empty(n_rows if n_steps else 0),
         power=np.zeros((n_curves, n_conn, n_steps if n_curves else 0)),
     )
-    light = [np.zeros((chunks, n_steps)) for _ in range(5)]
-    scratch = Scratch(
-        *light,
-        power=np.zeros((chunks, n_conn if n_steps else 0, n_steps)),
-        above=np.zeros((chunks, n_loads)),
-        whole=np.zeros((chunks, n_loads + 1)),
-        run=np.zeros((chunks, n_loads if contiguous else 1, 2)),
-        nodes=np.zeros((chunks, 3, TABLE_BLOCK if n_steps else 0), dtype=np.uint64),
-        weights=np.zeros((chunks, 4, TABLE_BLOCK if n_steps else 0)),
-        low=np.zeros((chunks, n_steps // WALK_BLOCK + 1)),
-        high=np.zeros((chunks, n_steps // WALK_BLOCK + 1)),
-        held=np.zeros((chunks, n_steps + 1)),
+    table_block, walk_blocks = (TABLE_BLOCK if n_steps else 0), n_steps // WALK_BLOCK + 1
+    light = ((n_steps,), np.float64)
+    return out, _scratch(
+        chunks,
+        (
+            *(light,) * 5,
+            ((n_conn if n_steps else 0, n_steps), np.float64),
+            ((n_loads,), np.float64),
+            ((n_loads + 1,), np.float64),
+            ((n_loads if contiguous else 1, 2), np.float64),
+            ((3, table_block), np.uint64),
+            ((4, table_block), np.float64),
+            ((walk_blocks,), np.float64),
+            ((walk_blocks,), np.float64),
+            ((n_steps + 1,), np.float64),
+        ),
     )
-    return out, scratch
+
+
+def _scratch(chunks: int, fields) -> Scratch:
+    """A :class:`Scratch` of ``chunks`` chunks in the calling thread's workspace, ``fields`` the
+    (shape, dtype) of each field's chunk: each chunk's fields one after the other, each on a
+    cache line of its own (:data:`foldopt.threads.ALIGN`), so the chunks' lines are apart."""
+    from foldopt.threads import ALIGN, workspace
+
+    offsets, strides, stride = [], [], 0
+    for shape, dtype in fields:
+        # C order within a chunk: each axis steps over the product of the later ones.
+        steps = [np.dtype(dtype).itemsize]
+        for size in reversed(shape):
+            steps.insert(0, steps[0] * size)
+        offsets.append(stride)
+        strides.append((*steps[1:],))
+        stride += -(-steps[0] // ALIGN) * ALIGN
+    buffer = workspace(chunks * stride)
+    return Scratch(
+        *(
+            np.ndarray((chunks, *shape), dtype, buffer, offset, (stride, *inner))
+            for (shape, dtype), offset, inner in zip(fields, offsets, strides, strict=True)
+        )
+    )
 
 
 def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
@@ -316,7 +349,8 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
         ``_chunk_rows`` or ``_chunk_curves``.
     n_rows : int
     scratch : Scratch
-        Of every chunk (:func:`allocate`): its first axis is the chunk.
+        Of every chunk (:func:`allocate`): its first axis is the chunk. Every chunk has ended
+        when this returns or raises.
     *records
         The arguments of ``body`` between ``stop`` and the chunk's scratch.
     """
@@ -335,5 +369,11 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
         for k in range(n_chunks):
             chunk(k)
         return
-    for done in submit(threads, [functools.partial(chunk, k) for k in range(n_chunks)]):
-        done.result()  # a chunk's error, raised here
+    from concurrent.futures import wait
+
+    tasks = submit(threads, [functools.partial(chunk, k) for k in range(n_chunks)])
+    # Every chunk ended before a chunk's error is raised: the scratch is the calling thread's
+    # workspace, which its next call takes again.
+    wait(tasks)
+    for done in tasks:
+        done.result()
