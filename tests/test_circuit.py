@@ -62,24 +62,24 @@ def sampled(curve):
     return current[keep], voltage[keep]
 
 
-def reference_parallel(east, west, drop, switch_resistance, bus=None):
-    """The pair's best power on a bus grid (or at the bus voltage ``bus``)."""
+def reference_parallel(east, west, drop, switch_resistance, bus=None, samples=None):
+    """The pair's best power on a bus grid (or at the bus voltage ``bus``); ``samples``: the two
+    curves' :func:`sampled`, where the caller has them."""
     grid = np.linspace(0.0, max(float(east.v_oc[0]), float(west.v_oc[0]), 1e-9), SAMPLES) if bus is None else bus
     total = np.zeros_like(np.atleast_1d(grid))
-    for curve in (east, west):
-        current, voltage = sampled(curve)
+    for current, voltage in samples or map(sampled, (east, west)):
         if current.size:
             out = voltage - drop(current) - current * switch_resistance  # increasing along the sample
             total = total + np.interp(grid, out, current, right=0.0)
     return float(np.max(grid * total, initial=0.0))
 
 
-def string(east, west, drop, switch_resistance, current):
-    """The series string's voltage at ``current``, each sub-panel bypassed past its Isc."""
+def string(east, west, drop, switch_resistance, current, samples=None):
+    """The series string's voltage at ``current``, each sub-panel bypassed past its Isc;
+    ``samples`` as :func:`reference_parallel`'s."""
     total = -current * switch_resistance
-    for curve in (east, west):
+    for curve, (i, v) in zip((east, west), samples or map(sampled, (east, west)), strict=True):
         isc = float(curve.i_sc[0])
-        i, v = sampled(curve)
         inside = np.interp(np.minimum(current, isc), i[::-1], v[::-1]) if i.size else np.zeros_like(current)
         total = total + np.where(current <= isc, inside, -drop(np.maximum(current - isc, 0.0)))
     return total
@@ -150,11 +150,12 @@ def test_direct_coupling_matches_the_sampled_curves(model, kind):
     built, drop = DROPS[kind]
     for poa_east, poa_west in ((1000.0, 1000.0), (900.0, 250.0), (60.0, 700.0)):
         east, west = curves(poa_east, poa_west, 30.0, model)
+        samples = sampled(east), sampled(west)  # the loads' references read the same samples
         for load in (0.5, 1.0, 1.6, 2.2):
-            expected = reference_parallel(east, west, drop, 0.03, bus=np.array([load]))
+            expected = reference_parallel(east, west, drop, 0.03, bus=np.array([load]), samples=samples)
             power = circuit.parallel_power(east, west, built, load_voltage=load, switch_resistance=0.03)[0]
             assert power == pytest.approx(expected, rel=1e-6, abs=1e-9)
-            current, voltage = sampled(east)
+            current, voltage = samples[0]
             out = voltage - current * 0.03
             assert circuit.alone_power(east, load_voltage=load, switch_resistance=0.03)[0] == pytest.approx(
                 load * np.interp(load, out, current, right=0.0), rel=1e-6, abs=1e-9)
@@ -163,7 +164,7 @@ def test_direct_coupling_matches_the_sampled_curves(model, kind):
             iscs = [float(east.i_sc[0]), float(west.i_sc[0])]
             grid = np.unique(np.concatenate([np.linspace(0.0, max(iscs), SAMPLES), iscs,
                                              np.nextafter(iscs, np.inf)]))
-            volts = string(east, west, drop, 0.03, grid)
+            volts = string(east, west, drop, 0.03, grid, samples)
             at = np.interp(2 * load, volts[::-1], grid[::-1], left=grid[-1], right=0.0)
             series = circuit.series_power(east, west, built, load_voltage=2 * load, switch_resistance=0.03)[0]
             assert series == pytest.approx(2 * load * at, rel=1e-4, abs=1e-6)

@@ -88,17 +88,36 @@ def assert_engines_agree(compiled, reference):
     np.testing.assert_allclose(compiled.irradiation, reference.irradiation, rtol=1e-9, atol=1e-9)
 
 
+#: The thread counts the kernel is compared on: one, as a pytest-xdist worker runs it
+#: (tests/conftest.py), and two, where its rows go to threads in chunks.
+THREADS = (1, 2)
+
+
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(case=cases())
-def test_kernel_equals_the_reference_path(case):
+def kernel_equals_the_reference_path(case):
+    """The kernel on each of :data:`THREADS` against one reference path's run of the case (the
+    process launched numba's threads for them all)."""
+    import numba
+
     study, sites, dates, angles, loads = case
     sky, rows, electrical = _sky(study, sites, dates), _rows(study, sites, angles), engine_options(study).electrical
     peak = engine.row_metrics(sky, rows=rows, loads=[1.0], electrical=electrical, outputs=("independent",),
                               engine="numpy").peak
     loads = loads / 60 * max(peak.max(), 1e-3)  # from a sliver of the peak to above it
-    results = {name: engine.row_metrics(sky, rows=rows, loads=loads, electrical=electrical, outputs=engine.OUTPUTS,
-                                        contiguous=True, engine=name) for name in ("numba", "numpy")}
-    assert_engines_agree(results["numba"], results["numpy"])
+
+    def metrics(name):
+        return engine.row_metrics(sky, rows=rows, loads=loads, electrical=electrical, outputs=engine.OUTPUTS,
+                                  contiguous=True, engine=name)
+
+    reference, before = metrics("numpy"), numba.get_num_threads()
+    try:
+        for threads in THREADS:
+            numba.set_num_threads(threads)
+            assert numba.get_num_threads() == threads
+            assert_engines_agree(metrics("numba"), reference)
+    finally:
+        numba.set_num_threads(before)
 
 
 #: The comparison above and test_kernel_threads below, called in a process of their own (numba
@@ -109,27 +128,22 @@ import sys
 sys.path.insert(0, {str(Path(__file__).parent)!r})
 import test_engine
 test_engine.test_kernel_threads()
-test_engine.test_kernel_equals_the_reference_path()
+test_engine.kernel_equals_the_reference_path()
 print("both passed")
 """
 
 
 def test_the_kernel_on_two_threads():
-    """The kernel's rows go to threads in chunks, each with its own scratch (arrays zero-filled
-    inside a prange body have given wrong sums): the comparison above on two threads. numba
+    """The kernel equals the reference path on one thread and on two (the comparison's examples
+    run the reference once and the kernel on each): its rows go to threads in chunks, each with
+    its own scratch (arrays zero-filled inside a prange body have given wrong sums). numba
     launches its threads once, as it is imported, and can then run on fewer but never on more:
-    where this process launched two or more (``-n 0``) the comparison runs here on two; a
-    pytest-xdist worker launched one (tests/conftest.py), and runs it in a process of its own."""
+    where this process launched two or more (``-n 0``) the comparison runs here; a pytest-xdist
+    worker launched one (tests/conftest.py), and runs it in a process of its own."""
     import numba
 
-    if numba.config.NUMBA_NUM_THREADS >= 2:
-        before = numba.get_num_threads()
-        numba.set_num_threads(2)
-        try:
-            assert numba.get_num_threads() == 2
-            test_kernel_equals_the_reference_path()
-        finally:
-            numba.set_num_threads(before)
+    if numba.config.NUMBA_NUM_THREADS >= max(THREADS):
+        kernel_equals_the_reference_path()
         return
     environment = {**os.environ, "NUMBA_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"}
     done = subprocess.run([sys.executable, "-c", ON_TWO_THREADS], env=environment, capture_output=True, text=True,

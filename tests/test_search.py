@@ -5,6 +5,7 @@ objectives (the grid evaluated in full in the test, through the same design eval
 from __future__ import annotations
 
 import datetime as dt
+import functools
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ from hypothesis import strategies as st
 import foldopt
 from foldopt.engine.search import Axis, grid_search
 from foldopt.inputs.plan import make_plan
-from foldopt.studies.designs import Blocks, design_hours
+from foldopt.studies.designs import Blocks, _orientations, requested_hours
 from foldopt.studies.objectives import objective_quantum
 from foldopt.studies.objectives import objective_value
 
@@ -182,6 +183,22 @@ def test_several_targets_each_get_their_own_best():
 STEP_MIN = 10.0
 
 
+def _axes(equator):
+    """The fold angle x tilt x azimuth grid searched around the equator's azimuth [deg]."""
+    return [Axis("fold_angle", 10, 180, 2), Axis("tilt", 0, 90, 3), Axis("azimuth", equator - 60, equator + 60, 6)]
+
+
+@functools.cache
+def _grid(equator):
+    """:func:`_axes`' full grid and its designs' sub-panel orientations, worked out once for each
+    azimuth as the design evaluation works them out (:func:`foldopt.studies.designs.requested_hours`;
+    one geometry call per tilt and azimuth, most of a brute force's time), and read by the search's
+    points as :func:`foldopt.studies.joint.optimize_plan` reads its grid's."""
+    axes = _axes(equator)
+    points = _full_grid(axes)
+    return axes, points, _orientations("hinge", points[:, 0], points[:, 1], points[:, 2] % 360.0)
+
+
 def _objective(latitude, longitude, dates, loads, statistic):
     data = {**foldopt.default_study().data(), "mode": "exact", "sky": "ineichen", "step_min": STEP_MIN,
             "site": {"latitude": latitude, "longitude": longitude}, "geometry": "hinge"}
@@ -189,9 +206,14 @@ def _objective(latitude, longitude, dates, loads, statistic):
     blocks = Blocks.of_dates(study, dates)
     parts = [(blocks[part], blocks[part].sky()) for part in blocks.chunks(len(loads))]
     months = np.array([date.month for date in dates])
+    axes, _, orientations = _grid(study.panel.azimuth)
 
     def evaluate(points):
-        return objective_value(design_hours(parts, points, loads), months, statistic)
+        at = [np.searchsorted(axis.values(), points[:, k]) for k, axis in enumerate(axes)]
+        every = np.arange(sum(sky.n_blocks for _, sky in parts))
+        chosen = orientations[np.ravel_multi_index(at, [axis.size for axis in axes])]
+        hours = requested_hours(parts, [(every, points)], loads, orientations=[chosen])[0][0]
+        return objective_value(hours, months, statistic)
 
     return study, evaluate
 
@@ -206,11 +228,10 @@ def test_the_study_objective_matches_the_brute_force_grid(latitude, longitude, d
     dates = [dt.date(2025, 1, 1) + dt.timedelta(days=day - 1 + 5 * k) for k in range(n_days)]
     loads = np.asarray(loads)
     study, evaluate = _objective(latitude, longitude, dates, loads, statistic)
-    equator = study.panel.azimuth
-    axes = [Axis("fold_angle", 10, 180, 2), Axis("tilt", 0, 90, 3), Axis("azimuth", equator - 60, equator + 60, 6)]
     months = np.array([date.month for date in dates])
+    axes, points, _ = _grid(study.panel.azimuth)
     result = grid_search(evaluate, axes, 0.01, quantum=objective_quantum(statistic, STEP_MIN / 60, n_days, months))
-    brute = evaluate(_full_grid(axes)).max(axis=0)
+    brute = evaluate(points).max(axis=0)
     np.testing.assert_array_less(brute - result.best_value, result.tolerance + 1e-9)
     assert np.all(result.best_value <= brute + 1e-9)
 

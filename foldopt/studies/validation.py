@@ -57,11 +57,10 @@ def hourly_means(frame: pd.DataFrame) -> pd.DataFrame:
     return hours
 
 
-def _design_hours(study: Study, date, loads, members: int = 1):
-    """(members, loads, designs) t_solar and (loads,) fold angles of one day's blocks: the twofold
-    panel at each member's own best angle without an ensemble, at the ensemble's with one."""
-    blocks = Blocks.of_dates(study, [date])
-    sky = blocks.sky()
+def _design_hours(blocks: Blocks, sky, loads):
+    """(members, loads, designs) t_solar and (loads,) fold angles of one day's blocks and their sky:
+    the twofold panel at each member's own best angle without an ensemble, at the ensemble's with
+    one."""
     fold_angles, hours, _ = fold_hours(sky, blocks, loads)  # (members, angles, loads)
     hours = hours.transpose(0, 2, 1)
     chosen = best_angle_index(hours.mean(axis=0))  # (loads,)
@@ -135,12 +134,13 @@ def minute_validation(study: Study, loads, members: int = 20, seed: int = 0) -> 
                     date=day.isoformat(),
                 )
             )
+            # Each sky built once: the designs' hours and the spread of its GHI read the same.
+            skies = {name: _day(of, day) for name, of in (("measured", study), ("smooth", hourly))}
             sources = {
-                "measured": _design_hours(study, day, loads),
-                "smooth": _design_hours(hourly, day, loads),
-                "ensemble": _design_hours(ensemble, day, loads, members),
+                **{name: _design_hours(*blocks_sky, loads) for name, blocks_sky in skies.items()},
+                "ensemble": _design_hours(*_day(ensemble, day), loads),
             }
-            spread = {"measured": _spread(study, day), "smooth": _spread(hourly, day)}
+            spread = {name: _spread(sky) for name, (_, sky) in skies.items()}
             for index, load in enumerate(loads):
                 for design in COMPARED:
                     d = DESIGNS.index(design)
@@ -171,9 +171,14 @@ def minute_validation(study: Study, loads, members: int = 20, seed: int = 0) -> 
     return pd.DataFrame(rows)
 
 
-def _spread(study: Study, day) -> float:
+def _day(study: Study, day):
+    """One day's blocks of ``study`` and their sky."""
+    blocks = Blocks.of_dates(study, [day])
+    return blocks, blocks.sky()
+
+
+def _spread(sky) -> float:
     """The mean over a day's lit hours of the standard deviation of GHI within each hour [W/m^2]."""
-    sky = Blocks.of_dates(study, [day]).sky()
     per_hour = round(1.0 / sky.step_hours)
     ghi = sky.ghi[0].reshape(24, per_hour)
     lit = (ghi > 0).all(axis=1)
