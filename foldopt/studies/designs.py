@@ -26,6 +26,7 @@ import numpy as np
 from foldopt.engine import evaluation as engines
 from foldopt.engine.choice import engine_for
 from foldopt.physics.connections import CONNECTIONS
+from foldopt.physics.geometry import subpanel_orientation
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.engine.sky import Sky
@@ -766,7 +767,7 @@ def requested_hours(
         if loadset is None
         else loadset
     )
-    # Every request's orientations in one call (one geometry call per distinct base).
+    # Every request's orientations in one call.
     every = np.concatenate([points for _, points in requests])
     if orientations is not None:
         table = np.concatenate([np.asarray(given, dtype=float) for given in orientations])
@@ -834,14 +835,7 @@ def requested_hours(
 
 
 def _orientations(geometry: str, fold_angle, tilt, azimuth) -> np.ndarray:
-    """(n, 4) the sub-panels' orientation of each design: one geometry call per distinct base."""
-    bases = np.stack([tilt, azimuth], axis=-1)
-    unique, inverse = np.unique(bases, axis=0, return_inverse=True)
-    inverse = np.ravel(inverse)
-    orientation = np.empty((fold_angle.size, 4))
-    for index, (base_tilt, base_azimuth) in enumerate(unique):
-        take = inverse == index
-        orientation[take] = engines.fold_orientations(
-            geometry, [base_tilt], [base_azimuth], fold_angle[take]
-        )[0]
-    return orientation
+    """(n, 4) the sub-panels' orientation of each design, in one geometry call over the designs."""
+    sides = subpanel_orientation(fold_angle, tilt, azimuth, geometry)
+    parts = ("tilt_east", "azimuth_east", "tilt_west", "azimuth_west")
+    return np.stack([sides[f"surface_{part}"] for part in parts], axis=-1)
