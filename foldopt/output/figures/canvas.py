@@ -6,10 +6,12 @@ its own figure: a pyplot figure, which a notebook shows, or inside :func:`for_fi
 :class:`matplotlib.figure.Figure`, which needs no backend and no pyplot (a PNG is drawn by Agg
 whatever backend the user chose), so that writing a results folder changes nothing of theirs.
 
-A file's figure is made at the file's resolution (:data:`DPI`) on its own Agg canvas, so that its
-layout and its draw measure text with one renderer. Its layout is the fixed :class:`Margins` its
-registry entry gives, where they serve (one Axes whose labels' size is known: a figure of one day);
-otherwise ``tight_layout``, which measures every label once more before the draw.
+A file's figure is made at the file's resolution (:data:`DPI`) on its own Agg canvas, whose
+renderer is the one every figure of its size drawn in the thread shares
+(:func:`_shared_renderer_canvas`), so that its layout and its draw, and the figures after it,
+measure a label's text once. Its layout is the fixed :class:`Margins` its registry entry gives,
+where they serve (one Axes whose labels' size is known: a figure of one day); otherwise the tight
+layout, which measures every label once more before the draw.
 """
 
 from __future__ import annotations
@@ -189,27 +191,35 @@ def new_axes(
     return plt.subplots(nrows, ncols, figsize=figsize, squeeze=squeeze)
 
 
-#: This thread's Agg renderers, by (width, height) [px] and dpi: see :func:`_shared_renderer_canvas`.
+#: This thread's Agg renderers, by (width, height) [px] and dpi, the last used last: see
+#: :func:`_shared_renderer_canvas`.
 _RENDERERS = threading.local()
+
+#: The most renderers a thread keeps (a figure's size follows its loads and sites: a process that
+#: writes many folders meets many sizes; each keeps a pixel buffer of some 2-7 MB).
+RENDERERS_KEPT = 8
 
 
 @functools.cache
 def _shared_renderer_canvas():
     """The Agg canvas class of a file's figure: every figure of one size drawn in a thread draws on
-    that thread's one renderer of that size. matplotlib keeps the text metrics it measures per
-    renderer: with a new renderer a figure, every label's glyphs were laid out afresh by FreeType
-    each figure (some 0.2-0.9 ms a string). A figure is drawn whole by ``savefig`` before its
-    pixels are read, so that one figure's draw never sees another's pixels."""
+    that thread's one renderer of that size (the last :data:`RENDERERS_KEPT` sizes kept).
+    matplotlib keeps the text metrics it measures per renderer, and laying out a label's glyphs
+    with FreeType is the dearest part of a label: a new renderer a figure measured the same tick
+    labels, titles and legends again in every figure. ``savefig`` clears and draws the whole
+    figure before it reads the pixels, so that no figure's pixels are another's."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
 
     class SharedRendererCanvas(FigureCanvasAgg):
         def get_renderer(self):
             key = (*self.get_width_height(physical=True), self.figure.dpi)
             renderers = _RENDERERS.__dict__.setdefault("by_size", {})
-            if key not in renderers:
-                renderers[key] = RendererAgg(*key)
-            self.renderer, self._lastKey = renderers[key], key
-            return self.renderer
+            renderer = renderers.pop(key, None) or RendererAgg(*key)
+            renderers[key] = renderer
+            if len(renderers) > RENDERERS_KEPT:
+                del renderers[next(iter(renderers))]
+            self.renderer, self._lastKey = renderer, key
+            return renderer
 
     return SharedRendererCanvas
 
