@@ -316,6 +316,8 @@ SHIPPED = {"shin2015": ["run", "-q"], "camera-buffer": ["run", "configs/camera-b
 @pytest.mark.skipif(sys.platform != "linux", reason="the probe sets a command's cores on Linux")
 @pytest.mark.parametrize("config", SHIPPED)
 def test_a_shipped_studys_folder_as_a_user_gets_it(commands, config):
+    """The shipped study's folder, written by the command line's own process on one core, every
+    figure drawn whole: as tests/test_cli_studies.py checks every other shipped study's."""
     from test_cli_studies import RUN_ELSEWHERE, assert_a_users_folder
 
     assert RUN_ELSEWHERE[config] == Path(__file__).name
