@@ -1,6 +1,7 @@
 """Study files, sweeps, sizing and script output through the command line."""
 
 import json
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -15,6 +16,8 @@ runner = CliRunner()
 #: Shipped studies a test of their own runs as a user does (and checks the same folder of): each
 #: run once in the suite.
 RUN_ELSEWHERE = {"camera-winter": "test_camera_winter.py", "pvgis-offgrid": "test_pvgis_offgrid.py"}
+if sys.platform == "linux":  # where test_figure_pool.py's commands run (they set their cores)
+    RUN_ELSEWHERE |= {name: "test_figure_pool.py" for name in ("shin2015", "camera-buffer")}
 CONFIGS = sorted(
     path
     for path in Path(__file__).resolve().parent.parent.joinpath("configs").glob("*.yaml")

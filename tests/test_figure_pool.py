@@ -307,6 +307,29 @@ def test_the_workers_write_the_bytes_the_command_draws_itself(commands, args):
     assert seen[1] == seen[2]
 
 
+#: The shipped studies whose folder, as a user gets it, the module's commands write on one core
+#: (every figure drawn whole in the command's process), checked here: tests/test_cli_studies.py
+#: does not run them again (its RUN_ELSEWHERE). ``foldopt run`` runs configs/shin2015.yaml.
+SHIPPED = {"shin2015": ["run", "-q"], "camera-buffer": ["run", "configs/camera-buffer.yaml"]}
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="the probe sets a command's cores on Linux")
+@pytest.mark.parametrize("config", SHIPPED)
+def test_a_shipped_studys_folder_as_a_user_gets_it(commands, config):
+    """The shipped study's folder, written by the command line's own process on one core, every
+    figure drawn whole: as tests/test_cli_studies.py checks every other shipped study's."""
+    from test_cli_studies import RUN_ELSEWHERE, assert_a_users_folder
+
+    assert RUN_ELSEWHERE[config] == Path(__file__).name
+    if config == "shin2015":  # the study of a bare `foldopt run`
+        from foldopt.studies.request import make_request
+
+        assert Path(make_request("run", None).source) == Path("configs/shin2015.yaml")
+    ran, out = commands(SHIPPED[config], 1)
+    assert ran.code == 0, ran.stderr
+    assert_a_users_folder(out)
+
+
 @needs_two_cores
 def test_a_figure_that_fails_fails_the_command_as_it_does_without_workers(server, tmp_path):
     """A figure that raises in a worker ends the command with the one line and the exit code it

@@ -355,3 +355,36 @@ def test_a_landscape_of_one_fold_angle_or_one_tilt_is_the_objectives_line(fixed)
     assert (default.get_xdata()[0], default.get_ydata()[0]) == (15.0, 9.4)
     assert ax.get_ylabel() == "objective [h]"
     plt.close(fig)
+
+
+def _weather_minutes(seed: int) -> tuple:
+    """weather_minutes.png's arguments: a day of five members' GHI (laid out by its labels)."""
+    ghi = np.random.default_rng(seed).uniform(0, 900, (5, 96))
+    return ({"date": "2025-06-01", "hours": np.arange(96) / 4 + 0.125, "kind": "members", "ghi": ghi,
+             "hourly_ghi": np.full(24, 300.0)}, "t"), {}
+
+
+@pytest.mark.figure_pixels  # the pixels are what is compared
+def test_a_figure_file_is_drawn_once_and_its_pixels_are_its_own(monkeypatch):
+    """A file's figure laid out by its labels is drawn once (savefig drew it twice), and figures of
+    one size share their thread's renderer without sharing pixels: a figure's bytes are the same
+    after another figure of its size as drawn first in a thread of its own."""
+    import threading
+
+    from matplotlib.figure import Figure
+
+    from foldopt.output.figures import figure_bytes
+
+    assert FIGURES["weather_minutes.png"].margins is None
+    draws = []
+    draw = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda figure, renderer: draws.append(figure) or draw(figure, renderer))
+    first = figure_bytes("weather_minutes.png", *_weather_minutes(0))
+    assert len(draws) == 1
+    other = figure_bytes("weather_minutes.png", *_weather_minutes(1))
+    assert other != first and figure_bytes("weather_minutes.png", *_weather_minutes(0)) == first
+    alone = []
+    thread = threading.Thread(target=lambda: alone.append(figure_bytes("weather_minutes.png", *_weather_minutes(0))))
+    thread.start()
+    thread.join()
+    assert alone == [first]

@@ -6,19 +6,23 @@ its own figure: a pyplot figure, which a notebook shows, or inside :func:`for_fi
 :class:`matplotlib.figure.Figure`, which needs no backend and no pyplot (a PNG is drawn by Agg
 whatever backend the user chose), so that writing a results folder changes nothing of theirs.
 
-A file's figure is made at the file's resolution (:data:`DPI`) on its own Agg canvas, so that its
-layout and its draw measure text with one renderer. Its layout is the fixed :class:`Margins` its
-registry entry gives, where they serve (one Axes whose labels' size is known: a figure of one day);
-otherwise ``tight_layout``, which measures every label once more before the draw.
+A file's figure is made at the file's resolution (:data:`DPI`) on its own Agg canvas, whose
+renderer is the one every figure of its size drawn in the thread shares
+(:func:`_shared_renderer_canvas`), so that its layout and its draw, and the figures after it,
+measure a label's text once. Its layout is the fixed :class:`Margins` its registry entry gives,
+where they serve (one Axes whose labels' size is known: a figure of one day); otherwise the tight
+layout, which measures every label once more before the draw.
 """
 
 from __future__ import annotations
 
 import atexit
 import contextvars
+import functools
 import os
 import shutil
 import tempfile
+import threading
 from collections.abc import Callable
 from contextlib import contextmanager
 from pathlib import Path
@@ -177,15 +181,47 @@ def new_axes(
         return ax.figure, ax
     load_matplotlib()
     if _FOR_FILES.get():
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
         fig = Figure(figsize=figsize, dpi=DPI)
-        FigureCanvasAgg(fig)
+        _shared_renderer_canvas()(fig)
         return fig, fig.subplots(nrows, ncols, squeeze=squeeze)
     import matplotlib.pyplot as plt
 
     return plt.subplots(nrows, ncols, figsize=figsize, squeeze=squeeze)
+
+
+#: This thread's Agg renderers, by (width, height) [px] and dpi, the last used last: see
+#: :func:`_shared_renderer_canvas`.
+_RENDERERS = threading.local()
+
+#: The most renderers a thread keeps (a figure's size follows its loads and sites: a process that
+#: writes many folders meets many sizes; each keeps a pixel buffer of some 2-7 MB).
+RENDERERS_KEPT = 8
+
+
+@functools.cache
+def _shared_renderer_canvas():
+    """The Agg canvas class of a file's figure: every figure of one size drawn in a thread draws on
+    that thread's one renderer of that size (the last :data:`RENDERERS_KEPT` sizes kept).
+    matplotlib keeps the text metrics it measures per renderer, and laying out a label's glyphs
+    with FreeType is the dearest part of a label: a new renderer a figure measured the same tick
+    labels, titles and legends again in every figure. ``savefig`` clears and draws the whole
+    figure before it reads the pixels, so that no figure's pixels are another's."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
+
+    class SharedRendererCanvas(FigureCanvasAgg):
+        def get_renderer(self):
+            key = (*self.get_width_height(physical=True), self.figure.dpi)
+            renderers = _RENDERERS.__dict__.setdefault("by_size", {})
+            renderer = renderers.pop(key, None) or RendererAgg(*key)
+            renderers[key] = renderer
+            if len(renderers) > RENDERERS_KEPT:
+                del renderers[next(iter(renderers))]
+            self.renderer, self._lastKey = renderer, key
+            return renderer
+
+    return SharedRendererCanvas
 
 
 def save_plot(ax, path, margins: Margins | None = None, file_format: str | None = None):
@@ -209,7 +245,11 @@ def save_plot(ax, path, margins: Margins | None = None, file_format: str | None 
     """
     fig = np.ravel(ax)[0].figure
     if margins is None:
-        fig.tight_layout()
+        from matplotlib.layout_engine import TightLayoutEngine
+
+        # The engine run once, not set on the figure (as tight_layout() leaves a placeholder):
+        # savefig lays out, and so draws, a figure that has an engine once more before its draw.
+        TightLayoutEngine().execute(fig)
     else:
         width, height = fig.get_size_inches()
         fig.subplots_adjust(
