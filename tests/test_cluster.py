@@ -55,9 +55,10 @@ SECONDS = 240  # any one run or cluster start
 
 
 def _kill(process) -> None:
-    if process.poll() is None:
+    """End a process of :func:`hand_started`'s (a :class:`multiprocessing.Process`)."""
+    if process.is_alive():
         process.kill()
-        process.wait(timeout=30)
+        process.join(timeout=30)
 
 
 def _wait_for(condition, what: str, seconds: float = SECONDS) -> None:
@@ -267,23 +268,47 @@ def test_a_task_that_fails_is_one_line(tmp_path, scheduler, fault, code, line):
 # --- a cluster started here: a worker killed, then its scheduler --------------------------------------------
 
 
+#: Dask's command line ``MODULE ARGS`` (``python -m MODULE ARGS``) run by a process of
+#: :func:`hand_started`, its output (Dask's records) to /dev/null; a script run by :func:`exec`, so
+#: that the process imports nothing of this module's.
+DASK_COMMAND = """
+import importlib, os, sys
+nowhere = os.open(os.devnull, os.O_WRONLY)
+for stream in (1, 2):
+    os.dup2(nowhere, stream)
+sys.argv = [MODULE, *ARGS]
+importlib.import_module(MODULE).main()
+"""
+
+
 @pytest.fixture(scope="module")
 def hand_started(tmp_path_factory):
     """A scheduler and two single-threaded workers on 127.0.0.1 (without a nanny, so that killing
     one kills the worker): the scheduler file, the workers' processes and the scheduler's. Each
     process the module's own, killed at its end. The workers start with the scheduler: they wait
-    for its file."""
+    for its file. Each is a fork of the server the embedded cluster's workers are forked from
+    (start_worker_server), which imports Dask and the map's task once for the three: spawned, each
+    imported them again (2-3 s of CPU a worker)."""
+    import multiprocessing
+
+    from foldopt.studies.cluster import TASK_MODULES
+    from foldopt.studies.dask_client import start_worker_server
+
+    if not start_worker_server(TASK_MODULES):
+        pytest.skip("no forkserver on this platform")
     scheduler_file = tmp_path_factory.mktemp("cluster") / "scheduler.json"
-    python = [sys.executable, "-m"]
     # Without the dashboard (bokeh's import): nothing looks at it. Its HTTP server on a free port.
-    commands = [[*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)]]
-    commands += 2 * [[*python, "distributed.cli.dask_worker", "--scheduler-file", str(scheduler_file), "--nthreads",
-                      "1", "--no-nanny", "--host", "127.0.0.1"]]
-    processes = []
+    commands = [("distributed.cli.dask_scheduler", ["--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                                                    "--dashboard-address", "127.0.0.1:0", "--scheduler-file",
+                                                    str(scheduler_file)])]
+    commands += 2 * [("distributed.cli.dask_worker", ["--scheduler-file", str(scheduler_file), "--nthreads", "1",
+                                                      "--no-nanny", "--host", "127.0.0.1"])]
+    context, processes = multiprocessing.get_context("forkserver"), []
     try:
         for command in commands:
-            processes.append(subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+            script = {"MODULE": command[0], "ARGS": command[1]}
+            processes.append(context.Process(target=exec, args=(DASK_COMMAND, script), daemon=True))
+            processes[-1].start()
         _wait_for(scheduler_file.exists, "the scheduler's file", 60)
         yield scheduler_file, processes[1:], processes[0]
     finally:
@@ -328,7 +353,7 @@ def worker_killed(hand_started, tmp_path_factory, figures_drawn_elsewhere) -> tu
     out = tmp_path_factory.mktemp("worker-killed") / "map"
 
     def kill():
-        alive = workers[0].poll() is None
+        alive = workers[0].is_alive()
         workers[0].kill()
         return alive, len(_parts(out))
 
