@@ -98,7 +98,9 @@ def direct() -> pd.DataFrame:
 #: so the embedded cluster's workers run it): foldopt's task but for the FAULT, raise (a RuntimeError, an
 #: internal fault), bad-input (a ConfigError, as a weather file broken mid-run raises), die (the worker's
 #: process ends), die-once (the first time only: it makes MARK), none. Where SEEN names a file, each task
-#: first adds a line to it: whether foldopt is quiet in its worker. The map's figures are a PNG of one
+#: first adds a line to it: whether foldopt is quiet in its worker, whether the worker came with every module
+#: a chunk needs imported, and how many threads of its own its parent process (the server it was forked
+#: from) holds. The map's figures are a PNG of one
 #: pixel, not drawn (matplotlib's import and five figures, some 2 s of the client's core): they are
 #: tests/test_figures.py's; what is tested here is the cluster's processes, the terminal and the table.
 FAULTY_TASK = """
@@ -115,8 +117,12 @@ evaluate_chunk = cluster.evaluate_chunk
 def task(study, sites, loads, relative, year, engine):
     if SEEN:
         from foldopt.cache import quiet
+        from foldopt.studies.cluster import TASK_MODULES
+        server = f"/proc/{os.getppid()}"
+        name = open(f"{server}/comm").read()
+        own = sum(open(f"{server}/task/{thread}/comm").read() == name for thread in os.listdir(f"{server}/task"))
         with open(SEEN, "a") as seen:
-            print(quiet(), file=seen)
+            print(quiet(), all(module in sys.modules for module in TASK_MODULES), own, file=seen)
     if FAULT == "raise":
         raise RuntimeError("a fault in the task")
     if FAULT == "bad-input":
@@ -171,10 +177,9 @@ class Resumed:
     lines: list[str]
     stdout: str
     died: bool
-    #: Whether foldopt was quiet in the workers, each task's word: the killed run's (--quiet), the
-    #: resuming run's (not).
-    quiet_killed: list[str]
-    quiet_resuming: list[str]
+    #: What each task said (FAULTY_TASK's SEEN): the killed run's (--quiet), the resuming run's (not).
+    seen_killed: list[list[str]]
+    seen_resuming: list[list[str]]
 
 
 @pytest.fixture(scope="session")
@@ -198,7 +203,7 @@ def resumed(tmp_path_factory) -> Resumed:
     code, lines, stdout = _faulty_map("die-once", folder, [*EMBEDDED, "--resume", "--format", "json"],
                                       SEEN=str(seen_resuming))
     return Resumed(out, before, table_before, refused, code, lines, stdout, (folder / "died").exists(),
-                   seen_killed.read_text().split(), seen_resuming.read_text().split())
+                   *([line.split() for line in seen.read_text().splitlines()] for seen in (seen_killed, seen_resuming)))
 
 
 def test_a_maps_terminal_holds_only_foldopts_lines(resumed):
@@ -216,8 +221,17 @@ def test_quiet_reaches_the_embedded_clusters_workers(resumed):
     """The embedded cluster's worker processes take --quiet as their environment (their notices
     of a cache built again reach the terminal), given to them explicitly: foldopt sets no
     environment variable of its own, and these runs do not inherit FOLDOPT_QUIET."""
-    assert resumed.quiet_killed and set(resumed.quiet_killed) == {"True"}
-    assert resumed.quiet_resuming and set(resumed.quiet_resuming) == {"False"}
+    assert resumed.seen_killed and {quiet for quiet, *_ in resumed.seen_killed} == {"True"}
+    assert resumed.seen_resuming and {quiet for quiet, *_ in resumed.seen_resuming} == {"False"}
+
+
+def test_the_embedded_clusters_workers_are_forked_with_a_chunks_modules(resumed):
+    """The embedded cluster's worker processes (the one the nanny started again too) are forks of
+    a server that imported every module a chunk needs while the client went on
+    (start_worker_server), and that holds a single thread of its own: no BLAS thread (the nanny's
+    environment), nothing that a fork would copy half-way."""
+    seen = resumed.seen_killed + resumed.seen_resuming
+    assert {(preloaded, threads) for _, preloaded, threads in seen} == {("True", "1")}, seen
 
 
 def test_embedded_map_equals_the_computation_without_dask(resumed, direct):

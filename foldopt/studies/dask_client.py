@@ -168,23 +168,37 @@ def start_worker_server(modules: tuple[str, ...] = WORKER_MODULES) -> bool:
     """
     if "forkserver" not in multiprocessing.get_all_start_methods():
         return False
-    import dask
     from multiprocessing import forkserver
 
-    import distributed  # noqa: F401 - its configuration's defaults (the nanny's environment)
-
-    environment = {
-        name: os.environ.get(name, str(value))
-        for name, value in dask.config.get("distributed.nanny.pre-spawn-environ").items()
-        if value is not None
-    }
-    if environment.get("PYTHONHASHSEED") in (None, "0"):
-        environment["PYTHONHASHSEED"] = "6640"  # the nanny's, for hashes equal on every worker
-    os.environ.update(environment)
+    os.environ.update(_nanny_environment())
     # The script this process runs (the command line's), which each worker imports as it starts.
     multiprocessing.get_context("forkserver").set_forkserver_preload(["__main__", *modules])
     forkserver.ensure_running()
     return True
+
+
+def _nanny_environment() -> dict[str, str]:
+    """The variables Dask's nanny sets in this process's environment before it starts a worker
+    process: ``distributed.nanny.pre-spawn-environ`` as configured, over Dask's defaults, and a
+    fixed hash seed. Read without importing distributed, 0.4-1 s that would delay the server."""
+    from importlib.util import find_spec
+
+    import dask
+    import yaml
+
+    defaults = Path(find_spec("distributed").origin).with_name("distributed.yaml")
+    environment = {
+        **yaml.safe_load(defaults.read_text())["distributed"]["nanny"]["pre-spawn-environ"],
+        **dask.config.get("distributed.nanny.pre-spawn-environ", default={}),
+    }
+    environment = {
+        name: os.environ.get(name, str(value))
+        for name, value in environment.items()
+        if value is not None
+    }
+    if environment.get("PYTHONHASHSEED") in (None, "0"):
+        environment["PYTHONHASHSEED"] = "6640"  # the nanny's, for hashes equal on every worker
+    return environment
 
 
 @contextmanager
