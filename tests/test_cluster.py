@@ -98,11 +98,14 @@ def direct() -> pd.DataFrame:
 #: so the embedded cluster's workers run it): foldopt's task but for the FAULT, raise (a RuntimeError, an
 #: internal fault), bad-input (a ConfigError, as a weather file broken mid-run raises), die (the worker's
 #: process ends), die-once (the first time only: it makes MARK), none. Where SEEN names a file, each task
-#: first adds a line to it: whether foldopt is quiet in its worker, whether the worker came with every module
-#: a chunk needs imported, and how many threads of its own its parent process (the server it was forked
-#: from) holds. The map's figures are a PNG of one
-#: pixel, not drawn (matplotlib's import and five figures, some 2 s of the client's core): they are
-#: tests/test_figures.py's; what is tested here is the cluster's processes, the terminal and the table.
+#: adds a line to it, as it ends or before its process does: whether foldopt is quiet in its worker, whether
+#: the worker came with every module a chunk needs imported, how many threads of its own its parent process
+#: (the server it was forked from) holds, and what modules of foldopt's and its heavy dependencies' its
+#: chunk imported ("-": none). The faults that end a task before its chunk start no server importing a
+#: chunk's modules (numba, pvlib, SciPy: 1.5-2 s of CPU): their workers would not use them. The map's
+#: figures are a PNG of one pixel, not drawn (matplotlib's import and five figures, some 2 s of the
+#: client's core): they are tests/test_figures.py's; what is tested here is the cluster's processes, the
+#: terminal and the table.
 FAULTY_TASK = """
 import base64, os, sys
 import foldopt.output.figures as figures
@@ -113,25 +116,32 @@ figures.figure_bytes = lambda file, args, kwargs: base64.b64decode(
 
 FAULT, MARK, SEEN = os.environ["FAULT"], os.environ["MARK"], os.environ.get("SEEN")  # the task takes them along
 evaluate_chunk = cluster.evaluate_chunk
+HEAVY = ("foldopt", "pvlib", "scipy", "pandas", "distributed")
+if FAULT in ("raise", "die"):  # tasks that end before their chunk: workers forked with Dask's modules only
+    cluster.TASK_MODULES = cluster.WORKER_MODULES
 
 def task(study, sites, loads, relative, year, engine):
+    loaded = set(sys.modules)
+    if FAULT == "raise":
+        raise RuntimeError("a fault in the task")
+    if FAULT == "bad-input":
+        from foldopt.errors import ConfigError
+        raise ConfigError(["weather: a file that broke mid-run"])
+    dies = FAULT == "die" or FAULT == "die-once" and not os.path.exists(MARK)
+    table = None if dies else evaluate_chunk(study, sites, loads, relative, year, engine)
     if SEEN:
         from foldopt.cache import quiet
         from foldopt.studies.cluster import TASK_MODULES
         server = f"/proc/{os.getppid()}"
         name = open(f"{server}/comm").read()
         own = sum(open(f"{server}/task/{thread}/comm").read() == name for thread in os.listdir(f"{server}/task"))
+        new = sorted(module for module in set(sys.modules) - loaded if module.split(".")[0] in HEAVY)
         with open(SEEN, "a") as seen:
-            print(quiet(), all(module in sys.modules for module in TASK_MODULES), own, file=seen)
-    if FAULT == "raise":
-        raise RuntimeError("a fault in the task")
-    if FAULT == "bad-input":
-        from foldopt.errors import ConfigError
-        raise ConfigError(["weather: a file that broke mid-run"])
-    if FAULT == "die" or FAULT == "die-once" and not os.path.exists(MARK):
+            print(quiet(), all(module in loaded for module in TASK_MODULES), own, ",".join(new) or "-", file=seen)
+    if dies:
         open(MARK, "w").close()
         os._exit(1)
-    return evaluate_chunk(study, sites, loads, relative, year, engine)
+    return table
 
 cluster.evaluate_chunk = task
 from foldopt.cli.app import app
@@ -228,10 +238,11 @@ def test_quiet_reaches_the_embedded_clusters_workers(resumed):
 def test_the_embedded_clusters_workers_are_forked_with_a_chunks_modules(resumed):
     """The embedded cluster's worker processes (the one the nanny started again too) are forks of
     a server that imported every module a chunk needs while the client went on
-    (start_worker_server), and that holds a single thread of its own: no BLAS thread (the nanny's
-    environment), nothing that a fork would copy half-way."""
+    (start_worker_server: a chunk imports none of foldopt's, pvlib's, SciPy's, pandas' or Dask's),
+    and that holds a single thread of its own: no BLAS thread (the nanny's environment), nothing
+    that a fork would copy half-way."""
     seen = resumed.seen_killed + resumed.seen_resuming
-    assert {(preloaded, threads) for _, preloaded, threads in seen} == {("True", "1")}, seen
+    assert {(preloaded, threads, new) for _, preloaded, threads, new in seen} == {("True", "1", "-")}, seen
 
 
 def test_embedded_map_equals_the_computation_without_dask(resumed, direct):

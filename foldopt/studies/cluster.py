@@ -56,12 +56,11 @@ from foldopt.studies.map_request import MapSpec
 from foldopt.tables import write_csv
 
 PARTS = "parts"
-#: What a chunk's task imports (:func:`evaluate_chunk`), in the order it needs them: the embedded
+#: What a chunk's task imports (:func:`evaluate_chunk`, foldopt's engine on first use): the embedded
 #: cluster's worker processes are forked with them imported (start_worker_server).
 TASK_MODULES = (
     *WORKER_MODULES,
     __name__,
-    "pyarrow.parquet",
     "numba",
     "pvlib",
     "foldopt.studies.worldmap",

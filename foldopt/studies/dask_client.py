@@ -149,10 +149,11 @@ def start_worker_server(modules: tuple[str, ...] = WORKER_MODULES) -> bool:
     The server is started with the environment Dask's nanny gives a worker it spawns
     (``distributed.nanny.pre-spawn-environ``: one BLAS thread, malloc's trim threshold; a fixed
     hash seed), set in this process as the nanny sets it, so that a forked worker computes as a
-    spawned one did. It then holds no thread of Python's, and no BLAS thread; a fork copies its one
-    thread, and the only other thread of its libraries, jemalloc's (pyarrow's allocator), is made
-    again by jemalloc after a fork. Numba's compiled code is loaded by each worker at its first
-    task: a kernel run in the server would start numba's threads before the forks.
+    spawned one did. A fork copies only the thread that forks, so the server runs nothing but
+    imports: it holds no thread of Python's and no BLAS thread, and the only other thread of its
+    libraries, jemalloc's (pyarrow's allocator), is jemalloc's to handle across a fork (its fork
+    handlers hold its locks). Numba's compiled code is loaded by each worker at its first task: a
+    kernel run in the server could start numba's threads before the forks.
 
     Parameters
     ----------
@@ -171,7 +172,8 @@ def start_worker_server(modules: tuple[str, ...] = WORKER_MODULES) -> bool:
     from multiprocessing import forkserver
 
     os.environ.update(_nanny_environment())
-    # The script this process runs (the command line's), which each worker imports as it starts.
+    # The script this process runs (the command line's), imported once there rather than by each
+    # worker as it starts.
     multiprocessing.get_context("forkserver").set_forkserver_preload(["__main__", *modules])
     forkserver.ensure_running()
     return True
