@@ -62,6 +62,10 @@ TASK_MODULES = (
     *WORKER_MODULES,
     __name__,
     "numba",
+    # numba's implementations, which its first compilation imports (a cached kernel's load too)
+    "numba.cpython.listobj",
+    "numba.cpython.charseq",
+    "numba.np.arraymath",
     "pvlib",
     "foldopt.studies.worldmap",
     "foldopt.engine.kernel",

@@ -20,6 +20,7 @@ import logging
 import multiprocessing
 import os
 import re
+import signal
 import socket
 import threading
 import time
@@ -262,7 +263,9 @@ def dask_setup(worker) -> None:
     process exits, every object is frozen (:func:`gc.freeze`), so that the exit's passes of the
     collector walk none, as the command line's own process does
     (:func:`foldopt.cli.process.ending`): over the objects of numba, pandas and pvlib a worker has
-    loaded they took 1-3 s, which the map waits for as it closes its cluster.
+    loaded they took 1-3 s, which the map waits for as it closes its cluster. A terminal's Ctrl-C,
+    which reaches the worker processes too (the command's process group), is the client's to
+    answer (one line; it closes the cluster): a worker interrupted printed its traceback.
 
     Parameters
     ----------
@@ -272,6 +275,8 @@ def dask_setup(worker) -> None:
         logger.setLevel(SILENT)
     warnings.filterwarnings("ignore", module=DASK_WARNINGS)
     atexit.register(gc.freeze)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def check_cluster(scheduler: str | None, workers: int | None) -> None:
