@@ -130,12 +130,12 @@ def task(study, sites, loads, relative, year, engine):
     dies = FAULT == "die" or FAULT == "die-once" and not os.path.exists(MARK)
     table = None if dies else evaluate_chunk(study, sites, loads, relative, year, engine)
     if SEEN:
+        new = sorted(module for module in set(sys.modules) - loaded if module.split(".")[0] in HEAVY)
         from foldopt.cache import quiet
         from foldopt.studies.cluster import TASK_MODULES
         server = f"/proc/{os.getppid()}"
         name = open(f"{server}/comm").read()
         own = sum(open(f"{server}/task/{thread}/comm").read() == name for thread in os.listdir(f"{server}/task"))
-        new = sorted(module for module in set(sys.modules) - loaded if module.split(".")[0] in HEAVY)
         with open(SEEN, "a") as seen:
             print(quiet(), all(module in loaded for module in TASK_MODULES), own, ",".join(new) or "-", file=seen)
     if dies:
