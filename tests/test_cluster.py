@@ -55,9 +55,10 @@ SECONDS = 240  # any one run or cluster start
 
 
 def _kill(process) -> None:
-    if process.poll() is None:
+    """End a process of :func:`hand_started`'s (a :class:`multiprocessing.Process`)."""
+    if process.is_alive():
         process.kill()
-        process.wait(timeout=30)
+        process.join(timeout=30)
 
 
 def _wait_for(condition, what: str, seconds: float = SECONDS) -> None:
@@ -97,9 +98,14 @@ def direct() -> pd.DataFrame:
 #: so the embedded cluster's workers run it): foldopt's task but for the FAULT, raise (a RuntimeError, an
 #: internal fault), bad-input (a ConfigError, as a weather file broken mid-run raises), die (the worker's
 #: process ends), die-once (the first time only: it makes MARK), none. Where SEEN names a file, each task
-#: first adds a line to it: whether foldopt is quiet in its worker. The map's figures are a PNG of one
-#: pixel, not drawn (matplotlib's import and five figures, some 2 s of the client's core): they are
-#: tests/test_figures.py's; what is tested here is the cluster's processes, the terminal and the table.
+#: adds a line to it, as it ends or before its process does: whether foldopt is quiet in its worker, whether
+#: the worker came with every module a chunk needs imported, how many threads of its own its parent process
+#: (the server it was forked from) holds, and what modules of foldopt's and its heavy dependencies' its
+#: chunk imported ("-": none). The faults that end a task before its chunk start no server importing a
+#: chunk's modules (numba, pvlib, SciPy: 1.5-2 s of CPU): their workers would not use them. The map's
+#: figures are a PNG of one pixel, not drawn (matplotlib's import and five figures, some 2 s of the
+#: client's core): they are tests/test_figures.py's; what is tested here is the cluster's processes, the
+#: terminal and the table.
 FAULTY_TASK = """
 import base64, os, sys
 import foldopt.output.figures as figures
@@ -110,21 +116,32 @@ figures.figure_bytes = lambda file, args, kwargs: base64.b64decode(
 
 FAULT, MARK, SEEN = os.environ["FAULT"], os.environ["MARK"], os.environ.get("SEEN")  # the task takes them along
 evaluate_chunk = cluster.evaluate_chunk
+HEAVY = ("foldopt", "pvlib", "scipy", "pandas", "distributed")
+if FAULT in ("raise", "die"):  # tasks that end before their chunk: workers forked with Dask's modules only
+    cluster.TASK_MODULES = cluster.WORKER_MODULES
 
 def task(study, sites, loads, relative, year, engine):
-    if SEEN:
-        from foldopt.cache import quiet
-        with open(SEEN, "a") as seen:
-            print(quiet(), file=seen)
+    loaded = set(sys.modules)
     if FAULT == "raise":
         raise RuntimeError("a fault in the task")
     if FAULT == "bad-input":
         from foldopt.errors import ConfigError
         raise ConfigError(["weather: a file that broke mid-run"])
-    if FAULT == "die" or FAULT == "die-once" and not os.path.exists(MARK):
+    dies = FAULT == "die" or FAULT == "die-once" and not os.path.exists(MARK)
+    table = None if dies else evaluate_chunk(study, sites, loads, relative, year, engine)
+    if SEEN:
+        new = sorted(module for module in set(sys.modules) - loaded if module.split(".")[0] in HEAVY)
+        from foldopt.cache import quiet
+        from foldopt.studies.cluster import TASK_MODULES
+        server = f"/proc/{os.getppid()}"
+        name = open(f"{server}/comm").read()
+        own = sum(open(f"{server}/task/{thread}/comm").read() == name for thread in os.listdir(f"{server}/task"))
+        with open(SEEN, "a") as seen:
+            print(quiet(), all(module in loaded for module in TASK_MODULES), own, ",".join(new) or "-", file=seen)
+    if dies:
         open(MARK, "w").close()
         os._exit(1)
-    return evaluate_chunk(study, sites, loads, relative, year, engine)
+    return table
 
 cluster.evaluate_chunk = task
 from foldopt.cli.app import app
@@ -170,10 +187,9 @@ class Resumed:
     lines: list[str]
     stdout: str
     died: bool
-    #: Whether foldopt was quiet in the workers, each task's word: the killed run's (--quiet), the
-    #: resuming run's (not).
-    quiet_killed: list[str]
-    quiet_resuming: list[str]
+    #: What each task said (FAULTY_TASK's SEEN): the killed run's (--quiet), the resuming run's (not).
+    seen_killed: list[list[str]]
+    seen_resuming: list[list[str]]
 
 
 @pytest.fixture(scope="session")
@@ -197,7 +213,7 @@ def resumed(tmp_path_factory) -> Resumed:
     code, lines, stdout = _faulty_map("die-once", folder, [*EMBEDDED, "--resume", "--format", "json"],
                                       SEEN=str(seen_resuming))
     return Resumed(out, before, table_before, refused, code, lines, stdout, (folder / "died").exists(),
-                   seen_killed.read_text().split(), seen_resuming.read_text().split())
+                   *([line.split() for line in seen.read_text().splitlines()] for seen in (seen_killed, seen_resuming)))
 
 
 def test_a_maps_terminal_holds_only_foldopts_lines(resumed):
@@ -215,8 +231,18 @@ def test_quiet_reaches_the_embedded_clusters_workers(resumed):
     """The embedded cluster's worker processes take --quiet as their environment (their notices
     of a cache built again reach the terminal), given to them explicitly: foldopt sets no
     environment variable of its own, and these runs do not inherit FOLDOPT_QUIET."""
-    assert resumed.quiet_killed and set(resumed.quiet_killed) == {"True"}
-    assert resumed.quiet_resuming and set(resumed.quiet_resuming) == {"False"}
+    assert resumed.seen_killed and {quiet for quiet, *_ in resumed.seen_killed} == {"True"}
+    assert resumed.seen_resuming and {quiet for quiet, *_ in resumed.seen_resuming} == {"False"}
+
+
+def test_the_embedded_clusters_workers_are_forked_with_a_chunks_modules(resumed):
+    """The embedded cluster's worker processes (the one the nanny started again too) are forks of
+    a server that imported every module a chunk needs while the client went on
+    (start_worker_server: a chunk imports none of foldopt's, pvlib's, SciPy's, pandas' or Dask's),
+    and that holds a single thread of its own: no BLAS thread (the nanny's environment), nothing
+    that a fork would copy half-way."""
+    seen = resumed.seen_killed + resumed.seen_resuming
+    assert {(preloaded, threads, new) for _, preloaded, threads, new in seen} == {("True", "1", "-")}, seen
 
 
 def test_embedded_map_equals_the_computation_without_dask(resumed, direct):
@@ -267,23 +293,47 @@ def test_a_task_that_fails_is_one_line(tmp_path, scheduler, fault, code, line):
 # --- a cluster started here: a worker killed, then its scheduler --------------------------------------------
 
 
+#: Dask's command line ``MODULE ARGS`` (``python -m MODULE ARGS``) run by a process of
+#: :func:`hand_started`, its output (Dask's records) to /dev/null; a script run by :func:`exec`, so
+#: that the process imports nothing of this module's.
+DASK_COMMAND = """
+import importlib, os, sys
+nowhere = os.open(os.devnull, os.O_WRONLY)
+for stream in (1, 2):
+    os.dup2(nowhere, stream)
+sys.argv = [MODULE, *ARGS]
+importlib.import_module(MODULE).main()
+"""
+
+
 @pytest.fixture(scope="module")
 def hand_started(tmp_path_factory):
     """A scheduler and two single-threaded workers on 127.0.0.1 (without a nanny, so that killing
     one kills the worker): the scheduler file, the workers' processes and the scheduler's. Each
     process the module's own, killed at its end. The workers start with the scheduler: they wait
-    for its file."""
+    for its file. Each is a fork of the server the embedded cluster's workers are forked from
+    (start_worker_server), which imports Dask and the map's task once for the three: spawned, each
+    imported them again (2-3 s of CPU a worker)."""
+    import multiprocessing
+
+    from foldopt.studies.cluster import TASK_MODULES
+    from foldopt.studies.dask_client import start_worker_server
+
+    if not start_worker_server(TASK_MODULES):
+        pytest.skip("no forkserver on this platform")
     scheduler_file = tmp_path_factory.mktemp("cluster") / "scheduler.json"
-    python = [sys.executable, "-m"]
     # Without the dashboard (bokeh's import): nothing looks at it. Its HTTP server on a free port.
-    commands = [[*python, "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(scheduler_file)]]
-    commands += 2 * [[*python, "distributed.cli.dask_worker", "--scheduler-file", str(scheduler_file), "--nthreads",
-                      "1", "--no-nanny", "--host", "127.0.0.1"]]
-    processes = []
+    commands = [("distributed.cli.dask_scheduler", ["--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                                                    "--dashboard-address", "127.0.0.1:0", "--scheduler-file",
+                                                    str(scheduler_file)])]
+    commands += 2 * [("distributed.cli.dask_worker", ["--scheduler-file", str(scheduler_file), "--nthreads", "1",
+                                                      "--no-nanny", "--host", "127.0.0.1"])]
+    context, processes = multiprocessing.get_context("forkserver"), []
     try:
         for command in commands:
-            processes.append(subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+            script = {"MODULE": command[0], "ARGS": command[1]}
+            processes.append(context.Process(target=exec, args=(DASK_COMMAND, script), daemon=True))
+            processes[-1].start()
         _wait_for(scheduler_file.exists, "the scheduler's file", 60)
         yield scheduler_file, processes[1:], processes[0]
     finally:
@@ -328,7 +378,7 @@ def worker_killed(hand_started, tmp_path_factory, figures_drawn_elsewhere) -> tu
     out = tmp_path_factory.mktemp("worker-killed") / "map"
 
     def kill():
-        alive = workers[0].poll() is None
+        alive = workers[0].is_alive()
         workers[0].kill()
         return alive, len(_parts(out))
 

@@ -45,11 +45,36 @@ from foldopt.files import (
     write_atomically,
     writing,
 )
-from foldopt.studies.dask_client import CONNECT_TIMEOUT, check_cluster, connect
+from foldopt.studies.dask_client import (
+    CONNECT_TIMEOUT,
+    WORKER_MODULES,
+    check_cluster,
+    connect,
+    start_worker_server,
+)
 from foldopt.studies.map_request import MapSpec
 from foldopt.tables import write_csv
 
 PARTS = "parts"
+#: What a chunk's task imports (:func:`evaluate_chunk`, foldopt's engine on first use): the embedded
+#: cluster's worker processes are forked with them imported (start_worker_server).
+TASK_MODULES = (
+    *WORKER_MODULES,
+    __name__,
+    "numba",
+    # numba's implementations, which its first compilation imports (a cached kernel's load too)
+    "numba.cpython.listobj",
+    "numba.cpython.charseq",
+    "numba.np.arraymath",
+    "pvlib",
+    "foldopt.studies.worldmap",
+    "foldopt.engine.kernel",
+    "foldopt.engine.incidence",
+    "foldopt.engine.curve_reduction",
+    "foldopt.physics.clearsky",
+    "foldopt.physics.spa_site",
+    "foldopt.physics.tracker_moves",
+)
 #: Key of the map's digest (:attr:`MapSpec.key`) in the metadata of its Parquet files.
 MAP_KEY = b"foldopt.map_key"
 
@@ -329,6 +354,8 @@ def run_map(
         resuming = in_place and out.exists()
         done = chunks_on_disk(out, spec) if resuming else []
         missing = [index for index in range(len(chunks)) if index not in done]
+        if missing and scheduler is None:
+            start_worker_server(TASK_MODULES)  # its imports beside this process's work
         if progress is not None:
             progress(sum(len(chunks[index]) for index in done), len(spec.sites))
         folder = finals = None

@@ -17,8 +17,10 @@ import atexit
 import gc
 import json
 import logging
+import multiprocessing
 import os
 import re
+import signal
 import socket
 import threading
 import time
@@ -89,24 +91,26 @@ def connect(
 
         if address is None:
             count = workers or os.cpu_count() or 1
-            cluster = LocalCluster(
-                n_workers=count,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address="127.0.0.1:0",
-                silence_logs=SILENT,
-                preload=[__name__],  # dask_setup: the workers' processes log nothing either
-                # --quiet reaches the worker processes' notices (a cache built again) too
-                env={"FOLDOPT_QUIET": "1"} if quiet() else {},
-            )
-            try:
-                with Client(cluster) as client:
-                    yield (
-                        client,
-                        f"embedded LocalCluster, {count} worker process{'es' if count > 1 else ''}",
-                    )
-            finally:
-                cluster.close()
+            with _forked_workers():
+                cluster = LocalCluster(
+                    n_workers=count,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address="127.0.0.1:0",
+                    silence_logs=SILENT,
+                    preload=[__name__],  # dask_setup: the workers' processes log nothing either
+                    # --quiet reaches the worker processes' notices (a cache built again) too
+                    env={"FOLDOPT_QUIET": "1"} if quiet() else {},
+                )
+                try:
+                    with Client(cluster) as client:
+                        yield (
+                            client,
+                            f"embedded LocalCluster, {count} worker process"
+                            f"{'es' if count > 1 else ''}",
+                        )
+                finally:
+                    cluster.close()
             return
         deadline = time.monotonic() + timeout
         check_scheduler(scheduler, address, timeout)
@@ -128,6 +132,90 @@ def connect(
             yield client, f"Dask scheduler {client.scheduler.address}"
         finally:
             client.close()
+
+
+#: The modules the embedded cluster's worker processes import before their first task where no
+#: caller names its own (:func:`start_worker_server`): Dask's worker and its preload, this module.
+WORKER_MODULES = ("distributed", __name__)
+
+
+def start_worker_server(modules: tuple[str, ...] = WORKER_MODULES) -> bool:
+    """Start this process's server of worker processes, once, where the platform has one
+    (multiprocessing's ``forkserver``: Linux and macOS, not Windows): a fresh Python process that
+    imports ``modules`` and then forks each worker process of an embedded cluster
+    (:func:`connect`) whole, its imports done. Started before the cluster is asked for, it imports
+    while this process goes on (its own imports, the scheduler's start) rather than after, as each
+    spawned worker did; a worker the nanny starts again is a fork too.
+
+    The server is started with the environment Dask's nanny gives a worker it spawns
+    (``distributed.nanny.pre-spawn-environ``: one BLAS thread, malloc's trim threshold; a fixed
+    hash seed), set in this process as the nanny sets it, so that a forked worker computes as a
+    spawned one did. A fork copies only the thread that forks, so the server runs nothing but
+    imports: it holds no thread of Python's and no BLAS thread, and the only other thread of its
+    libraries, jemalloc's (pyarrow's allocator), is jemalloc's to handle across a fork (its fork
+    handlers hold its locks). Numba's compiled code is loaded by each worker at its first task: a
+    kernel run in the server could start numba's threads before the forks.
+
+    Parameters
+    ----------
+    modules : tuple of str
+        Modules the server imports (one it cannot import is passed over): those the workers' first
+        task needs (:data:`foldopt.studies.cluster.TASK_MODULES`). Only the first call that starts
+        the server chooses them.
+
+    Returns
+    -------
+    bool
+        Whether the server runs: the embedded cluster's workers are then forked from it.
+    """
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return False
+    from multiprocessing import forkserver
+
+    os.environ.update(_nanny_environment())
+    # The script this process runs (the command line's), imported once there rather than by each
+    # worker as it starts.
+    multiprocessing.get_context("forkserver").set_forkserver_preload(["__main__", *modules])
+    forkserver.ensure_running()
+    return True
+
+
+def _nanny_environment() -> dict[str, str]:
+    """The variables Dask's nanny sets in this process's environment before it starts a worker
+    process: ``distributed.nanny.pre-spawn-environ`` as configured, over Dask's defaults, and a
+    fixed hash seed. Read without importing distributed, 0.4-1 s that would delay the server."""
+    from importlib.util import find_spec
+
+    import dask
+    import yaml
+
+    defaults = Path(find_spec("distributed").origin).with_name("distributed.yaml")
+    environment = {
+        **yaml.safe_load(defaults.read_text())["distributed"]["nanny"]["pre-spawn-environ"],
+        **dask.config.get("distributed.nanny.pre-spawn-environ", default={}),
+    }
+    environment = {
+        name: os.environ.get(name, str(value))
+        for name, value in environment.items()
+        if value is not None
+    }
+    if environment.get("PYTHONHASHSEED") in (None, "0"):
+        environment["PYTHONHASHSEED"] = "6640"  # the nanny's, for hashes equal on every worker
+    return environment
+
+
+@contextmanager
+def _forked_workers():
+    """While the block runs, the embedded cluster's worker processes are forks of
+    :func:`start_worker_server`'s server where it runs (Dask spawns them otherwise): a worker the
+    nanny starts again is forked too."""
+    if not start_worker_server():
+        yield
+        return
+    import dask
+
+    with dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"}):
+        yield
 
 
 @contextmanager
@@ -175,7 +263,9 @@ def dask_setup(worker) -> None:
     process exits, every object is frozen (:func:`gc.freeze`), so that the exit's passes of the
     collector walk none, as the command line's own process does
     (:func:`foldopt.cli.process.ending`): over the objects of numba, pandas and pvlib a worker has
-    loaded they took 1-3 s, which the map waits for as it closes its cluster.
+    loaded they took 1-3 s, which the map waits for as it closes its cluster. A terminal's Ctrl-C,
+    which reaches the worker processes too (the command's process group), is the client's to
+    answer (one line; it closes the cluster): a worker interrupted printed its traceback.
 
     Parameters
     ----------
@@ -185,6 +275,8 @@ def dask_setup(worker) -> None:
         logger.setLevel(SILENT)
     warnings.filterwarnings("ignore", module=DASK_WARNINGS)
     atexit.register(gc.freeze)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def check_cluster(scheduler: str | None, workers: int | None) -> None:
