@@ -177,7 +177,8 @@ def test_only_the_front_door_makes_a_plan_or_a_request():
 _ENVIRONMENT_WRITERS = {"pop", "popitem", "clear", "update", "setdefault", "__setitem__", "__delitem__"}
 #: The one place foldopt writes the environment, and why: matplotlib reads ``MPLCONFIGDIR`` once as
 #: it is first imported, and has no other way to be given a folder; it is deleted at once after.
-_SET_AND_UNDONE = {("foldopt.output.figures.canvas", "_matplotlib_imported")}
+_SET_AND_UNDONE = {("foldopt.output.figures.canvas", "_matplotlib_imported"),
+                   ("foldopt.studies.dask_client", "start_worker_server")}
 
 
 def _environment_writes(module: str) -> list[tuple[int, str | None]]:
@@ -212,7 +213,9 @@ def test_foldopt_sets_no_environment_variable():
     """No state set behind the caller's back (issue 48): --quiet and --offline are context
     variables of foldopt.cache, and no module writes ``os.environ``, but the moment matplotlib is
     first imported (output.figures.canvas), which sets MPLCONFIGDIR and deletes it at once after
-    (tests/test_faults_inputs.py: the environment is as it was)."""
+    (tests/test_faults_inputs.py: the environment is as it was), and the moment the embedded
+    cluster's worker server starts with the environment Dask's nanny gives a worker, restored at
+    once after (tests/test_cluster.py's hand-started cluster: the environment is as it was)."""
     writes = [(module, line, function) for module in MODULES for line, function in _environment_writes(module)]
     assert [f"{module}:{line}" for module, line, function in writes
             if (module, function) not in _SET_AND_UNDONE] == []

@@ -319,8 +319,11 @@ def hand_started(tmp_path_factory):
     from foldopt.studies.cluster import TASK_MODULES
     from foldopt.studies.dask_client import start_worker_server
 
+    environment = dict(os.environ)
     if not start_worker_server(TASK_MODULES):
         pytest.skip("no forkserver on this platform")
+    # The nanny's environment is the server's, not left in this process (an API caller's).
+    assert dict(os.environ) == environment
     scheduler_file = tmp_path_factory.mktemp("cluster") / "scheduler.json"
     # Without the dashboard (bokeh's import): nothing looks at it. Its HTTP server on a free port.
     commands = [("distributed.cli.dask_scheduler", ["--host", "127.0.0.1", "--port", "0", "--no-dashboard",

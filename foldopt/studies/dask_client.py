@@ -148,13 +148,14 @@ def start_worker_server(modules: tuple[str, ...] = WORKER_MODULES) -> bool:
     spawned worker did; a worker the nanny starts again is a fork too.
 
     The server is started with the environment Dask's nanny gives a worker it spawns
-    (``distributed.nanny.pre-spawn-environ``: one BLAS thread, malloc's trim threshold; a fixed
-    hash seed), set in this process as the nanny sets it, so that a forked worker computes as a
-    spawned one did. A fork copies only the thread that forks, so the server runs nothing but
-    imports: it holds no thread of Python's and no BLAS thread, and the only other thread of its
-    libraries, jemalloc's (pyarrow's allocator), is jemalloc's to handle across a fork (its fork
-    handlers hold its locks). Numba's compiled code is loaded by each worker at its first task: a
-    kernel run in the server could start numba's threads before the forks.
+    (``distributed.nanny.pre-spawn-environ``: one BLAS thread, malloc's trim threshold; a fixed hash
+    seed), set in this process's environment only while the server starts (the nanny, too, sets it
+    only while it spawns), so that a forked worker computes as a spawned one did. A fork copies only
+    the thread that forks, so the server runs nothing but imports: it holds no thread of Python's
+    and no BLAS thread, and the only other thread of its libraries, jemalloc's (pyarrow's
+    allocator), is jemalloc's to handle across a fork (its fork handlers hold its locks). Numba's
+    compiled code is loaded by each worker at its first task: a kernel run in the server could start
+    numba's threads before the forks.
 
     Parameters
     ----------
@@ -172,11 +173,20 @@ def start_worker_server(modules: tuple[str, ...] = WORKER_MODULES) -> bool:
         return False
     from multiprocessing import forkserver
 
-    os.environ.update(_nanny_environment())
     # The script this process runs (the command line's), imported once there rather than by each
     # worker as it starts.
     multiprocessing.get_context("forkserver").set_forkserver_preload(["__main__", *modules])
-    forkserver.ensure_running()
+    environment = _nanny_environment()
+    before = {name: os.environ.get(name) for name in environment}
+    os.environ.update(environment)  # the server's, from its start; not left to this process's
+    try:
+        forkserver.ensure_running()
+    finally:
+        for name, value in before.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
     return True
 
 
