@@ -388,3 +388,22 @@ def figures_drawn_elsewhere():
     and answers only: the context manager :func:`_figures_not_drawn`. Drawing a figure, even
     without its pixels, costs a few tenths of a second."""
     return _figures_not_drawn
+
+
+@contextlib.contextmanager
+def _folders_not_written():
+    """Within the block, :func:`foldopt.api.write` (the command line's too) makes the results
+    folder and writes nothing in it."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr("foldopt.api.write", lambda result, out, *args, **kwargs: Path(out).mkdir(
+            parents=True, exist_ok=True))
+        yield
+
+
+@pytest.fixture(scope="session")
+def folders_written_elsewhere():
+    """For a command whose folder the test writes in another run of the same answer, or reads
+    nothing of (its document, its terminal's lines): the context manager
+    :func:`_folders_not_written`. Writing a folder (its tables, series, report and figures) costs
+    most of a day's command."""
+    return _folders_not_written

@@ -128,13 +128,13 @@ def test_one_json_document_and_quiet_silence(tmp_path, command, figures_drawn_el
     ],
     ids=["polar-night", "polar-day", "above-peak", "overcast", "clear"],
 )
-def test_notes_name_the_day(tmp_path, args, note, line, figures_drawn_elsewhere):
+def test_notes_name_the_day(tmp_path, args, note, line, folders_written_elsewhere):
     result = invoke("sweep", "angle", *args, "--angle-step", "10", "--out", tmp_path / "o", "--format", "json")
     assert result.exit_code == 0, result.output
     document = json.loads(result.stdout)
     assert [entry["note"] for entry in document["answer"]["notes"]] == note
     assert {row["note"] for row in document["rows"]} == {"; ".join(note)}
-    with figures_drawn_elsewhere():  # the same answer's figures again
+    with folders_written_elsewhere():  # the same answer's folder again
         text = invoke("sweep", "angle", *args, "--angle-step", "10", "--out", tmp_path / "t").stdout
     assert line in text and (f"note: {note[0]}" in text if note else "note:" not in text)
 

@@ -128,15 +128,19 @@ def test_the_steps_are_the_readmes():
     assert sum(len(FIGURE.findall(step["prose"])) for step in steps) >= 15
 
 
-def test_every_readme_command_runs_in_order_and_prints_what_the_readme_quotes(tmp_path, monkeypatch):
-    import foldopt.api
-
+def test_every_readme_command_runs_in_order_and_prints_what_the_readme_quotes(tmp_path, monkeypatch,
+                                                                             folders_written_elsewhere):
     every = os.environ.get("FOLDOPT_README_ALL") == "1"
     for name in ("configs", "tests"):
         (tmp_path / name).symlink_to(ROOT / name)
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(foldopt.api, "write", lambda result, out, *args, **kwargs: Path(out).mkdir(
-        parents=True, exist_ok=True))
+    with folders_written_elsewhere():
+        _run_the_readme(every)
+
+
+def _run_the_readme(every: bool) -> None:
+    """Run the README's commands in order (every one with ``every``, else all but :data:`SLOW`'s)
+    in the working folder, and assert that they print what it quotes."""
     runner, printed, folders, wrong = CliRunner(), {}, {}, []
     for step in readme_steps():
         if "mention" in step:  # a caption's `foldopt run`: what the command run before printed

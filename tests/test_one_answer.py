@@ -32,16 +32,19 @@ OLD_NAMES = ("pct_of_tracker_t_solar", "t_solar_pct_of_tracker", "t_solar_gain_v
              "twofold_t_solar_h", "mean_h", "p10_h", "min_h", "flat_objective_h", "tracker_objective_h")
 
 
-def cli(tmp_path: Path, *args, terminal: bool = False) -> tuple[dict, Path, str]:
+def cli(tmp_path: Path, *args, terminal=None) -> tuple[dict, Path, str]:
     """Run ``foldopt ARGS --format json`` through the command line's own entry point (in-process:
     what is compared is the command's answer, not a process; a process of its own cost some 4 s of
     interpreter, imports and compiled-code loading a call): its document and folder; and, with
-    ``terminal``, the terminal's text of the same command."""
+    ``terminal`` (conftest's ``folders_written_elsewhere``), the terminal's text of the same
+    command, whose run then writes the folder over the JSON run's (made, not filled: the same
+    answer's folder, tables and figures, written once)."""
     out = tmp_path / "cli"
     args = [*map(str, args), "--out", str(out)]
     runner = CliRunner(env={"COLUMNS": "200"})
     with contextlib.chdir(ROOT):
-        done = runner.invoke(app, [*args, "--format", "json"])
+        with terminal() if terminal else contextlib.nullcontext():
+            done = runner.invoke(app, [*args, "--format", "json"])
         assert done.exit_code == 0, done.output
         text = ""
         if terminal:
@@ -84,8 +87,8 @@ def no_old_names(folder: Path, document: dict) -> None:
         assert f'"{name}"' not in text, name
 
 
-def test_embedded_run(tmp_path):
-    document, folder, terminal = cli(tmp_path, "run", terminal=True)
+def test_embedded_run(tmp_path, folders_written_elsewhere):
+    document, folder, terminal = cli(tmp_path, "run", terminal=folders_written_elsewhere)
     result = foldopt.run(foldopt.default_study())
     same_rows(document, result.summary)
     assert_views_agree(document, folder, terminal, result.answer)
@@ -106,20 +109,20 @@ def test_latitude_sweep_plans_the_same_study(tmp_path):
     assert (result.plan.base.mode, result.plan.base.geometry) == ("exact", "hinge")
 
 
-def test_an_angle_sweep_is_the_api_sweep_over_angle(tmp_path):
+def test_an_angle_sweep_is_the_api_sweep_over_angle(tmp_path, folders_written_elsewhere):
     """``foldopt.sweep(study, "angle", ...)`` runs the request as the command line does: one case is
     a day's study with its refined best angle (it was a one-case plan, its grid's 23 deg for 22.6)."""
     document, folder, terminal = cli(tmp_path, "sweep", "angle", "--lat", "52.5", "--lon", "13.4", "--p-load", "2",
-                                     terminal=True)
+                                     terminal=folders_written_elsewhere)
     result = foldopt.sweep(foldopt.default_study(), "angle", latitude=52.5, longitude=13.4, p_load=2)
     same_rows(document, result.summary)
     assert_views_agree(document, folder, terminal, result.answer)
 
 
-def test_worst_month_year_at_nairobi(tmp_path):
+def test_worst_month_year_at_nairobi(tmp_path, folders_written_elsewhere):
     args = ("--lat", "-1.29", "--lon", "36.82", "--days", "year", "--objective", "worst-month", "--p-load", "3",
             "--step-min", "10")
-    document, folder, terminal = cli(tmp_path, "sweep", "day", *args, terminal=True)
+    document, folder, terminal = cli(tmp_path, "sweep", "day", *args, terminal=folders_written_elsewhere)
     result = foldopt.sweep(foldopt.default_study(), "day", latitude=-1.29, longitude=36.82, date="year",
                            objective="worst-month", p_load=3, step_min=10)
     same_rows(document, result.table)
@@ -194,7 +197,7 @@ def test_size_refuses_what_the_api_refuses(option, parameter, value):
     assert "must be a finite number > 0 and at most" in line
 
 
-def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler):
+def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler, figures_drawn_elsewhere):
     """A map of named sites at the study's load through the command line, and the same request
     made with foldopt.studies.request.make_request and run by foldopt.world_map: the same rows
     to the bit, the same answer, the same things taken from the study; every view carries the
@@ -213,7 +216,8 @@ def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler):
     assert [site["name"] for site in request.plan.sites] == ["quito", "oslo", "sydney"]
     assert isinstance(request.plan.study, foldopt.Study)  # what the map ships to its workers
     monkeypatch.setattr(foldopt.studies.map_request, "map_request", None)  # a second build would fail
-    result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", scheduler=scheduler)
+    with figures_drawn_elsewhere():  # the command line's run drew this answer's maps
+        result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", scheduler=scheduler)
     year = result.table[result.table["period"] == "year"].reset_index(drop=True)
     same_rows(document, year)
     api = json.loads(json.dumps(answer.to_dict()))
