@@ -240,7 +240,7 @@ def _linear_steps(c, code, start, count, scales, east, west, buffer):
             buffer[c, s] = p_east + p_west
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _linear_connections(b, first, n, sets, terms, connections, scales, curves):
     """Every asked connection's power [W] of a PV model without I-V curve (the ideal model's and
     PVWatts': the pairs lose nothing) into ``power[c]`` at steps ``first .. first + n - 1`` of
@@ -259,7 +259,7 @@ def _linear_connections(b, first, n, sets, terms, connections, scales, curves):
             _linear_steps(c, connections[c], start, count, scales, east, west, buffer)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _table_row(b, first, last, sets, pair_tables, connections, settings, curves):
     """Every asked connection's power [W] at steps ``first..last`` into ``power`` from the
     electrical tables (``pair_tables``: the tables' subpanel, parallel and series) at both
@@ -408,6 +408,13 @@ def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
             low[(begin - start + part) // walk] = lowest
             high[(begin - start + part) // walk] = highest
     return harvested, peak
+
+
+@njit(cache=True, _nrt=False)
+def _switching_call(b, first, n, step_table, pair_tables, curves, coordinates):
+    """:func:`_switching_row` called rather than inlined, for :func:`_chunk_rows`, whose rows
+    take it only off the common case (:func:`_chunk_switching` inlines it)."""
+    return _switching_row(b, first, n, step_table, pair_tables, curves, coordinates)
 
 
 @njit(cache=True, inline="always")
@@ -656,7 +663,7 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         elif not with_tables:
             _linear_connections(b, first, n, sets, terms, connections, scales, curves)
         elif switching_alone:
-            harvested, peak = _switching_row(b, first, n, sets[0], pair_tables, curves, coordinates)
+            harvested, peak = _switching_call(b, first, n, sets[0], pair_tables, curves, coordinates)
         else:
             _table_row(b, first, last, sets, pair_tables, connections, settings, curves)
         if curve[r] >= 0:
