@@ -53,7 +53,7 @@ EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
 ZETA_MAX = 4.0  # top of a converter's table in input / rating (foldopt.physics.converter)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _linear(values, position):
     """``values`` linear between nodes at ``position`` >= 0 [nodes]. The index is unsigned: no
     index can wrap around, so the compiled look-up tests no sign."""
@@ -62,7 +62,7 @@ def _linear(values, position):
     return values[index] * (1.0 - weight) + values[index + uint64(1)] * weight
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _bilinear(values, first, second):
     """``values`` bilinear between nodes at ``first``, ``second`` >= 0 [nodes] (unsigned indices,
     as :func:`_linear`'s)."""
@@ -145,7 +145,7 @@ def _built_parts(root_east, root_west, tables, t, need_series):
     return Parts(m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _between(lo, hi, w):
     """:class:`Parts` at ``w`` of the way from ``lo`` to ``hi``."""
     return Parts(
@@ -160,7 +160,7 @@ def _between(lo, hi, w):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _delivered(power, conv_table, conv_rated):
     """What a converter of rating ``conv_rated`` [W] delivers of ``power`` [W], from its table of
     delivered power / rating on nodes uniform in sqrt(input / rating / ZETA_MAX)
@@ -171,7 +171,7 @@ def _delivered(power, conv_table, conv_rated):
     return conv_rated * _linear(conv_table, math.sqrt(zeta / ZETA_MAX) * (conv_table.shape[0] - 1))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _connection_power(
     code, p_east, p_west, p_parallel, p_series, p_panel, converter_efficiency, switch_series
 ):
@@ -417,7 +417,7 @@ def _switching_call(b, first, n, step_table, pair_tables, curves, coordinates):
     return _switching_row(b, first, n, step_table, pair_tables, curves, coordinates)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _built_power(code, parts, p_panel, tables):
     """The power a connection delivers to the load [W] from the :class:`Parts` of
     :func:`_built_parts` (and the whole panel's ``p_panel``): through the converter, or the
