@@ -145,11 +145,17 @@ engine.row_metrics(build_sky(options.sky, [study.site], [study.date]), rows=engi
     "curves": """
 import numpy as np
 from foldopt.engine import evaluation as engine
-from foldopt.engine.curve_reduction import period_means
+from foldopt.engine.curve_reduction import blocked_day, period_means
 from foldopt.engine.incidence import turning_poa
+from foldopt.engine.kernel import _keep_curves
 
+# What both kernel parts call, first, in the argument types they call it with: they find it in the
+# cache (a day's walk by blocks; a row's curves kept).
+one, two = np.zeros(1), np.zeros(2)
+blocked_day(np.zeros(4), (0, 3), np.ones(1), 0.25, np.zeros(4), (one, one), (one, two), np.zeros(1))
+_keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
 # The reduction of given curves (a tracker's, a design's: constant loads and a load profile's
-# alike); the means over periods of days; a tracker's irradiance.
+# alike; the kernel's rows call it too); the means over periods of days; a tracker's irradiance.
 power = np.zeros((2, 96))
 engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba")
 period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))

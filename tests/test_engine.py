@@ -348,14 +348,28 @@ def test_the_kernels_loops_count_no_references():
     holds no call to NRT_incref or NRT_decref."""
     import numba
 
-    from foldopt.engine import curve_reduction, kernel
+    from foldopt.engine import curve_reduction, incidence, kernel
 
     called = (
         kernel._chunk_switching,
         kernel._chunk_rows,
         kernel._built_row,
         kernel._keep_curves,
+        kernel._table_row,
+        kernel._linear_connections,
+        kernel._switching_call,
+        kernel._linear,
+        kernel._bilinear,
+        kernel._between,
+        kernel._delivered,
+        kernel._connection_power,
+        kernel._built_power,
+        incidence.incidence,
         curve_reduction.blocked_day,
+        curve_reduction.day_metrics,
+        curve_reduction._runs,
+        curve_reduction._gather,
+        curve_reduction._per_load,
         curve_reduction._chunk_curves,
     )
     assert [f.py_func.__name__ for f in called if f.targetoptions.get("_nrt") is not False] == []

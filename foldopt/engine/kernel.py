@@ -21,8 +21,16 @@ are indexed as unsigned integers) and that nothing in it depends on a setting kn
 time. So the loops are written once and inlined once per case, each case's settings passed as
 constants (the incidence per mode, diffuse terms and modifier; the power of a model without
 I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
-rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
-loop, not called. The chunk's loops, and the functions they call rather than inline, are compiled
+rows whose scratch is taken once. The common case's chunk (:func:`_chunk_switching`) inlines a
+row's work into its loop; the general one (:func:`_chunk_rows`) calls each of a row's loops
+(the incidence, the power of each kind of circuit, the reduction), each compiled once and
+handed the tuples of arrays it reads: inlined, numba typed, lowered and LLVM optimised them as
+one function several times their size, in a quarter more of the compile, where a call costs
+less than a row's loop over its steps. The small functions of a step (a table's look-up, a
+connection's power, a converter's) are called, not inlined by numba: numba compiles each once
+and LLVM inlines it where it is used; the few that LLVM would leave as calls in a loop over the
+steps (:func:`_pair_powers`, :func:`_built_parts`) numba inlines. The chunk's loops, and the
+functions they call rather than inline, are compiled
 without numba's reference counting (``_nrt=False``): they allocate nothing, every array they see is
 the caller's and lives through the call, and numba would otherwise count each array handed to an
 inlined function, or each view taken (``power[0]``, ``t_solar[r, 0]``), and release it at every
@@ -599,8 +607,8 @@ def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
 
 @njit(cache=True, nogil=True, _nrt=False)
 def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
-    """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work``, the row's
-    functions inlined into it (a thread of :func:`foldopt.engine.records.in_chunks` calls it).
+    """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work`` (a thread
+    of :func:`foldopt.engine.records.in_chunks` calls it).
 
     Each row takes three loops over its lit steps. The first (:func:`foldopt.engine.incidence.incidence`)
     gives both sub-panels' irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) and
@@ -608,9 +616,10 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     connection's power to ``work.power[c, step]``: from the tables (:func:`_table_row`), for a model
     without I-V curve from :func:`_linear_connections`, or with the circuit as built from
     :func:`_built_row`, through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
-    third reduces each power curve to the daily metrics. The row's work is inlined here rather than
-    called: a call that passes the kernel's some thirty arrays is a large share of a short row's
-    time (``docs/performance.rst``)."""
+    third reduces each power curve to the daily metrics. Each loop is a call, handed the tuples of
+    arrays it reads (not the records: a call that passed the kernel's some thirty arrays was a
+    large share of a short row's time), so that numba compiles each apart (the module's
+    docstring)."""
     connections = tables.connections
     n_conn = connections.shape[0]
     with_tables = tables.power_terms.shape[0] == 0
@@ -663,7 +672,9 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         elif not with_tables:
             _linear_connections(b, first, n, sets, terms, connections, scales, curves)
         elif switching_alone:
-            harvested, peak = _switching_call(b, first, n, sets[0], pair_tables, curves, coordinates)
+            harvested, peak = _switching_call(
+                b, first, n, sets[0], pair_tables, curves, coordinates
+            )
         else:
             _table_row(b, first, last, sets, pair_tables, connections, settings, curves)
         if curve[r] >= 0:
