@@ -159,8 +159,9 @@ _keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
 power = np.zeros((2, 96))
 engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba")
 period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))
-turning_poa(np.zeros((1, 1, 3)), np.zeros((1, 3, 1)), np.zeros((1, 1)), np.zeros((1, 1, 1)),
-            np.zeros((1, 2), dtype=np.int64), np.zeros((1, 1)))
+# (its normal a view along the steps, as foldopt.studies.designs.sky_tracker_poa hands it)
+turning_poa(np.moveaxis(np.zeros((2, 3, 2)), 1, -1), np.zeros((2, 3, 2)), np.zeros((2, 2)), np.zeros((2, 1, 2)),
+            np.zeros((2, 2), dtype=np.int64), np.zeros((2, 2)))
 """,
 }
 #: The warm-up's processes (the controller's), to wait for or end at the session's end.
