@@ -98,7 +98,7 @@ WARM_UP = "SUITE_WARM_UP_FOLDER"
 #: compiled them for itself, and again the Dask worker of the first map and the docs build, the
 #: compile costing more than most modules' tests. Three parts run beside the workers, which start
 #: with :data:`BEFORE_THE_WARM_UP`, on one cache: the fold kernel's rows, the longest, alone in its
-#: process; what they share (the sky's passes, the reduction of a day) each part compiles at a
+#: process; what they share (the sky's passes, a day's walk by blocks) each part compiles at a
 #: different time, so that the later finds it in the cache rather than compiling it too.
 WARM_UP_PARTS = {
     "rows": """
@@ -155,7 +155,7 @@ one, two = np.zeros(1), np.zeros(2)
 blocked_day(np.zeros(4), (0, 3), np.ones(1), 0.25, np.zeros(4), (one, one), (one, two), np.zeros(1))
 _keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
 # The reduction of given curves (a tracker's, a design's: constant loads and a load profile's
-# alike; the kernel's rows call it too); the means over periods of days; a tracker's irradiance.
+# alike); the means over periods of days; a tracker's irradiance.
 power = np.zeros((2, 96))
 engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba")
 period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))

@@ -348,7 +348,7 @@ def test_the_kernels_loops_count_no_references():
     holds no call to NRT_incref or NRT_decref."""
     import numba
 
-    from foldopt.engine import curve_reduction, incidence, kernel
+    from foldopt.engine import curve_reduction, kernel
 
     called = (
         kernel._chunk_switching,
@@ -356,7 +356,6 @@ def test_the_kernels_loops_count_no_references():
         kernel._built_row,
         kernel._keep_curves,
         kernel._table_row,
-        kernel._linear_connections,
         kernel._switching_call,
         kernel._linear,
         kernel._bilinear,
@@ -364,9 +363,7 @@ def test_the_kernels_loops_count_no_references():
         kernel._delivered,
         kernel._connection_power,
         kernel._built_power,
-        incidence.incidence,
         curve_reduction.blocked_day,
-        curve_reduction.day_metrics,
         curve_reduction._runs,
         curve_reduction._gather,
         curve_reduction._per_load,

@@ -76,7 +76,7 @@ def _per_load(p, shape, s, use_shape):
     return p / g if g > 0.0 else -math.inf
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, inline="always")
 def day_metrics(power, span, p_load, profile, how, scratch, t_out, cont_out):
     """Daily metrics of one power curve [W] sampled at step centres, of which only steps
     ``first..last`` (``span``) need walking: the power before and after them is that of the first

@@ -153,7 +153,7 @@ def incidence_steps(r, b, start, count, light, panels, case, lit):
             east[s], west[s] = g_east + d_east, g_west + d_west
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, inline="always")
 def incidence(r, b, first, n, arrays, how, tables):
     """Both sub-panels' irradiance at steps ``first .. first + n - 1`` of row ``r`` (over block
     ``b``) into ``east`` and ``west`` (as sqrt(E / E_max) with ``tables``), and their mean incident

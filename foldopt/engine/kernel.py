@@ -21,16 +21,17 @@ are indexed as unsigned integers) and that nothing in it depends on a setting kn
 time. So the loops are written once and inlined once per case, each case's settings passed as
 constants (the incidence per mode, diffuse terms and modifier; the power of a model without
 I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
-rows whose scratch is taken once. The common case's chunk (:func:`_chunk_switching`) inlines a
-row's work into its loop; the general one (:func:`_chunk_rows`) calls each of a row's loops
-(the incidence, the power of each kind of circuit, the reduction), each compiled once and
-handed the tuples of arrays it reads: inlined, numba typed, lowered and LLVM optimised them as
-one function several times their size, in a quarter more of the compile, where a call costs
-less than a row's loop over its steps. The small functions of a step (a table's look-up, a
+rows whose scratch is taken once, and a row's work is inlined into that chunk's loop, not called
+(a call costs some 6 ns an array it is handed, a map's row some 20 %), but for the power of the
+cases that are neither the common one (:func:`_chunk_switching`) nor a map's: the tables' rows
+(:func:`_table_row`, a weather year's), switching's off the common case (:func:`_switching_call`)
+and the circuit as built (:func:`_built_row`) are each called, compiled apart, so that numba does
+not type, lower and LLVM does not optimise them as one function several times their size (the
+compile grows faster than the code). The small functions of a step (a table's look-up, a
 connection's power, a converter's) are called, not inlined by numba: numba compiles each once
-and LLVM inlines it where it is used; the few that LLVM would leave as calls in a loop over the
-steps (:func:`_pair_powers`, :func:`_built_parts`) numba inlines. The chunk's loops, and the
-functions they call rather than inline, are compiled
+and LLVM inlines it where it is used, the same code at a fraction of the compile; the few that
+LLVM would leave as calls in a loop over the steps (:func:`_pair_powers`, :func:`_built_parts`)
+numba inlines. The chunk's loops, and the functions they call rather than inline, are compiled
 without numba's reference counting (``_nrt=False``): they allocate nothing, every array they see is
 the caller's and lives through the call, and numba would otherwise count each array handed to an
 inlined function, or each view taken (``power[0]``, ``t_solar[r, 0]``), and release it at every
@@ -248,7 +249,7 @@ def _linear_steps(c, code, start, count, scales, east, west, buffer):
             buffer[c, s] = p_east + p_west
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, inline="always")
 def _linear_connections(b, first, n, sets, terms, connections, scales, curves):
     """Every asked connection's power [W] of a PV model without I-V curve (the ideal model's and
     PVWatts': the pairs lose nothing) into ``power[c]`` at steps ``first .. first + n - 1`` of
@@ -616,10 +617,10 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     connection's power to ``work.power[c, step]``: from the tables (:func:`_table_row`), for a model
     without I-V curve from :func:`_linear_connections`, or with the circuit as built from
     :func:`_built_row`, through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
-    third reduces each power curve to the daily metrics. Each loop is a call, handed the tuples of
-    arrays it reads (not the records: a call that passed the kernel's some thirty arrays was a
-    large share of a short row's time), so that numba compiles each apart (the module's
-    docstring)."""
+    third reduces each power curve to the daily metrics. The row's work is inlined here rather than
+    called: a call that passes the kernel's some thirty arrays is a large share of a short row's
+    time (``docs/performance.rst``); but for the power of the tables' rows, of switching and of the
+    circuit as built, loops longer than a call, each compiled apart (the module's docstring)."""
     connections = tables.connections
     n_conn = connections.shape[0]
     with_tables = tables.power_terms.shape[0] == 0
