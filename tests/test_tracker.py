@@ -275,3 +275,5 @@ def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitu
     turning_poa(np.moveaxis(along, 1, -1), sun, beam, terms, span, compiled)
     np.testing.assert_array_equal(compiled, reference)
     np.testing.assert_array_equal(sky_tracker_poa(sky, orientation, "numba"), reference)
+    # One array type compiled (the suite's warm-up compiles it too: tests/conftest.py).
+    assert len(turning_poa.signatures) == 1
