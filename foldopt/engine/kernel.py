@@ -22,7 +22,7 @@ time. So the loops are written once and inlined once per case, each case's setti
 constants (the incidence per mode, diffuse terms and modifier; the power of a model without
 I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
 rows whose scratch is taken once, and a row's work is inlined into that chunk's loop, not called
-(a call costs some 6 ns an array it is handed, a map's row some 20 %), but for the power of the
+(a call costs some 6 ns an array it is handed: a map's row 10-25 % more), but for the power of the
 cases that are neither the common one (:func:`_chunk_switching`) nor a map's: the tables' rows
 (:func:`_table_row`, a weather year's), switching's off the common case (:func:`_switching_call`)
 and the circuit as built (:func:`_built_row`) are each called, compiled apart, so that numba does
