@@ -96,9 +96,10 @@ WARM_UP = "SUITE_WARM_UP_FOLDER"
 #: What each warm-up process runs (``python -c``): the numba functions the suite calls, in the
 #: argument types it calls them with, compiled into numba's cache. On a fresh clone each worker
 #: compiled them for itself, and again the Dask worker of the first map and the docs build, the
-#: compile costing more than most modules' tests. Four parts, each compiling what no other does,
-#: run beside the workers, which start with :data:`BEFORE_THE_WARM_UP`: the fold kernel's compile,
-#: the longest, alone in its process.
+#: compile costing more than most modules' tests. Three parts run beside the workers, which start
+#: with :data:`BEFORE_THE_WARM_UP`, on one cache: the fold kernel's rows, the longest, alone in its
+#: process; what they share (the sky's passes, a day's walk by blocks) each part compiles at a
+#: different time, so that the later finds it in the cache rather than compiling it too.
 WARM_UP_PARTS = {
     "rows": """
 import numpy as np
@@ -121,8 +122,13 @@ for name in ("shin2015", "site-as-built"):
 import numpy as np
 from foldopt.engine import evaluation as engine
 from foldopt.engine.sky import build_sky
+from foldopt.engine.storage import Buffer, simulate
 from foldopt.inputs.study import make_study
 from foldopt.studies.engine_options import engine_options
+
+# The buffer's simulation (one series or several, one buffer or one a series alike), first: by its
+# end the rows' part has compiled the sky's passes, which this part's sky then loads.
+simulate(np.ones((1, 96)), 0.5, Buffer(1.0), 0.25, engine="numba")
 
 # The fold kernel's common case (switching alone from one table set, exact incidence, constant loads):
 # every clear-sky study with I-V tables and a year of weather takes it, and until it is compiled
@@ -139,23 +145,23 @@ engine.row_metrics(build_sky(options.sky, [study.site], [study.date]), rows=engi
     "curves": """
 import numpy as np
 from foldopt.engine import evaluation as engine
-from foldopt.engine.curve_reduction import period_means
+from foldopt.engine.curve_reduction import blocked_day, period_means
 from foldopt.engine.incidence import turning_poa
+from foldopt.engine.kernel import _keep_curves
 
+# What both kernel parts call, first, in the argument types they call it with: they find it in the
+# cache (a day's walk by blocks; a row's curves kept).
+one, two = np.zeros(1), np.zeros(2)
+blocked_day(np.zeros(4), (0, 3), np.ones(1), 0.25, np.zeros(4), (one, one), (one, two), np.zeros(1))
+_keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
 # The reduction of given curves (a tracker's, a design's: constant loads and a load profile's
 # alike); the means over periods of days; a tracker's irradiance.
 power = np.zeros((2, 96))
 engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba")
 period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))
-turning_poa(np.zeros((1, 1, 3)), np.zeros((1, 3, 1)), np.zeros((1, 1)), np.zeros((1, 1, 1)),
-            np.zeros((1, 2), dtype=np.int64), np.zeros((1, 1)))
-""",
-    "storage": """
-import numpy as np
-from foldopt.engine.storage import Buffer, simulate
-
-# The buffer's simulation (one series or several, one buffer or one a series alike).
-simulate(np.ones((1, 96)), 0.5, Buffer(1.0), 0.25, engine="numba")
+# (its normal a view along the steps, as foldopt.studies.designs.sky_tracker_poa hands it)
+turning_poa(np.moveaxis(np.zeros((2, 3, 2)), 1, -1), np.zeros((2, 3, 2)), np.zeros((2, 2)), np.zeros((2, 1, 2)),
+            np.zeros((2, 2), dtype=np.int64), np.zeros((2, 2)))
 """,
 }
 #: The warm-up's processes (the controller's), to wait for or end at the session's end.

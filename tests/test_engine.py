@@ -355,7 +355,18 @@ def test_the_kernels_loops_count_no_references():
         kernel._chunk_rows,
         kernel._built_row,
         kernel._keep_curves,
+        kernel._table_row,
+        kernel._switching_call,
+        kernel._linear,
+        kernel._bilinear,
+        kernel._between,
+        kernel._delivered,
+        kernel._connection_power,
+        kernel._built_power,
         curve_reduction.blocked_day,
+        curve_reduction._runs,
+        curve_reduction._gather,
+        curve_reduction._per_load,
         curve_reduction._chunk_curves,
     )
     assert [f.py_func.__name__ for f in called if f.targetoptions.get("_nrt") is not False] == []

@@ -43,7 +43,7 @@ def _walk(loads, position, power):
     return position
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _runs(start_at, lo_at, length, run):
     """Longest runs: a sample below a load ends that load's run (the segment starts a new one);
     loads below the segment's low end run on through it."""
@@ -54,7 +54,7 @@ def _runs(start_at, lo_at, length, run):
         run[j, 0] += length
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _gather(whole, pending_at, pending, lo_at, length):
     """Add ``length`` to the pending sum for ``whole[lo_at]``, writing the previous sum out when
     the index changes."""
@@ -64,7 +64,7 @@ def _gather(whole, pending_at, pending, lo_at, length):
     return lo_at, length
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _per_load(p, shape, s, use_shape):
     """The power against which the loads are compared at step ``s``: the power itself for constant
     loads, or for a load profile P_load(t) = scale x shape(t) the ratio P_pv / shape, so that

@@ -21,8 +21,17 @@ are indexed as unsigned integers) and that nothing in it depends on a setting kn
 time. So the loops are written once and inlined once per case, each case's settings passed as
 constants (the incidence per mode, diffuse terms and modifier; the power of a model without
 I-V curve per connection; the metrics per flag); the parallel loop hands each thread a chunk of
-rows (:func:`_chunk_rows`) whose scratch is taken once, and a row's work is inlined into that chunk's
-loop, not called. The chunk's loops, and the functions they call rather than inline, are compiled
+rows whose scratch is taken once, and a row's work is inlined into that chunk's loop, not called
+(a call costs some 6 ns an array it is handed: a map's row 10-25 % more), but for the power of the
+cases that are neither the common one (:func:`_chunk_switching`) nor a map's: the tables' rows
+(:func:`_table_row`, a weather year's), switching's off the common case (:func:`_switching_call`)
+and the circuit as built (:func:`_built_row`) are each called, compiled apart, so that numba does
+not type, lower and LLVM does not optimise them as one function several times their size (the
+compile grows faster than the code). The small functions of a step (a table's look-up, a
+connection's power, a converter's) are called, not inlined by numba: numba compiles each once
+and LLVM inlines it where it is used, the same code at a fraction of the compile; the few that
+LLVM would leave as calls in a loop over the steps (:func:`_pair_powers`, :func:`_built_parts`)
+numba inlines. The chunk's loops, and the functions they call rather than inline, are compiled
 without numba's reference counting (``_nrt=False``): they allocate nothing, every array they see is
 the caller's and lives through the call, and numba would otherwise count each array handed to an
 inlined function, or each view taken (``power[0]``, ``t_solar[r, 0]``), and release it at every
@@ -53,7 +62,7 @@ EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
 ZETA_MAX = 4.0  # top of a converter's table in input / rating (foldopt.physics.converter)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _linear(values, position):
     """``values`` linear between nodes at ``position`` >= 0 [nodes]. The index is unsigned: no
     index can wrap around, so the compiled look-up tests no sign."""
@@ -62,7 +71,7 @@ def _linear(values, position):
     return values[index] * (1.0 - weight) + values[index + uint64(1)] * weight
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _bilinear(values, first, second):
     """``values`` bilinear between nodes at ``first``, ``second`` >= 0 [nodes] (unsigned indices,
     as :func:`_linear`'s)."""
@@ -145,7 +154,7 @@ def _built_parts(root_east, root_west, tables, t, need_series):
     return Parts(m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _between(lo, hi, w):
     """:class:`Parts` at ``w`` of the way from ``lo`` to ``hi``."""
     return Parts(
@@ -160,7 +169,7 @@ def _between(lo, hi, w):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _delivered(power, conv_table, conv_rated):
     """What a converter of rating ``conv_rated`` [W] delivers of ``power`` [W], from its table of
     delivered power / rating on nodes uniform in sqrt(input / rating / ZETA_MAX)
@@ -171,7 +180,7 @@ def _delivered(power, conv_table, conv_rated):
     return conv_rated * _linear(conv_table, math.sqrt(zeta / ZETA_MAX) * (conv_table.shape[0] - 1))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _connection_power(
     code, p_east, p_west, p_parallel, p_series, p_panel, converter_efficiency, switch_series
 ):
@@ -259,7 +268,7 @@ def _linear_connections(b, first, n, sets, terms, connections, scales, curves):
             _linear_steps(c, connections[c], start, count, scales, east, west, buffer)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def _table_row(b, first, last, sets, pair_tables, connections, settings, curves):
     """Every asked connection's power [W] at steps ``first..last`` into ``power`` from the
     electrical tables (``pair_tables``: the tables' subpanel, parallel and series) at both
@@ -410,7 +419,14 @@ def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
     return harvested, peak
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
+def _switching_call(b, first, n, step_table, pair_tables, curves, coordinates):
+    """:func:`_switching_row` called rather than inlined, for :func:`_chunk_rows`, whose rows
+    take it only off the common case (:func:`_chunk_switching` inlines it)."""
+    return _switching_row(b, first, n, step_table, pair_tables, curves, coordinates)
+
+
+@njit(cache=True, _nrt=False)
 def _built_power(code, parts, p_panel, tables):
     """The power a connection delivers to the load [W] from the :class:`Parts` of
     :func:`_built_parts` (and the whole panel's ``p_panel``): through the converter, or the
@@ -592,8 +608,8 @@ def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
 
 @njit(cache=True, nogil=True, _nrt=False)
 def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
-    """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work``, the row's
-    functions inlined into it (a thread of :func:`foldopt.engine.records.in_chunks` calls it).
+    """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work`` (a thread
+    of :func:`foldopt.engine.records.in_chunks` calls it).
 
     Each row takes three loops over its lit steps. The first (:func:`foldopt.engine.incidence.incidence`)
     gives both sub-panels' irradiance (as sqrt(E / E_max), the tables' coordinate, with tables) and
@@ -603,7 +619,8 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     :func:`_built_row`, through :func:`_built_power`, and a row that keeps its curves copies them to ``out.power``. The
     third reduces each power curve to the daily metrics. The row's work is inlined here rather than
     called: a call that passes the kernel's some thirty arrays is a large share of a short row's
-    time (``docs/performance.rst``)."""
+    time (``docs/performance.rst``); but for the power of the tables' rows, of switching and of the
+    circuit as built, loops longer than a call, each compiled apart (the module's docstring)."""
     connections = tables.connections
     n_conn = connections.shape[0]
     with_tables = tables.power_terms.shape[0] == 0
@@ -656,7 +673,9 @@ def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
         elif not with_tables:
             _linear_connections(b, first, n, sets, terms, connections, scales, curves)
         elif switching_alone:
-            harvested, peak = _switching_row(b, first, n, sets[0], pair_tables, curves, coordinates)
+            harvested, peak = _switching_call(
+                b, first, n, sets[0], pair_tables, curves, coordinates
+            )
         else:
             _table_row(b, first, last, sets, pair_tables, connections, settings, curves)
         if curve[r] >= 0:

@@ -171,6 +171,11 @@ def _at(cold, d, j, column):
     return cold[d if cold.shape[0] > 1 else 0, j if cold.shape[1] > 1 else 0, column]
 
 
+#: Day or segment 0 as an int64, not a literal: numba compiles a function once more for each
+#: literal argument's type (:func:`_levels` thrice).
+FIRST = np.int64(0)
+
+
 @njit(cache=True, error_model="numpy")
 def _levels(par, cold, d, j):
     """Day ``d``'s segment ``j``: the cut-off and the reconnection [Wh] the cold raises
@@ -203,7 +208,7 @@ def _run(curves, par, cold, stored, on, merge, days):
     eta_discharge = par.eta_discharge
     max_discharge = par.max_discharge
     for d in range(n_days):
-        floor, restart = _levels(par, cold, d, 0)
+        floor, restart = _levels(par, cold, d, FIRST)
         on = on or stored >= restart
         flag = 1.0 if on else 0.0
         if merge and state[d, 0] == stored and state[d, 1] == flag:
@@ -344,7 +349,7 @@ def _run(curves, par, cold, stored, on, merge, days):
         )
         row[FULL], row[EMPTY] = 1.0 if full else 0.0, 1.0 if empty else 0.0
         row[DRAWN] = drawn
-    on = on or stored >= _levels(par, cold, 0, 0)[1]
+    on = on or stored >= _levels(par, cold, FIRST, FIRST)[1]
     state[n_days, 0], state[n_days, 1] = stored, 1.0 if on else 0.0
     return stored, on
 
@@ -361,7 +366,7 @@ def _series(curves, par, cold, days, max_iterations, tolerance):
     capacity = par.capacity
     if not math.isnan(par.initial_soc):
         stored = par.initial_soc * capacity
-        on = stored >= _levels(par, cold, 0, 0)[1]
+        on = stored >= _levels(par, cold, FIRST, FIRST)[1]
         # np.bool_, not a literal: numba compiles a function again for a literal argument's type.
         _run(curves, par, cold, stored, on, np.bool_(False), days)
         return 1
