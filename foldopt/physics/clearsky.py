@@ -94,21 +94,27 @@ def _ineichen_terms(
         )
         b_coefficient = 0.664 + 0.163 / fh1
         correction_base = 0.1 + 0.882 / fh1
+        # The turbidity's own terms, worked out again only where it changes (a block's day
+        # takes one or two values: its UTC days'), the same operations on the same values.
+        tl = math.nan
+        above_one = turbid = correction = 0.0
         for s in range(n_steps):
             z = apparent_zenith[b, s]
             if not z < 90.0:
                 continue
+            if linke_turbidity[b, s] != tl:
+                tl = linke_turbidity[b, s]
+                above_one = tl - 1.0
+                turbid = fh1 + fh2 * above_one
+                correction = 1.0 - (0.1 - 0.2 * math.exp(-tl)) / correction_base
             z_rad = math.radians(z)
             cos_z = math.cos(z_rad)
             airmass = 1.0 / (cos_z + 0.50572 * (6.07995 + (90.0 - z)) ** -1.6364)
             absolute = airmass * pressure_ratio
-            tl = linke_turbidity[b, s]
             extra = dni_extra[b, s]
-            g = cg1 * extra * cos_z * max(math.exp(-cg2 * absolute * (fh1 + fh2 * (tl - 1.0))), 0.0)
-            beam = extra * max(b_coefficient * math.exp(-0.09 * absolute * (tl - 1.0)), 0.0)
-            capped = g * min(
-                max((1.0 - (0.1 - 0.2 * math.exp(-tl)) / correction_base) / cos_z, 0.0), 1e20
-            )
+            g = cg1 * extra * cos_z * max(math.exp(-cg2 * absolute * turbid), 0.0)
+            beam = extra * max(b_coefficient * math.exp(-0.09 * absolute * above_one), 0.0)
+            capped = g * min(max(correction / cos_z, 0.0), 1e20)
             d = min(beam, capped)
             diffuse = g - d * cos_z
             dni[b, s], ghi[b, s], dhi[b, s] = d, g, diffuse
