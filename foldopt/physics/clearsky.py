@@ -79,7 +79,8 @@ def _ineichen_terms(
     dhi,
     terms,
 ):
-    """The loop of :func:`ineichen_terms` over blocks and steps; writes only steps with the sun up.
+    """The loop of :func:`ineichen_terms` over blocks and steps; writes 0 where the sun is down
+    (the arrays come uninitialised: zeroing them first is a pass over every step).
     ``error_model="numpy"``: no division or power of the lit steps is by zero (their cosine is
     positive, their air mass finite), and Python's check of each would cost the loop a branch."""
     n_blocks, n_steps = apparent_zenith.shape
@@ -101,6 +102,9 @@ def _ineichen_terms(
         for s in range(n_steps):
             z = apparent_zenith[b, s]
             if not z < 90.0:
+                dni[b, s] = ghi[b, s] = dhi[b, s] = 0.0
+                for k in range(terms.shape[1]):
+                    terms[b, k, s] = 0.0
                 continue
             if linke_turbidity[b, s] != tl:
                 tl = linke_turbidity[b, s]
@@ -205,9 +209,9 @@ def ineichen_terms(
         # Read-only whether given, broadcast or copied: numba compiles the pass again for each
         # array type it is called with, and the pass only reads them.
         array.flags.writeable = False
-    dni, ghi, dhi = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    dni, ghi, dhi = np.empty(shape), np.empty(shape), np.empty(shape)
     code = TRANSPOSITION_CODES[transposition]
-    terms = np.zeros((shape[0], 4 if code else 0, shape[1]))
+    terms = np.empty((shape[0], 4 if code else 0, shape[1]))
     _ineichen_terms(
         *inputs,
         code,

@@ -635,17 +635,19 @@ def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None)
             points[:, 0],
             hours,
             energy,
-            flat[blocks],
-            flat_energy[blocks],
-            gross_h[blocks],
-            net_h[blocks],
-            gross_wh[blocks],
-            available[_days(blocks)],
-            flat_peak[blocks],
+            flat[days],
+            flat_energy[days],
+            gross_h[days],
+            net_h[days],
+            gross_wh[days],
+            available[days],
+            flat_peak[days],
             points[:, 1] if tilted else None,
             flat_tilted,
         )
-        for blocks, (points, hours, energy, flat_tilted) in zip(sites, searched, strict=True)
+        for days, (points, hours, energy, flat_tilted) in zip(
+            map(_days, sites), searched, strict=True
+        )
     ]
 
 
