@@ -108,16 +108,11 @@ def panel_power(sky: Sky, *, poa_global, electrical: ElectricalOptions, area: fl
     """
     area = electrical.area if area is None else area
     power = np.zeros_like(poa_global)
-    lit = None
     for temp, weight in node_weights(sky, slice(None), poa_global.shape):
         cells = electrical_for(electrical, temp, sky.wind_ref)
         take = weight > 0
-        if take.all() and cells.panel_power(np.zeros(1), area)[0] == 0.0:
-            # One table at every step (a sky of one air temperature), whose cells give nothing
-            # without light: the lit steps alone (the dark steps keep the 0 they would add to).
-            lit = poa_global != 0.0 if lit is None else lit
-            power[lit] += weight[lit] * cells.panel_power(poa_global[lit], area)
-        elif take.all():
+        if take.all():
+            # One table at every step (a sky of one air temperature): no copy of the steps.
             power += weight * cells.panel_power(poa_global, area)
         else:
             power[take] += weight[take] * cells.panel_power(poa_global[take], area)
