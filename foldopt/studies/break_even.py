@@ -97,17 +97,26 @@ def break_even_standby(
         if days is not None:
             keep &= days
         walked = np.where(keep[:, None], span, 0)
+        # Each site's loads in ascending order, the order the engine takes them in (it sorts
+        # them): its answers then need no reordering row by row, only each site's own at the end.
+        order = np.argsort(sets, axis=1, kind="stable")
         daily = (
             engines.curve_metrics(
-                available, sets, step_hours, site_of_day, engine=engine, span=walked
+                available,
+                np.take_along_axis(sets, order, axis=1),
+                step_hours,
+                site_of_day,
+                engine=engine,
+                span=walked,
             )
             .t_solar[:, 0]
             .reshape(n_sites, n_days, -1)
         )
         value = np.full((n_sites, n_periods, sets.shape[1]), np.nan)
         for site in np.flatnonzero(count):
+            place = np.argsort(order[site])[: count[site]]  # each load's place among the sorted
             value[site, :, : count[site]] = period_values(
-                np.ascontiguousarray(daily[site, :, : count[site]]),
+                daily[site][:, place],
                 months,
                 statistic,
                 seasons,
