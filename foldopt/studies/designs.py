@@ -830,10 +830,19 @@ def requested_hours(
             for (k, inside, piece), b, n in zip(call, blocks, counts, strict=True):
                 rows = slice(position, position + b.size * n)
                 position = rows.stop
+                inside = _consecutive(inside)
                 out[k][0][inside, piece] = metrics.t_solar[rows, 0].reshape(b.size, n, -1)
                 out[k][1][inside, piece] = metrics.energy[rows, 0].reshape(b.size, n)
         start = stop
     return out
+
+
+def _consecutive(indices):
+    """Ascending indices as a slice where they are consecutive (a map's site's days), so that
+    values are written into their place without an index array; else as they are."""
+    if indices.size and indices[-1] - indices[0] == indices.size - 1:
+        return slice(int(indices[0]), int(indices[-1]) + 1)
+    return indices
 
 
 def _orientations(geometry: str, fold_angle, tilt, azimuth) -> np.ndarray:
