@@ -819,7 +819,7 @@ def requested_hours(
             metrics = engines.row_metrics(
                 sky,
                 rows=engines.PanelRows(
-                    row_block, orientation, row_orientation, loadset[start + row_block]
+                    row_block, orientation, row_orientation, np.take(loadset, start + row_block)
                 ),
                 loads=loads,
                 electrical=options.electrical,
