@@ -402,7 +402,7 @@ def build_sky(
     grid = _clock(sites, dates, options.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, options.mode, sun_terms)
     solar_zenith = sun["solar_zenith"]
-    dni_extra = np.take(extraterrestrial_spencer(np.arange(367)), grid.dayofyear)
+    dni_extra = extraterrestrial_spencer(np.arange(367))[grid.dayofyear]
     temp_air, balance = np.full(len(sites), float(options.temp_air)), None
     temp_steps = wind_speed = wind_ref = terms = None
     notes = ()

@@ -422,9 +422,8 @@ def hour_angle_paper(times: pd.DatetimeIndex, longitude: float):
 
 
 def _by_dayofyear(function, dayofyear):
-    """``function`` of the day of year at every step, evaluated once per day (1..366) and looked up
-    (``take``: NumPy's fancy indexing costs twice as much over a map's steps)."""
-    return np.take(function(np.arange(367)), dayofyear)
+    """``function`` of the day of year at every step, evaluated once per day (1..366) and looked up."""
+    return function(np.arange(367))[dayofyear]
 
 
 def _hour_angle_paper(clock_hours, utc_offset_hours, dayofyear, longitude):
