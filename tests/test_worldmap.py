@@ -92,6 +92,29 @@ def test_break_even_standby_is_where_the_tracker_falls_to_the_twofold_panel(la_m
     assert (table["break_even_standby_tracker_w"] > 0).any()
 
 
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), engine=st.sampled_from(["numba", "numpy"]))
+def test_a_day_below_every_load_carries_none_walked_or_not(seed, engine):
+    """The break-even's passes leave unwalked the days whose power stays below every load of their
+    site (foldopt.studies.break_even): such a day has no time above a load, and the other days'
+    t_solar are the same bits whether it is walked or not."""
+    from foldopt.engine import evaluation as engines
+
+    rng = np.random.default_rng(seed)
+    power = rng.uniform(0.0, 10.0, (8, 48)) * (rng.uniform(size=(8, 48)) > 0.3)
+    power[:3] *= 0.15  # days that reach at most 1.5 W
+    loads = np.sort(rng.uniform(1.5, 12.0, (1, 5)), axis=1)
+    reach = power.max(axis=1)
+    kept = reach >= loads.min()
+    walked = engines.curve_metrics(power, loads, 0.25, engine=engine).t_solar
+    skipped = engines.curve_metrics(
+        power, loads, 0.25, engine=engine, span=np.where(kept[:, None], engines.power_span(power), 0)
+    ).t_solar
+    assert not kept[:3].any()
+    assert (walked[~kept] == 0.0).all()
+    assert np.array_equal(walked, skipped)
+
+
 def test_a_panel_folded_only_to_180_deg_is_the_flat_panel():
     flat_only = {**COARSE, "fold_angles": {"start": 180, "stop": 180, "step": 1}}
     table = evaluate_sites(flat_only, [LA, {"latitude": -45.0, "longitude": 170.0}], [0.2, 0.6], relative=True)

@@ -79,7 +79,8 @@ def _ineichen_terms(
     dhi,
     terms,
 ):
-    """The loop of :func:`ineichen_terms` over blocks and steps; writes only steps with the sun up.
+    """The loop of :func:`ineichen_terms` over blocks and steps; writes 0 where the sun is down
+    (the arrays come uninitialised: zeroing them first is a pass over every step).
     ``error_model="numpy"``: no division or power of the lit steps is by zero (their cosine is
     positive, their air mass finite), and Python's check of each would cost the loop a branch."""
     n_blocks, n_steps = apparent_zenith.shape
@@ -94,21 +95,30 @@ def _ineichen_terms(
         )
         b_coefficient = 0.664 + 0.163 / fh1
         correction_base = 0.1 + 0.882 / fh1
+        # The turbidity's own terms, worked out again only where it changes (a block's day
+        # takes one or two values: its UTC days'), the same operations on the same values.
+        tl = math.nan
+        above_one = turbid = correction = 0.0
         for s in range(n_steps):
             z = apparent_zenith[b, s]
             if not z < 90.0:
+                dni[b, s] = ghi[b, s] = dhi[b, s] = 0.0
+                for k in range(terms.shape[1]):
+                    terms[b, k, s] = 0.0
                 continue
+            if linke_turbidity[b, s] != tl:
+                tl = linke_turbidity[b, s]
+                above_one = tl - 1.0
+                turbid = fh1 + fh2 * above_one
+                correction = 1.0 - (0.1 - 0.2 * math.exp(-tl)) / correction_base
             z_rad = math.radians(z)
             cos_z = math.cos(z_rad)
             airmass = 1.0 / (cos_z + 0.50572 * (6.07995 + (90.0 - z)) ** -1.6364)
             absolute = airmass * pressure_ratio
-            tl = linke_turbidity[b, s]
             extra = dni_extra[b, s]
-            g = cg1 * extra * cos_z * max(math.exp(-cg2 * absolute * (fh1 + fh2 * (tl - 1.0))), 0.0)
-            beam = extra * max(b_coefficient * math.exp(-0.09 * absolute * (tl - 1.0)), 0.0)
-            capped = g * min(
-                max((1.0 - (0.1 - 0.2 * math.exp(-tl)) / correction_base) / cos_z, 0.0), 1e20
-            )
+            g = cg1 * extra * cos_z * max(math.exp(-cg2 * absolute * turbid), 0.0)
+            beam = extra * max(b_coefficient * math.exp(-0.09 * absolute * above_one), 0.0)
+            capped = g * min(max(correction / cos_z, 0.0), 1e20)
             d = min(beam, capped)
             diffuse = g - d * cos_z
             dni[b, s], ghi[b, s], dhi[b, s] = d, g, diffuse
@@ -199,9 +209,9 @@ def ineichen_terms(
         # Read-only whether given, broadcast or copied: numba compiles the pass again for each
         # array type it is called with, and the pass only reads them.
         array.flags.writeable = False
-    dni, ghi, dhi = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    dni, ghi, dhi = np.empty(shape), np.empty(shape), np.empty(shape)
     code = TRANSPOSITION_CODES[transposition]
-    terms = np.zeros((shape[0], 4 if code else 0, shape[1]))
+    terms = np.empty((shape[0], 4 if code else 0, shape[1]))
     _ineichen_terms(
         *inputs,
         code,

@@ -200,10 +200,16 @@ def _dual_axis(solar_zenith, solar_azimuth, hour_angle, declination, latitude, o
         if sun_vector is None
         else np.asarray(sun_vector, dtype=float)
     )
+    # The normal made with its components along the time steps, as the sun's vector is laid out
+    # where it comes from a sky and as the moves and the irradiance read it: no copy across.
+    shape = np.broadcast_shapes(down.shape + (1,), on_sun.shape)
+    normal = np.array(np.moveaxis(np.broadcast_to(on_sun, shape), -1, -2), order="C")
+    for component, level in enumerate(_UP):  # (a mask a component: a third quicker than one where)
+        np.copyto(normal[..., component, :], level, where=down)
     return (
         np.where(down, 0.0, solar_zenith),
         np.where(down, level_azimuth, solar_azimuth),
-        np.where(down[..., None], _UP, on_sun),
+        np.moveaxis(normal, -2, -1),
     )
 
 

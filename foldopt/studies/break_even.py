@@ -81,24 +81,42 @@ def break_even_standby(
     site_of_day = np.repeat(np.arange(n_sites), n_days)
     member = period_days(months, seasons)  # every pass's periods
     span = engines.power_span(available)
+    reach = available.max(axis=1)  # each day's largest power [W]
 
-    def objectives(sets, count):
+    def objectives(sets, count, days=None):
         """(sites, periods, n) every period's objective [h] at each site's first ``count[site]``
         loads of ``sets`` (sites, n) [W], the rest padded with loads no power reaches, so that each
         site's loads go to the engine as its own set and get the same bits whatever other sites
-        ask; a site with none is not walked (NaN)."""
-        walked = np.where((count > 0)[site_of_day, None], span, 0)
+        ask; a site with none is not walked (NaN). ``days`` (sites x days,) bool, where given, the
+        days whose periods the caller reads (the others' objectives are then not the days').
+
+        A day whose power stays below all of its site's loads carries none of them: its t_solar
+        is 0 walked or not (no segment of it reaches a load), so it is not walked."""
+        lowest = np.where(count > 0, sets.min(axis=1, initial=np.inf), np.inf)
+        keep = reach >= lowest[site_of_day]
+        if days is not None:
+            keep &= days
+        walked = np.where(keep[:, None], span, 0)
+        # Each site's loads in ascending order, the order the engine takes them in (it sorts
+        # them): its answers then need no reordering row by row, only each site's own at the end.
+        order = np.argsort(sets, axis=1, kind="stable")
         daily = (
             engines.curve_metrics(
-                available, sets, step_hours, site_of_day, engine=engine, span=walked
+                available,
+                np.take_along_axis(sets, order, axis=1),
+                step_hours,
+                site_of_day,
+                engine=engine,
+                span=walked,
             )
             .t_solar[:, 0]
             .reshape(n_sites, n_days, -1)
         )
         value = np.full((n_sites, n_periods, sets.shape[1]), np.nan)
         for site in np.flatnonzero(count):
+            place = np.argsort(order[site])[: count[site]]  # each load's place among the sorted
             value[site, :, : count[site]] = period_values(
-                np.ascontiguousarray(daily[site, :, : count[site]]),
+                daily[site][:, place],
                 months,
                 statistic,
                 seasons,
@@ -113,7 +131,9 @@ def break_even_standby(
         sets = np.full((n_sites, max(int(count.max()), 1)), np.inf)
         for site in np.flatnonzero(count):
             sets[site, : count[site]] = (p_load[site][None, :] + draws[site])[asked[site]]
-        every = objectives(sets, count)
+        # Only the days of the periods some asked target of the site is of.
+        days = (asked.any(axis=2)[:, :, None] & member[None]).any(axis=1).ravel()
+        every = objectives(sets, count, days)
         value = np.full(targets.shape, np.nan)
         for site in np.flatnonzero(count):
             mine = asked[site]  # each target's own period kept

@@ -635,17 +635,19 @@ def site_designs(parts, sites, loads, engine: str = DEFAULT_ENGINE, search=None)
             points[:, 0],
             hours,
             energy,
-            flat[blocks],
-            flat_energy[blocks],
-            gross_h[blocks],
-            net_h[blocks],
-            gross_wh[blocks],
-            available[_days(blocks)],
-            flat_peak[blocks],
+            flat[days],
+            flat_energy[days],
+            gross_h[days],
+            net_h[days],
+            gross_wh[days],
+            available[days],
+            flat_peak[days],
             points[:, 1] if tilted else None,
             flat_tilted,
         )
-        for blocks, (points, hours, energy, flat_tilted) in zip(sites, searched, strict=True)
+        for days, (points, hours, energy, flat_tilted) in zip(
+            map(_days, sites), searched, strict=True
+        )
     ]
 
 
@@ -817,7 +819,7 @@ def requested_hours(
             metrics = engines.row_metrics(
                 sky,
                 rows=engines.PanelRows(
-                    row_block, orientation, row_orientation, loadset[start + row_block]
+                    row_block, orientation, row_orientation, np.take(loadset, start + row_block)
                 ),
                 loads=loads,
                 electrical=options.electrical,
@@ -828,10 +830,19 @@ def requested_hours(
             for (k, inside, piece), b, n in zip(call, blocks, counts, strict=True):
                 rows = slice(position, position + b.size * n)
                 position = rows.stop
+                inside = _consecutive(inside)
                 out[k][0][inside, piece] = metrics.t_solar[rows, 0].reshape(b.size, n, -1)
                 out[k][1][inside, piece] = metrics.energy[rows, 0].reshape(b.size, n)
         start = stop
     return out
+
+
+def _consecutive(indices):
+    """Ascending indices as a slice where they are consecutive (a map's site's days), so that
+    values are written into their place without an index array; else as they are."""
+    if indices.size and indices[-1] - indices[0] == indices.size - 1:
+        return slice(int(indices[0]), int(indices[-1]) + 1)
+    return indices
 
 
 def _orientations(geometry: str, fold_angle, tilt, azimuth) -> np.ndarray:

@@ -84,8 +84,12 @@ class DesignSearch:
         in ascending order of the first axis, then the next."""
         points = np.concatenate([points for points, _, _ in self.found])
         order = np.lexsort(points.T[::-1])
-        hours = np.concatenate([hours for _, hours, _ in self.found], axis=1)[:, order].transpose(
-            0, 2, 1
+        # Laid out as the statistics over the days read it (a transposed view is copied again
+        # by each of them).
+        hours = np.ascontiguousarray(
+            np.concatenate([hours for _, hours, _ in self.found], axis=1)[:, order].transpose(
+                0, 2, 1
+            )
         )
         energy = np.concatenate([energy for _, _, energy in self.found], axis=1)[:, order]
         return points[order], hours, energy
