@@ -44,13 +44,32 @@ def _metrics(prefix: str, result, out: dict) -> None:
             out[f"{prefix}/{name}"] = np.asarray(value)
 
 
+def _drawn(study, rng, n_blocks: int, bounds: tuple, angles):
+    """The engine's options, a sky of ``n_blocks`` sites and days drawn from ``rng`` (latitudes
+    within ``bounds[0]`` deg of the equator, altitudes up to ``bounds[1]`` m) and its rows at
+    fold ``angles``."""
+    from foldopt.engine import evaluation as engine
+    from foldopt.engine.sky import build_sky
+    from foldopt.studies.engine_options import engine_options
+
+    latitude, altitude = bounds
+    sites = [study.variant(site={"latitude": float(rng.uniform(-latitude, latitude)),
+                                 "longitude": float(rng.uniform(-180, 180)),
+                                 "altitude": float(rng.uniform(0, altitude))}).site for _ in range(n_blocks)]
+    dates = [dt.date(2025, 1, 1) + dt.timedelta(days=int(rng.integers(0, 365))) for _ in range(n_blocks)]
+    options = engine_options(study)
+    resolved = [study.variant(site=site.model_dump()).panel for site in sites]
+    orientation = engine.fold_orientations(study.geometry, [p.tilt for p in resolved],
+                                           [p.azimuth for p in resolved], angles)
+    rows = engine.PanelRows(np.repeat(np.arange(n_blocks), angles.size), orientation.reshape(-1, 4))
+    return options, build_sky(options.sky, sites, dates), rows
+
+
 def _random_cases(out: dict, n_cases: int) -> None:
     import numba
 
     from foldopt.engine import evaluation as engine
-    from foldopt.engine.sky import build_sky
     from foldopt.inputs.study import make_study
-    from foldopt.studies.engine_options import engine_options
 
     rng = np.random.default_rng(49)
     for case in range(n_cases):
@@ -77,18 +96,8 @@ def _random_cases(out: dict, n_cases: int) -> None:
                       "azimuth": None if rng.random() < 0.5 else float(rng.uniform(0, 359.9))},
             "p_load": 1.0, "step_min": int(rng.choice([1, 5, 10, 15])),
         })
-        n_blocks = int(rng.integers(1, 4))
-        sites = [study.variant(site={"latitude": float(rng.uniform(-70, 70)),
-                                     "longitude": float(rng.uniform(-180, 180)),
-                                     "altitude": float(rng.uniform(0, 2000))}).site for _ in range(n_blocks)]
-        dates = [dt.date(2025, 1, 1) + dt.timedelta(days=int(rng.integers(0, 365))) for _ in range(n_blocks)]
         angles = np.r_[rng.uniform(1, 180, int(rng.integers(1, 12))), 180.0]
-        options = engine_options(study)
-        the_sky = build_sky(options.sky, sites, dates)
-        resolved = [study.variant(site=site.model_dump()).panel for site in sites]
-        orientation = engine.fold_orientations(study.geometry, [p.tilt for p in resolved],
-                                               [p.azimuth for p in resolved], angles)
-        rows = engine.PanelRows(np.repeat(np.arange(n_blocks), angles.size), orientation.reshape(-1, 4))
+        options, the_sky, rows = _drawn(study, rng, int(rng.integers(1, 4)), (70.0, 2000.0), angles)
         loads = np.sort(rng.uniform(0.01, 25.0, int(rng.integers(1, 12))))
         contiguous = bool(rng.random() < 0.4)
         for threads in (1, 2):
@@ -106,9 +115,7 @@ def _common_cases(out: dict, n_cases: int) -> None:
     import numba
 
     from foldopt.engine import evaluation as engine
-    from foldopt.engine.sky import build_sky
     from foldopt.inputs.study import make_study
-    from foldopt.studies.engine_options import engine_options
 
     rng = np.random.default_rng(50)
     for case in range(n_cases):
@@ -121,17 +128,8 @@ def _common_cases(out: dict, n_cases: int) -> None:
             "panel": {"area": 0.108, "efficiency": 0.19},
             "step_min": int(rng.choice([1, 1, 2, 5])),
         })
-        n_blocks = int(rng.integers(1, 6))
-        sites = [study.variant(site={"latitude": float(rng.uniform(-66, 66)),
-                                     "longitude": float(rng.uniform(-180, 180))}).site for _ in range(n_blocks)]
-        dates = [dt.date(2025, 1, 1) + dt.timedelta(days=int(rng.integers(0, 365))) for _ in range(n_blocks)]
         angles = np.r_[np.sort(rng.uniform(1, 180, int(rng.integers(5, 60)))), 180.0]
-        options = engine_options(study)
-        the_sky = build_sky(options.sky, sites, dates)
-        resolved = [study.variant(site=site.model_dump()).panel for site in sites]
-        orientation = engine.fold_orientations(study.geometry, [p.tilt for p in resolved],
-                                               [p.azimuth for p in resolved], angles)
-        rows = engine.PanelRows(np.repeat(np.arange(n_blocks), angles.size), orientation.reshape(-1, 4))
+        options, the_sky, rows = _drawn(study, rng, int(rng.integers(1, 6)), (66.0, 0.0), angles)
         loads = np.sort(rng.uniform(0.01, 30.0, int(rng.integers(1, 40))))
         for threads in (1, 2):
             numba.set_num_threads(threads)
