@@ -362,20 +362,23 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
 
     n_chunks = scratch.above.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
-    taken, errors = itertools.count(), []
+    taken, errors, halted = itertools.count(), [], []
 
     def chunks() -> None:
         # ``next`` of a count is one step of C under the GIL: each chunk is taken once.
         for k in taken:
-            if k >= n_chunks:
+            if k >= n_chunks or halted:
                 return
             stop = min((k + 1) * per_chunk, n_rows)
             if k * per_chunk >= stop:
                 continue
             try:
                 body(k * per_chunk, stop, *records, Scratch(*(field[k] for field in scratch)))
-            except BaseException as error:  # raised once every chunk has ended
+            except Exception as error:  # the other chunks run on: raised once they all ended
                 errors.append(error)
+            except BaseException as error:  # an interrupt: no chunk is taken after it
+                halted.append(error)
+                return
 
     threads = min(get_num_threads(), n_chunks)
     others = submit(threads - 1, [chunks] * (threads - 1)) if threads > 1 else []
@@ -384,5 +387,5 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
     # workspace, which its next call takes again.
     for done in others:
         done.result()
-    if errors:
-        raise errors[0]
+    if halted or errors:
+        raise (halted or errors)[0]
