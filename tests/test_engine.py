@@ -470,6 +470,35 @@ def test_a_chunk_error_is_raised_after_every_chunk_ended(monkeypatch):
     assert len(ended) == scratch.east.shape[0] - 1
 
 
+def test_an_interrupt_in_a_chunk_stops_the_pass_once_the_running_chunks_ended(monkeypatch):
+    """An interrupt (``KeyboardInterrupt``) in one chunk: no chunk is taken after it, the chunks
+    running on other threads end, and the interrupt reaches the caller, not a pass to its end."""
+    import threading
+    import time
+
+    import numba
+
+    from foldopt.engine.records import allocate, in_chunks
+
+    monkeypatch.setattr(numba, "get_num_threads", lambda: 2)
+    _, scratch = allocate(1000, 1, 1, 10, False)
+    started, ended, lock = [], [], threading.Lock()
+
+    def body(start, stop, work):
+        with lock:
+            started.append(start)
+        if start == 0:
+            raise KeyboardInterrupt
+        time.sleep(0.02)
+        with lock:
+            ended.append(start)
+
+    with pytest.raises(KeyboardInterrupt):
+        in_chunks(body, 1000, scratch)
+    assert sorted(ended) == sorted(set(started) - {0})  # every chunk taken ended
+    assert len(started) <= 3  # the interrupted chunk and those running beside it, no more
+
+
 def _poison_workspaces():
     """Every byte of this thread's workspace set to 0xff (a NaN in each float, the largest
     integer): what a call left there must not reach the next call's answer."""

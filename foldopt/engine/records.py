@@ -13,7 +13,6 @@ with its own :class:`Scratch`.
 
 from __future__ import annotations
 
-import functools
 from typing import NamedTuple
 
 import numpy as np
@@ -336,12 +335,15 @@ def _scratch(chunks: int, fields) -> Scratch:
 
 def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
     """``body(start, stop, *records, work)`` over rows ``0 .. n_rows - 1`` in chunks, one chunk's
-    :class:`Scratch` each, on numba's number of threads.
+    :class:`Scratch` each, on numba's number of threads, the calling thread one of them.
 
     ``body`` is compiled with ``nogil=True``, so the chunks run in parallel on Python threads.
     They did in a numba ``prange`` loop, whose compile took a fifth of the kernel's (some 7 s
     of ``fold_rows``' 25 s on 2 cores; ``python bench/startup.py --events sweep-weather``),
-    for nothing the chunks need: they share no writes.
+    for nothing the chunks need: they share no writes. Each thread takes the next chunk not
+    taken until none is left; the calling thread takes chunks too rather than wait, so that a
+    call wakes one thread fewer and is not woken at the end (the wake-ups of threads on a virtual
+    machine are a pass's milliseconds' tenths).
 
     Parameters
     ----------
@@ -354,26 +356,36 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
     *records
         The arguments of ``body`` between ``stop`` and the chunk's scratch.
     """
+    import itertools
+
     from numba import get_num_threads
 
     n_chunks = scratch.above.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
+    taken, errors, halted = itertools.count(), [], []
 
-    def chunk(k: int) -> None:
-        stop = min((k + 1) * per_chunk, n_rows)
-        if k * per_chunk < stop:
-            body(k * per_chunk, stop, *records, Scratch(*(field[k] for field in scratch)))
+    def chunks() -> None:
+        # ``next`` of a count is one step of C under the GIL: each chunk is taken once.
+        for k in taken:
+            if k >= n_chunks or halted:
+                return
+            stop = min((k + 1) * per_chunk, n_rows)
+            if k * per_chunk >= stop:
+                continue
+            try:
+                body(k * per_chunk, stop, *records, Scratch(*(field[k] for field in scratch)))
+            except Exception as error:  # the other chunks run on: raised once they all ended
+                errors.append(error)
+            except BaseException as error:  # an interrupt: no chunk is taken after it
+                halted.append(error)
+                return
 
     threads = min(get_num_threads(), n_chunks)
-    if threads == 1:
-        for k in range(n_chunks):
-            chunk(k)
-        return
-    from concurrent.futures import wait
-
-    tasks = submit(threads, [functools.partial(chunk, k) for k in range(n_chunks)])
+    others = submit(threads - 1, [chunks] * (threads - 1)) if threads > 1 else []
+    chunks()
     # Every chunk ended before a chunk's error is raised: the scratch is the calling thread's
     # workspace, which its next call takes again.
-    wait(tasks)
-    for done in tasks:
+    for done in others:
         done.result()
+    if halted or errors:
+        raise (halted or errors)[0]
