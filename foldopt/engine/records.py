@@ -13,6 +13,7 @@ with its own :class:`Scratch`.
 
 from __future__ import annotations
 
+import itertools
 from typing import NamedTuple
 
 import numpy as np
@@ -356,8 +357,6 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
     *records
         The arguments of ``body`` between ``stop`` and the chunk's scratch.
     """
-    import itertools
-
     from numba import get_num_threads
 
     n_chunks = scratch.above.shape[0]
