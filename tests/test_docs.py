@@ -10,7 +10,6 @@ import filecmp
 import html
 import re
 import shutil
-import subprocess
 import sys
 import typing
 from pathlib import Path
@@ -32,17 +31,33 @@ PAGES = ("index", "quickstart", "cli", "study-file", "outputs", "api", "reproduc
 
 @pytest.fixture(scope="session")
 def built(tmp_path_factory):
-    """The HTML manual, built from a copy of docs/ with the working folder outside the source tree,
-    by the foldopt the suite tests (on every started process's ``PYTHONPATH``: tests/conftest.py)."""
+    """The HTML manual, built with warnings as errors from a copy of docs/ with the working folder
+    outside the source tree, by the foldopt the suite tests. Sphinx runs in this process, as
+    ``python -m sphinx -W -b html`` runs it: a process of its own imported again what the suite has
+    imported. It leaves the working folder, ``sys.path`` (conf.py puts its extensions' folder first)
+    and matplotlib's settings (its plot directive sets ``figure.autolayout``) as it found them. Its
+    search index, which nothing here reads, is not built."""
     pytest.importorskip("sphinx")
     pytest.importorskip("numpydoc")
+    import io
+
+    import matplotlib
+    from sphinx.application import Sphinx
+    from sphinx.util.console import strip_colors
+    from sphinx.util.docutils import docutils_namespace, patch_docutils
 
     work = tmp_path_factory.mktemp("docs")
     shutil.copytree(ROOT / "docs", work / "docs", ignore=shutil.ignore_patterns("_build", "generated"))
-    result = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
-                             "-d", str(work / "doctrees"), str(work / "docs"), str(work / "html")],
-                            cwd=work, capture_output=True, text=True, timeout=900)
-    assert result.returncode == 0, result.stderr[-3000:]
+    log = io.StringIO()
+    with pytest.MonkeyPatch.context() as patch, matplotlib.rc_context():
+        patch.chdir(work)
+        patch.setattr(sys, "path", list(sys.path))
+        with patch_docutils(work / "docs"), docutils_namespace():
+            app = Sphinx(work / "docs", work / "docs", work / "html", work / "doctrees", "html", status=None,
+                         warning=log, warningiserror=True)
+            app.builder.search = False
+            app.build()
+    assert app.statuscode == 0, strip_colors(log.getvalue())[-3000:]
     return work / "html"
 
 

@@ -157,14 +157,17 @@ def test_a_months_bars_are_its_mean_day_however_many_days_it_samples():
             assert set(bars.values()) == {designs[design][column]}, (design, column)
 
 
-def test_the_monthly_figure_draws_each_months_mean_day_of_results_csv(tmp_path):
+def test_the_monthly_figure_draws_each_months_mean_day_of_results_csv(tmp_path, figures_drawn_elsewhere):
     """A year of every 7th day, through the folder: the monthly figure's bars are, per design, the
-    mean over the month's days in results.csv (a grid point: no site name) of energy and t_solar."""
+    mean over the month's days in results.csv (a grid point: no site name) of energy and t_solar.
+    The folder's figures are drawn here from its table and its results.csv (the others of a sweep of
+    dates by the notebook's folder above and the reports' annual folder)."""
     from matplotlib.figure import Figure
 
     study = foldopt.default_study().variant(step_min=30, fold_angles={"start": 30, "stop": 180, "step": 30})
     result = foldopt.sweep(study, "day", date="1:365:7", p_load=[2.0])
-    foldopt.write(result, tmp_path / "year")
+    with figures_drawn_elsewhere():
+        foldopt.write(result, tmp_path / "year")
     days = pd.read_csv(tmp_path / "year" / "results.csv")
     assert (tmp_path / "year" / "monthly_energy_t_solar.png").exists()
     days["month"] = pd.to_datetime(days["date"]).dt.month
