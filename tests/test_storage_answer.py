@@ -59,6 +59,13 @@ def storage_less():
     return _run()
 
 
+@pytest.fixture(scope="module")
+def carried_24h():
+    """The paper's day carrying CARRIED with an ideal buffer sized for 24 h: the one run the
+    answer's keys, the sizing's curve and its table are read from."""
+    return _run(IDEAL_24H, p_load=CARRIED)
+
+
 @pytest.mark.parametrize("preset", [None, "supercapacitor", "lifepo4"])
 def test_an_empty_buffer_is_t_solar_for_every_design(storage_less, preset):
     result = _run({"capacity_wh": 0, **({"preset": preset} if preset else {})})
@@ -114,20 +121,20 @@ def _keys(value):
             yield from _keys(item)
 
 
-def test_every_key_of_a_buffer_s_answer_is_written_in_the_source():
+def test_every_key_of_a_buffer_s_answer_is_written_in_the_source(carried_24h):
     # Issue 48: a key of the answer is found by searching the package for it, in quotes (a key
     # built at run time from its parts is found by no search).
-    part = _run(IDEAL_24H, p_load=CARRIED).answer.result["storage"]
+    part = carried_24h.answer.result["storage"]
     source = "\n".join(path.read_text() for path in (ROOT / "foldopt").rglob("*.py"))
     keys = set(_keys(part))
     assert {"powered_by_design_h", "capacity_by_design_wh", "capacity_wh"} <= keys
     assert sorted(key for key in keys if f'"{key}"' not in source) == []
 
 
-def test_powered_time_never_falls_as_the_buffer_grows():
+def test_powered_time_never_falls_as_the_buffer_grows(carried_24h):
     # An ideal controller (no hysteresis, no leak): on the curve of every design, and on a finer
     # independent sweep of the capacity through the engine for the flat panel.
-    result = _run(IDEAL_24H, p_load=CARRIED)
+    result = carried_24h
     curve = result.storage.sizing.curve
     assert len(curve) >= 20 and curve["capacity_wh"].is_monotonic_increasing
     step = result.day.step_hours
@@ -152,8 +159,8 @@ def test_powered_time_never_falls_as_the_buffer_grows():
     assert (swept.powered_h[:, 0] <= min(24.0, harvested / result.study.p_load) + slack).all()
 
 
-def test_each_design_s_buffer_reaches_the_target_and_a_smaller_one_does_not():
-    result = _run(IDEAL_24H, p_load=CARRIED)
+def test_each_design_s_buffer_reaches_the_target_and_a_smaller_one_does_not(carried_24h):
+    result = carried_24h
     study, sizing = result.study, result.storage.sizing
     table = sizing.table.set_index("design")
     assert list(table.index) == ["flat", "twofold", "tracker", "tracker-net"]
