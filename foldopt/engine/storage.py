@@ -767,6 +767,7 @@ def _run_numpy(
     out, state, soc, soc_curves = days
     n_series, n_days, n_steps = power.shape
     first, second, demand, half = _segments(curves, par)
+    first_lasts, second_lasts = ((part.tau > 0.0).any(axis=0) for part in (first, second))
     levels = _cold_levels(cold, par, half)
     capacity = par.capacity
     level = np.zeros((n_series, n_days, n_steps + 1))
@@ -784,10 +785,11 @@ def _run_numpy(
         sums["empty"] = stored <= floor
         for j in range(n_steps + 1):
             *limits, keep = at(d, j)
-            for part in (first, second):
-                stored, on = _part_numpy(
-                    part.at(d, j), demand[:, d, j], stored, on, par, limits, sums
-                )
+            for part, lasts in ((first, first_lasts), (second, second_lasts)):
+                if lasts[d, j]:  # a part of no length in every series changes nothing
+                    stored, on = _part_numpy(
+                        part.at(d, j), demand[:, d, j], stored, on, par, limits, sums
+                    )
             kept = np.where(keep < 1.0, stored * keep, stored)
             sums["self_discharge"] += stored - kept
             stored = kept
