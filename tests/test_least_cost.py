@@ -67,20 +67,29 @@ COSTS = Costs(
 )
 
 
-def _search(costs=COSTS, curves=None, storage=STORAGE, load=LOAD):
-    return design_space(
-        curves or _curves(),
-        ANGLES,
-        area_m2=AREA,
-        load=load,
-        storage=storage,
-        costs=costs,
-        tracker_model="dual-axis",
-        step_hours=1.0,
-        engine="numba",
-        in_sequence=True,
-        draw=DRAW,
-    )
+def _search(costs=COSTS, storage=STORAGE, load=LOAD):
+    """The design space of :func:`_curves`, each search run once for the module (four tests read
+    the default one, two the LiFePO4's); a copy."""
+    key = (costs.model_dump_json(), storage.model_dump_json(), load)
+    if key not in _SEARCHED:
+        _SEARCHED[key] = design_space(
+            _curves(),
+            ANGLES,
+            area_m2=AREA,
+            load=load,
+            storage=storage,
+            costs=costs,
+            tracker_model="dual-axis",
+            step_hours=1.0,
+            engine="numba",
+            in_sequence=True,
+            draw=DRAW,
+        )
+    return _SEARCHED[key].copy()
+
+
+#: The searches run so far, by their costs, storage and load.
+_SEARCHED = {}
 
 
 def _meets(curve, capacities, draw=None, load=LOAD, storage=STORAGE):

@@ -183,16 +183,18 @@ def test_a_range_on_a_grid_holds_the_best_evaluated_angle(values, data, fraction
     assert got["near_optimal_lo_deg"][0] <= got["recommended_deg"][0] <= got["near_optimal_hi_deg"][0]
 
 
-def test_foldopt_run_prints_a_range_that_holds_its_best_angle(tmp_path):
+def test_foldopt_run_prints_a_range_that_holds_its_best_angle(tmp_path, folders_written_elsewhere):
     """The newcomer's `foldopt run`: the best angle it prints lies in the near-optimal range it
-    prints (it printed best 28.5 deg, near-optimal 29 to 52 deg)."""
+    prints (it printed best 28.5 deg, near-optimal 29 to 52 deg). Its terminal's lines only: the
+    default study's folder is written by the tests of the folder."""
     import re
 
     from typer.testing import CliRunner
 
     from foldopt.cli.app import app
 
-    done = CliRunner().invoke(app, ["run", "--out", str(tmp_path / "run")])
+    with folders_written_elsewhere():
+        done = CliRunner().invoke(app, ["run", "--out", str(tmp_path / "run")])
     assert done.exit_code == 0, done.output
     best = float(re.search(r"best fold angle ([\d.]+) deg", done.stdout)[1])
     lo, hi, recommended = map(float, re.search(r"near-optimal ([\d.]+) to ([\d.]+) deg .*recommended ([\d.]+) deg",
@@ -227,17 +229,19 @@ def test_the_recommended_angle_lies_in_its_range_and_is_flat_where_flat_is_best(
             assert recommended == 180.0
 
 
-def test_a_day_best_flat_is_recommended_flat(tmp_path):
+def test_a_day_best_flat_is_recommended_flat(tmp_path, folders_written_elsewhere):
     """The paper's day at 17 W: the flat panel is the best design (no fold reaches further), and the
     answer recommends it, not a fold at the range's centre (it recommended 177 deg), nor does it claim
-    a gain over flat for it."""
+    a gain over flat for it. The JSON answer only: its folder is not read."""
     import json
 
     from typer.testing import CliRunner
 
     from foldopt.cli.app import app
 
-    done = CliRunner().invoke(app, ["run", "--set", "p_load=17", "--format", "json", "--out", str(tmp_path / "o")])
+    with folders_written_elsewhere():
+        done = CliRunner().invoke(app, ["run", "--set", "p_load=17", "--format", "json", "--out",
+                                        str(tmp_path / "o")])
     assert done.exit_code == 0, done.output
     answer = json.loads(done.stdout)["answer"]
     result = answer["result"]

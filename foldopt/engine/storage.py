@@ -547,18 +547,31 @@ def _clipped_energy(a, b, tau, cap):
         )
 
 
-def _charge_numpy(charging, stored, spare, limit, par, row):
-    """:func:`foldopt.engine.storage_kernel._charge` over arrays, writing into the day's
-    ``row``."""
+#: The sums of a day that :func:`_part_numpy` adds to, and their columns.
+_SUMS = {
+    "powered": layout.POWERED,
+    "served": layout.SERVED,
+    "missing": layout.MISSING,
+    "lost": layout.LOST,
+    "charge_loss": layout.CHARGE_LOSS,
+    "discharge_loss": layout.DISCHARGE_LOSS,
+    "self_discharge": layout.SELF_DISCHARGE,
+    "drawn": layout.DRAWN,
+}
+
+
+def _charge_numpy(charging, stored, spare, limit, par, day):
+    """:func:`foldopt.engine.storage_kernel._charge` over arrays, adding to the ``day``'s
+    sums."""
     capacity, eta = par.capacity, par.eta_charge
     room = np.maximum(capacity - stored, 0.0) / eta
     take = np.minimum(spare, limit)
     fills = charging & (take >= room)
     take = np.where(fills, room, take)
     stored = np.where(fills, capacity, np.where(charging, stored + take * eta, stored))
-    row[:, layout.FULL] = np.where(fills & (capacity > 0.0), 1.0, row[:, layout.FULL])
-    row[:, layout.CHARGE_LOSS] += np.where(charging, take * (1.0 - eta), 0.0)
-    row[:, layout.LOST] += np.where(charging, spare - take, 0.0)
+    day["full"] |= fills & (capacity > 0.0)
+    day["charge_loss"] += np.where(charging, take * (1.0 - eta), 0.0)
+    day["lost"] += np.where(charging, spare - take, 0.0)
     return stored
 
 
@@ -580,76 +593,124 @@ def _time_to_draw(da, db, tau, energy):
         )
 
 
-def _part_numpy(ends, tau, surplus, demand, stored, on, par, cold, *, row):
-    """:func:`foldopt.engine.storage_kernel._part` over arrays of series (``demand``: whether the
-    load runs at both ends of the segment, where its time counts; ``cold`` the segment's cut-off
-    and reconnection [Wh] and whether the buffer may charge and discharge), writing into the
-    day's ``row``; returns the content and the load's state."""
+class _Part(NamedTuple):
+    """One part of every segment (the one first in time, or the second), of every series and
+    day: (n_series, n_days, n_steps + 1) arrays, or one segment's (n_series,). What does not
+    depend on the buffer's state, computed over the whole arrays at once: the six ``ends``
+    (power left after the design's own draw, load, draw at the part's two ends [W]), its length
+    ``tau`` [h], whether the power is at or above the load (``surplus``), the load's and the
+    draw's energies [Wh] (``need``, ``own``; ``short`` the deficit and ``taken`` what covering
+    it takes from the buffer), whether the deficit stays within ``max_discharge_w``
+    (``within``), the surplus the running load leaves (``spare_on``) and the power with the
+    load off (``spare_off``), and the charge limits over the part running or off
+    (``limit_on``, ``limit_off``)."""
+
+    ends: tuple
+    tau: np.ndarray
+    surplus: np.ndarray
+    need: np.ndarray
+    own: np.ndarray
+    short: np.ndarray
+    taken: np.ndarray
+    within: np.ndarray
+    spare_on: np.ndarray
+    spare_off: np.ndarray
+    limit_on: np.ndarray
+    limit_off: np.ndarray
+
+    def at(self, d, j):
+        """Day ``d``'s segment ``j`` of every series."""
+        return _Part(tuple(a[:, d, j] for a in self.ends), *(a[:, d, j] for a in self[1:]))
+
+
+def _part_energies(ends, tau, surplus, par) -> _Part:
+    """A part's energies, as :func:`foldopt.engine.storage_kernel._part` computes them before
+    it reads the state (the fields of :class:`_Part`), over whole arrays; ``par``'s fields
+    (n_series, 1, 1)."""
     pa, pb, la, lb, da, db = ends
-    floor, restart, charge, discharge = cold
-    active = tau > 0.0
     pv = 0.5 * tau * (pa + pb)
     need = 0.5 * tau * (la + lb)
-    own = 0.5 * tau * (da + db)
+    short = np.maximum(need - pv, 0.0)
+    whole_a, whole_b = pa + da, pb + db
+    return _Part(
+        ends=ends,
+        tau=tau,
+        surplus=surplus,
+        need=need,
+        own=0.5 * tau * (da + db),
+        short=short,
+        taken=short / par.eta_discharge,
+        within=np.maximum(la - pa, lb - pb) <= par.max_discharge,
+        spare_on=np.maximum(pv - need, 0.0),
+        spare_off=_clipped_energy(whole_a, whole_b, tau, np.inf),
+        limit_on=_clipped_energy(pa - la, pb - lb, tau, par.max_charge),
+        limit_off=_clipped_energy(whole_a, whole_b, tau, par.max_charge),
+    )
+
+
+def _part_numpy(part: _Part, demand, stored, on, par, cold, day):
+    """:func:`foldopt.engine.storage_kernel._part` over arrays of series (``part`` one
+    segment's, ``demand``: whether the load runs at both ends of the segment, where its time
+    counts; ``cold`` the segment's cut-off and reconnection [Wh] and whether the buffer may
+    charge and discharge), adding to the ``day``'s sums; returns the content and the load's
+    state."""
+    tau, surplus, need = part.tau, part.surplus, part.need
+    floor, restart, charge, discharge = cold
+    active = tau > 0.0
     on = on | (active & (stored >= restart))
     run = active & on & surplus
     usable = stored - floor
     eta_d = par.eta_discharge
-    short = np.maximum(need - pv, 0.0)
-    able = (
-        active
-        & on
-        & ~surplus
-        & discharge
-        & (usable > 0.0)
-        & (np.maximum(la - pa, lb - pb) <= par.max_discharge)
-    )
-    covered = able & (short <= eta_d * usable)
+    able = active & on & ~surplus & discharge & (usable > 0.0) & part.within
+    covered = able & (part.short <= eta_d * usable)
     partial = able & ~covered
     cut = active & on & ~surplus & ~covered
     off = active & ~on | cut
     whole = run | covered
-    taken = short / eta_d
-    ran = _time_to_draw(la - pa, lb - pb, tau, eta_d * usable)
-    # Only the series that run out part of the way (partial) keep what follows.
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        x = ran / tau
-        pm, lm, dm = pa + x * (pb - pa), la + x * (lb - la), da + x * (db - da)
-        ran_served, ran_drawn = 0.5 * ran * (la + lm), 0.5 * ran * (da + dm)
-    row[:, layout.SERVED] += np.where(whole, need, np.where(partial, ran_served, 0.0))
-    row[:, layout.DRAWN] += np.where(whole, own, np.where(partial, ran_drawn, 0.0))
-    ran = np.where(whole, tau, np.where(partial, ran, 0.0))
-    row[:, layout.POWERED] += np.where(demand, ran, 0.0)
-    row[:, layout.DISCHARGE_LOSS] += np.where(
-        covered, taken - short, np.where(partial, usable - eta_d * usable, 0.0)
-    )
-    stored = np.where(covered, stored - taken, np.where(partial, floor, stored))
-    pa, la, da = np.where(partial, pm, pa), np.where(partial, lm, la), np.where(partial, dm, da)
-    tau = np.where(partial, tau - ran, tau)
-    need = np.where(partial, 0.5 * tau * (la + lb), need)
+    served = np.where(whole, need, 0.0)
+    drawn = np.where(whole, part.own, 0.0)
+    ran = np.where(whole, tau, 0.0)
+    loss = np.where(covered, part.taken - part.short, 0.0)
+    stored = np.where(covered, stored - part.taken, stored)
+    spare_off, limit_off = part.spare_off, part.limit_off
+    if partial.any():
+        # The buffer carries the load part of the way, to its cut-off; the rest is off, and
+        # what follows is of the rest of the part (the other series keep the whole part's).
+        pa, pb, la, lb, da, db = part.ends
+        until = _time_to_draw(la - pa, lb - pb, tau, eta_d * usable)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            x = until / tau
+            pm, lm, dm = pa + x * (pb - pa), la + x * (lb - la), da + x * (db - da)
+            served = np.where(partial, 0.5 * until * (la + lm), served)
+            drawn = np.where(partial, 0.5 * until * (da + dm), drawn)
+            loss = np.where(partial, usable - eta_d * usable, loss)
+            ran = np.where(partial, until, ran)
+            rest = tau - until
+            need = np.where(partial, 0.5 * rest * (lm + lb), need)
+            rest_a, rest_b = pm + dm, pb + db
+            spare_off = np.where(partial, _clipped_energy(rest_a, rest_b, rest, np.inf), spare_off)
+            limit_off = np.where(
+                partial, _clipped_energy(rest_a, rest_b, rest, par.max_charge), limit_off
+            )
+        stored = np.where(partial, floor, stored)
+    day["served"] += served
+    day["drawn"] += drawn
+    day["discharge_loss"] += loss
+    day["powered"] += np.where(demand, ran, 0.0)
     on = on & ~cut
-    row[:, layout.EMPTY] = np.where(cut & (stored <= floor), 1.0, row[:, layout.EMPTY])
-    row[:, layout.MISSING] += np.where(off, need, 0.0)
-    max_c = par.max_charge
+    day["empty"] |= cut & (stored <= floor)
+    day["missing"] += np.where(off, need, 0.0)
     # Off, the controller has the load and the design's own draw off: the whole power charges.
-    whole_a, whole_b = pa + da, pb + db
-    spare = np.where(
-        run,
-        np.maximum(pv - need, 0.0),
-        np.where(off, _clipped_energy(whole_a, whole_b, tau, np.inf), 0.0),
-    )
-    limit = np.where(
-        run & charge,
-        _clipped_energy(pa - la, pb - lb, tau, max_c),
-        np.where(off & charge, _clipped_energy(whole_a, whole_b, tau, max_c), 0.0),
-    )
-    return _charge_numpy(run | off, stored, spare, limit, par, row), on
+    spare = np.where(run, part.spare_on, np.where(off, spare_off, 0.0))
+    limit = np.where(run & charge, part.limit_on, np.where(off & charge, limit_off, 0.0))
+    return _charge_numpy(run | off, stored, spare, limit, par, day), on
 
 
-def _segments(curves: layout.Curves):
+def _segments(curves: layout.Curves, par: layout.Parameters):
     """Each day's segments and their two parts, over whole arrays (n_series, n_days, n_steps + 1):
     the part with the power (less the design's own draw) at or above the load and the one below
-    it, in their order, each ``(ends, tau, surplus)`` as :func:`_part_numpy` takes them."""
+    it, in their order, each a :class:`_Part`; whether the load runs at both ends of each
+    segment; and which segments are the half steps at the day's ends."""
     power, load, draw, step_hours = curves
 
     def ends(curve):
@@ -672,22 +733,29 @@ def _segments(curves: layout.Curves):
     ps, ls = p0 + split * (p1 - p0), l0 + split * (l1 - l0)
     ds = d0 + split * (d1 - d0)
     t_above, t_below = tau * above, tau * (1.0 - above)
-    first = ((p0, ps, l0, ls, d0, ds), np.where(rising, t_below, t_above), ~rising)
-    second = ((ps, p1, ls, l1, ds, d1), np.where(rising, t_above, t_below), rising)
+    per_series = layout.Parameters(*(field[:, None, None] for field in par))
+    first = _part_energies(
+        (p0, ps, l0, ls, d0, ds), np.where(rising, t_below, t_above), ~rising, per_series
+    )
+    second = _part_energies(
+        (ps, p1, ls, l1, ds, d1), np.where(rising, t_above, t_below), rising, per_series
+    )
     return first, second, (l0 > 0.0) & (l1 > 0.0), half
 
 
-def _cold_at(cold: np.ndarray, par: layout.Parameters, d: int, j: int):
-    """Day ``d``'s segment ``j`` of every series: the cut-off and the reconnection [Wh], whether
-    the buffer may charge and discharge, and the share kept (NaN: the buffer's own), as
-    :func:`foldopt.engine.storage_kernel._levels` and ``_at`` read them."""
-
-    at = cold[:, d if cold.shape[1] > 1 else 0, j if cold.shape[2] > 1 else 0]
-    cut = at[:, layout.COLD_CUT]
+def _cold_levels(cold: np.ndarray, par: layout.Parameters, half):
+    """Every segment's cut-off and reconnection [Wh], whether the buffer may charge and
+    discharge, and the share of the content it keeps (the buffer's own where the cold array's
+    is NaN), as :func:`foldopt.engine.storage_kernel._levels` and ``_at`` read them: arrays
+    (n_series, n_days or 1, n_steps + 1 or 1), the cold array's sizes."""
+    par = layout.Parameters(*(field[:, None, None] for field in par))
+    cut = cold[..., layout.COLD_CUT]
     floor = (par.min_soc + cut * (1.0 - par.min_soc)) * par.capacity
     restart = (par.restart_soc + cut * (1.0 - par.restart_soc)) * par.capacity
-    charge, discharge = at[:, layout.COLD_CHARGE] > 0.0, at[:, layout.COLD_DISCHARGE] > 0.0
-    return floor, restart, charge, discharge, at[:, layout.COLD_KEEP]
+    charge, discharge = cold[..., layout.COLD_CHARGE] > 0.0, cold[..., layout.COLD_DISCHARGE] > 0.0
+    keep = cold[..., layout.COLD_KEEP]
+    keep = np.where(np.isnan(keep), np.where(half, par.keep_half, par.keep_step), keep)
+    return floor, restart, charge, discharge, keep
 
 
 def _run_numpy(
@@ -697,46 +765,52 @@ def _run_numpy(
     without merging), the steps in turn and the series at once."""
     power, _, draw, step_hours = curves
     out, state, soc, soc_curves = days
-    n_days, n_steps = power.shape[1:]
-    first, second, demand, half = _segments(curves)
+    n_series, n_days, n_steps = power.shape
+    first, second, demand, half = _segments(curves, par)
+    first_lasts, second_lasts = ((part.tau > 0.0).any(axis=0) for part in (first, second))
+    levels = _cold_levels(cold, par, half)
     capacity = par.capacity
-    n_bins = out.shape[-1] - layout.HISTOGRAM
-    series = np.arange(power.shape[0])
+    level = np.zeros((n_series, n_days, n_steps + 1))
+
+    def at(d, j):  # a size 1 of the cold array serves every day or segment
+        return [a[:, d if a.shape[1] > 1 else 0, j if a.shape[2] > 1 else 0] for a in levels]
+
     for d in range(n_days):
-        floor, restart = _cold_at(cold, par, d, 0)[:2]
+        floor, restart = at(d, 0)[:2]
         on = on | (stored >= restart)
         state[:, d, 0], state[:, d, 1] = stored, on
-        row = out[:, d]
-        row[:] = 0.0
-        row[:, layout.FULL] = np.where((capacity > 0.0) & (stored >= capacity), 1.0, 0.0)
-        row[:, layout.EMPTY] = np.where(stored <= floor, 1.0, 0.0)
+        # The day's sums, each series' added to part by part in the compiled loop's order.
+        sums = {name: np.zeros(n_series) for name in _SUMS}
+        sums["full"] = (capacity > 0.0) & (stored >= capacity)
+        sums["empty"] = stored <= floor
         for j in range(n_steps + 1):
-            *limits, keep = _cold_at(cold, par, d, j)
-            for ends, tau, surplus in (first, second):
-                stored, on = _part_numpy(
-                    tuple(a[:, d, j] for a in ends),
-                    tau[:, d, j],
-                    surplus[:, d, j],
-                    demand[:, d, j],
-                    stored,
-                    on,
-                    par,
-                    limits,
-                    row=row,
-                )
-            keep = np.where(np.isnan(keep), par.keep_half if half[j] else par.keep_step, keep)
+            *limits, keep = at(d, j)
+            for part, lasts in ((first, first_lasts), (second, second_lasts)):
+                if lasts[d, j]:  # a part of no length in every series changes nothing
+                    stored, on = _part_numpy(
+                        part.at(d, j), demand[:, d, j], stored, on, par, limits, sums
+                    )
             kept = np.where(keep < 1.0, stored * keep, stored)
-            row[:, layout.SELF_DISCHARGE] += stored - kept
+            sums["self_discharge"] += stored - kept
             stored = kept
             with np.errstate(invalid="ignore", divide="ignore"):
-                level = np.where(capacity > 0.0, stored / capacity, 0.0)
-            bins = np.clip((level * n_bins).astype(np.int64), 0, n_bins - 1)
-            row[series, layout.HISTOGRAM + bins] += 0.5 * step_hours if half[j] else step_hours
-            if soc_curves and j < n_steps:
-                soc[:, d, j] = level
+                level[:, d, j] = np.where(capacity > 0.0, stored / capacity, 0.0)
+        row = out[:, d]
+        for name, column in _SUMS.items():
+            row[:, column] = sums[name]
+        row[:, layout.FULL], row[:, layout.EMPTY] = sums["full"], sums["empty"]
         whole = power[:, d] + np.broadcast_to(draw, power.shape)[:, d]
         row[:, layout.HARVESTED] = np.cumsum(whole, axis=-1)[:, -1] * step_hours
-    on = on | (stored >= _cold_at(cold, par, 0, 0)[1])
+    # Each segment's state at its end, for the segment's length, in the segments' order.
+    n_bins = out.shape[-1] - layout.HISTOGRAM
+    bins = np.clip((level * n_bins).astype(np.int64), 0, n_bins - 1)
+    histogram = np.zeros((n_series, n_days, n_bins))
+    series, day = np.indices(bins.shape)[:2]
+    np.add.at(histogram, (series, day, bins), np.where(half, 0.5 * step_hours, step_hours))
+    out[..., layout.HISTOGRAM :] = histogram
+    if soc_curves:
+        soc[...] = level[..., :n_steps]
+    on = on | (stored >= at(0, 0)[1])
     state[:, n_days, 0], state[:, n_days, 1] = stored, on
     return stored, on
 
@@ -752,7 +826,7 @@ def _simulate_numpy(curves, params, cold, days, passes, max_iterations, toleranc
     capacity = par.capacity
     given = ~np.isnan(par.initial_soc)
     stored = np.where(given, par.initial_soc * capacity, capacity)
-    on = np.where(given, stored >= _cold_at(cold, par, 0, 0)[1], True)
+    on = np.where(given, stored >= _cold_levels(cold, par, False)[1][:, 0, 0], True)
     resolution = load.reshape(n_series, -1).max(axis=1) * step_hours
     low, high = np.zeros(n_series), capacity.copy()
     todo = np.ones(n_series, dtype=bool)
