@@ -499,14 +499,15 @@ def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_
     assert requests_made(server, dead) == 0
 
 
-def test_a_study_files_horizon_names_pvgis(pvgis, server, tmp_path):
+def test_a_study_files_horizon_names_pvgis(pvgis, server, tmp_path, figures_drawn_elsewhere):
     route = pvgis("ok")
     embedded = {k: v for k, v in yaml.safe_load(default_study_path().read_text()).items() if k != "sky"}
     study = {**embedded, "mode": "exact", "date": "2025-06-21", "p_load": 4, "step_min": 10,
              "site": {"latitude": 45.0, "longitude": 8.0, "horizon": "pvgis"},
              "fold_angles": {"start": 30, "stop": 180, "step": 30}}
     (tmp_path / "site.yaml").write_text(yaml.safe_dump(study))
-    result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet", "--engine", "numpy"])
+    with figures_drawn_elsewhere():  # a day under this horizon: test_the_fetched_horizon's fetched run
+        result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet", "--engine", "numpy"])
     assert result.exit_code == 0, result.output
     assert requests_made(server, route) == 1
     meta = json.loads((tmp_path / "out" / "run.json").read_text())
@@ -607,10 +608,10 @@ def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis,
     assert cached.read_bytes() == HOURLY.read_bytes()
     days = ["--days", "2020-06-21,2021-01-15"]
     dead = pvgis("e500")  # a service that would fail: offline never asks it
-    offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
-                                  "--out", "offline"])
-    assert offline.exit_code == 0, offline.output
-    with figures_drawn_elsewhere():  # the offline run's, of the same data
+    with figures_drawn_elsewhere():  # days of this series: test_the_fetched_series_is_the_recorded_file's
+        offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
+                                      "--out", "offline"])
+        assert offline.exit_code == 0, offline.output
         read = runner.invoke(app, [*read_as_a_users_file(*days), "--out", "read"])
     assert json.loads(offline.stdout)["rows"] == json.loads(read.stdout)["rows"]
     assert requests_made(server, dead) == 0
@@ -671,7 +672,8 @@ def test_a_source_read_as_a_measured_file_is_named_so():
         MEASURED_WEATHER_SOURCES)
 
 
-def test_a_study_file_names_the_hourly_source_its_years_and_database(pvgis, server, tmp_path):
+def test_a_study_file_names_the_hourly_source_its_years_and_database(pvgis, server, tmp_path,
+                                                                     folders_written_elsewhere):
     route = pvgis("ok")
     embedded = {k: v for k, v in yaml.safe_load(default_study_path().read_text()).items()
                 if k not in ("sky", "step_min")}
@@ -679,7 +681,9 @@ def test_a_study_file_names_the_hourly_source_its_years_and_database(pvgis, serv
              "date": "2021-06-21", "p_load": 4, "fold_angles": {"start": 30, "stop": 180, "step": 30},
              "weather": {"source": "pvgis-hourly", "years": "2020:2021", "raddatabase": "PVGIS-SARAH3"}}
     (tmp_path / "site.yaml").write_text(yaml.safe_dump(study))
-    result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet"])
+    # The request is what is read here; a measured day's folder is test_weather_minutes'.
+    with folders_written_elsewhere():
+        result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet"])
     assert result.exit_code == 0, result.output
     ((where, query),) = queries_made(server, route)
     assert where == "seriescalc" and "raddatabase=PVGIS-SARAH3" in query.split("&")
