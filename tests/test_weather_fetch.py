@@ -266,6 +266,26 @@ def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server
     assert (tmp_path / "site.json").read_bytes() == RECORDED.read_bytes()
 
 
+def test_a_fetched_year_is_read_once_and_as_its_file(pvgis, server, tmp_path, monkeypatch):
+    """The answer's check before it is cached reads the year the study that fetched it reads next:
+    that read takes the check's hours, the same bits as the cached file read afresh."""
+    import pandas as pd
+
+    from foldopt.inputs.weather import reader
+
+    pvgis("ok")
+    assert runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"]).exit_code == 0
+    (answer,) = (p for p in (tmp_path / "cache" / "weather").iterdir() if "provenance" not in p.name)
+    reads = []
+    checked = reader._read_checked
+    monkeypatch.setattr(reader, "_read_checked", lambda *args: reads.append(args) or checked(*args))
+    fetched = reader.read_weather(answer)
+    assert reads == []
+    reader._read_once.cache_clear()
+    pd.testing.assert_frame_equal(fetched, reader.read_weather(answer), check_exact=True)
+    assert len(reads) == 1
+
+
 def test_offline_without_a_cached_copy_is_one_line(pvgis, server, tmp_path):
     route = pvgis("ok")
     result = runner.invoke(app, [*SWEEP, "--weather", "pvgis-tmy", "--offline", "--out", "x"])

@@ -120,10 +120,18 @@ def _read(path: str, fmt: str, year: int, mtime: float):
     return result
 
 
+#: The last answer :func:`check_answer` read before it was cached, by its :func:`_read_once` key
+#: as the cached file: the study that fetched it reads it next, and takes it from here.
+_checked: dict = {}
+
+
 @functools.lru_cache(maxsize=8)
 def _read_once(path: str, fmt: str, year: int, mtime: float):
     """:func:`_read`'s result, or its error message: a study validates its file once per value of
     every axis, and a bad file must not be read again each time."""
+    checked = _checked.pop((path, fmt, year, mtime), None)
+    if checked is not None:
+        return checked, None
     try:
         return _read_checked(path, fmt, year), None
     except WeatherError as error:
@@ -149,7 +157,7 @@ def _read_checked(path: str, fmt: str, year: int):
     return frame, meta
 
 
-def check_answer(path, fmt: str) -> None:
+def check_answer(path, fmt: str, cached_as=None) -> None:
     """Check a service's answer as the weather file of format ``fmt`` it is, with every check a
     file of that format gets (:mod:`~foldopt.inputs.weather.sources`, before it is cached).
 
@@ -158,6 +166,9 @@ def check_answer(path, fmt: str) -> None:
     path : str or pathlib.Path
     fmt : str
         One of :data:`FORMATS` or :data:`MEASURED_FORMATS`.
+    cached_as : str or pathlib.Path, optional
+        Where ``path`` is renamed to once checked (its modification time kept): a typical year's
+        hours, read here, are :func:`read_weather`'s of that file in 2025, not read again.
 
     Raises
     ------
@@ -166,8 +177,11 @@ def check_answer(path, fmt: str) -> None:
     """
     if fmt in MEASURED_FORMATS:
         read_measured(path, fmt)
-    else:
-        _read_checked(str(path), fmt, 2025)
+        return
+    result = _read_checked(str(path), fmt, 2025)
+    if cached_as is not None:
+        _checked.clear()
+        _checked[(str(Path(cached_as).resolve()), fmt, 2025, Path(path).stat().st_mtime)] = result
 
 
 def weather_site(path, fmt: str | None = None, site: dict | None = None, **measured) -> dict | None:
