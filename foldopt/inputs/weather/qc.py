@@ -229,8 +229,7 @@ def check_rows(
         ),
     )
     # The sun where there is direct light only: a row without any brings no beam to the ground
-    # (ghi >= 0 above), and pvlib's SPA, elementwise, gives those rows the same bits as the whole
-    # year's (some half of a year's rows, and of its reading's SPA time).
+    # (ghi >= 0 above). pvlib's SPA is elementwise: those rows' zenith is the whole year's.
     lit = np.flatnonzero(dni > 0)
     zenith, beam = np.full(len(dni), np.nan), np.zeros(len(dni))
     with warnings.catch_warnings():

@@ -906,7 +906,8 @@ def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> Wea
 
 def _unreadable(path: Path, fmt: str, cached_as: Path) -> str | None:
     """Why an answer is not a readable file of its format (every check a file of it gets), or
-    None; ``cached_as``, the file it becomes (:func:`~foldopt.inputs.weather.reader.check_answer`)."""
+    None; ``cached_as`` is the file it becomes
+    (:func:`~foldopt.inputs.weather.reader.check_answer`)."""
     if fmt != "horizon":
         from foldopt.inputs.weather import reader as files
 
