@@ -615,8 +615,10 @@ def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_p
     assert meta["weather_source"]["sha256"] == hashlib.sha256(HOURLY.read_bytes()).hexdigest()
 
 
-def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path,
+def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path, monkeypatch,
                                                                           figures_drawn_elsewhere):
+    from foldopt.inputs.weather import reader
+
     route = pvgis("ok")
     for _ in range(2):
         result = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8", *YEARS])
@@ -627,12 +629,16 @@ def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis,
     assert cached.read_bytes() == HOURLY.read_bytes()
     days = ["--days", "2020-06-21,2021-01-15"]
     dead = pvgis("e500")  # a service that would fail: offline never asks it
+    reads = []  # the files read: the answer was read by the fetch's check, before it was cached
+    measured = reader.read_measured
+    monkeypatch.setattr(reader, "read_measured", lambda path, *args: reads.append(path) or measured(path, *args))
     with figures_drawn_elsewhere():  # days of this series: test_the_fetched_series_is_the_recorded_file's
         offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
                                       "--out", "offline"])
         assert offline.exit_code == 0, offline.output
         read = runner.invoke(app, [*read_as_a_users_file(*days), "--out", "read"])
-    assert json.loads(offline.stdout)["rows"] == json.loads(read.stdout)["rows"]
+    assert json.loads(offline.stdout)["rows"] == json.loads(read.stdout)["rows"]  # the same bits
+    assert cached.name not in [Path(path).name for path in reads]
     assert requests_made(server, dead) == 0
     other = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", "--years", "2019:2020", *days,
                                 "--offline", "--out", "x"])  # other years: no cached copy

@@ -120,8 +120,9 @@ def _read(path: str, fmt: str, year: int, mtime: float):
     return result
 
 
-#: The last answer :func:`check_answer` read before it was cached, by its :func:`_read_once` key
-#: as the cached file: the study that fetched it reads it next, and takes it from here.
+#: The last answer :func:`check_answer` read before it was cached, by its :func:`_read_once` (or
+#: :func:`_measured_once`) key as the cached file: the study that fetched it reads it next, and
+#: takes it from here.
 _checked: dict = {}
 
 
@@ -175,13 +176,21 @@ def check_answer(path, fmt: str, cached_as=None) -> None:
     foldopt.errors.WeatherError
         Naming the file, where and why.
     """
+    mtime = Path(path).stat().st_mtime
     if fmt in MEASURED_FORMATS:
-        read_measured(path, fmt)
-        return
-    result = _read_checked(str(path), fmt, 2025)
-    if cached_as is not None:
-        _checked.clear()
-        _checked[(str(Path(cached_as).resolve()), fmt, 2025, Path(path).stat().st_mtime)] = result
+        result = read_measured(path, fmt)
+        if cached_as is None:
+            return
+        result.frame.attrs["weather"] = Path(cached_as).name  # as its read names it
+        # read_measured's defaults: the options this answer was read with
+        key = _measured_key(Path(cached_as), mtime, fmt, *read_measured.__defaults__)
+    else:
+        result = _read_checked(str(path), fmt, 2025)
+        if cached_as is None:
+            return
+        key = (str(Path(cached_as).resolve()), fmt, 2025, mtime)
+    _checked.clear()
+    _checked[key] = result
 
 
 def weather_site(path, fmt: str | None = None, site: dict | None = None, **measured) -> dict | None:
@@ -252,6 +261,18 @@ def measured_weather(
     foldopt.errors.WeatherError
     """
     path = Path(path)
+    check_file(path)
+    key = _measured_key(
+        path, path.stat().st_mtime, fmt, label, timezone, site, decomposition, max_gap_min
+    )
+    result, message = _measured_once(*key)
+    if message is not None:
+        raise WeatherError(message)
+    return result
+
+
+def _measured_key(path: Path, mtime, fmt, label, timezone, site, decomposition, max_gap_min):
+    """:func:`_measured_once`'s arguments for a file and its options (the site hashable)."""
     where = (
         None
         if site is None
@@ -263,10 +284,9 @@ def measured_weather(
             )
         )
     )
-    check_file(path)
-    result, message = _measured_once(
+    return (
         str(path.resolve()),
-        path.stat().st_mtime,
+        mtime,
         fmt,
         label,
         timezone,
@@ -274,14 +294,16 @@ def measured_weather(
         decomposition,
         float(max_gap_min),
     )
-    if message is not None:
-        raise WeatherError(message)
-    return result
 
 
 @functools.lru_cache(maxsize=8)
 def _measured_once(path, mtime, fmt, label, timezone, site, decomposition, max_gap_min):
     """:func:`measured_weather`'s result, or its error message (a bad file is read once)."""
+    checked = _checked.pop(
+        (path, mtime, fmt, label, timezone, site, decomposition, max_gap_min), None
+    )
+    if checked is not None:
+        return checked, None
     try:
         return read_measured(
             path,
