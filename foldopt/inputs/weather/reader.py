@@ -168,8 +168,9 @@ def check_answer(path, fmt: str, cached_as=None) -> None:
     fmt : str
         One of :data:`FORMATS` or :data:`MEASURED_FORMATS`.
     cached_as : str or pathlib.Path, optional
-        Where ``path`` is renamed to once checked (its modification time kept): a typical year's
-        hours, read here, are :func:`read_weather`'s of that file in 2025, not read again.
+        Where ``path`` is renamed to once checked (its modification time kept): what is read here
+        (a typical year's hours in 2025, a measured series with ``read_measured``'s options) is
+        the next read of that file, not read again.
 
     Raises
     ------
