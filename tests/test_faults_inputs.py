@@ -213,18 +213,33 @@ def foldopt_process(args, cwd: Path, env: dict) -> subprocess.CompletedProcess:
 C_LOCALE = {"LC_ALL": "C", "LANG": "C", "PYTHONUTF8": "0", "PYTHONIOENCODING": None}
 
 
-def test_utf8_input_files_under_the_c_locale(tmp_path):
-    (tmp_path / "sites.csv").write_bytes("name,latitude,longitude\nSão Paulo,-23.55,-46.63\n".encode())
-    (tmp_path / "p.csv").write_bytes("time,watts\n07:00,6\n".encode())
-    (tmp_path / "s.yaml").write_bytes(yaml.safe_dump({**FAST, "description": "Zürich"}, allow_unicode=True).encode())
-    code = ("from foldopt.inputs.study_file import read_profile, read_study; "
+@pytest.fixture(scope="module")
+def c_locale_without_home(tmp_path_factory):
+    """One process (each costs a second of imports) under a C locale with HOME unusable: it reads
+    UTF-8 input files, then loads matplotlib for foldopt's figures. Returns its folder, its
+    CompletedProcess and stdout's lines."""
+    folder = tmp_path_factory.mktemp("c-locale")
+    (folder / "sites.csv").write_bytes("name,latitude,longitude\nSão Paulo,-23.55,-46.63\n".encode())
+    (folder / "p.csv").write_bytes("time,watts\n07:00,6\n".encode())
+    (folder / "s.yaml").write_bytes(yaml.safe_dump({**FAST, "description": "Zürich"}, allow_unicode=True).encode())
+    (folder / "a-file").write_text("")
+    env = foldopt_env(**C_LOCALE, HOME=str(folder / "a-file" / "home"), XDG_CONFIG_HOME=None, XDG_CACHE_HOME=None,
+                      MPLCONFIGDIR=None, FOLDOPT_CACHE_DIR=str(folder / "cache"))
+    code = ("import os; before = dict(os.environ); "
+            "from foldopt.inputs.study_file import read_profile, read_study; "
             "from foldopt.inputs.sites import read_sites; "
             "print(ascii([read_sites('sites.csv')[0]['name'], read_profile('p.csv'), "
-            "read_study('s.yaml')[0]['description']]))")
-    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=foldopt_env(**C_LOCALE),
-                          capture_output=True, timeout=TIMEOUT)
+            "read_study('s.yaml')[0]['description']])); "
+            "from foldopt.output.figures import canvas; canvas.load_matplotlib(); import matplotlib; "
+            "print(dict(os.environ) == before, matplotlib.get_configdir(), matplotlib.get_cachedir())")
+    done = subprocess.run([sys.executable, "-c", code], cwd=folder, env=env, capture_output=True, timeout=TIMEOUT)
+    return folder, done, done.stdout.decode().splitlines()
+
+
+def test_utf8_input_files_under_the_c_locale(c_locale_without_home):
+    _, done, lines = c_locale_without_home
     assert done.returncode == 0, done.stderr.decode(errors="replace")
-    assert done.stdout.decode().strip() == ascii(["São Paulo", {"07:00": 6.0}, "Zürich"])
+    assert lines[0] == ascii(["São Paulo", {"07:00": 6.0}, "Zürich"])
 
 
 def test_a_unicode_folder_under_the_c_locale_with_an_unusable_home(tmp_path):
@@ -246,22 +261,15 @@ def test_a_unicode_folder_under_the_c_locale_with_an_unusable_home(tmp_path):
     assert (cache / "matplotlib").is_dir()
 
 
-def test_matplotlib_gets_a_folder_and_the_environment_is_as_it_was(tmp_path):
+def test_matplotlib_gets_a_folder_and_the_environment_is_as_it_was(c_locale_without_home):
     """With HOME unusable, loading matplotlib for foldopt's figures (as the first figure drawn
     does) gives it foldopt's cache folder for its configuration and fonts (it reads MPLCONFIGDIR
     once, as it is imported) and leaves the process's environment as it was: no MPLCONFIGDIR
     behind the caller's back."""
-    (tmp_path / "a-file").write_text("")
-    cache = tmp_path / "cache"
-    env = foldopt_env(HOME=str(tmp_path / "a-file" / "home"), XDG_CONFIG_HOME=None, XDG_CACHE_HOME=None,
-                      MPLCONFIGDIR=None, FOLDOPT_CACHE_DIR=str(cache))
-    code = ("import os; before = dict(os.environ); from foldopt.output.figures import canvas; "
-            "canvas.load_matplotlib(); import matplotlib; "
-            "print(dict(os.environ) == before, matplotlib.get_configdir(), matplotlib.get_cachedir())")
-    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
-                          timeout=TIMEOUT)
-    assert (done.returncode, done.stderr) == (0, "")
-    assert done.stdout.split() == ["True", str(cache / "matplotlib"), str(cache / "matplotlib")]
+    folder, done, lines = c_locale_without_home
+    assert (done.returncode, done.stderr) == (0, b"")
+    cache = folder / "cache"
+    assert lines[1].split() == ["True", str(cache / "matplotlib"), str(cache / "matplotlib")]
 
 
 def _interrupt_while_writing(folder):

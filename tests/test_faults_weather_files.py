@@ -140,10 +140,11 @@ def test_a_cloud_ensemble_over_one_day_runs_its_members(here):
     assert (here / "out" / "results.csv").is_file()
 
 
-def test_a_study_file_of_a_cloud_ensemble_over_one_day_runs_its_members(here):
+def test_a_study_file_of_a_cloud_ensemble_over_one_day_runs_its_members(here, figures_drawn_elsewhere):
     study = {**FAST, "date": "2025-06-21", "objective": "mean", "weather": {"path": str(TMY3), "members": 2}}
     (here / "study.yaml").write_text(yaml.safe_dump(study))
-    result = runner.invoke(app, ["run", "study.yaml", "--out", "out"])
+    with figures_drawn_elsewhere():  # the command line's ensemble over this day, above: its folder's
+        result = runner.invoke(app, ["run", "study.yaml", "--out", "out"])
     assert result.exit_code == 0, result.output
     assert "over 2 cloud members" in result.stdout
 
@@ -294,10 +295,11 @@ def test_a_weather_option_without_a_weather_file_names_the_options(here, axis, o
     assert "weather.path" not in line and "objective" not in line
 
 
-def test_a_horizon_beside_a_weather_files_site_takes_the_files_site(here):
+def test_a_horizon_beside_a_weather_files_site_takes_the_files_site(here, folders_written_elsewhere):
     horizon = ROOT / "tests" / "data" / "horizon" / "street_canyon.csv"
     quick = ["--step-min", "60", "--angle-step", "30", "--days", "172:172:1", "--format", "json"]
-    open_sky = runner.invoke(app, ["sweep", "angle", "--weather", str(TMY3), *quick, "--out", "open"])
+    with folders_written_elsewhere():  # its answer alone is read; the canyon's folder, of its kind, is written
+        open_sky = runner.invoke(app, ["sweep", "angle", "--weather", str(TMY3), *quick, "--out", "open"])
     canyon = runner.invoke(app, ["sweep", "angle", "--weather", str(TMY3), "--horizon", str(horizon), *quick,
                                  "--out", "canyon"])
     assert open_sky.exit_code == 0 and canyon.exit_code == 0, canyon.output

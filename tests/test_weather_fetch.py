@@ -266,6 +266,26 @@ def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server
     assert (tmp_path / "site.json").read_bytes() == RECORDED.read_bytes()
 
 
+def test_a_fetched_year_is_read_once_and_as_its_file(pvgis, server, tmp_path, monkeypatch):
+    """The answer's check before it is cached reads the year the study that fetched it reads next:
+    that read takes the check's hours, the same bits as the cached file read afresh."""
+    import pandas as pd
+
+    from foldopt.inputs.weather import reader
+
+    pvgis("ok")
+    assert runner.invoke(app, ["weather", "fetch", "--lat", "45", "--lon", "8"]).exit_code == 0
+    (answer,) = (p for p in (tmp_path / "cache" / "weather").iterdir() if "provenance" not in p.name)
+    reads = []
+    checked = reader._read_checked
+    monkeypatch.setattr(reader, "_read_checked", lambda *args: reads.append(args) or checked(*args))
+    fetched = reader.read_weather(answer)
+    assert reads == []
+    reader._read_once.cache_clear()
+    pd.testing.assert_frame_equal(fetched, reader.read_weather(answer), check_exact=True)
+    assert len(reads) == 1
+
+
 def test_offline_without_a_cached_copy_is_one_line(pvgis, server, tmp_path):
     route = pvgis("ok")
     result = runner.invoke(app, [*SWEEP, "--weather", "pvgis-tmy", "--offline", "--out", "x"])
@@ -595,8 +615,10 @@ def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_p
     assert meta["weather_source"]["sha256"] == hashlib.sha256(HOURLY.read_bytes()).hexdigest()
 
 
-def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path,
+def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path, monkeypatch,
                                                                           figures_drawn_elsewhere):
+    from foldopt.inputs.weather import reader
+
     route = pvgis("ok")
     for _ in range(2):
         result = runner.invoke(app, ["weather", "fetch", "pvgis-hourly", "--lat", "45", "--lon", "8", *YEARS])
@@ -607,12 +629,16 @@ def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis,
     assert cached.read_bytes() == HOURLY.read_bytes()
     days = ["--days", "2020-06-21,2021-01-15"]
     dead = pvgis("e500")  # a service that would fail: offline never asks it
-    offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
-                                  "--out", "offline"])
-    assert offline.exit_code == 0, offline.output
-    with figures_drawn_elsewhere():  # the offline run's, of the same data
+    reads = []  # the files read: the answer was read by the fetch's check, before it was cached
+    measured = reader.read_measured
+    monkeypatch.setattr(reader, "read_measured", lambda path, *args: reads.append(path) or measured(path, *args))
+    with figures_drawn_elsewhere():  # days of this series: test_the_fetched_series_is_the_recorded_file's
+        offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
+                                      "--out", "offline"])
+        assert offline.exit_code == 0, offline.output
         read = runner.invoke(app, [*read_as_a_users_file(*days), "--out", "read"])
-    assert json.loads(offline.stdout)["rows"] == json.loads(read.stdout)["rows"]
+    assert json.loads(offline.stdout)["rows"] == json.loads(read.stdout)["rows"]  # the same bits
+    assert cached.name not in [Path(path).name for path in reads]
     assert requests_made(server, dead) == 0
     other = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", "--years", "2019:2020", *days,
                                 "--offline", "--out", "x"])  # other years: no cached copy
@@ -671,7 +697,8 @@ def test_a_source_read_as_a_measured_file_is_named_so():
         MEASURED_WEATHER_SOURCES)
 
 
-def test_a_study_file_names_the_hourly_source_its_years_and_database(pvgis, server, tmp_path):
+def test_a_study_file_names_the_hourly_source_its_years_and_database(pvgis, server, tmp_path,
+                                                                     folders_written_elsewhere):
     route = pvgis("ok")
     embedded = {k: v for k, v in yaml.safe_load(default_study_path().read_text()).items()
                 if k not in ("sky", "step_min")}
@@ -679,7 +706,8 @@ def test_a_study_file_names_the_hourly_source_its_years_and_database(pvgis, serv
              "date": "2021-06-21", "p_load": 4, "fold_angles": {"start": 30, "stop": 180, "step": 30},
              "weather": {"source": "pvgis-hourly", "years": "2020:2021", "raddatabase": "PVGIS-SARAH3"}}
     (tmp_path / "site.yaml").write_text(yaml.safe_dump(study))
-    result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet"])
+    with folders_written_elsewhere():  # its request is what is read here, nothing of its folder
+        result = runner.invoke(app, ["run", "site.yaml", "--out", "out", "--quiet"])
     assert result.exit_code == 0, result.output
     ((where, query),) = queries_made(server, route)
     assert where == "seriescalc" and "raddatabase=PVGIS-SARAH3" in query.split("&")

@@ -46,10 +46,11 @@ def test_a_measured_day_through_the_cli_and_the_api_gives_the_same_answer(tmp_pa
     assert api["result"] == cli["result"]  # the same numbers to the bit
 
 
-def test_a_five_minute_csv_runs_at_its_own_step(tmp_path):
-    result = invoke("sweep", "angle", "--weather", FIVE, "--weather-format", "csv", "--lat", UAT["latitude"], "--lon",
-                    UAT["longitude"], "--altitude", UAT["altitude"], "--p-load", "2", "--angle-step", "15",
-                    "--out", tmp_path / "c", "-q")
+def test_a_five_minute_csv_runs_at_its_own_step(tmp_path, figures_drawn_elsewhere):
+    with figures_drawn_elsewhere():  # a measured day's: test_a_measured_day_through_the_cli_and_the_api's
+        result = invoke("sweep", "angle", "--weather", FIVE, "--weather-format", "csv", "--lat", UAT["latitude"],
+                        "--lon", UAT["longitude"], "--altitude", UAT["altitude"], "--p-load", "2", "--angle-step",
+                        "15", "--out", tmp_path / "c", "-q")
     assert result.exit_code == 0, result.output
     assert json.loads((tmp_path / "c" / "run.json").read_text())["study"]["step_min"] == 5.0
     table = pd.read_csv(tmp_path / "c" / "results.csv")
@@ -148,9 +149,11 @@ def test_a_days_time_series_carries_the_light_and_air_it_used(tmp_path):
     assert series["temp_air"].nunique() > 100  # the cells follow the air through the day
 
 
-def test_an_ensemble_through_the_cli_and_the_api_gives_the_same_answer(tmp_path):
-    result = invoke("sweep", "angle", "--weather", TMY3, "--members", "4", "--seed", "2", "--days", DAYS, "--year",
-                    "2025", "--p-load", "3", "--angle-step", "30", "--out", tmp_path / "e", "--format", "json")
+def test_an_ensemble_through_the_cli_and_the_api_gives_the_same_answer(tmp_path, folders_written_elsewhere):
+    with folders_written_elsewhere():  # its answer alone is read (an ensemble of days: test_weather_ensemble)
+        result = invoke("sweep", "angle", "--weather", TMY3, "--members", "4", "--seed", "2", "--days", DAYS,
+                        "--year", "2025", "--p-load", "3", "--angle-step", "30", "--out", tmp_path / "e",
+                        "--format", "json")
     assert result.exit_code == 0, result.output
     cli = json.loads(result.stdout)["answer"]
     api = foldopt.sweep(foldopt.default_study(), "angle", weather={"path": str(TMY3), "members": 4, "seed": 2},

@@ -257,6 +257,17 @@ def test_a_file_without_temperature_or_wind_gets_the_defaults(tmp_path):
     pd.testing.assert_frame_equal(frame[["ghi", "dni", "dhi"]], read_weather(TMY3)[["ghi", "dni", "dhi"]])
 
 
+def test_a_file_without_direct_light_reads_as_it_is(tmp_path):
+    # The beam test's sun is asked for the rows with direct light only: a file without any (a
+    # week of overcast) has no row to ask for, and reads with its diffuse light whole.
+    header, rows = tmy3_lines()[:2], [row.split(",") for row in tmy3_lines()[2:2 + 7 * 24]]
+    path = tmp_path / "overcast.csv"
+    path.write_text("\n".join([*header, *(",".join([*row[:DNI], "0", *row[DNI + 1:]]) for row in rows)]) + "\n")
+    frame, sample = read_weather(path), read_weather(TMY3).iloc[:7 * 24]
+    assert (frame["dni"] == 0).all() and (frame["ghi"] > 0).any()
+    pd.testing.assert_frame_equal(frame[["ghi", "dhi"]], sample[["ghi", "dhi"]], check_freq=False)
+
+
 def test_a_leap_year_study_on_a_typical_year_lacks_only_february_29():
     # A TMY holds 365 days. In a leap year its days keep their dates, and February 29 is a day the
     # file does not hold, with the same light around it as in a common year.

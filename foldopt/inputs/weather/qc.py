@@ -228,12 +228,17 @@ def check_rows(
             f"(tolerance {fraction:.0%} + {absolute:g} W/m^2)"
         ),
     )
+    # The sun where there is direct light only: a row without any brings no beam to the ground
+    # (ghi >= 0 above). pvlib's SPA is elementwise: those rows' zenith is the whole year's.
+    lit = np.flatnonzero(dni > 0)
+    zenith, beam = np.full(len(dni), np.nan), np.zeros(len(dni))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pvlib reads DatetimeIndex.dayofyear, deprecated by pandas
-        zenith = pvlib.solarposition.get_solarposition(
-            centres, site["latitude"], site["longitude"], site["altitude"]
-        )["zenith"].to_numpy(dtype=float)
-    beam = dni * np.maximum(np.cos(np.radians(zenith)), 0.0)
+        if lit.size:
+            zenith[lit] = pvlib.solarposition.get_solarposition(
+                centres[lit], site["latitude"], site["longitude"], site["altitude"]
+            )["zenith"].to_numpy(dtype=float)
+    beam[lit] = dni[lit] * np.maximum(np.cos(np.radians(zenith[lit])), 0.0)
     refuse(
         beam > ghi + BEAM_TOLERANCE,
         lambda i: (

@@ -120,10 +120,19 @@ def _read(path: str, fmt: str, year: int, mtime: float):
     return result
 
 
+#: The last answer :func:`check_answer` read before it was cached, by its :func:`_read_once` (or
+#: :func:`_measured_once`) key as the cached file: the study that fetched it reads it next, and
+#: takes it from here.
+_checked: dict = {}
+
+
 @functools.lru_cache(maxsize=8)
 def _read_once(path: str, fmt: str, year: int, mtime: float):
     """:func:`_read`'s result, or its error message: a study validates its file once per value of
     every axis, and a bad file must not be read again each time."""
+    checked = _checked.pop((path, fmt, year, mtime), None)
+    if checked is not None:
+        return checked, None
     try:
         return _read_checked(path, fmt, year), None
     except WeatherError as error:
@@ -149,7 +158,7 @@ def _read_checked(path: str, fmt: str, year: int):
     return frame, meta
 
 
-def check_answer(path, fmt: str) -> None:
+def check_answer(path, fmt: str, cached_as=None) -> None:
     """Check a service's answer as the weather file of format ``fmt`` it is, with every check a
     file of that format gets (:mod:`~foldopt.inputs.weather.sources`, before it is cached).
 
@@ -158,16 +167,31 @@ def check_answer(path, fmt: str) -> None:
     path : str or pathlib.Path
     fmt : str
         One of :data:`FORMATS` or :data:`MEASURED_FORMATS`.
+    cached_as : str or pathlib.Path, optional
+        Where ``path`` is renamed to once checked (its modification time kept): what is read here
+        (a typical year's hours in 2025, a measured series with ``read_measured``'s options) is
+        the next read of that file, not read again.
 
     Raises
     ------
     foldopt.errors.WeatherError
         Naming the file, where and why.
     """
+    mtime = Path(path).stat().st_mtime
     if fmt in MEASURED_FORMATS:
-        read_measured(path, fmt)
+        result = read_measured(path, fmt)
+        if cached_as is None:
+            return
+        result.frame.attrs["weather"] = Path(cached_as).name  # as its read names it
+        # read_measured's defaults: the options this answer was read with
+        key = _measured_key(Path(cached_as), mtime, fmt, *read_measured.__defaults__)
     else:
-        _read_checked(str(path), fmt, 2025)
+        result = _read_checked(str(path), fmt, 2025)
+        if cached_as is None:
+            return
+        key = (str(Path(cached_as).resolve()), fmt, 2025, mtime)
+    _checked.clear()
+    _checked[key] = result
 
 
 def weather_site(path, fmt: str | None = None, site: dict | None = None, **measured) -> dict | None:
@@ -238,6 +262,18 @@ def measured_weather(
     foldopt.errors.WeatherError
     """
     path = Path(path)
+    check_file(path)
+    key = _measured_key(
+        path, path.stat().st_mtime, fmt, label, timezone, site, decomposition, max_gap_min
+    )
+    result, message = _measured_once(*key)
+    if message is not None:
+        raise WeatherError(message)
+    return result
+
+
+def _measured_key(path: Path, mtime, fmt, label, timezone, site, decomposition, max_gap_min):
+    """:func:`_measured_once`'s arguments for a file and its options (the site hashable)."""
     where = (
         None
         if site is None
@@ -249,10 +285,9 @@ def measured_weather(
             )
         )
     )
-    check_file(path)
-    result, message = _measured_once(
+    return (
         str(path.resolve()),
-        path.stat().st_mtime,
+        mtime,
         fmt,
         label,
         timezone,
@@ -260,14 +295,16 @@ def measured_weather(
         decomposition,
         float(max_gap_min),
     )
-    if message is not None:
-        raise WeatherError(message)
-    return result
 
 
 @functools.lru_cache(maxsize=8)
 def _measured_once(path, mtime, fmt, label, timezone, site, decomposition, max_gap_min):
     """:func:`measured_weather`'s result, or its error message (a bad file is read once)."""
+    checked = _checked.pop(
+        (path, mtime, fmt, label, timezone, site, decomposition, max_gap_min), None
+    )
+    if checked is not None:
+        return checked, None
     try:
         return read_measured(
             path,

@@ -878,7 +878,7 @@ def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> Wea
 
     def check(temporary: Path) -> None:
         temporary.write_bytes(payload)
-        reason = _unreadable(temporary, source.format)
+        reason = _unreadable(temporary, source.format, path)
         if reason is not None:
             raise WeatherError(
                 f"{label}: {source.service}'s answer is not a readable {source.label} ({reason}); "
@@ -904,14 +904,15 @@ def _store(request: _Request, payload: bytes, retrieved: str, label: str) -> Wea
     return provenance
 
 
-def _unreadable(path: Path, fmt: str) -> str | None:
+def _unreadable(path: Path, fmt: str, cached_as: Path) -> str | None:
     """Why an answer is not a readable file of its format (every check a file of it gets), or
-    None."""
+    None; ``cached_as`` is the file it becomes
+    (:func:`~foldopt.inputs.weather.reader.check_answer`)."""
     if fmt != "horizon":
         from foldopt.inputs.weather import reader as files
 
         try:
-            files.check_answer(path, fmt)
+            files.check_answer(path, fmt, cached_as)
         except WeatherError as error:
             return error.errors[0].split(": ", 1)[-1]
         return None
