@@ -105,7 +105,8 @@ def direct() -> pd.DataFrame:
 #: chunk's modules (numba, pvlib, SciPy: 1.5-2 s of CPU): their workers would not use them. The map's
 #: figures are a PNG of one pixel, not drawn (matplotlib's import and five figures, some 2 s of the
 #: client's core): they are tests/test_figures.py's; what is tested here is the cluster's processes, the
-#: terminal and the table.
+#: terminal and the table. The app is called as the foldopt script calls it (on the process's own
+#: arguments): the command line's own process, whose exit walks no object (foldopt.cli.process).
 FAULTY_TASK = """
 import base64, os, sys
 import foldopt.output.figures as figures
@@ -145,7 +146,7 @@ def task(study, sites, loads, relative, year, engine):
 
 cluster.evaluate_chunk = task
 from foldopt.cli.app import app
-app(sys.argv[1:], prog_name="foldopt")
+app(prog_name="foldopt")
 """
 #: Two sites, a chunk each, at hourly steps and fold angles 90 and 180 deg.
 SMALL = ["--lat", "0,30", "--lon", "0", "--p-load", "1", "--area", "0.108", "--step-min", "60", "--angle-step",
