@@ -160,7 +160,8 @@ EMBEDDED_ONE = r"embedded LocalCluster, 1 worker process; dashboard: http://127\
 #: (TASK_MODULES): imported once by the server this module's map processes are forked from
 #: (:func:`_faulty_run`).
 COMMAND_MODULES = (*TASK_MODULES, "foldopt.cli.app", "foldopt.studies.request", "foldopt.api",
-                   "foldopt.output.figures", "foldopt.output.folders")
+                   "foldopt.output.figures", "foldopt.output.folders", "distributed.dashboard.scheduler",
+                   "rich.console", "pyarrow.pandas_compat")
 #: What a process of :func:`_faulty_run` runs (by :func:`exec`): ``python -c CODE *ARGS`` as a
 #: fresh interpreter would, its imports done. Its own session where SESSION, stdout and stderr
 #: to the files STDOUT and STDERR, the environment ENV (Dask's configuration read from it again,
