@@ -210,6 +210,18 @@ class _Forked:
             shutil.rmtree(self.files[0].parent)
 
 
+def _start_the_server() -> None:
+    """Start this process's worker server (start_worker_server) with :data:`COMMAND_MODULES`,
+    where it does not run yet; skip where the platform has none."""
+    from foldopt.studies.dask_client import start_worker_server
+
+    environment = dict(os.environ)
+    if not start_worker_server(COMMAND_MODULES):
+        pytest.skip("no forkserver on this platform")
+    # The nanny's environment is the server's, not left in this process (an API caller's).
+    assert dict(os.environ) == environment
+
+
 def _faulty_run(fault: str, folder: Path, args: list[str], env=None, start_new_session=False) -> _Forked:
     """Start the map of ``args`` (its cluster's options too) with ``fault`` into ``folder / "map"``
     (:data:`FAULTY_TASK`); ``env``'s variables are added to this process's but for
@@ -220,10 +232,7 @@ def _faulty_run(fault: str, folder: Path, args: list[str], env=None, start_new_s
     imports is tests/test_imports.py's)."""
     import multiprocessing
 
-    from foldopt.studies.dask_client import start_worker_server
-
-    if not start_worker_server(COMMAND_MODULES):
-        pytest.skip("no forkserver on this platform")
+    _start_the_server()
     environment = {**os.environ, "FAULT": fault, "MARK": str(folder / "died"), **(env or {})}
     environment.pop("FOLDOPT_QUIET", None)
     where = Path(tempfile.mkdtemp(prefix="foldopt-map-"))  # not in folder: the tests list what is there
@@ -388,13 +397,7 @@ def hand_started(tmp_path_factory):
     processes of :func:`_faulty_run`): spawned, each imported them again (2-3 s of CPU a worker)."""
     import multiprocessing
 
-    from foldopt.studies.dask_client import start_worker_server
-
-    environment = dict(os.environ)
-    if not start_worker_server(COMMAND_MODULES):
-        pytest.skip("no forkserver on this platform")
-    # The nanny's environment is the server's, not left in this process (an API caller's).
-    assert dict(os.environ) == environment
+    _start_the_server()
     scheduler_file = tmp_path_factory.mktemp("cluster") / "scheduler.json"
     # Without the dashboard (bokeh's import): nothing looks at it. Its HTTP server on a free port.
     commands = [("distributed.cli.dask_scheduler", ["--host", "127.0.0.1", "--port", "0", "--no-dashboard",
