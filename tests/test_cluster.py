@@ -156,7 +156,8 @@ SMALL = ["--lat", "0,30", "--lon", "0", "--p-load", "1", "--area", "0.108", "--s
 EMBEDDED_ONE = r"embedded LocalCluster, 1 worker process; dashboard: http://127\.0\.0\.1:\d+/status"
 
 
-#: The modules the command line imports before its map's work, and the map's task's
+#: The modules a map's command line imports (its parsing, request and folder, its embedded
+#: scheduler's dashboard, its terminal's rich, the parts' pyarrow), and the map's task's
 #: (TASK_MODULES): imported once by the server this module's map processes are forked from
 #: (:func:`_faulty_run`).
 COMMAND_MODULES = (*TASK_MODULES, "foldopt.cli.app", "foldopt.studies.request", "foldopt.api",
