@@ -135,14 +135,18 @@ def test_ideal_model_connections_are_sums():
 SOLSTICES, MIDSUMMER = "2025-06-21,2025-12-21", "2025-06-20,2025-06-21,2025-06-22"
 
 
-def _sweep_folder(tmp_path, *extra):
+def _sweep_folder(tmp_path, figures_drawn_elsewhere, *extra):
     from typer.testing import CliRunner
 
     from foldopt.cli.app import app
 
     out = tmp_path / "out"
-    result = CliRunner().invoke(app, ["sweep", "day", "--lat", "52.52", "--lon", "13.40", "--p-load", "2",
-                                      "--step-min", "15", "--angle-step", "2", "-q", *extra, "--out", str(out)])
+    # What is read is the folder's tables: a day sweep's figures are drawn whole by
+    # tests/test_cli_studies.py (days with different angles too).
+    with figures_drawn_elsewhere():
+        result = CliRunner().invoke(app, ["sweep", "day", "--lat", "52.52", "--lon", "13.40", "--p-load", "2",
+                                          "--step-min", "15", "--angle-step", "2", "-q", *extra, "--out",
+                                          str(out)])
     assert result.exit_code == 0, result.output
     return out
 
@@ -150,12 +154,13 @@ def _sweep_folder(tmp_path, *extra):
 @pytest.mark.parametrize("dates,objective,angles", [(SOLSTICES, (), 2), (SOLSTICES, ("--objective", "mean"), 1),
                                                    (MIDSUMMER, (), 1)],
                          ids=["solstices", "solstices-one-angle", "days-in-a-row"])
-def test_the_annual_summary_says_what_its_angle_and_totals_stand_for(tmp_path, dates, objective, angles):
+def test_the_annual_summary_says_what_its_angle_and_totals_stand_for(tmp_path, figures_drawn_elsewhere, dates,
+                                                                      objective, angles):
     """A design's fold_angle_deg in annual_summary.csv is the angle of every one of its days in
     results.csv; where the days differ (each day's own best) it is empty, the range of the days'
     angles is given and a note says so (it was the first day's). Where the days skip some of their
     period, the note says the totals are the days' only."""
-    out = _sweep_folder(tmp_path, "--days", dates, *objective)
+    out = _sweep_folder(tmp_path, figures_drawn_elsewhere, "--days", dates, *objective)
     days = pd.read_csv(out / "results.csv")
     summary = pd.read_csv(out / "annual_summary.csv", keep_default_na=False, na_values=[""]).set_index("design")
     assert set(summary.index) == set(days["design"])

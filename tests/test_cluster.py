@@ -9,16 +9,18 @@ run share it: the killed map is finished by the run whose worker dies and whose 
 (:func:`resumed`), both runs' tasks say whether --quiet reached their workers, and the scheduler
 lost is that of the cluster whose worker was killed (:func:`worker_killed`). The maps on that
 cluster run their client in this process (:func:`_map_on`): what is killed there is a worker and
-the scheduler, processes of their own."""
+the scheduler, processes of their own. The other maps' command lines are processes of their own,
+forked from one server that imported their modules (:func:`_faulty_run`)."""
 
 from __future__ import annotations
 
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
-import sys
+import tempfile
 import threading
 import time
 from contextlib import contextmanager
@@ -32,7 +34,7 @@ from typer.testing import CliRunner
 from foldopt.cli.app import app
 from foldopt.errors import ConfigError
 from foldopt.inputs.sites import grid_sites
-from foldopt.studies.cluster import run_map
+from foldopt.studies.cluster import TASK_MODULES, run_map
 from foldopt.studies.map_request import MapSpec
 from foldopt.errors import OutputError
 from foldopt.studies.worldmap import evaluate_sites
@@ -105,7 +107,8 @@ def direct() -> pd.DataFrame:
 #: chunk's modules (numba, pvlib, SciPy: 1.5-2 s of CPU): their workers would not use them. The map's
 #: figures are a PNG of one pixel, not drawn (matplotlib's import and five figures, some 2 s of the
 #: client's core): they are tests/test_figures.py's; what is tested here is the cluster's processes, the
-#: terminal and the table.
+#: terminal and the table. The app is called as the foldopt script calls it (on the process's own
+#: arguments): the command line's own process, whose exit walks no object (foldopt.cli.process).
 FAULTY_TASK = """
 import base64, os, sys
 import foldopt.output.figures as figures
@@ -145,7 +148,7 @@ def task(study, sites, loads, relative, year, engine):
 
 cluster.evaluate_chunk = task
 from foldopt.cli.app import app
-app(sys.argv[1:], prog_name="foldopt")
+app(prog_name="foldopt")
 """
 #: Two sites, a chunk each, at hourly steps and fold angles 90 and 180 deg.
 SMALL = ["--lat", "0,30", "--lon", "0", "--p-load", "1", "--area", "0.108", "--step-min", "60", "--angle-step",
@@ -153,14 +156,93 @@ SMALL = ["--lat", "0,30", "--lon", "0", "--p-load", "1", "--area", "0.108", "--s
 EMBEDDED_ONE = r"embedded LocalCluster, 1 worker process; dashboard: http://127\.0\.0\.1:\d+/status"
 
 
-def _faulty_run(fault: str, folder: Path, args: list[str], **popen) -> subprocess.Popen:
+#: The modules a map's command line imports (its parsing, request and folder, its embedded
+#: scheduler's dashboard, its terminal's rich, the parts' pyarrow), and the map's task's
+#: (TASK_MODULES): imported once by the server this module's map processes are forked from
+#: (:func:`_faulty_run`).
+COMMAND_MODULES = (*TASK_MODULES, "foldopt.cli.app", "foldopt.studies.request", "foldopt.api",
+                   "foldopt.output.figures", "foldopt.output.folders", "distributed.dashboard.scheduler",
+                   "rich.console", "pyarrow.pandas_compat")
+#: What a process of :func:`_faulty_run` runs (by :func:`exec`): ``python -c CODE *ARGS`` as a
+#: fresh interpreter would, its imports done. Its own session where SESSION, stdout and stderr
+#: to the files STDOUT and STDERR, the environment ENV (Dask's configuration read from it again,
+#: as at Dask's import), no resource tracker of its parent's (the command starts its own), and the
+#: exit's handlers run as the interpreter's exit runs them.
+FORKED_COMMAND = """
+import atexit, os, sys
+from multiprocessing import resource_tracker
+if SESSION:
+    os.setsid()
+for stream, path in ((1, STDOUT), (2, STDERR)):
+    os.dup2(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC), stream)
+os.environ.clear()
+os.environ.update(ENV)
+import dask
+dask.config.refresh()
+resource_tracker._resource_tracker._fd = None
+sys.argv = ["-c", *ARGS]
+try:
+    exec(CODE, {"__name__": "__main__"})
+finally:
+    atexit._run_exitfuncs()
+"""
+
+
+class _Forked:
+    """A process of :func:`_faulty_run`: what :class:`subprocess.Popen` gives the tests."""
+
+    def __init__(self, process, stdout: Path, stderr: Path):
+        self.process, self.pid, self.files = process, process.pid, (stdout, stderr)
+
+    def poll(self) -> int | None:
+        return None if self.process.is_alive() else self.process.exitcode
+
+    @property
+    def returncode(self) -> int | None:
+        return self.poll()
+
+    def communicate(self, timeout: float) -> tuple[str, str]:
+        self.process.join(timeout)
+        if self.process.is_alive():
+            raise subprocess.TimeoutExpired("foldopt map", timeout)
+        try:
+            return tuple(path.read_text() for path in self.files)
+        finally:
+            shutil.rmtree(self.files[0].parent)
+
+
+def _start_the_server() -> None:
+    """Start this process's worker server (start_worker_server) with :data:`COMMAND_MODULES`,
+    where it does not run yet; skip where the platform has none."""
+    from foldopt.studies.dask_client import start_worker_server
+
+    environment = dict(os.environ)
+    if not start_worker_server(COMMAND_MODULES):
+        pytest.skip("no forkserver on this platform")
+    # The nanny's environment is the server's, not left in this process (an API caller's).
+    assert dict(os.environ) == environment
+
+
+def _faulty_run(fault: str, folder: Path, args: list[str], env=None, start_new_session=False) -> _Forked:
     """Start the map of ``args`` (its cluster's options too) with ``fault`` into ``folder / "map"``
-    (:data:`FAULTY_TASK`); ``popen["env"]``'s variables are added to this process's but for
-    ``FOLDOPT_QUIET``: the map's own options say whether it is quiet."""
-    env = {**os.environ, "FAULT": fault, "MARK": str(folder / "died"), **popen.pop("env", {})}
-    env.pop("FOLDOPT_QUIET", None)
-    return subprocess.Popen([sys.executable, "-c", FAULTY_TASK, "map", *args, "--out", str(folder / "map")], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen)
+    (:data:`FAULTY_TASK`); ``env``'s variables are added to this process's but for
+    ``FOLDOPT_QUIET``: the map's own options say whether it is quiet. The process is a fork of
+    the server the embedded cluster's workers are forked from (start_worker_server), which
+    imported the command line's modules once (:data:`COMMAND_MODULES`): started by
+    ``python -c``, each run imported them again, some 1.2 s of CPU (what a fresh command line
+    imports is tests/test_imports.py's)."""
+    import multiprocessing
+
+    _start_the_server()
+    environment = {**os.environ, "FAULT": fault, "MARK": str(folder / "died"), **(env or {})}
+    environment.pop("FOLDOPT_QUIET", None)
+    where = Path(tempfile.mkdtemp(prefix="foldopt-map-"))  # not in folder: the tests list what is there
+    streams = (where / "stdout", where / "stderr")
+    script = {"CODE": FAULTY_TASK, "ARGS": ["map", *args, "--out", str(folder / "map")], "ENV": environment,
+              "SESSION": start_new_session, "STDOUT": str(streams[0]), "STDERR": str(streams[1])}
+    process = multiprocessing.get_context("forkserver").Process(target=exec, args=(FORKED_COMMAND, script))
+    process.start()
+    return _Forked(process, *streams)
 
 
 def _faulty_map(fault: str, folder: Path, args: list[str], **environment) -> tuple[int, list[str], str]:
@@ -312,18 +394,11 @@ def hand_started(tmp_path_factory):
     one kills the worker): the scheduler file, the workers' processes and the scheduler's. Each
     process the module's own, killed at its end. The workers start with the scheduler: they wait
     for its file. Each is a fork of the server the embedded cluster's workers are forked from
-    (start_worker_server), which imports Dask and the map's task once for the three: spawned, each
-    imported them again (2-3 s of CPU a worker)."""
+    (start_worker_server), which imports Dask and the map's task once for the three (and the map
+    processes of :func:`_faulty_run`): spawned, each imported them again (2-3 s of CPU a worker)."""
     import multiprocessing
 
-    from foldopt.studies.cluster import TASK_MODULES
-    from foldopt.studies.dask_client import start_worker_server
-
-    environment = dict(os.environ)
-    if not start_worker_server(TASK_MODULES):
-        pytest.skip("no forkserver on this platform")
-    # The nanny's environment is the server's, not left in this process (an API caller's).
-    assert dict(os.environ) == environment
+    _start_the_server()
     scheduler_file = tmp_path_factory.mktemp("cluster") / "scheduler.json"
     # Without the dashboard (bokeh's import): nothing looks at it. Its HTTP server on a free port.
     commands = [("distributed.cli.dask_scheduler", ["--host", "127.0.0.1", "--port", "0", "--no-dashboard",
