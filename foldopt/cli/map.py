@@ -28,6 +28,7 @@ from foldopt.cli.options import (
 )
 from foldopt import names
 from foldopt.cli.output import INVOCATION, Output, fail
+from foldopt.cli.process import loading
 from foldopt.errors import ConfigError
 from foldopt.names import CONNECT_TIMEOUT, DEFAULT_ENGINE, WORKER_TIMEOUT
 
@@ -223,7 +224,8 @@ def map_(
         if value is not None and value < 1
     ]
     # The cluster's client (logging, sockets) loads with a map: other commands need none of it.
-    from foldopt.studies.dask_client import check_cluster
+    with loading():
+        from foldopt.studies.dask_client import check_cluster
 
     try:
         check_cluster(scheduler, workers)
@@ -231,7 +233,8 @@ def map_(
         errors += error.errors
     if errors:
         fail(errors)
-    from foldopt.studies.request import make_request
+    with loading():
+        from foldopt.studies.request import make_request
 
     options = {
         "area": area,
@@ -284,7 +287,8 @@ def map_(
     with output.progress(
         f"map: {len(spec.sites)} sites", total=len(spec.sites), unit="sites"
     ) as progress:
-        from foldopt.api import world_map
+        with loading():
+            from foldopt.api import world_map
 
         try:
             result, figures, answer = world_map(
