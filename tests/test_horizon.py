@@ -9,7 +9,6 @@ The files are in tests/data/horizon (README.md there).
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -185,15 +184,19 @@ def test_bad_arguments_are_refused(bad, match):
         sky_view_factors(**arguments)
 
 
-def test_speed_of_many_surfaces():
-    """1e5 surfaces under the PVGIS profile: about 0.5 s on one core (1 s for near-vertical ones);
-    the bound leaves room for a busy machine."""
+def test_many_surfaces_at_once_are_each_surface_alone():
+    """1e5 surfaces under the PVGIS profile in one call (the map's and the optimiser's use) give each
+    surface's own factors, within the bounds of its plane (the time: ``python bench/horizon.py``)."""
     azimuth, elevation = read_horizon(PVGIS_JSON)
     rng = np.random.default_rng(3)
     tilt, facing = rng.uniform(0.0, 180.0, 100_000), rng.uniform(0.0, 360.0, 100_000)
-    start = time.perf_counter()
-    sky_view_factors(tilt, facing, azimuth, elevation)
-    assert time.perf_counter() - start < 5.0
+    isotropic, band = sky_view_factors(tilt, facing, azimuth, elevation)
+    radians = np.radians(tilt)
+    assert (isotropic >= 0).all() and (isotropic <= (1 + np.cos(radians)) / 2 + 1e-12).all()
+    assert (band >= 0).all() and (band <= np.sin(radians) + 1e-12).all()
+    for k in rng.choice(tilt.size, 20, replace=False):
+        alone = tuple(map(float, sky_view_factors(tilt[k], facing[k], azimuth, elevation)))
+        assert (isotropic[k], band[k]) == pytest.approx(alone, rel=1e-12, abs=1e-15)
 
 
 # The sun and the horizon line ----------------------------------------------------------------
