@@ -98,10 +98,13 @@ WARM_UP = "SUITE_WARM_UP_FOLDER"
 #: compiled them for itself, and again the Dask worker of the first map and the docs build, the
 #: compile costing more than most modules' tests. Three parts run beside the workers, which start
 #: with :data:`BEFORE_THE_WARM_UP`, on one cache: the fold kernel's rows, the longest, alone in its
-#: process; what they share (the sky's passes, a day's walk by blocks) each part compiles at a
-#: different time, so that the later finds it in the cache rather than compiling it too.
+#: process. Each part is two steps, each marked done by a lock its process lets go of: ``first``,
+#: what the modules of :data:`BEFORE_THE_WARM_UP` call (the sun and the sky's passes, the means over
+#: periods, a tracker's irradiance), which they wait for; then the rest, which the other modules
+#: wait for. What two parts share one compiles and the other waits for (``wait_for``), so that it
+#: loads it from the cache rather than compiling it at the same time.
 WARM_UP_PARTS = {
-    "rows": """
+    "rows": ("""
 import numpy as np
 import foldopt
 from foldopt.engine import evaluation as engine
@@ -109,16 +112,19 @@ from foldopt.engine.sky import build_sky
 from foldopt.inputs.study_file import default_study_path
 from foldopt.studies.engine_options import engine_options
 
-# The fold kernel's rows: the ideal circuit's (the paper's study) and the circuit as built.
-for name in ("shin2015", "site-as-built"):
-    study = foldopt.load_study(default_study_path().parent / f"{name}.yaml")
-    options = engine_options(study)
+# The sun and the sky's passes, of the ideal circuit (the paper's study) and the circuit as built.
+studies = [foldopt.load_study(default_study_path().parent / f"{name}.yaml") for name in ("shin2015", "site-as-built")]
+skies = [build_sky(engine_options(study).sky, [study.site], [study.date]) for study in studies]
+""", """
+# The fold kernel's rows, which call a day's walk by blocks.
+wait_for("curves.first")
+for study, sky in zip(studies, skies):
     orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth], [90.0, 180.0])
-    engine.row_metrics(build_sky(options.sky, [study.site], [study.date]), rows=engine.PanelRows(
-        np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)), loads=[1.0], electrical=options.electrical,
-        outputs=engine.OUTPUTS, contiguous=True, engine="numba")
-""",
-    "common": """
+    engine.row_metrics(sky, rows=engine.PanelRows(np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)),
+                       loads=[1.0], electrical=engine_options(study).electrical, outputs=engine.OUTPUTS,
+                       contiguous=True, engine="numba")
+"""),
+    "common": ("", """
 import numpy as np
 from foldopt.engine import evaluation as engine
 from foldopt.engine.sky import build_sky
@@ -126,44 +132,58 @@ from foldopt.engine.storage import Buffer, simulate
 from foldopt.inputs.study import make_study
 from foldopt.studies.engine_options import engine_options
 
-# The buffer's simulation (one series or several, one buffer or one a series alike), first: by its
-# end the rows' part has compiled the sky's passes, which this part's sky then loads.
+# The buffer's simulation (one series or several, one buffer or one a series alike).
 simulate(np.ones((1, 96)), 0.5, Buffer(1.0), 0.25, engine="numba")
 
 # The fold kernel's common case (switching alone from one table set, exact incidence, constant loads):
 # every clear-sky study with I-V tables and a year of weather takes it, and until it is compiled
-# `auto` sends such studies to the NumPy path (a year 41 s there against 2.5 s).
+# `auto` sends such studies to the NumPy path (a year 41 s there against 2.5 s). Its sky's passes
+# the rows' part compiles, a day's walk the curves' part.
 study = make_study({"name": "common", "mode": "exact", "sky": "ineichen", "pv_model": "single-diode",
                     "connection": "switching", "site": {"latitude": 34.05, "longitude": -118.25},
                     "date": "2025-06-21", "panel": {"area": 0.108, "efficiency": 0.19}, "p_load": 1.0})
 options = engine_options(study)
 orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth], [90.0, 180.0])
-engine.row_metrics(build_sky(options.sky, [study.site], [study.date]), rows=engine.PanelRows(
-    np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)), loads=[1.0], electrical=options.electrical,
-    outputs=("switching",), engine="numba")
-""",
-    "curves": """
+wait_for("rows.first")
+sky = build_sky(options.sky, [study.site], [study.date])
+wait_for("curves.first")
+engine.row_metrics(sky, rows=engine.PanelRows(np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)),
+                   loads=[1.0], electrical=options.electrical, outputs=("switching",), engine="numba")
+"""),
+    "curves": ("""
 import numpy as np
 from foldopt.engine import evaluation as engine
 from foldopt.engine.curve_reduction import blocked_day, period_means
 from foldopt.engine.incidence import turning_poa
 from foldopt.engine.kernel import _keep_curves
+from foldopt.physics.trackers import TrackerDrive, moved_degrees
 
-# What both kernel parts call, first, in the argument types they call it with: they find it in the
-# cache (a day's walk by blocks; a row's curves kept).
+# What both kernel parts call, in the argument types they call it with (a day's walk by blocks; a
+# row's curves kept); the means over periods of days; a tracker's irradiance (its normal's
+# components along the steps, as foldopt.studies.designs.sky_tracker_poa hands them) and moves.
 one, two = np.zeros(1), np.zeros(2)
 blocked_day(np.zeros(4), (0, 3), np.ones(1), 0.25, np.zeros(4), (one, one), (one, two), np.zeros(1))
 _keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
-# The reduction of given curves (a tracker's, a design's: constant loads and a load profile's
-# alike); the means over periods of days; a tracker's irradiance.
-power = np.zeros((2, 96))
-engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba")
 period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))
-# (its normal a view along the steps, as foldopt.studies.designs.sky_tracker_poa hands it)
-turning_poa(np.moveaxis(np.zeros((2, 3, 2)), 1, -1), np.zeros((2, 3, 2)), np.zeros((2, 2)), np.zeros((2, 1, 2)),
+turning_poa(np.zeros((2, 3, 2)), np.zeros((2, 3, 2)), np.zeros((2, 2)), np.zeros((2, 1, 2)),
             np.zeros((2, 2), dtype=np.int64), np.zeros((2, 2)))
-""",
+TrackerDrive(standby_w=0.3).move_energy_wh(moved_degrees(np.eye(3)[None], "numba"), "numba")
+""", """
+# The reduction of given curves (a tracker's, a design's: constant loads and a load profile's alike).
+engine.curve_metrics(np.zeros((2, 96)), [1.0], 0.25, contiguous=True, engine="numba")
+"""),
 }
+#: What each warm-up process runs before its part's steps: ``wait_for(step)`` returns once the
+#: process of another part has let go of the step's lock (``<part>.first`` or ``<part>``), in the
+#: warm-up's folder, its working folder.
+_WARM_UP_PRELUDE = """
+import fcntl
+import os
+
+def wait_for(step):
+    with open(step + ".lock") as held:
+        fcntl.flock(held, fcntl.LOCK_SH)
+"""
 #: The warm-up's processes (the controller's), to wait for or end at the session's end.
 _warm_up_processes: dict[str, subprocess.Popen] = {}
 
@@ -175,21 +195,28 @@ def _whole_suite(config) -> bool:
 
 
 def _start_the_warm_up(config) -> None:
-    """Start the warm-up's processes, each holding an exclusive lock on ``<part>.lock`` in a folder
-    of its own until it ends (the lock is taken here and handed over, so that no worker can find it
-    free before the process has it); the workers learn the folder from :data:`WARM_UP`."""
+    """Start the warm-up's processes, each holding an exclusive lock on ``<part>.lock`` (and on
+    ``<part>.first.lock`` while its first step runs) in a folder of its own until it ends (the locks
+    are taken here and handed over, so that no worker can find one free before the process has
+    it); the workers learn the folder from :data:`WARM_UP`."""
     if fcntl is None:
         return
     folder = Path(tempfile.mkdtemp(prefix="foldopt-warm-up-"))
     os.environ[WARM_UP] = str(folder)
     # The suite's foldopt is on PYTHONPATH (_every_process_imports_this_foldopt).
     env = {**os.environ, "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
-    for part, code in WARM_UP_PARTS.items():
-        with open(folder / f"{part}.lock", "w") as lock, open(folder / f"{part}.log", "w") as log:
-            fcntl.flock(lock, fcntl.LOCK_EX)
+    for part, (first, then) in WARM_UP_PARTS.items():
+        with contextlib.ExitStack() as stack:
+            log = stack.enter_context(open(folder / f"{part}.log", "w"))
+            locks = [stack.enter_context(open(folder / f"{step}.lock", "w"))
+                     for step in (part, *([f"{part}.first"] if first else []))]
+            for lock in locks:
+                fcntl.flock(lock, fcntl.LOCK_EX)
+            # The first step's end closes the process's copy of its lock (this one closes here).
+            code = _WARM_UP_PRELUDE + first + (f"os.close({locks[1].fileno()})\n" if first else "") + then
             _warm_up_processes[part] = subprocess.Popen(
                 [sys.executable, "-c", code], cwd=folder, env=env, stdout=log, stderr=subprocess.STDOUT,
-                stdin=subprocess.DEVNULL, pass_fds=(lock.fileno(),))
+                stdin=subprocess.DEVNULL, pass_fds=[lock.fileno() for lock in locks])
     config.add_cleanup(_end_the_warm_up)
 
 
@@ -219,21 +246,22 @@ def pytest_terminal_summary(terminalreporter):
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_runtest_setup(item):
-    """In a worker, before the fixtures of its first test that evaluates a study (here, in a command
-    line or in a Dask worker it starts), wait until every warm-up process has ended: numba's cache
-    then holds what they compiled, nothing is compiled twice, and ``auto`` finds the kernel
-    compiled whole or not at all."""
-    global _warmed_up
+    """In a worker, before the fixtures of a test, wait until the warm-up has compiled what the test
+    calls: the first step of every part (``<part>.first.lock``) for the modules of
+    :data:`BEFORE_THE_WARM_UP`, every part whole for the others (the first that evaluates a study,
+    here, in a command line or in a Dask worker it starts). numba's cache then holds what they
+    compiled, nothing is compiled twice, and ``auto`` finds the kernel compiled whole or not at all."""
     folder = os.environ.get(WARM_UP)
-    if folder and fcntl is not None and not _warmed_up and item.path.name not in BEFORE_THE_WARM_UP:
-        for path in sorted(Path(folder).glob("*.lock")):
+    steps = "*.first.lock" if item.path.name in BEFORE_THE_WARM_UP else "*.lock"
+    if folder and fcntl is not None and steps not in _waited_for:
+        for path in sorted(Path(folder).glob(steps)):
             with open(path) as held:
-                fcntl.flock(held, fcntl.LOCK_SH)  # free once its process has ended
-        _warmed_up = True
+                fcntl.flock(held, fcntl.LOCK_SH)  # free once its process has let go of it
+        _waited_for.add(steps)
 
 
-#: Whether this worker has waited for the warm-up.
-_warmed_up = False
+#: The warm-up's steps this worker has waited for (a pattern of their locks' names).
+_waited_for: set[str] = set()
 
 
 # --- the order of the suite -------------------------------------------------------------------------
