@@ -96,79 +96,75 @@ WARM_UP = "SUITE_WARM_UP_FOLDER"
 #: What each warm-up process runs (``python -c``): the numba functions the suite calls, in the
 #: argument types it calls them with, compiled into numba's cache. On a fresh clone each worker
 #: compiled them for itself, and again the Dask worker of the first map and the docs build, the
-#: compile costing more than most modules' tests. Three parts run beside the workers, which start
-#: with :data:`BEFORE_THE_WARM_UP`, on one cache: the fold kernel's rows, the longest, alone in its
-#: process. Each part is two steps, each marked done by a lock its process lets go of: ``first``,
-#: what the modules of :data:`BEFORE_THE_WARM_UP` call (the sun and the sky's passes, the means over
-#: periods, a tracker's irradiance), which they wait for; then the rest, which the other modules
-#: wait for. What two parts share one compiles and the other waits for (``wait_for``), so that it
-#: loads it from the cache rather than compiling it at the same time.
+#: compile costing more than most modules' tests. Two parts run beside the workers, which start
+#: with :data:`BEFORE_THE_WARM_UP`, on one cache, each some 15 s of one core: the fold kernel's
+#: rows (its general loop), and the rest (the sun and the sky, the common case's loop, the buffer,
+#: the reduction of given curves); a third process cost its imports and numba's start again. Each
+#: part is two steps, each marked done by a lock its process lets go of: ``first``, what the
+#: modules of :data:`BEFORE_THE_WARM_UP` call and what the other part's loop calls, which they wait
+#: for (``wait_for`` in a part), so that it is loaded from the cache, never compiled twice at once;
+#: then the rest, which the other modules wait for.
 WARM_UP_PARTS = {
     "rows": ("""
 import numpy as np
 import foldopt
 from foldopt.engine import evaluation as engine
+from foldopt.engine.curve_reduction import blocked_day
+from foldopt.engine.kernel import _keep_curves
 from foldopt.engine.sky import build_sky
 from foldopt.inputs.study_file import default_study_path
 from foldopt.studies.engine_options import engine_options
 
-# The sun and the sky's passes, of the ideal circuit (the paper's study) and the circuit as built.
-studies = [foldopt.load_study(default_study_path().parent / f"{name}.yaml") for name in ("shin2015", "site-as-built")]
-skies = [build_sky(engine_options(study).sky, [study.site], [study.date]) for study in studies]
+# What both kernel parts call, in the argument types they call it with: a day's walk by blocks, a
+# row's curves kept.
+one, two = np.zeros(1), np.zeros(2)
+blocked_day(np.zeros(4), (0, 3), np.ones(1), 0.25, np.zeros(4), (one, one), (one, two), np.zeros(1))
+_keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
 """, """
-# The fold kernel's rows, which call a day's walk by blocks.
-wait_for("curves.first")
-for study, sky in zip(studies, skies):
+# The fold kernel's rows: the ideal circuit's (the paper's study) and the circuit as built, on skies
+# whose passes the other part compiles.
+wait_for("common.first")
+for name in ("shin2015", "site-as-built"):
+    study = foldopt.load_study(default_study_path().parent / f"{name}.yaml")
+    options = engine_options(study)
     orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth], [90.0, 180.0])
-    engine.row_metrics(sky, rows=engine.PanelRows(np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)),
-                       loads=[1.0], electrical=engine_options(study).electrical, outputs=engine.OUTPUTS,
-                       contiguous=True, engine="numba")
+    engine.row_metrics(build_sky(options.sky, [study.site], [study.date]), rows=engine.PanelRows(
+        np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)), loads=[1.0], electrical=options.electrical,
+        outputs=engine.OUTPUTS, contiguous=True, engine="numba")
 """),
-    "common": ("", """
+    "common": ("""
 import numpy as np
 from foldopt.engine import evaluation as engine
+from foldopt.engine.curve_reduction import period_means
+from foldopt.engine.incidence import turning_poa
 from foldopt.engine.sky import build_sky
 from foldopt.engine.storage import Buffer, simulate
 from foldopt.inputs.study import make_study
+from foldopt.physics.trackers import TrackerDrive, moved_degrees
 from foldopt.studies.engine_options import engine_options
 
-# The buffer's simulation (one series or several, one buffer or one a series alike).
-simulate(np.ones((1, 96)), 0.5, Buffer(1.0), 0.25, engine="numba")
-
-# The fold kernel's common case (switching alone from one table set, exact incidence, constant loads):
-# every clear-sky study with I-V tables and a year of weather takes it, and until it is compiled
-# `auto` sends such studies to the NumPy path (a year 41 s there against 2.5 s). Its sky's passes
-# the rows' part compiles, a day's walk the curves' part.
+# The sun and the sky's passes (SPA's, the clear sky's), of the fold kernel's common case (switching
+# alone from one table set, exact incidence, constant loads).
 study = make_study({"name": "common", "mode": "exact", "sky": "ineichen", "pv_model": "single-diode",
                     "connection": "switching", "site": {"latitude": 34.05, "longitude": -118.25},
                     "date": "2025-06-21", "panel": {"area": 0.108, "efficiency": 0.19}, "p_load": 1.0})
 options = engine_options(study)
-orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth], [90.0, 180.0])
-wait_for("rows.first")
 sky = build_sky(options.sky, [study.site], [study.date])
-wait_for("curves.first")
-engine.row_metrics(sky, rows=engine.PanelRows(np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)),
-                   loads=[1.0], electrical=options.electrical, outputs=("switching",), engine="numba")
-"""),
-    "curves": ("""
-import numpy as np
-from foldopt.engine import evaluation as engine
-from foldopt.engine.curve_reduction import blocked_day, period_means
-from foldopt.engine.incidence import turning_poa
-from foldopt.engine.kernel import _keep_curves
-from foldopt.physics.trackers import TrackerDrive, moved_degrees
-
-# What both kernel parts call, in the argument types they call it with (a day's walk by blocks; a
-# row's curves kept); the means over periods of days; a tracker's irradiance (its normal's
-# components along the steps, as foldopt.studies.designs.sky_tracker_poa hands them) and moves.
-one, two = np.zeros(1), np.zeros(2)
-blocked_day(np.zeros(4), (0, 3), np.ones(1), 0.25, np.zeros(4), (one, one), (one, two), np.zeros(1))
-_keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
+# The means over periods of days; a tracker's irradiance (its normal's components along the steps,
+# as foldopt.studies.designs.sky_tracker_poa hands them) and moves.
 period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))
 turning_poa(np.zeros((2, 3, 2)), np.zeros((2, 3, 2)), np.zeros((2, 2)), np.zeros((2, 1, 2)),
             np.zeros((2, 2), dtype=np.int64), np.zeros((2, 2)))
 TrackerDrive(standby_w=0.3).move_energy_wh(moved_degrees(np.eye(3)[None], "numba"), "numba")
 """, """
+# The buffer's simulation (one series or several, one buffer or one a series alike).
+simulate(np.ones((1, 96)), 0.5, Buffer(1.0), 0.25, engine="numba")
+# The common case's loop: every clear-sky study with I-V tables and a year of weather takes it, and
+# until it is compiled `auto` sends such studies to the NumPy path (a year 41 s there against 2.5 s).
+orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth], [90.0, 180.0])
+wait_for("rows.first")
+engine.row_metrics(sky, rows=engine.PanelRows(np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)),
+                   loads=[1.0], electrical=options.electrical, outputs=("switching",), engine="numba")
 # The reduction of given curves (a tracker's, a design's: constant loads and a load profile's alike).
 engine.curve_metrics(np.zeros((2, 96)), [1.0], 0.25, contiguous=True, engine="numba")
 """),
@@ -269,7 +265,9 @@ _waited_for: set[str] = set()
 #: Modules that evaluate no study above ``auto``'s bound for a compiled kernel (physics against its
 #: references, the code's layout, days on the NumPy path): what they compute does not hang on how far
 #: the warm-up has got (``auto`` takes the kernel for a smaller request once it is compiled), so the
-#: workers run them first, while the warm-up compiles.
+#: workers run them first, while the warm-up compiles. What they call compiled (the sun, the sky,
+#: a tracker's irradiance and moves, the means over periods) is the warm-up parts' first steps,
+#: which they wait for: with those in numba's cache they compile nothing the warm-up compiles.
 BEFORE_THE_WARM_UP = ("test_weather_validation.py", "test_architecture.py", "test_aggregation.py",
                       "test_near_optimal.py", "test_storage_section.py", "test_atmosphere.py", "test_clearsky.py",
                       "test_converter.py", "test_electrical.py", "test_geometry.py", "test_horizon.py",
