@@ -97,13 +97,14 @@ WARM_UP = "SUITE_WARM_UP_FOLDER"
 #: argument types it calls them with, compiled into numba's cache. On a fresh clone each worker
 #: compiled them for itself, and again the Dask worker of the first map and the docs build, the
 #: compile costing more than most modules' tests. Two parts run beside the workers, which start
-#: with :data:`BEFORE_THE_WARM_UP`, on one cache, each some 15 s of one core: the fold kernel's
+#: with :data:`BEFORE_THE_WARM_UP`, on one cache, each about half the compile: the fold kernel's
 #: rows (its general loop), and the rest (the sun and the sky, the common case's loop, the buffer,
-#: the reduction of given curves); a third process cost its imports and numba's start again. Each
+#: the reduction of given curves); a third process would cost its imports and numba's start. Each
 #: part is two steps, each marked done by a lock its process lets go of: ``first``, what the
 #: modules of :data:`BEFORE_THE_WARM_UP` call and what the other part's loop calls, which they wait
 #: for (``wait_for`` in a part), so that it is loaded from the cache, never compiled twice at once;
-#: then the rest, which the other modules wait for.
+#: then the rest, which the other modules wait for. The rows' first step is the shorter: while its
+#: process waits for the other's, the workers still collect the suite, and no core is idle.
 WARM_UP_PARTS = {
     "rows": ("""
 import numpy as np
