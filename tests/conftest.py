@@ -96,20 +96,35 @@ WARM_UP = "SUITE_WARM_UP_FOLDER"
 #: What each warm-up process runs (``python -c``): the numba functions the suite calls, in the
 #: argument types it calls them with, compiled into numba's cache. On a fresh clone each worker
 #: compiled them for itself, and again the Dask worker of the first map and the docs build, the
-#: compile costing more than most modules' tests. Three parts run beside the workers, which start
-#: with :data:`BEFORE_THE_WARM_UP`, on one cache: the fold kernel's rows, the longest, alone in its
-#: process; what they share (the sky's passes, a day's walk by blocks) each part compiles at a
-#: different time, so that the later finds it in the cache rather than compiling it too.
+#: compile costing more than most modules' tests. Two parts run beside the workers, which start
+#: with :data:`BEFORE_THE_WARM_UP`, on one cache, each about half the compile: the fold kernel's
+#: rows (its general loop), and the rest (the sun and the sky, the common case's loop, the buffer,
+#: the reduction of given curves); a third process would cost its imports and numba's start. Each
+#: part is two steps, each marked done by a lock its process lets go of: ``first``, what the
+#: modules of :data:`BEFORE_THE_WARM_UP` call and what the other part's loop calls, which they wait
+#: for (``wait_for`` in a part), so that it is loaded from the cache, never compiled twice at once;
+#: then the rest, which the other modules wait for. The rows' first step is the shorter: while its
+#: process waits for the other's, the workers still collect the suite, and no core is idle.
 WARM_UP_PARTS = {
-    "rows": """
+    "rows": ("""
 import numpy as np
 import foldopt
 from foldopt.engine import evaluation as engine
+from foldopt.engine.curve_reduction import blocked_day
+from foldopt.engine.kernel import _keep_curves
 from foldopt.engine.sky import build_sky
 from foldopt.inputs.study_file import default_study_path
 from foldopt.studies.engine_options import engine_options
 
-# The fold kernel's rows: the ideal circuit's (the paper's study) and the circuit as built.
+# What both kernel parts call, in the argument types they call it with: a day's walk by blocks, a
+# row's curves kept.
+one, two = np.zeros(1), np.zeros(2)
+blocked_day(np.zeros(4), (0, 3), np.ones(1), 0.25, np.zeros(4), (one, one), (one, two), np.zeros(1))
+_keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
+""", """
+# The fold kernel's rows: the ideal circuit's (the paper's study) and the circuit as built, on skies
+# whose passes the other part compiles.
+wait_for("common.first")
 for name in ("shin2015", "site-as-built"):
     study = foldopt.load_study(default_study_path().parent / f"{name}.yaml")
     options = engine_options(study)
@@ -117,53 +132,55 @@ for name in ("shin2015", "site-as-built"):
     engine.row_metrics(build_sky(options.sky, [study.site], [study.date]), rows=engine.PanelRows(
         np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)), loads=[1.0], electrical=options.electrical,
         outputs=engine.OUTPUTS, contiguous=True, engine="numba")
-""",
-    "common": """
+"""),
+    "common": ("""
 import numpy as np
 from foldopt.engine import evaluation as engine
+from foldopt.engine.curve_reduction import period_means
+from foldopt.engine.incidence import turning_poa
 from foldopt.engine.sky import build_sky
 from foldopt.engine.storage import Buffer, simulate
 from foldopt.inputs.study import make_study
+from foldopt.physics.trackers import TrackerDrive, moved_degrees
 from foldopt.studies.engine_options import engine_options
 
-# The buffer's simulation (one series or several, one buffer or one a series alike), first: by its
-# end the rows' part has compiled the sky's passes, which this part's sky then loads.
-simulate(np.ones((1, 96)), 0.5, Buffer(1.0), 0.25, engine="numba")
-
-# The fold kernel's common case (switching alone from one table set, exact incidence, constant loads):
-# every clear-sky study with I-V tables and a year of weather takes it, and until it is compiled
-# `auto` sends such studies to the NumPy path (a year 41 s there against 2.5 s).
+# The sun and the sky's passes (SPA's, the clear sky's), of the fold kernel's common case (switching
+# alone from one table set, exact incidence, constant loads).
 study = make_study({"name": "common", "mode": "exact", "sky": "ineichen", "pv_model": "single-diode",
                     "connection": "switching", "site": {"latitude": 34.05, "longitude": -118.25},
                     "date": "2025-06-21", "panel": {"area": 0.108, "efficiency": 0.19}, "p_load": 1.0})
 options = engine_options(study)
-orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth], [90.0, 180.0])
-engine.row_metrics(build_sky(options.sky, [study.site], [study.date]), rows=engine.PanelRows(
-    np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)), loads=[1.0], electrical=options.electrical,
-    outputs=("switching",), engine="numba")
-""",
-    "curves": """
-import numpy as np
-from foldopt.engine import evaluation as engine
-from foldopt.engine.curve_reduction import blocked_day, period_means
-from foldopt.engine.incidence import turning_poa
-from foldopt.engine.kernel import _keep_curves
-
-# What both kernel parts call, first, in the argument types they call it with: they find it in the
-# cache (a day's walk by blocks; a row's curves kept).
-one, two = np.zeros(1), np.zeros(2)
-blocked_day(np.zeros(4), (0, 3), np.ones(1), 0.25, np.zeros(4), (one, one), (one, two), np.zeros(1))
-_keep_curves(np.zeros((1, 4)), np.zeros((1, 4)), 0, 3)
-# The reduction of given curves (a tracker's, a design's: constant loads and a load profile's
-# alike); the means over periods of days; a tracker's irradiance.
-power = np.zeros((2, 96))
-engine.curve_metrics(power, [1.0], 0.25, contiguous=True, engine="numba")
+sky = build_sky(options.sky, [study.site], [study.date])
+# The means over periods of days; a tracker's irradiance (its normal's components along the steps,
+# as foldopt.studies.designs.sky_tracker_poa hands them) and moves.
 period_means(np.zeros((1, 2)), np.ones((1, 1), dtype=bool))
-# (its normal a view along the steps, as foldopt.studies.designs.sky_tracker_poa hands it)
-turning_poa(np.moveaxis(np.zeros((2, 3, 2)), 1, -1), np.zeros((2, 3, 2)), np.zeros((2, 2)), np.zeros((2, 1, 2)),
+turning_poa(np.zeros((2, 3, 2)), np.zeros((2, 3, 2)), np.zeros((2, 2)), np.zeros((2, 1, 2)),
             np.zeros((2, 2), dtype=np.int64), np.zeros((2, 2)))
-""",
+TrackerDrive(standby_w=0.3).move_energy_wh(moved_degrees(np.eye(3)[None], "numba"), "numba")
+""", """
+# The buffer's simulation (one series or several, one buffer or one a series alike).
+simulate(np.ones((1, 96)), 0.5, Buffer(1.0), 0.25, engine="numba")
+# The common case's loop: every clear-sky study with I-V tables and a year of weather takes it, and
+# until it is compiled `auto` sends such studies to the NumPy path (a year 41 s there against 2.5 s).
+orientation = engine.fold_orientations(study.geometry, [study.panel.tilt], [study.panel.azimuth], [90.0, 180.0])
+wait_for("rows.first")
+engine.row_metrics(sky, rows=engine.PanelRows(np.zeros(2, dtype=np.int64), orientation.reshape(-1, 4)),
+                   loads=[1.0], electrical=options.electrical, outputs=("switching",), engine="numba")
+# The reduction of given curves (a tracker's, a design's: constant loads and a load profile's alike).
+engine.curve_metrics(np.zeros((2, 96)), [1.0], 0.25, contiguous=True, engine="numba")
+"""),
 }
+#: What each warm-up process runs before its part's steps: ``wait_for(step)`` returns once the
+#: process of another part has let go of the step's lock (``<part>.first`` or ``<part>``), in the
+#: warm-up's folder, its working folder.
+_WARM_UP_PRELUDE = """
+import fcntl
+import os
+
+def wait_for(step):
+    with open(step + ".lock") as held:
+        fcntl.flock(held, fcntl.LOCK_SH)
+"""
 #: The warm-up's processes (the controller's), to wait for or end at the session's end.
 _warm_up_processes: dict[str, subprocess.Popen] = {}
 
@@ -175,21 +192,28 @@ def _whole_suite(config) -> bool:
 
 
 def _start_the_warm_up(config) -> None:
-    """Start the warm-up's processes, each holding an exclusive lock on ``<part>.lock`` in a folder
-    of its own until it ends (the lock is taken here and handed over, so that no worker can find it
-    free before the process has it); the workers learn the folder from :data:`WARM_UP`."""
+    """Start the warm-up's processes, each holding an exclusive lock on ``<part>.lock`` (and on
+    ``<part>.first.lock`` while its first step runs) in a folder of its own until it ends (the locks
+    are taken here and handed over, so that no worker can find one free before the process has
+    it); the workers learn the folder from :data:`WARM_UP`."""
     if fcntl is None:
         return
     folder = Path(tempfile.mkdtemp(prefix="foldopt-warm-up-"))
     os.environ[WARM_UP] = str(folder)
     # The suite's foldopt is on PYTHONPATH (_every_process_imports_this_foldopt).
     env = {**os.environ, "NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
-    for part, code in WARM_UP_PARTS.items():
-        with open(folder / f"{part}.lock", "w") as lock, open(folder / f"{part}.log", "w") as log:
-            fcntl.flock(lock, fcntl.LOCK_EX)
+    for part, (first, then) in WARM_UP_PARTS.items():
+        with contextlib.ExitStack() as stack:
+            log = stack.enter_context(open(folder / f"{part}.log", "w"))
+            locks = [stack.enter_context(open(folder / f"{step}.lock", "w"))
+                     for step in (part, *([f"{part}.first"] if first else []))]
+            for lock in locks:
+                fcntl.flock(lock, fcntl.LOCK_EX)
+            # The first step's end closes the process's copy of its lock (this one closes here).
+            code = _WARM_UP_PRELUDE + first + (f"os.close({locks[1].fileno()})\n" if first else "") + then
             _warm_up_processes[part] = subprocess.Popen(
                 [sys.executable, "-c", code], cwd=folder, env=env, stdout=log, stderr=subprocess.STDOUT,
-                stdin=subprocess.DEVNULL, pass_fds=(lock.fileno(),))
+                stdin=subprocess.DEVNULL, pass_fds=[lock.fileno() for lock in locks])
     config.add_cleanup(_end_the_warm_up)
 
 
@@ -219,21 +243,22 @@ def pytest_terminal_summary(terminalreporter):
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_runtest_setup(item):
-    """In a worker, before the fixtures of its first test that evaluates a study (here, in a command
-    line or in a Dask worker it starts), wait until every warm-up process has ended: numba's cache
-    then holds what they compiled, nothing is compiled twice, and ``auto`` finds the kernel
-    compiled whole or not at all."""
-    global _warmed_up
+    """In a worker, before the fixtures of a test, wait until the warm-up has compiled what the test
+    calls: the first step of every part (``<part>.first.lock``) for the modules of
+    :data:`BEFORE_THE_WARM_UP`, every part whole for the others (the first that evaluates a study,
+    here, in a command line or in a Dask worker it starts). numba's cache then holds what they
+    compiled, nothing is compiled twice, and ``auto`` finds the kernel compiled whole or not at all."""
     folder = os.environ.get(WARM_UP)
-    if folder and fcntl is not None and not _warmed_up and item.path.name not in BEFORE_THE_WARM_UP:
-        for path in sorted(Path(folder).glob("*.lock")):
+    steps = "*.first.lock" if item.path.name in BEFORE_THE_WARM_UP else "*.lock"
+    if folder and fcntl is not None and steps not in _waited_for:
+        for path in sorted(Path(folder).glob(steps)):
             with open(path) as held:
-                fcntl.flock(held, fcntl.LOCK_SH)  # free once its process has ended
-        _warmed_up = True
+                fcntl.flock(held, fcntl.LOCK_SH)  # free once its process has let go of it
+        _waited_for.add(steps)
 
 
-#: Whether this worker has waited for the warm-up.
-_warmed_up = False
+#: The warm-up's steps this worker has waited for (a pattern of their locks' names).
+_waited_for: set[str] = set()
 
 
 # --- the order of the suite -------------------------------------------------------------------------
@@ -241,7 +266,9 @@ _warmed_up = False
 #: Modules that evaluate no study above ``auto``'s bound for a compiled kernel (physics against its
 #: references, the code's layout, days on the NumPy path): what they compute does not hang on how far
 #: the warm-up has got (``auto`` takes the kernel for a smaller request once it is compiled), so the
-#: workers run them first, while the warm-up compiles.
+#: workers run them first, while the warm-up compiles. What they call compiled (the sun, the sky,
+#: a tracker's irradiance and moves, the means over periods) is the warm-up parts' first steps,
+#: which they wait for: with those in numba's cache they compile nothing the warm-up compiles.
 BEFORE_THE_WARM_UP = ("test_weather_validation.py", "test_architecture.py", "test_aggregation.py",
                       "test_near_optimal.py", "test_storage_section.py", "test_atmosphere.py", "test_clearsky.py",
                       "test_converter.py", "test_electrical.py", "test_geometry.py", "test_horizon.py",

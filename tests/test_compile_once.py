@@ -56,3 +56,23 @@ def test_the_clear_sky_compiles_once_whatever_its_inputs_broadcast(monkeypatch):
         for given in (zenith, np.broadcast_to(zenith, zenith.shape)):
             clearsky.ineichen_terms(given, dni_extra, turbidity, altitude)
     assert len(seen) == 1, seen
+
+
+def test_a_trackers_irradiance_compiles_once_for_one_block_or_several(monkeypatch):
+    import datetime as dt
+
+    from foldopt.api import load_study
+    from foldopt.engine import incidence
+    from foldopt.engine.sky import build_sky
+    from foldopt.inputs.study_file import default_study_path
+    from foldopt.studies.designs import sky_tracker_orientation, sky_tracker_poa
+    from foldopt.studies.engine_options import engine_options
+
+    seen = _recorded(monkeypatch, incidence, "turning_poa")
+    for model in ("dual-axis", "single-axis"):  # the sun's vector as the normal, and another's
+        study = load_study(default_study_path()).variant(mode="exact", step_min=60, tracker={"model": model})
+        for blocks in (1, 3):
+            dates = [dt.date(2025, 3, 1) + dt.timedelta(days=30 * k) for k in range(blocks)]
+            sky = build_sky(engine_options(study).sky, [study.site] * blocks, dates)
+            sky_tracker_poa(sky, sky_tracker_orientation(sky, study), "numba")
+    assert len(seen) == 1, seen

@@ -270,9 +270,9 @@ def test_a_trackers_compiled_irradiance_is_the_reference_paths(latitude, longitu
     reference = engines.poa(sky, orientation[0], orientation[1], normal=orientation[2])
     sun, _, beam, terms, span = sky.kernel_layout(False)
     compiled = np.empty(beam.shape)
-    # The normal as sky_tracker_poa hands it (a view along the steps): one array type compiled.
+    # The normal as sky_tracker_poa hands it (each component along the steps): one array type.
     along = np.ascontiguousarray(np.moveaxis(orientation[2], -1, 1), dtype=float)
-    turning_poa(np.moveaxis(along, 1, -1), sun, beam, terms, span, compiled)
+    turning_poa(along, sun, beam, terms, span, compiled)
     np.testing.assert_array_equal(compiled, reference)
     np.testing.assert_array_equal(sky_tracker_poa(sky, orientation, "numba"), reference)
     # One array type compiled (the suite's warm-up compiles it too: tests/conftest.py).

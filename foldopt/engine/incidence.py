@@ -227,13 +227,13 @@ def turning_poa(normal, sun, beam, terms, span, poa):
     The arithmetic of :func:`foldopt.physics.irradiance.plane_of_array` for the exact incidence on
     an open plain without an incidence-angle modifier, in its order of operations (so the same
     bits), walked over the span alone: outside it there is no light, and the NumPy expression gives 0
-    there too. ``normal`` is (n_blocks, n_steps, 3); ``sun``, ``beam``, ``terms`` and ``span`` are
-    :meth:`foldopt.engine.sky.Sky.kernel_layout`'s."""
+    there too. ``normal`` is (n_blocks, 3, n_steps), each component along the steps as the sun's;
+    ``sun``, ``beam``, ``terms`` and ``span`` are :meth:`foldopt.engine.sky.Sky.kernel_layout`'s."""
     has_terms = terms.shape[1] == 4
     for b in range(normal.shape[0]):
         poa[b, :] = 0.0
         for s in range(span[b, 0], span[b, 1] + 1):
-            nx, ny, nz = normal[b, s, 0], normal[b, s, 1], normal[b, s, 2]
+            nx, ny, nz = normal[b, 0, s], normal[b, 1, s], normal[b, 2, s]
             cos_aoi = nx * sun[b, 0, s] + ny * sun[b, 1, s] + nz * sun[b, 2, s]
             lit = max(cos_aoi, 0.0)
             value = beam[b, s] * lit

@@ -128,10 +128,11 @@ def sky_tracker_poa(sky: Sky, orientation, engine: str = "auto") -> np.ndarray:
 
     sun, _, beam, terms, span = sky.kernel_layout(False)
     poa = np.empty(beam.shape)
-    # The normal's components each along the steps, as the sun's: a view of a dual-axis
-    # tracker's (the sun's vector), a copy of any other; one array type for the compiled pass.
+    # The normal's components each along the steps, as the sun's, C-contiguous whatever the
+    # tracker and the number of blocks: one array type for the compiled pass (a view would be
+    # typed F for one block and A for several, each compiled).
     along = np.ascontiguousarray(np.moveaxis(normal, -1, 1), dtype=float)
-    turning_poa(np.moveaxis(along, 1, -1), sun, beam, terms, span, poa)
+    turning_poa(along, sun, beam, terms, span, poa)
     return poa
 
 
