@@ -310,13 +310,14 @@ def _localised(naive: np.ndarray, zone: zoneinfo.ZoneInfo) -> tuple[np.ndarray, 
         Same shape: each step's instant [ns since the epoch, UTC] and its clock time as the zone
         reads it [ns since 1970-01-01 00:00 local] (a skipped clock time moved forward).
     """
-    utc, local = np.empty_like(naive), naive.copy()
-    for row, times in enumerate(naive):
-        offset = _day_offset(int(times[0]) // _NS_PER_DAY * _NS_PER_DAY, zone)
-        if offset is not None:
-            utc[row] = times - offset
-            continue
-        utc[row] = [_localised_step(int(t), zone) for t in times]
+    offsets = [
+        _day_offset(first // _NS_PER_DAY * _NS_PER_DAY, zone) for first in naive[:, 0].tolist()
+    ]
+    # The days of one offset in one subtraction; the days on which the clocks change, step by step.
+    utc = naive - np.array([offset or 0 for offset in offsets], dtype=np.int64)[:, None]
+    local = naive.copy()
+    for row in [row for row, offset in enumerate(offsets) if offset is None]:
+        utc[row] = [_localised_step(int(t), zone) for t in naive[row]]
         local[row] = utc[row] + [
             _offset_s(zone, int(t) // 1_000_000_000) * 1_000_000_000 for t in utc[row]
         ]

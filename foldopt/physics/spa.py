@@ -364,11 +364,13 @@ def _hour_nodes(hours: np.ndarray) -> tuple:
     if width > 8 * flat.size + 1_000_000:  # instants spread over centuries: sorting is cheaper
         nodes = np.unique(np.concatenate([flat, flat + 1]))
         return nodes, np.searchsorted(nodes, hours)
+    marks = flat - low
     touched = np.zeros(width, dtype=bool)
-    touched[flat - low] = True
-    touched[flat - low + 1] = True
+    touched[marks] = True
+    # each hour's next one: a pass over the range rather than a second scatter of the instants
+    touched[1:] |= touched[:-1].copy()
     nodes = np.flatnonzero(touched) + low
-    return nodes, (np.cumsum(touched) - 1)[hours - low]
+    return nodes, (np.cumsum(touched) - 1)[marks].reshape(hours.shape)
 
 
 def _equatorial(utc_ns, sun_terms: SunTerms) -> np.ndarray:
