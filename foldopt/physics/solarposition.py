@@ -241,7 +241,7 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
         If ``step_min`` does not divide 1440 min.
     """
     n_steps = 24 * 60 / step_min
-    if not np.isclose(n_steps, round(n_steps)):
+    if abs(n_steps - round(n_steps)) > 1e-8 + 1e-5 * abs(round(n_steps)):  # np.isclose
         raise ValueError(f"step_min must divide 1440 min exactly, got {step_min}")
     offsets = np.round((np.arange(round(n_steps)) + 0.5) * step_min * 60e9).astype(np.int64)
     # Days since 1970-01-01 from each date's ordinal: NumPy converts date objects one at a time,
@@ -421,13 +421,41 @@ def hour_angle_paper(times: pd.DatetimeIndex, longitude: float):
     return _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, grid.dayofyear, longitude)[0]
 
 
-def _by_dayofyear(function, dayofyear):
-    """``function`` of the day of year at every step, evaluated once per day (1..366) and looked up."""
-    return function(np.arange(367))[dayofyear]
+def by_dayofyear(function, dayofyear):
+    """``function`` of the day of year at every step, looked up in its table of days 0..366.
+
+    Parameters
+    ----------
+    function : callable
+        Of the day of year (array_like) alone, elementwise; a module's function, whose table is
+        worked out once a process.
+    dayofyear : numpy.ndarray of int
+        Day of year of each step, 1 on 1 January.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``function(dayofyear)``'s values, shaped as ``dayofyear``.
+    """
+    return _day_table(function)[dayofyear]
+
+
+@functools.cache
+def _day_table(function) -> np.ndarray:
+    table = np.asarray(function(np.arange(367)))
+    table.flags.writeable = False  # shared by every call
+    return table
+
+
+def _declination_spencer(dayofyear):
+    """pvlib's ``declination_spencer71`` [deg]."""
+    import pvlib
+
+    return np.degrees(pvlib.solarposition.declination_spencer71(dayofyear))
 
 
 def _hour_angle_paper(clock_hours, utc_offset_hours, dayofyear, longitude):
-    equation_of_time = _by_dayofyear(equation_of_time_paper, dayofyear)
+    equation_of_time = by_dayofyear(equation_of_time_paper, dayofyear)
     time_correction_min = 4.0 * (longitude - 15.0 * utc_offset_hours) + equation_of_time
     local_solar_time = clock_hours + time_correction_min / 60.0
     return (15.0 * (local_solar_time - 12.0) + 180.0) % 360.0 - 180.0
@@ -499,7 +527,7 @@ def solar_position_grid(
     """
     dayofyear = grid.dayofyear
     if model == "paper":
-        declination = _by_dayofyear(declination_paper, dayofyear)
+        declination = by_dayofyear(declination_paper, dayofyear)
         hour_angle = _hour_angle_paper(
             grid.clock_hours, grid.utc_offset_hours, dayofyear, longitude
         )
@@ -509,11 +537,7 @@ def solar_position_grid(
         solar_zenith, solar_azimuth, hour_angle, vector = spa_solar_position(
             grid.utc_ns, latitude, longitude, altitude, sun_terms
         )
-        import pvlib
-
-        declination = _by_dayofyear(
-            lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), dayofyear
-        )
+        declination = by_dayofyear(_declination_spencer, dayofyear)
     else:
         raise ValueError(f"model must be one of {', '.join(MODES)}; got {model!r}")
     return {
