@@ -241,7 +241,7 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
         If ``step_min`` does not divide 1440 min.
     """
     n_steps = 24 * 60 / step_min
-    if abs(n_steps - round(n_steps)) > 1e-8 + 1e-5 * abs(round(n_steps)):  # np.isclose
+    if abs(n_steps - round(n_steps)) > 1e-8 + 1e-5 * abs(round(n_steps)):  # as np.isclose tests
         raise ValueError(f"step_min must divide 1440 min exactly, got {step_min}")
     offsets = np.round((np.arange(round(n_steps)) + 0.5) * step_min * 60e9).astype(np.int64)
     # Days since 1970-01-01 from each date's ordinal: NumPy converts date objects one at a time,
@@ -427,8 +427,8 @@ def by_dayofyear(function, dayofyear):
     Parameters
     ----------
     function : callable
-        Of the day of year (array_like) alone, elementwise; a module's function, whose table is
-        worked out once a process.
+        Of the day of year (array_like) alone, elementwise; a module's function (not a lambda
+        made per call), whose table is worked out once a process.
     dayofyear : numpy.ndarray of int
         Day of year of each step, 1 on 1 January.
 
@@ -440,8 +440,9 @@ def by_dayofyear(function, dayofyear):
     return _day_table(function)[dayofyear]
 
 
-@functools.cache
+@functools.lru_cache(maxsize=32)
 def _day_table(function) -> np.ndarray:
+    """``function`` at days 0..366, read-only (:func:`by_dayofyear`)."""
     table = np.asarray(function(np.arange(367)))
     table.flags.writeable = False  # shared by every call
     return table
