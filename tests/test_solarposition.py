@@ -571,3 +571,26 @@ def test_a_grids_day_of_year_is_the_calendars(seed, across):
     grid = ClockGrid(utc, offset, ("UTC",) * n_blocks, 24.0 / n_steps)
     expected = pd.DatetimeIndex(grid.local_ns.ravel().astype("datetime64[ns]")).day_of_year
     np.testing.assert_array_equal(grid.dayofyear, np.reshape(expected, grid.shape))
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_a_day_table_looked_up_is_the_function_at_each_step(seed):
+    """by_dayofyear's table (worked out once a process) gives pvlib's declination and the
+    extraterrestrial irradiance evaluated at each step's day directly, to the bit, whichever days
+    and shape (and however often it is asked)."""
+    import pvlib
+
+    from foldopt.physics.atmosphere import extraterrestrial_spencer
+    from foldopt.physics.solarposition import _declination_spencer, by_dayofyear
+
+    rng = np.random.default_rng(seed)
+    days = rng.integers(1, 367, tuple(rng.integers(1, 6, 2)))
+    for _ in range(2):
+        np.testing.assert_array_equal(
+            by_dayofyear(_declination_spencer, days),
+            np.degrees(pvlib.solarposition.declination_spencer71(days)),
+        )
+        np.testing.assert_array_equal(
+            by_dayofyear(extraterrestrial_spencer, days), extraterrestrial_spencer(days)
+        )

@@ -592,13 +592,8 @@ def _kernel_rows(sky: Sky, rows: PanelRows, curve, paper: bool) -> Rows:
     """The kernel's rows: each orientation's normals (and Eq. 5 factors) worked out once, then
     taken per row; the exact incidence reads no Eq. 5 factors (zeros stand in)."""
     orientation, orientation_of = rows.orientation, rows.orientation_of
-    normals = np.stack(
-        [
-            normal_vector(orientation[:, 0], orientation[:, 1]),
-            normal_vector(orientation[:, 2], orientation[:, 3]),
-        ],
-        axis=1,
-    )
+    # (n_orientations, 2, 3): both sides in one call, east's tilt and azimuth then west's
+    normals = normal_vector(orientation[:, 0::2], orientation[:, 1::2])
     row_paper = np.zeros((rows.block.size, 2, 4))
     if paper:
         tilt, azimuth = np.radians(orientation[:, 0::2]), np.radians(orientation[:, 1::2])

@@ -31,7 +31,12 @@ from foldopt.inputs.sections import parse_timezone
 from foldopt.names import CLEAR_SKIES
 from foldopt.physics.atmosphere import clear_sky_dni, extraterrestrial_spencer
 from foldopt.physics.horizon import sun_visible
-from foldopt.physics.solarposition import ClockGrid, clock_grid, solar_position_grid
+from foldopt.physics.solarposition import (
+    ClockGrid,
+    by_dayofyear,
+    clock_grid,
+    solar_position_grid,
+)
 from foldopt.physics.spa import SunTerms
 from foldopt.physics.temperature import equivalent_temp_air
 
@@ -402,7 +407,7 @@ def build_sky(
     grid = _clock(sites, dates, options.step_min)
     sun = solar_position_grid(grid, latitude, longitude, altitude, options.mode, sun_terms)
     solar_zenith = sun["solar_zenith"]
-    dni_extra = extraterrestrial_spencer(np.arange(367))[grid.dayofyear]
+    dni_extra = by_dayofyear(extraterrestrial_spencer, grid.dayofyear)
     temp_air, balance = np.full(len(sites), float(options.temp_air)), None
     temp_steps = wind_speed = wind_ref = terms = None
     notes = ()

@@ -56,10 +56,9 @@ def normal_vector(surface_tilt, surface_azimuth):
            [ 0., -1.,  0.]])
     """
     tilt, azimuth = np.radians(surface_tilt), np.radians(surface_azimuth)
+    sin_tilt = np.sin(tilt)
     return np.stack(
-        np.broadcast_arrays(
-            np.sin(tilt) * np.sin(azimuth), np.sin(tilt) * np.cos(azimuth), np.cos(tilt)
-        ),
+        np.broadcast_arrays(sin_tilt * np.sin(azimuth), sin_tilt * np.cos(azimuth), np.cos(tilt)),
         axis=-1,
     )
 

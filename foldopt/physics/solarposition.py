@@ -241,7 +241,7 @@ def clock_grid(dates, timezone, step_min: float = 1.0) -> ClockGrid:
         If ``step_min`` does not divide 1440 min.
     """
     n_steps = 24 * 60 / step_min
-    if not np.isclose(n_steps, round(n_steps)):
+    if abs(n_steps - round(n_steps)) > 1e-8 + 1e-5 * abs(round(n_steps)):  # as np.isclose tests
         raise ValueError(f"step_min must divide 1440 min exactly, got {step_min}")
     offsets = np.round((np.arange(round(n_steps)) + 0.5) * step_min * 60e9).astype(np.int64)
     # Days since 1970-01-01 from each date's ordinal: NumPy converts date objects one at a time,
@@ -310,26 +310,26 @@ def _localised(naive: np.ndarray, zone: zoneinfo.ZoneInfo) -> tuple[np.ndarray, 
         Same shape: each step's instant [ns since the epoch, UTC] and its clock time as the zone
         reads it [ns since 1970-01-01 00:00 local] (a skipped clock time moved forward).
     """
-    utc, local = np.empty_like(naive), naive.copy()
-    # A day's one offset (or None), once a day: a sweep repeats its dates at every site of a zone.
-    day_offsets: dict[int, int | None] = {}
-    for row, times in enumerate(naive):
-        midnight = int(times[0]) // _NS_PER_DAY * _NS_PER_DAY
-        if midnight not in day_offsets:
-            day_offsets[midnight] = _day_offset(midnight, zone)
-        if day_offsets[midnight] is not None:
-            utc[row] = times - day_offsets[midnight]
-            continue
-        utc[row] = [_localised_step(int(t), zone) for t in times]
+    offsets = [
+        _day_offset(first // _NS_PER_DAY * _NS_PER_DAY, zone) for first in naive[:, 0].tolist()
+    ]
+    # The days of one offset in one subtraction; the days on which the clocks change, step by step.
+    utc = naive - np.array([offset or 0 for offset in offsets], dtype=np.int64)[:, None]
+    local = naive.copy()
+    for row in [row for row, offset in enumerate(offsets) if offset is None]:
+        utc[row] = [_localised_step(int(t), zone) for t in naive[row]]
         local[row] = utc[row] + [
             _offset_s(zone, int(t) // 1_000_000_000) * 1_000_000_000 for t in utc[row]
         ]
     return utc, local
 
 
+@functools.lru_cache(maxsize=65536)
 def _day_offset(midnight: int, zone: zoneinfo.ZoneInfo) -> int | None:
     """The UTC offset [ns] of a local day [its midnight, ns since 1970-01-01 00:00 local] in which
-    the zone's clocks do not change, None where they do.
+    the zone's clocks do not change, None where they do; once a day and zone a process (a sweep
+    repeats its dates at every site of a zone, a run's passes the same days: 26 readings of the
+    zone a day).
 
     The offsets read at each whole hour of the day (zones change their clocks on whole hours or
     half hours, at most once in an hour) are one offset on a day with no transition: a repeated
@@ -421,13 +421,42 @@ def hour_angle_paper(times: pd.DatetimeIndex, longitude: float):
     return _hour_angle_paper(grid.clock_hours, grid.utc_offset_hours, grid.dayofyear, longitude)[0]
 
 
-def _by_dayofyear(function, dayofyear):
-    """``function`` of the day of year at every step, evaluated once per day (1..366) and looked up."""
-    return function(np.arange(367))[dayofyear]
+def by_dayofyear(function, dayofyear):
+    """``function`` of the day of year at every step, looked up in its table of days 0..366.
+
+    Parameters
+    ----------
+    function : callable
+        Of the day of year (array_like) alone, elementwise; a module's function (not a lambda
+        made per call), whose table is worked out once a process.
+    dayofyear : numpy.ndarray of int
+        Day of year of each step, 1 on 1 January.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``function(dayofyear)``'s values, shaped as ``dayofyear``.
+    """
+    return _day_table(function)[dayofyear]
+
+
+@functools.lru_cache(maxsize=32)
+def _day_table(function) -> np.ndarray:
+    """``function`` at days 0..366, read-only (:func:`by_dayofyear`)."""
+    table = np.asarray(function(np.arange(367)))
+    table.flags.writeable = False  # shared by every call
+    return table
+
+
+def _declination_spencer(dayofyear):
+    """pvlib's ``declination_spencer71`` [deg]."""
+    import pvlib
+
+    return np.degrees(pvlib.solarposition.declination_spencer71(dayofyear))
 
 
 def _hour_angle_paper(clock_hours, utc_offset_hours, dayofyear, longitude):
-    equation_of_time = _by_dayofyear(equation_of_time_paper, dayofyear)
+    equation_of_time = by_dayofyear(equation_of_time_paper, dayofyear)
     time_correction_min = 4.0 * (longitude - 15.0 * utc_offset_hours) + equation_of_time
     local_solar_time = clock_hours + time_correction_min / 60.0
     return (15.0 * (local_solar_time - 12.0) + 180.0) % 360.0 - 180.0
@@ -499,7 +528,7 @@ def solar_position_grid(
     """
     dayofyear = grid.dayofyear
     if model == "paper":
-        declination = _by_dayofyear(declination_paper, dayofyear)
+        declination = by_dayofyear(declination_paper, dayofyear)
         hour_angle = _hour_angle_paper(
             grid.clock_hours, grid.utc_offset_hours, dayofyear, longitude
         )
@@ -509,11 +538,7 @@ def solar_position_grid(
         solar_zenith, solar_azimuth, hour_angle, vector = spa_solar_position(
             grid.utc_ns, latitude, longitude, altitude, sun_terms
         )
-        import pvlib
-
-        declination = _by_dayofyear(
-            lambda d: np.degrees(pvlib.solarposition.declination_spencer71(d)), dayofyear
-        )
+        declination = by_dayofyear(_declination_spencer, dayofyear)
     else:
         raise ValueError(f"model must be one of {', '.join(MODES)}; got {model!r}")
     return {

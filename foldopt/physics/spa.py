@@ -116,11 +116,13 @@ def _geocentric(unixtime: np.ndarray, delta_t: float) -> dict:
 _SERIES = ("L", "B", "R")  # the Earth's heliocentric longitude, latitude and radius
 
 
+@functools.cache
 def _periodic_tables(spa) -> tuple:
     """``pvlib.spa``'s tables of the heliocentric series' periodic terms (Table A4.2: ``L0``,
     ``L1``..., ``B0``..., ``R0``... of ``spa``, the module ``pvlib.spa``) one after the other, (n,
     3), the bounds of each table's rows, and the tables of each series, as
-    :func:`foldopt.physics.spa_site.periodic_sums` reads them."""
+    :func:`foldopt.physics.spa_site.periodic_sums` reads them: constants, gathered once a
+    process (writable, as the compiled pass's one specialisation takes them: never written)."""
     tables = {
         series: [getattr(spa, f"{series}{k}") for k in range(6) if hasattr(spa, f"{series}{k}")]
         for series in _SERIES
@@ -362,11 +364,13 @@ def _hour_nodes(hours: np.ndarray) -> tuple:
     if width > 8 * flat.size + 1_000_000:  # instants spread over centuries: sorting is cheaper
         nodes = np.unique(np.concatenate([flat, flat + 1]))
         return nodes, np.searchsorted(nodes, hours)
+    marks = flat - low
     touched = np.zeros(width, dtype=bool)
-    touched[flat - low] = True
-    touched[flat - low + 1] = True
+    touched[marks] = True
+    # each hour's next one: a pass over the range rather than a second scatter of the instants
+    touched[1:] |= touched[:-1].copy()
     nodes = np.flatnonzero(touched) + low
-    return nodes, (np.cumsum(touched) - 1)[hours - low]
+    return nodes, (np.cumsum(touched) - 1)[marks].reshape(hours.shape)
 
 
 def _equatorial(utc_ns, sun_terms: SunTerms) -> np.ndarray:
@@ -407,8 +411,7 @@ def _on_threads(run, n: int, steps: int, least: int) -> None:
     from numba import get_num_threads
 
     threads = min(get_num_threads(), n, max(1, steps // least))
-    edges = np.linspace(0, n, threads + 1).astype(int)
-    parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    parts = [slice(n * k // threads, n * (k + 1) // threads) for k in range(threads)]
     if threads == 1:
         run(parts[0])
         return
