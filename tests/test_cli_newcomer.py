@@ -54,7 +54,8 @@ def test_every_command_runs_with_no_option(tmp_path, command, check):
         assert "(default range)" in taken[0] and "panel 0.108 m^2" in taken
 
 
-def test_the_summary_says_which_values_were_defaults(tmp_path, figures_drawn_elsewhere):
+def test_the_summary_says_which_values_were_defaults(tmp_path, figures_drawn_elsewhere,
+                                                     folders_written_elsewhere):
     with figures_drawn_elsewhere():  # the answer of test_every_command_runs_with_no_option[day]
         result = invoke("sweep", "day", "--out", tmp_path / "o")
     assert result.exit_code == 0, result.output
@@ -66,7 +67,8 @@ def test_the_summary_says_which_values_were_defaults(tmp_path, figures_drawn_els
     assert "(--table prints the full table)" in lines and len(lines) < 8
     study = json.loads((tmp_path / "o" / "run.json").read_text())["study"]
     assert (study["mode"], study["geometry"]) == ("exact", "hinge")  # the geometry follows the mode
-    table = invoke("sweep", "day", "--days", "1:365:120", "--out", tmp_path / "t", "--table")
+    with folders_written_elsewhere():  # its terminal's table is what is read
+        table = invoke("sweep", "day", "--days", "1:365:120", "--out", tmp_path / "t", "--table")
     assert "t_solar_h" in table.stdout and len(table.stdout.splitlines()) > 4
 
 
@@ -100,16 +102,16 @@ def test_help_keeps_units_and_lists_every_accepted_name():
      ["sweep", "load", "--p-load", "2:6:2", "--step-min", "10"]],
     ids=["run", "reproduce", "size", "sweep"],
 )
-def test_one_json_document_and_quiet_silence(tmp_path, command, figures_drawn_elsewhere):
-    result = invoke(*command, "--out", tmp_path / "j", "--format", "json")
+def test_one_json_document_and_quiet_silence(tmp_path, command, folders_written_elsewhere):
+    with folders_written_elsewhere():  # the same answer's folder is the quiet run's, below
+        result = invoke(*command, "--out", tmp_path / "j", "--format", "json")
     assert result.exit_code == 0, result.output
     document = json.loads(result.stdout)
     assert document["command"] == " ".join(command[:2] if command[0] == "sweep" else command[:1])
     assert set(document) == {"command", "out", "answer", "rows"}
     assert document["answer"]["lines"] and document["answer"]["question"]
     assert result.stderr == ""  # no progress, no status line in the document's way
-    with figures_drawn_elsewhere():  # the same answer's figures again
-        quiet = invoke(*command, "--out", tmp_path / "q", "--quiet")
+    quiet = invoke(*command, "--out", tmp_path / "q", "--quiet")  # its folder written whole
     assert quiet.exit_code == 0, quiet.output
     assert quiet.stdout == "" and quiet.stderr == ""
     assert (tmp_path / "q" / "run.json").exists()
@@ -139,11 +141,13 @@ def test_notes_name_the_day(tmp_path, args, note, line, folders_written_elsewher
     assert line in text and (f"note: {note[0]}" in text if note else "note:" not in text)
 
 
-def test_overcast_is_no_polar_night_in_a_year(tmp_path):
+def test_overcast_is_no_polar_night_in_a_year(tmp_path, folders_written_elsewhere):
     # 2.25 W: above the peak of the tracker net of its drive on 3 days that are not overcast, below
-    # every other design's peak on those days (the paper's ideal model's peaks).
-    result = invoke("sweep", "angle", "--weather", TMY3, "--p-load", "2.25", "--angle-step", "30",
-                    "--pv-model", "ideal", "--out", tmp_path / "y", "--format", "json")
+    # every other design's peak on those days (the paper's ideal model's peaks). Its document is
+    # what is read: the folder a weather file's year writes is test_cli_studies'.
+    with folders_written_elsewhere():
+        result = invoke("sweep", "angle", "--weather", TMY3, "--p-load", "2.25", "--angle-step", "30",
+                        "--pv-model", "ideal", "--out", tmp_path / "y", "--format", "json")
     assert result.exit_code == 0, result.output
     notes = {entry["note"]: entry for entry in json.loads(result.stdout)["answer"]["notes"]}
     assert "polar night" not in notes and 0 < notes["overcast"]["cases"] < 30
