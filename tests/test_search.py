@@ -15,7 +15,8 @@ from hypothesis import strategies as st
 import foldopt
 from foldopt.engine.search import Axis, grid_search
 from foldopt.inputs.plan import make_plan
-from foldopt.studies.designs import Blocks, _orientations, requested_hours
+from foldopt.engine.evaluation import design_orientations
+from foldopt.studies.designs import Blocks, requested_hours
 from foldopt.studies.objectives import objective_quantum
 from foldopt.studies.objectives import objective_value
 
@@ -192,11 +193,11 @@ def _axes(equator):
 def _grid(equator):
     """:func:`_axes`' full grid and its designs' sub-panel orientations, worked out once for each
     azimuth as the design evaluation works them out (:func:`foldopt.studies.designs.requested_hours`;
-    one geometry call per tilt and azimuth, most of a brute force's time), and read by the search's
+    one geometry call over the designs), and read by the search's
     points as :func:`foldopt.studies.joint.optimize_plan` reads its grid's."""
     axes = _axes(equator)
     points = _full_grid(axes)
-    return axes, points, _orientations("hinge", points[:, 0], points[:, 1], points[:, 2] % 360.0)
+    return axes, points, design_orientations("hinge", points[:, 0], points[:, 1], points[:, 2] % 360.0)
 
 
 def _objective(latitude, longitude, dates, loads, statistic):

@@ -127,21 +127,31 @@ def fold_orientations(geometry: str, surface_tilt, surface_azimuth, fold_angles)
         [np.asarray(surface_tilt, dtype=float), np.asarray(surface_azimuth, dtype=float)], axis=-1
     )
     unique, inverse = np.unique(panels, axis=0, return_inverse=True)
-    per_panel = []
-    for tilt, azimuth in unique:
-        sides = subpanel_orientation(fold_angles, tilt, azimuth, geometry)
-        per_panel.append(
-            np.stack(
-                [
-                    sides["surface_tilt_east"],
-                    sides["surface_azimuth_east"],
-                    sides["surface_tilt_west"],
-                    sides["surface_azimuth_west"],
-                ],
-                axis=-1,
-            )
-        )
+    per_panel = [
+        design_orientations(geometry, fold_angles, tilt, azimuth) for tilt, azimuth in unique
+    ]
     return np.stack(per_panel)[np.ravel(inverse)]
+
+
+def design_orientations(geometry: str, fold_angle, surface_tilt, surface_azimuth) -> np.ndarray:
+    """Sub-panel orientations of designs, each its own fold angle and flat panel.
+
+    Parameters
+    ----------
+    geometry : str
+        How the panel folds, one of :data:`foldopt.names.GEOMETRIES`.
+    fold_angle, surface_tilt, surface_azimuth : array_like
+        [deg], broadcast against each other.
+
+    Returns
+    -------
+    numpy.ndarray
+        (..., 4), the broadcast shape: tilt and azimuth of the east, then of the west sub-panel
+        [deg], as :func:`fold_orientations` gives them.
+    """
+    sides = subpanel_orientation(fold_angle, surface_tilt, surface_azimuth, geometry)
+    parts = ("tilt_east", "azimuth_east", "tilt_west", "azimuth_west")
+    return np.stack([sides[f"surface_{part}"] for part in parts], axis=-1)
 
 
 def flat_orientation(surface_tilt, surface_azimuth) -> np.ndarray:

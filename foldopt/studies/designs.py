@@ -26,7 +26,6 @@ import numpy as np
 from foldopt.engine import evaluation as engines
 from foldopt.engine.choice import engine_for
 from foldopt.physics.connections import CONNECTIONS
-from foldopt.physics.geometry import subpanel_orientation
 from foldopt.inputs.study import Study
 from foldopt.engine.metrics import design_condition, energy, energy_served, metric_columns
 from foldopt.engine.sky import Sky
@@ -777,7 +776,9 @@ def requested_hours(
     elif flat:
         table = engines.flat_orientation(every[:, 1], every[:, 2] % 360.0)
     else:
-        table = _orientations(study.geometry, every[:, 0], every[:, 1], every[:, 2] % 360.0)
+        table = engines.design_orientations(
+            study.geometry, every[:, 0], every[:, 1], every[:, 2] % 360.0
+        )
     tables = np.split(table, np.cumsum([points.shape[0] for _, points in requests])[:-1])
     out = [
         (
@@ -844,10 +845,3 @@ def _consecutive(indices):
     if indices.size and indices[-1] - indices[0] == indices.size - 1:
         return slice(int(indices[0]), int(indices[-1]) + 1)
     return indices
-
-
-def _orientations(geometry: str, fold_angle, tilt, azimuth) -> np.ndarray:
-    """(n, 4) the sub-panels' orientation of each design, in one geometry call over the designs."""
-    sides = subpanel_orientation(fold_angle, tilt, azimuth, geometry)
-    parts = ("tilt_east", "azimuth_east", "tilt_west", "azimuth_west")
-    return np.stack([sides[f"surface_{part}"] for part in parts], axis=-1)
