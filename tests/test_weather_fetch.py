@@ -67,7 +67,7 @@ class Handler(BaseHTTPRequestHandler):
         if mode == "auth":  # a mirror behind a user and password: user:secret
             good = self.headers.get("Authorization") == "Basic dXNlcjpzZWNyZXQ="
             return self.send(200, BODY) if good else self.send(401, b"")
-        if mode in ("trickle", "tricklehead"):  # a byte every 0.2 s, each read in time
+        if mode in ("trickle", "tricklehead"):  # a byte every 0.05 s, each read in time
             return self.trickle(BODY, mode == "trickle")
         if mode == "ok" or (mode == "rate" and n > 1) or (mode == "flaky" and n != 2):
             return self.send(200, BODY)
@@ -108,10 +108,10 @@ class Handler(BaseHTTPRequestHandler):
         else:  # not even the status line in one piece
             slow = b"HTTP/1.0 200 OK\r\nContent-Length: %d\r\n\r\n" % len(body) + body
         try:
-            for byte in slow[:120]:  # 24 s at most, then the connection closes
+            for byte in slow[:240]:  # 12 s at most, then the connection closes
                 self.wfile.write(bytes([byte]))
                 self.wfile.flush()
-                time.sleep(0.2)
+                time.sleep(0.05)
         except (BrokenPipeError, ConnectionResetError):
             pass  # the client gave up: what is tested
         self.close_connection = True
