@@ -86,14 +86,14 @@ def test_a_trickling_service_is_given_up_on_at_the_deadline(pvgis, server, cache
 
 
 def test_a_trickle_through_a_sweep_and_a_horizon_meets_the_studys_timeout(pvgis, server, tmp_path,
-                                                                         figures_drawn_elsewhere):
+                                                                         folders_written_elsewhere):
     """weather.timeout_s (--set) bounds the weather's fetch and the horizon's alike."""
     route = pvgis("trickle")
     for options, label in [(["--weather", "pvgis-tmy"], "--weather pvgis-tmy"),
                            (["--weather", "pvgis-tmy", "--horizon", "pvgis"], "horizon pvgis")]:
         if label == "horizon pvgis":  # the weather cached, the horizon trickles
             pvgis("ok")
-            with figures_drawn_elsewhere():  # test_weather_fetch's fetched year: this sweep
+            with folders_written_elsewhere():  # test_weather_fetch's fetched year: this sweep
                 assert runner.invoke(app, [*SWEEP, "--days", "2025-06-21", "--weather", "pvgis-tmy",
                                            "--out", "w"]).exit_code == 0
             route = pvgis("trickle")
