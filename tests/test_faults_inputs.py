@@ -181,9 +181,11 @@ def test_served_energy_never_exceeds_a_negative_harvest():
     assert columns["energy_harvested_wh"].tolist() == [10.0, -3.0, -1.0]  # the net harvest keeps its sign
 
 
-def test_an_altitude_takes_the_paper_study_to_exact_mode_and_says_so(here):
+def test_an_altitude_takes_the_paper_study_to_exact_mode_and_says_so(here, folders_written_elsewhere):
     # The paper's Eq. 5 has no altitude term: a paper-mode study at 8000 m runs in exact mode.
-    result = runner.invoke(app, ["sweep", "angle", "--altitude", "8000", *QUICK, "--out", "out", "--format", "json"])
+    with folders_written_elsewhere():  # its answer is what is read, nothing of its folder
+        result = runner.invoke(app, ["sweep", "angle", "--altitude", "8000", *QUICK, "--out", "out", "--format",
+                                     "json"])
     assert result.exit_code == 0, result.output
     answer = json.loads(result.stdout)["answer"]
     assert answer["question"]["models"].startswith("exact mode")

@@ -67,7 +67,7 @@ class Handler(BaseHTTPRequestHandler):
         if mode == "auth":  # a mirror behind a user and password: user:secret
             good = self.headers.get("Authorization") == "Basic dXNlcjpzZWNyZXQ="
             return self.send(200, BODY) if good else self.send(401, b"")
-        if mode in ("trickle", "tricklehead"):  # a byte every 0.2 s, each read in time
+        if mode in ("trickle", "tricklehead"):  # a byte every 0.05 s, each read in time
             return self.trickle(BODY, mode == "trickle")
         if mode == "ok" or (mode == "rate" and n > 1) or (mode == "flaky" and n != 2):
             return self.send(200, BODY)
@@ -108,10 +108,10 @@ class Handler(BaseHTTPRequestHandler):
         else:  # not even the status line in one piece
             slow = b"HTTP/1.0 200 OK\r\nContent-Length: %d\r\n\r\n" % len(body) + body
         try:
-            for byte in slow[:120]:  # 24 s at most, then the connection closes
+            for byte in slow[:240]:  # 12 s at most, then the connection closes
                 self.wfile.write(bytes([byte]))
                 self.wfile.flush()
-                time.sleep(0.2)
+                time.sleep(0.05)
         except (BrokenPipeError, ConnectionResetError):
             pass  # the client gave up: what is tested
         self.close_connection = True
@@ -244,7 +244,7 @@ def test_fetch_is_silent_quiet_and_one_json_document(pvgis, server, tmp_path):
 
 
 def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path,
-                                                                 figures_drawn_elsewhere):
+                                                                 folders_written_elsewhere):
     route = pvgis("ok")
     first = runner.invoke(app, ["weather", "fetch", "pvgis-tmy", "--lat", "45", "--lon", "8"])
     assert first.exit_code == 0, first.output
@@ -254,7 +254,7 @@ def test_a_second_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server
     assert requests_made(server, route) == 1
     assert cache_files(tmp_path)[next(iter(cache_files(tmp_path)))] == RECORDED.read_bytes()
     dead = pvgis("e500")  # a service that would fail: offline never asks it
-    with figures_drawn_elsewhere():  # test_the_fetched_year's [a day, every angle]: this sweep
+    with folders_written_elsewhere():  # test_the_fetched_year's [a day, every angle]: this sweep
         offline = runner.invoke(app, [*SWEEP, "--days", "2025-06-21", "--weather", "pvgis-tmy",
                                       "--offline", "--out", "offline"])
     assert offline.exit_code == 0, offline.output
@@ -483,14 +483,15 @@ def test_a_maps_weather_options_are_checked_before_anything_is_fetched(pvgis, se
 HORIZON_DAY = [*SWEEP, "--days", "2025-01-15"]  # a low winter sun, under the hills to the south
 
 
-def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, figures_drawn_elsewhere):
+def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_path, figures_drawn_elsewhere,
+                                                             folders_written_elsewhere):
     route = pvgis("ok")
     fetched = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "fetched"])
     assert fetched.exit_code == 0, fetched.output
     with figures_drawn_elsewhere():  # the fetched run's, of the same data
         read = runner.invoke(app, [*HORIZON_DAY, "--horizon", str(HORIZON), "--out", "read"])
     assert read.exit_code == 0, read.output
-    with figures_drawn_elsewhere():  # the fetched run's sweep, the horizon left out: its rows alone
+    with folders_written_elsewhere():  # the fetched run's sweep, the horizon left out: its rows alone
         flat = runner.invoke(app, [*HORIZON_DAY, "--out", "flat"])
     assert flat.exit_code == 0, flat.output
     fetched, read, flat = (json.loads(r.stdout) for r in (fetched, read, flat))
@@ -508,7 +509,7 @@ def test_the_fetched_horizon_is_the_recorded_file_to_the_bit(pvgis, server, tmp_
     assert meta["horizon_source"]["sha256"] == provenance["sha256"]
     assert "horizon_source" not in json.loads((tmp_path / "read" / "run.json").read_text())
     # a second run asks nothing; offline, a service that would fail is never asked
-    with figures_drawn_elsewhere():  # the first run's, of the same data
+    with folders_written_elsewhere():  # the first run's, of the same data: their rows alone
         again = runner.invoke(app, [*HORIZON_DAY, "--horizon", "pvgis", "--out", "again"])
         assert again.exit_code == 0 and json.loads(again.stdout)["rows"] == read["rows"]
         assert requests_made(server, route) == 1
@@ -616,7 +617,7 @@ def test_the_fetched_series_is_the_recorded_file_to_the_bit(pvgis, server, tmp_p
 
 
 def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis, server, tmp_path, monkeypatch,
-                                                                          figures_drawn_elsewhere):
+                                                                          folders_written_elsewhere):
     from foldopt.inputs.weather import reader
 
     route = pvgis("ok")
@@ -632,7 +633,7 @@ def test_a_second_hourly_run_asks_nothing_and_offline_runs_from_the_cache(pvgis,
     reads = []  # the files read: the answer was read by the fetch's check, before it was cached
     measured = reader.read_measured
     monkeypatch.setattr(reader, "read_measured", lambda path, *args: reads.append(path) or measured(path, *args))
-    with figures_drawn_elsewhere():  # days of this series: test_the_fetched_series_is_the_recorded_file's
+    with folders_written_elsewhere():  # days of this series, their rows alone (test_the_fetched_series')
         offline = runner.invoke(app, [*HOURLY_SWEEP, "--weather", "pvgis-hourly", *YEARS, *days, "--offline",
                                       "--out", "offline"])
         assert offline.exit_code == 0, offline.output

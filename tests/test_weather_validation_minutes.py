@@ -25,7 +25,15 @@ def table():
     spec = importlib.util.spec_from_file_location("weather_validation", BENCH)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    frame = module.validation(members=20)
+    with pytest.MonkeyPatch.context() as patch:
+        # Most of the table's engine calls (a day's 36 fold angles, one sky or 20 members, at 288
+        # to 1440 steps) are under the bound up to which ``auto`` takes the NumPy reference though
+        # the kernel is compiled: here ``auto`` takes the kernel where numba's cache holds it (the
+        # suite's warm-up compiled it), the reference where it does not (never a compile). What
+        # is checked is the minutes against their hourly means, which the two paths give alike
+        # (here to 1.3e-13 h; test_engine.py holds the kernel to the reference): half the CPU.
+        patch.setattr("foldopt.engine.choice.AUTO_CACHED_NUMPY_ROW_STEPS", 0)
+        frame = module.validation(members=20)
     frame["bias_min"] = 60 * (frame["smooth_h"] - frame["measured_h"])
     frame["inside"] = (frame["ensemble_p5_h"] - 1e-9 <= frame["measured_h"]) & (
         frame["measured_h"] <= frame["ensemble_p95_h"] + 1e-9)
