@@ -307,11 +307,26 @@ class IVCurve:
                 "gsh": gsh,
             }
 
+    @functools.cached_property
+    def _explicit_anywhere(self):
+        """Whether any curve takes :meth:`current`'s and :meth:`voltage`'s explicit forms (R_s = 0,
+        R_sh infinite): elsewhere they skip them."""
+        terms = self._terms
+        return not np.all(terms["i_lambert"]), not np.all(terms["v_lambert"])
+
+    @functools.cached_property
+    def _by_rank(self):
+        return {}
+
     def _diode_terms(self, x):
-        """:attr:`_terms` and the parameters, shaped to broadcast against ``x``."""
-        names = tuple(self._terms)
-        shaped = [trailing_axes(p, x) for p in (*self._terms.values(), *self.params)]
-        return dict(zip(names, shaped)), shaped[len(names) :]
+        """:attr:`_terms` and the parameters, shaped to broadcast against ``x`` (once a rank: a
+        search asks at the same rank some 40 times)."""
+        rank = np.ndim(x)
+        if rank not in self._by_rank:
+            names = tuple(self._terms)
+            shaped = [trailing_axes(p, x) for p in (*self._terms.values(), *self.params)]
+            self._by_rank[rank] = dict(zip(names, shaped)), shaped[len(names) :]
+        return self._by_rank[rank]
 
     def current(self, voltage):
         """Current of each curve at a voltage.
@@ -334,13 +349,11 @@ class IVCurve:
             t, (il, io, _, _, a) = self._diode_terms(voltage)
             # The Lambert-W argument may overflow to inf where the explicit form holds instead.
             with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-                w = pvlib.singlediode._lambertw_pvlib(
-                    t["i_factor"] * np.exp((t["i_shift"] + voltage) / t["i_scale"])
-                )
+                w = _lambertw(t["i_factor"] * np.exp((t["i_shift"] + voltage) / t["i_scale"]))
                 current = (t["i_offset"] - voltage * t["gsh"]) / t["denominator"] - t[
                     "a_over_rs"
                 ] * w
-                if np.all(t["i_lambert"]):
+                if not self._explicit_anywhere[0]:
                     return current
                 explicit = il - io * np.expm1(voltage / a) - t["gsh"] * voltage
             return np.where(t["i_lambert"], current, np.where(t["i_explicit"], explicit, np.nan))
@@ -371,16 +384,12 @@ class IVCurve:
                     return pvlib.pvsystem.v_from_i(current, *self._params(current))
                 t, (il, io, rs, _, a) = self._diode_terms(current)
                 exponent = (-current + il + io) / t["v_scale"]
-                argument = t["v_factor"] * np.exp(exponent)
                 # Where the argument overflows, Lambert W from its logarithm.
-                overflow = np.isinf(argument)
-                finite = ~overflow
-                w = np.empty_like(argument)
-                w[finite] = pvlib.singlediode._lambertw_pvlib(argument[finite])
-                if np.any(overflow):
-                    w[overflow] = pvlib.singlediode._log_lambertw((t["v_log"] + exponent)[overflow])
+                w = _lambertw(
+                    t["v_factor"] * np.exp(exponent), log_x=lambda: t["v_log"] + exponent
+                )
                 voltage = (t["i_offset"] - current) / t["gsh"] - current * rs - a * w
-                if np.all(t["v_lambert"]):
+                if not self._explicit_anywhere[1]:
                     return voltage
                 explicit = a * np.log1p((il - current) / io) - current * rs
             return np.where(t["v_lambert"], voltage, np.where(t["v_explicit"], explicit, np.nan))
@@ -501,6 +510,53 @@ def _kept(values):
     if isinstance(values, np.ndarray):
         values.flags.writeable = False
     return values
+
+
+def _lambertw(x, log_x=None):
+    """Lambert's W (principal branch) of ``x`` as pvlib's ``_lambertw_pvlib`` computes it for
+    ``i_from_v`` and ``v_from_i``, to the bit, in fewer passes over the arrays: pvlib's operations
+    in its order, Halley's three steps from ``log1p`` for ``x <= 100`` (written out here) and
+    pvlib's ``_log_lambertw`` of ``log(x)`` beyond, over all the arguments at once rather than
+    masked copies of each part, which cost about as much as the arithmetic on a search's blocks of
+    curves.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Arguments (>= 0).
+    log_x : callable, optional
+        ``log_x()``: ``log(x)`` by another route, taken where ``x`` overflowed to inf (as
+        ``v_from_i`` does).
+
+    Returns
+    -------
+    numpy.ndarray
+        W(x), shaped as ``x``.
+    """
+    small = x <= 100
+    if small.all():
+        return _halley_lambertw(x)
+    import pvlib.singlediode
+
+    log = np.log(x)
+    if log_x is not None:
+        log = np.where(np.isinf(x), log_x(), log)
+    w = pvlib.singlediode._log_lambertw(log)
+    if small.any():
+        w[small] = _halley_lambertw(x[small])
+    return w
+
+
+def _halley_lambertw(z):
+    """pvlib's ``_lambertw_pvlib`` for arguments of at most 100, its operations in its order."""
+    temp = np.log1p(z)
+    g = temp - np.log1p(temp)
+    for _ in range(3):
+        expg = np.exp(g)
+        g_expg_z = g * expg - z
+        g_p1 = g + 1.0
+        g = g - g_expg_z * g_p1 / (expg * g_p1**2 - 0.5 * (g + 2.0) * g_expg_z)
+    return g
 
 
 def _lambertw_exp(x):
