@@ -58,12 +58,16 @@ def golden_section(evaluate, lo, hi, steps=_GOLDEN_STEPS):
     for _ in range(steps):
         left = fa > fb  # the maximum lies in [lo, b]: b's bracket shrinks from above
         lo, hi = np.where(left, lo, a), np.where(left, b, hi)
-        kept, f_kept = np.where(left, a, b), np.where(left, fa, fb)
         inset = _INVPHI * (hi - lo)
         probe = np.where(left, hi - inset, lo + inset)
         f_probe = evaluate(probe)
-        a, fa = np.where(left, probe, kept), np.where(left, f_probe, f_kept)
-        b, fb = np.where(left, kept, probe), np.where(left, f_kept, f_probe)
+        # The inner point kept: a (becoming b) where left, b (becoming a) elsewhere.
+        a, fa, b, fb = (
+            np.where(left, probe, b),
+            np.where(left, f_probe, fb),
+            np.where(left, a, probe),
+            np.where(left, fa, f_probe),
+        )
     better = fa >= fb
     return np.where(better, fa, fb), np.where(better, a, b)
 
@@ -101,14 +105,10 @@ def parallel_power(east: IVCurve, west: IVCurve):
         return _in_blocks(parallel_power, east, west)
     (p_east, v_east), (p_west, v_west) = east.mpp(), west.mpp()
 
-    def sourced(side, voltage):
-        # Blocking diodes: a sub-panel adds its current only while it sources it; NaN (dark) is
-        # none and an overflow the largest float, as numpy.nan_to_num has them.
-        current = np.maximum(side.current(voltage), 0.0)
-        return np.minimum(np.fmax(current, 0.0, out=current), _LARGEST, out=current)
-
     def power(voltage):
-        return _finite(voltage * (sourced(east, voltage) + sourced(west, voltage)))
+        return _finite(
+            voltage * (_sourced(east.current(voltage)) + _sourced(west.current(voltage)))
+        )
 
     lower = np.minimum(v_east, v_west)
     # The sub-panel whose maximum-power voltage is the lower one stops sourcing at its own Voc.
@@ -118,10 +118,23 @@ def parallel_power(east: IVCurve, west: IVCurve):
     return np.maximum(searched, np.maximum(p_east, p_west))
 
 
+def _sourced(current):
+    """``numpy.nan_to_num(numpy.clip(current, 0, None))`` in three passes rather than some ten:
+    behind a blocking diode a sub-panel adds its current only while it sources it, NaN (a dark
+    curve) adds none and an overflow the largest float."""
+    return np.minimum(np.fmax(np.maximum(current, 0.0), 0.0), _LARGEST)
+
+
+def _inside(voltage, voc):
+    """``numpy.clip(numpy.nan_to_num(voltage), 0, voc)`` for finite ``voc``, in two passes: up to its
+    Isc a sub-panel's voltage lies in [0, Voc], and NaN is 0 V."""
+    return np.clip(np.fmax(voltage, 0.0), 0.0, voc)
+
+
 def _finite(power):
-    """``numpy.nan_to_num(power, nan=-inf)`` for powers that are not -inf, in place: a search's
+    """``numpy.nan_to_num(power, nan=-inf)`` for powers that are not -inf, in two passes: a search's
     value where the curves give none (NaN) is below every other."""
-    return np.fmax(np.clip(power, -_LARGEST, _LARGEST, out=power), -np.inf, out=power)
+    return np.fmax(np.clip(power, -_LARGEST, _LARGEST), -np.inf)
 
 
 def _size(curve: IVCurve) -> int:
@@ -167,16 +180,12 @@ def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
     isc_e, isc_w = east.i_sc, west.i_sc
     voc_e, voc_w = east.v_oc, west.v_oc
 
-    def side_voltage(curve, voc, current):
-        # Between 0 and Isc a sub-panel's voltage lies in [0, Voc]; clipping to it also removes
-        # the absurd voltages pvlib returns for a practically dark cell (Voc is 0 there). NaN is
-        # 0 V (fmax) and an overflow Voc, as numpy.nan_to_num and the clip have them.
-        voltage = curve.voltage(current)
-        return np.clip(np.fmax(voltage, 0.0, out=voltage), 0.0, voc, out=voltage)
-
     def power(current):
+        # Clipping to [0, Voc] also removes the absurd voltages pvlib returns for a practically
+        # dark cell (Voc is 0 there).
         return _finite(
-            current * (side_voltage(east, voc_e, current) + side_voltage(west, voc_w, current))
+            current
+            * (_inside(east.voltage(current), voc_e) + _inside(west.voltage(current), voc_w))
         )
 
     # Each sub-panel's voltage is concave and decreasing in the current, so the string's power is

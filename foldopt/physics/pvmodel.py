@@ -385,9 +385,7 @@ class IVCurve:
                 t, (il, io, rs, _, a) = self._diode_terms(current)
                 exponent = (-current + il + io) / t["v_scale"]
                 # Where the argument overflows, Lambert W from its logarithm.
-                w = _lambertw(
-                    t["v_factor"] * np.exp(exponent), log_x=lambda: t["v_log"] + exponent
-                )
+                w = _lambertw(t["v_factor"] * np.exp(exponent), log_x=lambda: t["v_log"] + exponent)
                 voltage = (t["i_offset"] - current) / t["gsh"] - current * rs - a * w
                 if not self._explicit_anywhere[1]:
                     return voltage
@@ -538,24 +536,31 @@ def _lambertw(x, log_x=None):
         return _halley_lambertw(x)
     import pvlib.singlediode
 
-    log = np.log(x)
-    if log_x is not None:
-        log = np.where(np.isinf(x), log_x(), log)
-    w = pvlib.singlediode._log_lambertw(log)
+    with np.errstate(divide="ignore", invalid="ignore"):  # the small ones' logarithms, unused
+        log = np.log(x)
+        if log_x is not None:
+            log = np.where(np.isinf(x), log_x(), log)
+        w = pvlib.singlediode._log_lambertw(log)
     if small.any():
         w[small] = _halley_lambertw(x[small])
     return w
 
 
 def _halley_lambertw(z):
-    """pvlib's ``_lambertw_pvlib`` for arguments of at most 100, its operations in its order."""
+    """pvlib's ``_lambertw_pvlib`` for arguments of at most 100, its operations in its order, into
+    buffers a step reuses (a search calls it some 80 times a block of curves)."""
     temp = np.log1p(z)
-    g = temp - np.log1p(temp)
+    g = np.asarray(temp - np.log1p(temp))
+    expg, g_expg_z, g_p1, step = (np.empty_like(g) for _ in range(4))
     for _ in range(3):
-        expg = np.exp(g)
-        g_expg_z = g * expg - z
-        g_p1 = g + 1.0
-        g = g - g_expg_z * g_p1 / (expg * g_p1**2 - 0.5 * (g + 2.0) * g_expg_z)
+        # pvlib: g - g_expg_z * g_p1 / (expg * g_p1**2 - 0.5 * (g + 2) * g_expg_z)
+        np.exp(g, out=expg)
+        np.subtract(np.multiply(g, expg, out=g_expg_z), z, out=g_expg_z)
+        np.add(g, 1.0, out=g_p1)
+        np.multiply(g_expg_z, g_p1, out=step)
+        denominator = np.multiply(np.square(g_p1, out=g_p1), expg, out=g_p1)
+        half = np.multiply(np.multiply(np.add(g, 2.0, out=expg), 0.5, out=expg), g_expg_z, out=expg)
+        np.subtract(g, np.divide(step, np.subtract(denominator, half, out=g_p1), out=step), out=g)
     return g
 
 
