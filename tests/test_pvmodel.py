@@ -188,7 +188,8 @@ def test_a_pvlib_without_its_own_lambert_w_is_called_itself(monkeypatch):
 
 
 @settings(max_examples=30, deadline=None)
-@given(st.lists(st.floats(-0.36, 1e300) | st.sampled_from([0.0, -0.0, 100.0, np.nextafter(100.0, 200.0), np.inf, np.nan]),
+@given(st.lists(st.floats(-0.36, 1e300)
+                | st.sampled_from([0.0, -0.0, 100.0, np.nextafter(100.0, 200.0), np.inf, np.nan]),
                 min_size=1, max_size=40))
 def test_the_curves_lambert_w_is_pvlibs_to_the_bit(values):
     """The curves' Lambert W (pvlib's operations written out, without its masked copies) is pvlib's

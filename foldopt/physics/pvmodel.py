@@ -100,6 +100,13 @@ def _squashed(name: str) -> str:
     return re.sub(r"[^0-9a-z]", "", name.lower())
 
 
+@functools.cache
+def _squashed_modules() -> dict:
+    """Every module of the database by its squashed name (:func:`_squashed`), worked out once: a
+    module is looked up by each PV model that names it."""
+    return {_squashed(module): module for module in _cec_modules().columns}
+
+
 def cec_module_name(name: str) -> str:
     """The exact name in pvlib's bundled CEC database [2]_ of a module given by any part of it,
     without regard to case and punctuation: ``CS5P-220M`` is ``Canadian_Solar_Inc__CS5P_220M``.
@@ -123,7 +130,7 @@ def cec_module_name(name: str) -> str:
     if name in modules:
         return name
     key = _squashed(name)
-    squashed = {_squashed(module): module for module in modules}
+    squashed = _squashed_modules()
     if key in squashed:
         return squashed[key]
     matches = [module for short, module in squashed.items() if key and key in short]
