@@ -188,20 +188,3 @@ def test_a_pvlib_without_its_own_lambert_w_is_called_itself(monkeypatch):
     # Were the terms used, the Lambert W hidden above would be called and fail.
     assert np.array_equal(curve.current(points), currents, equal_nan=True)
     assert np.array_equal(curve.voltage(points), voltages, equal_nan=True)
-
-
-@settings(max_examples=30, deadline=None)
-@given(st.lists(st.floats(-0.36, 1e300)
-                | st.sampled_from([0.0, -0.0, 100.0, np.nextafter(100.0, 200.0), np.inf, np.nan]),
-                min_size=1, max_size=40))
-def test_the_curves_lambert_w_is_pvlibs_to_the_bit(values):
-    """The curves' Lambert W (pvlib's operations written out, without its masked copies) is pvlib's
-    _lambertw_pvlib to the bit, on either side of its switch at 100 and mixed."""
-    from foldopt.physics.pvmodel import _lambertw
-
-    x = np.array(values)
-    with np.errstate(all="ignore"):
-        expected = pvlib.singlediode._lambertw_pvlib(x)
-    ours = _lambertw(x)
-    assert np.array_equal(np.isnan(ours), np.isnan(expected))
-    assert np.array_equal(ours[~np.isnan(ours)].view(np.int64), expected[~np.isnan(expected)].view(np.int64))

@@ -356,7 +356,9 @@ class IVCurve:
             t, (il, io, _, _, a) = self._diode_terms(voltage)
             # The Lambert-W argument may overflow to inf where the explicit form holds instead.
             with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-                w = _lambertw(t["i_factor"] * np.exp((t["i_shift"] + voltage) / t["i_scale"]))
+                w = pvlib.singlediode._lambertw_pvlib(
+                    t["i_factor"] * np.exp((t["i_shift"] + voltage) / t["i_scale"])
+                )
                 current = (t["i_offset"] - voltage * t["gsh"]) / t["denominator"] - t[
                     "a_over_rs"
                 ] * w
@@ -392,7 +394,13 @@ class IVCurve:
                 t, (il, io, rs, _, a) = self._diode_terms(current)
                 exponent = (-current + il + io) / t["v_scale"]
                 # Where the argument overflows, Lambert W from its logarithm.
-                w = _lambertw(t["v_factor"] * np.exp(exponent), log_x=lambda: t["v_log"] + exponent)
+                argument = t["v_factor"] * np.exp(exponent)
+                overflow = np.isinf(argument)
+                finite = ~overflow
+                w = np.empty_like(argument)
+                w[finite] = pvlib.singlediode._lambertw_pvlib(argument[finite])
+                if np.any(overflow):
+                    w[overflow] = pvlib.singlediode._log_lambertw((t["v_log"] + exponent)[overflow])
                 voltage = (t["i_offset"] - current) / t["gsh"] - current * rs - a * w
                 if not self._explicit_anywhere[1]:
                     return voltage
@@ -515,60 +523,6 @@ def _kept(values):
     if isinstance(values, np.ndarray):
         values.flags.writeable = False
     return values
-
-
-def _lambertw(x, log_x=None):
-    """Lambert's W (principal branch) of ``x`` as pvlib's ``_lambertw_pvlib`` computes it for
-    ``i_from_v`` and ``v_from_i``, to the bit, in fewer passes over the arrays: pvlib's operations
-    in its order, Halley's three steps from ``log1p`` for ``x <= 100`` (written out here) and
-    pvlib's ``_log_lambertw`` of ``log(x)`` beyond, over all the arguments at once rather than
-    masked copies of each part, which cost about as much as the arithmetic on a search's blocks of
-    curves.
-
-    Parameters
-    ----------
-    x : numpy.ndarray
-        Arguments (>= 0).
-    log_x : callable, optional
-        ``log_x()``: ``log(x)`` by another route, taken where ``x`` overflowed to inf (as
-        ``v_from_i`` does).
-
-    Returns
-    -------
-    numpy.ndarray
-        W(x), shaped as ``x``.
-    """
-    small = x <= 100
-    if small.all():
-        return _halley_lambertw(x)
-    import pvlib.singlediode
-
-    with np.errstate(divide="ignore", invalid="ignore"):  # the small ones' logarithms, unused
-        log = np.log(x)
-        if log_x is not None:
-            log = np.where(np.isinf(x), log_x(), log)
-        w = pvlib.singlediode._log_lambertw(log)
-    if small.any():
-        w[small] = _halley_lambertw(x[small])
-    return w
-
-
-def _halley_lambertw(z):
-    """pvlib's ``_lambertw_pvlib`` for arguments of at most 100, its operations in its order, into
-    buffers a step reuses (a search calls it some 80 times a block of curves)."""
-    temp = np.log1p(z)
-    g = np.asarray(temp - np.log1p(temp))
-    expg, g_expg_z, g_p1, step = (np.empty_like(g) for _ in range(4))
-    for _ in range(3):
-        # pvlib: g - g_expg_z * g_p1 / (expg * g_p1**2 - 0.5 * (g + 2) * g_expg_z)
-        np.exp(g, out=expg)
-        np.subtract(np.multiply(g, expg, out=g_expg_z), z, out=g_expg_z)
-        np.add(g, 1.0, out=g_p1)
-        np.multiply(g_expg_z, g_p1, out=step)
-        denominator = np.multiply(np.square(g_p1, out=g_p1), expg, out=g_p1)
-        half = np.multiply(np.multiply(np.add(g, 2.0, out=expg), 0.5, out=expg), g_expg_z, out=expg)
-        np.subtract(g, np.divide(step, np.subtract(denominator, half, out=g_p1), out=step), out=g)
-    return g
 
 
 def _lambertw_exp(x):
