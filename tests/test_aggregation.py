@@ -187,3 +187,47 @@ def test_the_annual_summary_says_what_its_angle_and_totals_stand_for(tmp_path, f
         assert (row["note"] if isinstance(row["note"], str) else "") == "; ".join(expected)
     # The case each run is about: each solstice its own best angle, or one angle for all days.
     assert days[days["design"] == "twofold"]["fold_angle_deg"].nunique() == angles
+
+
+def _bits(values):
+    return np.asarray(values, dtype=float).view(np.int64)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_pair_searches_a_block_at_a_time_are_the_searches_at_once(model, monkeypatch):
+    """Over many pairs (an electrical table's 51,681) the searches run a block of curves at a time:
+    every pair's power is, to the bit, that of one pass over all of them, at the curves' shape."""
+    from foldopt.physics import connections
+
+    rng = np.random.default_rng(5)
+    poa_east = rng.uniform(0, 1500, (12, 25))
+    poa_west = poa_east * rng.choice([1.0, 0.5, 0.01, 1e-6, 0.0], poa_east.shape)
+    temp = rng.uniform(-10, 70, poa_east.shape)
+
+    def solved():
+        east = MODELS[model].curves(poa_east, cell_temperature(poa_east, temp, 1.0, "sapm"), AREA)
+        west = MODELS[model].curves(poa_west, cell_temperature(poa_west, temp, 1.0, "sapm"), AREA)
+        return [parallel_power(east, west), series_power(east, west, False), series_power(east, west, True)]
+
+    at_once = solved()
+    monkeypatch.setattr(connections, "_BLOCK", 128)  # three blocks of 100
+    for blocked, whole in zip(solved(), at_once, strict=True):
+        assert blocked.shape == poa_east.shape
+        assert np.array_equal(_bits(blocked), _bits(whole))
+
+
+@settings(max_examples=25, deadline=None)
+@given(values=st.lists(st.floats() | st.sampled_from([0.0, -0.0, np.inf, np.nan, np.finfo(float).max]), min_size=1,
+                       max_size=20),
+       voc=st.floats(0.0, 1e3) | st.sampled_from([0.0, -0.0]))
+def test_the_searches_clip_and_replace_nan_as_numpy_does(values, voc):
+    """The searches' short forms of numpy.nan_to_num and clip give NumPy's values to the bit
+    (signed zeros too): a sourced current, a voltage within [0, Voc], a power NaN is least."""
+    from foldopt.physics.connections import _finite, _inside, _sourced
+
+    x, vocs = np.array(values), np.full(len(values), voc)
+    with np.errstate(all="ignore"):
+        assert np.array_equal(_bits(_sourced(x)), _bits(np.nan_to_num(np.clip(x, 0.0, None))))
+        assert np.array_equal(_bits(_inside(x, vocs)), _bits(np.clip(np.nan_to_num(x), 0.0, vocs)))
+        powers = x[x != -np.inf]  # a power is never -inf (voltages and currents >= 0)
+        assert np.array_equal(_bits(_finite(powers)), _bits(np.nan_to_num(powers, nan=-np.inf)))

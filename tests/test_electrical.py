@@ -46,8 +46,13 @@ def test_tables_are_cached_on_disk_by_their_settings(tmp_path, monkeypatch):
     from foldopt.physics.pvmodel import PVModel
 
     monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path))
+    # Tables of few nodes (they name their files too): what is checked is where a table comes from,
+    # not its values, and the test builds four.
+    monkeypatch.setattr(electrical, "TABLE_NODES_2D", 9)
+    monkeypatch.setattr(electrical, "TABLE_NODES_RATIO", 17)
     settings = dict(pv=PVModel("b-model", 0.19), subpanel_area=0.054, temp_air=25.0, temperature_model="sapm")
     built = electrical.Electrical(**settings)._table("parallel")
+    assert built.shape == (9, 17)
     files = list((tmp_path / "tables").glob("parallel-*.npz"))
     assert len(files) == 1
     # A second model of the same settings loads the table instead of solving I-V curves.
@@ -55,6 +60,8 @@ def test_tables_are_cached_on_disk_by_their_settings(tmp_path, monkeypatch):
     np.testing.assert_array_equal(electrical.Electrical(**settings)._table("parallel"), built)
     monkeypatch.undo()
     monkeypatch.setenv("FOLDOPT_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(electrical, "TABLE_NODES_2D", 9)
+    monkeypatch.setattr(electrical, "TABLE_NODES_RATIO", 17)
     # Other settings, another file; a damaged file is rebuilt; no writable cache is no error.
     electrical.Electrical(**{**settings, "temp_air": 30.0})._table("parallel")
     assert len(list((tmp_path / "tables").glob("parallel-*.npz"))) == 2

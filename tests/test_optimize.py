@@ -92,7 +92,7 @@ def test_the_heuristic_angle_reaches_the_load():
     (20, 120, 8.0, ""),
 ])
 def test_the_heuristic_is_stated_only_within_the_studys_fold_angles(tmp_path, shin_study, start, stop, p_load,
-                                                                    outside):
+                                                                    outside, figures_drawn_elsewhere):
     """The paper's heuristic is stated where its angle lies among the study's fold angles, and there it
     reaches the load at noon where a hundredth of a degree less does not (Eq. 8, on the day's own
     sub-panel curves); elsewhere the best fold angle's line says where the rule's angle lies and why (the
@@ -107,9 +107,12 @@ def test_the_heuristic_is_stated_only_within_the_studys_fold_angles(tmp_path, sh
     from foldopt.engine.optimize import noon_valley
 
     out = tmp_path / "out"
-    done = CliRunner().invoke(app, ["run", "--set", f"fold_angles.start={start}", "--set",
-                                    f"fold_angles.stop={stop}", "--set", f"p_load={p_load}", "--format", "json",
-                                    "--out", str(out)])
+    # What is read is the answer and run.json: the run's figures are drawn whole by
+    # tests/test_cli_studies.py (the shipped study, every grid).
+    with figures_drawn_elsewhere():
+        done = CliRunner().invoke(app, ["run", "--set", f"fold_angles.start={start}", "--set",
+                                        f"fold_angles.stop={stop}", "--set", f"p_load={p_load}", "--format",
+                                        "json", "--out", str(out)])
     assert done.exit_code == 0, done.output
     answer = json.loads(done.stdout)["answer"]
     angle = answer["result"]["fold_angle_twofold_heuristic_deg"]
@@ -216,7 +219,7 @@ def test_a_landscape_of_zeros_is_answered_at_once(fields, polar_night):
     assert not any("near-optimal" in line for line in lines[2:])
 
 
-def test_no_nan_reaches_an_answer_at_polar_night(tmp_path, polar_night):
+def test_no_nan_reaches_an_answer_at_polar_night(tmp_path, polar_night, figures_drawn_elsewhere):
     """The terminal's lines, --format json (strict JSON), the CSVs and report.html of a search where no
     design carries the load: no NaN (it printed '+nan % over the flat panel' and 'fold nan to nan
     deg'); the command line gives the API's numbers."""
@@ -230,8 +233,10 @@ def test_no_nan_reaches_an_answer_at_polar_night(tmp_path, polar_night):
         raise ValueError(f"{constant} in the JSON")
 
     out = tmp_path / "out"
-    result = CliRunner().invoke(app, ["optimize", *SMALL, "--lat", "80", "--date", "2014-12-21", "--format", "json",
-                                      "--out", str(out)])
+    # The files' text is read, not the figures' pixels (an optimisation's figures: test_cli_studies.py).
+    with figures_drawn_elsewhere():
+        result = CliRunner().invoke(app, ["optimize", *SMALL, "--lat", "80", "--date", "2014-12-21", "--format",
+                                          "json", "--out", str(out)])
     assert result.exit_code == 0, result.output
     document = json.loads(result.stdout, parse_constant=refuse)
     assert all(_no_nan(line) for line in document["answer"]["lines"])
@@ -538,7 +543,7 @@ def test_no_fold_of_180_deg_beats_the_flat_panel_at_its_own_best(latitude, longi
             assert not (load["gain_vs_flat_pct"] or 0.0) > 0.0
 
 
-def test_the_flat_panel_at_its_own_best_holds_its_default_mounting(tmp_path):
+def test_the_flat_panel_at_its_own_best_holds_its_default_mounting(tmp_path, figures_drawn_elsewhere):
     """At 14.3 S the flat panel's search, on a 2-deg grid of tilts, missed the default mounting's tilt
     of 14.3 deg: its 'own best' (7.7405 h at 14 deg) was short of the default (7.7407 h) and of the
     180 deg designs evaluated.csv holds; optimum.csv's flat row is now the best of them all, and the
@@ -549,10 +554,12 @@ def test_the_flat_panel_at_its_own_best_holds_its_default_mounting(tmp_path):
     from foldopt.cli.app import app
 
     out = tmp_path / "out"
-    done = CliRunner().invoke(app, ["optimize", "--lat", "-14.3", "--lon", "76.8", "--days", "1:365:30",
-                                    "--objective", "mean", "--p-load", "9.47", "--vary", "fold_angle,tilt",
-                                    "--fold-range", "10:180:5", "--tilt-range", "0:90:2", "--step-min", "15",
-                                    "--out", str(out)])
+    # Its tables and lines are read (an optimisation's figures: test_cli_studies.py).
+    with figures_drawn_elsewhere():
+        done = CliRunner().invoke(app, ["optimize", "--lat", "-14.3", "--lon", "76.8", "--days", "1:365:30",
+                                        "--objective", "mean", "--p-load", "9.47", "--vary", "fold_angle,tilt",
+                                        "--fold-range", "10:180:5", "--tilt-range", "0:90:2", "--step-min", "15",
+                                        "--out", str(out)])
     assert done.exit_code == 0, done.output
     optimum = pd.read_csv(out / "optimum.csv").set_index("design")
     evaluated = pd.read_csv(out / "evaluated.csv")

@@ -28,6 +28,11 @@ from foldopt.physics.pvmodel import IVCurve
 SWITCH_STATES = ("east", "west", "parallel", "series")  # ties go to the earlier, simpler state
 _GOLDEN_STEPS = 40
 _INVPHI = (np.sqrt(5.0) - 1.0) / 2.0
+#: Curves a pair's search takes at once: its some 40 temporaries of this many values stay in the
+#: processor's cache and below the size the C library maps afresh from the system (page faults),
+#: which a whole electrical table (51,681 pairs) is not.
+_BLOCK = 8192
+_LARGEST = np.finfo(float).max
 
 
 def golden_section(evaluate, lo, hi, steps=_GOLDEN_STEPS):
@@ -53,12 +58,16 @@ def golden_section(evaluate, lo, hi, steps=_GOLDEN_STEPS):
     for _ in range(steps):
         left = fa > fb  # the maximum lies in [lo, b]: b's bracket shrinks from above
         lo, hi = np.where(left, lo, a), np.where(left, b, hi)
-        kept, f_kept = np.where(left, a, b), np.where(left, fa, fb)
         inset = _INVPHI * (hi - lo)
         probe = np.where(left, hi - inset, lo + inset)
         f_probe = evaluate(probe)
-        a, fa = np.where(left, probe, kept), np.where(left, f_probe, f_kept)
-        b, fb = np.where(left, kept, probe), np.where(left, f_kept, f_probe)
+        # The inner point kept: a (becoming b) where left, b (becoming a) elsewhere.
+        a, fa, b, fb = (
+            np.where(left, probe, b),
+            np.where(left, f_probe, fb),
+            np.where(left, a, probe),
+            np.where(left, fa, f_probe),
+        )
     better = fa >= fb
     return np.where(better, fa, fb), np.where(better, a, b)
 
@@ -92,23 +101,55 @@ def parallel_power(east: IVCurve, west: IVCurve):
     .. [2] J. Kiefer, "Sequential minimax search for a maximum", Proc. Amer. Math. Soc. 4(3),
        502-506, 1953 (golden-section search).
     """
+    if _size(east) > _BLOCK:
+        return _in_blocks(parallel_power, east, west)
     (p_east, v_east), (p_west, v_west) = east.mpp(), west.mpp()
 
     def power(voltage):
-        # Blocking diodes: a sub-panel adds its current only while it sources it (NaN: dark).
-        current = sum(
-            np.nan_to_num(np.clip(side.current(voltage), 0.0, None)) for side in (east, west)
+        return _finite(
+            voltage * (_sourced(east.current(voltage)) + _sourced(west.current(voltage)))
         )
-        return voltage * current
 
     lower = np.minimum(v_east, v_west)
     # The sub-panel whose maximum-power voltage is the lower one stops sourcing at its own Voc.
     voc_lower = np.where(v_east <= v_west, east.v_oc, west.v_oc)
     upper = np.maximum(lower, np.minimum(np.maximum(v_east, v_west), voc_lower))
-    searched = golden_section(
-        lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf), lower, upper
-    )[0]
+    searched = golden_section(power, lower, upper)[0]
     return np.maximum(searched, np.maximum(p_east, p_west))
+
+
+def _sourced(current):
+    """``numpy.nan_to_num(numpy.clip(current, 0, None))`` in three passes rather than some ten:
+    behind a blocking diode a sub-panel adds its current only while it sources it, NaN (a dark
+    curve) adds none and an overflow the largest float."""
+    return np.minimum(np.fmax(np.maximum(current, 0.0), 0.0), _LARGEST)
+
+
+def _inside(voltage, voc):
+    """``numpy.clip(numpy.nan_to_num(voltage), 0, voc)`` for finite ``voc``, in two passes: up to its
+    Isc a sub-panel's voltage lies in [0, Voc], and NaN is 0 V."""
+    return np.clip(np.fmax(voltage, 0.0), 0.0, voc)
+
+
+def _finite(power):
+    """``numpy.nan_to_num(power, nan=-inf)`` for powers that are not -inf, in two passes: a search's
+    value where the curves give none (NaN) is below every other."""
+    return np.fmax(np.clip(power, -_LARGEST, _LARGEST), -np.inf)
+
+
+def _size(curve: IVCurve) -> int:
+    return int(np.prod(np.broadcast_shapes(*(np.shape(p) for p in curve.params))))
+
+
+def _in_blocks(pair, east: IVCurve, west: IVCurve, *args):
+    """``pair(east, west, *args)`` over consecutive blocks of at most :data:`_BLOCK` curves, the
+    same values as at once: each curve's search is its own, and the curves' maximum-power points
+    and end points are worked out once on all of them (:meth:`IVCurve.taken`)."""
+    shape = np.broadcast_shapes(*(np.shape(p) for p in (*east.params, *west.params)))
+    blocks = np.array_split(np.arange(_size(east)), -(-_size(east) // _BLOCK))
+    return np.concatenate(
+        [pair(east.taken(block), west.taken(block), *args) for block in blocks]
+    ).reshape(shape)
 
 
 def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
@@ -134,29 +175,23 @@ def series_power(east: IVCurve, west: IVCurve, bypass: bool = True):
     numpy.ndarray
         Maximum power of the string [W], shaped as the curves.
     """
+    if _size(east) > _BLOCK:
+        return _in_blocks(series_power, east, west, bypass)
     isc_e, isc_w = east.i_sc, west.i_sc
     voc_e, voc_w = east.v_oc, west.v_oc
 
-    def side_voltage(curve, voc, current):
-        # Between 0 and Isc a sub-panel's voltage lies in [0, Voc]; clipping to it also removes
-        # the absurd voltages pvlib returns for a practically dark cell (Voc is 0 there).
-        return np.clip(np.nan_to_num(curve.voltage(current)), 0.0, voc[..., None])
-
     def power(current):
-        return current * (side_voltage(east, voc_e, current) + side_voltage(west, voc_w, current))
+        # Clipping to [0, Voc] also removes the absurd voltages pvlib returns for a practically
+        # dark cell (Voc is 0 there).
+        return _finite(
+            current
+            * (_inside(east.voltage(current), voc_e) + _inside(west.voltage(current), voc_w))
+        )
 
     # Each sub-panel's voltage is concave and decreasing in the current, so the string's power is
     # concave on [0, the weaker Isc]: golden-section search finds its maximum.
     upper = np.minimum(isc_e, isc_w)
-    string = np.clip(
-        golden_section(
-            lambda x: np.nan_to_num(power(x[..., None])[..., 0], nan=-np.inf),
-            np.zeros_like(upper),
-            upper,
-        )[0],
-        0.0,
-        None,
-    )
+    string = np.clip(golden_section(power, np.zeros_like(upper), upper)[0], 0.0, None)
     if not bypass:
         return string
     return np.maximum(string, np.maximum(east.max_power(), west.max_power()))

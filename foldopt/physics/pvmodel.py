@@ -100,6 +100,13 @@ def _squashed(name: str) -> str:
     return re.sub(r"[^0-9a-z]", "", name.lower())
 
 
+@functools.cache
+def _squashed_modules() -> dict:
+    """Every module of the database by its squashed name (:func:`_squashed`), worked out once: a
+    module is looked up by each PV model that names it."""
+    return {_squashed(module): module for module in _cec_modules().columns}
+
+
 def cec_module_name(name: str) -> str:
     """The exact name in pvlib's bundled CEC database [2]_ of a module given by any part of it,
     without regard to case and punctuation: ``CS5P-220M`` is ``Canadian_Solar_Inc__CS5P_220M``.
@@ -123,7 +130,7 @@ def cec_module_name(name: str) -> str:
     if name in modules:
         return name
     key = _squashed(name)
-    squashed = {_squashed(module): module for module in modules}
+    squashed = _squashed_modules()
     if key in squashed:
         return squashed[key]
     matches = [module for short, module in squashed.items() if key and key in short]
@@ -307,11 +314,26 @@ class IVCurve:
                 "gsh": gsh,
             }
 
+    @functools.cached_property
+    def _explicit_anywhere(self):
+        """Whether any curve takes :meth:`current`'s and :meth:`voltage`'s explicit forms (R_s = 0,
+        R_sh infinite): elsewhere they skip them."""
+        terms = self._terms
+        return not np.all(terms["i_lambert"]), not np.all(terms["v_lambert"])
+
+    @functools.cached_property
+    def _by_rank(self):
+        return {}
+
     def _diode_terms(self, x):
-        """:attr:`_terms` and the parameters, shaped to broadcast against ``x``."""
-        names = tuple(self._terms)
-        shaped = [trailing_axes(p, x) for p in (*self._terms.values(), *self.params)]
-        return dict(zip(names, shaped)), shaped[len(names) :]
+        """:attr:`_terms` and the parameters, shaped to broadcast against ``x`` (once a rank: a
+        search asks at the same rank some 40 times)."""
+        rank = np.ndim(x)
+        if rank not in self._by_rank:
+            names = tuple(self._terms)
+            shaped = [trailing_axes(p, x) for p in (*self._terms.values(), *self.params)]
+            self._by_rank[rank] = dict(zip(names, shaped)), shaped[len(names) :]
+        return self._by_rank[rank]
 
     def current(self, voltage):
         """Current of each curve at a voltage.
@@ -340,7 +362,7 @@ class IVCurve:
                 current = (t["i_offset"] - voltage * t["gsh"]) / t["denominator"] - t[
                     "a_over_rs"
                 ] * w
-                if np.all(t["i_lambert"]):
+                if not self._explicit_anywhere[0]:
                     return current
                 explicit = il - io * np.expm1(voltage / a) - t["gsh"] * voltage
             return np.where(t["i_lambert"], current, np.where(t["i_explicit"], explicit, np.nan))
@@ -371,8 +393,8 @@ class IVCurve:
                     return pvlib.pvsystem.v_from_i(current, *self._params(current))
                 t, (il, io, rs, _, a) = self._diode_terms(current)
                 exponent = (-current + il + io) / t["v_scale"]
-                argument = t["v_factor"] * np.exp(exponent)
                 # Where the argument overflows, Lambert W from its logarithm.
+                argument = t["v_factor"] * np.exp(exponent)
                 overflow = np.isinf(argument)
                 finite = ~overflow
                 w = np.empty_like(argument)
@@ -380,7 +402,7 @@ class IVCurve:
                 if np.any(overflow):
                     w[overflow] = pvlib.singlediode._log_lambertw((t["v_log"] + exponent)[overflow])
                 voltage = (t["i_offset"] - current) / t["gsh"] - current * rs - a * w
-                if np.all(t["v_lambert"]):
+                if not self._explicit_anywhere[1]:
                     return voltage
                 explicit = a * np.log1p((il - current) / io) - current * rs
             return np.where(t["v_lambert"], voltage, np.where(t["v_explicit"], explicit, np.nan))
