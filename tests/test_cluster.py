@@ -412,11 +412,20 @@ def hand_started(tmp_path_factory):
             script = {"MODULE": command[0], "ARGS": command[1]}
             processes.append(context.Process(target=exec, args=(DASK_COMMAND, script), daemon=True))
             processes[-1].start()
-        _wait_for(scheduler_file.exists, "the scheduler's file", 60)
+        _wait_for(lambda: _address_in(scheduler_file), "the scheduler's file", 60)
         yield scheduler_file, processes[1:], processes[0]
     finally:
         for process in processes:
             _kill(process)
+
+
+def _address_in(scheduler_file: Path) -> bool:
+    """Whether the scheduler has written its file whole: Dask creates it, then writes its JSON, and a
+    map that read it between the two was refused (an empty file is not a scheduler file)."""
+    try:
+        return "address" in json.loads(scheduler_file.read_text())
+    except (OSError, ValueError):
+        return False
 
 
 @contextmanager

@@ -40,7 +40,8 @@ def snapshot(folder: Path) -> dict[str, str]:
 
 
 def world_map(scheduler, out, sites, loads, **keywords):
-    return foldopt.world_map(sites, loads, out, STUDY, scheduler=scheduler, engine="numpy", **keywords)
+    """The map on the compiled kernel, a map's engine (what is tested is its folder)."""
+    return foldopt.world_map(sites, loads, out, STUDY, scheduler=scheduler, engine="numba", **keywords)
 
 
 #: Tables a map can legally hold, at their edges: the sites and loads of each.
