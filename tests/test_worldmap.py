@@ -358,3 +358,41 @@ def test_a_searched_sites_answer_is_the_same_whatever_the_batch_it_shares():
     alone = evaluate_sites(searched, sites[:1], [0.1, 0.3], relative=True)
     pd.testing.assert_frame_equal(after[after["site_id"] == 0].reset_index(drop=True), alone,
                                   check_exact=True)
+
+
+def test_a_maps_chunk_is_sized_by_the_designs_its_sites_evaluate(monkeypatch):
+    """A chunk holds about CHUNK_SECONDS of a site's estimated work: a searched site's estimate
+    counts the designs its search evaluates (the search's own count on real sites, at the year's
+    steps: within a quarter of the share the estimate takes), not its grid's, so its chunk holds
+    more sites than a sweep's of the same grid, a search of the tilt too fewer, and a chunk of a
+    batch or more whole batches."""
+    from foldopt.studies import site_search
+    from foldopt.studies.map_request import (
+        CHUNK_SECONDS,
+        SEARCHED_SHARE,
+        SITES_PER_BATCH,
+        MapSpec,
+        site_seconds,
+    )
+
+    study = {**map_study({"name": "shin2015", "panel": {"area": 0.108}}), "step_min": 30.0}
+    counted = []
+    result = site_search.DesignSearch.result
+    monkeypatch.setattr(site_search.DesignSearch, "result",
+                        lambda self: counted.append(result(self)[0].shape[0]) or result(self))
+    sites = [{"latitude": latitude, "longitude": 20.0} for latitude in (-35.0, 48.0)]
+    searched = {**study, "optimize": {"vary": ["fold_angle"]}}
+    # W5's ten loads: fewer loads refine fewer plateaus (three, some 30 angles), their chunks short.
+    evaluate_sites(searched, sites, np.arange(1, 11) * 0.05, relative=True)
+    share = np.mean(counted) / 180
+    assert 0.75 * SEARCHED_SHARE[1] <= share <= 1.25 * SEARCHED_SHARE[1], share
+    tilted = {**study, "optimize": {"vary": ["fold_angle", "tilt"]}}
+    specs = [MapSpec(data, tuple(sites), (0.1,), relative=True) for data in (study, searched, tilted)]
+    sizes = [spec.sites_per_chunk for spec in specs]
+    assert sizes[0] < sizes[1] and sizes[2] < sizes[0], sizes
+    for spec in specs:
+        seconds = site_seconds(spec.study, spec.year)
+        size = spec.sites_per_chunk
+        assert size == 1 or size * seconds <= CHUNK_SECONDS * 1.1, (size, seconds)
+        assert size < SITES_PER_BATCH or size % SITES_PER_BATCH == 0
+        assert (size + max(1, size // 2)) * seconds > CHUNK_SECONDS or size >= SITES_PER_BATCH
