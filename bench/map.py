@@ -4,7 +4,7 @@
     python bench/map.py --write          # ... and written to results/bench/map.md and map.json
     python bench/map.py --sites 200      # a quicker look
     python bench/map.py --phases         # a site's cost by phase, one core (W4's sites: every angle)
-    python bench/map.py --w5 --phases    # ... W5's: land sites, fold angles searched; 100 workers' time
+    python bench/map.py --w5 --phases    # ... W5's: a chunk of land sites, fold angles searched; 100 workers' time
     python bench/map.py --w5 --sites 1000 # W5 on 1,000 of the 1-degree land grid's sites, the grid projected
     python bench/map.py --w5             # W5: the whole 1-degree land grid (target 600 s)
     python bench/map.py --w5 --sites 1000 --step-min 10  # ... projected at 10-min steps
@@ -237,14 +237,19 @@ def main() -> None:
     args = parser.parse_args()
     if args.w5 and args.phases:
         from foldopt.inputs.study_file import default_study_path, read_study
-        from foldopt.studies.map_request import map_study
+        from foldopt.studies.map_request import MapSpec, map_study
 
-        land, sites = _land_sites(25)
         searched = {**map_study(read_study(default_study_path())[0]), "optimize": {"vary": ["fold_angle"]},
                     "step_min": args.step_min}
-        cost = phases(searched, sites, tuple(np.round(np.arange(1, 11) * 0.05, 6)), relative=True)
-        print(f"W5's sites (24 of the 1-degree land grid, fold angles searched, {args.step_min:g}-min steps): ",
-              end="")
+        loads = tuple(np.round(np.arange(1, 11) * 0.05, 6))
+        # As many sites as a run's chunk holds, in one call as a worker runs a chunk: what a chunk
+        # works out once (SPA's lattice of the year) is shared as in a run.
+        land, _ = _land_sites(None)
+        chunk = MapSpec(searched, tuple(land[:1]), loads, relative=True).sites_per_chunk
+        _, sites = _land_sites(chunk + 1)
+        cost = phases(searched, sites, loads, relative=True)
+        print(f"W5's sites ({chunk} of the 1-degree land grid, a run's chunk, fold angles searched, "
+              f"{args.step_min:g}-min steps): ", end="")
         _print_phases(cost)
         per_site = cost["per_site_s"]
         print(f"the {len(land):,} land sites at that cost: {len(land) * per_site / 3600:.2f} core-hours; "

@@ -358,3 +358,45 @@ def test_a_searched_sites_answer_is_the_same_whatever_the_batch_it_shares():
     alone = evaluate_sites(searched, sites[:1], [0.1, 0.3], relative=True)
     pd.testing.assert_frame_equal(after[after["site_id"] == 0].reset_index(drop=True), alone,
                                   check_exact=True)
+
+
+def test_a_maps_chunk_is_sized_by_the_designs_its_sites_evaluate(monkeypatch):
+    """A chunk holds about CHUNK_SECONDS of its sites' estimated work, within half a batch of
+    sites and the one a whole number leaves: a searched site's estimate counts the designs its
+    search evaluates (held here to the search's own count on real sites, within a quarter), not
+    its grid's, so that its chunk holds more sites than a sweep's of the same grid, and a search
+    of the tilt with the fold angle fewer; a chunk of a batch or more holds whole batches."""
+    from foldopt.studies import site_search
+    from foldopt.studies.map_request import (
+        CHUNK_SECONDS,
+        SEARCHED_SHARE,
+        SITES_PER_BATCH,
+        MapSpec,
+        site_seconds,
+    )
+
+    study = {**map_study({"name": "shin2015", "panel": {"area": 0.108}}), "step_min": 30.0}
+    counted = []
+    result = site_search.DesignSearch.result
+
+    def counting(self):
+        found = result(self)
+        counted.append(found[0].shape[0])
+        return found
+
+    monkeypatch.setattr(site_search.DesignSearch, "result", counting)
+    sites = [{"latitude": latitude, "longitude": 20.0} for latitude in (-35.0, 48.0)]
+    searched = {**study, "optimize": {"vary": ["fold_angle"]}}
+    # W5's ten loads: fewer loads refine fewer plateaus (three, some 30 angles), their chunks short.
+    evaluate_sites(searched, sites, np.arange(1, 11) * 0.05, relative=True)
+    share = np.mean(counted) / 180
+    assert 0.75 * SEARCHED_SHARE[1] <= share <= 1.25 * SEARCHED_SHARE[1], share
+    tilted = {**study, "optimize": {"vary": ["fold_angle", "tilt"]}}
+    specs = [MapSpec(data, tuple(sites), (0.1,), relative=True) for data in (study, searched, tilted)]
+    sizes = [spec.sites_per_chunk for spec in specs]
+    assert sizes[2] < sizes[0] < sizes[1], sizes
+    for spec, size in zip(specs, sizes):
+        seconds = site_seconds(spec.study, spec.year)
+        # within half a batch of the sites that fit, whole ones
+        assert size == 1 or abs(size * seconds - CHUNK_SECONDS) <= seconds * (SITES_PER_BATCH / 2 + 1)
+        assert size < SITES_PER_BATCH or size % SITES_PER_BATCH == 0

@@ -11,6 +11,7 @@ where it is read. :mod:`foldopt.studies.worldmap` evaluates a map's sites;
 
 from __future__ import annotations
 
+import calendar
 import dataclasses
 import datetime as dt
 import functools
@@ -21,7 +22,7 @@ from pathlib import Path
 
 from foldopt import names
 from foldopt.errors import ConfigError
-from foldopt.inputs.optimize_section import vary_names
+from foldopt.inputs.optimize_section import DEFAULT_TILT, grid_points, vary_names
 from foldopt.inputs.fields import year_problem
 from foldopt.inputs.plan import check_distinct, parse_dates, parse_values
 from foldopt.inputs.sites import SITE_COLUMNS, grid_sites, read_sites, weather_sites
@@ -264,9 +265,20 @@ def map_request(
 #: Seconds of work a chunk aims at: long enough that scheduling costs little (a task costs Dask
 #: about a millisecond), short enough that a lost worker loses little and progress moves.
 CHUNK_SECONDS = 5.0
-#: Single-core seconds per site-day x fold angle x time step of a map, everything included (sky,
-#: trackers, break-even search): the chunk size's estimate, calibrated by ``bench/map.py``'s W4.
-SECONDS_PER_EVALUATION = 13e-9
+#: Single-core seconds of a map's site, the chunk size's estimate (:func:`site_seconds`), fitted to
+#: ``bench/map.py --phases``' sites (W4's sweep of 18 to 180 angles and W5's search, at 1-, 5- and
+#: 15-min steps, within 25 %): per day x time step whatever it evaluates (its sky, flat panel,
+#: tracker and break-even), per day x design evaluated (the search's and the rows' bookkeeping)
+#: and per day x time step x design (the kernel's rows).
+SECONDS_PER_STEP = 3.7e-7
+SECONDS_PER_DESIGN_DAY = 3.5e-7
+SECONDS_PER_EVALUATION = 1.3e-9
+#: What a site whose designs are searched (``optimize``) costs in designs of its grid, by the
+#: axes searched: the fold angle's search evaluates some 60 of 180 angles; with the tilt, some
+#: 2,000 of 180 x 91 designs, whose search's own bookkeeping (its boxes, its days x loads x
+#: designs tables) costs more than three times their rows' (W5's sites and ten loads; fewer
+#: loads refine fewer plateaus, three some 30 angles, and their chunks run short, not long).
+SEARCHED_SHARE = {1: 0.34, 2: 0.42}
 
 
 @dataclass(frozen=True)
@@ -339,15 +351,43 @@ def default_sites_per_chunk(study: Study, year: int) -> int:
     Parameters
     ----------
     study : Study
-        :attr:`MapSpec.study` (its fold angles and step).
+        :attr:`MapSpec.study` (its fold angles, search and step).
     year : int
     """
-    angles = len(study.fold_angles.grid())
-    steps = 1440 / study.step_min
-    per_site = 365 * angles * steps * SECONDS_PER_EVALUATION
-    count = max(1, int(CHUNK_SECONDS / per_site))
+    count = max(1, int(CHUNK_SECONDS / site_seconds(study, year)))
     # Whole batches of sites where a chunk holds one or more, so that no batch runs part-full.
     return count if count < SITES_PER_BATCH else SITES_PER_BATCH * round(count / SITES_PER_BATCH)
+
+
+def site_seconds(study: Study, year: int) -> float:
+    """The single-core seconds a map's site costs, estimated: its year's steps, and the designs it
+    evaluates on each, every fold angle of the grid or, searched, a share of the grid's designs
+    (:data:`SEARCHED_SHARE`).
+
+    Parameters
+    ----------
+    study : Study
+        :attr:`MapSpec.study`.
+    year : int
+
+    Returns
+    -------
+    float
+        [s]
+    """
+    designs = float(len(study.fold_angles.grid()))
+    search = study.optimize
+    if search is not None:
+        tilted = "tilt" in vary_names(search.vary)
+        if tilted:
+            designs *= grid_points(*search.range_of("tilt", DEFAULT_TILT))
+        designs *= SEARCHED_SHARE[1 + tilted]
+    days = 366 if calendar.isleap(year) else 365
+    steps = days * 1440 / study.step_min
+    return (
+        steps * (SECONDS_PER_STEP + designs * SECONDS_PER_EVALUATION)
+        + days * designs * SECONDS_PER_DESIGN_DAY
+    )
 
 
 def map_data(study: dict | Study) -> dict:
