@@ -1,12 +1,11 @@
 """The public Python API: what `import foldopt` offers, that it is documented, and that it gives the
-command line's numbers as pandas objects in pvlib's conventions."""
+command line's numbers as pandas objects in pvlib's conventions. What it imports, in fresh
+processes, is tests/test_imports.py's."""
 
 from __future__ import annotations
 
 import doctest
 import inspect
-import subprocess
-import sys
 from pathlib import Path
 
 import matplotlib
@@ -30,31 +29,6 @@ def test_every_public_name_resolves_and_is_documented(name):
     assert len(doc) > 40, name
     if inspect.isfunction(value) and name.startswith(("run", "sweep", "load", "default", "write", "evaluate")):
         assert "Returns" in doc and ("Parameters" in doc or not inspect.signature(value).parameters), name
-
-
-@pytest.mark.parametrize("module", ["foldopt", "foldopt.cli.app", "foldopt.api, foldopt.studies.request"])
-def test_import_stays_light(module):
-    """The command line's help and a bad value must not pay for pandas or pvlib (2 s of a 0.5 s budget):
-    neither `import foldopt` nor the command line with every command loads them (a command module that
-    imported a study's module at its top once made `foldopt --help` take 2.2 s), nor what checks a
-    study (the API, a request): numpy only where a horizon is given (foldopt.inputs.horizon)."""
-    code = (f"import sys, {module}; "
-            "print(sorted(m for m in ('numpy', 'pandas', 'pvlib', 'numba', 'matplotlib', 'scipy') "
-            "if m in sys.modules))")
-    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "[]"
-
-
-def test_a_run_imports_only_what_it_uses():
-    """A day's study (what ``foldopt run`` computes before it prints its answer) loads no cluster,
-    no figures or report, no weather readers (pvlib.iotools: requests) and no scipy.integrate
-    (pvlib.spectrum); pvlib loads those two where first used (foldopt/__init__.py)."""
-    unused = ("dask", "distributed", "xarray", "matplotlib", "jinja2", "requests", "scipy.integrate")
-    code = ("import sys, foldopt; foldopt.run(foldopt.default_study()); "
-            f"print(sorted(m for m in {unused!r} if m in sys.modules)); "
-            "import pvlib; print(callable(pvlib.iotools.read_tmy3), 'requests' in sys.modules, "
-            "callable(pvlib.spectrum.spectral_factor_sapm))")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert done.stdout.split("\n")[:2] == ["[]", "True True True"], done.stderr
 
 
 def test_docstring_examples_run():
