@@ -31,6 +31,13 @@ def test_every_public_name_resolves_and_is_documented(name):
         assert "Returns" in doc and ("Parameters" in doc or not inspect.signature(value).parameters), name
 
 
+@pytest.fixture(scope="module")
+def embedded():
+    """``foldopt.run(foldopt.default_study())``, run once for the tests that read, draw or write it
+    (none changes it)."""
+    return foldopt.run(foldopt.default_study())
+
+
 def test_docstring_examples_run():
     from foldopt import api
 
@@ -38,8 +45,8 @@ def test_docstring_examples_run():
     assert tried >= 4 and failures == 0
 
 
-def test_run_gives_a_tz_aware_time_series_and_the_papers_numbers():
-    result = foldopt.run(foldopt.default_study())
+def test_run_gives_a_tz_aware_time_series_and_the_papers_numbers(embedded):
+    result = embedded
     index = result.timeseries.index
     assert isinstance(index, pd.DatetimeIndex) and str(index.tz) == "America/Los_Angeles"
     assert index[0] == pd.Timestamp("2014-09-23 00:00:30", tz="America/Los_Angeles")
@@ -66,8 +73,8 @@ def test_sweep_is_the_plan_the_yaml_would_make():
         foldopt.sweep(study)
 
 
-def test_plots_return_axes_and_draw_into_the_given_one():
-    result = foldopt.run(foldopt.default_study())
+def test_plots_return_axes_and_draw_into_the_given_one(embedded):
+    result = embedded
     fig, axes = plt.subplots(1, 2)
     assert foldopt.plot_power_curves(result, ax=axes[0]) is axes[0]
     assert foldopt.plot_comparison(result, ax=axes[1]) is axes[1]
@@ -77,8 +84,8 @@ def test_plots_return_axes_and_draw_into_the_given_one():
     plt.close("all")
 
 
-def test_write_makes_the_command_lines_folder(tmp_path):
-    result = foldopt.run(foldopt.default_study())
+def test_write_makes_the_command_lines_folder(tmp_path, embedded):
+    result = embedded
     out = foldopt.write(result, tmp_path / "study")
     assert {"summary.csv", "sweep.csv", "timeseries.csv", "run.json", "report.html"} <= {p.name for p in out.iterdir()}
 
