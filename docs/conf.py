@@ -56,7 +56,7 @@ def _modules_not_found_once(app) -> None:
 
     modules = (sphinx.ext.autosummary, sphinx.ext.autosummary.generate)
     tried = getattr(sphinx.ext.autosummary, "_import_module", None)
-    if tried is None or any(getattr(module, "_import_module", None) is not tried for module in modules):
+    if tried is None or any(getattr(m, "_import_module", None) is not tried for m in modules):
         return  # another Sphinx than the one this is written for: it imports as it does
     missing = {}
 

@@ -202,7 +202,8 @@ API_RUN = (
     "result.answer.schedule)]; "
     "import pvlib; lazy = [callable(pvlib.iotools.read_tmy3), 'requests' in sys.modules, "
     "callable(pvlib.spectrum.spectral_factor_sapm)]; "
-    "print(json.dumps([bool(lines), before, unused, tables, str(result.timeseries.index.tz), lazy]))"
+    "print(json.dumps([bool(lines), before, unused, tables, str(result.timeseries.index.tz), "
+    "lazy]))"
 )
 
 
