@@ -440,3 +440,23 @@ def folders_written_elsewhere():
     :func:`_folders_not_written`. Writing a folder (its tables, series, report and figures) costs
     most of a day's command."""
     return _folders_not_written
+
+
+@pytest.fixture(scope="module")
+def command_line_built_once():
+    """Within a module of many in-process commands: typer's CliRunner builds a Typer app's click
+    command from its commands' signatures at every invoke (26 ms of CPU for foldopt's), here once
+    an app. A click command keeps nothing of one invocation for the next (each has its context)."""
+    import typer.main
+    import typer.testing
+
+    built = {}
+
+    def command(app):
+        if app not in built:
+            built[app] = typer.main.get_command(app)
+        return built[app]
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(typer.testing, "_get_command", command)
+        yield

@@ -1,12 +1,11 @@
 """The public Python API: what `import foldopt` offers, that it is documented, and that it gives the
-command line's numbers as pandas objects in pvlib's conventions."""
+command line's numbers as pandas objects in pvlib's conventions. What it imports, in fresh
+processes, is tests/test_imports.py's."""
 
 from __future__ import annotations
 
 import doctest
 import inspect
-import subprocess
-import sys
 from pathlib import Path
 
 import matplotlib
@@ -32,29 +31,11 @@ def test_every_public_name_resolves_and_is_documented(name):
         assert "Returns" in doc and ("Parameters" in doc or not inspect.signature(value).parameters), name
 
 
-@pytest.mark.parametrize("module", ["foldopt", "foldopt.cli.app", "foldopt.api, foldopt.studies.request"])
-def test_import_stays_light(module):
-    """The command line's help and a bad value must not pay for pandas or pvlib (2 s of a 0.5 s budget):
-    neither `import foldopt` nor the command line with every command loads them (a command module that
-    imported a study's module at its top once made `foldopt --help` take 2.2 s), nor what checks a
-    study (the API, a request): numpy only where a horizon is given (foldopt.inputs.horizon)."""
-    code = (f"import sys, {module}; "
-            "print(sorted(m for m in ('numpy', 'pandas', 'pvlib', 'numba', 'matplotlib', 'scipy') "
-            "if m in sys.modules))")
-    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "[]"
-
-
-def test_a_run_imports_only_what_it_uses():
-    """A day's study (what ``foldopt run`` computes before it prints its answer) loads no cluster,
-    no figures or report, no weather readers (pvlib.iotools: requests) and no scipy.integrate
-    (pvlib.spectrum); pvlib loads those two where first used (foldopt/__init__.py)."""
-    unused = ("dask", "distributed", "xarray", "matplotlib", "jinja2", "requests", "scipy.integrate")
-    code = ("import sys, foldopt; foldopt.run(foldopt.default_study()); "
-            f"print(sorted(m for m in {unused!r} if m in sys.modules)); "
-            "import pvlib; print(callable(pvlib.iotools.read_tmy3), 'requests' in sys.modules, "
-            "callable(pvlib.spectrum.spectral_factor_sapm))")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert done.stdout.split("\n")[:2] == ["[]", "True True True"], done.stderr
+@pytest.fixture(scope="module")
+def embedded():
+    """``foldopt.run(foldopt.default_study())``, run once for the tests that read, draw or write it
+    (none changes it)."""
+    return foldopt.run(foldopt.default_study())
 
 
 def test_docstring_examples_run():
@@ -64,8 +45,8 @@ def test_docstring_examples_run():
     assert tried >= 4 and failures == 0
 
 
-def test_run_gives_a_tz_aware_time_series_and_the_papers_numbers():
-    result = foldopt.run(foldopt.default_study())
+def test_run_gives_a_tz_aware_time_series_and_the_papers_numbers(embedded):
+    result = embedded
     index = result.timeseries.index
     assert isinstance(index, pd.DatetimeIndex) and str(index.tz) == "America/Los_Angeles"
     assert index[0] == pd.Timestamp("2014-09-23 00:00:30", tz="America/Los_Angeles")
@@ -92,8 +73,8 @@ def test_sweep_is_the_plan_the_yaml_would_make():
         foldopt.sweep(study)
 
 
-def test_plots_return_axes_and_draw_into_the_given_one():
-    result = foldopt.run(foldopt.default_study())
+def test_plots_return_axes_and_draw_into_the_given_one(embedded):
+    result = embedded
     fig, axes = plt.subplots(1, 2)
     assert foldopt.plot_power_curves(result, ax=axes[0]) is axes[0]
     assert foldopt.plot_comparison(result, ax=axes[1]) is axes[1]
@@ -103,8 +84,8 @@ def test_plots_return_axes_and_draw_into_the_given_one():
     plt.close("all")
 
 
-def test_write_makes_the_command_lines_folder(tmp_path):
-    result = foldopt.run(foldopt.default_study())
+def test_write_makes_the_command_lines_folder(tmp_path, embedded):
+    result = embedded
     out = foldopt.write(result, tmp_path / "study")
     assert {"summary.csv", "sweep.csv", "timeseries.csv", "run.json", "report.html"} <= {p.name for p in out.iterdir()}
 

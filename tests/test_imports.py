@@ -11,10 +11,11 @@ does and, as it ends, prints the heavy modules it imported; a meta-path hook wri
 the process's stdout the moment a watched module is first imported, after flushing what the
 command printed before, so the order of answer and import is the order of the lines read back.
 The processes are forked, one a command, from one interpreter (:data:`PROBE`) that has imported
-what the ``foldopt`` script imports before it runs a command and, for the refusals, the request's
-front door (:data:`FRONT_DOOR`): none of it heavy (:func:`test_the_probes_own_imports_are_light`),
-so a command's child imports each heavy library a fresh ``foldopt`` would, and an interpreter's
-start and the command line's light imports are paid once, not once a command.
+what the ``foldopt`` script imports before it runs a command, the request's front door and the
+API (:data:`PRELOAD`): none of it heavy (:func:`test_import_stays_light`), so a command's child
+imports each heavy library a fresh ``foldopt`` would, and an interpreter's start and the light
+imports are paid once, not once a command. The API's run (as a notebook makes it) is one more
+child of the same interpreter.
 """
 
 from __future__ import annotations
@@ -41,10 +42,18 @@ MARKER = "<<imported {}>>"
 #: map's too): the modules the refusals' server imports once for all of them.
 SCRIPT = ("foldopt.cli.app",)
 FRONT_DOOR = (*SCRIPT, "foldopt.studies.request", "foldopt.studies.map_request")
+#: What the probe's interpreter imports, in this order, before it forks the requests' children:
+#: the package, the front door and the API (what a notebook imports first).
+PRELOAD = ("foldopt", *FRONT_DOOR, "foldopt.api")
+#: What a day's study (what ``foldopt run`` computes before it prints its answer) loads none of:
+#: no cluster, no figures or report, no weather readers (pvlib.iotools: requests) and no
+#: scipy.integrate (pvlib.spectrum); pvlib loads those two where first used (foldopt/__init__.py).
+UNUSED = ("dask", "distributed", "xarray", "matplotlib", "jinja2", "requests", "scipy.integrate")
 REPOSITORY = Path(__file__).resolve().parents[1]
 
-#: Imports ``preload``, prints the heavy modules it then holds, and runs each request in a child
-#: forked from it (one at a time), as the ``foldopt`` script runs a command: the child's stdout and
+#: Imports ``preload`` one module at a time, prints the heavy modules it holds after each, and runs
+#: each request in a child forked from it (one at a time), as the ``foldopt`` script runs a command
+#: (or, for a request whose arguments are a string, runs that Python code): the child's stdout and
 #: stderr go to ``<folder>/<index>.out`` and ``.err``; it ends as the script does (the exit code,
 #: the exit handlers), having printed the heavy modules it imported. The server prints the
 #: children's exit codes.
@@ -52,9 +61,11 @@ PROBE = r"""
 import json, os, sys
 
 heavy, preload, requests, folder = json.loads(sys.argv[1])
+held = []
 for name in preload:
     __import__(name)
-print(json.dumps(sorted(m for m in heavy if m in sys.modules)))
+    held.append(sorted(m for m in heavy if m in sys.modules))
+print(json.dumps(held))
 codes = []
 for index, (args, watched, imports, cwd, one_core) in enumerate(requests):
     sys.stdout.flush()
@@ -95,6 +106,9 @@ sys.meta_path.insert(0, Watch())
 for name in imports:
     __import__(name)
 atexit.register(lambda: print(json.dumps(sorted(m for m in heavy if m in sys.modules))))
+if isinstance(args, str):
+    exec(args, {})
+    sys.exit()
 sys.argv = ["foldopt", *args]
 from foldopt.cli.app import app
 
@@ -113,12 +127,13 @@ class Done:
         self.stderr = stderr
 
 
-def _probe(folder: Path, preload, requests) -> tuple[list[str], list[Done]]:
-    """Run ``requests`` (each ``(args, watched, imports, cwd, one_core)``: ``foldopt args`` in
-    ``cwd``, ``watched`` modules marked, ``imports`` imported before it, on one core where
-    ``one_core``, where the command draws its figures itself; on more, its workers do:
-    tests/test_figure_pool.py) in the children of a server that has imported ``preload``: (the
-    heavy modules the server held, what each child did)."""
+def _probe(folder: Path, preload, requests) -> tuple[list[list[str]], list[Done]]:
+    """Run ``requests`` (each ``(args, watched, imports, cwd, one_core)``: ``foldopt args``, or
+    the Python code ``args`` is, in ``cwd``, ``watched`` modules marked, ``imports`` imported
+    before it, on one core where ``one_core``, where the command draws its figures itself; on
+    more, its workers do: tests/test_figure_pool.py) in the children of a server that has imported
+    ``preload``: (the heavy modules the server held after each of ``preload``, what each child
+    did)."""
     payload = [HEAVY, preload, requests, str(folder)]
     done = subprocess.run(
         [sys.executable, "-c", PROBE, json.dumps(payload)],
@@ -171,53 +186,89 @@ SEEN = [
 ]
 
 
+#: The API's run of the embedded study, as a notebook asks for it (Python code, a probe's child):
+#: ``foldopt.run()``'s answer, the heavy modules held then; the :data:`UNUSED` modules held after
+#: ``foldopt.run(foldopt.default_study())`` too (none after both: none after either); the result's
+#: and the answer's tables' types and the series' time zone; then pvlib's two modules foldopt loads
+#: where first used (foldopt/__init__.py), and whether the weather readers' ``requests`` came with
+#: them.
+API_RUN = (
+    "import json, sys, foldopt; result = foldopt.run(); lines = result.answer.lines(); "
+    f"before = sorted(m for m in {HEAVY!r} if m in sys.modules); "
+    "foldopt.run(foldopt.default_study()); "
+    f"unused = sorted(m for m in {UNUSED!r} if m in sys.modules); "
+    "tables = [type(t).__name__ for t in (result.summary, result.sweep, result.timeseries, "
+    "result.standby.table, result.answer.designs, result.answer.near_optimal, "
+    "result.answer.schedule)]; "
+    "import pvlib; lazy = [callable(pvlib.iotools.read_tmy3), 'requests' in sys.modules, "
+    "callable(pvlib.spectrum.spectral_factor_sapm)]; "
+    "print(json.dumps([bool(lines), before, unused, tables, str(result.timeseries.index.tz), "
+    "lazy]))"
+)
+
+
 @pytest.fixture(scope="module")
-def light(tmp_path_factory) -> dict:
-    """The refusals, the helps and the probe's own checks, each in a child of one server that has
-    imported the script's and the front door's modules, and none of the heavy libraries (else
-    none of these would say what a fresh command imports): what each did, by its arguments and the
-    modules imported before it."""
+def probed(tmp_path_factory) -> dict:
+    """Every request, each in a child of one server that has imported :data:`PRELOAD` and none of
+    the heavy libraries (else none of these would say what a fresh command imports): the
+    refusals, the helps and the probe's own checks; ``foldopt run`` on one core, where it draws
+    its figures itself, every heavy module the answer needs none of watched; the API's run
+    (:data:`API_RUN`). What each did, by its arguments and the modules imported before it, with
+    ``"server"`` (the heavy modules the server held after each of :data:`PRELOAD`) and
+    ``"folder"`` (the run's results folder)."""
+    folder = tmp_path_factory.mktemp("probe")
     requests = [
         *((args, [], [], str(REPOSITORY), False) for args, _ in REFUSALS),
         *((args, [], [], None, False) for args in HELP),
         *((args, watched, imports, None, False) for args, watched, imports in SEEN),
+        (["run", "--out", str(folder / "out")], NOT_FOR_THE_ANSWER, [], str(REPOSITORY), True),
+        (API_RUN, [], [], None, False),
     ]
-    server, children = _probe(tmp_path_factory.mktemp("light"), FRONT_DOOR, requests)
-    assert server == [], f"importing {FRONT_DOOR} imported {server}"
-    return {(tuple(r[0]), tuple(r[2])): done for r, done in zip(requests, children, strict=True)}
+    server, children = _probe(folder, PRELOAD, requests)
+    done = {(tuple(r[0]) if isinstance(r[0], list) else r[0], tuple(r[2])): child
+            for r, child in zip(requests, children, strict=True)}
+    return {**done, "server": dict(zip(PRELOAD, server, strict=True)), "folder": folder / "out"}
+
+
+@pytest.mark.parametrize("module", ["foldopt", "foldopt.cli.app", "foldopt.api, foldopt.studies.request"])
+def test_import_stays_light(probed, module):
+    """The command line's help and a bad value must not pay for pandas or pvlib (2 s of a 0.5 s budget):
+    neither `import foldopt` nor the command line with every command loads them (a command module that
+    imported a study's module at its top once made `foldopt --help` take 2.2 s), nor what checks a
+    study (the API, a request): numpy only where a horizon is given (foldopt.inputs.horizon). The
+    probe's server imports them in turn: what it holds after the last of ``module``'s (and the
+    modules before them) is a bound on what ``module`` alone imports."""
+    last = max(PRELOAD.index(name.strip()) for name in module.split(","))
+    held = probed["server"][PRELOAD[last]]
+    assert held == [], f"importing {PRELOAD[:last + 1]} imported {held}"
 
 
 @pytest.mark.parametrize(("args", "says"), REFUSALS, ids=[" ".join(a) for a, _ in REFUSALS])
-def test_a_refused_request_imports_no_heavy_library(light, args, says):
+def test_a_refused_request_imports_no_heavy_library(probed, args, says):
     """Validating a request (the command line, the front door make_request, the study's models)
     is refused before pvlib, pandas, matplotlib, scipy, numba or numpy load."""
-    done = light[tuple(args), ()]
+    done = probed[tuple(args), ()]
     assert done.code == 2 and says in done.stderr, done.stderr
     assert done.imported == [], f"foldopt {' '.join(args)} imported {done.imported}"
 
 
 @pytest.mark.parametrize("args", HELP)
-def test_help_imports_no_heavy_library(light, args):
-    done = light[tuple(args), ()]
+def test_help_imports_no_heavy_library(probed, args):
+    done = probed[tuple(args), ()]
     assert done.code == 0 and any("Usage" in line for line in done.lines), done.stderr
     assert done.imported == []
 
 
-@pytest.fixture(scope="module")
-def answered(tmp_path_factory) -> tuple[Done, Path]:
-    """``foldopt run`` on one core, where it draws its figures itself, in the child of an
-    interpreter that has imported nothing of foldopt's, every heavy module the answer needs none
-    of watched: what it did, and its folder."""
-    folder = tmp_path_factory.mktemp("run")
-    request = (["run", "--out", str(folder / "out")], NOT_FOR_THE_ANSWER, [], str(REPOSITORY), True)
-    _, (done,) = _probe(folder, [], [request])
-    return done, folder / "out"
+def _answered(probed) -> tuple[Done, Path]:
+    """``foldopt run``'s child (on one core, the answer's unneeded heavy modules watched) and its
+    folder."""
+    return probed[("run", "--out", str(probed["folder"])), ()], probed["folder"]
 
 
-def test_the_answer_prints_before_matplotlib_loads(answered):
+def test_the_answer_prints_before_matplotlib_loads(probed):
     """``foldopt run`` drawing its figures itself prints its answer, then loads matplotlib and
     draws them."""
-    done, out = answered
+    done, out = _answered(probed)
     assert done.code == 0, done.stderr
     assert MARKER.format("matplotlib") in done.lines and "matplotlib" in done.imported
     before = done.lines[: done.lines.index(MARKER.format("matplotlib"))]
@@ -226,11 +277,11 @@ def test_the_answer_prints_before_matplotlib_loads(answered):
     assert (out / "power_curves.png").is_file()
 
 
-def test_the_embedded_studys_answer_imports_numpy_alone(answered):
+def test_the_embedded_studys_answer_imports_numpy_alone(probed):
     """``foldopt run`` computes and prints the embedded study's whole answer with numpy alone;
     writing its folder then adds pandas (its tables) and matplotlib (its figures, which it draws
     itself on one core), nothing else heavy."""
-    done, out = answered
+    done, out = _answered(probed)
     assert done.code == 0, done.stderr
     markers = [line for line in done.lines if line.startswith("<<imported")]
     assert sorted(markers) == [MARKER.format("matplotlib"), MARKER.format("pandas")]
@@ -240,24 +291,24 @@ def test_the_embedded_studys_answer_imports_numpy_alone(answered):
     assert (out / "summary.csv").is_file()
 
 
-def test_the_apis_run_of_the_embedded_study_imports_numpy_alone_until_a_table_is_asked():
+def test_the_apis_run_of_the_embedded_study_imports_numpy_alone_until_a_table_is_asked(probed):
     """``foldopt.run()`` and its answer, as a notebook asks for them: numpy alone; the result's
     and the answer's tables are DataFrames when asked for, and pandas loads then."""
-    probe = (
-        "import json, sys, foldopt; result = foldopt.run(); lines = result.answer.lines(); "
-        f"before = sorted(m for m in {HEAVY!r} if m in sys.modules); "
-        "tables = [type(t).__name__ for t in (result.summary, result.sweep, result.timeseries, "
-        "result.standby.table, result.answer.designs, result.answer.near_optimal, "
-        "result.answer.schedule)]; "
-        "print(json.dumps([bool(lines), before, tables, str(result.timeseries.index.tz)]))"
-    )
-    done = subprocess.run(
-        [sys.executable, "-c", probe], capture_output=True, text=True, timeout=300
-    )
-    assert done.returncode == 0, done.stderr
-    answered, imported, tables, zone = json.loads(done.stdout.splitlines()[-1])
+    done = probed[API_RUN, ()]
+    assert done.code == 0, done.stderr
+    answered, imported, _, tables, zone, _ = json.loads(done.lines[-1])
     assert answered and imported == ["numpy"]
     assert tables == ["DataFrame"] * 7 and zone == "America/Los_Angeles"
+
+
+def test_a_run_imports_only_what_it_uses(probed):
+    """A day's study (what ``foldopt run`` computes before it prints its answer) loads none of
+    :data:`UNUSED`; pvlib loads the weather readers and the spectral factors where first used
+    (foldopt/__init__.py), the readers with ``requests``."""
+    done = probed[API_RUN, ()]
+    assert done.code == 0, done.stderr
+    _, _, unused, _, _, lazy = json.loads(done.lines[-1])
+    assert unused == [] and lazy == [True, True, True], done.stderr
 
 
 def test_an_in_process_caller_keeps_its_collector():
@@ -280,10 +331,10 @@ def test_an_in_process_caller_keeps_its_collector():
     assert gc.get_freeze_count() == before
 
 
-def test_the_probe_sees_an_import(light):
+def test_the_probe_sees_an_import(probed):
     """The checks can fail: a module imported before the command (as a command that imported it
     would) is reported, and its marker comes before the answer."""
-    assert "numpy" in light[("sweep", "angle", "--lat", "95"), ("numpy",)].imported
-    done = light[("--version",), ("matplotlib",)]
+    assert "numpy" in probed[("sweep", "angle", "--lat", "95"), ("numpy",)].imported
+    done = probed[("--version",), ("matplotlib",)]
     assert done.code == 0 and done.lines[0] == MARKER.format("matplotlib")
     assert done.lines[1].startswith("foldopt ")
