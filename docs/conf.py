@@ -45,46 +45,10 @@ html_theme_options = {"description": "Design-space optimiser for twofold PV pane
 nitpicky = False
 
 
-def _modules_not_found_once(app) -> None:
-    """autosummary finds each name of its tables (``~Study.model_dump``) by trying its prefixes as
-    module names, each a search of ``sys.path`` and a copy of ``sys.modules``: some 5,400 tries
-    of 1,500 names that are no module, the same pydantic members of every model again. A name
-    that is no module stays none within a build, so each is tried once and its error raised again
-    after. Undone when the build ends (a build in a process that goes on, as the tests')."""
-    import sphinx.ext.autosummary
-    import sphinx.ext.autosummary.generate
-
-    modules = (sphinx.ext.autosummary, sphinx.ext.autosummary.generate)
-    tried = getattr(sphinx.ext.autosummary, "_import_module", None)
-    if tried is None or any(getattr(m, "_import_module", None) is not tried for m in modules):
-        return  # another Sphinx than the one this is written for: it imports as it does
-    missing = {}
-
-    def import_module(modname, try_reload=False):
-        if modname in missing and modname not in sys.modules:
-            raise missing[modname].with_traceback(None)
-        try:
-            return tried(modname, try_reload)
-        except ImportError as error:
-            missing[modname] = error
-            raise
-
-    def restore(*args):
-        for module in modules:
-            module._import_module = tried
-
-    for module in modules:
-        module._import_module = import_module
-    app.connect("build-finished", restore)
-
-
 def setup(app):
     """numpydoc (1.x) builds a template environment and compiles its docstring template anew for
-    every object it documents; the template never changes within a build, so it is compiled once.
-    autosummary's names that are no module are tried once (:func:`_modules_not_found_once`)."""
+    every object it documents; the template never changes within a build, so it is compiled once."""
     from numpydoc import docscrape_sphinx
-
-    _modules_not_found_once(app)
 
     class OneTemplate(docscrape_sphinx.SandboxedEnvironment):
         compiled = {}
