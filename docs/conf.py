@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import foldopt
+import pydantic
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "_ext"))
 
@@ -26,6 +27,10 @@ extensions = [
     "foldopt_reference",  # the CLI and study-file references, the names, the reproduction
 ]
 autosummary_generate = True
+# A model's page lists what foldopt defines, not the members every pydantic model inherits
+# (model_dump, parse_obj, ...: pydantic's own reference documents them).
+templates_path = ["_templates"]
+autosummary_context = {"pydantic_members": sorted(dir(pydantic.BaseModel))}
 autodoc_default_options = {"members": False}
 # No signature foldopt documents has a type comment: autodoc would parse each one's source for one.
 autodoc_use_type_comments = False
