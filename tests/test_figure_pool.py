@@ -9,8 +9,10 @@ does (:data:`WATCH`, :data:`COMMAND`), on the cores it is given (``os.sched_seta
 core draws in the command's process, two in the workers. The probe records the process that drew
 each figure, and the collector's work (the command line's process freezes what it loads, issue
 49). The processes are forked by one interpreter a module (:data:`SERVER`) that has imported what
-a command loads before its figures, as a fresh one would (not matplotlib); a command that
-completes is run once a module (:func:`commands`) for every check of its run.
+a command loads before its figures, as a fresh one would (matplotlib only for a command on one
+core); a command that completes is run once a module (:func:`commands`) for every check of its
+run. A caller in its own process is tests/test_report_html.py's (its commands' folders, each
+figure drawn in the caller's process).
 """
 
 from __future__ import annotations
@@ -113,6 +115,8 @@ runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
 #: before a command freezes), then the modules a command loads before its figures, which a
 #: command's own interpreter spends 0.8-1.5 s CPU importing; not matplotlib (a command on two
 #: cores never imports it), nor the command line's (run as ``__main__``, as the script runs it).
+#: A command on one core loads matplotlib before its figures (as it writes its folder), some
+#: 0.35 s CPU: those are forked by a server forked once with it loaded.
 #: It reads a command a line (its folder, cores and probe's argument) and answers with its
 #: process id, then its exit code (as ``Popen``'s).
 SERVER = (
@@ -126,15 +130,42 @@ import foldopt.cli.map, foldopt.cli.optimize, foldopt.cli.run, foldopt.cli.size,
 import foldopt.cli.weather
 
 assert "matplotlib" not in sys.modules and "foldopt.cli.app" not in sys.modules
-for request in sys.stdin:
-    folder, cores, argument = json.loads(request)
-    pid = os.fork()
-    if pid == 0:
-        break
-    print(pid, flush=True)
-    print(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]), flush=True)
-else:  # no command left: the server ends without the exit's walk of what it imported
-    os._exit(0)
+
+
+# Forks a command for each request; in the command's process, returns its request. A command on
+# one core is handed to the server forked at the first one (`ended`: its pipe that says the
+# command ended), which has loaded matplotlib as such a command loads it before its figures.
+def serve(requests, ended=None):
+    one_core = None
+    for request in requests:
+        if ended is None and len(json.loads(request)[1]) == 1:
+            if one_core is None:
+                one_core = (*os.pipe(), *os.pipe())  # its requests, and its ends of commands
+                child = os.fork() == 0
+                for fd in one_core[1:3] if child else one_core[::3]:  # each end in one process
+                    os.close(fd)
+                if child:
+                    from foldopt.output.figures import canvas
+
+                    canvas.load_matplotlib()
+                    return serve(os.fdopen(one_core[0]), one_core[3])
+            os.write(one_core[1], request.encode())
+            os.read(one_core[2], 1)
+            continue
+        pid = os.fork()
+        if pid == 0:
+            return request
+        print(pid, flush=True)
+        print(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]), flush=True)
+        if ended is not None:
+            os.write(ended, b"\n")
+    if one_core is not None:
+        os.close(one_core[1])
+        os.wait()
+    os._exit(0)  # no command left: the server ends without the exit's walk of what it imported
+
+
+folder, cores, argument = json.loads(serve(sys.stdin))
 os.sched_setaffinity(0, cores)
 os.chdir(folder)
 for fd, name, flags in ((0, os.devnull, os.O_RDONLY), (1, folder + ".stdout", os.O_WRONLY),
@@ -444,32 +475,6 @@ def test_the_command_lines_process_freezes_what_it_loads(commands):
     # workers' pool, ended as the command ends, has freed what it held, frozen with the rest.
     frozen_at_exit, unfrozen_at_exit = state["exit"]
     assert frozen_at_exit > 50_000 and unfrozen_at_exit < 1_000
-
-
-def test_an_in_process_caller_draws_in_its_own_process(tmp_path, monkeypatch):
-    """A command run in the caller's process (a test's CliRunner, as a notebook would call it)
-    starts no worker: every figure is drawn in the caller's process."""
-    from typer.testing import CliRunner
-
-    import foldopt.output.figures as figures
-    from foldopt.cli.app import app
-    from foldopt.output import drawing
-
-    drawers = []
-    draw = figures.figure_bytes
-
-    def recorded(file, args, kwargs):
-        drawers.append(os.getpid())
-        return draw(file, args, kwargs)
-
-    monkeypatch.setattr(figures, "figure_bytes", recorded)
-    done = CliRunner().invoke(app, ["run", "--out", str(tmp_path / "out"), "-q"])
-    assert done.exit_code == 0, done.output
-    assert drawers == [os.getpid()] * 5
-    assert drawing._POOL["leader"] is None
-    assert sorted(path.name for path in (tmp_path / "out").glob("*.png")) == sorted(
-        figures.day.FIGURES
-    )
 
 
 @pytest.mark.parametrize(
