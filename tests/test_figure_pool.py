@@ -9,10 +9,10 @@ does (:data:`WATCH`, :data:`COMMAND`), on the cores it is given (``os.sched_seta
 core draws in the command's process, two in the workers. The probe records the process that drew
 each figure, and the collector's work (the command line's process freezes what it loads, issue
 49). The processes are forked by one interpreter a module (:data:`SERVER`) that has imported what
-a command loads before its figures, as a fresh one would (matplotlib only for a command on one
-core); a command that completes is run once a module (:func:`commands`) for every check of its
-run. A caller in its own process is tests/test_report_html.py's (its commands' folders, each
-figure drawn in the caller's process).
+a command loads before its figures, as a fresh one would (not matplotlib); a command that
+completes is run once a module (:func:`commands`) for every check of its run. A caller in its own
+process is tests/test_report_html.py's (each figure of its commands' folders drawn in the
+caller's process).
 """
 
 from __future__ import annotations
@@ -115,8 +115,6 @@ runpy.run_module("foldopt.cli.app", run_name="__main__", alter_sys=True)
 #: before a command freezes), then the modules a command loads before its figures, which a
 #: command's own interpreter spends 0.8-1.5 s CPU importing; not matplotlib (a command on two
 #: cores never imports it), nor the command line's (run as ``__main__``, as the script runs it).
-#: A command on one core loads matplotlib before its figures (as it writes its folder), some
-#: 0.35 s CPU: those are forked by a server forked once with it loaded.
 #: It reads a command a line (its folder, cores and probe's argument) and answers with its
 #: process id, then its exit code (as ``Popen``'s).
 SERVER = (
@@ -130,42 +128,15 @@ import foldopt.cli.map, foldopt.cli.optimize, foldopt.cli.run, foldopt.cli.size,
 import foldopt.cli.weather
 
 assert "matplotlib" not in sys.modules and "foldopt.cli.app" not in sys.modules
-
-
-# Forks a command for each request; in the command's process, returns its request. A command on
-# one core is handed to the server forked at the first one (`ended`: its pipe that says the
-# command ended), which has loaded matplotlib as such a command loads it before its figures.
-def serve(requests, ended=None):
-    one_core = None
-    for request in requests:
-        if ended is None and len(json.loads(request)[1]) == 1:
-            if one_core is None:
-                one_core = (*os.pipe(), *os.pipe())  # its requests, and its ends of commands
-                child = os.fork() == 0
-                for fd in one_core[1:3] if child else one_core[::3]:  # each end in one process
-                    os.close(fd)
-                if child:
-                    from foldopt.output.figures import canvas
-
-                    canvas.load_matplotlib()
-                    return serve(os.fdopen(one_core[0]), one_core[3])
-            os.write(one_core[1], request.encode())
-            os.read(one_core[2], 1)
-            continue
-        pid = os.fork()
-        if pid == 0:
-            return request
-        print(pid, flush=True)
-        print(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]), flush=True)
-        if ended is not None:
-            os.write(ended, b"\n")
-    if one_core is not None:
-        os.close(one_core[1])
-        os.wait()
-    os._exit(0)  # no command left: the server ends without the exit's walk of what it imported
-
-
-folder, cores, argument = json.loads(serve(sys.stdin))
+for request in sys.stdin:
+    folder, cores, argument = json.loads(request)
+    pid = os.fork()
+    if pid == 0:
+        break
+    print(pid, flush=True)
+    print(os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]), flush=True)
+else:  # no command left: the server ends without the exit's walk of what it imported
+    os._exit(0)
 os.sched_setaffinity(0, cores)
 os.chdir(folder)
 for fd, name, flags in ((0, os.devnull, os.O_RDONLY), (1, folder + ".stdout", os.O_WRONLY),

@@ -1,5 +1,6 @@
 """report.html in every results folder, opened in a real headless Chromium: every image decodes,
-the page logs nothing to the console, it fetches nothing, and it renders at a phone's width.
+the page logs nothing to the console, it fetches nothing, and it renders at a phone's width. The
+commands run in this process, as a notebook's would: each draws its figures here, with no worker.
 
 One Chromium opens every report, each in a tab of its own at a phone's width, driven through the
 DevTools protocol on a pipe (``--remote-debugging-pipe``): a browser's start is most of what
