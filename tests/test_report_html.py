@@ -123,7 +123,7 @@ class _Browser:
 
 
 @pytest.fixture(scope="session")
-def written(tmp_path_factory, in_process_scheduler) -> dict[str, tuple[Path, list[tuple[str, int]], bool]]:
+def written(tmp_path_factory, in_process_scheduler) -> dict[str, tuple[Path, list, bool]]:
     """Each command run in this process (a test's CliRunner, as a notebook would call it), by its
     name: (its results folder, each figure it drew and the id of the process that drew it, whether
     it left a figure pool's worker)."""
