@@ -10,7 +10,9 @@ core draws in the command's process, two in the workers. The probe records the p
 each figure, and the collector's work (the command line's process freezes what it loads, issue
 49). The processes are forked by one interpreter a module (:data:`SERVER`) that has imported what
 a command loads before its figures, as a fresh one would (not matplotlib); a command that
-completes is run once a module (:func:`commands`) for every check of its run.
+completes is run once a module (:func:`commands`) for every check of its run. A caller in its own
+process is tests/test_report_html.py's (each figure of its commands' folders drawn in the
+caller's process).
 """
 
 from __future__ import annotations
@@ -444,32 +446,6 @@ def test_the_command_lines_process_freezes_what_it_loads(commands):
     # workers' pool, ended as the command ends, has freed what it held, frozen with the rest.
     frozen_at_exit, unfrozen_at_exit = state["exit"]
     assert frozen_at_exit > 50_000 and unfrozen_at_exit < 1_000
-
-
-def test_an_in_process_caller_draws_in_its_own_process(tmp_path, monkeypatch):
-    """A command run in the caller's process (a test's CliRunner, as a notebook would call it)
-    starts no worker: every figure is drawn in the caller's process."""
-    from typer.testing import CliRunner
-
-    import foldopt.output.figures as figures
-    from foldopt.cli.app import app
-    from foldopt.output import drawing
-
-    drawers = []
-    draw = figures.figure_bytes
-
-    def recorded(file, args, kwargs):
-        drawers.append(os.getpid())
-        return draw(file, args, kwargs)
-
-    monkeypatch.setattr(figures, "figure_bytes", recorded)
-    done = CliRunner().invoke(app, ["run", "--out", str(tmp_path / "out"), "-q"])
-    assert done.exit_code == 0, done.output
-    assert drawers == [os.getpid()] * 5
-    assert drawing._POOL["leader"] is None
-    assert sorted(path.name for path in (tmp_path / "out").glob("*.png")) == sorted(
-        figures.day.FIGURES
-    )
 
 
 @pytest.mark.parametrize(

@@ -1,5 +1,6 @@
 """report.html in every results folder, opened in a real headless Chromium: every image decodes,
-the page logs nothing to the console, it fetches nothing, and it renders at a phone's width.
+the page logs nothing to the console, it fetches nothing, and it renders at a phone's width. The
+commands run in this process, as a notebook's would: each draws its figures here, with no worker.
 
 One Chromium opens every report, each in a tab of its own at a phone's width, driven through the
 DevTools protocol on a pipe (``--remote-debugging-pipe``): a browser's start is most of what
@@ -122,18 +123,39 @@ class _Browser:
 
 
 @pytest.fixture(scope="session")
-def folders(tmp_path_factory, in_process_scheduler) -> dict[str, Path]:
+def written(tmp_path_factory, in_process_scheduler) -> dict[str, tuple[Path, list, bool]]:
+    """Each command run in this process (a test's CliRunner, as a notebook would call it), by its
+    name: (its results folder, each figure it drew and the id of the process that drew it, whether
+    it left a figure pool's worker)."""
+    import foldopt.output.figures as figures
+    from foldopt.output import drawing
+
     root = tmp_path_factory.mktemp("reports")
     out = {}
+    draw = figures.figure_bytes
     for name, args in COMMANDS.items():
+        drawn = []
+
+        def recorded(file, args, kwargs, drawn=drawn):
+            drawn.append((file, os.getpid()))
+            return draw(file, args, kwargs)
+
         # The map on a cluster in this process: an embedded one (--workers 1) started a process that
         # imported foldopt and loaded its compiled code again.
-        with in_process_scheduler() if name == "map" else contextlib.nullcontext() as address:
+        with (in_process_scheduler() if name == "map" else contextlib.nullcontext() as address,
+              pytest.MonkeyPatch.context() as patch):
+            patch.setattr(figures, "figure_bytes", recorded)
             cluster = ["--scheduler", address] if address else []
             result = runner.invoke(app, [*args, *cluster, "--out", str(root / name), "-q"])
         assert result.exit_code == 0, (name, result.output)
-        out[name] = root / name
+        out[name] = (root / name, drawn, drawing._POOL["leader"] is not None)
     return out
+
+
+@pytest.fixture(scope="session")
+def folders(written) -> dict[str, Path]:
+    """Each command's results folder (:func:`written`), by its name."""
+    return {name: folder for name, (folder, _, _) in written.items()}
 
 
 @pytest.mark.parametrize("name", list(COMMANDS))
@@ -147,6 +169,20 @@ def test_every_results_folder_has_a_self_contained_report(folders, name):
     figures = [p for p in folders[name].glob("*.png")]
     assert len(images) == len(figures)
     assert "<h2>Answer</h2>" in page and "<h2>Provenance</h2>" in page
+
+
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_an_in_process_caller_draws_in_its_own_process(written, name):
+    """A command run in the caller's process starts no figure worker: every figure of its folder
+    is drawn in the caller's process (tests/test_figure_pool.py runs the command line's own)."""
+    from foldopt.output.figures import day
+
+    folder, drawn, pool = written[name]
+    assert not pool
+    assert {pid for _, pid in drawn} <= {os.getpid()}
+    assert sorted(file for file, _ in drawn) == sorted(path.name for path in folder.glob("*.png"))
+    if name == "run":
+        assert sorted(file for file, _ in drawn) == sorted(day.FIGURES)
 
 
 @pytest.fixture(scope="session")
