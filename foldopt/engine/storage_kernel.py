@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from foldopt.engine.storage_records import (
     CHARGE_LOSS,
@@ -174,6 +174,9 @@ def _at(cold, d, j, column):
 #: Day or segment 0 as an int64, not a literal: numba compiles a function once more for each
 #: literal argument's type (:func:`_levels` thrice).
 FIRST = np.int64(0)
+#: The fewest steps (series x days x steps a day) a chunk of :func:`simulate_series` takes: a
+#: thread woken for less costs more than it takes off.
+STEPS_PER_CHUNK = 20_000
 
 
 @njit(cache=True, error_model="numpy")
@@ -406,9 +409,42 @@ def _one(values, s):
     return values[s if values.shape[0] > 1 else 0]
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
+def _series_range(start, stop, curves, params, cold, days, passes, max_iterations, tolerance):
+    """Series ``start .. stop - 1`` of :func:`simulate_series` (a thread of
+    :func:`foldopt.engine.records.in_chunks` calls it)."""
+    power, load, draw, step_hours = curves
+    out, state, soc, keep_soc = days
+    for s in range(start, stop):
+        passes[s] = _series(
+            Curves(_one(power, s), _one(load, s), _one(draw, s), step_hours),
+            Parameters(
+                params.capacity[s],
+                params.min_soc[s],
+                params.restart_soc[s],
+                params.eta_charge[s],
+                params.eta_discharge[s],
+                params.keep_step[s],
+                params.keep_half[s],
+                params.max_charge[s],
+                params.max_discharge[s],
+                params.initial_soc[s],
+            ),
+            _one(cold, s),
+            Days(out[s], state[s], soc[s if keep_soc else 0], keep_soc),
+            max_iterations,
+            tolerance,
+        )
+
+
 def simulate_series(curves, params, cold, days, passes, max_iterations, tolerance):
-    """Every series, spread over threads (:func:`foldopt.engine.storage.simulate`).
+    """Every series, spread over the engine's threads (:func:`foldopt.engine.storage.simulate`).
+
+    The series run in chunks of :func:`_series_range`, compiled with ``nogil``, on the threads of
+    :func:`foldopt.engine.records.in_chunks`, as the fold kernel's rows do: a numba ``prange`` loop
+    compiled several times slower, and its OpenMP threads, woken at every call, cost a call of
+    one series milliseconds under load against a tenth of one on the calling thread, which a call
+    of fewer steps than two chunks' (:data:`STEPS_PER_CHUNK`) keeps to.
 
     Parameters
     ----------
@@ -426,42 +462,14 @@ def simulate_series(curves, params, cold, days, passes, max_iterations, toleranc
     max_iterations : int
     tolerance : float
     """
-    # The records' arrays are taken out before the parallel loop: a write through a named tuple's
-    # field inside a parallel loop is lost (numba issues 5872 and 7135).
-    power, load, draw, step_hours = curves
-    out, state, soc, keep_soc = days
-    (
-        capacity,
-        min_soc,
-        restart_soc,
-        eta_charge,
-        eta_discharge,
-        keep_step,
-        keep_half,
-        max_charge,
-        max_discharge,
-        initial_soc,
-    ) = params
-    for k in prange(out.shape[0]):
-        s = np.int64(
-            k
-        )  # prange's index is unsigned: with the literal 0 below it would unify to float
-        passes[s] = _series(
-            Curves(_one(power, s), _one(load, s), _one(draw, s), step_hours),
-            Parameters(
-                capacity[s],
-                min_soc[s],
-                restart_soc[s],
-                eta_charge[s],
-                eta_discharge[s],
-                keep_step[s],
-                keep_half[s],
-                max_charge[s],
-                max_discharge[s],
-                initial_soc[s],
-            ),
-            _one(cold, s),
-            Days(out[s], state[s], soc[s if keep_soc else 0], keep_soc),
-            max_iterations,
-            tolerance,
-        )
+    from numba import get_num_threads
+
+    from foldopt.engine.records import in_chunks
+
+    n_series = passes.shape[0]
+    steps = n_series * curves.power.shape[1] * curves.power.shape[2]
+    # Chunks of STEPS_PER_CHUNK steps or more, up to four a thread: the series' passes differ in
+    # number, and a thread that ends its chunk takes the next.
+    n_chunks = max(1, min(n_series, steps // STEPS_PER_CHUNK, 4 * get_num_threads()))
+    records = (curves, params, cold, days, passes, max_iterations, tolerance)
+    in_chunks(_series_range, n_series, None, *records, n_chunks=n_chunks)
