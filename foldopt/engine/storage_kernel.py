@@ -7,7 +7,8 @@ One plain loop per series, the series spread over threads (:func:`simulate_serie
 are named records, module-level named tuples numba takes (:class:`Curves`, :class:`Parameters`,
 :class:`Days`, of :mod:`foldopt.engine.storage_records`), each field with the same type at every
 call (arrays of float64 laid out C-contiguous, a float, a bool), so that numba compiles one
-specialisation once and caches it.
+specialisation once and caches it. The functions only compiled code calls have no wrapper for
+Python's calls (as :mod:`foldopt.engine.kernel`'s).
 NumPy's error model spares every division Python's check for a zero divisor (the model divides
 by efficiencies, lengths and the capacity only where they are above zero). Dark
 steps and steps with the buffer full, most of a day, take short cuts through the same
@@ -45,7 +46,7 @@ from foldopt.engine.storage_records import (
 )
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _ramp(x, cap):
     """Antiderivative of ``clip(x, 0, cap)`` in ``x``, zero at ``x = 0``."""
     if x <= 0.0:
@@ -55,7 +56,7 @@ def _ramp(x, cap):
     return cap * (0.5 * cap + (x - cap))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def clipped_energy(a, b, tau, cap):
     """Energy [Wh] of a power running linearly from ``a`` to ``b`` [W] over ``tau`` [h], each
     instant's power clipped to ``[0, cap]``."""
@@ -69,7 +70,7 @@ def clipped_energy(a, b, tau, cap):
     return tau * (_ramp(hi, cap) - _ramp(lo, cap)) / (hi - lo)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _charge(stored, spare, limit, capacity, eta):
     """Charge ``spare`` [Wh] offered at the bus, at most ``limit``, into the buffer holding
     ``stored`` [Wh]. Returns the new content, the charge loss and the energy lost [Wh], and
@@ -103,7 +104,7 @@ def time_to_draw(da, db, tau, energy):
     return min(2.0 * energy / (da + root), tau)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _part(ends, tau, surplus, stored, on, par, cold):
     """One part of a segment over ``tau`` [h] (``tau`` > 0), in which the power left after the
     design's own draw runs from ``pa`` to ``pb``, the load from ``la`` to ``lb`` and that draw
@@ -179,7 +180,7 @@ FIRST = np.int64(0)
 STEPS_PER_CHUNK = 20_000
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _levels(par, cold, d, j):
     """Day ``d``'s segment ``j``: the cut-off and the reconnection [Wh] the cold raises
     (:func:`foldopt.physics.buffer_temperature.cold_cut_off`; the buffer's own without it)."""
@@ -189,7 +190,7 @@ def _levels(par, cold, d, j):
     return floor, restart
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _run(curves, par, cold, stored, on, merge, days):
     """One pass over a series' days (its :class:`Curves`, :class:`Parameters`, cold array and
     :class:`Days`) from the content ``stored`` [Wh] and load state ``on``.
@@ -357,7 +358,7 @@ def _run(curves, par, cold, stored, on, merge, days):
     return stored, on
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _series(curves, par, cold, days, max_iterations, tolerance):
     """A series (its :class:`Curves`, :class:`Parameters`, cold array and :class:`Days`) from
     its initial
@@ -409,7 +410,7 @@ def _one(values, s):
     return values[s if values.shape[0] > 1 else 0]
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", no_cfunc_wrapper=True)
 def _series_range(start, stop, curves, params, cold, days, passes, max_iterations, tolerance):
     """Series ``start .. stop - 1`` of :func:`simulate_series` (a thread of
     :func:`foldopt.engine.records.in_chunks` calls it)."""
