@@ -177,7 +177,7 @@ def _at(cold, d, j, column):
 FIRST = np.int64(0)
 #: The fewest steps (series x days x steps a day) a chunk of :func:`simulate_series` takes: a
 #: thread woken for less costs more than it takes off.
-STEPS_PER_CHUNK = 20_000
+STEPS_PER_CHUNK = 2_000
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -469,8 +469,9 @@ def simulate_series(curves, params, cold, days, passes, max_iterations, toleranc
 
     n_series = passes.shape[0]
     steps = n_series * curves.power.shape[1] * curves.power.shape[2]
-    # Chunks of STEPS_PER_CHUNK steps or more, up to four a thread: the series' passes differ in
-    # number, and a thread that ends its chunk takes the next.
-    n_chunks = max(1, min(n_series, steps // STEPS_PER_CHUNK, 4 * get_num_threads()))
+    # Chunks of STEPS_PER_CHUNK steps or more, one a thread: each chunk is a call of the compiled
+    # loop, whose records' arrays numba takes again at every call (a sizing search calls this
+    # hundreds of times).
+    n_chunks = max(1, min(n_series, steps // STEPS_PER_CHUNK, get_num_threads()))
     records = (curves, params, cold, days, passes, max_iterations, tolerance)
     in_chunks(_series_range, n_series, None, *records, n_chunks=n_chunks)
