@@ -6,10 +6,10 @@ pass. Stated agreement (issue 11): t_solar and its longest run within 1 s a day,
 within 1e-9 relative, on random sites, days, loads, fold angles and models.
 """
 
+import contextlib
 import datetime as dt
 import os
-import subprocess
-import sys
+from unittest import mock
 from pathlib import Path
 
 import numpy as np
@@ -93,11 +93,32 @@ def assert_engines_agree(compiled, reference):
 THREADS = (1, 2)
 
 
+@contextlib.contextmanager
+def _engine_threads(threads):
+    """The engine on ``threads`` threads. Its passes take as many of the process's Python threads
+    (:func:`foldopt.engine.records.in_chunks`, :mod:`foldopt.threads`) as ``numba.get_num_threads()``
+    says, which they read at each call; none runs on numba's own threads (no ``prange``). numba
+    launches those once, as it is imported, and ``numba.set_num_threads`` can then ask fewer but
+    never more: where it launched fewer (a pytest-xdist worker launched one, tests/conftest.py),
+    the count is given to the engine here instead."""
+    import numba
+
+    if threads <= numba.config.NUMBA_NUM_THREADS:
+        before = numba.get_num_threads()
+        numba.set_num_threads(threads)
+        try:
+            yield
+        finally:
+            numba.set_num_threads(before)
+        return
+    with mock.patch.object(numba, "get_num_threads", lambda: threads):
+        yield
+
+
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(case=cases())
 def kernel_equals_the_reference_path(case):
-    """The kernel on each of :data:`THREADS` against one reference path's run of the case (the
-    process launched numba's threads for them all)."""
+    """The kernel on each of :data:`THREADS` against one reference path's run of the case."""
     import numba
 
     study, sites, dates, angles, loads = case
@@ -110,50 +131,41 @@ def kernel_equals_the_reference_path(case):
         return engine.row_metrics(sky, rows=rows, loads=loads, electrical=electrical, outputs=engine.OUTPUTS,
                                   contiguous=True, engine=name)
 
-    reference, before = metrics("numpy"), numba.get_num_threads()
-    try:
-        for threads in THREADS:
-            numba.set_num_threads(threads)
+    reference = metrics("numpy")
+    for threads in THREADS:
+        with _engine_threads(threads):
             assert numba.get_num_threads() == threads
             assert_engines_agree(metrics("numba"), reference)
-    finally:
-        numba.set_num_threads(before)
-
-
-#: The comparison above and test_kernel_threads below, called in a process of their own (numba
-#: reads its number of threads once, as it is imported); hypothesis runs the comparison's examples
-#: as under pytest.
-ON_TWO_THREADS = f"""
-import sys
-sys.path.insert(0, {str(Path(__file__).parent)!r})
-import test_engine
-test_engine.test_kernel_threads()
-test_engine.kernel_equals_the_reference_path()
-print("both passed")
-"""
 
 
 def test_the_kernel_on_two_threads():
     """The kernel equals the reference path on one thread and on two (the comparison's examples
     run the reference once and the kernel on each): its rows go to threads in chunks, each with
-    its own scratch (arrays zero-filled inside a prange body have given wrong sums). numba
-    launches its threads once, as it is imported, and can then run on fewer but never on more:
-    where this process launched two or more (``-n 0``) the comparison runs here; a pytest-xdist
-    worker launched one (tests/conftest.py), and runs it in a process of its own."""
-    import numba
+    its own scratch (arrays zero-filled inside a prange body have given wrong sums)."""
+    kernel_equals_the_reference_path()
 
-    if numba.config.NUMBA_NUM_THREADS >= max(THREADS):
-        kernel_equals_the_reference_path()
-        return
-    environment = {**os.environ, "NUMBA_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"}
-    done = subprocess.run([sys.executable, "-c", ON_TWO_THREADS], env=environment, capture_output=True, text=True,
-                          timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-    assert done.stdout.splitlines()[-1] == "both passed"
+
+def test_the_chunks_of_two_threads_run_on_two_threads():
+    """Where the engine is given two threads (:func:`_engine_threads`), a pass's chunks run on two
+    threads at once: the calling thread and one of the process's pool."""
+    import threading
+
+    from foldopt.engine import records
+
+    seen, both = set(), threading.Barrier(2, timeout=60)
+
+    def body(start, stop):
+        seen.add(threading.get_ident())
+        both.wait()  # each of two chunks waits for the other: they run at once, or time out
+
+    with _engine_threads(2):
+        records.in_chunks(body, 2, None, n_chunks=2)
+    assert len(seen) == 2 and threading.get_ident() in seen
 
 
 def test_kernel_threads():
-    """How many threads the kernel runs on: two under test_the_kernel_on_two_threads."""
+    """How many threads numba launched: those the environment asks (one in a pytest-xdist
+    worker, tests/conftest.py), or numba's default."""
     import numba
 
     assert numba.get_num_threads() == int(os.environ.get("NUMBA_NUM_THREADS", numba.config.NUMBA_DEFAULT_NUM_THREADS))

@@ -70,17 +70,25 @@ def test_a_request_decides_by_its_days_angles_and_steps(cached):
     assert request_engine("numpy", year) == "numpy" and request_engine("numba", study) == "numba"
 
 
-#: A module of one cached compiled function, and a process that, for each line on its stdin,
-#: executes the module anew (a new dispatcher, which knows nothing the last one compiled, as in a
-#: new process), says whether foldopt.engine.choice.in_cache finds it cached, then calls it and
-#: says whether numba loaded it from its cache (numba's own count of cache hits).
+#: A module of one cached compiled function, and a process that, for each line ``load`` on its
+#: stdin, executes the module anew (a new dispatcher, which knows nothing the last one compiled, as
+#: in a new process), says whether foldopt.engine.choice.in_cache finds it cached, then calls it and
+#: says whether numba loaded it from its cache (numba's own count of cache hits). A line
+#: ``cache FOLDER`` sets ``NUMBA_CACHE_DIR`` as a new process would find it: in the environment,
+#: which foldopt.engine.choice reads, and in numba's configuration, read again from it (numba reads
+#: it once, as it is imported, and a dispatcher's cache takes it from there as it is made).
 _MODULE = "from numba import njit\n\n\n@njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n"
 _PROCESS = textwrap.dedent(
     """
-    import importlib.util, json, sys
+    import importlib.util, json, os, sys
     from pathlib import Path
+    from numba.core import config
     from foldopt.engine.choice import _numba_version, in_cache
-    for _ in sys.stdin:
+    for line in sys.stdin:
+        if line.startswith("cache "):
+            os.environ["NUMBA_CACHE_DIR"] = line.split(" ", 1)[1].strip()
+            config.reload_config()
+            continue
         spec = importlib.util.spec_from_file_location("tiny", Path(sys.argv[1]) / "tiny.py")
         tiny = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(tiny)
@@ -95,18 +103,17 @@ def test_the_cache_is_found_held_exactly_where_numba_loads_from_it(tmp_path):
     """foldopt.engine.choice's reading of numba's cache, held to numba's own behaviour: in each
     state of the cache (empty, filled, the source edited, the index of another numba, in the
     source's __pycache__ or NUMBA_CACHE_DIR), it finds the function cached exactly where numba
-    then loads it from the cache rather than compiling it. One process per cache folder (numba
-    reads NUMBA_CACHE_DIR once), the module loaded anew in it for each state."""
+    then loads it from the cache rather than compiling it. One process, the module loaded anew in
+    it for each state, NUMBA_CACHE_DIR set in it for the last two."""
     source = tmp_path / "tiny.py"
     source.write_text(_MODULE)
 
-    def process(**environment) -> subprocess.Popen:
+    def process() -> subprocess.Popen:
         return subprocess.Popen(
             [sys.executable, "-c", _PROCESS, str(tmp_path)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
             # numba's cache where each state puts it: not the one this suite may run with.
-            env={**{k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}, "PYTHONPATH": str(ROOT),
-                 **environment},
+            env={**{k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}, "PYTHONPATH": str(ROOT)},
         )
 
     def loaded(running: subprocess.Popen) -> bool:
@@ -135,16 +142,13 @@ def test_the_cache_is_found_held_exactly_where_numba_loads_from_it(tmp_path):
             rest = file.read()
         index.write_bytes(pickle.dumps("0.0.1") + rest)
         assert loaded(here) is False  # another numba's index
+        here.stdin.write(f"cache {tmp_path / 'numba-cache'}\n")
+        assert loaded(here) is False
+        assert loaded(here) is True
+        assert list((tmp_path / "numba-cache").rglob("tiny.twice-*.nbi"))
         ended(here)
     finally:
         here.kill()
-    elsewhere = process(NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
-    try:
-        assert loaded(elsewhere) is False
-        assert loaded(elsewhere) is True
-        ended(elsewhere)
-    finally:
-        elsewhere.kill()
 
 
 def test_the_kernels_cache_is_looked_for_where_numba_keeps_it():

@@ -19,7 +19,8 @@ blocks that cross a load.
 Rows are split into chunks, a few per thread (:func:`foldopt.engine.records.in_chunks`), and each
 chunk has its own scratch, in the calling thread's workspace
 (:func:`foldopt.engine.records.allocate`), cleared per row. A chunk's loop allocates nothing and
-is compiled without numba's reference counting, as the kernel's (:mod:`foldopt.engine.kernel`).
+is compiled without numba's reference counting, as the kernel's (:mod:`foldopt.engine.kernel`), and
+the functions only compiled code calls without a wrapper for Python's calls, as the kernel's.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ def _walk(loads, position, power):
     return position
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _runs(start_at, lo_at, length, run):
     """Longest runs: a sample below a load ends that load's run (the segment starts a new one);
     loads below the segment's low end run on through it."""
@@ -54,7 +55,7 @@ def _runs(start_at, lo_at, length, run):
         run[j, 0] += length
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _gather(whole, pending_at, pending, lo_at, length):
     """Add ``length`` to the pending sum for ``whole[lo_at]``, writing the previous sum out when
     the index changes."""
@@ -64,7 +65,7 @@ def _gather(whole, pending_at, pending, lo_at, length):
     return lo_at, length
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _per_load(p, shape, s, use_shape):
     """The power against which the loads are compared at step ``s``: the power itself for constant
     loads, or for a load profile P_load(t) = scale x shape(t) the ratio P_pv / shape, so that
@@ -174,7 +175,7 @@ def _run_length(start, count, step_hours, held):
     return start
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@njit(cache=True, nogil=True, _nrt=False, no_cfunc_wrapper=True)
 def blocked_day(power, span, p_load, step_hours, held, extremes, scratch, t_out):
     """t_solar of every load of ``p_load`` (ascending) of one power curve [W] into ``t_out``, as
     :func:`day_metrics` for constant loads without their longest runs, walking steps
@@ -273,7 +274,7 @@ def curve_rows(power, span, row_loadset, loads, out, scratch):
     in_chunks(_chunk_curves, power.shape[0], scratch, power, span, row_loadset, loads, out)
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@njit(cache=True, nogil=True, _nrt=False, no_cfunc_wrapper=True)
 def _chunk_curves(start, stop, power, span, row_loadset, loads, out, work):
     """Rows ``start .. stop - 1`` of :func:`curve_rows` with one chunk's scratch ``work`` (a thread
     of :func:`foldopt.engine.records.in_chunks` calls it)."""

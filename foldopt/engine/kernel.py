@@ -36,7 +36,12 @@ without numba's reference counting (``_nrt=False``): they allocate nothing, ever
 the caller's and lives through the call, and numba would otherwise count each array handed to an
 inlined function, or each view taken (``power[0]``, ``t_solar[r, 0]``), and release it at every
 row, an atomic operation each, which its pruning of the counts does not remove from loops this
-large. The chunk's loop takes the records' arrays once, into tuples of the arrays each function
+large. The functions only compiled code calls are compiled without the wrappers that would make
+them callable from Python and as first-class functions (``no_cpython_wrapper``,
+``no_cfunc_wrapper``; the chunk loops, which Python calls, without the latter): numba lowers each
+wrapper and LLVM optimises it at every compile, and again in each caller that links the function
+in, for code the kernel never runs (a wrapper that takes records unpacks each of their arrays).
+The chunk's loop takes the records' arrays once, into tuples of the arrays each function
 reads (:func:`foldopt.engine.incidence.row_arrays`). The common case (switching alone from one table
 set a block, the exact incidence without the modifier, constant loads) has a chunk's loop of its
 own, :func:`_chunk_switching`, chosen before numba sees the call, so that a request compiles only
@@ -62,7 +67,7 @@ EAST, WEST, PARALLEL, SERIES, INDEPENDENT, SWITCHING, PANEL = range(7)
 ZETA_MAX = 4.0  # top of a converter's table in input / rating (foldopt.physics.converter)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _linear(values, position):
     """``values`` linear between nodes at ``position`` >= 0 [nodes]. The index is unsigned: no
     index can wrap around, so the compiled look-up tests no sign."""
@@ -71,7 +76,7 @@ def _linear(values, position):
     return values[index] * (1.0 - weight) + values[index + uint64(1)] * weight
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _bilinear(values, first, second):
     """``values`` bilinear between nodes at ``first``, ``second`` >= 0 [nodes] (unsigned indices,
     as :func:`_linear`'s)."""
@@ -154,7 +159,7 @@ def _built_parts(root_east, root_west, tables, t, need_series):
     return Parts(m_east, m_west, a_east, a_west, p_parallel, p_series, p_switching, p_panel)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _between(lo, hi, w):
     """:class:`Parts` at ``w`` of the way from ``lo`` to ``hi``."""
     return Parts(
@@ -169,7 +174,7 @@ def _between(lo, hi, w):
     )
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _delivered(power, conv_table, conv_rated):
     """What a converter of rating ``conv_rated`` [W] delivers of ``power`` [W], from its table of
     delivered power / rating on nodes uniform in sqrt(input / rating / ZETA_MAX)
@@ -180,7 +185,7 @@ def _delivered(power, conv_table, conv_rated):
     return conv_rated * _linear(conv_table, math.sqrt(zeta / ZETA_MAX) * (conv_table.shape[0] - 1))
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _connection_power(
     code, p_east, p_west, p_parallel, p_series, p_panel, converter_efficiency, switch_series
 ):
@@ -268,7 +273,7 @@ def _linear_connections(b, first, n, sets, terms, connections, scales, curves):
             _linear_steps(c, connections[c], start, count, scales, east, west, buffer)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _table_row(b, first, last, sets, pair_tables, connections, settings, curves):
     """Every asked connection's power [W] at steps ``first..last`` into ``power`` from the
     electrical tables (``pair_tables``: the tables' subpanel, parallel and series) at both
@@ -419,14 +424,14 @@ def _switching_row(b, first, n, step_table, pair_tables, curves, coordinates):
     return harvested, peak
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _switching_call(b, first, n, step_table, pair_tables, curves, coordinates):
     """:func:`_switching_row` called rather than inlined, for :func:`_chunk_rows`, whose rows
     take it only off the common case (:func:`_chunk_switching` inlines it)."""
     return _switching_row(b, first, n, step_table, pair_tables, curves, coordinates)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _built_power(code, parts, p_panel, tables):
     """The power a connection delivers to the load [W] from the :class:`Parts` of
     :func:`_built_parts` (and the whole panel's ``p_panel``): through the converter, or the
@@ -456,7 +461,7 @@ def _built_power(code, parts, p_panel, tables):
     return _delivered(power, conv_table, conv_rated)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _built_row(b, first, last, sky, tables, need_series, work):
     """:func:`_chunk_rows`' second loop for the circuit as built: the parts at each step (linear
     between two table sets where the step's air temperature lies between them), then what each
@@ -501,7 +506,7 @@ def _built_row(b, first, last, sky, tables, need_series, work):
             buffer[c, s] = _built_power(connections[c], parts, p_panel, tables)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, no_cfunc_wrapper=True)
 def _keep_curves(kept, power, first, last):
     """Every connection's power [W] at steps ``first..last`` of a row (``power``, (n_conn,
     n_steps)) into ``kept``, the row's curves of :attr:`foldopt.engine.records.Outputs.power`.
@@ -560,7 +565,7 @@ def _held(held, step_hours):
     return held
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@njit(cache=True, nogil=True, _nrt=False, no_cfunc_wrapper=True)
 def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
     """:func:`_chunk_rows` for the common case, apart: switching alone from one table set a block,
     the exact incidence without the modifier, constant loads without their longest runs (W1-W3,
@@ -606,7 +611,7 @@ def _chunk_switching(start, stop, sky, rows, tables, loads, out, work):
         )
 
 
-@njit(cache=True, nogil=True, _nrt=False)
+@njit(cache=True, nogil=True, _nrt=False, no_cfunc_wrapper=True)
 def _chunk_rows(start, stop, sky, rows, tables, loads, out, work):
     """Rows ``start .. stop - 1`` of :func:`fold_rows` with one chunk's scratch ``work`` (a thread
     of :func:`foldopt.engine.records.in_chunks` calls it).

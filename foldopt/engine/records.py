@@ -334,9 +334,10 @@ def _scratch(chunks: int, fields) -> Scratch:
     )
 
 
-def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
+def in_chunks(body, n_rows: int, scratch: Scratch | None, *records, n_chunks: int = 0) -> None:
     """``body(start, stop, *records, work)`` over rows ``0 .. n_rows - 1`` in chunks, one chunk's
-    :class:`Scratch` each, on numba's number of threads, the calling thread one of them.
+    :class:`Scratch` each, on numba's number of threads, the calling thread one of them (without
+    ``scratch``, ``body(start, stop, *records)`` over ``n_chunks`` chunks).
 
     ``body`` is compiled with ``nogil=True``, so the chunks run in parallel on Python threads.
     They did in a numba ``prange`` loop, whose compile took a fifth of the kernel's (some 7 s
@@ -349,17 +350,20 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
     Parameters
     ----------
     body : numba dispatcher
-        ``_chunk_rows`` or ``_chunk_curves``.
+        ``_chunk_rows``, ``_chunk_curves`` or :func:`foldopt.engine.storage_kernel._series_range`.
     n_rows : int
-    scratch : Scratch
+    scratch : Scratch or None
         Of every chunk (:func:`allocate`): its first axis is the chunk. Every chunk has ended
         when this returns or raises.
     *records
         The arguments of ``body`` between ``stop`` and the chunk's scratch.
+    n_chunks : int
+        The chunks, without ``scratch`` (:func:`foldopt.engine.storage_kernel.simulate_series`).
     """
     from numba import get_num_threads
 
-    n_chunks = scratch.above.shape[0]
+    if scratch is not None:
+        n_chunks = scratch.above.shape[0]
     per_chunk = (n_rows + n_chunks - 1) // n_chunks
     taken, errors, halted = itertools.count(), [], []
 
@@ -372,7 +376,8 @@ def in_chunks(body, n_rows: int, scratch: Scratch, *records) -> None:
             if k * per_chunk >= stop:
                 continue
             try:
-                body(k * per_chunk, stop, *records, Scratch(*(field[k] for field in scratch)))
+                work = () if scratch is None else (Scratch(*(field[k] for field in scratch)),)
+                body(k * per_chunk, stop, *records, *work)
             except Exception as error:  # the other chunks run on: raised once they all ended
                 errors.append(error)
             except BaseException as error:  # an interrupt: no chunk is taken after it

@@ -7,7 +7,8 @@ One plain loop per series, the series spread over threads (:func:`simulate_serie
 are named records, module-level named tuples numba takes (:class:`Curves`, :class:`Parameters`,
 :class:`Days`, of :mod:`foldopt.engine.storage_records`), each field with the same type at every
 call (arrays of float64 laid out C-contiguous, a float, a bool), so that numba compiles one
-specialisation once and caches it.
+specialisation once and caches it. The functions only compiled code calls have no wrapper for
+Python's calls (as :mod:`foldopt.engine.kernel`'s).
 NumPy's error model spares every division Python's check for a zero divisor (the model divides
 by efficiencies, lengths and the capacity only where they are above zero). Dark
 steps and steps with the buffer full, most of a day, take short cuts through the same
@@ -19,7 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from foldopt.engine.storage_records import (
     CHARGE_LOSS,
@@ -45,7 +46,7 @@ from foldopt.engine.storage_records import (
 )
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _ramp(x, cap):
     """Antiderivative of ``clip(x, 0, cap)`` in ``x``, zero at ``x = 0``."""
     if x <= 0.0:
@@ -55,7 +56,7 @@ def _ramp(x, cap):
     return cap * (0.5 * cap + (x - cap))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def clipped_energy(a, b, tau, cap):
     """Energy [Wh] of a power running linearly from ``a`` to ``b`` [W] over ``tau`` [h], each
     instant's power clipped to ``[0, cap]``."""
@@ -69,7 +70,7 @@ def clipped_energy(a, b, tau, cap):
     return tau * (_ramp(hi, cap) - _ramp(lo, cap)) / (hi - lo)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _charge(stored, spare, limit, capacity, eta):
     """Charge ``spare`` [Wh] offered at the bus, at most ``limit``, into the buffer holding
     ``stored`` [Wh]. Returns the new content, the charge loss and the energy lost [Wh], and
@@ -103,7 +104,7 @@ def time_to_draw(da, db, tau, energy):
     return min(2.0 * energy / (da + root), tau)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _part(ends, tau, surplus, stored, on, par, cold):
     """One part of a segment over ``tau`` [h] (``tau`` > 0), in which the power left after the
     design's own draw runs from ``pa`` to ``pb``, the load from ``la`` to ``lb`` and that draw
@@ -174,9 +175,12 @@ def _at(cold, d, j, column):
 #: Day or segment 0 as an int64, not a literal: numba compiles a function once more for each
 #: literal argument's type (:func:`_levels` thrice).
 FIRST = np.int64(0)
+#: The fewest steps (series x days x steps a day) a chunk of :func:`simulate_series` takes: a
+#: thread woken for less costs more than it takes off.
+STEPS_PER_CHUNK = 2_000
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _levels(par, cold, d, j):
     """Day ``d``'s segment ``j``: the cut-off and the reconnection [Wh] the cold raises
     (:func:`foldopt.physics.buffer_temperature.cold_cut_off`; the buffer's own without it)."""
@@ -186,7 +190,7 @@ def _levels(par, cold, d, j):
     return floor, restart
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _run(curves, par, cold, stored, on, merge, days):
     """One pass over a series' days (its :class:`Curves`, :class:`Parameters`, cold array and
     :class:`Days`) from the content ``stored`` [Wh] and load state ``on``.
@@ -354,7 +358,7 @@ def _run(curves, par, cold, stored, on, merge, days):
     return stored, on
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _series(curves, par, cold, days, max_iterations, tolerance):
     """A series (its :class:`Curves`, :class:`Parameters`, cold array and :class:`Days`) from
     its initial
@@ -406,9 +410,42 @@ def _one(values, s):
     return values[s if values.shape[0] > 1 else 0]
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy", no_cfunc_wrapper=True)
+def _series_range(start, stop, curves, params, cold, days, passes, max_iterations, tolerance):
+    """Series ``start .. stop - 1`` of :func:`simulate_series` (a thread of
+    :func:`foldopt.engine.records.in_chunks` calls it)."""
+    power, load, draw, step_hours = curves
+    out, state, soc, keep_soc = days
+    for s in range(start, stop):
+        passes[s] = _series(
+            Curves(_one(power, s), _one(load, s), _one(draw, s), step_hours),
+            Parameters(
+                params.capacity[s],
+                params.min_soc[s],
+                params.restart_soc[s],
+                params.eta_charge[s],
+                params.eta_discharge[s],
+                params.keep_step[s],
+                params.keep_half[s],
+                params.max_charge[s],
+                params.max_discharge[s],
+                params.initial_soc[s],
+            ),
+            _one(cold, s),
+            Days(out[s], state[s], soc[s if keep_soc else 0], keep_soc),
+            max_iterations,
+            tolerance,
+        )
+
+
 def simulate_series(curves, params, cold, days, passes, max_iterations, tolerance):
-    """Every series, spread over threads (:func:`foldopt.engine.storage.simulate`).
+    """Every series, spread over the engine's threads (:func:`foldopt.engine.storage.simulate`).
+
+    The series run in chunks of :func:`_series_range`, compiled with ``nogil``, on the threads of
+    :func:`foldopt.engine.records.in_chunks`, as the fold kernel's rows do: a numba ``prange`` loop
+    compiled several times slower, and its OpenMP threads, woken at every call, cost a call of
+    one series milliseconds under load against a tenth of one on the calling thread, which a call
+    of fewer steps than two chunks' (:data:`STEPS_PER_CHUNK`) keeps to.
 
     Parameters
     ----------
@@ -426,42 +463,15 @@ def simulate_series(curves, params, cold, days, passes, max_iterations, toleranc
     max_iterations : int
     tolerance : float
     """
-    # The records' arrays are taken out before the parallel loop: a write through a named tuple's
-    # field inside a parallel loop is lost (numba issues 5872 and 7135).
-    power, load, draw, step_hours = curves
-    out, state, soc, keep_soc = days
-    (
-        capacity,
-        min_soc,
-        restart_soc,
-        eta_charge,
-        eta_discharge,
-        keep_step,
-        keep_half,
-        max_charge,
-        max_discharge,
-        initial_soc,
-    ) = params
-    for k in prange(out.shape[0]):
-        s = np.int64(
-            k
-        )  # prange's index is unsigned: with the literal 0 below it would unify to float
-        passes[s] = _series(
-            Curves(_one(power, s), _one(load, s), _one(draw, s), step_hours),
-            Parameters(
-                capacity[s],
-                min_soc[s],
-                restart_soc[s],
-                eta_charge[s],
-                eta_discharge[s],
-                keep_step[s],
-                keep_half[s],
-                max_charge[s],
-                max_discharge[s],
-                initial_soc[s],
-            ),
-            _one(cold, s),
-            Days(out[s], state[s], soc[s if keep_soc else 0], keep_soc),
-            max_iterations,
-            tolerance,
-        )
+    from numba import get_num_threads
+
+    from foldopt.engine.records import in_chunks
+
+    n_series = passes.shape[0]
+    steps = n_series * curves.power.shape[1] * curves.power.shape[2]
+    # Chunks of STEPS_PER_CHUNK steps or more, one a thread: each chunk is a call of the compiled
+    # loop, whose records' arrays numba takes again at every call (a sizing search calls this
+    # hundreds of times).
+    n_chunks = max(1, min(n_series, steps // STEPS_PER_CHUNK, get_num_threads()))
+    records = (curves, params, cold, days, passes, max_iterations, tolerance)
+    in_chunks(_series_range, n_series, None, *records, n_chunks=n_chunks)
