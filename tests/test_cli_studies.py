@@ -97,10 +97,11 @@ def assert_a_users_folder(out: Path):
     assert len(json.loads((out / "run.json").read_text())["input_sha256"]) == 64
 
 
-def test_sweep_latitude_makes_the_design_map(tmp_path):
+def test_sweep_latitude_makes_the_design_map(tmp_path, figures_drawn_elsewhere):
     out = tmp_path / "map"
-    result = invoke("sweep", "latitude", "--lat", "-40:40:40", "--p-load", "1:9:4", "--days", "2025-03-20",
-                    *SMALL, "--out", out)
+    with figures_drawn_elsewhere():  # the maps' kinds: configs/design-map.yaml's, drawn whole above
+        result = invoke("sweep", "latitude", "--lat", "-40:40:40", "--p-load", "1:9:4", "--days", "2025-03-20",
+                        *SMALL, "--out", out)
     assert result.exit_code == 0, result.output
     table = pd.read_csv(out / "results.csv")
     assert len(table) == 3 * 3 * 4  # latitudes x loads x designs (flat, twofold, tracker gross and net)
@@ -110,14 +111,17 @@ def test_sweep_latitude_makes_the_design_map(tmp_path):
 def test_sweep_day_and_load_and_identical_reruns(tmp_path, figures_drawn_elsewhere):
     out = tmp_path / "days"
     args = ["sweep", "day", "--lat", "34", "--days", "1:365:120", "--p-load", "3", *SMALL, "--out", out]
-    assert invoke(*args).exit_code == 0
-    first = (out / "results.csv").read_bytes()
-    assert (out / "annual_t_solar.png").exists()
-    with figures_drawn_elsewhere():  # the same request's figures again
+    # The figures written, not drawn: a day sweep's are drawn whole by test_report_html.py's
+    # (``annual``), the load sweep's by configs/load-sweep.yaml's above.
+    with figures_drawn_elsewhere():
+        assert invoke(*args).exit_code == 0
+        first = (out / "results.csv").read_bytes()
+        assert (out / "annual_t_solar.png").exists()
         assert invoke(*args, "--overwrite").exit_code == 0
-    assert (out / "results.csv").read_bytes() == first
-    out = tmp_path / "loads"
-    result = invoke("sweep", "load", "--lat", "34", "--days", "2025-06-21", "--p-load", "1:10:3", *SMALL, "--out", out)
+        assert (out / "results.csv").read_bytes() == first
+        out = tmp_path / "loads"
+        result = invoke("sweep", "load", "--lat", "34", "--days", "2025-06-21", "--p-load", "1:10:3", *SMALL,
+                        "--out", out)
     assert result.exit_code == 0, result.output
     assert (out / "t_solar_vs_load.png").exists()
 
@@ -181,16 +185,18 @@ def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, words):
     assert not out.exists()
 
 
-def test_a_weather_file_alone_runs_a_year(tmp_path):
+def test_a_weather_file_alone_runs_a_year(tmp_path, figures_drawn_elsewhere):
     import pvlib
 
     tmy3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
     out = tmp_path / "year"
     # 15-min steps and 30 deg between fold angles: what is checked is the study the file completes and
     # the year's table, not the steps or the angles.
-    result = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--angle-step", "30",
-                    "--step-min", "15", "--albedo", "0.3", "--iam", "ashrae", "--set", "tracker.model=single-axis",
-                    "--out", out, "-q", "--format", "json")
+    # Its figures written, not drawn: a weather year's, drawn by configs/annual-weather.yaml's above.
+    with figures_drawn_elsewhere():
+        result = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--angle-step",
+                        "30", "--step-min", "15", "--albedo", "0.3", "--iam", "ashrae", "--set",
+                        "tracker.model=single-axis", "--out", out, "-q", "--format", "json")
     assert result.exit_code == 0, result.output
     meta = json.loads((out / "run.json").read_text())
     study = meta["study"]
@@ -215,15 +221,17 @@ def test_a_weather_file_alone_runs_a_year(tmp_path):
     assert_one_line_error(bad, "tracker.gcr", "(0, 1]")
 
 
-def test_a_map_takes_the_load_range_of_its_study_file(tmp_path, scheduler):
+def test_a_map_takes_the_load_range_of_its_study_file(tmp_path, scheduler, figures_drawn_elsewhere):
     """A study file's ``p_load`` range is the map's loads, checked like ``--p-load`` (it was an
     internal error); a load no site carries is said without a best site."""
     study = tmp_path / "ranged.yaml"
     shipped = Path(__file__).resolve().parent.parent / "configs" / "load-sweep.yaml"
     study.write_text(shipped.read_text().replace('p_load: "0.5:19:0.5"', 'p_load: "1:31:30"'))
     # On the in-process cluster (conftest.scheduler): what is tested is the map's loads, not its cluster.
-    shown = invoke("map", "--config", study, "--lat", "0", "--lon", "0", "--step-min", "60", "--angle-step", "90",
-                   "--scheduler", scheduler, "--out", tmp_path / "m", "--format", "json")
+    # Its maps written, not drawn: what is read is the answer (a map's are drawn by test_report_html.py).
+    with figures_drawn_elsewhere():
+        shown = invoke("map", "--config", study, "--lat", "0", "--lon", "0", "--step-min", "60", "--angle-step",
+                       "90", "--scheduler", scheduler, "--out", tmp_path / "m", "--format", "json")
     assert shown.exit_code == 0, shown.output
     answer = json.loads(shown.stdout)["answer"]
     assert "P_load 2 loads, 1 to 31 W" in answer["defaults"]["taken"]
