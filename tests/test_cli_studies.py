@@ -40,14 +40,16 @@ def one_line_error(result, *words):
 
 
 #: Shipped studies run smaller than they ship (fewer days, members, latitudes, loads or angles):
-#: the folder holds the same files and figures as at full size (camera-profile's series still above
-#: foldopt.studies.series.PARQUET_ROWS), for a fraction of the work; the study as shipped is still
-#: made a request whole (validated, within the size limits).
+#: the folder holds the same files and figures as at full size (annual's and camera-profile's
+#: series still above foldopt.studies.series.PARQUET_ROWS), for a fraction of the work; the study
+#: as shipped is still made a request whole (validated, within the size limits).
 SMALLER = {
+    "annual": ["--set", "date=1:365:14", "--set", "fold_angles.step=10"],  # 27 of 53 days, 18 angles
     "annual-weather": ["--set", "date=1:365:30"],  # 13 of the file's 365 days
     "camera-profile": ["--set", "date=1:365:14", "--set", "fold_angles.step=30"],
     "cloud-ensemble": ["--set", "weather.members=2", "--set", "date=1:365:30"],
     "design-map": ["--set", "site.latitude=-60:60:30", "--set", "p_load='1:19:6'"],
+    "load-sweep": ["--set", "p_load='1:19:6'"],  # 4 of 38 loads
 }
 
 
