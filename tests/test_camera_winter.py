@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import html
 import json
-import struct
 from pathlib import Path
 
 import pandas as pd
@@ -20,7 +19,7 @@ from foldopt.cli.app import app
 from foldopt.studies.annual import annual_cases, annual_summary
 from foldopt.studies.request import make_request
 from foldopt.tables import write_csv
-from test_cli_studies import WHOLE_IN_CAMERA_WINTER, assert_a_users_folder
+from test_cli_studies import WHOLE_IN_CAMERA_WINTER, assert_a_users_folder, assert_drawn_whole
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = ROOT / "configs" / "camera-winter.yaml"
@@ -74,8 +73,7 @@ def test_every_view_says_the_years_the_cold_and_the_least_cost(views):
     assert_a_users_folder(views["folder"] / "cli")
     # Drawn whole here, these stand in test_cli_studies' pixels of the weather years' figures.
     for name in WHOLE_IN_CAMERA_WINTER:
-        png = (views["folder"] / "cli" / name).read_bytes()
-        assert png[12:16] == b"IHDR" and min(struct.unpack(">II", png[16:24])) > 100, name
+        assert_drawn_whole(views["folder"] / "cli" / name)
     # The JSON's parts the lines come from.
     part = views["json"]["result"]
     assert part["storage"]["worst_years"] and part["least_cost"]["least_cost"]
