@@ -138,13 +138,11 @@ def test_an_angle_sweep_is_the_api_sweep_over_angle(tmp_path, two_views):
 
 
 def test_worst_month_year_at_nairobi(tmp_path, two_views):
-    # 30-min steps: what is checked (the two routes' rows to the bit, the worst month against the
-    # daily rows, the views) holds at any step.
     args = ("--lat", "-1.29", "--lon", "36.82", "--days", "year", "--objective", "worst-month", "--p-load", "3",
-            "--step-min", "30")
+            "--step-min", "10")
     document, folder, terminal = cli(tmp_path, "sweep", "day", *args, terminal=two_views)
     result = foldopt.sweep(foldopt.default_study(), "day", latitude=-1.29, longitude=36.82, date="year",
-                           objective="worst-month", p_load=3, step_min=30)
+                           objective="worst-month", p_load=3, step_min=10)
     same_rows(document, result.table)
     assert_views_agree(document, folder, terminal, result.answer)
     case = document["answer"]["result"]["per_case"][0]
