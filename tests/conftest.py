@@ -460,3 +460,38 @@ def command_line_built_once():
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(typer.testing, "_get_command", command)
         yield
+
+
+@contextlib.contextmanager
+def _runs_shared():
+    """Within the block, a request is evaluated once: :func:`foldopt.api.run` (``foldopt.run``,
+    the command line's too) given a request equal to an earlier one's, with the same engine, is
+    given the earlier result (one answer, decided once). A request that differs in anything
+    (its plan, its source, its labels) runs anew."""
+    import foldopt
+    import foldopt.api
+    from foldopt.names import DEFAULT_ENGINE
+    from foldopt.studies.request import make_request
+
+    real, done = foldopt.api.run, []
+
+    def run(study=None, engine=DEFAULT_ENGINE, progress=None, request=None):
+        if request is None:  # as foldopt.api.run makes it
+            request = make_request("run", study)
+        for asked, result in done:
+            if asked == (request, engine):
+                return result
+        done.append(((request, engine), real(None, engine, progress, request)))
+        return done[-1][1]
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(foldopt.api, "run", run)
+        patch.setattr(foldopt, "run", run)
+        yield
+
+
+@pytest.fixture(scope="session")
+def runs_shared():
+    """For tests that ask one request by several routes (a command's ``--format json`` and its
+    terminal, the command line and the API): the context manager :func:`_runs_shared`."""
+    return _runs_shared

@@ -6,7 +6,6 @@ request with its buffer emptied reduces to the storage-less answer."""
 
 from __future__ import annotations
 
-import contextlib
 import html
 import json
 from pathlib import Path
@@ -17,11 +16,10 @@ from typer.testing import CliRunner
 
 import foldopt
 from foldopt.cli.app import app
-from foldopt.names import DEFAULT_ENGINE
 from foldopt.studies.annual import annual_cases, annual_summary
 from foldopt.studies.request import make_request
 from foldopt.tables import write_csv
-from test_cli_studies import assert_a_users_folder
+from test_cli_studies import WHOLE_IN_CAMERA_WINTER, assert_a_users_folder, assert_drawn_whole
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = ROOT / "configs" / "camera-winter.yaml"
@@ -30,38 +28,19 @@ PARTS = ("  worst year: ", "  the cold: charge blocked ", "the cheapest panel an
 TABLES = ("storage_annual", "storage_years", "storage_monthly", "design_space")
 
 
-@contextlib.contextmanager
-def one_run():
-    """Within the block, the command line's runs (:func:`foldopt.api.run`) are one: the first
-    runs its request, a later one is given its result, its request and engine asserted the same.
-    Two views of one command (``--format json`` and the terminal) are two renderings of one
-    answer, decided once."""
-    real, done = foldopt.api.run, {}
-
-    def run(study=None, engine=DEFAULT_ENGINE, progress=None, request=None):
-        if done:
-            assert (request, engine) == done["asked"], "the views' commands ask the same"
-            return done["result"]
-        done.update(asked=(request, engine), result=real(study, engine, progress, request))
-        return done["result"]
-
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(foldopt.api, "run", run)
-        yield
-
-
 @pytest.fixture(scope="module")
-def views(tmp_path_factory, folders_written_elsewhere):
-    """The study through the command line (JSON and terminal: one run of its request, rendered
-    twice, :func:`one_run`) and through the API (a run of its own). The terminal's folder is the
-    one a user gets, its figures drawn whole (set up before any test's own fixtures, it is drawn
-    outside conftest's patch; it stands in test_cli_studies' run of every shipped study); the
-    JSON's folder is made, not filled (the terminal's is the same answer's); of the API's result
-    the tables the folder holds are written (:func:`foldopt.tables.write_csv`, as
-    :func:`foldopt.api.write` writes them)."""
+def views(tmp_path_factory, folders_written_elsewhere, runs_shared):
+    """The study through the command line (JSON and terminal) and through the API, one request
+    evaluated once (conftest's ``runs_shared``: the API's request, made by
+    :func:`foldopt.run` from the file, is the command line's, and is given its result). The
+    terminal's folder is the one a user gets, its figures drawn whole (set up before any test's
+    own fixtures, it is drawn outside conftest's patch; it stands in test_cli_studies' run of
+    every shipped study); the JSON's folder is made, not filled (the terminal's is the same
+    answer's); of the API's result the tables the folder holds are written
+    (:func:`foldopt.tables.write_csv`, as :func:`foldopt.api.write` writes them)."""
     folder = tmp_path_factory.mktemp("camera-winter")
     runner = CliRunner()
-    with one_run():
+    with runs_shared():
         with folders_written_elsewhere():
             done = runner.invoke(
                 app, ["run", str(STUDY), "--out", str(folder / "json"), "--format", "json"]
@@ -69,7 +48,7 @@ def views(tmp_path_factory, folders_written_elsewhere):
         assert done.exit_code == 0, done.output
         terminal = runner.invoke(app, ["run", str(STUDY), "--out", str(folder / "cli")])
         assert terminal.exit_code == 0, terminal.output
-    result = foldopt.run(STUDY)
+        result = foldopt.run(STUDY)
     (folder / "api").mkdir()
     for name in TABLES:
         write_csv(result.extras[name], folder / "api" / f"{name}.csv")
@@ -92,6 +71,9 @@ def test_every_view_says_the_years_the_cold_and_the_least_cost(views):
         assert said[0].strip() in html.unescape(page)
     assert views["api"].answer.lines() == lines
     assert_a_users_folder(views["folder"] / "cli")
+    # Drawn whole here, these stand in test_cli_studies' pixels of the weather years' figures.
+    for name in WHOLE_IN_CAMERA_WINTER:
+        assert_drawn_whole(views["folder"] / "cli" / name)
     # The JSON's parts the lines come from.
     part = views["json"]["result"]
     assert part["storage"]["worst_years"] and part["least_cost"]["least_cost"]

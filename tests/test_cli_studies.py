@@ -1,6 +1,8 @@
 """Study files, sweeps, sizing and script output through the command line."""
 
+import contextlib
 import json
+import struct
 import sys
 from pathlib import Path
 
@@ -9,6 +11,7 @@ import pytest
 from typer.testing import CliRunner
 
 from foldopt.cli.app import app
+from foldopt.output import figures
 from foldopt.studies.request import make_request
 from test_cli import assert_one_line_error
 
@@ -38,26 +41,72 @@ def one_line_error(result, *words):
 
 
 #: Shipped studies run smaller than they ship (fewer days, members, latitudes, loads or angles):
-#: the folder holds the same files and figures as at full size (camera-profile's series still above
-#: foldopt.studies.series.PARQUET_ROWS), for a fraction of the work; the study as shipped is still
-#: made a request whole (validated, within the size limits).
+#: the folder holds the same files and figures as at full size (annual's and camera-profile's
+#: series still above foldopt.studies.series.PARQUET_ROWS), for a fraction of the work; the study
+#: as shipped is still made a request whole (validated, within the size limits).
 SMALLER = {
+    "annual": ["--set", "date=1:365:14", "--set", "fold_angles.step=10"],  # 27 of 53 days, 18 angles
     "annual-weather": ["--set", "date=1:365:30"],  # 13 of the file's 365 days
     "camera-profile": ["--set", "date=1:365:14", "--set", "fold_angles.step=30"],
     "cloud-ensemble": ["--set", "weather.members=2", "--set", "date=1:365:30"],
     "design-map": ["--set", "site.latitude=-60:60:30", "--set", "p_load='1:19:6'"],
+    "load-sweep": ["--set", "p_load='1:19:6'"],  # 4 of 38 loads
 }
 
 
-@pytest.mark.figure_pixels  # every shipped study's folder as a user gets it, its figures drawn whole
+#: The figures of a weather year (the year's, the days', the weather's) that test_camera_winter.py's
+#: shipped study draws whole, and checks it does: of the studies here, drawn without their pixels
+#: (every artist drawn, nothing laid out or rasterised), as most of their folders' drawing.
+WHOLE_IN_CAMERA_WINTER = frozenset({
+    "annual_t_solar.png", "annual_t_solar_vs_fold_angle.png", "daily_t_solar_distribution.png",
+    "day_hour_power.png", "day_hour_switch_state.png", "monthly_energy_t_solar.png", "weather_minutes.png",
+})  # fmt: skip
+#: Figures a shipped study here draws whole, and checks it does, for the others here that draw them
+#: (drawn there without their pixels): the study -> the files.
+WHOLE_HERE = {
+    "shin2015-single-diode": frozenset({
+        "comparison.png", "power_curves.png", "switching.png", "t_solar_vs_fold_angle.png", "tracker_standby.png",
+    }),
+}  # fmt: skip
+
+
+def assert_drawn_whole(png: Path) -> None:
+    """A figure's file is drawn whole: a PNG of more than 100 pixels each way (not conftest's PNG
+    of one pixel)."""
+    data = png.read_bytes()
+    assert data[12:16] == b"IHDR" and min(struct.unpack(">II", data[16:24])) > 100, png.name
+
+
+@contextlib.contextmanager
+def pixels_but_for(files, without_pixels):
+    """Within the block, a results folder's figures are drawn whole but those named in ``files``,
+    drawn without pixels (conftest's ``without_pixels``)."""
+    whole = figures.figure_bytes
+
+    def figure_bytes(file, args, kwargs):
+        with without_pixels() if file in files else contextlib.nullcontext():
+            return whole(file, args, kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(figures, "figure_bytes", figure_bytes)
+        yield
+
+
+#: Every shipped study's folder as a user gets it, its figures drawn whole (but those another
+#: study draws whole: :data:`WHOLE_IN_CAMERA_WINTER`, :data:`WHOLE_HERE`).
+@pytest.mark.figure_pixels
 @pytest.mark.parametrize("config", CONFIGS, ids=[c.stem for c in CONFIGS])
-def test_every_shipped_config_runs(tmp_path, config):
+def test_every_shipped_config_runs(tmp_path, config, without_pixels):
     if config.stem in SMALLER:
         make_request("run", config)  # the study as shipped: valid, within the limits
     out = tmp_path / config.stem
-    result = invoke("run", config, *SMALLER.get(config.stem, []), "--out", out, "--quiet")
+    whole = WHOLE_HERE.get(config.stem, frozenset())
+    with pixels_but_for(WHOLE_IN_CAMERA_WINTER.union(*WHOLE_HERE.values()) - whole, without_pixels):
+        result = invoke("run", config, *SMALLER.get(config.stem, []), "--out", out, "--quiet")
     assert result.exit_code == 0, result.output
     assert_a_users_folder(out)
+    for name in whole:
+        assert_drawn_whole(out / name)
 
 
 def assert_a_users_folder(out: Path):
@@ -68,10 +117,11 @@ def assert_a_users_folder(out: Path):
     assert len(json.loads((out / "run.json").read_text())["input_sha256"]) == 64
 
 
-def test_sweep_latitude_makes_the_design_map(tmp_path):
+def test_sweep_latitude_makes_the_design_map(tmp_path, figures_drawn_elsewhere):
     out = tmp_path / "map"
-    result = invoke("sweep", "latitude", "--lat", "-40:40:40", "--p-load", "1:9:4", "--days", "2025-03-20",
-                    *SMALL, "--out", out)
+    with figures_drawn_elsewhere():  # the maps' kinds: configs/design-map.yaml's, drawn whole above
+        result = invoke("sweep", "latitude", "--lat", "-40:40:40", "--p-load", "1:9:4", "--days", "2025-03-20",
+                        *SMALL, "--out", out)
     assert result.exit_code == 0, result.output
     table = pd.read_csv(out / "results.csv")
     assert len(table) == 3 * 3 * 4  # latitudes x loads x designs (flat, twofold, tracker gross and net)
@@ -81,14 +131,17 @@ def test_sweep_latitude_makes_the_design_map(tmp_path):
 def test_sweep_day_and_load_and_identical_reruns(tmp_path, figures_drawn_elsewhere):
     out = tmp_path / "days"
     args = ["sweep", "day", "--lat", "34", "--days", "1:365:120", "--p-load", "3", *SMALL, "--out", out]
-    assert invoke(*args).exit_code == 0
-    first = (out / "results.csv").read_bytes()
-    assert (out / "annual_t_solar.png").exists()
-    with figures_drawn_elsewhere():  # the same request's figures again
+    # The figures written, not drawn: a day sweep's are drawn whole by test_report_html.py's
+    # (``annual``), the load sweep's by configs/load-sweep.yaml's above.
+    with figures_drawn_elsewhere():
+        assert invoke(*args).exit_code == 0
+        first = (out / "results.csv").read_bytes()
+        assert (out / "annual_t_solar.png").exists()
         assert invoke(*args, "--overwrite").exit_code == 0
-    assert (out / "results.csv").read_bytes() == first
-    out = tmp_path / "loads"
-    result = invoke("sweep", "load", "--lat", "34", "--days", "2025-06-21", "--p-load", "1:10:3", *SMALL, "--out", out)
+        assert (out / "results.csv").read_bytes() == first
+        out = tmp_path / "loads"
+        result = invoke("sweep", "load", "--lat", "34", "--days", "2025-06-21", "--p-load", "1:10:3", *SMALL,
+                        "--out", out)
     assert result.exit_code == 0, result.output
     assert (out / "t_solar_vs_load.png").exists()
 
@@ -152,16 +205,18 @@ def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, words):
     assert not out.exists()
 
 
-def test_a_weather_file_alone_runs_a_year(tmp_path):
+def test_a_weather_file_alone_runs_a_year(tmp_path, figures_drawn_elsewhere):
     import pvlib
 
     tmy3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
     out = tmp_path / "year"
     # 15-min steps and 30 deg between fold angles: what is checked is the study the file completes and
     # the year's table, not the steps or the angles.
-    result = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--angle-step", "30",
-                    "--step-min", "15", "--albedo", "0.3", "--iam", "ashrae", "--set", "tracker.model=single-axis",
-                    "--out", out, "-q", "--format", "json")
+    # Its figures written, not drawn: a weather year's, drawn by configs/annual-weather.yaml's above.
+    with figures_drawn_elsewhere():
+        result = invoke("sweep", "angle", "--weather", tmy3, "--p-load", "2", "--area", "0.108", "--angle-step",
+                        "30", "--step-min", "15", "--albedo", "0.3", "--iam", "ashrae", "--set",
+                        "tracker.model=single-axis", "--out", out, "-q", "--format", "json")
     assert result.exit_code == 0, result.output
     meta = json.loads((out / "run.json").read_text())
     study = meta["study"]
@@ -186,15 +241,17 @@ def test_a_weather_file_alone_runs_a_year(tmp_path):
     assert_one_line_error(bad, "tracker.gcr", "(0, 1]")
 
 
-def test_a_map_takes_the_load_range_of_its_study_file(tmp_path, scheduler):
+def test_a_map_takes_the_load_range_of_its_study_file(tmp_path, scheduler, figures_drawn_elsewhere):
     """A study file's ``p_load`` range is the map's loads, checked like ``--p-load`` (it was an
     internal error); a load no site carries is said without a best site."""
     study = tmp_path / "ranged.yaml"
     shipped = Path(__file__).resolve().parent.parent / "configs" / "load-sweep.yaml"
     study.write_text(shipped.read_text().replace('p_load: "0.5:19:0.5"', 'p_load: "1:31:30"'))
     # On the in-process cluster (conftest.scheduler): what is tested is the map's loads, not its cluster.
-    shown = invoke("map", "--config", study, "--lat", "0", "--lon", "0", "--step-min", "60", "--angle-step", "90",
-                   "--scheduler", scheduler, "--out", tmp_path / "m", "--format", "json")
+    # Its maps written, not drawn: what is read is the answer (a map's are drawn by test_report_html.py).
+    with figures_drawn_elsewhere():
+        shown = invoke("map", "--config", study, "--lat", "0", "--lon", "0", "--step-min", "60", "--angle-step",
+                       "90", "--scheduler", scheduler, "--out", tmp_path / "m", "--format", "json")
     assert shown.exit_code == 0, shown.output
     answer = json.loads(shown.stdout)["answer"]
     assert "P_load 2 loads, 1 to 31 W" in answer["defaults"]["taken"]

@@ -153,13 +153,16 @@ def test_every_committed_example_follows_the_grammar():
 
 
 @pytest.fixture(scope="module")
-def written(tmp_path_factory, without_pixels):
+def written(tmp_path_factory, figures_drawn_elsewhere):
     """Each command of :data:`COMMANDS` run through the command line with ``--format json``: the
-    CSV files' columns, by file name, and the JSON document's row and table columns."""
+    CSV files' columns, by file name, and the JSON document's row and table columns. Their figures
+    are not drawn (conftest's ``figures_drawn_elsewhere``): nothing here reads them, and each
+    kind is drawn by the tests of the same studies (test_cli_studies.py, test_figure_pool.py,
+    test_report_html.py)."""
     out = tmp_path_factory.mktemp("columns")
     runner = CliRunner(env={"COLUMNS": "200"})
     files, documents = {}, {}
-    with contextlib.chdir(out), without_pixels():
+    with contextlib.chdir(out), figures_drawn_elsewhere():
         for name, args in COMMANDS.items():
             done = runner.invoke(app, [*map(str, args), "--format", "json", "--out", name, "-q"])
             assert done.exit_code == 0, (name, done.output)

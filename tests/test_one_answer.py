@@ -36,14 +36,15 @@ def cli(tmp_path: Path, *args, terminal=None) -> tuple[dict, Path, str]:
     """Run ``foldopt ARGS --format json`` through the command line's own entry point (in-process:
     what is compared is the command's answer, not a process; a process of its own cost some 4 s of
     interpreter, imports and compiled-code loading a call): its document and folder; and, with
-    ``terminal`` (conftest's ``folders_written_elsewhere``), the terminal's text of the same
-    command, whose run then writes the folder over the JSON run's (made, not filled: the same
-    answer's folder, tables and figures, written once)."""
+    ``terminal`` (the fixture ``two_views``), the terminal's text of the same command, whose run then writes the
+    folder over the JSON run's (made, not filled: the same answer's folder, tables and figures,
+    written once), the two commands one run of their request (the same answer, decided once)."""
     out = tmp_path / "cli"
     args = [*map(str, args), "--out", str(out)]
     runner = CliRunner(env={"COLUMNS": "200"})
-    with contextlib.chdir(ROOT):
-        with terminal() if terminal else contextlib.nullcontext():
+    not_written, shared = terminal or (contextlib.nullcontext, contextlib.nullcontext)
+    with contextlib.chdir(ROOT), shared():
+        with not_written():
             done = runner.invoke(app, [*args, "--format", "json"])
         assert done.exit_code == 0, done.output
         text = ""
@@ -55,6 +56,23 @@ def cli(tmp_path: Path, *args, terminal=None) -> tuple[dict, Path, str]:
     # Without a run of its own, the terminal's words are the answer's lines the document holds
     # (Answer.lines(), which the terminal prints).
     return document, out, text or "\n".join(document["answer"]["lines"])
+
+
+@pytest.fixture
+def two_views(folders_written_elsewhere, runs_shared):
+    """For :func:`cli`: the terminal's view too, of the JSON's run (conftest's
+    ``folders_written_elsewhere`` and ``runs_shared``)."""
+    return folders_written_elsewhere, runs_shared
+
+
+@pytest.fixture(autouse=True)
+def _figures_not_drawn(figures_drawn_elsewhere):
+    """No test here reads a figure (the folders' tables, report.html and the answers are what is
+    compared): their figures are written without being drawn (conftest's
+    ``figures_drawn_elsewhere``), each kind drawn by the tests of the shipped studies and reports
+    (test_cli_studies.py, test_camera_winter.py, test_report_html.py)."""
+    with figures_drawn_elsewhere():
+        yield
 
 
 def same_rows(document: dict, table: pd.DataFrame) -> None:
@@ -87,8 +105,8 @@ def no_old_names(folder: Path, document: dict) -> None:
         assert f'"{name}"' not in text, name
 
 
-def test_embedded_run(tmp_path, folders_written_elsewhere):
-    document, folder, terminal = cli(tmp_path, "run", terminal=folders_written_elsewhere)
+def test_embedded_run(tmp_path, two_views):
+    document, folder, terminal = cli(tmp_path, "run", terminal=two_views)
     result = foldopt.run(foldopt.default_study())
     same_rows(document, result.summary)
     assert_views_agree(document, folder, terminal, result.answer)
@@ -109,20 +127,20 @@ def test_latitude_sweep_plans_the_same_study(tmp_path):
     assert (result.plan.base.mode, result.plan.base.geometry) == ("exact", "hinge")
 
 
-def test_an_angle_sweep_is_the_api_sweep_over_angle(tmp_path, folders_written_elsewhere):
+def test_an_angle_sweep_is_the_api_sweep_over_angle(tmp_path, two_views):
     """``foldopt.sweep(study, "angle", ...)`` runs the request as the command line does: one case is
     a day's study with its refined best angle (it was a one-case plan, its grid's 23 deg for 22.6)."""
     document, folder, terminal = cli(tmp_path, "sweep", "angle", "--lat", "52.5", "--lon", "13.4", "--p-load", "2",
-                                     terminal=folders_written_elsewhere)
+                                     terminal=two_views)
     result = foldopt.sweep(foldopt.default_study(), "angle", latitude=52.5, longitude=13.4, p_load=2)
     same_rows(document, result.summary)
     assert_views_agree(document, folder, terminal, result.answer)
 
 
-def test_worst_month_year_at_nairobi(tmp_path, folders_written_elsewhere):
+def test_worst_month_year_at_nairobi(tmp_path, two_views):
     args = ("--lat", "-1.29", "--lon", "36.82", "--days", "year", "--objective", "worst-month", "--p-load", "3",
             "--step-min", "10")
-    document, folder, terminal = cli(tmp_path, "sweep", "day", *args, terminal=folders_written_elsewhere)
+    document, folder, terminal = cli(tmp_path, "sweep", "day", *args, terminal=two_views)
     result = foldopt.sweep(foldopt.default_study(), "day", latitude=-1.29, longitude=36.82, date="year",
                            objective="worst-month", p_load=3, step_min=10)
     same_rows(document, result.table)
@@ -147,10 +165,12 @@ def test_worst_month_year_at_nairobi(tmp_path, folders_written_elsewhere):
 def test_weather_year_with_a_profile_and_two_visits(tmp_path):
     profile = tmp_path / "camera.csv"
     profile.write_text("time,watts\n00:00,1.5\n07:00,6\n19:00,1.5\n")
+    # 30 deg between fold angles: what is checked (both routes' rows to the bit, the schedules of one
+    # and two settings in every view, the profile's name) holds on any grid of angles.
     document, folder, terminal = cli(tmp_path, "sweep", "angle", "--weather", TMY3, "--load-profile", profile,
-                                     "--visits", "2", "--angle-step", "10", "--step-min", "15")
+                                     "--visits", "2", "--angle-step", "30", "--step-min", "15")
     result = foldopt.sweep(foldopt.default_study(), "angle", weather=str(TMY3), load_profile={"file": str(profile)},
-                           visits=2, fold_angles={"step": 10}, step_min=15)
+                           visits=2, fold_angles={"step": 30}, step_min=15)
     same_rows(document, result.table)
     assert_views_agree(document, folder, terminal, result.answer)
     schedule = pd.DataFrame(document["answer"]["schedule"])
@@ -197,7 +217,7 @@ def test_size_refuses_what_the_api_refuses(option, parameter, value):
     assert "must be a finite number > 0 and at most" in line
 
 
-def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler, figures_drawn_elsewhere):
+def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler):
     """A map of named sites at the study's load through the command line, and the same request
     made with foldopt.studies.request.make_request and run by foldopt.world_map: the same rows
     to the bit, the same answer, the same things taken from the study; every view carries the
@@ -216,8 +236,7 @@ def test_a_map_request_is_the_api_request(tmp_path, monkeypatch, scheduler, figu
     assert [site["name"] for site in request.plan.sites] == ["quito", "oslo", "sydney"]
     assert isinstance(request.plan.study, foldopt.Study)  # what the map ships to its workers
     monkeypatch.setattr(foldopt.studies.map_request, "map_request", None)  # a second build would fail
-    with figures_drawn_elsewhere():  # the command line's run drew this answer's maps
-        result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", scheduler=scheduler)
+    result, _, answer = foldopt.world_map(request=request, out=tmp_path / "api", scheduler=scheduler)
     year = result.table[result.table["period"] == "year"].reset_index(drop=True)
     same_rows(document, year)
     api = json.loads(json.dumps(answer.to_dict()))

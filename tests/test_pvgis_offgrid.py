@@ -30,7 +30,7 @@ from foldopt.cli.app import app
 from foldopt.inputs.load_profile import hourly_steps
 from foldopt.inputs.plan import load_plan
 from foldopt.tables import write_csv
-from test_cli_studies import assert_a_users_folder
+from test_cli_studies import WHOLE_IN_CAMERA_WINTER, assert_a_users_folder, pixels_but_for
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDY = ROOT / "configs" / "pvgis-offgrid.yaml"
@@ -51,10 +51,6 @@ TOTALS = PVCALC["outputs"]["totals"]["fixed"]
 TOLERANCE = sum(abs(float(TOTALS[term])) for term in ("l_aoi", "l_spec", "l_tg")) / 100.0
 runner = CliRunner()
 
-
-#: The folder as a user gets it, its figures drawn whole (it stands in test_cli_studies' run of
-#: every shipped study).
-pytestmark = pytest.mark.figure_pixels
 
 def pvgis_monthly(answer: dict, name: str) -> np.ndarray:
     """A monthly column of SHScalc's answer, month 1 first."""
@@ -78,19 +74,27 @@ def mean_irradiation() -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def folder(tmp_path_factory):
-    """The study run as a user runs it: ``foldopt run configs/pvgis-offgrid.yaml``."""
+def runs(tmp_path_factory, without_pixels, runs_shared):
+    """The study run as a user runs it, ``foldopt run configs/pvgis-offgrid.yaml`` (it stands in
+    test_cli_studies' run of every shipped study), and by the API, ``foldopt.run``: one request
+    evaluated once (conftest's ``runs_shared``: the API's request is the command line's, and is
+    given its result). The folder and the API's result. Its figures are a weather year's, which
+    test_camera_winter.py's study draws whole: drawn here without their pixels, as
+    test_cli_studies draws them (:func:`test_cli_studies.pixels_but_for`)."""
     out = tmp_path_factory.mktemp("pvgis-offgrid") / "run"
-    result = runner.invoke(app, ["run", str(STUDY), "--out", str(out), "--quiet"])
-    assert result.exit_code == 0, result.output
+    with runs_shared():
+        with pixels_but_for(WHOLE_IN_CAMERA_WINTER, without_pixels):
+            result = runner.invoke(app, ["run", str(STUDY), "--out", str(out), "--quiet"])
+        assert result.exit_code == 0, result.output
+        api = foldopt.run(STUDY)
     assert_a_users_folder(out)  # test_cli_studies' check of every shipped study
-    return out
+    return out, api
 
 
 @pytest.fixture(scope="module")
-def monthly(folder) -> pd.DataFrame:
+def monthly(runs) -> pd.DataFrame:
     """The flat design's rows of ``storage_monthly.csv``, by month."""
-    table = pd.read_csv(folder / "storage_monthly.csv")
+    table = pd.read_csv(runs[0] / "storage_monthly.csv")
     return table[table["design"] == "flat"].set_index("month").sort_index()
 
 
@@ -170,8 +174,8 @@ def test_each_month_s_e_d_agrees_with_pvgis(monthly):
     np.testing.assert_array_less(np.abs(e_d * offgrid / shscalc - 1.0), TOLERANCE)
 
 
-def test_the_cli_writes_the_api_s_monthly_table(folder, tmp_path):
-    result = foldopt.run(STUDY)
+def test_the_cli_writes_the_api_s_monthly_table(runs, tmp_path):
+    folder, result = runs
     written = write_csv(result.extras["storage_monthly"], tmp_path / "storage_monthly.csv")
     assert written.read_bytes() == (folder / "storage_monthly.csv").read_bytes()
 

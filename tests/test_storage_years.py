@@ -91,9 +91,21 @@ def _study(folder: Path, years=(2020, 2021), **storage) -> Path:
 
 
 @pytest.fixture(scope="module")
-def two_years(tmp_path_factory):
-    path = _study(tmp_path_factory.mktemp("two"))
-    return path, foldopt.run(request=make_request("run", path))
+def two_years(tmp_path_factory, runs_shared, figures_drawn_elsewhere):
+    """The two years' study, its API's result, and the command line's ``--format json`` document
+    and folder of the same request: one request evaluated once (conftest's ``runs_shared``).
+    The folder's figures are not drawn: storage_years.png is drawn by test_camera_winter.py's
+    study (whole) and by test_the_figure_draws_each_design_s_years below."""
+    folder = tmp_path_factory.mktemp("two")
+    path = _study(folder)
+    with runs_shared():
+        result = foldopt.run(request=make_request("run", path))
+        with figures_drawn_elsewhere():
+            done = runner.invoke(
+                app, ["run", str(path), "--format", "json", "--out", str(folder / "out"), "-q"]
+            )
+    assert done.exit_code == 0, done.output
+    return path, result, json.loads(done.stdout), folder / "out"
 
 
 @pytest.fixture(scope="module")
@@ -158,7 +170,7 @@ def test_a_bracket_known_on_the_grid_sizes_the_buffer_the_grid_s_search_sizes():
 
 
 def test_the_years_partition_the_series(two_years):
-    _, result = two_years
+    result = two_years[1]
     annual = result.extras["storage_annual"].set_index("design")
     years = result.extras["storage_years"]
     assert sorted(years["year"].unique()) == [2020, 2021]
@@ -181,7 +193,7 @@ def test_the_years_partition_the_series(two_years):
 
 
 def test_the_worst_year_is_the_least_and_said(two_years):
-    _, result = two_years
+    result = two_years[1]
     years = result.extras["storage_years"]
     for _, rows in years.groupby("design"):
         flagged = rows[rows["worst_year"]]
@@ -201,7 +213,7 @@ def test_the_worst_year_is_the_least_and_said(two_years):
 
 
 def test_the_month_s_energy_a_day_times_its_days_is_the_energy_served(two_years):
-    _, result = two_years
+    result = two_years[1]
     monthly = result.extras["storage_monthly"]
     annual = result.extras["storage_annual"].set_index("design")
     demand = 2.0 * 24.0  # Wh a day
@@ -312,30 +324,27 @@ def test_periods_partition_any_series(years, seed, load, capacity, min_soc):
     )
 
 
-def test_the_command_line_is_the_api_to_the_bit(two_years, tmp_path, monkeypatch):
-    path, api = two_years
-    monkeypatch.chdir(tmp_path)
-    done = runner.invoke(app, ["run", str(path), "--format", "json", "--out", "out", "-q"])
-    assert done.exit_code == 0, done.output
-    printed = json.loads(done.stdout)["answer"]
+def test_the_command_line_is_the_api_to_the_bit(two_years):
+    _, api, document, out = two_years
+    printed = document["answer"]
     assert printed["lines"] == api.answer.lines()
     assert printed["result"]["storage"] == json.loads(
         json.dumps(plain(api.answer.result["storage"]))
     )
     for table in ("storage_years", "storage_monthly"):
-        written = pd.read_csv(tmp_path / "out" / f"{table}.csv")
+        written = pd.read_csv(out / f"{table}.csv")
         expected = api.extras[table]
         assert list(written.columns) == list(expected.columns)
         numbers = expected.select_dtypes("number").columns
         assert np.allclose(written[numbers], expected[numbers], rtol=1e-9, equal_nan=True)
-    assert (tmp_path / "out" / "storage_years.png").exists()
-    html = (tmp_path / "out" / "report.html").read_text()
+    assert (out / "storage_years.png").exists()
+    html = (out / "report.html").read_text()
     assert "worst year: " in html and "storage_years.png" in html
 
 
 @pytest.mark.parametrize("value", ["some", "0", "101", "-5"])
 def test_a_bad_share_of_years_is_one_line_and_exit_2(two_years, tmp_path, monkeypatch, value):
-    path, _ = two_years
+    path = two_years[0]
     monkeypatch.chdir(tmp_path)
     done = runner.invoke(
         app, ["run", str(path), "--set", f"storage.target.years={value}", "--out", "out", "-q"]
@@ -349,7 +358,7 @@ def test_a_bad_share_of_years_is_one_line_and_exit_2(two_years, tmp_path, monkey
 
 def test_the_figure_draws_each_design_s_years(two_years):
     # The lines' points are the table's powered time per year, per design; the worst ringed.
-    _, result = two_years
+    result = two_years[1]
     years = result.extras["storage_years"]
     ax = foldopt.plot_powered_by_year(years, "t")
     lines = {line.get_label(): line for line in ax.get_lines()}
