@@ -485,8 +485,10 @@ def _runs_shared():
         return done[-1][1]
 
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(foldopt.api, "run", run)
+        # foldopt's package first: its ``run`` is looked up in foldopt.api when first asked for, and
+        # once foldopt.api's is patched would be recorded, and put back, as the patch.
         patch.setattr(foldopt, "run", run)
+        patch.setattr(foldopt.api, "run", run)
         yield
 
 

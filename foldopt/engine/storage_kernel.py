@@ -411,9 +411,11 @@ def _one(values, s):
 
 
 @njit(cache=True, nogil=True, error_model="numpy", no_cfunc_wrapper=True)
-def _series_range(start, stop, curves, params, cold, days, passes, max_iterations, tolerance):
+def _series_range(start, stop, curves, params, cold, days, passes, limits):
     """Series ``start .. stop - 1`` of :func:`simulate_series` (a thread of
-    :func:`foldopt.engine.records.in_chunks` calls it)."""
+    :func:`foldopt.engine.records.in_chunks` calls it); ``limits``: its ``(max_iterations,
+    tolerance)``."""
+    max_iterations, tolerance = limits
     power, load, draw, step_hours = curves
     out, state, soc, keep_soc = days
     for s in range(start, stop):
@@ -473,5 +475,5 @@ def simulate_series(curves, params, cold, days, passes, max_iterations, toleranc
     # loop, whose records' arrays numba takes again at every call (a sizing search calls this
     # hundreds of times).
     n_chunks = max(1, min(n_series, steps // STEPS_PER_CHUNK, get_num_threads()))
-    records = (curves, params, cold, days, passes, max_iterations, tolerance)
+    records = (curves, params, cold, days, passes, (int(max_iterations), float(tolerance)))
     in_chunks(_series_range, n_series, None, *records, n_chunks=n_chunks)
