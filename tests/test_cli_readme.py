@@ -164,7 +164,7 @@ def _run_the_readme(every: bool) -> None:
             if "--scheduler" in args:  # the README starts one by hand: here a cluster of the test's own
                 from distributed import LocalCluster
 
-                cluster = LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None)
+                cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None)
                 args[args.index("--scheduler") + 1] = cluster.scheduler_address
             result = runner.invoke(app, args, prog_name="foldopt")
             if "--scheduler" in args:
