@@ -442,26 +442,6 @@ def folders_written_elsewhere():
     return _folders_not_written
 
 
-@pytest.fixture(scope="module")
-def command_line_built_once():
-    """Within a module of many in-process commands: typer's CliRunner builds a Typer app's click
-    command from its commands' signatures at every invoke (26 ms of CPU for foldopt's), here once
-    an app. A click command keeps nothing of one invocation for the next (each has its context)."""
-    import typer.main
-    import typer.testing
-
-    built = {}
-
-    def command(app):
-        if app not in built:
-            built[app] = typer.main.get_command(app)
-        return built[app]
-
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(typer.testing, "_get_command", command)
-        yield
-
-
 @contextlib.contextmanager
 def _runs_shared():
     """Within the block, a request is evaluated once: :func:`foldopt.api.run` (``foldopt.run``,

@@ -15,8 +15,6 @@ from foldopt.cli.app import app
 from test_cli import assert_one_line_error
 
 runner = CliRunner()
-#: The command line built once for the module's commands (tests/conftest.py).
-pytestmark = pytest.mark.usefixtures("command_line_built_once")
 TMY3 = Path(pvlib.__file__).parent / "data" / "723170TYA.CSV"
 
 

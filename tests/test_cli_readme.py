@@ -35,8 +35,6 @@ README = (ROOT / "README.md").read_text(encoding="utf-8")
 FIGURE = re.compile(r"([+-]?\d+(?:\.\d+)?)\s?(?:h|%|°|deg|min)(?![\w/])")
 #: Commands too slow for the suite (see the module's docstring), by a part of their line.
 SLOW = ("foldopt map ", "--members 20")
-#: The command line built once for the module's commands (tests/conftest.py).
-pytestmark = pytest.mark.usefixtures("command_line_built_once")
 
 
 def _paragraph_after(lines: list[str], start: int) -> str:
