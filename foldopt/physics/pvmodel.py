@@ -323,6 +323,7 @@ class IVCurve:
 
     @functools.cached_property
     def _by_rank(self):
+        """:meth:`_diode_terms`' shaped terms and parameters by the rank of what they meet."""
         return {}
 
     def _diode_terms(self, x):
@@ -393,8 +394,8 @@ class IVCurve:
                     return pvlib.pvsystem.v_from_i(current, *self._params(current))
                 t, (il, io, rs, _, a) = self._diode_terms(current)
                 exponent = (-current + il + io) / t["v_scale"]
-                # Where the argument overflows, Lambert W from its logarithm.
                 argument = t["v_factor"] * np.exp(exponent)
+                # Where the argument overflows, Lambert W from its logarithm.
                 overflow = np.isinf(argument)
                 finite = ~overflow
                 w = np.empty_like(argument)
