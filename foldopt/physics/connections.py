@@ -146,7 +146,8 @@ def _in_blocks(pair, east: IVCurve, west: IVCurve, *args):
     same values as at once: each curve's search is its own, and the curves' maximum-power points
     and end points are worked out once on all of them (:meth:`IVCurve.taken`)."""
     shape = np.broadcast_shapes(*(np.shape(p) for p in (*east.params, *west.params)))
-    blocks = np.array_split(np.arange(_size(east)), -(-_size(east) // _BLOCK))
+    size = _size(east)
+    blocks = np.array_split(np.arange(size), -(-size // _BLOCK))
     return np.concatenate(
         [pair(east.taken(block), west.taken(block), *args) for block in blocks]
     ).reshape(shape)
